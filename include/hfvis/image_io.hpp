@@ -1,0 +1,50 @@
+// hfvis/image_io.hpp: reading height fields and writing results through OpenImageIO.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "hfvis/height_field.hpp"
+
+namespace hfvis {
+
+struct HeightFieldReadOptions {
+  // Channel to read: "" = the only channel (an error for multi-channel images),
+  // else a channel name ("Y", "R", "height") or a zero-based index ("0").
+  std::string channel;
+  // Ground units per pixel; <= 0 = take it from the file (GeoTIFF pixel scale,
+  // geographic degrees converted to metres at the field's centre latitude) or 1.
+  double cell_size_x = 0.0;
+  double cell_size_y = 0.0;
+  double z_scale = 1.0;
+};
+
+// Reads a height field from EXR, TIFF (float, 16-bit; GeoTIFF spacing), PNG (8/16-bit) or
+// any format OpenImageIO reads. Integer pixels are converted to their stored integer
+// values (a 16-bit PNG holds heights 0..65535), not normalised. Throws IoError naming the
+// file and reason (missing, unreadable, truncated, zero-sized, multi-channel without a
+// channel choice, unknown channel).
+HeightField readHeightField(const std::string& path, const HeightFieldReadOptions& options = {});
+
+// One float32 image to write: planar channels of width*height values each.
+struct ImageChannels {
+  int width = 0;
+  int height = 0;
+  std::vector<std::string> names;           // one per channel
+  std::vector<std::vector<float>> planes;   // one per channel, row-major
+  std::vector<std::pair<std::string, std::string>> attributes;  // string metadata
+};
+
+// Writes an EXR (or any float format OpenImageIO writes, by extension) atomically: to a
+// temporary file beside `path`, renamed into place only when complete. Throws IoError.
+void writeImage(const std::string& path, const ImageChannels& image);
+
+// Writes an 8-bit PNG preview of one plane, linearly mapped from [lo, hi] to [0, 255]
+// (lo == hi: the plane's finite min and max); NaN pixels are drawn black. Atomic as above.
+void writePreviewPng(const std::string& path, int width, int height, const std::vector<float>& plane,
+                     float lo = 0.0f, float hi = 0.0f);
+
+// Zero-padded channel names whose sorted order is the direction order: h000, h001, ...
+std::vector<std::string> directionChannelNames(const std::string& prefix, int count);
+
+}  // namespace hfvis

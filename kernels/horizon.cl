@@ -1,0 +1,244 @@
+// horizon.cl: horizons by the convex-hull-stack sweep (Timonen & Westerholm 2010,
+// Algorithm 1), the reduction that rotates line buffers back onto the grid and reduces
+// them to the requested outputs, and the naive per-pixel ray march (baseline and oracle).
+//
+// Heights arrive offset and z-scaled (h' = (h - reference) * z_scale) so that tilted
+// planes at large offsets keep their precision; NaN = nodata.
+//
+// Compile-time parameters, besides those of sweep_framework.cl:
+//   HFVIS_WANT_ANGLES, HFVIS_WANT_DISTANCES  store per-direction planes of the batch
+//   HFVIS_WANT_SVF, HFVIS_WANT_AO            accumulate sky-view / ambient occlusion terms
+//   HFVIS_DIRECTIONS                         K, the directions of the whole run
+#include "sweep_framework.cl"
+
+#ifndef HFVIS_WANT_ANGLES
+#define HFVIS_WANT_ANGLES 1
+#endif
+#ifndef HFVIS_WANT_DISTANCES
+#define HFVIS_WANT_DISTANCES 1
+#endif
+#ifndef HFVIS_WANT_SVF
+#define HFVIS_WANT_SVF 1
+#endif
+#ifndef HFVIS_WANT_AO
+#define HFVIS_WANT_AO 1
+#endif
+#ifndef HFVIS_DIRECTIONS
+#define HFVIS_DIRECTIONS 64
+#endif
+
+#define HFVIS_PI 3.14159265358979323846f
+
+// Hull-stack sweep: one work-item per line. Reads each presampled height and writes, in
+// place, the occluder that casts its horizon: (occluder height, occluder step), or
+// (NaN, -1) when nothing nearer the far end is on the line. Stack entries (height, step)
+// of line j at depth k live at stacks[buffer_offset + k * n_lines + j]; the depth never
+// exceeds the line's sample count, so the stack buffer is as large as the line buffer.
+// Global size: (max lines, directions in batch).
+__kernel void horizon_sweep(__global const SweepDirection* directions, __global float2* lines,
+                            __global float2* stacks) {
+  int line = get_global_id(0);
+  const SweepDirection d = directions[get_global_id(1)];
+  if (line >= d.n_lines) return;
+  const uint stride = (uint)d.n_lines;
+  __global float2* entry = lines + d.buffer_offset + (uint)line;
+  __global float2* stack = stacks + d.buffer_offset + (uint)line;
+  uint size = 0;
+  for (int step = 0; step < d.n_steps; ++step, entry += stride) {
+    float h = entry->x;
+    if (isnan(h)) {
+      *entry = (float2)(NAN, -1.0f);
+      continue;
+    }
+    float2 occluder = (float2)(NAN, -1.0f);
+    float here = (float)step;
+    if (size > 0) {
+      // Algorithm 1: pop while the second entry casts at least as steep a slope on the
+      // new sample as the top one; the top that remains is the horizon's occluder.
+      float2 top = stack[(size - 1) * stride];
+      float v1h = top.x - h;
+      float v1d = here - top.y;
+      while (size > 1) {
+        float2 below = stack[(size - 2) * stride];
+        float v2h = below.x - h;
+        float v2d = here - below.y;
+        if (v2h * v1d >= v1h * v2d) {
+          top = below;
+          v1h = v2h;
+          v1d = v2d;
+          --size;
+        } else {
+          break;
+        }
+      }
+      occluder = top;
+    }
+    stack[size * stride] = (float2)(h, here);
+    ++size;
+    *entry = occluder;
+  }
+}
+
+// Unnormalised normal at pixel (c, r): the sum of the normals of the (up to) four quads
+// around it (Timonen & Westerholm 2010, Sec. 7), in ground units; quads touching nodata
+// or the border are left out; (0, 0, 1) when none is left.
+inline float3 surface_normal(__global const float* heights, int width, int height, int c, int r, float h,
+                             float cell_x, float cell_y) {
+  float3 n = (float3)(0.0f, 0.0f, 0.0f);
+  for (int sy = -1; sy <= 1; sy += 2) {
+    for (int sx = -1; sx <= 1; sx += 2) {
+      int cx = c + sx, ry = r + sy;
+      if (cx < 0 || cx >= width || ry < 0 || ry >= height) continue;
+      float hx = heights[r * width + cx];
+      float hy = heights[ry * width + c];
+      if (isnan(hx) || isnan(hy)) continue;
+      float gx = (hx - h) / ((float)sx * cell_x);
+      float gy = (hy - h) / ((float)sy * cell_y);
+      n += (float3)(-gx, -gy, 1.0f);
+    }
+  }
+  return n.z > 0.0f ? normalize(n) : (float3)(0.0f, 0.0f, 1.0f);
+}
+
+// Uniform-sky irradiance of one azimuthal swath (Eq. 5 of Timonen & Westerholm 2010) for
+// horizon elevation `elevation`, normalised so that a flat plane sums to 1 over K swaths.
+// The zenith angle is clamped where the sky falls behind the surface (N . e = 0).
+inline float ambient_term(float elevation, float3 normal, float cos_az, float sin_az) {
+  float toward = normal.x * cos_az + normal.y * sin_az;
+  float zenith = 0.5f * HFVIS_PI - elevation;
+  zenith = min(zenith, 0.5f * HFVIS_PI + atan(toward / normal.z));
+  float s = sin(zenith);
+  return normal.z / (float)HFVIS_DIRECTIONS * s * s +
+         sin(HFVIS_PI / (float)HFVIS_DIRECTIONS) / HFVIS_PI * (zenith - 0.5f * sin(2.0f * zenith)) * toward;
+}
+
+// Writes or accumulates one direction's outputs at one pixel; shared by the sweep
+// reduction and the naive kernel so both reduce identically.
+inline void emit_direction(int b, uint pixel, uint plane, float elevation, float distance, float3 normal,
+                           const SweepDirection d, __global float* angles, __global float* distances,
+                           float* svf, float* ao) {
+#if HFVIS_WANT_ANGLES
+  angles[(uint)b * plane + pixel] = elevation;
+#endif
+#if HFVIS_WANT_DISTANCES
+  distances[(uint)b * plane + pixel] = distance;
+#endif
+  *svf += sin(fmax(0.0f, elevation));
+  *ao += ambient_term(elevation, normal, d.cos_azimuth, d.sin_azimuth);
+}
+
+// Adds the batch's sums to the run's accumulators; NaN at nodata receivers.
+inline void accumulate_pixel(uint pixel, int nodata, float svf, float ao, __global float* svf_sum,
+                             __global float* ao_sum) {
+#if HFVIS_WANT_SVF
+  svf_sum[pixel] = nodata ? NAN : svf_sum[pixel] + svf;
+#endif
+#if HFVIS_WANT_AO
+  ao_sum[pixel] = nodata ? NAN : ao_sum[pixel] + ao;
+#endif
+}
+
+// Reduction: for every receiver pixel and every direction of the batch, interpolates the
+// occluders recorded on the (up to) four surrounding (line, step) entries, seen from the
+// receiver's own position and height, and writes or accumulates the requested outputs.
+// An entry contributes when it has an occluder ahead of the receiver; with none, the
+// horizon is -pi/2 (the ray leaves the field at once). Global size: (W, H) rounded up.
+__kernel void horizon_reduce(__global const float* heights, int width, int height, float cell_x,
+                             float cell_y, __global const SweepDirection* directions, int batch_size,
+                             __global const float2* lines, __global float* angles, __global float* distances,
+                             __global float* svf_sum, __global float* ao_sum) {
+  int c = get_global_id(0), r = get_global_id(1);
+  if (c >= width || r >= height) return;
+  const uint pixel = (uint)(r * width + c);
+  const uint plane = (uint)(width * height);
+  float h = heights[pixel];
+  float3 normal = (float3)(0.0f, 0.0f, 1.0f);
+#if HFVIS_WANT_AO
+  if (!isnan(h)) normal = surface_normal(heights, width, height, c, r, h, cell_x, cell_y);
+#endif
+  float svf = 0.0f, ao = 0.0f;
+  for (int b = 0; b < batch_size; ++b) {
+    const SweepDirection d = directions[b];
+    float x = (float)c, y = (float)r;
+    float t = x * d.dir_x + y * d.dir_y;
+    float u = (x * d.perp_x + y * d.perp_y) * d.lines_per_unit - (float)d.line_first;
+    float v = (float)d.step_top - t * d.samples_per_unit;
+    int j0 = (int)floor(u), i0 = (int)floor(v);
+    float fu = u - (float)j0, fv = v - (float)i0;
+    float weight = 0.0f, angle_sum = 0.0f, distance_sum = 0.0f;
+    for (int k = 0; k < 4; ++k) {
+      int j = j0 + (k & 1), i = i0 + (k >> 1);
+      float w = ((k & 1) ? fu : 1.0f - fu) * ((k >> 1) ? fv : 1.0f - fv);
+      if (w <= 0.0f || j < 0 || j >= d.n_lines || i < 0 || i >= d.n_steps) continue;
+      float2 occ = lines[d.buffer_offset + (uint)i * (uint)d.n_lines + (uint)j];
+      float ahead = ((float)d.step_top - occ.y) * d.step_length - t;  // pixels along dir
+      if (occ.y < 0.0f || !(ahead > 0.0f)) continue;
+      float ground = ahead * d.ground_per_pixel;
+      weight += w;
+      angle_sum += w * atan2(occ.x - h, ground);
+      distance_sum += w * ground;
+    }
+    float elevation = weight > 0.0f ? angle_sum / weight : -0.5f * HFVIS_PI;
+    float distance = weight > 0.0f ? distance_sum / weight : 0.0f;
+    if (isnan(h)) elevation = distance = NAN;
+    emit_direction(b, pixel, plane, elevation, distance, normal, d, angles, distances, &svf, &ao);
+  }
+  accumulate_pixel(pixel, isnan(h), svf, ao, svf_sum, ao_sum);
+}
+
+// Naive method (Timonen 2013, Sec. 1): for every pixel, march the ray in steps of
+// step_length pixels, sample bilinearly and keep the steepest slope. The trip count is
+// the same for the whole work-group (the longest ray of the group's tile, found in closed
+// form because the exit distance separates into a column and a row term), so PoCL can
+// vectorise the march across work-items; samples outside the field are masked.
+// Global size: (W, H) rounded up to the local size; the tile is the work-group.
+__kernel void horizon_naive(__global const float* heights, int width, int height, float cell_x, float cell_y,
+                            __global const SweepDirection* directions, int batch_size,
+                            __global float* angles, __global float* distances, __global float* svf_sum,
+                            __global float* ao_sum) {
+  int c = get_global_id(0), r = get_global_id(1);
+  // The tile's extent, clamped to the field (work-items past the edge still march, so that
+  // the whole group runs the same loop, and only skip the writes).
+  int c_lo = get_group_id(0) * get_local_size(0), r_lo = get_group_id(1) * get_local_size(1);
+  int c_hi = min(c_lo + (int)get_local_size(0), width) - 1;
+  int r_hi = min(r_lo + (int)get_local_size(1), height) - 1;
+  int valid = c < width && r < height;
+  int cc = min(c, width - 1), rr = min(r, height - 1);
+  const uint pixel = (uint)(rr * width + cc);
+  const uint plane = (uint)(width * height);
+  float h = heights[pixel];
+  float3 normal = (float3)(0.0f, 0.0f, 1.0f);
+#if HFVIS_WANT_AO
+  if (!isnan(h)) normal = surface_normal(heights, width, height, cc, rr, h, cell_x, cell_y);
+#endif
+  float svf = 0.0f, ao = 0.0f;
+  for (int b = 0; b < batch_size; ++b) {
+    const SweepDirection d = directions[b];
+    const float far = (float)(width + height);
+    float reach_x = d.dir_x > 0.0f ? ((float)(width - 1) - (float)c_lo) / d.dir_x
+                    : d.dir_x < 0.0f ? (float)c_hi / -d.dir_x : far;
+    float reach_y = d.dir_y > 0.0f ? ((float)(height - 1) - (float)r_lo) / d.dir_y
+                    : d.dir_y < 0.0f ? (float)r_hi / -d.dir_y : far;
+    int steps = (int)(fmin(fmin(reach_x, reach_y), far) * d.samples_per_unit) + 1;
+    float best_rise = 0.0f;  // height gain to the steepest sample so far
+    int best_step = 0;       // its step, 0 = none yet
+    for (int i = 1; i <= steps; ++i) {
+      float t = (float)i * d.step_length;
+      float2 p = (float2)((float)cc + t * d.dir_x, (float)rr + t * d.dir_y);
+      float q = sample_height(heights, width, height, p);
+      float rise = q - h;
+      // rise / i >= best_rise / best_step, decided without division as the sweep does;
+      // on ties the farther sample wins, as on the sweep's hull.
+      int better = inside_field(p, width, height) && !isnan(q) &&
+                   (best_step == 0 || rise * (float)best_step >= best_rise * (float)i);
+      best_rise = better ? rise : best_rise;
+      best_step = better ? i : best_step;
+    }
+    float ground = (float)best_step * d.step_length * d.ground_per_pixel;
+    float elevation = best_step > 0 ? atan2(best_rise, ground) : -0.5f * HFVIS_PI;
+    float distance = best_step > 0 ? ground : 0.0f;
+    if (isnan(h)) elevation = distance = NAN;
+    if (valid) emit_direction(b, pixel, plane, elevation, distance, normal, d, angles, distances, &svf, &ao);
+  }
+  if (valid) accumulate_pixel(pixel, isnan(h), svf, ao, svf_sum, ao_sum);
+}

@@ -1,0 +1,6 @@
+#!/usr/bin/env bash
+# Configures and builds hfvis into build/ (Release). Usage: scripts/build.sh [extra cmake args]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "$@" >/dev/null
+cmake --build build -j "$(nproc)"

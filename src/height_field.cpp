@@ -1,0 +1,41 @@
+// height_field.cpp: HeightField helpers and validation.
+#include "hfvis/height_field.hpp"
+
+#include <cmath>
+#include <string>
+
+#include "hfvis/errors.hpp"
+
+namespace hfvis {
+
+std::size_t HeightField::nodataCount() const {
+  std::size_t count = 0;
+  for (float h : heights) count += std::isfinite(h) ? 0 : 1;
+  return count;
+}
+
+void validate(const HeightField& field) {
+  if (field.width <= 0 || field.height <= 0) {
+    throw InvalidArgument("height field is empty (" + std::to_string(field.width) + " x " +
+                          std::to_string(field.height) + " pixels)");
+  }
+  if (field.heights.size() != field.pixelCount()) {
+    throw InvalidArgument("height field holds " + std::to_string(field.heights.size()) +
+                          " heights for " + std::to_string(field.width) + " x " +
+                          std::to_string(field.height) + " pixels");
+  }
+  auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  if (!positive(field.cell_size_x) || !positive(field.cell_size_y)) {
+    throw InvalidArgument("cell size must be finite and positive (got " +
+                          std::to_string(field.cell_size_x) + ", " +
+                          std::to_string(field.cell_size_y) + ")");
+  }
+  if (!positive(field.z_scale)) {
+    throw InvalidArgument("z-scale must be finite and positive (got " + std::to_string(field.z_scale) + ")");
+  }
+  if (field.nodataCount() == field.pixelCount()) {
+    throw InvalidArgument("every height is nodata (NaN or infinite)");
+  }
+}
+
+}  // namespace hfvis

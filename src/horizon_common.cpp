@@ -1,0 +1,84 @@
+// horizon_common.cpp: pieces shared by the horizon device path and its reference.
+#include "horizon_common.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "hfvis/errors.hpp"
+
+namespace hfvis {
+
+double directionAzimuth(int k, const HorizonOptions& options) {
+  return 2.0 * M_PI * k / options.directions + options.azimuth_offset;
+}
+
+void validate(const HorizonOptions& options, const HorizonOutputs& outputs) {
+  if (options.directions < 1) {
+    throw InvalidArgument("the number of directions K must be at least 1 (got " +
+                          std::to_string(options.directions) + ")");
+  }
+  auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  if (!positive(options.samples_per_unit) || options.samples_per_unit > 64.0) {
+    throw InvalidArgument("samples per unit must be in (0, 64] (got " + std::to_string(options.samples_per_unit) + ")");
+  }
+  if (!positive(options.lines_per_unit) || options.lines_per_unit > 64.0) {
+    throw InvalidArgument("lines per unit must be in (0, 64] (got " + std::to_string(options.lines_per_unit) + ")");
+  }
+  if (!std::isfinite(options.azimuth_offset)) throw InvalidArgument("the azimuth offset must be finite");
+  if (!outputs.horizon_angles && !outputs.horizon_distances && !outputs.sky_view_factor &&
+      !outputs.ambient_occlusion) {
+    throw InvalidArgument("no output requested");
+  }
+}
+
+namespace detail {
+
+PreparedHeights prepareHeights(const HeightField& field) {
+  double lowest = std::numeric_limits<double>::max();
+  for (float h : field.heights)
+    if (std::isfinite(h)) lowest = std::min(lowest, static_cast<double>(h));
+  PreparedHeights prepared;
+  prepared.heights.resize(field.heights.size());
+  for (std::size_t i = 0; i < field.heights.size(); ++i) {
+    const float h = field.heights[i];
+    if (std::isfinite(h)) {
+      prepared.heights[i] = static_cast<float>((static_cast<double>(h) - lowest) * field.z_scale);
+    } else {
+      prepared.heights[i] = std::numeric_limits<float>::quiet_NaN();
+      prepared.has_nodata = true;
+    }
+  }
+  return prepared;
+}
+
+std::vector<SweepDirection> runDirections(const HeightField& field, const HorizonOptions& options) {
+  std::vector<SweepDirection> directions;
+  for (int k = 0; k < options.directions; ++k) {
+    directions.push_back(
+        makeSweepDirection(field, directionAzimuth(k, options), options.samples_per_unit, options.lines_per_unit));
+  }
+  return directions;
+}
+
+HorizonResult allocateResult(const HeightField& field, const HorizonOptions& options,
+                             const HorizonOutputs& outputs) {
+  HorizonResult result;
+  result.width = field.width;
+  result.height = field.height;
+  result.directions = options.directions;
+  for (int k = 0; k < options.directions; ++k) result.azimuths.push_back(directionAzimuth(k, options));
+  const std::size_t plane = field.pixelCount();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  if (outputs.horizon_angles) result.angles.assign(plane * options.directions, nan);
+  if (outputs.horizon_distances) result.distances.assign(plane * options.directions, nan);
+  if (outputs.sky_view_factor) result.sky_view_factor.assign(plane, 0.0f);
+  if (outputs.ambient_occlusion) result.ambient_occlusion.assign(plane, 0.0f);
+  return result;
+}
+
+void finishReduction(const HorizonOptions& options, HorizonResult& result) {
+  for (float& v : result.sky_view_factor) v = 1.0f - v / static_cast<float>(options.directions);
+}
+
+}  // namespace detail
+}  // namespace hfvis

@@ -1,0 +1,232 @@
+// horizon_reference.cpp: scalar mirrors of kernels/horizon.cl (presample, hull-stack
+// sweep, reduction, naive march). Keep every expression in the kernels' order: the
+// build disables FP contraction on both sides so the predicates decide identically.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "hfvis/reference.hpp"
+#include "horizon_common.hpp"
+#include "reference_internal.hpp"
+
+namespace hfvis {
+namespace detail {
+namespace {
+
+constexpr float kPi = 3.14159265358979323846f;
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+struct Normal {
+  float x = 0.0f, y = 0.0f, z = 1.0f;
+};
+
+Normal surfaceNormal(const std::vector<float>& h, int width, int height, int c, int r, float hp, float cell_x,
+                     float cell_y) {
+  float nx = 0.0f, ny = 0.0f, nz = 0.0f;
+  for (int sy = -1; sy <= 1; sy += 2) {
+    for (int sx = -1; sx <= 1; sx += 2) {
+      const int cx = c + sx, ry = r + sy;
+      if (cx < 0 || cx >= width || ry < 0 || ry >= height) continue;
+      const float hx = h[r * width + cx], hy = h[ry * width + c];
+      if (std::isnan(hx) || std::isnan(hy)) continue;
+      const float gx = (hx - hp) / (static_cast<float>(sx) * cell_x);
+      const float gy = (hy - hp) / (static_cast<float>(sy) * cell_y);
+      nx += -gx, ny += -gy, nz += 1.0f;
+    }
+  }
+  if (!(nz > 0.0f)) return {};
+  const float len = std::sqrt(nx * nx + ny * ny + nz * nz);
+  return {nx / len, ny / len, nz / len};
+}
+
+float ambientTerm(float elevation, Normal n, float cos_az, float sin_az, int directions) {
+  const float toward = n.x * cos_az + n.y * sin_az;
+  float zenith = 0.5f * kPi - elevation;
+  zenith = std::min(zenith, 0.5f * kPi + std::atan(toward / n.z));
+  const float s = std::sin(zenith);
+  return n.z / static_cast<float>(directions) * s * s +
+         std::sin(kPi / static_cast<float>(directions)) / kPi * (zenith - 0.5f * std::sin(2.0f * zenith)) * toward;
+}
+
+// Per-pixel sinks, as emit_direction / accumulate_pixel in the kernel.
+struct PixelSums {
+  float svf = 0.0f, ao = 0.0f;
+};
+
+void emitDirection(HorizonResult& result, int k, std::size_t pixel, float elevation, float distance, Normal n,
+                   const SweepDirection& d, int directions, PixelSums& sums) {
+  const std::size_t plane = static_cast<std::size_t>(result.width) * result.height;
+  if (!result.angles.empty()) result.angles[k * plane + pixel] = elevation;
+  if (!result.distances.empty()) result.distances[k * plane + pixel] = distance;
+  sums.svf += std::sin(std::fmax(0.0f, elevation));
+  sums.ao += ambientTerm(elevation, n, d.cos_azimuth, d.sin_azimuth, directions);
+}
+
+void accumulatePixel(HorizonResult& result, std::size_t pixel, bool nodata, const PixelSums& sums) {
+  if (!result.sky_view_factor.empty())
+    result.sky_view_factor[pixel] = nodata ? kNaN : result.sky_view_factor[pixel] + sums.svf;
+  if (!result.ambient_occlusion.empty())
+    result.ambient_occlusion[pixel] = nodata ? kNaN : result.ambient_occlusion[pixel] + sums.ao;
+}
+
+void sweepReference(const HeightField& field, const PreparedHeights& prepared, const HorizonOptions& options,
+                    const HorizonOutputs& outputs, HorizonResult& result) {
+  const int width = field.width, height = field.height;
+  const auto& h = prepared.heights;
+  const auto cell_x = static_cast<float>(field.cell_size_x), cell_y = static_cast<float>(field.cell_size_y);
+  const auto directions = runDirections(field, options);
+  // Directions one at a time; the kernels sum per batch first, so the sums may differ from
+  // the kernels' in the last bits.
+  std::vector<PixelSums> sums(field.pixelCount());
+  for (int k = 0; k < options.directions; ++k) {
+    const SweepDirection& d = directions[k];
+    const LineOccluders lines = referenceSweepLines(field, h, d);
+    for (int r = 0; r < height; ++r) {
+      for (int c = 0; c < width; ++c) {
+        const std::size_t pixel = static_cast<std::size_t>(r) * width + c;
+        const float hp = h[pixel];
+        const Normal n = (outputs.ambient_occlusion && !std::isnan(hp))
+                             ? surfaceNormal(h, width, height, c, r, hp, cell_x, cell_y)
+                             : Normal{};
+        const float x = static_cast<float>(c), y = static_cast<float>(r);
+        const float t = x * d.dir_x + y * d.dir_y;
+        const float u = (x * d.perp_x + y * d.perp_y) * d.lines_per_unit - static_cast<float>(d.line_first);
+        const float v = static_cast<float>(d.step_top) - t * d.samples_per_unit;
+        const int j0 = static_cast<int>(std::floor(u)), i0 = static_cast<int>(std::floor(v));
+        const float fu = u - static_cast<float>(j0), fv = v - static_cast<float>(i0);
+        float weight = 0.0f, angle_sum = 0.0f, distance_sum = 0.0f;
+        for (int q = 0; q < 4; ++q) {
+          const int j = j0 + (q & 1), i = i0 + (q >> 1);
+          const float w = ((q & 1) ? fu : 1.0f - fu) * ((q >> 1) ? fv : 1.0f - fv);
+          if (w <= 0.0f || j < 0 || j >= d.n_lines || i < 0 || i >= d.n_steps) continue;
+          const std::size_t e = static_cast<std::size_t>(i) * d.n_lines + j;
+          const float occ_h = lines.heights[e], occ_step = lines.steps[e];
+          const float ahead = (static_cast<float>(d.step_top) - occ_step) * d.step_length - t;
+          if (occ_step < 0.0f || !(ahead > 0.0f)) continue;
+          const float ground = ahead * d.ground_per_pixel;
+          weight += w;
+          angle_sum += w * std::atan2(occ_h - hp, ground);
+          distance_sum += w * ground;
+        }
+        float elevation = weight > 0.0f ? angle_sum / weight : -0.5f * kPi;
+        float distance = weight > 0.0f ? distance_sum / weight : 0.0f;
+        if (std::isnan(hp)) elevation = distance = kNaN;
+        PixelSums one;
+        emitDirection(result, k, pixel, elevation, distance, n, d, options.directions, one);
+        sums[pixel].svf += one.svf;
+        sums[pixel].ao += one.ao;
+      }
+    }
+  }
+  for (std::size_t p = 0; p < sums.size(); ++p) accumulatePixel(result, p, std::isnan(h[p]), sums[p]);
+}
+
+void naiveReference(const HeightField& field, const PreparedHeights& prepared, const HorizonOptions& options,
+                    const HorizonOutputs& outputs, HorizonResult& result) {
+  const int width = field.width, height = field.height;
+  const auto& h = prepared.heights;
+  const auto cell_x = static_cast<float>(field.cell_size_x), cell_y = static_cast<float>(field.cell_size_y);
+  const auto directions = runDirections(field, options);
+  for (int r = 0; r < height; ++r) {
+    for (int c = 0; c < width; ++c) {
+      const std::size_t pixel = static_cast<std::size_t>(r) * width + c;
+      const float hp = h[pixel];
+      const Normal n = (outputs.ambient_occlusion && !std::isnan(hp))
+                           ? surfaceNormal(h, width, height, c, r, hp, cell_x, cell_y)
+                           : Normal{};
+      PixelSums sums;
+      for (int k = 0; k < options.directions; ++k) {
+        const SweepDirection& d = directions[k];
+        float best_rise = 0.0f;
+        int best_step = 0;
+        // March until the ray has left the field for good (the kernel's trip count may be
+        // longer; the extra samples are outside and masked).
+        for (int i = 1;; ++i) {
+          const float t = static_cast<float>(i) * d.step_length;
+          const Point2 p{static_cast<float>(c) + t * d.dir_x, static_cast<float>(r) + t * d.dir_y};
+          if (!insideField(p, width, height)) break;
+          const float q = sampleHeight(h, width, height, p);
+          const float rise = q - hp;
+          if (!std::isnan(q) &&
+              (best_step == 0 || rise * static_cast<float>(best_step) >= best_rise * static_cast<float>(i))) {
+            best_rise = rise;
+            best_step = i;
+          }
+        }
+        const float ground = static_cast<float>(best_step) * d.step_length * d.ground_per_pixel;
+        float elevation = best_step > 0 ? std::atan2(best_rise, ground) : -0.5f * kPi;
+        float distance = best_step > 0 ? ground : 0.0f;
+        if (std::isnan(hp)) elevation = distance = kNaN;
+        emitDirection(result, k, pixel, elevation, distance, n, d, options.directions, sums);
+      }
+      accumulatePixel(result, pixel, std::isnan(hp), sums);
+    }
+  }
+}
+
+}  // namespace
+
+LineOccluders referenceSweepLines(const HeightField& field, const std::vector<float>& prepared_heights,
+                                  const SweepDirection& d) {
+  LineOccluders out;
+  const std::size_t entries = d.entries();
+  out.samples.assign(entries, kNaN);
+  out.heights.assign(entries, kNaN);
+  out.steps.assign(entries, -1.0f);
+  for (int j = 0; j < d.n_lines; ++j) {
+    for (int i = 0; i < d.n_steps; ++i) {
+      const Point2 p = sweepPosition(d, j, i);
+      if (insideField(p, field.width, field.height))
+        out.samples[static_cast<std::size_t>(i) * d.n_lines + j] =
+            sampleHeight(prepared_heights, field.width, field.height, p);
+    }
+  }
+  // Algorithm 1 of Timonen & Westerholm 2010 per line, as horizon_sweep.
+  std::vector<std::pair<float, float>> stack;
+  for (int j = 0; j < d.n_lines; ++j) {
+    stack.clear();
+    for (int i = 0; i < d.n_steps; ++i) {
+      const std::size_t e = static_cast<std::size_t>(i) * d.n_lines + j;
+      const float h = out.samples[e];
+      if (std::isnan(h)) continue;
+      const float here = static_cast<float>(i);
+      if (!stack.empty()) {
+        auto top = stack.back();
+        float v1h = top.first - h, v1d = here - top.second;
+        while (stack.size() > 1) {
+          const auto below = stack[stack.size() - 2];
+          const float v2h = below.first - h, v2d = here - below.second;
+          if (v2h * v1d >= v1h * v2d) {
+            top = below, v1h = v2h, v1d = v2d;
+            stack.pop_back();
+          } else {
+            break;
+          }
+        }
+        out.heights[e] = top.first;
+        out.steps[e] = top.second;
+      }
+      stack.emplace_back(h, here);
+    }
+  }
+  return out;
+}
+
+}  // namespace detail
+
+HorizonResult referenceHorizons(const HeightField& field, const HorizonOptions& options,
+                                const HorizonOutputs& outputs) {
+  validate(field);
+  validate(options, outputs);
+  const detail::PreparedHeights prepared = detail::prepareHeights(field);
+  HorizonResult result = detail::allocateResult(field, options, outputs);
+  if (options.method == HorizonMethod::Sweep) {
+    detail::sweepReference(field, prepared, options, outputs, result);
+  } else {
+    detail::naiveReference(field, prepared, options, outputs, result);
+  }
+  detail::finishReduction(options, result);
+  return result;
+}
+
+}  // namespace hfvis

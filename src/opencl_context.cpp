@@ -1,0 +1,173 @@
+// opencl_context.cpp: device discovery and selection, context creation, program cache.
+#include "opencl_context.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+namespace hfvis {
+namespace detail {
+
+const std::map<std::string, std::string>& embeddedKernelSources();  // generated
+
+namespace {
+
+constexpr const char* kInstallHint =
+    "install an OpenCL driver: `apt-get install pocl-opencl-icd` runs kernels on the CPU; "
+    "GPUs need their vendor's ICD";
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s;
+}
+
+std::string trim(std::string s) {
+  while (!s.empty() && (s.back() == '\0' || std::isspace(static_cast<unsigned char>(s.back())))) s.pop_back();
+  return s;
+}
+
+std::string typeName(cl_device_type type) {
+  if (type & CL_DEVICE_TYPE_GPU) return "GPU";
+  if (type & CL_DEVICE_TYPE_CPU) return "CPU";
+  if (type & CL_DEVICE_TYPE_ACCELERATOR) return "accelerator";
+  return "other";
+}
+
+struct FoundDevice {
+  DeviceInfo info;
+  cl::Device device;
+};
+
+std::vector<FoundDevice> findDevices() {
+  std::vector<cl::Platform> platforms;
+  try {
+    cl::Platform::get(&platforms);
+  } catch (const cl::Error& e) {
+    throw NoDeviceError(std::string("no OpenCL platform found (") + e.what() + " returned " +
+                        std::to_string(e.err()) + "): " + kInstallHint);
+  }
+  std::vector<FoundDevice> found;
+  for (const auto& platform : platforms) {
+    std::vector<cl::Device> devices;
+    try {
+      platform.getDevices(CL_DEVICE_TYPE_ALL, &devices);
+    } catch (const cl::Error&) {
+      continue;  // a platform without devices (CL_DEVICE_NOT_FOUND)
+    }
+    for (const auto& device : devices) {
+      FoundDevice f{{}, device};
+      f.info.index = static_cast<int>(found.size());
+      f.info.platform = trim(platform.getInfo<CL_PLATFORM_NAME>());
+      f.info.name = trim(device.getInfo<CL_DEVICE_NAME>());
+      f.info.type = typeName(device.getInfo<CL_DEVICE_TYPE>());
+      f.info.driver_version = trim(device.getInfo<CL_DRIVER_VERSION>());
+      f.info.opencl_version = trim(device.getInfo<CL_DEVICE_VERSION>());
+      f.info.global_memory_bytes = device.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
+      f.info.max_allocation_bytes = device.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
+      f.info.compute_units = static_cast<int>(device.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>());
+      found.push_back(f);
+    }
+  }
+  if (found.empty()) throw NoDeviceError(std::string("no OpenCL device found: ") + kInstallHint);
+  return found;
+}
+
+const FoundDevice& selectDevice(const std::vector<FoundDevice>& devices, const std::string& selector) {
+  if (selector.empty()) {
+    for (const auto& d : devices)
+      if (d.info.type == "GPU") return d;
+    for (const auto& d : devices)
+      if (d.info.type == "CPU") return d;
+    return devices.front();
+  }
+  const bool numeric = std::all_of(selector.begin(), selector.end(), [](unsigned char c) { return std::isdigit(c); });
+  if (numeric) {
+    const unsigned long index = std::stoul(selector);
+    if (index < devices.size()) return devices[index];
+  } else {
+    const std::string want = lower(selector);
+    for (const auto& d : devices)
+      if (lower(d.info.type) == want) return d;
+    for (const auto& d : devices)
+      if (lower(d.info.name).find(want) != std::string::npos || lower(d.info.platform).find(want) != std::string::npos)
+        return d;
+  }
+  std::string names;
+  for (const auto& d : devices) names += "\n  " + std::to_string(d.info.index) + ": " + d.info.name + " (" + d.info.type + ")";
+  throw NoDeviceError("no OpenCL device matches '" + selector + "'; devices are:" + names);
+}
+
+}  // namespace
+
+std::string kernelSource(const std::string& file, std::string* include_dir) {
+  if (const char* dir = std::getenv("HFVIS_KERNEL_DIR"); dir && *dir) {
+    const std::string path = std::string(dir) + "/" + file;
+    std::ifstream in(path);
+    if (!in) throw IoError(path, "cannot read kernel source (HFVIS_KERNEL_DIR is set)");
+    std::ostringstream text;
+    text << in.rdbuf();
+    *include_dir = dir;
+    return text.str();
+  }
+  const auto& sources = embeddedKernelSources();
+  const auto it = sources.find(file);
+  if (it == sources.end()) throw Error("no embedded kernel source named " + file);
+  include_dir->clear();
+  return it->second;
+}
+
+cl::Program ContextState::program(const std::string& file, const std::string& options) {
+  std::string include_dir;
+  const std::string source = kernelSource(file, &include_dir);
+  std::string build_options = "-cl-std=CL1.2 " + options;
+  if (!include_dir.empty()) build_options += " -I " + include_dir;
+  const std::string key = file + '\n' + build_options + '\n' + source;
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (auto it = programs_.find(key); it != programs_.end()) return it->second;
+  cl::Program program(context, source);
+  try {
+    program.build({device}, build_options.c_str());
+  } catch (const cl::Error&) {
+    std::string log;
+    try {
+      log = program.getBuildInfo<CL_PROGRAM_BUILD_LOG>(device);
+    } catch (const cl::Error&) {
+      log = "(no build log)";
+    }
+    throw KernelBuildError(file + " with options '" + build_options + "'", log);
+  }
+  programs_.emplace(key, program);
+  return program;
+}
+
+}  // namespace detail
+
+std::vector<DeviceInfo> listDevices() {
+  std::vector<DeviceInfo> infos;
+  for (const auto& d : detail::findDevices()) infos.push_back(d.info);
+  return infos;
+}
+
+ComputeContext ComputeContext::create(const std::string& selector) {
+  std::string chosen = selector;
+  if (chosen.empty())
+    if (const char* env = std::getenv("HFVIS_DEVICE"); env) chosen = env;
+  const auto devices = detail::findDevices();
+  const auto& found = detail::selectDevice(devices, chosen);
+  ComputeContext context;
+  context.state_ = std::make_shared<detail::ContextState>();
+  detail::translateOpenClErrors([&] {
+    context.state_->info = found.info;
+    context.state_->device = found.device;
+    context.state_->context = cl::Context(found.device);
+    context.state_->queue = cl::CommandQueue(context.state_->context, found.device);
+    return 0;
+  });
+  return context;
+}
+
+const DeviceInfo& ComputeContext::device() const { return state_->info; }
+
+}  // namespace hfvis

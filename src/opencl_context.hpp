@@ -1,0 +1,46 @@
+// opencl_context.hpp: the OpenCL plumbing every operation shares: context, queue, the
+// program cache and OpenCL error translation. Internal to the library.
+#pragma once
+
+#include <CL/opencl.hpp>
+
+#include <map>
+#include <mutex>
+#include <string>
+
+#include "hfvis/device.hpp"
+#include "hfvis/errors.hpp"
+
+namespace hfvis::detail {
+
+struct ContextState {
+  DeviceInfo info;
+  cl::Device device;
+  cl::Context context;
+  cl::CommandQueue queue;
+
+  // The program built from kernels/<file> with `options` (e.g. "-DHFVIS_WANT_AO=1"),
+  // built once per (device, options, source) and cached. Throws KernelBuildError with the
+  // device's build log.
+  cl::Program program(const std::string& file, const std::string& options);
+
+ private:
+  std::mutex mutex_;
+  std::map<std::string, cl::Program> programs_;
+};
+
+// Kernel source by file name: embedded at build time, or read from the directory named
+// by HFVIS_KERNEL_DIR (development: edit kernels without rebuilding).
+std::string kernelSource(const std::string& file, std::string* include_dir);
+
+// Runs `body`, turning cl::Error into OpenClError.
+template <typename Body>
+auto translateOpenClErrors(Body&& body) -> decltype(body()) {
+  try {
+    return body();
+  } catch (const cl::Error& e) {
+    throw OpenClError(e.what(), e.err());
+  }
+}
+
+}  // namespace hfvis::detail

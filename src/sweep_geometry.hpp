@@ -1,0 +1,52 @@
+// sweep_geometry.hpp: the line geometry of one sweep direction, shared by the host code
+// that launches the sweep kernels and by the scalar references, so both sample the very
+// same points. Mirrors `SweepDirection` in kernels/sweep_framework.cl.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "hfvis/height_field.hpp"
+
+namespace hfvis::detail {
+
+// Sixteen 4-byte members, no padding: uploaded as is (see kernels/sweep_framework.cl).
+struct SweepDirection {
+  float dir_x, dir_y;    // unit line direction in pixel axes (x = column, y = row)
+  float perp_x, perp_y;  // (-dir_y, dir_x)
+  float line_spacing;    // pixels between lines
+  float lines_per_unit;
+  float step_length;  // pixels between samples along a line
+  float samples_per_unit;
+  float ground_per_pixel;  // ground length of one pixel length along dir
+  float cos_azimuth, sin_azimuth;
+  std::int32_t line_first;  // line j at offset (line_first + j) * line_spacing along perp
+  std::int32_t n_lines;
+  std::int32_t step_top;  // step i at (step_top - i) * step_length along dir
+  std::int32_t n_steps;
+  std::uint32_t buffer_offset;  // first entry in the batch's line buffer
+
+  std::size_t entries() const { return static_cast<std::size_t>(n_lines) * static_cast<std::size_t>(n_steps); }
+};
+static_assert(sizeof(SweepDirection) == 64, "SweepDirection must match the kernel struct");
+
+// The geometry of a sweep at ground azimuth `azimuth` (radians) over `field`, with one
+// line of margin on every side so that every receiver has its four surrounding entries.
+SweepDirection makeSweepDirection(const HeightField& field, double azimuth, double samples_per_unit,
+                                  double lines_per_unit);
+
+// Position of step `step` of line `line`, rounded exactly as the kernels do.
+struct Point2 {
+  float x, y;
+};
+Point2 sweepPosition(const SweepDirection& d, int line, int step);
+
+// Mirrors of the kernels' helpers (same operations, same order, same rounding).
+bool insideField(Point2 p, int width, int height);
+float sampleHeight(const std::vector<float>& heights, int width, int height, Point2 p);
+
+// Sample pitch at which positions count as inside; must equal HFVIS_EDGE_EPS.
+constexpr float kEdgeEpsilon = 1e-3f;
+
+}  // namespace hfvis::detail

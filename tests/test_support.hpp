@@ -1,0 +1,55 @@
+// test_support.hpp: what the kernel tests share: one device context, comparisons that
+// report where they fail, and the sizes every operation is tried on.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "hfvis/device.hpp"
+#include "hfvis/height_field.hpp"
+
+namespace hfvis::testing {
+
+// The device every test runs on (HFVIS_DEVICE or automatic), created once.
+inline const ComputeContext& testContext() {
+  static const ComputeContext context = ComputeContext::create();
+  return context;
+}
+
+// Awkward sizes (CLBlast style): 1x1, 1xN, Nx1, odd, non-square.
+inline const std::vector<std::pair<int, int>>& awkwardSizes() {
+  static const std::vector<std::pair<int, int>> sizes = {{1, 1}, {1, 9}, {9, 1}, {7, 13}, {33, 20}, {40, 41}};
+  return sizes;
+}
+
+// Element-wise comparison: NaN must match NaN, otherwise |a - b| <= tolerance. Reports the
+// first few mismatches with their index.
+inline ::testing::AssertionResult nearlyEqual(const std::vector<float>& actual, const std::vector<float>& expected,
+                                              float tolerance) {
+  if (actual.size() != expected.size())
+    return ::testing::AssertionFailure() << "sizes differ: " << actual.size() << " vs " << expected.size();
+  int failures = 0;
+  std::string report;
+  for (std::size_t i = 0; i < actual.size(); ++i) {
+    const float a = actual[i], e = expected[i];
+    const bool ok = (std::isnan(a) && std::isnan(e)) || (!std::isnan(a) && !std::isnan(e) && std::abs(a - e) <= tolerance);
+    if (!ok && failures++ < 5) report += "\n  [" + std::to_string(i) + "] " + std::to_string(a) + " vs " + std::to_string(e);
+  }
+  if (failures == 0) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << failures << " of " << actual.size() << " values differ by more than "
+                                       << tolerance << ":" << report;
+}
+
+inline HeightField fieldFrom(int width, int height, std::vector<float> heights) {
+  HeightField f;
+  f.width = width;
+  f.height = height;
+  f.heights = std::move(heights);
+  return f;
+}
+
+}  // namespace hfvis::testing
