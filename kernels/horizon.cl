@@ -30,8 +30,8 @@
 #define HFVIS_PI 3.14159265358979323846f
 
 // Hull-stack sweep: one work-item per line. Reads each presampled height and writes, in
-// place, the occluder that casts its horizon: (occluder height, occluder step), or
-// (NaN, -1) when nothing nearer the far end is on the line. Stack entries (height, step)
+// place, the occluder that casts its horizon: (occluder height - sample height, occluder
+// step), or (NaN, -1) when nothing nearer the far end is on the line. Stack entries (height, step)
 // of line j at depth k live at stacks[buffer_offset + k * n_lines + j]; the depth never
 // exceeds the line's sample count, so the stack buffer is as large as the line buffer.
 // Global size: (max lines, directions in batch).
@@ -75,7 +75,7 @@ __kernel void horizon_sweep(__global const SweepDirection* directions, __global 
     }
     stack[size * stride] = (float2)(h, here);
     ++size;
-    *entry = occluder;
+    *entry = (float2)(occluder.x - h, occluder.y);
   }
 }
 
@@ -138,10 +138,12 @@ inline void accumulate_pixel(uint pixel, int nodata, float svf, float ao, __glob
 #endif
 }
 
-// Reduction: for every receiver pixel and every direction of the batch, interpolates the
-// occluders recorded on the (up to) four surrounding (line, step) entries, seen from the
-// receiver's own position and height, and writes or accumulates the requested outputs.
-// An entry contributes when it has an occluder ahead of the receiver; with none, the
+// Reduction: for every receiver pixel and every direction of the batch, bilinearly
+// interpolates the horizons of the (up to) four surrounding (line, step) entries, each
+// exact for its own sample, and writes or accumulates the requested outputs. (Seeing the
+// neighbours' occluders from the receiver instead would be biased by the lateral offset
+// between line and receiver on every slope, and unstable where an occluder is nearly
+// beside the receiver.) Entries without an occluder are left out; with none left, the
 // horizon is -pi/2 (the ray leaves the field at once). Global size: (W, H) rounded up.
 __kernel void horizon_reduce(__global const float* heights, int width, int height, float cell_x,
                              float cell_y, __global const SweepDirection* directions, int batch_size,
@@ -171,11 +173,10 @@ __kernel void horizon_reduce(__global const float* heights, int width, int heigh
       float w = ((k & 1) ? fu : 1.0f - fu) * ((k >> 1) ? fv : 1.0f - fv);
       if (w <= 0.0f || j < 0 || j >= d.n_lines || i < 0 || i >= d.n_steps) continue;
       float2 occ = lines[d.buffer_offset + (uint)i * (uint)d.n_lines + (uint)j];
-      float ahead = ((float)d.step_top - occ.y) * d.step_length - t;  // pixels along dir
-      if (occ.y < 0.0f || !(ahead > 0.0f)) continue;
-      float ground = ahead * d.ground_per_pixel;
+      if (occ.y < 0.0f) continue;
+      float ground = ((float)i - occ.y) * d.step_length * d.ground_per_pixel;
       weight += w;
-      angle_sum += w * atan2(occ.x - h, ground);
+      angle_sum += w * atan2(occ.x, ground);
       distance_sum += w * ground;
     }
     float elevation = weight > 0.0f ? angle_sum / weight : -0.5f * HFVIS_PI;

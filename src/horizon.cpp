@@ -227,7 +227,7 @@ SweepLineBuffers sweepLinesOnDevice(const ComputeContext& context, const HeightF
     enqueueSweep(st, program, heights, field, directions, batch, lines, stacks, true);
     st.queue.enqueueReadBuffer(lines, CL_TRUE, 0, pairs.size() * sizeof(float), pairs.data());
     for (std::size_t e = 0; e < entries; ++e) {
-      out.occluder_heights.push_back(pairs[2 * e]);
+      out.occluder_rises.push_back(pairs[2 * e]);
       out.occluder_steps.push_back(pairs[2 * e + 1]);
     }
     return out;

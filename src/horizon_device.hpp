@@ -12,11 +12,12 @@ namespace hfvis::detail {
 
 // One direction's line buffers as the kernels left them: entry (step i, line j) at
 // i * geometry.n_lines + j. `samples` are the presampled heights (NaN = no sample);
-// `occluder_heights` / `occluder_steps` what the hull-stack sweep recorded (step -1 = none).
+// `occluder_rises` (occluder height - sample height) and `occluder_steps` what the
+// hull-stack sweep recorded (step -1 = none).
 struct SweepLineBuffers {
   SweepDirection geometry;
   std::vector<float> samples;
-  std::vector<float> occluder_heights;
+  std::vector<float> occluder_rises;
   std::vector<float> occluder_steps;
 };
 

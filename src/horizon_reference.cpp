@@ -100,12 +100,11 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
           const float w = ((q & 1) ? fu : 1.0f - fu) * ((q >> 1) ? fv : 1.0f - fv);
           if (w <= 0.0f || j < 0 || j >= d.n_lines || i < 0 || i >= d.n_steps) continue;
           const std::size_t e = static_cast<std::size_t>(i) * d.n_lines + j;
-          const float occ_h = lines.heights[e], occ_step = lines.steps[e];
-          const float ahead = (static_cast<float>(d.step_top) - occ_step) * d.step_length - t;
-          if (occ_step < 0.0f || !(ahead > 0.0f)) continue;
-          const float ground = ahead * d.ground_per_pixel;
+          const float rise = lines.rises[e], occ_step = lines.steps[e];
+          if (occ_step < 0.0f) continue;
+          const float ground = (static_cast<float>(i) - occ_step) * d.step_length * d.ground_per_pixel;
           weight += w;
-          angle_sum += w * std::atan2(occ_h - hp, ground);
+          angle_sum += w * std::atan2(rise, ground);
           distance_sum += w * ground;
         }
         float elevation = weight > 0.0f ? angle_sum / weight : -0.5f * kPi;
@@ -171,7 +170,7 @@ LineOccluders referenceSweepLines(const HeightField& field, const std::vector<fl
   LineOccluders out;
   const std::size_t entries = d.entries();
   out.samples.assign(entries, kNaN);
-  out.heights.assign(entries, kNaN);
+  out.rises.assign(entries, kNaN);
   out.steps.assign(entries, -1.0f);
   for (int j = 0; j < d.n_lines; ++j) {
     for (int i = 0; i < d.n_steps; ++i) {
@@ -203,7 +202,7 @@ LineOccluders referenceSweepLines(const HeightField& field, const std::vector<fl
             break;
           }
         }
-        out.heights[e] = top.first;
+        out.rises[e] = top.first - h;
         out.steps[e] = top.second;
       }
       stack.emplace_back(h, here);

@@ -10,10 +10,11 @@
 namespace hfvis::detail {
 
 // Presampled heights and hull-stack occluders of every line of one direction, laid out as
-// the kernels' line buffer (entry (step i, line j) at i * n_lines + j; step -1 = none).
+// the kernels' line buffer (entry (step i, line j) at i * n_lines + j): the occluder's
+// height above the sample (rise) and its step (-1 = none).
 struct LineOccluders {
   std::vector<float> samples;
-  std::vector<float> heights;
+  std::vector<float> rises;
   std::vector<float> steps;
 };
 

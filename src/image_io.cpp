@@ -1,0 +1,598 @@
+// image_io.cpp: reading height fields and writing results through OpenImageIO, plus the small
+// GeoTIFF tag reader that finds the pixel spacing (OpenImageIO 2.4 does not expose GeoTIFF tags).
+#include "hfvis/image_io.hpp"
+
+#include <OpenImageIO/imageio.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <new>
+#include <optional>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "hfvis/errors.hpp"
+
+namespace hfvis {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kPi = 3.14159265358979323846;
+
+std::string joinNames(const std::vector<std::string>& names) {
+  std::string joined;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (i > 0) joined += ", ";
+    joined += "'" + names[i] + "'";
+  }
+  return joined;
+}
+
+// OpenImageIO's error strings sometimes end in a newline; a reason reads better without it.
+std::string trimmed(std::string text) {
+  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
+  return text;
+}
+
+std::string withDetail(const std::string& reason, const std::string& detail) {
+  const std::string d = trimmed(detail);
+  return d.empty() ? reason : reason + " (" + d + ")";
+}
+
+// ---------------------------------------------------------------------------------------------
+// GeoTIFF tags. Only what the pixel spacing needs: ModelPixelScale (33550), ModelTiepoint
+// (33922), ModelTransformation (34264) and the inline SHORT keys of the GeoKeyDirectory
+// (34735) of the first IFD. Classic TIFF and BigTIFF, either byte order. Anything malformed
+// simply yields "no GeoTIFF information": OpenImageIO has already accepted the file as a TIFF.
+
+struct GeoTiffInfo {
+  std::vector<double> pixel_scale;  // ScaleX, ScaleY, ScaleZ
+  std::vector<double> tiepoint;     // I, J, K, X, Y, Z (the first tiepoint)
+  std::vector<double> transform;    // 4x4 row-major raster -> model matrix
+  int model_type = 0;               // GTModelTypeGeoKey: 1 projected, 2 geographic, 3 geocentric
+  int raster_type = 1;              // GTRasterTypeGeoKey: 1 PixelIsArea, 2 PixelIsPoint
+  int angular_units = 9102;         // GeogAngularUnitsGeoKey: EPSG unit code, 9102 = degree
+};
+
+class TiffReader {
+ public:
+  explicit TiffReader(const std::string& path) : file_(path, std::ios::binary) {
+    if (file_) {
+      file_.seekg(0, std::ios::end);
+      size_ = static_cast<std::uint64_t>(std::max<std::streamoff>(0, file_.tellg()));
+    }
+  }
+
+  std::optional<GeoTiffInfo> readGeoTiff() {
+    std::uint8_t header[16];
+    if (!readAt(0, header, 8)) return std::nullopt;
+    if (header[0] == 'I' && header[1] == 'I') {
+      little_ = true;
+    } else if (header[0] == 'M' && header[1] == 'M') {
+      little_ = false;
+    } else {
+      return std::nullopt;
+    }
+    const unsigned magic = decode(header + 2, 2);
+    std::uint64_t ifd = 0;
+    if (magic == 42) {
+      ifd = decode(header + 4, 4);
+    } else if (magic == 43) {
+      big_ = true;
+      if (!readAt(0, header, 16) || decode(header + 4, 2) != 8) return std::nullopt;
+      ifd = decode(header + 8, 8);
+    } else {
+      return std::nullopt;
+    }
+
+    const unsigned count_bytes = big_ ? 8 : 2;
+    const unsigned entry_bytes = big_ ? 20 : 12;
+    std::uint8_t buf[20];
+    if (!readAt(ifd, buf, count_bytes)) return std::nullopt;
+    const std::uint64_t entries = decode(buf, count_bytes);
+    if (entries > 4096) return std::nullopt;
+
+    GeoTiffInfo info;
+    bool any = false;
+    std::vector<std::uint64_t> keys;
+    for (std::uint64_t i = 0; i < entries; ++i) {
+      if (!readAt(ifd + count_bytes + i * entry_bytes, buf, entry_bytes)) return std::nullopt;
+      const unsigned tag = static_cast<unsigned>(decode(buf, 2));
+      if (tag == 33550) {
+        any |= readValues(buf, &info.pixel_scale);
+      } else if (tag == 33922) {
+        any |= readValues(buf, &info.tiepoint);
+      } else if (tag == 34264) {
+        any |= readValues(buf, &info.transform);
+      } else if (tag == 34735) {
+        std::vector<double> raw;
+        if (readValues(buf, &raw)) {
+          for (double v : raw) keys.push_back(static_cast<std::uint64_t>(v));
+        }
+      }
+    }
+    if (!any) return std::nullopt;
+    // GeoKeyDirectory: a 4-SHORT header (version, revision, minor, key count), then one
+    // (KeyID, TIFFTagLocation, Count, Value) quadruple per key; location 0 = value inline.
+    if (keys.size() >= 4) {
+      const std::size_t n = std::min<std::size_t>(keys[3], (keys.size() - 4) / 4);
+      for (std::size_t k = 0; k < n; ++k) {
+        const std::uint64_t* key = &keys[4 + 4 * k];
+        if (key[1] != 0) continue;
+        const int value = static_cast<int>(key[3]);
+        if (key[0] == 1024) info.model_type = value;
+        if (key[0] == 1025) info.raster_type = value;
+        if (key[0] == 2054) info.angular_units = value;
+      }
+    }
+    return info;
+  }
+
+ private:
+  bool readAt(std::uint64_t offset, std::uint8_t* out, std::uint64_t n) {
+    if (!file_ || offset > size_ || n > size_ - offset) return false;
+    file_.seekg(static_cast<std::streamoff>(offset));
+    file_.read(reinterpret_cast<char*>(out), static_cast<std::streamsize>(n));
+    return static_cast<bool>(file_);
+  }
+
+  std::uint64_t decode(const std::uint8_t* p, unsigned n) const {
+    std::uint64_t v = 0;
+    for (unsigned i = 0; i < n; ++i) {
+      const unsigned shift = 8 * (little_ ? i : n - 1 - i);
+      v |= static_cast<std::uint64_t>(p[i]) << shift;
+    }
+    return v;
+  }
+
+  // Reads the values of one IFD entry of type SHORT (3), LONG (4), DOUBLE (12) or LONG8 (16).
+  bool readValues(const std::uint8_t* entry, std::vector<double>* out) {
+    const unsigned type = static_cast<unsigned>(decode(entry + 2, 2));
+    const std::uint64_t count = big_ ? decode(entry + 4, 8) : decode(entry + 4, 4);
+    const std::uint8_t* value_field = entry + (big_ ? 12 : 8);
+    const unsigned inline_bytes = big_ ? 8 : 4;
+    unsigned size = 0;
+    if (type == 3) size = 2;
+    if (type == 4) size = 4;
+    if (type == 12 || type == 16) size = 8;
+    if (size == 0 || count == 0 || count > 65536) return false;
+    std::vector<std::uint8_t> bytes(count * size);
+    if (count * size <= inline_bytes) {
+      std::memcpy(bytes.data(), value_field, bytes.size());
+    } else if (!readAt(decode(value_field, inline_bytes), bytes.data(), bytes.size())) {
+      return false;
+    }
+    out->clear();
+    for (std::uint64_t i = 0; i < count; ++i) {
+      const std::uint64_t raw = decode(bytes.data() + i * size, size);
+      if (type == 12) {
+        double d;
+        std::memcpy(&d, &raw, sizeof d);
+        out->push_back(d);
+      } else {
+        out->push_back(static_cast<double>(raw));
+      }
+    }
+    return true;
+  }
+
+  std::ifstream file_;
+  std::uint64_t size_ = 0;
+  bool little_ = true;
+  bool big_ = false;
+};
+
+// Ground metres per degree on the WGS84 ellipsoid at geodetic latitude `lat_deg`:
+// along a meridian (radius of curvature M) and along a parallel (N cos(lat)).
+void metresPerDegree(double lat_deg, double* along_meridian, double* along_parallel) {
+  const double a = 6378137.0;
+  const double f = 1.0 / 298.257223563;
+  const double e2 = f * (2.0 - f);
+  const double lat = lat_deg * kPi / 180.0;
+  const double s = std::sin(lat);
+  const double w = 1.0 - e2 * s * s;
+  const double m = a * (1.0 - e2) / (w * std::sqrt(w));
+  const double n = a / std::sqrt(w);
+  *along_meridian = m * kPi / 180.0;
+  *along_parallel = n * std::cos(lat) * kPi / 180.0;
+}
+
+// Cell size from GeoTIFF tags, or nullopt when the file carries no pixel spacing.
+std::optional<std::pair<double, double>> geoTiffCellSize(const std::string& path, int width, int height) {
+  TiffReader reader(path);
+  const std::optional<GeoTiffInfo> info = reader.readGeoTiff();
+  if (!info) return std::nullopt;
+
+  double sx = 0.0, sy = 0.0;  // model units per pixel
+  double centre_y = 0.0;      // model y (latitude) at the field's centre
+  bool have_centre = false;
+  // PixelIsArea: raster (0, 0) is the corner of the first pixel; PixelIsPoint: its centre.
+  const double half = info->raster_type == 2 ? 0.5 : 0.0;
+  const double col_c = width / 2.0 - half;
+  const double row_c = height / 2.0 - half;
+  if (info->pixel_scale.size() >= 2) {
+    sx = std::fabs(info->pixel_scale[0]);
+    sy = std::fabs(info->pixel_scale[1]);
+    if (info->tiepoint.size() >= 6) {
+      // Row index grows southwards: y = Y_tie - (row - J) * ScaleY.
+      centre_y = info->tiepoint[4] - (row_c - info->tiepoint[1]) * info->pixel_scale[1];
+      have_centre = true;
+    }
+  } else if (info->transform.size() >= 16) {
+    const std::vector<double>& m = info->transform;
+    sx = std::hypot(m[0], m[4]);
+    sy = std::hypot(m[1], m[5]);
+    centre_y = m[4] * col_c + m[5] * row_c + m[7];
+    have_centre = true;
+  } else {
+    return std::nullopt;
+  }
+  if (!std::isfinite(sx) || !std::isfinite(sy) || sx <= 0.0 || sy <= 0.0) {
+    throw IoError(path, "GeoTIFF pixel scale (" + std::to_string(sx) + ", " + std::to_string(sy) +
+                            ") is not positive; give the cell size explicitly");
+  }
+  if (info->model_type != 2) return std::make_pair(sx, sy);  // projected: model units as they are
+
+  // Geographic model: pixel spacing is an angle; convert it to metres at the centre latitude.
+  // EPSG angular unit codes: radian, degree, arc-minute, arc-second, grad.
+  double to_degrees = 0.0;
+  if (info->angular_units == 9101) to_degrees = 180.0 / kPi;
+  if (info->angular_units == 9102) to_degrees = 1.0;
+  if (info->angular_units == 9103) to_degrees = 1.0 / 60.0;
+  if (info->angular_units == 9104) to_degrees = 1.0 / 3600.0;
+  if (info->angular_units == 9105) to_degrees = 0.9;
+  if (to_degrees == 0.0) {
+    throw IoError(path, "GeoTIFF angular unit code " + std::to_string(info->angular_units) +
+                            " is not supported; give the cell size explicitly");
+  }
+  const double lat = centre_y * to_degrees;
+  if (!have_centre || !std::isfinite(lat) || std::fabs(lat) > 90.0) {
+    throw IoError(path,
+                  "geographic GeoTIFF has no usable tiepoint to find its latitude; "
+                  "give the cell size explicitly");
+  }
+  double per_deg_y = 0.0, per_deg_x = 0.0;
+  metresPerDegree(lat, &per_deg_y, &per_deg_x);
+  return std::make_pair(sx * to_degrees * per_deg_x, sy * to_degrees * per_deg_y);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Reading pixels.
+
+int selectChannel(const std::string& path, const OIIO::ImageSpec& spec, const std::string& choice) {
+  const std::vector<std::string>& names = spec.channelnames;
+  const std::string available = std::to_string(spec.nchannels) + " channels: " + joinNames(names);
+  if (choice.empty()) {
+    if (spec.nchannels == 1) return 0;
+    throw IoError(path,
+                  "image has " + available + "; choose one by name or zero-based index (hfvis --channel)");
+  }
+  for (int c = 0; c < spec.nchannels && c < static_cast<int>(names.size()); ++c) {
+    if (names[c] == choice) return c;
+  }
+  if (choice.size() <= 9 &&
+      std::all_of(choice.begin(), choice.end(), [](char ch) { return ch >= '0' && ch <= '9'; })) {
+    const int index = std::stoi(choice);
+    if (index < spec.nchannels) return index;
+  }
+  throw IoError(path, "no channel '" + choice + "' (image has " + available + ")");
+}
+
+template <typename T>
+void convertIntegers(const std::vector<unsigned char>& raw, double rescale, std::vector<float>* out) {
+  const T* values = reinterpret_cast<const T*>(raw.data());
+  for (std::size_t i = 0; i < out->size(); ++i) {
+    const double v = static_cast<double>(values[i]);
+    (*out)[i] = static_cast<float>(rescale == 1.0 ? v : std::round(v * rescale));
+  }
+}
+
+// Reads channel `ch` of subimage 0 as the stored values (integers are not normalised).
+std::vector<float> readChannel(const std::string& path, OIIO::ImageInput& in, int ch) {
+  const OIIO::ImageSpec& spec = in.spec();
+  const OIIO::TypeDesc type = spec.channelformat(ch);
+  const std::size_t count = static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.height);
+  auto readAs = [&](OIIO::TypeDesc as, void* data) {
+    if (!in.read_image(0, 0, ch, ch + 1, as, data)) {
+      throw IoError(path,
+                    withDetail("cannot read pixel data; the file is truncated or corrupt", in.geterror()));
+    }
+  };
+  std::vector<float> heights(count);
+  switch (type.basetype) {
+    case OIIO::TypeDesc::HALF:
+    case OIIO::TypeDesc::FLOAT:
+    case OIIO::TypeDesc::DOUBLE:
+      readAs(OIIO::TypeDesc::FLOAT, heights.data());
+      return heights;
+    case OIIO::TypeDesc::UINT8:
+    case OIIO::TypeDesc::INT8:
+    case OIIO::TypeDesc::UINT16:
+    case OIIO::TypeDesc::INT16:
+    case OIIO::TypeDesc::UINT32:
+    case OIIO::TypeDesc::INT32:
+    case OIIO::TypeDesc::UINT64:
+    case OIIO::TypeDesc::INT64:
+      break;
+    default:
+      throw IoError(path, "unsupported pixel type '" + std::string(type.c_str()) + "'");
+  }
+  // Integers: read in their own type, since OpenImageIO's conversion to float would
+  // normalise them to [0, 1]. Files with fewer bits than the type (a 12-bit TIFF) are
+  // delivered scaled up to the type's full range; scale them back to the stored values.
+  std::vector<unsigned char> raw(count * type.size());
+  readAs(OIIO::TypeDesc(static_cast<OIIO::TypeDesc::BASETYPE>(type.basetype)), raw.data());
+  double rescale = 1.0;
+  const int bits = spec.get_int_attribute("oiio:BitsPerSample", 0);
+  const int type_bits = static_cast<int>(8 * type.size());
+  if (bits > 0 && bits < type_bits && bits < 64 && type_bits < 64 && !type.is_signed()) {
+    rescale = (std::ldexp(1.0, bits) - 1.0) / (std::ldexp(1.0, type_bits) - 1.0);
+  }
+  switch (type.basetype) {
+    case OIIO::TypeDesc::UINT8:
+      convertIntegers<std::uint8_t>(raw, rescale, &heights);
+      break;
+    case OIIO::TypeDesc::INT8:
+      convertIntegers<std::int8_t>(raw, rescale, &heights);
+      break;
+    case OIIO::TypeDesc::UINT16:
+      convertIntegers<std::uint16_t>(raw, rescale, &heights);
+      break;
+    case OIIO::TypeDesc::INT16:
+      convertIntegers<std::int16_t>(raw, rescale, &heights);
+      break;
+    case OIIO::TypeDesc::UINT32:
+      convertIntegers<std::uint32_t>(raw, rescale, &heights);
+      break;
+    case OIIO::TypeDesc::INT32:
+      convertIntegers<std::int32_t>(raw, rescale, &heights);
+      break;
+    case OIIO::TypeDesc::UINT64:
+      convertIntegers<std::uint64_t>(raw, rescale, &heights);
+      break;
+    default:
+      convertIntegers<std::int64_t>(raw, rescale, &heights);
+      break;
+  }
+  return heights;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Atomic writing: everything goes to a temporary file beside the target, which is renamed
+// into place only after a successful close. The temporary keeps the target's extension so
+// OpenImageIO picks the same format.
+
+std::string temporaryPathFor(const std::string& path) {
+  static std::atomic<unsigned> counter{0};
+  const fs::path target(path);
+  const std::string name = "." + target.stem().string() + ".tmp" + std::to_string(::getpid()) + "_" +
+                           std::to_string(counter.fetch_add(1)) + target.extension().string();
+  return (target.parent_path() / name).string();
+}
+
+class TemporaryFile {
+ public:
+  explicit TemporaryFile(std::string path) : path_(std::move(path)) {}
+  ~TemporaryFile() {
+    if (!committed_) {
+      std::error_code ignored;
+      fs::remove(path_, ignored);
+    }
+  }
+  TemporaryFile(const TemporaryFile&) = delete;
+  TemporaryFile& operator=(const TemporaryFile&) = delete;
+  const std::string& path() const { return path_; }
+  void commitTo(const std::string& target) {
+    if (std::rename(path_.c_str(), target.c_str()) != 0) {
+      throw IoError(target, "cannot rename the finished temporary file '" + path_ + "' into place (" +
+                                std::strerror(errno) + ")");
+    }
+    committed_ = true;
+  }
+
+ private:
+  std::string path_;
+  bool committed_ = false;
+};
+
+// Writes `spec.height` rows produced by `fill_rows(y_begin, y_end, buffer)` (interleaved pixels
+// of `spec.format`, at most `rows_per_chunk` rows at a time) to `path` atomically.
+template <typename Pixel, typename FillRows>
+void writeAtomically(const std::string& path, const OIIO::ImageSpec& spec, FillRows fill_rows) {
+  const fs::path target(path);
+  if (target.filename().empty()) throw IoError(path, "not a file name");
+  const fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) {
+    throw IoError(path, "directory '" + dir.string() + "' does not exist");
+  }
+  TemporaryFile temporary(temporaryPathFor(path));
+  std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create(temporary.path());
+  if (!out) {
+    throw IoError(path, withDetail("no image writer for this file extension", OIIO::geterror()));
+  }
+  if (!out->open(temporary.path(), spec)) {
+    throw IoError(path, withDetail("cannot write the image", out->geterror()));
+  }
+  // Rows go out in chunks so a large many-channel image never needs a second full copy.
+  const std::size_t row_values = static_cast<std::size_t>(spec.width) * spec.nchannels;
+  const int rows_per_chunk =
+      static_cast<int>(std::clamp<std::size_t>((std::size_t(1) << 22) / row_values, 1, 256));
+  std::vector<Pixel> buffer(row_values * static_cast<std::size_t>(std::min(rows_per_chunk, spec.height)));
+  const OIIO::TypeDesc format = spec.format;
+  for (int y = 0; y < spec.height; y += rows_per_chunk) {
+    const int y_end = std::min(spec.height, y + rows_per_chunk);
+    fill_rows(y, y_end, buffer.data());
+    if (!out->write_scanlines(y, y_end, 0, format, buffer.data())) {
+      const std::string error = out->geterror();
+      out->close();
+      throw IoError(path, withDetail("cannot write the image", error));
+    }
+  }
+  if (!out->close()) {
+    throw IoError(path, withDetail("cannot finish writing the image", out->geterror()));
+  }
+  out.reset();
+  temporary.commitTo(path);
+}
+
+}  // namespace
+
+HeightField readHeightField(const std::string& path, const HeightFieldReadOptions& options) {
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (!fs::exists(status)) throw IoError(path, "no such file");
+  if (fs::is_directory(status)) throw IoError(path, "is a directory, not an image file");
+  if (fs::is_regular_file(status) && fs::file_size(path, ec) == 0 && !ec) {
+    throw IoError(path, "file is empty (0 bytes)");
+  }
+
+  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(path);
+  if (!in) throw IoError(path, withDetail("cannot read as an image", OIIO::geterror()));
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0) {
+    throw IoError(path, "image is empty (" + std::to_string(spec.width) + " x " +
+                            std::to_string(spec.height) + " pixels, " + std::to_string(spec.nchannels) +
+                            " channels)");
+  }
+  if (spec.depth > 1) throw IoError(path, "volume images (depth > 1) are not supported");
+  if (spec.deep) throw IoError(path, "deep images are not supported");
+  const int channel = selectChannel(path, spec, options.channel);
+
+  HeightField field;
+  field.width = spec.width;
+  field.height = spec.height;
+  try {
+    field.heights = readChannel(path, *in, channel);
+  } catch (const std::bad_alloc&) {
+    throw IoError(path, "image is too large to hold in memory (" + std::to_string(spec.width) + " x " +
+                            std::to_string(spec.height) + " pixels)");
+  }
+  const bool is_tiff = std::string(in->format_name()) == "tiff";
+  in->close();
+
+  if (options.cell_size_x > 0.0 || options.cell_size_y > 0.0) {
+    // One given size applies to both axes.
+    field.cell_size_x = options.cell_size_x > 0.0 ? options.cell_size_x : options.cell_size_y;
+    field.cell_size_y = options.cell_size_y > 0.0 ? options.cell_size_y : options.cell_size_x;
+  } else if (is_tiff) {
+    if (auto cell = geoTiffCellSize(path, field.width, field.height)) {
+      field.cell_size_x = cell->first;
+      field.cell_size_y = cell->second;
+    }
+  }
+  field.z_scale = options.z_scale;
+  return field;
+}
+
+void writeImage(const std::string& path, const ImageChannels& image) {
+  if (image.width <= 0 || image.height <= 0) {
+    throw InvalidArgument("image to write to '" + path + "' is empty (" + std::to_string(image.width) +
+                          " x " + std::to_string(image.height) + " pixels)");
+  }
+  if (image.planes.empty() || image.names.size() != image.planes.size()) {
+    throw InvalidArgument("image to write to '" + path + "' has " + std::to_string(image.planes.size()) +
+                          " planes and " + std::to_string(image.names.size()) + " channel names");
+  }
+  const std::size_t count = static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
+  std::set<std::string> seen;
+  for (std::size_t c = 0; c < image.planes.size(); ++c) {
+    if (image.planes[c].size() != count) {
+      throw InvalidArgument("channel '" + image.names[c] + "' to write to '" + path + "' holds " +
+                            std::to_string(image.planes[c].size()) + " values for " +
+                            std::to_string(image.width) + " x " + std::to_string(image.height) + " pixels");
+    }
+    if (image.names[c].empty() || !seen.insert(image.names[c]).second) {
+      throw InvalidArgument("channel names to write to '" + path + "' must be non-empty and unique (got '" +
+                            image.names[c] + "')");
+    }
+  }
+
+  const int channels = static_cast<int>(image.planes.size());
+  OIIO::ImageSpec spec(image.width, image.height, channels, OIIO::TypeDesc::FLOAT);
+  spec.channelnames = image.names;
+  spec.alpha_channel = -1;  // every channel is data; none may be treated as alpha
+  spec.z_channel = -1;
+  for (const auto& [name, value] : image.attributes) spec.attribute(name, value);
+
+  writeAtomically<float>(path, spec, [&](int y_begin, int y_end, float* rows) {
+    for (int y = y_begin; y < y_end; ++y) {
+      for (int x = 0; x < image.width; ++x) {
+        const std::size_t src = static_cast<std::size_t>(y) * image.width + x;
+        float* pixel = rows + (static_cast<std::size_t>(y - y_begin) * image.width + x) * channels;
+        for (int c = 0; c < channels; ++c) pixel[c] = image.planes[c][src];
+      }
+    }
+  });
+}
+
+void writePreviewPng(const std::string& path, int width, int height, const std::vector<float>& plane,
+                     float lo, float hi) {
+  if (width <= 0 || height <= 0) {
+    throw InvalidArgument("preview '" + path + "' is empty (" + std::to_string(width) + " x " +
+                          std::to_string(height) + " pixels)");
+  }
+  const std::size_t count = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  if (plane.size() != count) {
+    throw InvalidArgument("preview '" + path + "' has " + std::to_string(plane.size()) + " values for " +
+                          std::to_string(width) + " x " + std::to_string(height) + " pixels");
+  }
+  if (!std::isfinite(lo) || !std::isfinite(hi)) {
+    throw InvalidArgument("preview '" + path + "' range must be finite (got " + std::to_string(lo) + ", " +
+                          std::to_string(hi) + ")");
+  }
+  bool any_finite = true;
+  if (lo == hi) {
+    any_finite = false;
+    for (float v : plane) {
+      if (!std::isfinite(v)) continue;
+      lo = any_finite ? std::min(lo, v) : v;
+      hi = any_finite ? std::max(hi, v) : v;
+      any_finite = true;
+    }
+  }
+  // A constant plane has no range to map: draw it mid-grey (black when nothing is finite).
+  const bool flat = lo == hi;
+  const double scale = flat ? 0.0 : 255.0 / (static_cast<double>(hi) - lo);
+  auto grey = [&](float v) -> std::uint8_t {
+    if (std::isnan(v)) return 0;
+    if (flat) return any_finite ? 128 : 0;
+    const double g = std::round((static_cast<double>(v) - lo) * scale);
+    return static_cast<std::uint8_t>(std::clamp(g, 0.0, 255.0));
+  };
+
+  OIIO::ImageSpec spec(width, height, 1, OIIO::TypeDesc::UINT8);
+  spec.channelnames = {"Y"};
+  writeAtomically<std::uint8_t>(path, spec, [&](int y_begin, int y_end, std::uint8_t* rows) {
+    const std::size_t begin = static_cast<std::size_t>(y_begin) * width;
+    const std::size_t end = static_cast<std::size_t>(y_end) * width;
+    for (std::size_t i = begin; i < end; ++i) rows[i - begin] = grey(plane[i]);
+  });
+}
+
+std::vector<std::string> directionChannelNames(const std::string& prefix, int count) {
+  if (count < 0)
+    throw InvalidArgument("direction count must not be negative (got " + std::to_string(count) + ")");
+  const int digits = static_cast<int>(std::to_string(std::max(count - 1, 0)).size());
+  const int width = std::max(3, digits);
+  std::vector<std::string> names;
+  names.reserve(static_cast<std::size_t>(count));
+  for (int k = 0; k < count; ++k) {
+    const std::string index = std::to_string(k);
+    names.push_back(prefix + std::string(static_cast<std::size_t>(width) - index.size(), '0') + index);
+  }
+  return names;
+}
+
+}  // namespace hfvis

@@ -1,0 +1,115 @@
+// test_horizon_analytic.cpp: horizons, sky-view factor and ambient occlusion on fields
+// with a closed-form answer (DESIGN.md "Analytic cases"), for both methods.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "hfvis/horizon.hpp"
+#include "hfvis/synthetic_fields.hpp"
+#include "test_support.hpp"
+
+namespace hfvis {
+namespace {
+
+using testing::testContext;
+
+class HorizonAnalytic : public ::testing::TestWithParam<HorizonMethod> {
+ protected:
+  HorizonResult run(const HeightField& field, int directions, HorizonOutputs outputs) {
+    HorizonOptions options;
+    options.directions = directions;
+    options.method = GetParam();
+    return computeHorizons(testContext(), field, options, outputs);
+  }
+  static HorizonOutputs everything() {
+    HorizonOutputs o;
+    o.horizon_angles = o.horizon_distances = o.sky_view_factor = o.ambient_occlusion = true;
+    return o;
+  }
+};
+
+TEST_P(HorizonAnalytic, FlatPlaneHasZeroHorizonInsideAndSkyViewAndOcclusionOfOne) {
+  const HeightField field = makeSyntheticField("flat", 19, 14);
+  const auto r = run(field, 8, everything());
+  const std::size_t plane = field.pixelCount();
+  for (int k = 0; k < 8; ++k) {
+    for (int row = 1; row < field.height - 1; ++row)
+      for (int c = 1; c < field.width - 1; ++c)
+        ASSERT_NEAR(r.angles[k * plane + row * field.width + c], 0.0f, 1e-6) << "k " << k << " at " << c << "," << row;
+  }
+  // Axis directions: the edge pixel facing out sees nothing (-pi/2), its neighbour 0.
+  for (int row = 0; row < field.height; ++row) {
+    EXPECT_FLOAT_EQ(r.angles[0 * plane + row * field.width + field.width - 1], -M_PI / 2);
+    EXPECT_FLOAT_EQ(r.angles[4 * plane + row * field.width + 0], -M_PI / 2);
+    EXPECT_FLOAT_EQ(r.angles[0 * plane + row * field.width + field.width - 2], 0.0f);
+  }
+  for (std::size_t p = 0; p < plane; ++p) {
+    ASSERT_NEAR(r.sky_view_factor[p], 1.0f, 1e-6);
+    ASSERT_NEAR(r.ambient_occlusion[p], 1.0f, 1e-5);
+  }
+}
+
+// A wall of height 10 from column 30 on, seen from the ground in front of it along +x:
+// horizon atan(z * 10 / (cell_x * (30 - c))), cast from the foot of the wall's top.
+TEST_P(HorizonAnalytic, LongWallCastsAtanOfHeightOverDistance) {
+  HeightField field = makeSyntheticField("flat", 40, 9);
+  for (int row = 0; row < field.height; ++row)
+    for (int c = 30; c < field.width; ++c) field.heights[row * field.width + c] += 10.0f;
+  field.cell_size_x = 2.0;
+  field.z_scale = 3.0;
+  HorizonOutputs outputs;
+  outputs.horizon_angles = outputs.horizon_distances = true;
+  const auto r = run(field, 4, outputs);
+  for (int row = 0; row < field.height; ++row) {
+    for (int c = 0; c < 30; ++c) {
+      const std::size_t p = row * field.width + c;
+      EXPECT_NEAR(r.angles[p], std::atan(30.0 / (2.0 * (30 - c))), 1e-5) << c << "," << row;
+      EXPECT_NEAR(r.distances[p], 2.0 * (30 - c), 1e-3) << c << "," << row;
+    }
+  }
+}
+
+// A cone of slope 0.5 around (20, 20): along its row every receiver looks up the cone's
+// straight flank to the apex.
+TEST_P(HorizonAnalytic, ConeFlankSeesTheApexAtTheConeSlope) {
+  HeightField field = makeSyntheticField("flat", 41, 41);
+  for (int row = 0; row < 41; ++row)
+    for (int c = 0; c < 41; ++c) field.heights[row * 41 + c] = float(20.0 - 0.5 * std::hypot(c - 20.0, row - 20.0));
+  HorizonOutputs outputs;
+  outputs.horizon_angles = outputs.horizon_distances = true;
+  const auto r = run(field, 4, outputs);
+  const std::size_t plane = field.pixelCount();
+  for (int c = 0; c < 20; ++c) {
+    EXPECT_NEAR(r.angles[0 * plane + 20 * 41 + c], std::atan(0.5), 1e-5) << c;  // toward +x
+    EXPECT_NEAR(r.distances[0 * plane + 20 * 41 + c], 20.0 - c, 1e-3) << c;
+    EXPECT_NEAR(r.angles[1 * plane + c * 41 + 20], std::atan(0.5), 1e-5) << c;  // toward +y
+  }
+}
+
+// A tilted plane h = a x sees the whole hemisphere around its normal: ambient occlusion 1
+// up to the swath discretisation of Eq. 5, and sky-view factor
+// 1 - mean over uphill directions of sin(atan(a cos phi)).
+TEST_P(HorizonAnalytic, TiltedPlaneOcclusionAndSkyView) {
+  const double a = 0.5;
+  HeightField field = makeSyntheticField("flat", 33, 33);
+  for (int row = 0; row < 33; ++row)
+    for (int c = 0; c < 33; ++c) field.heights[row * 33 + c] = float(a * c);
+  const int K = 64;
+  const auto r = run(field, K, everything());
+  double svf = 0.0;
+  for (int k = 0; k < K; ++k) svf += std::sin(std::max(0.0, std::atan(a * std::cos(2 * M_PI * k / K))));
+  svf = 1.0 - svf / K;
+  for (int row = 4; row < 29; ++row) {
+    for (int c = 4; c < 20; ++c) {  // far enough from the uphill edge for every ray to meet samples
+      const std::size_t p = row * 33 + c;
+      EXPECT_NEAR(r.ambient_occlusion[p], 1.0, 2e-3) << c << "," << row;
+      EXPECT_NEAR(r.sky_view_factor[p], svf, 5e-3) << c << "," << row;
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Methods, HorizonAnalytic, ::testing::Values(HorizonMethod::Sweep, HorizonMethod::Naive),
+                         [](const auto& info) { return info.param == HorizonMethod::Sweep ? "Sweep" : "Naive"; });
+
+}  // namespace
+}  // namespace hfvis

@@ -1,0 +1,665 @@
+// test_image_io.cpp: reading height fields (formats, pixel types, channels, GeoTIFF spacing,
+// bad files) and writing results (channel order round trip, atomic replace, previews).
+#include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "hfvis/errors.hpp"
+#include "hfvis/image_io.hpp"
+
+namespace hfvis {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+// A fresh, empty directory per test, so tests can run in parallel and leftovers are visible.
+class ImageIoTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::path(HFVIS_TEST_TMP_DIR) / "image_io" / info->name();
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  std::vector<std::string> filesInDir() const {
+    std::vector<std::string> names;
+    for (const auto& entry : fs::directory_iterator(dir_)) names.push_back(entry.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+  }
+  fs::path dir_;
+};
+
+// Writes interleaved `data` of type `type` with OpenImageIO itself (independent of the code under
+// test), stored as `file_type` (default: `type`).
+void writeWithOiio(const std::string& path, int width, int height, int channels, OIIO::TypeDesc type,
+                   const void* data, const std::vector<std::string>& names = {},
+                   OIIO::TypeDesc file_type = OIIO::TypeDesc::UNKNOWN) {
+  OIIO::ImageSpec spec(width, height, channels, file_type == OIIO::TypeDesc::UNKNOWN ? type : file_type);
+  if (!names.empty()) spec.channelnames = names;
+  std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create(path);
+  ASSERT_TRUE(out) << OIIO::geterror();
+  ASSERT_TRUE(out->open(path, spec)) << out->geterror();
+  ASSERT_TRUE(out->write_image(type, data)) << out->geterror();
+  ASSERT_TRUE(out->close()) << out->geterror();
+}
+
+// Fixed test data with negative values and a NaN: 7 x 13.
+std::vector<float> oddField(int width, int height) {
+  std::vector<float> values(static_cast<std::size_t>(width) * height);
+  for (int r = 0; r < height; ++r) {
+    for (int c = 0; c < width; ++c)
+      values[static_cast<std::size_t>(r) * width + c] = 0.25f * c - 1.5f * r + 3.0f;
+  }
+  values[5] = kNaN;
+  values[17] = -1234.5f;
+  return values;
+}
+
+void expectSameHeights(const std::vector<float>& expected, const std::vector<float>& actual) {
+  ASSERT_EQ(expected.size(), actual.size());
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    if (std::isnan(expected[i])) {
+      EXPECT_TRUE(std::isnan(actual[i])) << "at " << i;
+    } else {
+      EXPECT_EQ(expected[i], actual[i]) << "at " << i;
+    }
+  }
+}
+
+// Expects `call` to throw IoError whose path is `path` and whose message names it.
+template <typename Call>
+void expectIoError(const std::string& path, Call call, const std::string& message_part = "") {
+  try {
+    call();
+    ADD_FAILURE() << "no IoError for " << path;
+  } catch (const IoError& e) {
+    EXPECT_EQ(e.path(), path);
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    EXPECT_FALSE(e.reason().empty());
+    if (!message_part.empty()) {
+      EXPECT_NE(std::string(e.what()).find(message_part), std::string::npos) << e.what();
+    }
+  }
+}
+
+// A minimal uncompressed single-strip float32 GeoTIFF written byte by byte, because
+// OpenImageIO's TIFF writer does not write GeoTIFF tags. The tags follow the GeoTIFF 1.1
+// specification (ModelPixelScale 33550, ModelTiepoint 33922, ModelTransformation 34264,
+// GeoKeyDirectory 34735).
+struct GeoTiffSpec {
+  int width = 4;
+  int height = 2;
+  bool big_endian = false;
+  std::vector<double> pixel_scale;  // empty = no tag
+  std::vector<double> tiepoint;
+  std::vector<double> transform;
+  std::vector<std::uint16_t> geo_keys;  // full GeoKeyDirectory contents; empty = no tag
+};
+
+class TiffBytes {
+ public:
+  explicit TiffBytes(bool big_endian) : big_(big_endian) {}
+  void put(std::uint64_t v, int size) {
+    for (int i = 0; i < size; ++i)
+      bytes.push_back(static_cast<std::uint8_t>(v >> (8 * (big_ ? size - 1 - i : i))));
+  }
+  void putDouble(double d) {
+    std::uint64_t raw;
+    std::memcpy(&raw, &d, sizeof raw);
+    put(raw, 8);
+  }
+  void putFloat(float f) {
+    std::uint32_t raw;
+    std::memcpy(&raw, &f, sizeof raw);
+    put(raw, 4);
+  }
+  void setAt(std::size_t at, std::uint64_t v, int size) {
+    for (int i = 0; i < size; ++i)
+      bytes[at + i] = static_cast<std::uint8_t>(v >> (8 * (big_ ? size - 1 - i : i)));
+  }
+  std::vector<std::uint8_t> bytes;
+
+ private:
+  bool big_;
+};
+
+std::vector<float> writeGeoTiff(const std::string& path, const GeoTiffSpec& g) {
+  TiffBytes t(g.big_endian);
+  t.put(g.big_endian ? 0x4D4D : 0x4949, 2);
+  t.put(42, 2);
+  t.put(0, 4);  // IFD offset, set below
+  std::vector<float> pixels(static_cast<std::size_t>(g.width) * g.height);
+  for (std::size_t i = 0; i < pixels.size(); ++i) pixels[i] = 10.0f * static_cast<float>(i) - 5.0f;
+  const std::size_t pixel_offset = t.bytes.size();
+  for (float p : pixels) t.putFloat(p);
+  // Out-of-line values first, then the IFD.
+  auto doubles = [&](const std::vector<double>& v) {
+    const std::size_t at = t.bytes.size();
+    for (double d : v) t.putDouble(d);
+    return at;
+  };
+  const std::size_t scale_at = doubles(g.pixel_scale);
+  const std::size_t tie_at = doubles(g.tiepoint);
+  const std::size_t transform_at = doubles(g.transform);
+  const std::size_t keys_at = t.bytes.size();
+  for (std::uint16_t k : g.geo_keys) t.put(k, 2);
+
+  struct Entry {
+    std::uint16_t tag, type;
+    std::uint32_t count, value;  // value: inline SHORT/LONG or an offset
+  };
+  std::vector<Entry> entries = {
+      {256, 4, 1, static_cast<std::uint32_t>(g.width)},
+      {257, 4, 1, static_cast<std::uint32_t>(g.height)},
+      {258, 3, 1, 32},  // BitsPerSample
+      {259, 3, 1, 1},   // no compression
+      {262, 3, 1, 1},   // BlackIsZero
+      {273, 4, 1, static_cast<std::uint32_t>(pixel_offset)},
+      {277, 3, 1, 1},  // SamplesPerPixel
+      {278, 4, 1, static_cast<std::uint32_t>(g.height)},
+      {279, 4, 1, static_cast<std::uint32_t>(pixels.size() * 4)},
+      {284, 3, 1, 1},  // contiguous
+      {339, 3, 1, 3},  // IEEE float
+  };
+  auto add = [&](std::uint16_t tag, std::uint16_t type, std::size_t count, std::size_t at) {
+    if (count > 0)
+      entries.push_back({tag, type, static_cast<std::uint32_t>(count), static_cast<std::uint32_t>(at)});
+  };
+  add(33550, 12, g.pixel_scale.size(), scale_at);
+  add(33922, 12, g.tiepoint.size(), tie_at);
+  add(34264, 12, g.transform.size(), transform_at);
+  add(34735, 3, g.geo_keys.size(), keys_at);
+
+  const std::size_t ifd = t.bytes.size();
+  t.setAt(4, ifd, 4);
+  t.put(entries.size(), 2);
+  for (const Entry& e : entries) {
+    t.put(e.tag, 2);
+    t.put(e.type, 2);
+    t.put(e.count, 4);
+    if (e.type == 3 && e.count == 1) {
+      t.put(e.value, 2);  // a SHORT sits in the first two bytes of the value field
+      t.put(0, 2);
+    } else {
+      t.put(e.value, 4);
+    }
+  }
+  t.put(0, 4);  // no next IFD
+  std::ofstream(path, std::ios::binary)
+      .write(reinterpret_cast<const char*>(t.bytes.data()), static_cast<std::streamsize>(t.bytes.size()));
+  return pixels;
+}
+
+// GeoKeyDirectory with the given (key, value) pairs, all inline SHORTs.
+std::vector<std::uint16_t> geoKeys(const std::vector<std::pair<std::uint16_t, std::uint16_t>>& keys) {
+  std::vector<std::uint16_t> dir = {1, 1, 0, static_cast<std::uint16_t>(keys.size())};
+  for (const auto& [key, value] : keys) dir.insert(dir.end(), {key, 0, 1, value});
+  return dir;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Formats and pixel types.
+
+TEST_F(ImageIoTest, FloatExrSingleChannelRoundTripKeepsNaNAndNegatives) {
+  const int w = 7, h = 13;
+  const std::vector<float> values = oddField(w, h);
+  writeWithOiio(path("field.exr"), w, h, 1, OIIO::TypeDesc::FLOAT, values.data());
+
+  const HeightField field = readHeightField(path("field.exr"));
+  EXPECT_EQ(field.width, w);
+  EXPECT_EQ(field.height, h);
+  expectSameHeights(values, field.heights);
+  EXPECT_EQ(field.at(3, 4), 0.25f * 3 - 1.5f * 4 + 3.0f);  // row-major, row 0 first
+  EXPECT_EQ(field.cell_size_x, 1.0);
+  EXPECT_EQ(field.cell_size_y, 1.0);
+  EXPECT_EQ(field.z_scale, 1.0);
+  EXPECT_EQ(field.nodataCount(), 1u);
+}
+
+TEST_F(ImageIoTest, HalfExrReadsAsFloat) {
+  const std::vector<float> values = {-2.5f, 0.0f, 1.0f, 1024.0f, 0.125f, kNaN};  // exact in half
+  writeWithOiio(path("half.exr"), 3, 2, 1, OIIO::TypeDesc::FLOAT, values.data(), {}, OIIO::TypeDesc::HALF);
+  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(path("half.exr"));
+  ASSERT_TRUE(in);
+  EXPECT_EQ(in->spec().format, OIIO::TypeDesc::HALF);
+  in->close();
+  expectSameHeights(values, readHeightField(path("half.exr")).heights);
+}
+
+TEST_F(ImageIoTest, MultiChannelExrNeedsAChannelChoice) {
+  const int w = 5, h = 3;
+  std::vector<float> rgb(static_cast<std::size_t>(w) * h * 3);
+  for (std::size_t i = 0; i < rgb.size(); ++i)
+    rgb[i] = static_cast<float>(i % 3) * 100.0f + static_cast<float>(i / 3);
+  const std::string file = path("rgb.exr");
+  writeWithOiio(file, w, h, 3, OIIO::TypeDesc::FLOAT, rgb.data(), {"R", "G", "B"});
+
+  try {
+    readHeightField(file);
+    ADD_FAILURE() << "a 3-channel image was read without a channel choice";
+  } catch (const IoError& e) {
+    const std::string message = e.what();
+    EXPECT_EQ(e.path(), file);
+    EXPECT_NE(message.find("channels"), std::string::npos) << message;
+    for (const char* name : {"'R'", "'G'", "'B'"})
+      EXPECT_NE(message.find(name), std::string::npos) << message;
+    EXPECT_NE(message.find("choose"), std::string::npos) << message;
+  }
+
+  HeightFieldReadOptions by_name;
+  by_name.channel = "G";
+  const HeightField green = readHeightField(file, by_name);
+  HeightFieldReadOptions by_index;
+  by_index.channel = "2";
+  const HeightField blue = readHeightField(file, by_index);
+  for (int i = 0; i < w * h; ++i) {
+    EXPECT_EQ(green.heights[i], 100.0f + i);
+    EXPECT_EQ(blue.heights[i], 200.0f + i);
+  }
+
+  HeightFieldReadOptions unknown;
+  unknown.channel = "height";
+  expectIoError(
+      file, [&] { readHeightField(file, unknown); }, "'height'");
+  unknown.channel = "3";  // one past the last index
+  expectIoError(
+      file, [&] { readHeightField(file, unknown); }, "'R'");
+}
+
+TEST_F(ImageIoTest, Png16BitReadsStoredIntegers) {
+  const std::vector<std::uint16_t> values = {0,     1,     2,     255,   256,   1000,
+                                             32767, 32768, 65534, 65535, 12345, 54321};
+  writeWithOiio(path("dem.png"), 4, 3, 1, OIIO::TypeDesc::UINT16, values.data());
+  const HeightField field = readHeightField(path("dem.png"));
+  ASSERT_EQ(field.heights.size(), values.size());
+  for (std::size_t i = 0; i < values.size(); ++i)
+    EXPECT_EQ(field.heights[i], static_cast<float>(values[i])) << i;
+}
+
+TEST_F(ImageIoTest, Png8BitReadsStoredIntegers) {
+  const std::vector<std::uint8_t> values = {0, 1, 127, 128, 254, 255};
+  writeWithOiio(path("dem8.png"), 2, 3, 1, OIIO::TypeDesc::UINT8, values.data());
+  const HeightField field = readHeightField(path("dem8.png"));
+  for (std::size_t i = 0; i < values.size(); ++i)
+    EXPECT_EQ(field.heights[i], static_cast<float>(values[i])) << i;
+}
+
+TEST_F(ImageIoTest, Int16TiffKeepsNegativeValues) {
+  const std::vector<std::int16_t> values = {-32768, -1000, -1, 0, 1, 32767};
+  writeWithOiio(path("bathy.tif"), 3, 2, 1, OIIO::TypeDesc::INT16, values.data());
+  const HeightField field = readHeightField(path("bathy.tif"));
+  for (std::size_t i = 0; i < values.size(); ++i)
+    EXPECT_EQ(field.heights[i], static_cast<float>(values[i])) << i;
+  EXPECT_EQ(field.cell_size_x, 1.0);  // a plain TIFF has no spacing
+}
+
+TEST_F(ImageIoTest, Uint32TiffReadsStoredIntegers) {
+  const std::vector<std::uint32_t> values = {0, 123456, 4000000000u, 65536};  // all exact in float
+  writeWithOiio(path("u32.tif"), 2, 2, 1, OIIO::TypeDesc::UINT32, values.data());
+  const HeightField field = readHeightField(path("u32.tif"));
+  for (std::size_t i = 0; i < values.size(); ++i)
+    EXPECT_EQ(field.heights[i], static_cast<float>(values[i])) << i;
+}
+
+TEST_F(ImageIoTest, TwelveBitTiffReadsStoredIntegers) {
+  // OpenImageIO delivers a 12-bit TIFF scaled to the full uint16 range; the reader undoes that.
+  const std::string file = path("dem12.tif");
+  OIIO::ImageSpec spec(4, 1, 1, OIIO::TypeDesc::UINT16);
+  spec.attribute("oiio:BitsPerSample", 12);
+  const std::vector<std::uint16_t> full_range = {0, 65535, 1600, 32768};  // 12-bit values 0, 4095, 100, 2048
+  std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create(file);
+  ASSERT_TRUE(out && out->open(file, spec));
+  ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT16, full_range.data()));
+  ASSERT_TRUE(out->close());
+  const HeightField field = readHeightField(file);
+  EXPECT_EQ(field.heights, (std::vector<float>{0.0f, 4095.0f, 100.0f, 2048.0f}));
+}
+
+TEST_F(ImageIoTest, FloatTiffRoundTrip) {
+  const int w = 7, h = 13;
+  const std::vector<float> values = oddField(w, h);
+  writeWithOiio(path("field.tif"), w, h, 1, OIIO::TypeDesc::FLOAT, values.data());
+  expectSameHeights(values, readHeightField(path("field.tif")).heights);
+}
+
+TEST(ImageIoData, BundledExrFieldsRead) {
+  // Every height field shipped in data/ must read without options.
+  int count = 0;
+  for (const auto& entry : fs::directory_iterator(HFVIS_DATA_DIR)) {
+    if (entry.path().extension() != ".exr") continue;
+    const HeightField field = readHeightField(entry.path().string());
+    EXPECT_GT(field.width, 0) << entry.path();
+    EXPECT_GT(field.height, 0) << entry.path();
+    EXPECT_LT(field.nodataCount(), field.pixelCount()) << entry.path();
+    ++count;
+  }
+  if (count == 0) GTEST_SKIP() << "no .exr files in " << HFVIS_DATA_DIR;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Cell size and z-scale.
+
+TEST_F(ImageIoTest, ExplicitCellSizeAndZScale) {
+  const std::vector<float> values = {1, 2, 3, 4};
+  writeWithOiio(path("f.exr"), 2, 2, 1, OIIO::TypeDesc::FLOAT, values.data());
+  HeightFieldReadOptions options;
+  options.cell_size_x = 2.5;
+  options.z_scale = 3.0;
+  HeightField field = readHeightField(path("f.exr"), options);
+  EXPECT_EQ(field.cell_size_x, 2.5);
+  EXPECT_EQ(field.cell_size_y, 2.5);  // only x given: both axes
+  EXPECT_EQ(field.z_scale, 3.0);
+  options.cell_size_y = 4.0;
+  field = readHeightField(path("f.exr"), options);
+  EXPECT_EQ(field.cell_size_x, 2.5);
+  EXPECT_EQ(field.cell_size_y, 4.0);
+}
+
+TEST_F(ImageIoTest, GeoTiffProjectedPixelScale) {
+  GeoTiffSpec g;
+  g.pixel_scale = {30.0, 25.0, 0.0};
+  g.tiepoint = {0, 0, 0, 500000.0, 4100000.0, 0};
+  g.geo_keys = geoKeys({{1024, 1}, {1025, 1}, {3072, 32633}});  // projected, PixelIsArea, UTM 33N
+  const std::vector<float> pixels = writeGeoTiff(path("utm.tif"), g);
+  HeightField field = readHeightField(path("utm.tif"));
+  EXPECT_EQ(field.heights, pixels);
+  EXPECT_EQ(field.cell_size_x, 30.0);
+  EXPECT_EQ(field.cell_size_y, 25.0);
+
+  HeightFieldReadOptions options;  // explicit sizes win over the file's
+  options.cell_size_x = 7.0;
+  field = readHeightField(path("utm.tif"), options);
+  EXPECT_EQ(field.cell_size_x, 7.0);
+  EXPECT_EQ(field.cell_size_y, 7.0);
+}
+
+TEST_F(ImageIoTest, GeoTiffBigEndianAndTransformationMatrix) {
+  GeoTiffSpec g;
+  g.big_endian = true;
+  g.transform = {10, 0, 0, 300000, 0, -12, 0, 5000000, 0, 0, 1, 0, 0, 0, 0, 1};
+  g.geo_keys = geoKeys({{1024, 1}});
+  const std::vector<float> pixels = writeGeoTiff(path("mm.tif"), g);
+  const HeightField field = readHeightField(path("mm.tif"));
+  EXPECT_EQ(field.heights, pixels);
+  EXPECT_EQ(field.cell_size_x, 10.0);
+  EXPECT_EQ(field.cell_size_y, 12.0);
+}
+
+TEST_F(ImageIoTest, GeoTiffGeographicDegreesBecomeMetres) {
+  // 1 arc-second cells, 2 rows, PixelIsArea, top edge 1" north of 45 N: centre latitude 45.
+  // WGS84 at 45 degrees: 111132.954 m per degree of latitude, 78846.835 m per degree of longitude.
+  GeoTiffSpec g;
+  const double arcsec = 1.0 / 3600.0;
+  g.pixel_scale = {arcsec, arcsec, 0.0};
+  g.tiepoint = {0, 0, 0, 7.0, 45.0 + arcsec, 0};
+  g.geo_keys = geoKeys({{1024, 2}, {1025, 1}, {2048, 4326}});
+  writeGeoTiff(path("wgs84.tif"), g);
+  const HeightField field = readHeightField(path("wgs84.tif"));
+  EXPECT_NEAR(field.cell_size_x, 78846.835 * arcsec, 1e-3);
+  EXPECT_NEAR(field.cell_size_y, 111132.954 * arcsec, 1e-3);
+}
+
+TEST_F(ImageIoTest, GeoTiffGeographicMatchesJacksboroDataNotes) {
+  // data/jacksboro_fault_dem.txt: 3 arc-second cells, 403 x 344, top edge 36.732917 N,
+  // cell size 74.573 x 92.475 m (WGS84 at the centre latitude 36.58958).
+  GeoTiffSpec g;
+  g.width = 403;
+  g.height = 344;
+  const double step = 0.0008333333333333334;
+  g.pixel_scale = {step, step, 0.0};
+  g.tiepoint = {0, 0, 0, -84.41375, 36.73291666666667, 0};
+  g.geo_keys = geoKeys({{1024, 2}, {2048, 4326}});
+  writeGeoTiff(path("jacksboro.tif"), g);
+  const HeightField field = readHeightField(path("jacksboro.tif"));
+  EXPECT_NEAR(field.cell_size_x, 74.573, 1e-3);
+  EXPECT_NEAR(field.cell_size_y, 92.475, 1e-3);
+}
+
+TEST_F(ImageIoTest, GeoTiffGeographicWithoutTiepointIsAnError) {
+  GeoTiffSpec g;
+  g.pixel_scale = {0.001, 0.001, 0.0};
+  g.geo_keys = geoKeys({{1024, 2}});
+  writeGeoTiff(path("notie.tif"), g);
+  expectIoError(
+      path("notie.tif"), [&] { readHeightField(path("notie.tif")); }, "cell size");
+  HeightFieldReadOptions options;  // an explicit cell size needs no tags
+  options.cell_size_x = 20.0;
+  EXPECT_EQ(readHeightField(path("notie.tif"), options).cell_size_y, 20.0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Bad input.
+
+TEST_F(ImageIoTest, MissingFileIsAnIoError) {
+  expectIoError(
+      path("missing.exr"), [&] { readHeightField(path("missing.exr")); }, "no such file");
+}
+
+TEST_F(ImageIoTest, GarbageBytesAreAnIoError) {
+  std::ofstream(path("garbage.exr"), std::ios::binary) << "this is not an image, only some text bytes";
+  expectIoError(path("garbage.exr"), [&] { readHeightField(path("garbage.exr")); });
+  const char tiff_garbage[] = "II*\0garbage after a TIFF magic number";
+  std::ofstream(path("garbage.tif"), std::ios::binary).write(tiff_garbage, sizeof tiff_garbage - 1);
+  expectIoError(path("garbage.tif"), [&] { readHeightField(path("garbage.tif")); });
+}
+
+TEST_F(ImageIoTest, TruncatedExrIsAnIoError) {
+  const int w = 64, h = 64;
+  std::vector<float> values(static_cast<std::size_t>(w) * h);
+  for (std::size_t i = 0; i < values.size(); ++i)
+    values[i] = std::sin(0.37f * static_cast<float>(i)) * 100.0f;
+  const std::string file = path("cut.exr");
+  writeWithOiio(file, w, h, 1, OIIO::TypeDesc::FLOAT, values.data());
+  ASSERT_NO_THROW(readHeightField(file));
+  fs::resize_file(file, fs::file_size(file) / 2);
+  expectIoError(
+      file, [&] { readHeightField(file); }, "truncated");
+}
+
+TEST_F(ImageIoTest, ZeroByteFileIsAnIoError) {
+  std::ofstream(path("empty.exr")).close();
+  expectIoError(
+      path("empty.exr"), [&] { readHeightField(path("empty.exr")); }, "empty");
+}
+
+TEST_F(ImageIoTest, DirectoryIsAnIoError) {
+  fs::create_directories(path("folder.exr"));
+  expectIoError(
+      path("folder.exr"), [&] { readHeightField(path("folder.exr")); }, "directory");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Writing.
+
+TEST(DirectionChannelNames, ZeroPaddedInDirectionOrder) {
+  EXPECT_EQ(directionChannelNames("h", 1), (std::vector<std::string>{"h000"}));
+  EXPECT_TRUE(directionChannelNames("h", 0).empty());
+  const std::vector<std::string> k64 = directionChannelNames("h", 64);
+  ASSERT_EQ(k64.size(), 64u);
+  EXPECT_EQ(k64.front(), "h000");
+  EXPECT_EQ(k64.back(), "h063");
+  EXPECT_EQ(directionChannelNames("h", 1000).back(), "h999");
+  const std::vector<std::string> k1001 = directionChannelNames("h", 1001);
+  EXPECT_EQ(k1001.front(), "h0000");
+  EXPECT_EQ(k1001.back(), "h1000");
+  EXPECT_TRUE(std::is_sorted(k1001.begin(), k1001.end()));
+  EXPECT_EQ(directionChannelNames("dir_", 3)[2], "dir_002");
+  EXPECT_THROW(directionChannelNames("h", -1), InvalidArgument);
+}
+
+// K planes where plane k holds k * 1000 + pixel index: any channel reordering shows.
+ImageChannels horizonImage(int width, int height, int k) {
+  ImageChannels image;
+  image.width = width;
+  image.height = height;
+  image.names = directionChannelNames("h", k);
+  for (int d = 0; d < k; ++d) {
+    std::vector<float> plane(static_cast<std::size_t>(width) * height);
+    for (std::size_t i = 0; i < plane.size(); ++i)
+      plane[i] = static_cast<float>(d) * 1000.0f + static_cast<float>(i);
+    image.planes.push_back(plane);
+  }
+  return image;
+}
+
+TEST_F(ImageIoTest, HorizonExrChannelsRoundTripInDirectionOrder) {
+  const int w = 7, h = 13, k = 12;
+  ImageChannels image = horizonImage(w, h, k);
+  image.planes[3][4] = kNaN;
+  image.planes[5][0] = -1.25f;
+  image.attributes = {{"hfvis:directions", "12"}, {"hfvis:convention", "phi_k = 2 pi k / K"}};
+  const std::string file = path("horizon.exr");
+  writeImage(file, image);
+
+  // The file stores the channels sorted by name, which is the direction order.
+  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(file);
+  ASSERT_TRUE(in) << OIIO::geterror();
+  EXPECT_EQ(in->spec().channelnames, image.names);
+  EXPECT_EQ(in->spec().format, OIIO::TypeDesc::FLOAT);
+  EXPECT_EQ(in->spec().get_string_attribute("hfvis:directions"), "12");
+  EXPECT_EQ(in->spec().get_string_attribute("hfvis:convention"), "phi_k = 2 pi k / K");
+  in->close();
+
+  for (int d = 0; d < k; ++d) {
+    HeightFieldReadOptions options;
+    options.channel = image.names[d];
+    const HeightField plane = readHeightField(file, options);
+    EXPECT_EQ(plane.width, w);
+    EXPECT_EQ(plane.height, h);
+    expectSameHeights(image.planes[d], plane.heights);
+  }
+  EXPECT_EQ(filesInDir(), (std::vector<std::string>{"horizon.exr"}));
+}
+
+TEST_F(ImageIoTest, ThousandDirectionExrKeepsDirectionOrder) {
+  const int k = 1001;  // names h0000 .. h1000
+  const ImageChannels image = horizonImage(2, 1, k);
+  const std::string file = path("many.exr");
+  writeImage(file, image);
+
+  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(file);
+  ASSERT_TRUE(in) << OIIO::geterror();
+  ASSERT_EQ(in->spec().nchannels, k);
+  EXPECT_EQ(in->spec().channelnames, image.names);
+  std::vector<float> all(static_cast<std::size_t>(2) * k);
+  ASSERT_TRUE(in->read_image(0, 0, 0, k, OIIO::TypeDesc::FLOAT, all.data()));
+  for (int d = 0; d < k; ++d) {
+    EXPECT_EQ(all[d], image.planes[d][0]) << image.names[d];
+    EXPECT_EQ(all[k + d], image.planes[d][1]) << image.names[d];
+  }
+  in->close();
+  for (int d : {0, 9, 10, 99, 100, 999, 1000}) {
+    HeightFieldReadOptions options;
+    options.channel = image.names[d];
+    EXPECT_EQ(readHeightField(file, options).heights, image.planes[d]) << image.names[d];
+  }
+}
+
+TEST_F(ImageIoTest, WriteImageValidatesArguments) {
+  ImageChannels image = horizonImage(3, 2, 2);
+  image.names.pop_back();
+  EXPECT_THROW(writeImage(path("a.exr"), image), InvalidArgument);
+  image = horizonImage(3, 2, 2);
+  image.planes[1].pop_back();
+  EXPECT_THROW(writeImage(path("a.exr"), image), InvalidArgument);
+  image = horizonImage(3, 2, 2);
+  image.width = 0;
+  EXPECT_THROW(writeImage(path("a.exr"), image), InvalidArgument);
+  image = horizonImage(3, 2, 2);
+  image.names[1] = image.names[0];
+  EXPECT_THROW(writeImage(path("a.exr"), image), InvalidArgument);
+  EXPECT_TRUE(filesInDir().empty());
+}
+
+TEST_F(ImageIoTest, WriteImageFailureLeavesNoFileBehind) {
+  const ImageChannels image = horizonImage(3, 2, 2);
+  const std::string nowhere = path("no_such_dir/out.exr");
+  expectIoError(nowhere, [&] { writeImage(nowhere, image); });
+  EXPECT_TRUE(filesInDir().empty());
+
+  // A failure after the temporary file exists (PNG cannot hold 12 channels) removes it and
+  // keeps the existing output untouched.
+  const std::string png = path("out.png");
+  writePreviewPng(png, 3, 2, image.planes[0]);
+  const auto before = fs::file_size(png);
+  expectIoError(png, [&] { writeImage(png, horizonImage(3, 2, 12)); });
+  EXPECT_EQ(filesInDir(), (std::vector<std::string>{"out.png"}));
+  EXPECT_EQ(fs::file_size(png), before);
+
+  expectIoError(path("out.unknown_ext"), [&] { writeImage(path("out.unknown_ext"), image); });
+  EXPECT_EQ(filesInDir(), (std::vector<std::string>{"out.png"}));
+}
+
+TEST_F(ImageIoTest, WriteImageReplacesAnExistingFile) {
+  const std::string file = path("result.exr");
+  writeImage(file, horizonImage(5, 4, 3));
+  ImageChannels second = horizonImage(2, 3, 1);
+  second.planes[0] = {-1, -2, -3, -4, -5, -6};
+  writeImage(file, second);
+  HeightFieldReadOptions options;
+  options.channel = "h000";
+  const HeightField field = readHeightField(file);  // one channel now: no choice needed
+  EXPECT_EQ(field.width, 2);
+  EXPECT_EQ(field.height, 3);
+  EXPECT_EQ(field.heights, second.planes[0]);
+  EXPECT_EQ(readHeightField(file, options).heights, second.planes[0]);
+  EXPECT_EQ(filesInDir(), (std::vector<std::string>{"result.exr"}));
+}
+
+std::vector<std::uint8_t> readPng8(const std::string& file, int* width, int* height) {
+  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(file);
+  EXPECT_TRUE(in) << OIIO::geterror();
+  if (!in) return {};
+  EXPECT_EQ(std::string(in->format_name()), "png");
+  EXPECT_EQ(in->spec().format, OIIO::TypeDesc::UINT8);
+  EXPECT_EQ(in->spec().nchannels, 1);
+  *width = in->spec().width;
+  *height = in->spec().height;
+  std::vector<std::uint8_t> pixels(static_cast<std::size_t>(*width) * *height);
+  EXPECT_TRUE(in->read_image(0, 0, 0, 1, OIIO::TypeDesc::UINT8, pixels.data()));
+  return pixels;
+}
+
+TEST_F(ImageIoTest, PreviewPngMapsRangeToGrey) {
+  const std::vector<float> plane = {
+      -1.0f, 0.0f, 0.5f, 1.0f, 2.0f, kNaN, 0.25f, std::numeric_limits<float>::infinity(), 0.75f};
+  int w = 0, h = 0;
+  writePreviewPng(path("explicit.png"), 3, 3, plane, 0.0f, 1.0f);
+  EXPECT_EQ(readPng8(path("explicit.png"), &w, &h),
+            (std::vector<std::uint8_t>{0, 0, 128, 255, 255, 0, 64, 255, 191}));
+  EXPECT_EQ(w, 3);
+  EXPECT_EQ(h, 3);
+
+  // lo == hi: the finite min (-1) and max (2) of the plane.
+  writePreviewPng(path("auto.png"), 3, 3, plane);
+  EXPECT_EQ(readPng8(path("auto.png"), &w, &h),
+            (std::vector<std::uint8_t>{0, 85, 128, 170, 255, 0, 106, 255, 149}));
+  EXPECT_EQ(filesInDir(), (std::vector<std::string>{"auto.png", "explicit.png"}));
+}
+
+TEST_F(ImageIoTest, PreviewPngOfFlatOrEmptyPlane) {
+  int w = 0, h = 0;
+  writePreviewPng(path("flat.png"), 2, 1, {5.0f, 5.0f});
+  EXPECT_EQ(readPng8(path("flat.png"), &w, &h), (std::vector<std::uint8_t>{128, 128}));
+  writePreviewPng(path("nan.png"), 1, 2, {kNaN, kNaN});
+  EXPECT_EQ(readPng8(path("nan.png"), &w, &h), (std::vector<std::uint8_t>{0, 0}));
+  EXPECT_THROW(writePreviewPng(path("bad.png"), 2, 2, {1.0f}), InvalidArgument);
+  EXPECT_THROW(writePreviewPng(path("bad.png"), 0, 0, {}), InvalidArgument);
+  expectIoError(path("none/p.png"), [&] { writePreviewPng(path("none/p.png"), 2, 1, {0.0f, 1.0f}); });
+}
+
+}  // namespace
+}  // namespace hfvis
