@@ -449,6 +449,21 @@ void writeAtomically(const std::string& path, const OIIO::ImageSpec& spec, FillR
 
 }  // namespace
 
+// Cell size stored by hfvis itself (data/make_data.py and hfvis outputs write the string
+// attributes "hfvis:cell_size_x" and "hfvis:cell_size_y"); both must parse as positive.
+static std::optional<std::pair<double, double>> hfvisCellSize(const OIIO::ImageSpec& spec) {
+  auto number = [&](const char* name) -> double {
+    const std::string text = spec.get_string_attribute(name);
+    if (text.empty()) return 0.0;
+    char* end = nullptr;
+    const double v = std::strtod(text.c_str(), &end);
+    return (end && *end == '\0' && std::isfinite(v) && v > 0.0) ? v : 0.0;
+  };
+  const double x = number("hfvis:cell_size_x"), y = number("hfvis:cell_size_y");
+  if (x > 0.0 && y > 0.0) return std::make_pair(x, y);
+  return std::nullopt;
+}
+
 HeightField readHeightField(const std::string& path, const HeightFieldReadOptions& options) {
   std::error_code ec;
   const fs::file_status status = fs::status(path, ec);
@@ -480,12 +495,16 @@ HeightField readHeightField(const std::string& path, const HeightFieldReadOption
                             std::to_string(spec.height) + " pixels)");
   }
   const bool is_tiff = std::string(in->format_name()) == "tiff";
+  const auto stored_cell_size = hfvisCellSize(spec);
   in->close();
 
   if (options.cell_size_x > 0.0 || options.cell_size_y > 0.0) {
     // One given size applies to both axes.
     field.cell_size_x = options.cell_size_x > 0.0 ? options.cell_size_x : options.cell_size_y;
     field.cell_size_y = options.cell_size_y > 0.0 ? options.cell_size_y : options.cell_size_x;
+  } else if (stored_cell_size) {
+    field.cell_size_x = stored_cell_size->first;
+    field.cell_size_y = stored_cell_size->second;
   } else if (is_tiff) {
     if (auto cell = geoTiffCellSize(path, field.width, field.height)) {
       field.cell_size_x = cell->first;

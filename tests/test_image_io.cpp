@@ -346,7 +346,19 @@ TEST(ImageIoData, BundledExrFieldsRead) {
     EXPECT_LT(field.nodataCount(), field.pixelCount()) << entry.path();
     ++count;
   }
-  if (count == 0) GTEST_SKIP() << "no .exr files in " << HFVIS_DATA_DIR;
+  EXPECT_GE(count, 6) << "data/ should hold the four synthetic fields and two DEMs";
+}
+
+TEST(ImageIoData, CellSizeStoredByHfvisIsUsedUnlessOverridden) {
+  const std::string dem = std::string(HFVIS_DATA_DIR) + "/jacksboro_fault_dem.exr";
+  const HeightField field = readHeightField(dem);
+  EXPECT_DOUBLE_EQ(field.cell_size_x, 74.573);
+  EXPECT_DOUBLE_EQ(field.cell_size_y, 92.475);
+  HeightFieldReadOptions options;
+  options.cell_size_x = 30.0;
+  const HeightField overridden = readHeightField(dem, options);
+  EXPECT_DOUBLE_EQ(overridden.cell_size_x, 30.0);
+  EXPECT_DOUBLE_EQ(overridden.cell_size_y, 30.0);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -13,8 +13,9 @@ struct HeightFieldReadOptions {
   // Channel to read: "" = the only channel (an error for multi-channel images),
   // else a channel name ("Y", "R", "height") or a zero-based index ("0").
   std::string channel;
-  // Ground units per pixel; <= 0 = take it from the file (GeoTIFF pixel scale,
-  // geographic degrees converted to metres at the field's centre latitude) or 1.
+  // Ground units per pixel; <= 0 = take it from the file (the string attributes
+  // hfvis:cell_size_x/y that hfvis and data/make_data.py write, else the GeoTIFF pixel
+  // scale, geographic degrees converted to metres at the field's centre latitude) or 1.
   double cell_size_x = 0.0;
   double cell_size_y = 0.0;
   double z_scale = 1.0;
