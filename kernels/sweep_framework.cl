@@ -5,25 +5,39 @@
 // unit direction `dir`; line j lies at perpendicular offset (line_first + j) * line_spacing
 // along `perp`; step i of every line lies at t = (step_top - i) * step_length along `dir`,
 // so step 0 is the far end and a line is swept toward -dir. All lines of a direction share
-// the step lattice, so the line buffer entry (step i, line j) sits at
-// buffer_offset + i * n_lines + j and adjacent work-items write adjacent addresses.
+// the step lattice. Line buffers have one entry per (line, step); where it sits is the
+// layout (HFVIS_LINE_MAJOR below), reached only through line_entry() and line_stride().
 //
 // Compile-time parameters (prepended #defines; every kernel compiles with the defaults):
 //   HFVIS_HAS_NODATA  the field holds NaN heights: bilinear samples renormalise over the
 //                     valid corners (0 = the faster path without checks)
 //   HFVIS_EDGE_EPS    how far outside [0, W-1] x [0, H-1] (pixels) a sample still counts as
 //                     inside (absorbs rounding of directions that are exactly axis-aligned)
+//   HFVIS_LINE_MAJOR  0: entry (line j, step i) at i * n_lines + j, so work-items (lines)
+//                     at the same step touch adjacent addresses: coalesced on GPUs.
+//                     1: at j * n_steps + i, so one work-item walks its line contiguously:
+//                     CPUs run a work-item's loop serially, and the step-major stride
+//                     costs a cache line and often a TLB entry per step.
 #ifndef HFVIS_SWEEP_FRAMEWORK_CL
 #define HFVIS_SWEEP_FRAMEWORK_CL
 
 // Rounding must be identical in the scalar C++ references (built with -ffp-contract=off).
 #pragma OPENCL FP_CONTRACT OFF
 
+// Helpers must inline: PoCL vectorises across work-items only through straight-line code,
+// and it does not inline calls of this size by itself.
+#ifndef HFVIS_INLINE
+#define HFVIS_INLINE inline __attribute__((always_inline))
+#endif
+
 #ifndef HFVIS_HAS_NODATA
 #define HFVIS_HAS_NODATA 1
 #endif
 #ifndef HFVIS_EDGE_EPS
 #define HFVIS_EDGE_EPS 1e-3f
+#endif
+#ifndef HFVIS_LINE_MAJOR
+#define HFVIS_LINE_MAJOR 0
 #endif
 
 // One direction's sweep geometry. Must match struct SweepDirection in
@@ -44,26 +58,74 @@ typedef struct {
   uint buffer_offset;              // first entry of this direction in the line buffer
 } SweepDirection;
 
-inline float2 sweep_position(const SweepDirection d, int line, int step) {
+// A direction's geometry read field by field: an aggregate load from global memory is
+// an instruction PoCL's vectoriser cannot widen, which would keep a whole kernel scalar.
+HFVIS_INLINE SweepDirection load_direction(__global const SweepDirection* p) {
+  SweepDirection d;
+  d.dir_x = p->dir_x;
+  d.dir_y = p->dir_y;
+  d.perp_x = p->perp_x;
+  d.perp_y = p->perp_y;
+  d.line_spacing = p->line_spacing;
+  d.lines_per_unit = p->lines_per_unit;
+  d.step_length = p->step_length;
+  d.samples_per_unit = p->samples_per_unit;
+  d.ground_per_pixel = p->ground_per_pixel;
+  d.cos_azimuth = p->cos_azimuth;
+  d.sin_azimuth = p->sin_azimuth;
+  d.line_first = p->line_first;
+  d.n_lines = p->n_lines;
+  d.step_top = p->step_top;
+  d.n_steps = p->n_steps;
+  d.buffer_offset = p->buffer_offset;
+  return d;
+}
+
+// Index of entry (line, step) of direction d in a line-sized buffer, and the distance
+// between consecutive steps of one line.
+HFVIS_INLINE uint line_entry(const SweepDirection d, int line, int step) {
+#if HFVIS_LINE_MAJOR
+  return d.buffer_offset + (uint)line * (uint)d.n_steps + (uint)step;
+#else
+  return d.buffer_offset + (uint)step * (uint)d.n_lines + (uint)line;
+#endif
+}
+
+HFVIS_INLINE uint line_stride(const SweepDirection d) {
+#if HFVIS_LINE_MAJOR
+  return 1u;
+#else
+  return (uint)d.n_lines;
+#endif
+}
+
+// Position of step `step` of line `line` (pixel axes). Scalars, not float2: PoCL's
+// vectoriser widens scalar code across work-items but not vector-typed values.
+HFVIS_INLINE void sweep_position(const SweepDirection d, int line, int step, float* x, float* y) {
   float s = (float)(d.line_first + line) * d.line_spacing;
   float t = (float)(d.step_top - step) * d.step_length;
-  return (float2)(s * d.perp_x + t * d.dir_x, s * d.perp_y + t * d.dir_y);
+  *x = s * d.perp_x + t * d.dir_x;
+  *y = s * d.perp_y + t * d.dir_y;
 }
 
-inline int inside_field(float2 p, int width, int height) {
-  return p.x >= -HFVIS_EDGE_EPS && p.x <= (float)(width - 1) + HFVIS_EDGE_EPS && p.y >= -HFVIS_EDGE_EPS &&
-         p.y <= (float)(height - 1) + HFVIS_EDGE_EPS;
+HFVIS_INLINE int inside_field(float x, float y, int width, int height) {
+  return x >= -HFVIS_EDGE_EPS && x <= (float)(width - 1) + HFVIS_EDGE_EPS && y >= -HFVIS_EDGE_EPS &&
+         y <= (float)(height - 1) + HFVIS_EDGE_EPS;
 }
 
-// Bilinear height at p (clamped into the field). With nodata, only the valid corners
+// Bilinear height at (px, py), clamped into the field. With nodata, only the valid corners
 // count and their weights are renormalised; NaN when no corner with weight is valid.
-inline float sample_height(__global const float* heights, int width, int height, float2 p) {
-  float x = clamp(p.x, 0.0f, (float)(width - 1));
-  float y = clamp(p.y, 0.0f, (float)(height - 1));
-  int x0 = min((int)floor(x), max(width - 2, 0));
-  int y0 = min((int)floor(y), max(height - 2, 0));
-  int x1 = min(x0 + 1, width - 1);
-  int y1 = min(y0 + 1, height - 1);
+// Branch-free (masked sums add exact zeros), so it vectorises.
+HFVIS_INLINE float sample_height(__global const float* heights, int width, int height, float px, float py) {
+  // Plain comparisons instead of clamp/floor/min builtins, which PoCL leaves as calls that
+  // stop vectorisation. After clamping x, y >= 0, so truncation is floor.
+  float x = px < 0.0f ? 0.0f : (px > (float)(width - 1) ? (float)(width - 1) : px);
+  float y = py < 0.0f ? 0.0f : (py > (float)(height - 1) ? (float)(height - 1) : py);
+  int x0 = (int)x, y0 = (int)y;
+  x0 = x0 > width - 2 ? (width > 1 ? width - 2 : 0) : x0;
+  y0 = y0 > height - 2 ? (height > 1 ? height - 2 : 0) : y0;
+  int x1 = x0 + 1 < width ? x0 + 1 : x0;
+  int y1 = y0 + 1 < height ? y0 + 1 : y0;
   float fx = x - (float)x0;
   float fy = y - (float)y0;
   float h00 = heights[y0 * width + x0];
@@ -74,32 +136,49 @@ inline float sample_height(__global const float* heights, int width, int height,
   float w10 = fx * (1.0f - fy);
   float w01 = (1.0f - fx) * fy;
   float w11 = fx * fy;
+  float plain = w00 * h00 + w10 * h10 + w01 * h01 + w11 * h11;
 #if HFVIS_HAS_NODATA
-  if (isnan(h00) || isnan(h10) || isnan(h01) || isnan(h11)) {
-    float sum = 0.0f, weight = 0.0f;
-    if (!isnan(h00)) { sum += w00 * h00; weight += w00; }
-    if (!isnan(h10)) { sum += w10 * h10; weight += w10; }
-    if (!isnan(h01)) { sum += w01 * h01; weight += w01; }
-    if (!isnan(h11)) { sum += w11 * h11; weight += w11; }
-    return weight > 0.0f ? sum / weight : NAN;
-  }
+  int n00 = h00 != h00, n10 = h10 != h10, n01 = h01 != h01, n11 = h11 != h11;  // isnan
+  float sum = 0.0f, weight = 0.0f;
+  sum += n00 ? 0.0f : w00 * h00;
+  weight += n00 ? 0.0f : w00;
+  sum += n10 ? 0.0f : w10 * h10;
+  weight += n10 ? 0.0f : w10;
+  sum += n01 ? 0.0f : w01 * h01;
+  weight += n01 ? 0.0f : w01;
+  sum += n11 ? 0.0f : w11 * h11;
+  weight += n11 ? 0.0f : w11;
+  float renormalised = weight > 0.0f ? sum / weight : NAN;
+  return (n00 || n10 || n01 || n11) ? renormalised : plain;
+#else
+  return plain;
 #endif
-  return w00 * h00 + w10 * h10 + w01 * h01 + w11 * h11;
 }
 
 // Presampling pass: the height at every (step, line) of the batch's directions, NaN where
 // the sample lies outside the field or has no valid corner. Uniform control flow, so
 // PoCL vectorises it across lines; the sweep then only reads one float per step.
-// Global size: (max lines, max steps, directions in batch), any local size.
+// Global size: (max lines, max steps, directions in batch), or (max steps, max lines, ...)
+// with HFVIS_LINE_MAJOR; any local size.
 __kernel void presample_lines(__global const float* heights, int width, int height,
                               __global const SweepDirection* directions, __global float2* lines) {
-  int line = get_global_id(0);
-  int step = get_global_id(1);
-  const SweepDirection d = directions[get_global_id(2)];
+#if HFVIS_LINE_MAJOR  // work-items adjacent along a line write adjacent entries
+  int step = get_global_id(0), line = get_global_id(1);
+#else
+  int line = get_global_id(0), step = get_global_id(1);
+#endif
+  const SweepDirection d = load_direction(directions + get_global_id(2));
   if (line >= d.n_lines || step >= d.n_steps) return;
-  float2 p = sweep_position(d, line, step);
-  float h = inside_field(p, width, height) ? sample_height(heights, width, height, p) : NAN;
-  lines[d.buffer_offset + (uint)step * (uint)d.n_lines + (uint)line] = (float2)(h, -1.0f);
+  float x, y;
+  sweep_position(d, line, step, &x, &y);
+  // Sample unconditionally (reads are clamped into the field), then mask: a call under a
+  // condition keeps PoCL from vectorising.
+  float sampled = sample_height(heights, width, height, x, y);
+  float h = inside_field(x, y, width, height) ? sampled : NAN;
+  // Two scalar stores rather than one float2 store, for the vectoriser.
+  __global float* entry = (__global float*)(lines + line_entry(d, line, step));
+  entry[0] = h;
+  entry[1] = -1.0f;
 }
 
 #endif  // HFVIS_SWEEP_FRAMEWORK_CL

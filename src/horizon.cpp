@@ -21,20 +21,20 @@ constexpr std::size_t kLineEntryBytes = 2 * sizeof(float);  // (rise, occluder s
 std::string programOptions(const HorizonOptions& options, const HorizonOutputs& outputs, bool has_nodata) {
   std::ostringstream s;
   s << "-DHFVIS_HAS_NODATA=" << has_nodata << " -DHFVIS_WANT_ANGLES=" << outputs.horizon_angles
-    << " -DHFVIS_WANT_DISTANCES=" << outputs.horizon_distances << " -DHFVIS_WANT_SVF=" << outputs.sky_view_factor
-    << " -DHFVIS_WANT_AO=" << outputs.ambient_occlusion << " -DHFVIS_DIRECTIONS=" << options.directions;
+    << " -DHFVIS_WANT_DISTANCES=" << outputs.horizon_distances
+    << " -DHFVIS_WANT_SVF=" << outputs.sky_view_factor << " -DHFVIS_WANT_AO=" << outputs.ambient_occlusion
+    << " -DHFVIS_DIRECTIONS=" << options.directions;
   return s.str();
 }
 
-void enqueueHullSweep(ContextState& st, cl::Program& program, const cl::Buffer& directions, const SweepBatch& batch,
-                      const cl::Buffer& lines, const cl::Buffer& stacks) {
+void enqueueHullSweep(ContextState& st, cl::Program& program, const cl::Buffer& directions,
+                      const SweepBatch& batch, const cl::Buffer& lines, const cl::Buffer& stacks) {
   cl::Kernel hull(program, "horizon_sweep");
   hull.setArg(0, directions);
   hull.setArg(1, lines);
   hull.setArg(2, stacks);
-  st.queue.enqueueNDRangeKernel(hull, cl::NullRange,
-                                cl::NDRange(roundUp(batch.maxLines(), kLineGroup), batch.directions.size()),
-                                cl::NDRange(kLineGroup, 1));
+  st.launch(hull, cl::NDRange(roundUp(batch.maxLines(), kLineGroup), batch.directions.size()),
+            cl::NDRange(kLineGroup, 1));
 }
 
 HorizonResult run(const ComputeContext& context, const HeightField& field, const HorizonOptions& options,
@@ -42,7 +42,8 @@ HorizonResult run(const ComputeContext& context, const HeightField& field, const
   ContextState& st = context.state();
   const PreparedHeights prepared = prepareHeights(field);
   const bool sweep = options.method == HorizonMethod::Sweep;
-  cl::Program program = st.program("horizon.cl", programOptions(options, outputs, prepared.has_nodata));
+  cl::Program program = st.program("horizon.cl", programOptions(options, outputs, prepared.has_nodata) + " " +
+                                                     layoutProgramOption(st.info));
   const std::size_t plane = field.pixelCount();
 
   SweepMemory memory;
@@ -50,7 +51,8 @@ HorizonResult run(const ComputeContext& context, const HeightField& field, const
   memory.bytes_per_entry = sweep ? 2 * kLineEntryBytes : 0;  // line buffer + hull stacks
   memory.largest_entry_bytes = kLineEntryBytes;
   memory.bytes_per_direction = plane * sizeof(float) * (outputs.horizon_angles + outputs.horizon_distances);
-  const auto batches = planSweepBatches(runDirections(field, options), memory, options.memory_budget_bytes, st.info);
+  const auto batches =
+      planSweepBatches(runDirections(field, options), memory, options.memory_budget_bytes, st.info);
   std::size_t max_entries = 0, max_directions = 0;
   for (const auto& b : batches) {
     max_entries = std::max(max_entries, b.entries);
@@ -97,10 +99,11 @@ HorizonResult run(const ComputeContext& context, const HeightField& field, const
     reduce.setArg(arg++, distances);
     reduce.setArg(arg++, svf);
     reduce.setArg(arg++, ao);
-    st.queue.enqueueNDRangeKernel(reduce, cl::NullRange, pixels, cl::NDRange(kTileX, kTileY));
+    st.launch(reduce, pixels, cl::NDRange(kTileX, kTileY));
     const std::size_t batch_bytes = batch_size * plane * sizeof(float);
     const std::size_t at = batch.first * plane;
-    if (outputs.horizon_angles) st.queue.enqueueReadBuffer(angles, CL_TRUE, 0, batch_bytes, &result.angles[at]);
+    if (outputs.horizon_angles)
+      st.queue.enqueueReadBuffer(angles, CL_TRUE, 0, batch_bytes, &result.angles[at]);
     if (outputs.horizon_distances)
       st.queue.enqueueReadBuffer(distances, CL_TRUE, 0, batch_bytes, &result.distances[at]);
     st.queue.finish();
@@ -118,30 +121,42 @@ HorizonResult run(const ComputeContext& context, const HeightField& field, const
 }  // namespace
 
 SweepLineBuffers sweepLinesOnDevice(const ComputeContext& context, const HeightField& field,
-                                    const std::vector<float>& prepared_heights, const SweepDirection& direction) {
+                                    const std::vector<float>& prepared_heights,
+                                    const SweepDirection& direction) {
   return translateOpenClErrors([&] {
     ContextState& st = context.state();
-    cl::Program program = st.program("horizon.cl", "");
+    cl::Program program = st.program("horizon.cl", layoutProgramOption(st.info));
+    const bool line_major = lineMajorLayout(st.info);
     SweepBatch batch;
     batch.directions = {direction};
     batch.directions[0].buffer_offset = 0;
     batch.entries = direction.entries();
     SweepLineBuffers out;
     out.geometry = batch.directions[0];
-    cl::Buffer heights(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, prepared_heights.size() * sizeof(float),
-                       const_cast<float*>(prepared_heights.data()));
+    cl::Buffer heights(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                       prepared_heights.size() * sizeof(float), const_cast<float*>(prepared_heights.data()));
     const cl::Buffer directions = uploadDirections(st, batch.directions);
     cl::Buffer lines = deviceBuffer(st, batch.entries * kLineEntryBytes);
     cl::Buffer stacks = deviceBuffer(st, batch.entries * kLineEntryBytes);
     std::vector<float> pairs(batch.entries * 2);
     enqueuePresample(st, program, heights, field.width, field.height, directions, batch, lines);
     st.queue.enqueueReadBuffer(lines, CL_TRUE, 0, pairs.size() * sizeof(float), pairs.data());
-    for (std::size_t e = 0; e < batch.entries; ++e) out.samples.push_back(pairs[2 * e]);
+    // Back to the canonical step-major order of SweepLineBuffers.
+    const SweepDirection& d = out.geometry;
+    out.samples.resize(batch.entries);
+    out.occluder_rises.resize(batch.entries);
+    out.occluder_steps.resize(batch.entries);
+    for (int j = 0; j < d.n_lines; ++j)
+      for (int i = 0; i < d.n_steps; ++i)
+        out.samples[std::size_t(i) * d.n_lines + j] = pairs[2 * lineEntry(d, j, i, line_major)];
     enqueueHullSweep(st, program, directions, batch, lines, stacks);
     st.queue.enqueueReadBuffer(lines, CL_TRUE, 0, pairs.size() * sizeof(float), pairs.data());
-    for (std::size_t e = 0; e < batch.entries; ++e) {
-      out.occluder_rises.push_back(pairs[2 * e]);
-      out.occluder_steps.push_back(pairs[2 * e + 1]);
+    for (int j = 0; j < d.n_lines; ++j) {
+      for (int i = 0; i < d.n_steps; ++i) {
+        const std::size_t e = lineEntry(d, j, i, line_major), canonical = std::size_t(i) * d.n_lines + j;
+        out.occluder_rises[canonical] = pairs[2 * e];
+        out.occluder_steps[canonical] = pairs[2 * e + 1];
+      }
     }
     return out;
   });
@@ -149,8 +164,8 @@ SweepLineBuffers sweepLinesOnDevice(const ComputeContext& context, const HeightF
 
 }  // namespace detail
 
-HorizonResult computeHorizons(const ComputeContext& context, const HeightField& field, const HorizonOptions& options,
-                              const HorizonOutputs& outputs) {
+HorizonResult computeHorizons(const ComputeContext& context, const HeightField& field,
+                              const HorizonOptions& options, const HorizonOutputs& outputs) {
   validate(field);
   validate(options, outputs);
   return detail::translateOpenClErrors([&] { return detail::run(context, field, options, outputs); });

@@ -10,8 +10,8 @@
 
 namespace hfvis::detail {
 
-// One direction's line buffers as the kernels left them: entry (step i, line j) at
-// i * geometry.n_lines + j. `samples` are the presampled heights (NaN = no sample);
+// One direction's line buffers as the kernels left them, in step-major order whatever the
+// device's layout: entry (step i, line j) at i * geometry.n_lines + j. `samples` are the presampled heights (NaN = no sample);
 // `occluder_rises` (occluder height - sample height) and `occluder_steps` what the
 // hull-stack sweep recorded (step -1 = none).
 struct SweepLineBuffers {

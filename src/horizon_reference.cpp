@@ -8,6 +8,7 @@
 #include "hfvis/reference.hpp"
 #include "horizon_common.hpp"
 #include "reference_internal.hpp"
+#include "fast_math.hpp"
 
 namespace hfvis {
 namespace detail {
@@ -42,10 +43,10 @@ Normal surfaceNormal(const std::vector<float>& h, int width, int height, int c, 
 float ambientTerm(float elevation, Normal n, float cos_az, float sin_az, int directions) {
   const float toward = n.x * cos_az + n.y * sin_az;
   float zenith = 0.5f * kPi - elevation;
-  zenith = std::min(zenith, 0.5f * kPi + std::atan(toward / n.z));
-  const float s = std::sin(zenith);
+  zenith = std::fmin(zenith, 0.5f * kPi + hfAtan(toward / n.z));
+  const float s = hfSin(zenith);
   return n.z / static_cast<float>(directions) * s * s +
-         std::sin(kPi / static_cast<float>(directions)) / kPi * (zenith - 0.5f * std::sin(2.0f * zenith)) * toward;
+         hfSin(kPi / static_cast<float>(directions)) / kPi * (zenith - 0.5f * hfSin(2.0f * zenith)) * toward;
 }
 
 // Per-pixel sinks, as emit_direction / accumulate_pixel in the kernel.
@@ -58,7 +59,7 @@ void emitDirection(HorizonResult& result, int k, std::size_t pixel, float elevat
   const std::size_t plane = static_cast<std::size_t>(result.width) * result.height;
   if (!result.angles.empty()) result.angles[k * plane + pixel] = elevation;
   if (!result.distances.empty()) result.distances[k * plane + pixel] = distance;
-  sums.svf += std::sin(std::fmax(0.0f, elevation));
+  sums.svf += hfSin(std::fmax(0.0f, elevation));
   sums.ao += ambientTerm(elevation, n, d.cos_azimuth, d.sin_azimuth, directions);
 }
 
@@ -104,7 +105,7 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
           if (occ_step < 0.0f) continue;
           const float ground = (static_cast<float>(i) - occ_step) * d.step_length * d.ground_per_pixel;
           weight += w;
-          angle_sum += w * std::atan2(rise, ground);
+          angle_sum += w * hfAtan2Ahead(rise, ground);
           distance_sum += w * ground;
         }
         float elevation = weight > 0.0f ? angle_sum / weight : -0.5f * kPi;
@@ -153,7 +154,7 @@ void naiveReference(const HeightField& field, const PreparedHeights& prepared, c
           }
         }
         const float ground = static_cast<float>(best_step) * d.step_length * d.ground_per_pixel;
-        float elevation = best_step > 0 ? std::atan2(best_rise, ground) : -0.5f * kPi;
+        float elevation = best_step > 0 ? hfAtan2Ahead(best_rise, ground) : -0.5f * kPi;
         float distance = best_step > 0 ? ground : 0.0f;
         if (std::isnan(hp)) elevation = distance = kNaN;
         emitDirection(result, k, pixel, elevation, distance, n, d, options.directions, sums);

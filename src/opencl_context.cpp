@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -82,7 +83,8 @@ const FoundDevice& selectDevice(const std::vector<FoundDevice>& devices, const s
       if (d.info.type == "CPU") return d;
     return devices.front();
   }
-  const bool numeric = std::all_of(selector.begin(), selector.end(), [](unsigned char c) { return std::isdigit(c); });
+  const bool numeric =
+      std::all_of(selector.begin(), selector.end(), [](unsigned char c) { return std::isdigit(c); });
   if (numeric) {
     const unsigned long index = std::stoul(selector);
     if (index < devices.size()) return devices[index];
@@ -91,11 +93,13 @@ const FoundDevice& selectDevice(const std::vector<FoundDevice>& devices, const s
     for (const auto& d : devices)
       if (lower(d.info.type) == want) return d;
     for (const auto& d : devices)
-      if (lower(d.info.name).find(want) != std::string::npos || lower(d.info.platform).find(want) != std::string::npos)
+      if (lower(d.info.name).find(want) != std::string::npos ||
+          lower(d.info.platform).find(want) != std::string::npos)
         return d;
   }
   std::string names;
-  for (const auto& d : devices) names += "\n  " + std::to_string(d.info.index) + ": " + d.info.name + " (" + d.info.type + ")";
+  for (const auto& d : devices)
+    names += "\n  " + std::to_string(d.info.index) + ": " + d.info.name + " (" + d.info.type + ")";
   throw NoDeviceError("no OpenCL device matches '" + selector + "'; devices are:" + names);
 }
 
@@ -142,6 +146,28 @@ cl::Program ContextState::program(const std::string& file, const std::string& op
   return program;
 }
 
+void ContextState::launch(const cl::Kernel& kernel, const cl::NDRange& global, const cl::NDRange& local) {
+  if (!profiling) {
+    queue.enqueueNDRangeKernel(kernel, cl::NullRange, global, local);
+    return;
+  }
+  cl::Event event;
+  queue.enqueueNDRangeKernel(kernel, cl::NullRange, global, local, nullptr, &event);
+  event.wait();
+  const double seconds = (event.getProfilingInfo<CL_PROFILING_COMMAND_END>() -
+                          event.getProfilingInfo<CL_PROFILING_COMMAND_START>()) *
+                         1e-9;
+  auto& entry = kernel_seconds[kernel.getInfo<CL_KERNEL_FUNCTION_NAME>()];
+  entry.first += seconds;
+  entry.second += 1;
+}
+
+ContextState::~ContextState() {
+  for (const auto& [name, entry] : kernel_seconds)
+    std::fprintf(stderr, "hfvis profile: %-20s %9.3f s in %d launches\n", name.c_str(), entry.first,
+                 entry.second);
+}
+
 }  // namespace detail
 
 std::vector<DeviceInfo> listDevices() {
@@ -162,7 +188,10 @@ ComputeContext ComputeContext::create(const std::string& selector) {
     context.state_->info = found.info;
     context.state_->device = found.device;
     context.state_->context = cl::Context(found.device);
-    context.state_->queue = cl::CommandQueue(context.state_->context, found.device);
+    const char* profile = std::getenv("HFVIS_PROFILE");
+    context.state_->profiling = profile && std::string(profile) == "1";
+    context.state_->queue = cl::CommandQueue(context.state_->context, found.device,
+                                             context.state_->profiling ? CL_QUEUE_PROFILING_ENABLE : 0);
     return 0;
   });
   return context;

@@ -5,6 +5,7 @@
 #include <CL/opencl.hpp>
 
 #include <map>
+#include <utility>
 #include <mutex>
 #include <string>
 
@@ -23,6 +24,14 @@ struct ContextState {
   // built once per (device, options, source) and cached. Throws KernelBuildError with the
   // device's build log.
   cl::Program program(const std::string& file, const std::string& options);
+
+  // Enqueues `kernel`. With HFVIS_PROFILE=1 in the environment (queue created with
+  // profiling), waits for it and adds its device time to kernel_seconds, which is printed
+  // to stderr when the context is destroyed: per-kernel statistics of a run.
+  void launch(const cl::Kernel& kernel, const cl::NDRange& global, const cl::NDRange& local);
+  bool profiling = false;
+  std::map<std::string, std::pair<double, int>> kernel_seconds;  // name -> (seconds, launches)
+  ~ContextState();
 
  private:
   std::mutex mutex_;

@@ -2,6 +2,7 @@
 #include "sweep_framework.hpp"
 
 #include <algorithm>
+#include <cstdlib>
 #include <sstream>
 
 namespace hfvis::detail {
@@ -25,6 +26,20 @@ std::string mebibytes(std::size_t bytes) {
   return s.str();
 }
 
+bool lineMajorLayout(const DeviceInfo& device) {
+  if (const char* env = std::getenv("HFVIS_LINE_LAYOUT"); env && *env) {
+    const std::string layout = env;
+    if (layout == "line") return true;
+    if (layout == "step") return false;
+    throw InvalidArgument("HFVIS_LINE_LAYOUT must be 'line' or 'step' (got '" + layout + "')");
+  }
+  return device.type == "CPU";
+}
+
+std::string layoutProgramOption(const DeviceInfo& device) {
+  return std::string("-DHFVIS_LINE_MAJOR=") + (lineMajorLayout(device) ? "1" : "0");
+}
+
 std::size_t defaultMemoryBudget(const DeviceInfo& device) {
   return std::min<std::size_t>(std::size_t(1) << 30, device.global_memory_bytes / 2);
 }
@@ -38,12 +53,12 @@ std::vector<SweepBatch> planSweepBatches(const std::vector<SweepDirection>& all,
   std::size_t used = memory.fixed_bytes;
   for (std::size_t k = 0; k < all.size(); ++k) {
     const std::size_t entries = memory.bytes_per_entry ? all[k].entries() : 0;
-    const std::size_t need = entries * memory.bytes_per_entry + memory.bytes_per_direction + sizeof(SweepDirection);
+    const std::size_t need =
+        entries * memory.bytes_per_entry + memory.bytes_per_direction + sizeof(SweepDirection);
     const std::size_t count = batch.directions.size() + 1;
-    const bool fits = used + need <= budget &&
-                      (batch.entries + entries) * memory.largest_entry_bytes <= max_alloc &&
-                      batch.entries + entries < (std::size_t(1) << 31) &&
-                      count * memory.bytes_per_direction <= max_alloc;
+    const bool fits =
+        used + need <= budget && (batch.entries + entries) * memory.largest_entry_bytes <= max_alloc &&
+        batch.entries + entries < (std::size_t(1) << 31) && count * memory.bytes_per_direction <= max_alloc;
     if (!fits && batch.directions.empty()) {
       throw MemoryBudgetError("one direction needs " + mebibytes(memory.fixed_bytes + need) +
                               " of device memory but the budget is " + mebibytes(budget) +
@@ -70,22 +85,28 @@ cl::Buffer deviceBuffer(ContextState& st, std::size_t bytes) {
 }
 
 cl::Buffer uploadDirections(ContextState& st, const std::vector<SweepDirection>& directions) {
-  return cl::Buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, directions.size() * sizeof(SweepDirection),
+  return cl::Buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                    directions.size() * sizeof(SweepDirection),
                     const_cast<SweepDirection*>(directions.data()));
 }
 
-void enqueuePresample(ContextState& st, cl::Program& program, const cl::Buffer& heights, int width, int height,
-                      const cl::Buffer& directions, const SweepBatch& batch, const cl::Buffer& lines) {
+void enqueuePresample(ContextState& st, cl::Program& program, const cl::Buffer& heights, int width,
+                      int height, const cl::Buffer& directions, const SweepBatch& batch,
+                      const cl::Buffer& lines) {
   cl::Kernel presample(program, "presample_lines");
   presample.setArg(0, heights);
   presample.setArg(1, width);
   presample.setArg(2, height);
   presample.setArg(3, directions);
   presample.setArg(4, lines);
-  st.queue.enqueueNDRangeKernel(presample, cl::NullRange,
-                                cl::NDRange(roundUp(batch.maxLines(), kLineGroup), batch.maxSteps(),
-                                            batch.directions.size()),
-                                cl::NDRange(kLineGroup, 1, 1));
+  const std::size_t lines_count = batch.maxLines(), steps = batch.maxSteps();
+  const bool line_major = lineMajorLayout(st.info);
+  // Work-groups of kLineGroup x kPresampleRows: PoCL pays about a microsecond per
+  // work-group, which one row per group made the larger part of this pass.
+  st.launch(presample,
+            cl::NDRange(roundUp(line_major ? steps : lines_count, kLineGroup),
+                        roundUp(line_major ? lines_count : steps, kPresampleRows), batch.directions.size()),
+            cl::NDRange(kLineGroup, kPresampleRows, 1));
 }
 
 }  // namespace hfvis::detail

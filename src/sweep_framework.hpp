@@ -13,6 +13,7 @@
 namespace hfvis::detail {
 
 constexpr std::size_t kLineGroup = 64;              // work-items per group along lines
+constexpr std::size_t kPresampleRows = 4;           // rows of a presampling work-group
 constexpr std::size_t kTileX = 16, kTileY = 4;      // pixel tile of per-pixel kernels
 constexpr int kMaxDirectionsPerBatch = 32;          // bounds kernel time, paces progress
 
@@ -34,6 +35,17 @@ struct SweepMemory {
   std::size_t largest_entry_bytes = 0;  // per entry in the largest single buffer
   std::size_t bytes_per_direction = 0;  // per direction besides its entries (output planes)
 };
+
+// Line-buffer layout for a device (HFVIS_LINE_MAJOR in kernels/sweep_framework.cl):
+// line-major on CPUs, step-major elsewhere; the environment variable
+// HFVIS_LINE_LAYOUT=line|step overrides (for benchmarks).
+bool lineMajorLayout(const DeviceInfo& device);
+std::string layoutProgramOption(const DeviceInfo& device);  // "-DHFVIS_LINE_MAJOR=0|1"
+
+// Index of entry (line, step) of d, as line_entry() in the kernels.
+inline std::size_t lineEntry(const SweepDirection& d, int line, int step, bool line_major) {
+  return d.buffer_offset + (line_major ? std::size_t(line) * d.n_steps + step : std::size_t(step) * d.n_lines + line);
+}
 
 // The budget when the caller gives none: half the device memory, at most 1 GiB.
 std::size_t defaultMemoryBudget(const DeviceInfo& device);

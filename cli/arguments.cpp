@@ -1,0 +1,396 @@
+// cli/arguments.cpp: parsing and validating the hfvis command line.
+#include "arguments.hpp"
+
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <limits>
+
+#include "hfvis/errors.hpp"
+
+namespace hfvis::cli {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// One option of the compute commands (horizon, svf, ao).
+enum class Option {
+  Output,
+  Directions,
+  Method,
+  AzimuthOffset,
+  SamplesPerUnit,
+  LinesPerUnit,
+  CellSize,
+  ZScale,
+  Channel,
+  Device,
+  MemoryBudget,
+  Preview,
+  DistanceOutput,
+  Quiet,
+};
+
+struct OptionSpec {
+  Option option;
+  const char* long_name;   // "--output"
+  const char* short_name;  // "-o", or nullptr
+  bool takes_value;
+};
+
+constexpr OptionSpec kOptions[] = {
+    {Option::Output, "--output", "-o", true},
+    {Option::Directions, "--directions", "-k", true},
+    {Option::Method, "--method", nullptr, true},
+    {Option::AzimuthOffset, "--azimuth-offset", nullptr, true},
+    {Option::SamplesPerUnit, "--samples-per-unit", nullptr, true},
+    {Option::LinesPerUnit, "--lines-per-unit", nullptr, true},
+    {Option::CellSize, "--cell-size", nullptr, true},
+    {Option::ZScale, "--z-scale", nullptr, true},
+    {Option::Channel, "--channel", nullptr, true},
+    {Option::Device, "--device", nullptr, true},
+    {Option::MemoryBudget, "--memory-budget", nullptr, true},
+    {Option::Preview, "--preview", nullptr, true},
+    {Option::DistanceOutput, "--distance-out", nullptr, true},
+    {Option::Quiet, "--quiet", "-q", false},
+};
+
+bool isHelpFlag(const std::string& arg) { return arg == "-h" || arg == "--help"; }
+
+std::optional<Command> findCommand(const std::string& name) {
+  if (name == "horizon") return Command::Horizon;
+  if (name == "svf") return Command::SkyViewFactor;
+  if (name == "ao") return Command::AmbientOcclusion;
+  if (name == "devices") return Command::Devices;
+  if (name == "help") return Command::Help;
+  return std::nullopt;
+}
+
+const OptionSpec* findOption(const std::string& name) {
+  for (const OptionSpec& spec : kOptions) {
+    if (name == spec.long_name || (spec.short_name && name == spec.short_name)) return &spec;
+  }
+  return nullptr;
+}
+
+std::string inQuotes(const std::string& text) { return "'" + text + "'"; }
+
+// Strict number parsing: the whole text must be a finite number.
+double parseNumber(const std::string& option, const std::string& text) {
+  const char* begin = text.c_str();
+  char* end = nullptr;
+  errno = 0;
+  const double value = std::strtod(begin, &end);
+  if (text.empty() || end != begin + text.size() || errno == ERANGE || !std::isfinite(value)) {
+    throw UsageError(option + ": expected a number, got " + inQuotes(text));
+  }
+  return value;
+}
+
+double parsePositive(const std::string& option, const std::string& text) {
+  const double value = parseNumber(option, text);
+  if (!(value > 0.0)) throw UsageError(option + ": must be greater than 0, got " + inQuotes(text));
+  return value;
+}
+
+int parseDirectionCount(const std::string& option, const std::string& text) {
+  const char* begin = text.c_str();
+  char* end = nullptr;
+  errno = 0;
+  const long value = std::strtol(begin, &end, 10);
+  if (text.empty() || end != begin + text.size() || errno == ERANGE) {
+    throw UsageError(option + ": expected a whole number of directions, got " + inQuotes(text));
+  }
+  if (value < 1 || value > std::numeric_limits<int>::max()) {
+    throw UsageError(option + ": the number of directions must be at least 1, got " + inQuotes(text));
+  }
+  return static_cast<int>(value);
+}
+
+HorizonMethod parseMethod(const std::string& option, const std::string& text) {
+  if (text == "sweep") return HorizonMethod::Sweep;
+  if (text == "naive") return HorizonMethod::Naive;
+  throw UsageError(option + ": expected 'sweep' or 'naive', got " + inQuotes(text));
+}
+
+// "X" or "X,Y", ground units per pixel along columns and rows.
+void parseCellSize(const std::string& option, const std::string& text, RunArguments& run) {
+  const std::size_t comma = text.find(',');
+  if (comma == std::string::npos) {
+    run.cell_size_x = run.cell_size_y = parsePositive(option, text);
+  } else {
+    run.cell_size_x = parsePositive(option, text.substr(0, comma));
+    run.cell_size_y = parsePositive(option, text.substr(comma + 1));
+  }
+}
+
+std::size_t parseMemoryBudget(const std::string& option, const std::string& text) {
+  const double megabytes = parsePositive(option, text);
+  const double bytes = std::ceil(megabytes * 1024.0 * 1024.0);
+  if (bytes > static_cast<double>(std::numeric_limits<std::size_t>::max() / 2)) {
+    throw UsageError(option + ": " + inQuotes(text) + " MB is too large");
+  }
+  return static_cast<std::size_t>(bytes);
+}
+
+bool hasPngExtension(const std::string& path) {
+  std::string extension = std::filesystem::path(path).extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return extension == ".png";
+}
+
+void requireNonEmpty(const std::string& option, const std::string& value) {
+  if (value.empty()) throw UsageError(option + ": the value must not be empty");
+}
+
+void applyOption(const OptionSpec& spec, const std::string& typed, const std::string& value, Command command,
+                 RunArguments& run) {
+  switch (spec.option) {
+    case Option::Output:
+      requireNonEmpty(typed, value);
+      run.output = value;
+      break;
+    case Option::Directions:
+      run.directions = parseDirectionCount(typed, value);
+      break;
+    case Option::Method:
+      run.method = parseMethod(typed, value);
+      break;
+    case Option::AzimuthOffset:
+      run.azimuth_offset_deg = parseNumber(typed, value);
+      break;
+    case Option::SamplesPerUnit:
+      run.samples_per_unit = parsePositive(typed, value);
+      break;
+    case Option::LinesPerUnit:
+      run.lines_per_unit = parsePositive(typed, value);
+      break;
+    case Option::CellSize:
+      parseCellSize(typed, value, run);
+      break;
+    case Option::ZScale:
+      run.z_scale = parsePositive(typed, value);
+      break;
+    case Option::Channel:
+      requireNonEmpty(typed, value);
+      run.channel = value;
+      break;
+    case Option::Device:
+      requireNonEmpty(typed, value);
+      run.device = value;
+      break;
+    case Option::MemoryBudget:
+      run.memory_budget_bytes = parseMemoryBudget(typed, value);
+      break;
+    case Option::Preview:
+      requireNonEmpty(typed, value);
+      if (!hasPngExtension(value)) {
+        throw UsageError(typed + ": the preview is a PNG file; its name must end in .png, got " +
+                         inQuotes(value));
+      }
+      run.preview = value;
+      break;
+    case Option::DistanceOutput:
+      if (command != Command::Horizon) {
+        throw UsageError(typed + " is only available with 'hfvis horizon'");
+      }
+      requireNonEmpty(typed, value);
+      run.distance_output = value;
+      break;
+    case Option::Quiet:
+      run.quiet = true;
+      break;
+  }
+}
+
+bool samePath(const std::string& a, const std::string& b) {
+  return std::filesystem::path(a).lexically_normal() == std::filesystem::path(b).lexically_normal();
+}
+
+// Checks that involve more than one option, and the library's own argument checks.
+void validateRun(Command command, const RunArguments& run) {
+  const std::string name = commandName(command);
+  if (run.input.empty())
+    throw UsageError("missing the input height field (hfvis " + name + " IN -o OUT.exr)");
+  if (run.output.empty()) throw UsageError("missing -o OUT.exr (the output file of 'hfvis " + name + "')");
+  if (!run.distance_output.empty() && samePath(run.output, run.distance_output)) {
+    throw UsageError("--distance-out must differ from -o, both are " + inQuotes(run.output));
+  }
+  if (!run.preview.empty() && samePath(run.output, run.preview)) {
+    throw UsageError("--preview must differ from -o, both are " + inQuotes(run.output));
+  }
+  if (!run.preview.empty() && !run.distance_output.empty() && samePath(run.preview, run.distance_output)) {
+    throw UsageError("--preview must differ from --distance-out, both are " + inQuotes(run.preview));
+  }
+  try {
+    validate(horizonOptions(run), horizonOutputs(command, run));
+  } catch (const InvalidArgument& error) {
+    throw UsageError(error.what());
+  }
+}
+
+RunArguments parseRunArguments(Command command, const std::vector<std::string>& args) {
+  RunArguments run;
+  std::vector<std::string> positional;
+  bool options_ended = false;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& arg = args[i];
+    if (options_ended || arg.size() < 2 || arg[0] != '-') {
+      positional.push_back(arg);
+      continue;
+    }
+    if (arg == "--") {
+      options_ended = true;
+      continue;
+    }
+    // Split "--name=value" and "-kVALUE"; otherwise the value is the next argument.
+    std::string typed = arg;
+    std::optional<std::string> attached;
+    if (arg.rfind("--", 0) == 0) {
+      const std::size_t equals = arg.find('=');
+      if (equals != std::string::npos) {
+        typed = arg.substr(0, equals);
+        attached = arg.substr(equals + 1);
+      }
+    } else if (arg.size() > 2) {
+      typed = arg.substr(0, 2);
+      attached = arg.substr(2);
+    }
+    const OptionSpec* spec = findOption(typed);
+    if (!spec) {
+      // Name what was typed ("-foo", not "-f") unless it was "--name=value".
+      const std::string shown = attached && typed.size() > 2 ? typed : arg;
+      throw UsageError("unknown option " + inQuotes(shown) + " for 'hfvis " + commandName(command) + "'");
+    }
+    if (!spec->takes_value) {
+      if (attached) throw UsageError(typed + " takes no value, got " + inQuotes(arg));
+      applyOption(*spec, typed, "", command, run);
+      continue;
+    }
+    std::string value;
+    if (attached) {
+      value = *attached;
+    } else {
+      // A following option ("-o --quiet") is a forgotten value, not a file name; a
+      // negative number ("--azimuth-offset -45") is a value.
+      if (i + 1 >= args.size() || args[i + 1].rfind("--", 0) == 0) {
+        throw UsageError(typed + ": missing value");
+      }
+      value = args[++i];
+    }
+    applyOption(*spec, typed, value, command, run);
+  }
+  if (positional.size() > 1) {
+    throw UsageError("unexpected argument " + inQuotes(positional[1]) + " ('hfvis " + commandName(command) +
+                     "' reads one input file)");
+  }
+  if (!positional.empty()) run.input = positional[0];
+  validateRun(command, run);
+  return run;
+}
+
+}  // namespace
+
+const char* commandName(Command command) {
+  switch (command) {
+    case Command::Help:
+      return "help";
+    case Command::Devices:
+      return "devices";
+    case Command::Horizon:
+      return "horizon";
+    case Command::SkyViewFactor:
+      return "svf";
+    case Command::AmbientOcclusion:
+      return "ao";
+  }
+  return "?";
+}
+
+CommandLine parseCommandLine(const std::vector<std::string>& args) {
+  CommandLine line;
+  if (args.empty()) throw UsageError("no command given (horizon, svf, ao or devices)");
+  const std::string& first = args[0];
+  if (isHelpFlag(first)) return line;  // Command::Help, no topic
+  if (!first.empty() && first[0] == '-') {
+    throw UsageError("unknown option " + inQuotes(first) +
+                     " (give a command first: horizon, svf, ao or devices)");
+  }
+  const std::optional<Command> command = findCommand(first);
+  if (!command) {
+    throw UsageError("unknown command " + inQuotes(first) + " (expected horizon, svf, ao or devices)");
+  }
+  const std::vector<std::string> rest(args.begin() + 1, args.end());
+
+  if (*command == Command::Help) {  // "hfvis help [COMMAND]"
+    if (rest.size() > 1) throw UsageError("unexpected argument " + inQuotes(rest[1]) + " after 'help'");
+    if (!rest.empty()) {
+      const std::optional<Command> topic = findCommand(rest[0]);
+      if (!topic)
+        throw UsageError("unknown command " + inQuotes(rest[0]) + " (expected horizon, svf, ao or devices)");
+      if (*topic != Command::Help) line.help_topic = topic;
+    }
+    return line;
+  }
+
+  // "--help" anywhere before "--" wins over everything else on the line.
+  for (const std::string& arg : rest) {
+    if (arg == "--") break;
+    if (isHelpFlag(arg)) {
+      line.help_topic = command;
+      return line;
+    }
+  }
+
+  line.command = *command;
+  if (*command == Command::Devices) {
+    if (!rest.empty()) throw UsageError("'hfvis devices' takes no arguments, got " + inQuotes(rest[0]));
+    return line;
+  }
+  line.run = parseRunArguments(*command, rest);
+  return line;
+}
+
+HorizonOptions horizonOptions(const RunArguments& run) {
+  HorizonOptions options;
+  options.directions = run.directions;
+  options.azimuth_offset = run.azimuth_offset_deg * (kPi / 180.0);
+  options.samples_per_unit = run.samples_per_unit;
+  options.lines_per_unit = run.lines_per_unit;
+  options.method = run.method;
+  options.memory_budget_bytes = run.memory_budget_bytes;
+  return options;
+}
+
+HorizonOutputs horizonOutputs(Command command, const RunArguments& run) {
+  HorizonOutputs outputs;
+  switch (command) {
+    case Command::Horizon:
+      outputs.horizon_angles = true;
+      outputs.horizon_distances = !run.distance_output.empty();
+      break;
+    case Command::SkyViewFactor:
+      outputs.sky_view_factor = true;
+      break;
+    case Command::AmbientOcclusion:
+      outputs.ambient_occlusion = true;
+      break;
+    case Command::Help:
+    case Command::Devices:
+      break;
+  }
+  return outputs;
+}
+
+HeightFieldReadOptions readOptions(const RunArguments& run) {
+  HeightFieldReadOptions options;
+  options.channel = run.channel;
+  options.cell_size_x = run.cell_size_x;
+  options.cell_size_y = run.cell_size_y;
+  options.z_scale = run.z_scale;
+  return options;
+}
+
+}  // namespace hfvis::cli

@@ -1,0 +1,64 @@
+// cli/arguments.hpp: the hfvis command line, parsed and validated into plain structs.
+// A small hand-written parser: every value is checked here, before any file is read or
+// any device is created, so a typo costs nothing and exits with status 2.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "hfvis/horizon.hpp"
+#include "hfvis/image_io.hpp"
+
+namespace hfvis::cli {
+
+// A malformed command line: unknown option or subcommand, missing or bad value.
+// main() prints it and exits with status 2.
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+enum class Command { Help, Devices, Horizon, SkyViewFactor, AmbientOcclusion };
+
+// The subcommand's name as typed ("horizon", "svf", ...).
+const char* commandName(Command command);
+
+// Everything a horizon/svf/ao run needs, already validated.
+struct RunArguments {
+  std::string input;
+  std::string output;
+  std::string distance_output;  // horizon only; "" = not asked for
+  std::string preview;          // "" = no preview
+  int directions = 64;
+  double azimuth_offset_deg = 0.0;
+  double samples_per_unit = 1.0;
+  double lines_per_unit = 1.0;
+  HorizonMethod method = HorizonMethod::Sweep;
+  double cell_size_x = 0.0;  // <= 0: from the file, else 1
+  double cell_size_y = 0.0;
+  double z_scale = 1.0;
+  std::string channel;                  // "" = the only channel
+  std::string device;                   // "" = HFVIS_DEVICE, else automatic
+  std::size_t memory_budget_bytes = 0;  // 0 = from the device
+  bool quiet = false;
+};
+
+struct CommandLine {
+  Command command = Command::Help;
+  // For Command::Help: the subcommand whose help was asked for, if any.
+  std::optional<Command> help_topic;
+  RunArguments run;
+};
+
+// Parses argv (without argv[0]). Throws UsageError naming the offending argument.
+CommandLine parseCommandLine(const std::vector<std::string>& args);
+
+// The library options and outputs a run asks for.
+HorizonOptions horizonOptions(const RunArguments& run);
+HorizonOutputs horizonOutputs(Command command, const RunArguments& run);
+HeightFieldReadOptions readOptions(const RunArguments& run);
+
+}  // namespace hfvis::cli

@@ -1,0 +1,393 @@
+// cli/commands.cpp: the hfvis subcommands: listing devices, and horizon/svf/ao runs
+// (read, compute, then write every output all-or-nothing).
+#include "commands.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <functional>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <system_error>
+#include <utility>
+#include <vector>
+
+#include "hfvis/device.hpp"
+#include "hfvis/errors.hpp"
+#include "hfvis/height_field.hpp"
+#include "hfvis/horizon.hpp"
+#include "hfvis/image_io.hpp"
+
+namespace hfvis::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string formatNumber(double value) {
+  std::ostringstream out;
+  out << std::setprecision(10) << value;
+  return out.str();
+}
+
+std::string formatFixed(double value, int digits) {
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(digits) << value;
+  return out.str();
+}
+
+std::string formatMemory(std::uint64_t bytes) {
+  const double gib = static_cast<double>(bytes) / (1024.0 * 1024.0 * 1024.0);
+  if (gib >= 1.0) return formatFixed(gib, 1) + " GiB";
+  return formatFixed(static_cast<double>(bytes) / (1024.0 * 1024.0), 0) + " MiB";
+}
+
+// The files of one run appear together or not at all. Each is first written completely
+// under a temporary name beside its destination (same extension, so the format is kept);
+// commit() renames them all into place. Whatever is not committed is removed, and if a
+// rename fails, the files this run already renamed are removed too, so no mismatched set
+// (a new OUT.exr beside an old preview) is left behind.
+class StagedOutputs {
+ public:
+  StagedOutputs() = default;
+  StagedOutputs(const StagedOutputs&) = delete;
+  StagedOutputs& operator=(const StagedOutputs&) = delete;
+  ~StagedOutputs() { discard(); }
+
+  void stage(const std::string& path, const std::function<void(const std::string&)>& write) {
+    const std::string temp = temporaryPath(path);
+    staged_.push_back({path, temp});
+    try {
+      write(temp);
+    } catch (const IoError& error) {  // name the file the user asked for, not our temporary
+      throw IoError(path, error.reason());
+    }
+  }
+
+  void commit() {
+    std::vector<std::string> committed;
+    for (const Entry& entry : staged_) {
+      std::error_code error;
+      fs::rename(entry.temp_path, entry.final_path, error);
+      if (error) {
+        for (const std::string& path : committed) removeQuietly(path);
+        discard();
+        throw IoError(entry.final_path, "cannot move the finished file into place: " + error.message());
+      }
+      committed.push_back(entry.final_path);
+    }
+    staged_.clear();
+  }
+
+  std::vector<std::string> paths() const {
+    std::vector<std::string> result;
+    for (const Entry& entry : staged_) result.push_back(entry.final_path);
+    return result;
+  }
+
+ private:
+  struct Entry {
+    std::string final_path;
+    std::string temp_path;
+  };
+
+  static std::string temporaryPath(const std::string& path) {
+    const fs::path target(path);
+    const std::string name = "." + target.stem().string() + ".hfvis-tmp-" + std::to_string(::getpid()) +
+                             target.extension().string();
+    return (target.parent_path() / name).string();
+  }
+
+  static void removeQuietly(const std::string& path) {
+    std::error_code ignored;
+    fs::remove(path, ignored);
+  }
+
+  void discard() {
+    for (const Entry& entry : staged_) removeQuietly(entry.temp_path);
+    staged_.clear();
+  }
+
+  std::vector<Entry> staged_;
+};
+
+// Fails early (before reading or computing) when an output cannot possibly be written.
+void requireOutputLocation(const std::string& path) {
+  const fs::path target(path);
+  const fs::path directory = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  std::error_code error;
+  if (!fs::is_directory(directory, error)) {
+    throw IoError(path, "cannot write here: the directory '" + directory.string() + "' does not exist");
+  }
+  if (fs::is_directory(target, error)) throw IoError(path, "cannot write here: it is a directory");
+}
+
+std::vector<std::string> outputPaths(const RunArguments& run) {
+  std::vector<std::string> paths{run.output};
+  if (!run.distance_output.empty()) paths.push_back(run.distance_output);
+  if (!run.preview.empty()) paths.push_back(run.preview);
+  return paths;
+}
+
+// Mean over the finite values (nodata pixels are NaN and do not count).
+double finiteMean(const std::vector<float>& values) {
+  double sum = 0.0;
+  std::size_t count = 0;
+  for (const float value : values) {
+    if (std::isfinite(value)) {
+      sum += value;
+      ++count;
+    }
+  }
+  return count ? sum / static_cast<double>(count) : std::nan("");
+}
+
+// The horizon preview: per pixel, the mean elevation over the directions whose ray stays
+// in the field (-pi/2 marks a ray that leaves it at once; averaging those in would make the
+// border dominate the stretch). NaN where every direction is NaN (nodata) or leaves at once.
+std::vector<float> meanInFieldElevation(const std::vector<float>& planes, std::size_t pixels,
+                                        int directions) {
+  constexpr float kLeavesAtOnce = -1.57079632679489661923f;
+  std::vector<double> sum(pixels, 0.0);
+  std::vector<int> count(pixels, 0);
+  for (int k = 0; k < directions; ++k) {
+    const float* plane = planes.data() + static_cast<std::size_t>(k) * pixels;
+    for (std::size_t i = 0; i < pixels; ++i) {
+      if (std::isfinite(plane[i]) && plane[i] > kLeavesAtOnce) {
+        sum[i] += plane[i];
+        ++count[i];
+      }
+    }
+  }
+  std::vector<float> mean(pixels);
+  for (std::size_t i = 0; i < pixels; ++i) {
+    mean[i] = count[i] ? static_cast<float>(sum[i] / count[i]) : std::nanf("");
+  }
+  return mean;
+}
+
+std::vector<std::vector<float>> splitPlanes(const std::vector<float>& planes, std::size_t pixels, int count) {
+  std::vector<std::vector<float>> result;
+  result.reserve(count);
+  for (int k = 0; k < count; ++k) {
+    const auto begin = planes.begin() + static_cast<std::ptrdiff_t>(k * pixels);
+    result.emplace_back(begin, begin + static_cast<std::ptrdiff_t>(pixels));
+  }
+  return result;
+}
+
+// The library's result must hold what was asked for; a mismatch is a library bug, caught
+// here rather than written out as a corrupt image.
+void requireSize(const std::vector<float>& values, std::size_t expected, const char* what) {
+  if (values.size() != expected) {
+    throw Error(std::string("internal error: the computed ") + what + " holds " +
+                std::to_string(values.size()) + " values, expected " + std::to_string(expected));
+  }
+}
+
+const char* methodName(HorizonMethod method) { return method == HorizonMethod::Naive ? "naive" : "sweep"; }
+
+using Attributes = std::vector<std::pair<std::string, std::string>>;
+
+// String attributes describing the run, written into every EXR output.
+Attributes runAttributes(Command command, const RunArguments& run, const HeightField& field,
+                         const DeviceInfo& device) {
+  Attributes attributes{
+      {"hfvis:command", commandName(command)},
+      {"hfvis:input", run.input},
+      {"hfvis:directions", std::to_string(run.directions)},
+      {"hfvis:azimuth_offset_deg", formatNumber(run.azimuth_offset_deg)},
+      {"hfvis:azimuth_convention",
+       "phi_k = 360*k/K deg + offset, on the ground from the +column axis toward +row; "
+       "compass azimuth = 90 + phi_k deg when row 0 is north"},
+      {"hfvis:method", methodName(run.method)},
+      {"hfvis:samples_per_unit", formatNumber(run.samples_per_unit)},
+      {"hfvis:lines_per_unit", formatNumber(run.lines_per_unit)},
+      // Read back by readHeightField, so an output keeps the input's ground spacing.
+      {"hfvis:cell_size_x", formatNumber(field.cell_size_x)},
+      {"hfvis:cell_size_y", formatNumber(field.cell_size_y)},
+      {"hfvis:z_scale", formatNumber(field.z_scale)},
+      {"hfvis:nodata", "NaN where the input height is not finite"},
+      {"hfvis:device", device.name + " (" + device.platform + ")"},
+  };
+  if (!run.channel.empty()) attributes.emplace_back("hfvis:channel", run.channel);
+  return attributes;
+}
+
+ImageChannels makeImage(const HorizonResult& result, std::vector<std::string> names,
+                        std::vector<std::vector<float>> planes, Attributes attributes,
+                        const std::string& quantity, const std::string& units) {
+  ImageChannels image;
+  image.width = result.width;
+  image.height = result.height;
+  image.names = std::move(names);
+  image.planes = std::move(planes);
+  image.attributes = std::move(attributes);
+  image.attributes.emplace_back("hfvis:quantity", quantity);
+  image.attributes.emplace_back("hfvis:units", units);
+  return image;
+}
+
+std::string joinPaths(const std::vector<std::string>& paths) {
+  std::string joined;
+  for (const std::string& path : paths) joined += (joined.empty() ? "" : ", ") + path;
+  return joined;
+}
+
+}  // namespace
+
+int runDevices() {
+  const std::vector<DeviceInfo> devices = listDevices();
+
+  // Which device automatic selection picks (honours HFVIS_DEVICE, as every command does).
+  int automatic = -1;
+  std::string automatic_error;
+  try {
+    automatic = ComputeContext::create("").device().index;
+  } catch (const Error& error) {
+    automatic_error = error.what();
+  }
+
+  const std::vector<std::string> header{"index", "type", "name", "platform", "driver", "memory"};
+  std::vector<std::vector<std::string>> rows;
+  for (const DeviceInfo& device : devices) {
+    rows.push_back({std::to_string(device.index), device.type, device.name, device.platform,
+                    device.driver_version, formatMemory(device.global_memory_bytes)});
+  }
+  std::vector<std::size_t> widths(header.size());
+  for (std::size_t c = 0; c < header.size(); ++c) {
+    widths[c] = header[c].size();
+    for (const auto& row : rows) widths[c] = std::max(widths[c], row[c].size());
+  }
+  const auto printRow = [&](const std::string& mark, const std::vector<std::string>& row) {
+    std::string line = mark;
+    for (std::size_t c = 0; c < row.size(); ++c) {
+      line += row[c];
+      if (c + 1 < row.size()) line += std::string(widths[c] - row[c].size() + 2, ' ');
+    }
+    std::cout << line << "\n";
+  };
+  printRow("  ", header);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    printRow(devices[i].index == automatic ? "* " : "  ", rows[i]);
+  }
+  if (automatic >= 0) {
+    std::cout << "* = automatic selection"
+              << (std::getenv("HFVIS_DEVICE")
+                      ? " (HFVIS_DEVICE=" + std::string(std::getenv("HFVIS_DEVICE")) + ")"
+                      : std::string(" (HFVIS_DEVICE not set)"))
+              << "\n";
+  } else {
+    std::cerr << "hfvis: warning: automatic device selection failed: " << automatic_error << "\n";
+  }
+  return 0;
+}
+
+int runCompute(Command command, const RunArguments& run) {
+  for (const std::string& path : outputPaths(run)) requireOutputLocation(path);
+
+  HeightField field = readHeightField(run.input, readOptions(run));
+  try {
+    validate(field);
+  } catch (const InvalidArgument& error) {
+    throw Error(run.input + ": " + error.what());
+  }
+
+  const ComputeContext context = ComputeContext::create(run.device);
+  const DeviceInfo& device = context.device();
+
+  HorizonOptions options = horizonOptions(run);
+  bool progress_line_open = false;  // a progress line without its newline yet
+  if (!run.quiet && ::isatty(::fileno(stderr))) {
+    // One line rewritten in place, at most a few times a second (batches can be tiny).
+    options.progress = [&progress_line_open, last = std::chrono::steady_clock::time_point()](
+                           int done, int total) mutable {
+      const auto now = std::chrono::steady_clock::now();
+      if (done < total && now - last < std::chrono::milliseconds(250)) return;
+      last = now;
+      progress_line_open = done < total;
+      std::fprintf(stderr, "\rhfvis: %d/%d directions%s", done, total, progress_line_open ? "" : "\n");
+      std::fflush(stderr);
+    };
+  }
+  const auto start = std::chrono::steady_clock::now();
+  HorizonResult result;
+  try {
+    result = computeHorizons(context, field, options, horizonOutputs(command, run));
+  } catch (...) {
+    if (progress_line_open) std::fputc('\n', stderr);  // the error message gets its own line
+    throw;
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (result.width != field.width || result.height != field.height) {
+    throw Error("internal error: the result is " + std::to_string(result.width) + "x" +
+                std::to_string(result.height) + ", the height field " + std::to_string(field.width) + "x" +
+                std::to_string(field.height));
+  }
+
+  const std::size_t pixels = static_cast<std::size_t>(result.width) * static_cast<std::size_t>(result.height);
+  const int directions = run.directions;
+  const Attributes attributes = runAttributes(command, run, field, device);
+
+  // Everything is computed; now stage every file, then move them all into place.
+  StagedOutputs outputs;
+  std::string mean_note;
+  if (command == Command::Horizon) {
+    const std::size_t values = pixels * static_cast<std::size_t>(directions);
+    requireSize(result.angles, values, "horizon angles");
+    const ImageChannels angles = makeImage(
+        result, directionChannelNames("h", directions), splitPlanes(result.angles, pixels, directions),
+        attributes, "horizon elevation angle per direction (channel k = direction k)",
+        "radians above the horizontal; -pi/2 where the ray leaves the field at once");
+    outputs.stage(run.output, [&](const std::string& path) { writeImage(path, angles); });
+    if (!run.distance_output.empty()) {
+      requireSize(result.distances, values, "horizon distances");
+      const ImageChannels distances = makeImage(
+          result, directionChannelNames("d", directions), splitPlanes(result.distances, pixels, directions),
+          attributes, "ground distance to the point casting the horizon, per direction",
+          "ground units (pixels times cell size); 0 where no point casts a horizon");
+      outputs.stage(run.distance_output, [&](const std::string& path) { writeImage(path, distances); });
+    }
+    if (!run.preview.empty()) {
+      const std::vector<float> mean = meanInFieldElevation(result.angles, pixels, directions);
+      outputs.stage(run.preview, [&](const std::string& path) {
+        writePreviewPng(path, result.width, result.height, mean);  // stretched min..max
+      });
+    }
+  } else {
+    const bool svf = command == Command::SkyViewFactor;
+    const std::vector<float>& plane = svf ? result.sky_view_factor : result.ambient_occlusion;
+    const std::string channel = svf ? "svf" : "ao";
+    requireSize(plane, pixels, svf ? "sky-view factor" : "ambient occlusion");
+    const ImageChannels image =
+        makeImage(result, {channel}, {plane}, attributes,
+                  svf ? "sky-view factor 1 - mean_k sin(max(0, elevation_k))"
+                      : "ambient occlusion, uniform sky of radiance 1 (Timonen & Westerholm 2010, Eq. 5)",
+                  svf ? "fraction of the sky visible, 0..1" : "0..1, a flat unoccluded plane gives 1");
+    outputs.stage(run.output, [&](const std::string& path) { writeImage(path, image); });
+    if (!run.preview.empty()) {
+      outputs.stage(run.preview, [&](const std::string& path) {
+        writePreviewPng(path, result.width, result.height, plane, 0.0f, 1.0f);
+      });
+    }
+    mean_note = "; mean " + channel + " " + formatFixed(finiteMean(plane), 4);
+  }
+  const std::vector<std::string> written = outputs.paths();
+  outputs.commit();
+
+  if (!run.quiet) {
+    std::cout << "wrote " << joinPaths(written) << " (" << result.width << "x" << result.height << ", "
+              << directions << (directions == 1 ? " direction, " : " directions, ") << methodName(run.method)
+              << ", " << formatFixed(seconds, 2) << " s on " << device.name << ")" << mean_note << "\n";
+  }
+  return 0;
+}
+
+}  // namespace hfvis::cli

@@ -1,0 +1,65 @@
+// cli/main.cpp: the hfvis command line tool: dispatch, and the one place where errors
+// become a message and an exit status (0 success, 1 runtime error, 2 usage error).
+#include <exception>
+#include <iostream>
+#include <new>
+#include <string>
+#include <vector>
+
+#include "arguments.hpp"
+#include "commands.hpp"
+#include "help.hpp"
+#include "hfvis/errors.hpp"
+
+namespace {
+
+constexpr int kExitRuntimeError = 1;
+constexpr int kExitUsageError = 2;
+
+int run(const std::vector<std::string>& args) {
+  using namespace hfvis::cli;
+  const CommandLine line = parseCommandLine(args);
+  switch (line.command) {
+    case Command::Help:
+      std::cout << (line.help_topic ? commandHelp(*line.help_topic) : generalHelp());
+      return 0;
+    case Command::Devices:
+      return runDevices();
+    case Command::Horizon:
+    case Command::SkyViewFactor:
+    case Command::AmbientOcclusion:
+      return runCompute(line.command, line.run);
+  }
+  return kExitUsageError;
+}
+
+// "hfvis horizon --help" when the command is known, else "hfvis --help".
+std::string helpHint(const std::vector<std::string>& args) {
+  if (!args.empty() &&
+      (args[0] == "horizon" || args[0] == "svf" || args[0] == "ao" || args[0] == "devices")) {
+    return "hfvis " + args[0] + " --help";
+  }
+  return "hfvis --help";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::vector<std::string> args(argv + 1, argv + argc);
+  try {
+    return run(args);
+  } catch (const hfvis::cli::UsageError& error) {
+    std::cerr << "hfvis: error: " << error.what() << "\n"
+              << "Run '" << helpHint(args) << "' for usage.\n";
+    return kExitUsageError;
+  } catch (const hfvis::Error& error) {
+    std::cerr << "hfvis: error: " << error.what() << "\n";
+    return kExitRuntimeError;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "hfvis: error: out of host memory (try a smaller field or fewer directions)\n";
+    return kExitRuntimeError;
+  } catch (const std::exception& error) {
+    std::cerr << "hfvis: error: " << error.what() << "\n";
+    return kExitRuntimeError;
+  }
+}
