@@ -30,55 +30,61 @@
 
 #define HFVIS_PI 3.14159265358979323846f
 
-// Hull-stack sweep: one work-item per line. Reads each presampled height and writes, in
-// place, the occluder that casts its horizon: (occluder height - sample height, occluder
-// step), or (NaN, -1) when nothing nearer the far end is on the line. The stack of line j
-// holds (height, step) entries in the line's own slots of the stacks buffer, depth k at
-// line_entry(d, j, k): the depth never exceeds the line's sample count, so the stack
-// buffer is as large as the line buffer.
+// One step of Algorithm 1 (Timonen & Westerholm 2010) on one line: reads the presampled
+// height at *entry and writes, in place, the occluder that casts its horizon:
+// (occluder height - sample height, occluder step), or (NaN, -1) when nothing farther along
+// the line has been seen. Pops while the second stack entry casts at least as steep a slope
+// on the new sample as the top one; the top that remains is the occluder.
+HFVIS_INLINE void hull_stack_step(__global float2* entry, __global float2* stack, uint stride, uint* size,
+                                  int step) {
+  float h = entry->x;
+  if (isnan(h)) {
+    *entry = (float2)(NAN, -1.0f);
+    return;
+  }
+  float2 occluder = (float2)(NAN, -1.0f);
+  float here = (float)step;
+  uint n = *size;
+  if (n > 0) {
+    float2 top = stack[(n - 1) * stride];
+    float v1h = top.x - h;
+    float v1d = here - top.y;
+    while (n > 1) {
+      float2 below = stack[(n - 2) * stride];
+      float v2h = below.x - h;
+      float v2d = here - below.y;
+      if (v2h * v1d >= v1h * v2d) {
+        top = below;
+        v1h = v2h;
+        v1d = v2d;
+        --n;
+      } else {
+        break;
+      }
+    }
+    occluder = top;
+  }
+  stack[n * stride] = (float2)(h, here);
+  *size = n + 1;
+  *entry = (float2)(occluder.x - h, occluder.y);
+}
+
+// Hull-stack sweep: one work-item per line. The stack of line j holds (height, step)
+// entries in the line's own slots of the stacks buffer, depth k at line_entry(d, j, k): the
+// depth never exceeds the line's sample count, so the stack buffer is as large as the line
+// buffer. (Interleaving 2, 4 or 8 lines per work-item to overlap their serial chains was
+// measured slower on PoCL, so each work-item keeps one line.)
 // Global size: (max lines, directions in batch).
 __kernel void horizon_sweep(__global const SweepDirection* directions, __global float2* lines,
                             __global float2* stacks) {
-  int line = get_global_id(0);
+  const int line = get_global_id(0);
   const SweepDirection d = load_direction(directions + get_global_id(1));
   if (line >= d.n_lines) return;
   const uint stride = line_stride(d);
   __global float2* entry = lines + line_entry(d, line, 0);
   __global float2* stack = stacks + line_entry(d, line, 0);
   uint size = 0;
-  for (int step = 0; step < d.n_steps; ++step, entry += stride) {
-    float h = entry->x;
-    if (isnan(h)) {
-      *entry = (float2)(NAN, -1.0f);
-      continue;
-    }
-    float2 occluder = (float2)(NAN, -1.0f);
-    float here = (float)step;
-    if (size > 0) {
-      // Algorithm 1: pop while the second entry casts at least as steep a slope on the
-      // new sample as the top one; the top that remains is the horizon's occluder.
-      float2 top = stack[(size - 1) * stride];
-      float v1h = top.x - h;
-      float v1d = here - top.y;
-      while (size > 1) {
-        float2 below = stack[(size - 2) * stride];
-        float v2h = below.x - h;
-        float v2d = here - below.y;
-        if (v2h * v1d >= v1h * v2d) {
-          top = below;
-          v1h = v2h;
-          v1d = v2d;
-          --size;
-        } else {
-          break;
-        }
-      }
-      occluder = top;
-    }
-    stack[size * stride] = (float2)(h, here);
-    ++size;
-    *entry = (float2)(occluder.x - h, occluder.y);
-  }
+  for (int step = 0; step < d.n_steps; ++step, entry += stride) hull_stack_step(entry, stack, stride, &size, step);
 }
 
 // Unit normal at pixel (c, r): the normalised sum of the unnormalised normals of the (up to)

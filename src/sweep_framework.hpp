@@ -12,10 +12,10 @@
 
 namespace hfvis::detail {
 
-constexpr std::size_t kLineGroup = 64;              // work-items per group along lines
-constexpr std::size_t kPresampleRows = 4;           // rows of a presampling work-group
-constexpr std::size_t kTileX = 16, kTileY = 4;      // pixel tile of per-pixel kernels
-constexpr int kMaxDirectionsPerBatch = 32;          // bounds kernel time, paces progress
+constexpr std::size_t kLineGroup = 64;          // work-items per group along lines
+constexpr std::size_t kPresampleRows = 4;       // rows of a presampling work-group
+constexpr std::size_t kTileX = 16, kTileY = 4;  // pixel tile of per-pixel kernels
+constexpr int kMaxDirectionsPerBatch = 32;      // bounds kernel time, paces progress
 
 inline std::size_t roundUp(std::size_t n, std::size_t m) { return (n + m - 1) / m * m; }
 
@@ -40,11 +40,13 @@ struct SweepMemory {
 // line-major on CPUs, step-major elsewhere; the environment variable
 // HFVIS_LINE_LAYOUT=line|step overrides (for benchmarks).
 bool lineMajorLayout(const DeviceInfo& device);
-std::string layoutProgramOption(const DeviceInfo& device);  // "-DHFVIS_LINE_MAJOR=0|1"
+// "-DHFVIS_LINE_MAJOR=0|1" for a device.
+std::string layoutProgramOption(const DeviceInfo& device);
 
 // Index of entry (line, step) of d, as line_entry() in the kernels.
 inline std::size_t lineEntry(const SweepDirection& d, int line, int step, bool line_major) {
-  return d.buffer_offset + (line_major ? std::size_t(line) * d.n_steps + step : std::size_t(step) * d.n_lines + line);
+  return d.buffer_offset +
+         (line_major ? std::size_t(line) * d.n_steps + step : std::size_t(step) * d.n_lines + line);
 }
 
 // The budget when the caller gives none: half the device memory, at most 1 GiB.
@@ -64,7 +66,8 @@ cl::Buffer uploadDirections(ContextState& st, const std::vector<SweepDirection>&
 
 // Launches presample_lines of `program` (any program including sweep_framework.cl) over
 // the batch: every (step, line) of every direction gets its height, NaN where absent.
-void enqueuePresample(ContextState& st, cl::Program& program, const cl::Buffer& heights, int width, int height,
-                      const cl::Buffer& directions, const SweepBatch& batch, const cl::Buffer& lines);
+void enqueuePresample(ContextState& st, cl::Program& program, const cl::Buffer& heights, int width,
+                      int height, const cl::Buffer& directions, const SweepBatch& batch,
+                      const cl::Buffer& lines);
 
 }  // namespace hfvis::detail
