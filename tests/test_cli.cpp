@@ -284,6 +284,26 @@ TEST_F(Cli, DevicesListsAndMarksTheAutomaticChoice) {
   EXPECT_NE(result.out.find("\n* "), std::string::npos) << "no device marked:\n" << result.out;
 }
 
+TEST_F(Cli, NoOpenClPlatformSaysWhichPackageProvidesOne) {
+  // ocl-icd reads its vendor list from OCL_ICD_VENDORS: an empty directory means no
+  // platform at all, as on a machine without any OpenCL driver.
+  fs::create_directories(root_ / "no_vendors");
+  const std::string no_platform = "OCL_ICD_VENDORS=" + shellQuoted((root_ / "no_vendors").string()) + " ";
+  for (const std::string& args :
+       {std::string("devices"), "svf " + shellQuoted(ramp()) + " -o " + shellQuoted(out("o.exr")) + " -k 4"}) {
+    const fs::path err_file = root_ / "stderr.txt";
+    const std::string command = no_platform + shellQuoted(HFVIS_CLI_PATH) + " " + args + " >/dev/null 2>" +
+                                shellQuoted(err_file.string()) + " </dev/null";
+    const int raw = std::system(command.c_str());
+    ASSERT_TRUE(raw != -1 && WIFEXITED(raw)) << args;
+    EXPECT_EQ(WEXITSTATUS(raw), 1) << args;
+    const std::string err = readText(err_file);
+    EXPECT_NE(err.find("no OpenCL platform"), std::string::npos) << err;
+    EXPECT_NE(err.find("pocl-opencl-icd"), std::string::npos) << err;
+    EXPECT_TRUE(listDirectory(outputs()).empty());
+  }
+}
+
 // ---- successful runs ----
 
 TEST_F(Cli, HorizonWritesOneChannelPerDirection) {
