@@ -137,8 +137,13 @@ HFVIS_INLINE void emit_direction(int b, uint pixel, uint plane, float elevation,
 #if HFVIS_WANT_DISTANCES
   distances[(uint)b * plane + pixel] = distance;
 #endif
+  // Only what is asked for: PoCL keeps unused terms alive across the barriers.
+#if HFVIS_WANT_SVF
   *svf += hf_sin(fmax(0.0f, elevation));
+#endif
+#if HFVIS_WANT_AO
   *ao += ambient_term(elevation, nx, ny, nz, d.cos_azimuth, d.sin_azimuth);
+#endif
 }
 
 // Adds the batch's sums to the run's accumulators; NaN at nodata receivers.
@@ -216,8 +221,9 @@ __kernel void horizon_reduce(__global const float* heights, int width, int heigh
 // Naive method (Timonen 2013, Sec. 1): for every pixel, march the ray in steps of
 // step_length pixels, sample bilinearly and keep the steepest slope. The trip count is
 // the same for the whole work-group (the longest ray of the group's tile, found in closed
-// form because the exit distance separates into a column and a row term), so PoCL can
-// vectorise the march across work-items; samples outside the field are masked.
+// form because the exit distance separates into a column and a row term), so the march
+// can run in lock-step across work-items and vectorise; samples outside the field are
+// masked.
 // Global size: (W, H) rounded up to the local size; the tile is the work-group.
 __kernel void horizon_naive(__global const float* heights, int width, int height, float cell_x, float cell_y,
                             __global const SweepDirection* directions, int batch_size,
@@ -250,6 +256,10 @@ __kernel void horizon_naive(__global const float* heights, int width, int height
     float best_rise = 0.0f;  // height gain to the steepest sample so far
     int best_step = 0;       // its step, 0 = none yet
     for (int i = 1; i <= steps; ++i) {
+      // `steps` is the same for the whole work-group, so every work-item reaches this
+      // barrier; it makes PoCL run the work-items inside each step, the one loop it
+      // vectorises: 5x faster there (1.05 -> 0.20 s, 256^2 fractal, K = 8, one thread).
+      barrier(CLK_LOCAL_MEM_FENCE);
       float t = (float)i * d.step_length;
       float px = (float)cc + t * d.dir_x, py = (float)rr + t * d.dir_y;
       float q = sample_height(heights, width, height, px, py);
