@@ -5,10 +5,10 @@
 #include <cmath>
 #include <limits>
 
+#include "fast_math.hpp"
 #include "hfvis/reference.hpp"
 #include "horizon_common.hpp"
 #include "reference_internal.hpp"
-#include "fast_math.hpp"
 
 namespace hfvis {
 namespace detail {
@@ -38,6 +38,21 @@ Normal surfaceNormal(const std::vector<float>& h, int width, int height, int c, 
   if (!(nz > 0.0f)) return {};
   const float len = std::sqrt(nx * nx + ny * ny + nz * nz);
   return {nx / len, ny / len, nz / len};
+}
+
+// Every pixel's normal, as the kernels compute it (only needed for ambient occlusion).
+std::vector<Normal> pixelNormals(const HeightField& field, const std::vector<float>& h, bool wanted) {
+  std::vector<Normal> normals(field.pixelCount());
+  if (!wanted) return normals;
+  const auto cell_x = static_cast<float>(field.cell_size_x), cell_y = static_cast<float>(field.cell_size_y);
+  for (int r = 0; r < field.height; ++r) {
+    for (int c = 0; c < field.width; ++c) {
+      const std::size_t pixel = static_cast<std::size_t>(r) * field.width + c;
+      if (!std::isnan(h[pixel]))
+        normals[pixel] = surfaceNormal(h, field.width, field.height, c, r, h[pixel], cell_x, cell_y);
+    }
+  }
+  return normals;
 }
 
 float ambientTerm(float elevation, Normal n, float cos_az, float sin_az, int directions) {
@@ -74,7 +89,7 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
                     const HorizonOutputs& outputs, HorizonResult& result) {
   const int width = field.width, height = field.height;
   const auto& h = prepared.heights;
-  const auto cell_x = static_cast<float>(field.cell_size_x), cell_y = static_cast<float>(field.cell_size_y);
+  const auto normals = pixelNormals(field, h, outputs.ambient_occlusion);
   const auto directions = runDirections(field, options);
   // Directions one at a time; the kernels sum per batch first, so the sums may differ from
   // the kernels' in the last bits.
@@ -86,9 +101,6 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
       for (int c = 0; c < width; ++c) {
         const std::size_t pixel = static_cast<std::size_t>(r) * width + c;
         const float hp = h[pixel];
-        const Normal n = (outputs.ambient_occlusion && !std::isnan(hp))
-                             ? surfaceNormal(h, width, height, c, r, hp, cell_x, cell_y)
-                             : Normal{};
         const float x = static_cast<float>(c), y = static_cast<float>(r);
         const float t = x * d.dir_x + y * d.dir_y;
         const float u = (x * d.perp_x + y * d.perp_y) * d.lines_per_unit - static_cast<float>(d.line_first);
@@ -112,7 +124,7 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
         float distance = weight > 0.0f ? distance_sum / weight : 0.0f;
         if (std::isnan(hp)) elevation = distance = kNaN;
         PixelSums one;
-        emitDirection(result, k, pixel, elevation, distance, n, d, options.directions, one);
+        emitDirection(result, k, pixel, elevation, distance, normals[pixel], d, options.directions, one);
         sums[pixel].svf += one.svf;
         sums[pixel].ao += one.ao;
       }
@@ -125,15 +137,12 @@ void naiveReference(const HeightField& field, const PreparedHeights& prepared, c
                     const HorizonOutputs& outputs, HorizonResult& result) {
   const int width = field.width, height = field.height;
   const auto& h = prepared.heights;
-  const auto cell_x = static_cast<float>(field.cell_size_x), cell_y = static_cast<float>(field.cell_size_y);
+  const auto normals = pixelNormals(field, h, outputs.ambient_occlusion);
   const auto directions = runDirections(field, options);
   for (int r = 0; r < height; ++r) {
     for (int c = 0; c < width; ++c) {
       const std::size_t pixel = static_cast<std::size_t>(r) * width + c;
       const float hp = h[pixel];
-      const Normal n = (outputs.ambient_occlusion && !std::isnan(hp))
-                           ? surfaceNormal(h, width, height, c, r, hp, cell_x, cell_y)
-                           : Normal{};
       PixelSums sums;
       for (int k = 0; k < options.directions; ++k) {
         const SweepDirection& d = directions[k];
@@ -157,7 +166,7 @@ void naiveReference(const HeightField& field, const PreparedHeights& prepared, c
         float elevation = best_step > 0 ? hfAtan2Ahead(best_rise, ground) : -0.5f * kPi;
         float distance = best_step > 0 ? ground : 0.0f;
         if (std::isnan(hp)) elevation = distance = kNaN;
-        emitDirection(result, k, pixel, elevation, distance, n, d, options.directions, sums);
+        emitDirection(result, k, pixel, elevation, distance, normals[pixel], d, options.directions, sums);
       }
       accumulatePixel(result, pixel, std::isnan(hp), sums);
     }
