@@ -1,0 +1,96 @@
+// hfvis/intervisibility.hpp: visibility between all points of a height field: for every
+// receiver, the number of surface samples it sees summed over K azimuthal directions, the
+// visible ground area estimated from them ("total viewshed"), and the convex hull tree's
+// statistics (Timonen 2013, Table 2).
+//
+// Conventions (../shared/DESIGN.md): direction k of K has azimuth
+// phi_k = 2*pi*k/K + azimuth_offset on the ground, in the (column, row) axes. Along
+// direction k, receiver p sees the surface samples q = p + i * step * d_k, i >= 1, inside
+// the field (bilinear heights, nodata samples absent). Tie rule: q is visible when its
+// slope from p is >= the slope of every sample strictly between them (grazing samples are
+// visible; on a flat plane every sample is). Decided exactly, so the sweep, the naive
+// march and brute force agree sample for sample on identical samples.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "hfvis/device.hpp"
+#include "hfvis/height_field.hpp"
+
+namespace hfvis {
+
+enum class IntervisibilityMethod {
+  HullTree,  // convex hull tree sweep, one work-item per line (Timonen 2013, Algorithm 1)
+  Naive,     // per-pixel visibility march, bilinear samples: the O(N^3) baseline and oracle
+};
+
+struct IntervisibilityOptions {
+  int directions = 64;            // K >= 1
+  double azimuth_offset = 0.0;    // radians added to every phi_k
+  double samples_per_unit = 1.0;  // samples per pixel length along a line or ray, (0, 64]
+  double lines_per_unit = 1.0;    // sweep lines per pixel length across the direction, (0, 64]
+  IntervisibilityMethod method = IntervisibilityMethod::HullTree;
+  std::size_t memory_budget_bytes = 0;  // device memory for one batch; 0 = from the device
+  // Called after each batch of directions with (directions done, directions in all).
+  std::function<void(int, int)> progress;
+};
+
+// What to compute; only what is asked for is stored or reduced.
+struct IntervisibilityOutputs {
+  // Visible samples summed over the K directions, per pixel (samples at samples_per_unit
+  // per pixel length: at the default 1, one per unit length). With the hull tree, a pixel
+  // takes the bilinear interpolation of the counts of the (up to) four line samples around
+  // it (each exact for its own sample); on axis directions lines pass through the pixel
+  // centres and the count is exactly that of the pixel's own sample.
+  bool visible_count = false;
+  // Visible ground area, in ground units squared: each visible sample at ground distance
+  // rho stands for (2*pi/K) * rho * drho, drho the ground step along the direction (the
+  // ring sector it represents around the receiver).
+  bool visible_area = false;
+  // Horizon and iteration totals of the hull tree (HullTree only).
+  bool statistics = false;
+};
+
+// Totals over every receiver of every line of every direction (line samples, not pixels).
+struct IntervisibilityStatistics {
+  std::uint64_t receivers = 0;         // present line samples, each a receiver once
+  std::uint64_t lines = 0;             // lines with at least one present sample
+  std::uint64_t horizons = 0;          // sum of m_i: distinct visibility horizons
+  std::uint64_t iterations = 0;        // sum of t_i: convexity checks of Algorithm 1
+  std::uint64_t visible_samples = 0;   // sum of visible samples (Table 1's p_a * receivers)
+  std::uint64_t naive_iterations = 0;  // samples the naive method would test on the same lines
+  std::uint64_t lines_over_bound = 0;  // lines where t > 2m + n (Section 6 proves none)
+
+  double meanHorizons() const { return receivers ? double(horizons) / receivers : 0.0; }      // m_a
+  double meanIterations() const { return receivers ? double(iterations) / receivers : 0.0; }  // t_a
+  double meanVisible() const { return receivers ? double(visible_samples) / receivers : 0.0; }
+  double meanNaiveIterations() const { return receivers ? double(naive_iterations) / receivers : 0.0; }
+};
+
+struct IntervisibilityResult {
+  int width = 0;
+  int height = 0;
+  int directions = 0;
+  std::vector<double> azimuths;          // phi_k, radians
+  std::vector<float> visible_count;      // width*height if asked; NaN at nodata receivers
+  std::vector<float> visible_area;       // width*height if asked; NaN at nodata receivers
+  IntervisibilityStatistics statistics;  // if asked
+};
+
+// Azimuth of direction k, in radians.
+double intervisibilityAzimuth(int k, const IntervisibilityOptions& options);
+
+// Throws InvalidArgument for K < 1, sampling densities outside (0, 64], a non-finite
+// azimuth offset, no output requested, or statistics asked of the naive method.
+void validate(const IntervisibilityOptions& options, const IntervisibilityOutputs& outputs);
+
+// Runs options.method on the device of `context`. Throws InvalidArgument (bad field or
+// options), MemoryBudgetError (one direction does not fit), OpenClError, KernelBuildError.
+IntervisibilityResult computeIntervisibility(const ComputeContext& context, const HeightField& field,
+                                             const IntervisibilityOptions& options,
+                                             const IntervisibilityOutputs& outputs);
+
+}  // namespace hfvis

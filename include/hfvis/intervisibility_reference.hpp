@@ -1,0 +1,18 @@
+// hfvis/intervisibility_reference.hpp: scalar C++ references of the intervisibility
+// kernels: the same convex hull tree, the same samples, the same exact predicate, one line
+// or pixel at a time on the host. The oracles of the tests and baselines of the benchmark.
+#pragma once
+
+#include "hfvis/intervisibility.hpp"
+
+namespace hfvis {
+
+// options.method chooses the reference: the hull-tree sweep with its reduction, or the
+// naive per-pixel march. progress and memory_budget_bytes are ignored. Per-line results
+// equal the kernels' exactly; per-pixel sums may differ in the last bits (the kernels sum
+// a batch of directions before adding it).
+IntervisibilityResult referenceIntervisibility(const HeightField& field,
+                                               const IntervisibilityOptions& options,
+                                               const IntervisibilityOutputs& outputs);
+
+}  // namespace hfvis

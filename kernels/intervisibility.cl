@@ -1,0 +1,523 @@
+// intervisibility.cl: visibility between all points along sweep lines by the convex hull
+// tree (Timonen 2013, Algorithm 1 with segment starts per Eq. 1 and leaf duplication),
+// the visible count per receiver derived from its visibility horizons, the reduction that
+// rotates line buffers back onto the grid, and the naive per-pixel visibility march
+// (baseline and oracle).
+//
+// Visibility (the tie rule, the same everywhere, tests included): on one line, a farther
+// sample q is visible from receiver p when no sample strictly between them lies strictly
+// above the chord from q to p; equivalently q's slope from p is >= the slope of every
+// sample in between. Grazing samples are visible, so on a flat plane everything is. Only
+// present samples count (outside the field or without a valid corner: absent). Every
+// geometric decision is chord_side(), an exact sign, so the tree, the scalar reference and
+// the brute-force oracles agree exactly (see src/chord_side.hpp for why).
+//
+// Heights arrive offset and z-scaled (see prepareHeights); NaN = nodata.
+//
+// Compile-time parameters, besides those of sweep_framework.cl:
+//   HFVIS_WANT_AREA         sum the distances of the visible samples (for the area estimate)
+//   HFVIS_WANT_STATS        per-line totals of receivers, horizons, iterations, ...
+//   HFVIS_WANT_ENTRY_STATS  per-entry (horizons, iterations, horizon hash) for the tests
+#include "sweep_framework.cl"
+
+#ifndef HFVIS_WANT_AREA
+#define HFVIS_WANT_AREA 1
+#endif
+#ifndef HFVIS_WANT_STATS
+#define HFVIS_WANT_STATS 1
+#endif
+#ifndef HFVIS_WANT_ENTRY_STATS
+#define HFVIS_WANT_ENTRY_STATS 0
+#endif
+
+// The exact predicate's fallback is rare but long: inlined at every call site it made the
+// sweep 30 % slower (code size), so it stays a call.
+#ifndef HFVIS_NOINLINE
+#define HFVIS_NOINLINE __attribute__((noinline))
+#endif
+
+#define HFVIS_NONE (-1)
+#define HFVIS_CONCAVE 0
+#define HFVIS_CONVEX 1
+#define HFVIS_LINE_TOTALS 8  // ulongs per line in line_totals
+
+// ---------------------------------------------------------------------------------------
+// The exact predicate (mirror of src/chord_side.hpp).
+
+#define HFVIS_CHORD_ERROR_BOUND ((3.0f + 16.0f * 0x1p-24f) * 0x1p-24f)
+#define HFVIS_CHORD_FILTER_FLOOR 0x1p-100f
+
+// a + b = *s + *err exactly (Knuth's branch-free TwoSum).
+HFVIS_INLINE void two_sum(float a, float b, float* s, float* err) {
+  float sum = a + b;
+  float bb = sum - a;
+  *err = (a - (sum - bb)) + (b - bb);
+  *s = sum;
+}
+
+// q + e = new q + new e exactly: one step of Shewchuk's Grow-Expansion.
+#define HFVIS_GROW(q, e)         \
+  {                              \
+    float sum_, err_;            \
+    two_sum(q, e, &sum_, &err_); \
+    e = err_;                    \
+    q = sum_;                    \
+  }
+
+HFVIS_INLINE int sign_of(float v) { return v > 0.0f ? 1 : v < 0.0f ? -1 : 0; }
+
+// Exact sign of hb * dac - ha * dbc - hc * dab: fma splits each product exactly into
+// (product, rounding error); Grow-Expansion (Shewchuk) sums the six terms into a
+// nonoverlapping expansion e0..e5 of increasing magnitude, whose largest nonzero
+// component has the sign of the whole. Straight-line (unrolled, selects only): it
+// keeps no private array; the same operations as the loops of src/chord_side.hpp.
+HFVIS_NOINLINE int exact_chord_side(float ha, float hb, float hc, float dab, float dbc, float dac) {
+  float p1 = hb * dac, p2 = ha * dbc, p3 = hc * dab;
+  float e0 = fma(hb, dac, -p1), e1 = p1, e2, e3, e4, e5, q;
+  q = -fma(ha, dbc, -p2);
+  HFVIS_GROW(q, e0) HFVIS_GROW(q, e1) e2 = q;
+  q = -p2;
+  HFVIS_GROW(q, e0) HFVIS_GROW(q, e1) HFVIS_GROW(q, e2) e3 = q;
+  q = -fma(hc, dab, -p3);
+  HFVIS_GROW(q, e0) HFVIS_GROW(q, e1) HFVIS_GROW(q, e2) HFVIS_GROW(q, e3) e4 = q;
+  q = -p3;
+  HFVIS_GROW(q, e0) HFVIS_GROW(q, e1) HFVIS_GROW(q, e2) HFVIS_GROW(q, e3) HFVIS_GROW(q, e4) e5 = q;
+  return e5 != 0.0f   ? sign_of(e5)
+         : e4 != 0.0f ? sign_of(e4)
+         : e3 != 0.0f ? sign_of(e3)
+         : e2 != 0.0f ? sign_of(e2)
+         : e1 != 0.0f ? sign_of(e1)
+                      : sign_of(e0);
+}
+
+// Sign of sample b relative to the chord from a to c (a, b, c in line order, b - a = dab
+// and c - b = dbc steps, integers below 2^24): +1 strictly above, 0 on it, -1 below.
+HFVIS_INLINE int chord_side(float ha, float hb, float hc, float dab, float dbc) {
+  if (ha == hc && hb == hc) return 0;
+  float dac = dab + dbc;
+  float p1 = (hb - hc) * dac;
+  float p2 = (ha - hc) * dbc;
+  float det = p1 - p2;
+  float magnitude = fabs(p1) + fabs(p2);
+  if (magnitude >= HFVIS_CHORD_FILTER_FLOOR) {
+    float bound = HFVIS_CHORD_ERROR_BOUND * magnitude;
+    if (det > bound) return 1;
+    if (-det > bound) return -1;
+  }
+  return exact_chord_side(ha, hb, hc, dab, dbc, dac);
+}
+
+// The float filter of chord_side() alone, branch-free: returns whether it decides, and
+// then *side is the exact sign. For the naive march, whose straight-line loop PoCL
+// vectorises across work-items; rays with an undecided step are marched again with
+// chord_side().
+HFVIS_INLINE int chord_side_filter(float ha, float hb, float hc, float dab, float dbc, int* side) {
+  float dac = dab + dbc;
+  float p1 = (hb - hc) * dac;
+  float p2 = (ha - hc) * dbc;
+  float det = p1 - p2;
+  float magnitude = fabs(p1) + fabs(p2);
+  int flat = ha == hc && hb == hc;
+  *side = flat ? 0 : sign_of(det);
+  return flat || (magnitude >= HFVIS_CHORD_FILTER_FLOOR && fabs(det) > HFVIS_CHORD_ERROR_BOUND * magnitude);
+}
+
+// ---------------------------------------------------------------------------------------
+// The convex hull tree sweep.
+//
+// Tree nodes of line j live at trees[line_entry(d, j, k)] as int4 (height bits,
+// rank * 2 + leaf flag, first child, next sibling), the node of the sample at step k in
+// slot k, links by slot, HFVIS_NONE for none. So a line's tree needs one slot per step: the
+// tree buffer is as large as the line buffer. The rank (present samples before it) counts
+// run lengths without another read. The leaf flag marks a segment start (Eq. 1: the first
+// present sample, and every convex sample after a concave one), whose node is never
+// deleted: it starts the convex hull path of its segment.
+//
+// Leaf duplication (Sec. 5) with twins merged: when a segment start is detected, its own
+// node may still be in the tree (the old root kept a child and is the root's last child).
+// The paper then adds a leaf copy beside it; the two are siblings with the same geometry,
+// so every convexity check treats them alike, forever. Here that node is flagged instead,
+// and a leaf is created (in the sample's own, now free, slot) only when the node was
+// deleted. Same tree, same horizons, no duplicate horizons, no iterations spent on twins;
+// and Sec. 6's bound t <= 2m + n then holds with m = distinct horizons (with separate twins
+// it held only counting each twin: 7 lines of blocks_256 at K = 64 exceeded it).
+//
+// Children are ordered farthest first. The root's children are the receiver's visibility
+// horizons, one per segment start j: the farthest sample of maximal slope from the
+// receiver among samples j .. receiver - 1.
+
+#define HFVIS_LEAF 1  // bit 0 of node.y
+
+// Whether sample x (farther than the next horizon n) is seen over n from receiver r.
+inline int seen_over(float hx, int x, float hn, int n, float hr, int r) {
+  return chord_side(hx, hn, hr, (float)(n - x), (float)(r - n)) <= 0;
+}
+
+// The visible samples between horizon `start` and the next horizon `next` form a prefix
+// (every start of a visible run is a horizon), and are exactly those seen over `next`.
+// Returns the step that ends the prefix: the first present sample hidden behind `next`,
+// or `next`. Without absent samples in between, galloping then bisection (O(log run));
+// otherwise a scan.
+inline int run_end(__global const float2* samples, uint stride, int start, int next, float h_next,
+                   int receiver, float h_receiver, int holes) {
+  if (!holes) {
+    int lo = start, hi = next, jump = 1;
+    while (lo + jump < hi) {
+      int x = lo + jump;
+      if (seen_over(samples[(uint)x * stride].x, x, h_next, next, h_receiver, receiver)) {
+        lo = x;
+        jump *= 2;
+      } else {
+        hi = x;
+        break;
+      }
+    }
+    while (hi - lo > 1) {
+      int mid = lo + (hi - lo) / 2;
+      if (seen_over(samples[(uint)mid * stride].x, mid, h_next, next, h_receiver, receiver))
+        lo = mid;
+      else
+        hi = mid;
+    }
+    return hi;
+  }
+  for (int x = start + 1; x < next; ++x) {
+    float hx = samples[(uint)x * stride].x;
+    if (!isnan(hx) && !seen_over(hx, x, h_next, next, h_receiver, receiver)) return x;
+  }
+  return next;
+}
+
+// One work-item per line. Reads the presampled heights (lines[].x, left intact) and writes:
+//   lines[].y    the rank of the step: present samples before it (run lengths across holes),
+//   visible[]    (visible samples, sum of their distances in steps), NaN where absent,
+//   prefix[]     sum of the steps of the present samples before it (mod 2^32), if AREA,
+//   entry_stats[] (horizons m, iterations t, horizon hash, 0), if ENTRY_STATS,
+//   line_totals[(b * totals_stride + j) * 8 + ...] (receivers, sum m, sum t, naive
+//                iterations, visible samples, 0, 0, 0), if STATS.
+// Preconditions: lines presampled by presample_lines; a line has fewer than 2^24 steps and
+// the distance sum of a receiver stays below 2^32 (checkLineLimits). Memory safety does not
+// rest on the predicate: leaves are never deleted and a node only when childless, so every
+// subtree holds a leaf and the root never loses all children; a slot is reused only for
+// the deleted old root.
+// Global size: (max lines, directions in batch).
+__kernel void intervisibility_sweep(__global const SweepDirection* directions, __global float2* lines,
+                                    __global int4* trees, __global float2* visible, __global uint* prefix,
+                                    __global uint4* entry_stats, __global ulong* line_totals,
+                                    int totals_stride) {
+  const int line = get_global_id(0);
+  const int b = get_global_id(1);
+  const SweepDirection d = load_direction(directions + b);
+  if (line >= d.n_lines) return;
+  // Entry of step k of this line: base + k * stride, in either line-buffer layout.
+  const uint stride = line_stride(d);
+  const uint base = line_entry(d, line, 0);
+  __global float2* samples = lines + base;
+  __global int4* tree = trees + base;
+  __global float2* out = visible + base;
+
+  int rank = 0;       // present samples before `step`
+  uint step_sum = 0;  // the sum of their steps
+  int root = HFVIS_NONE;
+  int prev = HFVIS_NONE, prev2 = HFVIS_NONE;  // the two latest present samples
+  float h_prev = 0.0f, h_prev2 = 0.0f;
+  int class_last = HFVIS_CONVEX;  // Eq. 1 class of prev2 (the first sample is convex)
+  ulong total_m = 0, total_t = 0, total_naive = 0, total_visible = 0;
+
+  for (int step = 0; step < d.n_steps; ++step) {
+    const uint e = (uint)step * stride;
+    const float h = samples[e].x;
+    samples[e].y = (float)rank;
+#if HFVIS_WANT_AREA
+    prefix[base + e] = step_sum;
+#endif
+    if (isnan(h)) {
+      out[e] = (float2)(NAN, NAN);
+#if HFVIS_WANT_ENTRY_STATS
+      entry_stats[base + e] = (uint4)(0u, 0u, 0u, 0u);
+#endif
+      continue;
+    }
+    uint m = 0, t = 0, hash = 2166136261u;
+    int count = 0;
+    uint distance_sum = 0;
+    if (root == HFVIS_NONE) {
+      tree[e] = (int4)(as_int(h), HFVIS_LEAF, HFVIS_NONE, HFVIS_NONE);  // rank 0
+    } else {
+      // 1. Algorithm 1 for the new root: the old root is its only child; every child that
+      // fails the convexity check (child -> parent -> root) joins the root before its
+      // parent, its own children are checked in turn, and a parent left without children
+      // is deleted (leaves never are). Done as a post-order walk that appends the root's
+      // new children in order; the walk's stack is threaded through the `next` links of the
+      // nodes on it (a detached child's sibling link is free until it is appended).
+      int head = HFVIS_NONE, tail = HFVIS_NONE;
+      int cur = root;
+      int4 node = tree[(uint)cur * stride];
+      for (;;) {
+        const int c = node.z;
+        if (c != HFVIS_NONE) {
+          int4 child = tree[(uint)c * stride];
+          ++t;
+          // Convex when the parent lies strictly above the chord from the child to the root.
+          const int side =
+              chord_side(as_float(child.x), as_float(node.x), h, (float)(cur - c), (float)(step - cur));
+          if (side <= 0) {
+            tree[(uint)cur * stride].z = child.w;  // the next child becomes the first
+            tree[(uint)c * stride].w = cur;        // back link to resume the parent
+            child.w = cur;
+            cur = c;
+            node = child;
+            continue;
+          }
+        }
+        const int parent = node.w;
+        if (c != HFVIS_NONE || (node.y & HFVIS_LEAF)) {  // keeps a child, or is a leaf: a root child
+          if (tail == HFVIS_NONE)
+            head = cur;
+          else
+            tree[(uint)tail * stride].w = cur;
+          tail = cur;
+        }
+        if (parent == HFVIS_NONE) break;
+        cur = parent;
+        node = tree[(uint)cur * stride];
+      }
+
+      // 2. Now that the old root's next sample is known, classify it (Eq. 1). A convex
+      // sample after a concave one starts a segment: if its node survived it is the root's
+      // last child and becomes a leaf; otherwise a new leaf becomes the last child.
+      if (prev2 != HFVIS_NONE) {
+        const int side = chord_side(h_prev2, h_prev, h, (float)(prev - prev2), (float)(step - prev));
+        const int cls = side > 0 ? HFVIS_CONVEX : side < 0 ? HFVIS_CONCAVE : class_last;
+        if (cls == HFVIS_CONVEX && class_last == HFVIS_CONCAVE) {
+          if (tail == prev) {
+            tree[(uint)prev * stride].y = (rank - 1) * 2 + HFVIS_LEAF;
+          } else {
+            tree[(uint)prev * stride] =
+                (int4)(as_int(h_prev), (rank - 1) * 2 + HFVIS_LEAF, HFVIS_NONE, HFVIS_NONE);
+            tree[(uint)tail * stride].w = prev;
+            tail = prev;
+          }
+        }
+        class_last = cls;
+      }
+      tree[(uint)tail * stride].w = HFVIS_NONE;
+      tree[e] = (int4)(as_int(h), rank * 2, head, HFVIS_NONE);
+
+      // 3. Visible samples from the horizons, farthest first: the run of horizon hp ends
+      // at run_end() before the next horizon np, or at the receiver. Without absent
+      // samples in between, ranks and distance sums follow from the steps alone.
+      int hp = head;
+      int4 hz = tree[(uint)hp * stride];
+      int hp_rank = hz.y >> 1;
+      for (;;) {
+        const int np = hz.w;
+        ++m;
+        hash = (hash ^ (uint)hp) * 16777619u;
+        int end = step, end_rank = rank, np_rank = rank;
+        int4 nz = hz;
+        if (np != HFVIS_NONE) {
+          nz = tree[(uint)np * stride];
+          np_rank = nz.y >> 1;
+          end = np;
+          end_rank = np_rank;
+        }
+        const int holes = end_rank - hp_rank != end - hp;
+        if (np != HFVIS_NONE) {
+          end = run_end(samples, stride, hp, np, as_float(nz.x), step, h, holes);
+          end_rank = end == np ? np_rank : holes ? (int)samples[(uint)end * stride].y : hp_rank + (end - hp);
+        }
+        const int run = end_rank - hp_rank;
+        count += run;
+#if HFVIS_WANT_AREA
+        // Sum of (step - x) over the run's present samples x, mod 2^32 (the total is below).
+        uint steps_sum;
+        if (!holes) {  // x = hp .. end - 1: run * (hp + end - 1) / 2, halving the even factor
+          const uint a = (uint)run, b = (uint)(hp + end - 1);
+          steps_sum = (a & 1u) ? a * (b >> 1) : (a >> 1) * b;
+        } else {
+          const uint end_sum = end == step ? step_sum : prefix[base + (uint)end * stride];
+          steps_sum = end_sum - prefix[base + (uint)hp * stride];
+        }
+        distance_sum += (uint)step * (uint)run - steps_sum;
+#endif
+        if (np == HFVIS_NONE) break;
+        hz = nz;
+        hp = np;
+        hp_rank = np_rank;
+      }
+    }
+    out[e] = (float2)((float)count, (float)distance_sum);
+#if HFVIS_WANT_ENTRY_STATS
+    entry_stats[base + e] = (uint4)(m, t, hash, 0u);
+#endif
+    total_m += m;
+    total_t += t;
+    total_naive += (ulong)rank;
+    total_visible += (ulong)count;
+    prev2 = prev;
+    h_prev2 = h_prev;
+    prev = step;
+    h_prev = h;
+    root = step;
+    ++rank;
+    step_sum += (uint)step;
+  }
+#if HFVIS_WANT_STATS
+  __global ulong* totals = line_totals + ((uint)b * (uint)totals_stride + (uint)line) * HFVIS_LINE_TOTALS;
+  totals[0] = (ulong)rank;
+  totals[1] = total_m;
+  totals[2] = total_t;
+  totals[3] = total_naive;
+  totals[4] = total_visible;
+  totals[5] = 0;
+  totals[6] = 0;
+  totals[7] = 0;
+#endif
+}
+
+// ---------------------------------------------------------------------------------------
+// Reduction and the naive method.
+//
+// Visible ground area (the "total viewshed"): around receiver p, direction k stands for
+// the azimuthal sector 2*pi/K, and a sample at distance rho (ground units) along it for
+// the ring of width drho = step_length * ground_per_pixel between rho -/+ drho/2, whose
+// sector has area (2*pi/K) * rho * drho. With rho = i * drho for the sample i steps away,
+// direction k adds (2*pi/K) * drho^2 * (sum of i over the visible samples). On a flat
+// field this tends to the field's area seen from p as K grows.
+
+// Adds one direction's visible samples (count and distance sum in steps) to the sums.
+HFVIS_INLINE void add_direction(const SweepDirection d, float sector, float count, float distance_steps,
+                                float* count_sum, float* area_sum) {
+  float ground = d.step_length * d.ground_per_pixel;
+  *count_sum += count;
+  *area_sum += sector * ground * ground * distance_steps;
+}
+
+HFVIS_INLINE void accumulate_visible(uint pixel, int nodata, float count, float area,
+                                     __global float* count_sum, __global float* area_sum) {
+  count_sum[pixel] = nodata ? NAN : count_sum[pixel] + count;
+#if HFVIS_WANT_AREA
+  area_sum[pixel] = nodata ? NAN : area_sum[pixel] + area;
+#endif
+}
+
+// Reduction: for every receiver pixel and every direction of the batch, the bilinear
+// interpolation of the (count, distance sum) of the (up to) four surrounding line entries,
+// each exact for its own sample; absent entries are left out and the weights renormalised
+// (none left: nothing seen in that direction). On axis directions every pixel is a line
+// sample (weight 1 on one entry), so the result is exactly that sample's count.
+// `sector` = 2*pi/K. Straight-line code (clamped reads, masked sums, a uniform barrier)
+// so that PoCL vectorises it, as horizon_reduce. Global size: (W, H) rounded up to the
+// local size.
+__kernel void intervisibility_reduce(__global const float* heights, int width, int height,
+                                     __global const SweepDirection* directions, int batch_size, float sector,
+                                     __global const float2* visible, __global float* count_sum,
+                                     __global float* area_sum) {
+  int c = get_global_id(0), r = get_global_id(1);
+  int valid = c < width && r < height;
+  int cc = min(c, width - 1), rr = min(r, height - 1);
+  const uint pixel = (uint)(rr * width + cc);
+  float counts = 0.0f, area = 0.0f;
+  for (int b = 0; b < batch_size; ++b) {
+    barrier(CLK_LOCAL_MEM_FENCE);  // see horizon_reduce: keeps the work-item loop innermost
+    const SweepDirection d = load_direction(directions + b);
+    float x = (float)cc, y = (float)rr;
+    float t = x * d.dir_x + y * d.dir_y;
+    float u = (x * d.perp_x + y * d.perp_y) * d.lines_per_unit - (float)d.line_first;
+    float v = (float)d.step_top - t * d.samples_per_unit;
+    int j0 = (int)floor(u), i0 = (int)floor(v);
+    float fu = u - (float)j0, fv = v - (float)i0;
+    float weight = 0.0f, count = 0.0f, distance = 0.0f;
+    for (int k = 0; k < 4; ++k) {
+      int j = j0 + (k & 1), i = i0 + (k >> 1);
+      float w = ((k & 1) ? fu : 1.0f - fu) * ((k >> 1) ? fv : 1.0f - fv);
+      int in_buffer = j >= 0 && j < d.n_lines && i >= 0 && i < d.n_steps;
+      __global const float* seen = (__global const float*)(visible + line_entry(d, clamp(j, 0, d.n_lines - 1),
+                                                                                clamp(i, 0, d.n_steps - 1)));
+      float seen_count = seen[0], seen_distance = seen[1];  // scalar loads, for the vectoriser
+      int use = w > 0.0f && in_buffer && !isnan(seen_count);
+      weight += use ? w : 0.0f;
+      count += use ? w * seen_count : 0.0f;
+      distance += use ? w * seen_distance : 0.0f;
+    }
+    // Divide only when weights are missing: a single full weight stays exact.
+    int renormalise = weight > 0.0f && weight != 1.0f;
+    count = renormalise ? count / weight : count;
+    distance = renormalise ? distance / weight : distance;
+    add_direction(d, sector, count, distance, &counts, &area);
+  }
+  if (valid) accumulate_visible(pixel, isnan(heights[pixel]), counts, area, count_sum, area_sum);
+}
+
+// Naive method (Timonen 2013, Sec. 1): for every pixel, march the ray in steps of
+// step_length pixels, sample bilinearly, and count the samples that reach the steepest
+// slope so far (the same tie rule and predicate as the sweep). The trip count is uniform
+// over the work-group (the longest ray of its tile), as in horizon_naive; samples outside
+// the field are masked. Global size: (W, H) rounded up to the local size.
+__kernel void intervisibility_naive(__global const float* heights, int width, int height,
+                                    __global const SweepDirection* directions, int batch_size, float sector,
+                                    __global float* count_sum, __global float* area_sum) {
+  int c = get_global_id(0), r = get_global_id(1);
+  int c_lo = get_group_id(0) * get_local_size(0), r_lo = get_group_id(1) * get_local_size(1);
+  int c_hi = min(c_lo + (int)get_local_size(0), width) - 1;
+  int r_hi = min(r_lo + (int)get_local_size(1), height) - 1;
+  int valid = c < width && r < height;
+  int cc = min(c, width - 1), rr = min(r, height - 1);
+  const uint pixel = (uint)(rr * width + cc);
+  float h = heights[pixel];
+  float counts = 0.0f, area = 0.0f;
+  for (int b = 0; b < batch_size; ++b) {
+    const SweepDirection d = load_direction(directions + b);
+    const float far = (float)(width + height);
+    float reach_x = d.dir_x > 0.0f   ? ((float)(width - 1) - (float)c_lo) / d.dir_x
+                    : d.dir_x < 0.0f ? (float)c_hi / -d.dir_x
+                                     : far;
+    float reach_y = d.dir_y > 0.0f   ? ((float)(height - 1) - (float)r_lo) / d.dir_y
+                    : d.dir_y < 0.0f ? (float)r_hi / -d.dir_y
+                                     : far;
+    int steps = (int)(fmin(fmin(reach_x, reach_y), far) * d.samples_per_unit) + 1;
+    float best_h = 0.0f;  // the steepest sample so far (the latest visible one)
+    int best_step = 0;    // its step, 0 = none yet
+    int count = 0, undecided = 0;
+    uint distance_sum = 0;
+    for (int i = 1; i <= steps; ++i) {
+      // `steps` is the same for the whole work-group, so every work-item reaches this
+      // barrier; it makes PoCL run the work-items inside each step, the loop it vectorises
+      // (as in horizon_naive). Only the filter runs here: an exact fallback inside would
+      // keep the loop scalar (7x slower).
+      barrier(CLK_LOCAL_MEM_FENCE);
+      float t = (float)i * d.step_length;
+      float px = (float)cc + t * d.dir_x, py = (float)rr + t * d.dir_y;
+      float q = sample_height(heights, width, height, px, py);
+      int present = inside_field(px, py, width, height) && !isnan(q);
+      int side;
+      // best_step = 0 (none yet) would make the chord degenerate; its answer is ignored.
+      int decided = chord_side_filter(q, best_h, h, (float)(i - best_step), (float)max(best_step, 1), &side);
+      undecided |= present && best_step > 0 && !decided;
+      int seen = present && (best_step == 0 || side <= 0);
+      count += seen;
+      distance_sum += seen ? (uint)i : 0u;
+      best_h = seen ? q : best_h;
+      best_step = seen ? i : best_step;
+    }
+    if (undecided) {  // a near-tie somewhere on this ray: march it again, exactly
+      best_h = 0.0f;
+      best_step = count = 0;
+      distance_sum = 0;
+      for (int i = 1; i <= steps; ++i) {
+        float t = (float)i * d.step_length;
+        float px = (float)cc + t * d.dir_x, py = (float)rr + t * d.dir_y;
+        float q = sample_height(heights, width, height, px, py);
+        if (!inside_field(px, py, width, height) || isnan(q)) continue;
+        if (best_step > 0 && chord_side(q, best_h, h, (float)(i - best_step), (float)best_step) > 0) continue;
+        ++count;
+        distance_sum += (uint)i;
+        best_h = q;
+        best_step = i;
+      }
+    }
+    add_direction(d, sector, (float)count, (float)distance_sum, &counts, &area);
+  }
+  if (valid) accumulate_visible(pixel, isnan(h), counts, area, count_sum, area_sum);
+}

@@ -1,0 +1,255 @@
+// intervisibility.cpp: the intervisibility operation on the device: presample -> convex
+// hull tree sweep -> reduction (or the naive march) per batch of directions, downloading
+// only the requested outputs.
+#include "hfvis/intervisibility.hpp"
+
+#include <algorithm>
+#include <sstream>
+
+#include "hfvis/errors.hpp"
+#include "horizon_common.hpp"
+#include "intervisibility_internal.hpp"
+#include "opencl_context.hpp"
+#include "sweep_framework.hpp"
+
+namespace hfvis {
+namespace detail {
+namespace {
+
+constexpr const char* kProgramFile = "intervisibility.cl";
+constexpr std::size_t kLineBytes = 2 * sizeof(float);     // (height, rank)
+constexpr std::size_t kNodeBytes = 4 * sizeof(int);       // tree node
+constexpr std::size_t kVisibleBytes = 2 * sizeof(float);  // (count, distance sum)
+constexpr std::size_t kPrefixBytes = sizeof(std::uint32_t);
+constexpr std::size_t kEntryStatsBytes = 4 * sizeof(std::uint32_t);
+constexpr std::size_t kLineTotals = 8;  // ulongs per line (HFVIS_LINE_TOTALS)
+
+struct ProgramFlags {
+  bool has_nodata = true;
+  bool area = true;
+  bool stats = true;
+  bool entry_stats = false;
+};
+
+std::string programOptions(const ProgramFlags& f, const DeviceInfo& device) {
+  std::ostringstream s;
+  s << "-DHFVIS_HAS_NODATA=" << f.has_nodata << " -DHFVIS_WANT_AREA=" << f.area
+    << " -DHFVIS_WANT_STATS=" << f.stats << " -DHFVIS_WANT_ENTRY_STATS=" << f.entry_stats << " "
+    << layoutProgramOption(device);
+  return s.str();
+}
+
+// The device buffers of one batch's sweep (sized for the largest batch).
+struct SweepBuffers {
+  cl::Buffer lines, trees, visible, prefix, entry_stats, line_totals;
+  int totals_stride = 0;
+};
+
+void enqueueTreeSweep(ContextState& st, cl::Program& program, const cl::Buffer& directions,
+                      const SweepBatch& batch, const SweepBuffers& b) {
+  cl::Kernel sweep(program, "intervisibility_sweep");
+  sweep.setArg(0, directions);
+  sweep.setArg(1, b.lines);
+  sweep.setArg(2, b.trees);
+  sweep.setArg(3, b.visible);
+  sweep.setArg(4, b.prefix);
+  sweep.setArg(5, b.entry_stats);
+  sweep.setArg(6, b.line_totals);
+  sweep.setArg(7, b.totals_stride);
+  st.launch(sweep, cl::NDRange(roundUp(batch.maxLines(), kLineGroup), batch.directions.size()),
+            cl::NDRange(kLineGroup, 1));
+}
+
+// Adds one batch's per-line totals (receivers, m, t, naive, visible) to the statistics.
+void addLineTotals(const std::vector<cl_ulong>& totals, const SweepBatch& batch, int stride,
+                   IntervisibilityStatistics& s) {
+  for (std::size_t b = 0; b < batch.directions.size(); ++b) {
+    for (int j = 0; j < batch.directions[b].n_lines; ++j) {
+      const cl_ulong* t = &totals[(b * stride + j) * kLineTotals];
+      s.receivers += t[0];
+      s.lines += t[0] > 0;
+      s.horizons += t[1];
+      s.iterations += t[2];
+      s.naive_iterations += t[3];
+      s.visible_samples += t[4];
+      s.lines_over_bound += t[2] > 2 * t[1] + t[0];
+    }
+  }
+}
+
+IntervisibilityResult run(const ComputeContext& context, const HeightField& field,
+                          const IntervisibilityOptions& options, const IntervisibilityOutputs& outputs) {
+  ContextState& st = context.state();
+  const PreparedHeights prepared = prepareHeights(field);
+  const auto all = intervisibilityDirections(field, options);
+  checkLineLimits(all, prepared.heights, outputs);
+  const bool tree = options.method == IntervisibilityMethod::HullTree;
+  ProgramFlags flags;
+  flags.has_nodata = prepared.has_nodata;
+  flags.area = outputs.visible_area;
+  flags.stats = outputs.statistics;
+  cl::Program program = st.program(kProgramFile, programOptions(flags, st.info));
+  const std::size_t plane = field.pixelCount();
+  int max_lines = 0;
+  for (const auto& d : all) max_lines = std::max(max_lines, d.n_lines);
+
+  const bool want_pixels = outputs.visible_count || outputs.visible_area;
+  SweepMemory memory;
+  // Heights, and the accumulators: the count (also when only the area is asked for: the
+  // reduction writes both) and the area.
+  memory.fixed_bytes = plane * sizeof(float) * (1 + want_pixels + outputs.visible_area);
+  if (tree) {
+    memory.bytes_per_entry =
+        kLineBytes + kNodeBytes + kVisibleBytes + (outputs.visible_area ? kPrefixBytes : 0);
+    memory.largest_entry_bytes = kNodeBytes;
+    memory.bytes_per_direction = outputs.statistics ? max_lines * kLineTotals * sizeof(cl_ulong) : 0;
+  }
+  const auto batches = planSweepBatches(all, memory, options.memory_budget_bytes, st.info);
+  std::size_t max_entries = 0, max_directions = 0;
+  for (const auto& b : batches) {
+    max_entries = std::max(max_entries, b.entries);
+    max_directions = std::max(max_directions, b.directions.size());
+  }
+
+  IntervisibilityResult result;
+  result.width = field.width;
+  result.height = field.height;
+  result.directions = options.directions;
+  for (int k = 0; k < options.directions; ++k) result.azimuths.push_back(intervisibilityAzimuth(k, options));
+
+  cl::Buffer heights(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, plane * sizeof(float),
+                     const_cast<float*>(prepared.heights.data()));
+  SweepBuffers buffers;
+  if (tree) {
+    buffers.lines = deviceBuffer(st, max_entries * kLineBytes);
+    buffers.trees = deviceBuffer(st, max_entries * kNodeBytes);
+    buffers.visible = deviceBuffer(st, max_entries * kVisibleBytes);
+    buffers.prefix = deviceBuffer(st, outputs.visible_area ? max_entries * kPrefixBytes : 0);
+    buffers.entry_stats = deviceBuffer(st, 0);
+    buffers.totals_stride = max_lines;
+    buffers.line_totals = deviceBuffer(
+        st, outputs.statistics ? max_directions * max_lines * kLineTotals * sizeof(cl_ulong) : 0);
+  }
+  cl::Buffer count_sum = deviceBuffer(st, want_pixels ? plane * sizeof(float) : 0);
+  cl::Buffer area_sum = deviceBuffer(st, outputs.visible_area ? plane * sizeof(float) : 0);
+  const float zero = 0.0f;
+  if (want_pixels) st.queue.enqueueFillBuffer(count_sum, zero, 0, plane * sizeof(float));
+  if (outputs.visible_area) st.queue.enqueueFillBuffer(area_sum, zero, 0, plane * sizeof(float));
+
+  const float sector = intervisibilitySector(options);
+  const cl::NDRange pixels(roundUp(field.width, kTileX), roundUp(field.height, kTileY));
+  std::vector<cl_ulong> totals;
+  int done = 0;
+  for (const SweepBatch& batch : batches) {
+    const cl::Buffer directions = uploadDirections(st, batch.directions);
+    const int batch_size = static_cast<int>(batch.directions.size());
+    if (tree) {
+      enqueuePresample(st, program, heights, field.width, field.height, directions, batch, buffers.lines);
+      enqueueTreeSweep(st, program, directions, batch, buffers);
+    }
+    if (want_pixels) {
+      cl::Kernel reduce(program, tree ? "intervisibility_reduce" : "intervisibility_naive");
+      int arg = 0;
+      reduce.setArg(arg++, heights);
+      reduce.setArg(arg++, field.width);
+      reduce.setArg(arg++, field.height);
+      reduce.setArg(arg++, directions);
+      reduce.setArg(arg++, batch_size);
+      reduce.setArg(arg++, sector);
+      if (tree) reduce.setArg(arg++, buffers.visible);
+      reduce.setArg(arg++, count_sum);
+      reduce.setArg(arg++, area_sum);
+      st.launch(reduce, pixels, cl::NDRange(kTileX, kTileY));
+    }
+    if (outputs.statistics) {
+      totals.resize(batch.directions.size() * max_lines * kLineTotals);
+      st.queue.enqueueReadBuffer(buffers.line_totals, CL_TRUE, 0, totals.size() * sizeof(cl_ulong),
+                                 totals.data());
+      addLineTotals(totals, batch, max_lines, result.statistics);
+    }
+    st.queue.finish();
+    done += batch_size;
+    if (options.progress) options.progress(done, options.directions);
+  }
+  if (outputs.visible_count) {
+    result.visible_count.resize(plane);
+    st.queue.enqueueReadBuffer(count_sum, CL_TRUE, 0, plane * sizeof(float), result.visible_count.data());
+  }
+  if (outputs.visible_area) {
+    result.visible_area.resize(plane);
+    st.queue.enqueueReadBuffer(area_sum, CL_TRUE, 0, plane * sizeof(float), result.visible_area.data());
+  }
+  return result;
+}
+
+}  // namespace
+
+IntervisibilityLines intervisibilityLinesOnDevice(const ComputeContext& context, const HeightField& field,
+                                                  const std::vector<float>& prepared_heights,
+                                                  const SweepDirection& direction) {
+  return translateOpenClErrors([&] {
+    ContextState& st = context.state();
+    ProgramFlags flags;
+    flags.entry_stats = true;
+    cl::Program program = st.program(kProgramFile, programOptions(flags, st.info));
+    const bool line_major = lineMajorLayout(st.info);
+    SweepBatch batch;
+    batch.directions = {direction};
+    batch.directions[0].buffer_offset = 0;
+    batch.entries = direction.entries();
+    const std::size_t entries = batch.entries;
+    IntervisibilityLines out;
+    out.geometry = batch.directions[0];
+    cl::Buffer heights(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                       prepared_heights.size() * sizeof(float), const_cast<float*>(prepared_heights.data()));
+    const cl::Buffer directions = uploadDirections(st, batch.directions);
+    SweepBuffers buffers;
+    buffers.lines = deviceBuffer(st, entries * kLineBytes);
+    buffers.trees = deviceBuffer(st, entries * kNodeBytes);
+    buffers.visible = deviceBuffer(st, entries * kVisibleBytes);
+    buffers.prefix = deviceBuffer(st, entries * kPrefixBytes);
+    buffers.entry_stats = deviceBuffer(st, entries * kEntryStatsBytes);
+    buffers.totals_stride = direction.n_lines;
+    buffers.line_totals = deviceBuffer(st, direction.n_lines * kLineTotals * sizeof(cl_ulong));
+    enqueuePresample(st, program, heights, field.width, field.height, directions, batch, buffers.lines);
+    enqueueTreeSweep(st, program, directions, batch, buffers);
+    std::vector<float> pairs(entries * 2), visible(entries * 2);
+    std::vector<std::uint32_t> stats(entries * 4);
+    st.queue.enqueueReadBuffer(buffers.lines, CL_TRUE, 0, pairs.size() * sizeof(float), pairs.data());
+    st.queue.enqueueReadBuffer(buffers.visible, CL_TRUE, 0, visible.size() * sizeof(float), visible.data());
+    st.queue.enqueueReadBuffer(buffers.entry_stats, CL_TRUE, 0, stats.size() * sizeof(std::uint32_t),
+                               stats.data());
+    // Back to the canonical step-major order of IntervisibilityLines.
+    const SweepDirection& d = out.geometry;
+    out.samples.resize(entries);
+    out.counts.resize(entries);
+    out.distance_sums.resize(entries);
+    out.horizons.resize(entries);
+    out.iterations.resize(entries);
+    out.horizon_hashes.resize(entries);
+    for (int j = 0; j < d.n_lines; ++j) {
+      for (int i = 0; i < d.n_steps; ++i) {
+        const std::size_t e = lineEntry(d, j, i, line_major), canonical = std::size_t(i) * d.n_lines + j;
+        out.samples[canonical] = pairs[2 * e];
+        out.counts[canonical] = visible[2 * e];
+        out.distance_sums[canonical] = visible[2 * e + 1];
+        out.horizons[canonical] = stats[4 * e];
+        out.iterations[canonical] = stats[4 * e + 1];
+        out.horizon_hashes[canonical] = stats[4 * e + 2];
+      }
+    }
+    return out;
+  });
+}
+
+}  // namespace detail
+
+IntervisibilityResult computeIntervisibility(const ComputeContext& context, const HeightField& field,
+                                             const IntervisibilityOptions& options,
+                                             const IntervisibilityOutputs& outputs) {
+  validate(field);
+  validate(options, outputs);
+  return detail::translateOpenClErrors([&] { return detail::run(context, field, options, outputs); });
+}
+
+}  // namespace hfvis

@@ -1,0 +1,79 @@
+// intervisibility_common.cpp: option validation, direction geometry and the limits that
+// the intervisibility device path and its scalar reference share.
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "hfvis/errors.hpp"
+#include "intervisibility_internal.hpp"
+
+namespace hfvis {
+
+double intervisibilityAzimuth(int k, const IntervisibilityOptions& options) {
+  return 2.0 * M_PI * k / options.directions + options.azimuth_offset;
+}
+
+void validate(const IntervisibilityOptions& options, const IntervisibilityOutputs& outputs) {
+  if (options.directions < 1) {
+    throw InvalidArgument("the number of directions K must be at least 1 (got " +
+                          std::to_string(options.directions) + ")");
+  }
+  auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  if (!positive(options.samples_per_unit) || options.samples_per_unit > 64.0) {
+    throw InvalidArgument("samples per unit must be in (0, 64] (got " +
+                          std::to_string(options.samples_per_unit) + ")");
+  }
+  if (!positive(options.lines_per_unit) || options.lines_per_unit > 64.0) {
+    throw InvalidArgument("lines per unit must be in (0, 64] (got " + std::to_string(options.lines_per_unit) +
+                          ")");
+  }
+  if (!std::isfinite(options.azimuth_offset)) throw InvalidArgument("the azimuth offset must be finite");
+  if (!outputs.visible_count && !outputs.visible_area && !outputs.statistics) {
+    throw InvalidArgument("no output requested");
+  }
+  if (outputs.statistics && options.method != IntervisibilityMethod::HullTree) {
+    throw InvalidArgument("statistics (horizons and iterations) exist only for the hull-tree method");
+  }
+}
+
+namespace detail {
+
+std::vector<SweepDirection> intervisibilityDirections(const HeightField& field,
+                                                      const IntervisibilityOptions& options) {
+  std::vector<SweepDirection> directions;
+  for (int k = 0; k < options.directions; ++k) {
+    directions.push_back(makeSweepDirection(field, intervisibilityAzimuth(k, options),
+                                            options.samples_per_unit, options.lines_per_unit));
+  }
+  return directions;
+}
+
+float intervisibilitySector(const IntervisibilityOptions& options) {
+  return static_cast<float>(2.0 * M_PI / options.directions);
+}
+
+void checkLineLimits(const std::vector<SweepDirection>& directions,
+                     const std::vector<float>& prepared_heights, const IntervisibilityOutputs& outputs) {
+  int longest = 0;
+  for (const auto& d : directions) longest = std::max(longest, d.n_steps);
+  if (longest >= (1 << 24)) {
+    throw InvalidArgument("a sweep line would have " + std::to_string(longest) +
+                          " samples; at most 2^24 are supported: lower the samples per unit");
+  }
+  // Distance sums of one receiver: at most longest^2 / 2 steps, kept in 32 bits.
+  if (outputs.visible_area && static_cast<double>(longest) * longest / 2.0 >= 4294967295.0) {
+    throw InvalidArgument(
+        "a sweep line would have " + std::to_string(longest) +
+        " samples, too many for the visible area (at most 92681): lower the samples per unit");
+  }
+  float highest = 0.0f;  // prepared heights are >= 0 (offset by the lowest one)
+  for (float h : prepared_heights)
+    if (!std::isnan(h)) highest = std::max(highest, std::fabs(h));
+  if (!(static_cast<double>(highest) * 4.0 * longest < 1e37)) {
+    throw InvalidArgument("the height range times the z-scale is too large for single precision (" +
+                          std::to_string(highest) + "): lower the z-scale");
+  }
+}
+
+}  // namespace detail
+}  // namespace hfvis

@@ -1,0 +1,63 @@
+// intervisibility_internal.hpp: what the intervisibility device path, its scalar reference
+// and the tests share: direction geometry and the line-level view of one direction's sweep
+// (per-sample counts, horizons and iterations), to compare a sweep line by line.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "hfvis/device.hpp"
+#include "hfvis/height_field.hpp"
+#include "hfvis/intervisibility.hpp"
+#include "sweep_geometry.hpp"
+
+namespace hfvis::detail {
+
+// The sweep geometry of every direction of the run (buffer offsets left at 0).
+std::vector<SweepDirection> intervisibilityDirections(const HeightField& field,
+                                                      const IntervisibilityOptions& options);
+
+// 2*pi/K: the azimuthal sector one direction stands for in the area estimate.
+float intervisibilitySector(const IntervisibilityOptions& options);
+
+// Limits of the kernels' integer and exact arithmetic, checked before launching: a line
+// has fewer than 2^24 steps (steps are exact floats), distance sums stay below 2^32 when
+// the area is asked for, and |height| * steps stays far below FLT_MAX (the predicate's
+// products). Throws InvalidArgument saying what to change.
+void checkLineLimits(const std::vector<SweepDirection>& directions,
+                     const std::vector<float>& prepared_heights, const IntervisibilityOutputs& outputs);
+
+// One direction's per-sample results in step-major order whatever the device's line
+// layout: entry (step i, line j) at i * geometry.n_lines + j. Absent samples: NaN sample,
+// NaN count and distance sum, zero statistics and hash.
+struct IntervisibilityLines {
+  SweepDirection geometry{};
+  std::vector<float> samples;                 // presampled heights
+  std::vector<float> counts;                  // visible samples (farther along the line)
+  std::vector<float> distance_sums;           // sum of their distances, in steps
+  std::vector<std::uint32_t> horizons;        // m_i: distinct visibility horizons
+  std::vector<std::uint32_t> iterations;      // t_i: convexity checks of Algorithm 1
+  std::vector<std::uint32_t> horizon_hashes;  // FNV-1a over the horizons' steps, farthest first
+  // Reference only, when asked: the horizons' steps, farthest first.
+  std::vector<std::vector<int>> horizon_steps;
+};
+
+// FNV-1a step of the horizon hash (kernel: `hash = (hash ^ step) * 16777619u`).
+constexpr std::uint32_t kHorizonHashSeed = 2166136261u;
+inline std::uint32_t hashHorizon(std::uint32_t hash, int step) {
+  return (hash ^ static_cast<std::uint32_t>(step)) * 16777619u;
+}
+
+// Presampling and the hull-tree sweep kernels for one direction on prepared heights (see
+// prepareHeights), with per-entry statistics.
+IntervisibilityLines intervisibilityLinesOnDevice(const ComputeContext& context, const HeightField& field,
+                                                  const std::vector<float>& prepared_heights,
+                                                  const SweepDirection& direction);
+
+// The scalar mirror of the same; keep_horizons fills horizon_steps.
+IntervisibilityLines referenceIntervisibilityLines(const HeightField& field,
+                                                   const std::vector<float>& prepared_heights,
+                                                   const SweepDirection& direction,
+                                                   bool keep_horizons = false);
+
+}  // namespace hfvis::detail

@@ -1,0 +1,376 @@
+// intervisibility_reference.cpp: scalar mirrors of kernels/intervisibility.cl (convex hull
+// tree sweep, visible counts, reduction, naive march). Same tree layout, same walk, same
+// exact predicate, in the kernels' order, so every per-sample result matches exactly.
+#include "hfvis/intervisibility_reference.hpp"
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include "chord_side.hpp"
+#include "hfvis/errors.hpp"
+#include "horizon_common.hpp"
+#include "intervisibility_internal.hpp"
+
+namespace hfvis {
+namespace detail {
+namespace {
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+constexpr int kNone = -1;
+constexpr int kConcave = 0, kConvex = 1;
+
+// A tree node as the kernel's int4: (height, rank * 2 + leaf flag, first child, next
+// sibling); the node of step k in slot k, links by slot.
+struct Node {
+  float h = 0.0f;
+  int rank = 0;  // present samples before this one
+  bool leaf = false;
+  int first = kNone;
+  int next = kNone;
+};
+
+// The presampled heights, ranks and step sums of one line, indexed by step.
+struct LineView {
+  const std::vector<float>& samples;
+  std::size_t offset;  // entry of step 0 of this line
+  std::size_t stride;  // n_lines
+  float height(int step) const { return samples[offset + static_cast<std::size_t>(step) * stride]; }
+};
+
+bool seenOver(float hx, int x, float hn, int n, float hr, int r) {
+  return chordSide(hx, hn, hr, static_cast<float>(n - x), static_cast<float>(r - n)) <= 0;
+}
+
+// Mirror of run_end().
+int runEnd(const LineView& line, int start, int next, float h_next, int receiver, float h_receiver,
+           bool holes) {
+  if (!holes) {
+    int lo = start, hi = next, jump = 1;
+    while (lo + jump < hi) {
+      const int x = lo + jump;
+      if (seenOver(line.height(x), x, h_next, next, h_receiver, receiver)) {
+        lo = x;
+        jump *= 2;
+      } else {
+        hi = x;
+        break;
+      }
+    }
+    while (hi - lo > 1) {
+      const int mid = lo + (hi - lo) / 2;
+      if (seenOver(line.height(mid), mid, h_next, next, h_receiver, receiver))
+        lo = mid;
+      else
+        hi = mid;
+    }
+    return hi;
+  }
+  for (int x = start + 1; x < next; ++x) {
+    const float hx = line.height(x);
+    if (!std::isnan(hx) && !seenOver(hx, x, h_next, next, h_receiver, receiver)) return x;
+  }
+  return next;
+}
+
+// Mirror of intervisibility_sweep() for line j.
+void sweepLine(const SweepDirection& d, int j, IntervisibilityLines& out, bool keep_horizons) {
+  const std::size_t stride = static_cast<std::size_t>(d.n_lines);
+  const LineView line{out.samples, static_cast<std::size_t>(j), stride};
+  std::vector<Node> tree(static_cast<std::size_t>(d.n_steps));
+  std::vector<int> ranks(static_cast<std::size_t>(d.n_steps));
+  std::vector<std::uint32_t> step_sums(static_cast<std::size_t>(d.n_steps));
+
+  int rank = 0;
+  std::uint32_t step_sum = 0;
+  int root = kNone, prev = kNone, prev2 = kNone;
+  float h_prev = 0.0f, h_prev2 = 0.0f;
+  int class_last = kConvex;
+  for (int step = 0; step < d.n_steps; ++step) {
+    const std::size_t e = static_cast<std::size_t>(j) + static_cast<std::size_t>(step) * stride;
+    const float h = out.samples[e];
+    ranks[step] = rank;
+    step_sums[step] = step_sum;
+    if (std::isnan(h)) continue;  // outputs stay NaN / zero
+    std::uint32_t m = 0, t = 0, hash = kHorizonHashSeed;
+    int count = 0;
+    std::uint32_t distance_sum = 0;
+    std::vector<int> horizons;
+    if (root == kNone) {
+      tree[step] = {h, 0, true, kNone, kNone};
+    } else {
+      // 1. Algorithm 1 as a post-order walk with the stack threaded through `next`.
+      int head = kNone, tail = kNone;
+      int cur = root;
+      Node node = tree[cur];
+      for (;;) {
+        const int c = node.first;
+        if (c != kNone) {
+          Node child = tree[c];
+          ++t;
+          // Convex when the parent lies strictly above the chord from the child to the root.
+          const int side =
+              chordSide(child.h, node.h, h, static_cast<float>(cur - c), static_cast<float>(step - cur));
+          if (side <= 0) {
+            tree[cur].first = child.next;
+            tree[c].next = cur;
+            child.next = cur;
+            cur = c;
+            node = child;
+            continue;
+          }
+        }
+        const int parent = node.next;
+        if (c != kNone || node.leaf) {
+          if (tail == kNone)
+            head = cur;
+          else
+            tree[tail].next = cur;
+          tail = cur;
+        }
+        if (parent == kNone) break;
+        cur = parent;
+        node = tree[cur];
+      }
+
+      // 2. Eq. 1 for the old root; a segment start's node becomes (or is re-created as) a
+      // leaf, the root's last child.
+      if (prev2 != kNone) {
+        const int side =
+            chordSide(h_prev2, h_prev, h, static_cast<float>(prev - prev2), static_cast<float>(step - prev));
+        const int cls = side > 0 ? kConvex : side < 0 ? kConcave : class_last;
+        if (cls == kConvex && class_last == kConcave) {
+          if (tail == prev) {
+            tree[prev].leaf = true;
+          } else {
+            tree[prev] = {h_prev, rank - 1, true, kNone, kNone};
+            tree[tail].next = prev;
+            tail = prev;
+          }
+        }
+        class_last = cls;
+      }
+      tree[tail].next = kNone;
+      tree[step] = {h, rank, false, head, kNone};
+
+      // 3. Visible samples from the horizons, farthest first (closed forms without holes).
+      int hp = head;
+      Node hz = tree[hp];
+      int hp_rank = hz.rank;
+      for (;;) {
+        const int np = hz.next;
+        ++m;
+        hash = hashHorizon(hash, hp);
+        if (keep_horizons) horizons.push_back(hp);
+        int end = step, end_rank = rank, np_rank = rank;
+        Node nz = hz;
+        if (np != kNone) {
+          nz = tree[np];
+          np_rank = nz.rank;
+          end = np;
+          end_rank = np_rank;
+        }
+        const bool holes = end_rank - hp_rank != end - hp;
+        if (np != kNone) {
+          end = runEnd(line, hp, np, nz.h, step, h, holes);
+          end_rank = end == np ? np_rank : holes ? ranks[end] : hp_rank + (end - hp);
+        }
+        const int run = end_rank - hp_rank;
+        count += run;
+        std::uint32_t steps_sum;
+        if (!holes) {
+          const auto a = static_cast<std::uint32_t>(run), b = static_cast<std::uint32_t>(hp + end - 1);
+          steps_sum = (a & 1u) ? a * (b >> 1) : (a >> 1) * b;
+        } else {
+          const std::uint32_t end_sum = end == step ? step_sum : step_sums[end];
+          steps_sum = end_sum - step_sums[hp];
+        }
+        distance_sum += static_cast<std::uint32_t>(step) * static_cast<std::uint32_t>(run) - steps_sum;
+        if (np == kNone) break;
+        hz = nz;
+        hp = np;
+        hp_rank = np_rank;
+      }
+    }
+    out.counts[e] = static_cast<float>(count);
+    out.distance_sums[e] = static_cast<float>(distance_sum);
+    out.horizons[e] = m;
+    out.iterations[e] = t;
+    out.horizon_hashes[e] = hash;
+    if (keep_horizons) out.horizon_steps[e] = std::move(horizons);
+    prev2 = prev;
+    h_prev2 = h_prev;
+    prev = step;
+    h_prev = h;
+    root = step;
+    ++rank;
+    step_sum += static_cast<std::uint32_t>(step);
+  }
+}
+
+// Per-pixel sums of one direction, as add_direction / accumulate_visible.
+struct PixelSums {
+  float count = 0.0f, area = 0.0f;
+  void add(const SweepDirection& d, float sector, float c, float distance_steps) {
+    const float ground = d.step_length * d.ground_per_pixel;
+    count += c;
+    area += sector * ground * ground * distance_steps;
+  }
+};
+
+void finish(IntervisibilityResult& result, const std::vector<PixelSums>& sums,
+            const std::vector<float>& heights) {
+  for (std::size_t p = 0; p < sums.size(); ++p) {
+    const bool nodata = std::isnan(heights[p]);
+    if (!result.visible_count.empty()) result.visible_count[p] = nodata ? kNaN : sums[p].count;
+    if (!result.visible_area.empty()) result.visible_area[p] = nodata ? kNaN : sums[p].area;
+  }
+}
+
+void sweepReference(const HeightField& field, const std::vector<float>& h,
+                    const IntervisibilityOptions& options, IntervisibilityResult& result) {
+  const auto directions = intervisibilityDirections(field, options);
+  const float sector = intervisibilitySector(options);
+  std::vector<PixelSums> sums(field.pixelCount());
+  auto& stats = result.statistics;
+  for (const SweepDirection& d : directions) {
+    const IntervisibilityLines lines = referenceIntervisibilityLines(field, h, d);
+    for (int j = 0; j < d.n_lines; ++j) {
+      std::uint64_t n = 0, m = 0, t = 0;
+      for (int i = 0; i < d.n_steps; ++i) {
+        const std::size_t e = static_cast<std::size_t>(i) * d.n_lines + j;
+        if (std::isnan(lines.samples[e])) continue;
+        stats.naive_iterations += n;
+        ++n;
+        m += lines.horizons[e];
+        t += lines.iterations[e];
+        stats.visible_samples += static_cast<std::uint64_t>(lines.counts[e]);
+      }
+      stats.receivers += n;
+      stats.horizons += m;
+      stats.iterations += t;
+      stats.lines += n > 0;
+      stats.lines_over_bound += t > 2 * m + n;
+    }
+    for (int r = 0; r < field.height; ++r) {
+      for (int c = 0; c < field.width; ++c) {
+        const float x = static_cast<float>(c), y = static_cast<float>(r);
+        const float t = x * d.dir_x + y * d.dir_y;
+        const float u = (x * d.perp_x + y * d.perp_y) * d.lines_per_unit - static_cast<float>(d.line_first);
+        const float v = static_cast<float>(d.step_top) - t * d.samples_per_unit;
+        const int j0 = static_cast<int>(std::floor(u)), i0 = static_cast<int>(std::floor(v));
+        const float fu = u - static_cast<float>(j0), fv = v - static_cast<float>(i0);
+        float weight = 0.0f, count = 0.0f, distance = 0.0f;
+        for (int k = 0; k < 4; ++k) {
+          const int j = j0 + (k & 1), i = i0 + (k >> 1);
+          const float w = ((k & 1) ? fu : 1.0f - fu) * ((k >> 1) ? fv : 1.0f - fv);
+          if (w <= 0.0f || j < 0 || j >= d.n_lines || i < 0 || i >= d.n_steps) continue;
+          const std::size_t e = static_cast<std::size_t>(i) * d.n_lines + j;
+          if (std::isnan(lines.counts[e])) continue;
+          weight += w;
+          count += w * lines.counts[e];
+          distance += w * lines.distance_sums[e];
+        }
+        if (weight > 0.0f && weight != 1.0f) {
+          count /= weight;
+          distance /= weight;
+        }
+        sums[static_cast<std::size_t>(r) * field.width + c].add(d, sector, count, distance);
+      }
+    }
+  }
+  finish(result, sums, h);
+}
+
+void naiveReference(const HeightField& field, const std::vector<float>& h,
+                    const IntervisibilityOptions& options, IntervisibilityResult& result) {
+  const int width = field.width, height = field.height;
+  const auto directions = intervisibilityDirections(field, options);
+  const float sector = intervisibilitySector(options);
+  std::vector<PixelSums> sums(field.pixelCount());
+  for (int r = 0; r < height; ++r) {
+    for (int c = 0; c < width; ++c) {
+      const std::size_t pixel = static_cast<std::size_t>(r) * width + c;
+      const float hp = h[pixel];
+      for (const SweepDirection& d : directions) {
+        float best_h = 0.0f;
+        int best_step = 0, count = 0;
+        std::uint32_t distance_sum = 0;
+        // March until the ray has left the field for good (the kernel may march further;
+        // those samples are outside and masked).
+        for (int i = 1;; ++i) {
+          const float t = static_cast<float>(i) * d.step_length;
+          const Point2 p{static_cast<float>(c) + t * d.dir_x, static_cast<float>(r) + t * d.dir_y};
+          if (!insideField(p, width, height)) break;
+          const float q = sampleHeight(h, width, height, p);
+          const bool seen =
+              !std::isnan(q) && (best_step == 0 || chordSide(q, best_h, hp, static_cast<float>(i - best_step),
+                                                             static_cast<float>(best_step)) <= 0);
+          if (seen) {
+            ++count;
+            distance_sum += static_cast<std::uint32_t>(i);
+            best_h = q;
+            best_step = i;
+          }
+        }
+        sums[pixel].add(d, sector, static_cast<float>(count), static_cast<float>(distance_sum));
+      }
+    }
+  }
+  finish(result, sums, h);
+}
+
+}  // namespace
+
+IntervisibilityLines referenceIntervisibilityLines(const HeightField& field,
+                                                   const std::vector<float>& prepared_heights,
+                                                   const SweepDirection& d, bool keep_horizons) {
+  IntervisibilityLines out;
+  out.geometry = d;
+  const std::size_t entries = d.entries();
+  out.samples.assign(entries, kNaN);
+  out.counts.assign(entries, kNaN);
+  out.distance_sums.assign(entries, kNaN);
+  out.horizons.assign(entries, 0);
+  out.iterations.assign(entries, 0);
+  out.horizon_hashes.assign(entries, 0);
+  if (keep_horizons) out.horizon_steps.assign(entries, {});
+  for (int j = 0; j < d.n_lines; ++j) {
+    for (int i = 0; i < d.n_steps; ++i) {
+      const Point2 p = sweepPosition(d, j, i);
+      if (insideField(p, field.width, field.height))
+        out.samples[static_cast<std::size_t>(i) * d.n_lines + j] =
+            sampleHeight(prepared_heights, field.width, field.height, p);
+    }
+  }
+  for (int j = 0; j < d.n_lines; ++j) sweepLine(d, j, out, keep_horizons);
+  return out;
+}
+
+}  // namespace detail
+
+IntervisibilityResult referenceIntervisibility(const HeightField& field,
+                                               const IntervisibilityOptions& options,
+                                               const IntervisibilityOutputs& outputs) {
+  validate(field);
+  validate(options, outputs);
+  const detail::PreparedHeights prepared = detail::prepareHeights(field);
+  detail::checkLineLimits(detail::intervisibilityDirections(field, options), prepared.heights, outputs);
+  IntervisibilityResult result;
+  result.width = field.width;
+  result.height = field.height;
+  result.directions = options.directions;
+  for (int k = 0; k < options.directions; ++k) result.azimuths.push_back(intervisibilityAzimuth(k, options));
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  if (outputs.visible_count) result.visible_count.assign(field.pixelCount(), nan);
+  if (outputs.visible_area) result.visible_area.assign(field.pixelCount(), nan);
+  if (options.method == IntervisibilityMethod::HullTree) {
+    detail::sweepReference(field, prepared.heights, options, result);
+  } else {
+    detail::naiveReference(field, prepared.heights, options, result);
+  }
+  if (!outputs.statistics) result.statistics = {};
+  return result;
+}
+
+}  // namespace hfvis
