@@ -8,23 +8,8 @@
 
 namespace hfvis {
 
-double directionAzimuth(int k, const HorizonOptions& options) {
-  return 2.0 * M_PI * k / options.directions + options.azimuth_offset;
-}
-
 void validate(const HorizonOptions& options, const HorizonOutputs& outputs) {
-  if (options.directions < 1) {
-    throw InvalidArgument("the number of directions K must be at least 1 (got " +
-                          std::to_string(options.directions) + ")");
-  }
-  auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
-  if (!positive(options.samples_per_unit) || options.samples_per_unit > 64.0) {
-    throw InvalidArgument("samples per unit must be in (0, 64] (got " + std::to_string(options.samples_per_unit) + ")");
-  }
-  if (!positive(options.lines_per_unit) || options.lines_per_unit > 64.0) {
-    throw InvalidArgument("lines per unit must be in (0, 64] (got " + std::to_string(options.lines_per_unit) + ")");
-  }
-  if (!std::isfinite(options.azimuth_offset)) throw InvalidArgument("the azimuth offset must be finite");
+  validate(static_cast<const SweepOptions&>(options));
   if (!outputs.horizon_angles && !outputs.horizon_distances && !outputs.sky_view_factor &&
       !outputs.ambient_occlusion) {
     throw InvalidArgument("no output requested");
@@ -49,15 +34,6 @@ PreparedHeights prepareHeights(const HeightField& field) {
     }
   }
   return prepared;
-}
-
-std::vector<SweepDirection> runDirections(const HeightField& field, const HorizonOptions& options) {
-  std::vector<SweepDirection> directions;
-  for (int k = 0; k < options.directions; ++k) {
-    directions.push_back(
-        makeSweepDirection(field, directionAzimuth(k, options), options.samples_per_unit, options.lines_per_unit));
-  }
-  return directions;
 }
 
 HorizonResult allocateResult(const HeightField& field, const HorizonOptions& options,

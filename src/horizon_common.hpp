@@ -17,9 +17,6 @@ struct PreparedHeights {
 };
 PreparedHeights prepareHeights(const HeightField& field);
 
-// The sweep geometry of every direction of the run (buffer offsets left at 0).
-std::vector<SweepDirection> runDirections(const HeightField& field, const HorizonOptions& options);
-
 // Turns the accumulated sums into the outputs: svf = 1 - sum / K; ao is the sum itself.
 void finishReduction(const HorizonOptions& options, HorizonResult& result);
 

@@ -81,7 +81,7 @@ IntervisibilityResult run(const ComputeContext& context, const HeightField& fiel
                           const IntervisibilityOptions& options, const IntervisibilityOutputs& outputs) {
   ContextState& st = context.state();
   const PreparedHeights prepared = prepareHeights(field);
-  const auto all = intervisibilityDirections(field, options);
+  const auto all = runDirections(field, options);
   checkLineLimits(all, prepared.heights, outputs);
   const bool tree = options.method == IntervisibilityMethod::HullTree;
   ProgramFlags flags;
@@ -115,7 +115,7 @@ IntervisibilityResult run(const ComputeContext& context, const HeightField& fiel
   result.width = field.width;
   result.height = field.height;
   result.directions = options.directions;
-  for (int k = 0; k < options.directions; ++k) result.azimuths.push_back(intervisibilityAzimuth(k, options));
+  for (int k = 0; k < options.directions; ++k) result.azimuths.push_back(directionAzimuth(k, options));
 
   cl::Buffer heights(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, plane * sizeof(float),
                      const_cast<float*>(prepared.heights.data()));

@@ -9,25 +9,8 @@
 
 namespace hfvis {
 
-double intervisibilityAzimuth(int k, const IntervisibilityOptions& options) {
-  return 2.0 * M_PI * k / options.directions + options.azimuth_offset;
-}
-
 void validate(const IntervisibilityOptions& options, const IntervisibilityOutputs& outputs) {
-  if (options.directions < 1) {
-    throw InvalidArgument("the number of directions K must be at least 1 (got " +
-                          std::to_string(options.directions) + ")");
-  }
-  auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
-  if (!positive(options.samples_per_unit) || options.samples_per_unit > 64.0) {
-    throw InvalidArgument("samples per unit must be in (0, 64] (got " +
-                          std::to_string(options.samples_per_unit) + ")");
-  }
-  if (!positive(options.lines_per_unit) || options.lines_per_unit > 64.0) {
-    throw InvalidArgument("lines per unit must be in (0, 64] (got " + std::to_string(options.lines_per_unit) +
-                          ")");
-  }
-  if (!std::isfinite(options.azimuth_offset)) throw InvalidArgument("the azimuth offset must be finite");
+  validate(static_cast<const SweepOptions&>(options));
   if (!outputs.visible_count && !outputs.visible_area && !outputs.statistics) {
     throw InvalidArgument("no output requested");
   }
@@ -37,16 +20,6 @@ void validate(const IntervisibilityOptions& options, const IntervisibilityOutput
 }
 
 namespace detail {
-
-std::vector<SweepDirection> intervisibilityDirections(const HeightField& field,
-                                                      const IntervisibilityOptions& options) {
-  std::vector<SweepDirection> directions;
-  for (int k = 0; k < options.directions; ++k) {
-    directions.push_back(makeSweepDirection(field, intervisibilityAzimuth(k, options),
-                                            options.samples_per_unit, options.lines_per_unit));
-  }
-  return directions;
-}
 
 float intervisibilitySector(const IntervisibilityOptions& options) {
   return static_cast<float>(2.0 * M_PI / options.directions);

@@ -13,9 +13,6 @@
 
 namespace hfvis::detail {
 
-// The sweep geometry of every direction of the run (buffer offsets left at 0).
-std::vector<SweepDirection> intervisibilityDirections(const HeightField& field,
-                                                      const IntervisibilityOptions& options);
 
 // 2*pi/K: the azimuthal sector one direction stands for in the area estimate.
 float intervisibilitySector(const IntervisibilityOptions& options);

@@ -229,7 +229,7 @@ void finish(IntervisibilityResult& result, const std::vector<PixelSums>& sums,
 
 void sweepReference(const HeightField& field, const std::vector<float>& h,
                     const IntervisibilityOptions& options, IntervisibilityResult& result) {
-  const auto directions = intervisibilityDirections(field, options);
+  const auto directions = runDirections(field, options);
   const float sector = intervisibilitySector(options);
   std::vector<PixelSums> sums(field.pixelCount());
   auto& stats = result.statistics;
@@ -285,7 +285,7 @@ void sweepReference(const HeightField& field, const std::vector<float>& h,
 void naiveReference(const HeightField& field, const std::vector<float>& h,
                     const IntervisibilityOptions& options, IntervisibilityResult& result) {
   const int width = field.width, height = field.height;
-  const auto directions = intervisibilityDirections(field, options);
+  const auto directions = runDirections(field, options);
   const float sector = intervisibilitySector(options);
   std::vector<PixelSums> sums(field.pixelCount());
   for (int r = 0; r < height; ++r) {
@@ -355,12 +355,12 @@ IntervisibilityResult referenceIntervisibility(const HeightField& field,
   validate(field);
   validate(options, outputs);
   const detail::PreparedHeights prepared = detail::prepareHeights(field);
-  detail::checkLineLimits(detail::intervisibilityDirections(field, options), prepared.heights, outputs);
+  detail::checkLineLimits(detail::runDirections(field, options), prepared.heights, outputs);
   IntervisibilityResult result;
   result.width = field.width;
   result.height = field.height;
   result.directions = options.directions;
-  for (int k = 0; k < options.directions; ++k) result.azimuths.push_back(intervisibilityAzimuth(k, options));
+  for (int k = 0; k < options.directions; ++k) result.azimuths.push_back(directionAzimuth(k, options));
   const float nan = std::numeric_limits<float>::quiet_NaN();
   if (outputs.visible_count) result.visible_count.assign(field.pixelCount(), nan);
   if (outputs.visible_area) result.visible_area.assign(field.pixelCount(), nan);

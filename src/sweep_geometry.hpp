@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "hfvis/height_field.hpp"
+#include "hfvis/sweep_options.hpp"
 
 namespace hfvis::detail {
 
@@ -27,7 +28,9 @@ struct SweepDirection {
   std::int32_t n_steps;
   std::uint32_t buffer_offset;  // first entry in the batch's line buffer
 
-  std::size_t entries() const { return static_cast<std::size_t>(n_lines) * static_cast<std::size_t>(n_steps); }
+  std::size_t entries() const {
+    return static_cast<std::size_t>(n_lines) * static_cast<std::size_t>(n_steps);
+  }
 };
 static_assert(sizeof(SweepDirection) == 64, "SweepDirection must match the kernel struct");
 
@@ -35,6 +38,9 @@ static_assert(sizeof(SweepDirection) == 64, "SweepDirection must match the kerne
 // line of margin on every side so that every receiver has its four surrounding entries.
 SweepDirection makeSweepDirection(const HeightField& field, double azimuth, double samples_per_unit,
                                   double lines_per_unit);
+
+// The sweep geometry of every direction of a run (buffer offsets left at 0).
+std::vector<SweepDirection> runDirections(const HeightField& field, const SweepOptions& options);
 
 // Position of step `step` of line `line`, rounded exactly as the kernels do.
 struct Point2 {

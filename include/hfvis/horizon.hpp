@@ -1,20 +1,15 @@
 // hfvis/horizon.hpp: horizon maps, sky-view factor and ambient occlusion.
 //
-// Conventions (../shared/DESIGN.md): direction k of K has azimuth
-// phi_k = 2*pi*k/K + azimuth_offset, measured on the ground in the (column, row) axes, so
-// the ground direction is (cos phi_k, sin phi_k); with square cells this is the
-// pixel-axes direction itself. Compass azimuth (clockwise from north = row -1) is
-// 90 deg + phi in degrees when rows run south. The horizon of receiver p in direction k
+// Directions follow hfvis/sweep_options.hpp. The horizon of receiver p in direction k
 // is the largest elevation angle atan2(h(q) - h(p), ground distance) over surface
 // samples q on the ray from p, in radians; -pi/2 where the ray leaves the field at once.
 #pragma once
 
-#include <cstddef>
-#include <functional>
 #include <vector>
 
 #include "hfvis/device.hpp"
 #include "hfvis/height_field.hpp"
+#include "hfvis/sweep_options.hpp"
 
 namespace hfvis {
 
@@ -23,15 +18,8 @@ enum class HorizonMethod {
   Naive,  // per-pixel ray march, bilinear samples: the O(N^3) baseline and oracle
 };
 
-struct HorizonOptions {
-  int directions = 64;              // K >= 1
-  double azimuth_offset = 0.0;      // radians added to every phi_k
-  double samples_per_unit = 1.0;    // height samples per pixel length along a line or ray
-  double lines_per_unit = 1.0;      // sweep lines per pixel length across the direction
+struct HorizonOptions : SweepOptions {
   HorizonMethod method = HorizonMethod::Sweep;
-  std::size_t memory_budget_bytes = 0;  // device memory for one batch; 0 = from the device
-  // Called after each batch of directions with (directions done, directions in all).
-  std::function<void(int, int)> progress;
 };
 
 // What to compute; only what is asked for is stored or reduced.
@@ -47,18 +35,15 @@ struct HorizonResult {
   int width = 0;
   int height = 0;
   int directions = 0;
-  std::vector<double> azimuths;           // phi_k, radians
-  std::vector<float> angles;              // directions planes of width*height, if asked
-  std::vector<float> distances;           // same layout; 0 where no point casts a horizon
-  std::vector<float> sky_view_factor;     // width*height, if asked
-  std::vector<float> ambient_occlusion;   // width*height, if asked
+  std::vector<double> azimuths;          // phi_k, radians
+  std::vector<float> angles;             // directions planes of width*height, if asked
+  std::vector<float> distances;          // same layout; 0 where no point casts a horizon
+  std::vector<float> sky_view_factor;    // width*height, if asked
+  std::vector<float> ambient_occlusion;  // width*height, if asked
 };
 
-// Azimuth of direction k, in radians.
-double directionAzimuth(int k, const HorizonOptions& options);
-
-// Throws InvalidArgument for K < 1, non-positive or non-finite sampling densities, or
-// when no output is requested.
+// Throws InvalidArgument for bad sweep options (see sweep_options.hpp) or when no output
+// is requested.
 void validate(const HorizonOptions& options, const HorizonOutputs& outputs);
 
 // Runs options.method on the device of `context`.

@@ -32,8 +32,8 @@ HeightField readHeightField(const std::string& path, const HeightFieldReadOption
 struct ImageChannels {
   int width = 0;
   int height = 0;
-  std::vector<std::string> names;           // one per channel
-  std::vector<std::vector<float>> planes;   // one per channel, row-major
+  std::vector<std::string> names;                               // one per channel
+  std::vector<std::vector<float>> planes;                       // one per channel, row-major
   std::vector<std::pair<std::string, std::string>> attributes;  // string metadata
 };
 

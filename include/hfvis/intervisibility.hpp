@@ -3,8 +3,7 @@
 // visible ground area estimated from them ("total viewshed"), and the convex hull tree's
 // statistics (Timonen 2013, Table 2).
 //
-// Conventions (../shared/DESIGN.md): direction k of K has azimuth
-// phi_k = 2*pi*k/K + azimuth_offset on the ground, in the (column, row) axes. Along
+// Directions follow hfvis/sweep_options.hpp. Along
 // direction k, receiver p sees the surface samples q = p + i * step * d_k, i >= 1, inside
 // the field (bilinear heights, nodata samples absent). Tie rule: q is visible when its
 // slope from p is >= the slope of every sample strictly between them (grazing samples are
@@ -12,13 +11,12 @@
 // march and brute force agree sample for sample on identical samples.
 #pragma once
 
-#include <cstddef>
 #include <cstdint>
-#include <functional>
 #include <vector>
 
 #include "hfvis/device.hpp"
 #include "hfvis/height_field.hpp"
+#include "hfvis/sweep_options.hpp"
 
 namespace hfvis {
 
@@ -27,15 +25,8 @@ enum class IntervisibilityMethod {
   Naive,     // per-pixel visibility march, bilinear samples: the O(N^3) baseline and oracle
 };
 
-struct IntervisibilityOptions {
-  int directions = 64;            // K >= 1
-  double azimuth_offset = 0.0;    // radians added to every phi_k
-  double samples_per_unit = 1.0;  // samples per pixel length along a line or ray, (0, 64]
-  double lines_per_unit = 1.0;    // sweep lines per pixel length across the direction, (0, 64]
+struct IntervisibilityOptions : SweepOptions {
   IntervisibilityMethod method = IntervisibilityMethod::HullTree;
-  std::size_t memory_budget_bytes = 0;  // device memory for one batch; 0 = from the device
-  // Called after each batch of directions with (directions done, directions in all).
-  std::function<void(int, int)> progress;
 };
 
 // What to compute; only what is asked for is stored or reduced.
@@ -80,11 +71,8 @@ struct IntervisibilityResult {
   IntervisibilityStatistics statistics;  // if asked
 };
 
-// Azimuth of direction k, in radians.
-double intervisibilityAzimuth(int k, const IntervisibilityOptions& options);
-
-// Throws InvalidArgument for K < 1, sampling densities outside (0, 64], a non-finite
-// azimuth offset, no output requested, or statistics asked of the naive method.
+// Throws InvalidArgument for bad sweep options (see sweep_options.hpp), no output
+// requested, or statistics asked of the naive method.
 void validate(const IntervisibilityOptions& options, const IntervisibilityOutputs& outputs);
 
 // Runs options.method on the device of `context`. Throws InvalidArgument (bad field or

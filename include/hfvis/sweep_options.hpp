@@ -1,0 +1,32 @@
+// hfvis/sweep_options.hpp: the options every sweep operation shares: directions, sampling
+// density along and across the sweep lines, device memory budget and progress.
+//
+// Direction k of K has azimuth phi_k = 2*pi*k/K + azimuth_offset, measured on the ground
+// in the (column, row) axes, so the ground direction is (cos phi_k, sin phi_k); with square
+// cells this is the pixel-axes direction itself (../shared/DESIGN.md). Compass azimuth
+// (clockwise from north = row -1) is 90 deg + phi in degrees when rows run south.
+#pragma once
+
+#include <cstddef>
+#include <functional>
+
+namespace hfvis {
+
+struct SweepOptions {
+  int directions = 64;                  // K >= 1
+  double azimuth_offset = 0.0;          // radians added to every phi_k
+  double samples_per_unit = 1.0;        // height samples per pixel length along a line or ray, (0, 64]
+  double lines_per_unit = 1.0;          // sweep lines per pixel length across the direction, (0, 64]
+  std::size_t memory_budget_bytes = 0;  // device memory for one batch; 0 = from the device
+  // Called after each batch of directions with (directions done, directions in all).
+  std::function<void(int, int)> progress;
+};
+
+// Azimuth of direction k, in radians.
+double directionAzimuth(int k, const SweepOptions& options);
+
+// Throws InvalidArgument for K < 1, sampling densities outside (0, 64] or a non-finite
+// azimuth offset.
+void validate(const SweepOptions& options);
+
+}  // namespace hfvis
