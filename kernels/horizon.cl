@@ -209,8 +209,21 @@ __kernel void horizon_reduce(__global const float* heights, int width, int heigh
       angle_sum += use ? w * angle : 0.0f;
       distance_sum += use ? w * ground : 0.0f;
     }
+    // Near the field's edges the surrounding line samples and the receiver's own ray can
+    // disagree on whether anything lies ahead: the receiver's first ray sample decides.
+    // A ray that leaves the field at once has horizon -pi/2; one that has a sample while
+    // no surrounding line sample saw an occluder gets that first sample's elevation.
+    float first_x = x + d.step_length * d.dir_x, first_y = y + d.step_length * d.dir_y;
+    int ray_has_sample = inside_field(first_x, first_y, width, height);
+    float first_rise = sample_height(heights, width, height, first_x, first_y) - h;
+    float first_ground = d.step_length * d.ground_per_pixel;
+    int use_first = ray_has_sample && !(weight > 0.0f) && !isnan(first_rise);
     float elevation = weight > 0.0f ? angle_sum / weight : -0.5f * HFVIS_PI;
     float distance = weight > 0.0f ? distance_sum / weight : 0.0f;
+    elevation = use_first ? hf_atan2_ahead(first_rise, first_ground) : elevation;
+    distance = use_first ? first_ground : distance;
+    elevation = ray_has_sample ? elevation : -0.5f * HFVIS_PI;
+    distance = ray_has_sample ? distance : 0.0f;
     elevation = isnan(h) ? NAN : elevation;
     distance = isnan(h) ? NAN : distance;
     if (valid) emit_direction(b, pixel, plane, elevation, distance, nx, ny, nz, d, angles, distances, &svf, &ao);

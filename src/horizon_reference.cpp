@@ -120,8 +120,16 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
           angle_sum += w * hfAtan2Ahead(rise, ground);
           distance_sum += w * ground;
         }
+        // The receiver's first ray sample decides at the edges, as in horizon_reduce.
+        const Point2 first{x + d.step_length * d.dir_x, y + d.step_length * d.dir_y};
+        const bool ray_has_sample = insideField(first, width, height);
+        const float first_rise = sampleHeight(h, width, height, first) - hp;
+        const float first_ground = d.step_length * d.ground_per_pixel;
+        const bool use_first = ray_has_sample && !(weight > 0.0f) && !std::isnan(first_rise);
         float elevation = weight > 0.0f ? angle_sum / weight : -0.5f * kPi;
         float distance = weight > 0.0f ? distance_sum / weight : 0.0f;
+        if (use_first) elevation = hfAtan2Ahead(first_rise, first_ground), distance = first_ground;
+        if (!ray_has_sample) elevation = -0.5f * kPi, distance = 0.0f;
         if (std::isnan(hp)) elevation = distance = kNaN;
         PixelSums one;
         emitDirection(result, k, pixel, elevation, distance, normals[pixel], d, options.directions, one);

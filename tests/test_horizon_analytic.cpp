@@ -37,6 +37,19 @@ TEST_P(HorizonAnalytic, FlatPlaneHasZeroHorizonInsideAndSkyViewAndOcclusionOfOne
       for (int c = 1; c < field.width - 1; ++c)
         ASSERT_NEAR(r.angles[k * plane + row * field.width + c], 0.0f, 1e-6) << "k " << k << " at " << c << "," << row;
   }
+  // Every direction: a pixel whose ray leaves the field at once sees nothing (-pi/2); one
+  // whose ray meets the plane sees it level (0).
+  for (int k = 0; k < 8; ++k) {
+    const double dx = std::cos(M_PI * k / 4), dy = std::sin(M_PI * k / 4);
+    for (int row = 0; row < field.height; ++row) {
+      for (int c = 0; c < field.width; ++c) {
+        const double x = c + dx, y = row + dy;
+        const bool leaves = x < -1e-3 || y < -1e-3 || x > field.width - 1 + 1e-3 || y > field.height - 1 + 1e-3;
+        ASSERT_NEAR(r.angles[k * plane + row * field.width + c], leaves ? -M_PI / 2 : 0.0, 1e-6)
+            << "k " << k << " at " << c << "," << row;
+      }
+    }
+  }
   // Axis directions: the edge pixel facing out sees nothing (-pi/2), its neighbour 0.
   for (int row = 0; row < field.height; ++row) {
     EXPECT_FLOAT_EQ(r.angles[0 * plane + row * field.width + field.width - 1], -M_PI / 2);
