@@ -23,7 +23,7 @@ std::string programOptions(const HorizonOptions& options, const HorizonOutputs& 
   s << "-DHFVIS_HAS_NODATA=" << has_nodata << " -DHFVIS_WANT_ANGLES=" << outputs.horizon_angles
     << " -DHFVIS_WANT_DISTANCES=" << outputs.horizon_distances
     << " -DHFVIS_WANT_SVF=" << outputs.sky_view_factor << " -DHFVIS_WANT_AO=" << outputs.ambient_occlusion
-    << " -DHFVIS_DIRECTIONS=" << options.directions;
+    << " -DHFVIS_DIRECTIONS=" << options.directions << " -DHFVIS_NEAR_SAMPLES=" << options.near_field_samples;
   return s.str();
 }
 

@@ -10,6 +10,10 @@ namespace hfvis {
 
 void validate(const HorizonOptions& options, const HorizonOutputs& outputs) {
   validate(static_cast<const SweepOptions&>(options));
+  if (options.near_field_samples < 1 || options.near_field_samples > 16) {
+    throw InvalidArgument("near-field samples must be in 1..16 (got " + std::to_string(options.near_field_samples) +
+                          ")");
+  }
   if (!outputs.horizon_angles && !outputs.horizon_distances && !outputs.sky_view_factor &&
       !outputs.ambient_occlusion) {
     throw InvalidArgument("no output requested");

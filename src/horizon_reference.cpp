@@ -16,6 +16,7 @@ namespace {
 
 constexpr float kPi = 3.14159265358979323846f;
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+constexpr float kNearMargin = 4e-6f;  // HFVIS_NEAR_MARGIN
 
 struct Normal {
   float x = 0.0f, y = 0.0f, z = 1.0f;
@@ -120,15 +121,26 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
           angle_sum += w * hfAtan2Ahead(rise, ground);
           distance_sum += w * ground;
         }
-        // The receiver's first ray sample decides at the edges, as in horizon_reduce.
-        const Point2 first{x + d.step_length * d.dir_x, y + d.step_length * d.dir_y};
-        const bool ray_has_sample = insideField(first, width, height);
-        const float first_rise = sampleHeight(h, width, height, first) - hp;
-        const float first_ground = d.step_length * d.ground_per_pixel;
-        const bool use_first = ray_has_sample && !(weight > 0.0f) && !std::isnan(first_rise);
+        // The exact near field of the receiver's own ray, as in horizon_reduce.
+        float near_slope = 0.0f, near_t = 0.0f;
+        bool near_found = false, ray_has_sample = false;
+        for (int q = 1; q <= options.near_field_samples; ++q) {
+          const float t =
+              static_cast<float>(q) * (d.step_length / static_cast<float>(options.near_field_samples));
+          const Point2 at{x + t * d.dir_x, y + t * d.dir_y};
+          const bool inside = insideField(at, width, height);
+          const float slope = (sampleHeight(h, width, height, at) - hp) / t;
+          if (inside && !std::isnan(slope) && (!near_found || slope >= near_slope)) {
+            near_slope = slope, near_t = t, near_found = true;
+          }
+          if (q == 1) ray_has_sample = inside;
+        }
+        const float near_elevation = hfAtan(near_slope / d.ground_per_pixel);
         float elevation = weight > 0.0f ? angle_sum / weight : -0.5f * kPi;
         float distance = weight > 0.0f ? distance_sum / weight : 0.0f;
-        if (use_first) elevation = hfAtan2Ahead(first_rise, first_ground), distance = first_ground;
+        if (near_found && (!(weight > 0.0f) || near_elevation > elevation + kNearMargin)) {
+          elevation = near_elevation, distance = near_t * d.ground_per_pixel;
+        }
         if (!ray_has_sample) elevation = -0.5f * kPi, distance = 0.0f;
         if (std::isnan(hp)) elevation = distance = kNaN;
         PixelSums one;

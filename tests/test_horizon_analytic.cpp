@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "hfvis/horizon.hpp"
+#include "hfvis/image_io.hpp"
 #include "hfvis/synthetic_fields.hpp"
 #include "test_support.hpp"
 
@@ -123,6 +124,51 @@ TEST_P(HorizonAnalytic, TiltedPlaneOcclusionAndSkyView) {
 
 INSTANTIATE_TEST_SUITE_P(Methods, HorizonAnalytic, ::testing::Values(HorizonMethod::Sweep, HorizonMethod::Naive),
                          [](const auto& info) { return info.param == HorizonMethod::Sweep ? "Sweep" : "Naive"; });
+
+}  // namespace
+}  // namespace hfvis
+
+namespace hfvis {
+namespace {
+
+// Grid accuracy, a loose regression bound (the benchmark reports the figures): on a crop of
+// the bundled fractal terrain, the sweep's mean horizon error against a dense naive march
+// (8 samples per pixel) stays small, and sampling the receiver's own near field makes it
+// smaller than interpolating line samples alone.
+TEST(HorizonAccuracy, SweepWithExactNearFieldIsCloseToADenseMarch) {
+  const HeightField whole = readHeightField(std::string(HFVIS_DATA_DIR) + "/fractal_256.exr");
+  const int size = 96, origin = 80;
+  HeightField field = testing::fieldFrom(size, size, {});
+  for (int r = 0; r < size; ++r)
+    for (int c = 0; c < size; ++c) field.heights.push_back(whole.at(origin + c, origin + r));
+  HorizonOutputs outputs;
+  outputs.horizon_angles = true;
+  HorizonOptions dense;
+  dense.directions = 16;
+  dense.method = HorizonMethod::Naive;
+  dense.samples_per_unit = 8;
+  const auto truth = computeHorizons(testing::testContext(), field, dense, outputs);
+  auto meanErrorDegrees = [&](int near_field_samples) {
+    HorizonOptions options;
+    options.directions = 16;
+    options.near_field_samples = near_field_samples;
+    const auto sweep = computeHorizons(testing::testContext(), field, options, outputs);
+    double sum = 0.0;
+    int count = 0;
+    for (int k = 0; k < 16; ++k)
+      for (int r = 2; r < size - 2; ++r)
+        for (int c = 2; c < size - 2; ++c) {
+          const std::size_t i = k * field.pixelCount() + r * size + c;
+          sum += std::abs(sweep.angles[i] - truth.angles[i]), ++count;
+        }
+    return sum / count * 180.0 / M_PI;
+  };
+  const double lines_only = meanErrorDegrees(1), with_near_field = meanErrorDegrees(4);
+  RecordProperty("mean_error_deg_lines_only", std::to_string(lines_only));
+  RecordProperty("mean_error_deg_near_field", std::to_string(with_near_field));
+  EXPECT_LT(with_near_field, 0.6) << "lines only: " << lines_only;
+  EXPECT_LT(with_near_field, 0.7 * lines_only);
+}
 
 }  // namespace
 }  // namespace hfvis

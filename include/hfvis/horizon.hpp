@@ -20,6 +20,11 @@ enum class HorizonMethod {
 
 struct HorizonOptions : SweepOptions {
   HorizonMethod method = HorizonMethod::Sweep;
+  // Sweep only: samples of the receiver's own ray over its first step (1..16). The sweep's
+  // horizons come from line samples up to a line spacing away, whose first steps differ
+  // from the receiver's; the receiver's exact near field bounds its horizon from below and
+  // wins where steeper. 1 samples the first step only, as the naive march does.
+  int near_field_samples = 4;
 };
 
 // What to compute; only what is asked for is stored or reduced.
