@@ -14,8 +14,9 @@ namespace hfvis::cli {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+constexpr const char* kCommandList = "horizon, svf, ao, viewcount, horizons, bounce or devices";
 
-// One option of the compute commands (horizon, svf, ao).
+// One option of the compute commands (horizon, svf, ao, viewcount, horizons, bounce).
 enum class Option {
   Output,
   Directions,
@@ -30,6 +31,9 @@ enum class Option {
   MemoryBudget,
   Preview,
   DistanceOutput,
+  Statistics,
+  At,
+  Radiance,
   Quiet,
 };
 
@@ -54,8 +58,21 @@ constexpr OptionSpec kOptions[] = {
     {Option::MemoryBudget, "--memory-budget", nullptr, true},
     {Option::Preview, "--preview", nullptr, true},
     {Option::DistanceOutput, "--distance-out", nullptr, true},
+    {Option::Statistics, "--stats", nullptr, false},
+    {Option::At, "--at", nullptr, true},
+    {Option::Radiance, "--radiance", nullptr, true},
     {Option::Quiet, "--quiet", "-q", false},
 };
+
+// The options every sweep operation shares, as typed (degrees become radians).
+template <typename Options>
+void setSweepOptions(const RunArguments& run, Options& options) {
+  options.directions = run.directions;
+  options.azimuth_offset = run.azimuth_offset_deg * (kPi / 180.0);
+  options.samples_per_unit = run.samples_per_unit;
+  options.lines_per_unit = run.lines_per_unit;
+  options.memory_budget_bytes = run.memory_budget_bytes;
+}
 
 bool isHelpFlag(const std::string& arg) { return arg == "-h" || arg == "--help"; }
 
@@ -63,6 +80,9 @@ std::optional<Command> findCommand(const std::string& name) {
   if (name == "horizon") return Command::Horizon;
   if (name == "svf") return Command::SkyViewFactor;
   if (name == "ao") return Command::AmbientOcclusion;
+  if (name == "viewcount") return Command::ViewCount;
+  if (name == "horizons") return Command::HorizonLists;
+  if (name == "bounce") return Command::Bounce;
   if (name == "devices") return Command::Devices;
   if (name == "help") return Command::Help;
   return std::nullopt;
@@ -115,6 +135,69 @@ HorizonMethod parseMethod(const std::string& option, const std::string& text) {
   throw UsageError(option + ": expected 'sweep' or 'naive', got " + inQuotes(text));
 }
 
+IntervisibilityMethod parseVisibilityMethod(const std::string& option, const std::string& text) {
+  if (text == "tree") return IntervisibilityMethod::HullTree;
+  if (text == "naive") return IntervisibilityMethod::Naive;
+  throw UsageError(option + ": expected 'tree' or 'naive', got " + inQuotes(text));
+}
+
+// "COL,ROW": a pixel, zero-based. Whether it lies inside the field is checked once the
+// field's size is known (checkReceivers).
+ReceiverPixel parseReceiver(const std::string& option, const std::string& text) {
+  const std::string expected =
+      option + ": expected COL,ROW (zero-based pixel column and row, e.g. 12,40), got " + inQuotes(text);
+  const std::size_t comma = text.find(',');
+  if (comma == std::string::npos) throw UsageError(expected);
+  auto whole = [&](const std::string& part) {
+    const char* begin = part.c_str();
+    char* end = nullptr;
+    errno = 0;
+    const long value = std::strtol(begin, &end, 10);
+    if (part.empty() || end != begin + part.size() || errno == ERANGE ||
+        value > std::numeric_limits<int>::max() || value < std::numeric_limits<int>::min()) {
+      throw UsageError(expected);
+    }
+    return static_cast<int>(value);
+  };
+  ReceiverPixel pixel{whole(text.substr(0, comma)), whole(text.substr(comma + 1))};
+  if (pixel.col < 0 || pixel.row < 0) {
+    throw UsageError(option + " " + text + ": outside the field (column and row count from 0)");
+  }
+  return pixel;
+}
+
+bool hasExtension(const std::string& path, const char* wanted) {
+  std::string extension = std::filesystem::path(path).extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return extension == wanted;
+}
+
+// Which commands take an option; nullptr = every compute command.
+const char* onlyFor(Option option) {
+  switch (option) {
+    case Option::DistanceOutput:
+      return "horizon";
+    case Option::Statistics:
+      return "viewcount";
+    case Option::At:
+      return "horizons";
+    case Option::Radiance:
+      return "bounce";
+    default:
+      return nullptr;
+  }
+}
+
+// Options that make no sense for a command (the horizon lists are computed on the host,
+// one ray per receiver and direction, and written as text).
+bool notFor(Option option, Command command) {
+  if (command == Command::HorizonLists) {
+    return option == Option::Method || option == Option::LinesPerUnit || option == Option::Device ||
+           option == Option::MemoryBudget || option == Option::Preview;
+  }
+  return command == Command::Bounce && option == Option::Method;
+}
+
 // "X" or "X,Y", ground units per pixel along columns and rows.
 void parseCellSize(const std::string& option, const std::string& text, RunArguments& run) {
   const std::size_t comma = text.find(',');
@@ -135,11 +218,7 @@ std::size_t parseMemoryBudget(const std::string& option, const std::string& text
   return static_cast<std::size_t>(bytes);
 }
 
-bool hasPngExtension(const std::string& path) {
-  std::string extension = std::filesystem::path(path).extension().string();
-  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return extension == ".png";
-}
+bool hasPngExtension(const std::string& path) { return hasExtension(path, ".png"); }
 
 void requireNonEmpty(const std::string& option, const std::string& value) {
   if (value.empty()) throw UsageError(option + ": the value must not be empty");
@@ -147,6 +226,12 @@ void requireNonEmpty(const std::string& option, const std::string& value) {
 
 void applyOption(const OptionSpec& spec, const std::string& typed, const std::string& value, Command command,
                  RunArguments& run) {
+  if (const char* only = onlyFor(spec.option); only && commandName(command) != std::string(only)) {
+    throw UsageError(typed + " is only available with 'hfvis " + only + "'");
+  }
+  if (notFor(spec.option, command)) {
+    throw UsageError(typed + " is not available with 'hfvis " + commandName(command) + "'");
+  }
   switch (spec.option) {
     case Option::Output:
       requireNonEmpty(typed, value);
@@ -156,7 +241,11 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
       run.directions = parseDirectionCount(typed, value);
       break;
     case Option::Method:
-      run.method = parseMethod(typed, value);
+      if (command == Command::ViewCount) {
+        run.visibility_method = parseVisibilityMethod(typed, value);
+      } else {
+        run.method = parseMethod(typed, value);
+      }
       break;
     case Option::AzimuthOffset:
       run.azimuth_offset_deg = parseNumber(typed, value);
@@ -193,11 +282,18 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
       run.preview = value;
       break;
     case Option::DistanceOutput:
-      if (command != Command::Horizon) {
-        throw UsageError(typed + " is only available with 'hfvis horizon'");
-      }
       requireNonEmpty(typed, value);
       run.distance_output = value;
+      break;
+    case Option::Statistics:
+      run.statistics = true;
+      break;
+    case Option::At:
+      run.receivers.push_back(parseReceiver(typed, value));
+      break;
+    case Option::Radiance:
+      requireNonEmpty(typed, value);
+      run.radiance = value;
       break;
     case Option::Quiet:
       run.quiet = true;
@@ -212,9 +308,31 @@ bool samePath(const std::string& a, const std::string& b) {
 // Checks that involve more than one option, and the library's own argument checks.
 void validateRun(Command command, const RunArguments& run) {
   const std::string name = commandName(command);
+  const std::string out = command == Command::HorizonLists ? "OUT.json|OUT.csv" : "OUT.exr";
   if (run.input.empty())
-    throw UsageError("missing the input height field (hfvis " + name + " IN -o OUT.exr)");
-  if (run.output.empty()) throw UsageError("missing -o OUT.exr (the output file of 'hfvis " + name + "')");
+    throw UsageError("missing the input height field (hfvis " + name + " IN -o " + out + ")");
+  if (run.output.empty())
+    throw UsageError("missing -o " + out + " (the output file of 'hfvis " + name + "')");
+  if (command == Command::HorizonLists) {
+    if (!hasExtension(run.output, ".json") && !hasExtension(run.output, ".csv")) {
+      throw UsageError(
+          "-o: the horizon lists are written as JSON or CSV; the name must end in .json or .csv, got " +
+          inQuotes(run.output));
+    }
+    if (run.receivers.empty())
+      throw UsageError("missing --at COL,ROW (the receivers whose horizons to list)");
+  }
+  if (command == Command::Bounce) {
+    if (run.radiance.empty()) {
+      throw UsageError("missing --radiance RAD.exr (the exit radiance to bounce, same size as the input)");
+    }
+    if (samePath(run.output, run.radiance)) {
+      throw UsageError("--radiance must differ from -o, both are " + inQuotes(run.output));
+    }
+    if (!run.preview.empty() && samePath(run.preview, run.radiance)) {
+      throw UsageError("--preview must differ from --radiance, both are " + inQuotes(run.preview));
+    }
+  }
   if (!run.distance_output.empty() && samePath(run.output, run.distance_output)) {
     throw UsageError("--distance-out must differ from -o, both are " + inQuotes(run.output));
   }
@@ -225,8 +343,27 @@ void validateRun(Command command, const RunArguments& run) {
     throw UsageError("--preview must differ from --distance-out, both are " + inQuotes(run.preview));
   }
   try {
-    validate(horizonOptions(run), horizonOutputs(command, run));
+    switch (command) {
+      case Command::ViewCount:
+        validate(intervisibilityOptions(run), intervisibilityOutputs(run));
+        break;
+      case Command::HorizonLists:
+        validate(horizonListOptions(run));
+        break;
+      case Command::Bounce:
+        validate(bounceOptions(run));
+        break;
+      default:
+        validate(horizonOptions(run), horizonOutputs(command, run));
+        break;
+    }
   } catch (const InvalidArgument& error) {
+    // "statistics ... only for the hull-tree method" reads better in the CLI's words.
+    if (command == Command::ViewCount && run.statistics &&
+        run.visibility_method != IntervisibilityMethod::HullTree) {
+      throw UsageError(
+          "--stats needs --method tree (the naive method has no horizons or iterations to count)");
+    }
     throw UsageError(error.what());
   }
 }
@@ -305,22 +442,27 @@ const char* commandName(Command command) {
       return "svf";
     case Command::AmbientOcclusion:
       return "ao";
+    case Command::ViewCount:
+      return "viewcount";
+    case Command::HorizonLists:
+      return "horizons";
+    case Command::Bounce:
+      return "bounce";
   }
   return "?";
 }
 
 CommandLine parseCommandLine(const std::vector<std::string>& args) {
   CommandLine line;
-  if (args.empty()) throw UsageError("no command given (horizon, svf, ao or devices)");
+  if (args.empty()) throw UsageError(std::string("no command given (") + kCommandList + ")");
   const std::string& first = args[0];
   if (isHelpFlag(first)) return line;  // Command::Help, no topic
   if (!first.empty() && first[0] == '-') {
-    throw UsageError("unknown option " + inQuotes(first) +
-                     " (give a command first: horizon, svf, ao or devices)");
+    throw UsageError("unknown option " + inQuotes(first) + " (give a command first: " + kCommandList + ")");
   }
   const std::optional<Command> command = findCommand(first);
   if (!command) {
-    throw UsageError("unknown command " + inQuotes(first) + " (expected horizon, svf, ao or devices)");
+    throw UsageError("unknown command " + inQuotes(first) + " (expected " + kCommandList + ")");
   }
   const std::vector<std::string> rest(args.begin() + 1, args.end());
 
@@ -329,7 +471,7 @@ CommandLine parseCommandLine(const std::vector<std::string>& args) {
     if (!rest.empty()) {
       const std::optional<Command> topic = findCommand(rest[0]);
       if (!topic)
-        throw UsageError("unknown command " + inQuotes(rest[0]) + " (expected horizon, svf, ao or devices)");
+        throw UsageError("unknown command " + inQuotes(rest[0]) + " (expected " + kCommandList + ")");
       if (*topic != Command::Help) line.help_topic = topic;
     }
     return line;
@@ -355,12 +497,8 @@ CommandLine parseCommandLine(const std::vector<std::string>& args) {
 
 HorizonOptions horizonOptions(const RunArguments& run) {
   HorizonOptions options;
-  options.directions = run.directions;
-  options.azimuth_offset = run.azimuth_offset_deg * (kPi / 180.0);
-  options.samples_per_unit = run.samples_per_unit;
-  options.lines_per_unit = run.lines_per_unit;
+  setSweepOptions(run, options);
   options.method = run.method;
-  options.memory_budget_bytes = run.memory_budget_bytes;
   return options;
 }
 
@@ -377,11 +515,37 @@ HorizonOutputs horizonOutputs(Command command, const RunArguments& run) {
     case Command::AmbientOcclusion:
       outputs.ambient_occlusion = true;
       break;
-    case Command::Help:
-    case Command::Devices:
+    default:
       break;
   }
   return outputs;
+}
+
+IntervisibilityOptions intervisibilityOptions(const RunArguments& run) {
+  IntervisibilityOptions options;
+  setSweepOptions(run, options);
+  options.method = run.visibility_method;
+  return options;
+}
+
+IntervisibilityOutputs intervisibilityOutputs(const RunArguments& run) {
+  IntervisibilityOutputs outputs;
+  outputs.visible_count = true;
+  outputs.visible_area = true;
+  outputs.statistics = run.statistics;
+  return outputs;
+}
+
+SweepOptions horizonListOptions(const RunArguments& run) {
+  SweepOptions options;
+  setSweepOptions(run, options);
+  return options;
+}
+
+BounceOptions bounceOptions(const RunArguments& run) {
+  BounceOptions options;
+  setSweepOptions(run, options);
+  return options;
 }
 
 HeightFieldReadOptions readOptions(const RunArguments& run) {

@@ -9,8 +9,11 @@
 #include <string>
 #include <vector>
 
+#include "hfvis/bounce.hpp"
 #include "hfvis/horizon.hpp"
+#include "hfvis/horizon_lists.hpp"
 #include "hfvis/image_io.hpp"
+#include "hfvis/intervisibility.hpp"
 
 namespace hfvis::cli {
 
@@ -21,12 +24,21 @@ class UsageError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-enum class Command { Help, Devices, Horizon, SkyViewFactor, AmbientOcclusion };
+enum class Command {
+  Help,
+  Devices,
+  Horizon,
+  SkyViewFactor,
+  AmbientOcclusion,
+  ViewCount,     // visible samples and ground area per pixel (intervisibility)
+  HorizonLists,  // "horizons": visibility horizons of chosen receivers, JSON or CSV
+  Bounce,        // one diffuse bounce of a given exit radiance
+};
 
 // The subcommand's name as typed ("horizon", "svf", ...).
 const char* commandName(Command command);
 
-// Everything a horizon/svf/ao run needs, already validated.
+// Everything a compute command's run needs, already validated.
 struct RunArguments {
   std::string input;
   std::string output;
@@ -36,8 +48,12 @@ struct RunArguments {
   double azimuth_offset_deg = 0.0;
   double samples_per_unit = 1.0;
   double lines_per_unit = 1.0;
-  HorizonMethod method = HorizonMethod::Sweep;
-  double cell_size_x = 0.0;  // <= 0: from the file, else 1
+  HorizonMethod method = HorizonMethod::Sweep;                                // horizon, svf, ao
+  IntervisibilityMethod visibility_method = IntervisibilityMethod::HullTree;  // viewcount
+  bool statistics = false;                                                    // viewcount --stats
+  std::vector<ReceiverPixel> receivers;  // horizons --at, in the order given
+  std::string radiance;                  // bounce --radiance
+  double cell_size_x = 0.0;              // <= 0: from the file, else 1
   double cell_size_y = 0.0;
   double z_scale = 1.0;
   std::string channel;                  // "" = the only channel
@@ -59,6 +75,10 @@ CommandLine parseCommandLine(const std::vector<std::string>& args);
 // The library options and outputs a run asks for.
 HorizonOptions horizonOptions(const RunArguments& run);
 HorizonOutputs horizonOutputs(Command command, const RunArguments& run);
+IntervisibilityOptions intervisibilityOptions(const RunArguments& run);
+IntervisibilityOutputs intervisibilityOutputs(const RunArguments& run);
+SweepOptions horizonListOptions(const RunArguments& run);
+BounceOptions bounceOptions(const RunArguments& run);
 HeightFieldReadOptions readOptions(const RunArguments& run);
 
 }  // namespace hfvis::cli

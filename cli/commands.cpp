@@ -1,16 +1,21 @@
-// cli/commands.cpp: the hfvis subcommands: listing devices, and horizon/svf/ao runs
-// (read, compute, then write every output all-or-nothing).
+// cli/commands.cpp: the hfvis subcommands: listing devices, and the compute commands
+// (horizon, svf, ao, viewcount, horizons, bounce): read, compute, then write every output
+// all-or-nothing.
 #include "commands.hpp"
 
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <iomanip>
 #include <iostream>
@@ -20,11 +25,15 @@
 #include <utility>
 #include <vector>
 
+#include "hfvis/bounce.hpp"
 #include "hfvis/device.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/height_field.hpp"
 #include "hfvis/horizon.hpp"
+#include "hfvis/horizon_lists.hpp"
 #include "hfvis/image_io.hpp"
+#include "hfvis/intervisibility.hpp"
+#include "horizon_list_files.hpp"
 
 namespace hfvis::cli {
 namespace {
@@ -192,7 +201,17 @@ void requireSize(const std::vector<float>& values, std::size_t expected, const c
   }
 }
 
-const char* methodName(HorizonMethod method) { return method == HorizonMethod::Naive ? "naive" : "sweep"; }
+const char* methodName(Command command, const RunArguments& run) {
+  switch (command) {
+    case Command::ViewCount:
+      return run.visibility_method == IntervisibilityMethod::Naive ? "naive" : "tree";
+    case Command::HorizonLists:
+    case Command::Bounce:
+      return "tree";
+    default:
+      return run.method == HorizonMethod::Naive ? "naive" : "sweep";
+  }
+}
 
 using Attributes = std::vector<std::pair<std::string, std::string>>;
 
@@ -207,7 +226,7 @@ Attributes runAttributes(Command command, const RunArguments& run, const HeightF
       {"hfvis:azimuth_convention",
        "phi_k = 360*k/K deg + offset, on the ground from the +column axis toward +row; "
        "compass azimuth = 90 + phi_k deg when row 0 is north"},
-      {"hfvis:method", methodName(run.method)},
+      {"hfvis:method", methodName(command, run)},
       {"hfvis:samples_per_unit", formatNumber(run.samples_per_unit)},
       {"hfvis:lines_per_unit", formatNumber(run.lines_per_unit)},
       // Read back by readHeightField, so an output keeps the input's ground spacing.
@@ -221,12 +240,12 @@ Attributes runAttributes(Command command, const RunArguments& run, const HeightF
   return attributes;
 }
 
-ImageChannels makeImage(const HorizonResult& result, std::vector<std::string> names,
+ImageChannels makeImage(int width, int height, std::vector<std::string> names,
                         std::vector<std::vector<float>> planes, Attributes attributes,
                         const std::string& quantity, const std::string& units) {
   ImageChannels image;
-  image.width = result.width;
-  image.height = result.height;
+  image.width = width;
+  image.height = height;
   image.names = std::move(names);
   image.planes = std::move(planes);
   image.attributes = std::move(attributes);
@@ -239,6 +258,82 @@ std::string joinPaths(const std::vector<std::string>& paths) {
   std::string joined;
   for (const std::string& path : paths) joined += (joined.empty() ? "" : ", ") + path;
   return joined;
+}
+
+// Reads the input height field and checks it (a bad field is the input file's fault).
+HeightField readValidField(const RunArguments& run) {
+  HeightField field = readHeightField(run.input, readOptions(run));
+  try {
+    validate(field);
+  } catch (const InvalidArgument& error) {
+    throw Error(run.input + ": " + error.what());
+  }
+  return field;
+}
+
+// Progress on stderr when it is a terminal: one line rewritten in place, at most a few
+// times a second (batches can be tiny). Wrap the computation in run() so that an error
+// message after a half-written progress line starts on a line of its own.
+class Progress {
+ public:
+  explicit Progress(bool quiet) : enabled_(!quiet && ::isatty(::fileno(stderr))) {}
+
+  std::function<void(int, int)> callback() {
+    if (!enabled_) return {};
+    return [this](int done, int total) {
+      const auto now = std::chrono::steady_clock::now();
+      if (done < total && now - last_ < std::chrono::milliseconds(250)) return;
+      last_ = now;
+      line_open_ = done < total;
+      std::fprintf(stderr, "\rhfvis: %d/%d directions%s", done, total, line_open_ ? "" : "\n");
+      std::fflush(stderr);
+    };
+  }
+
+  template <typename Body>
+  auto run(Body&& body) -> decltype(body()) {
+    try {
+      return body();
+    } catch (...) {
+      if (line_open_) std::fputc('\n', stderr);
+      throw;
+    }
+  }
+
+ private:
+  bool enabled_;
+  bool line_open_ = false;
+  std::chrono::steady_clock::time_point last_{};
+};
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void requireResultSize(int width, int height, const HeightField& field) {
+  if (width != field.width || height != field.height) {
+    throw Error("internal error: the result is " + std::to_string(width) + "x" + std::to_string(height) +
+                ", the height field " + std::to_string(field.width) + "x" + std::to_string(field.height));
+  }
+}
+
+// "wrote FILES (WxH, K directions, METHOD, T s on DEVICE)NOTE".
+void printSummary(const std::vector<std::string>& written, int width, int height, int directions,
+                  const std::string& method, double seconds, const std::string& device,
+                  const std::string& note) {
+  std::cout << "wrote " << joinPaths(written) << " (" << width << "x" << height << ", " << directions
+            << (directions == 1 ? " direction, " : " directions, ") << method << ", "
+            << formatFixed(seconds, 2) << " s" << (device.empty() ? "" : " on " + device) << ")" << note
+            << "\n";
+}
+
+// Writes `text` to `path` completely or throws IoError.
+void writeTextFile(const std::string& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) throw IoError(path, std::string("cannot open for writing: ") + std::strerror(errno));
+  out << text;
+  out.flush();
+  if (!out) throw IoError(path, std::string("cannot write: ") + std::strerror(errno));
 }
 
 }  // namespace
@@ -293,44 +388,18 @@ int runDevices() {
 int runCompute(Command command, const RunArguments& run) {
   for (const std::string& path : outputPaths(run)) requireOutputLocation(path);
 
-  HeightField field = readHeightField(run.input, readOptions(run));
-  try {
-    validate(field);
-  } catch (const InvalidArgument& error) {
-    throw Error(run.input + ": " + error.what());
-  }
-
+  const HeightField field = readValidField(run);
   const ComputeContext context = ComputeContext::create(run.device);
   const DeviceInfo& device = context.device();
 
   HorizonOptions options = horizonOptions(run);
-  bool progress_line_open = false;  // a progress line without its newline yet
-  if (!run.quiet && ::isatty(::fileno(stderr))) {
-    // One line rewritten in place, at most a few times a second (batches can be tiny).
-    options.progress = [&progress_line_open, last = std::chrono::steady_clock::time_point()](
-                           int done, int total) mutable {
-      const auto now = std::chrono::steady_clock::now();
-      if (done < total && now - last < std::chrono::milliseconds(250)) return;
-      last = now;
-      progress_line_open = done < total;
-      std::fprintf(stderr, "\rhfvis: %d/%d directions%s", done, total, progress_line_open ? "" : "\n");
-      std::fflush(stderr);
-    };
-  }
+  Progress progress(run.quiet);
+  options.progress = progress.callback();
   const auto start = std::chrono::steady_clock::now();
-  HorizonResult result;
-  try {
-    result = computeHorizons(context, field, options, horizonOutputs(command, run));
-  } catch (...) {
-    if (progress_line_open) std::fputc('\n', stderr);  // the error message gets its own line
-    throw;
-  }
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (result.width != field.width || result.height != field.height) {
-    throw Error("internal error: the result is " + std::to_string(result.width) + "x" +
-                std::to_string(result.height) + ", the height field " + std::to_string(field.width) + "x" +
-                std::to_string(field.height));
-  }
+  const HorizonResult result =
+      progress.run([&] { return computeHorizons(context, field, options, horizonOutputs(command, run)); });
+  const double seconds = secondsSince(start);
+  requireResultSize(result.width, result.height, field);
 
   const std::size_t pixels = static_cast<std::size_t>(result.width) * static_cast<std::size_t>(result.height);
   const int directions = run.directions;
@@ -342,17 +411,19 @@ int runCompute(Command command, const RunArguments& run) {
   if (command == Command::Horizon) {
     const std::size_t values = pixels * static_cast<std::size_t>(directions);
     requireSize(result.angles, values, "horizon angles");
-    const ImageChannels angles = makeImage(
-        result, directionChannelNames("h", directions), splitPlanes(result.angles, pixels, directions),
-        attributes, "horizon elevation angle per direction (channel k = direction k)",
-        "radians above the horizontal; -pi/2 where the ray leaves the field at once");
+    const ImageChannels angles =
+        makeImage(result.width, result.height, directionChannelNames("h", directions),
+                  splitPlanes(result.angles, pixels, directions), attributes,
+                  "horizon elevation angle per direction (channel k = direction k)",
+                  "radians above the horizontal; -pi/2 where the ray leaves the field at once");
     outputs.stage(run.output, [&](const std::string& path) { writeImage(path, angles); });
     if (!run.distance_output.empty()) {
       requireSize(result.distances, values, "horizon distances");
-      const ImageChannels distances = makeImage(
-          result, directionChannelNames("d", directions), splitPlanes(result.distances, pixels, directions),
-          attributes, "ground distance to the point casting the horizon, per direction",
-          "ground units (pixels times cell size); 0 where no point casts a horizon");
+      const ImageChannels distances =
+          makeImage(result.width, result.height, directionChannelNames("d", directions),
+                    splitPlanes(result.distances, pixels, directions), attributes,
+                    "ground distance to the point casting the horizon, per direction",
+                    "ground units (pixels times cell size); 0 where no point casts a horizon");
       outputs.stage(run.distance_output, [&](const std::string& path) { writeImage(path, distances); });
     }
     if (!run.preview.empty()) {
@@ -367,7 +438,7 @@ int runCompute(Command command, const RunArguments& run) {
     const std::string channel = svf ? "svf" : "ao";
     requireSize(plane, pixels, svf ? "sky-view factor" : "ambient occlusion");
     const ImageChannels image =
-        makeImage(result, {channel}, {plane}, attributes,
+        makeImage(result.width, result.height, {channel}, {plane}, attributes,
                   svf ? "sky-view factor 1 - mean_k sin(max(0, elevation_k))"
                       : "ambient occlusion, uniform sky of radiance 1 (Timonen & Westerholm 2010, Eq. 5)",
                   svf ? "fraction of the sky visible, 0..1" : "0..1, a flat unoccluded plane gives 1");
@@ -383,9 +454,185 @@ int runCompute(Command command, const RunArguments& run) {
   outputs.commit();
 
   if (!run.quiet) {
-    std::cout << "wrote " << joinPaths(written) << " (" << result.width << "x" << result.height << ", "
-              << directions << (directions == 1 ? " direction, " : " directions, ") << methodName(run.method)
-              << ", " << formatFixed(seconds, 2) << " s on " << device.name << ")" << mean_note << "\n";
+    printSummary(written, result.width, result.height, directions, methodName(command, run), seconds,
+                 device.name, mean_note);
+  }
+  return 0;
+}
+
+int runViewCount(const RunArguments& run) {
+  for (const std::string& path : outputPaths(run)) requireOutputLocation(path);
+  const HeightField field = readValidField(run);
+  const ComputeContext context = ComputeContext::create(run.device);
+  const DeviceInfo& device = context.device();
+
+  IntervisibilityOptions options = intervisibilityOptions(run);
+  Progress progress(run.quiet);
+  options.progress = progress.callback();
+  const auto start = std::chrono::steady_clock::now();
+  const IntervisibilityResult result = progress.run(
+      [&] { return computeIntervisibility(context, field, options, intervisibilityOutputs(run)); });
+  const double seconds = secondsSince(start);
+  requireResultSize(result.width, result.height, field);
+  const std::size_t pixels = field.pixelCount();
+  requireSize(result.visible_count, pixels, "visible counts");
+  requireSize(result.visible_area, pixels, "visible areas");
+
+  Attributes attributes = runAttributes(Command::ViewCount, run, field, device);
+  attributes.emplace_back("hfvis:tie_rule",
+                          "a sample is visible when its slope from the receiver is >= the slope of every "
+                          "sample between them (grazing samples are visible), decided exactly");
+  const IntervisibilityStatistics& stats = result.statistics;
+  std::string stats_line;
+  if (run.statistics) {
+    // Seed 000, Table 2: per receiver (line sample) and direction.
+    attributes.emplace_back("hfvis:stats_m_a", formatNumber(stats.meanHorizons()));
+    attributes.emplace_back("hfvis:stats_t_a", formatNumber(stats.meanIterations()));
+    attributes.emplace_back("hfvis:stats_visible_per_point", formatNumber(stats.meanVisible()));
+    attributes.emplace_back("hfvis:stats_naive_iterations_per_point",
+                            formatNumber(stats.meanNaiveIterations()));
+    attributes.emplace_back("hfvis:stats_receivers", std::to_string(stats.receivers));
+    stats_line = "statistics per point and direction (Timonen 2013, Table 2): m_a " +
+                 formatFixed(stats.meanHorizons(), 3) + ", t_a " + formatFixed(stats.meanIterations(), 3) +
+                 ", visible " + formatFixed(stats.meanVisible(), 3) + ", naive iterations " +
+                 formatFixed(stats.meanNaiveIterations(), 3) + " (" + std::to_string(stats.receivers) +
+                 " line samples, " + std::to_string(stats.lines_over_bound) + " lines over t <= 2m + n)";
+  }
+
+  StagedOutputs outputs;
+  // "count" sorts before "visible_area", so the count is channel 0 in the EXR, whose
+  // channels are stored sorted by name.
+  const ImageChannels image = makeImage(
+      field.width, field.height, {"count", "visible_area"}, {result.visible_count, result.visible_area},
+      attributes,
+      "count: visible surface samples summed over the K directions; visible_area: the visible ground area "
+      "(total viewshed), each visible sample at ground distance rho standing for (2*pi/K) * rho * drho",
+      "count: samples (one per 1/S pixel lengths along each direction, S = samples per unit); "
+      "visible_area: ground units squared");
+  outputs.stage(run.output, [&](const std::string& path) { writeImage(path, image); });
+  if (!run.preview.empty()) {
+    outputs.stage(run.preview, [&](const std::string& path) {
+      writePreviewPng(path, field.width, field.height, result.visible_count);  // stretched min..max
+    });
+  }
+  const std::vector<std::string> written = outputs.paths();
+  outputs.commit();
+
+  if (!run.quiet) {
+    printSummary(written, field.width, field.height, run.directions, methodName(Command::ViewCount, run),
+                 seconds, device.name, "; mean count " + formatFixed(finiteMean(result.visible_count), 2));
+  }
+  if (run.statistics) std::cout << stats_line << "\n";  // asked for explicitly: printed even with --quiet
+  return 0;
+}
+
+int runHorizonLists(const RunArguments& run) {
+  requireOutputLocation(run.output);
+  const HeightField field = readValidField(run);
+  for (const ReceiverPixel& p : run.receivers) {
+    if (p.col >= field.width || p.row >= field.height) {
+      throw UsageError(
+          "--at " + std::to_string(p.col) + "," + std::to_string(p.row) + ": outside the field " + run.input +
+          ", which is " + std::to_string(field.width) + "x" + std::to_string(field.height) + " (columns 0.." +
+          std::to_string(field.width - 1) + ", rows 0.." + std::to_string(field.height - 1) + ")");
+    }
+  }
+  const auto start = std::chrono::steady_clock::now();
+  const std::vector<ReceiverHorizons> lists =
+      computeHorizonLists(field, horizonListOptions(run), run.receivers);
+  const double seconds = secondsSince(start);
+  std::size_t horizons = 0;
+  for (const auto& receiver : lists)
+    for (const auto& direction : receiver.directions) horizons += direction.horizons.size();
+
+  std::string ext = fs::path(run.output).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string text = ext == ".csv" ? horizonListsCsv(lists) : horizonListsJson(run, field, lists);
+  StagedOutputs outputs;
+  outputs.stage(run.output, [&](const std::string& path) { writeTextFile(path, text); });
+  const std::vector<std::string> written = outputs.paths();
+  outputs.commit();
+  if (!run.quiet) {
+    printSummary(written, field.width, field.height, run.directions, "tree on the receivers' rays", seconds,
+                 "",
+                 "; " + std::to_string(lists.size()) + (lists.size() == 1 ? " receiver, " : " receivers, ") +
+                     std::to_string(horizons) + " horizons");
+  }
+  return 0;
+}
+
+int runBounce(const RunArguments& run) {
+  for (const std::string& path : outputPaths(run)) requireOutputLocation(path);
+  const HeightField field = readValidField(run);
+  const ImageChannels radiance_image = readImage(run.radiance);
+  if (radiance_image.width != field.width || radiance_image.height != field.height) {
+    throw IoError(run.radiance,
+                  "is " + std::to_string(radiance_image.width) + "x" + std::to_string(radiance_image.height) +
+                      ", the height field " + run.input + " is " + std::to_string(field.width) + "x" +
+                      std::to_string(field.height) + ": the exit radiance needs one value per height");
+  }
+  if (radiance_image.planes.size() > static_cast<std::size_t>(kMaxBounceChannels)) {
+    throw IoError(run.radiance, "has " + std::to_string(radiance_image.planes.size()) +
+                                    " channels; at most " + std::to_string(kMaxBounceChannels) +
+                                    " are gathered in one run (split the channels into several files)");
+  }
+  ExitRadiance radiance;
+  radiance.width = radiance_image.width;
+  radiance.height = radiance_image.height;
+  radiance.channels = radiance_image.planes;
+  try {
+    validate(field, radiance);
+  } catch (const InvalidArgument& error) {
+    throw Error(run.radiance + ": " + error.what());
+  }
+
+  const ComputeContext context = ComputeContext::create(run.device);
+  const DeviceInfo& device = context.device();
+  BounceOptions options = bounceOptions(run);
+  Progress progress(run.quiet);
+  options.progress = progress.callback();
+  const auto start = std::chrono::steady_clock::now();
+  const BounceResult result = progress.run([&] { return computeBounce(context, field, radiance, options); });
+  const double seconds = secondsSince(start);
+  requireResultSize(result.width, result.height, field);
+  if (result.irradiance.size() != radiance.channels.size()) {
+    throw Error("internal error: the bounce returned " + std::to_string(result.irradiance.size()) +
+                " channels for " + std::to_string(radiance.channels.size()));
+  }
+  for (const auto& plane : result.irradiance) requireSize(plane, field.pixelCount(), "irradiance");
+
+  Attributes attributes = runAttributes(Command::Bounce, run, field, device);
+  attributes.emplace_back("hfvis:radiance", run.radiance);
+  StagedOutputs outputs;
+  // The radiance's channel names, so that R, G, B stay R, G, B.
+  const ImageChannels image = makeImage(
+      field.width, field.height, radiance_image.names, result.irradiance, attributes,
+      "incident indirect irradiance of one diffuse bounce of the exit radiance (hfvis:radiance), per "
+      "channel: "
+      "sum over directions and visible samples of radiance times projected solid angle",
+      "radiance units times steradians (W/m^2 for W m^-2 sr^-1); a Lambertian surface of albedo rho "
+      "re-emits rho * E / pi");
+  outputs.stage(run.output, [&](const std::string& path) { writeImage(path, image); });
+  if (!run.preview.empty()) {
+    std::vector<float> mean(field.pixelCount(), 0.0f);
+    for (const auto& plane : result.irradiance)
+      for (std::size_t p = 0; p < mean.size(); ++p)
+        mean[p] += plane[p] / static_cast<float>(result.irradiance.size());
+    outputs.stage(run.preview, [&](const std::string& path) {
+      writePreviewPng(path, field.width, field.height, mean);  // stretched min..max
+    });
+  }
+  const std::vector<std::string> written = outputs.paths();
+  outputs.commit();
+
+  if (!run.quiet) {
+    std::string note = "; mean irradiance";
+    for (std::size_t c = 0; c < result.irradiance.size(); ++c) {
+      note +=
+          (c ? ", " : " ") + radiance_image.names[c] + " " + formatNumber(finiteMean(result.irradiance[c]));
+    }
+    printSummary(written, field.width, field.height, run.directions, methodName(Command::Bounce, run),
+                 seconds, device.name, note);
   }
   return 0;
 }

@@ -12,4 +12,14 @@ int runDevices();
 // (all or none). Throws hfvis::Error on failure. Returns the exit status.
 int runCompute(Command command, const RunArguments& run);
 
+// `hfvis viewcount`: visible counts and areas (and --stats), as runCompute.
+int runViewCount(const RunArguments& run);
+
+// `hfvis horizons`: the horizon lists of the --at receivers, as JSON or CSV by the
+// extension of -o. Throws UsageError for a receiver outside the field.
+int runHorizonLists(const RunArguments& run);
+
+// `hfvis bounce`: the irradiance of one diffuse bounce of the --radiance image.
+int runBounce(const RunArguments& run);
+
 }  // namespace hfvis::cli

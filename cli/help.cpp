@@ -1,14 +1,18 @@
 // cli/help.cpp: the help texts. The conventions here are the contract of ../shared/DESIGN.md
-// stated for users; keep them in step with include/hfvis/horizon.hpp.
+// stated for users; keep them in step with include/hfvis/horizon.hpp, intervisibility.hpp,
+// horizon_lists.hpp and bounce.hpp.
 #include "help.hpp"
 
 namespace hfvis::cli {
 namespace {
 
 const char* const kUsage = R"(Usage:
-  hfvis horizon IN -o OUT.exr [-k K] [--distance-out DIST.exr] [options]
-  hfvis svf     IN -o OUT.exr [-k K] [options]
-  hfvis ao      IN -o OUT.exr [-k K] [options]
+  hfvis horizon   IN -o OUT.exr [-k K] [--distance-out DIST.exr] [options]
+  hfvis svf       IN -o OUT.exr [-k K] [options]
+  hfvis ao        IN -o OUT.exr [-k K] [options]
+  hfvis viewcount IN -o OUT.exr [-k K] [--method tree|naive] [--stats] [options]
+  hfvis horizons  IN --at COL,ROW [--at COL,ROW ...] -o OUT.json|OUT.csv [-k K] [options]
+  hfvis bounce    IN --radiance RAD.exr -o OUT.exr [-k K] [options]
   hfvis devices
   hfvis --help | hfvis COMMAND --help
 )";
@@ -18,6 +22,10 @@ Commands:
   horizon   K float32 channels h000..h(K-1): horizon elevation angle per direction, radians
   svf       one float32 channel "svf": sky-view factor, 0..1
   ao        one float32 channel "ao": ambient occlusion, 0..1 (1 = unoccluded flat ground)
+  viewcount channel 0 "count": visible surface samples summed over the K directions;
+            channel 1 "visible_area": the visible ground area (total viewshed), ground units^2
+  horizons  the visibility horizons of chosen receivers per direction, as JSON or CSV
+  bounce    incident indirect irradiance of one diffuse bounce of a given exit radiance
   devices   list the OpenCL devices and mark the one automatic selection picks
 )";
 
@@ -25,8 +33,10 @@ const char* const kOptions = R"(
 Options:
   -o, --output FILE        output image, float32 EXR (required)
   -k, --directions K       number of azimuth directions, K >= 1 (default 64)
-  --method sweep|naive     sweep: convex-hull-stack sweep, linear time per direction;
-                           naive: per-pixel ray march, slow reference (default sweep)
+  --method sweep|naive     horizon, svf, ao: sweep = convex-hull-stack sweep, linear time per
+                           direction; naive = per-pixel ray march, slow reference (default sweep)
+  --method tree|naive      viewcount: tree = convex hull tree sweep (Timonen 2013); naive =
+                           per-pixel visibility march, slow reference (default tree)
   --azimuth-offset DEG     added to every direction's azimuth, degrees (default 0)
   --samples-per-unit S     height samples per pixel length along a line or ray (default 1)
   --lines-per-unit L       sweep lines per pixel length across a direction (default 1)
@@ -41,6 +51,8 @@ Options:
   --preview PNG            also write an 8-bit PNG preview
   -q, --quiet              print neither progress nor the summary line
   -h, --help               show help
+  (horizons takes only -o, -k, --azimuth-offset, --samples-per-unit, --cell-size, --z-scale,
+  --channel and --quiet: it runs on the host, one ray per receiver and direction.)
 )";
 
 const char* const kHorizonOnly = R"(
@@ -50,6 +62,58 @@ Horizon only:
   Its preview shows the mean horizon elevation over the directions whose ray stays in
   the field (low = dark, high = bright), stretched from its minimum to its maximum; the
   svf and ao previews map 0..1 to black..white. Nodata is black in every preview.
+)";
+
+const char* const kViewCount = R"(
+Viewcount:
+  --stats                  also print, for the tree method, the statistics of seed 000's
+                           Table 2 per point and direction: m_a (visibility horizons), t_a
+                           (convexity iterations), visible samples and naive iterations (the
+                           samples the naive method tests); also stored as hfvis:stats_* EXR
+                           attributes. Printed even with --quiet.
+  Tie rule   along direction k a pixel sees the samples q_i = p + i/S * d_k (S samples per
+             unit, bilinear heights, inside the field); q is visible when its slope from p is
+             >= the slope of every sample between them (grazing samples are visible: on a flat
+             plane every sample is), decided exactly. Count: the visible samples summed over
+             the K directions; an N x M flat plane gives N + M - 2 at K = 4. The tree method
+             gives a pixel the bilinear interpolation of the counts of the (up to) four sweep-
+             line samples around it (exact on the axis directions, where lines pass through
+             pixel centres); the naive method marches each pixel's own ray.
+  Area       each visible sample at ground distance rho stands for (2*pi/K) * rho * drho,
+             drho the ground step: ground units squared; it tends to the area seen as K grows.
+  The preview stretches the count from its minimum to its maximum.
+)";
+
+const char* const kHorizonLists = R"(
+Horizons:
+  --at COL,ROW             a receiver pixel (zero-based column, row); repeat for more. A pixel
+                           outside the field is a usage error (status 2).
+  -o OUT.json|OUT.csv      JSON: every receiver, direction and horizon, with the conventions
+                           spelled out; CSV: one row per horizon with the columns
+                           col,row,direction,azimuth_rad,horizon,sample,distance,elevation_rad,
+                           segment_begin,segment_end,near_distance,visible_samples
+                           (a direction without horizons: one row with the horizon fields empty).
+  Along direction k the receiver's own ray is sampled at i = 1, 2, ... (i/S pixel lengths,
+  the naive method's samples; tie rule as viewcount). Horizons are listed nearest first: each
+  is the farthest visible sample of its segment (distance in ground units, elevation in
+  radians); its visible segment is the samples [segment_begin, segment_end) toward the
+  receiver, from near_distance up to distance. The segments hold every visible sample once.
+)";
+
+const char* const kBounce = R"(
+Bounce:
+  --radiance RAD.exr       exit radiance of every surface point: an image of the input's size
+                           with 1 to 4 channels (grey, RGB, ...), finite and >= 0 where the
+                           height is valid. The output has the same channel names.
+  For every pixel, direction and visible sample along its sweep line, the sample's radiance
+  times the projected solid angle of its elevation band (from the visible segments: bands
+  split at mean elevations between adjacent visible samples; across hidden samples the band
+  goes to the farther sample), for a Lambertian receiver whose normal comes from the four
+  quads around it, each direction standing for an azimuthal wedge of 2*pi/K; surface behind
+  the receiver's tangent plane adds nothing. The sum is the incident indirect irradiance, in
+  radiance units times steradians (W/m^2 for W m^-2 sr^-1); a surface of albedo rho re-emits
+  rho * E / pi, the next bounce's radiance. A flat plane receives 0. The preview stretches
+  the mean over the channels from its minimum to its maximum.
 )";
 
 const char* const kConventions = R"(
@@ -73,10 +137,10 @@ Conventions and units:
              2010, Eq. 5), normalised so that a flat plane gives 1.
   Nodata     non-finite heights (NaN, +-inf) are nodata: they neither cast nor receive;
              every output is NaN there, and holes do not spread into valid neighbours.
-  Outputs    float32 EXR (any float format OpenImageIO writes, by extension), with the
-             run described in string attributes hfvis:*. Files are written to a temporary
-             name and renamed only once every output of the run is complete, so a failed
-             run leaves no partial or mismatched output behind.
+  Outputs    float32 EXR (any float format OpenImageIO writes, by extension), with the run
+             described in string attributes hfvis:* (horizons: JSON or CSV text). Files are
+             written to a temporary name and renamed only once every output of the run is
+             complete, so a failed run leaves no partial or mismatched output behind.
 )";
 
 const char* const kExitStatus = R"(
@@ -90,8 +154,11 @@ Exit status: 0 success, 1 runtime error (unreadable input, device or write failu
 }  // namespace
 
 std::string generalHelp() {
-  return std::string("hfvis: horizons, sky-view factor and ambient occlusion on height fields (OpenCL)\n\n") +
-         kUsage + kCommands + kOptions + kHorizonOnly + kConventions + kExitStatus;
+  return std::string(
+             "hfvis: horizons, sky-view factor, ambient occlusion, intervisibility and one-bounce light on "
+             "height fields (OpenCL)\n\n") +
+         kUsage + kCommands + kOptions + kHorizonOnly + kViewCount + kHorizonLists + kBounce + kConventions +
+         kExitStatus;
 }
 
 std::string commandHelp(Command command) {
@@ -116,6 +183,27 @@ std::string commandHelp(Command command) {
                  "normalised so a flat plane gives 1 (0 = fully occluded).\n"
                  "The preview (--preview) maps ao 0..1 to black..white; NaN (nodata) is black.\n") +
              kOptions + kConventions + kExitStatus;
+    case Command::ViewCount:
+      return std::string(
+                 "hfvis viewcount IN -o OUT.exr [-k K] [--method tree|naive] [--stats] [options]\n\n"
+                 "Writes two float32 channels: channel 0 \"count\" = the number of visible surface samples\n"
+                 "summed over the K directions (one sample per 1/S pixel lengths along each direction, S =\n"
+                 "--samples-per-unit, default 1); channel 1 \"visible_area\" = the visible ground area, "
+                 "ground\n"
+                 "units squared. NaN at nodata pixels.\n") +
+             kOptions + kViewCount + kConventions + kExitStatus;
+    case Command::HorizonLists:
+      return std::string(
+                 "hfvis horizons IN --at COL,ROW [--at COL,ROW ...] -o OUT.json|OUT.csv [-k K] [options]\n\n"
+                 "Writes, for each receiver and direction, the visibility horizons along the receiver's ray\n"
+                 "and the visible segments they bound, as JSON or CSV (by the extension of -o).\n") +
+             kOptions + kHorizonLists + kConventions + kExitStatus;
+    case Command::Bounce:
+      return std::string(
+                 "hfvis bounce IN --radiance RAD.exr -o OUT.exr [-k K] [options]\n\n"
+                 "Writes the incident indirect irradiance of one diffuse bounce of the exit radiance RAD,\n"
+                 "one float32 channel per radiance channel (same names). NaN at nodata pixels.\n") +
+             kOptions + kBounce + kConventions + kExitStatus;
     case Command::Devices:
       return "hfvis devices\n\n"
              "Lists every OpenCL device of every platform: index, type, name, platform, driver\n"

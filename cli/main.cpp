@@ -29,15 +29,20 @@ int run(const std::vector<std::string>& args) {
     case Command::SkyViewFactor:
     case Command::AmbientOcclusion:
       return runCompute(line.command, line.run);
+    case Command::ViewCount:
+      return runViewCount(line.run);
+    case Command::HorizonLists:
+      return runHorizonLists(line.run);
+    case Command::Bounce:
+      return runBounce(line.run);
   }
   return kExitUsageError;
 }
 
 // "hfvis horizon --help" when the command is known, else "hfvis --help".
 std::string helpHint(const std::vector<std::string>& args) {
-  if (!args.empty() &&
-      (args[0] == "horizon" || args[0] == "svf" || args[0] == "ao" || args[0] == "devices")) {
-    return "hfvis " + args[0] + " --help";
+  for (const char* command : {"horizon", "svf", "ao", "viewcount", "horizons", "bounce", "devices"}) {
+    if (!args.empty() && args[0] == command) return "hfvis " + args[0] + " --help";
   }
   return "hfvis --help";
 }

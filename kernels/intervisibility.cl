@@ -1,8 +1,9 @@
 // intervisibility.cl: visibility between all points along sweep lines by the convex hull
 // tree (Timonen 2013, Algorithm 1 with segment starts per Eq. 1 and leaf duplication),
-// the visible count per receiver derived from its visibility horizons, the reduction that
-// rotates line buffers back onto the grid, and the naive per-pixel visibility march
-// (baseline and oracle).
+// the visible count per receiver derived from its visibility horizons, the one-bounce
+// gather over the visible runs (Sec. 10.1, alternative 3; its other kernels are in
+// bounce.cl), the reduction that rotates line buffers back onto the grid, and the naive
+// per-pixel visibility march (baseline and oracle).
 //
 // Visibility (the tie rule, the same everywhere, tests included): on one line, a farther
 // sample q is visible from receiver p when no sample strictly between them lies strictly
@@ -18,6 +19,8 @@
 //   HFVIS_WANT_AREA         sum the distances of the visible samples (for the area estimate)
 //   HFVIS_WANT_STATS        per-line totals of receivers, horizons, iterations, ...
 //   HFVIS_WANT_ENTRY_STATS  per-entry (horizons, iterations, horizon hash) for the tests
+//   HFVIS_WANT_BOUNCE       gather exit radiance over the visible samples (bounce.cl sets it)
+//   HFVIS_CHANNELS          radiance channels of the bounce, 1..4
 #include "sweep_framework.cl"
 
 #ifndef HFVIS_WANT_AREA
@@ -29,6 +32,14 @@
 #ifndef HFVIS_WANT_ENTRY_STATS
 #define HFVIS_WANT_ENTRY_STATS 0
 #endif
+#ifndef HFVIS_WANT_BOUNCE
+#define HFVIS_WANT_BOUNCE 0
+#endif
+#ifndef HFVIS_CHANNELS
+#define HFVIS_CHANNELS 1
+#endif
+// Floats per entry of the bounce's line attributes: the radiance channels, then the unit normal.
+#define HFVIS_BOUNCE_STRIDE (HFVIS_CHANNELS + 3)
 
 // The exact predicate's fallback is rare but long: inlined at every call site it made the
 // sweep 30 % slower (code size), so it stays a call.
@@ -188,13 +199,97 @@ inline int run_end(__global const float2* samples, uint stride, int start, int n
   return next;
 }
 
+// ---------------------------------------------------------------------------------------
+// The one-bounce gather (see include/hfvis/bounce.hpp for the formula and its derivation).
+// For one receiver, the visible samples are visited farthest first (the runs of the
+// horizons, each from its horizon toward the receiver). A sample's elevation band reaches
+// up to the mean of its and its farther neighbour's elevations when the two are adjacent
+// (no hidden sample between), else up to its own elevation (the gap's band went to the
+// farther sample); it reaches down likewise toward its nearer neighbour. Each band adds
+// radiance * (G(upper) - G(lower)), G the wedge integral of the projected solid angle,
+// clipped below at the tangent elevation. Mirrored by BounceGather in
+// src/intervisibility_reference.cpp.
+
+#if HFVIS_WANT_BOUNCE
+typedef struct {
+  float nz_term;  // n_z * D / 2
+  float nh_term;  // (n . d) * 2 sin(D / 2)
+  float tangent;  // lower clip of G: where its wedge-integrated cosine factor vanishes
+  float ground;   // ground length of one step
+  float h;        // the receiver's height and step
+  int step;
+  int have_prev;  // a farther visible sample awaits its lower band edge
+  int adjacent;   // the next sample visited is adjacent to it
+  float prev_theta, prev_g_hi;
+  float prev_radiance[HFVIS_CHANNELS];
+  float sum[HFVIS_CHANNELS];
+} BounceGather;
+
+HFVIS_INLINE float bounce_g(const BounceGather* g, float theta) {
+  float t = fmax(theta, g->tangent);
+  float s = sin(t), c = cos(t);
+  return g->nz_term * (s * s) + g->nh_term * (0.5f * (t + s * c));
+}
+
+// `attributes`: the receiver's entry of the bounce line attributes (its normal after the radiance).
+HFVIS_INLINE void bounce_begin(BounceGather* g, const SweepDirection d, __global const float* attributes,
+                               float h, int step, float half_sector, float wedge) {
+  float nx = attributes[HFVIS_CHANNELS], ny = attributes[HFVIS_CHANNELS + 1],
+        nz = attributes[HFVIS_CHANNELS + 2];
+  float toward = nx * d.cos_azimuth + ny * d.sin_azimuth;
+  g->nz_term = nz * half_sector;
+  g->nh_term = toward * wedge;
+  g->tangent = atan2(-g->nh_term, 2.0f * g->nz_term);
+  g->ground = d.step_length * d.ground_per_pixel;
+  g->h = h;
+  g->step = step;
+  g->have_prev = 0;
+  g->adjacent = 0;
+  g->prev_theta = 0.0f;
+  g->prev_g_hi = 0.0f;
+  for (int c = 0; c < HFVIS_CHANNELS; ++c) g->prev_radiance[c] = g->sum[c] = 0.0f;
+}
+
+// Visible sample x at height hx, nearer than every sample visited before it; `radiance` is
+// its entry of the bounce line attributes.
+HFVIS_INLINE void bounce_visit(BounceGather* g, float hx, int x, __global const float* radiance) {
+  float theta = atan2(hx - g->h, (float)(g->step - x) * g->ground);
+  float g_hi;
+  if (!g->have_prev) {
+    g_hi = bounce_g(g, theta);
+  } else {
+    float edge = g->adjacent ? 0.5f * (g->prev_theta + theta) : theta;
+    float g_edge = bounce_g(g, edge);
+    for (int c = 0; c < HFVIS_CHANNELS; ++c) g->sum[c] += g->prev_radiance[c] * (g->prev_g_hi - g_edge);
+    g_hi = g_edge;
+  }
+  g->prev_theta = theta;
+  g->prev_g_hi = g_hi;
+  for (int c = 0; c < HFVIS_CHANNELS; ++c) g->prev_radiance[c] = radiance[c];
+  g->have_prev = 1;
+  g->adjacent = 1;
+}
+
+// The nearest visible sample's band ends at its own elevation; writes the sums.
+HFVIS_INLINE void bounce_finish(BounceGather* g, __global float* irradiance) {
+  if (g->have_prev) {
+    float g_lo = bounce_g(g, g->prev_theta);
+    for (int c = 0; c < HFVIS_CHANNELS; ++c) g->sum[c] += g->prev_radiance[c] * (g->prev_g_hi - g_lo);
+  }
+  for (int c = 0; c < HFVIS_CHANNELS; ++c) irradiance[c] = g->sum[c];
+}
+#endif  // HFVIS_WANT_BOUNCE
+
 // One work-item per line. Reads the presampled heights (lines[].x, left intact) and writes:
 //   lines[].y    the rank of the step: present samples before it (run lengths across holes),
 //   visible[]    (visible samples, sum of their distances in steps), NaN where absent,
 //   prefix[]     sum of the steps of the present samples before it (mod 2^32), if AREA,
 //   entry_stats[] (horizons m, iterations t, horizon hash, 0), if ENTRY_STATS,
 //   line_totals[(b * totals_stride + j) * 8 + ...] (receivers, sum m, sum t, naive
-//                iterations, visible samples, 0, 0, 0), if STATS.
+//                iterations, visible samples, 0, 0, 0), if STATS,
+//   bounce_out[entry * CHANNELS + c] the gathered irradiance, NaN where absent, if BOUNCE
+//                (reading bounce_lines[entry * BOUNCE_STRIDE + ...], see bounce_presample;
+//                half_sector = D / 2 and wedge = 2 sin(D / 2) for D = 2*pi/K).
 // Preconditions: lines presampled by presample_lines; a line has fewer than 2^24 steps and
 // the distance sum of a receiver stays below 2^32 (checkLineLimits). Memory safety does not
 // rest on the predicate: leaves are never deleted and a node only when childless, so every
@@ -204,7 +299,8 @@ inline int run_end(__global const float2* samples, uint stride, int start, int n
 __kernel void intervisibility_sweep(__global const SweepDirection* directions, __global float2* lines,
                                     __global int4* trees, __global float2* visible, __global uint* prefix,
                                     __global uint4* entry_stats, __global ulong* line_totals,
-                                    int totals_stride) {
+                                    int totals_stride, __global const float* bounce_lines,
+                                    __global float* bounce_out, float half_sector, float wedge) {
   const int line = get_global_id(0);
   const int b = get_global_id(1);
   const SweepDirection d = load_direction(directions + b);
@@ -236,11 +332,18 @@ __kernel void intervisibility_sweep(__global const SweepDirection* directions, _
 #if HFVIS_WANT_ENTRY_STATS
       entry_stats[base + e] = (uint4)(0u, 0u, 0u, 0u);
 #endif
+#if HFVIS_WANT_BOUNCE
+      for (int c = 0; c < HFVIS_CHANNELS; ++c) bounce_out[(base + e) * HFVIS_CHANNELS + c] = NAN;
+#endif
       continue;
     }
     uint m = 0, t = 0, hash = 2166136261u;
     int count = 0;
     uint distance_sum = 0;
+#if HFVIS_WANT_BOUNCE
+    BounceGather gather;
+    bounce_begin(&gather, d, bounce_lines + (base + e) * HFVIS_BOUNCE_STRIDE, h, step, half_sector, wedge);
+#endif
     if (root == HFVIS_NONE) {
       tree[e] = (int4)(as_int(h), HFVIS_LEAF, HFVIS_NONE, HFVIS_NONE);  // rank 0
     } else {
@@ -327,6 +430,14 @@ __kernel void intervisibility_sweep(__global const SweepDirection* directions, _
           end = run_end(samples, stride, hp, np, as_float(nz.x), step, h, holes);
           end_rank = end == np ? np_rank : holes ? (int)samples[(uint)end * stride].y : hp_rank + (end - hp);
         }
+#if HFVIS_WANT_BOUNCE
+        for (int x = hp; x < end; ++x) {
+          const float hx = samples[(uint)x * stride].x;
+          if (!isnan(hx))
+            bounce_visit(&gather, hx, x, bounce_lines + (base + (uint)x * stride) * HFVIS_BOUNCE_STRIDE);
+        }
+        gather.adjacent = end == np;
+#endif
         const int run = end_rank - hp_rank;
         count += run;
 #if HFVIS_WANT_AREA
@@ -348,6 +459,9 @@ __kernel void intervisibility_sweep(__global const SweepDirection* directions, _
       }
     }
     out[e] = (float2)((float)count, (float)distance_sum);
+#if HFVIS_WANT_BOUNCE
+    bounce_finish(&gather, bounce_out + (base + e) * HFVIS_CHANNELS);
+#endif
 #if HFVIS_WANT_ENTRY_STATS
     entry_stats[base + e] = (uint4)(m, t, hash, 0u);
 #endif

@@ -464,7 +464,11 @@ static std::optional<std::pair<double, double>> hfvisCellSize(const OIIO::ImageS
   return std::nullopt;
 }
 
-HeightField readHeightField(const std::string& path, const HeightFieldReadOptions& options) {
+namespace {
+
+// Opens an image for reading, with the checks every reader shares: the file exists, is not
+// empty, and holds a 2D, non-deep image with pixels.
+std::unique_ptr<OIIO::ImageInput> openImage(const std::string& path) {
   std::error_code ec;
   const fs::file_status status = fs::status(path, ec);
   if (!fs::exists(status)) throw IoError(path, "no such file");
@@ -483,6 +487,14 @@ HeightField readHeightField(const std::string& path, const HeightFieldReadOption
   }
   if (spec.depth > 1) throw IoError(path, "volume images (depth > 1) are not supported");
   if (spec.deep) throw IoError(path, "deep images are not supported");
+  return in;
+}
+
+}  // namespace
+
+HeightField readHeightField(const std::string& path, const HeightFieldReadOptions& options) {
+  std::unique_ptr<OIIO::ImageInput> in = openImage(path);
+  const OIIO::ImageSpec& spec = in->spec();
   const int channel = selectChannel(path, spec, options.channel);
 
   HeightField field;
@@ -513,6 +525,27 @@ HeightField readHeightField(const std::string& path, const HeightFieldReadOption
   }
   field.z_scale = options.z_scale;
   return field;
+}
+
+ImageChannels readImage(const std::string& path) {
+  std::unique_ptr<OIIO::ImageInput> in = openImage(path);
+  const OIIO::ImageSpec& spec = in->spec();
+  ImageChannels image;
+  image.width = spec.width;
+  image.height = spec.height;
+  try {
+    for (int c = 0; c < spec.nchannels; ++c) {
+      const bool named = c < static_cast<int>(spec.channelnames.size()) && !spec.channelnames[c].empty();
+      image.names.push_back(named ? spec.channelnames[c] : "channel" + std::to_string(c));
+      image.planes.push_back(readChannel(path, *in, c));
+    }
+  } catch (const std::bad_alloc&) {
+    throw IoError(path, "image is too large to hold in memory (" + std::to_string(spec.width) + " x " +
+                            std::to_string(spec.height) + " pixels, " + std::to_string(spec.nchannels) +
+                            " channels)");
+  }
+  in->close();
+  return image;
 }
 
 void writeImage(const std::string& path, const ImageChannels& image) {

@@ -8,56 +8,53 @@
 
 #include "hfvis/errors.hpp"
 #include "horizon_common.hpp"
+#include "intervisibility_device.hpp"
 #include "intervisibility_internal.hpp"
 #include "opencl_context.hpp"
 #include "sweep_framework.hpp"
 
 namespace hfvis {
 namespace detail {
-namespace {
 
-constexpr const char* kProgramFile = "intervisibility.cl";
-constexpr std::size_t kLineBytes = 2 * sizeof(float);     // (height, rank)
-constexpr std::size_t kNodeBytes = 4 * sizeof(int);       // tree node
-constexpr std::size_t kVisibleBytes = 2 * sizeof(float);  // (count, distance sum)
-constexpr std::size_t kPrefixBytes = sizeof(std::uint32_t);
-constexpr std::size_t kEntryStatsBytes = 4 * sizeof(std::uint32_t);
-constexpr std::size_t kLineTotals = 8;  // ulongs per line (HFVIS_LINE_TOTALS)
+const char* treeProgramFile(const TreeProgramFlags& flags) {
+  return flags.bounce_channels > 0 ? "bounce.cl" : "intervisibility.cl";
+}
 
-struct ProgramFlags {
-  bool has_nodata = true;
-  bool area = true;
-  bool stats = true;
-  bool entry_stats = false;
-};
-
-std::string programOptions(const ProgramFlags& f, const DeviceInfo& device) {
+std::string treeProgramOptions(const TreeProgramFlags& f, const DeviceInfo& device) {
   std::ostringstream s;
   s << "-DHFVIS_HAS_NODATA=" << f.has_nodata << " -DHFVIS_WANT_AREA=" << f.area
     << " -DHFVIS_WANT_STATS=" << f.stats << " -DHFVIS_WANT_ENTRY_STATS=" << f.entry_stats << " "
     << layoutProgramOption(device);
+  if (f.bounce_channels > 0) s << " -DHFVIS_WANT_BOUNCE=1 -DHFVIS_CHANNELS=" << f.bounce_channels;
   return s.str();
 }
 
-// The device buffers of one batch's sweep (sized for the largest batch).
-struct SweepBuffers {
-  cl::Buffer lines, trees, visible, prefix, entry_stats, line_totals;
-  int totals_stride = 0;
-};
-
 void enqueueTreeSweep(ContextState& st, cl::Program& program, const cl::Buffer& directions,
-                      const SweepBatch& batch, const SweepBuffers& b) {
+                      const SweepBatch& batch, const TreeSweepBuffers& b) {
   cl::Kernel sweep(program, "intervisibility_sweep");
-  sweep.setArg(0, directions);
-  sweep.setArg(1, b.lines);
-  sweep.setArg(2, b.trees);
-  sweep.setArg(3, b.visible);
-  sweep.setArg(4, b.prefix);
-  sweep.setArg(5, b.entry_stats);
-  sweep.setArg(6, b.line_totals);
-  sweep.setArg(7, b.totals_stride);
+  int arg = 0;
+  sweep.setArg(arg++, directions);
+  sweep.setArg(arg++, b.lines);
+  sweep.setArg(arg++, b.trees);
+  sweep.setArg(arg++, b.visible);
+  sweep.setArg(arg++, b.prefix);
+  sweep.setArg(arg++, b.entry_stats);
+  sweep.setArg(arg++, b.line_totals);
+  sweep.setArg(arg++, b.totals_stride);
+  sweep.setArg(arg++, b.bounce_lines);
+  sweep.setArg(arg++, b.bounce_out);
+  sweep.setArg(arg++, b.half_sector);
+  sweep.setArg(arg++, b.wedge);
   st.launch(sweep, cl::NDRange(roundUp(batch.maxLines(), kLineGroup), batch.directions.size()),
             cl::NDRange(kLineGroup, 1));
+}
+
+namespace {
+
+// Buffers a program without the bounce still binds.
+void bindNoBounce(ContextState& st, TreeSweepBuffers& b) {
+  b.bounce_lines = deviceBuffer(st, 0);
+  b.bounce_out = deviceBuffer(st, 0);
 }
 
 // Adds one batch's per-line totals (receivers, m, t, naive, visible) to the statistics.
@@ -65,7 +62,7 @@ void addLineTotals(const std::vector<cl_ulong>& totals, const SweepBatch& batch,
                    IntervisibilityStatistics& s) {
   for (std::size_t b = 0; b < batch.directions.size(); ++b) {
     for (int j = 0; j < batch.directions[b].n_lines; ++j) {
-      const cl_ulong* t = &totals[(b * stride + j) * kLineTotals];
+      const cl_ulong* t = &totals[(b * stride + j) * kTreeLineTotals];
       s.receivers += t[0];
       s.lines += t[0] > 0;
       s.horizons += t[1];
@@ -84,11 +81,11 @@ IntervisibilityResult run(const ComputeContext& context, const HeightField& fiel
   const auto all = runDirections(field, options);
   checkLineLimits(all, prepared.heights, outputs);
   const bool tree = options.method == IntervisibilityMethod::HullTree;
-  ProgramFlags flags;
+  TreeProgramFlags flags;
   flags.has_nodata = prepared.has_nodata;
   flags.area = outputs.visible_area;
   flags.stats = outputs.statistics;
-  cl::Program program = st.program(kProgramFile, programOptions(flags, st.info));
+  cl::Program program = st.program(treeProgramFile(flags), treeProgramOptions(flags, st.info));
   const std::size_t plane = field.pixelCount();
   int max_lines = 0;
   for (const auto& d : all) max_lines = std::max(max_lines, d.n_lines);
@@ -100,9 +97,9 @@ IntervisibilityResult run(const ComputeContext& context, const HeightField& fiel
   memory.fixed_bytes = plane * sizeof(float) * (1 + want_pixels + outputs.visible_area);
   if (tree) {
     memory.bytes_per_entry =
-        kLineBytes + kNodeBytes + kVisibleBytes + (outputs.visible_area ? kPrefixBytes : 0);
-    memory.largest_entry_bytes = kNodeBytes;
-    memory.bytes_per_direction = outputs.statistics ? max_lines * kLineTotals * sizeof(cl_ulong) : 0;
+        kTreeLineBytes + kTreeNodeBytes + kTreeVisibleBytes + (outputs.visible_area ? kTreePrefixBytes : 0);
+    memory.largest_entry_bytes = kTreeNodeBytes;
+    memory.bytes_per_direction = outputs.statistics ? max_lines * kTreeLineTotals * sizeof(cl_ulong) : 0;
   }
   const auto batches = planSweepBatches(all, memory, options.memory_budget_bytes, st.info);
   std::size_t max_entries = 0, max_directions = 0;
@@ -119,16 +116,17 @@ IntervisibilityResult run(const ComputeContext& context, const HeightField& fiel
 
   cl::Buffer heights(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, plane * sizeof(float),
                      const_cast<float*>(prepared.heights.data()));
-  SweepBuffers buffers;
+  TreeSweepBuffers buffers;
   if (tree) {
-    buffers.lines = deviceBuffer(st, max_entries * kLineBytes);
-    buffers.trees = deviceBuffer(st, max_entries * kNodeBytes);
-    buffers.visible = deviceBuffer(st, max_entries * kVisibleBytes);
-    buffers.prefix = deviceBuffer(st, outputs.visible_area ? max_entries * kPrefixBytes : 0);
+    bindNoBounce(st, buffers);
+    buffers.lines = deviceBuffer(st, max_entries * kTreeLineBytes);
+    buffers.trees = deviceBuffer(st, max_entries * kTreeNodeBytes);
+    buffers.visible = deviceBuffer(st, max_entries * kTreeVisibleBytes);
+    buffers.prefix = deviceBuffer(st, outputs.visible_area ? max_entries * kTreePrefixBytes : 0);
     buffers.entry_stats = deviceBuffer(st, 0);
     buffers.totals_stride = max_lines;
     buffers.line_totals = deviceBuffer(
-        st, outputs.statistics ? max_directions * max_lines * kLineTotals * sizeof(cl_ulong) : 0);
+        st, outputs.statistics ? max_directions * max_lines * kTreeLineTotals * sizeof(cl_ulong) : 0);
   }
   cl::Buffer count_sum = deviceBuffer(st, want_pixels ? plane * sizeof(float) : 0);
   cl::Buffer area_sum = deviceBuffer(st, outputs.visible_area ? plane * sizeof(float) : 0);
@@ -162,7 +160,7 @@ IntervisibilityResult run(const ComputeContext& context, const HeightField& fiel
       st.launch(reduce, pixels, cl::NDRange(kTileX, kTileY));
     }
     if (outputs.statistics) {
-      totals.resize(batch.directions.size() * max_lines * kLineTotals);
+      totals.resize(batch.directions.size() * max_lines * kTreeLineTotals);
       st.queue.enqueueReadBuffer(buffers.line_totals, CL_TRUE, 0, totals.size() * sizeof(cl_ulong),
                                  totals.data());
       addLineTotals(totals, batch, max_lines, result.statistics);
@@ -189,9 +187,9 @@ IntervisibilityLines intervisibilityLinesOnDevice(const ComputeContext& context,
                                                   const SweepDirection& direction) {
   return translateOpenClErrors([&] {
     ContextState& st = context.state();
-    ProgramFlags flags;
+    TreeProgramFlags flags;
     flags.entry_stats = true;
-    cl::Program program = st.program(kProgramFile, programOptions(flags, st.info));
+    cl::Program program = st.program(treeProgramFile(flags), treeProgramOptions(flags, st.info));
     const bool line_major = lineMajorLayout(st.info);
     SweepBatch batch;
     batch.directions = {direction};
@@ -203,14 +201,15 @@ IntervisibilityLines intervisibilityLinesOnDevice(const ComputeContext& context,
     cl::Buffer heights(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
                        prepared_heights.size() * sizeof(float), const_cast<float*>(prepared_heights.data()));
     const cl::Buffer directions = uploadDirections(st, batch.directions);
-    SweepBuffers buffers;
-    buffers.lines = deviceBuffer(st, entries * kLineBytes);
-    buffers.trees = deviceBuffer(st, entries * kNodeBytes);
-    buffers.visible = deviceBuffer(st, entries * kVisibleBytes);
-    buffers.prefix = deviceBuffer(st, entries * kPrefixBytes);
-    buffers.entry_stats = deviceBuffer(st, entries * kEntryStatsBytes);
+    TreeSweepBuffers buffers;
+    bindNoBounce(st, buffers);
+    buffers.lines = deviceBuffer(st, entries * kTreeLineBytes);
+    buffers.trees = deviceBuffer(st, entries * kTreeNodeBytes);
+    buffers.visible = deviceBuffer(st, entries * kTreeVisibleBytes);
+    buffers.prefix = deviceBuffer(st, entries * kTreePrefixBytes);
+    buffers.entry_stats = deviceBuffer(st, entries * kTreeEntryStatsBytes);
     buffers.totals_stride = direction.n_lines;
-    buffers.line_totals = deviceBuffer(st, direction.n_lines * kLineTotals * sizeof(cl_ulong));
+    buffers.line_totals = deviceBuffer(st, direction.n_lines * kTreeLineTotals * sizeof(cl_ulong));
     enqueuePresample(st, program, heights, field.width, field.height, directions, batch, buffers.lines);
     enqueueTreeSweep(st, program, directions, batch, buffers);
     std::vector<float> pairs(entries * 2), visible(entries * 2);

@@ -1,6 +1,7 @@
-// intervisibility_internal.hpp: what the intervisibility device path, its scalar reference
-// and the tests share: direction geometry and the line-level view of one direction's sweep
-// (per-sample counts, horizons and iterations), to compare a sweep line by line.
+// intervisibility_internal.hpp: what the intervisibility device path, its scalar reference,
+// the horizon lists, the bounce and the tests share: direction geometry and the line-level
+// view of one direction's sweep (per-sample counts, horizons, iterations and the bounce
+// gather), to compare a sweep line by line.
 #pragma once
 
 #include <cstdint>
@@ -12,7 +13,6 @@
 #include "sweep_geometry.hpp"
 
 namespace hfvis::detail {
-
 
 // 2*pi/K: the azimuthal sector one direction stands for in the area estimate.
 float intervisibilitySector(const IntervisibilityOptions& options);
@@ -35,9 +35,32 @@ struct IntervisibilityLines {
   std::vector<std::uint32_t> horizons;        // m_i: distinct visibility horizons
   std::vector<std::uint32_t> iterations;      // t_i: convexity checks of Algorithm 1
   std::vector<std::uint32_t> horizon_hashes;  // FNV-1a over the horizons' steps, farthest first
-  // Reference only, when asked: the horizons' steps, farthest first.
+  // Reference only, when asked: the horizons' steps, farthest first, and where each one's
+  // visible run ends (run_end(): the first hidden sample, the next horizon or the receiver),
+  // so horizon h's visible samples are the present ones of steps [h, end).
   std::vector<std::vector<int>> horizon_steps;
+  std::vector<std::vector<int>> horizon_run_ends;
 };
+
+// The bounce gather on one direction's lines (see hfvis/bounce.hpp for the formula), in the
+// canonical step-major order of IntervisibilityLines. Inputs per entry: the exit radiance
+// channels, then the receiver's unit normal (x, y, z), kBounceNormalFloats after them.
+struct BounceLines {
+  int channels = 1;
+  float half_sector = 0.0f;       // D / 2, D = 2*pi/K: the wedge a direction stands for
+  float wedge = 0.0f;             // 2 sin(D / 2): the wedge integral of cos(phi - phi_k)
+  std::vector<float> attributes;  // (channels + 3) floats per entry
+  std::vector<float> irradiance;  // output: channels floats per entry; NaN where absent
+};
+constexpr int kBounceNormalFloats = 3;
+
+// The D / 2 and 2 sin(D / 2) of a run of K directions, as the host passes them to the kernels.
+void bounceWedge(int directions, float* half_sector, float* wedge);
+
+// Runs the reference hull-tree sweep over lines whose `geometry` (n_lines, n_steps, and
+// the step's ground length) and `samples` are set: fills every other per-entry vector;
+// keep_horizons fills horizon_steps and horizon_run_ends; `bounce`, when given, gathers.
+void sweepPresampledLines(IntervisibilityLines& lines, bool keep_horizons, BounceLines* bounce = nullptr);
 
 // FNV-1a step of the horizon hash (kernel: `hash = (hash ^ step) * 16777619u`).
 constexpr std::uint32_t kHorizonHashSeed = 2166136261u;

@@ -1,13 +1,16 @@
 // intervisibility_reference.cpp: scalar mirrors of kernels/intervisibility.cl (convex hull
-// tree sweep, visible counts, reduction, naive march). Same tree layout, same walk, same
-// exact predicate, in the kernels' order, so every per-sample result matches exactly.
+// tree sweep, visible counts, the bounce gather, reduction, naive march). Same tree layout,
+// same walk, same exact predicate, in the kernels' order, so every per-sample result
+// matches exactly (the gather's transcendentals up to their last bits).
 #include "hfvis/intervisibility_reference.hpp"
 
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 
 #include "chord_side.hpp"
+#include "hfvis/bounce.hpp"
 #include "hfvis/errors.hpp"
 #include "horizon_common.hpp"
 #include "intervisibility_internal.hpp"
@@ -73,8 +76,72 @@ int runEnd(const LineView& line, int start, int next, float h_next, int receiver
   return next;
 }
 
+// Mirror of the bounce gather of kernels/intervisibility.cl (BounceGather and its helpers):
+// the visible samples of one receiver, visited farthest first, each adding its radiance
+// times the projected solid angle of its elevation band.
+class BounceGather {
+ public:
+  BounceGather(const BounceLines& in, const SweepDirection& d, std::size_t receiver_entry, float h, int step)
+      : in_(in), h_(h), step_(step) {
+    const float* normal = &in.attributes[receiver_entry * (in.channels + kBounceNormalFloats) + in.channels];
+    const float toward = normal[0] * d.cos_azimuth + normal[1] * d.sin_azimuth;
+    nz_term_ = normal[2] * in.half_sector;
+    nh_term_ = toward * in.wedge;
+    tangent_ = std::atan2(-nh_term_, 2.0f * nz_term_);
+    ground_ = d.step_length * d.ground_per_pixel;
+  }
+
+  // Visible sample x at height hx; nearer than every sample visited before it.
+  void visit(float hx, int x, std::size_t entry) {
+    const float theta = std::atan2(hx - h_, static_cast<float>(step_ - x) * ground_);
+    float g_hi;
+    if (!have_prev_) {
+      g_hi = g(theta);
+    } else {
+      const float edge = adjacent_ ? 0.5f * (prev_theta_ + theta) : theta;
+      const float g_edge = g(edge);
+      for (int c = 0; c < in_.channels; ++c) sum_[c] += prev_radiance_[c] * (prev_g_hi_ - g_edge);
+      g_hi = g_edge;
+    }
+    prev_theta_ = theta;
+    prev_g_hi_ = g_hi;
+    const float* radiance = &in_.attributes[entry * (in_.channels + kBounceNormalFloats)];
+    for (int c = 0; c < in_.channels; ++c) prev_radiance_[c] = radiance[c];
+    have_prev_ = true;
+    adjacent_ = true;
+  }
+
+  // Whether the next sample visited is adjacent to the last one (no hidden sample between).
+  void setAdjacent(bool adjacent) { adjacent_ = adjacent; }
+
+  void finish(float* irradiance) {
+    if (have_prev_) {
+      const float g_lo = g(prev_theta_);
+      for (int c = 0; c < in_.channels; ++c) sum_[c] += prev_radiance_[c] * (prev_g_hi_ - g_lo);
+    }
+    for (int c = 0; c < in_.channels; ++c) irradiance[c] = sum_[c];
+  }
+
+ private:
+  float g(float theta) const {
+    const float t = std::fmax(theta, tangent_);
+    const float s = std::sin(t), c = std::cos(t);
+    return nz_term_ * (s * s) + nh_term_ * (0.5f * (t + s * c));
+  }
+
+  const BounceLines& in_;
+  float h_;
+  int step_;
+  float nz_term_ = 0.0f, nh_term_ = 0.0f, tangent_ = 0.0f, ground_ = 0.0f;
+  bool have_prev_ = false, adjacent_ = false;
+  float prev_theta_ = 0.0f, prev_g_hi_ = 0.0f;
+  float prev_radiance_[kMaxBounceChannels] = {};
+  float sum_[kMaxBounceChannels] = {};
+};
+
 // Mirror of intervisibility_sweep() for line j.
-void sweepLine(const SweepDirection& d, int j, IntervisibilityLines& out, bool keep_horizons) {
+void sweepLine(const SweepDirection& d, int j, IntervisibilityLines& out, bool keep_horizons,
+               BounceLines* bounce) {
   const std::size_t stride = static_cast<std::size_t>(d.n_lines);
   const LineView line{out.samples, static_cast<std::size_t>(j), stride};
   std::vector<Node> tree(static_cast<std::size_t>(d.n_steps));
@@ -95,7 +162,9 @@ void sweepLine(const SweepDirection& d, int j, IntervisibilityLines& out, bool k
     std::uint32_t m = 0, t = 0, hash = kHorizonHashSeed;
     int count = 0;
     std::uint32_t distance_sum = 0;
-    std::vector<int> horizons;
+    std::vector<int> horizons, run_ends;
+    std::optional<BounceGather> gather;
+    if (bounce) gather.emplace(*bounce, d, e, h, step);
     if (root == kNone) {
       tree[step] = {h, 0, true, kNone, kNone};
     } else {
@@ -175,6 +244,15 @@ void sweepLine(const SweepDirection& d, int j, IntervisibilityLines& out, bool k
           end = runEnd(line, hp, np, nz.h, step, h, holes);
           end_rank = end == np ? np_rank : holes ? ranks[end] : hp_rank + (end - hp);
         }
+        if (keep_horizons) run_ends.push_back(end);
+        if (gather) {
+          for (int x = hp; x < end; ++x) {
+            const float hx = line.height(x);
+            if (!std::isnan(hx))
+              gather->visit(hx, x, static_cast<std::size_t>(j) + static_cast<std::size_t>(x) * stride);
+          }
+          gather->setAdjacent(end == np);
+        }
         const int run = end_rank - hp_rank;
         count += run;
         std::uint32_t steps_sum;
@@ -197,7 +275,11 @@ void sweepLine(const SweepDirection& d, int j, IntervisibilityLines& out, bool k
     out.horizons[e] = m;
     out.iterations[e] = t;
     out.horizon_hashes[e] = hash;
-    if (keep_horizons) out.horizon_steps[e] = std::move(horizons);
+    if (keep_horizons) {
+      out.horizon_steps[e] = std::move(horizons);
+      out.horizon_run_ends[e] = std::move(run_ends);
+    }
+    if (gather) gather->finish(&bounce->irradiance[e * bounce->channels]);
     prev2 = prev;
     h_prev2 = h_prev;
     prev = step;
@@ -322,19 +404,40 @@ void naiveReference(const HeightField& field, const std::vector<float>& h,
 
 }  // namespace
 
+void bounceWedge(int directions, float* half_sector, float* wedge) {
+  const double sector = 2.0 * M_PI / directions;
+  *half_sector = static_cast<float>(0.5 * sector);
+  *wedge = static_cast<float>(2.0 * std::sin(0.5 * sector));
+}
+
+void sweepPresampledLines(IntervisibilityLines& lines, bool keep_horizons, BounceLines* bounce) {
+  const SweepDirection& d = lines.geometry;
+  const std::size_t entries = d.entries();
+  if (lines.samples.size() != entries)
+    throw InvalidArgument("internal error: line samples do not fit the geometry");
+  lines.counts.assign(entries, kNaN);
+  lines.distance_sums.assign(entries, kNaN);
+  lines.horizons.assign(entries, 0);
+  lines.iterations.assign(entries, 0);
+  lines.horizon_hashes.assign(entries, 0);
+  lines.horizon_steps.assign(keep_horizons ? entries : 0, {});
+  lines.horizon_run_ends.assign(keep_horizons ? entries : 0, {});
+  if (bounce) {
+    if (bounce->channels < 1 || bounce->channels > kMaxBounceChannels ||
+        bounce->attributes.size() != entries * (bounce->channels + kBounceNormalFloats)) {
+      throw InvalidArgument("internal error: bounce attributes do not fit the lines");
+    }
+    bounce->irradiance.assign(entries * bounce->channels, kNaN);
+  }
+  for (int j = 0; j < d.n_lines; ++j) sweepLine(d, j, lines, keep_horizons, bounce);
+}
+
 IntervisibilityLines referenceIntervisibilityLines(const HeightField& field,
                                                    const std::vector<float>& prepared_heights,
                                                    const SweepDirection& d, bool keep_horizons) {
   IntervisibilityLines out;
   out.geometry = d;
-  const std::size_t entries = d.entries();
-  out.samples.assign(entries, kNaN);
-  out.counts.assign(entries, kNaN);
-  out.distance_sums.assign(entries, kNaN);
-  out.horizons.assign(entries, 0);
-  out.iterations.assign(entries, 0);
-  out.horizon_hashes.assign(entries, 0);
-  if (keep_horizons) out.horizon_steps.assign(entries, {});
+  out.samples.assign(d.entries(), kNaN);
   for (int j = 0; j < d.n_lines; ++j) {
     for (int i = 0; i < d.n_steps; ++i) {
       const Point2 p = sweepPosition(d, j, i);
@@ -343,7 +446,7 @@ IntervisibilityLines referenceIntervisibilityLines(const HeightField& field,
             sampleHeight(prepared_heights, field.width, field.height, p);
     }
   }
-  for (int j = 0; j < d.n_lines; ++j) sweepLine(d, j, out, keep_horizons);
+  sweepPresampledLines(out, keep_horizons);
   return out;
 }
 

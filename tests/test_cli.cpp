@@ -10,10 +10,14 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <random>
+#include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "hfvis/horizon_lists.hpp"
 #include "hfvis/image_io.hpp"
 
 namespace {
@@ -73,6 +77,158 @@ ReadBack readBack(const fs::path& path) {
   EXPECT_TRUE(in->read_image(0, 0, 0, image.spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data()))
       << in->geterror();
   return image;
+}
+
+// A small strict JSON reader (RFC 8259 values; \uXXXX escapes only below 0x80), enough to
+// check that `hfvis horizons` writes well-formed JSON and to read its values back.
+struct Json {
+  enum class Type { Null, Bool, Number, String, Array, Object } type = Type::Null;
+  bool boolean = false;
+  double number = 0.0;
+  std::string text;
+  std::vector<Json> items;
+  std::map<std::string, Json> members;
+
+  const Json& operator[](const std::string& key) const {
+    const auto it = members.find(key);
+    if (type != Type::Object || it == members.end()) throw std::runtime_error("no member '" + key + "'");
+    return it->second;
+  }
+  const Json& operator[](std::size_t i) const {
+    if (type != Type::Array || i >= items.size()) throw std::runtime_error("no item " + std::to_string(i));
+    return items[i];
+  }
+};
+
+class JsonParser {
+ public:
+  static Json parse(const std::string& text) {
+    JsonParser p(text);
+    Json value = p.value();
+    p.space();
+    if (p.at_ != text.size()) p.fail("trailing characters");
+    return value;
+  }
+
+ private:
+  explicit JsonParser(const std::string& text) : s_(text) {}
+  [[noreturn]] void fail(const std::string& what) const {
+    throw std::runtime_error("JSON: " + what + " at offset " + std::to_string(at_));
+  }
+  void space() {
+    while (at_ < s_.size() && (s_[at_] == ' ' || s_[at_] == '\n' || s_[at_] == '\r' || s_[at_] == '\t'))
+      ++at_;
+  }
+  void expect(char c) {
+    space();
+    if (at_ >= s_.size() || s_[at_] != c) fail(std::string("expected '") + c + "'");
+    ++at_;
+  }
+  bool word(const char* w) {
+    const std::string text(w);
+    if (s_.compare(at_, text.size(), text) != 0) return false;
+    at_ += text.size();
+    return true;
+  }
+  std::string string() {
+    expect('"');
+    std::string out;
+    while (true) {
+      if (at_ >= s_.size()) fail("unterminated string");
+      const char c = s_[at_++];
+      if (c == '"') return out;
+      if (static_cast<unsigned char>(c) < 0x20) fail("control character in a string");
+      if (c != '\\') {
+        out += c;
+        continue;
+      }
+      if (at_ >= s_.size()) fail("unterminated escape");
+      const char e = s_[at_++];
+      const std::string simple = "\"\\/bfnrt", meaning = "\"\\/\b\f\n\r\t";
+      if (const auto k = simple.find(e); k != std::string::npos) {
+        out += meaning[k];
+      } else if (e == 'u' && at_ + 4 <= s_.size()) {
+        const int code = std::stoi(s_.substr(at_, 4), nullptr, 16);
+        if (code >= 0x80) fail("non-ASCII escape");
+        out += static_cast<char>(code);
+        at_ += 4;
+      } else {
+        fail("bad escape");
+      }
+    }
+  }
+  Json value() {
+    space();
+    if (at_ >= s_.size()) fail("missing value");
+    Json v;
+    const char c = s_[at_];
+    if (c == '{') {
+      v.type = Json::Type::Object;
+      ++at_;
+      space();
+      if (at_ < s_.size() && s_[at_] == '}') return ++at_, v;
+      do {
+        const std::string key = string();
+        expect(':');
+        if (!v.members.emplace(key, value()).second) fail("duplicate key '" + key + "'");
+        space();
+      } while (at_ < s_.size() && s_[at_] == ',' && ++at_);
+      expect('}');
+    } else if (c == '[') {
+      v.type = Json::Type::Array;
+      ++at_;
+      space();
+      if (at_ < s_.size() && s_[at_] == ']') return ++at_, v;
+      do {
+        v.items.push_back(value());
+        space();
+      } while (at_ < s_.size() && s_[at_] == ',' && ++at_);
+      expect(']');
+    } else if (c == '"') {
+      v.type = Json::Type::String;
+      v.text = string();
+    } else if (word("true") || word("false")) {
+      v.type = Json::Type::Bool;
+      v.boolean = s_[at_ - 1] == 'e' && s_[at_ - 2] == 'u';
+    } else if (word("null")) {
+      v.type = Json::Type::Null;
+    } else {
+      // -?(0|[1-9][0-9]*)(\.[0-9]+)?([eE][+-]?[0-9]+)?
+      const std::size_t begin = at_;
+      auto digits = [&] {
+        const std::size_t from = at_;
+        while (at_ < s_.size() && std::isdigit(static_cast<unsigned char>(s_[at_]))) ++at_;
+        if (at_ == from) fail("expected a digit");
+      };
+      if (s_[at_] == '-') ++at_;
+      if (at_ < s_.size() && s_[at_] == '0') {
+        ++at_;
+      } else {
+        digits();
+      }
+      if (at_ < s_.size() && s_[at_] == '.') ++at_, digits();
+      if (at_ < s_.size() && (s_[at_] == 'e' || s_[at_] == 'E')) {
+        ++at_;
+        if (at_ < s_.size() && (s_[at_] == '+' || s_[at_] == '-')) ++at_;
+        digits();
+      }
+      v.type = Json::Type::Number;
+      v.number = std::stod(s_.substr(begin, at_ - begin));
+    }
+    return v;
+  }
+
+  const std::string& s_;
+  std::size_t at_ = 0;
+};
+
+std::vector<std::string> splitText(const std::string& text, char separator) {
+  std::vector<std::string> parts;
+  std::string part;
+  std::istringstream in(text);
+  while (std::getline(in, part, separator)) parts.push_back(part);
+  if (!text.empty() && text.back() == separator) parts.emplace_back();
+  return parts;
 }
 
 // Each test gets fresh directories: `inputs` for what the test writes, `outputs` for what
@@ -269,7 +425,11 @@ TEST_F(Cli, HelpDocumentsTheConventions) {
                            "1 - mean_k sin(max(0, elevation_k))", "Nodata", "float32 EXR", "Exit status"}) {
     EXPECT_NE(general.out.find(text), std::string::npos) << "hfvis --help lacks '" << text << "'";
   }
-  for (const char* command : {"horizon", "svf", "ao", "devices"}) {
+  for (const char* text : {"viewcount", "horizons", "bounce", "grazing samples are visible",
+                           "ground units squared", "projected solid angle", "steradians"}) {
+    EXPECT_NE(general.out.find(text), std::string::npos) << "hfvis --help lacks '" << text << "'";
+  }
+  for (const char* command : {"horizon", "svf", "ao", "viewcount", "horizons", "bounce", "devices"}) {
     const CliResult help = run(std::string(command) + " --help");
     EXPECT_EQ(help.status, 0) << command;
     EXPECT_NE(help.out.find(std::string("hfvis ") + command), std::string::npos) << help.out;
@@ -289,8 +449,8 @@ TEST_F(Cli, NoOpenClPlatformSaysWhichPackageProvidesOne) {
   // platform at all, as on a machine without any OpenCL driver.
   fs::create_directories(root_ / "no_vendors");
   const std::string no_platform = "OCL_ICD_VENDORS=" + shellQuoted((root_ / "no_vendors").string()) + " ";
-  for (const std::string& args :
-       {std::string("devices"), "svf " + shellQuoted(ramp()) + " -o " + shellQuoted(out("o.exr")) + " -k 4"}) {
+  for (const std::string& args : {std::string("devices"), "svf " + shellQuoted(ramp()) + " -o " +
+                                                              shellQuoted(out("o.exr")) + " -k 4"}) {
     const fs::path err_file = root_ / "stderr.txt";
     const std::string command = no_platform + shellQuoted(HFVIS_CLI_PATH) + " " + args + " >/dev/null 2>" +
                                 shellQuoted(err_file.string()) + " </dev/null";
@@ -395,7 +555,7 @@ TEST_F(Cli, BundledDemKeepsItsCellSize) {
 }
 
 TEST_F(Cli, PreviewIsAnEightBitPng) {
-  for (const char* command : {"horizon", "svf", "ao"}) {
+  for (const char* command : {"horizon", "svf", "ao", "viewcount"}) {
     const std::string exr = out(std::string(command) + ".exr");
     const std::string png = out(std::string(command) + ".png");
     const CliResult result = run(std::string(command) + " " + shellQuoted(ramp()) + " -o " +
@@ -408,13 +568,273 @@ TEST_F(Cli, PreviewIsAnEightBitPng) {
     EXPECT_EQ(input->spec().height, 12);
     EXPECT_EQ(input->spec().format, OIIO::TypeDesc::UINT8);
   }
-  EXPECT_EQ(listDirectory(outputs()).size(), 6u);
+  EXPECT_EQ(listDirectory(outputs()).size(), 8u);
 }
 
 TEST_F(Cli, PreviewMustBeAPng) {
   expectFailure(run("svf " + shellQuoted(ramp()) + " -o " + shellQuoted(out("o.exr")) + " --preview " +
                     shellQuoted(out("p.jpg"))),
                 2, "p.jpg");
+}
+
+// ---- viewcount ----
+
+// The contract of issue 4: channel 0 = visible samples summed over the K directions. On a
+// 16 x 12 flat plane at K = 4 every pixel sees the rest of its row and column: 15 + 11.
+TEST_F(Cli, ViewcountChannelZeroIsTheVisibleCount) {
+  for (const char* method : {"tree", "naive"}) {
+    fs::remove(out("v.exr"));
+    const CliResult result = run("viewcount " + shellQuoted(flat()) + " -o " + shellQuoted(out("v.exr")) +
+                                 " -k 4 --method " + method);
+    ASSERT_EQ(result.status, 0) << method << ": " << result.err;
+    EXPECT_NE(result.out.find("mean count 26.00"), std::string::npos) << result.out;
+    const ReadBack image = readBack(out("v.exr"));
+    ASSERT_EQ(image.channels, (std::vector<std::string>{"count", "visible_area"}));
+    EXPECT_EQ(image.spec.format, OIIO::TypeDesc::FLOAT);
+    for (int y = 0; y < image.height; ++y) {
+      for (int x = 0; x < image.width; ++x) {
+        ASSERT_EQ(image.at(x, y, 0), 26.0f) << method << " pixel " << x << "," << y;
+        ASSERT_GT(image.at(x, y, 1), 0.0f);
+      }
+    }
+    EXPECT_EQ(image.spec.get_string_attribute("hfvis:command"), "viewcount");
+    EXPECT_EQ(image.spec.get_string_attribute("hfvis:method"), method);
+    EXPECT_NE(image.spec.get_string_attribute("hfvis:tie_rule").find(">="), std::string::npos);
+  }
+}
+
+TEST_F(Cli, ViewcountStatistics) {
+  const std::string dem = std::string(HFVIS_DATA_DIR) + "/fractal_256.exr";
+  const CliResult result =
+      run("viewcount " + shellQuoted(dem) + " -o " + shellQuoted(out("v.exr")) + " -k 4 --stats --quiet");
+  ASSERT_EQ(result.status, 0) << result.err;
+  EXPECT_EQ(result.out.find("wrote"), std::string::npos) << "--quiet printed the summary:\n" << result.out;
+  for (const char* text : {"m_a ", "t_a ", "visible ", "naive iterations ", "0 lines over"}) {
+    EXPECT_NE(result.out.find(text), std::string::npos) << "--stats lacks '" << text << "':\n" << result.out;
+  }
+  const ReadBack image = readBack(out("v.exr"));
+  const double m_a = std::stod(image.spec.get_string_attribute("hfvis:stats_m_a"));
+  const double t_a = std::stod(image.spec.get_string_attribute("hfvis:stats_t_a"));
+  EXPECT_GT(m_a, 1.0);
+  EXPECT_LE(t_a, 2 * m_a + 1);
+  fs::remove(out("v.exr"));
+  expectFailure(
+      run("viewcount " + shellQuoted(dem) + " -o " + shellQuoted(out("w.exr")) + " --stats --method naive"),
+      2, "--stats");
+}
+
+TEST_F(Cli, ViewcountOptionsAreChecked) {
+  const std::string base = "viewcount " + shellQuoted(ramp()) + " -o " + shellQuoted(out("o.exr"));
+  expectFailure(run(base + " --method sweep"), 2, "'sweep'");
+  expectFailure(run(base + " --radiance " + shellQuoted(ramp())), 2, "--radiance");
+  expectFailure(run(base + " --at 1,1"), 2, "--at");
+  expectFailure(run("svf " + shellQuoted(ramp()) + " -o " + shellQuoted(out("o.exr")) + " --stats"), 2,
+                "--stats");
+}
+
+// ---- horizons ----
+
+// Level ground with a wall 100 high at column 10 (as tests/test_horizon_lists.cpp).
+std::vector<float> wallHeights(int width, int height) {
+  std::vector<float> h(width * height, 0.0f);
+  for (int r = 0; r < height; ++r) h[r * width + 10] = 100.0f;
+  return h;
+}
+
+TEST_F(Cli, HorizonsJsonIsWellFormedAndMatchesTheLibrary) {
+  const int w = 21, h = 5;
+  const std::vector<float> heights = wallHeights(w, h);
+  const std::string field = writeField("wall.exr", w, h, [&](int c, int r) { return heights[r * w + c]; });
+  const CliResult result =
+      run("horizons " + shellQuoted(field) + " --at 3,2 --at 15,4 -k 8 --azimuth-offset 10 -o " +
+          shellQuoted(out("h.json")));
+  ASSERT_EQ(result.status, 0) << result.err;
+  EXPECT_NE(result.out.find("2 receivers"), std::string::npos) << result.out;
+  Json json;
+  ASSERT_NO_THROW(json = JsonParser::parse(readText(out("h.json")))) << readText(out("h.json"));
+
+  hfvis::HeightField library_field;
+  library_field.width = w;
+  library_field.height = h;
+  library_field.heights = heights;
+  hfvis::SweepOptions options;
+  options.directions = 8;
+  options.azimuth_offset = 10.0 * M_PI / 180.0;
+  const auto lists = hfvis::computeHorizonLists(library_field, options, {{3, 2}, {15, 4}});
+
+  EXPECT_EQ(json["width"].number, w);
+  EXPECT_EQ(json["directions"].number, 8);
+  EXPECT_EQ(json["conventions"]["visible"].type, Json::Type::String);
+  ASSERT_EQ(json["receivers"].items.size(), 2u);
+  int horizons = 0, lists_without = 0;
+  for (std::size_t n = 0; n < 2; ++n) {
+    const Json& receiver = json["receivers"][n];
+    EXPECT_EQ(receiver["col"].number, lists[n].pixel.col);
+    EXPECT_FALSE(receiver["nodata"].boolean);
+    ASSERT_EQ(receiver["directions"].items.size(), 8u);
+    for (std::size_t k = 0; k < 8; ++k) {
+      const Json& d = receiver["directions"][k];
+      const auto& expected = lists[n].directions[k];
+      EXPECT_DOUBLE_EQ(d["azimuth_rad"].number, expected.azimuth);
+      EXPECT_EQ(d["visible_samples"].number, expected.visible_samples);
+      ASSERT_EQ(d["horizons"].items.size(), expected.horizons.size());
+      lists_without += expected.horizons.empty();
+      for (std::size_t i = 0; i < expected.horizons.size(); ++i) {
+        const Json& z = d["horizons"][i];
+        EXPECT_EQ(z["sample"].number, expected.horizons[i].sample);
+        EXPECT_DOUBLE_EQ(z["distance"].number, expected.horizons[i].distance);
+        EXPECT_DOUBLE_EQ(z["elevation_rad"].number, expected.horizons[i].elevation);
+        EXPECT_EQ(z["segment_begin"].number, expected.horizons[i].segment_begin);
+        EXPECT_EQ(z["segment_end"].number, expected.horizons[i].segment_end);
+        EXPECT_DOUBLE_EQ(z["near_distance"].number, expected.horizons[i].near_distance);
+        EXPECT_EQ(z["visible_samples"].number, expected.horizons[i].visible_samples);
+        ++horizons;
+      }
+    }
+  }
+  EXPECT_GE(horizons, 12);
+  EXPECT_EQ(lists_without, 4);  // (15, 4) is on the last row: the rays at 10, 55, 100, 145 deg leave at once
+  // From (3, 2) toward the wall (k = 0, 10 degrees off the row), the wall is the one horizon.
+  const Json& toward_wall = json["receivers"][0]["directions"][0]["horizons"];
+  ASSERT_EQ(toward_wall.items.size(), 1u);
+  EXPECT_GT(toward_wall[0]["elevation_rad"].number, 1.4);
+  EXPECT_EQ(listDirectory(outputs()), std::vector<std::string>{"h.json"});
+}
+
+TEST_F(Cli, HorizonsCsvIsWellFormed) {
+  const int w = 21, h = 5;
+  const std::vector<float> heights = wallHeights(w, h);
+  const std::string field = writeField("wall.exr", w, h, [&](int c, int r) { return heights[r * w + c]; });
+  const CliResult result = run("horizons " + shellQuoted(field) +
+                               " --at 3,2 --at 20,2 -k 4 --cell-size 2 -o " + shellQuoted(out("h.CSV")));
+  ASSERT_EQ(result.status, 0) << result.err;
+  std::vector<std::string> lines = splitText(readText(out("h.CSV")), '\n');
+  ASSERT_FALSE(lines.empty());
+  ASSERT_EQ(lines.back(), "");
+  lines.pop_back();
+  const std::vector<std::string> header = splitText(lines[0], ',');
+  ASSERT_EQ(header.size(), 12u) << lines[0];
+  EXPECT_EQ(header[0], "col");
+  EXPECT_EQ(header[7], "elevation_rad");
+  int rows_without = 0;
+  bool wall_seen = false;
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    const std::vector<std::string> fields = splitText(lines[i], ',');
+    ASSERT_EQ(fields.size(), 12u) << lines[i];
+    if (fields[4].empty()) {  // a direction without horizons: (20, 2) looking out of the field
+      ++rows_without;
+      EXPECT_EQ(fields[0], "20");
+      EXPECT_EQ(fields[11], "0");
+      continue;
+    }
+    for (const std::string& f : fields) EXPECT_NO_THROW(std::stod(f)) << lines[i];
+    // (3, 2) toward +x: the wall, 7 samples (14 ground units) away, segment [1, 8).
+    if (fields[0] == "3" && fields[2] == "0") {
+      wall_seen = true;
+      EXPECT_EQ(fields[5], "7");
+      EXPECT_DOUBLE_EQ(std::stod(fields[6]), 14.0);
+      EXPECT_DOUBLE_EQ(std::stod(fields[7]), std::atan2(100.0, 14.0));
+      EXPECT_EQ(fields[8], "1");
+      EXPECT_EQ(fields[9], "8");
+      EXPECT_EQ(fields[11], "7");
+    }
+  }
+  EXPECT_TRUE(wall_seen);
+  EXPECT_EQ(rows_without, 1);  // (20, 2) is on the last column: direction 0 leaves at once
+}
+
+TEST_F(Cli, HorizonsBadReceiversAreUsageErrors) {
+  const std::string base = "horizons " + shellQuoted(ramp()) + " -o " + shellQuoted(out("h.json")) + " -k 4";
+  const CliResult outside = run(base + " --at 3,3 --at 16,2");  // the ramp is 16 x 12
+  expectFailure(outside, 2, "--at 16,2");
+  EXPECT_NE(outside.err.find("16x12"), std::string::npos) << outside.err;
+  expectFailure(run(base + " --at 3,12"), 2, "--at 3,12");
+  expectFailure(run(base + " --at -1,2"), 2, "--at");
+  expectFailure(run(base + " --at 3"), 2, "'3'");
+  expectFailure(run(base + " --at 3,x"), 2, "'3,x'");
+  expectFailure(run(base), 2, "--at");
+  expectFailure(run("horizons " + shellQuoted(ramp()) + " --at 1,1 -o " + shellQuoted(out("h.txt"))), 2,
+                "h.txt");
+  expectFailure(run(base + " --at 1,1 --preview " + shellQuoted(out("p.png"))), 2, "--preview");
+  expectFailure(run(base + " --at 1,1 --device cpu"), 2, "--device");
+}
+
+// ---- bounce ----
+
+TEST_F(Cli, BounceKeepsTheRadianceChannels) {
+  // A V valley along the rows; exit radiance R = 1, G = 2, B = 0.5 everywhere.
+  const std::string field =
+      writeField("valley.exr", 24, 10, [](int c, int) { return std::abs(static_cast<float>(c - 12)); });
+  hfvis::ImageChannels radiance;
+  radiance.width = 24;
+  radiance.height = 10;
+  radiance.names = {"R", "G", "B"};
+  radiance.planes = {std::vector<float>(240, 1.0f), std::vector<float>(240, 2.0f),
+                     std::vector<float>(240, 0.5f)};
+  hfvis::writeImage(in("radiance.exr"), radiance);
+  const CliResult result =
+      run("bounce " + shellQuoted(field) + " --radiance " + shellQuoted(in("radiance.exr")) + " -o " +
+          shellQuoted(out("b.exr")) + " -k 8 --preview " + shellQuoted(out("b.png")));
+  ASSERT_EQ(result.status, 0) << result.err;
+  EXPECT_NE(result.out.find("mean irradiance R "), std::string::npos) << result.out;
+  const ReadBack image = readBack(out("b.exr"));
+  ASSERT_EQ(image.channels, (std::vector<std::string>{"R", "G", "B"}));
+  EXPECT_EQ(image.spec.get_string_attribute("hfvis:command"), "bounce");
+  EXPECT_EQ(image.spec.get_string_attribute("hfvis:radiance"), in("radiance.exr"));
+  double largest = 0.0;
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      const float r = image.at(x, y, 0);
+      ASSERT_GE(r, -1e-6f);
+      ASSERT_NEAR(image.at(x, y, 1), 2.0f * r, 1e-5f * (1.0f + r));  // linear in the radiance
+      ASSERT_NEAR(image.at(x, y, 2), 0.5f * r, 1e-5f * (1.0f + r));
+      largest = std::max(largest, double(r));
+    }
+  }
+  EXPECT_GT(largest, 0.1) << "the flanks see each other";
+  EXPECT_EQ(listDirectory(outputs()).size(), 2u);
+}
+
+TEST_F(Cli, BounceOfAFlatPlaneIsZero) {
+  hfvis::ImageChannels radiance;
+  radiance.width = 16;
+  radiance.height = 12;
+  radiance.names = {"Y"};
+  radiance.planes = {std::vector<float>(16 * 12, 3.0f)};
+  hfvis::writeImage(in("radiance.exr"), radiance);
+  const CliResult result =
+      run("bounce " + shellQuoted(flat()) + " --radiance " + shellQuoted(in("radiance.exr")) + " -o " +
+          shellQuoted(out("b.exr")) + " -k 4 -q");
+  ASSERT_EQ(result.status, 0) << result.err;
+  const ReadBack image = readBack(out("b.exr"));
+  EXPECT_EQ(image.channels, std::vector<std::string>{"Y"});
+  for (const float v : image.pixels) ASSERT_EQ(v, 0.0f);
+}
+
+TEST_F(Cli, BounceBadRadiance) {
+  const std::string base = "bounce " + shellQuoted(flat()) + " -o " + shellQuoted(out("b.exr")) + " -k 4";
+  expectFailure(run(base), 2, "--radiance");
+  expectFailure(run(base + " --radiance " + shellQuoted(out("b.exr"))), 2, "--radiance");
+  expectFailure(run(base + " --radiance " + shellQuoted(in("absent.exr"))), 1, "absent.exr");
+  expectFailure(run(base + " --radiance " + shellQuoted(ramp()) + " --method naive"), 2, "--method");
+  hfvis::ImageChannels radiance;
+  radiance.width = 16;
+  radiance.height = 11;  // the field is 16 x 12
+  radiance.names = {"Y"};
+  radiance.planes = {std::vector<float>(16 * 11, 1.0f)};
+  hfvis::writeImage(in("small.exr"), radiance);
+  const CliResult small = run(base + " --radiance " + shellQuoted(in("small.exr")));
+  expectFailure(small, 1, "small.exr");
+  EXPECT_NE(small.err.find("16x11"), std::string::npos) << small.err;
+  radiance.height = 12;
+  radiance.planes = {std::vector<float>(16 * 12, 1.0f)};
+  radiance.planes[0][5] = std::nanf("");
+  hfvis::writeImage(in("nan.exr"), radiance);
+  expectFailure(run(base + " --radiance " + shellQuoted(in("nan.exr"))), 1, "nan.exr");
+  radiance.names = {"a", "b", "c", "d", "e"};
+  radiance.planes.assign(5, std::vector<float>(16 * 12, 1.0f));
+  hfvis::writeImage(in("five.exr"), radiance);
+  expectFailure(run(base + " --radiance " + shellQuoted(in("five.exr"))), 1, "5 channels");
 }
 
 }  // namespace

@@ -28,7 +28,7 @@ struct HeightFieldReadOptions {
 // channel choice, unknown channel).
 HeightField readHeightField(const std::string& path, const HeightFieldReadOptions& options = {});
 
-// One float32 image to write: planar channels of width*height values each.
+// One float32 image to write (or read by readImage): planar channels of width*height values each.
 struct ImageChannels {
   int width = 0;
   int height = 0;
@@ -36,6 +36,11 @@ struct ImageChannels {
   std::vector<std::vector<float>> planes;                       // one per channel, row-major
   std::vector<std::pair<std::string, std::string>> attributes;  // string metadata
 };
+
+// Reads every channel of an image as float32 planes, in the order OpenImageIO reports them
+// (for EXR: R, G, B, A first, then the others sorted by name), with their names; integer
+// pixels as their stored values, as readHeightField. Throws IoError as readHeightField.
+ImageChannels readImage(const std::string& path);
 
 // Writes an EXR (or any float format OpenImageIO writes, by extension) atomically: to a
 // temporary file beside `path`, renamed into place only when complete. Throws IoError.

@@ -1,0 +1,148 @@
+// cli/horizon_list_files.cpp: writing the horizon lists as JSON and CSV text.
+#include "horizon_list_files.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <iomanip>
+#include <sstream>
+
+namespace hfvis::cli {
+namespace {
+
+// Shortest text that reads back as the same double (JSON and CSV readers parse doubles).
+std::string number(double value) {
+  if (!std::isfinite(value)) return "null";
+  std::ostringstream out;
+  out << std::setprecision(17) << value;
+  const std::string exact = out.str();
+  for (int digits = 6; digits < 17; ++digits) {
+    std::ostringstream shorter;
+    shorter << std::setprecision(digits) << value;
+    if (std::stod(shorter.str()) == value) return shorter.str();
+  }
+  return exact;
+}
+
+// The same for a float (the input heights): the shortest text that reads back as that float.
+std::string number(float value) {
+  if (!std::isfinite(value)) return "null";
+  for (int digits = 6; digits < 9; ++digits) {
+    std::ostringstream shorter;
+    shorter << std::setprecision(digits) << value;
+    if (std::stof(shorter.str()) == value) return shorter.str();
+  }
+  std::ostringstream out;
+  out << std::setprecision(9) << value;
+  return out.str();
+}
+
+std::string jsonString(const std::string& text) {
+  std::string out = "\"";
+  for (const char ch : text) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (ch == '"' || ch == '\\') {
+      out += '\\';
+      out += ch;
+    } else if (c < 0x20) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\u%04x", c);
+      out += escaped;
+    } else {
+      out += ch;
+    }
+  }
+  return out + "\"";
+}
+
+constexpr const char* kAzimuthConvention =
+    "phi_k = 2*pi*k/K + offset, radians, on the ground from the +column axis toward +row; "
+    "compass azimuth = 90 deg + phi_k when row 0 is north";
+constexpr const char* kRayConvention =
+    "samples i = 1, 2, ... of the receiver's own ray from its pixel centre, i / samples_per_unit pixel "
+    "lengths along direction k, bilinear heights, while inside the field (the naive method's samples)";
+constexpr const char* kVisibleConvention =
+    "a sample is visible when its slope from the receiver is >= the slope of every sample between them "
+    "(grazing samples are visible; decided exactly)";
+constexpr const char* kHorizonConvention =
+    "nearest first; a horizon is the farthest visible sample of its segment; its segment is the visible "
+    "samples [segment_begin, segment_end) toward the receiver, up to the first hidden sample or the next "
+    "horizon; the segments hold every visible sample once";
+constexpr const char* kUnits =
+    "distance, near_distance, sample_spacing: ground units (pixels times cell size); elevation_rad, "
+    "azimuth_rad: radians; heights in the input's units";
+
+}  // namespace
+
+std::string horizonListsJson(const RunArguments& run, const HeightField& field,
+                             const std::vector<ReceiverHorizons>& lists) {
+  std::ostringstream out;
+  out << "{\n";
+  out << "  \"format\": \"hfvis horizon lists 1\",\n";
+  out << "  \"input\": " << jsonString(run.input) << ",\n";
+  out << "  \"width\": " << field.width << ",\n  \"height\": " << field.height << ",\n";
+  out << "  \"cell_size\": [" << number(field.cell_size_x) << ", " << number(field.cell_size_y) << "],\n";
+  out << "  \"z_scale\": " << number(field.z_scale) << ",\n";
+  out << "  \"directions\": " << run.directions << ",\n";
+  out << "  \"azimuth_offset_deg\": " << number(run.azimuth_offset_deg) << ",\n";
+  out << "  \"samples_per_unit\": " << number(run.samples_per_unit) << ",\n";
+  out << "  \"conventions\": {\n";
+  out << "    \"azimuth\": " << jsonString(kAzimuthConvention) << ",\n";
+  out << "    \"ray\": " << jsonString(kRayConvention) << ",\n";
+  out << "    \"visible\": " << jsonString(kVisibleConvention) << ",\n";
+  out << "    \"horizons\": " << jsonString(kHorizonConvention) << ",\n";
+  out << "    \"units\": " << jsonString(kUnits) << "\n";
+  out << "  },\n";
+  out << "  \"receivers\": [";
+  for (std::size_t r = 0; r < lists.size(); ++r) {
+    const ReceiverHorizons& receiver = lists[r];
+    out << (r ? "," : "") << "\n    {\"col\": " << receiver.pixel.col << ", \"row\": " << receiver.pixel.row
+        << ", \"height\": " << number(receiver.height)
+        << ", \"nodata\": " << (receiver.nodata ? "true" : "false") << ",\n     \"directions\": [";
+    for (std::size_t k = 0; k < receiver.directions.size(); ++k) {
+      const DirectionHorizons& d = receiver.directions[k];
+      out << (k ? "," : "") << "\n       {\"k\": " << d.direction
+          << ", \"azimuth_rad\": " << number(d.azimuth)
+          << ", \"sample_spacing\": " << number(d.sample_spacing) << ", \"ray_samples\": " << d.ray_samples
+          << ", \"visible_samples\": " << d.visible_samples << ",\n        \"horizons\": [";
+      for (std::size_t h = 0; h < d.horizons.size(); ++h) {
+        const VisibilityHorizon& z = d.horizons[h];
+        out << (h ? "," : "") << "\n          {\"sample\": " << z.sample
+            << ", \"distance\": " << number(z.distance) << ", \"elevation_rad\": " << number(z.elevation)
+            << ", \"segment_begin\": " << z.segment_begin << ", \"segment_end\": " << z.segment_end
+            << ", \"near_distance\": " << number(z.near_distance)
+            << ", \"visible_samples\": " << z.visible_samples << "}";
+      }
+      out << (d.horizons.empty() ? "" : "\n        ") << "]}";
+    }
+    out << "\n     ]}";
+  }
+  out << (lists.empty() ? "" : "\n  ") << "]\n}\n";
+  return out.str();
+}
+
+const char* horizonListsCsvHeader() {
+  return "col,row,direction,azimuth_rad,horizon,sample,distance,elevation_rad,segment_begin,segment_end,"
+         "near_distance,visible_samples";
+}
+
+std::string horizonListsCsv(const std::vector<ReceiverHorizons>& lists) {
+  std::ostringstream out;
+  out << horizonListsCsvHeader() << "\n";
+  for (const ReceiverHorizons& receiver : lists) {
+    for (const DirectionHorizons& d : receiver.directions) {
+      const std::string prefix = std::to_string(receiver.pixel.col) + "," +
+                                 std::to_string(receiver.pixel.row) + "," + std::to_string(d.direction) +
+                                 "," + number(d.azimuth) + ",";
+      if (d.horizons.empty()) out << prefix << ",,,,,,,0\n";  // no horizon: nodata, or a ray leaving at once
+      for (std::size_t h = 0; h < d.horizons.size(); ++h) {
+        const VisibilityHorizon& z = d.horizons[h];
+        out << prefix << h << "," << z.sample << "," << number(z.distance) << "," << number(z.elevation)
+            << "," << z.segment_begin << "," << z.segment_end << "," << number(z.near_distance) << ","
+            << z.visible_samples << "\n";
+      }
+    }
+  }
+  return out.str();
+}
+
+}  // namespace hfvis::cli

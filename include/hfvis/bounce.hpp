@@ -1,0 +1,87 @@
+// hfvis/bounce.hpp: one diffuse light bounce on a height field: from a given exit radiance
+// per surface point, the incident indirect irradiance at every pixel, gathered over the
+// visible segments of each sweep line (Timonen 2013, Sec. 10.1, alternative 3: step through
+// the visible samples of each visibility horizon's segment).
+//
+// The formula. Receiver p has the unit normal n of the four quads around its pixel (in
+// ground units, as ambient occlusion uses). Direction k stands for the azimuthal wedge of
+// width D = 2*pi/K around phi_k. In the vertical plane of direction k, the visible samples x
+// at ground distance r_x and height difference dz_x are seen at elevations
+// theta_x = atan2(dz_x, r_x), which never decrease outward (visibility, tie rule as in
+// hfvis/intervisibility.hpp). Together they cover the elevations from the nearest visible
+// sample's to the farthest's, split into one band per visible sample:
+//   - between two visible samples with no hidden sample between them (the surface piece
+//     between them is visible) at the mean of their two elevations;
+//   - across hidden samples (between a segment's horizon and the nearest visible sample of
+//     the next farther segment) the whole band goes to the farther sample: what shows there
+//     is the surface rising toward it.
+// A band [a, b] of sample x adds L_x * (G(b) - G(a)), where
+//   G(theta) = n_z * (D/2) * sin^2(theta) + (n . d_k) * 2 sin(D/2) * (theta + sin(theta) cos(theta)) / 2
+// is the exact integral over the wedge of the projected solid angle (n . w) dw up to
+// elevation theta (the same integral as ambient occlusion's Eq. 5), with theta clipped from
+// below at theta_t = atan2(-(n . d_k) * 2 sin(D/2), n_z * D), where the wedge's cosine factor
+// changes sign: surface behind the receiver's tangent plane adds nothing, and every band
+// adds a non-negative amount. The irradiance is E = sum_k sum_x L_x (G_k(hi_x) - G_k(lo_x)).
+// A uniform radiance L gives L * (G(theta_farthest) - G(theta_nearest)) per direction (the
+// bands telescope); a flat plane gives 0 (every band is empty); and since the sky above the
+// horizon is what ambient occlusion integrates with the same G, E / (pi L) + AO stays <= about 1.
+//
+// Units: E is in radiance units times steradians (W/m^2 for W m^-2 sr^-1). A Lambertian
+// surface of albedo rho re-emits rho * E / pi, which can feed the next bounce.
+//
+// Per-pixel values, as the visible counts: each line sample gathers exactly over its own
+// line (its normal interpolated bilinearly from the four surrounding pixel normals, its
+// exit radiance sampled bilinearly like its height), and a pixel takes the bilinear
+// interpolation of the (up to) four line samples around it; on axis directions that is the
+// pixel's own sample. Nodata pixels receive NaN and emit nothing.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "hfvis/device.hpp"
+#include "hfvis/height_field.hpp"
+#include "hfvis/sweep_options.hpp"
+
+namespace hfvis {
+
+// Exit radiance channels gathered in one run (one tree sweep serves all of them).
+constexpr int kMaxBounceChannels = 4;
+
+struct BounceOptions : SweepOptions {};
+
+// Exit radiance per pixel of the height field: 1..kMaxBounceChannels planes (grey, RGB,
+// ...), each width*height, finite and >= 0 at every pixel whose height is valid (values at
+// nodata pixels are ignored).
+struct ExitRadiance {
+  int width = 0;
+  int height = 0;
+  std::vector<std::vector<float>> channels;
+};
+
+struct BounceResult {
+  int width = 0;
+  int height = 0;
+  int directions = 0;
+  std::vector<double> azimuths;                // phi_k, radians
+  std::vector<std::vector<float>> irradiance;  // one plane per radiance channel; NaN at nodata
+};
+
+// Throws InvalidArgument for bad sweep options (see sweep_options.hpp).
+void validate(const BounceOptions& options);
+
+// Throws InvalidArgument when the radiance does not fit the field (size, 1..4 channels,
+// plane sizes) or is not finite and >= 0 at a pixel with a valid height (names the pixel).
+void validate(const HeightField& field, const ExitRadiance& radiance);
+
+// Tree sweep with the gather, and the reduction, on the device of `context`. Throws
+// InvalidArgument, MemoryBudgetError, OpenClError, KernelBuildError.
+BounceResult computeBounce(const ComputeContext& context, const HeightField& field,
+                           const ExitRadiance& radiance, const BounceOptions& options);
+
+// The scalar C++ reference of the same (same samples, same visible sets, same bands; the
+// kernels' transcendentals may differ in the last bits).
+BounceResult referenceBounce(const HeightField& field, const ExitRadiance& radiance,
+                             const BounceOptions& options);
+
+}  // namespace hfvis

@@ -1,0 +1,195 @@
+// bounce_reference.cpp: what the bounce's two paths share (validation, prepared inputs) and
+// its scalar reference: the mirrors of bounce_presample, the gather inside the hull-tree
+// sweep (src/intervisibility_reference.cpp) and bounce_reduce.
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "bounce_internal.hpp"
+#include "hfvis/errors.hpp"
+#include "horizon_common.hpp"
+
+namespace hfvis {
+namespace detail {
+namespace {
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+// The unit normal of the (up to) four quads around pixel (c, r), in ground units; quads
+// touching nodata or the border are left out, (0, 0, 1) when none is left. The same normal
+// as ambient occlusion (surface_normal in kernels/horizon.cl).
+void pixelNormal(const std::vector<float>& h, int width, int height, int c, int r, float cell_x, float cell_y,
+                 float* n) {
+  const float hp = h[static_cast<std::size_t>(r) * width + c];
+  float sx_sum = 0.0f, sy_sum = 0.0f, sz_sum = 0.0f;
+  for (int q = 0; q < 4; ++q) {
+    const int sx = (q & 1) ? 1 : -1, sy = (q & 2) ? 1 : -1;
+    const int cx = c + sx, ry = r + sy;
+    if (cx < 0 || cx >= width || ry < 0 || ry >= height) continue;
+    const float hx = h[static_cast<std::size_t>(r) * width + cx],
+                hy = h[static_cast<std::size_t>(ry) * width + c];
+    if (std::isnan(hx) || std::isnan(hy)) continue;
+    sx_sum += -(hx - hp) / (static_cast<float>(sx) * cell_x);
+    sy_sum += -(hy - hp) / (static_cast<float>(sy) * cell_y);
+    sz_sum += 1.0f;
+  }
+  if (!(sz_sum > 0.0f)) {
+    n[0] = 0.0f, n[1] = 0.0f, n[2] = 1.0f;
+    return;
+  }
+  const float length = std::sqrt(sx_sum * sx_sum + sy_sum * sy_sum + sz_sum * sz_sum);
+  n[0] = sx_sum / length, n[1] = sy_sum / length, n[2] = sz_sum / length;
+}
+
+}  // namespace
+
+BounceInputs prepareBounce(const HeightField& field, const ExitRadiance& radiance) {
+  BounceInputs in;
+  PreparedHeights prepared = prepareHeights(field);
+  in.heights = std::move(prepared.heights);
+  in.has_nodata = prepared.has_nodata;
+  const std::size_t plane = field.pixelCount();
+  in.normals.assign(3, std::vector<float>(plane, kNaN));
+  const auto cell_x = static_cast<float>(field.cell_size_x), cell_y = static_cast<float>(field.cell_size_y);
+  for (int r = 0; r < field.height; ++r) {
+    for (int c = 0; c < field.width; ++c) {
+      const std::size_t p = static_cast<std::size_t>(r) * field.width + c;
+      if (std::isnan(in.heights[p])) continue;
+      float n[3];
+      pixelNormal(in.heights, field.width, field.height, c, r, cell_x, cell_y, n);
+      for (int i = 0; i < 3; ++i) in.normals[i][p] = n[i];
+    }
+  }
+  for (const auto& channel : radiance.channels) {
+    in.radiance.push_back(channel);
+    for (std::size_t p = 0; p < plane; ++p)
+      if (std::isnan(in.heights[p])) in.radiance.back()[p] = kNaN;
+  }
+  return in;
+}
+
+BounceLineView referenceBounceLines(const HeightField& field, const BounceInputs& inputs,
+                                    const SweepDirection& d, int directions) {
+  BounceLineView view;
+  view.lines.geometry = d;
+  const std::size_t entries = d.entries();
+  const int channels = inputs.channels();
+  const int stride = channels + kBounceNormalFloats;
+  view.lines.samples.assign(entries, kNaN);
+  view.bounce.channels = channels;
+  bounceWedge(directions, &view.bounce.half_sector, &view.bounce.wedge);
+  view.bounce.attributes.assign(entries * stride, kNaN);
+  for (int j = 0; j < d.n_lines; ++j) {
+    for (int i = 0; i < d.n_steps; ++i) {
+      const Point2 p = sweepPosition(d, j, i);
+      const std::size_t e = static_cast<std::size_t>(i) * d.n_lines + j;
+      // As presample_lines and bounce_presample (attributes are sampled everywhere; only
+      // those of present samples are read).
+      if (insideField(p, field.width, field.height))
+        view.lines.samples[e] = sampleHeight(inputs.heights, field.width, field.height, p);
+      float* out = &view.bounce.attributes[e * stride];
+      for (int c = 0; c < channels; ++c)
+        out[c] = sampleHeight(inputs.radiance[c], field.width, field.height, p);
+      const float nx = sampleHeight(inputs.normals[0], field.width, field.height, p);
+      const float ny = sampleHeight(inputs.normals[1], field.width, field.height, p);
+      const float nz = sampleHeight(inputs.normals[2], field.width, field.height, p);
+      const float length = std::sqrt(nx * nx + ny * ny + nz * nz);
+      out[channels] = nx / length;
+      out[channels + 1] = ny / length;
+      out[channels + 2] = nz / length;
+    }
+  }
+  sweepPresampledLines(view.lines, false, &view.bounce);
+  return view;
+}
+
+}  // namespace detail
+
+void validate(const BounceOptions& options) { validate(static_cast<const SweepOptions&>(options)); }
+
+void validate(const HeightField& field, const ExitRadiance& radiance) {
+  if (radiance.width != field.width || radiance.height != field.height) {
+    throw InvalidArgument("the exit radiance is " + std::to_string(radiance.width) + " x " +
+                          std::to_string(radiance.height) + " pixels, the height field " +
+                          std::to_string(field.width) + " x " + std::to_string(field.height) +
+                          ": it needs one value per height");
+  }
+  const int channels = static_cast<int>(radiance.channels.size());
+  if (channels < 1 || channels > kMaxBounceChannels) {
+    throw InvalidArgument("the exit radiance has " + std::to_string(channels) + " channels; 1 to " +
+                          std::to_string(kMaxBounceChannels) + " are gathered in one run");
+  }
+  for (int c = 0; c < channels; ++c) {
+    const auto& plane = radiance.channels[c];
+    if (plane.size() != field.pixelCount()) {
+      throw InvalidArgument("exit radiance channel " + std::to_string(c) + " holds " +
+                            std::to_string(plane.size()) + " values for " +
+                            std::to_string(field.pixelCount()) + " pixels");
+    }
+    for (std::size_t p = 0; p < plane.size(); ++p) {
+      if (!std::isfinite(field.heights[p])) continue;  // nodata: ignored
+      if (!std::isfinite(plane[p]) || plane[p] < 0.0f) {
+        throw InvalidArgument(
+            "the exit radiance must be finite and >= 0 where the height is valid; channel " +
+            std::to_string(c) + " at pixel (" + std::to_string(p % field.width) + ", " +
+            std::to_string(p / field.width) + ") is " + std::to_string(plane[p]));
+      }
+    }
+  }
+}
+
+BounceResult referenceBounce(const HeightField& field, const ExitRadiance& radiance,
+                             const BounceOptions& options) {
+  validate(field);
+  validate(options);
+  validate(field, radiance);
+  const detail::BounceInputs inputs = detail::prepareBounce(field, radiance);
+  const auto directions = detail::runDirections(field, options);
+  IntervisibilityOutputs counts;
+  counts.visible_count = true;
+  detail::checkLineLimits(directions, inputs.heights, counts);
+  const int channels = inputs.channels();
+  const std::size_t plane = field.pixelCount();
+
+  BounceResult result;
+  result.width = field.width;
+  result.height = field.height;
+  result.directions = options.directions;
+  for (int k = 0; k < options.directions; ++k) result.azimuths.push_back(directionAzimuth(k, options));
+  result.irradiance.assign(channels, std::vector<float>(plane, 0.0f));
+  for (const detail::SweepDirection& d : directions) {
+    const detail::BounceLineView view = detail::referenceBounceLines(field, inputs, d, options.directions);
+    const std::vector<float>& gathered = view.bounce.irradiance;
+    // Mirror of bounce_reduce, one direction at a time.
+    for (int r = 0; r < field.height; ++r) {
+      for (int c = 0; c < field.width; ++c) {
+        const float x = static_cast<float>(c), y = static_cast<float>(r);
+        const float t = x * d.dir_x + y * d.dir_y;
+        const float u = (x * d.perp_x + y * d.perp_y) * d.lines_per_unit - static_cast<float>(d.line_first);
+        const float v = static_cast<float>(d.step_top) - t * d.samples_per_unit;
+        const int j0 = static_cast<int>(std::floor(u)), i0 = static_cast<int>(std::floor(v));
+        const float fu = u - static_cast<float>(j0), fv = v - static_cast<float>(i0);
+        float weight = 0.0f, acc[kMaxBounceChannels] = {};
+        for (int k = 0; k < 4; ++k) {
+          const int j = j0 + (k & 1), i = i0 + (k >> 1);
+          const float w = ((k & 1) ? fu : 1.0f - fu) * ((k >> 1) ? fv : 1.0f - fv);
+          if (w <= 0.0f || j < 0 || j >= d.n_lines || i < 0 || i >= d.n_steps) continue;
+          const std::size_t e = static_cast<std::size_t>(i) * d.n_lines + j;
+          if (std::isnan(gathered[e * channels])) continue;
+          weight += w;
+          for (int ch = 0; ch < channels; ++ch) acc[ch] += w * gathered[e * channels + ch];
+        }
+        const bool renormalise = weight > 0.0f && weight != 1.0f;
+        const std::size_t p = static_cast<std::size_t>(r) * field.width + c;
+        for (int ch = 0; ch < channels; ++ch)
+          result.irradiance[ch][p] += renormalise ? acc[ch] / weight : acc[ch];
+      }
+    }
+  }
+  for (std::size_t p = 0; p < plane; ++p)
+    if (std::isnan(inputs.heights[p]))
+      for (auto& channel : result.irradiance) channel[p] = std::numeric_limits<float>::quiet_NaN();
+  return result;
+}
+
+}  // namespace hfvis

@@ -1,0 +1,121 @@
+// horizon_lists.cpp: the visibility horizons of chosen receivers: each receiver's ray is
+// sampled as the naive method samples it and swept, receiver last, by the scalar hull-tree
+// sweep (the mirror of kernels/intervisibility.cl), which keeps every horizon and the end
+// of its visible run.
+#include "hfvis/horizon_lists.hpp"
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "hfvis/errors.hpp"
+#include "horizon_common.hpp"
+#include "intervisibility_internal.hpp"
+
+namespace hfvis {
+namespace {
+
+// The heights of the ray from pixel (c, r) along d: sample i (1 = nearest) at index i - 1,
+// NaN where absent, up to the last sample inside the field (as the naive march).
+std::vector<float> raySamples(const HeightField& field, const std::vector<float>& heights,
+                              const detail::SweepDirection& d, int c, int r) {
+  std::vector<float> ray;
+  for (int i = 1;; ++i) {
+    const float t = static_cast<float>(i) * d.step_length;
+    const detail::Point2 p{static_cast<float>(c) + t * d.dir_x, static_cast<float>(r) + t * d.dir_y};
+    if (!detail::insideField(p, field.width, field.height)) break;
+    ray.push_back(detail::sampleHeight(heights, field.width, field.height, p));
+  }
+  return ray;
+}
+
+DirectionHorizons listDirection(const HeightField& field, const std::vector<float>& heights,
+                                const detail::SweepDirection& d, int k, double azimuth, int c, int r) {
+  DirectionHorizons out;
+  out.direction = k;
+  out.azimuth = azimuth;
+  out.sample_spacing = static_cast<double>(d.step_length) * d.ground_per_pixel;
+  const std::vector<float> ray = raySamples(field, heights, d, c, r);
+  const int n = static_cast<int>(ray.size());
+  out.ray_samples = n;
+  const float h = heights[static_cast<std::size_t>(r) * field.width + c];
+  if (std::isnan(h) || n == 0) return out;
+
+  // One line, swept from the far end: step s holds sample n - s, the receiver is step n.
+  detail::IntervisibilityLines line;
+  line.geometry = d;
+  line.geometry.n_lines = 1;
+  line.geometry.n_steps = n + 1;
+  line.geometry.buffer_offset = 0;
+  line.samples.resize(static_cast<std::size_t>(n) + 1);
+  for (int s = 0; s < n; ++s) line.samples[s] = ray[n - 1 - s];
+  line.samples[n] = h;
+  detail::sweepPresampledLines(line, true);
+
+  const std::vector<int>& steps = line.horizon_steps[n];  // farthest first
+  const std::vector<int>& ends = line.horizon_run_ends[n];
+  for (std::size_t idx = steps.size(); idx-- > 0;) {  // nearest first
+    VisibilityHorizon horizon;
+    horizon.sample = n - steps[idx];
+    horizon.segment_end = horizon.sample + 1;
+    // Steps [h, end) hold the run; its nearest present sample begins the segment.
+    horizon.segment_begin = n - ends[idx] + 1;
+    while (std::isnan(ray[horizon.segment_begin - 1])) ++horizon.segment_begin;
+    horizon.distance = horizon.sample * out.sample_spacing;
+    horizon.near_distance = horizon.segment_begin * out.sample_spacing;
+    horizon.elevation = std::atan2(static_cast<double>(ray[horizon.sample - 1]) - h, horizon.distance);
+    for (int i = horizon.segment_begin; i < horizon.segment_end; ++i)
+      horizon.visible_samples += !std::isnan(ray[i - 1]);
+    out.visible_samples += horizon.visible_samples;
+    out.horizons.push_back(horizon);
+  }
+  if (out.visible_samples != static_cast<int>(line.counts[n])) {
+    throw Error("internal error: the horizon segments hold " + std::to_string(out.visible_samples) +
+                " samples, the sweep counted " + std::to_string(line.counts[n]));
+  }
+  return out;
+}
+
+}  // namespace
+
+void validateReceivers(const HeightField& field, const std::vector<ReceiverPixel>& receivers) {
+  for (const ReceiverPixel& p : receivers) {
+    if (p.col < 0 || p.col >= field.width || p.row < 0 || p.row >= field.height) {
+      throw InvalidArgument("receiver (" + std::to_string(p.col) + ", " + std::to_string(p.row) +
+                            ") is outside the field, which is " + std::to_string(field.width) + " x " +
+                            std::to_string(field.height) + " pixels (columns 0.." +
+                            std::to_string(field.width - 1) + ", rows 0.." +
+                            std::to_string(field.height - 1) + ")");
+    }
+  }
+}
+
+std::vector<ReceiverHorizons> computeHorizonLists(const HeightField& field, const SweepOptions& options,
+                                                  const std::vector<ReceiverPixel>& receivers) {
+  validate(field);
+  validate(options);
+  validateReceivers(field, receivers);
+  const detail::PreparedHeights prepared = detail::prepareHeights(field);
+  const auto directions = detail::runDirections(field, options);
+  IntervisibilityOutputs counts;
+  counts.visible_count = true;
+  detail::checkLineLimits(directions, prepared.heights, counts);  // rays are no longer than lines
+
+  std::vector<ReceiverHorizons> lists;
+  lists.reserve(receivers.size());
+  for (const ReceiverPixel& p : receivers) {
+    ReceiverHorizons receiver;
+    receiver.pixel = p;
+    receiver.height = field.at(p.col, p.row);
+    receiver.nodata = std::isnan(prepared.heights[static_cast<std::size_t>(p.row) * field.width + p.col]);
+    if (receiver.nodata) receiver.height = std::numeric_limits<float>::quiet_NaN();
+    for (int k = 0; k < options.directions; ++k) {
+      receiver.directions.push_back(listDirection(field, prepared.heights, directions[k], k,
+                                                  directionAzimuth(k, options), p.col, p.row));
+    }
+    lists.push_back(std::move(receiver));
+  }
+  return lists;
+}
+
+}  // namespace hfvis
