@@ -33,7 +33,6 @@
 #define HFVIS_NEAR_SAMPLES 4  // receiver's own ray samples over its first step (reduction)
 #endif
 
-#define HFVIS_PI 3.14159265358979323846f
 
 // One step of Algorithm 1 (Timonen & Westerholm 2010) on one line: reads the presampled
 // height at *entry and writes, in place, the occluder that casts its horizon:
@@ -124,11 +123,11 @@ HFVIS_INLINE void surface_normal(__global const float* heights, int width, int h
 // The zenith angle is clamped where the sky falls behind the surface (N . e = 0).
 HFVIS_INLINE float ambient_term(float elevation, float nx, float ny, float nz, float cos_az, float sin_az) {
   float toward = nx * cos_az + ny * sin_az;
-  float zenith = 0.5f * HFVIS_PI - elevation;
-  zenith = fmin(zenith, 0.5f * HFVIS_PI + hf_atan(toward / nz));
+  float zenith = 0.5f * HFVIS_PI_F - elevation;
+  zenith = fmin(zenith, 0.5f * HFVIS_PI_F + hf_atan(toward / nz));
   float s = hf_sin(zenith);
   return nz / (float)HFVIS_DIRECTIONS * s * s +
-         hf_sin(HFVIS_PI / (float)HFVIS_DIRECTIONS) / HFVIS_PI * (zenith - 0.5f * hf_sin(2.0f * zenith)) * toward;
+         hf_sin(HFVIS_PI_F / (float)HFVIS_DIRECTIONS) / HFVIS_PI_F * (zenith - 0.5f * hf_sin(2.0f * zenith)) * toward;
 }
 
 // Writes or accumulates one direction's outputs at one pixel; shared by the sweep
@@ -236,14 +235,14 @@ __kernel void horizon_reduce(__global const float* heights, int width, int heigh
       ray_has_sample = ray_has_sample || (q == 1 && inside);
     }
     float near_elevation = hf_atan(near_slope / d.ground_per_pixel);
-    float elevation = weight > 0.0f ? angle_sum / weight : -0.5f * HFVIS_PI;
+    float elevation = weight > 0.0f ? angle_sum / weight : -0.5f * HFVIS_PI_F;
     float distance = weight > 0.0f ? distance_sum / weight : 0.0f;
     // Steeper by more than the two paths' rounding: where they agree (a straight flank)
     // the line samples' farther occluder stays, as on the hull.
     int use_near = near_found && (!(weight > 0.0f) || near_elevation > elevation + HFVIS_NEAR_MARGIN);
     elevation = use_near ? near_elevation : elevation;
     distance = use_near ? near_t * d.ground_per_pixel : distance;
-    elevation = ray_has_sample ? elevation : -0.5f * HFVIS_PI;
+    elevation = ray_has_sample ? elevation : -0.5f * HFVIS_PI_F;
     distance = ray_has_sample ? distance : 0.0f;
     elevation = isnan(h) ? NAN : elevation;
     distance = isnan(h) ? NAN : distance;
@@ -306,7 +305,7 @@ __kernel void horizon_naive(__global const float* heights, int width, int height
       best_step = better ? i : best_step;
     }
     float ground = (float)best_step * d.step_length * d.ground_per_pixel;
-    float elevation = best_step > 0 ? hf_atan2_ahead(best_rise, ground) : -0.5f * HFVIS_PI;
+    float elevation = best_step > 0 ? hf_atan2_ahead(best_rise, ground) : -0.5f * HFVIS_PI_F;
     float distance = best_step > 0 ? ground : 0.0f;
     if (isnan(h)) elevation = distance = NAN;
     if (valid) emit_direction(b, pixel, plane, elevation, distance, nx, ny, nz, d, angles, distances, &svf, &ao);
