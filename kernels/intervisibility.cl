@@ -536,21 +536,16 @@ __kernel void intervisibility_reduce(__global const float* heights, int width, i
   for (int b = 0; b < batch_size; ++b) {
     barrier(CLK_LOCAL_MEM_FENCE);  // see horizon_reduce: keeps the work-item loop innermost
     const SweepDirection d = load_direction(directions + b);
-    float x = (float)cc, y = (float)rr;
-    float t = x * d.dir_x + y * d.dir_y;
-    float u = (x * d.perp_x + y * d.perp_y) * d.lines_per_unit - (float)d.line_first;
-    float v = (float)d.step_top - t * d.samples_per_unit;
-    int j0 = (int)floor(u), i0 = (int)floor(v);
-    float fu = u - (float)j0, fv = v - (float)i0;
+    int j0, i0;
+    float fu, fv;
+    receiver_cell(d, (float)cc, (float)rr, &j0, &i0, &fu, &fv);
     float weight = 0.0f, count = 0.0f, distance = 0.0f;
     for (int k = 0; k < 4; ++k) {
-      int j = j0 + (k & 1), i = i0 + (k >> 1);
-      float w = ((k & 1) ? fu : 1.0f - fu) * ((k >> 1) ? fv : 1.0f - fv);
-      int in_buffer = j >= 0 && j < d.n_lines && i >= 0 && i < d.n_steps;
-      __global const float* seen = (__global const float*)(visible + line_entry(d, clamp(j, 0, d.n_lines - 1),
-                                                                                clamp(i, 0, d.n_steps - 1)));
+      float w;
+      int i;
+      __global const float* seen = (__global const float*)(visible + cell_corner(d, j0, i0, fu, fv, k, &w, &i));
       float seen_count = seen[0], seen_distance = seen[1];  // scalar loads, for the vectoriser
-      int use = w > 0.0f && in_buffer && !isnan(seen_count);
+      int use = w > 0.0f && !isnan(seen_count);
       weight += use ? w : 0.0f;
       count += use ? w * seen_count : 0.0f;
       distance += use ? w * seen_distance : 0.0f;

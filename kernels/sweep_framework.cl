@@ -43,11 +43,11 @@
 // One direction's sweep geometry. Must match struct SweepDirection in
 // src/sweep_geometry.hpp: sixteen 4-byte members, no padding.
 typedef struct {
-  float dir_x, dir_y;              // unit line direction in pixel axes
-  float perp_x, perp_y;            // (-dir_y, dir_x)
-  float line_spacing;              // pixels between lines (1 / lines_per_unit)
+  float dir_x, dir_y;    // unit line direction in pixel axes
+  float perp_x, perp_y;  // (-dir_y, dir_x)
+  float line_spacing;    // pixels between lines (1 / lines_per_unit)
   float lines_per_unit;
-  float step_length;               // pixels between samples (1 / samples_per_unit)
+  float step_length;  // pixels between samples (1 / samples_per_unit)
   float samples_per_unit;
   float ground_per_pixel;          // ground length of one pixel length along dir
   float cos_azimuth, sin_azimuth;  // the direction on the ground, for shading
@@ -55,7 +55,7 @@ typedef struct {
   int n_lines;
   int step_top;
   int n_steps;
-  uint buffer_offset;              // first entry of this direction in the line buffer
+  uint buffer_offset;  // first entry of this direction in the line buffer
 } SweepDirection;
 
 // A direction's geometry read field by field: an aggregate load from global memory is
@@ -153,6 +153,33 @@ HFVIS_INLINE float sample_height(__global const float* heights, int width, int h
 #else
   return plain;
 #endif
+}
+
+// Where receiver pixel (x, y) falls among direction d's line samples: the cell of the
+// four entries around it, corner k = 0..3 at (line j0 + (k & 1), step i0 + (k >> 1)), and
+// its fractional position (fu, fv) in the cell. Every reduction interpolates this way.
+HFVIS_INLINE void receiver_cell(const SweepDirection d, float x, float y, int* j0, int* i0, float* fu,
+                                float* fv) {
+  float t = x * d.dir_x + y * d.dir_y;
+  float u = (x * d.perp_x + y * d.perp_y) * d.lines_per_unit - (float)d.line_first;
+  float v = (float)d.step_top - t * d.samples_per_unit;
+  *j0 = (int)floor(u);
+  *i0 = (int)floor(v);
+  *fu = u - (float)*j0;
+  *fv = v - (float)*i0;
+}
+
+// Corner k of a receiver's cell: its bilinear weight (0 where it lies outside the line
+// buffer), its step, and its entry index, clamped into the buffer so that reading it is
+// always safe (branch-free, for the vectoriser).
+HFVIS_INLINE uint cell_corner(const SweepDirection d, int j0, int i0, float fu, float fv, int k,
+                              float* weight, int* step) {
+  int j = j0 + (k & 1), i = i0 + (k >> 1);
+  float w = ((k & 1) ? fu : 1.0f - fu) * ((k >> 1) ? fv : 1.0f - fv);
+  int in_buffer = j >= 0 && j < d.n_lines && i >= 0 && i < d.n_steps;
+  *weight = in_buffer ? w : 0.0f;
+  *step = i;
+  return line_entry(d, clamp(j, 0, d.n_lines - 1), clamp(i, 0, d.n_steps - 1));
 }
 
 // Presampling pass: the height at every (step, line) of the batch's directions, NaN where

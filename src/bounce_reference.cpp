@@ -163,18 +163,11 @@ BounceResult referenceBounce(const HeightField& field, const ExitRadiance& radia
     // Mirror of bounce_reduce, one direction at a time.
     for (int r = 0; r < field.height; ++r) {
       for (int c = 0; c < field.width; ++c) {
-        const float x = static_cast<float>(c), y = static_cast<float>(r);
-        const float t = x * d.dir_x + y * d.dir_y;
-        const float u = (x * d.perp_x + y * d.perp_y) * d.lines_per_unit - static_cast<float>(d.line_first);
-        const float v = static_cast<float>(d.step_top) - t * d.samples_per_unit;
-        const int j0 = static_cast<int>(std::floor(u)), i0 = static_cast<int>(std::floor(v));
-        const float fu = u - static_cast<float>(j0), fv = v - static_cast<float>(i0);
         float weight = 0.0f, acc[kMaxBounceChannels] = {};
-        for (int k = 0; k < 4; ++k) {
-          const int j = j0 + (k & 1), i = i0 + (k >> 1);
-          const float w = ((k & 1) ? fu : 1.0f - fu) * ((k >> 1) ? fv : 1.0f - fv);
-          if (w <= 0.0f || j < 0 || j >= d.n_lines || i < 0 || i >= d.n_steps) continue;
-          const std::size_t e = static_cast<std::size_t>(i) * d.n_lines + j;
+        for (const detail::CellCorner& corner : detail::receiverCell(d, c, r)) {
+          const float w = corner.weight;
+          const std::size_t e = corner.entry;
+          if (w <= 0.0f) continue;
           if (std::isnan(gathered[e * channels])) continue;
           weight += w;
           for (int ch = 0; ch < channels; ++ch) acc[ch] += w * gathered[e * channels + ch];

@@ -103,17 +103,12 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
         const std::size_t pixel = static_cast<std::size_t>(r) * width + c;
         const float hp = h[pixel];
         const float x = static_cast<float>(c), y = static_cast<float>(r);
-        const float t = x * d.dir_x + y * d.dir_y;
-        const float u = (x * d.perp_x + y * d.perp_y) * d.lines_per_unit - static_cast<float>(d.line_first);
-        const float v = static_cast<float>(d.step_top) - t * d.samples_per_unit;
-        const int j0 = static_cast<int>(std::floor(u)), i0 = static_cast<int>(std::floor(v));
-        const float fu = u - static_cast<float>(j0), fv = v - static_cast<float>(i0);
         float weight = 0.0f, angle_sum = 0.0f, distance_sum = 0.0f;
-        for (int q = 0; q < 4; ++q) {
-          const int j = j0 + (q & 1), i = i0 + (q >> 1);
-          const float w = ((q & 1) ? fu : 1.0f - fu) * ((q >> 1) ? fv : 1.0f - fv);
-          if (w <= 0.0f || j < 0 || j >= d.n_lines || i < 0 || i >= d.n_steps) continue;
-          const std::size_t e = static_cast<std::size_t>(i) * d.n_lines + j;
+        for (const CellCorner& corner : receiverCell(d, c, r)) {
+          const float w = corner.weight;
+          const int i = corner.step;
+          const std::size_t e = corner.entry;
+          if (w <= 0.0f) continue;
           const float rise = lines.rises[e], occ_step = lines.steps[e];
           if (occ_step < 0.0f) continue;
           const float ground = (static_cast<float>(i) - occ_step) * d.step_length * d.ground_per_pixel;

@@ -3,6 +3,7 @@
 // same points. Mirrors `SweepDirection` in kernels/sweep_framework.cl.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -47,6 +48,16 @@ struct Point2 {
   float x, y;
 };
 Point2 sweepPosition(const SweepDirection& d, int line, int step);
+
+// Corner k of the cell of line samples around receiver pixel (c, r), as receiver_cell()
+// and cell_corner() in kernels/sweep_framework.cl: bilinear weight (0 outside the line
+// buffer), step, and entry in step-major order (step * n_lines + line).
+struct CellCorner {
+  float weight;
+  int step;
+  std::size_t entry;
+};
+std::array<CellCorner, 4> receiverCell(const SweepDirection& d, int c, int r);
 
 // Mirrors of the kernels' helpers (same operations, same order, same rounding).
 bool insideField(Point2 p, int width, int height);
