@@ -1,0 +1,211 @@
+// bench/main.cpp: hfvis_bench, the benchmark harness's command line.
+//
+//   hfvis_bench suite [--quick | --tiny] --out DIR [--data DIR] [--dem FILE] [--cache DIR]
+//                     [--commit TEXT]
+//       the standard suite: writes DIR/results.csv and DIR/environment.txt
+//       (bench/run_report.sh builds, generates inputs, runs this and writes bench/report/)
+//   hfvis_bench run FIELD [--method M] [-k K] [--spu S] [--lpu L] [--param P]
+//                   [--outputs angles|svf|device] [--reps N]
+//       one method on one field: min and median time and core-ns per pixel-direction
+//       (methods: sweep, naive, naive_bench, radius, pyramid, floor)
+//   hfvis_bench inputs [--quick]
+//       the generated fields the suite reads, one "<content> <N>" per line
+//   hfvis_bench check-truth
+//       the ground truth's self-checks (analytic cases, convergence of a dense march)
+//   hfvis_bench vectorize-report
+//       PoCL's vectorisation remarks for the march kernels, by source line
+//   hfvis_bench vectorize-run all|library|bench
+//       runs the march kernels once (what vectorize-report re-runs under
+//       POCL_VECTORIZER_REMARKS=1)
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <filesystem>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "ground_truth.hpp"
+#include "hfvis/errors.hpp"
+#include "hfvis/image_io.hpp"
+#include "methods.hpp"
+#include "metrics.hpp"
+#include "suite.hpp"
+
+namespace {
+
+using namespace hfvis;
+using namespace hfvis::bench;
+
+constexpr const char* kUsage =
+    "usage: hfvis_bench suite [--quick | --tiny] --out DIR [--data DIR] [--dem FILE] [--cache DIR] [--commit "
+    "TEXT]\n"
+    "       hfvis_bench run FIELD [--method sweep|naive|naive_bench|radius|pyramid|floor] [-k K] [--spu S]\n"
+    "                   [--lpu L] [--param P] [--outputs angles|svf|device] [--reps N]\n"
+    "       hfvis_bench inputs [--quick]\n"
+    "       hfvis_bench check-truth\n"
+    "       hfvis_bench vectorize-report\n"
+    "       hfvis_bench vectorize-run all|library|bench\n";
+
+struct Usage : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Options of the form --name VALUE, in any order after the positional arguments.
+class Arguments {
+ public:
+  Arguments(int argc, char** argv, int first) {
+    for (int i = first; i < argc; ++i) {
+      const std::string a = argv[i];
+      if (a == "--quick" || a == "--tiny") {
+        flags_.push_back(a);
+      } else if (a.rfind("-", 0) == 0) {
+        if (i + 1 >= argc) throw Usage(a + " needs a value");
+        values_.emplace_back(a, argv[++i]);
+      } else {
+        positional_.push_back(a);
+      }
+    }
+  }
+  std::string get(const std::string& name, const std::string& fallback = "") {
+    for (auto& [k, v] : values_)
+      if (k == name) {
+        used_.push_back(k);
+        return v;
+      }
+    return fallback;
+  }
+  bool flag(const std::string& name) const {
+    for (const auto& f : flags_)
+      if (f == name) return true;
+    return false;
+  }
+  const std::vector<std::string>& positional() const { return positional_; }
+  void rejectUnused() const {
+    for (const auto& [k, v] : values_) {
+      bool used = false;
+      for (const auto& u : used_) used = used || u == k;
+      if (!used) throw Usage("unknown option " + k);
+    }
+  }
+
+ private:
+  std::vector<std::pair<std::string, std::string>> values_;
+  std::vector<std::string> flags_, positional_, used_;
+};
+
+double number(const std::string& text, const std::string& what) {
+  try {
+    std::size_t used = 0;
+    const double v = std::stod(text, &used);
+    if (used == text.size()) return v;
+  } catch (const std::exception&) {
+  }
+  throw Usage(what + " must be a number (got '" + text + "')");
+}
+
+MethodKind methodKind(const std::string& name) {
+  if (name == "sweep") return MethodKind::Sweep;
+  if (name == "naive") return MethodKind::Naive;
+  if (name == "naive_bench") return MethodKind::BenchNaive;
+  if (name == "radius") return MethodKind::Radius;
+  if (name == "pyramid") return MethodKind::Pyramid;
+  if (name == "floor") return MethodKind::Floor;
+  throw Usage("unknown method '" + name + "'");
+}
+
+int runOne(Arguments& args) {
+  if (args.positional().size() != 1) throw Usage("run takes one height field");
+  MethodSpec spec;
+  spec.kind = methodKind(args.get("--method", "sweep"));
+  spec.directions = static_cast<int>(number(args.get("-k", "64"), "-k"));
+  spec.samples_per_unit = number(args.get("--spu", "1"), "--spu");
+  spec.lines_per_unit = number(args.get("--lpu", "1"), "--lpu");
+  spec.parameter =
+      static_cast<int>(number(args.get("--param", spec.kind == MethodKind::Radius ? "32" : "16"), "--param"));
+  const std::string outputs = args.get("--outputs", "angles");
+  if (outputs != "angles" && outputs != "svf" && outputs != "device")
+    throw Usage("--outputs: angles, svf or device");
+  spec.angles = outputs == "angles";
+  TimingPolicy policy;
+  policy.min_reps = policy.max_reps = static_cast<int>(number(args.get("--reps", "3"), "--reps"));
+  args.rejectUnused();
+  const HeightField field = readHeightField(args.positional()[0]);
+  const ComputeContext context = ComputeContext::create();
+  const Measured m = measureMethod(context, field, spec, policy);
+  const double pd = static_cast<double>(field.pixelCount()) * spec.directions;
+  const int cores = std::max(1, context.device().compute_units);
+  std::printf(
+      "%s (%s) on %dx%d, K=%d, spu=%g, lpu=%g: min %.4f s, median %.4f s over %zu runs; "
+      "%.2f core-ns per pixel-direction on %s (%d compute units)\n",
+      spec.name().c_str(), spec.outputs().c_str(), field.width, field.height, spec.directions,
+      spec.samples_per_unit, spec.lines_per_unit, m.timing.min(), m.timing.median(), m.timing.seconds.size(),
+      m.timing.min() * cores / pd * 1e9, context.device().name.c_str(), cores);
+  if (spec.kind != MethodKind::Sweep && spec.kind != MethodKind::Floor && spec.kind != MethodKind::Pyramid) {
+    const MarchSteps steps =
+        naiveMarchSteps(field, spec.directions, spec.samples_per_unit, baselineTileX(), baselineTileY(),
+                        spec.kind == MethodKind::Radius ? spec.parameter * spec.samples_per_unit : 0);
+    std::printf("  %.3g ray steps executed (%.3g inside the field): %.2f core-ns per executed step\n",
+                steps.executed, steps.inside, m.timing.min() * cores / steps.executed * 1e9);
+  }
+  return 0;
+}
+
+int checkTruth() {
+  std::string summary;
+  const auto failures = checkGroundTruth(&summary);
+  for (const auto& f : failures) std::fprintf(stderr, "ground truth check failed: %s\n", f.c_str());
+  std::printf("%s\n", summary.c_str());
+  return failures.empty() ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    if (argc < 2) throw Usage("no command given");
+    const std::string command = argv[1];
+    Arguments args(argc, argv, 2);
+    if (command == "suite") {
+      SuiteOptions options;
+      options.mode = args.flag("--tiny") ? "tiny" : args.flag("--quick") ? "quick" : "full";
+      options.out_dir = args.get("--out");
+      options.data_dir = args.get("--data");
+      options.dem_path = args.get("--dem");
+      options.cache_dir = args.get("--cache", options.out_dir.empty() ? "" : options.out_dir + "/truth");
+      options.commit = args.get("--commit", "unknown");
+      options.self_path = std::filesystem::canonical("/proc/self/exe").string();
+      args.rejectUnused();
+      if (options.out_dir.empty()) throw Usage("suite needs --out DIR");
+      if (options.mode != "tiny" && (options.data_dir.empty() || options.dem_path.empty()))
+        throw Usage("suite needs --data DIR and --dem FILE (bench/run_report.sh passes both)");
+      return runSuite(ComputeContext::create(), options);
+    }
+    if (command == "run") return runOne(args);
+    if (command == "inputs") {
+      for (const auto& [name, n] : requiredInputs(args.flag("--quick") ? "quick" : "full"))
+        std::printf("%s %d\n", name.c_str(), n);
+      return 0;
+    }
+    if (command == "check-truth") return checkTruth();
+    if (command == "vectorize-report") {
+      std::printf("%s", vectorizationRemarks(std::filesystem::canonical("/proc/self/exe").string()).c_str());
+      return 0;
+    }
+    if (command == "vectorize-run") {
+      const std::string which = args.positional().empty() ? "all" : args.positional()[0];
+      return runKernelsOnce(ComputeContext::create(), which);
+    }
+    if (command == "-h" || command == "--help") {
+      std::printf("%s", kUsage);
+      return 0;
+    }
+    throw Usage("unknown command '" + command + "'");
+  } catch (const Usage& e) {
+    std::fprintf(stderr, "hfvis_bench: %s\n%s", e.what(), kUsage);
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "hfvis_bench: %s\n", e.what());
+    return 1;
+  }
+}

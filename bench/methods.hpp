@@ -1,0 +1,67 @@
+// bench/methods.hpp: every horizon method the benchmark runs, behind one call: the
+// library's sweep and naive kernels (through computeHorizons) and the baselines of
+// kernels/horizon_baselines.cl (launched here on the library's context and queue).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "hfvis/device.hpp"
+#include "hfvis/height_field.hpp"
+
+namespace hfvis::bench {
+
+enum class MethodKind {
+  Sweep,       // library: hull-stack sweep (HorizonMethod::Sweep)
+  Naive,       // library: naive march (HorizonMethod::Naive)
+  BenchNaive,  // baselines: naive march with forced-inline sampling (vectorises on PoCL)
+  Radius,      // baselines: naive march limited to `parameter` pixels
+  Pyramid,     // baselines: max-pyramid march, `parameter` unit steps then parameter/2 per octave
+  Floor,       // baselines: read heights, write one value per pixel and direction
+};
+
+struct MethodSpec {
+  MethodKind kind = MethodKind::Sweep;
+  int directions = 64;
+  double samples_per_unit = 1.0;
+  double lines_per_unit = 1.0;  // the sweep's only
+  int parameter = 0;            // radius (Radius) or near steps (Pyramid)
+  // true: K horizon planes downloaded to the host (the `hfvis horizon` job). false: the
+  // library computes the sky-view factor only; the floor writes its planes on the device only.
+  bool angles = true;
+
+  std::string name() const;     // "sweep", "naive", "naive_bench", "radius_16", "pyramid_16", "floor"
+  std::string outputs() const;  // "angles", "svf" or "device"
+};
+
+struct MethodOutput {
+  std::vector<float> angles;  // K planes of width * height when spec.angles
+  std::vector<float> svf;     // library methods without angles
+};
+
+// Runs the method once on `field` (no nodata; width and height >= 2 for the baselines).
+MethodOutput runMethod(const ComputeContext& context, const HeightField& field, const MethodSpec& spec);
+
+// The library with sky-view factor and ambient occlusion outputs (no angles): the
+// azimuthal discretisation study compares these across K.
+struct ShadingOutput {
+  std::vector<float> svf, ao;
+};
+ShadingOutput runShading(const ComputeContext& context, const HeightField& field, MethodKind kind,
+                         int directions);
+
+// Ray steps a per-pixel march takes over the whole field for K directions at
+// `samples_per_unit`, at most `max_steps` per ray (0 = no limit): `executed` as the kernels
+// run them (every lane of a tile_x x tile_y tile runs the tile's longest ray), `inside`
+// those that sample inside the field.
+struct MarchSteps {
+  double executed = 0.0, inside = 0.0;
+};
+MarchSteps naiveMarchSteps(const HeightField& field, int directions, double samples_per_unit, int tile_x,
+                           int tile_y, int max_steps = 0);
+
+// The per-pixel tile (work-group) shape of the baselines, the library's kTileX x kTileY.
+int baselineTileX();
+int baselineTileY();
+
+}  // namespace hfvis::bench

@@ -1,0 +1,65 @@
+#!/usr/bin/env bash
+# bench/run_report.sh: the one command behind the benchmark report. Builds hfvis_bench
+# (Release) if needed, generates the input fields into bench/out/ (git-ignored), runs the
+# suite and writes the report: results.csv (every measurement), environment.txt, REPORT.md
+# and the PNG plots.
+#
+#   bench/run_report.sh            full suite (under 30 minutes on the 2-core test machine)
+#                                  -> bench/report/
+#   bench/run_report.sh --quick    smaller sizes (under 3 minutes) -> bench/out/report-quick/
+#   options: --out DIR (report directory), BUILD_DIR=... (default build/)
+#
+# Needs the build dependencies (scripts/install-deps.sh) and Debian's python3 with numpy and
+# matplotlib (python3-numpy, python3-matplotlib); nothing from pip.
+set -euo pipefail
+
+root=$(cd "$(dirname "$0")/.." && pwd)
+mode=full
+report_dir=""
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --quick) mode=quick ;;
+    --out) report_dir=$2; shift ;;
+    -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
+    *) echo "run_report.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
+  esac
+  shift
+done
+if [[ -z "$report_dir" ]]; then
+  if [[ $mode == full ]]; then report_dir=$root/bench/report; else report_dir=$root/bench/out/report-quick; fi
+fi
+build_dir=${BUILD_DIR:-$root/build}
+python=/usr/bin/python3  # Debian's, for its matplotlib and numpy
+# PoCL's compiled-kernel cache of its own: other processes compiling the same kernels into the
+# shared cache at the same moment have made PoCL abort ("Final linking of kernel ... failed").
+export POCL_CACHE_DIR=${POCL_CACHE_DIR:-$root/bench/out/pocl-cache}
+start=$(date +%s)
+
+echo "== building hfvis_bench in $build_dir"
+cmake -S "$root" -B "$build_dir" -DCMAKE_BUILD_TYPE=Release > /dev/null
+cmake --build "$build_dir" -j "$(nproc)" --target hfvis_bench
+bench=$build_dir/bench/hfvis_bench
+
+echo "== generating inputs into bench/out/data"
+data_dir=$root/bench/out/data
+mkdir -p "$data_dir"
+flag=""
+[[ $mode == quick ]] && flag=--quick
+# data/make_data.py is deterministic, so fields already there are reused.
+"$bench" inputs $flag | while read -r content size; do
+  if [[ ! -f "$data_dir/${content}_${size}.exr" ]]; then
+    "$python" "$root/data/make_data.py" --size "$size" --out "$data_dir" --no-dem --fields "$content"
+  fi
+done
+
+commit=$(git -C "$root" rev-parse --short HEAD 2> /dev/null || echo unknown)
+if ! git -C "$root" diff --quiet HEAD 2> /dev/null; then commit="$commit (with uncommitted changes)"; fi
+
+echo "== running the $mode suite (log: bench/out/suite-$mode.log)"
+mkdir -p "$report_dir"
+"$bench" suite $flag --data "$data_dir" --dem "$root/data/jacksboro_fault_dem.exr" --out "$report_dir" \
+  --cache "$root/bench/out/truth" --commit "$commit" | tee "$root/bench/out/suite-$mode.log"
+
+echo "== writing the report"
+"$python" "$root/bench/make_report.py" "$report_dir" --total-seconds $(( $(date +%s) - start ))
+echo "report: $report_dir/REPORT.md ($(( $(date +%s) - start )) s in all)"
