@@ -8,8 +8,10 @@
 //                   [--outputs angles|svf|device] [--reps N]
 //       one method on one field: min and median time and core-ns per pixel-direction
 //       (methods: sweep, naive, naive_bench, radius, pyramid, floor)
+//   hfvis_bench visibility [--quick | --tiny] --out DIR [--data DIR] [--dem FILE] [--commit TEXT]
+//       the intervisibility suite: writes DIR/visibility.csv and DIR/visibility_environment.txt
 //   hfvis_bench inputs [--quick]
-//       the generated fields the suite reads, one "<content> <N>" per line
+//       the generated fields both suites read, one "<content> <N>" per line
 //   hfvis_bench check-truth
 //       the ground truth's self-checks (analytic cases, convergence of a dense march)
 //   hfvis_bench vectorize-report
@@ -22,6 +24,7 @@
 #include <exception>
 #include <filesystem>
 #include <iostream>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -42,6 +45,7 @@ constexpr const char* kUsage =
     "TEXT]\n"
     "       hfvis_bench run FIELD [--method sweep|naive|naive_bench|radius|pyramid|floor] [-k K] [--spu S]\n"
     "                   [--lpu L] [--param P] [--outputs angles|svf|device] [--reps N]\n"
+    "       hfvis_bench visibility [--quick | --tiny] --out DIR [--data DIR] [--dem FILE] [--commit TEXT]\n"
     "       hfvis_bench inputs [--quick]\n"
     "       hfvis_bench check-truth\n"
     "       hfvis_bench vectorize-report\n"
@@ -166,7 +170,7 @@ int main(int argc, char** argv) {
     if (argc < 2) throw Usage("no command given");
     const std::string command = argv[1];
     Arguments args(argc, argv, 2);
-    if (command == "suite") {
+    if (command == "suite" || command == "visibility") {
       SuiteOptions options;
       options.mode = args.flag("--tiny") ? "tiny" : args.flag("--quick") ? "quick" : "full";
       options.out_dir = args.get("--out");
@@ -179,12 +183,16 @@ int main(int argc, char** argv) {
       if (options.out_dir.empty()) throw Usage("suite needs --out DIR");
       if (options.mode != "tiny" && (options.data_dir.empty() || options.dem_path.empty()))
         throw Usage("suite needs --data DIR and --dem FILE (bench/run_report.sh passes both)");
-      return runSuite(ComputeContext::create(), options);
+      const ComputeContext context = ComputeContext::create();
+      return command == "suite" ? runSuite(context, options) : runVisibilitySuite(context, options);
     }
     if (command == "run") return runOne(args);
     if (command == "inputs") {
-      for (const auto& [name, n] : requiredInputs(args.flag("--quick") ? "quick" : "full"))
-        std::printf("%s %d\n", name.c_str(), n);
+      const std::string mode = args.flag("--quick") ? "quick" : "full";
+      std::set<std::pair<std::string, int>> inputs;
+      for (const auto& input : requiredInputs(mode)) inputs.insert(input);
+      for (const auto& input : visibilityInputs(mode)) inputs.insert(input);
+      for (const auto& [name, n] : inputs) std::printf("%s %d\n", name.c_str(), n);
       return 0;
     }
     if (command == "check-truth") return checkTruth();

@@ -35,6 +35,7 @@
 #include "hfvis/image_io.hpp"
 #include "hfvis/synthetic_fields.hpp"
 #include "opencl_context.hpp"
+#include "suite_support.hpp"
 
 namespace hfvis::bench {
 namespace {
@@ -134,40 +135,12 @@ const std::vector<std::string> kColumns = {
     "int_max_deg", "svf_mean_abs", "svf_max_abs", "ao_mean_abs", "ao_max_abs", "metric", "value", "note"};
 // clang-format on
 
-using Row = std::map<std::string, std::string>;
-
-std::string num(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.6g", v);
-  return text;
-}
-
-std::string csvField(const std::string& text) {
-  if (text.find_first_of(",\"\n") == std::string::npos) return text;
-  std::string quoted = "\"";
-  for (char ch : text) quoted += ch == '"' ? std::string("\"\"") : std::string(1, ch);
-  return quoted + "\"";
-}
-
-class Results {
+class Results : public CsvWriter {
  public:
-  Results(const std::string& path, int cores) : out_(path), cores_(cores) {
-    if (!out_) throw IoError(path, "cannot write");
-    for (std::size_t i = 0; i < kColumns.size(); ++i) out_ << (i ? "," : "") << kColumns[i];
-    out_ << "\n";
-  }
-  void write(const Row& row) {
-    for (std::size_t i = 0; i < kColumns.size(); ++i) {
-      const auto it = row.find(kColumns[i]);
-      out_ << (i ? "," : "") << (it == row.end() ? "" : csvField(it->second));
-    }
-    out_ << "\n";
-    out_.flush();
-  }
+  Results(const std::string& path, int cores) : CsvWriter(path, kColumns), cores_(cores) {}
   int cores() const { return cores_; }
 
  private:
-  std::ofstream out_;
   int cores_;
 };
 
@@ -250,67 +223,6 @@ Row metricRow(const std::string& section, const std::string& content, const Heig
 
 // ------------------------------------------------------------------------------------------
 // Inputs.
-
-HeightField crop(const HeightField& field, int width, int height) {
-  HeightField c = field;
-  c.width = std::min(width, field.width);
-  c.height = std::min(height, field.height);
-  c.heights.clear();
-  for (int r = 0; r < c.height; ++r)
-    for (int col = 0; col < c.width; ++col) c.heights.push_back(field.at(col, r));
-  return c;
-}
-
-struct Content {
-  std::string name;   // "fractal", ..., "dem"
-  std::string label;  // name with size, for the cache and the log
-  HeightField field;
-};
-
-Content loadContent(const SuiteOptions& options, const std::string& name, int n) {
-  Content c;
-  c.name = name;
-  if (options.mode == "tiny") {
-    // Odd, non-square sizes; the "dome" stands in for the DEM with non-square cells.
-    if (name == "dem") {
-      c.field = makeSyntheticField("dome", n + 5, n - 1, 3);
-      c.field.cell_size_x = 1.5, c.field.cell_size_y = 0.75;
-    } else {
-      c.field = makeSyntheticField(name == "fractal" ? "noise" : name, n, n - 3, 3);
-    }
-  } else if (name == "dem") {
-    // The central n x n of the DEM (all of it when smaller), so that every content of the
-    // speed/error plane has the same size.
-    const HeightField dem = readHeightField(options.dem_path);
-    const int w = std::min(n, dem.width), h = std::min(n, dem.height);
-    const int c0 = (dem.width - w) / 2, r0 = (dem.height - h) / 2;
-    c.field = dem;
-    c.field.width = w, c.field.height = h;
-    c.field.heights.clear();
-    for (int r = r0; r < r0 + h; ++r)
-      for (int col = c0; col < c0 + w; ++col) c.field.heights.push_back(dem.at(col, r));
-  } else {
-    c.field =
-        readHeightField((fs::path(options.data_dir) / (name + "_" + std::to_string(n) + ".exr")).string());
-  }
-  c.label = name + "_" + std::to_string(c.field.width) + "x" + std::to_string(c.field.height);
-  return c;
-}
-
-int threads() { return std::max(1u, std::thread::hardware_concurrency()); }
-
-void say(const char* format, ...) __attribute__((format(printf, 1, 2)));
-void say(const char* format, ...) {
-  // Seconds since the first line, so a log shows where a run spends its time.
-  static const auto start = Clock::now();
-  std::fprintf(stdout, "%7.1fs ", std::chrono::duration<double>(Clock::now() - start).count());
-  va_list args;
-  va_start(args, format);
-  std::vfprintf(stdout, format, args);
-  va_end(args);
-  std::fputc('\n', stdout);
-  std::fflush(stdout);
-}
 
 std::string describe(const MethodSpec& spec) {
   std::ostringstream s;
@@ -621,23 +533,13 @@ std::vector<std::string> embeddedLines(const std::string& file) {
 
 Measured measureMethod(const ComputeContext& context, const HeightField& field, const MethodSpec& spec,
                        const TimingPolicy& policy) {
-  runMethod(context, crop(field, 64, 64), spec);  // builds the program for these options
   Measured m;
-  auto run = [&] {
-    m.output = MethodOutput{};  // free the previous output first, as a fresh process would
-    m.output = runMethod(context, field, spec);
-  };
-  const Timing first = timeRepeated(run, {1, 1, 0.0});
-  TimingPolicy rest = policy;
-  if (first.min() >= 1.0) {  // expensive: the crop was warm-up enough, this run counts
-    m.timing = first;
-    rest.min_reps = std::max(0, policy.min_reps - 1);
-    rest.max_reps = std::max(0, policy.max_reps - 1);
-    rest.budget_seconds = policy.budget_seconds - first.min();
-  }
-  const Timing more = timeRepeated(run, rest);
-  m.timing.seconds.insert(m.timing.seconds.end(), more.seconds.begin(), more.seconds.end());
-  m.timing.cpu_seconds.insert(m.timing.cpu_seconds.end(), more.cpu_seconds.begin(), more.cpu_seconds.end());
+  m.timing = timeWithWarmUp([&] { runMethod(context, crop(field, 64, 64), spec); },
+                            [&] {
+                              m.output = MethodOutput{};  // free the previous output first, as a fresh process would
+                              m.output = runMethod(context, field, spec);
+                            },
+                            policy);
   return m;
 }
 

@@ -1,5 +1,6 @@
-// bench/suite.hpp: the standard benchmark suite (issue 3): which methods, sizes, contents
-// and directions are measured in each mode, and the CSV every measurement goes to.
+// bench/suite.hpp: the standard benchmark suites, horizons (issue 3) and intervisibility
+// (issue 4): which methods, sizes, contents and directions are measured in each mode, and
+// the CSVs the measurements go to.
 #pragma once
 
 #include <string>
@@ -29,6 +30,11 @@ std::vector<std::pair<std::string, int>> requiredInputs(const std::string& mode)
 
 // Runs the suite; returns the process exit status.
 int runSuite(const ComputeContext& context, const SuiteOptions& options);
+
+// The intervisibility suite (bench/visibility_suite.cpp): DIR/visibility.csv and
+// DIR/visibility_environment.txt; its generated inputs.
+int runVisibilitySuite(const ComputeContext& context, const SuiteOptions& options);
+std::vector<std::pair<std::string, int>> visibilityInputs(const std::string& mode);
 
 // One timed measurement as the suite takes it: a warm-up run on a 64 x 64 crop (builds and
 // caches the program), one full-size run discarded as warm-up when it takes under a second,

@@ -21,6 +21,15 @@
 //   HFVIS_WANT_ENTRY_STATS  per-entry (horizons, iterations, horizon hash) for the tests
 //   HFVIS_WANT_BOUNCE       gather exit radiance over the visible samples (bounce.cl sets it)
 //   HFVIS_CHANNELS          radiance channels of the bounce, 1..4
+//   HFVIS_DEFERRED_WRITES   the tree walk with the old root's level in registers and link
+//                           writes only where a link changes (the aim of Algorithm 2); 0 =
+//                           Algorithm 1's walk as written, every relink stored at once
+//   HFVIS_SAFE_ZONE         the safe zone (Algorithm 3): a new sample that replaces the old
+//                           root without touching the rest of the tree skips the walk
+//                           (needs HFVIS_DEFERRED_WRITES)
+//   HFVIS_SAFE_ZONE_STEPS   steps past the receiver that one safe zone covers (a power of 2)
+// Every combination builds the same trees (tests/test_intervisibility.cpp): the options
+// change the work (iterations t, memory traffic), never a result.
 #include "sweep_framework.cl"
 
 #ifndef HFVIS_WANT_AREA
@@ -37,6 +46,18 @@
 #endif
 #ifndef HFVIS_CHANNELS
 #define HFVIS_CHANNELS 1
+#endif
+#ifndef HFVIS_DEFERRED_WRITES
+#define HFVIS_DEFERRED_WRITES 1
+#endif
+#ifndef HFVIS_SAFE_ZONE
+#define HFVIS_SAFE_ZONE 1
+#endif
+#ifndef HFVIS_SAFE_ZONE_STEPS
+#define HFVIS_SAFE_ZONE_STEPS 16
+#endif
+#if HFVIS_SAFE_ZONE && !HFVIS_DEFERRED_WRITES
+#error "the safe zone works inside the deferred-writes walk"
 #endif
 // Floats per entry of the bounce's line attributes: the radiance channels, then the unit normal.
 #define HFVIS_BOUNCE_STRIDE (HFVIS_CHANNELS + 3)
@@ -280,13 +301,113 @@ HFVIS_INLINE void bounce_finish(BounceGather* g, __global float* irradiance) {
 }
 #endif  // HFVIS_WANT_BOUNCE
 
+// The root's new child list while Algorithm 1 builds it: appending x links the last child
+// to x. `tail_next` is what the last child's `next` link holds in memory, so that with
+// deferred writes a link that is already right (a run of siblings that join the root in
+// their old order, the common case) is not written again.
+typedef struct {
+  int head, tail, tail_next;
+  float tail_h;  // the last child's height (the safe zone's last-child check reads it)
+} RootList;
+
+HFVIS_INLINE void root_append(__global int4* tree, uint stride, RootList* list, int x, float hx,
+                              int x_next_in_memory) {
+  if (list->tail == HFVIS_NONE)
+    list->head = x;
+  else if (!HFVIS_DEFERRED_WRITES || list->tail_next != x)
+    tree[(uint)list->tail * stride].w = x;
+  list->tail = x;
+  list->tail_next = x_next_in_memory;
+  list->tail_h = hx;
+}
+
+// Algorithm 1 below node `top` (the old root, or with deferred writes a child of it already
+// detached): every child that fails the convexity check (child -> parent -> new root) joins
+// the root before its parent, its own children are checked in turn, and a parent left
+// without children is deleted (leaves never are). A post-order walk that appends the
+// root's new children in order; its stack is threaded through the `next` links of the
+// nodes on it (a detached child's sibling link is free until it is appended), and `top`
+// returns to the caller. Returns the convexity checks made.
+HFVIS_INLINE uint hull_tree_walk(__global int4* tree, uint stride, int top, int4 node, float h, int step,
+                                 RootList* list) {
+  uint t = 0;
+  int cur = top;
+  for (;;) {
+    const int c = node.z;
+    if (c != HFVIS_NONE) {
+      int4 child = tree[(uint)c * stride];
+      ++t;
+      // Convex when the parent lies strictly above the chord from the child to the root.
+      const int side = chord_side(as_float(child.x), as_float(node.x), h, (float)(cur - c), (float)(step - cur));
+      if (side <= 0) {
+        tree[(uint)cur * stride].z = child.w;  // the next child becomes the first
+        tree[(uint)c * stride].w = cur;        // back link to resume the parent
+        child.w = cur;
+        cur = c;
+        node = child;
+        continue;
+      }
+    }
+    // A node keeps its `next` in memory: the back link on the walk, the sibling for `top`.
+    if (c != HFVIS_NONE || (node.y & HFVIS_LEAF)) root_append(tree, stride, list, cur, as_float(node.x), node.w);
+    if (cur == top) break;
+    cur = node.w;
+    node = tree[(uint)cur * stride];
+  }
+  return t;
+}
+
+#if HFVIS_SAFE_ZONE
+// The safe zone (Sec. 7, Figure 9, Algorithm 3): a new root replaces the old one without
+// other change when every child of the old root fails its convexity check (it suffices that
+// the last one fails: the children's slopes from the root fall toward it) and every first
+// grandchild passes (c stays above the chord from its first child g to the new sample: the
+// new sample lies strictly below the line g -> c). Below the lowest of those lines at two
+// boundaries b1 and b2, the chord between the two lowest points bounds a zone where the
+// second holds for every child (the lowest of lines is concave). The zone holds while the
+// children and their first children stay: until the walk runs, or the receiver passes b2.
+typedef struct {
+  int first, last;  // steps it covers, b1 .. b2 = b1 + HFVIS_SAFE_ZONE_STEPS
+  float z1, z2;     // bound at b1 and b2
+  float margin;     // covers the rounding of the bound: inside only below bound - margin
+} SafeZone;
+
+// One root child c (at step c, height hc) with first child g: lowers the bound.
+HFVIS_INLINE void safe_zone_add(SafeZone* z, float hc, int c, float hg, int g) {
+  const float slope = (hc - hg) / (float)(c - g);
+  const float at1 = hc + slope * (float)(z->first - c);
+  const float at2 = hc + slope * (float)(z->last - c);
+  z->z1 = fmin(z->z1, at1);
+  z->z2 = fmin(z->z2, at2);
+  // |rounding| of at1, at2 and of the interpolation stays within a few ulps of this.
+  z->margin = fmax(z->margin, fabs(hc) + fabs(slope) * (float)(z->last - c));
+}
+
+HFVIS_INLINE void safe_zone_begin(SafeZone* z, int receiver) {
+  z->first = receiver + 1;
+  z->last = receiver + 1 + HFVIS_SAFE_ZONE_STEPS;
+  z->z1 = z->z2 = FLT_MAX;  // no first grandchild: nothing to stay convex
+  z->margin = 0.0f;
+}
+
+// Relative to the magnitudes, plus an absolute floor for subnormal heights (whose
+// rounding is absolute, up to 2^-149 per operation).
+HFVIS_INLINE void safe_zone_end(SafeZone* z) { z->margin = z->margin * 0x1p-16f + 0x1p-100f; }
+
+// Whether a sample at `step`, height h is inside (the zone must not have expired).
+HFVIS_INLINE int safe_zone_inside(const SafeZone* z, int step, float h) {
+  const float bound = z->z1 + (z->z2 - z->z1) * ((float)(step - z->first) / (float)HFVIS_SAFE_ZONE_STEPS);
+  return step <= z->last && h < bound - z->margin;
+}
+#endif
+
 // One work-item per line. Reads the presampled heights (lines[].x, left intact) and writes:
 //   lines[].y    the rank of the step: present samples before it (run lengths across holes),
 //   visible[]    (visible samples, sum of their distances in steps), NaN where absent,
 //   prefix[]     sum of the steps of the present samples before it (mod 2^32), if AREA,
-//   entry_stats[] (horizons m, iterations t, horizon hash, 0), if ENTRY_STATS,
+//   entry_stats[] (horizons m, iterations t, horizon hash, walk skipped by the safe zone), if ENTRY_STATS,
 //   line_totals[(b * totals_stride + j) * 8 + ...] (receivers, sum m, sum t, naive
-//                iterations, visible samples, 0, 0, 0), if STATS,
+//                iterations, visible samples, walks skipped by the safe zone, 0, 0), if STATS,
 //   bounce_out[entry * CHANNELS + c] the gathered irradiance, NaN where absent, if BOUNCE
 //                (reading bounce_lines[entry * BOUNCE_STRIDE + ...], see bounce_presample;
 //                half_sector = D / 2 and wedge = 2 sin(D / 2) for D = 2*pi/K).
@@ -318,6 +439,13 @@ __kernel void intervisibility_sweep(__global const SweepDirection* directions, _
   int prev = HFVIS_NONE, prev2 = HFVIS_NONE;  // the two latest present samples
   float h_prev = 0.0f, h_prev2 = 0.0f;
   int class_last = HFVIS_CONVEX;  // Eq. 1 class of prev2 (the first sample is convex)
+  int head = HFVIS_NONE, tail = HFVIS_NONE;  // the root's first and last child
+  float tail_h = 0.0f;                       // the last child's height
+#if HFVIS_SAFE_ZONE
+  SafeZone zone;
+  int zone_valid = 0;
+#endif
+  uint zone_skips = 0;  // walks the safe zone skipped
   ulong total_m = 0, total_t = 0, total_naive = 0, total_visible = 0;
 
   for (int step = 0; step < d.n_steps; ++step) {
@@ -337,7 +465,7 @@ __kernel void intervisibility_sweep(__global const SweepDirection* directions, _
 #endif
       continue;
     }
-    uint m = 0, t = 0, hash = 2166136261u;
+    uint m = 0, t = 0, hash = 2166136261u, skipped = 0;
     int count = 0;
     uint distance_sum = 0;
 #if HFVIS_WANT_BOUNCE
@@ -346,44 +474,65 @@ __kernel void intervisibility_sweep(__global const SweepDirection* directions, _
 #endif
     if (root == HFVIS_NONE) {
       tree[e] = (int4)(as_int(h), HFVIS_LEAF, HFVIS_NONE, HFVIS_NONE);  // rank 0
+      head = tail = HFVIS_NONE;
     } else {
-      // 1. Algorithm 1 for the new root: the old root is its only child; every child that
-      // fails the convexity check (child -> parent -> root) joins the root before its
-      // parent, its own children are checked in turn, and a parent left without children
-      // is deleted (leaves never are). Done as a post-order walk that appends the root's
-      // new children in order; the walk's stack is threaded through the `next` links of the
-      // nodes on it (a detached child's sibling link is free until it is appended).
-      int head = HFVIS_NONE, tail = HFVIS_NONE;
-      int cur = root;
-      int4 node = tree[(uint)cur * stride];
-      for (;;) {
-        const int c = node.z;
-        if (c != HFVIS_NONE) {
-          int4 child = tree[(uint)c * stride];
-          ++t;
-          // Convex when the parent lies strictly above the chord from the child to the root.
-          const int side =
-              chord_side(as_float(child.x), as_float(node.x), h, (float)(cur - c), (float)(step - cur));
-          if (side <= 0) {
-            tree[(uint)cur * stride].z = child.w;  // the next child becomes the first
-            tree[(uint)c * stride].w = cur;        // back link to resume the parent
-            child.w = cur;
-            cur = c;
-            node = child;
-            continue;
+      // 1. Algorithm 1 for the new root: the old root is its only child; the walk gives the
+      // root's children in order.
+      RootList list = {HFVIS_NONE, HFVIS_NONE, HFVIS_NONE, 0.0f};
+      const int4 old_root = tree[(uint)root * stride];
+      int walk = 1;
+#if HFVIS_SAFE_ZONE
+      // The last child first (Sec. 7): when it fails, every child fails (their slopes from
+      // the old root fall toward it) and the old root is replaced; inside the safe zone
+      // nothing else changes and the walk is skipped. When it passes, the old root stays.
+      int replaced = 0;
+      if (tail != HFVIS_NONE) {
+        ++t;
+        replaced = chord_side(tail_h, h_prev, h, (float)(root - tail), (float)(step - root)) <= 0;
+      }
+      zone_valid = zone_valid && replaced && safe_zone_inside(&zone, step, h);
+      if (zone_valid) {
+        // The old root's children are the new root's; the old root follows them if it is
+        // a leaf (the line's first sample), else it is deleted.
+        walk = 0;
+        skipped = 1;
+        list.head = head;
+        list.tail = tail;
+        list.tail_h = tail_h;
+        if (old_root.y & HFVIS_LEAF) {
+          tree[(uint)root * stride].z = HFVIS_NONE;
+          root_append(tree, stride, &list, root, h_prev, HFVIS_NONE);
+        }
+      }
+#else
+      const int replaced = 0;  // not known
+#endif
+      if (walk) {
+#if HFVIS_DEFERRED_WRITES
+        // The old root's level in registers: its children in order, each checked (unless
+        // the last child's check decided it) and, when it fails, walked and appended; links
+        // are written only where they change.
+        int c = old_root.z;
+        while (c != HFVIS_NONE) {
+          const int4 child = tree[(uint)c * stride];
+          if (!replaced) {
+            if (HFVIS_SAFE_ZONE && c == tail) break;  // known to pass
+            ++t;
+            if (chord_side(as_float(child.x), h_prev, h, (float)(root - c), (float)(step - root)) > 0) break;
           }
+          t += hull_tree_walk(tree, stride, c, child, h, step, &list);
+          c = child.w;
         }
-        const int parent = node.w;
-        if (c != HFVIS_NONE || (node.y & HFVIS_LEAF)) {  // keeps a child, or is a leaf: a root child
-          if (tail == HFVIS_NONE)
-            head = cur;
-          else
-            tree[(uint)tail * stride].w = cur;
-          tail = cur;
+        if (c != HFVIS_NONE || (old_root.y & HFVIS_LEAF)) {  // it stays, as the last child
+          if (c != old_root.z) tree[(uint)root * stride].z = c;
+          root_append(tree, stride, &list, root, h_prev, HFVIS_NONE);
         }
-        if (parent == HFVIS_NONE) break;
-        cur = parent;
-        node = tree[(uint)cur * stride];
+#else
+        t += hull_tree_walk(tree, stride, root, old_root, h, step, &list);
+#endif
+#if HFVIS_SAFE_ZONE
+        zone_valid = 0;
+#endif
       }
 
       // 2. Now that the old root's next sample is known, classify it (Eq. 1). A convex
@@ -393,29 +542,41 @@ __kernel void intervisibility_sweep(__global const SweepDirection* directions, _
         const int side = chord_side(h_prev2, h_prev, h, (float)(prev - prev2), (float)(step - prev));
         const int cls = side > 0 ? HFVIS_CONVEX : side < 0 ? HFVIS_CONCAVE : class_last;
         if (cls == HFVIS_CONVEX && class_last == HFVIS_CONCAVE) {
-          if (tail == prev) {
+          if (list.tail == prev) {
             tree[(uint)prev * stride].y = (rank - 1) * 2 + HFVIS_LEAF;
           } else {
             tree[(uint)prev * stride] =
                 (int4)(as_int(h_prev), (rank - 1) * 2 + HFVIS_LEAF, HFVIS_NONE, HFVIS_NONE);
-            tree[(uint)tail * stride].w = prev;
-            tail = prev;
+            root_append(tree, stride, &list, prev, h_prev, HFVIS_NONE);
           }
         }
         class_last = cls;
       }
-      tree[(uint)tail * stride].w = HFVIS_NONE;
-      tree[e] = (int4)(as_int(h), rank * 2, head, HFVIS_NONE);
+      if (!HFVIS_DEFERRED_WRITES || list.tail_next != HFVIS_NONE) tree[(uint)list.tail * stride].w = HFVIS_NONE;
+      tree[e] = (int4)(as_int(h), rank * 2, list.head, HFVIS_NONE);
+      head = list.head;
+      tail = list.tail;
+      tail_h = list.tail_h;
 
       // 3. Visible samples from the horizons, farthest first: the run of horizon hp ends
       // at run_end() before the next horizon np, or at the receiver. Without absent
       // samples in between, ranks and distance sums follow from the steps alone.
+      // The safe zone for the next samples is refreshed here, where the root's children
+      // (the horizons) are visited anyway.
+#if HFVIS_SAFE_ZONE
+      const int refresh_zone = !zone_valid;
+      if (refresh_zone) safe_zone_begin(&zone, step);
+#endif
       int hp = head;
       int4 hz = tree[(uint)hp * stride];
       int hp_rank = hz.y >> 1;
       for (;;) {
         const int np = hz.w;
         ++m;
+#if HFVIS_SAFE_ZONE
+        if (refresh_zone && hz.z != HFVIS_NONE)
+          safe_zone_add(&zone, as_float(hz.x), hp, as_float(tree[(uint)hz.z * stride].x), hz.z);
+#endif
         hash = (hash ^ (uint)hp) * 16777619u;
         int end = step, end_rank = rank, np_rank = rank;
         int4 nz = hz;
@@ -457,16 +618,23 @@ __kernel void intervisibility_sweep(__global const SweepDirection* directions, _
         hp = np;
         hp_rank = np_rank;
       }
+#if HFVIS_SAFE_ZONE
+      if (refresh_zone) {
+        safe_zone_end(&zone);
+        zone_valid = 1;
+      }
+#endif
     }
     out[e] = (float2)((float)count, (float)distance_sum);
 #if HFVIS_WANT_BOUNCE
     bounce_finish(&gather, bounce_out + (base + e) * HFVIS_CHANNELS);
 #endif
 #if HFVIS_WANT_ENTRY_STATS
-    entry_stats[base + e] = (uint4)(m, t, hash, 0u);
+    entry_stats[base + e] = (uint4)(m, t, hash, skipped);
 #endif
     total_m += m;
     total_t += t;
+    zone_skips += skipped;
     total_naive += (ulong)rank;
     total_visible += (ulong)count;
     prev2 = prev;
@@ -484,7 +652,7 @@ __kernel void intervisibility_sweep(__global const SweepDirection* directions, _
   totals[2] = total_t;
   totals[3] = total_naive;
   totals[4] = total_visible;
-  totals[5] = 0;
+  totals[5] = (ulong)zone_skips;
   totals[6] = 0;
   totals[7] = 0;
 #endif

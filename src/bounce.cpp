@@ -15,8 +15,9 @@ namespace {
 
 std::size_t attributeBytes(int channels) { return (channels + kBounceNormalFloats) * sizeof(float); }
 
-TreeProgramFlags bounceFlags(const BounceInputs& inputs) {
+TreeProgramFlags bounceFlags(const BounceInputs& inputs, const HullTreeTuning& tuning) {
   TreeProgramFlags flags;
+  flags.tuning = tuning;
   flags.has_nodata = inputs.has_nodata;
   flags.area = false;
   flags.stats = false;
@@ -90,7 +91,7 @@ BounceResult run(const ComputeContext& context, const HeightField& field, const 
   IntervisibilityOutputs counts;
   counts.visible_count = true;
   checkLineLimits(all, inputs.heights, counts);
-  const TreeProgramFlags flags = bounceFlags(inputs);
+  const TreeProgramFlags flags = bounceFlags(inputs, options.tree);
   cl::Program program = st.program(treeProgramFile(flags), treeProgramOptions(flags, st.info));
   const std::size_t plane = field.pixelCount();
 
@@ -148,10 +149,11 @@ BounceResult run(const ComputeContext& context, const HeightField& field, const 
 
 BounceLineView bounceLinesOnDevice(const ComputeContext& context, const HeightField& field,
                                    const BounceInputs& inputs, const SweepDirection& direction,
-                                   int directions) {
+                                   int directions, const HullTreeTuning& tuning) {
+  validate(tuning);
   return translateOpenClErrors([&] {
     ContextState& st = context.state();
-    const TreeProgramFlags flags = bounceFlags(inputs);
+    const TreeProgramFlags flags = bounceFlags(inputs, tuning);
     cl::Program program = st.program(treeProgramFile(flags), treeProgramOptions(flags, st.info));
     const bool line_major = lineMajorLayout(st.info);
     const int channels = inputs.channels();

@@ -32,9 +32,10 @@ struct BounceLineView {
 
 BounceLineView bounceLinesOnDevice(const ComputeContext& context, const HeightField& field,
                                    const BounceInputs& inputs, const SweepDirection& direction,
-                                   int directions);
+                                   int directions, const HullTreeTuning& tuning = {});
 
 BounceLineView referenceBounceLines(const HeightField& field, const BounceInputs& inputs,
-                                    const SweepDirection& direction, int directions);
+                                    const SweepDirection& direction, int directions,
+                                    const HullTreeTuning& tuning = {});
 
 }  // namespace hfvis::detail

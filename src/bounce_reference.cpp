@@ -69,7 +69,7 @@ BounceInputs prepareBounce(const HeightField& field, const ExitRadiance& radianc
 }
 
 BounceLineView referenceBounceLines(const HeightField& field, const BounceInputs& inputs,
-                                    const SweepDirection& d, int directions) {
+                                    const SweepDirection& d, int directions, const HullTreeTuning& tuning) {
   BounceLineView view;
   view.lines.geometry = d;
   const std::size_t entries = d.entries();
@@ -99,13 +99,16 @@ BounceLineView referenceBounceLines(const HeightField& field, const BounceInputs
       out[channels + 2] = nz / length;
     }
   }
-  sweepPresampledLines(view.lines, false, &view.bounce);
+  sweepPresampledLines(view.lines, tuning, false, &view.bounce);
   return view;
 }
 
 }  // namespace detail
 
-void validate(const BounceOptions& options) { validate(static_cast<const SweepOptions&>(options)); }
+void validate(const BounceOptions& options) {
+  validate(static_cast<const SweepOptions&>(options));
+  validate(options.tree);
+}
 
 void validate(const HeightField& field, const ExitRadiance& radiance) {
   if (radiance.width != field.width || radiance.height != field.height) {
@@ -158,7 +161,7 @@ BounceResult referenceBounce(const HeightField& field, const ExitRadiance& radia
   for (int k = 0; k < options.directions; ++k) result.azimuths.push_back(directionAzimuth(k, options));
   result.irradiance.assign(channels, std::vector<float>(plane, 0.0f));
   for (const detail::SweepDirection& d : directions) {
-    const detail::BounceLineView view = detail::referenceBounceLines(field, inputs, d, options.directions);
+    const detail::BounceLineView view = detail::referenceBounceLines(field, inputs, d, options.directions, options.tree);
     const std::vector<float>& gathered = view.bounce.irradiance;
     // Mirror of bounce_reduce, one direction at a time.
     for (int r = 0; r < field.height; ++r) {

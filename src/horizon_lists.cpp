@@ -50,7 +50,7 @@ DirectionHorizons listDirection(const HeightField& field, const std::vector<floa
   line.samples.resize(static_cast<std::size_t>(n) + 1);
   for (int s = 0; s < n; ++s) line.samples[s] = ray[n - 1 - s];
   line.samples[n] = h;
-  detail::sweepPresampledLines(line, true);
+  detail::sweepPresampledLines(line, HullTreeTuning{}, true);
 
   const std::vector<int>& steps = line.horizon_steps[n];  // farthest first
   const std::vector<int>& ends = line.horizon_run_ends[n];

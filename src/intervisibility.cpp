@@ -25,6 +25,8 @@ std::string treeProgramOptions(const TreeProgramFlags& f, const DeviceInfo& devi
   s << "-DHFVIS_HAS_NODATA=" << f.has_nodata << " -DHFVIS_WANT_AREA=" << f.area
     << " -DHFVIS_WANT_STATS=" << f.stats << " -DHFVIS_WANT_ENTRY_STATS=" << f.entry_stats << " "
     << layoutProgramOption(device);
+  s << " -DHFVIS_DEFERRED_WRITES=" << f.tuning.deferred_writes << " -DHFVIS_SAFE_ZONE=" << f.tuning.safe_zone
+    << " -DHFVIS_SAFE_ZONE_STEPS=" << f.tuning.safe_zone_steps;
   if (f.bounce_channels > 0) s << " -DHFVIS_WANT_BOUNCE=1 -DHFVIS_CHANNELS=" << f.bounce_channels;
   return s.str();
 }
@@ -57,7 +59,7 @@ void bindNoBounce(ContextState& st, TreeSweepBuffers& b) {
   b.bounce_out = deviceBuffer(st, 0);
 }
 
-// Adds one batch's per-line totals (receivers, m, t, naive, visible) to the statistics.
+// Adds one batch's per-line totals (receivers, m, t, naive, visible, skips) to the statistics.
 void addLineTotals(const std::vector<cl_ulong>& totals, const SweepBatch& batch, int stride,
                    IntervisibilityStatistics& s) {
   for (std::size_t b = 0; b < batch.directions.size(); ++b) {
@@ -69,6 +71,7 @@ void addLineTotals(const std::vector<cl_ulong>& totals, const SweepBatch& batch,
       s.iterations += t[2];
       s.naive_iterations += t[3];
       s.visible_samples += t[4];
+      s.safe_zone_skips += t[5];
       s.lines_over_bound += t[2] > 2 * t[1] + t[0];
     }
   }
@@ -85,6 +88,7 @@ IntervisibilityResult run(const ComputeContext& context, const HeightField& fiel
   flags.has_nodata = prepared.has_nodata;
   flags.area = outputs.visible_area;
   flags.stats = outputs.statistics;
+  flags.tuning = options.tree;
   cl::Program program = st.program(treeProgramFile(flags), treeProgramOptions(flags, st.info));
   const std::size_t plane = field.pixelCount();
   int max_lines = 0;
@@ -184,11 +188,14 @@ IntervisibilityResult run(const ComputeContext& context, const HeightField& fiel
 
 IntervisibilityLines intervisibilityLinesOnDevice(const ComputeContext& context, const HeightField& field,
                                                   const std::vector<float>& prepared_heights,
-                                                  const SweepDirection& direction) {
+                                                  const SweepDirection& direction,
+                                                  const HullTreeTuning& tuning) {
+  validate(tuning);
   return translateOpenClErrors([&] {
     ContextState& st = context.state();
     TreeProgramFlags flags;
     flags.entry_stats = true;
+    flags.tuning = tuning;
     cl::Program program = st.program(treeProgramFile(flags), treeProgramOptions(flags, st.info));
     const bool line_major = lineMajorLayout(st.info);
     SweepBatch batch;
@@ -226,6 +233,7 @@ IntervisibilityLines intervisibilityLinesOnDevice(const ComputeContext& context,
     out.horizons.resize(entries);
     out.iterations.resize(entries);
     out.horizon_hashes.resize(entries);
+    out.walks_skipped.resize(entries);
     for (int j = 0; j < d.n_lines; ++j) {
       for (int i = 0; i < d.n_steps; ++i) {
         const std::size_t e = lineEntry(d, j, i, line_major), canonical = std::size_t(i) * d.n_lines + j;
@@ -235,6 +243,7 @@ IntervisibilityLines intervisibilityLinesOnDevice(const ComputeContext& context,
         out.horizons[canonical] = stats[4 * e];
         out.iterations[canonical] = stats[4 * e + 1];
         out.horizon_hashes[canonical] = stats[4 * e + 2];
+        out.walks_skipped[canonical] = stats[4 * e + 3];
       }
     }
     return out;

@@ -9,8 +9,19 @@
 
 namespace hfvis {
 
+void validate(const HullTreeTuning& tuning) {
+  if (tuning.safe_zone && !tuning.deferred_writes) {
+    throw InvalidArgument("the safe zone needs the deferred-writes walk (it works inside it)");
+  }
+  const int z = tuning.safe_zone_steps;
+  if (z < 1 || z > 4096 || (z & (z - 1)) != 0) {
+    throw InvalidArgument("the safe zone's steps must be a power of two in 1 .. 4096, not " + std::to_string(z));
+  }
+}
+
 void validate(const IntervisibilityOptions& options, const IntervisibilityOutputs& outputs) {
   validate(static_cast<const SweepOptions&>(options));
+  validate(options.tree);
   if (!outputs.visible_count && !outputs.visible_area && !outputs.statistics) {
     throw InvalidArgument("no output requested");
   }

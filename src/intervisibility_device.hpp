@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <string>
 
+#include "hfvis/intervisibility.hpp"
 #include "opencl_context.hpp"
 #include "sweep_framework.hpp"
 
@@ -26,6 +27,7 @@ struct TreeProgramFlags {
   bool stats = true;
   bool entry_stats = false;
   int bounce_channels = 0;  // > 0: the bounce program (bounce.cl) with that many channels
+  HullTreeTuning tuning;
 };
 
 // The kernel file and the -D options of a program with these flags, for `device`.

@@ -35,6 +35,7 @@ struct IntervisibilityLines {
   std::vector<std::uint32_t> horizons;        // m_i: distinct visibility horizons
   std::vector<std::uint32_t> iterations;      // t_i: convexity checks of Algorithm 1
   std::vector<std::uint32_t> horizon_hashes;  // FNV-1a over the horizons' steps, farthest first
+  std::vector<std::uint32_t> walks_skipped;   // 1 where the safe zone skipped the walk
   // Reference only, when asked: the horizons' steps, farthest first, and where each one's
   // visible run ends (run_end(): the first hidden sample, the next horizon or the receiver),
   // so horizon h's visible samples are the present ones of steps [h, end).
@@ -60,7 +61,8 @@ void bounceWedge(int directions, float* half_sector, float* wedge);
 // Runs the reference hull-tree sweep over lines whose `geometry` (n_lines, n_steps, and
 // the step's ground length) and `samples` are set: fills every other per-entry vector;
 // keep_horizons fills horizon_steps and horizon_run_ends; `bounce`, when given, gathers.
-void sweepPresampledLines(IntervisibilityLines& lines, bool keep_horizons, BounceLines* bounce = nullptr);
+void sweepPresampledLines(IntervisibilityLines& lines, const HullTreeTuning& tuning, bool keep_horizons,
+                          BounceLines* bounce = nullptr);
 
 // FNV-1a step of the horizon hash (kernel: `hash = (hash ^ step) * 16777619u`).
 constexpr std::uint32_t kHorizonHashSeed = 2166136261u;
@@ -72,12 +74,14 @@ inline std::uint32_t hashHorizon(std::uint32_t hash, int step) {
 // prepareHeights), with per-entry statistics.
 IntervisibilityLines intervisibilityLinesOnDevice(const ComputeContext& context, const HeightField& field,
                                                   const std::vector<float>& prepared_heights,
-                                                  const SweepDirection& direction);
+                                                  const SweepDirection& direction,
+                                                  const HullTreeTuning& tuning = {});
 
 // The scalar mirror of the same; keep_horizons fills horizon_steps.
 IntervisibilityLines referenceIntervisibilityLines(const HeightField& field,
                                                    const std::vector<float>& prepared_heights,
                                                    const SweepDirection& direction,
+                                                   const HullTreeTuning& tuning = {},
                                                    bool keep_horizons = false);
 
 }  // namespace hfvis::detail

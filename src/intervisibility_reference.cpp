@@ -139,9 +139,81 @@ class BounceGather {
   float sum_[kMaxBounceChannels] = {};
 };
 
+// Mirror of RootList / root_append(): the root's new child list; `tail_next` is what the
+// last child's `next` holds in the tree, so deferred writes skip links already right.
+struct RootList {
+  int head = kNone, tail = kNone, tail_next = kNone;
+  float tail_h = 0.0f;
+  void append(std::vector<Node>& tree, bool deferred, int x, float hx, int x_next_in_tree) {
+    if (tail == kNone)
+      head = x;
+    else if (!deferred || tail_next != x)
+      tree[tail].next = x;
+    tail = x;
+    tail_next = x_next_in_tree;
+    tail_h = hx;
+  }
+};
+
+// Mirror of hull_tree_walk(): Algorithm 1 below `top`; returns the convexity checks.
+std::uint32_t hullTreeWalk(std::vector<Node>& tree, bool deferred, int top, Node node, float h, int step,
+                           RootList& list) {
+  std::uint32_t t = 0;
+  int cur = top;
+  for (;;) {
+    const int c = node.first;
+    if (c != kNone) {
+      Node child = tree[c];
+      ++t;
+      const int side =
+          chordSide(child.h, node.h, h, static_cast<float>(cur - c), static_cast<float>(step - cur));
+      if (side <= 0) {
+        tree[cur].first = child.next;
+        tree[c].next = cur;
+        child.next = cur;
+        cur = c;
+        node = child;
+        continue;
+      }
+    }
+    if (c != kNone || node.leaf) list.append(tree, deferred, cur, node.h, node.next);
+    if (cur == top) break;
+    cur = node.next;
+    node = tree[cur];
+  }
+  return t;
+}
+
+// Mirror of SafeZone and its helpers, the same float operations in the same order.
+struct SafeZone {
+  int first = 0, last = 0, steps = 16;
+  float z1 = 0.0f, z2 = 0.0f, margin = 0.0f;
+  void begin(int receiver) {
+    first = receiver + 1;
+    last = receiver + 1 + steps;
+    z1 = z2 = std::numeric_limits<float>::max();
+    margin = 0.0f;
+  }
+  void add(float hc, int c, float hg, int g) {
+    const float slope = (hc - hg) / static_cast<float>(c - g);
+    const float at1 = hc + slope * static_cast<float>(first - c);
+    const float at2 = hc + slope * static_cast<float>(last - c);
+    z1 = std::fmin(z1, at1);
+    z2 = std::fmin(z2, at2);
+    margin = std::fmax(margin, std::fabs(hc) + std::fabs(slope) * static_cast<float>(last - c));
+  }
+  void end() { margin = margin * 0x1p-16f + 0x1p-100f; }
+  bool inside(int step, float h) const {
+    const float bound =
+        z1 + (z2 - z1) * (static_cast<float>(step - first) / static_cast<float>(steps));
+    return step <= last && h < bound - margin;
+  }
+};
+
 // Mirror of intervisibility_sweep() for line j.
-void sweepLine(const SweepDirection& d, int j, IntervisibilityLines& out, bool keep_horizons,
-               BounceLines* bounce) {
+void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, IntervisibilityLines& out,
+               bool keep_horizons, BounceLines* bounce) {
+  const bool deferred = tuning.deferred_writes;
   const std::size_t stride = static_cast<std::size_t>(d.n_lines);
   const LineView line{out.samples, static_cast<std::size_t>(j), stride};
   std::vector<Node> tree(static_cast<std::size_t>(d.n_steps));
@@ -153,6 +225,11 @@ void sweepLine(const SweepDirection& d, int j, IntervisibilityLines& out, bool k
   int root = kNone, prev = kNone, prev2 = kNone;
   float h_prev = 0.0f, h_prev2 = 0.0f;
   int class_last = kConvex;
+  int head = kNone, tail = kNone;  // the root's first and last child
+  float tail_h = 0.0f;
+  SafeZone zone;
+  zone.steps = tuning.safe_zone_steps;
+  bool zone_valid = false;
   for (int step = 0; step < d.n_steps; ++step) {
     const std::size_t e = static_cast<std::size_t>(j) + static_cast<std::size_t>(step) * stride;
     const float h = out.samples[e];
@@ -167,39 +244,55 @@ void sweepLine(const SweepDirection& d, int j, IntervisibilityLines& out, bool k
     if (bounce) gather.emplace(*bounce, d, e, h, step);
     if (root == kNone) {
       tree[step] = {h, 0, true, kNone, kNone};
+      head = tail = kNone;
     } else {
-      // 1. Algorithm 1 as a post-order walk with the stack threaded through `next`.
-      int head = kNone, tail = kNone;
-      int cur = root;
-      Node node = tree[cur];
-      for (;;) {
-        const int c = node.first;
-        if (c != kNone) {
-          Node child = tree[c];
+      // 1. Algorithm 1 for the new root (see the kernel for the variants).
+      RootList list;
+      const Node old_root = tree[root];
+      bool walk = true;
+      bool replaced = false;
+      if (tuning.safe_zone) {
+        if (tail != kNone) {
           ++t;
-          // Convex when the parent lies strictly above the chord from the child to the root.
-          const int side =
-              chordSide(child.h, node.h, h, static_cast<float>(cur - c), static_cast<float>(step - cur));
-          if (side <= 0) {
-            tree[cur].first = child.next;
-            tree[c].next = cur;
-            child.next = cur;
-            cur = c;
-            node = child;
-            continue;
+          replaced =
+              chordSide(tail_h, h_prev, h, static_cast<float>(root - tail), static_cast<float>(step - root)) <= 0;
+        }
+        zone_valid = zone_valid && replaced && zone.inside(step, h);
+        if (zone_valid) {
+          walk = false;
+          out.walks_skipped[e] = 1;
+          list.head = head;
+          list.tail = tail;
+          list.tail_h = tail_h;
+          if (old_root.leaf) {
+            tree[root].first = kNone;
+            list.append(tree, deferred, root, h_prev, kNone);
           }
         }
-        const int parent = node.next;
-        if (c != kNone || node.leaf) {
-          if (tail == kNone)
-            head = cur;
-          else
-            tree[tail].next = cur;
-          tail = cur;
+      }
+      if (walk) {
+        if (deferred) {
+          int c = old_root.first;
+          while (c != kNone) {
+            const Node child = tree[c];
+            if (!replaced) {
+              if (tuning.safe_zone && c == tail) break;
+              ++t;
+              if (chordSide(child.h, h_prev, h, static_cast<float>(root - c), static_cast<float>(step - root)) >
+                  0)
+                break;
+            }
+            t += hullTreeWalk(tree, deferred, c, child, h, step, list);
+            c = child.next;
+          }
+          if (c != kNone || old_root.leaf) {
+            if (c != old_root.first) tree[root].first = c;
+            list.append(tree, deferred, root, h_prev, kNone);
+          }
+        } else {
+          t += hullTreeWalk(tree, deferred, root, old_root, h, step, list);
         }
-        if (parent == kNone) break;
-        cur = parent;
-        node = tree[cur];
+        zone_valid = false;
       }
 
       // 2. Eq. 1 for the old root; a segment start's node becomes (or is re-created as) a
@@ -209,26 +302,31 @@ void sweepLine(const SweepDirection& d, int j, IntervisibilityLines& out, bool k
             chordSide(h_prev2, h_prev, h, static_cast<float>(prev - prev2), static_cast<float>(step - prev));
         const int cls = side > 0 ? kConvex : side < 0 ? kConcave : class_last;
         if (cls == kConvex && class_last == kConcave) {
-          if (tail == prev) {
+          if (list.tail == prev) {
             tree[prev].leaf = true;
           } else {
             tree[prev] = {h_prev, rank - 1, true, kNone, kNone};
-            tree[tail].next = prev;
-            tail = prev;
+            list.append(tree, deferred, prev, h_prev, kNone);
           }
         }
         class_last = cls;
       }
-      tree[tail].next = kNone;
-      tree[step] = {h, rank, false, head, kNone};
+      if (!deferred || list.tail_next != kNone) tree[list.tail].next = kNone;
+      tree[step] = {h, rank, false, list.head, kNone};
+      head = list.head;
+      tail = list.tail;
+      tail_h = list.tail_h;
 
       // 3. Visible samples from the horizons, farthest first (closed forms without holes).
+      const bool refresh_zone = tuning.safe_zone && !zone_valid;
+      if (refresh_zone) zone.begin(step);
       int hp = head;
       Node hz = tree[hp];
       int hp_rank = hz.rank;
       for (;;) {
         const int np = hz.next;
         ++m;
+        if (refresh_zone && hz.first != kNone) zone.add(hz.h, hp, tree[hz.first].h, hz.first);
         hash = hashHorizon(hash, hp);
         if (keep_horizons) horizons.push_back(hp);
         int end = step, end_rank = rank, np_rank = rank;
@@ -268,6 +366,10 @@ void sweepLine(const SweepDirection& d, int j, IntervisibilityLines& out, bool k
         hz = nz;
         hp = np;
         hp_rank = np_rank;
+      }
+      if (refresh_zone) {
+        zone.end();
+        zone_valid = true;
       }
     }
     out.counts[e] = static_cast<float>(count);
@@ -316,7 +418,7 @@ void sweepReference(const HeightField& field, const std::vector<float>& h,
   std::vector<PixelSums> sums(field.pixelCount());
   auto& stats = result.statistics;
   for (const SweepDirection& d : directions) {
-    const IntervisibilityLines lines = referenceIntervisibilityLines(field, h, d);
+    const IntervisibilityLines lines = referenceIntervisibilityLines(field, h, d, options.tree);
     for (int j = 0; j < d.n_lines; ++j) {
       std::uint64_t n = 0, m = 0, t = 0;
       for (int i = 0; i < d.n_steps; ++i) {
@@ -326,6 +428,7 @@ void sweepReference(const HeightField& field, const std::vector<float>& h,
         ++n;
         m += lines.horizons[e];
         t += lines.iterations[e];
+        stats.safe_zone_skips += lines.walks_skipped[e];
         stats.visible_samples += static_cast<std::uint64_t>(lines.counts[e]);
       }
       stats.receivers += n;
@@ -403,7 +506,9 @@ void bounceWedge(int directions, float* half_sector, float* wedge) {
   *wedge = static_cast<float>(2.0 * std::sin(0.5 * sector));
 }
 
-void sweepPresampledLines(IntervisibilityLines& lines, bool keep_horizons, BounceLines* bounce) {
+void sweepPresampledLines(IntervisibilityLines& lines, const HullTreeTuning& tuning, bool keep_horizons,
+                          BounceLines* bounce) {
+  validate(tuning);
   const SweepDirection& d = lines.geometry;
   const std::size_t entries = d.entries();
   if (lines.samples.size() != entries)
@@ -413,6 +518,7 @@ void sweepPresampledLines(IntervisibilityLines& lines, bool keep_horizons, Bounc
   lines.horizons.assign(entries, 0);
   lines.iterations.assign(entries, 0);
   lines.horizon_hashes.assign(entries, 0);
+  lines.walks_skipped.assign(entries, 0);
   lines.horizon_steps.assign(keep_horizons ? entries : 0, {});
   lines.horizon_run_ends.assign(keep_horizons ? entries : 0, {});
   if (bounce) {
@@ -422,12 +528,13 @@ void sweepPresampledLines(IntervisibilityLines& lines, bool keep_horizons, Bounc
     }
     bounce->irradiance.assign(entries * bounce->channels, kNaN);
   }
-  for (int j = 0; j < d.n_lines; ++j) sweepLine(d, j, lines, keep_horizons, bounce);
+  for (int j = 0; j < d.n_lines; ++j) sweepLine(d, j, tuning, lines, keep_horizons, bounce);
 }
 
 IntervisibilityLines referenceIntervisibilityLines(const HeightField& field,
                                                    const std::vector<float>& prepared_heights,
-                                                   const SweepDirection& d, bool keep_horizons) {
+                                                   const SweepDirection& d, const HullTreeTuning& tuning,
+                                                   bool keep_horizons) {
   IntervisibilityLines out;
   out.geometry = d;
   out.samples.assign(d.entries(), kNaN);
@@ -439,7 +546,7 @@ IntervisibilityLines referenceIntervisibilityLines(const HeightField& field,
             sampleHeight(prepared_heights, field.width, field.height, p);
     }
   }
-  sweepPresampledLines(out, keep_horizons);
+  sweepPresampledLines(out, tuning, keep_horizons);
   return out;
 }
 

@@ -68,6 +68,8 @@ std::vector<FoundDevice> findDevices() {
       f.info.global_memory_bytes = device.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
       f.info.max_allocation_bytes = device.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
       f.info.compute_units = static_cast<int>(device.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>());
+      f.info.correctly_rounded_divide =
+          (device.getInfo<CL_DEVICE_SINGLE_FP_CONFIG>() & CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT) != 0;
       found.push_back(f);
     }
   }
@@ -126,6 +128,7 @@ cl::Program ContextState::program(const std::string& file, const std::string& op
   std::string include_dir;
   const std::string source = kernelSource(file, &include_dir);
   std::string build_options = "-cl-std=CL1.2 " + options;
+  if (info.correctly_rounded_divide) build_options += " -cl-fp32-correctly-rounded-divide-sqrt";
   if (!include_dir.empty()) build_options += " -I " + include_dir;
   const std::string key = file + '\n' + build_options + '\n' + source;
   std::lock_guard<std::mutex> lock(mutex_);

@@ -202,12 +202,24 @@ BruteForce bruteForce(const std::vector<LineSample>& s, const std::vector<bool>&
   return out;
 }
 
+// The tree tunings under test: Algorithm 1's walk as written, each optimisation alone, both
+// (the default), and the safe zone's extreme spans. Each must build the same trees.
+struct NamedTuning {
+  const char* name;
+  HullTreeTuning tuning;
+};
+const NamedTuning kTunings[] = {
+    {"plain", {false, false, 16}},         {"deferred writes", {true, false, 16}},
+    {"default", {true, true, 16}},         {"safe zone 1 step", {true, true, 1}},
+    {"safe zone 4096 steps", {true, true, 4096}},
+};
+
 void expectTreeEqualsBruteForce(const HeightField& field, const detail::SweepDirection& d, bool check_device,
-                                std::uint64_t* receivers_checked) {
+                                std::uint64_t* receivers_checked, const HullTreeTuning& tuning = {}) {
   const auto prepared = detail::prepareHeights(field);
-  const auto ref = detail::referenceIntervisibilityLines(field, prepared.heights, d, true);
+  const auto ref = detail::referenceIntervisibilityLines(field, prepared.heights, d, tuning, true);
   if (check_device) {
-    const auto dev = detail::intervisibilityLinesOnDevice(testContext(), field, prepared.heights, d);
+    const auto dev = detail::intervisibilityLinesOnDevice(testContext(), field, prepared.heights, d, tuning);
     ASSERT_TRUE(nearlyEqual(dev.samples, ref.samples, 0.0f)) << "presampled heights differ";
     ASSERT_TRUE(nearlyEqual(dev.counts, ref.counts, 0.0f)) << "visible counts: kernel vs reference";
     ASSERT_TRUE(nearlyEqual(dev.distance_sums, ref.distance_sums, 0.0f))
@@ -215,6 +227,7 @@ void expectTreeEqualsBruteForce(const HeightField& field, const detail::SweepDir
     ASSERT_EQ(dev.horizons, ref.horizons) << "horizon counts m_i: kernel vs reference";
     ASSERT_EQ(dev.iterations, ref.iterations) << "iterations t_i: kernel vs reference";
     ASSERT_EQ(dev.horizon_hashes, ref.horizon_hashes) << "horizon lists: kernel vs reference";
+    ASSERT_EQ(dev.walks_skipped, ref.walks_skipped) << "safe-zone skips: kernel vs reference";
   }
   for (int j = 0; j < d.n_lines; ++j) {
     const auto s = presentSamples(ref, j);
@@ -258,20 +271,59 @@ void expectTreeEqualsBruteForce(const HeightField& field, const detail::SweepDir
 }
 
 TEST(IntervisibilityLine, TreeEqualsBruteForceOnEveryHardCase) {
-  std::uint64_t checked = 0;
-  for (const auto& name : syntheticFieldNames()) {
-    for (auto [w, h] : awkwardSizes()) {
-      const HeightField field = makeSyntheticField(name, w, h, 7);
-      for (double azimuth : kAzimuths) {
-        SCOPED_TRACE(name + " " + std::to_string(w) + "x" + std::to_string(h) + " azimuth " +
-                     std::to_string(azimuth));
-        const auto d = detail::makeSweepDirection(field, azimuth, 1.0, 1.0);
-        expectTreeEqualsBruteForce(field, d, true, &checked);
-        if (::testing::Test::HasFatalFailure()) return;
+  for (const NamedTuning& variant : kTunings) {
+    std::uint64_t checked = 0;
+    for (const auto& name : syntheticFieldNames()) {
+      for (auto [w, h] : awkwardSizes()) {
+        const HeightField field = makeSyntheticField(name, w, h, 7);
+        for (double azimuth : kAzimuths) {
+          SCOPED_TRACE(std::string(variant.name) + ": " + name + " " + std::to_string(w) + "x" +
+                       std::to_string(h) + " azimuth " + std::to_string(azimuth));
+          const auto d = detail::makeSweepDirection(field, azimuth, 1.0, 1.0);
+          expectTreeEqualsBruteForce(field, d, true, &checked, variant.tuning);
+          if (::testing::Test::HasFatalFailure()) return;
+        }
+      }
+    }
+    EXPECT_GT(checked, 100000u) << variant.name;
+  }
+}
+
+// The tunings change the work, never the result: per receiver the same counts, distances
+// and horizons as Algorithm 1's walk; the deferred writes make the same convexity checks,
+// the safe zone fewer, and it does skip walks (on these fields by a wide margin).
+TEST(IntervisibilityLine, TuningsChangeTheWorkNotTheResult) {
+  const HeightField fractal = readHeightField(std::string(HFVIS_DATA_DIR) + "/fractal_256.exr");
+  const HeightField fields[] = {fractal, makeSyntheticField("noise", 97, 61, 2),
+                                makeSyntheticField("dome", 80, 80, 1), makeSyntheticField("terraces", 64, 50, 1)};
+  for (const HeightField& field : fields) {
+    const auto prepared = detail::prepareHeights(field);
+    for (double azimuth : {0.0, 0.7, 3.5}) {
+      const auto d = detail::makeSweepDirection(field, azimuth, 1.0, 1.0);
+      const auto plain = detail::intervisibilityLinesOnDevice(testContext(), field, prepared.heights, d,
+                                                              kTunings[0].tuning);
+      std::uint64_t plain_t = 0;
+      for (auto t : plain.iterations) plain_t += t;
+      for (const NamedTuning& variant : kTunings) {
+        SCOPED_TRACE(std::string(variant.name) + ", " + std::to_string(field.width) + "x" +
+                     std::to_string(field.height) + ", azimuth " + std::to_string(azimuth));
+        const auto v = detail::intervisibilityLinesOnDevice(testContext(), field, prepared.heights, d,
+                                                            variant.tuning);
+        ASSERT_TRUE(nearlyEqual(v.counts, plain.counts, 0.0f));
+        ASSERT_TRUE(nearlyEqual(v.distance_sums, plain.distance_sums, 0.0f));
+        ASSERT_EQ(v.horizons, plain.horizons);
+        ASSERT_EQ(v.horizon_hashes, plain.horizon_hashes);
+        std::uint64_t t = 0;
+        for (auto x : v.iterations) t += x;
+        if (!variant.tuning.safe_zone) {
+          EXPECT_EQ(v.iterations, plain.iterations);
+        } else {
+          EXPECT_LE(t, plain_t);
+          if (field.width == 256) EXPECT_LT(double(t), 0.9 * double(plain_t)) << "the safe zone never skipped a walk";
+        }
       }
     }
   }
-  EXPECT_GT(checked, 100000u);
 }
 
 // Long lines of tie-rich random heights (small integers), smooth random walks and float
@@ -337,6 +389,7 @@ void expectStatisticsEqual(const IntervisibilityStatistics& a, const Intervisibi
   EXPECT_EQ(a.visible_samples, b.visible_samples);
   EXPECT_EQ(a.naive_iterations, b.naive_iterations);
   EXPECT_EQ(a.lines_over_bound, b.lines_over_bound);
+  EXPECT_EQ(a.safe_zone_skips, b.safe_zone_skips);
 }
 
 // Counts are sums of (interpolated) integers; areas relative to their size.
@@ -573,6 +626,14 @@ TEST(IntervisibilityKernels, InvalidOptionsAreRejectedBeforeLaunch) {
   huge.heights[0] = 1e36f;  // |h| * steps would overflow the predicate's products
   EXPECT_THROW(computeIntervisibility(testContext(), huge, IntervisibilityOptions{}, allOutputs()),
                InvalidArgument);
+  IntervisibilityOptions zone;
+  for (int steps : {0, 3, 8192}) {  // not a power of two in 1 .. 4096
+    zone.tree.safe_zone_steps = steps;
+    EXPECT_THROW(computeIntervisibility(testContext(), field, zone, allOutputs()), InvalidArgument) << steps;
+  }
+  zone.tree = {};
+  zone.tree.deferred_writes = false;  // the safe zone works inside the deferred walk
+  EXPECT_THROW(computeIntervisibility(testContext(), field, zone, allOutputs()), InvalidArgument);
 }
 
 }  // namespace

@@ -41,6 +41,7 @@
 
 #include "hfvis/device.hpp"
 #include "hfvis/height_field.hpp"
+#include "hfvis/intervisibility.hpp"
 #include "hfvis/sweep_options.hpp"
 
 namespace hfvis {
@@ -48,7 +49,9 @@ namespace hfvis {
 // Exit radiance channels gathered in one run (one tree sweep serves all of them).
 constexpr int kMaxBounceChannels = 4;
 
-struct BounceOptions : SweepOptions {};
+struct BounceOptions : SweepOptions {
+  HullTreeTuning tree;  // how the tree sweep works; never changes the result
+};
 
 // Exit radiance per pixel of the height field: 1..kMaxBounceChannels planes (grey, RGB,
 // ...), each width*height, finite and >= 0 at every pixel whose height is valid (values at
@@ -67,7 +70,7 @@ struct BounceResult {
   std::vector<std::vector<float>> irradiance;  // one plane per radiance channel; NaN at nodata
 };
 
-// Throws InvalidArgument for bad sweep options (see sweep_options.hpp).
+// Throws InvalidArgument for bad sweep options (see sweep_options.hpp) or tree tuning.
 void validate(const BounceOptions& options);
 
 // Throws InvalidArgument when the radiance does not fit the field (size, 1..4 channels,

@@ -18,6 +18,10 @@ struct DeviceInfo {
   std::uint64_t global_memory_bytes = 0;
   std::uint64_t max_allocation_bytes = 0;
   int compute_units = 0;
+  // CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT: programs are then built with
+  // -cl-fp32-correctly-rounded-divide-sqrt, so float division rounds as in C++ (the scalar
+  // references); without it a division may differ by 2.5 ulp.
+  bool correctly_rounded_divide = false;
 };
 
 // Every device of every platform. Throws NoDeviceError when no platform is installed.

@@ -25,8 +25,26 @@ enum class IntervisibilityMethod {
   Naive,     // per-pixel visibility march, bilinear samples: the O(N^3) baseline and oracle
 };
 
+// How the convex hull tree sweep does its work. Every setting builds the same trees and gives
+// the same results (horizons, counts, areas, bounce); they change only the work done: the
+// convexity checks t and the memory traffic (bench/report/REPORT.md measures each).
+struct HullTreeTuning {
+  // The walk keeps the old root's level in registers and writes a link only where it
+  // changes (the aim of Timonen 2013's Algorithm 2: postponed, consolidated linkage
+  // writes). false = Algorithm 1's walk as written, every relink stored at once.
+  bool deferred_writes = true;
+  // The safe zone (Sec. 7, Algorithm 3): the old root's last child is checked first; when
+  // it fails the old root is replaced, and a new sample inside the zone skips the walk.
+  // Needs deferred_writes (it works inside that walk, as Algorithm 3 inside Algorithm 2).
+  bool safe_zone = true;
+  // Steps past the receiver one safe zone covers before it is recomputed: a power of two,
+  // 1 .. 4096.
+  int safe_zone_steps = 16;
+};
+
 struct IntervisibilityOptions : SweepOptions {
   IntervisibilityMethod method = IntervisibilityMethod::HullTree;
+  HullTreeTuning tree;  // HullTree only
 };
 
 // What to compute; only what is asked for is stored or reduced.
@@ -50,10 +68,12 @@ struct IntervisibilityStatistics {
   std::uint64_t receivers = 0;         // present line samples, each a receiver once
   std::uint64_t lines = 0;             // lines with at least one present sample
   std::uint64_t horizons = 0;          // sum of m_i: distinct visibility horizons
-  std::uint64_t iterations = 0;        // sum of t_i: convexity checks of Algorithm 1
+  std::uint64_t iterations = 0;        // sum of t_i: convexity checks made (Algorithm 1's with
+                                       // tree.safe_zone off, fewer with it)
   std::uint64_t visible_samples = 0;   // sum of visible samples (Table 1's p_a * receivers)
   std::uint64_t naive_iterations = 0;  // samples the naive method would test on the same lines
   std::uint64_t lines_over_bound = 0;  // lines where t > 2m + n (Section 6 proves none)
+  std::uint64_t safe_zone_skips = 0;   // receivers whose tree update skipped the walk
 
   double meanHorizons() const { return receivers ? double(horizons) / receivers : 0.0; }      // m_a
   double meanIterations() const { return receivers ? double(iterations) / receivers : 0.0; }  // t_a
@@ -71,8 +91,12 @@ struct IntervisibilityResult {
   IntervisibilityStatistics statistics;  // if asked
 };
 
-// Throws InvalidArgument for bad sweep options (see sweep_options.hpp), no output
-// requested, or statistics asked of the naive method.
+// Throws InvalidArgument for a safe zone without deferred writes, or a safe_zone_steps that
+// is not a power of two in 1 .. 4096.
+void validate(const HullTreeTuning& tuning);
+
+// Throws InvalidArgument for bad sweep options (see sweep_options.hpp), a bad tree tuning,
+// no output requested, or statistics asked of the naive method.
 void validate(const IntervisibilityOptions& options, const IntervisibilityOutputs& outputs);
 
 // Runs options.method on the device of `context`. Throws InvalidArgument (bad field or

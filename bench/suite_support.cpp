@@ -1,0 +1,123 @@
+// bench/suite_support.cpp: see suite_support.hpp.
+#include "suite_support.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdarg>
+#include <cstdio>
+#include <filesystem>
+#include <thread>
+
+#include "hfvis/errors.hpp"
+#include "hfvis/image_io.hpp"
+#include "hfvis/synthetic_fields.hpp"
+
+namespace hfvis::bench {
+
+namespace fs = std::filesystem;
+
+std::string num(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", v);
+  return text;
+}
+
+namespace {
+
+std::string csvField(const std::string& text) {
+  if (text.find_first_of(",\"\n") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (char ch : text) quoted += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+  return quoted + "\"";
+}
+
+}  // namespace
+
+CsvWriter::CsvWriter(const std::string& path, std::vector<std::string> columns)
+    : out_(path), columns_(std::move(columns)) {
+  if (!out_) throw IoError(path, "cannot write");
+  for (std::size_t i = 0; i < columns_.size(); ++i) out_ << (i ? "," : "") << columns_[i];
+  out_ << "\n";
+}
+
+void CsvWriter::write(const Row& row) {
+  for (std::size_t i = 0; i < columns_.size(); ++i) {
+    const auto it = row.find(columns_[i]);
+    out_ << (i ? "," : "") << (it == row.end() ? "" : csvField(it->second));
+  }
+  out_ << "\n";
+  out_.flush();
+}
+
+HeightField crop(const HeightField& field, int width, int height) {
+  HeightField c = field;
+  c.width = std::min(width, field.width);
+  c.height = std::min(height, field.height);
+  c.heights.clear();
+  for (int r = 0; r < c.height; ++r)
+    for (int col = 0; col < c.width; ++col) c.heights.push_back(field.at(col, r));
+  return c;
+}
+
+Content loadContent(const SuiteOptions& options, const std::string& name, int n) {
+  Content c;
+  c.name = name;
+  if (options.mode == "tiny") {
+    // Odd, non-square sizes; the "dome" stands in for the DEM with non-square cells.
+    if (name == "dem") {
+      c.field = makeSyntheticField("dome", n + 5, n - 1, 3);
+      c.field.cell_size_x = 1.5, c.field.cell_size_y = 0.75;
+    } else {
+      c.field = makeSyntheticField(name == "fractal" ? "noise" : name, n, n - 3, 3);
+    }
+  } else if (name == "dem") {
+    // The central n x n of the DEM (all of it when smaller), so that every content of the
+    // speed/error plane has the same size.
+    const HeightField dem = readHeightField(options.dem_path);
+    const int w = std::min(n, dem.width), h = std::min(n, dem.height);
+    const int c0 = (dem.width - w) / 2, r0 = (dem.height - h) / 2;
+    c.field = dem;
+    c.field.width = w, c.field.height = h;
+    c.field.heights.clear();
+    for (int r = r0; r < r0 + h; ++r)
+      for (int col = c0; col < c0 + w; ++col) c.field.heights.push_back(dem.at(col, r));
+  } else {
+    c.field =
+        readHeightField((fs::path(options.data_dir) / (name + "_" + std::to_string(n) + ".exr")).string());
+  }
+  c.label = name + "_" + std::to_string(c.field.width) + "x" + std::to_string(c.field.height);
+  return c;
+}
+
+Timing timeWithWarmUp(const std::function<void()>& warm_up, const std::function<void()>& run,
+                      const TimingPolicy& policy) {
+  warm_up();
+  Timing timing;
+  const Timing first = timeRepeated(run, {1, 1, 0.0});
+  TimingPolicy rest = policy;
+  if (first.min() >= 1.0) {  // expensive: the small run was warm-up enough, this one counts
+    timing = first;
+    rest.min_reps = std::max(0, policy.min_reps - 1);
+    rest.max_reps = std::max(0, policy.max_reps - 1);
+    rest.budget_seconds = policy.budget_seconds - first.min();
+  }
+  const Timing more = timeRepeated(run, rest);
+  timing.seconds.insert(timing.seconds.end(), more.seconds.begin(), more.seconds.end());
+  timing.cpu_seconds.insert(timing.cpu_seconds.end(), more.cpu_seconds.begin(), more.cpu_seconds.end());
+  return timing;
+}
+
+int threads() { return std::max(1u, std::thread::hardware_concurrency()); }
+
+void say(const char* format, ...) {
+  static const auto start = std::chrono::steady_clock::now();
+  std::fprintf(stdout, "%7.1fs ", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  va_list args;
+  va_start(args, format);
+  std::vfprintf(stdout, format, args);
+  va_end(args);
+  std::fputc('\n', stdout);
+  std::fflush(stdout);
+}
+
+}  // namespace hfvis::bench
