@@ -10,6 +10,9 @@
 //       (methods: sweep, naive, naive_bench, radius, pyramid, floor)
 //   hfvis_bench visibility [--quick | --tiny] --out DIR [--data DIR] [--dem FILE] [--commit TEXT]
 //       the intervisibility suite: writes DIR/visibility.csv and DIR/visibility_environment.txt
+//   hfvis_bench vis-run FIELD [--method tree|naive] [-k K] [--tuning plain|deferred|default|zone]
+//                       [--zone-steps S] [--reps N]
+//       visible counts by one method on one field: min and median time, statistics
 //   hfvis_bench inputs [--quick]
 //       the generated fields both suites read, one "<content> <N>" per line
 //   hfvis_bench check-truth
@@ -31,9 +34,11 @@
 #include "ground_truth.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/image_io.hpp"
+#include "hfvis/intervisibility.hpp"
 #include "methods.hpp"
 #include "metrics.hpp"
 #include "suite.hpp"
+#include "suite_support.hpp"
 
 namespace {
 
@@ -46,6 +51,8 @@ constexpr const char* kUsage =
     "       hfvis_bench run FIELD [--method sweep|naive|naive_bench|radius|pyramid|floor] [-k K] [--spu S]\n"
     "                   [--lpu L] [--param P] [--outputs angles|svf|device] [--reps N]\n"
     "       hfvis_bench visibility [--quick | --tiny] --out DIR [--data DIR] [--dem FILE] [--commit TEXT]\n"
+    "       hfvis_bench vis-run FIELD [--method tree|naive] [-k K] [--tuning plain|deferred|default|zone]\n"
+    "                           [--zone-steps S] [--reps N]\n"
     "       hfvis_bench inputs [--quick]\n"
     "       hfvis_bench check-truth\n"
     "       hfvis_bench vectorize-report\n"
@@ -155,6 +162,47 @@ int runOne(Arguments& args) {
   return 0;
 }
 
+int runVisibilityOne(Arguments& args) {
+  if (args.positional().size() != 1) throw Usage("vis-run takes one height field");
+  IntervisibilityOptions options;
+  const std::string method = args.get("--method", "tree");
+  if (method != "tree" && method != "naive") throw Usage("--method: tree or naive");
+  options.method = method == "tree" ? IntervisibilityMethod::HullTree : IntervisibilityMethod::Naive;
+  options.directions = static_cast<int>(number(args.get("-k", "16"), "-k"));
+  const std::string tuning = args.get("--tuning", "default");
+  if (tuning == "plain")
+    options.tree.deferred_writes = options.tree.replacement_check = false;
+  else if (tuning == "deferred")
+    options.tree.replacement_check = false;
+  else if (tuning == "zone")
+    options.tree.safe_zone = true;
+  else if (tuning != "default")
+    throw Usage("--tuning: plain, deferred, default or zone");
+  options.tree.safe_zone_steps = static_cast<int>(number(args.get("--zone-steps", "16"), "--zone-steps"));
+  TimingPolicy policy;
+  policy.min_reps = policy.max_reps = static_cast<int>(number(args.get("--reps", "3"), "--reps"));
+  args.rejectUnused();
+  const HeightField field = readHeightField(args.positional()[0]);
+  const ComputeContext context = ComputeContext::create();
+  IntervisibilityOutputs outputs;
+  outputs.visible_count = true;
+  const Timing t = timeWithWarmUp([&] { computeIntervisibility(context, crop(field, 64, 64), options, outputs); },
+                                  [&] { computeIntervisibility(context, field, options, outputs); }, policy);
+  const double pd = static_cast<double>(field.pixelCount()) * options.directions;
+  const int cores = std::max(1, context.device().compute_units);
+  std::printf("%s (%s) on %dx%d, K=%d: min %.4f s, median %.4f s over %zu runs; %.1f core-ns per pixel-direction\n",
+              method.c_str(), method == "tree" ? tuning.c_str() : "-", field.width, field.height,
+              options.directions, t.min(), t.median(), t.seconds.size(), t.min() * cores / pd * 1e9);
+  if (method == "tree") {
+    IntervisibilityOutputs stats;
+    stats.statistics = true;
+    const auto s = computeIntervisibility(context, field, options, stats).statistics;
+    std::printf("  m_a %.3f, t_a %.3f, visible %.3f, walks skipped by the safe zone %.1f %%\n", s.meanHorizons(),
+                s.meanIterations(), s.meanVisible(), s.receivers ? 100.0 * s.safe_zone_skips / s.receivers : 0.0);
+  }
+  return 0;
+}
+
 int checkTruth() {
   std::string summary;
   const auto failures = checkGroundTruth(&summary);
@@ -187,6 +235,7 @@ int main(int argc, char** argv) {
       return command == "suite" ? runSuite(context, options) : runVisibilitySuite(context, options);
     }
     if (command == "run") return runOne(args);
+    if (command == "vis-run") return runVisibilityOne(args);
     if (command == "inputs") {
       const std::string mode = args.flag("--quick") ? "quick" : "full";
       std::set<std::pair<std::string, int>> inputs;

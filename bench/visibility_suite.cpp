@@ -33,7 +33,9 @@ struct VisibilityConfig {
   std::vector<std::string> zone_contents = {"fractal", "dem"};
   std::vector<int> scale_ns;  // line lengths of the scaling study
   int scale_lines = 64;       // lines per length
-  TimingPolicy policy;
+  int rounds = 3;             // vis_time: timed runs of each tree tuning ...
+  int naive_rounds = 2;       // ... and of the naive march (interleaved)
+  TimingPolicy policy;        // vis_zone
 };
 
 VisibilityConfig visibilityConfigFor(const std::string& mode) {
@@ -46,6 +48,7 @@ VisibilityConfig visibilityConfigFor(const std::string& mode) {
     c.time_k = 8;
     c.stats_k = 16;
     c.zone_steps = {1, 16, 256};
+    c.rounds = c.naive_rounds = 2;
     c.policy = {2, 2, 0.3};
     for (int n = 64; n <= 2048; n *= 2) c.scale_ns.push_back(n);
   } else {  // tiny: the smoke test
@@ -57,6 +60,7 @@ VisibilityConfig visibilityConfigFor(const std::string& mode) {
     c.zone_steps = {1, 16};
     c.scale_ns = {16, 32, 64};
     c.scale_lines = 4;
+    c.rounds = c.naive_rounds = 1;
     c.policy = {1, 1, 0.0};
   }
   return c;
@@ -75,9 +79,19 @@ struct NamedTuning {
   HullTreeTuning tuning;
 };
 
-// Algorithm 1 as written, the deferred writes alone, and the default (both optimisations).
+// Algorithm 1 as written, each optimisation added in turn: deferred writes, the replacement
+// check (the library's default), the safe zone.
+HullTreeTuning zoneTuning(int steps) {
+  HullTreeTuning t;
+  t.safe_zone = true;
+  t.safe_zone_steps = steps;
+  return t;
+}
 std::vector<NamedTuning> tunings() {
-  return {{"plain", {false, false, 16}}, {"deferred", {true, false, 16}}, {"default", HullTreeTuning{}}};
+  return {{"plain", {false, false, false, 16}},
+          {"deferred", {true, false, false, 16}},
+          {"default", HullTreeTuning{}},
+          {"zone", zoneTuning(16)}};
 }
 
 class VisibilitySuite {
@@ -153,32 +167,50 @@ class VisibilitySuite {
     return computeIntervisibility(context_, field, options, outputs).statistics;
   }
 
-  // Visible counts by every tree tuning and by the naive march, same K.
+  // Visible counts by every tree tuning and by the naive march, same K. The runs are
+  // interleaved (one of each method per round) so that a slow spell of the machine does
+  // not land on one method only; the naive march, the slowest, runs naive_rounds of them.
   void timeContent(const Content& content) {
     IntervisibilityOutputs outputs;
     outputs.visible_count = true;
+    std::vector<IntervisibilityOptions> methods;
     for (const NamedTuning& t : tunings()) {
-      IntervisibilityOptions options;
-      options.directions = config_.time_k;
-      options.tree = t.tuning;
-      const Timing timing = timed(content.field, options, outputs);
-      Row row = timingRow("vis_time", content, "tree", t.name, t.tuning.safe_zone ? t.tuning.safe_zone_steps : 0,
-                          config_.time_k, timing);
-      addStatistics(row, statisticsOf(content.field, config_.time_k, t.tuning));
-      out_.write(row);
-      say("[vis_time] %s tree (%s) K=%d: min %.3f s", content.label.c_str(), t.name.c_str(), config_.time_k,
-          timing.min());
+      methods.emplace_back();
+      methods.back().directions = config_.time_k;
+      methods.back().tree = t.tuning;
     }
-    IntervisibilityOptions naive;
-    naive.directions = config_.time_k;
-    naive.method = IntervisibilityMethod::Naive;
-    const Timing timing = timed(content.field, naive, outputs);
-    out_.write(timingRow("vis_time", content, "naive", "", 0, config_.time_k, timing));
-    say("[vis_time] %s naive K=%d: min %.3f s", content.label.c_str(), config_.time_k, timing.min());
+    methods.emplace_back();
+    methods.back().directions = config_.time_k;
+    methods.back().method = IntervisibilityMethod::Naive;
+    for (const auto& options : methods)  // builds and caches each program
+      computeIntervisibility(context_, crop(content.field, 64, 64), options, outputs);
+    std::vector<Timing> timings(methods.size());
+    for (int round = 0; round < config_.rounds; ++round) {
+      for (std::size_t i = 0; i < methods.size(); ++i) {
+        const bool naive = methods[i].method == IntervisibilityMethod::Naive;
+        if (naive && round >= config_.naive_rounds) continue;
+        const Timing one =
+            timeRepeated([&] { computeIntervisibility(context_, content.field, methods[i], outputs); }, {1, 1, 0.0});
+        timings[i].seconds.push_back(one.seconds[0]);
+        timings[i].cpu_seconds.push_back(one.cpu_seconds[0]);
+      }
+    }
+    for (std::size_t i = 0; i < methods.size(); ++i) {
+      const bool naive = methods[i].method == IntervisibilityMethod::Naive;
+      const HullTreeTuning& tuning = methods[i].tree;
+      const std::string name = naive ? "" : tunings()[i].name;
+      Row row = timingRow("vis_time", content, naive ? "naive" : "tree", name,
+                          !naive && tuning.safe_zone ? tuning.safe_zone_steps : 0, config_.time_k, timings[i]);
+      if (!naive) addStatistics(row, statisticsOf(content.field, config_.time_k, tuning));
+      out_.write(row);
+      say("[vis_time] %s %s %s K=%d: min %.3f s (%zu runs)", content.label.c_str(), naive ? "naive" : "tree",
+          name.c_str(), config_.time_k, timings[i].min(), timings[i].seconds.size());
+    }
   }
 
   void statistics(const Content& content) {
-    for (const NamedTuning& t : {tunings().front(), tunings().back()}) {
+    for (const NamedTuning& t : tunings()) {
+      if (t.name == "deferred") continue;  // the same iterations as plain
       Row row;
       row["section"] = "vis_stats";
       row["content"] = content.name;
@@ -202,9 +234,9 @@ class VisibilitySuite {
     for (int steps : config_.zone_steps) {
       IntervisibilityOptions options;
       options.directions = config_.time_k;
-      options.tree.safe_zone_steps = steps;
+      options.tree = zoneTuning(steps);
       const Timing timing = timed(content.field, options, outputs);
-      Row row = timingRow("vis_zone", content, "tree", "default", steps, config_.time_k, timing);
+      Row row = timingRow("vis_zone", content, "tree", "zone", steps, config_.time_k, timing);
       addStatistics(row, statisticsOf(content.field, config_.time_k, options.tree));
       out_.write(row);
       say("[vis_zone] %s zone %d steps: min %.3f s", content.label.c_str(), steps, timing.min());

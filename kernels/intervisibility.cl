@@ -24,12 +24,15 @@
 //   HFVIS_DEFERRED_WRITES   the tree walk with the old root's level in registers and link
 //                           writes only where a link changes (the aim of Algorithm 2); 0 =
 //                           Algorithm 1's walk as written, every relink stored at once
-//   HFVIS_SAFE_ZONE         the safe zone (Algorithm 3): a new sample that replaces the old
-//                           root without touching the rest of the tree skips the walk
-//                           (needs HFVIS_DEFERRED_WRITES)
+//   HFVIS_REPLACEMENT_CHECK the old root's last child is checked first (Sec. 7): when it
+//                           fails, every child fails and their own checks are skipped; when
+//                           it passes, the old root stays (needs HFVIS_DEFERRED_WRITES)
+//   HFVIS_SAFE_ZONE         the safe zone (Algorithm 3): a replaced old root whose children
+//                           stay as they are skips the walk (needs HFVIS_REPLACEMENT_CHECK)
 //   HFVIS_SAFE_ZONE_STEPS   steps past the receiver that one safe zone covers (a power of 2)
 // Every combination builds the same trees (tests/test_intervisibility.cpp): the options
 // change the work (iterations t, memory traffic), never a result.
+#include "fast_math.cl"
 #include "sweep_framework.cl"
 
 #ifndef HFVIS_WANT_AREA
@@ -50,14 +53,17 @@
 #ifndef HFVIS_DEFERRED_WRITES
 #define HFVIS_DEFERRED_WRITES 1
 #endif
+#ifndef HFVIS_REPLACEMENT_CHECK
+#define HFVIS_REPLACEMENT_CHECK 1
+#endif
 #ifndef HFVIS_SAFE_ZONE
-#define HFVIS_SAFE_ZONE 1
+#define HFVIS_SAFE_ZONE 0
 #endif
 #ifndef HFVIS_SAFE_ZONE_STEPS
 #define HFVIS_SAFE_ZONE_STEPS 16
 #endif
-#if HFVIS_SAFE_ZONE && !HFVIS_DEFERRED_WRITES
-#error "the safe zone works inside the deferred-writes walk"
+#if (HFVIS_REPLACEMENT_CHECK && !HFVIS_DEFERRED_WRITES) || (HFVIS_SAFE_ZONE && !HFVIS_REPLACEMENT_CHECK)
+#error "the safe zone needs the replacement check, which works inside the deferred-writes walk"
 #endif
 // Floats per entry of the bounce's line attributes: the radiance channels, then the unit normal.
 #define HFVIS_BOUNCE_STRIDE (HFVIS_CHANNELS + 3)
@@ -247,7 +253,7 @@ typedef struct {
 } BounceGather;
 
 HFVIS_INLINE float bounce_g(const BounceGather* g, float theta) {
-  float t = fmax(theta, g->tangent);
+  float t = hf_max(theta, g->tangent);
   float s = sin(t), c = cos(t);
   return g->nz_term * (s * s) + g->nh_term * (0.5f * (t + s * c));
 }
@@ -377,10 +383,10 @@ HFVIS_INLINE void safe_zone_add(SafeZone* z, float hc, int c, float hg, int g) {
   const float slope = (hc - hg) / (float)(c - g);
   const float at1 = hc + slope * (float)(z->first - c);
   const float at2 = hc + slope * (float)(z->last - c);
-  z->z1 = fmin(z->z1, at1);
-  z->z2 = fmin(z->z2, at2);
+  z->z1 = hf_min(z->z1, at1);
+  z->z2 = hf_min(z->z2, at2);
   // |rounding| of at1, at2 and of the interpolation stays within a few ulps of this.
-  z->margin = fmax(z->margin, fabs(hc) + fabs(slope) * (float)(z->last - c));
+  z->margin = hf_max(z->margin, fabs(hc) + fabs(slope) * (float)(z->last - c));
 }
 
 HFVIS_INLINE void safe_zone_begin(SafeZone* z, int receiver) {
@@ -403,8 +409,10 @@ HFVIS_INLINE int safe_zone_inside(const SafeZone* z, int step, float h) {
 
 // One work-item per line. Reads the presampled heights (lines[].x, left intact) and writes:
 //   lines[].y    the rank of the step: present samples before it (run lengths across holes),
+//                if HAS_NODATA (else there are no holes: see `holes`),
 //   visible[]    (visible samples, sum of their distances in steps), NaN where absent,
-//   prefix[]     sum of the steps of the present samples before it (mod 2^32), if AREA,
+//   prefix[]     sum of the steps of the present samples before it (mod 2^32), if AREA
+//                and HAS_NODATA,
 //   entry_stats[] (horizons m, iterations t, horizon hash, walk skipped by the safe zone), if ENTRY_STATS,
 //   line_totals[(b * totals_stride + j) * 8 + ...] (receivers, sum m, sum t, naive
 //                iterations, visible samples, walks skipped by the safe zone, 0, 0), if STATS,
@@ -451,9 +459,11 @@ __kernel void intervisibility_sweep(__global const SweepDirection* directions, _
   for (int step = 0; step < d.n_steps; ++step) {
     const uint e = (uint)step * stride;
     const float h = samples[e].x;
+#if HFVIS_HAS_NODATA  // ranks and step sums serve runs with holes only
     samples[e].y = (float)rank;
 #if HFVIS_WANT_AREA
     prefix[base + e] = step_sum;
+#endif
 #endif
     if (isnan(h)) {
       out[e] = (float2)(NAN, NAN);
@@ -481,7 +491,7 @@ __kernel void intervisibility_sweep(__global const SweepDirection* directions, _
       RootList list = {HFVIS_NONE, HFVIS_NONE, HFVIS_NONE, 0.0f};
       const int4 old_root = tree[(uint)root * stride];
       int walk = 1;
-#if HFVIS_SAFE_ZONE
+#if HFVIS_REPLACEMENT_CHECK
       // The last child first (Sec. 7): when it fails, every child fails (their slopes from
       // the old root fall toward it) and the old root is replaced; inside the safe zone
       // nothing else changes and the walk is skipped. When it passes, the old root stays.
@@ -490,6 +500,8 @@ __kernel void intervisibility_sweep(__global const SweepDirection* directions, _
         ++t;
         replaced = chord_side(tail_h, h_prev, h, (float)(root - tail), (float)(step - root)) <= 0;
       }
+#endif
+#if HFVIS_SAFE_ZONE
       zone_valid = zone_valid && replaced && safe_zone_inside(&zone, step, h);
       if (zone_valid) {
         // The old root's children are the new root's; the old root follows them if it is
@@ -504,7 +516,8 @@ __kernel void intervisibility_sweep(__global const SweepDirection* directions, _
           root_append(tree, stride, &list, root, h_prev, HFVIS_NONE);
         }
       }
-#else
+#endif
+#if !HFVIS_REPLACEMENT_CHECK
       const int replaced = 0;  // not known
 #endif
       if (walk) {
@@ -516,7 +529,7 @@ __kernel void intervisibility_sweep(__global const SweepDirection* directions, _
         while (c != HFVIS_NONE) {
           const int4 child = tree[(uint)c * stride];
           if (!replaced) {
-            if (HFVIS_SAFE_ZONE && c == tail) break;  // known to pass
+            if (HFVIS_REPLACEMENT_CHECK && c == tail) break;  // known to pass
             ++t;
             if (chord_side(as_float(child.x), h_prev, h, (float)(root - c), (float)(step - root)) > 0) break;
           }
@@ -586,7 +599,9 @@ __kernel void intervisibility_sweep(__global const SweepDirection* directions, _
           end = np;
           end_rank = np_rank;
         }
-        const int holes = end_rank - hp_rank != end - hp;
+        // Absent samples lie between present ones only where heights are missing: a line
+        // enters and leaves the (convex) field once.
+        const int holes = HFVIS_HAS_NODATA && end_rank - hp_rank != end - hp;
         if (np != HFVIS_NONE) {
           end = run_end(samples, stride, hp, np, as_float(nz.x), step, h, holes);
           end_rank = end == np ? np_rank : holes ? (int)samples[(uint)end * stride].y : hp_rank + (end - hp);

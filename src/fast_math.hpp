@@ -8,6 +8,10 @@ namespace hfvis::detail {
 
 constexpr float kPiF = 3.14159265358979323846f;
 
+// Mirrors of hf_min / hf_max (compare and select).
+inline float hfMin(float a, float b) { return a < b ? a : b; }
+inline float hfMax(float a, float b) { return a > b ? a : b; }
+
 inline float hfAtan(float x) {
   const float a = std::fabs(x);
   const bool big = a > 2.414213562373095f;

@@ -25,7 +25,8 @@ std::string treeProgramOptions(const TreeProgramFlags& f, const DeviceInfo& devi
   s << "-DHFVIS_HAS_NODATA=" << f.has_nodata << " -DHFVIS_WANT_AREA=" << f.area
     << " -DHFVIS_WANT_STATS=" << f.stats << " -DHFVIS_WANT_ENTRY_STATS=" << f.entry_stats << " "
     << layoutProgramOption(device);
-  s << " -DHFVIS_DEFERRED_WRITES=" << f.tuning.deferred_writes << " -DHFVIS_SAFE_ZONE=" << f.tuning.safe_zone
+  s << " -DHFVIS_DEFERRED_WRITES=" << f.tuning.deferred_writes
+    << " -DHFVIS_REPLACEMENT_CHECK=" << f.tuning.replacement_check << " -DHFVIS_SAFE_ZONE=" << f.tuning.safe_zone
     << " -DHFVIS_SAFE_ZONE_STEPS=" << f.tuning.safe_zone_steps;
   if (f.bounce_channels > 0) s << " -DHFVIS_WANT_BOUNCE=1 -DHFVIS_CHANNELS=" << f.bounce_channels;
   return s.str();
@@ -95,13 +96,15 @@ IntervisibilityResult run(const ComputeContext& context, const HeightField& fiel
   for (const auto& d : all) max_lines = std::max(max_lines, d.n_lines);
 
   const bool want_pixels = outputs.visible_count || outputs.visible_area;
+  // Step sums for the area across holes, which only nodata makes.
+  const bool want_prefix = outputs.visible_area && prepared.has_nodata;
   SweepMemory memory;
   // Heights, and the accumulators: the count (also when only the area is asked for: the
   // reduction writes both) and the area.
   memory.fixed_bytes = plane * sizeof(float) * (1 + want_pixels + outputs.visible_area);
   if (tree) {
     memory.bytes_per_entry =
-        kTreeLineBytes + kTreeNodeBytes + kTreeVisibleBytes + (outputs.visible_area ? kTreePrefixBytes : 0);
+        kTreeLineBytes + kTreeNodeBytes + kTreeVisibleBytes + (want_prefix ? kTreePrefixBytes : 0);
     memory.largest_entry_bytes = kTreeNodeBytes;
     memory.bytes_per_direction = outputs.statistics ? max_lines * kTreeLineTotals * sizeof(cl_ulong) : 0;
   }
@@ -126,7 +129,7 @@ IntervisibilityResult run(const ComputeContext& context, const HeightField& fiel
     buffers.lines = deviceBuffer(st, max_entries * kTreeLineBytes);
     buffers.trees = deviceBuffer(st, max_entries * kTreeNodeBytes);
     buffers.visible = deviceBuffer(st, max_entries * kTreeVisibleBytes);
-    buffers.prefix = deviceBuffer(st, outputs.visible_area ? max_entries * kTreePrefixBytes : 0);
+    buffers.prefix = deviceBuffer(st, want_prefix ? max_entries * kTreePrefixBytes : 0);
     buffers.entry_stats = deviceBuffer(st, 0);
     buffers.totals_stride = max_lines;
     buffers.line_totals = deviceBuffer(

@@ -10,8 +10,11 @@
 namespace hfvis {
 
 void validate(const HullTreeTuning& tuning) {
-  if (tuning.safe_zone && !tuning.deferred_writes) {
-    throw InvalidArgument("the safe zone needs the deferred-writes walk (it works inside it)");
+  if (tuning.replacement_check && !tuning.deferred_writes) {
+    throw InvalidArgument("the replacement check needs the deferred-writes walk (it works inside it)");
+  }
+  if (tuning.safe_zone && !tuning.replacement_check) {
+    throw InvalidArgument("the safe zone needs the replacement check");
   }
   const int z = tuning.safe_zone_steps;
   if (z < 1 || z > 4096 || (z & (z - 1)) != 0) {

@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "chord_side.hpp"
+#include "fast_math.hpp"
 #include "hfvis/bounce.hpp"
 #include "hfvis/errors.hpp"
 #include "horizon_common.hpp"
@@ -124,7 +125,7 @@ class BounceGather {
 
  private:
   float g(float theta) const {
-    const float t = std::fmax(theta, tangent_);
+    const float t = hfMax(theta, tangent_);
     const float s = std::sin(t), c = std::cos(t);
     return nz_term_ * (s * s) + nh_term_ * (0.5f * (t + s * c));
   }
@@ -198,9 +199,9 @@ struct SafeZone {
     const float slope = (hc - hg) / static_cast<float>(c - g);
     const float at1 = hc + slope * static_cast<float>(first - c);
     const float at2 = hc + slope * static_cast<float>(last - c);
-    z1 = std::fmin(z1, at1);
-    z2 = std::fmin(z2, at2);
-    margin = std::fmax(margin, std::fabs(hc) + std::fabs(slope) * static_cast<float>(last - c));
+    z1 = hfMin(z1, at1);
+    z2 = hfMin(z2, at2);
+    margin = hfMax(margin, std::fabs(hc) + std::fabs(slope) * static_cast<float>(last - c));
   }
   void end() { margin = margin * 0x1p-16f + 0x1p-100f; }
   bool inside(int step, float h) const {
@@ -251,12 +252,12 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
       const Node old_root = tree[root];
       bool walk = true;
       bool replaced = false;
+      if (tuning.replacement_check && tail != kNone) {
+        ++t;
+        replaced =
+            chordSide(tail_h, h_prev, h, static_cast<float>(root - tail), static_cast<float>(step - root)) <= 0;
+      }
       if (tuning.safe_zone) {
-        if (tail != kNone) {
-          ++t;
-          replaced =
-              chordSide(tail_h, h_prev, h, static_cast<float>(root - tail), static_cast<float>(step - root)) <= 0;
-        }
         zone_valid = zone_valid && replaced && zone.inside(step, h);
         if (zone_valid) {
           walk = false;
@@ -276,7 +277,7 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
           while (c != kNone) {
             const Node child = tree[c];
             if (!replaced) {
-              if (tuning.safe_zone && c == tail) break;
+              if (tuning.replacement_check && c == tail) break;
               ++t;
               if (chordSide(child.h, h_prev, h, static_cast<float>(root - c), static_cast<float>(step - root)) >
                   0)

@@ -33,10 +33,15 @@ struct HullTreeTuning {
   // changes (the aim of Timonen 2013's Algorithm 2: postponed, consolidated linkage
   // writes). false = Algorithm 1's walk as written, every relink stored at once.
   bool deferred_writes = true;
-  // The safe zone (Sec. 7, Algorithm 3): the old root's last child is checked first; when
-  // it fails the old root is replaced, and a new sample inside the zone skips the walk.
-  // Needs deferred_writes (it works inside that walk, as Algorithm 3 inside Algorithm 2).
-  bool safe_zone = true;
+  // The old root's last child is checked first (Sec. 7): when it fails every child fails,
+  // the old root is replaced and the children's own checks are skipped; when it passes the
+  // old root stays. Needs deferred_writes (it works inside that walk).
+  bool replacement_check = true;
+  // The safe zone (Sec. 7, Algorithm 3): a replaced old root whose children stay as they are
+  // (the new sample lies in the zone below every child's edge to its first child) skips the
+  // walk. Needs replacement_check. Off by default: on CPUs, keeping the zone up to date cost
+  // more than the walks it skipped (bench/report/REPORT.md).
+  bool safe_zone = false;
   // Steps past the receiver one safe zone covers before it is recomputed: a power of two,
   // 1 .. 4096.
   int safe_zone_steps = 16;
@@ -91,8 +96,8 @@ struct IntervisibilityResult {
   IntervisibilityStatistics statistics;  // if asked
 };
 
-// Throws InvalidArgument for a safe zone without deferred writes, or a safe_zone_steps that
-// is not a power of two in 1 .. 4096.
+// Throws InvalidArgument for a replacement check without deferred writes, a safe zone
+// without the replacement check, or a safe_zone_steps that is not a power of two in 1 .. 4096.
 void validate(const HullTreeTuning& tuning);
 
 // Throws InvalidArgument for bad sweep options (see sweep_options.hpp), a bad tree tuning,
