@@ -1,13 +1,16 @@
 #!/usr/bin/env bash
 # bench/run_report.sh: the one command behind the benchmark report. Builds hfvis_bench
 # (Release) if needed, generates the input fields into bench/out/ (git-ignored), runs the
-# suite and writes the report: results.csv (every measurement), environment.txt, REPORT.md
-# and the PNG plots.
+# two suites and writes the report: results.csv and environment.txt (horizons),
+# visibility.csv and visibility_environment.txt (intervisibility), REPORT.md and the PNG
+# plots.
 #
-#   bench/run_report.sh            full suite (under 30 minutes on the 2-core test machine)
-#                                  -> bench/report/
+#   bench/run_report.sh            both suites, full size (about 45 minutes on the 2-core test
+#                                  machine) -> bench/report/
 #   bench/run_report.sh --quick    smaller sizes (under 3 minutes) -> bench/out/report-quick/
-#   options: --out DIR (report directory), BUILD_DIR=... (default build/)
+#   options: --out DIR (report directory), BUILD_DIR=... (default build/),
+#            --only horizon|visibility  run one suite; REPORT.md keeps the other suite's
+#                                       results already in the report directory
 #
 # Needs the build dependencies (scripts/install-deps.sh) and Debian's python3 with numpy and
 # matplotlib (python3-numpy, python3-matplotlib); nothing from pip.
@@ -16,11 +19,15 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 mode=full
 report_dir=""
+only=""
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --quick) mode=quick ;;
     --out) report_dir=$2; shift ;;
-    -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
+    --only)
+      only=$2; shift
+      [[ $only == horizon || $only == visibility ]] || { echo "run_report.sh: --only horizon or visibility" >&2; exit 2; } ;;
+    -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
     *) echo "run_report.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
   shift
@@ -55,10 +62,17 @@ done
 commit=$(git -C "$root" rev-parse --short HEAD 2> /dev/null || echo unknown)
 if ! git -C "$root" diff --quiet HEAD 2> /dev/null; then commit="$commit (with uncommitted changes)"; fi
 
-echo "== running the $mode suite (log: bench/out/suite-$mode.log)"
 mkdir -p "$report_dir"
-"$bench" suite $flag --data "$data_dir" --dem "$root/data/jacksboro_fault_dem.exr" --out "$report_dir" \
-  --cache "$root/bench/out/truth" --commit "$commit" | tee "$root/bench/out/suite-$mode.log"
+if [[ $only != visibility ]]; then
+  echo "== running the $mode horizon suite (log: bench/out/suite-$mode.log)"
+  "$bench" suite $flag --data "$data_dir" --dem "$root/data/jacksboro_fault_dem.exr" --out "$report_dir" \
+    --cache "$root/bench/out/truth" --commit "$commit" | tee "$root/bench/out/suite-$mode.log"
+fi
+if [[ $only != horizon ]]; then
+  echo "== running the $mode intervisibility suite (log: bench/out/visibility-$mode.log)"
+  "$bench" visibility $flag --data "$data_dir" --dem "$root/data/jacksboro_fault_dem.exr" --out "$report_dir" \
+    --commit "$commit" | tee "$root/bench/out/visibility-$mode.log"
+fi
 
 echo "== writing the report"
 "$python" "$root/bench/make_report.py" "$report_dir" --total-seconds $(( $(date +%s) - start ))
