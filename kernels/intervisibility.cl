@@ -313,7 +313,7 @@ HFVIS_INLINE void bounce_finish(BounceGather* g, __global float* irradiance) {
 // their old order, the common case) is not written again.
 typedef struct {
   int head, tail, tail_next;
-  float tail_h;  // the last child's height (the safe zone's last-child check reads it)
+  float tail_h;  // the last child's height (the replacement check reads it)
 } RootList;
 
 HFVIS_INLINE void root_append(__global int4* tree, uint stride, RootList* list, int x, float hx,

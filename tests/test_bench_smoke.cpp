@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <set>
 #include <sstream>
 #include <string>
@@ -113,6 +114,47 @@ TEST_F(BenchSmoke, TinySuiteMeasuresEveryMethodInEverySection) {
     EXPECT_TRUE(methods.count(m)) << "no rows for method " << m;
   EXPECT_GT(rows_with_errors, 0);
   EXPECT_TRUE(fs::exists(dir_ / "report" / "environment.txt"));
+}
+
+// The intervisibility suite on tiny fields: every section, every tuning, the naive march;
+// statistics are present and the tunings agree on the horizons (they change only the work).
+TEST_F(BenchSmoke, TinyVisibilitySuiteMeasuresEverySection) {
+  const fs::path log = dir_ / "visibility.log";
+  ASSERT_EQ(runBench("visibility --tiny --out '" + (dir_ / "report").string() + "'", log), 0) << readText(log);
+  std::ifstream csv(dir_ / "report" / "visibility.csv");
+  std::string line;
+  ASSERT_TRUE(std::getline(csv, line));
+  const std::vector<std::string> columns = splitCsv(line);
+  auto column = [&](const std::string& name) {
+    for (std::size_t i = 0; i < columns.size(); ++i)
+      if (columns[i] == name) return i;
+    ADD_FAILURE() << "visibility.csv has no column " << name;
+    return std::size_t{0};
+  };
+  const std::size_t section = column("section"), method = column("method"), tuning = column("tuning");
+  const std::size_t content = column("content"), m_a = column("m_a"), over = column("lines_over_bound");
+  std::set<std::string> sections, methods, tunings;
+  std::map<std::string, std::string> horizons;  // vis_time content -> m_a of every tuning
+  while (std::getline(csv, line)) {
+    const auto f = splitCsv(line);
+    ASSERT_EQ(f.size(), columns.size()) << line;
+    sections.insert(f[section]);
+    methods.insert(f[method]);
+    if (!f[tuning].empty()) tunings.insert(f[tuning]);
+    if (f[method] == "tree") {
+      ASSERT_FALSE(f[m_a].empty()) << line;
+      EXPECT_EQ(f[over], "0") << line;
+      if (f[section] == "vis_time") {
+        auto [it, fresh] = horizons.emplace(f[content], f[m_a]);
+        EXPECT_EQ(it->second, f[m_a]) << "tunings disagree on m_a: " << line;
+      }
+    }
+  }
+  for (const char* s : {"vis_time", "vis_stats", "vis_zone", "vis_scale"})
+    EXPECT_TRUE(sections.count(s)) << "no rows for section " << s;
+  EXPECT_TRUE(methods.count("naive"));
+  for (const char* t : {"plain", "deferred", "default", "zone"}) EXPECT_TRUE(tunings.count(t)) << t;
+  EXPECT_TRUE(fs::exists(dir_ / "report" / "visibility_environment.txt"));
 }
 
 }  // namespace
