@@ -170,14 +170,9 @@ int runVisibilityOne(Arguments& args) {
   options.method = method == "tree" ? IntervisibilityMethod::HullTree : IntervisibilityMethod::Naive;
   options.directions = static_cast<int>(number(args.get("-k", "16"), "-k"));
   const std::string tuning = args.get("--tuning", "default");
-  if (tuning == "plain")
-    options.tree.deferred_writes = options.tree.replacement_check = false;
-  else if (tuning == "deferred")
-    options.tree.replacement_check = false;
-  else if (tuning == "zone")
-    options.tree.safe_zone = true;
-  else if (tuning != "default")
-    throw Usage("--tuning: plain, deferred, default or zone");
+  const auto named = hullTreeTuningNamed(tuning);
+  if (!named) throw Usage("--tuning: plain, deferred, default or zone");
+  options.tree = *named;
   options.tree.safe_zone_steps = static_cast<int>(number(args.get("--zone-steps", "16"), "--zone-steps"));
   TimingPolicy policy;
   policy.min_reps = policy.max_reps = static_cast<int>(number(args.get("--reps", "3"), "--reps"));

@@ -79,19 +79,18 @@ struct NamedTuning {
   HullTreeTuning tuning;
 };
 
-// Algorithm 1 as written, each optimisation added in turn: deferred writes, the replacement
-// check (the library's default), the safe zone.
 HullTreeTuning zoneTuning(int steps) {
-  HullTreeTuning t;
-  t.safe_zone = true;
+  HullTreeTuning t = *hullTreeTuningNamed("zone");
   t.safe_zone_steps = steps;
   return t;
 }
+
+// Algorithm 1 as written, each optimisation added in turn: deferred writes, the replacement
+// check (the library's default), the safe zone.
 std::vector<NamedTuning> tunings() {
-  return {{"plain", {false, false, false, 16}},
-          {"deferred", {true, false, false, 16}},
-          {"default", HullTreeTuning{}},
-          {"zone", zoneTuning(16)}};
+  std::vector<NamedTuning> all;
+  for (const char* name : {"plain", "deferred", "default", "zone"}) all.push_back({name, *hullTreeTuningNamed(name)});
+  return all;
 }
 
 class VisibilitySuite {

@@ -32,6 +32,7 @@ enum class Option {
   Preview,
   DistanceOutput,
   Statistics,
+  HullTree,
   At,
   Radiance,
   Quiet,
@@ -59,6 +60,7 @@ constexpr OptionSpec kOptions[] = {
     {Option::Preview, "--preview", nullptr, true},
     {Option::DistanceOutput, "--distance-out", nullptr, true},
     {Option::Statistics, "--stats", nullptr, false},
+    {Option::HullTree, "--hull-tree", nullptr, true},
     {Option::At, "--at", nullptr, true},
     {Option::Radiance, "--radiance", nullptr, true},
     {Option::Quiet, "--quiet", "-q", false},
@@ -195,6 +197,7 @@ bool notFor(Option option, Command command) {
     return option == Option::Method || option == Option::LinesPerUnit || option == Option::Device ||
            option == Option::MemoryBudget || option == Option::Preview;
   }
+  if (option == Option::HullTree) return command != Command::ViewCount && command != Command::Bounce;
   return command == Command::Bounce && option == Option::Method;
 }
 
@@ -287,6 +290,14 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
       break;
     case Option::Statistics:
       run.statistics = true;
+      break;
+    case Option::HullTree:
+      if (const auto tuning = hullTreeTuningNamed(value)) {
+        run.hull_tree = *tuning;
+        run.hull_tree_name = value;
+      } else {
+        throw UsageError(typed + ": expected plain, deferred, default or zone, got " + inQuotes(value));
+      }
       break;
     case Option::At:
       run.receivers.push_back(parseReceiver(typed, value));
@@ -525,6 +536,7 @@ IntervisibilityOptions intervisibilityOptions(const RunArguments& run) {
   IntervisibilityOptions options;
   setSweepOptions(run, options);
   options.method = run.visibility_method;
+  options.tree = run.hull_tree;
   return options;
 }
 
@@ -545,6 +557,7 @@ SweepOptions horizonListOptions(const RunArguments& run) {
 BounceOptions bounceOptions(const RunArguments& run) {
   BounceOptions options;
   setSweepOptions(run, options);
+  options.tree = run.hull_tree;
   return options;
 }
 

@@ -68,9 +68,16 @@ const char* const kViewCount = R"(
 Viewcount:
   --stats                  also print, for the tree method, the statistics of seed 000's
                            Table 2 per point and direction: m_a (visibility horizons), t_a
-                           (convexity iterations), visible samples and naive iterations (the
+                           (convexity checks made), visible samples and naive iterations (the
                            samples the naive method tests); also stored as hfvis:stats_* EXR
-                           attributes. Printed even with --quiet.
+                           attributes. Printed even with --quiet. Table 2's t_a is Algorithm
+                           1's: add --hull-tree plain.
+  --hull-tree T            (viewcount and bounce) how the convex hull tree does its work; the
+                           results are the same for every T: plain = Algorithm 1 as written,
+                           deferred = link writes only where a link changes (Algorithm 2's
+                           aim), default = deferred + the old root's last child checked
+                           first, zone = default + the safe zone (Algorithm 3) (default:
+                           default)
   Tie rule   along direction k a pixel sees the samples q_i = p + i/S * d_k (S samples per
              unit, bilinear heights, inside the field); q is visible when its slope from p is
              >= the slope of every sample between them (grazing samples are visible: on a flat

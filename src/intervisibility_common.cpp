@@ -9,6 +9,20 @@
 
 namespace hfvis {
 
+std::optional<HullTreeTuning> hullTreeTuningNamed(const std::string& name) {
+  HullTreeTuning t;
+  if (name == "plain") {
+    t.deferred_writes = t.replacement_check = false;
+  } else if (name == "deferred") {
+    t.replacement_check = false;
+  } else if (name == "zone") {
+    t.safe_zone = true;
+  } else if (name != "default") {
+    return std::nullopt;
+  }
+  return t;
+}
+
 void validate(const HullTreeTuning& tuning) {
   if (tuning.replacement_check && !tuning.deferred_writes) {
     throw InvalidArgument("the replacement check needs the deferred-writes walk (it works inside it)");

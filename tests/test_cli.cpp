@@ -623,6 +623,36 @@ TEST_F(Cli, ViewcountStatistics) {
       2, "--stats");
 }
 
+// --hull-tree changes the work (t_a), never the counts; Algorithm 1 as written ("plain")
+// makes at least as many checks as the default minus one per receiver (see
+// tests/test_intervisibility.cpp), on this terrain many more.
+TEST_F(Cli, ViewcountHullTreeTuningsGiveTheSameCounts) {
+  const std::string dem = std::string(HFVIS_DATA_DIR) + "/fractal_256.exr";
+  std::vector<std::vector<float>> counts;
+  std::vector<double> t_a;
+  for (const char* tuning : {"plain", "deferred", "default", "zone"}) {
+    const std::string file = out(std::string(tuning) + ".exr");
+    const CliResult result = run("viewcount " + shellQuoted(dem) + " -o " + shellQuoted(file) +
+                                 " -k 4 --stats --quiet --hull-tree " + tuning);
+    ASSERT_EQ(result.status, 0) << tuning << ": " << result.err;
+    EXPECT_NE(result.out.find(std::string("(--hull-tree ") + tuning + ")"), std::string::npos) << result.out;
+    const ReadBack image = readBack(file);
+    counts.emplace_back();
+    for (int y = 0; y < image.height; ++y)
+      for (int x = 0; x < image.width; ++x) counts.back().push_back(image.at(x, y, 0));
+    t_a.push_back(std::stod(image.spec.get_string_attribute("hfvis:stats_t_a")));
+  }
+  for (std::size_t i = 1; i < counts.size(); ++i) EXPECT_EQ(counts[i], counts[0]) << "tuning " << i;
+  EXPECT_EQ(t_a[1], t_a[0]);         // deferred writes: the same checks
+  EXPECT_LT(t_a[2], 0.9 * t_a[0]);   // the replacement check saves many
+  EXPECT_LE(t_a[3], t_a[2]);         // the safe zone skips walks
+  for (const char* tuning : {"plain", "deferred", "default", "zone"}) fs::remove(out(std::string(tuning) + ".exr"));
+  const std::string base = "viewcount " + shellQuoted(dem) + " -o " + shellQuoted(out("bad.exr"));
+  expectFailure(run(base + " --hull-tree fast"), 2, "--hull-tree");
+  expectFailure(run("svf " + shellQuoted(dem) + " -o " + shellQuoted(out("bad.exr")) + " --hull-tree plain"), 2,
+                "--hull-tree");
+}
+
 TEST_F(Cli, ViewcountOptionsAreChecked) {
   const std::string base = "viewcount " + shellQuoted(ramp()) + " -o " + shellQuoted(out("o.exr"));
   expectFailure(run(base + " --method sweep"), 2, "'sweep'");

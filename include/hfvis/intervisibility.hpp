@@ -12,6 +12,8 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "hfvis/device.hpp"
@@ -46,6 +48,11 @@ struct HullTreeTuning {
   // 1 .. 4096.
   int safe_zone_steps = 16;
 };
+
+// The named tunings the CLI (--hull-tree) and the benchmark offer: "plain" (Algorithm 1 as
+// written: every option off), "deferred" (deferred_writes only), "default" (HullTreeTuning{})
+// and "zone" (the default with the safe zone). std::nullopt for any other name.
+std::optional<HullTreeTuning> hullTreeTuningNamed(const std::string& name);
 
 struct IntervisibilityOptions : SweepOptions {
   IntervisibilityMethod method = IntervisibilityMethod::HullTree;
