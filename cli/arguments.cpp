@@ -353,6 +353,10 @@ void validateRun(Command command, const RunArguments& run) {
   if (!run.preview.empty() && !run.distance_output.empty() && samePath(run.preview, run.distance_output)) {
     throw UsageError("--preview must differ from --distance-out, both are " + inQuotes(run.preview));
   }
+  if (command == Command::ViewCount && !run.hull_tree_name.empty() &&
+      run.visibility_method != IntervisibilityMethod::HullTree) {
+    throw UsageError("--hull-tree needs --method tree (the naive method builds no tree)");
+  }
   try {
     switch (command) {
       case Command::ViewCount:

@@ -52,7 +52,7 @@ struct RunArguments {
   IntervisibilityMethod visibility_method = IntervisibilityMethod::HullTree;  // viewcount
   bool statistics = false;                                                    // viewcount --stats
   HullTreeTuning hull_tree;                                                   // viewcount, bounce
-  std::string hull_tree_name = "default";                                     // --hull-tree
+  std::string hull_tree_name;  // --hull-tree as given; "" = not given (the default tuning)
   std::vector<ReceiverPixel> receivers;  // horizons --at, in the order given
   std::string radiance;                  // bounce --radiance
   double cell_size_x = 0.0;              // <= 0: from the file, else 1

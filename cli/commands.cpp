@@ -494,7 +494,7 @@ int runViewCount(const RunArguments& run) {
     attributes.emplace_back("hfvis:stats_receivers", std::to_string(stats.receivers));
     stats_line = "statistics per point and direction (Timonen 2013, Table 2): m_a " +
                  formatFixed(stats.meanHorizons(), 3) + ", t_a " + formatFixed(stats.meanIterations(), 3) +
-                 " (--hull-tree " + run.hull_tree_name + ")" +
+                 " (--hull-tree " + (run.hull_tree_name.empty() ? "default" : run.hull_tree_name) + ")" +
                  ", visible " + formatFixed(stats.meanVisible(), 3) + ", naive iterations " +
                  formatFixed(stats.meanNaiveIterations(), 3) + " (" + std::to_string(stats.receivers) +
                  " line samples, " + std::to_string(stats.lines_over_bound) + " lines over t <= 2m + n)";

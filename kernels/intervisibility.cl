@@ -494,7 +494,8 @@ __kernel void intervisibility_sweep(__global const SweepDirection* directions, _
 #if HFVIS_REPLACEMENT_CHECK
       // The last child first (Sec. 7): when it fails, every child fails (their slopes from
       // the old root fall toward it) and the old root is replaced; inside the safe zone
-      // nothing else changes and the walk is skipped. When it passes, the old root stays.
+      // nothing else changes and the walk is skipped (a walk leaves the zone invalid: it
+      // runs only when the zone is). When it passes, the old root stays.
       int replaced = 0;
       if (tail != HFVIS_NONE) {
         ++t;
@@ -504,17 +505,13 @@ __kernel void intervisibility_sweep(__global const SweepDirection* directions, _
 #if HFVIS_SAFE_ZONE
       zone_valid = zone_valid && replaced && safe_zone_inside(&zone, step, h);
       if (zone_valid) {
-        // The old root's children are the new root's; the old root follows them if it is
-        // a leaf (the line's first sample), else it is deleted.
+        // The old root's children are the new root's, and the old root is deleted (it is
+        // no leaf: only a line's first sample is a leaf as root, and it has no children).
         walk = 0;
         skipped = 1;
         list.head = head;
         list.tail = tail;
         list.tail_h = tail_h;
-        if (old_root.y & HFVIS_LEAF) {
-          tree[(uint)root * stride].z = HFVIS_NONE;
-          root_append(tree, stride, &list, root, h_prev, HFVIS_NONE);
-        }
       }
 #endif
 #if !HFVIS_REPLACEMENT_CHECK
@@ -542,9 +539,6 @@ __kernel void intervisibility_sweep(__global const SweepDirection* directions, _
         }
 #else
         t += hull_tree_walk(tree, stride, root, old_root, h, step, &list);
-#endif
-#if HFVIS_SAFE_ZONE
-        zone_valid = 0;
 #endif
       }
 

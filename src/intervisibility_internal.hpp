@@ -33,7 +33,7 @@ struct IntervisibilityLines {
   std::vector<float> counts;                  // visible samples (farther along the line)
   std::vector<float> distance_sums;           // sum of their distances, in steps
   std::vector<std::uint32_t> horizons;        // m_i: distinct visibility horizons
-  std::vector<std::uint32_t> iterations;      // t_i: convexity checks of Algorithm 1
+  std::vector<std::uint32_t> iterations;      // t_i: convexity checks made (by the tuning)
   std::vector<std::uint32_t> horizon_hashes;  // FNV-1a over the horizons' steps, farthest first
   std::vector<std::uint32_t> walks_skipped;   // 1 where the safe zone skipped the walk
   // Reference only, when asked: the horizons' steps, farthest first, and where each one's

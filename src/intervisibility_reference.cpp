@@ -265,10 +265,6 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
           list.head = head;
           list.tail = tail;
           list.tail_h = tail_h;
-          if (old_root.leaf) {
-            tree[root].first = kNone;
-            list.append(tree, deferred, root, h_prev, kNone);
-          }
         }
       }
       if (walk) {
@@ -293,7 +289,6 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
         } else {
           t += hullTreeWalk(tree, deferred, root, old_root, h, step, list);
         }
-        zone_valid = false;
       }
 
       // 2. Eq. 1 for the old root; a segment start's node becomes (or is re-created as) a

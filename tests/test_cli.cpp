@@ -649,6 +649,7 @@ TEST_F(Cli, ViewcountHullTreeTuningsGiveTheSameCounts) {
   for (const char* tuning : {"plain", "deferred", "default", "zone"}) fs::remove(out(std::string(tuning) + ".exr"));
   const std::string base = "viewcount " + shellQuoted(dem) + " -o " + shellQuoted(out("bad.exr"));
   expectFailure(run(base + " --hull-tree fast"), 2, "--hull-tree");
+  expectFailure(run(base + " --hull-tree plain --method naive"), 2, "--hull-tree");
   expectFailure(run("svf " + shellQuoted(dem) + " -o " + shellQuoted(out("bad.exr")) + " --hull-tree plain"), 2,
                 "--hull-tree");
 }

@@ -29,7 +29,8 @@ enum class IntervisibilityMethod {
 
 // How the convex hull tree sweep does its work. Every setting builds the same trees and gives
 // the same results (horizons, counts, areas, bounce); they change only the work done: the
-// convexity checks t and the memory traffic (bench/report/REPORT.md measures each).
+// convexity checks t and the links written (bench/report/REPORT.md measures the time and t
+// of each).
 struct HullTreeTuning {
   // The walk keeps the old root's level in registers and writes a link only where it
   // changes (the aim of Timonen 2013's Algorithm 2: postponed, consolidated linkage
@@ -41,8 +42,8 @@ struct HullTreeTuning {
   bool replacement_check = true;
   // The safe zone (Sec. 7, Algorithm 3): a replaced old root whose children stay as they are
   // (the new sample lies in the zone below every child's edge to its first child) skips the
-  // walk. Needs replacement_check. Off by default: on CPUs, keeping the zone up to date cost
-  // more than the walks it skipped (bench/report/REPORT.md).
+  // walk. Needs replacement_check. Off by default: it skips up to two thirds of the walks
+  // but showed no measurable gain in time on a CPU (bench/report/REPORT.md).
   bool safe_zone = false;
   // Steps past the receiver one safe zone covers before it is recomputed: a power of two,
   // 1 .. 4096.
@@ -81,7 +82,7 @@ struct IntervisibilityStatistics {
   std::uint64_t lines = 0;             // lines with at least one present sample
   std::uint64_t horizons = 0;          // sum of m_i: distinct visibility horizons
   std::uint64_t iterations = 0;        // sum of t_i: convexity checks made (Algorithm 1's with
-                                       // tree.safe_zone off, fewer with it)
+                                       // hullTreeTuningNamed("plain"), fewer by default)
   std::uint64_t visible_samples = 0;   // sum of visible samples (Table 1's p_a * receivers)
   std::uint64_t naive_iterations = 0;  // samples the naive method would test on the same lines
   std::uint64_t lines_over_bound = 0;  // lines where t > 2m + n (Section 6 proves none)
