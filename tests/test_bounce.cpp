@@ -180,14 +180,7 @@ TEST(BounceLine, ReferenceEqualsBruteForceOnLongRandomLinesAndDenseSampling) {
   std::mt19937 rng(3);
   for (int kind = 0; kind < 3; ++kind) {
     const int w = 201, h = 4;
-    std::vector<float> heights(w * h);
-    float walk = 0.0f;
-    for (auto& v : heights) {
-      if (kind == 0) v = float(std::uniform_int_distribution<int>(0, 3)(rng));
-      if (kind == 1) v = walk += std::uniform_real_distribution<float>(-1.0f, 1.0f)(rng);
-      if (kind == 2) v = std::uniform_real_distribution<float>(0.0f, 30.0f)(rng);
-    }
-    const HeightField field = fieldFrom(w, h, heights);
+    const HeightField field = fieldFrom(w, h, testing::randomLineHeights(kind, w, h, 30.0f, rng));
     const auto inputs = detail::prepareBounce(field, randomRadiance(field, 2, kind));
     for (double azimuth : {0.0, M_PI, 0.05}) {
       SCOPED_TRACE("kind " + std::to_string(kind) + " azimuth " + std::to_string(azimuth));

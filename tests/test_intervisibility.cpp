@@ -370,15 +370,7 @@ TEST(IntervisibilityLine, TreeEqualsBruteForceOnLongRandomLines) {
   std::uint64_t checked = 0;
   for (int kind = 0; kind < 4; ++kind) {
     const int w = 301, h = 5;
-    std::vector<float> heights(w * h);
-    float walk = 0.0f;
-    for (auto& v : heights) {
-      if (kind == 0) v = float(std::uniform_int_distribution<int>(0, 3)(rng));
-      if (kind == 1) v = walk += std::uniform_real_distribution<float>(-1.0f, 1.0f)(rng);
-      if (kind == 2) v = std::uniform_real_distribution<float>(0.0f, 100.0f)(rng);
-      if (kind == 3) v = float(std::uniform_int_distribution<int>(0, 1)(rng)) * 0.5f + 1000.0f;
-    }
-    const HeightField field = fieldFrom(w, h, heights);
+    const HeightField field = fieldFrom(w, h, testing::randomLineHeights(kind, w, h, 100.0f, rng));
     for (double azimuth : {0.0, M_PI, 0.05}) {
       for (const NamedTuning& variant : kTunings) {
         SCOPED_TRACE("kind " + std::to_string(kind) + " azimuth " + std::to_string(azimuth) + ", " + variant.name);

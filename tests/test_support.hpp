@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 #include <string>
 #include <utility>
 #include <vector>
@@ -50,6 +51,22 @@ inline HeightField fieldFrom(int width, int height, std::vector<float> heights) 
   f.height = height;
   f.heights = std::move(heights);
   return f;
+}
+
+// Heights of long random lines, width * height values by kind: 0 tie-rich small integers
+// 0..3, 1 a smooth random walk (steps in [-1, 1]), 2 float noise in [0, noise_range), 3 two
+// levels 0.5 apart at 1000 (ties at a large offset).
+inline std::vector<float> randomLineHeights(int kind, int width, int height, float noise_range,
+                                            std::mt19937& rng) {
+  std::vector<float> heights(static_cast<std::size_t>(width) * height);
+  float walk = 0.0f;
+  for (auto& v : heights) {
+    if (kind == 0) v = float(std::uniform_int_distribution<int>(0, 3)(rng));
+    if (kind == 1) v = walk += std::uniform_real_distribution<float>(-1.0f, 1.0f)(rng);
+    if (kind == 2) v = std::uniform_real_distribution<float>(0.0f, noise_range)(rng);
+    if (kind == 3) v = float(std::uniform_int_distribution<int>(0, 1)(rng)) * 0.5f + 1000.0f;
+  }
+  return heights;
 }
 
 }  // namespace hfvis::testing
