@@ -1,15 +1,24 @@
 // horizon.cl: horizons by the convex-hull-stack sweep (Timonen & Westerholm 2010,
-// Algorithm 1), the reduction that rotates line buffers back onto the grid and reduces
-// them to the requested outputs, and the naive per-pixel ray march (baseline and oracle).
+// Algorithm 1) on lines through the pixel centres, reduced straight into the requested
+// outputs, and the naive per-pixel ray march (the baseline and oracle).
 //
-// Heights arrive offset and z-scaled (h' = (h - reference) * z_scale) so that tilted
-// planes at large offsets keep their precision; NaN = nodata.
+// The sweep (horizon_lattice): a direction is a primitive integer step (a, b) in pixel
+// axes. Every pixel centre lies on exactly one line of that direction, so every receiver is
+// a sample of the line through its own centre, and the hull stack gives the horizon of the
+// receiver's own ray from its own height. The line's samples between consecutive pixel
+// centres (receivers) are where it crosses grid columns and rows, exact heights of the
+// bilinear surface, and points between crossings; src/lattice_geometry.hpp builds the
+// per-period table. Each receiver also takes the exact limit of its ray's elevation at
+// t -> 0 (the surface's slope along the ray in its first cell): along a ray from a grid
+// point the bilinear surface is a quadratic in the first cell, so (h(t) - h0) / t is linear
+// there and its supremum is that limit or the first crossing, which is a sample.
+//
+// Heights arrive offset and z-scaled (h' = (h - lowest) * z_scale) so that tilted planes at
+// large offsets keep their precision; NaN = nodata.
 //
 // Compile-time parameters, besides those of sweep_framework.cl:
-//   HFVIS_WANT_ANGLES, HFVIS_WANT_DISTANCES  store per-direction planes of the batch
+//   HFVIS_WANT_ANGLES, HFVIS_WANT_DISTANCES  write the direction's planes
 //   HFVIS_WANT_SVF, HFVIS_WANT_AO            accumulate sky-view / ambient occlusion terms
-//   HFVIS_DIRECTIONS                         K, the directions of the whole run
-//   HFVIS_NEAR_SAMPLES                       exact near-field samples per receiver (>= 1)
 #include "sweep_framework.cl"
 #include "fast_math.cl"
 
@@ -25,71 +34,6 @@
 #ifndef HFVIS_WANT_AO
 #define HFVIS_WANT_AO 1
 #endif
-#ifndef HFVIS_DIRECTIONS
-#define HFVIS_DIRECTIONS 64
-#endif
-#define HFVIS_NEAR_MARGIN 4e-6f  // radians: rounding of hf_atan and of the interpolation
-#ifndef HFVIS_NEAR_SAMPLES
-#define HFVIS_NEAR_SAMPLES 4  // receiver's own ray samples over its first step (reduction)
-#endif
-
-
-// One step of Algorithm 1 (Timonen & Westerholm 2010) on one line: reads the presampled
-// height at *entry and writes, in place, the occluder that casts its horizon:
-// (occluder height - sample height, occluder step), or (NaN, -1) when nothing farther along
-// the line has been seen. Pops while the second stack entry casts at least as steep a slope
-// on the new sample as the top one; the top that remains is the occluder.
-HFVIS_INLINE void hull_stack_step(__global float2* entry, __global float2* stack, uint stride, uint* size,
-                                  int step) {
-  float h = entry->x;
-  if (isnan(h)) {
-    *entry = (float2)(NAN, -1.0f);
-    return;
-  }
-  float2 occluder = (float2)(NAN, -1.0f);
-  float here = (float)step;
-  uint n = *size;
-  if (n > 0) {
-    float2 top = stack[(n - 1) * stride];
-    float v1h = top.x - h;
-    float v1d = here - top.y;
-    while (n > 1) {
-      float2 below = stack[(n - 2) * stride];
-      float v2h = below.x - h;
-      float v2d = here - below.y;
-      if (v2h * v1d >= v1h * v2d) {
-        top = below;
-        v1h = v2h;
-        v1d = v2d;
-        --n;
-      } else {
-        break;
-      }
-    }
-    occluder = top;
-  }
-  stack[n * stride] = (float2)(h, here);
-  *size = n + 1;
-  *entry = (float2)(occluder.x - h, occluder.y);
-}
-
-// Hull-stack sweep: one work-item per line. The stack of line j holds (height, step)
-// entries in the line's own slots of the stacks buffer, depth k at line_entry(d, j, k): the
-// depth never exceeds the line's sample count, so the stack buffer is as large as the line
-// buffer. (Interleaving 2, 4 or 8 lines per work-item to overlap their serial chains was
-// measured slower on PoCL, so each work-item keeps one line.)
-// Global size: (max lines, directions in batch).
-__kernel void horizon_sweep(__global const SweepDirection* directions, __global float2* lines,
-                            __global float2* stacks) {
-  const int line = get_global_id(0);
-  const SweepDirection d = load_direction(directions + get_global_id(1));
-  if (line >= d.n_lines) return;
-  const uint stride = line_stride(d);
-  __global float2* entry = lines + line_entry(d, line, 0);
-  __global float2* stack = stacks + line_entry(d, line, 0);
-  uint size = 0;
-  for (int step = 0; step < d.n_steps; ++step, entry += stride) hull_stack_step(entry, stack, stride, &size, step);
-}
 
 // Unit normal at pixel (c, r): the normalised sum of the unnormalised normals of the (up to)
 // four quads around it (Timonen & Westerholm 2010, Sec. 7), in ground units; quads touching nodata
@@ -118,193 +62,226 @@ HFVIS_INLINE void surface_normal(__global const float* heights, int width, int h
   *nz = any ? sz_sum / length : 1.0f;
 }
 
-// Uniform-sky irradiance of one azimuthal swath (Eq. 5 of Timonen & Westerholm 2010) for
-// horizon elevation `elevation`, normalised so that a flat plane sums to 1 over K swaths.
-// The zenith angle is clamped where the sky falls behind the surface (N . e = 0).
-HFVIS_INLINE float ambient_term(float elevation, float nx, float ny, float nz, float cos_az, float sin_az) {
+// Every pixel's unit normal (three planes x, y, z of width*height), for ambient occlusion.
+// Global size: (W, H) rounded up.
+__kernel void pixel_normals(__global const float* heights, int width, int height, float cell_x, float cell_y,
+                            __global float* normals) {
+  int c = get_global_id(0), r = get_global_id(1);
+  if (c >= width || r >= height) return;
+  const uint pixel = (uint)(r * width + c), plane = (uint)(width * height);
+  float nx, ny, nz;
+  surface_normal(heights, width, height, c, r, heights[pixel], cell_x, cell_y, &nx, &ny, &nz);
+  normals[pixel] = nx;
+  normals[plane + pixel] = ny;
+  normals[2 * plane + pixel] = nz;
+}
+
+// Uniform-sky irradiance of one azimuthal swath (Eq. 5 of Timonen & Westerholm 2010) of
+// width 2 pi * `weight` for horizon elevation `elevation`, normalised so that a flat plane
+// sums to 1 over a run's swaths. The zenith angle is clamped where the sky falls behind the
+// surface (N . e = 0).
+HFVIS_INLINE float ambient_term(float elevation, float nx, float ny, float nz, float cos_az, float sin_az,
+                                float weight) {
   float toward = nx * cos_az + ny * sin_az;
   float zenith = 0.5f * HFVIS_PI_F - elevation;
-  zenith = fmin(zenith, 0.5f * HFVIS_PI_F + hf_atan(toward / nz));
+  zenith = hf_min(zenith, 0.5f * HFVIS_PI_F + hf_atan(toward / nz));
   float s = hf_sin(zenith);
-  return nz / (float)HFVIS_DIRECTIONS * s * s +
-         hf_sin(HFVIS_PI_F / (float)HFVIS_DIRECTIONS) / HFVIS_PI_F * (zenith - 0.5f * hf_sin(2.0f * zenith)) * toward;
+  return nz * weight * s * s +
+         hf_sin(HFVIS_PI_F * weight) / HFVIS_PI_F * (zenith - 0.5f * hf_sin(2.0f * zenith)) * toward;
 }
 
-// Writes or accumulates one direction's outputs at one pixel; shared by the sweep
-// reduction and the naive kernel so both reduce identically.
-HFVIS_INLINE void emit_direction(int b, uint pixel, uint plane, float elevation, float distance, float nx,
-                                 float ny, float nz, const SweepDirection d, __global float* angles, __global float* distances,
-                           float* svf, float* ao) {
+// What one direction contributes at one receiver. Shared by the sweep and the naive march
+// so both reduce identically. Each launch runs one direction and every pixel is written by
+// one work-item of it, so the read-modify-writes of the sums need no atomics.
+typedef struct {
+  float cos_azimuth, sin_azimuth;  // the direction on the ground
+  float weight;                    // its share of the circle of azimuth
+  uint plane;                      // first entry of its planes in `angles` / `distances`
+} DirectionOutputs;
+
+HFVIS_INLINE void emit_direction(uint pixel, int nodata, float elevation, float distance, const DirectionOutputs o,
+                                 __global const float* normals, uint pixel_count, __global float* angles,
+                                 __global float* distances, __global float* svf_sum, __global float* ao_sum) {
+  elevation = nodata ? NAN : elevation;
+  distance = nodata ? NAN : distance;
 #if HFVIS_WANT_ANGLES
-  angles[(uint)b * plane + pixel] = elevation;
+  angles[o.plane + pixel] = elevation;
 #endif
 #if HFVIS_WANT_DISTANCES
-  distances[(uint)b * plane + pixel] = distance;
+  distances[o.plane + pixel] = distance;
 #endif
-  // Only what is asked for: PoCL keeps unused terms alive across the barriers.
 #if HFVIS_WANT_SVF
-  *svf += hf_sin(fmax(0.0f, elevation));
+  svf_sum[pixel] = nodata ? NAN : svf_sum[pixel] + o.weight * hf_sin(hf_max(0.0f, elevation));
 #endif
 #if HFVIS_WANT_AO
-  *ao += ambient_term(elevation, nx, ny, nz, d.cos_azimuth, d.sin_azimuth);
+  float nx = normals[pixel], ny = normals[pixel_count + pixel], nz = normals[2 * pixel_count + pixel];
+  ao_sum[pixel] = nodata ? NAN : ao_sum[pixel] + ambient_term(elevation, nx, ny, nz, o.cos_azimuth, o.sin_azimuth, o.weight);
 #endif
 }
 
-// Adds the batch's sums to the run's accumulators; NaN at nodata receivers.
-HFVIS_INLINE void accumulate_pixel(uint pixel, int nodata, float svf, float ao, __global float* svf_sum,
-                             __global float* ao_sum) {
-#if HFVIS_WANT_SVF
-  svf_sum[pixel] = nodata ? NAN : svf_sum[pixel] + svf;
-#endif
-#if HFVIS_WANT_AO
-  ao_sum[pixel] = nodata ? NAN : ao_sum[pixel] + ao;
+// One sample of a period (src/lattice_geometry.hpp, struct LatticeSample): nine 4-byte
+// members, read field by field.
+typedef struct {
+  float tau;       // pixels from the period's receiver toward +(a, b)
+  int ox, oy;      // the cell's lower corner, relative to the receiver
+  int ex, ey;      // 1 where the sample is strictly inside the cell along x (y)
+  float w00, w10, w01, w11;  // bilinear weights of the cell's corners
+} LatticeSample;
+
+// Height of the bilinear surface at a lattice sample whose cell corner is at entry `at`;
+// with nodata, only the valid corners of positive weight count, renormalised (NaN when
+// none). Crossing samples have ex or ey 0: their zero-weight corners repeat a used one.
+HFVIS_INLINE float lattice_height(__global const float* heights, uint at, uint right, uint down, float w00, float w10,
+                                  float w01, float w11) {
+  float h00 = heights[at], h10 = heights[at + right], h01 = heights[at + down], h11 = heights[at + down + right];
+  float plain = w00 * h00 + w10 * h10 + w01 * h01 + w11 * h11;
+#if HFVIS_HAS_NODATA
+  int v00 = w00 > 0.0f && !isnan(h00), v10 = w10 > 0.0f && !isnan(h10);
+  int v01 = w01 > 0.0f && !isnan(h01), v11 = w11 > 0.0f && !isnan(h11);
+  float sum = (v00 ? w00 * h00 : 0.0f) + (v10 ? w10 * h10 : 0.0f) + (v01 ? w01 * h01 : 0.0f) + (v11 ? w11 * h11 : 0.0f);
+  float weight = (v00 ? w00 : 0.0f) + (v10 ? w10 : 0.0f) + (v01 ? w01 : 0.0f) + (v11 ? w11 : 0.0f);
+  return isnan(plain) ? (weight > 0.0f ? sum / weight : NAN) : plain;
+#else
+  return plain;
 #endif
 }
 
-// Reduction: for every receiver pixel and every direction of the batch, bilinearly
-// interpolates the horizons of the (up to) four surrounding (line, step) entries, each
-// exact for its own sample, and writes or accumulates the requested outputs. (Seeing the
-// neighbours' occluders from the receiver instead would be biased by the lateral offset
-// between line and receiver on every slope, and unstable where an occluder is nearly
-// beside the receiver.) Entries without an occluder are left out; with none left, the
-// horizon is -pi/2 (the ray leaves the field at once). Global size: (W, H) rounded up.
-__kernel void horizon_reduce(__global const float* heights, int width, int height, float cell_x,
-                             float cell_y, __global const SweepDirection* directions, int batch_size,
-                             __global const float2* lines, __global float* angles, __global float* distances,
-                             __global float* svf_sum, __global float* ao_sum) {
-  // Straight-line code throughout (clamped reads, masked sums, no early exits): PoCL only
-  // vectorises across work-items where control flow is uniform, and this kernel runs its
-  // transcendentals once per pixel and direction.
-  int c = get_global_id(0), r = get_global_id(1);
-  int valid = c < width && r < height;
-  int cc = min(c, width - 1), rr = min(r, height - 1);
-  const uint pixel = (uint)(rr * width + cc);
-  const uint plane = (uint)(width * height);
-  float h = heights[pixel];
-  float nx = 0.0f, ny = 0.0f, nz = 1.0f;
-#if HFVIS_WANT_AO
-  surface_normal(heights, width, height, cc, rr, h, cell_x, cell_y, &nx, &ny, &nz);
-#endif
-  float svf = 0.0f, ao = 0.0f;
-  for (int b = 0; b < batch_size; ++b) {
-    // The barrier (every work-item reaches it: the loop is uniform) makes PoCL run the
-    // work-items inside each iteration rather than each work-item's whole loop in turn,
-    // and only that innermost work-item loop gets vectorised: 3x faster on PoCL.
-    barrier(CLK_LOCAL_MEM_FENCE);
-    const SweepDirection d = load_direction(directions + b);
-    float x = (float)cc, y = (float)rr;
-    int j0, i0;
-    float fu, fv;
-    receiver_cell(d, x, y, &j0, &i0, &fu, &fv);
-    float weight = 0.0f, angle_sum = 0.0f, distance_sum = 0.0f;
-    for (int k = 0; k < 4; ++k) {
-      float w;
-      int i;
-      __global const float* occ = (__global const float*)(lines + cell_corner(d, j0, i0, fu, fv, k, &w, &i));
-      float rise = occ[0], occ_step = occ[1];  // scalar loads, for the vectoriser
-      int use = w > 0.0f && occ_step >= 0.0f;
-      float ground = ((float)i - occ_step) * d.step_length * d.ground_per_pixel;
-      float angle = hf_atan2_ahead(rise, ground);
-      weight += use ? w : 0.0f;
-      angle_sum += use ? w * angle : 0.0f;
-      distance_sum += use ? w * ground : 0.0f;
+// The exact limit of receiver (c, r)'s elevation slope at t -> 0 along (a, b), as rise per
+// pixel length: the bilinear surface's directional derivative into the first cell, from
+// the receiver's height h and its neighbours along the two axes. NaN where the ray leaves
+// the field at once or a needed neighbour is nodata.
+HFVIS_INLINE float near_slope(__global const float* heights, int width, int height, int c, int r, float h, int a, int b,
+                              float period) {
+  int sx = a > 0 ? 1 : (a < 0 ? -1 : 0), sy = b > 0 ? 1 : (b < 0 ? -1 : 0);
+  int leaves = c + sx < 0 || c + sx >= width || r + sy < 0 || r + sy >= height;
+  float hx = heights[r * width + clamp(c + sx, 0, width - 1)];
+  float hy = heights[clamp(r + sy, 0, height - 1) * width + c];
+  float slope = ((hx - h) * (float)abs(a) + (hy - h) * (float)abs(b)) / period;
+  return leaves ? NAN : slope;
+}
+
+// The sweep of one direction (a, b): one work-item per line, from the line's far end toward
+// -(a, b). Line j's farthest receiver is lines[j] = (col, row, receivers, stack); receiver
+// i sits at (col - i a, row - i b). Per receiver, the period's samples farther along the
+// line come first (farthest first), then the receiver itself (samples[n_samples - 1]).
+// Algorithm 1: a new sample pops the stack while the entry below the top casts at least as
+// steep a slope on it as the top (so the farther wins ties), and the remaining top is its
+// horizon occluder; then it is pushed. Samples outside the field or without height are
+// absent. Stack entry k of a line is (height, position along the line in pixels from its
+// far end) at stacks[stack + k * stride]; the capacity is every sample of its periods.
+// Preconditions: lines of this launch only; stride 1 (line-major) or the launch's line
+// count (step-major). Global size: n_lines rounded up; any local size.
+__kernel void horizon_lattice(__global const float* heights, int width, int height,
+                              __global const int4* lines, int n_lines, __global const LatticeSample* samples,
+                              int n_samples, int a, int b, float period, float ground_per_pixel,
+                              float cos_azimuth, float sin_azimuth, float weight, uint plane,
+                              __global float2* stacks, uint stride, __global const float* normals,
+                              __global float* angles, __global float* distances, __global float* svf_sum,
+                              __global float* ao_sum) {
+  const int j = get_global_id(0);
+  if (j >= n_lines) return;
+  const int4 line = lines[j];
+  const DirectionOutputs outputs = {cos_azimuth, sin_azimuth, weight, plane};
+  const uint pixel_count = (uint)(width * height);
+  __global float2* stack = stacks + line.w;
+  int c = line.x, r = line.y;
+  uint n = 0;                     // stack size
+  float top_h = 0.0f, top_p = 0.0f;  // the top entry, kept in registers
+  for (int i = 0; i < line.z; ++i, c -= a, r -= b) {
+    const float base = (float)i * period;  // the receiver's position along the line
+    for (int q = 0; q < n_samples; ++q) {
+      __global const LatticeSample* s = samples + q;
+      const int x0 = c + s->ox, y0 = r + s->oy, ex = s->ex, ey = s->ey;
+      if (x0 < 0 || x0 + ex > width - 1 || y0 < 0 || y0 + ey > height - 1) continue;
+      const uint at = (uint)(y0 * width + x0);
+      const float h = lattice_height(heights, at, (uint)ex, (uint)(ey * width), s->w00, s->w10, s->w01, s->w11);
+      const int receiver = q == n_samples - 1;
+      if (isnan(h)) {
+        if (receiver) emit_direction(at, 1, 0.0f, 0.0f, outputs, normals, pixel_count, angles, distances, svf_sum, ao_sum);
+        continue;
+      }
+      const float here = base - s->tau;
+      float rise = 0.0f, ground = 0.0f;  // to the occluder, when the stack is not empty
+      if (n > 0) {
+        float v1h = top_h - h, v1d = here - top_p;
+        while (n > 1) {
+          const float2 below = stack[(n - 2) * stride];
+          const float v2h = below.x - h, v2d = here - below.y;
+          if (v2h * v1d >= v1h * v2d) {
+            top_h = below.x;
+            top_p = below.y;
+            v1h = v2h;
+            v1d = v2d;
+            --n;
+          } else {
+            break;
+          }
+        }
+        rise = v1h;
+        ground = v1d * ground_per_pixel;
+      }
+      if (receiver) {
+        // The steeper of the hull's occluder and the limit at the receiver; the occluder
+        // wins ties (it is the farther point casting that elevation).
+        const float near = near_slope(heights, width, height, c, r, h, a, b, period) / ground_per_pixel;
+        const int has_far = n > 0, has_near = !isnan(near);
+        const float far = has_far ? rise / ground : 0.0f;
+        const int use_near = has_near && (!has_far || near > far);
+        const float elevation = has_far || has_near ? hf_atan(use_near ? near : far) : -0.5f * HFVIS_PI_F;
+        const float distance = has_far && !use_near ? ground : 0.0f;
+        emit_direction(at, 0, elevation, distance, outputs, normals, pixel_count, angles, distances, svf_sum, ao_sum);
+      }
+      stack[n * stride] = (float2)(h, here);
+      top_h = h;
+      top_p = here;
+      ++n;
     }
-    // Exact near field: the surrounding line samples lie up to a line spacing away and
-    // their own first steps differ from the receiver's, where the bilinear surface can rise
-    // steeply; that was the larger part of the sweep's error (fractal 256^2, K = 16: mean
-    // 1.17 -> 0.30 deg against a 4x-sampled naive march, HorizonOptions::near_field_samples
-    // 1 -> 4). The receiver's own ray, sampled
-    // at HFVIS_NEAR_SAMPLES points over its first step, bounds the horizon from below, so
-    // the steeper of the two wins. It also decides at the field's edges: a ray that leaves
-    // the field before its first near sample has horizon -pi/2.
-    float near_slope = 0.0f, near_t = 0.0f;  // steepest rise per pixel length, and where
-    int near_found = 0, ray_has_sample = 0;
-    for (int q = 1; q <= HFVIS_NEAR_SAMPLES; ++q) {
-      float t = (float)q * (d.step_length / (float)HFVIS_NEAR_SAMPLES);
-      float qx = x + t * d.dir_x, qy = y + t * d.dir_y;
-      int inside = inside_field(qx, qy, width, height);
-      float slope = (sample_height(heights, width, height, qx, qy) - h) / t;
-      int better = inside && !isnan(slope) && (!near_found || slope >= near_slope);  // farther wins ties
-      near_slope = better ? slope : near_slope;
-      near_t = better ? t : near_t;
-      near_found = near_found || better;
-      ray_has_sample = ray_has_sample || (q == 1 && inside);
-    }
-    float near_elevation = hf_atan(near_slope / d.ground_per_pixel);
-    float elevation = weight > 0.0f ? angle_sum / weight : -0.5f * HFVIS_PI_F;
-    float distance = weight > 0.0f ? distance_sum / weight : 0.0f;
-    // Steeper by more than the two paths' rounding: where they agree (a straight flank)
-    // the line samples' farther occluder stays, as on the hull.
-    int use_near = near_found && (!(weight > 0.0f) || near_elevation > elevation + HFVIS_NEAR_MARGIN);
-    elevation = use_near ? near_elevation : elevation;
-    distance = use_near ? near_t * d.ground_per_pixel : distance;
-    elevation = ray_has_sample ? elevation : -0.5f * HFVIS_PI_F;
-    distance = ray_has_sample ? distance : 0.0f;
-    elevation = isnan(h) ? NAN : elevation;
-    distance = isnan(h) ? NAN : distance;
-    if (valid) emit_direction(b, pixel, plane, elevation, distance, nx, ny, nz, d, angles, distances, &svf, &ao);
   }
-  if (valid) accumulate_pixel(pixel, isnan(h), svf, ao, svf_sum, ao_sum);
 }
 
 // Naive method (Timonen 2013, Sec. 1): for every pixel, march the ray in steps of
-// step_length pixels, sample bilinearly and keep the steepest slope. The trip count is
-// the same for the whole work-group (the longest ray of the group's tile, found in closed
-// form because the exit distance separates into a column and a row term), so the march
-// can run in lock-step across work-items and vectorise; samples outside the field are
-// masked.
-// Global size: (W, H) rounded up to the local size; the tile is the work-group.
-__kernel void horizon_naive(__global const float* heights, int width, int height, float cell_x, float cell_y,
-                            __global const SweepDirection* directions, int batch_size,
-                            __global float* angles, __global float* distances, __global float* svf_sum,
-                            __global float* ao_sum) {
+// step_length pixels along (dir_x, dir_y), sample bilinearly and keep the steepest slope.
+// One direction per launch, its geometry passed as arguments (uniform for certain, no
+// per-step loads). The trip count is the same for the whole work-group (the longest ray of
+// the group's tile, in closed form because the exit distance separates into a column and a
+// row term), and a barrier ends every step: PoCL runs the work-items inside each step, the
+// one loop it vectorises (the march ran 5x faster that way on PoCL); samples past a
+// pixel's own exit are masked. Global size: (W, H) rounded up to the local size (the tile).
+__kernel void horizon_naive(__global const float* heights, int width, int height, float dir_x, float dir_y,
+                            float step_length, float ground_per_pixel, float cos_azimuth, float sin_azimuth,
+                            float weight, uint plane, __global const float* normals, __global float* angles,
+                            __global float* distances, __global float* svf_sum, __global float* ao_sum) {
   int c = get_global_id(0), r = get_global_id(1);
-  // The tile's extent, clamped to the field (work-items past the edge still march, so that
-  // the whole group runs the same loop, and only skip the writes).
   int c_lo = get_group_id(0) * get_local_size(0), r_lo = get_group_id(1) * get_local_size(1);
   int c_hi = min(c_lo + (int)get_local_size(0), width) - 1;
   int r_hi = min(r_lo + (int)get_local_size(1), height) - 1;
   int valid = c < width && r < height;
   int cc = min(c, width - 1), rr = min(r, height - 1);
   const uint pixel = (uint)(rr * width + cc);
-  const uint plane = (uint)(width * height);
-  float h = heights[pixel];
-  float nx = 0.0f, ny = 0.0f, nz = 1.0f;
-#if HFVIS_WANT_AO
-  surface_normal(heights, width, height, cc, rr, h, cell_x, cell_y, &nx, &ny, &nz);
-#endif
-  float svf = 0.0f, ao = 0.0f;
-  for (int b = 0; b < batch_size; ++b) {
-    const SweepDirection d = load_direction(directions + b);
-    const float far = (float)(width + height);
-    float reach_x = d.dir_x > 0.0f ? ((float)(width - 1) - (float)c_lo) / d.dir_x
-                    : d.dir_x < 0.0f ? (float)c_hi / -d.dir_x : far;
-    float reach_y = d.dir_y > 0.0f ? ((float)(height - 1) - (float)r_lo) / d.dir_y
-                    : d.dir_y < 0.0f ? (float)r_hi / -d.dir_y : far;
-    int steps = (int)(fmin(fmin(reach_x, reach_y), far) * d.samples_per_unit) + 1;
-    float best_rise = 0.0f;  // height gain to the steepest sample so far
-    int best_step = 0;       // its step, 0 = none yet
-    for (int i = 1; i <= steps; ++i) {
-      // `steps` is the same for the whole work-group, so every work-item reaches this
-      // barrier; it makes PoCL run the work-items inside each step, the one loop it
-      // vectorises: 5x faster there (1.05 -> 0.20 s, 256^2 fractal, K = 8, one thread).
-      barrier(CLK_LOCAL_MEM_FENCE);
-      float t = (float)i * d.step_length;
-      float px = (float)cc + t * d.dir_x, py = (float)rr + t * d.dir_y;
-      float q = sample_height(heights, width, height, px, py);
-      float rise = q - h;
-      // rise / i >= best_rise / best_step, decided without division as the sweep does;
-      // on ties the farther sample wins, as on the sweep's hull.
-      int better = inside_field(px, py, width, height) && !isnan(q) &&
-                   (best_step == 0 || rise * (float)best_step >= best_rise * (float)i);
-      best_rise = better ? rise : best_rise;
-      best_step = better ? i : best_step;
-    }
-    float ground = (float)best_step * d.step_length * d.ground_per_pixel;
-    float elevation = best_step > 0 ? hf_atan2_ahead(best_rise, ground) : -0.5f * HFVIS_PI_F;
-    float distance = best_step > 0 ? ground : 0.0f;
-    if (isnan(h)) elevation = distance = NAN;
-    if (valid) emit_direction(b, pixel, plane, elevation, distance, nx, ny, nz, d, angles, distances, &svf, &ao);
+  const float h = heights[pixel];
+  const float far = (float)(width + height);
+  float reach_x = dir_x > 0.0f ? ((float)(width - 1) - (float)c_lo) / dir_x : dir_x < 0.0f ? (float)c_hi / -dir_x : far;
+  float reach_y = dir_y > 0.0f ? ((float)(height - 1) - (float)r_lo) / dir_y : dir_y < 0.0f ? (float)r_hi / -dir_y : far;
+  const int steps = (int)(hf_min(hf_min(reach_x, reach_y), far) / step_length) + 1;
+  float best_rise = 0.0f;  // height gain to the steepest sample so far
+  int best_step = 0;       // its step, 0 = none yet
+  for (int i = 1; i <= steps; ++i) {
+    float t = (float)i * step_length;
+    float px = (float)cc + t * dir_x, py = (float)rr + t * dir_y;
+    float q = sample_height(heights, width, height, px, py);
+    float rise = q - h;
+    // rise / i >= best_rise / best_step without a division; ties go to the farther sample.
+    int better = inside_field(px, py, width, height) & !isnan(q) &
+                 ((best_step == 0) | (rise * (float)best_step >= best_rise * (float)i));
+    best_rise = better ? rise : best_rise;
+    best_step = better ? i : best_step;
+    barrier(CLK_LOCAL_MEM_FENCE);
   }
-  if (valid) accumulate_pixel(pixel, isnan(h), svf, ao, svf_sum, ao_sum);
+  const float ground = (float)best_step * step_length * ground_per_pixel;
+  const float elevation = best_step > 0 ? hf_atan(best_rise / ground) : -0.5f * HFVIS_PI_F;
+  const float distance = best_step > 0 ? ground : 0.0f;
+  const DirectionOutputs outputs = {cos_azimuth, sin_azimuth, weight, plane};
+  if (valid)
+    emit_direction(pixel, isnan(h), elevation, distance, outputs, normals, (uint)(width * height), angles, distances,
+                   svf_sum, ao_sum);
 }

@@ -1,14 +1,15 @@
-// horizon.cpp: the horizon operation on the device: presample -> hull-stack sweep ->
-// reduction (or the naive march) per batch of directions, downloading only the
-// requested outputs.
+// horizon.cpp: the horizon operation on the device. Per direction, one launch of the
+// lattice sweep (receiver-exact hull stacks, reduced straight into the requested outputs)
+// or of the naive march; per batch of directions, the requested planes are downloaded.
 #include "hfvis/horizon.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "hfvis/errors.hpp"
 #include "horizon_common.hpp"
-#include "horizon_device.hpp"
+#include "lattice_geometry.hpp"
 #include "opencl_context.hpp"
 #include "sweep_framework.hpp"
 
@@ -16,159 +17,245 @@ namespace hfvis {
 namespace detail {
 namespace {
 
-constexpr std::size_t kLineEntryBytes = 2 * sizeof(float);  // (rise, occluder step) or stack (h, step)
+constexpr std::size_t kStackEntryBytes = 2 * sizeof(float);  // (height, position)
 
-std::string programOptions(const HorizonOptions& options, const HorizonOutputs& outputs, bool has_nodata) {
+std::string programOptions(const HorizonOutputs& outputs, bool has_nodata, const DeviceInfo& device) {
   std::ostringstream s;
   s << "-DHFVIS_HAS_NODATA=" << has_nodata << " -DHFVIS_WANT_ANGLES=" << outputs.horizon_angles
-    << " -DHFVIS_WANT_DISTANCES=" << outputs.horizon_distances
-    << " -DHFVIS_WANT_SVF=" << outputs.sky_view_factor << " -DHFVIS_WANT_AO=" << outputs.ambient_occlusion
-    << " -DHFVIS_DIRECTIONS=" << options.directions << " -DHFVIS_NEAR_SAMPLES=" << options.near_field_samples;
+    << " -DHFVIS_WANT_DISTANCES=" << outputs.horizon_distances << " -DHFVIS_WANT_SVF=" << outputs.sky_view_factor
+    << " -DHFVIS_WANT_AO=" << outputs.ambient_occlusion << " " << layoutProgramOption(device);
   return s.str();
 }
 
-void enqueueHullSweep(ContextState& st, cl::Program& program, const cl::Buffer& directions,
-                      const SweepBatch& batch, const cl::Buffer& lines, const cl::Buffer& stacks) {
-  cl::Kernel hull(program, "horizon_sweep");
-  hull.setArg(0, directions);
-  hull.setArg(1, lines);
-  hull.setArg(2, stacks);
-  st.launch(hull, cl::NDRange(roundUp(batch.maxLines(), kLineGroup), batch.directions.size()),
-            cl::NDRange(kLineGroup, 1));
-}
+// One direction of a run, whichever method: what the kernels and the outputs need.
+struct RunDirection {
+  LatticeDirection lattice;  // sweep (azimuth and weight for both methods)
+  SweepDirection ray;        // naive march
+  std::vector<LatticeSample> samples;
+  float cos_azimuth = 1.0f, sin_azimuth = 0.0f;  // as the scalar reference rounds them
+};
 
-HorizonResult run(const ComputeContext& context, const HeightField& field, const HorizonOptions& options,
-                  const HorizonOutputs& outputs) {
-  ContextState& st = context.state();
-  const PreparedHeights prepared = prepareHeights(field);
+// How a run uses its device memory budget: directions per downloaded batch of planes and
+// the hull-stack scratch (entries) every launch of the sweep shares.
+struct RunPlan {
+  int directions_per_batch = 1;
+  std::size_t stack_entries = 0;
+};
+
+RunPlan planRun(const HeightField& field, const HorizonOptions& options, const HorizonOutputs& outputs,
+                const std::vector<RunDirection>& directions, const DeviceInfo& device) {
   const bool sweep = options.method == HorizonMethod::Sweep;
-  cl::Program program = st.program("horizon.cl", programOptions(options, outputs, prepared.has_nodata) + " " +
-                                                     layoutProgramOption(st.info));
-  const std::size_t plane = field.pixelCount();
-
-  SweepMemory memory;
-  memory.fixed_bytes = plane * sizeof(float) * (1 + outputs.sky_view_factor + outputs.ambient_occlusion);
-  memory.bytes_per_entry = sweep ? 2 * kLineEntryBytes : 0;  // line buffer + hull stacks
-  memory.largest_entry_bytes = kLineEntryBytes;
-  memory.bytes_per_direction = plane * sizeof(float) * (outputs.horizon_angles + outputs.horizon_distances);
-  const auto batches =
-      planSweepBatches(runDirections(field, options), memory, options.memory_budget_bytes, st.info);
-  std::size_t max_entries = 0, max_directions = 0;
-  for (const auto& b : batches) {
-    max_entries = std::max(max_entries, b.entries);
-    max_directions = std::max(max_directions, b.directions.size());
-  }
-
-  HorizonResult result = allocateResult(field, options, outputs);
-  cl::Buffer heights(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, plane * sizeof(float),
-                     const_cast<float*>(prepared.heights.data()));
-  cl::Buffer lines, stacks;
+  const std::size_t budget = options.memory_budget_bytes ? options.memory_budget_bytes : defaultMemoryBudget(device);
+  const std::size_t max_alloc = device.max_allocation_bytes ? device.max_allocation_bytes : budget;
+  const std::size_t plane = field.pixelCount() * sizeof(float);
+  const std::size_t fixed = plane * (1 + outputs.sky_view_factor + outputs.ambient_occlusion * 4);
+  const std::size_t per_direction = plane * (outputs.horizon_angles + outputs.horizon_distances);
+  // Scratch: all of a direction's stacks in one launch when it fits; one line at a time at least.
+  std::size_t whole = 0, longest = 0;
   if (sweep) {
-    lines = deviceBuffer(st, max_entries * kLineEntryBytes);
-    stacks = deviceBuffer(st, max_entries * kLineEntryBytes);
-  }
-  const std::size_t planes_bytes = max_directions * plane * sizeof(float);
-  cl::Buffer angles = deviceBuffer(st, outputs.horizon_angles ? planes_bytes : 0);
-  cl::Buffer distances = deviceBuffer(st, outputs.horizon_distances ? planes_bytes : 0);
-  cl::Buffer svf = deviceBuffer(st, outputs.sky_view_factor ? plane * sizeof(float) : 0);
-  cl::Buffer ao = deviceBuffer(st, outputs.ambient_occlusion ? plane * sizeof(float) : 0);
-  const float zero = 0.0f;
-  if (outputs.sky_view_factor) st.queue.enqueueFillBuffer(svf, zero, 0, plane * sizeof(float));
-  if (outputs.ambient_occlusion) st.queue.enqueueFillBuffer(ao, zero, 0, plane * sizeof(float));
-
-  const cl::NDRange pixels(roundUp(field.width, kTileX), roundUp(field.height, kTileY));
-  int done = 0;
-  for (const SweepBatch& batch : batches) {
-    const cl::Buffer directions = uploadDirections(st, batch.directions);
-    const int batch_size = static_cast<int>(batch.directions.size());
-    if (sweep) {
-      enqueuePresample(st, program, heights, field.width, field.height, directions, batch, lines);
-      enqueueHullSweep(st, program, directions, batch, lines, stacks);
+    for (const RunDirection& d : directions) {
+      std::size_t total = 0;
+      for (const LatticeLine& line : latticeLines(d.lattice, field.width, field.height)) {
+        const std::size_t capacity = lineCapacity(line, d.samples.size());
+        total += capacity;
+        longest = std::max(longest, capacity);
+      }
+      whole = std::max(whole, total);
     }
-    cl::Kernel reduce(program, sweep ? "horizon_reduce" : "horizon_naive");
-    int arg = 0;
-    reduce.setArg(arg++, heights);
-    reduce.setArg(arg++, field.width);
-    reduce.setArg(arg++, field.height);
-    reduce.setArg(arg++, static_cast<float>(field.cell_size_x));
-    reduce.setArg(arg++, static_cast<float>(field.cell_size_y));
-    reduce.setArg(arg++, directions);
-    reduce.setArg(arg++, batch_size);
-    if (sweep) reduce.setArg(arg++, lines);
-    reduce.setArg(arg++, angles);
-    reduce.setArg(arg++, distances);
-    reduce.setArg(arg++, svf);
-    reduce.setArg(arg++, ao);
-    st.launch(reduce, pixels, cl::NDRange(kTileX, kTileY));
-    const std::size_t batch_bytes = batch_size * plane * sizeof(float);
-    const std::size_t at = batch.first * plane;
-    if (outputs.horizon_angles)
-      st.queue.enqueueReadBuffer(angles, CL_TRUE, 0, batch_bytes, &result.angles[at]);
-    if (outputs.horizon_distances)
-      st.queue.enqueueReadBuffer(distances, CL_TRUE, 0, batch_bytes, &result.distances[at]);
-    st.queue.finish();
-    done += batch_size;
-    if (options.progress) options.progress(done, options.directions);
   }
-  if (outputs.sky_view_factor)
-    st.queue.enqueueReadBuffer(svf, CL_TRUE, 0, plane * sizeof(float), result.sky_view_factor.data());
-  if (outputs.ambient_occlusion)
-    st.queue.enqueueReadBuffer(ao, CL_TRUE, 0, plane * sizeof(float), result.ambient_occlusion.data());
-  finishReduction(options, result);
-  return result;
+  auto fail = [&](std::size_t need) {
+    throw MemoryBudgetError("one direction needs " + mebibytes(need) + " of device memory but the budget is " +
+                            mebibytes(budget) + " (largest single buffer " + mebibytes(max_alloc) +
+                            "); raise the memory budget or use a smaller field");
+  };
+  const std::size_t least = fixed + per_direction + longest * kStackEntryBytes;
+  if (least > budget || per_direction > max_alloc || longest * kStackEntryBytes > max_alloc) fail(least);
+  const std::size_t available = budget - fixed;
+  RunPlan plan;
+  // Planes of up to kMaxDirectionsPerBatch directions, leaving the scratch at least half.
+  const std::size_t stack_bytes = std::min(whole * kStackEntryBytes, max_alloc);
+  const std::size_t for_planes = available - std::min(stack_bytes, std::max(available / 2, longest * kStackEntryBytes));
+  plan.directions_per_batch = static_cast<int>(std::min<std::size_t>(
+      {static_cast<std::size_t>(std::min(options.directions, kMaxDirectionsPerBatch)),
+       per_direction ? std::max<std::size_t>(1, for_planes / per_direction) : std::size_t(kMaxDirectionsPerBatch),
+       per_direction ? std::max<std::size_t>(1, max_alloc / per_direction) : std::size_t(kMaxDirectionsPerBatch)}));
+  plan.stack_entries =
+      std::min(whole, std::min(available - plan.directions_per_batch * per_direction, max_alloc) / kStackEntryBytes);
+  return plan;
 }
+
+std::vector<RunDirection> runDirectionsOf(const HeightField& field, const HorizonOptions& options,
+                                          const HorizonOutputs& outputs) {
+  std::vector<RunDirection> out;
+  if (options.method == HorizonMethod::Sweep) {
+    for (const LatticeDirection& d : horizonDirections(field, options, outputs))
+      out.push_back({d, SweepDirection{}, latticeSamples(d, options.samples_per_unit),
+                     static_cast<float>(std::cos(d.azimuth)), static_cast<float>(std::sin(d.azimuth))});
+  } else {
+    const std::vector<SweepDirection> rays = runDirections(field, options);
+    for (int k = 0; k < options.directions; ++k) {
+      const SweepDirection& d = rays[k];
+      RunDirection r;
+      r.ray = d;
+      r.lattice.azimuth = directionAzimuth(k, options);
+      r.lattice.weight = 1.0 / options.directions;
+      r.cos_azimuth = d.cos_azimuth;
+      r.sin_azimuth = d.sin_azimuth;
+      out.push_back(r);
+    }
+  }
+  return out;
+}
+
+class HorizonRun {
+ public:
+  HorizonRun(ContextState& st, const HeightField& field, const HorizonOptions& options,
+             const HorizonOutputs& outputs)
+      : st_(st), field_(field), options_(options), outputs_(outputs) {}
+
+  HorizonResult run() {
+    const PreparedHeights prepared = prepareHeights(field_);
+    program_ = st_.program("horizon.cl", programOptions(outputs_, prepared.has_nodata, st_.info));
+    const std::vector<RunDirection> directions = runDirectionsOf(field_, options_, outputs_);
+    const RunPlan plan = planRun(field_, options_, outputs_, directions, st_.info);
+    HorizonResult result = allocateResult(field_, options_, outputs_);
+    for (int k = 0; k < options_.directions; ++k) result.azimuths[k] = directions[k].lattice.azimuth;
+
+    const std::size_t plane = field_.pixelCount();
+    heights_ = cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, plane * sizeof(float),
+                          const_cast<float*>(prepared.heights.data()));
+    const std::size_t planes_bytes = plan.directions_per_batch * plane * sizeof(float);
+    angles_ = st_.reusableBuffer("horizon angles", outputs_.horizon_angles ? planes_bytes : 0);
+    distances_ = st_.reusableBuffer("horizon distances", outputs_.horizon_distances ? planes_bytes : 0);
+    svf_ = deviceBuffer(st_, outputs_.sky_view_factor ? plane * sizeof(float) : 0);
+    ao_ = deviceBuffer(st_, outputs_.ambient_occlusion ? plane * sizeof(float) : 0);
+    normals_ = deviceBuffer(st_, outputs_.ambient_occlusion ? 3 * plane * sizeof(float) : 0);
+    stacks_ = st_.reusableBuffer("lattice stacks", plan.stack_entries * kStackEntryBytes);
+    stack_entries_ = plan.stack_entries;
+    const float zero = 0.0f;
+    if (outputs_.sky_view_factor) st_.queue.enqueueFillBuffer(svf_, zero, 0, plane * sizeof(float));
+    if (outputs_.ambient_occlusion) {
+      st_.queue.enqueueFillBuffer(ao_, zero, 0, plane * sizeof(float));
+      cl::Kernel normals(program_, "pixel_normals");
+      normals.setArg(0, heights_);
+      normals.setArg(1, field_.width);
+      normals.setArg(2, field_.height);
+      normals.setArg(3, static_cast<float>(field_.cell_size_x));
+      normals.setArg(4, static_cast<float>(field_.cell_size_y));
+      normals.setArg(5, normals_);
+      st_.launch(normals, cl::NDRange(roundUp(field_.width, kTileX), roundUp(field_.height, kTileY)),
+                 cl::NDRange(kTileX, kTileY));
+    }
+
+    for (int first = 0; first < options_.directions; first += plan.directions_per_batch) {
+      const int count = std::min(plan.directions_per_batch, options_.directions - first);
+      for (int b = 0; b < count; ++b) {
+        const RunDirection& d = directions[first + b];
+        const cl_uint plane_offset = static_cast<cl_uint>(b * plane);
+        if (options_.method == HorizonMethod::Sweep) {
+          launchSweep(d, plane_offset);
+        } else {
+          launchNaive(d, plane_offset);
+        }
+      }
+      const std::size_t batch_bytes = count * plane * sizeof(float), at = first * plane;
+      if (outputs_.horizon_angles) st_.queue.enqueueReadBuffer(angles_, CL_TRUE, 0, batch_bytes, &result.angles[at]);
+      if (outputs_.horizon_distances)
+        st_.queue.enqueueReadBuffer(distances_, CL_TRUE, 0, batch_bytes, &result.distances[at]);
+      st_.queue.finish();
+      if (options_.progress) options_.progress(first + count, options_.directions);
+    }
+    if (outputs_.sky_view_factor)
+      st_.queue.enqueueReadBuffer(svf_, CL_TRUE, 0, plane * sizeof(float), result.sky_view_factor.data());
+    if (outputs_.ambient_occlusion)
+      st_.queue.enqueueReadBuffer(ao_, CL_TRUE, 0, plane * sizeof(float), result.ambient_occlusion.data());
+    finishReduction(result);
+    return result;
+  }
+
+ private:
+  // The arguments every direction's kernel ends with: its outputs.
+  void setOutputs(cl::Kernel& kernel, int arg, const RunDirection& d, cl_uint plane_offset) {
+    kernel.setArg(arg++, d.cos_azimuth);
+    kernel.setArg(arg++, d.sin_azimuth);
+    kernel.setArg(arg++, static_cast<float>(d.lattice.weight));
+    kernel.setArg(arg++, plane_offset);
+    if (options_.method == HorizonMethod::Sweep) {
+      kernel.setArg(arg++, stacks_);
+      ++arg;  // the stride, set per chunk
+    }
+    kernel.setArg(arg++, normals_);
+    kernel.setArg(arg++, angles_);
+    kernel.setArg(arg++, distances_);
+    kernel.setArg(arg++, svf_);
+    kernel.setArg(arg++, ao_);
+  }
+
+  void launchSweep(const RunDirection& d, cl_uint plane_offset) {
+    const bool line_major = lineMajorLayout(st_.info);
+    std::vector<LatticeLine> lines = latticeLines(d.lattice, field_.width, field_.height);
+    if (lines.empty()) return;
+    const std::vector<LineChunk> chunks = chunkLines(lines, d.samples.size(), stack_entries_, line_major);
+    const cl::Buffer line_table(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                lines.size() * sizeof(LatticeLine), lines.data());
+    cl::Buffer samples(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                       d.samples.size() * sizeof(LatticeSample), const_cast<LatticeSample*>(d.samples.data()));
+    cl::Kernel kernel(program_, "horizon_lattice");
+    kernel.setArg(0, heights_);
+    kernel.setArg(1, field_.width);
+    kernel.setArg(2, field_.height);
+    kernel.setArg(5, samples);
+    kernel.setArg(6, static_cast<int>(d.samples.size()));
+    kernel.setArg(7, d.lattice.a);
+    kernel.setArg(8, d.lattice.b);
+    kernel.setArg(9, static_cast<float>(d.lattice.period));
+    kernel.setArg(10, static_cast<float>(d.lattice.ground_per_pixel));
+    setOutputs(kernel, 11, d, plane_offset);
+    for (const LineChunk& chunk : chunks) {
+      // Sub-buffer offsets must be aligned on some devices: a chunk gets a copy of its lines.
+      cl::Buffer chunk_lines = chunks.size() == 1
+                                   ? line_table
+                                   : cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                                chunk.count * sizeof(LatticeLine), lines.data() + chunk.first);
+      kernel.setArg(3, chunk_lines);
+      kernel.setArg(4, static_cast<int>(chunk.count));
+      kernel.setArg(16, static_cast<cl_uint>(chunk.stride));
+      st_.launch(kernel, cl::NDRange(roundUp(chunk.count, kLineGroup)), cl::NDRange(kLineGroup));
+    }
+  }
+
+  void launchNaive(const RunDirection& d, cl_uint plane_offset) {
+    cl::Kernel kernel(program_, "horizon_naive");
+    kernel.setArg(0, heights_);
+    kernel.setArg(1, field_.width);
+    kernel.setArg(2, field_.height);
+    kernel.setArg(3, d.ray.dir_x);
+    kernel.setArg(4, d.ray.dir_y);
+    kernel.setArg(5, d.ray.step_length);
+    kernel.setArg(6, d.ray.ground_per_pixel);
+    setOutputs(kernel, 7, d, plane_offset);
+    st_.launch(kernel, cl::NDRange(roundUp(field_.width, kTileX), roundUp(field_.height, kTileY)),
+               cl::NDRange(kTileX, kTileY));
+  }
+
+  ContextState& st_;
+  const HeightField& field_;
+  const HorizonOptions& options_;
+  const HorizonOutputs& outputs_;
+  cl::Program program_;
+  cl::Buffer heights_, angles_, distances_, svf_, ao_, normals_, stacks_;
+  std::size_t stack_entries_ = 0;
+};
 
 }  // namespace
-
-SweepLineBuffers sweepLinesOnDevice(const ComputeContext& context, const HeightField& field,
-                                    const std::vector<float>& prepared_heights,
-                                    const SweepDirection& direction) {
-  return translateOpenClErrors([&] {
-    ContextState& st = context.state();
-    cl::Program program = st.program("horizon.cl", layoutProgramOption(st.info));
-    const bool line_major = lineMajorLayout(st.info);
-    SweepBatch batch;
-    batch.directions = {direction};
-    batch.directions[0].buffer_offset = 0;
-    batch.entries = direction.entries();
-    SweepLineBuffers out;
-    out.geometry = batch.directions[0];
-    cl::Buffer heights(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                       prepared_heights.size() * sizeof(float), const_cast<float*>(prepared_heights.data()));
-    const cl::Buffer directions = uploadDirections(st, batch.directions);
-    cl::Buffer lines = deviceBuffer(st, batch.entries * kLineEntryBytes);
-    cl::Buffer stacks = deviceBuffer(st, batch.entries * kLineEntryBytes);
-    std::vector<float> pairs(batch.entries * 2);
-    enqueuePresample(st, program, heights, field.width, field.height, directions, batch, lines);
-    st.queue.enqueueReadBuffer(lines, CL_TRUE, 0, pairs.size() * sizeof(float), pairs.data());
-    // Back to the canonical step-major order of SweepLineBuffers.
-    const SweepDirection& d = out.geometry;
-    out.samples.resize(batch.entries);
-    out.occluder_rises.resize(batch.entries);
-    out.occluder_steps.resize(batch.entries);
-    for (int j = 0; j < d.n_lines; ++j)
-      for (int i = 0; i < d.n_steps; ++i)
-        out.samples[std::size_t(i) * d.n_lines + j] = pairs[2 * lineEntry(d, j, i, line_major)];
-    enqueueHullSweep(st, program, directions, batch, lines, stacks);
-    st.queue.enqueueReadBuffer(lines, CL_TRUE, 0, pairs.size() * sizeof(float), pairs.data());
-    for (int j = 0; j < d.n_lines; ++j) {
-      for (int i = 0; i < d.n_steps; ++i) {
-        const std::size_t e = lineEntry(d, j, i, line_major), canonical = std::size_t(i) * d.n_lines + j;
-        out.occluder_rises[canonical] = pairs[2 * e];
-        out.occluder_steps[canonical] = pairs[2 * e + 1];
-      }
-    }
-    return out;
-  });
-}
-
 }  // namespace detail
 
 HorizonResult computeHorizons(const ComputeContext& context, const HeightField& field,
                               const HorizonOptions& options, const HorizonOutputs& outputs) {
   validate(field);
   validate(options, outputs);
-  return detail::translateOpenClErrors([&] { return detail::run(context, field, options, outputs); });
+  return detail::translateOpenClErrors(
+      [&] { return detail::HorizonRun(context.state(), field, options, outputs).run(); });
 }
 
 }  // namespace hfvis

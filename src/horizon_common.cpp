@@ -10,9 +10,14 @@ namespace hfvis {
 
 void validate(const HorizonOptions& options, const HorizonOutputs& outputs) {
   validate(static_cast<const SweepOptions&>(options));
-  if (options.near_field_samples < 1 || options.near_field_samples > 16) {
-    throw InvalidArgument("near-field samples must be in 1..16 (got " + std::to_string(options.near_field_samples) +
-                          ")");
+  if (!(options.azimuth_tolerance > 0.0) || !(options.azimuth_tolerance <= 0.1)) {
+    throw InvalidArgument("the azimuth tolerance must be in (0, 0.1] radians (got " +
+                          std::to_string(options.azimuth_tolerance) + ")");
+  }
+  if (options.method == HorizonMethod::Sweep && options.lines_per_unit != 1.0) {
+    throw InvalidArgument(
+        "lines per unit applies to the intervisibility sweeps only: the horizon sweep runs one line through "
+        "every pixel centre");
   }
   if (!outputs.horizon_angles && !outputs.horizon_distances && !outputs.sky_view_factor &&
       !outputs.ambient_occlusion) {
@@ -56,8 +61,14 @@ HorizonResult allocateResult(const HeightField& field, const HorizonOptions& opt
   return result;
 }
 
-void finishReduction(const HorizonOptions& options, HorizonResult& result) {
-  for (float& v : result.sky_view_factor) v = 1.0f - v / static_cast<float>(options.directions);
+std::vector<LatticeDirection> horizonDirections(const HeightField& field, const HorizonOptions& options,
+                                                const HorizonOutputs& outputs) {
+  const bool exact = outputs.horizon_angles || outputs.horizon_distances;
+  return latticeDirections(field, options, exact, options.azimuth_tolerance);
+}
+
+void finishReduction(HorizonResult& result) {
+  for (float& v : result.sky_view_factor) v = 1.0f - v;
 }
 
 }  // namespace detail

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "hfvis/horizon.hpp"
+#include "lattice_geometry.hpp"
 #include "sweep_geometry.hpp"
 
 namespace hfvis::detail {
@@ -17,8 +18,13 @@ struct PreparedHeights {
 };
 PreparedHeights prepareHeights(const HeightField& field);
 
-// Turns the accumulated sums into the outputs: svf = 1 - sum / K; ao is the sum itself.
-void finishReduction(const HorizonOptions& options, HorizonResult& result);
+// The sweep directions of a run: exact azimuths (within options.azimuth_tolerance) when
+// per-direction planes are requested, quadrature directions otherwise.
+std::vector<LatticeDirection> horizonDirections(const HeightField& field, const HorizonOptions& options,
+                                                const HorizonOutputs& outputs);
+
+// Turns the accumulated sums into the outputs: svf = 1 - weighted sum; ao is the sum itself.
+void finishReduction(HorizonResult& result);
 
 // An empty result with the requested planes allocated (NaN-filled).
 HorizonResult allocateResult(const HeightField& field, const HorizonOptions& options,

@@ -1,6 +1,6 @@
-// horizon_reference.cpp: scalar mirrors of kernels/horizon.cl (presample, hull-stack
-// sweep, reduction, naive march). Keep every expression in the kernels' order: the
-// build disables FP contraction on both sides so the predicates decide identically.
+// horizon_reference.cpp: scalar mirrors of kernels/horizon.cl (the lattice sweep with its
+// per-receiver outputs, and the naive march). Keep every expression in the kernels' order:
+// the build disables FP contraction on both sides so the predicates decide identically.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -8,6 +8,7 @@
 #include "fast_math.hpp"
 #include "hfvis/reference.hpp"
 #include "horizon_common.hpp"
+#include "lattice_geometry.hpp"
 #include "reference_internal.hpp"
 
 namespace hfvis {
@@ -16,7 +17,6 @@ namespace {
 
 constexpr float kPi = 3.14159265358979323846f;
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-constexpr float kNearMargin = 4e-6f;  // HFVIS_NEAR_MARGIN
 
 struct Normal {
   float x = 0.0f, y = 0.0f, z = 1.0f;
@@ -56,34 +56,63 @@ std::vector<Normal> pixelNormals(const HeightField& field, const std::vector<flo
   return normals;
 }
 
-float ambientTerm(float elevation, Normal n, float cos_az, float sin_az, int directions) {
+float ambientTerm(float elevation, Normal n, float cos_az, float sin_az, float weight) {
   const float toward = n.x * cos_az + n.y * sin_az;
   float zenith = 0.5f * kPi - elevation;
-  zenith = std::fmin(zenith, 0.5f * kPi + hfAtan(toward / n.z));
+  zenith = hfMin(zenith, 0.5f * kPi + hfAtan(toward / n.z));
   const float s = hfSin(zenith);
-  return n.z / static_cast<float>(directions) * s * s +
-         hfSin(kPi / static_cast<float>(directions)) / kPi * (zenith - 0.5f * hfSin(2.0f * zenith)) * toward;
+  return n.z * weight * s * s + hfSin(kPi * weight) / kPi * (zenith - 0.5f * hfSin(2.0f * zenith)) * toward;
 }
 
-// Per-pixel sinks, as emit_direction / accumulate_pixel in the kernel.
-struct PixelSums {
-  float svf = 0.0f, ao = 0.0f;
+// What one direction contributes at one receiver, as emit_direction in the kernel.
+struct DirectionOutputs {
+  float cos_azimuth, sin_azimuth, weight;
+  int k;  // the direction's plane
 };
 
-void emitDirection(HorizonResult& result, int k, std::size_t pixel, float elevation, float distance, Normal n,
-                   const SweepDirection& d, int directions, PixelSums& sums) {
+void emitDirection(HorizonResult& result, std::size_t pixel, bool nodata, float elevation, float distance,
+                   const DirectionOutputs& o, const std::vector<Normal>& normals) {
   const std::size_t plane = static_cast<std::size_t>(result.width) * result.height;
-  if (!result.angles.empty()) result.angles[k * plane + pixel] = elevation;
-  if (!result.distances.empty()) result.distances[k * plane + pixel] = distance;
-  sums.svf += hfSin(std::fmax(0.0f, elevation));
-  sums.ao += ambientTerm(elevation, n, d.cos_azimuth, d.sin_azimuth, directions);
+  if (nodata) elevation = distance = kNaN;
+  if (!result.angles.empty()) result.angles[o.k * plane + pixel] = elevation;
+  if (!result.distances.empty()) result.distances[o.k * plane + pixel] = distance;
+  if (!result.sky_view_factor.empty()) {
+    float& sum = result.sky_view_factor[pixel];
+    sum = nodata ? kNaN : sum + o.weight * hfSin(hfMax(0.0f, elevation));
+  }
+  if (!result.ambient_occlusion.empty()) {
+    float& sum = result.ambient_occlusion[pixel];
+    sum = nodata ? kNaN : sum + ambientTerm(elevation, normals[pixel], o.cos_azimuth, o.sin_azimuth, o.weight);
+  }
 }
 
-void accumulatePixel(HorizonResult& result, std::size_t pixel, bool nodata, const PixelSums& sums) {
-  if (!result.sky_view_factor.empty())
-    result.sky_view_factor[pixel] = nodata ? kNaN : result.sky_view_factor[pixel] + sums.svf;
-  if (!result.ambient_occlusion.empty())
-    result.ambient_occlusion[pixel] = nodata ? kNaN : result.ambient_occlusion[pixel] + sums.ao;
+DirectionOutputs outputsOf(const LatticeDirection& d, int k) {
+  return {static_cast<float>(std::cos(d.azimuth)), static_cast<float>(std::sin(d.azimuth)),
+          static_cast<float>(d.weight), k};
+}
+
+// lattice_height in the kernel.
+float latticeHeight(const std::vector<float>& h, std::size_t at, std::size_t right, std::size_t down,
+                    const LatticeSample& s) {
+  const float h00 = h[at], h10 = h[at + right], h01 = h[at + down], h11 = h[at + down + right];
+  const float plain = s.w00 * h00 + s.w10 * h10 + s.w01 * h01 + s.w11 * h11;
+  if (!std::isnan(plain)) return plain;
+  const bool v00 = s.w00 > 0.0f && !std::isnan(h00), v10 = s.w10 > 0.0f && !std::isnan(h10);
+  const bool v01 = s.w01 > 0.0f && !std::isnan(h01), v11 = s.w11 > 0.0f && !std::isnan(h11);
+  const float sum = (v00 ? s.w00 * h00 : 0.0f) + (v10 ? s.w10 * h10 : 0.0f) + (v01 ? s.w01 * h01 : 0.0f) +
+                    (v11 ? s.w11 * h11 : 0.0f);
+  const float weight = (v00 ? s.w00 : 0.0f) + (v10 ? s.w10 : 0.0f) + (v01 ? s.w01 : 0.0f) + (v11 ? s.w11 : 0.0f);
+  return weight > 0.0f ? sum / weight : kNaN;
+}
+
+// near_slope in the kernel.
+float nearSlope(const std::vector<float>& h, int width, int height, int c, int r, float hp, int a, int b,
+                float period) {
+  const int sx = (a > 0) - (a < 0), sy = (b > 0) - (b < 0);
+  if (c + sx < 0 || c + sx >= width || r + sy < 0 || r + sy >= height) return kNaN;
+  const float hx = h[static_cast<std::size_t>(r) * width + (c + sx)];
+  const float hy = h[static_cast<std::size_t>(r + sy) * width + c];
+  return ((hx - hp) * static_cast<float>(std::abs(a)) + (hy - hp) * static_cast<float>(std::abs(b))) / period;
 }
 
 void sweepReference(const HeightField& field, const PreparedHeights& prepared, const HorizonOptions& options,
@@ -91,61 +120,32 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
   const int width = field.width, height = field.height;
   const auto& h = prepared.heights;
   const auto normals = pixelNormals(field, h, outputs.ambient_occlusion);
-  const auto directions = runDirections(field, options);
-  // Directions one at a time; the kernels sum per batch first, so the sums may differ from
-  // the kernels' in the last bits.
-  std::vector<PixelSums> sums(field.pixelCount());
+  const auto directions = horizonDirections(field, options, outputs);
   for (int k = 0; k < options.directions; ++k) {
-    const SweepDirection& d = directions[k];
-    const LineOccluders lines = referenceSweepLines(field, h, d);
-    for (int r = 0; r < height; ++r) {
-      for (int c = 0; c < width; ++c) {
-        const std::size_t pixel = static_cast<std::size_t>(r) * width + c;
-        const float hp = h[pixel];
-        const float x = static_cast<float>(c), y = static_cast<float>(r);
-        float weight = 0.0f, angle_sum = 0.0f, distance_sum = 0.0f;
-        for (const CellCorner& corner : receiverCell(d, c, r)) {
-          const float w = corner.weight;
-          const int i = corner.step;
-          const std::size_t e = corner.entry;
-          if (w <= 0.0f) continue;
-          const float rise = lines.rises[e], occ_step = lines.steps[e];
-          if (occ_step < 0.0f) continue;
-          const float ground = (static_cast<float>(i) - occ_step) * d.step_length * d.ground_per_pixel;
-          weight += w;
-          angle_sum += w * hfAtan2Ahead(rise, ground);
-          distance_sum += w * ground;
+    const LatticeDirection& d = directions[k];
+    const DirectionOutputs out = outputsOf(d, k);
+    const auto samples = latticeSamples(d, options.samples_per_unit);
+    const float period = static_cast<float>(d.period), gpp = static_cast<float>(d.ground_per_pixel);
+    for (const LatticeLine& line : latticeLines(d, width, height)) {
+      for (const LatticeLineSample& s : latticeLineSamples(field, h, d, samples, line)) {
+        if (s.receiver < 0) continue;
+        const std::size_t pixel = static_cast<std::size_t>(s.receiver);
+        if (std::isnan(s.height)) {
+          emitDirection(result, pixel, true, 0.0f, 0.0f, out, normals);
+          continue;
         }
-        // The exact near field of the receiver's own ray, as in horizon_reduce.
-        float near_slope = 0.0f, near_t = 0.0f;
-        bool near_found = false, ray_has_sample = false;
-        for (int q = 1; q <= options.near_field_samples; ++q) {
-          const float t =
-              static_cast<float>(q) * (d.step_length / static_cast<float>(options.near_field_samples));
-          const Point2 at{x + t * d.dir_x, y + t * d.dir_y};
-          const bool inside = insideField(at, width, height);
-          const float slope = (sampleHeight(h, width, height, at) - hp) / t;
-          if (inside && !std::isnan(slope) && (!near_found || slope >= near_slope)) {
-            near_slope = slope, near_t = t, near_found = true;
-          }
-          if (q == 1) ray_has_sample = inside;
-        }
-        const float near_elevation = hfAtan(near_slope / d.ground_per_pixel);
-        float elevation = weight > 0.0f ? angle_sum / weight : -0.5f * kPi;
-        float distance = weight > 0.0f ? distance_sum / weight : 0.0f;
-        if (near_found && (!(weight > 0.0f) || near_elevation > elevation + kNearMargin)) {
-          elevation = near_elevation, distance = near_t * d.ground_per_pixel;
-        }
-        if (!ray_has_sample) elevation = -0.5f * kPi, distance = 0.0f;
-        if (std::isnan(hp)) elevation = distance = kNaN;
-        PixelSums one;
-        emitDirection(result, k, pixel, elevation, distance, normals[pixel], d, options.directions, one);
-        sums[pixel].svf += one.svf;
-        sums[pixel].ao += one.ao;
+        const int c = static_cast<int>(pixel % width), r = static_cast<int>(pixel / width);
+        const float near = nearSlope(h, width, height, c, r, s.height, d.a, d.b, period) / gpp;
+        const bool has_far = s.occluder >= 0, has_near = !std::isnan(near);
+        const float ground = has_far ? s.occluder_run * gpp : 0.0f;
+        const float far = has_far ? s.occluder_rise / ground : 0.0f;
+        const bool use_near = has_near && (!has_far || near > far);
+        const float elevation = has_far || has_near ? hfAtan(use_near ? near : far) : -0.5f * kPi;
+        const float distance = has_far && !use_near ? ground : 0.0f;
+        emitDirection(result, pixel, false, elevation, distance, out, normals);
       }
     }
   }
-  for (std::size_t p = 0; p < sums.size(); ++p) accumulatePixel(result, p, std::isnan(h[p]), sums[p]);
 }
 
 void naiveReference(const HeightField& field, const PreparedHeights& prepared, const HorizonOptions& options,
@@ -154,13 +154,13 @@ void naiveReference(const HeightField& field, const PreparedHeights& prepared, c
   const auto& h = prepared.heights;
   const auto normals = pixelNormals(field, h, outputs.ambient_occlusion);
   const auto directions = runDirections(field, options);
-  for (int r = 0; r < height; ++r) {
-    for (int c = 0; c < width; ++c) {
-      const std::size_t pixel = static_cast<std::size_t>(r) * width + c;
-      const float hp = h[pixel];
-      PixelSums sums;
-      for (int k = 0; k < options.directions; ++k) {
-        const SweepDirection& d = directions[k];
+  for (int k = 0; k < options.directions; ++k) {
+    const SweepDirection& d = directions[k];
+    const DirectionOutputs out{d.cos_azimuth, d.sin_azimuth, static_cast<float>(1.0 / options.directions), k};
+    for (int r = 0; r < height; ++r) {
+      for (int c = 0; c < width; ++c) {
+        const std::size_t pixel = static_cast<std::size_t>(r) * width + c;
+        const float hp = h[pixel];
         float best_rise = 0.0f;
         int best_step = 0;
         // March until the ray has left the field for good (the kernel's trip count may be
@@ -178,48 +178,48 @@ void naiveReference(const HeightField& field, const PreparedHeights& prepared, c
           }
         }
         const float ground = static_cast<float>(best_step) * d.step_length * d.ground_per_pixel;
-        float elevation = best_step > 0 ? hfAtan2Ahead(best_rise, ground) : -0.5f * kPi;
-        float distance = best_step > 0 ? ground : 0.0f;
-        if (std::isnan(hp)) elevation = distance = kNaN;
-        emitDirection(result, k, pixel, elevation, distance, normals[pixel], d, options.directions, sums);
+        const float elevation = best_step > 0 ? hfAtan(best_rise / ground) : -0.5f * kPi;
+        const float distance = best_step > 0 ? ground : 0.0f;
+        emitDirection(result, pixel, std::isnan(hp), elevation, distance, out, normals);
       }
-      accumulatePixel(result, pixel, std::isnan(hp), sums);
     }
   }
 }
 
 }  // namespace
 
-LineOccluders referenceSweepLines(const HeightField& field, const std::vector<float>& prepared_heights,
-                                  const SweepDirection& d) {
-  LineOccluders out;
-  const std::size_t entries = d.entries();
-  out.samples.assign(entries, kNaN);
-  out.rises.assign(entries, kNaN);
-  out.steps.assign(entries, -1.0f);
-  for (int j = 0; j < d.n_lines; ++j) {
-    for (int i = 0; i < d.n_steps; ++i) {
-      const Point2 p = sweepPosition(d, j, i);
-      if (insideField(p, field.width, field.height))
-        out.samples[static_cast<std::size_t>(i) * d.n_lines + j] =
-            sampleHeight(prepared_heights, field.width, field.height, p);
-    }
-  }
-  // Algorithm 1 of Timonen & Westerholm 2010 per line, as horizon_sweep.
-  std::vector<std::pair<float, float>> stack;
-  for (int j = 0; j < d.n_lines; ++j) {
-    stack.clear();
-    for (int i = 0; i < d.n_steps; ++i) {
-      const std::size_t e = static_cast<std::size_t>(i) * d.n_lines + j;
-      const float h = out.samples[e];
-      if (std::isnan(h)) continue;
-      const float here = static_cast<float>(i);
+std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, const std::vector<float>& h,
+                                                  const LatticeDirection& d,
+                                                  const std::vector<LatticeSample>& samples,
+                                                  const LatticeLine& line) {
+  const int width = field.width, height = field.height;
+  const float period = static_cast<float>(d.period);
+  std::vector<LatticeLineSample> out;
+  // Algorithm 1 of Timonen & Westerholm 2010 along the line, as horizon_lattice.
+  std::vector<std::pair<float, float>> stack;  // (height, position)
+  int c = line.col, r = line.row;
+  for (int i = 0; i < line.receivers; ++i, c -= d.a, r -= d.b) {
+    const float base = static_cast<float>(i) * period;
+    for (std::size_t q = 0; q < samples.size(); ++q) {
+      const LatticeSample& s = samples[q];
+      const int x0 = c + s.ox, y0 = r + s.oy;
+      if (x0 < 0 || x0 + s.ex > width - 1 || y0 < 0 || y0 + s.ey > height - 1) continue;
+      const std::size_t at = static_cast<std::size_t>(y0) * width + x0;
+      LatticeLineSample sample;
+      sample.height = latticeHeight(h, at, s.ex, static_cast<std::size_t>(s.ey) * width, s);
+      sample.position = base - s.tau;
+      sample.receiver = q + 1 == samples.size() ? static_cast<long>(at) : -1;
+      if (std::isnan(sample.height)) {
+        if (sample.receiver >= 0) out.push_back(sample);
+        continue;
+      }
+      const float hq = sample.height, here = sample.position;
       if (!stack.empty()) {
         auto top = stack.back();
-        float v1h = top.first - h, v1d = here - top.second;
+        float v1h = top.first - hq, v1d = here - top.second;
         while (stack.size() > 1) {
           const auto below = stack[stack.size() - 2];
-          const float v2h = below.first - h, v2d = here - below.second;
+          const float v2h = below.first - hq, v2d = here - below.second;
           if (v2h * v1d >= v1h * v2d) {
             top = below, v1h = v2h, v1d = v2d;
             stack.pop_back();
@@ -227,10 +227,13 @@ LineOccluders referenceSweepLines(const HeightField& field, const std::vector<fl
             break;
           }
         }
-        out.rises[e] = top.first - h;
-        out.steps[e] = top.second;
+        sample.occluder = static_cast<long>(stack.size()) - 1;
+        sample.occluder_rise = v1h;
+        sample.occluder_run = v1d;
+        sample.occluder_position = top.second;
       }
-      stack.emplace_back(h, here);
+      stack.emplace_back(hq, here);
+      out.push_back(sample);
     }
   }
   return out;
@@ -245,11 +248,13 @@ HorizonResult referenceHorizons(const HeightField& field, const HorizonOptions& 
   const detail::PreparedHeights prepared = detail::prepareHeights(field);
   HorizonResult result = detail::allocateResult(field, options, outputs);
   if (options.method == HorizonMethod::Sweep) {
+    const auto directions = detail::horizonDirections(field, options, outputs);
+    for (int k = 0; k < options.directions; ++k) result.azimuths[k] = directions[k].azimuth;
     detail::sweepReference(field, prepared, options, outputs, result);
   } else {
     detail::naiveReference(field, prepared, options, outputs, result);
   }
-  detail::finishReduction(options, result);
+  detail::finishReduction(result);
   return result;
 }
 

@@ -165,6 +165,17 @@ void ContextState::launch(const cl::Kernel& kernel, const cl::NDRange& global, c
   entry.second += 1;
 }
 
+cl::Buffer ContextState::reusableBuffer(const std::string& role, std::size_t bytes) {
+  bytes = std::max<std::size_t>(bytes, sizeof(float));
+  auto& entry = buffers_[role];
+  if (entry.second < bytes) {
+    entry.first = cl::Buffer();  // release the smaller one before allocating
+    entry.first = cl::Buffer(context, CL_MEM_READ_WRITE, bytes);
+    entry.second = bytes;
+  }
+  return entry.first;
+}
+
 ContextState::~ContextState() {
   for (const auto& [name, entry] : kernel_seconds)
     std::fprintf(stderr, "hfvis profile: %-20s %9.3f s in %d launches\n", name.c_str(), entry.first,

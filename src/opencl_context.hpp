@@ -30,12 +30,19 @@ struct ContextState {
   // to stderr when the context is destroyed: per-kernel statistics of a run.
   void launch(const cl::Kernel& kernel, const cl::NDRange& global, const cl::NDRange& local);
   bool profiling = false;
+
+  // A device buffer of at least `bytes` for `role` ("lattice stacks", ...), kept between
+  // calls and grown when a call needs more: large scratch buffers are allocated (and, on
+  // CPUs, their pages first touched) once rather than per batch or per call. A context
+  // runs one operation at a time, so one buffer per role suffices.
+  cl::Buffer reusableBuffer(const std::string& role, std::size_t bytes);
   std::map<std::string, std::pair<double, int>> kernel_seconds;  // name -> (seconds, launches)
   ~ContextState();
 
  private:
   std::mutex mutex_;
   std::map<std::string, cl::Program> programs_;
+  std::map<std::string, std::pair<cl::Buffer, std::size_t>> buffers_;
 };
 
 // Kernel source by file name: embedded at build time, or read from the directory named

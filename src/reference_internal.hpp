@@ -1,24 +1,32 @@
 // reference_internal.hpp: line-level pieces of the scalar horizon reference, for tests
-// that compare a sweep line by line.
+// that check a sweep line by line against brute force.
 #pragma once
 
 #include <vector>
 
 #include "hfvis/height_field.hpp"
-#include "sweep_geometry.hpp"
+#include "lattice_geometry.hpp"
 
 namespace hfvis::detail {
 
-// Presampled heights and hull-stack occluders of every line of one direction, laid out as
-// the kernels' line buffer (entry (step i, line j) at i * n_lines + j): the occluder's
-// height above the sample (rise) and its step (-1 = none).
-struct LineOccluders {
-  std::vector<float> samples;
-  std::vector<float> rises;
-  std::vector<float> steps;
+// One sample of a lattice line as the sweep meets it (farthest first): its height (NaN =
+// absent; only receivers are listed then), its position along the line (pixels from the
+// line's far end), the receiver pixel it is (-1 for samples between receivers), and what
+// the hull stack gave it: the occluder's stack depth (-1 = none), its rise above the sample,
+// its distance along the line (pixels) and its position.
+struct LatticeLineSample {
+  float height = 0.0f;
+  float position = 0.0f;
+  long receiver = -1;
+  long occluder = -1;
+  float occluder_rise = 0.0f, occluder_run = 0.0f, occluder_position = 0.0f;
 };
 
-LineOccluders referenceSweepLines(const HeightField& field, const std::vector<float>& prepared_heights,
-                                  const SweepDirection& direction);
+// The samples of one line of direction d (prepared heights h), with Algorithm 1 run over
+// them exactly as horizon_lattice runs it.
+std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, const std::vector<float>& h,
+                                                  const LatticeDirection& d,
+                                                  const std::vector<LatticeSample>& samples,
+                                                  const LatticeLine& line);
 
 }  // namespace hfvis::detail

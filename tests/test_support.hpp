@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <random>
 #include <string>
 #include <utility>
@@ -20,6 +21,23 @@ inline const ComputeContext& testContext() {
   static const ComputeContext context = ComputeContext::create();
   return context;
 }
+
+// Runs `body` once in each line-buffer layout (HFVIS_LINE_LAYOUT=line, the CPU default,
+// then step, the GPU default): CI has no GPU, so the GPU layout is tested here. Programs are
+// cached per layout, so both really run.
+template <typename Body>
+void forEachLayout(Body&& body) {
+  for (const char* layout : {"line", "step"}) {
+    SCOPED_TRACE(std::string("layout ") + layout);
+    setenv("HFVIS_LINE_LAYOUT", layout, 1);
+    body();
+  }
+  unsetenv("HFVIS_LINE_LAYOUT");
+}
+
+// Kernel-against-reference tolerance for values of order one computed through a division:
+// none where the device divides correctly rounded (as C++ does), else a few ulp.
+inline float divisionTolerance() { return testContext().device().correctly_rounded_divide ? 0.0f : 2e-6f; }
 
 // Awkward sizes (CLBlast style): 1x1, 1xN, Nx1, odd, non-square.
 inline const std::vector<std::pair<int, int>>& awkwardSizes() {

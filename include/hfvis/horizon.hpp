@@ -20,18 +20,22 @@ enum class HorizonMethod {
 
 struct HorizonOptions : SweepOptions {
   HorizonMethod method = HorizonMethod::Sweep;
-  // Sweep only: samples of the receiver's own ray over its first step (1..16). The sweep's
-  // horizons come from line samples up to a line spacing away, whose first steps differ
-  // from the receiver's; the receiver's exact near field bounds its horizon from below and
-  // wins where steeper. 1 samples the first step only, as the naive march does.
-  int near_field_samples = 4;
+  // Sweep only. The sweep runs along primitive integer steps (a, b), so that every receiver
+  // lies on a line through its own centre (see README, "How the sweep works"). When the
+  // per-direction planes are requested, direction k is the cheapest step whose azimuth is
+  // within this many radians of phi_k (the closest one when none is; steps up to 64
+  // pixels); HorizonResult::azimuths gives the azimuths used. Sky-view factor and ambient
+  // occlusion alone integrate over azimuth: they take the cheapest step within half the
+  // spacing 2 pi / K of phi_k, weighted by the share of the circle it stands for.
+  // lines_per_unit must stay 1 for the sweep. Default: 0.12 degrees.
+  double azimuth_tolerance = 0.12 * 3.14159265358979323846 / 180.0;
 };
 
 // What to compute; only what is asked for is stored or reduced.
 struct HorizonOutputs {
   bool horizon_angles = false;     // K channels of elevation angle, radians
   bool horizon_distances = false;  // K channels of ground distance to the horizon point
-  bool sky_view_factor = false;    // 1 - mean_k sin(max(0, elevation_k))
+  bool sky_view_factor = false;    // 1 - sum_k w_k sin(max(0, elevation_k)), w_k the directions' weights
   bool ambient_occlusion = false;  // Eq. 5 of Timonen & Westerholm 2010, uniform sky of
                                    // radiance 1, normalised so a flat plane gives 1
 };
@@ -40,7 +44,7 @@ struct HorizonResult {
   int width = 0;
   int height = 0;
   int directions = 0;
-  std::vector<double> azimuths;          // phi_k, radians
+  std::vector<double> azimuths;          // azimuth of each direction as computed, radians
   std::vector<float> angles;             // directions planes of width*height, if asked
   std::vector<float> distances;          // same layout; 0 where no point casts a horizon
   std::vector<float> sky_view_factor;    // width*height, if asked

@@ -1,0 +1,198 @@
+// lattice_geometry.cpp: direction sets, per-period sample tables and line tables of the
+// receiver-exact horizon sweep (see lattice_geometry.hpp).
+#include "lattice_geometry.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include "hfvis/errors.hpp"
+
+namespace hfvis::detail {
+namespace {
+
+constexpr double kTwoPi = 2.0 * M_PI;
+
+// Signed difference of two angles, in (-pi, pi].
+double angleDifference(double x, double y) {
+  double d = std::fmod(x - y, kTwoPi);
+  if (d > M_PI) d -= kTwoPi;
+  if (d <= -M_PI) d += kTwoPi;
+  return d;
+}
+
+struct Candidate {
+  int a, b;
+  int cost;        // crossings of one period: |a| + |b| - 1, or 1 on the axes
+  double azimuth;  // ground azimuth
+};
+
+// Every primitive step with |a|, |b| <= kMaxLatticeStep, cheapest first (ties: shorter
+// period first, then a fixed order, so the choice is deterministic).
+std::vector<Candidate> candidates(const HeightField& field) {
+  std::vector<Candidate> all;
+  for (int a = -kMaxLatticeStep; a <= kMaxLatticeStep; ++a) {
+    for (int b = -kMaxLatticeStep; b <= kMaxLatticeStep; ++b) {
+      if (std::gcd(a, b) != 1) continue;
+      const int cost = (a != 0 && b != 0) ? std::abs(a) + std::abs(b) - 1 : 1;
+      all.push_back({a, b, cost, std::atan2(b * field.cell_size_y, a * field.cell_size_x)});
+    }
+  }
+  std::stable_sort(all.begin(), all.end(), [](const Candidate& x, const Candidate& y) {
+    if (x.cost != y.cost) return x.cost < y.cost;
+    return x.a * x.a + x.b * x.b < y.a * y.a + y.b * y.b;
+  });
+  return all;
+}
+
+LatticeDirection makeDirection(const HeightField& field, const Candidate& c) {
+  LatticeDirection d;
+  d.a = c.a;
+  d.b = c.b;
+  d.azimuth = c.azimuth;
+  d.period = std::hypot(double(c.a), double(c.b));
+  d.ground_per_pixel = std::hypot(c.a * field.cell_size_x, c.b * field.cell_size_y) / d.period;
+  return d;
+}
+
+}  // namespace
+
+std::vector<LatticeDirection> latticeDirections(const HeightField& field, const SweepOptions& options,
+                                                bool exact_azimuths, double tolerance) {
+  const std::vector<Candidate> all = candidates(field);
+  const int K = options.directions;
+  // Quadrature directions stay strictly inside their own half-spacing, so no two coincide.
+  const double window = exact_azimuths ? tolerance : 0.4999 * kTwoPi / K;
+  std::vector<LatticeDirection> out;
+  for (int k = 0; k < K; ++k) {
+    const double target = directionAzimuth(k, options);
+    const Candidate* chosen = nullptr;
+    const Candidate* closest = &all.front();
+    for (const Candidate& c : all) {
+      const double error = std::abs(angleDifference(c.azimuth, target));
+      if (error <= window) {
+        chosen = &c;
+        break;
+      }
+      if (error < std::abs(angleDifference(closest->azimuth, target))) closest = &c;
+    }
+    out.push_back(makeDirection(field, chosen ? *chosen : *closest));
+    out.back().azimuth = target + angleDifference(out.back().azimuth, target);  // next to phi_k
+  }
+  if (exact_azimuths || K == 1) {
+    for (auto& d : out) d.weight = 1.0 / K;
+    return out;
+  }
+  // Quadrature weights: each direction stands for the azimuths closer to it than to its
+  // neighbours (directions k are in increasing azimuth order around the circle).
+  for (int k = 0; k < K; ++k) {
+    const double previous = out[(k + K - 1) % K].azimuth, next = out[(k + 1) % K].azimuth;
+    double gap_before = angleDifference(out[k].azimuth, previous), gap_after = angleDifference(next, out[k].azimuth);
+    if (K == 2) gap_before = gap_after = M_PI;
+    out[k].weight = 0.5 * (gap_before + gap_after) / kTwoPi;
+  }
+  return out;
+}
+
+std::vector<LatticeSample> latticeSamples(const LatticeDirection& d, double samples_per_unit) {
+  // Crossings as fractions of the period: columns at i / |a|, rows at j / |b|.
+  std::vector<double> crossings = {0.0, 1.0};
+  for (int i = 1; i < std::abs(d.a); ++i) crossings.push_back(double(i) / std::abs(d.a));
+  for (int j = 1; j < std::abs(d.b); ++j) crossings.push_back(double(j) / std::abs(d.b));
+  std::sort(crossings.begin(), crossings.end());
+  // Fractions of the period at which samples lie (the receiver's 0 included, the next
+  // receiver's 1 not), each with whether it is a crossing.
+  std::vector<double> fractions;
+  for (std::size_t q = 0; q + 1 < crossings.size(); ++q) {
+    const double span = crossings[q + 1] - crossings[q];
+    const int parts = std::max(2, static_cast<int>(std::ceil(samples_per_unit * span * d.period - 1e-9)));
+    for (int s = 0; s < parts; ++s) fractions.push_back(crossings[q] + span * s / parts);
+  }
+  std::vector<LatticeSample> samples;
+  for (auto it = fractions.rbegin(); it != fractions.rend(); ++it) {
+    const double f = *it;
+    // Offsets from the receiver; crossings fall exactly on grid lines (snap the rounding).
+    auto snapped = [](double v) { return std::abs(v - std::round(v)) < 1e-9 ? std::round(v) : v; };
+    const double x = snapped(d.a * f), y = snapped(d.b * f);
+    const double ox = std::floor(x), oy = std::floor(y);
+    const float fx = static_cast<float>(x - ox), fy = static_cast<float>(y - oy);
+    LatticeSample s;
+    s.tau = static_cast<float>(f * d.period);
+    s.ox = static_cast<std::int32_t>(ox);
+    s.oy = static_cast<std::int32_t>(oy);
+    s.ex = fx > 0.0f;
+    s.ey = fy > 0.0f;
+    s.w00 = (1.0f - fx) * (1.0f - fy);
+    s.w10 = fx * (1.0f - fy);
+    s.w01 = (1.0f - fx) * fy;
+    s.w11 = fx * fy;
+    samples.push_back(s);
+  }
+  return samples;
+}
+
+std::vector<LatticeLine> latticeLines(const LatticeDirection& d, int width, int height) {
+  // Each line with a receiver has exactly one farthest receiver: a pixel whose next step
+  // (c + a, r + b) leaves the field. Those lie in a band |a| columns wide at the far column
+  // edge and |b| rows high at the far row edge.
+  auto outside = [&](long c, long r) { return c < 0 || c >= width || r < 0 || r >= height; };
+  auto receivers = [&](long c, long r) {
+    // Steps back (c - m a, r - m b) that stay inside: m <= c / a for a > 0, and so on.
+    long m = std::numeric_limits<long>::max();
+    if (d.a > 0) m = std::min(m, c / d.a);
+    if (d.a < 0) m = std::min(m, (width - 1 - c) / -d.a);
+    if (d.b > 0) m = std::min(m, r / d.b);
+    if (d.b < 0) m = std::min(m, (height - 1 - r) / -d.b);
+    return m + 1;
+  };
+  std::vector<LatticeLine> lines;
+  auto add = [&](int c, int r) { lines.push_back({c, r, static_cast<std::int32_t>(receivers(c, r)), 0}); };
+  for (int r = 0; r < height; ++r) {
+    if (outside(0, long(r) + d.b)) {  // the whole row is in the row band
+      for (int c = 0; c < width; ++c) add(c, r);
+    } else if (d.a > 0) {
+      for (int c = std::max(0, width - d.a); c < width; ++c) add(c, r);
+    } else if (d.a < 0) {
+      for (int c = 0; c < std::min(width, -d.a); ++c) add(c, r);
+    }
+  }
+  return lines;
+}
+
+std::size_t lineCapacity(const LatticeLine& line, std::size_t samples_per_period) {
+  return static_cast<std::size_t>(line.receivers) * samples_per_period;
+}
+
+std::vector<LineChunk> chunkLines(std::vector<LatticeLine>& lines, std::size_t samples_per_period,
+                                  std::size_t max_entries, bool line_major) {
+  std::vector<LineChunk> chunks;
+  LineChunk chunk;
+  std::size_t longest = 0;  // largest capacity in the chunk (step-major)
+  auto close = [&] {
+    if (chunk.count == 0) return;
+    chunk.stack_entries = line_major ? chunk.stack_entries : longest * chunk.count;
+    chunk.stride = line_major ? 1u : static_cast<std::uint32_t>(chunk.count);
+    if (!line_major)
+      for (std::size_t j = 0; j < chunk.count; ++j) lines[chunk.first + j].stack = static_cast<std::int32_t>(j);
+    chunks.push_back(chunk);
+  };
+  for (std::size_t j = 0; j < lines.size(); ++j) {
+    const std::size_t capacity = lineCapacity(lines[j], samples_per_period);
+    const std::size_t need = line_major ? chunk.stack_entries + capacity
+                                        : std::max(longest, capacity) * (chunk.count + 1);
+    if (chunk.count > 0 && (need > max_entries || need >= (std::size_t(1) << 31))) {
+      close();
+      chunk = LineChunk{j, 0, 0, 1};
+      longest = 0;
+    }
+    if (line_major) lines[j].stack = static_cast<std::int32_t>(chunk.stack_entries);
+    chunk.stack_entries += line_major ? capacity : 0;
+    longest = std::max(longest, capacity);
+    ++chunk.count;
+  }
+  close();
+  return chunks;
+}
+
+}  // namespace hfvis::detail

@@ -1,0 +1,90 @@
+// lattice_geometry.hpp: the receiver-exact sweep geometry of the horizon operation. A
+// direction is a primitive integer step (a, b) in pixel axes; every pixel centre lies on
+// exactly one line of that direction, so every receiver is a sample of the line through
+// its own centre and its hull-stack horizon is the horizon of its own ray. Between two
+// consecutive pixel centres of a line the samples sit where the line crosses the grid's
+// columns and rows (there the bilinear surface is linear, so these heights are exact) and
+// between consecutive crossings (inside a cell the surface is a quadratic along the ray,
+// which can peak between them). The pattern is the same for every period of every line,
+// so it is one small table per direction. Shared by the kernels' host code and the scalar
+// references, so both sample the very same points.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "hfvis/height_field.hpp"
+#include "hfvis/sweep_options.hpp"
+
+namespace hfvis::detail {
+
+// One sweep direction of a run.
+struct LatticeDirection {
+  int a = 1, b = 0;       // primitive step between consecutive receivers of a line (columns, rows)
+  double azimuth = 0.0;   // ground azimuth of (a, b), radians
+  double weight = 0.0;    // share of the circle of azimuth it stands for (sums to 1 over a run)
+  double ground_per_pixel = 1.0;  // ground length of one pixel length along (a, b)
+  double period = 1.0;    // |(a, b)| in pixels: distance between consecutive receivers of a line
+};
+
+// The directions of a run. With `exact_azimuths` (per-direction planes requested),
+// direction k is the cheapest primitive step whose ground azimuth is within `tolerance`
+// radians of phi_k = 2 pi k / K + offset (the closest one when none is), each with weight
+// 1/K. Otherwise (sky-view factor and occlusion, which integrate over azimuth) the
+// cheapest within a quarter of the spacing 2 pi / K, with quadrature weights from the
+// azimuths actually used (half the gap to each neighbour). Cost is |a| + |b|: the crossings
+// of one period. Steps are bounded by kMaxLatticeStep.
+constexpr int kMaxLatticeStep = 64;
+std::vector<LatticeDirection> latticeDirections(const HeightField& field, const SweepOptions& options,
+                                                bool exact_azimuths, double tolerance);
+
+// One sample of a period, as the kernel reads it (nine 4-byte members, uploaded as is; must
+// match LatticeSample in kernels/horizon.cl). The sample lies at `tau` pixels from the
+// period's receiver toward +(a, b), in the cell whose lower corner is (ox, oy) from the
+// receiver, at fractions (fx, fy) with bilinear weights w00..w11; ex (ey) is 1 when fx
+// (fy) > 0, i.e. when the cell's far column (row) is needed.
+struct LatticeSample {
+  float tau;
+  std::int32_t ox, oy, ex, ey;
+  float w00, w10, w01, w11;
+};
+static_assert(sizeof(LatticeSample) == 36, "LatticeSample must match the kernel struct");
+
+// The samples of one period of direction d, farthest first; the last one is the receiver
+// itself (tau = 0). Each interval between consecutive crossings is cut into
+// max(2, ceil(S * length)) equal parts (S = samples per unit), so there is at least its
+// midpoint and samples are at most 1/S pixel apart.
+std::vector<LatticeSample> latticeSamples(const LatticeDirection& d, double samples_per_unit);
+
+// One line of a direction: its farthest receiver (along +(a, b)) and how many receivers it
+// has; receiver i sits at (col - i a, row - i b). `stack` is the first entry of its hull
+// stack in the scratch buffer (entries at stack + depth * stride).
+struct LatticeLine {
+  std::int32_t col, row, receivers, stack;
+};
+static_assert(sizeof(LatticeLine) == 16, "LatticeLine must match the kernel's int4");
+
+// Every line of direction d over a width x height field that holds a receiver, stack
+// offsets left at 0.
+std::vector<LatticeLine> latticeLines(const LatticeDirection& d, int width, int height);
+
+// Lines [first, first + count) of a direction, as one launch runs them, with their hull
+// stacks laid out in one scratch buffer: line-major (each line's stack contiguous, at the
+// sum of the capacities before it; stride 1) for CPUs, step-major (depth k of line j at
+// k * count + j, stride count) for GPUs. Capacity: every sample of the line's periods.
+struct LineChunk {
+  std::size_t first = 0, count = 0;
+  std::size_t stack_entries = 0;  // scratch entries the chunk needs
+  std::uint32_t stride = 1;
+};
+// Splits `lines` into chunks whose scratch fits `max_entries` (at least one line each),
+// setting each line's stack offset within its chunk.
+std::vector<LineChunk> chunkLines(std::vector<LatticeLine>& lines, std::size_t samples_per_period,
+                                  std::size_t max_entries, bool line_major);
+
+// Scratch entries one line needs (its capacity) and the most any line of d over the field
+// needs: a direction can always be run one line at a time.
+std::size_t lineCapacity(const LatticeLine& line, std::size_t samples_per_period);
+
+}  // namespace hfvis::detail
