@@ -160,17 +160,47 @@ HFVIS_INLINE float near_slope(__global const float* heights, int width, int heig
   return leaves ? NAN : slope;
 }
 
+// One step of Algorithm 1 (Timonen & Westerholm 2010) for a sample of height h at
+// position `here` along the line: pops the stack while the entry below the top casts at
+// least as steep a slope on the sample as the top (so the farther wins ties); the top that
+// remains is its horizon occluder, whose rise above the sample and distance along the line
+// (pixels) it returns in *rise, *run (run 0: none). Then pushes the sample. The top entry
+// is kept in registers (*top_h, *top_p) as well as in the stack.
+HFVIS_INLINE void hull_stack_step(__global float2* stack, uint stride, uint* size, float* top_h, float* top_p,
+                                  float h, float here, float* rise, float* run) {
+  uint n = *size;
+  float v1h = *top_h - h, v1d = here - *top_p;
+  while (n > 1) {
+    const float2 below = stack[(n - 2) * stride];
+    const float v2h = below.x - h, v2d = here - below.y;
+    if (v2h * v1d >= v1h * v2d) {
+      v1h = v2h;
+      v1d = v2d;
+      *top_h = below.x;
+      *top_p = below.y;
+      --n;
+    } else {
+      break;
+    }
+  }
+  *rise = v1h;
+  *run = n > 0 ? v1d : 0.0f;
+  stack[n * stride] = (float2)(h, here);
+  *top_h = h;
+  *top_p = here;
+  *size = n + 1;
+}
+
 // The sweep of one direction (a, b): one work-item per line, from the line's far end toward
 // -(a, b). Line j's farthest receiver is lines[j] = (col, row, receivers, stack); receiver
 // i sits at (col - i a, row - i b). Per receiver, the period's samples farther along the
-// line come first (farthest first), then the receiver itself (samples[n_samples - 1]).
-// Algorithm 1: a new sample pops the stack while the entry below the top casts at least as
-// steep a slope on it as the top (so the farther wins ties), and the remaining top is its
-// horizon occluder; then it is pushed. Samples outside the field or without height are
-// absent. Stack entry k of a line is (height, position along the line in pixels from its
-// far end) at stacks[stack + k * stride]; the capacity is every sample of its periods.
-// Preconditions: lines of this launch only; stride 1 (line-major) or the launch's line
-// count (step-major). Global size: n_lines rounded up; any local size.
+// line come first (samples[0 .. n_samples - 2], farthest first), then the receiver itself,
+// each through hull_stack_step. Only the first period can reach outside the field (the
+// others lie between two receivers, inside it), so only it tests; samples outside the
+// field or without height are absent. Stack entry k of a line is (height, position along
+// the line in pixels from its far end) at stacks[stack + k * stride]; the capacity is every
+// sample of its periods. Preconditions: lines of this launch only; stride 1 (line-major) or
+// the launch's line count (step-major). Global size: n_lines rounded up; any local size.
 __kernel void horizon_lattice(__global const float* heights, int width, int height,
                               __global const int4* lines, int n_lines, __global const LatticeSample* samples,
                               int n_samples, int a, int b, float period, float ground_per_pixel,
@@ -185,57 +215,41 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
   const uint pixel_count = (uint)(width * height);
   __global float2* stack = stacks + line.w;
   int c = line.x, r = line.y;
-  uint n = 0;                     // stack size
-  float top_h = 0.0f, top_p = 0.0f;  // the top entry, kept in registers
+  uint n = 0;                        // stack size
+  float top_h = 0.0f, top_p = 0.0f;  // the top entry
+  float rise, run;
   for (int i = 0; i < line.z; ++i, c -= a, r -= b) {
     const float base = (float)i * period;  // the receiver's position along the line
-    for (int q = 0; q < n_samples; ++q) {
+    for (int q = 0; q < n_samples - 1; ++q) {
       __global const LatticeSample* s = samples + q;
       const int x0 = c + s->ox, y0 = r + s->oy, ex = s->ex, ey = s->ey;
-      if (x0 < 0 || x0 + ex > width - 1 || y0 < 0 || y0 + ey > height - 1) continue;
-      const uint at = (uint)(y0 * width + x0);
-      const float h = lattice_height(heights, at, (uint)ex, (uint)(ey * width), s->w00, s->w10, s->w01, s->w11);
-      const int receiver = q == n_samples - 1;
-      if (isnan(h)) {
-        if (receiver) emit_direction(at, 1, 0.0f, 0.0f, outputs, normals, pixel_count, angles, distances, svf_sum, ao_sum);
-        continue;
-      }
-      const float here = base - s->tau;
-      float rise = 0.0f, ground = 0.0f;  // to the occluder, when the stack is not empty
-      if (n > 0) {
-        float v1h = top_h - h, v1d = here - top_p;
-        while (n > 1) {
-          const float2 below = stack[(n - 2) * stride];
-          const float v2h = below.x - h, v2d = here - below.y;
-          if (v2h * v1d >= v1h * v2d) {
-            top_h = below.x;
-            top_p = below.y;
-            v1h = v2h;
-            v1d = v2d;
-            --n;
-          } else {
-            break;
-          }
-        }
-        rise = v1h;
-        ground = v1d * ground_per_pixel;
-      }
-      if (receiver) {
-        // The steeper of the hull's occluder and the limit at the receiver; the occluder
-        // wins ties (it is the farther point casting that elevation).
-        const float near = near_slope(heights, width, height, c, r, h, a, b, period) / ground_per_pixel;
-        const int has_far = n > 0, has_near = !isnan(near);
-        const float far = has_far ? rise / ground : 0.0f;
-        const int use_near = has_near && (!has_far || near > far);
-        const float elevation = has_far || has_near ? hf_atan(use_near ? near : far) : -0.5f * HFVIS_PI_F;
-        const float distance = has_far && !use_near ? ground : 0.0f;
-        emit_direction(at, 0, elevation, distance, outputs, normals, pixel_count, angles, distances, svf_sum, ao_sum);
-      }
-      stack[n * stride] = (float2)(h, here);
-      top_h = h;
-      top_p = here;
-      ++n;
+      if (i == 0 && (x0 < 0 || x0 + ex > width - 1 || y0 < 0 || y0 + ey > height - 1)) continue;
+      const float h = lattice_height(heights, (uint)(y0 * width + x0), (uint)ex, (uint)(ey * width), s->w00, s->w10,
+                                     s->w01, s->w11);
+#if HFVIS_HAS_NODATA
+      if (isnan(h)) continue;
+#endif
+      hull_stack_step(stack, stride, &n, &top_h, &top_p, h, base - s->tau, &rise, &run);
     }
+    const uint pixel = (uint)(r * width + c);
+    const float h = heights[pixel];
+#if HFVIS_HAS_NODATA
+    if (isnan(h)) {
+      emit_direction(pixel, 1, 0.0f, 0.0f, outputs, normals, pixel_count, angles, distances, svf_sum, ao_sum);
+      continue;
+    }
+#endif
+    hull_stack_step(stack, stride, &n, &top_h, &top_p, h, base, &rise, &run);
+    // The steeper of the hull's occluder and the limit at the receiver; the occluder wins
+    // ties (it is the farther point casting that elevation).
+    const float near = near_slope(heights, width, height, c, r, h, a, b, period) / ground_per_pixel;
+    const float ground = run * ground_per_pixel;
+    const int has_far = run > 0.0f, has_near = !isnan(near);
+    const float far = has_far ? rise / ground : 0.0f;
+    const int use_near = has_near && (!has_far || near > far);
+    const float elevation = has_far || has_near ? hf_atan(use_near ? near : far) : -0.5f * HFVIS_PI_F;
+    const float distance = has_far && !use_near ? ground : 0.0f;
+    emit_direction(pixel, 0, elevation, distance, outputs, normals, pixel_count, angles, distances, svf_sum, ao_sum);
   }
 }
 
