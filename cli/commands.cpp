@@ -403,7 +403,12 @@ int runCompute(Command command, const RunArguments& run) {
 
   const std::size_t pixels = static_cast<std::size_t>(result.width) * static_cast<std::size_t>(result.height);
   const int directions = run.directions;
-  const Attributes attributes = runAttributes(command, run, field, device);
+  Attributes attributes = runAttributes(command, run, field, device);
+  // The sweep's directions are lattice steps near phi_k (horizon planes) or quadrature
+  // directions (svf, ao): record the azimuths it used.
+  std::string used;
+  for (double azimuth : result.azimuths) used += (used.empty() ? "" : ",") + formatNumber(azimuth * 180.0 / M_PI);
+  attributes.emplace_back("hfvis:azimuths_deg", used);
 
   // Everything is computed; now stage every file, then move them all into place.
   StagedOutputs outputs;
@@ -423,7 +428,8 @@ int runCompute(Command command, const RunArguments& run) {
           makeImage(result.width, result.height, directionChannelNames("d", directions),
                     splitPlanes(result.distances, pixels, directions), attributes,
                     "ground distance to the point casting the horizon, per direction",
-                    "ground units (pixels times cell size); 0 where no point casts a horizon");
+                    "ground units (pixels times cell size); 0 where no point casts a horizon or the "
+                  "surface's own slope at the receiver is the horizon");
       outputs.stage(run.distance_output, [&](const std::string& path) { writeImage(path, distances); });
     }
     if (!run.preview.empty()) {

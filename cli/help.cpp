@@ -33,13 +33,20 @@ const char* const kOptions = R"(
 Options:
   -o, --output FILE        output image, float32 EXR (required)
   -k, --directions K       number of azimuth directions, K >= 1 (default 64)
-  --method sweep|naive     horizon, svf, ao: sweep = convex-hull-stack sweep, linear time per
-                           direction; naive = per-pixel ray march, slow reference (default sweep)
+  --method sweep|naive     horizon, svf, ao: sweep = convex-hull-stack sweep along lines through
+                           every pixel centre, linear time per direction, exact for each receiver's
+                           own ray; naive = per-pixel ray march, slow reference (default sweep).
+                           The sweep's directions are integer pixel steps: within 0.12 deg of
+                           phi_k for horizon, within half the spacing (weighted) for svf and ao;
+                           the hfvis:azimuths_deg attribute lists those used
   --method tree|naive      viewcount: tree = convex hull tree sweep (Timonen 2013); naive =
                            per-pixel visibility march, slow reference (default tree)
   --azimuth-offset DEG     added to every direction's azimuth, degrees (default 0)
-  --samples-per-unit S     height samples per pixel length along a line or ray (default 1)
-  --lines-per-unit L       sweep lines per pixel length across a direction (default 1)
+  --samples-per-unit S     naive, viewcount, bounce: height samples per pixel length along a
+                           line or ray; sweep: besides the grid-line crossings, samples at most
+                           1/S pixel apart and at least one between two crossings (default 1)
+  --lines-per-unit L       viewcount, bounce: sweep lines per pixel length across a direction
+                           (default 1; the horizon sweep always has one line per pixel centre)
   --cell-size X[,Y]        ground units per pixel along columns (X) and rows (Y)
                            (default: from the file (hfvis:cell_size_x/y attributes,
                            GeoTIFF pixel scale), else 1)

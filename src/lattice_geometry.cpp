@@ -104,7 +104,11 @@ std::vector<LatticeSample> latticeSamples(const LatticeDirection& d, double samp
   // Fractions of the period at which samples lie (the receiver's 0 included, the next
   // receiver's 1 not), each with whether it is a crossing.
   std::vector<double> fractions;
-  for (std::size_t q = 0; q + 1 < crossings.size(); ++q) {
+  // Along a grid line the bilinear surface is linear between pixel centres: the centres are
+  // the whole surface's hull there, and points between them would only add ties.
+  const bool along_grid_line = d.a == 0 || d.b == 0;
+  if (along_grid_line) fractions.push_back(0.0);
+  for (std::size_t q = 0; q + 1 < crossings.size() && !along_grid_line; ++q) {
     const double span = crossings[q + 1] - crossings[q];
     const int parts = std::max(2, static_cast<int>(std::ceil(samples_per_unit * span * d.period - 1e-9)));
     for (int s = 0; s < parts; ++s) fractions.push_back(crossings[q] + span * s / parts);

@@ -54,7 +54,8 @@ static_assert(sizeof(LatticeSample) == 36, "LatticeSample must match the kernel 
 // The samples of one period of direction d, farthest first; the last one is the receiver
 // itself (tau = 0). Each interval between consecutive crossings is cut into
 // max(2, ceil(S * length)) equal parts (S = samples per unit), so there is at least its
-// midpoint and samples are at most 1/S pixel apart.
+// midpoint and samples are at most 1/S pixel apart. Lines along a grid row or column have
+// only their pixel centres: the surface is linear between them.
 std::vector<LatticeSample> latticeSamples(const LatticeDirection& d, double samples_per_unit);
 
 // One line of a direction: its farthest receiver (along +(a, b)) and how many receivers it
