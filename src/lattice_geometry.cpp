@@ -110,7 +110,7 @@ std::vector<LatticeSample> latticeSamples(const LatticeDirection& d, double samp
   if (along_grid_line) fractions.push_back(0.0);
   for (std::size_t q = 0; q + 1 < crossings.size() && !along_grid_line; ++q) {
     const double span = crossings[q + 1] - crossings[q];
-    const int parts = std::max(2, static_cast<int>(std::ceil(samples_per_unit * span * d.period - 1e-9)));
+    const int parts = std::max(1, static_cast<int>(std::lround(samples_per_unit * span * d.period)));
     for (int s = 0; s < parts; ++s) fractions.push_back(crossings[q] + span * s / parts);
   }
   std::vector<LatticeSample> samples;

@@ -3,9 +3,9 @@
 // exactly one line of that direction, so every receiver is a sample of the line through
 // its own centre and its hull-stack horizon is the horizon of its own ray. Between two
 // consecutive pixel centres of a line the samples sit where the line crosses the grid's
-// columns and rows (there the bilinear surface is linear, so these heights are exact) and
-// between consecutive crossings (inside a cell the surface is a quadratic along the ray,
-// which can peak between them). The pattern is the same for every period of every line,
+// columns and rows (there the bilinear surface is linear, so these heights are exact) and,
+// with denser sampling, between consecutive crossings (inside a cell the surface is a
+// quadratic along the ray, which can peak between them). The pattern is the same for every period of every line,
 // so it is one small table per direction. Shared by the kernels' host code and the scalar
 // references, so both sample the very same points.
 #pragma once
@@ -52,10 +52,11 @@ struct LatticeSample {
 static_assert(sizeof(LatticeSample) == 36, "LatticeSample must match the kernel struct");
 
 // The samples of one period of direction d, farthest first; the last one is the receiver
-// itself (tau = 0). Each interval between consecutive crossings is cut into
-// max(2, ceil(S * length)) equal parts (S = samples per unit), so there is at least its
-// midpoint and samples are at most 1/S pixel apart. Lines along a grid row or column have
-// only their pixel centres: the surface is linear between them.
+// itself (tau = 0). Each interval between consecutive crossings (at most a cell diagonal
+// long) is cut into max(1, round(S * length)) equal parts (S = samples per unit): S = 1
+// takes the crossings alone, larger S adds points between them about 1/S pixel apart,
+// where the surface can peak inside a cell. Lines along a grid row or column have only
+// their pixel centres: the surface is linear between them.
 std::vector<LatticeSample> latticeSamples(const LatticeDirection& d, double samples_per_unit);
 
 // One line of a direction: its farthest receiver (along +(a, b)) and how many receivers it

@@ -112,8 +112,9 @@ TEST_F(BenchSmoke, TinySuiteMeasuresEveryMethodInEverySection) {
   const CsvTable csv = readCsv(dir_ / "report" / "results.csv");
   const std::size_t section = csv.column("section"), method = csv.column("method");
   const std::size_t error = csv.column("err_mean_deg"), metric = csv.column("metric"), value = csv.column("value");
-  std::set<std::string> sections, methods;
-  int rows_with_errors = 0;
+  const std::size_t outputs = csv.column("outputs"), spu = csv.column("spu"), svf_error = csv.column("svf_mean_abs");
+  std::set<std::string> sections, methods, plane_sweep_spus;
+  int rows_with_errors = 0, svf_only_with_errors = 0;
   for (const auto& f : csv.rows) {
     if (f.size() != csv.columns.size()) continue;  // reported by readCsv
     const std::string line = f[section] + "," + f[method] + ",...";
@@ -123,17 +124,33 @@ TEST_F(BenchSmoke, TinySuiteMeasuresEveryMethodInEverySection) {
       ++rows_with_errors;
       EXPECT_TRUE(std::isfinite(std::stod(f[error]))) << line;
     }
-    // The benchmark's naive march and the library's are the same method.
-    if (f[metric] == "naive_bench_vs_library_naive_max_deg") {
+    if (f[section] == "plane" && f[method] == "sweep") plane_sweep_spus.insert(f[spu]);
+    // The headline's SVF-only runs (sweep and naive) carry their SVF error against the truth.
+    if (f[section] == "headline" && f[outputs] == "svf") {
+      EXPECT_FALSE(f[svf_error].empty()) << line;
+      if (!f[svf_error].empty()) {
+        EXPECT_TRUE(std::isfinite(std::stod(f[svf_error]))) << line;
+        EXPECT_LT(std::stod(f[svf_error]), 0.2) << line;
+        ++svf_only_with_errors;
+      }
+    }
+    // The baselines' march (radius_R's kernel, unbounded) and the library's naive march are
+    // the same method.
+    if (f[metric] == "baseline_march_vs_library_naive_max_deg") {
       EXPECT_LT(std::stod(f[value]), 0.01) << line;
     }
+    // One naive kernel: no bench-only naive march, and the horizon sweep has no lines per unit.
+    EXPECT_NE(f[method], "naive_bench") << line;
   }
   for (const char* s :
        {"checks", "truth", "plane", "sources", "azimuth", "stack", "headline", "scale_n", "scale_k"})
     EXPECT_TRUE(sections.count(s)) << "no rows for section " << s;
-  for (const char* m : {"sweep", "naive", "naive_bench", "radius_4", "pyramid_4", "floor"})
+  for (const char* m : {"sweep", "naive", "radius_4", "pyramid_4", "floor"})
     EXPECT_TRUE(methods.count(m)) << "no rows for method " << m;
+  for (const char* s : {"1", "4"}) EXPECT_TRUE(plane_sweep_spus.count(s)) << "no plane rows for the sweep at spu " << s;
+  for (const auto& c : csv.columns) EXPECT_NE(c, "lpu");
   EXPECT_GT(rows_with_errors, 0);
+  EXPECT_EQ(svf_only_with_errors, 2);  // sweep and naive
   EXPECT_TRUE(fs::exists(dir_ / "report" / "environment.txt"));
 }
 
