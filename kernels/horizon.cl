@@ -62,32 +62,32 @@ HFVIS_INLINE void surface_normal(__global const float* heights, int width, int h
   *nz = any ? sz_sum / length : 1.0f;
 }
 
-// Every pixel's unit normal (three planes x, y, z of width*height), for ambient occlusion.
-// Global size: (W, H) rounded up.
+// Every pixel's unit normal as (x, y, z, 0), one 16-byte load per receiver, for ambient
+// occlusion. Global size: (W, H) rounded up.
 __kernel void pixel_normals(__global const float* heights, int width, int height, float cell_x, float cell_y,
-                            __global float* normals) {
+                            __global float4* normals) {
   int c = get_global_id(0), r = get_global_id(1);
   if (c >= width || r >= height) return;
-  const uint pixel = (uint)(r * width + c), plane = (uint)(width * height);
+  const uint pixel = (uint)(r * width + c);
   float nx, ny, nz;
   surface_normal(heights, width, height, c, r, heights[pixel], cell_x, cell_y, &nx, &ny, &nz);
-  normals[pixel] = nx;
-  normals[plane + pixel] = ny;
-  normals[2 * plane + pixel] = nz;
+  normals[pixel] = (float4)(nx, ny, nz, 0.0f);
 }
 
 // Uniform-sky irradiance of one azimuthal swath (Eq. 5 of Timonen & Westerholm 2010) of
-// width 2 pi * `weight` for horizon elevation `elevation`, normalised so that a flat plane
-// sums to 1 over a run's swaths. The zenith angle is clamped where the sky falls behind the
-// surface (N . e = 0).
-HFVIS_INLINE float ambient_term(float elevation, float nx, float ny, float nz, float cos_az, float sin_az,
-                                float weight) {
-  float toward = nx * cos_az + ny * sin_az;
-  float zenith = 0.5f * HFVIS_PI_F - elevation;
-  zenith = hf_min(zenith, 0.5f * HFVIS_PI_F + hf_atan(toward / nz));
-  float s = hf_sin(zenith);
-  return nz * weight * s * s +
-         hf_sin(HFVIS_PI_F * weight) / HFVIS_PI_F * (zenith - 0.5f * hf_sin(2.0f * zenith)) * toward;
+// width 2 pi * weight, normalised so that a flat plane sums to 1 over a run's swaths, for a
+// horizon of slope rise / run (found 0: none, elevation -pi/2). With elevation e and zenith
+// angle z = pi/2 - e, Eq. 5's sin^2 z = cos^2 e = 1 / (1 + x^2) and sin 2z / 2 = x cos^2 e for
+// x = tan e, so only e itself needs an arctangent. The sky behind the surface (N . e < 0)
+// does not count: the horizon is at least the tangent plane's slope -toward / nz in this
+// azimuth. swath = sin(pi weight) / pi, per direction.
+HFVIS_INLINE float ambient_term(int found, float rise, float run, float4 n, float cos_az, float sin_az, float weight,
+                                float swath) {
+  float toward = n.x * cos_az + n.y * sin_az;
+  int behind = !found || rise * n.z < -toward * run;
+  float x = behind ? -toward / n.z : rise / run;
+  float cos2 = 1.0f / (1.0f + x * x);
+  return n.z * weight * cos2 + swath * (0.5f * HFVIS_PI_F - hf_atan(x) - x * cos2) * toward;
 }
 
 // What one direction contributes at one receiver. Shared by the sweep and the naive march
@@ -96,26 +96,31 @@ HFVIS_INLINE float ambient_term(float elevation, float nx, float ny, float nz, f
 typedef struct {
   float cos_azimuth, sin_azimuth;  // the direction on the ground
   float weight;                    // its share of the circle of azimuth
+  float swath;                     // sin(pi weight) / pi (ambient_term)
   uint plane;                      // first entry of its planes in `angles` / `distances`
 } DirectionOutputs;
 
-HFVIS_INLINE void emit_direction(uint pixel, int nodata, float elevation, float distance, const DirectionOutputs o,
-                                 __global const float* normals, uint pixel_count, __global float* angles,
-                                 __global float* distances, __global float* svf_sum, __global float* ao_sum) {
-  elevation = nodata ? NAN : elevation;
-  distance = nodata ? NAN : distance;
+// The horizon arrives as the slope rise / run of its elevation (run > 0; `found` 0 when
+// no point casts one: elevation -pi/2). The sky-view term sin(max(0, elevation)) is
+// rise / sqrt(rise^2 + run^2) for a rising horizon, so the angle itself is only computed
+// where an output needs it.
+HFVIS_INLINE void emit_direction(uint pixel, int nodata, int found, float rise, float run, float distance,
+                                 const DirectionOutputs o, __global const float4* normals,
+                                 __global float* angles, __global float* distances, __global float* svf_sum,
+                                 __global float* ao_sum) {
 #if HFVIS_WANT_ANGLES
-  angles[o.plane + pixel] = elevation;
+  angles[o.plane + pixel] = nodata ? NAN : (found ? hf_atan(rise / run) : -0.5f * HFVIS_PI_F);
 #endif
 #if HFVIS_WANT_DISTANCES
-  distances[o.plane + pixel] = distance;
+  distances[o.plane + pixel] = nodata ? NAN : distance;
 #endif
 #if HFVIS_WANT_SVF
-  svf_sum[pixel] = nodata ? NAN : svf_sum[pixel] + o.weight * hf_sin(hf_max(0.0f, elevation));
+  float sky = found && rise > 0.0f ? rise / sqrt(rise * rise + run * run) : 0.0f;
+  svf_sum[pixel] = nodata ? NAN : svf_sum[pixel] + o.weight * sky;
 #endif
 #if HFVIS_WANT_AO
-  float nx = normals[pixel], ny = normals[pixel_count + pixel], nz = normals[2 * pixel_count + pixel];
-  ao_sum[pixel] = nodata ? NAN : ao_sum[pixel] + ambient_term(elevation, nx, ny, nz, o.cos_azimuth, o.sin_azimuth, o.weight);
+  float term = ambient_term(found, rise, run, normals[pixel], o.cos_azimuth, o.sin_azimuth, o.weight, o.swath);
+  ao_sum[pixel] = nodata ? NAN : ao_sum[pixel] + term;
 #endif
 }
 
@@ -146,18 +151,18 @@ HFVIS_INLINE float lattice_height(__global const float* heights, uint at, uint r
 #endif
 }
 
-// The exact limit of receiver (c, r)'s elevation slope at t -> 0 along (a, b), as rise per
-// pixel length: the bilinear surface's directional derivative into the first cell, from
-// the receiver's height h and its neighbours along the two axes. NaN where the ray leaves
-// the field at once or a needed neighbour is nodata.
-HFVIS_INLINE float near_slope(__global const float* heights, int width, int height, int c, int r, float h, int a, int b,
-                              float period) {
+// The exact limit of receiver (c, r)'s elevation slope at t -> 0 along (a, b): the bilinear
+// surface's directional derivative into the first cell, from the receiver's height h and
+// its neighbours along the two axes, as a rise over the period |(a, b)| (the caller's run).
+// NaN where the ray leaves the field at once or a needed neighbour is nodata.
+HFVIS_INLINE float near_rise(__global const float* heights, int width, int height, int c, int r, float h, int a,
+                             int b) {
   int sx = a > 0 ? 1 : (a < 0 ? -1 : 0), sy = b > 0 ? 1 : (b < 0 ? -1 : 0);
   int leaves = c + sx < 0 || c + sx >= width || r + sy < 0 || r + sy >= height;
   float hx = heights[r * width + clamp(c + sx, 0, width - 1)];
   float hy = heights[clamp(r + sy, 0, height - 1) * width + c];
-  float slope = ((hx - h) * (float)abs(a) + (hy - h) * (float)abs(b)) / period;
-  return leaves ? NAN : slope;
+  float rise = (hx - h) * (float)abs(a) + (hy - h) * (float)abs(b);
+  return leaves ? NAN : rise;
 }
 
 // One step of Algorithm 1 (Timonen & Westerholm 2010) for a sample of height h at
@@ -199,20 +204,20 @@ HFVIS_INLINE void hull_stack_step(__global float2* stack, uint stride, uint* siz
 // others lie between two receivers, inside it), so only it tests; samples outside the
 // field or without height are absent. Stack entry k of a line is (height, position along
 // the line in pixels from its far end) at stacks[stack + k * stride]; the capacity is every
-// sample of its periods. Preconditions: lines of this launch only; stride 1 (line-major) or
-// the launch's line count (step-major). Global size: n_lines rounded up; any local size.
+// sample of its periods. period_ground = period * ground_per_pixel, the ground length of a
+// period. Preconditions: lines of this launch only; stride 1 (line-major) or the launch's
+// line count (step-major). Global size: n_lines rounded up; any local size.
 __kernel void horizon_lattice(__global const float* heights, int width, int height,
                               __global const int4* lines, int n_lines, __global const LatticeSample* samples,
-                              int n_samples, int a, int b, float period, float ground_per_pixel,
-                              float cos_azimuth, float sin_azimuth, float weight, uint plane,
-                              __global float2* stacks, uint stride, __global const float* normals,
+                              int n_samples, int a, int b, float period, float ground_per_pixel, float period_ground,
+                              float cos_azimuth, float sin_azimuth, float weight, float swath, uint plane,
+                              __global float2* stacks, uint stride, __global const float4* normals,
                               __global float* angles, __global float* distances, __global float* svf_sum,
                               __global float* ao_sum) {
   const int j = get_global_id(0);
   if (j >= n_lines) return;
   const int4 line = lines[j];
-  const DirectionOutputs outputs = {cos_azimuth, sin_azimuth, weight, plane};
-  const uint pixel_count = (uint)(width * height);
+  const DirectionOutputs outputs = {cos_azimuth, sin_azimuth, weight, swath, plane};
   __global float2* stack = stacks + line.w;
   int c = line.x, r = line.y;
   uint n = 0;                        // stack size
@@ -235,21 +240,21 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
     const float h = heights[pixel];
 #if HFVIS_HAS_NODATA
     if (isnan(h)) {
-      emit_direction(pixel, 1, 0.0f, 0.0f, outputs, normals, pixel_count, angles, distances, svf_sum, ao_sum);
+      emit_direction(pixel, 1, 0, 0.0f, 1.0f, 0.0f, outputs, normals, angles, distances, svf_sum, ao_sum);
       continue;
     }
 #endif
     hull_stack_step(stack, stride, &n, &top_h, &top_p, h, base, &rise, &run);
-    // The steeper of the hull's occluder and the limit at the receiver; the occluder wins
-    // ties (it is the farther point casting that elevation).
-    const float near = near_slope(heights, width, height, c, r, h, a, b, period) / ground_per_pixel;
+    // The steeper of the hull's occluder and the limit at the receiver, compared without a
+    // division (both runs are positive); the occluder wins ties (it is the farther point
+    // casting that elevation).
+    const float near = near_rise(heights, width, height, c, r, h, a, b);
     const float ground = run * ground_per_pixel;
     const int has_far = run > 0.0f, has_near = !isnan(near);
-    const float far = has_far ? rise / ground : 0.0f;
-    const int use_near = has_near && (!has_far || near > far);
-    const float elevation = has_far || has_near ? hf_atan(use_near ? near : far) : -0.5f * HFVIS_PI_F;
+    const int use_near = has_near && (!has_far || near * ground > rise * period_ground);
     const float distance = has_far && !use_near ? ground : 0.0f;
-    emit_direction(pixel, 0, elevation, distance, outputs, normals, pixel_count, angles, distances, svf_sum, ao_sum);
+    emit_direction(pixel, 0, has_far || has_near, use_near ? near : rise, use_near ? period_ground : ground, distance,
+                   outputs, normals, angles, distances, svf_sum, ao_sum);
   }
 }
 
@@ -263,7 +268,7 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 // pixel's own exit are masked. Global size: (W, H) rounded up to the local size (the tile).
 __kernel void horizon_naive(__global const float* heights, int width, int height, float dir_x, float dir_y,
                             float step_length, float ground_per_pixel, float cos_azimuth, float sin_azimuth,
-                            float weight, uint plane, __global const float* normals, __global float* angles,
+                            float weight, float swath, uint plane, __global const float4* normals, __global float* angles,
                             __global float* distances, __global float* svf_sum, __global float* ao_sum) {
   int c = get_global_id(0), r = get_global_id(1);
   int c_lo = get_group_id(0) * get_local_size(0), r_lo = get_group_id(1) * get_local_size(1);
@@ -292,10 +297,9 @@ __kernel void horizon_naive(__global const float* heights, int width, int height
     barrier(CLK_LOCAL_MEM_FENCE);
   }
   const float ground = (float)best_step * step_length * ground_per_pixel;
-  const float elevation = best_step > 0 ? hf_atan(best_rise / ground) : -0.5f * HFVIS_PI_F;
   const float distance = best_step > 0 ? ground : 0.0f;
-  const DirectionOutputs outputs = {cos_azimuth, sin_azimuth, weight, plane};
+  const DirectionOutputs outputs = {cos_azimuth, sin_azimuth, weight, swath, plane};
   if (valid)
-    emit_direction(pixel, isnan(h), elevation, distance, outputs, normals, (uint)(width * height), angles, distances,
+    emit_direction(pixel, isnan(h), best_step > 0, best_rise, ground, distance, outputs, normals, angles, distances,
                    svf_sum, ao_sum);
 }

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "hfvis/errors.hpp"
+#include "fast_math.hpp"
 #include "horizon_common.hpp"
 #include "lattice_geometry.hpp"
 #include "opencl_context.hpp"
@@ -48,7 +49,7 @@ RunPlan planRun(const HeightField& field, const HorizonOptions& options, const H
   const std::size_t budget = options.memory_budget_bytes ? options.memory_budget_bytes : defaultMemoryBudget(device);
   const std::size_t max_alloc = device.max_allocation_bytes ? device.max_allocation_bytes : budget;
   const std::size_t plane = field.pixelCount() * sizeof(float);
-  const std::size_t fixed = plane * (1 + outputs.sky_view_factor + outputs.ambient_occlusion * 4);
+  const std::size_t fixed = plane * (1 + outputs.sky_view_factor + outputs.ambient_occlusion * 5);  // + float4 normals
   const std::size_t per_direction = plane * (outputs.horizon_angles + outputs.horizon_distances);
   // Scratch: all of a direction's stacks in one launch when it fits; one line at a time at least.
   std::size_t whole = 0, longest = 0;
@@ -129,7 +130,7 @@ class HorizonRun {
     distances_ = st_.reusableBuffer("horizon distances", outputs_.horizon_distances ? planes_bytes : 0);
     svf_ = deviceBuffer(st_, outputs_.sky_view_factor ? plane * sizeof(float) : 0);
     ao_ = deviceBuffer(st_, outputs_.ambient_occlusion ? plane * sizeof(float) : 0);
-    normals_ = deviceBuffer(st_, outputs_.ambient_occlusion ? 3 * plane * sizeof(float) : 0);
+    normals_ = deviceBuffer(st_, outputs_.ambient_occlusion ? 4 * plane * sizeof(float) : 0);
     stacks_ = st_.reusableBuffer("lattice stacks", plan.stack_entries * kStackEntryBytes);
     stack_entries_ = plan.stack_entries;
     const float zero = 0.0f;
@@ -179,10 +180,11 @@ class HorizonRun {
     kernel.setArg(arg++, d.cos_azimuth);
     kernel.setArg(arg++, d.sin_azimuth);
     kernel.setArg(arg++, static_cast<float>(d.lattice.weight));
+    kernel.setArg(arg++, swathFactor(static_cast<float>(d.lattice.weight)));
     kernel.setArg(arg++, plane_offset);
     if (options_.method == HorizonMethod::Sweep) {
       kernel.setArg(arg++, stacks_);
-      ++arg;  // the stride, set per chunk
+      stride_arg_ = arg++;  // set per chunk
     }
     kernel.setArg(arg++, normals_);
     kernel.setArg(arg++, angles_);
@@ -210,7 +212,8 @@ class HorizonRun {
     kernel.setArg(8, d.lattice.b);
     kernel.setArg(9, static_cast<float>(d.lattice.period));
     kernel.setArg(10, static_cast<float>(d.lattice.ground_per_pixel));
-    setOutputs(kernel, 11, d, plane_offset);
+    kernel.setArg(11, static_cast<float>(d.lattice.period * d.lattice.ground_per_pixel));
+    setOutputs(kernel, 12, d, plane_offset);
     for (const LineChunk& chunk : chunks) {
       // Sub-buffer offsets must be aligned on some devices: a chunk gets a copy of its lines.
       cl::Buffer chunk_lines = chunks.size() == 1
@@ -219,7 +222,7 @@ class HorizonRun {
                                                 chunk.count * sizeof(LatticeLine), lines.data() + chunk.first);
       kernel.setArg(3, chunk_lines);
       kernel.setArg(4, static_cast<int>(chunk.count));
-      kernel.setArg(16, static_cast<cl_uint>(chunk.stride));
+      kernel.setArg(stride_arg_, static_cast<cl_uint>(chunk.stride));
       st_.launch(kernel, cl::NDRange(roundUp(chunk.count, kLineGroup)), cl::NDRange(kLineGroup));
     }
   }
@@ -245,6 +248,7 @@ class HorizonRun {
   cl::Program program_;
   cl::Buffer heights_, angles_, distances_, svf_, ao_, normals_, stacks_;
   std::size_t stack_entries_ = 0;
+  int stride_arg_ = 0;  // horizon_lattice's `stride` argument
 };
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "fast_math.hpp"
 #include "hfvis/errors.hpp"
 
 namespace hfvis {
@@ -66,6 +67,8 @@ std::vector<LatticeDirection> horizonDirections(const HeightField& field, const 
   const bool exact = outputs.horizon_angles || outputs.horizon_distances;
   return latticeDirections(field, options, exact, options.azimuth_tolerance);
 }
+
+float swathFactor(float weight) { return hfSin(kPiF * weight) / kPiF; }
 
 void finishReduction(HorizonResult& result) {
   for (float& v : result.sky_view_factor) v = 1.0f - v;

@@ -23,6 +23,10 @@ PreparedHeights prepareHeights(const HeightField& field);
 std::vector<LatticeDirection> horizonDirections(const HeightField& field, const HorizonOptions& options,
                                                 const HorizonOutputs& outputs);
 
+// sin(pi weight) / pi: the factor of the ambient-occlusion swath of a direction of that
+// weight (ambient_term in kernels/horizon.cl), computed once per direction on the host.
+float swathFactor(float weight);
+
 // Turns the accumulated sums into the outputs: svf = 1 - weighted sum; ao is the sum itself.
 void finishReduction(HorizonResult& result);
 

@@ -56,33 +56,37 @@ std::vector<Normal> pixelNormals(const HeightField& field, const std::vector<flo
   return normals;
 }
 
-float ambientTerm(float elevation, Normal n, float cos_az, float sin_az, float weight) {
+// ambient_term in the kernel.
+float ambientTerm(bool found, float rise, float run, Normal n, float cos_az, float sin_az, float weight, float swath) {
   const float toward = n.x * cos_az + n.y * sin_az;
-  float zenith = 0.5f * kPi - elevation;
-  zenith = hfMin(zenith, 0.5f * kPi + hfAtan(toward / n.z));
-  const float s = hfSin(zenith);
-  return n.z * weight * s * s + hfSin(kPi * weight) / kPi * (zenith - 0.5f * hfSin(2.0f * zenith)) * toward;
+  const bool behind = !found || rise * n.z < -toward * run;
+  const float x = behind ? -toward / n.z : rise / run;
+  const float cos2 = 1.0f / (1.0f + x * x);
+  return n.z * weight * cos2 + swath * (0.5f * kPi - hfAtan(x) - x * cos2) * toward;
 }
 
 // What one direction contributes at one receiver, as emit_direction in the kernel.
 struct DirectionOutputs {
   float cos_azimuth, sin_azimuth, weight;
   int k;  // the direction's plane
+  float swath() const { return swathFactor(weight); }
 };
 
-void emitDirection(HorizonResult& result, std::size_t pixel, bool nodata, float elevation, float distance,
-                   const DirectionOutputs& o, const std::vector<Normal>& normals) {
+void emitDirection(HorizonResult& result, std::size_t pixel, bool nodata, bool found, float rise, float run,
+                   float distance, const DirectionOutputs& o, const std::vector<Normal>& normals) {
   const std::size_t plane = static_cast<std::size_t>(result.width) * result.height;
-  if (nodata) elevation = distance = kNaN;
+  const float elevation = nodata ? kNaN : (found ? hfAtan(rise / run) : -0.5f * kPi);
   if (!result.angles.empty()) result.angles[o.k * plane + pixel] = elevation;
-  if (!result.distances.empty()) result.distances[o.k * plane + pixel] = distance;
+  if (!result.distances.empty()) result.distances[o.k * plane + pixel] = nodata ? kNaN : distance;
   if (!result.sky_view_factor.empty()) {
+    const float sky = found && rise > 0.0f ? rise / std::sqrt(rise * rise + run * run) : 0.0f;
     float& sum = result.sky_view_factor[pixel];
-    sum = nodata ? kNaN : sum + o.weight * hfSin(hfMax(0.0f, elevation));
+    sum = nodata ? kNaN : sum + o.weight * sky;
   }
   if (!result.ambient_occlusion.empty()) {
     float& sum = result.ambient_occlusion[pixel];
-    sum = nodata ? kNaN : sum + ambientTerm(elevation, normals[pixel], o.cos_azimuth, o.sin_azimuth, o.weight);
+    const float term = ambientTerm(found, rise, run, normals[pixel], o.cos_azimuth, o.sin_azimuth, o.weight, o.swath());
+    sum = nodata ? kNaN : sum + term;
   }
 }
 
@@ -105,14 +109,13 @@ float latticeHeight(const std::vector<float>& h, std::size_t at, std::size_t rig
   return weight > 0.0f ? sum / weight : kNaN;
 }
 
-// near_slope in the kernel.
-float nearSlope(const std::vector<float>& h, int width, int height, int c, int r, float hp, int a, int b,
-                float period) {
+// near_rise in the kernel.
+float nearRise(const std::vector<float>& h, int width, int height, int c, int r, float hp, int a, int b) {
   const int sx = (a > 0) - (a < 0), sy = (b > 0) - (b < 0);
   if (c + sx < 0 || c + sx >= width || r + sy < 0 || r + sy >= height) return kNaN;
   const float hx = h[static_cast<std::size_t>(r) * width + (c + sx)];
   const float hy = h[static_cast<std::size_t>(r + sy) * width + c];
-  return ((hx - hp) * static_cast<float>(std::abs(a)) + (hy - hp) * static_cast<float>(std::abs(b))) / period;
+  return (hx - hp) * static_cast<float>(std::abs(a)) + (hy - hp) * static_cast<float>(std::abs(b));
 }
 
 void sweepReference(const HeightField& field, const PreparedHeights& prepared, const HorizonOptions& options,
@@ -125,24 +128,24 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
     const LatticeDirection& d = directions[k];
     const DirectionOutputs out = outputsOf(d, k);
     const auto samples = latticeSamples(d, options.samples_per_unit);
-    const float period = static_cast<float>(d.period), gpp = static_cast<float>(d.ground_per_pixel);
+    const float gpp = static_cast<float>(d.ground_per_pixel);
+    const float period_ground = static_cast<float>(d.period * d.ground_per_pixel);
     for (const LatticeLine& line : latticeLines(d, width, height)) {
       for (const LatticeLineSample& s : latticeLineSamples(field, h, d, samples, line)) {
         if (s.receiver < 0) continue;
         const std::size_t pixel = static_cast<std::size_t>(s.receiver);
         if (std::isnan(s.height)) {
-          emitDirection(result, pixel, true, 0.0f, 0.0f, out, normals);
+          emitDirection(result, pixel, true, false, 0.0f, 1.0f, 0.0f, out, normals);
           continue;
         }
         const int c = static_cast<int>(pixel % width), r = static_cast<int>(pixel / width);
-        const float near = nearSlope(h, width, height, c, r, s.height, d.a, d.b, period) / gpp;
+        const float near = nearRise(h, width, height, c, r, s.height, d.a, d.b);
         const bool has_far = s.occluder >= 0, has_near = !std::isnan(near);
         const float ground = has_far ? s.occluder_run * gpp : 0.0f;
-        const float far = has_far ? s.occluder_rise / ground : 0.0f;
-        const bool use_near = has_near && (!has_far || near > far);
-        const float elevation = has_far || has_near ? hfAtan(use_near ? near : far) : -0.5f * kPi;
+        const bool use_near = has_near && (!has_far || near * ground > s.occluder_rise * period_ground);
         const float distance = has_far && !use_near ? ground : 0.0f;
-        emitDirection(result, pixel, false, elevation, distance, out, normals);
+        emitDirection(result, pixel, false, has_far || has_near, use_near ? near : s.occluder_rise,
+                      use_near ? period_ground : ground, distance, out, normals);
       }
     }
   }
@@ -178,9 +181,8 @@ void naiveReference(const HeightField& field, const PreparedHeights& prepared, c
           }
         }
         const float ground = static_cast<float>(best_step) * d.step_length * d.ground_per_pixel;
-        const float elevation = best_step > 0 ? hfAtan(best_rise / ground) : -0.5f * kPi;
         const float distance = best_step > 0 ? ground : 0.0f;
-        emitDirection(result, pixel, std::isnan(hp), elevation, distance, out, normals);
+        emitDirection(result, pixel, std::isnan(hp), best_step > 0, best_rise, ground, distance, out, normals);
       }
     }
   }
