@@ -27,7 +27,9 @@ struct HorizonOptions : SweepOptions {
   // pixels); HorizonResult::azimuths gives the azimuths used. Sky-view factor and ambient
   // occlusion alone integrate over azimuth: they take the cheapest step within half the
   // spacing 2 pi / K of phi_k, weighted by the share of the circle it stands for.
-  // lines_per_unit must stay 1 for the sweep. Default: 0.12 degrees.
+  // samples_per_unit S: the sweep samples every grid-line crossing of a receiver's ray
+  // (exact heights of the bilinear surface) and, for S > 1, about S points per pixel length
+  // between crossings. lines_per_unit must stay 1 for the sweep. Default: 0.12 degrees.
   double azimuth_tolerance = 0.12 * 3.14159265358979323846 / 180.0;
 };
 
@@ -46,7 +48,8 @@ struct HorizonResult {
   int directions = 0;
   std::vector<double> azimuths;          // azimuth of each direction as computed, radians
   std::vector<float> angles;             // directions planes of width*height, if asked
-  std::vector<float> distances;          // same layout; 0 where no point casts a horizon
+  std::vector<float> distances;          // same layout; 0 where no point casts a horizon or the
+                                         // surface's own slope at the receiver is the horizon
   std::vector<float> sky_view_factor;    // width*height, if asked
   std::vector<float> ambient_occlusion;  // width*height, if asked
 };
