@@ -31,6 +31,7 @@ enum class Option {
   MemoryBudget,
   Preview,
   DistanceOutput,
+  AzimuthTolerance,
   Statistics,
   HullTree,
   At,
@@ -59,6 +60,7 @@ constexpr OptionSpec kOptions[] = {
     {Option::MemoryBudget, "--memory-budget", nullptr, true},
     {Option::Preview, "--preview", nullptr, true},
     {Option::DistanceOutput, "--distance-out", nullptr, true},
+    {Option::AzimuthTolerance, "--azimuth-tolerance", nullptr, true},
     {Option::Statistics, "--stats", nullptr, false},
     {Option::HullTree, "--hull-tree", nullptr, true},
     {Option::At, "--at", nullptr, true},
@@ -178,6 +180,7 @@ bool hasExtension(const std::string& path, const char* wanted) {
 const char* onlyFor(Option option) {
   switch (option) {
     case Option::DistanceOutput:
+    case Option::AzimuthTolerance:
       return "horizon";
     case Option::Statistics:
       return "viewcount";
@@ -287,6 +290,9 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
     case Option::DistanceOutput:
       requireNonEmpty(typed, value);
       run.distance_output = value;
+      break;
+    case Option::AzimuthTolerance:
+      run.azimuth_tolerance_deg = parsePositive(typed, value);
       break;
     case Option::Statistics:
       run.statistics = true;
@@ -514,6 +520,7 @@ HorizonOptions horizonOptions(const RunArguments& run) {
   HorizonOptions options;
   setSweepOptions(run, options);
   options.method = run.method;
+  options.azimuth_tolerance = run.azimuth_tolerance_deg * (kPi / 180.0);
   return options;
 }
 

@@ -43,6 +43,7 @@ struct RunArguments {
   std::string input;
   std::string output;
   std::string distance_output;  // horizon only; "" = not asked for
+  double azimuth_tolerance_deg = 0.25;  // horizon only: the sweep's directions within this of phi_k
   std::string preview;          // "" = no preview
   int directions = 64;
   double azimuth_offset_deg = 0.0;

@@ -36,7 +36,7 @@ Options:
   --method sweep|naive     horizon, svf, ao: sweep = convex-hull-stack sweep along lines through
                            every pixel centre, linear time per direction, exact for each receiver's
                            own ray; naive = per-pixel ray march, slow reference (default sweep).
-                           The sweep's directions are integer pixel steps: within 0.12 deg of
+                           The sweep's directions are integer pixel steps: within 0.25 deg of
                            phi_k for horizon, within half the spacing (weighted) for svf and ao;
                            the hfvis:azimuths_deg attribute lists those used
   --method tree|naive      viewcount: tree = convex hull tree sweep (Timonen 2013); naive =
@@ -66,6 +66,9 @@ const char* const kHorizonOnly = R"(
 Horizon only:
   --distance-out FILE      also write K channels d000.. of ground distance to the
                            horizon point (ground units), computed in the same run
+  --azimuth-tolerance DEG  the sweep's direction k is the cheapest integer pixel step within
+                           DEG of phi_k (default 0.25; at most 5.7). Smaller is closer to
+                           phi_k and slower: steps with more grid crossings per pixel
   Its preview shows the mean horizon elevation over the directions whose ray stays in
   the field (low = dark, high = bright), stretched from its minimum to its maximum; the
   svf and ao previews map 0..1 to black..white. Nodata is black in every preview.

@@ -12,8 +12,8 @@ namespace hfvis {
 void validate(const HorizonOptions& options, const HorizonOutputs& outputs) {
   validate(static_cast<const SweepOptions&>(options));
   if (!(options.azimuth_tolerance > 0.0) || !(options.azimuth_tolerance <= 0.1)) {
-    throw InvalidArgument("the azimuth tolerance must be in (0, 0.1] radians (got " +
-                          std::to_string(options.azimuth_tolerance) + ")");
+    throw InvalidArgument("the azimuth tolerance must be in (0, 0.1] radians, (0, 5.73] degrees (got " +
+                          std::to_string(options.azimuth_tolerance * 180.0 / M_PI) + " degrees)");
   }
   if (options.method == HorizonMethod::Sweep && options.lines_per_unit != 1.0) {
     throw InvalidArgument(

@@ -143,7 +143,7 @@ TEST_F(BenchSmoke, TinySuiteMeasuresEveryMethodInEverySection) {
     EXPECT_NE(f[method], "naive_bench") << line;
   }
   for (const char* s :
-       {"checks", "truth", "plane", "sources", "azimuth", "stack", "headline", "scale_n", "scale_k"})
+       {"checks", "truth", "plane", "sources", "azimuth", "stack", "lattice", "headline", "scale_n", "scale_k"})
     EXPECT_TRUE(sections.count(s)) << "no rows for section " << s;
   for (const char* m : {"sweep", "naive", "radius_4", "pyramid_4", "floor"})
     EXPECT_TRUE(methods.count(m)) << "no rows for method " << m;

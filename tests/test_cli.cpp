@@ -356,6 +356,20 @@ TEST_F(Cli, DistanceOutputOnlyForHorizon) {
                 2, "--distance-out");
 }
 
+TEST_F(Cli, AzimuthToleranceOnlyForHorizonAndInRange) {
+  const std::string base = shellQuoted(ramp()) + " -o " + shellQuoted(out("o.exr")) + " -k 7";
+  expectFailure(run("svf " + base + " --azimuth-tolerance 1"), 2, "--azimuth-tolerance");
+  expectFailure(run("horizon " + base + " --azimuth-tolerance 6"), 2, "azimuth tolerance");
+  expectFailure(run("horizon " + base + " --azimuth-tolerance 0"), 2, "--azimuth-tolerance");
+  const CliResult loose = run("horizon " + base + " --azimuth-tolerance 5");
+  ASSERT_EQ(loose.status, 0) << loose.err;
+  // The attribute lists the azimuths the sweep used, each within the tolerance of 360 k / 7.
+  std::istringstream azimuths(readBack(out("o.exr")).spec.get_string_attribute("hfvis:azimuths_deg"));
+  int k = 0;
+  for (std::string item; std::getline(azimuths, item, ','); ++k) EXPECT_NEAR(std::stod(item), 360.0 * k / 7, 5.0);
+  EXPECT_EQ(k, 7);
+}
+
 TEST_F(Cli, ArgumentsAreCheckedBeforeTheInputIsRead) {
   // The input does not exist, yet the bad -k is what is reported (status 2, not 1).
   const CliResult result =
@@ -492,6 +506,8 @@ TEST_F(Cli, HorizonWritesOneChannelPerDirection) {
   EXPECT_EQ(horizons.spec.get_string_attribute("hfvis:command"), "horizon");
   EXPECT_EQ(horizons.spec.get_string_attribute("hfvis:directions"), "8");
   EXPECT_EQ(horizons.spec.get_string_attribute("hfvis:method"), "sweep");
+  // K = 8 lands on the axes and diagonals exactly.
+  EXPECT_EQ(horizons.spec.get_string_attribute("hfvis:azimuths_deg"), "0,45,90,135,180,225,270,315");
 
   const ReadBack distances = readBack(out("d.exr"));
   EXPECT_EQ(distances.channels, hfvis::directionChannelNames("d", 8));

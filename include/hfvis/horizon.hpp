@@ -29,8 +29,8 @@ struct HorizonOptions : SweepOptions {
   // spacing 2 pi / K of phi_k, weighted by the share of the circle it stands for.
   // samples_per_unit S: the sweep samples every grid-line crossing of a receiver's ray
   // (exact heights of the bilinear surface) and, for S > 1, about S points per pixel length
-  // between crossings. lines_per_unit must stay 1 for the sweep. Default: 0.12 degrees.
-  double azimuth_tolerance = 0.12 * 3.14159265358979323846 / 180.0;
+  // between crossings. lines_per_unit must stay 1 for the sweep. Default: 0.25 degrees.
+  double azimuth_tolerance = 0.25 * 3.14159265358979323846 / 180.0;
 };
 
 // What to compute; only what is asked for is stored or reduced.
