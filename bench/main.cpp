@@ -4,10 +4,10 @@
 //                     [--commit TEXT]
 //       the standard suite: writes DIR/results.csv and DIR/environment.txt
 //       (bench/run_report.sh builds, generates inputs, runs this and writes bench/report/)
-//   hfvis_bench run FIELD [--method M] [-k K] [--spu S] [--lpu L] [--param P]
+//   hfvis_bench run FIELD [--method M] [-k K] [--spu S] [--param P]
 //                   [--outputs angles|svf|device] [--reps N]
 //       one method on one field: min and median time and core-ns per pixel-direction
-//       (methods: sweep, naive, naive_bench, radius, pyramid, floor)
+//       (methods: sweep, naive, radius, pyramid, floor)
 //   hfvis_bench visibility [--quick | --tiny] --out DIR [--data DIR] [--dem FILE] [--commit TEXT]
 //       the intervisibility suite: writes DIR/visibility.csv and DIR/visibility_environment.txt
 //   hfvis_bench vis-run FIELD [--method tree|naive] [-k K] [--tuning plain|deferred|default|zone]
@@ -48,8 +48,8 @@ using namespace hfvis::bench;
 constexpr const char* kUsage =
     "usage: hfvis_bench suite [--quick | --tiny] --out DIR [--data DIR] [--dem FILE] [--cache DIR] [--commit "
     "TEXT]\n"
-    "       hfvis_bench run FIELD [--method sweep|naive|naive_bench|radius|pyramid|floor] [-k K] [--spu S]\n"
-    "                   [--lpu L] [--param P] [--outputs angles|svf|device] [--reps N]\n"
+    "       hfvis_bench run FIELD [--method sweep|naive|radius|pyramid|floor] [-k K] [--spu S] [--param P]\n"
+    "                   [--outputs angles|svf|device] [--reps N]\n"
     "       hfvis_bench visibility [--quick | --tiny] --out DIR [--data DIR] [--dem FILE] [--commit TEXT]\n"
     "       hfvis_bench vis-run FIELD [--method tree|naive] [-k K] [--tuning plain|deferred|default|zone]\n"
     "                           [--zone-steps S] [--reps N]\n"
@@ -118,7 +118,6 @@ double number(const std::string& text, const std::string& what) {
 MethodKind methodKind(const std::string& name) {
   if (name == "sweep") return MethodKind::Sweep;
   if (name == "naive") return MethodKind::Naive;
-  if (name == "naive_bench") return MethodKind::BenchNaive;
   if (name == "radius") return MethodKind::Radius;
   if (name == "pyramid") return MethodKind::Pyramid;
   if (name == "floor") return MethodKind::Floor;
@@ -131,7 +130,6 @@ int runOne(Arguments& args) {
   spec.kind = methodKind(args.get("--method", "sweep"));
   spec.directions = static_cast<int>(number(args.get("-k", "64"), "-k"));
   spec.samples_per_unit = number(args.get("--spu", "1"), "--spu");
-  spec.lines_per_unit = number(args.get("--lpu", "1"), "--lpu");
   spec.parameter =
       static_cast<int>(number(args.get("--param", spec.kind == MethodKind::Radius ? "32" : "16"), "--param"));
   const std::string outputs = args.get("--outputs", "angles");
@@ -147,10 +145,10 @@ int runOne(Arguments& args) {
   const double pd = static_cast<double>(field.pixelCount()) * spec.directions;
   const int cores = std::max(1, context.device().compute_units);
   std::printf(
-      "%s (%s) on %dx%d, K=%d, spu=%g, lpu=%g: min %.4f s, median %.4f s over %zu runs; "
+      "%s (%s) on %dx%d, K=%d, spu=%g: min %.4f s, median %.4f s over %zu runs; "
       "%.2f core-ns per pixel-direction on %s (%d compute units)\n",
       spec.name().c_str(), spec.outputs().c_str(), field.width, field.height, spec.directions,
-      spec.samples_per_unit, spec.lines_per_unit, m.timing.min(), m.timing.median(), m.timing.seconds.size(),
+      spec.samples_per_unit, m.timing.min(), m.timing.median(), m.timing.seconds.size(),
       m.timing.min() * cores / pd * 1e9, context.device().name.c_str(), cores);
   if (spec.kind != MethodKind::Sweep && spec.kind != MethodKind::Floor && spec.kind != MethodKind::Pyramid) {
     const MarchSteps steps =

@@ -95,7 +95,7 @@ MethodOutput runBaseline(const ComputeContext& context, const HeightField& field
     if (spec.angles) out.angles.resize(spec.directions * plane);
     const char* name = spec.kind == MethodKind::Pyramid ? "pyramid_march"
                        : spec.kind == MethodKind::Floor ? "bandwidth_floor"
-                                                        : "naive_march";
+                                                        : "radius_march";
     cl::Kernel kernel(program, name);
     // The marches run in the library's pixel tiles (their trip count is the tile's longest
     // ray); the floor has one work-item per 16 pixels of a row.
@@ -119,7 +119,7 @@ MethodOutput runBaseline(const ComputeContext& context, const HeightField& field
         kernel.setArg(5, planes);
         st.queue.enqueueNDRangeKernel(kernel, cl::NullRange, global, local);
       } else {
-        // One launch per direction, the geometry as arguments (see naive_march).
+        // One launch per direction, the geometry as arguments (see radius_march).
         for (int b = 0; b < count; ++b) {
           const detail::SweepDirection& d = all[first + b];
           int arg = 0;
@@ -158,8 +158,6 @@ std::string MethodSpec::name() const {
       return "sweep";
     case MethodKind::Naive:
       return "naive";
-    case MethodKind::BenchNaive:
-      return "naive_bench";
     case MethodKind::Radius:
       return "radius_" + std::to_string(parameter);
     case MethodKind::Pyramid:
@@ -181,7 +179,6 @@ MethodOutput runMethod(const ComputeContext& context, const HeightField& field, 
   HorizonOptions options;
   options.directions = spec.directions;
   options.samples_per_unit = spec.samples_per_unit;
-  options.lines_per_unit = spec.lines_per_unit;
   options.method = spec.kind == MethodKind::Sweep ? HorizonMethod::Sweep : HorizonMethod::Naive;
   HorizonOutputs outputs;
   outputs.horizon_angles = spec.angles;
@@ -190,6 +187,7 @@ MethodOutput runMethod(const ComputeContext& context, const HeightField& field, 
   MethodOutput out;
   out.angles = std::move(result.angles);
   out.svf = std::move(result.sky_view_factor);
+  out.azimuths = std::move(result.azimuths);
   return out;
 }
 
@@ -208,7 +206,8 @@ MarchSteps naiveMarchSteps(const HeightField& field, int directions, double samp
                            int tile_y, int max_steps) {
   MarchSteps steps;
   const int w = field.width, h = field.height;
-  // The exit distance of pixel (c, r) is min(column term, row term), as in tile_reach().
+  // The exit distance of pixel (c, r) is min(column term, row term), as in horizon_naive
+  // (kernels/horizon.cl) and bl_tile_reach (kernels/horizon_baselines.cl).
   auto reach = [&](double dir, int coordinate, int size) {
     return dir > 0.0 ? (size - 1 - coordinate) / dir : dir < 0.0 ? coordinate / -dir : double(w + h);
   };

@@ -10,7 +10,7 @@
 #include <limits>
 
 #include "hfvis/errors.hpp"
-#include "sweep_geometry.hpp"
+#include "lattice_geometry.hpp"
 
 namespace hfvis::bench {
 namespace {
@@ -178,12 +178,15 @@ double skyViewFactor(const std::vector<double>& elevations) {
   return 1.0 - sum / elevations.size();
 }
 
-double ambientOcclusion(const std::vector<double>& elevations, const Normal& n) {
+double ambientOcclusion(const std::vector<double>& elevations, const Normal& n,
+                        const std::vector<double>& azimuths) {
   // Eq. 5 of Timonen & Westerholm 2010 per azimuthal swath, as ambient_term in the kernel.
   const int k_count = static_cast<int>(elevations.size());
+  if (!azimuths.empty() && azimuths.size() != elevations.size())
+    throw InvalidArgument("ambientOcclusion: one azimuth per elevation");
   double sum = 0.0;
   for (int k = 0; k < k_count; ++k) {
-    const double phi = 2.0 * kPi * k / k_count;
+    const double phi = azimuths.empty() ? 2.0 * kPi * k / k_count : azimuths[k];
     const double cos_az = std::abs(std::cos(phi)) < 1e-12 ? 0.0 : std::cos(phi);
     const double sin_az = std::abs(std::sin(phi)) < 1e-12 ? 0.0 : std::sin(phi);
     const double toward = n.x * cos_az + n.y * sin_az;
@@ -211,6 +214,30 @@ ErrorStats horizonDifference(const HeightField& field, const GroundTruth& truth,
   });
 }
 
+SvfErrorStats svfErrors(const HeightField& field, const GroundTruth& truth, const std::vector<float>& svf,
+                        int directions) {
+  if (directions < 1 || truth.directions % directions != 0)
+    throw InvalidArgument("SVF error evaluation needs K dividing the ground truth's " +
+                          std::to_string(truth.directions) + " directions (got " +
+                          std::to_string(directions) + ")");
+  if (svf.size() != field.pixelCount())
+    throw InvalidArgument("sky-view factor plane missing for the error evaluation");
+  const int every = truth.directions / directions;
+  Accumulator acc;
+  std::vector<double> exact(directions);
+  for (std::size_t n = 0; n < truth.receivers.size(); ++n) {
+    for (int k = 0; k < directions; ++k) exact[k] = truth.angle(n, k * every);
+    acc.add(static_cast<double>(svf[truth.receivers[n]]) - skyViewFactor(exact));
+  }
+  SvfErrorStats s;
+  s.receivers = acc.abs_values.size();
+  s.nan_receivers = acc.nan;
+  s.mean_abs = acc.mean();
+  s.max_abs = acc.max();
+  s.bias = s.receivers ? acc.signed_sum / s.receivers : 0.0;
+  return s;
+}
+
 PlaneDifference planeDifference(const std::vector<float>& a, const std::vector<float>& b) {
   Accumulator acc;
   for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i)
@@ -220,32 +247,47 @@ PlaneDifference planeDifference(const std::vector<float>& a, const std::vector<f
 
 StackStats hullStackStatistics(const HeightField& field, int directions) {
   const std::vector<float> heights = preparedHeights(field);
+  const int w = field.width, h = field.height;
+  SweepOptions options;
+  options.directions = directions;
   StackStats stats;
   double pops = 0.0, depth = 0.0;
-  std::vector<std::pair<float, float>> stack;  // (height, step)
-  for (int k = 0; k < directions; ++k) {
-    const detail::SweepDirection d = detail::makeSweepDirection(field, 2.0 * kPi * k / directions, 1.0, 1.0);
-    for (int line = 0; line < d.n_lines; ++line) {
-      stack.clear();
-      for (int step = 0; step < d.n_steps; ++step) {
-        const detail::Point2 p = detail::sweepPosition(d, line, step);
-        if (!detail::insideField(p, field.width, field.height)) continue;
-        const float h = detail::sampleHeight(heights, field.width, field.height, p);
-        const float here = static_cast<float>(step);
-        ++stats.samples;
-        depth += static_cast<double>(stack.size());
-        // Algorithm 1: pop while the entry below the top casts at least as steep a slope.
-        while (stack.size() > 1) {
-          const auto top = stack.back(), below = stack[stack.size() - 2];
-          if ((below.first - h) * (here - top.second) >= (top.first - h) * (here - below.second)) {
-            stack.pop_back();
-            pops += 1.0;
-          } else {
-            break;
-          }
+  std::vector<std::pair<float, float>> stack;  // (height, position along the line)
+  for (const detail::LatticeDirection& d : detail::latticeDirections(field, options, false, 0.0)) {
+    const std::vector<detail::LatticeSample> samples = detail::latticeSamples(d, 1.0);
+    auto push = [&](float height, float here) {
+      ++stats.samples;
+      depth += static_cast<double>(stack.size());
+      // Algorithm 1 as hull_stack_step: pop while the entry below the top casts at least as
+      // steep a slope on the sample as the top.
+      while (stack.size() > 1) {
+        const auto top = stack.back(), below = stack[stack.size() - 2];
+        if ((below.first - height) * (here - top.second) >= (top.first - height) * (here - below.second)) {
+          stack.pop_back();
+          pops += 1.0;
+        } else {
+          break;
         }
-        stack.emplace_back(h, here);
-        stats.max_depth = std::max(stats.max_depth, static_cast<int>(stack.size()));
+      }
+      stack.emplace_back(height, here);
+      stats.max_depth = std::max(stats.max_depth, static_cast<int>(stack.size()));
+    };
+    for (const detail::LatticeLine& line : detail::latticeLines(d, w, h)) {
+      stack.clear();
+      int c = line.col, r = line.row;
+      for (int i = 0; i < line.receivers; ++i, c -= d.a, r -= d.b) {
+        const float base = static_cast<float>(i * d.period);
+        for (std::size_t q = 0; q + 1 < samples.size(); ++q) {
+          const detail::LatticeSample& s = samples[q];
+          const int x0 = c + s.ox, y0 = r + s.oy;
+          if (x0 < 0 || x0 + s.ex > w - 1 || y0 < 0 || y0 + s.ey > h - 1) continue;
+          const std::size_t at = static_cast<std::size_t>(y0) * w + x0;
+          const float height = s.w00 * heights[at] + s.w10 * heights[at + s.ex] +
+                               s.w01 * heights[at + s.ey * w] + s.w11 * heights[at + s.ey * w + s.ex];
+          push(height, base - s.tau);
+        }
+        push(heights[static_cast<std::size_t>(r) * w + c], base);
+        ++stats.receivers;
       }
     }
   }

@@ -37,13 +37,17 @@ Timing timeRepeated(const std::function<void()>& run, const TimingPolicy& policy
 std::vector<float> preparedHeights(const HeightField& field);
 
 // The library's formulas (kernels/horizon.cl surface_normal, ambient_term; svf = 1 - mean
-// sin(max(0, elevation))), in double, for one receiver from its K elevation angles.
+// sin(max(0, elevation))), in double, for one receiver from its K elevation angles, each
+// direction weighted 1/K (the library's weights when it computes the K angle planes).
+// ambientOcclusion's directions are at `azimuths` (radians; the library's
+// HorizonResult::azimuths), or at 2 pi k / K when none are given.
 struct Normal {
   double x = 0.0, y = 0.0, z = 1.0;
 };
 Normal surfaceNormal(const HeightField& field, int col, int row);
 double skyViewFactor(const std::vector<double>& elevations);
-double ambientOcclusion(const std::vector<double>& elevations, const Normal& normal);
+double ambientOcclusion(const std::vector<double>& elevations, const Normal& normal,
+                        const std::vector<double>& azimuths = {});
 
 // Errors of a method's horizons (K planes of width * height, radians) against the ground
 // truth on its receivers, in the truth's directions k * truth.directions / K (K must divide
@@ -66,6 +70,17 @@ ErrorStats horizonDifference(const HeightField& field, const GroundTruth& truth,
                              const std::vector<float>& angles, const std::vector<float>& reference,
                              int directions);
 
+// Error of a sky-view factor plane (width * height, e.g. an SVF-only run's output) on the
+// truth's receivers against the SVF of the exact horizons in K directions 2 pi k / K (K must
+// divide the truth's directions): 1 - (1/K) sum_k sin(max(0, exact_k)). The SVF is
+// compared as it is, whatever directions and weights the method integrated over.
+struct SvfErrorStats {
+  std::size_t receivers = 0, nan_receivers = 0;
+  double mean_abs = 0.0, max_abs = 0.0, bias = 0.0;  // bias: mean of method - truth
+};
+SvfErrorStats svfErrors(const HeightField& field, const GroundTruth& truth, const std::vector<float>& svf,
+                        int directions);
+
 // Mean and largest absolute difference of two planes (NaN pairs skipped).
 struct PlaneDifference {
   double mean_abs = 0.0, max_abs = 0.0;
@@ -73,10 +88,13 @@ struct PlaneDifference {
 PlaneDifference planeDifference(const std::vector<float>& a, const std::vector<float>& b);
 
 // The hull stack of Algorithm 1 (Timonen & Westerholm 2010) run on the host over every line
-// of `directions` sweeps (azimuths 2 pi k / directions, one sample and one line per unit, as
-// the library's default), counting what the kernel does per sample.
+// of the library's lattice sweep (src/lattice_geometry.hpp) in `directions` directions as an
+// SVF / AO run takes them (quadrature directions), one sample per unit (the default),
+// counting what the kernel horizon_lattice does per sample: the samples of each line's
+// periods farthest first, then the receiver.
 struct StackStats {
-  std::size_t samples = 0;
+  std::size_t samples = 0;    // samples pushed, receivers included
+  std::size_t receivers = 0;  // receiver-direction pairs (pixels x directions)
   double pops_per_sample = 0.0;
   double mean_depth = 0.0;  // stack size each sample is tested against
   int max_depth = 0;

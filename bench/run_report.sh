@@ -11,6 +11,10 @@
 #   options: --out DIR (report directory), BUILD_DIR=... (default build/),
 #            --only horizon|visibility  run one suite; REPORT.md keeps the other suite's
 #                                       results already in the report directory
+#            HEMAN_DIR=...  a heman built by hand (see bench/README.md): also runs
+#                           bench/heman_compare.sh (quick: 1024 only, 3 rounds) into
+#                           bench/out/heman-<mode>/ and copies its tables to REPORT_DIR
+#                           (heman.md, heman_timings.csv) for the `hfvis ao` vs heman target
 #
 # Needs the build dependencies (scripts/install-deps.sh) and Debian's python3 with numpy and
 # matplotlib (python3-numpy, python3-matplotlib); nothing from pip.
@@ -27,7 +31,7 @@ while [[ $# -gt 0 ]]; do
     --only)
       only=$2; shift
       [[ $only == horizon || $only == visibility ]] || { echo "run_report.sh: --only horizon or visibility" >&2; exit 2; } ;;
-    -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,20p' "$0"; exit 0 ;;
     *) echo "run_report.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
   shift
@@ -44,7 +48,9 @@ start=$(date +%s)
 
 echo "== building hfvis_bench in $build_dir"
 cmake -S "$root" -B "$build_dir" -DCMAKE_BUILD_TYPE=Release > /dev/null
-cmake --build "$build_dir" -j "$(nproc)" --target hfvis_bench
+targets=(hfvis_bench)
+[[ -n ${HEMAN_DIR:-} && $only != visibility ]] && targets+=(hfvis_cli)
+cmake --build "$build_dir" -j "$(nproc)" --target "${targets[@]}"
 bench=$build_dir/bench/hfvis_bench
 
 echo "== generating inputs into bench/out/data"
@@ -67,6 +73,16 @@ if [[ $only != visibility ]]; then
   echo "== running the $mode horizon suite (log: bench/out/suite-$mode.log)"
   "$bench" suite $flag --data "$data_dir" --dem "$root/data/jacksboro_fault_dem.exr" --out "$report_dir" \
     --cache "$root/bench/out/truth" --commit "$commit" | tee "$root/bench/out/suite-$mode.log"
+fi
+if [[ -n ${HEMAN_DIR:-} && $only != visibility ]]; then
+  echo "== timing hfvis ao against heman (log: bench/out/heman-$mode.log)"
+  heman_sizes=()
+  [[ $mode == quick ]] && heman_sizes=(--sizes 1024 --rounds 3)
+  # Its outputs (EXRs of both programs) stay in bench/out/; the report directory gets the tables.
+  "$root/bench/heman_compare.sh" --heman-dir "$HEMAN_DIR" --hfvis "$build_dir/hfvis" \
+    --out "$root/bench/out/heman-$mode" "${heman_sizes[@]}" | tee "$root/bench/out/heman-$mode.log"
+  cp "$root/bench/out/heman-$mode/results.md" "$report_dir/heman.md"
+  cp "$root/bench/out/heman-$mode/timings.csv" "$report_dir/heman_timings.csv"
 fi
 if [[ $only != horizon ]]; then
   echo "== running the $mode intervisibility suite (log: bench/out/visibility-$mode.log)"

@@ -2,14 +2,17 @@
 //   checks    the oracle's self-checks; the baselines and the host SVF/AO formulas against
 //             the library on the same input
 //   headline  N = 1024 (quick: 256), K = 64 on the fractal terrain: sweep against the naive
-//             march, the bandwidth floor and the sweep's accuracy options, with errors
-//   plane     every content, every method, every K: time and error (the speed/error plane)
-//   sources   the sweep's two error sources apart: samples per unit, lines per unit, and
-//             the difference from the per-pixel march at the same sampling (line grid only)
+//             march (both with the K angle planes and with the SVF only), the bandwidth
+//             floor and the sweep's denser sampling, with horizon and SVF errors
+//   plane     every content, every method, every K: time and error (the speed/error plane),
+//             the sweep at 1 and 4 samples per unit
+//   sources   error against samples per unit, the naive march and the sweep side by side
 //   azimuth   SVF / AO at K against K = 1024 (quick: 512) of the same method (azimuthal
 //             discretisation)
 //   scale_n, scale_k   time against N and K (the report fits the exponents)
 //   stack     the hull stack's pops per sample and depth (host run of Algorithm 1)
+//   lattice   the sweep's directions per K (angle planes: exact azimuths; SVF only:
+//             quadrature): samples per receiver and period, what the sweep's cost follows
 //   vectorize PoCL's vectorisation remarks for the march kernels
 #include "suite.hpp"
 
@@ -34,6 +37,7 @@
 #include "hfvis/horizon.hpp"
 #include "hfvis/image_io.hpp"
 #include "hfvis/synthetic_fields.hpp"
+#include "lattice_geometry.hpp"
 #include "opencl_context.hpp"
 #include "suite_support.hpp"
 
@@ -50,16 +54,16 @@ struct Config {
   std::vector<std::string> contents;  // synthetic fields at plane_n (plus the DEM unless tiny)
   int plane_n = 512;
   std::vector<int> ks = {8, 16, 32, 64, 128, 256};
-  std::vector<int> naive_ks;          // K at which the naive march enters the plane
-  std::vector<int> library_naive_ks;  // K at which the library's naive kernel enters the plane
-  std::vector<int> radii = {16, 64};  // Radius baselines, pixels
+  std::vector<int> naive_ks;                      // K at which the naive march enters the plane
+  std::vector<double> plane_sweep_spus = {1, 4};  // the sweep's samples per unit in the plane
+  std::vector<int> radii = {16, 64};              // Radius baselines, pixels
   std::vector<int> pyramid_near = {8, 16};
   int headline_n = 1024, headline_k = 64;
   int scale_k_n = 512;  // time against K on the fractal terrain of this size
   std::vector<int> sweep_scale_ns, naive_scale_ns;
   int sweep_scale_k = 64, naive_scale_k = 8;
   double max_scale_run_seconds = 200.0;  // larger sizes of the N series are skipped
-  std::vector<double> source_spus = {1, 2, 4, 8}, source_lpus = {1, 2, 4};
+  std::vector<double> source_spus = {1, 2, 4, 8};
   int truth_receivers = 8192;
   int azimuth_reference_k = 1024;
   int stack_directions = 16;
@@ -73,13 +77,11 @@ Config configFor(const std::string& mode) {
     c.contents = {"fractal", "bricks", "sine", "blocks"};
     c.plane_n = 256;
     c.naive_ks = {8, 16, 32, 64, 128, 256};
-    c.library_naive_ks = {8};
     c.headline_n = 1024;
     c.scale_k_n = 512;
     c.sweep_scale_ns = {256, 512, 1024, 2048, 4096};
     c.naive_scale_ns = {256, 512, 1024, 2048};
     c.source_spus = {1, 2, 4, 8};
-    c.source_lpus = {1, 2, 4};
     c.truth_receivers = 8192;
     c.azimuth_reference_k = 1024;
     c.policy = {2, 5, 2.0};
@@ -88,13 +90,11 @@ Config configFor(const std::string& mode) {
     c.plane_n = 128;
     c.ks = {8, 32, 128};
     c.naive_ks = {8, 32, 128};
-    c.library_naive_ks = {8};
     c.headline_n = 256;
     c.scale_k_n = 256;
     c.sweep_scale_ns = {128, 256, 512};
     c.naive_scale_ns = {128, 256};
     c.source_spus = {1, 4};
-    c.source_lpus = {1, 2};
     c.truth_receivers = 1024;
     c.azimuth_reference_k = 512;
     c.policy = {2, 3, 0.3};
@@ -104,7 +104,6 @@ Config configFor(const std::string& mode) {
     c.plane_n = 40;
     c.ks = {4, 8};
     c.naive_ks = {4, 8};
-    c.library_naive_ks = {4};
     c.radii = {4};
     c.pyramid_near = {4};
     c.headline_n = 48, c.headline_k = 8;
@@ -113,7 +112,7 @@ Config configFor(const std::string& mode) {
     c.naive_scale_ns = {24, 48};
     c.sweep_scale_k = 8, c.naive_scale_k = 4;
     c.max_scale_run_seconds = 0.0;  // exercises the skip: every size after the first
-    c.source_spus = {1, 2}, c.source_lpus = {1, 2};
+    c.source_spus = {1, 2};
     c.truth_receivers = 300;
     c.azimuth_reference_k = 32;
     c.stack_directions = 4;
@@ -128,7 +127,7 @@ Config configFor(const std::string& mode) {
 
 // clang-format off
 const std::vector<std::string> kColumns = {
-    "section", "content", "width", "height", "method", "outputs", "K", "spu", "lpu", "param", "reps",
+    "section", "content", "width", "height", "method", "outputs", "K", "spu", "param", "reps",
     "t_min_s", "t_median_s", "t_all_s", "cpu_min_s", "load_1min", "pixel_dirs", "core_ns_per_pd",
     "cpu_ns_per_pd", "steps_executed", "steps_inside", "core_ns_per_step", "cpu_ns_per_step", "err_samples",
     "err_nan", "err_mean_deg", "err_p99_deg", "err_max_deg", "err_bias_deg", "int_mean_deg", "int_p99_deg",
@@ -155,7 +154,6 @@ Row measurementRow(const std::string& section, const std::string& content, const
   row["outputs"] = spec.outputs();
   row["K"] = std::to_string(spec.directions);
   row["spu"] = num(spec.samples_per_unit);
-  row["lpu"] = num(spec.lines_per_unit);
   row["param"] = std::to_string(spec.parameter);
   row["reps"] = std::to_string(timing.seconds.size());
   row["t_min_s"] = num(timing.min());
@@ -189,8 +187,7 @@ void addErrors(Row& row, const ErrorStats& e) {
 }
 
 bool isMarch(const MethodSpec& spec) {
-  return spec.kind == MethodKind::Naive || spec.kind == MethodKind::BenchNaive ||
-         spec.kind == MethodKind::Radius;
+  return spec.kind == MethodKind::Naive || spec.kind == MethodKind::Radius;
 }
 
 void addSteps(Row& row, const HeightField& field, const MethodSpec& spec, const Timing& timing, int cores) {
@@ -228,19 +225,16 @@ std::string describe(const MethodSpec& spec) {
   std::ostringstream s;
   s << spec.name() << " (" << spec.outputs() << ") K=" << spec.directions;
   if (spec.samples_per_unit != 1.0) s << " spu=" << spec.samples_per_unit;
-  if (spec.lines_per_unit != 1.0) s << " lpu=" << spec.lines_per_unit;
   return s.str();
 }
 
-MethodSpec spec(MethodKind kind, int k, bool angles = true, int parameter = 0, double spu = 1.0,
-                double lpu = 1.0) {
+MethodSpec spec(MethodKind kind, int k, bool angles = true, int parameter = 0, double spu = 1.0) {
   MethodSpec s;
   s.kind = kind;
   s.directions = k;
   s.angles = angles;
   s.parameter = parameter;
   s.samples_per_unit = spu;
-  s.lines_per_unit = lpu;
   return s;
 }
 
@@ -258,25 +252,37 @@ class Suite {
     sources();
     azimuth();
     stack();
+    lattice();
     headline();
     scaling();
     if (config_.vectorize) vectorize();
   }
 
  private:
-  // Times one method, writes its row (with errors when a truth is given), returns the output.
+  // Times one method, writes its row (with errors when a truth is given: horizon errors
+  // from the angle planes, or the SVF error of an SVF-only run), returns the output.
   MethodOutput timed(const std::string& section, const Content& content, const MethodSpec& s,
                      const GroundTruth* truth, Row* written = nullptr) {
     Measured m = measureMethod(context_, content.field, s, config_.policy);
     Row row = measurementRow(section, content.name, content.field, s, m.timing, results_.cores());
     addSteps(row, content.field, s, m.timing, results_.cores());
     std::string error_text;
+    char text[128];
     if (truth && s.angles && !m.output.angles.empty()) {
       const ErrorStats e = horizonErrors(content.field, *truth, m.output.angles, s.directions);
       addErrors(row, e);
-      char text[96];
-      std::snprintf(text, sizeof text, ", error mean %.3f p99 %.3f max %.2f deg", e.mean_deg, e.p99_deg,
-                    e.max_deg);
+      std::snprintf(text, sizeof text, ", error mean %.3f p99 %.3f max %.2f deg, SVF mean %.2e max %.2e",
+                    e.mean_deg, e.p99_deg, e.max_deg, e.svf_mean, e.svf_max);
+      error_text = text;
+    } else if (truth && !m.output.svf.empty()) {
+      const SvfErrorStats e = svfErrors(content.field, *truth, m.output.svf, s.directions);
+      row["svf_mean_abs"] = num(e.mean_abs);
+      row["svf_max_abs"] = num(e.max_abs);
+      row["note"] = "SVF output against the exact horizons' SVF (K = " + std::to_string(s.directions) +
+                    ", azimuths 2 pi k / K) on " + std::to_string(e.receivers) + " receivers; bias " +
+                    num(e.bias);
+      std::snprintf(text, sizeof text, ", SVF error mean %.2e max %.2e (bias %.2e)", e.mean_abs, e.max_abs,
+                    e.bias);
       error_text = text;
     }
     results_.write(row);
@@ -307,16 +313,22 @@ class Suite {
     say("[checks] %s", summary.c_str());
     if (!failures.empty()) throw Error("the ground truth failed its self-checks");
 
-    // The bench's naive march against the library's (same method, rounding may differ), and
-    // the host SVF / AO formulas against the library's reduction, on the same input.
+    // The baselines' march (radius_march, what radius_R runs) with a radius past every ray's
+    // end against the library's naive march: the same method, so radius_R is the library's
+    // march cut short (rounding may differ). Then the host SVF / AO formulas against the
+    // library's reduction, on the same input.
+    // K = 16: directions off the grid's axes and diagonals, where the sweep's lattice steps
+    // are not at 2 pi k / K exactly.
     const Content c = loadContent(options_, config_.contents.front(), config_.plane_n);
-    const int k = config_.ks.front();
-    const MethodOutput mine = runMethod(context_, c.field, spec(MethodKind::BenchNaive, k));
+    const int k = 16;
+    const int whole = c.field.width + c.field.height;
+    const MethodOutput baseline = runMethod(context_, c.field, spec(MethodKind::Radius, k, true, whole));
     const MethodOutput library = runMethod(context_, c.field, spec(MethodKind::Naive, k));
-    const PlaneDifference naive = planeDifference(mine.angles, library.angles);
-    results_.write(metricRow("checks", c.name, &c.field, "naive_bench_vs_library_naive_max_deg",
-                             naive.max_abs * 180.0 / M_PI, "K=" + std::to_string(k)));
-    say("[checks] naive_bench vs library naive, K=%d: max difference %.3g deg", k,
+    const PlaneDifference naive = planeDifference(baseline.angles, library.angles);
+    results_.write(metricRow("checks", c.name, &c.field, "baseline_march_vs_library_naive_max_deg",
+                             naive.max_abs * 180.0 / M_PI,
+                             "K=" + std::to_string(k) + ", radius_" + std::to_string(whole)));
+    say("[checks] baseline march (radius_%d) vs library naive, K=%d: max difference %.3g deg", whole, k,
         naive.max_abs * 180.0 / M_PI);
 
     HorizonOptions o;
@@ -331,8 +343,10 @@ class Suite {
       for (int d = 0; d < k; ++d) e[d] = r.angles[d * plane + p];
       const Normal n =
           surfaceNormal(c.field, static_cast<int>(p % c.field.width), static_cast<int>(p / c.field.width));
+      // With the angle planes the library takes the directions within its azimuth tolerance
+      // of 2 pi k / K, weighted 1/K: the AO formula needs the azimuths it used.
       svf_diff = std::max(svf_diff, std::abs(skyViewFactor(e) - r.sky_view_factor[p]));
-      ao_diff = std::max(ao_diff, std::abs(ambientOcclusion(e, n) - r.ambient_occlusion[p]));
+      ao_diff = std::max(ao_diff, std::abs(ambientOcclusion(e, n, r.azimuths) - r.ambient_occlusion[p]));
     }
     results_.write(metricRow("checks", c.name, &c.field, "host_svf_vs_library_max_abs", svf_diff));
     results_.write(metricRow("checks", c.name, &c.field, "host_ao_vs_library_max_abs", ao_diff));
@@ -348,10 +362,11 @@ class Suite {
     const GroundTruth truth = truthFor(c, k);
     const std::string s = "headline";
     timed(s, c, spec(MethodKind::Sweep, k), &truth);
-    timed(s, c, spec(MethodKind::Sweep, k, false), nullptr);
+    timed(s, c, spec(MethodKind::Sweep, k, false), &truth);  // SVF only: its SVF error
     timed(s, c, spec(MethodKind::Floor, k), nullptr);
     timed(s, c, spec(MethodKind::Floor, k, false), nullptr);
-    timed(s, c, spec(MethodKind::BenchNaive, k), &truth);
+    timed(s, c, spec(MethodKind::Naive, k), &truth);
+    timed(s, c, spec(MethodKind::Naive, k, false), &truth);
     for (double spu : {2.0, 4.0}) timed(s, c, spec(MethodKind::Sweep, k, true, 0, spu), &truth);
     timed(s, c, spec(MethodKind::Radius, k, true, config_.radii.back()), &truth);
     timed(s, c, spec(MethodKind::Pyramid, k, true, config_.pyramid_near.back()), &truth);
@@ -369,48 +384,27 @@ class Suite {
       const int k_max = *std::max_element(config_.ks.begin(), config_.ks.end());
       const GroundTruth truth = truthFor(c, k_max);
       for (int k : config_.ks) {
-        timed("plane", c, spec(MethodKind::Sweep, k), &truth);
+        for (double spu : config_.plane_sweep_spus)
+          timed("plane", c, spec(MethodKind::Sweep, k, true, 0, spu), &truth);
         if (std::count(config_.naive_ks.begin(), config_.naive_ks.end(), k))
-          timed("plane", c, spec(MethodKind::BenchNaive, k), &truth);
+          timed("plane", c, spec(MethodKind::Naive, k), &truth);
         for (int r : config_.radii) timed("plane", c, spec(MethodKind::Radius, k, true, r), &truth);
         for (int p : config_.pyramid_near) timed("plane", c, spec(MethodKind::Pyramid, k, true, p), &truth);
-        if (std::count(config_.library_naive_ks.begin(), config_.library_naive_ks.end(), k))
-          timed("plane", c, spec(MethodKind::Naive, k), &truth);
       }
     }
   }
 
-  // The sweep's error sources apart, on the fractal terrain and the DEM at K = 64 (tiny: 8).
+  // Error against samples per unit, on the fractal terrain and the DEM at K = 64 (tiny: 8):
+  // the naive march (its sampling error alone: steps of 1/S pixel) and the sweep (the exact
+  // grid crossings, and with S > 1 about S samples per pixel between them).
   void sources() {
     const int k = options_.mode == "tiny" ? 8 : 64;
     for (const std::string name : {"fractal", "dem"}) {
       const Content c = loadContent(options_, name, config_.plane_n);
       const GroundTruth truth = truthFor(c, *std::max_element(config_.ks.begin(), config_.ks.end()));
-      std::map<double, std::vector<float>> naive_at;
       for (double spu : config_.source_spus) {
-        if (spu > 4.0) continue;  // the per-pixel march at 8 samples per unit costs too much
-        naive_at[spu] = timed("sources", c, spec(MethodKind::BenchNaive, k, true, 0, spu), &truth).angles;
-      }
-      for (double lpu : config_.source_lpus) {
-        for (double spu : config_.source_spus) {
-          if (lpu != 1.0 && spu != 1.0 && spu != 4.0) continue;  // the corners of the grid suffice
-          MethodSpec s = spec(MethodKind::Sweep, k, true, 0, spu, lpu);
-          const MethodOutput out = timed("sources", c, s, &truth);
-          const auto naive = naive_at.find(spu);
-          if (naive == naive_at.end()) continue;
-          // Same samples per unit, so what remains is the line grid and the reduction.
-          const ErrorStats d = horizonDifference(c.field, truth, out.angles, naive->second, k);
-          Row row = metricRow("sources", c.name, &c.field, "sweep_minus_naive_same_spu", d.mean_deg,
-                              "line grid + reduction interpolation alone");
-          row["method"] = "sweep_vs_naive_bench";
-          row["K"] = std::to_string(k);
-          row["spu"] = num(spu);
-          row["lpu"] = num(lpu);
-          addErrors(row, d);
-          results_.write(row);
-          say("[sources] %s sweep spu=%g lpu=%g vs naive_bench spu=%g: mean %.3f deg, p99 %.3f, max %.2f",
-              c.label.c_str(), spu, lpu, spu, d.mean_deg, d.p99_deg, d.max_deg);
-        }
+        timed("sources", c, spec(MethodKind::Naive, k, true, 0, spu), &truth);
+        timed("sources", c, spec(MethodKind::Sweep, k, true, 0, spu), &truth);
       }
     }
   }
@@ -441,8 +435,8 @@ class Suite {
 
   void scaling() {
     // Time against N: the sweep (SVF only: what the kernels cost, no K planes to download)
-    // at sweep_scale_k, and the sweep and the vectorised naive march (device-side planes
-    // only) at naive_scale_k, so each N has a same-K ratio. "As far as the machine allows":
+    // at sweep_scale_k, and the sweep and the library's naive march (both SVF only, the
+    // whole library call) at naive_scale_k, so each N has a same-K ratio. "As far as the machine allows":
     // a size whose run, extrapolated from the size before (N^2 for the sweep, N^3 for the
     // march), would exceed max_scale_run_seconds is skipped, and the skip is recorded.
     std::map<std::string, std::pair<int, double>> last;  // series -> (N, seconds) measured last
@@ -475,7 +469,7 @@ class Suite {
       scaled(c, spec(MethodKind::Sweep, config_.sweep_scale_k, false), 2.0);
       if (std::count(config_.naive_scale_ns.begin(), config_.naive_scale_ns.end(), n)) {
         scaled(c, spec(MethodKind::Sweep, config_.naive_scale_k, false), 2.0);
-        scaled(c, spec(MethodKind::BenchNaive, config_.naive_scale_k, false), 3.0);
+        scaled(c, spec(MethodKind::Naive, config_.naive_scale_k, false), 3.0);
       }
     }
     // Time against K (the plane has every method against K at its size).
@@ -493,8 +487,60 @@ class Suite {
       results_.write(metricRow("stack", c.name, &c.field, "pops_per_sample", s.pops_per_sample, note));
       results_.write(metricRow("stack", c.name, &c.field, "mean_depth", s.mean_depth, note));
       results_.write(metricRow("stack", c.name, &c.field, "max_depth", s.max_depth, note));
-      say("[stack] %s: %.3f pops per sample, mean depth %.2f, max depth %d", c.label.c_str(),
-          s.pops_per_sample, s.mean_depth, s.max_depth);
+      results_.write(metricRow("stack", c.name, &c.field, "samples_per_receiver",
+                               s.receivers ? double(s.samples) / s.receivers : 0.0, note));
+      say("[stack] %s: %.3f pops per sample, mean depth %.2f, max depth %d, %.2f samples per receiver",
+          c.label.c_str(), s.pops_per_sample, s.mean_depth, s.max_depth,
+          s.receivers ? double(s.samples) / s.receivers : 0.0);
+    }
+  }
+
+  // The directions the sweep takes at each K, as the library chooses them, on a square-cell
+  // field (the fractal) and the DEM (its cells are not square): per receiver and direction
+  // the sweep pushes one period's samples, so its cost per pixel-direction follows
+  // samples_per_receiver (host only, no timing).
+  void lattice() {
+    std::vector<int> ks = config_.ks;
+    if (!std::count(ks.begin(), ks.end(), config_.headline_k)) ks.push_back(config_.headline_k);
+    std::sort(ks.begin(), ks.end());
+    for (const std::string name : {"fractal", "dem"}) {
+      const Content c = loadContent(options_, name, config_.plane_n);
+      for (int k : ks) {
+        for (const bool angles : {true, false}) {
+          HorizonOptions o;
+          o.directions = k;
+          const auto directions = detail::latticeDirections(c.field, o, angles, o.azimuth_tolerance);
+          double period = 0.0, longest = 0.0, offset = 0.0;
+          int a_max = 0, b_max = 0;
+          for (std::size_t q = 0; q < directions.size(); ++q) {
+            const auto& d = directions[q];
+            period += d.period / directions.size();
+            if (d.period > longest) longest = d.period, a_max = d.a, b_max = d.b;
+            offset = std::max(offset, std::abs(d.azimuth - directionAzimuth(static_cast<int>(q), o)));
+          }
+          for (double spu : {1.0, 4.0}) {
+            double samples = 0.0, most = 0.0;
+            for (const auto& d : directions) {
+              const double n = static_cast<double>(detail::latticeSamples(d, spu).size());
+              samples += n / directions.size();
+              most = std::max(most, n);
+            }
+            char note[200];
+            std::snprintf(note, sizeof note,
+                          "max %g samples; period mean %.2f px, max %.2f px (step %d, %d); largest azimuth "
+                          "offset %.3g deg",
+                          most, period, longest, a_max, b_max, offset * 180.0 / M_PI);
+            Row row = metricRow("lattice", c.name, &c.field, "samples_per_receiver", samples, note);
+            row["method"] = "sweep";
+            row["outputs"] = angles ? "angles" : "svf";
+            row["K"] = std::to_string(k);
+            row["spu"] = num(spu);
+            results_.write(row);
+            say("[lattice] %s K=%d %s spu=%g: %.2f samples per receiver (%s)", c.label.c_str(), k,
+                angles ? "angles" : "svf", spu, samples, note);
+          }
+        }
+      }
     }
   }
 
@@ -548,7 +594,7 @@ int runKernelsOnce(const ComputeContext& context, const std::string& which) {
   const bool library = which == "all" || which == "library", bench = which == "all" || which == "bench";
   if (library) runMethod(context, field, spec(MethodKind::Naive, 8));
   if (bench) {
-    runMethod(context, field, spec(MethodKind::BenchNaive, 8));
+    runMethod(context, field, spec(MethodKind::Radius, 8, true, 32));  // radius_march
     runMethod(context, field, spec(MethodKind::Pyramid, 8, true, 16));
   }
   return 0;
@@ -641,6 +687,7 @@ int runSuite(const ComputeContext& context, const SuiteOptions& options) {
   KeyValues environment = describeEnvironment(context.device());
   environment.emplace_back("mode", options.mode);
   environment.emplace_back("commit", options.commit);
+  environment.emplace_back("sweep_azimuth_tolerance_deg", num(HorizonOptions{}.azimuth_tolerance * 180.0 / M_PI));
   const int cores = std::max(1, context.device().compute_units);
   {
     Results results((fs::path(options.out_dir) / "results.csv").string(), cores);

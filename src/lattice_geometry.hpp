@@ -32,9 +32,9 @@ struct LatticeDirection {
 // direction k is the cheapest primitive step whose ground azimuth is within `tolerance`
 // radians of phi_k = 2 pi k / K + offset (the closest one when none is), each with weight
 // 1/K. Otherwise (sky-view factor and occlusion, which integrate over azimuth) the
-// cheapest within a quarter of the spacing 2 pi / K, with quadrature weights from the
-// azimuths actually used (half the gap to each neighbour). Cost is |a| + |b|: the crossings
-// of one period. Steps are bounded by kMaxLatticeStep.
+// cheapest strictly within half the spacing 2 pi / K, with quadrature weights from the
+// azimuths actually used (half the gap to each neighbour). Cost is the crossings of one
+// period, |a| + |b| - 1 (1 on the axes). Steps are bounded by kMaxLatticeStep.
 constexpr int kMaxLatticeStep = 64;
 std::vector<LatticeDirection> latticeDirections(const HeightField& field, const SweepOptions& options,
                                                 bool exact_azimuths, double tolerance);
