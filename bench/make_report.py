@@ -226,7 +226,7 @@ def plot_scaling(series, xlabel, title, path):
 # ------------------------------------------------------------------------------------------
 # Intervisibility (visibility.csv, hfvis_bench visibility)
 
-# Seed 000 (Timonen 2013): Table 3's speedups of the tree over the naive method (GPU, per
+# Timonen (2013): Table 3's speedups of the tree over the naive method (GPU, per
 # sweep) and Table 2's m_a, t_a (N = 1024, K = 256); Figure 8's iteration exponents.
 PAPER_SPEEDUP = {"fractal": 2.4, "bricks": 4.2, "sine": 13.0, "blocks": 41.0}
 PAPER_TABLE2 = {"fractal": (9.25, 11.7, 2.4), "bricks": (3.06, 4.80, 0.99), "sine": (1.68, 3.02, 0.62),
@@ -256,7 +256,7 @@ def plot_visibility_scaling(series, path):
     ax.set_ylabel("convexity checks t per line")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7)
-    ax.set_title("Hull tree iterations against line length (seed 000, Figure 8)")
+    ax.set_title("Hull tree iterations against line length (Timonen 2013, Figure 8)")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -290,7 +290,7 @@ def visibility_section(d, say, targets):
         say("Each run is the whole library call `computeIntervisibility` with the visible-count output (what "
             "`hfvis viewcount` computes for channel 0): upload, presampling, the sweep, the reduction, download. "
             "The methods' runs are interleaved (one of each per round; the table gives the minimum of the rounds), "
-            "so a slow spell of the machine does not land on one method only. Seed 000's Table 3 gives the "
+            "so a slow spell of the machine does not land on one method only. Timonen (2013)'s Table 3 gives the "
             "speedup of the tree sweep over the naive method on a GPU (the sweep kernel alone); the target is at "
             "least that ratio here.")
         say("")
@@ -308,7 +308,7 @@ def visibility_section(d, say, targets):
                           fmt(wall), fmt(cpu), fmt(num(tree, "core_ns_per_pd")), fmt(num(naive, "core_ns_per_pd")),
                           ("%sx" % fmt(paper)) if paper else "n/a", outcome])
             if paper:
-                targets.append(("tree vs naive, %s %s, K = %s: at least %sx (seed 000 Table 3)" % (
+                targets.append(("tree vs naive, %s %s, K = %s: at least %sx (Timonen 2013, Table 3)" % (
                     CONTENT_TITLES.get(c, c), size, k, fmt(paper)), "%sx wall, %sx CPU" % (fmt(wall), fmt(cpu)),
                     outcome))
         say(table(["content", "size", "tree (s)", "naive (s)", "naive / tree, wall", "naive / tree, CPU",
@@ -363,7 +363,7 @@ def visibility_section(d, say, targets):
     stats = vis.select("vis_stats")
     if stats:
         k = stats[0]["K"]
-        say("### Horizons and iterations per point and direction (seed 000, Table 2)")
+        say("### Horizons and iterations per point and direction (Timonen 2013, Table 2)")
         say("")
         say("Over every receiver of every line of K = %s directions (the paper: K = 256, N = 1024, naive "
             "iterations 484 per point). *naive* is the samples the naive method tests per receiver on the same "
@@ -393,7 +393,7 @@ def visibility_section(d, say, targets):
 
     scale = vis.select("vis_scale")
     if scale:
-        say("### Iterations against line length (seed 000, Figure 8)")
+        say("### Iterations against line length (Timonen 2013, Figure 8)")
         say("")
         say("Lines of n samples (%s lines per n, swept along the rows; Figure 8 counts Algorithm 1's iterations, the "
             "`plain` rows, and the default tuning's are given beside them): *fractal detail* "

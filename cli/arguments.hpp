@@ -42,9 +42,9 @@ const char* commandName(Command command);
 struct RunArguments {
   std::string input;
   std::string output;
-  std::string distance_output;  // horizon only; "" = not asked for
+  std::string distance_output;          // horizon only; "" = not asked for
   double azimuth_tolerance_deg = 0.25;  // horizon only: the sweep's directions within this of phi_k
-  std::string preview;          // "" = no preview
+  std::string preview;                  // "" = no preview
   int directions = 64;
   double azimuth_offset_deg = 0.0;
   double samples_per_unit = 1.0;
@@ -53,7 +53,7 @@ struct RunArguments {
   IntervisibilityMethod visibility_method = IntervisibilityMethod::HullTree;  // viewcount
   bool statistics = false;                                                    // viewcount --stats
   HullTreeTuning hull_tree;                                                   // viewcount, bounce
-  std::string hull_tree_name;  // --hull-tree as given; "" = not given (the default tuning)
+  std::string hull_tree_name;            // --hull-tree as given; "" = not given (the default tuning)
   std::vector<ReceiverPixel> receivers;  // horizons --at, in the order given
   std::string radiance;                  // bounce --radiance
   double cell_size_x = 0.0;              // <= 0: from the file, else 1

@@ -407,7 +407,8 @@ int runCompute(Command command, const RunArguments& run) {
   // The sweep's directions are lattice steps near phi_k (horizon planes) or quadrature
   // directions (svf, ao): record the azimuths it used.
   std::string used;
-  for (double azimuth : result.azimuths) used += (used.empty() ? "" : ",") + formatNumber(azimuth * 180.0 / M_PI);
+  for (double azimuth : result.azimuths)
+    used += (used.empty() ? "" : ",") + formatNumber(azimuth * 180.0 / M_PI);
   attributes.emplace_back("hfvis:azimuths_deg", used);
 
   // Everything is computed; now stage every file, then move them all into place.
@@ -429,7 +430,7 @@ int runCompute(Command command, const RunArguments& run) {
                     splitPlanes(result.distances, pixels, directions), attributes,
                     "ground distance to the point casting the horizon, per direction",
                     "ground units (pixels times cell size); 0 where no point casts a horizon or the "
-                  "surface's own slope at the receiver is the horizon");
+                    "surface's own slope at the receiver is the horizon");
       outputs.stage(run.distance_output, [&](const std::string& path) { writeImage(path, distances); });
     }
     if (!run.preview.empty()) {
@@ -491,7 +492,7 @@ int runViewCount(const RunArguments& run) {
   const IntervisibilityStatistics& stats = result.statistics;
   std::string stats_line;
   if (run.statistics) {
-    // Seed 000, Table 2: per receiver (line sample) and direction.
+    // Timonen (2013), Table 2: per receiver (line sample) and direction.
     attributes.emplace_back("hfvis:stats_m_a", formatNumber(stats.meanHorizons()));
     attributes.emplace_back("hfvis:stats_t_a", formatNumber(stats.meanIterations()));
     attributes.emplace_back("hfvis:stats_visible_per_point", formatNumber(stats.meanVisible()));

@@ -34,8 +34,9 @@ Options:
   -o, --output FILE        output image, float32 EXR (required)
   -k, --directions K       number of azimuth directions, K >= 1 (default 64)
   --method sweep|naive     horizon, svf, ao: sweep = convex-hull-stack sweep along lines through
-                           every pixel centre, linear time per direction, exact for each receiver's
-                           own ray; naive = per-pixel ray march, slow reference (default sweep).
+                           every pixel centre, linear time per direction, exact over the samples
+                           of each receiver's own ray; naive = per-pixel ray march, slow
+                           reference (default sweep).
                            The sweep's directions are integer pixel steps: within 0.25 deg of
                            phi_k for horizon, within half the spacing (weighted) for svf and ao;
                            the hfvis:azimuths_deg attribute lists those used
@@ -43,8 +44,9 @@ Options:
                            per-pixel visibility march, slow reference (default tree)
   --azimuth-offset DEG     added to every direction's azimuth, degrees (default 0)
   --samples-per-unit S     naive, viewcount, bounce: height samples per pixel length along a
-                           line or ray; sweep: besides the grid-line crossings, samples at most
-                           1/S pixel apart and at least one between two crossings (default 1)
+                           line or ray; sweep: every grid-line crossing of the ray (exact heights)
+                           and, for S > 1, about S points per pixel length between crossings
+                           (default 1: the crossings alone)
   --lines-per-unit L       viewcount, bounce: sweep lines per pixel length across a direction
                            (default 1; the horizon sweep always has one line per pixel centre)
   --cell-size X[,Y]        ground units per pixel along columns (X) and rows (Y)
@@ -67,7 +69,7 @@ Horizon only:
   --distance-out FILE      also write K channels d000.. of ground distance to the
                            horizon point (ground units), computed in the same run
   --azimuth-tolerance DEG  the sweep's direction k is the cheapest integer pixel step within
-                           DEG of phi_k (default 0.25; at most 5.7). Smaller is closer to
+                           DEG of phi_k (default 0.25; at most 5.73). Smaller is closer to
                            phi_k and slower: steps with more grid crossings per pixel
   Its preview shows the mean horizon elevation over the directions whose ray stays in
   the field (low = dark, high = bright), stretched from its minimum to its maximum; the
@@ -76,7 +78,7 @@ Horizon only:
 
 const char* const kViewCount = R"(
 Viewcount:
-  --stats                  also print, for the tree method, the statistics of seed 000's
+  --stats                  also print, for the tree method, the statistics of Timonen (2013)'s
                            Table 2 per point and direction: m_a (visibility horizons), t_a
                            (convexity checks made), visible samples and naive iterations (the
                            samples the naive method tests); also stored as hfvis:stats_* EXR

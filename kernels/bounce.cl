@@ -57,7 +57,7 @@ __kernel void bounce_reduce(__global const float* heights, int width, int height
   float sums[HFVIS_CHANNELS];
   for (int ch = 0; ch < HFVIS_CHANNELS; ++ch) sums[ch] = 0.0f;
   for (int b = 0; b < batch_size; ++b) {
-    barrier(CLK_LOCAL_MEM_FENCE);  // see horizon_reduce: keeps the work-item loop innermost
+    barrier(CLK_LOCAL_MEM_FENCE);  // see horizon_naive: keeps the work-item loop innermost
     const SweepDirection d = load_direction(directions + b);
     int j0, i0;
     float fu, fv;

@@ -34,9 +34,6 @@ HFVIS_INLINE float hf_atan(float x) {
   return x < 0.0f ? -y : y;
 }
 
-// atan2(y, x) for x > 0, the only case the horizon reductions meet (the occluder is
-// strictly ahead); y may be +-inf.
-HFVIS_INLINE float hf_atan2_ahead(float y, float x) { return hf_atan(y / x); }
 
 // sin(x) for |x| <= 2 pi: reduced to [-pi/2, pi/2], then Taylor to x^11.
 HFVIS_INLINE float hf_sin(float x) {

@@ -699,7 +699,7 @@ HFVIS_INLINE void accumulate_visible(uint pixel, int nodata, float count, float 
 // (none left: nothing seen in that direction). On axis directions every pixel is a line
 // sample (weight 1 on one entry), so the result is exactly that sample's count.
 // `sector` = 2*pi/K. Straight-line code (clamped reads, masked sums, a uniform barrier)
-// so that PoCL vectorises it, as horizon_reduce. Global size: (W, H) rounded up to the
+// so that PoCL vectorises it, as horizon_naive. Global size: (W, H) rounded up to the
 // local size.
 __kernel void intervisibility_reduce(__global const float* heights, int width, int height,
                                      __global const SweepDirection* directions, int batch_size, float sector,
@@ -711,7 +711,7 @@ __kernel void intervisibility_reduce(__global const float* heights, int width, i
   const uint pixel = (uint)(rr * width + cc);
   float counts = 0.0f, area = 0.0f;
   for (int b = 0; b < batch_size; ++b) {
-    barrier(CLK_LOCAL_MEM_FENCE);  // see horizon_reduce: keeps the work-item loop innermost
+    barrier(CLK_LOCAL_MEM_FENCE);  // see horizon_naive: keeps the work-item loop innermost
     const SweepDirection d = load_direction(directions + b);
     int j0, i0;
     float fu, fv;

@@ -25,7 +25,6 @@ inline float hfAtan(float x) {
   return x < 0.0f ? -y : y;
 }
 
-inline float hfAtan2Ahead(float y, float x) { return hfAtan(y / x); }
 
 inline float hfSin(float x) {
   float r = x - 2.0f * kPiF * std::rint(x * (0.5f / kPiF));

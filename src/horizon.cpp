@@ -7,8 +7,8 @@
 #include <cmath>
 #include <sstream>
 
-#include "hfvis/errors.hpp"
 #include "fast_math.hpp"
+#include "hfvis/errors.hpp"
 #include "horizon_common.hpp"
 #include "lattice_geometry.hpp"
 #include "opencl_context.hpp"
@@ -20,11 +20,11 @@ namespace {
 
 constexpr std::size_t kStackEntryBytes = 2 * sizeof(float);  // (height, position)
 
-std::string programOptions(const HorizonOutputs& outputs, bool has_nodata, const DeviceInfo& device) {
+std::string programOptions(const HorizonOutputs& outputs, bool has_nodata) {
   std::ostringstream s;
   s << "-DHFVIS_HAS_NODATA=" << has_nodata << " -DHFVIS_WANT_ANGLES=" << outputs.horizon_angles
-    << " -DHFVIS_WANT_DISTANCES=" << outputs.horizon_distances << " -DHFVIS_WANT_SVF=" << outputs.sky_view_factor
-    << " -DHFVIS_WANT_AO=" << outputs.ambient_occlusion << " " << layoutProgramOption(device);
+    << " -DHFVIS_WANT_DISTANCES=" << outputs.horizon_distances
+    << " -DHFVIS_WANT_SVF=" << outputs.sky_view_factor << " -DHFVIS_WANT_AO=" << outputs.ambient_occlusion;
   return s.str();
 }
 
@@ -46,10 +46,12 @@ struct RunPlan {
 RunPlan planRun(const HeightField& field, const HorizonOptions& options, const HorizonOutputs& outputs,
                 const std::vector<RunDirection>& directions, const DeviceInfo& device) {
   const bool sweep = options.method == HorizonMethod::Sweep;
-  const std::size_t budget = options.memory_budget_bytes ? options.memory_budget_bytes : defaultMemoryBudget(device);
+  const std::size_t budget =
+      options.memory_budget_bytes ? options.memory_budget_bytes : defaultMemoryBudget(device);
   const std::size_t max_alloc = device.max_allocation_bytes ? device.max_allocation_bytes : budget;
   const std::size_t plane = field.pixelCount() * sizeof(float);
-  const std::size_t fixed = plane * (1 + outputs.sky_view_factor + outputs.ambient_occlusion * 5);  // + float4 normals
+  const std::size_t fixed =
+      plane * (1 + outputs.sky_view_factor + outputs.ambient_occlusion * 5);  // + float4 normals
   const std::size_t per_direction = plane * (outputs.horizon_angles + outputs.horizon_distances);
   // Scratch: all of a direction's stacks in one launch when it fits; one line at a time at least.
   std::size_t whole = 0, longest = 0;
@@ -65,8 +67,9 @@ RunPlan planRun(const HeightField& field, const HorizonOptions& options, const H
     }
   }
   auto fail = [&](std::size_t need) {
-    throw MemoryBudgetError("one direction needs " + mebibytes(need) + " of device memory but the budget is " +
-                            mebibytes(budget) + " (largest single buffer " + mebibytes(max_alloc) +
+    throw MemoryBudgetError("one direction needs " + mebibytes(need) +
+                            " of device memory but the budget is " + mebibytes(budget) +
+                            " (largest single buffer " + mebibytes(max_alloc) +
                             "); raise the memory budget or use a smaller field");
   };
   const std::size_t least = fixed + per_direction + longest * kStackEntryBytes;
@@ -75,13 +78,19 @@ RunPlan planRun(const HeightField& field, const HorizonOptions& options, const H
   RunPlan plan;
   // Planes of up to kMaxDirectionsPerBatch directions, leaving the scratch at least half.
   const std::size_t stack_bytes = std::min(whole * kStackEntryBytes, max_alloc);
-  const std::size_t for_planes = available - std::min(stack_bytes, std::max(available / 2, longest * kStackEntryBytes));
+  const std::size_t for_planes =
+      available - std::min(stack_bytes, std::max(available / 2, longest * kStackEntryBytes));
+  plan.directions_per_batch = static_cast<int>(
+      std::min<std::size_t>({static_cast<std::size_t>(std::min(options.directions, kMaxDirectionsPerBatch)),
+                             per_direction ? std::max<std::size_t>(1, for_planes / per_direction)
+                                           : std::size_t(kMaxDirectionsPerBatch),
+                             per_direction ? std::max<std::size_t>(1, max_alloc / per_direction)
+                                           : std::size_t(kMaxDirectionsPerBatch)}));
+  // Plane offsets within a batch are 32-bit in the kernels.
   plan.directions_per_batch = static_cast<int>(std::min<std::size_t>(
-      {static_cast<std::size_t>(std::min(options.directions, kMaxDirectionsPerBatch)),
-       per_direction ? std::max<std::size_t>(1, for_planes / per_direction) : std::size_t(kMaxDirectionsPerBatch),
-       per_direction ? std::max<std::size_t>(1, max_alloc / per_direction) : std::size_t(kMaxDirectionsPerBatch)}));
-  plan.stack_entries =
-      std::min(whole, std::min(available - plan.directions_per_batch * per_direction, max_alloc) / kStackEntryBytes);
+      plan.directions_per_batch, std::max<std::size_t>(1, std::size_t(0xffffffffu) / field.pixelCount())));
+  plan.stack_entries = std::min(
+      whole, std::min(available - plan.directions_per_batch * per_direction, max_alloc) / kStackEntryBytes);
   return plan;
 }
 
@@ -116,13 +125,14 @@ class HorizonRun {
 
   HorizonResult run() {
     const PreparedHeights prepared = prepareHeights(field_);
-    program_ = st_.program("horizon.cl", programOptions(outputs_, prepared.has_nodata, st_.info));
+    program_ = st_.program("horizon.cl", programOptions(outputs_, prepared.has_nodata));
     const std::vector<RunDirection> directions = runDirectionsOf(field_, options_, outputs_);
     const RunPlan plan = planRun(field_, options_, outputs_, directions, st_.info);
     HorizonResult result = allocateResult(field_, options_, outputs_);
     for (int k = 0; k < options_.directions; ++k) result.azimuths[k] = directions[k].lattice.azimuth;
 
     const std::size_t plane = field_.pixelCount();
+    const bool planes = outputs_.horizon_angles || outputs_.horizon_distances;
     heights_ = cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, plane * sizeof(float),
                           const_cast<float*>(prepared.heights.data()));
     const std::size_t planes_bytes = plan.directions_per_batch * plane * sizeof(float);
@@ -152,6 +162,7 @@ class HorizonRun {
       const int count = std::min(plan.directions_per_batch, options_.directions - first);
       for (int b = 0; b < count; ++b) {
         const RunDirection& d = directions[first + b];
+        if (d.lattice.weight == 0.0 && !planes) continue;  // merged into an equal step (latticeDirections)
         const cl_uint plane_offset = static_cast<cl_uint>(b * plane);
         if (options_.method == HorizonMethod::Sweep) {
           launchSweep(d, plane_offset);
@@ -160,7 +171,8 @@ class HorizonRun {
         }
       }
       const std::size_t batch_bytes = count * plane * sizeof(float), at = first * plane;
-      if (outputs_.horizon_angles) st_.queue.enqueueReadBuffer(angles_, CL_TRUE, 0, batch_bytes, &result.angles[at]);
+      if (outputs_.horizon_angles)
+        st_.queue.enqueueReadBuffer(angles_, CL_TRUE, 0, batch_bytes, &result.angles[at]);
       if (outputs_.horizon_distances)
         st_.queue.enqueueReadBuffer(distances_, CL_TRUE, 0, batch_bytes, &result.distances[at]);
       st_.queue.finish();
@@ -201,7 +213,8 @@ class HorizonRun {
     const cl::Buffer line_table(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
                                 lines.size() * sizeof(LatticeLine), lines.data());
     cl::Buffer samples(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                       d.samples.size() * sizeof(LatticeSample), const_cast<LatticeSample*>(d.samples.data()));
+                       d.samples.size() * sizeof(LatticeSample),
+                       const_cast<LatticeSample*>(d.samples.data()));
     cl::Kernel kernel(program_, "horizon_lattice");
     kernel.setArg(0, heights_);
     kernel.setArg(1, field_.width);
@@ -216,10 +229,10 @@ class HorizonRun {
     setOutputs(kernel, 12, d, plane_offset);
     for (const LineChunk& chunk : chunks) {
       // Sub-buffer offsets must be aligned on some devices: a chunk gets a copy of its lines.
-      cl::Buffer chunk_lines = chunks.size() == 1
-                                   ? line_table
-                                   : cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                                                chunk.count * sizeof(LatticeLine), lines.data() + chunk.first);
+      cl::Buffer chunk_lines =
+          chunks.size() == 1 ? line_table
+                             : cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                          chunk.count * sizeof(LatticeLine), lines.data() + chunk.first);
       kernel.setArg(3, chunk_lines);
       kernel.setArg(4, static_cast<int>(chunk.count));
       kernel.setArg(stride_arg_, static_cast<cl_uint>(chunk.stride));
@@ -258,6 +271,11 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
                               const HorizonOptions& options, const HorizonOutputs& outputs) {
   validate(field);
   validate(options, outputs);
+  // The kernels index pixels with 32-bit signed arithmetic.
+  if (field.pixelCount() >= (std::size_t(1) << 31))
+    throw InvalidArgument("fields of 2^31 pixels or more are not supported yet (got " +
+                          std::to_string(field.width) + " x " + std::to_string(field.height) +
+                          "); split the field into tiles");
   return detail::translateOpenClErrors(
       [&] { return detail::HorizonRun(context.state(), field, options, outputs).run(); });
 }

@@ -57,7 +57,8 @@ std::vector<Normal> pixelNormals(const HeightField& field, const std::vector<flo
 }
 
 // ambient_term in the kernel.
-float ambientTerm(bool found, float rise, float run, Normal n, float cos_az, float sin_az, float weight, float swath) {
+float ambientTerm(bool found, float rise, float run, Normal n, float cos_az, float sin_az, float weight,
+                  float swath) {
   const float toward = n.x * cos_az + n.y * sin_az;
   const bool behind = !found || rise * n.z < -toward * run;
   const float x = behind ? -toward / n.z : rise / run;
@@ -85,7 +86,8 @@ void emitDirection(HorizonResult& result, std::size_t pixel, bool nodata, bool f
   }
   if (!result.ambient_occlusion.empty()) {
     float& sum = result.ambient_occlusion[pixel];
-    const float term = ambientTerm(found, rise, run, normals[pixel], o.cos_azimuth, o.sin_azimuth, o.weight, o.swath());
+    const float term =
+        ambientTerm(found, rise, run, normals[pixel], o.cos_azimuth, o.sin_azimuth, o.weight, o.swath());
     sum = nodata ? kNaN : sum + term;
   }
 }
@@ -105,7 +107,8 @@ float latticeHeight(const std::vector<float>& h, std::size_t at, std::size_t rig
   const bool v01 = s.w01 > 0.0f && !std::isnan(h01), v11 = s.w11 > 0.0f && !std::isnan(h11);
   const float sum = (v00 ? s.w00 * h00 : 0.0f) + (v10 ? s.w10 * h10 : 0.0f) + (v01 ? s.w01 * h01 : 0.0f) +
                     (v11 ? s.w11 * h11 : 0.0f);
-  const float weight = (v00 ? s.w00 : 0.0f) + (v10 ? s.w10 : 0.0f) + (v01 ? s.w01 : 0.0f) + (v11 ? s.w11 : 0.0f);
+  const float weight =
+      (v00 ? s.w00 : 0.0f) + (v10 ? s.w10 : 0.0f) + (v01 ? s.w01 : 0.0f) + (v11 ? s.w11 : 0.0f);
   return weight > 0.0f ? sum / weight : kNaN;
 }
 
@@ -126,6 +129,7 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
   const auto directions = horizonDirections(field, options, outputs);
   for (int k = 0; k < options.directions; ++k) {
     const LatticeDirection& d = directions[k];
+    if (d.weight == 0.0 && result.angles.empty() && result.distances.empty()) continue;  // merged step
     const DirectionOutputs out = outputsOf(d, k);
     const auto samples = latticeSamples(d, options.samples_per_unit);
     const float gpp = static_cast<float>(d.ground_per_pixel);
@@ -140,7 +144,7 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
         }
         const int c = static_cast<int>(pixel % width), r = static_cast<int>(pixel / width);
         const float near = nearRise(h, width, height, c, r, s.height, d.a, d.b);
-        const bool has_far = s.occluder >= 0, has_near = !std::isnan(near);
+        const bool has_far = s.occluder_run > 0.0f, has_near = !std::isnan(near);
         const float ground = has_far ? s.occluder_run * gpp : 0.0f;
         const bool use_near = has_near && (!has_far || near * ground > s.occluder_rise * period_ground);
         const float distance = has_far && !use_near ? ground : 0.0f;
@@ -182,7 +186,8 @@ void naiveReference(const HeightField& field, const PreparedHeights& prepared, c
         }
         const float ground = static_cast<float>(best_step) * d.step_length * d.ground_per_pixel;
         const float distance = best_step > 0 ? ground : 0.0f;
-        emitDirection(result, pixel, std::isnan(hp), best_step > 0, best_rise, ground, distance, out, normals);
+        emitDirection(result, pixel, std::isnan(hp), best_step > 0, best_rise, ground, distance, out,
+                      normals);
       }
     }
   }
@@ -232,7 +237,6 @@ std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, cons
         sample.occluder = static_cast<long>(stack.size()) - 1;
         sample.occluder_rise = v1h;
         sample.occluder_run = v1d;
-        sample.occluder_position = top.second;
       }
       stack.emplace_back(hq, here);
       out.push_back(sample);

@@ -62,20 +62,20 @@ std::vector<LatticeDirection> latticeDirections(const HeightField& field, const 
                                                 bool exact_azimuths, double tolerance) {
   const std::vector<Candidate> all = candidates(field);
   const int K = options.directions;
-  // Quadrature directions stay strictly inside their own half-spacing, so no two coincide.
+  // Quadrature windows are strictly inside each direction's half-spacing.
   const double window = exact_azimuths ? tolerance : 0.4999 * kTwoPi / K;
   std::vector<LatticeDirection> out;
   for (int k = 0; k < K; ++k) {
     const double target = directionAzimuth(k, options);
-    const Candidate* chosen = nullptr;
-    const Candidate* closest = &all.front();
+    // The cheapest cost class with a step inside the window, and in it the closest step;
+    // the closest of all when none is inside.
+    const Candidate *chosen = nullptr, *closest = nullptr;
+    double chosen_error = 0.0, closest_error = 0.0;
     for (const Candidate& c : all) {
+      if (chosen && c.cost > chosen->cost) break;
       const double error = std::abs(angleDifference(c.azimuth, target));
-      if (error <= window) {
-        chosen = &c;
-        break;
-      }
-      if (error < std::abs(angleDifference(closest->azimuth, target))) closest = &c;
+      if (error <= window && (!chosen || error < chosen_error)) chosen = &c, chosen_error = error;
+      if (!closest || error < closest_error) closest = &c, closest_error = error;
     }
     out.push_back(makeDirection(field, chosen ? *chosen : *closest));
     out.back().azimuth = target + angleDifference(out.back().azimuth, target);  // next to phi_k
@@ -85,12 +85,25 @@ std::vector<LatticeDirection> latticeDirections(const HeightField& field, const 
     return out;
   }
   // Quadrature weights: each direction stands for the azimuths closer to it than to its
-  // neighbours (directions k are in increasing azimuth order around the circle).
+  // neighbours (the chosen azimuths are in increasing order around the circle).
   for (int k = 0; k < K; ++k) {
     const double previous = out[(k + K - 1) % K].azimuth, next = out[(k + 1) % K].azimuth;
-    double gap_before = angleDifference(out[k].azimuth, previous), gap_after = angleDifference(next, out[k].azimuth);
+    double gap_before = angleDifference(out[k].azimuth, previous),
+           gap_after = angleDifference(next, out[k].azimuth);
     if (K == 2) gap_before = gap_after = M_PI;
     out[k].weight = 0.5 * (gap_before + gap_after) / kTwoPi;
+  }
+  // Where no step lies inside a window (K beyond the lattice's angular resolution near
+  // the axes: atan(1/64) = 0.9 deg) neighbours can fall back to the same step: the first
+  // one takes their weight and the others get 0, so the sweep runs each step once.
+  for (int k = 1; k < K; ++k) {
+    for (int m = 0; m < k; ++m) {
+      if (out[m].a == out[k].a && out[m].b == out[k].b && out[m].weight > 0.0) {
+        out[m].weight += out[k].weight;
+        out[k].weight = 0.0;
+        break;
+      }
+    }
   }
   return out;
 }
@@ -178,13 +191,14 @@ std::vector<LineChunk> chunkLines(std::vector<LatticeLine>& lines, std::size_t s
     chunk.stack_entries = line_major ? chunk.stack_entries : longest * chunk.count;
     chunk.stride = line_major ? 1u : static_cast<std::uint32_t>(chunk.count);
     if (!line_major)
-      for (std::size_t j = 0; j < chunk.count; ++j) lines[chunk.first + j].stack = static_cast<std::int32_t>(j);
+      for (std::size_t j = 0; j < chunk.count; ++j)
+        lines[chunk.first + j].stack = static_cast<std::int32_t>(j);
     chunks.push_back(chunk);
   };
   for (std::size_t j = 0; j < lines.size(); ++j) {
     const std::size_t capacity = lineCapacity(lines[j], samples_per_period);
-    const std::size_t need = line_major ? chunk.stack_entries + capacity
-                                        : std::max(longest, capacity) * (chunk.count + 1);
+    const std::size_t need =
+        line_major ? chunk.stack_entries + capacity : std::max(longest, capacity) * (chunk.count + 1);
     if (chunk.count > 0 && (need > max_entries || need >= (std::size_t(1) << 31))) {
       close();
       chunk = LineChunk{j, 0, 0, 1};

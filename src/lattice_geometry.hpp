@@ -5,9 +5,9 @@
 // consecutive pixel centres of a line the samples sit where the line crosses the grid's
 // columns and rows (there the bilinear surface is linear, so these heights are exact) and,
 // with denser sampling, between consecutive crossings (inside a cell the surface is a
-// quadratic along the ray, which can peak between them). The pattern is the same for every period of every line,
-// so it is one small table per direction. Shared by the kernels' host code and the scalar
-// references, so both sample the very same points.
+// quadratic along the ray, which can peak between them). The pattern is the same for every period of every
+// line, so it is one small table per direction. Shared by the kernels' host code and the scalar references,
+// so both sample the very same points.
 #pragma once
 
 #include <cstddef>
@@ -21,11 +21,11 @@ namespace hfvis::detail {
 
 // One sweep direction of a run.
 struct LatticeDirection {
-  int a = 1, b = 0;       // primitive step between consecutive receivers of a line (columns, rows)
-  double azimuth = 0.0;   // ground azimuth of (a, b), radians
-  double weight = 0.0;    // share of the circle of azimuth it stands for (sums to 1 over a run)
+  int a = 1, b = 0;               // primitive step between consecutive receivers of a line (columns, rows)
+  double azimuth = 0.0;           // ground azimuth of (a, b), radians
+  double weight = 0.0;            // share of the circle of azimuth it stands for (sums to 1 over a run)
   double ground_per_pixel = 1.0;  // ground length of one pixel length along (a, b)
-  double period = 1.0;    // |(a, b)| in pixels: distance between consecutive receivers of a line
+  double period = 1.0;            // |(a, b)| in pixels: distance between consecutive receivers of a line
 };
 
 // The directions of a run. With `exact_azimuths` (per-direction planes requested),
@@ -33,8 +33,11 @@ struct LatticeDirection {
 // radians of phi_k = 2 pi k / K + offset (the closest one when none is), each with weight
 // 1/K. Otherwise (sky-view factor and occlusion, which integrate over azimuth) the
 // cheapest strictly within half the spacing 2 pi / K, with quadrature weights from the
-// azimuths actually used (half the gap to each neighbour). Cost is the crossings of one
-// period, |a| + |b| - 1 (1 on the axes). Steps are bounded by kMaxLatticeStep.
+// azimuths actually used (half the gap to each neighbour). "Cheapest" is the fewest
+// crossings per period, |a| + |b| - 1 (1 on the axes), and among those the closest to phi_k.
+// Steps are bounded by kMaxLatticeStep. Quadrature directions that fall back to the same
+// step (very large K) are merged: one carries their weight, the others have weight 0 and
+// are not swept.
 constexpr int kMaxLatticeStep = 64;
 std::vector<LatticeDirection> latticeDirections(const HeightField& field, const SweepOptions& options,
                                                 bool exact_azimuths, double tolerance);
@@ -85,8 +88,8 @@ struct LineChunk {
 std::vector<LineChunk> chunkLines(std::vector<LatticeLine>& lines, std::size_t samples_per_period,
                                   std::size_t max_entries, bool line_major);
 
-// Scratch entries one line needs (its capacity) and the most any line of d over the field
-// needs: a direction can always be run one line at a time.
+// Scratch entries one line needs (its capacity): a direction can always be run one line at
+// a time.
 std::size_t lineCapacity(const LatticeLine& line, std::size_t samples_per_period);
 
 }  // namespace hfvis::detail

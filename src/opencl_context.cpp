@@ -168,7 +168,9 @@ void ContextState::launch(const cl::Kernel& kernel, const cl::NDRange& global, c
 cl::Buffer ContextState::reusableBuffer(const std::string& role, std::size_t bytes) {
   bytes = std::max<std::size_t>(bytes, sizeof(float));
   auto& entry = buffers_[role];
-  if (entry.second < bytes) {
+  // Grown when too small, and shrunk when more than twice the size asked for, so a context
+  // never holds much more than its last call needed.
+  if (entry.second < bytes || entry.second / 2 > bytes) {
     entry.first = cl::Buffer();  // release the smaller one before allocating
     entry.first = cl::Buffer(context, CL_MEM_READ_WRITE, bytes);
     entry.second = bytes;

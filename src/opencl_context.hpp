@@ -3,11 +3,10 @@
 #pragma once
 
 #include <CL/opencl.hpp>
-
 #include <map>
-#include <utility>
 #include <mutex>
 #include <string>
+#include <utility>
 
 #include "hfvis/device.hpp"
 #include "hfvis/errors.hpp"
@@ -31,10 +30,11 @@ struct ContextState {
   void launch(const cl::Kernel& kernel, const cl::NDRange& global, const cl::NDRange& local);
   bool profiling = false;
 
-  // A device buffer of at least `bytes` for `role` ("lattice stacks", ...), kept between
-  // calls and grown when a call needs more: large scratch buffers are allocated (and, on
-  // CPUs, their pages first touched) once rather than per batch or per call. A context
-  // runs one operation at a time, so one buffer per role suffices.
+  // A device buffer of at least `bytes` (at most twice that) for `role` ("lattice
+  // stacks", ...), kept between calls: large scratch buffers are allocated (and, on CPUs,
+  // their pages first touched) once rather than per batch or per call, as long as calls
+  // need about the same. A context runs one operation at a time (see ComputeContext), so
+  // one buffer per role suffices.
   cl::Buffer reusableBuffer(const std::string& role, std::size_t bytes);
   std::map<std::string, std::pair<double, int>> kernel_seconds;  // name -> (seconds, launches)
   ~ContextState();

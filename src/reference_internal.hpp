@@ -12,14 +12,14 @@ namespace hfvis::detail {
 // One sample of a lattice line as the sweep meets it (farthest first): its height (NaN =
 // absent; only receivers are listed then), its position along the line (pixels from the
 // line's far end), the receiver pixel it is (-1 for samples between receivers), and what
-// the hull stack gave it: the occluder's stack depth (-1 = none), its rise above the sample,
-// its distance along the line (pixels) and its position.
+// the hull stack gave it: the occluder's stack depth (-1 = none), its rise above the sample
+// and its distance along the line (pixels).
 struct LatticeLineSample {
   float height = 0.0f;
   float position = 0.0f;
   long receiver = -1;
   long occluder = -1;
-  float occluder_rise = 0.0f, occluder_run = 0.0f, occluder_position = 0.0f;
+  float occluder_rise = 0.0f, occluder_run = 0.0f;
 };
 
 // The samples of one line of direction d (prepared heights h), with Algorithm 1 run over

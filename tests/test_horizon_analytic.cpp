@@ -7,6 +7,7 @@
 #include "hfvis/horizon.hpp"
 #include "hfvis/image_io.hpp"
 #include "hfvis/synthetic_fields.hpp"
+#include "lattice_geometry.hpp"
 #include "test_support.hpp"
 
 namespace hfvis {
@@ -36,7 +37,8 @@ TEST_P(HorizonAnalytic, FlatPlaneHasZeroHorizonInsideAndSkyViewAndOcclusionOfOne
   for (int k = 0; k < 8; ++k) {
     for (int row = 1; row < field.height - 1; ++row)
       for (int c = 1; c < field.width - 1; ++c)
-        ASSERT_NEAR(r.angles[k * plane + row * field.width + c], 0.0f, 1e-6) << "k " << k << " at " << c << "," << row;
+        ASSERT_NEAR(r.angles[k * plane + row * field.width + c], 0.0f, 1e-6)
+            << "k " << k << " at " << c << "," << row;
   }
   // Every direction: a pixel whose ray leaves the field at once sees nothing (-pi/2); one
   // whose ray meets the plane sees it level (0).
@@ -45,7 +47,8 @@ TEST_P(HorizonAnalytic, FlatPlaneHasZeroHorizonInsideAndSkyViewAndOcclusionOfOne
     for (int row = 0; row < field.height; ++row) {
       for (int c = 0; c < field.width; ++c) {
         const double x = c + dx, y = row + dy;
-        const bool leaves = x < -1e-3 || y < -1e-3 || x > field.width - 1 + 1e-3 || y > field.height - 1 + 1e-3;
+        const bool leaves =
+            x < -1e-3 || y < -1e-3 || x > field.width - 1 + 1e-3 || y > field.height - 1 + 1e-3;
         ASSERT_NEAR(r.angles[k * plane + row * field.width + c], leaves ? -M_PI / 2 : 0.0, 1e-6)
             << "k " << k << " at " << c << "," << row;
       }
@@ -88,7 +91,8 @@ TEST_P(HorizonAnalytic, LongWallCastsAtanOfHeightOverDistance) {
 TEST_P(HorizonAnalytic, ConeFlankSeesTheApexAtTheConeSlope) {
   HeightField field = makeSyntheticField("flat", 41, 41);
   for (int row = 0; row < 41; ++row)
-    for (int c = 0; c < 41; ++c) field.heights[row * 41 + c] = float(20.0 - 0.5 * std::hypot(c - 20.0, row - 20.0));
+    for (int c = 0; c < 41; ++c)
+      field.heights[row * 41 + c] = float(20.0 - 0.5 * std::hypot(c - 20.0, row - 20.0));
   HorizonOutputs outputs;
   outputs.horizon_angles = outputs.horizon_distances = true;
   const auto r = run(field, 4, outputs);
@@ -122,8 +126,10 @@ TEST_P(HorizonAnalytic, TiltedPlaneOcclusionAndSkyView) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Methods, HorizonAnalytic, ::testing::Values(HorizonMethod::Sweep, HorizonMethod::Naive),
-                         [](const auto& info) { return info.param == HorizonMethod::Sweep ? "Sweep" : "Naive"; });
+INSTANTIATE_TEST_SUITE_P(Methods, HorizonAnalytic,
+                         ::testing::Values(HorizonMethod::Sweep, HorizonMethod::Naive), [](const auto& info) {
+                           return info.param == HorizonMethod::Sweep ? "Sweep" : "Naive";
+                         });
 
 }  // namespace
 }  // namespace hfvis
@@ -143,9 +149,10 @@ TEST(HorizonAccuracy, SweepBeatsTheUnitMarchAndImprovesWithSampling) {
     for (int c = 0; c < size; ++c) field.heights.push_back(whole.at(origin + c, origin + r));
   HorizonOutputs outputs;
   outputs.horizon_angles = true;
+  // K = 8: the sweep's steps (the axes and diagonals) lie exactly at phi_k, as the truth's.
   auto horizons = [&](HorizonMethod method, double samples_per_unit) {
     HorizonOptions options;
-    options.directions = 16;
+    options.directions = 8;
     options.method = method;
     options.samples_per_unit = samples_per_unit;
     return computeHorizons(testing::testContext(), field, options, outputs);
@@ -154,7 +161,7 @@ TEST(HorizonAccuracy, SweepBeatsTheUnitMarchAndImprovesWithSampling) {
   auto meanErrorDegrees = [&](const HorizonResult& result) {
     double sum = 0.0;
     int count = 0;
-    for (int k = 0; k < 16; ++k)
+    for (int k = 0; k < 8; ++k)
       for (int r = 2; r < size - 2; ++r)
         for (int c = 2; c < size - 2; ++c) {
           const std::size_t i = k * field.pixelCount() + r * size + c;
@@ -170,6 +177,47 @@ TEST(HorizonAccuracy, SweepBeatsTheUnitMarchAndImprovesWithSampling) {
   RecordProperty("mean_error_deg_sweep_spu4", std::to_string(sweep_dense));
   EXPECT_LT(sweep, 0.5 * naive);
   EXPECT_LT(sweep_dense, sweep);
+}
+
+// On a dome (a concave surface; its bilinear interpolation is piecewise linear along any
+// ray, since the cross term of x^2 + y^2 vanishes) no chord from a receiver is steeper than
+// the surface at the receiver, so the horizon is the limit at t -> 0, the sweep's exact
+// near limit, also for steps off the axes. The first cell is linear along the ray, so the
+// first crossing ties with that limit: the horizon point lies within the first cell.
+TEST(HorizonAccuracy, DomeHorizonIsTheSlopeAtTheReceiver) {
+  const int n = 31;
+  HeightField field = testing::fieldFrom(n, n, {});
+  for (int r = 0; r < n; ++r)
+    for (int c = 0; c < n; ++c)
+      field.heights.push_back(-0.02f * float((c - 15) * (c - 15) + (r - 15) * (r - 15)));
+  field.cell_size_x = 1.5;
+  HorizonOptions options;
+  options.directions = 16;
+  HorizonOutputs outputs;
+  outputs.horizon_angles = outputs.horizon_distances = true;
+  const auto result = computeHorizons(testContext(), field, options, outputs);
+  int off_axis = 0;
+  for (int k = 0; k < 16; ++k) {
+    const auto d = detail::latticeDirections(field, options, true, options.azimuth_tolerance)[k];
+    off_axis += d.a != 0 && d.b != 0;
+    const int sx = (d.a > 0) - (d.a < 0), sy = (d.b > 0) - (d.b < 0);
+    for (int r = 1; r < n - 1; ++r) {
+      for (int c = 1; c < n - 1; ++c) {
+        const std::size_t i = k * field.pixelCount() + r * n + c;
+        const double h = field.at(c, r);
+        const double rise =
+            (field.at(c + sx, r) - h) * std::abs(d.a) + (field.at(c, r + sy) - h) * std::abs(d.b);
+        const double expected = std::atan(rise / (d.period * d.ground_per_pixel));
+        ASSERT_NEAR(result.angles[i], expected, 2e-6) << "k " << k << " pixel " << c << "," << r;
+        const double first_crossing =
+            (d.a != 0 && d.b != 0 ? 1.0 / std::max(std::abs(d.a), std::abs(d.b)) : 1.0) * d.period *
+            d.ground_per_pixel;
+        ASSERT_LE(result.distances[i], first_crossing * (1 + 1e-6))
+            << "k " << k << " pixel " << c << "," << r;
+      }
+    }
+  }
+  EXPECT_GE(off_axis, 8);
 }
 
 }  // namespace

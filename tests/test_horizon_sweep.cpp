@@ -42,8 +42,8 @@ TEST(HorizonSweepLine, StackEqualsBruteForceMaximumOnEveryHardCase) {
         options.samples_per_unit = spu;
         int checked = 0;
         for (const auto& d : detail::latticeDirections(field, options, true, options.azimuth_tolerance)) {
-          SCOPED_TRACE(name + " " + std::to_string(w) + "x" + std::to_string(h) + " step (" + std::to_string(d.a) +
-                       ", " + std::to_string(d.b) + ") spu " + std::to_string(spu));
+          SCOPED_TRACE(name + " " + std::to_string(w) + "x" + std::to_string(h) + " step (" +
+                       std::to_string(d.a) + ", " + std::to_string(d.b) + ") spu " + std::to_string(spu));
           const auto table = detail::latticeSamples(d, spu);
           for (const auto& line : detail::latticeLines(d, w, h)) {
             const auto samples = detail::latticeLineSamples(field, prepared.heights, d, table, line);
@@ -63,7 +63,8 @@ TEST(HorizonSweepLine, StackEqualsBruteForceMaximumOnEveryHardCase) {
               }
               ASSERT_GE(s.occluder, 0) << "sample " << q;
               ASSERT_GT(s.occluder_run, 0.0f);
-              ASSERT_NEAR(std::atan2(double(s.occluder_rise), double(s.occluder_run)), brute, 1e-6) << "sample " << q;
+              ASSERT_NEAR(std::atan2(double(s.occluder_rise), double(s.occluder_run)), brute, 1e-6)
+                  << "sample " << q;
               ++checked;
             }
           }
@@ -80,34 +81,85 @@ TEST(HorizonSweepLine, StackEqualsBruteForceMaximumOnEveryHardCase) {
 // receiver of one line per direction, and the sample table puts exact grid crossings on
 // grid lines.
 TEST(HorizonSweepLine, EveryPixelIsOneReceiverAndCrossingsLieOnGridLines) {
-  HeightField field = makeSyntheticField("noise", 37, 23, 1);
-  HorizonOptions options;
-  options.directions = 64;
-  for (bool exact : {true, false}) {
-    for (const auto& d : detail::latticeDirections(field, options, exact, options.azimuth_tolerance)) {
-      SCOPED_TRACE("step (" + std::to_string(d.a) + ", " + std::to_string(d.b) + ")");
-      std::vector<int> seen(field.pixelCount(), 0);
-      for (const auto& line : detail::latticeLines(d, field.width, field.height)) {
-        for (int i = 0; i < line.receivers; ++i) {
-          const int c = line.col - i * d.a, r = line.row - i * d.b;
-          ASSERT_TRUE(c >= 0 && c < field.width && r >= 0 && r < field.height);
-          ++seen[r * field.width + c];
+  for (auto [w, h] : awkwardSizes()) {  // steps longer than the field included
+    HeightField field = makeSyntheticField("noise", w, h, 1);
+    HorizonOptions options;
+    options.directions = 64;
+    for (bool exact : {true, false}) {
+      for (const auto& d : detail::latticeDirections(field, options, exact, options.azimuth_tolerance)) {
+        SCOPED_TRACE("step (" + std::to_string(d.a) + ", " + std::to_string(d.b) + ")");
+        std::vector<int> seen(field.pixelCount(), 0);
+        for (const auto& line : detail::latticeLines(d, field.width, field.height)) {
+          for (int i = 0; i < line.receivers; ++i) {
+            const int c = line.col - i * d.a, r = line.row - i * d.b;
+            ASSERT_TRUE(c >= 0 && c < field.width && r >= 0 && r < field.height);
+            ++seen[r * field.width + c];
+          }
+          const int c = line.col + d.a, r = line.row + d.b;  // the next step leaves the field
+          EXPECT_FALSE(c >= 0 && c < field.width && r >= 0 && r < field.height);
         }
-        const int c = line.col + d.a, r = line.row + d.b;  // the next step leaves the field
-        EXPECT_FALSE(c >= 0 && c < field.width && r >= 0 && r < field.height);
+        for (int n : seen) ASSERT_EQ(n, 1);
+        const auto samples = detail::latticeSamples(d, 1.0);
+        ASSERT_EQ(samples.back().tau, 0.0f);
+        std::size_t on_grid_lines = 0;
+        for (const auto& s : samples) on_grid_lines += s.ex == 0 || s.ey == 0;
+        if (d.a != 0 && d.b != 0) {  // |a| + |b| - 1 crossings; denser sampling adds points between
+          EXPECT_EQ(on_grid_lines, std::size_t(std::abs(d.a) + std::abs(d.b) - 1));
+          EXPECT_EQ(samples.size(), on_grid_lines);
+          EXPECT_GT(detail::latticeSamples(d, 4.0).size(), samples.size());
+        } else {  // along a grid line the surface is linear: the pixel centre alone
+          EXPECT_EQ(samples.size(), 1u);
+          EXPECT_EQ(detail::latticeSamples(d, 4.0).size(), 1u);
+        }
       }
-      for (int n : seen) ASSERT_EQ(n, 1);
-      const auto samples = detail::latticeSamples(d, 1.0);
-      ASSERT_EQ(samples.back().tau, 0.0f);
-      std::size_t on_grid_lines = 0;
-      for (const auto& s : samples) on_grid_lines += s.ex == 0 || s.ey == 0;
-      if (d.a != 0 && d.b != 0) {  // |a| + |b| - 1 crossings; denser sampling adds points between
-        EXPECT_EQ(on_grid_lines, std::size_t(std::abs(d.a) + std::abs(d.b) - 1));
-        EXPECT_EQ(samples.size(), on_grid_lines);
-        EXPECT_GT(detail::latticeSamples(d, 4.0).size(), samples.size());
-      } else {  // along a grid line the surface is linear: the pixel centre alone
-        EXPECT_EQ(samples.size(), 1u);
-        EXPECT_EQ(detail::latticeSamples(d, 4.0).size(), 1u);
+    }
+  }
+}
+
+// Direction choice: planes get steps within the tolerance of phi_k; quadrature directions
+// honour the azimuth offset, carry weights summing to 1, and where K outruns the lattice
+// (near the axes no step lies within atan(1/64)) equal steps are merged into one.
+TEST(HorizonSweepLine, DirectionsHonourTheToleranceAndQuadratureWeightsSumToOne) {
+  HeightField field = makeSyntheticField("flat", 50, 40);
+  for (double cell_y : {1.0, 1.24}) {
+    field.cell_size_y = cell_y;
+    for (int K : {1, 2, 3, 7, 64, 1024}) {
+      HorizonOptions options;
+      options.directions = K;
+      options.azimuth_offset = 0.3;
+      SCOPED_TRACE("K " + std::to_string(K) + " cell_y " + std::to_string(cell_y));
+      const auto exact = detail::latticeDirections(field, options, true, options.azimuth_tolerance);
+      // Within the tolerance wherever a step is; the lattice's widest gap (between an axis and
+      // (64, 1), 0.9 deg, stretched by the cells' aspect) bounds the fallback to the closest.
+      const double fallback = 0.6 * M_PI / 180.0;
+      for (int k = 0; k < std::min(K, 64); ++k)
+        EXPECT_NEAR(exact[k].azimuth, directionAzimuth(k, options), fallback);
+      if (cell_y == 1.0 && K <= 64) {
+        HorizonOptions plain = options;
+        plain.azimuth_offset = 0.0;
+        const auto at_phi = detail::latticeDirections(field, plain, true, plain.azimuth_tolerance);
+        for (int k = 0; k < K; ++k)
+          EXPECT_NEAR(at_phi[k].azimuth, directionAzimuth(k, plain), plain.azimuth_tolerance);
+      }
+      const auto quadrature = detail::latticeDirections(field, options, false, options.azimuth_tolerance);
+      double sum = 0.0;
+      int runs = 0;
+      for (int k = 0; k < K; ++k) {
+        EXPECT_GE(quadrature[k].weight, 0.0);
+        sum += quadrature[k].weight;
+        runs += quadrature[k].weight > 0.0;
+        for (int m = 0; m < k; ++m) {
+          if (quadrature[m].a == quadrature[k].a && quadrature[m].b == quadrature[k].b) {
+            EXPECT_TRUE(quadrature[m].weight == 0.0 || quadrature[k].weight == 0.0);
+          }
+        }
+        if (K <= 64) {
+          EXPECT_LT(std::abs(quadrature[k].azimuth - directionAzimuth(k, options)), M_PI / K);
+        }
+      }
+      EXPECT_NEAR(sum, 1.0, 1e-12);
+      if (K == 1024) {
+        EXPECT_LT(runs, K);
       }
     }
   }
@@ -175,20 +227,63 @@ TEST(HorizonKernels, SweepEqualsNaiveOnAxisDirections) {
 
 TEST(HorizonKernels, BatchingUnderATinyMemoryBudgetChangesNothing) {
   const HeightField field = makeSyntheticField("noise", 40, 41, 9);
+  testing::forEachLayout([&] {
+    HorizonOptions options;
+    options.directions = 9;
+    const auto outputs = allOutputs();
+    const auto whole = computeHorizons(testContext(), field, options, outputs);
+    int batches = 0;
+    options.memory_budget_bytes = 100 * 1024;  // two directions per batch, stacks in chunks of lines
+    options.progress = [&](int, int) { ++batches; };
+    const auto batched = computeHorizons(testContext(), field, options, outputs);
+    EXPECT_GT(batches, 2);
+    EXPECT_TRUE(nearlyEqual(batched.angles, whole.angles, 0.0f));
+    EXPECT_TRUE(nearlyEqual(batched.distances, whole.distances, 0.0f));
+    EXPECT_TRUE(nearlyEqual(batched.sky_view_factor, whole.sky_view_factor, 0.0f));
+    EXPECT_TRUE(nearlyEqual(batched.ambient_occlusion, whole.ambient_occlusion, 0.0f));
+    options.memory_budget_bytes = 1024;
+    EXPECT_THROW(computeHorizons(testContext(), field, options, outputs), MemoryBudgetError);
+  });
+}
+
+// Chunks of lines cover every line once, fit the scratch they are given (a single line may
+// exceed it: a direction always runs), and give each line its own stack slots.
+TEST(HorizonSweepLine, ChunksOfLinesFitTheScratchAndNeverShareStacks) {
+  const HeightField field = makeSyntheticField("flat", 40, 41);
   HorizonOptions options;
   options.directions = 9;
-  const auto outputs = allOutputs();
-  const auto whole = computeHorizons(testContext(), field, options, outputs);
-  int batches = 0;
-  options.memory_budget_bytes = 100 * 1024;  // two directions per batch, stacks in chunks of lines
-  options.progress = [&](int, int) { ++batches; };
-  const auto batched = computeHorizons(testContext(), field, options, outputs);
-  EXPECT_GT(batches, 2);
-  EXPECT_TRUE(nearlyEqual(batched.angles, whole.angles, 0.0f));
-  EXPECT_TRUE(nearlyEqual(batched.sky_view_factor, whole.sky_view_factor, 0.0f));
-  EXPECT_TRUE(nearlyEqual(batched.ambient_occlusion, whole.ambient_occlusion, 0.0f));
-  options.memory_budget_bytes = 1024;
-  EXPECT_THROW(computeHorizons(testContext(), field, options, outputs), MemoryBudgetError);
+  for (bool line_major : {true, false}) {
+    for (const auto& d : detail::latticeDirections(field, options, true, options.azimuth_tolerance)) {
+      const std::size_t per_period = detail::latticeSamples(d, 1.0).size();
+      for (std::size_t max_entries : {std::size_t(1), std::size_t(500), std::size_t(1) << 30}) {
+        auto lines = detail::latticeLines(d, field.width, field.height);
+        const auto chunks = detail::chunkLines(lines, per_period, max_entries, line_major);
+        std::size_t next = 0;
+        for (const auto& chunk : chunks) {
+          ASSERT_EQ(chunk.first, next);
+          ASSERT_GT(chunk.count, 0u);
+          next += chunk.count;
+          if (chunk.count > 1) {
+            EXPECT_LE(chunk.stack_entries, max_entries);
+          }
+          EXPECT_EQ(chunk.stride, line_major ? 1u : chunk.count);
+          // Every (line, depth) slot of the chunk is a distinct entry below stack_entries.
+          std::vector<int> used(chunk.stack_entries, 0);
+          for (std::size_t j = chunk.first; j < chunk.first + chunk.count; ++j) {
+            for (std::size_t k = 0; k < detail::lineCapacity(lines[j], per_period); ++k) {
+              const std::size_t entry = std::size_t(lines[j].stack) + k * chunk.stride;
+              ASSERT_LT(entry, chunk.stack_entries);
+              ASSERT_EQ(used[entry]++, 0);
+            }
+          }
+        }
+        EXPECT_EQ(next, lines.size());
+        if (max_entries == 1) {
+          EXPECT_EQ(chunks.size(), lines.size());
+        }
+      }
+    }
+  }
 }
 
 TEST(HorizonKernels, NodataReceiversAreNaNAndNeverPoisonNeighbours) {
@@ -223,7 +318,8 @@ TEST(HorizonKernels, AzimuthOffsetRotatesTheDirections) {
   for (int k = 0; k < 4; ++k) {
     const std::vector<float> a(rotated.angles.begin() + k * plane, rotated.angles.begin() + (k + 1) * plane);
     const int same = (k + 1) % 4;
-    const std::vector<float> b(plain.angles.begin() + same * plane, plain.angles.begin() + (same + 1) * plane);
+    const std::vector<float> b(plain.angles.begin() + same * plane,
+                               plain.angles.begin() + (same + 1) * plane);
     EXPECT_TRUE(nearlyEqual(a, b, 1e-5f)) << "direction " << k;
   }
 }

@@ -47,20 +47,22 @@ inline const std::vector<std::pair<int, int>>& awkwardSizes() {
 
 // Element-wise comparison: NaN must match NaN, otherwise |a - b| <= tolerance. Reports the
 // first few mismatches with their index.
-inline ::testing::AssertionResult nearlyEqual(const std::vector<float>& actual, const std::vector<float>& expected,
-                                              float tolerance) {
+inline ::testing::AssertionResult nearlyEqual(const std::vector<float>& actual,
+                                              const std::vector<float>& expected, float tolerance) {
   if (actual.size() != expected.size())
     return ::testing::AssertionFailure() << "sizes differ: " << actual.size() << " vs " << expected.size();
   int failures = 0;
   std::string report;
   for (std::size_t i = 0; i < actual.size(); ++i) {
     const float a = actual[i], e = expected[i];
-    const bool ok = (std::isnan(a) && std::isnan(e)) || (!std::isnan(a) && !std::isnan(e) && std::abs(a - e) <= tolerance);
-    if (!ok && failures++ < 5) report += "\n  [" + std::to_string(i) + "] " + std::to_string(a) + " vs " + std::to_string(e);
+    const bool ok = (std::isnan(a) && std::isnan(e)) ||
+                    (!std::isnan(a) && !std::isnan(e) && std::abs(a - e) <= tolerance);
+    if (!ok && failures++ < 5)
+      report += "\n  [" + std::to_string(i) + "] " + std::to_string(a) + " vs " + std::to_string(e);
   }
   if (failures == 0) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << failures << " of " << actual.size() << " values differ by more than "
-                                       << tolerance << ":" << report;
+  return ::testing::AssertionFailure() << failures << " of " << actual.size()
+                                       << " values differ by more than " << tolerance << ":" << report;
 }
 
 inline HeightField fieldFrom(int width, int height, std::vector<float> heights) {

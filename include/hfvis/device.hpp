@@ -31,7 +31,10 @@ namespace detail {
 struct ContextState;
 }
 
-// An OpenCL context, queue and program cache on one device. Cheap to copy (shared).
+// An OpenCL context, queue and program cache on one device. Cheap to copy (shared). It
+// runs one operation at a time: use one context per thread. It keeps the scratch buffers of
+// its last horizon call (hull stacks, direction planes) for the next one; they count
+// against the device's memory, not against a later call's memory budget.
 class ComputeContext {
  public:
   // selector: "" uses the HFVIS_DEVICE environment variable, else prefers a GPU, else

@@ -7,8 +7,8 @@
 
 namespace hfvis {
 
-// options.method chooses the reference: the hull-stack sweep with its reduction, or the
-// naive per-pixel march. progress and memory_budget_bytes are ignored.
+// options.method chooses the reference: the lattice hull-stack sweep with its per-receiver
+// outputs, or the naive per-pixel march. progress and memory_budget_bytes are ignored.
 HorizonResult referenceHorizons(const HeightField& field, const HorizonOptions& options,
                                 const HorizonOutputs& outputs);
 
