@@ -73,9 +73,9 @@ case "$field" in fractal|bricks|sine|blocks|random) ;; *) echo "heman_compare.sh
 
 # --- heman: the user's own build ------------------------------------------------------------
 how_to_build="heman is not part of this repository and this script does not build it: build it
-yourself from https://github.com/prideout/heman with optimisation on and OpenMP reaching its C
-files (its stock CMakeLists adds -fopenmp only to C++, so the C sweeps would run on one core), e.g.
-configure it with -DCMAKE_BUILD_TYPE=Release -DCMAKE_C_FLAGS=-fopenmp, then pass --heman-dir DIR
+yourself from https://github.com/prideout/heman, optimised and with OpenMP reaching its C sources
+(its stock configuration gives neither, so its sweeps would run unoptimised on one core), then
+pass --heman-dir DIR
 (DIR holding include/heman.h and libheman.a) or --heman-include DIR --heman-lib FILE (see
 bench/README.md)."
 if [[ -z $heman_include && -n $heman_dir ]]; then
