@@ -34,6 +34,7 @@ struct RunDirection {
   SweepDirection ray;        // naive march
   std::vector<LatticeSample> samples;
   float cos_azimuth = 1.0f, sin_azimuth = 0.0f;  // as the scalar reference rounds them
+  std::vector<LatticeLine> lines;                // sweep: the direction's lines over the field
 };
 
 // How a run uses its device memory budget: directions per downloaded batch of planes and
@@ -58,7 +59,7 @@ RunPlan planRun(const HeightField& field, const HorizonOptions& options, const H
   if (sweep) {
     for (const RunDirection& d : directions) {
       std::size_t total = 0;
-      for (const LatticeLine& line : latticeLines(d.lattice, field.width, field.height)) {
+      for (const LatticeLine& line : d.lines) {
         const std::size_t capacity = lineCapacity(line, d.samples.size());
         total += capacity;
         longest = std::max(longest, capacity);
@@ -100,7 +101,8 @@ std::vector<RunDirection> runDirectionsOf(const HeightField& field, const Horizo
   if (options.method == HorizonMethod::Sweep) {
     for (const LatticeDirection& d : horizonDirections(field, options, outputs))
       out.push_back({d, SweepDirection{}, latticeSamples(d, options.samples_per_unit),
-                     static_cast<float>(std::cos(d.azimuth)), static_cast<float>(std::sin(d.azimuth))});
+                     static_cast<float>(std::cos(d.azimuth)), static_cast<float>(std::sin(d.azimuth)),
+                     latticeLines(d, field.width, field.height)});
   } else {
     const std::vector<SweepDirection> rays = runDirections(field, options);
     for (int k = 0; k < options.directions; ++k) {
@@ -207,7 +209,7 @@ class HorizonRun {
 
   void launchSweep(const RunDirection& d, cl_uint plane_offset) {
     const bool line_major = lineMajorLayout(st_.info);
-    std::vector<LatticeLine> lines = latticeLines(d.lattice, field_.width, field_.height);
+    std::vector<LatticeLine> lines = d.lines;  // chunkLines sets the stack offsets
     if (lines.empty()) return;
     const std::vector<LineChunk> chunks = chunkLines(lines, d.samples.size(), stack_entries_, line_major);
     const cl::Buffer line_table(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
