@@ -115,7 +115,7 @@ std::vector<LatticeSample> latticeSamples(const LatticeDirection& d, double samp
   for (int j = 1; j < std::abs(d.b); ++j) crossings.push_back(double(j) / std::abs(d.b));
   std::sort(crossings.begin(), crossings.end());
   // Fractions of the period at which samples lie (the receiver's 0 included, the next
-  // receiver's 1 not), each with whether it is a crossing.
+  // receiver's 1 not).
   std::vector<double> fractions;
   // Along a grid line the bilinear surface is linear between pixel centres: the centres are
   // the whole surface's hull there, and points between them would only add ties.
