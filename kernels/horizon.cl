@@ -165,96 +165,187 @@ HFVIS_INLINE float near_rise(__global const float* heights, int width, int heigh
   return leaves ? NAN : rise;
 }
 
-// One step of Algorithm 1 (Timonen & Westerholm 2010) for a sample of height h at
-// position `here` along the line: pops the stack while the entry below the top casts at
-// least as steep a slope on the sample as the top (so the farther wins ties); the top that
-// remains is its horizon occluder, whose rise above the sample and distance along the line
-// (pixels) it returns in *rise, *run (run 0: none). Then pushes the sample. The top entry
-// is kept in registers (*top_h, *top_p) as well as in the stack.
-HFVIS_INLINE void hull_stack_step(__global float2* stack, uint stride, uint* size, float* top_h, float* top_p,
-                                  float h, float here, float* rise, float* run) {
-  uint n = *size;
-  float v1h = *top_h - h, v1d = here - *top_p;
-  while (n > 1) {
-    const float2 below = stack[(n - 2) * stride];
-    const float v2h = below.x - h, v2d = here - below.y;
-    if (v2h * v1d >= v1h * v2d) {
-      v1h = v2h;
-      v1d = v2d;
-      *top_h = below.x;
-      *top_p = below.y;
-      --n;
-    } else {
-      break;
-    }
-  }
-  *rise = v1h;
-  *run = n > 0 ? v1d : 0.0f;
-  stack[n * stride] = (float2)(h, here);
-  *top_h = h;
-  *top_p = here;
-  *size = n + 1;
+// Lanes (compile-time HFVIS_LANES): one work-item sweeps HFVIS_LANES lines side by side,
+// one per SIMD lane, in the line-major (CPU) layout, where a work-item's loop runs serially on one core: the hull
+// stacks' pops are data-dependent branches, and running 16 lines in lock step turns them
+// into masked vector steps that end when no lane pops (fewer mispredicted branches per
+// sample; 1.4x to 1.6x faster on an AVX-512 CPU under PoCL). On GPUs (step-major layout)
+// each work-item runs one line (HFVIS_LANES 1), so neighbouring work-items coalesce.
+// LANE(v, l) is lane l of v; comparisons give -1 in a vector lane and 1 in a scalar, so
+// masks are only combined with &, tested for nonzero and used by select().
+#ifndef HFVIS_LANES
+#define HFVIS_LANES 1
+#endif
+#if HFVIS_LANES == 1
+typedef float lane_float;
+typedef int lane_int;
+#define LANE(v, l) (v)
+#define ILANE(v, l) (v)
+#define ANY_LANE(m) ((m) != 0)
+#elif HFVIS_LANES == 16
+typedef float16 lane_float;
+typedef int16 lane_int;
+#define LANE(v, l) (((__private float*)&(v))[l])
+#define ILANE(v, l) (((__private int*)&(v))[l])
+// An OR tree, one branch at the end (any() compiles to a test and branch per lane).
+HFVIS_INLINE int any_lane(int16 m) {
+  int8 m8 = m.lo | m.hi;
+  int4 m4 = m8.lo | m8.hi;
+  int2 m2 = m4.lo | m4.hi;
+  return (m2.x | m2.y) < 0;
 }
+#define ANY_LANE(m) any_lane(m)
+#else
+#error "HFVIS_LANES must be 1 or 16"
+#endif
 
-// The sweep of one direction (a, b): one work-item per line, from the line's far end toward
-// -(a, b). Line j's farthest receiver is lines[j] = (col, row, receivers, stack); receiver
-// i sits at (col - i a, row - i b). Per receiver, the period's samples farther along the
-// line come first (samples[0 .. n_samples - 2], farthest first), then the receiver itself,
-// each through hull_stack_step. Only the first period can reach outside the field (the
-// others lie between two receivers, inside it), so only it tests; samples outside the
-// field or without height are absent. Stack entry k of a line is (height, position along
-// the line in pixels from its far end) at stacks[stack + k * stride]; the capacity is every
-// sample of its periods. period_ground = period * ground_per_pixel, the ground length of a
-// period. Preconditions: lines of this launch only; stride 1 (line-major) or the launch's
-// line count (step-major). Global size: n_lines rounded up; any local size.
+// The sweep of one direction (a, b): lines j = lanes * work-item + lane, each from its far
+// end toward -(a, b), in lock step (a lane whose line has ended is masked). Line j's farthest
+// receiver is lines[j] = (col, row, receivers, stack); receiver i sits at (col - i a, row - i b).
+// Per receiver, the period's samples farther along the line come first (samples[0 ..
+// n_samples - 2], farthest first), then the receiver itself (the last sample: tau 0, weight
+// 1 on its own pixel). Each sample is one step of Algorithm 1 (Timonen & Westerholm 2010):
+// pop the stack while the entry below the top casts at least as steep a slope on the sample
+// as the top (so the farther wins ties); the top that remains is its horizon occluder; push
+// the sample. Only the first period can reach outside the field (the others lie between two
+// receivers, inside it), so only it tests; samples outside the field or without height are
+// absent. Stack entry k of a line is (height, position along the line) at
+// stacks + 2 (line.w + k stride). The top entry is kept in registers as well. Global size:
+// ceil(n_lines / HFVIS_LANES) rounded up to the local size.
 __kernel void horizon_lattice(__global const float* heights, int width, int height,
                               __global const int4* lines, int n_lines, __global const LatticeSample* samples,
                               int n_samples, int a, int b, float period, float ground_per_pixel, float period_ground,
                               float cos_azimuth, float sin_azimuth, float weight, float swath, uint plane,
-                              __global float2* stacks, uint stride, __global const float4* normals,
+                              __global float* stacks, uint stride, __global const float4* normals,
                               __global float* angles, __global float* distances, __global float* svf_sum,
                               __global float* ao_sum) {
-  const int j = get_global_id(0);
-  if (j >= n_lines) return;
-  const int4 line = lines[j];
+  const int first = get_global_id(0) * HFVIS_LANES;
+  if (first >= n_lines) return;
   const DirectionOutputs outputs = {cos_azimuth, sin_azimuth, weight, swath, plane};
-  __global float2* stack = stacks + line.w;
-  int c = line.x, r = line.y;
-  uint n = 0;                        // stack size
-  float top_h = 0.0f, top_p = 0.0f;  // the top entry
-  float rise, run;
-  for (int i = 0; i < line.z; ++i, c -= a, r -= b) {
-    const float base = (float)i * period;  // the receiver's position along the line
-    for (int q = 0; q < n_samples - 1; ++q) {
+  lane_int c, r, receivers, stack;
+  int trips = 0;  // the longest line's receivers
+  #pragma unroll
+  for (int l = 0; l < HFVIS_LANES; ++l) {
+    const int4 line = lines[min(first + l, n_lines - 1)];
+    ILANE(c, l) = line.x;
+    ILANE(r, l) = line.y;
+    ILANE(receivers, l) = first + l < n_lines ? line.z : 0;
+    ILANE(stack, l) = 2 * line.w;
+    trips = max(trips, ILANE(receivers, l));
+  }
+  const int entry = 2 * (int)stride;  // floats between a line's consecutive stack entries
+  lane_int n = 0;                     // stack sizes
+  // The top two entries are kept in registers as well (below: valid where n >= 2).
+  lane_float top_h = 0.0f, top_p = 0.0f, below_h = 0.0f, below_p = 0.0f, rise = 0.0f, run = 0.0f;
+  for (int i = 0; i < trips; ++i, c -= a, r -= b) {
+    const lane_int live = i < receivers;
+    const float base = (float)i * period;  // the receivers' position along their lines
+    for (int q = 0; q < n_samples; ++q) {
       __global const LatticeSample* s = samples + q;
-      const int x0 = c + s->ox, y0 = r + s->oy, ex = s->ex, ey = s->ey;
-      if (i == 0 && (x0 < 0 || x0 + ex > width - 1 || y0 < 0 || y0 + ey > height - 1)) continue;
-      const float h = lattice_height(heights, (uint)(y0 * width + x0), (uint)ex, (uint)(ey * width), s->w00, s->w10,
-                                     s->w01, s->w11);
+      const int ex = s->ex, ey = s->ey;
+      const float w00 = s->w00, w10 = s->w10, w01 = s->w01, w11 = s->w11;
+      const lane_int x0 = c + s->ox, y0 = r + s->oy;
+      lane_int ok = live;
+      if (i == 0) ok = ok & (x0 >= 0) & (x0 + ex <= width - 1) & (y0 >= 0) & (y0 + ey <= height - 1);
+      const lane_int at = select((lane_int)0, y0 * width + x0, ok);
+      lane_float h;
+      if (ex + ey < 2) {
+        // A crossing or the receiver: at most two corners of positive weight, and the
+        // zero-weight terms of the four-corner sum add nothing.
+        const int next = ex + ey * width;
+        lane_float h0, h1;
+        #pragma unroll
+        for (int l = 0; l < HFVIS_LANES; ++l) {
+          LANE(h0, l) = heights[ILANE(at, l)];
+          LANE(h1, l) = heights[ILANE(at, l) + next];
+        }
+        h = w00 * h0 + (ex ? w10 : w01) * h1;
 #if HFVIS_HAS_NODATA
-      if (isnan(h)) continue;
+        #pragma unroll
+        for (int l = 0; l < HFVIS_LANES; ++l) {
+          if (isnan(LANE(h, l)))
+            LANE(h, l) = lattice_height(heights, (uint)ILANE(at, l), (uint)ex, (uint)(ey * width), w00, w10, w01, w11);
+        }
 #endif
-      hull_stack_step(stack, stride, &n, &top_h, &top_p, h, base - s->tau, &rise, &run);
-    }
-    const uint pixel = (uint)(r * width + c);
-    const float h = heights[pixel];
+      } else {
+        #pragma unroll
+        for (int l = 0; l < HFVIS_LANES; ++l)
+          LANE(h, l) =
+              lattice_height(heights, (uint)ILANE(at, l), (uint)ex, (uint)(ey * width), w00, w10, w01, w11);
+      }
 #if HFVIS_HAS_NODATA
-    if (isnan(h)) {
-      emit_direction(pixel, 1, 0, 0.0f, 1.0f, 0.0f, outputs, normals, angles, distances, svf_sum, ao_sum);
-      continue;
-    }
+      const lane_int valid = ok & !isnan(h);
+#else
+      const lane_int valid = ok;
 #endif
-    hull_stack_step(stack, stride, &n, &top_h, &top_p, h, base, &rise, &run);
-    // The steeper of the hull's occluder and the limit at the receiver, compared without a
-    // division (both runs are positive); the occluder wins ties (it is the farther point
-    // casting that elevation).
-    const float near = near_rise(heights, width, height, c, r, h, a, b);
-    const float ground = run * ground_per_pixel;
-    const int has_far = run > 0.0f, has_near = !isnan(near);
-    const int use_near = has_near && (!has_far || near * ground > rise * period_ground);
-    const float distance = has_far && !use_near ? ground : 0.0f;
-    emit_direction(pixel, 0, has_far || has_near, use_near ? near : rise, use_near ? period_ground : ground, distance,
-                   outputs, normals, angles, distances, svf_sum, ao_sum);
+      const float here = base - s->tau;
+      // Pop while the entry below the top casts at least as steep a slope on the sample as
+      // the top. Every pop loads the next entry down before it is known to be needed, so
+      // the load does not wait for the comparison (it is used only where a lane pops).
+      lane_float v1h = top_h - h, v1d = here - top_p, v2h = below_h - h, v2d = here - below_p;
+      lane_int popping = valid & (n > 1);
+      lane_int deeper = stack + (n - 3) * entry;  // entry n - 3, below `below`
+      while (ANY_LANE(popping)) {
+        lane_float next_h, next_p;
+        #pragma unroll
+        for (int l = 0; l < HFVIS_LANES; ++l) {
+          const int k = max(ILANE(deeper, l), ILANE(stack, l));
+          LANE(next_h, l) = stacks[k];
+          LANE(next_p, l) = stacks[k + 1];
+        }
+        const lane_int pop = popping & (v2h * v1d >= v1h * v2d);
+        v1h = select(v1h, v2h, pop);
+        v1d = select(v1d, v2d, pop);
+        top_h = select(top_h, below_h, pop);
+        top_p = select(top_p, below_p, pop);
+        below_h = select(below_h, next_h, pop);
+        below_p = select(below_p, next_p, pop);
+        v2h = below_h - h;
+        v2d = here - below_p;
+        n = select(n, n - 1, pop);
+        popping = pop & (n > 1);
+        deeper -= entry;
+      }
+      const lane_int push = stack + n * entry;
+      #pragma unroll
+      for (int l = 0; l < HFVIS_LANES; ++l) {
+        if (ILANE(valid, l)) {
+          stacks[ILANE(push, l)] = LANE(h, l);
+          stacks[ILANE(push, l) + 1] = here;
+        }
+      }
+      rise = select(rise, v1h, valid);
+      run = select(run, select((lane_float)0.0f, v1d, n > 0), valid);  // 0: no occluder
+      below_h = select(below_h, top_h, valid);
+      below_p = select(below_p, top_p, valid);
+      top_h = select(top_h, h, valid);
+      top_p = select(top_p, (lane_float)here, valid);
+      n = select(n, n + 1, valid);
+    }
+    // The receivers (the last sample of the period): the steeper of the hull's occluder and
+    // the limit at the receiver, compared without a division (both runs are positive); the
+    // occluder wins ties (it is the farther point casting that elevation).
+    #pragma unroll
+    for (int l = 0; l < HFVIS_LANES; ++l) {
+      if (!ILANE(live, l)) continue;
+      const int cl = ILANE(c, l), rl = ILANE(r, l);
+      const uint pixel = (uint)(rl * width + cl);
+      const float hp = heights[pixel];
+#if HFVIS_HAS_NODATA
+      if (isnan(hp)) {
+        emit_direction(pixel, 1, 0, 0.0f, 1.0f, 0.0f, outputs, normals, angles, distances, svf_sum, ao_sum);
+        continue;
+      }
+#endif
+      const float far_rise = LANE(rise, l), far_run = LANE(run, l);
+      const float near = near_rise(heights, width, height, cl, rl, hp, a, b);
+      const float ground = far_run * ground_per_pixel;
+      const int has_far = far_run > 0.0f, has_near = !isnan(near);
+      const int use_near = has_near && (!has_far || near * ground > far_rise * period_ground);
+      const float distance = has_far && !use_near ? ground : 0.0f;
+      emit_direction(pixel, 0, has_far || has_near, use_near ? near : far_rise, use_near ? period_ground : ground,
+                     distance, outputs, normals, angles, distances, svf_sum, ao_sum);
+    }
   }
 }
 

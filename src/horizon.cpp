@@ -20,9 +20,15 @@ namespace {
 
 constexpr std::size_t kStackEntryBytes = 2 * sizeof(float);  // (height, position)
 
-std::string programOptions(const HorizonOutputs& outputs, bool has_nodata) {
+// Lines one work-item of horizon_lattice sweeps side by side (HFVIS_LANES): SIMD lanes
+// where a work-item runs on a CPU core (the line-major layout), one line per work-item on
+// GPUs, whose neighbouring work-items then read neighbouring stack entries.
+int sweepLanes(bool line_major) { return line_major ? 16 : 1; }
+
+std::string programOptions(const HorizonOutputs& outputs, bool has_nodata, int lanes) {
   std::ostringstream s;
-  s << "-DHFVIS_HAS_NODATA=" << has_nodata << " -DHFVIS_WANT_ANGLES=" << outputs.horizon_angles
+  s << "-DHFVIS_LANES=" << lanes << " -DHFVIS_HAS_NODATA=" << has_nodata
+    << " -DHFVIS_WANT_ANGLES=" << outputs.horizon_angles
     << " -DHFVIS_WANT_DISTANCES=" << outputs.horizon_distances
     << " -DHFVIS_WANT_SVF=" << outputs.sky_view_factor << " -DHFVIS_WANT_AO=" << outputs.ambient_occlusion;
   return s.str();
@@ -127,7 +133,8 @@ class HorizonRun {
 
   HorizonResult run() {
     const PreparedHeights prepared = prepareHeights(field_);
-    program_ = st_.program("horizon.cl", programOptions(outputs_, prepared.has_nodata));
+    lanes_ = sweepLanes(lineMajorLayout(st_.info));
+    program_ = st_.program("horizon.cl", programOptions(outputs_, prepared.has_nodata, lanes_));
     const std::vector<RunDirection> directions = runDirectionsOf(field_, options_, outputs_);
     const RunPlan plan = planRun(field_, options_, outputs_, directions, st_.info);
     HorizonResult result = allocateResult(field_, options_, outputs_);
@@ -238,7 +245,10 @@ class HorizonRun {
       kernel.setArg(3, chunk_lines);
       kernel.setArg(4, static_cast<int>(chunk.count));
       kernel.setArg(stride_arg_, static_cast<cl_uint>(chunk.stride));
-      st_.launch(kernel, cl::NDRange(roundUp(chunk.count, kLineGroup)), cl::NDRange(kLineGroup));
+      // With lanes, groups of one work-item: 64 work-items of 16 lines would put all of a
+      // 1024-line direction in one group, on one core.
+      const std::size_t items = (chunk.count + lanes_ - 1) / lanes_, group = lanes_ > 1 ? 1 : kLineGroup;
+      st_.launch(kernel, cl::NDRange(roundUp(items, group)), cl::NDRange(group));
     }
   }
 
@@ -264,6 +274,7 @@ class HorizonRun {
   cl::Buffer heights_, angles_, distances_, svf_, ao_, normals_, stacks_;
   std::size_t stack_entries_ = 0;
   int stride_arg_ = 0;  // horizon_lattice's `stride` argument
+  int lanes_ = 1;       // HFVIS_LANES of the program
 };
 
 }  // namespace
