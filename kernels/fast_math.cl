@@ -21,19 +21,21 @@ HFVIS_INLINE float hf_min(float a, float b) { return a < b ? a : b; }
 HFVIS_INLINE float hf_max(float a, float b) { return a > b ? a : b; }
 
 // atan(x) for any x (+-inf gives +-pi/2): Cephes' atanf range reduction to
-// |x| <= tan(pi/8) and its degree-9 odd polynomial.
-HFVIS_INLINE float hf_atan(float x) {
-  float a = fabs(x);
-  int big = a > 2.414213562373095f;     // tan(3 pi / 8)
-  int mid = a > 0.4142135623730950f;    // tan(pi / 8)
-  float reduced = big ? -1.0f / a : (mid ? (a - 1.0f) / (a + 1.0f) : a);
-  float base = big ? 0.5f * HFVIS_PI_F : (mid ? 0.25f * HFVIS_PI_F : 0.0f);
-  float z = reduced * reduced;
-  float p = (((8.05374449538e-2f * z - 1.38776856032e-1f) * z + 1.99777106478e-1f) * z - 3.33329491539e-1f) * z;
-  float y = base + (p * reduced + reduced);
-  return x < 0.0f ? -y : y;
-}
-
+// |x| <= tan(pi/8) and its degree-9 odd polynomial. Defined for float and, through
+// HFVIS_DEFINE_ATAN, for the vector types a kernel needs (the same operations lane by lane).
+#define HFVIS_DEFINE_ATAN(T, IT)                                                                              \
+  HFVIS_INLINE __attribute__((overloadable)) T hf_atan(T x) {                                                  \
+    T a = fabs(x);                                                                                            \
+    IT big = a > 2.414213562373095f;  /* tan(3 pi / 8) */                                                    \
+    IT mid = a > 0.4142135623730950f; /* tan(pi / 8) */                                                      \
+    T reduced = big ? -1.0f / a : (mid ? (a - 1.0f) / (a + 1.0f) : a);                                        \
+    T base = big ? (T)(0.5f * HFVIS_PI_F) : (mid ? (T)(0.25f * HFVIS_PI_F) : (T)0.0f);                       \
+    T z = reduced * reduced;                                                                                  \
+    T p = (((8.05374449538e-2f * z - 1.38776856032e-1f) * z + 1.99777106478e-1f) * z - 3.33329491539e-1f) * z; \
+    T y = base + (p * reduced + reduced);                                                                     \
+    return x < 0.0f ? -y : y;                                                                                 \
+  }
+HFVIS_DEFINE_ATAN(float, int)
 
 // sin(x) for |x| <= 2 pi: reduced to [-pi/2, pi/2], then Taylor to x^11.
 HFVIS_INLINE float hf_sin(float x) {

@@ -74,97 +74,6 @@ __kernel void pixel_normals(__global const float* heights, int width, int height
   normals[pixel] = (float4)(nx, ny, nz, 0.0f);
 }
 
-// Uniform-sky irradiance of one azimuthal swath (Eq. 5 of Timonen & Westerholm 2010) of
-// width 2 pi * weight, normalised so that a flat plane sums to 1 over a run's swaths, for a
-// horizon of slope rise / run (found 0: none, elevation -pi/2). With elevation e and zenith
-// angle z = pi/2 - e, Eq. 5's sin^2 z = cos^2 e = 1 / (1 + x^2) and sin 2z / 2 = x cos^2 e for
-// x = tan e, so only e itself needs an arctangent. The sky behind the surface (N . e < 0)
-// does not count: the horizon is at least the tangent plane's slope -toward / nz in this
-// azimuth. swath = sin(pi weight) / pi, per direction.
-HFVIS_INLINE float ambient_term(int found, float rise, float run, float4 n, float cos_az, float sin_az, float weight,
-                                float swath) {
-  float toward = n.x * cos_az + n.y * sin_az;
-  int behind = !found || rise * n.z < -toward * run;
-  float x = behind ? -toward / n.z : rise / run;
-  float cos2 = 1.0f / (1.0f + x * x);
-  return n.z * weight * cos2 + swath * (0.5f * HFVIS_PI_F - hf_atan(x) - x * cos2) * toward;
-}
-
-// What one direction contributes at one receiver. Shared by the sweep and the naive march
-// so both reduce identically. Each launch runs one direction and every pixel is written by
-// one work-item of it, so the read-modify-writes of the sums need no atomics.
-typedef struct {
-  float cos_azimuth, sin_azimuth;  // the direction on the ground
-  float weight;                    // its share of the circle of azimuth
-  float swath;                     // sin(pi weight) / pi (ambient_term)
-  uint plane;                      // first entry of its planes in `angles` / `distances`
-} DirectionOutputs;
-
-// The horizon arrives as the slope rise / run of its elevation (run > 0; `found` 0 when
-// no point casts one: elevation -pi/2). The sky-view term sin(max(0, elevation)) is
-// rise / sqrt(rise^2 + run^2) for a rising horizon, so the angle itself is only computed
-// where an output needs it.
-HFVIS_INLINE void emit_direction(uint pixel, int nodata, int found, float rise, float run, float distance,
-                                 const DirectionOutputs o, __global const float4* normals,
-                                 __global float* angles, __global float* distances, __global float* svf_sum,
-                                 __global float* ao_sum) {
-#if HFVIS_WANT_ANGLES
-  angles[o.plane + pixel] = nodata ? NAN : (found ? hf_atan(rise / run) : -0.5f * HFVIS_PI_F);
-#endif
-#if HFVIS_WANT_DISTANCES
-  distances[o.plane + pixel] = nodata ? NAN : distance;
-#endif
-#if HFVIS_WANT_SVF
-  float sky = found && rise > 0.0f ? rise / sqrt(rise * rise + run * run) : 0.0f;
-  svf_sum[pixel] = nodata ? NAN : svf_sum[pixel] + o.weight * sky;
-#endif
-#if HFVIS_WANT_AO
-  float term = ambient_term(found, rise, run, normals[pixel], o.cos_azimuth, o.sin_azimuth, o.weight, o.swath);
-  ao_sum[pixel] = nodata ? NAN : ao_sum[pixel] + term;
-#endif
-}
-
-// One sample of a period (src/lattice_geometry.hpp, struct LatticeSample): nine 4-byte
-// members, read field by field.
-typedef struct {
-  float tau;       // pixels from the period's receiver toward +(a, b)
-  int ox, oy;      // the cell's lower corner, relative to the receiver
-  int ex, ey;      // 1 where the sample is strictly inside the cell along x (y)
-  float w00, w10, w01, w11;  // bilinear weights of the cell's corners
-} LatticeSample;
-
-// Height of the bilinear surface at a lattice sample whose cell corner is at entry `at`;
-// with nodata, only the valid corners of positive weight count, renormalised (NaN when
-// none). Crossing samples have ex or ey 0: their zero-weight corners repeat a used one.
-HFVIS_INLINE float lattice_height(__global const float* heights, uint at, uint right, uint down, float w00, float w10,
-                                  float w01, float w11) {
-  float h00 = heights[at], h10 = heights[at + right], h01 = heights[at + down], h11 = heights[at + down + right];
-  float plain = w00 * h00 + w10 * h10 + w01 * h01 + w11 * h11;
-#if HFVIS_HAS_NODATA
-  int v00 = w00 > 0.0f && !isnan(h00), v10 = w10 > 0.0f && !isnan(h10);
-  int v01 = w01 > 0.0f && !isnan(h01), v11 = w11 > 0.0f && !isnan(h11);
-  float sum = (v00 ? w00 * h00 : 0.0f) + (v10 ? w10 * h10 : 0.0f) + (v01 ? w01 * h01 : 0.0f) + (v11 ? w11 * h11 : 0.0f);
-  float weight = (v00 ? w00 : 0.0f) + (v10 ? w10 : 0.0f) + (v01 ? w01 : 0.0f) + (v11 ? w11 : 0.0f);
-  return isnan(plain) ? (weight > 0.0f ? sum / weight : NAN) : plain;
-#else
-  return plain;
-#endif
-}
-
-// The exact limit of receiver (c, r)'s elevation slope at t -> 0 along (a, b): the bilinear
-// surface's directional derivative into the first cell, from the receiver's height h and
-// its neighbours along the two axes, as a rise over the period |(a, b)| (the caller's run).
-// NaN where the ray leaves the field at once or a needed neighbour is nodata.
-HFVIS_INLINE float near_rise(__global const float* heights, int width, int height, int c, int r, float h, int a,
-                             int b) {
-  int sx = a > 0 ? 1 : (a < 0 ? -1 : 0), sy = b > 0 ? 1 : (b < 0 ? -1 : 0);
-  int leaves = c + sx < 0 || c + sx >= width || r + sy < 0 || r + sy >= height;
-  float hx = heights[r * width + clamp(c + sx, 0, width - 1)];
-  float hy = heights[clamp(r + sy, 0, height - 1) * width + c];
-  float rise = (hx - h) * (float)abs(a) + (hy - h) * (float)abs(b);
-  return leaves ? NAN : rise;
-}
-
 // Lanes (compile-time HFVIS_LANES): one work-item sweeps HFVIS_LANES lines side by side,
 // one per SIMD lane, in the line-major (CPU) layout, where a work-item's loop runs serially on one core: the hull
 // stacks' pops are data-dependent branches, and running 16 lines in lock step turns them
@@ -198,6 +107,164 @@ HFVIS_INLINE int any_lane(int16 m) {
 #else
 #error "HFVIS_LANES must be 1 or 16"
 #endif
+
+// What one direction contributes at a receiver whose horizon has slope rise / run (run > 0;
+// found 0 when no point casts one: elevation -pi/2), for scalars and lane vectors alike
+// (HFVIS_DIRECTION_TERMS below). The sky-view term sin(max(0, elevation)) is
+// rise / sqrt(rise^2 + run^2) for a rising horizon, so the angle itself is only computed
+// where an output needs it.
+//
+// ambient_term: uniform-sky irradiance of one azimuthal swath (Eq. 5 of Timonen &
+// Westerholm 2010) of width 2 pi * weight, normalised so that a flat plane sums to 1 over a
+// run's swaths, at a receiver of unit normal (nx, ny, nz). With elevation e and zenith
+// angle z = pi/2 - e, Eq. 5's sin^2 z = cos^2 e = 1 / (1 + x^2) and sin 2z / 2 = x cos^2 e for
+// x = tan e, so only e itself needs an arctangent. The sky behind the surface (N . e < 0)
+// does not count: the horizon is at least the tangent plane's slope -toward / nz in this
+// azimuth. swath = sin(pi weight) / pi, per direction.
+#define HFVIS_DIRECTION_TERMS(T, IT)                                                                          \
+  HFVIS_INLINE __attribute__((overloadable)) T elevation_term(IT found, T rise, T run) {                      \
+    return found ? hf_atan(rise / run) : (T)(-0.5f * HFVIS_PI_F);                                            \
+  }                                                                                                           \
+  HFVIS_INLINE __attribute__((overloadable)) T sky_term(IT found, T rise, T run) {                            \
+    return (found & (rise > 0.0f)) ? rise / sqrt(rise * rise + run * run) : (T)0.0f;                         \
+  }                                                                                                           \
+  HFVIS_INLINE __attribute__((overloadable)) T ambient_term(IT found, T rise, T run, T nx, T ny, T nz,        \
+                                                            float cos_az, float sin_az, float weight,         \
+                                                            float swath) {                                    \
+    T toward = nx * cos_az + ny * sin_az;                                                                     \
+    IT behind = !found | (rise * nz < -toward * run);                                                         \
+    T x = behind ? -toward / nz : rise / run;                                                                 \
+    T cos2 = 1.0f / (1.0f + x * x);                                                                           \
+    return nz * weight * cos2 + swath * (0.5f * HFVIS_PI_F - hf_atan(x) - x * cos2) * toward;                 \
+  }
+HFVIS_DIRECTION_TERMS(float, int)
+#if HFVIS_LANES > 1
+HFVIS_DEFINE_ATAN(lane_float, lane_int)
+HFVIS_DIRECTION_TERMS(lane_float, lane_int)
+#endif
+
+// A direction's outputs, and where they go. Each launch runs one direction and every
+// pixel is written by one work-item of it, so the read-modify-writes of the sums need no
+// atomics.
+typedef struct {
+  float cos_azimuth, sin_azimuth;  // the direction on the ground
+  float weight;                    // its share of the circle of azimuth
+  float swath;                     // sin(pi weight) / pi (ambient_term)
+  uint plane;                      // first entry of its planes in `angles` / `distances`
+} DirectionOutputs;
+
+// One receiver's outputs (the naive march).
+HFVIS_INLINE void emit_direction(uint pixel, int nodata, int found, float rise, float run, float distance,
+                                 const DirectionOutputs o, __global const float4* normals,
+                                 __global float* angles, __global float* distances, __global float* svf_sum,
+                                 __global float* ao_sum) {
+#if HFVIS_WANT_ANGLES
+  angles[o.plane + pixel] = nodata ? NAN : elevation_term(found, rise, run);
+#endif
+#if HFVIS_WANT_DISTANCES
+  distances[o.plane + pixel] = nodata ? NAN : distance;
+#endif
+#if HFVIS_WANT_SVF
+  svf_sum[pixel] = nodata ? NAN : svf_sum[pixel] + o.weight * sky_term(found, rise, run);
+#endif
+#if HFVIS_WANT_AO
+  const float4 n = normals[pixel];
+  float term = ambient_term(found, rise, run, n.x, n.y, n.z, o.cos_azimuth, o.sin_azimuth, o.weight, o.swath);
+  ao_sum[pixel] = nodata ? NAN : ao_sum[pixel] + term;
+#endif
+}
+
+// The outputs of a lane vector of receivers (the sweep): the terms lane-parallel, the
+// stores lane by lane where `live`.
+HFVIS_INLINE void emit_lanes(lane_int live, lane_int pixel, lane_int nodata, lane_int found, lane_float rise,
+                             lane_float run, lane_float distance, const DirectionOutputs o,
+                             __global const float4* normals, __global float* angles, __global float* distances,
+                             __global float* svf_sum, __global float* ao_sum) {
+#if HFVIS_WANT_ANGLES
+  const lane_float elevation = select(elevation_term(found, rise, run), (lane_float)NAN, nodata);
+  #pragma unroll
+  for (int l = 0; l < HFVIS_LANES; ++l)
+    if (ILANE(live, l)) angles[o.plane + (uint)ILANE(pixel, l)] = LANE(elevation, l);
+#endif
+#if HFVIS_WANT_DISTANCES
+  const lane_float dist = select(distance, (lane_float)NAN, nodata);
+  #pragma unroll
+  for (int l = 0; l < HFVIS_LANES; ++l)
+    if (ILANE(live, l)) distances[o.plane + (uint)ILANE(pixel, l)] = LANE(dist, l);
+#endif
+#if HFVIS_WANT_SVF
+  const lane_float sky = o.weight * sky_term(found, rise, run);
+  #pragma unroll
+  for (int l = 0; l < HFVIS_LANES; ++l) {
+    const uint p = (uint)ILANE(pixel, l);
+    if (ILANE(live, l)) svf_sum[p] = ILANE(nodata, l) ? NAN : svf_sum[p] + LANE(sky, l);
+  }
+#endif
+#if HFVIS_WANT_AO
+  lane_float nx, ny, nz;
+  #pragma unroll
+  for (int l = 0; l < HFVIS_LANES; ++l) {
+    const float4 n = normals[ILANE(live, l) ? (uint)ILANE(pixel, l) : 0u];
+    LANE(nx, l) = n.x;
+    LANE(ny, l) = n.y;
+    LANE(nz, l) = n.z;
+  }
+  const lane_float term = ambient_term(found, rise, run, nx, ny, nz, o.cos_azimuth, o.sin_azimuth, o.weight, o.swath);
+  #pragma unroll
+  for (int l = 0; l < HFVIS_LANES; ++l) {
+    const uint p = (uint)ILANE(pixel, l);
+    if (ILANE(live, l)) ao_sum[p] = ILANE(nodata, l) ? NAN : ao_sum[p] + LANE(term, l);
+  }
+#endif
+}
+
+// One sample of a period (src/lattice_geometry.hpp, struct LatticeSample): nine 4-byte
+// members, read field by field.
+typedef struct {
+  float tau;       // pixels from the period's receiver toward +(a, b)
+  int ox, oy;      // the cell's lower corner, relative to the receiver
+  int ex, ey;      // 1 where the sample is strictly inside the cell along x (y)
+  float w00, w10, w01, w11;  // bilinear weights of the cell's corners
+} LatticeSample;
+
+// Height of the bilinear surface at a lattice sample whose cell corner is at entry `at`;
+// with nodata, only the valid corners of positive weight count, renormalised (NaN when
+// none). Crossing samples have ex or ey 0: their zero-weight corners repeat a used one.
+HFVIS_INLINE float lattice_height(__global const float* heights, uint at, uint right, uint down, float w00, float w10,
+                                  float w01, float w11) {
+  float h00 = heights[at], h10 = heights[at + right], h01 = heights[at + down], h11 = heights[at + down + right];
+  float plain = w00 * h00 + w10 * h10 + w01 * h01 + w11 * h11;
+#if HFVIS_HAS_NODATA
+  int v00 = w00 > 0.0f && !isnan(h00), v10 = w10 > 0.0f && !isnan(h10);
+  int v01 = w01 > 0.0f && !isnan(h01), v11 = w11 > 0.0f && !isnan(h11);
+  float sum = (v00 ? w00 * h00 : 0.0f) + (v10 ? w10 * h10 : 0.0f) + (v01 ? w01 * h01 : 0.0f) + (v11 ? w11 * h11 : 0.0f);
+  float weight = (v00 ? w00 : 0.0f) + (v10 ? w10 : 0.0f) + (v01 ? w01 : 0.0f) + (v11 ? w11 : 0.0f);
+  return isnan(plain) ? (weight > 0.0f ? sum / weight : NAN) : plain;
+#else
+  return plain;
+#endif
+}
+
+// The exact limit of the receivers' elevation slope at t -> 0 along (a, b): the bilinear
+// surface's directional derivative into the first cell, from each receiver's height h and
+// its neighbours along the two axes, as a rise over the period |(a, b)| (the caller's run).
+// NaN where the ray leaves the field at once or a needed neighbour is nodata; lanes not
+// `live` read pixel 0.
+HFVIS_INLINE lane_float near_rise(__global const float* heights, int width, int height, lane_int live, lane_int c,
+                                  lane_int r, lane_float h, int a, int b) {
+  const int sx = a > 0 ? 1 : (a < 0 ? -1 : 0), sy = b > 0 ? 1 : (b < 0 ? -1 : 0);
+  const lane_int leaves = (c + sx < 0) | (c + sx >= width) | (r + sy < 0) | (r + sy >= height);
+  const lane_int x_at = select((lane_int)0, r * width + clamp(c + sx, 0, width - 1), live);
+  const lane_int y_at = select((lane_int)0, clamp(r + sy, 0, height - 1) * width + c, live);
+  lane_float hx, hy;
+  #pragma unroll
+  for (int l = 0; l < HFVIS_LANES; ++l) {
+    LANE(hx, l) = heights[ILANE(x_at, l)];
+    LANE(hy, l) = heights[ILANE(y_at, l)];
+  }
+  const lane_float rise = (hx - h) * (float)abs(a) + (hy - h) * (float)abs(b);
+  return select(rise, (lane_float)NAN, leaves);
+}
 
 // The sweep of one direction (a, b): lines j = lanes * work-item + lane, each from its far
 // end toward -(a, b), in lock step (a lane whose line has ended is masked). Line j's farthest
@@ -240,6 +307,7 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
   for (int i = 0; i < trips; ++i, c -= a, r -= b) {
     const lane_int live = i < receivers;
     const float base = (float)i * period;  // the receivers' position along their lines
+    lane_float h;                          // the sample's heights, finally the receivers'
     for (int q = 0; q < n_samples; ++q) {
       __global const LatticeSample* s = samples + q;
       const int ex = s->ex, ey = s->ey;
@@ -248,7 +316,6 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
       lane_int ok = live;
       if (i == 0) ok = ok & (x0 >= 0) & (x0 + ex <= width - 1) & (y0 >= 0) & (y0 + ey <= height - 1);
       const lane_int at = select((lane_int)0, y0 * width + x0, ok);
-      lane_float h;
       if (ex + ey < 2) {
         // A crossing or the receiver: at most two corners of positive weight, and the
         // zero-weight terms of the four-corner sum add nothing.
@@ -322,30 +389,22 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
       top_p = select(top_p, (lane_float)here, valid);
       n = select(n, n + 1, valid);
     }
-    // The receivers (the last sample of the period): the steeper of the hull's occluder and
-    // the limit at the receiver, compared without a division (both runs are positive); the
-    // occluder wins ties (it is the farther point casting that elevation).
-    #pragma unroll
-    for (int l = 0; l < HFVIS_LANES; ++l) {
-      if (!ILANE(live, l)) continue;
-      const int cl = ILANE(c, l), rl = ILANE(r, l);
-      const uint pixel = (uint)(rl * width + cl);
-      const float hp = heights[pixel];
+    // The receivers (the last sample of the period, h its height): the steeper of the hull's
+    // occluder and the limit at the receiver, compared without a division (both runs are
+    // positive); the occluder wins ties (it is the farther point casting that elevation).
+    const lane_float near = near_rise(heights, width, height, live, c, r, h, a, b);
+    const lane_float ground = run * ground_per_pixel;
+    const lane_int has_far = run > 0.0f, has_near = !isnan(near);
+    const lane_int use_near = has_near & (!has_far | (near * ground > rise * period_ground));
+    const lane_float distance = select((lane_float)0.0f, ground, has_far & !use_near);
 #if HFVIS_HAS_NODATA
-      if (isnan(hp)) {
-        emit_direction(pixel, 1, 0, 0.0f, 1.0f, 0.0f, outputs, normals, angles, distances, svf_sum, ao_sum);
-        continue;
-      }
+    const lane_int nodata = isnan(h);
+#else
+    const lane_int nodata = 0;
 #endif
-      const float far_rise = LANE(rise, l), far_run = LANE(run, l);
-      const float near = near_rise(heights, width, height, cl, rl, hp, a, b);
-      const float ground = far_run * ground_per_pixel;
-      const int has_far = far_run > 0.0f, has_near = !isnan(near);
-      const int use_near = has_near && (!has_far || near * ground > far_rise * period_ground);
-      const float distance = has_far && !use_near ? ground : 0.0f;
-      emit_direction(pixel, 0, has_far || has_near, use_near ? near : far_rise, use_near ? period_ground : ground,
-                     distance, outputs, normals, angles, distances, svf_sum, ao_sum);
-    }
+    emit_lanes(live, r * width + c, nodata, has_far | has_near, select(rise, near, use_near),
+               select(ground, (lane_float)period_ground, use_near), distance, outputs, normals, angles, distances,
+               svf_sum, ao_sum);
   }
 }
 
