@@ -74,14 +74,17 @@ __kernel void pixel_normals(__global const float* heights, int width, int height
   normals[pixel] = (float4)(nx, ny, nz, 0.0f);
 }
 
-// Lanes (compile-time HFVIS_LANES): one work-item sweeps HFVIS_LANES lines side by side,
-// one per SIMD lane, in the line-major (CPU) layout, where a work-item's loop runs serially on one core: the hull
-// stacks' pops are data-dependent branches, and running 16 lines in lock step turns them
-// into masked vector steps that end when no lane pops (fewer mispredicted branches per
-// sample; 1.4x to 1.6x faster on an AVX-512 CPU under PoCL). On GPUs (step-major layout)
-// each work-item runs one line (HFVIS_LANES 1), so neighbouring work-items coalesce.
+// Lanes (compile-time HFVIS_LANES): in the line-major (CPU) layout one work-item sweeps 8
+// lines side by side, one per SIMD lane. A work-item's loop runs serially on one core and
+// the hull stacks' pops are data-dependent branches; in lock step they become masked vector
+// steps that end when no lane pops, with fewer mispredicted branches per sample. Measured
+// on a 2-core AVX-512 CPU under PoCL (`hfvis svf -k 64`, 1024^2): 8 lanes 1.05 s of kernel
+// time, 16 lanes 1.26 s, 4 lanes 1.45 s, one line per work-item 2.09 s. On GPUs
+// (step-major layout) each work-item runs one line (HFVIS_LANES 1), so that neighbouring
+// work-items read neighbouring stack entries.
 // LANE(v, l) is lane l of v; comparisons give -1 in a vector lane and 1 in a scalar, so
-// masks are only combined with &, tested for nonzero and used by select().
+// masks are only combined with &, tested for nonzero and used by select(). any() would
+// compile to a test and branch per lane; any_lane ORs the lanes and branches once.
 #ifndef HFVIS_LANES
 #define HFVIS_LANES 1
 #endif
@@ -91,21 +94,19 @@ typedef int lane_int;
 #define LANE(v, l) (v)
 #define ILANE(v, l) (v)
 #define ANY_LANE(m) ((m) != 0)
-#elif HFVIS_LANES == 16
-typedef float16 lane_float;
-typedef int16 lane_int;
+#elif HFVIS_LANES == 8
+typedef float8 lane_float;
+typedef int8 lane_int;
 #define LANE(v, l) (((__private float*)&(v))[l])
 #define ILANE(v, l) (((__private int*)&(v))[l])
-// An OR tree, one branch at the end (any() compiles to a test and branch per lane).
-HFVIS_INLINE int any_lane(int16 m) {
-  int8 m8 = m.lo | m.hi;
-  int4 m4 = m8.lo | m8.hi;
+HFVIS_INLINE int any_lane(int8 m) {
+  int4 m4 = m.lo | m.hi;
   int2 m2 = m4.lo | m4.hi;
   return (m2.x | m2.y) < 0;
 }
 #define ANY_LANE(m) any_lane(m)
 #else
-#error "HFVIS_LANES must be 1 or 16"
+#error "HFVIS_LANES must be 1 or 8"
 #endif
 
 // What one direction contributes at a receiver whose horizon has slope rise / run (run > 0;
@@ -277,7 +278,7 @@ HFVIS_INLINE lane_float near_rise(__global const float* heights, int width, int 
 // the sample. Only the first period can reach outside the field (the others lie between two
 // receivers, inside it), so only it tests; samples outside the field or without height are
 // absent. Stack entry k of a line is (height, position along the line) at
-// stacks + 2 (line.w + k stride). The top entry is kept in registers as well. Global size:
+// stacks + 2 (line.w + k stride); the top two entries are kept in registers as well. Global size:
 // ceil(n_lines / HFVIS_LANES) rounded up to the local size.
 __kernel void horizon_lattice(__global const float* heights, int width, int height,
                               __global const int4* lines, int n_lines, __global const LatticeSample* samples,

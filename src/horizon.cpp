@@ -23,7 +23,7 @@ constexpr std::size_t kStackEntryBytes = 2 * sizeof(float);  // (height, positio
 // Lines one work-item of horizon_lattice sweeps side by side (HFVIS_LANES): SIMD lanes
 // where a work-item runs on a CPU core (the line-major layout), one line per work-item on
 // GPUs, whose neighbouring work-items then read neighbouring stack entries.
-int sweepLanes(bool line_major) { return line_major ? 16 : 1; }
+int sweepLanes(bool line_major) { return line_major ? 8 : 1; }
 
 std::string programOptions(const HorizonOutputs& outputs, bool has_nodata, int lanes) {
   std::ostringstream s;
@@ -245,8 +245,8 @@ class HorizonRun {
       kernel.setArg(3, chunk_lines);
       kernel.setArg(4, static_cast<int>(chunk.count));
       kernel.setArg(stride_arg_, static_cast<cl_uint>(chunk.stride));
-      // With lanes, groups of one work-item: 64 work-items of 16 lines would put all of a
-      // 1024-line direction in one group, on one core.
+      // With lanes, groups of one work-item: 64 work-items of 8 lines would put all of a
+      // 512-line direction in one group, on one core.
       const std::size_t items = (chunk.count + lanes_ - 1) / lanes_, group = lanes_ > 1 ? 1 : kLineGroup;
       st_.launch(kernel, cl::NDRange(roundUp(items, group)), cl::NDRange(group));
     }
