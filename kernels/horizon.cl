@@ -83,8 +83,8 @@ __kernel void pixel_normals(__global const float* heights, int width, int height
 // (step-major layout) each work-item runs one line (HFVIS_LANES 1), so that neighbouring
 // work-items read neighbouring stack entries.
 // LANE(v, l) is lane l of v; comparisons give -1 in a vector lane and 1 in a scalar, so
-// masks are only combined with &, tested for nonzero and used by select(). any() would
-// compile to a test and branch per lane; any_lane ORs the lanes and branches once.
+// masks are only combined with &, tested for nonzero and used by select(). any() compiles
+// to a test and branch per lane; any_lane packs the lanes' masks into one 64-bit word.
 #ifndef HFVIS_LANES
 #define HFVIS_LANES 1
 #endif
@@ -99,11 +99,7 @@ typedef float8 lane_float;
 typedef int8 lane_int;
 #define LANE(v, l) (((__private float*)&(v))[l])
 #define ILANE(v, l) (((__private int*)&(v))[l])
-HFVIS_INLINE int any_lane(int8 m) {
-  int4 m4 = m.lo | m.hi;
-  int2 m2 = m4.lo | m4.hi;
-  return (m2.x | m2.y) < 0;
-}
+HFVIS_INLINE int any_lane(int8 m) { return as_ulong(convert_char8(m)) != 0; }
 #define ANY_LANE(m) any_lane(m)
 #else
 #error "HFVIS_LANES must be 1 or 8"
