@@ -6,7 +6,7 @@
 # heman, ...). Prints a Markdown table of min / median wall time of each and heman / hfvis,
 # for the whole process and for the computation alone, and writes it with the raw timings.
 #
-#   bench/heman_compare.sh --heman-dir DIR [--hfvis PATH] [--sizes 1024,2048] [--rounds 5]
+#   bench/heman_compare.sh --heman-dir DIR [--hfvis PATH] [--bench PATH] [--sizes 1024,2048] [--rounds 5]
 #                          [--warmup 1] [--field fractal] [--threads N] [--out DIR]
 #
 #   --heman-dir DIR       a heman you built yourself (also: env HEMAN_DIR): DIR/include/heman.h
@@ -15,6 +15,11 @@
 #                         C files and optimisation on (see bench/README.md); this script never
 #                         builds heman, and none of heman's code belongs in this repository.
 #   --hfvis PATH          the hfvis CLI to time (default build/hfvis)
+#   --bench PATH          hfvis_bench, for the library-call row: `hfvis_bench run FIELD -k 16
+#                         --outputs ao --reps 1` times one computeHorizons call on a context
+#                         that has built its program and buffers, as a renderer calling the
+#                         library repeatedly sees it (default build/bench/hfvis_bench;
+#                         the row is left out when there is none)
 #   --sizes N[,N...]      square field sizes (default 1024,2048)
 #   --rounds R            timed runs of each program per size, interleaved (default 5)
 #   --warmup W            untimed runs of each first, per size (default 1; fills PoCL's cache)
@@ -35,6 +40,7 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 python=/usr/bin/python3  # Debian's, for its numpy
 hfvis=$root/build/hfvis
+bench=$root/build/bench/hfvis_bench
 heman_dir=${HEMAN_DIR:-}
 heman_include=""
 heman_lib=""
@@ -54,6 +60,7 @@ while [[ $# -gt 0 ]]; do
     --heman-include) need_value "$@"; heman_include=$2; shift ;;
     --heman-lib) need_value "$@"; heman_lib=$2; shift ;;
     --hfvis) need_value "$@"; hfvis=$2; shift ;;
+    --bench) need_value "$@"; bench=$2; shift ;;
     --sizes) need_value "$@"; sizes=$2; shift ;;
     --rounds) need_value "$@"; rounds=$2; shift ;;
     --warmup) need_value "$@"; warmup=$2; shift ;;
@@ -113,6 +120,12 @@ fi
 # --- hfvis --------------------------------------------------------------------------------------
 [[ -x $hfvis ]] || die "hfvis binary not found or not executable: $hfvis (build it, or pass --hfvis PATH)"
 hfvis=$(cd "$(dirname "$hfvis")" && pwd)/$(basename "$hfvis")
+if [[ -x $bench ]]; then
+  bench=$(cd "$(dirname "$bench")" && pwd)/$(basename "$bench")
+else
+  echo "heman_compare.sh: no hfvis_bench at $bench: the library-call row is left out" >&2
+  bench=""
+fi
 
 mkdir -p "$out"
 out=$(cd "$out" && pwd)
@@ -173,12 +186,12 @@ if ! git -C "$root" diff --quiet HEAD 2> /dev/null; then commit="$commit (with u
 cpu=$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -1)
 
 "$python" - "$hfvis" "$driver" "$data" "$field" "$sizes" "$rounds" "$warmup" "$out" "$root/data" \
-  "$threads" "$heman_lib" "$heman_float" "$commit" "$cpu" << 'EOF'
+  "$threads" "$heman_lib" "$heman_float" "$commit" "$cpu" "$bench" << 'EOF'
 import csv, datetime, os, re, resource, statistics, subprocess, sys, time
 import numpy as np
 
 (hfvis, driver, data, field, sizes, rounds, warmup, out, data_dir, threads, heman_lib, heman_float,
- commit, cpu) = sys.argv[1:]
+ commit, cpu, bench) = sys.argv[1:]
 sizes = [int(s) for s in sizes.split(",")]
 rounds, warmup = int(rounds), int(warmup)
 
@@ -215,8 +228,18 @@ def heman_run(n):
     return wall, cpu_s, float(kv["compute_seconds"]), float(kv["mean_ao"])
 
 
+def library_run(n):
+    exr = os.path.join(data, "%s_%d.exr" % (field, n))
+    wall, cpu_s, text = run([bench, "run", exr, "-k", "16", "--outputs", "ao", "--reps", "1"])
+    m = re.search(r"min ([0-9.]+) s, .* on (.*) \(", text)
+    if not m:
+        sys.exit("heman_compare.sh: cannot read hfvis_bench's line: %r" % text)
+    devices.add(m.group(2))
+    return wall, cpu_s, float(m.group(1)), float("nan")
+
+
 devices = set()
-tools = (("hfvis", hfvis_run), ("heman", heman_run))
+tools = (("hfvis", hfvis_run), ("heman", heman_run)) + ((("hfvis_lib", library_run),) if bench else ())
 rows = []
 load_before = open("/proc/loadavg").read().split()[:3]
 for n in sizes:
@@ -258,9 +281,12 @@ lines.append("")
 lines.append("| size | timed | hfvis min (s) | hfvis median (s) | heman min (s) | heman median (s) "
              "| heman/hfvis min | heman/hfvis median |")
 lines.append("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |")
+timed = [("hfvis", "wall_s", "whole process"), ("hfvis", "compute_s", "computation")]
+if bench:
+    timed.append(("hfvis_lib", "compute_s", "library call (program built)"))
 for n in sizes:
-    for key, what in (("wall_s", "whole process"), ("compute_s", "computation")):
-        a, b = pick(n, "hfvis", key), pick(n, "heman", key)
+    for prog, key, what in timed:
+        a, b = pick(n, prog, key), pick(n, "heman", key)
         amin, amed, bmin, bmed = min(a), statistics.median(a), min(b), statistics.median(b)
         lines.append("| %dx%d | %s | %.3f | %.3f | %.3f | %.3f | %.2f | %.2f |"
                      % (n, n, what, amin, amed, bmin, bmed, bmin / amin, bmed / amed))
@@ -288,6 +314,10 @@ lines.append("- whole process: hfvis reads the ZIP EXR, sets up OpenCL (kernels 
 lines.append("- computation: hfvis's `computeHorizons` call as its summary line prints it (10 ms steps; "
              "includes building the program from PoCL's cache and the transfers); heman's "
              "`heman_lighting_compute_occlusion` call (with its allocations), timed in the driver.")
+if bench:
+    lines.append("- library call (program built): one `computeHorizons` call (ambient occlusion, K = 16) timed "
+                 "by `hfvis_bench run FIELD -k 16 --outputs ao --reps 1` after a full-size untimed call on the "
+                 "same context, as a renderer calling the library again sees it; against heman's call.")
 lines.append("- same geometry: heights in pixel units, cell size 1 (heman: occlusion scale = field size). "
              "hfvis: 16 azimuths 22.5 deg apart, bilinear heights; heman: 16 lattice steps "
              "(rook, bishop, knight), heights at the lattice points, HEMAN_FLOAT = %s." % heman_float)

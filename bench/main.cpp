@@ -5,7 +5,7 @@
 //       the standard suite: writes DIR/results.csv and DIR/environment.txt
 //       (bench/run_report.sh builds, generates inputs, runs this and writes bench/report/)
 //   hfvis_bench run FIELD [--method M] [-k K] [--spu S] [--param P]
-//                   [--outputs angles|svf|device] [--reps N]
+//                   [--outputs angles|svf|ao|device] [--reps N]
 //       one method on one field: min and median time and core-ns per pixel-direction
 //       (methods: sweep, naive, radius, pyramid, floor)
 //   hfvis_bench visibility [--quick | --tiny] --out DIR [--data DIR] [--dem FILE] [--commit TEXT]
@@ -49,7 +49,7 @@ constexpr const char* kUsage =
     "usage: hfvis_bench suite [--quick | --tiny] --out DIR [--data DIR] [--dem FILE] [--cache DIR] [--commit "
     "TEXT]\n"
     "       hfvis_bench run FIELD [--method sweep|naive|radius|pyramid|floor] [-k K] [--spu S] [--param P]\n"
-    "                   [--outputs angles|svf|device] [--reps N]\n"
+    "                   [--outputs angles|svf|ao|device] [--reps N]\n"
     "       hfvis_bench visibility [--quick | --tiny] --out DIR [--data DIR] [--dem FILE] [--commit TEXT]\n"
     "       hfvis_bench vis-run FIELD [--method tree|naive] [-k K] [--tuning plain|deferred|default|zone]\n"
     "                           [--zone-steps S] [--reps N]\n"
@@ -133,9 +133,10 @@ int runOne(Arguments& args) {
   spec.parameter =
       static_cast<int>(number(args.get("--param", spec.kind == MethodKind::Radius ? "32" : "16"), "--param"));
   const std::string outputs = args.get("--outputs", "angles");
-  if (outputs != "angles" && outputs != "svf" && outputs != "device")
-    throw Usage("--outputs: angles, svf or device");
+  if (outputs != "angles" && outputs != "svf" && outputs != "ao" && outputs != "device")
+    throw Usage("--outputs: angles, svf, ao or device");
   spec.angles = outputs == "angles";
+  spec.ambient_occlusion = outputs == "ao";
   TimingPolicy policy;
   policy.min_reps = policy.max_reps = static_cast<int>(number(args.get("--reps", "3"), "--reps"));
   args.rejectUnused();

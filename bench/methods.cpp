@@ -170,7 +170,8 @@ std::string MethodSpec::name() const {
 
 std::string MethodSpec::outputs() const {
   if (angles) return "angles";
-  return kind == MethodKind::Sweep || kind == MethodKind::Naive ? "svf" : "device";
+  if (kind != MethodKind::Sweep && kind != MethodKind::Naive) return "device";
+  return ambient_occlusion ? "ao" : "svf";
 }
 
 MethodOutput runMethod(const ComputeContext& context, const HeightField& field, const MethodSpec& spec) {
@@ -182,11 +183,12 @@ MethodOutput runMethod(const ComputeContext& context, const HeightField& field, 
   options.method = spec.kind == MethodKind::Sweep ? HorizonMethod::Sweep : HorizonMethod::Naive;
   HorizonOutputs outputs;
   outputs.horizon_angles = spec.angles;
-  outputs.sky_view_factor = !spec.angles;
+  outputs.sky_view_factor = !spec.angles && !spec.ambient_occlusion;
+  outputs.ambient_occlusion = !spec.angles && spec.ambient_occlusion;
   HorizonResult result = computeHorizons(context, field, options, outputs);
   MethodOutput out;
   out.angles = std::move(result.angles);
-  out.svf = std::move(result.sky_view_factor);
+  out.svf = std::move(outputs.ambient_occlusion ? result.ambient_occlusion : result.sky_view_factor);
   out.azimuths = std::move(result.azimuths);
   return out;
 }

@@ -29,14 +29,17 @@ struct MethodSpec {
   // true: K horizon planes downloaded to the host (the `hfvis horizon` job). false: the
   // library computes the sky-view factor only; the floor writes its planes on the device only.
   bool angles = true;
+  // Library methods without angles: ambient occlusion instead of the sky-view factor (the
+  // `hfvis ao` job, for the comparison with heman).
+  bool ambient_occlusion = false;
 
   std::string name() const;     // "sweep", "naive", "radius_16", "pyramid_16", "floor"
-  std::string outputs() const;  // "angles", "svf" or "device"
+  std::string outputs() const;  // "angles", "svf", "ao" or "device"
 };
 
 struct MethodOutput {
   std::vector<float> angles;     // K planes of width * height when spec.angles
-  std::vector<float> svf;        // library methods without angles
+  std::vector<float> svf;        // library methods without angles (or ao, with ambient_occlusion)
   std::vector<double> azimuths;  // library methods: the azimuths computed (HorizonResult::azimuths)
 };
 

@@ -79,7 +79,7 @@ if [[ -n ${HEMAN_DIR:-} && $only != visibility ]]; then
   heman_sizes=()
   [[ $mode == quick ]] && heman_sizes=(--sizes 1024 --rounds 3)
   # Its outputs (EXRs of both programs) stay in bench/out/; the report directory gets the tables.
-  "$root/bench/heman_compare.sh" --heman-dir "$HEMAN_DIR" --hfvis "$build_dir/hfvis" \
+  "$root/bench/heman_compare.sh" --heman-dir "$HEMAN_DIR" --hfvis "$build_dir/hfvis" --bench "$bench" \
     --out "$root/bench/out/heman-$mode" "${heman_sizes[@]}" | tee "$root/bench/out/heman-$mode.log"
   cp "$root/bench/out/heman-$mode/results.md" "$report_dir/heman.md"
   cp "$root/bench/out/heman-$mode/timings.csv" "$report_dir/heman_timings.csv"
