@@ -180,19 +180,22 @@ int runVisibilityOne(Arguments& args) {
   const ComputeContext context = ComputeContext::create();
   IntervisibilityOutputs outputs;
   outputs.visible_count = true;
-  const Timing t = timeWithWarmUp([&] { computeIntervisibility(context, crop(field, 64, 64), options, outputs); },
-                                  [&] { computeIntervisibility(context, field, options, outputs); }, policy);
+  const Timing t =
+      timeWithWarmUp([&] { computeIntervisibility(context, crop(field, 64, 64), options, outputs); },
+                     [&] { computeIntervisibility(context, field, options, outputs); }, policy);
   const double pd = static_cast<double>(field.pixelCount()) * options.directions;
   const int cores = std::max(1, context.device().compute_units);
-  std::printf("%s (%s) on %dx%d, K=%d: min %.4f s, median %.4f s over %zu runs; %.1f core-ns per pixel-direction\n",
-              method.c_str(), method == "tree" ? tuning.c_str() : "-", field.width, field.height,
-              options.directions, t.min(), t.median(), t.seconds.size(), t.min() * cores / pd * 1e9);
+  std::printf(
+      "%s (%s) on %dx%d, K=%d: min %.4f s, median %.4f s over %zu runs; %.1f core-ns per pixel-direction\n",
+      method.c_str(), method == "tree" ? tuning.c_str() : "-", field.width, field.height, options.directions,
+      t.min(), t.median(), t.seconds.size(), t.min() * cores / pd * 1e9);
   if (method == "tree") {
     IntervisibilityOutputs stats;
     stats.statistics = true;
     const auto s = computeIntervisibility(context, field, options, stats).statistics;
-    std::printf("  m_a %.3f, t_a %.3f, visible %.3f, walks skipped by the safe zone %.1f %%\n", s.meanHorizons(),
-                s.meanIterations(), s.meanVisible(), s.receivers ? 100.0 * s.safe_zone_skips / s.receivers : 0.0);
+    std::printf("  m_a %.3f, t_a %.3f, visible %.3f, walks skipped by the safe zone %.1f %%\n",
+                s.meanHorizons(), s.meanIterations(), s.meanVisible(),
+                s.receivers ? 100.0 * s.safe_zone_skips / s.receivers : 0.0);
   }
   return 0;
 }

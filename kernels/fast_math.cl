@@ -23,17 +23,18 @@ HFVIS_INLINE float hf_max(float a, float b) { return a > b ? a : b; }
 // atan(x) for any x (+-inf gives +-pi/2): Cephes' atanf range reduction to
 // |x| <= tan(pi/8) and its degree-9 odd polynomial. Defined for float and, through
 // HFVIS_DEFINE_ATAN, for the vector types a kernel needs (the same operations lane by lane).
-#define HFVIS_DEFINE_ATAN(T, IT)                                                                              \
-  HFVIS_INLINE __attribute__((overloadable)) T hf_atan(T x) {                                                  \
-    T a = fabs(x);                                                                                            \
+#define HFVIS_DEFINE_ATAN(T, IT)                                                                             \
+  HFVIS_INLINE __attribute__((overloadable)) T hf_atan(T x) {                                                \
+    T a = fabs(x);                                                                                           \
     IT big = a > 2.414213562373095f;  /* tan(3 pi / 8) */                                                    \
     IT mid = a > 0.4142135623730950f; /* tan(pi / 8) */                                                      \
-    T reduced = big ? -1.0f / a : (mid ? (a - 1.0f) / (a + 1.0f) : a);                                        \
+    T reduced = big ? -1.0f / a : (mid ? (a - 1.0f) / (a + 1.0f) : a);                                       \
     T base = big ? (T)(0.5f * HFVIS_PI_F) : (mid ? (T)(0.25f * HFVIS_PI_F) : (T)0.0f);                       \
-    T z = reduced * reduced;                                                                                  \
-    T p = (((8.05374449538e-2f * z - 1.38776856032e-1f) * z + 1.99777106478e-1f) * z - 3.33329491539e-1f) * z; \
-    T y = base + (p * reduced + reduced);                                                                     \
-    return x < 0.0f ? -y : y;                                                                                 \
+    T z = reduced * reduced;                                                                                 \
+    T p =                                                                                                    \
+        (((8.05374449538e-2f * z - 1.38776856032e-1f) * z + 1.99777106478e-1f) * z - 3.33329491539e-1f) * z; \
+    T y = base + (p * reduced + reduced);                                                                    \
+    return x < 0.0f ? -y : y;                                                                                \
   }
 HFVIS_DEFINE_ATAN(float, int)
 
@@ -43,8 +44,10 @@ HFVIS_INLINE float hf_sin(float x) {
   r = r > 0.5f * HFVIS_PI_F ? HFVIS_PI_F - r : r;
   r = r < -0.5f * HFVIS_PI_F ? -HFVIS_PI_F - r : r;
   float z = r * r;
-  float p = ((((-2.5052108385e-8f * z + 2.7557319224e-6f) * z - 1.9841269841e-4f) * z + 8.3333333333e-3f) * z -
-             1.6666666667e-1f) * z;
+  float p =
+      ((((-2.5052108385e-8f * z + 2.7557319224e-6f) * z - 1.9841269841e-4f) * z + 8.3333333333e-3f) * z -
+       1.6666666667e-1f) *
+      z;
   return p * r + r;
 }
 

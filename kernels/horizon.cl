@@ -19,8 +19,8 @@
 // Compile-time parameters, besides those of sweep_framework.cl:
 //   HFVIS_WANT_ANGLES, HFVIS_WANT_DISTANCES  write the direction's planes
 //   HFVIS_WANT_SVF, HFVIS_WANT_AO            accumulate sky-view / ambient occlusion terms
-#include "sweep_framework.cl"
 #include "fast_math.cl"
+#include "sweep_framework.cl"
 
 #ifndef HFVIS_WANT_ANGLES
 #define HFVIS_WANT_ANGLES 1
@@ -39,7 +39,7 @@
 // four quads around it (Timonen & Westerholm 2010, Sec. 7), in ground units; quads touching nodata
 // or the border are left out; (0, 0, 1) when none is left.
 HFVIS_INLINE void surface_normal(__global const float* heights, int width, int height, int c, int r, float h,
-                                float cell_x, float cell_y, float* nx, float* ny, float* nz) {
+                                 float cell_x, float cell_y, float* nx, float* ny, float* nz) {
   // Straight-line scalar code (clamped reads, masked sums) so that PoCL vectorises callers.
   float sx_sum = 0.0f, sy_sum = 0.0f, sz_sum = 0.0f;
   for (int q = 0; q < 4; ++q) {
@@ -118,21 +118,20 @@ HFVIS_INLINE int any_lane(int8 m) { return as_ulong(convert_char8(m)) != 0; }
 // x = tan e, so only e itself needs an arctangent. The sky behind the surface (N . e < 0)
 // does not count: the horizon is at least the tangent plane's slope -toward / nz in this
 // azimuth. swath = sin(pi weight) / pi, per direction.
-#define HFVIS_DIRECTION_TERMS(T, IT)                                                                          \
-  HFVIS_INLINE __attribute__((overloadable)) T elevation_term(IT found, T rise, T run) {                      \
-    return found ? hf_atan(rise / run) : (T)(-0.5f * HFVIS_PI_F);                                            \
-  }                                                                                                           \
-  HFVIS_INLINE __attribute__((overloadable)) T sky_term(IT found, T rise, T run) {                            \
-    return (found & (rise > 0.0f)) ? rise / sqrt(rise * rise + run * run) : (T)0.0f;                         \
-  }                                                                                                           \
-  HFVIS_INLINE __attribute__((overloadable)) T ambient_term(IT found, T rise, T run, T nx, T ny, T nz,        \
-                                                            float cos_az, float sin_az, float weight,         \
-                                                            float swath) {                                    \
-    T toward = nx * cos_az + ny * sin_az;                                                                     \
-    IT behind = !found | (rise * nz < -toward * run);                                                         \
-    T x = behind ? -toward / nz : rise / run;                                                                 \
-    T cos2 = 1.0f / (1.0f + x * x);                                                                           \
-    return nz * weight * cos2 + swath * (0.5f * HFVIS_PI_F - hf_atan(x) - x * cos2) * toward;                 \
+#define HFVIS_DIRECTION_TERMS(T, IT)                                                                      \
+  HFVIS_INLINE __attribute__((overloadable)) T elevation_term(IT found, T rise, T run) {                  \
+    return found ? hf_atan(rise / run) : (T)(-0.5f * HFVIS_PI_F);                                         \
+  }                                                                                                       \
+  HFVIS_INLINE __attribute__((overloadable)) T sky_term(IT found, T rise, T run) {                        \
+    return (found & (rise > 0.0f)) ? rise / sqrt(rise * rise + run * run) : (T)0.0f;                      \
+  }                                                                                                       \
+  HFVIS_INLINE __attribute__((overloadable)) T ambient_term(                                              \
+      IT found, T rise, T run, T nx, T ny, T nz, float cos_az, float sin_az, float weight, float swath) { \
+    T toward = nx * cos_az + ny * sin_az;                                                                 \
+    IT behind = !found | (rise * nz < -toward * run);                                                     \
+    T x = behind ? -toward / nz : rise / run;                                                             \
+    T cos2 = 1.0f / (1.0f + x * x);                                                                       \
+    return nz * weight * cos2 + swath * (0.5f * HFVIS_PI_F - hf_atan(x) - x * cos2) * toward;             \
   }
 HFVIS_DIRECTION_TERMS(float, int)
 #if HFVIS_LANES > 1
@@ -175,23 +174,23 @@ HFVIS_INLINE void emit_direction(uint pixel, int nodata, int found, float rise, 
 // stores lane by lane where `live`.
 HFVIS_INLINE void emit_lanes(lane_int live, lane_int pixel, lane_int nodata, lane_int found, lane_float rise,
                              lane_float run, lane_float distance, const DirectionOutputs o,
-                             __global const float4* normals, __global float* angles, __global float* distances,
-                             __global float* svf_sum, __global float* ao_sum) {
+                             __global const float4* normals, __global float* angles,
+                             __global float* distances, __global float* svf_sum, __global float* ao_sum) {
 #if HFVIS_WANT_ANGLES
   const lane_float elevation = select(elevation_term(found, rise, run), (lane_float)NAN, nodata);
-  #pragma unroll
+#pragma unroll
   for (int l = 0; l < HFVIS_LANES; ++l)
     if (ILANE(live, l)) angles[o.plane + (uint)ILANE(pixel, l)] = LANE(elevation, l);
 #endif
 #if HFVIS_WANT_DISTANCES
   const lane_float dist = select(distance, (lane_float)NAN, nodata);
-  #pragma unroll
+#pragma unroll
   for (int l = 0; l < HFVIS_LANES; ++l)
     if (ILANE(live, l)) distances[o.plane + (uint)ILANE(pixel, l)] = LANE(dist, l);
 #endif
 #if HFVIS_WANT_SVF
   const lane_float sky = o.weight * sky_term(found, rise, run);
-  #pragma unroll
+#pragma unroll
   for (int l = 0; l < HFVIS_LANES; ++l) {
     const uint p = (uint)ILANE(pixel, l);
     if (ILANE(live, l)) svf_sum[p] = ILANE(nodata, l) ? NAN : svf_sum[p] + LANE(sky, l);
@@ -199,15 +198,16 @@ HFVIS_INLINE void emit_lanes(lane_int live, lane_int pixel, lane_int nodata, lan
 #endif
 #if HFVIS_WANT_AO
   lane_float nx, ny, nz;
-  #pragma unroll
+#pragma unroll
   for (int l = 0; l < HFVIS_LANES; ++l) {
     const float4 n = normals[ILANE(live, l) ? (uint)ILANE(pixel, l) : 0u];
     LANE(nx, l) = n.x;
     LANE(ny, l) = n.y;
     LANE(nz, l) = n.z;
   }
-  const lane_float term = ambient_term(found, rise, run, nx, ny, nz, o.cos_azimuth, o.sin_azimuth, o.weight, o.swath);
-  #pragma unroll
+  const lane_float term =
+      ambient_term(found, rise, run, nx, ny, nz, o.cos_azimuth, o.sin_azimuth, o.weight, o.swath);
+#pragma unroll
   for (int l = 0; l < HFVIS_LANES; ++l) {
     const uint p = (uint)ILANE(pixel, l);
     if (ILANE(live, l)) ao_sum[p] = ILANE(nodata, l) ? NAN : ao_sum[p] + LANE(term, l);
@@ -218,23 +218,25 @@ HFVIS_INLINE void emit_lanes(lane_int live, lane_int pixel, lane_int nodata, lan
 // One sample of a period (src/lattice_geometry.hpp, struct LatticeSample): nine 4-byte
 // members, read field by field.
 typedef struct {
-  float tau;       // pixels from the period's receiver toward +(a, b)
-  int ox, oy;      // the cell's lower corner, relative to the receiver
-  int ex, ey;      // 1 where the sample is strictly inside the cell along x (y)
+  float tau;                 // pixels from the period's receiver toward +(a, b)
+  int ox, oy;                // the cell's lower corner, relative to the receiver
+  int ex, ey;                // 1 where the sample is strictly inside the cell along x (y)
   float w00, w10, w01, w11;  // bilinear weights of the cell's corners
 } LatticeSample;
 
 // Height of the bilinear surface at a lattice sample whose cell corner is at entry `at`;
 // with nodata, only the valid corners of positive weight count, renormalised (NaN when
 // none). Crossing samples have ex or ey 0: their zero-weight corners repeat a used one.
-HFVIS_INLINE float lattice_height(__global const float* heights, uint at, uint right, uint down, float w00, float w10,
-                                  float w01, float w11) {
-  float h00 = heights[at], h10 = heights[at + right], h01 = heights[at + down], h11 = heights[at + down + right];
+HFVIS_INLINE float lattice_height(__global const float* heights, uint at, uint right, uint down, float w00,
+                                  float w10, float w01, float w11) {
+  float h00 = heights[at], h10 = heights[at + right], h01 = heights[at + down],
+        h11 = heights[at + down + right];
   float plain = w00 * h00 + w10 * h10 + w01 * h01 + w11 * h11;
 #if HFVIS_HAS_NODATA
   int v00 = w00 > 0.0f && !isnan(h00), v10 = w10 > 0.0f && !isnan(h10);
   int v01 = w01 > 0.0f && !isnan(h01), v11 = w11 > 0.0f && !isnan(h11);
-  float sum = (v00 ? w00 * h00 : 0.0f) + (v10 ? w10 * h10 : 0.0f) + (v01 ? w01 * h01 : 0.0f) + (v11 ? w11 * h11 : 0.0f);
+  float sum = (v00 ? w00 * h00 : 0.0f) + (v10 ? w10 * h10 : 0.0f) + (v01 ? w01 * h01 : 0.0f) +
+              (v11 ? w11 * h11 : 0.0f);
   float weight = (v00 ? w00 : 0.0f) + (v10 ? w10 : 0.0f) + (v01 ? w01 : 0.0f) + (v11 ? w11 : 0.0f);
   return isnan(plain) ? (weight > 0.0f ? sum / weight : NAN) : plain;
 #else
@@ -247,14 +249,14 @@ HFVIS_INLINE float lattice_height(__global const float* heights, uint at, uint r
 // its neighbours along the two axes, as a rise over the period |(a, b)| (the caller's run).
 // NaN where the ray leaves the field at once or a needed neighbour is nodata; lanes not
 // `live` read pixel 0.
-HFVIS_INLINE lane_float near_rise(__global const float* heights, int width, int height, lane_int live, lane_int c,
-                                  lane_int r, lane_float h, int a, int b) {
+HFVIS_INLINE lane_float near_rise(__global const float* heights, int width, int height, lane_int live,
+                                  lane_int c, lane_int r, lane_float h, int a, int b) {
   const int sx = a > 0 ? 1 : (a < 0 ? -1 : 0), sy = b > 0 ? 1 : (b < 0 ? -1 : 0);
   const lane_int leaves = (c + sx < 0) | (c + sx >= width) | (r + sy < 0) | (r + sy >= height);
   const lane_int x_at = select((lane_int)0, r * width + clamp(c + sx, 0, width - 1), live);
   const lane_int y_at = select((lane_int)0, clamp(r + sy, 0, height - 1) * width + c, live);
   lane_float hx, hy;
-  #pragma unroll
+#pragma unroll
   for (int l = 0; l < HFVIS_LANES; ++l) {
     LANE(hx, l) = heights[ILANE(x_at, l)];
     LANE(hy, l) = heights[ILANE(y_at, l)];
@@ -273,22 +275,25 @@ HFVIS_INLINE lane_float near_rise(__global const float* heights, int width, int 
 // as the top (so the farther wins ties); the top that remains is its horizon occluder; push
 // the sample. Only the first period can reach outside the field (the others lie between two
 // receivers, inside it), so only it tests; samples outside the field or without height are
-// absent. Stack entry k of a line is (height, position along the line) at
-// stacks + 2 (line.w + k stride); the top two entries are kept in registers as well. Global size:
-// ceil(n_lines / HFVIS_LANES) rounded up to the local size.
+// absent. Stack entry k of a line is (height, position along the line in pixels from its
+// far end) at stacks + 2 (line.w + k stride), the top two entries kept in registers as well;
+// the capacity is every sample of its periods. period_ground = period * ground_per_pixel, the
+// ground length of a period. Preconditions: lines of this launch only; stride 1
+// (line-major) or the launch's line count (step-major). Global size: ceil(n_lines /
+// HFVIS_LANES) rounded up to the local size.
 __kernel void horizon_lattice(__global const float* heights, int width, int height,
                               __global const int4* lines, int n_lines, __global const LatticeSample* samples,
-                              int n_samples, int a, int b, float period, float ground_per_pixel, float period_ground,
-                              float cos_azimuth, float sin_azimuth, float weight, float swath, uint plane,
-                              __global float* stacks, uint stride, __global const float4* normals,
-                              __global float* angles, __global float* distances, __global float* svf_sum,
-                              __global float* ao_sum) {
+                              int n_samples, int a, int b, float period, float ground_per_pixel,
+                              float period_ground, float cos_azimuth, float sin_azimuth, float weight,
+                              float swath, uint plane, __global float* stacks, uint stride,
+                              __global const float4* normals, __global float* angles,
+                              __global float* distances, __global float* svf_sum, __global float* ao_sum) {
   const int first = get_global_id(0) * HFVIS_LANES;
   if (first >= n_lines) return;
   const DirectionOutputs outputs = {cos_azimuth, sin_azimuth, weight, swath, plane};
   lane_int c, r, receivers, stack;
   int trips = 0;  // the longest line's receivers
-  #pragma unroll
+#pragma unroll
   for (int l = 0; l < HFVIS_LANES; ++l) {
     const int4 line = lines[min(first + l, n_lines - 1)];
     ILANE(c, l) = line.x;
@@ -312,30 +317,34 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
       const lane_int x0 = c + s->ox, y0 = r + s->oy;
       lane_int ok = live;
       if (i == 0) ok = ok & (x0 >= 0) & (x0 + ex <= width - 1) & (y0 >= 0) & (y0 + ey <= height - 1);
+      // Lanes without a sample read pixel 0 alone (their cell may lie outside the field).
       const lane_int at = select((lane_int)0, y0 * width + x0, ok);
+      const lane_int right = select((lane_int)0, (lane_int)ex, ok);
+      const lane_int down = select((lane_int)0, (lane_int)(ey * width), ok);
       if (ex + ey < 2) {
         // A crossing or the receiver: at most two corners of positive weight, and the
         // zero-weight terms of the four-corner sum add nothing.
-        const int next = ex + ey * width;
+        const lane_int at_next = at + right + down;
         lane_float h0, h1;
-        #pragma unroll
+#pragma unroll
         for (int l = 0; l < HFVIS_LANES; ++l) {
           LANE(h0, l) = heights[ILANE(at, l)];
-          LANE(h1, l) = heights[ILANE(at, l) + next];
+          LANE(h1, l) = heights[ILANE(at_next, l)];
         }
         h = w00 * h0 + (ex ? w10 : w01) * h1;
 #if HFVIS_HAS_NODATA
-        #pragma unroll
+#pragma unroll
         for (int l = 0; l < HFVIS_LANES; ++l) {
           if (isnan(LANE(h, l)))
-            LANE(h, l) = lattice_height(heights, (uint)ILANE(at, l), (uint)ex, (uint)(ey * width), w00, w10, w01, w11);
+            LANE(h, l) = lattice_height(heights, (uint)ILANE(at, l), (uint)ILANE(right, l),
+                                        (uint)ILANE(down, l), w00, w10, w01, w11);
         }
 #endif
       } else {
-        #pragma unroll
+#pragma unroll
         for (int l = 0; l < HFVIS_LANES; ++l)
-          LANE(h, l) =
-              lattice_height(heights, (uint)ILANE(at, l), (uint)ex, (uint)(ey * width), w00, w10, w01, w11);
+          LANE(h, l) = lattice_height(heights, (uint)ILANE(at, l), (uint)ILANE(right, l),
+                                      (uint)ILANE(down, l), w00, w10, w01, w11);
       }
 #if HFVIS_HAS_NODATA
       const lane_int valid = ok & !isnan(h);
@@ -351,7 +360,7 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
       lane_int deeper = stack + (n - 3) * entry;  // entry n - 3, below `below`
       while (ANY_LANE(popping)) {
         lane_float next_h, next_p;
-        #pragma unroll
+#pragma unroll
         for (int l = 0; l < HFVIS_LANES; ++l) {
           const int k = max(ILANE(deeper, l), ILANE(stack, l));
           LANE(next_h, l) = stacks[k];
@@ -371,7 +380,7 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
         deeper -= entry;
       }
       const lane_int push = stack + n * entry;
-      #pragma unroll
+#pragma unroll
       for (int l = 0; l < HFVIS_LANES; ++l) {
         if (ILANE(valid, l)) {
           stacks[ILANE(push, l)] = LANE(h, l);
@@ -400,8 +409,8 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
     const lane_int nodata = 0;
 #endif
     emit_lanes(live, r * width + c, nodata, has_far | has_near, select(rise, near, use_near),
-               select(ground, (lane_float)period_ground, use_near), distance, outputs, normals, angles, distances,
-               svf_sum, ao_sum);
+               select(ground, (lane_float)period_ground, use_near), distance, outputs, normals, angles,
+               distances, svf_sum, ao_sum);
   }
 }
 
@@ -415,8 +424,9 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 // pixel's own exit are masked. Global size: (W, H) rounded up to the local size (the tile).
 __kernel void horizon_naive(__global const float* heights, int width, int height, float dir_x, float dir_y,
                             float step_length, float ground_per_pixel, float cos_azimuth, float sin_azimuth,
-                            float weight, float swath, uint plane, __global const float4* normals, __global float* angles,
-                            __global float* distances, __global float* svf_sum, __global float* ao_sum) {
+                            float weight, float swath, uint plane, __global const float4* normals,
+                            __global float* angles, __global float* distances, __global float* svf_sum,
+                            __global float* ao_sum) {
   int c = get_global_id(0), r = get_global_id(1);
   int c_lo = get_group_id(0) * get_local_size(0), r_lo = get_group_id(1) * get_local_size(1);
   int c_hi = min(c_lo + (int)get_local_size(0), width) - 1;
@@ -426,8 +436,12 @@ __kernel void horizon_naive(__global const float* heights, int width, int height
   const uint pixel = (uint)(rr * width + cc);
   const float h = heights[pixel];
   const float far = (float)(width + height);
-  float reach_x = dir_x > 0.0f ? ((float)(width - 1) - (float)c_lo) / dir_x : dir_x < 0.0f ? (float)c_hi / -dir_x : far;
-  float reach_y = dir_y > 0.0f ? ((float)(height - 1) - (float)r_lo) / dir_y : dir_y < 0.0f ? (float)r_hi / -dir_y : far;
+  float reach_x = dir_x > 0.0f   ? ((float)(width - 1) - (float)c_lo) / dir_x
+                  : dir_x < 0.0f ? (float)c_hi / -dir_x
+                                 : far;
+  float reach_y = dir_y > 0.0f   ? ((float)(height - 1) - (float)r_lo) / dir_y
+                  : dir_y < 0.0f ? (float)r_hi / -dir_y
+                                 : far;
   const int steps = (int)(hf_min(hf_min(reach_x, reach_y), far) / step_length) + 1;
   float best_rise = 0.0f;  // height gain to the steepest sample so far
   int best_step = 0;       // its step, 0 = none yet
@@ -447,6 +461,6 @@ __kernel void horizon_naive(__global const float* heights, int width, int height
   const float distance = best_step > 0 ? ground : 0.0f;
   const DirectionOutputs outputs = {cos_azimuth, sin_azimuth, weight, swath, plane};
   if (valid)
-    emit_direction(pixel, isnan(h), best_step > 0, best_rise, ground, distance, outputs, normals, angles, distances,
-                   svf_sum, ao_sum);
+    emit_direction(pixel, isnan(h), best_step > 0, best_rise, ground, distance, outputs, normals, angles,
+                   distances, svf_sum, ao_sum);
 }
