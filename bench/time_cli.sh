@@ -49,6 +49,17 @@ done
 echo "device: $("$bench" run "$data/fractal_64.exr" -k 1 --reps 1 | sed -n 's/.* on \(.*\) (\([0-9]*\) compute units)$/\1, \2 compute units/p')"
 echo "commit: $(git -C "$root" rev-parse --short HEAD 2> /dev/null || echo unknown), $(date -u +%Y-%m-%dT%H:%M:%SZ)," \
   "load average $(cut -d' ' -f1-3 /proc/loadavg)"
+# Start-up alone (the dynamic loader, no OpenCL): the min of 5 runs of `hfvis --help`.
+if [[ $use_cli == 1 ]]; then
+  startup=9999
+  for ((i = 0; i < 5; ++i)); do
+    start=$(date +%s.%N)
+    "$cli" --help > /dev/null
+    end=$(date +%s.%N)
+    startup=$(echo "t = $end - $start; if (t < $startup) t else $startup" | bc -l)
+  done
+  printf 'start-up: hfvis --help takes %.3f s (min of 5 runs)\n' "$startup"
+fi
 declare -A best
 for method in sweep naive; do
   if [[ $use_cli == 1 ]]; then
