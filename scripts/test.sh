@@ -1,8 +1,15 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds, and runs the whole test suite (CTest + GoogleTest).
+# Installs what is missing, builds, runs the whole test suite (CTest + GoogleTest), then
+# installs hfvis into build/install and builds and runs examples/ against that package, as a
+# downstream project would (find_package(hfvis CONFIG), no source tree).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 bash scripts/build.sh
-cd build
-ctest --output-on-failure -j "$(nproc)"
+(cd build && ctest --output-on-failure -j "$(nproc)")
+echo "== examples/ against the installed package (build/install)"
+rm -rf build/install build/examples
+cmake --install build --prefix "$PWD/build/install" > /dev/null
+cmake -S examples -B build/examples -DCMAKE_PREFIX_PATH="$PWD/build/install" > /dev/null
+cmake --build build/examples -j "$(nproc)" > /dev/null
+build/examples/sky_view_factor

@@ -1,0 +1,29 @@
+// hfvis/hfvis.hpp: everything a user of the library calls, in one include.
+//
+//   hfvis/version.hpp          HFVIS_VERSION_STRING, versionString()
+//   hfvis/errors.hpp           the exceptions every call may throw
+//   hfvis/device.hpp           listDevices(), ComputeContext
+//   hfvis/height_field.hpp     HeightField (heights, cell size, nodata)
+//   hfvis/sweep_options.hpp    directions, samples per unit, memory budget, progress
+//   hfvis/horizon.hpp          computeHorizons: horizon angles and distances, sky-view factor,
+//                              ambient occlusion
+//   hfvis/horizon_lists.hpp    the visibility horizons of chosen receivers
+//   hfvis/intervisibility.hpp  computeIntervisibility: visible counts and areas (hull tree)
+//   hfvis/bounce.hpp           one diffuse bounce over the visible surface
+//   hfvis/image_io.hpp         reading height fields, writing float EXRs and PNG previews
+//
+// The scalar references of the kernels (hfvis/reference.hpp,
+// hfvis/intervisibility_reference.hpp) and the synthetic test fields
+// (hfvis/synthetic_fields.hpp) serve the tests and the benchmark and are not installed.
+#pragma once
+
+#include "hfvis/bounce.hpp"
+#include "hfvis/device.hpp"
+#include "hfvis/errors.hpp"
+#include "hfvis/height_field.hpp"
+#include "hfvis/horizon.hpp"
+#include "hfvis/horizon_lists.hpp"
+#include "hfvis/image_io.hpp"
+#include "hfvis/intervisibility.hpp"
+#include "hfvis/sweep_options.hpp"
+#include "hfvis/version.hpp"
