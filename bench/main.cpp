@@ -141,7 +141,7 @@ int runOne(Arguments& args) {
   policy.min_reps = policy.max_reps = static_cast<int>(number(args.get("--reps", "3"), "--reps"));
   args.rejectUnused();
   const HeightField field = readHeightField(args.positional()[0]);
-  const ComputeContext context = ComputeContext::create();
+  const ComputeContext context = ComputeContext::create(ContextOptions::fromEnvironment());
   const Measured m = measureMethod(context, field, spec, policy);
   const double pd = static_cast<double>(field.pixelCount()) * spec.directions;
   const int cores = std::max(1, context.device().compute_units);
@@ -177,7 +177,7 @@ int runVisibilityOne(Arguments& args) {
   policy.min_reps = policy.max_reps = static_cast<int>(number(args.get("--reps", "3"), "--reps"));
   args.rejectUnused();
   const HeightField field = readHeightField(args.positional()[0]);
-  const ComputeContext context = ComputeContext::create();
+  const ComputeContext context = ComputeContext::create(ContextOptions::fromEnvironment());
   IntervisibilityOutputs outputs;
   outputs.visible_count = true;
   const Timing t =
@@ -228,7 +228,7 @@ int main(int argc, char** argv) {
       if (options.out_dir.empty()) throw Usage("suite needs --out DIR");
       if (options.mode != "tiny" && (options.data_dir.empty() || options.dem_path.empty()))
         throw Usage("suite needs --data DIR and --dem FILE (bench/run_report.sh passes both)");
-      const ComputeContext context = ComputeContext::create();
+      const ComputeContext context = ComputeContext::create(ContextOptions::fromEnvironment());
       return command == "suite" ? runSuite(context, options) : runVisibilitySuite(context, options);
     }
     if (command == "run") return runOne(args);
@@ -248,7 +248,7 @@ int main(int argc, char** argv) {
     }
     if (command == "vectorize-run") {
       const std::string which = args.positional().empty() ? "all" : args.positional()[0];
-      return runKernelsOnce(ComputeContext::create(), which);
+      return runKernelsOnce(ComputeContext::create(ContextOptions::fromEnvironment()), which);
     }
     if (command == "-h" || command == "--help") {
       std::printf("%s", kUsage);

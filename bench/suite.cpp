@@ -569,7 +569,7 @@ class Suite {
 // Source lines (1-based) of `file` as embedded; for naming the loops PoCL remarks on.
 std::vector<std::string> embeddedLines(const std::string& file) {
   std::string include_dir;
-  std::istringstream in(detail::kernelSource(file, &include_dir));
+  std::istringstream in(detail::kernelSource(file, "", &include_dir));
   std::vector<std::string> lines;
   for (std::string line; std::getline(in, line);) lines.push_back(line);
   return lines;

@@ -336,6 +336,14 @@ void writeTextFile(const std::string& path, const std::string& text) {
   if (!out) throw IoError(path, std::string("cannot write: ") + std::strerror(errno));
 }
 
+// The context of a run: the HFVIS_* environment variables (ContextOptions::fromEnvironment),
+// --device taking precedence over HFVIS_DEVICE.
+ComputeContext contextFor(const RunArguments& run) {
+  ContextOptions options = ContextOptions::fromEnvironment();
+  if (!run.device.empty()) options.device = run.device;
+  return ComputeContext::create(options);
+}
+
 }  // namespace
 
 int runDevices() {
@@ -345,7 +353,7 @@ int runDevices() {
   int automatic = -1;
   std::string automatic_error;
   try {
-    automatic = ComputeContext::create("").device().index;
+    automatic = ComputeContext::create(ContextOptions::fromEnvironment()).device().index;
   } catch (const Error& error) {
     automatic_error = error.what();
   }
@@ -389,7 +397,7 @@ int runCompute(Command command, const RunArguments& run) {
   for (const std::string& path : outputPaths(run)) requireOutputLocation(path);
 
   const HeightField field = readValidField(run);
-  const ComputeContext context = ComputeContext::create(run.device);
+  const ComputeContext context = contextFor(run);
   const DeviceInfo& device = context.device();
 
   HorizonOptions options = horizonOptions(run);
@@ -470,7 +478,7 @@ int runCompute(Command command, const RunArguments& run) {
 int runViewCount(const RunArguments& run) {
   for (const std::string& path : outputPaths(run)) requireOutputLocation(path);
   const HeightField field = readValidField(run);
-  const ComputeContext context = ComputeContext::create(run.device);
+  const ComputeContext context = contextFor(run);
   const DeviceInfo& device = context.device();
 
   IntervisibilityOptions options = intervisibilityOptions(run);
@@ -594,7 +602,7 @@ int runBounce(const RunArguments& run) {
     throw Error(run.radiance + ": " + error.what());
   }
 
-  const ComputeContext context = ComputeContext::create(run.device);
+  const ComputeContext context = contextFor(run);
   const DeviceInfo& device = context.device();
   BounceOptions options = bounceOptions(run);
   Progress progress(run.quiet);

@@ -18,7 +18,7 @@
 // The sky-view factor of every pixel (NaN at nodata). One context serves many calls: it
 // keeps the compiled kernels and the scratch buffers.
 std::vector<float> skyViewFactor(const hfvis::ComputeContext& context, const hfvis::HeightField& field) {
-  hfvis::HorizonOptions options;   // 64 directions, 1 sample per pixel length, ...
+  hfvis::HorizonOptions options;  // 64 directions, 1 sample per pixel length, ...
   hfvis::HorizonOutputs outputs;
   outputs.sky_view_factor = true;  // only what is asked for is computed and stored
   return hfvis::computeHorizons(context, field, options, outputs).sky_view_factor;
@@ -58,8 +58,8 @@ int main(int argc, char** argv) try {
   const float centre = skyViewFactor(context, field)[(field.height / 2) * field.width + field.width / 2];
   const double expected = 1.0 - slope / 180.0;  // 1 - alpha / pi
   const bool ok = std::fabs(centre - expected) < 2e-3;
-  std::printf("plane tilted by %.0f deg, centre pixel on %s: sky-view factor %.5f, closed form %.5f: %s\n", slope,
-              context.device().name.c_str(), centre, expected, ok ? "ok" : "WRONG");
+  std::printf("plane tilted by %.0f deg, centre pixel on %s: sky-view factor %.5f, closed form %.5f: %s\n",
+              slope, context.device().name.c_str(), centre, expected, ok ? "ok" : "WRONG");
   return ok ? 0 : 1;
 } catch (const std::exception& error) {
   std::fprintf(stderr, "sky_view_factor: %s\n", error.what());

@@ -75,7 +75,7 @@ void enqueueBouncePresample(ContextState& st, cl::Program& program, const Bounce
   presample.setArg(4, directions);
   presample.setArg(5, b.bounce_lines);
   const std::size_t lines = batch.maxLines(), steps = batch.maxSteps();
-  const bool line_major = lineMajorLayout(st.info);
+  const bool line_major = lineMajorLayout(st);
   st.launch(presample,
             cl::NDRange(roundUp(line_major ? steps : lines, kLineGroup),
                         roundUp(line_major ? lines : steps, kPresampleRows), batch.directions.size()),
@@ -92,7 +92,7 @@ BounceResult run(const ComputeContext& context, const HeightField& field, const 
   counts.visible_count = true;
   checkLineLimits(all, inputs.heights, counts);
   const TreeProgramFlags flags = bounceFlags(inputs, options.tree);
-  cl::Program program = st.program(treeProgramFile(flags), treeProgramOptions(flags, st.info));
+  cl::Program program = st.program(treeProgramFile(flags), treeProgramOptions(flags, st));
   const std::size_t plane = field.pixelCount();
 
   SweepMemory memory;
@@ -154,8 +154,8 @@ BounceLineView bounceLinesOnDevice(const ComputeContext& context, const HeightFi
   return translateOpenClErrors([&] {
     ContextState& st = context.state();
     const TreeProgramFlags flags = bounceFlags(inputs, tuning);
-    cl::Program program = st.program(treeProgramFile(flags), treeProgramOptions(flags, st.info));
-    const bool line_major = lineMajorLayout(st.info);
+    cl::Program program = st.program(treeProgramFile(flags), treeProgramOptions(flags, st));
+    const bool line_major = lineMajorLayout(st);
     const int channels = inputs.channels();
     const int stride = channels + kBounceNormalFloats;
     SweepBatch batch;

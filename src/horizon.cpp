@@ -133,7 +133,7 @@ class HorizonRun {
 
   HorizonResult run() {
     const PreparedHeights prepared = prepareHeights(field_);
-    lanes_ = sweepLanes(lineMajorLayout(st_.info));
+    lanes_ = sweepLanes(lineMajorLayout(st_));
     program_ = st_.program("horizon.cl", programOptions(outputs_, prepared.has_nodata, lanes_));
     const std::vector<RunDirection> directions = runDirectionsOf(field_, options_, outputs_);
     const RunPlan plan = planRun(field_, options_, outputs_, directions, st_.info);
@@ -215,7 +215,7 @@ class HorizonRun {
   }
 
   void launchSweep(const RunDirection& d, cl_uint plane_offset) {
-    const bool line_major = lineMajorLayout(st_.info);
+    const bool line_major = lineMajorLayout(st_);
     std::vector<LatticeLine> lines = d.lines;  // chunkLines sets the stack offsets
     if (lines.empty()) return;
     const std::vector<LineChunk> chunks = chunkLines(lines, d.samples.size(), stack_entries_, line_major);

@@ -20,14 +20,14 @@ const char* treeProgramFile(const TreeProgramFlags& flags) {
   return flags.bounce_channels > 0 ? "bounce.cl" : "intervisibility.cl";
 }
 
-std::string treeProgramOptions(const TreeProgramFlags& f, const DeviceInfo& device) {
+std::string treeProgramOptions(const TreeProgramFlags& f, const ContextState& st) {
   std::ostringstream s;
   s << "-DHFVIS_HAS_NODATA=" << f.has_nodata << " -DHFVIS_WANT_AREA=" << f.area
     << " -DHFVIS_WANT_STATS=" << f.stats << " -DHFVIS_WANT_ENTRY_STATS=" << f.entry_stats << " "
-    << layoutProgramOption(device);
+    << layoutProgramOption(st);
   s << " -DHFVIS_DEFERRED_WRITES=" << f.tuning.deferred_writes
-    << " -DHFVIS_REPLACEMENT_CHECK=" << f.tuning.replacement_check << " -DHFVIS_SAFE_ZONE=" << f.tuning.safe_zone
-    << " -DHFVIS_SAFE_ZONE_STEPS=" << f.tuning.safe_zone_steps;
+    << " -DHFVIS_REPLACEMENT_CHECK=" << f.tuning.replacement_check
+    << " -DHFVIS_SAFE_ZONE=" << f.tuning.safe_zone << " -DHFVIS_SAFE_ZONE_STEPS=" << f.tuning.safe_zone_steps;
   if (f.bounce_channels > 0) s << " -DHFVIS_WANT_BOUNCE=1 -DHFVIS_CHANNELS=" << f.bounce_channels;
   return s.str();
 }
@@ -90,7 +90,7 @@ IntervisibilityResult run(const ComputeContext& context, const HeightField& fiel
   flags.area = outputs.visible_area;
   flags.stats = outputs.statistics;
   flags.tuning = options.tree;
-  cl::Program program = st.program(treeProgramFile(flags), treeProgramOptions(flags, st.info));
+  cl::Program program = st.program(treeProgramFile(flags), treeProgramOptions(flags, st));
   const std::size_t plane = field.pixelCount();
   int max_lines = 0;
   for (const auto& d : all) max_lines = std::max(max_lines, d.n_lines);
@@ -199,8 +199,8 @@ IntervisibilityLines intervisibilityLinesOnDevice(const ComputeContext& context,
     TreeProgramFlags flags;
     flags.entry_stats = true;
     flags.tuning = tuning;
-    cl::Program program = st.program(treeProgramFile(flags), treeProgramOptions(flags, st.info));
-    const bool line_major = lineMajorLayout(st.info);
+    cl::Program program = st.program(treeProgramFile(flags), treeProgramOptions(flags, st));
+    const bool line_major = lineMajorLayout(st);
     SweepBatch batch;
     batch.directions = {direction};
     batch.directions[0].buffer_offset = 0;

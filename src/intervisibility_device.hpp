@@ -32,7 +32,7 @@ struct TreeProgramFlags {
 
 // The kernel file and the -D options of a program with these flags, for `device`.
 const char* treeProgramFile(const TreeProgramFlags& flags);
-std::string treeProgramOptions(const TreeProgramFlags& flags, const DeviceInfo& device);
+std::string treeProgramOptions(const TreeProgramFlags& flags, const ContextState& st);
 
 // The device buffers of one batch's sweep (sized for the largest batch); those a program
 // does not use may be minimal (deviceBuffer(st, 0)).

@@ -107,14 +107,14 @@ const FoundDevice& selectDevice(const std::vector<FoundDevice>& devices, const s
 
 }  // namespace
 
-std::string kernelSource(const std::string& file, std::string* include_dir) {
-  if (const char* dir = std::getenv("HFVIS_KERNEL_DIR"); dir && *dir) {
-    const std::string path = std::string(dir) + "/" + file;
+std::string kernelSource(const std::string& file, const std::string& kernel_dir, std::string* include_dir) {
+  if (!kernel_dir.empty()) {
+    const std::string path = kernel_dir + "/" + file;
     std::ifstream in(path);
-    if (!in) throw IoError(path, "cannot read kernel source (HFVIS_KERNEL_DIR is set)");
+    if (!in) throw IoError(path, "cannot read kernel source (a kernel directory is set)");
     std::ostringstream text;
     text << in.rdbuf();
-    *include_dir = dir;
+    *include_dir = kernel_dir;
     return text.str();
   }
   const auto& sources = embeddedKernelSources();
@@ -124,10 +124,10 @@ std::string kernelSource(const std::string& file, std::string* include_dir) {
   return it->second;
 }
 
-cl::Program ContextState::program(const std::string& file, const std::string& options) {
+cl::Program ContextState::program(const std::string& file, const std::string& defines) {
   std::string include_dir;
-  const std::string source = kernelSource(file, &include_dir);
-  std::string build_options = "-cl-std=CL1.2 " + options;
+  const std::string source = kernelSource(file, options.kernel_dir, &include_dir);
+  std::string build_options = "-cl-std=CL1.2 " + defines;
   if (info.correctly_rounded_divide) build_options += " -cl-fp32-correctly-rounded-divide-sqrt";
   if (!include_dir.empty()) build_options += " -I " + include_dir;
   const std::string key = file + '\n' + build_options + '\n' + source;
@@ -150,7 +150,7 @@ cl::Program ContextState::program(const std::string& file, const std::string& op
 }
 
 void ContextState::launch(const cl::Kernel& kernel, const cl::NDRange& global, const cl::NDRange& local) {
-  if (!profiling) {
+  if (!options.profile) {
     queue.enqueueNDRangeKernel(kernel, cl::NullRange, global, local);
     return;
   }
@@ -192,27 +192,48 @@ std::vector<DeviceInfo> listDevices() {
   return infos;
 }
 
-ComputeContext ComputeContext::create(const std::string& selector) {
-  std::string chosen = selector;
-  if (chosen.empty())
-    if (const char* env = std::getenv("HFVIS_DEVICE"); env) chosen = env;
+ContextOptions ContextOptions::fromEnvironment() {
+  auto variable = [](const char* name) {
+    const char* value = std::getenv(name);
+    return std::string(value ? value : "");
+  };
+  ContextOptions options;
+  options.device = variable("HFVIS_DEVICE");
+  options.kernel_dir = variable("HFVIS_KERNEL_DIR");
+  const std::string profile = variable("HFVIS_PROFILE");
+  if (profile != "" && profile != "0" && profile != "1")
+    throw InvalidArgument("HFVIS_PROFILE must be 1 (or 0) (got '" + profile + "')");
+  options.profile = profile == "1";
+  const std::string layout = variable("HFVIS_LINE_LAYOUT");
+  if (layout == "line") {
+    options.line_layout = LineLayout::LineMajor;
+  } else if (layout == "step") {
+    options.line_layout = LineLayout::StepMajor;
+  } else if (!layout.empty()) {
+    throw InvalidArgument("HFVIS_LINE_LAYOUT must be 'line' or 'step' (got '" + layout + "')");
+  }
+  return options;
+}
+
+ComputeContext ComputeContext::create(const ContextOptions& options) {
   const auto devices = detail::findDevices();
-  const auto& found = detail::selectDevice(devices, chosen);
+  const auto& found = detail::selectDevice(devices, options.device);
   ComputeContext context;
   context.state_ = std::make_shared<detail::ContextState>();
+  context.state_->options = options;
   detail::translateOpenClErrors([&] {
     context.state_->info = found.info;
     context.state_->device = found.device;
     context.state_->context = cl::Context(found.device);
-    const char* profile = std::getenv("HFVIS_PROFILE");
-    context.state_->profiling = profile && std::string(profile) == "1";
     context.state_->queue = cl::CommandQueue(context.state_->context, found.device,
-                                             context.state_->profiling ? CL_QUEUE_PROFILING_ENABLE : 0);
+                                             options.profile ? CL_QUEUE_PROFILING_ENABLE : 0);
     return 0;
   });
   return context;
 }
 
 const DeviceInfo& ComputeContext::device() const { return state_->info; }
+
+const ContextOptions& ComputeContext::options() const { return state_->options; }
 
 }  // namespace hfvis

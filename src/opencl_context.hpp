@@ -14,21 +14,21 @@
 namespace hfvis::detail {
 
 struct ContextState {
+  ContextOptions options;  // as the context was created
   DeviceInfo info;
   cl::Device device;
   cl::Context context;
   cl::CommandQueue queue;
 
-  // The program built from kernels/<file> with `options` (e.g. "-DHFVIS_WANT_AO=1"),
+  // The program built from kernels/<file> with `defines` (e.g. "-DHFVIS_WANT_AO=1"),
   // built once per (device, options, source) and cached. Throws KernelBuildError with the
   // device's build log.
-  cl::Program program(const std::string& file, const std::string& options);
+  cl::Program program(const std::string& file, const std::string& defines);
 
-  // Enqueues `kernel`. With HFVIS_PROFILE=1 in the environment (queue created with
-  // profiling), waits for it and adds its device time to kernel_seconds, which is printed
-  // to stderr when the context is destroyed: per-kernel statistics of a run.
+  // Enqueues `kernel`. With options.profile (queue created with profiling), waits for it
+  // and adds its device time to kernel_seconds, which is printed to stderr when the context
+  // is destroyed: per-kernel statistics of a run.
   void launch(const cl::Kernel& kernel, const cl::NDRange& global, const cl::NDRange& local);
-  bool profiling = false;
 
   // A device buffer of at least `bytes` (at most twice that) for `role` ("lattice
   // stacks", ...), kept between calls: large scratch buffers are allocated (and, on CPUs,
@@ -45,9 +45,9 @@ struct ContextState {
   std::map<std::string, std::pair<cl::Buffer, std::size_t>> buffers_;
 };
 
-// Kernel source by file name: embedded at build time, or read from the directory named
-// by HFVIS_KERNEL_DIR (development: edit kernels without rebuilding).
-std::string kernelSource(const std::string& file, std::string* include_dir);
+// Kernel source by file name: embedded at build time, or read from `kernel_dir` when it is
+// not empty (ContextOptions::kernel_dir; development: edit kernels without rebuilding).
+std::string kernelSource(const std::string& file, const std::string& kernel_dir, std::string* include_dir);
 
 // Runs `body`, turning cl::Error into OpenClError.
 template <typename Body>

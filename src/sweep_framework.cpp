@@ -2,7 +2,6 @@
 #include "sweep_framework.hpp"
 
 #include <algorithm>
-#include <cstdlib>
 #include <sstream>
 
 namespace hfvis::detail {
@@ -26,18 +25,20 @@ std::string mebibytes(std::size_t bytes) {
   return s.str();
 }
 
-bool lineMajorLayout(const DeviceInfo& device) {
-  if (const char* env = std::getenv("HFVIS_LINE_LAYOUT"); env && *env) {
-    const std::string layout = env;
-    if (layout == "line") return true;
-    if (layout == "step") return false;
-    throw InvalidArgument("HFVIS_LINE_LAYOUT must be 'line' or 'step' (got '" + layout + "')");
+bool lineMajorLayout(const ContextState& st) {
+  switch (st.options.line_layout) {
+    case LineLayout::LineMajor:
+      return true;
+    case LineLayout::StepMajor:
+      return false;
+    case LineLayout::Automatic:
+      break;
   }
-  return device.type == "CPU";
+  return st.info.type == "CPU";
 }
 
-std::string layoutProgramOption(const DeviceInfo& device) {
-  return std::string("-DHFVIS_LINE_MAJOR=") + (lineMajorLayout(device) ? "1" : "0");
+std::string layoutProgramOption(const ContextState& st) {
+  return std::string("-DHFVIS_LINE_MAJOR=") + (lineMajorLayout(st) ? "1" : "0");
 }
 
 std::size_t defaultMemoryBudget(const DeviceInfo& device) {
@@ -100,7 +101,7 @@ void enqueuePresample(ContextState& st, cl::Program& program, const cl::Buffer& 
   presample.setArg(3, directions);
   presample.setArg(4, lines);
   const std::size_t lines_count = batch.maxLines(), steps = batch.maxSteps();
-  const bool line_major = lineMajorLayout(st.info);
+  const bool line_major = lineMajorLayout(st);
   // Work-groups of kLineGroup x kPresampleRows: PoCL pays about a microsecond per
   // work-group, which one row per group made the larger part of this pass.
   st.launch(presample,

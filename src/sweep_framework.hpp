@@ -36,12 +36,11 @@ struct SweepMemory {
   std::size_t bytes_per_direction = 0;  // per direction besides its entries (output planes)
 };
 
-// Line-buffer layout for a device (HFVIS_LINE_MAJOR in kernels/sweep_framework.cl):
-// line-major on CPUs, step-major elsewhere; the environment variable
-// HFVIS_LINE_LAYOUT=line|step overrides (for benchmarks).
-bool lineMajorLayout(const DeviceInfo& device);
-// "-DHFVIS_LINE_MAJOR=0|1" for a device.
-std::string layoutProgramOption(const DeviceInfo& device);
+// Line-buffer layout of a context (HFVIS_LINE_MAJOR in kernels/sweep_framework.cl): its
+// options' line_layout, automatically line-major on CPUs and step-major elsewhere.
+bool lineMajorLayout(const ContextState& st);
+// "-DHFVIS_LINE_MAJOR=0|1" for a context.
+std::string layoutProgramOption(const ContextState& st);
 
 // Index of entry (line, step) of d, as line_entry() in the kernels.
 inline std::size_t lineEntry(const SweepDirection& d, int line, int step, bool line_major) {

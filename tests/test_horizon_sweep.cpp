@@ -168,7 +168,7 @@ TEST(HorizonSweepLine, DirectionsHonourTheToleranceAndQuadratureWeightsSumToOne)
 // Kernel results equal the scalar reference of the same algorithm, for both methods, in
 // both buffer layouts.
 void expectKernelMatchesReference(HorizonMethod method, double samples_per_unit) {
-  testing::forEachLayout([&] {
+  testing::forEachLayout([&](const ComputeContext& context) {
     for (const auto& name : syntheticFieldNames()) {
       for (auto [w, h] : awkwardSizes()) {
         SCOPED_TRACE(name + " " + std::to_string(w) + "x" + std::to_string(h));
@@ -183,7 +183,7 @@ void expectKernelMatchesReference(HorizonMethod method, double samples_per_unit)
           HorizonOutputs outputs;
           outputs.horizon_angles = outputs.horizon_distances = planes;
           outputs.sky_view_factor = outputs.ambient_occlusion = true;
-          const auto device = computeHorizons(testContext(), field, options, outputs);
+          const auto device = computeHorizons(context, field, options, outputs);
           const auto reference = referenceHorizons(field, options, outputs);
           const float tolerance = testing::divisionTolerance();
           EXPECT_EQ(device.azimuths, reference.azimuths);
@@ -227,22 +227,22 @@ TEST(HorizonKernels, SweepEqualsNaiveOnAxisDirections) {
 
 TEST(HorizonKernels, BatchingUnderATinyMemoryBudgetChangesNothing) {
   const HeightField field = makeSyntheticField("noise", 40, 41, 9);
-  testing::forEachLayout([&] {
+  testing::forEachLayout([&](const ComputeContext& context) {
     HorizonOptions options;
     options.directions = 9;
     const auto outputs = allOutputs();
-    const auto whole = computeHorizons(testContext(), field, options, outputs);
+    const auto whole = computeHorizons(context, field, options, outputs);
     int batches = 0;
     options.memory_budget_bytes = 100 * 1024;  // two directions per batch, stacks in chunks of lines
     options.progress = [&](int, int) { ++batches; };
-    const auto batched = computeHorizons(testContext(), field, options, outputs);
+    const auto batched = computeHorizons(context, field, options, outputs);
     EXPECT_GT(batches, 2);
     EXPECT_TRUE(nearlyEqual(batched.angles, whole.angles, 0.0f));
     EXPECT_TRUE(nearlyEqual(batched.distances, whole.distances, 0.0f));
     EXPECT_TRUE(nearlyEqual(batched.sky_view_factor, whole.sky_view_factor, 0.0f));
     EXPECT_TRUE(nearlyEqual(batched.ambient_occlusion, whole.ambient_occlusion, 0.0f));
     options.memory_budget_bytes = 1024;
-    EXPECT_THROW(computeHorizons(testContext(), field, options, outputs), MemoryBudgetError);
+    EXPECT_THROW(computeHorizons(context, field, options, outputs), MemoryBudgetError);
   });
 }
 

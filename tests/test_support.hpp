@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <map>
 #include <random>
 #include <string>
 #include <utility>
@@ -16,23 +17,29 @@
 
 namespace hfvis::testing {
 
-// The device every test runs on (HFVIS_DEVICE or automatic), created once.
-inline const ComputeContext& testContext() {
-  static const ComputeContext context = ComputeContext::create();
-  return context;
+// A context on the device every test runs on (HFVIS_DEVICE, else automatic: the HFVIS_*
+// variables as ContextOptions::fromEnvironment reads them), in `layout` (Automatic: the
+// environment's or the device's), created once per layout.
+inline const ComputeContext& testContext(LineLayout layout = LineLayout::Automatic) {
+  static std::map<LineLayout, ComputeContext> contexts;
+  auto it = contexts.find(layout);
+  if (it == contexts.end()) {
+    ContextOptions options = ContextOptions::fromEnvironment();
+    if (layout != LineLayout::Automatic) options.line_layout = layout;
+    it = contexts.emplace(layout, ComputeContext::create(options)).first;
+  }
+  return it->second;
 }
 
-// Runs `body` once in each line-buffer layout (HFVIS_LINE_LAYOUT=line, the CPU default,
-// then step, the GPU default): CI has no GPU, so the GPU layout is tested here. Programs are
-// cached per layout, so both really run.
+// Runs `body(context)` with a context in each line-buffer layout: line-major (the CPU
+// default; the horizon sweep in SIMD lanes), then step-major (the GPU default; one line per
+// work-item). CI has no GPU, so the GPU layout is tested here.
 template <typename Body>
 void forEachLayout(Body&& body) {
-  for (const char* layout : {"line", "step"}) {
-    SCOPED_TRACE(std::string("layout ") + layout);
-    setenv("HFVIS_LINE_LAYOUT", layout, 1);
-    body();
+  for (LineLayout layout : {LineLayout::LineMajor, LineLayout::StepMajor}) {
+    SCOPED_TRACE(layout == LineLayout::LineMajor ? "line-major layout" : "step-major layout");
+    body(testContext(layout));
   }
-  unsetenv("HFVIS_LINE_LAYOUT");
 }
 
 // Kernel-against-reference tolerance for values of order one computed through a division:

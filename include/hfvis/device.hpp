@@ -31,21 +31,51 @@ namespace detail {
 struct ContextState;
 }
 
-// An OpenCL context, queue and program cache on one device. Cheap to copy (shared). It
-// runs one operation at a time: use one context per thread. It keeps the scratch buffers of
-// its last horizon call (hull stacks, direction planes) for the next one; they count
-// against the device's memory, not against a later call's memory budget.
+// How the sweep kernels lay out their per-line buffers (hull stacks, line samples).
+enum class LineLayout {
+  Automatic,  // line-major on CPUs (and the horizon sweep in SIMD lanes), step-major elsewhere
+  LineMajor,  // each line's entries contiguous: a work-item walks its line in one stream
+  StepMajor,  // entries of one step of all lines contiguous: neighbouring work-items coalesce
+};
+
+// How a context is set up. The library reads no environment variable; the CLI and the
+// benchmark map theirs onto these with fromEnvironment().
+struct ContextOptions {
+  // The device: "" prefers a GPU, else the first CPU. Otherwise a device index ("1"), a type
+  // ("gpu", "cpu") or a case-insensitive substring of the platform or device name.
+  std::string device;
+  // Time every kernel launch on the device (each launch then waits for the one before) and
+  // print each kernel's total to stderr when the context is destroyed.
+  bool profile = false;
+  // Development: read the kernels (kernels/*.cl) from this directory instead of the copies
+  // embedded in the library, to try a kernel change without rebuilding. "" = embedded.
+  std::string kernel_dir;
+  // Every layout gives the same results; forcing one lets a CPU test the GPU layout.
+  LineLayout line_layout = LineLayout::Automatic;
+
+  // The options the HFVIS_* environment variables give: HFVIS_DEVICE (device), HFVIS_PROFILE=1
+  // (profile), HFVIS_KERNEL_DIR (kernel_dir), HFVIS_LINE_LAYOUT=line|step (line_layout).
+  // Throws InvalidArgument for another HFVIS_LINE_LAYOUT or HFVIS_PROFILE value.
+  static ContextOptions fromEnvironment();
+};
+
+// An OpenCL context, queue and program cache on one device. Cheap to copy (shared); never
+// empty: create() is the only way to get one. It runs one operation at a time: use one
+// context per thread. It keeps the scratch buffers of its last horizon call (hull stacks,
+// direction planes) for the next one; they count against the device's memory, not against a
+// later call's memory budget.
 class ComputeContext {
  public:
-  // selector: "" uses the HFVIS_DEVICE environment variable, else prefers a GPU, else
-  // the first CPU. Otherwise a device index ("1"), a type ("gpu", "cpu") or a
-  // case-insensitive substring of the platform or device name.
-  static ComputeContext create(const std::string& selector = "");
+  // Throws NoDeviceError when no OpenCL platform is installed or no device matches
+  // options.device (the message lists the devices).
+  static ComputeContext create(const ContextOptions& options = {});
 
   const DeviceInfo& device() const;
+  const ContextOptions& options() const;
   detail::ContextState& state() const { return *state_; }
 
  private:
+  ComputeContext() = default;
   std::shared_ptr<detail::ContextState> state_;
 };
 

@@ -1,0 +1,114 @@
+// test_context.cpp: ContextOptions and ComputeContext: the library reads no environment
+// variable itself; fromEnvironment() maps HFVIS_* onto options; a context is never empty.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <string>
+#include <type_traits>
+
+#include "hfvis/errors.hpp"
+#include "hfvis/horizon.hpp"
+#include "hfvis/synthetic_fields.hpp"
+#include "test_support.hpp"
+
+namespace hfvis {
+namespace {
+
+// Sets the environment variables for one test and restores them after.
+class ScopedEnvironment {
+ public:
+  void set(const char* name, const char* value) {
+    const char* old = std::getenv(name);
+    saved_.push_back({name, old ? std::string(old) : std::string(), old != nullptr});
+    setenv(name, value, 1);
+  }
+  ~ScopedEnvironment() {
+    for (auto it = saved_.rbegin(); it != saved_.rend(); ++it) {
+      if (it->had) {
+        setenv(it->name.c_str(), it->value.c_str(), 1);
+      } else {
+        unsetenv(it->name.c_str());
+      }
+    }
+  }
+
+ private:
+  struct Saved {
+    std::string name, value;
+    bool had;
+  };
+  std::vector<Saved> saved_;
+};
+
+static_assert(!std::is_default_constructible_v<ComputeContext>, "a ComputeContext comes only from create()");
+
+TEST(ContextOptions, FromEnvironmentReadsEachVariable) {
+  ScopedEnvironment env;
+  env.set("HFVIS_DEVICE", "cpu");
+  env.set("HFVIS_PROFILE", "1");
+  env.set("HFVIS_KERNEL_DIR", "/some/kernels");
+  env.set("HFVIS_LINE_LAYOUT", "step");
+  const ContextOptions options = ContextOptions::fromEnvironment();
+  EXPECT_EQ(options.device, "cpu");
+  EXPECT_TRUE(options.profile);
+  EXPECT_EQ(options.kernel_dir, "/some/kernels");
+  EXPECT_EQ(options.line_layout, LineLayout::StepMajor);
+  env.set("HFVIS_LINE_LAYOUT", "line");
+  env.set("HFVIS_PROFILE", "0");
+  EXPECT_EQ(ContextOptions::fromEnvironment().line_layout, LineLayout::LineMajor);
+  EXPECT_FALSE(ContextOptions::fromEnvironment().profile);
+}
+
+TEST(ContextOptions, FromEnvironmentRefusesBadValues) {
+  ScopedEnvironment env;
+  env.set("HFVIS_LINE_LAYOUT", "diagonal");
+  EXPECT_THROW(ContextOptions::fromEnvironment(), InvalidArgument);
+  env.set("HFVIS_LINE_LAYOUT", "");
+  env.set("HFVIS_PROFILE", "yes");
+  EXPECT_THROW(ContextOptions::fromEnvironment(), InvalidArgument);
+}
+
+// The library itself ignores the environment: a variable that would break the run changes
+// nothing for a context created from explicit options.
+TEST(ComputeContext, IgnoresTheEnvironment) {
+  ContextOptions options;
+  options.device = testing::testContext().device().name;
+  ScopedEnvironment env;
+  env.set("HFVIS_KERNEL_DIR", "/nonexistent/kernel/dir");
+  env.set("HFVIS_LINE_LAYOUT", "diagonal");
+  env.set("HFVIS_DEVICE", "no such device");
+  const ComputeContext context = ComputeContext::create(options);
+  EXPECT_EQ(context.options().kernel_dir, "");
+  HorizonOptions horizon;
+  horizon.directions = 4;
+  HorizonOutputs outputs;
+  outputs.sky_view_factor = true;
+  const auto result = computeHorizons(context, makeSyntheticField("noise", 9, 7, 1), horizon, outputs);
+  EXPECT_EQ(result.sky_view_factor.size(), 63u);
+}
+
+TEST(ComputeContext, KernelDirectoryThatLacksTheKernelsIsAnIoError) {
+  ContextOptions options = ContextOptions::fromEnvironment();
+  options.kernel_dir = "/nonexistent/kernel/dir";
+  const ComputeContext context = ComputeContext::create(options);
+  HorizonOptions horizon;
+  horizon.directions = 4;
+  HorizonOutputs outputs;
+  outputs.sky_view_factor = true;
+  EXPECT_THROW(computeHorizons(context, makeSyntheticField("noise", 9, 7, 1), horizon, outputs), IoError);
+}
+
+TEST(ComputeContext, UnknownDeviceListsTheDevices) {
+  ContextOptions options;
+  options.device = "no device is called this";
+  try {
+    ComputeContext::create(options);
+    FAIL() << "a context on an unknown device";
+  } catch (const NoDeviceError& error) {
+    EXPECT_NE(std::string(error.what()).find(testing::testContext().device().name), std::string::npos)
+        << error.what();
+  }
+}
+
+}  // namespace
+}  // namespace hfvis
