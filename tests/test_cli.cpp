@@ -555,6 +555,99 @@ TEST_F(Cli, NaiveMethodAndOptionsRun) {
   EXPECT_EQ(horizons.spec.get_string_attribute("hfvis:cell_size_y"), "1");
 }
 
+// ---- options change the results as the conventions (README) say ----
+
+// On the ramp h = 0.5 col + 0.25 row (pixel units, cell size 1) an inner pixel's horizon
+// toward +columns (h000) is the ramp's slope along columns, toward +rows (h001) along rows:
+// atan(rise per ground unit). --z-scale multiplies the heights, --cell-size the ground.
+TEST_F(Cli, ZScaleAndCellSizeSetTheSlopes) {
+  const std::string ramp_field = ramp();
+  auto horizon = [&](const std::string& options) {
+    fs::remove(out("h.exr"));
+    const CliResult result = run("horizon " + shellQuoted(ramp_field) + " -o " + shellQuoted(out("h.exr")) +
+                                 " -k 4 --quiet " + options);
+    EXPECT_EQ(result.status, 0) << options << ": " << result.err;
+    const ReadBack h = readBack(out("h.exr"));
+    return std::make_pair(h.at(4, 6, 0), h.at(4, 6, 1));
+  };
+  const auto plain = horizon("");
+  EXPECT_NEAR(plain.first, std::atan(0.5), 1e-5);
+  EXPECT_NEAR(plain.second, std::atan(0.25), 1e-5);
+  const auto taller = horizon("--z-scale 2");
+  EXPECT_NEAR(taller.first, std::atan(1.0), 1e-5);
+  EXPECT_NEAR(taller.second, std::atan(0.5), 1e-5);
+  const auto wider = horizon("--cell-size 2,4");
+  EXPECT_NEAR(wider.first, std::atan(0.25), 1e-5);
+  EXPECT_NEAR(wider.second, std::atan(0.0625), 1e-5);
+  const auto square = horizon("--cell-size 2");  // one value: both axes
+  EXPECT_NEAR(square.first, std::atan(0.25), 1e-5);
+  EXPECT_NEAR(square.second, std::atan(0.125), 1e-5);
+}
+
+// --samples-per-unit S: the samples at S = 2 include those at S = 1 (the naive march's unit
+// steps; the sweep's grid crossings), so no horizon is lower, and on a bumpy field some
+// are higher (a peak between the unit samples).
+TEST_F(Cli, DenserSamplesNeverLowerAHorizon) {
+  const std::string bumps = writeField("bumps.exr", 24, 20, [](int col, int row) {
+    return static_cast<float>(3.0 * std::sin(1.7 * col) * std::cos(1.3 * row) + 0.2 * col);
+  });
+  for (const char* method : {"sweep", "naive"}) {
+    SCOPED_TRACE(method);
+    std::vector<ReadBack> results;
+    for (const char* spu : {"1", "2"}) {
+      fs::remove(out("h.exr"));
+      const CliResult result = run("horizon " + shellQuoted(bumps) + " -o " + shellQuoted(out("h.exr")) +
+                                   " -k 8 --quiet --method " + method + " --samples-per-unit " + spu);
+      ASSERT_EQ(result.status, 0) << result.err;
+      results.push_back(readBack(out("h.exr")));
+    }
+    ASSERT_EQ(results[0].pixels.size(), results[1].pixels.size());
+    int higher = 0;
+    for (std::size_t i = 0; i < results[0].pixels.size(); ++i) {
+      ASSERT_GE(results[1].pixels[i], results[0].pixels[i] - 1e-6f) << "entry " << i;
+      higher += results[1].pixels[i] > results[0].pixels[i] + 1e-4f;
+    }
+    EXPECT_GT(higher, 0);
+  }
+}
+
+// viewcount on a flat plane, K = 4 (the axes): every sample is visible, and a pixel's
+// rays along its row and column hold (W - 1) S + (H - 1) S samples at S samples per pixel
+// length. --lines-per-unit L puts L sweep lines per pixel length across each direction: the
+// pixel centres stay on lines, so the counts stay, while the line samples swept (--stats)
+// grow L-fold.
+TEST_F(Cli, SamplesAndLinesPerUnitInViewcount) {
+  const std::string plane = flat();  // 16 x 12
+  auto viewcount = [&](const std::string& options, std::string* stats) {
+    fs::remove(out("v.exr"));
+    const CliResult result =
+        run("viewcount " + shellQuoted(plane) + " -o " + shellQuoted(out("v.exr")) + " -k 4 --stats " + options);
+    EXPECT_EQ(result.status, 0) << options << ": " << result.err;
+    *stats = result.out;
+    return readBack(out("v.exr"));
+  };
+  auto lineSamples = [](const std::string& stats) {
+    const auto at = stats.find(" line samples");
+    const auto start = stats.rfind('(', at);
+    return at == std::string::npos || start == std::string::npos ? -1.0 : std::stod(stats.substr(start + 1));
+  };
+  std::string stats1, stats2, stats3;
+  const ReadBack base = viewcount("", &stats1);
+  const ReadBack denser = viewcount("--samples-per-unit 2", &stats2);
+  const ReadBack more_lines = viewcount("--lines-per-unit 2", &stats3);
+  for (int y = 0; y < 12; ++y) {
+    for (int x = 0; x < 16; ++x) {
+      ASSERT_EQ(base.at(x, y, 0), 26.0f) << x << "," << y;
+      ASSERT_EQ(denser.at(x, y, 0), 52.0f) << x << "," << y;
+      ASSERT_EQ(more_lines.at(x, y, 0), 26.0f) << x << "," << y;
+    }
+  }
+  const double samples1 = lineSamples(stats1), samples2 = lineSamples(stats2), samples3 = lineSamples(stats3);
+  ASSERT_GT(samples1, 0.0) << stats1;
+  EXPECT_NEAR(samples2 / samples1, 2.0, 0.15) << stats2;
+  EXPECT_NEAR(samples3 / samples1, 2.0, 0.15) << stats3;
+}
+
 TEST_F(Cli, BundledDemKeepsItsCellSize) {
   // The DEM stores its ground spacing (hfvis:cell_size_x/y); the output carries it on.
   const std::string dem = std::string(HFVIS_DATA_DIR) + "/jacksboro_fault_dem.exr";

@@ -513,8 +513,10 @@ TEST(IntervisibilityKernels, TreeEqualsNaiveOnAxisDirections) {
 // DEM): the totals over all pixels agree within 3 %, and the mean absolute difference per
 // pixel and direction is below 1.5 samples. On rough fields (i.i.d. noise, terraces, the
 // checkerboard bowl, the float-quantised tilted plane) interpolation smooths away exactly
-// the features that decide visibility, and totals differ by up to about 20 %: reported,
-// not bounded.
+// the features that decide visibility: there the bounds are what the interpolation gives
+// today (totals within 20 %, measured up to 17.6 % on the bowl; mean |diff| below 4
+// samples, measured 3.5), to catch a regression until receiver-exact trees (lines through
+// the pixel centres, as the horizon sweep's) remove the interpolation.
 TEST(IntervisibilityKernels, TreeNearNaiveOffAxis) {
   const HeightField fractal = readHeightField(std::string(HFVIS_DATA_DIR) + "/fractal_256.exr");
   for (const char* name : {"dome", "sine", "flat", "fractal", "tilted_plane", "noise", "terraces", "bowl"}) {
@@ -543,10 +545,8 @@ TEST(IntervisibilityKernels, TreeNearNaiveOffAxis) {
     std::printf("%-13s %-6s total tree %.0f naive %.0f (%+.2f %%), mean |diff| %.3f per pixel-direction\n",
                 name, smooth ? "smooth" : "rough", total_tree, total_naive,
                 100.0 * (total_tree - total_naive) / total_naive, per_direction);
-    if (smooth) {
-      EXPECT_NEAR(total_tree / total_naive, 1.0, 0.03);
-      EXPECT_LT(per_direction, 1.5);
-    }
+    EXPECT_NEAR(total_tree / total_naive, 1.0, smooth ? 0.03 : 0.2);
+    EXPECT_LT(per_direction, smooth ? 1.5 : 4.0);
   }
 }
 
