@@ -258,7 +258,7 @@ StackStats hullStackStatistics(const HeightField& field, int directions) {
     auto push = [&](float height, float here) {
       ++stats.samples;
       depth += static_cast<double>(stack.size());
-      // Algorithm 1 as hull_stack_step: pop while the entry below the top casts at least as
+      // Algorithm 1 as horizon_lattice runs it: pop while the entry below the top casts at least as
       // steep a slope on the sample as the top.
       while (stack.size() > 1) {
         const auto top = stack.back(), below = stack[stack.size() - 2];

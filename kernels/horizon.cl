@@ -83,8 +83,9 @@ __kernel void pixel_normals(__global const float* heights, int width, int height
 // (step-major layout) each work-item runs one line (HFVIS_LANES 1), so that neighbouring
 // work-items read neighbouring stack entries.
 // LANE(v, l) is lane l of v; comparisons give -1 in a vector lane and 1 in a scalar, so
-// masks are only combined with &, tested for nonzero and used by select(). any() compiles
-// to a test and branch per lane; any_lane packs the lanes' masks into one 64-bit word.
+// masks come only from comparisons, !, & and |, are tested for nonzero, and choose through
+// select() or ?: (both take -1 / 0 lanes and 1 / 0 scalars alike). any() compiles to a test
+// and branch per lane; any_lane packs the lanes' masks into one 64-bit word.
 #ifndef HFVIS_LANES
 #define HFVIS_LANES 1
 #endif
@@ -276,7 +277,7 @@ HFVIS_INLINE lane_float near_rise(__global const float* heights, int width, int 
 // the sample. Only the first period can reach outside the field (the others lie between two
 // receivers, inside it), so only it tests; samples outside the field or without height are
 // absent. Stack entry k of a line is (height, position along the line in pixels from its
-// far end) at stacks + 2 (line.w + k stride), the top two entries kept in registers as well;
+// far end) at stacks[line.w + k stride], the top two entries kept in registers as well;
 // the capacity is every sample of its periods. period_ground = period * ground_per_pixel, the
 // ground length of a period. Preconditions: lines of this launch only; stride 1
 // (line-major) or the launch's line count (step-major). Global size: ceil(n_lines /
@@ -285,7 +286,7 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
                               __global const int4* lines, int n_lines, __global const LatticeSample* samples,
                               int n_samples, int a, int b, float period, float ground_per_pixel,
                               float period_ground, float cos_azimuth, float sin_azimuth, float weight,
-                              float swath, uint plane, __global float* stacks, uint stride,
+                              float swath, uint plane, __global float2* stacks, uint stride,
                               __global const float4* normals, __global float* angles,
                               __global float* distances, __global float* svf_sum, __global float* ao_sum) {
   const int first = get_global_id(0) * HFVIS_LANES;
@@ -299,11 +300,11 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
     ILANE(c, l) = line.x;
     ILANE(r, l) = line.y;
     ILANE(receivers, l) = first + l < n_lines ? line.z : 0;
-    ILANE(stack, l) = 2 * line.w;
+    ILANE(stack, l) = line.w;
     trips = max(trips, ILANE(receivers, l));
   }
-  const int entry = 2 * (int)stride;  // floats between a line's consecutive stack entries
-  lane_int n = 0;                     // stack sizes
+  const int entry = (int)stride;  // between a line's consecutive stack entries
+  lane_int n = 0;                 // stack sizes
   // The top two entries are kept in registers as well (below: valid where n >= 2).
   lane_float top_h = 0.0f, top_p = 0.0f, below_h = 0.0f, below_p = 0.0f, rise = 0.0f, run = 0.0f;
   for (int i = 0; i < trips; ++i, c -= a, r -= b) {
@@ -331,7 +332,9 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
           LANE(h0, l) = heights[ILANE(at, l)];
           LANE(h1, l) = heights[ILANE(at_next, l)];
         }
-        h = w00 * h0 + (ex ? w10 : w01) * h1;
+        // The receiver (ex = ey = 0, weight 1) is its pixel's height as it is (1 h + 0 h would
+        // turn an infinite height into NaN).
+        h = ex + ey == 0 ? h0 : w00 * h0 + (ex ? w10 : w01) * h1;
 #if HFVIS_HAS_NODATA
 #pragma unroll
         for (int l = 0; l < HFVIS_LANES; ++l) {
@@ -363,8 +366,9 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 #pragma unroll
         for (int l = 0; l < HFVIS_LANES; ++l) {
           const int k = max(ILANE(deeper, l), ILANE(stack, l));
-          LANE(next_h, l) = stacks[k];
-          LANE(next_p, l) = stacks[k + 1];
+          const float2 e = stacks[k];
+          LANE(next_h, l) = e.x;
+          LANE(next_p, l) = e.y;
         }
         const lane_int pop = popping & (v2h * v1d >= v1h * v2d);
         v1h = select(v1h, v2h, pop);
@@ -383,8 +387,7 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 #pragma unroll
       for (int l = 0; l < HFVIS_LANES; ++l) {
         if (ILANE(valid, l)) {
-          stacks[ILANE(push, l)] = LANE(h, l);
-          stacks[ILANE(push, l) + 1] = here;
+          stacks[ILANE(push, l)] = (float2)(LANE(h, l), here);
         }
       }
       rise = select(rise, v1h, valid);

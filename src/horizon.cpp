@@ -21,9 +21,10 @@ namespace {
 constexpr std::size_t kStackEntryBytes = 2 * sizeof(float);  // (height, position)
 
 // Lines one work-item of horizon_lattice sweeps side by side (HFVIS_LANES): SIMD lanes
-// where a work-item runs on a CPU core (the line-major layout), one line per work-item on
-// GPUs, whose neighbouring work-items then read neighbouring stack entries.
-int sweepLanes(bool line_major) { return line_major ? 8 : 1; }
+// where a work-item runs on a CPU core in the line-major layout; one line per work-item on
+// GPUs (whatever the layout: a lane-wide work-item would run alone in its group there) and in
+// the step-major layout, whose neighbouring work-items read neighbouring stack entries.
+int sweepLanes(const ContextState& st) { return lineMajorLayout(st) && st.info.type == "CPU" ? 8 : 1; }
 
 std::string programOptions(const HorizonOutputs& outputs, bool has_nodata, int lanes) {
   std::ostringstream s;
@@ -133,7 +134,7 @@ class HorizonRun {
 
   HorizonResult run() {
     const PreparedHeights prepared = prepareHeights(field_);
-    lanes_ = sweepLanes(lineMajorLayout(st_));
+    lanes_ = sweepLanes(st_);
     program_ = st_.program("horizon.cl", programOptions(outputs_, prepared.has_nodata, lanes_));
     const std::vector<RunDirection> directions = runDirectionsOf(field_, options_, outputs_);
     const RunPlan plan = planRun(field_, options_, outputs_, directions, st_.info);

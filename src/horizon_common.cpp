@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <limits>
+#include <sstream>
 
 #include "fast_math.hpp"
 #include "hfvis/errors.hpp"
@@ -37,7 +38,16 @@ PreparedHeights prepareHeights(const HeightField& field) {
   for (std::size_t i = 0; i < field.heights.size(); ++i) {
     const float h = field.heights[i];
     if (std::isfinite(h)) {
-      prepared.heights[i] = static_cast<float>((static_cast<double>(h) - lowest) * field.z_scale);
+      const double offset = (static_cast<double>(h) - lowest) * field.z_scale;
+      // The kernels multiply height differences by distances in float: keep the products finite.
+      if (offset > kMaxPreparedHeight) {
+        std::ostringstream message;
+        message << "heights from " << lowest << " to " << h << " times the z-scale " << field.z_scale
+                << " rise more than " << kMaxPreparedHeight
+                << " above the lowest, beyond what the kernels' float arithmetic holds";
+        throw InvalidArgument(message.str());
+      }
+      prepared.heights[i] = static_cast<float>(offset);
     } else {
       prepared.heights[i] = std::numeric_limits<float>::quiet_NaN();
       prepared.has_nodata = true;

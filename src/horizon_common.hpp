@@ -11,7 +11,11 @@
 namespace hfvis::detail {
 
 // Heights as the kernels see them: (h - lowest finite height) * z_scale in float, so that
-// a plane at 8848 m keeps its millimetres; every non-finite height becomes NaN.
+// a plane at 8848 m keeps its millimetres; every non-finite height becomes NaN. Throws
+// InvalidArgument when a prepared height would exceed kMaxPreparedHeight: the kernels
+// multiply height differences by distances (up to 2^31 pixels) in float, which must stay
+// finite.
+constexpr double kMaxPreparedHeight = 1e28;
 struct PreparedHeights {
   std::vector<float> heights;
   bool has_nodata = false;

@@ -66,7 +66,7 @@ float ambientTerm(bool found, float rise, float run, Normal n, float cos_az, flo
   return n.z * weight * cos2 + swath * (0.5f * kPi - hfAtan(x) - x * cos2) * toward;
 }
 
-// What one direction contributes at one receiver, as emit_direction in the kernel.
+// What one direction contributes at one receiver, as emit_direction / emit_lanes in the kernel.
 struct DirectionOutputs {
   float cos_azimuth, sin_azimuth, weight;
   int k;  // the direction's plane

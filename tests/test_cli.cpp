@@ -366,7 +366,8 @@ TEST_F(Cli, AzimuthToleranceOnlyForHorizonAndInRange) {
   // The attribute lists the azimuths the sweep used, each within the tolerance of 360 k / 7.
   std::istringstream azimuths(readBack(out("o.exr")).spec.get_string_attribute("hfvis:azimuths_deg"));
   int k = 0;
-  for (std::string item; std::getline(azimuths, item, ','); ++k) EXPECT_NEAR(std::stod(item), 360.0 * k / 7, 5.0);
+  for (std::string item; std::getline(azimuths, item, ','); ++k)
+    EXPECT_NEAR(std::stod(item), 360.0 * k / 7, 5.0);
   EXPECT_EQ(k, 7);
 }
 
@@ -620,8 +621,8 @@ TEST_F(Cli, SamplesAndLinesPerUnitInViewcount) {
   const std::string plane = flat();  // 16 x 12
   auto viewcount = [&](const std::string& options, std::string* stats) {
     fs::remove(out("v.exr"));
-    const CliResult result =
-        run("viewcount " + shellQuoted(plane) + " -o " + shellQuoted(out("v.exr")) + " -k 4 --stats " + options);
+    const CliResult result = run("viewcount " + shellQuoted(plane) + " -o " + shellQuoted(out("v.exr")) +
+                                 " -k 4 --stats " + options);
     EXPECT_EQ(result.status, 0) << options << ": " << result.err;
     *stats = result.out;
     return readBack(out("v.exr"));
@@ -752,15 +753,16 @@ TEST_F(Cli, ViewcountHullTreeTuningsGiveTheSameCounts) {
     t_a.push_back(std::stod(image.spec.get_string_attribute("hfvis:stats_t_a")));
   }
   for (std::size_t i = 1; i < counts.size(); ++i) EXPECT_EQ(counts[i], counts[0]) << "tuning " << i;
-  EXPECT_EQ(t_a[1], t_a[0]);         // deferred writes: the same checks
-  EXPECT_LT(t_a[2], 0.9 * t_a[0]);   // the replacement check saves many
-  EXPECT_LE(t_a[3], t_a[2]);         // the safe zone skips walks
-  for (const char* tuning : {"plain", "deferred", "default", "zone"}) fs::remove(out(std::string(tuning) + ".exr"));
+  EXPECT_EQ(t_a[1], t_a[0]);        // deferred writes: the same checks
+  EXPECT_LT(t_a[2], 0.9 * t_a[0]);  // the replacement check saves many
+  EXPECT_LE(t_a[3], t_a[2]);        // the safe zone skips walks
+  for (const char* tuning : {"plain", "deferred", "default", "zone"})
+    fs::remove(out(std::string(tuning) + ".exr"));
   const std::string base = "viewcount " + shellQuoted(dem) + " -o " + shellQuoted(out("bad.exr"));
   expectFailure(run(base + " --hull-tree fast"), 2, "--hull-tree");
   expectFailure(run(base + " --hull-tree plain --method naive"), 2, "--hull-tree");
-  expectFailure(run("svf " + shellQuoted(dem) + " -o " + shellQuoted(out("bad.exr")) + " --hull-tree plain"), 2,
-                "--hull-tree");
+  expectFailure(run("svf " + shellQuoted(dem) + " -o " + shellQuoted(out("bad.exr")) + " --hull-tree plain"),
+                2, "--hull-tree");
 }
 
 TEST_F(Cli, ViewcountOptionsAreChecked) {

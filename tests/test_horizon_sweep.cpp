@@ -324,6 +324,24 @@ TEST(HorizonKernels, AzimuthOffsetRotatesTheDirections) {
   }
 }
 
+// Finite heights whose span overflows the kernels' float products are refused (an infinite
+// prepared height would turn hull comparisons into NaN).
+TEST(HorizonKernels, HeightSpanBeyondFloatArithmeticIsRefused) {
+  HeightField field = makeSyntheticField("noise", 5, 4, 1);
+  field.heights[0] = -3e38f;
+  field.heights[7] = 3e38f;
+  HorizonOptions options;
+  options.directions = 4;
+  HorizonOutputs outputs;
+  outputs.sky_view_factor = true;
+  EXPECT_THROW(computeHorizons(testContext(), field, options, outputs), InvalidArgument);
+  field.heights[0] = field.heights[7] = 1.0f;
+  field.z_scale = 1e30;
+  EXPECT_THROW(computeHorizons(testContext(), field, options, outputs), InvalidArgument);
+  field.z_scale = 1e20;  // heights of noise in [0, 1): spans up to 1e20, fine
+  EXPECT_NO_THROW(computeHorizons(testContext(), field, options, outputs));
+}
+
 TEST(HorizonKernels, InvalidOptionsAreRejectedBeforeLaunch) {
   const HeightField field = makeSyntheticField("flat", 5, 5);
   HorizonOptions options;

@@ -305,13 +305,14 @@ TEST(IntervisibilityLine, TreeEqualsBruteForceOnEveryHardCase) {
 TEST(IntervisibilityLine, TuningsChangeTheWorkNotTheResult) {
   const HeightField fractal = readHeightField(std::string(HFVIS_DATA_DIR) + "/fractal_256.exr");
   const HeightField fields[] = {fractal, makeSyntheticField("noise", 97, 61, 2),
-                                makeSyntheticField("dome", 80, 80, 1), makeSyntheticField("terraces", 64, 50, 1)};
+                                makeSyntheticField("dome", 80, 80, 1),
+                                makeSyntheticField("terraces", 64, 50, 1)};
   for (const HeightField& field : fields) {
     const auto prepared = detail::prepareHeights(field);
     for (double azimuth : {0.0, 0.7, 3.5}) {
       const auto d = detail::makeSweepDirection(field, azimuth, 1.0, 1.0);
-      const auto plain = detail::intervisibilityLinesOnDevice(testContext(), field, prepared.heights, d,
-                                                              kTunings[0].tuning);
+      const auto plain =
+          detail::intervisibilityLinesOnDevice(testContext(), field, prepared.heights, d, kTunings[0].tuning);
       HullTreeTuning replacement = kTunings[0].tuning;
       replacement.deferred_writes = replacement.replacement_check = true;
       const auto no_zone =
@@ -322,8 +323,8 @@ TEST(IntervisibilityLine, TuningsChangeTheWorkNotTheResult) {
       for (const NamedTuning& variant : kTunings) {
         SCOPED_TRACE(std::string(variant.name) + ", " + std::to_string(field.width) + "x" +
                      std::to_string(field.height) + ", azimuth " + std::to_string(azimuth));
-        const auto v = detail::intervisibilityLinesOnDevice(testContext(), field, prepared.heights, d,
-                                                            variant.tuning);
+        const auto v =
+            detail::intervisibilityLinesOnDevice(testContext(), field, prepared.heights, d, variant.tuning);
         ASSERT_TRUE(nearlyEqual(v.counts, plain.counts, 0.0f));
         ASSERT_TRUE(nearlyEqual(v.distance_sums, plain.distance_sums, 0.0f));
         ASSERT_EQ(v.horizons, plain.horizons);
@@ -373,9 +374,10 @@ TEST(IntervisibilityLine, TreeEqualsBruteForceOnLongRandomLines) {
     const HeightField field = fieldFrom(w, h, testing::randomLineHeights(kind, w, h, 100.0f, rng));
     for (double azimuth : {0.0, M_PI, 0.05}) {
       for (const NamedTuning& variant : kTunings) {
-        SCOPED_TRACE("kind " + std::to_string(kind) + " azimuth " + std::to_string(azimuth) + ", " + variant.name);
-        expectTreeEqualsBruteForce(field, detail::makeSweepDirection(field, azimuth, 1.0, 1.0), true, &checked,
-                                   variant.tuning);
+        SCOPED_TRACE("kind " + std::to_string(kind) + " azimuth " + std::to_string(azimuth) + ", " +
+                     variant.name);
+        expectTreeEqualsBruteForce(field, detail::makeSweepDirection(field, azimuth, 1.0, 1.0), true,
+                                   &checked, variant.tuning);
         if (::testing::Test::HasFatalFailure()) return;
       }
     }
@@ -458,7 +460,8 @@ void expectKernelMatchesReference(IntervisibilityMethod method, double samples_p
       EXPECT_TRUE(nearlyEqual(device.visible_count, reference.visible_count, 1e-3f));
       EXPECT_TRUE(
           nearlyEqual(device.visible_area, reference.visible_area, areaTolerance(reference.visible_area)));
-      if (!tuning.safe_zone || testContext().device().correctly_rounded_divide)  // see expectTreeEqualsBruteForce
+      if (!tuning.safe_zone ||
+          testContext().device().correctly_rounded_divide)  // see expectTreeEqualsBruteForce
         expectStatisticsEqual(device.statistics, reference.statistics);
       EXPECT_EQ(device.statistics.lines_over_bound, 0u);
     }

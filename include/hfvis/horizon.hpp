@@ -14,7 +14,7 @@
 namespace hfvis {
 
 enum class HorizonMethod {
-  Sweep,  // convex-hull-stack sweep, one work-item per line (Timonen & Westerholm 2010)
+  Sweep,  // convex-hull-stack sweep along lines through the pixel centres (Timonen & Westerholm 2010)
   Naive,  // per-pixel ray march, bilinear samples: the O(N^3) baseline and oracle
 };
 
