@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds, runs the whole test suite (CTest + GoogleTest), then
 # installs hfvis into build/install and builds and runs examples/ against that package, as a
-# downstream project would (find_package(hfvis CONFIG), no source tree).
+# downstream project would (find_package(hfvis CONFIG), no source tree), and finally runs the
+# suite again built with AddressSanitizer and UndefinedBehaviorSanitizer (scripts/sanitize.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -13,3 +14,5 @@ cmake --install build --prefix "$PWD/build/install" > /dev/null
 cmake -S examples -B build/examples -DCMAKE_PREFIX_PATH="$PWD/build/install" > /dev/null
 cmake --build build/examples -j "$(nproc)" > /dev/null
 build/examples/sky_view_factor
+echo "== the test suite under AddressSanitizer and UndefinedBehaviorSanitizer (build-asan)"
+bash scripts/sanitize.sh
