@@ -145,6 +145,33 @@ std::vector<std::string> outputPaths(const RunArguments& run) {
   return paths;
 }
 
+// The same file, whether or not it exists yet (links and relative paths resolved).
+bool sameFile(const std::string& a, const std::string& b) {
+  std::error_code error;
+  if (fs::exists(a, error) && fs::exists(b, error)) return fs::equivalent(a, b, error);
+  return fs::weakly_canonical(a, error) == fs::weakly_canonical(b, error);
+}
+
+// Every output can be written, none is an input (an output never replaces an input), and no
+// two outputs are the same file (the second would replace the first). Checked before the
+// input is read.
+void requireOutputs(const RunArguments& run, const std::vector<std::string>& outputs) {
+  std::vector<std::string> inputs{run.input};
+  if (!run.radiance.empty()) inputs.push_back(run.radiance);
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    requireOutputLocation(outputs[i]);
+    for (const std::string& input : inputs) {
+      if (sameFile(outputs[i], input))
+        throw UsageError("output '" + outputs[i] + "' is the input '" + input +
+                         "': outputs never replace an input");
+    }
+    for (std::size_t j = 0; j < i; ++j) {
+      if (sameFile(outputs[i], outputs[j]))
+        throw UsageError("outputs '" + outputs[j] + "' and '" + outputs[i] + "' are the same file");
+    }
+  }
+}
+
 // Mean over the finite values (nodata pixels are NaN and do not count).
 double finiteMean(const std::vector<float>& values) {
   double sum = 0.0;
@@ -394,7 +421,7 @@ int runDevices() {
 }
 
 int runCompute(Command command, const RunArguments& run) {
-  for (const std::string& path : outputPaths(run)) requireOutputLocation(path);
+  requireOutputs(run, outputPaths(run));
 
   const HeightField field = readValidField(run);
   const ComputeContext context = contextFor(run);
@@ -476,7 +503,7 @@ int runCompute(Command command, const RunArguments& run) {
 }
 
 int runViewCount(const RunArguments& run) {
-  for (const std::string& path : outputPaths(run)) requireOutputLocation(path);
+  requireOutputs(run, outputPaths(run));
   const HeightField field = readValidField(run);
   const ComputeContext context = contextFor(run);
   const DeviceInfo& device = context.device();
@@ -543,7 +570,7 @@ int runViewCount(const RunArguments& run) {
 }
 
 int runHorizonLists(const RunArguments& run) {
-  requireOutputLocation(run.output);
+  requireOutputs(run, {run.output});
   const HeightField field = readValidField(run);
   for (const ReceiverPixel& p : run.receivers) {
     if (p.col >= field.width || p.row >= field.height) {
@@ -578,7 +605,7 @@ int runHorizonLists(const RunArguments& run) {
 }
 
 int runBounce(const RunArguments& run) {
-  for (const std::string& path : outputPaths(run)) requireOutputLocation(path);
+  requireOutputs(run, outputPaths(run));
   const HeightField field = readValidField(run);
   const ImageChannels radiance_image = readImage(run.radiance);
   if (radiance_image.width != field.width || radiance_image.height != field.height) {

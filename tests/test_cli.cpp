@@ -408,6 +408,37 @@ TEST_F(Cli, MissingOutputDirectory) {
   expectFailure(result, 1, "no/such/dir");
 }
 
+// An output never replaces an input: the same path, the same file through another path or a
+// symbolic link, or the bounce's radiance input; refused before anything is read or written.
+TEST_F(Cli, OutputNeverReplacesAnInput) {
+  const std::string field = ramp();
+  const std::string before = readText(field);
+  const std::string link = in("link.exr");
+  fs::create_symlink(field, link);
+  const std::string via_parent = (inputs() / ".." / "inputs" / "ramp.exr").string();
+  for (const std::string& output : {field, via_parent, link}) {
+    SCOPED_TRACE(output);
+    const CliResult result = run("svf " + shellQuoted(field) + " -o " + shellQuoted(output) + " -k 4");
+    EXPECT_EQ(result.status, 2) << result.err;
+    EXPECT_NE(result.err.find("outputs never replace an input"), std::string::npos) << result.err;
+    EXPECT_EQ(readText(field), before);
+  }
+  const CliResult preview = run("svf " + shellQuoted(field) + " -o " + shellQuoted(out("svf.exr")) +
+                                " --preview " + shellQuoted(field) + " -k 4");
+  EXPECT_EQ(preview.status, 2) << preview.err;
+  const std::string radiance = writeField("radiance.exr", 16, 12, [](int, int) { return 1.0f; });
+  const std::string radiance_before = readText(radiance);
+  const std::string radiance_link = in("radiance_link.exr");
+  fs::create_symlink(radiance, radiance_link);
+  const CliResult bounce = run("bounce " + shellQuoted(field) + " --radiance " + shellQuoted(radiance) +
+                               " -o " + shellQuoted(radiance_link) + " -k 4");
+  EXPECT_EQ(bounce.status, 2) << bounce.err;
+  EXPECT_NE(bounce.err.find("outputs never replace an input"), std::string::npos) << bounce.err;
+  EXPECT_EQ(readText(radiance), radiance_before);
+  EXPECT_EQ(readText(field), before);
+  EXPECT_TRUE(listDirectory(outputs()).empty());
+}
+
 TEST_F(Cli, FailedRunLeavesAnExistingOutputUntouched) {
   { std::ofstream(out("o.exr")) << "previous result"; }
   const CliResult result =
