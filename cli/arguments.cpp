@@ -127,8 +127,9 @@ int parseDirectionCount(const std::string& option, const std::string& text) {
   if (text.empty() || end != begin + text.size() || errno == ERANGE) {
     throw UsageError(option + ": expected a whole number of directions, got " + inQuotes(text));
   }
-  if (value < 1 || value > std::numeric_limits<int>::max()) {
-    throw UsageError(option + ": the number of directions must be at least 1, got " + inQuotes(text));
+  if (value < 1 || value > kMaxDirections) {
+    throw UsageError(option + ": the number of directions must be in 1 .. " + std::to_string(kMaxDirections) +
+                     ", got " + inQuotes(text));
   }
   return static_cast<int>(value);
 }

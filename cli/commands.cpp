@@ -155,11 +155,12 @@ bool sameFile(const std::string& a, const std::string& b) {
 // Every output can be written, none is an input (an output never replaces an input), and no
 // two outputs are the same file (the second would replace the first). Checked before the
 // input is read.
-void requireOutputs(const RunArguments& run, const std::vector<std::string>& outputs) {
+void requireOutputs(const RunArguments& run, const std::vector<std::string>& outputs, bool images = true) {
   std::vector<std::string> inputs{run.input};
   if (!run.radiance.empty()) inputs.push_back(run.radiance);
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     requireOutputLocation(outputs[i]);
+    if (images) requireImageWriter(outputs[i]);
     for (const std::string& input : inputs) {
       if (sameFile(outputs[i], input))
         throw UsageError("output '" + outputs[i] + "' is the input '" + input +
@@ -570,7 +571,7 @@ int runViewCount(const RunArguments& run) {
 }
 
 int runHorizonLists(const RunArguments& run) {
-  requireOutputs(run, {run.output});
+  requireOutputs(run, {run.output}, /*images=*/false);
   const HeightField field = readValidField(run);
   for (const ReceiverPixel& p : run.receivers) {
     if (p.col >= field.width || p.row >= field.height) {

@@ -410,6 +410,7 @@ class TemporaryFile {
 // of `spec.format`, at most `rows_per_chunk` rows at a time) to `path` atomically.
 template <typename Pixel, typename FillRows>
 void writeAtomically(const std::string& path, const OIIO::ImageSpec& spec, FillRows fill_rows) {
+  requireImageWriter(path);
   const fs::path target(path);
   if (target.filename().empty()) throw IoError(path, "not a file name");
   const fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
@@ -417,11 +418,9 @@ void writeAtomically(const std::string& path, const OIIO::ImageSpec& spec, FillR
   if (!fs::is_directory(dir, ec)) {
     throw IoError(path, "directory '" + dir.string() + "' does not exist");
   }
-  TemporaryFile temporary(temporaryPathFor(path));
+  TemporaryFile temporary(temporaryPathFor(path));  // same extension: the same writer
   std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create(temporary.path());
-  if (!out) {
-    throw IoError(path, withDetail("no image writer for this file extension", OIIO::geterror()));
-  }
+  if (!out) throw IoError(path, withDetail("no image writer for this file", OIIO::geterror()));
   if (!out->open(temporary.path(), spec)) {
     throw IoError(path, withDetail("cannot write the image", out->geterror()));
   }
@@ -546,6 +545,14 @@ ImageChannels readImage(const std::string& path) {
   }
   in->close();
   return image;
+}
+
+void requireImageWriter(const std::string& path) {
+  if (OIIO::ImageOutput::create(path)) return;
+  OIIO::geterror();  // clear OpenImageIO's message: this one says what to do instead
+  const std::string extension = fs::path(path).extension().string();
+  throw IoError(path, "no image writer for the extension '" + extension +
+                          "' (write .exr; .tif and .png also hold float or 16-bit images)");
 }
 
 void writeImage(const std::string& path, const ImageChannels& image) {

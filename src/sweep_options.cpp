@@ -14,9 +14,9 @@ double directionAzimuth(int k, const SweepOptions& options) {
 }
 
 void validate(const SweepOptions& options) {
-  if (options.directions < 1) {
-    throw InvalidArgument("the number of directions K must be at least 1 (got " +
-                          std::to_string(options.directions) + ")");
+  if (options.directions < 1 || options.directions > kMaxDirections) {
+    throw InvalidArgument("the number of directions K must be in 1 .. " + std::to_string(kMaxDirections) +
+                          " (got " + std::to_string(options.directions) + ")");
   }
   auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
   if (!positive(options.samples_per_unit) || options.samples_per_unit > 64.0) {

@@ -324,11 +324,20 @@ TEST_F(Cli, UnknownOption) {
       "--frobnicate");
 }
 
-TEST_F(Cli, ZeroDirections) {
-  const CliResult result =
-      run("horizon " + shellQuoted(ramp()) + " -o " + shellQuoted(out("o.exr")) + " -k 0");
-  expectFailure(result, 2, "-k");
-  EXPECT_NE(result.err.find("at least 1"), std::string::npos) << result.err;
+TEST_F(Cli, DirectionsOutOfRange) {
+  for (const char* k : {"0", "65537", "100000000"}) {
+    const CliResult result =
+        run("horizon " + shellQuoted(ramp()) + " -o " + shellQuoted(out("o.exr")) + " -k " + k);
+    expectFailure(result, 2, "-k");
+    EXPECT_NE(result.err.find("in 1 .. 65536"), std::string::npos) << result.err;
+  }
+}
+
+TEST_F(Cli, UnknownOutputFormatIsRefusedBeforeComputing) {
+  const CliResult result = run("svf " + shellQuoted(ramp()) + " -o " + shellQuoted(out("o.xyz")) + " -k 4");
+  expectFailure(result, 1, "o.xyz");
+  EXPECT_NE(result.err.find("no image writer for the extension '.xyz'"), std::string::npos) << result.err;
+  EXPECT_EQ(result.err.find("hfvis-tmp"), std::string::npos) << "names a temporary file: " << result.err;
 }
 
 TEST_F(Cli, NonNumericValues) {

@@ -347,6 +347,8 @@ TEST(HorizonKernels, InvalidOptionsAreRejectedBeforeLaunch) {
   HorizonOptions options;
   options.directions = 0;
   EXPECT_THROW(computeHorizons(testContext(), field, options, allOutputs()), InvalidArgument);
+  options.directions = kMaxDirections + 1;
+  EXPECT_THROW(computeHorizons(testContext(), field, options, allOutputs()), InvalidArgument);
   options.directions = 4;
   EXPECT_THROW(computeHorizons(testContext(), field, options, HorizonOutputs{}), InvalidArgument);
   options.samples_per_unit = 0.0;

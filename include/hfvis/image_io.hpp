@@ -42,6 +42,10 @@ struct ImageChannels {
 // pixels as their stored values, as readHeightField. Throws IoError as readHeightField.
 ImageChannels readImage(const std::string& path);
 
+// Throws IoError when no image writer handles the extension of `path` (nothing is created):
+// to refuse an output before computing it.
+void requireImageWriter(const std::string& path);
+
 // Writes an EXR (or any float format OpenImageIO writes, by extension) atomically: to a
 // temporary file beside `path`, renamed into place only when complete. Throws IoError.
 void writeImage(const std::string& path, const ImageChannels& image);

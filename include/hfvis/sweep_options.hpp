@@ -12,8 +12,12 @@
 
 namespace hfvis {
 
+// The most directions a run takes: 0.0055 degrees apart, far finer than a height field
+// resolves, and a bound that keeps a mistyped K from running for hours.
+constexpr int kMaxDirections = 65536;
+
 struct SweepOptions {
-  int directions = 64;                  // K >= 1
+  int directions = 64;                  // K, 1 .. kMaxDirections
   double azimuth_offset = 0.0;          // radians added to every phi_k
   double samples_per_unit = 1.0;        // height samples per pixel length along a line or ray, (0, 64]
   double lines_per_unit = 1.0;          // sweep lines per pixel length across the direction, (0, 64]

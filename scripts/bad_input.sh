@@ -1,0 +1,125 @@
+#!/usr/bin/env bash
+# Tries the CLI on hostile input and prints, as a Markdown table, what each case gets: the
+# exit status (0 success, 1 a run error, 2 a usage error), the first line of the error and
+# whether the run left the input intact and wrote no output. docs/BAD_INPUT.md holds this
+# table; the test BadInputTableIsCurrent regenerates it and fails when the two differ.
+#
+#   scripts/bad_input.sh [HFVIS]                   print the table (HFVIS default build/hfvis)
+#   scripts/bad_input.sh --check DOC.md [HFVIS]    compare with the table in DOC.md: every case,
+#                                                  command, status and the last column must match
+#                                                  (the error text is the program's, printed for
+#                                                  people; it may name device figures)
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+check=""
+if [[ ${1:-} == --check ]]; then
+  check=$(cd "$(dirname "$2")" && pwd)/$(basename "$2")
+  shift 2
+fi
+if [[ -n $check ]]; then
+  fresh=$(bash "$0" "$@")
+  # The CLI table: from its "| case | command" header to the first line not in the table.
+  columns() {
+    awk -F ' [|] ' '/^[|] case [|] command/ { on = 1 } on && !/^[|]/ { exit } on { print $1 " | " $2 " | " $3 " | " $NF }'
+  }
+  if ! diff <(columns < "$check") <(columns <<< "$fresh"); then
+    echo "bad_input.sh: $check is not what the CLI does now (< the document, > now); regenerate it:" >&2
+    echo "  scripts/bad_input.sh > table, and paste it into $check" >&2
+    exit 1
+  fi
+  empty=$(awk -F ' [|] ' '$3 != "0" && $3 != "status" && $3 != "---:" && $4 == ""' <<< "$fresh")
+  [[ -z $empty ]] || { echo "bad_input.sh: failures without an error message:" >&2; echo "$empty" >&2; exit 1; }
+  exit 0
+fi
+hfvis=$(cd "$(dirname "${1:-$root/build/hfvis}")" && pwd)/$(basename "${1:-$root/build/hfvis}")
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+cd "$work"
+
+# Inputs: a good field, and bad ones.
+cp "$root/data/sine_256.exr" field.exr
+printf 'not an image' > garbage.exr
+: > empty.exr
+head -c 1000 field.exr > truncated.exr
+mkdir -p folder.exr out
+python3 - << 'PY'
+import struct, zlib
+# A two-channel float EXR would need OpenEXR; a 16-bit two-channel PNG is written by hand.
+def png(path, w, h, channels, rows):
+    color = {1: 0, 2: 4, 3: 2, 4: 6}[channels]
+    raw = b"".join(b"\0" + b"".join(struct.pack(">H", v) for v in row) for row in rows)
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+    with open(path, "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 16, color, 0, 0, 0))
+                + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+png("two_channels.png", 4, 3, 2, [[1, 2] * 4 for _ in range(3)])
+PY
+sum_before=$(md5sum < field.exr)
+
+echo "| case | command | status | error (first line) | input intact, nothing written |"
+echo "| --- | --- | ---: | --- | --- |"
+# try CASE [VAR=VALUE] -- ARGS...: runs hfvis ARGS (with VAR=VALUE in its environment).
+try() {
+  local what=$1 env=$2; shift 3
+  rm -rf out/*
+  set +e
+  if [[ -n $env ]]; then env "$env" "$hfvis" "$@" > stdout.txt 2> stderr.txt < /dev/null; else
+    "$hfvis" "$@" > stdout.txt 2> stderr.txt < /dev/null; fi
+  local status=$?
+  set -e
+  local message
+  message=$(head -1 stderr.txt | sed 's/^hfvis: error: //; s/|/\\|/g')
+  [[ $status == 0 ]] && message="(none: it runs)"
+  local clean=yes
+  [[ "$(md5sum < field.exr)" == "$sum_before" ]] || clean="NO: input changed"
+  if [[ $status != 0 && -n "$(ls -A out)" ]]; then clean="NO: wrote $(ls -A out | tr '\n' ' ')"; fi
+  local shown="hfvis${*:+ $*}"
+  [[ -n $env ]] && shown="$env $shown"
+  echo "| $what | \`$shown\` | $status | $message | $clean |"
+}
+# Files.
+try "input missing" "" -- svf absent.exr -o out/o.exr
+try "input is a directory" "" -- svf folder.exr -o out/o.exr
+try "input empty" "" -- svf empty.exr -o out/o.exr
+try "input not an image" "" -- svf garbage.exr -o out/o.exr
+try "input truncated" "" -- svf truncated.exr -o out/o.exr
+try "two channels, none chosen" "" -- svf two_channels.png -o out/o.exr
+try "channel that is not there" "" -- svf field.exr -o out/o.exr --channel Z
+try "output directory missing" "" -- svf field.exr -o nowhere/o.exr
+try "output is a directory" "" -- svf field.exr -o out
+try "output is the input" "" -- svf field.exr -o field.exr
+try "output is the input by another path" "" -- svf field.exr -o ./out/../field.exr
+try "output format unknown" "" -- svf field.exr -o out/o.xyz
+try "preview not a PNG" "" -- svf field.exr -o out/o.exr --preview out/p.jpg
+# Arguments.
+try "no arguments" "" --
+try "unknown command" "" -- shade field.exr -o out/o.exr
+try "unknown option" "" -- svf field.exr -o out/o.exr --fast
+try "option without its value" "" -- svf field.exr -o out/o.exr -k
+try "no output" "" -- svf field.exr
+try "zero directions" "" -- svf field.exr -o out/o.exr -k 0
+try "negative directions" "" -- svf field.exr -o out/o.exr -k -3
+try "directions not a number" "" -- svf field.exr -o out/o.exr -k many
+try "directions beyond the limit" "" -- svf field.exr -o out/o.exr -k 100000000
+try "samples per unit zero" "" -- svf field.exr -o out/o.exr --samples-per-unit 0
+try "samples per unit NaN" "" -- svf field.exr -o out/o.exr --samples-per-unit nan
+try "samples per unit infinite" "" -- svf field.exr -o out/o.exr --samples-per-unit inf
+try "lines per unit for the horizon sweep" "" -- svf field.exr -o out/o.exr --lines-per-unit 2
+try "cell size zero" "" -- svf field.exr -o out/o.exr --cell-size 0
+try "cell size negative" "" -- svf field.exr -o out/o.exr --cell-size 1,-2
+try "cell size not a number" "" -- svf field.exr -o out/o.exr --cell-size 1,abc
+try "z-scale zero" "" -- svf field.exr -o out/o.exr --z-scale 0
+try "z-scale overflowing float" "" -- svf field.exr -o out/o.exr --z-scale 1e35
+try "azimuth tolerance too large" "" -- horizon field.exr -o out/o.exr --azimuth-tolerance 10
+try "azimuth tolerance for svf" "" -- svf field.exr -o out/o.exr --azimuth-tolerance 1
+try "distance output for svf" "" -- svf field.exr -o out/o.exr --distance-out out/d.exr
+try "unknown method" "" -- svf field.exr -o out/o.exr --method exact
+try "memory budget too small" "" -- horizon field.exr -o out/o.exr --memory-budget 0.001
+try "receiver outside the field" "" -- horizons field.exr --at 300,2 -o out/h.json
+try "receiver not a pair" "" -- horizons field.exr --at 3 -o out/h.json
+try "radiance of another size" "" -- bounce field.exr --radiance two_channels.png -o out/o.exr
+# Environment.
+try "HFVIS_LINE_LAYOUT not line or step" HFVIS_LINE_LAYOUT=diagonal -- svf field.exr -o out/o.exr
+try "HFVIS_PROFILE not 0 or 1" HFVIS_PROFILE=yes -- svf field.exr -o out/o.exr
+try "HFVIS_KERNEL_DIR without the kernels" HFVIS_KERNEL_DIR=/nonexistent -- svf field.exr -o out/o.exr

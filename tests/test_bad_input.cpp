@@ -1,0 +1,120 @@
+// test_bad_input.cpp: the library's side of docs/BAD_INPUT.md: each misuse of the API it
+// lists gets the exception it says, with a message that names the problem (the CLI's side is
+// the table that scripts/bad_input.sh checks).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <string>
+
+#include "hfvis/hfvis.hpp"
+#include "hfvis/synthetic_fields.hpp"
+#include "test_support.hpp"
+
+namespace hfvis {
+namespace {
+
+using testing::testContext;
+
+// Runs `call`, which must throw E with `words` in its message.
+template <typename E>
+void expectError(const std::function<void()>& call, const std::string& words) {
+  try {
+    call();
+    ADD_FAILURE() << "no error; expected one naming '" << words << "'";
+  } catch (const E& error) {
+    EXPECT_NE(std::string(error.what()).find(words), std::string::npos) << error.what();
+  } catch (const std::exception& error) {
+    ADD_FAILURE() << "another kind of error than expected: " << error.what();
+  }
+}
+
+HorizonOutputs svfOnly() {
+  HorizonOutputs outputs;
+  outputs.sky_view_factor = true;
+  return outputs;
+}
+
+void horizons(const HeightField& field, const HorizonOptions& options = {},
+              HorizonOutputs outputs = svfOnly()) {
+  computeHorizons(testContext(), field, options, outputs);
+}
+
+TEST(BadInput, Fields) {
+  const HeightField good = makeSyntheticField("noise", 9, 7, 1);
+  expectError<InvalidArgument>([] { horizons(HeightField{}); }, "empty");
+  HeightField short_of_heights = good;
+  short_of_heights.heights.pop_back();
+  expectError<InvalidArgument>([&] { horizons(short_of_heights); }, "holds");
+  for (double cell : {0.0, -1.0, std::nan("")}) {
+    HeightField field = good;
+    field.cell_size_y = cell;
+    expectError<InvalidArgument>([&] { horizons(field); }, "cell size");
+  }
+  HeightField flat_z = good;
+  flat_z.z_scale = 0.0;
+  expectError<InvalidArgument>([&] { horizons(flat_z); }, "z-scale");
+  HeightField holes = good;
+  for (float& h : holes.heights) h = std::numeric_limits<float>::quiet_NaN();
+  expectError<InvalidArgument>([&] { horizons(holes); }, "nodata");
+  HeightField towering = good;
+  towering.heights[3] = 3e38f;
+  towering.heights[4] = -3e38f;
+  expectError<InvalidArgument>([&] { horizons(towering); }, "float arithmetic");
+}
+
+TEST(BadInput, Options) {
+  const HeightField field = makeSyntheticField("noise", 9, 7, 1);
+  for (int k : {0, -5, kMaxDirections + 1}) {
+    HorizonOptions options;
+    options.directions = k;
+    expectError<InvalidArgument>([&] { horizons(field, options); }, "directions");
+  }
+  for (double spu : {0.0, -1.0, 65.0, std::nan("")}) {
+    HorizonOptions options;
+    options.samples_per_unit = spu;
+    expectError<InvalidArgument>([&] { horizons(field, options); }, "samples per unit");
+  }
+  HorizonOptions lines;
+  lines.lines_per_unit = 2.0;
+  expectError<InvalidArgument>([&] { horizons(field, lines); }, "lines per unit");
+  expectError<InvalidArgument>([&] { horizons(field, {}, HorizonOutputs{}); }, "output");
+  HorizonOptions budget;
+  budget.memory_budget_bytes = 16;
+  expectError<MemoryBudgetError>([&] { horizons(makeSyntheticField("noise", 64, 64, 1), budget); }, "budget");
+  IntervisibilityOptions naive;
+  naive.method = IntervisibilityMethod::Naive;
+  IntervisibilityOutputs statistics;
+  statistics.statistics = true;
+  expectError<InvalidArgument>([&] { computeIntervisibility(testContext(), field, naive, statistics); },
+                               "statistics");
+  ExitRadiance radiance;
+  radiance.width = 3;
+  radiance.height = 3;
+  radiance.channels = {std::vector<float>(9, 1.0f)};
+  expectError<InvalidArgument>([&] { computeBounce(testContext(), field, radiance, BounceOptions{}); },
+                               "one value per height");
+}
+
+TEST(BadInput, ContextsAndFiles) {
+  ContextOptions unknown;
+  unknown.device = "a device nobody has";
+  expectError<NoDeviceError>([&] { ComputeContext::create(unknown); }, "no OpenCL device matches");
+  ContextOptions no_kernels = ContextOptions::fromEnvironment();
+  no_kernels.kernel_dir = "/nonexistent/kernels";
+  const ComputeContext context = ComputeContext::create(no_kernels);
+  expectError<IoError>(
+      [&] { computeHorizons(context, makeSyntheticField("noise", 9, 7, 1), HorizonOptions{}, svfOnly()); },
+      "cannot read kernel source");
+  expectError<IoError>([] { readHeightField("/nonexistent/field.exr"); }, "no such file");
+  ImageChannels image;
+  image.width = image.height = 2;
+  image.names = {"Y"};
+  image.planes = {std::vector<float>(4, 0.0f)};
+  expectError<IoError>([&] { writeImage(std::string(HFVIS_TEST_TMP_DIR) + "/bad.xyz", image); },
+                       "no image writer");
+}
+
+}  // namespace
+}  // namespace hfvis
