@@ -420,9 +420,9 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 // Naive method (Timonen 2013, Sec. 1): for every pixel, march the ray in steps of
 // step_length pixels along (dir_x, dir_y), sample bilinearly and keep the steepest slope.
 // One direction per launch, its geometry passed as arguments (uniform for certain, no
-// per-step loads). The trip count is the same for the whole work-group (the longest ray of
-// the group's tile, in closed form because the exit distance separates into a column and a
-// row term), and a barrier ends every step: PoCL runs the work-items inside each step, the
+// per-step loads). The trip count is the same for the whole work-group (tile_reach: the
+// longest ray of the group's tile), and a barrier ends every step: PoCL runs the work-items
+// inside each step, the
 // one loop it vectorises (the march ran 5x faster that way on PoCL); samples past a
 // pixel's own exit are masked. Global size: (W, H) rounded up to the local size (the tile).
 __kernel void horizon_naive(__global const float* heights, int width, int height, float dir_x, float dir_y,
@@ -431,21 +431,11 @@ __kernel void horizon_naive(__global const float* heights, int width, int height
                             __global float* angles, __global float* distances, __global float* svf_sum,
                             __global float* ao_sum) {
   int c = get_global_id(0), r = get_global_id(1);
-  int c_lo = get_group_id(0) * get_local_size(0), r_lo = get_group_id(1) * get_local_size(1);
-  int c_hi = min(c_lo + (int)get_local_size(0), width) - 1;
-  int r_hi = min(r_lo + (int)get_local_size(1), height) - 1;
   int valid = c < width && r < height;
   int cc = min(c, width - 1), rr = min(r, height - 1);
   const uint pixel = (uint)(rr * width + cc);
   const float h = heights[pixel];
-  const float far = (float)(width + height);
-  float reach_x = dir_x > 0.0f   ? ((float)(width - 1) - (float)c_lo) / dir_x
-                  : dir_x < 0.0f ? (float)c_hi / -dir_x
-                                 : far;
-  float reach_y = dir_y > 0.0f   ? ((float)(height - 1) - (float)r_lo) / dir_y
-                  : dir_y < 0.0f ? (float)r_hi / -dir_y
-                                 : far;
-  const int steps = (int)(hf_min(hf_min(reach_x, reach_y), far) / step_length) + 1;
+  const int steps = (int)(tile_reach(dir_x, dir_y, width, height) / step_length) + 1;
   float best_rise = 0.0f;  // height gain to the steepest sample so far
   int best_step = 0;       // its step, 0 = none yet
   for (int i = 1; i <= steps; ++i) {

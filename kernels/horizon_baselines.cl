@@ -55,24 +55,6 @@ BASELINE_INLINE float bl_bilinear(__global const float* heights, int width, int 
   return top + fy * (bottom - top);
 }
 
-// How far (pixels along the direction) the longest ray of this work-group's tile runs
-// inside the field: the same for every work-item of the group, so loops bounded by it have
-// a uniform trip count and PoCL runs the group's work-items as vector lanes. The exit
-// distance separates into a column and a row term, so the worst case is a tile corner's.
-BASELINE_INLINE float bl_tile_reach(float dir_x, float dir_y, int width, int height) {
-  int c_lo = get_group_id(0) * get_local_size(0), r_lo = get_group_id(1) * get_local_size(1);
-  int c_hi = min(c_lo + (int)get_local_size(0), width) - 1;
-  int r_hi = min(r_lo + (int)get_local_size(1), height) - 1;
-  const float far = (float)(width + height);
-  float reach_x = dir_x > 0.0f ? ((float)(width - 1) - (float)c_lo) / dir_x
-                  : dir_x < 0.0f ? (float)c_hi / -dir_x
-                                 : far;
-  float reach_y = dir_y > 0.0f ? ((float)(height - 1) - (float)r_lo) / dir_y
-                  : dir_y < 0.0f ? (float)r_hi / -dir_y
-                                 : far;
-  return fmin(fmin(reach_x, reach_y), far);
-}
-
 // Keeps the steepest sample: rise / t >= best_rise / best_t decided without a division
 // (ties go to the farther sample); masked, never skipped, so all lanes run the same code.
 BASELINE_INLINE void bl_keep_steepest(float rise, float t, int inside, float* best_rise, float* best_t) {
@@ -124,7 +106,7 @@ __kernel void radius_march(__global const float* heights, int width, int height,
   int cc = min(c, width - 1), rr = min(r, height - 1);
   const uint pixel = (uint)(rr * width + cc);
   const float h = heights[pixel];
-  int steps = (int)(bl_tile_reach(dir_x, dir_y, width, height) * samples_per_unit) + 1;
+  int steps = (int)(tile_reach(dir_x, dir_y, width, height) * samples_per_unit) + 1;
 #if HFVIS_RADIUS_STEPS > 0
   steps = min(steps, HFVIS_RADIUS_STEPS);
 #endif
@@ -171,7 +153,7 @@ __kernel void pyramid_march(__global const float* heights, int width, int height
   const uint pixel = (uint)(rr * width + cc);
   const float h = heights[pixel];
   const float x0 = (float)cc, y0 = (float)rr;
-  const float reach = bl_tile_reach(dir_x, dir_y, width, height);
+  const float reach = tile_reach(dir_x, dir_y, width, height);
   float best_rise = 0.0f, best_t = 0.0f;
   const int near = min(HFVIS_PYRAMID_NEAR, (int)reach + 1);
   for (int n = 0; n < near; ++n) {

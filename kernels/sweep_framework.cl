@@ -108,6 +108,26 @@ HFVIS_INLINE void sweep_position(const SweepDirection d, int line, int step, flo
   *y = s * d.perp_y + t * d.dir_y;
 }
 
+// How far (pixels along the unit direction (dir_x, dir_y)) the longest ray of this
+// work-group's pixel tile runs inside the field: the same for every work-item of the group,
+// so loops bounded by it have a uniform trip count and PoCL runs the group's work-items as
+// vector lanes. The exit distance separates into a column and a row term, so the worst case
+// is a tile corner's. For the per-pixel marches, whose work-groups are pixel tiles.
+HFVIS_INLINE float tile_reach(float dir_x, float dir_y, int width, int height) {
+  const int c_lo = get_group_id(0) * get_local_size(0), r_lo = get_group_id(1) * get_local_size(1);
+  const int c_hi = min(c_lo + (int)get_local_size(0), width) - 1;
+  const int r_hi = min(r_lo + (int)get_local_size(1), height) - 1;
+  const float far = (float)(width + height);
+  const float reach_x = dir_x > 0.0f   ? ((float)(width - 1) - (float)c_lo) / dir_x
+                        : dir_x < 0.0f ? (float)c_hi / -dir_x
+                                       : far;
+  const float reach_y = dir_y > 0.0f   ? ((float)(height - 1) - (float)r_lo) / dir_y
+                        : dir_y < 0.0f ? (float)r_hi / -dir_y
+                                       : far;
+  const float reach = reach_x < reach_y ? reach_x : reach_y;  // no fmin: PoCL calls it in scalar code
+  return reach < far ? reach : far;
+}
+
 HFVIS_INLINE int inside_field(float x, float y, int width, int height) {
   return x >= -HFVIS_EDGE_EPS && x <= (float)(width - 1) + HFVIS_EDGE_EPS && y >= -HFVIS_EDGE_EPS &&
          y <= (float)(height - 1) + HFVIS_EDGE_EPS;
