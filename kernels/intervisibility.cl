@@ -235,7 +235,7 @@ inline int run_end(__global const float2* samples, uint stride, int start, int n
 // farther sample); it reaches down likewise toward its nearer neighbour. Each band adds
 // radiance * (G(upper) - G(lower)), G the wedge integral of the projected solid angle,
 // clipped below at the tangent elevation. Mirrored by BounceGather in
-// src/intervisibility_reference.cpp.
+// src/scalar_hull_tree.cpp.
 
 #if HFVIS_WANT_BOUNCE
 typedef struct {

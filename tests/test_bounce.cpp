@@ -12,6 +12,7 @@
 #include "bounce_internal.hpp"
 #include "chord_side.hpp"
 #include "hfvis/bounce.hpp"
+#include "hfvis/bounce_reference.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
 #include "hfvis/image_io.hpp"

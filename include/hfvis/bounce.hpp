@@ -82,9 +82,4 @@ void validate(const HeightField& field, const ExitRadiance& radiance);
 BounceResult computeBounce(const ComputeContext& context, const HeightField& field,
                            const ExitRadiance& radiance, const BounceOptions& options);
 
-// The scalar C++ reference of the same (same samples, same visible sets, same bands; the
-// kernels' transcendentals may differ in the last bits).
-BounceResult referenceBounce(const HeightField& field, const ExitRadiance& radiance,
-                             const BounceOptions& options);
-
 }  // namespace hfvis

@@ -12,9 +12,8 @@
 //   hfvis/bounce.hpp           one diffuse bounce over the visible surface
 //   hfvis/image_io.hpp         reading height fields, writing float EXRs and PNG previews
 //
-// The scalar references of the kernels (hfvis/reference.hpp,
-// hfvis/intervisibility_reference.hpp) and the synthetic test fields
-// (hfvis/synthetic_fields.hpp) serve the tests and the benchmark and are not installed.
+// The scalar references of the kernels and the synthetic test fields are in the test support
+// library (testing/, hfvis_testing), which is not installed.
 #pragma once
 
 #include "hfvis/bounce.hpp"

@@ -17,7 +17,8 @@ using Generator = std::function<float(int c, int r, int w, int h, std::mt19937& 
 const std::map<std::string, Generator>& generators() {
   static const std::map<std::string, Generator> table = {
       {"flat", [](int, int, int, int, std::mt19937&) { return 3.0f; }},
-      {"tilted_plane", [](int c, int, int, int, std::mt19937&) { return static_cast<float>(8848.0 + 0.001 * c); }},
+      {"tilted_plane",
+       [](int c, int, int, int, std::mt19937&) { return static_cast<float>(8848.0 + 0.001 * c); }},
       {"terraces",
        [](int c, int r, int, int, std::mt19937&) { return static_cast<float>((c / 4 + r / 7) % 5); }},
       {"cliff", [](int c, int, int w, int, std::mt19937&) { return c < w / 2 ? 0.0f : 1e6f; }},
@@ -25,10 +26,8 @@ const std::map<std::string, Generator>& generators() {
        [](int, int, int, int, std::mt19937& rng) {
          return std::uniform_int_distribution<int>(0, 16)(rng) == 0 ? 40.0f : 0.0f;
        }},
-      {"sine",
-       [](int c, int r, int, int, std::mt19937&) {
-         return static_cast<float>(4.0 * std::sin(c * 0.4) * std::sin(r * 0.3));
-       }},
+      {"sine", [](int c, int r, int, int,
+                  std::mt19937&) { return static_cast<float>(4.0 * std::sin(c * 0.4) * std::sin(r * 0.3)); }},
       {"bowl",
        [](int c, int r, int w, int h, std::mt19937&) {
          const double x = c - (w - 1) / 2.0, y = r - (h - 1) / 2.0;
@@ -40,8 +39,8 @@ const std::map<std::string, Generator>& generators() {
          const double x = c - (w - 1) / 2.0, y = r - (h - 1) / 2.0, rad = std::max(w, h) / 2.0;
          return static_cast<float>(std::sqrt(std::max(0.0, rad * rad - x * x - y * y)));
        }},
-      {"noise",
-       [](int, int, int, int, std::mt19937& rng) { return std::uniform_real_distribution<float>(0, 10)(rng); }},
+      {"noise", [](int, int, int, int,
+                   std::mt19937& rng) { return std::uniform_real_distribution<float>(0, 10)(rng); }},
       {"nan_holes",
        [](int c, int r, int, int, std::mt19937& rng) {
          const float h = std::uniform_real_distribution<float>(0, 5)(rng);
@@ -88,7 +87,8 @@ HeightField makeSyntheticField(const std::string& name, int width, int height, s
   field.heights.resize(field.pixelCount());
   std::mt19937 rng(seed);
   for (int r = 0; r < height; ++r)
-    for (int c = 0; c < width; ++c) field.heights[static_cast<std::size_t>(r) * width + c] = it->second(c, r, width, height, rng);
+    for (int c = 0; c < width; ++c)
+      field.heights[static_cast<std::size_t>(r) * width + c] = it->second(c, r, width, height, rng);
   return field;
 }
 

@@ -1,5 +1,6 @@
-// hfvis/synthetic_fields.hpp: the hard cases of DESIGN.md as generated height fields,
-// shared by the tests and the benchmark so both exercise the same inputs.
+// hfvis/synthetic_fields.hpp: the hard cases (README, Tests) as generated height fields,
+// shared by the tests and the benchmark so both exercise the same inputs (test support
+// library hfvis_testing; not installed).
 #pragma once
 
 #include <cstdint>

@@ -1,0 +1,175 @@
+// intervisibility_reference.cpp: the scalar reference of the intervisibility operation:
+// the presampling, the hull tree sweep (src/scalar_hull_tree.cpp, the mirror of the kernel's),
+// the reduction to pixels, and the naive visibility march, in the kernels' order, so every
+// per-sample result matches exactly.
+#include "hfvis/intervisibility_reference.hpp"
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include "chord_side.hpp"
+#include "hfvis/errors.hpp"
+#include "horizon_common.hpp"
+#include "intervisibility_internal.hpp"
+
+namespace hfvis {
+namespace detail {
+namespace {
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+// Per-pixel sums of one direction, as add_direction / accumulate_visible.
+struct PixelSums {
+  float count = 0.0f, area = 0.0f;
+  void add(const SweepDirection& d, float sector, float c, float distance_steps) {
+    const float ground = d.step_length * d.ground_per_pixel;
+    count += c;
+    area += sector * ground * ground * distance_steps;
+  }
+};
+
+void finish(IntervisibilityResult& result, const std::vector<PixelSums>& sums,
+            const std::vector<float>& heights) {
+  for (std::size_t p = 0; p < sums.size(); ++p) {
+    const bool nodata = std::isnan(heights[p]);
+    if (!result.visible_count.empty()) result.visible_count[p] = nodata ? kNaN : sums[p].count;
+    if (!result.visible_area.empty()) result.visible_area[p] = nodata ? kNaN : sums[p].area;
+  }
+}
+
+void sweepReference(const HeightField& field, const std::vector<float>& h,
+                    const IntervisibilityOptions& options, IntervisibilityResult& result) {
+  const auto directions = runDirections(field, options);
+  const float sector = intervisibilitySector(options);
+  std::vector<PixelSums> sums(field.pixelCount());
+  auto& stats = result.statistics;
+  for (const SweepDirection& d : directions) {
+    const IntervisibilityLines lines = referenceIntervisibilityLines(field, h, d, options.tree);
+    for (int j = 0; j < d.n_lines; ++j) {
+      std::uint64_t n = 0, m = 0, t = 0;
+      for (int i = 0; i < d.n_steps; ++i) {
+        const std::size_t e = static_cast<std::size_t>(i) * d.n_lines + j;
+        if (std::isnan(lines.samples[e])) continue;
+        stats.naive_iterations += n;
+        ++n;
+        m += lines.horizons[e];
+        t += lines.iterations[e];
+        stats.safe_zone_skips += lines.walks_skipped[e];
+        stats.visible_samples += static_cast<std::uint64_t>(lines.counts[e]);
+      }
+      stats.receivers += n;
+      stats.horizons += m;
+      stats.iterations += t;
+      stats.lines += n > 0;
+      stats.lines_over_bound += t > 2 * m + n;
+    }
+    for (int r = 0; r < field.height; ++r) {
+      for (int c = 0; c < field.width; ++c) {
+        float weight = 0.0f, count = 0.0f, distance = 0.0f;
+        for (const CellCorner& corner : receiverCell(d, c, r)) {
+          const float w = corner.weight;
+          const std::size_t e = corner.entry;
+          if (w <= 0.0f) continue;
+          if (std::isnan(lines.counts[e])) continue;
+          weight += w;
+          count += w * lines.counts[e];
+          distance += w * lines.distance_sums[e];
+        }
+        if (weight > 0.0f && weight != 1.0f) {
+          count /= weight;
+          distance /= weight;
+        }
+        sums[static_cast<std::size_t>(r) * field.width + c].add(d, sector, count, distance);
+      }
+    }
+  }
+  finish(result, sums, h);
+}
+
+void naiveReference(const HeightField& field, const std::vector<float>& h,
+                    const IntervisibilityOptions& options, IntervisibilityResult& result) {
+  const int width = field.width, height = field.height;
+  const auto directions = runDirections(field, options);
+  const float sector = intervisibilitySector(options);
+  std::vector<PixelSums> sums(field.pixelCount());
+  for (int r = 0; r < height; ++r) {
+    for (int c = 0; c < width; ++c) {
+      const std::size_t pixel = static_cast<std::size_t>(r) * width + c;
+      const float hp = h[pixel];
+      for (const SweepDirection& d : directions) {
+        float best_h = 0.0f;
+        int best_step = 0, count = 0;
+        std::uint32_t distance_sum = 0;
+        // March until the ray has left the field for good (the kernel may march further;
+        // those samples are outside and masked).
+        for (int i = 1;; ++i) {
+          const float t = static_cast<float>(i) * d.step_length;
+          const Point2 p{static_cast<float>(c) + t * d.dir_x, static_cast<float>(r) + t * d.dir_y};
+          if (!insideField(p, width, height)) break;
+          const float q = sampleHeight(h, width, height, p);
+          const bool seen =
+              !std::isnan(q) && (best_step == 0 || chordSide(q, best_h, hp, static_cast<float>(i - best_step),
+                                                             static_cast<float>(best_step)) <= 0);
+          if (seen) {
+            ++count;
+            distance_sum += static_cast<std::uint32_t>(i);
+            best_h = q;
+            best_step = i;
+          }
+        }
+        sums[pixel].add(d, sector, static_cast<float>(count), static_cast<float>(distance_sum));
+      }
+    }
+  }
+  finish(result, sums, h);
+}
+
+}  // namespace
+
+IntervisibilityLines referenceIntervisibilityLines(const HeightField& field,
+                                                   const std::vector<float>& prepared_heights,
+                                                   const SweepDirection& d, const HullTreeTuning& tuning,
+                                                   bool keep_horizons) {
+  IntervisibilityLines out;
+  out.geometry = d;
+  out.samples.assign(d.entries(), kNaN);
+  for (int j = 0; j < d.n_lines; ++j) {
+    for (int i = 0; i < d.n_steps; ++i) {
+      const Point2 p = sweepPosition(d, j, i);
+      if (insideField(p, field.width, field.height))
+        out.samples[static_cast<std::size_t>(i) * d.n_lines + j] =
+            sampleHeight(prepared_heights, field.width, field.height, p);
+    }
+  }
+  sweepPresampledLines(out, tuning, keep_horizons);
+  return out;
+}
+
+}  // namespace detail
+
+IntervisibilityResult referenceIntervisibility(const HeightField& field,
+                                               const IntervisibilityOptions& options,
+                                               const IntervisibilityOutputs& outputs) {
+  validate(field);
+  validate(options, outputs);
+  const detail::PreparedHeights prepared = detail::prepareHeights(field);
+  detail::checkLineLimits(detail::runDirections(field, options), prepared.heights, outputs);
+  IntervisibilityResult result;
+  result.width = field.width;
+  result.height = field.height;
+  result.directions = options.directions;
+  for (int k = 0; k < options.directions; ++k) result.azimuths.push_back(directionAzimuth(k, options));
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  if (outputs.visible_count) result.visible_count.assign(field.pixelCount(), nan);
+  if (outputs.visible_area) result.visible_area.assign(field.pixelCount(), nan);
+  if (options.method == IntervisibilityMethod::HullTree) {
+    detail::sweepReference(field, prepared.heights, options, result);
+  } else {
+    detail::naiveReference(field, prepared.heights, options, result);
+  }
+  if (!outputs.statistics) result.statistics = {};
+  return result;
+}
+
+}  // namespace hfvis
