@@ -8,6 +8,7 @@ packages=(
   ocl-icd-opencl-dev opencl-clhpp-headers opencl-c-headers pocl-opencl-icd clinfo
   libopenimageio-dev openimageio-tools libopenexr-dev libglm-dev
   googletest libgtest-dev
+  clang libclang-rt-14-dev
   python3 python3-numpy python3-matplotlib python-matplotlib-data
 )
 

@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds, runs the whole test suite (CTest + GoogleTest), then
 # installs hfvis into build/install and builds and runs examples/ against that package, as a
-# downstream project would (find_package(hfvis CONFIG), no source tree), and finally runs the
-# suite again built with AddressSanitizer and UndefinedBehaviorSanitizer (scripts/sanitize.sh).
+# downstream project would (find_package(hfvis CONFIG), no source tree), runs the suite again
+# built with AddressSanitizer and UndefinedBehaviorSanitizer (scripts/sanitize.sh), and
+# finally replays the fuzz regressions and fuzzes the height-field loader and the CLI's
+# argument parser for a minute each (scripts/fuzz.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -16,3 +18,5 @@ cmake --build build/examples -j "$(nproc)" > /dev/null
 build/examples/sky_view_factor
 echo "== the test suite under AddressSanitizer and UndefinedBehaviorSanitizer (build-asan)"
 bash scripts/sanitize.sh
+echo "== fuzzing (libFuzzer, Clang): the height-field loader and the CLI argument parser (build-fuzz)"
+bash scripts/fuzz.sh

@@ -1,0 +1,34 @@
+// height_field_fuzzer: libFuzzer over the height-field loader. The input's first byte picks
+// the file type (EXR, PNG, TIFF or any extension OpenImageIO guesses from the bytes), the rest
+// is the file. Reading must either give a valid field or throw hfvis::Error: any other
+// exception, a crash or a sanitizer report is a bug.
+#include <unistd.h>
+
+#include <cstdint>
+#include <cstdio>
+#include <exception>
+#include <string>
+
+#include "hfvis/errors.hpp"
+#include "hfvis/height_field.hpp"
+#include "hfvis/image_io.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  if (size < 1) return 0;
+  static const char* const kExtensions[] = {".exr", ".png", ".tif", ".hdr"};
+  const std::string path = "/tmp/hfvis_fuzz_" + std::to_string(::getpid()) + kExtensions[data[0] % 4];
+  if (std::FILE* f = std::fopen(path.c_str(), "wb")) {
+    std::fwrite(data + 1, 1, size - 1, f);
+    std::fclose(f);
+  } else {
+    return 0;
+  }
+  try {
+    const hfvis::HeightField field = hfvis::readHeightField(path);
+    hfvis::validate(field);  // what the loader returns must pass the library's own checks
+  } catch (const hfvis::Error&) {
+    // a clear error: what bad files get
+  }
+  std::remove(path.c_str());
+  return 0;
+}
