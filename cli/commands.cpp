@@ -149,7 +149,12 @@ std::vector<std::string> outputPaths(const RunArguments& run) {
 bool sameFile(const std::string& a, const std::string& b) {
   std::error_code error;
   if (fs::exists(a, error) && fs::exists(b, error)) return fs::equivalent(a, b, error);
-  return fs::weakly_canonical(a, error) == fs::weakly_canonical(b, error);
+  std::error_code error_a, error_b;
+  const fs::path canonical_a = fs::weakly_canonical(a, error_a),
+                 canonical_b = fs::weakly_canonical(b, error_b);
+  if (error_a || error_b)  // (an error gives empty paths, which would compare equal)
+    return fs::absolute(a, error).lexically_normal() == fs::absolute(b, error).lexically_normal();
+  return canonical_a == canonical_b;
 }
 
 // Every output can be written, none is an input (an output never replaces an input), and no
