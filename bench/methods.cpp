@@ -76,7 +76,7 @@ MethodOutput runBaseline(const ComputeContext& context, const HeightField& field
     throw InvalidArgument("the baselines need a field of at least 2 x 2");
   if (field.nodataCount() > 0) throw InvalidArgument("the baselines do not handle nodata heights");
   return detail::translateOpenClErrors([&] {
-    detail::ContextState& st = context.state();
+    detail::ContextState& st = detail::stateOf(context);
     cl::Program program = st.program("horizon_baselines.cl", programOptions(spec));
     const std::vector<float> prepared = preparedHeights(field);
     const std::size_t plane = field.pixelCount();

@@ -84,7 +84,7 @@ void enqueueBouncePresample(ContextState& st, cl::Program& program, const Bounce
 
 BounceResult run(const ComputeContext& context, const HeightField& field, const ExitRadiance& radiance,
                  const BounceOptions& options) {
-  ContextState& st = context.state();
+  ContextState& st = stateOf(context);
   const BounceInputs inputs = prepareBounce(field, radiance);
   const int channels = inputs.channels();
   const auto all = runDirections(field, options);
@@ -152,7 +152,7 @@ BounceLineView bounceLinesOnDevice(const ComputeContext& context, const HeightFi
                                    int directions, const HullTreeTuning& tuning) {
   validate(tuning);
   return translateOpenClErrors([&] {
-    ContextState& st = context.state();
+    ContextState& st = stateOf(context);
     const TreeProgramFlags flags = bounceFlags(inputs, tuning);
     cl::Program program = st.program(treeProgramFile(flags), treeProgramOptions(flags, st));
     const bool line_major = lineMajorLayout(st);

@@ -291,7 +291,7 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
                           std::to_string(field.width) + " x " + std::to_string(field.height) +
                           "); split the field into tiles");
   return detail::translateOpenClErrors(
-      [&] { return detail::HorizonRun(context.state(), field, options, outputs).run(); });
+      [&] { return detail::HorizonRun(detail::stateOf(context), field, options, outputs).run(); });
 }
 
 }  // namespace hfvis

@@ -80,7 +80,7 @@ void addLineTotals(const std::vector<cl_ulong>& totals, const SweepBatch& batch,
 
 IntervisibilityResult run(const ComputeContext& context, const HeightField& field,
                           const IntervisibilityOptions& options, const IntervisibilityOutputs& outputs) {
-  ContextState& st = context.state();
+  ContextState& st = stateOf(context);
   const PreparedHeights prepared = prepareHeights(field);
   const auto all = runDirections(field, options);
   checkLineLimits(all, prepared.heights, outputs);
@@ -195,7 +195,7 @@ IntervisibilityLines intervisibilityLinesOnDevice(const ComputeContext& context,
                                                   const HullTreeTuning& tuning) {
   validate(tuning);
   return translateOpenClErrors([&] {
-    ContextState& st = context.state();
+    ContextState& st = stateOf(context);
     TreeProgramFlags flags;
     flags.entry_stats = true;
     flags.tuning = tuning;

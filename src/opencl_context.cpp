@@ -234,6 +234,8 @@ ComputeContext ComputeContext::create(const ContextOptions& options) {
 
 const DeviceInfo& ComputeContext::device() const { return state_->info; }
 
+detail::ContextState& detail::stateOf(const ComputeContext& context) { return *context.state_; }
+
 const ContextOptions& ComputeContext::options() const { return state_->options; }
 
 }  // namespace hfvis

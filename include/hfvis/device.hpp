@@ -27,9 +27,12 @@ struct DeviceInfo {
 // Every device of every platform. Throws NoDeviceError when no platform is installed.
 std::vector<DeviceInfo> listDevices();
 
+class ComputeContext;
 namespace detail {
 struct ContextState;
-}
+// The library's access to a context's OpenCL state (src/opencl_context.hpp defines the type).
+ContextState& stateOf(const ComputeContext& context);
+}  // namespace detail
 
 // How the sweep kernels lay out their per-line buffers (hull stacks, line samples).
 enum class LineLayout {
@@ -72,9 +75,9 @@ class ComputeContext {
 
   const DeviceInfo& device() const;
   const ContextOptions& options() const;
-  detail::ContextState& state() const { return *state_; }
 
  private:
+  friend detail::ContextState& detail::stateOf(const ComputeContext& context);
   ComputeContext() = default;
   std::shared_ptr<detail::ContextState> state_;
 };
