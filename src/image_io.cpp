@@ -298,24 +298,45 @@ void convertIntegers(const std::vector<unsigned char>& raw, double rescale, std:
   }
 }
 
+// Reads channel `ch` of subimage 0 as type `as` (T: float, or bytes for other types) in
+// blocks of rows, the buffer growing with the rows read: a header that claims more pixels
+// than the file holds fails at its first missing rows, not after allocating the whole claim.
+// Tiled files are read whole (OpenImageIO reads them a tile row at a time internally).
+template <typename T>
+std::vector<T> readRows(const std::string& path, OIIO::ImageInput& in, int ch, OIIO::TypeDesc as) {
+  const OIIO::ImageSpec& spec = in.spec();
+  const std::size_t row_values = static_cast<std::size_t>(spec.width) * as.size() / sizeof(T);
+  const auto fail = [&] {
+    throw IoError(path,
+                  withDetail("cannot read pixel data; the file is truncated or corrupt", in.geterror()));
+  };
+  std::vector<T> values;
+  if (spec.tile_width > 0) {
+    values.resize(row_values * static_cast<std::size_t>(spec.height));
+    if (!in.read_image(0, 0, ch, ch + 1, as, values.data())) fail();
+    return values;
+  }
+  const int block = static_cast<int>(std::clamp<std::size_t>(
+      (std::size_t(16) << 20) / (row_values * sizeof(T)), 1, static_cast<std::size_t>(spec.height)));
+  for (int y = 0; y < spec.height; y += block) {
+    const int y_end = std::min(spec.height, y + block);
+    values.resize(row_values * static_cast<std::size_t>(y_end));
+    if (!in.read_scanlines(0, 0, spec.y + y, spec.y + y_end, 0, ch, ch + 1, as,
+                           values.data() + row_values * static_cast<std::size_t>(y)))
+      fail();
+  }
+  return values;
+}
+
 // Reads channel `ch` of subimage 0 as the stored values (integers are not normalised).
 std::vector<float> readChannel(const std::string& path, OIIO::ImageInput& in, int ch) {
   const OIIO::ImageSpec& spec = in.spec();
   const OIIO::TypeDesc type = spec.channelformat(ch);
-  const std::size_t count = static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.height);
-  auto readAs = [&](OIIO::TypeDesc as, void* data) {
-    if (!in.read_image(0, 0, ch, ch + 1, as, data)) {
-      throw IoError(path,
-                    withDetail("cannot read pixel data; the file is truncated or corrupt", in.geterror()));
-    }
-  };
-  std::vector<float> heights(count);
   switch (type.basetype) {
     case OIIO::TypeDesc::HALF:
     case OIIO::TypeDesc::FLOAT:
     case OIIO::TypeDesc::DOUBLE:
-      readAs(OIIO::TypeDesc::FLOAT, heights.data());
-      return heights;
+      return readRows<float>(path, in, ch, OIIO::TypeDesc::FLOAT);
     case OIIO::TypeDesc::UINT8:
     case OIIO::TypeDesc::INT8:
     case OIIO::TypeDesc::UINT16:
@@ -331,8 +352,9 @@ std::vector<float> readChannel(const std::string& path, OIIO::ImageInput& in, in
   // Integers: read in their own type, since OpenImageIO's conversion to float would
   // normalise them to [0, 1]. Files with fewer bits than the type (a 12-bit TIFF) are
   // delivered scaled up to the type's full range; scale them back to the stored values.
-  std::vector<unsigned char> raw(count * type.size());
-  readAs(OIIO::TypeDesc(static_cast<OIIO::TypeDesc::BASETYPE>(type.basetype)), raw.data());
+  const std::vector<unsigned char> raw = readRows<unsigned char>(
+      path, in, ch, OIIO::TypeDesc(static_cast<OIIO::TypeDesc::BASETYPE>(type.basetype)));
+  std::vector<float> heights(raw.size() / type.size());
   double rescale = 1.0;
   const int bits = spec.get_int_attribute("oiio:BitsPerSample", 0);
   const int type_bits = static_cast<int>(8 * type.size());
@@ -483,6 +505,13 @@ std::unique_ptr<OIIO::ImageInput> openImage(const std::string& path) {
     throw IoError(path, "image is empty (" + std::to_string(spec.width) + " x " +
                             std::to_string(spec.height) + " pixels, " + std::to_string(spec.nchannels) +
                             " channels)");
+  }
+  // The kernels index pixels with 32-bit integers (computeHorizons refuses larger fields), so
+  // a larger image is refused before any of it is read.
+  if (static_cast<std::uint64_t>(spec.width) * static_cast<std::uint64_t>(spec.height) >=
+      (std::uint64_t(1) << 31)) {
+    throw IoError(path, "image is " + std::to_string(spec.width) + " x " + std::to_string(spec.height) +
+                            " pixels; hfvis reads fields below 2^31 pixels (split it into tiles)");
   }
   if (spec.depth > 1) throw IoError(path, "volume images (depth > 1) are not supported");
   if (spec.deep) throw IoError(path, "deep images are not supported");
