@@ -24,7 +24,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     return 0;
   }
   try {
-    const hfvis::HeightField field = hfvis::readHeightField(path);
+    // Images up to 64 MiB as stored: larger claims are refused before reading, as the
+    // default 64 GiB limit does for a real run (the fuzzer's memory limit is 4 GiB).
+    hfvis::HeightFieldReadOptions options;
+    options.max_image_bytes = std::uint64_t(64) << 20;
+    const hfvis::HeightField field = hfvis::readHeightField(path, options);
     hfvis::validate(field);  // what the loader returns must pass the library's own checks
   } catch (const hfvis::Error&) {
     // a clear error: what bad files get

@@ -489,7 +489,9 @@ namespace {
 
 // Opens an image for reading, with the checks every reader shares: the file exists, is not
 // empty, and holds a 2D, non-deep image with pixels.
-std::unique_ptr<OIIO::ImageInput> openImage(const std::string& path) {
+constexpr std::uint64_t kDefaultMaxImageBytes = std::uint64_t(64) << 30;
+
+std::unique_ptr<OIIO::ImageInput> openImage(const std::string& path, std::uint64_t max_image_bytes = 0) {
   std::error_code ec;
   const fs::file_status status = fs::status(path, ec);
   if (!fs::exists(status)) throw IoError(path, "no such file");
@@ -513,6 +515,19 @@ std::unique_ptr<OIIO::ImageInput> openImage(const std::string& path) {
     throw IoError(path, "image is " + std::to_string(spec.width) + " x " + std::to_string(spec.height) +
                             " pixels; hfvis reads fields below 2^31 pixels (split it into tiles)");
   }
+  // What the header claims, before the readers allocate for it (a damaged or hostile header
+  // can claim terabytes in a few bytes).
+  // A TIFF's strips may claim more rows than the image has; OpenImageIO buffers a whole strip.
+  const std::uint64_t limit = max_image_bytes ? max_image_bytes : kDefaultMaxImageBytes;
+  const std::uint64_t rows =
+      std::max<std::uint64_t>(spec.height, std::max(0, spec.get_int_attribute("tiff:RowsPerStrip", 0)));
+  const std::uint64_t scanline = static_cast<std::uint64_t>(spec.width) * spec.pixel_bytes(true);
+  if (scanline / std::max<std::uint64_t>(spec.width, 1) != spec.pixel_bytes(true) ||
+      scanline * rows / rows != scanline || scanline * rows > limit) {
+    throw IoError(path, "image claims " + std::to_string(spec.width) + " x " + std::to_string(spec.height) +
+                            " pixels of " + std::to_string(spec.nchannels) + " channels, more than the " +
+                            std::to_string(limit >> 20) + " MiB read at most");
+  }
   if (spec.depth > 1) throw IoError(path, "volume images (depth > 1) are not supported");
   if (spec.deep) throw IoError(path, "deep images are not supported");
   return in;
@@ -521,7 +536,7 @@ std::unique_ptr<OIIO::ImageInput> openImage(const std::string& path) {
 }  // namespace
 
 HeightField readHeightField(const std::string& path, const HeightFieldReadOptions& options) {
-  std::unique_ptr<OIIO::ImageInput> in = openImage(path);
+  std::unique_ptr<OIIO::ImageInput> in = openImage(path, options.max_image_bytes);
   const OIIO::ImageSpec& spec = in->spec();
   const int channel = selectChannel(path, spec, options.channel);
 

@@ -1,6 +1,7 @@
 // hfvis/image_io.hpp: reading height fields and writing results through OpenImageIO.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
@@ -19,6 +20,9 @@ struct HeightFieldReadOptions {
   double cell_size_x = 0.0;
   double cell_size_y = 0.0;
   double z_scale = 1.0;
+  // The largest image (all its channels, as stored) read: a larger one is refused before
+  // any of it is read, whatever its header claims. 0 = 64 GiB.
+  std::uint64_t max_image_bytes = 0;
 };
 
 // Reads a height field from EXR, TIFF (float, 16-bit; GeoTIFF spacing), PNG (8/16-bit) or
