@@ -1,5 +1,5 @@
 // bench/ground_truth.hpp: the oracle every method's error is measured against: the exact
-// horizon of the bilinear surface (DESIGN.md's definition, the supremum over all t > 0, not
+// horizon of the bilinear surface (README's conventions: the supremum over all t > 0, not
 // over samples), in double precision, in the exact direction from the exact pixel, for a
 // random subset of receivers; computed on all cores and cached on disk.
 #pragma once

@@ -1,4 +1,4 @@
-// synthetic_fields.cpp: generated hard-case height fields (DESIGN.md, "Hard cases").
+// synthetic_fields.cpp: generated hard-case height fields (README, Tests).
 #include "hfvis/synthetic_fields.hpp"
 
 #include <cmath>
