@@ -1,85 +1,108 @@
-// bounce.cl: one diffuse light bounce (Timonen 2013, Sec. 10.1, alternative 3): the
-// presampling of exit radiance and receiver normals along the sweep lines, and the
-// reduction of the gathered irradiance onto the grid. The gather itself runs inside the
-// convex hull tree sweep of intervisibility.cl (HFVIS_WANT_BOUNCE), over the visible runs
-// the tree finds; include/hfvis/bounce.hpp states the formula.
+// bounce.cl: the one-bounce gather (Timonen 2013, Sec. 10.1, alternative 3;
+// include/hfvis/bounce.hpp states the formula), included by intervisibility.cl when
+// HFVIS_WANT_BOUNCE is set: the lattice sweep visits each receiver's visible samples, and
+// these helpers turn them into the receiver's irradiance. Mirrored by BounceGather in
+// src/scalar_hull_tree.cpp.
 //
-// Compile-time parameters, besides those of intervisibility.cl and sweep_framework.cl:
-//   HFVIS_CHANNELS  radiance channels, 1..4 (default 1)
-#ifndef HFVIS_WANT_BOUNCE
-#define HFVIS_WANT_BOUNCE 1
-#endif
-#include "intervisibility.cl"
+// For one receiver, the visible samples are visited farthest first (the runs of the
+// horizons, each from its horizon toward the receiver). A sample's elevation band reaches
+// up to the mean of its and its farther neighbour's elevations when the two are adjacent
+// (no hidden sample between), else up to its own elevation (the gap's band went to the
+// farther sample); it reaches down likewise toward its nearer neighbour. Each band adds
+// radiance * (G(upper) - G(lower)), G the wedge integral of the projected solid angle,
+// clipped below at the tangent elevation.
+//
+// Compile-time parameters: HFVIS_CHANNELS, radiance channels 1..4 (default 1).
+#ifndef HFVIS_BOUNCE_CL
+#define HFVIS_BOUNCE_CL
 
-// Per (line, step) of the batch: the exit radiance channels sampled bilinearly at the
-// sample's position (as its height), then the unit normal there: the bilinear
-// interpolation of the pixel normals, renormalised. `radiance` holds HFVIS_CHANNELS planes
-// and `normals` three planes (x, y, z) of width*height, NaN at nodata pixels (so that a
-// sample uses the same valid corners as its height). Global size as presample_lines.
-__kernel void bounce_presample(__global const float* radiance, __global const float* normals, int width,
-                               int height, __global const SweepDirection* directions,
-                               __global float* attributes) {
-#if HFVIS_LINE_MAJOR
-  int step = get_global_id(0), line = get_global_id(1);
-#else
-  int line = get_global_id(0), step = get_global_id(1);
+#ifndef HFVIS_CHANNELS
+#define HFVIS_CHANNELS 1
 #endif
-  const SweepDirection d = load_direction(directions + get_global_id(2));
-  if (line >= d.n_lines || step >= d.n_steps) return;
-  const uint plane = (uint)(width * height);
-  float x, y;
-  sweep_position(d, line, step, &x, &y);
-  __global float* out = attributes + line_entry(d, line, step) * HFVIS_BOUNCE_STRIDE;
-  for (int c = 0; c < HFVIS_CHANNELS; ++c)
-    out[c] = sample_height(radiance + (uint)c * plane, width, height, x, y);
-  float nx = sample_height(normals, width, height, x, y);
-  float ny = sample_height(normals + plane, width, height, x, y);
-  float nz = sample_height(normals + 2u * plane, width, height, x, y);
-  float length = sqrt(nx * nx + ny * ny + nz * nz);
-  out[HFVIS_CHANNELS] = nx / length;
-  out[HFVIS_CHANNELS + 1] = ny / length;
-  out[HFVIS_CHANNELS + 2] = nz / length;
+
+typedef struct {
+  float nz_term;  // n_z * D / 2 (D: the direction's wedge of azimuth)
+  float nh_term;  // (n . d) * 2 sin(D / 2)
+  float tangent;  // lower clip of G: where its wedge-integrated cosine factor vanishes
+  float ground;   // ground length of one step
+  float h;        // the receiver's height and step
+  int step;
+  int have_prev;  // a farther visible sample awaits its lower band edge
+  int adjacent;   // the next sample visited is adjacent to it
+  float prev_theta, prev_g_hi;
+  float prev_radiance[HFVIS_CHANNELS];
+  float sum[HFVIS_CHANNELS];
+} BounceGather;
+
+HFVIS_INLINE float bounce_g(const BounceGather* g, float theta) {
+  float t = hf_max(theta, g->tangent);
+  float s = sin(t), c = cos(t);
+  return g->nz_term * (s * s) + g->nh_term * (0.5f * (t + s * c));
 }
 
-// For every receiver pixel and every direction of the batch, the bilinear interpolation of
-// the irradiance of the (up to) four surrounding line entries (absent ones left out and the
-// weights renormalised, none left: nothing gathered), added to the run's sums
-// (HFVIS_CHANNELS planes); NaN at nodata pixels. Straight-line code with a uniform
-// barrier, as intervisibility_reduce. Global size: (W, H) rounded up to the local size.
-__kernel void bounce_reduce(__global const float* heights, int width, int height,
-                            __global const SweepDirection* directions, int batch_size,
-                            __global const float* gathered, __global float* irradiance) {
-  int c = get_global_id(0), r = get_global_id(1);
-  int valid = c < width && r < height;
-  int cc = min(c, width - 1), rr = min(r, height - 1);
-  const uint pixel = (uint)(rr * width + cc);
-  const uint plane = (uint)(width * height);
-  float sums[HFVIS_CHANNELS];
-  for (int ch = 0; ch < HFVIS_CHANNELS; ++ch) sums[ch] = 0.0f;
-  for (int b = 0; b < batch_size; ++b) {
-    barrier(CLK_LOCAL_MEM_FENCE);  // see horizon_naive: keeps the work-item loop innermost
-    const SweepDirection d = load_direction(directions + b);
-    int j0, i0;
-    float fu, fv;
-    receiver_cell(d, (float)cc, (float)rr, &j0, &i0, &fu, &fv);
-    float weight = 0.0f;
-    float acc[HFVIS_CHANNELS];
-    for (int ch = 0; ch < HFVIS_CHANNELS; ++ch) acc[ch] = 0.0f;
-    for (int k = 0; k < 4; ++k) {
-      float w;
-      int i;
-      __global const float* entry = gathered + cell_corner(d, j0, i0, fu, fv, k, &w, &i) * HFVIS_CHANNELS;
-      int use = w > 0.0f && !isnan(entry[0]);
-      weight += use ? w : 0.0f;
-      for (int ch = 0; ch < HFVIS_CHANNELS; ++ch) acc[ch] += use ? w * entry[ch] : 0.0f;
-    }
-    // Divide only when weights are missing: a single full weight stays exact.
-    int renormalise = weight > 0.0f && weight != 1.0f;
-    for (int ch = 0; ch < HFVIS_CHANNELS; ++ch) sums[ch] += renormalise ? acc[ch] / weight : acc[ch];
+// The receiver's unit normal (nx, ny, nz), the direction on the ground, its step's ground
+// length, and half_sector = D / 2 and wedge = 2 sin(D / 2) of its wedge D.
+HFVIS_INLINE void bounce_begin(BounceGather* g, float nx, float ny, float nz, float cos_azimuth,
+                               float sin_azimuth, float step_ground, float h, int step, float half_sector,
+                               float wedge) {
+  float toward = nx * cos_azimuth + ny * sin_azimuth;
+  g->nz_term = nz * half_sector;
+  g->nh_term = toward * wedge;
+  g->tangent = atan2(-g->nh_term, 2.0f * g->nz_term);
+  g->ground = step_ground;
+  g->h = h;
+  g->step = step;
+  g->have_prev = 0;
+  g->adjacent = 0;
+  g->prev_theta = 0.0f;
+  g->prev_g_hi = 0.0f;
+  for (int c = 0; c < HFVIS_CHANNELS; ++c) g->prev_radiance[c] = g->sum[c] = 0.0f;
+}
+
+// Visible sample x at height hx with exit radiance `radiance`, nearer than every sample
+// visited before it.
+HFVIS_INLINE void bounce_visit(BounceGather* g, float hx, int x, const float* radiance) {
+  float theta = atan2(hx - g->h, (float)(g->step - x) * g->ground);
+  float g_hi;
+  if (!g->have_prev) {
+    g_hi = bounce_g(g, theta);
+  } else {
+    float edge = g->adjacent ? 0.5f * (g->prev_theta + theta) : theta;
+    float g_edge = bounce_g(g, edge);
+    for (int c = 0; c < HFVIS_CHANNELS; ++c) g->sum[c] += g->prev_radiance[c] * (g->prev_g_hi - g_edge);
+    g_hi = g_edge;
   }
-  if (valid) {
-    int nodata = isnan(heights[pixel]);
-    for (int ch = 0; ch < HFVIS_CHANNELS; ++ch)
-      irradiance[(uint)ch * plane + pixel] = nodata ? NAN : irradiance[(uint)ch * plane + pixel] + sums[ch];
+  g->prev_theta = theta;
+  g->prev_g_hi = g_hi;
+  for (int c = 0; c < HFVIS_CHANNELS; ++c) g->prev_radiance[c] = radiance[c];
+  g->have_prev = 1;
+  g->adjacent = 1;
+}
+
+// The nearest visible sample's band ends at its own elevation; gives the sums.
+HFVIS_INLINE void bounce_finish(BounceGather* g, float* irradiance) {
+  if (g->have_prev) {
+    float g_lo = bounce_g(g, g->prev_theta);
+    for (int c = 0; c < HFVIS_CHANNELS; ++c) g->sum[c] += g->prev_radiance[c] * (g->prev_g_hi - g_lo);
+  }
+  for (int c = 0; c < HFVIS_CHANNELS; ++c) irradiance[c] = g->sum[c];
+}
+
+// The exit radiance at step x of a lattice line (`line`, as intervisibility_lattice reads it),
+// sampled like its height: the receiver's pixel as it is, other samples bilinearly over the
+// valid corners (`radiance` is NaN at nodata pixels). HFVIS_CHANNELS planes of `plane` floats.
+HFVIS_INLINE void lattice_radiance(__global const float* radiance, int width, uint plane, int4 line,
+                                   __global const LatticeSample* samples, int n_samples, int a, int b, int x,
+                                   float* out) {
+  const int i = x / n_samples, q = x - i * n_samples;
+  __global const LatticeSample* s = samples + q;
+  const int ex = s->ex, ey = s->ey;
+  const uint at = (uint)((line.y - i * b + s->oy) * width + (line.x - i * a + s->ox));
+  for (int c = 0; c < HFVIS_CHANNELS; ++c) {
+    __global const float* channel = radiance + (uint)c * plane;
+    out[c] = ex + ey == 0 ? channel[at]
+                          : lattice_height(channel, at, (uint)ex, (uint)(ey * width), s->w00, s->w10, s->w01, s->w11);
   }
 }
+
+#endif  // HFVIS_BOUNCE_CL

@@ -216,35 +216,6 @@ HFVIS_INLINE void emit_lanes(lane_int live, lane_int pixel, lane_int nodata, lan
 #endif
 }
 
-// One sample of a period (src/lattice_geometry.hpp, struct LatticeSample): nine 4-byte
-// members, read field by field.
-typedef struct {
-  float tau;                 // pixels from the period's receiver toward +(a, b)
-  int ox, oy;                // the cell's lower corner, relative to the receiver
-  int ex, ey;                // 1 where the sample is strictly inside the cell along x (y)
-  float w00, w10, w01, w11;  // bilinear weights of the cell's corners
-} LatticeSample;
-
-// Height of the bilinear surface at a lattice sample whose cell corner is at entry `at`;
-// with nodata, only the valid corners of positive weight count, renormalised (NaN when
-// none). Crossing samples have ex or ey 0: their zero-weight corners repeat a used one.
-HFVIS_INLINE float lattice_height(__global const float* heights, uint at, uint right, uint down, float w00,
-                                  float w10, float w01, float w11) {
-  float h00 = heights[at], h10 = heights[at + right], h01 = heights[at + down],
-        h11 = heights[at + down + right];
-  float plain = w00 * h00 + w10 * h10 + w01 * h01 + w11 * h11;
-#if HFVIS_HAS_NODATA
-  int v00 = w00 > 0.0f && !isnan(h00), v10 = w10 > 0.0f && !isnan(h10);
-  int v01 = w01 > 0.0f && !isnan(h01), v11 = w11 > 0.0f && !isnan(h11);
-  float sum = (v00 ? w00 * h00 : 0.0f) + (v10 ? w10 * h10 : 0.0f) + (v01 ? w01 * h01 : 0.0f) +
-              (v11 ? w11 * h11 : 0.0f);
-  float weight = (v00 ? w00 : 0.0f) + (v10 ? w10 : 0.0f) + (v01 ? w01 : 0.0f) + (v11 ? w11 : 0.0f);
-  return isnan(plain) ? (weight > 0.0f ? sum / weight : NAN) : plain;
-#else
-  return plain;
-#endif
-}
-
 // The exact limit of the receivers' elevation slope at t -> 0 along (a, b): the bilinear
 // surface's directional derivative into the first cell, from each receiver's height h and
 // its neighbours along the two axes, as a rise over the period |(a, b)| (the caller's run).

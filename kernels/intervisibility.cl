@@ -16,6 +16,7 @@
 // Heights arrive offset and z-scaled (see prepareHeights); NaN = nodata.
 //
 // Compile-time parameters, besides those of sweep_framework.cl:
+//   HFVIS_WANT_COUNT        add the visible counts to count_sum
 //   HFVIS_WANT_AREA         sum the distances of the visible samples (for the area estimate)
 //   HFVIS_WANT_STATS        per-line totals of receivers, horizons, iterations, ...
 //   HFVIS_WANT_ENTRY_STATS  per-entry (horizons, iterations, horizon hash) for the tests
@@ -35,6 +36,9 @@
 #include "fast_math.cl"
 #include "sweep_framework.cl"
 
+#ifndef HFVIS_WANT_COUNT
+#define HFVIS_WANT_COUNT 1
+#endif
 #ifndef HFVIS_WANT_AREA
 #define HFVIS_WANT_AREA 1
 #endif
@@ -62,11 +66,12 @@
 #ifndef HFVIS_SAFE_ZONE_STEPS
 #define HFVIS_SAFE_ZONE_STEPS 16
 #endif
+// Statistics need every sample's horizons (Table 2 and Section 6's bound count them all);
+// otherwise only receivers (pixel centres) read theirs.
+#define HFVIS_ALL_HORIZONS (HFVIS_WANT_STATS || HFVIS_WANT_ENTRY_STATS)
 #if (HFVIS_REPLACEMENT_CHECK && !HFVIS_DEFERRED_WRITES) || (HFVIS_SAFE_ZONE && !HFVIS_REPLACEMENT_CHECK)
 #error "the safe zone needs the replacement check, which works inside the deferred-writes walk"
 #endif
-// Floats per entry of the bounce's line attributes: the radiance channels, then the unit normal.
-#define HFVIS_BOUNCE_STRIDE (HFVIS_CHANNELS + 3)
 
 // The exact predicate's fallback is rare but long: inlined at every call site it made the
 // sweep 30 % slower (code size), so it stays a call.
@@ -194,15 +199,16 @@ inline int seen_over(float hx, int x, float hn, int n, float hr, int r) {
 // The visible samples between horizon `start` and the next horizon `next` form a prefix
 // (every start of a visible run is a horizon), and are exactly those seen over `next`.
 // Returns the step that ends the prefix: the first present sample hidden behind `next`,
-// or `next`. Without absent samples in between, galloping then bisection (O(log run));
-// otherwise a scan.
-inline int run_end(__global const float2* samples, uint stride, int start, int next, float h_next,
-                   int receiver, float h_receiver, int holes) {
+// or `next`. Heights are read from the tree slots (a slot keeps its sample's height for
+// good; absent samples' slots hold NaN). Without absent samples in between, galloping then
+// bisection (O(log run)); otherwise a scan.
+inline int run_end(__global const int4* tree, uint stride, int start, int next, float h_next, int receiver,
+                   float h_receiver, int holes) {
   if (!holes) {
     int lo = start, hi = next, jump = 1;
     while (lo + jump < hi) {
       int x = lo + jump;
-      if (seen_over(samples[(uint)x * stride].x, x, h_next, next, h_receiver, receiver)) {
+      if (seen_over(as_float(tree[(uint)x * stride].x), x, h_next, next, h_receiver, receiver)) {
         lo = x;
         jump *= 2;
       } else {
@@ -212,7 +218,7 @@ inline int run_end(__global const float2* samples, uint stride, int start, int n
     }
     while (hi - lo > 1) {
       int mid = lo + (hi - lo) / 2;
-      if (seen_over(samples[(uint)mid * stride].x, mid, h_next, next, h_receiver, receiver))
+      if (seen_over(as_float(tree[(uint)mid * stride].x), mid, h_next, next, h_receiver, receiver))
         lo = mid;
       else
         hi = mid;
@@ -220,92 +226,15 @@ inline int run_end(__global const float2* samples, uint stride, int start, int n
     return hi;
   }
   for (int x = start + 1; x < next; ++x) {
-    float hx = samples[(uint)x * stride].x;
+    float hx = as_float(tree[(uint)x * stride].x);
     if (!isnan(hx) && !seen_over(hx, x, h_next, next, h_receiver, receiver)) return x;
   }
   return next;
 }
 
-// ---------------------------------------------------------------------------------------
-// The one-bounce gather (see include/hfvis/bounce.hpp for the formula and its derivation).
-// For one receiver, the visible samples are visited farthest first (the runs of the
-// horizons, each from its horizon toward the receiver). A sample's elevation band reaches
-// up to the mean of its and its farther neighbour's elevations when the two are adjacent
-// (no hidden sample between), else up to its own elevation (the gap's band went to the
-// farther sample); it reaches down likewise toward its nearer neighbour. Each band adds
-// radiance * (G(upper) - G(lower)), G the wedge integral of the projected solid angle,
-// clipped below at the tangent elevation. Mirrored by BounceGather in
-// src/scalar_hull_tree.cpp.
-
 #if HFVIS_WANT_BOUNCE
-typedef struct {
-  float nz_term;  // n_z * D / 2
-  float nh_term;  // (n . d) * 2 sin(D / 2)
-  float tangent;  // lower clip of G: where its wedge-integrated cosine factor vanishes
-  float ground;   // ground length of one step
-  float h;        // the receiver's height and step
-  int step;
-  int have_prev;  // a farther visible sample awaits its lower band edge
-  int adjacent;   // the next sample visited is adjacent to it
-  float prev_theta, prev_g_hi;
-  float prev_radiance[HFVIS_CHANNELS];
-  float sum[HFVIS_CHANNELS];
-} BounceGather;
-
-HFVIS_INLINE float bounce_g(const BounceGather* g, float theta) {
-  float t = hf_max(theta, g->tangent);
-  float s = sin(t), c = cos(t);
-  return g->nz_term * (s * s) + g->nh_term * (0.5f * (t + s * c));
-}
-
-// `attributes`: the receiver's entry of the bounce line attributes (its normal after the radiance).
-HFVIS_INLINE void bounce_begin(BounceGather* g, const SweepDirection d, __global const float* attributes,
-                               float h, int step, float half_sector, float wedge) {
-  float nx = attributes[HFVIS_CHANNELS], ny = attributes[HFVIS_CHANNELS + 1],
-        nz = attributes[HFVIS_CHANNELS + 2];
-  float toward = nx * d.cos_azimuth + ny * d.sin_azimuth;
-  g->nz_term = nz * half_sector;
-  g->nh_term = toward * wedge;
-  g->tangent = atan2(-g->nh_term, 2.0f * g->nz_term);
-  g->ground = d.step_length * d.ground_per_pixel;
-  g->h = h;
-  g->step = step;
-  g->have_prev = 0;
-  g->adjacent = 0;
-  g->prev_theta = 0.0f;
-  g->prev_g_hi = 0.0f;
-  for (int c = 0; c < HFVIS_CHANNELS; ++c) g->prev_radiance[c] = g->sum[c] = 0.0f;
-}
-
-// Visible sample x at height hx, nearer than every sample visited before it; `radiance` is
-// its entry of the bounce line attributes.
-HFVIS_INLINE void bounce_visit(BounceGather* g, float hx, int x, __global const float* radiance) {
-  float theta = atan2(hx - g->h, (float)(g->step - x) * g->ground);
-  float g_hi;
-  if (!g->have_prev) {
-    g_hi = bounce_g(g, theta);
-  } else {
-    float edge = g->adjacent ? 0.5f * (g->prev_theta + theta) : theta;
-    float g_edge = bounce_g(g, edge);
-    for (int c = 0; c < HFVIS_CHANNELS; ++c) g->sum[c] += g->prev_radiance[c] * (g->prev_g_hi - g_edge);
-    g_hi = g_edge;
-  }
-  g->prev_theta = theta;
-  g->prev_g_hi = g_hi;
-  for (int c = 0; c < HFVIS_CHANNELS; ++c) g->prev_radiance[c] = radiance[c];
-  g->have_prev = 1;
-  g->adjacent = 1;
-}
-
-// The nearest visible sample's band ends at its own elevation; writes the sums.
-HFVIS_INLINE void bounce_finish(BounceGather* g, __global float* irradiance) {
-  if (g->have_prev) {
-    float g_lo = bounce_g(g, g->prev_theta);
-    for (int c = 0; c < HFVIS_CHANNELS; ++c) g->sum[c] += g->prev_radiance[c] * (g->prev_g_hi - g_lo);
-  }
-  for (int c = 0; c < HFVIS_CHANNELS; ++c) irradiance[c] = g->sum[c];
-}
-#endif  // HFVIS_WANT_BOUNCE
+#include "bounce.cl"
+#endif
 
 // The root's new child list while Algorithm 1 builds it: appending x links the last child
 // to x. `tail_next` is what the last child's `next` link holds in memory, so that with
@@ -407,42 +336,57 @@ HFVIS_INLINE int safe_zone_inside(const SafeZone* z, int step, float h) {
 }
 #endif
 
-// One work-item per line. Reads the presampled heights (lines[].x, left intact) and writes:
-//   lines[].y    the rank of the step: present samples before it (run lengths across holes),
-//                if HAS_NODATA (else there are no holes: see `holes`),
-//   visible[]    (visible samples, sum of their distances in steps), NaN where absent,
-//   prefix[]     sum of the steps of the present samples before it (mod 2^32), if AREA
-//                and HAS_NODATA,
-//   entry_stats[] (horizons m, iterations t, horizon hash, walk skipped by the safe zone), if ENTRY_STATS,
-//   line_totals[(b * totals_stride + j) * 8 + ...] (receivers, sum m, sum t, naive
-//                iterations, visible samples, walks skipped by the safe zone, 0, 0), if STATS,
-//   bounce_out[entry * CHANNELS + c] the gathered irradiance, NaN where absent, if BOUNCE
-//                (reading bounce_lines[entry * BOUNCE_STRIDE + ...], see bounce_presample;
-//                half_sector = D / 2 and wedge = 2 sin(D / 2) for D = 2*pi/K).
-// Preconditions: lines presampled by presample_lines; a line has fewer than 2^24 steps and
-// the distance sum of a receiver stays below 2^32 (checkLineLimits). Memory safety does not
-// rest on the predicate: leaves are never deleted and a node only when childless, so every
-// subtree holds a leaf and the root never loses all children; a slot is reused only for
-// the deleted old root.
-// Global size: (max lines, directions in batch).
-__kernel void intervisibility_sweep(__global const SweepDirection* directions, __global float2* lines,
-                                    __global int4* trees, __global float2* visible, __global uint* prefix,
-                                    __global uint4* entry_stats, __global ulong* line_totals,
-                                    int totals_stride, __global const float* bounce_lines,
-                                    __global float* bounce_out, float half_sector, float wedge) {
-  const int line = get_global_id(0);
-  const int b = get_global_id(1);
-  const SweepDirection d = load_direction(directions + b);
-  if (line >= d.n_lines) return;
-  // Entry of step k of this line: base + k * stride, in either line-buffer layout.
-  const uint stride = line_stride(d);
-  const uint base = line_entry(d, line, 0);
-  __global float2* samples = lines + base;
+// The sweep of one direction (a, b) on lattice lines (src/lattice_geometry.hpp): every pixel
+// centre lies on exactly one line of the direction, so every receiver is a sample of the
+// line through its own centre, at its own height, and its tree gives the visible samples
+// of its own ray. One work-item per line, from its far end toward -(a, b). Line j's
+// farthest receiver is lines[j] = (col, row, receivers, scratch); receiver i sits at
+// (col - i a, row - i b). Per receiver, the n_samples samples of its period come farthest
+// first (samples[0 .. n_samples - 2], equally spaced between the previous receiver and
+// this one), then the receiver itself (tau 0, weight 1 on its own pixel): steps along the
+// line are uniform, step s of a line is its s-th sample. Only the first period can reach
+// outside the field; samples outside it or without a valid corner are absent. Every sample
+// is inserted into the tree; only receivers read their visible runs (step 3).
+//
+// Scratch (stride 1 in the line-major layout, the launch's line count in the step-major
+// one), entry s of line j at lines[j].w + s * stride:
+//   trees[]   the tree node of step s (height, rank * 2 + leaf, first child, next sibling);
+//             an absent sample's slot holds a NaN height,
+//   prefix[]  the sum of the steps of the present samples before step s (for the area
+//             across holes), if AREA and HAS_NODATA,
+//   visible[], entry_stats[] per-step (count, distance sum) and (horizons m, iterations t,
+//             horizon hash, walk skipped), if ENTRY_STATS.
+// Outputs, added at each receiver's pixel (one launch per direction, and each pixel is a
+// receiver of one line of it, so no atomics; NaN at nodata receivers):
+//   count_sum[]   count_factor * visible samples,
+//   area_sum[]    area_factor * their distance sum in steps, if AREA,
+//   irradiance[]  the gathered irradiance, HFVIS_CHANNELS planes, if BOUNCE (reading
+//                 `radiance`, HFVIS_CHANNELS planes, and `normals`, three planes x, y, z),
+//   line_totals[(first_line + j) * 8 + ...] (present samples, sum m, sum t, naive
+//                 iterations, visible samples, walks skipped by the safe zone, 0, 0), if STATS.
+// With statistics (STATS or ENTRY_STATS) every sample reads its visible runs, as Timonen
+// 2013's Table 2 counts them per line sample; outputs still come from the receivers only.
+// Preconditions: a line has fewer than 2^24 steps (checked by the host). Memory safety does
+// not rest on the predicate: leaves are never deleted and a node only when childless, so
+// every subtree holds a leaf and the root never loses all children; a slot is reused only
+// for the deleted old root. Global size: the launch's lines rounded up to the local size.
+__kernel void intervisibility_lattice(
+    __global const float* heights, int width, int height, __global const int4* lines, int n_lines,
+    __global const LatticeSample* samples, int n_samples, int a, int b, float count_factor, float area_factor,
+    __global int4* trees, __global ulong* prefix, uint stride, __global float2* visible,
+    __global uint4* entry_stats, __global ulong* line_totals, int first_line, __global float* count_sum,
+    __global float* area_sum, __global const float* radiance, __global const float* normals,
+    float cos_azimuth, float sin_azimuth, float step_ground, float half_sector, float wedge,
+    __global float* irradiance) {
+  const int j = get_global_id(0);
+  if (j >= n_lines) return;
+  const int4 line = lines[j];
+  const uint base = (uint)line.w;
   __global int4* tree = trees + base;
-  __global float2* out = visible + base;
+  const uint plane = (uint)(width * height);
 
-  int rank = 0;       // present samples before `step`
-  uint step_sum = 0;  // the sum of their steps
+  int rank = 0;        // present samples before `step`
+  ulong step_sum = 0;  // the sum of their steps
   int root = HFVIS_NONE;
   int prev = HFVIS_NONE, prev2 = HFVIS_NONE;  // the two latest present samples
   float h_prev = 0.0f, h_prev2 = 0.0f;
@@ -456,206 +400,242 @@ __kernel void intervisibility_sweep(__global const SweepDirection* directions, _
   uint zone_skips = 0;  // walks the safe zone skipped
   ulong total_m = 0, total_t = 0, total_naive = 0, total_visible = 0;
 
-  for (int step = 0; step < d.n_steps; ++step) {
-    const uint e = (uint)step * stride;
-    const float h = samples[e].x;
-#if HFVIS_HAS_NODATA  // ranks and step sums serve runs with holes only
-    samples[e].y = (float)rank;
-#if HFVIS_WANT_AREA
-    prefix[base + e] = step_sum;
-#endif
-#endif
-    if (isnan(h)) {
-      out[e] = (float2)(NAN, NAN);
-#if HFVIS_WANT_ENTRY_STATS
-      entry_stats[base + e] = (uint4)(0u, 0u, 0u, 0u);
-#endif
-#if HFVIS_WANT_BOUNCE
-      for (int c = 0; c < HFVIS_CHANNELS; ++c) bounce_out[(base + e) * HFVIS_CHANNELS + c] = NAN;
-#endif
-      continue;
-    }
-    uint m = 0, t = 0, hash = 2166136261u, skipped = 0;
-    int count = 0;
-    uint distance_sum = 0;
-#if HFVIS_WANT_BOUNCE
-    BounceGather gather;
-    bounce_begin(&gather, d, bounce_lines + (base + e) * HFVIS_BOUNCE_STRIDE, h, step, half_sector, wedge);
-#endif
-    if (root == HFVIS_NONE) {
-      tree[e] = (int4)(as_int(h), HFVIS_LEAF, HFVIS_NONE, HFVIS_NONE);  // rank 0
-      head = tail = HFVIS_NONE;
-    } else {
-      // 1. Algorithm 1 for the new root: the old root is its only child; the walk gives the
-      // root's children in order.
-      RootList list = {HFVIS_NONE, HFVIS_NONE, HFVIS_NONE, 0.0f};
-      const int4 old_root = tree[(uint)root * stride];
-      int walk = 1;
-#if HFVIS_REPLACEMENT_CHECK
-      // The last child first (Sec. 7): when it fails, every child fails (their slopes from
-      // the old root fall toward it) and the old root is replaced; inside the safe zone
-      // nothing else changes and the walk is skipped (a walk leaves the zone invalid: it
-      // runs only when the zone is). When it passes, the old root stays.
-      int replaced = 0;
-      if (tail != HFVIS_NONE) {
-        ++t;
-        replaced = chord_side(tail_h, h_prev, h, (float)(root - tail), (float)(step - root)) <= 0;
+  int step = 0;
+  int col = line.x, row = line.y;  // the current period's receiver
+  for (int i = 0; i < line.z; ++i, col -= a, row -= b) {
+    const uint pixel = (uint)(row * width + col);
+    for (int q = 0; q < n_samples; ++q, ++step) {
+      const uint e = (uint)step * stride;
+      const int receiver = q == n_samples - 1;
+      __global const LatticeSample* s = samples + q;
+      const int x0 = col + s->ox, y0 = row + s->oy, ex = s->ex, ey = s->ey;
+      float h = NAN;
+      if (i > 0 || (x0 >= 0 && x0 + ex <= width - 1 && y0 >= 0 && y0 + ey <= height - 1)) {
+        const uint at = (uint)(y0 * width + x0);
+        // The receiver is its pixel's height as it is (1 h + 0 h would make an infinity NaN).
+        h = ex + ey == 0 ? heights[at]
+                         : lattice_height(heights, at, (uint)ex, (uint)(ey * width), s->w00, s->w10, s->w01, s->w11);
       }
+#if HFVIS_HAS_NODATA && HFVIS_WANT_AREA  // step sums serve runs with holes only
+      prefix[base + e] = step_sum;
+#endif
+      if (isnan(h)) {
+        tree[e] = (int4)(as_int(NAN), 0, HFVIS_NONE, HFVIS_NONE);
+#if HFVIS_WANT_ENTRY_STATS
+        visible[base + e] = (float2)(NAN, NAN);
+        entry_stats[base + e] = (uint4)(0u, 0u, 0u, 0u);
+#endif
+        if (receiver) {  // a nodata pixel
+#if HFVIS_WANT_COUNT
+          count_sum[pixel] = NAN;
+#endif
+#if HFVIS_WANT_AREA
+          area_sum[pixel] = NAN;
+#endif
+#if HFVIS_WANT_BOUNCE
+          for (int ch = 0; ch < HFVIS_CHANNELS; ++ch) irradiance[(uint)ch * plane + pixel] = NAN;
+#endif
+        }
+        continue;
+      }
+      uint m = 0, t = 0, hash = 2166136261u, skipped = 0;
+      int count = 0;
+      ulong distance_sum = 0;
+#if HFVIS_WANT_BOUNCE
+      BounceGather gather;
+      if (receiver)
+        bounce_begin(&gather, normals[pixel], normals[plane + pixel], normals[2u * plane + pixel], cos_azimuth,
+                     sin_azimuth, step_ground, h, step, half_sector, wedge);
+#endif
+      if (root == HFVIS_NONE) {
+        tree[e] = (int4)(as_int(h), HFVIS_LEAF, HFVIS_NONE, HFVIS_NONE);  // rank 0
+        head = tail = HFVIS_NONE;
+      } else {
+        // 1. Algorithm 1 for the new root: the old root is its only child; the walk gives the
+        // root's children in order.
+        RootList list = {HFVIS_NONE, HFVIS_NONE, HFVIS_NONE, 0.0f};
+        const int4 old_root = tree[(uint)root * stride];
+        int walk = 1;
+#if HFVIS_REPLACEMENT_CHECK
+        // The last child first (Sec. 7): when it fails, every child fails (their slopes from
+        // the old root fall toward it) and the old root is replaced; inside the safe zone
+        // nothing else changes and the walk is skipped (a walk leaves the zone invalid: it
+        // runs only when the zone is). When it passes, the old root stays.
+        int replaced = 0;
+        if (tail != HFVIS_NONE) {
+          ++t;
+          replaced = chord_side(tail_h, h_prev, h, (float)(root - tail), (float)(step - root)) <= 0;
+        }
 #endif
 #if HFVIS_SAFE_ZONE
-      zone_valid = zone_valid && replaced && safe_zone_inside(&zone, step, h);
-      if (zone_valid) {
-        // The old root's children are the new root's, and the old root is deleted (it is
-        // no leaf: only a line's first sample is a leaf as root, and it has no children).
-        walk = 0;
-        skipped = 1;
-        list.head = head;
-        list.tail = tail;
-        list.tail_h = tail_h;
-      }
+        zone_valid = zone_valid && replaced && safe_zone_inside(&zone, step, h);
+        if (zone_valid) {
+          // The old root's children are the new root's, and the old root is deleted (it is
+          // no leaf: only a line's first sample is a leaf as root, and it has no children).
+          walk = 0;
+          skipped = 1;
+          list.head = head;
+          list.tail = tail;
+          list.tail_h = tail_h;
+        }
 #endif
 #if !HFVIS_REPLACEMENT_CHECK
-      const int replaced = 0;  // not known
+        const int replaced = 0;  // not known
 #endif
-      if (walk) {
+        if (walk) {
 #if HFVIS_DEFERRED_WRITES
-        // The old root's level in registers: its children in order, each checked (unless
-        // the last child's check decided it) and, when it fails, walked and appended; links
-        // are written only where they change.
-        int c = old_root.z;
-        while (c != HFVIS_NONE) {
-          const int4 child = tree[(uint)c * stride];
-          if (!replaced) {
-            if (HFVIS_REPLACEMENT_CHECK && c == tail) break;  // known to pass
-            ++t;
-            if (chord_side(as_float(child.x), h_prev, h, (float)(root - c), (float)(step - root)) > 0) break;
+          // The old root's level in registers: its children in order, each checked (unless
+          // the last child's check decided it) and, when it fails, walked and appended; links
+          // are written only where they change.
+          int c = old_root.z;
+          while (c != HFVIS_NONE) {
+            const int4 child = tree[(uint)c * stride];
+            if (!replaced) {
+              if (HFVIS_REPLACEMENT_CHECK && c == tail) break;  // known to pass
+              ++t;
+              if (chord_side(as_float(child.x), h_prev, h, (float)(root - c), (float)(step - root)) > 0) break;
+            }
+            t += hull_tree_walk(tree, stride, c, child, h, step, &list);
+            c = child.w;
           }
-          t += hull_tree_walk(tree, stride, c, child, h, step, &list);
-          c = child.w;
-        }
-        if (c != HFVIS_NONE || (old_root.y & HFVIS_LEAF)) {  // it stays, as the last child
-          if (c != old_root.z) tree[(uint)root * stride].z = c;
-          root_append(tree, stride, &list, root, h_prev, HFVIS_NONE);
-        }
+          if (c != HFVIS_NONE || (old_root.y & HFVIS_LEAF)) {  // it stays, as the last child
+            if (c != old_root.z) tree[(uint)root * stride].z = c;
+            root_append(tree, stride, &list, root, h_prev, HFVIS_NONE);
+          }
 #else
-        t += hull_tree_walk(tree, stride, root, old_root, h, step, &list);
+          t += hull_tree_walk(tree, stride, root, old_root, h, step, &list);
 #endif
-      }
+        }
 
-      // 2. Now that the old root's next sample is known, classify it (Eq. 1). A convex
-      // sample after a concave one starts a segment: if its node survived it is the root's
-      // last child and becomes a leaf; otherwise a new leaf becomes the last child.
-      if (prev2 != HFVIS_NONE) {
-        const int side = chord_side(h_prev2, h_prev, h, (float)(prev - prev2), (float)(step - prev));
-        const int cls = side > 0 ? HFVIS_CONVEX : side < 0 ? HFVIS_CONCAVE : class_last;
-        if (cls == HFVIS_CONVEX && class_last == HFVIS_CONCAVE) {
-          if (list.tail == prev) {
-            tree[(uint)prev * stride].y = (rank - 1) * 2 + HFVIS_LEAF;
-          } else {
-            tree[(uint)prev * stride] =
-                (int4)(as_int(h_prev), (rank - 1) * 2 + HFVIS_LEAF, HFVIS_NONE, HFVIS_NONE);
-            root_append(tree, stride, &list, prev, h_prev, HFVIS_NONE);
+        // 2. Now that the old root's next sample is known, classify it (Eq. 1). A convex
+        // sample after a concave one starts a segment: if its node survived it is the root's
+        // last child and becomes a leaf; otherwise a new leaf becomes the last child.
+        if (prev2 != HFVIS_NONE) {
+          const int side = chord_side(h_prev2, h_prev, h, (float)(prev - prev2), (float)(step - prev));
+          const int cls = side > 0 ? HFVIS_CONVEX : side < 0 ? HFVIS_CONCAVE : class_last;
+          if (cls == HFVIS_CONVEX && class_last == HFVIS_CONCAVE) {
+            if (list.tail == prev) {
+              tree[(uint)prev * stride].y = (rank - 1) * 2 + HFVIS_LEAF;
+            } else {
+              tree[(uint)prev * stride] = (int4)(as_int(h_prev), (rank - 1) * 2 + HFVIS_LEAF, HFVIS_NONE, HFVIS_NONE);
+              root_append(tree, stride, &list, prev, h_prev, HFVIS_NONE);
+            }
           }
+          class_last = cls;
         }
-        class_last = cls;
-      }
-      if (!HFVIS_DEFERRED_WRITES || list.tail_next != HFVIS_NONE) tree[(uint)list.tail * stride].w = HFVIS_NONE;
-      tree[e] = (int4)(as_int(h), rank * 2, list.head, HFVIS_NONE);
-      head = list.head;
-      tail = list.tail;
-      tail_h = list.tail_h;
+        if (!HFVIS_DEFERRED_WRITES || list.tail_next != HFVIS_NONE) tree[(uint)list.tail * stride].w = HFVIS_NONE;
+        tree[e] = (int4)(as_int(h), rank * 2, list.head, HFVIS_NONE);
+        head = list.head;
+        tail = list.tail;
+        tail_h = list.tail_h;
 
-      // 3. Visible samples from the horizons, farthest first: the run of horizon hp ends
-      // at run_end() before the next horizon np, or at the receiver. Without absent
-      // samples in between, ranks and distance sums follow from the steps alone.
-      // The safe zone for the next samples is refreshed here, where the root's children
-      // (the horizons) are visited anyway.
+        // 3. At a receiver (at every sample for statistics), the visible samples from the
+        // horizons, farthest first: the run of horizon hp ends at run_end() before the next
+        // horizon np, or at the sample.
+        // Without absent samples in between, ranks and distance sums follow from the steps
+        // alone. The safe zone for the next samples is refreshed here, where the root's
+        // children (the horizons) are visited anyway.
+        if (receiver || HFVIS_ALL_HORIZONS) {
 #if HFVIS_SAFE_ZONE
-      const int refresh_zone = !zone_valid;
-      if (refresh_zone) safe_zone_begin(&zone, step);
+          const int refresh_zone = !zone_valid;
+          if (refresh_zone) safe_zone_begin(&zone, step);
 #endif
-      int hp = head;
-      int4 hz = tree[(uint)hp * stride];
-      int hp_rank = hz.y >> 1;
-      for (;;) {
-        const int np = hz.w;
-        ++m;
+          int hp = head;
+          int4 hz = tree[(uint)hp * stride];
+          int hp_rank = hz.y >> 1;
+          for (;;) {
+            const int np = hz.w;
+            ++m;
 #if HFVIS_SAFE_ZONE
-        if (refresh_zone && hz.z != HFVIS_NONE)
-          safe_zone_add(&zone, as_float(hz.x), hp, as_float(tree[(uint)hz.z * stride].x), hz.z);
+            if (refresh_zone && hz.z != HFVIS_NONE)
+              safe_zone_add(&zone, as_float(hz.x), hp, as_float(tree[(uint)hz.z * stride].x), hz.z);
 #endif
-        hash = (hash ^ (uint)hp) * 16777619u;
-        int end = step, end_rank = rank, np_rank = rank;
-        int4 nz = hz;
-        if (np != HFVIS_NONE) {
-          nz = tree[(uint)np * stride];
-          np_rank = nz.y >> 1;
-          end = np;
-          end_rank = np_rank;
-        }
-        // Absent samples lie between present ones only where heights are missing: a line
-        // enters and leaves the (convex) field once.
-        const int holes = HFVIS_HAS_NODATA && end_rank - hp_rank != end - hp;
-        if (np != HFVIS_NONE) {
-          end = run_end(samples, stride, hp, np, as_float(nz.x), step, h, holes);
-          end_rank = end == np ? np_rank : holes ? (int)samples[(uint)end * stride].y : hp_rank + (end - hp);
-        }
+            hash = (hash ^ (uint)hp) * 16777619u;
+            int end = step, end_rank = rank, np_rank = rank;
+            int4 nz = hz;
+            if (np != HFVIS_NONE) {
+              nz = tree[(uint)np * stride];
+              np_rank = nz.y >> 1;
+              end = np;
+              end_rank = np_rank;
+            }
+            // Absent samples lie between present ones only where heights are missing: a line
+            // enters the (convex) field once, and leaves it at its last receiver.
+            const int holes = HFVIS_HAS_NODATA && end_rank - hp_rank != end - hp;
+            if (np != HFVIS_NONE) {
+              end = run_end(tree, stride, hp, np, as_float(nz.x), step, h, holes);
+              end_rank = end == np ? np_rank : holes ? tree[(uint)end * stride].y >> 1 : hp_rank + (end - hp);
+            }
 #if HFVIS_WANT_BOUNCE
-        for (int x = hp; x < end; ++x) {
-          const float hx = samples[(uint)x * stride].x;
-          if (!isnan(hx))
-            bounce_visit(&gather, hx, x, bounce_lines + (base + (uint)x * stride) * HFVIS_BOUNCE_STRIDE);
-        }
-        gather.adjacent = end == np;
+            for (int x = hp; receiver && x < end; ++x) {
+              const float hx = as_float(tree[(uint)x * stride].x);
+              if (!isnan(hx)) {
+                float emitted[HFVIS_CHANNELS];
+                lattice_radiance(radiance, width, plane, line, samples, n_samples, a, b, x, emitted);
+                bounce_visit(&gather, hx, x, emitted);
+              }
+            }
+            gather.adjacent = end == np;
 #endif
-        const int run = end_rank - hp_rank;
-        count += run;
+            const int run = end_rank - hp_rank;
+            count += run;
 #if HFVIS_WANT_AREA
-        // Sum of (step - x) over the run's present samples x, mod 2^32 (the total is below).
-        uint steps_sum;
-        if (!holes) {  // x = hp .. end - 1: run * (hp + end - 1) / 2, halving the even factor
-          const uint a = (uint)run, b = (uint)(hp + end - 1);
-          steps_sum = (a & 1u) ? a * (b >> 1) : (a >> 1) * b;
-        } else {
-          const uint end_sum = end == step ? step_sum : prefix[base + (uint)end * stride];
-          steps_sum = end_sum - prefix[base + (uint)hp * stride];
-        }
-        distance_sum += (uint)step * (uint)run - steps_sum;
+            // Sum of (step - x) over the run's present samples x.
+            ulong steps_sum;
+            if (!holes) {  // x = hp .. end - 1
+              steps_sum = (ulong)run * (ulong)(hp + end - 1) / 2;
+            } else {
+              const ulong end_sum = end == step ? step_sum : prefix[base + (uint)end * stride];
+              steps_sum = end_sum - prefix[base + (uint)hp * stride];
+            }
+            distance_sum += (ulong)step * (ulong)run - steps_sum;
 #endif
-        if (np == HFVIS_NONE) break;
-        hz = nz;
-        hp = np;
-        hp_rank = np_rank;
-      }
+            if (np == HFVIS_NONE) break;
+            hz = nz;
+            hp = np;
+            hp_rank = np_rank;
+          }
 #if HFVIS_SAFE_ZONE
-      if (refresh_zone) {
-        safe_zone_end(&zone);
-        zone_valid = 1;
+          if (refresh_zone) {
+            safe_zone_end(&zone);
+            zone_valid = 1;
+          }
+#endif
+        }
       }
+      if (receiver) {
+#if HFVIS_WANT_COUNT
+        count_sum[pixel] += count_factor * (float)count;
 #endif
-    }
-    out[e] = (float2)((float)count, (float)distance_sum);
+#if HFVIS_WANT_AREA
+        area_sum[pixel] += area_factor * (float)distance_sum;
+#endif
 #if HFVIS_WANT_BOUNCE
-    bounce_finish(&gather, bounce_out + (base + e) * HFVIS_CHANNELS);
+        float gathered[HFVIS_CHANNELS];
+        bounce_finish(&gather, gathered);
+        for (int ch = 0; ch < HFVIS_CHANNELS; ++ch) irradiance[(uint)ch * plane + pixel] += gathered[ch];
 #endif
+      }
 #if HFVIS_WANT_ENTRY_STATS
-    entry_stats[base + e] = (uint4)(m, t, hash, skipped);
+      visible[base + e] = (float2)((float)count, (float)distance_sum);
+      entry_stats[base + e] = (uint4)(m, t, hash, skipped);
 #endif
-    total_m += m;
-    total_t += t;
-    zone_skips += skipped;
-    total_naive += (ulong)rank;
-    total_visible += (ulong)count;
-    prev2 = prev;
-    h_prev2 = h_prev;
-    prev = step;
-    h_prev = h;
-    root = step;
-    ++rank;
-    step_sum += (uint)step;
+      total_m += m;
+      total_naive += (ulong)rank;
+      total_visible += (ulong)count;
+      total_t += t;
+      zone_skips += skipped;
+      prev2 = prev;
+      h_prev2 = h_prev;
+      prev = step;
+      h_prev = h;
+      root = step;
+      ++rank;
+      step_sum += (ulong)step;
+    }
   }
 #if HFVIS_WANT_STATS
-  __global ulong* totals = line_totals + ((uint)b * (uint)totals_stride + (uint)line) * HFVIS_LINE_TOTALS;
+  __global ulong* totals = line_totals + (uint)(first_line + j) * HFVIS_LINE_TOTALS;
   totals[0] = (ulong)rank;
   totals[1] = total_m;
   totals[2] = total_t;
@@ -668,14 +648,15 @@ __kernel void intervisibility_sweep(__global const SweepDirection* directions, _
 }
 
 // ---------------------------------------------------------------------------------------
-// Reduction and the naive method.
+// The naive method.
 //
 // Visible ground area (the "total viewshed"): around receiver p, direction k stands for
 // the azimuthal sector 2*pi/K, and a sample at distance rho (ground units) along it for
 // the ring of width drho = step_length * ground_per_pixel between rho -/+ drho/2, whose
 // sector has area (2*pi/K) * rho * drho. With rho = i * drho for the sample i steps away,
 // direction k adds (2*pi/K) * drho^2 * (sum of i over the visible samples). On a flat
-// field this tends to the field's area seen from p as K grows.
+// field this tends to the field's area seen from p as K grows. The sweep does the same
+// with its own step and each direction's share of the circle.
 
 // Adds one direction's visible samples (count and distance sum in steps) to the sums.
 HFVIS_INLINE void add_direction(const SweepDirection d, float sector, float count, float distance_steps,
@@ -691,49 +672,6 @@ HFVIS_INLINE void accumulate_visible(uint pixel, int nodata, float count, float 
 #if HFVIS_WANT_AREA
   area_sum[pixel] = nodata ? NAN : area_sum[pixel] + area;
 #endif
-}
-
-// Reduction: for every receiver pixel and every direction of the batch, the bilinear
-// interpolation of the (count, distance sum) of the (up to) four surrounding line entries,
-// each exact for its own sample; absent entries are left out and the weights renormalised
-// (none left: nothing seen in that direction). On axis directions every pixel is a line
-// sample (weight 1 on one entry), so the result is exactly that sample's count.
-// `sector` = 2*pi/K. Straight-line code (clamped reads, masked sums, a uniform barrier)
-// so that PoCL vectorises it, as horizon_naive. Global size: (W, H) rounded up to the
-// local size.
-__kernel void intervisibility_reduce(__global const float* heights, int width, int height,
-                                     __global const SweepDirection* directions, int batch_size, float sector,
-                                     __global const float2* visible, __global float* count_sum,
-                                     __global float* area_sum) {
-  int c = get_global_id(0), r = get_global_id(1);
-  int valid = c < width && r < height;
-  int cc = min(c, width - 1), rr = min(r, height - 1);
-  const uint pixel = (uint)(rr * width + cc);
-  float counts = 0.0f, area = 0.0f;
-  for (int b = 0; b < batch_size; ++b) {
-    barrier(CLK_LOCAL_MEM_FENCE);  // see horizon_naive: keeps the work-item loop innermost
-    const SweepDirection d = load_direction(directions + b);
-    int j0, i0;
-    float fu, fv;
-    receiver_cell(d, (float)cc, (float)rr, &j0, &i0, &fu, &fv);
-    float weight = 0.0f, count = 0.0f, distance = 0.0f;
-    for (int k = 0; k < 4; ++k) {
-      float w;
-      int i;
-      __global const float* seen = (__global const float*)(visible + cell_corner(d, j0, i0, fu, fv, k, &w, &i));
-      float seen_count = seen[0], seen_distance = seen[1];  // scalar loads, for the vectoriser
-      int use = w > 0.0f && !isnan(seen_count);
-      weight += use ? w : 0.0f;
-      count += use ? w * seen_count : 0.0f;
-      distance += use ? w * seen_distance : 0.0f;
-    }
-    // Divide only when weights are missing: a single full weight stays exact.
-    int renormalise = weight > 0.0f && weight != 1.0f;
-    count = renormalise ? count / weight : count;
-    distance = renormalise ? distance / weight : distance;
-    add_direction(d, sector, count, distance, &counts, &area);
-  }
-  if (valid) accumulate_visible(pixel, isnan(heights[pixel]), counts, area, count_sum, area_sum);
 }
 
 // Naive method (Timonen 2013, Sec. 1): for every pixel, march the ray in steps of

@@ -81,33 +81,6 @@ HFVIS_INLINE SweepDirection load_direction(__global const SweepDirection* p) {
   return d;
 }
 
-// Index of entry (line, step) of direction d in a line-sized buffer, and the distance
-// between consecutive steps of one line.
-HFVIS_INLINE uint line_entry(const SweepDirection d, int line, int step) {
-#if HFVIS_LINE_MAJOR
-  return d.buffer_offset + (uint)line * (uint)d.n_steps + (uint)step;
-#else
-  return d.buffer_offset + (uint)step * (uint)d.n_lines + (uint)line;
-#endif
-}
-
-HFVIS_INLINE uint line_stride(const SweepDirection d) {
-#if HFVIS_LINE_MAJOR
-  return 1u;
-#else
-  return (uint)d.n_lines;
-#endif
-}
-
-// Position of step `step` of line `line` (pixel axes). Scalars, not float2: PoCL's
-// vectoriser widens scalar code across work-items but not vector-typed values.
-HFVIS_INLINE void sweep_position(const SweepDirection d, int line, int step, float* x, float* y) {
-  float s = (float)(d.line_first + line) * d.line_spacing;
-  float t = (float)(d.step_top - step) * d.step_length;
-  *x = s * d.perp_x + t * d.dir_x;
-  *y = s * d.perp_y + t * d.dir_y;
-}
-
 // How far (pixels along the unit direction (dir_x, dir_y)) the longest ray of this
 // work-group's pixel tile runs inside the field: the same for every work-item of the group,
 // so loops bounded by it have a uniform trip count and PoCL runs the group's work-items as
@@ -175,57 +148,33 @@ HFVIS_INLINE float sample_height(__global const float* heights, int width, int h
 #endif
 }
 
-// Where receiver pixel (x, y) falls among direction d's line samples: the cell of the
-// four entries around it, corner k = 0..3 at (line j0 + (k & 1), step i0 + (k >> 1)), and
-// its fractional position (fu, fv) in the cell. Every reduction interpolates this way.
-HFVIS_INLINE void receiver_cell(const SweepDirection d, float x, float y, int* j0, int* i0, float* fu,
-                                float* fv) {
-  float t = x * d.dir_x + y * d.dir_y;
-  float u = (x * d.perp_x + y * d.perp_y) * d.lines_per_unit - (float)d.line_first;
-  float v = (float)d.step_top - t * d.samples_per_unit;
-  *j0 = (int)floor(u);
-  *i0 = (int)floor(v);
-  *fu = u - (float)*j0;
-  *fv = v - (float)*i0;
-}
+// One sample of a period (src/lattice_geometry.hpp, struct LatticeSample): nine 4-byte
+// members, read field by field.
+typedef struct {
+  float tau;                 // pixels from the period's receiver toward +(a, b)
+  int ox, oy;                // the cell's lower corner, relative to the receiver
+  int ex, ey;                // 1 where the sample is strictly inside the cell along x (y)
+  float w00, w10, w01, w11;  // bilinear weights of the cell's corners
+} LatticeSample;
 
-// Corner k of a receiver's cell: its bilinear weight (0 where it lies outside the line
-// buffer), its step, and its entry index, clamped into the buffer so that reading it is
-// always safe (branch-free, for the vectoriser).
-HFVIS_INLINE uint cell_corner(const SweepDirection d, int j0, int i0, float fu, float fv, int k,
-                              float* weight, int* step) {
-  int j = j0 + (k & 1), i = i0 + (k >> 1);
-  float w = ((k & 1) ? fu : 1.0f - fu) * ((k >> 1) ? fv : 1.0f - fv);
-  int in_buffer = j >= 0 && j < d.n_lines && i >= 0 && i < d.n_steps;
-  *weight = in_buffer ? w : 0.0f;
-  *step = i;
-  return line_entry(d, clamp(j, 0, d.n_lines - 1), clamp(i, 0, d.n_steps - 1));
-}
-
-// Presampling pass: the height at every (step, line) of the batch's directions, NaN where
-// the sample lies outside the field or has no valid corner. Uniform control flow, so
-// PoCL vectorises it across lines; the sweep then only reads one float per step.
-// Global size: (max lines, max steps, directions in batch), or (max steps, max lines, ...)
-// with HFVIS_LINE_MAJOR; any local size.
-__kernel void presample_lines(__global const float* heights, int width, int height,
-                              __global const SweepDirection* directions, __global float2* lines) {
-#if HFVIS_LINE_MAJOR  // work-items adjacent along a line write adjacent entries
-  int step = get_global_id(0), line = get_global_id(1);
+// Height of the bilinear surface at a lattice sample whose cell corner is at entry `at`;
+// with nodata, only the valid corners of positive weight count, renormalised (NaN when
+// none). Crossing samples have ex or ey 0: their zero-weight corners repeat a used one.
+HFVIS_INLINE float lattice_height(__global const float* heights, uint at, uint right, uint down, float w00,
+                                  float w10, float w01, float w11) {
+  float h00 = heights[at], h10 = heights[at + right], h01 = heights[at + down],
+        h11 = heights[at + down + right];
+  float plain = w00 * h00 + w10 * h10 + w01 * h01 + w11 * h11;
+#if HFVIS_HAS_NODATA
+  int v00 = w00 > 0.0f && !isnan(h00), v10 = w10 > 0.0f && !isnan(h10);
+  int v01 = w01 > 0.0f && !isnan(h01), v11 = w11 > 0.0f && !isnan(h11);
+  float sum = (v00 ? w00 * h00 : 0.0f) + (v10 ? w10 * h10 : 0.0f) + (v01 ? w01 * h01 : 0.0f) +
+              (v11 ? w11 * h11 : 0.0f);
+  float weight = (v00 ? w00 : 0.0f) + (v10 ? w10 : 0.0f) + (v01 ? w01 : 0.0f) + (v11 ? w11 : 0.0f);
+  return isnan(plain) ? (weight > 0.0f ? sum / weight : NAN) : plain;
 #else
-  int line = get_global_id(0), step = get_global_id(1);
+  return plain;
 #endif
-  const SweepDirection d = load_direction(directions + get_global_id(2));
-  if (line >= d.n_lines || step >= d.n_steps) return;
-  float x, y;
-  sweep_position(d, line, step, &x, &y);
-  // Sample unconditionally (reads are clamped into the field), then mask: a call under a
-  // condition keeps PoCL from vectorising.
-  float sampled = sample_height(heights, width, height, x, y);
-  float h = inside_field(x, y, width, height) ? sampled : NAN;
-  // Two scalar stores rather than one float2 store, for the vectoriser.
-  __global float* entry = (__global float*)(lines + line_entry(d, line, step));
-  entry[0] = h;
-  entry[1] = -1.0f;
 }
 
 #endif  // HFVIS_SWEEP_FRAMEWORK_CL

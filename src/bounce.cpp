@@ -1,7 +1,8 @@
-// bounce.cpp: the one-bounce operation on the device: per batch of directions, presample
-// heights, radiance and normals -> convex hull tree sweep with the gather -> reduction into
-// the irradiance sums.
+// bounce.cpp: the one-bounce operation on the device: per direction, one launch of the
+// convex hull tree sweep on lattice lines with the gather, each receiver adding its
+// irradiance straight into its pixel's sums.
 #include <algorithm>
+#include <cmath>
 
 #include "bounce_internal.hpp"
 #include "hfvis/errors.hpp"
@@ -13,73 +14,21 @@ namespace hfvis {
 namespace detail {
 namespace {
 
-std::size_t attributeBytes(int channels) { return (channels + kBounceNormalFloats) * sizeof(float); }
-
 TreeProgramFlags bounceFlags(const BounceInputs& inputs, const HullTreeTuning& tuning) {
   TreeProgramFlags flags;
   flags.tuning = tuning;
   flags.has_nodata = inputs.has_nodata;
+  flags.count = false;
   flags.area = false;
   flags.stats = false;
   flags.bounce_channels = inputs.channels();
   return flags;
 }
 
-// The inputs' planes, uploaded once per run.
-struct BouncePlanes {
-  cl::Buffer heights, normals, radiance;
-};
-
-BouncePlanes uploadPlanes(ContextState& st, const BounceInputs& inputs) {
-  auto upload = [&](const std::vector<std::vector<float>>& planes) {
-    std::vector<float> joined;
-    for (const auto& p : planes) joined.insert(joined.end(), p.begin(), p.end());
-    return cl::Buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, joined.size() * sizeof(float),
-                      joined.data());
-  };
-  BouncePlanes planes;
-  planes.heights =
-      cl::Buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, inputs.heights.size() * sizeof(float),
-                 const_cast<float*>(inputs.heights.data()));
-  planes.normals = upload(inputs.normals);
-  planes.radiance = upload(inputs.radiance);
-  return planes;
-}
-
-// The sweep's buffers for `entries` line entries (the bounce needs no area, statistics or
-// per-entry statistics).
-TreeSweepBuffers sweepBuffers(ContextState& st, std::size_t entries, int channels, int directions) {
-  TreeSweepBuffers b;
-  b.lines = deviceBuffer(st, entries * kTreeLineBytes);
-  b.trees = deviceBuffer(st, entries * kTreeNodeBytes);
-  b.visible = deviceBuffer(st, entries * kTreeVisibleBytes);
-  b.prefix = deviceBuffer(st, 0);
-  b.entry_stats = deviceBuffer(st, 0);
-  b.line_totals = deviceBuffer(st, 0);
-  b.bounce_lines = deviceBuffer(st, entries * attributeBytes(channels));
-  b.bounce_out = deviceBuffer(st, entries * channels * sizeof(float));
-  bounceWedge(directions, &b.half_sector, &b.wedge);
-  return b;
-}
-
-// Presampling of heights (presample_lines) and of radiance and normals (bounce_presample).
-void enqueueBouncePresample(ContextState& st, cl::Program& program, const BouncePlanes& planes, int width,
-                            int height, const cl::Buffer& directions, const SweepBatch& batch,
-                            const TreeSweepBuffers& b) {
-  enqueuePresample(st, program, planes.heights, width, height, directions, batch, b.lines);
-  cl::Kernel presample(program, "bounce_presample");
-  presample.setArg(0, planes.radiance);
-  presample.setArg(1, planes.normals);
-  presample.setArg(2, width);
-  presample.setArg(3, height);
-  presample.setArg(4, directions);
-  presample.setArg(5, b.bounce_lines);
-  const std::size_t lines = batch.maxLines(), steps = batch.maxSteps();
-  const bool line_major = lineMajorLayout(st);
-  st.launch(presample,
-            cl::NDRange(roundUp(line_major ? steps : lines, kLineGroup),
-                        roundUp(line_major ? lines : steps, kPresampleRows), batch.directions.size()),
-            cl::NDRange(kLineGroup, kPresampleRows, 1));
+std::vector<float> joined(const std::vector<std::vector<float>>& planes) {
+  std::vector<float> all;
+  for (const auto& p : planes) all.insert(all.end(), p.begin(), p.end());
+  return all;
 }
 
 BounceResult run(const ComputeContext& context, const HeightField& field, const ExitRadiance& radiance,
@@ -87,59 +36,42 @@ BounceResult run(const ComputeContext& context, const HeightField& field, const 
   ContextState& st = stateOf(context);
   const BounceInputs inputs = prepareBounce(field, radiance);
   const int channels = inputs.channels();
-  const auto all = runDirections(field, options);
-  IntervisibilityOutputs counts;
-  counts.visible_count = true;
-  checkLineLimits(all, inputs.heights, counts);
+  const std::vector<TreeDirection> directions = treeDirections(field, options);
+  checkTreeLimits(directions, inputs.heights);
   const TreeProgramFlags flags = bounceFlags(inputs, options.tree);
-  cl::Program program = st.program(treeProgramFile(flags), treeProgramOptions(flags, st));
+  cl::Program program = st.program("intervisibility.cl", treeProgramOptions(flags, st));
   const std::size_t plane = field.pixelCount();
-
-  SweepMemory memory;
   // Heights, normals, radiance and the irradiance sums.
-  memory.fixed_bytes = plane * sizeof(float) * (1 + 3 + 2 * channels);
-  memory.bytes_per_entry = kTreeLineBytes + kTreeNodeBytes + kTreeVisibleBytes + attributeBytes(channels) +
-                           channels * sizeof(float);
-  memory.largest_entry_bytes = std::max(kTreeNodeBytes, attributeBytes(channels));
-  const auto batches = planSweepBatches(all, memory, options.memory_budget_bytes, st.info);
-  std::size_t max_entries = 0;
-  for (const auto& b : batches) max_entries = std::max(max_entries, b.entries);
+  const std::size_t fixed = plane * sizeof(float) * (1 + 3 + 2 * channels);
+  TreeBuffers b;
+  allocateTreeScratch(st, flags, directions,
+                      planTreeScratch(directions, fixed, treeEntryBytes(flags), options.memory_budget_bytes, st.info),
+                      b);
+  auto upload = [&](const std::vector<float>& values) {
+    return cl::Buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, values.size() * sizeof(float),
+                      const_cast<float*>(values.data()));
+  };
+  b.heights = upload(inputs.heights);
+  b.normals = upload(joined(inputs.normals));
+  b.radiance = upload(joined(inputs.radiance));
+  b.count_sum = b.area_sum = deviceBuffer(st, 0);
+  b.irradiance = deviceBuffer(st, channels * plane * sizeof(float));
+  const float zero = 0.0f;
+  st.queue.enqueueFillBuffer(b.irradiance, zero, 0, channels * plane * sizeof(float));
 
   BounceResult result;
   result.width = field.width;
   result.height = field.height;
   result.directions = options.directions;
   for (int k = 0; k < options.directions; ++k) result.azimuths.push_back(directionAzimuth(k, options));
-
-  const BouncePlanes planes = uploadPlanes(st, inputs);
-  const TreeSweepBuffers buffers = sweepBuffers(st, max_entries, channels, options.directions);
-  cl::Buffer sums = deviceBuffer(st, channels * plane * sizeof(float));
-  const float zero = 0.0f;
-  st.queue.enqueueFillBuffer(sums, zero, 0, channels * plane * sizeof(float));
-
-  const cl::NDRange pixels(roundUp(field.width, kTileX), roundUp(field.height, kTileY));
-  int done = 0;
-  for (const SweepBatch& batch : batches) {
-    const cl::Buffer directions = uploadDirections(st, batch.directions);
-    const int batch_size = static_cast<int>(batch.directions.size());
-    enqueueBouncePresample(st, program, planes, field.width, field.height, directions, batch, buffers);
-    enqueueTreeSweep(st, program, directions, batch, buffers);
-    cl::Kernel reduce(program, "bounce_reduce");
-    reduce.setArg(0, planes.heights);
-    reduce.setArg(1, field.width);
-    reduce.setArg(2, field.height);
-    reduce.setArg(3, directions);
-    reduce.setArg(4, batch_size);
-    reduce.setArg(5, buffers.bounce_out);
-    reduce.setArg(6, sums);
-    st.launch(reduce, pixels, cl::NDRange(kTileX, kTileY));
+  for (std::size_t k = 0; k < directions.size(); ++k) {
+    enqueueTreeDirection(st, program, directions[k], field.width, field.height, b);
     st.queue.finish();
-    done += batch_size;
-    if (options.progress) options.progress(done, options.directions);
+    if (options.progress) options.progress(static_cast<int>(k + 1), static_cast<int>(directions.size()));
   }
   result.irradiance.assign(channels, std::vector<float>(plane));
   for (int c = 0; c < channels; ++c) {
-    st.queue.enqueueReadBuffer(sums, CL_TRUE, c * plane * sizeof(float), plane * sizeof(float),
+    st.queue.enqueueReadBuffer(b.irradiance, CL_TRUE, c * plane * sizeof(float), plane * sizeof(float),
                                result.irradiance[c].data());
   }
   return result;
@@ -148,54 +80,31 @@ BounceResult run(const ComputeContext& context, const HeightField& field, const 
 }  // namespace
 
 BounceLineView bounceLinesOnDevice(const ComputeContext& context, const HeightField& field,
-                                   const BounceInputs& inputs, const SweepDirection& direction,
-                                   int directions, const HullTreeTuning& tuning) {
+                                   const BounceInputs& inputs, const TreeDirection& d,
+                                   const HullTreeTuning& tuning) {
   validate(tuning);
   return translateOpenClErrors([&] {
-    ContextState& st = stateOf(context);
-    const TreeProgramFlags flags = bounceFlags(inputs, tuning);
-    cl::Program program = st.program(treeProgramFile(flags), treeProgramOptions(flags, st));
-    const bool line_major = lineMajorLayout(st);
-    const int channels = inputs.channels();
-    const int stride = channels + kBounceNormalFloats;
-    SweepBatch batch;
-    batch.directions = {direction};
-    batch.directions[0].buffer_offset = 0;
-    batch.entries = direction.entries();
-    const std::size_t entries = batch.entries;
-    const BouncePlanes planes = uploadPlanes(st, inputs);
-    const cl::Buffer directions_buffer = uploadDirections(st, batch.directions);
-    const TreeSweepBuffers buffers = sweepBuffers(st, entries, channels, directions);
-    enqueueBouncePresample(st, program, planes, field.width, field.height, directions_buffer, batch, buffers);
-    enqueueTreeSweep(st, program, directions_buffer, batch, buffers);
-    std::vector<float> pairs(entries * 2), visible(entries * 2), attributes(entries * stride),
-        gathered(entries * channels);
-    st.queue.enqueueReadBuffer(buffers.lines, CL_TRUE, 0, pairs.size() * sizeof(float), pairs.data());
-    st.queue.enqueueReadBuffer(buffers.visible, CL_TRUE, 0, visible.size() * sizeof(float), visible.data());
-    st.queue.enqueueReadBuffer(buffers.bounce_lines, CL_TRUE, 0, attributes.size() * sizeof(float),
-                               attributes.data());
-    st.queue.enqueueReadBuffer(buffers.bounce_out, CL_TRUE, 0, gathered.size() * sizeof(float),
-                               gathered.data());
-
-    // Back to the canonical step-major order.
     BounceLineView view;
-    const SweepDirection& d = batch.directions[0];
-    view.lines.geometry = d;
-    view.lines.samples.resize(entries);
-    view.lines.counts.resize(entries);
+    std::vector<float> irradiance;
+    view.lines = treeLinesOnDevice(stateOf(context), bounceFlags(inputs, tuning), field, inputs.heights, d, &inputs,
+                                   &irradiance);
+    // Each receiver entry takes its pixel's irradiance of this one direction.
+    const int channels = inputs.channels();
+    const std::size_t plane = field.pixelCount();
     view.bounce.channels = channels;
-    bounceWedge(directions, &view.bounce.half_sector, &view.bounce.wedge);
-    view.bounce.attributes.resize(entries * stride);
-    view.bounce.irradiance.resize(entries * channels);
-    for (int j = 0; j < d.n_lines; ++j) {
-      for (int i = 0; i < d.n_steps; ++i) {
-        const std::size_t e = lineEntry(d, j, i, line_major), canonical = std::size_t(i) * d.n_lines + j;
-        view.lines.samples[canonical] = pairs[2 * e];
-        view.lines.counts[canonical] = visible[2 * e];
-        for (int a = 0; a < stride; ++a)
-          view.bounce.attributes[canonical * stride + a] = attributes[e * stride + a];
-        for (int c = 0; c < channels; ++c)
-          view.bounce.irradiance[canonical * channels + c] = gathered[e * channels + c];
+    view.bounce.half_sector = d.half_sector;
+    view.bounce.wedge = d.wedge;
+    view.bounce.step_ground = d.step_ground;
+    const auto& g = view.lines.geometry;
+    view.bounce.irradiance.assign(std::size_t(g.n_lines) * g.n_steps * channels, std::nanf(""));
+    for (int j = 0; j < g.n_lines; ++j) {
+      for (int i = view.lines.receiver_every - 1; i < g.n_steps; i += view.lines.receiver_every) {
+        const std::size_t e = std::size_t(i) * g.n_lines + j;
+        if (i >= d.lines[j].receivers * view.lines.receiver_every) break;
+        const int receiver = i / view.lines.receiver_every;
+        const std::size_t pixel = std::size_t(d.lines[j].row - receiver * d.lattice.b) * field.width +
+                                  (d.lines[j].col - receiver * d.lattice.a);
+        for (int c = 0; c < channels; ++c) view.bounce.irradiance[e * channels + c] = irradiance[c * plane + pixel];
       }
     }
     return view;

@@ -23,19 +23,22 @@ struct BounceInputs {
 BounceInputs prepareBounce(const HeightField& field, const ExitRadiance& radiance);
 
 // One direction's sweep and gather: `lines` as the intervisibility line view (samples,
-// counts, ...), `bounce` with the attributes (radiance and normal per entry) and the
-// gathered irradiance per entry, all in canonical step-major order.
+// counts, ...), `bounce` with the attributes (radiance per entry, the receivers' normals)
+// and the gathered irradiance per receiver entry, all in canonical step-major order.
 struct BounceLineView {
   IntervisibilityLines lines;
   BounceLines bounce;
 };
 
+// The kernel's view (attributes left empty: the kernel samples them itself).
 BounceLineView bounceLinesOnDevice(const ComputeContext& context, const HeightField& field,
-                                   const BounceInputs& inputs, const SweepDirection& direction,
-                                   int directions, const HullTreeTuning& tuning = {});
+                                   const BounceInputs& inputs, const TreeDirection& direction,
+                                   const HullTreeTuning& tuning = {});
 
+// The scalar reference's; `all_horizons`: every sample reads its horizons (as the kernel
+// with per-entry statistics), else receivers only.
 BounceLineView referenceBounceLines(const HeightField& field, const BounceInputs& inputs,
-                                    const SweepDirection& direction, int directions,
-                                    const HullTreeTuning& tuning = {});
+                                    const TreeDirection& direction, const HullTreeTuning& tuning = {},
+                                    bool all_horizons = true);
 
 }  // namespace hfvis::detail

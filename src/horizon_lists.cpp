@@ -97,9 +97,9 @@ std::vector<ReceiverHorizons> computeHorizonLists(const HeightField& field, cons
   validateReceivers(field, receivers);
   const detail::PreparedHeights prepared = detail::prepareHeights(field);
   const auto directions = detail::runDirections(field, options);
-  IntervisibilityOutputs counts;
-  counts.visible_count = true;
-  detail::checkLineLimits(directions, prepared.heights, counts);  // rays are no longer than lines
+  // A ray (and its receiver) has at most width + height samples per unit step.
+  detail::checkStepLimits(static_cast<std::size_t>((field.width + field.height) * options.samples_per_unit) + 2,
+                          prepared.heights);
 
   std::vector<ReceiverHorizons> lists;
   lists.reserve(receivers.size());

@@ -1,11 +1,16 @@
-// intervisibility.cpp: the intervisibility operation on the device: presample -> convex
-// hull tree sweep -> reduction (or the naive march) per batch of directions, downloading
-// only the requested outputs.
+// intervisibility.cpp: the intervisibility operation on the device: per direction, one
+// launch of the convex hull tree sweep on lattice lines (each receiver on the line through
+// its own centre, its results added straight into the pixel sums), or of the naive march per
+// batch of directions; the requested outputs are downloaded once at the end.
 #include "hfvis/intervisibility.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
 #include <sstream>
 
+#include "bounce_internal.hpp"
 #include "hfvis/errors.hpp"
 #include "horizon_common.hpp"
 #include "intervisibility_device.hpp"
@@ -16,13 +21,10 @@
 namespace hfvis {
 namespace detail {
 
-const char* treeProgramFile(const TreeProgramFlags& flags) {
-  return flags.bounce_channels > 0 ? "bounce.cl" : "intervisibility.cl";
-}
-
 std::string treeProgramOptions(const TreeProgramFlags& f, const ContextState& st) {
   std::ostringstream s;
-  s << "-DHFVIS_HAS_NODATA=" << f.has_nodata << " -DHFVIS_WANT_AREA=" << f.area
+  s << "-DHFVIS_HAS_NODATA=" << f.has_nodata << " -DHFVIS_WANT_COUNT=" << f.count
+    << " -DHFVIS_WANT_AREA=" << f.area
     << " -DHFVIS_WANT_STATS=" << f.stats << " -DHFVIS_WANT_ENTRY_STATS=" << f.entry_stats << " "
     << layoutProgramOption(st);
   s << " -DHFVIS_DEFERRED_WRITES=" << f.tuning.deferred_writes
@@ -32,224 +34,312 @@ std::string treeProgramOptions(const TreeProgramFlags& f, const ContextState& st
   return s.str();
 }
 
-void enqueueTreeSweep(ContextState& st, cl::Program& program, const cl::Buffer& directions,
-                      const SweepBatch& batch, const TreeSweepBuffers& b) {
-  cl::Kernel sweep(program, "intervisibility_sweep");
+std::size_t treeEntryBytes(const TreeProgramFlags& f) {
+  return kTreeNodeBytes + (f.area && f.has_nodata ? kTreePrefixBytes : 0) +
+         (f.entry_stats ? kTreeVisibleBytes + kTreeEntryStatsBytes : 0);
+}
+
+std::size_t planTreeScratch(const std::vector<TreeDirection>& directions, std::size_t fixed_bytes,
+                            std::size_t entry_bytes, std::size_t budget_bytes, const DeviceInfo& device) {
+  const std::size_t budget = budget_bytes ? budget_bytes : defaultMemoryBudget(device);
+  const std::size_t max_alloc = device.max_allocation_bytes ? device.max_allocation_bytes : budget;
+  std::size_t whole = 0, longest = 0;
+  for (const TreeDirection& d : directions) {
+    std::size_t total = 0;
+    for (const LatticeLine& line : d.lines) {
+      const std::size_t capacity = lineCapacity(line, d.samples.size());
+      total += capacity;
+      longest = std::max(longest, capacity);
+    }
+    whole = std::max(whole, total);
+  }
+  const std::size_t least = fixed_bytes + longest * entry_bytes;
+  if (least > budget || longest * kTreeNodeBytes > max_alloc) {
+    throw MemoryBudgetError("one direction needs " + mebibytes(least) + " of device memory but the budget is " +
+                            mebibytes(budget) + " (largest single buffer " + mebibytes(max_alloc) +
+                            "); raise the memory budget or use a smaller field");
+  }
+  return std::min({whole, (budget - fixed_bytes) / entry_bytes, max_alloc / kTreeNodeBytes});
+}
+
+void allocateTreeScratch(ContextState& st, const TreeProgramFlags& flags, const std::vector<TreeDirection>& all,
+                         std::size_t entries, TreeBuffers& b) {
+  b.scratch_entries = entries;
+  b.trees = st.reusableBuffer("tree nodes", entries * kTreeNodeBytes);
+  b.prefix = deviceBuffer(st, flags.area && flags.has_nodata ? entries * kTreePrefixBytes : 0);
+  b.visible = deviceBuffer(st, flags.entry_stats ? entries * kTreeVisibleBytes : 0);
+  b.entry_stats = deviceBuffer(st, flags.entry_stats ? entries * kTreeEntryStatsBytes : 0);
+  std::size_t max_lines = 0;
+  for (const TreeDirection& d : all) max_lines = std::max(max_lines, d.lines.size());
+  b.line_totals = deviceBuffer(st, flags.stats ? max_lines * kTreeLineTotals * sizeof(cl_ulong) : 0);
+}
+
+void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDirection& d, int width, int height,
+                          const TreeBuffers& b) {
+  std::vector<LatticeLine> lines = d.lines;  // chunkLines sets the scratch offsets
+  if (lines.empty()) return;
+  const std::vector<LineChunk> chunks = chunkLines(lines, d.samples.size(), b.scratch_entries, lineMajorLayout(st));
+  const cl::Buffer samples(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                           d.samples.size() * sizeof(LatticeSample), const_cast<LatticeSample*>(d.samples.data()));
+  cl::Kernel kernel(program, "intervisibility_lattice");
   int arg = 0;
-  sweep.setArg(arg++, directions);
-  sweep.setArg(arg++, b.lines);
-  sweep.setArg(arg++, b.trees);
-  sweep.setArg(arg++, b.visible);
-  sweep.setArg(arg++, b.prefix);
-  sweep.setArg(arg++, b.entry_stats);
-  sweep.setArg(arg++, b.line_totals);
-  sweep.setArg(arg++, b.totals_stride);
-  sweep.setArg(arg++, b.bounce_lines);
-  sweep.setArg(arg++, b.bounce_out);
-  sweep.setArg(arg++, b.half_sector);
-  sweep.setArg(arg++, b.wedge);
-  st.launch(sweep, cl::NDRange(roundUp(batch.maxLines(), kLineGroup), batch.directions.size()),
-            cl::NDRange(kLineGroup, 1));
+  kernel.setArg(arg++, b.heights);
+  kernel.setArg(arg++, width);
+  kernel.setArg(arg++, height);
+  const int lines_arg = arg;
+  arg += 2;  // lines, n_lines: per chunk
+  kernel.setArg(arg++, samples);
+  kernel.setArg(arg++, static_cast<int>(d.samples.size()));
+  kernel.setArg(arg++, d.lattice.a);
+  kernel.setArg(arg++, d.lattice.b);
+  kernel.setArg(arg++, d.count_factor);
+  kernel.setArg(arg++, d.area_factor);
+  kernel.setArg(arg++, b.trees);
+  kernel.setArg(arg++, b.prefix);
+  const int stride_arg = arg++;
+  kernel.setArg(arg++, b.visible);
+  kernel.setArg(arg++, b.entry_stats);
+  kernel.setArg(arg++, b.line_totals);
+  const int first_line_arg = arg++;
+  kernel.setArg(arg++, b.count_sum);
+  kernel.setArg(arg++, b.area_sum);
+  kernel.setArg(arg++, b.radiance);
+  kernel.setArg(arg++, b.normals);
+  kernel.setArg(arg++, d.cos_azimuth);
+  kernel.setArg(arg++, d.sin_azimuth);
+  kernel.setArg(arg++, d.step_ground);
+  kernel.setArg(arg++, d.half_sector);
+  kernel.setArg(arg++, d.wedge);
+  kernel.setArg(arg++, b.irradiance);
+  for (const LineChunk& chunk : chunks) {
+    // Sub-buffer offsets must be aligned on some devices: a chunk gets a copy of its lines.
+    const cl::Buffer chunk_lines(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                 chunk.count * sizeof(LatticeLine), lines.data() + chunk.first);
+    kernel.setArg(lines_arg, chunk_lines);
+    kernel.setArg(lines_arg + 1, static_cast<int>(chunk.count));
+    kernel.setArg(stride_arg, static_cast<cl_uint>(chunk.stride));
+    kernel.setArg(first_line_arg, static_cast<int>(chunk.first));
+    st.launch(kernel, cl::NDRange(roundUp(chunk.count, kLineGroup)), cl::NDRange(kLineGroup));
+  }
 }
 
 namespace {
 
-// Buffers a program without the bounce still binds.
-void bindNoBounce(ContextState& st, TreeSweepBuffers& b) {
-  b.bounce_lines = deviceBuffer(st, 0);
-  b.bounce_out = deviceBuffer(st, 0);
-}
-
-// Adds one batch's per-line totals (receivers, m, t, naive, visible, skips) to the statistics.
-void addLineTotals(const std::vector<cl_ulong>& totals, const SweepBatch& batch, int stride,
-                   IntervisibilityStatistics& s) {
-  for (std::size_t b = 0; b < batch.directions.size(); ++b) {
-    for (int j = 0; j < batch.directions[b].n_lines; ++j) {
-      const cl_ulong* t = &totals[(b * stride + j) * kTreeLineTotals];
-      s.receivers += t[0];
-      s.lines += t[0] > 0;
-      s.horizons += t[1];
-      s.iterations += t[2];
-      s.naive_iterations += t[3];
-      s.visible_samples += t[4];
-      s.safe_zone_skips += t[5];
-      s.lines_over_bound += t[2] > 2 * t[1] + t[0];
-    }
+// Adds one direction's per-line totals (receivers, m, t, naive, visible, skips).
+void addLineTotals(const std::vector<cl_ulong>& totals, std::size_t lines, IntervisibilityStatistics& s) {
+  for (std::size_t j = 0; j < lines; ++j) {
+    const cl_ulong* t = &totals[j * kTreeLineTotals];
+    s.receivers += t[0];
+    s.lines += t[0] > 0;
+    s.horizons += t[1];
+    s.iterations += t[2];
+    s.naive_iterations += t[3];
+    s.visible_samples += t[4];
+    s.safe_zone_skips += t[5];
+    s.lines_over_bound += t[2] > 2 * t[1] + t[0];
   }
 }
 
-IntervisibilityResult run(const ComputeContext& context, const HeightField& field,
-                          const IntervisibilityOptions& options, const IntervisibilityOutputs& outputs) {
-  ContextState& st = stateOf(context);
-  const PreparedHeights prepared = prepareHeights(field);
-  const auto all = runDirections(field, options);
-  checkLineLimits(all, prepared.heights, outputs);
-  const bool tree = options.method == IntervisibilityMethod::HullTree;
-  TreeProgramFlags flags;
-  flags.has_nodata = prepared.has_nodata;
-  flags.area = outputs.visible_area;
-  flags.stats = outputs.statistics;
-  flags.tuning = options.tree;
-  cl::Program program = st.program(treeProgramFile(flags), treeProgramOptions(flags, st));
-  const std::size_t plane = field.pixelCount();
-  int max_lines = 0;
-  for (const auto& d : all) max_lines = std::max(max_lines, d.n_lines);
-
-  const bool want_pixels = outputs.visible_count || outputs.visible_area;
-  // Step sums for the area across holes, which only nodata makes.
-  const bool want_prefix = outputs.visible_area && prepared.has_nodata;
-  SweepMemory memory;
-  // Heights, and the accumulators: the count (also when only the area is asked for: the
-  // reduction writes both) and the area.
-  memory.fixed_bytes = plane * sizeof(float) * (1 + want_pixels + outputs.visible_area);
-  if (tree) {
-    memory.bytes_per_entry =
-        kTreeLineBytes + kTreeNodeBytes + kTreeVisibleBytes + (want_prefix ? kTreePrefixBytes : 0);
-    memory.largest_entry_bytes = kTreeNodeBytes;
-    memory.bytes_per_direction = outputs.statistics ? max_lines * kTreeLineTotals * sizeof(cl_ulong) : 0;
-  }
-  const auto batches = planSweepBatches(all, memory, options.memory_budget_bytes, st.info);
-  std::size_t max_entries = 0, max_directions = 0;
-  for (const auto& b : batches) {
-    max_entries = std::max(max_entries, b.entries);
-    max_directions = std::max(max_directions, b.directions.size());
-  }
-
+IntervisibilityResult allocateResult(const HeightField& field, const IntervisibilityOptions& options,
+                                     const IntervisibilityOutputs& outputs) {
   IntervisibilityResult result;
   result.width = field.width;
   result.height = field.height;
   result.directions = options.directions;
   for (int k = 0; k < options.directions; ++k) result.azimuths.push_back(directionAzimuth(k, options));
+  if (outputs.visible_count) result.visible_count.resize(field.pixelCount());
+  if (outputs.visible_area) result.visible_area.resize(field.pixelCount());
+  return result;
+}
 
-  cl::Buffer heights(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, plane * sizeof(float),
-                     const_cast<float*>(prepared.heights.data()));
-  TreeSweepBuffers buffers;
-  if (tree) {
-    bindNoBounce(st, buffers);
-    buffers.lines = deviceBuffer(st, max_entries * kTreeLineBytes);
-    buffers.trees = deviceBuffer(st, max_entries * kTreeNodeBytes);
-    buffers.visible = deviceBuffer(st, max_entries * kTreeVisibleBytes);
-    buffers.prefix = deviceBuffer(st, want_prefix ? max_entries * kTreePrefixBytes : 0);
-    buffers.entry_stats = deviceBuffer(st, 0);
-    buffers.totals_stride = max_lines;
-    buffers.line_totals = deviceBuffer(
-        st, outputs.statistics ? max_directions * max_lines * kTreeLineTotals * sizeof(cl_ulong) : 0);
-  }
-  cl::Buffer count_sum = deviceBuffer(st, want_pixels ? plane * sizeof(float) : 0);
-  cl::Buffer area_sum = deviceBuffer(st, outputs.visible_area ? plane * sizeof(float) : 0);
+void download(ContextState& st, const cl::Buffer& sums, std::vector<float>& out) {
+  if (!out.empty()) st.queue.enqueueReadBuffer(sums, CL_TRUE, 0, out.size() * sizeof(float), out.data());
+}
+
+IntervisibilityResult runTree(ContextState& st, const HeightField& field, const IntervisibilityOptions& options,
+                              const IntervisibilityOutputs& outputs) {
+  const PreparedHeights prepared = prepareHeights(field);
+  const std::vector<TreeDirection> directions = treeDirections(field, options);
+  checkTreeLimits(directions, prepared.heights);
+  TreeProgramFlags flags;
+  flags.has_nodata = prepared.has_nodata;
+  flags.area = outputs.visible_area;
+  flags.stats = outputs.statistics;
+  flags.tuning = options.tree;
+  cl::Program program = st.program("intervisibility.cl", treeProgramOptions(flags, st));
+  const std::size_t plane = field.pixelCount();
+  // Heights and the sums (the count also when only the area is asked for: the kernel adds both).
+  const std::size_t fixed = plane * sizeof(float) * (2 + outputs.visible_area);
+  TreeBuffers b;
+  allocateTreeScratch(st, flags, directions,
+                      planTreeScratch(directions, fixed, treeEntryBytes(flags), options.memory_budget_bytes, st.info),
+                      b);
+  b.heights = cl::Buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, plane * sizeof(float),
+                         const_cast<float*>(prepared.heights.data()));
+  b.count_sum = deviceBuffer(st, plane * sizeof(float));
+  b.area_sum = deviceBuffer(st, outputs.visible_area ? plane * sizeof(float) : 0);
+  b.radiance = b.normals = b.irradiance = deviceBuffer(st, 0);
   const float zero = 0.0f;
-  if (want_pixels) st.queue.enqueueFillBuffer(count_sum, zero, 0, plane * sizeof(float));
-  if (outputs.visible_area) st.queue.enqueueFillBuffer(area_sum, zero, 0, plane * sizeof(float));
+  st.queue.enqueueFillBuffer(b.count_sum, zero, 0, plane * sizeof(float));
+  if (outputs.visible_area) st.queue.enqueueFillBuffer(b.area_sum, zero, 0, plane * sizeof(float));
 
-  const float sector = intervisibilitySector(options);
-  const cl::NDRange pixels(roundUp(field.width, kTileX), roundUp(field.height, kTileY));
+  IntervisibilityResult result = allocateResult(field, options, outputs);
   std::vector<cl_ulong> totals;
-  int done = 0;
-  for (const SweepBatch& batch : batches) {
-    const cl::Buffer directions = uploadDirections(st, batch.directions);
-    const int batch_size = static_cast<int>(batch.directions.size());
-    if (tree) {
-      enqueuePresample(st, program, heights, field.width, field.height, directions, batch, buffers.lines);
-      enqueueTreeSweep(st, program, directions, batch, buffers);
-    }
-    if (want_pixels) {
-      cl::Kernel reduce(program, tree ? "intervisibility_reduce" : "intervisibility_naive");
-      int arg = 0;
-      reduce.setArg(arg++, heights);
-      reduce.setArg(arg++, field.width);
-      reduce.setArg(arg++, field.height);
-      reduce.setArg(arg++, directions);
-      reduce.setArg(arg++, batch_size);
-      reduce.setArg(arg++, sector);
-      if (tree) reduce.setArg(arg++, buffers.visible);
-      reduce.setArg(arg++, count_sum);
-      reduce.setArg(arg++, area_sum);
-      st.launch(reduce, pixels, cl::NDRange(kTileX, kTileY));
-    }
+  for (std::size_t k = 0; k < directions.size(); ++k) {
+    const TreeDirection& d = directions[k];
+    enqueueTreeDirection(st, program, d, field.width, field.height, b);
     if (outputs.statistics) {
-      totals.resize(batch.directions.size() * max_lines * kTreeLineTotals);
-      st.queue.enqueueReadBuffer(buffers.line_totals, CL_TRUE, 0, totals.size() * sizeof(cl_ulong),
-                                 totals.data());
-      addLineTotals(totals, batch, max_lines, result.statistics);
+      totals.resize(d.lines.size() * kTreeLineTotals);
+      st.queue.enqueueReadBuffer(b.line_totals, CL_TRUE, 0, totals.size() * sizeof(cl_ulong), totals.data());
+      addLineTotals(totals, d.lines.size(), result.statistics);
     }
     st.queue.finish();
-    done += batch_size;
-    if (options.progress) options.progress(done, options.directions);
+    if (options.progress) options.progress(static_cast<int>(k + 1), static_cast<int>(directions.size()));
   }
-  if (outputs.visible_count) {
-    result.visible_count.resize(plane);
-    st.queue.enqueueReadBuffer(count_sum, CL_TRUE, 0, plane * sizeof(float), result.visible_count.data());
+  download(st, b.count_sum, result.visible_count);
+  download(st, b.area_sum, result.visible_area);
+  return result;
+}
+
+IntervisibilityResult runNaive(ContextState& st, const HeightField& field, const IntervisibilityOptions& options,
+                               const IntervisibilityOutputs& outputs) {
+  const PreparedHeights prepared = prepareHeights(field);
+  TreeProgramFlags flags;
+  flags.has_nodata = prepared.has_nodata;
+  flags.area = outputs.visible_area;
+  flags.stats = false;
+  cl::Program program = st.program("intervisibility.cl", treeProgramOptions(flags, st));
+  const std::size_t plane = field.pixelCount();
+  const std::vector<SweepDirection> all = runDirections(field, options);
+  const cl::Buffer heights(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, plane * sizeof(float),
+                           const_cast<float*>(prepared.heights.data()));
+  const cl::Buffer count_sum = deviceBuffer(st, plane * sizeof(float));
+  const cl::Buffer area_sum = deviceBuffer(st, outputs.visible_area ? plane * sizeof(float) : 0);
+  const float zero = 0.0f;
+  st.queue.enqueueFillBuffer(count_sum, zero, 0, plane * sizeof(float));
+  if (outputs.visible_area) st.queue.enqueueFillBuffer(area_sum, zero, 0, plane * sizeof(float));
+  const float sector = intervisibilitySector(options);
+  IntervisibilityResult result = allocateResult(field, options, outputs);
+  for (int first = 0; first < options.directions; first += kMaxDirectionsPerBatch) {
+    const int count = std::min(kMaxDirectionsPerBatch, options.directions - first);
+    const std::vector<SweepDirection> batch(all.begin() + first, all.begin() + first + count);
+    const cl::Buffer directions = uploadDirections(st, batch);
+    cl::Kernel naive(program, "intervisibility_naive");
+    int arg = 0;
+    naive.setArg(arg++, heights);
+    naive.setArg(arg++, field.width);
+    naive.setArg(arg++, field.height);
+    naive.setArg(arg++, directions);
+    naive.setArg(arg++, count);
+    naive.setArg(arg++, sector);
+    naive.setArg(arg++, count_sum);
+    naive.setArg(arg++, area_sum);
+    st.launch(naive, cl::NDRange(roundUp(field.width, kTileX), roundUp(field.height, kTileY)),
+              cl::NDRange(kTileX, kTileY));
+    st.queue.finish();
+    if (options.progress) options.progress(first + count, options.directions);
   }
-  if (outputs.visible_area) {
-    result.visible_area.resize(plane);
-    st.queue.enqueueReadBuffer(area_sum, CL_TRUE, 0, plane * sizeof(float), result.visible_area.data());
-  }
+  download(st, count_sum, result.visible_count);
+  download(st, area_sum, result.visible_area);
   return result;
 }
 
 }  // namespace
 
-IntervisibilityLines intervisibilityLinesOnDevice(const ComputeContext& context, const HeightField& field,
-                                                  const std::vector<float>& prepared_heights,
-                                                  const SweepDirection& direction,
-                                                  const HullTreeTuning& tuning) {
-  validate(tuning);
-  return translateOpenClErrors([&] {
-    ContextState& st = stateOf(context);
-    TreeProgramFlags flags;
-    flags.entry_stats = true;
-    flags.tuning = tuning;
-    cl::Program program = st.program(treeProgramFile(flags), treeProgramOptions(flags, st));
-    const bool line_major = lineMajorLayout(st);
-    SweepBatch batch;
-    batch.directions = {direction};
-    batch.directions[0].buffer_offset = 0;
-    batch.entries = direction.entries();
-    const std::size_t entries = batch.entries;
-    IntervisibilityLines out;
-    out.geometry = batch.directions[0];
-    cl::Buffer heights(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                       prepared_heights.size() * sizeof(float), const_cast<float*>(prepared_heights.data()));
-    const cl::Buffer directions = uploadDirections(st, batch.directions);
-    TreeSweepBuffers buffers;
-    bindNoBounce(st, buffers);
-    buffers.lines = deviceBuffer(st, entries * kTreeLineBytes);
-    buffers.trees = deviceBuffer(st, entries * kTreeNodeBytes);
-    buffers.visible = deviceBuffer(st, entries * kTreeVisibleBytes);
-    buffers.prefix = deviceBuffer(st, entries * kTreePrefixBytes);
-    buffers.entry_stats = deviceBuffer(st, entries * kTreeEntryStatsBytes);
-    buffers.totals_stride = direction.n_lines;
-    buffers.line_totals = deviceBuffer(st, direction.n_lines * kTreeLineTotals * sizeof(cl_ulong));
-    enqueuePresample(st, program, heights, field.width, field.height, directions, batch, buffers.lines);
-    enqueueTreeSweep(st, program, directions, batch, buffers);
-    std::vector<float> pairs(entries * 2), visible(entries * 2);
-    std::vector<std::uint32_t> stats(entries * 4);
-    st.queue.enqueueReadBuffer(buffers.lines, CL_TRUE, 0, pairs.size() * sizeof(float), pairs.data());
-    st.queue.enqueueReadBuffer(buffers.visible, CL_TRUE, 0, visible.size() * sizeof(float), visible.data());
-    st.queue.enqueueReadBuffer(buffers.entry_stats, CL_TRUE, 0, stats.size() * sizeof(std::uint32_t),
-                               stats.data());
-    // Back to the canonical step-major order of IntervisibilityLines.
-    const SweepDirection& d = out.geometry;
-    out.samples.resize(entries);
-    out.counts.resize(entries);
-    out.distance_sums.resize(entries);
-    out.horizons.resize(entries);
-    out.iterations.resize(entries);
-    out.horizon_hashes.resize(entries);
-    out.walks_skipped.resize(entries);
-    for (int j = 0; j < d.n_lines; ++j) {
-      for (int i = 0; i < d.n_steps; ++i) {
-        const std::size_t e = lineEntry(d, j, i, line_major), canonical = std::size_t(i) * d.n_lines + j;
-        out.samples[canonical] = pairs[2 * e];
-        out.counts[canonical] = visible[2 * e];
-        out.distance_sums[canonical] = visible[2 * e + 1];
-        out.horizons[canonical] = stats[4 * e];
-        out.iterations[canonical] = stats[4 * e + 1];
-        out.horizon_hashes[canonical] = stats[4 * e + 2];
-        out.walks_skipped[canonical] = stats[4 * e + 3];
+IntervisibilityLines treeLinesOnDevice(ContextState& st, const TreeProgramFlags& program_flags,
+                                       const HeightField& field, const std::vector<float>& prepared_heights,
+                                       const TreeDirection& d, const BounceInputs* bounce,
+                                       std::vector<float>* irradiance) {
+  TreeProgramFlags flags = program_flags;
+  flags.entry_stats = true;
+  cl::Program program = st.program("intervisibility.cl", treeProgramOptions(flags, st));
+  const std::size_t plane = field.pixelCount();
+  const std::size_t per_period = d.samples.size(), longest = d.longestLine();
+  std::size_t entries = 0;
+  for (const LatticeLine& line : d.lines) entries += lineCapacity(line, per_period);
+  // Scratch for all lines in one launch; the step-major layout pads every line to the longest.
+  entries = std::max(entries, longest * d.lines.size());
+  TreeBuffers b;
+  allocateTreeScratch(st, flags, {d}, entries, b);
+  auto upload = [&](const std::vector<float>& values) {
+    return cl::Buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, values.size() * sizeof(float),
+                      const_cast<float*>(values.data()));
+  };
+  auto joined = [](const std::vector<std::vector<float>>& planes) {
+    std::vector<float> all;
+    for (const auto& p : planes) all.insert(all.end(), p.begin(), p.end());
+    return all;
+  };
+  const int channels = bounce ? bounce->channels() : 0;
+  b.heights = upload(prepared_heights);
+  b.count_sum = deviceBuffer(st, plane * sizeof(float));
+  b.area_sum = deviceBuffer(st, plane * sizeof(float));
+  b.radiance = bounce ? upload(joined(bounce->radiance)) : deviceBuffer(st, 0);
+  b.normals = bounce ? upload(joined(bounce->normals)) : deviceBuffer(st, 0);
+  b.irradiance = deviceBuffer(st, channels * plane * sizeof(float));
+  const float zero = 0.0f;
+  st.queue.enqueueFillBuffer(b.count_sum, zero, 0, plane * sizeof(float));
+  st.queue.enqueueFillBuffer(b.area_sum, zero, 0, plane * sizeof(float));
+  if (channels) st.queue.enqueueFillBuffer(b.irradiance, zero, 0, channels * plane * sizeof(float));
+  enqueueTreeDirection(st, program, d, field.width, field.height, b);
+  std::vector<cl_int> nodes(entries * 4);
+  std::vector<float> visible(entries * 2);
+  std::vector<std::uint32_t> stats(entries * 4);
+  st.queue.enqueueReadBuffer(b.trees, CL_TRUE, 0, nodes.size() * sizeof(cl_int), nodes.data());
+  st.queue.enqueueReadBuffer(b.visible, CL_TRUE, 0, visible.size() * sizeof(float), visible.data());
+  st.queue.enqueueReadBuffer(b.entry_stats, CL_TRUE, 0, stats.size() * sizeof(std::uint32_t), stats.data());
+  if (irradiance) {
+    irradiance->resize(channels * plane);
+    st.queue.enqueueReadBuffer(b.irradiance, CL_TRUE, 0, irradiance->size() * sizeof(float), irradiance->data());
+  }
+
+  // Back to the canonical step-major order, as the launch laid the lines out.
+  std::vector<LatticeLine> lines = d.lines;
+  const auto chunks = chunkLines(lines, per_period, entries, lineMajorLayout(st));
+  IntervisibilityLines out;
+  out.geometry.n_lines = static_cast<int>(lines.size());
+  out.geometry.n_steps = static_cast<int>(longest);
+  out.geometry.step_length = d.step_length;
+  out.geometry.ground_per_pixel = static_cast<float>(d.lattice.ground_per_pixel);
+  out.geometry.cos_azimuth = d.cos_azimuth;
+  out.geometry.sin_azimuth = d.sin_azimuth;
+  out.receiver_every = static_cast<int>(per_period);
+  const std::size_t canonical_entries = longest * lines.size();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  out.samples.assign(canonical_entries, nan);
+  out.counts.assign(canonical_entries, nan);
+  out.distance_sums.assign(canonical_entries, nan);
+  out.horizons.assign(canonical_entries, 0);
+  out.iterations.assign(canonical_entries, 0);
+  out.horizon_hashes.assign(canonical_entries, 0);
+  out.walks_skipped.assign(canonical_entries, 0);
+  for (const LineChunk& chunk : chunks) {
+    for (std::size_t j = chunk.first; j < chunk.first + chunk.count; ++j) {
+      const std::size_t steps = lineCapacity(lines[j], per_period);
+      for (std::size_t i = 0; i < steps; ++i) {
+        const std::size_t e = static_cast<std::size_t>(lines[j].stack) + i * chunk.stride;
+        const std::size_t c = i * lines.size() + j;
+        std::memcpy(&out.samples[c], &nodes[4 * e], sizeof(float));
+        out.counts[c] = visible[2 * e];
+        out.distance_sums[c] = visible[2 * e + 1];
+        out.horizons[c] = stats[4 * e];
+        out.iterations[c] = stats[4 * e + 1];
+        out.horizon_hashes[c] = stats[4 * e + 2];
+        out.walks_skipped[c] = stats[4 * e + 3];
       }
     }
-    return out;
+  }
+  return out;
+}
+
+IntervisibilityLines intervisibilityLinesOnDevice(const ComputeContext& context, const HeightField& field,
+                                                  const std::vector<float>& prepared_heights,
+                                                  const TreeDirection& d, const HullTreeTuning& tuning) {
+  validate(tuning);
+  return translateOpenClErrors([&] {
+    TreeProgramFlags flags;
+    flags.tuning = tuning;
+    return treeLinesOnDevice(stateOf(context), flags, field, prepared_heights, d, nullptr, nullptr);
   });
 }
 
@@ -260,7 +350,11 @@ IntervisibilityResult computeIntervisibility(const ComputeContext& context, cons
                                              const IntervisibilityOutputs& outputs) {
   validate(field);
   validate(options, outputs);
-  return detail::translateOpenClErrors([&] { return detail::run(context, field, options, outputs); });
+  return detail::translateOpenClErrors([&] {
+    detail::ContextState& st = detail::stateOf(context);
+    return options.method == IntervisibilityMethod::HullTree ? detail::runTree(st, field, options, outputs)
+                                                             : detail::runNaive(st, field, options, outputs);
+  });
 }
 
 }  // namespace hfvis

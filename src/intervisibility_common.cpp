@@ -1,5 +1,5 @@
-// intervisibility_common.cpp: option validation, direction geometry and the limits that
-// the intervisibility device path and its scalar reference share.
+// intervisibility_common.cpp: option validation, the tree sweep's directions and the limits
+// that the intervisibility and bounce device paths and their scalar references share.
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -42,6 +42,10 @@ void validate(const IntervisibilityOptions& options, const IntervisibilityOutput
   if (!outputs.visible_count && !outputs.visible_area && !outputs.statistics) {
     throw InvalidArgument("no output requested");
   }
+  if (options.method == IntervisibilityMethod::HullTree && options.lines_per_unit != 1.0) {
+    throw InvalidArgument(
+        "lines per unit must stay 1 for the hull tree: it runs one line through every pixel centre");
+  }
   if (outputs.statistics && options.method != IntervisibilityMethod::HullTree) {
     throw InvalidArgument("statistics (horizons and iterations) exist only for the hull-tree method");
   }
@@ -53,24 +57,54 @@ float intervisibilitySector(const IntervisibilityOptions& options) {
   return static_cast<float>(2.0 * M_PI / options.directions);
 }
 
-void checkLineLimits(const std::vector<SweepDirection>& directions,
-                     const std::vector<float>& prepared_heights, const IntervisibilityOutputs& outputs) {
-  int longest = 0;
-  for (const auto& d : directions) longest = std::max(longest, d.n_steps);
-  if (longest >= (1 << 24)) {
+std::size_t TreeDirection::longestLine() const {
+  std::size_t longest = 0;
+  for (const LatticeLine& line : lines) longest = std::max(longest, lineCapacity(line, samples.size()));
+  return longest;
+}
+
+TreeDirection makeTreeDirection(const HeightField& field, const LatticeDirection& lattice, double samples_per_unit,
+                                int directions) {
+  TreeDirection d;
+  d.lattice = lattice;
+  d.per_period = samplesPerPeriod(lattice, samples_per_unit);
+  d.samples = uniformLatticeSamples(lattice, d.per_period);
+  d.lines = latticeLines(lattice, field.width, field.height);
+  const double step = lattice.period / d.per_period, ground = step * lattice.ground_per_pixel;
+  d.step_length = static_cast<float>(step);
+  d.step_ground = static_cast<float>(ground);
+  d.count_factor = static_cast<float>(directions * lattice.weight * step * samples_per_unit);
+  d.area_factor = static_cast<float>(2.0 * M_PI * lattice.weight * ground * ground);
+  d.half_sector = static_cast<float>(M_PI * lattice.weight);
+  d.wedge = static_cast<float>(2.0 * std::sin(M_PI * lattice.weight));
+  d.cos_azimuth = static_cast<float>(std::cos(lattice.azimuth));
+  d.sin_azimuth = static_cast<float>(std::sin(lattice.azimuth));
+  return d;
+}
+
+std::vector<TreeDirection> treeDirections(const HeightField& field, const SweepOptions& options) {
+  const double window = kTreeAzimuthWindow * 2.0 * M_PI / options.directions;
+  std::vector<TreeDirection> out;
+  for (const LatticeDirection& lattice : latticeDirections(field, options, true, window))
+    out.push_back(makeTreeDirection(field, lattice, options.samples_per_unit, options.directions));
+  return out;
+}
+
+void checkTreeLimits(const std::vector<TreeDirection>& directions, const std::vector<float>& prepared_heights) {
+  std::size_t longest = 0;
+  for (const auto& d : directions) longest = std::max(longest, d.longestLine());
+  checkStepLimits(longest, prepared_heights);
+}
+
+void checkStepLimits(std::size_t longest, const std::vector<float>& prepared_heights) {
+  if (longest >= (std::size_t(1) << 24)) {
     throw InvalidArgument("a sweep line would have " + std::to_string(longest) +
                           " samples; at most 2^24 are supported: lower the samples per unit");
-  }
-  // Distance sums of one receiver: at most longest^2 / 2 steps, kept in 32 bits.
-  if (outputs.visible_area && static_cast<double>(longest) * longest / 2.0 >= 4294967295.0) {
-    throw InvalidArgument(
-        "a sweep line would have " + std::to_string(longest) +
-        " samples, too many for the visible area (at most 92681): lower the samples per unit");
   }
   float highest = 0.0f;  // prepared heights are >= 0 (offset by the lowest one)
   for (float h : prepared_heights)
     if (!std::isnan(h)) highest = std::max(highest, std::fabs(h));
-  if (!(static_cast<double>(highest) * 4.0 * longest < 1e37)) {
+  if (!(static_cast<double>(highest) * 4.0 * static_cast<double>(longest) < 1e37)) {
     throw InvalidArgument("the height range times the z-scale is too large for single precision (" +
                           std::to_string(highest) + "): lower the z-scale");
   }

@@ -1,50 +1,76 @@
-// intervisibility_device.hpp: the device plumbing of the convex hull tree sweep that the
-// intervisibility operation and the bounce share: program options, the sweep's buffers and
-// its launch (kernels/intervisibility.cl, included by kernels/bounce.cl).
+// intervisibility_device.hpp: the convex hull tree sweep on lattice lines that the
+// intervisibility operation and the bounce share: its directions, program options, device
+// buffers, scratch planning and the launch of one direction (kernel intervisibility_lattice in
+// kernels/intervisibility.cl; the bounce's gather in kernels/bounce.cl).
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "hfvis/intervisibility.hpp"
+#include "intervisibility_internal.hpp"
 #include "opencl_context.hpp"
-#include "sweep_framework.hpp"
 
 namespace hfvis::detail {
 
-constexpr std::size_t kTreeLineBytes = 2 * sizeof(float);     // (height, rank)
-constexpr std::size_t kTreeNodeBytes = 4 * sizeof(int);       // tree node
-constexpr std::size_t kTreeVisibleBytes = 2 * sizeof(float);  // (count, distance sum)
-constexpr std::size_t kTreePrefixBytes = sizeof(std::uint32_t);
+constexpr std::size_t kTreeNodeBytes = 4 * sizeof(int);  // tree node (int4)
+constexpr std::size_t kTreePrefixBytes = sizeof(std::uint64_t);
+constexpr std::size_t kTreeVisibleBytes = 2 * sizeof(float);  // (count, distance sum), per-entry tests only
 constexpr std::size_t kTreeEntryStatsBytes = 4 * sizeof(std::uint32_t);
 constexpr std::size_t kTreeLineTotals = 8;  // ulongs per line (HFVIS_LINE_TOTALS)
 
 // What the program computes besides the sweep itself (the HFVIS_WANT_* of the kernels).
 struct TreeProgramFlags {
   bool has_nodata = true;
+  bool count = true;
   bool area = true;
   bool stats = true;
   bool entry_stats = false;
-  int bounce_channels = 0;  // > 0: the bounce program (bounce.cl) with that many channels
+  int bounce_channels = 0;  // > 0: the bounce's gather, with that many channels
   HullTreeTuning tuning;
 };
 
-// The kernel file and the -D options of a program with these flags, for `device`.
-const char* treeProgramFile(const TreeProgramFlags& flags);
+// The -D options of kernels/intervisibility.cl with these flags, for a context.
 std::string treeProgramOptions(const TreeProgramFlags& flags, const ContextState& st);
 
-// The device buffers of one batch's sweep (sized for the largest batch); those a program
-// does not use may be minimal (deviceBuffer(st, 0)).
-struct TreeSweepBuffers {
-  cl::Buffer lines, trees, visible, prefix, entry_stats, line_totals;
-  int totals_stride = 0;
-  cl::Buffer bounce_lines, bounce_out;  // the bounce's attributes and gathered irradiance
-  float half_sector = 0.0f, wedge = 0.0f;
+// The device buffers a run binds; those its program does not use are minimal
+// (deviceBuffer(st, 0)).
+struct TreeBuffers {
+  cl::Buffer heights;
+  cl::Buffer trees, prefix, visible, entry_stats;  // scratch, `scratch_entries` entries
+  std::size_t scratch_entries = 0;
+  cl::Buffer line_totals;          // kTreeLineTotals ulongs per line of the direction
+  cl::Buffer count_sum, area_sum;  // per pixel
+  cl::Buffer radiance, normals, irradiance;  // the bounce's planes
 };
 
-// Launches intervisibility_sweep over the batch (lines presampled).
-void enqueueTreeSweep(ContextState& st, cl::Program& program, const cl::Buffer& directions,
-                      const SweepBatch& batch, const TreeSweepBuffers& buffers);
+// Bytes of scratch per line entry for a program with these flags.
+std::size_t treeEntryBytes(const TreeProgramFlags& flags);
+
+// Scratch entries a run gets: all of its largest direction's lines in one launch when the
+// budget allows, down to its longest line. Throws MemoryBudgetError when even that does not
+// fit beside `fixed_bytes`.
+std::size_t planTreeScratch(const std::vector<TreeDirection>& directions, std::size_t fixed_bytes,
+                            std::size_t entry_bytes, std::size_t budget_bytes, const DeviceInfo& device);
+
+// Buffers of the scratch and line totals for `entries` entries (and the largest direction's
+// lines when statistics are asked for).
+void allocateTreeScratch(ContextState& st, const TreeProgramFlags& flags, const std::vector<TreeDirection>& all,
+                         std::size_t entries, TreeBuffers& b);
+
+// Launches intervisibility_lattice for direction d, its lines in chunks whose scratch fits.
+void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDirection& d, int width, int height,
+                          const TreeBuffers& b);
+
+struct BounceInputs;
+
+// One direction's sweep with per-entry statistics (and with `bounce`, its gather: the
+// per-pixel irradiance of that direction into `irradiance`, channel planes), read back as
+// canonical lines (IntervisibilityLines, every sample's horizons read). For the tests' hooks.
+IntervisibilityLines treeLinesOnDevice(ContextState& st, const TreeProgramFlags& flags, const HeightField& field,
+                                       const std::vector<float>& prepared_heights, const TreeDirection& d,
+                                       const BounceInputs* bounce, std::vector<float>* irradiance);
 
 }  // namespace hfvis::detail

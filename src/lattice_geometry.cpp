@@ -56,7 +56,31 @@ LatticeDirection makeDirection(const HeightField& field, const Candidate& c) {
   return d;
 }
 
+// The sample at fraction f of the period from the receiver toward +(a, b).
+LatticeSample sampleAt(const LatticeDirection& d, double f) {
+  // Offsets from the receiver; crossings fall exactly on grid lines (snap the rounding).
+  auto snapped = [](double v) { return std::abs(v - std::round(v)) < 1e-9 ? std::round(v) : v; };
+  const double x = snapped(d.a * f), y = snapped(d.b * f);
+  const double ox = std::floor(x), oy = std::floor(y);
+  const float fx = static_cast<float>(x - ox), fy = static_cast<float>(y - oy);
+  LatticeSample s;
+  s.tau = static_cast<float>(f * d.period);
+  s.ox = static_cast<std::int32_t>(ox);
+  s.oy = static_cast<std::int32_t>(oy);
+  s.ex = fx > 0.0f;
+  s.ey = fy > 0.0f;
+  s.w00 = (1.0f - fx) * (1.0f - fy);
+  s.w10 = fx * (1.0f - fy);
+  s.w01 = (1.0f - fx) * fy;
+  s.w11 = fx * fy;
+  return s;
+}
+
 }  // namespace
+
+LatticeDirection latticeStep(const HeightField& field, int a, int b) {
+  return makeDirection(field, {a, b, 0, std::atan2(b * field.cell_size_y, a * field.cell_size_x)});
+}
 
 std::vector<LatticeDirection> latticeDirections(const HeightField& field, const SweepOptions& options,
                                                 bool exact_azimuths, double tolerance) {
@@ -127,25 +151,17 @@ std::vector<LatticeSample> latticeSamples(const LatticeDirection& d, double samp
     for (int s = 0; s < parts; ++s) fractions.push_back(crossings[q] + span * s / parts);
   }
   std::vector<LatticeSample> samples;
-  for (auto it = fractions.rbegin(); it != fractions.rend(); ++it) {
-    const double f = *it;
-    // Offsets from the receiver; crossings fall exactly on grid lines (snap the rounding).
-    auto snapped = [](double v) { return std::abs(v - std::round(v)) < 1e-9 ? std::round(v) : v; };
-    const double x = snapped(d.a * f), y = snapped(d.b * f);
-    const double ox = std::floor(x), oy = std::floor(y);
-    const float fx = static_cast<float>(x - ox), fy = static_cast<float>(y - oy);
-    LatticeSample s;
-    s.tau = static_cast<float>(f * d.period);
-    s.ox = static_cast<std::int32_t>(ox);
-    s.oy = static_cast<std::int32_t>(oy);
-    s.ex = fx > 0.0f;
-    s.ey = fy > 0.0f;
-    s.w00 = (1.0f - fx) * (1.0f - fy);
-    s.w10 = fx * (1.0f - fy);
-    s.w01 = (1.0f - fx) * fy;
-    s.w11 = fx * fy;
-    samples.push_back(s);
-  }
+  for (auto it = fractions.rbegin(); it != fractions.rend(); ++it) samples.push_back(sampleAt(d, *it));
+  return samples;
+}
+
+int samplesPerPeriod(const LatticeDirection& d, double samples_per_unit) {
+  return std::max(1, static_cast<int>(std::ceil(d.period * samples_per_unit - 1e-9)));
+}
+
+std::vector<LatticeSample> uniformLatticeSamples(const LatticeDirection& d, int per_period) {
+  std::vector<LatticeSample> samples;
+  for (int q = per_period - 1; q >= 0; --q) samples.push_back(sampleAt(d, double(q) / per_period));
   return samples;
 }
 

@@ -42,6 +42,10 @@ constexpr int kMaxLatticeStep = 64;
 std::vector<LatticeDirection> latticeDirections(const HeightField& field, const SweepOptions& options,
                                                 bool exact_azimuths, double tolerance);
 
+// The direction of primitive step (a, b) over a field (azimuth and ground length from its
+// cell sizes; weight left 0).
+LatticeDirection latticeStep(const HeightField& field, int a, int b);
+
 // One sample of a period, as the kernel reads it (nine 4-byte members, uploaded as is; must
 // match LatticeSample in kernels/horizon.cl). The sample lies at `tau` pixels from the
 // period's receiver toward +(a, b), in the cell whose lower corner is (ox, oy) from the
@@ -61,6 +65,13 @@ static_assert(sizeof(LatticeSample) == 36, "LatticeSample must match the kernel 
 // where the surface can peak inside a cell. Lines along a grid row or column have only
 // their pixel centres: the surface is linear between them.
 std::vector<LatticeSample> latticeSamples(const LatticeDirection& d, double samples_per_unit);
+
+// The hull tree's samples (the intervisibility sweep): `per_period` equally spaced samples
+// of one period, farthest first, the receiver last, so steps along a line are uniform
+// (period / per_period pixels) and the tree's geometry stays in exact integer steps.
+// samplesPerPeriod: ceil(period * S), at least 1: steps of at most 1 / S pixel.
+int samplesPerPeriod(const LatticeDirection& d, double samples_per_unit);
+std::vector<LatticeSample> uniformLatticeSamples(const LatticeDirection& d, int per_period);
 
 // One line of a direction: its farthest receiver (along +(a, b)) and how many receivers it
 // has; receiver i sits at (col - i a, row - i b). `stack` is the first entry of its hull

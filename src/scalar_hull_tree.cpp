@@ -82,13 +82,12 @@ int runEnd(const LineView& line, int start, int next, float h_next, int receiver
 class BounceGather {
  public:
   BounceGather(const BounceLines& in, const SweepDirection& d, std::size_t receiver_entry, float h, int step)
-      : in_(in), h_(h), step_(step) {
+      : in_(in), h_(h), step_(step), ground_(in.step_ground) {
     const float* normal = &in.attributes[receiver_entry * (in.channels + kBounceNormalFloats) + in.channels];
     const float toward = normal[0] * d.cos_azimuth + normal[1] * d.sin_azimuth;
     nz_term_ = normal[2] * in.half_sector;
     nh_term_ = toward * in.wedge;
     tangent_ = std::atan2(-nh_term_, 2.0f * nz_term_);
-    ground_ = d.step_length * d.ground_per_pixel;
   }
 
   // Visible sample x at height hx; nearer than every sample visited before it.
@@ -132,7 +131,8 @@ class BounceGather {
   const BounceLines& in_;
   float h_;
   int step_;
-  float nz_term_ = 0.0f, nh_term_ = 0.0f, tangent_ = 0.0f, ground_ = 0.0f;
+  float ground_;
+  float nz_term_ = 0.0f, nh_term_ = 0.0f, tangent_ = 0.0f;
   bool have_prev_ = false, adjacent_ = false;
   float prev_theta_ = 0.0f, prev_g_hi_ = 0.0f;
   float prev_radiance_[kMaxBounceChannels] = {};
@@ -217,10 +217,10 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
   const LineView line{out.samples, static_cast<std::size_t>(j), stride};
   std::vector<Node> tree(static_cast<std::size_t>(d.n_steps));
   std::vector<int> ranks(static_cast<std::size_t>(d.n_steps));
-  std::vector<std::uint32_t> step_sums(static_cast<std::size_t>(d.n_steps));
+  std::vector<std::uint64_t> step_sums(static_cast<std::size_t>(d.n_steps));
 
   int rank = 0;
-  std::uint32_t step_sum = 0;
+  std::uint64_t step_sum = 0;
   int root = kNone, prev = kNone, prev2 = kNone;
   float h_prev = 0.0f, h_prev2 = 0.0f;
   int class_last = kConvex;
@@ -237,10 +237,12 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
     if (std::isnan(h)) continue;  // outputs stay NaN / zero
     std::uint32_t m = 0, t = 0, hash = kHorizonHashSeed;
     int count = 0;
-    std::uint32_t distance_sum = 0;
+    std::uint64_t distance_sum = 0;
     std::vector<int> horizons, run_ends;
+    const bool receiver = step % out.receiver_every == out.receiver_every - 1;
+    const bool visit = receiver || out.horizons_at_every_sample;
     std::optional<BounceGather> gather;
-    if (bounce) gather.emplace(*bounce, d, e, h, step);
+    if (bounce && receiver) gather.emplace(*bounce, d, e, h, step);
     if (root == kNone) {
       tree[step] = {h, 0, true, kNone, kNone};
       head = tail = kNone;
@@ -311,7 +313,9 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
       tail = list.tail;
       tail_h = list.tail_h;
 
-      // 3. Visible samples from the horizons, farthest first (closed forms without holes).
+      // 3. Visible samples from the horizons, farthest first (closed forms without holes);
+      // at receivers, or at every sample when asked (statistics).
+      if (visit) {
       const bool refresh_zone = tuning.safe_zone && !zone_valid;
       if (refresh_zone) zone.begin(step);
       int hp = head;
@@ -347,15 +351,14 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
         }
         const int run = end_rank - hp_rank;
         count += run;
-        std::uint32_t steps_sum;
+        std::uint64_t steps_sum;
         if (!holes) {
-          const auto a = static_cast<std::uint32_t>(run), b = static_cast<std::uint32_t>(hp + end - 1);
-          steps_sum = (a & 1u) ? a * (b >> 1) : (a >> 1) * b;
+          steps_sum = static_cast<std::uint64_t>(run) * static_cast<std::uint64_t>(hp + end - 1) / 2;
         } else {
-          const std::uint32_t end_sum = end == step ? step_sum : step_sums[end];
+          const std::uint64_t end_sum = end == step ? step_sum : step_sums[end];
           steps_sum = end_sum - step_sums[hp];
         }
-        distance_sum += static_cast<std::uint32_t>(step) * static_cast<std::uint32_t>(run) - steps_sum;
+        distance_sum += static_cast<std::uint64_t>(step) * static_cast<std::uint64_t>(run) - steps_sum;
         if (np == kNone) break;
         hz = nz;
         hp = np;
@@ -365,9 +368,10 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
         zone.end();
         zone_valid = true;
       }
+      }
     }
-    out.counts[e] = static_cast<float>(count);
-    out.distance_sums[e] = static_cast<float>(distance_sum);
+    out.counts[e] = visit ? static_cast<float>(count) : kNaN;
+    out.distance_sums[e] = visit ? static_cast<float>(distance_sum) : kNaN;
     out.horizons[e] = m;
     out.iterations[e] = t;
     out.horizon_hashes[e] = hash;
@@ -382,17 +386,11 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
     h_prev = h;
     root = step;
     ++rank;
-    step_sum += static_cast<std::uint32_t>(step);
+    step_sum += static_cast<std::uint64_t>(step);
   }
 }
 
 }  // namespace
-
-void bounceWedge(int directions, float* half_sector, float* wedge) {
-  const double sector = 2.0 * M_PI / directions;
-  *half_sector = static_cast<float>(0.5 * sector);
-  *wedge = static_cast<float>(2.0 * std::sin(0.5 * sector));
-}
 
 void sweepPresampledLines(IntervisibilityLines& lines, const HullTreeTuning& tuning, bool keep_horizons,
                           BounceLines* bounce) {

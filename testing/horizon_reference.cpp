@@ -97,7 +97,8 @@ DirectionOutputs outputsOf(const LatticeDirection& d, int k) {
           static_cast<float>(d.weight), k};
 }
 
-// lattice_height in the kernel.
+}  // namespace
+
 float latticeHeight(const std::vector<float>& h, std::size_t at, std::size_t right, std::size_t down,
                     const LatticeSample& s) {
   const float h00 = h[at], h10 = h[at + right], h01 = h[at + down], h11 = h[at + down + right];
@@ -111,6 +112,8 @@ float latticeHeight(const std::vector<float>& h, std::size_t at, std::size_t rig
       (v00 ? s.w00 : 0.0f) + (v10 ? s.w10 : 0.0f) + (v01 ? s.w01 : 0.0f) + (v11 ? s.w11 : 0.0f);
   return weight > 0.0f ? sum / weight : kNaN;
 }
+
+namespace {
 
 // near_rise in the kernel.
 float nearRise(const std::vector<float>& h, int width, int height, int c, int r, float hp, int a, int b) {

@@ -1,7 +1,8 @@
 // intervisibility_reference.cpp: the scalar reference of the intervisibility operation:
-// the presampling, the hull tree sweep (src/scalar_hull_tree.cpp, the mirror of the kernel's),
-// the reduction to pixels, and the naive visibility march, in the kernels' order, so every
-// per-sample result matches exactly.
+// the lattice lines sampled as the kernel samples them, the hull tree sweep
+// (src/scalar_hull_tree.cpp, the mirror of the kernel's), each receiver's results added to
+// its pixel, and the naive visibility march, in the kernels' order, so every per-sample
+// result matches exactly.
 #include "hfvis/intervisibility_reference.hpp"
 
 #include <cmath>
@@ -12,6 +13,7 @@
 #include "hfvis/errors.hpp"
 #include "horizon_common.hpp"
 #include "intervisibility_internal.hpp"
+#include "reference_internal.hpp"
 
 namespace hfvis {
 namespace detail {
@@ -39,48 +41,39 @@ void finish(IntervisibilityResult& result, const std::vector<PixelSums>& sums,
 }
 
 void sweepReference(const HeightField& field, const std::vector<float>& h,
-                    const IntervisibilityOptions& options, IntervisibilityResult& result) {
-  const auto directions = runDirections(field, options);
-  const float sector = intervisibilitySector(options);
+                    const IntervisibilityOptions& options, bool statistics, IntervisibilityResult& result) {
   std::vector<PixelSums> sums(field.pixelCount());
   auto& stats = result.statistics;
-  for (const SweepDirection& d : directions) {
-    const IntervisibilityLines lines = referenceIntervisibilityLines(field, h, d, options.tree);
-    for (int j = 0; j < d.n_lines; ++j) {
+  for (const TreeDirection& d : treeDirections(field, options)) {
+    IntervisibilityLines lines = latticeTreeLines(field, h, d);
+    lines.horizons_at_every_sample = statistics;  // as the kernel without statistics
+    sweepPresampledLines(lines, options.tree, false);
+    const auto& g = lines.geometry;
+    for (int j = 0; j < g.n_lines; ++j) {
       std::uint64_t n = 0, m = 0, t = 0;
-      for (int i = 0; i < d.n_steps; ++i) {
-        const std::size_t e = static_cast<std::size_t>(i) * d.n_lines + j;
+      for (int i = 0; i < g.n_steps; ++i) {
+        const std::size_t e = static_cast<std::size_t>(i) * g.n_lines + j;
         if (std::isnan(lines.samples[e])) continue;
         stats.naive_iterations += n;
         ++n;
         m += lines.horizons[e];
         t += lines.iterations[e];
         stats.safe_zone_skips += lines.walks_skipped[e];
-        stats.visible_samples += static_cast<std::uint64_t>(lines.counts[e]);
+        if (statistics) stats.visible_samples += static_cast<std::uint64_t>(lines.counts[e]);
       }
       stats.receivers += n;
       stats.horizons += m;
       stats.iterations += t;
       stats.lines += n > 0;
       stats.lines_over_bound += t > 2 * m + n;
-    }
-    for (int r = 0; r < field.height; ++r) {
-      for (int c = 0; c < field.width; ++c) {
-        float weight = 0.0f, count = 0.0f, distance = 0.0f;
-        for (const CellCorner& corner : receiverCell(d, c, r)) {
-          const float w = corner.weight;
-          const std::size_t e = corner.entry;
-          if (w <= 0.0f) continue;
-          if (std::isnan(lines.counts[e])) continue;
-          weight += w;
-          count += w * lines.counts[e];
-          distance += w * lines.distance_sums[e];
-        }
-        if (weight > 0.0f && weight != 1.0f) {
-          count /= weight;
-          distance /= weight;
-        }
-        sums[static_cast<std::size_t>(r) * field.width + c].add(d, sector, count, distance);
+      // Receivers add their counts to their pixels, as intervisibility_lattice.
+      for (int i = lines.receiver_every - 1; i < d.lines[j].receivers * lines.receiver_every;
+           i += lines.receiver_every) {
+        const std::size_t e = static_cast<std::size_t>(i) * g.n_lines + j;
+        if (std::isnan(lines.samples[e])) continue;
+        PixelSums& sum = sums[receiverPixel(d, field.width, j, i)];
+        sum.count += d.count_factor * lines.counts[e];
+        sum.area += d.area_factor * lines.distance_sums[e];
       }
     }
   }
@@ -127,23 +120,42 @@ void naiveReference(const HeightField& field, const std::vector<float>& h,
 
 }  // namespace
 
-IntervisibilityLines referenceIntervisibilityLines(const HeightField& field,
-                                                   const std::vector<float>& prepared_heights,
-                                                   const SweepDirection& d, const HullTreeTuning& tuning,
-                                                   bool keep_horizons) {
+IntervisibilityLines latticeTreeLines(const HeightField& field, const std::vector<float>& prepared_heights,
+                                      const TreeDirection& d) {
+  const int width = field.width, height = field.height;
+  const std::size_t per_period = d.samples.size(), longest = d.longestLine();
   IntervisibilityLines out;
-  out.geometry = d;
-  out.samples.assign(d.entries(), kNaN);
-  for (int j = 0; j < d.n_lines; ++j) {
-    for (int i = 0; i < d.n_steps; ++i) {
-      const Point2 p = sweepPosition(d, j, i);
-      if (insideField(p, field.width, field.height))
-        out.samples[static_cast<std::size_t>(i) * d.n_lines + j] =
-            sampleHeight(prepared_heights, field.width, field.height, p);
+  out.geometry.n_lines = static_cast<int>(d.lines.size());
+  out.geometry.n_steps = static_cast<int>(longest);
+  out.geometry.step_length = d.step_length;
+  out.geometry.ground_per_pixel = static_cast<float>(d.lattice.ground_per_pixel);
+  out.geometry.cos_azimuth = d.cos_azimuth;
+  out.geometry.sin_azimuth = d.sin_azimuth;
+  out.receiver_every = static_cast<int>(per_period);
+  out.samples.assign(longest * d.lines.size(), kNaN);
+  for (std::size_t j = 0; j < d.lines.size(); ++j) {
+    const LatticeLine& line = d.lines[j];
+    int c = line.col, r = line.row;
+    std::size_t step = 0;
+    for (int i = 0; i < line.receivers; ++i, c -= d.lattice.a, r -= d.lattice.b) {
+      for (std::size_t q = 0; q < per_period; ++q, ++step) {
+        const LatticeSample& s = d.samples[q];
+        const int x0 = c + s.ox, y0 = r + s.oy;
+        if (i == 0 && (x0 < 0 || x0 + s.ex > width - 1 || y0 < 0 || y0 + s.ey > height - 1)) continue;
+        const std::size_t at = static_cast<std::size_t>(y0) * width + x0;
+        out.samples[step * d.lines.size() + j] =
+            s.ex + s.ey == 0 ? prepared_heights[at]
+                             : latticeHeight(prepared_heights, at, s.ex, static_cast<std::size_t>(s.ey) * width, s);
+      }
     }
   }
-  sweepPresampledLines(out, tuning, keep_horizons);
   return out;
+}
+
+std::size_t receiverPixel(const TreeDirection& d, int width, int j, int i) {
+  const int receiver = i / static_cast<int>(d.samples.size());
+  const LatticeLine& line = d.lines[j];
+  return static_cast<std::size_t>(line.row - receiver * d.lattice.b) * width + (line.col - receiver * d.lattice.a);
 }
 
 }  // namespace detail
@@ -154,7 +166,8 @@ IntervisibilityResult referenceIntervisibility(const HeightField& field,
   validate(field);
   validate(options, outputs);
   const detail::PreparedHeights prepared = detail::prepareHeights(field);
-  detail::checkLineLimits(detail::runDirections(field, options), prepared.heights, outputs);
+  if (options.method == IntervisibilityMethod::HullTree)
+    detail::checkTreeLimits(detail::treeDirections(field, options), prepared.heights);
   IntervisibilityResult result;
   result.width = field.width;
   result.height = field.height;
@@ -164,7 +177,7 @@ IntervisibilityResult referenceIntervisibility(const HeightField& field,
   if (outputs.visible_count) result.visible_count.assign(field.pixelCount(), nan);
   if (outputs.visible_area) result.visible_area.assign(field.pixelCount(), nan);
   if (options.method == IntervisibilityMethod::HullTree) {
-    detail::sweepReference(field, prepared.heights, options, result);
+    detail::sweepReference(field, prepared.heights, options, outputs.statistics, result);
   } else {
     detail::naiveReference(field, prepared.heights, options, result);
   }

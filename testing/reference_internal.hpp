@@ -1,10 +1,11 @@
-// reference_internal.hpp: line-level pieces of the scalar horizon reference, for tests
-// that check a sweep line by line against brute force.
+// reference_internal.hpp: line-level pieces of the scalar references, for tests that
+// check a sweep line by line against brute force.
 #pragma once
 
 #include <vector>
 
 #include "hfvis/height_field.hpp"
+#include "intervisibility_internal.hpp"
 #include "lattice_geometry.hpp"
 
 namespace hfvis::detail {
@@ -28,5 +29,19 @@ std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, cons
                                                   const LatticeDirection& d,
                                                   const std::vector<LatticeSample>& samples,
                                                   const LatticeLine& line);
+
+// lattice_height in the kernels: the bilinear height of sample s whose cell corner is at
+// entry `at` (right = 1 or 0, down = width or 0), over the valid corners.
+float latticeHeight(const std::vector<float>& h, std::size_t at, std::size_t right, std::size_t down,
+                    const LatticeSample& s);
+
+// The canonical lines of tree direction d over prepared heights (or any plane sampled like
+// them), as intervisibility_lattice samples them: geometry, receiver_every and samples set,
+// nothing swept yet.
+IntervisibilityLines latticeTreeLines(const HeightField& field, const std::vector<float>& prepared_heights,
+                                      const TreeDirection& d);
+
+// The pixel of the receiver at step i (a receiver step) of line j of d.
+std::size_t receiverPixel(const TreeDirection& d, int width, int j, int i);
 
 }  // namespace hfvis::detail
