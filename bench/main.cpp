@@ -9,7 +9,10 @@
 //       one method on one field: min and median time and core-ns per pixel-direction
 //       (methods: sweep, naive, radius, pyramid, floor)
 //   hfvis_bench visibility [--quick | --tiny] --out DIR [--data DIR] [--dem FILE] [--commit TEXT]
-//       the intervisibility suite: writes DIR/visibility.csv and DIR/visibility_environment.txt
+//                          [--sections LIST]
+//       the intervisibility suite: writes DIR/visibility.csv and DIR/visibility_environment.txt;
+//       --sections runs some of its sections (comma-separated: time, stats, zone, scale,
+//       accuracy; default all)
 //   hfvis_bench vis-run FIELD [--method tree|naive] [-k K] [--tuning plain|deferred|default|zone]
 //                       [--zone-steps S] [--reps N]
 //       visible counts by one method on one field: min and median time, statistics
@@ -22,6 +25,7 @@
 //   hfvis_bench vectorize-run all|library|bench
 //       runs the march kernels once (what vectorize-report re-runs under
 //       POCL_VECTORIZER_REMARKS=1)
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -51,6 +55,7 @@ constexpr const char* kUsage =
     "       hfvis_bench run FIELD [--method sweep|naive|radius|pyramid|floor] [-k K] [--spu S] [--param P]\n"
     "                   [--outputs angles|svf|ao|device] [--reps N]\n"
     "       hfvis_bench visibility [--quick | --tiny] --out DIR [--data DIR] [--dem FILE] [--commit TEXT]\n"
+    "                              [--sections time,stats,zone,scale,accuracy]\n"
     "       hfvis_bench vis-run FIELD [--method tree|naive] [-k K] [--tuning plain|deferred|default|zone]\n"
     "                           [--zone-steps S] [--reps N]\n"
     "       hfvis_bench inputs [--quick]\n"
@@ -224,6 +229,18 @@ int main(int argc, char** argv) {
       options.cache_dir = args.get("--cache", options.out_dir.empty() ? "" : options.out_dir + "/truth");
       options.commit = args.get("--commit", "unknown");
       options.self_path = std::filesystem::canonical("/proc/self/exe").string();
+      if (command == "visibility") {
+        const std::string list = args.get("--sections");
+        for (std::size_t at = 0; at < list.size();) {
+          const std::size_t end = std::min(list.find(',', at), list.size());
+          const std::string name = list.substr(at, end - at);
+          const auto& known = visibilitySections();
+          if (std::find(known.begin(), known.end(), name) == known.end())
+            throw Usage("--sections: unknown section '" + name + "' (time, stats, zone, scale, accuracy)");
+          options.sections.push_back(name);
+          at = end + 1;
+        }
+      }
       args.rejectUnused();
       if (options.out_dir.empty()) throw Usage("suite needs --out DIR");
       if (options.mode != "tiny" && (options.data_dir.empty() || options.dem_path.empty()))

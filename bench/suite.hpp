@@ -22,6 +22,8 @@ struct SuiteOptions {
   std::string cache_dir;      // ground-truth cache
   std::string commit;         // recorded in environment.txt
   std::string self_path;      // this program, re-run for the vectorisation remarks
+  // The intervisibility suite's sections to run (visibilitySections()); empty = all.
+  std::vector<std::string> sections;
 };
 
 // The generated fields a mode reads from data_dir: (content, N) pairs, N x N each, for
@@ -35,6 +37,9 @@ int runSuite(const ComputeContext& context, const SuiteOptions& options);
 // DIR/visibility_environment.txt; its generated inputs.
 int runVisibilitySuite(const ComputeContext& context, const SuiteOptions& options);
 std::vector<std::pair<std::string, int>> visibilityInputs(const std::string& mode);
+// The names `hfvis_bench visibility --sections` takes: time (vis_time), stats, zone, scale,
+// accuracy (vis_accuracy).
+const std::vector<std::string>& visibilitySections();
 
 // One timed measurement as the suite takes it: a warm-up run on a 64 x 64 crop (builds and
 // caches the program), one full-size run discarded as warm-up when it takes under a second,

@@ -8,12 +8,22 @@
 //   vis_zone   the safe zone's span (steps) against time, iterations and skips
 //   vis_scale  iterations per line against line length n for fractal detail and random
 //              extent (seed 000, Figure 8; the report fits the exponents for n >= 512)
+//   vis_accuracy  issue 8's target (e): the visible counts of the hull tree (default options)
+//              and of the naive per-pixel unit march against a dense reference march
+//              (bench/dense_visibility.hpp, D samples per pixel length): per-pixel relative
+//              error |count - ref| / ref, mean over the pixels (the target's metric: the
+//              tree's at most 1.1 x the naive march's on every content) and aggregate
+//              sum |count - ref| / sum ref; on small crops of the synthetic fields, the DEM
+//              and a city-like surface model, with the two methods' times
+// `--sections` picks some of them (time = vis_time, stats, zone, scale, accuracy).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <random>
+#include <tuple>
 
+#include "dense_visibility.hpp"
 #include "environment.hpp"
 #include "hfvis/intervisibility.hpp"
 #include "metrics.hpp"
@@ -36,6 +46,14 @@ struct VisibilityConfig {
   int rounds = 3;             // vis_time: timed runs of each tree tuning ...
   int naive_rounds = 2;       // ... and of the naive march (interleaved)
   TimingPolicy policy;        // vis_zone
+  // vis_accuracy: n x n crops (the DEM's centre; the city generated at that size), K
+  // directions, the dense reference at dense_per_unit samples per pixel length, the tree and
+  // the naive march timed accuracy_rounds times each, interleaved.
+  std::vector<std::string> accuracy_contents = {"fractal", "bricks", "sine", "blocks", "dem", "city"};
+  int accuracy_n = 256;
+  int accuracy_k = 16;
+  int dense_per_unit = 16;
+  int accuracy_rounds = 2;
 };
 
 VisibilityConfig visibilityConfigFor(const std::string& mode) {
@@ -46,6 +64,8 @@ VisibilityConfig visibilityConfigFor(const std::string& mode) {
   } else if (mode == "quick") {
     c.n = 256;
     c.time_k = 8;
+    c.accuracy_n = 128;
+    c.accuracy_k = 8;
     c.stats_k = 16;
     c.zone_steps = {1, 16, 256};
     c.rounds = c.naive_rounds = 2;
@@ -61,6 +81,10 @@ VisibilityConfig visibilityConfigFor(const std::string& mode) {
     c.scale_ns = {16, 32, 64};
     c.scale_lines = 4;
     c.rounds = c.naive_rounds = 1;
+    c.accuracy_contents = {"sine", "fractal", "dem", "city"};
+    c.accuracy_n = 40;
+    c.accuracy_k = 8;  // diagonals too (K = 4 runs along the axes, where the tree is exact)
+    c.dense_per_unit = 8;
     c.policy = {1, 1, 0.0};
   }
   return c;
@@ -71,7 +95,9 @@ const std::vector<std::string> kVisibilityColumns = {
     "section", "content", "width", "height", "method", "tuning", "zone_steps", "K", "reps", "t_min_s",
     "t_median_s", "t_all_s", "cpu_min_s", "load_1min", "pixel_dirs", "core_ns_per_pd", "cpu_ns_per_pd",
     "receivers", "lines", "m_a", "t_a", "visible_a", "naive_a", "skip_fraction", "lines_over_bound", "n",
-    "t_per_line", "m_per_line", "note"};
+    "t_per_line", "m_per_line", "dense_per_unit", "ref_mean", "count_mean", "rel_err_mean", "rel_err_agg",
+    "rel_err_p99", "rel_err_max", "rel_bias_mean", "err_pixels", "ref_seconds", "differ_pixels",
+    "offset_differ_pixels", "note"};
 // clang-format on
 
 struct NamedTuning {
@@ -102,14 +128,38 @@ class VisibilitySuite {
         out_(out),
         cores_(std::max(1, context.device().compute_units)) {}
 
-  void run() {
-    for (const auto& name : config_.contents) {
-      const Content content = loadContent(options_, name, config_.n);
-      timeContent(content);
-      statistics(content);
-      if (std::count(config_.zone_contents.begin(), config_.zone_contents.end(), name)) zone(content);
+  // Runs the sections options.sections names (all when empty); records each part's seconds
+  // in `environment`.
+  void run(KeyValues& environment) {
+    const auto want = [&](const std::string& section) {
+      return options_.sections.empty() ||
+             std::count(options_.sections.begin(), options_.sections.end(), section) > 0;
+    };
+    const auto seconds_since = [](std::chrono::steady_clock::time_point start) {
+      return num(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    };
+    auto start = std::chrono::steady_clock::now();
+    if (want("time") || want("stats") || want("zone")) {
+      for (const auto& name : config_.contents) {
+        const Content content = loadContent(options_, name, config_.n);
+        if (want("time")) timeContent(content);
+        if (want("stats")) statistics(content);
+        if (want("zone") && std::count(config_.zone_contents.begin(), config_.zone_contents.end(), name))
+          zone(content);
+      }
+      environment.emplace_back("time_stats_zone_seconds", seconds_since(start));
     }
-    scaling();
+    if (want("scale")) {
+      start = std::chrono::steady_clock::now();
+      scaling();
+      environment.emplace_back("scale_seconds", seconds_since(start));
+    }
+    if (want("accuracy")) {
+      start = std::chrono::steady_clock::now();
+      accuracy();
+      environment.emplace_back("accuracy_seconds", seconds_since(start));
+      say("[vis_accuracy] section done in %s s", environment.back().second.c_str());
+    }
   }
 
  private:
@@ -299,6 +349,170 @@ class VisibilitySuite {
     }
   }
 
+  // Issue 8, target (e): visible counts against the dense reference (see the file's head and
+  // bench/dense_visibility.hpp). Per content: the reference at D samples per pixel length, the
+  // host unit march (the reference's code at D = 1: the naive march's samples in double), then
+  // the hull tree (default options, HullTree) and the naive march (IntervisibilityMethod::Naive),
+  // both at samples_per_unit 1 and the same K, timed accuracy_rounds times each, interleaved
+  // (tree, naive, tree, naive); the counts of their last runs are compared with the reference.
+  void accuracy() {
+    for (const auto& name : config_.accuracy_contents) accuracyOf(accuracyContent(name));
+  }
+
+  Content accuracyContent(const std::string& name) const {
+    const int n = config_.accuracy_n;
+    if (name != "city") return loadContent(options_, name, n);
+    Content c;
+    c.name = name;
+    // Tiny mode: odd, non-square, as the other tiny stand-ins.
+    c.field = options_.mode == "tiny" ? makeCityField(n + 3, n - 2, 2013) : makeCityField(n, n, 2013);
+    c.label = name + "_" + std::to_string(c.field.width) + "x" + std::to_string(c.field.height);
+    return c;
+  }
+
+  // Azimuth offset (radians) of the host unit march's convention check.
+  static constexpr double kCheckOffset = 0.1;
+
+  struct CountErrors {
+    double ref_mean = 0, count_mean = 0;  // over the compared pixels
+    double mean = 0, aggregate = 0, p99 = 0, max = 0, bias = 0;
+    std::size_t pixels = 0, ref_zero = 0;
+  };
+
+  // Per-pixel relative error |count - ref| / ref over the pixels with ref > 0 (mean, p99, max,
+  // signed mean), and the aggregate sum |count - ref| / sum ref over the same pixels.
+  template <typename T>
+  static CountErrors countErrors(const std::vector<T>& counts, const std::vector<double>& ref) {
+    CountErrors e;
+    std::vector<double> relative;
+    double sum_ref = 0, sum_count = 0, sum_abs = 0, sum_signed = 0;
+    for (std::size_t i = 0; i < ref.size(); ++i) {
+      if (!(ref[i] > 0)) {
+        ++e.ref_zero;
+        continue;
+      }
+      const double c = counts[i], d = c - ref[i];
+      relative.push_back(std::fabs(d) / ref[i]);
+      sum_ref += ref[i], sum_count += c, sum_abs += std::fabs(d), sum_signed += d / ref[i];
+    }
+    e.pixels = relative.size();
+    if (relative.empty()) return e;
+    const double n = double(relative.size());
+    e.ref_mean = sum_ref / n;
+    e.count_mean = sum_count / n;
+    e.aggregate = sum_abs / sum_ref;
+    e.bias = sum_signed / n;
+    double total = 0;
+    for (double r : relative) total += r, e.max = std::max(e.max, r);
+    e.mean = total / n;
+    const std::size_t at =
+        std::min(relative.size() - 1, static_cast<std::size_t>(0.99 * (relative.size() - 1) + 0.5));
+    std::nth_element(relative.begin(), relative.begin() + at, relative.end());
+    e.p99 = relative[at];
+    return e;
+  }
+
+  void addErrors(Row& row, const CountErrors& e, double ref_seconds) const {
+    row["dense_per_unit"] = std::to_string(config_.dense_per_unit);
+    row["ref_mean"] = num(e.ref_mean);
+    row["count_mean"] = num(e.count_mean);
+    row["rel_err_mean"] = num(e.mean);
+    row["rel_err_agg"] = num(e.aggregate);
+    row["rel_err_p99"] = num(e.p99);
+    row["rel_err_max"] = num(e.max);
+    row["rel_bias_mean"] = num(e.bias);
+    row["err_pixels"] = std::to_string(e.pixels);
+    row["ref_seconds"] = num(ref_seconds);
+    if (e.ref_zero) row["note"] = std::to_string(e.ref_zero) + " pixels with reference 0 left out";
+  }
+
+  void accuracyOf(const Content& content) {
+    const HeightField& field = content.field;
+    const int k = config_.accuracy_k;
+    SweepOptions sweep;
+    sweep.directions = k;
+    const auto start = std::chrono::steady_clock::now();
+    const std::vector<double> ref = denseVisibleCounts(field, sweep, config_.dense_per_unit);
+    const double ref_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const std::vector<double> unit = denseVisibleCounts(field, sweep, 1);
+
+    IntervisibilityOptions tree;  // the library's defaults: HullTree, default tuning, 1 sample per unit
+    tree.directions = k;
+    IntervisibilityOptions naive = tree;
+    naive.method = IntervisibilityMethod::Naive;
+    IntervisibilityOutputs outputs;
+    outputs.visible_count = true;
+    for (const auto* options : {&tree, &naive})  // builds and caches each program
+      computeIntervisibility(context_, crop(field, 64, 64), *options, outputs);
+    Timing tree_time, naive_time;
+    std::vector<float> tree_counts, naive_counts;
+    for (int round = 0; round < config_.accuracy_rounds; ++round) {
+      for (auto [options, timing, counts] :
+           {std::tuple{&tree, &tree_time, &tree_counts}, std::tuple{&naive, &naive_time, &naive_counts}}) {
+        const Timing one = timeRepeated(
+            [&] { *counts = computeIntervisibility(context_, field, *options, outputs).visible_count; },
+            {1, 1, 0.0});
+        timing->seconds.push_back(one.seconds[0]);
+        timing->cpu_seconds.push_back(one.cpu_seconds[0]);
+      }
+    }
+
+    const CountErrors tree_e = countErrors(tree_counts, ref), naive_e = countErrors(naive_counts, ref);
+    Row row = timingRow("vis_accuracy", content, "tree", "default", 0, k, tree_time);
+    addStatistics(row, statisticsOf(field, k, tree.tree));
+    addErrors(row, tree_e, ref_seconds);
+    out_.write(row);
+    row = timingRow("vis_accuracy", content, "naive", "", 0, k, naive_time);
+    addErrors(row, naive_e, ref_seconds);
+    out_.write(row);
+    // The host unit march: the reference's code at D = 1, i.e. the naive march's samples
+    // decided in double (ties within the tolerance). Where it differs from the library's naive
+    // march, the difference is the library's float sampling (or a convention bug). The sum over
+    // K directions 2 pi k / K is the same for mirrored directions, so a wrong azimuth sign would
+    // not show at offset 0: the convention check compares the two again at an azimuth offset.
+    const auto differing = [](const std::vector<float>& library, const std::vector<double>& host,
+                              double* mean) {
+      std::size_t differ = 0;
+      double sum = 0;
+      for (std::size_t i = 0; i < host.size(); ++i) {
+        const double d = std::fabs(double(library[i]) - host[i]);
+        differ += d > 0.5;
+        sum += d;
+      }
+      *mean = host.empty() ? 0.0 : sum / host.size();
+      return differ;
+    };
+    double diff_mean = 0, offset_diff_mean = 0;
+    const std::size_t differ = differing(naive_counts, unit, &diff_mean);
+    IntervisibilityOptions naive_offset = naive;
+    naive_offset.azimuth_offset = kCheckOffset;
+    const std::size_t offset_differ =
+        differing(computeIntervisibility(context_, field, naive_offset, outputs).visible_count,
+                  denseVisibleCounts(field, naive_offset, 1), &offset_diff_mean);
+    row = Row();
+    row["section"] = "vis_accuracy";
+    row["content"] = content.name;
+    row["width"] = std::to_string(field.width);
+    row["height"] = std::to_string(field.height);
+    row["method"] = "host_unit";
+    row["K"] = std::to_string(k);
+    addErrors(row, countErrors(unit, ref), ref_seconds);
+    row["differ_pixels"] = std::to_string(differ);
+    row["offset_differ_pixels"] = std::to_string(offset_differ);
+    row["note"] = "against the library's naive march: counts differ at " + std::to_string(differ) + " of " +
+                  std::to_string(unit.size()) + " pixels, mean |difference| " + num(diff_mean) +
+                  " samples; at azimuth offset " + num(kCheckOffset) + " rad at " +
+                  std::to_string(offset_differ) + " pixels, mean |difference| " + num(offset_diff_mean);
+    out_.write(row);
+    say("[vis_accuracy] %s K=%d D=%d: reference mean count %.2f (%.2f s); mean relative error tree %.4f, "
+        "naive %.4f (tree / naive %.2f); aggregate tree %.4f, naive %.4f; time tree %.3f s, naive %.3f s; "
+        "host unit march differs from naive at %zu pixels (%zu at an azimuth offset)",
+        content.label.c_str(), k, config_.dense_per_unit, tree_e.ref_mean, ref_seconds, tree_e.mean,
+        naive_e.mean, naive_e.mean > 0 ? tree_e.mean / naive_e.mean : 0.0, tree_e.aggregate,
+        naive_e.aggregate, tree_time.min(), naive_time.min(), differ, offset_differ);
+  }
+
   const ComputeContext& context_;
   const SuiteOptions& options_;
   VisibilityConfig config_;
@@ -308,11 +522,18 @@ class VisibilitySuite {
 
 }  // namespace
 
+const std::vector<std::string>& visibilitySections() {
+  static const std::vector<std::string> names = {"time", "stats", "zone", "scale", "accuracy"};
+  return names;
+}
+
 std::vector<std::pair<std::string, int>> visibilityInputs(const std::string& mode) {
   const VisibilityConfig c = visibilityConfigFor(mode);
   std::vector<std::pair<std::string, int>> inputs;
   for (const auto& name : c.contents)
     if (name != "dem") inputs.emplace_back(name, c.n);
+  for (const auto& name : c.accuracy_contents)
+    if (name != "dem" && name != "city") inputs.emplace_back(name, c.accuracy_n);
   return inputs;
 }
 
@@ -322,9 +543,12 @@ int runVisibilitySuite(const ComputeContext& context, const SuiteOptions& option
   KeyValues environment = describeEnvironment(context.device());
   environment.emplace_back("mode", options.mode);
   environment.emplace_back("commit", options.commit);
+  std::string sections;
+  for (const auto& s : options.sections) sections += (sections.empty() ? "" : ",") + s;
+  environment.emplace_back("sections", sections.empty() ? "all" : sections);
   {
     CsvWriter out((fs::path(options.out_dir) / "visibility.csv").string(), kVisibilityColumns);
-    VisibilitySuite(context, options, out).run();
+    VisibilitySuite(context, options, out).run(environment);
   }
   environment.emplace_back("load_average_end", loadAverage());
   environment.emplace_back("suite_seconds",

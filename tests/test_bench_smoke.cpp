@@ -154,6 +154,41 @@ TEST_F(BenchSmoke, TinySuiteMeasuresEveryMethodInEverySection) {
   EXPECT_TRUE(fs::exists(dir_ / "report" / "environment.txt"));
 }
 
+// The vis_accuracy rows of a visibility.csv (issue 8, target e): for every content the tree,
+// the naive march and the host unit march, with finite errors against a reference whose mean
+// count is positive; where there are no exact ties (every content but the city's flat roofs
+// and tilted ground), the host unit march (the dense reference's code at one sample per unit)
+// gives the library's naive counts at an azimuth offset, which checks the reference's
+// directions (azimuth sign and origin, cell sizes) and conventions.
+// Returns the contents seen.
+std::set<std::string> checkAccuracyRows(const CsvTable& csv) {
+  const std::size_t section = csv.column("section"), method = csv.column("method"),
+                    content = csv.column("content");
+  const std::size_t ref = csv.column("ref_mean"), mean = csv.column("rel_err_mean"),
+                    agg = csv.column("rel_err_agg");
+  const std::size_t differ = csv.column("offset_differ_pixels"), pixels = csv.column("err_pixels");
+  std::map<std::string, std::set<std::string>> methods;  // content -> methods
+  for (const auto& f : csv.rows) {
+    if (f.size() != csv.columns.size() || f[section] != "vis_accuracy") continue;
+    const std::string line = f[content] + "," + f[method];
+    methods[f[content]].insert(f[method]);
+    EXPECT_GT(std::stod(f[ref]), 0.0) << line;
+    EXPECT_TRUE(std::isfinite(std::stod(f[mean]))) << line;
+    EXPECT_TRUE(std::isfinite(std::stod(f[agg]))) << line;
+    EXPECT_GT(std::stoi(f[pixels]), 0) << line;
+    if (f[method] == "host_unit" && f[content] != "city") {
+      EXPECT_LE(std::stod(f[differ]), 0.01 * std::stod(f[pixels])) << line;
+    }
+  }
+  std::set<std::string> contents;
+  for (const auto& [c, m] : methods) {
+    contents.insert(c);
+    for (const char* name : {"tree", "naive", "host_unit"})
+      EXPECT_TRUE(m.count(name)) << c << " has no " << name;
+  }
+  return contents;
+}
+
 // The intervisibility suite on tiny fields: every section, every tuning, the naive march;
 // statistics are present and the tunings agree on the horizons (they change only the work).
 TEST_F(BenchSmoke, TinyVisibilitySuiteMeasuresEverySection) {
@@ -180,11 +215,31 @@ TEST_F(BenchSmoke, TinyVisibilitySuiteMeasuresEverySection) {
       }
     }
   }
-  for (const char* s : {"vis_time", "vis_stats", "vis_zone", "vis_scale"})
+  for (const char* s : {"vis_time", "vis_stats", "vis_zone", "vis_scale", "vis_accuracy"})
     EXPECT_TRUE(sections.count(s)) << "no rows for section " << s;
+  EXPECT_TRUE(checkAccuracyRows(csv).count("city"));
   EXPECT_TRUE(methods.count("naive"));
   for (const char* t : {"plain", "deferred", "default", "zone"}) EXPECT_TRUE(tunings.count(t)) << t;
   EXPECT_TRUE(fs::exists(dir_ / "report" / "visibility_environment.txt"));
+}
+
+// --sections runs only the sections it names; an unknown name is a usage error.
+TEST_F(BenchSmoke, VisibilitySectionsRunsOnlyThoseNamed) {
+  const fs::path log = dir_ / "accuracy.log";
+  ASSERT_EQ(runBench("visibility --tiny --sections accuracy --out '" + (dir_ / "report").string() + "'", log),
+            0)
+      << readText(log);
+  const CsvTable csv = readCsv(dir_ / "report" / "visibility.csv");
+  const std::size_t section = csv.column("section");
+  for (const auto& f : csv.rows) {
+    if (f.size() == csv.columns.size()) {
+      EXPECT_EQ(f[section], "vis_accuracy");
+    }
+  }
+  EXPECT_EQ(checkAccuracyRows(csv).size(), 4u);  // sine, fractal, the dome for the DEM, city
+  EXPECT_EQ(runBench("visibility --tiny --sections accuracy,nonsense --out '" + (dir_ / "bad").string() + "'",
+                     dir_ / "bad.log"),
+            2);
 }
 
 }  // namespace
