@@ -24,7 +24,7 @@ std::vector<detail::SweepDirection> directionsOf(const HeightField& field, int d
                                                  double samples_per_unit) {
   std::vector<detail::SweepDirection> all;
   for (int k = 0; k < directions; ++k)
-    all.push_back(detail::makeSweepDirection(field, 2.0 * kPi * k / directions, samples_per_unit, 1.0));
+    all.push_back(detail::makeSweepDirection(field, 2.0 * kPi * k / directions, samples_per_unit));
   return all;
 }
 

@@ -23,7 +23,6 @@ enum class Option {
   Method,
   AzimuthOffset,
   SamplesPerUnit,
-  LinesPerUnit,
   CellSize,
   ZScale,
   Channel,
@@ -52,7 +51,6 @@ constexpr OptionSpec kOptions[] = {
     {Option::Method, "--method", nullptr, true},
     {Option::AzimuthOffset, "--azimuth-offset", nullptr, true},
     {Option::SamplesPerUnit, "--samples-per-unit", nullptr, true},
-    {Option::LinesPerUnit, "--lines-per-unit", nullptr, true},
     {Option::CellSize, "--cell-size", nullptr, true},
     {Option::ZScale, "--z-scale", nullptr, true},
     {Option::Channel, "--channel", nullptr, true},
@@ -74,7 +72,6 @@ void setSweepOptions(const RunArguments& run, Options& options) {
   options.directions = run.directions;
   options.azimuth_offset = run.azimuth_offset_deg * (kPi / 180.0);
   options.samples_per_unit = run.samples_per_unit;
-  options.lines_per_unit = run.lines_per_unit;
   options.memory_budget_bytes = run.memory_budget_bytes;
 }
 
@@ -198,7 +195,7 @@ const char* onlyFor(Option option) {
 // one ray per receiver and direction, and written as text).
 bool notFor(Option option, Command command) {
   if (command == Command::HorizonLists) {
-    return option == Option::Method || option == Option::LinesPerUnit || option == Option::Device ||
+    return option == Option::Method || option == Option::Device ||
            option == Option::MemoryBudget || option == Option::Preview;
   }
   if (option == Option::HullTree) return command != Command::ViewCount && command != Command::Bounce;
@@ -260,8 +257,6 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
     case Option::SamplesPerUnit:
       run.samples_per_unit = parsePositive(typed, value);
       break;
-    case Option::LinesPerUnit:
-      run.lines_per_unit = parsePositive(typed, value);
       break;
     case Option::CellSize:
       parseCellSize(typed, value, run);

@@ -48,7 +48,6 @@ struct RunArguments {
   int directions = 64;
   double azimuth_offset_deg = 0.0;
   double samples_per_unit = 1.0;
-  double lines_per_unit = 1.0;
   HorizonMethod method = HorizonMethod::Sweep;                                // horizon, svf, ao
   IntervisibilityMethod visibility_method = IntervisibilityMethod::HullTree;  // viewcount
   bool statistics = false;                                                    // viewcount --stats

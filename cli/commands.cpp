@@ -261,7 +261,6 @@ Attributes runAttributes(Command command, const RunArguments& run, const HeightF
        "compass azimuth = 90 + phi_k deg when row 0 is north"},
       {"hfvis:method", methodName(command, run)},
       {"hfvis:samples_per_unit", formatNumber(run.samples_per_unit)},
-      {"hfvis:lines_per_unit", formatNumber(run.lines_per_unit)},
       // Read back by readHeightField, so an output keeps the input's ground spacing.
       {"hfvis:cell_size_x", formatNumber(field.cell_size_x)},
       {"hfvis:cell_size_y", formatNumber(field.cell_size_y)},

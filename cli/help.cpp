@@ -47,8 +47,6 @@ Options:
                            line or ray; sweep: every grid-line crossing of the ray (exact heights)
                            and, for S > 1, about S points per pixel length between crossings
                            (default 1: the crossings alone)
-  --lines-per-unit L       viewcount, bounce: sweep lines per pixel length across a direction
-                           (default 1; the horizon sweep always has one line per pixel centre)
   --cell-size X[,Y]        ground units per pixel along columns (X) and rows (Y)
                            (default: from the file (hfvis:cell_size_x/y attributes,
                            GeoTIFF pixel scale), else 1)

@@ -1,9 +1,9 @@
-// intervisibility.cl: visibility between all points along sweep lines by the convex hull
-// tree (Timonen 2013, Algorithm 1 with segment starts per Eq. 1 and leaf duplication),
-// the visible count per receiver derived from its visibility horizons, the one-bounce
-// gather over the visible runs (Sec. 10.1, alternative 3; its other kernels are in
-// bounce.cl), the reduction that rotates line buffers back onto the grid, and the naive
-// per-pixel visibility march (baseline and oracle).
+// intervisibility.cl: visibility between all points along lattice lines through the pixel
+// centres by the convex hull tree (Timonen 2013, Algorithm 1 with segment starts per Eq. 1
+// and leaf duplication): the visible count and area of every receiver from its visibility
+// horizons, added straight into its pixel, and with HFVIS_WANT_BOUNCE the one-bounce gather
+// over the visible runs (Sec. 10.1, alternative 3; bounce.cl); and the naive per-pixel
+// visibility march (baseline and oracle).
 //
 // Visibility (the tie rule, the same everywhere, tests included): on one line, a farther
 // sample q is visible from receiver p when no sample strictly between them lies strictly
@@ -20,7 +20,7 @@
 //   HFVIS_WANT_AREA         sum the distances of the visible samples (for the area estimate)
 //   HFVIS_WANT_STATS        per-line totals of receivers, horizons, iterations, ...
 //   HFVIS_WANT_ENTRY_STATS  per-entry (horizons, iterations, horizon hash) for the tests
-//   HFVIS_WANT_BOUNCE       gather exit radiance over the visible samples (bounce.cl sets it)
+//   HFVIS_WANT_BOUNCE       gather exit radiance over the visible samples (bounce.cl)
 //   HFVIS_CHANNELS          radiance channels of the bounce, 1..4
 //   HFVIS_DEFERRED_WRITES   the tree walk with the old root's level in registers and link
 //                           writes only where a link changes (the aim of Algorithm 2); 0 =
@@ -168,11 +168,11 @@ HFVIS_INLINE int chord_side_filter(float ha, float hb, float hc, float dab, floa
 // ---------------------------------------------------------------------------------------
 // The convex hull tree sweep.
 //
-// Tree nodes of line j live at trees[line_entry(d, j, k)] as int4 (height bits,
-// rank * 2 + leaf flag, first child, next sibling), the node of the sample at step k in
-// slot k, links by slot, HFVIS_NONE for none. So a line's tree needs one slot per step: the
-// tree buffer is as large as the line buffer. The rank (present samples before it) counts
-// run lengths without another read. The leaf flag marks a segment start (Eq. 1: the first
+// Tree nodes of a line live in its scratch as int4 (height bits, rank * 2 + leaf flag,
+// first child, next sibling), the node of the sample at step k in slot k, links by slot,
+// HFVIS_NONE for none. So a line's tree needs one slot per step, and a slot keeps its
+// sample's height for good (the visible runs read heights from it). The rank (present
+// samples before it) counts run lengths without another read. The leaf flag marks a segment start (Eq. 1: the first
 // present sample, and every convex sample after a concave one), whose node is never
 // deleted: it starts the convex hull path of its segment.
 //

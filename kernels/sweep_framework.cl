@@ -1,23 +1,18 @@
-// sweep_framework.cl: what every sweep kernel shares: the per-direction line geometry,
-// bilinear height sampling with the nodata policy, and the line presampling pass.
+// sweep_framework.cl: what every sweep kernel shares: the ray geometry of the naive
+// marches, bilinear height sampling with the nodata policy, and the per-period samples of
+// the lattice lines that the horizon and hull-tree sweeps run on.
 //
-// Geometry (pixel axes, x = column, y = row; pixel (c, r) at (c, r)): lines run along the
-// unit direction `dir`; line j lies at perpendicular offset (line_first + j) * line_spacing
-// along `perp`; step i of every line lies at t = (step_top - i) * step_length along `dir`,
-// so step 0 is the far end and a line is swept toward -dir. All lines of a direction share
-// the step lattice. Line buffers have one entry per (line, step); where it sits is the
-// layout (HFVIS_LINE_MAJOR below), reached only through line_entry() and line_stride().
+// Pixel axes: x = column, y = row; pixel (c, r) at (c, r). The lattice sweeps' scratch
+// (hull stacks, tree nodes) is laid out by the host (src/lattice_geometry.hpp, chunkLines):
+// line-major for CPUs, whose work-item runs one line serially, step-major for GPUs, whose
+// neighbouring work-items then touch neighbouring entries; the kernels see only each line's
+// first entry and the stride between its entries.
 //
 // Compile-time parameters (prepended #defines; every kernel compiles with the defaults):
 //   HFVIS_HAS_NODATA  the field holds NaN heights: bilinear samples renormalise over the
 //                     valid corners (0 = the faster path without checks)
 //   HFVIS_EDGE_EPS    how far outside [0, W-1] x [0, H-1] (pixels) a sample still counts as
 //                     inside (absorbs rounding of directions that are exactly axis-aligned)
-//   HFVIS_LINE_MAJOR  0: entry (line j, step i) at i * n_lines + j, so work-items (lines)
-//                     at the same step touch adjacent addresses: coalesced on GPUs.
-//                     1: at j * n_steps + i, so one work-item walks its line contiguously:
-//                     CPUs run a work-item's loop serially, and the step-major stride
-//                     costs a cache line and often a TLB entry per step.
 #ifndef HFVIS_SWEEP_FRAMEWORK_CL
 #define HFVIS_SWEEP_FRAMEWORK_CL
 
@@ -36,12 +31,10 @@
 #ifndef HFVIS_EDGE_EPS
 #define HFVIS_EDGE_EPS 1e-3f
 #endif
-#ifndef HFVIS_LINE_MAJOR
-#define HFVIS_LINE_MAJOR 0
-#endif
 
-// One direction's sweep geometry. Must match struct SweepDirection in
-// src/sweep_geometry.hpp: sixteen 4-byte members, no padding.
+// One direction's ray geometry (the naive visibility march reads dir, step and ground
+// lengths). Must match struct SweepDirection in src/sweep_geometry.hpp: sixteen 4-byte
+// members, no padding.
 typedef struct {
   float dir_x, dir_y;    // unit line direction in pixel axes
   float perp_x, perp_y;  // (-dir_y, dir_x)

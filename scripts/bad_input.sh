@@ -105,7 +105,7 @@ try "directions beyond the limit" "" -- svf field.exr -o out/o.exr -k 100000000
 try "samples per unit zero" "" -- svf field.exr -o out/o.exr --samples-per-unit 0
 try "samples per unit NaN" "" -- svf field.exr -o out/o.exr --samples-per-unit nan
 try "samples per unit infinite" "" -- svf field.exr -o out/o.exr --samples-per-unit inf
-try "lines per unit for the horizon sweep" "" -- svf field.exr -o out/o.exr --lines-per-unit 2
+try "lines per unit (removed: every sweep runs one line through each pixel centre)" "" -- viewcount field.exr -o out/o.exr --lines-per-unit 2
 try "cell size zero" "" -- svf field.exr -o out/o.exr --cell-size 0
 try "cell size negative" "" -- svf field.exr -o out/o.exr --cell-size 1,-2
 try "cell size not a number" "" -- svf field.exr -o out/o.exr --cell-size 1,abc

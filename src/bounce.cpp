@@ -39,7 +39,7 @@ BounceResult run(const ComputeContext& context, const HeightField& field, const 
   const std::vector<TreeDirection> directions = treeDirections(field, options);
   checkTreeLimits(directions, inputs.heights);
   const TreeProgramFlags flags = bounceFlags(inputs, options.tree);
-  cl::Program program = st.program("intervisibility.cl", treeProgramOptions(flags, st));
+  cl::Program program = st.program("intervisibility.cl", treeProgramOptions(flags));
   const std::size_t plane = field.pixelCount();
   // Heights, normals, radiance and the irradiance sums.
   const std::size_t fixed = plane * sizeof(float) * (1 + 3 + 2 * channels);

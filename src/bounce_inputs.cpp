@@ -72,10 +72,6 @@ BounceInputs prepareBounce(const HeightField& field, const ExitRadiance& radianc
 void validate(const BounceOptions& options) {
   validate(static_cast<const SweepOptions&>(options));
   validate(options.tree);
-  if (options.lines_per_unit != 1.0) {
-    throw InvalidArgument(
-        "lines per unit must stay 1: the bounce's tree sweep runs one line through every pixel centre");
-  }
 }
 
 void validate(const HeightField& field, const ExitRadiance& radiance) {

@@ -16,11 +16,6 @@ void validate(const HorizonOptions& options, const HorizonOutputs& outputs) {
     throw InvalidArgument("the azimuth tolerance must be in (0, 0.1] radians, (0, 5.73] degrees (got " +
                           std::to_string(options.azimuth_tolerance * 180.0 / M_PI) + " degrees)");
   }
-  if (options.method == HorizonMethod::Sweep && options.lines_per_unit != 1.0) {
-    throw InvalidArgument(
-        "lines per unit applies to the intervisibility sweeps only: the horizon sweep runs one line through "
-        "every pixel centre");
-  }
   if (!outputs.horizon_angles && !outputs.horizon_distances && !outputs.sky_view_factor &&
       !outputs.ambient_occlusion) {
     throw InvalidArgument("no output requested");

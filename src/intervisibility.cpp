@@ -21,12 +21,11 @@
 namespace hfvis {
 namespace detail {
 
-std::string treeProgramOptions(const TreeProgramFlags& f, const ContextState& st) {
+std::string treeProgramOptions(const TreeProgramFlags& f) {
   std::ostringstream s;
   s << "-DHFVIS_HAS_NODATA=" << f.has_nodata << " -DHFVIS_WANT_COUNT=" << f.count
     << " -DHFVIS_WANT_AREA=" << f.area
-    << " -DHFVIS_WANT_STATS=" << f.stats << " -DHFVIS_WANT_ENTRY_STATS=" << f.entry_stats << " "
-    << layoutProgramOption(st);
+    << " -DHFVIS_WANT_STATS=" << f.stats << " -DHFVIS_WANT_ENTRY_STATS=" << f.entry_stats;
   s << " -DHFVIS_DEFERRED_WRITES=" << f.tuning.deferred_writes
     << " -DHFVIS_REPLACEMENT_CHECK=" << f.tuning.replacement_check
     << " -DHFVIS_SAFE_ZONE=" << f.tuning.safe_zone << " -DHFVIS_SAFE_ZONE_STEPS=" << f.tuning.safe_zone_steps;
@@ -166,7 +165,7 @@ IntervisibilityResult runTree(ContextState& st, const HeightField& field, const 
   flags.area = outputs.visible_area;
   flags.stats = outputs.statistics;
   flags.tuning = options.tree;
-  cl::Program program = st.program("intervisibility.cl", treeProgramOptions(flags, st));
+  cl::Program program = st.program("intervisibility.cl", treeProgramOptions(flags));
   const std::size_t plane = field.pixelCount();
   // Heights and the sums (the count also when only the area is asked for: the kernel adds both).
   const std::size_t fixed = plane * sizeof(float) * (2 + outputs.visible_area);
@@ -208,7 +207,7 @@ IntervisibilityResult runNaive(ContextState& st, const HeightField& field, const
   flags.has_nodata = prepared.has_nodata;
   flags.area = outputs.visible_area;
   flags.stats = false;
-  cl::Program program = st.program("intervisibility.cl", treeProgramOptions(flags, st));
+  cl::Program program = st.program("intervisibility.cl", treeProgramOptions(flags));
   const std::size_t plane = field.pixelCount();
   const std::vector<SweepDirection> all = runDirections(field, options);
   const cl::Buffer heights(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, plane * sizeof(float),
@@ -252,7 +251,7 @@ IntervisibilityLines treeLinesOnDevice(ContextState& st, const TreeProgramFlags&
                                        std::vector<float>* irradiance) {
   TreeProgramFlags flags = program_flags;
   flags.entry_stats = true;
-  cl::Program program = st.program("intervisibility.cl", treeProgramOptions(flags, st));
+  cl::Program program = st.program("intervisibility.cl", treeProgramOptions(flags));
   const std::size_t plane = field.pixelCount();
   const std::size_t per_period = d.samples.size(), longest = d.longestLine();
   std::size_t entries = 0;

@@ -42,10 +42,6 @@ void validate(const IntervisibilityOptions& options, const IntervisibilityOutput
   if (!outputs.visible_count && !outputs.visible_area && !outputs.statistics) {
     throw InvalidArgument("no output requested");
   }
-  if (options.method == IntervisibilityMethod::HullTree && options.lines_per_unit != 1.0) {
-    throw InvalidArgument(
-        "lines per unit must stay 1 for the hull tree: it runs one line through every pixel centre");
-  }
   if (outputs.statistics && options.method != IntervisibilityMethod::HullTree) {
     throw InvalidArgument("statistics (horizons and iterations) exist only for the hull-tree method");
   }

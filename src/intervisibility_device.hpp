@@ -32,8 +32,8 @@ struct TreeProgramFlags {
   HullTreeTuning tuning;
 };
 
-// The -D options of kernels/intervisibility.cl with these flags, for a context.
-std::string treeProgramOptions(const TreeProgramFlags& flags, const ContextState& st);
+// The -D options of kernels/intervisibility.cl with these flags.
+std::string treeProgramOptions(const TreeProgramFlags& flags);
 
 // The device buffers a run binds; those its program does not use are minimal
 // (deviceBuffer(st, 0)).

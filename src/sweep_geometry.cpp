@@ -14,8 +14,8 @@ namespace {
 double snap(double v) { return std::abs(v) < 1e-12 ? 0.0 : v; }
 }  // namespace
 
-SweepDirection makeSweepDirection(const HeightField& field, double azimuth, double samples_per_unit,
-                                  double lines_per_unit) {
+SweepDirection makeSweepDirection(const HeightField& field, double azimuth, double samples_per_unit) {
+  const double lines_per_unit = 1.0;
   SweepDirection d{};
   const double cos_az = snap(std::cos(azimuth)), sin_az = snap(std::sin(azimuth));
   // The ground direction (cos, sin) seen in pixel axes, where cells may not be square.
@@ -48,29 +48,6 @@ SweepDirection makeSweepDirection(const HeightField& field, double azimuth, doub
   d.step_top = static_cast<std::int32_t>(std::ceil(t_hi * samples_per_unit)) + 1;
   d.n_steps = d.step_top - (static_cast<std::int32_t>(std::floor(t_lo * samples_per_unit)) - 1) + 1;
   return d;
-}
-
-Point2 sweepPosition(const SweepDirection& d, int line, int step) {
-  const float s = static_cast<float>(d.line_first + line) * d.line_spacing;
-  const float t = static_cast<float>(d.step_top - step) * d.step_length;
-  return {s * d.perp_x + t * d.dir_x, s * d.perp_y + t * d.dir_y};
-}
-
-std::array<CellCorner, 4> receiverCell(const SweepDirection& d, int c, int r) {
-  const float x = static_cast<float>(c), y = static_cast<float>(r);
-  const float t = x * d.dir_x + y * d.dir_y;
-  const float u = (x * d.perp_x + y * d.perp_y) * d.lines_per_unit - static_cast<float>(d.line_first);
-  const float v = static_cast<float>(d.step_top) - t * d.samples_per_unit;
-  const int j0 = static_cast<int>(std::floor(u)), i0 = static_cast<int>(std::floor(v));
-  const float fu = u - static_cast<float>(j0), fv = v - static_cast<float>(i0);
-  std::array<CellCorner, 4> corners;
-  for (int k = 0; k < 4; ++k) {
-    const int j = j0 + (k & 1), i = i0 + (k >> 1);
-    const float w = ((k & 1) ? fu : 1.0f - fu) * ((k >> 1) ? fv : 1.0f - fv);
-    const bool in_buffer = j >= 0 && j < d.n_lines && i >= 0 && i < d.n_steps;
-    corners[k] = {in_buffer ? w : 0.0f, i, in_buffer ? static_cast<std::size_t>(i) * d.n_lines + j : 0};
-  }
-  return corners;
 }
 
 bool insideField(Point2 p, int width, int height) {

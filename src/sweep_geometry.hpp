@@ -37,27 +37,15 @@ static_assert(sizeof(SweepDirection) == 64, "SweepDirection must match the kerne
 
 // The geometry of a sweep at ground azimuth `azimuth` (radians) over `field`, with one
 // line of margin on every side so that every receiver has its four surrounding entries.
-SweepDirection makeSweepDirection(const HeightField& field, double azimuth, double samples_per_unit,
-                                  double lines_per_unit);
+SweepDirection makeSweepDirection(const HeightField& field, double azimuth, double samples_per_unit);
 
 // The sweep geometry of every direction of a run (buffer offsets left at 0).
 std::vector<SweepDirection> runDirections(const HeightField& field, const SweepOptions& options);
 
-// Position of step `step` of line `line`, rounded exactly as the kernels do.
+// A point in pixel axes.
 struct Point2 {
   float x, y;
 };
-Point2 sweepPosition(const SweepDirection& d, int line, int step);
-
-// Corner k of the cell of line samples around receiver pixel (c, r), as receiver_cell()
-// and cell_corner() in kernels/sweep_framework.cl: bilinear weight (0 outside the line
-// buffer), step, and entry in step-major order (step * n_lines + line).
-struct CellCorner {
-  float weight;
-  int step;
-  std::size_t entry;
-};
-std::array<CellCorner, 4> receiverCell(const SweepDirection& d, int c, int r);
 
 // Mirrors of the kernels' helpers (same operations, same order, same rounding).
 bool insideField(Point2 p, int width, int height);

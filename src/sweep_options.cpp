@@ -23,10 +23,6 @@ void validate(const SweepOptions& options) {
     throw InvalidArgument("samples per unit must be in (0, 64] (got " +
                           std::to_string(options.samples_per_unit) + ")");
   }
-  if (!positive(options.lines_per_unit) || options.lines_per_unit > 64.0) {
-    throw InvalidArgument("lines per unit must be in (0, 64] (got " + std::to_string(options.lines_per_unit) +
-                          ")");
-  }
   if (!std::isfinite(options.azimuth_offset)) throw InvalidArgument("the azimuth offset must be finite");
 }
 
@@ -35,8 +31,7 @@ namespace detail {
 std::vector<SweepDirection> runDirections(const HeightField& field, const SweepOptions& options) {
   std::vector<SweepDirection> directions;
   for (int k = 0; k < options.directions; ++k) {
-    directions.push_back(makeSweepDirection(field, directionAzimuth(k, options), options.samples_per_unit,
-                                            options.lines_per_unit));
+    directions.push_back(makeSweepDirection(field, directionAzimuth(k, options), options.samples_per_unit));
   }
   return directions;
 }

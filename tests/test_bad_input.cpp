@@ -76,9 +76,6 @@ TEST(BadInput, Options) {
     options.samples_per_unit = spu;
     expectError<InvalidArgument>([&] { horizons(field, options); }, "samples per unit");
   }
-  HorizonOptions lines;
-  lines.lines_per_unit = 2.0;
-  expectError<InvalidArgument>([&] { horizons(field, lines); }, "lines per unit");
   expectError<InvalidArgument>([&] { horizons(field, {}, HorizonOutputs{}); }, "output");
   HorizonOptions budget;
   budget.memory_budget_bytes = 16;

@@ -716,9 +716,6 @@ TEST(IntervisibilityKernels, InvalidOptionsAreRejectedBeforeLaunch) {
   options.samples_per_unit = 0.0;
   EXPECT_THROW(computeIntervisibility(testContext(), field, options, allOutputs()), InvalidArgument);
   options.samples_per_unit = 1.0;
-  options.lines_per_unit = 100.0;
-  EXPECT_THROW(computeIntervisibility(testContext(), field, options, allOutputs()), InvalidArgument);
-  options.lines_per_unit = 1.0;
   options.method = IntervisibilityMethod::Naive;  // statistics exist only for the tree
   EXPECT_THROW(computeIntervisibility(testContext(), field, options, allOutputs()), InvalidArgument);
   HeightField empty;

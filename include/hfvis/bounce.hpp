@@ -29,11 +29,10 @@
 // Units: E is in radiance units times steradians (W/m^2 for W m^-2 sr^-1). A Lambertian
 // surface of albedo rho re-emits rho * E / pi, which can feed the next bounce.
 //
-// Per-pixel values, as the visible counts: each line sample gathers exactly over its own
-// line (its normal interpolated bilinearly from the four surrounding pixel normals, its
-// exit radiance sampled bilinearly like its height), and a pixel takes the bilinear
-// interpolation of the (up to) four line samples around it; on axis directions that is the
-// pixel's own sample. Nodata pixels receive NaN and emit nothing.
+// Per-pixel values, as the visible counts: every pixel is the receiver of its own lattice
+// line in each direction (hfvis/intervisibility.hpp), gathering with its own normal over the
+// visible samples of its own ray, whose exit radiance is sampled bilinearly like their
+// heights. Direction k's wedge D is 2 pi / K. Nodata pixels receive NaN and emit nothing.
 #pragma once
 
 #include <string>

@@ -29,7 +29,7 @@ struct HorizonOptions : SweepOptions {
   // spacing 2 pi / K of phi_k, weighted by the share of the circle it stands for.
   // samples_per_unit S: the sweep samples every grid-line crossing of a receiver's ray
   // (exact heights of the bilinear surface) and, for S > 1, about S points per pixel length
-  // between crossings. lines_per_unit must stay 1 for the sweep. Default: 0.25 degrees.
+  // between crossings. Default: 0.25 degrees.
   double azimuth_tolerance = 0.25 * 3.14159265358979323846 / 180.0;
 };
 

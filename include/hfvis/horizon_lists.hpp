@@ -67,8 +67,8 @@ struct ReceiverHorizons {
 // Throws InvalidArgument naming the first receiver outside the field.
 void validateReceivers(const HeightField& field, const std::vector<ReceiverPixel>& receivers);
 
-// The lists for every receiver, in the order given. options.lines_per_unit,
-// memory_budget_bytes and progress are not used (one ray per receiver and direction).
+// The lists for every receiver, in the order given. options.memory_budget_bytes and
+// progress are not used (one ray per receiver and direction).
 // Throws InvalidArgument for a bad field, bad options or a receiver outside the field.
 std::vector<ReceiverHorizons> computeHorizonLists(const HeightField& field, const SweepOptions& options,
                                                   const std::vector<ReceiverPixel>& receivers);

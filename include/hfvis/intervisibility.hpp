@@ -3,9 +3,13 @@
 // visible ground area estimated from them ("total viewshed"), and the convex hull tree's
 // statistics (Timonen 2013, Table 2).
 //
-// Directions follow hfvis/sweep_options.hpp. Along
-// direction k, receiver p sees the surface samples q = p + i * step * d_k, i >= 1, inside
-// the field (bilinear heights, nodata samples absent). Tie rule: q is visible when its
+// Directions follow hfvis/sweep_options.hpp. Along direction k, receiver p sees the
+// surface samples q = p + i * step * d_k, i >= 1, inside the field (bilinear heights,
+// nodata samples absent). The naive march takes d_k at phi_k and step 1 / S (S =
+// samples_per_unit). The hull tree runs on lattice lines through the pixel centres: d_k is
+// the cheapest integer step (a, b) within 1/8 of the spacing 2 pi / K of phi_k, and the
+// step |(a, b)| / ceil(|(a, b)| S), at most 1 / S, so every receiver is a sample of its own
+// line at its own height (README.md, "How the sweep works"). Tie rule: q is visible when its
 // slope from p is >= the slope of every sample strictly between them (grazing samples are
 // visible; on a flat plane every sample is). Decided exactly, so the sweep, the naive
 // march and brute force agree sample for sample on identical samples.
@@ -23,7 +27,7 @@
 namespace hfvis {
 
 enum class IntervisibilityMethod {
-  HullTree,  // convex hull tree sweep, one work-item per line (Timonen 2013, Algorithm 1)
+  HullTree,  // convex hull tree sweep on lattice lines, one work-item per line (Timonen 2013, Algorithm 1)
   Naive,     // per-pixel visibility march, bilinear samples: the O(N^3) baseline and oracle
 };
 
@@ -62,11 +66,11 @@ struct IntervisibilityOptions : SweepOptions {
 
 // What to compute; only what is asked for is stored or reduced.
 struct IntervisibilityOutputs {
-  // Visible samples summed over the K directions, per pixel (samples at samples_per_unit
-  // per pixel length: at the default 1, one per unit length). With the hull tree, a pixel
-  // takes the bilinear interpolation of the counts of the (up to) four line samples around
-  // it (each exact for its own sample); on axis directions lines pass through the pixel
-  // centres and the count is exactly that of the pixel's own sample.
+  // Visible samples summed over the K directions, per pixel, counted at samples_per_unit
+  // S per pixel length: each visible sample counts step * S (1 for the naive march; the
+  // tree's steps are at most 1 / S), so a direction's count is its visible length along
+  // the ray in units of 1 / S pixel. Each pixel is the receiver of its own line: no
+  // interpolation between lines.
   bool visible_count = false;
   // Visible ground area, in ground units squared: each visible sample at ground distance
   // rho stands for (2*pi/K) * rho * drho, drho the ground step along the direction (the
@@ -76,7 +80,8 @@ struct IntervisibilityOutputs {
   bool statistics = false;
 };
 
-// Totals over every receiver of every line of every direction (line samples, not pixels).
+// Totals over every sample of every line of every direction (line samples, not pixels: a
+// statistics run reads every sample's horizons, as Timonen 2013's Table 2 counts them).
 struct IntervisibilityStatistics {
   std::uint64_t receivers = 0;         // present line samples, each a receiver once
   std::uint64_t lines = 0;             // lines with at least one present sample

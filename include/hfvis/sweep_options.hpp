@@ -1,5 +1,6 @@
 // hfvis/sweep_options.hpp: the options every sweep operation shares: directions, sampling
-// density along and across the sweep lines, device memory budget and progress.
+// density along the sweep lines and rays, device memory budget and progress. (The sweeps run
+// one line through every pixel centre per direction: there is no density across lines.)
 //
 // Direction k of K has azimuth phi_k = 2*pi*k/K + azimuth_offset, measured on the ground
 // in the (column, row) axes, so the ground direction is (cos phi_k, sin phi_k); with square
@@ -20,7 +21,6 @@ struct SweepOptions {
   int directions = 64;                  // K, 1 .. kMaxDirections
   double azimuth_offset = 0.0;          // radians added to every phi_k
   double samples_per_unit = 1.0;        // height samples per pixel length along a line or ray, (0, 64]
-  double lines_per_unit = 1.0;          // sweep lines per pixel length across the direction, (0, 64]
   std::size_t memory_budget_bytes = 0;  // device memory for one batch; 0 = from the device
   // Called after each batch of directions with (directions done, directions in all).
   std::function<void(int, int)> progress;
@@ -29,7 +29,7 @@ struct SweepOptions {
 // Azimuth of direction k, in radians.
 double directionAzimuth(int k, const SweepOptions& options);
 
-// Throws InvalidArgument for K < 1, sampling densities outside (0, 64] or a non-finite
+// Throws InvalidArgument for K < 1, a sampling density outside (0, 64] or a non-finite
 // azimuth offset.
 void validate(const SweepOptions& options);
 
