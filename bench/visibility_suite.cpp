@@ -38,7 +38,7 @@ struct VisibilityConfig {
   std::vector<std::string> contents = {"fractal", "bricks", "sine", "blocks", "dem"};
   int n = 1024;       // synthetic fields are n x n; the DEM is used whole (403 x 344)
   int time_k = 16;    // K of the timed runs (tree and naive)
-  int stats_k = 64;   // K of the statistics
+  int stats_k = 16;   // K of the statistics (statistics runs read every line sample's horizons)
   std::vector<int> zone_steps = {1, 4, 16, 64, 256};
   std::vector<std::string> zone_contents = {"fractal", "dem"};
   std::vector<int> scale_ns;  // line lengths of the scaling study
