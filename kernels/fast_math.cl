@@ -1,15 +1,24 @@
 // fast_math.cl: the few transcendental functions the reductions need, as straight-line
 // polynomials. Library atan2/sin calls are not vectorised by PoCL and cost ~100 ns each
-// there; these vectorise and are mirrored operation for operation by src/fast_math.hpp,
-// so the scalar references round exactly as the kernels do. Accuracy: |error| < 2e-7 rad
-// for hf_atan, < 1e-7 for hf_sin on |x| <= 2 pi (measured by tests/test_fast_math.cpp).
+// there; these vectorise. Written once in the common subset of OpenCL C and C++: the
+// kernels include it, and so does src/fast_math.hpp (inside namespace hfvis::detail, with
+// fabs and rint from <cmath>), so the scalar references round exactly as the kernels do.
+// Accuracy: |error| < 2e-7 rad for hf_atan, < 1e-7 for hf_sin on |x| <= 2 pi (measured by
+// tests/test_fast_math.cpp).
 #ifndef HFVIS_FAST_MATH_CL
 #define HFVIS_FAST_MATH_CL
 
+#ifdef __OPENCL_VERSION__
 #pragma OPENCL FP_CONTRACT OFF
-
 #ifndef HFVIS_INLINE
 #define HFVIS_INLINE inline __attribute__((always_inline))
+#endif
+#define HFVIS_OVERLOADABLE __attribute__((overloadable))  // hf_atan for floats and lane vectors
+#else  // C++: header functions, built with -ffp-contract=off; overloading is the language's
+#ifndef HFVIS_INLINE
+#define HFVIS_INLINE inline
+#endif
+#define HFVIS_OVERLOADABLE
 #endif
 
 #define HFVIS_PI_F 3.14159265358979323846f
@@ -24,7 +33,7 @@ HFVIS_INLINE float hf_max(float a, float b) { return a > b ? a : b; }
 // |x| <= tan(pi/8) and its degree-9 odd polynomial. Defined for float and, through
 // HFVIS_DEFINE_ATAN, for the vector types a kernel needs (the same operations lane by lane).
 #define HFVIS_DEFINE_ATAN(T, IT)                                                                             \
-  HFVIS_INLINE __attribute__((overloadable)) T hf_atan(T x) {                                                \
+  HFVIS_INLINE HFVIS_OVERLOADABLE T hf_atan(T x) {                                                \
     T a = fabs(x);                                                                                           \
     IT big = a > 2.414213562373095f;  /* tan(3 pi / 8) */                                                    \
     IT mid = a > 0.4142135623730950f; /* tan(pi / 8) */                                                      \

@@ -33,6 +33,7 @@
 //   HFVIS_SAFE_ZONE_STEPS   steps past the receiver that one safe zone covers (a power of 2)
 // Every combination builds the same trees (tests/test_intervisibility.cpp): the options
 // change the work (iterations t, memory traffic), never a result.
+#include "chord_side.cl"
 #include "fast_math.cl"
 #include "sweep_framework.cl"
 
@@ -73,97 +74,10 @@
 #error "the safe zone needs the replacement check, which works inside the deferred-writes walk"
 #endif
 
-// The exact predicate's fallback is rare but long: inlined at every call site it made the
-// sweep 30 % slower (code size), so it stays a call.
-#ifndef HFVIS_NOINLINE
-#define HFVIS_NOINLINE __attribute__((noinline))
-#endif
-
 #define HFVIS_NONE (-1)
 #define HFVIS_CONCAVE 0
 #define HFVIS_CONVEX 1
 #define HFVIS_LINE_TOTALS 8  // ulongs per line in line_totals
-
-// ---------------------------------------------------------------------------------------
-// The exact predicate (mirror of src/chord_side.hpp).
-
-#define HFVIS_CHORD_ERROR_BOUND ((3.0f + 16.0f * 0x1p-24f) * 0x1p-24f)
-#define HFVIS_CHORD_FILTER_FLOOR 0x1p-100f
-
-// a + b = *s + *err exactly (Knuth's branch-free TwoSum).
-HFVIS_INLINE void two_sum(float a, float b, float* s, float* err) {
-  float sum = a + b;
-  float bb = sum - a;
-  *err = (a - (sum - bb)) + (b - bb);
-  *s = sum;
-}
-
-// q + e = new q + new e exactly: one step of Shewchuk's Grow-Expansion.
-#define HFVIS_GROW(q, e)         \
-  {                              \
-    float sum_, err_;            \
-    two_sum(q, e, &sum_, &err_); \
-    e = err_;                    \
-    q = sum_;                    \
-  }
-
-HFVIS_INLINE int sign_of(float v) { return v > 0.0f ? 1 : v < 0.0f ? -1 : 0; }
-
-// Exact sign of hb * dac - ha * dbc - hc * dab: fma splits each product exactly into
-// (product, rounding error); Grow-Expansion (Shewchuk) sums the six terms into a
-// nonoverlapping expansion e0..e5 of increasing magnitude, whose largest nonzero
-// component has the sign of the whole. Straight-line (unrolled, selects only): it
-// keeps no private array; the same operations as the loops of src/chord_side.hpp.
-HFVIS_NOINLINE int exact_chord_side(float ha, float hb, float hc, float dab, float dbc, float dac) {
-  float p1 = hb * dac, p2 = ha * dbc, p3 = hc * dab;
-  float e0 = fma(hb, dac, -p1), e1 = p1, e2, e3, e4, e5, q;
-  q = -fma(ha, dbc, -p2);
-  HFVIS_GROW(q, e0) HFVIS_GROW(q, e1) e2 = q;
-  q = -p2;
-  HFVIS_GROW(q, e0) HFVIS_GROW(q, e1) HFVIS_GROW(q, e2) e3 = q;
-  q = -fma(hc, dab, -p3);
-  HFVIS_GROW(q, e0) HFVIS_GROW(q, e1) HFVIS_GROW(q, e2) HFVIS_GROW(q, e3) e4 = q;
-  q = -p3;
-  HFVIS_GROW(q, e0) HFVIS_GROW(q, e1) HFVIS_GROW(q, e2) HFVIS_GROW(q, e3) HFVIS_GROW(q, e4) e5 = q;
-  return e5 != 0.0f   ? sign_of(e5)
-         : e4 != 0.0f ? sign_of(e4)
-         : e3 != 0.0f ? sign_of(e3)
-         : e2 != 0.0f ? sign_of(e2)
-         : e1 != 0.0f ? sign_of(e1)
-                      : sign_of(e0);
-}
-
-// Sign of sample b relative to the chord from a to c (a, b, c in line order, b - a = dab
-// and c - b = dbc steps, integers below 2^24): +1 strictly above, 0 on it, -1 below.
-HFVIS_INLINE int chord_side(float ha, float hb, float hc, float dab, float dbc) {
-  if (ha == hc && hb == hc) return 0;
-  float dac = dab + dbc;
-  float p1 = (hb - hc) * dac;
-  float p2 = (ha - hc) * dbc;
-  float det = p1 - p2;
-  float magnitude = fabs(p1) + fabs(p2);
-  if (magnitude >= HFVIS_CHORD_FILTER_FLOOR) {
-    float bound = HFVIS_CHORD_ERROR_BOUND * magnitude;
-    if (det > bound) return 1;
-    if (-det > bound) return -1;
-  }
-  return exact_chord_side(ha, hb, hc, dab, dbc, dac);
-}
-
-// The float filter of chord_side() alone, branch-free: returns whether it decides, and
-// then *side is the exact sign. For the naive march, whose straight-line loop PoCL
-// vectorises across work-items; rays with an undecided step are marched again with
-// chord_side().
-HFVIS_INLINE int chord_side_filter(float ha, float hb, float hc, float dab, float dbc, int* side) {
-  float dac = dab + dbc;
-  float p1 = (hb - hc) * dac;
-  float p2 = (ha - hc) * dbc;
-  float det = p1 - p2;
-  float magnitude = fabs(p1) + fabs(p2);
-  int flat = ha == hc && hb == hc;
-  *side = flat ? 0 : sign_of(det);
-  return flat || (magnitude >= HFVIS_CHORD_FILTER_FLOOR && fabs(det) > HFVIS_CHORD_ERROR_BOUND * magnitude);
-}
 
 // ---------------------------------------------------------------------------------------
 // The convex hull tree sweep.

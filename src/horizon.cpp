@@ -206,7 +206,7 @@ class HorizonRun {
     kernel.setArg(arg++, plane_offset);
     if (options_.method == HorizonMethod::Sweep) {
       kernel.setArg(arg++, stacks_);
-      stride_arg_ = arg++;  // set per chunk
+      stride_arg_ = arg++;  // set per chunk (launchLineChunks)
     }
     kernel.setArg(arg++, normals_);
     kernel.setArg(arg++, angles_);
@@ -216,12 +216,6 @@ class HorizonRun {
   }
 
   void launchSweep(const RunDirection& d, cl_uint plane_offset) {
-    const bool line_major = lineMajorLayout(st_);
-    std::vector<LatticeLine> lines = d.lines;  // chunkLines sets the stack offsets
-    if (lines.empty()) return;
-    const std::vector<LineChunk> chunks = chunkLines(lines, d.samples.size(), stack_entries_, line_major);
-    const cl::Buffer line_table(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                                lines.size() * sizeof(LatticeLine), lines.data());
     cl::Buffer samples(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
                        d.samples.size() * sizeof(LatticeSample),
                        const_cast<LatticeSample*>(d.samples.data()));
@@ -237,20 +231,14 @@ class HorizonRun {
     kernel.setArg(10, static_cast<float>(d.lattice.ground_per_pixel));
     kernel.setArg(11, static_cast<float>(d.lattice.period * d.lattice.ground_per_pixel));
     setOutputs(kernel, 12, d, plane_offset);
-    for (const LineChunk& chunk : chunks) {
-      // Sub-buffer offsets must be aligned on some devices: a chunk gets a copy of its lines.
-      cl::Buffer chunk_lines =
-          chunks.size() == 1 ? line_table
-                             : cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                                          chunk.count * sizeof(LatticeLine), lines.data() + chunk.first);
-      kernel.setArg(3, chunk_lines);
-      kernel.setArg(4, static_cast<int>(chunk.count));
-      kernel.setArg(stride_arg_, static_cast<cl_uint>(chunk.stride));
-      // With lanes, groups of one work-item: 64 work-items of 8 lines would put all of a
-      // 512-line direction in one group, on one core.
-      const std::size_t items = (chunk.count + lanes_ - 1) / lanes_, group = lanes_ > 1 ? 1 : kLineGroup;
-      st_.launch(kernel, cl::NDRange(roundUp(items, group)), cl::NDRange(group));
-    }
+    LineChunkArguments chunk;
+    chunk.lines = 3;
+    chunk.count = 4;
+    chunk.stride = stride_arg_;
+    // With lanes, groups of one work-item: 64 work-items of 8 lines would put all of a
+    // 512-line direction in one group, on one core.
+    launchLineChunks(st_, kernel, d.lines, d.samples.size(), stack_entries_, chunk, lanes_,
+                     lanes_ > 1 ? 1 : kLineGroup);
   }
 
   void launchNaive(const RunDirection& d, cl_uint plane_offset) {

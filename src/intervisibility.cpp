@@ -75,18 +75,16 @@ void allocateTreeScratch(ContextState& st, const TreeProgramFlags& flags, const 
 
 void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDirection& d, int width, int height,
                           const TreeBuffers& b) {
-  std::vector<LatticeLine> lines = d.lines;  // chunkLines sets the scratch offsets
-  if (lines.empty()) return;
-  const std::vector<LineChunk> chunks = chunkLines(lines, d.samples.size(), b.scratch_entries, lineMajorLayout(st));
   const cl::Buffer samples(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
                            d.samples.size() * sizeof(LatticeSample), const_cast<LatticeSample*>(d.samples.data()));
   cl::Kernel kernel(program, "intervisibility_lattice");
+  LineChunkArguments chunk;
   int arg = 0;
   kernel.setArg(arg++, b.heights);
   kernel.setArg(arg++, width);
   kernel.setArg(arg++, height);
-  const int lines_arg = arg;
-  arg += 2;  // lines, n_lines: per chunk
+  chunk.lines = arg++;
+  chunk.count = arg++;
   kernel.setArg(arg++, samples);
   kernel.setArg(arg++, static_cast<int>(d.samples.size()));
   kernel.setArg(arg++, d.lattice.a);
@@ -95,11 +93,11 @@ void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDire
   kernel.setArg(arg++, d.area_factor);
   kernel.setArg(arg++, b.trees);
   kernel.setArg(arg++, b.prefix);
-  const int stride_arg = arg++;
+  chunk.stride = arg++;
   kernel.setArg(arg++, b.visible);
   kernel.setArg(arg++, b.entry_stats);
   kernel.setArg(arg++, b.line_totals);
-  const int first_line_arg = arg++;
+  chunk.first_line = arg++;
   kernel.setArg(arg++, b.count_sum);
   kernel.setArg(arg++, b.area_sum);
   kernel.setArg(arg++, b.radiance);
@@ -110,16 +108,7 @@ void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDire
   kernel.setArg(arg++, d.half_sector);
   kernel.setArg(arg++, d.wedge);
   kernel.setArg(arg++, b.irradiance);
-  for (const LineChunk& chunk : chunks) {
-    // Sub-buffer offsets must be aligned on some devices: a chunk gets a copy of its lines.
-    const cl::Buffer chunk_lines(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                                 chunk.count * sizeof(LatticeLine), lines.data() + chunk.first);
-    kernel.setArg(lines_arg, chunk_lines);
-    kernel.setArg(lines_arg + 1, static_cast<int>(chunk.count));
-    kernel.setArg(stride_arg, static_cast<cl_uint>(chunk.stride));
-    kernel.setArg(first_line_arg, static_cast<int>(chunk.first));
-    st.launch(kernel, cl::NDRange(roundUp(chunk.count, kLineGroup)), cl::NDRange(kLineGroup));
-  }
+  launchLineChunks(st, kernel, d.lines, d.samples.size(), b.scratch_entries, chunk, 1, kLineGroup);
 }
 
 namespace {

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "lattice_geometry.hpp"
 #include "opencl_context.hpp"
 #include "sweep_geometry.hpp"
 
@@ -31,5 +32,20 @@ std::string mebibytes(std::size_t bytes);
 cl::Buffer deviceBuffer(ContextState& st, std::size_t bytes);
 
 cl::Buffer uploadDirections(ContextState& st, const std::vector<SweepDirection>& directions);
+
+// Where a lattice sweep kernel takes its chunk of lines: argument indices of the line table,
+// the chunk's line count, the scratch stride and (if >= 0) the chunk's first line.
+struct LineChunkArguments {
+  int lines = 0, count = 0, stride = 0, first_line = -1;
+};
+
+// Runs a lattice sweep kernel (its other arguments set) over the lines of one direction, in
+// chunks whose scratch fits `scratch_entries` (chunkLines, in the context's layout): per
+// chunk it sets a copy of the chunk's line table (sub-buffer offsets must be aligned on some
+// devices), the count, stride and first line, and launches ceil(count / lanes) work-items in
+// groups of `group`.
+void launchLineChunks(ContextState& st, cl::Kernel& kernel, std::vector<LatticeLine> lines,
+                      std::size_t samples_per_period, std::size_t scratch_entries, const LineChunkArguments& at,
+                      int lanes, std::size_t group);
 
 }  // namespace hfvis::detail
