@@ -289,7 +289,8 @@ def visibility_section(d, say, targets):
         say("### Time against the naive march, visible counts, K = %s" % k)
         say("")
         say("Each run is the whole library call `computeIntervisibility` with the visible-count output (what "
-            "`hfvis viewcount` computes for channel 0): upload, presampling, the sweep, the reduction, download. "
+            "`hfvis viewcount` computes for channel 0): upload, the sweep on lattice lines (each receiver adding "
+            "its count into its pixel), download. "
             "The methods' runs are interleaved (one of each per round; the table gives the minimum of the rounds), "
             "so a slow spell of the machine does not land on one method only. Timonen (2013)'s Table 3 gives the "
             "speedup of the tree sweep over the naive method on a GPU (the sweep kernel alone); the target is at "
@@ -505,7 +506,8 @@ def accuracy_section(vis, say):
         "visible, the library's rule; a tie is within 1e-9 of the field's relief, so flat roofs and tilted planes "
         "stay ties in double precision), and the direction counts (visible samples) / D; summed over the K "
         "directions. *tree* is `computeIntervisibility` with the default options (the hull tree, whose counts "
-        "are the bilinear interpolation of the line samples' around each pixel), *naive* the per-pixel unit "
+        "runs on lattice lines through the pixel centres, each pixel the receiver of its own line, in "
+        "directions within 1/8 of the spacing of phi_k), *naive* the per-pixel unit "
         "march (`IntervisibilityMethod::Naive`), both at 1 sample per unit and the same K. Errors per pixel: "
         "|count - ref| / ref (%s); *mean* is the target's metric (the tree's at most %s x the "
         "naive march's on every content), *aggregate* is sum |count - ref| / sum ref, *bias* the mean of "
