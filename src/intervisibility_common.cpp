@@ -79,9 +79,8 @@ TreeDirection makeTreeDirection(const HeightField& field, const LatticeDirection
 }
 
 std::vector<TreeDirection> treeDirections(const HeightField& field, const SweepOptions& options) {
-  const double window = std::max(kTreeAzimuthWindow * 2.0 * M_PI / options.directions, kTreeAzimuthFloor);
   std::vector<TreeDirection> out;
-  for (const LatticeDirection& lattice : latticeDirections(field, options, false, 0.0, window)) {
+  for (const LatticeDirection& lattice : latticeDirections(field, options, false, 0.0)) {
     if (lattice.weight == 0.0) continue;  // merged into an equal step
     out.push_back(makeTreeDirection(field, lattice, options.samples_per_unit, options.directions));
   }

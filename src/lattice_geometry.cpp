@@ -83,14 +83,11 @@ LatticeDirection latticeStep(const HeightField& field, int a, int b) {
 }
 
 std::vector<LatticeDirection> latticeDirections(const HeightField& field, const SweepOptions& options,
-                                                bool exact_azimuths, double tolerance, double quadrature_window) {
+                                                bool exact_azimuths, double tolerance) {
   const std::vector<Candidate> all = candidates(field);
   const int K = options.directions;
   // Quadrature windows are strictly inside each direction's half-spacing.
-  const double half_spacing = 0.4999 * kTwoPi / K;
-  const double window = exact_azimuths ? tolerance
-                                       : (quadrature_window > 0.0 ? std::min(quadrature_window, half_spacing)
-                                                                  : half_spacing);
+  const double window = exact_azimuths ? tolerance : 0.4999 * kTwoPi / K;
   std::vector<LatticeDirection> out;
   for (int k = 0; k < K; ++k) {
     const double target = directionAzimuth(k, options);

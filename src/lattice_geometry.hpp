@@ -31,18 +31,16 @@ struct LatticeDirection {
 // The directions of a run. With `exact_azimuths` (per-direction planes requested),
 // direction k is the cheapest primitive step whose ground azimuth is within `tolerance`
 // radians of phi_k = 2 pi k / K + offset (the closest one when none is), each with weight
-// 1/K. Otherwise (sky-view factor and occlusion, which integrate over azimuth) the
-// cheapest strictly within `quadrature_window` radians (0: half the spacing 2 pi / K, the
-// most it may be), with quadrature weights from the azimuths actually used (half the gap to
-// each neighbour). "Cheapest" is the fewest
+// 1/K. Otherwise (sky-view factor, occlusion and the hull tree's counts, which integrate
+// over azimuth) the cheapest strictly within half the spacing 2 pi / K, with quadrature
+// weights from the azimuths actually used (half the gap to each neighbour). "Cheapest" is the fewest
 // crossings per period, |a| + |b| - 1 (1 on the axes), and among those the closest to phi_k.
 // Steps are bounded by kMaxLatticeStep. Quadrature directions that fall back to the same
 // step (very large K) are merged: one carries their weight, the others have weight 0 and
 // are not swept.
 constexpr int kMaxLatticeStep = 64;
 std::vector<LatticeDirection> latticeDirections(const HeightField& field, const SweepOptions& options,
-                                                bool exact_azimuths, double tolerance,
-                                                double quadrature_window = 0.0);
+                                                bool exact_azimuths, double tolerance);
 
 // The direction of primitive step (a, b) over a field (azimuth and ground length from its
 // cell sizes; weight left 0).
