@@ -14,14 +14,14 @@ namespace hfvis {
 namespace detail {
 namespace {
 
-TreeProgramFlags bounceFlags(const BounceInputs& inputs, const HullTreeTuning& tuning) {
+// The tree program with the gather of `channels` radiance channels, nothing else.
+TreeProgramFlags bounceFlags(int channels, const HullTreeTuning& tuning) {
   TreeProgramFlags flags;
   flags.tuning = tuning;
-  flags.has_nodata = inputs.has_nodata;
   flags.count = false;
   flags.area = false;
   flags.stats = false;
-  flags.bounce_channels = inputs.channels();
+  flags.bounce_channels = channels;
   return flags;
 }
 
@@ -31,51 +31,50 @@ std::vector<float> joined(const std::vector<std::vector<float>>& planes) {
   return all;
 }
 
-BounceResult run(const ComputeContext& context, const HeightField& field, const ExitRadiance& radiance,
-                 const BounceOptions& options) {
-  ContextState& st = stateOf(context);
-  const BounceInputs inputs = prepareBounce(field, radiance);
-  const int channels = inputs.channels();
-  const std::vector<TreeDirection> directions = treeDirections(field, options);
-  checkTreeLimits(directions, inputs.heights);
-  const TreeProgramFlags flags = bounceFlags(inputs, options.tree);
-  cl::Program program = st.program("intervisibility.cl", treeProgramOptions(flags));
-  const std::size_t plane = field.pixelCount();
-  // Heights, normals, radiance and the irradiance sums.
-  const std::size_t fixed = plane * sizeof(float) * (1 + 3 + 2 * channels);
-  TreeBuffers b;
-  allocateTreeScratch(st, flags, directions,
-                      planTreeScratch(directions, fixed, treeEntryBytes(flags), options.memory_budget_bytes, st.info),
-                      b);
-  auto upload = [&](const std::vector<float>& values) {
-    return cl::Buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, values.size() * sizeof(float),
-                      const_cast<float*>(values.data()));
-  };
-  b.heights = upload(inputs.heights);
-  b.normals = upload(joined(inputs.normals));
-  b.radiance = upload(joined(inputs.radiance));
-  b.count_sum = b.area_sum = deviceBuffer(st, 0);
-  b.irradiance = deviceBuffer(st, channels * plane * sizeof(float));
-  const float zero = 0.0f;
-  st.queue.enqueueFillBuffer(b.irradiance, zero, 0, channels * plane * sizeof(float));
+class BounceRoutine : public TreeRoutine {
+ public:
+  BounceRoutine(ContextState& st, const HeightField& field, const ExitRadiance& radiance, const BounceOptions& options)
+      : TreeRoutine(st, field, options, bounceFlags(static_cast<int>(radiance.channels.size()), options.tree)),
+        radiance_(radiance),
+        bounce_(options) {}
 
-  BounceResult result;
-  result.width = field.width;
-  result.height = field.height;
-  result.directions = options.directions;
-  for (int k = 0; k < options.directions; ++k) result.azimuths.push_back(directionAzimuth(k, options));
-  for (std::size_t k = 0; k < directions.size(); ++k) {
-    enqueueTreeDirection(st, program, directions[k], field.width, field.height, b);
-    st.queue.finish();
-    if (options.progress) options.progress(static_cast<int>(k + 1), static_cast<int>(directions.size()));
+  BounceResult take() { return std::move(result_); }
+
+ private:
+  PreparedHeights prepare() override {
+    inputs_ = prepareBounce(field_, radiance_);
+    return {inputs_.heights, inputs_.has_nodata};
   }
-  result.irradiance.assign(channels, std::vector<float>(plane));
-  for (int c = 0; c < channels; ++c) {
-    st.queue.enqueueReadBuffer(b.irradiance, CL_TRUE, c * plane * sizeof(float), plane * sizeof(float),
-                               result.irradiance[c].data());
+
+  void allocate() override {
+    const int channels = inputs_.channels();
+    const std::size_t plane = field_.pixelCount();
+    // Heights, normals, radiance and the irradiance sums.
+    allocateScratch(plane * sizeof(float) * (1 + 3 + 2 * channels));
+    buffers_.normals = upload(joined(inputs_.normals));
+    buffers_.radiance = upload(joined(inputs_.radiance));
+    buffers_.count_sum = buffers_.area_sum = deviceBuffer(st_, 0);
+    buffers_.irradiance = zeros(channels * plane);
+    result_.width = field_.width;
+    result_.height = field_.height;
+    result_.directions = bounce_.directions;
+    for (int k = 0; k < bounce_.directions; ++k) result_.azimuths.push_back(directionAzimuth(k, bounce_));
   }
-  return result;
-}
+
+  void finish() override {
+    const std::size_t plane = field_.pixelCount();
+    result_.irradiance.assign(inputs_.channels(), std::vector<float>(plane));
+    for (int c = 0; c < inputs_.channels(); ++c) {
+      st_.queue.enqueueReadBuffer(buffers_.irradiance, CL_TRUE, c * plane * sizeof(float), plane * sizeof(float),
+                                  result_.irradiance[c].data());
+    }
+  }
+
+  const ExitRadiance& radiance_;
+  const BounceOptions& bounce_;
+  BounceInputs inputs_;
+  BounceResult result_;
+};
 
 }  // namespace
 
@@ -86,8 +85,9 @@ BounceLineView bounceLinesOnDevice(const ComputeContext& context, const HeightFi
   return translateOpenClErrors([&] {
     BounceLineView view;
     std::vector<float> irradiance;
-    view.lines = treeLinesOnDevice(stateOf(context), bounceFlags(inputs, tuning), field, inputs.heights, d, &inputs,
-                                   &irradiance);
+    TreeProgramFlags flags = bounceFlags(inputs.channels(), tuning);
+    flags.has_nodata = inputs.has_nodata;
+    view.lines = treeLinesOnDevice(stateOf(context), flags, field, inputs.heights, d, &inputs, &irradiance);
     // Each receiver entry takes its pixel's irradiance of this one direction.
     const int channels = inputs.channels();
     const std::size_t plane = field.pixelCount();
@@ -118,7 +118,11 @@ BounceResult computeBounce(const ComputeContext& context, const HeightField& fie
   validate(field);
   validate(options);
   validate(field, radiance);
-  return detail::translateOpenClErrors([&] { return detail::run(context, field, radiance, options); });
+  return detail::translateOpenClErrors([&] {
+    detail::BounceRoutine routine(detail::stateOf(context), field, radiance, options);
+    routine.run();
+    return routine.take();
+  });
 }
 
 }  // namespace hfvis

@@ -13,6 +13,7 @@
 #include "lattice_geometry.hpp"
 #include "opencl_context.hpp"
 #include "sweep_framework.hpp"
+#include "sweep_routine.hpp"
 
 namespace hfvis {
 namespace detail {
@@ -126,37 +127,37 @@ std::vector<RunDirection> runDirectionsOf(const HeightField& field, const Horizo
   return out;
 }
 
-class HorizonRun {
+class HorizonRoutine : public SweepRoutine {
  public:
-  HorizonRun(ContextState& st, const HeightField& field, const HorizonOptions& options,
-             const HorizonOutputs& outputs)
-      : st_(st), field_(field), options_(options), outputs_(outputs) {}
+  HorizonRoutine(ContextState& st, const HeightField& field, const HorizonOptions& options,
+                 const HorizonOutputs& outputs)
+      : SweepRoutine(st, field, options), horizon_(options), outputs_(outputs) {}
 
-  HorizonResult run() {
-    const PreparedHeights prepared = prepareHeights(field_);
+  HorizonResult take() { return std::move(result_); }
+
+ private:
+  std::string programFile() const override { return "horizon.cl"; }
+  std::string programOptions() const override {
+    return detail::programOptions(outputs_, prepared_.has_nodata, sweepLanes(st_));
+  }
+
+  void allocate() override {
     lanes_ = sweepLanes(st_);
-    program_ = st_.program("horizon.cl", programOptions(outputs_, prepared.has_nodata, lanes_));
-    const std::vector<RunDirection> directions = runDirectionsOf(field_, options_, outputs_);
-    const RunPlan plan = planRun(field_, options_, outputs_, directions, st_.info);
-    HorizonResult result = allocateResult(field_, options_, outputs_);
-    for (int k = 0; k < options_.directions; ++k) result.azimuths[k] = directions[k].lattice.azimuth;
-
+    directions_ = runDirectionsOf(field_, horizon_, outputs_);
+    const RunPlan plan = planRun(field_, horizon_, outputs_, directions_, st_.info);
+    batch_ = plan.directions_per_batch;
+    result_ = allocateResult(field_, horizon_, outputs_);
+    for (int k = 0; k < horizon_.directions; ++k) result_.azimuths[k] = directions_[k].lattice.azimuth;
     const std::size_t plane = field_.pixelCount();
-    const bool planes = outputs_.horizon_angles || outputs_.horizon_distances;
-    heights_ = cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, plane * sizeof(float),
-                          const_cast<float*>(prepared.heights.data()));
     const std::size_t planes_bytes = plan.directions_per_batch * plane * sizeof(float);
     angles_ = st_.reusableBuffer("horizon angles", outputs_.horizon_angles ? planes_bytes : 0);
     distances_ = st_.reusableBuffer("horizon distances", outputs_.horizon_distances ? planes_bytes : 0);
-    svf_ = deviceBuffer(st_, outputs_.sky_view_factor ? plane * sizeof(float) : 0);
-    ao_ = deviceBuffer(st_, outputs_.ambient_occlusion ? plane * sizeof(float) : 0);
+    svf_ = zeros(outputs_.sky_view_factor ? plane : 0);
+    ao_ = zeros(outputs_.ambient_occlusion ? plane : 0);
     normals_ = deviceBuffer(st_, outputs_.ambient_occlusion ? 4 * plane * sizeof(float) : 0);
     stacks_ = st_.reusableBuffer("lattice stacks", plan.stack_entries * kStackEntryBytes);
     stack_entries_ = plan.stack_entries;
-    const float zero = 0.0f;
-    if (outputs_.sky_view_factor) st_.queue.enqueueFillBuffer(svf_, zero, 0, plane * sizeof(float));
     if (outputs_.ambient_occlusion) {
-      st_.queue.enqueueFillBuffer(ao_, zero, 0, plane * sizeof(float));
       cl::Kernel normals(program_, "pixel_normals");
       normals.setArg(0, heights_);
       normals.setArg(1, field_.width);
@@ -167,36 +168,40 @@ class HorizonRun {
       st_.launch(normals, cl::NDRange(roundUp(field_.width, kTileX), roundUp(field_.height, kTileY)),
                  cl::NDRange(kTileX, kTileY));
     }
-
-    for (int first = 0; first < options_.directions; first += plan.directions_per_batch) {
-      const int count = std::min(plan.directions_per_batch, options_.directions - first);
-      for (int b = 0; b < count; ++b) {
-        const RunDirection& d = directions[first + b];
-        if (d.lattice.weight == 0.0 && !planes) continue;  // merged into an equal step (latticeDirections)
-        const cl_uint plane_offset = static_cast<cl_uint>(b * plane);
-        if (options_.method == HorizonMethod::Sweep) {
-          launchSweep(d, plane_offset);
-        } else {
-          launchNaive(d, plane_offset);
-        }
-      }
-      const std::size_t batch_bytes = count * plane * sizeof(float), at = first * plane;
-      if (outputs_.horizon_angles)
-        st_.queue.enqueueReadBuffer(angles_, CL_TRUE, 0, batch_bytes, &result.angles[at]);
-      if (outputs_.horizon_distances)
-        st_.queue.enqueueReadBuffer(distances_, CL_TRUE, 0, batch_bytes, &result.distances[at]);
-      st_.queue.finish();
-      if (options_.progress) options_.progress(first + count, options_.directions);
-    }
-    if (outputs_.sky_view_factor)
-      st_.queue.enqueueReadBuffer(svf_, CL_TRUE, 0, plane * sizeof(float), result.sky_view_factor.data());
-    if (outputs_.ambient_occlusion)
-      st_.queue.enqueueReadBuffer(ao_, CL_TRUE, 0, plane * sizeof(float), result.ambient_occlusion.data());
-    finishReduction(result);
-    return result;
   }
 
- private:
+  int directionCount() const override { return horizon_.directions; }
+  int batchSize() const override { return batch_; }
+
+  void sweep(int k, int slot) override {
+    const RunDirection& d = directions_[k];
+    const bool planes = outputs_.horizon_angles || outputs_.horizon_distances;
+    if (d.lattice.weight == 0.0 && !planes) return;  // merged into an equal step (latticeDirections)
+    const cl_uint plane_offset = static_cast<cl_uint>(slot * field_.pixelCount());
+    if (horizon_.method == HorizonMethod::Sweep) {
+      launchSweep(d, plane_offset);
+    } else {
+      launchNaive(d, plane_offset);
+    }
+  }
+
+  void endBatch(int first, int count) override {
+    const std::size_t plane = field_.pixelCount();
+    const std::size_t batch_bytes = count * plane * sizeof(float), at = first * plane;
+    if (outputs_.horizon_angles) st_.queue.enqueueReadBuffer(angles_, CL_TRUE, 0, batch_bytes, &result_.angles[at]);
+    if (outputs_.horizon_distances)
+      st_.queue.enqueueReadBuffer(distances_, CL_TRUE, 0, batch_bytes, &result_.distances[at]);
+  }
+
+  void finish() override {
+    const std::size_t bytes = field_.pixelCount() * sizeof(float);
+    if (outputs_.sky_view_factor)
+      st_.queue.enqueueReadBuffer(svf_, CL_TRUE, 0, bytes, result_.sky_view_factor.data());
+    if (outputs_.ambient_occlusion)
+      st_.queue.enqueueReadBuffer(ao_, CL_TRUE, 0, bytes, result_.ambient_occlusion.data());
+    finishReduction(result_);
+  }
+
   // The arguments every direction's kernel ends with: its outputs.
   void setOutputs(cl::Kernel& kernel, int arg, const RunDirection& d, cl_uint plane_offset) {
     kernel.setArg(arg++, d.cos_azimuth);
@@ -204,7 +209,7 @@ class HorizonRun {
     kernel.setArg(arg++, static_cast<float>(d.lattice.weight));
     kernel.setArg(arg++, swathFactor(static_cast<float>(d.lattice.weight)));
     kernel.setArg(arg++, plane_offset);
-    if (options_.method == HorizonMethod::Sweep) {
+    if (horizon_.method == HorizonMethod::Sweep) {
       kernel.setArg(arg++, stacks_);
       stride_arg_ = arg++;  // set per chunk (launchLineChunks)
     }
@@ -255,12 +260,12 @@ class HorizonRun {
                cl::NDRange(kTileX, kTileY));
   }
 
-  ContextState& st_;
-  const HeightField& field_;
-  const HorizonOptions& options_;
+  const HorizonOptions& horizon_;  // options_ as the horizon operation's
   const HorizonOutputs& outputs_;
-  cl::Program program_;
-  cl::Buffer heights_, angles_, distances_, svf_, ao_, normals_, stacks_;
+  std::vector<RunDirection> directions_;
+  HorizonResult result_;
+  int batch_ = 1;
+  cl::Buffer angles_, distances_, svf_, ao_, normals_, stacks_;
   std::size_t stack_entries_ = 0;
   int stride_arg_ = 0;  // horizon_lattice's `stride` argument
   int lanes_ = 1;       // HFVIS_LANES of the program
@@ -278,8 +283,11 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
     throw InvalidArgument("fields of 2^31 pixels or more are not supported yet (got " +
                           std::to_string(field.width) + " x " + std::to_string(field.height) +
                           "); split the field into tiles");
-  return detail::translateOpenClErrors(
-      [&] { return detail::HorizonRun(detail::stateOf(context), field, options, outputs).run(); });
+  return detail::translateOpenClErrors([&] {
+    detail::HorizonRoutine routine(detail::stateOf(context), field, options, outputs);
+    routine.run();
+    return routine.take();
+  });
 }
 
 }  // namespace hfvis

@@ -3,7 +3,6 @@
 
 #include <cmath>
 #include <limits>
-#include <sstream>
 
 #include "fast_math.hpp"
 #include "hfvis/errors.hpp"
@@ -23,36 +22,6 @@ void validate(const HorizonOptions& options, const HorizonOutputs& outputs) {
 }
 
 namespace detail {
-
-PreparedHeights prepareHeights(const HeightField& field) {
-  double lowest = std::numeric_limits<double>::max(), highest = std::numeric_limits<double>::lowest();
-  for (float h : field.heights) {
-    if (std::isfinite(h)) {
-      lowest = std::min(lowest, static_cast<double>(h));
-      highest = std::max(highest, static_cast<double>(h));
-    }
-  }
-  // The kernels multiply height differences by distances in float: keep the products finite.
-  if (highest >= lowest && (highest - lowest) * field.z_scale > kMaxPreparedHeight) {
-    std::ostringstream message;
-    message << "the heights span " << lowest << " .. " << highest << ", a rise of "
-            << (highest - lowest) * field.z_scale << " with the z-scale " << field.z_scale
-            << ": more than the " << kMaxPreparedHeight << " the kernels' float arithmetic holds";
-    throw InvalidArgument(message.str());
-  }
-  PreparedHeights prepared;
-  prepared.heights.resize(field.heights.size());
-  for (std::size_t i = 0; i < field.heights.size(); ++i) {
-    const float h = field.heights[i];
-    if (std::isfinite(h)) {
-      prepared.heights[i] = static_cast<float>((static_cast<double>(h) - lowest) * field.z_scale);
-    } else {
-      prepared.heights[i] = std::numeric_limits<float>::quiet_NaN();
-      prepared.has_nodata = true;
-    }
-  }
-  return prepared;
-}
 
 HorizonResult allocateResult(const HeightField& field, const HorizonOptions& options,
                              const HorizonOutputs& outputs) {

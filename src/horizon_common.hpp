@@ -1,5 +1,5 @@
 // horizon_common.hpp: what the device path and the scalar reference of the horizon
-// operation share: height preparation, direction geometry and the final reduction step.
+// operation share: direction geometry and the final reduction step.
 #pragma once
 
 #include <vector>
@@ -9,18 +9,6 @@
 #include "sweep_geometry.hpp"
 
 namespace hfvis::detail {
-
-// Heights as the kernels see them: (h - lowest finite height) * z_scale in float, so that
-// a plane at 8848 m keeps its millimetres; every non-finite height becomes NaN. Throws
-// InvalidArgument when a prepared height would exceed kMaxPreparedHeight: the kernels
-// multiply height differences by distances (up to 2^31 pixels) in float, which must stay
-// finite.
-constexpr double kMaxPreparedHeight = 1e28;
-struct PreparedHeights {
-  std::vector<float> heights;
-  bool has_nodata = false;
-};
-PreparedHeights prepareHeights(const HeightField& field);
 
 // The sweep directions of a run: exact azimuths (within options.azimuth_tolerance) when
 // per-direction planes are requested, quadrature directions otherwise.

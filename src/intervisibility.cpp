@@ -111,6 +111,27 @@ void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDire
   launchLineChunks(st, kernel, d.lines, d.samples.size(), b.scratch_entries, chunk, 1, kLineGroup);
 }
 
+std::string TreeRoutine::programOptions() const {
+  TreeProgramFlags flags = flags_;
+  flags.has_nodata = prepared_.has_nodata;
+  return treeProgramOptions(flags);
+}
+
+void TreeRoutine::allocateScratch(std::size_t fixed_bytes) {
+  flags_.has_nodata = prepared_.has_nodata;
+  directions_ = treeDirections(field_, options_);
+  checkTreeLimits(directions_, prepared_.heights);
+  allocateTreeScratch(st_, flags_, directions_,
+                      planTreeScratch(directions_, fixed_bytes, treeEntryBytes(flags_), options_.memory_budget_bytes,
+                                      st_.info),
+                      buffers_);
+  buffers_.heights = heights_;
+}
+
+void TreeRoutine::sweep(int direction, int) {
+  enqueueTreeDirection(st_, program_, directions_[direction], field_.width, field_.height, buffers_);
+}
+
 namespace {
 
 // Adds one direction's per-line totals (receivers, m, t, naive, visible, skips).
@@ -144,93 +165,114 @@ void download(ContextState& st, const cl::Buffer& sums, std::vector<float>& out)
   if (!out.empty()) st.queue.enqueueReadBuffer(sums, CL_TRUE, 0, out.size() * sizeof(float), out.data());
 }
 
-IntervisibilityResult runTree(ContextState& st, const HeightField& field, const IntervisibilityOptions& options,
-                              const IntervisibilityOutputs& outputs) {
-  const PreparedHeights prepared = prepareHeights(field);
-  const std::vector<TreeDirection> directions = treeDirections(field, options);
-  checkTreeLimits(directions, prepared.heights);
-  TreeProgramFlags flags;
-  flags.has_nodata = prepared.has_nodata;
-  flags.area = outputs.visible_area;
-  flags.stats = outputs.statistics;
-  flags.tuning = options.tree;
-  cl::Program program = st.program("intervisibility.cl", treeProgramOptions(flags));
-  const std::size_t plane = field.pixelCount();
-  // Heights and the sums (the count also when only the area is asked for: the kernel adds both).
-  const std::size_t fixed = plane * sizeof(float) * (2 + outputs.visible_area);
-  TreeBuffers b;
-  allocateTreeScratch(st, flags, directions,
-                      planTreeScratch(directions, fixed, treeEntryBytes(flags), options.memory_budget_bytes, st.info),
-                      b);
-  b.heights = cl::Buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, plane * sizeof(float),
-                         const_cast<float*>(prepared.heights.data()));
-  b.count_sum = deviceBuffer(st, plane * sizeof(float));
-  b.area_sum = deviceBuffer(st, outputs.visible_area ? plane * sizeof(float) : 0);
-  b.radiance = b.normals = b.irradiance = deviceBuffer(st, 0);
-  const float zero = 0.0f;
-  st.queue.enqueueFillBuffer(b.count_sum, zero, 0, plane * sizeof(float));
-  if (outputs.visible_area) st.queue.enqueueFillBuffer(b.area_sum, zero, 0, plane * sizeof(float));
+// Visible counts and areas by the tree.
+class CountRoutine : public TreeRoutine {
+ public:
+  CountRoutine(ContextState& st, const HeightField& field, const IntervisibilityOptions& options,
+               const IntervisibilityOutputs& outputs)
+      : TreeRoutine(st, field, options, flagsFor(options, outputs)), visibility_(options), outputs_(outputs) {}
 
-  IntervisibilityResult result = allocateResult(field, options, outputs);
-  std::vector<cl_ulong> totals;
-  for (std::size_t k = 0; k < directions.size(); ++k) {
-    const TreeDirection& d = directions[k];
-    enqueueTreeDirection(st, program, d, field.width, field.height, b);
-    if (outputs.statistics) {
-      totals.resize(d.lines.size() * kTreeLineTotals);
-      st.queue.enqueueReadBuffer(b.line_totals, CL_TRUE, 0, totals.size() * sizeof(cl_ulong), totals.data());
-      addLineTotals(totals, d.lines.size(), result.statistics);
-    }
-    st.queue.finish();
-    if (options.progress) options.progress(static_cast<int>(k + 1), static_cast<int>(directions.size()));
+  IntervisibilityResult take() { return std::move(result_); }
+
+ private:
+  static TreeProgramFlags flagsFor(const IntervisibilityOptions& options, const IntervisibilityOutputs& outputs) {
+    TreeProgramFlags flags;
+    flags.area = outputs.visible_area;
+    flags.stats = outputs.statistics;
+    flags.tuning = options.tree;
+    return flags;
   }
-  download(st, b.count_sum, result.visible_count);
-  download(st, b.area_sum, result.visible_area);
-  return result;
-}
 
-IntervisibilityResult runNaive(ContextState& st, const HeightField& field, const IntervisibilityOptions& options,
-                               const IntervisibilityOutputs& outputs) {
-  const PreparedHeights prepared = prepareHeights(field);
-  TreeProgramFlags flags;
-  flags.has_nodata = prepared.has_nodata;
-  flags.area = outputs.visible_area;
-  flags.stats = false;
-  cl::Program program = st.program("intervisibility.cl", treeProgramOptions(flags));
-  const std::size_t plane = field.pixelCount();
-  const std::vector<SweepDirection> all = runDirections(field, options);
-  const cl::Buffer heights(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, plane * sizeof(float),
-                           const_cast<float*>(prepared.heights.data()));
-  const cl::Buffer count_sum = deviceBuffer(st, plane * sizeof(float));
-  const cl::Buffer area_sum = deviceBuffer(st, outputs.visible_area ? plane * sizeof(float) : 0);
-  const float zero = 0.0f;
-  st.queue.enqueueFillBuffer(count_sum, zero, 0, plane * sizeof(float));
-  if (outputs.visible_area) st.queue.enqueueFillBuffer(area_sum, zero, 0, plane * sizeof(float));
-  const float sector = intervisibilitySector(options);
-  IntervisibilityResult result = allocateResult(field, options, outputs);
-  for (int first = 0; first < options.directions; first += kMaxDirectionsPerBatch) {
-    const int count = std::min(kMaxDirectionsPerBatch, options.directions - first);
-    const std::vector<SweepDirection> batch(all.begin() + first, all.begin() + first + count);
-    const cl::Buffer directions = uploadDirections(st, batch);
-    cl::Kernel naive(program, "intervisibility_naive");
+  void allocate() override {
+    const std::size_t plane = field_.pixelCount();
+    // Heights and the sums (the count also when only the area is asked for: the kernel adds both).
+    allocateScratch(plane * sizeof(float) * (2 + outputs_.visible_area));
+    buffers_.count_sum = zeros(plane);
+    buffers_.area_sum = zeros(outputs_.visible_area ? plane : 0);
+    buffers_.radiance = buffers_.normals = buffers_.irradiance = deviceBuffer(st_, 0);
+    result_ = allocateResult(field_, visibility_, outputs_);
+  }
+
+  void endBatch(int first, int count) override {
+    if (!outputs_.statistics) return;
+    for (int k = first; k < first + count; ++k) {
+      totals_.resize(directions_[k].lines.size() * kTreeLineTotals);
+      st_.queue.enqueueReadBuffer(buffers_.line_totals, CL_TRUE, 0, totals_.size() * sizeof(cl_ulong),
+                                  totals_.data());
+      addLineTotals(totals_, directions_[k].lines.size(), result_.statistics);
+    }
+  }
+
+  void finish() override {
+    download(st_, buffers_.count_sum, result_.visible_count);
+    download(st_, buffers_.area_sum, result_.visible_area);
+  }
+
+  const IntervisibilityOptions& visibility_;
+  const IntervisibilityOutputs& outputs_;
+  IntervisibilityResult result_;
+  std::vector<cl_ulong> totals_;
+};
+
+// Visible counts and areas by the naive march, a batch of directions per launch.
+class NaiveCountRoutine : public SweepRoutine {
+ public:
+  NaiveCountRoutine(ContextState& st, const HeightField& field, const IntervisibilityOptions& options,
+                    const IntervisibilityOutputs& outputs)
+      : SweepRoutine(st, field, options), visibility_(options), outputs_(outputs) {}
+
+  IntervisibilityResult take() { return std::move(result_); }
+
+ private:
+  std::string programFile() const override { return "intervisibility.cl"; }
+  std::string programOptions() const override {
+    TreeProgramFlags flags;
+    flags.has_nodata = prepared_.has_nodata;
+    flags.area = outputs_.visible_area;
+    flags.stats = false;
+    return treeProgramOptions(flags);
+  }
+
+  void allocate() override {
+    const std::size_t plane = field_.pixelCount();
+    rays_ = runDirections(field_, visibility_);
+    count_sum_ = zeros(plane);
+    area_sum_ = zeros(outputs_.visible_area ? plane : 0);
+    result_ = allocateResult(field_, visibility_, outputs_);
+  }
+
+  int directionCount() const override { return visibility_.directions; }
+  int batchSize() const override { return kMaxDirectionsPerBatch; }
+  void sweep(int, int) override {}  // a launch per batch
+
+  void endBatch(int first, int count) override {
+    const std::vector<SweepDirection> batch(rays_.begin() + first, rays_.begin() + first + count);
+    const cl::Buffer directions = uploadDirections(st_, batch);
+    cl::Kernel naive(program_, "intervisibility_naive");
     int arg = 0;
-    naive.setArg(arg++, heights);
-    naive.setArg(arg++, field.width);
-    naive.setArg(arg++, field.height);
+    naive.setArg(arg++, heights_);
+    naive.setArg(arg++, field_.width);
+    naive.setArg(arg++, field_.height);
     naive.setArg(arg++, directions);
     naive.setArg(arg++, count);
-    naive.setArg(arg++, sector);
-    naive.setArg(arg++, count_sum);
-    naive.setArg(arg++, area_sum);
-    st.launch(naive, cl::NDRange(roundUp(field.width, kTileX), roundUp(field.height, kTileY)),
-              cl::NDRange(kTileX, kTileY));
-    st.queue.finish();
-    if (options.progress) options.progress(first + count, options.directions);
+    naive.setArg(arg++, intervisibilitySector(visibility_));
+    naive.setArg(arg++, count_sum_);
+    naive.setArg(arg++, area_sum_);
+    st_.launch(naive, cl::NDRange(roundUp(field_.width, kTileX), roundUp(field_.height, kTileY)),
+               cl::NDRange(kTileX, kTileY));
   }
-  download(st, count_sum, result.visible_count);
-  download(st, area_sum, result.visible_area);
-  return result;
-}
+
+  void finish() override {
+    download(st_, count_sum_, result_.visible_count);
+    download(st_, area_sum_, result_.visible_area);
+  }
+
+  const IntervisibilityOptions& visibility_;
+  const IntervisibilityOutputs& outputs_;
+  std::vector<SweepDirection> rays_;
+  cl::Buffer count_sum_, area_sum_;
+  IntervisibilityResult result_;
+};
 
 }  // namespace
 
@@ -340,8 +382,14 @@ IntervisibilityResult computeIntervisibility(const ComputeContext& context, cons
   validate(options, outputs);
   return detail::translateOpenClErrors([&] {
     detail::ContextState& st = detail::stateOf(context);
-    return options.method == IntervisibilityMethod::HullTree ? detail::runTree(st, field, options, outputs)
-                                                             : detail::runNaive(st, field, options, outputs);
+    if (options.method == IntervisibilityMethod::HullTree) {
+      detail::CountRoutine routine(st, field, options, outputs);
+      routine.run();
+      return routine.take();
+    }
+    detail::NaiveCountRoutine routine(st, field, options, outputs);
+    routine.run();
+    return routine.take();
   });
 }
 

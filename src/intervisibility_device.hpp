@@ -12,6 +12,7 @@
 #include "hfvis/intervisibility.hpp"
 #include "intervisibility_internal.hpp"
 #include "opencl_context.hpp"
+#include "sweep_routine.hpp"
 
 namespace hfvis::detail {
 
@@ -63,6 +64,26 @@ void allocateTreeScratch(ContextState& st, const TreeProgramFlags& flags, const 
 // Launches intervisibility_lattice for direction d, its lines in chunks whose scratch fits.
 void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDirection& d, int width, int height,
                           const TreeBuffers& b);
+
+// The routine of an operation built on the tree sweep (visible counts and areas, the
+// bounce): its program, its directions, its scratch, one launch per direction.
+class TreeRoutine : public SweepRoutine {
+ protected:
+  TreeRoutine(ContextState& st, const HeightField& field, const SweepOptions& options, const TreeProgramFlags& flags)
+      : SweepRoutine(st, field, options), flags_(flags) {}
+
+  std::string programFile() const override { return "intervisibility.cl"; }
+  std::string programOptions() const override;
+  // The directions and the scratch, planned beside `fixed_bytes` of the operation's own
+  // buffers (heights included).
+  void allocateScratch(std::size_t fixed_bytes);
+  int directionCount() const override { return static_cast<int>(directions_.size()); }
+  void sweep(int direction, int slot) override;
+
+  TreeProgramFlags flags_;  // has_nodata follows the prepared heights
+  std::vector<TreeDirection> directions_;
+  TreeBuffers buffers_;
+};
 
 struct BounceInputs;
 

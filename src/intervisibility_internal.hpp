@@ -73,7 +73,7 @@ struct IntervisibilityLines {
   SweepDirection geometry{};
   int receiver_every = 1;
   bool horizons_at_every_sample = true;  // else only receivers read theirs (the kernels without statistics)
-  std::vector<float> samples;                 // presampled heights
+  std::vector<float> samples;                 // sampled heights
   std::vector<float> counts;                  // visible samples (farther along the line)
   std::vector<float> distance_sums;           // sum of their distances, in steps
   std::vector<std::uint32_t> horizons;        // m_i: distinct visibility horizons

@@ -1,4 +1,4 @@
-// scalar_hull_tree.cpp: the convex hull tree sweep (Timonen 2013) of presampled lines on
+// scalar_hull_tree.cpp: the convex hull tree sweep (Timonen 2013) of sampled lines on
 // the host, a scalar mirror of kernels/intervisibility.cl's sweep (same tree layout, same
 // walk, same exact predicate, in the kernel's order, with the bounce gather): the horizon
 // lists run it, and the scalar references of the tests build on it.
@@ -33,7 +33,7 @@ struct Node {
   int next = kNone;
 };
 
-// The presampled heights, ranks and step sums of one line, indexed by step.
+// The sampled heights of one line, indexed by step.
 struct LineView {
   const std::vector<float>& samples;
   std::size_t offset;  // entry of step 0 of this line

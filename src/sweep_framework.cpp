@@ -1,4 +1,5 @@
-// sweep_framework.cpp: batching, geometry upload and presampling for sweep kernels.
+// sweep_framework.cpp: scratch layout, memory budgets, buffers and the chunked launch of the
+// lattice sweeps.
 #include "sweep_framework.hpp"
 
 #include <algorithm>

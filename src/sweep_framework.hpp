@@ -1,5 +1,5 @@
 // sweep_framework.hpp: host side of the sweep framework every sweep kernel shares
-// (kernels/sweep_framework.cl): the line-buffer layout of a context, memory budgets,
+// (kernels/sweep_framework.cl): the scratch layout of a context, memory budgets,
 // buffers, the naive marches' direction uploads, and launch shapes.
 #pragma once
 

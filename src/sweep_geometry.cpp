@@ -1,10 +1,13 @@
-// sweep_geometry.cpp: line geometry of a sweep direction and the scalar mirrors of the
-// kernels' sampling helpers (kernels/sweep_framework.cl).
+// sweep_geometry.cpp: prepared heights, the ray geometry of a sweep direction and the scalar
+// mirrors of the kernels' sampling helpers (kernels/sweep_framework.cl).
 #include "sweep_geometry.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
+
+#include "hfvis/errors.hpp"
 
 namespace hfvis::detail {
 
@@ -75,6 +78,36 @@ float sampleHeight(const std::vector<float>& heights, int width, int height, Poi
     return weight > 0.0f ? sum / weight : std::numeric_limits<float>::quiet_NaN();
   }
   return w00 * h00 + w10 * h10 + w01 * h01 + w11 * h11;
+}
+
+PreparedHeights prepareHeights(const HeightField& field) {
+  double lowest = std::numeric_limits<double>::max(), highest = std::numeric_limits<double>::lowest();
+  for (float h : field.heights) {
+    if (std::isfinite(h)) {
+      lowest = std::min(lowest, static_cast<double>(h));
+      highest = std::max(highest, static_cast<double>(h));
+    }
+  }
+  // The kernels multiply height differences by distances in float: keep the products finite.
+  if (highest >= lowest && (highest - lowest) * field.z_scale > kMaxPreparedHeight) {
+    std::ostringstream message;
+    message << "the heights span " << lowest << " .. " << highest << ", a rise of "
+            << (highest - lowest) * field.z_scale << " with the z-scale " << field.z_scale
+            << ": more than the " << kMaxPreparedHeight << " the kernels' float arithmetic holds";
+    throw InvalidArgument(message.str());
+  }
+  PreparedHeights prepared;
+  prepared.heights.resize(field.heights.size());
+  for (std::size_t i = 0; i < field.heights.size(); ++i) {
+    const float h = field.heights[i];
+    if (std::isfinite(h)) {
+      prepared.heights[i] = static_cast<float>((static_cast<double>(h) - lowest) * field.z_scale);
+    } else {
+      prepared.heights[i] = std::numeric_limits<float>::quiet_NaN();
+      prepared.has_nodata = true;
+    }
+  }
+  return prepared;
 }
 
 }  // namespace hfvis::detail

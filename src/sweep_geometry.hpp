@@ -1,6 +1,7 @@
-// sweep_geometry.hpp: the line geometry of one sweep direction, shared by the host code
-// that launches the sweep kernels and by the scalar references, so both sample the very
-// same points. Mirrors `SweepDirection` in kernels/sweep_framework.cl.
+// sweep_geometry.hpp: the host side of the sweep framework that every operation and the
+// scalar references share without OpenCL: the heights as the kernels see them, the ray
+// geometry of one direction (mirrors `SweepDirection` in kernels/sweep_framework.cl) and the
+// scalar mirrors of the kernels' sampling helpers, so both sample the very same points.
 #pragma once
 
 #include <array>
@@ -27,7 +28,7 @@ struct SweepDirection {
   std::int32_t n_lines;
   std::int32_t step_top;  // step i at (step_top - i) * step_length along dir
   std::int32_t n_steps;
-  std::uint32_t buffer_offset;  // first entry in the batch's line buffer
+  std::uint32_t buffer_offset;  // unused by the naive marches (kept: the kernel struct's layout)
 
   std::size_t entries() const {
     return static_cast<std::size_t>(n_lines) * static_cast<std::size_t>(n_steps);
@@ -50,6 +51,18 @@ struct Point2 {
 // Mirrors of the kernels' helpers (same operations, same order, same rounding).
 bool insideField(Point2 p, int width, int height);
 float sampleHeight(const std::vector<float>& heights, int width, int height, Point2 p);
+
+// Heights as the kernels see them: (h - lowest finite height) * z_scale in float, so that
+// a plane at 8848 m keeps its millimetres; every non-finite height becomes NaN. Throws
+// InvalidArgument when a prepared height would exceed kMaxPreparedHeight: the kernels
+// multiply height differences by distances (up to 2^31 pixels) in float, which must stay
+// finite.
+constexpr double kMaxPreparedHeight = 1e28;
+struct PreparedHeights {
+  std::vector<float> heights;
+  bool has_nodata = false;
+};
+PreparedHeights prepareHeights(const HeightField& field);
 
 // Sample pitch at which positions count as inside; must equal HFVIS_EDGE_EPS.
 constexpr float kEdgeEpsilon = 1e-3f;

@@ -1,10 +1,12 @@
 // horizon_reference.cpp: scalar mirrors of kernels/horizon.cl (the lattice sweep with its
-// per-receiver outputs, and the naive march). Keep every expression in the kernels' order:
-// the build disables FP contraction on both sides so the predicates decide identically.
+// per-receiver outputs, and the naive march); the per-direction terms are the kernels' own
+// (src/direction_terms.hpp). Keep every expression in the kernels' order: the build disables
+// FP contraction on both sides so the predicates decide identically.
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
+#include "direction_terms.hpp"
 #include "fast_math.hpp"
 #include "hfvis/reference.hpp"
 #include "horizon_common.hpp"
@@ -15,7 +17,6 @@ namespace hfvis {
 namespace detail {
 namespace {
 
-constexpr float kPi = 3.14159265358979323846f;
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
 struct Normal {
@@ -56,16 +57,6 @@ std::vector<Normal> pixelNormals(const HeightField& field, const std::vector<flo
   return normals;
 }
 
-// ambient_term in the kernel.
-float ambientTerm(bool found, float rise, float run, Normal n, float cos_az, float sin_az, float weight,
-                  float swath) {
-  const float toward = n.x * cos_az + n.y * sin_az;
-  const bool behind = !found || rise * n.z < -toward * run;
-  const float x = behind ? -toward / n.z : rise / run;
-  const float cos2 = 1.0f / (1.0f + x * x);
-  return n.z * weight * cos2 + swath * (0.5f * kPi - hfAtan(x) - x * cos2) * toward;
-}
-
 // What one direction contributes at one receiver, as emit_direction / emit_lanes in the kernel.
 struct DirectionOutputs {
   float cos_azimuth, sin_azimuth, weight;
@@ -76,18 +67,19 @@ struct DirectionOutputs {
 void emitDirection(HorizonResult& result, std::size_t pixel, bool nodata, bool found, float rise, float run,
                    float distance, const DirectionOutputs& o, const std::vector<Normal>& normals) {
   const std::size_t plane = static_cast<std::size_t>(result.width) * result.height;
-  const float elevation = nodata ? kNaN : (found ? hfAtan(rise / run) : -0.5f * kPi);
+  const float elevation = nodata ? kNaN : elevation_term(found, rise, run);
   if (!result.angles.empty()) result.angles[o.k * plane + pixel] = elevation;
   if (!result.distances.empty()) result.distances[o.k * plane + pixel] = nodata ? kNaN : distance;
   if (!result.sky_view_factor.empty()) {
-    const float sky = found && rise > 0.0f ? rise / std::sqrt(rise * rise + run * run) : 0.0f;
+    const float sky = sky_term(found, rise, run);
     float& sum = result.sky_view_factor[pixel];
     sum = nodata ? kNaN : sum + o.weight * sky;
   }
   if (!result.ambient_occlusion.empty()) {
     float& sum = result.ambient_occlusion[pixel];
+    const Normal& n = normals[pixel];
     const float term =
-        ambientTerm(found, rise, run, normals[pixel], o.cos_azimuth, o.sin_azimuth, o.weight, o.swath());
+        ambient_term(found, rise, run, n.x, n.y, n.z, o.cos_azimuth, o.sin_azimuth, o.weight, o.swath());
     sum = nodata ? kNaN : sum + term;
   }
 }

@@ -34,7 +34,7 @@ struct ContextState;
 ContextState& stateOf(const ComputeContext& context);
 }  // namespace detail
 
-// How the sweep kernels lay out their per-line buffers (hull stacks, line samples).
+// How the sweep kernels lay out their per-line scratch (hull stacks, tree nodes).
 enum class LineLayout {
   Automatic,  // line-major on CPUs (and the horizon sweep in SIMD lanes), step-major elsewhere
   LineMajor,  // each line's entries contiguous: a work-item walks its line in one stream

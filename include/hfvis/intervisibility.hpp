@@ -7,9 +7,9 @@
 // surface samples q = p + i * step * d_k, i >= 1, inside the field (bilinear heights,
 // nodata samples absent). The naive march takes d_k at phi_k and step 1 / S (S =
 // samples_per_unit). The hull tree runs on lattice lines through the pixel centres: d_k is
-// the cheapest integer step (a, b) within 1/8 of the spacing 2 pi / K of phi_k, and the
-// step |(a, b)| / ceil(|(a, b)| S), at most 1 / S, so every receiver is a sample of its own
-// line at its own height (README.md, "How the sweep works"). Tie rule: q is visible when its
+// the cheapest integer step (a, b) within half the spacing 2 pi / K of phi_k, weighted by the
+// azimuths it stands for, and the step |(a, b)| / ceil(|(a, b)| S), at most 1 / S, so every
+// receiver is a sample of its own line at its own height (README.md, "How the sweep works"). Tie rule: q is visible when its
 // slope from p is >= the slope of every sample strictly between them (grazing samples are
 // visible; on a flat plane every sample is). Decided exactly, so the sweep, the naive
 // march and brute force agree sample for sample on identical samples.
