@@ -326,23 +326,8 @@ IntervisibilityLines treeLinesOnDevice(ContextState& st, const TreeProgramFlags&
   // Back to the canonical step-major order, as the launch laid the lines out.
   std::vector<LatticeLine> lines = d.lines;
   const auto chunks = chunkLines(lines, per_period, entries, lineMajorLayout(st));
-  IntervisibilityLines out;
-  out.geometry.n_lines = static_cast<int>(lines.size());
-  out.geometry.n_steps = static_cast<int>(longest);
-  out.geometry.step_length = d.step_length;
-  out.geometry.ground_per_pixel = static_cast<float>(d.lattice.ground_per_pixel);
-  out.geometry.cos_azimuth = d.cos_azimuth;
-  out.geometry.sin_azimuth = d.sin_azimuth;
-  out.receiver_every = static_cast<int>(per_period);
-  const std::size_t canonical_entries = longest * lines.size();
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  out.samples.assign(canonical_entries, nan);
-  out.counts.assign(canonical_entries, nan);
-  out.distance_sums.assign(canonical_entries, nan);
-  out.horizons.assign(canonical_entries, 0);
-  out.iterations.assign(canonical_entries, 0);
-  out.horizon_hashes.assign(canonical_entries, 0);
-  out.walks_skipped.assign(canonical_entries, 0);
+  IntervisibilityLines out = canonicalTreeLines(d);
+  out.resetResults();
   for (const LineChunk& chunk : chunks) {
     for (std::size_t j = chunk.first; j < chunk.first + chunk.count; ++j) {
       const std::size_t steps = lineCapacity(lines[j], per_period);

@@ -2,6 +2,7 @@
 // that the intervisibility and bounce device paths and their scalar references share.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "hfvis/errors.hpp"
@@ -84,6 +85,33 @@ std::vector<TreeDirection> treeDirections(const HeightField& field, const SweepO
     if (lattice.weight == 0.0) continue;  // merged into an equal step
     out.push_back(makeTreeDirection(field, lattice, options.samples_per_unit, options.directions));
   }
+  return out;
+}
+
+void IntervisibilityLines::resetResults(bool keep_horizons) {
+  const std::size_t entries = samples.size();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  counts.assign(entries, nan);
+  distance_sums.assign(entries, nan);
+  horizons.assign(entries, 0);
+  iterations.assign(entries, 0);
+  horizon_hashes.assign(entries, 0);
+  walks_skipped.assign(entries, 0);
+  horizon_steps.assign(keep_horizons ? entries : 0, {});
+  horizon_run_ends.assign(keep_horizons ? entries : 0, {});
+}
+
+IntervisibilityLines canonicalTreeLines(const TreeDirection& d) {
+  IntervisibilityLines out;
+  const std::size_t longest = d.longestLine();
+  out.geometry.n_lines = static_cast<int>(d.lines.size());
+  out.geometry.n_steps = static_cast<int>(longest);
+  out.geometry.step_length = d.step_length;
+  out.geometry.ground_per_pixel = static_cast<float>(d.lattice.ground_per_pixel);
+  out.geometry.cos_azimuth = d.cos_azimuth;
+  out.geometry.sin_azimuth = d.sin_azimuth;
+  out.receiver_every = static_cast<int>(d.samples.size());
+  out.samples.assign(longest * d.lines.size(), std::numeric_limits<float>::quiet_NaN());
   return out;
 }
 

@@ -85,7 +85,14 @@ struct IntervisibilityLines {
   // so horizon h's visible samples are the present ones of steps [h, end).
   std::vector<std::vector<int>> horizon_steps;
   std::vector<std::vector<int>> horizon_run_ends;
+
+  // Every per-entry result for samples.size() entries: NaN counts and sums, zero statistics.
+  void resetResults(bool keep_horizons = false);
 };
+
+// The canonical lines of tree direction d (geometry, receiver_every, every sample absent):
+// lines in the order of d.lines, each padded with absent samples to the longest.
+IntervisibilityLines canonicalTreeLines(const TreeDirection& d);
 
 // The bounce gather on one direction's lines (see hfvis/bounce.hpp for the formula), in the
 // canonical step-major order of IntervisibilityLines. Inputs per entry: the exit radiance

@@ -399,14 +399,7 @@ void sweepPresampledLines(IntervisibilityLines& lines, const HullTreeTuning& tun
   const std::size_t entries = d.entries();
   if (lines.samples.size() != entries)
     throw InvalidArgument("internal error: line samples do not fit the geometry");
-  lines.counts.assign(entries, kNaN);
-  lines.distance_sums.assign(entries, kNaN);
-  lines.horizons.assign(entries, 0);
-  lines.iterations.assign(entries, 0);
-  lines.horizon_hashes.assign(entries, 0);
-  lines.walks_skipped.assign(entries, 0);
-  lines.horizon_steps.assign(keep_horizons ? entries : 0, {});
-  lines.horizon_run_ends.assign(keep_horizons ? entries : 0, {});
+  lines.resetResults(keep_horizons);
   if (bounce) {
     if (bounce->channels < 1 || bounce->channels > kMaxBounceChannels ||
         bounce->attributes.size() != entries * (bounce->channels + kBounceNormalFloats)) {

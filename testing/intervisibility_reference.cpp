@@ -123,16 +123,8 @@ void naiveReference(const HeightField& field, const std::vector<float>& h,
 IntervisibilityLines latticeTreeLines(const HeightField& field, const std::vector<float>& prepared_heights,
                                       const TreeDirection& d) {
   const int width = field.width, height = field.height;
-  const std::size_t per_period = d.samples.size(), longest = d.longestLine();
-  IntervisibilityLines out;
-  out.geometry.n_lines = static_cast<int>(d.lines.size());
-  out.geometry.n_steps = static_cast<int>(longest);
-  out.geometry.step_length = d.step_length;
-  out.geometry.ground_per_pixel = static_cast<float>(d.lattice.ground_per_pixel);
-  out.geometry.cos_azimuth = d.cos_azimuth;
-  out.geometry.sin_azimuth = d.sin_azimuth;
-  out.receiver_every = static_cast<int>(per_period);
-  out.samples.assign(longest * d.lines.size(), kNaN);
+  const std::size_t per_period = d.samples.size();
+  IntervisibilityLines out = canonicalTreeLines(d);
   for (std::size_t j = 0; j < d.lines.size(); ++j) {
     const LatticeLine& line = d.lines[j];
     int c = line.col, r = line.row;
