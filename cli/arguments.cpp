@@ -36,6 +36,8 @@ enum class Option {
   At,
   Radiance,
   Quiet,
+  Curvature,
+  Refraction,
 };
 
 struct OptionSpec {
@@ -64,6 +66,8 @@ constexpr OptionSpec kOptions[] = {
     {Option::At, "--at", nullptr, true},
     {Option::Radiance, "--radiance", nullptr, true},
     {Option::Quiet, "--quiet", "-q", false},
+    {Option::Curvature, "--curvature", nullptr, false},
+    {Option::Refraction, "--refraction", nullptr, true},
 };
 
 // The options every sweep operation shares, as typed (degrees become radians).
@@ -73,6 +77,7 @@ void setSweepOptions(const RunArguments& run, Options& options) {
   options.azimuth_offset = run.azimuth_offset_deg * (kPi / 180.0);
   options.samples_per_unit = run.samples_per_unit;
   options.memory_budget_bytes = run.memory_budget_bytes;
+  options.curvature = run.curvature ? earthCurvature(run.refraction) : 0.0;
 }
 
 bool isHelpFlag(const std::string& arg) { return arg == "-h" || arg == "--help"; }
@@ -195,10 +200,13 @@ const char* onlyFor(Option option) {
 // one ray per receiver and direction, and written as text).
 bool notFor(Option option, Command command) {
   if (command == Command::HorizonLists) {
-    return option == Option::Method || option == Option::Device ||
-           option == Option::MemoryBudget || option == Option::Preview;
+    return option == Option::Method || option == Option::Device || option == Option::MemoryBudget ||
+           option == Option::Preview || option == Option::Curvature || option == Option::Refraction;
   }
   if (option == Option::HullTree) return command != Command::ViewCount && command != Command::Bounce;
+  // Earth curvature: horizons, sky view and occlusion so far.
+  if (option == Option::Curvature || option == Option::Refraction)
+    return command == Command::ViewCount || command == Command::Bounce;
   return command == Command::Bounce && option == Option::Method;
 }
 
@@ -310,6 +318,15 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
       break;
     case Option::Quiet:
       run.quiet = true;
+      break;
+    case Option::Curvature:
+      run.curvature = true;
+      break;
+    case Option::Refraction:
+      run.refraction = parseNumber(typed, value);
+      if (!(run.refraction >= -1.0 && run.refraction <= 1.0))
+        throw UsageError(typed + ": the refraction coefficient must be in -1 .. 1, got " + inQuotes(value));
+      run.curvature = true;  // refraction bends rays over the curved Earth
       break;
   }
 }

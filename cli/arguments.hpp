@@ -62,6 +62,8 @@ struct RunArguments {
   std::string device;                   // "" = HFVIS_DEVICE, else automatic
   std::size_t memory_budget_bytes = 0;  // 0 = from the device
   bool quiet = false;
+  bool curvature = false;                    // --curvature (or --refraction): the Earth's drop
+  double refraction = kDefaultRefraction;  // --refraction K
 };
 
 struct CommandLine {

@@ -269,6 +269,11 @@ Attributes runAttributes(Command command, const RunArguments& run, const HeightF
       {"hfvis:device", device.name + " (" + device.platform + ")"},
   };
   if (!run.channel.empty()) attributes.emplace_back("hfvis:channel", run.channel);
+  if (run.curvature) {
+    attributes.emplace_back("hfvis:curvature", "drop = d^2 (1 - K) / (2 R), R = " + formatNumber(kEarthRadius) +
+                                                   " m, K = " + formatNumber(run.refraction) +
+                                                   " (ground units taken as metres)");
+  }
   return attributes;
 }
 

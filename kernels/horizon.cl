@@ -19,6 +19,9 @@
 // Compile-time parameters, besides those of sweep_framework.cl:
 //   HFVIS_WANT_ANGLES, HFVIS_WANT_DISTANCES  write the direction's planes
 //   HFVIS_WANT_SVF, HFVIS_WANT_AO            accumulate sky-view / ambient occlusion terms
+//   HFVIS_CURVATURE                          lower every sample by the Earth's drop (argument
+//                                            `drop`: c times the ground length of a pixel
+//                                            along the line, squared; README "Conventions")
 #include "direction_terms.cl"
 #include "fast_math.cl"
 #include "sweep_framework.cl"
@@ -34,6 +37,9 @@
 #endif
 #ifndef HFVIS_WANT_AO
 #define HFVIS_WANT_AO 1
+#endif
+#ifndef HFVIS_CURVATURE
+#define HFVIS_CURVATURE 0
 #endif
 
 // Unit normal at pixel (c, r): the normalised sum of the unnormalised normals of the (up to)
@@ -229,7 +235,7 @@ HFVIS_INLINE lane_float near_rise(__global const float* heights, int width, int 
 __kernel void horizon_lattice(__global const float* heights, int width, int height,
                               __global const int4* lines, int n_lines, __global const LatticeSample* samples,
                               int n_samples, int a, int b, float period, float ground_per_pixel,
-                              float period_ground, float cos_azimuth, float sin_azimuth, float weight,
+                              float period_ground, float drop, float cos_azimuth, float sin_azimuth, float weight,
                               float swath, uint plane, __global float2* stacks, uint stride,
                               __global const float4* normals, __global float* angles,
                               __global float* distances, __global float* svf_sum, __global float* ao_sum) {
@@ -299,10 +305,18 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
       const lane_int valid = ok;
 #endif
       const float here = base - s->tau;
+#if HFVIS_CURVATURE
+      // The Earth's drop below the receiver p, drop (p - here)^2, is a parabola along the line:
+      // subtracting drop * here^2 from every sample instead changes every slope from p by the
+      // same 2 drop p (restored at the receiver), so the hull and its answers stay exact.
+      const lane_float hs = h - drop * here * here;
+#else
+      const lane_float hs = h;
+#endif
       // Pop while the entry below the top casts at least as steep a slope on the sample as
       // the top. Every pop loads the next entry down before it is known to be needed, so
       // the load does not wait for the comparison (it is used only where a lane pops).
-      lane_float v1h = top_h - h, v1d = here - top_p, v2h = below_h - h, v2d = here - below_p;
+      lane_float v1h = top_h - hs, v1d = here - top_p, v2h = below_h - hs, v2d = here - below_p;
       lane_int popping = valid & (n > 1);
       lane_int deeper = stack + (n - 3) * entry;  // entry n - 3, below `below`
       while (ANY_LANE(popping)) {
@@ -321,7 +335,7 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
         top_p = select(top_p, below_p, pop);
         below_h = select(below_h, next_h, pop);
         below_p = select(below_p, next_p, pop);
-        v2h = below_h - h;
+        v2h = below_h - hs;
         v2d = here - below_p;
         n = select(n, n - 1, pop);
         popping = pop & (n > 1);
@@ -331,31 +345,37 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 #pragma unroll
       for (int l = 0; l < HFVIS_LANES; ++l) {
         if (ILANE(valid, l)) {
-          stacks[ILANE(push, l)] = (float2)(LANE(h, l), here);
+          stacks[ILANE(push, l)] = (float2)(LANE(hs, l), here);
         }
       }
       rise = select(rise, v1h, valid);
       run = select(run, select((lane_float)0.0f, v1d, n > 0), valid);  // 0: no occluder
       below_h = select(below_h, top_h, valid);
       below_p = select(below_p, top_p, valid);
-      top_h = select(top_h, h, valid);
+      top_h = select(top_h, hs, valid);
       top_p = select(top_p, (lane_float)here, valid);
       n = select(n, n + 1, valid);
     }
     // The receivers (the last sample of the period, h its height): the steeper of the hull's
     // occluder and the limit at the receiver, compared without a division (both runs are
     // positive); the occluder wins ties (it is the farther point casting that elevation).
+    // With curvature the near limit is unchanged (the drop is of second order in distance).
     const lane_float near = near_rise(heights, width, height, live, c, r, h, a, b);
     const lane_float ground = run * ground_per_pixel;
+#if HFVIS_CURVATURE
+    const lane_float far_rise = rise - 2.0f * drop * base * run;
+#else
+    const lane_float far_rise = rise;
+#endif
     const lane_int has_far = run > 0.0f, has_near = !isnan(near);
-    const lane_int use_near = has_near & (!has_far | (near * ground > rise * period_ground));
+    const lane_int use_near = has_near & (!has_far | (near * ground > far_rise * period_ground));
     const lane_float distance = select((lane_float)0.0f, ground, has_far & !use_near);
 #if HFVIS_HAS_NODATA
     const lane_int nodata = isnan(h);
 #else
     const lane_int nodata = 0;
 #endif
-    emit_lanes(live, r * width + c, nodata, has_far | has_near, select(rise, near, use_near),
+    emit_lanes(live, r * width + c, nodata, has_far | has_near, select(far_rise, near, use_near),
                select(ground, (lane_float)period_ground, use_near), distance, outputs, normals, angles,
                distances, svf_sum, ao_sum);
   }
@@ -370,7 +390,8 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 // one loop it vectorises (the march ran 5x faster that way on PoCL); samples past a
 // pixel's own exit are masked. Global size: (W, H) rounded up to the local size (the tile).
 __kernel void horizon_naive(__global const float* heights, int width, int height, float dir_x, float dir_y,
-                            float step_length, float ground_per_pixel, float cos_azimuth, float sin_azimuth,
+                            float step_length, float ground_per_pixel, float drop, float cos_azimuth,
+                            float sin_azimuth,
                             float weight, float swath, uint plane, __global const float4* normals,
                             __global float* angles, __global float* distances, __global float* svf_sum,
                             __global float* ao_sum) {
@@ -386,7 +407,11 @@ __kernel void horizon_naive(__global const float* heights, int width, int height
     float t = (float)i * step_length;
     float px = (float)cc + t * dir_x, py = (float)rr + t * dir_y;
     float q = sample_height(heights, width, height, px, py);
+#if HFVIS_CURVATURE
+    float rise = q - h - drop * t * t;  // the Earth's drop at t pixels (drop per pixel^2)
+#else
     float rise = q - h;
+#endif
     // rise / i >= best_rise / best_step without a division; ties go to the farther sample.
     int better = inside_field(px, py, width, height) & !isnan(q) &
                  ((best_step == 0) | (rise * (float)best_step >= best_rise * (float)i));

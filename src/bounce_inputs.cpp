@@ -72,6 +72,7 @@ BounceInputs prepareBounce(const HeightField& field, const ExitRadiance& radianc
 void validate(const BounceOptions& options) {
   validate(static_cast<const SweepOptions&>(options));
   validate(options.tree);
+  if (options.curvature != 0.0) throw InvalidArgument("Earth curvature is not supported for the bounce");
 }
 
 void validate(const HeightField& field, const ExitRadiance& radiance) {

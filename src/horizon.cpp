@@ -27,9 +27,9 @@ constexpr std::size_t kStackEntryBytes = 2 * sizeof(float);  // (height, positio
 // the step-major layout, whose neighbouring work-items read neighbouring stack entries.
 int sweepLanes(const ContextState& st) { return lineMajorLayout(st) && st.info.type == "CPU" ? 8 : 1; }
 
-std::string programOptions(const HorizonOutputs& outputs, bool has_nodata, int lanes) {
+std::string programOptions(const HorizonOutputs& outputs, bool has_nodata, int lanes, bool curvature) {
   std::ostringstream s;
-  s << "-DHFVIS_LANES=" << lanes << " -DHFVIS_HAS_NODATA=" << has_nodata
+  s << "-DHFVIS_LANES=" << lanes << " -DHFVIS_HAS_NODATA=" << has_nodata << " -DHFVIS_CURVATURE=" << curvature
     << " -DHFVIS_WANT_ANGLES=" << outputs.horizon_angles
     << " -DHFVIS_WANT_DISTANCES=" << outputs.horizon_distances
     << " -DHFVIS_WANT_SVF=" << outputs.sky_view_factor << " -DHFVIS_WANT_AO=" << outputs.ambient_occlusion;
@@ -138,7 +138,7 @@ class HorizonRoutine : public SweepRoutine {
  private:
   std::string programFile() const override { return "horizon.cl"; }
   std::string programOptions() const override {
-    return detail::programOptions(outputs_, prepared_.has_nodata, sweepLanes(st_));
+    return detail::programOptions(outputs_, prepared_.has_nodata, sweepLanes(st_), horizon_.curvature != 0.0);
   }
 
   void allocate() override {
@@ -202,6 +202,11 @@ class HorizonRoutine : public SweepRoutine {
     finishReduction(result_);
   }
 
+  // The Earth's drop per pixel length squared along a direction of that ground length per pixel.
+  float curvatureDrop(double ground_per_pixel) const {
+    return static_cast<float>(horizon_.curvature * ground_per_pixel * ground_per_pixel);
+  }
+
   // The arguments every direction's kernel ends with: its outputs.
   void setOutputs(cl::Kernel& kernel, int arg, const RunDirection& d, cl_uint plane_offset) {
     kernel.setArg(arg++, d.cos_azimuth);
@@ -235,7 +240,8 @@ class HorizonRoutine : public SweepRoutine {
     kernel.setArg(9, static_cast<float>(d.lattice.period));
     kernel.setArg(10, static_cast<float>(d.lattice.ground_per_pixel));
     kernel.setArg(11, static_cast<float>(d.lattice.period * d.lattice.ground_per_pixel));
-    setOutputs(kernel, 12, d, plane_offset);
+    kernel.setArg(12, curvatureDrop(d.lattice.ground_per_pixel));
+    setOutputs(kernel, 13, d, plane_offset);
     LineChunkArguments chunk;
     chunk.lines = 3;
     chunk.count = 4;
@@ -255,7 +261,8 @@ class HorizonRoutine : public SweepRoutine {
     kernel.setArg(4, d.ray.dir_y);
     kernel.setArg(5, d.ray.step_length);
     kernel.setArg(6, d.ray.ground_per_pixel);
-    setOutputs(kernel, 7, d, plane_offset);
+    kernel.setArg(7, curvatureDrop(d.ray.ground_per_pixel));
+    setOutputs(kernel, 8, d, plane_offset);
     st_.launch(kernel, cl::NDRange(roundUp(field_.width, kTileX), roundUp(field_.height, kTileY)),
                cl::NDRange(kTileX, kTileY));
   }

@@ -94,6 +94,7 @@ std::vector<ReceiverHorizons> computeHorizonLists(const HeightField& field, cons
                                                   const std::vector<ReceiverPixel>& receivers) {
   validate(field);
   validate(options);
+  if (options.curvature != 0.0) throw InvalidArgument("Earth curvature is not supported for horizon lists yet");
   validateReceivers(field, receivers);
   const detail::PreparedHeights prepared = detail::prepareHeights(field);
   const auto directions = detail::runDirections(field, options);

@@ -40,6 +40,7 @@ void validate(const HullTreeTuning& tuning) {
 void validate(const IntervisibilityOptions& options, const IntervisibilityOutputs& outputs) {
   validate(static_cast<const SweepOptions&>(options));
   validate(options.tree);
+  if (options.curvature != 0.0) throw InvalidArgument("Earth curvature is not supported for intervisibility yet");
   if (!outputs.visible_count && !outputs.visible_area && !outputs.statistics) {
     throw InvalidArgument("no output requested");
   }

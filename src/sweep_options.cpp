@@ -24,6 +24,10 @@ void validate(const SweepOptions& options) {
                           std::to_string(options.samples_per_unit) + ")");
   }
   if (!std::isfinite(options.azimuth_offset)) throw InvalidArgument("the azimuth offset must be finite");
+  if (!std::isfinite(options.curvature) || std::abs(options.curvature) > 1.0) {
+    throw InvalidArgument("the curvature coefficient must be finite and at most 1 per ground unit (got " +
+                          std::to_string(options.curvature) + "); earthCurvature() gives the Earth's in 1/m");
+  }
 }
 
 namespace detail {

@@ -128,9 +128,10 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
     const DirectionOutputs out = outputsOf(d, k);
     const auto samples = latticeSamples(d, options.samples_per_unit);
     const float gpp = static_cast<float>(d.ground_per_pixel);
+    const float drop = static_cast<float>(options.curvature * d.ground_per_pixel * d.ground_per_pixel);
     const float period_ground = static_cast<float>(d.period * d.ground_per_pixel);
     for (const LatticeLine& line : latticeLines(d, width, height)) {
-      for (const LatticeLineSample& s : latticeLineSamples(field, h, d, samples, line)) {
+      for (const LatticeLineSample& s : latticeLineSamples(field, h, d, samples, line, drop)) {
         if (s.receiver < 0) continue;
         const std::size_t pixel = static_cast<std::size_t>(s.receiver);
         if (std::isnan(s.height)) {
@@ -141,9 +142,11 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
         const float near = nearRise(h, width, height, c, r, s.height, d.a, d.b);
         const bool has_far = s.occluder_run > 0.0f, has_near = !std::isnan(near);
         const float ground = has_far ? s.occluder_run * gpp : 0.0f;
-        const bool use_near = has_near && (!has_far || near * ground > s.occluder_rise * period_ground);
+        // The kernel's far_rise (its curvature correction is an exact 0 without curvature).
+        const float far_rise = s.occluder_rise - 2.0f * drop * s.position * s.occluder_run;
+        const bool use_near = has_near && (!has_far || near * ground > far_rise * period_ground);
         const float distance = has_far && !use_near ? ground : 0.0f;
-        emitDirection(result, pixel, false, has_far || has_near, use_near ? near : s.occluder_rise,
+        emitDirection(result, pixel, false, has_far || has_near, use_near ? near : far_rise,
                       use_near ? period_ground : ground, distance, out, normals);
       }
     }
@@ -159,6 +162,7 @@ void naiveReference(const HeightField& field, const PreparedHeights& prepared, c
   for (int k = 0; k < options.directions; ++k) {
     const SweepDirection& d = directions[k];
     const DirectionOutputs out{d.cos_azimuth, d.sin_azimuth, static_cast<float>(1.0 / options.directions), k};
+    const float drop = static_cast<float>(options.curvature * double(d.ground_per_pixel) * double(d.ground_per_pixel));
     for (int r = 0; r < height; ++r) {
       for (int c = 0; c < width; ++c) {
         const std::size_t pixel = static_cast<std::size_t>(r) * width + c;
@@ -172,7 +176,7 @@ void naiveReference(const HeightField& field, const PreparedHeights& prepared, c
           const Point2 p{static_cast<float>(c) + t * d.dir_x, static_cast<float>(r) + t * d.dir_y};
           if (!insideField(p, width, height)) break;
           const float q = sampleHeight(h, width, height, p);
-          const float rise = q - hp;
+          const float rise = q - hp - drop * t * t;
           if (!std::isnan(q) &&
               (best_step == 0 || rise * static_cast<float>(best_step) >= best_rise * static_cast<float>(i))) {
             best_rise = rise;
@@ -193,7 +197,7 @@ void naiveReference(const HeightField& field, const PreparedHeights& prepared, c
 std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, const std::vector<float>& h,
                                                   const LatticeDirection& d,
                                                   const std::vector<LatticeSample>& samples,
-                                                  const LatticeLine& line) {
+                                                  const LatticeLine& line, float drop) {
   const int width = field.width, height = field.height;
   const float period = static_cast<float>(d.period);
   std::vector<LatticeLineSample> out;
@@ -215,7 +219,8 @@ std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, cons
         if (sample.receiver >= 0) out.push_back(sample);
         continue;
       }
-      const float hq = sample.height, here = sample.position;
+      // The kernel's curvature transform (an exact no-op at drop 0).
+      const float here = sample.position, hq = sample.height - drop * here * here;
       if (!stack.empty()) {
         auto top = stack.back();
         float v1h = top.first - hq, v1d = here - top.second;

@@ -24,11 +24,13 @@ struct LatticeLineSample {
 };
 
 // The samples of one line of direction d (prepared heights h), with Algorithm 1 run over
-// them exactly as horizon_lattice runs it.
+// them exactly as horizon_lattice runs it; with `drop` (curvature per pixel squared along the
+// line) the stack holds the heights lowered by drop * position^2, and occluder_rise is that
+// stack's (the receiver adds -2 drop position run).
 std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, const std::vector<float>& h,
                                                   const LatticeDirection& d,
                                                   const std::vector<LatticeSample>& samples,
-                                                  const LatticeLine& line);
+                                                  const LatticeLine& line, float drop = 0.0f);
 
 // lattice_height in the kernels: the bilinear height of sample s whose cell corner is at
 // entry `at` (right = 1 or 0, down = width or 0), over the valid corners.

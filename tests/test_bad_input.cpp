@@ -76,6 +76,29 @@ TEST(BadInput, Options) {
     options.samples_per_unit = spu;
     expectError<InvalidArgument>([&] { horizons(field, options); }, "samples per unit");
   }
+  for (double c : {std::nan(""), 2.0, -std::numeric_limits<double>::infinity()}) {
+    HorizonOptions options;
+    options.curvature = c;
+    expectError<InvalidArgument>([&] { horizons(field, options); }, "curvature coefficient");
+  }
+  IntervisibilityOptions curved;
+  curved.curvature = earthCurvature();
+  IntervisibilityOutputs counts;
+  counts.visible_count = true;
+  expectError<InvalidArgument>([&] { computeIntervisibility(testContext(), field, curved, counts); },
+                               "curvature is not supported");
+  BounceOptions curved_bounce;
+  curved_bounce.curvature = earthCurvature();
+  ExitRadiance lit;
+  lit.width = field.width;
+  lit.height = field.height;
+  lit.channels = {std::vector<float>(field.pixelCount(), 1.0f)};
+  expectError<InvalidArgument>([&] { computeBounce(testContext(), field, lit, curved_bounce); },
+                               "curvature is not supported");
+  SweepOptions curved_lists;
+  curved_lists.curvature = earthCurvature();
+  expectError<InvalidArgument>([&] { computeHorizonLists(field, curved_lists, {{1, 1}}); },
+                               "curvature is not supported");
   expectError<InvalidArgument>([&] { horizons(field, {}, HorizonOutputs{}); }, "output");
   HorizonOptions budget;
   budget.memory_budget_bytes = 16;

@@ -652,6 +652,32 @@ TEST_F(Cli, DenserSamplesNeverLowerAHorizon) {
   }
 }
 
+// --curvature lowers far points by the Earth's drop: a wall 30 units high 500 m of ground
+// away appears lower than without it (by atan(drop / d), drop = d^2 (1 - 1/7) / (2 R));
+// --refraction 1 bends rays along the Earth, no drop at all; the options are refused where
+// they are not implemented and out of range.
+TEST_F(Cli, CurvatureLowersFarTerrainByTheEarthsDrop) {
+  const std::string wall = writeField("wall.exr", 40, 5, [](int x, int) { return x >= 30 ? 30.0f : 0.0f; });
+  auto angle = [&](const std::string& options) {
+    fs::remove(out("h.exr"));
+    const CliResult result = run("horizon " + shellQuoted(wall) + " -o " + shellQuoted(out("h.exr")) +
+                                 " -k 4 --cell-size 50 " + options);
+    EXPECT_EQ(result.status, 0) << options << ": " << result.err;
+    const ReadBack h = readBack(out("h.exr"));
+    EXPECT_EQ(h.spec.get_string_attribute("hfvis:curvature").empty(), options.find("--") == std::string::npos);
+    return h.at(20, 2, 0);  // toward +x, 10 pixels = 500 m from the wall
+  };
+  const double d = 500.0, drop = d * d * (1.0 - 1.0 / 7.0) / (2.0 * 6370997.0);
+  EXPECT_NEAR(angle(""), std::atan(30.0 / d), 1e-6);
+  EXPECT_NEAR(angle("--curvature"), std::atan((30.0 - drop) / d), 1e-6);
+  EXPECT_NEAR(angle("--refraction 1"), std::atan(30.0 / d), 1e-6);
+  fs::remove(out("h.exr"));
+  expectFailure(run("viewcount " + shellQuoted(wall) + " -o " + shellQuoted(out("v.exr")) + " --curvature"), 2,
+                "--curvature");
+  expectFailure(run("svf " + shellQuoted(wall) + " -o " + shellQuoted(out("s.exr")) + " --refraction 2"), 2,
+                "--refraction");
+}
+
 // viewcount on a flat plane, K = 4 (the axes): every sample is visible, and a pixel's
 // rays along its row and column hold (W - 1) S + (H - 1) S samples at S samples per pixel
 // length; the line samples swept (--stats) grow S-fold.

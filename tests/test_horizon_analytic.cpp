@@ -17,9 +17,10 @@ using testing::testContext;
 
 class HorizonAnalytic : public ::testing::TestWithParam<HorizonMethod> {
  protected:
-  HorizonResult run(const HeightField& field, int directions, HorizonOutputs outputs) {
+  HorizonResult run(const HeightField& field, int directions, HorizonOutputs outputs, double curvature = 0.0) {
     HorizonOptions options;
     options.directions = directions;
+    options.curvature = curvature;
     options.method = GetParam();
     return computeHorizons(testContext(), field, options, outputs);
   }
@@ -84,6 +85,49 @@ TEST_P(HorizonAnalytic, LongWallCastsAtanOfHeightOverDistance) {
       EXPECT_NEAR(r.distances[p], 2.0 * (30 - c), 1e-3) << c << "," << row;
     }
   }
+}
+
+// The same wall over a curved Earth (drop c d^2 at ground distance d): its top is seen at
+// atan((z * 10 - c d^2) / d), d = cell_x * (30 - c), still from the foot of its top (the
+// farther wall lies lower still). c is large enough to halve the nearest elevations. Right in
+// front of the wall (column 29) the sweep's horizon is the ramp's own slope at the receiver,
+// its limit at t -> 0 (the drop is of second order there), at distance 0; the naive march
+// samples the wall's top.
+TEST_P(HorizonAnalytic, LongWallOverACurvedEarthSinksByTheDrop) {
+  HeightField field = makeSyntheticField("flat", 40, 9);
+  for (int row = 0; row < field.height; ++row)
+    for (int c = 30; c < field.width; ++c) field.heights[row * field.width + c] += 10.0f;
+  field.cell_size_x = 2.0;
+  field.z_scale = 3.0;
+  const double curvature = 0.005;
+  HorizonOutputs outputs;
+  outputs.horizon_angles = outputs.horizon_distances = true;
+  const auto r = run(field, 4, outputs, curvature);
+  for (int row = 0; row < field.height; ++row) {
+    for (int c = 0; c < 30; ++c) {
+      const std::size_t p = row * field.width + c;
+      const double d = 2.0 * (30 - c);
+      const bool ramp = c == 29 && GetParam() == HorizonMethod::Sweep;
+      EXPECT_NEAR(r.angles[p], std::atan(ramp ? 30.0 / d : (30.0 - curvature * d * d) / d), 1e-5) << c << "," << row;
+      EXPECT_NEAR(r.distances[p], ramp ? 0.0 : d, 1e-3) << c << "," << row;
+    }
+  }
+}
+
+// Flat ground over a curved Earth falls away from every receiver: the horizon is level (the
+// ground's own slope at the receiver) for the sweep, and the nearest sample's drop below the
+// receiver, -atan(c step) at a step of 1 ground unit, for the naive march.
+TEST_P(HorizonAnalytic, FlatGroundOverACurvedEarthFallsAway) {
+  const HeightField field = makeSyntheticField("flat", 19, 14);
+  const double curvature = 0.01;
+  HorizonOutputs outputs;
+  outputs.horizon_angles = true;
+  const auto r = run(field, 4, outputs, curvature);
+  const double expected = GetParam() == HorizonMethod::Sweep ? 0.0 : -std::atan(curvature);
+  for (int row = 1; row < field.height - 1; ++row)
+    for (int c = 1; c < field.width - 1; ++c)
+      for (int k = 0; k < 4; ++k)
+        ASSERT_NEAR(r.angles[k * field.pixelCount() + row * field.width + c], expected, 1e-6) << k;
 }
 
 // A cone of slope 0.5 around (20, 20): along its row every receiver looks up the cone's

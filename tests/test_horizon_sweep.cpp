@@ -167,7 +167,7 @@ TEST(HorizonSweepLine, DirectionsHonourTheToleranceAndQuadratureWeightsSumToOne)
 
 // Kernel results equal the scalar reference of the same algorithm, for both methods, in
 // both buffer layouts.
-void expectKernelMatchesReference(HorizonMethod method, double samples_per_unit) {
+void expectKernelMatchesReference(HorizonMethod method, double samples_per_unit, double curvature = 0.0) {
   testing::forEachLayout([&](const ComputeContext& context) {
     for (const auto& name : syntheticFieldNames()) {
       for (auto [w, h] : awkwardSizes()) {
@@ -179,6 +179,7 @@ void expectKernelMatchesReference(HorizonMethod method, double samples_per_unit)
         options.azimuth_offset = 0.1;
         options.method = method;
         options.samples_per_unit = samples_per_unit;
+        options.curvature = curvature;
         for (bool planes : {true, false}) {  // exact azimuths, or quadrature directions
           HorizonOutputs outputs;
           outputs.horizon_angles = outputs.horizon_distances = planes;
@@ -204,6 +205,16 @@ TEST(HorizonKernels, SweepMatchesScalarReferenceWithDenserSampling) {
 }
 
 TEST(HorizonKernels, NaiveMatchesScalarReference) { expectKernelMatchesReference(HorizonMethod::Naive, 1.0); }
+
+// Earth curvature, with a coefficient large enough to matter on these small fields (a drop of
+// several height units across them).
+TEST(HorizonKernels, SweepMatchesScalarReferenceWithCurvature) {
+  expectKernelMatchesReference(HorizonMethod::Sweep, 1.0, 0.004);
+}
+
+TEST(HorizonKernels, NaiveMatchesScalarReferenceWithCurvature) {
+  expectKernelMatchesReference(HorizonMethod::Naive, 1.0, 0.004);
+}
 
 // On the four axis directions the naive march samples the pixel centres of the receiver's
 // own row or column, which are the sweep's samples, and the sweep's limit at the receiver

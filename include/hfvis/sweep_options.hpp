@@ -13,6 +13,16 @@
 
 namespace hfvis {
 
+// Earth curvature and atmospheric refraction, as GRASS r.viewshed and gdal_viewshed take them:
+// a point at ground distance d from the receiver lies drop = d^2 (1 - K) / (2 R) lower, K the
+// refraction coefficient and R the Earth's radius, in metres (so the ground units must be
+// metres). SweepOptions::curvature is the coefficient (1 - K) / (2 R) of d^2.
+constexpr double kEarthRadius = 6370997.0;       // metres, GRASS's and GDAL's sphere
+constexpr double kDefaultRefraction = 1.0 / 7.0;  // GRASS's and GDAL's default K
+constexpr double earthCurvature(double refraction = kDefaultRefraction, double radius = kEarthRadius) {
+  return (1.0 - refraction) / (2.0 * radius);
+}
+
 // The most directions a run takes: 0.0055 degrees apart, far finer than a height field
 // resolves, and a bound that keeps a mistyped K from running for hours.
 constexpr int kMaxDirections = 65536;
@@ -21,6 +31,10 @@ struct SweepOptions {
   int directions = 64;                  // K, 1 .. kMaxDirections
   double azimuth_offset = 0.0;          // radians added to every phi_k
   double samples_per_unit = 1.0;        // height samples per pixel length along a line or ray, (0, 64]
+  // Drop coefficient c: a point at ground distance d from the receiver counts c d^2 lower
+  // (earthCurvature() for the Earth with refraction, ground units metres); 0 = flat.
+  // Horizons, sky-view factor and ambient occlusion take it; the other operations refuse it.
+  double curvature = 0.0;
   std::size_t memory_budget_bytes = 0;  // device memory for one batch; 0 = from the device
   // Called after each batch of directions with (directions done, directions in all).
   std::function<void(int, int)> progress;
@@ -29,8 +43,8 @@ struct SweepOptions {
 // Azimuth of direction k, in radians.
 double directionAzimuth(int k, const SweepOptions& options);
 
-// Throws InvalidArgument for K < 1, a sampling density outside (0, 64] or a non-finite
-// azimuth offset.
+// Throws InvalidArgument for K < 1, a sampling density outside (0, 64], a non-finite
+// azimuth offset or curvature.
 void validate(const SweepOptions& options);
 
 }  // namespace hfvis
