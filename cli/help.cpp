@@ -96,12 +96,14 @@ Viewcount:
              unit, bilinear heights, inside the field); q is visible when its slope from p is
              >= the slope of every sample between them (grazing samples are visible: on a flat
              plane every sample is), decided exactly. Count: the visible samples summed over
-             the K directions; an N x M flat plane gives N + M - 2 at K = 4. The tree method
-             gives a pixel the bilinear interpolation of the counts of the (up to) four sweep-
-             line samples around it (exact on the axis directions, where lines pass through
-             pixel centres); the naive method marches each pixel's own ray.
-  Area       each visible sample at ground distance rho stands for (2*pi/K) * rho * drho,
-             drho the ground step: ground units squared; it tends to the area seen as K grows.
+             the K directions, each counting its step times S; an N x M flat plane gives
+             N + M - 2 at K = 4. The tree method runs on lines through the pixel centres along
+             integer steps (a, b) close to d_k, each pixel the receiver of its own line, its
+             steps |(a, b)| / ceil(|(a, b)| S); the naive method marches each pixel's own ray.
+  Area       each visible sample at ground distance rho stands for its direction's share of
+             the circle (2*pi/K for the naive march, the quadrature weight of the tree's
+             step) times rho * drho, drho the ground step: ground units squared; it tends to
+             the area seen as K grows.
   The preview stretches the count from its minimum to its maximum.
 )";
 
@@ -130,7 +132,8 @@ Bounce:
   times the projected solid angle of its elevation band (from the visible segments: bands
   split at mean elevations between adjacent visible samples; across hidden samples the band
   goes to the farther sample), for a Lambertian receiver whose normal comes from the four
-  quads around it, each direction standing for an azimuthal wedge of 2*pi/K; surface behind
+  quads around it, each direction standing for its wedge of azimuth (the quadrature weight of
+  its lattice step times 2*pi, about 2*pi/K); surface behind
   the receiver's tangent plane adds nothing. The sum is the incident indirect irradiance, in
   radiance units times steradians (W/m^2 for W m^-2 sr^-1); a surface of albedo rho re-emits
   rho * E / pi, the next bounce's radiance. A flat plane receives 0. The preview stretches

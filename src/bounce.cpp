@@ -118,6 +118,8 @@ BounceResult computeBounce(const ComputeContext& context, const HeightField& fie
   validate(field);
   validate(options);
   validate(field, radiance);
+  // The radiance, irradiance and normal planes are indexed across one buffer each.
+  detail::checkPixelIndexing(field, std::max<int>(3, static_cast<int>(radiance.channels.size())));
   return detail::translateOpenClErrors([&] {
     detail::BounceRoutine routine(detail::stateOf(context), field, radiance, options);
     routine.run();

@@ -285,11 +285,7 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
                               const HorizonOptions& options, const HorizonOutputs& outputs) {
   validate(field);
   validate(options, outputs);
-  // The kernels index pixels with 32-bit signed arithmetic.
-  if (field.pixelCount() >= (std::size_t(1) << 31))
-    throw InvalidArgument("fields of 2^31 pixels or more are not supported yet (got " +
-                          std::to_string(field.width) + " x " + std::to_string(field.height) +
-                          "); split the field into tiles");
+  detail::checkPixelIndexing(field, 1);
   return detail::translateOpenClErrors([&] {
     detail::HorizonRoutine routine(detail::stateOf(context), field, options, outputs);
     routine.run();

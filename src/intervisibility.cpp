@@ -39,7 +39,8 @@ std::size_t treeEntryBytes(const TreeProgramFlags& f) {
 }
 
 std::size_t planTreeScratch(const std::vector<TreeDirection>& directions, std::size_t fixed_bytes,
-                            std::size_t entry_bytes, std::size_t budget_bytes, const DeviceInfo& device) {
+                            std::size_t entry_bytes, std::size_t budget_bytes, const DeviceInfo& device,
+                            bool line_major) {
   const std::size_t budget = budget_bytes ? budget_bytes : defaultMemoryBudget(device);
   const std::size_t max_alloc = device.max_allocation_bytes ? device.max_allocation_bytes : budget;
   std::size_t whole = 0, longest = 0;
@@ -49,6 +50,12 @@ std::size_t planTreeScratch(const std::vector<TreeDirection>& directions, std::s
       const std::size_t capacity = lineCapacity(line, d.samples.size());
       total += capacity;
       longest = std::max(longest, capacity);
+    }
+    // Step-major chunks pad every line to the chunk's longest (chunkLines).
+    if (!line_major) {
+      std::size_t direction_longest = 0;
+      for (const LatticeLine& line : d.lines) direction_longest = std::max(direction_longest, lineCapacity(line, d.samples.size()));
+      total = std::max(total, direction_longest * d.lines.size());
     }
     whole = std::max(whole, total);
   }
@@ -121,9 +128,13 @@ void TreeRoutine::allocateScratch(std::size_t fixed_bytes) {
   flags_.has_nodata = prepared_.has_nodata;
   directions_ = treeDirections(field_, options_);
   checkTreeLimits(directions_, prepared_.heights);
+  // The per-line totals of the statistics count beside the operation's own buffers.
+  std::size_t max_lines = 0;
+  for (const TreeDirection& d : directions_) max_lines = std::max(max_lines, d.lines.size());
+  if (flags_.stats) fixed_bytes += max_lines * kTreeLineTotals * sizeof(cl_ulong);
   allocateTreeScratch(st_, flags_, directions_,
                       planTreeScratch(directions_, fixed_bytes, treeEntryBytes(flags_), options_.memory_budget_bytes,
-                                      st_.info),
+                                      st_.info, lineMajorLayout(st_)),
                       buffers_);
   buffers_.heights = heights_;
 }
@@ -236,6 +247,15 @@ class NaiveCountRoutine : public SweepRoutine {
   void allocate() override {
     const std::size_t plane = field_.pixelCount();
     rays_ = runDirections(field_, visibility_);
+    // A ray has at most (W + H) S steps; the kernel's predicate takes steps as exact floats,
+    // and its distance sums (up to n^2 / 2 steps) are 32-bit to keep its loop vectorised.
+    const double longest = (double(field_.width) + field_.height) * visibility_.samples_per_unit + 2.0;
+    checkStepLimits(static_cast<std::size_t>(longest), prepared_.heights);
+    if (outputs_.visible_area && longest * longest / 2.0 >= 4294967295.0) {
+      throw InvalidArgument("the naive march's rays would have up to " + std::to_string(std::size_t(longest)) +
+                            " samples, too many for its visible area (at most 92681): lower the samples per "
+                            "unit or use the hull tree");
+    }
     count_sum_ = zeros(plane);
     area_sum_ = zeros(outputs_.visible_area ? plane : 0);
     result_ = allocateResult(field_, visibility_, outputs_);
@@ -365,6 +385,7 @@ IntervisibilityResult computeIntervisibility(const ComputeContext& context, cons
                                              const IntervisibilityOutputs& outputs) {
   validate(field);
   validate(options, outputs);
+  detail::checkPixelIndexing(field, 1);
   return detail::translateOpenClErrors([&] {
     detail::ContextState& st = detail::stateOf(context);
     if (options.method == IntervisibilityMethod::HullTree) {

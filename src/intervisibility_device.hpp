@@ -54,7 +54,8 @@ std::size_t treeEntryBytes(const TreeProgramFlags& flags);
 // budget allows, down to its longest line. Throws MemoryBudgetError when even that does not
 // fit beside `fixed_bytes`.
 std::size_t planTreeScratch(const std::vector<TreeDirection>& directions, std::size_t fixed_bytes,
-                            std::size_t entry_bytes, std::size_t budget_bytes, const DeviceInfo& device);
+                            std::size_t entry_bytes, std::size_t budget_bytes, const DeviceInfo& device,
+                            bool line_major);
 
 // Buffers of the scratch and line totals for `entries` entries (and the largest direction's
 // lines when statistics are asked for).

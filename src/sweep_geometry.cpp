@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <string>
 
 #include "hfvis/errors.hpp"
 
@@ -108,6 +109,15 @@ PreparedHeights prepareHeights(const HeightField& field) {
     }
   }
   return prepared;
+}
+
+void checkPixelIndexing(const HeightField& field, int planes) {
+  const std::size_t pixels = field.pixelCount();
+  if (pixels >= (std::size_t(1) << 31) || pixels * static_cast<std::size_t>(planes) >= (std::size_t(1) << 32)) {
+    throw InvalidArgument("fields of 2^31 pixels or more (or planes of them beyond 2^32 values) are not supported "
+                          "yet (got " + std::to_string(field.width) + " x " + std::to_string(field.height) +
+                          "); split the field into tiles");
+  }
 }
 
 }  // namespace hfvis::detail

@@ -36,8 +36,9 @@ struct SweepDirection {
 };
 static_assert(sizeof(SweepDirection) == 64, "SweepDirection must match the kernel struct");
 
-// The geometry of a sweep at ground azimuth `azimuth` (radians) over `field`, with one
-// line of margin on every side so that every receiver has its four surrounding entries.
+// The ray geometry at ground azimuth `azimuth` (radians) over `field` for the naive marches
+// (direction, step, ground length, cos/sin); the line fields are what a sweep with one line
+// per pixel length would have, which only the host's canonical line views use.
 SweepDirection makeSweepDirection(const HeightField& field, double azimuth, double samples_per_unit);
 
 // The sweep geometry of every direction of a run (buffer offsets left at 0).
@@ -63,6 +64,10 @@ struct PreparedHeights {
   bool has_nodata = false;
 };
 PreparedHeights prepareHeights(const HeightField& field);
+
+// The kernels index pixels with 32-bit arithmetic: signed within a plane, unsigned across the
+// `planes` planes of one buffer. Throws InvalidArgument for fields beyond that.
+void checkPixelIndexing(const HeightField& field, int planes);
 
 // Sample pitch at which positions count as inside; must equal HFVIS_EDGE_EPS.
 constexpr float kEdgeEpsilon = 1e-3f;

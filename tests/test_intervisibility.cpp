@@ -243,7 +243,11 @@ void expectTreeEqualsBruteForce(const HeightField& field, const detail::TreeDire
   const auto ref = referenceLines(field, prepared.heights, direction, tuning);
   const auto& d = ref.geometry;
   if (check_device) {
-    const auto dev = detail::intervisibilityLinesOnDevice(testContext(), field, prepared.heights, direction, tuning);
+    // Alternate the layouts from call to call: both are covered without doubling the time.
+    static int calls = 0;
+    const LineLayout layout = ++calls % 2 ? LineLayout::LineMajor : LineLayout::StepMajor;
+    const auto dev = detail::intervisibilityLinesOnDevice(testing::testContext(layout), field, prepared.heights,
+                                                          direction, tuning);
     ASSERT_TRUE(nearlyEqual(dev.samples, ref.samples, 0.0f)) << "sampled heights differ";
     ASSERT_TRUE(nearlyEqual(dev.counts, ref.counts, 0.0f)) << "visible counts: kernel vs reference";
     ASSERT_TRUE(nearlyEqual(dev.distance_sums, ref.distance_sums, 0.0f))
@@ -448,7 +452,7 @@ void expectStatisticsEqual(const IntervisibilityStatistics& a, const Intervisibi
   EXPECT_EQ(a.safe_zone_skips, b.safe_zone_skips);
 }
 
-// Counts are sums of (interpolated) integers; areas relative to their size.
+// Areas relative to their size.
 float areaTolerance(const std::vector<float>& area) {
   float largest = 0.0f;
   for (float a : area)
@@ -456,32 +460,40 @@ float areaTolerance(const std::vector<float>& area) {
   return 1e-5f * largest + 1e-6f;
 }
 
+// In both layouts; the tree with statistics (every sample reads its horizons) and without
+// (only receivers do: the production path).
 void expectKernelMatchesReference(IntervisibilityMethod method, double samples_per_unit,
                                   const HullTreeTuning& tuning = {}) {
-  for (const auto& name : syntheticFieldNames()) {
-    for (auto [w, h] : awkwardSizes()) {
-      SCOPED_TRACE(name + " " + std::to_string(w) + "x" + std::to_string(h));
-      HeightField field = makeSyntheticField(name, w, h, 3);
-      field.cell_size_x = 1.5;
-      IntervisibilityOptions options;
-      options.directions = 7;
-      options.azimuth_offset = 0.1;
-      options.method = method;
-      options.samples_per_unit = samples_per_unit;
-      options.tree = tuning;
-      auto outputs = allOutputs();
-      outputs.statistics = method == IntervisibilityMethod::HullTree;
-      const auto device = computeIntervisibility(testContext(), field, options, outputs);
-      const auto reference = referenceIntervisibility(field, options, outputs);
-      // The same float operations in the same order: equal bit for bit (NaN at nodata).
-      EXPECT_TRUE(nearlyEqual(device.visible_count, reference.visible_count, 0.0f));
-      EXPECT_TRUE(nearlyEqual(device.visible_area, reference.visible_area, 0.0f));
-      if (!tuning.safe_zone ||
-          testContext().device().correctly_rounded_divide)  // see expectTreeEqualsBruteForce
-        expectStatisticsEqual(device.statistics, reference.statistics);
-      EXPECT_EQ(device.statistics.lines_over_bound, 0u);
+  testing::forEachLayout([&](const ComputeContext& context) {
+    for (const auto& name : syntheticFieldNames()) {
+      for (auto [w, h] : awkwardSizes()) {
+        SCOPED_TRACE(name + " " + std::to_string(w) + "x" + std::to_string(h));
+        HeightField field = makeSyntheticField(name, w, h, 3);
+        field.cell_size_x = 1.5;
+        IntervisibilityOptions options;
+        options.directions = 7;
+        options.azimuth_offset = 0.1;
+        options.method = method;
+        options.samples_per_unit = samples_per_unit;
+        options.tree = tuning;
+        for (bool statistics : {true, false}) {
+          if (statistics && method != IntervisibilityMethod::HullTree) continue;
+          auto outputs = allOutputs();
+          outputs.statistics = statistics;
+          const auto device = computeIntervisibility(context, field, options, outputs);
+          const auto reference = referenceIntervisibility(field, options, outputs);
+          // The same float operations in the same order: equal bit for bit (NaN at nodata).
+          EXPECT_TRUE(nearlyEqual(device.visible_count, reference.visible_count, 0.0f)) << statistics;
+          EXPECT_TRUE(nearlyEqual(device.visible_area, reference.visible_area, 0.0f)) << statistics;
+          if (!statistics) continue;
+          if (!tuning.safe_zone ||
+              context.device().correctly_rounded_divide)  // see expectTreeEqualsBruteForce
+            expectStatisticsEqual(device.statistics, reference.statistics);
+          EXPECT_EQ(device.statistics.lines_over_bound, 0u);
+        }
+      }
     }
-  }
+  });
 }
 
 TEST(IntervisibilityKernels, TreeMatchesScalarReference) {
@@ -492,7 +504,7 @@ TEST(IntervisibilityKernels, TreeMatchesScalarReferenceWithDenserSampling) {
   expectKernelMatchesReference(IntervisibilityMethod::HullTree, 2.5);
 }
 
-// The whole operation (presampling, sweep, reduction, statistics) in the other tunings.
+// The whole operation (sampling, sweep, pixel sums, statistics) in the other tunings.
 TEST(IntervisibilityKernels, TreeMatchesScalarReferenceInEveryTuning) {
   for (const char* name : {"plain", "deferred", "zone"}) {
     SCOPED_TRACE(name);
@@ -505,7 +517,7 @@ TEST(IntervisibilityKernels, NaiveMatchesScalarReference) {
 }
 
 // On the four axis directions the lines pass through the pixel centres, so the tree and
-// the naive march see the very same samples: counts and areas must be identical.
+// the naive march see the very same samples: counts must be identical, areas equal to rounding.
 TEST(IntervisibilityKernels, TreeEqualsNaiveOnAxisDirections) {
   for (const auto& name : syntheticFieldNames()) {
     for (auto [w, h] : awkwardSizes()) {
@@ -643,10 +655,11 @@ TEST(IntervisibilityAnalytic, WallHidesWhatIsBehindIt) {
 
 TEST(IntervisibilityKernels, BatchingUnderATinyMemoryBudgetChangesNothing) {
   const HeightField field = makeSyntheticField("noise", 40, 41, 9);
+  testing::forEachLayout([&](const ComputeContext& context) {
   IntervisibilityOptions options;
   options.directions = 9;
   const auto outputs = allOutputs();
-  const auto whole = computeIntervisibility(testContext(), field, options, outputs);
+  const auto whole = computeIntervisibility(context, field, options, outputs);
   int reports = 0, last = 0;
   // The field's planes take 3 * 4 * 1640 bytes; the tree scratch (16 bytes per sample, at
   // least 1640 samples per direction) gets room for 700: every direction runs in chunks.
@@ -656,14 +669,15 @@ TEST(IntervisibilityKernels, BatchingUnderATinyMemoryBudgetChangesNothing) {
     last = done;
     EXPECT_EQ(all, 9);  // no two of the nine directions share a step here
   };
-  const auto batched = computeIntervisibility(testContext(), field, options, outputs);
+  const auto batched = computeIntervisibility(context, field, options, outputs);
   EXPECT_EQ(reports, 9);
   EXPECT_EQ(last, 9);
   EXPECT_TRUE(nearlyEqual(batched.visible_count, whole.visible_count, 0.0f));
   EXPECT_TRUE(nearlyEqual(batched.visible_area, whole.visible_area, 0.0f));
   expectStatisticsEqual(batched.statistics, whole.statistics);
   options.memory_budget_bytes = 1024;
-  EXPECT_THROW(computeIntervisibility(testContext(), field, options, outputs), MemoryBudgetError);
+  EXPECT_THROW(computeIntervisibility(context, field, options, outputs), MemoryBudgetError);
+  });
 }
 
 TEST(IntervisibilityKernels, NodataReceiversAreNaNAndNeverPoisonNeighbours) {
@@ -717,7 +731,14 @@ TEST(IntervisibilityKernels, InvalidOptionsAreRejectedBeforeLaunch) {
   options.samples_per_unit = 0.0;
   EXPECT_THROW(computeIntervisibility(testContext(), field, options, allOutputs()), InvalidArgument);
   options.samples_per_unit = 1.0;
-  options.method = IntervisibilityMethod::Naive;  // statistics exist only for the tree
+  options.method = IntervisibilityMethod::Naive;
+  const HeightField long_row = makeSyntheticField("flat", 1500, 1, 1);
+  IntervisibilityOptions dense = options;
+  dense.samples_per_unit = 64.0;  // 96064 samples a ray: distance sums past 32 bits
+  IntervisibilityOutputs area;
+  area.visible_area = true;
+  EXPECT_THROW(computeIntervisibility(testContext(), long_row, dense, area), InvalidArgument);
+  // statistics exist only for the tree
   EXPECT_THROW(computeIntervisibility(testContext(), field, options, allOutputs()), InvalidArgument);
   HeightField empty;
   EXPECT_THROW(computeIntervisibility(testContext(), empty, IntervisibilityOptions{}, allOutputs()),

@@ -4,8 +4,8 @@
 // the visible samples of each visibility horizon's segment).
 //
 // The formula. Receiver p has the unit normal n of the four quads around its pixel (in
-// ground units, as ambient occlusion uses). Direction k stands for the azimuthal wedge of
-// width D = 2*pi/K around phi_k. In the vertical plane of direction k, the visible samples x
+// ground units, as ambient occlusion uses). Direction k stands for an azimuthal wedge of
+// width D around it (about 2*pi/K; see below). In the vertical plane of direction k, the visible samples x
 // at ground distance r_x and height difference dz_x are seen at elevations
 // theta_x = atan2(dz_x, r_x), which never decrease outward (visibility, tie rule as in
 // hfvis/intervisibility.hpp). Together they cover the elevations from the nearest visible
@@ -32,7 +32,9 @@
 // Per-pixel values, as the visible counts: every pixel is the receiver of its own lattice
 // line in each direction (hfvis/intervisibility.hpp), gathering with its own normal over the
 // visible samples of its own ray, whose exit radiance is sampled bilinearly like their
-// heights. Direction k's wedge D is 2 pi / K. Nodata pixels receive NaN and emit nothing.
+// heights. Direction k's wedge D is 2 pi times the quadrature weight of its lattice step
+// (about 2 pi / K; the steps and weights of hfvis/intervisibility.hpp). Nodata pixels
+// receive NaN and emit nothing.
 #pragma once
 
 #include <string>

@@ -6,11 +6,9 @@
 // Which samples: the receiver's own ray, exactly the samples of the naive method: from the
 // pixel centre p, q_i = p + i * step * d_k for i = 1, 2, ... while inside the field
 // (bilinear heights, nodata samples absent), step = 1 / samples_per_unit pixel lengths along
-// d_k (directions as in hfvis/sweep_options.hpp). On the four axis directions this ray is
-// the receiver's own sweep line, so the lists describe exactly what the hull-tree sweep
-// counts there; off the axes the sweep's per-pixel count interpolates neighbouring lines,
-// while these lists stay on the receiver's own ray (and equal the naive method's visible
-// set sample for sample in every direction).
+// d_k (directions as in hfvis/sweep_options.hpp), at phi_k exactly. The lists equal the naive
+// method's visible set sample for sample in every direction; the hull-tree sweep's counts
+// come from each receiver's own lattice line, a step close to phi_k (hfvis/intervisibility.hpp).
 //
 // Visibility and tie rule as in hfvis/intervisibility.hpp (grazing samples are visible).
 // A visibility horizon is the farthest sample of maximal slope from the receiver among the

@@ -73,8 +73,9 @@ struct IntervisibilityOutputs {
   // interpolation between lines.
   bool visible_count = false;
   // Visible ground area, in ground units squared: each visible sample at ground distance
-  // rho stands for (2*pi/K) * rho * drho, drho the ground step along the direction (the
-  // ring sector it represents around the receiver).
+  // rho stands for D * rho * drho, drho the ground step along the direction and D its wedge
+  // of azimuth (2*pi/K for the naive march, 2*pi times the quadrature weight of the tree's
+  // step): the ring sector it represents around the receiver.
   bool visible_area = false;
   // Horizon and iteration totals of the hull tree (HullTree only).
   bool statistics = false;
