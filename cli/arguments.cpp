@@ -204,9 +204,8 @@ bool notFor(Option option, Command command) {
            option == Option::Preview || option == Option::Curvature || option == Option::Refraction;
   }
   if (option == Option::HullTree) return command != Command::ViewCount && command != Command::Bounce;
-  // Earth curvature: horizons, sky view and occlusion so far.
-  if (option == Option::Curvature || option == Option::Refraction)
-    return command == Command::ViewCount || command == Command::Bounce;
+  // Earth curvature: not for the bounce (a rendering operation) so far.
+  if (option == Option::Curvature || option == Option::Refraction) return command == Command::Bounce;
   return command == Command::Bounce && option == Option::Method;
 }
 

@@ -17,6 +17,7 @@
 //
 // Compile-time parameters, besides those of sweep_framework.cl:
 //   HFVIS_WANT_COUNT        add the visible counts to count_sum
+//   HFVIS_CURVATURE         lower every sample by the Earth's drop (README "Conventions")
 //   HFVIS_WANT_AREA         sum the distances of the visible samples (for the area estimate)
 //   HFVIS_WANT_STATS        per-line totals of receivers, horizons, iterations, ...
 //   HFVIS_WANT_ENTRY_STATS  per-entry (horizons, iterations, horizon hash) for the tests
@@ -39,6 +40,9 @@
 
 #ifndef HFVIS_WANT_COUNT
 #define HFVIS_WANT_COUNT 1
+#endif
+#ifndef HFVIS_CURVATURE
+#define HFVIS_CURVATURE 0
 #endif
 #ifndef HFVIS_WANT_AREA
 #define HFVIS_WANT_AREA 1
@@ -287,6 +291,7 @@ HFVIS_INLINE int safe_zone_inside(const SafeZone* z, int step, float h) {
 __kernel void intervisibility_lattice(
     __global const float* heights, int width, int height, __global const int4* lines, int n_lines,
     __global const LatticeSample* samples, int n_samples, int a, int b, float count_factor, float area_factor,
+    float drop,
     __global int4* trees, __global ulong* prefix, uint stride, __global float2* visible,
     __global uint4* entry_stats, __global ulong* line_totals, int first_line, __global float* count_sum,
     __global float* area_sum, __global const float* radiance, __global const float* normals,
@@ -330,6 +335,12 @@ __kernel void intervisibility_lattice(
         h = ex + ey == 0 ? heights[at]
                          : lattice_height(heights, at, (uint)ex, (uint)(ey * width), s->w00, s->w10, s->w01, s->w11);
       }
+#if HFVIS_CURVATURE
+      // The Earth's drop from any receiver p, drop (p - step)^2 (drop per step squared), differs
+      // from drop step^2 by a term linear in step: every slope seen from p shifts alike, so
+      // every visibility decision (and the tree) is that of the heights lowered by drop step^2.
+      h = h - drop * (float)step * (float)step;
+#endif
 #if HFVIS_HAS_NODATA && HFVIS_WANT_AREA  // step sums serve runs with holes only
       prefix[base + e] = step_sum;
 #endif
@@ -595,7 +606,7 @@ HFVIS_INLINE void accumulate_visible(uint pixel, int nodata, float count, float 
 // the field are masked. Global size: (W, H) rounded up to the local size.
 __kernel void intervisibility_naive(__global const float* heights, int width, int height,
                                     __global const SweepDirection* directions, int batch_size, float sector,
-                                    __global float* count_sum, __global float* area_sum) {
+                                    float curvature, __global float* count_sum, __global float* area_sum) {
   int c = get_global_id(0), r = get_global_id(1);
   int c_lo = get_group_id(0) * get_local_size(0), r_lo = get_group_id(1) * get_local_size(1);
   int c_hi = min(c_lo + (int)get_local_size(0), width) - 1;
@@ -615,6 +626,9 @@ __kernel void intervisibility_naive(__global const float* heights, int width, in
                     : d.dir_y < 0.0f ? (float)r_hi / -d.dir_y
                                      : far;
     int steps = (int)(fmin(fmin(reach_x, reach_y), far) * d.samples_per_unit) + 1;
+    // The Earth's drop per step squared (0 without curvature).
+    const float step_ground = d.step_length * d.ground_per_pixel;
+    const float drop = curvature * step_ground * step_ground;
     float best_h = 0.0f;  // the steepest sample so far (the latest visible one)
     int best_step = 0;    // its step, 0 = none yet
     int count = 0, undecided = 0;
@@ -628,6 +642,9 @@ __kernel void intervisibility_naive(__global const float* heights, int width, in
       float t = (float)i * d.step_length;
       float px = (float)cc + t * d.dir_x, py = (float)rr + t * d.dir_y;
       float q = sample_height(heights, width, height, px, py);
+#if HFVIS_CURVATURE
+      q = q - drop * (float)i * (float)i;
+#endif
       int present = inside_field(px, py, width, height) && !isnan(q);
       int side;
       // best_step = 0 (none yet) would make the chord degenerate; its answer is ignored.
@@ -647,6 +664,9 @@ __kernel void intervisibility_naive(__global const float* heights, int width, in
         float t = (float)i * d.step_length;
         float px = (float)cc + t * d.dir_x, py = (float)rr + t * d.dir_y;
         float q = sample_height(heights, width, height, px, py);
+#if HFVIS_CURVATURE
+        q = q - drop * (float)i * (float)i;
+#endif
         if (!inside_field(px, py, width, height) || isnan(q)) continue;
         if (best_step > 0 && chord_side(q, best_h, h, (float)(i - best_step), (float)best_step) > 0) continue;
         ++count;

@@ -26,6 +26,7 @@ std::string treeProgramOptions(const TreeProgramFlags& f) {
   s << "-DHFVIS_HAS_NODATA=" << f.has_nodata << " -DHFVIS_WANT_COUNT=" << f.count
     << " -DHFVIS_WANT_AREA=" << f.area
     << " -DHFVIS_WANT_STATS=" << f.stats << " -DHFVIS_WANT_ENTRY_STATS=" << f.entry_stats;
+  s << " -DHFVIS_CURVATURE=" << f.curvature;
   s << " -DHFVIS_DEFERRED_WRITES=" << f.tuning.deferred_writes
     << " -DHFVIS_REPLACEMENT_CHECK=" << f.tuning.replacement_check
     << " -DHFVIS_SAFE_ZONE=" << f.tuning.safe_zone << " -DHFVIS_SAFE_ZONE_STEPS=" << f.tuning.safe_zone_steps;
@@ -98,6 +99,7 @@ void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDire
   kernel.setArg(arg++, d.lattice.b);
   kernel.setArg(arg++, d.count_factor);
   kernel.setArg(arg++, d.area_factor);
+  kernel.setArg(arg++, d.drop);
   kernel.setArg(arg++, b.trees);
   kernel.setArg(arg++, b.prefix);
   chunk.stride = arg++;
@@ -191,6 +193,7 @@ class CountRoutine : public TreeRoutine {
     flags.area = outputs.visible_area;
     flags.stats = outputs.statistics;
     flags.tuning = options.tree;
+    flags.curvature = options.curvature != 0.0;
     return flags;
   }
 
@@ -241,6 +244,7 @@ class NaiveCountRoutine : public SweepRoutine {
     flags.has_nodata = prepared_.has_nodata;
     flags.area = outputs_.visible_area;
     flags.stats = false;
+    flags.curvature = visibility_.curvature != 0.0;
     return treeProgramOptions(flags);
   }
 
@@ -276,6 +280,7 @@ class NaiveCountRoutine : public SweepRoutine {
     naive.setArg(arg++, directions);
     naive.setArg(arg++, count);
     naive.setArg(arg++, intervisibilitySector(visibility_));
+    naive.setArg(arg++, static_cast<float>(visibility_.curvature));
     naive.setArg(arg++, count_sum_);
     naive.setArg(arg++, area_sum_);
     st_.launch(naive, cl::NDRange(roundUp(field_.width, kTileX), roundUp(field_.height, kTileY)),

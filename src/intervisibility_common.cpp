@@ -40,7 +40,6 @@ void validate(const HullTreeTuning& tuning) {
 void validate(const IntervisibilityOptions& options, const IntervisibilityOutputs& outputs) {
   validate(static_cast<const SweepOptions&>(options));
   validate(options.tree);
-  if (options.curvature != 0.0) throw InvalidArgument("Earth curvature is not supported for intervisibility yet");
   if (!outputs.visible_count && !outputs.visible_area && !outputs.statistics) {
     throw InvalidArgument("no output requested");
   }
@@ -62,7 +61,7 @@ std::size_t TreeDirection::longestLine() const {
 }
 
 TreeDirection makeTreeDirection(const HeightField& field, const LatticeDirection& lattice, double samples_per_unit,
-                                int directions) {
+                                int directions, double curvature) {
   TreeDirection d;
   d.lattice = lattice;
   d.per_period = samplesPerPeriod(lattice, samples_per_unit);
@@ -73,6 +72,7 @@ TreeDirection makeTreeDirection(const HeightField& field, const LatticeDirection
   d.step_ground = static_cast<float>(ground);
   d.count_factor = static_cast<float>(directions * lattice.weight * step * samples_per_unit);
   d.area_factor = static_cast<float>(2.0 * M_PI * lattice.weight * ground * ground);
+  d.drop = static_cast<float>(curvature * ground * ground);
   d.half_sector = static_cast<float>(M_PI * lattice.weight);
   d.wedge = static_cast<float>(2.0 * std::sin(M_PI * lattice.weight));
   d.cos_azimuth = static_cast<float>(std::cos(lattice.azimuth));
@@ -84,7 +84,7 @@ std::vector<TreeDirection> treeDirections(const HeightField& field, const SweepO
   std::vector<TreeDirection> out;
   for (const LatticeDirection& lattice : latticeDirections(field, options, false, 0.0)) {
     if (lattice.weight == 0.0) continue;  // merged into an equal step
-    out.push_back(makeTreeDirection(field, lattice, options.samples_per_unit, options.directions));
+    out.push_back(makeTreeDirection(field, lattice, options.samples_per_unit, options.directions, options.curvature));
   }
   return out;
 }

@@ -25,6 +25,7 @@ constexpr std::size_t kTreeLineTotals = 8;  // ulongs per line (HFVIS_LINE_TOTAL
 // What the program computes besides the sweep itself (the HFVIS_WANT_* of the kernels).
 struct TreeProgramFlags {
   bool has_nodata = true;
+  bool curvature = false;  // HFVIS_CURVATURE
   bool count = true;
   bool area = true;
   bool stats = true;

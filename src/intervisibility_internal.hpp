@@ -33,6 +33,8 @@ struct TreeDirection {
   // area_sum += area_factor * (sum of the visible samples' steps from the receiver):
   // 2 pi weight * step_ground^2, the ring sectors the samples stand for.
   float area_factor = 0.0f;
+  // The Earth's drop per step squared, c step_ground^2 (SweepOptions::curvature).
+  float drop = 0.0f;
   float half_sector = 0.0f, wedge = 0.0f;  // the bounce's pi weight and 2 sin(pi weight)
   float cos_azimuth = 1.0f, sin_azimuth = 0.0f;
   std::size_t longestLine() const;  // entries (steps) of its longest line
@@ -51,7 +53,7 @@ struct TreeDirection {
 std::vector<TreeDirection> treeDirections(const HeightField& field, const SweepOptions& options);
 // One of them: `lattice` (its weight set) sampled at S samples per unit, in a run of K directions.
 TreeDirection makeTreeDirection(const HeightField& field, const LatticeDirection& lattice, double samples_per_unit,
-                                int directions);
+                                int directions, double curvature = 0.0);
 
 // Limits of the kernels' exact arithmetic, checked before launching: a line has fewer than
 // 2^24 steps (steps are exact floats in the predicate), and |height| * steps stays far

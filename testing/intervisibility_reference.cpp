@@ -46,6 +46,14 @@ void sweepReference(const HeightField& field, const std::vector<float>& h,
   auto& stats = result.statistics;
   for (const TreeDirection& d : treeDirections(field, options)) {
     IntervisibilityLines lines = latticeTreeLines(field, h, d);
+    // The kernel's curvature transform: every sample lowered by drop * step^2.
+    if (options.curvature != 0.0) {
+      for (int i = 0; i < lines.geometry.n_steps; ++i)
+        for (int j = 0; j < lines.geometry.n_lines; ++j) {
+          float& s = lines.samples[static_cast<std::size_t>(i) * lines.geometry.n_lines + j];
+          s = s - d.drop * static_cast<float>(i) * static_cast<float>(i);
+        }
+    }
     lines.horizons_at_every_sample = statistics;  // as the kernel without statistics
     sweepPresampledLines(lines, options.tree, false);
     const auto& g = lines.geometry;
@@ -91,6 +99,8 @@ void naiveReference(const HeightField& field, const std::vector<float>& h,
       const std::size_t pixel = static_cast<std::size_t>(r) * width + c;
       const float hp = h[pixel];
       for (const SweepDirection& d : directions) {
+        const float step_ground = d.step_length * d.ground_per_pixel;
+        const float drop = static_cast<float>(options.curvature) * step_ground * step_ground;
         float best_h = 0.0f;
         int best_step = 0, count = 0;
         std::uint32_t distance_sum = 0;
@@ -100,7 +110,8 @@ void naiveReference(const HeightField& field, const std::vector<float>& h,
           const float t = static_cast<float>(i) * d.step_length;
           const Point2 p{static_cast<float>(c) + t * d.dir_x, static_cast<float>(r) + t * d.dir_y};
           if (!insideField(p, width, height)) break;
-          const float q = sampleHeight(h, width, height, p);
+          const float q = sampleHeight(h, width, height, p) -
+                          (options.curvature != 0.0 ? drop * static_cast<float>(i) * static_cast<float>(i) : 0.0f);
           const bool seen =
               !std::isnan(q) && (best_step == 0 || chordSide(q, best_h, hp, static_cast<float>(i - best_step),
                                                              static_cast<float>(best_step)) <= 0);

@@ -81,12 +81,6 @@ TEST(BadInput, Options) {
     options.curvature = c;
     expectError<InvalidArgument>([&] { horizons(field, options); }, "curvature coefficient");
   }
-  IntervisibilityOptions curved;
-  curved.curvature = earthCurvature();
-  IntervisibilityOutputs counts;
-  counts.visible_count = true;
-  expectError<InvalidArgument>([&] { computeIntervisibility(testContext(), field, curved, counts); },
-                               "curvature is not supported");
   BounceOptions curved_bounce;
   curved_bounce.curvature = earthCurvature();
   ExitRadiance lit;

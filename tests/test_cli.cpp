@@ -655,7 +655,7 @@ TEST_F(Cli, DenserSamplesNeverLowerAHorizon) {
 // --curvature lowers far points by the Earth's drop: a wall 30 units high 500 m of ground
 // away appears lower than without it (by atan(drop / d), drop = d^2 (1 - 1/7) / (2 R));
 // --refraction 1 bends rays along the Earth, no drop at all; the options are refused where
-// they are not implemented and out of range.
+// they are not implemented (the bounce) and out of range.
 TEST_F(Cli, CurvatureLowersFarTerrainByTheEarthsDrop) {
   const std::string wall = writeField("wall.exr", 40, 5, [](int x, int) { return x >= 30 ? 30.0f : 0.0f; });
   auto angle = [&](const std::string& options) {
@@ -672,8 +672,9 @@ TEST_F(Cli, CurvatureLowersFarTerrainByTheEarthsDrop) {
   EXPECT_NEAR(angle("--curvature"), std::atan((30.0 - drop) / d), 1e-6);
   EXPECT_NEAR(angle("--refraction 1"), std::atan(30.0 / d), 1e-6);
   fs::remove(out("h.exr"));
-  expectFailure(run("viewcount " + shellQuoted(wall) + " -o " + shellQuoted(out("v.exr")) + " --curvature"), 2,
-                "--curvature");
+  expectFailure(run("bounce " + shellQuoted(wall) + " --radiance " + shellQuoted(wall) + " -o " +
+                    shellQuoted(out("b.exr")) + " --curvature"),
+                2, "--curvature");
   expectFailure(run("svf " + shellQuoted(wall) + " -o " + shellQuoted(out("s.exr")) + " --refraction 2"), 2,
                 "--refraction");
 }

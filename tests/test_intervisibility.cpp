@@ -463,7 +463,7 @@ float areaTolerance(const std::vector<float>& area) {
 // In both layouts; the tree with statistics (every sample reads its horizons) and without
 // (only receivers do: the production path).
 void expectKernelMatchesReference(IntervisibilityMethod method, double samples_per_unit,
-                                  const HullTreeTuning& tuning = {}) {
+                                  const HullTreeTuning& tuning = {}, double curvature = 0.0) {
   testing::forEachLayout([&](const ComputeContext& context) {
     for (const auto& name : syntheticFieldNames()) {
       for (auto [w, h] : awkwardSizes()) {
@@ -476,6 +476,7 @@ void expectKernelMatchesReference(IntervisibilityMethod method, double samples_p
         options.method = method;
         options.samples_per_unit = samples_per_unit;
         options.tree = tuning;
+        options.curvature = curvature;
         for (bool statistics : {true, false}) {
           if (statistics && method != IntervisibilityMethod::HullTree) continue;
           auto outputs = allOutputs();
@@ -509,6 +510,34 @@ TEST(IntervisibilityKernels, TreeMatchesScalarReferenceInEveryTuning) {
   for (const char* name : {"plain", "deferred", "zone"}) {
     SCOPED_TRACE(name);
     expectKernelMatchesReference(IntervisibilityMethod::HullTree, 1.0, *hullTreeTuningNamed(name));
+  }
+}
+
+// Earth curvature, large enough to matter on these small fields.
+TEST(IntervisibilityKernels, TreeMatchesScalarReferenceWithCurvature) {
+  expectKernelMatchesReference(IntervisibilityMethod::HullTree, 1.0, {}, 0.004);
+}
+
+TEST(IntervisibilityKernels, NaiveMatchesScalarReferenceWithCurvature) {
+  expectKernelMatchesReference(IntervisibilityMethod::Naive, 1.0, {}, 0.004);
+}
+
+// Flat ground over a curved Earth falls away from every receiver: along each direction only
+// its nearest sample is seen (each farther one lies below the line of sight over it). At
+// K = 4 (steps of one pixel) an interior pixel sees 4 samples, with both methods.
+TEST(IntervisibilityAnalytic, FlatGroundOverACurvedEarthShowsOnlyTheNearestSamples) {
+  const HeightField field = makeSyntheticField("flat", 21, 15);
+  for (auto method : {IntervisibilityMethod::HullTree, IntervisibilityMethod::Naive}) {
+    IntervisibilityOptions options;
+    options.directions = 4;
+    options.method = method;
+    options.curvature = 0.001;
+    IntervisibilityOutputs outputs;
+    outputs.visible_count = true;
+    const auto r = computeIntervisibility(testContext(), field, options, outputs);
+    for (int row = 1; row < field.height - 1; ++row)
+      for (int c = 1; c < field.width - 1; ++c)
+        ASSERT_EQ(r.visible_count[row * field.width + c], 4.0f) << c << "," << row;
   }
 }
 
