@@ -201,7 +201,7 @@ const char* onlyFor(Option option) {
 bool notFor(Option option, Command command) {
   if (command == Command::HorizonLists) {
     return option == Option::Method || option == Option::Device || option == Option::MemoryBudget ||
-           option == Option::Preview || option == Option::Curvature || option == Option::Refraction;
+           option == Option::Preview;
   }
   if (option == Option::HullTree) return command != Command::ViewCount && command != Command::Bounce;
   // Earth curvature: not for the bounce (a rendering operation) so far.

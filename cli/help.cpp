@@ -43,7 +43,7 @@ Options:
   --method tree|naive      viewcount: tree = convex hull tree sweep (Timonen 2013); naive =
                            per-pixel visibility march, slow reference (default tree)
   --azimuth-offset DEG     added to every direction's azimuth, degrees (default 0)
-  --curvature              horizon, svf, ao, viewcount: lower every point at ground distance d by
+  --curvature              all but bounce: lower every point at ground distance d by
                            the Earth's drop d^2 (1 - K) / (2 R), R = 6370997 m, K = 1/7 (GRASS and
                            GDAL's convention; cell sizes must be in metres)
   --refraction K           the same with refraction coefficient K in -1 .. 1 (implies --curvature)

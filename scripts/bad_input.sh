@@ -107,7 +107,7 @@ try "samples per unit NaN" "" -- svf field.exr -o out/o.exr --samples-per-unit n
 try "samples per unit infinite" "" -- svf field.exr -o out/o.exr --samples-per-unit inf
 try "lines per unit (removed: every sweep runs one line through each pixel centre)" "" -- viewcount field.exr -o out/o.exr --lines-per-unit 2
 try "refraction out of range" "" -- svf field.exr -o out/o.exr --refraction 2
-try "curvature for horizon lists (not supported yet)" "" -- horizons field.exr -o out/h.json --at 1,1 --curvature
+try "curvature for the bounce (not supported)" "" -- bounce field.exr --radiance field.exr -o out/b.exr --curvature
 try "cell size zero" "" -- svf field.exr -o out/o.exr --cell-size 0
 try "cell size negative" "" -- svf field.exr -o out/o.exr --cell-size 1,-2
 try "cell size not a number" "" -- svf field.exr -o out/o.exr --cell-size 1,abc

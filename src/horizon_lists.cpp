@@ -16,26 +16,32 @@ namespace hfvis {
 namespace {
 
 // The heights of the ray from pixel (c, r) along d: sample i (1 = nearest) at index i - 1,
-// NaN where absent, up to the last sample inside the field (as the naive march).
+// NaN where absent, up to the last sample inside the field (as the naive march), each lowered
+// by the Earth's drop at its distance (as intervisibility_naive: c times its step's ground
+// length squared, times i^2, in float).
 std::vector<float> raySamples(const HeightField& field, const std::vector<float>& heights,
-                              const detail::SweepDirection& d, int c, int r) {
+                              const detail::SweepDirection& d, int c, int r, double curvature) {
+  const float step_ground = d.step_length * d.ground_per_pixel;
+  const float drop = static_cast<float>(curvature) * step_ground * step_ground;
   std::vector<float> ray;
   for (int i = 1;; ++i) {
     const float t = static_cast<float>(i) * d.step_length;
     const detail::Point2 p{static_cast<float>(c) + t * d.dir_x, static_cast<float>(r) + t * d.dir_y};
     if (!detail::insideField(p, field.width, field.height)) break;
-    ray.push_back(detail::sampleHeight(heights, field.width, field.height, p));
+    const float q = detail::sampleHeight(heights, field.width, field.height, p);
+    ray.push_back(curvature != 0.0 ? q - drop * static_cast<float>(i) * static_cast<float>(i) : q);
   }
   return ray;
 }
 
 DirectionHorizons listDirection(const HeightField& field, const std::vector<float>& heights,
-                                const detail::SweepDirection& d, int k, double azimuth, int c, int r) {
+                                const detail::SweepDirection& d, int k, double azimuth, int c, int r,
+                                double curvature) {
   DirectionHorizons out;
   out.direction = k;
   out.azimuth = azimuth;
   out.sample_spacing = static_cast<double>(d.step_length) * d.ground_per_pixel;
-  const std::vector<float> ray = raySamples(field, heights, d, c, r);
+  const std::vector<float> ray = raySamples(field, heights, d, c, r, curvature);
   const int n = static_cast<int>(ray.size());
   out.ray_samples = n;
   const float h = heights[static_cast<std::size_t>(r) * field.width + c];
@@ -94,7 +100,6 @@ std::vector<ReceiverHorizons> computeHorizonLists(const HeightField& field, cons
                                                   const std::vector<ReceiverPixel>& receivers) {
   validate(field);
   validate(options);
-  if (options.curvature != 0.0) throw InvalidArgument("Earth curvature is not supported for horizon lists yet");
   validateReceivers(field, receivers);
   const detail::PreparedHeights prepared = detail::prepareHeights(field);
   const auto directions = detail::runDirections(field, options);
@@ -112,7 +117,7 @@ std::vector<ReceiverHorizons> computeHorizonLists(const HeightField& field, cons
     if (receiver.nodata) receiver.height = std::numeric_limits<float>::quiet_NaN();
     for (int k = 0; k < options.directions; ++k) {
       receiver.directions.push_back(listDirection(field, prepared.heights, directions[k], k,
-                                                  directionAzimuth(k, options), p.col, p.row));
+                                                  directionAzimuth(k, options), p.col, p.row, options.curvature));
     }
     lists.push_back(std::move(receiver));
   }

@@ -89,10 +89,6 @@ TEST(BadInput, Options) {
   lit.channels = {std::vector<float>(field.pixelCount(), 1.0f)};
   expectError<InvalidArgument>([&] { computeBounce(testContext(), field, lit, curved_bounce); },
                                "curvature is not supported");
-  SweepOptions curved_lists;
-  curved_lists.curvature = earthCurvature();
-  expectError<InvalidArgument>([&] { computeHorizonLists(field, curved_lists, {{1, 1}}); },
-                               "curvature is not supported");
   expectError<InvalidArgument>([&] { horizons(field, {}, HorizonOutputs{}); }, "output");
   HorizonOptions budget;
   budget.memory_budget_bytes = 16;

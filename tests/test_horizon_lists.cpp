@@ -185,12 +185,15 @@ TEST(HorizonLists, EqualBruteForceOnEveryHardCase) {
 
 // Every direction: the lists' visible samples equal the naive visibility kernel's count
 // for that direction alone (a run of K = 1 at that azimuth marches the same ray); on the
-// axis directions also the tree sweep's per-pixel count (lines through pixel centres).
-TEST(HorizonLists, AgreeWithTheNaiveKernelAndTheTreeOnTheAxes) {
+// axis directions also the tree sweep's per-pixel count (lines through pixel centres). Flat
+// and over a curved Earth (a drop of several height units across the field).
+void expectListsAgreeWithTheKernels(double curvature) {
+  SCOPED_TRACE("curvature " + std::to_string(curvature));
   const HeightField field = makeSyntheticField("noise", 33, 20, 8);
   SweepOptions options;
   options.directions = 8;
   options.azimuth_offset = 0.0;
+  options.curvature = curvature;
   std::vector<ReceiverPixel> receivers;
   for (int r = 0; r < field.height; r += 3)
     for (int c = 0; c < field.width; c += 4) receivers.push_back({c, r});
@@ -203,6 +206,7 @@ TEST(HorizonLists, AgreeWithTheNaiveKernelAndTheTreeOnTheAxes) {
     one.directions = 1;
     one.azimuth_offset = directionAzimuth(k, options);
     one.method = IntervisibilityMethod::Naive;
+    one.curvature = curvature;
     const auto naive = computeIntervisibility(testContext(), field, one, counts);
     for (std::size_t n = 0; n < receivers.size(); ++n) {
       const std::size_t p = std::size_t(receivers[n].row) * field.width + receivers[n].col;
@@ -212,12 +216,18 @@ TEST(HorizonLists, AgreeWithTheNaiveKernelAndTheTreeOnTheAxes) {
   }
   IntervisibilityOptions axes;
   axes.directions = 4;
+  axes.curvature = curvature;
   const auto tree = computeIntervisibility(testContext(), field, axes, counts);
   for (std::size_t n = 0; n < receivers.size(); ++n) {
     int sum = 0;
     for (int k = 0; k < 8; k += 2) sum += lists[n].directions[k].visible_samples;  // 0, 90, 180, 270 deg
     EXPECT_EQ(float(sum), tree.visible_count[std::size_t(receivers[n].row) * field.width + receivers[n].col]);
   }
+}
+
+TEST(HorizonLists, AgreeWithTheNaiveKernelAndTheTreeOnTheAxes) {
+  expectListsAgreeWithTheKernels(0.0);
+  expectListsAgreeWithTheKernels(0.004);
 }
 
 // The farthest horizon is the horizon of README's conventions (the largest elevation, the farther on

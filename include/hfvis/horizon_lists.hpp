@@ -65,7 +65,8 @@ struct ReceiverHorizons {
 // Throws InvalidArgument naming the first receiver outside the field.
 void validateReceivers(const HeightField& field, const std::vector<ReceiverPixel>& receivers);
 
-// The lists for every receiver, in the order given. options.memory_budget_bytes and
+// The lists for every receiver, in the order given (options.curvature lowers each sample by
+// its drop, as the naive march does). options.memory_budget_bytes and
 // progress are not used (one ray per receiver and direction).
 // Throws InvalidArgument for a bad field, bad options or a receiver outside the field.
 std::vector<ReceiverHorizons> computeHorizonLists(const HeightField& field, const SweepOptions& options,

@@ -33,8 +33,7 @@ struct SweepOptions {
   double samples_per_unit = 1.0;        // height samples per pixel length along a line or ray, (0, 64]
   // Drop coefficient c: a point at ground distance d from the receiver counts c d^2 lower
   // (earthCurvature() for the Earth with refraction, ground units metres); 0 = flat.
-  // Horizons, sky-view factor, ambient occlusion and intervisibility take it; the bounce and
-  // the horizon lists refuse it.
+  // Every operation takes it but the bounce, which refuses it.
   double curvature = 0.0;
   std::size_t memory_budget_bytes = 0;  // device memory for one batch; 0 = from the device
   // Called after each batch of directions with (directions done, directions in all).
