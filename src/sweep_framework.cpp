@@ -27,9 +27,7 @@ bool lineMajorLayout(const ContextState& st) {
 }
 
 
-std::size_t defaultMemoryBudget(const DeviceInfo& device) {
-  return std::min<std::size_t>(std::size_t(1) << 30, device.global_memory_bytes / 2);
-}
+std::size_t defaultMemoryBudget(const DeviceInfo& device) { return device.global_memory_bytes / 2; }
 
 cl::Buffer deviceBuffer(ContextState& st, std::size_t bytes) {
   return cl::Buffer(st.context, CL_MEM_READ_WRITE, std::max<std::size_t>(bytes, sizeof(float)));
