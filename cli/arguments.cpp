@@ -38,6 +38,7 @@ enum class Option {
   Quiet,
   Curvature,
   Refraction,
+  MaxDistance,
 };
 
 struct OptionSpec {
@@ -68,6 +69,7 @@ constexpr OptionSpec kOptions[] = {
     {Option::Quiet, "--quiet", "-q", false},
     {Option::Curvature, "--curvature", nullptr, false},
     {Option::Refraction, "--refraction", nullptr, true},
+    {Option::MaxDistance, "--max-distance", nullptr, true},
 };
 
 // The options every sweep operation shares, as typed (degrees become radians).
@@ -78,6 +80,7 @@ void setSweepOptions(const RunArguments& run, Options& options) {
   options.samples_per_unit = run.samples_per_unit;
   options.memory_budget_bytes = run.memory_budget_bytes;
   options.curvature = run.curvature ? earthCurvature(run.refraction) : 0.0;
+  options.max_distance = run.max_distance;
 }
 
 bool isHelpFlag(const std::string& arg) { return arg == "-h" || arg == "--help"; }
@@ -186,6 +189,7 @@ const char* onlyFor(Option option) {
     case Option::AzimuthTolerance:
       return "horizon";
     case Option::Statistics:
+    case Option::MaxDistance:
       return "viewcount";
     case Option::At:
       return "horizons";
@@ -326,6 +330,9 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
       if (!(run.refraction >= -1.0 && run.refraction <= 1.0))
         throw UsageError(typed + ": the refraction coefficient must be in -1 .. 1, got " + inQuotes(value));
       run.curvature = true;  // refraction bends rays over the curved Earth
+      break;
+    case Option::MaxDistance:
+      run.max_distance = parsePositive(typed, value);
       break;
   }
 }

@@ -64,6 +64,7 @@ struct RunArguments {
   bool quiet = false;
   bool curvature = false;                    // --curvature (or --refraction): the Earth's drop
   double refraction = kDefaultRefraction;  // --refraction K
+  double max_distance = 0.0;                 // viewcount --max-distance D (ground units); 0 = none
 };
 
 struct CommandLine {

@@ -269,6 +269,7 @@ Attributes runAttributes(Command command, const RunArguments& run, const HeightF
       {"hfvis:device", device.name + " (" + device.platform + ")"},
   };
   if (!run.channel.empty()) attributes.emplace_back("hfvis:channel", run.channel);
+  if (run.max_distance > 0.0) attributes.emplace_back("hfvis:max_distance", formatNumber(run.max_distance));
   if (run.curvature) {
     attributes.emplace_back("hfvis:curvature", "drop = d^2 (1 - K) / (2 R), R = " + formatNumber(kEarthRadius) +
                                                    " m, K = " + formatNumber(run.refraction) +

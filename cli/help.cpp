@@ -80,6 +80,8 @@ Horizon only:
 
 const char* const kViewCount = R"(
 Viewcount:
+  --max-distance D         count only the samples within D ground units of each receiver
+                           (farther terrain neither counts nor hides anything nearer)
   --stats                  also print, for the tree method, the statistics of Timonen (2013)'s
                            Table 2 per point and direction: m_a (visibility horizons), t_a
                            (convexity checks made), visible samples and naive iterations (the

@@ -276,7 +276,7 @@ HFVIS_INLINE int safe_zone_inside(const SafeZone* z, int step, float h) {
 //             horizon hash, walk skipped), if ENTRY_STATS.
 // Outputs, added at each receiver's pixel (one launch per direction, and each pixel is a
 // receiver of one line of it, so no atomics; NaN at nodata receivers):
-//   count_sum[]   count_factor * visible samples,
+//   count_sum[]   count_factor * visible samples (within max_steps of the receiver),
 //   area_sum[]    area_factor * their distance sum in steps, if AREA,
 //   irradiance[]  the gathered irradiance, HFVIS_CHANNELS planes, if BOUNCE (reading
 //                 `radiance`, HFVIS_CHANNELS planes, and `normals`, three planes x, y, z),
@@ -291,7 +291,7 @@ HFVIS_INLINE int safe_zone_inside(const SafeZone* z, int step, float h) {
 __kernel void intervisibility_lattice(
     __global const float* heights, int width, int height, __global const int4* lines, int n_lines,
     __global const LatticeSample* samples, int n_samples, int a, int b, float count_factor, float area_factor,
-    float drop,
+    float drop, int max_steps,
     __global int4* trees, __global ulong* prefix, uint stride, __global float2* visible,
     __global uint4* entry_stats, __global ulong* line_totals, int first_line, __global float* count_sum,
     __global float* area_sum, __global const float* radiance, __global const float* normals,
@@ -345,7 +345,7 @@ __kernel void intervisibility_lattice(
       prefix[base + e] = step_sum;
 #endif
       if (isnan(h)) {
-        tree[e] = (int4)(as_int(NAN), 0, HFVIS_NONE, HFVIS_NONE);
+        tree[e] = (int4)(as_int(NAN), rank * 2, HFVIS_NONE, HFVIS_NONE);  // its rank, for clipped runs
 #if HFVIS_WANT_ENTRY_STATS
         visible[base + e] = (float2)(NAN, NAN);
         entry_stats[base + e] = (uint4)(0u, 0u, 0u, 0u);
@@ -502,16 +502,21 @@ __kernel void intervisibility_lattice(
             }
             gather.adjacent = end == np;
 #endif
-            const int run = end_rank - hp_rank;
+            // Within the maximum distance only the run's samples from `first` on count (terrain
+            // farther away neither counts nor hides anything nearer). Every slot holds its rank.
+            const int first = max(hp, step - max_steps);
+            const int first_rank = first == hp ? hp_rank : holes ? tree[(uint)first * stride].y >> 1 : hp_rank + (first - hp);
+            const int run = first < end ? end_rank - first_rank : 0;
             count += run;
 #if HFVIS_WANT_AREA
-            // Sum of (step - x) over the run's present samples x.
-            ulong steps_sum;
-            if (!holes) {  // x = hp .. end - 1
-              steps_sum = (ulong)run * (ulong)(hp + end - 1) / 2;
+            // Sum of (step - x) over the counted present samples x.
+            ulong steps_sum = 0;
+            if (run == 0) {
+            } else if (!holes) {  // x = first .. end - 1
+              steps_sum = (ulong)run * (ulong)(first + end - 1) / 2;
             } else {
               const ulong end_sum = end == step ? step_sum : prefix[base + (uint)end * stride];
-              steps_sum = end_sum - prefix[base + (uint)hp * stride];
+              steps_sum = end_sum - prefix[base + (uint)first * stride];
             }
             distance_sum += (ulong)step * (ulong)run - steps_sum;
 #endif
@@ -606,7 +611,8 @@ HFVIS_INLINE void accumulate_visible(uint pixel, int nodata, float count, float 
 // the field are masked. Global size: (W, H) rounded up to the local size.
 __kernel void intervisibility_naive(__global const float* heights, int width, int height,
                                     __global const SweepDirection* directions, int batch_size, float sector,
-                                    float curvature, __global float* count_sum, __global float* area_sum) {
+                                    float curvature, __global const int* max_steps, __global float* count_sum,
+                                    __global float* area_sum) {
   int c = get_global_id(0), r = get_global_id(1);
   int c_lo = get_group_id(0) * get_local_size(0), r_lo = get_group_id(1) * get_local_size(1);
   int c_hi = min(c_lo + (int)get_local_size(0), width) - 1;
@@ -629,6 +635,7 @@ __kernel void intervisibility_naive(__global const float* heights, int width, in
     // The Earth's drop per step squared (0 without curvature).
     const float step_ground = d.step_length * d.ground_per_pixel;
     const float drop = curvature * step_ground * step_ground;
+    const int counted_steps = max_steps[b];  // samples farther away are not counted
     float best_h = 0.0f;  // the steepest sample so far (the latest visible one)
     int best_step = 0;    // its step, 0 = none yet
     int count = 0, undecided = 0;
@@ -651,8 +658,9 @@ __kernel void intervisibility_naive(__global const float* heights, int width, in
       int decided = chord_side_filter(q, best_h, h, (float)(i - best_step), (float)max(best_step, 1), &side);
       undecided |= present && best_step > 0 && !decided;
       int seen = present && (best_step == 0 || side <= 0);
-      count += seen;
-      distance_sum += seen ? (uint)i : 0u;
+      int counted = seen && i <= counted_steps;
+      count += counted;
+      distance_sum += counted ? (uint)i : 0u;
       best_h = seen ? q : best_h;
       best_step = seen ? i : best_step;
     }
@@ -669,8 +677,10 @@ __kernel void intervisibility_naive(__global const float* heights, int width, in
 #endif
         if (!inside_field(px, py, width, height) || isnan(q)) continue;
         if (best_step > 0 && chord_side(q, best_h, h, (float)(i - best_step), (float)best_step) > 0) continue;
-        ++count;
-        distance_sum += (uint)i;
+        if (i <= counted_steps) {
+          ++count;
+          distance_sum += (uint)i;
+        }
         best_h = q;
         best_step = i;
       }

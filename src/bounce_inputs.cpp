@@ -73,6 +73,7 @@ void validate(const BounceOptions& options) {
   validate(static_cast<const SweepOptions&>(options));
   validate(options.tree);
   if (options.curvature != 0.0) throw InvalidArgument("Earth curvature is not supported for the bounce");
+  if (options.max_distance != 0.0) throw InvalidArgument("a maximum distance is not supported for the bounce");
 }
 
 void validate(const HeightField& field, const ExitRadiance& radiance) {

@@ -100,6 +100,8 @@ std::vector<ReceiverHorizons> computeHorizonLists(const HeightField& field, cons
                                                   const std::vector<ReceiverPixel>& receivers) {
   validate(field);
   validate(options);
+  if (options.max_distance != 0.0)
+    throw InvalidArgument("a maximum distance is not supported for horizon lists yet (visible counts take it)");
   validateReceivers(field, receivers);
   const detail::PreparedHeights prepared = detail::prepareHeights(field);
   const auto directions = detail::runDirections(field, options);

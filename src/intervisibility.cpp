@@ -100,6 +100,7 @@ void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDire
   kernel.setArg(arg++, d.count_factor);
   kernel.setArg(arg++, d.area_factor);
   kernel.setArg(arg++, d.drop);
+  kernel.setArg(arg++, d.max_steps);
   kernel.setArg(arg++, b.trees);
   kernel.setArg(arg++, b.prefix);
   chunk.stride = arg++;
@@ -281,6 +282,12 @@ class NaiveCountRoutine : public SweepRoutine {
     naive.setArg(arg++, count);
     naive.setArg(arg++, intervisibilitySector(visibility_));
     naive.setArg(arg++, static_cast<float>(visibility_.curvature));
+    std::vector<cl_int> max_steps;
+    for (const SweepDirection& d : batch)
+      max_steps.push_back(stepsWithin(visibility_.max_distance, double(d.step_length) * d.ground_per_pixel));
+    const cl::Buffer max_steps_buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                      max_steps.size() * sizeof(cl_int), max_steps.data());
+    naive.setArg(arg++, max_steps_buffer);
     naive.setArg(arg++, count_sum_);
     naive.setArg(arg++, area_sum_);
     st_.launch(naive, cl::NDRange(roundUp(field_.width, kTileX), roundUp(field_.height, kTileY)),

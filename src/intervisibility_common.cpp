@@ -60,8 +60,13 @@ std::size_t TreeDirection::longestLine() const {
   return longest;
 }
 
+int stepsWithin(double max_distance, double step_ground) {
+  if (max_distance <= 0.0) return kAllSteps;
+  return static_cast<int>(std::min<double>(kAllSteps, std::floor(max_distance / step_ground)));
+}
+
 TreeDirection makeTreeDirection(const HeightField& field, const LatticeDirection& lattice, double samples_per_unit,
-                                int directions, double curvature) {
+                                int directions, double curvature, double max_distance) {
   TreeDirection d;
   d.lattice = lattice;
   d.per_period = samplesPerPeriod(lattice, samples_per_unit);
@@ -73,6 +78,7 @@ TreeDirection makeTreeDirection(const HeightField& field, const LatticeDirection
   d.count_factor = static_cast<float>(directions * lattice.weight * step * samples_per_unit);
   d.area_factor = static_cast<float>(2.0 * M_PI * lattice.weight * ground * ground);
   d.drop = static_cast<float>(curvature * ground * ground);
+  d.max_steps = stepsWithin(max_distance, ground);
   d.half_sector = static_cast<float>(M_PI * lattice.weight);
   d.wedge = static_cast<float>(2.0 * std::sin(M_PI * lattice.weight));
   d.cos_azimuth = static_cast<float>(std::cos(lattice.azimuth));
@@ -84,7 +90,8 @@ std::vector<TreeDirection> treeDirections(const HeightField& field, const SweepO
   std::vector<TreeDirection> out;
   for (const LatticeDirection& lattice : latticeDirections(field, options, false, 0.0)) {
     if (lattice.weight == 0.0) continue;  // merged into an equal step
-    out.push_back(makeTreeDirection(field, lattice, options.samples_per_unit, options.directions, options.curvature));
+    out.push_back(makeTreeDirection(field, lattice, options.samples_per_unit, options.directions, options.curvature,
+                                    options.max_distance));
   }
   return out;
 }
@@ -112,6 +119,7 @@ IntervisibilityLines canonicalTreeLines(const TreeDirection& d) {
   out.geometry.cos_azimuth = d.cos_azimuth;
   out.geometry.sin_azimuth = d.sin_azimuth;
   out.receiver_every = static_cast<int>(d.samples.size());
+  out.max_steps = d.max_steps;
   out.samples.assign(longest * d.lines.size(), std::numeric_limits<float>::quiet_NaN());
   return out;
 }

@@ -16,6 +16,9 @@
 
 namespace hfvis::detail {
 
+// No maximum distance: more steps than any line has.
+constexpr int kAllSteps = 1 << 30;
+
 // One direction of the hull tree sweep: a lattice direction (every pixel centre on one of
 // its lines, see lattice_geometry.hpp) sampled uniformly, per_period samples per period, and
 // what the kernels scale its results by. The same for the device path and the references.
@@ -35,6 +38,8 @@ struct TreeDirection {
   float area_factor = 0.0f;
   // The Earth's drop per step squared, c step_ground^2 (SweepOptions::curvature).
   float drop = 0.0f;
+  // Steps within the maximum distance: floor(max_distance / step_ground), or kAllSteps.
+  int max_steps = kAllSteps;
   float half_sector = 0.0f, wedge = 0.0f;  // the bounce's pi weight and 2 sin(pi weight)
   float cos_azimuth = 1.0f, sin_azimuth = 0.0f;
   std::size_t longestLine() const;  // entries (steps) of its longest line
@@ -53,7 +58,10 @@ struct TreeDirection {
 std::vector<TreeDirection> treeDirections(const HeightField& field, const SweepOptions& options);
 // One of them: `lattice` (its weight set) sampled at S samples per unit, in a run of K directions.
 TreeDirection makeTreeDirection(const HeightField& field, const LatticeDirection& lattice, double samples_per_unit,
-                                int directions, double curvature = 0.0);
+                                int directions, double curvature = 0.0, double max_distance = 0.0);
+
+// Steps of `step_ground` ground units within `max_distance` (0: kAllSteps).
+int stepsWithin(double max_distance, double step_ground);
 
 // Limits of the kernels' exact arithmetic, checked before launching: a line has fewer than
 // 2^24 steps (steps are exact floats in the predicate), and |height| * steps stays far
@@ -74,6 +82,7 @@ float intervisibilitySector(const IntervisibilityOptions& options);
 struct IntervisibilityLines {
   SweepDirection geometry{};
   int receiver_every = 1;
+  int max_steps = kAllSteps;  // only samples within this many steps of a receiver count
   bool horizons_at_every_sample = true;  // else only receivers read theirs (the kernels without statistics)
   std::vector<float> samples;                 // sampled heights
   std::vector<float> counts;                  // visible samples (farther along the line)

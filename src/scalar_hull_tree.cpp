@@ -3,6 +3,7 @@
 // walk, same exact predicate, in the kernel's order, with the bounce gather): the horizon
 // lists run it, and the scalar references of the tests build on it.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -349,14 +350,18 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
           }
           gather->setAdjacent(end == np);
         }
-        const int run = end_rank - hp_rank;
+        // Within the maximum distance: the run's samples from `first` on.
+        const int first = std::max(hp, step - out.max_steps);
+        const int first_rank = first == hp ? hp_rank : holes ? ranks[first] : hp_rank + (first - hp);
+        const int run = first < end ? end_rank - first_rank : 0;
         count += run;
-        std::uint64_t steps_sum;
-        if (!holes) {
-          steps_sum = static_cast<std::uint64_t>(run) * static_cast<std::uint64_t>(hp + end - 1) / 2;
+        std::uint64_t steps_sum = 0;
+        if (run == 0) {
+        } else if (!holes) {
+          steps_sum = static_cast<std::uint64_t>(run) * static_cast<std::uint64_t>(first + end - 1) / 2;
         } else {
           const std::uint64_t end_sum = end == step ? step_sum : step_sums[end];
-          steps_sum = end_sum - step_sums[hp];
+          steps_sum = end_sum - step_sums[first];
         }
         distance_sum += static_cast<std::uint64_t>(step) * static_cast<std::uint64_t>(run) - steps_sum;
         if (np == kNone) break;

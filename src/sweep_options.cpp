@@ -28,6 +28,10 @@ void validate(const SweepOptions& options) {
     throw InvalidArgument("the curvature coefficient must be finite and at most 1 per ground unit (got " +
                           std::to_string(options.curvature) + "); earthCurvature() gives the Earth's in 1/m");
   }
+  if (!std::isfinite(options.max_distance) || options.max_distance < 0.0) {
+    throw InvalidArgument("the maximum distance must be finite and >= 0 ground units, 0 for the whole field (got " +
+                          std::to_string(options.max_distance) + ")");
+  }
 }
 
 namespace detail {

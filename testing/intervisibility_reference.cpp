@@ -101,6 +101,7 @@ void naiveReference(const HeightField& field, const std::vector<float>& h,
       for (const SweepDirection& d : directions) {
         const float step_ground = d.step_length * d.ground_per_pixel;
         const float drop = static_cast<float>(options.curvature) * step_ground * step_ground;
+        const int counted_steps = stepsWithin(options.max_distance, double(d.step_length) * d.ground_per_pixel);
         float best_h = 0.0f;
         int best_step = 0, count = 0;
         std::uint32_t distance_sum = 0;
@@ -116,8 +117,10 @@ void naiveReference(const HeightField& field, const std::vector<float>& h,
               !std::isnan(q) && (best_step == 0 || chordSide(q, best_h, hp, static_cast<float>(i - best_step),
                                                              static_cast<float>(best_step)) <= 0);
           if (seen) {
-            ++count;
-            distance_sum += static_cast<std::uint32_t>(i);
+            if (i <= counted_steps) {
+              ++count;
+              distance_sum += static_cast<std::uint32_t>(i);
+            }
             best_h = q;
             best_step = i;
           }

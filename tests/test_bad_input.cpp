@@ -81,6 +81,14 @@ TEST(BadInput, Options) {
     options.curvature = c;
     expectError<InvalidArgument>([&] { horizons(field, options); }, "curvature coefficient");
   }
+  for (double d : {-1.0, std::nan("")}) {
+    HorizonOptions options;
+    options.max_distance = d;
+    expectError<InvalidArgument>([&] { horizons(field, options); }, "maximum distance");
+  }
+  HorizonOptions within;
+  within.max_distance = 10.0;
+  expectError<InvalidArgument>([&] { horizons(field, within); }, "maximum distance is not supported");
   BounceOptions curved_bounce;
   curved_bounce.curvature = earthCurvature();
   ExitRadiance lit;

@@ -463,7 +463,8 @@ float areaTolerance(const std::vector<float>& area) {
 // In both layouts; the tree with statistics (every sample reads its horizons) and without
 // (only receivers do: the production path).
 void expectKernelMatchesReference(IntervisibilityMethod method, double samples_per_unit,
-                                  const HullTreeTuning& tuning = {}, double curvature = 0.0) {
+                                  const HullTreeTuning& tuning = {}, double curvature = 0.0,
+                                  double max_distance = 0.0) {
   testing::forEachLayout([&](const ComputeContext& context) {
     for (const auto& name : syntheticFieldNames()) {
       for (auto [w, h] : awkwardSizes()) {
@@ -477,6 +478,7 @@ void expectKernelMatchesReference(IntervisibilityMethod method, double samples_p
         options.samples_per_unit = samples_per_unit;
         options.tree = tuning;
         options.curvature = curvature;
+        options.max_distance = max_distance;
         for (bool statistics : {true, false}) {
           if (statistics && method != IntervisibilityMethod::HullTree) continue;
           auto outputs = allOutputs();
@@ -522,6 +524,37 @@ TEST(IntervisibilityKernels, NaiveMatchesScalarReferenceWithCurvature) {
   expectKernelMatchesReference(IntervisibilityMethod::Naive, 1.0, {}, 0.004);
 }
 
+// Within a maximum distance (4.5 ground units: 3 pixels across, 4.5 along the columns).
+TEST(IntervisibilityKernels, TreeMatchesScalarReferenceWithinAMaximumDistance) {
+  expectKernelMatchesReference(IntervisibilityMethod::HullTree, 1.0, {}, 0.0, 4.5);
+}
+
+TEST(IntervisibilityKernels, NaiveMatchesScalarReferenceWithinAMaximumDistance) {
+  expectKernelMatchesReference(IntervisibilityMethod::Naive, 1.0, {}, 0.0, 4.5);
+}
+
+// On a flat plane within a maximum distance D, a pixel sees along each axis direction the
+// min(D, distance to the edge) samples of its row or column, with both methods.
+TEST(IntervisibilityAnalytic, FlatPlaneWithinAMaximumDistance) {
+  const HeightField field = makeSyntheticField("flat", 21, 15);
+  for (auto method : {IntervisibilityMethod::HullTree, IntervisibilityMethod::Naive}) {
+    IntervisibilityOptions options;
+    options.directions = 4;
+    options.method = method;
+    options.max_distance = 5.0;
+    IntervisibilityOutputs outputs;
+    outputs.visible_count = true;
+    const auto r = computeIntervisibility(testContext(), field, options, outputs);
+    for (int row = 0; row < field.height; ++row) {
+      for (int c = 0; c < field.width; ++c) {
+        const int expected = std::min(5, field.width - 1 - c) + std::min(5, c) + std::min(5, field.height - 1 - row) +
+                             std::min(5, row);
+        ASSERT_EQ(r.visible_count[row * field.width + c], float(expected)) << c << "," << row;
+      }
+    }
+  }
+}
+
 // Flat ground over a curved Earth falls away from every receiver: along each direction only
 // its nearest sample is seen (each farther one lies below the line of sight over it). At
 // K = 4 (steps of one pixel) an interior pixel sees 4 samples, with both methods.
@@ -546,23 +579,27 @@ TEST(IntervisibilityKernels, NaiveMatchesScalarReference) {
 }
 
 // On the four axis directions the lines pass through the pixel centres, so the tree and
-// the naive march see the very same samples: counts must be identical, areas equal to rounding.
+// the naive march see the very same samples: counts must be identical, areas equal to
+// rounding; within a maximum distance too.
 TEST(IntervisibilityKernels, TreeEqualsNaiveOnAxisDirections) {
   for (const auto& name : syntheticFieldNames()) {
     for (auto [w, h] : awkwardSizes()) {
       SCOPED_TRACE(name + " " + std::to_string(w) + "x" + std::to_string(h));
       HeightField field = makeSyntheticField(name, w, h, 5);
       field.cell_size_y = 0.5;
-      IntervisibilityOptions options;
-      options.directions = 4;
-      IntervisibilityOutputs outputs;
-      outputs.visible_count = outputs.visible_area = true;
-      const auto tree = computeIntervisibility(testContext(), field, options, outputs);
-      options.method = IntervisibilityMethod::Naive;
-      const auto naive = computeIntervisibility(testContext(), field, options, outputs);
-      EXPECT_TRUE(nearlyEqual(tree.visible_count, naive.visible_count, 0.0f));
-      // The area's factors round differently (2 pi w g^2 in double, then float).
-      EXPECT_TRUE(nearlyEqual(tree.visible_area, naive.visible_area, areaTolerance(naive.visible_area)));
+      for (double max_distance : {0.0, 3.75}) {  // the whole field; 7 rows, 3 columns
+        IntervisibilityOptions options;
+        options.directions = 4;
+        options.max_distance = max_distance;
+        IntervisibilityOutputs outputs;
+        outputs.visible_count = outputs.visible_area = true;
+        const auto tree = computeIntervisibility(testContext(), field, options, outputs);
+        options.method = IntervisibilityMethod::Naive;
+        const auto naive = computeIntervisibility(testContext(), field, options, outputs);
+        EXPECT_TRUE(nearlyEqual(tree.visible_count, naive.visible_count, 0.0f)) << max_distance;
+        // The area's factors round differently (2 pi w g^2 in double, then float).
+        EXPECT_TRUE(nearlyEqual(tree.visible_area, naive.visible_area, areaTolerance(naive.visible_area)));
+      }
     }
   }
 }

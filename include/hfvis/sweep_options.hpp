@@ -35,6 +35,10 @@ struct SweepOptions {
   // (earthCurvature() for the Earth with refraction, ground units metres); 0 = flat.
   // Every operation takes it but the bounce, which refuses it.
   double curvature = 0.0;
+  // Only terrain within this ground distance of the receiver counts (ground units; 0 = the
+  // whole field). Intervisibility (visible counts and areas) takes it; the other operations
+  // refuse it so far.
+  double max_distance = 0.0;
   std::size_t memory_budget_bytes = 0;  // device memory for one batch; 0 = from the device
   // Called after each batch of directions with (directions done, directions in all).
   std::function<void(int, int)> progress;
@@ -44,7 +48,7 @@ struct SweepOptions {
 double directionAzimuth(int k, const SweepOptions& options);
 
 // Throws InvalidArgument for K < 1, a sampling density outside (0, 64], a non-finite
-// azimuth offset or curvature.
+// azimuth offset or curvature, or a negative or non-finite maximum distance.
 void validate(const SweepOptions& options);
 
 }  // namespace hfvis
