@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake pkg-config
   ocl-icd-opencl-dev opencl-clhpp-headers opencl-c-headers pocl-opencl-icd clinfo
-  libopenimageio-dev openimageio-tools libopenexr-dev libglm-dev
+  libopenimageio-dev openimageio-tools libopenexr-dev libglm-dev libgdal-dev
   googletest libgtest-dev
   clang libclang-rt-14-dev
   python3 python3-numpy python3-matplotlib python-matplotlib-data

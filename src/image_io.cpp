@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "hfvis/errors.hpp"
+#include "gdal_io.hpp"
 
 namespace hfvis {
 namespace {
@@ -536,6 +537,7 @@ std::unique_ptr<OIIO::ImageInput> openImage(const std::string& path, std::uint64
 }  // namespace
 
 HeightField readHeightField(const std::string& path, const HeightFieldReadOptions& options) {
+  if (detail::isGdalRaster(path)) return detail::readGdalHeightField(path, options);
   std::unique_ptr<OIIO::ImageInput> in = openImage(path, options.max_image_bytes);
   const OIIO::ImageSpec& spec = in->spec();
   const int channel = selectChannel(path, spec, options.channel);

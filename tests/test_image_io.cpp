@@ -675,3 +675,28 @@ TEST_F(ImageIoTest, PreviewPngOfFlatOrEmptyPlane) {
 
 }  // namespace
 }  // namespace hfvis
+
+namespace hfvis {
+namespace {
+
+// A georeferenced raster GDAL reads and OpenImageIO does not (ESRI ASCII grid): its nodata
+// value becomes NaN and its cell size the field's.
+TEST(GdalRasters, AsciiGridWithNodataAndCellSize) {
+  const std::string path = std::string(HFVIS_TEST_TMP_DIR) + "/grid.asc";
+  {
+    std::ofstream out(path);
+    out << "ncols 3\nnrows 2\nxllcorner 500000\nyllcorner 4000000\ncellsize 30\nNODATA_value -9999\n"
+        << "1 2 3\n4 -9999 6\n";
+  }
+  const HeightField field = readHeightField(path);
+  ASSERT_EQ(field.width, 3);
+  ASSERT_EQ(field.height, 2);
+  EXPECT_EQ(field.heights[0], 1.0f);
+  EXPECT_EQ(field.heights[5], 6.0f);
+  EXPECT_TRUE(std::isnan(field.heights[4]));
+  EXPECT_DOUBLE_EQ(field.cell_size_x, 30.0);
+  EXPECT_DOUBLE_EQ(field.cell_size_y, 30.0);
+}
+
+}  // namespace
+}  // namespace hfvis
