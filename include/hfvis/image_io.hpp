@@ -1,4 +1,5 @@
-// hfvis/image_io.hpp: reading height fields and writing results through OpenImageIO.
+// hfvis/image_io.hpp: reading height fields (GDAL for georeferenced rasters, OpenImageIO for
+// images) and writing results through OpenImageIO.
 #pragma once
 
 #include <cstdint>
@@ -15,8 +16,8 @@ struct HeightFieldReadOptions {
   // else a channel name ("Y", "R", "height") or a zero-based index ("0").
   std::string channel;
   // Ground units per pixel; <= 0 = take it from the file (the string attributes
-  // hfvis:cell_size_x/y that hfvis and data/make_data.py write, else the GeoTIFF pixel
-  // scale, geographic degrees converted to metres at the field's centre latitude) or 1.
+  // hfvis:cell_size_x/y that hfvis and data/make_data.py write in EXR, else a raster's
+  // geotransform, geographic degrees converted to metres at the field's centre latitude) or 1.
   double cell_size_x = 0.0;
   double cell_size_y = 0.0;
   double z_scale = 1.0;
@@ -25,8 +26,11 @@ struct HeightFieldReadOptions {
   std::uint64_t max_image_bytes = 0;
 };
 
-// Reads a height field from EXR, TIFF (float, 16-bit; GeoTIFF spacing), PNG (8/16-bit) or
-// any format OpenImageIO reads. Integer pixels are converted to their stored integer
+// Reads a height field. Georeferenced rasters (.tif/.tiff, .hgt, .asc, .vrt, .img, .bil, .dem,
+// .grd, .adf) go through GDAL: the band's nodata value becomes NaN, the cell size comes from
+// the geotransform (geographic degrees in metres at the centre latitude), a rotated or sheared
+// geotransform is an IoError. Everything else (EXR, PNG 8/16-bit, ...) goes through
+// OpenImageIO. Integer pixels are converted to their stored integer
 // values (a 16-bit PNG holds heights 0..65535), not normalised. Throws IoError naming the
 // file and reason (missing, unreadable, truncated, zero-sized, multi-channel without a
 // channel choice, unknown channel).
