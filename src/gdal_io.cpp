@@ -36,15 +36,22 @@ struct DatasetCloser {
   void operator()(void* dataset) const { GDALClose(dataset); }
 };
 
-// Metres per degree of latitude and of longitude at latitude `lat` on the WGS84 ellipsoid.
-void metresPerDegree(double lat_deg, double* along_meridian, double* along_parallel) {
-  const double a = 6378137.0, e2 = 6.69437999014e-3, lat = lat_deg * M_PI / 180.0;
-  const double s = std::sin(lat), w = std::sqrt(1.0 - e2 * s * s);
-  *along_meridian = M_PI / 180.0 * a * (1.0 - e2) / (w * w * w);
-  *along_parallel = M_PI / 180.0 * a * std::cos(lat) / w;
-}
-
 }  // namespace
+
+// Ground metres per degree on the WGS84 ellipsoid at geodetic latitude `lat_deg`:
+// along a meridian (radius of curvature M) and along a parallel (N cos(lat)).
+void metresPerDegree(double lat_deg, double* along_meridian, double* along_parallel) {
+  const double a = 6378137.0;
+  const double f = 1.0 / 298.257223563;
+  const double e2 = f * (2.0 - f);
+  const double lat = lat_deg * M_PI / 180.0;
+  const double s = std::sin(lat);
+  const double w = 1.0 - e2 * s * s;
+  const double m = a * (1.0 - e2) / (w * std::sqrt(w));
+  const double n = a / std::sqrt(w);
+  *along_meridian = m * M_PI / 180.0;
+  *along_parallel = n * std::cos(lat) * M_PI / 180.0;
+}
 
 bool isGdalRaster(const std::string& path) {
   std::string extension = std::filesystem::path(path).extension().string();

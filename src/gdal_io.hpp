@@ -9,6 +9,10 @@
 
 namespace hfvis::detail {
 
+// Ground metres per degree on the WGS84 ellipsoid at geodetic latitude `lat_deg`, along a
+// meridian and along a parallel (both readers convert geographic spacing with it).
+void metresPerDegree(double lat_deg, double* along_meridian, double* along_parallel);
+
 // Whether `path` names a raster format that GDAL reads rather than OpenImageIO.
 bool isGdalRaster(const std::string& path);
 

@@ -194,21 +194,6 @@ class TiffReader {
   bool big_ = false;
 };
 
-// Ground metres per degree on the WGS84 ellipsoid at geodetic latitude `lat_deg`:
-// along a meridian (radius of curvature M) and along a parallel (N cos(lat)).
-void metresPerDegree(double lat_deg, double* along_meridian, double* along_parallel) {
-  const double a = 6378137.0;
-  const double f = 1.0 / 298.257223563;
-  const double e2 = f * (2.0 - f);
-  const double lat = lat_deg * kPi / 180.0;
-  const double s = std::sin(lat);
-  const double w = 1.0 - e2 * s * s;
-  const double m = a * (1.0 - e2) / (w * std::sqrt(w));
-  const double n = a / std::sqrt(w);
-  *along_meridian = m * kPi / 180.0;
-  *along_parallel = n * std::cos(lat) * kPi / 180.0;
-}
-
 // Cell size from GeoTIFF tags, or nullopt when the file carries no pixel spacing.
 std::optional<std::pair<double, double>> geoTiffCellSize(const std::string& path, int width, int height) {
   TiffReader reader(path);
@@ -264,7 +249,7 @@ std::optional<std::pair<double, double>> geoTiffCellSize(const std::string& path
                   "give the cell size explicitly");
   }
   double per_deg_y = 0.0, per_deg_x = 0.0;
-  metresPerDegree(lat, &per_deg_y, &per_deg_x);
+  detail::metresPerDegree(lat, &per_deg_y, &per_deg_x);
   return std::make_pair(sx * to_degrees * per_deg_x, sy * to_degrees * per_deg_y);
 }
 
