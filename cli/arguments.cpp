@@ -189,7 +189,6 @@ const char* onlyFor(Option option) {
     case Option::AzimuthTolerance:
       return "horizon";
     case Option::Statistics:
-    case Option::MaxDistance:
       return "viewcount";
     case Option::At:
       return "horizons";
@@ -205,9 +204,10 @@ const char* onlyFor(Option option) {
 bool notFor(Option option, Command command) {
   if (command == Command::HorizonLists) {
     return option == Option::Method || option == Option::Device || option == Option::MemoryBudget ||
-           option == Option::Preview;
+           option == Option::Preview || option == Option::MaxDistance;
   }
   if (option == Option::HullTree) return command != Command::ViewCount && command != Command::Bounce;
+  if (option == Option::MaxDistance) return command == Command::Bounce;
   // Earth curvature: not for the bounce (a rendering operation) so far.
   if (option == Option::Curvature || option == Option::Refraction) return command == Command::Bounce;
   return command == Command::Bounce && option == Option::Method;

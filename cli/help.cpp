@@ -47,6 +47,9 @@ Options:
                            the Earth's drop d^2 (1 - K) / (2 R), R = 6370997 m, K = 1/7 (GRASS and
                            GDAL's convention; cell sizes must be in metres)
   --refraction K           the same with refraction coefficient K in -1 .. 1 (implies --curvature)
+  --max-distance D         horizon, svf, ao, viewcount: only terrain within D ground units of the
+                           receiver counts (farther terrain neither casts a horizon nor hides
+                           anything nearer; r.horizon's maxdistance, RVT's svf_r_max)
   --samples-per-unit S     naive, viewcount, bounce: height samples per pixel length along a
                            line or ray; sweep: every grid-line crossing of the ray (exact heights)
                            and, for S > 1, about S points per pixel length between crossings
@@ -62,8 +65,9 @@ Options:
   --preview PNG            also write an 8-bit PNG preview
   -q, --quiet              print neither progress nor the summary line
   -h, --help               show help
-  (horizons takes only -o, -k, --azimuth-offset, --samples-per-unit, --cell-size, --z-scale,
-  --channel and --quiet: it runs on the host, one ray per receiver and direction.)
+  (horizons takes only -o, -k, --azimuth-offset, --curvature, --refraction, --samples-per-unit,
+  --cell-size, --z-scale, --channel and --quiet: it runs on the host, one ray per receiver and
+  direction.)
 )";
 
 const char* const kHorizonOnly = R"(
@@ -80,8 +84,6 @@ Horizon only:
 
 const char* const kViewCount = R"(
 Viewcount:
-  --max-distance D         count only the samples within D ground units of each receiver
-                           (farther terrain neither counts nor hides anything nearer)
   --stats                  also print, for the tree method, the statistics of Timonen (2013)'s
                            Table 2 per point and direction: m_a (visibility horizons), t_a
                            (convexity checks made), visible samples and naive iterations (the

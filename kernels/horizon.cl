@@ -22,6 +22,9 @@
 //   HFVIS_CURVATURE                          lower every sample by the Earth's drop (argument
 //                                            `drop`: c times the ground length of a pixel
 //                                            along the line, squared; README "Conventions")
+//   HFVIS_MAX_DISTANCE                       only samples within `window` pixels along the line
+//                                            count (horizon_lattice: blocks and a backward
+//                                            pass, below; horizon_naive: `max_steps`)
 #include "direction_terms.cl"
 #include "fast_math.cl"
 #include "sweep_framework.cl"
@@ -40,6 +43,9 @@
 #endif
 #ifndef HFVIS_CURVATURE
 #define HFVIS_CURVATURE 0
+#endif
+#ifndef HFVIS_MAX_DISTANCE
+#define HFVIS_MAX_DISTANCE 0
 #endif
 
 // Unit normal at pixel (c, r): the normalised sum of the unnormalised normals of the (up to)
@@ -216,29 +222,215 @@ HFVIS_INLINE lane_float near_rise(__global const float* heights, int width, int 
   return select(rise, (lane_float)NAN, leaves);
 }
 
+// The height of lattice sample s for the lanes' period receivers at (c, r): `ok` are the lanes
+// that take it (live, and inside the field where `edge`: only the first period of a line can
+// reach outside it); *valid: those with a height. Lanes without the sample read pixel 0 alone
+// (their cell may lie outside the field).
+HFVIS_INLINE lane_float lane_sample_height(__global const float* heights, int width, int height,
+                                           __global const LatticeSample* s, lane_int c, lane_int r, lane_int ok,
+                                           int edge, lane_int* valid) {
+  const int ex = s->ex, ey = s->ey;
+  const float w00 = s->w00, w10 = s->w10, w01 = s->w01, w11 = s->w11;
+  const lane_int x0 = c + s->ox, y0 = r + s->oy;
+  if (edge) ok = ok & (x0 >= 0) & (x0 + ex <= width - 1) & (y0 >= 0) & (y0 + ey <= height - 1);
+  const lane_int at = select((lane_int)0, y0 * width + x0, ok);
+  const lane_int right = select((lane_int)0, (lane_int)ex, ok);
+  const lane_int down = select((lane_int)0, (lane_int)(ey * width), ok);
+  lane_float h;
+  if (ex + ey < 2) {
+    // A crossing or the receiver: at most two corners of positive weight, and the
+    // zero-weight terms of the four-corner sum add nothing.
+    const lane_int at_next = at + right + down;
+    lane_float h0, h1;
+#pragma unroll
+    for (int l = 0; l < HFVIS_LANES; ++l) {
+      LANE(h0, l) = heights[ILANE(at, l)];
+      LANE(h1, l) = heights[ILANE(at_next, l)];
+    }
+    // The receiver (ex = ey = 0, weight 1) is its pixel's height as it is (1 h + 0 h would
+    // turn an infinite height into NaN).
+    h = ex + ey == 0 ? h0 : w00 * h0 + (ex ? w10 : w01) * h1;
+#if HFVIS_HAS_NODATA
+#pragma unroll
+    for (int l = 0; l < HFVIS_LANES; ++l) {
+      if (isnan(LANE(h, l)))
+        LANE(h, l) = lattice_height(heights, (uint)ILANE(at, l), (uint)ILANE(right, l), (uint)ILANE(down, l), w00,
+                                    w10, w01, w11);
+    }
+#endif
+  } else {
+#pragma unroll
+    for (int l = 0; l < HFVIS_LANES; ++l)
+      LANE(h, l) = lattice_height(heights, (uint)ILANE(at, l), (uint)ILANE(right, l), (uint)ILANE(down, l), w00,
+                                  w10, w01, w11);
+  }
+#if HFVIS_HAS_NODATA
+  *valid = ok & !isnan(h);
+#else
+  *valid = ok;
+#endif
+  return h;
+}
+
+// One step of Algorithm 1 (Timonen & Westerholm 2010) on the lanes' hull stacks: the sample
+// (hs, here) arrives beyond every entry, on the side `toward` (+1: positions grow, the
+// forward sweep; -1: they shrink, the backward pass of a window). Pop while the entry below
+// the top casts at least as steep a slope on the sample as the top (so the farther wins
+// ties); (rise, run) become the remaining top's rise above the sample and its distance
+// (run 0: no entry) where `valid`; push the sample. Entry k of a lane's stack is at
+// stacks[stack + k entry]; the top two entries are in registers as well (below: valid where
+// n >= 2). Every pop loads the next entry down before it is known to be needed, so the load
+// does not wait for the comparison (it is used only where a lane pops).
+HFVIS_INLINE void hull_step(__global float2* stacks, lane_int stack, int entry, lane_int valid, lane_float hs,
+                            float here, float toward, lane_int* n, lane_float* top_h, lane_float* top_p,
+                            lane_float* below_h, lane_float* below_p, lane_float* rise, lane_float* run) {
+  lane_float v1h = *top_h - hs, v1d = toward * (here - *top_p), v2h = *below_h - hs,
+             v2d = toward * (here - *below_p);
+  lane_int popping = valid & (*n > 1);
+  lane_int deeper = stack + (*n - 3) * entry;  // entry n - 3, below `below`
+  while (ANY_LANE(popping)) {
+    lane_float next_h, next_p;
+#pragma unroll
+    for (int l = 0; l < HFVIS_LANES; ++l) {
+      const int k = max(ILANE(deeper, l), ILANE(stack, l));
+      const float2 e = stacks[k];
+      LANE(next_h, l) = e.x;
+      LANE(next_p, l) = e.y;
+    }
+    const lane_int pop = popping & (v2h * v1d >= v1h * v2d);
+    v1h = select(v1h, v2h, pop);
+    v1d = select(v1d, v2d, pop);
+    *top_h = select(*top_h, *below_h, pop);
+    *top_p = select(*top_p, *below_p, pop);
+    *below_h = select(*below_h, next_h, pop);
+    *below_p = select(*below_p, next_p, pop);
+    v2h = *below_h - hs;
+    v2d = toward * (here - *below_p);
+    *n = select(*n, *n - 1, pop);
+    popping = pop & (*n > 1);
+    deeper -= entry;
+  }
+  const lane_int push = stack + *n * entry;
+#pragma unroll
+  for (int l = 0; l < HFVIS_LANES; ++l) {
+    if (ILANE(valid, l)) stacks[ILANE(push, l)] = (float2)(LANE(hs, l), here);
+  }
+  *rise = select(*rise, v1h, valid);
+  *run = select(*run, select((lane_float)0.0f, v1d, *n > 0), valid);  // 0: no occluder
+  *below_h = select(*below_h, *top_h, valid);
+  *below_p = select(*below_p, *top_p, valid);
+  *top_h = select(*top_h, hs, valid);
+  *top_p = select(*top_p, (lane_float)here, valid);
+  *n = select(*n, *n + 1, valid);
+}
+
+#if HFVIS_MAX_DISTANCE
+// The sample's height as the stack holds it: lowered by the Earth's drop (see horizon_lattice).
+#if HFVIS_CURVATURE
+#define HFVIS_STACK_HEIGHT(h, here) ((h) - drop * (here) * (here))
+#else
+#define HFVIS_STACK_HEIGHT(h, here) (h)
+#endif
+
+// Horizons within a window of `window` pixels along the line (HFVIS_MAX_DISTANCE). The line's
+// positions are cut into blocks of the window's length (block = floor(position / window));
+// a receiver's window then lies in its own block and the one before. The forward sweep
+// restarts its stack at every block, so it gives the steepest sample of the receiver's own
+// block (all nearer than the window). This pass gives the rest, the steepest sample of the
+// block before within the window: on entering block k (at sample q of period i), it walks
+// block k's receivers nearest-first and the samples of block k - 1 backwards from the
+// nearest, pushing each sample once it is within the window of the current receiver (the
+// set grows at its far end, so Algorithm 1 runs backwards: hull_step toward -1); that hull's
+// tangent from the receiver is found by binary search (the slopes from a point beyond an upper
+// hull rise and then fall along it; ties go to the farther entry). Writes (rise, run) per
+// receiver pixel into window_far (run 0: none), which the forward sweep combines. Every sample
+// is pushed twice and each receiver searches once: O(n log m) for m hull entries.
+HFVIS_INLINE void window_pass(__global const float* heights, int width, int height,
+                              __global const LatticeSample* samples, int n_samples, int a, int b, float period,
+                              float window, float inv_window, float drop, lane_int c, lane_int r,
+                              lane_int receivers, lane_int stack, int entry, int i, int q, int k, int trips,
+                              __global float2* stacks, __global float2* window_far) {
+  int end = i;  // block k's receivers are periods i .. end - 1 (none if it ends within period i)
+  while (end < trips && (int)floor((float)end * period * inv_window) == k) ++end;
+  int ci = q > 0 ? i : i - 1, cq = q > 0 ? q - 1 : n_samples - 1;  // the nearest sample before (i, q)
+  lane_int n = 0;
+  lane_float top_h = 0.0f, top_p = 0.0f, below_h = 0.0f, below_p = 0.0f, rise = 0.0f, run = 0.0f;
+  for (int j = end - 1; j >= i; --j) {
+    const float x = (float)j * period;
+    while (ci >= 0) {
+      __global const LatticeSample* s = samples + cq;
+      const float here = (float)ci * period - s->tau;
+      if ((int)floor(here * inv_window) != k - 1 || x - here > window) break;
+      lane_int valid;
+      const lane_float h = lane_sample_height(heights, width, height, s, c - (ci - i) * a, r - (ci - i) * b,
+                                              ci < receivers, ci == 0, &valid);
+      hull_step(stacks, stack, entry, valid, HFVIS_STACK_HEIGHT(h, here), here, -1.0f, &n, &top_h, &top_p,
+                &below_h, &below_p, &rise, &run);
+      if (--cq < 0) cq = n_samples - 1, --ci;
+    }
+    // The tangent from receiver j: the peak of the slopes along the stack (entry 0 nearest).
+    const lane_int live = j < receivers;
+    const lane_int pixel = select((lane_int)0, (r - (j - i) * b) * width + (c - (j - i) * a), live);
+    lane_float hx;
+#pragma unroll
+    for (int l = 0; l < HFVIS_LANES; ++l) LANE(hx, l) = heights[ILANE(pixel, l)];
+    const lane_float hs = HFVIS_STACK_HEIGHT(hx, x);
+    lane_int lo = 0, hi = n - 1;
+    lane_int searching = live & (lo < hi);
+    while (ANY_LANE(searching)) {
+      const lane_int mid = (lo + hi) >> 1;
+      lane_float h0, p0, h1, p1;
+#pragma unroll
+      for (int l = 0; l < HFVIS_LANES; ++l) {
+        const int at = ILANE(stack, l) + (ILANE(searching, l) ? ILANE(mid, l) * entry : 0);
+        const float2 e0 = stacks[at], e1 = stacks[at + (ILANE(searching, l) ? entry : 0)];
+        LANE(h0, l) = e0.x;
+        LANE(p0, l) = e0.y;
+        LANE(h1, l) = e1.x;
+        LANE(p1, l) = e1.y;
+      }
+      const lane_int up = (h1 - hs) * (x - p0) >= (h0 - hs) * (x - p1);
+      lo = select(lo, mid + 1, searching & up);
+      hi = select(hi, mid, searching & !up);
+      searching = searching & (lo < hi);
+    }
+    lane_float far_h, far_p;
+#pragma unroll
+    for (int l = 0; l < HFVIS_LANES; ++l) {
+      const float2 e = stacks[ILANE(stack, l) + (ILANE(n, l) > 0 ? ILANE(lo, l) * entry : 0)];
+      LANE(far_h, l) = e.x;
+      LANE(far_p, l) = e.y;
+    }
+    const lane_float far_rise = far_h - hs, far_run = select((lane_float)0.0f, x - far_p, n > 0);
+#pragma unroll
+    for (int l = 0; l < HFVIS_LANES; ++l)
+      if (ILANE(live, l)) window_far[ILANE(pixel, l)] = (float2)(LANE(far_rise, l), LANE(far_run, l));
+  }
+}
+#endif
+
 // The sweep of one direction (a, b): lines j = lanes * work-item + lane, each from its far
 // end toward -(a, b), in lock step (a lane whose line has ended is masked). Line j's farthest
 // receiver is lines[j] = (col, row, receivers, stack); receiver i sits at (col - i a, row - i b).
 // Per receiver, the period's samples farther along the line come first (samples[0 ..
 // n_samples - 2], farthest first), then the receiver itself (the last sample: tau 0, weight
-// 1 on its own pixel). Each sample is one step of Algorithm 1 (Timonen & Westerholm 2010):
-// pop the stack while the entry below the top casts at least as steep a slope on the sample
-// as the top (so the farther wins ties); the top that remains is its horizon occluder; push
-// the sample. Only the first period can reach outside the field (the others lie between two
-// receivers, inside it), so only it tests; samples outside the field or without height are
-// absent. Stack entry k of a line is (height, position along the line in pixels from its
-// far end) at stacks[line.w + k stride], the top two entries kept in registers as well;
-// the capacity is every sample of its periods. period_ground = period * ground_per_pixel, the
-// ground length of a period. Preconditions: lines of this launch only; stride 1
-// (line-major) or the launch's line count (step-major). Global size: ceil(n_lines /
-// HFVIS_LANES) rounded up to the local size.
+// 1 on its own pixel). Each sample is one step of Algorithm 1 (hull_step); the top that
+// remains before the push is its horizon occluder. Samples outside the field or without
+// height are absent. Stack entry k of a line is (height, position along the line in pixels
+// from its far end) at stacks[line.w + k stride]; the capacity is every sample of its
+// periods. period_ground = period * ground_per_pixel, the ground length of a period. With
+// HFVIS_MAX_DISTANCE only samples within `window` pixels (inv_window = 1 / window) count
+// (window_pass; window_far: one (rise, run) per pixel). Preconditions: lines of this launch
+// only; stride 1 (line-major) or the launch's line count (step-major). Global size:
+// ceil(n_lines / HFVIS_LANES) rounded up to the local size.
 __kernel void horizon_lattice(__global const float* heights, int width, int height,
                               __global const int4* lines, int n_lines, __global const LatticeSample* samples,
                               int n_samples, int a, int b, float period, float ground_per_pixel,
-                              float period_ground, float drop, float cos_azimuth, float sin_azimuth, float weight,
-                              float swath, uint plane, __global float2* stacks, uint stride,
-                              __global const float4* normals, __global float* angles,
-                              __global float* distances, __global float* svf_sum, __global float* ao_sum) {
+                              float period_ground, float drop, float window, float inv_window, float cos_azimuth,
+                              float sin_azimuth, float weight, float swath, uint plane, __global float2* stacks,
+                              uint stride, __global float2* window_far, __global const float4* normals,
+                              __global float* angles, __global float* distances, __global float* svf_sum,
+                              __global float* ao_sum) {
   const int first = get_global_id(0) * HFVIS_LANES;
   if (first >= n_lines) return;
   const DirectionOutputs outputs = {cos_azimuth, sin_azimuth, weight, swath, plane};
@@ -255,56 +447,31 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
   }
   const int entry = (int)stride;  // between a line's consecutive stack entries
   lane_int n = 0;                 // stack sizes
-  // The top two entries are kept in registers as well (below: valid where n >= 2).
   lane_float top_h = 0.0f, top_p = 0.0f, below_h = 0.0f, below_p = 0.0f, rise = 0.0f, run = 0.0f;
+#if HFVIS_MAX_DISTANCE
+  int block = INT_MIN;  // the block of the stack's samples (none yet)
+  int far_part = 0;     // whether window_pass gave this block's receivers the block before
+#endif
   for (int i = 0; i < trips; ++i, c -= a, r -= b) {
     const lane_int live = i < receivers;
     const float base = (float)i * period;  // the receivers' position along their lines
     lane_float h;                          // the sample's heights, finally the receivers'
     for (int q = 0; q < n_samples; ++q) {
       __global const LatticeSample* s = samples + q;
-      const int ex = s->ex, ey = s->ey;
-      const float w00 = s->w00, w10 = s->w10, w01 = s->w01, w11 = s->w11;
-      const lane_int x0 = c + s->ox, y0 = r + s->oy;
-      lane_int ok = live;
-      if (i == 0) ok = ok & (x0 >= 0) & (x0 + ex <= width - 1) & (y0 >= 0) & (y0 + ey <= height - 1);
-      // Lanes without a sample read pixel 0 alone (their cell may lie outside the field).
-      const lane_int at = select((lane_int)0, y0 * width + x0, ok);
-      const lane_int right = select((lane_int)0, (lane_int)ex, ok);
-      const lane_int down = select((lane_int)0, (lane_int)(ey * width), ok);
-      if (ex + ey < 2) {
-        // A crossing or the receiver: at most two corners of positive weight, and the
-        // zero-weight terms of the four-corner sum add nothing.
-        const lane_int at_next = at + right + down;
-        lane_float h0, h1;
-#pragma unroll
-        for (int l = 0; l < HFVIS_LANES; ++l) {
-          LANE(h0, l) = heights[ILANE(at, l)];
-          LANE(h1, l) = heights[ILANE(at_next, l)];
-        }
-        // The receiver (ex = ey = 0, weight 1) is its pixel's height as it is (1 h + 0 h would
-        // turn an infinite height into NaN).
-        h = ex + ey == 0 ? h0 : w00 * h0 + (ex ? w10 : w01) * h1;
-#if HFVIS_HAS_NODATA
-#pragma unroll
-        for (int l = 0; l < HFVIS_LANES; ++l) {
-          if (isnan(LANE(h, l)))
-            LANE(h, l) = lattice_height(heights, (uint)ILANE(at, l), (uint)ILANE(right, l),
-                                        (uint)ILANE(down, l), w00, w10, w01, w11);
-        }
-#endif
-      } else {
-#pragma unroll
-        for (int l = 0; l < HFVIS_LANES; ++l)
-          LANE(h, l) = lattice_height(heights, (uint)ILANE(at, l), (uint)ILANE(right, l),
-                                      (uint)ILANE(down, l), w00, w10, w01, w11);
-      }
-#if HFVIS_HAS_NODATA
-      const lane_int valid = ok & !isnan(h);
-#else
-      const lane_int valid = ok;
-#endif
       const float here = base - s->tau;
+#if HFVIS_MAX_DISTANCE
+      const int sample_block = (int)floor(here * inv_window);
+      if (sample_block != block) {
+        far_part = block != INT_MIN;
+        if (far_part)
+          window_pass(heights, width, height, samples, n_samples, a, b, period, window, inv_window, drop, c, r,
+                      receivers, stack, entry, i, q, sample_block, trips, stacks, window_far);
+        block = sample_block;
+        n = 0;
+      }
+#endif
+      lane_int valid;
+      h = lane_sample_height(heights, width, height, s, c, r, live, i == 0, &valid);
 #if HFVIS_CURVATURE
       // The Earth's drop below the receiver p, drop (p - here)^2, is a parabola along the line:
       // subtracting drop * here^2 from every sample instead changes every slope from p by the
@@ -313,49 +480,24 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 #else
       const lane_float hs = h;
 #endif
-      // Pop while the entry below the top casts at least as steep a slope on the sample as
-      // the top. Every pop loads the next entry down before it is known to be needed, so
-      // the load does not wait for the comparison (it is used only where a lane pops).
-      lane_float v1h = top_h - hs, v1d = here - top_p, v2h = below_h - hs, v2d = here - below_p;
-      lane_int popping = valid & (n > 1);
-      lane_int deeper = stack + (n - 3) * entry;  // entry n - 3, below `below`
-      while (ANY_LANE(popping)) {
-        lane_float next_h, next_p;
-#pragma unroll
-        for (int l = 0; l < HFVIS_LANES; ++l) {
-          const int k = max(ILANE(deeper, l), ILANE(stack, l));
-          const float2 e = stacks[k];
-          LANE(next_h, l) = e.x;
-          LANE(next_p, l) = e.y;
-        }
-        const lane_int pop = popping & (v2h * v1d >= v1h * v2d);
-        v1h = select(v1h, v2h, pop);
-        v1d = select(v1d, v2d, pop);
-        top_h = select(top_h, below_h, pop);
-        top_p = select(top_p, below_p, pop);
-        below_h = select(below_h, next_h, pop);
-        below_p = select(below_p, next_p, pop);
-        v2h = below_h - hs;
-        v2d = here - below_p;
-        n = select(n, n - 1, pop);
-        popping = pop & (n > 1);
-        deeper -= entry;
-      }
-      const lane_int push = stack + n * entry;
+      hull_step(stacks, stack, entry, valid, hs, here, 1.0f, &n, &top_h, &top_p, &below_h, &below_p, &rise, &run);
+    }
+#if HFVIS_MAX_DISTANCE
+    if (far_part) {
+      // The steeper of the block's own occluder and the block before's (which wins ties: it
+      // is farther).
+      lane_float rise2, run2;
 #pragma unroll
       for (int l = 0; l < HFVIS_LANES; ++l) {
-        if (ILANE(valid, l)) {
-          stacks[ILANE(push, l)] = (float2)(LANE(hs, l), here);
-        }
+        const float2 f = window_far[ILANE(live, l) ? (uint)(ILANE(r, l) * width + ILANE(c, l)) : 0u];
+        LANE(rise2, l) = f.x;
+        LANE(run2, l) = f.y;
       }
-      rise = select(rise, v1h, valid);
-      run = select(run, select((lane_float)0.0f, v1d, n > 0), valid);  // 0: no occluder
-      below_h = select(below_h, top_h, valid);
-      below_p = select(below_p, top_p, valid);
-      top_h = select(top_h, hs, valid);
-      top_p = select(top_p, (lane_float)here, valid);
-      n = select(n, n + 1, valid);
+      const lane_int use2 = (run2 > 0.0f) & ((run <= 0.0f) | (rise2 * run >= rise * run2));
+      rise = select(rise, rise2, use2);
+      run = select(run, run2, use2);
     }
+#endif
     // The receivers (the last sample of the period, h its height): the steeper of the hull's
     // occluder and the limit at the receiver, compared without a division (both runs are
     // positive); the occluder wins ties (it is the farther point casting that elevation).
@@ -388,11 +530,12 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 // longest ray of the group's tile), and a barrier ends every step: PoCL runs the work-items
 // inside each step, the
 // one loop it vectorises (the march ran 5x faster that way on PoCL); samples past a
-// pixel's own exit are masked. Global size: (W, H) rounded up to the local size (the tile).
+// pixel's own exit are masked; with a maximum distance the march ends after `max_steps`
+// (else INT_MAX). Global size: (W, H) rounded up to the local size (the tile).
 __kernel void horizon_naive(__global const float* heights, int width, int height, float dir_x, float dir_y,
-                            float step_length, float ground_per_pixel, float drop, float cos_azimuth,
-                            float sin_azimuth,
-                            float weight, float swath, uint plane, __global const float4* normals,
+                            float step_length, float ground_per_pixel, float drop, int max_steps,
+                            float cos_azimuth, float sin_azimuth, float weight, float swath, uint plane,
+                            __global const float4* normals,
                             __global float* angles, __global float* distances, __global float* svf_sum,
                             __global float* ao_sum) {
   int c = get_global_id(0), r = get_global_id(1);
@@ -400,7 +543,7 @@ __kernel void horizon_naive(__global const float* heights, int width, int height
   int cc = min(c, width - 1), rr = min(r, height - 1);
   const uint pixel = (uint)(rr * width + cc);
   const float h = heights[pixel];
-  const int steps = (int)(tile_reach(dir_x, dir_y, width, height) / step_length) + 1;
+  const int steps = min((int)(tile_reach(dir_x, dir_y, width, height) / step_length) + 1, max_steps);
   float best_rise = 0.0f;  // height gain to the steepest sample so far
   int best_step = 0;       // its step, 0 = none yet
   for (int i = 1; i <= steps; ++i) {

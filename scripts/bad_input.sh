@@ -109,7 +109,8 @@ try "lines per unit (removed: every sweep runs one line through each pixel centr
 try "refraction out of range" "" -- svf field.exr -o out/o.exr --refraction 2
 try "curvature for the bounce (not supported)" "" -- bounce field.exr --radiance field.exr -o out/b.exr --curvature
 try "maximum distance zero" "" -- viewcount field.exr -o out/o.exr --max-distance 0
-try "maximum distance for horizons (not supported yet)" "" -- svf field.exr -o out/o.exr --max-distance 10
+try "maximum distance for the bounce (not supported)" "" -- bounce field.exr --radiance field.exr -o out/b.exr --max-distance 10
+try "maximum distance too short for the field" "" -- svf field.exr -o out/o.exr --max-distance 1e-9
 try "cell size zero" "" -- svf field.exr -o out/o.exr --cell-size 0
 try "cell size negative" "" -- svf field.exr -o out/o.exr --cell-size 1,-2
 try "cell size not a number" "" -- svf field.exr -o out/o.exr --cell-size 1,abc

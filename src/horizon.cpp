@@ -27,9 +27,11 @@ constexpr std::size_t kStackEntryBytes = 2 * sizeof(float);  // (height, positio
 // the step-major layout, whose neighbouring work-items read neighbouring stack entries.
 int sweepLanes(const ContextState& st) { return lineMajorLayout(st) && st.info.type == "CPU" ? 8 : 1; }
 
-std::string programOptions(const HorizonOutputs& outputs, bool has_nodata, int lanes, bool curvature) {
+std::string programOptions(const HorizonOutputs& outputs, bool has_nodata, int lanes, bool curvature,
+                           bool max_distance) {
   std::ostringstream s;
   s << "-DHFVIS_LANES=" << lanes << " -DHFVIS_HAS_NODATA=" << has_nodata << " -DHFVIS_CURVATURE=" << curvature
+    << " -DHFVIS_MAX_DISTANCE=" << max_distance
     << " -DHFVIS_WANT_ANGLES=" << outputs.horizon_angles
     << " -DHFVIS_WANT_DISTANCES=" << outputs.horizon_distances
     << " -DHFVIS_WANT_SVF=" << outputs.sky_view_factor << " -DHFVIS_WANT_AO=" << outputs.ambient_occlusion;
@@ -43,6 +45,8 @@ struct RunDirection {
   std::vector<LatticeSample> samples;
   float cos_azimuth = 1.0f, sin_azimuth = 0.0f;  // as the scalar reference rounds them
   std::vector<LatticeLine> lines;                // sweep: the direction's lines over the field
+  LatticeWindow window;                          // sweep: the maximum distance along its lines
+  int max_steps = kAllSteps;                     // naive march: the steps within the maximum distance
 };
 
 // How a run uses its device memory budget: directions per downloaded batch of planes and
@@ -59,8 +63,9 @@ RunPlan planRun(const HeightField& field, const HorizonOptions& options, const H
       options.memory_budget_bytes ? options.memory_budget_bytes : defaultMemoryBudget(device);
   const std::size_t max_alloc = device.max_allocation_bytes ? device.max_allocation_bytes : budget;
   const std::size_t plane = field.pixelCount() * sizeof(float);
-  const std::size_t fixed =
-      plane * (1 + outputs.sky_view_factor + outputs.ambient_occlusion * 5);  // + float4 normals
+  // Heights, the sums, float4 normals, the window's float2 per pixel.
+  const std::size_t fixed = plane * (1 + outputs.sky_view_factor + outputs.ambient_occlusion * 5 +
+                                     (sweep && options.max_distance > 0.0) * 2);
   const std::size_t per_direction = plane * (outputs.horizon_angles + outputs.horizon_distances);
   // Scratch: all of a direction's stacks in one launch when it fits; one line at a time at least.
   std::size_t whole = 0, longest = 0;
@@ -110,7 +115,7 @@ std::vector<RunDirection> runDirectionsOf(const HeightField& field, const Horizo
     for (const LatticeDirection& d : horizonDirections(field, options, outputs))
       out.push_back({d, SweepDirection{}, latticeSamples(d, options.samples_per_unit),
                      static_cast<float>(std::cos(d.azimuth)), static_cast<float>(std::sin(d.azimuth)),
-                     latticeLines(d, field.width, field.height)});
+                     latticeLines(d, field.width, field.height), latticeWindow(field, d, options.max_distance)});
   } else {
     const std::vector<SweepDirection> rays = runDirections(field, options);
     for (int k = 0; k < options.directions; ++k) {
@@ -121,6 +126,7 @@ std::vector<RunDirection> runDirectionsOf(const HeightField& field, const Horizo
       r.lattice.weight = 1.0 / options.directions;
       r.cos_azimuth = d.cos_azimuth;
       r.sin_azimuth = d.sin_azimuth;
+      r.max_steps = stepsWithin(options.max_distance, double(d.step_length) * d.ground_per_pixel);
       out.push_back(r);
     }
   }
@@ -138,7 +144,8 @@ class HorizonRoutine : public SweepRoutine {
  private:
   std::string programFile() const override { return "horizon.cl"; }
   std::string programOptions() const override {
-    return detail::programOptions(outputs_, prepared_.has_nodata, sweepLanes(st_), horizon_.curvature != 0.0);
+    return detail::programOptions(outputs_, prepared_.has_nodata, sweepLanes(st_), horizon_.curvature != 0.0,
+                                  horizon_.max_distance > 0.0);
   }
 
   void allocate() override {
@@ -156,6 +163,8 @@ class HorizonRoutine : public SweepRoutine {
     ao_ = zeros(outputs_.ambient_occlusion ? plane : 0);
     normals_ = deviceBuffer(st_, outputs_.ambient_occlusion ? 4 * plane * sizeof(float) : 0);
     stacks_ = st_.reusableBuffer("lattice stacks", plan.stack_entries * kStackEntryBytes);
+    const bool window = horizon_.method == HorizonMethod::Sweep && horizon_.max_distance > 0.0;
+    window_far_ = deviceBuffer(st_, window ? 2 * plane * sizeof(float) : 0);
     stack_entries_ = plan.stack_entries;
     if (outputs_.ambient_occlusion) {
       cl::Kernel normals(program_, "pixel_normals");
@@ -217,6 +226,7 @@ class HorizonRoutine : public SweepRoutine {
     if (horizon_.method == HorizonMethod::Sweep) {
       kernel.setArg(arg++, stacks_);
       stride_arg_ = arg++;  // set per chunk (launchLineChunks)
+      kernel.setArg(arg++, window_far_);
     }
     kernel.setArg(arg++, normals_);
     kernel.setArg(arg++, angles_);
@@ -241,7 +251,9 @@ class HorizonRoutine : public SweepRoutine {
     kernel.setArg(10, static_cast<float>(d.lattice.ground_per_pixel));
     kernel.setArg(11, static_cast<float>(d.lattice.period * d.lattice.ground_per_pixel));
     kernel.setArg(12, curvatureDrop(d.lattice.ground_per_pixel));
-    setOutputs(kernel, 13, d, plane_offset);
+    kernel.setArg(13, d.window.window);
+    kernel.setArg(14, d.window.inv_window);
+    setOutputs(kernel, 15, d, plane_offset);
     LineChunkArguments chunk;
     chunk.lines = 3;
     chunk.count = 4;
@@ -262,7 +274,8 @@ class HorizonRoutine : public SweepRoutine {
     kernel.setArg(5, d.ray.step_length);
     kernel.setArg(6, d.ray.ground_per_pixel);
     kernel.setArg(7, curvatureDrop(d.ray.ground_per_pixel));
-    setOutputs(kernel, 8, d, plane_offset);
+    kernel.setArg(8, d.max_steps);
+    setOutputs(kernel, 9, d, plane_offset);
     st_.launch(kernel, cl::NDRange(roundUp(field_.width, kTileX), roundUp(field_.height, kTileY)),
                cl::NDRange(kTileX, kTileY));
   }
@@ -272,7 +285,7 @@ class HorizonRoutine : public SweepRoutine {
   std::vector<RunDirection> directions_;
   HorizonResult result_;
   int batch_ = 1;
-  cl::Buffer angles_, distances_, svf_, ao_, normals_, stacks_;
+  cl::Buffer angles_, distances_, svf_, ao_, normals_, stacks_, window_far_;
   std::size_t stack_entries_ = 0;
   int stride_arg_ = 0;  // horizon_lattice's `stride` argument
   int lanes_ = 1;       // HFVIS_LANES of the program

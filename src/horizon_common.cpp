@@ -11,8 +11,6 @@ namespace hfvis {
 
 void validate(const HorizonOptions& options, const HorizonOutputs& outputs) {
   validate(static_cast<const SweepOptions&>(options));
-  if (options.max_distance != 0.0)
-    throw InvalidArgument("a maximum distance is not supported for horizons yet (visible counts take it)");
   if (!(options.azimuth_tolerance > 0.0) || !(options.azimuth_tolerance <= 0.1)) {
     throw InvalidArgument("the azimuth tolerance must be in (0, 0.1] radians, (0, 5.73] degrees (got " +
                           std::to_string(options.azimuth_tolerance * 180.0 / M_PI) + " degrees)");

@@ -60,11 +60,6 @@ std::size_t TreeDirection::longestLine() const {
   return longest;
 }
 
-int stepsWithin(double max_distance, double step_ground) {
-  if (max_distance <= 0.0) return kAllSteps;
-  return static_cast<int>(std::min<double>(kAllSteps, std::floor(max_distance / step_ground)));
-}
-
 TreeDirection makeTreeDirection(const HeightField& field, const LatticeDirection& lattice, double samples_per_unit,
                                 int directions, double curvature, double max_distance) {
   TreeDirection d;

@@ -16,9 +16,6 @@
 
 namespace hfvis::detail {
 
-// No maximum distance: more steps than any line has.
-constexpr int kAllSteps = 1 << 30;
-
 // One direction of the hull tree sweep: a lattice direction (every pixel centre on one of
 // its lines, see lattice_geometry.hpp) sampled uniformly, per_period samples per period, and
 // what the kernels scale its results by. The same for the device path and the references.
@@ -59,9 +56,6 @@ std::vector<TreeDirection> treeDirections(const HeightField& field, const SweepO
 // One of them: `lattice` (its weight set) sampled at S samples per unit, in a run of K directions.
 TreeDirection makeTreeDirection(const HeightField& field, const LatticeDirection& lattice, double samples_per_unit,
                                 int directions, double curvature = 0.0, double max_distance = 0.0);
-
-// Steps of `step_ground` ground units within `max_distance` (0: kAllSteps).
-int stepsWithin(double max_distance, double step_ground);
 
 // Limits of the kernels' exact arithmetic, checked before launching: a line has fewer than
 // 2^24 steps (steps are exact floats in the predicate), and |height| * steps stays far

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <sstream>
 
 #include "hfvis/errors.hpp"
 
@@ -227,6 +228,23 @@ std::vector<LineChunk> chunkLines(std::vector<LatticeLine>& lines, std::size_t s
   }
   close();
   return chunks;
+}
+
+LatticeWindow latticeWindow(const HeightField& field, const LatticeDirection& d, double max_distance) {
+  LatticeWindow w;
+  if (max_distance <= 0.0) return w;
+  const double pixels = max_distance / d.ground_per_pixel;
+  // Positions along a line stay below 2 (W + H) pixels.
+  const double longest = 2.0 * (static_cast<double>(field.width) + field.height);
+  if (longest / pixels >= double(1 << 30)) {
+    std::ostringstream message;
+    message << "the maximum distance " << max_distance << " is too short for a field of this size (at least "
+            << longest / double(1 << 30) * d.ground_per_pixel << " ground units)";
+    throw InvalidArgument(message.str());
+  }
+  w.window = static_cast<float>(pixels);
+  w.inv_window = static_cast<float>(1.0 / pixels);
+  return w;
 }
 
 }  // namespace hfvis::detail

@@ -103,4 +103,14 @@ std::vector<LineChunk> chunkLines(std::vector<LatticeLine>& lines, std::size_t s
 // a time.
 std::size_t lineCapacity(const LatticeLine& line, std::size_t samples_per_period);
 
+// A maximum distance along direction d as horizon_lattice takes it (HFVIS_MAX_DISTANCE):
+// `window` pixels along the line (max_distance over the ground length per pixel) and its
+// reciprocal, whose product with a position is the position's block. Both the kernel and the
+// reference get these very floats. Both 0 without a maximum distance. Throws InvalidArgument
+// when the window is so short that a position's block would overflow an int.
+struct LatticeWindow {
+  float window = 0.0f, inv_window = 0.0f;
+};
+LatticeWindow latticeWindow(const HeightField& field, const LatticeDirection& d, double max_distance);
+
 }  // namespace hfvis::detail

@@ -120,4 +120,9 @@ void checkPixelIndexing(const HeightField& field, int planes) {
   }
 }
 
+int stepsWithin(double max_distance, double step_ground) {
+  if (max_distance <= 0.0) return kAllSteps;
+  return static_cast<int>(std::min<double>(kAllSteps, std::floor(max_distance / step_ground)));
+}
+
 }  // namespace hfvis::detail

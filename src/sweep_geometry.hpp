@@ -72,4 +72,11 @@ void checkPixelIndexing(const HeightField& field, int planes);
 // Sample pitch at which positions count as inside; must equal HFVIS_EDGE_EPS.
 constexpr float kEdgeEpsilon = 1e-3f;
 
+// No maximum distance: more steps than any line or ray has.
+constexpr int kAllSteps = 1 << 30;
+
+// Steps of `step_ground` ground units within `max_distance` (0: kAllSteps): the steps a
+// march or a uniformly sampled line takes within a maximum distance.
+int stepsWithin(double max_distance, double step_ground);
+
 }  // namespace hfvis::detail

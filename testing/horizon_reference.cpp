@@ -130,8 +130,9 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
     const float gpp = static_cast<float>(d.ground_per_pixel);
     const float drop = static_cast<float>(options.curvature * d.ground_per_pixel * d.ground_per_pixel);
     const float period_ground = static_cast<float>(d.period * d.ground_per_pixel);
+    const LatticeWindow window = latticeWindow(field, d, options.max_distance);
     for (const LatticeLine& line : latticeLines(d, width, height)) {
-      for (const LatticeLineSample& s : latticeLineSamples(field, h, d, samples, line, drop)) {
+      for (const LatticeLineSample& s : latticeLineSamples(field, h, d, samples, line, drop, window)) {
         if (s.receiver < 0) continue;
         const std::size_t pixel = static_cast<std::size_t>(s.receiver);
         if (std::isnan(s.height)) {
@@ -163,6 +164,7 @@ void naiveReference(const HeightField& field, const PreparedHeights& prepared, c
     const SweepDirection& d = directions[k];
     const DirectionOutputs out{d.cos_azimuth, d.sin_azimuth, static_cast<float>(1.0 / options.directions), k};
     const float drop = static_cast<float>(options.curvature * double(d.ground_per_pixel) * double(d.ground_per_pixel));
+    const int max_steps = stepsWithin(options.max_distance, double(d.step_length) * d.ground_per_pixel);
     for (int r = 0; r < height; ++r) {
       for (int c = 0; c < width; ++c) {
         const std::size_t pixel = static_cast<std::size_t>(r) * width + c;
@@ -171,7 +173,7 @@ void naiveReference(const HeightField& field, const PreparedHeights& prepared, c
         int best_step = 0;
         // March until the ray has left the field for good (the kernel's trip count may be
         // longer; the extra samples are outside and masked).
-        for (int i = 1;; ++i) {
+        for (int i = 1; i <= max_steps; ++i) {
           const float t = static_cast<float>(i) * d.step_length;
           const Point2 p{static_cast<float>(c) + t * d.dir_x, static_cast<float>(r) + t * d.dir_y};
           if (!insideField(p, width, height)) break;
@@ -197,50 +199,116 @@ void naiveReference(const HeightField& field, const PreparedHeights& prepared, c
 std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, const std::vector<float>& h,
                                                   const LatticeDirection& d,
                                                   const std::vector<LatticeSample>& samples,
-                                                  const LatticeLine& line, float drop) {
+                                                  const LatticeLine& line, float drop, const LatticeWindow& window) {
   const int width = field.width, height = field.height;
   const float period = static_cast<float>(d.period);
-  std::vector<LatticeLineSample> out;
-  // Algorithm 1 of Timonen & Westerholm 2010 along the line, as horizon_lattice.
-  std::vector<std::pair<float, float>> stack;  // (height, position)
+  const bool windowed = window.window > 0.0f;
+  // Every sample of the line in sweep order (height NaN where it is absent: outside the field
+  // or without height), with its block (horizon_lattice's window_pass) and its height as the
+  // stack holds it (the kernel's curvature transform, an exact no-op at drop 0).
+  struct Raw {
+    LatticeLineSample sample;
+    int block = 0;
+    float stacked = 0.0f;
+  };
+  std::vector<Raw> raw;
   int c = line.col, r = line.row;
   for (int i = 0; i < line.receivers; ++i, c -= d.a, r -= d.b) {
     const float base = static_cast<float>(i) * period;
     for (std::size_t q = 0; q < samples.size(); ++q) {
       const LatticeSample& s = samples[q];
+      Raw e;
+      e.sample.position = base - s.tau;
+      e.sample.height = kNaN;
+      e.block = windowed ? static_cast<int>(std::floor(e.sample.position * window.inv_window)) : 0;
       const int x0 = c + s.ox, y0 = r + s.oy;
-      if (x0 < 0 || x0 + s.ex > width - 1 || y0 < 0 || y0 + s.ey > height - 1) continue;
-      const std::size_t at = static_cast<std::size_t>(y0) * width + x0;
-      LatticeLineSample sample;
-      sample.height = latticeHeight(h, at, s.ex, static_cast<std::size_t>(s.ey) * width, s);
-      sample.position = base - s.tau;
-      sample.receiver = q + 1 == samples.size() ? static_cast<long>(at) : -1;
-      if (std::isnan(sample.height)) {
-        if (sample.receiver >= 0) out.push_back(sample);
-        continue;
+      if (x0 >= 0 && x0 + s.ex <= width - 1 && y0 >= 0 && y0 + s.ey <= height - 1) {
+        const std::size_t at = static_cast<std::size_t>(y0) * width + x0;
+        e.sample.height = latticeHeight(h, at, s.ex, static_cast<std::size_t>(s.ey) * width, s);
+        e.sample.receiver = q + 1 == samples.size() ? static_cast<long>(at) : -1;
       }
-      // The kernel's curvature transform (an exact no-op at drop 0).
-      const float here = sample.position, hq = sample.height - drop * here * here;
-      if (!stack.empty()) {
-        auto top = stack.back();
-        float v1h = top.first - hq, v1d = here - top.second;
-        while (stack.size() > 1) {
-          const auto below = stack[stack.size() - 2];
-          const float v2h = below.first - hq, v2d = here - below.second;
-          if (v2h * v1d >= v1h * v2d) {
-            top = below, v1h = v2h, v1d = v2d;
-            stack.pop_back();
+      e.stacked = e.sample.height - drop * e.sample.position * e.sample.position;
+      raw.push_back(e);
+    }
+  }
+  using Entry = std::pair<float, float>;  // (stacked height, position)
+  // Algorithm 1 of Timonen & Westerholm 2010, one sample arriving beyond every entry of the
+  // stack (toward +1: positions grow; -1: they shrink), as hull_step: returns (rise, run) of
+  // the occluder and its depth (-1: none), then pushes the sample.
+  auto hullStep = [](std::vector<Entry>& stack, float hs, float here, float toward, float* rise, float* run) {
+    long depth = -1;
+    if (!stack.empty()) {
+      auto top = stack.back();
+      float v1h = top.first - hs, v1d = toward > 0.0f ? here - top.second : top.second - here;
+      while (stack.size() > 1) {
+        const auto below = stack[stack.size() - 2];
+        const float v2h = below.first - hs, v2d = toward > 0.0f ? here - below.second : below.second - here;
+        if (v2h * v1d >= v1h * v2d) {
+          top = below, v1h = v2h, v1d = v2d;
+          stack.pop_back();
+        } else {
+          break;
+        }
+      }
+      depth = static_cast<long>(stack.size()) - 1;
+      *rise = v1h;
+      *run = v1d;
+    }
+    stack.emplace_back(hs, here);
+    return depth;
+  };
+  // The forward sweep, restarted at every block.
+  std::vector<Entry> stack;
+  std::vector<Entry> far(raw.size(), Entry(0.0f, 0.0f));  // window_pass's (rise, run) per receiver
+  int block = raw.empty() ? 0 : raw.front().block;
+  for (std::size_t t = 0; t < raw.size(); ++t) {
+    if (raw[t].block != block) {
+      // window_pass for the new block: its receivers nearest first, the block before's samples
+      // pushed backwards once within the window, the tangent by binary search.
+      const int k = raw[t].block;
+      std::size_t end = t;
+      while (end < raw.size() && raw[end].block == k) ++end;
+      std::vector<Entry> back;
+      std::size_t cursor = t;  // samples [0, cursor) not pushed yet
+      float unused_rise = 0.0f, unused_run = 0.0f;
+      for (std::size_t j = end; j-- > t;) {
+        if (j % samples.size() != samples.size() - 1) continue;  // not a period's receiver
+        const float x = raw[j].sample.position;
+        while (cursor > 0 && raw[cursor - 1].block == k - 1 && !(x - raw[cursor - 1].sample.position > window.window)) {
+          const Raw& e = raw[--cursor];
+          if (!std::isnan(e.sample.height)) hullStep(back, e.stacked, e.sample.position, -1.0f, &unused_rise, &unused_run);
+        }
+        const float hs = raw[j].stacked;
+        std::size_t lo = 0, hi = back.empty() ? 0 : back.size() - 1;
+        while (lo < hi) {
+          const std::size_t mid = (lo + hi) >> 1;
+          const Entry e0 = back[mid], e1 = back[mid + 1];
+          if ((e1.first - hs) * (x - e0.second) >= (e0.first - hs) * (x - e1.second)) {
+            lo = mid + 1;
           } else {
-            break;
+            hi = mid;
           }
         }
-        sample.occluder = static_cast<long>(stack.size()) - 1;
-        sample.occluder_rise = v1h;
-        sample.occluder_run = v1d;
+        if (!back.empty()) far[j] = Entry(back[lo].first - hs, x - back[lo].second);
       }
-      stack.emplace_back(hq, here);
-      out.push_back(sample);
+      block = k;
+      stack.clear();
     }
+    Raw& e = raw[t];
+    if (std::isnan(e.sample.height)) continue;
+    e.sample.occluder = hullStep(stack, e.stacked, e.sample.position, 1.0f, &e.sample.occluder_rise,
+                                 &e.sample.occluder_run);
+    // The steeper of the block's own occluder and the block before's (which wins ties).
+    const auto [rise2, run2] = far[t];
+    if (run2 > 0.0f && (e.sample.occluder_run <= 0.0f || rise2 * e.sample.occluder_run >= e.sample.occluder_rise * run2)) {
+      e.sample.occluder = 0;
+      e.sample.occluder_rise = rise2;
+      e.sample.occluder_run = run2;
+    }
+  }
+  std::vector<LatticeLineSample> out;
+  for (const Raw& e : raw) {
+    if (!std::isnan(e.sample.height) || e.sample.receiver >= 0) out.push_back(e.sample);
   }
   return out;
 }

@@ -26,11 +26,15 @@ struct LatticeLineSample {
 // The samples of one line of direction d (prepared heights h), with Algorithm 1 run over
 // them exactly as horizon_lattice runs it; with `drop` (curvature per pixel squared along the
 // line) the stack holds the heights lowered by drop * position^2, and occluder_rise is that
-// stack's (the receiver adds -2 drop position run).
+// stack's (the receiver adds -2 drop position run). With a window (a maximum distance), as
+// horizon_lattice with HFVIS_MAX_DISTANCE: the receivers' occluders are the steepest samples
+// within the window (occluder 0 where it lies in the block before the receiver's); the other
+// samples' occluders are those of their own block only.
 std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, const std::vector<float>& h,
                                                   const LatticeDirection& d,
                                                   const std::vector<LatticeSample>& samples,
-                                                  const LatticeLine& line, float drop = 0.0f);
+                                                  const LatticeLine& line, float drop = 0.0f,
+                                                  const LatticeWindow& window = {});
 
 // lattice_height in the kernels: the bilinear height of sample s whose cell corner is at
 // entry `at` (right = 1 or 0, down = width or 0), over the valid corners.

@@ -679,6 +679,42 @@ TEST_F(Cli, CurvatureLowersFarTerrainByTheEarthsDrop) {
                 "--refraction");
 }
 
+// --max-distance D: a wall 30 high 500 m of ground away is the horizon with D = 600 m and
+// gone with D = 400 m (flat ground: 0), in horizon, svf and ao (whose values rise to those of
+// flat ground); the attribute records D; horizon lists and the bounce refuse it.
+TEST_F(Cli, MaxDistanceLimitsTheTerrainThatCounts) {
+  const std::string wall = writeField("wall.exr", 40, 5, [](int x, int) { return x >= 30 ? 30.0f : 0.0f; });
+  auto value = [&](const std::string& command, const std::string& options) {
+    fs::remove(out("h.exr"));
+    const CliResult result = run(command + " " + shellQuoted(wall) + " -o " + shellQuoted(out("h.exr")) +
+                                 " -k 4 --cell-size 50 " + options);
+    EXPECT_EQ(result.status, 0) << options << ": " << result.err;
+    const ReadBack h = readBack(out("h.exr"));
+    EXPECT_EQ(h.spec.get_string_attribute("hfvis:max_distance").empty(),
+              options.find("--max-distance") == std::string::npos)
+        << options;
+    return h.at(20, 2, 0);  // horizon: toward +x, 10 pixels = 500 m from the wall
+  };
+  for (const char* method : {"sweep", "naive"}) {
+    SCOPED_TRACE(method);
+    const std::string m = std::string(" --method ") + method;
+    EXPECT_NEAR(value("horizon", m), std::atan(30.0 / 500.0), 1e-6);
+    EXPECT_NEAR(value("horizon", m + " --max-distance 600"), std::atan(30.0 / 500.0), 1e-6);
+    EXPECT_NEAR(value("horizon", m + " --max-distance 400"), 0.0, 1e-6);
+    EXPECT_LT(value("svf", m), 1.0f);
+    EXPECT_NEAR(value("svf", m + " --max-distance 400"), 1.0, 1e-6);
+    EXPECT_LT(value("ao", m), 1.0f);
+    EXPECT_NEAR(value("ao", m + " --max-distance 400"), 1.0, 1e-5);
+  }
+  fs::remove(out("h.exr"));
+  expectFailure(run("horizons " + shellQuoted(wall) + " --at 1,1 -o " + shellQuoted(out("h.json")) +
+                    " --max-distance 10"),
+                2, "--max-distance");
+  expectFailure(run("bounce " + shellQuoted(wall) + " --radiance " + shellQuoted(wall) + " -o " +
+                    shellQuoted(out("b.exr")) + " --max-distance 10"),
+                2, "--max-distance");
+}
+
 // viewcount on a flat plane, K = 4 (the axes): every sample is visible, and a pixel's
 // rays along its row and column hold (W - 1) S + (H - 1) S samples at S samples per pixel
 // length; the line samples swept (--stats) grow S-fold.

@@ -17,10 +17,12 @@ using testing::testContext;
 
 class HorizonAnalytic : public ::testing::TestWithParam<HorizonMethod> {
  protected:
-  HorizonResult run(const HeightField& field, int directions, HorizonOutputs outputs, double curvature = 0.0) {
+  HorizonResult run(const HeightField& field, int directions, HorizonOutputs outputs, double curvature = 0.0,
+                    double max_distance = 0.0) {
     HorizonOptions options;
     options.directions = directions;
     options.curvature = curvature;
+    options.max_distance = max_distance;
     options.method = GetParam();
     return computeHorizons(testContext(), field, options, outputs);
   }
@@ -83,6 +85,34 @@ TEST_P(HorizonAnalytic, LongWallCastsAtanOfHeightOverDistance) {
       const std::size_t p = row * field.width + c;
       EXPECT_NEAR(r.angles[p], std::atan(30.0 / (2.0 * (30 - c))), 1e-5) << c << "," << row;
       EXPECT_NEAR(r.distances[p], 2.0 * (30 - c), 1e-3) << c << "," << row;
+    }
+  }
+}
+
+// Within a maximum distance D the wall is seen only from where its top is at most D away;
+// farther receivers see flat ground (horizon 0, cast from within D).
+TEST_P(HorizonAnalytic, LongWallBeyondTheMaximumDistanceIsNotSeen) {
+  HeightField field = makeSyntheticField("flat", 40, 9);
+  for (int row = 0; row < field.height; ++row)
+    for (int c = 30; c < field.width; ++c) field.heights[row * field.width + c] += 10.0f;
+  field.cell_size_x = 2.0;
+  HorizonOutputs outputs;
+  outputs.horizon_angles = outputs.horizon_distances = true;
+  for (double max_distance : {7.0, 19.0}) {
+    SCOPED_TRACE("max distance " + std::to_string(max_distance));
+    const auto r = run(field, 4, outputs, 0.0, max_distance);
+    for (int row = 0; row < field.height; ++row) {
+      for (int c = 0; c < 30; ++c) {
+        const std::size_t p = row * field.width + c;
+        const double d = 2.0 * (30 - c);
+        if (d <= max_distance) {
+          EXPECT_NEAR(r.angles[p], std::atan(10.0 / d), 1e-5) << c << "," << row;
+          EXPECT_NEAR(r.distances[p], d, 1e-3) << c << "," << row;
+        } else {
+          EXPECT_NEAR(r.angles[p], 0.0, 1e-6) << c << "," << row;
+          EXPECT_LE(r.distances[p], max_distance) << c << "," << row;
+        }
+      }
     }
   }
 }

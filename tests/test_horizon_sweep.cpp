@@ -77,6 +77,58 @@ TEST(HorizonSweepLine, StackEqualsBruteForceMaximumOnEveryHardCase) {
   }
 }
 
+// The same within a maximum distance (a window of W pixels along the line): every receiver's
+// occluder casts the elevation of the steepest farther sample at most W away, or there is
+// none, on every hard case, for windows shorter than a period, a few periods and longer.
+TEST(HorizonSweepLine, WindowedStackEqualsBruteForceWithinTheWindow) {
+  for (const auto& name : syntheticFieldNames()) {
+    for (auto [w, h] : awkwardSizes()) {
+      const HeightField field = makeSyntheticField(name, w, h, 7);
+      const auto prepared = detail::prepareHeights(field);
+      HorizonOptions options;
+      options.directions = 9;
+      options.azimuth_offset = 0.3;
+      for (double spu : {1.0, 3.0}) {
+        for (float window : {0.6f, 2.37f, 7.9f}) {
+          const detail::LatticeWindow cut{window, 1.0f / window};
+          int checked = 0;
+          for (const auto& d : detail::latticeDirections(field, options, true, options.azimuth_tolerance)) {
+            SCOPED_TRACE(name + " " + std::to_string(w) + "x" + std::to_string(h) + " step (" +
+                         std::to_string(d.a) + ", " + std::to_string(d.b) + ") spu " + std::to_string(spu) +
+                         " window " + std::to_string(window));
+            const auto table = detail::latticeSamples(d, spu);
+            for (const auto& line : detail::latticeLines(d, w, h)) {
+              const auto samples = detail::latticeLineSamples(field, prepared.heights, d, table, line, 0.0f, cut);
+              for (std::size_t q = 0; q < samples.size(); ++q) {
+                const auto& s = samples[q];
+                if (std::isnan(s.height) || s.receiver < 0) continue;
+                double brute = -M_PI;  // steepest farther sample within the window
+                for (std::size_t k = 0; k < q; ++k) {
+                  if (std::isnan(samples[k].height) || s.position - samples[k].position > window) continue;
+                  brute = std::max(brute, std::atan2(double(samples[k].height) - s.height,
+                                                     double(s.position) - samples[k].position));
+                }
+                if (brute == -M_PI) {
+                  ASSERT_EQ(s.occluder_run, 0.0f) << "receiver " << q << " has no sample within the window";
+                  continue;
+                }
+                ASSERT_GT(s.occluder_run, 0.0f) << "receiver " << q;
+                ASSERT_LE(s.occluder_run, window) << "receiver " << q;
+                ASSERT_NEAR(std::atan2(double(s.occluder_rise), double(s.occluder_run)), brute, 1e-6)
+                    << "receiver " << q;
+                ++checked;
+              }
+            }
+          }
+          if (w > 1 && h > 1 && name != "nan_holes" && window > 1.0f) {  // a shorter one may hold none
+            EXPECT_GT(checked, 0);
+          }
+        }
+      }
+    }
+  }
+}
+
 // Every receiver sits on the line through its own centre: each pixel is exactly one
 // receiver of one line per direction, and the sample table puts exact grid crossings on
 // grid lines.
@@ -167,7 +219,8 @@ TEST(HorizonSweepLine, DirectionsHonourTheToleranceAndQuadratureWeightsSumToOne)
 
 // Kernel results equal the scalar reference of the same algorithm, for both methods, in
 // both buffer layouts.
-void expectKernelMatchesReference(HorizonMethod method, double samples_per_unit, double curvature = 0.0) {
+void expectKernelMatchesReference(HorizonMethod method, double samples_per_unit, double curvature = 0.0,
+                                  double max_distance = 0.0) {
   testing::forEachLayout([&](const ComputeContext& context) {
     for (const auto& name : syntheticFieldNames()) {
       for (auto [w, h] : awkwardSizes()) {
@@ -180,6 +233,7 @@ void expectKernelMatchesReference(HorizonMethod method, double samples_per_unit,
         options.method = method;
         options.samples_per_unit = samples_per_unit;
         options.curvature = curvature;
+        options.max_distance = max_distance;
         for (bool planes : {true, false}) {  // exact azimuths, or quadrature directions
           HorizonOutputs outputs;
           outputs.horizon_angles = outputs.horizon_distances = planes;
@@ -216,6 +270,23 @@ TEST(HorizonKernels, NaiveMatchesScalarReferenceWithCurvature) {
   expectKernelMatchesReference(HorizonMethod::Naive, 1.0, 0.004);
 }
 
+// Within a maximum distance (ground units; the cells are 1.5 x 1): shorter than a pixel, a
+// few pixels, about the fields' size.
+TEST(HorizonKernels, SweepMatchesScalarReferenceWithinAMaximumDistance) {
+  for (double d : {1.2, 4.3, 29.0}) {
+    SCOPED_TRACE("max distance " + std::to_string(d));
+    expectKernelMatchesReference(HorizonMethod::Sweep, 1.0, 0.0, d);
+  }
+}
+
+TEST(HorizonKernels, SweepMatchesScalarReferenceWithinAMaximumDistanceDenserAndCurved) {
+  expectKernelMatchesReference(HorizonMethod::Sweep, 2.5, 0.004, 6.1);
+}
+
+TEST(HorizonKernels, NaiveMatchesScalarReferenceWithinAMaximumDistance) {
+  expectKernelMatchesReference(HorizonMethod::Naive, 1.0, 0.0, 4.3);
+}
+
 // On the four axis directions the naive march samples the pixel centres of the receiver's
 // own row or column, which are the sweep's samples, and the sweep's limit at the receiver
 // is the slope to the first pixel. So both give the same horizons.
@@ -234,6 +305,34 @@ TEST(HorizonKernels, SweepEqualsNaiveOnAxisDirections) {
       EXPECT_TRUE(nearlyEqual(sweep.angles, naive.angles, 1e-5f));
     }
   }
+}
+
+// The same within a maximum distance: both count the pixel centres at most D away (D a whole
+// number of pixels, so both cut at the same samples), in both layouts.
+TEST(HorizonKernels, SweepEqualsNaiveOnAxisDirectionsWithinAMaximumDistance) {
+  testing::forEachLayout([&](const ComputeContext& context) {
+    for (const auto& name : syntheticFieldNames()) {
+      for (auto [w, h] : awkwardSizes()) {
+        for (double d : {1.0, 3.0, 10.0}) {
+          SCOPED_TRACE(name + " " + std::to_string(w) + "x" + std::to_string(h) + " max distance " +
+                       std::to_string(d));
+          const HeightField field = makeSyntheticField(name, w, h, 5);
+          HorizonOptions options;
+          options.directions = 4;
+          options.max_distance = d;
+          HorizonOutputs outputs;
+          outputs.horizon_angles = outputs.horizon_distances = true;
+          const auto sweep = computeHorizons(context, field, options, outputs);
+          options.method = HorizonMethod::Naive;
+          const auto naive = computeHorizons(context, field, options, outputs);
+          EXPECT_TRUE(nearlyEqual(sweep.angles, naive.angles, 1e-5f));
+          for (float distance : sweep.distances) {
+            if (!std::isnan(distance)) ASSERT_LE(distance, d);
+          }
+        }
+      }
+    }
+  });
 }
 
 TEST(HorizonKernels, BatchingUnderATinyMemoryBudgetChangesNothing) {
