@@ -5,7 +5,7 @@
 //       the standard suite: writes DIR/results.csv and DIR/environment.txt
 //       (bench/run_report.sh builds, generates inputs, runs this and writes bench/report/)
 //   hfvis_bench run FIELD [--method M] [-k K] [--spu S] [--param P]
-//                   [--outputs angles|svf|ao|device] [--reps N]
+//                   [--outputs angles|svf|ao|device] [--max-distance D] [--reps N]
 //       one method on one field: min and median time and core-ns per pixel-direction
 //       (methods: sweep, naive, radius, pyramid, floor)
 //   hfvis_bench visibility [--quick | --tiny] --out DIR [--data DIR] [--dem FILE] [--commit TEXT]
@@ -53,7 +53,7 @@ constexpr const char* kUsage =
     "usage: hfvis_bench suite [--quick | --tiny] --out DIR [--data DIR] [--dem FILE] [--cache DIR] [--commit "
     "TEXT]\n"
     "       hfvis_bench run FIELD [--method sweep|naive|radius|pyramid|floor] [-k K] [--spu S] [--param P]\n"
-    "                   [--outputs angles|svf|ao|device] [--reps N]\n"
+    "                   [--outputs angles|svf|ao|device] [--max-distance D] [--reps N]\n"
     "       hfvis_bench visibility [--quick | --tiny] --out DIR [--data DIR] [--dem FILE] [--commit TEXT]\n"
     "                              [--sections time,stats,zone,scale,accuracy]\n"
     "       hfvis_bench vis-run FIELD [--method tree|naive] [-k K] [--tuning plain|deferred|default|zone]\n"
@@ -142,6 +142,9 @@ int runOne(Arguments& args) {
     throw Usage("--outputs: angles, svf, ao or device");
   spec.angles = outputs == "angles";
   spec.ambient_occlusion = outputs == "ao";
+  spec.max_distance = number(args.get("--max-distance", "0"), "--max-distance");
+  if (spec.max_distance != 0.0 && spec.kind != MethodKind::Sweep && spec.kind != MethodKind::Naive)
+    throw Usage("--max-distance: the sweep and naive methods only");
   TimingPolicy policy;
   policy.min_reps = policy.max_reps = static_cast<int>(number(args.get("--reps", "3"), "--reps"));
   args.rejectUnused();
@@ -156,7 +159,8 @@ int runOne(Arguments& args) {
       spec.name().c_str(), spec.outputs().c_str(), field.width, field.height, spec.directions,
       spec.samples_per_unit, m.timing.min(), m.timing.median(), m.timing.seconds.size(),
       m.timing.min() * cores / pd * 1e9, context.device().name.c_str(), cores);
-  if (spec.kind != MethodKind::Sweep && spec.kind != MethodKind::Floor && spec.kind != MethodKind::Pyramid) {
+  if (spec.kind != MethodKind::Sweep && spec.kind != MethodKind::Floor && spec.kind != MethodKind::Pyramid &&
+      spec.max_distance == 0.0) {
     const MarchSteps steps =
         naiveMarchSteps(field, spec.directions, spec.samples_per_unit, baselineTileX(), baselineTileY(),
                         spec.kind == MethodKind::Radius ? spec.parameter * spec.samples_per_unit : 0);

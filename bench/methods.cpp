@@ -180,6 +180,7 @@ MethodOutput runMethod(const ComputeContext& context, const HeightField& field, 
   HorizonOptions options;
   options.directions = spec.directions;
   options.samples_per_unit = spec.samples_per_unit;
+  options.max_distance = spec.max_distance;
   options.method = spec.kind == MethodKind::Sweep ? HorizonMethod::Sweep : HorizonMethod::Naive;
   HorizonOutputs outputs;
   outputs.horizon_angles = spec.angles;

@@ -32,6 +32,8 @@ struct MethodSpec {
   // Library methods without angles: ambient occlusion instead of the sky-view factor (the
   // `hfvis ao` job, for the comparison with heman).
   bool ambient_occlusion = false;
+  // Library methods: only terrain within this ground distance counts (0 = the whole field).
+  double max_distance = 0.0;
 
   std::string name() const;     // "sweep", "naive", "radius_16", "pyramid_16", "floor"
   std::string outputs() const;  // "angles", "svf", "ao" or "device"

@@ -16,7 +16,8 @@
 //
 // ambient_term: uniform-sky irradiance of one azimuthal swath (Eq. 5 of Timonen &
 // Westerholm 2010) of width 2 pi * weight, normalised so that a flat plane sums to 1 over a
-// run's swaths, at a receiver of unit normal (nx, ny, nz). With elevation e and zenith
+// run's swaths, at a receiver of unit normal (nx, ny, nz); linear in the normal (a multiple
+// of it scales the term: x and `behind` are ratios). With elevation e and zenith
 // angle z = pi/2 - e, Eq. 5's sin^2 z = cos^2 e = 1 / (1 + x^2) and sin 2z / 2 = x cos^2 e for
 // x = tan e, so only e itself needs an arctangent. The sky behind the surface (N . e < 0)
 // does not count: the horizon is at least the tangent plane's slope -toward / nz in this

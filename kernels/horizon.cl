@@ -48,11 +48,12 @@
 #define HFVIS_MAX_DISTANCE 0
 #endif
 
-// Unit normal at pixel (c, r): the normalised sum of the unnormalised normals of the (up to)
-// four quads around it (Timonen & Westerholm 2010, Sec. 7), in ground units; quads touching nodata
-// or the border are left out; (0, 0, 1) when none is left.
-HFVIS_INLINE void surface_normal(__global const float* heights, int width, int height, int c, int r, float h,
-                                 float cell_x, float cell_y, float* nx, float* ny, float* nz) {
+// The normal at pixel (c, r), the sum of the unnormalised normals of the (up to) four quads
+// around it (Timonen & Westerholm 2010, Sec. 7) in ground units, divided by its z: the normal
+// is (x, y, 1) / |(x, y, 1)|, and (x, y) its slopes. Quads touching nodata or the border are
+// left out; (0, 0) when none is left.
+HFVIS_INLINE float2 surface_slopes(__global const float* heights, int width, int height, int c, int r, float h,
+                                   float cell_x, float cell_y) {
   // Straight-line scalar code (clamped reads, masked sums) so that PoCL vectorises callers.
   float sx_sum = 0.0f, sy_sum = 0.0f, sz_sum = 0.0f;
   for (int q = 0; q < 4; ++q) {
@@ -68,23 +69,29 @@ HFVIS_INLINE void surface_normal(__global const float* heights, int width, int h
     sy_sum += use ? -gy : 0.0f;
     sz_sum += use ? 1.0f : 0.0f;
   }
-  float length = sqrt(sx_sum * sx_sum + sy_sum * sy_sum + sz_sum * sz_sum);
   int any = sz_sum > 0.0f;
-  *nx = any ? sx_sum / length : 0.0f;
-  *ny = any ? sy_sum / length : 0.0f;
-  *nz = any ? sz_sum / length : 1.0f;
+  return (float2)(any ? sx_sum / sz_sum : 0.0f, any ? sy_sum / sz_sum : 0.0f);
 }
 
-// Every pixel's unit normal as (x, y, z, 0), one 16-byte load per receiver, for ambient
-// occlusion. Global size: (W, H) rounded up.
+// Every pixel's normal as its slopes (surface_slopes), 8 bytes per pixel, for ambient
+// occlusion. ambient_term is linear in the normal (its arctangent argument and its test
+// are ratios), so the sweep passes (x, y, 1) and occlusion_scale divides the sum by
+// |(x, y, 1)| once at the end. Global size: (W, H) rounded up.
 __kernel void pixel_normals(__global const float* heights, int width, int height, float cell_x, float cell_y,
-                            __global float4* normals) {
+                            __global float2* normals) {
   int c = get_global_id(0), r = get_global_id(1);
   if (c >= width || r >= height) return;
   const uint pixel = (uint)(r * width + c);
-  float nx, ny, nz;
-  surface_normal(heights, width, height, c, r, heights[pixel], cell_x, cell_y, &nx, &ny, &nz);
-  normals[pixel] = (float4)(nx, ny, nz, 0.0f);
+  normals[pixel] = surface_slopes(heights, width, height, c, r, heights[pixel], cell_x, cell_y);
+}
+
+// The occlusion sums of normals (x, y, 1) made those of the unit normals. Global size: pixels
+// rounded up.
+__kernel void occlusion_scale(__global const float2* normals, uint pixels, __global float* ao_sum) {
+  const uint p = get_global_id(0);
+  if (p >= pixels) return;
+  const float2 n = normals[p];
+  ao_sum[p] = ao_sum[p] / sqrt(n.x * n.x + n.y * n.y + 1.0f);
 }
 
 // Lanes (compile-time HFVIS_LANES): in the line-major (CPU) layout one work-item sweeps 8
@@ -137,7 +144,7 @@ typedef struct {
 
 // One receiver's outputs (the naive march).
 HFVIS_INLINE void emit_direction(uint pixel, int nodata, int found, float rise, float run, float distance,
-                                 const DirectionOutputs o, __global const float4* normals,
+                                 const DirectionOutputs o, __global const float2* normals,
                                  __global float* angles, __global float* distances, __global float* svf_sum,
                                  __global float* ao_sum) {
 #if HFVIS_WANT_ANGLES
@@ -150,8 +157,8 @@ HFVIS_INLINE void emit_direction(uint pixel, int nodata, int found, float rise, 
   svf_sum[pixel] = nodata ? NAN : svf_sum[pixel] + o.weight * sky_term(found, rise, run);
 #endif
 #if HFVIS_WANT_AO
-  const float4 n = normals[pixel];
-  float term = ambient_term(found, rise, run, n.x, n.y, n.z, o.cos_azimuth, o.sin_azimuth, o.weight, o.swath);
+  const float2 n = normals[pixel];
+  float term = ambient_term(found, rise, run, n.x, n.y, 1.0f, o.cos_azimuth, o.sin_azimuth, o.weight, o.swath);
   ao_sum[pixel] = nodata ? NAN : ao_sum[pixel] + term;
 #endif
 }
@@ -160,7 +167,7 @@ HFVIS_INLINE void emit_direction(uint pixel, int nodata, int found, float rise, 
 // stores lane by lane where `live`.
 HFVIS_INLINE void emit_lanes(lane_int live, lane_int pixel, lane_int nodata, lane_int found, lane_float rise,
                              lane_float run, lane_float distance, const DirectionOutputs o,
-                             __global const float4* normals, __global float* angles,
+                             __global const float2* normals, __global float* angles,
                              __global float* distances, __global float* svf_sum, __global float* ao_sum) {
 #if HFVIS_WANT_ANGLES
   const lane_float elevation = select(elevation_term(found, rise, run), (lane_float)NAN, nodata);
@@ -183,16 +190,15 @@ HFVIS_INLINE void emit_lanes(lane_int live, lane_int pixel, lane_int nodata, lan
   }
 #endif
 #if HFVIS_WANT_AO
-  lane_float nx, ny, nz;
+  lane_float nx, ny;
 #pragma unroll
   for (int l = 0; l < HFVIS_LANES; ++l) {
-    const float4 n = normals[ILANE(live, l) ? (uint)ILANE(pixel, l) : 0u];
+    const float2 n = normals[ILANE(live, l) ? (uint)ILANE(pixel, l) : 0u];
     LANE(nx, l) = n.x;
     LANE(ny, l) = n.y;
-    LANE(nz, l) = n.z;
   }
   const lane_float term =
-      ambient_term(found, rise, run, nx, ny, nz, o.cos_azimuth, o.sin_azimuth, o.weight, o.swath);
+      ambient_term(found, rise, run, nx, ny, (lane_float)1.0f, o.cos_azimuth, o.sin_azimuth, o.weight, o.swath);
 #pragma unroll
   for (int l = 0; l < HFVIS_LANES; ++l) {
     const uint p = (uint)ILANE(pixel, l);
@@ -428,7 +434,7 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
                               int n_samples, int a, int b, float period, float ground_per_pixel,
                               float period_ground, float drop, float window, float inv_window, float cos_azimuth,
                               float sin_azimuth, float weight, float swath, uint plane, __global float2* stacks,
-                              uint stride, __global float2* window_far, __global const float4* normals,
+                              uint stride, __global float2* window_far, __global const float2* normals,
                               __global float* angles, __global float* distances, __global float* svf_sum,
                               __global float* ao_sum) {
   const int first = get_global_id(0) * HFVIS_LANES;
@@ -535,7 +541,7 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 __kernel void horizon_naive(__global const float* heights, int width, int height, float dir_x, float dir_y,
                             float step_length, float ground_per_pixel, float drop, int max_steps,
                             float cos_azimuth, float sin_azimuth, float weight, float swath, uint plane,
-                            __global const float4* normals,
+                            __global const float2* normals,
                             __global float* angles, __global float* distances, __global float* svf_sum,
                             __global float* ao_sum) {
   int c = get_global_id(0), r = get_global_id(1);

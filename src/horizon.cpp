@@ -63,8 +63,8 @@ RunPlan planRun(const HeightField& field, const HorizonOptions& options, const H
       options.memory_budget_bytes ? options.memory_budget_bytes : defaultMemoryBudget(device);
   const std::size_t max_alloc = device.max_allocation_bytes ? device.max_allocation_bytes : budget;
   const std::size_t plane = field.pixelCount() * sizeof(float);
-  // Heights, the sums, float4 normals, the window's float2 per pixel.
-  const std::size_t fixed = plane * (1 + outputs.sky_view_factor + outputs.ambient_occlusion * 5 +
+  // Heights, the sums, the normals' two slopes, the window's float2 per pixel.
+  const std::size_t fixed = plane * (1 + outputs.sky_view_factor + outputs.ambient_occlusion * 3 +
                                      (sweep && options.max_distance > 0.0) * 2);
   const std::size_t per_direction = plane * (outputs.horizon_angles + outputs.horizon_distances);
   // Scratch: all of a direction's stacks in one launch when it fits; one line at a time at least.
@@ -161,7 +161,7 @@ class HorizonRoutine : public SweepRoutine {
     distances_ = st_.reusableBuffer("horizon distances", outputs_.horizon_distances ? planes_bytes : 0);
     svf_ = zeros(outputs_.sky_view_factor ? plane : 0);
     ao_ = zeros(outputs_.ambient_occlusion ? plane : 0);
-    normals_ = deviceBuffer(st_, outputs_.ambient_occlusion ? 4 * plane * sizeof(float) : 0);
+    normals_ = deviceBuffer(st_, outputs_.ambient_occlusion ? 2 * plane * sizeof(float) : 0);
     stacks_ = st_.reusableBuffer("lattice stacks", plan.stack_entries * kStackEntryBytes);
     const bool window = horizon_.method == HorizonMethod::Sweep && horizon_.max_distance > 0.0;
     window_far_ = deviceBuffer(st_, window ? 2 * plane * sizeof(float) : 0);
@@ -206,8 +206,14 @@ class HorizonRoutine : public SweepRoutine {
     const std::size_t bytes = field_.pixelCount() * sizeof(float);
     if (outputs_.sky_view_factor)
       st_.queue.enqueueReadBuffer(svf_, CL_TRUE, 0, bytes, result_.sky_view_factor.data());
-    if (outputs_.ambient_occlusion)
+    if (outputs_.ambient_occlusion) {
+      cl::Kernel scale(program_, "occlusion_scale");
+      scale.setArg(0, normals_);
+      scale.setArg(1, static_cast<cl_uint>(field_.pixelCount()));
+      scale.setArg(2, ao_);
+      st_.launch(scale, cl::NDRange(roundUp(field_.pixelCount(), kLineGroup)), cl::NDRange(kLineGroup));
       st_.queue.enqueueReadBuffer(ao_, CL_TRUE, 0, bytes, result_.ambient_occlusion.data());
+    }
     finishReduction(result_);
   }
 

@@ -19,8 +19,9 @@ namespace {
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
+// A normal as its slopes: (x, y, 1) / |(x, y, 1)| (surface_slopes in the kernel).
 struct Normal {
-  float x = 0.0f, y = 0.0f, z = 1.0f;
+  float x = 0.0f, y = 0.0f;
 };
 
 Normal surfaceNormal(const std::vector<float>& h, int width, int height, int c, int r, float hp, float cell_x,
@@ -38,8 +39,7 @@ Normal surfaceNormal(const std::vector<float>& h, int width, int height, int c, 
     }
   }
   if (!(nz > 0.0f)) return {};
-  const float len = std::sqrt(nx * nx + ny * ny + nz * nz);
-  return {nx / len, ny / len, nz / len};
+  return {nx / nz, ny / nz};
 }
 
 // Every pixel's normal, as the kernels compute it (only needed for ambient occlusion).
@@ -79,8 +79,16 @@ void emitDirection(HorizonResult& result, std::size_t pixel, bool nodata, bool f
     float& sum = result.ambient_occlusion[pixel];
     const Normal& n = normals[pixel];
     const float term =
-        ambient_term(found, rise, run, n.x, n.y, n.z, o.cos_azimuth, o.sin_azimuth, o.weight, o.swath());
+        ambient_term(found, rise, run, n.x, n.y, 1.0f, o.cos_azimuth, o.sin_azimuth, o.weight, o.swath());
     sum = nodata ? kNaN : sum + term;
+  }
+}
+
+// occlusion_scale in the kernel: the sums of normals (x, y, 1) made those of unit normals.
+void scaleOcclusion(HorizonResult& result, const std::vector<Normal>& normals) {
+  for (std::size_t p = 0; p < result.ambient_occlusion.size(); ++p) {
+    const Normal& n = normals[p];
+    result.ambient_occlusion[p] = result.ambient_occlusion[p] / std::sqrt(n.x * n.x + n.y * n.y + 1.0f);
   }
 }
 
@@ -152,6 +160,7 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
       }
     }
   }
+  scaleOcclusion(result, normals);
 }
 
 void naiveReference(const HeightField& field, const PreparedHeights& prepared, const HorizonOptions& options,
@@ -192,6 +201,7 @@ void naiveReference(const HeightField& field, const PreparedHeights& prepared, c
       }
     }
   }
+  scaleOcclusion(result, normals);
 }
 
 }  // namespace

@@ -36,8 +36,8 @@ struct SweepOptions {
   // Every operation takes it but the bounce, which refuses it.
   double curvature = 0.0;
   // Only terrain within this ground distance of the receiver counts (ground units; 0 = the
-  // whole field). Intervisibility (visible counts and areas) takes it; the other operations
-  // refuse it so far.
+  // whole field): horizons, sky-view factor, occlusion and intervisibility take it (exact, the
+  // cut decided in float arithmetic); the horizon lists and the bounce refuse it.
   double max_distance = 0.0;
   std::size_t memory_budget_bytes = 0;  // device memory for one batch; 0 = from the device
   // Called after each batch of directions with (directions done, directions in all).
