@@ -39,6 +39,7 @@ enum class Option {
   Curvature,
   Refraction,
   MaxDistance,
+  Nodata,
 };
 
 struct OptionSpec {
@@ -70,6 +71,7 @@ constexpr OptionSpec kOptions[] = {
     {Option::Curvature, "--curvature", nullptr, false},
     {Option::Refraction, "--refraction", nullptr, true},
     {Option::MaxDistance, "--max-distance", nullptr, true},
+    {Option::Nodata, "--nodata", nullptr, true},
 };
 
 // The options every sweep operation shares, as typed (degrees become radians).
@@ -116,6 +118,26 @@ double parseNumber(const std::string& option, const std::string& text) {
     throw UsageError(option + ": expected a number, got " + inQuotes(text));
   }
   return value;
+}
+
+// A nodata value for float32 bands: "nan" (any case), or a finite number float32 holds.
+float parseNodata(const std::string& option, const std::string& text) {
+  std::string lower = text;
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (lower == "nan") return std::numeric_limits<float>::quiet_NaN();
+  const char* begin = text.c_str();
+  char* end = nullptr;
+  errno = 0;
+  const double value = std::strtod(begin, &end);
+  if (text.empty() || end != begin + text.size() || std::isnan(value)) {
+    throw UsageError(option + ": expected a number or nan, got " + inQuotes(text));
+  }
+  if (!std::isfinite(value) || errno == ERANGE || std::fabs(value) > std::numeric_limits<float>::max()) {
+    throw UsageError(option +
+                     ": the nodata value must be nan or a finite number within float32's range, got " +
+                     inQuotes(text));
+  }
+  return static_cast<float>(value);
 }
 
 double parsePositive(const std::string& option, const std::string& text) {
@@ -204,7 +226,7 @@ const char* onlyFor(Option option) {
 bool notFor(Option option, Command command) {
   if (command == Command::HorizonLists) {
     return option == Option::Method || option == Option::Device || option == Option::MemoryBudget ||
-           option == Option::Preview || option == Option::MaxDistance;
+           option == Option::Preview || option == Option::MaxDistance || option == Option::Nodata;
   }
   if (option == Option::HullTree) return command != Command::ViewCount && command != Command::Bounce;
   if (option == Option::MaxDistance) return command == Command::Bounce;
@@ -267,7 +289,6 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
       break;
     case Option::SamplesPerUnit:
       run.samples_per_unit = parsePositive(typed, value);
-      break;
       break;
     case Option::CellSize:
       parseCellSize(typed, value, run);
@@ -334,6 +355,9 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
     case Option::MaxDistance:
       run.max_distance = parsePositive(typed, value);
       break;
+    case Option::Nodata:
+      run.nodata = parseNodata(typed, value);
+      break;
   }
 }
 
@@ -377,6 +401,13 @@ void validateRun(Command command, const RunArguments& run) {
   }
   if (!run.preview.empty() && !run.distance_output.empty() && samePath(run.preview, run.distance_output)) {
     throw UsageError("--preview must differ from --distance-out, both are " + inQuotes(run.preview));
+  }
+  // Only a GeoTIFF declares a nodata value; other outputs keep NaN, so the option would do nothing.
+  if (run.nodata && !writesGeoTiff(run.output) &&
+      (run.distance_output.empty() || !writesGeoTiff(run.distance_output))) {
+    throw UsageError(
+        "--nodata: only GeoTIFF outputs (.tif, .tiff) hold a nodata value, and no output is one; "
+        "other outputs keep NaN");
   }
   if (command == Command::ViewCount && !run.hull_tree_name.empty() &&
       run.visibility_method != IntervisibilityMethod::HullTree) {

@@ -65,6 +65,7 @@ struct RunArguments {
   bool curvature = false;                    // --curvature (or --refraction): the Earth's drop
   double refraction = kDefaultRefraction;  // --refraction K
   double max_distance = 0.0;                 // viewcount --max-distance D (ground units); 0 = none
+  std::optional<float> nodata;               // --nodata VALUE for GeoTIFF outputs (may be NaN); none = NaN
 };
 
 struct CommandLine {

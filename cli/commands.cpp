@@ -248,7 +248,8 @@ const char* methodName(Command command, const RunArguments& run) {
 
 using Attributes = std::vector<std::pair<std::string, std::string>>;
 
-// String attributes describing the run, written into every EXR output.
+// String attributes describing the run, written into every output (EXR attributes, GeoTIFF
+// metadata items).
 Attributes runAttributes(Command command, const RunArguments& run, const HeightField& field,
                          const DeviceInfo& device) {
   Attributes attributes{
@@ -265,7 +266,10 @@ Attributes runAttributes(Command command, const RunArguments& run, const HeightF
       {"hfvis:cell_size_x", formatNumber(field.cell_size_x)},
       {"hfvis:cell_size_y", formatNumber(field.cell_size_y)},
       {"hfvis:z_scale", formatNumber(field.z_scale)},
-      {"hfvis:nodata", "NaN where the input height is not finite"},
+      {"hfvis:nodata", run.nodata && !std::isnan(*run.nodata)
+                           ? "where the input height is not finite: " + formatNumber(*run.nodata) +
+                                 " (the bands' nodata value) in GeoTIFF outputs, NaN in others"
+                           : std::string("NaN where the input height is not finite")},
       {"hfvis:device", device.name + " (" + device.platform + ")"},
   };
   if (!run.channel.empty()) attributes.emplace_back("hfvis:channel", run.channel);
@@ -278,12 +282,16 @@ Attributes runAttributes(Command command, const RunArguments& run, const HeightF
   return attributes;
 }
 
-ImageChannels makeImage(int width, int height, std::vector<std::string> names,
+// An output of the field's size. A GeoTIFF output also carries the field's georeference, so that
+// it overlays its input, and the --nodata value.
+ImageChannels makeImage(const HeightField& field, const RunArguments& run, std::vector<std::string> names,
                         std::vector<std::vector<float>> planes, Attributes attributes,
                         const std::string& quantity, const std::string& units) {
   ImageChannels image;
-  image.width = width;
-  image.height = height;
+  image.width = field.width;
+  image.height = field.height;
+  image.georeference = field.georeference;
+  if (run.nodata) image.nodata = *run.nodata;
   image.names = std::move(names);
   image.planes = std::move(planes);
   image.attributes = std::move(attributes);
@@ -463,16 +471,15 @@ int runCompute(Command command, const RunArguments& run) {
   if (command == Command::Horizon) {
     const std::size_t values = pixels * static_cast<std::size_t>(directions);
     requireSize(result.angles, values, "horizon angles");
-    const ImageChannels angles =
-        makeImage(result.width, result.height, directionChannelNames("h", directions),
-                  splitPlanes(result.angles, pixels, directions), attributes,
-                  "horizon elevation angle per direction (channel k = direction k)",
-                  "radians above the horizontal; -pi/2 where the ray leaves the field at once");
+    const ImageChannels angles = makeImage(
+        field, run, directionChannelNames("h", directions), splitPlanes(result.angles, pixels, directions),
+        attributes, "horizon elevation angle per direction (channel k = direction k)",
+        "radians above the horizontal; -pi/2 where the ray leaves the field at once");
     outputs.stage(run.output, [&](const std::string& path) { writeImage(path, angles); });
     if (!run.distance_output.empty()) {
       requireSize(result.distances, values, "horizon distances");
       const ImageChannels distances =
-          makeImage(result.width, result.height, directionChannelNames("d", directions),
+          makeImage(field, run, directionChannelNames("d", directions),
                     splitPlanes(result.distances, pixels, directions), attributes,
                     "ground distance to the point casting the horizon, per direction",
                     "ground units (pixels times cell size); 0 where no point casts a horizon or the "
@@ -491,7 +498,7 @@ int runCompute(Command command, const RunArguments& run) {
     const std::string channel = svf ? "svf" : "ao";
     requireSize(plane, pixels, svf ? "sky-view factor" : "ambient occlusion");
     const ImageChannels image =
-        makeImage(result.width, result.height, {channel}, {plane}, attributes,
+        makeImage(field, run, {channel}, {plane}, attributes,
                   svf ? "sky-view factor 1 - mean_k sin(max(0, elevation_k))"
                       : "ambient occlusion, uniform sky of radiance 1 (Timonen & Westerholm 2010, Eq. 5)",
                   svf ? "fraction of the sky visible, 0..1" : "0..1, a flat unoccluded plane gives 1");
@@ -557,8 +564,7 @@ int runViewCount(const RunArguments& run) {
   // "count" sorts before "visible_area", so the count is channel 0 in the EXR, whose
   // channels are stored sorted by name.
   const ImageChannels image = makeImage(
-      field.width, field.height, {"count", "visible_area"}, {result.visible_count, result.visible_area},
-      attributes,
+      field, run, {"count", "visible_area"}, {result.visible_count, result.visible_area}, attributes,
       "count: visible surface samples summed over the K directions; visible_area: the visible ground area "
       "(total viewshed), each visible sample at ground distance rho standing for (2*pi/K) * rho * drho",
       "count: samples (one per 1/S pixel lengths along each direction, S = samples per unit); "
@@ -660,7 +666,7 @@ int runBounce(const RunArguments& run) {
   StagedOutputs outputs;
   // The radiance's channel names, so that R, G, B stay R, G, B.
   const ImageChannels image = makeImage(
-      field.width, field.height, radiance_image.names, result.irradiance, attributes,
+      field, run, radiance_image.names, result.irradiance, attributes,
       "incident indirect irradiance of one diffuse bounce of the exit radiance (hfvis:radiance), per "
       "channel: "
       "sum over directions and visible samples of radiance times projected solid angle",

@@ -31,7 +31,9 @@ Commands:
 
 const char* const kOptions = R"(
 Options:
-  -o, --output FILE        output image, float32 EXR (required)
+  -o, --output FILE        output image (required): float32 EXR, or a float32 GeoTIFF when the
+                           name ends in .tif or .tiff (the input's georeference kept; see
+                           Conventions, GIS)
   -k, --directions K       number of azimuth directions, K >= 1 (default 64)
   --method sweep|naive     horizon, svf, ao: sweep = convex-hull-stack sweep along lines through
                            every pixel centre, linear time per direction, exact over the samples
@@ -55,19 +57,23 @@ Options:
                            and, for S > 1, about S points per pixel length between crossings
                            (default 1: the crossings alone)
   --cell-size X[,Y]        ground units per pixel along columns (X) and rows (Y)
-                           (default: from the file (hfvis:cell_size_x/y attributes,
-                           GeoTIFF pixel scale), else 1)
+                           (default: from the file (a raster's geotransform, the
+                           hfvis:cell_size_x/y attributes), else 1)
   --z-scale Z              multiplies every height, e.g. 0.3048 for feet over metre cells (default 1)
-  --channel NAME|INDEX     input channel to read; needed for multi-channel images
+  --channel NAME|INDEX     input channel (a raster's band: its description or zero-based index)
+                           to read; needed for multi-channel images
+  --nodata VALUE           GeoTIFF outputs: write VALUE (a finite float32 number, or nan) in
+                           nodata cells and declare it as every band's nodata value (default
+                           nan); EXR outputs keep NaN. Needs a .tif/.tiff output
   --device SEL             device index, "gpu", "cpu" or part of a device/platform name
                            (default: env HFVIS_DEVICE, else a GPU, else the first CPU)
   --memory-budget MB       device memory for one batch of directions, MiB (default: from the device)
   --preview PNG            also write an 8-bit PNG preview
   -q, --quiet              print neither progress nor the summary line
   -h, --help               show help
-  (horizons takes only -o, -k, --azimuth-offset, --curvature, --refraction, --samples-per-unit,
-  --cell-size, --z-scale, --channel and --quiet: it runs on the host, one ray per receiver and
-  direction.)
+  (horizons takes only -o, -k, --azimuth-offset, --samples-per-unit, --cell-size, --z-scale,
+  --channel, --curvature, --refraction and --quiet: it runs on the host, one ray per receiver
+  and direction, and writes text.)
 )";
 
 const char* const kHorizonOnly = R"(
@@ -146,8 +152,9 @@ Bounce:
 
 const char* const kConventions = R"(
 Conventions and units:
-  Input      one height channel of any image OpenImageIO reads (EXR, TIFF/GeoTIFF, PNG, ...),
-             row-major, row 0 first as stored. Pixel (col, row) lies at ground position
+  Input      one band of a raster GDAL reads (GeoTIFF/COG .tif/.tiff, .hgt, .asc, .vrt, .img,
+             .bil, .dem, .grd, .adf) or one channel of an image OpenImageIO reads (EXR, PNG,
+             ...), row-major, row 0 first as stored. Pixel (col, row) lies at ground position
              (col*X, row*Y); the surface is bilinear between pixels; height = value * Z.
              Integer pixels are read as their stored values (16-bit PNG: 0..65535).
   Directions direction k of K has azimuth phi_k = 360*k/K deg + offset, measured on the
@@ -166,9 +173,20 @@ Conventions and units:
   Nodata     non-finite heights (NaN, +-inf) are nodata: they neither cast nor receive;
              every output is NaN there, and holes do not spread into valid neighbours.
   Outputs    float32 EXR (any float format OpenImageIO writes, by extension), with the run
-             described in string attributes hfvis:* (horizons: JSON or CSV text). Files are
-             written to a temporary name and renamed only once every output of the run is
-             complete, so a failed run leaves no partial or mismatched output behind.
+             described in string attributes hfvis:*; GeoTIFF for .tif/.tiff (horizons: JSON
+             or CSV text). Files are written to a temporary name and renamed only once every
+             output of the run is complete, so a failed run leaves no partial or mismatched
+             output behind.
+  GIS        A georeferenced input keeps its CRS (projected or geographic, copied as it is)
+             and geotransform in GeoTIFF outputs, so they overlay it. Cell sizes come from
+             the geotransform in the CRS's units; geographic degrees become metres (WGS84,
+             at the field's centre latitude); rotated geotransforms are refused. A band's
+             nodata value reads as nodata. GeoTIFF outputs: one float32 band per channel,
+             named by its description (h000.., svf, ao, count, visible_area), nodata declared
+             on every band (NaN, or --nodata VALUE written in those cells), DEFLATE with the
+             floating-point predictor, 256x256 tiles, BigTIFF when needed; the hfvis:*
+             attributes become metadata items hfvis_* (GDAL splits names at ':'). EXR
+             outputs keep the cell size (hfvis:cell_size_x/y) but no georeference.
 )";
 
 const char* const kExitStatus = R"(

@@ -55,7 +55,9 @@ def png(path, w, h, channels, rows):
                 + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
 png("two_channels.png", 4, 3, 2, [[1, 2] * 4 for _ in range(3)])
 PY
-sum_before=$(md5sum < field.exr)
+# A GeoTIFF of the field (no georeference: only its name matters here).
+"$hfvis" svf field.exr -o field.tif -k 1 -q
+sum_before=$(cat field.exr field.tif | md5sum)
 
 echo "| case | command | status | error (first line) | input intact, nothing written |"
 echo "| --- | --- | ---: | --- | --- |"
@@ -72,7 +74,7 @@ try() {
   message=$(head -1 stderr.txt | sed 's/^hfvis: error: //; s/|/\\|/g')
   [[ $status == 0 ]] && message="(none: it runs)"
   local clean=yes
-  [[ "$(md5sum < field.exr)" == "$sum_before" ]] || clean="NO: input changed"
+  [[ "$(cat field.exr field.tif | md5sum)" == "$sum_before" ]] || clean="NO: input changed"
   if [[ $status != 0 && -n "$(ls -A out)" ]]; then clean="NO: wrote $(ls -A out | tr '\n' ' ')"; fi
   local shown="hfvis${*:+ $*}"
   [[ -n $env ]] && shown="$env $shown"
@@ -90,6 +92,8 @@ try "output directory missing" "" -- svf field.exr -o nowhere/o.exr
 try "output is a directory" "" -- svf field.exr -o out
 try "output is the input" "" -- svf field.exr -o field.exr
 try "output is the input by another path" "" -- svf field.exr -o ./out/../field.exr
+try "GeoTIFF output is the GeoTIFF input" "" -- svf field.tif -o field.tif
+try "GeoTIFF output is the input by another path" "" -- horizon field.tif -o out/h.tif --distance-out out/../field.tif
 try "output format unknown" "" -- svf field.exr -o out/o.xyz
 try "preview not a PNG" "" -- svf field.exr -o out/o.exr --preview out/p.jpg
 # Arguments.
@@ -111,6 +115,11 @@ try "curvature for the bounce (not supported)" "" -- bounce field.exr --radiance
 try "maximum distance zero" "" -- viewcount field.exr -o out/o.exr --max-distance 0
 try "maximum distance for the bounce (not supported)" "" -- bounce field.exr --radiance field.exr -o out/b.exr --max-distance 10
 try "maximum distance too short for the field" "" -- svf field.exr -o out/o.exr --max-distance 1e-9
+try "nodata not a number" "" -- svf field.exr -o out/o.tif --nodata none
+try "nodata infinite" "" -- svf field.exr -o out/o.tif --nodata inf
+try "nodata beyond float32" "" -- svf field.exr -o out/o.tif --nodata 1e39
+try "nodata without a GeoTIFF output" "" -- svf field.exr -o out/o.exr --nodata -9999
+try "nodata for the horizon lists (text)" "" -- horizons field.exr --at 3,3 -o out/h.json --nodata 0
 try "cell size zero" "" -- svf field.exr -o out/o.exr --cell-size 0
 try "cell size negative" "" -- svf field.exr -o out/o.exr --cell-size 1,-2
 try "cell size not a number" "" -- svf field.exr -o out/o.exr --cell-size 1,abc

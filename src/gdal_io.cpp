@@ -1,16 +1,25 @@
-// gdal_io.cpp: reading georeferenced rasters through GDAL (see gdal_io.hpp).
+// gdal_io.cpp: georeferenced rasters through GDAL (see gdal_io.hpp).
 #include "gdal_io.hpp"
 
+#include <cpl_conv.h>
+#include <cpl_error.h>
+#include <cpl_string.h>
 #include <gdal.h>
 #include <ogr_srs_api.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <new>
+#include <optional>
+#include <string>
+#include <vector>
 
 #include "hfvis/errors.hpp"
 
@@ -18,6 +27,8 @@ namespace hfvis::detail {
 namespace {
 
 constexpr std::uint64_t kDefaultMaxImageBytes = std::uint64_t(64) << 30;
+// GeoTIFF blocks: square tiles, what GIS tools read windows and overviews from fastest.
+constexpr int kTileSize = 256;
 
 void registerOnce() {
   static std::once_flag once;
@@ -34,6 +45,129 @@ std::string lastError() {
 
 struct DatasetCloser {
   void operator()(void* dataset) const { GDALClose(dataset); }
+};
+using Dataset = std::unique_ptr<void, DatasetCloser>;
+
+Dataset openRaster(const std::string& path) {
+  registerOnce();
+  if (!std::filesystem::exists(path)) throw IoError(path, "no such file");
+  Dataset dataset(GDALOpen(path.c_str(), GA_ReadOnly));
+  if (!dataset) throw IoError(path, lastError());
+  if (GDALGetRasterXSize(dataset.get()) <= 0 || GDALGetRasterYSize(dataset.get()) <= 0 ||
+      GDALGetRasterCount(dataset.get()) <= 0)
+    throw IoError(path, "the raster has no pixels");
+  return dataset;
+}
+
+// Refuses, before reading, a raster of more than `limit` bytes as float32 (0 = 64 GiB).
+void requireReadable(const std::string& path, GDALDatasetH dataset, int bands, std::uint64_t limit) {
+  limit = limit ? limit : kDefaultMaxImageBytes;
+  const std::uint64_t width = GDALGetRasterXSize(dataset), height = GDALGetRasterYSize(dataset);
+  if (width * height * std::uint64_t(bands) * sizeof(float) > limit)
+    throw IoError(path, "raster of " + std::to_string(width) + " x " + std::to_string(height) +
+                            " pixels and " + std::to_string(bands) + (bands == 1 ? " band" : " bands") +
+                            " is more than the " + std::to_string(limit >> 20) + " MiB read at most");
+}
+
+// Band `band_index` (zero-based) as float32, its nodata cells NaN.
+std::vector<float> readBand(const std::string& path, GDALDatasetH dataset, int band_index) {
+  const int width = GDALGetRasterXSize(dataset), height = GDALGetRasterYSize(dataset);
+  GDALRasterBandH band = GDALGetRasterBand(dataset, band_index + 1);
+  std::vector<float> values;
+  try {
+    values.resize(std::size_t(width) * height);
+  } catch (const std::bad_alloc&) {
+    throw IoError(path, "raster is too large to hold in memory (" + std::to_string(width) + " x " +
+                            std::to_string(height) + " pixels)");
+  }
+  if (GDALRasterIO(band, GF_Read, 0, 0, width, height, values.data(), width, height, GDT_Float32, 0, 0) !=
+      CE_None)
+    throw IoError(path, lastError());
+  int has_nodata = 0;
+  const double nodata = GDALGetRasterNoDataValue(band, &has_nodata);
+  if (has_nodata && !std::isnan(nodata)) {
+    const float value = static_cast<float>(nodata);
+    for (float& v : values)
+      if (v == value) v = std::numeric_limits<float>::quiet_NaN();
+  }
+  return values;
+}
+
+Georeference georeferenceOf(GDALDatasetH dataset) {
+  Georeference georeference;
+  std::array<double, 6> transform;
+  // Without a geotransform GDAL answers CE_Failure (and fills in the identity).
+  if (GDALGetGeoTransform(dataset, transform.data()) == CE_None) georeference.geotransform = transform;
+  if (OGRSpatialReferenceH srs = GDALGetSpatialRef(dataset)) {
+    // WKT2 keeps every detail of the CRS; WKT1 cannot hold some (datum ensembles, ...).
+    const char* const options[] = {"FORMAT=WKT2_2019", nullptr};
+    char* wkt = nullptr;
+    if (OSRExportToWktEx(srs, &wkt, options) == OGRERR_NONE && wkt) georeference.crs_wkt = wkt;
+    CPLFree(wkt);
+  }
+  return georeference;
+}
+
+bool isGeographic(GDALDatasetH dataset) {
+  OGRSpatialReferenceH srs = GDALGetSpatialRef(dataset);
+  return srs && OSRIsGeographic(srs);
+}
+
+// Metadata names: GDAL's name=value lists also split at ':', so hfvis:units is stored as
+// hfvis_units (and read back as hfvis:units).
+constexpr const char* kStoredPrefix = "hfvis_";
+constexpr const char* kAttributePrefix = "hfvis:";
+
+std::string storedName(std::string name) {
+  std::replace(name.begin(), name.end(), ':', '_');
+  return name;
+}
+
+std::string attributeName(const std::string& stored) {
+  if (stored.rfind(kStoredPrefix, 0) == 0)
+    return kAttributePrefix + stored.substr(std::string(kStoredPrefix).size());
+  return stored;
+}
+
+// Collects the errors GDAL reports on this thread while it lives: the GeoTIFF writer reports a
+// failed write (disk full, ...) only that way, and a later warning would hide it from
+// CPLGetLastErrorMsg.
+class ErrorCollector {
+ public:
+  ErrorCollector() { CPLPushErrorHandlerEx(&ErrorCollector::handle, this); }
+  ~ErrorCollector() { CPLPopErrorHandler(); }
+  ErrorCollector(const ErrorCollector&) = delete;
+  ErrorCollector& operator=(const ErrorCollector&) = delete;
+
+  bool failed() const { return !first_failure_.empty(); }
+  // `what`, with GDAL's first failure message when there was one.
+  std::string reason(const std::string& what) const {
+    return first_failure_.empty() ? what : what + " (" + first_failure_ + ")";
+  }
+
+ private:
+  static void CPL_STDCALL handle(CPLErr level, CPLErrorNum, const char* message) {
+    auto* self = static_cast<ErrorCollector*>(CPLGetErrorHandlerUserData());
+    if ((level == CE_Failure || level == CE_Fatal) && self->first_failure_.empty())
+      self->first_failure_ = message && *message ? message : "GDAL reported a failure";
+  }
+  std::string first_failure_;
+};
+
+// A GDAL configuration option set on this thread while it lives, then restored.
+class ScopedThreadConfig {
+ public:
+  ScopedThreadConfig(const char* key, const char* value) : key_(key) {
+    if (const char* old = CPLGetThreadLocalConfigOption(key, nullptr)) old_ = std::string(old);
+    CPLSetThreadLocalConfigOption(key, value);
+  }
+  ~ScopedThreadConfig() { CPLSetThreadLocalConfigOption(key_, old_ ? old_->c_str() : nullptr); }
+  ScopedThreadConfig(const ScopedThreadConfig&) = delete;
+  ScopedThreadConfig& operator=(const ScopedThreadConfig&) = delete;
+
+ private:
+  const char* key_;
+  std::optional<std::string> old_;
 };
 
 }  // namespace
@@ -53,29 +187,42 @@ void metresPerDegree(double lat_deg, double* along_meridian, double* along_paral
   *along_parallel = n * std::cos(lat) * M_PI / 180.0;
 }
 
-bool isGdalRaster(const std::string& path) {
+std::optional<std::pair<double, double>> storedCellSize(const char* x, const char* y) {
+  auto number = [](const char* text) -> double {
+    if (!text || !*text) return 0.0;
+    char* end = nullptr;
+    const double v = std::strtod(text, &end);
+    return (end && *end == '\0' && std::isfinite(v) && v > 0.0) ? v : 0.0;
+  };
+  const double sx = number(x), sy = number(y);
+  if (sx > 0.0 && sy > 0.0) return std::make_pair(sx, sy);
+  return std::nullopt;
+}
+
+std::string lowercaseExtension(const std::string& path) {
   std::string extension = std::filesystem::path(path).extension().string();
   std::transform(extension.begin(), extension.end(), extension.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return extension;
+}
+
+bool isGdalRaster(const std::string& path) {
+  const std::string extension = lowercaseExtension(path);
   for (const char* gdal : {".tif", ".tiff", ".hgt", ".asc", ".vrt", ".img", ".bil", ".dem", ".grd", ".adf"})
     if (extension == gdal) return true;
   return false;
 }
 
 HeightField readGdalHeightField(const std::string& path, const HeightFieldReadOptions& options) {
-  registerOnce();
-  if (!std::filesystem::exists(path)) throw IoError(path, "no such file");
-  std::unique_ptr<void, DatasetCloser> dataset(GDALOpen(path.c_str(), GA_ReadOnly));
-  if (!dataset) throw IoError(path, lastError());
-  const int width = GDALGetRasterXSize(dataset.get()), height = GDALGetRasterYSize(dataset.get());
+  const Dataset dataset = openRaster(path);
   const int bands = GDALGetRasterCount(dataset.get());
-  if (width <= 0 || height <= 0 || bands <= 0) throw IoError(path, "the raster has no pixels");
   // The band: the only one, an index, or a description.
   int band_index = 0;
   if (options.channel.empty()) {
     if (bands != 1)
       throw IoError(path, "the raster has " + std::to_string(bands) + " bands: choose one with --channel");
-  } else if (std::all_of(options.channel.begin(), options.channel.end(), ::isdigit)) {
+  } else if (options.channel.size() <= 9 &&
+             std::all_of(options.channel.begin(), options.channel.end(), ::isdigit)) {
     band_index = std::stoi(options.channel);
     if (band_index >= bands) throw IoError(path, "no band " + options.channel);
   } else {
@@ -84,53 +231,136 @@ HeightField readGdalHeightField(const std::string& path, const HeightFieldReadOp
       if (options.channel == GDALGetDescription(GDALGetRasterBand(dataset.get(), b + 1))) band_index = b;
     if (band_index < 0) throw IoError(path, "no band named '" + options.channel + "'");
   }
-  const std::uint64_t limit = options.max_image_bytes ? options.max_image_bytes : kDefaultMaxImageBytes;
-  if (std::uint64_t(width) * std::uint64_t(height) * sizeof(float) > limit)
-    throw IoError(path, "raster of " + std::to_string(width) + " x " + std::to_string(height) +
-                            " pixels is more than the " + std::to_string(limit >> 20) + " MiB read at most");
-  GDALRasterBandH band = GDALGetRasterBand(dataset.get(), band_index + 1);
+  requireReadable(path, dataset.get(), 1, options.max_image_bytes);
   HeightField field;
-  field.width = width;
-  field.height = height;
-  field.heights.resize(std::size_t(width) * height);
-  if (GDALRasterIO(band, GF_Read, 0, 0, width, height, field.heights.data(), width, height, GDT_Float32, 0, 0) !=
-      CE_None)
-    throw IoError(path, lastError());
-  int has_nodata = 0;
-  const double nodata = GDALGetRasterNoDataValue(band, &has_nodata);
-  if (has_nodata) {
-    const float value = static_cast<float>(nodata);
-    for (float& h : field.heights)
-      if (h == value || (std::isnan(nodata) && std::isnan(h))) h = std::numeric_limits<float>::quiet_NaN();
-  }
-  // Cell sizes: given, else from the geotransform (north-up or south-up only).
-  double gt[6];
+  field.width = GDALGetRasterXSize(dataset.get());
+  field.height = GDALGetRasterYSize(dataset.get());
+  field.heights = readBand(path, dataset.get(), band_index);
+  field.georeference = georeferenceOf(dataset.get());
+  // Cell sizes: given, else from the geotransform (north-up or south-up only), else as hfvis
+  // stored them.
   if (options.cell_size_x > 0.0 || options.cell_size_y > 0.0) {
     field.cell_size_x = options.cell_size_x > 0.0 ? options.cell_size_x : options.cell_size_y;
     field.cell_size_y = options.cell_size_y > 0.0 ? options.cell_size_y : options.cell_size_x;
-  } else if (GDALGetGeoTransform(dataset.get(), gt) != CE_None) {
-    // No geotransform: a geographic raster's spacing in metres cannot be known.
-    OGRSpatialReferenceH srs = GDALGetSpatialRef(dataset.get());
-    if (srs && OSRIsGeographic(srs))
-      throw IoError(path, "a geographic raster without a geotransform (no tiepoint) has no cell size in "
-                          "metres; give one with --cell-size");
-  } else {
-    if (gt[2] != 0.0 || gt[4] != 0.0)
-      throw IoError(path, "rotated or sheared geotransforms are not supported (terms " + std::to_string(gt[2]) +
-                              ", " + std::to_string(gt[4]) + "); warp the raster north-up first (gdalwarp)");
-    field.cell_size_x = std::fabs(gt[1]);
-    field.cell_size_y = std::fabs(gt[5]);
-    OGRSpatialReferenceH srs = GDALGetSpatialRef(dataset.get());
-    if (srs && OSRIsGeographic(srs)) {
-      const double lat = gt[3] + gt[5] * 0.5 * height;
+  } else if (const auto& gt = field.georeference.geotransform) {
+    if ((*gt)[2] != 0.0 || (*gt)[4] != 0.0)
+      throw IoError(path, "rotated or sheared geotransforms are not supported (terms " +
+                              std::to_string((*gt)[2]) + ", " + std::to_string((*gt)[4]) +
+                              "); warp the raster north-up first (gdalwarp)");
+    field.cell_size_x = std::fabs((*gt)[1]);
+    field.cell_size_y = std::fabs((*gt)[5]);
+    if (isGeographic(dataset.get())) {
+      const double lat = (*gt)[3] + (*gt)[5] * 0.5 * field.height;
       double per_deg_y, per_deg_x;
       metresPerDegree(lat, &per_deg_y, &per_deg_x);
       field.cell_size_x *= per_deg_x;
       field.cell_size_y *= per_deg_y;
     }
+  } else if (const auto stored =
+                 storedCellSize(GDALGetMetadataItem(dataset.get(), "hfvis_cell_size_x", nullptr),
+                                GDALGetMetadataItem(dataset.get(), "hfvis_cell_size_y", nullptr))) {
+    field.cell_size_x = stored->first;
+    field.cell_size_y = stored->second;
+  } else if (isGeographic(dataset.get())) {
+    // No geotransform: a geographic raster's spacing in metres cannot be known.
+    throw IoError(path,
+                  "a geographic raster without a geotransform (no tiepoint) has no cell size in "
+                  "metres; give one with --cell-size");
   }
   field.z_scale = options.z_scale;
   return field;
+}
+
+ImageChannels readGdalImage(const std::string& path) {
+  const Dataset dataset = openRaster(path);
+  const int bands = GDALGetRasterCount(dataset.get());
+  requireReadable(path, dataset.get(), bands, 0);
+  ImageChannels image;
+  image.width = GDALGetRasterXSize(dataset.get());
+  image.height = GDALGetRasterYSize(dataset.get());
+  for (int b = 0; b < bands; ++b) {
+    const std::string description = GDALGetDescription(GDALGetRasterBand(dataset.get(), b + 1));
+    image.names.push_back(description.empty() ? "channel" + std::to_string(b) : description);
+    image.planes.push_back(readBand(path, dataset.get(), b));
+  }
+  for (char** item = GDALGetMetadata(dataset.get(), nullptr); item && *item; ++item) {
+    char* name = nullptr;
+    const char* value = CPLParseNameValue(*item, &name);
+    if (name && value) image.attributes.emplace_back(attributeName(name), value);
+    CPLFree(name);
+  }
+  image.georeference = georeferenceOf(dataset.get());
+  return image;
+}
+
+bool hasGeoTiffWriter() {
+  registerOnce();
+  return GDALGetDriverByName("GTiff") != nullptr;
+}
+
+void writeGeoTiff(const std::string& file, const std::string& path, const ImageChannels& image) {
+  if (!hasGeoTiffWriter()) throw IoError(path, "this GDAL has no GTiff driver to write a GeoTIFF");
+  // Everything must go into the TIFF itself: with PAM on, GDAL puts what no TIFF tag holds into
+  // a side file FILE.aux.xml, which the rename into place would leave behind.
+  const ScopedThreadConfig no_side_file("GDAL_PAM_ENABLED", "NO");
+  const ErrorCollector errors;
+  char** options = nullptr;
+  options = CSLSetNameValue(options, "TILED", "YES");
+  options = CSLSetNameValue(options, "BLOCKXSIZE", std::to_string(kTileSize).c_str());
+  options = CSLSetNameValue(options, "BLOCKYSIZE", std::to_string(kTileSize).c_str());
+  options = CSLSetNameValue(options, "COMPRESS", "DEFLATE");
+  options = CSLSetNameValue(options, "PREDICTOR", "3");  // floating-point predictor
+  // Band by band: each plane is written whole, so each compressed tile is written once (pixel
+  // interleaving would recompress every tile for every band).
+  options = CSLSetNameValue(options, "INTERLEAVE", "BAND");
+  options = CSLSetNameValue(options, "BIGTIFF", "IF_SAFER");
+  // DEFLATE is most of the writing time of a large output; the tiles compress independently.
+  options = CSLSetNameValue(options, "NUM_THREADS", "ALL_CPUS");
+  const int bands = static_cast<int>(image.planes.size());
+  Dataset dataset(GDALCreate(GDALGetDriverByName("GTiff"), file.c_str(), image.width, image.height, bands,
+                             GDT_Float32, options));
+  CSLDestroy(options);
+  if (!dataset) throw IoError(path, errors.reason("cannot create the GeoTIFF"));
+
+  const Georeference& georeference = image.georeference;
+  if (georeference.geotransform) {
+    std::array<double, 6> transform = *georeference.geotransform;
+    if (GDALSetGeoTransform(dataset.get(), transform.data()) != CE_None)
+      throw IoError(path, errors.reason("cannot write the geotransform"));
+  }
+  if (!georeference.crs_wkt.empty() &&
+      GDALSetProjection(dataset.get(), georeference.crs_wkt.c_str()) != CE_None)
+    throw IoError(path, errors.reason("cannot write the CRS"));
+  for (const auto& [name, value] : image.attributes) {
+    if (GDALSetMetadataItem(dataset.get(), storedName(name).c_str(), value.c_str(), nullptr) != CE_None)
+      throw IoError(path, errors.reason("cannot write the metadata item '" + name + "'"));
+  }
+
+  const bool replace_nan = !std::isnan(image.nodata);
+  // NaN cells become the nodata value a tile row at a time, so no plane is copied whole.
+  std::vector<float> rows(replace_nan ? std::size_t(image.width) * std::min(kTileSize, image.height) : 0);
+  for (int b = 0; b < bands; ++b) {
+    GDALRasterBandH band = GDALGetRasterBand(dataset.get(), b + 1);
+    GDALSetDescription(band, image.names[b].c_str());
+    if (GDALSetRasterNoDataValue(band, image.nodata) != CE_None)
+      throw IoError(path, errors.reason("cannot write the nodata value"));
+    const std::vector<float>& plane = image.planes[b];
+    for (int y = 0; y < image.height; y += kTileSize) {
+      const int count = std::min(kTileSize, image.height - y);
+      const float* source = plane.data() + std::size_t(y) * image.width;
+      if (replace_nan) {
+        std::transform(source, source + std::size_t(count) * image.width, rows.begin(),
+                       [&](float v) { return std::isnan(v) ? image.nodata : v; });
+        source = rows.data();
+      }
+      if (GDALRasterIO(band, GF_Write, 0, y, image.width, count, const_cast<float*>(source), image.width,
+                       count, GDT_Float32, 0, 0) != CE_None)
+        throw IoError(path, errors.reason("cannot write the pixels"));
+    }
+  }
+  GDALFlushCache(dataset.get());
+  dataset.reset();  // closing writes the last tiles and the directory
+  if (errors.failed()) throw IoError(path, errors.reason("cannot write the GeoTIFF"));
 }
 
 }  // namespace hfvis::detail

@@ -1,9 +1,12 @@
 // gdal_io.hpp: georeferenced rasters through GDAL (GeoTIFF, COG, HGT, AAIGrid, VRT, ...):
-// heights with their nodata value (those cells become NaN), geotransform and CRS.
-// OpenImageIO keeps EXR, PNG and other images (image_io.cpp decides by extension).
+// reading heights and bands with their nodata value (those cells become NaN), geotransform and
+// CRS, and writing results as GeoTIFF. OpenImageIO keeps EXR, PNG and other images
+// (image_io.cpp decides by extension).
 #pragma once
 
+#include <optional>
 #include <string>
+#include <utility>
 
 #include "hfvis/image_io.hpp"
 
@@ -13,13 +16,31 @@ namespace hfvis::detail {
 // meridian and along a parallel (both readers convert geographic spacing with it).
 void metresPerDegree(double lat_deg, double* along_meridian, double* along_parallel);
 
+// The cell sizes in the texts of the hfvis:cell_size_x/y attributes (null: absent), when both
+// parse as finite positive numbers (both readers take them from files hfvis wrote).
+std::optional<std::pair<double, double>> storedCellSize(const char* x, const char* y);
+
+// The extension of `path` in lower case, with its dot ("" when it has none).
+std::string lowercaseExtension(const std::string& path);
+
 // Whether `path` names a raster format that GDAL reads rather than OpenImageIO.
 bool isGdalRaster(const std::string& path);
 
 // Reads band `options.channel` ("" = the only band; an index "0".. or a band description) as
-// heights: nodata cells NaN, cell sizes from the geotransform (geographic degrees in metres at
-// the field's centre latitude) unless the options give them. Throws IoError (unreadable,
-// rotated or sheared geotransform, too large).
+// heights: nodata cells NaN, the georeference from the file, cell sizes from the geotransform
+// (geographic degrees in metres at the field's centre latitude; without a geotransform, the
+// hfvis_cell_size_x/y metadata items hfvis writes) unless the options give them. Throws IoError
+// (unreadable, rotated or sheared geotransform, too large).
 HeightField readGdalHeightField(const std::string& path, const HeightFieldReadOptions& options);
+
+// Reads every band (see readImage). Throws IoError.
+ImageChannels readGdalImage(const std::string& path);
+
+// Whether this GDAL has the GTiff driver that writeGeoTiff needs.
+bool hasGeoTiffWriter();
+
+// Writes `image`, already checked by writeImage, to the new file `file` as a GeoTIFF (see
+// writeImage); errors are IoErrors naming `path`, the file the caller is writing for.
+void writeGeoTiff(const std::string& file, const std::string& path, const ImageChannels& image);
 
 }  // namespace hfvis::detail

@@ -1,5 +1,5 @@
-// image_io.cpp: reading height fields and writing results through OpenImageIO, plus the small
-// GeoTIFF tag reader that finds the pixel spacing (OpenImageIO 2.4 does not expose GeoTIFF tags).
+// image_io.cpp: reading height fields and writing results: OpenImageIO for EXR and other
+// images; georeferenced rasters and GeoTIFF outputs are handed to gdal_io.cpp.
 #include "hfvis/image_io.hpp"
 
 #include <OpenImageIO/imageio.h>
@@ -13,7 +13,6 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <new>
 #include <optional>
@@ -22,14 +21,13 @@
 #include <utility>
 #include <vector>
 
-#include "hfvis/errors.hpp"
 #include "gdal_io.hpp"
+#include "hfvis/errors.hpp"
 
 namespace hfvis {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kPi = 3.14159265358979323846;
 
 std::string joinNames(const std::vector<std::string>& names) {
   std::string joined;
@@ -49,208 +47,6 @@ std::string trimmed(std::string text) {
 std::string withDetail(const std::string& reason, const std::string& detail) {
   const std::string d = trimmed(detail);
   return d.empty() ? reason : reason + " (" + d + ")";
-}
-
-// ---------------------------------------------------------------------------------------------
-// GeoTIFF tags. Only what the pixel spacing needs: ModelPixelScale (33550), ModelTiepoint
-// (33922), ModelTransformation (34264) and the inline SHORT keys of the GeoKeyDirectory
-// (34735) of the first IFD. Classic TIFF and BigTIFF, either byte order. Anything malformed
-// simply yields "no GeoTIFF information": OpenImageIO has already accepted the file as a TIFF.
-
-struct GeoTiffInfo {
-  std::vector<double> pixel_scale;  // ScaleX, ScaleY, ScaleZ
-  std::vector<double> tiepoint;     // I, J, K, X, Y, Z (the first tiepoint)
-  std::vector<double> transform;    // 4x4 row-major raster -> model matrix
-  int model_type = 0;               // GTModelTypeGeoKey: 1 projected, 2 geographic, 3 geocentric
-  int raster_type = 1;              // GTRasterTypeGeoKey: 1 PixelIsArea, 2 PixelIsPoint
-  int angular_units = 9102;         // GeogAngularUnitsGeoKey: EPSG unit code, 9102 = degree
-};
-
-class TiffReader {
- public:
-  explicit TiffReader(const std::string& path) : file_(path, std::ios::binary) {
-    if (file_) {
-      file_.seekg(0, std::ios::end);
-      size_ = static_cast<std::uint64_t>(std::max<std::streamoff>(0, file_.tellg()));
-    }
-  }
-
-  std::optional<GeoTiffInfo> readGeoTiff() {
-    std::uint8_t header[16];
-    if (!readAt(0, header, 8)) return std::nullopt;
-    if (header[0] == 'I' && header[1] == 'I') {
-      little_ = true;
-    } else if (header[0] == 'M' && header[1] == 'M') {
-      little_ = false;
-    } else {
-      return std::nullopt;
-    }
-    const unsigned magic = decode(header + 2, 2);
-    std::uint64_t ifd = 0;
-    if (magic == 42) {
-      ifd = decode(header + 4, 4);
-    } else if (magic == 43) {
-      big_ = true;
-      if (!readAt(0, header, 16) || decode(header + 4, 2) != 8) return std::nullopt;
-      ifd = decode(header + 8, 8);
-    } else {
-      return std::nullopt;
-    }
-
-    const unsigned count_bytes = big_ ? 8 : 2;
-    const unsigned entry_bytes = big_ ? 20 : 12;
-    std::uint8_t buf[20];
-    if (!readAt(ifd, buf, count_bytes)) return std::nullopt;
-    const std::uint64_t entries = decode(buf, count_bytes);
-    if (entries > 4096) return std::nullopt;
-
-    GeoTiffInfo info;
-    bool any = false;
-    std::vector<std::uint64_t> keys;
-    for (std::uint64_t i = 0; i < entries; ++i) {
-      if (!readAt(ifd + count_bytes + i * entry_bytes, buf, entry_bytes)) return std::nullopt;
-      const unsigned tag = static_cast<unsigned>(decode(buf, 2));
-      if (tag == 33550) {
-        any |= readValues(buf, &info.pixel_scale);
-      } else if (tag == 33922) {
-        any |= readValues(buf, &info.tiepoint);
-      } else if (tag == 34264) {
-        any |= readValues(buf, &info.transform);
-      } else if (tag == 34735) {
-        std::vector<double> raw;
-        if (readValues(buf, &raw)) {
-          for (double v : raw) keys.push_back(static_cast<std::uint64_t>(v));
-        }
-      }
-    }
-    if (!any) return std::nullopt;
-    // GeoKeyDirectory: a 4-SHORT header (version, revision, minor, key count), then one
-    // (KeyID, TIFFTagLocation, Count, Value) quadruple per key; location 0 = value inline.
-    if (keys.size() >= 4) {
-      const std::size_t n = std::min<std::size_t>(keys[3], (keys.size() - 4) / 4);
-      for (std::size_t k = 0; k < n; ++k) {
-        const std::uint64_t* key = &keys[4 + 4 * k];
-        if (key[1] != 0) continue;
-        const int value = static_cast<int>(key[3]);
-        if (key[0] == 1024) info.model_type = value;
-        if (key[0] == 1025) info.raster_type = value;
-        if (key[0] == 2054) info.angular_units = value;
-      }
-    }
-    return info;
-  }
-
- private:
-  bool readAt(std::uint64_t offset, std::uint8_t* out, std::uint64_t n) {
-    if (!file_ || offset > size_ || n > size_ - offset) return false;
-    file_.seekg(static_cast<std::streamoff>(offset));
-    file_.read(reinterpret_cast<char*>(out), static_cast<std::streamsize>(n));
-    return static_cast<bool>(file_);
-  }
-
-  std::uint64_t decode(const std::uint8_t* p, unsigned n) const {
-    std::uint64_t v = 0;
-    for (unsigned i = 0; i < n; ++i) {
-      const unsigned shift = 8 * (little_ ? i : n - 1 - i);
-      v |= static_cast<std::uint64_t>(p[i]) << shift;
-    }
-    return v;
-  }
-
-  // Reads the values of one IFD entry of type SHORT (3), LONG (4), DOUBLE (12) or LONG8 (16).
-  bool readValues(const std::uint8_t* entry, std::vector<double>* out) {
-    const unsigned type = static_cast<unsigned>(decode(entry + 2, 2));
-    const std::uint64_t count = big_ ? decode(entry + 4, 8) : decode(entry + 4, 4);
-    const std::uint8_t* value_field = entry + (big_ ? 12 : 8);
-    const unsigned inline_bytes = big_ ? 8 : 4;
-    unsigned size = 0;
-    if (type == 3) size = 2;
-    if (type == 4) size = 4;
-    if (type == 12 || type == 16) size = 8;
-    if (size == 0 || count == 0 || count > 65536) return false;
-    std::vector<std::uint8_t> bytes(count * size);
-    if (count * size <= inline_bytes) {
-      std::memcpy(bytes.data(), value_field, bytes.size());
-    } else if (!readAt(decode(value_field, inline_bytes), bytes.data(), bytes.size())) {
-      return false;
-    }
-    out->clear();
-    for (std::uint64_t i = 0; i < count; ++i) {
-      const std::uint64_t raw = decode(bytes.data() + i * size, size);
-      if (type == 12) {
-        double d;
-        std::memcpy(&d, &raw, sizeof d);
-        out->push_back(d);
-      } else {
-        out->push_back(static_cast<double>(raw));
-      }
-    }
-    return true;
-  }
-
-  std::ifstream file_;
-  std::uint64_t size_ = 0;
-  bool little_ = true;
-  bool big_ = false;
-};
-
-// Cell size from GeoTIFF tags, or nullopt when the file carries no pixel spacing.
-std::optional<std::pair<double, double>> geoTiffCellSize(const std::string& path, int width, int height) {
-  TiffReader reader(path);
-  const std::optional<GeoTiffInfo> info = reader.readGeoTiff();
-  if (!info) return std::nullopt;
-
-  double sx = 0.0, sy = 0.0;  // model units per pixel
-  double centre_y = 0.0;      // model y (latitude) at the field's centre
-  bool have_centre = false;
-  // PixelIsArea: raster (0, 0) is the corner of the first pixel; PixelIsPoint: its centre.
-  const double half = info->raster_type == 2 ? 0.5 : 0.0;
-  const double col_c = width / 2.0 - half;
-  const double row_c = height / 2.0 - half;
-  if (info->pixel_scale.size() >= 2) {
-    sx = std::fabs(info->pixel_scale[0]);
-    sy = std::fabs(info->pixel_scale[1]);
-    if (info->tiepoint.size() >= 6) {
-      // Row index grows southwards: y = Y_tie - (row - J) * ScaleY.
-      centre_y = info->tiepoint[4] - (row_c - info->tiepoint[1]) * info->pixel_scale[1];
-      have_centre = true;
-    }
-  } else if (info->transform.size() >= 16) {
-    const std::vector<double>& m = info->transform;
-    sx = std::hypot(m[0], m[4]);
-    sy = std::hypot(m[1], m[5]);
-    centre_y = m[4] * col_c + m[5] * row_c + m[7];
-    have_centre = true;
-  } else {
-    return std::nullopt;
-  }
-  if (!std::isfinite(sx) || !std::isfinite(sy) || sx <= 0.0 || sy <= 0.0) {
-    throw IoError(path, "GeoTIFF pixel scale (" + std::to_string(sx) + ", " + std::to_string(sy) +
-                            ") is not positive; give the cell size explicitly");
-  }
-  if (info->model_type != 2) return std::make_pair(sx, sy);  // projected: model units as they are
-
-  // Geographic model: pixel spacing is an angle; convert it to metres at the centre latitude.
-  // EPSG angular unit codes: radian, degree, arc-minute, arc-second, grad.
-  double to_degrees = 0.0;
-  if (info->angular_units == 9101) to_degrees = 180.0 / kPi;
-  if (info->angular_units == 9102) to_degrees = 1.0;
-  if (info->angular_units == 9103) to_degrees = 1.0 / 60.0;
-  if (info->angular_units == 9104) to_degrees = 1.0 / 3600.0;
-  if (info->angular_units == 9105) to_degrees = 0.9;
-  if (to_degrees == 0.0) {
-    throw IoError(path, "GeoTIFF angular unit code " + std::to_string(info->angular_units) +
-                            " is not supported; give the cell size explicitly");
-  }
-  const double lat = centre_y * to_degrees;
-  if (!have_centre || !std::isfinite(lat) || std::fabs(lat) > 90.0) {
-    throw IoError(path,
-                  "geographic GeoTIFF has no usable tiepoint to find its latitude; "
-                  "give the cell size explicitly");
-  }
-  double per_deg_y = 0.0, per_deg_x = 0.0;
-  detail::metresPerDegree(lat, &per_deg_y, &per_deg_x);
-  return std::make_pair(sx * to_degrees * per_deg_x, sy * to_degrees * per_deg_y);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -379,7 +175,7 @@ std::vector<float> readChannel(const std::string& path, OIIO::ImageInput& in, in
 // ---------------------------------------------------------------------------------------------
 // Atomic writing: everything goes to a temporary file beside the target, which is renamed
 // into place only after a successful close. The temporary keeps the target's extension so
-// OpenImageIO picks the same format.
+// the same writer (OpenImageIO's, by extension, or the GeoTIFF one) takes it.
 
 std::string temporaryPathFor(const std::string& path) {
   static std::atomic<unsigned> counter{0};
@@ -414,10 +210,9 @@ class TemporaryFile {
   bool committed_ = false;
 };
 
-// Writes `spec.height` rows produced by `fill_rows(y_begin, y_end, buffer)` (interleaved pixels
-// of `spec.format`, at most `rows_per_chunk` rows at a time) to `path` atomically.
-template <typename Pixel, typename FillRows>
-void writeAtomically(const std::string& path, const OIIO::ImageSpec& spec, FillRows fill_rows) {
+// The checks every writer makes before it creates anything, and the temporary file beside
+// `path` that it writes.
+TemporaryFile temporaryBeside(const std::string& path) {
   requireImageWriter(path);
   const fs::path target(path);
   if (target.filename().empty()) throw IoError(path, "not a file name");
@@ -426,7 +221,14 @@ void writeAtomically(const std::string& path, const OIIO::ImageSpec& spec, FillR
   if (!fs::is_directory(dir, ec)) {
     throw IoError(path, "directory '" + dir.string() + "' does not exist");
   }
-  TemporaryFile temporary(temporaryPathFor(path));  // same extension: the same writer
+  return TemporaryFile(temporaryPathFor(path));
+}
+
+// Writes `spec.height` rows produced by `fill_rows(y_begin, y_end, buffer)` (interleaved pixels
+// of `spec.format`, at most `rows_per_chunk` rows at a time) to `path` atomically.
+template <typename Pixel, typename FillRows>
+void writeAtomically(const std::string& path, const OIIO::ImageSpec& spec, FillRows fill_rows) {
+  TemporaryFile temporary = temporaryBeside(path);
   std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create(temporary.path());
   if (!out) throw IoError(path, withDetail("no image writer for this file", OIIO::geterror()));
   if (!out->open(temporary.path(), spec)) {
@@ -459,16 +261,8 @@ void writeAtomically(const std::string& path, const OIIO::ImageSpec& spec, FillR
 // Cell size stored by hfvis itself (data/make_data.py and hfvis outputs write the string
 // attributes "hfvis:cell_size_x" and "hfvis:cell_size_y"); both must parse as positive.
 static std::optional<std::pair<double, double>> hfvisCellSize(const OIIO::ImageSpec& spec) {
-  auto number = [&](const char* name) -> double {
-    const std::string text = spec.get_string_attribute(name);
-    if (text.empty()) return 0.0;
-    char* end = nullptr;
-    const double v = std::strtod(text.c_str(), &end);
-    return (end && *end == '\0' && std::isfinite(v) && v > 0.0) ? v : 0.0;
-  };
-  const double x = number("hfvis:cell_size_x"), y = number("hfvis:cell_size_y");
-  if (x > 0.0 && y > 0.0) return std::make_pair(x, y);
-  return std::nullopt;
+  return detail::storedCellSize(spec.get_string_attribute("hfvis:cell_size_x").c_str(),
+                                spec.get_string_attribute("hfvis:cell_size_y").c_str());
 }
 
 namespace {
@@ -536,7 +330,6 @@ HeightField readHeightField(const std::string& path, const HeightFieldReadOption
     throw IoError(path, "image is too large to hold in memory (" + std::to_string(spec.width) + " x " +
                             std::to_string(spec.height) + " pixels)");
   }
-  const bool is_tiff = std::string(in->format_name()) == "tiff";
   const auto stored_cell_size = hfvisCellSize(spec);
   in->close();
 
@@ -547,17 +340,13 @@ HeightField readHeightField(const std::string& path, const HeightFieldReadOption
   } else if (stored_cell_size) {
     field.cell_size_x = stored_cell_size->first;
     field.cell_size_y = stored_cell_size->second;
-  } else if (is_tiff) {
-    if (auto cell = geoTiffCellSize(path, field.width, field.height)) {
-      field.cell_size_x = cell->first;
-      field.cell_size_y = cell->second;
-    }
   }
   field.z_scale = options.z_scale;
   return field;
 }
 
 ImageChannels readImage(const std::string& path) {
+  if (detail::isGdalRaster(path)) return detail::readGdalImage(path);
   std::unique_ptr<OIIO::ImageInput> in = openImage(path);
   const OIIO::ImageSpec& spec = in->spec();
   ImageChannels image;
@@ -578,12 +367,21 @@ ImageChannels readImage(const std::string& path) {
   return image;
 }
 
+bool writesGeoTiff(const std::string& path) {
+  const std::string extension = detail::lowercaseExtension(path);
+  return extension == ".tif" || extension == ".tiff";
+}
+
 void requireImageWriter(const std::string& path) {
+  if (writesGeoTiff(path)) {
+    if (detail::hasGeoTiffWriter()) return;
+    throw IoError(path, "this GDAL has no GTiff driver to write a GeoTIFF (write .exr)");
+  }
   if (OIIO::ImageOutput::create(path)) return;
   OIIO::geterror();  // clear OpenImageIO's message: this one says what to do instead
   const std::string extension = fs::path(path).extension().string();
-  throw IoError(path, "no image writer for the extension '" + extension +
-                          "' (write .exr; .tif and .png also hold float or 16-bit images)");
+  throw IoError(path,
+                "no image writer for the extension '" + extension + "' (write .exr, or .tif for a GeoTIFF)");
 }
 
 void writeImage(const std::string& path, const ImageChannels& image) {
@@ -607,6 +405,21 @@ void writeImage(const std::string& path, const ImageChannels& image) {
       throw InvalidArgument("channel names to write to '" + path + "' must be non-empty and unique (got '" +
                             image.names[c] + "')");
     }
+  }
+  if (std::isinf(image.nodata)) {
+    throw InvalidArgument("the nodata value to write to '" + path + "' must be finite or NaN (got " +
+                          std::to_string(image.nodata) + ")");
+  }
+  if (const auto& transform = image.georeference.geotransform) {
+    if (!std::all_of(transform->begin(), transform->end(), [](double t) { return std::isfinite(t); }))
+      throw InvalidArgument("the geotransform to write to '" + path + "' is not finite");
+  }
+
+  if (writesGeoTiff(path)) {
+    TemporaryFile temporary = temporaryBeside(path);
+    detail::writeGeoTiff(temporary.path(), path, image);
+    temporary.commitTo(path);
+    return;
   }
 
   const int channels = static_cast<int>(image.planes.size());

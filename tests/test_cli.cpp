@@ -1,22 +1,26 @@
 // tests/test_cli.cpp: the hfvis command line tool, run as a separate process: exit status,
-// messages, outputs read back with OpenImageIO, and no partial output after a failure.
+// messages, outputs read back with OpenImageIO (GeoTIFFs with GDAL), and no partial output
+// after a failure.
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "geotiff_support.hpp"
 #include "hfvis/horizon_lists.hpp"
 #include "hfvis/image_io.hpp"
 
@@ -1075,6 +1079,263 @@ TEST_F(Cli, BounceBadRadiance) {
   radiance.planes.assign(5, std::vector<float>(16 * 12, 1.0f));
   hfvis::writeImage(in("five.exr"), radiance);
   expectFailure(run(base + " --radiance " + shellQuoted(in("five.exr"))), 1, "5 channels");
+}
+
+// ---- GeoTIFF: the input's georeference and nodata carried into the outputs ----
+
+// A 24 x 20 bumpy DEM in UTM zone 33N (30 m cells, row 0 north), its nodata value -9999 in a
+// corner, a pair of neighbours in the middle and one cell near the border: as a GeoTIFF made
+// with GDAL, and the same heights as an EXR with NaN in those cells.
+class CliGeoTiff : public Cli {
+ protected:
+  static constexpr int kWidth = 24;
+  static constexpr int kHeight = 20;
+
+  static bool isNodataCell(int col, int row) {
+    return (col == 0 && row == 0) || (row == 8 && (col == 10 || col == 11)) || (col == 3 && row == 15);
+  }
+  static float height(int col, int row) {
+    return static_cast<float>(40.0 * std::sin(0.45 * col) * std::cos(0.35 * row) + 2.0 * col);
+  }
+  std::string geoTiffInput(const std::string& name = "dem.tif",
+                           const std::array<double, 6>& geotransform = hfvis::testing::kUtmGeotransform,
+                           const std::string& crs = "EPSG:32633") const {
+    std::vector<float> values;
+    for (int row = 0; row < kHeight; ++row)
+      for (int col = 0; col < kWidth; ++col)
+        values.push_back(isNodataCell(col, row) ? -9999.0f : height(col, row));
+    hfvis::testing::writeGdalGeoTiff(in(name), kWidth, kHeight, values, geotransform, crs, -9999.0);
+    return in(name);
+  }
+  std::string exrInput() const {
+    return writeField("dem.exr", kWidth, kHeight, [](int col, int row) {
+      return isNodataCell(col, row) ? std::nanf("") : height(col, row);
+    });
+  }
+
+  // The checks every GeoTIFF output of the UTM input gets, through GDAL itself.
+  static hfvis::testing::GdalRaster checkGeoTiffOutput(const std::string& path,
+                                                       const std::vector<std::string>& bands,
+                                                       const std::string& command) {
+    SCOPED_TRACE(path);
+    hfvis::testing::GdalRaster raster = hfvis::testing::readGdalRaster(path);
+    EXPECT_EQ(raster.driver, "GTiff");
+    EXPECT_EQ(raster.width, kWidth);
+    EXPECT_EQ(raster.height, kHeight);
+    EXPECT_EQ(raster.descriptions, bands);
+    EXPECT_TRUE(raster.geotransform && *raster.geotransform == hfvis::testing::kUtmGeotransform);
+    EXPECT_TRUE(hfvis::testing::sameCrs(raster.crs_wkt, hfvis::testing::crsWkt("EPSG:32633")))
+        << raster.crs_wkt;
+    for (std::size_t b = 0; b < raster.bands.size(); ++b) {
+      EXPECT_TRUE(raster.nodata[b].has_value()) << "band " << b << " declares no nodata";
+      EXPECT_EQ(raster.block_sizes[b], (std::array<int, 2>{256, 256})) << "band " << b << " is not tiled";
+    }
+    EXPECT_EQ(raster.image_structure["COMPRESSION"], "DEFLATE");
+    EXPECT_EQ(raster.image_structure["PREDICTOR"], "3");
+    EXPECT_EQ(raster.metadata["hfvis_command"], command);
+    EXPECT_EQ(raster.metadata["hfvis_cell_size_x"], "30");
+    return raster;
+  }
+};
+
+// Every command that writes a raster (and --distance-out) writes GeoTIFF bands in the input's
+// CRS and geotransform; its -9999 cells are NaN, and every other cell, the nodata cells' valid
+// neighbours included, holds exactly what the same heights with NaN holes in an EXR give:
+// nodata cells neither cast nor receive.
+TEST_F(CliGeoTiff, EveryRasterCommandCarriesTheGeoreferenceAndTheNodata) {
+  const std::string tif = geoTiffInput();
+  const std::string exr = exrInput();
+  hfvis::ImageChannels radiance;
+  radiance.width = kWidth;
+  radiance.height = kHeight;
+  radiance.names = {"Y"};
+  radiance.planes = {std::vector<float>(kWidth * kHeight, 1.0f)};
+  hfvis::writeImage(in("radiance.exr"), radiance);
+  struct Case {
+    std::string command, options;
+    std::vector<std::string> bands;
+    std::string distance_option;  // horizon: --distance-out too
+  };
+  const std::vector<Case> cases = {
+      {"svf", "-k 8", {"svf"}, ""},
+      {"ao", "-k 8", {"ao"}, ""},
+      {"viewcount", "-k 4", {"count", "visible_area"}, ""},
+      {"bounce", "-k 4 --radiance " + shellQuoted(in("radiance.exr")), {"Y"}, ""},
+      {"horizon", "-k 4", hfvis::directionChannelNames("h", 4), "--distance-out"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.command);
+    const std::string tif_out = out(c.command + ".tif"), exr_out = out(c.command + ".exr");
+    const std::string tif_distance = out(c.command + "_d.tiff"), exr_distance = out(c.command + "_d.exr");
+    const auto distance = [&](const std::string& file) {
+      return c.distance_option.empty() ? std::string() : " " + c.distance_option + " " + shellQuoted(file);
+    };
+    const CliResult from_tif = run(c.command + " " + shellQuoted(tif) + " -o " + shellQuoted(tif_out) + " " +
+                                   c.options + distance(tif_distance) + " -q");
+    ASSERT_EQ(from_tif.status, 0) << from_tif.err;
+    const CliResult from_exr = run(c.command + " " + shellQuoted(exr) + " --cell-size 30 -o " +
+                                   shellQuoted(exr_out) + " " + c.options + distance(exr_distance) + " -q");
+    ASSERT_EQ(from_exr.status, 0) << from_exr.err;
+
+    std::vector<std::pair<std::string, std::string>> pairs = {{tif_out, exr_out}};
+    std::vector<std::vector<std::string>> names = {c.bands};
+    if (!c.distance_option.empty()) {
+      pairs.emplace_back(tif_distance, exr_distance);
+      names.push_back(hfvis::directionChannelNames("d", 4));
+    }
+    for (std::size_t p = 0; p < pairs.size(); ++p) {
+      const hfvis::testing::GdalRaster raster = checkGeoTiffOutput(pairs[p].first, names[p], c.command);
+      const ReadBack reference = readBack(pairs[p].second);
+      ASSERT_EQ(raster.bands.size(), names[p].size());
+      for (std::size_t b = 0; b < names[p].size(); ++b) {
+        SCOPED_TRACE(names[p][b]);
+        EXPECT_TRUE(raster.nodata[b] && std::isnan(*raster.nodata[b]));  // NaN by default
+        const auto channel = std::find(reference.channels.begin(), reference.channels.end(), names[p][b]);
+        ASSERT_NE(channel, reference.channels.end());
+        const int exr_channel = static_cast<int>(channel - reference.channels.begin());
+        int finite_neighbours = 0;
+        for (int row = 0; row < kHeight; ++row) {
+          for (int col = 0; col < kWidth; ++col) {
+            const float value = raster.bands[b][static_cast<std::size_t>(row) * kWidth + col];
+            const float expected = reference.at(col, row, exr_channel);
+            if (isNodataCell(col, row)) {
+              ASSERT_TRUE(std::isnan(value)) << col << "," << row;
+              continue;
+            }
+            ASSERT_TRUE(std::isfinite(value)) << col << "," << row;
+            ASSERT_EQ(value, expected) << col << "," << row;
+            bool next_to_nodata = false;
+            for (int dr = -1; dr <= 1; ++dr)
+              for (int dc = -1; dc <= 1; ++dc) next_to_nodata |= isNodataCell(col + dc, row + dr);
+            finite_neighbours += next_to_nodata;
+          }
+        }
+        EXPECT_EQ(finite_neighbours, 3 + 10 + 8);  // the corner's, the pair's and the single cell's
+      }
+    }
+  }
+  EXPECT_EQ(listDirectory(outputs()).size(), 12u);  // nothing beside the outputs (no .aux.xml)
+}
+
+// --nodata VALUE: written in the nodata cells and declared on every band of a GeoTIFF output;
+// hfvis reads it back as nodata. An EXR output of the same run keeps NaN.
+TEST_F(CliGeoTiff, NodataValueIsWrittenAndDeclared) {
+  const std::string tif = geoTiffInput();
+  const CliResult nan_run =
+      run("svf " + shellQuoted(tif) + " -o " + shellQuoted(out("nan.tif")) + " -k 8 -q");
+  ASSERT_EQ(nan_run.status, 0) << nan_run.err;
+  const CliResult value_run =
+      run("svf " + shellQuoted(tif) + " -o " + shellQuoted(out("v.tif")) + " -k 8 -q --nodata -9999");
+  ASSERT_EQ(value_run.status, 0) << value_run.err;
+  const hfvis::testing::GdalRaster with_nan = checkGeoTiffOutput(out("nan.tif"), {"svf"}, "svf");
+  const hfvis::testing::GdalRaster with_value = checkGeoTiffOutput(out("v.tif"), {"svf"}, "svf");
+  ASSERT_TRUE(with_value.nodata[0]);
+  EXPECT_EQ(*with_value.nodata[0], -9999.0);
+  EXPECT_NE(with_value.metadata.at("hfvis_nodata").find("-9999"), std::string::npos);
+  const hfvis::HeightField back = hfvis::readHeightField(out("v.tif"));
+  for (int row = 0; row < kHeight; ++row) {
+    for (int col = 0; col < kWidth; ++col) {
+      const std::size_t i = static_cast<std::size_t>(row) * kWidth + col;
+      if (isNodataCell(col, row)) {
+        EXPECT_EQ(with_value.bands[0][i], -9999.0f) << col << "," << row;
+        EXPECT_TRUE(std::isnan(back.heights[i])) << col << "," << row;
+      } else {
+        EXPECT_EQ(with_value.bands[0][i], with_nan.bands[0][i]) << col << "," << row;
+        EXPECT_EQ(back.heights[i], with_nan.bands[0][i]) << col << "," << row;
+      }
+    }
+  }
+  // The distances as EXR beside the angles as GeoTIFF: only the GeoTIFF holds the value.
+  const CliResult mixed = run("horizon " + shellQuoted(tif) + " -o " + shellQuoted(out("h.tif")) +
+                              " --distance-out " + shellQuoted(out("d.exr")) + " -k 4 -q --nodata -32768");
+  ASSERT_EQ(mixed.status, 0) << mixed.err;
+  const hfvis::testing::GdalRaster angles =
+      checkGeoTiffOutput(out("h.tif"), hfvis::directionChannelNames("h", 4), "horizon");
+  EXPECT_EQ(angles.nodata[3], std::optional<double>(-32768.0));
+  EXPECT_EQ(angles.bands[3][0], -32768.0f);
+  EXPECT_TRUE(std::isnan(readBack(out("d.exr")).at(0, 0, 0)));
+
+  // An output is an input again: a band by its description or its index, its nodata as nodata,
+  // its georeference carried on.
+  for (const char* channel : {"h002", "2"}) {
+    SCOPED_TRACE(channel);
+    const std::string again = out(std::string("again_") + channel + ".tif");
+    const CliResult result = run("svf " + shellQuoted(out("h.tif")) + " --channel " + channel + " -o " +
+                                 shellQuoted(again) + " -k 4 -q");
+    ASSERT_EQ(result.status, 0) << result.err;
+    const hfvis::testing::GdalRaster raster = checkGeoTiffOutput(again, {"svf"}, "svf");
+    EXPECT_TRUE(std::isnan(raster.bands[0][0]));
+    EXPECT_TRUE(std::isfinite(raster.bands[0][1]));
+  }
+  const std::vector<float> by_name = hfvis::testing::readGdalRaster(out("again_h002.tif")).bands.at(0);
+  const std::vector<float> by_index = hfvis::testing::readGdalRaster(out("again_2.tif")).bands.at(0);
+  ASSERT_EQ(by_name.size(), by_index.size());
+  for (std::size_t i = 0; i < by_name.size(); ++i)
+    EXPECT_TRUE(by_name[i] == by_index[i] || (std::isnan(by_name[i]) && std::isnan(by_index[i]))) << i;
+}
+
+TEST_F(CliGeoTiff, BadNodataValuesAreUsageErrors) {
+  const std::string tif = geoTiffInput();
+  const std::string base = "svf " + shellQuoted(tif) + " -o " + shellQuoted(out("o.tif")) + " -k 4 --nodata ";
+  for (const char* value : {"abc", "inf", "-inf", "1e39", "nan(1)", "", "-9999x"}) {
+    SCOPED_TRACE(value);
+    const CliResult result = run(base + shellQuoted(value));
+    expectFailure(result, 2, "--nodata");
+    EXPECT_NE(result.err.find(std::string("'") + value + "'"), std::string::npos) << result.err;
+  }
+  expectFailure(run("svf " + shellQuoted(tif) + " -o " + shellQuoted(out("o.tif")) + " --nodata"), 2,
+                "--nodata");
+  const CliResult exr =
+      run("svf " + shellQuoted(tif) + " -o " + shellQuoted(out("o.exr")) + " --nodata -9999");
+  expectFailure(exr, 2, "--nodata");
+  EXPECT_NE(exr.err.find("GeoTIFF"), std::string::npos) << exr.err;
+  expectFailure(
+      run("horizons " + shellQuoted(tif) + " --at 1,1 -o " + shellQuoted(out("h.json")) + " --nodata 0"), 2,
+      "--nodata");
+  for (const char* value : {"nan", "NaN", "0", "-3.4e38"}) {
+    SCOPED_TRACE(value);
+    const CliResult good = run(base + shellQuoted(value) + " -q");
+    EXPECT_EQ(good.status, 0) << good.err;
+    fs::remove(out("o.tif"));
+  }
+}
+
+// No output replaces an input, GeoTIFF or not: the same path, another path to it, a symbolic
+// link or a hard link to it are refused before anything is read or written.
+TEST_F(CliGeoTiff, GeoTiffOutputNeverReplacesTheInput) {
+  const std::string tif = geoTiffInput();
+  const std::string before = readText(tif);
+  fs::create_symlink(tif, in("symlink.tif"));
+  fs::create_hard_link(tif, in("hardlink.tif"));
+  const std::string via_parent = (inputs() / ".." / "inputs" / "dem.tif").string();
+  for (const std::string& output : {tif, via_parent, in("symlink.tif"), in("hardlink.tif")}) {
+    SCOPED_TRACE(output);
+    const CliResult result = run("svf " + shellQuoted(tif) + " -o " + shellQuoted(output) + " -k 4");
+    expectFailure(result, 2, "outputs never replace an input");
+    const CliResult distance = run("horizon " + shellQuoted(tif) + " -o " + shellQuoted(out("h.tif")) +
+                                   " --distance-out " + shellQuoted(output) + " -k 4");
+    expectFailure(distance, 2, "outputs never replace an input");
+    EXPECT_EQ(readText(tif), before);
+  }
+  EXPECT_EQ(listDirectory(inputs()).size(), 3u);  // no temporary file beside the input
+}
+
+// A geographic (lat/lon) input stays geographic: its CRS and geotransform in degrees are copied
+// as they are; only the cell size that the computation uses is in metres.
+TEST_F(CliGeoTiff, GeographicInputStaysGeographic) {
+  const double arcsec = 1.0 / 3600.0;
+  const std::array<double, 6> degrees = {7.0, arcsec, 0.0, 45.0 + 10 * arcsec, 0.0, -arcsec};
+  const std::string tif = geoTiffInput("wgs84.tif", degrees, "EPSG:4326");
+  const CliResult result =
+      run("svf " + shellQuoted(tif) + " -o " + shellQuoted(out("svf.TIFF")) + " -k 4 -q");
+  ASSERT_EQ(result.status, 0) << result.err;
+  const hfvis::testing::GdalRaster raster = hfvis::testing::readGdalRaster(out("svf.TIFF"));
+  ASSERT_TRUE(raster.geotransform);
+  EXPECT_EQ(*raster.geotransform, degrees);
+  EXPECT_TRUE(hfvis::testing::sameCrs(raster.crs_wkt, hfvis::testing::crsWkt("EPSG:4326"))) << raster.crs_wkt;
+  // WGS84 near 45 N: about 78847 m per degree of longitude, 111133 m per degree of latitude.
+  EXPECT_NEAR(std::stod(raster.metadata.at("hfvis_cell_size_x")), 78846.8 * arcsec, 0.05);
+  EXPECT_NEAR(std::stod(raster.metadata.at("hfvis_cell_size_y")), 111133.0 * arcsec, 0.05);
 }
 
 }  // namespace

@@ -1,24 +1,35 @@
 // test_image_io.cpp: reading height fields (formats, pixel types, channels, GeoTIFF spacing,
-// bad files) and writing results (channel order round trip, atomic replace, previews).
+// bad files) and writing results (channel order round trip, atomic replace, previews, GeoTIFF
+// outputs checked with GDAL itself).
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "geotiff_support.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/image_io.hpp"
 
 namespace hfvis {
 namespace {
+
+using testing::crsWkt;
+using testing::GdalRaster;
+using testing::kUtmGeotransform;
+using testing::readGdalRaster;
+using testing::sameCrs;
 
 namespace fs = std::filesystem;
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
@@ -95,9 +106,9 @@ void expectIoError(const std::string& path, Call call, const std::string& messag
   }
 }
 
-// A minimal uncompressed single-strip float32 GeoTIFF written byte by byte, because
-// OpenImageIO's TIFF writer does not write GeoTIFF tags. The tags follow the GeoTIFF 1.1
-// specification (ModelPixelScale 33550, ModelTiepoint 33922, ModelTransformation 34264,
+// A minimal uncompressed single-strip float32 GeoTIFF written byte by byte, so that the tags
+// are exactly the ones a test names (GDAL reads it, as every .tif). The tags follow the GeoTIFF
+// 1.1 specification (ModelPixelScale 33550, ModelTiepoint 33922, ModelTransformation 34264,
 // GeoKeyDirectory 34735).
 struct GeoTiffSpec {
   int width = 4;
@@ -452,6 +463,38 @@ TEST_F(ImageIoTest, GeoTiffGeographicWithoutTiepointIsAnError) {
   EXPECT_EQ(readHeightField(path("notie.tif"), options).cell_size_y, 20.0);
 }
 
+TEST_F(ImageIoTest, TiffBytesUnderAnotherExtensionReadWithoutGeoreference) {
+  // OpenImageIO reads what GDAL is not asked to (by extension); it reads no GeoTIFF tags.
+  GeoTiffSpec g;
+  g.pixel_scale = {30.0, 25.0, 0.0};
+  g.tiepoint = {0, 0, 0, 500000.0, 4100000.0, 0};
+  g.geo_keys = geoKeys({{1024, 1}, {1025, 1}, {3072, 32633}});
+  const std::vector<float> pixels = writeGeoTiff(path("utm.hdr"), g);
+  const HeightField field = readHeightField(path("utm.hdr"));
+  EXPECT_EQ(field.heights, pixels);
+  EXPECT_EQ(field.cell_size_x, 1.0);
+  EXPECT_EQ(field.cell_size_y, 1.0);
+  EXPECT_TRUE(field.georeference.empty());
+}
+
+TEST_F(ImageIoTest, GeoTiffInputFillsTheGeoreference) {
+  const std::vector<float> heights = {1, 2, 3, -9999, 5, 6};
+  const std::string file = path("dem.tif");
+  testing::writeGdalGeoTiff(file, 3, 2, heights, kUtmGeotransform, "EPSG:32633", -9999.0);
+  const HeightField field = readHeightField(file);
+  ASSERT_TRUE(field.georeference.geotransform);
+  EXPECT_EQ(*field.georeference.geotransform, kUtmGeotransform);
+  EXPECT_TRUE(sameCrs(field.georeference.crs_wkt, crsWkt("EPSG:32633"))) << field.georeference.crs_wkt;
+  EXPECT_EQ(field.cell_size_x, 30.0);
+  EXPECT_EQ(field.cell_size_y, 30.0);
+  EXPECT_TRUE(std::isnan(field.heights[3]));
+  EXPECT_EQ(field.heights[4], 5.0f);
+  // Images OpenImageIO reads have none, as a field filled in memory.
+  writeWithOiio(path("f.exr"), 3, 2, 1, OIIO::TypeDesc::FLOAT, heights.data());
+  EXPECT_TRUE(readHeightField(path("f.exr")).georeference.empty());
+  EXPECT_TRUE(HeightField{}.georeference.empty());
+}
+
 // ---------------------------------------------------------------------------------------------
 // Bad input.
 
@@ -629,6 +672,134 @@ TEST_F(ImageIoTest, WriteImageReplacesAnExistingFile) {
   EXPECT_EQ(field.heights, second.planes[0]);
   EXPECT_EQ(readHeightField(file, options).heights, second.planes[0]);
   EXPECT_EQ(filesInDir(), (std::vector<std::string>{"result.exr"}));
+}
+
+// ---------------------------------------------------------------------------------------------
+// GeoTIFF outputs, read back with GDAL itself and with hfvis.
+
+TEST(ImageWriters, GeoTiffNamesGoThroughGdal) {
+  for (const char* name : {"a.tif", "a.tiff", "dir.x/A.TIF", "a.TiFf"}) {
+    EXPECT_TRUE(writesGeoTiff(name)) << name;
+    EXPECT_NO_THROW(requireImageWriter(name)) << name;
+  }
+  for (const char* name : {"a.exr", "a.tif.exr", "tif", "a.tifx", "a.png"})
+    EXPECT_FALSE(writesGeoTiff(name)) << name;
+}
+
+TEST_F(ImageIoTest, GeoTiffOutputKeepsBandsGeoreferenceAndNodata) {
+  ImageChannels image = horizonImage(7, 5, 3);
+  image.planes[0][4] = kNaN;
+  image.planes[2][0] = kNaN;
+  image.planes[1][6] = -1.25f;
+  image.attributes = {{"hfvis:directions", "3"}, {"hfvis:units", "radians: up = positive"}};
+  image.georeference.geotransform = kUtmGeotransform;
+  image.georeference.crs_wkt = crsWkt("EPSG:32633");
+  image.nodata = -9999.0f;
+  const std::string file = path("h.tif");
+  writeImage(file, image);
+  EXPECT_EQ(filesInDir(), (std::vector<std::string>{"h.tif"}));  // no temporary, no .aux.xml
+
+  const GdalRaster raster = readGdalRaster(file);
+  EXPECT_EQ(raster.driver, "GTiff");
+  ASSERT_EQ(raster.width, 7);
+  ASSERT_EQ(raster.height, 5);
+  EXPECT_EQ(raster.descriptions, image.names);
+  ASSERT_EQ(raster.bands.size(), 3u);
+  for (std::size_t b = 0; b < 3; ++b) {
+    SCOPED_TRACE(image.names[b]);
+    ASSERT_TRUE(raster.nodata[b]);
+    EXPECT_EQ(*raster.nodata[b], -9999.0);
+    EXPECT_EQ(raster.block_sizes[b], (std::array<int, 2>{256, 256}));  // tiled
+    for (std::size_t i = 0; i < raster.bands[b].size(); ++i) {
+      const float expected = std::isnan(image.planes[b][i]) ? -9999.0f : image.planes[b][i];
+      EXPECT_EQ(raster.bands[b][i], expected) << "at " << i;
+    }
+  }
+  ASSERT_TRUE(raster.geotransform);
+  EXPECT_EQ(*raster.geotransform, kUtmGeotransform);
+  EXPECT_TRUE(sameCrs(raster.crs_wkt, image.georeference.crs_wkt)) << raster.crs_wkt;
+  EXPECT_EQ(raster.image_structure.at("COMPRESSION"), "DEFLATE");
+  EXPECT_EQ(raster.image_structure.at("PREDICTOR"), "3");
+  EXPECT_EQ(raster.image_structure.at("INTERLEAVE"), "BAND");
+  EXPECT_EQ(raster.metadata.at("hfvis_directions"), "3");
+  EXPECT_EQ(raster.metadata.at("hfvis_units"), "radians: up = positive");
+
+  // Back through hfvis: the bands by description or index, nodata as NaN, the georeference.
+  const ImageChannels back = readImage(file);
+  EXPECT_EQ(back.names, image.names);
+  ASSERT_EQ(back.planes.size(), 3u);
+  for (std::size_t b = 0; b < 3; ++b) expectSameHeights(image.planes[b], back.planes[b]);
+  const auto has = [&](const std::string& name, const std::string& value) {
+    return std::find(back.attributes.begin(), back.attributes.end(), std::make_pair(name, value)) !=
+           back.attributes.end();
+  };
+  EXPECT_TRUE(has("hfvis:directions", "3"));
+  EXPECT_TRUE(has("hfvis:units", "radians: up = positive"));
+  ASSERT_TRUE(back.georeference.geotransform);
+  EXPECT_EQ(*back.georeference.geotransform, kUtmGeotransform);
+  EXPECT_TRUE(sameCrs(back.georeference.crs_wkt, image.georeference.crs_wkt));
+
+  HeightFieldReadOptions by_name;
+  by_name.channel = "h002";
+  const HeightField h2 = readHeightField(file, by_name);
+  expectSameHeights(image.planes[2], h2.heights);
+  EXPECT_EQ(h2.cell_size_x, 30.0);
+  EXPECT_EQ(h2.cell_size_y, 30.0);
+  HeightFieldReadOptions by_index;
+  by_index.channel = "1";
+  expectSameHeights(image.planes[1], readHeightField(file, by_index).heights);
+  expectIoError(
+      file, [&] { readHeightField(file); }, "3 bands");
+  HeightFieldReadOptions unknown;
+  unknown.channel = "h003";
+  expectIoError(
+      file, [&] { readHeightField(file, unknown); }, "'h003'");
+}
+
+TEST_F(ImageIoTest, GeoTiffOutputWithoutGeoreferenceKeepsNaNAndTheCellSize) {
+  ImageChannels image = horizonImage(4, 3, 1);
+  image.planes[0][2] = kNaN;
+  image.attributes = {{"hfvis:cell_size_x", "2.5"}, {"hfvis:cell_size_y", "4"}};
+  const std::string file = path("plain.TIFF");
+  writeImage(file, image);
+  const GdalRaster raster = readGdalRaster(file);
+  EXPECT_FALSE(raster.geotransform);
+  EXPECT_TRUE(raster.crs_wkt.empty()) << raster.crs_wkt;
+  ASSERT_TRUE(raster.nodata[0]);
+  EXPECT_TRUE(std::isnan(*raster.nodata[0]));
+  EXPECT_TRUE(std::isnan(raster.bands[0][2]));
+  EXPECT_EQ(raster.bands[0][3], image.planes[0][3]);
+  const HeightField field = readHeightField(file);  // one band: no choice needed
+  EXPECT_TRUE(field.georeference.empty());
+  EXPECT_EQ(field.cell_size_x, 2.5);
+  EXPECT_EQ(field.cell_size_y, 4.0);
+  expectSameHeights(image.planes[0], field.heights);
+}
+
+TEST_F(ImageIoTest, GeoTiffWriteFailureLeavesTheOldFileAndNothingElse) {
+  const std::string file = path("r.tif");
+  writeImage(file, horizonImage(5, 4, 2));
+  const std::vector<std::string> before_files = filesInDir();
+  std::ifstream before_stream(file, std::ios::binary);
+  const std::string before((std::istreambuf_iterator<char>(before_stream)), std::istreambuf_iterator<char>());
+
+  ImageChannels unwritable = horizonImage(5, 4, 3);
+  unwritable.georeference.crs_wkt = "not a coordinate reference system";  // fails once the file exists
+  expectIoError(
+      file, [&] { writeImage(file, unwritable); }, "CRS");
+  ImageChannels infinite = horizonImage(5, 4, 3);
+  infinite.nodata = std::numeric_limits<float>::infinity();
+  EXPECT_THROW(writeImage(file, infinite), InvalidArgument);
+  ImageChannels bad_transform = horizonImage(5, 4, 3);
+  bad_transform.georeference.geotransform = {0.0, std::nan(""), 0.0, 0.0, 0.0, -1.0};
+  EXPECT_THROW(writeImage(file, bad_transform), InvalidArgument);
+  expectIoError(
+      path("none/r.tif"), [&] { writeImage(path("none/r.tif"), unwritable); }, "does not exist");
+
+  EXPECT_EQ(filesInDir(), before_files);
+  std::ifstream after_stream(file, std::ios::binary);
+  const std::string after((std::istreambuf_iterator<char>(after_stream)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(after, before);
 }
 
 std::vector<std::uint8_t> readPng8(const std::string& file, int* width, int* height) {

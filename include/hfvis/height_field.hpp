@@ -1,10 +1,27 @@
 // hfvis/height_field.hpp: the height field every operation reads.
 #pragma once
 
+#include <array>
 #include <cstddef>
+#include <optional>
+#include <string>
 #include <vector>
 
 namespace hfvis {
+
+// Where a raster lies on the Earth, as the file it was read from says, so that results written
+// as GeoTIFF overlay their input in a GIS. hfvis computes nothing from it (the cell sizes are
+// what the operations use); it is carried from the input to the outputs as it was.
+struct Georeference {
+  // GDAL's geotransform of the pixel corners: ground x = t[0] + col * t[1] + row * t[2],
+  // y = t[3] + col * t[4] + row * t[5] (north-up: t[2] = t[4] = 0, t[5] < 0). None when the
+  // file had none.
+  std::optional<std::array<double, 6>> geotransform;
+  // The coordinate reference system as WKT; empty when the file had none.
+  std::string crs_wkt;
+
+  bool empty() const { return !geotransform && crs_wkt.empty(); }
+};
 
 // A W x H grid of heights, row-major, row 0 first as stored in the image.
 // Pixel (col, row) sits at ground position (col * cell_size_x, row * cell_size_y);
@@ -21,6 +38,7 @@ struct HeightField {
   double cell_size_x = 1.0;    // ground units per pixel along columns
   double cell_size_y = 1.0;    // ground units per pixel along rows
   double z_scale = 1.0;        // multiplies every height
+  Georeference georeference;   // from a georeferenced raster; empty for a field filled in memory
 
   float at(int col, int row) const { return heights[static_cast<std::size_t>(row) * width + col]; }
   std::size_t pixelCount() const { return static_cast<std::size_t>(width) * height; }

@@ -1,8 +1,9 @@
-// hfvis/image_io.hpp: reading height fields (GDAL for georeferenced rasters, OpenImageIO for
-// images) and writing results through OpenImageIO.
+// hfvis/image_io.hpp: reading height fields and writing results: GeoTIFF and the other
+// georeferenced rasters through GDAL, EXR and other images through OpenImageIO.
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -15,9 +16,9 @@ struct HeightFieldReadOptions {
   // Channel to read: "" = the only channel (an error for multi-channel images),
   // else a channel name ("Y", "R", "height") or a zero-based index ("0").
   std::string channel;
-  // Ground units per pixel; <= 0 = take it from the file (the string attributes
-  // hfvis:cell_size_x/y that hfvis and data/make_data.py write in EXR, else a raster's
-  // geotransform, geographic degrees converted to metres at the field's centre latitude) or 1.
+  // Ground units per pixel; <= 0 = take it from the file (a raster's geotransform, geographic
+  // degrees converted to metres at the field's centre latitude, else the hfvis:cell_size_x/y
+  // attributes that hfvis and data/make_data.py write) or 1.
   double cell_size_x = 0.0;
   double cell_size_y = 0.0;
   double z_scale = 1.0;
@@ -27,13 +28,15 @@ struct HeightFieldReadOptions {
 };
 
 // Reads a height field. Georeferenced rasters (.tif/.tiff, .hgt, .asc, .vrt, .img, .bil, .dem,
-// .grd, .adf) go through GDAL: the band's nodata value becomes NaN, the cell size comes from
-// the geotransform (geographic degrees in metres at the centre latitude), a rotated or sheared
-// geotransform is an IoError. Everything else (EXR, PNG 8/16-bit, ...) goes through
-// OpenImageIO. Integer pixels are converted to their stored integer
-// values (a 16-bit PNG holds heights 0..65535), not normalised. Throws IoError naming the
-// file and reason (missing, unreadable, truncated, zero-sized, multi-channel without a
-// channel choice, unknown channel).
+// .grd, .adf, by extension in any case) go through GDAL: the band (a zero-based index or a band
+// description) is read, its nodata value becomes NaN, the cell size comes from the
+// geotransform (geographic degrees in metres at the centre latitude), the geotransform and CRS
+// fill `georeference`, and a rotated or sheared geotransform is an IoError. Everything else
+// (EXR, PNG 8/16-bit, ...) goes through OpenImageIO, without georeference; TIFF bytes under
+// another extension too (no GeoTIFF tags are read then). Integer pixels are converted to their
+// stored integer values (a 16-bit PNG holds heights 0..65535), not normalised. Throws IoError
+// naming the file and reason (missing, unreadable, truncated, zero-sized, multi-channel without
+// a channel choice, unknown channel).
 HeightField readHeightField(const std::string& path, const HeightFieldReadOptions& options = {});
 
 // One float32 image to write (or read by readImage): planar channels of width*height values each.
@@ -43,19 +46,40 @@ struct ImageChannels {
   std::vector<std::string> names;                               // one per channel
   std::vector<std::vector<float>> planes;                       // one per channel, row-major
   std::vector<std::pair<std::string, std::string>> attributes;  // string metadata
+  // GeoTIFF only (other formats have neither): where the image lies, and the value its NaN
+  // (nodata) cells hold, declared as every band's nodata value. NaN keeps them NaN.
+  Georeference georeference;
+  float nodata = std::numeric_limits<float>::quiet_NaN();
 };
 
-// Reads every channel of an image as float32 planes, in the order OpenImageIO reports them
-// (for EXR: R, G, B, A first, then the others sorted by name), with their names; integer
-// pixels as their stored values, as readHeightField. Throws IoError as readHeightField.
+// Reads every channel of an image as float32 planes with their names. Rasters GDAL reads (the
+// extensions of readHeightField) give their bands in order, named by their descriptions
+// ("channel<i>" where a band has none), nodata cells as NaN, the dataset's metadata items as
+// attributes (hfvis_NAME back as hfvis:NAME, see writeImage) and their georeference. Other
+// images give their channels in the order OpenImageIO reports them (for EXR: R, G, B, A first,
+// then the others sorted by name). Integer pixels are read as their stored values, as
+// readHeightField. Throws IoError as readHeightField.
 ImageChannels readImage(const std::string& path);
+
+// Whether writeImage writes `path` as a GeoTIFF through GDAL: its name ends in .tif or .tiff,
+// in any case.
+bool writesGeoTiff(const std::string& path);
 
 // Throws IoError when no image writer handles the extension of `path` (nothing is created):
 // to refuse an output before computing it.
 void requireImageWriter(const std::string& path);
 
-// Writes an EXR (or any float format OpenImageIO writes, by extension) atomically: to a
-// temporary file beside `path`, renamed into place only when complete. Throws IoError.
+// Writes `image` atomically: to a temporary file beside `path`, renamed into place only when
+// complete (a failure leaves nothing behind and an existing `path` as it was).
+// - .tif/.tiff: a GeoTIFF through GDAL: one float32 band per channel, its description the
+//   channel's name; the georeference's geotransform and CRS where it has them; every band's
+//   nodata value `image.nodata`, written into the NaN cells; DEFLATE with the floating-point
+//   predictor, 256 x 256 tiles, bands stored one after another, BigTIFF when the size needs
+//   it. Attributes become the dataset's metadata items, each ':' of a name written as '_'
+//   (GDAL's name=value lists take ':' for a separator): hfvis:units becomes hfvis_units.
+// - otherwise an EXR (or any float format OpenImageIO writes, by extension) with the
+//   attributes as string attributes; no georeference, NaN in nodata cells.
+// Throws InvalidArgument for an inconsistent image, IoError when writing fails.
 void writeImage(const std::string& path, const ImageChannels& image);
 
 // Writes an 8-bit PNG preview of one plane, linearly mapped from [lo, hi] to [0, 255]
