@@ -307,6 +307,39 @@ std::string joinPaths(const std::vector<std::string>& paths) {
 }
 
 // Reads the input height field and checks it (a bad field is the input file's fault).
+// The host memory a run may use: what the kernel says is available (free memory plus what it
+// can reclaim), else the physical memory.
+double availableHostBytes() {
+  std::ifstream meminfo("/proc/meminfo");
+  std::string key;
+  double kib = 0.0;
+  std::string unit;
+  while (meminfo >> key >> kib >> unit) {
+    if (key == "MemAvailable:") return kib * 1024.0;
+  }
+  return static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGE_SIZE));
+}
+
+// K-channel horizon maps of a huge field outgrow the host before anything is computed: the
+// planes are held about three times (the result, its channels, the writer's buffer). Refused
+// then, saying what to ask for instead.
+void requireHostMemoryForPlanes(Command command, const RunArguments& run, const HeightField& field) {
+  if (command != Command::Horizon) return;
+  const double plane = static_cast<double>(field.pixelCount()) * sizeof(float);
+  const double planes = plane * run.directions * (run.distance_output.empty() ? 1 : 2);
+  const double need = 3.0 * planes, available = availableHostBytes();
+  if (need <= available) return;
+  std::ostringstream message;
+  message << std::fixed << std::setprecision(1) << "the " << run.directions << "-channel horizon map"
+          << (run.distance_output.empty() ? "" : " and its distances") << " of this " << field.width << " x "
+          << field.height << " field need about " << need / 1073741824.0 << " GiB of host memory ("
+          << planes / 1073741824.0 << " GiB of planes, held about three times while written) but "
+          << available / 1073741824.0
+          << " GiB is available: ask for svf or ao (one channel each), fewer directions (-k), or a crop of the "
+             "field";
+  throw Error(message.str());
+}
+
 HeightField readValidField(const RunArguments& run) {
   HeightField field = readHeightField(run.input, readOptions(run));
   try {
@@ -443,6 +476,7 @@ int runCompute(Command command, const RunArguments& run) {
   requireOutputs(run, outputPaths(run));
 
   const HeightField field = readValidField(run);
+  requireHostMemoryForPlanes(command, run, field);
   const ComputeContext context = contextFor(run);
   const DeviceInfo& device = context.device();
 

@@ -23,7 +23,8 @@ inline std::size_t roundUp(std::size_t n, std::size_t m) { return (n + m - 1) / 
 // automatically line-major on CPUs and step-major elsewhere.
 bool lineMajorLayout(const ContextState& st);
 
-// The budget when the caller gives none: half the device memory.
+// The budget when the caller gives none: half the device memory (for a CPU device, whose
+// memory is the host's, half the host's physical memory).
 std::size_t defaultMemoryBudget(const DeviceInfo& device);
 
 std::string mebibytes(std::size_t bytes);

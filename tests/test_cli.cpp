@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -335,6 +336,19 @@ TEST_F(Cli, DirectionsOutOfRange) {
     expectFailure(result, 2, "-k");
     EXPECT_NE(result.err.find("in 1 .. 65536"), std::string::npos) << result.err;
   }
+}
+
+// A horizon map that cannot fit in host memory (65536 planes of a 1024 x 1024 field: 256 GiB)
+// is refused before anything is computed, saying what to ask for instead; nothing is written.
+TEST_F(Cli, HorizonMapBeyondHostMemoryIsRefusedBeforeComputing) {
+  const std::string big = writeField("big.exr", 1024, 1024, [](int x, int y) { return float(x ^ y); });
+  const auto start = std::chrono::steady_clock::now();
+  const CliResult result = run("horizon " + shellQuoted(big) + " -o " + shellQuoted(out("o.exr")) + " -k 65536");
+  expectFailure(result, 1, "GiB of host memory");
+  EXPECT_NE(result.err.find("ask for svf or ao"), std::string::npos) << result.err;
+  EXPECT_FALSE(fs::exists(out("o.exr")));
+  // Refused, not computed: a sweep of 65536 directions would take minutes.
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 30.0);
 }
 
 TEST_F(Cli, UnknownOutputFormatIsRefusedBeforeComputing) {

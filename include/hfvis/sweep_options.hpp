@@ -39,7 +39,8 @@ struct SweepOptions {
   // whole field): horizons, sky-view factor, occlusion and intervisibility take it (exact, the
   // cut decided in float arithmetic); the horizon lists and the bounce refuse it.
   double max_distance = 0.0;
-  std::size_t memory_budget_bytes = 0;  // device memory for one batch; 0 = from the device
+  // Device memory for one batch; 0 = half the device memory (a CPU device: half the host's).
+  std::size_t memory_budget_bytes = 0;
   // Called after each batch of directions with (directions done, directions in all).
   std::function<void(int, int)> progress;
 };

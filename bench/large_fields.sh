@@ -1,0 +1,62 @@
+#!/usr/bin/env bash
+# bench/large_fields.sh: the whole `hfvis` command on large fields with default settings (the
+# memory budget, batching and chunking as a user gets them): wall time and peak resident host
+# memory (/usr/bin/time -v) of `hfvis svf` and `hfvis ao` at K directions on data/make_data.py's
+# sine field at each size N, svf also within a maximum distance (--max-distance D ground
+# units; cell size 1). Prints a Markdown table; inputs go to bench/out/data/ (the 16384^2 EXR
+# is 139 MB), outputs to bench/out/large/.
+#
+#   bench/large_fields.sh [--sizes 1024,4096,16384] [-k K] [--max-distance D] [--field NAME]
+#   BUILD_DIR=... selects the build (default build/).
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+sizes=1024,4096,16384
+k=16
+max_distance=256
+field=sine
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --sizes) sizes=$2; shift ;;
+    -k) k=$2; shift ;;
+    --max-distance) max_distance=$2; shift ;;
+    --field) field=$2; shift ;;
+    -h|--help) sed -n '2,11p' "$0"; exit 0 ;;
+    *) echo "large_fields.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
+  esac
+  shift
+done
+[[ $sizes =~ ^[0-9]+(,[0-9]+)*$ ]] || { echo "large_fields.sh: --sizes takes N[,N...]" >&2; exit 2; }
+cli=${BUILD_DIR:-$root/build}/hfvis
+[[ -x $cli ]] || { echo "large_fields.sh: no hfvis at $cli (build it first)" >&2; exit 1; }
+[[ -x /usr/bin/time ]] || { echo "large_fields.sh: needs /usr/bin/time (Debian package time)" >&2; exit 1; }
+export POCL_CACHE_DIR=${POCL_CACHE_DIR:-$root/bench/out/pocl-cache}
+data=$root/bench/out/data
+out=$root/bench/out/large
+mkdir -p "$data" "$out"
+
+echo "\`hfvis\` with default settings, K = $k, data/make_data.py's $field field; commit" \
+  "$(git -C "$root" rev-parse --short HEAD), $("$cli" devices | sed -n 's/^\* [0-9]* *CPU *//p;s/^\* [0-9]* *GPU *//p' | head -1 | sed 's/  .*//'), $(nproc) cores, $(awk '/MemTotal/ {printf "%.1f GiB", $2 / 1048576}' /proc/meminfo) of host memory."
+echo
+echo "| N | command | wall (s) | peak resident memory (GiB) |"
+echo "| ---: | --- | ---: | ---: |"
+# Every program variant once on a small field first, so that no timed run compiles kernels.
+warm=$data/${field}_64.exr
+[[ -f $warm ]] || /usr/bin/python3 "$root/data/make_data.py" --size 64 --out "$data" --no-dem --fields "$field" > /dev/null
+for job in "svf" "svf --max-distance $max_distance" "ao"; do
+  read -r -a words <<< "$job"
+  "$cli" "${words[@]}" "$warm" -o "$out/warm.exr" -k "$k" -q
+done
+IFS=, read -r -a size_list <<< "$sizes"
+for n in "${size_list[@]}"; do
+  exr=$data/${field}_$n.exr
+  [[ -f $exr ]] || /usr/bin/python3 "$root/data/make_data.py" --size "$n" --out "$data" --no-dem --fields "$field" > /dev/null
+  for job in "svf" "svf --max-distance $max_distance" "ao"; do
+    read -r -a words <<< "$job"
+    log=$out/time_${n}_${words[0]}.log
+    /usr/bin/time -v "$cli" "${words[@]}" "$exr" -o "$out/${words[0]}_$n.exr" -k "$k" -q 2> "$log" \
+      || { echo "large_fields.sh: hfvis $job failed on $exr:" >&2; cat "$log" >&2; exit 1; }
+    wall=$(awk -F': ' '/Elapsed \(wall clock\)/ {n = split($2, t, ":"); s = 0; for (i = 1; i <= n; ++i) s = s * 60 + t[i]; print s}' "$log")
+    rss=$(awk -F': ' '/Maximum resident set size/ {printf "%.2f", $2 / 1048576}' "$log")
+    echo "| $n | \`hfvis $job -k $k\` | $wall | $rss |"
+  done
+done
