@@ -350,6 +350,18 @@ HeightField readValidField(const RunArguments& run) {
   return field;
 }
 
+// A latitude / longitude grid has a spacing per row, which only the horizon operation follows:
+// the others are told to take the centre row's for the whole field, and say so.
+void warnOfCentreRowSpacing(const HeightField& field, const char* command) {
+  if (field.row_cell_size_x.empty()) return;
+  std::cerr << std::setprecision(6) << "hfvis: warning: " << command
+            << " takes the centre row's cell size (" << field.cell_size_x << " x " << field.cell_size_y
+            << ") for the whole field; its rows range from " << field.row_cell_size_x.front() << " to "
+            << field.row_cell_size_x.back()
+            << " along columns (per-row spacing of latitude / longitude grids is followed by horizon, svf "
+               "and ao only)\n";
+}
+
 // Progress on stderr when it is a terminal: one line rewritten in place, at most a few
 // times a second (batches can be tiny). Wrap the computation in run() so that an error
 // message after a half-written progress line starts on a line of its own.
@@ -557,6 +569,7 @@ int runCompute(Command command, const RunArguments& run) {
 int runViewCount(const RunArguments& run) {
   requireOutputs(run, outputPaths(run));
   const HeightField field = readValidField(run);
+  warnOfCentreRowSpacing(field, "viewcount");
   const ComputeContext context = contextFor(run);
   const DeviceInfo& device = context.device();
 
@@ -623,6 +636,7 @@ int runViewCount(const RunArguments& run) {
 int runHorizonLists(const RunArguments& run) {
   requireOutputs(run, {run.output}, /*images=*/false);
   const HeightField field = readValidField(run);
+  warnOfCentreRowSpacing(field, "horizons");
   for (const ReceiverPixel& p : run.receivers) {
     if (p.col >= field.width || p.row >= field.height) {
       throw UsageError(
@@ -658,6 +672,7 @@ int runHorizonLists(const RunArguments& run) {
 int runBounce(const RunArguments& run) {
   requireOutputs(run, outputPaths(run));
   const HeightField field = readValidField(run);
+  warnOfCentreRowSpacing(field, "bounce");
   const ImageChannels radiance_image = readImage(run.radiance);
   if (radiance_image.width != field.width || radiance_image.height != field.height) {
     throw IoError(run.radiance,

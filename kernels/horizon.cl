@@ -25,6 +25,10 @@
 //   HFVIS_MAX_DISTANCE                       only samples within `window` pixels along the line
 //                                            count (horizon_lattice: blocks and a backward
 //                                            pass, below; horizon_naive: `max_steps`)
+//   HFVIS_ROW_SPACING                        the ground spacing differs per row (latitude /
+//                                            longitude grids): positions along a line or ray
+//                                            are ground lengths summed step by step, from the
+//                                            per-row tables `row_length` and `row_direction`
 #include "direction_terms.cl"
 #include "fast_math.cl"
 #include "sweep_framework.cl"
@@ -46,6 +50,12 @@
 #endif
 #ifndef HFVIS_MAX_DISTANCE
 #define HFVIS_MAX_DISTANCE 0
+#endif
+#ifndef HFVIS_ROW_SPACING
+#define HFVIS_ROW_SPACING 0
+#endif
+#if HFVIS_MAX_DISTANCE && HFVIS_ROW_SPACING
+#error "a maximum distance on a field with per-row spacing is not supported"
 #endif
 
 // The normal at pixel (c, r), the sum of the unnormalised normals of the (up to) four quads
@@ -144,7 +154,8 @@ typedef struct {
 
 // One receiver's outputs (the naive march).
 HFVIS_INLINE void emit_direction(uint pixel, int nodata, int found, float rise, float run, float distance,
-                                 const DirectionOutputs o, __global const float2* normals,
+                                 float cos_az, float sin_az, const DirectionOutputs o,
+                                 __global const float2* normals,
                                  __global float* angles, __global float* distances, __global float* svf_sum,
                                  __global float* ao_sum) {
 #if HFVIS_WANT_ANGLES
@@ -158,7 +169,7 @@ HFVIS_INLINE void emit_direction(uint pixel, int nodata, int found, float rise, 
 #endif
 #if HFVIS_WANT_AO
   const float2 n = normals[pixel];
-  float term = ambient_term(found, rise, run, n.x, n.y, 1.0f, o.cos_azimuth, o.sin_azimuth, o.weight, o.swath);
+  float term = ambient_term(found, rise, run, n.x, n.y, 1.0f, cos_az, sin_az, o.weight, o.swath);
   ao_sum[pixel] = nodata ? NAN : ao_sum[pixel] + term;
 #endif
 }
@@ -166,7 +177,8 @@ HFVIS_INLINE void emit_direction(uint pixel, int nodata, int found, float rise, 
 // The outputs of a lane vector of receivers (the sweep): the terms lane-parallel, the
 // stores lane by lane where `live`.
 HFVIS_INLINE void emit_lanes(lane_int live, lane_int pixel, lane_int nodata, lane_int found, lane_float rise,
-                             lane_float run, lane_float distance, const DirectionOutputs o,
+                             lane_float run, lane_float distance, lane_float cos_az, lane_float sin_az,
+                             const DirectionOutputs o,
                              __global const float2* normals, __global float* angles,
                              __global float* distances, __global float* svf_sum, __global float* ao_sum) {
 #if HFVIS_WANT_ANGLES
@@ -198,7 +210,7 @@ HFVIS_INLINE void emit_lanes(lane_int live, lane_int pixel, lane_int nodata, lan
     LANE(ny, l) = n.y;
   }
   const lane_float term =
-      ambient_term(found, rise, run, nx, ny, (lane_float)1.0f, o.cos_azimuth, o.sin_azimuth, o.weight, o.swath);
+      ambient_term(found, rise, run, nx, ny, (lane_float)1.0f, cos_az, sin_az, o.weight, o.swath);
 #pragma unroll
   for (int l = 0; l < HFVIS_LANES; ++l) {
     const uint p = (uint)ILANE(pixel, l);
@@ -288,7 +300,7 @@ HFVIS_INLINE lane_float lane_sample_height(__global const float* heights, int wi
 // n >= 2). Every pop loads the next entry down before it is known to be needed, so the load
 // does not wait for the comparison (it is used only where a lane pops).
 HFVIS_INLINE void hull_step(__global float2* stacks, lane_int stack, int entry, lane_int valid, lane_float hs,
-                            float here, float toward, lane_int* n, lane_float* top_h, lane_float* top_p,
+                            lane_float here, float toward, lane_int* n, lane_float* top_h, lane_float* top_p,
                             lane_float* below_h, lane_float* below_p, lane_float* rise, lane_float* run) {
   lane_float v1h = *top_h - hs, v1d = toward * (here - *top_p), v2h = *below_h - hs,
              v2d = toward * (here - *below_p);
@@ -319,14 +331,14 @@ HFVIS_INLINE void hull_step(__global float2* stacks, lane_int stack, int entry, 
   const lane_int push = stack + *n * entry;
 #pragma unroll
   for (int l = 0; l < HFVIS_LANES; ++l) {
-    if (ILANE(valid, l)) stacks[ILANE(push, l)] = (float2)(LANE(hs, l), here);
+    if (ILANE(valid, l)) stacks[ILANE(push, l)] = (float2)(LANE(hs, l), LANE(here, l));
   }
   *rise = select(*rise, v1h, valid);
   *run = select(*run, select((lane_float)0.0f, v1d, *n > 0), valid);  // 0: no occluder
   *below_h = select(*below_h, *top_h, valid);
   *below_p = select(*below_p, *top_p, valid);
   *top_h = select(*top_h, hs, valid);
-  *top_p = select(*top_p, (lane_float)here, valid);
+  *top_p = select(*top_p, here, valid);
   *n = select(*n, *n + 1, valid);
 }
 
@@ -370,8 +382,8 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
       lane_int valid;
       const lane_float h = lane_sample_height(heights, width, height, s, c - (ci - i) * a, r - (ci - i) * b,
                                               ci < receivers, ci == 0, &valid);
-      hull_step(stacks, stack, entry, valid, HFVIS_STACK_HEIGHT(h, here), here, -1.0f, &n, &top_h, &top_p,
-                &below_h, &below_p, &rise, &run);
+      hull_step(stacks, stack, entry, valid, HFVIS_STACK_HEIGHT(h, here), (lane_float)here, -1.0f, &n, &top_h,
+                &top_p, &below_h, &below_p, &rise, &run);
       if (--cq < 0) cq = n_samples - 1, --ci;
     }
     // The tangent from receiver j: the peak of the slopes along the stack (entry 0 nearest).
@@ -426,13 +438,18 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
 // from its far end) at stacks[line.w + k stride]; the capacity is every sample of its
 // periods. period_ground = period * ground_per_pixel, the ground length of a period. With
 // HFVIS_MAX_DISTANCE only samples within `window` pixels (inv_window = 1 / window) count
-// (window_pass; window_far: one (rise, run) per pixel). Preconditions: lines of this launch
-// only; stride 1 (line-major) or the launch's line count (step-major). Global size:
-// ceil(n_lines / HFVIS_LANES) rounded up to the local size.
+// (window_pass; window_far: one (rise, run) per pixel). With HFVIS_ROW_SPACING positions are
+// ground lengths: row_length[r] is the ground length of the period from a receiver in row r to
+// the next one along +(a, b), row_direction[r] that period's unit ground direction, and
+// ground_per_pixel is 1. Preconditions: lines of this launch only; stride 1 (line-major) or
+// the launch's line count (step-major). Global size: ceil(n_lines / HFVIS_LANES) rounded up to
+// the local size.
 __kernel void horizon_lattice(__global const float* heights, int width, int height,
                               __global const int4* lines, int n_lines, __global const LatticeSample* samples,
                               int n_samples, int a, int b, float period, float ground_per_pixel,
-                              float period_ground, float drop, float window, float inv_window, float cos_azimuth,
+                              float period_ground, float drop, float window, float inv_window,
+                              __global const float* row_length, __global const float2* row_direction,
+                              float cos_azimuth,
                               float sin_azimuth, float weight, float swath, uint plane, __global float2* stacks,
                               uint stride, __global float2* window_far, __global const float2* normals,
                               __global float* angles, __global float* distances, __global float* svf_sum,
@@ -458,13 +475,39 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
   int block = INT_MIN;  // the block of the stack's samples (none yet)
   int far_part = 0;     // whether window_pass gave this block's receivers the block before
 #endif
+#if HFVIS_ROW_SPACING
+  const float inv_period = 1.0f / period;
+  lane_float base = 0.0f;  // the receivers' ground position along their lines
+#endif
   for (int i = 0; i < trips; ++i, c -= a, r -= b) {
     const lane_int live = i < receivers;
+#if HFVIS_ROW_SPACING
+    // The period from the receivers toward +(a, b): its ground length and direction by row.
+    lane_float period_length, cos_az, sin_az;
+#pragma unroll
+    for (int l = 0; l < HFVIS_LANES; ++l) {
+      const int row = ILANE(live, l) ? ILANE(r, l) : 0;
+      const float2 direction = row_direction[row];
+      LANE(period_length, l) = row_length[row];
+      LANE(cos_az, l) = direction.x;
+      LANE(sin_az, l) = direction.y;
+    }
+    if (i > 0) base += period_length;
+    const lane_float tau_scale = period_length * inv_period;  // ground length per pixel of tau
+    const lane_float period_ground_l = period_length;
+#else
     const float base = (float)i * period;  // the receivers' position along their lines
-    lane_float h;                          // the sample's heights, finally the receivers'
+    const lane_float cos_az = (lane_float)cos_azimuth, sin_az = (lane_float)sin_azimuth;
+    const lane_float period_ground_l = (lane_float)period_ground;
+#endif
+    lane_float h;  // the sample's heights, finally the receivers'
     for (int q = 0; q < n_samples; ++q) {
       __global const LatticeSample* s = samples + q;
+#if HFVIS_ROW_SPACING
+      const lane_float here = base - s->tau * tau_scale;
+#else
       const float here = base - s->tau;
+#endif
 #if HFVIS_MAX_DISTANCE
       const int sample_block = (int)floor(here * inv_window);
       if (sample_block != block) {
@@ -486,7 +529,8 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 #else
       const lane_float hs = h;
 #endif
-      hull_step(stacks, stack, entry, valid, hs, here, 1.0f, &n, &top_h, &top_p, &below_h, &below_p, &rise, &run);
+      hull_step(stacks, stack, entry, valid, hs, (lane_float)here, 1.0f, &n, &top_h, &top_p, &below_h, &below_p,
+                &rise, &run);
     }
 #if HFVIS_MAX_DISTANCE
     if (far_part) {
@@ -516,7 +560,7 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
     const lane_float far_rise = rise;
 #endif
     const lane_int has_far = run > 0.0f, has_near = !isnan(near);
-    const lane_int use_near = has_near & (!has_far | (near * ground > far_rise * period_ground));
+    const lane_int use_near = has_near & (!has_far | (near * ground > far_rise * period_ground_l));
     const lane_float distance = select((lane_float)0.0f, ground, has_far & !use_near);
 #if HFVIS_HAS_NODATA
     const lane_int nodata = isnan(h);
@@ -524,10 +568,22 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
     const lane_int nodata = 0;
 #endif
     emit_lanes(live, r * width + c, nodata, has_far | has_near, select(far_rise, near, use_near),
-               select(ground, (lane_float)period_ground, use_near), distance, outputs, normals, angles,
+               select(ground, period_ground_l, use_near), distance, cos_az, sin_az, outputs, normals, angles,
                distances, svf_sum, ao_sum);
   }
 }
+
+#if HFVIS_ROW_SPACING
+// The naive march's ground length per pixel at row y (fractional), linear between the rows of
+// the table (one entry per row), clamped to the field.
+HFVIS_INLINE float row_ground_at(__global const float* row_length, int height, float y) {
+  const float clamped = clamp(y, 0.0f, (float)(height - 1));
+  const int r0 = (int)clamped;
+  const int r1 = min(r0 + 1, height - 1);
+  const float w = clamped - (float)r0;
+  return (1.0f - w) * row_length[r0] + w * row_length[r1];
+}
+#endif
 
 // Naive method (Timonen 2013, Sec. 1): for every pixel, march the ray in steps of
 // step_length pixels along (dir_x, dir_y), sample bilinearly and keep the steepest slope.
@@ -537,9 +593,13 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 // inside each step, the
 // one loop it vectorises (the march ran 5x faster that way on PoCL); samples past a
 // pixel's own exit are masked; with a maximum distance the march ends after `max_steps`
-// (else INT_MAX). Global size: (W, H) rounded up to the local size (the tile).
+// (else INT_MAX). With HFVIS_ROW_SPACING the ray is straight in pixels and its ground length
+// is summed step by step: row_length[r] is the ground length per pixel along it at row r,
+// row_direction[r] its unit ground direction there. Global size: (W, H) rounded up to the
+// local size (the tile).
 __kernel void horizon_naive(__global const float* heights, int width, int height, float dir_x, float dir_y,
                             float step_length, float ground_per_pixel, float drop, int max_steps,
+                            __global const float* row_length, __global const float2* row_direction,
                             float cos_azimuth, float sin_azimuth, float weight, float swath, uint plane,
                             __global const float2* normals,
                             __global float* angles, __global float* distances, __global float* svf_sum,
@@ -552,26 +612,50 @@ __kernel void horizon_naive(__global const float* heights, int width, int height
   const int steps = min((int)(tile_reach(dir_x, dir_y, width, height) / step_length) + 1, max_steps);
   float best_rise = 0.0f;  // height gain to the steepest sample so far
   int best_step = 0;       // its step, 0 = none yet
+#if HFVIS_ROW_SPACING
+  float along = 0.0f, best_along = 0.0f;  // ground length of the ray so far, to the steepest sample
+#endif
   for (int i = 1; i <= steps; ++i) {
     float t = (float)i * step_length;
     float px = (float)cc + t * dir_x, py = (float)rr + t * dir_y;
     float q = sample_height(heights, width, height, px, py);
+#if HFVIS_ROW_SPACING
+    // This step's ground length: the ground length per pixel along the ray at its middle row.
+    along += step_length * row_ground_at(row_length, height, (float)rr + ((float)i - 0.5f) * step_length * dir_y);
+    const float g = along;
+#else
+    const float g = t;
+#endif
 #if HFVIS_CURVATURE
-    float rise = q - h - drop * t * t;  // the Earth's drop at t pixels (drop per pixel^2)
+    float rise = q - h - drop * g * g;  // the Earth's drop at g (drop per unit of g, squared)
 #else
     float rise = q - h;
 #endif
+#if HFVIS_ROW_SPACING
+    int steeper = rise * best_along >= best_rise * along;
+#else
     // rise / i >= best_rise / best_step without a division; ties go to the farther sample.
-    int better = inside_field(px, py, width, height) & !isnan(q) &
-                 ((best_step == 0) | (rise * (float)best_step >= best_rise * (float)i));
+    int steeper = rise * (float)best_step >= best_rise * (float)i;
+#endif
+    int better = inside_field(px, py, width, height) & !isnan(q) & ((best_step == 0) | steeper);
     best_rise = better ? rise : best_rise;
     best_step = better ? i : best_step;
+#if HFVIS_ROW_SPACING
+    best_along = better ? along : best_along;
+#endif
     barrier(CLK_LOCAL_MEM_FENCE);
   }
+#if HFVIS_ROW_SPACING
+  const float ground = best_along;
+  const float2 direction = row_direction[rr];
+  const float cos_az = direction.x, sin_az = direction.y;
+#else
   const float ground = (float)best_step * step_length * ground_per_pixel;
+  const float cos_az = cos_azimuth, sin_az = sin_azimuth;
+#endif
   const float distance = best_step > 0 ? ground : 0.0f;
   const DirectionOutputs outputs = {cos_azimuth, sin_azimuth, weight, swath, plane};
   if (valid)
-    emit_direction(pixel, isnan(h), best_step > 0, best_rise, ground, distance, outputs, normals, angles,
-                   distances, svf_sum, ao_sum);
+    emit_direction(pixel, isnan(h), best_step > 0, best_rise, ground, distance, cos_az, sin_az, outputs,
+                   normals, angles, distances, svf_sum, ao_sum);
 }

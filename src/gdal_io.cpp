@@ -250,11 +250,18 @@ HeightField readGdalHeightField(const std::string& path, const HeightFieldReadOp
     field.cell_size_x = std::fabs((*gt)[1]);
     field.cell_size_y = std::fabs((*gt)[5]);
     if (isGeographic(dataset.get())) {
-      const double lat = (*gt)[3] + (*gt)[5] * 0.5 * field.height;
+      // Degrees to metres on the ellipsoid at each row's latitude (its pixel centres); the
+      // field's cell sizes are those at its centre latitude.
+      const double degrees_x = field.cell_size_x, degrees_y = field.cell_size_y;
       double per_deg_y, per_deg_x;
-      metresPerDegree(lat, &per_deg_y, &per_deg_x);
-      field.cell_size_x *= per_deg_x;
-      field.cell_size_y *= per_deg_y;
+      for (int r = 0; r < field.height; ++r) {
+        metresPerDegree((*gt)[3] + (*gt)[5] * (r + 0.5), &per_deg_y, &per_deg_x);
+        field.row_cell_size_x.push_back(degrees_x * per_deg_x);
+        field.row_cell_size_y.push_back(degrees_y * per_deg_y);
+      }
+      metresPerDegree((*gt)[3] + (*gt)[5] * 0.5 * field.height, &per_deg_y, &per_deg_x);
+      field.cell_size_x = degrees_x * per_deg_x;
+      field.cell_size_y = degrees_y * per_deg_y;
     }
   } else if (const auto stored =
                  storedCellSize(GDALGetMetadataItem(dataset.get(), "hfvis_cell_size_x", nullptr),

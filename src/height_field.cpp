@@ -30,6 +30,18 @@ void validate(const HeightField& field) {
                           std::to_string(field.cell_size_x) + ", " +
                           std::to_string(field.cell_size_y) + ")");
   }
+  if (!field.row_cell_size_x.empty() || !field.row_cell_size_y.empty()) {
+    if (field.row_cell_size_x.size() != static_cast<std::size_t>(field.height) ||
+        field.row_cell_size_y.size() != static_cast<std::size_t>(field.height)) {
+      throw InvalidArgument("per-row cell sizes need one entry per row (" + std::to_string(field.height) +
+                            "), got " + std::to_string(field.row_cell_size_x.size()) + " and " +
+                            std::to_string(field.row_cell_size_y.size()));
+    }
+    for (std::size_t r = 0; r < field.row_cell_size_x.size(); ++r) {
+      if (!positive(field.row_cell_size_x[r]) || !positive(field.row_cell_size_y[r]))
+        throw InvalidArgument("the cell size of row " + std::to_string(r) + " must be finite and positive");
+    }
+  }
   if (!positive(field.z_scale)) {
     throw InvalidArgument("z-scale must be finite and positive (got " + std::to_string(field.z_scale) + ")");
   }

@@ -4,6 +4,7 @@
 #include "hfvis/horizon.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <sstream>
 
@@ -28,10 +29,10 @@ constexpr std::size_t kStackEntryBytes = 2 * sizeof(float);  // (height, positio
 int sweepLanes(const ContextState& st) { return lineMajorLayout(st) && st.info.type == "CPU" ? 8 : 1; }
 
 std::string programOptions(const HorizonOutputs& outputs, bool has_nodata, int lanes, bool curvature,
-                           bool max_distance) {
+                           bool max_distance, bool row_spacing) {
   std::ostringstream s;
   s << "-DHFVIS_LANES=" << lanes << " -DHFVIS_HAS_NODATA=" << has_nodata << " -DHFVIS_CURVATURE=" << curvature
-    << " -DHFVIS_MAX_DISTANCE=" << max_distance
+    << " -DHFVIS_MAX_DISTANCE=" << max_distance << " -DHFVIS_ROW_SPACING=" << row_spacing
     << " -DHFVIS_WANT_ANGLES=" << outputs.horizon_angles
     << " -DHFVIS_WANT_DISTANCES=" << outputs.horizon_distances
     << " -DHFVIS_WANT_SVF=" << outputs.sky_view_factor << " -DHFVIS_WANT_AO=" << outputs.ambient_occlusion;
@@ -47,6 +48,8 @@ struct RunDirection {
   std::vector<LatticeLine> lines;                // sweep: the direction's lines over the field
   LatticeWindow window;                          // sweep: the maximum distance along its lines
   int max_steps = kAllSteps;                     // naive march: the steps within the maximum distance
+  // Per-row spacing: ground length and direction by row (latticeRowTable, rayRowTable).
+  std::vector<float> row_length, row_direction;
 };
 
 // How a run uses its device memory budget: directions per downloaded batch of planes and
@@ -112,10 +115,16 @@ std::vector<RunDirection> runDirectionsOf(const HeightField& field, const Horizo
                                           const HorizonOutputs& outputs) {
   std::vector<RunDirection> out;
   if (options.method == HorizonMethod::Sweep) {
-    for (const LatticeDirection& d : horizonDirections(field, options, outputs))
+    for (const LatticeDirection& d : horizonDirections(field, options, outputs)) {
       out.push_back({d, SweepDirection{}, latticeSamples(d, options.samples_per_unit),
                      static_cast<float>(std::cos(d.azimuth)), static_cast<float>(std::sin(d.azimuth)),
                      latticeLines(d, field.width, field.height), latticeWindow(field, d, options.max_distance)});
+      if (hasRowSpacing(field)) {
+        LatticeRowTable rows = latticeRowTable(field, d);
+        out.back().row_length = std::move(rows.length);
+        out.back().row_direction = std::move(rows.direction);
+      }
+    }
   } else {
     const std::vector<SweepDirection> rays = runDirections(field, options);
     for (int k = 0; k < options.directions; ++k) {
@@ -127,6 +136,11 @@ std::vector<RunDirection> runDirectionsOf(const HeightField& field, const Horizo
       r.cos_azimuth = d.cos_azimuth;
       r.sin_azimuth = d.sin_azimuth;
       r.max_steps = stepsWithin(options.max_distance, double(d.step_length) * d.ground_per_pixel);
+      if (hasRowSpacing(field)) {
+        RayRowTable rows = rayRowTable(field, d);
+        r.row_length = std::move(rows.length);
+        r.row_direction = std::move(rows.direction);
+      }
       out.push_back(r);
     }
   }
@@ -145,7 +159,7 @@ class HorizonRoutine : public SweepRoutine {
   std::string programFile() const override { return "horizon.cl"; }
   std::string programOptions() const override {
     return detail::programOptions(outputs_, prepared_.has_nodata, sweepLanes(st_), horizon_.curvature != 0.0,
-                                  horizon_.max_distance > 0.0);
+                                  horizon_.max_distance > 0.0, hasRowSpacing(field_));
   }
 
   void allocate() override {
@@ -222,6 +236,24 @@ class HorizonRoutine : public SweepRoutine {
     return static_cast<float>(horizon_.curvature * ground_per_pixel * ground_per_pixel);
   }
 
+  // The unit of positions along lines and rays: pixels of that ground length, or (per-row
+  // spacing) ground units.
+  double positionUnit(double ground_per_pixel) const { return hasRowSpacing(field_) ? 1.0 : ground_per_pixel; }
+
+  // The per-row tables of a direction (placeholders without per-row spacing), set as the
+  // kernel's arguments `arg` and `arg + 1`; the caller keeps them until the launch.
+  std::array<cl::Buffer, 2> setRowTables(cl::Kernel& kernel, int arg, const RunDirection& d) {
+    auto table = [&](const std::vector<float>& values) {
+      if (values.empty()) return deviceBuffer(st_, 0);
+      return cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, values.size() * sizeof(float),
+                        const_cast<float*>(values.data()));
+    };
+    std::array<cl::Buffer, 2> tables{table(d.row_length), table(d.row_direction)};
+    kernel.setArg(arg, tables[0]);
+    kernel.setArg(arg + 1, tables[1]);
+    return tables;
+  }
+
   // The arguments every direction's kernel ends with: its outputs.
   void setOutputs(cl::Kernel& kernel, int arg, const RunDirection& d, cl_uint plane_offset) {
     kernel.setArg(arg++, d.cos_azimuth);
@@ -254,12 +286,14 @@ class HorizonRoutine : public SweepRoutine {
     kernel.setArg(7, d.lattice.a);
     kernel.setArg(8, d.lattice.b);
     kernel.setArg(9, static_cast<float>(d.lattice.period));
-    kernel.setArg(10, static_cast<float>(d.lattice.ground_per_pixel));
+    const double unit = positionUnit(d.lattice.ground_per_pixel);
+    kernel.setArg(10, static_cast<float>(unit));
     kernel.setArg(11, static_cast<float>(d.lattice.period * d.lattice.ground_per_pixel));
-    kernel.setArg(12, curvatureDrop(d.lattice.ground_per_pixel));
+    kernel.setArg(12, curvatureDrop(unit));
     kernel.setArg(13, d.window.window);
     kernel.setArg(14, d.window.inv_window);
-    setOutputs(kernel, 15, d, plane_offset);
+    const auto row_tables = setRowTables(kernel, 15, d);
+    setOutputs(kernel, 17, d, plane_offset);
     LineChunkArguments chunk;
     chunk.lines = 3;
     chunk.count = 4;
@@ -279,9 +313,10 @@ class HorizonRoutine : public SweepRoutine {
     kernel.setArg(4, d.ray.dir_y);
     kernel.setArg(5, d.ray.step_length);
     kernel.setArg(6, d.ray.ground_per_pixel);
-    kernel.setArg(7, curvatureDrop(d.ray.ground_per_pixel));
+    kernel.setArg(7, curvatureDrop(positionUnit(d.ray.ground_per_pixel)));
     kernel.setArg(8, d.max_steps);
-    setOutputs(kernel, 9, d, plane_offset);
+    const auto row_tables = setRowTables(kernel, 9, d);
+    setOutputs(kernel, 11, d, plane_offset);
     st_.launch(kernel, cl::NDRange(roundUp(field_.width, kTileX), roundUp(field_.height, kTileY)),
                cl::NDRange(kTileX, kTileY));
   }
@@ -304,6 +339,7 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
                               const HorizonOptions& options, const HorizonOutputs& outputs) {
   validate(field);
   validate(options, outputs);
+  detail::requireSupported(field, options);
   detail::checkPixelIndexing(field, 1);
   return detail::translateOpenClErrors([&] {
     detail::HorizonRoutine routine(detail::stateOf(context), field, options, outputs);

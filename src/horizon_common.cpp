@@ -23,6 +23,14 @@ void validate(const HorizonOptions& options, const HorizonOutputs& outputs) {
 
 namespace detail {
 
+bool hasRowSpacing(const HeightField& field) { return !field.row_cell_size_x.empty(); }
+
+void requireSupported(const HeightField& field, const HorizonOptions& options) {
+  if (hasRowSpacing(field) && options.max_distance > 0.0)
+    throw InvalidArgument("a maximum distance is not supported on a field with per-row spacing (a latitude / "
+                          "longitude grid) yet: reproject it, or leave out the maximum distance");
+}
+
 HorizonResult allocateResult(const HeightField& field, const HorizonOptions& options,
                              const HorizonOutputs& outputs) {
   HorizonResult result;

@@ -22,6 +22,14 @@ float swathFactor(float weight);
 // Turns the accumulated sums into the outputs: svf = 1 - weighted sum; ao is the sum itself.
 void finishReduction(HorizonResult& result);
 
+// Whether the field has per-row spacing (HeightField::row_cell_size_x/y): positions along the
+// sweep's lines and the naive march's rays are then ground lengths summed step by step.
+bool hasRowSpacing(const HeightField& field);
+
+// Throws InvalidArgument for what the horizon operation does not do on this field: a maximum
+// distance with per-row spacing.
+void requireSupported(const HeightField& field, const HorizonOptions& options);
+
 // An empty result with the requested planes allocated (NaN-filled).
 HorizonResult allocateResult(const HeightField& field, const HorizonOptions& options,
                              const HorizonOutputs& outputs);

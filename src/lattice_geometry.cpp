@@ -247,4 +247,26 @@ LatticeWindow latticeWindow(const HeightField& field, const LatticeDirection& d,
   return w;
 }
 
+void cellSizeAtRow(const HeightField& field, double y, double* cell_x, double* cell_y) {
+  const double clamped = std::clamp(y, 0.0, static_cast<double>(field.height - 1));
+  const std::size_t r0 = static_cast<std::size_t>(clamped);
+  const std::size_t r1 = std::min(r0 + 1, static_cast<std::size_t>(field.height - 1));
+  const double w = clamped - static_cast<double>(r0);
+  *cell_x = (1.0 - w) * field.row_cell_size_x[r0] + w * field.row_cell_size_x[r1];
+  *cell_y = (1.0 - w) * field.row_cell_size_y[r0] + w * field.row_cell_size_y[r1];
+}
+
+LatticeRowTable latticeRowTable(const HeightField& field, const LatticeDirection& d) {
+  LatticeRowTable t;
+  for (int r = 0; r < field.height; ++r) {
+    double cell_x = 0.0, cell_y = 0.0;
+    cellSizeAtRow(field, r + 0.5 * d.b, &cell_x, &cell_y);
+    const double gx = d.a * cell_x, gy = d.b * cell_y, length = std::hypot(gx, gy);
+    t.length.push_back(static_cast<float>(length));
+    t.direction.push_back(static_cast<float>(gx / length));
+    t.direction.push_back(static_cast<float>(gy / length));
+  }
+  return t;
+}
+
 }  // namespace hfvis::detail

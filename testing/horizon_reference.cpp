@@ -133,14 +133,19 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
   for (int k = 0; k < options.directions; ++k) {
     const LatticeDirection& d = directions[k];
     if (d.weight == 0.0 && result.angles.empty() && result.distances.empty()) continue;  // merged step
-    const DirectionOutputs out = outputsOf(d, k);
+    DirectionOutputs out = outputsOf(d, k);
     const auto samples = latticeSamples(d, options.samples_per_unit);
-    const float gpp = static_cast<float>(d.ground_per_pixel);
-    const float drop = static_cast<float>(options.curvature * d.ground_per_pixel * d.ground_per_pixel);
-    const float period_ground = static_cast<float>(d.period * d.ground_per_pixel);
+    // Positions in pixels of the direction's ground length, or (per-row spacing) ground units.
+    const bool rows = hasRowSpacing(field);
+    const double unit = rows ? 1.0 : d.ground_per_pixel;
+    const LatticeRowTable table = rows ? latticeRowTable(field, d) : LatticeRowTable{};
+    const float gpp = static_cast<float>(unit);
+    const float drop = static_cast<float>(options.curvature * unit * unit);
+    float period_ground = static_cast<float>(d.period * d.ground_per_pixel);
     const LatticeWindow window = latticeWindow(field, d, options.max_distance);
     for (const LatticeLine& line : latticeLines(d, width, height)) {
-      for (const LatticeLineSample& s : latticeLineSamples(field, h, d, samples, line, drop, window)) {
+      for (const LatticeLineSample& s :
+           latticeLineSamples(field, h, d, samples, line, drop, window, rows ? &table : nullptr)) {
         if (s.receiver < 0) continue;
         const std::size_t pixel = static_cast<std::size_t>(s.receiver);
         if (std::isnan(s.height)) {
@@ -148,6 +153,11 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
           continue;
         }
         const int c = static_cast<int>(pixel % width), r = static_cast<int>(pixel / width);
+        if (rows) {  // the receiver's period: its ground length and direction
+          period_ground = table.length[r];
+          out.cos_azimuth = table.direction[2 * r];
+          out.sin_azimuth = table.direction[2 * r + 1];
+        }
         const float near = nearRise(h, width, height, c, r, s.height, d.a, d.b);
         const bool has_far = s.occluder_run > 0.0f, has_near = !std::isnan(near);
         const float ground = has_far ? s.occluder_run * gpp : 0.0f;
@@ -171,14 +181,24 @@ void naiveReference(const HeightField& field, const PreparedHeights& prepared, c
   const auto directions = runDirections(field, options);
   for (int k = 0; k < options.directions; ++k) {
     const SweepDirection& d = directions[k];
-    const DirectionOutputs out{d.cos_azimuth, d.sin_azimuth, static_cast<float>(1.0 / options.directions), k};
-    const float drop = static_cast<float>(options.curvature * double(d.ground_per_pixel) * double(d.ground_per_pixel));
+    DirectionOutputs out{d.cos_azimuth, d.sin_azimuth, static_cast<float>(1.0 / options.directions), k};
+    // Per-row spacing: the ray's ground length summed step by step (horizon_naive's row_ground_at).
+    const bool rows = hasRowSpacing(field);
+    const RayRowTable table = rows ? rayRowTable(field, d) : RayRowTable{};
+    auto groundAt = [&](float y) {
+      const float clamped = std::clamp(y, 0.0f, static_cast<float>(height - 1));
+      const int r0 = static_cast<int>(clamped), r1 = std::min(r0 + 1, height - 1);
+      const float w = clamped - static_cast<float>(r0);
+      return (1.0f - w) * table.length[r0] + w * table.length[r1];
+    };
+    const double unit = rows ? 1.0 : double(d.ground_per_pixel);
+    const float drop = static_cast<float>(options.curvature * unit * unit);
     const int max_steps = stepsWithin(options.max_distance, double(d.step_length) * d.ground_per_pixel);
     for (int r = 0; r < height; ++r) {
       for (int c = 0; c < width; ++c) {
         const std::size_t pixel = static_cast<std::size_t>(r) * width + c;
         const float hp = h[pixel];
-        float best_rise = 0.0f;
+        float best_rise = 0.0f, along = 0.0f, best_along = 0.0f;
         int best_step = 0;
         // March until the ray has left the field for good (the kernel's trip count may be
         // longer; the extra samples are outside and masked).
@@ -187,15 +207,27 @@ void naiveReference(const HeightField& field, const PreparedHeights& prepared, c
           const Point2 p{static_cast<float>(c) + t * d.dir_x, static_cast<float>(r) + t * d.dir_y};
           if (!insideField(p, width, height)) break;
           const float q = sampleHeight(h, width, height, p);
-          const float rise = q - hp - drop * t * t;
-          if (!std::isnan(q) &&
-              (best_step == 0 || rise * static_cast<float>(best_step) >= best_rise * static_cast<float>(i))) {
+          if (rows) {
+            along += d.step_length *
+                     groundAt(static_cast<float>(r) + (static_cast<float>(i) - 0.5f) * d.step_length * d.dir_y);
+          }
+          const float g = rows ? along : t;
+          const float rise = q - hp - drop * g * g;
+          const bool steeper = rows ? rise * best_along >= best_rise * along
+                                    : rise * static_cast<float>(best_step) >= best_rise * static_cast<float>(i);
+          if (!std::isnan(q) && (best_step == 0 || steeper)) {
             best_rise = rise;
             best_step = i;
+            best_along = along;
           }
         }
-        const float ground = static_cast<float>(best_step) * d.step_length * d.ground_per_pixel;
+        const float ground =
+            rows ? best_along : static_cast<float>(best_step) * d.step_length * d.ground_per_pixel;
         const float distance = best_step > 0 ? ground : 0.0f;
+        if (rows) {
+          out.cos_azimuth = table.direction[2 * r];
+          out.sin_azimuth = table.direction[2 * r + 1];
+        }
         emitDirection(result, pixel, std::isnan(hp), best_step > 0, best_rise, ground, distance, out,
                       normals);
       }
@@ -209,9 +241,12 @@ void naiveReference(const HeightField& field, const PreparedHeights& prepared, c
 std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, const std::vector<float>& h,
                                                   const LatticeDirection& d,
                                                   const std::vector<LatticeSample>& samples,
-                                                  const LatticeLine& line, float drop, const LatticeWindow& window) {
+                                                  const LatticeLine& line, float drop, const LatticeWindow& window,
+                                                  const LatticeRowTable* rows) {
   const int width = field.width, height = field.height;
   const float period = static_cast<float>(d.period);
+  const float inv_period = 1.0f / period;
+  float row_base = 0.0f;  // per-row spacing: the receiver's ground position
   const bool windowed = window.window > 0.0f;
   // Every sample of the line in sweep order (height NaN where it is absent: outside the field
   // or without height), with its block (horizon_lattice's window_pass) and its height as the
@@ -224,11 +259,17 @@ std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, cons
   std::vector<Raw> raw;
   int c = line.col, r = line.row;
   for (int i = 0; i < line.receivers; ++i, c -= d.a, r -= d.b) {
-    const float base = static_cast<float>(i) * period;
+    float base = static_cast<float>(i) * period, tau_scale = 1.0f;
+    if (rows) {  // horizon_lattice with HFVIS_ROW_SPACING
+      const float length = rows->length[r];
+      if (i > 0) row_base += length;
+      base = row_base;
+      tau_scale = length * inv_period;
+    }
     for (std::size_t q = 0; q < samples.size(); ++q) {
       const LatticeSample& s = samples[q];
       Raw e;
-      e.sample.position = base - s.tau;
+      e.sample.position = rows ? base - s.tau * tau_scale : base - s.tau;
       e.sample.height = kNaN;
       e.block = windowed ? static_cast<int>(std::floor(e.sample.position * window.inv_window)) : 0;
       const int x0 = c + s.ox, y0 = r + s.oy;
@@ -329,6 +370,7 @@ HorizonResult referenceHorizons(const HeightField& field, const HorizonOptions& 
                                 const HorizonOutputs& outputs) {
   validate(field);
   validate(options, outputs);
+  detail::requireSupported(field, options);
   const detail::PreparedHeights prepared = detail::prepareHeights(field);
   HorizonResult result = detail::allocateResult(field, options, outputs);
   if (options.method == HorizonMethod::Sweep) {

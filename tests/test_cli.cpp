@@ -1352,4 +1352,34 @@ TEST_F(CliGeoTiff, GeographicInputStaysGeographic) {
   EXPECT_NEAR(std::stod(raster.metadata.at("hfvis_cell_size_y")), 111133.0 * arcsec, 0.05);
 }
 
+// A tall latitude / longitude grid (1 degree cells, rows centred on 65 .. 55 N): a wall 4 cells
+// east of the receivers is seen from 4 times each row's own east-west spacing on the WGS84
+// ellipsoid (47.2 km per cell at 65 N, 64.0 km at 55 N), not the centre row's. A maximum
+// distance is refused there, and viewcount says it takes the centre row's spacing.
+TEST_F(Cli, GeographicGridTakesEachRowsSpacing) {
+  const int width = 8, height = 11;
+  std::vector<float> values(width * height, 0.0f);
+  for (int r = 0; r < height; ++r)
+    for (int c = 6; c < width; ++c) values[r * width + c] = 1000.0f;
+  const std::string tif = in("tall.tif");
+  hfvis::testing::writeGdalGeoTiff(tif, width, height, values, {10.0, 1.0, 0.0, 65.5, 0.0, -1.0}, "EPSG:4326",
+                                   std::nullopt);
+  const CliResult result = run("horizon " + shellQuoted(tif) + " -o " + shellQuoted(out("h.exr")) +
+                               " --distance-out " + shellQuoted(out("d.exr")) + " -k 4 -q");
+  ASSERT_EQ(result.status, 0) << result.err;
+  const ReadBack d = readBack(out("d.exr"));
+  for (int r = 0; r < height; ++r) {
+    const double lat = (65.0 - r) * M_PI / 180.0, a = 6378137.0, e2 = 0.00669437999014132;
+    const double east = a / std::sqrt(1.0 - e2 * std::sin(lat) * std::sin(lat)) * std::cos(lat) * M_PI / 180.0;
+    EXPECT_NEAR(d.at(2, r, 0), 4.0 * east, 1e-5 * 4.0 * east) << "row " << r;
+  }
+  fs::remove(out("h.exr"));
+  fs::remove(out("d.exr"));
+  expectFailure(run("svf " + shellQuoted(tif) + " -o " + shellQuoted(out("s.exr")) + " --max-distance 100000"), 1,
+                "per-row spacing");
+  const CliResult counts = run("viewcount " + shellQuoted(tif) + " -o " + shellQuoted(out("v.exr")) + " -k 4 -q");
+  ASSERT_EQ(counts.status, 0) << counts.err;
+  EXPECT_NE(counts.err.find("takes the centre row's cell size"), std::string::npos) << counts.err;
+}
+
 }  // namespace

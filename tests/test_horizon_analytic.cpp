@@ -117,6 +117,56 @@ TEST_P(HorizonAnalytic, LongWallBeyondTheMaximumDistanceIsNotSeen) {
   }
 }
 
+// A latitude / longitude grid's spacing per row: a wall of height 10 from column 30 on, each row
+// r with its own spacing along columns dx(r) = 2 + 0.5 r (as east-west spacing shrinks with
+// latitude): seen along +x at atan(10 / ((30 - c) dx(r))) from that distance. And a wall across
+// the rows from row 30 on, with spacing along rows dy(r) = 1 + 0.05 r: seen along +y from the
+// ground length between the rows, the sum of dy at the half rows between.
+TEST_P(HorizonAnalytic, PerRowSpacingSetsEachRowsGroundDistances) {
+  HeightField east = makeSyntheticField("flat", 40, 9);
+  for (int row = 0; row < east.height; ++row) {
+    for (int c = 30; c < east.width; ++c) east.heights[row * east.width + c] += 10.0f;
+    east.row_cell_size_x.push_back(2.0 + 0.5 * row);
+    east.row_cell_size_y.push_back(3.0);
+  }
+  east.cell_size_x = east.row_cell_size_x[4];
+  east.cell_size_y = 3.0;
+  HorizonOutputs outputs;
+  outputs.horizon_angles = outputs.horizon_distances = true;
+  const auto r = run(east, 4, outputs);
+  for (int row = 0; row < east.height; ++row) {
+    for (int c = 0; c < 30; ++c) {
+      const std::size_t p = row * east.width + c;
+      const double d = (30 - c) * (2.0 + 0.5 * row);
+      EXPECT_NEAR(r.angles[p], std::atan(10.0 / d), 1e-5) << c << "," << row;
+      EXPECT_NEAR(r.distances[p], d, 1e-3 * d) << c << "," << row;
+    }
+  }
+  HeightField south = makeSyntheticField("flat", 9, 40);
+  for (int row = 0; row < south.height; ++row) {
+    if (row >= 30)
+      for (int c = 0; c < south.width; ++c) south.heights[row * south.width + c] += 10.0f;
+    south.row_cell_size_x.push_back(2.0);
+    south.row_cell_size_y.push_back(1.0 + 0.05 * row);
+  }
+  south.cell_size_x = 2.0;
+  south.cell_size_y = south.row_cell_size_y[20];
+  const auto s = run(south, 4, outputs);
+  const std::size_t plane = south.pixelCount();
+  for (int row = 0; row < 30; ++row) {
+    double d = 0.0;
+    for (int j = row; j < 30; ++j) d += 1.0 + 0.05 * (j + 0.5);
+    for (int c = 0; c < south.width; ++c) {
+      const std::size_t p = plane + row * south.width + c;  // direction 1: +y
+      EXPECT_NEAR(s.angles[p], std::atan(10.0 / d), 1e-5) << c << "," << row;
+      // Next to the wall the slope at the receiver and the wall's top cast the same elevation,
+      // and the summed ground lengths decide that tie either way (distance 0: the slope).
+      if (row == 29 && s.distances[p] == 0.0f) continue;
+      EXPECT_NEAR(s.distances[p], d, 1e-3 * d) << c << "," << row;
+    }
+  }
+}
+
 // The same wall over a curved Earth (drop c d^2 at ground distance d): its top is seen at
 // atan((z * 10 - c d^2) / d), d = cell_x * (30 - c), still from the foot of its top (the
 // farther wall lies lower still). c is large enough to halve the nearest elevations. Right in

@@ -18,6 +18,7 @@
 #include <utility>
 #include <vector>
 
+#include "gdal_io.hpp"
 #include "geotiff_support.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/image_io.hpp"
@@ -433,6 +434,37 @@ TEST_F(ImageIoTest, GeoTiffGeographicDegreesBecomeMetres) {
   const HeightField field = readHeightField(path("wgs84.tif"));
   EXPECT_NEAR(field.cell_size_x, 78846.835 * arcsec, 1e-3);
   EXPECT_NEAR(field.cell_size_y, 111132.954 * arcsec, 1e-3);
+}
+
+// A tall latitude / longitude grid (1 degree cells, rows centred on 65 .. 55 N) gets each row's
+// own spacing on the WGS84 ellipsoid: along columns from about 47.2 km at 65 N to 64.0 km at
+// 55 N (55.80 km at 60 N), along rows about 111.4 km; the field's cell size is the centre row's.
+TEST_F(ImageIoTest, GeoTiffGeographicRowsGetTheirOwnSpacing) {
+  GeoTiffSpec g;
+  g.width = 3;
+  g.height = 11;
+  g.pixel_scale = {1.0, 1.0, 0.0};
+  g.tiepoint = {0, 0, 0, 10.0, 65.5, 0};
+  g.geo_keys = geoKeys({{1024, 2}, {1025, 1}, {2048, 4326}});
+  writeGeoTiff(path("tall.tif"), g);
+  const HeightField field = readHeightField(path("tall.tif"));
+  ASSERT_EQ(field.row_cell_size_x.size(), 11u);
+  ASSERT_EQ(field.row_cell_size_y.size(), 11u);
+  EXPECT_NEAR(field.row_cell_size_x[5], 55800.00, 0.05);  // 60 N
+  EXPECT_NEAR(field.row_cell_size_y[5], 111412.3, 0.5);
+  EXPECT_EQ(field.cell_size_x, field.row_cell_size_x[5]);
+  EXPECT_EQ(field.cell_size_y, field.row_cell_size_y[5]);
+  for (int r = 0; r < 11; ++r) {
+    double along_meridian = 0.0, along_parallel = 0.0;
+    detail::metresPerDegree(65.0 - r, &along_meridian, &along_parallel);
+    EXPECT_DOUBLE_EQ(field.row_cell_size_x[r], along_parallel) << r;
+    EXPECT_DOUBLE_EQ(field.row_cell_size_y[r], along_meridian) << r;
+    if (r > 0) EXPECT_GT(field.row_cell_size_x[r], field.row_cell_size_x[r - 1]);
+  }
+  // A projected raster, or a cell size given, has none.
+  HeightFieldReadOptions given;
+  given.cell_size_x = 30.0;
+  EXPECT_TRUE(readHeightField(path("tall.tif"), given).row_cell_size_x.empty());
 }
 
 TEST_F(ImageIoTest, GeoTiffGeographicMatchesJacksboroDataNotes) {

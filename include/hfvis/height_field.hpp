@@ -37,6 +37,12 @@ struct HeightField {
   std::vector<float> heights;  // width * height values
   double cell_size_x = 1.0;    // ground units per pixel along columns
   double cell_size_y = 1.0;    // ground units per pixel along rows
+  // Per-row spacing (latitude / longitude grids, whose east-west spacing shrinks with
+  // latitude): empty, or one entry per row, row r's cell sizes; cell_size_x/y are then those
+  // of the centre row. The horizon operation (horizon angles and distances, sky-view factor,
+  // occlusion) measures ground lengths along its lines and rays step by step with them;
+  // intervisibility, the horizon lists and the bounce take cell_size_x/y for the whole field.
+  std::vector<double> row_cell_size_x, row_cell_size_y;
   double z_scale = 1.0;        // multiplies every height
   Georeference georeference;   // from a georeferenced raster; empty for a field filled in memory
 
@@ -45,8 +51,9 @@ struct HeightField {
   std::size_t nodataCount() const;
 };
 
-// Throws InvalidArgument when the field is empty, its sizes disagree, a cell size or the
-// z-scale is not finite and positive, or every height is nodata.
+// Throws InvalidArgument when the field is empty, its sizes disagree, a cell size (per-row
+// ones included, one per row) or the z-scale is not finite and positive, or every height is
+// nodata.
 void validate(const HeightField& field);
 
 }  // namespace hfvis
