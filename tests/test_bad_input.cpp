@@ -52,6 +52,15 @@ TEST(BadInput, Fields) {
     field.cell_size_y = cell;
     expectError<InvalidArgument>([&] { horizons(field); }, "cell size");
   }
+  HeightField row_count = good;  // per-row cell sizes: one per row, finite and positive
+  row_count.row_cell_size_x.assign(good.height - 1, 1.0);
+  row_count.row_cell_size_y.assign(good.height - 1, 1.0);
+  expectError<InvalidArgument>([&] { horizons(row_count); }, "one entry per row");
+  HeightField row_value = good;
+  row_value.row_cell_size_x.assign(good.height, 1.0);
+  row_value.row_cell_size_y.assign(good.height, 1.0);
+  row_value.row_cell_size_x[2] = std::nan("");
+  expectError<InvalidArgument>([&] { horizons(row_value); }, "cell size of row 2");
   HeightField flat_z = good;
   flat_z.z_scale = 0.0;
   expectError<InvalidArgument>([&] { horizons(flat_z); }, "z-scale");
