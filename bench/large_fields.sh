@@ -34,8 +34,10 @@ data=$root/bench/out/data
 out=$root/bench/out/large
 mkdir -p "$data" "$out"
 
+commit=$(git -C "$root" rev-parse --short HEAD 2> /dev/null || echo unknown)
+git -C "$root" diff --quiet HEAD 2> /dev/null || commit="$commit (with uncommitted changes)"
 echo "\`hfvis\` with default settings, K = $k, data/make_data.py's $field field; commit" \
-  "$(git -C "$root" rev-parse --short HEAD), $("$cli" devices | sed -n 's/^\* [0-9]* *CPU *//p;s/^\* [0-9]* *GPU *//p' | head -1 | sed 's/  .*//'), $(nproc) cores, $(awk '/MemTotal/ {printf "%.1f GiB", $2 / 1048576}' /proc/meminfo) of host memory."
+  "$commit, $("$cli" devices | sed -n 's/^\* [0-9]* *CPU *//p;s/^\* [0-9]* *GPU *//p' | head -1 | sed 's/  .*//'), $(nproc) cores, $(awk '/MemTotal/ {printf "%.1f GiB", $2 / 1048576}' /proc/meminfo) of host memory."
 echo
 echo "| N | command | wall (s) | peak resident memory (GiB) |"
 echo "| ---: | --- | ---: | ---: |"

@@ -35,7 +35,9 @@ mkdir -p "$data"
 exr=$data/${field}_$size.exr
 [[ -f $exr ]] || /usr/bin/python3 "$root/data/make_data.py" --size "$size" --out "$data" --no-dem --fields "$field" > /dev/null
 
-/usr/bin/python3 - "$bench" "$exr" "$k" "$distances" "$rounds" "$(git -C "$root" rev-parse --short HEAD)" << 'PY'
+commit=$(git -C "$root" rev-parse --short HEAD 2> /dev/null || echo unknown)
+git -C "$root" diff --quiet HEAD 2> /dev/null || commit="$commit (with uncommitted changes)"
+/usr/bin/python3 - "$bench" "$exr" "$k" "$distances" "$rounds" "$commit" << 'PY'
 import re, subprocess, sys
 bench, exr, k, distances, rounds, commit = sys.argv[1:]
 distances = [float(d) for d in distances.split(",")]

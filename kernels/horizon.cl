@@ -146,13 +146,12 @@ HFVIS_DIRECTION_TERMS(lane_float, lane_int)
 // pixel is written by one work-item of it, so the read-modify-writes of the sums need no
 // atomics.
 typedef struct {
-  float cos_azimuth, sin_azimuth;  // the direction on the ground
-  float weight;                    // its share of the circle of azimuth
-  float swath;                     // sin(pi weight) / pi (ambient_term)
-  uint plane;                      // first entry of its planes in `angles` / `distances`
+  float weight;  // its share of the circle of azimuth
+  float swath;   // sin(pi weight) / pi (ambient_term)
+  uint plane;    // first entry of its planes in `angles` / `distances`
 } DirectionOutputs;
 
-// One receiver's outputs (the naive march).
+// One receiver's outputs (the naive march); (cos_az, sin_az) is the direction on the ground there.
 HFVIS_INLINE void emit_direction(uint pixel, int nodata, int found, float rise, float run, float distance,
                                  float cos_az, float sin_az, const DirectionOutputs o,
                                  __global const float2* normals,
@@ -175,7 +174,7 @@ HFVIS_INLINE void emit_direction(uint pixel, int nodata, int found, float rise, 
 }
 
 // The outputs of a lane vector of receivers (the sweep): the terms lane-parallel, the
-// stores lane by lane where `live`.
+// stores lane by lane where `live`; (cos_az, sin_az) is the direction on the ground there.
 HFVIS_INLINE void emit_lanes(lane_int live, lane_int pixel, lane_int nodata, lane_int found, lane_float rise,
                              lane_float run, lane_float distance, lane_float cos_az, lane_float sin_az,
                              const DirectionOutputs o,
@@ -456,7 +455,7 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
                               __global float* ao_sum) {
   const int first = get_global_id(0) * HFVIS_LANES;
   if (first >= n_lines) return;
-  const DirectionOutputs outputs = {cos_azimuth, sin_azimuth, weight, swath, plane};
+  const DirectionOutputs outputs = {weight, swath, plane};
   lane_int c, r, receivers, stack;
   int trips = 0;  // the longest line's receivers
 #pragma unroll
@@ -654,7 +653,7 @@ __kernel void horizon_naive(__global const float* heights, int width, int height
   const float cos_az = cos_azimuth, sin_az = sin_azimuth;
 #endif
   const float distance = best_step > 0 ? ground : 0.0f;
-  const DirectionOutputs outputs = {cos_azimuth, sin_azimuth, weight, swath, plane};
+  const DirectionOutputs outputs = {weight, swath, plane};
   if (valid)
     emit_direction(pixel, isnan(h), best_step > 0, best_rise, ground, distance, cos_az, sin_az, outputs,
                    normals, angles, distances, svf_sum, ao_sum);
