@@ -31,7 +31,7 @@ bool lineMajorLayout(const ContextState& st) {
 
 std::size_t defaultMemoryBudget(const DeviceInfo& device) {
   // A CPU device's memory is the host's: PoCL reports a fraction of it as its global memory
-  // (6.2 GiB on the 24 GB test machine) and allocates from the host beyond that, so there the
+  // (4.8 to 6.2 GiB on the 24 GB test machine) and allocates from the host beyond that, so the
   // budget is half the host's physical memory (its largest single buffer still applies).
   if (device.type == "CPU") {
     const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
