@@ -367,8 +367,10 @@ void warnOfCentreRowSpacing(const HeightField& field, const char* command) {
 // message after a half-written progress line starts on a line of its own.
 class Progress {
  public:
-  explicit Progress(bool quiet) : enabled_(!quiet && ::isatty(::fileno(stderr))) {}
+  explicit Progress(bool quiet)
+      : enabled_(!quiet && ::isatty(::fileno(stderr))), start_(std::chrono::steady_clock::now()) {}
 
+  // "done/total directions", and once some are done the time left at the pace so far.
   std::function<void(int, int)> callback() {
     if (!enabled_) return {};
     return [this](int done, int total) {
@@ -376,7 +378,15 @@ class Progress {
       if (done < total && now - last_ < std::chrono::milliseconds(250)) return;
       last_ = now;
       line_open_ = done < total;
-      std::fprintf(stderr, "\rhfvis: %d/%d directions%s", done, total, line_open_ ? "" : "\n");
+      std::string left;
+      if (done > 0 && done < total) {
+        const double elapsed = std::chrono::duration<double>(now - start_).count();
+        const long seconds = std::lround(elapsed * (total - done) / done);
+        left = ", about " + (seconds >= 60 ? std::to_string(seconds / 60) + " min " : std::string()) +
+               std::to_string(seconds % 60) + " s left";
+      }
+      std::fprintf(stderr, "\rhfvis: %d/%d directions%s%s", done, total, left.c_str(),
+                   line_open_ ? "   " : "\n");
       std::fflush(stderr);
     };
   }
@@ -394,7 +404,7 @@ class Progress {
  private:
   bool enabled_;
   bool line_open_ = false;
-  std::chrono::steady_clock::time_point last_{};
+  std::chrono::steady_clock::time_point start_, last_{};
 };
 
 double secondsSince(std::chrono::steady_clock::time_point start) {
