@@ -306,7 +306,6 @@ std::string joinPaths(const std::vector<std::string>& paths) {
   return joined;
 }
 
-// Reads the input height field and checks it (a bad field is the input file's fault).
 // The host memory a run may use: what the kernel says is available (free memory plus what it
 // can reclaim), else the physical memory.
 double availableHostBytes() {
@@ -340,6 +339,7 @@ void requireHostMemoryForPlanes(Command command, const RunArguments& run, const 
   throw Error(message.str());
 }
 
+// Reads the input height field and checks it (a bad field is the input file's fault).
 HeightField readValidField(const RunArguments& run) {
   HeightField field = readHeightField(run.input, readOptions(run));
   try {
@@ -351,13 +351,14 @@ HeightField readValidField(const RunArguments& run) {
 }
 
 // A latitude / longitude grid has a spacing per row, which only the horizon operation follows:
-// the others are told to take the centre row's for the whole field, and say so.
+// the others take the centre latitude's for the whole field, and say so.
 void warnOfCentreRowSpacing(const HeightField& field, const char* command) {
   if (field.row_cell_size_x.empty()) return;
+  const auto [narrowest, widest] =
+      std::minmax_element(field.row_cell_size_x.begin(), field.row_cell_size_x.end());
   std::cerr << std::setprecision(6) << "hfvis: warning: " << command
-            << " takes the centre row's cell size (" << field.cell_size_x << " x " << field.cell_size_y
-            << ") for the whole field; its rows range from " << field.row_cell_size_x.front() << " to "
-            << field.row_cell_size_x.back()
+            << " takes the centre latitude's cell size (" << field.cell_size_x << " x " << field.cell_size_y
+            << ") for the whole field; its rows range from " << *narrowest << " to " << *widest
             << " along columns (per-row spacing of latitude / longitude grids is followed by horizon, svf "
                "and ao only)\n";
 }
@@ -385,8 +386,9 @@ class Progress {
         left = ", about " + (seconds >= 60 ? std::to_string(seconds / 60) + " min " : std::string()) +
                std::to_string(seconds % 60) + " s left";
       }
-      std::fprintf(stderr, "\rhfvis: %d/%d directions%s%s", done, total, left.c_str(),
-                   line_open_ ? "   " : "\n");
+      // \033[K clears what a longer line before left behind.
+      std::fprintf(stderr, "\rhfvis: %d/%d directions%s\033[K%s", done, total, left.c_str(),
+                   line_open_ ? "" : "\n");
       std::fflush(stderr);
     };
   }

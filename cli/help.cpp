@@ -67,7 +67,8 @@ Options:
                            nan); EXR outputs keep NaN. Needs a .tif/.tiff output
   --device SEL             device index, "gpu", "cpu" or part of a device/platform name
                            (default: env HFVIS_DEVICE, else a GPU, else the first CPU)
-  --memory-budget MB       device memory for one batch of directions, MiB (default: from the device)
+  --memory-budget MB       device memory for one batch of directions, MiB (default: half the
+                           device's memory; on a CPU device half the host's)
   --preview PNG            also write an 8-bit PNG preview
   -q, --quiet              print neither progress nor the summary line
   -h, --help               show help
@@ -180,7 +181,8 @@ Conventions and units:
   GIS        A georeferenced input keeps its CRS (projected or geographic, copied as it is)
              and geotransform in GeoTIFF outputs, so they overlay it. Cell sizes come from
              the geotransform in the CRS's units; geographic degrees become metres (WGS84,
-             at the field's centre latitude); rotated geotransforms are refused. A band's
+             at each row's latitude: horizon, svf and ao follow each row's spacing, viewcount,
+             horizons and bounce the centre latitude's); rotated geotransforms are refused. A band's
              nodata value reads as nodata. GeoTIFF outputs: one float32 band per channel,
              named by its description (h000.., svf, ao, count, visible_area), nodata declared
              on every band (NaN, or --nodata VALUE written in those cells), DEFLATE with the

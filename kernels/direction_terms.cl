@@ -30,7 +30,7 @@
     return (found & (rise > 0.0f)) ? rise / sqrt(rise * rise + run * run) : (T)0.0f;                      \
   }                                                                                                       \
   HFVIS_INLINE HFVIS_OVERLOADABLE T ambient_term(                                              \
-      IT found, T rise, T run, T nx, T ny, T nz, T cos_az, T sin_az, float weight, float swath) {         \
+      IT found, T rise, T run, T nx, T ny, T nz, T cos_az, T sin_az, T weight, T swath) {                 \
     T toward = nx * cos_az + ny * sin_az;                                                                 \
     IT behind = !found | (rise * nz < -toward * run);                                                     \
     T x = behind ? -toward / nz : rise / run;                                                             \

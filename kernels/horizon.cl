@@ -20,15 +20,17 @@
 //   HFVIS_WANT_ANGLES, HFVIS_WANT_DISTANCES  write the direction's planes
 //   HFVIS_WANT_SVF, HFVIS_WANT_AO            accumulate sky-view / ambient occlusion terms
 //   HFVIS_CURVATURE                          lower every sample by the Earth's drop (argument
-//                                            `drop`: c times the ground length of a pixel
-//                                            along the line, squared; README "Conventions")
+//                                            `drop`: c times the ground length of a unit of
+//                                            position along the line or ray, squared: a pixel,
+//                                            or a ground unit with HFVIS_ROW_SPACING; README
+//                                            "Conventions")
 //   HFVIS_MAX_DISTANCE                       only samples within `window` pixels along the line
 //                                            count (horizon_lattice: blocks and a backward
 //                                            pass, below; horizon_naive: `max_steps`)
 //   HFVIS_ROW_SPACING                        the ground spacing differs per row (latitude /
 //                                            longitude grids): positions along a line or ray
 //                                            are ground lengths summed step by step, from the
-//                                            per-row tables `row_length` and `row_direction`
+//                                            per-row tables `row_length` and `row_terms`
 #include "direction_terms.cl"
 #include "fast_math.cl"
 #include "sweep_framework.cl"
@@ -86,12 +88,18 @@ HFVIS_INLINE float2 surface_slopes(__global const float* heights, int width, int
 // Every pixel's normal as its slopes (surface_slopes), 8 bytes per pixel, for ambient
 // occlusion. ambient_term is linear in the normal (its arctangent argument and its test
 // are ratios), so the sweep passes (x, y, 1) and occlusion_scale divides the sum by
-// |(x, y, 1)| once at the end. Global size: (W, H) rounded up.
+// |(x, y, 1)| once at the end. With HFVIS_ROW_SPACING each row takes its own cell sizes,
+// row_cells[r] (else cell_x, cell_y). Global size: (W, H) rounded up.
 __kernel void pixel_normals(__global const float* heights, int width, int height, float cell_x, float cell_y,
-                            __global float2* normals) {
+                            __global const float2* row_cells, __global float2* normals) {
   int c = get_global_id(0), r = get_global_id(1);
   if (c >= width || r >= height) return;
   const uint pixel = (uint)(r * width + c);
+#if HFVIS_ROW_SPACING
+  const float2 cells = row_cells[r];
+  cell_x = cells.x;
+  cell_y = cells.y;
+#endif
   normals[pixel] = surface_slopes(heights, width, height, c, r, heights[pixel], cell_x, cell_y);
 }
 
@@ -142,58 +150,55 @@ HFVIS_DEFINE_ATAN(lane_float, lane_int)
 HFVIS_DIRECTION_TERMS(lane_float, lane_int)
 #endif
 
-// A direction's outputs, and where they go. Each launch runs one direction and every
-// pixel is written by one work-item of it, so the read-modify-writes of the sums need no
-// atomics.
-typedef struct {
-  float weight;  // its share of the circle of azimuth
-  float swath;   // sin(pi weight) / pi (ambient_term)
-  uint plane;    // first entry of its planes in `angles` / `distances`
-} DirectionOutputs;
+// A direction's outputs go to its planes, from `plane` on in `angles` / `distances`, and into
+// the sums. Each launch runs one direction and every pixel is written by one work-item of it,
+// so the read-modify-writes of the sums need no atomics. (cos_az, sin_az) is the direction on
+// the ground at the receiver, weight its share of the circle of azimuth there and swath
+// sin(pi weight) / pi (ambient_term).
 
-// One receiver's outputs (the naive march); (cos_az, sin_az) is the direction on the ground there.
+// One receiver's outputs (the naive march).
 HFVIS_INLINE void emit_direction(uint pixel, int nodata, int found, float rise, float run, float distance,
-                                 float cos_az, float sin_az, const DirectionOutputs o,
+                                 float cos_az, float sin_az, float weight, float swath, uint plane,
                                  __global const float2* normals,
                                  __global float* angles, __global float* distances, __global float* svf_sum,
                                  __global float* ao_sum) {
 #if HFVIS_WANT_ANGLES
-  angles[o.plane + pixel] = nodata ? NAN : elevation_term(found, rise, run);
+  angles[plane + pixel] = nodata ? NAN : elevation_term(found, rise, run);
 #endif
 #if HFVIS_WANT_DISTANCES
-  distances[o.plane + pixel] = nodata ? NAN : distance;
+  distances[plane + pixel] = nodata ? NAN : distance;
 #endif
 #if HFVIS_WANT_SVF
-  svf_sum[pixel] = nodata ? NAN : svf_sum[pixel] + o.weight * sky_term(found, rise, run);
+  svf_sum[pixel] = nodata ? NAN : svf_sum[pixel] + weight * sky_term(found, rise, run);
 #endif
 #if HFVIS_WANT_AO
   const float2 n = normals[pixel];
-  float term = ambient_term(found, rise, run, n.x, n.y, 1.0f, cos_az, sin_az, o.weight, o.swath);
+  float term = ambient_term(found, rise, run, n.x, n.y, 1.0f, cos_az, sin_az, weight, swath);
   ao_sum[pixel] = nodata ? NAN : ao_sum[pixel] + term;
 #endif
 }
 
 // The outputs of a lane vector of receivers (the sweep): the terms lane-parallel, the
-// stores lane by lane where `live`; (cos_az, sin_az) is the direction on the ground there.
+// stores lane by lane where `live`.
 HFVIS_INLINE void emit_lanes(lane_int live, lane_int pixel, lane_int nodata, lane_int found, lane_float rise,
                              lane_float run, lane_float distance, lane_float cos_az, lane_float sin_az,
-                             const DirectionOutputs o,
+                             lane_float weight, lane_float swath, uint plane,
                              __global const float2* normals, __global float* angles,
                              __global float* distances, __global float* svf_sum, __global float* ao_sum) {
 #if HFVIS_WANT_ANGLES
   const lane_float elevation = select(elevation_term(found, rise, run), (lane_float)NAN, nodata);
 #pragma unroll
   for (int l = 0; l < HFVIS_LANES; ++l)
-    if (ILANE(live, l)) angles[o.plane + (uint)ILANE(pixel, l)] = LANE(elevation, l);
+    if (ILANE(live, l)) angles[plane + (uint)ILANE(pixel, l)] = LANE(elevation, l);
 #endif
 #if HFVIS_WANT_DISTANCES
   const lane_float dist = select(distance, (lane_float)NAN, nodata);
 #pragma unroll
   for (int l = 0; l < HFVIS_LANES; ++l)
-    if (ILANE(live, l)) distances[o.plane + (uint)ILANE(pixel, l)] = LANE(dist, l);
+    if (ILANE(live, l)) distances[plane + (uint)ILANE(pixel, l)] = LANE(dist, l);
 #endif
 #if HFVIS_WANT_SVF
-  const lane_float sky = o.weight * sky_term(found, rise, run);
+  const lane_float sky = weight * sky_term(found, rise, run);
 #pragma unroll
   for (int l = 0; l < HFVIS_LANES; ++l) {
     const uint p = (uint)ILANE(pixel, l);
@@ -209,7 +214,7 @@ HFVIS_INLINE void emit_lanes(lane_int live, lane_int pixel, lane_int nodata, lan
     LANE(ny, l) = n.y;
   }
   const lane_float term =
-      ambient_term(found, rise, run, nx, ny, (lane_float)1.0f, cos_az, sin_az, o.weight, o.swath);
+      ambient_term(found, rise, run, nx, ny, (lane_float)1.0f, cos_az, sin_az, weight, swath);
 #pragma unroll
   for (int l = 0; l < HFVIS_LANES; ++l) {
     const uint p = (uint)ILANE(pixel, l);
@@ -361,7 +366,10 @@ HFVIS_INLINE void hull_step(__global float2* stacks, lane_int stack, int entry, 
 // tangent from the receiver is found by binary search (the slopes from a point beyond an upper
 // hull rise and then fall along it; ties go to the farther entry). Writes (rise, run) per
 // receiver pixel into window_far (run 0: none), which the forward sweep combines. Every sample
-// is pushed twice and each receiver searches once: O(n log m) for m hull entries.
+// is pushed twice and each receiver searches once: O(n log m) for m hull entries. The cut is
+// decided in float arithmetic: by block membership (position * inv_window) in the forward
+// sweep and by x - here <= window here, so a sample within rounding of the window's length
+// (relative 1e-7) may go either way.
 HFVIS_INLINE void window_pass(__global const float* heights, int width, int height,
                               __global const LatticeSample* samples, int n_samples, int a, int b, float period,
                               float window, float inv_window, float drop, lane_int c, lane_int r,
@@ -439,15 +447,16 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
 // HFVIS_MAX_DISTANCE only samples within `window` pixels (inv_window = 1 / window) count
 // (window_pass; window_far: one (rise, run) per pixel). With HFVIS_ROW_SPACING positions are
 // ground lengths: row_length[r] is the ground length of the period from a receiver in row r to
-// the next one along +(a, b), row_direction[r] that period's unit ground direction, and
-// ground_per_pixel is 1. Preconditions: lines of this launch only; stride 1 (line-major) or
+// the next one along +(a, b), row_terms[r] that period's unit ground direction (x, y), weight
+// and swath (they replace cos_azimuth, sin_azimuth, weight and swath), drop is per ground unit
+// squared, and ground_per_pixel is 1 (period_ground is unused). Preconditions: lines of this launch only; stride 1 (line-major) or
 // the launch's line count (step-major). Global size: ceil(n_lines / HFVIS_LANES) rounded up to
 // the local size.
 __kernel void horizon_lattice(__global const float* heights, int width, int height,
                               __global const int4* lines, int n_lines, __global const LatticeSample* samples,
                               int n_samples, int a, int b, float period, float ground_per_pixel,
                               float period_ground, float drop, float window, float inv_window,
-                              __global const float* row_length, __global const float2* row_direction,
+                              __global const float* row_length, __global const float4* row_terms,
                               float cos_azimuth,
                               float sin_azimuth, float weight, float swath, uint plane, __global float2* stacks,
                               uint stride, __global float2* window_far, __global const float2* normals,
@@ -455,7 +464,6 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
                               __global float* ao_sum) {
   const int first = get_global_id(0) * HFVIS_LANES;
   if (first >= n_lines) return;
-  const DirectionOutputs outputs = {weight, swath, plane};
   lane_int c, r, receivers, stack;
   int trips = 0;  // the longest line's receivers
 #pragma unroll
@@ -481,15 +489,17 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
   for (int i = 0; i < trips; ++i, c -= a, r -= b) {
     const lane_int live = i < receivers;
 #if HFVIS_ROW_SPACING
-    // The period from the receivers toward +(a, b): its ground length and direction by row.
-    lane_float period_length, cos_az, sin_az;
+    // The period from the receivers toward +(a, b): its ground length and terms by row.
+    lane_float period_length, cos_az, sin_az, weight_l, swath_l;
 #pragma unroll
     for (int l = 0; l < HFVIS_LANES; ++l) {
       const int row = ILANE(live, l) ? ILANE(r, l) : 0;
-      const float2 direction = row_direction[row];
+      const float4 terms = row_terms[row];
       LANE(period_length, l) = row_length[row];
-      LANE(cos_az, l) = direction.x;
-      LANE(sin_az, l) = direction.y;
+      LANE(cos_az, l) = terms.x;
+      LANE(sin_az, l) = terms.y;
+      LANE(weight_l, l) = terms.z;
+      LANE(swath_l, l) = terms.w;
     }
     if (i > 0) base += period_length;
     const lane_float tau_scale = period_length * inv_period;  // ground length per pixel of tau
@@ -497,6 +507,7 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 #else
     const float base = (float)i * period;  // the receivers' position along their lines
     const lane_float cos_az = (lane_float)cos_azimuth, sin_az = (lane_float)sin_azimuth;
+    const lane_float weight_l = (lane_float)weight, swath_l = (lane_float)swath;
     const lane_float period_ground_l = (lane_float)period_ground;
 #endif
     lane_float h;  // the sample's heights, finally the receivers'
@@ -567,8 +578,8 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
     const lane_int nodata = 0;
 #endif
     emit_lanes(live, r * width + c, nodata, has_far | has_near, select(far_rise, near, use_near),
-               select(ground, period_ground_l, use_near), distance, cos_az, sin_az, outputs, normals, angles,
-               distances, svf_sum, ao_sum);
+               select(ground, period_ground_l, use_near), distance, cos_az, sin_az, weight_l, swath_l, plane,
+               normals, angles, distances, svf_sum, ao_sum);
   }
 }
 
@@ -594,11 +605,12 @@ HFVIS_INLINE float row_ground_at(__global const float* row_length, int height, f
 // pixel's own exit are masked; with a maximum distance the march ends after `max_steps`
 // (else INT_MAX). With HFVIS_ROW_SPACING the ray is straight in pixels and its ground length
 // is summed step by step: row_length[r] is the ground length per pixel along it at row r,
-// row_direction[r] its unit ground direction there. Global size: (W, H) rounded up to the
+// row_terms[r] its unit ground direction, weight and swath there, and drop is per ground unit
+// squared. Global size: (W, H) rounded up to the
 // local size (the tile).
 __kernel void horizon_naive(__global const float* heights, int width, int height, float dir_x, float dir_y,
                             float step_length, float ground_per_pixel, float drop, int max_steps,
-                            __global const float* row_length, __global const float2* row_direction,
+                            __global const float* row_length, __global const float4* row_terms,
                             float cos_azimuth, float sin_azimuth, float weight, float swath, uint plane,
                             __global const float2* normals,
                             __global float* angles, __global float* distances, __global float* svf_sum,
@@ -646,15 +658,14 @@ __kernel void horizon_naive(__global const float* heights, int width, int height
   }
 #if HFVIS_ROW_SPACING
   const float ground = best_along;
-  const float2 direction = row_direction[rr];
-  const float cos_az = direction.x, sin_az = direction.y;
+  const float4 terms = row_terms[rr];
+  const float cos_az = terms.x, sin_az = terms.y, weight_r = terms.z, swath_r = terms.w;
 #else
   const float ground = (float)best_step * step_length * ground_per_pixel;
-  const float cos_az = cos_azimuth, sin_az = sin_azimuth;
+  const float cos_az = cos_azimuth, sin_az = sin_azimuth, weight_r = weight, swath_r = swath;
 #endif
   const float distance = best_step > 0 ? ground : 0.0f;
-  const DirectionOutputs outputs = {weight, swath, plane};
   if (valid)
-    emit_direction(pixel, isnan(h), best_step > 0, best_rise, ground, distance, cos_az, sin_az, outputs,
-                   normals, angles, distances, svf_sum, ao_sum);
+    emit_direction(pixel, isnan(h), best_step > 0, best_rise, ground, distance, cos_az, sin_az, weight_r,
+                   swath_r, plane, normals, angles, distances, svf_sum, ao_sum);
 }

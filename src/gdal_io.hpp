@@ -28,7 +28,7 @@ bool isGdalRaster(const std::string& path);
 
 // Reads band `options.channel` ("" = the only band; an index "0".. or a band description) as
 // heights: nodata cells NaN, the georeference from the file, cell sizes from the geotransform
-// (geographic degrees in metres at the field's centre latitude; without a geotransform, the
+// (geographic degrees in metres per row and at the field's centre latitude; without a geotransform, the
 // hfvis_cell_size_x/y metadata items hfvis writes) unless the options give them. Throws IoError
 // (unreadable, rotated or sheared geotransform, too large).
 HeightField readGdalHeightField(const std::string& path, const HeightFieldReadOptions& options);

@@ -48,8 +48,8 @@ struct RunDirection {
   std::vector<LatticeLine> lines;                // sweep: the direction's lines over the field
   LatticeWindow window;                          // sweep: the maximum distance along its lines
   int max_steps = kAllSteps;                     // naive march: the steps within the maximum distance
-  // Per-row spacing: ground length and direction by row (latticeRowTable, rayRowTable).
-  std::vector<float> row_length, row_direction;
+  // Per-row spacing: ground length and terms by row (latticeRowTables, rayRowTables).
+  std::vector<float> row_length, row_terms;
 };
 
 // How a run uses its device memory budget: directions per downloaded batch of planes and
@@ -115,18 +115,23 @@ std::vector<RunDirection> runDirectionsOf(const HeightField& field, const Horizo
                                           const HorizonOutputs& outputs) {
   std::vector<RunDirection> out;
   if (options.method == HorizonMethod::Sweep) {
-    for (const LatticeDirection& d : horizonDirections(field, options, outputs)) {
+    const std::vector<LatticeDirection> directions = horizonDirections(field, options, outputs);
+    std::vector<RowTable> rows;
+    if (hasRowSpacing(field)) rows = latticeRowTables(field, directions, !exactAzimuths(outputs));
+    for (std::size_t k = 0; k < directions.size(); ++k) {
+      const LatticeDirection& d = directions[k];
       out.push_back({d, SweepDirection{}, latticeSamples(d, options.samples_per_unit),
                      static_cast<float>(std::cos(d.azimuth)), static_cast<float>(std::sin(d.azimuth)),
                      latticeLines(d, field.width, field.height), latticeWindow(field, d, options.max_distance)});
-      if (hasRowSpacing(field)) {
-        LatticeRowTable rows = latticeRowTable(field, d);
-        out.back().row_length = std::move(rows.length);
-        out.back().row_direction = std::move(rows.direction);
+      if (!rows.empty()) {
+        out.back().row_length = std::move(rows[k].length);
+        out.back().row_terms = std::move(rows[k].terms);
       }
     }
   } else {
     const std::vector<SweepDirection> rays = runDirections(field, options);
+    std::vector<RowTable> rows;
+    if (hasRowSpacing(field)) rows = rayRowTables(field, rays);
     for (int k = 0; k < options.directions; ++k) {
       const SweepDirection& d = rays[k];
       RunDirection r;
@@ -136,10 +141,9 @@ std::vector<RunDirection> runDirectionsOf(const HeightField& field, const Horizo
       r.cos_azimuth = d.cos_azimuth;
       r.sin_azimuth = d.sin_azimuth;
       r.max_steps = stepsWithin(options.max_distance, double(d.step_length) * d.ground_per_pixel);
-      if (hasRowSpacing(field)) {
-        RayRowTable rows = rayRowTable(field, d);
-        r.row_length = std::move(rows.length);
-        r.row_direction = std::move(rows.direction);
+      if (!rows.empty()) {
+        r.row_length = std::move(rows[k].length);
+        r.row_terms = std::move(rows[k].terms);
       }
       out.push_back(r);
     }
@@ -187,7 +191,9 @@ class HorizonRoutine : public SweepRoutine {
       normals.setArg(2, field_.height);
       normals.setArg(3, static_cast<float>(field_.cell_size_x));
       normals.setArg(4, static_cast<float>(field_.cell_size_y));
-      normals.setArg(5, normals_);
+      const cl::Buffer row_cells = rowCells();
+      normals.setArg(5, row_cells);
+      normals.setArg(6, normals_);
       st_.launch(normals, cl::NDRange(roundUp(field_.width, kTileX), roundUp(field_.height, kTileY)),
                  cl::NDRange(kTileX, kTileY));
     }
@@ -236,6 +242,19 @@ class HorizonRoutine : public SweepRoutine {
     return static_cast<float>(horizon_.curvature * ground_per_pixel * ground_per_pixel);
   }
 
+  // Per-row spacing: every row's cell sizes (x, y) as floats, for the normals (a placeholder
+  // without).
+  cl::Buffer rowCells() {
+    if (!hasRowSpacing(field_)) return deviceBuffer(st_, 0);
+    std::vector<float> cells;
+    for (int r = 0; r < field_.height; ++r) {
+      cells.push_back(static_cast<float>(field_.row_cell_size_x[r]));
+      cells.push_back(static_cast<float>(field_.row_cell_size_y[r]));
+    }
+    return cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, cells.size() * sizeof(float),
+                      cells.data());
+  }
+
   // The unit of positions along lines and rays: pixels of that ground length, or (per-row
   // spacing) ground units.
   double positionUnit(double ground_per_pixel) const { return hasRowSpacing(field_) ? 1.0 : ground_per_pixel; }
@@ -248,7 +267,7 @@ class HorizonRoutine : public SweepRoutine {
       return cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, values.size() * sizeof(float),
                         const_cast<float*>(values.data()));
     };
-    std::array<cl::Buffer, 2> tables{table(d.row_length), table(d.row_direction)};
+    std::array<cl::Buffer, 2> tables{table(d.row_length), table(d.row_terms)};
     kernel.setArg(arg, tables[0]);
     kernel.setArg(arg + 1, tables[1]);
     return tables;

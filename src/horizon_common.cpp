@@ -25,6 +25,57 @@ namespace detail {
 
 bool hasRowSpacing(const HeightField& field) { return !field.row_cell_size_x.empty(); }
 
+std::vector<RowTable> latticeRowTables(const HeightField& field, const std::vector<LatticeDirection>& directions,
+                                              bool quadrature) {
+  const std::size_t K = directions.size();
+  std::vector<RowTable> tables(K);
+  std::vector<LatticeDirection> at_row = directions;
+  for (int r = 0; r < field.height; ++r) {
+    std::vector<double> lengths(K);
+    for (std::size_t k = 0; k < K; ++k) {
+      const LatticeDirection& d = directions[k];
+      double cell_x = 0.0, cell_y = 0.0;
+      cellSizeAtRow(field, r + 0.5 * d.b, &cell_x, &cell_y);
+      const double gx = d.a * cell_x, gy = d.b * cell_y;
+      lengths[k] = std::hypot(gx, gy);
+      // The step's ground azimuth here, next to the one it has at the centre latitude.
+      at_row[k].azimuth = d.azimuth + angleDifference(std::atan2(gy, gx), d.azimuth);
+      at_row[k].weight = d.weight;
+    }
+    if (quadrature && K > 1) setQuadratureWeights(at_row);
+    for (std::size_t k = 0; k < K; ++k) {
+      RowTable& t = tables[k];
+      const float weight = static_cast<float>(at_row[k].weight);
+      t.length.push_back(static_cast<float>(lengths[k]));
+      t.terms.insert(t.terms.end(), {static_cast<float>(std::cos(at_row[k].azimuth)),
+                                     static_cast<float>(std::sin(at_row[k].azimuth)), weight, swathFactor(weight)});
+    }
+  }
+  return tables;
+}
+
+std::vector<RowTable> rayRowTables(const HeightField& field, const std::vector<SweepDirection>& rays) {
+  const std::size_t K = rays.size();
+  std::vector<RowTable> tables(K);
+  for (int r = 0; r < field.height; ++r) {
+    std::vector<double> lengths(K), azimuths(K);
+    for (std::size_t k = 0; k < K; ++k) {
+      const double gx = rays[k].dir_x * field.row_cell_size_x[r], gy = rays[k].dir_y * field.row_cell_size_y[r];
+      lengths[k] = std::hypot(gx, gy);
+      azimuths[k] = std::atan2(gy, gx);
+    }
+    const std::vector<double> weights = halfGapWeights(azimuths);
+    for (std::size_t k = 0; k < K; ++k) {
+      RowTable& t = tables[k];
+      const float weight = static_cast<float>(weights[k]);
+      t.length.push_back(static_cast<float>(lengths[k]));
+      t.terms.insert(t.terms.end(), {static_cast<float>(std::cos(azimuths[k])), static_cast<float>(std::sin(azimuths[k])),
+                                     weight, swathFactor(weight)});
+    }
+  }
+  return tables;
+}
+
 void requireSupported(const HeightField& field, const HorizonOptions& options) {
   if (hasRowSpacing(field) && options.max_distance > 0.0)
     throw InvalidArgument("a maximum distance is not supported on a field with per-row spacing (a latitude / "
@@ -47,10 +98,11 @@ HorizonResult allocateResult(const HeightField& field, const HorizonOptions& opt
   return result;
 }
 
+bool exactAzimuths(const HorizonOutputs& outputs) { return outputs.horizon_angles || outputs.horizon_distances; }
+
 std::vector<LatticeDirection> horizonDirections(const HeightField& field, const HorizonOptions& options,
                                                 const HorizonOutputs& outputs) {
-  const bool exact = outputs.horizon_angles || outputs.horizon_distances;
-  return latticeDirections(field, options, exact, options.azimuth_tolerance);
+  return latticeDirections(field, options, exactAzimuths(outputs), options.azimuth_tolerance);
 }
 
 float swathFactor(float weight) { return hfSin(kPiF * weight) / kPiF; }

@@ -10,6 +10,10 @@
 
 namespace hfvis::detail {
 
+// Whether a run's directions are exact azimuths (per-direction planes requested) rather than
+// quadrature directions.
+bool exactAzimuths(const HorizonOutputs& outputs);
+
 // The sweep directions of a run: exact azimuths (within options.azimuth_tolerance) when
 // per-direction planes are requested, quadrature directions otherwise.
 std::vector<LatticeDirection> horizonDirections(const HeightField& field, const HorizonOptions& options,
@@ -29,6 +33,26 @@ bool hasRowSpacing(const HeightField& field);
 // Throws InvalidArgument for what the horizon operation does not do on this field: a maximum
 // distance with per-row spacing.
 void requireSupported(const HeightField& field, const HorizonOptions& options);
+
+// A field with per-row spacing (HeightField::row_cell_size_x/y), as horizon_lattice takes it
+// (HFVIS_ROW_SPACING), one table per direction: per row r, the ground length of the period
+// from a receiver in row r to the next one along +(a, b) (the cell sizes at its middle row
+// r + b / 2, linear between rows), and its terms: unit ground direction (x, y), quadrature
+// weight and swath factor there. The step's ground azimuth turns with the spacing, so with
+// `quadrature` (sky-view factor, occlusion) the weights are the half gaps between the steps'
+// azimuths at that row (setQuadratureWeights); otherwise each keeps its own (1/K). Both the
+// kernel and the reference get these floats.
+struct RowTable {
+  std::vector<float> length;  // one per row
+  std::vector<float> terms;   // four per row: cos, sin, weight, swath
+};
+std::vector<RowTable> latticeRowTables(const HeightField& field, const std::vector<LatticeDirection>& directions,
+                                              bool quadrature);
+
+// The same for the naive march (horizon_naive with HFVIS_ROW_SPACING), one table per ray
+// direction: per row r, the ground length per pixel along the ray with row r's cell sizes, and
+// its terms there (its weight the half gaps between the rays' azimuths at that row).
+std::vector<RowTable> rayRowTables(const HeightField& field, const std::vector<SweepDirection>& rays);
 
 // An empty result with the requested planes allocated (NaN-filled).
 HorizonResult allocateResult(const HeightField& field, const HorizonOptions& options,

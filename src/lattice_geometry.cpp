@@ -15,13 +15,16 @@ namespace {
 
 constexpr double kTwoPi = 2.0 * M_PI;
 
-// Signed difference of two angles, in (-pi, pi].
+}  // namespace
+
 double angleDifference(double x, double y) {
   double d = std::fmod(x - y, kTwoPi);
   if (d > M_PI) d -= kTwoPi;
   if (d <= -M_PI) d += kTwoPi;
   return d;
 }
+
+namespace {
 
 struct Candidate {
   int a, b;
@@ -109,28 +112,41 @@ std::vector<LatticeDirection> latticeDirections(const HeightField& field, const 
     for (auto& d : out) d.weight = 1.0 / K;
     return out;
   }
-  // Quadrature weights: each direction stands for the azimuths closer to it than to its
-  // neighbours (the chosen azimuths are in increasing order around the circle).
+  setQuadratureWeights(out);
+  return out;
+}
+
+std::vector<double> halfGapWeights(const std::vector<double>& azimuths) {
+  const int K = static_cast<int>(azimuths.size());
+  std::vector<double> weights(K, 1.0);
+  if (K == 1) return weights;
   for (int k = 0; k < K; ++k) {
-    const double previous = out[(k + K - 1) % K].azimuth, next = out[(k + 1) % K].azimuth;
-    double gap_before = angleDifference(out[k].azimuth, previous),
-           gap_after = angleDifference(next, out[k].azimuth);
+    double gap_before = angleDifference(azimuths[k], azimuths[(k + K - 1) % K]),
+           gap_after = angleDifference(azimuths[(k + 1) % K], azimuths[k]);
     if (K == 2) gap_before = gap_after = M_PI;
-    out[k].weight = 0.5 * (gap_before + gap_after) / kTwoPi;
+    weights[k] = 0.5 * (gap_before + gap_after) / kTwoPi;
   }
+  return weights;
+}
+
+void setQuadratureWeights(std::vector<LatticeDirection>& directions) {
+  std::vector<double> azimuths;
+  for (const LatticeDirection& d : directions) azimuths.push_back(d.azimuth);
+  const std::vector<double> weights = halfGapWeights(azimuths);
+  const std::size_t K = directions.size();
+  for (std::size_t k = 0; k < K; ++k) directions[k].weight = weights[k];
   // Where no step lies inside a window (K beyond the lattice's angular resolution near
   // the axes: atan(1/64) = 0.9 deg) neighbours can fall back to the same step: the first
   // one takes their weight and the others get 0, so the sweep runs each step once.
-  for (int k = 1; k < K; ++k) {
-    for (int m = 0; m < k; ++m) {
-      if (out[m].a == out[k].a && out[m].b == out[k].b && out[m].weight > 0.0) {
-        out[m].weight += out[k].weight;
-        out[k].weight = 0.0;
+  for (std::size_t k = 1; k < K; ++k) {
+    for (std::size_t m = 0; m < k; ++m) {
+      if (directions[m].a == directions[k].a && directions[m].b == directions[k].b && directions[m].weight > 0.0) {
+        directions[m].weight += directions[k].weight;
+        directions[k].weight = 0.0;
         break;
       }
     }
   }
-  return out;
 }
 
 std::vector<LatticeSample> latticeSamples(const LatticeDirection& d, double samples_per_unit) {
@@ -256,17 +272,5 @@ void cellSizeAtRow(const HeightField& field, double y, double* cell_x, double* c
   *cell_y = (1.0 - w) * field.row_cell_size_y[r0] + w * field.row_cell_size_y[r1];
 }
 
-LatticeRowTable latticeRowTable(const HeightField& field, const LatticeDirection& d) {
-  LatticeRowTable t;
-  for (int r = 0; r < field.height; ++r) {
-    double cell_x = 0.0, cell_y = 0.0;
-    cellSizeAtRow(field, r + 0.5 * d.b, &cell_x, &cell_y);
-    const double gx = d.a * cell_x, gy = d.b * cell_y, length = std::hypot(gx, gy);
-    t.length.push_back(static_cast<float>(length));
-    t.direction.push_back(static_cast<float>(gx / length));
-    t.direction.push_back(static_cast<float>(gy / length));
-  }
-  return t;
-}
 
 }  // namespace hfvis::detail

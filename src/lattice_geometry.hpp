@@ -113,15 +113,17 @@ struct LatticeWindow {
 };
 LatticeWindow latticeWindow(const HeightField& field, const LatticeDirection& d, double max_distance);
 
-// A field with per-row spacing (HeightField::row_cell_size_x/y), as horizon_lattice takes it
-// (HFVIS_ROW_SPACING): per row r, the ground length of the period from a receiver in row r to
-// the next one along +(a, b) (the cell sizes at its middle row r + b / 2, linear between rows)
-// and its unit ground direction (x, y). Both the kernel and the reference get these floats.
-struct LatticeRowTable {
-  std::vector<float> length;     // one per row
-  std::vector<float> direction;  // two per row
-};
-LatticeRowTable latticeRowTable(const HeightField& field, const LatticeDirection& d);
+
+// Signed difference of two angles (radians), in (-pi, pi].
+double angleDifference(double x, double y);
+
+// Quadrature weights of directions at these azimuths (in increasing order around the circle):
+// half the gap to each neighbour, over 2 pi (1 for one direction, 1/2 each for two).
+std::vector<double> halfGapWeights(const std::vector<double>& azimuths);
+
+// Sets the directions' weights from their azimuths (halfGapWeights); steps that coincide
+// are merged: the first takes their weight, the others get 0 and are not swept.
+void setQuadratureWeights(std::vector<LatticeDirection>& directions);
 
 // The cell sizes at row y (fractional), linear between the rows' per-row sizes, clamped.
 void cellSizeAtRow(const HeightField& field, double y, double* cell_x, double* cell_y);

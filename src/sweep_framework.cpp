@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <fstream>
 #include <sstream>
 
 namespace hfvis::detail {
@@ -33,9 +34,18 @@ std::size_t defaultMemoryBudget(const DeviceInfo& device) {
   // A CPU device's memory is the host's: PoCL reports a fraction of it as its global memory
   // (4.8 to 6.2 GiB on the 24 GB test machine) and allocates from the host beyond that, so the
   // budget is half the host's physical memory (its largest single buffer still applies).
+  // Within a container the memory the process may use is its cgroup's limit, where that is lower.
+  // (Other CPU runtimes may refuse to allocate beyond their reported global memory: then the
+  // budget is an error they report, not a crash.)
   if (device.type == "CPU") {
     const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
-    if (pages > 0 && page > 0) return static_cast<std::size_t>(pages) * static_cast<std::size_t>(page) / 2;
+    if (pages > 0 && page > 0) {
+      std::size_t host = static_cast<std::size_t>(pages) * static_cast<std::size_t>(page);
+      std::ifstream limit("/sys/fs/cgroup/memory.max");
+      std::size_t bytes = 0;
+      if (limit >> bytes && bytes > 0) host = std::min(host, bytes);  // "max" (no limit) fails to parse
+      return host / 2;
+    }
   }
   return device.global_memory_bytes / 2;
 }

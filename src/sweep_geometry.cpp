@@ -125,16 +125,5 @@ int stepsWithin(double max_distance, double step_ground) {
   return static_cast<int>(std::min<double>(kAllSteps, std::floor(max_distance / step_ground)));
 }
 
-RayRowTable rayRowTable(const HeightField& field, const SweepDirection& d) {
-  RayRowTable t;
-  for (int r = 0; r < field.height; ++r) {
-    const double gx = d.dir_x * field.row_cell_size_x[r], gy = d.dir_y * field.row_cell_size_y[r];
-    const double length = std::hypot(gx, gy);
-    t.length.push_back(static_cast<float>(length));
-    t.direction.push_back(static_cast<float>(gx / length));
-    t.direction.push_back(static_cast<float>(gy / length));
-  }
-  return t;
-}
 
 }  // namespace hfvis::detail

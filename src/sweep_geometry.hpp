@@ -79,13 +79,5 @@ constexpr int kAllSteps = 1 << 30;
 // march or a uniformly sampled line takes within a maximum distance.
 int stepsWithin(double max_distance, double step_ground);
 
-// A field with per-row spacing, as horizon_naive takes it (HFVIS_ROW_SPACING): per row r,
-// the ground length per pixel along the ray direction (dir_x, dir_y) of d with row r's cell
-// sizes, and the ray's unit ground direction there (x, y).
-struct RayRowTable {
-  std::vector<float> length;     // one per row
-  std::vector<float> direction;  // two per row
-};
-RayRowTable rayRowTable(const HeightField& field, const SweepDirection& d);
 
 }  // namespace hfvis::detail

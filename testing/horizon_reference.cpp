@@ -20,11 +20,11 @@ namespace {
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
 // A normal as its slopes: (x, y, 1) / |(x, y, 1)| (surface_slopes in the kernel).
-struct Normal {
+struct Slopes {
   float x = 0.0f, y = 0.0f;
 };
 
-Normal surfaceNormal(const std::vector<float>& h, int width, int height, int c, int r, float hp, float cell_x,
+Slopes surfaceSlopes(const std::vector<float>& h, int width, int height, int c, int r, float hp, float cell_x,
                      float cell_y) {
   float nx = 0.0f, ny = 0.0f, nz = 0.0f;
   for (int sy = -1; sy <= 1; sy += 2) {
@@ -42,16 +42,19 @@ Normal surfaceNormal(const std::vector<float>& h, int width, int height, int c, 
   return {nx / nz, ny / nz};
 }
 
-// Every pixel's normal, as the kernels compute it (only needed for ambient occlusion).
-std::vector<Normal> pixelNormals(const HeightField& field, const std::vector<float>& h, bool wanted) {
-  std::vector<Normal> normals(field.pixelCount());
+// Every pixel's normal, as the kernels compute it (only needed for ambient occlusion), with
+// each row's own cell sizes where the field has them.
+std::vector<Slopes> pixelNormals(const HeightField& field, const std::vector<float>& h, bool wanted) {
+  std::vector<Slopes> normals(field.pixelCount());
   if (!wanted) return normals;
-  const auto cell_x = static_cast<float>(field.cell_size_x), cell_y = static_cast<float>(field.cell_size_y);
   for (int r = 0; r < field.height; ++r) {
+    const bool rows = hasRowSpacing(field);
+    const auto cell_x = static_cast<float>(rows ? field.row_cell_size_x[r] : field.cell_size_x);
+    const auto cell_y = static_cast<float>(rows ? field.row_cell_size_y[r] : field.cell_size_y);
     for (int c = 0; c < field.width; ++c) {
       const std::size_t pixel = static_cast<std::size_t>(r) * field.width + c;
       if (!std::isnan(h[pixel]))
-        normals[pixel] = surfaceNormal(h, field.width, field.height, c, r, h[pixel], cell_x, cell_y);
+        normals[pixel] = surfaceSlopes(h, field.width, field.height, c, r, h[pixel], cell_x, cell_y);
     }
   }
   return normals;
@@ -65,7 +68,7 @@ struct DirectionOutputs {
 };
 
 void emitDirection(HorizonResult& result, std::size_t pixel, bool nodata, bool found, float rise, float run,
-                   float distance, const DirectionOutputs& o, const std::vector<Normal>& normals) {
+                   float distance, const DirectionOutputs& o, const std::vector<Slopes>& normals) {
   const std::size_t plane = static_cast<std::size_t>(result.width) * result.height;
   const float elevation = nodata ? kNaN : elevation_term(found, rise, run);
   if (!result.angles.empty()) result.angles[o.k * plane + pixel] = elevation;
@@ -77,7 +80,7 @@ void emitDirection(HorizonResult& result, std::size_t pixel, bool nodata, bool f
   }
   if (!result.ambient_occlusion.empty()) {
     float& sum = result.ambient_occlusion[pixel];
-    const Normal& n = normals[pixel];
+    const Slopes& n = normals[pixel];
     const float term =
         ambient_term(found, rise, run, n.x, n.y, 1.0f, o.cos_azimuth, o.sin_azimuth, o.weight, o.swath());
     sum = nodata ? kNaN : sum + term;
@@ -85,9 +88,9 @@ void emitDirection(HorizonResult& result, std::size_t pixel, bool nodata, bool f
 }
 
 // occlusion_scale in the kernel: the sums of normals (x, y, 1) made those of unit normals.
-void scaleOcclusion(HorizonResult& result, const std::vector<Normal>& normals) {
+void scaleOcclusion(HorizonResult& result, const std::vector<Slopes>& normals) {
   for (std::size_t p = 0; p < result.ambient_occlusion.size(); ++p) {
-    const Normal& n = normals[p];
+    const Slopes& n = normals[p];
     result.ambient_occlusion[p] = result.ambient_occlusion[p] / std::sqrt(n.x * n.x + n.y * n.y + 1.0f);
   }
 }
@@ -130,22 +133,24 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
   const auto& h = prepared.heights;
   const auto normals = pixelNormals(field, h, outputs.ambient_occlusion);
   const auto directions = horizonDirections(field, options, outputs);
+  // Positions in pixels of the direction's ground length, or (per-row spacing) ground units.
+  const bool rows = hasRowSpacing(field);
+  const std::vector<RowTable> tables =
+      rows ? latticeRowTables(field, directions, !exactAzimuths(outputs)) : std::vector<RowTable>{};
   for (int k = 0; k < options.directions; ++k) {
     const LatticeDirection& d = directions[k];
     if (d.weight == 0.0 && result.angles.empty() && result.distances.empty()) continue;  // merged step
     DirectionOutputs out = outputsOf(d, k);
     const auto samples = latticeSamples(d, options.samples_per_unit);
-    // Positions in pixels of the direction's ground length, or (per-row spacing) ground units.
-    const bool rows = hasRowSpacing(field);
     const double unit = rows ? 1.0 : d.ground_per_pixel;
-    const LatticeRowTable table = rows ? latticeRowTable(field, d) : LatticeRowTable{};
+    const RowTable* table = rows ? &tables[k] : nullptr;
     const float gpp = static_cast<float>(unit);
     const float drop = static_cast<float>(options.curvature * unit * unit);
     float period_ground = static_cast<float>(d.period * d.ground_per_pixel);
     const LatticeWindow window = latticeWindow(field, d, options.max_distance);
     for (const LatticeLine& line : latticeLines(d, width, height)) {
       for (const LatticeLineSample& s :
-           latticeLineSamples(field, h, d, samples, line, drop, window, rows ? &table : nullptr)) {
+           latticeLineSamples(field, h, d, samples, line, drop, window, table)) {
         if (s.receiver < 0) continue;
         const std::size_t pixel = static_cast<std::size_t>(s.receiver);
         if (std::isnan(s.height)) {
@@ -153,10 +158,11 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
           continue;
         }
         const int c = static_cast<int>(pixel % width), r = static_cast<int>(pixel / width);
-        if (rows) {  // the receiver's period: its ground length and direction
-          period_ground = table.length[r];
-          out.cos_azimuth = table.direction[2 * r];
-          out.sin_azimuth = table.direction[2 * r + 1];
+        if (table) {  // the receiver's period: its ground length and terms
+          period_ground = table->length[r];
+          out.cos_azimuth = table->terms[4 * r];
+          out.sin_azimuth = table->terms[4 * r + 1];
+          out.weight = table->terms[4 * r + 2];
         }
         const float near = nearRise(h, width, height, c, r, s.height, d.a, d.b);
         const bool has_far = s.occluder_run > 0.0f, has_near = !std::isnan(near);
@@ -179,12 +185,14 @@ void naiveReference(const HeightField& field, const PreparedHeights& prepared, c
   const auto& h = prepared.heights;
   const auto normals = pixelNormals(field, h, outputs.ambient_occlusion);
   const auto directions = runDirections(field, options);
+  const std::vector<RowTable> tables =
+      hasRowSpacing(field) ? rayRowTables(field, directions) : std::vector<RowTable>(1);
   for (int k = 0; k < options.directions; ++k) {
     const SweepDirection& d = directions[k];
     DirectionOutputs out{d.cos_azimuth, d.sin_azimuth, static_cast<float>(1.0 / options.directions), k};
     // Per-row spacing: the ray's ground length summed step by step (horizon_naive's row_ground_at).
     const bool rows = hasRowSpacing(field);
-    const RayRowTable table = rows ? rayRowTable(field, d) : RayRowTable{};
+    const RowTable& table = tables[rows ? k : 0];
     auto groundAt = [&](float y) {
       const float clamped = std::clamp(y, 0.0f, static_cast<float>(height - 1));
       const int r0 = static_cast<int>(clamped), r1 = std::min(r0 + 1, height - 1);
@@ -225,8 +233,9 @@ void naiveReference(const HeightField& field, const PreparedHeights& prepared, c
             rows ? best_along : static_cast<float>(best_step) * d.step_length * d.ground_per_pixel;
         const float distance = best_step > 0 ? ground : 0.0f;
         if (rows) {
-          out.cos_azimuth = table.direction[2 * r];
-          out.sin_azimuth = table.direction[2 * r + 1];
+          out.cos_azimuth = table.terms[4 * r];
+          out.sin_azimuth = table.terms[4 * r + 1];
+          out.weight = table.terms[4 * r + 2];
         }
         emitDirection(result, pixel, std::isnan(hp), best_step > 0, best_rise, ground, distance, out,
                       normals);
@@ -242,7 +251,7 @@ std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, cons
                                                   const LatticeDirection& d,
                                                   const std::vector<LatticeSample>& samples,
                                                   const LatticeLine& line, float drop, const LatticeWindow& window,
-                                                  const LatticeRowTable* rows) {
+                                                  const RowTable* rows) {
   const int width = field.width, height = field.height;
   const float period = static_cast<float>(d.period);
   const float inv_period = 1.0f / period;

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "hfvis/height_field.hpp"
+#include "horizon_common.hpp"
 #include "intervisibility_internal.hpp"
 #include "lattice_geometry.hpp"
 
@@ -30,13 +31,14 @@ struct LatticeLineSample {
 // horizon_lattice with HFVIS_MAX_DISTANCE: the receivers' occluders are the steepest samples
 // within the window (occluder 0 where it lies in the block before the receiver's); the other
 // samples' occluders are those of their own block only. With per-row spacing (`rows`, the
-// direction's latticeRowTable) positions are ground lengths, as HFVIS_ROW_SPACING makes them.
+// direction's latticeRowTables entry) positions are ground lengths, as HFVIS_ROW_SPACING makes
+// them.
 std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, const std::vector<float>& h,
                                                   const LatticeDirection& d,
                                                   const std::vector<LatticeSample>& samples,
                                                   const LatticeLine& line, float drop = 0.0f,
                                                   const LatticeWindow& window = {},
-                                                  const LatticeRowTable* rows = nullptr);
+                                                  const RowTable* rows = nullptr);
 
 // lattice_height in the kernels: the bilinear height of sample s whose cell corner is at
 // entry `at` (right = 1 or 0, down = width or 0), over the valid corners.

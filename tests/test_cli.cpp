@@ -1355,7 +1355,7 @@ TEST_F(CliGeoTiff, GeographicInputStaysGeographic) {
 // A tall latitude / longitude grid (1 degree cells, rows centred on 65 .. 55 N): a wall 4 cells
 // east of the receivers is seen from 4 times each row's own east-west spacing on the WGS84
 // ellipsoid (47.2 km per cell at 65 N, 64.0 km at 55 N), not the centre row's. A maximum
-// distance is refused there, and viewcount says it takes the centre row's spacing.
+// distance is refused there, and viewcount says it takes the centre latitude's spacing.
 TEST_F(Cli, GeographicGridTakesEachRowsSpacing) {
   const int width = 8, height = 11;
   std::vector<float> values(width * height, 0.0f);
@@ -1379,7 +1379,7 @@ TEST_F(Cli, GeographicGridTakesEachRowsSpacing) {
                 "per-row spacing");
   const CliResult counts = run("viewcount " + shellQuoted(tif) + " -o " + shellQuoted(out("v.exr")) + " -k 4 -q");
   ASSERT_EQ(counts.status, 0) << counts.err;
-  EXPECT_NE(counts.err.find("takes the centre row's cell size"), std::string::npos) << counts.err;
+  EXPECT_NE(counts.err.find("takes the centre latitude's cell size"), std::string::npos) << counts.err;
 }
 
 }  // namespace

@@ -167,6 +167,29 @@ TEST_P(HorizonAnalytic, PerRowSpacingSetsEachRowsGroundDistances) {
   }
 }
 
+// Occlusion on a latitude / longitude-like grid: the top half's rows are 1 wide, the bottom
+// half's 2 (its centre row, whose size the field carries, among them). The surface rises 0.5 per
+// column, so in the top half it is a plane of slope 0.5 in ground units, which flattens beyond
+// the kink: unoccluded, occlusion 1, only if the normals take each row's own spacing.
+TEST_P(HorizonAnalytic, OcclusionNormalsTakeEachRowsSpacing) {
+  HeightField field = makeSyntheticField("flat", 33, 80);
+  for (int row = 0; row < field.height; ++row) {
+    for (int c = 0; c < field.width; ++c) field.heights[row * field.width + c] = 0.5f * c;
+    field.row_cell_size_x.push_back(row < 40 ? 1.0 : 2.0);
+    field.row_cell_size_y.push_back(1.0);
+  }
+  field.cell_size_x = field.row_cell_size_x[40];
+  field.cell_size_y = 1.0;
+  HorizonOutputs outputs;
+  outputs.ambient_occlusion = true;
+  const auto r = run(field, 64, outputs);
+  for (int row = 4; row < 36; ++row) {
+    for (int c = 4; c < 20; ++c) {  // far enough from the uphill edge for every ray to meet samples
+      EXPECT_NEAR(r.ambient_occlusion[row * field.width + c], 1.0, 2e-3) << c << "," << row;
+    }
+  }
+}
+
 // The same wall over a curved Earth (drop c d^2 at ground distance d): its top is seen at
 // atan((z * 10 - c d^2) / d), d = cell_x * (30 - c), still from the foot of its top (the
 // farther wall lies lower still). c is large enough to halve the nearest elevations. Right in

@@ -438,7 +438,7 @@ TEST_F(ImageIoTest, GeoTiffGeographicDegreesBecomeMetres) {
 
 // A tall latitude / longitude grid (1 degree cells, rows centred on 65 .. 55 N) gets each row's
 // own spacing on the WGS84 ellipsoid: along columns from about 47.2 km at 65 N to 64.0 km at
-// 55 N (55.80 km at 60 N), along rows about 111.4 km; the field's cell size is the centre row's.
+// 55 N (55.80 km at 60 N), along rows about 111.4 km; the field's cell size is the centre latitude's (row 5's).
 TEST_F(ImageIoTest, GeoTiffGeographicRowsGetTheirOwnSpacing) {
   GeoTiffSpec g;
   g.width = 3;

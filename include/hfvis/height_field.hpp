@@ -39,8 +39,9 @@ struct HeightField {
   double cell_size_y = 1.0;    // ground units per pixel along rows
   // Per-row spacing (latitude / longitude grids, whose east-west spacing shrinks with
   // latitude): empty, or one entry per row, row r's cell sizes; cell_size_x/y are then those
-  // of the centre row. The horizon operation (horizon angles and distances, sky-view factor,
-  // occlusion) measures ground lengths along its lines and rays step by step with them;
+  // at the centre latitude. The horizon operation (horizon angles and distances, sky-view
+  // factor, occlusion) measures ground lengths along its lines and rays step by step with
+  // them, and takes each row's normals, step directions and quadrature weights from them;
   // intervisibility, the horizon lists and the bounce take cell_size_x/y for the whole field.
   std::vector<double> row_cell_size_x, row_cell_size_y;
   double z_scale = 1.0;        // multiplies every height

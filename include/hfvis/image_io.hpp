@@ -17,8 +17,9 @@ struct HeightFieldReadOptions {
   // else a channel name ("Y", "R", "height") or a zero-based index ("0").
   std::string channel;
   // Ground units per pixel; <= 0 = take it from the file (a raster's geotransform, geographic
-  // degrees converted to metres at the field's centre latitude, else the hfvis:cell_size_x/y
-  // attributes that hfvis and data/make_data.py write) or 1.
+  // degrees converted to metres at each row's latitude and at the centre latitude for the
+  // field's own cell size, else the hfvis:cell_size_x/y attributes that hfvis and
+  // data/make_data.py write) or 1. Given cell sizes make no per-row spacing.
   double cell_size_x = 0.0;
   double cell_size_y = 0.0;
   double z_scale = 1.0;
@@ -30,7 +31,8 @@ struct HeightFieldReadOptions {
 // Reads a height field. Georeferenced rasters (.tif/.tiff, .hgt, .asc, .vrt, .img, .bil, .dem,
 // .grd, .adf, by extension in any case) go through GDAL: the band (a zero-based index or a band
 // description) is read, its nodata value becomes NaN, the cell size comes from the
-// geotransform (geographic degrees in metres at the centre latitude), the geotransform and CRS
+// geotransform (geographic degrees in metres on WGS84: per row in row_cell_size_x/y, at the
+// centre latitude in cell_size_x/y), the geotransform and CRS
 // fill `georeference`, and a rotated or sheared geotransform is an IoError. Everything else
 // (EXR, PNG 8/16-bit, ...) goes through OpenImageIO, without georeference; TIFF bytes under
 // another extension too (no GeoTIFF tags are read then). Integer pixels are converted to their
