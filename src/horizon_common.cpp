@@ -25,8 +25,20 @@ namespace detail {
 
 bool hasRowSpacing(const HeightField& field) { return !field.row_cell_size_x.empty(); }
 
+namespace {
+
+// One row of a table: the ground length, and the terms of ground azimuth `azimuth` and weight.
+void appendRow(RowTable& t, double length, double azimuth, double weight) {
+  const float w = static_cast<float>(weight);
+  t.length.push_back(static_cast<float>(length));
+  t.terms.insert(t.terms.end(),
+                 {static_cast<float>(std::cos(azimuth)), static_cast<float>(std::sin(azimuth)), w, swathFactor(w)});
+}
+
+}  // namespace
+
 std::vector<RowTable> latticeRowTables(const HeightField& field, const std::vector<LatticeDirection>& directions,
-                                              bool quadrature) {
+                                       bool quadrature) {
   const std::size_t K = directions.size();
   std::vector<RowTable> tables(K);
   std::vector<LatticeDirection> at_row = directions;
@@ -43,13 +55,7 @@ std::vector<RowTable> latticeRowTables(const HeightField& field, const std::vect
       at_row[k].weight = d.weight;
     }
     if (quadrature && K > 1) setQuadratureWeights(at_row);
-    for (std::size_t k = 0; k < K; ++k) {
-      RowTable& t = tables[k];
-      const float weight = static_cast<float>(at_row[k].weight);
-      t.length.push_back(static_cast<float>(lengths[k]));
-      t.terms.insert(t.terms.end(), {static_cast<float>(std::cos(at_row[k].azimuth)),
-                                     static_cast<float>(std::sin(at_row[k].azimuth)), weight, swathFactor(weight)});
-    }
+    for (std::size_t k = 0; k < K; ++k) appendRow(tables[k], lengths[k], at_row[k].azimuth, at_row[k].weight);
   }
   return tables;
 }
@@ -65,13 +71,7 @@ std::vector<RowTable> rayRowTables(const HeightField& field, const std::vector<S
       azimuths[k] = std::atan2(gy, gx);
     }
     const std::vector<double> weights = halfGapWeights(azimuths);
-    for (std::size_t k = 0; k < K; ++k) {
-      RowTable& t = tables[k];
-      const float weight = static_cast<float>(weights[k]);
-      t.length.push_back(static_cast<float>(lengths[k]));
-      t.terms.insert(t.terms.end(), {static_cast<float>(std::cos(azimuths[k])), static_cast<float>(std::sin(azimuths[k])),
-                                     weight, swathFactor(weight)});
-    }
+    for (std::size_t k = 0; k < K; ++k) appendRow(tables[k], lengths[k], azimuths[k], weights[k]);
   }
   return tables;
 }

@@ -47,7 +47,7 @@ struct RowTable {
   std::vector<float> terms;   // four per row: cos, sin, weight, swath
 };
 std::vector<RowTable> latticeRowTables(const HeightField& field, const std::vector<LatticeDirection>& directions,
-                                              bool quadrature);
+                                       bool quadrature);
 
 // The same for the naive march (horizon_naive with HFVIS_ROW_SPACING), one table per ray
 // direction: per row r, the ground length per pixel along the ray with row r's cell sizes, and
