@@ -63,17 +63,17 @@
 // The normal at pixel (c, r), the sum of the unnormalised normals of the (up to) four quads
 // around it (Timonen & Westerholm 2010, Sec. 7) in ground units, divided by its z: the normal
 // is (x, y, 1) / |(x, y, 1)|, and (x, y) its slopes. Quads touching nodata or the border are
-// left out; (0, 0) when none is left.
-HFVIS_INLINE float2 surface_slopes(__global const float* heights, int width, int height, int c, int r, float h,
-                                   float cell_x, float cell_y) {
+// left out; (0, 0) when none is left. `heights` holds the field's rows from row0 on.
+HFVIS_INLINE float2 surface_slopes(__global const float* heights, int width, int height, int row0, int c, int r,
+                                   float h, float cell_x, float cell_y) {
   // Straight-line scalar code (clamped reads, masked sums) so that PoCL vectorises callers.
   float sx_sum = 0.0f, sy_sum = 0.0f, sz_sum = 0.0f;
   for (int q = 0; q < 4; ++q) {
     int sx = (q & 1) ? 1 : -1, sy = (q & 2) ? 1 : -1;
     int cx = c + sx, ry = r + sy;
     int inside = cx >= 0 && cx < width && ry >= 0 && ry < height;
-    float hx = heights[r * width + clamp(cx, 0, width - 1)];
-    float hy = heights[clamp(ry, 0, height - 1) * width + c];
+    float hx = heights[(r - row0) * width + clamp(cx, 0, width - 1)];
+    float hy = heights[(clamp(ry, 0, height - 1) - row0) * width + c];
     float gx = (hx - h) / ((float)sx * cell_x);
     float gy = (hy - h) / ((float)sy * cell_y);
     int use = inside && !isnan(hx) && !isnan(hy);
@@ -89,18 +89,21 @@ HFVIS_INLINE float2 surface_slopes(__global const float* heights, int width, int
 // occlusion. ambient_term is linear in the normal (its arctangent argument and its test
 // are ratios), so the sweep passes (x, y, 1) and occlusion_scale divides the sum by
 // |(x, y, 1)| once at the end. With HFVIS_ROW_SPACING each row takes its own cell sizes,
-// row_cells[r] (else cell_x, cell_y). Global size: (W, H) rounded up.
-__kernel void pixel_normals(__global const float* heights, int width, int height, float cell_x, float cell_y,
-                            __global const float2* row_cells, __global float2* normals) {
-  int c = get_global_id(0), r = get_global_id(1);
-  if (c >= width || r >= height) return;
-  const uint pixel = (uint)(r * width + c);
+// row_cells[r] (else cell_x, cell_y). The normals of rows out_row0 .. out_row0 + rows - 1
+// (a strip, see horizon_lattice), from heights that hold the field's rows from row0 on (the
+// strip's and the rows around it). Global size: (W, rows) rounded up.
+__kernel void pixel_normals(__global const float* heights, int width, int height, int row0, int out_row0,
+                            int rows, float cell_x, float cell_y, __global const float2* row_cells,
+                            __global float2* normals) {
+  const int c = get_global_id(0), strip_row = get_global_id(1), r = out_row0 + strip_row;
+  if (c >= width || strip_row >= rows) return;
 #if HFVIS_ROW_SPACING
   const float2 cells = row_cells[r];
   cell_x = cells.x;
   cell_y = cells.y;
 #endif
-  normals[pixel] = surface_slopes(heights, width, height, c, r, heights[pixel], cell_x, cell_y);
+  normals[(uint)(strip_row * width + c)] =
+      surface_slopes(heights, width, height, row0, c, r, heights[(r - row0) * width + c], cell_x, cell_y);
 }
 
 // The occlusion sums of normals (x, y, 1) made those of the unit normals. Global size: pixels
@@ -133,6 +136,7 @@ typedef int lane_int;
 #define LANE(v, l) (v)
 #define ILANE(v, l) (v)
 #define ANY_LANE(m) ((m) != 0)
+#define LANE_FLOAT(v) ((float)(v))
 #elif HFVIS_LANES == 8
 typedef float8 lane_float;
 typedef int8 lane_int;
@@ -140,6 +144,7 @@ typedef int8 lane_int;
 #define ILANE(v, l) (((__private int*)&(v))[l])
 HFVIS_INLINE int any_lane(int8 m) { return as_ulong(convert_char8(m)) != 0; }
 #define ANY_LANE(m) any_lane(m)
+#define LANE_FLOAT(v) convert_float8(v)
 #else
 #error "HFVIS_LANES must be 1 or 8"
 #endif
@@ -227,13 +232,13 @@ HFVIS_INLINE void emit_lanes(lane_int live, lane_int pixel, lane_int nodata, lan
 // surface's directional derivative into the first cell, from each receiver's height h and
 // its neighbours along the two axes, as a rise over the period |(a, b)| (the caller's run).
 // NaN where the ray leaves the field at once or a needed neighbour is nodata; lanes not
-// `live` read pixel 0.
-HFVIS_INLINE lane_float near_rise(__global const float* heights, int width, int height, lane_int live,
+// `live` read the buffer's first height. `heights` holds the field's rows from row0 on.
+HFVIS_INLINE lane_float near_rise(__global const float* heights, int width, int height, int row0, lane_int live,
                                   lane_int c, lane_int r, lane_float h, int a, int b) {
   const int sx = a > 0 ? 1 : (a < 0 ? -1 : 0), sy = b > 0 ? 1 : (b < 0 ? -1 : 0);
   const lane_int leaves = (c + sx < 0) | (c + sx >= width) | (r + sy < 0) | (r + sy >= height);
-  const lane_int x_at = select((lane_int)0, r * width + clamp(c + sx, 0, width - 1), live);
-  const lane_int y_at = select((lane_int)0, clamp(r + sy, 0, height - 1) * width + c, live);
+  const lane_int x_at = select((lane_int)0, (r - row0) * width + clamp(c + sx, 0, width - 1), live);
+  const lane_int y_at = select((lane_int)0, (clamp(r + sy, 0, height - 1) - row0) * width + c, live);
   lane_float hx, hy;
 #pragma unroll
   for (int l = 0; l < HFVIS_LANES; ++l) {
@@ -246,16 +251,17 @@ HFVIS_INLINE lane_float near_rise(__global const float* heights, int width, int 
 
 // The height of lattice sample s for the lanes' period receivers at (c, r): `ok` are the lanes
 // that take it (live, and inside the field where `edge`: only the first period of a line can
-// reach outside it); *valid: those with a height. Lanes without the sample read pixel 0 alone
-// (their cell may lie outside the field).
-HFVIS_INLINE lane_float lane_sample_height(__global const float* heights, int width, int height,
+// reach outside it); *valid: those with a height. Lanes without the sample read the buffer's
+// first height alone (their cell may lie outside the field). `heights` holds the field's rows
+// from row0 on.
+HFVIS_INLINE lane_float lane_sample_height(__global const float* heights, int width, int height, int row0,
                                            __global const LatticeSample* s, lane_int c, lane_int r, lane_int ok,
                                            int edge, lane_int* valid) {
   const int ex = s->ex, ey = s->ey;
   const float w00 = s->w00, w10 = s->w10, w01 = s->w01, w11 = s->w11;
   const lane_int x0 = c + s->ox, y0 = r + s->oy;
   if (edge) ok = ok & (x0 >= 0) & (x0 + ex <= width - 1) & (y0 >= 0) & (y0 + ey <= height - 1);
-  const lane_int at = select((lane_int)0, y0 * width + x0, ok);
+  const lane_int at = select((lane_int)0, (y0 - row0) * width + x0, ok);
   const lane_int right = select((lane_int)0, (lane_int)ex, ok);
   const lane_int down = select((lane_int)0, (lane_int)(ey * width), ok);
   lane_float h;
@@ -370,7 +376,7 @@ HFVIS_INLINE void hull_step(__global float2* stacks, lane_int stack, int entry, 
 // decided in float arithmetic: by block membership (position * inv_window) in the forward
 // sweep and by x - here <= window here, so a sample within rounding of the window's length
 // (relative 1e-7) may go either way.
-HFVIS_INLINE void window_pass(__global const float* heights, int width, int height,
+HFVIS_INLINE void window_pass(__global const float* heights, int width, int height, int row0, int out_row0,
                               __global const LatticeSample* samples, int n_samples, int a, int b, float period,
                               float window, float inv_window, float drop, lane_int c, lane_int r,
                               lane_int receivers, lane_int stack, int entry, int i, int q, int k, int trips,
@@ -387,7 +393,7 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
       const float here = (float)ci * period - s->tau;
       if ((int)floor(here * inv_window) != k - 1 || x - here > window) break;
       lane_int valid;
-      const lane_float h = lane_sample_height(heights, width, height, s, c - (ci - i) * a, r - (ci - i) * b,
+      const lane_float h = lane_sample_height(heights, width, height, row0, s, c - (ci - i) * a, r - (ci - i) * b,
                                               ci < receivers, ci == 0, &valid);
       hull_step(stacks, stack, entry, valid, HFVIS_STACK_HEIGHT(h, here), (lane_float)here, -1.0f, &n, &top_h,
                 &top_p, &below_h, &below_p, &rise, &run);
@@ -395,10 +401,12 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
     }
     // The tangent from receiver j: the peak of the slopes along the stack (entry 0 nearest).
     const lane_int live = j < receivers;
-    const lane_int pixel = select((lane_int)0, (r - (j - i) * b) * width + (c - (j - i) * a), live);
+    const lane_int jr = r - (j - i) * b, jc = c - (j - i) * a;
+    const lane_int at = select((lane_int)0, (jr - row0) * width + jc, live);
+    const lane_int pixel = select((lane_int)0, (jr - out_row0) * width + jc, live);
     lane_float hx;
 #pragma unroll
-    for (int l = 0; l < HFVIS_LANES; ++l) LANE(hx, l) = heights[ILANE(pixel, l)];
+    for (int l = 0; l < HFVIS_LANES; ++l) LANE(hx, l) = heights[ILANE(at, l)];
     const lane_float hs = HFVIS_STACK_HEIGHT(hx, x);
     lane_int lo = 0, hi = n - 1;
     lane_int searching = live & (lo < hi);
@@ -435,36 +443,56 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
 #endif
 
 // The sweep of one direction (a, b): lines j = lanes * work-item + lane, each from its far
-// end toward -(a, b), in lock step (a lane whose line has ended is masked). Line j's farthest
-// receiver is lines[j] = (col, row, receivers, stack); receiver i sits at (col - i a, row - i b).
-// Per receiver, the period's samples farther along the line come first (samples[0 ..
-// n_samples - 2], farthest first), then the receiver itself (the last sample: tau 0, weight
-// 1 on its own pixel). Each sample is one step of Algorithm 1 (hull_step); the top that
-// remains before the push is its horizon occluder. Samples outside the field or without
-// height are absent. Stack entry k of a line is (height, position along the line in pixels
-// from its far end) at stacks[line.w + k stride]; the capacity is every sample of its
-// periods. period_ground = period * ground_per_pixel, the ground length of a period. With
-// HFVIS_MAX_DISTANCE only samples within `window` pixels (inv_window = 1 / window) count
-// (window_pass; window_far: one (rise, run) per pixel). With HFVIS_ROW_SPACING positions are
-// ground lengths: row_length[r] is the ground length of the period from a receiver in row r to
-// the next one along +(a, b), row_terms[r] that period's unit ground direction (x, y), weight
-// and swath (they replace cos_azimuth, sin_azimuth, weight and swath), drop is per ground unit
-// squared, and ground_per_pixel is 1 (period_ground is unused). Preconditions: lines of this launch only; stride 1 (line-major) or
-// the launch's line count (step-major). Global size: ceil(n_lines / HFVIS_LANES) rounded up to
-// the local size.
-__kernel void horizon_lattice(__global const float* heights, int width, int height,
+// end toward -(a, b), in lock step (a lane whose line has ended is masked). Line j of this
+// launch is lines[j] = (col, row, receivers, stack): its first receiver here at (col, row),
+// its t-th at (col - t a, row - t b), for t < receivers. Per receiver, the period's samples
+// farther along the line come first (samples[0 .. n_samples - 2], farthest first), then the
+// receiver itself (the last sample: tau 0, weight 1 on its own pixel). Each sample is one step
+// of Algorithm 1 (hull_step); the top that remains before the push is its horizon occluder.
+// Samples outside the field or without height are absent. Stack entry k of a line is (height,
+// position along the line in pixels from its far end) at stacks[line.w + k stride]; the
+// capacity is every sample of its periods here plus the entries it arrives with.
+// period_ground = period * ground_per_pixel, the ground length of a period.
+//
+// Strips (a field beyond the device's memory, src/horizon.cpp): `heights` holds the field's
+// rows from row0 on and the outputs (normals, planes, sums, window_far) its rows from out_row0
+// on. With `carried`, line j resumes its whole line's sweep: line_state[j] = (index of its
+// first receiver here along the whole line, entries of the stack it arrives with, their offset
+// in carry_in, the receivers' ground position before it as float bits (HFVIS_ROW_SPACING));
+// the kernel copies those entries into its stack, and on leaving writes the stack's size into
+// .y and the ground position into .w (carry_out then moves the stacks on). Without, every line
+// starts at its far end with an empty stack and line_state is not read.
+//
+// With HFVIS_MAX_DISTANCE only samples within `window` pixels (inv_window = 1 / window) count
+// (window_pass; window_far: one (rise, run) per pixel; lines start at their far end). With
+// HFVIS_ROW_SPACING positions are ground lengths: row_length[r] is the ground length of the
+// period from a receiver in row r to the next one along +(a, b), row_terms[r] that period's
+// unit ground direction (x, y), weight and swath (they replace cos_azimuth, sin_azimuth, weight
+// and swath), drop is per ground unit squared, and ground_per_pixel is 1 (period_ground is
+// unused). Preconditions: lines of this launch only; stride 1 (line-major) or the launch's line
+// count (step-major). Global size: ceil(n_lines / HFVIS_LANES) rounded up to the local size.
+__kernel void horizon_lattice(__global const float* heights, int width, int height, int row0, int out_row0,
                               __global const int4* lines, int n_lines, __global const LatticeSample* samples,
                               int n_samples, int a, int b, float period, float ground_per_pixel,
                               float period_ground, float drop, float window, float inv_window,
                               __global const float* row_length, __global const float4* row_terms,
                               float cos_azimuth,
                               float sin_azimuth, float weight, float swath, uint plane, __global float2* stacks,
-                              uint stride, __global float2* window_far, __global const float2* normals,
+                              uint stride, int carried, __global int4* line_state, __global const float2* carry_in,
+                              __global float2* window_far, __global const float2* normals,
                               __global float* angles, __global float* distances, __global float* svf_sum,
                               __global float* ao_sum) {
   const int first = get_global_id(0) * HFVIS_LANES;
   if (first >= n_lines) return;
+  const int entry = (int)stride;  // between a line's consecutive stack entries
   lane_int c, r, receivers, stack;
+  lane_int start = 0;             // the first receiver's index along the whole line
+  lane_int n = 0;                 // stack sizes
+  lane_float top_h = 0.0f, top_p = 0.0f, below_h = 0.0f, below_p = 0.0f, rise = 0.0f, run = 0.0f;
+#if HFVIS_ROW_SPACING
+  const float inv_period = 1.0f / period;
+  lane_float base = 0.0f;  // the receivers' ground position along their lines
+#endif
   int trips = 0;  // the longest line's receivers
 #pragma unroll
   for (int l = 0; l < HFVIS_LANES; ++l) {
@@ -475,19 +503,33 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
     ILANE(stack, l) = line.w;
     trips = max(trips, ILANE(receivers, l));
   }
-  const int entry = (int)stride;  // between a line's consecutive stack entries
-  lane_int n = 0;                 // stack sizes
-  lane_float top_h = 0.0f, top_p = 0.0f, below_h = 0.0f, below_p = 0.0f, rise = 0.0f, run = 0.0f;
+  if (carried) {
+#pragma unroll
+    for (int l = 0; l < HFVIS_LANES; ++l) {
+      if (first + l >= n_lines) continue;
+      const int4 state = line_state[first + l];
+      const int depth = state.y;
+      for (int k = 0; k < depth; ++k) stacks[ILANE(stack, l) + k * entry] = carry_in[state.z + k];
+      const float2 top = depth > 0 ? carry_in[state.z + depth - 1] : (float2)(0.0f, 0.0f);
+      const float2 below = depth > 1 ? carry_in[state.z + depth - 2] : (float2)(0.0f, 0.0f);
+      ILANE(start, l) = state.x;
+      ILANE(n, l) = depth;
+      LANE(top_h, l) = top.x;
+      LANE(top_p, l) = top.y;
+      LANE(below_h, l) = below.x;
+      LANE(below_p, l) = below.y;
+#if HFVIS_ROW_SPACING
+      LANE(base, l) = as_float(state.w);
+#endif
+    }
+  }
 #if HFVIS_MAX_DISTANCE
   int block = INT_MIN;  // the block of the stack's samples (none yet)
   int far_part = 0;     // whether window_pass gave this block's receivers the block before
 #endif
-#if HFVIS_ROW_SPACING
-  const float inv_period = 1.0f / period;
-  lane_float base = 0.0f;  // the receivers' ground position along their lines
-#endif
   for (int i = 0; i < trips; ++i, c -= a, r -= b) {
     const lane_int live = i < receivers;
+    const lane_int along = start + i;  // the receivers' index along their whole lines
 #if HFVIS_ROW_SPACING
     // The period from the receivers toward +(a, b): its ground length and terms by row.
     lane_float period_length, cos_az, sin_az, weight_l, swath_l;
@@ -501,11 +543,15 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
       LANE(weight_l, l) = terms.z;
       LANE(swath_l, l) = terms.w;
     }
-    if (i > 0) base += period_length;
+    base = select(base, base + period_length, live & (along > 0));  // kept where a line has ended (carried)
     const lane_float tau_scale = period_length * inv_period;  // ground length per pixel of tau
     const lane_float period_ground_l = period_length;
+#elif HFVIS_MAX_DISTANCE
+    const float base = (float)i * period;  // every line starts at its far end: along = i
 #else
-    const float base = (float)i * period;  // the receivers' position along their lines
+    const lane_float base = LANE_FLOAT(along) * period;  // the receivers' position along their lines
+#endif
+#if !HFVIS_ROW_SPACING
     const lane_float cos_az = (lane_float)cos_azimuth, sin_az = (lane_float)sin_azimuth;
     const lane_float weight_l = (lane_float)weight, swath_l = (lane_float)swath;
     const lane_float period_ground_l = (lane_float)period_ground;
@@ -516,21 +562,24 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 #if HFVIS_ROW_SPACING
       const lane_float here = base - s->tau * tau_scale;
 #else
-      const float here = base - s->tau;
+      const lane_float here = base - s->tau;
 #endif
 #if HFVIS_MAX_DISTANCE
-      const int sample_block = (int)floor(here * inv_window);
+      const int sample_block = (int)floor(LANE(here, 0) * inv_window);
       if (sample_block != block) {
         far_part = block != INT_MIN;
         if (far_part)
-          window_pass(heights, width, height, samples, n_samples, a, b, period, window, inv_window, drop, c, r,
-                      receivers, stack, entry, i, q, sample_block, trips, stacks, window_far);
+          window_pass(heights, width, height, row0, out_row0, samples, n_samples, a, b, period, window,
+                      inv_window, drop, c, r, receivers, stack, entry, i, q, sample_block, trips, stacks,
+                      window_far);
         block = sample_block;
         n = 0;
       }
 #endif
       lane_int valid;
-      h = lane_sample_height(heights, width, height, s, c, r, live, i == 0, &valid);
+      // Only a line's first period can reach outside the field (a later one lies between two
+      // receivers); testing every lane's first period here costs the same and changes nothing.
+      h = lane_sample_height(heights, width, height, row0, s, c, r, live, i == 0, &valid);
 #if HFVIS_CURVATURE
       // The Earth's drop below the receiver p, drop (p - here)^2, is a parabola along the line:
       // subtracting drop * here^2 from every sample instead changes every slope from p by the
@@ -539,8 +588,8 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 #else
       const lane_float hs = h;
 #endif
-      hull_step(stacks, stack, entry, valid, hs, (lane_float)here, 1.0f, &n, &top_h, &top_p, &below_h, &below_p,
-                &rise, &run);
+      hull_step(stacks, stack, entry, valid, hs, here, 1.0f, &n, &top_h, &top_p, &below_h, &below_p, &rise,
+                &run);
     }
 #if HFVIS_MAX_DISTANCE
     if (far_part) {
@@ -549,7 +598,7 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
       lane_float rise2, run2;
 #pragma unroll
       for (int l = 0; l < HFVIS_LANES; ++l) {
-        const float2 f = window_far[ILANE(live, l) ? (uint)(ILANE(r, l) * width + ILANE(c, l)) : 0u];
+        const float2 f = window_far[ILANE(live, l) ? (uint)((ILANE(r, l) - out_row0) * width + ILANE(c, l)) : 0u];
         LANE(rise2, l) = f.x;
         LANE(run2, l) = f.y;
       }
@@ -562,7 +611,7 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
     // occluder and the limit at the receiver, compared without a division (both runs are
     // positive); the occluder wins ties (it is the farther point casting that elevation).
     // With curvature the near limit is unchanged (the drop is of second order in distance).
-    const lane_float near = near_rise(heights, width, height, live, c, r, h, a, b);
+    const lane_float near = near_rise(heights, width, height, row0, live, c, r, h, a, b);
     const lane_float ground = run * ground_per_pixel;
 #if HFVIS_CURVATURE
     const lane_float far_rise = rise - 2.0f * drop * base * run;
@@ -577,10 +626,34 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 #else
     const lane_int nodata = 0;
 #endif
-    emit_lanes(live, r * width + c, nodata, has_far | has_near, select(far_rise, near, use_near),
+    emit_lanes(live, (r - out_row0) * width + c, nodata, has_far | has_near, select(far_rise, near, use_near),
                select(ground, period_ground_l, use_near), distance, cos_az, sin_az, weight_l, swath_l, plane,
                normals, angles, distances, svf_sum, ao_sum);
   }
+  if (carried) {
+#pragma unroll
+    for (int l = 0; l < HFVIS_LANES; ++l) {
+      if (first + l >= n_lines) continue;
+      __global int4* state = line_state + first + l;
+      state->y = ILANE(n, l);
+#if HFVIS_ROW_SPACING
+      state->w = as_int(LANE(base, l));
+#endif
+    }
+  }
+}
+
+// The hull stacks that lines take on into the next strip (see horizon_lattice): line j's
+// line_state[j].y entries from stacks[lines[j].w + k stride] to carry_out[offsets[j] + k];
+// lines with offsets[j] < 0 end in this strip. One work-item per line. Global size: n_lines
+// rounded up.
+__kernel void carry_stacks(__global const int4* lines, __global const int4* line_state,
+                           __global const int* offsets, int n_lines, __global const float2* stacks, uint stride,
+                           __global float2* carry_out) {
+  const int j = get_global_id(0);
+  if (j >= n_lines || offsets[j] < 0) return;
+  const int depth = line_state[j].y, stack = lines[j].w, at = offsets[j];
+  for (int k = 0; k < depth; ++k) carry_out[at + k] = stacks[stack + k * (int)stride];
 }
 
 #if HFVIS_ROW_SPACING

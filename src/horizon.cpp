@@ -52,12 +52,44 @@ struct RunDirection {
   std::vector<float> row_length, row_terms;
 };
 
-// How a run uses its device memory budget: directions per downloaded batch of planes and
-// the hull-stack scratch (entries) every launch of the sweep shares.
+// Rows a strip's heights take on each side beyond its own: a receiver's period reaches a step
+// (|b| <= kMaxLatticeStep rows) away, the normals one row.
+constexpr int kStripHalo = kMaxLatticeStep + 1;
+
+// How a run uses its device memory budget: directions per downloaded batch of planes, the
+// hull-stack scratch (entries) every launch of the sweep shares, and the strips.
 struct RunPlan {
   int directions_per_batch = 1;
   std::size_t stack_entries = 0;
+  int strip_rows = 0;             // rows per strip: the field's height when it runs in one piece
+  std::size_t carry_entries = 0;  // strips: entries each of the two buffers of carried stacks may take
 };
+
+// A field beyond the budget (or asked to): strips of as many rows as half the budget holds, the
+// rest for the hull stacks, a half of it for those carried from strip to strip.
+RunPlan planStrips(const HeightField& field, const HorizonOptions& options, const HorizonOutputs& outputs,
+                   std::size_t budget, std::size_t max_alloc) {
+  const std::size_t row = field.width * sizeof(float);
+  // Per row of a strip: heights, the sums, the normals' two slopes, one direction's planes.
+  const std::size_t per_row = row * (1 + outputs.sky_view_factor + outputs.ambient_occlusion * 3 +
+                                     outputs.horizon_angles + outputs.horizon_distances);
+  const std::size_t halo = 2 * kStripHalo * row;
+  std::size_t rows = budget / 2 > halo ? (budget / 2 - halo) / per_row : 0;
+  // The largest buffers: a strip's heights with its halo, and its normals.
+  rows = std::min({rows, max_alloc / row > 2 * kStripHalo ? max_alloc / row - 2 * kStripHalo : 0,
+                   max_alloc / (2 * row)});
+  if (options.strip_rows > 0) rows = std::min<std::size_t>(rows, options.strip_rows);
+  if (rows < 1)
+    throw MemoryBudgetError("a strip of one row needs " + mebibytes(2 * (per_row + halo)) +
+                            " of device memory but the budget is " + mebibytes(budget) +
+                            " (largest single buffer " + mebibytes(max_alloc) + "); raise the memory budget");
+  RunPlan plan;
+  plan.strip_rows = static_cast<int>(std::min<std::size_t>(rows, field.height));
+  const std::size_t rest = budget - (plan.strip_rows * per_row + halo);
+  plan.stack_entries = std::min(rest / 2, max_alloc) / kStackEntryBytes;
+  plan.carry_entries = std::min(rest / 4, max_alloc) / kStackEntryBytes;
+  return plan;
+}
 
 RunPlan planRun(const HeightField& field, const HorizonOptions& options, const HorizonOutputs& outputs,
                 const std::vector<RunDirection>& directions, const DeviceInfo& device) {
@@ -83,16 +115,20 @@ RunPlan planRun(const HeightField& field, const HorizonOptions& options, const H
       whole = std::max(whole, total);
     }
   }
-  auto fail = [&](std::size_t need) {
-    throw MemoryBudgetError("one direction needs " + mebibytes(need) +
-                            " of device memory but the budget is " + mebibytes(budget) +
-                            " (largest single buffer " + mebibytes(max_alloc) +
-                            "); raise the memory budget or use a smaller field");
-  };
   const std::size_t least = fixed + per_direction + longest * kStackEntryBytes;
-  if (least > budget || per_direction > max_alloc || longest * kStackEntryBytes > max_alloc) fail(least);
+  const bool fits = least <= budget && per_direction <= max_alloc && longest * kStackEntryBytes <= max_alloc &&
+                    fixed <= budget;
+  if (!fits || (options.strip_rows > 0 && options.strip_rows < field.height)) {
+    if (sweep && options.max_distance == 0.0) return planStrips(field, options, outputs, budget, max_alloc);
+    throw MemoryBudgetError("one direction needs " + mebibytes(least) + " of device memory but the budget is " +
+                            mebibytes(budget) + " (largest single buffer " + mebibytes(max_alloc) + "), and " +
+                            (sweep ? "a maximum distance" : "the naive method") +
+                            " needs the whole field at once (no strips); raise the memory budget or use a "
+                            "smaller field");
+  }
   const std::size_t available = budget - fixed;
   RunPlan plan;
+  plan.strip_rows = field.height;
   // Planes of up to kMaxDirectionsPerBatch directions, leaving the scratch at least half.
   const std::size_t stack_bytes = std::min(whole * kStackEntryBytes, max_alloc);
   const std::size_t for_planes =
@@ -155,66 +191,67 @@ class HorizonRoutine : public SweepRoutine {
  public:
   HorizonRoutine(ContextState& st, const HeightField& field, const HorizonOptions& options,
                  const HorizonOutputs& outputs)
-      : SweepRoutine(st, field, options), horizon_(options), outputs_(outputs) {}
+      : SweepRoutine(st, field, options),
+        horizon_(options),
+        outputs_(outputs),
+        lanes_(sweepLanes(st)),
+        directions_(runDirectionsOf(field, options, outputs)),
+        plan_(planRun(field, options, outputs, directions_, st.info)) {}
 
   HorizonResult take() { return std::move(result_); }
 
  private:
   std::string programFile() const override { return "horizon.cl"; }
   std::string programOptions() const override {
-    return detail::programOptions(outputs_, prepared_.has_nodata, sweepLanes(st_), horizon_.curvature != 0.0,
+    return detail::programOptions(outputs_, prepared_.has_nodata, lanes_, horizon_.curvature != 0.0,
                                   horizon_.max_distance > 0.0, hasRowSpacing(field_));
   }
+  bool heightsResident() const override { return !inStrips(); }
+  bool inStrips() const { return plan_.strip_rows < field_.height; }
 
   void allocate() override {
-    lanes_ = sweepLanes(st_);
-    directions_ = runDirectionsOf(field_, horizon_, outputs_);
-    const RunPlan plan = planRun(field_, horizon_, outputs_, directions_, st_.info);
-    batch_ = plan.directions_per_batch;
     result_ = allocateResult(field_, horizon_, outputs_);
     for (int k = 0; k < horizon_.directions; ++k) result_.azimuths[k] = directions_[k].lattice.azimuth;
-    const std::size_t plane = field_.pixelCount();
-    const std::size_t planes_bytes = plan.directions_per_batch * plane * sizeof(float);
+    // Device planes and sums cover a strip's rows (all of them in one piece).
+    const std::size_t plane = static_cast<std::size_t>(plan_.strip_rows) * field_.width;
+    const std::size_t planes_bytes = plan_.directions_per_batch * plane * sizeof(float);
     angles_ = st_.reusableBuffer("horizon angles", outputs_.horizon_angles ? planes_bytes : 0);
     distances_ = st_.reusableBuffer("horizon distances", outputs_.horizon_distances ? planes_bytes : 0);
     svf_ = zeros(outputs_.sky_view_factor ? plane : 0);
     ao_ = zeros(outputs_.ambient_occlusion ? plane : 0);
     normals_ = deviceBuffer(st_, outputs_.ambient_occlusion ? 2 * plane * sizeof(float) : 0);
-    stacks_ = st_.reusableBuffer("lattice stacks", plan.stack_entries * kStackEntryBytes);
+    stacks_ = st_.reusableBuffer("lattice stacks", plan_.stack_entries * kStackEntryBytes);
     const bool window = horizon_.method == HorizonMethod::Sweep && horizon_.max_distance > 0.0;
     window_far_ = deviceBuffer(st_, window ? 2 * plane * sizeof(float) : 0);
-    stack_entries_ = plan.stack_entries;
-    if (outputs_.ambient_occlusion) {
-      cl::Kernel normals(program_, "pixel_normals");
-      normals.setArg(0, heights_);
-      normals.setArg(1, field_.width);
-      normals.setArg(2, field_.height);
-      normals.setArg(3, static_cast<float>(field_.cell_size_x));
-      normals.setArg(4, static_cast<float>(field_.cell_size_y));
-      const cl::Buffer row_cells = rowCells();
-      normals.setArg(5, row_cells);
-      normals.setArg(6, normals_);
-      st_.launch(normals, cl::NDRange(roundUp(field_.width, kTileX), roundUp(field_.height, kTileY)),
-                 cl::NDRange(kTileX, kTileY));
+    placeholder_ = deviceBuffer(st_, 0);
+    row_cells_ = rowCells();
+    if (inStrips()) {
+      heights_ = deviceBuffer(
+          st_, std::min<std::size_t>(plan_.strip_rows + 2 * kStripHalo, field_.height) * field_.width * sizeof(float));
+    } else if (outputs_.ambient_occlusion) {
+      computeNormals(0, 0, field_.height);
     }
   }
 
   int directionCount() const override { return horizon_.directions; }
-  int batchSize() const override { return batch_; }
+  int batchSize() const override { return plan_.directions_per_batch; }
 
   void sweep(int k, int slot) override {
     const RunDirection& d = directions_[k];
     const bool planes = outputs_.horizon_angles || outputs_.horizon_distances;
     if (d.lattice.weight == 0.0 && !planes) return;  // merged into an equal step (latticeDirections)
     const cl_uint plane_offset = static_cast<cl_uint>(slot * field_.pixelCount());
-    if (horizon_.method == HorizonMethod::Sweep) {
-      launchSweep(d, plane_offset);
-    } else {
+    if (horizon_.method == HorizonMethod::Naive) {
       launchNaive(d, plane_offset);
+    } else if (inStrips()) {
+      sweepInStrips(d, k);
+    } else {
+      launchSweep(d, plane_offset);
     }
   }
 
   void endBatch(int first, int count) override {
+    if (inStrips()) return;  // each strip's planes came back with it
     const std::size_t plane = field_.pixelCount();
     const std::size_t batch_bytes = count * plane * sizeof(float), at = first * plane;
     if (outputs_.horizon_angles) st_.queue.enqueueReadBuffer(angles_, CL_TRUE, 0, batch_bytes, &result_.angles[at]);
@@ -223,18 +260,76 @@ class HorizonRoutine : public SweepRoutine {
   }
 
   void finish() override {
-    const std::size_t bytes = field_.pixelCount() * sizeof(float);
-    if (outputs_.sky_view_factor)
-      st_.queue.enqueueReadBuffer(svf_, CL_TRUE, 0, bytes, result_.sky_view_factor.data());
-    if (outputs_.ambient_occlusion) {
-      cl::Kernel scale(program_, "occlusion_scale");
-      scale.setArg(0, normals_);
-      scale.setArg(1, static_cast<cl_uint>(field_.pixelCount()));
-      scale.setArg(2, ao_);
-      st_.launch(scale, cl::NDRange(roundUp(field_.pixelCount(), kLineGroup)), cl::NDRange(kLineGroup));
-      st_.queue.enqueueReadBuffer(ao_, CL_TRUE, 0, bytes, result_.ambient_occlusion.data());
+    if (inStrips()) {
+      // The sums are on the host; occlusion's last pass runs strip by strip.
+      if (outputs_.ambient_occlusion) {
+        for (int s0 = 0; s0 < field_.height; s0 += plan_.strip_rows) {
+          const int s1 = std::min(field_.height, s0 + plan_.strip_rows);
+          loadStrip(s0, s1);
+          scaleOcclusion(s1 - s0);
+          readRows(ao_, result_.ambient_occlusion, s0, s1);
+        }
+      }
+    } else {
+      const std::size_t bytes = field_.pixelCount() * sizeof(float);
+      if (outputs_.sky_view_factor)
+        st_.queue.enqueueReadBuffer(svf_, CL_TRUE, 0, bytes, result_.sky_view_factor.data());
+      if (outputs_.ambient_occlusion) {
+        scaleOcclusion(field_.height);
+        st_.queue.enqueueReadBuffer(ao_, CL_TRUE, 0, bytes, result_.ambient_occlusion.data());
+      }
     }
     finishReduction(result_);
+  }
+
+  // The occlusion sums of the rows on the device made those of unit normals (occlusion_scale).
+  void scaleOcclusion(int rows) {
+    const std::size_t pixels = static_cast<std::size_t>(rows) * field_.width;
+    cl::Kernel scale(program_, "occlusion_scale");
+    scale.setArg(0, normals_);
+    scale.setArg(1, static_cast<cl_uint>(pixels));
+    scale.setArg(2, ao_);
+    st_.launch(scale, cl::NDRange(roundUp(pixels, kLineGroup)), cl::NDRange(kLineGroup));
+  }
+
+  // The normals of rows [s0, s1) from heights_, which holds the field's rows from row0 on.
+  void computeNormals(int row0, int s0, int s1) {
+    cl::Kernel normals(program_, "pixel_normals");
+    normals.setArg(0, heights_);
+    normals.setArg(1, field_.width);
+    normals.setArg(2, field_.height);
+    normals.setArg(3, row0);
+    normals.setArg(4, s0);
+    normals.setArg(5, s1 - s0);
+    normals.setArg(6, static_cast<float>(field_.cell_size_x));
+    normals.setArg(7, static_cast<float>(field_.cell_size_y));
+    normals.setArg(8, row_cells_);
+    normals.setArg(9, normals_);
+    st_.launch(normals, cl::NDRange(roundUp(field_.width, kTileX), roundUp(s1 - s0, kTileY)),
+               cl::NDRange(kTileX, kTileY));
+  }
+
+  // Strips: puts rows [s0, s1) on the device (their heights with kStripHalo rows around, their
+  // sums so far, their normals); returns the first row of the heights there.
+  int loadStrip(int s0, int s1) {
+    const std::size_t width = field_.width;
+    const int row0 = std::max(0, s0 - kStripHalo), row1 = std::min(field_.height, s1 + kStripHalo);
+    st_.queue.enqueueWriteBuffer(heights_, CL_FALSE, 0, (row1 - row0) * width * sizeof(float),
+                                 &prepared_.heights[row0 * width]);
+    const std::size_t bytes = (s1 - s0) * width * sizeof(float);
+    if (outputs_.sky_view_factor)
+      st_.queue.enqueueWriteBuffer(svf_, CL_FALSE, 0, bytes, &result_.sky_view_factor[s0 * width]);
+    if (outputs_.ambient_occlusion) {
+      st_.queue.enqueueWriteBuffer(ao_, CL_FALSE, 0, bytes, &result_.ambient_occlusion[s0 * width]);
+      computeNormals(row0, s0, s1);
+    }
+    return row0;
+  }
+
+  // Rows [s0, s1) of the device's `rows` (a strip's) into `host` from `at` on.
+  void readRows(const cl::Buffer& rows, std::vector<float>& host, int s0, int s1, std::size_t at = 0) {
+    const std::size_t width = field_.width;
+    st_.queue.enqueueReadBuffer(rows, CL_TRUE, 0, (s1 - s0) * width * sizeof(float), &host[at + s0 * width]);
   }
 
   // The Earth's drop per pixel length squared along a direction of that ground length per pixel.
@@ -282,7 +377,10 @@ class HorizonRoutine : public SweepRoutine {
     kernel.setArg(arg++, plane_offset);
     if (horizon_.method == HorizonMethod::Sweep) {
       kernel.setArg(arg++, stacks_);
-      stride_arg_ = arg++;  // set per chunk (launchLineChunks)
+      arg++;  // stride: set per chunk
+      kernel.setArg(arg++, 0);  // carried: not unless the caller sweeps in strips
+      kernel.setArg(arg++, placeholder_);
+      kernel.setArg(arg++, placeholder_);
       kernel.setArg(arg++, window_far_);
     }
     kernel.setArg(arg++, normals_);
@@ -292,35 +390,185 @@ class HorizonRoutine : public SweepRoutine {
     kernel.setArg(arg++, ao_);
   }
 
-  void launchSweep(const RunDirection& d, cl_uint plane_offset) {
-    cl::Buffer samples(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                       d.samples.size() * sizeof(LatticeSample),
-                       const_cast<LatticeSample*>(d.samples.data()));
+  // horizon_lattice's arguments where the chunks (and strips) differ.
+  enum SweepArgument { kRow0 = 3, kOutRow0 = 4, kLines = 5, kLineCount = 6, kStride = 25, kCarried = 26,
+                       kLineState = 27, kCarryIn = 28 };
+
+  // horizon_lattice for direction d with everything but the chunk's lines set (rows from 0 on,
+  // nothing carried); `keep` holds the buffers it takes until the launch.
+  cl::Kernel sweepKernel(const RunDirection& d, cl_uint plane_offset, std::vector<cl::Buffer>& keep) {
+    keep.emplace_back(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, d.samples.size() * sizeof(LatticeSample),
+                      const_cast<LatticeSample*>(d.samples.data()));
     cl::Kernel kernel(program_, "horizon_lattice");
     kernel.setArg(0, heights_);
     kernel.setArg(1, field_.width);
     kernel.setArg(2, field_.height);
-    kernel.setArg(5, samples);
-    kernel.setArg(6, static_cast<int>(d.samples.size()));
-    kernel.setArg(7, d.lattice.a);
-    kernel.setArg(8, d.lattice.b);
-    kernel.setArg(9, static_cast<float>(d.lattice.period));
+    kernel.setArg(kRow0, 0);
+    kernel.setArg(kOutRow0, 0);
+    kernel.setArg(7, keep.back());
+    kernel.setArg(8, static_cast<int>(d.samples.size()));
+    kernel.setArg(9, d.lattice.a);
+    kernel.setArg(10, d.lattice.b);
+    kernel.setArg(11, static_cast<float>(d.lattice.period));
     const double unit = positionUnit(d.lattice.ground_per_pixel);
-    kernel.setArg(10, static_cast<float>(unit));
-    kernel.setArg(11, static_cast<float>(d.lattice.period * d.lattice.ground_per_pixel));
-    kernel.setArg(12, curvatureDrop(unit));
-    kernel.setArg(13, d.window.window);
-    kernel.setArg(14, d.window.inv_window);
-    const auto row_tables = setRowTables(kernel, 15, d);
-    setOutputs(kernel, 17, d, plane_offset);
+    kernel.setArg(12, static_cast<float>(unit));
+    kernel.setArg(13, static_cast<float>(d.lattice.period * d.lattice.ground_per_pixel));
+    kernel.setArg(14, curvatureDrop(unit));
+    kernel.setArg(15, d.window.window);
+    kernel.setArg(16, d.window.inv_window);
+    for (cl::Buffer& table : setRowTables(kernel, 17, d)) keep.push_back(table);
+    setOutputs(kernel, 19, d, plane_offset);
+    return kernel;
+  }
+
+  // Work-items per group of horizon_lattice. With lanes, groups of one work-item: 64
+  // work-items of 8 lines would put all of a 512-line direction in one group, on one core.
+  std::size_t sweepGroup() const { return lanes_ > 1 ? 1 : kLineGroup; }
+
+  void launchSweep(const RunDirection& d, cl_uint plane_offset) {
+    std::vector<cl::Buffer> keep;
+    cl::Kernel kernel = sweepKernel(d, plane_offset, keep);
     LineChunkArguments chunk;
-    chunk.lines = 3;
-    chunk.count = 4;
-    chunk.stride = stride_arg_;
-    // With lanes, groups of one work-item: 64 work-items of 8 lines would put all of a
-    // 512-line direction in one group, on one core.
-    launchLineChunks(st_, kernel, d.lines, d.samples.size(), stack_entries_, chunk, lanes_,
-                     lanes_ > 1 ? 1 : kLineGroup);
+    chunk.lines = kLines;
+    chunk.count = kLineCount;
+    chunk.stride = kStride;
+    launchLineChunks(st_, kernel, d.lines, d.samples.size(), plan_.stack_entries, chunk, lanes_, sweepGroup());
+  }
+
+  // Direction k over a field in strips: the strips in the order its lines run through them
+  // (toward -(a, b)), each line's part in a strip resuming its sweep with the stack it left the
+  // strip before with (horizon_lattice, `carried`), which carry_stacks moves from the scratch
+  // into a compact buffer between strips. The sums go up and down with each strip.
+  void sweepInStrips(const RunDirection& d, int k) {
+    const int rows = plan_.strip_rows, strips = (field_.height + rows - 1) / rows;
+    const int a = d.lattice.a, b = d.lattice.b;
+    const std::size_t per_period = d.samples.size();
+    // Each line's sweep so far: (unused, its stack's size, the stack's offset in carry_in,
+    // its ground position's float bits).
+    std::vector<cl_int4> resume(d.lines.size(), cl_int4{{0, 0, 0, 0}});
+    std::vector<char> waiting(d.lines.size(), 0);  // whether its stack waits in carry_in
+    cl::Buffer carry_in = placeholder_;
+    for (int step = 0; step < strips; ++step) {
+      const int s = b > 0 ? strips - 1 - step : step;  // rows fall along a line when b > 0
+      const int s0 = s * rows, s1 = std::min(field_.height, s0 + rows);
+      const int row0 = loadStrip(s0, s1);
+      std::vector<cl::Buffer> keep;
+      cl::Kernel kernel = sweepKernel(d, 0, keep);
+      kernel.setArg(kRow0, row0);
+      kernel.setArg(kOutRow0, s0);
+      kernel.setArg(kCarried, 1);
+      kernel.setArg(kCarryIn, carry_in);
+      // The strip's part of every line that has receivers in it.
+      std::vector<LatticeLine> lines;
+      std::vector<cl_int4> states;
+      std::vector<std::size_t> capacities, owner;
+      for (std::size_t j = 0; j < d.lines.size(); ++j) {
+        const LatticeLine& line = d.lines[j];
+        const auto [first, end] = receiversInRows(line, b, s0, s1);
+        if (first == end) continue;
+        lines.push_back({line.col - first * a, line.row - first * b, end - first, 0});
+        cl_int4 state = resume[j];
+        state.s[0] = first;
+        states.push_back(state);
+        capacities.push_back(static_cast<std::size_t>(state.s[1]) + (end - first) * per_period);
+        if (capacities.back() > plan_.stack_entries) failCarry("one line's hull stack", capacities.back());
+        owner.push_back(j);
+      }
+      std::size_t carried = 0, capacity = 0;  // entries in carry_out
+      cl::Buffer carry_out;
+      // Stacks from `source` (entry k of line i at lines[i].w + k stride, states[i].y entries) into
+      // carry_out at `offsets` (from `carried` on; -1: none).
+      auto carryOut = [&](const cl::Buffer& lines_buffer, const cl::Buffer& states_buffer,
+                          const std::vector<cl_int>& offsets, const cl::Buffer& source, cl_uint stride) {
+        if (carried > capacity) {
+          if (carried > plan_.carry_entries || carried >= (std::size_t(1) << 31))
+            failCarry("the hull stacks carried into the next strip", carried);
+          const std::size_t grown = std::min(std::max(carried, 2 * capacity), plan_.carry_entries);
+          cl::Buffer bigger = deviceBuffer(st_, grown * kStackEntryBytes);
+          if (capacity) st_.queue.enqueueCopyBuffer(carry_out, bigger, 0, 0, capacity * kStackEntryBytes);
+          carry_out = bigger;
+          capacity = grown;
+        }
+        if (std::none_of(offsets.begin(), offsets.end(), [](cl_int o) { return o >= 0; })) return;
+        const cl::Buffer offsets_buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                        offsets.size() * sizeof(cl_int), const_cast<cl_int*>(offsets.data()));
+        cl::Kernel move(program_, "carry_stacks");
+        move.setArg(0, lines_buffer);
+        move.setArg(1, states_buffer);
+        move.setArg(2, offsets_buffer);
+        move.setArg(3, static_cast<int>(offsets.size()));
+        move.setArg(4, source);
+        move.setArg(5, stride);
+        move.setArg(6, carry_out);
+        st_.launch(move, cl::NDRange(roundUp(offsets.size(), kLineGroup)), cl::NDRange(kLineGroup));
+        st_.queue.finish();  // before the caller's buffers go
+      };
+      std::vector<char> next_waiting(d.lines.size(), 0);
+      for (const LineChunk& chunk : chunkLines(lines, capacities, plan_.stack_entries, lineMajorLayout(st_))) {
+        const cl::Buffer chunk_lines(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                     chunk.count * sizeof(LatticeLine), lines.data() + chunk.first);
+        const cl::Buffer chunk_states(st_.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR,
+                                      chunk.count * sizeof(cl_int4), states.data() + chunk.first);
+        kernel.setArg(kLines, chunk_lines);
+        kernel.setArg(kLineCount, static_cast<int>(chunk.count));
+        kernel.setArg(kStride, static_cast<cl_uint>(chunk.stride));
+        kernel.setArg(kLineState, chunk_states);
+        const std::size_t items = (chunk.count + lanes_ - 1) / lanes_;
+        st_.launch(kernel, cl::NDRange(roundUp(items, sweepGroup())), cl::NDRange(sweepGroup()));
+        st_.queue.enqueueReadBuffer(chunk_states, CL_TRUE, 0, chunk.count * sizeof(cl_int4),
+                                    states.data() + chunk.first);
+        // Where the stacks of the lines that go on into the next strip wait for it.
+        std::vector<cl_int> offsets(chunk.count, -1);
+        for (std::size_t i = 0; i < chunk.count; ++i) {
+          const std::size_t at = chunk.first + i, j = owner[at];
+          cl_int4& state = states[at];
+          if (state.s[0] + lines[at].receivers == d.lines[j].receivers) continue;  // the line ends here
+          offsets[i] = static_cast<cl_int>(carried);
+          state.s[2] = offsets[i];
+          resume[j] = state;
+          next_waiting[j] = 1;
+          carried += state.s[1];
+        }
+        carryOut(chunk_lines, chunk_states, offsets, stacks_, static_cast<cl_uint>(chunk.stride));
+      }
+      // Lines with no receiver in this strip (a step of more rows than a strip has) that are
+      // under way: their stacks move on from carry_in as they are.
+      std::vector<LatticeLine> passing;
+      std::vector<cl_int4> passing_states;
+      std::vector<cl_int> offsets;
+      for (std::size_t j = 0; j < d.lines.size(); ++j) {
+        if (!waiting[j] || next_waiting[j]) continue;
+        const auto [first, end] = receiversInRows(d.lines[j], b, s0, s1);
+        if (first != end) continue;  // it ended in this strip
+        passing.push_back({0, 0, 0, resume[j].s[2]});
+        passing_states.push_back(resume[j]);
+        offsets.push_back(static_cast<cl_int>(carried));
+        resume[j].s[2] = offsets.back();
+        next_waiting[j] = 1;
+        carried += resume[j].s[1];
+      }
+      if (!passing.empty()) {
+        const cl::Buffer passing_lines(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                       passing.size() * sizeof(LatticeLine), passing.data());
+        const cl::Buffer states_buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                       passing_states.size() * sizeof(cl_int4), passing_states.data());
+        carryOut(passing_lines, states_buffer, offsets, carry_in, 1);
+      }
+      waiting.swap(next_waiting);
+      const std::size_t plane = field_.pixelCount();
+      if (outputs_.horizon_angles) readRows(angles_, result_.angles, s0, s1, k * plane);
+      if (outputs_.horizon_distances) readRows(distances_, result_.distances, s0, s1, k * plane);
+      if (outputs_.sky_view_factor) readRows(svf_, result_.sky_view_factor, s0, s1);
+      if (outputs_.ambient_occlusion) readRows(ao_, result_.ambient_occlusion, s0, s1);
+      carry_in = carried ? carry_out : placeholder_;
+      if (horizon_.strip_progress) horizon_.strip_progress(step + 1, strips);
+    }
+  }
+
+  [[noreturn]] void failCarry(const std::string& what, std::size_t entries) const {
+    throw MemoryBudgetError(what + " needs " + mebibytes(entries * kStackEntryBytes) +
+                            " of device memory, more than the budget leaves beside strips of " +
+                            std::to_string(plan_.strip_rows) + " rows; raise the memory budget");
   }
 
   void launchNaive(const RunDirection& d, cl_uint plane_offset) {
@@ -342,13 +590,11 @@ class HorizonRoutine : public SweepRoutine {
 
   const HorizonOptions& horizon_;  // options_ as the horizon operation's
   const HorizonOutputs& outputs_;
+  int lanes_ = 1;  // HFVIS_LANES of the program
   std::vector<RunDirection> directions_;
+  RunPlan plan_;
   HorizonResult result_;
-  int batch_ = 1;
-  cl::Buffer angles_, distances_, svf_, ao_, normals_, stacks_, window_far_;
-  std::size_t stack_entries_ = 0;
-  int stride_arg_ = 0;  // horizon_lattice's `stride` argument
-  int lanes_ = 1;       // HFVIS_LANES of the program
+  cl::Buffer angles_, distances_, svf_, ao_, normals_, stacks_, window_far_, row_cells_, placeholder_;
 };
 
 }  // namespace

@@ -210,11 +210,36 @@ std::vector<LatticeLine> latticeLines(const LatticeDirection& d, int width, int 
   return lines;
 }
 
+std::pair<int, int> receiversInRows(const LatticeLine& line, int b, int first_row, int end_row) {
+  // Receiver i sits in row line.row - i b.
+  auto floorDiv = [](long x, long y) { return x / y - ((x % y != 0) && ((x < 0) != (y < 0))); };
+  long lo = 0, hi = line.receivers;  // [lo, hi)
+  if (b == 0) {
+    if (line.row < first_row || line.row >= end_row) hi = 0;
+  } else if (b > 0) {  // rows fall as i grows: row - i b < end_row and >= first_row
+    lo = std::max(lo, floorDiv(long(line.row) - end_row, b) + 1);
+    hi = std::min(hi, floorDiv(long(line.row) - first_row, b) + 1);
+  } else {  // rows rise: row + i |b| >= first_row and < end_row
+    lo = std::max(lo, -floorDiv(long(line.row) - first_row, -b));  // ceil((first_row - row) / |b|)
+    hi = std::min(hi, floorDiv(long(end_row) - 1 - line.row, -b) + 1);
+  }
+  if (hi < lo) hi = lo;
+  return {static_cast<int>(lo), static_cast<int>(hi)};
+}
+
 std::size_t lineCapacity(const LatticeLine& line, std::size_t samples_per_period) {
   return static_cast<std::size_t>(line.receivers) * samples_per_period;
 }
 
 std::vector<LineChunk> chunkLines(std::vector<LatticeLine>& lines, std::size_t samples_per_period,
+                                  std::size_t max_entries, bool line_major) {
+  std::vector<std::size_t> capacities;
+  capacities.reserve(lines.size());
+  for (const LatticeLine& line : lines) capacities.push_back(lineCapacity(line, samples_per_period));
+  return chunkLines(lines, capacities, max_entries, line_major);
+}
+
+std::vector<LineChunk> chunkLines(std::vector<LatticeLine>& lines, const std::vector<std::size_t>& capacities,
                                   std::size_t max_entries, bool line_major) {
   std::vector<LineChunk> chunks;
   LineChunk chunk;
@@ -229,7 +254,7 @@ std::vector<LineChunk> chunkLines(std::vector<LatticeLine>& lines, std::size_t s
     chunks.push_back(chunk);
   };
   for (std::size_t j = 0; j < lines.size(); ++j) {
-    const std::size_t capacity = lineCapacity(lines[j], samples_per_period);
+    const std::size_t capacity = capacities[j];
     const std::size_t need =
         line_major ? chunk.stack_entries + capacity : std::max(longest, capacity) * (chunk.count + 1);
     if (chunk.count > 0 && (need > max_entries || need >= (std::size_t(1) << 31))) {

@@ -12,6 +12,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "hfvis/height_field.hpp"
@@ -98,6 +99,14 @@ struct LineChunk {
 // setting each line's stack offset within its chunk.
 std::vector<LineChunk> chunkLines(std::vector<LatticeLine>& lines, std::size_t samples_per_period,
                                   std::size_t max_entries, bool line_major);
+// The same with each line's capacity given (a strip's part of a line: its samples there and
+// the stack it arrives with).
+std::vector<LineChunk> chunkLines(std::vector<LatticeLine>& lines, const std::vector<std::size_t>& capacities,
+                                  std::size_t max_entries, bool line_major);
+
+// The receivers [first, end) of a line of a direction with row step b that lie in rows
+// [first_row, end_row) (a strip); first == end when none do.
+std::pair<int, int> receiversInRows(const LatticeLine& line, int b, int first_row, int end_row);
 
 // Scratch entries one line needs (its capacity): a direction can always be run one line at
 // a time.

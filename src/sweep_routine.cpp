@@ -10,7 +10,7 @@ namespace hfvis::detail {
 void SweepRoutine::run() {
   prepared_ = prepare();
   program_ = st_.program(programFile(), programOptions());
-  heights_ = upload(prepared_.heights);
+  if (heightsResident()) heights_ = upload(prepared_.heights);
   allocate();
   const int directions = directionCount(), batch = std::max(1, batchSize());
   for (int first = 0; first < directions; first += batch) {

@@ -32,6 +32,9 @@ class SweepRoutine {
   // The program: its kernel file and -D options (after prepare()).
   virtual std::string programFile() const = 0;
   virtual std::string programOptions() const = 0;
+  // Whether run() uploads the whole field into heights_ before allocate() (an operation
+  // that runs a field in strips loads the heights strip by strip itself).
+  virtual bool heightsResident() const { return true; }
   // Plans device memory (throws MemoryBudgetError when one direction does not fit) and
   // allocates every buffer the sweeps need; heights_ and program_ are ready.
   virtual void allocate() = 0;

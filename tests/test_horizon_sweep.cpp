@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 
 #include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
@@ -410,6 +411,131 @@ TEST(HorizonKernels, BatchingUnderATinyMemoryBudgetChangesNothing) {
     options.memory_budget_bytes = 1024;
     EXPECT_THROW(computeHorizons(context, field, options, outputs), MemoryBudgetError);
   });
+}
+
+// Bit for bit: the same float in every place (NaN where the other has NaN).
+::testing::AssertionResult bitsEqual(const std::vector<float>& actual, const std::vector<float>& expected) {
+  if (actual.size() != expected.size())
+    return ::testing::AssertionFailure() << "sizes differ: " << actual.size() << " vs " << expected.size();
+  for (std::size_t i = 0; i < actual.size(); ++i) {
+    const float a = actual[i], e = expected[i];
+    if (std::isnan(a) ? !std::isnan(e) : std::memcmp(&a, &e, sizeof(float)) != 0)
+      return ::testing::AssertionFailure() << "[" << i << "] " << a << " vs " << e;
+  }
+  return ::testing::AssertionSuccess();
+}
+
+void expectBitsEqual(const HorizonResult& strips, const HorizonResult& whole) {
+  EXPECT_TRUE(bitsEqual(strips.angles, whole.angles));
+  EXPECT_TRUE(bitsEqual(strips.distances, whole.distances));
+  EXPECT_TRUE(bitsEqual(strips.sky_view_factor, whole.sky_view_factor));
+  EXPECT_TRUE(bitsEqual(strips.ambient_occlusion, whole.ambient_occlusion));
+}
+
+// A field in strips of rows, each line's hull stack carried from strip to strip, gives the
+// whole-field result bit for bit: every hard case on three awkward sizes, strips of 1 and 6 rows,
+// steps up to 5 rows (K = 24 exact azimuths), curvature, denser sampling and per-row spacing,
+// in both layouts.
+TEST(HorizonKernels, StripsEqualTheWholeFieldBitForBit) {
+  testing::forEachLayout([&](const ComputeContext& context) {
+    for (const auto& name : syntheticFieldNames()) {
+      for (auto [w, h] : {std::pair{1, 9}, std::pair{7, 13}, std::pair{33, 20}}) {
+        const HeightField field = makeSyntheticField(name, w, h, 3);
+        HorizonOptions options;
+        options.directions = 24;
+        const auto whole = computeHorizons(context, field, options, allOutputs());
+        for (int rows : {1, 6}) {
+          if (rows >= h) continue;
+          SCOPED_TRACE(name + " " + std::to_string(w) + "x" + std::to_string(h) + ", strips of " +
+                       std::to_string(rows) + " rows");
+          options.strip_rows = rows;
+          int strips = 0;
+          options.strip_progress = [&](int done, int all) {
+            EXPECT_EQ(all, (h + rows - 1) / rows);
+            strips += done == all;
+          };
+          expectBitsEqual(computeHorizons(context, field, options, allOutputs()), whole);
+          EXPECT_EQ(strips, options.directions);
+          options.strip_progress = nullptr;
+          options.strip_rows = 0;
+        }
+      }
+    }
+    // Curvature, denser sampling, per-row spacing; quadrature directions (svf and ao alone).
+    HeightField field = makeSyntheticField("sine", 37, 45, 1);
+    for (int variant = 0; variant < 3; ++variant) {
+      SCOPED_TRACE("variant " + std::to_string(variant));
+      HorizonOptions options;
+      options.directions = 32;
+      if (variant == 0) options.curvature = 0.01;
+      if (variant == 1) options.samples_per_unit = 3.0;
+      if (variant == 2) setRowSpacing(field);
+      for (const HorizonOutputs& outputs : {allOutputs(), HorizonOutputs{false, false, true, true}}) {
+        const auto whole = computeHorizons(context, field, options, outputs);
+        options.strip_rows = 4;
+        expectBitsEqual(computeHorizons(context, field, options, outputs), whole);
+        options.strip_rows = 0;
+      }
+    }
+  });
+}
+
+// A memory budget below the whole field's needs runs it in strips by itself, with the same
+// result; stacks too deep for what the budget leaves are a MemoryBudgetError, not a wrong answer.
+TEST(HorizonKernels, ABudgetBelowTheWholeFieldRunsItInStrips) {
+  const HeightField field = makeSyntheticField("noise", 300, 200, 4);
+  HorizonOptions options;
+  options.directions = 16;
+  HorizonOutputs outputs;
+  outputs.sky_view_factor = outputs.ambient_occlusion = true;
+  const auto whole = computeHorizons(testContext(), field, options, outputs);
+  options.memory_budget_bytes = 600 * 1024;  // the whole field's sums and normals alone take 1.2 MB
+  int strips = 0;
+  options.strip_progress = [&](int, int all) { strips = all; };
+  expectBitsEqual(computeHorizons(testContext(), field, options, outputs), whole);
+  EXPECT_GT(strips, 2);
+  options.strip_progress = nullptr;
+  // A dome keeps most samples of a line on its hull: strips of 4 rows (their buffers half the
+  // budget) leave 40 KB for stacks, a quarter of it for those carried, far too few.
+  const HeightField dome = makeSyntheticField("dome", 300, 200, 4);
+  options.strip_rows = 4;
+  options.memory_budget_bytes = 2 * (4 * 5 * 300 * 4 + 2 * 65 * 300 * 4) + 40 * 1024;
+  try {
+    computeHorizons(testContext(), dome, options, outputs);
+    ADD_FAILURE() << "no MemoryBudgetError";
+  } catch (const MemoryBudgetError& error) {
+    EXPECT_NE(std::string(error.what()).find("hull stack"), std::string::npos) << error.what();
+  }
+}
+
+// A strip's receivers of a line are those in its rows, and the strips together hold each
+// receiver once.
+TEST(HorizonSweepLine, StripsHoldEveryReceiverOnce) {
+  const HeightField field = makeSyntheticField("flat", 23, 31);
+  HorizonOptions options;
+  options.directions = 40;
+  for (const auto& d : detail::latticeDirections(field, options, true, options.azimuth_tolerance)) {
+    for (const auto& line : detail::latticeLines(d, field.width, field.height)) {
+      for (int rows : {1, 2, 5, 31}) {
+        int next = 0;
+        // In the order the line runs through them.
+        for (int step = 0; step * rows < field.height; ++step) {
+          const int strips = (field.height + rows - 1) / rows;
+          const int s = d.b > 0 ? strips - 1 - step : step;
+          const auto [first, end] = detail::receiversInRows(line, d.b, s * rows, (s + 1) * rows);
+          if (first == end) continue;
+          ASSERT_EQ(first, next) << "a=" << d.a << " b=" << d.b;
+          for (int i = first; i < end; ++i) {
+            const int row = line.row - i * d.b;
+            ASSERT_GE(row, s * rows);
+            ASSERT_LT(row, (s + 1) * rows);
+          }
+          next = end;
+        }
+        ASSERT_EQ(next, line.receivers);
+      }
+    }
+  }
 }
 
 // Chunks of lines cover every line once, fit the scratch they are given (a single line may

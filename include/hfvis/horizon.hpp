@@ -31,6 +31,12 @@ struct HorizonOptions : SweepOptions {
   // (exact heights of the bilinear surface) and, for S > 1, about S points per pixel length
   // between crossings. Default: 0.25 degrees.
   double azimuth_tolerance = 0.25 * 3.14159265358979323846 / 180.0;
+  // Sweep only. Rows per strip: a field whose heights, sums and planes do not fit the memory
+  // budget at once runs in horizontal strips, each line's hull stack carried from strip to
+  // strip, so the results equal a whole-field run bit for bit. 0: the whole field when it fits,
+  // else as many rows as half the budget holds; fewer rows than the field's force strips.
+  // A maximum distance and the naive method need the whole field.
+  int strip_rows = 0;
 };
 
 // What to compute; only what is asked for is stored or reduced.

@@ -40,9 +40,13 @@ struct SweepOptions {
   // cut decided in float arithmetic); the horizon lists and the bounce refuse it.
   double max_distance = 0.0;
   // Device memory for one batch; 0 = half the device memory (a CPU device: half the host's).
+  // The horizon operation runs a field beyond it in strips of rows (HorizonOptions::strip_rows).
   std::size_t memory_budget_bytes = 0;
   // Called after each batch of directions with (directions done, directions in all).
   std::function<void(int, int)> progress;
+  // When a field runs in strips (HorizonOptions::strip_rows): called after each strip of the
+  // direction under way with (strips done, strips in all).
+  std::function<void(int, int)> strip_progress;
 };
 
 // Azimuth of direction k, in radians.
