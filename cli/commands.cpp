@@ -371,25 +371,21 @@ class Progress {
   explicit Progress(bool quiet)
       : enabled_(!quiet && ::isatty(::fileno(stderr))), start_(std::chrono::steady_clock::now()) {}
 
-  // "done/total directions", and once some are done the time left at the pace so far.
-  std::function<void(int, int)> callback() {
-    if (!enabled_) return {};
-    return [this](int done, int total) {
-      const auto now = std::chrono::steady_clock::now();
-      if (done < total && now - last_ < std::chrono::milliseconds(250)) return;
-      last_ = now;
-      line_open_ = done < total;
-      std::string left;
-      if (done > 0 && done < total) {
-        const double elapsed = std::chrono::duration<double>(now - start_).count();
-        const long seconds = std::lround(elapsed * (total - done) / done);
-        left = ", about " + (seconds >= 60 ? std::to_string(seconds / 60) + " min " : std::string()) +
-               std::to_string(seconds % 60) + " s left";
-      }
-      // \033[K clears what a longer line before left behind.
-      std::fprintf(stderr, "\rhfvis: %d/%d directions%s\033[K%s", done, total, left.c_str(),
-                   line_open_ ? "" : "\n");
-      std::fflush(stderr);
+  // Sets the options' callbacks: "done/total directions", the strip under way when the field
+  // runs in strips, and once some are done the time left at the pace so far.
+  void attach(SweepOptions& options) {
+    if (!enabled_) return;
+    total_ = options.directions;
+    options.progress = [this](int done, int total) {
+      done_ = done;
+      total_ = total;
+      strip_ = 0;
+      report();
+    };
+    options.strip_progress = [this](int strip, int strips) {
+      strip_ = strip;
+      strips_ = strips;
+      report(false);
     };
   }
 
@@ -404,8 +400,32 @@ class Progress {
   }
 
  private:
+  // `finished_batch`: a batch of directions just ended (the last one ends the line).
+  void report(bool finished_batch = true) {
+    const auto now = std::chrono::steady_clock::now();
+    const bool last = finished_batch && total_ > 0 && done_ >= total_;
+    if (!last && now - last_ < std::chrono::milliseconds(250)) return;
+    last_ = now;
+    line_open_ = !last;
+    // Directions done, and the share of the one under way in strips.
+    const double fraction = total_ > 0 ? (done_ + (strips_ > 0 ? double(strip_) / strips_ : 0.0)) / total_ : 0.0;
+    std::string strip, left;
+    if (strip_ > 0 && !last) strip = ", strip " + std::to_string(strip_) + "/" + std::to_string(strips_);
+    if (fraction > 0.0 && !last) {
+      const double elapsed = std::chrono::duration<double>(now - start_).count();
+      const long seconds = std::lround(elapsed * (1.0 - fraction) / fraction);
+      left = ", about " + (seconds >= 60 ? std::to_string(seconds / 60) + " min " : std::string()) +
+             std::to_string(seconds % 60) + " s left";
+    }
+    // \033[K clears what a longer line before left behind.
+    std::fprintf(stderr, "\rhfvis: %d/%d directions%s%s\033[K%s", done_, total_, strip.c_str(), left.c_str(),
+                 line_open_ ? "" : "\n");
+    std::fflush(stderr);
+  }
+
   bool enabled_;
   bool line_open_ = false;
+  int done_ = 0, total_ = 0, strip_ = 0, strips_ = 0;
   std::chrono::steady_clock::time_point start_, last_{};
 };
 
@@ -506,7 +526,7 @@ int runCompute(Command command, const RunArguments& run) {
 
   HorizonOptions options = horizonOptions(run);
   Progress progress(run.quiet);
-  options.progress = progress.callback();
+  progress.attach(options);
   const auto start = std::chrono::steady_clock::now();
   const HorizonResult result =
       progress.run([&] { return computeHorizons(context, field, options, horizonOutputs(command, run)); });
@@ -587,7 +607,7 @@ int runViewCount(const RunArguments& run) {
 
   IntervisibilityOptions options = intervisibilityOptions(run);
   Progress progress(run.quiet);
-  options.progress = progress.callback();
+  progress.attach(options);
   const auto start = std::chrono::steady_clock::now();
   const IntervisibilityResult result = progress.run(
       [&] { return computeIntervisibility(context, field, options, intervisibilityOutputs(run)); });
@@ -711,7 +731,7 @@ int runBounce(const RunArguments& run) {
   const DeviceInfo& device = context.device();
   BounceOptions options = bounceOptions(run);
   Progress progress(run.quiet);
-  options.progress = progress.callback();
+  progress.attach(options);
   const auto start = std::chrono::steady_clock::now();
   const BounceResult result = progress.run([&] { return computeBounce(context, field, radiance, options); });
   const double seconds = secondsSince(start);

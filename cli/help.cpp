@@ -68,7 +68,8 @@ Options:
   --device SEL             device index, "gpu", "cpu" or part of a device/platform name
                            (default: env HFVIS_DEVICE, else a GPU, else the first CPU)
   --memory-budget MB       device memory for one batch of directions, MiB (default: half the
-                           device's memory; on a CPU device half the host's)
+                           device's memory; on a CPU device half the host's); horizon, svf and
+                           ao run a field beyond it in strips of rows, with the same result
   --preview PNG            also write an 8-bit PNG preview
   -q, --quiet              print neither progress nor the summary line
   -h, --help               show help

@@ -31,6 +31,8 @@
 //                                            longitude grids): positions along a line or ray
 //                                            are ground lengths summed step by step, from the
 //                                            per-row tables `row_length` and `row_terms`
+//   HFVIS_STRIPS                             horizon_lattice resumes lines part-way (a field in
+//                                            strips of rows, see there)
 #include "direction_terms.cl"
 #include "fast_math.cl"
 #include "sweep_framework.cl"
@@ -56,8 +58,14 @@
 #ifndef HFVIS_ROW_SPACING
 #define HFVIS_ROW_SPACING 0
 #endif
+#ifndef HFVIS_STRIPS
+#define HFVIS_STRIPS 0
+#endif
 #if HFVIS_MAX_DISTANCE && HFVIS_ROW_SPACING
 #error "a maximum distance on a field with per-row spacing is not supported"
+#endif
+#if HFVIS_MAX_DISTANCE && HFVIS_STRIPS
+#error "a maximum distance in strips is not supported"
 #endif
 
 // The normal at pixel (c, r), the sum of the unnormalised normals of the (up to) four quads
@@ -456,12 +464,12 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
 //
 // Strips (a field beyond the device's memory, src/horizon.cpp): `heights` holds the field's
 // rows from row0 on and the outputs (normals, planes, sums, window_far) its rows from out_row0
-// on. With `carried`, line j resumes its whole line's sweep: line_state[j] = (index of its
+// on. With HFVIS_STRIPS, line j resumes its whole line's sweep: line_state[j] = (index of its
 // first receiver here along the whole line, entries of the stack it arrives with, their offset
 // in carry_in, the receivers' ground position before it as float bits (HFVIS_ROW_SPACING));
 // the kernel copies those entries into its stack, and on leaving writes the stack's size into
-// .y and the ground position into .w (carry_out then moves the stacks on). Without, every line
-// starts at its far end with an empty stack and line_state is not read.
+// .y and the ground position into .w (carry_stacks then moves the stacks on). Without, every
+// line starts at its far end with an empty stack and line_state and carry_in are not used.
 //
 // With HFVIS_MAX_DISTANCE only samples within `window` pixels (inv_window = 1 / window) count
 // (window_pass; window_far: one (rise, run) per pixel; lines start at their far end). With
@@ -478,12 +486,15 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
                               __global const float* row_length, __global const float4* row_terms,
                               float cos_azimuth,
                               float sin_azimuth, float weight, float swath, uint plane, __global float2* stacks,
-                              uint stride, int carried, __global int4* line_state, __global const float2* carry_in,
+                              uint stride, __global int4* line_state, __global const float2* carry_in,
                               __global float2* window_far, __global const float2* normals,
                               __global float* angles, __global float* distances, __global float* svf_sum,
                               __global float* ao_sum) {
   const int first = get_global_id(0) * HFVIS_LANES;
   if (first >= n_lines) return;
+#if !HFVIS_STRIPS
+  row0 = out_row0 = 0;  // the whole field: constants, folded into the indexing
+#endif
   const int entry = (int)stride;  // between a line's consecutive stack entries
   lane_int c, r, receivers, stack;
   lane_int start = 0;             // the first receiver's index along the whole line
@@ -503,10 +514,10 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
     ILANE(stack, l) = line.w;
     trips = max(trips, ILANE(receivers, l));
   }
-  if (carried) {
+#if HFVIS_STRIPS
 #pragma unroll
-    for (int l = 0; l < HFVIS_LANES; ++l) {
-      if (first + l >= n_lines) continue;
+  for (int l = 0; l < HFVIS_LANES; ++l) {
+    if (first + l < n_lines) {
       const int4 state = line_state[first + l];
       const int depth = state.y;
       for (int k = 0; k < depth; ++k) stacks[ILANE(stack, l) + k * entry] = carry_in[state.z + k];
@@ -523,6 +534,7 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 #endif
     }
   }
+#endif
 #if HFVIS_MAX_DISTANCE
   int block = INT_MIN;  // the block of the stack's samples (none yet)
   int far_part = 0;     // whether window_pass gave this block's receivers the block before
@@ -546,10 +558,12 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
     base = select(base, base + period_length, live & (along > 0));  // kept where a line has ended (carried)
     const lane_float tau_scale = period_length * inv_period;  // ground length per pixel of tau
     const lane_float period_ground_l = period_length;
-#elif HFVIS_MAX_DISTANCE
-    const float base = (float)i * period;  // every line starts at its far end: along = i
-#else
+#elif HFVIS_STRIPS
     const lane_float base = LANE_FLOAT(along) * period;  // the receivers' position along their lines
+#else
+    // Every line starts at its far end (along = i): one position for all lanes, a scalar (a
+    // lane vector of positions made the whole sweep 35 % slower on the AVX-512 CPU).
+    const float base = (float)i * period;
 #endif
 #if !HFVIS_ROW_SPACING
     const lane_float cos_az = (lane_float)cos_azimuth, sin_az = (lane_float)sin_azimuth;
@@ -561,11 +575,13 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
       __global const LatticeSample* s = samples + q;
 #if HFVIS_ROW_SPACING
       const lane_float here = base - s->tau * tau_scale;
-#else
+#elif HFVIS_STRIPS
       const lane_float here = base - s->tau;
+#else
+      const float here = base - s->tau;
 #endif
 #if HFVIS_MAX_DISTANCE
-      const int sample_block = (int)floor(LANE(here, 0) * inv_window);
+      const int sample_block = (int)floor(here * inv_window);
       if (sample_block != block) {
         far_part = block != INT_MIN;
         if (far_part)
@@ -588,8 +604,8 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 #else
       const lane_float hs = h;
 #endif
-      hull_step(stacks, stack, entry, valid, hs, here, 1.0f, &n, &top_h, &top_p, &below_h, &below_p, &rise,
-                &run);
+      hull_step(stacks, stack, entry, valid, hs, (lane_float)here, 1.0f, &n, &top_h, &top_p, &below_h, &below_p,
+                &rise, &run);
     }
 #if HFVIS_MAX_DISTANCE
     if (far_part) {
@@ -630,10 +646,10 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
                select(ground, period_ground_l, use_near), distance, cos_az, sin_az, weight_l, swath_l, plane,
                normals, angles, distances, svf_sum, ao_sum);
   }
-  if (carried) {
+#if HFVIS_STRIPS
 #pragma unroll
-    for (int l = 0; l < HFVIS_LANES; ++l) {
-      if (first + l >= n_lines) continue;
+  for (int l = 0; l < HFVIS_LANES; ++l) {
+    if (first + l < n_lines) {
       __global int4* state = line_state + first + l;
       state->y = ILANE(n, l);
 #if HFVIS_ROW_SPACING
@@ -641,6 +657,7 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 #endif
     }
   }
+#endif
 }
 
 // The hull stacks that lines take on into the next strip (see horizon_lattice): line j's

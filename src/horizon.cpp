@@ -66,7 +66,7 @@ struct RunPlan {
 };
 
 // A field beyond the budget (or asked to): strips of as many rows as half the budget holds, the
-// rest for the hull stacks, a half of it for those carried from strip to strip.
+// rest for the hull stacks.
 RunPlan planStrips(const HeightField& field, const HorizonOptions& options, const HorizonOutputs& outputs,
                    std::size_t budget, std::size_t max_alloc) {
   const std::size_t row = field.width * sizeof(float);
@@ -86,8 +86,10 @@ RunPlan planStrips(const HeightField& field, const HorizonOptions& options, cons
   RunPlan plan;
   plan.strip_rows = static_cast<int>(std::min<std::size_t>(rows, field.height));
   const std::size_t rest = budget - (plan.strip_rows * per_row + halo);
-  plan.stack_entries = std::min(rest / 2, max_alloc) / kStackEntryBytes;
-  plan.carry_entries = std::min(rest / 4, max_alloc) / kStackEntryBytes;
+  // A quarter for the scratch (lines run in chunks of it), the rest for the two buffers of
+  // carried stacks, which must hold every line under way at once.
+  plan.stack_entries = std::min(rest / 4, max_alloc) / kStackEntryBytes;
+  plan.carry_entries = std::min(rest / 8 * 3, max_alloc) / kStackEntryBytes;
   return plan;
 }
 
@@ -187,6 +189,13 @@ std::vector<RunDirection> runDirectionsOf(const HeightField& field, const Horizo
   return out;
 }
 
+// Hull stacks that outgrow what the budget leaves beside strips of `rows` rows (thinner strips
+// leave more; computeHorizons retries with them).
+struct StacksBeyondStrips : MemoryBudgetError {
+  StacksBeyondStrips(const std::string& message, int strip_rows) : MemoryBudgetError(message), rows(strip_rows) {}
+  int rows;
+};
+
 class HorizonRoutine : public SweepRoutine {
  public:
   HorizonRoutine(ContextState& st, const HeightField& field, const HorizonOptions& options,
@@ -204,7 +213,8 @@ class HorizonRoutine : public SweepRoutine {
   std::string programFile() const override { return "horizon.cl"; }
   std::string programOptions() const override {
     return detail::programOptions(outputs_, prepared_.has_nodata, lanes_, horizon_.curvature != 0.0,
-                                  horizon_.max_distance > 0.0, hasRowSpacing(field_));
+                                  horizon_.max_distance > 0.0, hasRowSpacing(field_)) +
+           " -DHFVIS_STRIPS=" + std::to_string(inStrips());
   }
   bool heightsResident() const override { return !inStrips(); }
   bool inStrips() const { return plan_.strip_rows < field_.height; }
@@ -378,8 +388,7 @@ class HorizonRoutine : public SweepRoutine {
     if (horizon_.method == HorizonMethod::Sweep) {
       kernel.setArg(arg++, stacks_);
       arg++;  // stride: set per chunk
-      kernel.setArg(arg++, 0);  // carried: not unless the caller sweeps in strips
-      kernel.setArg(arg++, placeholder_);
+      kernel.setArg(arg++, placeholder_);  // line_state and carry_in, used in strips
       kernel.setArg(arg++, placeholder_);
       kernel.setArg(arg++, window_far_);
     }
@@ -391,11 +400,11 @@ class HorizonRoutine : public SweepRoutine {
   }
 
   // horizon_lattice's arguments where the chunks (and strips) differ.
-  enum SweepArgument { kRow0 = 3, kOutRow0 = 4, kLines = 5, kLineCount = 6, kStride = 25, kCarried = 26,
-                       kLineState = 27, kCarryIn = 28 };
+  enum SweepArgument { kRow0 = 3, kOutRow0 = 4, kLines = 5, kLineCount = 6, kStride = 25, kLineState = 26,
+                       kCarryIn = 27 };
 
   // horizon_lattice for direction d with everything but the chunk's lines set (rows from 0 on,
-  // nothing carried); `keep` holds the buffers it takes until the launch.
+  // no line states); `keep` holds the buffers it takes until the launch.
   cl::Kernel sweepKernel(const RunDirection& d, cl_uint plane_offset, std::vector<cl::Buffer>& keep) {
     keep.emplace_back(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, d.samples.size() * sizeof(LatticeSample),
                       const_cast<LatticeSample*>(d.samples.data()));
@@ -437,7 +446,7 @@ class HorizonRoutine : public SweepRoutine {
 
   // Direction k over a field in strips: the strips in the order its lines run through them
   // (toward -(a, b)), each line's part in a strip resuming its sweep with the stack it left the
-  // strip before with (horizon_lattice, `carried`), which carry_stacks moves from the scratch
+  // strip before with (horizon_lattice, HFVIS_STRIPS), which carry_stacks moves from the scratch
   // into a compact buffer between strips. The sums go up and down with each strip.
   void sweepInStrips(const RunDirection& d, int k) {
     const int rows = plan_.strip_rows, strips = (field_.height + rows - 1) / rows;
@@ -456,7 +465,6 @@ class HorizonRoutine : public SweepRoutine {
       cl::Kernel kernel = sweepKernel(d, 0, keep);
       kernel.setArg(kRow0, row0);
       kernel.setArg(kOutRow0, s0);
-      kernel.setArg(kCarried, 1);
       kernel.setArg(kCarryIn, carry_in);
       // The strip's part of every line that has receivers in it.
       std::vector<LatticeLine> lines;
@@ -566,9 +574,10 @@ class HorizonRoutine : public SweepRoutine {
   }
 
   [[noreturn]] void failCarry(const std::string& what, std::size_t entries) const {
-    throw MemoryBudgetError(what + " needs " + mebibytes(entries * kStackEntryBytes) +
-                            " of device memory, more than the budget leaves beside strips of " +
-                            std::to_string(plan_.strip_rows) + " rows; raise the memory budget");
+    throw StacksBeyondStrips(what + " needs " + mebibytes(entries * kStackEntryBytes) +
+                                 " of device memory, more than the budget leaves beside strips of " +
+                                 std::to_string(plan_.strip_rows) + " rows; raise the memory budget",
+                             plan_.strip_rows);
   }
 
   void launchNaive(const RunDirection& d, cl_uint plane_offset) {
@@ -607,9 +616,19 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
   detail::requireSupported(field, options);
   detail::checkPixelIndexing(field, 1);
   return detail::translateOpenClErrors([&] {
-    detail::HorizonRoutine routine(detail::stateOf(context), field, options, outputs);
-    routine.run();
-    return routine.take();
+    // Hull stacks too deep for the room strips leave: again from the start with strips half as
+    // tall (down to one row), as the sums of the strips done cannot be taken back.
+    HorizonOptions attempt = options;
+    for (;;) {
+      try {
+        detail::HorizonRoutine routine(detail::stateOf(context), field, attempt, outputs);
+        routine.run();
+        return routine.take();
+      } catch (const detail::StacksBeyondStrips& error) {
+        if (error.rows <= 1) throw MemoryBudgetError(error.what());
+        attempt.strip_rows = error.rows / 2;
+      }
+    }
   });
 }
 

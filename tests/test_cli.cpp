@@ -829,6 +829,23 @@ TEST_F(Cli, ViewcountChannelZeroIsTheVisibleCount) {
   }
 }
 
+// A memory budget below the whole field's needs (256 x 256 svf and ao: 1.5 MiB of heights, sums
+// and normals against 0.4 MiB) runs the field in strips, with the very same values.
+TEST_F(Cli, ATinyMemoryBudgetRunsInStripsWithTheSameResult) {
+  const std::string dem = std::string(HFVIS_DATA_DIR) + "/fractal_256.exr";
+  for (const char* command : {"svf", "ao"}) {
+    const CliResult whole = run(std::string(command) + " " + shellQuoted(dem) + " -o " +
+                                shellQuoted(out("whole.exr")) + " -k 16 --quiet");
+    ASSERT_EQ(whole.status, 0) << whole.err;
+    const CliResult strips = run(std::string(command) + " " + shellQuoted(dem) + " -o " +
+                                 shellQuoted(out("strips.exr")) + " -k 16 --quiet --memory-budget 0.4");
+    ASSERT_EQ(strips.status, 0) << strips.err;
+    EXPECT_EQ(readBack(out("strips.exr")).pixels, readBack(out("whole.exr")).pixels) << command;
+    fs::remove(out("whole.exr"));
+    fs::remove(out("strips.exr"));
+  }
+}
+
 TEST_F(Cli, ViewcountStatistics) {
   const std::string dem = std::string(HFVIS_DATA_DIR) + "/fractal_256.exr";
   const CliResult result =
