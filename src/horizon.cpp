@@ -52,9 +52,6 @@ struct RunDirection {
   std::vector<float> row_length, row_terms;
 };
 
-// Rows a strip's heights take on each side beyond its own: a receiver's period reaches a step
-// (|b| <= kMaxLatticeStep rows) away, the normals one row.
-constexpr int kStripHalo = kMaxLatticeStep + 1;
 
 // How a run uses its device memory budget: directions per downloaded batch of planes, the
 // hull-stack scratch (entries) every launch of the sweep shares, and the strips.
@@ -62,28 +59,33 @@ struct RunPlan {
   int directions_per_batch = 1;
   std::size_t stack_entries = 0;
   int strip_rows = 0;             // rows per strip: the field's height when it runs in one piece
+  int halo_rows = 0;              // strips: rows of heights on each side beyond a strip's own
   std::size_t carry_entries = 0;  // strips: entries each of the two buffers of carried stacks may take
 };
 
 // A field beyond the budget (or asked to): strips of as many rows as half the budget holds, the
 // rest for the hull stacks.
 RunPlan planStrips(const HeightField& field, const HorizonOptions& options, const HorizonOutputs& outputs,
-                   std::size_t budget, std::size_t max_alloc) {
+                   const std::vector<RunDirection>& directions, std::size_t budget, std::size_t max_alloc) {
+  RunPlan plan;
+  // A receiver's period reaches a step (|b| rows) away, the normals one row.
+  plan.halo_rows = 1;
+  for (const RunDirection& d : directions) plan.halo_rows = std::max(plan.halo_rows, std::abs(d.lattice.b) + 1);
+  const std::size_t halo_rows = plan.halo_rows;
   const std::size_t row = field.width * sizeof(float);
   // Per row of a strip: heights, the sums, the normals' two slopes, one direction's planes.
   const std::size_t per_row = row * (1 + outputs.sky_view_factor + outputs.ambient_occlusion * 3 +
                                      outputs.horizon_angles + outputs.horizon_distances);
-  const std::size_t halo = 2 * kStripHalo * row;
+  const std::size_t halo = 2 * halo_rows * row;
   std::size_t rows = budget / 2 > halo ? (budget / 2 - halo) / per_row : 0;
   // The largest buffers: a strip's heights with its halo, and its normals.
-  rows = std::min({rows, max_alloc / row > 2 * kStripHalo ? max_alloc / row - 2 * kStripHalo : 0,
+  rows = std::min({rows, max_alloc / row > 2 * halo_rows ? max_alloc / row - 2 * halo_rows : 0,
                    max_alloc / (2 * row)});
   if (options.strip_rows > 0) rows = std::min<std::size_t>(rows, options.strip_rows);
   if (rows < 1)
     throw MemoryBudgetError("a strip of one row needs " + mebibytes(2 * (per_row + halo)) +
                             " of device memory but the budget is " + mebibytes(budget) +
                             " (largest single buffer " + mebibytes(max_alloc) + "); raise the memory budget");
-  RunPlan plan;
   plan.strip_rows = static_cast<int>(std::min<std::size_t>(rows, field.height));
   const std::size_t rest = budget - (plan.strip_rows * per_row + halo);
   // A quarter for the scratch (lines run in chunks of it), the rest for the two buffers of
@@ -121,7 +123,8 @@ RunPlan planRun(const HeightField& field, const HorizonOptions& options, const H
   const bool fits = least <= budget && per_direction <= max_alloc && longest * kStackEntryBytes <= max_alloc &&
                     fixed <= budget;
   if (!fits || (options.strip_rows > 0 && options.strip_rows < field.height)) {
-    if (sweep && options.max_distance == 0.0) return planStrips(field, options, outputs, budget, max_alloc);
+    if (sweep && options.max_distance == 0.0)
+      return planStrips(field, options, outputs, directions, budget, max_alloc);
     throw MemoryBudgetError("one direction needs " + mebibytes(least) + " of device memory but the budget is " +
                             mebibytes(budget) + " (largest single buffer " + mebibytes(max_alloc) + "), and " +
                             (sweep ? "a maximum distance" : "the naive method") +
@@ -237,7 +240,8 @@ class HorizonRoutine : public SweepRoutine {
     row_cells_ = rowCells();
     if (inStrips()) {
       heights_ = deviceBuffer(
-          st_, std::min<std::size_t>(plan_.strip_rows + 2 * kStripHalo, field_.height) * field_.width * sizeof(float));
+          st_, std::min<std::size_t>(plan_.strip_rows + 2 * plan_.halo_rows, field_.height) * field_.width *
+                   sizeof(float));
     } else if (outputs_.ambient_occlusion) {
       computeNormals(0, 0, field_.height);
     }
@@ -319,11 +323,11 @@ class HorizonRoutine : public SweepRoutine {
                cl::NDRange(kTileX, kTileY));
   }
 
-  // Strips: puts rows [s0, s1) on the device (their heights with kStripHalo rows around, their
+  // Strips: puts rows [s0, s1) on the device (their heights with the halo's rows around, their
   // sums so far, their normals); returns the first row of the heights there.
   int loadStrip(int s0, int s1) {
     const std::size_t width = field_.width;
-    const int row0 = std::max(0, s0 - kStripHalo), row1 = std::min(field_.height, s1 + kStripHalo);
+    const int row0 = std::max(0, s0 - plan_.halo_rows), row1 = std::min(field_.height, s1 + plan_.halo_rows);
     st_.queue.enqueueWriteBuffer(heights_, CL_FALSE, 0, (row1 - row0) * width * sizeof(float),
                                  &prepared_.heights[row0 * width]);
     const std::size_t bytes = (s1 - s0) * width * sizeof(float);

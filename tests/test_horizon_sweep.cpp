@@ -495,12 +495,11 @@ TEST(HorizonKernels, ABudgetBelowTheWholeFieldRunsItInStrips) {
   expectBitsEqual(computeHorizons(testContext(), field, options, outputs), whole);
   EXPECT_GT(strips, 2);
   options.strip_progress = nullptr;
-  // A dome keeps most samples of a line on its hull: strips of 4 rows (their buffers half the
-  // budget) leave 40 KB for stacks, 15 KB for each buffer of those carried, far too few; thinner
-  // strips (down to one row, which computeHorizons tries) do not help enough.
+  // A dome keeps most samples of a line on its hull. 52 KB hold strips of two rows (their
+  // buffers half the budget) and leave about 28 KB for stacks, 11 KB for each buffer of those
+  // carried: far too few, and strips of one row (computeHorizons tries them) do not help enough.
   const HeightField dome = makeSyntheticField("dome", 300, 200, 4);
-  options.strip_rows = 4;
-  options.memory_budget_bytes = 2 * (4 * 5 * 300 * 4 + 2 * 65 * 300 * 4) + 40 * 1024;
+  options.memory_budget_bytes = 52 * 1024;
   try {
     computeHorizons(testContext(), dome, options, outputs);
     ADD_FAILURE() << "no MemoryBudgetError";
