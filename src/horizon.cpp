@@ -60,7 +60,8 @@ struct RunPlan {
   std::size_t stack_entries = 0;
   int strip_rows = 0;             // rows per strip: the field's height when it runs in one piece
   int halo_rows = 0;              // strips: rows of heights on each side beyond a strip's own
-  std::size_t carry_entries = 0;  // strips: entries each of the two buffers of carried stacks may take
+  std::size_t carry_entries = 0;  // strips: entries the two buffers of carried stacks may take together
+  std::size_t budget = 0, per_row = 0, halo_bytes = 0;  // strips: what they were planned from
 };
 
 // A field beyond the budget (or asked to): strips of as many rows as half the budget holds, the
@@ -87,11 +88,16 @@ RunPlan planStrips(const HeightField& field, const HorizonOptions& options, cons
                             " of device memory but the budget is " + mebibytes(budget) +
                             " (largest single buffer " + mebibytes(max_alloc) + "); raise the memory budget");
   plan.strip_rows = static_cast<int>(std::min<std::size_t>(rows, field.height));
+  plan.budget = budget;
+  plan.per_row = per_row;
+  plan.halo_bytes = halo;
   const std::size_t rest = budget - (plan.strip_rows * per_row + halo);
-  // A quarter for the scratch (lines run in chunks of it), the rest for the two buffers of
-  // carried stacks, which must hold every line under way at once.
-  plan.stack_entries = std::min(rest / 4, max_alloc) / kStackEntryBytes;
-  plan.carry_entries = std::min(rest / 8 * 3, max_alloc) / kStackEntryBytes;
+  // An eighth for the scratch (lines run in chunks of it), the rest for the two buffers of
+  // carried stacks (those a strip starts with and those it hands on), which must hold every
+  // line under way at once: smooth terrain keeps a hundred or more samples of a line on its
+  // hull (the sine field at 4096^2: 190 entries per line crossing a strip's edge).
+  plan.stack_entries = std::min(rest / 8, max_alloc) / kStackEntryBytes;
+  plan.carry_entries = rest / 8 * 7 / kStackEntryBytes;
   return plan;
 }
 
@@ -192,8 +198,8 @@ std::vector<RunDirection> runDirectionsOf(const HeightField& field, const Horizo
   return out;
 }
 
-// Hull stacks that outgrow what the budget leaves beside strips of `rows` rows (thinner strips
-// leave more; computeHorizons retries with them).
+// Hull stacks that outgrow what the budget leaves beside the strips; `rows`: thinner strips that
+// leave room for them (computeHorizons retries with those), 0 when none do.
 struct StacksBeyondStrips : MemoryBudgetError {
   StacksBeyondStrips(const std::string& message, int strip_rows) : MemoryBudgetError(message), rows(strip_rows) {}
   int rows;
@@ -461,6 +467,7 @@ class HorizonRoutine : public SweepRoutine {
     std::vector<cl_int4> resume(d.lines.size(), cl_int4{{0, 0, 0, 0}});
     std::vector<char> waiting(d.lines.size(), 0);  // whether its stack waits in carry_in
     cl::Buffer carry_in = placeholder_;
+    std::size_t carried_in = 0;  // entries in carry_in
     for (int step = 0; step < strips; ++step) {
       const int s = b > 0 ? strips - 1 - step : step;  // rows fall along a line when b > 0
       const int s0 = s * rows, s1 = std::min(field_.height, s0 + rows);
@@ -483,7 +490,8 @@ class HorizonRoutine : public SweepRoutine {
         state.s[0] = first;
         states.push_back(state);
         capacities.push_back(static_cast<std::size_t>(state.s[1]) + (end - first) * per_period);
-        if (capacities.back() > plan_.stack_entries) failCarry("one line's hull stack", capacities.back());
+        if (capacities.back() > plan_.stack_entries)  // the scratch is an eighth of the rest
+          failCarry("one line's hull stack", capacities.back(), capacities.back() * kStackEntryBytes * 8);
         owner.push_back(j);
       }
       std::size_t carried = 0, capacity = 0;  // entries in carry_out
@@ -493,9 +501,11 @@ class HorizonRoutine : public SweepRoutine {
       auto carryOut = [&](const cl::Buffer& lines_buffer, const cl::Buffer& states_buffer,
                           const std::vector<cl_int>& offsets, const cl::Buffer& source, cl_uint stride) {
         if (carried > capacity) {
-          if (carried > plan_.carry_entries || carried >= (std::size_t(1) << 31))
-            failCarry("the hull stacks carried into the next strip", carried);
-          const std::size_t grown = std::min(std::max(carried, 2 * capacity), plan_.carry_entries);
+          if (carried_in + carried > plan_.carry_entries || carried >= (std::size_t(1) << 31))
+            failCarry("the hull stacks carried into the next strip", carried_in + carried,
+                      (carried_in + carried) * kStackEntryBytes / 7 * 8);
+          const std::size_t grown =
+              std::min(std::max(carried, 2 * capacity), std::min(plan_.carry_entries - carried_in, max_alloc()));
           cl::Buffer bigger = deviceBuffer(st_, grown * kStackEntryBytes);
           if (capacity) st_.queue.enqueueCopyBuffer(carry_out, bigger, 0, 0, capacity * kStackEntryBytes);
           carry_out = bigger;
@@ -573,15 +583,25 @@ class HorizonRoutine : public SweepRoutine {
       if (outputs_.sky_view_factor) readRows(svf_, result_.sky_view_factor, s0, s1);
       if (outputs_.ambient_occlusion) readRows(ao_, result_.ambient_occlusion, s0, s1);
       carry_in = carried ? carry_out : placeholder_;
+      carried_in = carried;
       if (horizon_.strip_progress) horizon_.strip_progress(step + 1, strips);
     }
   }
 
-  [[noreturn]] void failCarry(const std::string& what, std::size_t entries) const {
+  std::size_t max_alloc() const {
+    return (st_.info.max_allocation_bytes ? st_.info.max_allocation_bytes : plan_.budget) / kStackEntryBytes;
+  }
+
+  // Stacks of `entries` do not fit beside the strips, which would need to leave `rest` bytes: the
+  // strips to try instead (at most half as tall, leaving 1.25 times that), 0 when none would do.
+  [[noreturn]] void failCarry(const std::string& what, std::size_t entries, std::size_t rest) const {
+    const std::size_t room = rest / 4 * 5;
+    const std::size_t fitting =
+        plan_.budget > plan_.halo_bytes + room ? (plan_.budget - plan_.halo_bytes - room) / plan_.per_row : 0;
     throw StacksBeyondStrips(what + " needs " + mebibytes(entries * kStackEntryBytes) +
                                  " of device memory, more than the budget leaves beside strips of " +
                                  std::to_string(plan_.strip_rows) + " rows; raise the memory budget",
-                             plan_.strip_rows);
+                             static_cast<int>(std::min<std::size_t>(plan_.strip_rows / 2, fitting)));
   }
 
   void launchNaive(const RunDirection& d, cl_uint plane_offset) {
@@ -620,8 +640,8 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
   detail::requireSupported(field, options);
   detail::checkPixelIndexing(field, 1);
   return detail::translateOpenClErrors([&] {
-    // Hull stacks too deep for the room strips leave: again from the start with strips half as
-    // tall (down to one row), as the sums of the strips done cannot be taken back.
+    // Hull stacks too deep for the room strips leave: again from the start with thinner strips
+    // (StacksBeyondStrips::rows), as the sums of the strips done cannot be taken back.
     HorizonOptions attempt = options;
     for (;;) {
       try {
@@ -629,8 +649,8 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
         routine.run();
         return routine.take();
       } catch (const detail::StacksBeyondStrips& error) {
-        if (error.rows <= 1) throw MemoryBudgetError(error.what());
-        attempt.strip_rows = error.rows / 2;
+        if (error.rows < 1) throw MemoryBudgetError(error.what());
+        attempt.strip_rows = error.rows;
       }
     }
   });
