@@ -3,9 +3,10 @@
 # memory budget, batching and chunking as a user gets them): wall time and peak resident host
 # memory (/usr/bin/time -v) of `hfvis svf` and `hfvis ao` at K directions on data/make_data.py's
 # sine field at each size N, svf also within a maximum distance (--max-distance D ground
-# units; cell size 1) and under a memory budget of N^2 bytes (a device a quarter of the
+# units; cell size 1) and under a memory budget of 2 N^2 bytes (a device half the size of the
 # field's heights: the field runs in strips), at least N / 128 MiB (room for the hull stacks
-# carried from strip to strip: 200 entries of 8 bytes per line on this smooth field). Prints a Markdown table; inputs go to
+# carried from strip to strip: on this smooth field about 200 entries of 8 bytes per line at
+# N = 4096 and 850 at 16384). Prints a Markdown table; inputs go to
 # bench/out/data/ (the 16384^2 EXR is 139 MB), outputs to bench/out/large/.
 #
 #   bench/large_fields.sh [--sizes 1024,4096,16384] [-k K] [--max-distance D] [--field NAME]
@@ -22,7 +23,7 @@ while [[ $# -gt 0 ]]; do
     -k) k=$2; shift ;;
     --max-distance) max_distance=$2; shift ;;
     --field) field=$2; shift ;;
-    -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,14p' "$0"; exit 0 ;;
     *) echo "large_fields.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
   shift
@@ -54,7 +55,7 @@ IFS=, read -r -a size_list <<< "$sizes"
 for n in "${size_list[@]}"; do
   exr=$data/${field}_$n.exr
   [[ -f $exr ]] || /usr/bin/python3 "$root/data/make_data.py" --size "$n" --out "$data" --no-dem --fields "$field" > /dev/null
-  budget=$(awk -v n="$n" 'BEGIN { b = n * n / 1048576; printf "%g", b < n / 128 ? n / 128 : b }')  # MiB
+  budget=$(awk -v n="$n" 'BEGIN { b = n * n / 524288; printf "%g", b < n / 128 ? n / 128 : b }')  # MiB
   for job in "svf" "svf --max-distance $max_distance" "ao" "svf --memory-budget $budget"; do
     read -r -a words <<< "$job"
     log=$out/time_${n}_${words[0]}.log

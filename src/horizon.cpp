@@ -501,11 +501,12 @@ class HorizonRoutine : public SweepRoutine {
       auto carryOut = [&](const cl::Buffer& lines_buffer, const cl::Buffer& states_buffer,
                           const std::vector<cl_int>& offsets, const cl::Buffer& source, cl_uint stride) {
         if (carried > capacity) {
-          if (carried_in + carried > plan_.carry_entries || carried >= (std::size_t(1) << 31))
+          if (carried_in + carried > plan_.carry_entries || carried > maxAllocationEntries() ||
+              carried >= (std::size_t(1) << 31))
             failCarry("the hull stacks carried into the next strip", carried_in + carried,
                       (carried_in + carried) * kStackEntryBytes / 7 * 8);
           const std::size_t grown =
-              std::min(std::max(carried, 2 * capacity), std::min(plan_.carry_entries - carried_in, max_alloc()));
+              std::min({std::max(carried, 2 * capacity), plan_.carry_entries - carried_in, maxAllocationEntries()});
           cl::Buffer bigger = deviceBuffer(st_, grown * kStackEntryBytes);
           if (capacity) st_.queue.enqueueCopyBuffer(carry_out, bigger, 0, 0, capacity * kStackEntryBytes);
           carry_out = bigger;
@@ -588,7 +589,8 @@ class HorizonRoutine : public SweepRoutine {
     }
   }
 
-  std::size_t max_alloc() const {
+  // Stack entries the device's largest single buffer holds.
+  std::size_t maxAllocationEntries() const {
     return (st_.info.max_allocation_bytes ? st_.info.max_allocation_bytes : plan_.budget) / kStackEntryBytes;
   }
 
