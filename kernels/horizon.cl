@@ -64,8 +64,8 @@
 #if HFVIS_MAX_DISTANCE && HFVIS_ROW_SPACING
 #error "a maximum distance on a field with per-row spacing is not supported"
 #endif
-#if HFVIS_MAX_DISTANCE && HFVIS_STRIPS
-#error "a maximum distance in strips is not supported"
+#if HFVIS_MAX_DISTANCE && HFVIS_STRIPS && HFVIS_LANES != 1
+#error "a maximum distance in strips needs one line per work-item (a window's blocks are per line)"
 #endif
 
 // The normal at pixel (c, r), the sum of the unnormalised normals of the (up to) four quads
@@ -368,6 +368,16 @@ HFVIS_INLINE void hull_step(__global float2* stacks, lane_int stack, int entry, 
 #define HFVIS_STACK_HEIGHT(h, here) (h)
 #endif
 
+#if HFVIS_STRIPS
+// The block of the sample `tau` before receiver `index` of a line, computed as horizon_lattice's
+// loop computes it (position and difference in statements of their own: no fused multiply-add).
+HFVIS_INLINE int block_of(int index, float tau, float period, float inv_window) {
+  const float base = (float)index * period;
+  const float here = base - tau;
+  return (int)floor(here * inv_window);
+}
+#endif
+
 // Horizons within a window of `window` pixels along the line (HFVIS_MAX_DISTANCE). The line's
 // positions are cut into blocks of the window's length (block = floor(position / window));
 // a receiver's window then lies in its own block and the one before. The forward sweep
@@ -388,21 +398,23 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
                               __global const LatticeSample* samples, int n_samples, int a, int b, float period,
                               float window, float inv_window, float drop, lane_int c, lane_int r,
                               lane_int receivers, lane_int stack, int entry, int i, int q, int k, int trips,
-                              __global float2* stacks, __global float2* window_far) {
-  int end = i;  // block k's receivers are periods i .. end - 1 (none if it ends within period i)
-  while (end < trips && (int)floor((float)end * period * inv_window) == k) ++end;
+                              int offset, __global float2* stacks, __global float2* window_far) {
+  // Periods are counted from the launch's first receiver, `offset` along the whole line (a
+  // strip's part of a line; 0 otherwise); receivers before it (j < 0) are another launch's.
+  int end = max(i, 0);  // block k's receivers here are periods max(i, 0) .. end - 1
+  while (end < trips && (int)floor((float)(offset + end) * period * inv_window) == k) ++end;
   int ci = q > 0 ? i : i - 1, cq = q > 0 ? q - 1 : n_samples - 1;  // the nearest sample before (i, q)
   lane_int n = 0;
   lane_float top_h = 0.0f, top_p = 0.0f, below_h = 0.0f, below_p = 0.0f, rise = 0.0f, run = 0.0f;
-  for (int j = end - 1; j >= i; --j) {
-    const float x = (float)j * period;
-    while (ci >= 0) {
+  for (int j = end - 1; j >= max(i, 0); --j) {
+    const float x = (float)(offset + j) * period;
+    while (offset + ci >= 0) {
       __global const LatticeSample* s = samples + cq;
-      const float here = (float)ci * period - s->tau;
+      const float here = (float)(offset + ci) * period - s->tau;
       if ((int)floor(here * inv_window) != k - 1 || x - here > window) break;
       lane_int valid;
       const lane_float h = lane_sample_height(heights, width, height, row0, s, c - (ci - i) * a, r - (ci - i) * b,
-                                              ci < receivers, ci == 0, &valid);
+                                              ci < receivers, offset + ci == 0, &valid);
       hull_step(stacks, stack, entry, valid, HFVIS_STACK_HEIGHT(h, here), (lane_float)here, -1.0f, &n, &top_h,
                 &top_p, &below_h, &below_p, &rise, &run);
       if (--cq < 0) cq = n_samples - 1, --ci;
@@ -538,6 +550,33 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 #if HFVIS_MAX_DISTANCE
   int block = INT_MIN;  // the block of the stack's samples (none yet)
   int far_part = 0;     // whether window_pass gave this block's receivers the block before
+#if HFVIS_STRIPS
+#define LINE_OFFSET start
+  if (start > 0) {
+    // Resuming a line (one per work-item): the block of its last sample before this strip (the
+    // receiver start - 1, tau 0) and whether that is not the line's first block, as the sweep
+    // there left them (positions computed as the loop below computes them).
+    block = block_of(start - 1, samples[n_samples - 1].tau, period, inv_window);
+    far_part = block != block_of(0, samples[0].tau, period, inv_window);
+    if (far_part && block_of(start, samples[0].tau, period, inv_window) == block) {
+      // The strip starts inside a block: its receivers here need the block before as well. The
+      // block's first sample (ib, qb), periods counted from this strip's first receiver; the
+      // pass runs above the carried stack, which the block's own sweep goes on with.
+      int ib = 0, qb = 0;
+      for (;;) {
+        const int pi = qb > 0 ? ib : ib - 1, pq = qb > 0 ? qb - 1 : n_samples - 1;
+        if (block_of(start + pi, samples[pq].tau, period, inv_window) != block) break;
+        ib = pi;
+        qb = pq;
+      }
+      window_pass(heights, width, height, row0, out_row0, samples, n_samples, a, b, period, window, inv_window,
+                  drop, c - ib * a, r - ib * b, receivers, stack + n * entry, entry, ib, qb, block,
+                  trips, start, stacks, window_far);
+    }
+  }
+#else
+#define LINE_OFFSET 0
+#endif
 #endif
   for (int i = 0; i < trips; ++i, c -= a, r -= b) {
     const lane_int live = i < receivers;
@@ -586,8 +625,8 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
         far_part = block != INT_MIN;
         if (far_part)
           window_pass(heights, width, height, row0, out_row0, samples, n_samples, a, b, period, window,
-                      inv_window, drop, c, r, receivers, stack, entry, i, q, sample_block, trips, stacks,
-                      window_far);
+                      inv_window, drop, c, r, receivers, stack, entry, i, q, sample_block, trips, LINE_OFFSET,
+                      stacks, window_far);
         block = sample_block;
         n = 0;
       }

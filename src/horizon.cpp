@@ -69,14 +69,22 @@ struct RunPlan {
 RunPlan planStrips(const HeightField& field, const HorizonOptions& options, const HorizonOutputs& outputs,
                    const std::vector<RunDirection>& directions, std::size_t budget, std::size_t max_alloc) {
   RunPlan plan;
-  // A receiver's period reaches a step (|b| rows) away, the normals one row.
+  // A receiver's period reaches a step (|b| rows) away, the normals one row; within a maximum
+  // distance the window's pass reaches back to the start of the block before, up to two
+  // windows and a period along the line.
   plan.halo_rows = 1;
-  for (const RunDirection& d : directions) plan.halo_rows = std::max(plan.halo_rows, std::abs(d.lattice.b) + 1);
+  for (const RunDirection& d : directions) {
+    double periods = 1.0;
+    if (options.max_distance > 0.0) periods = (2.0 * d.window.window + 2.0 * d.lattice.period) / d.lattice.period;
+    plan.halo_rows = std::max(plan.halo_rows, static_cast<int>(std::ceil(periods * std::abs(d.lattice.b))) + 1);
+  }
   const std::size_t halo_rows = plan.halo_rows;
   const std::size_t row = field.width * sizeof(float);
-  // Per row of a strip: heights, the sums, the normals' two slopes, one direction's planes.
+  // Per row of a strip: heights, the sums, the normals' two slopes, one direction's planes, the
+  // window's float2.
   const std::size_t per_row = row * (1 + outputs.sky_view_factor + outputs.ambient_occlusion * 3 +
-                                     outputs.horizon_angles + outputs.horizon_distances);
+                                     outputs.horizon_angles + outputs.horizon_distances +
+                                     (options.max_distance > 0.0) * 2);
   const std::size_t halo = 2 * halo_rows * row;
   std::size_t rows = budget / 2 > halo ? (budget / 2 - halo) / per_row : 0;
   // The largest buffers: a strip's heights with its halo, and its normals.
@@ -129,13 +137,11 @@ RunPlan planRun(const HeightField& field, const HorizonOptions& options, const H
   const bool fits = least <= budget && per_direction <= max_alloc && longest * kStackEntryBytes <= max_alloc &&
                     fixed <= budget;
   if (!fits || (options.strip_rows > 0 && options.strip_rows < field.height)) {
-    if (sweep && options.max_distance == 0.0)
-      return planStrips(field, options, outputs, directions, budget, max_alloc);
+    if (sweep) return planStrips(field, options, outputs, directions, budget, max_alloc);
     throw MemoryBudgetError("one direction needs " + mebibytes(least) + " of device memory but the budget is " +
-                            mebibytes(budget) + " (largest single buffer " + mebibytes(max_alloc) + "), and " +
-                            (sweep ? "a maximum distance" : "the naive method") +
-                            " needs the whole field at once (no strips); raise the memory budget or use a "
-                            "smaller field");
+                            mebibytes(budget) + " (largest single buffer " + mebibytes(max_alloc) +
+                            "), and the naive method needs the whole field at once (no strips); raise the "
+                            "memory budget or use a smaller field");
   }
   const std::size_t available = budget - fixed;
   RunPlan plan;
@@ -214,7 +220,10 @@ class HorizonRoutine : public SweepRoutine {
         outputs_(outputs),
         lanes_(sweepLanes(st)),
         directions_(runDirectionsOf(field, options, outputs)),
-        plan_(planRun(field, options, outputs, directions_, st.info)) {}
+        plan_(planRun(field, options, outputs, directions_, st.info)) {
+    // A window's blocks are per line, so its strips run one line per work-item.
+    if (inStrips() && options.max_distance > 0.0) lanes_ = 1;
+  }
 
   HorizonResult take() { return std::move(result_); }
 
@@ -462,6 +471,10 @@ class HorizonRoutine : public SweepRoutine {
     const int rows = plan_.strip_rows, strips = (field_.height + rows - 1) / rows;
     const int a = d.lattice.a, b = d.lattice.b;
     const std::size_t per_period = d.samples.size();
+    // Within a maximum distance the window's pass pushes the samples of the block before, up to a
+    // window and two periods of them, above a resumed line's stack.
+    const std::size_t window_periods =
+        horizon_.max_distance > 0.0 ? static_cast<std::size_t>(std::ceil(d.window.window / d.lattice.period)) + 2 : 0;
     // Each line's sweep so far: (unused, its stack's size, the stack's offset in carry_in,
     // its ground position's float bits).
     std::vector<cl_int4> resume(d.lines.size(), cl_int4{{0, 0, 0, 0}});
@@ -489,7 +502,7 @@ class HorizonRoutine : public SweepRoutine {
         cl_int4 state = resume[j];
         state.s[0] = first;
         states.push_back(state);
-        capacities.push_back(static_cast<std::size_t>(state.s[1]) + (end - first) * per_period);
+        capacities.push_back(static_cast<std::size_t>(state.s[1]) + (end - first + window_periods) * per_period);
         if (capacities.back() > plan_.stack_entries)  // the scratch is an eighth of the rest
           failCarry("one line's hull stack", capacities.back(), capacities.back() * kStackEntryBytes * 8);
         owner.push_back(j);

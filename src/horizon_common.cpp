@@ -24,8 +24,6 @@ void validate(const HorizonOptions& options, const HorizonOutputs& outputs) {
                           std::to_string(options.strip_rows) + ")");
   if (options.strip_rows > 0 && options.method == HorizonMethod::Naive)
     throw InvalidArgument("the naive method does not run in strips (each ray reads the whole field)");
-  if (options.strip_rows > 0 && options.max_distance > 0.0)
-    throw InvalidArgument("a maximum distance does not run in strips yet");
 }
 
 namespace detail {

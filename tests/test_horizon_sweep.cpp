@@ -434,8 +434,8 @@ void expectBitsEqual(const HorizonResult& strips, const HorizonResult& whole) {
 
 // A field in strips of rows, each line's hull stack carried from strip to strip, gives the
 // whole-field result bit for bit: every hard case on three awkward sizes, strips of 1 and 6 rows,
-// steps up to 5 rows (K = 24 exact azimuths), curvature, denser sampling and per-row spacing,
-// in both layouts.
+// steps up to 5 rows (K = 24 exact azimuths), curvature, denser sampling and per-row spacing, in
+// both layouts.
 TEST(HorizonKernels, StripsEqualTheWholeFieldBitForBit) {
   testing::forEachLayout([&](const ComputeContext& context) {
     for (const auto& name : syntheticFieldNames()) {
@@ -475,6 +475,30 @@ TEST(HorizonKernels, StripsEqualTheWholeFieldBitForBit) {
         options.strip_rows = 4;
         expectBitsEqual(computeHorizons(context, field, options, outputs), whole);
         options.strip_rows = 0;
+      }
+    }
+  });
+}
+
+// The same within maximum distances: the window's blocks resumed part-way, strips that start
+// inside a block (whose pass reaches back into the halo), a window of 40 pixels across many
+// strips, with curvature too, in both layouts.
+TEST(HorizonKernels, StripsWithinAMaximumDistanceEqualTheWholeFieldBitForBit) {
+  testing::forEachLayout([&](const ComputeContext& context) {
+    for (const char* name : {"noise", "nan_holes", "spikes"}) {
+      for (double max_distance : {2.5, 9.0, 40.0}) {
+        SCOPED_TRACE(std::string(name) + " max distance " + std::to_string(max_distance));
+        const HeightField field = makeSyntheticField(name, 33, 31, 2);
+        HorizonOptions options;
+        options.directions = 24;
+        options.max_distance = max_distance;
+        options.curvature = max_distance == 9.0 ? 0.01 : 0.0;
+        const auto whole = computeHorizons(context, field, options, allOutputs());
+        for (int rows : {1, 5}) {
+          SCOPED_TRACE("strips of " + std::to_string(rows) + " rows");
+          options.strip_rows = rows;
+          expectBitsEqual(computeHorizons(context, field, options, allOutputs()), whole);
+        }
       }
     }
   });

@@ -35,7 +35,7 @@ struct HorizonOptions : SweepOptions {
   // budget at once runs in horizontal strips, each line's hull stack carried from strip to
   // strip, so the results equal a whole-field run bit for bit. 0: the whole field when it fits,
   // else as many rows as half the budget holds; fewer rows than the field's force strips.
-  // A maximum distance and the naive method need the whole field.
+  // The naive method needs the whole field.
   int strip_rows = 0;
 };
 
