@@ -4,7 +4,8 @@
 # memory (/usr/bin/time -v) of `hfvis svf` and `hfvis ao` at K directions on data/make_data.py's
 # sine field at each size N, svf also within a maximum distance (--max-distance D ground
 # units; cell size 1) and under a memory budget of 2 N^2 bytes (a device half the size of the
-# field's heights: the field runs in strips; svf with and without the maximum distance), at least N / 128 MiB (room for the hull stacks
+# field's heights: the field runs in strips; svf with and without the maximum distance, whose
+# strips get room for their taller halo besides), at least N / 128 MiB (room for the hull stacks
 # carried from strip to strip: on this smooth field about 200 entries of 8 bytes per line at
 # N = 4096 and 850 at 16384). Prints a Markdown table; inputs go to
 # bench/out/data/ (the 16384^2 EXR is 139 MB), outputs to bench/out/large/.
@@ -56,8 +57,13 @@ for n in "${size_list[@]}"; do
   exr=$data/${field}_$n.exr
   [[ -f $exr ]] || /usr/bin/python3 "$root/data/make_data.py" --size "$n" --out "$data" --no-dem --fields "$field" > /dev/null
   budget=$(awk -v n="$n" 'BEGIN { b = n * n / 524288; printf "%g", b < n / 128 ? n / 128 : b }')  # MiB
-  for job in "svf" "svf --max-distance $max_distance" "ao" "svf --memory-budget $budget" \
-    "svf --max-distance $max_distance --memory-budget $budget"; do
+  # Within the maximum distance a strip's heights take up to 2 D + a period more rows on each
+  # side (at most 4 D + 8 rows for K = 16): the budget adds room for them in its half for strips.
+  window_budget=$(awk -v n="$n" -v b="$budget" -v d="$max_distance" 'BEGIN { printf "%g", b + 2 * (4 * d + 8) * n * 4 / 1048576 }')
+  jobs=("svf" "svf --max-distance $max_distance" "ao" "svf --memory-budget $budget")
+  # (Below N = 4096 that budget holds the whole field: no strips to measure.)
+  ((n >= 4096)) && jobs+=("svf --max-distance $max_distance --memory-budget $window_budget")
+  for job in "${jobs[@]}"; do
     read -r -a words <<< "$job"
     log=$out/time_${n}_${words[0]}.log
     /usr/bin/time -v "$cli" "${words[@]}" "$exr" -o "$out/${words[0]}_$n.exr" -k "$k" -q 2> "$log" \

@@ -52,7 +52,6 @@ struct RunDirection {
   std::vector<float> row_length, row_terms;
 };
 
-
 // How a run uses its device memory budget: directions per downloaded batch of planes, the
 // hull-stack scratch (entries) every launch of the sweep shares, and the strips.
 struct RunPlan {
