@@ -61,8 +61,8 @@
 #ifndef HFVIS_STRIPS
 #define HFVIS_STRIPS 0
 #endif
-#if HFVIS_MAX_DISTANCE && HFVIS_ROW_SPACING
-#error "a maximum distance on a field with per-row spacing is not supported"
+#if HFVIS_MAX_DISTANCE && HFVIS_ROW_SPACING && (HFVIS_LANES != 1 || HFVIS_STRIPS)
+#error "a maximum distance with per-row spacing runs one line per work-item, on the whole field"
 #endif
 #if HFVIS_MAX_DISTANCE && HFVIS_STRIPS && HFVIS_LANES != 1
 #error "a maximum distance in strips needs one line per work-item (a window's blocks are per line)"
@@ -378,7 +378,8 @@ HFVIS_INLINE int block_of(int index, float tau, float period, float inv_window) 
 }
 #endif
 
-// Horizons within a window of `window` pixels along the line (HFVIS_MAX_DISTANCE). The line's
+// Horizons within a window of `window` pixels along the line (HFVIS_MAX_DISTANCE; ground units,
+// and positions ground lengths, with HFVIS_ROW_SPACING, one line per work-item). The line's
 // positions are cut into blocks of the window's length (block = floor(position / window));
 // a receiver's window then lies in its own block and the one before. The forward sweep
 // restarts its stack at every block, so it gives the steepest sample of the receiver's own
@@ -398,19 +399,46 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
                               __global const LatticeSample* samples, int n_samples, int a, int b, float period,
                               float window, float inv_window, float drop, lane_int c, lane_int r,
                               lane_int receivers, lane_int stack, int entry, int i, int q, int k, int trips,
-                              int offset, __global float2* stacks, __global float2* window_far) {
+                              int offset, float base, float inv_period, __global const float* row_length,
+                              __global float* receiver_base, __global float2* stacks,
+                              __global float2* window_far) {
   // Periods are counted from the launch's first receiver, `offset` along the whole line (a
   // strip's part of a line; 0 otherwise); receivers before it (j < 0) are another launch's.
   int end = max(i, 0);  // block k's receivers here are periods max(i, 0) .. end - 1
+#if HFVIS_ROW_SPACING
+  // Positions are ground lengths, summed along the line (one line per work-item): receiver j's
+  // is receiver_base[its pixel], which the forward sweep stores as it reaches it (from `base`,
+  // receiver i's). Block k's receivers are not reached yet: their positions are summed on here
+  // as the forward sweep will sum them, and stored.
+  for (float x = base; end < trips; ++end) {
+    const int er = r - (end - i) * b;
+    if (end > i) x = x + row_length[er];
+    if ((int)floor(x * inv_window) != k) break;
+    receiver_base[(er - out_row0) * width + (c - (end - i) * a)] = x;
+  }
+#else
   while (end < trips && (int)floor((float)(offset + end) * period * inv_window) == k) ++end;
+#endif
   int ci = q > 0 ? i : i - 1, cq = q > 0 ? q - 1 : n_samples - 1;  // the nearest sample before (i, q)
   lane_int n = 0;
   lane_float top_h = 0.0f, top_p = 0.0f, below_h = 0.0f, below_p = 0.0f, rise = 0.0f, run = 0.0f;
   for (int j = end - 1; j >= max(i, 0); --j) {
+#if HFVIS_ROW_SPACING
+    const float x = receiver_base[(r - (j - i) * b - out_row0) * width + (c - (j - i) * a)];
+#else
     const float x = (float)(offset + j) * period;
+#endif
     while (offset + ci >= 0) {
       __global const LatticeSample* s = samples + cq;
+#if HFVIS_ROW_SPACING
+      // As the forward sweep computes a sample's position.
+      const int sr = r - (ci - i) * b;
+      const float sample_base = receiver_base[(sr - out_row0) * width + (c - (ci - i) * a)];
+      const float tau_scale = row_length[sr] * inv_period;
+      const float here = sample_base - s->tau * tau_scale;
+#else
       const float here = (float)(offset + ci) * period - s->tau;
+#endif
       if ((int)floor(here * inv_window) != k - 1 || x - here > window) break;
       lane_int valid;
       const lane_float h = lane_sample_height(heights, width, height, row0, s, c - (ci - i) * a, r - (ci - i) * b,
@@ -475,7 +503,8 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
 // period_ground = period * ground_per_pixel, the ground length of a period.
 //
 // Strips (a field beyond the device's memory, src/horizon.cpp): `heights` holds the field's
-// rows from row0 on and the outputs (normals, planes, sums, window_far) its rows from out_row0
+// rows from row0 on and the outputs (normals, planes, sums, window_far, receiver_base) its rows
+// from out_row0
 // on. With HFVIS_STRIPS, line j resumes its whole line's sweep: line_state[j] = (index of its
 // first receiver here along the whole line, entries of the stack it arrives with, their offset
 // in carry_in, the receivers' ground position before it as float bits (HFVIS_ROW_SPACING));
@@ -483,8 +512,10 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
 // .y and the ground position into .w (carry_stacks then moves the stacks on). Without, every
 // line starts at its far end with an empty stack and line_state and carry_in are not used.
 //
-// With HFVIS_MAX_DISTANCE only samples within `window` pixels (inv_window = 1 / window) count
-// (window_pass; window_far: one (rise, run) per pixel; lines start at their far end). With
+// With HFVIS_MAX_DISTANCE only samples within `window` (pixels along the line; ground units
+// with HFVIS_ROW_SPACING) count, inv_window = 1 / window (window_pass; window_far: one (rise,
+// run) per pixel; in strips one line per work-item; with HFVIS_ROW_SPACING one line per
+// work-item on the whole field, receiver_base the receivers' ground positions). With
 // HFVIS_ROW_SPACING positions are ground lengths: row_length[r] is the ground length of the
 // period from a receiver in row r to the next one along +(a, b), row_terms[r] that period's
 // unit ground direction (x, y), weight and swath (they replace cos_azimuth, sin_azimuth, weight
@@ -499,7 +530,8 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
                               float cos_azimuth,
                               float sin_azimuth, float weight, float swath, uint plane, __global float2* stacks,
                               uint stride, __global int4* line_state, __global const float2* carry_in,
-                              __global float2* window_far, __global const float2* normals,
+                              __global float2* window_far, __global float* receiver_base,
+                              __global const float2* normals,
                               __global float* angles, __global float* distances, __global float* svf_sum,
                               __global float* ao_sum) {
   const int first = get_global_id(0) * HFVIS_LANES;
@@ -515,6 +547,8 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 #if HFVIS_ROW_SPACING
   const float inv_period = 1.0f / period;
   lane_float base = 0.0f;  // the receivers' ground position along their lines
+#else
+  const float inv_period = 0.0f;  // (window_pass takes it with per-row spacing only)
 #endif
   int trips = 0;  // the longest line's receivers
 #pragma unroll
@@ -571,7 +605,7 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
       }
       window_pass(heights, width, height, row0, out_row0, samples, n_samples, a, b, period, window, inv_window,
                   drop, c - ib * a, r - ib * b, receivers, stack + n * entry, entry, ib, qb, block,
-                  trips, start, stacks, window_far);
+                  trips, start, 0.0f, inv_period, row_length, receiver_base, stacks, window_far);
     }
   }
 #else
@@ -595,6 +629,10 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
       LANE(swath_l, l) = terms.w;
     }
     base = select(base, base + period_length, live & (along > 0));  // kept where a line has ended (carried)
+#if HFVIS_MAX_DISTANCE
+    // The window's pass reads the positions of the receivers behind (one line per work-item).
+    if (live) receiver_base[(r - out_row0) * width + c] = base;
+#endif
     const lane_float tau_scale = period_length * inv_period;  // ground length per pixel of tau
     const lane_float period_ground_l = period_length;
 #elif HFVIS_STRIPS
@@ -626,7 +664,7 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
         if (far_part)
           window_pass(heights, width, height, row0, out_row0, samples, n_samples, a, b, period, window,
                       inv_window, drop, c, r, receivers, stack, entry, i, q, sample_block, trips, LINE_OFFSET,
-                      stacks, window_far);
+                      base, inv_period, row_length, receiver_base, stacks, window_far);
         block = sample_block;
         n = 0;
       }

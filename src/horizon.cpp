@@ -115,9 +115,11 @@ RunPlan planRun(const HeightField& field, const HorizonOptions& options, const H
       options.memory_budget_bytes ? options.memory_budget_bytes : defaultMemoryBudget(device);
   const std::size_t max_alloc = device.max_allocation_bytes ? device.max_allocation_bytes : budget;
   const std::size_t plane = field.pixelCount() * sizeof(float);
-  // Heights, the sums, the normals' two slopes, the window's float2 per pixel.
-  const std::size_t fixed = plane * (1 + outputs.sky_view_factor + outputs.ambient_occlusion * 3 +
-                                     (sweep && options.max_distance > 0.0) * 2);
+  // Heights, the sums, the normals' two slopes, the window's float2 per pixel (and with per-row
+  // spacing the receivers' positions).
+  const bool window = sweep && options.max_distance > 0.0;
+  const std::size_t fixed = plane * (1 + outputs.sky_view_factor + outputs.ambient_occlusion * 3 + window * 2 +
+                                     (window && hasRowSpacing(field)));
   const std::size_t per_direction = plane * (outputs.horizon_angles + outputs.horizon_distances);
   // Scratch: all of a direction's stacks in one launch when it fits; one line at a time at least.
   std::size_t whole = 0, longest = 0;
@@ -136,11 +138,14 @@ RunPlan planRun(const HeightField& field, const HorizonOptions& options, const H
   const bool fits = least <= budget && per_direction <= max_alloc && longest * kStackEntryBytes <= max_alloc &&
                     fixed <= budget;
   if (!fits || (options.strip_rows > 0 && options.strip_rows < field.height)) {
-    if (sweep) return planStrips(field, options, outputs, directions, budget, max_alloc);
+    if (sweep && !(window && hasRowSpacing(field)))
+      return planStrips(field, options, outputs, directions, budget, max_alloc);
     throw MemoryBudgetError("one direction needs " + mebibytes(least) + " of device memory but the budget is " +
                             mebibytes(budget) + " (largest single buffer " + mebibytes(max_alloc) +
-                            "), and the naive method needs the whole field at once (no strips); raise the "
-                            "memory budget or use a smaller field");
+                            "), and " +
+                            (sweep ? "a maximum distance on a field with per-row spacing" : "the naive method") +
+                            " needs the whole field at once (no strips); raise the memory budget or use a smaller "
+                            "field");
   }
   const std::size_t available = budget - fixed;
   RunPlan plan;
@@ -220,8 +225,9 @@ class HorizonRoutine : public SweepRoutine {
         lanes_(sweepLanes(st)),
         directions_(runDirectionsOf(field, options, outputs)),
         plan_(planRun(field, options, outputs, directions_, st.info)) {
-    // A window's blocks are per line, so its strips run one line per work-item.
-    if (inStrips() && options.max_distance > 0.0) lanes_ = 1;
+    // A window's blocks are per line, so its strips, and with per-row spacing its whole sweep
+    // (positions differ by line there), run one line per work-item.
+    if ((inStrips() || hasRowSpacing(field)) && options.max_distance > 0.0) lanes_ = 1;
   }
 
   HorizonResult take() { return std::move(result_); }
@@ -250,6 +256,7 @@ class HorizonRoutine : public SweepRoutine {
     stacks_ = st_.reusableBuffer("lattice stacks", plan_.stack_entries * kStackEntryBytes);
     const bool window = horizon_.method == HorizonMethod::Sweep && horizon_.max_distance > 0.0;
     window_far_ = deviceBuffer(st_, window ? 2 * plane * sizeof(float) : 0);
+    receiver_base_ = deviceBuffer(st_, window && hasRowSpacing(field_) ? plane * sizeof(float) : 0);
     placeholder_ = deviceBuffer(st_, 0);
     row_cells_ = rowCells();
     if (inStrips()) {
@@ -409,6 +416,7 @@ class HorizonRoutine : public SweepRoutine {
       kernel.setArg(arg++, placeholder_);  // line_state and carry_in, used in strips
       kernel.setArg(arg++, placeholder_);
       kernel.setArg(arg++, window_far_);
+      kernel.setArg(arg++, receiver_base_);
     }
     kernel.setArg(arg++, normals_);
     kernel.setArg(arg++, angles_);
@@ -641,7 +649,8 @@ class HorizonRoutine : public SweepRoutine {
   std::vector<RunDirection> directions_;
   RunPlan plan_;
   HorizonResult result_;
-  cl::Buffer angles_, distances_, svf_, ao_, normals_, stacks_, window_far_, row_cells_, placeholder_;
+  cl::Buffer angles_, distances_, svf_, ao_, normals_, stacks_, window_far_, receiver_base_, row_cells_,
+      placeholder_;
 };
 
 }  // namespace

@@ -30,8 +30,8 @@ void finishReduction(HorizonResult& result);
 // sweep's lines and the naive march's rays are then ground lengths summed step by step.
 bool hasRowSpacing(const HeightField& field);
 
-// Throws InvalidArgument for what the horizon operation does not do on this field: a maximum
-// distance with per-row spacing.
+// Throws InvalidArgument for what the horizon operation does not do on this field: with per-row
+// spacing, a maximum distance for the naive method or in strips.
 void requireSupported(const HeightField& field, const HorizonOptions& options);
 
 // A field with per-row spacing (HeightField::row_cell_size_x/y), as horizon_lattice takes it

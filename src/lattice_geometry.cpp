@@ -274,13 +274,19 @@ std::vector<LineChunk> chunkLines(std::vector<LatticeLine>& lines, const std::ve
 LatticeWindow latticeWindow(const HeightField& field, const LatticeDirection& d, double max_distance) {
   LatticeWindow w;
   if (max_distance <= 0.0) return w;
-  const double pixels = max_distance / d.ground_per_pixel;
-  // Positions along a line stay below 2 (W + H) pixels.
-  const double longest = 2.0 * (static_cast<double>(field.width) + field.height);
+  // Positions along a line are pixels, or ground lengths with per-row spacing; they stay below
+  // 2 (W + H) pixels, times the largest cell size.
+  double unit = d.ground_per_pixel, longest = 2.0 * (static_cast<double>(field.width) + field.height);
+  if (!field.row_cell_size_x.empty()) {
+    unit = 1.0;
+    longest *= std::max(*std::max_element(field.row_cell_size_x.begin(), field.row_cell_size_x.end()),
+                        *std::max_element(field.row_cell_size_y.begin(), field.row_cell_size_y.end()));
+  }
+  const double pixels = max_distance / unit;
   if (longest / pixels >= double(1 << 30)) {
     std::ostringstream message;
     message << "the maximum distance " << max_distance << " is too short for a field of this size (at least "
-            << longest / double(1 << 30) * d.ground_per_pixel << " ground units)";
+            << longest / double(1 << 30) * unit << " ground units)";
     throw InvalidArgument(message.str());
   }
   w.window = static_cast<float>(pixels);

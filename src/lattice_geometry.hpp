@@ -113,7 +113,8 @@ std::pair<int, int> receiversInRows(const LatticeLine& line, int b, int first_ro
 std::size_t lineCapacity(const LatticeLine& line, std::size_t samples_per_period);
 
 // A maximum distance along direction d as horizon_lattice takes it (HFVIS_MAX_DISTANCE):
-// `window` pixels along the line (max_distance over the ground length per pixel) and its
+// `window` pixels along the line (max_distance over the ground length per pixel; with per-row
+// spacing, whose positions are ground lengths, max_distance itself) and its
 // reciprocal, whose product with a position is the position's block. Both the kernel and the
 // reference get these very floats. Both 0 without a maximum distance. Throws InvalidArgument
 // when the window is so short that a position's block would overflow an int.

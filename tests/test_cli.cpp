@@ -1371,8 +1371,9 @@ TEST_F(CliGeoTiff, GeographicInputStaysGeographic) {
 
 // A tall latitude / longitude grid (1 degree cells, rows centred on 65 .. 55 N): a wall 4 cells
 // east of the receivers is seen from 4 times each row's own east-west spacing on the WGS84
-// ellipsoid (47.2 km per cell at 65 N, 64.0 km at 55 N), not the centre row's. A maximum
-// distance is refused there, and viewcount says it takes the centre latitude's spacing.
+// ellipsoid (47.2 km per cell at 65 N, 64.0 km at 55 N), not the centre row's, also within a
+// maximum distance (the naive method refuses one there), and viewcount says it takes the
+// centre latitude's spacing.
 TEST_F(Cli, GeographicGridTakesEachRowsSpacing) {
   const int width = 8, height = 11;
   std::vector<float> values(width * height, 0.0f);
@@ -1392,8 +1393,29 @@ TEST_F(Cli, GeographicGridTakesEachRowsSpacing) {
   }
   fs::remove(out("h.exr"));
   fs::remove(out("d.exr"));
-  expectFailure(run("svf " + shellQuoted(tif) + " -o " + shellQuoted(out("s.exr")) + " --max-distance 100000"), 1,
-                "per-row spacing");
+  // Within --max-distance 220 km the rows whose wall lies nearer (4 x 47.2 to 55 km, the
+  // northern rows) see it, the others see flat ground.
+  const CliResult within = run("horizon " + shellQuoted(tif) + " -o " + shellQuoted(out("h.exr")) +
+                               " -k 4 -q --max-distance 220000");
+  ASSERT_EQ(within.status, 0) << within.err;
+  const ReadBack h = readBack(out("h.exr"));
+  int seen = 0;
+  for (int r = 0; r < height; ++r) {
+    const double lat = (65.0 - r) * M_PI / 180.0, a = 6378137.0, e2 = 0.00669437999014132;
+    const double east = a / std::sqrt(1.0 - e2 * std::sin(lat) * std::sin(lat)) * std::cos(lat) * M_PI / 180.0;
+    if (4.0 * east < 219000.0) {
+      EXPECT_NEAR(h.at(2, r, 0), std::atan(1000.0 / (4.0 * east)), 1e-6) << "row " << r;
+      ++seen;
+    } else if (4.0 * east > 221000.0) {
+      EXPECT_NEAR(h.at(2, r, 0), 0.0, 1e-6) << "row " << r;
+    }
+  }
+  EXPECT_GT(seen, 2);
+  EXPECT_LT(seen, height - 2);
+  fs::remove(out("h.exr"));
+  expectFailure(run("svf " + shellQuoted(tif) + " -o " + shellQuoted(out("s.exr")) +
+                    " --max-distance 100000 --method naive"),
+                1, "per-row spacing");
   const CliResult counts = run("viewcount " + shellQuoted(tif) + " -o " + shellQuoted(out("v.exr")) + " -k 4 -q");
   ASSERT_EQ(counts.status, 0) << counts.err;
   EXPECT_NE(counts.err.find("takes the centre latitude's cell size"), std::string::npos) << counts.err;

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
 #include "hfvis/image_io.hpp"
 #include "hfvis/synthetic_fields.hpp"
@@ -141,6 +142,31 @@ TEST_P(HorizonAnalytic, PerRowSpacingSetsEachRowsGroundDistances) {
       EXPECT_NEAR(r.angles[p], std::atan(10.0 / d), 1e-5) << c << "," << row;
       EXPECT_NEAR(r.distances[p], d, 1e-3 * d) << c << "," << row;
     }
+  }
+  // Within a maximum distance of 40 ground units only the rows' own distances decide whether the
+  // wall is seen (the sweep; the naive method refuses it there).
+  if (GetParam() == HorizonMethod::Sweep) {
+    const double max_distance = 40.0;
+    const auto w = run(east, 4, outputs, 0.0, max_distance);
+    int seen = 0, unseen = 0;
+    for (int row = 0; row < east.height; ++row) {
+      for (int c = 0; c < 30; ++c) {
+        const std::size_t p = row * east.width + c;
+        const double d = (30 - c) * (2.0 + 0.5 * row);
+        if (d < max_distance - 1e-3) {
+          EXPECT_NEAR(w.angles[p], std::atan(10.0 / d), 1e-5) << c << "," << row;
+          ++seen;
+        } else if (d > max_distance + 1e-3) {
+          EXPECT_NEAR(w.angles[p], 0.0, 1e-6) << c << "," << row;
+          EXPECT_LE(w.distances[p], max_distance) << c << "," << row;
+          ++unseen;
+        }
+      }
+    }
+    EXPECT_GT(seen, 20);
+    EXPECT_GT(unseen, 20);
+  } else {
+    EXPECT_THROW(run(east, 4, outputs, 0.0, 40.0), hfvis::InvalidArgument);
   }
   HeightField south = makeSyntheticField("flat", 9, 40);
   for (int row = 0; row < south.height; ++row) {

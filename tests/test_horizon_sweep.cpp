@@ -310,13 +310,22 @@ TEST(HorizonKernels, SweepMatchesScalarReferenceWithPerRowSpacing) {
   expectKernelMatchesReference(HorizonMethod::Sweep, 2.5, 0.004, 0.0, true);
 }
 
+// And within maximum distances (ground units: positions are ground lengths there), denser and
+// curved too.
+TEST(HorizonKernels, SweepMatchesScalarReferenceWithPerRowSpacingWithinAMaximumDistance) {
+  for (double d : {1.2, 4.3, 29.0}) {
+    SCOPED_TRACE("max distance " + std::to_string(d));
+    expectKernelMatchesReference(HorizonMethod::Sweep, 1.0, 0.0, d, true);
+  }
+  expectKernelMatchesReference(HorizonMethod::Sweep, 2.5, 0.004, 6.1, true);
+}
+
 TEST(HorizonKernels, NaiveMatchesScalarReferenceWithPerRowSpacing) {
   expectKernelMatchesReference(HorizonMethod::Naive, 1.0, 0.004, 0.0, true);
 }
 
 // On the axes with per-row spacing both sum the same ground lengths: along a row its spacing,
-// along a column the spacing at the half rows between pixel centres. A maximum distance is
-// refused there (not supported yet).
+// along a column the spacing at the half rows between pixel centres.
 TEST(HorizonKernels, SweepEqualsNaiveOnAxisDirectionsWithPerRowSpacing) {
   testing::forEachLayout([&](const ComputeContext& context) {
     for (const auto& name : syntheticFieldNames()) {
@@ -335,12 +344,18 @@ TEST(HorizonKernels, SweepEqualsNaiveOnAxisDirectionsWithPerRowSpacing) {
       }
     }
   });
+  // Not yet with per-row spacing: the naive method within a maximum distance, and strips
+  // within one.
   HeightField field = makeSyntheticField("noise", 9, 7, 1);
   setRowSpacing(field);
   HorizonOptions options;
   options.max_distance = 3.0;
   HorizonOutputs outputs;
   outputs.sky_view_factor = true;
+  options.strip_rows = 2;
+  EXPECT_THROW(computeHorizons(testContext(), field, options, outputs), InvalidArgument);
+  options.strip_rows = 0;
+  options.method = HorizonMethod::Naive;
   EXPECT_THROW(computeHorizons(testContext(), field, options, outputs), InvalidArgument);
 }
 
