@@ -771,13 +771,13 @@ HFVIS_INLINE float row_ground_at(__global const float* row_length, int height, f
 // one loop it vectorises (the march ran 5x faster that way on PoCL); samples past a
 // pixel's own exit are masked; with a maximum distance the march ends after `max_steps`
 // (else INT_MAX). With HFVIS_ROW_SPACING the ray is straight in pixels and its ground length
-// is summed step by step: row_length[r] is the ground length per pixel along it at row r,
+// is summed step by step, a maximum distance is `max_ground` of it (INFINITY for none; then
+// max_steps is INT_MAX), row_length[r] is the ground length per pixel along it at row r,
 // row_terms[r] its unit ground direction, weight and swath there, and drop is per ground unit
-// squared. Global size: (W, H) rounded up to the
-// local size (the tile).
+// squared. Global size: (W, H) rounded up to the local size (the tile).
 __kernel void horizon_naive(__global const float* heights, int width, int height, float dir_x, float dir_y,
                             float step_length, float ground_per_pixel, float drop, int max_steps,
-                            __global const float* row_length, __global const float4* row_terms,
+                            float max_ground, __global const float* row_length, __global const float4* row_terms,
                             float cos_azimuth, float sin_azimuth, float weight, float swath, uint plane,
                             __global const float2* normals,
                             __global float* angles, __global float* distances, __global float* svf_sum,
@@ -816,6 +816,9 @@ __kernel void horizon_naive(__global const float* heights, int width, int height
     int steeper = rise * (float)best_step >= best_rise * (float)i;
 #endif
     int better = inside_field(px, py, width, height) & !isnan(q) & ((best_step == 0) | steeper);
+#if HFVIS_ROW_SPACING
+    better &= g <= max_ground;  // within the maximum distance (ground length: max_steps is all)
+#endif
     best_rise = better ? rise : best_rise;
     best_step = better ? i : best_step;
 #if HFVIS_ROW_SPACING

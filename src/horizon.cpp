@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "fast_math.hpp"
@@ -197,7 +198,9 @@ std::vector<RunDirection> runDirectionsOf(const HeightField& field, const Horizo
       r.lattice.weight = 1.0 / options.directions;
       r.cos_azimuth = d.cos_azimuth;
       r.sin_azimuth = d.sin_azimuth;
-      r.max_steps = stepsWithin(options.max_distance, double(d.step_length) * d.ground_per_pixel);
+      // With per-row spacing the march cuts at the ground length itself (horizon_naive's max_ground).
+      r.max_steps = hasRowSpacing(field) ? kAllSteps
+                                         : stepsWithin(options.max_distance, double(d.step_length) * d.ground_per_pixel);
       if (!rows.empty()) {
         r.row_length = std::move(rows[k].length);
         r.row_terms = std::move(rows[k].terms);
@@ -637,8 +640,10 @@ class HorizonRoutine : public SweepRoutine {
     kernel.setArg(6, d.ray.ground_per_pixel);
     kernel.setArg(7, curvatureDrop(positionUnit(d.ray.ground_per_pixel)));
     kernel.setArg(8, d.max_steps);
-    const auto row_tables = setRowTables(kernel, 9, d);
-    setOutputs(kernel, 11, d, plane_offset);
+    kernel.setArg(9, hasRowSpacing(field_) && horizon_.max_distance > 0.0 ? static_cast<float>(horizon_.max_distance)
+                                                                         : std::numeric_limits<float>::infinity());
+    const auto row_tables = setRowTables(kernel, 10, d);
+    setOutputs(kernel, 12, d, plane_offset);
     st_.launch(kernel, cl::NDRange(roundUp(field_.width, kTileX), roundUp(field_.height, kTileY)),
                cl::NDRange(kTileX, kTileY));
   }

@@ -83,9 +83,6 @@ std::vector<RowTable> rayRowTables(const HeightField& field, const std::vector<S
 
 void requireSupported(const HeightField& field, const HorizonOptions& options) {
   if (hasRowSpacing(field) && options.max_distance > 0.0) {
-    if (options.method == HorizonMethod::Naive)
-      throw InvalidArgument("the naive method takes no maximum distance on a field with per-row spacing (a "
-                            "latitude / longitude grid) yet: use the sweep, or reproject the field");
     if (options.strip_rows > 0 && options.strip_rows < field.height)
       throw InvalidArgument("a maximum distance on a field with per-row spacing (a latitude / longitude grid) "
                             "does not run in strips yet");

@@ -31,7 +31,7 @@ void finishReduction(HorizonResult& result);
 bool hasRowSpacing(const HeightField& field);
 
 // Throws InvalidArgument for what the horizon operation does not do on this field: with per-row
-// spacing, a maximum distance for the naive method or in strips.
+// spacing, a maximum distance in strips.
 void requireSupported(const HeightField& field, const HorizonOptions& options);
 
 // A field with per-row spacing (HeightField::row_cell_size_x/y), as horizon_lattice takes it

@@ -201,7 +201,11 @@ void naiveReference(const HeightField& field, const PreparedHeights& prepared, c
     };
     const double unit = rows ? 1.0 : double(d.ground_per_pixel);
     const float drop = static_cast<float>(options.curvature * unit * unit);
-    const int max_steps = stepsWithin(options.max_distance, double(d.step_length) * d.ground_per_pixel);
+    // With per-row spacing the march cuts at the ground length itself (horizon_naive's max_ground).
+    const int max_steps =
+        rows ? kAllSteps : stepsWithin(options.max_distance, double(d.step_length) * d.ground_per_pixel);
+    const float max_ground = rows && options.max_distance > 0.0 ? static_cast<float>(options.max_distance)
+                                                                 : std::numeric_limits<float>::infinity();
     for (int r = 0; r < height; ++r) {
       for (int c = 0; c < width; ++c) {
         const std::size_t pixel = static_cast<std::size_t>(r) * width + c;
@@ -220,6 +224,7 @@ void naiveReference(const HeightField& field, const PreparedHeights& prepared, c
                      groundAt(static_cast<float>(r) + (static_cast<float>(i) - 0.5f) * d.step_length * d.dir_y);
           }
           const float g = rows ? along : t;
+          if (g > max_ground) break;  // the ground length only grows
           const float rise = q - hp - drop * g * g;
           const bool steeper = rows ? rise * best_along >= best_rise * along
                                     : rise * static_cast<float>(best_step) >= best_rise * static_cast<float>(i);
