@@ -502,15 +502,14 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
 // capacity is every sample of its periods here plus the entries it arrives with.
 // period_ground = period * ground_per_pixel, the ground length of a period.
 //
-// Strips (a field beyond the device's memory, src/horizon.cpp): `heights` holds the field's
-// rows from row0 on and the outputs (normals, planes, sums, window_far, receiver_base) its rows
-// from out_row0
-// on. With HFVIS_STRIPS, line j resumes its whole line's sweep: line_state[j] = (index of its
-// first receiver here along the whole line, entries of the stack it arrives with, their offset
-// in carry_in, the receivers' ground position before it as float bits (HFVIS_ROW_SPACING));
-// the kernel copies those entries into its stack, and on leaving writes the stack's size into
-// .y and the ground position into .w (carry_stacks then moves the stacks on). Without, every
-// line starts at its far end with an empty stack and line_state and carry_in are not used.
+// Strips (a field beyond the device's memory, src/horizon.cpp): `heights` holds the field's rows
+// from row0 on and the outputs (normals, planes, sums, window_far, receiver_base) its rows from
+// out_row0 on. With HFVIS_STRIPS, line j resumes its whole line's sweep: line_state[j] = (index of
+// its first receiver here along the whole line, entries of the stack it arrives with, their offset
+// in carry_in, the receivers' ground position before it as float bits (HFVIS_ROW_SPACING)); the
+// kernel copies those entries into its stack, and on leaving writes the stack's size into .y and
+// the ground position into .w (carry_stacks then moves the stacks on). Without, every line starts
+// at its far end with an empty stack and line_state and carry_in are not used.
 //
 // With HFVIS_MAX_DISTANCE only samples within `window` (pixels along the line; ground units
 // with HFVIS_ROW_SPACING) count, inv_window = 1 / window (window_pass; window_far: one (rise,
