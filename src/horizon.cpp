@@ -136,8 +136,7 @@ RunPlan planRun(const HeightField& field, const HorizonOptions& options, const H
     }
   }
   const std::size_t least = fixed + per_direction + longest * kStackEntryBytes;
-  const bool fits = least <= budget && per_direction <= max_alloc && longest * kStackEntryBytes <= max_alloc &&
-                    fixed <= budget;
+  const bool fits = least <= budget && per_direction <= max_alloc && longest * kStackEntryBytes <= max_alloc;
   if (!fits || (options.strip_rows > 0 && options.strip_rows < field.height)) {
     if (sweep && !(window && hasRowSpacing(field)))
       return planStrips(field, options, outputs, directions, budget, max_alloc);
@@ -491,12 +490,12 @@ class HorizonRoutine : public SweepRoutine {
     std::vector<char> waiting(d.lines.size(), 0);  // whether its stack waits in carry_in
     cl::Buffer carry_in = placeholder_;
     std::size_t carried_in = 0;  // entries in carry_in
+    std::vector<cl::Buffer> keep;
+    cl::Kernel kernel = sweepKernel(d, 0, keep);  // the strip's rows and lines set per strip
     for (int step = 0; step < strips; ++step) {
       const int s = b > 0 ? strips - 1 - step : step;  // rows fall along a line when b > 0
       const int s0 = s * rows, s1 = std::min(field_.height, s0 + rows);
       const int row0 = loadStrip(s0, s1);
-      std::vector<cl::Buffer> keep;
-      cl::Kernel kernel = sweepKernel(d, 0, keep);
       kernel.setArg(kRow0, row0);
       kernel.setArg(kOutRow0, s0);
       kernel.setArg(kCarryIn, carry_in);
