@@ -350,8 +350,9 @@ HeightField readValidField(const RunArguments& run) {
   return field;
 }
 
-// A latitude / longitude grid has a spacing per row, which only the horizon operation follows:
-// the others take the centre latitude's for the whole field, and say so.
+// A latitude / longitude grid has a spacing per row, which the horizon and intervisibility
+// operations follow: the horizon lists and the bounce take the centre latitude's for the whole
+// field, and say so.
 void warnOfCentreRowSpacing(const HeightField& field, const char* command) {
   if (field.row_cell_size_x.empty()) return;
   const auto [narrowest, widest] =
@@ -359,8 +360,8 @@ void warnOfCentreRowSpacing(const HeightField& field, const char* command) {
   std::cerr << std::setprecision(6) << "hfvis: warning: " << command
             << " takes the centre latitude's cell size (" << field.cell_size_x << " x " << field.cell_size_y
             << ") for the whole field; its rows range from " << *narrowest << " to " << *widest
-            << " along columns (per-row spacing of latitude / longitude grids is followed by horizon, svf "
-               "and ao only)\n";
+            << " along columns (per-row spacing of latitude / longitude grids is followed by horizon, svf, "
+               "ao and viewcount only)\n";
 }
 
 // Progress on stderr when it is a terminal: one line rewritten in place, at most a few
@@ -601,7 +602,6 @@ int runCompute(Command command, const RunArguments& run) {
 int runViewCount(const RunArguments& run) {
   requireOutputs(run, outputPaths(run));
   const HeightField field = readValidField(run);
-  warnOfCentreRowSpacing(field, "viewcount");
   const ComputeContext context = contextFor(run);
   const DeviceInfo& device = context.device();
 

@@ -182,7 +182,7 @@ Conventions and units:
   GIS        A georeferenced input keeps its CRS (projected or geographic, copied as it is)
              and geotransform in GeoTIFF outputs, so they overlay it. Cell sizes come from
              the geotransform in the CRS's units; geographic degrees become metres (WGS84,
-             at each row's latitude: horizon, svf and ao follow each row's spacing, viewcount,
+             at each row's latitude: horizon, svf, ao and viewcount follow each row's spacing,
              horizons and bounce the centre latitude's); rotated geotransforms are refused. A band's
              nodata value reads as nodata. GeoTIFF outputs: one float32 band per channel,
              named by its description (h000.., svf, ao, count, visible_area), nodata declared

@@ -32,6 +32,10 @@
 //   HFVIS_SAFE_ZONE         the safe zone (Algorithm 3): a replaced old root whose children
 //                           stay as they are skips the walk (needs HFVIS_REPLACEMENT_CHECK)
 //   HFVIS_SAFE_ZONE_STEPS   steps past the receiver that one safe zone covers (a power of 2)
+//   HFVIS_ROW_SPACING       the ground spacing differs per row (latitude / longitude grids):
+//                           positions along a line are whole units of ground length summed
+//                           step by step (row_units), not the steps themselves; not with the
+//                           safe zone or the bounce
 // Every combination builds the same trees (tests/test_intervisibility.cpp): the options
 // change the work (iterations t, memory traffic), never a result.
 #include "chord_side.cl"
@@ -71,6 +75,12 @@
 #ifndef HFVIS_SAFE_ZONE_STEPS
 #define HFVIS_SAFE_ZONE_STEPS 16
 #endif
+#ifndef HFVIS_ROW_SPACING
+#define HFVIS_ROW_SPACING 0
+#endif
+#if HFVIS_ROW_SPACING && (HFVIS_SAFE_ZONE || HFVIS_WANT_BOUNCE)
+#error "per-row spacing takes neither the safe zone nor the bounce (both assume uniform steps)"
+#endif
 // Statistics need every sample's horizons (Table 2 and Section 6's bound count them all);
 // otherwise only receivers (pixel centres) read theirs.
 #define HFVIS_ALL_HORIZONS (HFVIS_WANT_STATS || HFVIS_WANT_ENTRY_STATS)
@@ -109,9 +119,19 @@
 
 #define HFVIS_LEAF 1  // bit 0 of node.y
 
-// Whether sample x (farther than the next horizon n) is seen over n from receiver r.
-inline int seen_over(float hx, int x, float hn, int n, float hr, int r) {
-  return chord_side(hx, hn, hr, (float)(n - x), (float)(r - n)) <= 0;
+// The position of step k of a line (its positions[] from the line's first entry): the step
+// itself, or with per-row spacing its units (whole numbers below 2^24: exact in a float, and
+// so are their differences).
+#if HFVIS_ROW_SPACING
+#define LINE_POSITION(positions, stride, k) ((float)(positions)[(uint)(k) * (stride)].x)
+#else
+#define LINE_POSITION(positions, stride, k) ((float)(k))
+#endif
+
+// Whether sample x at position px (farther than the next horizon n) is seen over n from
+// receiver r.
+inline int seen_over(float hx, float px, float hn, float pn, float hr, float pr) {
+  return chord_side(hx, hn, hr, pn - px, pr - pn) <= 0;
 }
 
 // The visible samples between horizon `start` and the next horizon `next` form a prefix
@@ -120,13 +140,15 @@ inline int seen_over(float hx, int x, float hn, int n, float hr, int r) {
 // or `next`. Heights are read from the tree slots (a slot keeps its sample's height for
 // good; absent samples' slots hold NaN). Without absent samples in between, galloping then
 // bisection (O(log run)); otherwise a scan.
-inline int run_end(__global const int4* tree, uint stride, int start, int next, float h_next, int receiver,
-                   float h_receiver, int holes) {
+inline int run_end(__global const int4* tree, __global const int2* positions, uint stride, int start, int next,
+                   float h_next, float p_receiver, float h_receiver, int holes) {
+  const float p_next = LINE_POSITION(positions, stride, next);
   if (!holes) {
     int lo = start, hi = next, jump = 1;
     while (lo + jump < hi) {
       int x = lo + jump;
-      if (seen_over(as_float(tree[(uint)x * stride].x), x, h_next, next, h_receiver, receiver)) {
+      if (seen_over(as_float(tree[(uint)x * stride].x), LINE_POSITION(positions, stride, x), h_next, p_next,
+                    h_receiver, p_receiver)) {
         lo = x;
         jump *= 2;
       } else {
@@ -136,7 +158,8 @@ inline int run_end(__global const int4* tree, uint stride, int start, int next, 
     }
     while (hi - lo > 1) {
       int mid = lo + (hi - lo) / 2;
-      if (seen_over(as_float(tree[(uint)mid * stride].x), mid, h_next, next, h_receiver, receiver))
+      if (seen_over(as_float(tree[(uint)mid * stride].x), LINE_POSITION(positions, stride, mid), h_next, p_next,
+                    h_receiver, p_receiver))
         lo = mid;
       else
         hi = mid;
@@ -145,7 +168,8 @@ inline int run_end(__global const int4* tree, uint stride, int start, int next, 
   }
   for (int x = start + 1; x < next; ++x) {
     float hx = as_float(tree[(uint)x * stride].x);
-    if (!isnan(hx) && !seen_over(hx, x, h_next, next, h_receiver, receiver)) return x;
+    if (!isnan(hx) && !seen_over(hx, LINE_POSITION(positions, stride, x), h_next, p_next, h_receiver, p_receiver))
+      return x;
   }
   return next;
 }
@@ -181,8 +205,8 @@ HFVIS_INLINE void root_append(__global int4* tree, uint stride, RootList* list, 
 // root's new children in order; its stack is threaded through the `next` links of the
 // nodes on it (a detached child's sibling link is free until it is appended), and `top`
 // returns to the caller. Returns the convexity checks made.
-HFVIS_INLINE uint hull_tree_walk(__global int4* tree, uint stride, int top, int4 node, float h, int step,
-                                 RootList* list) {
+HFVIS_INLINE uint hull_tree_walk(__global int4* tree, __global const int2* positions, uint stride, int top, int4 node,
+                                 float h, float p, RootList* list) {
   uint t = 0;
   int cur = top;
   for (;;) {
@@ -191,7 +215,9 @@ HFVIS_INLINE uint hull_tree_walk(__global int4* tree, uint stride, int top, int4
       int4 child = tree[(uint)c * stride];
       ++t;
       // Convex when the parent lies strictly above the chord from the child to the root.
-      const int side = chord_side(as_float(child.x), as_float(node.x), h, (float)(cur - c), (float)(step - cur));
+      const float p_cur = LINE_POSITION(positions, stride, cur);
+      const int side = chord_side(as_float(child.x), as_float(node.x), h, p_cur - LINE_POSITION(positions, stride, c),
+                                  p - p_cur);
       if (side <= 0) {
         tree[(uint)cur * stride].z = child.w;  // the next child becomes the first
         tree[(uint)c * stride].w = cur;        // back link to resume the parent
@@ -271,7 +297,15 @@ HFVIS_INLINE int safe_zone_inside(const SafeZone* z, int step, float h) {
 //   trees[]   the tree node of step s (height, rank * 2 + leaf, first child, next sibling);
 //             an absent sample's slot holds a NaN height,
 //   prefix[]  the sum of the steps of the present samples before step s (for the area
-//             across holes), if AREA and HAS_NODATA,
+//             across holes), if AREA and HAS_NODATA; with ROW_SPACING (and AREA) the sum
+//             of position * units over them,
+//   positions[] with ROW_SPACING: (position of step s in units, the sum of the units of the
+//             present samples before it). Per receiver row r, the period ending at the
+//             receiver has steps of row_units[r] units each, and row_factors[r] replaces
+//             (count_factor, area_factor) (the area's per unit squared); drop is per unit
+//             squared and max_steps counts units. The distance sum is then that of
+//             (receiver position - position) * ring units over the counted samples (the
+//             units of each one's step toward the receiver: the width of its ring),
 //   visible[], entry_stats[] per-step (count, distance sum) and (horizons m, iterations t,
 //             horizon hash, walk skipped), if ENTRY_STATS.
 // Outputs, added at each receiver's pixel (one launch per direction, and each pixel is a
@@ -291,8 +325,8 @@ HFVIS_INLINE int safe_zone_inside(const SafeZone* z, int step, float h) {
 __kernel void intervisibility_lattice(
     __global const float* heights, int width, int height, __global const int4* lines, int n_lines,
     __global const LatticeSample* samples, int n_samples, int a, int b, float count_factor, float area_factor,
-    float drop, int max_steps,
-    __global int4* trees, __global ulong* prefix, uint stride, __global float2* visible,
+    float drop, int max_steps, __global const int* row_units, __global const float2* row_factors,
+    __global int4* trees, __global ulong* prefix, __global int2* positions, uint stride, __global float2* visible,
     __global uint4* entry_stats, __global ulong* line_totals, int first_line, __global float* count_sum,
     __global float* area_sum, __global const float* radiance, __global const float* normals,
     float cos_azimuth, float sin_azimuth, float step_ground, float half_sector, float wedge,
@@ -302,6 +336,7 @@ __kernel void intervisibility_lattice(
   const int4 line = lines[j];
   const uint base = (uint)line.w;
   __global int4* tree = trees + base;
+  __global int2* line_positions = positions + base;
   const uint plane = (uint)(width * height);
 
   int rank = 0;        // present samples before `step`
@@ -309,6 +344,12 @@ __kernel void intervisibility_lattice(
   int root = HFVIS_NONE;
   int prev = HFVIS_NONE, prev2 = HFVIS_NONE;  // the two latest present samples
   float h_prev = 0.0f, h_prev2 = 0.0f;
+  float p_prev = 0.0f, p_prev2 = 0.0f;  // and their positions
+#if HFVIS_ROW_SPACING
+  int position = 0;        // the current step's, in units
+  uint unit_sum = 0;       // over the present samples before it: their steps' units,
+  ulong weighted_sum = 0;  // and position * units
+#endif
   int class_last = HFVIS_CONVEX;  // Eq. 1 class of prev2 (the first sample is convex)
   int head = HFVIS_NONE, tail = HFVIS_NONE;  // the root's first and last child
   float tail_h = 0.0f;                       // the last child's height
@@ -323,8 +364,18 @@ __kernel void intervisibility_lattice(
   int col = line.x, row = line.y;  // the current period's receiver
   for (int i = 0; i < line.z; ++i, col -= a, row -= b) {
     const uint pixel = (uint)(row * width + col);
+#if HFVIS_ROW_SPACING
+    const int units = row_units[row];  // each step of this period
+#endif
     for (int q = 0; q < n_samples; ++q, ++step) {
       const uint e = (uint)step * stride;
+#if HFVIS_ROW_SPACING
+      if (step > 0) position += units;
+      line_positions[e] = (int2)(position, (int)unit_sum);
+      const float p = (float)position;
+#else
+      const float p = (float)step;
+#endif
       const int receiver = q == n_samples - 1;
       __global const LatticeSample* s = samples + q;
       const int x0 = col + s->ox, y0 = row + s->oy, ex = s->ex, ey = s->ey;
@@ -338,10 +389,13 @@ __kernel void intervisibility_lattice(
 #if HFVIS_CURVATURE
       // The Earth's drop from any receiver p, drop (p - step)^2 (drop per step squared), differs
       // from drop step^2 by a term linear in step: every slope seen from p shifts alike, so
-      // every visibility decision (and the tree) is that of the heights lowered by drop step^2.
-      h = h - drop * (float)step * (float)step;
+      // every visibility decision (and the tree) is that of the heights lowered by drop step^2
+      // (positions with per-row spacing).
+      h = h - drop * p * p;
 #endif
-#if HFVIS_HAS_NODATA && HFVIS_WANT_AREA  // step sums serve runs with holes only
+#if HFVIS_ROW_SPACING && HFVIS_WANT_AREA
+      prefix[base + e] = weighted_sum;
+#elif HFVIS_HAS_NODATA && HFVIS_WANT_AREA  // step sums serve runs with holes only
       prefix[base + e] = step_sum;
 #endif
       if (isnan(h)) {
@@ -389,7 +443,7 @@ __kernel void intervisibility_lattice(
         int replaced = 0;
         if (tail != HFVIS_NONE) {
           ++t;
-          replaced = chord_side(tail_h, h_prev, h, (float)(root - tail), (float)(step - root)) <= 0;
+          replaced = chord_side(tail_h, h_prev, h, p_prev - LINE_POSITION(line_positions, stride, tail), p - p_prev) <= 0;
         }
 #endif
 #if HFVIS_SAFE_ZONE
@@ -418,9 +472,11 @@ __kernel void intervisibility_lattice(
             if (!replaced) {
               if (HFVIS_REPLACEMENT_CHECK && c == tail) break;  // known to pass
               ++t;
-              if (chord_side(as_float(child.x), h_prev, h, (float)(root - c), (float)(step - root)) > 0) break;
+              if (chord_side(as_float(child.x), h_prev, h, p_prev - LINE_POSITION(line_positions, stride, c),
+                             p - p_prev) > 0)
+                break;
             }
-            t += hull_tree_walk(tree, stride, c, child, h, step, &list);
+            t += hull_tree_walk(tree, line_positions, stride, c, child, h, p, &list);
             c = child.w;
           }
           if (c != HFVIS_NONE || (old_root.y & HFVIS_LEAF)) {  // it stays, as the last child
@@ -428,7 +484,7 @@ __kernel void intervisibility_lattice(
             root_append(tree, stride, &list, root, h_prev, HFVIS_NONE);
           }
 #else
-          t += hull_tree_walk(tree, stride, root, old_root, h, step, &list);
+          t += hull_tree_walk(tree, line_positions, stride, root, old_root, h, p, &list);
 #endif
         }
 
@@ -436,7 +492,7 @@ __kernel void intervisibility_lattice(
         // sample after a concave one starts a segment: if its node survived it is the root's
         // last child and becomes a leaf; otherwise a new leaf becomes the last child.
         if (prev2 != HFVIS_NONE) {
-          const int side = chord_side(h_prev2, h_prev, h, (float)(prev - prev2), (float)(step - prev));
+          const int side = chord_side(h_prev2, h_prev, h, p_prev - p_prev2, p - p_prev);
           const int cls = side > 0 ? HFVIS_CONVEX : side < 0 ? HFVIS_CONCAVE : class_last;
           if (cls == HFVIS_CONVEX && class_last == HFVIS_CONCAVE) {
             if (list.tail == prev) {
@@ -461,6 +517,22 @@ __kernel void intervisibility_lattice(
         // alone. The safe zone for the next samples is refreshed here, where the root's
         // children (the horizons) are visited anyway.
         if (receiver || HFVIS_ALL_HORIZONS) {
+          // Within the maximum distance: the first step within max_steps of this one.
+#if HFVIS_ROW_SPACING
+          int cut = 0;
+          if (position > max_steps) {  // positions rise along the line: bisection
+            int hi = step;
+            while (cut < hi) {
+              const int mid = cut + (hi - cut) / 2;
+              if (position - line_positions[(uint)mid * stride].x <= max_steps)
+                hi = mid;
+              else
+                cut = mid + 1;
+            }
+          }
+#else
+          const int cut = step - max_steps;
+#endif
 #if HFVIS_SAFE_ZONE
           const int refresh_zone = !zone_valid;
           if (refresh_zone) safe_zone_begin(&zone, step);
@@ -488,7 +560,7 @@ __kernel void intervisibility_lattice(
             // enters the (convex) field once, and leaves it at its last receiver.
             const int holes = HFVIS_HAS_NODATA && end_rank - hp_rank != end - hp;
             if (np != HFVIS_NONE) {
-              end = run_end(tree, stride, hp, np, as_float(nz.x), step, h, holes);
+              end = run_end(tree, line_positions, stride, hp, np, as_float(nz.x), p, h, holes);
               end_rank = end == np ? np_rank : holes ? tree[(uint)end * stride].y >> 1 : hp_rank + (end - hp);
             }
 #if HFVIS_WANT_BOUNCE
@@ -504,12 +576,21 @@ __kernel void intervisibility_lattice(
 #endif
             // Within the maximum distance only the run's samples from `first` on count (terrain
             // farther away neither counts nor hides anything nearer). Every slot holds its rank.
-            const int first = max(hp, step - max_steps);
+            const int first = max(hp, cut);
             const int first_rank = first == hp ? hp_rank : holes ? tree[(uint)first * stride].y >> 1 : hp_rank + (first - hp);
             const int run = first < end ? end_rank - first_rank : 0;
             count += run;
 #if HFVIS_WANT_AREA
             // Sum of (step - x) over the counted present samples x.
+#if HFVIS_ROW_SPACING
+            // Sum of (position - x's) * x's units over the counted present samples x (the
+            // sums at `step` are those before it, written above).
+            if (run > 0) {
+              const uint units_run = (uint)line_positions[(uint)end * stride].y - (uint)line_positions[(uint)first * stride].y;
+              distance_sum += (ulong)position * (ulong)units_run -
+                              (prefix[base + (uint)end * stride] - prefix[base + (uint)first * stride]);
+            }
+#else
             ulong steps_sum = 0;
             if (run == 0) {
             } else if (!holes) {  // x = first .. end - 1
@@ -519,6 +600,7 @@ __kernel void intervisibility_lattice(
               steps_sum = end_sum - prefix[base + (uint)first * stride];
             }
             distance_sum += (ulong)step * (ulong)run - steps_sum;
+#endif
 #endif
             if (np == HFVIS_NONE) break;
             hz = nz;
@@ -534,6 +616,11 @@ __kernel void intervisibility_lattice(
         }
       }
       if (receiver) {
+#if HFVIS_ROW_SPACING
+        const float2 factors = row_factors[row];
+        count_factor = factors.x;
+        area_factor = factors.y;
+#endif
 #if HFVIS_WANT_COUNT
         count_sum[pixel] += count_factor * (float)count;
 #endif
@@ -557,11 +644,20 @@ __kernel void intervisibility_lattice(
       zone_skips += skipped;
       prev2 = prev;
       h_prev2 = h_prev;
+      p_prev2 = p_prev;
       prev = step;
       h_prev = h;
+      p_prev = p;
       root = step;
       ++rank;
       step_sum += (ulong)step;
+#if HFVIS_ROW_SPACING
+      // The sample's ring width: the units of its step toward the receivers (into the next
+      // period at a receiver; the line's last sample is no one's farther sample).
+      const int ring = receiver && i + 1 < line.z ? row_units[row - b] : units;
+      unit_sum += (uint)ring;
+      weighted_sum += (ulong)position * (ulong)ring;
+#endif
     }
   }
 #if HFVIS_WANT_STATS
@@ -588,6 +684,14 @@ __kernel void intervisibility_lattice(
 // field this tends to the field's area seen from p as K grows. The sweep does the same
 // with its own step and each direction's share of the circle.
 
+#if HFVIS_ROW_SPACING
+// Index in a half-row table of the middle of step i of a ray from row `row` (i - 0.5 = `mid`
+// steps of step_y rows along it): rint(2 y), clamped to the field (samples outside are absent).
+HFVIS_INLINE int ray_half_row(float row, float mid, float step_y, int height) {
+  return clamp((int)rint(2.0f * (row + mid * step_y)), 0, 2 * height - 2);
+}
+#endif
+
 // Adds one direction's visible samples (count and distance sum in steps) to the sums.
 HFVIS_INLINE void add_direction(const SweepDirection d, float sector, float count, float distance_steps,
                                 float* count_sum, float* area_sum) {
@@ -609,10 +713,17 @@ HFVIS_INLINE void accumulate_visible(uint pixel, int nodata, float count, float 
 // slope so far (the same tie rule and predicate as the sweep). The trip count is uniform
 // over the work-group (the longest ray of its tile), as in horizon_naive; samples outside
 // the field are masked. Global size: (W, H) rounded up to the local size.
+// With HFVIS_ROW_SPACING the ray is straight in pixels and positions along it are whole
+// units of ground length (as the tree's): direction b's step whose middle is at row y has
+// row_units[b * (2 height - 1) + rint(2 y)] units (half-row table), a sample's ring width is
+// its step toward the receiver, and a receiver of row r adds row_factors[b * height + r]
+// (count factor, area factor per unit squared) times its count and its sum of position *
+// ring units; `curvature` is then the drop per unit squared and max_steps counts units.
 __kernel void intervisibility_naive(__global const float* heights, int width, int height,
                                     __global const SweepDirection* directions, int batch_size, float sector,
-                                    float curvature, __global const int* max_steps, __global float* count_sum,
-                                    __global float* area_sum) {
+                                    float curvature, __global const int* max_steps,
+                                    __global const int* row_units, __global const float2* row_factors,
+                                    __global float* count_sum, __global float* area_sum) {
   int c = get_global_id(0), r = get_global_id(1);
   int c_lo = get_group_id(0) * get_local_size(0), r_lo = get_group_id(1) * get_local_size(1);
   int c_hi = min(c_lo + (int)get_local_size(0), width) - 1;
@@ -632,14 +743,24 @@ __kernel void intervisibility_naive(__global const float* heights, int width, in
                     : d.dir_y < 0.0f ? (float)r_hi / -d.dir_y
                                      : far;
     int steps = (int)(fmin(fmin(reach_x, reach_y), far) * d.samples_per_unit) + 1;
+#if HFVIS_ROW_SPACING
+    const float drop = curvature;
+    __global const int* units = row_units + b * (2 * height - 1);
+    const float step_y = d.step_length * d.dir_y;
+#else
     // The Earth's drop per step squared (0 without curvature).
     const float step_ground = d.step_length * d.ground_per_pixel;
     const float drop = curvature * step_ground * step_ground;
+#endif
     const int counted_steps = max_steps[b];  // samples farther away are not counted
     float best_h = 0.0f;  // the steepest sample so far (the latest visible one)
-    int best_step = 0;    // its step, 0 = none yet
+    int best_step = 0;    // its position, 0 = none yet
     int count = 0, undecided = 0;
     uint distance_sum = 0;
+#if HFVIS_ROW_SPACING
+    int position = 0;
+    float weighted = 0.0f;  // sum of position * ring units over the counted samples
+#endif
     for (int i = 1; i <= steps; ++i) {
       // `steps` is the same for the whole work-group, so every work-item reaches this
       // barrier; it makes PoCL run the work-items inside each step, the loop it vectorises
@@ -649,43 +770,75 @@ __kernel void intervisibility_naive(__global const float* heights, int width, in
       float t = (float)i * d.step_length;
       float px = (float)cc + t * d.dir_x, py = (float)rr + t * d.dir_y;
       float q = sample_height(heights, width, height, px, py);
+#if HFVIS_ROW_SPACING
+      const int ring = units[ray_half_row((float)rr, (float)i - 0.5f, step_y, height)];
+      position += ring;
+      const int at = position;
+#else
+      const int at = i;
+#endif
 #if HFVIS_CURVATURE
-      q = q - drop * (float)i * (float)i;
+      q = q - drop * (float)at * (float)at;
 #endif
       int present = inside_field(px, py, width, height) && !isnan(q);
       int side;
       // best_step = 0 (none yet) would make the chord degenerate; its answer is ignored.
-      int decided = chord_side_filter(q, best_h, h, (float)(i - best_step), (float)max(best_step, 1), &side);
+      int decided = chord_side_filter(q, best_h, h, (float)(at - best_step), (float)max(best_step, 1), &side);
       undecided |= present && best_step > 0 && !decided;
       int seen = present && (best_step == 0 || side <= 0);
-      int counted = seen && i <= counted_steps;
+      int counted = seen && at <= counted_steps;
       count += counted;
+#if HFVIS_ROW_SPACING
+      weighted += counted ? (float)at * (float)ring : 0.0f;
+#else
       distance_sum += counted ? (uint)i : 0u;
+#endif
       best_h = seen ? q : best_h;
-      best_step = seen ? i : best_step;
+      best_step = seen ? at : best_step;
     }
     if (undecided) {  // a near-tie somewhere on this ray: march it again, exactly
       best_h = 0.0f;
       best_step = count = 0;
       distance_sum = 0;
+#if HFVIS_ROW_SPACING
+      position = 0;
+      weighted = 0.0f;
+#endif
       for (int i = 1; i <= steps; ++i) {
         float t = (float)i * d.step_length;
         float px = (float)cc + t * d.dir_x, py = (float)rr + t * d.dir_y;
         float q = sample_height(heights, width, height, px, py);
+#if HFVIS_ROW_SPACING
+        const int ring = units[ray_half_row((float)rr, (float)i - 0.5f, step_y, height)];
+        position += ring;
+        const int at = position;
+#else
+        const int at = i;
+#endif
 #if HFVIS_CURVATURE
-        q = q - drop * (float)i * (float)i;
+        q = q - drop * (float)at * (float)at;
 #endif
         if (!inside_field(px, py, width, height) || isnan(q)) continue;
-        if (best_step > 0 && chord_side(q, best_h, h, (float)(i - best_step), (float)best_step) > 0) continue;
-        if (i <= counted_steps) {
+        if (best_step > 0 && chord_side(q, best_h, h, (float)(at - best_step), (float)best_step) > 0) continue;
+        if (at <= counted_steps) {
           ++count;
+#if HFVIS_ROW_SPACING
+          weighted += (float)at * (float)ring;
+#else
           distance_sum += (uint)i;
+#endif
         }
         best_h = q;
-        best_step = i;
+        best_step = at;
       }
     }
+#if HFVIS_ROW_SPACING
+    const float2 factors = row_factors[b * height + rr];
+    counts += factors.x * (float)count;
+    area += factors.y * weighted;
+#else
     add_direction(d, sector, (float)count, (float)distance_sum, &counts, &area);
+#endif
   }
   if (valid) accumulate_visible(pixel, isnan(h), counts, area, count_sum, area_sum);
 }

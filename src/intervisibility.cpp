@@ -26,16 +26,21 @@ std::string treeProgramOptions(const TreeProgramFlags& f) {
   s << "-DHFVIS_HAS_NODATA=" << f.has_nodata << " -DHFVIS_WANT_COUNT=" << f.count
     << " -DHFVIS_WANT_AREA=" << f.area
     << " -DHFVIS_WANT_STATS=" << f.stats << " -DHFVIS_WANT_ENTRY_STATS=" << f.entry_stats;
-  s << " -DHFVIS_CURVATURE=" << f.curvature;
-  s << " -DHFVIS_DEFERRED_WRITES=" << f.tuning.deferred_writes
-    << " -DHFVIS_REPLACEMENT_CHECK=" << f.tuning.replacement_check
-    << " -DHFVIS_SAFE_ZONE=" << f.tuning.safe_zone << " -DHFVIS_SAFE_ZONE_STEPS=" << f.tuning.safe_zone_steps;
+  s << " -DHFVIS_CURVATURE=" << f.curvature << " -DHFVIS_ROW_SPACING=" << f.row_spacing;
+  const HullTreeTuning tuning = tuningFor(f.tuning, f.row_spacing);
+  s << " -DHFVIS_DEFERRED_WRITES=" << tuning.deferred_writes
+    << " -DHFVIS_REPLACEMENT_CHECK=" << tuning.replacement_check
+    << " -DHFVIS_SAFE_ZONE=" << tuning.safe_zone << " -DHFVIS_SAFE_ZONE_STEPS=" << tuning.safe_zone_steps;
   if (f.bounce_channels > 0) s << " -DHFVIS_WANT_BOUNCE=1 -DHFVIS_CHANNELS=" << f.bounce_channels;
   return s.str();
 }
 
+namespace {
+bool needsPrefix(const TreeProgramFlags& f) { return f.area && (f.has_nodata || f.row_spacing); }
+}  // namespace
+
 std::size_t treeEntryBytes(const TreeProgramFlags& f) {
-  return kTreeNodeBytes + (f.area && f.has_nodata ? kTreePrefixBytes : 0) +
+  return kTreeNodeBytes + (needsPrefix(f) ? kTreePrefixBytes : 0) + (f.row_spacing ? kTreePositionBytes : 0) +
          (f.entry_stats ? kTreeVisibleBytes + kTreeEntryStatsBytes : 0);
 }
 
@@ -73,7 +78,8 @@ void allocateTreeScratch(ContextState& st, const TreeProgramFlags& flags, const 
                          std::size_t entries, TreeBuffers& b) {
   b.scratch_entries = entries;
   b.trees = st.reusableBuffer("tree nodes", entries * kTreeNodeBytes);
-  b.prefix = deviceBuffer(st, flags.area && flags.has_nodata ? entries * kTreePrefixBytes : 0);
+  b.prefix = deviceBuffer(st, needsPrefix(flags) ? entries * kTreePrefixBytes : 0);
+  b.positions = deviceBuffer(st, flags.row_spacing ? entries * kTreePositionBytes : 0);
   b.visible = deviceBuffer(st, flags.entry_stats ? entries * kTreeVisibleBytes : 0);
   b.entry_stats = deviceBuffer(st, flags.entry_stats ? entries * kTreeEntryStatsBytes : 0);
   std::size_t max_lines = 0;
@@ -85,6 +91,12 @@ void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDire
                           const TreeBuffers& b) {
   const cl::Buffer samples(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
                            d.samples.size() * sizeof(LatticeSample), const_cast<LatticeSample*>(d.samples.data()));
+  auto table = [&](const auto& values) {
+    if (values.empty()) return deviceBuffer(st, 0);
+    return cl::Buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, values.size() * sizeof(values[0]),
+                      const_cast<void*>(static_cast<const void*>(values.data())));
+  };
+  const cl::Buffer row_units = table(d.row_units), row_factors = table(d.row_factors);
   cl::Kernel kernel(program, "intervisibility_lattice");
   LineChunkArguments chunk;
   int arg = 0;
@@ -101,8 +113,11 @@ void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDire
   kernel.setArg(arg++, d.area_factor);
   kernel.setArg(arg++, d.drop);
   kernel.setArg(arg++, d.max_steps);
+  kernel.setArg(arg++, row_units);
+  kernel.setArg(arg++, row_factors);
   kernel.setArg(arg++, b.trees);
   kernel.setArg(arg++, b.prefix);
+  kernel.setArg(arg++, b.positions);
   chunk.stride = arg++;
   kernel.setArg(arg++, b.visible);
   kernel.setArg(arg++, b.entry_stats);
@@ -129,7 +144,7 @@ std::string TreeRoutine::programOptions() const {
 
 void TreeRoutine::allocateScratch(std::size_t fixed_bytes) {
   flags_.has_nodata = prepared_.has_nodata;
-  directions_ = treeDirections(field_, options_);
+  directions_ = treeDirections(field_, options_, flags_.row_spacing);
   checkTreeLimits(directions_, prepared_.heights);
   // The per-line totals of the statistics count beside the operation's own buffers.
   std::size_t max_lines = 0;
@@ -184,17 +199,19 @@ class CountRoutine : public TreeRoutine {
  public:
   CountRoutine(ContextState& st, const HeightField& field, const IntervisibilityOptions& options,
                const IntervisibilityOutputs& outputs)
-      : TreeRoutine(st, field, options, flagsFor(options, outputs)), visibility_(options), outputs_(outputs) {}
+      : TreeRoutine(st, field, options, flagsFor(field, options, outputs)), visibility_(options), outputs_(outputs) {}
 
   IntervisibilityResult take() { return std::move(result_); }
 
  private:
-  static TreeProgramFlags flagsFor(const IntervisibilityOptions& options, const IntervisibilityOutputs& outputs) {
+  static TreeProgramFlags flagsFor(const HeightField& field, const IntervisibilityOptions& options,
+                                   const IntervisibilityOutputs& outputs) {
     TreeProgramFlags flags;
     flags.area = outputs.visible_area;
     flags.stats = outputs.statistics;
     flags.tuning = options.tree;
     flags.curvature = options.curvature != 0.0;
+    flags.row_spacing = hasRowSpacing(field);
     return flags;
   }
 
@@ -246,6 +263,7 @@ class NaiveCountRoutine : public SweepRoutine {
     flags.area = outputs_.visible_area;
     flags.stats = false;
     flags.curvature = visibility_.curvature != 0.0;
+    flags.row_spacing = hasRowSpacing(field_);
     return treeProgramOptions(flags);
   }
 
@@ -255,7 +273,13 @@ class NaiveCountRoutine : public SweepRoutine {
     // A ray has at most (W + H) S steps; the kernel's predicate takes steps as exact floats,
     // and its distance sums (up to n^2 / 2 steps) are 32-bit to keep its loop vectorised.
     const double longest = (double(field_.width) + field_.height) * visibility_.samples_per_unit + 2.0;
-    checkStepLimits(static_cast<std::size_t>(longest), prepared_.heights);
+    std::size_t longest_position = static_cast<std::size_t>(longest);
+    if (hasRowSpacing(field_)) {  // positions in units: at most the steps times a step's most units
+      unit_ = groundUnit(field_, visibility_);
+      rows_ = naiveRowTables(field_, rays_, unit_);
+      longest_position *= static_cast<std::size_t>(*std::max_element(rows_.units.begin(), rows_.units.end()));
+    }
+    checkStepLimits(longest_position, prepared_.heights);
     if (outputs_.visible_area && longest * longest / 2.0 >= 4294967295.0) {
       throw InvalidArgument("the naive march's rays would have up to " + std::to_string(std::size_t(longest)) +
                             " samples, too many for its visible area (at most 92681): lower the samples per "
@@ -281,13 +305,27 @@ class NaiveCountRoutine : public SweepRoutine {
     naive.setArg(arg++, directions);
     naive.setArg(arg++, count);
     naive.setArg(arg++, intervisibilitySector(visibility_));
-    naive.setArg(arg++, static_cast<float>(visibility_.curvature));
+    // With per-row spacing positions are units: the drop per unit squared, distances in units.
+    const double per_unit = unit_ * unit_;
+    naive.setArg(arg++, static_cast<float>(visibility_.curvature * (unit_ > 0.0 ? per_unit : 1.0)));
     std::vector<cl_int> max_steps;
     for (const SweepDirection& d : batch)
-      max_steps.push_back(stepsWithin(visibility_.max_distance, double(d.step_length) * d.ground_per_pixel));
-    const cl::Buffer max_steps_buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                                      max_steps.size() * sizeof(cl_int), max_steps.data());
+      max_steps.push_back(stepsWithin(visibility_.max_distance,
+                                      unit_ > 0.0 ? unit_ : double(d.step_length) * d.ground_per_pixel));
+    auto upload = [&](const void* data, std::size_t bytes) {
+      if (!bytes) return deviceBuffer(st_, 0);
+      return cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes, const_cast<void*>(data));
+    };
+    const cl::Buffer max_steps_buffer = upload(max_steps.data(), max_steps.size() * sizeof(cl_int));
     naive.setArg(arg++, max_steps_buffer);
+    // This batch's slices of the row tables.
+    const std::size_t half_rows = 2 * static_cast<std::size_t>(field_.height) - 1, rows = 2 * field_.height;
+    const cl::Buffer units = upload(rows_.units.empty() ? nullptr : &rows_.units[first * half_rows],
+                                    rows_.units.empty() ? 0 : count * half_rows * sizeof(cl_int));
+    const cl::Buffer factors = upload(rows_.factors.empty() ? nullptr : &rows_.factors[first * rows],
+                                      rows_.factors.empty() ? 0 : count * rows * sizeof(float));
+    naive.setArg(arg++, units);
+    naive.setArg(arg++, factors);
     naive.setArg(arg++, count_sum_);
     naive.setArg(arg++, area_sum_);
     st_.launch(naive, cl::NDRange(roundUp(field_.width, kTileX), roundUp(field_.height, kTileY)),
@@ -302,6 +340,8 @@ class NaiveCountRoutine : public SweepRoutine {
   const IntervisibilityOptions& visibility_;
   const IntervisibilityOutputs& outputs_;
   std::vector<SweepDirection> rays_;
+  double unit_ = 0.0;   // per-row spacing: the ground length of a position unit (groundUnit)
+  NaiveRowTables rows_;  // and the row tables
   cl::Buffer count_sum_, area_sum_;
   IntervisibilityResult result_;
 };
@@ -314,6 +354,7 @@ IntervisibilityLines treeLinesOnDevice(ContextState& st, const TreeProgramFlags&
                                        std::vector<float>* irradiance) {
   TreeProgramFlags flags = program_flags;
   flags.entry_stats = true;
+  flags.row_spacing = d.rowSpacing();
   cl::Program program = st.program("intervisibility.cl", treeProgramOptions(flags));
   const std::size_t plane = field.pixelCount();
   const std::size_t per_period = d.samples.size(), longest = d.longestLine();

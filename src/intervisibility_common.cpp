@@ -6,6 +6,7 @@
 #include <string>
 
 #include "hfvis/errors.hpp"
+#include "horizon_common.hpp"
 #include "intervisibility_internal.hpp"
 
 namespace hfvis {
@@ -81,12 +82,69 @@ TreeDirection makeTreeDirection(const HeightField& field, const LatticeDirection
   return d;
 }
 
-std::vector<TreeDirection> treeDirections(const HeightField& field, const SweepOptions& options) {
+std::int32_t stepUnits(const HeightField& field, double y, double dx, double dy, double unit) {
+  double cell_x = 0.0, cell_y = 0.0;
+  cellSizeAtRow(field, y, &cell_x, &cell_y);
+  return static_cast<std::int32_t>(std::max<long long>(1, std::llround(std::hypot(dx * cell_x, dy * cell_y) / unit)));
+}
+
+NaiveRowTables naiveRowTables(const HeightField& field, const std::vector<SweepDirection>& rays, double unit) {
+  NaiveRowTables t;
+  const std::vector<RowTable> rows = rayRowTables(field, rays);
+  const double K = static_cast<double>(rays.size());
+  for (std::size_t k = 0; k < rays.size(); ++k) {
+    const SweepDirection& d = rays[k];
+    for (int half = 0; half < 2 * field.height - 1; ++half)
+      t.units.push_back(stepUnits(field, 0.5 * half, double(d.step_length) * d.dir_x, double(d.step_length) * d.dir_y,
+                                  unit));
+    for (int r = 0; r < field.height; ++r) {
+      const double weight = rows[k].terms[4 * static_cast<std::size_t>(r) + 2];
+      t.factors.push_back(static_cast<float>(K * weight));
+      t.factors.push_back(static_cast<float>(2.0 * M_PI * weight * unit * unit));
+    }
+  }
+  return t;
+}
+
+double groundUnit(const HeightField& field, const SweepOptions& options) {
+  double longest_period = 0.0;
+  for (const LatticeDirection& d : latticeDirections(field, options, false, 0.0))
+    longest_period = std::max(longest_period, d.period);
+  const double largest_cell = std::max(*std::max_element(field.row_cell_size_x.begin(), field.row_cell_size_x.end()),
+                                       *std::max_element(field.row_cell_size_y.begin(), field.row_cell_size_y.end()));
+  return (double(field.width) + field.height + 2.0 * longest_period) * largest_cell / double(1 << 23);
+}
+
+void followRows(TreeDirection& d, const HeightField& field, const RowTable& rows, double unit,
+                double samples_per_unit, int directions, double curvature, double max_distance) {
+  const double n = d.per_period, step = d.lattice.period / n;
+  d.unit_ground = unit;
+  for (int r = 0; r < field.height; ++r) {
+    d.row_units.push_back(stepUnits(field, r + 0.5 * d.lattice.b, d.lattice.a / n, d.lattice.b / n, unit));
+    const double weight = rows.terms[4 * static_cast<std::size_t>(r) + 2];
+    d.row_factors.push_back(static_cast<float>(directions * weight * step * samples_per_unit));
+    d.row_factors.push_back(static_cast<float>(2.0 * M_PI * weight * unit * unit));
+  }
+  d.drop = static_cast<float>(curvature * unit * unit);
+  d.max_steps = stepsWithin(max_distance, unit);
+}
+
+std::vector<TreeDirection> treeDirections(const HeightField& field, const SweepOptions& options, bool follow_rows) {
+  const std::vector<LatticeDirection> lattice = latticeDirections(field, options, false, 0.0);
+  std::vector<RowTable> rows;
+  double unit = 0.0;
+  if (follow_rows && hasRowSpacing(field)) {
+    rows = latticeRowTables(field, lattice, true);
+    unit = groundUnit(field, options);
+  }
   std::vector<TreeDirection> out;
-  for (const LatticeDirection& lattice : latticeDirections(field, options, false, 0.0)) {
-    if (lattice.weight == 0.0) continue;  // merged into an equal step
-    out.push_back(makeTreeDirection(field, lattice, options.samples_per_unit, options.directions, options.curvature,
-                                    options.max_distance));
+  for (std::size_t k = 0; k < lattice.size(); ++k) {
+    if (lattice[k].weight == 0.0) continue;  // merged into an equal step
+    out.push_back(makeTreeDirection(field, lattice[k], options.samples_per_unit, options.directions,
+                                    options.curvature, options.max_distance));
+    if (!rows.empty())
+      followRows(out.back(), field, rows[k], unit, options.samples_per_unit, options.directions,
+                 options.curvature, options.max_distance);
   }
   return out;
 }
@@ -116,12 +174,39 @@ IntervisibilityLines canonicalTreeLines(const TreeDirection& d) {
   out.receiver_every = static_cast<int>(d.samples.size());
   out.max_steps = d.max_steps;
   out.samples.assign(longest * d.lines.size(), std::numeric_limits<float>::quiet_NaN());
+  if (d.rowSpacing()) {
+    // As the kernel sums them: step 0 at 0, then each step of period i the units of the row
+    // of receiver i (the first period's: receiver 0's). A sample's ring units are those of
+    // its step toward the receivers (the next one). Padding entries keep the last.
+    const std::size_t n_lines = d.lines.size(), per_period = d.samples.size();
+    out.positions.assign(out.samples.size(), 0);
+    out.step_units.assign(out.samples.size(), 0);
+    for (std::size_t j = 0; j < n_lines; ++j) {
+      const LatticeLine& line = d.lines[j];
+      const std::size_t steps = lineCapacity(line, per_period);
+      auto units_of = [&](std::size_t s) {  // of the step into s (s < steps)
+        return d.row_units[line.row - static_cast<int>(s / per_period) * d.lattice.b];
+      };
+      std::int32_t position = 0;
+      for (std::size_t s = 0; s < longest; ++s) {
+        if (s > 0 && s < steps) position += units_of(s);
+        out.positions[s * n_lines + j] = position;
+        out.step_units[s * n_lines + j] = units_of(std::min(s + 1, steps - 1));
+      }
+    }
+  }
   return out;
 }
 
 void checkTreeLimits(const std::vector<TreeDirection>& directions, const std::vector<float>& prepared_heights) {
   std::size_t longest = 0;
-  for (const auto& d : directions) longest = std::max(longest, d.longestLine());
+  for (const auto& d : directions) {
+    longest = std::max(longest, d.longestLine());
+    if (!d.rowSpacing()) continue;
+    // Positions in units: the line's steps times the most units a step has.
+    const std::size_t most = *std::max_element(d.row_units.begin(), d.row_units.end());
+    longest = std::max(longest, d.longestLine() * most);
+  }
   checkStepLimits(longest, prepared_heights);
 }
 

@@ -18,6 +18,7 @@ namespace hfvis::detail {
 
 constexpr std::size_t kTreeNodeBytes = 4 * sizeof(int);  // tree node (int4)
 constexpr std::size_t kTreePrefixBytes = sizeof(std::uint64_t);
+constexpr std::size_t kTreePositionBytes = 2 * sizeof(std::int32_t);  // (position, unit sum), per-row spacing
 constexpr std::size_t kTreeVisibleBytes = 2 * sizeof(float);  // (count, distance sum), per-entry tests only
 constexpr std::size_t kTreeEntryStatsBytes = 4 * sizeof(std::uint32_t);
 constexpr std::size_t kTreeLineTotals = 8;  // ulongs per line (HFVIS_LINE_TOTALS)
@@ -26,6 +27,9 @@ constexpr std::size_t kTreeLineTotals = 8;  // ulongs per line (HFVIS_LINE_TOTAL
 struct TreeProgramFlags {
   bool has_nodata = true;
   bool curvature = false;  // HFVIS_CURVATURE
+  // HFVIS_ROW_SPACING: the directions follow each row's spacing (TreeDirection::rowSpacing;
+  // the safe zone is then off, and there is no bounce).
+  bool row_spacing = false;
   bool count = true;
   bool area = true;
   bool stats = true;
@@ -41,7 +45,7 @@ std::string treeProgramOptions(const TreeProgramFlags& flags);
 // (deviceBuffer(st, 0)).
 struct TreeBuffers {
   cl::Buffer heights;
-  cl::Buffer trees, prefix, visible, entry_stats;  // scratch, `scratch_entries` entries
+  cl::Buffer trees, prefix, positions, visible, entry_stats;  // scratch, `scratch_entries` entries
   std::size_t scratch_entries = 0;
   cl::Buffer line_totals;          // kTreeLineTotals ulongs per line of the direction
   cl::Buffer count_sum, area_sum;  // per pixel

@@ -11,6 +11,7 @@
 #include "hfvis/device.hpp"
 #include "hfvis/height_field.hpp"
 #include "hfvis/intervisibility.hpp"
+#include "horizon_common.hpp"
 #include "lattice_geometry.hpp"
 #include "sweep_geometry.hpp"
 
@@ -39,8 +40,48 @@ struct TreeDirection {
   int max_steps = kAllSteps;
   float half_sector = 0.0f, wedge = 0.0f;  // the bounce's pi weight and 2 sin(pi weight)
   float cos_azimuth = 1.0f, sin_azimuth = 0.0f;
+  // Per-row spacing (a latitude / longitude grid; row_units empty otherwise): positions along
+  // a line are whole units of `unit_ground` ground length (groundUnit), so that the exact
+  // predicate keeps integer differences. The period ending at a receiver of row r (toward
+  // +(a, b), at its middle row, as the horizon sweep takes it) has per_period steps of
+  // row_units[r] units each; that receiver adds row_factors[2 r] * visible samples to its
+  // count and row_factors[2 r + 1] * its distance sum (units squared) to its area: the
+  // count and area factors with the step's weight at that row. drop is then per unit
+  // squared and max_steps counts units.
+  double unit_ground = 0.0;
+  std::vector<std::int32_t> row_units;
+  std::vector<float> row_factors;
+  bool rowSpacing() const { return !row_units.empty(); }
   std::size_t longestLine() const;  // entries (steps) of its longest line
 };
+
+// The tuning a sweep runs: `requested`, without the safe zone on lines of per-row spacing
+// (its bound interpolates over uniform steps).
+inline HullTreeTuning tuningFor(HullTreeTuning requested, bool row_spacing) {
+  if (row_spacing) requested.safe_zone = false;
+  return requested;
+}
+
+// The ground length of one position unit on a field with per-row spacing: the field's
+// extent (W + H plus twice the longest period of the run's lattice directions, in pixels,
+// times the largest cell size) over 2^23, so a line's or ray's position, each of its steps
+// rounded to whole units, stays below 2^24 (checked: checkTreeLimits). A step's ground
+// length is then off by at most half a unit: a relative 2^-24 (W + H + 2 P) / (step's pixels).
+// The tree and the naive march take the same unit, so on the axes they see the same positions.
+double groundUnit(const HeightField& field, const SweepOptions& options);
+// The naive march's tables on a field with per-row spacing (intervisibility_naive with
+// HFVIS_ROW_SPACING), for every ray, ray after ray: the step units by half row (2 H - 1 per
+// ray, entry k for a step whose middle is at row k / 2), and per row the count factor K w and
+// the area factor 2 pi w unit^2 (2 H per ray), w the ray's weight at that row (rayRowTables).
+struct NaiveRowTables {
+  std::vector<std::int32_t> units;
+  std::vector<float> factors;
+};
+NaiveRowTables naiveRowTables(const HeightField& field, const std::vector<SweepDirection>& rays, double unit);
+
+// Whole units (at least 1) of a step of (dx, dy) pixels whose middle is at row y (fractional:
+// cell sizes interpolated between rows, cellSizeAtRow).
+std::int32_t stepUnits(const HeightField& field, double y, double dx, double dy, double unit);
 
 // The directions of a run: the quadrature lattice directions of sky-view factor and ambient
 // occlusion (the cheapest step within half the spacing 2 pi / K of each phi_k, weighted by the
@@ -52,10 +93,19 @@ struct TreeDirection {
 // mean relative error fell from 0.49 - 0.91 to 0.37 - 0.72 times the naive march's), and the
 // cheapest: a step closer to phi_k has a longer period, and a period of P pixels takes P
 // samples per pixel.
-std::vector<TreeDirection> treeDirections(const HeightField& field, const SweepOptions& options);
+// With per-row spacing each row gets its steps' lengths and weights there (row_units,
+// row_factors), unless `follow_rows` is false (the bounce: the centre latitude's spacing).
+std::vector<TreeDirection> treeDirections(const HeightField& field, const SweepOptions& options,
+                                          bool follow_rows = true);
 // One of them: `lattice` (its weight set) sampled at S samples per unit, in a run of K directions.
 TreeDirection makeTreeDirection(const HeightField& field, const LatticeDirection& lattice, double samples_per_unit,
                                 int directions, double curvature = 0.0, double max_distance = 0.0);
+
+// Sets d's per-row members (see TreeDirection) on a field with per-row spacing: each row's
+// step length in units of `unit` (stepUnits at the period's middle row, as the naive march's
+// table takes them) and its weight there (`rows`: latticeRowTables' for d's run).
+void followRows(TreeDirection& d, const HeightField& field, const RowTable& rows, double unit,
+                double samples_per_unit, int directions, double curvature, double max_distance);
 
 // Limits of the kernels' exact arithmetic, checked before launching: a line has fewer than
 // 2^24 steps (steps are exact floats in the predicate), and |height| * steps stays far
@@ -76,7 +126,12 @@ float intervisibilitySector(const IntervisibilityOptions& options);
 struct IntervisibilityLines {
   SweepDirection geometry{};
   int receiver_every = 1;
-  int max_steps = kAllSteps;  // only samples within this many steps of a receiver count
+  int max_steps = kAllSteps;  // only samples within this many steps (units) of a receiver count
+  // Per-row spacing (empty otherwise): per entry, its position along the line in whole units
+  // and the units of the step that reached it (the ring width of its share of the area);
+  // distance sums are then sums of (receiver position - position) * units. Without, both
+  // are the step.
+  std::vector<std::int32_t> positions, step_units;
   bool horizons_at_every_sample = true;  // else only receivers read theirs (the kernels without statistics)
   std::vector<float> samples;                 // sampled heights
   std::vector<float> counts;                  // visible samples (farther along the line)

@@ -34,16 +34,22 @@ struct Node {
   int next = kNone;
 };
 
-// The sampled heights of one line, indexed by step.
+// The sampled heights of one line and their positions, indexed by step.
 struct LineView {
-  const std::vector<float>& samples;
+  const IntervisibilityLines& lines;
   std::size_t offset;  // entry of step 0 of this line
   std::size_t stride;  // n_lines
-  float height(int step) const { return samples[offset + static_cast<std::size_t>(step) * stride]; }
+  std::size_t entry(int step) const { return offset + static_cast<std::size_t>(step) * stride; }
+  float height(int step) const { return lines.samples[entry(step)]; }
+  // Position along the line: the step, or its units with per-row spacing (exact in a float).
+  float position(int step) const {
+    return lines.positions.empty() ? static_cast<float>(step) : static_cast<float>(lines.positions[entry(step)]);
+  }
 };
 
-bool seenOver(float hx, int x, float hn, int n, float hr, int r) {
-  return chordSide(hx, hn, hr, static_cast<float>(n - x), static_cast<float>(r - n)) <= 0;
+bool seenOver(const LineView& line, float hx, int x, float hn, int n, float hr, int r) {
+  const float px = line.position(x), pn = line.position(n), pr = line.position(r);
+  return chordSide(hx, hn, hr, pn - px, pr - pn) <= 0;
 }
 
 // Mirror of run_end().
@@ -53,7 +59,7 @@ int runEnd(const LineView& line, int start, int next, float h_next, int receiver
     int lo = start, hi = next, jump = 1;
     while (lo + jump < hi) {
       const int x = lo + jump;
-      if (seenOver(line.height(x), x, h_next, next, h_receiver, receiver)) {
+      if (seenOver(line, line.height(x), x, h_next, next, h_receiver, receiver)) {
         lo = x;
         jump *= 2;
       } else {
@@ -63,7 +69,7 @@ int runEnd(const LineView& line, int start, int next, float h_next, int receiver
     }
     while (hi - lo > 1) {
       const int mid = lo + (hi - lo) / 2;
-      if (seenOver(line.height(mid), mid, h_next, next, h_receiver, receiver))
+      if (seenOver(line, line.height(mid), mid, h_next, next, h_receiver, receiver))
         lo = mid;
       else
         hi = mid;
@@ -72,7 +78,7 @@ int runEnd(const LineView& line, int start, int next, float h_next, int receiver
   }
   for (int x = start + 1; x < next; ++x) {
     const float hx = line.height(x);
-    if (!std::isnan(hx) && !seenOver(hx, x, h_next, next, h_receiver, receiver)) return x;
+    if (!std::isnan(hx) && !seenOver(line, hx, x, h_next, next, h_receiver, receiver)) return x;
   }
   return next;
 }
@@ -157,8 +163,8 @@ struct RootList {
 };
 
 // Mirror of hull_tree_walk(): Algorithm 1 below `top`; returns the convexity checks.
-std::uint32_t hullTreeWalk(std::vector<Node>& tree, bool deferred, int top, Node node, float h, int step,
-                           RootList& list) {
+std::uint32_t hullTreeWalk(const LineView& line, std::vector<Node>& tree, bool deferred, int top, Node node, float h,
+                           int step, RootList& list) {
   std::uint32_t t = 0;
   int cur = top;
   for (;;) {
@@ -166,8 +172,8 @@ std::uint32_t hullTreeWalk(std::vector<Node>& tree, bool deferred, int top, Node
     if (c != kNone) {
       Node child = tree[c];
       ++t;
-      const int side =
-          chordSide(child.h, node.h, h, static_cast<float>(cur - c), static_cast<float>(step - cur));
+      const int side = chordSide(child.h, node.h, h, line.position(cur) - line.position(c),
+                                 line.position(step) - line.position(cur));
       if (side <= 0) {
         tree[cur].first = child.next;
         tree[c].next = cur;
@@ -215,13 +221,17 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
                bool keep_horizons, BounceLines* bounce) {
   const bool deferred = tuning.deferred_writes;
   const std::size_t stride = static_cast<std::size_t>(d.n_lines);
-  const LineView line{out.samples, static_cast<std::size_t>(j), stride};
+  const LineView line{out, static_cast<std::size_t>(j), stride};
+  const bool row_spacing = !out.positions.empty();
   std::vector<Node> tree(static_cast<std::size_t>(d.n_steps));
   std::vector<int> ranks(static_cast<std::size_t>(d.n_steps));
   std::vector<std::uint64_t> step_sums(static_cast<std::size_t>(d.n_steps));
+  // With per-row spacing, over the present samples before each step: the sum of their step
+  // units and of position * units (the kernel's positions[].y and prefix[]).
+  std::vector<std::uint64_t> unit_sums(step_sums.size()), weighted_sums(step_sums.size());
 
   int rank = 0;
-  std::uint64_t step_sum = 0;
+  std::uint64_t step_sum = 0, unit_sum = 0, weighted_sum = 0;
   int root = kNone, prev = kNone, prev2 = kNone;
   float h_prev = 0.0f, h_prev2 = 0.0f;
   int class_last = kConvex;
@@ -235,7 +245,10 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
     const float h = out.samples[e];
     ranks[step] = rank;
     step_sums[step] = step_sum;
+    unit_sums[step] = unit_sum;
+    weighted_sums[step] = weighted_sum;
     if (std::isnan(h)) continue;  // outputs stay NaN / zero
+    const float p = line.position(step);
     std::uint32_t m = 0, t = 0, hash = kHorizonHashSeed;
     int count = 0;
     std::uint64_t distance_sum = 0;
@@ -255,8 +268,7 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
       bool replaced = false;
       if (tuning.replacement_check && tail != kNone) {
         ++t;
-        replaced = chordSide(tail_h, h_prev, h, static_cast<float>(root - tail),
-                             static_cast<float>(step - root)) <= 0;
+        replaced = chordSide(tail_h, h_prev, h, line.position(root) - line.position(tail), p - line.position(root)) <= 0;
       }
       if (tuning.safe_zone) {
         zone_valid = zone_valid && replaced && zone.inside(step, h);
@@ -276,11 +288,10 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
             if (!replaced) {
               if (tuning.replacement_check && c == tail) break;
               ++t;
-              if (chordSide(child.h, h_prev, h, static_cast<float>(root - c),
-                            static_cast<float>(step - root)) > 0)
+              if (chordSide(child.h, h_prev, h, line.position(root) - line.position(c), p - line.position(root)) > 0)
                 break;
             }
-            t += hullTreeWalk(tree, deferred, c, child, h, step, list);
+            t += hullTreeWalk(line, tree, deferred, c, child, h, step, list);
             c = child.next;
           }
           if (c != kNone || old_root.leaf) {
@@ -288,15 +299,14 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
             list.append(tree, deferred, root, h_prev, kNone);
           }
         } else {
-          t += hullTreeWalk(tree, deferred, root, old_root, h, step, list);
+          t += hullTreeWalk(line, tree, deferred, root, old_root, h, step, list);
         }
       }
 
       // 2. Eq. 1 for the old root; a segment start's node becomes (or is re-created as) a
       // leaf, the root's last child.
       if (prev2 != kNone) {
-        const int side =
-            chordSide(h_prev2, h_prev, h, static_cast<float>(prev - prev2), static_cast<float>(step - prev));
+        const int side = chordSide(h_prev2, h_prev, h, line.position(prev) - line.position(prev2), p - line.position(prev));
         const int cls = side > 0 ? kConvex : side < 0 ? kConcave : class_last;
         if (cls == kConvex && class_last == kConcave) {
           if (list.tail == prev) {
@@ -317,6 +327,14 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
       // 3. Visible samples from the horizons, farthest first (closed forms without holes);
       // at receivers, or at every sample when asked (statistics).
       if (visit) {
+      // Within the maximum distance: the first step within max_steps (units) of this one.
+      int cut = step - out.max_steps;
+      if (row_spacing) {
+        cut = 0;
+        while (static_cast<std::int64_t>(out.positions[line.entry(step)]) - out.positions[line.entry(cut)] >
+               out.max_steps)
+          ++cut;
+      }
       const bool refresh_zone = tuning.safe_zone && !zone_valid;
       if (refresh_zone) zone.begin(step);
       int hp = head;
@@ -351,19 +369,23 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
           gather->setAdjacent(end == np);
         }
         // Within the maximum distance: the run's samples from `first` on.
-        const int first = std::max(hp, step - out.max_steps);
+        const int first = std::max(hp, cut);
         const int first_rank = first == hp ? hp_rank : holes ? ranks[first] : hp_rank + (first - hp);
         const int run = first < end ? end_rank - first_rank : 0;
         count += run;
         std::uint64_t steps_sum = 0;
         if (run == 0) {
+        } else if (row_spacing) {  // sum of (p - position) * units over the run (sums at `step`: before it)
+          const std::uint64_t units = unit_sums[end] - unit_sums[first];
+          distance_sum += static_cast<std::uint64_t>(out.positions[line.entry(step)]) * units -
+                          (weighted_sums[end] - weighted_sums[first]);
         } else if (!holes) {
           steps_sum = static_cast<std::uint64_t>(run) * static_cast<std::uint64_t>(first + end - 1) / 2;
         } else {
           const std::uint64_t end_sum = end == step ? step_sum : step_sums[end];
           steps_sum = end_sum - step_sums[first];
         }
-        distance_sum += static_cast<std::uint64_t>(step) * static_cast<std::uint64_t>(run) - steps_sum;
+        if (!row_spacing) distance_sum += static_cast<std::uint64_t>(step) * static_cast<std::uint64_t>(run) - steps_sum;
         if (np == kNone) break;
         hz = nz;
         hp = np;
@@ -392,14 +414,21 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
     root = step;
     ++rank;
     step_sum += static_cast<std::uint64_t>(step);
+    if (row_spacing) {
+      const std::uint64_t units = static_cast<std::uint64_t>(out.step_units[e]);
+      unit_sum += units;
+      weighted_sum += static_cast<std::uint64_t>(out.positions[e]) * units;
+    }
   }
 }
 
 }  // namespace
 
-void sweepPresampledLines(IntervisibilityLines& lines, const HullTreeTuning& tuning, bool keep_horizons,
+void sweepPresampledLines(IntervisibilityLines& lines, const HullTreeTuning& requested, bool keep_horizons,
                           BounceLines* bounce) {
-  validate(tuning);
+  validate(requested);
+  const HullTreeTuning tuning = tuningFor(requested, !lines.positions.empty());
+  if (bounce && !lines.positions.empty()) throw InvalidArgument("internal error: the bounce takes uniform steps");
   const SweepDirection& d = lines.geometry;
   const std::size_t entries = d.entries();
   if (lines.samples.size() != entries)

@@ -5,6 +5,7 @@
 // result matches exactly.
 #include "hfvis/intervisibility_reference.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -46,12 +47,14 @@ void sweepReference(const HeightField& field, const std::vector<float>& h,
   auto& stats = result.statistics;
   for (const TreeDirection& d : treeDirections(field, options)) {
     IntervisibilityLines lines = latticeTreeLines(field, h, d);
-    // The kernel's curvature transform: every sample lowered by drop * step^2.
+    // The kernel's curvature transform: every sample lowered by drop * position^2 (the step,
+    // or its units with per-row spacing).
     if (options.curvature != 0.0) {
       for (int i = 0; i < lines.geometry.n_steps; ++i)
         for (int j = 0; j < lines.geometry.n_lines; ++j) {
-          float& s = lines.samples[static_cast<std::size_t>(i) * lines.geometry.n_lines + j];
-          s = s - d.drop * static_cast<float>(i) * static_cast<float>(i);
+          const std::size_t e = static_cast<std::size_t>(i) * lines.geometry.n_lines + j;
+          const float p = lines.positions.empty() ? static_cast<float>(i) : static_cast<float>(lines.positions[e]);
+          lines.samples[e] = lines.samples[e] - d.drop * p * p;
         }
     }
     lines.horizons_at_every_sample = statistics;  // as the kernel without statistics
@@ -79,9 +82,12 @@ void sweepReference(const HeightField& field, const std::vector<float>& h,
            i += lines.receiver_every) {
         const std::size_t e = static_cast<std::size_t>(i) * g.n_lines + j;
         if (std::isnan(lines.samples[e])) continue;
-        PixelSums& sum = sums[receiverPixel(d, field.width, j, i)];
-        sum.count += d.count_factor * lines.counts[e];
-        sum.area += d.area_factor * lines.distance_sums[e];
+        const std::size_t pixel = receiverPixel(d, field.width, j, i);
+        const std::size_t row = pixel / static_cast<std::size_t>(field.width);
+        const float count_factor = d.rowSpacing() ? d.row_factors[2 * row] : d.count_factor;
+        const float area_factor = d.rowSpacing() ? d.row_factors[2 * row + 1] : d.area_factor;
+        sums[pixel].count += count_factor * lines.counts[e];
+        sums[pixel].area += area_factor * lines.distance_sums[e];
       }
     }
   }
@@ -93,17 +99,26 @@ void naiveReference(const HeightField& field, const std::vector<float>& h,
   const int width = field.width, height = field.height;
   const auto directions = runDirections(field, options);
   const float sector = intervisibilitySector(options);
+  // Per-row spacing: positions in units, as intervisibility_naive with HFVIS_ROW_SPACING.
+  const bool row_spacing = hasRowSpacing(field);
+  const double unit = row_spacing ? groundUnit(field, options) : 0.0;
+  const NaiveRowTables rows = row_spacing ? naiveRowTables(field, directions, unit) : NaiveRowTables{};
   std::vector<PixelSums> sums(field.pixelCount());
   for (int r = 0; r < height; ++r) {
     for (int c = 0; c < width; ++c) {
       const std::size_t pixel = static_cast<std::size_t>(r) * width + c;
       const float hp = h[pixel];
-      for (const SweepDirection& d : directions) {
+      for (std::size_t k = 0; k < directions.size(); ++k) {
+        const SweepDirection& d = directions[k];
         const float step_ground = d.step_length * d.ground_per_pixel;
-        const float drop = static_cast<float>(options.curvature) * step_ground * step_ground;
-        const int counted_steps = stepsWithin(options.max_distance, double(d.step_length) * d.ground_per_pixel);
-        float best_h = 0.0f;
-        int best_step = 0, count = 0;
+        const float drop = row_spacing ? static_cast<float>(options.curvature * unit * unit)
+                                       : static_cast<float>(options.curvature) * step_ground * step_ground;
+        const int counted_steps =
+            stepsWithin(options.max_distance, row_spacing ? unit : double(d.step_length) * d.ground_per_pixel);
+        const std::int32_t* units = row_spacing ? &rows.units[k * (2 * static_cast<std::size_t>(height) - 1)] : nullptr;
+        const float step_y = d.step_length * d.dir_y;
+        float best_h = 0.0f, weighted = 0.0f;
+        int best_step = 0, count = 0, position = 0;
         std::uint32_t distance_sum = 0;
         // March until the ray has left the field for good (the kernel may march further;
         // those samples are outside and masked).
@@ -111,21 +126,38 @@ void naiveReference(const HeightField& field, const std::vector<float>& h,
           const float t = static_cast<float>(i) * d.step_length;
           const Point2 p{static_cast<float>(c) + t * d.dir_x, static_cast<float>(r) + t * d.dir_y};
           if (!insideField(p, width, height)) break;
+          int ring = 0, at = i;
+          if (row_spacing) {  // ray_half_row
+            const float mid = static_cast<float>(i) - 0.5f;
+            const int half = static_cast<int>(std::nearbyint(2.0f * (static_cast<float>(r) + mid * step_y)));
+            ring = units[std::clamp(half, 0, 2 * height - 2)];
+            position += ring;
+            at = position;
+          }
           const float q = sampleHeight(h, width, height, p) -
-                          (options.curvature != 0.0 ? drop * static_cast<float>(i) * static_cast<float>(i) : 0.0f);
+                          (options.curvature != 0.0 ? drop * static_cast<float>(at) * static_cast<float>(at) : 0.0f);
           const bool seen =
-              !std::isnan(q) && (best_step == 0 || chordSide(q, best_h, hp, static_cast<float>(i - best_step),
+              !std::isnan(q) && (best_step == 0 || chordSide(q, best_h, hp, static_cast<float>(at - best_step),
                                                              static_cast<float>(best_step)) <= 0);
           if (seen) {
-            if (i <= counted_steps) {
+            if (at <= counted_steps) {
               ++count;
-              distance_sum += static_cast<std::uint32_t>(i);
+              if (row_spacing)
+                weighted += static_cast<float>(at) * static_cast<float>(ring);
+              else
+                distance_sum += static_cast<std::uint32_t>(i);
             }
             best_h = q;
-            best_step = i;
+            best_step = at;
           }
         }
-        sums[pixel].add(d, sector, static_cast<float>(count), static_cast<float>(distance_sum));
+        if (row_spacing) {
+          const float* factors = &rows.factors[(k * height + r) * 2];
+          sums[pixel].count += factors[0] * static_cast<float>(count);
+          sums[pixel].area += factors[1] * weighted;
+        } else {
+          sums[pixel].add(d, sector, static_cast<float>(count), static_cast<float>(distance_sum));
+        }
       }
     }
   }

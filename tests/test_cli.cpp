@@ -1372,7 +1372,8 @@ TEST_F(CliGeoTiff, GeographicInputStaysGeographic) {
 // A tall latitude / longitude grid (1 degree cells, rows centred on 65 .. 55 N): a wall 4 cells
 // east of the receivers is seen from 4 times each row's own east-west spacing on the WGS84
 // ellipsoid (47.2 km per cell at 65 N, 64.0 km at 55 N), not the centre row's, also within a
-// maximum distance (both methods), and viewcount says it takes the centre latitude's spacing.
+// maximum distance (both methods); on flat ground the visible area of viewcount sums each
+// row's own spacing too.
 TEST_F(Cli, GeographicGridTakesEachRowsSpacing) {
   const int width = 8, height = 11;
   std::vector<float> values(width * height, 0.0f);
@@ -1419,9 +1420,37 @@ TEST_F(Cli, GeographicGridTakesEachRowsSpacing) {
   for (int r = 0; r < height; ++r) EXPECT_NEAR(n.at(2, r, 0), h.at(2, r, 0), 1e-6) << "row " << r;
   fs::remove(out("h.exr"));
   fs::remove(out("n.exr"));
-  const CliResult counts = run("viewcount " + shellQuoted(tif) + " -o " + shellQuoted(out("v.exr")) + " -k 4 -q");
+  // Flat ground: from column 2 every sample is seen, 5 east, 2 west, r north and 10 - r south.
+  // Each axis stands for a quarter of the circle, so the area is pi / 2 times the sum over
+  // the samples of their distance times their step toward the receiver: along the row the
+  // row's east-west spacing, along the column the north-south spacing at each step's middle.
+  const std::string flat = in("flat.tif");
+  hfvis::testing::writeGdalGeoTiff(flat, width, height, std::vector<float>(width * height, 0.0f),
+                                   {10.0, 1.0, 0.0, 65.5, 0.0, -1.0}, "EPSG:4326", std::nullopt);
+  const CliResult counts = run("viewcount " + shellQuoted(flat) + " -o " + shellQuoted(out("v.exr")) + " -k 4 -q");
   ASSERT_EQ(counts.status, 0) << counts.err;
-  EXPECT_NE(counts.err.find("takes the centre latitude's cell size"), std::string::npos) << counts.err;
+  EXPECT_EQ(counts.err.find("centre latitude"), std::string::npos) << counts.err;
+  const ReadBack v = readBack(out("v.exr"));
+  std::vector<double> east(height), north(height);  // per row, metres per degree
+  for (int r = 0; r < height; ++r) {
+    const double lat = (65.0 - r) * M_PI / 180.0, a = 6378137.0, e2 = 0.00669437999014132;
+    const double w = 1.0 - e2 * std::sin(lat) * std::sin(lat);
+    east[r] = a / std::sqrt(w) * std::cos(lat) * M_PI / 180.0;
+    north[r] = a * (1.0 - e2) / (w * std::sqrt(w)) * M_PI / 180.0;
+  }
+  for (int r = 0; r < height; ++r) {
+    double sum = east[r] * east[r] * (5.0 * 6.0 / 2.0 + 2.0 * 3.0 / 2.0);
+    for (int dir : {-1, 1}) {
+      double along = 0.0;
+      for (int row = r + dir; row >= 0 && row < height; row += dir) {
+        const double step = 0.5 * (north[row] + north[row - dir]);
+        along += step;
+        sum += along * step;
+      }
+    }
+    EXPECT_EQ(v.at(2, r, 0), 7.0f + float(height - 1)) << "row " << r;
+    EXPECT_NEAR(v.at(2, r, 1), M_PI / 2.0 * sum, 1e-4 * M_PI / 2.0 * sum) << "row " << r;
+  }
 }
 
 }  // namespace

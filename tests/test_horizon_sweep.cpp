@@ -219,22 +219,7 @@ TEST(HorizonSweepLine, DirectionsHonourTheToleranceAndQuadratureWeightsSumToOne)
 }
 
 // Kernel results equal the scalar reference of the same algorithm, for both methods, in
-// both buffer layouts.
-// Per-row spacing as a latitude / longitude grid has it, exaggerated: along columns from 1.5 at
-// the top to 0.75 at the bottom, along rows slowly growing; the field's cell sizes the centre
-// row's.
-void setRowSpacing(HeightField& field) {
-  field.row_cell_size_x.clear();
-  field.row_cell_size_y.clear();
-  for (int r = 0; r < field.height; ++r) {
-    const double t = field.height > 1 ? double(r) / (field.height - 1) : 0.0;
-    field.row_cell_size_x.push_back(1.5 * (1.0 - 0.5 * t));
-    field.row_cell_size_y.push_back(1.0 + 0.02 * t);
-  }
-  field.cell_size_x = field.row_cell_size_x[field.height / 2];
-  field.cell_size_y = field.row_cell_size_y[field.height / 2];
-}
-
+// both buffer layouts (with row_spacing, on testing::setRowSpacing's grid).
 void expectKernelMatchesReference(HorizonMethod method, double samples_per_unit, double curvature = 0.0,
                                   double max_distance = 0.0, bool row_spacing = false) {
   testing::forEachLayout([&](const ComputeContext& context) {
@@ -243,7 +228,7 @@ void expectKernelMatchesReference(HorizonMethod method, double samples_per_unit,
         SCOPED_TRACE(name + " " + std::to_string(w) + "x" + std::to_string(h));
         HeightField field = makeSyntheticField(name, w, h, 3);
         field.cell_size_x = 1.5;
-        if (row_spacing) setRowSpacing(field);
+        if (row_spacing) testing::setRowSpacing(field);
         HorizonOptions options;
         options.directions = 7;
         options.azimuth_offset = 0.1;
@@ -336,7 +321,7 @@ TEST(HorizonKernels, SweepEqualsNaiveOnAxisDirectionsWithPerRowSpacing) {
           SCOPED_TRACE(name + " " + std::to_string(w) + "x" + std::to_string(h) + " max distance " +
                        std::to_string(max_distance));
           HeightField field = makeSyntheticField(name, w, h, 5);
-          setRowSpacing(field);
+          testing::setRowSpacing(field);
           HorizonOptions options;
           options.directions = 4;
           options.max_distance = max_distance;
@@ -352,7 +337,7 @@ TEST(HorizonKernels, SweepEqualsNaiveOnAxisDirectionsWithPerRowSpacing) {
   });
   // Not yet with per-row spacing: strips within a maximum distance.
   HeightField field = makeSyntheticField("noise", 9, 7, 1);
-  setRowSpacing(field);
+  testing::setRowSpacing(field);
   HorizonOptions options;
   options.max_distance = 3.0;
   HorizonOutputs outputs;
@@ -486,7 +471,7 @@ TEST(HorizonKernels, StripsEqualTheWholeFieldBitForBit) {
       options.directions = 32;
       if (variant == 0) options.curvature = 0.01;
       if (variant == 1) options.samples_per_unit = 3.0;
-      if (variant == 2) setRowSpacing(field);
+      if (variant == 2) testing::setRowSpacing(field);
       for (const HorizonOutputs& outputs : {allOutputs(), HorizonOutputs{false, false, true, true}}) {
         const auto whole = computeHorizons(context, field, options, outputs);
         options.strip_rows = 4;

@@ -46,6 +46,18 @@ detail::TreeDirection treeStep(const HeightField& field, std::pair<int, int> ste
   return detail::makeTreeDirection(field, lattice, samples_per_unit, 8);
 }
 
+// The same on a field with per-row spacing (testing::setRowSpacing): positions in units.
+detail::TreeDirection treeStepFollowingRows(const HeightField& field, std::pair<int, int> step,
+                                            double samples_per_unit = 1.0) {
+  detail::TreeDirection d = treeStep(field, step, samples_per_unit);
+  SweepOptions options;
+  options.directions = 8;
+  options.samples_per_unit = samples_per_unit;
+  const auto rows = detail::latticeRowTables(field, {d.lattice}, false);
+  detail::followRows(d, field, rows[0], detail::groundUnit(field, options), samples_per_unit, 8, 0.0, 0.0);
+  return d;
+}
+
 // The scalar reference's lines of direction d, every horizon kept.
 detail::IntervisibilityLines referenceLines(const HeightField& field, const std::vector<float>& heights,
                                             const detail::TreeDirection& d, const HullTreeTuning& tuning = {}) {
@@ -162,6 +174,8 @@ TEST(IntervisibilityPredicate, ChordSideIsExactOnRandomAndNearCollinearTriples) 
 struct LineSample {
   int step;
   float h;
+  float position;  // the step, or its units with per-row spacing
+  float ring;      // 1, or the units of its step toward the receivers (its ring width)
 };
 
 // The present samples of line j, in sweep order (far end first).
@@ -169,15 +183,20 @@ std::vector<LineSample> presentSamples(const detail::IntervisibilityLines& lines
   std::vector<LineSample> present;
   const auto& d = lines.geometry;
   for (int i = 0; i < d.n_steps; ++i) {
-    const float h = lines.samples[static_cast<std::size_t>(i) * d.n_lines + j];
-    if (!std::isnan(h)) present.push_back({i, h});
+    const std::size_t e = static_cast<std::size_t>(i) * d.n_lines + j;
+    const float h = lines.samples[e];
+    if (std::isnan(h)) continue;
+    if (lines.positions.empty())
+      present.push_back({i, h, float(i), 1.0f});
+    else
+      present.push_back({i, h, float(lines.positions[e]), float(lines.step_units[e])});
   }
   return present;
 }
 
 // Whether sample a is strictly above the chord from far sample q to receiver r (q < a < r).
 bool above(const LineSample& q, const LineSample& a, const LineSample& r) {
-  return detail::chordSide(q.h, a.h, r.h, float(a.step - q.step), float(r.step - a.step)) > 0;
+  return detail::chordSide(q.h, a.h, r.h, a.position - q.position, r.position - a.position) > 0;
 }
 
 // Eq. 1 segment starts of a line's present samples: the first, and every convex sample
@@ -189,8 +208,8 @@ std::vector<bool> segmentStarts(const std::vector<LineSample>& s) {
   start[0] = true;
   std::vector<int> cls(s.size(), 1);  // 1 convex, 0 concave; the first is convex
   for (std::size_t i = 1; i + 1 < s.size(); ++i) {
-    const int side = detail::chordSide(s[i - 1].h, s[i].h, s[i + 1].h, float(s[i].step - s[i - 1].step),
-                                       float(s[i + 1].step - s[i].step));
+    const int side = detail::chordSide(s[i - 1].h, s[i].h, s[i + 1].h, s[i].position - s[i - 1].position,
+                                       s[i + 1].position - s[i].position);
     cls[i] = side > 0 ? 1 : side < 0 ? 0 : cls[i - 1];
     start[i] = cls[i] == 1 && cls[i - 1] == 0;
   }
@@ -279,7 +298,7 @@ void expectTreeEqualsBruteForce(const HeightField& field, const detail::TreeDire
       // Visible counts and distances equal the enumeration.
       ASSERT_EQ(ref.counts[e], float(brute.visible.size()));
       double distance = 0.0;
-      for (int x : brute.visible) distance += s[r].step - s[x].step;
+      for (int x : brute.visible) distance += double(s[r].position - s[x].position) * s[x].ring;
       ASSERT_EQ(ref.distance_sums[e], float(distance));
       // Every start of a visible run (a visible sample whose farther neighbour is hidden)
       // is a horizon, and every horizon is visible.
@@ -319,6 +338,32 @@ TEST(IntervisibilityLine, TreeEqualsBruteForceOnEveryHardCase) {
     }
     EXPECT_GT(checked, 100000u) << variant.name;
   }
+}
+
+// On a field whose rows have their own spacing (a latitude / longitude grid), positions
+// along the lines are whole units of ground length that differ from row to row: the tree
+// still equals brute force on them, and its kernel the reference, on every hard case, in
+// every direction of kSteps and in every tuning (the safe zone is off there).
+TEST(IntervisibilityLine, TreeEqualsBruteForceOnRowsOfTheirOwnSpacing) {
+  std::uint64_t checked = 0;
+  for (const NamedTuning& variant : {kTunings[0], kTunings[2], kTunings[3]}) {
+    for (const auto& name : syntheticFieldNames()) {
+      for (auto [w, h] : awkwardSizes()) {
+        HeightField field = makeSyntheticField(name, w, h, 7);
+        testing::setRowSpacing(field);
+        for (auto step : kSteps) {
+          SCOPED_TRACE(std::string(variant.name) + ": " + name + " " + std::to_string(w) + "x" + std::to_string(h) +
+                       " step " + std::to_string(step.first) + "," + std::to_string(step.second));
+          const auto d = treeStepFollowingRows(field, step, step.second == 1 ? 2.0 : 1.0);
+          // The steps really differ in length along lines that cross rows.
+          if (step.second != 0 && h > 2) ASSERT_NE(d.row_units.front(), d.row_units.back());
+          expectTreeEqualsBruteForce(field, d, true, &checked, variant.tuning);
+          if (::testing::Test::HasFatalFailure()) return;
+        }
+      }
+    }
+  }
+  EXPECT_GT(checked, 50000u);
 }
 
 // The tunings change the work, never the result: per receiver the same counts, distances
@@ -464,13 +509,14 @@ float areaTolerance(const std::vector<float>& area) {
 // (only receivers do: the production path).
 void expectKernelMatchesReference(IntervisibilityMethod method, double samples_per_unit,
                                   const HullTreeTuning& tuning = {}, double curvature = 0.0,
-                                  double max_distance = 0.0) {
+                                  double max_distance = 0.0, bool row_spacing = false) {
   testing::forEachLayout([&](const ComputeContext& context) {
     for (const auto& name : syntheticFieldNames()) {
       for (auto [w, h] : awkwardSizes()) {
         SCOPED_TRACE(name + " " + std::to_string(w) + "x" + std::to_string(h));
         HeightField field = makeSyntheticField(name, w, h, 3);
         field.cell_size_x = 1.5;
+        if (row_spacing) testing::setRowSpacing(field);
         IntervisibilityOptions options;
         options.directions = 7;
         options.azimuth_offset = 0.1;
@@ -533,6 +579,19 @@ TEST(IntervisibilityKernels, NaiveMatchesScalarReferenceWithinAMaximumDistance) 
   expectKernelMatchesReference(IntervisibilityMethod::Naive, 1.0, {}, 0.0, 4.5);
 }
 
+// On rows of their own spacing (testing::setRowSpacing): plain, denser and in the safe zone's
+// tuning (off there); curved and within a maximum distance.
+TEST(IntervisibilityKernels, TreeMatchesScalarReferenceOnRowsOfTheirOwnSpacing) {
+  expectKernelMatchesReference(IntervisibilityMethod::HullTree, 1.0, {}, 0.0, 0.0, true);
+  expectKernelMatchesReference(IntervisibilityMethod::HullTree, 2.5, *hullTreeTuningNamed("zone"), 0.0, 0.0, true);
+  expectKernelMatchesReference(IntervisibilityMethod::HullTree, 1.0, {}, 0.004, 4.5, true);
+}
+
+TEST(IntervisibilityKernels, NaiveMatchesScalarReferenceOnRowsOfTheirOwnSpacing) {
+  expectKernelMatchesReference(IntervisibilityMethod::Naive, 1.0, {}, 0.0, 0.0, true);
+  expectKernelMatchesReference(IntervisibilityMethod::Naive, 1.0, {}, 0.004, 4.5, true);
+}
+
 // On a flat plane within a maximum distance D, a pixel sees along each axis direction the
 // min(D, distance to the edge) samples of its row or column, with both methods.
 TEST(IntervisibilityAnalytic, FlatPlaneWithinAMaximumDistance) {
@@ -574,6 +633,54 @@ TEST(IntervisibilityAnalytic, FlatGroundOverACurvedEarthShowsOnlyTheNearestSampl
   }
 }
 
+// A tower of height 1 on flat ground over a curved Earth (drop c d^2) sees the ground out to
+// about sqrt(1 / c): along a row, that many samples of the row's own east-west spacing. On a
+// latitude / longitude grid the spacing shrinks toward the pole, so a tower near it sees more
+// samples: K = 4, rows spaced 1 to 2 apart east-west and 1 north-south, towers at several
+// rows (one field each), against the march of each axis in double on the true spacing, with
+// both methods; and the centre row's spacing, as the whole field's, would be off by more.
+TEST(IntervisibilityAnalytic, TowerOverACurvedEarthSeesItsRowsOwnSpacing) {
+  const int width = 81, height = 41, col = 40;
+  const double c = 0.001;
+  auto spacing_x = [&](int row) { return 1.0 + double(row) / (height - 1); };
+  // Visible samples along one axis from the tower: k = 1 .. samples at k * spacing.
+  auto march = [&](int samples, double spacing) {
+    double best = -1e300;
+    int visible = 0;
+    for (int k = 1; k <= samples; ++k) {
+      const double d = k * spacing, slope = (-c * d * d - 1.0) / d;
+      if (slope >= best) ++visible, best = slope;
+    }
+    return visible;
+  };
+  for (int tower_row : {3, 20, 37}) {
+    SCOPED_TRACE("tower at row " + std::to_string(tower_row));
+    std::vector<float> heights(std::size_t(width) * height, 0.0f);
+    heights[std::size_t(tower_row) * width + col] = 1.0f;
+    HeightField field = fieldFrom(width, height, heights);
+    for (int r = 0; r < height; ++r) {
+      field.row_cell_size_x.push_back(spacing_x(r));
+      field.row_cell_size_y.push_back(1.0);
+    }
+    field.cell_size_x = spacing_x(height / 2);
+    const int east_west = 2 * march(col, spacing_x(tower_row));
+    const int north_south = march(tower_row, 1.0) + march(height - 1 - tower_row, 1.0);
+    const int centre_row = 2 * march(col, spacing_x(height / 2)) + north_south;
+    if (tower_row != 20) EXPECT_GE(std::abs(east_west + north_south - centre_row), 8);
+    for (auto method : {IntervisibilityMethod::HullTree, IntervisibilityMethod::Naive}) {
+      IntervisibilityOptions options;
+      options.directions = 4;
+      options.method = method;
+      options.curvature = c;
+      IntervisibilityOutputs outputs;
+      outputs.visible_count = true;
+      const auto r = computeIntervisibility(testContext(), field, options, outputs);
+      EXPECT_EQ(r.visible_count[std::size_t(tower_row) * width + col], float(east_west + north_south))
+          << (method == IntervisibilityMethod::Naive ? "naive" : "tree");
+    }
+  }
+}
+
 TEST(IntervisibilityKernels, NaiveMatchesScalarReference) {
   expectKernelMatchesReference(IntervisibilityMethod::Naive, 1.0);
 }
@@ -584,21 +691,25 @@ TEST(IntervisibilityKernels, NaiveMatchesScalarReference) {
 TEST(IntervisibilityKernels, TreeEqualsNaiveOnAxisDirections) {
   for (const auto& name : syntheticFieldNames()) {
     for (auto [w, h] : awkwardSizes()) {
-      SCOPED_TRACE(name + " " + std::to_string(w) + "x" + std::to_string(h));
-      HeightField field = makeSyntheticField(name, w, h, 5);
-      field.cell_size_y = 0.5;
-      for (double max_distance : {0.0, 3.75}) {  // the whole field; 7 rows, 3 columns
-        IntervisibilityOptions options;
-        options.directions = 4;
-        options.max_distance = max_distance;
-        IntervisibilityOutputs outputs;
-        outputs.visible_count = outputs.visible_area = true;
-        const auto tree = computeIntervisibility(testContext(), field, options, outputs);
-        options.method = IntervisibilityMethod::Naive;
-        const auto naive = computeIntervisibility(testContext(), field, options, outputs);
-        EXPECT_TRUE(nearlyEqual(tree.visible_count, naive.visible_count, 0.0f)) << max_distance;
-        // The area's factors round differently (2 pi w g^2 in double, then float).
-        EXPECT_TRUE(nearlyEqual(tree.visible_area, naive.visible_area, areaTolerance(naive.visible_area)));
+      for (bool row_spacing : {false, true}) {  // also on rows of their own spacing (same units)
+        SCOPED_TRACE(name + " " + std::to_string(w) + "x" + std::to_string(h) + (row_spacing ? " rows" : ""));
+        HeightField field = makeSyntheticField(name, w, h, 5);
+        field.cell_size_y = 0.5;
+        if (row_spacing) testing::setRowSpacing(field);
+        for (double max_distance : {0.0, 3.75}) {  // the whole field; 7 rows, 3 columns (uniform)
+          IntervisibilityOptions options;
+          options.directions = 4;
+          options.max_distance = max_distance;
+          IntervisibilityOutputs outputs;
+          outputs.visible_count = outputs.visible_area = true;
+          const auto tree = computeIntervisibility(testContext(), field, options, outputs);
+          options.method = IntervisibilityMethod::Naive;
+          const auto naive = computeIntervisibility(testContext(), field, options, outputs);
+          EXPECT_TRUE(nearlyEqual(tree.visible_count, naive.visible_count, 0.0f)) << max_distance;
+          // The area's factors round differently (2 pi w g^2 in double, then float), and with
+          // per-row spacing the naive march sums its area in float.
+          EXPECT_TRUE(nearlyEqual(tree.visible_area, naive.visible_area, areaTolerance(naive.visible_area)));
+        }
       }
     }
   }

@@ -96,4 +96,19 @@ inline std::vector<float> randomLineHeights(int kind, int width, int height, flo
   return heights;
 }
 
+// Per-row spacing as a latitude / longitude grid has it, exaggerated: along columns from 1.5 at
+// the top to 0.75 at the bottom, along rows slowly growing; the field's cell sizes the centre
+// row's.
+inline void setRowSpacing(HeightField& field) {
+  field.row_cell_size_x.clear();
+  field.row_cell_size_y.clear();
+  for (int r = 0; r < field.height; ++r) {
+    const double t = field.height > 1 ? double(r) / (field.height - 1) : 0.0;
+    field.row_cell_size_x.push_back(1.5 * (1.0 - 0.5 * t));
+    field.row_cell_size_y.push_back(1.0 + 0.02 * t);
+  }
+  field.cell_size_x = field.row_cell_size_x[field.height / 2];
+  field.cell_size_y = field.row_cell_size_y[field.height / 2];
+}
+
 }  // namespace hfvis::testing

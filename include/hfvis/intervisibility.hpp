@@ -47,7 +47,8 @@ struct HullTreeTuning {
   // The safe zone (Sec. 7, Algorithm 3): a replaced old root whose children stay as they are
   // (the new sample lies in the zone below every child's edge to its first child) skips the
   // walk. Needs replacement_check. Off by default: it skips up to two thirds of the walks
-  // but showed no measurable gain in time on a CPU (bench/report/REPORT.md).
+  // but showed no measurable gain in time on a CPU (bench/report/REPORT.md). Not taken on
+  // fields with per-row spacing (latitude / longitude grids), whose steps differ in length.
   bool safe_zone = false;
   // Steps past the receiver one safe zone covers before it is recomputed: a power of two,
   // 1 .. 4096.
