@@ -36,6 +36,9 @@
 //                           positions along a line are whole units of ground length summed
 //                           step by step (row_units), not the steps themselves; not with the
 //                           safe zone or the bounce
+//   HFVIS_STRIPS            intervisibility_lattice sweeps the receivers of one strip of rows
+//                           and resumes each line where the strip before left it (a field in
+//                           strips; not with the bounce)
 // Every combination builds the same trees (tests/test_intervisibility.cpp): the options
 // change the work (iterations t, memory traffic), never a result.
 #include "chord_side.cl"
@@ -80,6 +83,12 @@
 #endif
 #if HFVIS_ROW_SPACING && (HFVIS_SAFE_ZONE || HFVIS_WANT_BOUNCE)
 #error "per-row spacing takes neither the safe zone nor the bounce (both assume uniform steps)"
+#endif
+#ifndef HFVIS_STRIPS
+#define HFVIS_STRIPS 0
+#endif
+#if HFVIS_STRIPS && HFVIS_WANT_BOUNCE
+#error "the bounce reads the radiance of every earlier sample: it needs the whole field"
 #endif
 // Statistics need every sample's horizons (Table 2 and Section 6's bound count them all);
 // otherwise only receivers (pixel centres) read theirs.
@@ -280,6 +289,18 @@ HFVIS_INLINE int safe_zone_inside(const SafeZone* z, int step, float h) {
 }
 #endif
 
+// What a line's sweep keeps in registers between its samples, saved at the end of a strip and
+// restored at the start of the next one (HFVIS_STRIPS): the tree itself stays in the scratch.
+typedef struct {
+  ulong step_sum, weighted_sum, total_m, total_t, total_naive, total_visible;
+  int rank, root, prev, prev2, class_last, head, tail, position;
+  uint unit_sum, zone_skips;
+  int zone_valid, zone_first, zone_last;
+  float h_prev, h_prev2, p_prev, p_prev2, tail_h, zone_z1, zone_z2, zone_margin;
+} TreeLineState;
+// The host allocates kTreeLineStateBytes (src/intervisibility_device.hpp) per line.
+typedef char tree_line_state_is_136_bytes[sizeof(TreeLineState) == 136 ? 1 : -1];
+
 // The sweep of one direction (a, b) on lattice lines (src/lattice_geometry.hpp): every pixel
 // centre lies on exactly one line of the direction, so every receiver is a sample of the
 // line through its own centre, at its own height, and its tree gives the visible samples
@@ -322,6 +343,11 @@ HFVIS_INLINE int safe_zone_inside(const SafeZone* z, int step, float h) {
 // not rest on the predicate: leaves are never deleted and a node only when childless, so
 // every subtree holds a leaf and the root never loses all children; a slot is reused only
 // for the deleted old root. Global size: the launch's lines rounded up to the local size.
+// With HFVIS_STRIPS a launch sweeps line j's receivers strip_receivers[j].x .. .y - 1 (those
+// in one strip of rows; the strips go in the order the lines run through them), resuming from
+// states[j] when it does not start at receiver 0 and saving it at the end; heights holds rows
+// from row0 on (the strip and a halo of the rows its periods reach), count_sum and area_sum
+// rows from out_row0 on, and line_totals the totals so far.
 __kernel void intervisibility_lattice(
     __global const float* heights, int width, int height, __global const int4* lines, int n_lines,
     __global const LatticeSample* samples, int n_samples, int a, int b, float count_factor, float area_factor,
@@ -330,10 +356,19 @@ __kernel void intervisibility_lattice(
     __global uint4* entry_stats, __global ulong* line_totals, int first_line, __global float* count_sum,
     __global float* area_sum, __global const float* radiance, __global const float* normals,
     float cos_azimuth, float sin_azimuth, float step_ground, float half_sector, float wedge,
-    __global float* irradiance) {
+    __global float* irradiance, int row0, int out_row0, __global const int2* strip_receivers,
+    __global TreeLineState* states) {
   const int j = get_global_id(0);
   if (j >= n_lines) return;
   const int4 line = lines[j];
+#if HFVIS_STRIPS
+  const int2 strip = strip_receivers[j];
+  if (strip.x >= strip.y) return;  // no receiver of this line in the strip
+  const int i_begin = strip.x, i_end = strip.y;
+#else
+  const int i_begin = 0, i_end = line.z;
+  row0 = out_row0 = 0;
+#endif
   const uint base = (uint)line.w;
   __global int4* tree = trees + base;
   __global int2* line_positions = positions + base;
@@ -359,11 +394,48 @@ __kernel void intervisibility_lattice(
 #endif
   uint zone_skips = 0;  // walks the safe zone skipped
   ulong total_m = 0, total_t = 0, total_naive = 0, total_visible = 0;
+#if HFVIS_STRIPS
+  __global TreeLineState* state = states + j;
+  if (i_begin > 0) {
+    const TreeLineState st = *state;
+    step_sum = st.step_sum;
+    total_m = st.total_m;
+    total_t = st.total_t;
+    total_naive = st.total_naive;
+    total_visible = st.total_visible;
+    rank = st.rank;
+    root = st.root;
+    prev = st.prev;
+    prev2 = st.prev2;
+    class_last = st.class_last;
+    head = st.head;
+    tail = st.tail;
+    zone_skips = st.zone_skips;
+    h_prev = st.h_prev;
+    h_prev2 = st.h_prev2;
+    p_prev = st.p_prev;
+    p_prev2 = st.p_prev2;
+    tail_h = st.tail_h;
+#if HFVIS_ROW_SPACING
+    weighted_sum = st.weighted_sum;
+    position = st.position;
+    unit_sum = st.unit_sum;
+#endif
+#if HFVIS_SAFE_ZONE
+    zone_valid = st.zone_valid;
+    zone.first = st.zone_first;
+    zone.last = st.zone_last;
+    zone.z1 = st.zone_z1;
+    zone.z2 = st.zone_z2;
+    zone.margin = st.zone_margin;
+#endif
+  }
+#endif
 
-  int step = 0;
-  int col = line.x, row = line.y;  // the current period's receiver
-  for (int i = 0; i < line.z; ++i, col -= a, row -= b) {
-    const uint pixel = (uint)(row * width + col);
+  int step = i_begin * n_samples;
+  int col = line.x - i_begin * a, row = line.y - i_begin * b;  // the current period's receiver
+  for (int i = i_begin; i < i_end; ++i, col -= a, row -= b) {
+    const uint pixel = (uint)((row - out_row0) * width + col);
 #if HFVIS_ROW_SPACING
     const int units = row_units[row];  // each step of this period
 #endif
@@ -381,7 +453,7 @@ __kernel void intervisibility_lattice(
       const int x0 = col + s->ox, y0 = row + s->oy, ex = s->ex, ey = s->ey;
       float h = NAN;
       if (i > 0 || (x0 >= 0 && x0 + ex <= width - 1 && y0 >= 0 && y0 + ey <= height - 1)) {
-        const uint at = (uint)(y0 * width + x0);
+        const uint at = (uint)((y0 - row0) * width + x0);
         // The receiver is its pixel's height as it is (1 h + 0 h would make an infinity NaN).
         h = ex + ey == 0 ? heights[at]
                          : lattice_height(heights, at, (uint)ex, (uint)(ey * width), s->w00, s->w10, s->w01, s->w11);
@@ -660,7 +732,42 @@ __kernel void intervisibility_lattice(
 #endif
     }
   }
-#if HFVIS_WANT_STATS
+#if HFVIS_STRIPS
+  TreeLineState st;
+  st.step_sum = step_sum;
+  st.total_m = total_m;
+  st.total_t = total_t;
+  st.total_naive = total_naive;
+  st.total_visible = total_visible;
+  st.rank = rank;
+  st.root = root;
+  st.prev = prev;
+  st.prev2 = prev2;
+  st.class_last = class_last;
+  st.head = head;
+  st.tail = tail;
+  st.zone_skips = zone_skips;
+  st.h_prev = h_prev;
+  st.h_prev2 = h_prev2;
+  st.p_prev = p_prev;
+  st.p_prev2 = p_prev2;
+  st.tail_h = tail_h;
+#if HFVIS_ROW_SPACING
+  st.weighted_sum = weighted_sum;
+  st.position = position;
+  st.unit_sum = unit_sum;
+#endif
+#if HFVIS_SAFE_ZONE
+  st.zone_valid = zone_valid;
+  st.zone_first = zone.first;
+  st.zone_last = zone.last;
+  st.zone_z1 = zone.z1;
+  st.zone_z2 = zone.z2;
+  st.zone_margin = zone.margin;
+#endif
+  *state = st;
+#endif
+#if HFVIS_WANT_STATS  // (in strips: the totals so far)
   __global ulong* totals = line_totals + (uint)(first_line + j) * HFVIS_LINE_TOTALS;
   totals[0] = (ulong)rank;
   totals[1] = total_m;

@@ -26,7 +26,8 @@ std::string treeProgramOptions(const TreeProgramFlags& f) {
   s << "-DHFVIS_HAS_NODATA=" << f.has_nodata << " -DHFVIS_WANT_COUNT=" << f.count
     << " -DHFVIS_WANT_AREA=" << f.area
     << " -DHFVIS_WANT_STATS=" << f.stats << " -DHFVIS_WANT_ENTRY_STATS=" << f.entry_stats;
-  s << " -DHFVIS_CURVATURE=" << f.curvature << " -DHFVIS_ROW_SPACING=" << f.row_spacing;
+  s << " -DHFVIS_CURVATURE=" << f.curvature << " -DHFVIS_ROW_SPACING=" << f.row_spacing
+    << " -DHFVIS_STRIPS=" << f.strips;
   const HullTreeTuning tuning = tuningFor(f.tuning, f.row_spacing);
   s << " -DHFVIS_DEFERRED_WRITES=" << tuning.deferred_writes
     << " -DHFVIS_REPLACEMENT_CHECK=" << tuning.replacement_check
@@ -44,34 +45,36 @@ std::size_t treeEntryBytes(const TreeProgramFlags& f) {
          (f.entry_stats ? kTreeVisibleBytes + kTreeEntryStatsBytes : 0);
 }
 
+TreeScratchNeeds treeScratchNeeds(const std::vector<TreeDirection>& directions, bool line_major) {
+  TreeScratchNeeds needs;
+  for (const TreeDirection& d : directions) {
+    std::size_t total = 0, direction_longest = 0;
+    for (const LatticeLine& line : d.lines) {
+      const std::size_t capacity = lineCapacity(line, d.samples.size());
+      total += capacity;
+      direction_longest = std::max(direction_longest, capacity);
+    }
+    // Step-major chunks pad every line to the chunk's longest (chunkLines).
+    if (!line_major) total = std::max(total, direction_longest * d.lines.size());
+    needs.whole = std::max(needs.whole, total);
+    needs.longest = std::max(needs.longest, direction_longest);
+  }
+  return needs;
+}
+
 std::size_t planTreeScratch(const std::vector<TreeDirection>& directions, std::size_t fixed_bytes,
                             std::size_t entry_bytes, std::size_t budget_bytes, const DeviceInfo& device,
                             bool line_major) {
   const std::size_t budget = budget_bytes ? budget_bytes : defaultMemoryBudget(device);
   const std::size_t max_alloc = device.max_allocation_bytes ? device.max_allocation_bytes : budget;
-  std::size_t whole = 0, longest = 0;
-  for (const TreeDirection& d : directions) {
-    std::size_t total = 0;
-    for (const LatticeLine& line : d.lines) {
-      const std::size_t capacity = lineCapacity(line, d.samples.size());
-      total += capacity;
-      longest = std::max(longest, capacity);
-    }
-    // Step-major chunks pad every line to the chunk's longest (chunkLines).
-    if (!line_major) {
-      std::size_t direction_longest = 0;
-      for (const LatticeLine& line : d.lines) direction_longest = std::max(direction_longest, lineCapacity(line, d.samples.size()));
-      total = std::max(total, direction_longest * d.lines.size());
-    }
-    whole = std::max(whole, total);
-  }
-  const std::size_t least = fixed_bytes + longest * entry_bytes;
-  if (least > budget || longest * kTreeNodeBytes > max_alloc) {
+  const TreeScratchNeeds needs = treeScratchNeeds(directions, line_major);
+  const std::size_t least = fixed_bytes + needs.longest * entry_bytes;
+  if (least > budget || needs.longest * kTreeNodeBytes > max_alloc) {
     throw MemoryBudgetError("one direction needs " + mebibytes(least) + " of device memory but the budget is " +
                             mebibytes(budget) + " (largest single buffer " + mebibytes(max_alloc) +
                             "); raise the memory budget or use a smaller field");
   }
-  return std::min({whole, (budget - fixed_bytes) / entry_bytes, max_alloc / kTreeNodeBytes});
+  return std::min({needs.whole, (budget - fixed_bytes) / entry_bytes, max_alloc / kTreeNodeBytes});
 }
 
 void allocateTreeScratch(ContextState& st, const TreeProgramFlags& flags, const std::vector<TreeDirection>& all,
@@ -87,25 +90,26 @@ void allocateTreeScratch(ContextState& st, const TreeProgramFlags& flags, const 
   b.line_totals = deviceBuffer(st, flags.stats ? max_lines * kTreeLineTotals * sizeof(cl_ulong) : 0);
 }
 
-void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDirection& d, int width, int height,
-                          const TreeBuffers& b) {
-  const cl::Buffer samples(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                           d.samples.size() * sizeof(LatticeSample), const_cast<LatticeSample*>(d.samples.data()));
-  auto table = [&](const auto& values) {
-    if (values.empty()) return deviceBuffer(st, 0);
-    return cl::Buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, values.size() * sizeof(values[0]),
-                      const_cast<void*>(static_cast<const void*>(values.data())));
+TreeKernel treeKernel(ContextState& st, cl::Program& program, const TreeDirection& d, int width, int height,
+                      const TreeBuffers& b) {
+  auto table = [&](const void* data, std::size_t bytes) {
+    if (!bytes) return deviceBuffer(st, 0);
+    return cl::Buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes, const_cast<void*>(data));
   };
-  const cl::Buffer row_units = table(d.row_units), row_factors = table(d.row_factors);
-  cl::Kernel kernel(program, "intervisibility_lattice");
-  LineChunkArguments chunk;
+  TreeKernel k;
+  k.samples = table(d.samples.data(), d.samples.size() * sizeof(LatticeSample));
+  k.row_units = table(d.row_units.data(), d.row_units.size() * sizeof(std::int32_t));
+  k.row_factors = table(d.row_factors.data(), d.row_factors.size() * sizeof(float));
+  k.no_strips = deviceBuffer(st, 0);
+  k.kernel = cl::Kernel(program, "intervisibility_lattice");
+  cl::Kernel& kernel = k.kernel;
   int arg = 0;
   kernel.setArg(arg++, b.heights);
   kernel.setArg(arg++, width);
   kernel.setArg(arg++, height);
-  chunk.lines = arg++;
-  chunk.count = arg++;
-  kernel.setArg(arg++, samples);
+  k.chunk.lines = arg++;
+  k.chunk.count = arg++;
+  kernel.setArg(arg++, k.samples);
   kernel.setArg(arg++, static_cast<int>(d.samples.size()));
   kernel.setArg(arg++, d.lattice.a);
   kernel.setArg(arg++, d.lattice.b);
@@ -113,16 +117,16 @@ void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDire
   kernel.setArg(arg++, d.area_factor);
   kernel.setArg(arg++, d.drop);
   kernel.setArg(arg++, d.max_steps);
-  kernel.setArg(arg++, row_units);
-  kernel.setArg(arg++, row_factors);
+  kernel.setArg(arg++, k.row_units);
+  kernel.setArg(arg++, k.row_factors);
   kernel.setArg(arg++, b.trees);
   kernel.setArg(arg++, b.prefix);
   kernel.setArg(arg++, b.positions);
-  chunk.stride = arg++;
+  k.chunk.stride = arg++;
   kernel.setArg(arg++, b.visible);
   kernel.setArg(arg++, b.entry_stats);
   kernel.setArg(arg++, b.line_totals);
-  chunk.first_line = arg++;
+  k.chunk.first_line = arg++;
   kernel.setArg(arg++, b.count_sum);
   kernel.setArg(arg++, b.area_sum);
   kernel.setArg(arg++, b.radiance);
@@ -133,7 +137,18 @@ void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDire
   kernel.setArg(arg++, d.half_sector);
   kernel.setArg(arg++, d.wedge);
   kernel.setArg(arg++, b.irradiance);
-  launchLineChunks(st, kernel, d.lines, d.samples.size(), b.scratch_entries, chunk, 1, kLineGroup);
+  k.strip = arg;
+  kernel.setArg(arg++, 0);  // row0
+  kernel.setArg(arg++, 0);  // out_row0
+  kernel.setArg(arg++, k.no_strips);
+  kernel.setArg(arg++, k.no_strips);
+  return k;
+}
+
+void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDirection& d, int width, int height,
+                          const TreeBuffers& b) {
+  TreeKernel k = treeKernel(st, program, d, width, height, b);
+  launchLineChunks(st, k.kernel, d.lines, d.samples.size(), b.scratch_entries, k.chunk, 1, kLineGroup);
 }
 
 std::string TreeRoutine::programOptions() const {
@@ -195,6 +210,64 @@ void download(ContextState& st, const cl::Buffer& sums, std::vector<float>& out)
 }
 
 // Visible counts and areas by the tree.
+// How a count run uses its device memory budget: the scratch, and the strips of rows (the
+// field's height when it runs in one piece) with the halo of rows their periods reach.
+struct CountPlan {
+  std::size_t scratch_entries = 0;
+  int strip_rows = 0, halo_rows = 0;
+};
+
+CountPlan planCount(const HeightField& field, const std::vector<TreeDirection>& directions,
+                    const TreeProgramFlags& flags, const IntervisibilityOptions& options, const DeviceInfo& device,
+                    bool line_major) {
+  const std::size_t budget = options.memory_budget_bytes ? options.memory_budget_bytes : defaultMemoryBudget(device);
+  const std::size_t max_alloc = device.max_allocation_bytes ? device.max_allocation_bytes : budget;
+  const TreeScratchNeeds needs = treeScratchNeeds(directions, line_major);
+  const std::size_t entry = treeEntryBytes(flags), row = field.width * sizeof(float);
+  // Heights and the sums (the count also when only the area is asked for: the kernel adds both),
+  // and the statistics' per-line totals.
+  const std::size_t per_row = row * (2 + flags.area);
+  std::size_t max_lines = 0;
+  for (const TreeDirection& d : directions) max_lines = std::max(max_lines, d.lines.size());
+  const std::size_t totals = flags.stats ? max_lines * kTreeLineTotals * sizeof(cl_ulong) : 0;
+  const std::size_t whole = per_row * field.height + totals, least = needs.longest * entry;
+  const bool forced = options.strip_rows > 0 && options.strip_rows < field.height;
+  CountPlan plan;
+  if (!forced && whole + least <= budget && row * field.height <= max_alloc &&
+      needs.longest * kTreeNodeBytes <= max_alloc) {
+    plan.strip_rows = field.height;
+    plan.scratch_entries = std::min({needs.whole, (budget - whole) / entry, max_alloc / kTreeNodeBytes});
+    return plan;
+  }
+  // Strips beside a halo (a period's samples lie in the |b| rows toward its previous receiver) and the
+  // lines' states, with as many rows as the budget holds once the scratch has half the rest
+  // (or the longest line's tree, if more): a line's tree stays on the device through every
+  // strip it crosses.
+  plan.halo_rows = 0;
+  for (const TreeDirection& d : directions) plan.halo_rows = std::max(plan.halo_rows, std::abs(d.lattice.b));
+  const std::size_t halo = 2 * static_cast<std::size_t>(plan.halo_rows) * row;
+  const std::size_t states = max_lines * (kTreeLineStateBytes + sizeof(cl_int2)) + totals;
+  const std::size_t rest = budget > halo + states ? budget - halo - states : 0;
+  const std::size_t scratch = std::max(least, std::min(needs.whole * entry, rest / 2));
+  std::size_t rows = rest > scratch ? (rest - scratch) / per_row : 0;
+  rows = std::min(rows, max_alloc / row > 2 * static_cast<std::size_t>(plan.halo_rows)
+                            ? max_alloc / row - 2 * plan.halo_rows : 0);
+  if (forced) rows = std::min<std::size_t>(rows, options.strip_rows);
+  rows = std::min<std::size_t>(rows, field.height);
+  const std::size_t strips_bytes = rows * per_row + halo + states;
+  if (rows < 1 || needs.longest * kTreeNodeBytes > max_alloc) {
+    throw MemoryBudgetError("one direction needs " + mebibytes(per_row + halo + states + least) +
+                            " of device memory in strips of one row (its longest line's tree " + mebibytes(least) +
+                            ") but the budget is " + mebibytes(budget) + " (largest single buffer " +
+                            mebibytes(max_alloc) + "); raise the memory budget");
+  }
+  plan.strip_rows = static_cast<int>(rows);
+  plan.scratch_entries =
+      std::min({needs.whole, (budget - strips_bytes) / entry, max_alloc / kTreeNodeBytes});
+  return plan;
+}
+
+// Visible counts and areas by the tree, on the whole field or in strips of rows.
 class CountRoutine : public TreeRoutine {
  public:
   CountRoutine(ContextState& st, const HeightField& field, const IntervisibilityOptions& options,
@@ -215,14 +288,94 @@ class CountRoutine : public TreeRoutine {
     return flags;
   }
 
+  // The heights, then the directions and the plan (which decide the program: strips or not).
+  PreparedHeights prepare() override {
+    PreparedHeights prepared = prepareHeights(field_);
+    flags_.has_nodata = prepared.has_nodata;
+    directions_ = treeDirections(field_, options_, flags_.row_spacing);
+    checkTreeLimits(directions_, prepared.heights);
+    plan_ = planCount(field_, directions_, flags_, visibility_, st_.info, lineMajorLayout(st_));
+    flags_.strips = inStrips();
+    return prepared;
+  }
+  bool heightsResident() const override { return !inStrips(); }
+  bool inStrips() const { return plan_.strip_rows < field_.height; }
+
   void allocate() override {
-    const std::size_t plane = field_.pixelCount();
-    // Heights and the sums (the count also when only the area is asked for: the kernel adds both).
-    allocateScratch(plane * sizeof(float) * (2 + outputs_.visible_area));
-    buffers_.count_sum = zeros(plane);
-    buffers_.area_sum = zeros(outputs_.visible_area ? plane : 0);
-    buffers_.radiance = buffers_.normals = buffers_.irradiance = deviceBuffer(st_, 0);
     result_ = allocateResult(field_, visibility_, outputs_);
+    allocateTreeScratch(st_, flags_, directions_, plan_.scratch_entries, buffers_);
+    buffers_.radiance = buffers_.normals = buffers_.irradiance = deviceBuffer(st_, 0);
+    if (!inStrips()) {
+      const std::size_t plane = field_.pixelCount();
+      buffers_.heights = heights_;
+      buffers_.count_sum = zeros(plane);
+      buffers_.area_sum = zeros(outputs_.visible_area ? plane : 0);
+      return;
+    }
+    const std::size_t strip = static_cast<std::size_t>(plan_.strip_rows) * field_.width * sizeof(float);
+    const std::size_t rows = std::min(plan_.strip_rows + 2 * plan_.halo_rows, field_.height);
+    buffers_.heights = deviceBuffer(st_, rows * field_.width * sizeof(float));
+    buffers_.count_sum = deviceBuffer(st_, strip);
+    buffers_.area_sum = deviceBuffer(st_, outputs_.visible_area ? strip : 0);
+    std::size_t max_lines = 0;
+    for (const TreeDirection& d : directions_) max_lines = std::max(max_lines, d.lines.size());
+    states_ = deviceBuffer(st_, max_lines * kTreeLineStateBytes);
+    // The host holds the sums (allocateResult's zeros), a strip's rows on the device at a time.
+    if (result_.visible_count.empty()) result_.visible_count.assign(field_.pixelCount(), 0.0f);
+  }
+
+  void sweep(int direction, int) override {
+    if (!inStrips()) return TreeRoutine::sweep(direction, 0);
+    const TreeDirection& d = directions_[direction];
+    TreeKernel k = treeKernel(st_, program_, d, field_.width, field_.height, buffers_);
+    const int b = d.lattice.b, strips = (field_.height + plan_.strip_rows - 1) / plan_.strip_rows;
+    const std::size_t row = field_.width * sizeof(float);
+    std::vector<LatticeLine> lines = d.lines;
+    const auto chunks = chunkLines(lines, d.samples.size(), buffers_.scratch_entries, lineMajorLayout(st_));
+    for (std::size_t c = 0; c < chunks.size(); ++c) {
+      const LineChunk& chunk = chunks[c];
+      const cl::Buffer chunk_lines(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                   chunk.count * sizeof(LatticeLine), lines.data() + chunk.first);
+      k.kernel.setArg(k.chunk.lines, chunk_lines);
+      k.kernel.setArg(k.chunk.count, static_cast<int>(chunk.count));
+      k.kernel.setArg(k.chunk.stride, static_cast<cl_uint>(chunk.stride));
+      k.kernel.setArg(k.chunk.first_line, static_cast<int>(chunk.first));
+      k.kernel.setArg(k.strip + 3, states_);
+      // The strips in the order the lines run through them (receiver i in row row - i b).
+      for (int t = 0; t < strips; ++t) {
+        const int s = b > 0 ? strips - 1 - t : t;
+        const int s0 = s * plan_.strip_rows, s1 = std::min(field_.height, s0 + plan_.strip_rows);
+        std::vector<cl_int2> ranges(chunk.count);
+        bool any = false;
+        for (std::size_t i = 0; i < chunk.count; ++i) {
+          const auto [first, end] = receiversInRows(lines[chunk.first + i], b, s0, s1);
+          ranges[i] = {{first, end}};
+          any = any || first < end;
+        }
+        if (any) sweepStrip(k, ranges, s0, s1, row);
+        if (options_.strip_progress) options_.strip_progress(int(c) * strips + t + 1, int(chunks.size()) * strips);
+      }
+    }
+  }
+
+  // One strip of one chunk: its heights (with the halo) and sums up, the sweep, the sums back.
+  void sweepStrip(TreeKernel& k, const std::vector<cl_int2>& ranges, int s0, int s1, std::size_t row) {
+    const int h0 = std::max(0, s0 - plan_.halo_rows), h1 = std::min(field_.height, s1 + plan_.halo_rows);
+    const std::size_t width = field_.width, sums = (s1 - s0) * row;
+    st_.queue.enqueueWriteBuffer(buffers_.heights, CL_FALSE, 0, (h1 - h0) * row, &prepared_.heights[h0 * width]);
+    st_.queue.enqueueWriteBuffer(buffers_.count_sum, CL_FALSE, 0, sums, &result_.visible_count[s0 * width]);
+    if (outputs_.visible_area)
+      st_.queue.enqueueWriteBuffer(buffers_.area_sum, CL_FALSE, 0, sums, &result_.visible_area[s0 * width]);
+    const cl::Buffer ranges_buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                   ranges.size() * sizeof(cl_int2), const_cast<cl_int2*>(ranges.data()));
+    k.kernel.setArg(k.strip, h0);
+    k.kernel.setArg(k.strip + 1, s0);
+    k.kernel.setArg(k.strip + 2, ranges_buffer);
+    st_.launch(k.kernel, cl::NDRange(roundUp(ranges.size(), kLineGroup)), cl::NDRange(kLineGroup));
+    st_.queue.enqueueReadBuffer(buffers_.count_sum, CL_FALSE, 0, sums, &result_.visible_count[s0 * width]);
+    if (outputs_.visible_area)
+      st_.queue.enqueueReadBuffer(buffers_.area_sum, CL_FALSE, 0, sums, &result_.visible_area[s0 * width]);
+    st_.queue.finish();  // before the ranges go
   }
 
   void endBatch(int first, int count) override {
@@ -236,12 +389,18 @@ class CountRoutine : public TreeRoutine {
   }
 
   void finish() override {
+    if (inStrips()) {  // the host holds them; the count kept only when asked for
+      if (!outputs_.visible_count) result_.visible_count.clear();
+      return;
+    }
     download(st_, buffers_.count_sum, result_.visible_count);
     download(st_, buffers_.area_sum, result_.visible_area);
   }
 
   const IntervisibilityOptions& visibility_;
   const IntervisibilityOutputs& outputs_;
+  CountPlan plan_;
+  cl::Buffer states_;
   IntervisibilityResult result_;
   std::vector<cl_ulong> totals_;
 };

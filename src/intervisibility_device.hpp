@@ -12,6 +12,7 @@
 #include "hfvis/intervisibility.hpp"
 #include "intervisibility_internal.hpp"
 #include "opencl_context.hpp"
+#include "sweep_framework.hpp"
 #include "sweep_routine.hpp"
 
 namespace hfvis::detail {
@@ -22,6 +23,7 @@ constexpr std::size_t kTreePositionBytes = 2 * sizeof(std::int32_t);  // (positi
 constexpr std::size_t kTreeVisibleBytes = 2 * sizeof(float);  // (count, distance sum), per-entry tests only
 constexpr std::size_t kTreeEntryStatsBytes = 4 * sizeof(std::uint32_t);
 constexpr std::size_t kTreeLineTotals = 8;  // ulongs per line (HFVIS_LINE_TOTALS)
+constexpr std::size_t kTreeLineStateBytes = 136;  // TreeLineState, per line in strips
 
 // What the program computes besides the sweep itself (the HFVIS_WANT_* of the kernels).
 struct TreeProgramFlags {
@@ -30,6 +32,7 @@ struct TreeProgramFlags {
   // HFVIS_ROW_SPACING: the directions follow each row's spacing (TreeDirection::rowSpacing;
   // the safe zone is then off, and there is no bounce).
   bool row_spacing = false;
+  bool strips = false;  // HFVIS_STRIPS: a field in strips of rows (not with the bounce)
   bool count = true;
   bool area = true;
   bool stats = true;
@@ -55,6 +58,13 @@ struct TreeBuffers {
 // Bytes of scratch per line entry for a program with these flags.
 std::size_t treeEntryBytes(const TreeProgramFlags& flags);
 
+// Scratch entries a run's directions need: all lines of the largest direction in one launch,
+// and the longest line (a direction can always run one line at a time).
+struct TreeScratchNeeds {
+  std::size_t whole = 0, longest = 0;
+};
+TreeScratchNeeds treeScratchNeeds(const std::vector<TreeDirection>& directions, bool line_major);
+
 // Scratch entries a run gets: all of its largest direction's lines in one launch when the
 // budget allows, down to its longest line. Throws MemoryBudgetError when even that does not
 // fit beside `fixed_bytes`.
@@ -66,6 +76,19 @@ std::size_t planTreeScratch(const std::vector<TreeDirection>& directions, std::s
 // lines when statistics are asked for).
 void allocateTreeScratch(ContextState& st, const TreeProgramFlags& flags, const std::vector<TreeDirection>& all,
                          std::size_t entries, TreeBuffers& b);
+
+// intervisibility_lattice set up for direction d over the buffers b, with the tables it reads
+// (kept alive with it); `chunk` names the arguments each chunk of lines sets, `strip` the first
+// of those a strip sets (row0, out_row0, strip_receivers, states; without strips 0, 0 and
+// empty buffers).
+struct TreeKernel {
+  cl::Kernel kernel;
+  cl::Buffer samples, row_units, row_factors, no_strips;
+  LineChunkArguments chunk;
+  int strip = 0;
+};
+TreeKernel treeKernel(ContextState& st, cl::Program& program, const TreeDirection& d, int width, int height,
+                      const TreeBuffers& b);
 
 // Launches intervisibility_lattice for direction d, its lines in chunks whose scratch fits.
 void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDirection& d, int width, int height,

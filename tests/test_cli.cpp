@@ -830,10 +830,11 @@ TEST_F(Cli, ViewcountChannelZeroIsTheVisibleCount) {
 }
 
 // A memory budget below the whole field's needs (256 x 256 svf and ao: 1.5 MiB of heights, sums
-// and normals against 0.4 MiB) runs the field in strips, with the very same values.
+// and normals; viewcount 0.75 MiB of heights and sums; against 0.4 MiB) runs the field in
+// strips, with the very same values.
 TEST_F(Cli, ATinyMemoryBudgetRunsInStripsWithTheSameResult) {
   const std::string dem = std::string(HFVIS_DATA_DIR) + "/fractal_256.exr";
-  for (const char* command : {"svf", "ao"}) {
+  for (const char* command : {"svf", "ao", "viewcount"}) {
     const CliResult whole = run(std::string(command) + " " + shellQuoted(dem) + " -o " +
                                 shellQuoted(out("whole.exr")) + " -k 16 --quiet");
     ASSERT_EQ(whole.status, 0) << whole.err;

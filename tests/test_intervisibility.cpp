@@ -857,6 +857,82 @@ TEST(IntervisibilityKernels, BatchingUnderATinyMemoryBudgetChangesNothing) {
   });
 }
 
+// A field in strips of rows (forced with strip_rows): each line's tree stays on the device
+// from strip to strip, so counts, areas and statistics equal the whole-field run bit for bit,
+// on every hard case, in both layouts, in every tuning; with curvature within a maximum
+// distance, denser sampling and rows of their own spacing.
+TEST(IntervisibilityKernels, StripsEqualTheWholeFieldBitForBit) {
+  auto expectEqual = [](const IntervisibilityResult& strips, const IntervisibilityResult& whole) {
+    EXPECT_TRUE(nearlyEqual(strips.visible_count, whole.visible_count, 0.0f));
+    EXPECT_TRUE(nearlyEqual(strips.visible_area, whole.visible_area, 0.0f));
+    expectStatisticsEqual(strips.statistics, whole.statistics);
+  };
+  testing::forEachLayout([&](const ComputeContext& context) {
+    for (const auto& name : syntheticFieldNames()) {
+      for (auto [w, h] : {std::pair{1, 9}, std::pair{7, 13}, std::pair{33, 20}}) {
+        const HeightField field = makeSyntheticField(name, w, h, 3);
+        IntervisibilityOptions options;
+        options.directions = 24;  // steps of up to 4 rows
+        const auto whole = computeIntervisibility(context, field, options, allOutputs());
+        for (int rows : {1, 6}) {
+          SCOPED_TRACE(name + " " + std::to_string(w) + "x" + std::to_string(h) + ", strips of " +
+                       std::to_string(rows) + " rows");
+          options.strip_rows = rows;
+          int strips = 0;
+          options.strip_progress = [&](int done, int all) {
+            EXPECT_EQ(all % ((h + rows - 1) / rows), 0);  // chunks times strips
+            strips += done == all;
+          };
+          expectEqual(computeIntervisibility(context, field, options, allOutputs()), whole);
+          EXPECT_EQ(strips, int(detail::treeDirections(field, options).size()));  // one run per direction
+          options.strip_progress = nullptr;
+          options.strip_rows = 0;
+        }
+      }
+    }
+    HeightField field = makeSyntheticField("noise", 37, 45, 1);
+    for (int variant = 0; variant < 5; ++variant) {
+      SCOPED_TRACE("variant " + std::to_string(variant));
+      IntervisibilityOptions options;
+      options.directions = 16;
+      if (variant == 0) options.curvature = 0.01, options.max_distance = 9.5;
+      if (variant == 1) options.samples_per_unit = 2.5;
+      if (variant == 2) testing::setRowSpacing(field);
+      if (variant == 3) options.tree = *hullTreeTuningNamed("plain");
+      if (variant == 4) options.tree = *hullTreeTuningNamed("zone");
+      const auto whole = computeIntervisibility(context, field, options, allOutputs());
+      options.strip_rows = 4;
+      expectEqual(computeIntervisibility(context, field, options, allOutputs()), whole);
+    }
+  });
+}
+
+// A budget below the field's heights and sums runs it in strips by itself, with the same result;
+// below one row's strip beside the longest line's tree it is a MemoryBudgetError.
+TEST(IntervisibilityKernels, ABudgetBelowTheWholeFieldRunsItInStrips) {
+  const HeightField field = makeSyntheticField("noise", 64, 60, 2);
+  IntervisibilityOptions options;
+  options.directions = 8;
+  IntervisibilityOutputs outputs;
+  outputs.visible_count = outputs.visible_area = true;
+  const auto whole = computeIntervisibility(testContext(), field, options, outputs);
+  options.memory_budget_bytes = 3 * 4 * 64 * 60 * 3 / 4;  // three quarters of the heights and sums
+  int strips = 0;
+  options.strip_progress = [&](int, int all) { strips = std::max(strips, all); };
+  const auto in_strips = computeIntervisibility(testContext(), field, options, outputs);
+  EXPECT_GT(strips, 1);
+  EXPECT_TRUE(nearlyEqual(in_strips.visible_count, whole.visible_count, 0.0f));
+  EXPECT_TRUE(nearlyEqual(in_strips.visible_area, whole.visible_area, 0.0f));
+  options.memory_budget_bytes = 2048;
+  EXPECT_THROW(computeIntervisibility(testContext(), field, options, outputs), MemoryBudgetError);
+  options.memory_budget_bytes = 0;
+  options.strip_rows = -1;
+  EXPECT_THROW(computeIntervisibility(testContext(), field, options, outputs), InvalidArgument);
+  options.strip_rows = 4;
+  options.method = IntervisibilityMethod::Naive;
+  EXPECT_THROW(computeIntervisibility(testContext(), field, options, outputs), InvalidArgument);
+}
+
 TEST(IntervisibilityKernels, NodataReceiversAreNaNAndNeverPoisonNeighbours) {
   for (const char* name : {"nan_holes", "infinities"}) {
     const HeightField field = makeSyntheticField(name, 33, 20, 2);

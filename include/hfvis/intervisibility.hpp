@@ -63,6 +63,12 @@ std::optional<HullTreeTuning> hullTreeTuningNamed(const std::string& name);
 struct IntervisibilityOptions : SweepOptions {
   IntervisibilityMethod method = IntervisibilityMethod::HullTree;
   HullTreeTuning tree;  // HullTree only
+  // HullTree only. Rows per strip: a field whose heights and sums do not fit the memory budget
+  // beside one line's tree runs in horizontal strips, each line's tree kept on the device from
+  // strip to strip (only the strip's heights and sums are), so the results equal a whole-field
+  // run bit for bit. 0: the whole field when it fits, else as many rows as half the budget
+  // holds; fewer rows than the field's force strips. The naive method needs the whole field.
+  int strip_rows = 0;
 };
 
 // What to compute; only what is asked for is stored or reduced.
@@ -116,7 +122,8 @@ struct IntervisibilityResult {
 void validate(const HullTreeTuning& tuning);
 
 // Throws InvalidArgument for bad sweep options (see sweep_options.hpp), a bad tree tuning,
-// no output requested, or statistics asked of the naive method.
+// no output requested, statistics asked of the naive method, or a negative strip_rows (or
+// strips asked of the naive method).
 void validate(const IntervisibilityOptions& options, const IntervisibilityOutputs& outputs);
 
 // Runs options.method on the device of `context`. Throws InvalidArgument (bad field or
