@@ -61,8 +61,8 @@
 #ifndef HFVIS_STRIPS
 #define HFVIS_STRIPS 0
 #endif
-#if HFVIS_MAX_DISTANCE && HFVIS_ROW_SPACING && (HFVIS_LANES != 1 || HFVIS_STRIPS)
-#error "a maximum distance with per-row spacing runs one line per work-item, on the whole field"
+#if HFVIS_MAX_DISTANCE && HFVIS_ROW_SPACING && HFVIS_LANES != 1
+#error "a maximum distance with per-row spacing runs one line per work-item"
 #endif
 #if HFVIS_MAX_DISTANCE && HFVIS_STRIPS && HFVIS_LANES != 1
 #error "a maximum distance in strips needs one line per work-item (a window's blocks are per line)"
@@ -376,6 +376,22 @@ HFVIS_INLINE int block_of(int index, float tau, float period, float inv_window) 
   const float here = base - tau;
   return (int)floor(here * inv_window);
 }
+#if HFVIS_ROW_SPACING
+// The same with per-row spacing, for sample `tau` of period j (j <= 0) of a line resumed at its
+// receiver 0 in row r, column c: receiver -1's position is `base` (carried), receiver 0's base
+// plus its period, earlier ones' in receiver_base (rows from row0 on), as the loop sums them.
+HFVIS_INLINE int block_of_row(int j, float tau, int c, int r, int a, int b, float base, int row0, int width,
+                              float inv_period, float inv_window, __global const float* row_length,
+                              __global const float* receiver_base) {
+  const int row = r - j * b;
+  const float position = j == 0    ? base + row_length[row]
+                         : j == -1 ? base
+                                   : receiver_base[(row - row0) * width + (c - j * a)];
+  const float tau_scale = row_length[row] * inv_period;
+  const float here = position - tau * tau_scale;
+  return (int)floor(here * inv_window);
+}
+#endif
 #endif
 
 // Horizons within a window of `window` pixels along the line (HFVIS_MAX_DISTANCE; ground units,
@@ -407,14 +423,17 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
   int end = max(i, 0);  // block k's receivers here are periods max(i, 0) .. end - 1
 #if HFVIS_ROW_SPACING
   // Positions are ground lengths, summed along the line (one line per work-item): receiver j's
-  // is receiver_base[its pixel], which the forward sweep stores as it reaches it (from `base`,
-  // receiver i's). Block k's receivers are not reached yet: their positions are summed on here
-  // as the forward sweep will sum them, and stored.
-  for (float x = base; end < trips; ++end) {
+  // is receiver_base[its pixel] (rows from row0 on, as the heights; in strips those of earlier
+  // strips come from the host), which the forward sweep stores as it reaches it. `base` is
+  // receiver i's, or for i < 0 (a strip resumed inside a block) receiver -1's. Block k's
+  // receivers are not reached yet: their positions are summed on here as the forward sweep
+  // will sum them, and stored.
+  float x = i >= 0 ? base : base + row_length[r + i * b];  // receiver max(i, 0)'s
+  for (; end < trips; ++end) {
     const int er = r - (end - i) * b;
-    if (end > i) x = x + row_length[er];
+    if (end > max(i, 0)) x = x + row_length[er];
     if ((int)floor(x * inv_window) != k) break;
-    receiver_base[(er - out_row0) * width + (c - (end - i) * a)] = x;
+    receiver_base[(er - row0) * width + (c - (end - i) * a)] = x;
   }
 #else
   while (end < trips && (int)floor((float)(offset + end) * period * inv_window) == k) ++end;
@@ -424,7 +443,7 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
   lane_float top_h = 0.0f, top_p = 0.0f, below_h = 0.0f, below_p = 0.0f, rise = 0.0f, run = 0.0f;
   for (int j = end - 1; j >= max(i, 0); --j) {
 #if HFVIS_ROW_SPACING
-    const float x = receiver_base[(r - (j - i) * b - out_row0) * width + (c - (j - i) * a)];
+    const float x = receiver_base[(r - (j - i) * b - row0) * width + (c - (j - i) * a)];
 #else
     const float x = (float)(offset + j) * period;
 #endif
@@ -433,7 +452,7 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
 #if HFVIS_ROW_SPACING
       // As the forward sweep computes a sample's position.
       const int sr = r - (ci - i) * b;
-      const float sample_base = receiver_base[(sr - out_row0) * width + (c - (ci - i) * a)];
+      const float sample_base = receiver_base[(sr - row0) * width + (c - (ci - i) * a)];
       const float tau_scale = row_length[sr] * inv_period;
       const float here = sample_base - s->tau * tau_scale;
 #else
@@ -589,23 +608,37 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
     // Resuming a line (one per work-item): the block of its last sample before this strip (the
     // receiver start - 1, tau 0) and whether that is not the line's first block, as the sweep
     // there left them (positions computed as the loop below computes them).
-    block = block_of(start - 1, samples[n_samples - 1].tau, period, inv_window);
-    far_part = block != block_of(0, samples[0].tau, period, inv_window);
-    if (far_part && block_of(start, samples[0].tau, period, inv_window) == block) {
+#if HFVIS_ROW_SPACING
+#define BLOCK_OF(j, tau) \
+  block_of_row(j, tau, c, r, a, b, base, row0, width, inv_period, inv_window, row_length, receiver_base)
+#define RESUME_BASE base  // receiver -1's position
+    // The line's first sample: receiver 0 of the whole line (row r + start b) at position 0.
+    const float first_here = 0.0f - samples[0].tau * (row_length[r + start * b] * inv_period);
+    const int first_block = (int)floor(first_here * inv_window);
+#else
+#define BLOCK_OF(j, tau) block_of(start + (j), tau, period, inv_window)
+#define RESUME_BASE 0.0f  // (window_pass takes positions from the index)
+    const int first_block = block_of(0, samples[0].tau, period, inv_window);
+#endif
+    block = BLOCK_OF(-1, samples[n_samples - 1].tau);
+    far_part = block != first_block;
+    if (far_part && BLOCK_OF(0, samples[0].tau) == block) {
       // The strip starts inside a block: its receivers here need the block before as well. The
       // block's first sample (ib, qb), periods counted from this strip's first receiver; the
       // pass runs above the carried stack, which the block's own sweep goes on with.
       int ib = 0, qb = 0;
       for (;;) {
         const int pi = qb > 0 ? ib : ib - 1, pq = qb > 0 ? qb - 1 : n_samples - 1;
-        if (block_of(start + pi, samples[pq].tau, period, inv_window) != block) break;
+        if (BLOCK_OF(pi, samples[pq].tau) != block) break;
         ib = pi;
         qb = pq;
       }
       window_pass(heights, width, height, row0, out_row0, samples, n_samples, a, b, period, window, inv_window,
                   drop, c - ib * a, r - ib * b, receivers, stack + n * entry, entry, ib, qb, block,
-                  trips, start, 0.0f, inv_period, row_length, receiver_base, stacks, window_far);
+                  trips, start, RESUME_BASE, inv_period, row_length, receiver_base, stacks, window_far);
     }
+#undef BLOCK_OF
+#undef RESUME_BASE
   }
 #else
 #define LINE_OFFSET 0
@@ -630,7 +663,7 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
     base = select(base, base + period_length, live & (along > 0));  // kept where a line has ended (carried)
 #if HFVIS_MAX_DISTANCE
     // The window's pass reads the positions of the receivers behind (one line per work-item).
-    if (live) receiver_base[(r - out_row0) * width + c] = base;
+    if (live) receiver_base[(r - row0) * width + c] = base;
 #endif
     const lane_float tau_scale = period_length * inv_period;  // ground length per pixel of tau
     const lane_float period_ground_l = period_length;

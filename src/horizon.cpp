@@ -72,20 +72,28 @@ RunPlan planStrips(const HeightField& field, const HorizonOptions& options, cons
   // A receiver's period reaches a step (|b| rows) away, the normals one row; within a maximum
   // distance the window's pass reaches back to the start of the block before, up to two
   // windows and a period along the line.
+  // With per-row spacing the window is a ground length: so many of the shortest periods.
+  const bool window = options.max_distance > 0.0, positions = window && hasRowSpacing(field);
   plan.halo_rows = 1;
   for (const RunDirection& d : directions) {
     double periods = 1.0;
-    if (options.max_distance > 0.0) periods = (2.0 * d.window.window + 2.0 * d.lattice.period) / d.lattice.period;
+    if (window && positions) {
+      const double shortest = *std::min_element(d.row_length.begin(), d.row_length.end());
+      const double longest = *std::max_element(d.row_length.begin(), d.row_length.end());
+      periods = (2.0 * d.window.window + 2.0 * longest) / shortest;
+    } else if (window) {
+      periods = (2.0 * d.window.window + 2.0 * d.lattice.period) / d.lattice.period;
+    }
     plan.halo_rows = std::max(plan.halo_rows, static_cast<int>(std::ceil(periods * std::abs(d.lattice.b))) + 1);
   }
   const std::size_t halo_rows = plan.halo_rows;
   const std::size_t row = field.width * sizeof(float);
   // Per row of a strip: heights, the sums, the normals' two slopes, one direction's planes, the
-  // window's float2.
+  // window's float2 (and with per-row spacing the receivers' positions, which also take the
+  // halo's rows).
   const std::size_t per_row = row * (1 + outputs.sky_view_factor + outputs.ambient_occlusion * 3 +
-                                     outputs.horizon_angles + outputs.horizon_distances +
-                                     (options.max_distance > 0.0) * 2);
-  const std::size_t halo = 2 * halo_rows * row;
+                                     outputs.horizon_angles + outputs.horizon_distances + window * 2 + positions);
+  const std::size_t halo = 2 * halo_rows * row * (1 + positions);
   std::size_t rows = budget / 2 > halo ? (budget / 2 - halo) / per_row : 0;
   // The largest buffers: a strip's heights with its halo, and its normals.
   rows = std::min({rows, max_alloc / row > 2 * halo_rows ? max_alloc / row - 2 * halo_rows : 0,
@@ -138,14 +146,11 @@ RunPlan planRun(const HeightField& field, const HorizonOptions& options, const H
   const std::size_t least = fixed + per_direction + longest * kStackEntryBytes;
   const bool fits = least <= budget && per_direction <= max_alloc && longest * kStackEntryBytes <= max_alloc;
   if (!fits || (options.strip_rows > 0 && options.strip_rows < field.height)) {
-    if (sweep && !(window && hasRowSpacing(field)))
-      return planStrips(field, options, outputs, directions, budget, max_alloc);
+    if (sweep) return planStrips(field, options, outputs, directions, budget, max_alloc);
     throw MemoryBudgetError("one direction needs " + mebibytes(least) + " of device memory but the budget is " +
                             mebibytes(budget) + " (largest single buffer " + mebibytes(max_alloc) +
-                            "), and " +
-                            (sweep ? "a maximum distance on a field with per-row spacing" : "the naive method") +
-                            " needs the whole field at once (no strips); raise the memory budget or use a smaller "
-                            "field");
+                            "), and the naive method needs the whole field at once (no strips); raise the memory "
+                            "budget or use a smaller field");
   }
   const std::size_t available = budget - fixed;
   RunPlan plan;
@@ -258,7 +263,13 @@ class HorizonRoutine : public SweepRoutine {
     stacks_ = st_.reusableBuffer("lattice stacks", plan_.stack_entries * kStackEntryBytes);
     const bool window = horizon_.method == HorizonMethod::Sweep && horizon_.max_distance > 0.0;
     window_far_ = deviceBuffer(st_, window ? 2 * plane * sizeof(float) : 0);
-    receiver_base_ = deviceBuffer(st_, window && hasRowSpacing(field_) ? plane * sizeof(float) : 0);
+    // Per-row spacing within a maximum distance: the receivers' positions, over the heights' rows
+    // (in strips the halo's too: those of earlier strips come from the host, which holds them all).
+    const bool positions = window && hasRowSpacing(field_);
+    const std::size_t position_rows =
+        inStrips() ? std::min<std::size_t>(plan_.strip_rows + 2 * plan_.halo_rows, field_.height) : field_.height;
+    receiver_base_ = deviceBuffer(st_, positions ? position_rows * field_.width * sizeof(float) : 0);
+    if (positions && inStrips()) receiver_positions_.assign(field_.pixelCount(), 0.0f);
     placeholder_ = deviceBuffer(st_, 0);
     row_cells_ = rowCells();
     if (inStrips()) {
@@ -353,6 +364,9 @@ class HorizonRoutine : public SweepRoutine {
     const int row0 = std::max(0, s0 - plan_.halo_rows), row1 = std::min(field_.height, s1 + plan_.halo_rows);
     st_.queue.enqueueWriteBuffer(heights_, CL_FALSE, 0, (row1 - row0) * width * sizeof(float),
                                  &prepared_.heights[row0 * width]);
+    if (!receiver_positions_.empty())
+      st_.queue.enqueueWriteBuffer(receiver_base_, CL_FALSE, 0, (row1 - row0) * width * sizeof(float),
+                                   &receiver_positions_[row0 * width]);
     const std::size_t bytes = (s1 - s0) * width * sizeof(float);
     if (outputs_.sky_view_factor)
       st_.queue.enqueueWriteBuffer(svf_, CL_FALSE, 0, bytes, &result_.sky_view_factor[s0 * width]);
@@ -482,8 +496,11 @@ class HorizonRoutine : public SweepRoutine {
     const std::size_t per_period = d.samples.size();
     // Within a maximum distance the window's pass pushes the samples of the block before, up to a
     // window and two periods of them, above a resumed line's stack.
+    // (With per-row spacing the window is a ground length: so many of the shortest periods.)
+    const double shortest_period =
+        d.row_length.empty() ? d.lattice.period : *std::min_element(d.row_length.begin(), d.row_length.end());
     const std::size_t window_periods =
-        horizon_.max_distance > 0.0 ? static_cast<std::size_t>(std::ceil(d.window.window / d.lattice.period)) + 2 : 0;
+        horizon_.max_distance > 0.0 ? static_cast<std::size_t>(std::ceil(d.window.window / shortest_period)) + 2 : 0;
     // Each line's sweep so far: (unused, its stack's size, the stack's offset in carry_in,
     // its ground position's float bits).
     std::vector<cl_int4> resume(d.lines.size(), cl_int4{{0, 0, 0, 0}});
@@ -605,6 +622,11 @@ class HorizonRoutine : public SweepRoutine {
       if (outputs_.horizon_distances) readRows(distances_, result_.distances, s0, s1, k * plane);
       if (outputs_.sky_view_factor) readRows(svf_, result_.sky_view_factor, s0, s1);
       if (outputs_.ambient_occlusion) readRows(ao_, result_.ambient_occlusion, s0, s1);
+      if (!receiver_positions_.empty()) {  // the strip's receivers' positions, for the strips after
+        const std::size_t width = field_.width;
+        st_.queue.enqueueReadBuffer(receiver_base_, CL_TRUE, (s0 - row0) * width * sizeof(float),
+                                    (s1 - s0) * width * sizeof(float), &receiver_positions_[s0 * width]);
+      }
       carry_in = carried ? carry_out : placeholder_;
       carried_in = carried;
       if (horizon_.strip_progress) horizon_.strip_progress(step + 1, strips);
@@ -653,6 +675,7 @@ class HorizonRoutine : public SweepRoutine {
   std::vector<RunDirection> directions_;
   RunPlan plan_;
   HorizonResult result_;
+  std::vector<float> receiver_positions_;  // strips, per-row spacing and a maximum distance: receiver_base's
   cl::Buffer angles_, distances_, svf_, ao_, normals_, stacks_, window_far_, receiver_base_, row_cells_,
       placeholder_;
 };
@@ -664,7 +687,6 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
                               const HorizonOptions& options, const HorizonOutputs& outputs) {
   validate(field);
   validate(options, outputs);
-  detail::requireSupported(field, options);
   detail::checkPixelIndexing(field, 1);
   return detail::translateOpenClErrors([&] {
     // Hull stacks too deep for the room strips leave: again from the start with thinner strips

@@ -81,14 +81,6 @@ std::vector<RowTable> rayRowTables(const HeightField& field, const std::vector<S
   return tables;
 }
 
-void requireSupported(const HeightField& field, const HorizonOptions& options) {
-  if (hasRowSpacing(field) && options.max_distance > 0.0) {
-    if (options.strip_rows > 0 && options.strip_rows < field.height)
-      throw InvalidArgument("a maximum distance on a field with per-row spacing (a latitude / longitude grid) "
-                            "does not run in strips yet");
-  }
-}
-
 HorizonResult allocateResult(const HeightField& field, const HorizonOptions& options,
                              const HorizonOutputs& outputs) {
   HorizonResult result;

@@ -30,9 +30,6 @@ void finishReduction(HorizonResult& result);
 // sweep's lines and the naive march's rays are then ground lengths summed step by step.
 bool hasRowSpacing(const HeightField& field);
 
-// Throws InvalidArgument for what the horizon operation does not do on this field: with per-row
-// spacing, a maximum distance in strips.
-void requireSupported(const HeightField& field, const HorizonOptions& options);
 
 // A field with per-row spacing (HeightField::row_cell_size_x/y), as horizon_lattice takes it
 // (HFVIS_ROW_SPACING), one table per direction: per row r, the ground length of the period

@@ -384,7 +384,6 @@ HorizonResult referenceHorizons(const HeightField& field, const HorizonOptions& 
                                 const HorizonOutputs& outputs) {
   validate(field);
   validate(options, outputs);
-  detail::requireSupported(field, options);
   const detail::PreparedHeights prepared = detail::prepareHeights(field);
   HorizonResult result = detail::allocateResult(field, options, outputs);
   if (options.method == HorizonMethod::Sweep) {

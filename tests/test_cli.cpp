@@ -1413,6 +1413,7 @@ TEST_F(Cli, GeographicGridTakesEachRowsSpacing) {
   }
   EXPECT_GT(seen, 2);
   EXPECT_LT(seen, height - 2);
+
   // The naive march cuts at the same ground length: along a row it samples the same pixels.
   const CliResult naive = run("horizon " + shellQuoted(tif) + " -o " + shellQuoted(out("n.exr")) +
                               " -k 4 -q --max-distance 220000 --method naive");

@@ -335,15 +335,6 @@ TEST(HorizonKernels, SweepEqualsNaiveOnAxisDirectionsWithPerRowSpacing) {
       }
     }
   });
-  // Not yet with per-row spacing: strips within a maximum distance.
-  HeightField field = makeSyntheticField("noise", 9, 7, 1);
-  testing::setRowSpacing(field);
-  HorizonOptions options;
-  options.max_distance = 3.0;
-  HorizonOutputs outputs;
-  outputs.sky_view_factor = true;
-  options.strip_rows = 2;
-  EXPECT_THROW(computeHorizons(testContext(), field, options, outputs), InvalidArgument);
 }
 
 // On the four axis directions the naive march samples the pixel centres of the receiver's
@@ -484,13 +475,17 @@ TEST(HorizonKernels, StripsEqualTheWholeFieldBitForBit) {
 
 // The same within maximum distances: the window's blocks resumed part-way, strips that start
 // inside a block (whose pass reaches back into the halo), a window of 40 pixels across many
-// strips, with curvature too, in both layouts.
+// strips, with curvature too, in both layouts; and on rows of their own spacing, where
+// positions are ground lengths (the receivers' of earlier strips kept on the host).
 TEST(HorizonKernels, StripsWithinAMaximumDistanceEqualTheWholeFieldBitForBit) {
   testing::forEachLayout([&](const ComputeContext& context) {
     for (const char* name : {"noise", "nan_holes", "spikes"}) {
       for (double max_distance : {2.5, 9.0, 40.0}) {
-        SCOPED_TRACE(std::string(name) + " max distance " + std::to_string(max_distance));
-        const HeightField field = makeSyntheticField(name, 33, 31, 2);
+       for (bool row_spacing : {false, true}) {  // positions ground lengths summed row by row
+        SCOPED_TRACE(std::string(name) + " max distance " + std::to_string(max_distance) +
+                     (row_spacing ? ", rows of their own spacing" : ""));
+        HeightField field = makeSyntheticField(name, 33, 31, 2);
+        if (row_spacing) testing::setRowSpacing(field);
         HorizonOptions options;
         options.directions = 24;
         options.max_distance = max_distance;
@@ -501,6 +496,22 @@ TEST(HorizonKernels, StripsWithinAMaximumDistanceEqualTheWholeFieldBitForBit) {
           options.strip_rows = rows;
           expectBitsEqual(computeHorizons(context, field, options, allOutputs()), whole);
         }
+       }
+      }
+    }
+    // A tall field at K = 8 (steps of at most one row): halos of a few rows, so strips read
+    // positions and heights of earlier strips from the halo alone.
+    for (bool row_spacing : {false, true}) {
+      HeightField field = makeSyntheticField("noise", 17, 90, 5);
+      if (row_spacing) testing::setRowSpacing(field);
+      HorizonOptions options;
+      options.directions = 8;
+      options.max_distance = 3.5;
+      const auto whole = computeHorizons(context, field, options, allOutputs());
+      for (int rows : {1, 4}) {
+        SCOPED_TRACE("tall field, strips of " + std::to_string(rows) + " rows" + (row_spacing ? ", own spacing" : ""));
+        options.strip_rows = rows;
+        expectBitsEqual(computeHorizons(context, field, options, allOutputs()), whole);
       }
     }
   });
