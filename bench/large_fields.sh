@@ -7,8 +7,11 @@
 # field's heights: the field runs in strips; svf with and without the maximum distance, whose
 # strips get room for their taller halo besides), at least N / 128 MiB (room for the hull stacks
 # carried from strip to strip: on this smooth field about 200 entries of 8 bytes per line at
-# N = 4096 and 850 at 16384). Prints a Markdown table; inputs go to
-# bench/out/data/ (the 16384^2 EXR is 139 MB), outputs to bench/out/large/.
+# N = 4096 and 850 at 16384). Device memory where the device reports it: on an NVIDIA GPU
+# (nvidia-smi on the PATH) the peak of memory.used sampled every 0.2 s during the job, less
+# its value before; PoCL on a CPU reports none (its buffers are host memory, in the peak
+# resident memory). Prints a Markdown table; inputs go to bench/out/data/ (the 16384^2 EXR is
+# 139 MB), outputs to bench/out/large/.
 #
 #   bench/large_fields.sh [--sizes 1024,4096,16384] [-k K] [--max-distance D] [--field NAME]
 #   BUILD_DIR=... selects the build (default build/).
@@ -24,7 +27,7 @@ while [[ $# -gt 0 ]]; do
     -k) k=$2; shift ;;
     --max-distance) max_distance=$2; shift ;;
     --field) field=$2; shift ;;
-    -h|--help) sed -n '2,14p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
     *) echo "large_fields.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
   shift
@@ -38,13 +41,24 @@ data=$root/bench/out/data
 out=$root/bench/out/large
 mkdir -p "$data" "$out"
 
+# Device memory in use (MiB) appended to $1, where the device reports it (nvidia-smi: the
+# first GPU); nothing otherwise. With --every, every 0.2 s until killed.
+sample_device_memory() {
+  command -v nvidia-smi > /dev/null || return 0
+  while :; do
+    nvidia-smi --query-gpu=memory.used --format=csv,noheader,nounits 2> /dev/null | head -1 >> "$1"
+    [[ ${2:-} == --every ]] || return 0
+    sleep 0.2
+  done
+}
+
 commit=$(git -C "$root" rev-parse --short HEAD 2> /dev/null || echo unknown)
 git -C "$root" diff --quiet HEAD 2> /dev/null || commit="$commit (with uncommitted changes)"
 echo "\`hfvis\` with default settings, K = $k, data/make_data.py's $field field; commit" \
   "$commit, $("$cli" devices | sed -n 's/^\* [0-9]* *CPU *//p;s/^\* [0-9]* *GPU *//p' | head -1 | sed 's/  .*//'), $(nproc) cores, $(awk '/MemTotal/ {printf "%.1f GiB", $2 / 1048576}' /proc/meminfo) of host memory."
 echo
-echo "| N | command | wall (s) | peak resident memory (GiB) |"
-echo "| ---: | --- | ---: | ---: |"
+echo "| N | command | wall (s) | peak resident memory (GiB) | peak device memory (GiB) |"
+echo "| ---: | --- | ---: | ---: | ---: |"
 # Every program variant once on a small field first, so that no timed run compiles kernels.
 warm=$data/${field}_64.exr
 [[ -f $warm ]] || /usr/bin/python3 "$root/data/make_data.py" --size 64 --out "$data" --no-dem --fields "$field" > /dev/null
@@ -66,10 +80,19 @@ for n in "${size_list[@]}"; do
   for job in "${jobs[@]}"; do
     read -r -a words <<< "$job"
     log=$out/time_${n}_${words[0]}.log
+    samples=$out/device_${n}_${words[0]}.log
+    : > "$samples"
+    sample_device_memory "$samples"  # before the job
+    sample_device_memory "$samples" --every &
+    sampler=$!
     /usr/bin/time -v "$cli" "${words[@]}" "$exr" -o "$out/${words[0]}_$n.exr" -k "$k" -q 2> "$log" \
-      || { echo "large_fields.sh: hfvis $job failed on $exr:" >&2; cat "$log" >&2; exit 1; }
+      || { kill "$sampler" 2> /dev/null; echo "large_fields.sh: hfvis $job failed on $exr:" >&2; cat "$log" >&2; exit 1; }
+    kill "$sampler" 2> /dev/null || true  # (it has ended where nothing reports)
+    wait "$sampler" 2> /dev/null || true
     wall=$(awk -F': ' '/Elapsed \(wall clock\)/ {n = split($2, t, ":"); s = 0; for (i = 1; i <= n; ++i) s = s * 60 + t[i]; print s}' "$log")
     rss=$(awk -F': ' '/Maximum resident set size/ {printf "%.2f", $2 / 1048576}' "$log")
-    echo "| $n | \`hfvis $job -k $k\` | $wall | $rss |"
+    # The first sample is the device's use before the job (MiB); none: not reported.
+    device=$(awk 'NR == 1 { base = $1 } { if ($1 > peak) peak = $1 } END { if (NR) printf "%.2f", (peak - base) / 1024; else print "not reported" }' "$samples")
+    echo "| $n | \`hfvis $job -k $k\` | $wall | $rss | $device |"
   done
 done
