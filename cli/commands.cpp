@@ -350,9 +350,8 @@ HeightField readValidField(const RunArguments& run) {
   return field;
 }
 
-// A latitude / longitude grid has a spacing per row, which the horizon and intervisibility
-// operations follow: the horizon lists and the bounce take the centre latitude's for the whole
-// field, and say so.
+// A latitude / longitude grid has a spacing per row, which every operation follows but the
+// bounce: it takes the centre latitude's for the whole field, and says so.
 void warnOfCentreRowSpacing(const HeightField& field, const char* command) {
   if (field.row_cell_size_x.empty()) return;
   const auto [narrowest, widest] =
@@ -361,7 +360,7 @@ void warnOfCentreRowSpacing(const HeightField& field, const char* command) {
             << " takes the centre latitude's cell size (" << field.cell_size_x << " x " << field.cell_size_y
             << ") for the whole field; its rows range from " << *narrowest << " to " << *widest
             << " along columns (per-row spacing of latitude / longitude grids is followed by horizon, svf, "
-               "ao and viewcount only)\n";
+               "ao, viewcount and horizons; not by bounce)\n";
 }
 
 // Progress on stderr when it is a terminal: one line rewritten in place, at most a few
@@ -668,7 +667,6 @@ int runViewCount(const RunArguments& run) {
 int runHorizonLists(const RunArguments& run) {
   requireOutputs(run, {run.output}, /*images=*/false);
   const HeightField field = readValidField(run);
-  warnOfCentreRowSpacing(field, "horizons");
   for (const ReceiverPixel& p : run.receivers) {
     if (p.col >= field.width || p.row >= field.height) {
       throw UsageError(

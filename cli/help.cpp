@@ -182,8 +182,8 @@ Conventions and units:
   GIS        A georeferenced input keeps its CRS (projected or geographic, copied as it is)
              and geotransform in GeoTIFF outputs, so they overlay it. Cell sizes come from
              the geotransform in the CRS's units; geographic degrees become metres (WGS84,
-             at each row's latitude: horizon, svf, ao and viewcount follow each row's spacing,
-             horizons and bounce the centre latitude's); rotated geotransforms are refused. A band's
+             at each row's latitude: every command follows each row's spacing but bounce, which
+             takes the centre latitude's); rotated geotransforms are refused. A band's
              nodata value reads as nodata. GeoTIFF outputs: one float32 band per channel,
              named by its description (h000.., svf, ao, count, visible_area), nodata declared
              on every band (NaN, or --nodata VALUE written in those cells), DEFLATE with the

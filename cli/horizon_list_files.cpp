@@ -68,8 +68,9 @@ constexpr const char* kHorizonConvention =
     "samples [segment_begin, segment_end) toward the receiver, up to the first hidden sample or the next "
     "horizon; the segments hold every visible sample once";
 constexpr const char* kUnits =
-    "distance, near_distance, sample_spacing: ground units (pixels times cell size); elevation_rad, "
-    "azimuth_rad: radians; heights in the input's units";
+    "distance, near_distance, sample_spacing: ground units (pixels times cell size; on a latitude / "
+    "longitude grid each step of the ray at its own row's spacing, sample_spacing the first step's); "
+    "elevation_rad, azimuth_rad: radians; heights in the input's units";
 
 }  // namespace
 

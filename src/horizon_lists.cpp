@@ -4,7 +4,9 @@
 // of its visible run.
 #include "hfvis/horizon_lists.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <string>
 
@@ -15,34 +17,60 @@
 namespace hfvis {
 namespace {
 
-// The heights of the ray from pixel (c, r) along d: sample i (1 = nearest) at index i - 1,
-// NaN where absent, up to the last sample inside the field (as the naive march), each lowered
-// by the Earth's drop at its distance (as intervisibility_naive: c times its step's ground
-// length squared, times i^2, in float).
-std::vector<float> raySamples(const HeightField& field, const std::vector<float>& heights,
-                              const detail::SweepDirection& d, int c, int r, double curvature) {
+// The ray from pixel (c, r) along d, as the naive visibility march samples it: sample i
+// (1 = nearest) at index i - 1, NaN where absent, up to the last sample inside the field, each
+// lowered by the Earth's drop at its distance (c times its step's ground length squared, times
+// i^2, in float). With per-row spacing (units: the ray's half-row table of step units,
+// naiveRowTables) sample i lies at `positions[i - 1]` whole units of `unit` ground length, its
+// step toward the receiver `rings[i - 1]` units long, and the drop is c unit^2 position^2.
+struct Ray {
+  std::vector<float> heights;
+  std::vector<std::int32_t> positions, rings;
+};
+
+Ray raySamples(const HeightField& field, const std::vector<float>& heights, const detail::SweepDirection& d, int c,
+               int r, double curvature, const std::int32_t* units, double unit) {
   const float step_ground = d.step_length * d.ground_per_pixel;
-  const float drop = static_cast<float>(curvature) * step_ground * step_ground;
-  std::vector<float> ray;
+  const float drop = units ? static_cast<float>(curvature * unit * unit)
+                           : static_cast<float>(curvature) * step_ground * step_ground;
+  const float step_y = d.step_length * d.dir_y;
+  Ray ray;
+  std::int32_t position = 0;
   for (int i = 1;; ++i) {
     const float t = static_cast<float>(i) * d.step_length;
     const detail::Point2 p{static_cast<float>(c) + t * d.dir_x, static_cast<float>(r) + t * d.dir_y};
     if (!detail::insideField(p, field.width, field.height)) break;
+    float at = static_cast<float>(i);
+    if (units) {  // as intervisibility_naive's ray_half_row
+      const float mid = static_cast<float>(i) - 0.5f;
+      const int half = static_cast<int>(std::nearbyint(2.0f * (static_cast<float>(r) + mid * step_y)));
+      const std::int32_t ring = units[std::clamp(half, 0, 2 * field.height - 2)];
+      position += ring;
+      ray.positions.push_back(position);
+      ray.rings.push_back(ring);
+      at = static_cast<float>(position);
+    }
     const float q = detail::sampleHeight(heights, field.width, field.height, p);
-    ray.push_back(curvature != 0.0 ? q - drop * static_cast<float>(i) * static_cast<float>(i) : q);
+    ray.heights.push_back(curvature != 0.0 ? q - drop * at * at : q);
   }
   return ray;
 }
 
 DirectionHorizons listDirection(const HeightField& field, const std::vector<float>& heights,
                                 const detail::SweepDirection& d, int k, double azimuth, int c, int r,
-                                double curvature) {
+                                double curvature, const std::int32_t* units, double unit) {
   DirectionHorizons out;
   out.direction = k;
   out.azimuth = azimuth;
-  out.sample_spacing = static_cast<double>(d.step_length) * d.ground_per_pixel;
-  const std::vector<float> ray = raySamples(field, heights, d, c, r, curvature);
+  const Ray samples = raySamples(field, heights, d, c, r, curvature, units, unit);
+  const std::vector<float>& ray = samples.heights;
   const int n = static_cast<int>(ray.size());
+  // Ground distance of sample i: i steps, or its position in units with per-row spacing.
+  auto distance = [&](int i) {
+    return units ? samples.positions[i - 1] * unit : i * out.sample_spacing;
+  };
+  out.sample_spacing = units ? (n > 0 ? samples.rings[0] * unit : 0.0)
+                             : static_cast<double>(d.step_length) * d.ground_per_pixel;
   out.ray_samples = n;
   const float h = heights[static_cast<std::size_t>(r) * field.width + c];
   if (std::isnan(h) || n == 0) return out;
@@ -56,6 +84,17 @@ DirectionHorizons listDirection(const HeightField& field, const std::vector<floa
   line.samples.resize(static_cast<std::size_t>(n) + 1);
   for (int s = 0; s < n; ++s) line.samples[s] = ray[n - 1 - s];
   line.samples[n] = h;
+  if (units) {  // positions rise toward the receiver, at the farthest sample's distance
+    const std::int32_t far = samples.positions[n - 1];
+    line.positions.resize(line.samples.size());
+    line.step_units.resize(line.samples.size());
+    for (int s = 0; s < n; ++s) {
+      line.positions[s] = far - samples.positions[n - 1 - s];
+      line.step_units[s] = samples.rings[n - 1 - s];
+    }
+    line.positions[n] = far;
+    line.step_units[n] = 0;  // the receiver is no one's farther sample
+  }
   detail::sweepPresampledLines(line, HullTreeTuning{}, true);
 
   const std::vector<int>& steps = line.horizon_steps[n];  // farthest first
@@ -67,8 +106,8 @@ DirectionHorizons listDirection(const HeightField& field, const std::vector<floa
     // Steps [h, end) hold the run; its nearest present sample begins the segment.
     horizon.segment_begin = n - ends[idx] + 1;
     while (std::isnan(ray[horizon.segment_begin - 1])) ++horizon.segment_begin;
-    horizon.distance = horizon.sample * out.sample_spacing;
-    horizon.near_distance = horizon.segment_begin * out.sample_spacing;
+    horizon.distance = distance(horizon.sample);
+    horizon.near_distance = distance(horizon.segment_begin);
     horizon.elevation = std::atan2(static_cast<double>(ray[horizon.sample - 1]) - h, horizon.distance);
     for (int i = horizon.segment_begin; i < horizon.segment_end; ++i)
       horizon.visible_samples += !std::isnan(ray[i - 1]);
@@ -109,6 +148,10 @@ std::vector<ReceiverHorizons> computeHorizonLists(const HeightField& field, cons
   detail::checkStepLimits(static_cast<std::size_t>((field.width + field.height) * options.samples_per_unit) + 2,
                           prepared.heights);
 
+  // Per-row spacing: positions in units along each ray, as the naive visibility march's.
+  const bool row_spacing = detail::hasRowSpacing(field);
+  const double unit = row_spacing ? detail::groundUnit(field) : 0.0;
+  const detail::NaiveRowTables rows = row_spacing ? detail::naiveRowTables(field, directions, unit) : detail::NaiveRowTables{};
   std::vector<ReceiverHorizons> lists;
   lists.reserve(receivers.size());
   for (const ReceiverPixel& p : receivers) {
@@ -118,8 +161,10 @@ std::vector<ReceiverHorizons> computeHorizonLists(const HeightField& field, cons
     receiver.nodata = std::isnan(prepared.heights[static_cast<std::size_t>(p.row) * field.width + p.col]);
     if (receiver.nodata) receiver.height = std::numeric_limits<float>::quiet_NaN();
     for (int k = 0; k < options.directions; ++k) {
+      const std::int32_t* units = row_spacing ? &rows.units[k * (2 * static_cast<std::size_t>(field.height) - 1)] : nullptr;
       receiver.directions.push_back(listDirection(field, prepared.heights, directions[k], k,
-                                                  directionAzimuth(k, options), p.col, p.row, options.curvature));
+                                                  directionAzimuth(k, options), p.col, p.row, options.curvature,
+                                                  units, unit));
     }
     lists.push_back(std::move(receiver));
   }

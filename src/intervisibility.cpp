@@ -434,7 +434,7 @@ class NaiveCountRoutine : public SweepRoutine {
     const double longest = (double(field_.width) + field_.height) * visibility_.samples_per_unit + 2.0;
     std::size_t longest_position = static_cast<std::size_t>(longest);
     if (hasRowSpacing(field_)) {  // positions in units: at most the steps times a step's most units
-      unit_ = groundUnit(field_, visibility_);
+      unit_ = groundUnit(field_);
       rows_ = naiveRowTables(field_, rays_, unit_);
       longest_position *= static_cast<std::size_t>(*std::max_element(rows_.units.begin(), rows_.units.end()));
     }

@@ -111,10 +111,8 @@ NaiveRowTables naiveRowTables(const HeightField& field, const std::vector<SweepD
   return t;
 }
 
-double groundUnit(const HeightField& field, const SweepOptions& options) {
-  double longest_period = 0.0;
-  for (const LatticeDirection& d : latticeDirections(field, options, false, 0.0))
-    longest_period = std::max(longest_period, d.period);
+double groundUnit(const HeightField& field) {
+  const double longest_period = std::hypot(double(kMaxLatticeStep), double(kMaxLatticeStep));
   const double largest_cell = std::max(*std::max_element(field.row_cell_size_x.begin(), field.row_cell_size_x.end()),
                                        *std::max_element(field.row_cell_size_y.begin(), field.row_cell_size_y.end()));
   return (double(field.width) + field.height + 2.0 * longest_period) * largest_cell / double(1 << 23);
@@ -140,7 +138,7 @@ std::vector<TreeDirection> treeDirections(const HeightField& field, const SweepO
   double unit = 0.0;
   if (follow_rows && hasRowSpacing(field)) {
     rows = latticeRowTables(field, lattice, true);
-    unit = groundUnit(field, options);
+    unit = groundUnit(field);
   }
   std::vector<TreeDirection> out;
   for (std::size_t k = 0; k < lattice.size(); ++k) {

@@ -101,7 +101,7 @@ void naiveReference(const HeightField& field, const std::vector<float>& h,
   const float sector = intervisibilitySector(options);
   // Per-row spacing: positions in units, as intervisibility_naive with HFVIS_ROW_SPACING.
   const bool row_spacing = hasRowSpacing(field);
-  const double unit = row_spacing ? groundUnit(field, options) : 0.0;
+  const double unit = row_spacing ? groundUnit(field) : 0.0;
   const NaiveRowTables rows = row_spacing ? naiveRowTables(field, directions, unit) : NaiveRowTables{};
   std::vector<PixelSums> sums(field.pixelCount());
   for (int r = 0; r < height; ++r) {

@@ -186,10 +186,12 @@ TEST(HorizonLists, EqualBruteForceOnEveryHardCase) {
 // Every direction: the lists' visible samples equal the naive visibility kernel's count
 // for that direction alone (a run of K = 1 at that azimuth marches the same ray); on the
 // axis directions also the tree sweep's per-pixel count (lines through pixel centres). Flat
-// and over a curved Earth (a drop of several height units across the field).
-void expectListsAgreeWithTheKernels(double curvature) {
-  SCOPED_TRACE("curvature " + std::to_string(curvature));
-  const HeightField field = makeSyntheticField("noise", 33, 20, 8);
+// and over a curved Earth (a drop of several height units across the field); also on rows of
+// their own spacing (positions in ground units, as the kernels take them).
+void expectListsAgreeWithTheKernels(double curvature, bool row_spacing = false) {
+  SCOPED_TRACE("curvature " + std::to_string(curvature) + (row_spacing ? ", rows of their own spacing" : ""));
+  HeightField field = makeSyntheticField("noise", 33, 20, 8);
+  if (row_spacing) testing::setRowSpacing(field);
   SweepOptions options;
   options.directions = 8;
   options.azimuth_offset = 0.0;
@@ -228,6 +230,8 @@ void expectListsAgreeWithTheKernels(double curvature) {
 TEST(HorizonLists, AgreeWithTheNaiveKernelAndTheTreeOnTheAxes) {
   expectListsAgreeWithTheKernels(0.0);
   expectListsAgreeWithTheKernels(0.004);
+  expectListsAgreeWithTheKernels(0.0, true);
+  expectListsAgreeWithTheKernels(0.004, true);
 }
 
 // The farthest horizon is the horizon of README's conventions (the largest elevation, the farther on
@@ -294,6 +298,20 @@ TEST(HorizonLists, WallAnalytic) {
   EXPECT_EQ(away.horizons[0].visible_samples, 3);
   // Along the column (k = 1: +row) the ray has 2 samples, both level.
   EXPECT_EQ(lists[0].directions[1].visible_samples, 2);
+  // With a spacing per row (row 2's east-west cells 3 long, the others' 1), the wall lies
+  // 7 x 3 away from row 2 (positions in whole units of ground length: each step within a
+  // relative 2^-24 (W + H + 181) = 1.2e-5).
+  field.row_cell_size_x = {1.0, 1.0, 3.0, 1.0, 1.0};
+  field.row_cell_size_y = {1.0, 1.0, 1.0, 1.0, 1.0};
+  field.cell_size_x = 3.0;
+  field.cell_size_y = 1.0;
+  const auto rows = computeHorizonLists(field, options, {{3, 2}, {3, 1}});
+  ASSERT_EQ(rows[0].directions[0].horizons.size(), 1u);
+  EXPECT_NEAR(rows[0].directions[0].horizons[0].distance, 21.0, 21.0 * 1.3e-5);
+  EXPECT_NEAR(rows[0].directions[0].horizons[0].near_distance, 3.0, 3.0 * 1.3e-5);
+  EXPECT_NEAR(rows[0].directions[0].sample_spacing, 3.0, 3.0 * 1.3e-5);
+  EXPECT_NEAR(rows[0].directions[0].horizons[0].elevation, std::atan2(100.0, 21.0), 1e-6);
+  EXPECT_NEAR(rows[1].directions[0].horizons[0].distance, 7.0, 7.0 * 1.3e-5);
 }
 
 TEST(HorizonLists, NodataAndBadReceivers) {

@@ -50,11 +50,8 @@ detail::TreeDirection treeStep(const HeightField& field, std::pair<int, int> ste
 detail::TreeDirection treeStepFollowingRows(const HeightField& field, std::pair<int, int> step,
                                             double samples_per_unit = 1.0) {
   detail::TreeDirection d = treeStep(field, step, samples_per_unit);
-  SweepOptions options;
-  options.directions = 8;
-  options.samples_per_unit = samples_per_unit;
   const auto rows = detail::latticeRowTables(field, {d.lattice}, false);
-  detail::followRows(d, field, rows[0], detail::groundUnit(field, options), samples_per_unit, 8, 0.0, 0.0);
+  detail::followRows(d, field, rows[0], detail::groundUnit(field), samples_per_unit, 8, 0.0, 0.0);
   return d;
 }
 

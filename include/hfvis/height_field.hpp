@@ -42,9 +42,8 @@ struct HeightField {
   // at the centre latitude. The horizon operation (horizon angles and distances, sky-view
   // factor, occlusion) measures ground lengths along its lines and rays step by step with
   // them, and takes each row's normals, step directions and quadrature weights from them;
-  // so does intervisibility (its positions along lines and rays in whole units of ground
-  // length, see computeIntervisibility); the horizon lists and the bounce take cell_size_x/y
-  // for the whole field.
+  // so do intervisibility and the horizon lists (their positions along lines and rays in
+  // whole units of ground length); the bounce takes cell_size_x/y for the whole field.
   std::vector<double> row_cell_size_x, row_cell_size_y;
   double z_scale = 1.0;        // multiplies every height
   Georeference georeference;   // from a georeferenced raster; empty for a field filled in memory

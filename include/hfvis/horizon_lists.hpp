@@ -35,7 +35,9 @@ struct ReceiverPixel {
 };
 
 // One visibility horizon and the visible segment it bounds. Samples are numbered along the
-// ray, 1 = nearest; sample i lies at ground distance i * sample_spacing.
+// ray, 1 = nearest; sample i lies at ground distance i * sample_spacing (with per-row spacing,
+// a latitude / longitude grid, the sum of its steps' ground lengths, each at its middle row
+// in whole units of groundUnit, as the visibility kernels take them).
 struct VisibilityHorizon {
   int sample = 0;              // the horizon point: the farthest visible sample of its segment
   double distance = 0.0;       // its ground distance from the receiver (ground units)
@@ -49,7 +51,8 @@ struct VisibilityHorizon {
 struct DirectionHorizons {
   int direction = 0;                        // k
   double azimuth = 0.0;                     // phi_k, radians
-  double sample_spacing = 0.0;              // ground distance between consecutive samples
+  double sample_spacing = 0.0;              // ground distance between consecutive samples (the first
+                                            // step's with per-row spacing)
   int ray_samples = 0;                      // samples on the ray inside the field, present or not
   int visible_samples = 0;                  // visible samples, the sum over the segments
   std::vector<VisibilityHorizon> horizons;  // nearest first; elevations never decrease
