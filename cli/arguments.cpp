@@ -9,12 +9,13 @@
 #include <limits>
 
 #include "hfvis/errors.hpp"
+#include "hfvis/sun.hpp"
 
 namespace hfvis::cli {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr const char* kCommandList = "horizon, svf, ao, viewcount, horizons, bounce or devices";
+constexpr const char* kCommandList = "horizon, svf, ao, viewcount, horizons, bounce, sunpos or devices";
 
 // One option of the compute commands (horizon, svf, ao, viewcount, horizons, bounce).
 enum class Option {
@@ -95,6 +96,7 @@ std::optional<Command> findCommand(const std::string& name) {
   if (name == "horizons") return Command::HorizonLists;
   if (name == "bounce") return Command::Bounce;
   if (name == "devices") return Command::Devices;
+  if (name == "sunpos") return Command::SunPosition;
   if (name == "help") return Command::Help;
   return std::nullopt;
 }
@@ -507,6 +509,8 @@ const char* commandName(Command command) {
       return "help";
     case Command::Devices:
       return "devices";
+    case Command::SunPosition:
+      return "sunpos";
     case Command::Horizon:
       return "horizon";
     case Command::SkyViewFactor:
@@ -522,6 +526,57 @@ const char* commandName(Command command) {
   }
   return "?";
 }
+
+namespace {
+
+// "hfvis sunpos --lat LAT --lon LON --at TIME [--apparent]": each once, all but --apparent required.
+SunArguments parseSunArguments(const std::vector<std::string>& args) {
+  SunArguments sun;
+  bool lat = false, lon = false, at = false;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& arg = args[i];
+    auto value = [&]() -> const std::string& {
+      if (i + 1 >= args.size()) throw UsageError(arg + " needs a value");
+      return args[++i];
+    };
+    auto once = [&](bool& seen) {
+      if (seen) throw UsageError(arg + " given twice");
+      seen = true;
+    };
+    if (arg == "--lat") {
+      once(lat);
+      sun.latitude_deg = parseNumber(arg, value());
+      if (sun.latitude_deg < -90.0 || sun.latitude_deg > 90.0)
+        throw UsageError("--lat: expected a latitude in -90 .. 90 degrees, got " + inQuotes(args[i]));
+    } else if (arg == "--lon") {
+      once(lon);
+      sun.longitude_deg = parseNumber(arg, value());
+      if (sun.longitude_deg < -180.0 || sun.longitude_deg > 360.0)
+        throw UsageError("--lon: expected a longitude in -180 .. 360 degrees, got " + inQuotes(args[i]));
+    } else if (arg == "--at") {
+      once(at);
+      try {
+        sun.utc_seconds = parseUtcTime(value());
+      } catch (const InvalidArgument& error) {
+        throw UsageError(std::string("--at: ") + error.what());
+      }
+    } else if (arg == "--apparent") {
+      if (sun.apparent) throw UsageError("--apparent given twice");
+      sun.apparent = true;
+    } else {
+      throw UsageError("'hfvis sunpos' takes --lat, --lon, --at and --apparent, not " + inQuotes(arg));
+    }
+  }
+  if (!lat || !lon || !at) throw UsageError("'hfvis sunpos' needs --lat LAT --lon LON --at TIME");
+  try {  // the algorithm's range of years
+    sunPosition(sun.utc_seconds, sun.latitude_deg, sun.longitude_deg);
+  } catch (const InvalidArgument& error) {
+    throw UsageError(std::string("--at: ") + error.what());
+  }
+  return sun;
+}
+
+}  // namespace
 
 CommandLine parseCommandLine(const std::vector<std::string>& args) {
   CommandLine line;
@@ -560,6 +615,10 @@ CommandLine parseCommandLine(const std::vector<std::string>& args) {
   line.command = *command;
   if (*command == Command::Devices) {
     if (!rest.empty()) throw UsageError("'hfvis devices' takes no arguments, got " + inQuotes(rest[0]));
+    return line;
+  }
+  if (*command == Command::SunPosition) {
+    line.sun = parseSunArguments(rest);
     return line;
   }
   line.run = parseRunArguments(*command, rest);

@@ -33,6 +33,7 @@ enum class Command {
   ViewCount,     // visible samples and ground area per pixel (intervisibility)
   HorizonLists,  // "horizons": visibility horizons of chosen receivers, JSON or CSV
   Bounce,        // one diffuse bounce of a given exit radiance
+  SunPosition,   // "sunpos": the sun's azimuth and elevation at a time and place
 };
 
 // The subcommand's name as typed ("horizon", "svf", ...).
@@ -68,11 +69,19 @@ struct RunArguments {
   std::optional<float> nodata;               // --nodata VALUE for GeoTIFF outputs (may be NaN); none = NaN
 };
 
+// What "hfvis sunpos" is asked.
+struct SunArguments {
+  double latitude_deg = 0.0, longitude_deg = 0.0;
+  double utc_seconds = 0.0;
+  bool apparent = false;  // add the atmosphere's refraction
+};
+
 struct CommandLine {
   Command command = Command::Help;
   // For Command::Help: the subcommand whose help was asked for, if any.
   std::optional<Command> help_topic;
   RunArguments run;
+  SunArguments sun;  // Command::SunPosition
 };
 
 // Parses argv (without argv[0]). Throws UsageError naming the offending argument.

@@ -33,6 +33,7 @@
 #include "hfvis/horizon_lists.hpp"
 #include "hfvis/image_io.hpp"
 #include "hfvis/intervisibility.hpp"
+#include "hfvis/sun.hpp"
 #include "horizon_list_files.hpp"
 
 namespace hfvis::cli {
@@ -468,6 +469,13 @@ ComputeContext contextFor(const RunArguments& run) {
 }
 
 }  // namespace
+
+int runSunPosition(const SunArguments& sun) {
+  const SunPosition p = sunPosition(sun.utc_seconds, sun.latitude_deg, sun.longitude_deg, sun.apparent);
+  std::cout << std::fixed << std::setprecision(4) << "azimuth=" << p.azimuth_deg << " elevation=" << p.elevation_deg
+            << "\n";
+  return 0;
+}
 
 int runDevices() {
   const std::vector<DeviceInfo> devices = listDevices();

@@ -7,6 +7,8 @@ namespace hfvis::cli {
 
 // `hfvis devices`: prints the device table to stdout. Returns the exit status.
 int runDevices();
+// "hfvis sunpos": prints "azimuth=<deg> elevation=<deg>".
+int runSunPosition(const SunArguments& sun);
 
 // `hfvis horizon|svf|ao`: reads the input, computes on the device, writes every output
 // (all or none). Throws hfvis::Error on failure. Returns the exit status.

@@ -13,6 +13,7 @@ const char* const kUsage = R"(Usage:
   hfvis viewcount IN -o OUT.exr [-k K] [--method tree|naive] [--stats] [options]
   hfvis horizons  IN --at COL,ROW [--at COL,ROW ...] -o OUT.json|OUT.csv [-k K] [options]
   hfvis bounce    IN --radiance RAD.exr -o OUT.exr [-k K] [options]
+  hfvis sunpos    --lat LAT --lon LON --at TIME [--apparent]
   hfvis devices
   hfvis --help | hfvis COMMAND --help
 )";
@@ -26,6 +27,7 @@ Commands:
             channel 1 "visible_area": the visible ground area (total viewshed), ground units^2
   horizons  the visibility horizons of chosen receivers per direction, as JSON or CSV
   bounce    incident indirect irradiance of one diffuse bounce of a given exit radiance
+  sunpos    the sun's compass azimuth and elevation at a time and place
   devices   list the OpenCL devices and mark the one automatic selection picks
 )";
 
@@ -259,6 +261,16 @@ std::string commandHelp(Command command) {
              "version and global memory. '*' marks the device automatic selection picks (the\n"
              "HFVIS_DEVICE environment variable if set, else a GPU, else the first CPU). Use the\n"
              "index, a type (gpu, cpu) or part of the name with --device or HFVIS_DEVICE.\n";
+    case Command::SunPosition:
+      return "hfvis sunpos --lat LAT --lon LON --at TIME [--apparent]\n\n"
+             "Prints 'azimuth=<deg> elevation=<deg>': where the sun stands seen from latitude LAT and\n"
+             "longitude LON (degrees, north and east positive) at TIME (ISO 8601 with a zone, e.g.\n"
+             "2026-06-21T12:00:00Z or 2026-06-21T14:00:00+02:00). The azimuth is the compass azimuth,\n"
+             "degrees clockwise from north; the elevation is geometric (the sun's centre, no\n"
+             "atmosphere; geocentric), or with --apparent raised by the refraction of a standard\n"
+             "atmosphere (1010 hPa, 10 C). The algorithm is Meeus's (1998, ch. 25) with Smart's\n"
+             "equation of time, as NOAA's solar calculator: within 0.003 degree of NREL's SPA on\n"
+             "its worked example; years 1800 - 2200 (the range it accepts).\n";
     case Command::Help:
       break;
   }

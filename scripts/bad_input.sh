@@ -133,6 +133,11 @@ try "memory budget too small" "" -- horizon field.exr -o out/o.exr --memory-budg
 try "receiver outside the field" "" -- horizons field.exr --at 300,2 -o out/h.json
 try "receiver not a pair" "" -- horizons field.exr --at 3 -o out/h.json
 try "radiance of another size" "" -- bounce field.exr --radiance two_channels.png -o out/o.exr
+try "sun position without a time" "" -- sunpos --lat 45 --lon 7
+try "sun position at a time without a zone" "" -- sunpos --lat 45 --lon 7 --at 2026-06-21T12:00:00
+try "sun position at a day that does not exist" "" -- sunpos --lat 45 --lon 7 --at 2026-02-30T12:00:00Z
+try "sun position at a latitude beyond the pole" "" -- sunpos --lat 95 --lon 7 --at 2026-06-21T12:00:00Z
+try "sun position beyond its years" "" -- sunpos --lat 45 --lon 7 --at 1700-06-21T12:00:00Z
 # Environment.
 try "HFVIS_LINE_LAYOUT not line or step" HFVIS_LINE_LAYOUT=diagonal -- svf field.exr -o out/o.exr
 try "HFVIS_PROFILE not 0 or 1" HFVIS_PROFILE=yes -- svf field.exr -o out/o.exr

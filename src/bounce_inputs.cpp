@@ -14,32 +14,6 @@ namespace {
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
-// The unit normal of the (up to) four quads around pixel (c, r), in ground units; quads
-// touching nodata or the border are left out, (0, 0, 1) when none is left. The same normal
-// as ambient occlusion (surface_normal in kernels/horizon.cl).
-void pixelNormal(const std::vector<float>& h, int width, int height, int c, int r, float cell_x, float cell_y,
-                 float* n) {
-  const float hp = h[static_cast<std::size_t>(r) * width + c];
-  float sx_sum = 0.0f, sy_sum = 0.0f, sz_sum = 0.0f;
-  for (int q = 0; q < 4; ++q) {
-    const int sx = (q & 1) ? 1 : -1, sy = (q & 2) ? 1 : -1;
-    const int cx = c + sx, ry = r + sy;
-    if (cx < 0 || cx >= width || ry < 0 || ry >= height) continue;
-    const float hx = h[static_cast<std::size_t>(r) * width + cx],
-                hy = h[static_cast<std::size_t>(ry) * width + c];
-    if (std::isnan(hx) || std::isnan(hy)) continue;
-    sx_sum += -(hx - hp) / (static_cast<float>(sx) * cell_x);
-    sy_sum += -(hy - hp) / (static_cast<float>(sy) * cell_y);
-    sz_sum += 1.0f;
-  }
-  if (!(sz_sum > 0.0f)) {
-    n[0] = 0.0f, n[1] = 0.0f, n[2] = 1.0f;
-    return;
-  }
-  const float length = std::sqrt(sx_sum * sx_sum + sy_sum * sy_sum + sz_sum * sz_sum);
-  n[0] = sx_sum / length, n[1] = sy_sum / length, n[2] = sz_sum / length;
-}
-
 }  // namespace
 
 BounceInputs prepareBounce(const HeightField& field, const ExitRadiance& radiance) {

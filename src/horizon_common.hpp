@@ -19,6 +19,13 @@ bool exactAzimuths(const HorizonOutputs& outputs);
 std::vector<LatticeDirection> horizonDirections(const HeightField& field, const HorizonOptions& options,
                                                 const HorizonOutputs& outputs);
 
+// The unit normal (x along +column, y along +row, z up) of the (up to) four quads around
+// pixel (c, r) of prepared heights h, in ground units; quads touching nodata or the border are
+// left out, (0, 0, 1) when none is left. The same normal as ambient occlusion's
+// (surface_slopes in kernels/horizon.cl).
+void pixelNormal(const std::vector<float>& h, int width, int height, int c, int r, float cell_x, float cell_y,
+                 float* n);
+
 // sin(pi weight) / pi: the factor of the ambient-occlusion swath of a direction of that
 // weight (ambient_term in kernels/horizon.cl), computed once per direction on the host.
 float swathFactor(float weight);

@@ -9,6 +9,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -844,6 +845,28 @@ TEST_F(Cli, ATinyMemoryBudgetRunsInStripsWithTheSameResult) {
     EXPECT_EQ(readBack(out("strips.exr")).pixels, readBack(out("whole.exr")).pixels) << command;
     fs::remove(out("whole.exr"));
     fs::remove(out("strips.exr"));
+  }
+}
+
+// "hfvis sunpos" prints the compass azimuth and the elevation (tests/test_sun.cpp checks the
+// algorithm): the SPA worked example's azimuth, 194.34 degrees; --apparent raises the elevation.
+TEST_F(Cli, SunPositionPrintsAzimuthAndElevation) {
+  const CliResult result = run("sunpos --lat 39.742476 --lon -105.1786 --at 2003-10-17T12:30:30-07:00");
+  ASSERT_EQ(result.status, 0) << result.err;
+  double azimuth = 0.0, elevation = 0.0;
+  ASSERT_EQ(std::sscanf(result.out.c_str(), "azimuth=%lf elevation=%lf", &azimuth, &elevation), 2) << result.out;
+  EXPECT_NEAR(azimuth, 194.34024, 0.005);
+  EXPECT_NEAR(elevation, 39.874, 0.005);
+  const CliResult apparent = run("sunpos --lat 39.742476 --lon -105.1786 --at 2003-10-17T12:30:30-07:00 --apparent");
+  ASSERT_EQ(apparent.status, 0) << apparent.err;
+  double apparent_elevation = 0.0;
+  ASSERT_EQ(std::sscanf(apparent.out.c_str(), "azimuth=%lf elevation=%lf", &azimuth, &apparent_elevation), 2);
+  EXPECT_NEAR(apparent_elevation - elevation, 0.02, 0.005);  // a standard atmosphere at 40 degrees
+  for (const char* bad : {"sunpos --lat 45 --lon 7", "sunpos --lat 45 --lon 7 --at noon",
+                          "sunpos --lat 45 --lon 7 --at 2026-06-21T12:00:00Z --lat 46", "sunpos --lat 45 --lon 7 --at"}) {
+    const CliResult r = run(bad);
+    EXPECT_EQ(r.status, 2) << bad;
+    EXPECT_TRUE(r.out.empty()) << bad;
   }
 }
 

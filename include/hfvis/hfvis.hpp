@@ -24,5 +24,7 @@
 #include "hfvis/horizon_lists.hpp"
 #include "hfvis/image_io.hpp"
 #include "hfvis/intervisibility.hpp"
+#include "hfvis/shading.hpp"
+#include "hfvis/sun.hpp"
 #include "hfvis/sweep_options.hpp"
 #include "hfvis/version.hpp"
