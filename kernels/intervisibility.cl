@@ -300,6 +300,28 @@ typedef struct {
 } TreeLineState;
 // The host allocates kTreeLineStateBytes (src/intervisibility_device.hpp) per line.
 typedef char tree_line_state_is_136_bytes[sizeof(TreeLineState) == 136 ? 1 : -1];
+// The registers saved and restored, X(register, its TreeLineState field), those of per-row
+// spacing and of the safe zone where compiled in.
+#if HFVIS_ROW_SPACING
+#define HFVIS_ROW_REGISTERS(X) X(weighted_sum, weighted_sum) X(position, position) X(unit_sum, unit_sum)
+#else
+#define HFVIS_ROW_REGISTERS(X)
+#endif
+#if HFVIS_SAFE_ZONE
+#define HFVIS_ZONE_REGISTERS(X)                                                                    \
+  X(zone_valid, zone_valid) X(zone.first, zone_first) X(zone.last, zone_last) X(zone.z1, zone_z1) \
+  X(zone.z2, zone_z2) X(zone.margin, zone_margin)
+#else
+#define HFVIS_ZONE_REGISTERS(X)
+#endif
+#define HFVIS_LINE_REGISTERS(X)                                                                       \
+  X(step_sum, step_sum) X(total_m, total_m) X(total_t, total_t) X(total_naive, total_naive)            \
+  X(total_visible, total_visible) X(rank, rank) X(root, root) X(prev, prev) X(prev2, prev2)            \
+  X(class_last, class_last) X(head, head) X(tail, tail) X(zone_skips, zone_skips) X(h_prev, h_prev)    \
+  X(h_prev2, h_prev2) X(p_prev, p_prev) X(p_prev2, p_prev2) X(tail_h, tail_h) HFVIS_ROW_REGISTERS(X) \
+  HFVIS_ZONE_REGISTERS(X)
+#define HFVIS_RESTORE(reg, field) reg = st.field;
+#define HFVIS_SAVE(reg, field) st.field = reg;
 
 // The sweep of one direction (a, b) on lattice lines (src/lattice_geometry.hpp): every pixel
 // centre lies on exactly one line of the direction, so every receiver is a sample of the
@@ -398,37 +420,7 @@ __kernel void intervisibility_lattice(
   __global TreeLineState* state = states + j;
   if (i_begin > 0) {
     const TreeLineState st = *state;
-    step_sum = st.step_sum;
-    total_m = st.total_m;
-    total_t = st.total_t;
-    total_naive = st.total_naive;
-    total_visible = st.total_visible;
-    rank = st.rank;
-    root = st.root;
-    prev = st.prev;
-    prev2 = st.prev2;
-    class_last = st.class_last;
-    head = st.head;
-    tail = st.tail;
-    zone_skips = st.zone_skips;
-    h_prev = st.h_prev;
-    h_prev2 = st.h_prev2;
-    p_prev = st.p_prev;
-    p_prev2 = st.p_prev2;
-    tail_h = st.tail_h;
-#if HFVIS_ROW_SPACING
-    weighted_sum = st.weighted_sum;
-    position = st.position;
-    unit_sum = st.unit_sum;
-#endif
-#if HFVIS_SAFE_ZONE
-    zone_valid = st.zone_valid;
-    zone.first = st.zone_first;
-    zone.last = st.zone_last;
-    zone.z1 = st.zone_z1;
-    zone.z2 = st.zone_z2;
-    zone.margin = st.zone_margin;
-#endif
+    HFVIS_LINE_REGISTERS(HFVIS_RESTORE)
   }
 #endif
 
@@ -734,37 +726,7 @@ __kernel void intervisibility_lattice(
   }
 #if HFVIS_STRIPS
   TreeLineState st;
-  st.step_sum = step_sum;
-  st.total_m = total_m;
-  st.total_t = total_t;
-  st.total_naive = total_naive;
-  st.total_visible = total_visible;
-  st.rank = rank;
-  st.root = root;
-  st.prev = prev;
-  st.prev2 = prev2;
-  st.class_last = class_last;
-  st.head = head;
-  st.tail = tail;
-  st.zone_skips = zone_skips;
-  st.h_prev = h_prev;
-  st.h_prev2 = h_prev2;
-  st.p_prev = p_prev;
-  st.p_prev2 = p_prev2;
-  st.tail_h = tail_h;
-#if HFVIS_ROW_SPACING
-  st.weighted_sum = weighted_sum;
-  st.position = position;
-  st.unit_sum = unit_sum;
-#endif
-#if HFVIS_SAFE_ZONE
-  st.zone_valid = zone_valid;
-  st.zone_first = zone.first;
-  st.zone_last = zone.last;
-  st.zone_z1 = zone.z1;
-  st.zone_z2 = zone.z2;
-  st.zone_margin = zone.margin;
-#endif
+  HFVIS_LINE_REGISTERS(HFVIS_SAVE)
   *state = st;
 #endif
 #if HFVIS_WANT_STATS  // (in strips: the totals so far)
@@ -796,6 +758,15 @@ __kernel void intervisibility_lattice(
 // steps of step_y rows along it): rint(2 y), clamped to the field (samples outside are absent).
 HFVIS_INLINE int ray_half_row(float row, float mid, float step_y, int height) {
   return clamp((int)rint(2.0f * (row + mid * step_y)), 0, 2 * height - 2);
+}
+
+// Step i of a ray from row rr: its units into *ring, the position it reaches (*position, the
+// running sum) returned.
+HFVIS_INLINE int ray_step(__global const int* units, int rr, int i, float step_y, int height, int* position,
+                          int* ring) {
+  *ring = units[ray_half_row((float)rr, (float)i - 0.5f, step_y, height)];
+  *position += *ring;
+  return *position;
 }
 #endif
 
@@ -878,9 +849,8 @@ __kernel void intervisibility_naive(__global const float* heights, int width, in
       float px = (float)cc + t * d.dir_x, py = (float)rr + t * d.dir_y;
       float q = sample_height(heights, width, height, px, py);
 #if HFVIS_ROW_SPACING
-      const int ring = units[ray_half_row((float)rr, (float)i - 0.5f, step_y, height)];
-      position += ring;
-      const int at = position;
+      int ring;
+      const int at = ray_step(units, rr, i, step_y, height, &position, &ring);
 #else
       const int at = i;
 #endif
@@ -916,9 +886,8 @@ __kernel void intervisibility_naive(__global const float* heights, int width, in
         float px = (float)cc + t * d.dir_x, py = (float)rr + t * d.dir_y;
         float q = sample_height(heights, width, height, px, py);
 #if HFVIS_ROW_SPACING
-        const int ring = units[ray_half_row((float)rr, (float)i - 0.5f, step_y, height)];
-        position += ring;
-        const int at = position;
+        int ring;
+        const int at = ray_step(units, rr, i, step_y, height, &position, &ring);
 #else
         const int at = i;
 #endif
