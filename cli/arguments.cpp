@@ -15,7 +15,7 @@ namespace hfvis::cli {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr const char* kCommandList = "horizon, svf, ao, viewcount, horizons, bounce, sunpos or devices";
+constexpr const char* kCommandList = "horizon, svf, ao, viewcount, horizons, bounce, shade, sunpos or devices";
 
 // One option of the compute commands (horizon, svf, ao, viewcount, horizons, bounce).
 enum class Option {
@@ -41,6 +41,10 @@ enum class Option {
   Refraction,
   MaxDistance,
   Nodata,
+  Sun,
+  SunSize,
+  Latitude,
+  Longitude,
 };
 
 struct OptionSpec {
@@ -73,6 +77,10 @@ constexpr OptionSpec kOptions[] = {
     {Option::Refraction, "--refraction", nullptr, true},
     {Option::MaxDistance, "--max-distance", nullptr, true},
     {Option::Nodata, "--nodata", nullptr, true},
+    {Option::Sun, "--sun", nullptr, true},
+    {Option::SunSize, "--sun-size", nullptr, true},
+    {Option::Latitude, "--lat", nullptr, true},
+    {Option::Longitude, "--lon", nullptr, true},
 };
 
 // The options every sweep operation shares, as typed (degrees become radians).
@@ -97,6 +105,7 @@ std::optional<Command> findCommand(const std::string& name) {
   if (name == "bounce") return Command::Bounce;
   if (name == "devices") return Command::Devices;
   if (name == "sunpos") return Command::SunPosition;
+  if (name == "shade") return Command::Shade;
   if (name == "help") return Command::Help;
   return std::nullopt;
 }
@@ -214,8 +223,11 @@ const char* onlyFor(Option option) {
       return "horizon";
     case Option::Statistics:
       return "viewcount";
-    case Option::At:
-      return "horizons";
+    case Option::Sun:
+    case Option::SunSize:
+    case Option::Latitude:
+    case Option::Longitude:
+      return "shade";
     case Option::Radiance:
       return "bounce";
     default:
@@ -226,6 +238,11 @@ const char* onlyFor(Option option) {
 // Options that make no sense for a command (the horizon lists are computed on the host,
 // one ray per receiver and direction, and written as text).
 bool notFor(Option option, Command command) {
+  // --at: receivers for the horizon lists, the sun's time for shade.
+  if (option == Option::At) return command != Command::HorizonLists && command != Command::Shade;
+  // shade sweeps the sun's azimuth alone, by the sweep.
+  if (command == Command::Shade)
+    return option == Option::Directions || option == Option::Method || option == Option::AzimuthOffset;
   if (command == Command::HorizonLists) {
     return option == Option::Method || option == Option::Device || option == Option::MemoryBudget ||
            option == Option::Preview || option == Option::MaxDistance || option == Option::Nodata;
@@ -336,7 +353,41 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
       }
       break;
     case Option::At:
-      run.receivers.push_back(parseReceiver(typed, value));
+      if (command == Command::Shade) {
+        if (run.sun_time) throw UsageError(typed + " given twice");
+        try {
+          run.sun_time = parseUtcTime(value);
+        } catch (const InvalidArgument& error) {
+          throw UsageError(typed + ": " + error.what());
+        }
+      } else {
+        run.receivers.push_back(parseReceiver(typed, value));
+      }
+      break;
+    case Option::Sun: {
+      const std::size_t comma = value.find(',');
+      if (comma == std::string::npos)
+        throw UsageError(typed + ": expected AZ,EL (compass azimuth and elevation, degrees), got " + inQuotes(value));
+      const double azimuth = parseNumber(typed, value.substr(0, comma));
+      const double elevation = parseNumber(typed, value.substr(comma + 1));
+      if (elevation < -90.0 || elevation > 90.0)
+        throw UsageError(typed + ": the elevation must be in -90 .. 90 degrees, got " + inQuotes(value));
+      run.sun = std::make_pair(azimuth, elevation);
+      break;
+    }
+    case Option::SunSize:
+      run.sun_size_deg = parsePositive(typed, value);
+      if (run.sun_size_deg > 10.0) throw UsageError(typed + ": at most 10 degrees, got " + inQuotes(value));
+      break;
+    case Option::Latitude:
+      run.latitude = parseNumber(typed, value);
+      if (*run.latitude < -90.0 || *run.latitude > 90.0)
+        throw UsageError(typed + ": expected a latitude in -90 .. 90 degrees, got " + inQuotes(value));
+      break;
+    case Option::Longitude:
+      run.longitude = parseNumber(typed, value);
+      if (*run.longitude < -180.0 || *run.longitude > 360.0)
+        throw UsageError(typed + ": expected a longitude in -180 .. 360 degrees, got " + inQuotes(value));
       break;
     case Option::Radiance:
       requireNonEmpty(typed, value);
@@ -384,6 +435,20 @@ void validateRun(Command command, const RunArguments& run) {
     if (run.receivers.empty())
       throw UsageError("missing --at COL,ROW (the receivers whose horizons to list)");
   }
+  if (command == Command::Shade) {
+    const bool placed = run.sun_time || run.latitude || run.longitude;
+    if (run.sun && placed)
+      throw UsageError("--sun AZ,EL or --at TIME --lat LAT --lon LON: give the sun one way, not both");
+    if (!run.sun && !(run.sun_time && run.latitude && run.longitude))
+      throw UsageError("missing the sun: --sun AZ,EL (compass azimuth, elevation) or --at TIME --lat LAT --lon LON");
+    if (run.sun_time) {
+      try {  // the solar position's range of years
+        sunPosition(*run.sun_time, *run.latitude, *run.longitude);
+      } catch (const InvalidArgument& error) {
+        throw UsageError(std::string("--at: ") + error.what());
+      }
+    }
+  }
   if (command == Command::Bounce) {
     if (run.radiance.empty()) {
       throw UsageError("missing --radiance RAD.exr (the exit radiance to bounce, same size as the input)");
@@ -425,6 +490,9 @@ void validateRun(Command command, const RunArguments& run) {
         break;
       case Command::Bounce:
         validate(bounceOptions(run));
+        break;
+      case Command::Shade:
+        validate(static_cast<const SweepOptions&>(horizonOptions(run)));
         break;
       default:
         validate(horizonOptions(run), horizonOutputs(command, run));
@@ -511,6 +579,8 @@ const char* commandName(Command command) {
       return "devices";
     case Command::SunPosition:
       return "sunpos";
+    case Command::Shade:
+      return "shade";
     case Command::Horizon:
       return "horizon";
     case Command::SkyViewFactor:

@@ -34,6 +34,7 @@ enum class Command {
   HorizonLists,  // "horizons": visibility horizons of chosen receivers, JSON or CSV
   Bounce,        // one diffuse bounce of a given exit radiance
   SunPosition,   // "sunpos": the sun's azimuth and elevation at a time and place
+  Shade,         // the surface lit by the sun: the part of its disc seen, the direct irradiance
 };
 
 // The subcommand's name as typed ("horizon", "svf", ...).
@@ -56,6 +57,11 @@ struct RunArguments {
   std::string hull_tree_name;            // --hull-tree as given; "" = not given (the default tuning)
   std::vector<ReceiverPixel> receivers;  // horizons --at, in the order given
   std::string radiance;                  // bounce --radiance
+  // shade: the sun, --sun AZ,EL (compass azimuth, elevation, degrees) or where it stands at
+  // --at TIME seen from --lat, --lon; --sun-size, its angular diameter.
+  std::optional<std::pair<double, double>> sun;
+  std::optional<double> sun_time, latitude, longitude;
+  double sun_size_deg = 0.53;
   double cell_size_x = 0.0;              // <= 0: from the file, else 1
   double cell_size_y = 0.0;
   double z_scale = 1.0;

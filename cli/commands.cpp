@@ -33,6 +33,7 @@
 #include "hfvis/horizon_lists.hpp"
 #include "hfvis/image_io.hpp"
 #include "hfvis/intervisibility.hpp"
+#include "hfvis/shading.hpp"
 #include "hfvis/sun.hpp"
 #include "horizon_list_files.hpp"
 
@@ -469,6 +470,57 @@ ComputeContext contextFor(const RunArguments& run) {
 }
 
 }  // namespace
+
+int runShade(const RunArguments& run) {
+  requireOutputs(run, outputPaths(run));
+  const HeightField field = readValidField(run);
+  const ComputeContext context = contextFor(run);
+  const DeviceInfo& device = context.device();
+  SunLight sun;
+  sun.size_deg = run.sun_size_deg;
+  if (run.sun) {
+    sun.position = {run.sun->first, run.sun->second};
+  } else {
+    sun.position = sunPosition(*run.sun_time, *run.latitude, *run.longitude);
+  }
+  HorizonOptions options = horizonOptions(run);
+  Progress progress(run.quiet);
+  progress.attach(options);
+  const auto start = std::chrono::steady_clock::now();
+  const SunShading result = progress.run([&] { return computeSunShading(context, field, sun, options); });
+  const double seconds = secondsSince(start);
+  requireResultSize(result.width, result.height, field);
+  requireSize(result.sun, field.pixelCount(), "sun fractions");
+  requireSize(result.direct, field.pixelCount(), "direct irradiances");
+
+  Attributes attributes = runAttributes(Command::Shade, run, field, device);
+  attributes.emplace_back("hfvis:sun_azimuth_deg", formatNumber(sun.position.azimuth_deg));
+  attributes.emplace_back("hfvis:sun_elevation_deg", formatNumber(sun.position.elevation_deg));
+  attributes.emplace_back("hfvis:sun_size_deg", formatNumber(sun.size_deg));
+  attributes.emplace_back("hfvis:swept_azimuth_deg", formatNumber(result.azimuth * 180.0 / M_PI));
+  StagedOutputs outputs;
+  // "direct" sorts before "sun": channel 0 in the EXR, whose channels are stored sorted by name.
+  const ImageChannels image = makeImage(
+      field, run, {"direct", "sun"}, {result.direct, result.sun}, attributes,
+      "sun: the fraction of the sun's disc above the pixel's horizon in the sun's azimuth; direct: sun * "
+      "max(0, n . s), the irradiance from a sun of normal irradiance 1 (row 0 taken as north)",
+      "sun: 0..1; direct: the sun's normal irradiance");
+  outputs.stage(run.output, [&](const std::string& path) { writeImage(path, image); });
+  if (!run.preview.empty()) {
+    outputs.stage(run.preview, [&](const std::string& path) {
+      writePreviewPng(path, field.width, field.height, result.direct);  // stretched min..max
+    });
+  }
+  const std::vector<std::string> written = outputs.paths();
+  outputs.commit();
+  if (!run.quiet) {
+    printSummary(written, field.width, field.height, 1, "sweep", seconds, device.name,
+                 "; sun at " + formatFixed(sun.position.azimuth_deg, 2) + " deg, " +
+                     formatFixed(sun.position.elevation_deg, 2) + " deg up; mean sun " +
+                     formatFixed(finiteMean(result.sun), 3));
+  }
+  return 0;
+}
 
 int runSunPosition(const SunArguments& sun) {
   const SunPosition p = sunPosition(sun.utc_seconds, sun.latitude_deg, sun.longitude_deg, sun.apparent);

@@ -9,6 +9,8 @@ namespace hfvis::cli {
 int runDevices();
 // "hfvis sunpos": prints "azimuth=<deg> elevation=<deg>".
 int runSunPosition(const SunArguments& sun);
+// "hfvis shade": the part of the sun's disc each pixel sees and the direct irradiance.
+int runShade(const RunArguments& run);
 
 // `hfvis horizon|svf|ao`: reads the input, computes on the device, writes every output
 // (all or none). Throws hfvis::Error on failure. Returns the exit status.

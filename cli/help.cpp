@@ -13,6 +13,7 @@ const char* const kUsage = R"(Usage:
   hfvis viewcount IN -o OUT.exr [-k K] [--method tree|naive] [--stats] [options]
   hfvis horizons  IN --at COL,ROW [--at COL,ROW ...] -o OUT.json|OUT.csv [-k K] [options]
   hfvis bounce    IN --radiance RAD.exr -o OUT.exr [-k K] [options]
+  hfvis shade     IN -o OUT.exr (--sun AZ,EL | --at TIME --lat LAT --lon LON) [--sun-size DEG] [options]
   hfvis sunpos    --lat LAT --lon LON --at TIME [--apparent]
   hfvis devices
   hfvis --help | hfvis COMMAND --help
@@ -27,6 +28,8 @@ Commands:
             channel 1 "visible_area": the visible ground area (total viewshed), ground units^2
   horizons  the visibility horizons of chosen receivers per direction, as JSON or CSV
   bounce    incident indirect irradiance of one diffuse bounce of a given exit radiance
+  shade     two float32 channels: "sun", the part of the sun's disc above the horizon (0..1),
+            and "direct", sun * max(0, n . s): the irradiance from a sun of normal irradiance 1
   sunpos    the sun's compass azimuth and elevation at a time and place
   devices   list the OpenCL devices and mark the one automatic selection picks
 )";
@@ -261,6 +264,19 @@ std::string commandHelp(Command command) {
              "version and global memory. '*' marks the device automatic selection picks (the\n"
              "HFVIS_DEVICE environment variable if set, else a GPU, else the first CPU). Use the\n"
              "index, a type (gpu, cpu) or part of the name with --device or HFVIS_DEVICE.\n";
+    case Command::Shade:
+      return std::string(
+                 "hfvis shade IN -o OUT.exr (--sun AZ,EL | --at TIME --lat LAT --lon LON) [--sun-size DEG]\n\n"
+                 "Lights the surface with the sun: channel \"sun\" is the fraction of the sun's disc\n"
+                 "(--sun-size degrees across, default 0.53) above each pixel's horizon in the sun's azimuth,\n"
+                 "the horizon taken as a straight line across the disc; \"direct\" is sun * max(0, n . s),\n"
+                 "n the surface normal (as for ao), s toward the sun: the irradiance from a sun of normal\n"
+                 "irradiance 1. The sun is --sun AZ,EL (compass azimuth, degrees clockwise from north;\n"
+                 "elevation, degrees), or where it stands at --at TIME seen from --lat, --lon (as 'hfvis\n"
+                 "sunpos', geometric). Row 0 of the field is taken as north (hfvis azimuth = compass\n"
+                 "azimuth - 90 deg). Only the sun's azimuth is swept: its integer step within 0.02 degree.\n"
+                 "NaN at nodata pixels.\n") +
+             kOptions + kConventions + kExitStatus;
     case Command::SunPosition:
       return "hfvis sunpos --lat LAT --lon LON --at TIME [--apparent]\n\n"
              "Prints 'azimuth=<deg> elevation=<deg>': where the sun stands seen from latitude LAT and\n"

@@ -37,13 +37,15 @@ int run(const std::vector<std::string>& args) {
       return runBounce(line.run);
     case Command::SunPosition:
       return runSunPosition(line.sun);
+    case Command::Shade:
+      return runShade(line.run);
   }
   return kExitUsageError;
 }
 
 // "hfvis horizon --help" when the command is known, else "hfvis --help".
 std::string helpHint(const std::vector<std::string>& args) {
-  for (const char* command : {"horizon", "svf", "ao", "viewcount", "horizons", "bounce", "sunpos", "devices"}) {
+  for (const char* command : {"horizon", "svf", "ao", "viewcount", "horizons", "bounce", "shade", "sunpos", "devices"}) {
     if (!args.empty() && args[0] == command) return "hfvis " + args[0] + " --help";
   }
   return "hfvis --help";

@@ -98,7 +98,7 @@ try "output format unknown" "" -- svf field.exr -o out/o.xyz
 try "preview not a PNG" "" -- svf field.exr -o out/o.exr --preview out/p.jpg
 # Arguments.
 try "no arguments" "" --
-try "unknown command" "" -- shade field.exr -o out/o.exr
+try "unknown command" "" -- paint field.exr -o out/o.exr
 try "unknown option" "" -- svf field.exr -o out/o.exr --fast
 try "option without its value" "" -- svf field.exr -o out/o.exr -k
 try "no output" "" -- svf field.exr
@@ -133,6 +133,9 @@ try "memory budget too small" "" -- horizon field.exr -o out/o.exr --memory-budg
 try "receiver outside the field" "" -- horizons field.exr --at 300,2 -o out/h.json
 try "receiver not a pair" "" -- horizons field.exr --at 3 -o out/h.json
 try "radiance of another size" "" -- bounce field.exr --radiance two_channels.png -o out/o.exr
+try "shade without a sun" "" -- shade field.exr -o out/o.exr
+try "shade given the sun two ways" "" -- shade field.exr -o out/o.exr --sun 180,30 --at 2026-06-21T12:00:00Z --lat 45 --lon 7
+try "shade with a sun below the nadir" "" -- shade field.exr -o out/o.exr --sun 180,-95
 try "sun position without a time" "" -- sunpos --lat 45 --lon 7
 try "sun position at a time without a zone" "" -- sunpos --lat 45 --lon 7 --at 2026-06-21T12:00:00
 try "sun position at a day that does not exist" "" -- sunpos --lat 45 --lon 7 --at 2026-02-30T12:00:00Z

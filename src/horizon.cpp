@@ -77,7 +77,7 @@ RunPlan planStrips(const HeightField& field, const HorizonOptions& options, cons
   plan.halo_rows = 1;
   for (const RunDirection& d : directions) {
     double periods = 1.0;
-    if (window && positions) {
+    if (positions) {
       const double shortest = *std::min_element(d.row_length.begin(), d.row_length.end());
       const double longest = *std::max_element(d.row_length.begin(), d.row_length.end());
       periods = (2.0 * d.window.window + 2.0 * longest) / shortest;

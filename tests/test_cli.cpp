@@ -850,6 +850,34 @@ TEST_F(Cli, ATinyMemoryBudgetRunsInStripsWithTheSameResult) {
 
 // "hfvis sunpos" prints the compass azimuth and the elevation (tests/test_sun.cpp checks the
 // algorithm): the SPA worked example's azimuth, 194.34 degrees; --apparent raises the elevation.
+// "hfvis shade": on flat ground every point sees the whole sun and receives sin(elevation), with
+// the sun given by azimuth and elevation or by a time and place; the sun given both ways or not
+// at all, or with options shade does not take, is a usage error with nothing written.
+TEST_F(Cli, ShadeLightsFlatGroundWithTheSun) {
+  const std::string field = flat();
+  const CliResult given = run("shade " + shellQuoted(field) + " -o " + shellQuoted(out("s.exr")) + " --sun 200,30 -q");
+  ASSERT_EQ(given.status, 0) << given.err;
+  const ReadBack s = readBack(out("s.exr"));
+  ASSERT_EQ(s.channels, (std::vector<std::string>{"direct", "sun"}));
+  for (int y = 0; y < s.height; ++y)
+    for (int x = 0; x < s.width; ++x) {
+      ASSERT_EQ(s.at(x, y, 1), 1.0f) << x << "," << y;
+      ASSERT_NEAR(s.at(x, y, 0), 0.5f, 1e-6f) << x << "," << y;
+    }
+  EXPECT_EQ(s.spec.get_string_attribute("hfvis:sun_elevation_deg"), "30");
+  // At the SPA worked example's time and place the sun stands 39.87 degrees up.
+  const CliResult placed = run("shade " + shellQuoted(field) + " -o " + shellQuoted(out("p.exr")) +
+                               " --at 2003-10-17T12:30:30-07:00 --lat 39.742476 --lon -105.1786 -q");
+  ASSERT_EQ(placed.status, 0) << placed.err;
+  EXPECT_NEAR(readBack(out("p.exr")).at(3, 3, 0), std::sin(39.872 * M_PI / 180.0), 1e-4);
+  for (const char* bad : {"", " --sun 200,30 --lat 40", " --sun 200", " --sun 200,95", " --sun 200,30 -k 8",
+                          " --at 2026-06-21T12:00Z --lat 40", " --sun 200,30 --sun-size 20"}) {
+    const CliResult r = run("shade " + shellQuoted(field) + " -o " + shellQuoted(out("bad.exr")) + bad);
+    EXPECT_EQ(r.status, 2) << bad << ": " << r.err;
+    EXPECT_FALSE(fs::exists(out("bad.exr"))) << bad;
+  }
+}
+
 TEST_F(Cli, SunPositionPrintsAzimuthAndElevation) {
   const CliResult result = run("sunpos --lat 39.742476 --lon -105.1786 --at 2003-10-17T12:30:30-07:00");
   ASSERT_EQ(result.status, 0) << result.err;
