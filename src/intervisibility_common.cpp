@@ -121,7 +121,6 @@ double groundUnit(const HeightField& field) {
 void followRows(TreeDirection& d, const HeightField& field, const RowTable& rows, double unit,
                 double samples_per_unit, int directions, double curvature, double max_distance) {
   const double n = d.per_period, step = d.lattice.period / n;
-  d.unit_ground = unit;
   for (int r = 0; r < field.height; ++r) {
     d.row_units.push_back(stepUnits(field, r + 0.5 * d.lattice.b, d.lattice.a / n, d.lattice.b / n, unit));
     const double weight = rows.terms[4 * static_cast<std::size_t>(r) + 2];

@@ -41,14 +41,13 @@ struct TreeDirection {
   float half_sector = 0.0f, wedge = 0.0f;  // the bounce's pi weight and 2 sin(pi weight)
   float cos_azimuth = 1.0f, sin_azimuth = 0.0f;
   // Per-row spacing (a latitude / longitude grid; row_units empty otherwise): positions along
-  // a line are whole units of `unit_ground` ground length (groundUnit), so that the exact
+  // a line are whole units of groundUnit(field) ground length, so that the exact
   // predicate keeps integer differences. The period ending at a receiver of row r (toward
   // +(a, b), at its middle row, as the horizon sweep takes it) has per_period steps of
   // row_units[r] units each; that receiver adds row_factors[2 r] * visible samples to its
   // count and row_factors[2 r + 1] * its distance sum (units squared) to its area: the
   // count and area factors with the step's weight at that row. drop is then per unit
   // squared and max_steps counts units.
-  double unit_ground = 0.0;
   std::vector<std::int32_t> row_units;
   std::vector<float> row_factors;
   bool rowSpacing() const { return !row_units.empty(); }
