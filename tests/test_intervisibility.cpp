@@ -353,7 +353,9 @@ TEST(IntervisibilityLine, TreeEqualsBruteForceOnRowsOfTheirOwnSpacing) {
                        " step " + std::to_string(step.first) + "," + std::to_string(step.second));
           const auto d = treeStepFollowingRows(field, step, step.second == 1 ? 2.0 : 1.0);
           // The steps really differ in length along lines that cross rows.
-          if (step.second != 0 && h > 2) ASSERT_NE(d.row_units.front(), d.row_units.back());
+          if (step.second != 0 && h > 2) {
+            ASSERT_NE(d.row_units.front(), d.row_units.back());
+          }
           expectTreeEqualsBruteForce(field, d, true, &checked, variant.tuning);
           if (::testing::Test::HasFatalFailure()) return;
         }
@@ -663,7 +665,9 @@ TEST(IntervisibilityAnalytic, TowerOverACurvedEarthSeesItsRowsOwnSpacing) {
     const int east_west = 2 * march(col, spacing_x(tower_row));
     const int north_south = march(tower_row, 1.0) + march(height - 1 - tower_row, 1.0);
     const int centre_row = 2 * march(col, spacing_x(height / 2)) + north_south;
-    if (tower_row != 20) EXPECT_GE(std::abs(east_west + north_south - centre_row), 8);
+    if (tower_row != 20) {
+      EXPECT_GE(std::abs(east_west + north_south - centre_row), 8);
+    }
     for (auto method : {IntervisibilityMethod::HullTree, IntervisibilityMethod::Naive}) {
       IntervisibilityOptions options;
       options.directions = 4;

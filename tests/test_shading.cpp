@@ -79,7 +79,9 @@ TEST(SunShading, AWallsShadowAndItsSoftEdge) {
     shadow += seen == 0.0f;
     lit += seen == 1.0f;
     penumbra += seen > 0.0f && seen < 1.0f;
-    if (seen == 1.0f) EXPECT_NEAR(s.direct[4 * w + c], std::sin(elevation), 1e-6) << "column " << c;
+    if (seen == 1.0f) {
+      EXPECT_NEAR(s.direct[4 * w + c], std::sin(elevation), 1e-6) << "column " << c;
+    }
   }
   EXPECT_GT(shadow, 5);
   EXPECT_GT(penumbra, 1);
