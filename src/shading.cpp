@@ -46,8 +46,8 @@ SunShading computeSunShading(const ComputeContext& context, const HeightField& f
   const double elevation = sun.position.elevation_deg * kDegree, radius = 0.5 * sun.size_deg * kDegree;
   const glm::dvec3 s = sunDirection(sun.position);
   const detail::PreparedHeights prepared = detail::prepareHeights(field);
+  const bool rows = detail::hasRowSpacing(field);
   for (int r = 0; r < field.height; ++r) {
-    const bool rows = detail::hasRowSpacing(field);
     const float cell_x = static_cast<float>(rows ? field.row_cell_size_x[r] : field.cell_size_x);
     const float cell_y = static_cast<float>(rows ? field.row_cell_size_y[r] : field.cell_size_y);
     for (int c = 0; c < field.width; ++c) {
