@@ -4,7 +4,6 @@
 // of its visible run.
 #include "hfvis/horizon_lists.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -41,10 +40,8 @@ Ray raySamples(const HeightField& field, const std::vector<float>& heights, cons
     const detail::Point2 p{static_cast<float>(c) + t * d.dir_x, static_cast<float>(r) + t * d.dir_y};
     if (!detail::insideField(p, field.width, field.height)) break;
     float at = static_cast<float>(i);
-    if (units) {  // as intervisibility_naive's ray_half_row
-      const float mid = static_cast<float>(i) - 0.5f;
-      const int half = static_cast<int>(std::nearbyint(2.0f * (static_cast<float>(r) + mid * step_y)));
-      const std::int32_t ring = units[std::clamp(half, 0, 2 * field.height - 2)];
+    if (units) {
+      const std::int32_t ring = detail::rayStepUnits(units, field.height, r, i, step_y);
       position += ring;
       ray.positions.push_back(position);
       ray.rings.push_back(ring);

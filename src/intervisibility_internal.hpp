@@ -4,6 +4,7 @@
 // gather), to compare a sweep line by line.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -78,6 +79,15 @@ struct NaiveRowTables {
   std::vector<float> factors;
 };
 NaiveRowTables naiveRowTables(const HeightField& field, const std::vector<SweepDirection>& rays, double unit);
+
+// The units of step i of a ray from row `row` (step_y rows a step) in its half-row table
+// `units` (height rows): the entry of the step's middle, as intervisibility_naive's
+// ray_half_row takes it, the same float operations.
+inline std::int32_t rayStepUnits(const std::int32_t* units, int height, int row, int i, float step_y) {
+  const float mid = static_cast<float>(i) - 0.5f;
+  const int half = static_cast<int>(std::nearbyint(2.0f * (static_cast<float>(row) + mid * step_y)));
+  return units[std::clamp(half, 0, 2 * height - 2)];
+}
 
 // Whole units (at least 1) of a step of (dx, dy) pixels whose middle is at row y (fractional:
 // cell sizes interpolated between rows, cellSizeAtRow).

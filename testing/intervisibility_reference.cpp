@@ -5,7 +5,6 @@
 // result matches exactly.
 #include "hfvis/intervisibility_reference.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -127,10 +126,8 @@ void naiveReference(const HeightField& field, const std::vector<float>& h,
           const Point2 p{static_cast<float>(c) + t * d.dir_x, static_cast<float>(r) + t * d.dir_y};
           if (!insideField(p, width, height)) break;
           int ring = 0, at = i;
-          if (row_spacing) {  // ray_half_row
-            const float mid = static_cast<float>(i) - 0.5f;
-            const int half = static_cast<int>(std::nearbyint(2.0f * (static_cast<float>(r) + mid * step_y)));
-            ring = units[std::clamp(half, 0, 2 * height - 2)];
+          if (row_spacing) {
+            ring = rayStepUnits(units, height, r, i, step_y);
             position += ring;
             at = position;
           }
