@@ -22,6 +22,8 @@
 // x = tan e, so only e itself needs an arctangent. The sky behind the surface (N . e < 0)
 // does not count: the horizon is at least the tangent plane's slope -toward / nz in this
 // azimuth. swath = sin(pi weight) / pi, per direction.
+// lower_limit: the slope tan(e) of that lowest elevation that counts, the horizon's or the
+// tangent plane's, for the normal's component `toward` the direction and its nz.
 #define HFVIS_DIRECTION_TERMS(T, IT)                                                                      \
   HFVIS_INLINE HFVIS_OVERLOADABLE T elevation_term(IT found, T rise, T run) {                  \
     return found ? hf_atan(rise / run) : (T)(-0.5f * HFVIS_PI_F);                                         \
@@ -29,11 +31,14 @@
   HFVIS_INLINE HFVIS_OVERLOADABLE T sky_term(IT found, T rise, T run) {                        \
     return (found & (rise > 0.0f)) ? rise / sqrt(rise * rise + run * run) : (T)0.0f;                      \
   }                                                                                                       \
+  HFVIS_INLINE HFVIS_OVERLOADABLE T lower_limit(IT found, T rise, T run, T toward, T nz) {     \
+    IT behind = !found | (rise * nz < -toward * run);                                                     \
+    return behind ? -toward / nz : rise / run;                                                            \
+  }                                                                                                       \
   HFVIS_INLINE HFVIS_OVERLOADABLE T ambient_term(                                              \
       IT found, T rise, T run, T nx, T ny, T nz, T cos_az, T sin_az, T weight, T swath) {                 \
     T toward = nx * cos_az + ny * sin_az;                                                                 \
-    IT behind = !found | (rise * nz < -toward * run);                                                     \
-    T x = behind ? -toward / nz : rise / run;                                                             \
+    T x = lower_limit(found, rise, run, toward, nz);                                                      \
     T cos2 = 1.0f / (1.0f + x * x);                                                                       \
     return nz * weight * cos2 + swath * (0.5f * HFVIS_PI_F - hf_atan(x) - x * cos2) * toward;             \
   }

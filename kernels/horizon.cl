@@ -19,6 +19,8 @@
 // Compile-time parameters, besides those of sweep_framework.cl:
 //   HFVIS_WANT_ANGLES, HFVIS_WANT_DISTANCES  write the direction's planes
 //   HFVIS_WANT_SVF, HFVIS_WANT_AO            accumulate sky-view / ambient occlusion terms
+//   HFVIS_WANT_ENV, HFVIS_ENV_CHANNELS       accumulate the irradiance from an environment's
+//                                            tables (environment.cl), of 1 or 3 channels
 //   HFVIS_CURVATURE                          lower every sample by the Earth's drop (argument
 //                                            `drop`: c times the ground length of a unit of
 //                                            position along the line or ray, squared: a pixel,
@@ -34,6 +36,7 @@
 //   HFVIS_STRIPS                             horizon_lattice resumes lines part-way (a field in
 //                                            strips of rows, see there)
 #include "direction_terms.cl"
+#include "environment.cl"
 #include "fast_math.cl"
 #include "sweep_framework.cl"
 
@@ -48,6 +51,12 @@
 #endif
 #ifndef HFVIS_WANT_AO
 #define HFVIS_WANT_AO 1
+#endif
+#ifndef HFVIS_WANT_ENV
+#define HFVIS_WANT_ENV 0
+#endif
+#ifndef HFVIS_ENV_CHANNELS
+#define HFVIS_ENV_CHANNELS 1
 #endif
 #ifndef HFVIS_CURVATURE
 #define HFVIS_CURVATURE 0
@@ -114,13 +123,15 @@ __kernel void pixel_normals(__global const float* heights, int width, int height
       surface_slopes(heights, width, height, row0, c, r, heights[(r - row0) * width + c], cell_x, cell_y);
 }
 
-// The occlusion sums of normals (x, y, 1) made those of the unit normals. Global size: pixels
-// rounded up.
-__kernel void occlusion_scale(__global const float2* normals, uint pixels, __global float* ao_sum) {
+// The sums of normals (x, y, 1) made those of the unit normals: occlusion's, or `planes` planes
+// of irradiance `stride` apart. Global size: pixels rounded up.
+__kernel void occlusion_scale(__global const float2* normals, uint pixels, int planes, uint stride,
+                              __global float* sums) {
   const uint p = get_global_id(0);
   if (p >= pixels) return;
   const float2 n = normals[p];
-  ao_sum[p] = ao_sum[p] / sqrt(n.x * n.x + n.y * n.y + 1.0f);
+  const float length = sqrt(n.x * n.x + n.y * n.y + 1.0f);
+  for (int i = 0; i < planes; ++i) sums[i * stride + p] = sums[i * stride + p] / length;
 }
 
 // Lanes (compile-time HFVIS_LANES): in the line-major (CPU) layout one work-item sweeps 8
@@ -167,14 +178,18 @@ HFVIS_DIRECTION_TERMS(lane_float, lane_int)
 // the sums. Each launch runs one direction and every pixel is written by one work-item of it,
 // so the read-modify-writes of the sums need no atomics. (cos_az, sin_az) is the direction on
 // the ground at the receiver, weight its share of the circle of azimuth there and swath
-// sin(pi weight) / pi (ambient_term).
+// sin(pi weight) / pi (ambient_term). The environment's sums (HFVIS_WANT_ENV): direction's
+// table at env_tables + env_offset of env_rows bands, channel c's sum at env_sum[c * env_stride].
+#define HFVIS_ENV_PARAMS \
+  , __global const float *env_tables, uint env_offset, int env_rows, __global float *env_sum, uint env_stride
+#define HFVIS_ENV_ARGS , env_tables, env_offset, env_rows, env_sum, env_stride
 
 // One receiver's outputs (the naive march).
 HFVIS_INLINE void emit_direction(uint pixel, int nodata, int found, float rise, float run, float distance,
                                  float cos_az, float sin_az, float weight, float swath, uint plane,
                                  __global const float2* normals,
                                  __global float* angles, __global float* distances, __global float* svf_sum,
-                                 __global float* ao_sum) {
+                                 __global float* ao_sum HFVIS_ENV_PARAMS) {
 #if HFVIS_WANT_ANGLES
   angles[plane + pixel] = nodata ? NAN : elevation_term(found, rise, run);
 #endif
@@ -189,6 +204,12 @@ HFVIS_INLINE void emit_direction(uint pixel, int nodata, int found, float rise, 
   float term = ambient_term(found, rise, run, n.x, n.y, 1.0f, cos_az, sin_az, weight, swath);
   ao_sum[pixel] = nodata ? NAN : ao_sum[pixel] + term;
 #endif
+#if HFVIS_WANT_ENV
+  const float2 m = normals[pixel];
+  const float x = lower_limit(found, rise, run, m.x * cos_az + m.y * sin_az, 1.0f);
+  environment_add(env_sum + pixel, env_stride, HFVIS_ENV_CHANNELS, nodata, x, m.x, m.y, 1.0f, cos_az, sin_az,
+                  env_tables + env_offset, env_rows);
+#endif
 }
 
 // The outputs of a lane vector of receivers (the sweep): the terms lane-parallel, the
@@ -197,7 +218,8 @@ HFVIS_INLINE void emit_lanes(lane_int live, lane_int pixel, lane_int nodata, lan
                              lane_float run, lane_float distance, lane_float cos_az, lane_float sin_az,
                              lane_float weight, lane_float swath, uint plane,
                              __global const float2* normals, __global float* angles,
-                             __global float* distances, __global float* svf_sum, __global float* ao_sum) {
+                             __global float* distances, __global float* svf_sum,
+                             __global float* ao_sum HFVIS_ENV_PARAMS) {
 #if HFVIS_WANT_ANGLES
   const lane_float elevation = select(elevation_term(found, rise, run), (lane_float)NAN, nodata);
 #pragma unroll
@@ -218,7 +240,7 @@ HFVIS_INLINE void emit_lanes(lane_int live, lane_int pixel, lane_int nodata, lan
     if (ILANE(live, l)) svf_sum[p] = ILANE(nodata, l) ? NAN : svf_sum[p] + LANE(sky, l);
   }
 #endif
-#if HFVIS_WANT_AO
+#if HFVIS_WANT_AO || HFVIS_WANT_ENV
   lane_float nx, ny;
 #pragma unroll
   for (int l = 0; l < HFVIS_LANES; ++l) {
@@ -226,6 +248,8 @@ HFVIS_INLINE void emit_lanes(lane_int live, lane_int pixel, lane_int nodata, lan
     LANE(nx, l) = n.x;
     LANE(ny, l) = n.y;
   }
+#endif
+#if HFVIS_WANT_AO
   const lane_float term =
       ambient_term(found, rise, run, nx, ny, (lane_float)1.0f, cos_az, sin_az, weight, swath);
 #pragma unroll
@@ -233,6 +257,15 @@ HFVIS_INLINE void emit_lanes(lane_int live, lane_int pixel, lane_int nodata, lan
     const uint p = (uint)ILANE(pixel, l);
     if (ILANE(live, l)) ao_sum[p] = ILANE(nodata, l) ? NAN : ao_sum[p] + LANE(term, l);
   }
+#endif
+#if HFVIS_WANT_ENV
+  const lane_float x = lower_limit(found, rise, run, nx * cos_az + ny * sin_az, (lane_float)1.0f);
+#pragma unroll
+  for (int l = 0; l < HFVIS_LANES; ++l)
+    if (ILANE(live, l))
+      environment_add(env_sum + (uint)ILANE(pixel, l), env_stride, HFVIS_ENV_CHANNELS, ILANE(nodata, l) != 0,
+                      LANE(x, l), LANE(nx, l), LANE(ny, l), 1.0f, LANE(cos_az, l), LANE(sin_az, l),
+                      env_tables + env_offset, env_rows);
 #endif
 }
 
@@ -551,7 +584,7 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
                               __global float2* window_far, __global float* receiver_base,
                               __global const float2* normals,
                               __global float* angles, __global float* distances, __global float* svf_sum,
-                              __global float* ao_sum) {
+                              __global float* ao_sum HFVIS_ENV_PARAMS) {
   const int first = get_global_id(0) * HFVIS_LANES;
   if (first >= n_lines) return;
 #if !HFVIS_STRIPS
@@ -753,7 +786,7 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 #endif
     emit_lanes(live, (r - out_row0) * width + c, nodata, has_far | has_near, select(far_rise, near, use_near),
                select(ground, period_ground_l, use_near), distance, cos_az, sin_az, weight_l, swath_l, plane,
-               normals, angles, distances, svf_sum, ao_sum);
+               normals, angles, distances, svf_sum, ao_sum HFVIS_ENV_ARGS);
   }
 #if HFVIS_STRIPS
 #pragma unroll
@@ -813,7 +846,7 @@ __kernel void horizon_naive(__global const float* heights, int width, int height
                             float cos_azimuth, float sin_azimuth, float weight, float swath, uint plane,
                             __global const float2* normals,
                             __global float* angles, __global float* distances, __global float* svf_sum,
-                            __global float* ao_sum) {
+                            __global float* ao_sum HFVIS_ENV_PARAMS) {
   int c = get_global_id(0), r = get_global_id(1);
   int valid = c < width && r < height;
   int cc = min(c, width - 1), rr = min(r, height - 1);
@@ -869,5 +902,5 @@ __kernel void horizon_naive(__global const float* heights, int width, int height
   const float distance = best_step > 0 ? ground : 0.0f;
   if (valid)
     emit_direction(pixel, isnan(h), best_step > 0, best_rise, ground, distance, cos_az, sin_az, weight_r,
-                   swath_r, plane, normals, angles, distances, svf_sum, ao_sum);
+                   swath_r, plane, normals, angles, distances, svf_sum, ao_sum HFVIS_ENV_ARGS);
 }

@@ -9,6 +9,7 @@
 #include <limits>
 #include <sstream>
 
+#include "environment_swaths.hpp"
 #include "fast_math.hpp"
 #include "hfvis/errors.hpp"
 #include "horizon_common.hpp"
@@ -36,7 +37,9 @@ std::string programOptions(const HorizonOutputs& outputs, bool has_nodata, int l
     << " -DHFVIS_MAX_DISTANCE=" << max_distance << " -DHFVIS_ROW_SPACING=" << row_spacing
     << " -DHFVIS_WANT_ANGLES=" << outputs.horizon_angles
     << " -DHFVIS_WANT_DISTANCES=" << outputs.horizon_distances
-    << " -DHFVIS_WANT_SVF=" << outputs.sky_view_factor << " -DHFVIS_WANT_AO=" << outputs.ambient_occlusion;
+    << " -DHFVIS_WANT_SVF=" << outputs.sky_view_factor << " -DHFVIS_WANT_AO=" << outputs.ambient_occlusion
+    << " -DHFVIS_WANT_ENV=" << (outputs.environment != nullptr)
+    << " -DHFVIS_ENV_CHANNELS=" << (outputs.environment ? outputs.environment->channels : 1);
   return s.str();
 }
 
@@ -51,7 +54,19 @@ struct RunDirection {
   int max_steps = kAllSteps;                     // naive march: the steps within the maximum distance
   // Per-row spacing: ground length and terms by row (latticeRowTables, rayRowTables).
   std::vector<float> row_length, row_terms;
+  int index = 0;  // k
 };
+
+// Planes per pixel an environment's sums take (one per channel), and the bytes of its map and of
+// the tables of `directions` directions.
+std::size_t environmentPlanes(const HorizonOutputs& outputs) {
+  return outputs.environment ? outputs.environment->channels : 0;
+}
+std::size_t environmentBytes(const HorizonOutputs& outputs, std::size_t directions) {
+  if (!outputs.environment) return 0;
+  const EnvironmentMap& map = *outputs.environment;
+  return (map.radiance.size() + directions * tableRows(map) * map.channels * kEnvTerms) * sizeof(float);
+}
 
 // How a run uses its device memory budget: directions per downloaded batch of planes, the
 // hull-stack scratch (entries) every launch of the sweep shares, and the strips.
@@ -91,9 +106,12 @@ RunPlan planStrips(const HeightField& field, const HorizonOptions& options, cons
   // Per row of a strip: heights, the sums, the normals' two slopes, one direction's planes, the
   // window's float2 (and with per-row spacing the receivers' positions, which also take the
   // halo's rows).
-  const std::size_t per_row = row * (1 + outputs.sky_view_factor + outputs.ambient_occlusion * 3 +
-                                     outputs.horizon_angles + outputs.horizon_distances + window * 2 + positions);
-  const std::size_t halo = 2 * halo_rows * row * (1 + positions);
+  const std::size_t per_row =
+      row * (1 + outputs.sky_view_factor + (outputs.ambient_occlusion || outputs.environment) * 2 +
+             outputs.ambient_occlusion + environmentPlanes(outputs) + outputs.horizon_angles +
+             outputs.horizon_distances + window * 2 + positions);
+  // The halo's rows, and the environment's map and tables.
+  const std::size_t halo = 2 * halo_rows * row * (1 + positions) + environmentBytes(outputs, directions.size());
   std::size_t rows = budget / 2 > halo ? (budget / 2 - halo) / per_row : 0;
   // The largest buffers: a strip's heights with its halo, and its normals.
   rows = std::min({rows, max_alloc / row > 2 * halo_rows ? max_alloc / row - 2 * halo_rows : 0,
@@ -127,8 +145,11 @@ RunPlan planRun(const HeightField& field, const HorizonOptions& options, const H
   // Heights, the sums, the normals' two slopes, the window's float2 per pixel (and with per-row
   // spacing the receivers' positions).
   const bool window = sweep && options.max_distance > 0.0;
-  const std::size_t fixed = plane * (1 + outputs.sky_view_factor + outputs.ambient_occlusion * 3 + window * 2 +
-                                     (window && hasRowSpacing(field)));
+  const std::size_t fixed =
+      plane * (1 + outputs.sky_view_factor + (outputs.ambient_occlusion || outputs.environment) * 2 +
+               outputs.ambient_occlusion + environmentPlanes(outputs) + window * 2 +
+               (window && hasRowSpacing(field))) +
+      environmentBytes(outputs, directions.size());
   const std::size_t per_direction = plane * (outputs.horizon_angles + outputs.horizon_distances);
   // Scratch: all of a direction's stacks in one launch when it fits; one line at a time at least.
   std::size_t whole = 0, longest = 0;
@@ -184,7 +205,8 @@ std::vector<RunDirection> runDirectionsOf(const HeightField& field, const Horizo
       const LatticeDirection& d = directions[k];
       out.push_back({d, SweepDirection{}, latticeSamples(d, options.samples_per_unit),
                      static_cast<float>(std::cos(d.azimuth)), static_cast<float>(std::sin(d.azimuth)),
-                     latticeLines(d, field.width, field.height), latticeWindow(field, d, options.max_distance)});
+                     latticeLines(d, field.width, field.height), latticeWindow(field, d, options.max_distance),
+                     kAllSteps, {}, {}, static_cast<int>(k)});
       if (!rows.empty()) {
         out.back().row_length = std::move(rows[k].length);
         out.back().row_terms = std::move(rows[k].terms);
@@ -197,6 +219,7 @@ std::vector<RunDirection> runDirectionsOf(const HeightField& field, const Horizo
     for (int k = 0; k < options.directions; ++k) {
       const SweepDirection& d = rays[k];
       RunDirection r;
+      r.index = k;
       r.ray = d;
       r.lattice.azimuth = directionAzimuth(k, options);
       r.lattice.weight = 1.0 / options.directions;
@@ -247,6 +270,8 @@ class HorizonRoutine : public SweepRoutine {
            " -DHFVIS_STRIPS=" + std::to_string(inStrips());
   }
   bool heightsResident() const override { return !inStrips(); }
+  bool needsNormals() const { return outputs_.ambient_occlusion || outputs_.environment; }
+  int environmentChannels() const { return outputs_.environment ? outputs_.environment->channels : 0; }
   bool inStrips() const { return plan_.strip_rows < field_.height; }
 
   void allocate() override {
@@ -259,7 +284,9 @@ class HorizonRoutine : public SweepRoutine {
     distances_ = st_.reusableBuffer("horizon distances", outputs_.horizon_distances ? planes_bytes : 0);
     svf_ = zeros(outputs_.sky_view_factor ? plane : 0);
     ao_ = zeros(outputs_.ambient_occlusion ? plane : 0);
-    normals_ = deviceBuffer(st_, outputs_.ambient_occlusion ? 2 * plane * sizeof(float) : 0);
+    env_sum_ = zeros(environmentChannels() * plane);
+    normals_ = deviceBuffer(st_, needsNormals() ? 2 * plane * sizeof(float) : 0);
+    env_tables_ = environmentTables();
     stacks_ = st_.reusableBuffer("lattice stacks", plan_.stack_entries * kStackEntryBytes);
     const bool window = horizon_.method == HorizonMethod::Sweep && horizon_.max_distance > 0.0;
     window_far_ = deviceBuffer(st_, window ? 2 * plane * sizeof(float) : 0);
@@ -276,9 +303,45 @@ class HorizonRoutine : public SweepRoutine {
       heights_ = deviceBuffer(
           st_, std::min<std::size_t>(plan_.strip_rows + 2 * plan_.halo_rows, field_.height) * field_.width *
                    sizeof(float));
-    } else if (outputs_.ambient_occlusion) {
+    } else if (needsNormals()) {
       computeNormals(0, 0, field_.height);
     }
+  }
+
+  // Every direction's table of the environment (environment_tables), in one buffer: direction
+  // k's from k * envTableFloats() on. A placeholder without an environment.
+  cl::Buffer environmentTables() {
+    if (!outputs_.environment) return deviceBuffer(st_, 0);
+    const EnvironmentMap& map = *outputs_.environment;
+    std::vector<LatticeDirection> directions;
+    for (const RunDirection& d : directions_) directions.push_back(d.lattice);
+    const EnvironmentSwaths swaths = environmentSwaths(map, directions);
+    auto upload = [&](const void* data, std::size_t bytes) {
+      return cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes, const_cast<void*>(data));
+    };
+    const cl::Buffer env = upload(map.radiance.data(), map.radiance.size() * sizeof(float));
+    const cl::Buffer bins = upload(swaths.bins.data(), swaths.bins.size() * sizeof(swaths.bins[0]));
+    const cl::Buffer spans = upload(swaths.spans.data(), swaths.spans.size() * sizeof(swaths.spans[0]));
+    cl::Buffer tables = deviceBuffer(st_, directions_.size() * envTableFloats() * sizeof(float));
+    cl::Kernel kernel(program_, "environment_tables");
+    kernel.setArg(0, env);
+    kernel.setArg(1, map.width);
+    kernel.setArg(2, map.height);
+    kernel.setArg(3, map.channels);
+    kernel.setArg(4, tableRows(map));
+    kernel.setArg(5, static_cast<int>(directions_.size()));
+    kernel.setArg(6, bins);
+    kernel.setArg(7, spans);
+    kernel.setArg(8, tables);
+    st_.launch(kernel, cl::NDRange(roundUp(directions_.size(), kLineGroup)), cl::NDRange(kLineGroup));
+    st_.queue.finish();  // before the map, bins and spans go
+    return tables;
+  }
+
+  // Floats of one direction's table.
+  std::size_t envTableFloats() const {
+    return outputs_.environment ? std::size_t(tableRows(*outputs_.environment)) * outputs_.environment->channels * kEnvTerms
+                                : 0;
   }
 
   int directionCount() const override { return horizon_.directions; }
@@ -309,35 +372,61 @@ class HorizonRoutine : public SweepRoutine {
 
   void finish() override {
     if (inStrips()) {
-      // The sums are on the host; occlusion's last pass runs strip by strip.
-      if (outputs_.ambient_occlusion) {
+      // The sums are on the host; the last pass of occlusion and irradiance runs strip by strip.
+      if (needsNormals()) {
         for (int s0 = 0; s0 < field_.height; s0 += plan_.strip_rows) {
           const int s1 = std::min(field_.height, s0 + plan_.strip_rows);
           loadStrip(s0, s1);
-          scaleOcclusion(s1 - s0);
-          readRows(ao_, result_.ambient_occlusion, s0, s1);
+          scaleByNormals(s1 - s0);
+          if (outputs_.ambient_occlusion) readRows(ao_, result_.ambient_occlusion, s0, s1);
+          readEnvironmentRows(s0, s1);
         }
       }
     } else {
       const std::size_t bytes = field_.pixelCount() * sizeof(float);
       if (outputs_.sky_view_factor)
         st_.queue.enqueueReadBuffer(svf_, CL_TRUE, 0, bytes, result_.sky_view_factor.data());
-      if (outputs_.ambient_occlusion) {
-        scaleOcclusion(field_.height);
+      if (needsNormals()) scaleByNormals(field_.height);
+      if (outputs_.ambient_occlusion)
         st_.queue.enqueueReadBuffer(ao_, CL_TRUE, 0, bytes, result_.ambient_occlusion.data());
-      }
+      if (outputs_.environment)
+        st_.queue.enqueueReadBuffer(env_sum_, CL_TRUE, 0, environmentChannels() * bytes, result_.irradiance.data());
     }
     finishReduction(result_);
   }
 
-  // The occlusion sums of the rows on the device made those of unit normals (occlusion_scale).
-  void scaleOcclusion(int rows) {
+  // The occlusion and irradiance sums of the rows on the device made those of unit normals
+  // (occlusion_scale).
+  void scaleByNormals(int rows) {
     const std::size_t pixels = static_cast<std::size_t>(rows) * field_.width;
-    cl::Kernel scale(program_, "occlusion_scale");
-    scale.setArg(0, normals_);
-    scale.setArg(1, static_cast<cl_uint>(pixels));
-    scale.setArg(2, ao_);
-    st_.launch(scale, cl::NDRange(roundUp(pixels, kLineGroup)), cl::NDRange(kLineGroup));
+    auto scale = [&](const cl::Buffer& sums, int planes) {
+      cl::Kernel kernel(program_, "occlusion_scale");
+      kernel.setArg(0, normals_);
+      kernel.setArg(1, static_cast<cl_uint>(pixels));
+      kernel.setArg(2, planes);
+      kernel.setArg(3, sumStride());
+      kernel.setArg(4, sums);
+      st_.launch(kernel, cl::NDRange(roundUp(pixels, kLineGroup)), cl::NDRange(kLineGroup));
+    };
+    if (outputs_.ambient_occlusion) scale(ao_, 1);
+    if (outputs_.environment) scale(env_sum_, environmentChannels());
+  }
+
+  // Between the planes of the environment's sums on the device: a strip's pixels (the field's
+  // in one piece).
+  cl_uint sumStride() const { return static_cast<cl_uint>(static_cast<std::size_t>(plan_.strip_rows) * field_.width); }
+
+  // Strips: the irradiance sums of rows [s0, s1) from the device (or to it, `upload`).
+  void readEnvironmentRows(int s0, int s1, bool upload = false) {
+    const std::size_t width = field_.width, bytes = (s1 - s0) * width * sizeof(float);
+    for (int c = 0; c < environmentChannels(); ++c) {
+      float* host = &result_.irradiance[c * field_.pixelCount() + s0 * width];
+      const std::size_t at = c * sumStride() * sizeof(float);
+      if (upload)
+        st_.queue.enqueueWriteBuffer(env_sum_, CL_FALSE, at, bytes, host);
+      else
+        st_.queue.enqueueReadBuffer(env_sum_, CL_TRUE, at, bytes, host);
+    }
   }
 
   // The normals of rows [s0, s1) from heights_, which holds the field's rows from row0 on.
@@ -370,10 +459,10 @@ class HorizonRoutine : public SweepRoutine {
     const std::size_t bytes = (s1 - s0) * width * sizeof(float);
     if (outputs_.sky_view_factor)
       st_.queue.enqueueWriteBuffer(svf_, CL_FALSE, 0, bytes, &result_.sky_view_factor[s0 * width]);
-    if (outputs_.ambient_occlusion) {
+    if (outputs_.ambient_occlusion)
       st_.queue.enqueueWriteBuffer(ao_, CL_FALSE, 0, bytes, &result_.ambient_occlusion[s0 * width]);
-      computeNormals(row0, s0, s1);
-    }
+    readEnvironmentRows(s0, s1, true);
+    if (needsNormals()) computeNormals(row0, s0, s1);
     return row0;
   }
 
@@ -439,6 +528,11 @@ class HorizonRoutine : public SweepRoutine {
     kernel.setArg(arg++, distances_);
     kernel.setArg(arg++, svf_);
     kernel.setArg(arg++, ao_);
+    kernel.setArg(arg++, env_tables_);
+    kernel.setArg(arg++, static_cast<cl_uint>(d.index * envTableFloats()));
+    kernel.setArg(arg++, outputs_.environment ? tableRows(*outputs_.environment) : 0);
+    kernel.setArg(arg++, env_sum_);
+    kernel.setArg(arg++, sumStride());
   }
 
   // horizon_lattice's arguments where the chunks (and strips) differ.
@@ -622,6 +716,7 @@ class HorizonRoutine : public SweepRoutine {
       if (outputs_.horizon_distances) readRows(distances_, result_.distances, s0, s1, k * plane);
       if (outputs_.sky_view_factor) readRows(svf_, result_.sky_view_factor, s0, s1);
       if (outputs_.ambient_occlusion) readRows(ao_, result_.ambient_occlusion, s0, s1);
+      readEnvironmentRows(s0, s1);
       if (!receiver_positions_.empty()) {  // the strip's receivers' positions, for the strips after
         const std::size_t width = field_.width;
         st_.queue.enqueueReadBuffer(receiver_base_, CL_TRUE, (s0 - row0) * width * sizeof(float),
@@ -677,7 +772,7 @@ class HorizonRoutine : public SweepRoutine {
   HorizonResult result_;
   std::vector<float> receiver_positions_;  // strips, per-row spacing and a maximum distance: receiver_base's
   cl::Buffer angles_, distances_, svf_, ao_, normals_, stacks_, window_far_, receiver_base_, row_cells_,
-      placeholder_;
+      placeholder_, env_sum_, env_tables_;
 };
 
 }  // namespace
@@ -688,6 +783,10 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
   validate(field);
   validate(options, outputs);
   detail::checkPixelIndexing(field, 1);
+  if (outputs.environment && detail::hasRowSpacing(field))
+    throw InvalidArgument(
+        "environment lighting takes a field of one cell size: this latitude / longitude grid's spacing differs "
+        "by row (reproject it, or give the cell size)");
   return detail::translateOpenClErrors([&] {
     // Hull stacks too deep for the room strips leave: again from the start with thinner strips
     // (StacksBeyondStrips::rows), as the sums of the strips done cannot be taken back.

@@ -16,7 +16,7 @@ void validate(const HorizonOptions& options, const HorizonOutputs& outputs) {
                           std::to_string(options.azimuth_tolerance * 180.0 / M_PI) + " degrees)");
   }
   if (!outputs.horizon_angles && !outputs.horizon_distances && !outputs.sky_view_factor &&
-      !outputs.ambient_occlusion) {
+      !outputs.ambient_occlusion && !outputs.environment) {
     throw InvalidArgument("no output requested");
   }
   if (options.strip_rows < 0)
@@ -24,6 +24,7 @@ void validate(const HorizonOptions& options, const HorizonOutputs& outputs) {
                           std::to_string(options.strip_rows) + ")");
   if (options.strip_rows > 0 && options.method == HorizonMethod::Naive)
     throw InvalidArgument("the naive method does not run in strips (each ray reads the whole field)");
+  if (outputs.environment) validate(*outputs.environment);
 }
 
 namespace detail {
@@ -94,6 +95,7 @@ HorizonResult allocateResult(const HeightField& field, const HorizonOptions& opt
   if (outputs.horizon_distances) result.distances.assign(plane * options.directions, nan);
   if (outputs.sky_view_factor) result.sky_view_factor.assign(plane, 0.0f);
   if (outputs.ambient_occlusion) result.ambient_occlusion.assign(plane, 0.0f);
+  if (outputs.environment) result.irradiance.assign(plane * outputs.environment->channels, 0.0f);
   return result;
 }
 

@@ -7,6 +7,8 @@
 #include <limits>
 
 #include "direction_terms.hpp"
+#include "environment_swaths.hpp"
+#include "environment_terms.hpp"
 #include "fast_math.hpp"
 #include "hfvis/reference.hpp"
 #include "horizon_common.hpp"
@@ -60,11 +62,62 @@ std::vector<Slopes> pixelNormals(const HeightField& field, const std::vector<flo
   return normals;
 }
 
+// The environment's tables (environment_tables in kernels/environment.cl) computed here on
+// their own, in double: per direction, band and channel (KA, LA, KB, LB, KC, LC).
+std::vector<float> environmentTables(const EnvironmentMap& map, const std::vector<LatticeDirection>& directions) {
+  const EnvironmentSwaths swaths = environmentSwaths(map, directions);
+  const int rows = tableRows(map), C = map.channels, W = map.width, H = map.height;
+  const double column = 2.0 * M_PI / W;
+  std::vector<float> tables;
+  for (std::size_t k = 0; k < directions.size(); ++k) {
+    std::vector<double> cum(3 * C, 0.0);
+    for (int i = 0; i < rows; ++i) {
+      const double t0 = i * M_PI / rows, t1 = (i + 1) * M_PI / rows;
+      std::vector<double> s(3 * C, 0.0);  // the band's (A, B, C) radiance integrals over azimuth
+      for (int j = 0; j < H; ++j) {
+        const double a = std::max(t0, j * M_PI / H), b = std::min(t1, (j + 1) * M_PI / H);
+        if (!(b > a)) continue;
+        const double share = (std::cos(a) - std::cos(b)) / (std::cos(t0) - std::cos(t1));
+        const auto [first, count] = swaths.spans[k];
+        for (int q = first; q < first + count; ++q) {
+          const auto& bin = swaths.bins[q];
+          for (int col = 0; col < W; ++col) {  // every column, each at its turns around the bin
+            for (int turn = -2; turn <= 2; ++turn) {
+              const double left = bin[2] + (col - bin[3] + turn * W) * column;
+              const double lo = std::max<double>(left, bin[0]), hi = std::min<double>(left + column, bin[1]);
+              if (!(hi > lo)) continue;
+              for (int c = 0; c < C; ++c) {
+                const double L = share * map.radiance[(static_cast<std::size_t>(c) * H + j) * W + col];
+                s[3 * c] += L * (hi - lo);
+                s[3 * c + 1] += L * (std::sin(hi) - std::sin(lo));
+                s[3 * c + 2] += L * (std::cos(lo) - std::cos(hi));
+              }
+            }
+          }
+        }
+      }
+      auto q1 = [](double t) { return 0.5 * std::sin(t) * std::sin(t); };
+      auto q2 = [](double t) { return 0.5 * (t - std::sin(t) * std::cos(t)); };
+      for (int c = 0; c < C; ++c) {
+        const double sa = s[3 * c], sb = s[3 * c + 1], sc = s[3 * c + 2];
+        for (double v : {cum[3 * c] - sa * q1(t0), sa, cum[3 * c + 1] - sb * q2(t0), sb, cum[3 * c + 2] - sc * q2(t0), sc})
+          tables.push_back(static_cast<float>(v));
+        cum[3 * c] += sa * (q1(t1) - q1(t0));
+        cum[3 * c + 1] += sb * (q2(t1) - q2(t0));
+        cum[3 * c + 2] += sc * (q2(t1) - q2(t0));
+      }
+    }
+  }
+  return tables;
+}
+
 // What one direction contributes at one receiver, as emit_direction / emit_lanes in the kernel.
 struct DirectionOutputs {
   float cos_azimuth, sin_azimuth, weight;
   int k;  // the direction's plane
   float swath() const { return swathFactor(weight); }
+  const float* environment = nullptr;  // the direction's table, if the environment is asked for
+  int table_rows = 0, channels = 0;
 };
 
 void emitDirection(HorizonResult& result, std::size_t pixel, bool nodata, bool found, float rise, float run,
@@ -85,6 +138,12 @@ void emitDirection(HorizonResult& result, std::size_t pixel, bool nodata, bool f
         ambient_term(found, rise, run, n.x, n.y, 1.0f, o.cos_azimuth, o.sin_azimuth, o.weight, o.swath());
     sum = nodata ? kNaN : sum + term;
   }
+  if (o.environment) {
+    const Slopes& n = normals[pixel];
+    const float x = lower_limit(found, rise, run, n.x * o.cos_azimuth + n.y * o.sin_azimuth, 1.0f);
+    environment_add(&result.irradiance[pixel], static_cast<unsigned int>(plane), o.channels, nodata, x, n.x, n.y,
+                    1.0f, o.cos_azimuth, o.sin_azimuth, o.environment, o.table_rows);
+  }
 }
 
 // occlusion_scale in the kernel: the sums of normals (x, y, 1) made those of unit normals.
@@ -93,6 +152,19 @@ void scaleOcclusion(HorizonResult& result, const std::vector<Slopes>& normals) {
     const Slopes& n = normals[p];
     result.ambient_occlusion[p] = result.ambient_occlusion[p] / std::sqrt(n.x * n.x + n.y * n.y + 1.0f);
   }
+  for (std::size_t i = 0; i < result.irradiance.size(); ++i) {
+    const Slopes& n = normals[i % normals.size()];
+    result.irradiance[i] = result.irradiance[i] / std::sqrt(n.x * n.x + n.y * n.y + 1.0f);
+  }
+}
+
+// The direction's outputs with its environment table, from `tables` (environmentTables).
+DirectionOutputs withEnvironment(DirectionOutputs out, const HorizonOutputs& outputs, const std::vector<float>& tables) {
+  if (!outputs.environment) return out;
+  out.table_rows = tableRows(*outputs.environment);
+  out.channels = outputs.environment->channels;
+  out.environment = tables.data() + static_cast<std::size_t>(out.k) * out.table_rows * out.channels * kEnvTerms;
+  return out;
 }
 
 DirectionOutputs outputsOf(const LatticeDirection& d, int k) {
@@ -131,8 +203,10 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
                     const HorizonOutputs& outputs, HorizonResult& result) {
   const int width = field.width, height = field.height;
   const auto& h = prepared.heights;
-  const auto normals = pixelNormals(field, h, outputs.ambient_occlusion);
+  const auto normals = pixelNormals(field, h, outputs.ambient_occlusion || outputs.environment);
   const auto directions = horizonDirections(field, options, outputs);
+  const std::vector<float> env_tables =
+      outputs.environment ? environmentTables(*outputs.environment, directions) : std::vector<float>{};
   // Positions in pixels of the direction's ground length, or (per-row spacing) ground units.
   const bool rows = hasRowSpacing(field);
   const std::vector<RowTable> tables =
@@ -140,7 +214,7 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
   for (int k = 0; k < options.directions; ++k) {
     const LatticeDirection& d = directions[k];
     if (d.weight == 0.0 && result.angles.empty() && result.distances.empty()) continue;  // merged step
-    DirectionOutputs out = outputsOf(d, k);
+    DirectionOutputs out = withEnvironment(outputsOf(d, k), outputs, env_tables);
     const auto samples = latticeSamples(d, options.samples_per_unit);
     const double unit = rows ? 1.0 : d.ground_per_pixel;
     const RowTable* table = rows ? &tables[k] : nullptr;
@@ -183,13 +257,21 @@ void naiveReference(const HeightField& field, const PreparedHeights& prepared, c
                     const HorizonOutputs& outputs, HorizonResult& result) {
   const int width = field.width, height = field.height;
   const auto& h = prepared.heights;
-  const auto normals = pixelNormals(field, h, outputs.ambient_occlusion);
+  const auto normals = pixelNormals(field, h, outputs.ambient_occlusion || outputs.environment);
   const auto directions = runDirections(field, options);
+  std::vector<LatticeDirection> env_directions(options.directions);
+  for (int k = 0; k < options.directions; ++k) {
+    env_directions[k].azimuth = directionAzimuth(k, options);
+    env_directions[k].weight = 1.0 / options.directions;
+  }
+  const std::vector<float> env_tables =
+      outputs.environment ? environmentTables(*outputs.environment, env_directions) : std::vector<float>{};
   const std::vector<RowTable> tables =
       hasRowSpacing(field) ? rayRowTables(field, directions) : std::vector<RowTable>(1);
   for (int k = 0; k < options.directions; ++k) {
     const SweepDirection& d = directions[k];
-    DirectionOutputs out{d.cos_azimuth, d.sin_azimuth, static_cast<float>(1.0 / options.directions), k};
+    DirectionOutputs out = withEnvironment(
+        {d.cos_azimuth, d.sin_azimuth, static_cast<float>(1.0 / options.directions), k}, outputs, env_tables);
     // Per-row spacing: the ray's ground length summed step by step (horizon_naive's row_ground_at).
     const bool rows = hasRowSpacing(field);
     const RowTable& table = tables[rows ? k : 0];

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "hfvis/device.hpp"
+#include "hfvis/environment.hpp"
 #include "hfvis/height_field.hpp"
 #include "hfvis/sweep_options.hpp"
 
@@ -46,6 +47,9 @@ struct HorizonOutputs {
   bool sky_view_factor = false;    // 1 - sum_k w_k sin(max(0, elevation_k)), w_k the directions' weights
   bool ambient_occlusion = false;  // Eq. 5 of Timonen & Westerholm 2010, uniform sky of
                                    // radiance 1, normalised so a flat plane gives 1
+  // The irradiance from this environment (hfvis/environment.hpp), one plane per channel; null:
+  // none. The map must outlive the call. Not on latitude / longitude grids (per-row spacing).
+  const EnvironmentMap* environment = nullptr;
 };
 
 struct HorizonResult {
@@ -58,6 +62,7 @@ struct HorizonResult {
                                          // surface's own slope at the receiver is the horizon
   std::vector<float> sky_view_factor;    // width*height, if asked
   std::vector<float> ambient_occlusion;  // width*height, if asked
+  std::vector<float> irradiance;         // the environment's channels' planes of width*height, if asked
 };
 
 // Throws InvalidArgument for bad sweep options (see sweep_options.hpp) or when no output

@@ -1,0 +1,63 @@
+// hfvis/environment.hpp: distant HDR light environments, and the irradiance they give a
+// height field through its horizons (Timonen & Westerholm 2010, Sec. 6.2).
+//
+// An environment is an equirectangular (latitude / longitude) image: row 0 at the zenith, the
+// last row at the nadir, each row a band of equal zenith angle pi / height; the columns span the
+// full circle of azimuth, the column at fraction u of the width (0 at the left edge, 1 at the
+// right) looking toward compass azimuth 360 u + rotation_deg degrees, clockwise from north: the
+// left edge north, a quarter of the way east, the middle south, three quarters west. Over a
+// field whose row 0 is north (hfvis azimuth = compass azimuth - 90 degrees) that is hfvis
+// azimuth 2 pi u + rotation - pi / 2. Radiance is constant over each pixel of the map.
+//
+// The irradiance at a point with unit normal N is E = integral of L(w) max(0, N . w) over the
+// directions w above its horizons: pi on open flat ground under a uniform environment of
+// radiance 1 (and pi times the ambient occlusion of hfvis/horizon.hpp everywhere).
+//
+// How it is evaluated: per azimuthal direction k of the sweep (its swath of azimuth), N . w is
+// N_z cos(theta) + sin(theta) (t cos(d) + p sin(d)) with theta the zenith angle, d the azimuth
+// from the direction's own, and t, p the normal's components along the direction and across
+// it. Eq. 7's table L_p(theta_n, theta_h) is then linear in (N_z, t, p): the swath's integral
+// from the zenith down to a lower limit theta_h is N_z A_k(theta_h) + t B_k(theta_h) +
+// p C_k(theta_h), with A, B, C integrals of the environment over the swath (exactly, column by
+// column) and over zenith angle, weighted by cos(theta) sin(theta) and sin^2(theta). So the
+// table needs no normal-angle axis: where the paper interpolates between normal angles, hfvis
+// is exact for every normal, and the lower limit is the horizon or the tangent plane's cut
+// (N . w = 0 in the direction's azimuth), whichever is higher, as for ambient occlusion. The
+// tables have one entry per band of zenith angle (table_rows bands); within a band the
+// radiance is the band's mean, and the zenith integral is exact, so with the map's own rows
+// (the default) the only approximation is the sweep's: the horizon is taken as constant over
+// each swath, and the tangent plane's cut at the direction's azimuth.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace hfvis {
+
+struct EnvironmentMap {
+  int width = 0;     // 2 * height
+  int height = 0;    // zenith to nadir
+  int channels = 0;  // 1 (Y) or 3 (R, G, B)
+  // Radiance, planar: channel c's row-major plane at c * width * height; finite and >= 0.
+  std::vector<float> radiance;
+  std::vector<std::string> names;  // the channels' names: {"Y"} or {"R", "G", "B"}
+  double rotation_deg = 0.0;       // compass degrees added to every column's azimuth
+  // Bands of zenith angle in the tables, each the mean of the map's rows it spans, weighted by
+  // solid angle; 0 = the map's own rows. 1 .. 65536.
+  int table_rows = 0;
+};
+
+// Throws InvalidArgument for a map that is not width = 2 * height > 0, not 1 or 3 channels with
+// as many names, the wrong number of values, a negative or non-finite radiance (naming the first
+// such pixel), a non-finite rotation or a table_rows outside 0 .. 65536.
+void validate(const EnvironmentMap& map);
+
+// Reads an environment through OpenImageIO (EXR, HDR, ...): one channel, or R, G, B (an alpha
+// channel A beside them is ignored). Throws IoError naming the file for what readImage refuses,
+// for a map with other channels, and for what validate refuses.
+EnvironmentMap readEnvironmentMap(const std::string& path);
+
+// A uniform environment of `radiance` in one channel, `height` rows (tests and tools).
+EnvironmentMap uniformEnvironment(float radiance, int height = 8);
+
+}  // namespace hfvis
