@@ -9,13 +9,15 @@
 #include <limits>
 
 #include "hfvis/errors.hpp"
+#include "hfvis/shading.hpp"
 #include "hfvis/sun.hpp"
 
 namespace hfvis::cli {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr const char* kCommandList = "horizon, svf, ao, viewcount, horizons, bounce, shade, sunpos or devices";
+constexpr const char* kCommandList =
+    "horizon, svf, ao, viewcount, horizons, bounce, shade, insolation, sunpos or devices";
 
 // One option of the compute commands (horizon, svf, ao, viewcount, horizons, bounce).
 enum class Option {
@@ -45,6 +47,16 @@ enum class Option {
   SunSize,
   Latitude,
   Longitude,
+  Environment,
+  EnvironmentRotation,
+  EnvironmentRows,
+  Albedo,
+  SunIrradiance,
+  From,
+  To,
+  Step,
+  AzimuthBucket,
+  Apparent,
 };
 
 struct OptionSpec {
@@ -81,6 +93,16 @@ constexpr OptionSpec kOptions[] = {
     {Option::SunSize, "--sun-size", nullptr, true},
     {Option::Latitude, "--lat", nullptr, true},
     {Option::Longitude, "--lon", nullptr, true},
+    {Option::Environment, "--env", nullptr, true},
+    {Option::EnvironmentRotation, "--env-rotate", nullptr, true},
+    {Option::EnvironmentRows, "--env-rows", nullptr, true},
+    {Option::Albedo, "--albedo", nullptr, true},
+    {Option::SunIrradiance, "--sun-irradiance", nullptr, true},
+    {Option::From, "--from", nullptr, true},
+    {Option::To, "--to", nullptr, true},
+    {Option::Step, "--step", nullptr, true},
+    {Option::AzimuthBucket, "--azimuth-bucket", nullptr, true},
+    {Option::Apparent, "--apparent", nullptr, false},
 };
 
 // The options every sweep operation shares, as typed (degrees become radians).
@@ -106,6 +128,7 @@ std::optional<Command> findCommand(const std::string& name) {
   if (name == "devices") return Command::Devices;
   if (name == "sunpos") return Command::SunPosition;
   if (name == "shade") return Command::Shade;
+  if (name == "insolation") return Command::Insolation;
   if (name == "help") return Command::Help;
   return std::nullopt;
 }
@@ -224,10 +247,18 @@ const char* onlyFor(Option option) {
     case Option::Statistics:
       return "viewcount";
     case Option::Sun:
-    case Option::SunSize:
-    case Option::Latitude:
-    case Option::Longitude:
+    case Option::Environment:
+    case Option::EnvironmentRotation:
+    case Option::EnvironmentRows:
+    case Option::Albedo:
+    case Option::SunIrradiance:
       return "shade";
+    case Option::From:
+    case Option::To:
+    case Option::Step:
+    case Option::AzimuthBucket:
+    case Option::Apparent:
+      return "insolation";
     case Option::Radiance:
       return "bounce";
     default:
@@ -240,9 +271,13 @@ const char* onlyFor(Option option) {
 bool notFor(Option option, Command command) {
   // --at: receivers for the horizon lists, the sun's time for shade.
   if (option == Option::At) return command != Command::HorizonLists && command != Command::Shade;
-  // shade sweeps the sun's azimuth alone, by the sweep.
-  if (command == Command::Shade)
-    return option == Option::Directions || option == Option::Method || option == Option::AzimuthOffset;
+  // The sun's place and size: shade and insolation.
+  if (option == Option::Latitude || option == Option::Longitude || option == Option::SunSize)
+    return command != Command::Shade && command != Command::Insolation;
+  // insolation sweeps the sun's azimuths alone, by the sweep; shade takes directions for --env.
+  if (command == Command::Insolation)
+    return option == Option::Directions || option == Option::Method || option == Option::AzimuthOffset ||
+           option == Option::MaxDistance;
   if (command == Command::HorizonLists) {
     return option == Option::Method || option == Option::Device || option == Option::MemoryBudget ||
            option == Option::Preview || option == Option::MaxDistance || option == Option::Nodata;
@@ -295,8 +330,10 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
       break;
     case Option::Directions:
       run.directions = parseDirectionCount(typed, value);
+      run.sweep_options_given = true;
       break;
     case Option::Method:
+      run.sweep_options_given = true;
       if (command == Command::ViewCount) {
         run.visibility_method = parseVisibilityMethod(typed, value);
       } else {
@@ -305,6 +342,7 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
       break;
     case Option::AzimuthOffset:
       run.azimuth_offset_deg = parseNumber(typed, value);
+      run.sweep_options_given = true;
       break;
     case Option::SamplesPerUnit:
       run.samples_per_unit = parsePositive(typed, value);
@@ -393,6 +431,49 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
       requireNonEmpty(typed, value);
       run.radiance = value;
       break;
+    case Option::Environment:
+      requireNonEmpty(typed, value);
+      run.environment = value;
+      break;
+    case Option::EnvironmentRotation:
+      run.environment_rotation_deg = parseNumber(typed, value);
+      break;
+    case Option::EnvironmentRows: {
+      const double rows = parsePositive(typed, value);
+      if (rows != std::floor(rows) || rows > 65536)
+        throw UsageError(typed + ": expected a whole number of bands in 1 .. 65536, got " + inQuotes(value));
+      run.environment_rows = static_cast<int>(rows);
+      break;
+    }
+    case Option::Albedo:
+      requireNonEmpty(typed, value);
+      run.albedo = value;
+      break;
+    case Option::SunIrradiance:
+      run.sun_irradiance = parsePositive(typed, value);
+      break;
+    case Option::From:
+    case Option::To: {
+      std::optional<double>& time = spec.option == Option::From ? run.from_time : run.to_time;
+      if (time) throw UsageError(typed + " given twice");
+      try {
+        time = parseUtcTime(value);
+      } catch (const InvalidArgument& error) {
+        throw UsageError(typed + ": " + error.what());
+      }
+      break;
+    }
+    case Option::Step:
+      run.step_minutes = parsePositive(typed, value);
+      if (run.step_minutes > 1440.0) throw UsageError(typed + ": at most 1440 minutes, got " + inQuotes(value));
+      break;
+    case Option::AzimuthBucket:
+      run.azimuth_bucket_deg = parsePositive(typed, value);
+      if (run.azimuth_bucket_deg > 10.0) throw UsageError(typed + ": at most 10 degrees, got " + inQuotes(value));
+      break;
+    case Option::Apparent:
+      run.apparent = true;
+      break;
     case Option::Quiet:
       run.quiet = true;
       break;
@@ -439,14 +520,36 @@ void validateRun(Command command, const RunArguments& run) {
     const bool placed = run.sun_time || run.latitude || run.longitude;
     if (run.sun && placed)
       throw UsageError("--sun AZ,EL or --at TIME --lat LAT --lon LON: give the sun one way, not both");
-    if (!run.sun && !(run.sun_time && run.latitude && run.longitude))
-      throw UsageError("missing the sun: --sun AZ,EL (compass azimuth, elevation) or --at TIME --lat LAT --lon LON");
+    const bool sun = run.sun || (run.sun_time && run.latitude && run.longitude);
+    if (!sun && (placed || run.environment.empty()))
+      throw UsageError(
+          "missing the light: --env ENV.exr and / or the sun, --sun AZ,EL (compass azimuth, elevation) or --at TIME "
+          "--lat LAT --lon LON");
+    if (run.environment.empty() && run.sweep_options_given)
+      throw UsageError("-k, --method and --azimuth-offset need --env (the sun alone sweeps its own azimuth)");
+    if (run.environment.empty() && (run.environment_rotation_deg != 0.0 || run.environment_rows != 0))
+      throw UsageError("--env-rotate and --env-rows need --env ENV.exr");
+    if (!sun && run.sun_irradiance != 1.0) throw UsageError("--sun-irradiance needs the sun");
+    if (!run.environment.empty() && samePath(run.output, run.environment))
+      throw UsageError("--env must differ from -o, both are " + inQuotes(run.output));
+    if (!run.albedo.empty() && samePath(run.output, run.albedo))
+      throw UsageError("--albedo must differ from -o, both are " + inQuotes(run.output));
     if (run.sun_time) {
       try {  // the solar position's range of years
         sunPosition(*run.sun_time, *run.latitude, *run.longitude);
       } catch (const InvalidArgument& error) {
         throw UsageError(std::string("--at: ") + error.what());
       }
+    }
+  }
+  if (command == Command::Insolation) {
+    if (!run.latitude || !run.longitude || !run.from_time || !run.to_time)
+      throw UsageError("missing the place or the span: --lat LAT --lon LON --from TIME --to TIME");
+    if (!(*run.from_time < *run.to_time)) throw UsageError("--from must come before --to");
+    try {
+      validate(insolationOptions(run));
+    } catch (const InvalidArgument& error) {
+      throw UsageError(error.what());
     }
   }
   if (command == Command::Bounce) {
@@ -492,6 +595,7 @@ void validateRun(Command command, const RunArguments& run) {
         validate(bounceOptions(run));
         break;
       case Command::Shade:
+      case Command::Insolation:
         validate(static_cast<const SweepOptions&>(horizonOptions(run)));
         break;
       default:
@@ -581,6 +685,8 @@ const char* commandName(Command command) {
       return "sunpos";
     case Command::Shade:
       return "shade";
+    case Command::Insolation:
+      return "insolation";
     case Command::Horizon:
       return "horizon";
     case Command::SkyViewFactor:
@@ -741,6 +847,19 @@ IntervisibilityOutputs intervisibilityOutputs(const RunArguments& run) {
 SweepOptions horizonListOptions(const RunArguments& run) {
   SweepOptions options;
   setSweepOptions(run, options);
+  return options;
+}
+
+InsolationOptions insolationOptions(const RunArguments& run) {
+  InsolationOptions options;
+  options.latitude_deg = run.latitude.value_or(0.0);
+  options.longitude_deg = run.longitude.value_or(0.0);
+  options.from_utc = run.from_time.value_or(0.0);
+  options.to_utc = run.to_time.value_or(0.0);
+  options.step_minutes = run.step_minutes;
+  options.size_deg = run.sun_size_deg;
+  options.azimuth_bucket_deg = run.azimuth_bucket_deg;
+  options.apparent = run.apparent;
   return options;
 }
 

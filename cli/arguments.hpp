@@ -14,6 +14,7 @@
 #include "hfvis/horizon_lists.hpp"
 #include "hfvis/image_io.hpp"
 #include "hfvis/intervisibility.hpp"
+#include "hfvis/shading.hpp"
 
 namespace hfvis::cli {
 
@@ -34,7 +35,8 @@ enum class Command {
   HorizonLists,  // "horizons": visibility horizons of chosen receivers, JSON or CSV
   Bounce,        // one diffuse bounce of a given exit radiance
   SunPosition,   // "sunpos": the sun's azimuth and elevation at a time and place
-  Shade,         // the surface lit by the sun: the part of its disc seen, the direct irradiance
+  Shade,         // the surface lit by an environment and / or the sun
+  Insolation,    // sunshine hours and direct irradiation over a span of time
 };
 
 // The subcommand's name as typed ("horizon", "svf", ...).
@@ -62,6 +64,17 @@ struct RunArguments {
   std::optional<std::pair<double, double>> sun;
   std::optional<double> sun_time, latitude, longitude;
   double sun_size_deg = 0.53;
+  double sun_irradiance = 1.0;          // shade --sun-irradiance: the sun's normal irradiance in --albedo's sum
+  std::string environment;              // shade --env ENV.exr
+  double environment_rotation_deg = 0.0;  // --env-rotate
+  int environment_rows = 0;               // --env-rows: the tables' bands, 0 = the map's rows
+  std::string albedo;                     // --albedo: a number in [0, 1] or an image; "" = none
+  bool sweep_options_given = false;       // shade: -k, --method or --azimuth-offset (they need --env)
+  // insolation: --from, --to, --step minutes, --azimuth-bucket degrees, --apparent.
+  std::optional<double> from_time, to_time;
+  double step_minutes = 10.0;
+  double azimuth_bucket_deg = 0.25;
+  bool apparent = false;
   double cell_size_x = 0.0;              // <= 0: from the file, else 1
   double cell_size_y = 0.0;
   double z_scale = 1.0;
@@ -100,6 +113,7 @@ IntervisibilityOptions intervisibilityOptions(const RunArguments& run);
 IntervisibilityOutputs intervisibilityOutputs(const RunArguments& run);
 SweepOptions horizonListOptions(const RunArguments& run);
 BounceOptions bounceOptions(const RunArguments& run);
+InsolationOptions insolationOptions(const RunArguments& run);
 HeightFieldReadOptions readOptions(const RunArguments& run);
 
 }  // namespace hfvis::cli

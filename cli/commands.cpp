@@ -27,6 +27,7 @@
 
 #include "hfvis/bounce.hpp"
 #include "hfvis/device.hpp"
+#include "hfvis/environment.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/height_field.hpp"
 #include "hfvis/horizon.hpp"
@@ -471,53 +472,243 @@ ComputeContext contextFor(const RunArguments& run) {
 
 }  // namespace
 
+// Lighting assumes row 0 is north (compass azimuth = hfvis azimuth + 90 degrees). A raster whose
+// geotransform runs south-up (t[5] > 0) is lit flipped north-up, and its results flipped back.
+struct NorthUp {
+  HeightField field;
+  bool flipped = false;
+  // A plane of the field's size (or several, one after another) back in the input's row order.
+  void restore(std::vector<float>& planes) const {
+    if (!flipped) return;
+    const std::size_t width = field.width, rows = field.height, plane = width * rows;
+    for (std::size_t at = 0; at + plane <= planes.size(); at += plane)
+      for (std::size_t r = 0; r < rows / 2; ++r)
+        std::swap_ranges(planes.begin() + at + r * width, planes.begin() + at + (r + 1) * width,
+                         planes.begin() + at + (rows - 1 - r) * width);
+  }
+};
+
+NorthUp northUp(const HeightField& field) {
+  NorthUp out{field, false};
+  const auto& t = field.georeference.geotransform;
+  if (!t || !((*t)[5] > 0.0)) return out;
+  out.flipped = true;
+  out.restore(out.field.heights);  // the flip is its own inverse
+  std::reverse(out.field.row_cell_size_x.begin(), out.field.row_cell_size_x.end());
+  std::reverse(out.field.row_cell_size_y.begin(), out.field.row_cell_size_y.end());
+  return out;
+}
+
+// --albedo: a number in [0, 1], or an image of the field's size (one channel, or R, G, B), as
+// planes (one value for a number).
+std::vector<std::vector<float>> readAlbedo(const RunArguments& run, const HeightField& field) {
+  const char* begin = run.albedo.c_str();
+  char* end = nullptr;
+  const double number = std::strtod(begin, &end);
+  if (end == begin + run.albedo.size()) {
+    if (!(number >= 0.0 && number <= 1.0))
+      throw UsageError("--albedo: a number must be in 0 .. 1, got '" + run.albedo + "'");
+    return {std::vector<float>(field.pixelCount(), static_cast<float>(number))};
+  }
+  ImageChannels image = readImage(run.albedo);
+  if (image.width != field.width || image.height != field.height)
+    throw IoError(run.albedo, "the albedo is " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+                                  ", the height field " + std::to_string(field.width) + "x" +
+                                  std::to_string(field.height));
+  std::vector<std::vector<float>> planes;
+  for (const char* name : {"R", "G", "B"})
+    for (std::size_t i = 0; i < image.names.size(); ++i)
+      if (image.names[i] == name) planes.push_back(image.planes[i]);
+  if (planes.size() != 3) {
+    if (image.planes.size() != 1)
+      throw IoError(run.albedo, "an albedo image needs one channel or R, G, B");
+    planes = {image.planes[0]};
+  }
+  for (const auto& plane : planes)
+    for (float v : plane)
+      if (!(v >= 0.0f && v <= 1.0f) && !std::isnan(v))
+        throw IoError(run.albedo, "albedo values must be in 0 .. 1 (found " + formatNumber(v) + ")");
+  return planes;
+}
+
 int runShade(const RunArguments& run) {
-  requireOutputs(run, outputPaths(run));
-  const HeightField field = readValidField(run);
+  std::vector<std::string> paths = outputPaths(run);
+  requireOutputs(run, paths);
+  for (const std::string& input : {run.environment, run.albedo})
+    for (const std::string& output : paths)
+      if (!input.empty() && sameFile(input, output))
+        throw UsageError("output '" + output + "' is the input '" + input + "': outputs never replace an input");
+  const NorthUp lit = northUp(readValidField(run));
+  const HeightField& field = lit.field;
+  std::optional<EnvironmentMap> environment;
+  if (!run.environment.empty()) {
+    environment = readEnvironmentMap(run.environment);
+    environment->rotation_deg = run.environment_rotation_deg;
+    environment->table_rows = run.environment_rows;
+  }
+  const std::vector<std::vector<float>> albedo =
+      run.albedo.empty() ? std::vector<std::vector<float>>{} : readAlbedo(run, field);
   const ComputeContext context = contextFor(run);
   const DeviceInfo& device = context.device();
-  SunLight sun;
-  sun.size_deg = run.sun_size_deg;
-  if (run.sun) {
-    sun.position = {run.sun->first, run.sun->second};
-  } else {
-    sun.position = sunPosition(*run.sun_time, *run.latitude, *run.longitude);
+  std::optional<SunLight> sun;
+  if (run.sun || run.sun_time) {
+    sun.emplace();
+    sun->size_deg = run.sun_size_deg;
+    sun->position = run.sun ? SunPosition{run.sun->first, run.sun->second}
+                            : sunPosition(*run.sun_time, *run.latitude, *run.longitude);
   }
   HorizonOptions options = horizonOptions(run);
   Progress progress(run.quiet);
   progress.attach(options);
   const auto start = std::chrono::steady_clock::now();
-  const SunShading result = progress.run([&] { return computeSunShading(context, field, sun, options); });
+  const std::size_t pixels = field.pixelCount();
+  HorizonResult env;
+  if (environment) {
+    HorizonOutputs outputs;
+    outputs.environment = &*environment;
+    env = progress.run([&] { return computeHorizons(context, field, options, outputs); });
+    requireSize(env.irradiance, pixels * environment->channels, "irradiances");
+    lit.restore(env.irradiance);
+  }
+  SunShading direct;
+  if (sun) {
+    direct = progress.run([&] { return computeSunShading(context, field, *sun, options); });
+    requireSize(direct.sun, pixels, "sun fractions");
+    requireSize(direct.direct, pixels, "direct irradiances");
+    lit.restore(direct.sun);
+    lit.restore(direct.direct);
+  }
   const double seconds = secondsSince(start);
-  requireResultSize(result.width, result.height, field);
-  requireSize(result.sun, field.pixelCount(), "sun fractions");
-  requireSize(result.direct, field.pixelCount(), "direct irradiances");
 
   Attributes attributes = runAttributes(Command::Shade, run, field, device);
-  attributes.emplace_back("hfvis:sun_azimuth_deg", formatNumber(sun.position.azimuth_deg));
-  attributes.emplace_back("hfvis:sun_elevation_deg", formatNumber(sun.position.elevation_deg));
-  attributes.emplace_back("hfvis:sun_size_deg", formatNumber(sun.size_deg));
-  attributes.emplace_back("hfvis:swept_azimuth_deg", formatNumber(result.azimuth * 180.0 / M_PI));
+  std::vector<std::string> names;
+  std::vector<std::vector<float>> planes;
+  std::string quantity, units;
+  if (environment) {
+    attributes.emplace_back("hfvis:environment", run.environment);
+    attributes.emplace_back("hfvis:environment_rotation_deg", formatNumber(run.environment_rotation_deg));
+    attributes.emplace_back("hfvis:environment_table_rows", std::to_string((environment->table_rows > 0 ? environment->table_rows : environment->height)));
+    names = environment->names;
+    planes = splitPlanes(env.irradiance, pixels, environment->channels);
+    quantity = environment->names.size() == 1 ? "Y" : "R, G, B";
+    quantity += ": the irradiance from the environment above each point's horizons, for its normal; ";
+    units = "the environment's radiance times steradians (a uniform radiance of 1 gives pi on open flat ground); ";
+  }
+  if (sun) {
+    attributes.emplace_back("hfvis:sun_azimuth_deg", formatNumber(sun->position.azimuth_deg));
+    attributes.emplace_back("hfvis:sun_elevation_deg", formatNumber(sun->position.elevation_deg));
+    attributes.emplace_back("hfvis:sun_size_deg", formatNumber(sun->size_deg));
+    attributes.emplace_back("hfvis:swept_azimuth_deg", formatNumber(direct.azimuth * 180.0 / M_PI));
+    names.insert(names.end(), {"direct", "sun"});
+    planes.insert(planes.end(), {direct.direct, direct.sun});
+    quantity += "sun: the fraction of the sun's disc above the pixel's horizon in the sun's azimuth; direct: sun * "
+                "max(0, n . s), the irradiance from a sun of normal irradiance 1 (row 0 taken as north); ";
+    units += "sun: 0..1; direct: the sun's normal irradiance; ";
+  }
+  // --albedo: the radiance a Lambertian surface of that albedo sends out, albedo / pi times the
+  // irradiance (the environment's and the sun's at --sun-irradiance).
+  std::vector<std::vector<float>> radiance;
+  if (!albedo.empty()) {
+    const std::size_t channels = std::max<std::size_t>(albedo.size(), environment ? environment->channels : 1);
+    for (std::size_t c = 0; c < channels; ++c) {
+      std::vector<float> out(pixels);
+      const std::vector<float>& a = albedo[std::min(c, albedo.size() - 1)];
+      for (std::size_t p = 0; p < pixels; ++p) {
+        double e = 0.0;
+        if (environment) e += env.irradiance[std::min<std::size_t>(c, environment->channels - 1) * pixels + p];
+        if (sun) e += run.sun_irradiance * direct.direct[p];
+        out[p] = static_cast<float>(a[p] / M_PI * e);
+      }
+      radiance.push_back(std::move(out));
+    }
+    const bool grey = channels == 1;
+    for (const char* name : {"R", "G", "B"}) {
+      names.push_back(grey ? std::string("radiance") : std::string("radiance.") + name);
+      if (grey) break;
+    }
+    planes.insert(planes.end(), radiance.begin(), radiance.end());
+    attributes.emplace_back("hfvis:albedo", run.albedo);
+    attributes.emplace_back("hfvis:sun_irradiance", formatNumber(run.sun_irradiance));
+    quantity += "radiance: albedo / pi times the irradiance (the environment's, and the sun's times its normal "
+                "irradiance)";
+    units += "radiance: per steradian";
+  }
   StagedOutputs outputs;
-  // "direct" sorts before "sun": channel 0 in the EXR, whose channels are stored sorted by name.
-  const ImageChannels image = makeImage(
-      field, run, {"direct", "sun"}, {result.direct, result.sun}, attributes,
-      "sun: the fraction of the sun's disc above the pixel's horizon in the sun's azimuth; direct: sun * "
-      "max(0, n . s), the irradiance from a sun of normal irradiance 1 (row 0 taken as north)",
-      "sun: 0..1; direct: the sun's normal irradiance");
+  const ImageChannels image = makeImage(field, run, names, planes, attributes, quantity, units);
   outputs.stage(run.output, [&](const std::string& path) { writeImage(path, image); });
   if (!run.preview.empty()) {
     outputs.stage(run.preview, [&](const std::string& path) {
-      writePreviewPng(path, field.width, field.height, result.direct);  // stretched min..max
+      if (!radiance.empty()) {
+        writeToneMappedPng(path, field.width, field.height, radiance);
+      } else if (environment) {
+        writeToneMappedPng(path, field.width, field.height, splitPlanes(env.irradiance, pixels, environment->channels));
+      } else {  // a hillshade with cast shadows: the direct light, 0 .. its largest value
+        writePreviewPng(path, field.width, field.height, direct.direct, 0.0f,
+                        std::max(1e-6f, quantileRange(direct.direct, 0.0, 1.0).second));
+      }
     });
   }
   const std::vector<std::string> written = outputs.paths();
   outputs.commit();
   if (!run.quiet) {
-    printSummary(written, field.width, field.height, 1, "sweep", seconds, device.name,
-                 "; sun at " + formatFixed(sun.position.azimuth_deg, 2) + " deg, " +
-                     formatFixed(sun.position.elevation_deg, 2) + " deg up; mean sun " +
-                     formatFixed(finiteMean(result.sun), 3));
+    std::string note;
+    if (environment) note += "; mean irradiance " + formatFixed(finiteMean(env.irradiance), 4);
+    if (sun)
+      note += "; sun at " + formatFixed(sun->position.azimuth_deg, 2) + " deg, " +
+              formatFixed(sun->position.elevation_deg, 2) + " deg up; mean sun " + formatFixed(finiteMean(direct.sun), 3);
+    printSummary(written, field.width, field.height, environment ? run.directions : 1,
+                 methodName(Command::Shade, run), seconds, device.name, note + (lit.flipped ? " (lit north-up)" : ""));
+  }
+  return 0;
+}
+
+int runInsolation(const RunArguments& run) {
+  requireOutputs(run, outputPaths(run));
+  const NorthUp lit = northUp(readValidField(run));
+  const HeightField& field = lit.field;
+  const ComputeContext context = contextFor(run);
+  const DeviceInfo& device = context.device();
+  const InsolationOptions options = insolationOptions(run);
+  HorizonOptions sweep = horizonOptions(run);
+  Progress progress(run.quiet);
+  progress.attach(sweep);
+  const auto start = std::chrono::steady_clock::now();
+  Insolation result = progress.run([&] { return computeInsolation(context, field, options, sweep); });
+  const double seconds = secondsSince(start);
+  requireResultSize(result.width, result.height, field);
+  requireSize(result.sun_hours, field.pixelCount(), "sun hours");
+  requireSize(result.direct, field.pixelCount(), "direct irradiations");
+  lit.restore(result.sun_hours);
+  lit.restore(result.direct);
+  Attributes attributes = runAttributes(Command::Insolation, run, field, device);
+  attributes.emplace_back("hfvis:latitude_deg", formatNumber(options.latitude_deg));
+  attributes.emplace_back("hfvis:longitude_deg", formatNumber(options.longitude_deg));
+  attributes.emplace_back("hfvis:from_utc_s", formatNumber(options.from_utc));
+  attributes.emplace_back("hfvis:to_utc_s", formatNumber(options.to_utc));
+  attributes.emplace_back("hfvis:step_minutes", formatNumber(options.step_minutes));
+  attributes.emplace_back("hfvis:sun_size_deg", formatNumber(options.size_deg));
+  attributes.emplace_back("hfvis:azimuth_bucket_deg", formatNumber(options.azimuth_bucket_deg));
+  attributes.emplace_back("hfvis:refraction", options.apparent ? "apparent (refracted) elevations" : "geometric");
+  StagedOutputs outputs;
+  // "direct" sorts before "sun_hours": channel 0 in the EXR.
+  const ImageChannels image = makeImage(
+      field, run, {"direct", "sun_hours"}, {result.direct, result.sun_hours}, attributes,
+      "sun_hours: hours with the sun's centre above the pixel's horizon (and elevation 0); direct: the sum over "
+      "steps of hours * the disc's part seen * max(0, n . s), the irradiation from a sun of normal irradiance 1",
+      "sun_hours: hours; direct: hours times the sun's normal irradiance (W/m^2 gives Wh/m^2)");
+  outputs.stage(run.output, [&](const std::string& path) { writeImage(path, image); });
+  if (!run.preview.empty()) {
+    outputs.stage(run.preview, [&](const std::string& path) {
+      const auto [lo, hi] = quantileRange(result.direct);
+      writePreviewPng(path, field.width, field.height, result.direct, lo, hi);
+    });
+  }
+  const std::vector<std::string> written = outputs.paths();
+  outputs.commit();
+  if (!run.quiet) {
+    printSummary(written, field.width, field.height, result.sweeps, "sweep", seconds, device.name,
+                 "; " + std::to_string(result.steps) + " steps with the sun up, mean sun " +
+                     formatFixed(finiteMean(result.sun_hours), 2) + " h" + (lit.flipped ? " (lit north-up)" : ""));
   }
   return 0;
 }
@@ -641,12 +832,15 @@ int runCompute(Command command, const RunArguments& run) {
                       : "ambient occlusion, uniform sky of radiance 1 (Timonen & Westerholm 2010, Eq. 5)",
                   svf ? "fraction of the sky visible, 0..1" : "0..1, a flat unoccluded plane gives 1");
     outputs.stage(run.output, [&](const std::string& path) { writeImage(path, image); });
-    if (!run.preview.empty()) {
-      outputs.stage(run.preview, [&](const std::string& path) {
-        writePreviewPng(path, result.width, result.height, plane, 0.0f, 1.0f);
-      });
-    }
     mean_note = "; mean " + channel + " " + formatFixed(finiteMean(plane), 4);
+    if (!run.preview.empty()) {
+      // Stretched over the 1st to 99th percentile: most of a DEM's svf lies within 0.85 .. 1.
+      const auto [lo, hi] = quantileRange(plane);
+      outputs.stage(run.preview, [&, lo = lo, hi = hi](const std::string& path) {
+        writePreviewPng(path, result.width, result.height, plane, lo, hi);
+      });
+      mean_note += "; preview black at " + formatFixed(lo, 3) + ", white at " + formatFixed(hi, 3);
+    }
   }
   const std::vector<std::string> written = outputs.paths();
   outputs.commit();

@@ -12,6 +12,9 @@ int runSunPosition(const SunArguments& sun);
 // "hfvis shade": the part of the sun's disc each pixel sees and the direct irradiance.
 int runShade(const RunArguments& run);
 
+// "hfvis insolation": sunshine hours and direct irradiation over a span of time.
+int runInsolation(const RunArguments& run);
+
 // `hfvis horizon|svf|ao`: reads the input, computes on the device, writes every output
 // (all or none). Throws hfvis::Error on failure. Returns the exit status.
 int runCompute(Command command, const RunArguments& run);

@@ -13,7 +13,9 @@ const char* const kUsage = R"(Usage:
   hfvis viewcount IN -o OUT.exr [-k K] [--method tree|naive] [--stats] [options]
   hfvis horizons  IN --at COL,ROW [--at COL,ROW ...] -o OUT.json|OUT.csv [-k K] [options]
   hfvis bounce    IN --radiance RAD.exr -o OUT.exr [-k K] [options]
-  hfvis shade     IN -o OUT.exr (--sun AZ,EL | --at TIME --lat LAT --lon LON) [--sun-size DEG] [options]
+  hfvis shade     IN -o OUT.exr [--env ENV.exr [-k K]] [--sun AZ,EL | --at TIME --lat LAT --lon LON]
+                  [--albedo A|FILE] [options]
+  hfvis insolation IN -o OUT.exr --lat LAT --lon LON --from TIME --to TIME [--step MINUTES] [options]
   hfvis sunpos    --lat LAT --lon LON --at TIME [--apparent]
   hfvis devices
   hfvis --help | hfvis COMMAND --help
@@ -28,8 +30,10 @@ Commands:
             channel 1 "visible_area": the visible ground area (total viewshed), ground units^2
   horizons  the visibility horizons of chosen receivers per direction, as JSON or CSV
   bounce    incident indirect irradiance of one diffuse bounce of a given exit radiance
-  shade     two float32 channels: "sun", the part of the sun's disc above the horizon (0..1),
-            and "direct", sun * max(0, n . s): the irradiance from a sun of normal irradiance 1
+  shade     --env: "R", "G", "B" (or "Y"), the irradiance from an HDR environment through the
+            horizons; the sun: "sun", the part of its disc above the horizon (0..1), and
+            "direct", sun * max(0, n . s); --albedo: "radiance[.R/G/B]", what the surface sends out
+  insolation "sun_hours" (hours of sun) and "direct" (irradiation of a unit sun, hours) over a span
   sunpos    the sun's compass azimuth and elevation at a time and place
   devices   list the OpenCL devices and mark the one automatic selection picks
 )";
@@ -92,7 +96,8 @@ Horizon only:
                            phi_k and slower: steps with more grid crossings per pixel
   Its preview shows the mean horizon elevation over the directions whose ray stays in
   the field (low = dark, high = bright), stretched from its minimum to its maximum; the
-  svf and ao previews map 0..1 to black..white. Nodata is black in every preview.
+  svf and ao previews stretch their 1st to 99th percentile over black..white (the summary
+  line prints both ends). Nodata is black in every preview.
 )";
 
 const char* const kViewCount = R"(
@@ -266,16 +271,48 @@ std::string commandHelp(Command command) {
              "index, a type (gpu, cpu) or part of the name with --device or HFVIS_DEVICE.\n";
     case Command::Shade:
       return std::string(
-                 "hfvis shade IN -o OUT.exr (--sun AZ,EL | --at TIME --lat LAT --lon LON) [--sun-size DEG]\n\n"
-                 "Lights the surface with the sun: channel \"sun\" is the fraction of the sun's disc\n"
-                 "(--sun-size degrees across, default 0.53) above each pixel's horizon in the sun's azimuth,\n"
-                 "the horizon taken as a straight line across the disc; \"direct\" is sun * max(0, n . s),\n"
-                 "n the surface normal (as for ao), s toward the sun: the irradiance from a sun of normal\n"
-                 "irradiance 1. The sun is --sun AZ,EL (compass azimuth, degrees clockwise from north;\n"
-                 "elevation, degrees), or where it stands at --at TIME seen from --lat, --lon (as 'hfvis\n"
-                 "sunpos', geometric). Row 0 of the field is taken as north (hfvis azimuth = compass\n"
-                 "azimuth - 90 deg). Only the sun's azimuth is swept: its integer step within 0.02 degree.\n"
-                 "NaN at nodata pixels.\n") +
+                 "hfvis shade IN -o OUT.exr [--env ENV.exr [--env-rotate DEG] [--env-rows N] [-k K]]\n"
+                 "            [--sun AZ,EL | --at TIME --lat LAT --lon LON] [--sun-size DEG]\n"
+                 "            [--albedo A|FILE [--sun-irradiance E]] [options]\n\n"
+                 "Lights the surface; give --env, the sun, or both.\n"
+                 "--env ENV.exr: an HDR environment, equirectangular (latitude / longitude, 2:1): row 0 at\n"
+                 "  the zenith, the last row at the nadir; the column at fraction u of the width looks toward\n"
+                 "  compass azimuth 360 u + DEG (--env-rotate; left edge north, a quarter east, the middle\n"
+                 "  south). One channel or R, G, B (an alpha channel is ignored). Channels R, G, B (or Y): the\n"
+                 "  irradiance at each point from the part of the environment above its horizons, for its\n"
+                 "  normal, in the environment's radiance times steradians (uniform radiance 1 gives pi on\n"
+                 "  open flat ground, pi times 'hfvis ao' everywhere). -k directions (default 64) and\n"
+                 "  --method as for ao; --env-rows N bands of zenith angle in the tables (default the map's\n"
+                 "  rows, exact for a map constant over each pixel; fewer are faster to build, not to light).\n"
+                 "The sun: channel \"sun\" is the fraction of the sun's disc (--sun-size degrees across,\n"
+                 "  default 0.53) above each pixel's horizon in the sun's azimuth; \"direct\" is sun * max(0,\n"
+                 "  n . s), the irradiance from a sun of normal irradiance 1. --sun AZ,EL (compass azimuth,\n"
+                 "  degrees clockwise from north; elevation, degrees), or where it stands at --at TIME seen\n"
+                 "  from --lat, --lon (as 'hfvis sunpos', geometric). Only the sun's azimuth is swept, along\n"
+                 "  the integer step closest to it (steps of up to 64 pixels: within 0.02 degree for most\n"
+                 "  azimuths, up to 0.45 degree next to the axes).\n"
+                 "--albedo A|FILE (a number in 0..1, or an image of the field's size, 1 or 3 channels): also\n"
+                 "  \"radiance\" (or radiance.R/G/B), albedo / pi times the irradiance: the environment's plus\n"
+                 "  the direct light times --sun-irradiance E (default 1), a Lambertian surface's radiance.\n"
+                 "Row 0 is taken as north (a south-up GeoTIFF is lit flipped north-up). The preview is the\n"
+                 "radiance or the irradiance tonemapped (ACES filmic, sRGB), or with the sun alone a\n"
+                 "hillshade with cast shadows: direct from 0 (black) to its largest value (white). NaN at\n"
+                 "nodata pixels.\n") +
+             kOptions + kConventions + kExitStatus;
+    case Command::Insolation:
+      return std::string(
+                 "hfvis insolation IN -o OUT.exr --lat LAT --lon LON --from TIME --to TIME [--step MINUTES]\n"
+                 "                 [--sun-size DEG] [--azimuth-bucket DEG] [--apparent] [options]\n\n"
+                 "Sunlight from TIME to TIME (ISO 8601 with a zone) at latitude LAT, longitude LON, in steps\n"
+                 "of MINUTES (default 10; the last one shorter), each taken at its middle. Channel\n"
+                 "\"sun_hours\": hours with the sun's centre above the pixel's horizon and above elevation 0\n"
+                 "(terrain beyond the field taken as level); \"direct\": the sum over the steps of hours *\n"
+                 "the disc's part seen * max(0, n . s), the irradiation from a sun of normal irradiance 1 in\n"
+                 "hours (times a normal irradiance in W/m^2 it is Wh/m^2). Steps whose sun azimuths fall in\n"
+                 "one bucket of DEG (default 0.25) share one horizon sweep, so a year costs a few hundred\n"
+                 "sweeps. --apparent lifts the sun by the atmosphere's refraction. Row 0 is taken as north (a\n"
+                 "south-up GeoTIFF is lit flipped north-up). The preview stretches direct over its 1st to\n"
+                 "99th percentile. NaN at nodata pixels.\n") +
              kOptions + kConventions + kExitStatus;
     case Command::SunPosition:
       return "hfvis sunpos --lat LAT --lon LON --at TIME [--apparent]\n\n"

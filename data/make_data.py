@@ -60,13 +60,20 @@ def _zip_block(raw):
     return out if len(out) < len(raw) else raw    # stored raw when it would not shrink
 
 
-def write_exr_builtin(path, img, attrs):
-    """Minimal single-part scanline EXR writer: one FLOAT channel "Y", ZIP (16 lines)."""
+def write_exr_builtin(path, img, attrs, names=("Y",)):
+    """Minimal single-part scanline EXR writer: FLOAT channels (one "Y", or `names` for an
+    (h, w, len(names)) image), ZIP (16 lines)."""
     img = np.ascontiguousarray(img, dtype="<f4")
-    h, w = img.shape
+    if img.ndim == 2:
+        img = img[:, :, None]
+    h, w, nc = img.shape
+    if nc != len(names):
+        raise ValueError("%d channels, %d names" % (nc, len(names)))
+    order = sorted(range(nc), key=lambda c: names[c])  # EXR keeps channels sorted by name
     lines_per_chunk = 16
     hdr = [b"\x76\x2f\x31\x01", struct.pack("<i", 2)]
-    chlist = b"Y\0" + struct.pack("<i", 2) + b"\0\0\0\0" + struct.pack("<ii", 1, 1) + b"\0"
+    chlist = b"".join(names[c].encode() + b"\0" + struct.pack("<i", 2) + b"\0\0\0\0" +
+                      struct.pack("<ii", 1, 1) for c in order) + b"\0"
     box = struct.pack("<iiii", 0, 0, w - 1, h - 1)
     header_attrs = [
         ("channels", "chlist", chlist),
@@ -86,9 +93,11 @@ def write_exr_builtin(path, img, attrs):
     header = b"".join(hdr)
     nchunks = (h + lines_per_chunk - 1) // lines_per_chunk
     starts = [c * lines_per_chunk for c in range(nchunks)]
+    # Each scanline holds its channels one after another, in the sorted order.
+    planar = np.ascontiguousarray(img[:, :, order].transpose(0, 2, 1))
     # zlib releases the GIL, so big images compress on all cores; order is kept.
     with ThreadPoolExecutor(max_workers=os.cpu_count() or 1) as pool:
-        blocks = list(pool.map(lambda y0: _zip_block(img[y0:y0 + lines_per_chunk].tobytes()),
+        blocks = list(pool.map(lambda y0: _zip_block(planar[y0:y0 + lines_per_chunk].tobytes()),
                                starts))
     chunks = [struct.pack("<ii", y0, len(data)) + data for y0, data in zip(starts, blocks)]
     offsets = []
@@ -101,6 +110,36 @@ def write_exr_builtin(path, img, attrs):
         f.write(struct.pack("<%dQ" % nchunks, *offsets))
         for ch in chunks:
             f.write(ch)
+
+
+def clear_sky(height=128, sun_compass=240.0, sun_elevation=25.0):
+    """A synthetic HDR environment for the lighting examples, equirectangular (row 0 at the
+    zenith; column fraction u looks toward compass azimuth 360 u): a blue sky brightening
+    toward the horizon and around the sun, a sun of one pixel (1.4 degrees) whose irradiance at normal
+    incidence is 8 times the sky's on flat ground, and dark ground below the horizon."""
+    w = 2 * height
+    zen = (np.arange(height) + 0.5) * math.pi / height
+    az = (np.arange(w) + 0.5) * 2 * math.pi / w
+    Z, A = np.meshgrid(zen, az, indexing="ij")
+    sz, sa = math.radians(90.0 - sun_elevation), math.radians(sun_compass)
+    # Angle from the sun.
+    cosg = np.cos(Z) * math.cos(sz) + np.sin(Z) * math.sin(sz) * np.cos(A - sa)
+    gamma = np.arccos(np.clip(cosg, -1.0, 1.0))
+    up = Z < math.pi / 2
+    t = np.clip(Z / (math.pi / 2), 0.0, 1.0)[:, :, None]  # 0 zenith .. 1 horizon
+    zenith, horizon = np.array([0.25, 0.45, 0.95]), np.array([0.85, 0.90, 1.0])
+    sky = (1 - t) * zenith + t * horizon
+    sky = sky * (1.0 + 2.5 * np.exp(-gamma / 0.25))[:, :, None]          # circumsolar glow
+    ground = np.array([0.10, 0.08, 0.06])
+    img = np.where(up[:, :, None], sky, ground)
+    # Sky irradiance on flat ground: sum over the upper rows of L cos(theta) dOmega.
+    dphi, dtheta = 2 * math.pi / w, math.pi / height
+    omega = np.sin(Z) * dtheta * dphi
+    e_sky = float((img[:, :, 1] * np.cos(Z) * omega * up).sum())
+    r = int(sz / dtheta)
+    c = int(sa / dphi)
+    img[r, c, :] += (8.0 * e_sky / omega[r, c]) * np.array([1.0, 0.95, 0.85])
+    return img.astype(np.float32)
 
 
 def write_exr_oiio(path, img, attrs):
@@ -356,6 +395,7 @@ def main(argv=None):
                     help="comma-separated synthetic fields: fractal, bricks, sine, blocks, "
                          "random (default: the four of Fig. 7)")
     ap.add_argument("--no-dem", action="store_true", help="skip the two real DEMs")
+    ap.add_argument("--no-env", action="store_true", help="skip the environment map clear_sky.exr")
     ap.add_argument("--writer", choices=sorted(WRITERS), default="builtin",
                     help="EXR writer: built-in (numpy+zlib, default) or OpenImageIO")
     args = ap.parse_args(argv)
@@ -387,6 +427,20 @@ def main(argv=None):
             "hfvis:cell_size_y": "1",
         })
         summary(os.path.basename(path), path, z, time.time() - t0)
+
+    if not args.no_env:
+        t0 = time.time()
+        sky = clear_sky()
+        path = os.path.join(args.out, "clear_sky.exr")
+        write_exr_builtin(path, sky, {
+            "hfvis:description": "synthetic clear sky for the lighting examples: sun at compass 240, "
+                                 "elevation 25 degrees",
+            "hfvis:generator": "data/make_data.py",
+            "hfvis:convention": "equirectangular: row 0 zenith; column fraction u looks toward compass "
+                                "azimuth 360 u",
+        }, names=("R", "G", "B"))
+        print("%-26s %5d x %-5d %10d bytes  %.2fs" % (os.path.basename(path), sky.shape[1], sky.shape[0],
+                                                    os.path.getsize(path), time.time() - t0))
 
     if not args.no_dem:
         for base, fn in (("jacksboro_fault_dem", jacksboro), ("topobathy", topobathy)):

@@ -484,6 +484,66 @@ void writePreviewPng(const std::string& path, int width, int height, const std::
   });
 }
 
+std::pair<float, float> quantileRange(const std::vector<float>& plane, double lo_q, double hi_q) {
+  std::vector<float> finite;
+  for (float v : plane)
+    if (std::isfinite(v)) finite.push_back(v);
+  if (finite.empty()) return {0.0f, 0.0f};
+  auto at = [&](double q) {
+    const std::size_t rank = static_cast<std::size_t>(std::clamp(q, 0.0, 1.0) * (finite.size() - 1) + 0.5);
+    std::nth_element(finite.begin(), finite.begin() + rank, finite.end());
+    return finite[rank];
+  };
+  const float lo = at(lo_q), hi = at(hi_q);
+  return {lo, hi};
+}
+
+void writeToneMappedPng(const std::string& path, int width, int height, const std::vector<std::vector<float>>& planes,
+                        double exposure) {
+  const std::size_t count = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  if (width <= 0 || height <= 0 || (planes.size() != 1 && planes.size() != 3))
+    throw InvalidArgument("preview '" + path + "' needs one or three planes of a non-empty image");
+  for (const auto& plane : planes)
+    if (plane.size() != count)
+      throw InvalidArgument("preview '" + path + "' has a plane of " + std::to_string(plane.size()) + " values for " +
+                            std::to_string(count) + " pixels");
+  const bool rgb = planes.size() == 3;
+  auto luminance = [&](std::size_t i) {
+    return rgb ? 0.2126 * planes[0][i] + 0.7152 * planes[1][i] + 0.0722 * planes[2][i] : double(planes[0][i]);
+  };
+  double log_sum = 0.0;
+  std::size_t finite = 0;
+  for (std::size_t i = 0; i < count; ++i) {
+    const double l = luminance(i);
+    if (!std::isfinite(l)) continue;
+    log_sum += std::log(1e-6 + std::max(0.0, l));
+    ++finite;
+  }
+  const double key = finite ? std::exp(log_sum / finite) : 1.0;
+  const double scale = 0.3 / std::max(key, 1e-6) * std::exp2(exposure);
+  // Narkowicz's (2015) fit of the ACES filmic curve: a toe that keeps shadows' contrast and a
+  // shoulder for the highlights.
+  auto filmic = [](double x) { return x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14); };
+  auto encode = [](double v) -> std::uint8_t {  // sRGB transfer curve
+    v = std::clamp(v, 0.0, 1.0);
+    const double s = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
+    return static_cast<std::uint8_t>(std::lround(255.0 * s));
+  };
+  const int channels = rgb ? 3 : 1;
+  OIIO::ImageSpec spec(width, height, channels, OIIO::TypeDesc::UINT8);
+  spec.channelnames = rgb ? std::vector<std::string>{"R", "G", "B"} : std::vector<std::string>{"Y"};
+  writeAtomically<std::uint8_t>(path, spec, [&](int y_begin, int y_end, std::uint8_t* rows) {
+    const std::size_t begin = static_cast<std::size_t>(y_begin) * width;
+    const std::size_t end = static_cast<std::size_t>(y_end) * width;
+    for (std::size_t i = begin; i < end; ++i) {
+      for (int c = 0; c < channels; ++c) {
+        const double v = planes[c][i] * scale;
+        rows[(i - begin) * channels + c] = std::isfinite(v) ? encode(filmic(std::max(0.0, v))) : 0;
+      }
+    }
+  });
+}
+
 std::vector<std::string> directionChannelNames(const std::string& prefix, int count) {
   if (count < 0)
     throw InvalidArgument("direction count must not be negative (got " + std::to_string(count) + ")");

@@ -9,8 +9,29 @@
 #include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
 #include "horizon_common.hpp"
+#include "shading_internal.hpp"
 
 namespace hfvis {
+namespace detail {
+
+std::vector<float> unitNormals(const HeightField& field) {
+  const PreparedHeights prepared = prepareHeights(field);
+  const bool rows = hasRowSpacing(field);
+  std::vector<float> normals(4 * field.pixelCount(), std::numeric_limits<float>::quiet_NaN());
+  for (int r = 0; r < field.height; ++r) {
+    const float cell_x = static_cast<float>(rows ? field.row_cell_size_x[r] : field.cell_size_x);
+    const float cell_y = static_cast<float>(rows ? field.row_cell_size_y[r] : field.cell_size_y);
+    for (int c = 0; c < field.width; ++c) {
+      const std::size_t p = static_cast<std::size_t>(r) * field.width + c;
+      if (std::isnan(prepared.heights[p])) continue;
+      pixelNormal(prepared.heights, field.width, field.height, c, r, cell_x, cell_y, &normals[4 * p]);
+      normals[4 * p + 3] = 0.0f;
+    }
+  }
+  return normals;
+}
+
+}  // namespace detail
 
 double discAboveHorizon(double above, double radius) {
   const double t = std::clamp(above / radius, -1.0, 1.0);
@@ -45,21 +66,14 @@ SunShading computeSunShading(const ComputeContext& context, const HeightField& f
   out.direct.assign(plane, nan);
   const double elevation = sun.position.elevation_deg * kDegree, radius = 0.5 * sun.size_deg * kDegree;
   const glm::dvec3 s = sunDirection(sun.position);
-  const detail::PreparedHeights prepared = detail::prepareHeights(field);
-  const bool rows = detail::hasRowSpacing(field);
-  for (int r = 0; r < field.height; ++r) {
-    const float cell_x = static_cast<float>(rows ? field.row_cell_size_x[r] : field.cell_size_x);
-    const float cell_y = static_cast<float>(rows ? field.row_cell_size_y[r] : field.cell_size_y);
-    for (int c = 0; c < field.width; ++c) {
-      const std::size_t p = static_cast<std::size_t>(r) * field.width + c;
-      if (std::isnan(prepared.heights[p])) continue;
-      const double seen = discAboveHorizon(elevation - horizons.angles[p], radius);
-      float n[3];
-      detail::pixelNormal(prepared.heights, field.width, field.height, c, r, cell_x, cell_y, n);
-      const double cosine = n[0] * s.x + n[1] * s.y + n[2] * s.z;
-      out.sun[p] = static_cast<float>(seen);
-      out.direct[p] = static_cast<float>(seen * std::max(0.0, cosine));
-    }
+  const std::vector<float> normals = detail::unitNormals(field);
+  for (std::size_t p = 0; p < plane; ++p) {
+    const float* n = &normals[4 * p];
+    if (std::isnan(n[0])) continue;
+    const double seen = discAboveHorizon(elevation - horizons.angles[p], radius);
+    const double cosine = n[0] * s.x + n[1] * s.y + n[2] * s.z;
+    out.sun[p] = static_cast<float>(seen);
+    out.direct[p] = static_cast<float>(seen * std::max(0.0, cosine));
   }
   return out;
 }

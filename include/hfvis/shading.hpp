@@ -4,8 +4,9 @@
 // The sun is a disc of angular diameter `size_deg` (0.53 degree by default) at compass azimuth
 // and elevation (hfvis/sun.hpp; over a field whose row 0 is north, hfvis azimuth = compass
 // azimuth - 90 degrees). Only the sun's azimuth is swept: the horizon of every pixel in that
-// one direction (the sweep's integer step within 0.02 degree of it, far inside the disc's
-// 0.265 degree radius), and the part of the disc above that horizon, taken as a straight line
+// one direction, along the sweep's integer step closest to it (steps of up to 64 pixels: within
+// 0.02 degree for most azimuths, up to 0.45 degree next to the axes and diagonals; the swept
+// azimuth is returned), and the part of the disc above that horizon, taken as a straight line
 // across the disc (the horizon's slope across a disc's width is left out).
 #pragma once
 
@@ -43,5 +44,43 @@ double discAboveHorizon(double above, double radius);
 // position), and what computeHorizons throws.
 SunShading computeSunShading(const ComputeContext& context, const HeightField& field, const SunLight& sun,
                              const SweepOptions& options = {});
+
+// Sunlight over a span of time at one place: GRASS r.sun's and WhiteboxTools' TimeInDaylight
+// question. The span [from, to) is cut into steps of step_minutes (the last one shorter), each
+// taken at its middle. The sun counts at a step while its centre is above the pixel's horizon in
+// its azimuth and above the astronomical horizon (terrain beyond the field is taken as level at
+// the pixel's height: the horizon is at least 0 there); steps with the whole disc below elevation
+// 0 are skipped. Steps whose sun azimuths fall in one bucket of azimuth_bucket_deg share one
+// horizon sweep (at the bucket's centre), so a year costs a few hundred sweeps, not one per step.
+struct InsolationOptions {
+  double latitude_deg = 0.0, longitude_deg = 0.0;
+  double from_utc = 0.0, to_utc = 0.0;  // seconds since 1970 (parseUtcTime), from < to
+  double step_minutes = 10.0;           // (0, 1440]
+  double size_deg = 0.53;               // the sun's disc, as SunLight
+  double azimuth_bucket_deg = 0.25;     // (0, 10]
+  bool apparent = false;                // refraction lifts the sun (sunPosition)
+};
+
+struct Insolation {
+  int width = 0;
+  int height = 0;
+  // Hours with the sun's centre above the horizon; NaN at nodata.
+  std::vector<float> sun_hours;
+  // The direct irradiation from a sun of normal irradiance 1: the sum over steps of hours times
+  // the disc's seen part times max(0, n . s), in hours (times the normal irradiance, W / m^2,
+  // it is Wh / m^2); NaN at nodata.
+  std::vector<float> direct;
+  int steps = 0;   // steps with the sun up
+  int sweeps = 0;  // horizon sweeps run (azimuth buckets)
+};
+
+// Throws InvalidArgument for options outside the ranges above, a span that does not run
+// forward or holds over 10 million steps, or a place or time sunPosition refuses.
+void validate(const InsolationOptions& options);
+
+// Throws InvalidArgument for a bad field, options (validate) or sweep options, and what computeHorizons throws. `progress` of `sweep` counts
+// buckets.
+Insolation computeInsolation(const ComputeContext& context, const HeightField& field,
+                             const InsolationOptions& options, const SweepOptions& sweep = {});
 
 }  // namespace hfvis
