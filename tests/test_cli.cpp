@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -874,6 +875,124 @@ TEST_F(Cli, ShadeLightsFlatGroundWithTheSun) {
                           " --at 2026-06-21T12:00Z --lat 40", " --sun 200,30 --sun-size 20"}) {
     const CliResult r = run("shade " + shellQuoted(field) + " -o " + shellQuoted(out("bad.exr")) + bad);
     EXPECT_EQ(r.status, 2) << bad << ": " << r.err;
+    EXPECT_FALSE(fs::exists(out("bad.exr"))) << bad;
+  }
+}
+
+// "hfvis shade --env": a uniform one-channel environment of radiance 2 gives channel Y = 2 pi on
+// flat ground; an RGB map gives R, G, B, and with --albedo the radiance albedo / pi times the
+// irradiance (plus the sun's direct light); bad maps are runtime errors naming the file, with
+// nothing written.
+TEST_F(Cli, ShadeLightsWithAnEnvironment) {
+  const std::string field = flat();
+  auto writeMap = [&](const std::string& name, int width, int height, std::vector<std::string> names, float value) {
+    hfvis::ImageChannels image;
+    image.width = width;
+    image.height = height;
+    image.names = std::move(names);
+    for (std::size_t c = 0; c < image.names.size(); ++c)
+      image.planes.emplace_back(static_cast<std::size_t>(width) * height, value * (1.0f + c));
+    hfvis::writeImage(in(name), image);
+    return in(name);
+  };
+  const std::string grey = writeMap("grey.exr", 16, 8, {"Y"}, 2.0f);
+  const CliResult y = run("shade " + shellQuoted(field) + " -o " + shellQuoted(out("y.exr")) + " --env " +
+                          shellQuoted(grey) + " -k 16 -q");
+  ASSERT_EQ(y.status, 0) << y.err;
+  const ReadBack ry = readBack(out("y.exr"));
+  ASSERT_EQ(ry.channels, (std::vector<std::string>{"Y"}));
+  for (int row = 0; row < ry.height; ++row)
+    for (int col = 0; col < ry.width; ++col) ASSERT_NEAR(ry.at(col, row, 0), 2.0 * M_PI, 1e-4) << col << "," << row;
+  const std::string rgb = writeMap("rgb.exr", 16, 8, {"R", "G", "B"}, 1.0f);  // R 1, G 2, B 3
+  const CliResult c = run("shade " + shellQuoted(field) + " -o " + shellQuoted(out("c.exr")) + " --env " +
+                          shellQuoted(rgb) + " --sun 100,30 --albedo 0.5 --sun-irradiance 4 -q --preview " +
+                          shellQuoted(out("c.png")));
+  ASSERT_EQ(c.status, 0) << c.err;
+  const ReadBack rc = readBack(out("c.exr"));
+  std::vector<std::string> names = rc.channels;
+  std::sort(names.begin(), names.end());
+  ASSERT_EQ(names, (std::vector<std::string>{"B", "G", "R", "direct", "radiance.B", "radiance.G", "radiance.R",
+                                             "sun"}));
+  auto channel = [&](const std::string& name) {
+    return static_cast<int>(std::find(rc.channels.begin(), rc.channels.end(), name) - rc.channels.begin());
+  };
+  for (int ch = 0; ch < 3; ++ch) {
+    const std::string colour(1, "RGB"[ch]);
+    EXPECT_NEAR(rc.at(5, 5, channel(colour)), M_PI * (1 + ch), 1e-4) << ch;
+    // 0.5 / pi (pi (1, 2, 3) + 4 sin(30 degrees)).
+    EXPECT_NEAR(rc.at(5, 5, channel("radiance." + colour)), 0.5 / M_PI * (M_PI * (1 + ch) + 4 * 0.5), 1e-4) << ch;
+  }
+  EXPECT_TRUE(fs::exists(out("c.png")));
+  // Bad maps: not 2:1, a negative or non-finite radiance, two channels, unreadable.
+  const std::string narrow = writeMap("narrow.exr", 12, 8, {"Y"}, 1.0f);
+  const std::string negative = writeMap("negative.exr", 16, 8, {"Y"}, -1.0f);
+  const std::string infinite = writeMap("infinite.exr", 16, 8, {"Y"}, INFINITY);
+  const std::string two = writeMap("two.exr", 16, 8, {"U", "V"}, 1.0f);
+  const std::string garbage = in("garbage.exr");
+  std::ofstream(garbage) << "not an image";
+  fs::remove_all(outputs());
+  fs::create_directories(outputs());
+  for (const auto& [map, named] : std::vector<std::pair<std::string, std::string>>{
+           {narrow, "twice as wide"}, {negative, "radiance must be finite and >= 0"},
+           {infinite, "radiance must be finite"}, {two, "one channel or R, G, B"}, {garbage, "garbage.exr"}}) {
+    const CliResult r = run("shade " + shellQuoted(field) + " -o " + shellQuoted(out("bad.exr")) + " --env " +
+                            shellQuoted(map) + " -q");
+    expectFailure(r, 1, named);
+  }
+  // Usage errors: --env-rotate without --env, --albedo out of range, an environment as the output.
+  for (const std::string& bad : {std::string(" --sun 100,30 --env-rotate 10"), " --env " + shellQuoted(grey) +
+                                     " --albedo 1.5", " --env " + shellQuoted(out("bad.exr"))}) {
+    const CliResult r = run("shade " + shellQuoted(field) + " -o " + shellQuoted(out("bad.exr")) + bad);
+    EXPECT_EQ(r.status, 2) << bad << ": " << r.err;
+    EXPECT_TRUE(listDirectory(outputs()).empty()) << bad;
+  }
+}
+
+// "hfvis insolation": flat ground at the equator on the 2026 March equinox has 12 hours of sun
+// (the geometric centre above the horizon; the equinox falls at 14:46 UTC that day, so the
+// declination moves by 0.4 degree over the day: a minute or two); direct is the integral of
+// sin(elevation) over the day. A south-up GeoTIFF is lit north-up: a wall's shadow falls on its
+// north side at noon in the northern winter.
+TEST_F(Cli, InsolationCountsSunHours) {
+  const std::string field = flat();
+  const CliResult r = run("insolation " + shellQuoted(field) + " -o " + shellQuoted(out("i.exr")) +
+                          " --lat 0 --lon 0 --from 2026-03-20T00:00:00Z --to 2026-03-21T00:00:00Z --step 2 -q");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const ReadBack i = readBack(out("i.exr"));
+  ASSERT_EQ(i.channels, (std::vector<std::string>{"direct", "sun_hours"}));
+  EXPECT_NEAR(i.at(4, 4, 1), 12.0, 0.05);
+  // The integral of sin(elevation) over a day at the equator's equinox: 24 / pi hours.
+  EXPECT_NEAR(i.at(4, 4, 0), 24.0 / M_PI, 0.01);
+  // North-up and south-up rasters of a wall along the rows at row 6 (of 12): at noon on the
+  // December solstice at 45 N the sun stands 21.6 degrees up in the south, so the wall (4 high,
+  // 1 m cells) shades the 10 m north of it.
+  const int width = 8, height = 24;
+  std::vector<float> north_up(width * height, 0.0f), south_up(width * height, 0.0f);
+  for (int c = 0; c < width; ++c) north_up[12 * width + c] = south_up[11 * width + c] = 4.0f;
+  const std::string n = in("north.tif"), s = in("south.tif");
+  hfvis::testing::writeGdalGeoTiff(n, width, height, north_up, {500000.0, 1.0, 0.0, 5000024.0, 0.0, -1.0},
+                                   "EPSG:32631", std::nullopt);
+  hfvis::testing::writeGdalGeoTiff(s, width, height, south_up, {500000.0, 1.0, 0.0, 5000000.0, 0.0, 1.0},
+                                   "EPSG:32631", std::nullopt);
+  for (const std::string& tif : {n, s}) {
+    const std::string o = out(fs::path(tif).stem().string() + ".exr");
+    const CliResult w = run("shade " + shellQuoted(tif) + " -o " + shellQuoted(o) +
+                            " --at 2026-12-21T11:47:00Z --lat 45 --lon 3 -q");
+    ASSERT_EQ(w.status, 0) << w.err;
+    const ReadBack shade = readBack(o);
+    const bool south = tif == s;
+    // The rows 2 m north of the wall (in file order) are in shadow, 2 m south lit.
+    const int north_row = south ? 13 : 10, south_row = south ? 9 : 14;
+    EXPECT_EQ(shade.at(3, north_row, 1), 0.0f) << tif;
+    EXPECT_EQ(shade.at(3, south_row, 1), 1.0f) << tif;
+  }
+  for (const char* bad : {" --lat 0 --lon 0 --from 2026-03-20T00:00:00Z",
+                          " --lat 0 --lon 0 --from 2026-03-21T00:00:00Z --to 2026-03-20T00:00:00Z",
+                          " --lat 0 --lon 0 --from 2026-03-20T00:00:00Z --to 2026-03-21T00:00:00Z --step 0",
+                          " --lat 0 --lon 0 --from 2026-03-20T00:00:00Z --to 2026-03-21T00:00:00Z -k 8",
+                          " --lat 95 --lon 0 --from 2026-03-20T00:00:00Z --to 2026-03-21T00:00:00Z"}) {
+    const CliResult b = run("insolation " + shellQuoted(field) + " -o " + shellQuoted(out("bad.exr")) + bad);
+    EXPECT_EQ(b.status, 2) << bad << ": " << b.err;
     EXPECT_FALSE(fs::exists(out("bad.exr"))) << bad;
   }
 }
