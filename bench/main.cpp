@@ -16,6 +16,11 @@
 //   hfvis_bench vis-run FIELD [--method tree|naive] [-k K] [--tuning plain|deferred|default|zone]
 //                       [--zone-steps S] [--reps N]
 //       visible counts by one method on one field: min and median time, statistics
+//   hfvis_bench lighting-time --env ENV [-k K[,K...]] [--reps N] FIELD...
+//       environment lighting (computeHorizons, irradiance only): the fastest of N runs per field and K
+//   hfvis_bench lighting-error FIELD --env ENV [--samples M] [-k K[,K...]] [--rows R[,R...]]
+//       environment lighting against a Monte-Carlo ray-traced reference: mean and 99th-percentile
+//       relative error against K (the map's rows) and against the table's bands (the largest K)
 //   hfvis_bench inputs [--quick]
 //       the generated fields both suites read, one "<content> <N>" per line
 //   hfvis_bench check-truth
@@ -26,6 +31,8 @@
 //       runs the march kernels once (what vectorize-report re-runs under
 //       POCL_VECTORIZER_REMARKS=1)
 #include <algorithm>
+#include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -36,6 +43,9 @@
 #include <vector>
 
 #include "ground_truth.hpp"
+#include "hfvis/environment.hpp"
+#include "hfvis/horizon.hpp"
+#include "lighting.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/image_io.hpp"
 #include "hfvis/intervisibility.hpp"
@@ -56,6 +66,8 @@ constexpr const char* kUsage =
     "                   [--outputs angles|svf|ao|device] [--max-distance D] [--reps N]\n"
     "       hfvis_bench visibility [--quick | --tiny] --out DIR [--data DIR] [--dem FILE] [--commit TEXT]\n"
     "                              [--sections time,stats,zone,scale,accuracy]\n"
+    "       hfvis_bench lighting-time --env ENV [-k K[,K...]] [--reps N] FIELD...\n"
+    "       hfvis_bench lighting-error FIELD --env ENV [--samples M] [-k K[,K...]] [--rows R[,R...]]\n"
     "       hfvis_bench vis-run FIELD [--method tree|naive] [-k K] [--tuning plain|deferred|default|zone]\n"
     "                           [--zone-steps S] [--reps N]\n"
     "       hfvis_bench inputs [--quick]\n"
@@ -219,6 +231,92 @@ int checkTruth() {
 
 }  // namespace
 
+// "A,B,C" as whole numbers.
+std::vector<int> intList(const std::string& text) {
+  std::vector<int> out;
+  for (std::size_t at = 0; at < text.size();) {
+    const std::size_t end = std::min(text.find(',', at), text.size());
+    out.push_back(std::stoi(text.substr(at, end - at)));
+    at = end + 1;
+  }
+  if (out.empty()) throw Usage("expected a list of whole numbers, got '" + text + "'");
+  return out;
+}
+
+int lightingTime(Arguments& args) {
+  const EnvironmentMap map = readEnvironmentMap(args.get("--env"));
+  const std::vector<int> ks = intList(args.get("-k", "16,64,256"));
+  const int reps = std::stoi(args.get("--reps", "3"));
+  const std::vector<std::string> fields = args.positional();
+  args.rejectUnused();
+  if (fields.empty()) throw Usage("lighting-time needs FIELD...");
+  const ComputeContext context = ComputeContext::create(ContextOptions::fromEnvironment());
+  std::printf("| N | K | seconds per frame | ns per pixel and direction |\n|---|---|---|---|\n");
+  for (const std::string& path : fields) {
+    const HeightField field = readHeightField(path);
+    timeEnvironmentLighting(context, field, map, 1, 1);  // the program built
+    for (int k : ks) {
+      const double s = timeEnvironmentLighting(context, field, map, k, reps);
+      std::printf("| %d | %d | %.3f | %.1f |\n", field.width, k, s, s * 1e9 / (double(field.pixelCount()) * k));
+      std::fflush(stdout);
+    }
+  }
+  std::printf("\n(%s, %s; the fastest of %d runs, the map %d x %d)\n", context.device().name.c_str(),
+              context.device().platform.c_str(), reps, map.width, map.height);
+  return 0;
+}
+
+int lightingError(Arguments& args) {
+  EnvironmentMap map = readEnvironmentMap(args.get("--env"));
+  const int samples = std::stoi(args.get("--samples", "4096"));
+  const std::vector<int> ks = intList(args.get("-k", "4,8,16,32,64,128,256"));
+  const std::vector<int> rows = intList(args.get("--rows", "8,16,32,64"));
+  const std::vector<std::string> fields = args.positional();
+  args.rejectUnused();
+  if (fields.size() != 1) throw Usage("lighting-error needs one FIELD");
+  const HeightField field = readHeightField(fields[0]);
+  const ComputeContext context = ComputeContext::create(ContextOptions::fromEnvironment());
+  const auto start = std::chrono::steady_clock::now();
+  const LightingReference ref = monteCarloIrradiance(field, map, samples);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const std::size_t values = ref.irradiance.size();
+  double noise = 0.0;
+  for (std::size_t i = 0; i < values; ++i) noise += ref.noise[i] / ref.irradiance[i];
+  std::printf("Reference: %d random directions per pixel, %d bright map pixels on grids, %.0f s on %d threads; "
+              "its own noise (half the difference of its halves) %.3f %% on the mean.\n\n",
+              ref.samples, ref.bright_pixels, seconds, threads(), 100.0 * noise / values);
+  auto errors = [&](int k, int table_rows) {
+    map.table_rows = table_rows;
+    HorizonOptions options;
+    options.directions = k;
+    HorizonOutputs outputs;
+    outputs.environment = &map;
+    const HorizonResult r = computeHorizons(context, field, options, outputs);
+    std::vector<double> e(values);
+    double sum = 0.0;
+    for (std::size_t i = 0; i < values; ++i) {
+      e[i] = std::fabs(r.irradiance[i] - ref.irradiance[i]) / ref.irradiance[i];
+      sum += e[i];
+    }
+    std::nth_element(e.begin(), e.begin() + values * 99 / 100, e.end());
+    return std::make_pair(sum / values, e[values * 99 / 100]);
+  };
+  std::printf("| K | bands | mean relative error | 99th percentile |\n|---|---|---|---|\n");
+  for (int k : ks) {
+    const auto [mean, worst] = errors(k, 0);
+    std::printf("| %d | %d (the map's) | %.3f %% | %.2f %% |\n", k, map.height, 100.0 * mean, 100.0 * worst);
+    std::fflush(stdout);
+  }
+  for (int table_rows : rows) {
+    const auto [mean, worst] = errors(ks.back(), table_rows);
+    std::printf("| %d | %d | %.3f %% | %.2f %% |\n", ks.back(), table_rows, 100.0 * mean, 100.0 * worst);
+    std::fflush(stdout);
+  }
+  std::printf("\n(%s: %d x %d; the map %d x %d, %d channels; %s)\n", fields[0].c_str(), field.width, field.height,
+              map.width, map.height, map.channels, context.device().name.c_str());
+  return 0;
+}
+
 int main(int argc, char** argv) {
   try {
     if (argc < 2) throw Usage("no command given");
@@ -254,6 +352,8 @@ int main(int argc, char** argv) {
     }
     if (command == "run") return runOne(args);
     if (command == "vis-run") return runVisibilityOne(args);
+    if (command == "lighting-time") return lightingTime(args);
+    if (command == "lighting-error") return lightingError(args);
     if (command == "inputs") {
       const std::string mode = args.flag("--quick") ? "quick" : "full";
       std::set<std::pair<std::string, int>> inputs;

@@ -55,6 +55,17 @@ def png(path, w, h, channels, rows):
                 + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
 png("two_channels.png", 4, 3, 2, [[1, 2] * 4 for _ in range(3)])
 PY
+# Environment maps with a negative and a non-finite radiance (2:1, one channel).
+/usr/bin/python3 - "$root/data" << 'PY'
+import sys
+import numpy as np
+sys.path.insert(0, sys.argv[1])
+import make_data
+make_data.write_exr_builtin("negative.exr", -np.ones((8, 16)), {})
+nan = np.ones((8, 16))
+nan[3, 5] = np.nan
+make_data.write_exr_builtin("nan.exr", nan, {})
+PY
 # A GeoTIFF of the field (no georeference: only its name matters here).
 "$hfvis" svf field.exr -o field.tif -k 1 -q
 sum_before=$(cat field.exr field.tif | md5sum)
@@ -136,6 +147,16 @@ try "radiance of another size" "" -- bounce field.exr --radiance two_channels.pn
 try "shade without a sun" "" -- shade field.exr -o out/o.exr
 try "shade given the sun two ways" "" -- shade field.exr -o out/o.exr --sun 180,30 --at 2026-06-21T12:00:00Z --lat 45 --lon 7
 try "shade with a sun below the nadir" "" -- shade field.exr -o out/o.exr --sun 180,-95
+try "environment map not 2:1" "" -- shade field.exr -o out/o.exr --env field.exr
+try "environment map not an image" "" -- shade field.exr -o out/o.exr --env garbage.exr
+try "environment map with two channels" "" -- shade field.exr -o out/o.exr --env two_channels.png
+try "environment map with a negative radiance" "" -- shade field.exr -o out/o.exr --env negative.exr
+try "environment map with a NaN radiance" "" -- shade field.exr -o out/o.exr --env nan.exr
+try "environment map is the output" "" -- shade field.exr -o out/o.exr --env out/o.exr
+try "albedo beyond 1" "" -- shade field.exr -o out/o.exr --sun 180,30 --albedo 1.5
+try "insolation without a span" "" -- insolation field.exr -o out/o.exr --lat 45 --lon 7
+try "insolation running backwards" "" -- insolation field.exr -o out/o.exr --lat 45 --lon 7 --from 2026-06-22T00:00:00Z --to 2026-06-21T00:00:00Z
+try "insolation in steps of 0 minutes" "" -- insolation field.exr -o out/o.exr --lat 45 --lon 7 --from 2026-06-21T00:00:00Z --to 2026-06-22T00:00:00Z --step 0
 try "sun position without a time" "" -- sunpos --lat 45 --lon 7
 try "sun position at a time without a zone" "" -- sunpos --lat 45 --lon 7 --at 2026-06-21T12:00:00
 try "sun position at a day that does not exist" "" -- sunpos --lat 45 --lon 7 --at 2026-02-30T12:00:00Z

@@ -21,6 +21,7 @@
 #include "gdal_io.hpp"
 #include "geotiff_support.hpp"
 #include "hfvis/errors.hpp"
+#include "hfvis/environment.hpp"
 #include "hfvis/image_io.hpp"
 
 namespace hfvis {
@@ -348,10 +349,16 @@ TEST_F(ImageIoTest, FloatTiffRoundTrip) {
 }
 
 TEST(ImageIoData, BundledExrFieldsRead) {
-  // Every height field shipped in data/ must read without options.
+  // Every height field shipped in data/ must read without options, and the environment map as one.
   int count = 0;
   for (const auto& entry : fs::directory_iterator(HFVIS_DATA_DIR)) {
     if (entry.path().extension() != ".exr") continue;
+    if (entry.path().filename() == "clear_sky.exr") {
+      const EnvironmentMap sky = readEnvironmentMap(entry.path().string());
+      EXPECT_EQ(sky.channels, 3);
+      EXPECT_EQ(sky.width, 2 * sky.height);
+      continue;
+    }
     const HeightField field = readHeightField(entry.path().string());
     EXPECT_GT(field.width, 0) << entry.path();
     EXPECT_GT(field.height, 0) << entry.path();
