@@ -2,7 +2,7 @@
 // K, and the error against a Monte-Carlo ray-traced reference against K and the table's bands.
 //
 // The reference: per pixel, stratified cosine-weighted directions about the surface normal (the
-// library's normal), each marched on the bilinear surface in steps of a quarter pixel until it
+// library's normal), each marched on the bilinear surface in steps of a twentieth of a pixel until it
 // leaves the field (seen: the map's radiance in that direction, nearest pixel) or passes below
 // the surface (hidden). The map's brightest pixels (a sun) are left out of the random directions
 // and integrated on a 16 x 16 grid of directions each, as they would dominate the variance.
@@ -45,7 +45,7 @@ bool unoccluded(const HeightField& f, int c, int r, const Vec& w, float top) {
   if (horizontal < 1e-9) return true;
   const double gx = w.x / horizontal, gy = w.y / horizontal, slope = w.z / horizontal;
   const double h0 = f.heights[static_cast<std::size_t>(r) * f.width + c];
-  const double step = 0.25 * std::min(f.cell_size_x, f.cell_size_y);
+  const double step = 0.05 * std::min(f.cell_size_x, f.cell_size_y);
   for (double t = step;; t += step) {
     const double px = c + t * gx / f.cell_size_x, py = r + t * gy / f.cell_size_y;
     if (px < 0.0 || py < 0.0 || px > f.width - 1 || py > f.height - 1) return true;

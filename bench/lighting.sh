@@ -54,8 +54,8 @@ git -C "$root" diff --quiet HEAD 2> /dev/null || commit="$commit (with uncommitt
   echo "## Error against a Monte-Carlo reference"
   echo
   echo "Per pixel, stratified cosine-weighted directions about the normal, each marched on the"
-  echo "bilinear surface in quarter-pixel steps; the map's sun pixel on a 16 x 16 grid of directions"
-  echo "(bench/lighting.cpp). Relative error per pixel and channel."
+  echo "bilinear surface in steps of 1/20 pixel (1/4 left 0.3 % of error in the reference); the map's sun"
+  echo "pixel on a 16 x 16 grid of directions (bench/lighting.cpp). Relative error per pixel and channel."
   echo
   "$bench" lighting-error "$data/fractal_64.exr" --env "$root/data/clear_sky.exr" --samples "$samples" \
     -k 4,8,16,32,64,128,256 --rows 8,16,32,64

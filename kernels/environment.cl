@@ -25,25 +25,47 @@
 #define HFVIS_ENV_TERMS 6
 
 // Adds one direction's irradiance at a receiver to its sums (channel c's at sums[c * stride]),
-// or makes them NaN at nodata. x: the slope tan(e) of the lowest elevation that counts
-// (lower_limit); at x = tan(e), sin^2(theta) = cos^2(e) = 1 / (1 + x^2), sin(theta) cos(theta)
-// = x cos^2(e) and theta = pi / 2 - atan(x), the same pieces as ambient_term. The band comes
-// from the polynomial atan: near a band's edge it may be the next band, where the two give the
-// same value up to rounding (the table is continuous across edges).
-HFVIS_INLINE void environment_add(HFVIS_GLOBAL float* sums, unsigned int stride, int channels, int nodata, float x,
-                                  float nx, float ny, float nz, float cos_az, float sin_az,
-                                  HFVIS_GLOBAL const float* table, int rows) {
-  const float toward = nx * cos_az + ny * sin_az, across = ny * cos_az - nx * sin_az;
-  const float cos2 = 1.0f / (1.0f + x * x), zenith = 0.5f * HFVIS_PI_F - hf_atan(x);
-  const float q1 = 0.5f * cos2, q2 = 0.5f * (zenith - x * cos2);
-  int band = (int)(zenith * ((float)rows / HFVIS_PI_F));
-  band = band < 0 ? 0 : (band >= rows ? rows - 1 : band);
+// or makes them NaN at nodata: nz A + toward B + across C at the zenith angle of band `band`, with
+// q1 and q2 there (environment_add).
+HFVIS_INLINE void environment_accumulate(HFVIS_GLOBAL float* sums, unsigned int stride, int channels, int nodata,
+                                         int band, float q1, float q2, float nz, float toward, float across,
+                                         HFVIS_GLOBAL const float* table) {
   HFVIS_GLOBAL const float* t = table + band * channels * HFVIS_ENV_TERMS;
   for (int c = 0; c < channels; ++c, t += HFVIS_ENV_TERMS) {
     const float e = nz * (t[0] + t[1] * q1) + toward * (t[2] + t[3] * q2) + across * (t[4] + t[5] * q2);
     HFVIS_GLOBAL float* sum = sums + c * stride;
     *sum = nodata ? NAN : *sum + e;
   }
+}
+
+// What environment_accumulate takes at a receiver, for scalars and lane vectors alike: for the
+// slope x = tan(e) of the lowest elevation that counts (lower_limit), sin^2(theta) = cos^2(e) =
+// 1 / (1 + x^2), sin(theta) cos(theta) = x cos^2(e) and theta = pi / 2 - atan(x), the same pieces
+// as ambient_term; the band from the polynomial atan (near a band's edge it may be the next band,
+// where the two give the same value up to rounding: the table is continuous across edges); the
+// normal's components toward the direction (cos_az, sin_az) and across it (+90 degrees).
+#define HFVIS_ENVIRONMENT_TERMS(T, IT, CONVERT_IT)                                                        \
+  HFVIS_INLINE HFVIS_OVERLOADABLE void environment_terms(T x, T nx, T ny, T cos_az, T sin_az, int rows,     \
+                                                         IT* band, T* q1, T* q2, T* toward, T* across) {    \
+    const T cos2 = 1.0f / (1.0f + x * x), zenith = 0.5f * HFVIS_PI_F - hf_atan(x);                          \
+    *q1 = 0.5f * cos2;                                                                                      \
+    *q2 = 0.5f * (zenith - x * cos2);                                                                       \
+    const IT b = CONVERT_IT(zenith * ((float)rows / HFVIS_PI_F));                                           \
+    *band = b < 0 ? (IT)0 : (b >= rows ? (IT)(rows - 1) : b);                                               \
+    *toward = nx * cos_az + ny * sin_az;                                                                    \
+    *across = ny * cos_az - nx * sin_az;                                                                    \
+  }
+#define HFVIS_CONVERT_INT(v) ((int)(v))
+HFVIS_ENVIRONMENT_TERMS(float, int, HFVIS_CONVERT_INT)
+
+// One direction's irradiance at a scalar receiver (the naive march and the scalar reference).
+HFVIS_INLINE void environment_add(HFVIS_GLOBAL float* sums, unsigned int stride, int channels, int nodata, float x,
+                                  float nx, float ny, float nz, float cos_az, float sin_az,
+                                  HFVIS_GLOBAL const float* table, int rows) {
+  int band;
+  float q1, q2, toward, across;
+  environment_terms(x, nx, ny, cos_az, sin_az, rows, &band, &q1, &q2, &toward, &across);
+  environment_accumulate(sums, stride, channels, nodata, band, q1, q2, nz, toward, across, table);
 }
 
 #ifdef __OPENCL_VERSION__

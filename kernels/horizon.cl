@@ -172,6 +172,7 @@ HFVIS_DIRECTION_TERMS(float, int)
 #if HFVIS_LANES > 1
 HFVIS_DEFINE_ATAN(lane_float, lane_int)
 HFVIS_DIRECTION_TERMS(lane_float, lane_int)
+HFVIS_ENVIRONMENT_TERMS(lane_float, lane_int, convert_int8)
 #endif
 
 // A direction's outputs go to its planes, from `plane` on in `angles` / `distances`, and into
@@ -259,13 +260,17 @@ HFVIS_INLINE void emit_lanes(lane_int live, lane_int pixel, lane_int nodata, lan
   }
 #endif
 #if HFVIS_WANT_ENV
+  // The terms lane-parallel (the arctangent above all), the tables' gathers lane by lane.
   const lane_float x = lower_limit(found, rise, run, nx * cos_az + ny * sin_az, (lane_float)1.0f);
+  lane_int band;
+  lane_float q1, q2, toward, across;
+  environment_terms(x, nx, ny, cos_az, sin_az, env_rows, &band, &q1, &q2, &toward, &across);
 #pragma unroll
   for (int l = 0; l < HFVIS_LANES; ++l)
     if (ILANE(live, l))
-      environment_add(env_sum + (uint)ILANE(pixel, l), env_stride, HFVIS_ENV_CHANNELS, ILANE(nodata, l) != 0,
-                      LANE(x, l), LANE(nx, l), LANE(ny, l), 1.0f, LANE(cos_az, l), LANE(sin_az, l),
-                      env_tables + env_offset, env_rows);
+      environment_accumulate(env_sum + (uint)ILANE(pixel, l), env_stride, HFVIS_ENV_CHANNELS, ILANE(nodata, l) != 0,
+                             ILANE(band, l), LANE(q1, l), LANE(q2, l), 1.0f, LANE(toward, l), LANE(across, l),
+                             env_tables + env_offset);
 #endif
 }
 

@@ -466,7 +466,9 @@ TEST_F(ImageIoTest, GeoTiffGeographicRowsGetTheirOwnSpacing) {
     detail::metresPerDegree(65.0 - r, &along_meridian, &along_parallel);
     EXPECT_DOUBLE_EQ(field.row_cell_size_x[r], along_parallel) << r;
     EXPECT_DOUBLE_EQ(field.row_cell_size_y[r], along_meridian) << r;
-    if (r > 0) EXPECT_GT(field.row_cell_size_x[r], field.row_cell_size_x[r - 1]);
+    if (r > 0) {
+      EXPECT_GT(field.row_cell_size_x[r], field.row_cell_size_x[r - 1]);
+    }
   }
   // A projected raster, or a cell size given, has none.
   HeightFieldReadOptions given;
