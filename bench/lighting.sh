@@ -59,6 +59,6 @@ git -C "$root" diff --quiet HEAD 2> /dev/null || commit="$commit (with uncommitt
   echo
   "$bench" lighting-error "$data/fractal_64.exr" --env "$root/data/clear_sky.exr" --samples "$samples" \
     -k 4,8,16,32,64,128,256 --rows 8,16,32,64
-} > "$out.tmp"
+} | sed "s|$root/||g" > "$out.tmp"
 mv "$out.tmp" "$out"
 echo "wrote $out"
