@@ -689,6 +689,8 @@ int runInsolation(const RunArguments& run) {
   attributes.emplace_back("hfvis:sun_size_deg", formatNumber(options.size_deg));
   attributes.emplace_back("hfvis:azimuth_bucket_deg", formatNumber(options.azimuth_bucket_deg));
   attributes.emplace_back("hfvis:refraction", options.apparent ? "apparent (refracted) elevations" : "geometric");
+  attributes.emplace_back("hfvis:steps_with_sun", std::to_string(result.steps));
+  attributes.emplace_back("hfvis:sweeps", std::to_string(result.sweeps));
   StagedOutputs outputs;
   // "direct" sorts before "sun_hours": channel 0 in the EXR.
   const ImageChannels image = makeImage(

@@ -93,7 +93,8 @@ Insolation computeInsolation(const ComputeContext& context, const HeightField& f
       horizon_options.directions = 1;
       horizon_options.azimuth_offset =
           std::remainder((bucket * options.azimuth_bucket_deg - 90.0) * kDegree, 2.0 * M_PI);
-      horizon_options.azimuth_tolerance = 0.02 * kDegree;
+      // A step within half a bucket of its centre: every step of the bucket within a bucket of it.
+      horizon_options.azimuth_tolerance = std::min(0.1, 0.5 * options.azimuth_bucket_deg * kDegree);
       HorizonOutputs outputs;
       outputs.horizon_angles = true;
       const HorizonResult h = computeHorizons(context, field, horizon_options, outputs);

@@ -51,7 +51,9 @@ SunShading computeSunShading(const ComputeContext& context, const HeightField& f
 // its azimuth and above the astronomical horizon (terrain beyond the field is taken as level at
 // the pixel's height: the horizon is at least 0 there); steps with the whole disc below elevation
 // 0 are skipped. Steps whose sun azimuths fall in one bucket of azimuth_bucket_deg share one
-// horizon sweep (at the bucket's centre), so a year costs a few hundred sweeps, not one per step.
+// horizon sweep, along the cheapest integer step within half a bucket of the bucket's centre (so
+// within a bucket of every sun it lights; the closest step where none is that close), so a year
+// costs a few hundred sweeps, not one per step.
 struct InsolationOptions {
   double latitude_deg = 0.0, longitude_deg = 0.0;
   double from_utc = 0.0, to_utc = 0.0;  // seconds since 1970 (parseUtcTime), from < to
