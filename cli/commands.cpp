@@ -472,6 +472,8 @@ ComputeContext contextFor(const RunArguments& run) {
 
 }  // namespace
 
+namespace {
+
 // Lighting assumes row 0 is north (compass azimuth = hfvis azimuth + 90 degrees). A raster whose
 // geotransform runs south-up (t[5] > 0) is lit flipped north-up, and its results flipped back.
 struct NorthUp {
@@ -530,6 +532,8 @@ std::vector<std::vector<float>> readAlbedo(const RunArguments& run, const Height
         throw IoError(run.albedo, "albedo values must be in 0 .. 1 (found " + formatNumber(v) + ")");
   return planes;
 }
+
+}  // namespace
 
 int runShade(const RunArguments& run) {
   std::vector<std::string> paths = outputPaths(run);

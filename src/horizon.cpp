@@ -379,7 +379,7 @@ class HorizonRoutine : public SweepRoutine {
           loadStrip(s0, s1);
           scaleByNormals(s1 - s0);
           if (outputs_.ambient_occlusion) readRows(ao_, result_.ambient_occlusion, s0, s1);
-          readEnvironmentRows(s0, s1);
+          copyEnvironmentRows(s0, s1);
         }
       }
     } else {
@@ -416,13 +416,13 @@ class HorizonRoutine : public SweepRoutine {
   // in one piece).
   cl_uint sumStride() const { return static_cast<cl_uint>(static_cast<std::size_t>(plan_.strip_rows) * field_.width); }
 
-  // Strips: the irradiance sums of rows [s0, s1) from the device (or to it, `upload`).
-  void readEnvironmentRows(int s0, int s1, bool upload = false) {
+  // Strips: the irradiance sums of rows [s0, s1) from the device (or to it, `to_device`).
+  void copyEnvironmentRows(int s0, int s1, bool to_device = false) {
     const std::size_t width = field_.width, bytes = (s1 - s0) * width * sizeof(float);
     for (int c = 0; c < environmentChannels(); ++c) {
       float* host = &result_.irradiance[c * field_.pixelCount() + s0 * width];
       const std::size_t at = c * sumStride() * sizeof(float);
-      if (upload)
+      if (to_device)
         st_.queue.enqueueWriteBuffer(env_sum_, CL_FALSE, at, bytes, host);
       else
         st_.queue.enqueueReadBuffer(env_sum_, CL_TRUE, at, bytes, host);
@@ -461,7 +461,7 @@ class HorizonRoutine : public SweepRoutine {
       st_.queue.enqueueWriteBuffer(svf_, CL_FALSE, 0, bytes, &result_.sky_view_factor[s0 * width]);
     if (outputs_.ambient_occlusion)
       st_.queue.enqueueWriteBuffer(ao_, CL_FALSE, 0, bytes, &result_.ambient_occlusion[s0 * width]);
-    readEnvironmentRows(s0, s1, true);
+    copyEnvironmentRows(s0, s1, true);
     if (needsNormals()) computeNormals(row0, s0, s1);
     return row0;
   }
@@ -716,7 +716,7 @@ class HorizonRoutine : public SweepRoutine {
       if (outputs_.horizon_distances) readRows(distances_, result_.distances, s0, s1, k * plane);
       if (outputs_.sky_view_factor) readRows(svf_, result_.sky_view_factor, s0, s1);
       if (outputs_.ambient_occlusion) readRows(ao_, result_.ambient_occlusion, s0, s1);
-      readEnvironmentRows(s0, s1);
+      copyEnvironmentRows(s0, s1);
       if (!receiver_positions_.empty()) {  // the strip's receivers' positions, for the strips after
         const std::size_t width = field_.width;
         st_.queue.enqueueReadBuffer(receiver_base_, CL_TRUE, (s0 - row0) * width * sizeof(float),
