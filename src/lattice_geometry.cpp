@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <sstream>
 
 #include "hfvis/errors.hpp"
@@ -48,6 +49,31 @@ std::vector<Candidate> candidates(const HeightField& field) {
     return x.a * x.a + x.b * x.b < y.a * y.a + y.b * y.b;
   });
   return all;
+}
+
+// A single direction at an exact azimuth (the sun's sweeps) where no step up to kMaxLatticeStep is
+// within `tolerance` of `target`: the cheapest primitive step of up to kMaxExactStep pixels along
+// its major axis that is (the closer of two equally cheap ones); none when none is. For each
+// major length a, the minor one nearest the target's slope.
+std::optional<Candidate> longStep(const HeightField& field, double target, double tolerance) {
+  // The target's direction in pixels: ground (cos, sin) over the cell sizes.
+  const double px = std::cos(target) / field.cell_size_x, py = std::sin(target) / field.cell_size_y;
+  const bool x_major = std::fabs(px) >= std::fabs(py);
+  const double slope = x_major ? std::fabs(py / px) : std::fabs(px / py);
+  const int sx = px < 0.0 ? -1 : 1, sy = py < 0.0 ? -1 : 1;
+  std::optional<Candidate> best;
+  double best_error = 0.0;
+  for (int major = 1; major <= kMaxExactStep; ++major) {
+    const int minor = static_cast<int>(std::lround(major * slope));
+    if (std::gcd(major, minor) != 1) continue;  // its reduced step came earlier
+    const int a = sx * (x_major ? major : minor), b = sy * (x_major ? minor : major);
+    const int cost = (a != 0 && b != 0) ? std::abs(a) + std::abs(b) - 1 : 1;
+    if (best && cost > best->cost) break;  // costs only grow with the major length
+    const double azimuth = std::atan2(b * field.cell_size_y, a * field.cell_size_x);
+    const double error = std::abs(angleDifference(azimuth, target));
+    if (error <= tolerance && (!best || error < best_error)) best = Candidate{a, b, cost, azimuth}, best_error = error;
+  }
+  return best;
 }
 
 LatticeDirection makeDirection(const HeightField& field, const Candidate& c) {
@@ -105,7 +131,9 @@ std::vector<LatticeDirection> latticeDirections(const HeightField& field, const 
       if (error <= window && (!chosen || error < chosen_error)) chosen = &c, chosen_error = error;
       if (!closest || error < closest_error) closest = &c, closest_error = error;
     }
-    out.push_back(makeDirection(field, chosen ? *chosen : *closest));
+    std::optional<Candidate> longer;
+    if (!chosen && exact_azimuths && K == 1) longer = longStep(field, target, window);
+    out.push_back(makeDirection(field, chosen ? *chosen : longer ? *longer : *closest));
     out.back().azimuth = target + angleDifference(out.back().azimuth, target);  // next to phi_k
   }
   if (exact_azimuths || K == 1) {

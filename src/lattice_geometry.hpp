@@ -36,10 +36,13 @@ struct LatticeDirection {
 // over azimuth) the cheapest strictly within half the spacing 2 pi / K, with quadrature
 // weights from the azimuths actually used (half the gap to each neighbour). "Cheapest" is the fewest
 // crossings per period, |a| + |b| - 1 (1 on the axes), and among those the closest to phi_k.
-// Steps are bounded by kMaxLatticeStep. Quadrature directions that fall back to the same
-// step (very large K) are merged: one carries their weight, the others have weight 0 and
-// are not swept.
+// Steps are bounded by kMaxLatticeStep, but a single exact direction (K = 1: the sun's sweeps)
+// that no such step comes within `tolerance` of takes the cheapest longer one that does, of up to
+// kMaxExactStep pixels (about 0.014 degree from an axis: a step's cost, its crossings per
+// receiver, is paid once). Quadrature directions that fall back to the same step (very large K)
+// are merged: one carries their weight, the others have weight 0 and are not swept.
 constexpr int kMaxLatticeStep = 64;
+constexpr int kMaxExactStep = 4096;
 std::vector<LatticeDirection> latticeDirections(const HeightField& field, const SweepOptions& options,
                                                 bool exact_azimuths, double tolerance);
 

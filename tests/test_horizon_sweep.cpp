@@ -377,7 +377,9 @@ TEST(HorizonKernels, SweepEqualsNaiveOnAxisDirectionsWithinAMaximumDistance) {
           const auto naive = computeHorizons(context, field, options, outputs);
           EXPECT_TRUE(nearlyEqual(sweep.angles, naive.angles, 1e-5f));
           for (float distance : sweep.distances) {
-            if (!std::isnan(distance)) ASSERT_LE(distance, d);
+if (!std::isnan(distance)) {
+  ASSERT_LE(distance, d);
+}
           }
         }
       }

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "hfvis/errors.hpp"
+#include "hfvis/reference.hpp"
 #include "hfvis/shading.hpp"
 #include "hfvis/synthetic_fields.hpp"
 #include "lattice_geometry.hpp"
@@ -102,27 +103,57 @@ TEST(SunShading, RefusesBadSuns) {
   EXPECT_THROW(computeSunShading(testContext(), flat, sun), InvalidArgument);
 }
 
-// The sun's sweep takes the integer step (up to 64 pixels) closest to its azimuth: over azimuths
-// 0.1 degree apart, how far that is (shading.hpp and README quote these figures; the farthest,
-// half of atan(1/64) = 0.448 degree, lie next to the axes).
+// The sun's sweep takes the cheapest integer step within 0.02 degree of its azimuth: of up to 64
+// pixels where one is, else a longer one (next to the axes, where the nearest short steps are up
+// to half of atan(1/64) = 0.448 degree away). Over azimuths 0.1 degree apart: how far, and how
+// long the steps get (shading.hpp and README quote these figures).
 TEST(SunShading, SweptStepIsCloseToTheSun) {
   const HeightField field = makeSyntheticField("flat", 8, 8);
   double worst = 0.0;
-  int close = 0;
+  int long_steps = 0, longest = 0;
   const int n = 3600;
   for (int i = 0; i < n; ++i) {
     SweepOptions options;
     options.directions = 1;
     options.azimuth_offset = (i * 0.1 - 180.0 + 0.05) * kDegree;
-    const double error =
-        std::fabs(detail::latticeDirections(field, options, true, 0.02 * kDegree)[0].azimuth - options.azimuth_offset);
-    worst = std::max(worst, error / kDegree);
-    close += error <= 0.02 * kDegree;
+    const detail::LatticeDirection d = detail::latticeDirections(field, options, true, 0.02 * kDegree)[0];
+    worst = std::max(worst, std::fabs(d.azimuth - options.azimuth_offset) / kDegree);
+    const int length = std::max(std::abs(d.a), std::abs(d.b));
+    long_steps += length > detail::kMaxLatticeStep;
+    longest = std::max(longest, length);
   }
-  std::printf("swept step: within 0.02 degree for %.1f %% of azimuths, at most %.3f degree off\n",
-              100.0 * close / n, worst);
-  EXPECT_LE(worst, 0.45);
-  EXPECT_GE(close, 0.75 * n);
+  std::printf("swept step: at most %.4f degree off; %.1f %% of azimuths take a step over 64 pixels, the longest %d\n",
+              worst, 100.0 * long_steps / n, longest);
+  EXPECT_LE(worst, 0.02);
+  EXPECT_LT(long_steps, n / 4);
+}
+
+// A long step (the sun 0.3 degree from an axis: a step of over 64 pixels) runs through the same kernel: its
+// horizons equal the scalar reference's, on the hard cases, in both layouts.
+TEST(SunShading, LongStepsMatchTheReference) {
+  for (const char* name : {"spikes", "cliff", "nan_holes", "noise"}) {
+    const HeightField field = makeSyntheticField(name, 300, 40);
+    HorizonOptions options;
+    options.directions = 1;
+    options.azimuth_offset = 0.3 * kDegree;
+    options.azimuth_tolerance = 0.02 * kDegree;
+    HorizonOutputs outputs;
+    outputs.horizon_angles = true;
+    const detail::LatticeDirection d = detail::latticeDirections(field, options, true, options.azimuth_tolerance)[0];
+    EXPECT_GT(d.a, detail::kMaxLatticeStep) << name;
+    const HorizonResult expected = referenceHorizons(field, options, outputs);
+    testing::forEachLayout([&](const ComputeContext& context) {
+      const HorizonResult got = computeHorizons(context, field, options, outputs);
+      ASSERT_EQ(got.angles.size(), expected.angles.size());
+      for (std::size_t p = 0; p < got.angles.size(); ++p) {
+        if (std::isnan(expected.angles[p])) {
+          ASSERT_TRUE(std::isnan(got.angles[p])) << name << " pixel " << p;
+        } else {
+          ASSERT_EQ(got.angles[p], expected.angles[p]) << name << " pixel " << p;
+        }
+      }
+    });
+  }
 }
 
 // Insolation: the buckets' shared sweeps against one exact sweep per step (computeSunShading),

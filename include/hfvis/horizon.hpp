@@ -25,9 +25,10 @@ struct HorizonOptions : SweepOptions {
   // lies on a line through its own centre (see README, "How the sweep works"). When the
   // per-direction planes are requested, direction k is the cheapest step whose azimuth is
   // within this many radians of phi_k (the closest one when none is; steps up to 64
-  // pixels); HorizonResult::azimuths gives the azimuths used. Sky-view factor and ambient
-  // occlusion alone integrate over azimuth: they take the cheapest step within half the
-  // spacing 2 pi / K of phi_k, weighted by the share of the circle it stands for.
+  // pixels, and for a single direction, K = 1, up to 4096 where no shorter one is within);
+  // HorizonResult::azimuths gives the azimuths used. Sky-view factor, ambient occlusion and
+  // the environment's irradiance alone integrate over azimuth: they take the cheapest step
+  // within half the spacing 2 pi / K of phi_k, weighted by the share of the circle it stands for.
   // samples_per_unit S: the sweep samples every grid-line crossing of a receiver's ray
   // (exact heights of the bilinear surface) and, for S > 1, about S points per pixel length
   // between crossings. Default: 0.25 degrees.
