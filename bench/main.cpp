@@ -281,10 +281,12 @@ int lightingError(Arguments& args) {
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const std::size_t values = ref.irradiance.size();
   double noise = 0.0;
-  for (std::size_t i = 0; i < values; ++i) noise += ref.noise[i] / ref.irradiance[i];
+  std::size_t lit = 0;
+  for (std::size_t i = 0; i < values; ++i)
+    if (ref.irradiance[i] > 0.0) noise += ref.noise[i] / ref.irradiance[i], ++lit;
   std::printf("Reference: %d random directions per pixel, %d bright map pixels on grids, %.0f s on %d threads; "
               "its own noise (half the difference of its halves) %.3f %% on the mean.\n\n",
-              ref.samples, ref.bright_pixels, seconds, threads(), 100.0 * noise / values);
+              ref.samples, ref.bright_pixels, seconds, threads(), 100.0 * noise / std::max<std::size_t>(lit, 1));
   auto errors = [&](int k, int table_rows) {
     map.table_rows = table_rows;
     HorizonOptions options;
@@ -292,14 +294,17 @@ int lightingError(Arguments& args) {
     HorizonOutputs outputs;
     outputs.environment = &map;
     const HorizonResult r = computeHorizons(context, field, options, outputs);
-    std::vector<double> e(values);
+    // Relative errors where the reference receives light (a wholly hidden value has no scale).
+    std::vector<double> e;
     double sum = 0.0;
     for (std::size_t i = 0; i < values; ++i) {
-      e[i] = std::fabs(r.irradiance[i] - ref.irradiance[i]) / ref.irradiance[i];
-      sum += e[i];
+      if (!(ref.irradiance[i] > 0.0)) continue;
+      e.push_back(std::fabs(r.irradiance[i] - ref.irradiance[i]) / ref.irradiance[i]);
+      sum += e.back();
     }
-    std::nth_element(e.begin(), e.begin() + values * 99 / 100, e.end());
-    return std::make_pair(sum / values, e[values * 99 / 100]);
+    if (e.empty()) throw std::runtime_error("the reference receives no light anywhere");
+    std::nth_element(e.begin(), e.begin() + e.size() * 99 / 100, e.end());
+    return std::make_pair(sum / e.size(), e[e.size() * 99 / 100]);
   };
   std::printf("| K | bands | mean relative error | 99th percentile |\n|---|---|---|---|\n");
   for (int k : ks) {

@@ -530,6 +530,7 @@ void validateRun(Command command, const RunArguments& run) {
     if (run.environment.empty() && (run.environment_rotation_deg != 0.0 || run.environment_rows != 0))
       throw UsageError("--env-rotate and --env-rows need --env ENV.exr");
     if (!sun && run.sun_irradiance != 1.0) throw UsageError("--sun-irradiance needs the sun");
+    if (!sun && run.sun_size_deg != 0.53) throw UsageError("--sun-size needs the sun");
     if (!run.environment.empty() && samePath(run.output, run.environment))
       throw UsageError("--env must differ from -o, both are " + inQuotes(run.output));
     if (!run.albedo.empty() && samePath(run.output, run.albedo))

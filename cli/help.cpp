@@ -289,7 +289,7 @@ std::string commandHelp(Command command) {
                  "  n . s), the irradiance from a sun of normal irradiance 1. --sun AZ,EL (compass azimuth,\n"
                  "  degrees clockwise from north; elevation, degrees), or where it stands at --at TIME seen\n"
                  "  from --lat, --lon (as 'hfvis sunpos', geometric). Only the sun's azimuth is swept, along\n"
-                 "  the cheapest integer step within 0.02 degree of it (near the axes hundreds of pixels\n"
+                 "  the cheapest integer step within 0.02 degree of it (near the axes up to 1415 pixels\n"
                  "  long, and as slow).\n"
                  "--albedo A|FILE (a number in 0..1, or an image of the field's size, 1 or 3 channels): also\n"
                  "  \"radiance\" (or radiance.R/G/B), albedo / pi times the irradiance: the environment's plus\n"

@@ -69,6 +69,10 @@ HFVIS_INLINE void environment_add(HFVIS_GLOBAL float* sums, unsigned int stride,
 }
 
 #ifdef __OPENCL_VERSION__
+// cos(a) - cos(b), the solid angle per radian of azimuth between zenith angles a < b, without the
+// cancellation of the difference near the zenith (bands of 65536 rows).
+inline float solid_between(float a, float b) { return 2.0f * sin(0.5f * (a + b)) * sin(0.5f * (b - a)); }
+
 // The tables of every direction, one work-item per direction (a table costs the map's rows
 // times the columns of its swath: microseconds, next to the sweep's N^2 per direction).
 // env: the map's planes (channel c at c * env_width * env_height), row 0 at the zenith.
@@ -88,7 +92,7 @@ __kernel void environment_tables(__global const float* env, int env_width, int e
   __global float* out = tables + (size_t)k * rows * channels * HFVIS_ENV_TERMS;
   for (int i = 0; i < rows; ++i) {
     const float theta0 = (float)i * HFVIS_PI_F / (float)rows, theta1 = (float)(i + 1) * HFVIS_PI_F / (float)rows;
-    const float band_solid = cos(theta0) - cos(theta1);
+    const float band_solid = solid_between(theta0, theta1);
     float sa[3] = {0.0f, 0.0f, 0.0f}, sb[3] = {0.0f, 0.0f, 0.0f}, sc[3] = {0.0f, 0.0f, 0.0f};
     // The map's rows the band spans (with the map's own rows, row i alone, wholly).
     const int same = env_height == rows;
@@ -97,12 +101,15 @@ __kernel void environment_tables(__global const float* env, int env_width, int e
     for (int j = j0; j < j1; ++j) {
       const float a = fmax(theta0, (float)j * HFVIS_PI_F / (float)env_height);
       const float b = fmin(theta1, (float)(j + 1) * HFVIS_PI_F / (float)env_height);
-      const float share = same ? 1.0f : (cos(a) - cos(b)) / band_solid;  // the row's share of the band
+      const float share = same ? 1.0f : solid_between(a, b) / band_solid;  // the row's share of the band
       if (!(share > 0.0f)) continue;
       for (int q = span.x; q < span.x + span.y; ++q) {
         const float4 bin = bins[q];
-        int column = (int)bin.w;
-        for (float edge = bin.z; edge < bin.y; edge += column_width, ++column) {
+        // Each column's left edge from its own count (a running sum would drift over wide swaths).
+        for (int n = 0;; ++n) {
+          const float edge = bin.z + (float)n * column_width;
+          if (!(edge < bin.y)) break;
+          const int column = (int)bin.w + n;
           const float lo = fmax(edge, bin.x), hi = fmin(edge + column_width, bin.y);
           if (!(hi > lo)) continue;
           // The column's azimuths lo .. hi: their measure, and the integrals of cos and sin.

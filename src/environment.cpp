@@ -94,12 +94,13 @@ EnvironmentSwaths environmentSwaths(const EnvironmentMap& map, const std::vector
   std::vector<std::vector<std::array<double, 2>>> spans(K);
   for (std::size_t k = 0; k < K; ++k) {
     const double azimuth = directions[k].azimuth;
-    double before = M_PI, after = M_PI;
+    // One direction stands for the whole circle, two for half of it each.
+    double before = 2.0 * M_PI, after = 2.0 * M_PI;
     if (K > 2) {
       before = angleDifference(azimuth, directions[(k + K - 1) % K].azimuth);
       after = angleDifference(directions[(k + 1) % K].azimuth, azimuth);
     } else if (K == 2) {
-      before = after = 0.5 * M_PI;
+      before = after = M_PI;
     }
     std::size_t owner = k;
     for (std::size_t m = 0; m < k && directions[k].weight == 0.0; ++m) {

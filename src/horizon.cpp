@@ -271,7 +271,7 @@ class HorizonRoutine : public SweepRoutine {
   }
   bool heightsResident() const override { return !inStrips(); }
   bool needsNormals() const { return outputs_.ambient_occlusion || outputs_.environment; }
-  int environmentChannels() const { return outputs_.environment ? outputs_.environment->channels : 0; }
+  int environmentChannels() const { return static_cast<int>(environmentPlanes(outputs_)); }
   bool inStrips() const { return plan_.strip_rows < field_.height; }
 
   void allocate() override {
@@ -316,13 +316,20 @@ class HorizonRoutine : public SweepRoutine {
     std::vector<LatticeDirection> directions;
     for (const RunDirection& d : directions_) directions.push_back(d.lattice);
     const EnvironmentSwaths swaths = environmentSwaths(map, directions);
+    // The tables are one buffer, each direction's found at a 32-bit offset.
+    const std::size_t table_bytes = directions_.size() * envTableFloats() * sizeof(float);
+    const std::size_t max_alloc = st_.info.max_allocation_bytes ? st_.info.max_allocation_bytes : table_bytes;
+    if (directions_.size() * envTableFloats() >= (std::size_t(1) << 32) || table_bytes > max_alloc)
+      throw MemoryBudgetError("the environment's tables take " + mebibytes(table_bytes) +
+                              ", beyond the device's largest buffer or 2^32 values; take fewer directions or "
+                              "fewer table rows (EnvironmentMap::table_rows, --env-rows)");
     auto upload = [&](const void* data, std::size_t bytes) {
       return cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes, const_cast<void*>(data));
     };
     const cl::Buffer env = upload(map.radiance.data(), map.radiance.size() * sizeof(float));
     const cl::Buffer bins = upload(swaths.bins.data(), swaths.bins.size() * sizeof(swaths.bins[0]));
     const cl::Buffer spans = upload(swaths.spans.data(), swaths.spans.size() * sizeof(swaths.spans[0]));
-    cl::Buffer tables = deviceBuffer(st_, directions_.size() * envTableFloats() * sizeof(float));
+    cl::Buffer tables = deviceBuffer(st_, table_bytes);
     cl::Kernel kernel(program_, "environment_tables");
     kernel.setArg(0, env);
     kernel.setArg(1, map.width);
@@ -782,7 +789,8 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
                               const HorizonOptions& options, const HorizonOutputs& outputs) {
   validate(field);
   validate(options, outputs);
-  detail::checkPixelIndexing(field, 1);
+  // The environment's sums: a plane per channel, indexed in 32 bits in the kernels.
+  detail::checkPixelIndexing(field, outputs.environment ? outputs.environment->channels : 1);
   if (outputs.environment && detail::hasRowSpacing(field))
     throw InvalidArgument(
         "environment lighting takes a field of one cell size: this latitude / longitude grid's spacing differs "

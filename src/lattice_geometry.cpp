@@ -53,27 +53,23 @@ std::vector<Candidate> candidates(const HeightField& field) {
 
 // A single direction at an exact azimuth (the sun's sweeps) where no step up to kMaxLatticeStep is
 // within `tolerance` of `target`: the cheapest primitive step of up to kMaxExactStep pixels along
-// its major axis that is (the closer of two equally cheap ones); none when none is. For each
-// major length a, the minor one nearest the target's slope.
+// its major axis that is; none when none is. For each major length, the minor one nearest the
+// target's slope; a step's cost grows with its major length, so the first one within wins.
 std::optional<Candidate> longStep(const HeightField& field, double target, double tolerance) {
   // The target's direction in pixels: ground (cos, sin) over the cell sizes.
   const double px = std::cos(target) / field.cell_size_x, py = std::sin(target) / field.cell_size_y;
   const bool x_major = std::fabs(px) >= std::fabs(py);
   const double slope = x_major ? std::fabs(py / px) : std::fabs(px / py);
   const int sx = px < 0.0 ? -1 : 1, sy = py < 0.0 ? -1 : 1;
-  std::optional<Candidate> best;
-  double best_error = 0.0;
   for (int major = 1; major <= kMaxExactStep; ++major) {
     const int minor = static_cast<int>(std::lround(major * slope));
     if (std::gcd(major, minor) != 1) continue;  // its reduced step came earlier
     const int a = sx * (x_major ? major : minor), b = sy * (x_major ? minor : major);
-    const int cost = (a != 0 && b != 0) ? std::abs(a) + std::abs(b) - 1 : 1;
-    if (best && cost > best->cost) break;  // costs only grow with the major length
     const double azimuth = std::atan2(b * field.cell_size_y, a * field.cell_size_x);
-    const double error = std::abs(angleDifference(azimuth, target));
-    if (error <= tolerance && (!best || error < best_error)) best = Candidate{a, b, cost, azimuth}, best_error = error;
+    if (std::abs(angleDifference(azimuth, target)) <= tolerance)
+      return Candidate{a, b, (a != 0 && b != 0) ? std::abs(a) + std::abs(b) - 1 : 1, azimuth};
   }
-  return best;
+  return std::nullopt;
 }
 
 LatticeDirection makeDirection(const HeightField& field, const Candidate& c) {

@@ -160,6 +160,22 @@ TEST(Environment, UniformEnvironmentIsPiTimesAmbientOcclusion) {
   }
 }
 
+// One direction stands for the whole circle, two for half of it each: open flat ground under a
+// uniform environment of radiance 1 receives pi whatever K, by the sweep and the naive march.
+TEST(Environment, FewDirectionsCoverTheCircle) {
+  const EnvironmentMap uniform = uniformEnvironment(1.0f, 8);
+  const HeightField flat = makeSyntheticField("flat", 9, 7);
+  for (HorizonMethod method : {HorizonMethod::Sweep, HorizonMethod::Naive}) {
+    for (int k : {1, 2, 3, 5}) {
+      HorizonOptions options;
+      options.directions = k;
+      options.method = method;
+      const HorizonResult r = computeHorizons(testContext(), flat, options, environmentOutputs(uniform));
+      for (float e : r.irradiance) ASSERT_NEAR(e, M_PI, 1e-5) << "K " << k << " method " << int(method);
+    }
+  }
+}
+
 // Open flat ground sees the upper hemisphere: E = the cosine-weighted integral of the map over
 // it, here by a quadrature of its own. A tilted plane (its interior: the plane is its own horizon
 // everywhere) sees the hemisphere around its normal, part of it below the horizontal; there the

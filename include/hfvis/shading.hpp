@@ -5,7 +5,7 @@
 // and elevation (hfvis/sun.hpp; over a field whose row 0 is north, hfvis azimuth = compass
 // azimuth - 90 degrees). Only the sun's azimuth is swept: the horizon of every pixel in that
 // one direction, along the sweep's cheapest integer step within 0.02 degree of it (far inside the
-// disc's 0.265 degree radius; next to the axes a step of hundreds of pixels, which costs as many
+// disc's 0.265 degree radius; next to the axes a step of up to 1415 pixels, which costs as many
 // samples per pixel; the swept azimuth is returned), and the part of the disc above that
 // horizon, taken as a straight line across the disc (the horizon's slope across a disc's width
 // is left out).
