@@ -214,7 +214,8 @@ Exit status: 0 success, 1 runtime error (unreadable input, device or write failu
 
 std::string generalHelp() {
   return std::string(
-             "hfvis: horizons, sky-view factor, ambient occlusion, intervisibility and one-bounce light on "
+             "hfvis: horizons, sky-view factor, ambient occlusion, intervisibility, one-bounce light, and lighting by "
+             "HDR environments and the sun on "
              "height fields (OpenCL)\n\n") +
          kUsage + kCommands + kOptions + kHorizonOnly + kViewCount + kHorizonLists + kBounce + kConventions +
          kExitStatus;
