@@ -591,7 +591,7 @@ int runShade(const RunArguments& run) {
   if (environment) {
     attributes.emplace_back("hfvis:environment", run.environment);
     attributes.emplace_back("hfvis:environment_rotation_deg", formatNumber(run.environment_rotation_deg));
-    attributes.emplace_back("hfvis:environment_table_rows", std::to_string((environment->table_rows > 0 ? environment->table_rows : environment->height)));
+    attributes.emplace_back("hfvis:environment_table_rows", std::to_string(tableRows(*environment)));
     names = environment->names;
     planes = splitPlanes(env.irradiance, pixels, environment->channels);
     quantity = environment->names.size() == 1 ? "Y" : "R, G, B";

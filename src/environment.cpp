@@ -75,6 +75,8 @@ EnvironmentMap readEnvironmentMap(const std::string& path) {
   return map;
 }
 
+int tableRows(const EnvironmentMap& map) { return map.table_rows > 0 ? map.table_rows : map.height; }
+
 EnvironmentMap uniformEnvironment(float radiance, int height) {
   EnvironmentMap map;
   map.width = 2 * height;
@@ -86,8 +88,6 @@ EnvironmentMap uniformEnvironment(float radiance, int height) {
 }
 
 namespace detail {
-
-int tableRows(const EnvironmentMap& map) { return map.table_rows > 0 ? map.table_rows : map.height; }
 
 EnvironmentSwaths environmentSwaths(const EnvironmentMap& map, const std::vector<LatticeDirection>& directions) {
   const std::size_t K = directions.size();

@@ -14,9 +14,6 @@ namespace hfvis::detail {
 // Floats per band and channel of a table (HFVIS_ENV_TERMS in kernels/environment.cl).
 constexpr int kEnvTerms = 6;
 
-// The bands of zenith angle in a map's tables (EnvironmentMap::table_rows, 0 = its rows).
-int tableRows(const EnvironmentMap& map);
-
 // As environment_tables in kernels/environment.cl takes them: bins (lo, hi, edge, column) as
 // float4, spans (first bin, bins) as int2 per direction.
 struct EnvironmentSwaths {

@@ -57,6 +57,9 @@ void validate(const EnvironmentMap& map);
 // for a map with other channels, and for what validate refuses.
 EnvironmentMap readEnvironmentMap(const std::string& path);
 
+// The bands of zenith angle in the map's tables: table_rows, or the map's rows when 0.
+int tableRows(const EnvironmentMap& map);
+
 // A uniform environment of `radiance` in one channel, `height` rows (tests and tools).
 EnvironmentMap uniformEnvironment(float radiance, int height = 8);
 
