@@ -1,0 +1,268 @@
+// viewshed.cpp: from-point visibility (see hfvis/viewshed.hpp): the field goes to the device
+// once per call; per observer the rays' bounds and the targets (kernels/viewshed.cl).
+#include "hfvis/viewshed.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "hfvis/errors.hpp"
+#include "horizon_common.hpp"
+#include "opencl_context.hpp"
+#include "sweep_framework.hpp"
+
+namespace hfvis {
+namespace {
+
+constexpr double kDegree = M_PI / 180.0;
+// Boxes whose farthest point is nearer than this many pixels march every target: their rays
+// would be as long as the sight lines.
+constexpr double kLeastRayPixels = 24.0;
+
+// The kernels' Field struct.
+struct DeviceField {
+  cl_int width, height;
+  cl_float cell_x, cell_y;
+  cl_float curvature;
+};
+
+bool finiteIn(double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; }
+
+// The grid points analysed: the field clipped to the maximum distance around the observer.
+cl_int4 targetBox(const HeightField& field, const Observer& o, double max_distance) {
+  cl_int4 box{{0, 0, field.width - 1, field.height - 1}};
+  if (max_distance > 0.0) {
+    const double rx = std::floor(max_distance / field.cell_size_x), ry = std::floor(max_distance / field.cell_size_y);
+    box.s[0] = static_cast<int>(std::max(0.0, o.col - rx));
+    box.s[1] = static_cast<int>(std::max(0.0, o.row - ry));
+    box.s[2] = static_cast<int>(std::min(field.width - 1.0, o.col + rx));
+    box.s[3] = static_cast<int>(std::min(field.height - 1.0, o.row + ry));
+  }
+  return box;
+}
+
+// Border point p of the box, as border_point in kernels/viewshed.cl counts.
+std::pair<int, int> borderPoint(int p, const cl_int4& box) {
+  const int w1 = box.s[2] - box.s[0], h1 = box.s[3] - box.s[1];
+  if (p <= w1) return {box.s[0] + p, box.s[1]};
+  p -= w1;
+  if (p <= h1) return {box.s[2], box.s[1] + p};
+  p -= h1;
+  if (p <= w1) return {box.s[2] - p, box.s[3]};
+  p -= w1;
+  return {box.s[0], box.s[3] - p};
+}
+
+// The device side of one field, kept for every observer of a call.
+class ViewshedRun {
+ public:
+  ViewshedRun(detail::ContextState& st, const HeightField& field, const ViewshedOptions& options)
+      : st_(st), field_(field), options_(options), program_(st.program("viewshed.cl", "")) {
+    const std::size_t pixels = field.pixelCount();
+    heights_.resize(pixels);
+    for (std::size_t p = 0; p < pixels; ++p)
+      heights_[p] = std::isfinite(field.heights[p]) ? static_cast<float>(field.heights[p] * field.z_scale)
+                                                    : std::numeric_limits<float>::quiet_NaN();
+    device_ = {field.width, field.height, static_cast<float>(field.cell_size_x), static_cast<float>(field.cell_size_y),
+               static_cast<float>(options.curvature)};
+    heights_buffer_ = cl::Buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, pixels * sizeof(float),
+                                 heights_.data());
+    const int cells_x = std::max(field.width - 1, 1), cells_y = std::max(field.height - 1, 1);
+    lipschitz_ = detail::deviceBuffer(st, static_cast<std::size_t>(cells_x) * cells_y * sizeof(float));
+    cl::Kernel k(program_, "viewshed_lipschitz");
+    k.setArg(0, heights_buffer_);
+    k.setArg(1, device_);
+    k.setArg(2, lipschitz_);
+    st.launch(k, cl::NDRange(detail::roundUp(cells_x, detail::kTileX), detail::roundUp(cells_y, detail::kTileY)),
+              cl::NDRange(detail::kTileX, detail::kTileY));
+    budget_ = options.memory_budget ? options.memory_budget : detail::defaultMemoryBudget(st.info);
+  }
+
+  // One observer's targets into `visible` (added to it when `accumulate`) and, if given, `angle`.
+  void observe(const Observer& o, cl::Buffer& visible, bool accumulate, cl::Buffer* angle) {
+    const std::size_t pixels = field_.pixelCount();
+    const float ze = static_cast<float>(options_.absolute ? o.height
+                                                          : heights_[static_cast<std::size_t>(o.row) * field_.width + o.col] + o.height);
+    const cl_int4 box = targetBox(field_, o, options_.max_distance);
+    const int w1 = box.s[2] - box.s[0], h1 = box.s[3] - box.s[1];
+    int rays = 0;
+    float spacing = 0.0f;
+    cl::Buffer offsets = detail::deviceBuffer(st_, sizeof(cl_uint)), bounds = detail::deviceBuffer(st_, 8);
+    const bool ray_major = detail::lineMajorLayout(st_);
+    const double far_pixels = std::max({o.col - box.s[0], box.s[2] - o.col, o.row - box.s[1], box.s[3] - o.row});
+    if (!options_.march_every_target && w1 >= 1 && h1 >= 1 && far_pixels >= kLeastRayPixels) {
+      rays = 2 * w1 + 2 * h1;
+      std::vector<double> lengths(rays);
+      for (int r = 0; r < rays; ++r) {
+        const auto [x, y] = borderPoint(r, box);
+        lengths[r] = std::hypot((x - o.col) * field_.cell_size_x, (y - o.row) * field_.cell_size_y);
+      }
+      const double least_cell = std::min(field_.cell_size_x, field_.cell_size_y);
+      std::vector<cl_uint> offset(rays + 1);
+      std::size_t entries = 0;
+      for (double step = 2.0;; step *= 2.0) {
+        spacing = static_cast<float>(step * least_cell);
+        std::size_t total = 0, longest = 0;
+        for (int r = 0; r < rays; ++r) {
+          const std::size_t n = static_cast<std::size_t>(std::floor(lengths[r] / spacing));
+          offset[r] = static_cast<cl_uint>(total);
+          total += n;
+          longest = std::max(longest, n);
+        }
+        offset[rays] = static_cast<cl_uint>(total);
+        entries = ray_major ? total : longest * rays;
+        if (entries * sizeof(cl_float2) <= budget_ / 2 && total < std::numeric_limits<cl_uint>::max()) break;
+        if (step >= 64.0)
+          throw MemoryBudgetError("the viewshed's ray bounds need " + detail::mebibytes(entries * sizeof(cl_float2)) +
+                                  " even 64 pixels apart, but the budget is " + detail::mebibytes(budget_));
+      }
+      offsets = cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, offset.size() * sizeof(cl_uint),
+                           offset.data());
+      bounds = detail::deviceBuffer(st_, std::max<std::size_t>(entries, 1) * sizeof(cl_float2));
+      cl::Kernel k(program_, "viewshed_rays");
+      int a = 0;
+      k.setArg(a++, heights_buffer_);
+      k.setArg(a++, device_);
+      k.setArg(a++, lipschitz_);
+      k.setArg(a++, static_cast<float>(o.col));
+      k.setArg(a++, static_cast<float>(o.row));
+      k.setArg(a++, ze);
+      k.setArg(a++, box);
+      k.setArg(a++, rays);
+      k.setArg(a++, offsets);
+      k.setArg(a++, ray_major ? 1 : 0);
+      k.setArg(a++, spacing);
+      k.setArg(a++, bounds);
+      st_.launch(k, cl::NDRange(detail::roundUp(rays, detail::kLineGroup)), cl::NDRange(detail::kLineGroup));
+    }
+    double az_span = 360.0;
+    if (options_.azimuth_from_deg != options_.azimuth_to_deg) {
+      az_span = std::fmod(options_.azimuth_to_deg - options_.azimuth_from_deg, 360.0);
+      if (az_span < 0.0) az_span += 360.0;
+    }
+    cl::Kernel k(program_, "viewshed_targets");
+    int a = 0;
+    k.setArg(a++, heights_buffer_);
+    k.setArg(a++, device_);
+    k.setArg(a++, o.col);
+    k.setArg(a++, o.row);
+    k.setArg(a++, ze);
+    k.setArg(a++, static_cast<float>(options_.target_height));
+    k.setArg(a++, box);
+    k.setArg(a++, static_cast<float>(options_.max_distance));
+    k.setArg(a++, az_span < 360.0 ? 1 : 0);
+    k.setArg(a++, static_cast<float>(options_.azimuth_from_deg));
+    k.setArg(a++, static_cast<float>(az_span));
+    k.setArg(a++, static_cast<float>(options_.elevation_min_deg * kDegree));
+    k.setArg(a++, static_cast<float>(options_.elevation_max_deg * kDegree));
+    k.setArg(a++, rays);
+    k.setArg(a++, offsets);
+    k.setArg(a++, ray_major ? 1 : 0);
+    k.setArg(a++, spacing);
+    k.setArg(a++, bounds);
+    k.setArg(a++, visible);
+    k.setArg(a++, accumulate ? 1 : 0);
+    k.setArg(a++, angle ? 1 : 0);
+    k.setArg(a++, angle ? *angle : visible);
+    st_.launch(k, cl::NDRange(detail::roundUp(field_.width, detail::kTileX), detail::roundUp(field_.height, detail::kTileY)),
+               cl::NDRange(detail::kTileX, detail::kTileY));
+    st_.queue.finish();  // before this observer's ray buffers go
+    (void)pixels;
+  }
+
+  cl::Buffer output() { return detail::deviceBuffer(st_, field_.pixelCount() * sizeof(float)); }
+
+  std::vector<float> read(const cl::Buffer& b) {
+    std::vector<float> out(field_.pixelCount());
+    st_.queue.enqueueReadBuffer(b, CL_TRUE, 0, out.size() * sizeof(float), out.data());
+    return out;
+  }
+
+ private:
+  detail::ContextState& st_;
+  const HeightField& field_;
+  const ViewshedOptions& options_;
+  cl::Program program_;
+  std::vector<float> heights_;
+  DeviceField device_{};
+  cl::Buffer heights_buffer_, lipschitz_;
+  std::size_t budget_ = 0;
+};
+
+void validateViewshed(const HeightField& field, const ViewshedOptions& options) {
+  validate(field);
+  validate(options);
+  if (detail::hasRowSpacing(field))
+    throw InvalidArgument("viewsheds on latitude / longitude grids (per-row spacing) are not supported; "
+                          "reproject the DEM to a projected CRS");
+}
+
+}  // namespace
+
+void validate(const ViewshedOptions& o) {
+  if (!(std::isfinite(o.target_height) && o.target_height >= 0.0))
+    throw InvalidArgument("the target height must be finite and >= 0 (got " + std::to_string(o.target_height) + ")");
+  if (!(std::isfinite(o.max_distance) && o.max_distance >= 0.0))
+    throw InvalidArgument("the maximum distance must be finite and >= 0 (got " + std::to_string(o.max_distance) + ")");
+  if (!std::isfinite(o.curvature)) throw InvalidArgument("the curvature coefficient must be finite");
+  if (!finiteIn(o.azimuth_from_deg, 0.0, 360.0) || !finiteIn(o.azimuth_to_deg, 0.0, 360.0))
+    throw InvalidArgument("field-of-view azimuths must be in [0, 360] degrees");
+  if (!finiteIn(o.elevation_min_deg, -90.0, 90.0) || !finiteIn(o.elevation_max_deg, -90.0, 90.0) ||
+      o.elevation_min_deg > o.elevation_max_deg)
+    throw InvalidArgument("elevation limits must be in [-90, 90] degrees, the lower first");
+}
+
+void validate(const HeightField& field, const Observer& o) {
+  if (o.col < 0 || o.col >= field.width || o.row < 0 || o.row >= field.height)
+    throw InvalidArgument("observer " + std::to_string(o.col) + "," + std::to_string(o.row) + " is outside the " +
+                          std::to_string(field.width) + " x " + std::to_string(field.height) + " field");
+  if (!std::isfinite(field.at(o.col, o.row)))
+    throw InvalidArgument("observer " + std::to_string(o.col) + "," + std::to_string(o.row) + " stands on nodata");
+  if (!std::isfinite(o.height)) throw InvalidArgument("the observer's height must be finite");
+}
+
+ViewshedResult computeViewshed(const ComputeContext& context, const HeightField& field, const Observer& observer,
+                               const ViewshedOptions& options, const ViewshedOutputs& outputs) {
+  validateViewshed(field, options);
+  validate(field, observer);
+  if (!outputs.visible && !outputs.angle) throw InvalidArgument("no viewshed output requested");
+  return detail::translateOpenClErrors([&] {
+    detail::ContextState& st = detail::stateOf(context);
+    ViewshedRun run(st, field, options);
+    cl::Buffer visible = run.output();
+    cl::Buffer angle = outputs.angle ? run.output() : cl::Buffer();
+    run.observe(observer, visible, false, outputs.angle ? &angle : nullptr);
+    ViewshedResult result;
+    result.width = field.width;
+    result.height = field.height;
+    if (outputs.visible) result.visible = run.read(visible);
+    if (outputs.angle) result.angle = run.read(angle);
+    return result;
+  });
+}
+
+CumulativeViewshed computeCumulativeViewshed(const ComputeContext& context, const HeightField& field,
+                                             const std::vector<Observer>& observers, const ViewshedOptions& options) {
+  validateViewshed(field, options);
+  if (observers.empty()) throw InvalidArgument("a cumulative viewshed needs at least one observer");
+  for (const Observer& o : observers) validate(field, o);
+  return detail::translateOpenClErrors([&] {
+    detail::ContextState& st = detail::stateOf(context);
+    ViewshedRun run(st, field, options);
+    cl::Buffer count = run.output();
+    st.queue.enqueueFillBuffer(count, 0.0f, 0, field.pixelCount() * sizeof(float));
+    for (std::size_t i = 0; i < observers.size(); ++i) {
+      run.observe(observers[i], count, true, nullptr);
+      if (options.progress) options.progress(static_cast<int>(i + 1), static_cast<int>(observers.size()));
+    }
+    CumulativeViewshed result;
+    result.width = field.width;
+    result.height = field.height;
+    result.observers = static_cast<int>(observers.size());
+    result.count = run.read(count);
+    return result;
+  });
+}
+
+}  // namespace hfvis

@@ -1,0 +1,29 @@
+// hfvis/viewshed_reference.hpp: the viewshed by brute force in double precision: every sight
+// line decided exactly, cell by cell, on the bilinear surface (hfvis/viewshed.hpp's
+// definition). The oracle of the viewshed tests and the reference of its benchmark (test
+// support library hfvis_testing; not installed).
+#pragma once
+
+#include <vector>
+
+#include "hfvis/viewshed.hpp"
+
+namespace hfvis {
+
+// One sight line: visible, and how far the surface rises above the sight line at most over
+// [0, 1] (height units; <= 0 where visible), which tells how near to grazing it is.
+struct SightLine {
+  bool visible = false;
+  double rise = 0.0;
+};
+
+// The sight line from `observer` to the target on grid point (col, row), in range or not.
+SightLine referenceSightLine(const HeightField& field, const Observer& observer, const ViewshedOptions& options,
+                             int col, int row);
+
+// Every target as computeViewshed decides them (visible and angle), in double; `rise`, when
+// given, gets each in-range target's SightLine::rise (NaN elsewhere).
+ViewshedResult referenceViewshed(const HeightField& field, const Observer& observer, const ViewshedOptions& options,
+                                 std::vector<double>* rise = nullptr);
+
+}  // namespace hfvis

@@ -1,0 +1,152 @@
+// viewshed_reference.cpp: see hfvis/viewshed_reference.hpp.
+#include "hfvis/viewshed_reference.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace hfvis {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+double heightAt(const HeightField& f, int x, int y) {
+  const float v = f.at(x, y);
+  return std::isfinite(v) ? v * f.z_scale : kNaN;
+}
+
+double eyeHeight(const HeightField& f, const Observer& o, const ViewshedOptions& options) {
+  return options.absolute ? o.height : heightAt(f, o.col, o.row) + o.height;
+}
+
+bool inRange(const HeightField& f, const Observer& o, const ViewshedOptions& options, int col, int row,
+             double angle) {
+  const double gx = (col - o.col) * f.cell_size_x, gy = (row - o.row) * f.cell_size_y;
+  const double dist = std::hypot(gx, gy);
+  if (options.max_distance > 0.0 && dist > options.max_distance) return false;
+  if (angle < options.elevation_min_deg * M_PI / 180.0 || angle > options.elevation_max_deg * M_PI / 180.0)
+    return false;
+  if (options.azimuth_from_deg != options.azimuth_to_deg && dist > 0.0) {
+    double span = std::fmod(options.azimuth_to_deg - options.azimuth_from_deg, 360.0);
+    if (span < 0.0) span += 360.0;
+    double from_start = std::fmod(std::atan2(gx, -gy) * 180.0 / M_PI - options.azimuth_from_deg, 360.0);
+    if (from_start < 0.0) from_start += 360.0;
+    if (from_start > span) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+SightLine referenceSightLine(const HeightField& f, const Observer& o, const ViewshedOptions& options, int col,
+                             int row) {
+  const double ze = eyeHeight(f, o, options);
+  const double dx = col - o.col, dy = row - o.row;
+  const double d2 = std::pow(dx * f.cell_size_x, 2) + std::pow(dy * f.cell_size_y, 2);
+  const double drop = options.curvature * d2;
+  const double zt = heightAt(f, col, row) + options.target_height - drop;
+  // Where the line crosses grid lines, in order: (t, column line i or -1, row line j or -1);
+  // both at a grid point.
+  struct Crossing {
+    double t;
+    int i, j;
+  };
+  std::vector<Crossing> cs = {{0.0, o.col, o.row}, {1.0, col, row}};
+  for (int i = std::min(o.col, col) + 1; i < std::max(o.col, col); ++i) cs.push_back({(i - o.col) / dx, i, -1});
+  for (int j = std::min(o.row, row) + 1; j < std::max(o.row, row); ++j) cs.push_back({(j - o.row) / dy, -1, j});
+  std::sort(cs.begin(), cs.end(), [](const Crossing& a, const Crossing& b) { return a.t < b.t; });
+  std::vector<Crossing> merged;
+  for (const Crossing& c : cs) {
+    if (!merged.empty() && c.t - merged.back().t < 1e-12) {
+      if (c.i >= 0) merged.back().i = c.i;
+      if (c.j >= 0) merged.back().j = c.j;
+      continue;
+    }
+    merged.push_back(c);
+  }
+  auto line = [&](double t) { return ze + t * (zt - ze) + drop * t * t; };  // the sight line, curvature added back
+  // f at a crossing: the surface on the grid line there (the linear interpolation between the
+  // grid line's two heights around it, valid where both are), less the sight line.
+  auto atCrossing = [&](const Crossing& c) {
+    if (c.t == 0.0) return heightAt(f, o.col, o.row) - ze;
+    if (c.t == 1.0) return std::isnan(heightAt(f, col, row)) ? kNaN : -options.target_height;
+    double h;
+    if (c.i >= 0 && c.j >= 0) {
+      h = heightAt(f, c.i, c.j);
+    } else if (c.i >= 0) {
+      const double y = o.row + c.t * dy;
+      const int j = std::clamp(static_cast<int>(std::floor(y)), 0, f.height - 1), j1 = std::min(j + 1, f.height - 1);
+      h = y == j ? heightAt(f, c.i, j) : heightAt(f, c.i, j) + (heightAt(f, c.i, j1) - heightAt(f, c.i, j)) * (y - j);
+    } else {
+      const double x = o.col + c.t * dx;
+      const int i = std::clamp(static_cast<int>(std::floor(x)), 0, f.width - 1), i1 = std::min(i + 1, f.width - 1);
+      h = x == i ? heightAt(f, i, c.j) : heightAt(f, i, c.j) + (heightAt(f, i1, c.j) - heightAt(f, i, c.j)) * (x - i);
+    }
+    return h - line(c.t);
+  };
+  // f inside cell (cx, cy): the bilinear surface less the sight line.
+  auto inCell = [&](int cx, int cy, double t) {
+    const double x = o.col + t * dx, y = o.row + t * dy;
+    const int x1 = std::min(cx + 1, f.width - 1), y1 = std::min(cy + 1, f.height - 1);
+    const double u = x - cx, v = y - cy;
+    const double top = heightAt(f, cx, cy) + (heightAt(f, x1, cy) - heightAt(f, cx, cy)) * u;
+    const double bottom = heightAt(f, cx, y1) + (heightAt(f, x1, y1) - heightAt(f, cx, y1)) * u;
+    return top + (bottom - top) * v - line(t);
+  };
+  double rise = -std::numeric_limits<double>::infinity();
+  std::vector<double> fs(merged.size());
+  for (std::size_t s = 0; s < merged.size(); ++s) {
+    fs[s] = atCrossing(merged[s]);
+    if (!std::isnan(fs[s])) rise = std::max(rise, fs[s]);
+  }
+  for (std::size_t s = 0; s + 1 < merged.size(); ++s) {
+    const double t0 = merged[s].t, t1 = merged[s + 1].t, tm = 0.5 * (t0 + t1);
+    const int cx = std::clamp(static_cast<int>(std::floor(o.col + tm * dx)), 0, std::max(f.width - 2, 0));
+    const int cy = std::clamp(static_cast<int>(std::floor(o.row + tm * dy)), 0, std::max(f.height - 2, 0));
+    const int x1 = std::min(cx + 1, f.width - 1), y1 = std::min(cy + 1, f.height - 1);
+    const double twist = heightAt(f, cx, cy) - heightAt(f, x1, cy) - heightAt(f, cx, y1) + heightAt(f, x1, y1);
+    if (std::isnan(twist)) continue;  // a cell with a nodata corner has no surface inside
+    const double a = twist * dx * dy - drop;  // t^2 coefficient of f
+    if (a < 0.0) {
+      const double tv = -(((fs[s + 1] - fs[s]) / (t1 - t0)) - a * (t0 + t1)) / (2.0 * a);  // vertex of f
+      if (tv > t0 && tv < t1) rise = std::max(rise, inCell(cx, cy, tv));
+    }
+  }
+  return {!(rise > 0.0), rise};
+}
+
+ViewshedResult referenceViewshed(const HeightField& f, const Observer& o, const ViewshedOptions& options,
+                                 std::vector<double>* rises) {
+  ViewshedResult r;
+  r.width = f.width;
+  r.height = f.height;
+  r.visible.assign(f.pixelCount(), 0.0f);
+  r.angle.assign(f.pixelCount(), 0.0f);
+  if (rises) rises->assign(f.pixelCount(), kNaN);
+  const double ze = eyeHeight(f, o, options);
+  for (int row = 0; row < f.height; ++row)
+    for (int col = 0; col < f.width; ++col) {
+      const std::size_t p = static_cast<std::size_t>(row) * f.width + col;
+      const double h = heightAt(f, col, row);
+      if (std::isnan(h)) {
+        r.visible[p] = r.angle[p] = std::numeric_limits<float>::quiet_NaN();
+        continue;
+      }
+      const double gx = (col - o.col) * f.cell_size_x, gy = (row - o.row) * f.cell_size_y;
+      const double d2 = gx * gx + gy * gy, dist = std::sqrt(d2);
+      const double rise = h + options.target_height - options.curvature * d2 - ze;
+      const double angle = dist > 0.0 ? std::atan2(rise, dist) : (rise >= 0.0 ? M_PI / 2 : -M_PI / 2);
+      r.angle[p] = static_cast<float>(angle);
+      if (!inRange(f, o, options, col, row, angle)) continue;
+      if (dist == 0.0) {
+        r.visible[p] = 1.0f;
+        continue;
+      }
+      const SightLine s = referenceSightLine(f, o, options, col, row);
+      r.visible[p] = s.visible ? 1.0f : 0.0f;
+      if (rises) (*rises)[p] = s.rise;
+    }
+  return r;
+}
+
+}  // namespace hfvis

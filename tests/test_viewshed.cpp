@@ -1,0 +1,253 @@
+// test_viewshed.cpp: the viewshed kernels against brute force in double (hfvis/
+// viewshed_reference.hpp) on rough terrain and the hard cases, for valley, ridge, plateau,
+// high and border observers, in both layouts; curvature against its closed form; cumulative
+// viewsheds against the sum of single ones; bad input.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "hfvis/errors.hpp"
+#include "hfvis/image_io.hpp"
+#include "hfvis/sweep_options.hpp"
+#include "hfvis/synthetic_fields.hpp"
+#include "hfvis/viewshed.hpp"
+#include "hfvis/viewshed_reference.hpp"
+#include "test_support.hpp"
+
+namespace hfvis {
+namespace {
+
+using testing::forEachLayout;
+using testing::testContext;
+
+HeightField crop(const HeightField& f, int x0, int y0, int w, int h) {
+  HeightField out = f;
+  out.width = w;
+  out.height = h;
+  out.heights.resize(static_cast<std::size_t>(w) * h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) out.heights[static_cast<std::size_t>(y) * w + x] = f.at(x0 + x, y0 + y);
+  return out;
+}
+
+HeightField roughTerrain(int w = 97, int h = 83) {
+  static const HeightField fractal = readHeightField(std::string(HFVIS_DATA_DIR) + "/fractal_256.exr");
+  return crop(fractal, 40, 60, w, h);
+}
+
+// Where the field is lowest, highest (ridge / peak) and at its middle.
+Observer lowest(const HeightField& f, double height) {
+  const auto it = std::min_element(f.heights.begin(), f.heights.end(),
+                                   [](float a, float b) { return std::isfinite(a) && (!std::isfinite(b) || a < b); });
+  const int p = static_cast<int>(it - f.heights.begin());
+  return {p % f.width, p / f.width, height};
+}
+Observer highest(const HeightField& f, double height) {
+  const auto it = std::max_element(f.heights.begin(), f.heights.end(),
+                                   [](float a, float b) { return !std::isfinite(a) || (std::isfinite(b) && a < b); });
+  const int p = static_cast<int>(it - f.heights.begin());
+  return {p % f.width, p / f.width, height};
+}
+
+struct Agreement {
+  std::size_t targets = 0, visible = 0, mismatches = 0, grazing = 0;
+};
+
+// The device's viewshed against brute force. A disagreement is allowed only where the sight
+// line grazes: brute force itself decides otherwise with the eye `graze` higher or lower.
+// Returns the counts.
+Agreement compare(const ComputeContext& context, const HeightField& field, const Observer& o,
+                  const ViewshedOptions& options, double graze) {
+  const ViewshedResult want = referenceViewshed(field, o, options);
+  ViewshedOutputs outputs;
+  outputs.angle = true;
+  const ViewshedResult got = computeViewshed(context, field, o, options, outputs);
+  Agreement a;
+  for (std::size_t p = 0; p < want.visible.size(); ++p) {
+    if (std::isnan(want.visible[p])) {
+      EXPECT_TRUE(std::isnan(got.visible[p])) << "nodata at " << p;
+      continue;
+    }
+    ++a.targets;
+    a.visible += want.visible[p] == 1.0f;
+    EXPECT_NEAR(got.angle[p], want.angle[p], 2e-6 * (1.0 + std::fabs(want.angle[p]))) << "angle at " << p;
+    if (got.visible[p] == want.visible[p]) continue;
+    ++a.mismatches;
+    const int col = static_cast<int>(p % field.width), row = static_cast<int>(p / field.width);
+    const Observer higher{o.col, o.row, o.height + graze}, lower{o.col, o.row, o.height - graze};
+    if (referenceSightLine(field, higher, options, col, row).visible !=
+        referenceSightLine(field, lower, options, col, row).visible)
+      ++a.grazing;
+    else
+      ADD_FAILURE() << "target " << col << "," << row << ": device " << got.visible[p] << ", brute force "
+                    << want.visible[p] << ", also with the eye " << graze << " higher and lower";
+  }
+  return a;
+}
+
+TEST(Viewshed, RoughTerrainMatchesBruteForce) {
+  const HeightField f = roughTerrain();
+  forEachLayout([&](const ComputeContext& context) {
+    const std::vector<std::pair<std::string, Observer>> observers = {
+        {"valley", lowest(f, 2.0)},      {"ridge", highest(f, 2.0)},          {"middle", {48, 41, 2.0}},
+        {"high", {48, 41, 60.0}},        {"ground", {30, 50, 0.0}},           {"corner", {0, 0, 2.0}},
+        {"border", {96, 40, 5.0}},       {"bottom edge", {50, 82, 1.0}},
+    };
+    std::size_t visible = 0, targets = 0, grazing = 0;
+    for (const auto& [name, o] : observers) {
+      SCOPED_TRACE(name);
+      ViewshedOptions options;
+      const Agreement a = compare(context, f, o, options, 1e-4);
+      visible += a.visible, targets += a.targets, grazing += a.grazing;
+    }
+    // Both answers occur often, and grazing disagreements stay rare.
+    EXPECT_GT(visible, targets / 10);
+    EXPECT_LT(visible, targets * 9 / 10);
+    EXPECT_LE(grazing, targets / 2000) << grazing << " grazing of " << targets;
+    std::printf("rough terrain: %zu targets, %zu visible, %zu grazing disagreements\n", targets, visible, grazing);
+  });
+}
+
+TEST(Viewshed, EveryTargetMarchedAgrees) {
+  // The rays' bounds only skip marches: marching every target gives the same visible set.
+  const HeightField f = roughTerrain(120, 110);
+  const Observer o{60, 55, 3.0};
+  ViewshedOptions fast, marched;
+  marched.march_every_target = true;
+  const ViewshedResult a = computeViewshed(testContext(), f, o, fast);
+  const ViewshedResult b = computeViewshed(testContext(), f, o, marched);
+  std::size_t differ = 0;
+  for (std::size_t p = 0; p < a.visible.size(); ++p) differ += a.visible[p] != b.visible[p];
+  EXPECT_LE(differ, a.visible.size() / 5000);
+}
+
+TEST(Viewshed, HardCasesMatchBruteForce) {
+  forEachLayout([&](const ComputeContext& context) {
+    for (const std::string& name : syntheticFieldNames()) {
+      SCOPED_TRACE(name);
+      const HeightField f = makeSyntheticField(name, 61, 53);
+      Observer o{30, 26, 1.5};
+      if (!std::isfinite(f.at(o.col, o.row))) o = lowest(f, 1.5);
+      // Heights of order 1e6 (the cliff) round at about 0.1 in single precision.
+      double scale = 1.0;
+      for (float v : f.heights)
+        if (std::isfinite(v)) scale = std::max(scale, std::fabs(static_cast<double>(v)));
+      const Agreement a = compare(context, f, o, {}, 1e-5 * scale);
+      EXPECT_LE(a.grazing, a.targets / 100);
+    }
+  });
+}
+
+TEST(Viewshed, OptionsMatchBruteForce) {
+  const HeightField f = roughTerrain();
+  const Observer o{48, 41, 2.0};
+  forEachLayout([&](const ComputeContext& context) {
+    ViewshedOptions options;
+    options.max_distance = 30.5;
+    options.target_height = 1.5;
+    compare(context, f, o, options, 1e-4);
+    options = {};
+    options.azimuth_from_deg = 300.0;  // across north
+    options.azimuth_to_deg = 45.0;
+    options.elevation_min_deg = -10.0;
+    options.elevation_max_deg = 5.0;
+    const Agreement a = compare(context, f, o, options, 1e-4);
+    EXPECT_GT(a.visible, 0u);
+    options = {};
+    options.absolute = true;
+    HeightField anisotropic = f;
+    anisotropic.cell_size_x = 2.0;
+    anisotropic.cell_size_y = 0.5;
+    anisotropic.z_scale = 0.3;
+    options.curvature = 0.01;
+    compare(context, anisotropic, {10, 70, 40.0}, options, 1e-4);
+  });
+}
+
+TEST(Viewshed, CurvatureHidesFlatGroundBeyondTheHorizon) {
+  // Flat ground, an eye h above it, targets on the ground: visible out to sqrt(2 R h / (1 - K)).
+  HeightField f;
+  f.width = 3000;
+  f.height = 3;
+  f.cell_size_x = f.cell_size_y = 10.0;
+  f.heights.assign(static_cast<std::size_t>(f.width) * f.height, 100.0f);
+  const double eye = 10.0, refraction = 0.13;
+  ViewshedOptions options;
+  options.curvature = earthCurvature(refraction);
+  const ViewshedResult r = computeViewshed(testContext(), f, {0, 1, eye}, options);
+  int farthest = 0;
+  for (int x = 0; x < f.width; ++x)
+    if (r.visible[f.width + x] == 1.0f) farthest = x;
+  const double expected = std::sqrt(2.0 * kEarthRadius * eye / (1.0 - refraction));
+  EXPECT_NEAR(farthest * f.cell_size_x, expected, f.cell_size_x) << "expected " << expected;
+  EXPECT_LT(farthest, f.width - 1);
+}
+
+TEST(Viewshed, CumulativeCountsTheObservers) {
+  HeightField f = roughTerrain(70, 64);
+  f.heights[5 * 70 + 9] = NAN;
+  const std::vector<Observer> observers = {{3, 3, 2.0}, {35, 30, 2.0}, {69, 63, 10.0}, {35, 30, 2.0}};
+  ViewshedOptions options;
+  int calls = 0;
+  options.progress = [&](int done, int total) {
+    ++calls;
+    EXPECT_EQ(total, 4);
+    EXPECT_EQ(done, calls);
+  };
+  const CumulativeViewshed c = computeCumulativeViewshed(testContext(), f, observers, options);
+  EXPECT_EQ(calls, 4);
+  std::vector<float> sum(f.pixelCount(), 0.0f);
+  for (const Observer& o : observers) {
+    const ViewshedResult r = computeViewshed(testContext(), f, o, {});
+    for (std::size_t p = 0; p < sum.size(); ++p) sum[p] += r.visible[p];
+  }
+  for (std::size_t p = 0; p < sum.size(); ++p) {
+    if (std::isnan(sum[p])) {
+      EXPECT_TRUE(std::isnan(c.count[p]));
+      continue;
+    }
+    ASSERT_EQ(c.count[p], sum[p]) << "at " << p;
+  }
+  for (const Observer& o : observers) EXPECT_GE(c.count[o.row * 70 + o.col], 1.0f);  // each sees its own point
+}
+
+TEST(Viewshed, AwkwardSizes) {
+  for (const auto& [w, h] : testing::awkwardSizes()) {
+    SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h));
+    const HeightField f = makeSyntheticField("noise", w, h);
+    compare(testContext(), f, {w / 2, h / 2, 0.5}, {}, 1e-4);
+  }
+}
+
+TEST(Viewshed, BadInputIsRefused) {
+  HeightField f = makeSyntheticField("sine", 20, 10);
+  f.heights[3 * 20 + 4] = NAN;
+  const ComputeContext& c = testContext();
+  EXPECT_THROW(computeViewshed(c, f, {20, 0, 2.0}, {}), InvalidArgument);
+  EXPECT_THROW(computeViewshed(c, f, {-1, 0, 2.0}, {}), InvalidArgument);
+  EXPECT_THROW(computeViewshed(c, f, {4, 3, 2.0}, {}), InvalidArgument);
+  EXPECT_THROW(computeViewshed(c, f, {1, 1, NAN}, {}), InvalidArgument);
+  ViewshedOptions o;
+  o.target_height = -1.0;
+  EXPECT_THROW(computeViewshed(c, f, {1, 1, 2.0}, o), InvalidArgument);
+  o = {};
+  o.max_distance = NAN;
+  EXPECT_THROW(computeViewshed(c, f, {1, 1, 2.0}, o), InvalidArgument);
+  o = {};
+  o.azimuth_to_deg = 400.0;
+  EXPECT_THROW(computeViewshed(c, f, {1, 1, 2.0}, o), InvalidArgument);
+  o = {};
+  o.elevation_min_deg = 10.0;
+  o.elevation_max_deg = 0.0;
+  EXPECT_THROW(computeViewshed(c, f, {1, 1, 2.0}, o), InvalidArgument);
+  EXPECT_THROW(computeCumulativeViewshed(c, f, {}, {}), InvalidArgument);
+  HeightField geographic = f;
+  geographic.row_cell_size_x.assign(10, 1.0);
+  geographic.row_cell_size_y.assign(10, 1.0);
+  EXPECT_THROW(computeViewshed(c, geographic, {1, 1, 2.0}, {}), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace hfvis
