@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <limits>
+#include <tuple>
 
 #include "hfvis/errors.hpp"
 #include "hfvis/shading.hpp"
@@ -17,7 +18,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr const char* kCommandList =
-    "horizon, svf, ao, viewcount, horizons, bounce, shade, insolation, sunpos or devices";
+    "horizon, svf, ao, viewcount, horizons, bounce, shade, insolation, viewshed, sunpos or devices";
 
 // One option of the compute commands (horizon, svf, ao, viewcount, horizons, bounce).
 enum class Option {
@@ -57,6 +58,14 @@ enum class Option {
   Step,
   AzimuthBucket,
   Apparent,
+  Observer,
+  Observers,
+  ObserverHeight,
+  TargetHeight,
+  Absolute,
+  FieldOfView,
+  ElevationRange,
+  Angle,
 };
 
 struct OptionSpec {
@@ -103,6 +112,14 @@ constexpr OptionSpec kOptions[] = {
     {Option::Step, "--step", nullptr, true},
     {Option::AzimuthBucket, "--azimuth-bucket", nullptr, true},
     {Option::Apparent, "--apparent", nullptr, false},
+    {Option::Observer, "--observer", nullptr, true},
+    {Option::Observers, "--observers", nullptr, true},
+    {Option::ObserverHeight, "--observer-height", nullptr, true},
+    {Option::TargetHeight, "--target-height", nullptr, true},
+    {Option::Absolute, "--absolute", nullptr, false},
+    {Option::FieldOfView, "--fov", nullptr, true},
+    {Option::ElevationRange, "--elevation-range", nullptr, true},
+    {Option::Angle, "--angle", nullptr, false},
 };
 
 // The options every sweep operation shares, as typed (degrees become radians).
@@ -129,6 +146,7 @@ std::optional<Command> findCommand(const std::string& name) {
   if (name == "sunpos") return Command::SunPosition;
   if (name == "shade") return Command::Shade;
   if (name == "insolation") return Command::Insolation;
+  if (name == "viewshed") return Command::Viewshed;
   if (name == "help") return Command::Help;
   return std::nullopt;
 }
@@ -261,6 +279,15 @@ const char* onlyFor(Option option) {
       return "insolation";
     case Option::Radiance:
       return "bounce";
+    case Option::Observer:
+    case Option::Observers:
+    case Option::ObserverHeight:
+    case Option::TargetHeight:
+    case Option::Absolute:
+    case Option::FieldOfView:
+    case Option::ElevationRange:
+    case Option::Angle:
+      return "viewshed";
     default:
       return nullptr;
   }
@@ -274,6 +301,9 @@ bool notFor(Option option, Command command) {
   // The sun's place and size: shade and insolation.
   if (option == Option::Latitude || option == Option::Longitude || option == Option::SunSize)
     return command != Command::Shade && command != Command::Insolation;
+  // A viewshed marches sight lines: no directions or sampling density.
+  if (command == Command::Viewshed)
+    return option == Option::Directions || option == Option::AzimuthOffset || option == Option::SamplesPerUnit;
   // insolation sweeps the sun's azimuths alone, by the sweep; shade takes directions for --env.
   if (command == Command::Insolation)
     return option == Option::Directions || option == Option::Method || option == Option::AzimuthOffset ||
@@ -336,6 +366,10 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
       run.sweep_options_given = true;
       if (command == Command::ViewCount) {
         run.visibility_method = parseVisibilityMethod(typed, value);
+      } else if (command == Command::Viewshed) {
+        if (value == "culled")
+          throw UsageError(typed + " culled: Stewart's culling pyramid is not built yet; use --method exact");
+        if (value != "exact") throw UsageError(typed + ": expected 'exact', got " + inQuotes(value));
       } else {
         run.method = parseMethod(typed, value);
       }
@@ -492,6 +526,43 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
     case Option::Nodata:
       run.nodata = parseNodata(typed, value);
       break;
+    case Option::Observer:
+      run.observers.push_back(parseReceiver(typed, value));
+      break;
+    case Option::Observers:
+      requireNonEmpty(typed, value);
+      if (!run.observers_file.empty()) throw UsageError(typed + " given twice");
+      run.observers_file = value;
+      break;
+    case Option::ObserverHeight:
+      run.observer_height = parseNumber(typed, value);
+      break;
+    case Option::TargetHeight:
+      run.target_height = parseNumber(typed, value);
+      if (run.target_height < 0.0) throw UsageError(typed + ": must be >= 0, got " + inQuotes(value));
+      break;
+    case Option::Absolute:
+      run.absolute = true;
+      break;
+    case Option::FieldOfView:
+    case Option::ElevationRange: {
+      const bool fov = spec.option == Option::FieldOfView;
+      const std::size_t comma = value.find(',');
+      if (comma == std::string::npos)
+        throw UsageError(typed + (fov ? ": expected FROM,TO (compass degrees, clockwise from FROM), got "
+                                      : ": expected LO,HI (elevation degrees), got ") +
+                         inQuotes(value));
+      const double a = parseNumber(typed, value.substr(0, comma)), b = parseNumber(typed, value.substr(comma + 1));
+      if (fov && !(a >= 0.0 && a <= 360.0 && b >= 0.0 && b <= 360.0))
+        throw UsageError(typed + ": compass azimuths are in 0 .. 360 degrees, got " + inQuotes(value));
+      if (!fov && !(a >= -90.0 && b <= 90.0 && a <= b))
+        throw UsageError(typed + ": expected -90 <= LO <= HI <= 90 degrees, got " + inQuotes(value));
+      (fov ? run.field_of_view : run.elevation_range) = std::make_pair(a, b);
+      break;
+    }
+    case Option::Angle:
+      run.with_angle = true;
+      break;
   }
 }
 
@@ -553,6 +624,19 @@ void validateRun(Command command, const RunArguments& run) {
       throw UsageError(error.what());
     }
   }
+  if (command == Command::Viewshed) {
+    if (run.observers.empty() && run.observers_file.empty())
+      throw UsageError("missing --observer COL,ROW or --observers FILE.csv (who looks)");
+    if (run.with_angle && (run.observers.size() > 1 || !run.observers_file.empty()))
+      throw UsageError("--angle is for one observer (several give a count)");
+    if (!run.observers_file.empty() && samePath(run.output, run.observers_file))
+      throw UsageError("--observers must differ from -o, both are " + inQuotes(run.output));
+    try {
+      validate(viewshedOptions(run));
+    } catch (const InvalidArgument& error) {
+      throw UsageError(error.what());
+    }
+  }
   if (command == Command::Bounce) {
     if (run.radiance.empty()) {
       throw UsageError("missing --radiance RAD.exr (the exit radiance to bounce, same size as the input)");
@@ -599,6 +683,8 @@ void validateRun(Command command, const RunArguments& run) {
       case Command::Insolation:
         validate(static_cast<const SweepOptions&>(horizonOptions(run)));
         break;
+      case Command::Viewshed:
+        break;  // above
       default:
         validate(horizonOptions(run), horizonOutputs(command, run));
         break;
@@ -688,6 +774,8 @@ const char* commandName(Command command) {
       return "shade";
     case Command::Insolation:
       return "insolation";
+    case Command::Viewshed:
+      return "viewshed";
     case Command::Horizon:
       return "horizon";
     case Command::SkyViewFactor:
@@ -861,6 +949,18 @@ InsolationOptions insolationOptions(const RunArguments& run) {
   options.size_deg = run.sun_size_deg;
   options.azimuth_bucket_deg = run.azimuth_bucket_deg;
   options.apparent = run.apparent;
+  return options;
+}
+
+ViewshedOptions viewshedOptions(const RunArguments& run) {
+  ViewshedOptions options;
+  options.absolute = run.absolute;
+  options.target_height = run.target_height;
+  options.max_distance = run.max_distance;
+  options.curvature = run.curvature ? earthCurvature(run.refraction) : 0.0;
+  if (run.field_of_view) std::tie(options.azimuth_from_deg, options.azimuth_to_deg) = *run.field_of_view;
+  if (run.elevation_range) std::tie(options.elevation_min_deg, options.elevation_max_deg) = *run.elevation_range;
+  options.memory_budget = run.memory_budget_bytes;
   return options;
 }
 

@@ -15,6 +15,7 @@
 #include "hfvis/image_io.hpp"
 #include "hfvis/intervisibility.hpp"
 #include "hfvis/shading.hpp"
+#include "hfvis/viewshed.hpp"
 
 namespace hfvis::cli {
 
@@ -37,6 +38,7 @@ enum class Command {
   SunPosition,   // "sunpos": the sun's azimuth and elevation at a time and place
   Shade,         // the surface lit by an environment and / or the sun
   Insolation,    // sunshine hours and direct irradiation over a span of time
+  Viewshed,      // what one observer sees, or how many of several see each point
 };
 
 // The subcommand's name as typed ("horizon", "svf", ...).
@@ -84,7 +86,17 @@ struct RunArguments {
   bool quiet = false;
   bool curvature = false;                    // --curvature (or --refraction): the Earth's drop
   double refraction = kDefaultRefraction;  // --refraction K
-  double max_distance = 0.0;                 // viewcount --max-distance D (ground units); 0 = none
+  double max_distance = 0.0;                 // --max-distance D (ground units); 0 = none
+  // viewshed: --observer COL,ROW (in order) and --observers FILE.csv (read with the field),
+  // --observer-height, --target-height, --absolute, --fov FROM,TO (compass degrees),
+  // --elevation-range LO,HI (degrees), --angle (an "angle" channel, one observer).
+  std::vector<ReceiverPixel> observers;
+  std::string observers_file;
+  double observer_height = 2.0;
+  double target_height = 0.0;
+  bool absolute = false;
+  std::optional<std::pair<double, double>> field_of_view, elevation_range;
+  bool with_angle = false;
   std::optional<float> nodata;               // --nodata VALUE for GeoTIFF outputs (may be NaN); none = NaN
 };
 
@@ -114,6 +126,7 @@ IntervisibilityOutputs intervisibilityOutputs(const RunArguments& run);
 SweepOptions horizonListOptions(const RunArguments& run);
 BounceOptions bounceOptions(const RunArguments& run);
 InsolationOptions insolationOptions(const RunArguments& run);
+ViewshedOptions viewshedOptions(const RunArguments& run);
 HeightFieldReadOptions readOptions(const RunArguments& run);
 
 }  // namespace hfvis::cli

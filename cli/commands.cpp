@@ -19,6 +19,7 @@
 #include <functional>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <system_error>
@@ -36,6 +37,7 @@
 #include "hfvis/intervisibility.hpp"
 #include "hfvis/shading.hpp"
 #include "hfvis/sun.hpp"
+#include "hfvis/viewshed.hpp"
 #include "horizon_list_files.hpp"
 
 namespace hfvis::cli {
@@ -392,6 +394,18 @@ class Progress {
     };
   }
 
+  // A callback for a run over observers: "done/total observers".
+  std::function<void(int, int)> observerCallback(int total) {
+    if (!enabled_) return nullptr;
+    total_ = total;
+    unit_ = "observers";
+    return [this](int done, int all) {
+      done_ = done;
+      total_ = all;
+      report();
+    };
+  }
+
   template <typename Body>
   auto run(Body&& body) -> decltype(body()) {
     try {
@@ -421,7 +435,7 @@ class Progress {
              std::to_string(seconds % 60) + " s left";
     }
     // \033[K clears what a longer line before left behind.
-    std::fprintf(stderr, "\rhfvis: %d/%d directions%s%s\033[K%s", done_, total_, strip.c_str(), left.c_str(),
+    std::fprintf(stderr, "\rhfvis: %d/%d %s%s%s\033[K%s", done_, total_, unit_, strip.c_str(), left.c_str(),
                  line_open_ ? "" : "\n");
     std::fflush(stderr);
   }
@@ -429,6 +443,7 @@ class Progress {
   bool enabled_;
   bool line_open_ = false;
   int done_ = 0, total_ = 0, strip_ = 0, strips_ = 0;
+  const char* unit_ = "directions";
   std::chrono::steady_clock::time_point start_, last_{};
 };
 
@@ -443,12 +458,12 @@ void requireResultSize(int width, int height, const HeightField& field) {
   }
 }
 
-// "wrote FILES (WxH, K directions, METHOD, T s on DEVICE)NOTE".
+// "wrote FILES (WxH, K directions, METHOD, T s on DEVICE)NOTE" (or K observers, ...).
 void printSummary(const std::vector<std::string>& written, int width, int height, int directions,
                   const std::string& method, double seconds, const std::string& device,
-                  const std::string& note) {
-  std::cout << "wrote " << joinPaths(written) << " (" << width << "x" << height << ", " << directions
-            << (directions == 1 ? " direction, " : " directions, ") << method << ", "
+                  const std::string& note, const std::string& unit = "direction") {
+  std::cout << "wrote " << joinPaths(written) << " (" << width << "x" << height << ", " << directions << " "
+            << unit << (directions == 1 ? ", " : "s, ") << method << ", "
             << formatFixed(seconds, 2) << " s" << (device.empty() ? "" : " on " + device) << ")" << note
             << "\n";
 }
@@ -716,6 +731,166 @@ int runInsolation(const RunArguments& run) {
                  "; " + std::to_string(result.steps) + " steps with the sun up, mean sun " +
                      formatFixed(finiteMean(result.sun_hours), 2) + " h" + (lit.flipped ? " (lit north-up)" : ""));
   }
+  return 0;
+}
+
+namespace {
+
+// --observers FILE.csv: "col,row[,height]" per line; blank lines, lines starting with '#' and
+// a first line that is not numbers (a header) are skipped. A malformed line is the file's fault.
+std::vector<Observer> readObserverFile(const std::string& path, double default_height) {
+  std::ifstream in(path);
+  if (!in) throw IoError(path, std::string("cannot open: ") + std::strerror(errno));
+  std::vector<Observer> observers;
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const std::size_t first = line.find_first_not_of(" \t");
+    if (first == std::string::npos || line[first] == '#') continue;
+    std::vector<std::string> fields;
+    std::stringstream row(line);
+    for (std::string f; std::getline(row, f, ',');) fields.push_back(f);
+    auto number_in = [](const std::string& text, double& value) {
+      const std::size_t a = text.find_first_not_of(" \t"), b = text.find_last_not_of(" \t");
+      if (a == std::string::npos) return false;
+      const std::string t = text.substr(a, b - a + 1);
+      char* end = nullptr;
+      value = std::strtod(t.c_str(), &end);
+      return end == t.c_str() + t.size() && std::isfinite(value);
+    };
+    double col = 0, row_index = 0, height = default_height;
+    const bool numbers = fields.size() >= 2 && number_in(fields[0], col) && number_in(fields[1], row_index);
+    if (!numbers && observers.empty() && number == 1) continue;  // a header
+    if (!numbers || fields.size() > 3 || (fields.size() == 3 && !number_in(fields[2], height)) ||
+        col != std::floor(col) || row_index != std::floor(row_index) || std::fabs(col) > 1e9 ||
+        std::fabs(row_index) > 1e9)
+      throw IoError(path, "line " + std::to_string(number) + ": expected col,row[,height] (whole column and row), got '" +
+                              line + "'");
+    observers.push_back({static_cast<int>(col), static_cast<int>(row_index), height});
+  }
+  if (observers.empty()) throw IoError(path, "no observers (lines col,row[,height])");
+  return observers;
+}
+
+// A hillshade in 0 .. 1 (light from the north-west, 45 degrees up), under the viewshed's preview.
+std::vector<float> hillshade(const HeightField& f) {
+  std::vector<float> shade(f.pixelCount(), 0.0f);
+  const double lx = -0.5, ly = -0.5, lz = std::sqrt(0.5);  // toward -column, -row (north-west), up
+  auto at = [&](int x, int y) {
+    const float v = f.at(std::clamp(x, 0, f.width - 1), std::clamp(y, 0, f.height - 1));
+    return std::isfinite(v) ? v * f.z_scale : std::numeric_limits<double>::quiet_NaN();
+  };
+  for (int y = 0; y < f.height; ++y)
+    for (int x = 0; x < f.width; ++x) {
+      const double gx = (at(x + 1, y) - at(x - 1, y)) / (2.0 * f.cell_size_x);
+      const double gy = (at(x, y + 1) - at(x, y - 1)) / (2.0 * f.cell_size_y);
+      const double n = std::sqrt(gx * gx + gy * gy + 1.0);
+      const double lit = (-gx * lx - gy * ly + lz) / n;
+      shade[static_cast<std::size_t>(y) * f.width + x] = std::isfinite(lit) ? static_cast<float>(std::max(lit, 0.0)) : 0.0f;
+    }
+  return shade;
+}
+
+}  // namespace
+
+int runViewshed(const RunArguments& run) {
+  requireOutputs(run, outputPaths(run));
+  const HeightField field = readValidField(run);
+  std::vector<Observer> observers;
+  for (const ReceiverPixel& p : run.observers) observers.push_back({p.col, p.row, run.observer_height});
+  if (!run.observers_file.empty()) {
+    const std::vector<Observer> listed = readObserverFile(run.observers_file, run.observer_height);
+    observers.insert(observers.end(), listed.begin(), listed.end());
+  }
+  for (const Observer& o : observers) {
+    try {
+      validate(field, o);
+    } catch (const InvalidArgument& error) {
+      throw UsageError(std::string(error.what()) + " (" + run.input + ")");
+    }
+  }
+  const ComputeContext context = contextFor(run);
+  const DeviceInfo& device = context.device();
+  ViewshedOptions options = viewshedOptions(run);
+  Progress progress(run.quiet || observers.size() == 1);
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<std::string> names;
+  std::vector<std::vector<float>> planes;
+  std::string quantity, units, note;
+  if (observers.size() == 1) {
+    ViewshedOutputs outputs;
+    outputs.angle = run.with_angle;
+    ViewshedResult r = computeViewshed(context, field, observers[0], options, outputs);
+    requireResultSize(r.width, r.height, field);
+    if (run.with_angle) {
+      for (float& a : r.angle) a = static_cast<float>(a * (180.0 / M_PI));
+      names.push_back("angle");
+      planes.push_back(std::move(r.angle));
+    }
+    std::size_t seen = 0, targets = 0;
+    for (float v : r.visible) seen += v == 1.0f, targets += !std::isnan(v);
+    note = "; " + formatFixed(100.0 * seen / std::max<std::size_t>(targets, 1), 2) + " % of the points visible";
+    names.push_back("visible");
+    planes.push_back(std::move(r.visible));
+    quantity = "visible: 1 where a target on the point is seen from the observer's eye, 0 where hidden or out of "
+               "range" + std::string(run.with_angle ? "; angle: the target's elevation angle from the eye" : "");
+    units = run.with_angle ? "visible: 1; angle: degrees" : "1";
+  } else {
+    options.progress = progress.observerCallback(static_cast<int>(observers.size()));
+    CumulativeViewshed c = progress.run([&] { return computeCumulativeViewshed(context, field, observers, options); });
+    requireResultSize(c.width, c.height, field);
+    float most = 0.0f;
+    for (float v : c.count)
+      if (v > most) most = v;
+    note = "; " + std::to_string(observers.size()) + " observers, at most " + formatNumber(most) + " see one point";
+    names.push_back("count");
+    planes.push_back(std::move(c.count));
+    quantity = "count: how many of the observers see a target on the point (a cumulative viewshed)";
+    units = "observers";
+  }
+  const double seconds = secondsSince(start);
+  Attributes attributes = runAttributes(Command::Viewshed, run, field, device);
+  std::string where;
+  for (const Observer& o : observers) {
+    if (where.size() > 4000) {
+      where += " ...";
+      break;
+    }
+    where += (where.empty() ? "" : "; ") + std::to_string(o.col) + "," + std::to_string(o.row) + " at " +
+             formatNumber(o.height);
+  }
+  attributes.emplace_back("hfvis:observers", where);
+  attributes.emplace_back("hfvis:observer_height", run.absolute ? "absolute" : "above the surface");
+  attributes.emplace_back("hfvis:target_height", formatNumber(options.target_height));
+  if (run.field_of_view)
+    attributes.emplace_back("hfvis:field_of_view_deg",
+                            formatNumber(run.field_of_view->first) + " .. " + formatNumber(run.field_of_view->second));
+  if (run.elevation_range)
+    attributes.emplace_back("hfvis:elevation_range_deg", formatNumber(run.elevation_range->first) + " .. " +
+                                                             formatNumber(run.elevation_range->second));
+  const ImageChannels image = makeImage(field, run, names, planes, attributes, quantity, units);
+  StagedOutputs outputs;
+  outputs.stage(run.output, [&](const std::string& path) { writeImage(path, image); });
+  if (!run.preview.empty()) {
+    outputs.stage(run.preview, [&](const std::string& path) {
+      // Visible points (or the count) bright over a dimmed hillshade; nodata black.
+      const std::vector<float>& seen = planes.back();
+      float most = 0.0f;
+      for (float v : seen)
+        if (v > most) most = v;
+      const std::vector<float> shade = hillshade(field);
+      std::vector<float> picture(seen.size());
+      for (std::size_t p = 0; p < seen.size(); ++p)
+        picture[p] = std::isnan(seen[p]) ? NAN
+                                         : 0.3f * shade[p] + (seen[p] > 0.0f ? 0.35f + 0.35f * seen[p] / std::max(most, 1.0f) : 0.0f);
+      writePreviewPng(path, field.width, field.height, picture, 0.0f, 1.0f);
+    });
+  }
+  const std::vector<std::string> written = outputs.paths();
+  outputs.commit();
+  if (!run.quiet)
+    printSummary(written, field.width, field.height, static_cast<int>(observers.size()), "exact", seconds, device.name,
+                 note, "observer");
   return 0;
 }
 

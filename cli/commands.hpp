@@ -14,6 +14,7 @@ int runShade(const RunArguments& run);
 
 // "hfvis insolation": sunshine hours and direct irradiation over a span of time.
 int runInsolation(const RunArguments& run);
+int runViewshed(const RunArguments& run);
 
 // `hfvis horizon|svf|ao`: reads the input, computes on the device, writes every output
 // (all or none). Throws hfvis::Error on failure. Returns the exit status.

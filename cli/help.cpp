@@ -16,6 +16,8 @@ const char* const kUsage = R"(Usage:
   hfvis shade     IN -o OUT.exr [--env ENV.exr [-k K]] [--sun AZ,EL | --at TIME --lat LAT --lon LON]
                   [--albedo A|FILE] [options]
   hfvis insolation IN -o OUT.exr --lat LAT --lon LON --from TIME --to TIME [--step MINUTES] [options]
+  hfvis viewshed  IN -o OUT.exr --observer COL,ROW [--observer COL,ROW ...] [--observers FILE.csv]
+                  [--observer-height H] [--target-height T] [--absolute] [options]
   hfvis sunpos    --lat LAT --lon LON --at TIME [--apparent]
   hfvis devices
   hfvis --help | hfvis COMMAND --help
@@ -34,6 +36,7 @@ Commands:
             horizons; the sun: "sun", the part of its disc above the horizon (0..1), and
             "direct", sun * max(0, n . s); --albedo: "radiance[.R/G/B]", what the surface sends out
   insolation "sun_hours" (hours of sun) and "direct" (irradiation of a unit sun, hours) over a span
+  viewshed  "visible" (1 / 0): what one observer sees; with several observers "count"
   sunpos    the sun's compass azimuth and elevation at a time and place
   devices   list the OpenCL devices and mark the one automatic selection picks
 )";
@@ -314,6 +317,29 @@ std::string commandHelp(Command command) {
                  "sweeps. --apparent lifts the sun by the atmosphere's refraction. Row 0 is taken as north (a\n"
                  "south-up GeoTIFF is lit flipped north-up). The preview stretches direct over its 1st to\n"
                  "99th percentile. NaN at nodata pixels.\n") +
+             kOptions + kConventions + kExitStatus;
+    case Command::Viewshed:
+      return std::string(
+                 "hfvis viewshed IN -o OUT.exr --observer COL,ROW [--observer COL,ROW ...] [--observers FILE.csv]\n"
+                 "               [--observer-height H] [--target-height T] [--absolute] [--max-distance D]\n"
+                 "               [--curvature] [--refraction K] [--fov FROM,TO] [--elevation-range LO,HI]\n"
+                 "               [--angle] [--method exact] [options]\n\n"
+                 "What an observer standing on grid point COL,ROW (zero-based) sees: channel \"visible\" is 1\n"
+                 "where a target standing T (default 0) above the surface is seen from the eye H (default 2)\n"
+                 "above the surface (--absolute: at height H), 0 where it is hidden or out of range, NaN at\n"
+                 "nodata. Seen means no point of the bilinear surface strictly between eye and target rises\n"
+                 "above the straight sight line (grazing sees); cells with a nodata corner hide nothing.\n"
+                 "Decided exactly for every target, up to single-precision rounding of sight lines that\n"
+                 "graze. --max-distance D: targets within D ground units; --fov FROM,TO: targets whose\n"
+                 "compass azimuth lies clockwise from FROM to TO; --elevation-range LO,HI: targets seen\n"
+                 "between LO and HI degrees above the eye's horizontal; --curvature and --refraction lower\n"
+                 "every point, targets too, by the Earth's drop. --angle adds channel \"angle\", the target's\n"
+                 "elevation angle from the eye in degrees.\n"
+                 "Several observers (--observer repeated, and / or --observers FILE.csv with columns\n"
+                 "col,row[,height], a header line allowed): channel \"count\", how many of them see each\n"
+                 "point (a cumulative viewshed); a row's height replaces --observer-height. An observer\n"
+                 "outside the field or on nodata is an error. --method exact is the only method so far.\n"
+                 "The preview shows the visible points (or the count) bright over a dimmed hillshade.\n") +
              kOptions + kConventions + kExitStatus;
     case Command::SunPosition:
       return "hfvis sunpos --lat LAT --lon LON --at TIME [--apparent]\n\n"

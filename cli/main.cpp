@@ -41,13 +41,16 @@ int run(const std::vector<std::string>& args) {
       return runShade(line.run);
     case Command::Insolation:
       return runInsolation(line.run);
+    case Command::Viewshed:
+      return runViewshed(line.run);
   }
   return kExitUsageError;
 }
 
 // "hfvis horizon --help" when the command is known, else "hfvis --help".
 std::string helpHint(const std::vector<std::string>& args) {
-  for (const char* command : {"horizon", "svf", "ao", "viewcount", "horizons", "bounce", "shade", "insolation", "sunpos", "devices"}) {
+  for (const char* command : {"horizon", "svf", "ao", "viewcount", "horizons", "bounce", "shade", "insolation", "viewshed", "sunpos",
+                              "devices"}) {
     if (!args.empty() && args[0] == command) return "hfvis " + args[0] + " --help";
   }
   return "hfvis --help";
