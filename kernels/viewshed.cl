@@ -15,6 +15,11 @@
 // target: the bounds of the two rays around its sight line decide it, or an exact march does).
 #pragma OPENCL FP_CONTRACT OFF
 
+#include "fast_math.cl"
+
+// Integer clamp as compare and select (PoCL makes library calls of the builtin in scalar code).
+inline int clamp_int(int v, int lo, int hi) { return v < lo ? lo : (v > hi ? hi : v); }
+
 typedef struct {
   int width, height;     // the field
   float cell_x, cell_y;  // ground units per pixel
@@ -31,9 +36,9 @@ inline float sample_cell(__global const float* h, int width, int cx, int cy, int
 // The cell under the point (x, y) of a segment's middle, clamped to the field; its corners'
 // far column and row (equal to the cell's own on a field one pixel wide or high).
 inline int4 cell_of(float x, float y, int width, int height) {
-  const int cx = clamp((int)floor(x), 0, max(width - 2, 0));
-  const int cy = clamp((int)floor(y), 0, max(height - 2, 0));
-  return (int4)(cx, cy, min(cx + 1, width - 1), min(cy + 1, height - 1));
+  const int cx = clamp_int((int)floor(x), 0, width > 2 ? width - 2 : 0);
+  const int cy = clamp_int((int)floor(y), 0, height > 2 ? height - 2 : 0);
+  return (int4)(cx, cy, cx + 1 < width ? cx + 1 : cx, cy + 1 < height ? cy + 1 : cy);
 }
 
 // The twist of a cell (h00 - h10 - h01 + h11): the t^2 coefficient of the surface along a
@@ -59,28 +64,51 @@ inline float crossing(float g, float e, float d, float inv) {
   return (d > 0.0f ? g < e + d : g > e + d) ? (g - e) * inv : INFINITY;
 }
 
-// The surface where the line from grid point (ex, ey) to (ex + dx, ey + dy) crosses column line
-// gx: the linear interpolation between the two heights of that line around the crossing,
-// whose position is found in integers (so a crossing at a grid point takes that point's height
-// exactly). A point of an edge whose two heights are valid is surface even where the cells
-// beside it are not. With the roles of x and y swapped (and `stride` 1 / width), a row line.
-inline float surface_on_grid_line(__global const float* h, int width, int g, int e_along, int e_across,
-                                  int d_along, int d_across, int stride_along, int stride_across) {
-  long num = (long)(g - e_along) * d_across, den = d_along;  // across = e_across + num / den
-  if (den < 0) num = -num, den = -den;
-  long q = num / den, r = num % den;
-  if (r < 0) q -= 1, r += den;
-  const size_t at = (size_t)g * stride_along + (size_t)(e_across + q) * stride_across;
-  if (r == 0) return h[at];
-  const float a = h[at], b = h[at + stride_across];
-  return a + (b - a) * ((float)r / (float)den);
+// The grid lines of one axis that a line from grid point e to e + d crosses, walked in order:
+// the next one, g (column lines for the x axis, row lines for y), its parameter t (INFINITY
+// once none is left before the line's end), and where the line crosses it across the axis,
+// e_across + q + r / den with 0 <= r < den = |d_along|, kept in integers (a crossing at a grid
+// point is one exactly, and no division is made per crossing): from one grid line to the next
+// the crossing moves by d_across / den = dq + dr / den.
+typedef struct {
+  float g, t, inv_den;
+  int q, r, den, dq, dr;
+} Axis;
+
+inline Axis axis_start(float g, float e_along, float d_along, float inv_along, float d_across) {
+  Axis a;
+  a.g = g;
+  a.t = crossing(g, e_along, d_along, inv_along);
+  a.den = max((int)fabs(d_along), 1);
+  a.inv_den = 1.0f / a.den;
+  const long n = (long)((int)g - (int)e_along) * (long)d_across * (d_along < 0.0f ? -1 : 1);
+  long q = n / a.den, r = n % a.den;
+  if (r < 0) q -= 1, r += a.den;
+  a.q = (int)q;
+  a.r = (int)r;
+  a.dq = (int)d_across / a.den;
+  a.dr = (int)d_across % a.den;
+  if (a.dr < 0) a.dq -= 1, a.dr += a.den;
+  return a;
 }
 
-// The surface at the crossing at t1: of column line gx where t1 == tx, else of row line gy.
-inline float surface_at_crossing(__global const float* h, int width, float t1, float tx, int gx, int gy, int ex,
-                                 int ey, int dx, int dy) {
-  return t1 == tx ? surface_on_grid_line(h, width, gx, ex, ey, dx, dy, 1, width)
-                  : surface_on_grid_line(h, width, gy, ey, ex, dy, dx, width, 1);
+inline void axis_next(Axis* a, float e_along, float d_along, float inv_along) {
+  a->g += sign(d_along);
+  a->t = crossing(a->g, e_along, d_along, inv_along);
+  a->q += a->dq;
+  a->r += a->dr;
+  if (a->r >= a->den) a->r -= a->den, a->q += 1;
+}
+
+// The surface where the line crosses the x axis's next column line (x_axis) or the y axis's next
+// row line: the linear interpolation between the grid line's two heights around the crossing.
+// A point of an edge whose two heights are valid is surface even where the cells beside it are
+// not.
+inline float surface_at_crossing(__global const float* h, int width, int x_axis, const Axis* a, int ex, int ey) {
+  const size_t at = x_axis ? (size_t)(ey + a->q) * width + (int)a->g : (size_t)a->g * width + (ex + a->q);
+  if (a->r == 0) return h[at];
+  const float lo = h[at], hi = h[at + (x_axis ? width : 1)];
+  return lo + (hi - lo) * ((float)a->r * a->inv_den);
 }
 
 // March of the sight line from E (ex, ey) along (dx, dy) over t in [ta, tb] (0 <= ta < tb <= 1),
@@ -91,24 +119,22 @@ inline float surface_at_crossing(__global const float* h, int width, float t1, f
 int sight_blocked(__global const float* h, Field f, float ex, float ey, float dx, float dy, float ze, float rise,
                   float d2, float target_height, float ta, float tb) {
   const float inv_dx = dx != 0.0f ? 1.0f / dx : 0.0f, inv_dy = dy != 0.0f ? 1.0f / dy : 0.0f;
-  const float sx = sign(dx), sy = sign(dy);
   // The next grid lines crossed after ta.
-  float gx = dx > 0.0f ? floor(ex + ta * dx) + 1.0f : ceil(ex + ta * dx) - 1.0f;
-  float gy = dy > 0.0f ? floor(ey + ta * dy) + 1.0f : ceil(ey + ta * dy) - 1.0f;
-  float tx = crossing(gx, ex, dx, inv_dx), ty = crossing(gy, ey, dy, inv_dy);
+  Axis ax = axis_start(dx > 0.0f ? floor(ex + ta * dx) + 1.0f : ceil(ex + ta * dx) - 1.0f, ex, dx, inv_dx, dy);
+  Axis ay = axis_start(dy > 0.0f ? floor(ey + ta * dy) + 1.0f : ceil(ey + ta * dy) - 1.0f, ey, dy, inv_dy, dx);
   const float drop = f.curvature * d2;
   float t0 = ta, f0 = NAN;
   if (ta == 0.0f) f0 = h[(int)ey * f.width + (int)ex] - ze;
   while (t0 < tb) {
-    const float t1 = fmin(fmin(tx, ty), tb);
+    const float tx = ax.t, ty = ay.t;
+    const float t1 = hf_min(hf_min(tx, ty), tb);
     const float tm = 0.5f * (t0 + t1);
     const int4 c = cell_of(ex + tm * dx, ey + tm * dy, f.width, f.height);
-    float s1;
-    if (t1 < tb) {
-      s1 = surface_at_crossing(h, f.width, t1, tx, (int)gx, (int)gy, (int)ex, (int)ey, (int)dx, (int)dy);
-    } else {
-      s1 = sample_cell(h, f.width, c.x, c.y, c.z, c.w, ex + t1 * dx - c.x, ey + t1 * dy - c.y);
-    }
+    // At a grid-line crossing (a march may also end on one) the grid line's surface; at an end
+    // inside a cell the cell's.
+    const float s1 = t1 == tx   ? surface_at_crossing(h, f.width, 1, &ax, (int)ex, (int)ey)
+                     : t1 == ty ? surface_at_crossing(h, f.width, 0, &ay, (int)ex, (int)ey)
+                                : sample_cell(h, f.width, c.x, c.y, c.z, c.w, ex + t1 * dx - c.x, ey + t1 * dy - c.y);
     const float f1 = t1 == 1.0f ? (isnan(s1) ? NAN : -target_height) : (s1 - ze) - t1 * rise - drop * t1 * t1;
     if (isnan(f0)) {  // the start of a march past the eye
       const float s0 = sample_cell(h, f.width, c.x, c.y, c.z, c.w, ex + t0 * dx - c.x, ey + t0 * dy - c.y);
@@ -118,35 +144,110 @@ int sight_blocked(__global const float* h, Field f, float ex, float ey, float dx
     const float a = (cell_twist(h, f.width, c) * dx * dy - drop) * span * span;
     if (f0 > 0.0f || f1 > 0.0f || quadratic_bump(f0, f1, a) > 0.0f) return 1;
     f0 = f1;
-    if (tx <= t1) gx += sx, tx = crossing(gx, ex, dx, inv_dx);
-    if (ty <= t1) gy += sy, ty = crossing(gy, ey, dy, inv_dy);
+    if (tx <= t1) axis_next(&ax, ex, dx, inv_dx);
+    if (ty <= t1) axis_next(&ay, ey, dy, inv_dy);
     t0 = t1;
   }
   return 0;
 }
 
-// lipschitz[cell]: a bound on the surface's ground slope |grad h| anywhere in the 3 x 3 cells
-// around it (cells past the field left out); INFINITY where one of them has a nodata corner.
-// Cells are indexed by their corner (x, y), x < max(width - 1, 1), y < max(height - 1, 1).
-__kernel void viewshed_lipschitz(__global const float* h, Field f, __global float* lipschitz) {
+// The maximum pyramid: level k >= 1 holds, per block of 2^k x 2^k cells, the largest height
+// of its grid points (the bilinear surface over the block lies below it; nodata left out, NaN
+// where the block has no valid point). Level k is levels[k].x blocks wide and levels[k].y high,
+// from levels[k].z in `pyramid`. viewshed_pyramid_first builds level 1 from the heights,
+// viewshed_pyramid_next level k from level k - 1.
+__kernel void viewshed_pyramid_first(__global const float* h, Field f, int4 level, __global float* pyramid) {
+  const int bx = get_global_id(0), by = get_global_id(1);
+  if (bx >= level.x || by >= level.y) return;
+  float m = NAN;
+  for (int y = 2 * by; y <= min(2 * by + 2, f.height - 1); ++y)
+    for (int x = 2 * bx; x <= min(2 * bx + 2, f.width - 1); ++x) m = fmax(m, h[y * f.width + x]);
+  pyramid[level.z + by * level.x + bx] = m;
+}
+
+__kernel void viewshed_pyramid_next(int4 below, int4 level, __global float* pyramid) {
+  const int bx = get_global_id(0), by = get_global_id(1);
+  if (bx >= level.x || by >= level.y) return;
+  float m = NAN;
+  for (int y = 2 * by; y <= min(2 * by + 1, below.y - 1); ++y)
+    for (int x = 2 * bx; x <= min(2 * bx + 1, below.x - 1); ++x) m = fmax(m, pyramid[below.z + y * below.x + x]);
+  pyramid[level.z + by * level.x + bx] = m;
+}
+
+// The block of side `size` (a power of two, in cells) holding the line's point at coordinate p
+// going in direction d, and the coordinate where the line leaves it (INFINITY along d = 0).
+inline int block_of(float p, float d, int size, int blocks) {
+  const float b = d < 0.0f ? ceil(p / size) - 1.0f : floor(p / size);
+  return clamp_int((int)b, 0, blocks - 1);
+}
+
+// sight_blocked over [ta, tb], skipping every block of the pyramid that lies wholly below the
+// sight line: a block's largest height, lowered by the curvature drop at the block's nearest
+// point, at or below the sight line's lower end over the block. Where no block can be skipped,
+// the cells of one level-1 block are marched exactly.
+int sight_blocked_pyramid(__global const float* h, __global const float* pyramid, __constant int4* levels,
+                          int top_level, Field f, float ex, float ey, float dx, float dy, float ze, float rise,
+                          float d2, float target_height, float ta, float tb) {
+  const float inv_dx = dx != 0.0f ? 1.0f / dx : 0.0f, inv_dy = dy != 0.0f ? 1.0f / dy : 0.0f;
+  const float drop = f.curvature * d2;
+  const float pixel_t = 1.0f / fmax(fabs(dx), fabs(dy));
+  float t = ta;
+  int k = 1;
+  while (t < tb) {
+    const float x = ex + t * dx, y = ey + t * dy;
+    const float line_t = ze + t * rise, fall = drop * t * t;
+    for (;;) {
+      const int4 L = levels[k];
+      const int size = 1 << k;
+      const int bx = block_of(x, dx, size, L.x), by = block_of(y, dy, size, L.y);
+      const float exit_x = crossing(dx < 0.0f ? bx * size : (bx + 1) * size, ex, dx, inv_dx);
+      const float exit_y = crossing(dy < 0.0f ? by * size : (by + 1) * size, ey, dy, inv_dy);
+      float t_exit = hf_min(hf_min(exit_x, exit_y), tb);
+      const float low = hf_min(line_t, ze + t_exit * rise);
+      if (t_exit > t && pyramid[L.z + by * L.x + bx] - fall <= low) {  // the block lies below the sight line
+        t = t_exit;
+        k = k < top_level ? k + 1 : top_level;
+        break;
+      }
+      if (k == 1) {  // march the block's cells (a pixel's length where rounding put t at its exit)
+        if (!(t_exit > t)) t_exit = hf_min(tb, t + pixel_t);
+        if (sight_blocked(h, f, ex, ey, dx, dy, ze, rise, d2, target_height, t, t_exit)) return 1;
+        t = t_exit;
+        break;
+      }
+      --k;
+    }
+  }
+  return 0;
+}
+
+// slopes[cell]: a bound on the surface's ground slope |grad h| anywhere in the cell (the
+// derivative along x lies between its two x edges' differences, and so for y), INFINITY where a
+// corner is nodata. Cells are indexed by their corner (x, y), x < max(width - 1, 1),
+// y < max(height - 1, 1).
+__kernel void viewshed_slopes(__global const float* h, Field f, __global float* slopes) {
   const int x = get_global_id(0), y = get_global_id(1);
-  const int cells_x = max(f.width - 1, 1), cells_y = max(f.height - 1, 1);
+  const int cells_x = f.width > 1 ? f.width - 1 : 1, cells_y = f.height > 1 ? f.height - 1 : 1;
+  if (x >= cells_x || y >= cells_y) return;
+  const int x1 = x + 1 < f.width ? x + 1 : x, y1 = y + 1 < f.height ? y + 1 : y;
+  const float h00 = h[y * f.width + x], h10 = h[y * f.width + x1];
+  const float h01 = h[y1 * f.width + x], h11 = h[y1 * f.width + x1];
+  const float gx = hf_max(fabs(h10 - h00), fabs(h11 - h01)) / f.cell_x;
+  const float gy = hf_max(fabs(h01 - h00), fabs(h11 - h10)) / f.cell_y;
+  const float g = sqrt(gx * gx + gy * gy) * 1.0001f;  // rounding of the bound itself
+  slopes[y * cells_x + x] = isfinite(h00) && isfinite(h10) && isfinite(h01) && isfinite(h11) ? g : INFINITY;
+}
+
+// lipschitz[cell]: the largest of slopes over the 3 x 3 cells around the cell (cells past the
+// field left out): a bound on the surface's slope within a pixel of any point of the cell.
+__kernel void viewshed_lipschitz(__global const float* slopes, Field f, __global float* lipschitz) {
+  const int x = get_global_id(0), y = get_global_id(1);
+  const int cells_x = f.width > 1 ? f.width - 1 : 1, cells_y = f.height > 1 ? f.height - 1 : 1;
   if (x >= cells_x || y >= cells_y) return;
   float bound = 0.0f;
-  for (int j = max(y - 1, 0); j <= min(y + 1, cells_y - 1); ++j)
-    for (int i = max(x - 1, 0); i <= min(x + 1, cells_x - 1); ++i) {
-      const int i1 = min(i + 1, f.width - 1), j1 = min(j + 1, f.height - 1);
-      const float h00 = h[j * f.width + i], h10 = h[j * f.width + i1];
-      const float h01 = h[j1 * f.width + i], h11 = h[j1 * f.width + i1];
-      if (!(isfinite(h00) && isfinite(h10) && isfinite(h01) && isfinite(h11))) {
-        bound = INFINITY;
-        continue;
-      }
-      const float gx = fmax(fabs(h10 - h00), fabs(h11 - h01)) / f.cell_x;
-      const float gy = fmax(fabs(h01 - h00), fabs(h11 - h10)) / f.cell_y;
-      bound = fmax(bound, sqrt(gx * gx + gy * gy));
-    }
-  lipschitz[y * cells_x + x] = bound * 1.0001f;  // rounding of the bound itself
+  for (int j = y > 0 ? y - 1 : 0; j <= (y + 1 < cells_y ? y + 1 : y); ++j)
+    for (int i = x > 0 ? x - 1 : 0; i <= (x + 1 < cells_x ? x + 1 : x); ++i) bound = hf_max(bound, slopes[j * cells_x + i]);
+  lipschitz[y * cells_x + x] = bound;
 }
 
 // The border point p of the box [x0, x1] x [y0, y1] (w = x1 - x0 + 1, hh = y1 - y0 + 1 points
@@ -170,10 +271,10 @@ inline float border_position(float ex, float ey, float dx, float dy, int4 box) {
   const float lx = dx > 0.0f ? (box.z - ex) / dx : dx < 0.0f ? (box.x - ex) / dx : INFINITY;
   const float ly = dy > 0.0f ? (box.w - ey) / dy : dy < 0.0f ? (box.y - ey) / dy : INFINITY;
   if (lx <= ly) {
-    const float y = clamp(ey + lx * dy, (float)box.y, (float)box.w);
+    const float y = hf_min(hf_max(ey + lx * dy, (float)box.y), (float)box.w);
     return dx > 0.0f ? w1 + (y - box.y) : 2 * w1 + h1 + (box.w - y);
   }
-  const float x = clamp(ex + ly * dx, (float)box.x, (float)box.z);
+  const float x = hf_min(hf_max(ex + ly * dx, (float)box.x), (float)box.z);
   return dy < 0.0f ? x - box.x : w1 + h1 + (box.z - x);
 }
 
@@ -215,25 +316,25 @@ __kernel void viewshed_rays(__global const float* h, Field f, __global const flo
   const float arc_limit = fmin(f.cell_x, f.cell_y) / angle;  // distance where the arc reaches a pixel
   const int cells_x = max(f.width - 1, 1);
   const float inv_dx = dx != 0.0f ? 1.0f / dx : 0.0f, inv_dy = dy != 0.0f ? 1.0f / dy : 0.0f;
-  const float sx = sign(dx), sy = sign(dy);
-  float gx = dx > 0.0f ? ex + 1.0f : ex - 1.0f;
-  float gy = dy > 0.0f ? ey + 1.0f : ey - 1.0f;
-  float tx = crossing(gx, ex, dx, inv_dx), ty = crossing(gy, ey, dy, inv_dy);
+  Axis ax = axis_start(dx > 0.0f ? ex + 1.0f : ex - 1.0f, ex, dx, inv_dx, dy);
+  Axis ay = axis_start(dy > 0.0f ? ey + 1.0f : ey - 1.0f, ey, dy, inv_dy, dx);
   const float drop = f.curvature * length * length;
   float lo = -INFINITY, hi = -INFINITY;
   float t0 = 0.0f, f0 = h[(int)ey * f.width + (int)ex] - ze;
   int q = 0;
   float next = spacing * inv_length;  // t of entry q's distance
   while (q < count) {
-    const float t1 = fmin(fmin(tx, ty), 1.0f);
+    const float tx = ax.t, ty = ay.t;
+    const float t1 = hf_min(hf_min(tx, ty), 1.0f);
     const float tm = 0.5f * (t0 + t1);
     const int4 c = cell_of(ex + tm * dx, ey + tm * dy, f.width, f.height);
-    const float s1 = t1 < 1.0f ? surface_at_crossing(h, f.width, t1, tx, (int)gx, (int)gy, (int)ex, (int)ey, (int)dx, (int)dy)
-                               : h[(int)end.y * f.width + (int)end.x];
+    const float s1 = t1 == tx   ? surface_at_crossing(h, f.width, 1, &ax, (int)ex, (int)ey)
+                     : t1 == ty ? surface_at_crossing(h, f.width, 0, &ay, (int)ex, (int)ey)
+                                : h[(int)end.y * f.width + (int)end.x];
     const float f1 = (s1 - ze) - drop * t1 * t1;  // height above the eye, curvature taken
     const float span = t1 - t0;
     const float alpha = cell_twist(h, f.width, c) * dx * dy - drop;  // t^2 coefficient of f
-    const float top = fmax(fmax(f0, f1), quadratic_bump(f0, f1, alpha * span * span));
+    const float top = hf_max(hf_max(f0, f1), quadratic_bump(f0, f1, alpha * span * span));  // NaN: no bound
     // The largest slope f / (t D) on the segment is at most its top over the nearest distance
     // (the farthest where the top is negative). On the first segment (t0 = 0, f0 = -eye
     // height <= 0) f / t <= (f - f0) / t, which is linear in t: at most its value at an end.
@@ -243,20 +344,20 @@ __kernel void viewshed_rays(__global const float* h, Field f, __global const flo
     else if (f0 > 0.0f)
       seg_hi = INFINITY;  // the eye below the surface
     else
-      seg_hi = fmax((f1 - f0) / t1 - alpha * t1, (f1 - f0) / t1) / length;
+      seg_hi = hf_max((f1 - f0) / t1 - alpha * t1, (f1 - f0) / t1) / length;
     const float seg_lo = f1 / (t1 * length);
     const float widen = t1 * length <= arc_limit ? lipschitz[c.y * cells_x + c.x] * angle : INFINITY;
     seg_hi = isnan(seg_hi) || isnan(widen) ? INFINITY : seg_hi + widen;
-    hi = fmax(hi, seg_hi);
+    hi = hf_max(hi, seg_hi);
     while (q < count && next <= t1) {
       bounds[bound_index(offsets, rays, ray_major, r, q)] = (float2)(lo, hi);
       ++q;
       next = (q + 1) * spacing * inv_length;
     }
-    if (!isnan(seg_lo)) lo = fmax(lo, seg_lo - widen);  // a surface point the sight lines pass near
+    if (!isnan(seg_lo)) lo = hf_max(lo, seg_lo - widen);  // a surface point the sight lines pass near
     f0 = f1;
-    if (tx <= t1) gx += sx, tx = crossing(gx, ex, dx, inv_dx);
-    if (ty <= t1) gy += sy, ty = crossing(gy, ey, dy, inv_dy);
+    if (tx <= t1) axis_next(&ax, ex, dx, inv_dx);
+    if (ty <= t1) axis_next(&ay, ey, dy, inv_dy);
     t0 = t1;
     if (t1 >= 1.0f) break;
   }
@@ -270,16 +371,28 @@ inline void put_visible(__global float* out, size_t p, float v, int accumulate) 
     out[p] = v;
 }
 
+// sight_blocked over [ta, tb], through the pyramid where there is one (top_level >= 1).
+inline int march(__global const float* h, __global const float* pyramid, __constant int4* levels, int top_level,
+                 Field f, float ex, float ey, float dx, float dy, float ze, float rise, float d2, float target_height,
+                 float ta, float tb) {
+  return top_level > 0 ? sight_blocked_pyramid(h, pyramid, levels, top_level, f, ex, ey, dx, dy, ze, rise, d2,
+                                               target_height, ta, tb)
+                       : sight_blocked(h, f, ex, ey, dx, dy, ze, rise, d2, target_height, ta, tb);
+}
+
 // One target per work-item over the field: out_visible 1 / 0 (NaN at nodata; added to it with
 // accumulate, a cumulative viewshed), out_angle the target's elevation angle from the eye
 // (radians; NaN at nodata; only with want_angle). Targets past max_distance (> 0; the box holds
 // every other), outside the azimuth range (compass degrees clockwise from az_from over
 // az_span, when az_on), or outside elevation angles [el_lo, el_hi] are not visible. rays = 0:
 // every target is marched; else the bounds of the rays (see viewshed_rays) decide what they can.
+// Marches skip what the maximum pyramid (levels 1 .. top_level; none when top_level = 0) shows
+// to lie below the sight line.
 __kernel void viewshed_targets(__global const float* h, Field f, int ex_i, int ey_i, float ze, float target_height,
                                int4 box, float max_distance, int az_on, float az_from, float az_span, float el_lo,
                                float el_hi, int rays, __global const uint* offsets, int ray_major, float spacing,
-                               __global const float2* bounds, __global float* out_visible, int accumulate,
+                               __global const float2* bounds, __global const float* pyramid,
+                               __constant int4* levels, int top_level, __global float* out_visible, int accumulate,
                                int want_angle, __global float* out_angle) {
   const int x = get_global_id(0), y = get_global_id(1);
   if (x >= f.width || y >= f.height) return;
@@ -322,7 +435,7 @@ __kernel void viewshed_targets(__global const float* h, Field f, int ex_i, int e
       if (q < (int)(offsets[a + 1] - offsets[a]) && q < (int)(offsets[b + 1] - offsets[b])) {
         const float2 ba = bounds[bound_index(offsets, rays, ray_major, a, q)];
         const float2 bb = bounds[bound_index(offsets, rays, ray_major, b, q)];
-        if (slope < fmax(ba.x, bb.x)) {  // something nearer rises above the sight line
+        if (slope < hf_max(ba.x, bb.x)) {  // something nearer rises above the sight line
           put_visible(out_visible, p, 0.0f, accumulate);
           return;
         }
@@ -331,16 +444,19 @@ __kernel void viewshed_targets(__global const float* h, Field f, int ex_i, int e
           put_visible(out_visible, p, 0.0f, accumulate);
           return;
         }
-        if (slope >= fmin(ba.y, bb.y)) {  // nothing nearer rises above it
+        if (slope >= hf_min(ba.y, bb.y)) {  // nothing nearer rises above it
           put_visible(out_visible, p, 1.0f, accumulate);
           return;
         }
         // Undecided: march the rest.
-        put_visible(out_visible, p, sight_blocked(h, f, ex, ey, dx, dy, ze, rise, d2, target_height, 0.0f, t_split) ? 0.0f : 1.0f,
-                    accumulate);
+        const int blocked =
+            march(h, pyramid, levels, top_level, f, ex, ey, dx, dy, ze, rise, d2, target_height, 0.0f, t_split);
+        put_visible(out_visible, p, blocked ? 0.0f : 1.0f, accumulate);
         return;
       }
     }
   }
-  put_visible(out_visible, p, sight_blocked(h, f, ex, ey, dx, dy, ze, rise, d2, target_height, 0.0f, 1.0f) ? 0.0f : 1.0f, accumulate);
+  const int blocked =
+      march(h, pyramid, levels, top_level, f, ex, ey, dx, dy, ze, rise, d2, target_height, 0.0f, 1.0f);
+  put_visible(out_visible, p, blocked ? 0.0f : 1.0f, accumulate);
 }

@@ -69,14 +69,22 @@ class ViewshedRun {
     heights_buffer_ = cl::Buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, pixels * sizeof(float),
                                  heights_.data());
     const int cells_x = std::max(field.width - 1, 1), cells_y = std::max(field.height - 1, 1);
-    lipschitz_ = detail::deviceBuffer(st, static_cast<std::size_t>(cells_x) * cells_y * sizeof(float));
+    const std::size_t cells = static_cast<std::size_t>(cells_x) * cells_y;
+    const cl::NDRange cell_range(detail::roundUp(cells_x, detail::kTileX), detail::roundUp(cells_y, detail::kTileY));
+    const cl::Buffer slopes = detail::deviceBuffer(st, cells * sizeof(float));
+    lipschitz_ = detail::deviceBuffer(st, cells * sizeof(float));
+    cl::Kernel slope(program_, "viewshed_slopes");
+    slope.setArg(0, heights_buffer_);
+    slope.setArg(1, device_);
+    slope.setArg(2, slopes);
+    st.launch(slope, cell_range, cl::NDRange(detail::kTileX, detail::kTileY));
     cl::Kernel k(program_, "viewshed_lipschitz");
-    k.setArg(0, heights_buffer_);
+    k.setArg(0, slopes);
     k.setArg(1, device_);
     k.setArg(2, lipschitz_);
-    st.launch(k, cl::NDRange(detail::roundUp(cells_x, detail::kTileX), detail::roundUp(cells_y, detail::kTileY)),
-              cl::NDRange(detail::kTileX, detail::kTileY));
+    st.launch(k, cell_range, cl::NDRange(detail::kTileX, detail::kTileY));
     budget_ = options.memory_budget ? options.memory_budget : detail::defaultMemoryBudget(st.info);
+    buildPyramid(cells_x, cells_y);
   }
 
   // One observer's targets into `visible` (added to it when `accumulate`) and, if given, `angle`.
@@ -161,6 +169,9 @@ class ViewshedRun {
     k.setArg(a++, ray_major ? 1 : 0);
     k.setArg(a++, spacing);
     k.setArg(a++, bounds);
+    k.setArg(a++, pyramid_);
+    k.setArg(a++, levels_);
+    k.setArg(a++, top_);
     k.setArg(a++, visible);
     k.setArg(a++, accumulate ? 1 : 0);
     k.setArg(a++, angle ? 1 : 0);
@@ -169,6 +180,37 @@ class ViewshedRun {
                cl::NDRange(detail::kTileX, detail::kTileY));
     st_.queue.finish();  // before this observer's ray buffers go
     (void)pixels;
+  }
+
+  // The maximum pyramid's levels 1 .. top_ (kernels/viewshed.cl), up to blocks of 4096 cells or one
+  // block over the field.
+  void buildPyramid(int cells_x, int cells_y) {
+    std::vector<cl_int4> levels(1, cl_int4{{0, 0, 0, 0}});
+    std::size_t total = 0;
+    for (int k = 1; k <= 12; ++k) {
+      const int bx = (cells_x + (1 << k) - 1) >> k, by = (cells_y + (1 << k) - 1) >> k;
+      levels.push_back(cl_int4{{bx, by, static_cast<int>(total), 0}});
+      total += static_cast<std::size_t>(bx) * by;
+      if (bx == 1 && by == 1) break;
+    }
+    top_ = static_cast<int>(levels.size()) - 1;
+    levels_ = cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, levels.size() * sizeof(cl_int4),
+                         levels.data());
+    pyramid_ = detail::deviceBuffer(st_, total * sizeof(float));
+    for (int k = 1; k <= top_; ++k) {
+      const cl_int4 level = levels[k];
+      cl::Kernel kernel(program_, k == 1 ? "viewshed_pyramid_first" : "viewshed_pyramid_next");
+      if (k == 1) {
+        kernel.setArg(0, heights_buffer_);
+        kernel.setArg(1, device_);
+      } else {
+        kernel.setArg(0, levels[k - 1]);
+      }
+      kernel.setArg(k == 1 ? 2 : 1, level);
+      kernel.setArg(k == 1 ? 3 : 2, pyramid_);
+      st_.launch(kernel, cl::NDRange(detail::roundUp(level.s[0], detail::kTileX), detail::roundUp(level.s[1], detail::kTileY)),
+                 cl::NDRange(detail::kTileX, detail::kTileY));
+    }
   }
 
   cl::Buffer output() { return detail::deviceBuffer(st_, field_.pixelCount() * sizeof(float)); }
@@ -186,7 +228,8 @@ class ViewshedRun {
   cl::Program program_;
   std::vector<float> heights_;
   DeviceField device_{};
-  cl::Buffer heights_buffer_, lipschitz_;
+  cl::Buffer heights_buffer_, lipschitz_, pyramid_, levels_;
+  int top_ = 0;
   std::size_t budget_ = 0;
 };
 

@@ -49,8 +49,9 @@ struct ViewshedOptions {
   // Vertical field of view: targets whose elevation angle from the eye lies within these
   // limits (degrees, -90 .. 90).
   double elevation_min_deg = -90.0, elevation_max_deg = 90.0;
-  // March every target in full instead of deciding most from the rays' bounds: the O(N^3)
-  // baseline, with the same decisions (tests and the benchmark compare the two).
+  // Decide every target by marching its whole sight line (through the maximum pyramid) instead
+  // of deciding most from the rays' bounds: the same decisions, more slowly (tests and the
+  // benchmark compare the two).
   bool march_every_target = false;
   // Device memory for the rays' bounds; 0 = half the device memory. When the rays' bounds at
   // every 2 pixels do not fit, they are kept farther apart (more of every sight line is marched).
