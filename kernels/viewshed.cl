@@ -17,6 +17,11 @@
 
 #include "fast_math.cl"
 
+// Divisions and square roots in the bounds and the classification are native_ ones: the program
+// is built for correctly rounded ones (which the exact marches' few divisions keep), whose
+// library calls cost more than the rest of a target there. Their last bits only move bounds
+// by rounding, as float arithmetic does anyway.
+
 // Integer clamp as compare and select (PoCL makes library calls of the builtin in scalar code).
 inline int clamp_int(int v, int lo, int hi) { return v < lo ? lo : (v > hi ? hi : v); }
 
@@ -52,7 +57,7 @@ inline float cell_twist(__global const float* h, int width, int4 c) {
 inline float quadratic_bump(float f0, float f1, float a) {
   if (!(a < 0.0f)) return -INFINITY;
   const float bump = -a;  // f(s) = f0 + (f1 - f0) s + bump s (1 - s)
-  const float s = 0.5f + (f1 - f0) / (2.0f * bump);
+  const float s = 0.5f + native_divide(f1 - f0, 2.0f * bump);
   if (!(s > 0.0f && s < 1.0f)) return -INFINITY;
   return f0 + (f1 - f0) * s + bump * s * (1.0f - s);
 }
@@ -268,8 +273,8 @@ inline float2 border_point(int p, int4 box) {
 // through T leaves the box.
 inline float border_position(float ex, float ey, float dx, float dy, int4 box) {
   const int w1 = box.z - box.x, h1 = box.w - box.y;
-  const float lx = dx > 0.0f ? (box.z - ex) / dx : dx < 0.0f ? (box.x - ex) / dx : INFINITY;
-  const float ly = dy > 0.0f ? (box.w - ey) / dy : dy < 0.0f ? (box.y - ey) / dy : INFINITY;
+  const float lx = dx > 0.0f ? native_divide(box.z - ex, dx) : dx < 0.0f ? native_divide(box.x - ex, dx) : INFINITY;
+  const float ly = dy > 0.0f ? native_divide(box.w - ey, dy) : dy < 0.0f ? native_divide(box.y - ey, dy) : INFINITY;
   if (lx <= ly) {
     const float y = hf_min(hf_max(ey + lx * dy, (float)box.y), (float)box.w);
     return dx > 0.0f ? w1 + (y - box.y) : 2 * w1 + h1 + (box.w - y);
@@ -340,12 +345,12 @@ __kernel void viewshed_rays(__global const float* h, Field f, __global const flo
     // height <= 0) f / t <= (f - f0) / t, which is linear in t: at most its value at an end.
     float seg_hi;
     if (t0 > 0.0f)
-      seg_hi = top >= 0.0f ? top / (t0 * length) : top / (t1 * length);
+      seg_hi = native_divide(top, (top >= 0.0f ? t0 : t1) * length);
     else if (f0 > 0.0f)
       seg_hi = INFINITY;  // the eye below the surface
     else
       seg_hi = hf_max((f1 - f0) / t1 - alpha * t1, (f1 - f0) / t1) / length;
-    const float seg_lo = f1 / (t1 * length);
+    const float seg_lo = native_divide(f1, t1 * length);
     const float widen = t1 * length <= arc_limit ? lipschitz[c.y * cells_x + c.x] * angle : INFINITY;
     seg_hi = isnan(seg_hi) || isnan(widen) ? INFINITY : seg_hi + widen;
     hi = hf_max(hi, seg_hi);
@@ -364,6 +369,7 @@ __kernel void viewshed_rays(__global const float* h, Field f, __global const flo
   for (; q < count; ++q) bounds[bound_index(offsets, rays, ray_major, r, q)] = (float2)(lo, INFINITY);
 }
 
+
 inline void put_visible(__global float* out, size_t p, float v, int accumulate) {
   if (accumulate)
     out[p] += v;
@@ -380,20 +386,52 @@ inline int march(__global const float* h, __global const float* pyramid, __const
                        : sight_blocked(h, f, ex, ey, dx, dy, ze, rise, d2, target_height, ta, tb);
 }
 
-// One target per work-item over the field: out_visible 1 / 0 (NaN at nodata; added to it with
-// accumulate, a cumulative viewshed), out_angle the target's elevation angle from the eye
-// (radians; NaN at nodata; only with want_angle). Targets past max_distance (> 0; the box holds
-// every other), outside the azimuth range (compass degrees clockwise from az_from over
-// az_span, when az_on), or outside elevation angles [el_lo, el_hi] are not visible. rays = 0:
-// every target is marched; else the bounds of the rays (see viewshed_rays) decide what they can.
-// Marches skip what the maximum pyramid (levels 1 .. top_level; none when top_level = 0) shows
-// to lie below the sight line.
-__kernel void viewshed_targets(__global const float* h, Field f, int ex_i, int ey_i, float ze, float target_height,
-                               int4 box, float max_distance, int az_on, float az_from, float az_span, float el_lo,
-                               float el_hi, int rays, __global const uint* offsets, int ray_major, float spacing,
-                               __global const float2* bounds, __global const float* pyramid,
-                               __constant int4* levels, int top_level, __global float* out_visible, int accumulate,
-                               int want_angle, __global float* out_angle) {
+// A target's sight line and where the rays' bounds apply to it.
+typedef struct {
+  float dx, dy, d2, dist, rise, slope;
+  int q;     // the entry of the rays' bounds for the part of the sight line before t_split
+  int a, b;  // the rays on either side of it
+  int use;   // whether the bounds apply (rays, and both rays long enough)
+  float t_split;
+} SightLine;
+
+inline SightLine sight_line(__global const float* h, Field f, int x, int y, int ex_i, int ey_i, float ze,
+                            float target_height, int4 box, int rays, __global const uint* offsets, float spacing) {
+  SightLine s;
+  s.dx = x - ex_i;
+  s.dy = y - ey_i;
+  const float gdx = s.dx * f.cell_x, gdy = s.dy * f.cell_y;
+  s.d2 = gdx * gdx + gdy * gdy;
+  s.dist = native_sqrt(s.d2);
+  s.rise = (h[(size_t)y * f.width + x] + target_height - f.curvature * s.d2) - ze;
+  s.slope = native_divide(s.rise, s.dist);
+  // Entry q covers distances up to (q + 1) spacing, at least 1.5 pixels short of the target.
+  s.q = (int)floor(native_divide(s.dist - 1.5f * hf_max(f.cell_x, f.cell_y), spacing)) - 1;
+  s.a = 0;
+  s.b = 0;
+  s.use = 0;
+  if (rays > 0 && s.dist > 0.0f) {
+    const int a = clamp_int((int)floor(border_position(ex_i, ey_i, s.dx, s.dy, box)) % rays, 0, rays - 1);
+    s.a = a;
+    s.b = a + 1 == rays ? 0 : a + 1;
+    s.use = s.q >= 0 && s.q < (int)(offsets[s.a + 1] - offsets[s.a]) && s.q < (int)(offsets[s.b + 1] - offsets[s.b]);
+  }
+  s.t_split = native_divide((s.q + 1) * spacing, s.dist);
+  return s;
+}
+
+// viewshed_classify, one work-item per grid point: what needs no march. Writes out_visible 1 / 0
+// (NaN at nodata; added to it with accumulate, a cumulative viewshed) and out_angle (radians; NaN
+// at nodata; only with want_angle) where that settles it, else marks the target in `pending`
+// for viewshed_march. Settled: nodata; targets past max_distance (> 0; the box holds every
+// other), outside the azimuth range (compass degrees clockwise from az_from over az_span, when
+// az_on) or outside elevation angles [el_lo, el_hi] (not visible); the eye's own point (visible);
+// targets the rays' bounds show hidden (rays = 0: none).
+__kernel void viewshed_classify(__global const float* h, Field f, int ex_i, int ey_i, float ze, float target_height,
+                                int4 box, float max_distance, int az_on, float az_from, float az_span, float el_lo,
+                                float el_hi, int rays, __global const uint* offsets, int ray_major, float spacing,
+                                __global const float2* bounds, __global float* out_visible, int accumulate,
+                                int want_angle, __global float* out_angle, __global uchar* pending) {
   const int x = get_global_id(0), y = get_global_id(1);
   if (x >= f.width || y >= f.height) return;
   const size_t p = (size_t)y * f.width + x;
@@ -401,62 +439,79 @@ __kernel void viewshed_targets(__global const float* h, Field f, int ex_i, int e
   if (isnan(ht)) {
     out_visible[p] = NAN;  // accumulated too: nodata stays NaN
     if (want_angle) out_angle[p] = NAN;
+    pending[p] = 0;
     return;
   }
-  const float ex = ex_i, ey = ey_i;
-  const float dx = x - ex_i, dy = y - ey_i;
-  const float gdx = dx * f.cell_x, gdy = dy * f.cell_y;
-  const float d2 = gdx * gdx + gdy * gdy;
-  const float dist = sqrt(d2);
-  const float zt = ht + target_height - f.curvature * d2;
-  const float rise = zt - ze;
-  const float angle = dist > 0.0f ? atan2(rise, dist) : (rise >= 0.0f ? M_PI_2_F : -M_PI_2_F);
-  if (want_angle) out_angle[p] = angle;
-  int in_range = !(max_distance > 0.0f && dist > max_distance) && angle >= el_lo && angle <= el_hi;
-  if (az_on && dist > 0.0f) {
-    const float compass = degrees(atan2(gdx, -gdy));
+  const SightLine s = sight_line(h, f, x, y, ex_i, ey_i, ze, target_height, box, rays, offsets, spacing);
+  int in_range = !(max_distance > 0.0f && s.dist > max_distance);
+  if (want_angle || el_lo > -M_PI_2_F || el_hi < M_PI_2_F) {  // a library atan2 costs more than the rest
+    const float angle = s.dist > 0.0f ? hf_atan(s.slope) : (s.rise >= 0.0f ? M_PI_2_F : -M_PI_2_F);
+    if (want_angle) out_angle[p] = angle;
+    in_range = in_range && angle >= el_lo && angle <= el_hi;
+  }
+  if (az_on && s.dist > 0.0f) {
+    const float compass = degrees(atan2(s.dx * f.cell_x, -s.dy * f.cell_y));
     const float from_start = compass - az_from;
     in_range = in_range && from_start - 360.0f * floor(from_start / 360.0f) <= az_span;
   }
-  if (!in_range) {
-    put_visible(out_visible, p, 0.0f, accumulate);
-    return;
-  }
-  if (dist == 0.0f) {
-    put_visible(out_visible, p, 1.0f, accumulate);
-    return;
-  }
-  if (rays > 0) {
-    const float slope = rise / dist;
-    const int q = (int)floor((dist - 1.5f * fmax(f.cell_x, f.cell_y)) / spacing) - 1;  // entry q: within (q + 1) spacing
-    if (q >= 0) {
-      const float s = border_position(ex, ey, dx, dy, box);
-      const int a = ((int)floor(s)) % rays, b = (a + 1) % rays;
-      if (q < (int)(offsets[a + 1] - offsets[a]) && q < (int)(offsets[b + 1] - offsets[b])) {
-        const float2 ba = bounds[bound_index(offsets, rays, ray_major, a, q)];
-        const float2 bb = bounds[bound_index(offsets, rays, ray_major, b, q)];
-        if (slope < hf_max(ba.x, bb.x)) {  // something nearer rises above the sight line
-          put_visible(out_visible, p, 0.0f, accumulate);
-          return;
-        }
-        const float t_split = (q + 1) * spacing / dist;
-        if (sight_blocked(h, f, ex, ey, dx, dy, ze, rise, d2, target_height, t_split, 1.0f)) {
-          put_visible(out_visible, p, 0.0f, accumulate);
-          return;
-        }
-        if (slope >= hf_min(ba.y, bb.y)) {  // nothing nearer rises above it
-          put_visible(out_visible, p, 1.0f, accumulate);
-          return;
-        }
-        // Undecided: march the rest.
-        const int blocked =
-            march(h, pyramid, levels, top_level, f, ex, ey, dx, dy, ze, rise, d2, target_height, 0.0f, t_split);
-        put_visible(out_visible, p, blocked ? 0.0f : 1.0f, accumulate);
-        return;
-      }
+  // The bounds are read unconditionally (index 0 where they do not apply), so that the work-items
+  // run alike.
+  const int q = s.use ? s.q : 0;
+  const float lo_a = bounds[s.use ? bound_index(offsets, rays, ray_major, s.a, q) : 0].x;
+  const float lo_b = bounds[s.use ? bound_index(offsets, rays, ray_major, s.b, q) : 0].x;
+  const int hidden = !in_range || (s.use && s.slope < hf_max(lo_a, lo_b));  // something nearer rises above it
+  const int settled = hidden || s.dist == 0.0f;
+  if (settled) put_visible(out_visible, p, hidden ? 0.0f : 1.0f, accumulate);
+  pending[p] = settled ? 0 : 1;
+}
+
+// counts[row]: the pending targets of each row; with offsets[row] (their running sum, from the
+// host), viewshed_pending_list writes their indices p in order into list[offsets[row] ...].
+__kernel void viewshed_pending_count(__global const uchar* pending, int width, int height, __global uint* counts) {
+  const int row = get_global_id(0);
+  if (row >= height) return;
+  uint n = 0;
+  for (int x = 0; x < width; ++x) n += pending[(size_t)row * width + x];
+  counts[row] = n;
+}
+
+__kernel void viewshed_pending_list(__global const uchar* pending, int width, int height,
+                                    __global const uint* offsets, __global uint* list) {
+  const int row = get_global_id(0);
+  if (row >= height) return;
+  uint n = offsets[row];
+  for (int x = 0; x < width; ++x)
+    if (pending[(size_t)row * width + x]) list[n++] = (uint)(row * width + x);
+}
+
+// viewshed_march, one work-item per pending target (list[0 .. count - 1]): where the rays'
+// bounds apply, an exact march of the sight line's last pixels (past t_split); if it is clear,
+// the bounds' upper ends, and if they do not settle it a march of the rest; elsewhere a march of
+// the whole sight line. Marches skip what the maximum pyramid (levels 1 .. top_level; none when
+// top_level = 0) shows to lie below the sight line.
+__kernel void viewshed_march(__global const float* h, Field f, int ex_i, int ey_i, float ze, float target_height,
+                             int4 box, int rays, __global const uint* offsets, int ray_major, float spacing,
+                             __global const float2* bounds, __global const float* pyramid, __constant int4* levels,
+                             int top_level, __global const uint* list, uint count, __global float* out_visible,
+                             int accumulate) {
+  const uint i = get_global_id(0);
+  if (i >= count) return;
+  const uint p = list[i];
+  const int x = p % f.width, y = p / f.width;
+  const SightLine s = sight_line(h, f, x, y, ex_i, ey_i, ze, target_height, box, rays, offsets, spacing);
+  const float ex = ex_i, ey = ey_i;
+  int blocked;
+  if (s.use) {
+    blocked = sight_blocked(h, f, ex, ey, s.dx, s.dy, ze, s.rise, s.d2, target_height, s.t_split, 1.0f);
+    if (!blocked) {
+      const float hi = hf_min(bounds[bound_index(offsets, rays, ray_major, s.a, s.q)].y,
+                              bounds[bound_index(offsets, rays, ray_major, s.b, s.q)].y);
+      if (!(s.slope >= hi))  // nothing nearer is known to stay below the sight line: march it
+        blocked = march(h, pyramid, levels, top_level, f, ex, ey, s.dx, s.dy, ze, s.rise, s.d2, target_height, 0.0f,
+                        s.t_split);
     }
+  } else {
+    blocked = march(h, pyramid, levels, top_level, f, ex, ey, s.dx, s.dy, ze, s.rise, s.d2, target_height, 0.0f, 1.0f);
   }
-  const int blocked =
-      march(h, pyramid, levels, top_level, f, ex, ey, dx, dy, ze, rise, d2, target_height, 0.0f, 1.0f);
   put_visible(out_visible, p, blocked ? 0.0f : 1.0f, accumulate);
 }

@@ -85,11 +85,13 @@ class ViewshedRun {
     st.launch(k, cell_range, cl::NDRange(detail::kTileX, detail::kTileY));
     budget_ = options.memory_budget ? options.memory_budget : detail::defaultMemoryBudget(st.info);
     buildPyramid(cells_x, cells_y);
+    pending_ = detail::deviceBuffer(st, pixels);
+    pending_list_ = detail::deviceBuffer(st, pixels * sizeof(cl_uint));
+    row_counts_ = detail::deviceBuffer(st, static_cast<std::size_t>(field.height) * sizeof(cl_uint));
   }
 
   // One observer's targets into `visible` (added to it when `accumulate`) and, if given, `angle`.
   void observe(const Observer& o, cl::Buffer& visible, bool accumulate, cl::Buffer* angle) {
-    const std::size_t pixels = field_.pixelCount();
     const float ze = static_cast<float>(options_.absolute ? o.height
                                                           : heights_[static_cast<std::size_t>(o.row) * field_.width + o.col] + o.height);
     const cl_int4 box = targetBox(field_, o, options_.max_distance);
@@ -149,7 +151,8 @@ class ViewshedRun {
       az_span = std::fmod(options_.azimuth_to_deg - options_.azimuth_from_deg, 360.0);
       if (az_span < 0.0) az_span += 360.0;
     }
-    cl::Kernel k(program_, "viewshed_targets");
+    // Classify every target; march the pending ones, listed row by row.
+    cl::Kernel k(program_, "viewshed_classify");
     int a = 0;
     k.setArg(a++, heights_buffer_);
     k.setArg(a++, device_);
@@ -169,18 +172,66 @@ class ViewshedRun {
     k.setArg(a++, ray_major ? 1 : 0);
     k.setArg(a++, spacing);
     k.setArg(a++, bounds);
-    k.setArg(a++, pyramid_);
-    k.setArg(a++, levels_);
-    k.setArg(a++, top_);
     k.setArg(a++, visible);
     k.setArg(a++, accumulate ? 1 : 0);
     k.setArg(a++, angle ? 1 : 0);
     k.setArg(a++, angle ? *angle : visible);
+    k.setArg(a++, pending_);
     st_.launch(k, cl::NDRange(detail::roundUp(field_.width, detail::kTileX), detail::roundUp(field_.height, detail::kTileY)),
                cl::NDRange(detail::kTileX, detail::kTileY));
+    const cl::NDRange row_range(detail::roundUp(field_.height, detail::kLineGroup));
+    cl::Kernel count(program_, "viewshed_pending_count");
+    count.setArg(0, pending_);
+    count.setArg(1, field_.width);
+    count.setArg(2, field_.height);
+    count.setArg(3, row_counts_);
+    st_.launch(count, row_range, cl::NDRange(detail::kLineGroup));
+    std::vector<cl_uint> rows(field_.height);
+    st_.queue.enqueueReadBuffer(row_counts_, CL_TRUE, 0, rows.size() * sizeof(cl_uint), rows.data());
+    cl_uint total = 0;
+    for (cl_uint& r : rows) {
+      const cl_uint n = r;
+      r = total;
+      total += n;
+    }
+    pending_targets_ += total;
+    if (total > 0) {
+      st_.queue.enqueueWriteBuffer(row_counts_, CL_FALSE, 0, rows.size() * sizeof(cl_uint), rows.data());
+      cl::Kernel list(program_, "viewshed_pending_list");
+      list.setArg(0, pending_);
+      list.setArg(1, field_.width);
+      list.setArg(2, field_.height);
+      list.setArg(3, row_counts_);
+      list.setArg(4, pending_list_);
+      st_.launch(list, row_range, cl::NDRange(detail::kLineGroup));
+      cl::Kernel m(program_, "viewshed_march");
+      a = 0;
+      m.setArg(a++, heights_buffer_);
+      m.setArg(a++, device_);
+      m.setArg(a++, o.col);
+      m.setArg(a++, o.row);
+      m.setArg(a++, ze);
+      m.setArg(a++, static_cast<float>(options_.target_height));
+      m.setArg(a++, box);
+      m.setArg(a++, rays);
+      m.setArg(a++, offsets);
+      m.setArg(a++, ray_major ? 1 : 0);
+      m.setArg(a++, spacing);
+      m.setArg(a++, bounds);
+      m.setArg(a++, pyramid_);
+      m.setArg(a++, levels_);
+      m.setArg(a++, top_);
+      m.setArg(a++, pending_list_);
+      m.setArg(a++, total);
+      m.setArg(a++, visible);
+      m.setArg(a++, accumulate ? 1 : 0);
+      st_.launch(m, cl::NDRange(detail::roundUp(total, detail::kLineGroup)), cl::NDRange(detail::kLineGroup));
+    }
     st_.queue.finish();  // before this observer's ray buffers go
-    (void)pixels;
   }
+
+  // Targets marched so far (the rest were settled by classification).
+  std::size_t pendingTargets() const { return pending_targets_; }
 
   // The maximum pyramid's levels 1 .. top_ (kernels/viewshed.cl), up to blocks of 4096 cells or one
   // block over the field.
@@ -229,6 +280,8 @@ class ViewshedRun {
   std::vector<float> heights_;
   DeviceField device_{};
   cl::Buffer heights_buffer_, lipschitz_, pyramid_, levels_;
+  cl::Buffer pending_, pending_list_, row_counts_;  // the targets classification leaves to viewshed_march
+  std::size_t pending_targets_ = 0;
   int top_ = 0;
   std::size_t budget_ = 0;
 };
