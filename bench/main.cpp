@@ -21,6 +21,10 @@
 //   hfvis_bench lighting-error FIELD --env ENV [--samples M] [-k K[,K...]] [--rows R[,R...]]
 //       environment lighting against a Monte-Carlo ray-traced reference: mean and 99th-percentile
 //       relative error against K (the map's rows) and against the table's bands (the largest K)
+//   hfvis_bench viewshed-agreement DEM --observer COL,ROW [--observer-height H] [--target-height T]
+//                                  [--samples N] [--seed S] RASTER...
+//       viewshed rasters (visible where > 0) against the exact sight-line test at N random targets:
+//       the Jaccard index of the visible sets and the disagreements that graze
 //   hfvis_bench inputs [--quick]
 //       the generated fields both suites read, one "<content> <N>" per line
 //   hfvis_bench check-truth
@@ -53,6 +57,7 @@
 #include "metrics.hpp"
 #include "suite.hpp"
 #include "suite_support.hpp"
+#include "viewshed_agreement.hpp"
 
 namespace {
 
@@ -70,6 +75,8 @@ constexpr const char* kUsage =
     "       hfvis_bench lighting-error FIELD --env ENV [--samples M] [-k K[,K...]] [--rows R[,R...]]\n"
     "       hfvis_bench vis-run FIELD [--method tree|naive] [-k K] [--tuning plain|deferred|default|zone]\n"
     "                           [--zone-steps S] [--reps N]\n"
+    "       hfvis_bench viewshed-agreement DEM --observer COL,ROW [--observer-height H] [--target-height T]\n"
+    "                                      [--samples N] [--seed S] RASTER...\n"
     "       hfvis_bench inputs [--quick]\n"
     "       hfvis_bench check-truth\n"
     "       hfvis_bench vectorize-report\n"
@@ -243,6 +250,32 @@ std::vector<int> intList(const std::string& text) {
   return out;
 }
 
+int viewshedAgreementCommand(Arguments& args) {
+  const std::string at = args.get("--observer");
+  const std::size_t comma = at.find(',');
+  if (comma == std::string::npos) throw Usage("viewshed-agreement needs --observer COL,ROW");
+  Observer o{static_cast<int>(number(at.substr(0, comma), "--observer")),
+             static_cast<int>(number(at.substr(comma + 1), "--observer")), number(args.get("--observer-height", "2"), "--observer-height")};
+  ViewshedOptions options;
+  options.target_height = number(args.get("--target-height", "0"), "--target-height");
+  const std::size_t samples = static_cast<std::size_t>(number(args.get("--samples", "20000"), "--samples"));
+  const unsigned seed = static_cast<unsigned>(number(args.get("--seed", "1"), "--seed"));
+  std::vector<std::string> paths = args.positional();
+  args.rejectUnused();
+  if (paths.size() < 2) throw Usage("viewshed-agreement needs DEM RASTER...");
+  const HeightField field = readHeightField(paths[0]);
+  validate(field, o);
+  paths.erase(paths.begin());
+  std::printf("| raster | targets | visible (exact) | visible (raster) | Jaccard | disagreements | of them grazing |\n"
+              "|---|---|---|---|---|---|---|\n");
+  for (const auto& a : viewshedAgreement(field, o, options, paths, samples, seed))
+    std::printf("| %s | %zu | %.2f %% | %.2f %% | %.4f | %zu | %zu |\n", a.raster.c_str(), a.targets,
+                100.0 * a.reference_visible / std::max<std::size_t>(a.targets, 1),
+                100.0 * a.raster_visible / std::max<std::size_t>(a.targets, 1), a.jaccard(),
+                a.reference_visible + a.raster_visible - 2 * a.both, a.grazing);
+  return 0;
+}
+
 int lightingTime(Arguments& args) {
   const EnvironmentMap map = readEnvironmentMap(args.get("--env"));
   const std::vector<int> ks = intList(args.get("-k", "16,64,256"));
@@ -359,6 +392,7 @@ int main(int argc, char** argv) {
     if (command == "vis-run") return runVisibilityOne(args);
     if (command == "lighting-time") return lightingTime(args);
     if (command == "lighting-error") return lightingError(args);
+    if (command == "viewshed-agreement") return viewshedAgreementCommand(args);
     if (command == "inputs") {
       const std::string mode = args.flag("--quick") ? "quick" : "full";
       std::set<std::pair<std::string, int>> inputs;
