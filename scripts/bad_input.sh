@@ -157,6 +157,14 @@ try "albedo beyond 1" "" -- shade field.exr -o out/o.exr --sun 180,30 --albedo 1
 try "insolation without a span" "" -- insolation field.exr -o out/o.exr --lat 45 --lon 7
 try "insolation running backwards" "" -- insolation field.exr -o out/o.exr --lat 45 --lon 7 --from 2026-06-22T00:00:00Z --to 2026-06-21T00:00:00Z
 try "insolation in steps of 0 minutes" "" -- insolation field.exr -o out/o.exr --lat 45 --lon 7 --from 2026-06-21T00:00:00Z --to 2026-06-22T00:00:00Z --step 0
+try "viewshed without an observer" "" -- viewshed field.exr -o out/o.exr
+try "viewshed observer outside the field" "" -- viewshed field.exr -o out/o.exr --observer 300,2
+try "viewshed observer not a pair" "" -- viewshed field.exr -o out/o.exr --observer 3
+try "viewshed observers file missing" "" -- viewshed field.exr -o out/o.exr --observers nowhere.csv
+try "viewshed observers file not CSV" "" -- viewshed field.exr -o out/o.exr --observers garbage.exr
+try "viewshed target below the surface" "" -- viewshed field.exr -o out/o.exr --observer 3,3 --target-height -1
+try "viewshed culled (not built yet)" "" -- viewshed field.exr -o out/o.exr --observer 3,3 --method culled
+try "viewshed angle for several observers" "" -- viewshed field.exr -o out/o.exr --observer 3,3 --observer 4,4 --angle
 try "sun position without a time" "" -- sunpos --lat 45 --lon 7
 try "sun position at a time without a zone" "" -- sunpos --lat 45 --lon 7 --at 2026-06-21T12:00:00
 try "sun position at a day that does not exist" "" -- sunpos --lat 45 --lon 7 --at 2026-02-30T12:00:00Z

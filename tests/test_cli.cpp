@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <iterator>
 #include <map>
 #include <optional>
@@ -1626,3 +1627,71 @@ TEST_F(Cli, GeographicGridTakesEachRowsSpacing) {
 }
 
 }  // namespace
+
+TEST_F(Cli, ViewshedSeesOverAWall) {
+  // A wall 5 high across column 8 of flat ground at 0; the eye 2 above the ground at column 2.
+  const std::string field = writeField("wall.exr", 16, 6, [](int col, int) { return col == 8 ? 5.0f : 0.0f; });
+  const CliResult r = run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) +
+                          " --observer 2,3 --angle --preview " + shellQuoted(out("v.png")));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("1 observer"), std::string::npos) << r.out;
+  const ReadBack v = readBack(out("v.exr"));
+  ASSERT_EQ(v.channels, (std::vector<std::string>{"angle", "visible"}));
+  EXPECT_EQ(v.at(5, 3, 1), 1.0f);   // before the wall
+  EXPECT_EQ(v.at(8, 3, 1), 1.0f);   // the wall's top
+  EXPECT_EQ(v.at(12, 3, 1), 0.0f);  // behind it
+  EXPECT_NEAR(v.at(8, 3, 0), std::atan2(3.0, 6.0) * 180.0 / M_PI, 1e-4);  // degrees above the eye's horizontal
+  // A target 7 high behind the wall is seen over it; an eye 10 up sees the ground behind it.
+  ASSERT_EQ(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("t.exr")) +
+                " --observer 2,3 --target-height 7 -q").status, 0);
+  EXPECT_EQ(readBack(out("t.exr")).at(12, 3, 0), 1.0f);
+  ASSERT_EQ(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("a.exr")) +
+                " --observer 2,3 --observer-height 10 --absolute -q").status, 0);
+  EXPECT_EQ(readBack(out("a.exr")).at(15, 3, 0), 1.0f);
+  // Several observers, on the command line and in a CSV: how many see each point.
+  {
+    std::ofstream csv(in("observers.csv"));
+    csv << "col,row,height\n14,3\n# a comment\n\n8,0,1\n";
+  }
+  const CliResult c = run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("c.exr")) +
+                          " --observer 2,3 --observers " + shellQuoted(in("observers.csv")) + " -q");
+  ASSERT_EQ(c.status, 0) << c.err;
+  const ReadBack count = readBack(out("c.exr"));
+  ASSERT_EQ(count.channels, (std::vector<std::string>{"count"}));
+  EXPECT_EQ(count.at(8, 3, 0), 3.0f);   // the wall's top: everyone
+  // Behind the wall from column 2, in front of it from 14, and seen from the eye on the wall's end.
+  EXPECT_EQ(count.at(12, 3, 0), 2.0f);
+}
+
+TEST_F(Cli, ViewshedRefusesBadObservers) {
+  const std::string field = flat();
+  expectFailure(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr"))), 2, "--observer");
+  expectFailure(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) + " --observer 16,2"), 2,
+                "outside");
+  expectFailure(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) +
+                    " --observer 1,2 --observer 3,4 --angle"),
+                2, "--angle");
+  expectFailure(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) +
+                    " --observer 1,2 --method culled"),
+                2, "culled");
+  expectFailure(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) +
+                    " --observer 1,2 --target-height -1"),
+                2, "--target-height");
+  expectFailure(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) +
+                    " --observer 1,2 --fov 10,400"),
+                2, "--fov");
+  expectFailure(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) + " --observer 1,2 -k 4"), 2,
+                "-k");
+  const std::string holes = writeField("holes.exr", 8, 8, [](int col, int row) {
+    return col == 3 && row == 3 ? std::numeric_limits<float>::quiet_NaN() : 1.0f;
+  });
+  expectFailure(run("viewshed " + shellQuoted(holes) + " -o " + shellQuoted(out("v.exr")) + " --observer 3,3"), 2,
+                "nodata");
+  {
+    std::ofstream csv(in("bad.csv"));
+    csv << "col,row\n1,2\n3,x\n";
+  }
+  expectFailure(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) + " --observers " +
+                    shellQuoted(in("bad.csv"))),
+                1, "line 3");
+}
