@@ -10,6 +10,9 @@
 //   hfvis/horizon_lists.hpp    the visibility horizons of chosen receivers
 //   hfvis/intervisibility.hpp  computeIntervisibility: visible counts and areas (hull tree)
 //   hfvis/bounce.hpp           one diffuse bounce over the visible surface
+//   hfvis/shading.hpp          the sun's light with cast shadows, insolation over a span of time
+//   hfvis/sun.hpp              where the sun stands at a time and place
+//   hfvis/viewshed.hpp         computeViewshed, computeCumulativeViewshed: what observers see
 //   hfvis/image_io.hpp         reading height fields, writing float EXRs and PNG previews
 //
 // The scalar references of the kernels and the synthetic test fields are in the test support
@@ -27,4 +30,5 @@
 #include "hfvis/shading.hpp"
 #include "hfvis/sun.hpp"
 #include "hfvis/sweep_options.hpp"
+#include "hfvis/viewshed.hpp"
 #include "hfvis/version.hpp"
