@@ -301,9 +301,10 @@ bool notFor(Option option, Command command) {
   // The sun's place and size: shade and insolation.
   if (option == Option::Latitude || option == Option::Longitude || option == Option::SunSize)
     return command != Command::Shade && command != Command::Insolation;
-  // A viewshed marches sight lines: no directions or sampling density.
+  // A viewshed marches sight lines: no directions, sampling density or hull tree.
   if (command == Command::Viewshed)
-    return option == Option::Directions || option == Option::AzimuthOffset || option == Option::SamplesPerUnit;
+    return option == Option::Directions || option == Option::AzimuthOffset || option == Option::SamplesPerUnit ||
+           option == Option::HullTree;
   // insolation sweeps the sun's azimuths alone, by the sweep; shade takes directions for --env.
   if (command == Command::Insolation)
     return option == Option::Directions || option == Option::Method || option == Option::AzimuthOffset ||
@@ -625,6 +626,8 @@ void validateRun(Command command, const RunArguments& run) {
     }
   }
   if (command == Command::Viewshed) {
+    if (!run.absolute && run.observer_height < 0.0)
+      throw UsageError("--observer-height: an eye below the surface sees nothing; give a height >= 0 (or --absolute)");
     if (run.observers.empty() && run.observers_file.empty())
       throw UsageError("missing --observer COL,ROW or --observers FILE.csv (who looks)");
     if (run.with_angle && (run.observers.size() > 1 || !run.observers_file.empty()))

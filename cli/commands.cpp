@@ -246,6 +246,8 @@ const char* methodName(Command command, const RunArguments& run) {
     case Command::HorizonLists:
     case Command::Bounce:
       return "tree";
+    case Command::Viewshed:
+      return "exact";
     default:
       return run.method == HorizonMethod::Naive ? "naive" : "sweep";
   }
@@ -737,12 +739,14 @@ int runInsolation(const RunArguments& run) {
 namespace {
 
 // --observers FILE.csv: "col,row[,height]" per line; blank lines, lines starting with '#' and
-// a first line that is not numbers (a header) are skipped. A malformed line is the file's fault.
+// one header line before the first observer (fields that start with letters) are skipped. A
+// malformed line is the file's fault.
 std::vector<Observer> readObserverFile(const std::string& path, double default_height) {
   std::ifstream in(path);
   if (!in) throw IoError(path, std::string("cannot open: ") + std::strerror(errno));
   std::vector<Observer> observers;
   std::string line;
+  bool header_seen = false;
   for (int number = 1; std::getline(in, line); ++number) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
     const std::size_t first = line.find_first_not_of(" \t");
@@ -758,9 +762,19 @@ std::vector<Observer> readObserverFile(const std::string& path, double default_h
       value = std::strtod(t.c_str(), &end);
       return end == t.c_str() + t.size() && std::isfinite(value);
     };
+    if (observers.empty() && fields[0].rfind("\xEF\xBB\xBF", 0) == 0) fields[0].erase(0, 3);  // a UTF-8 BOM
     double col = 0, row_index = 0, height = default_height;
     const bool numbers = fields.size() >= 2 && number_in(fields[0], col) && number_in(fields[1], row_index);
-    if (!numbers && observers.empty() && number == 1) continue;  // a header
+    // A header: before any observer, a line whose fields all start with a letter.
+    bool words = true;
+    for (const std::string& f : fields) {
+      const std::size_t a = f.find_first_not_of(" \t");
+      words = words && a != std::string::npos && std::isalpha(static_cast<unsigned char>(f[a]));
+    }
+    if (!numbers && observers.empty() && !header_seen && words) {
+      header_seen = true;
+      continue;
+    }
     if (!numbers || fields.size() > 3 || (fields.size() == 3 && !number_in(fields[2], height)) ||
         col != std::floor(col) || row_index != std::floor(row_index) || std::fabs(col) > 1e9 ||
         std::fabs(row_index) > 1e9)
@@ -795,7 +809,7 @@ std::vector<float> hillshade(const HeightField& f) {
 
 int runViewshed(const RunArguments& run) {
   requireOutputs(run, outputPaths(run));
-  const HeightField field = readValidField(run);
+  const HeightField input = readValidField(run);
   std::vector<Observer> observers;
   for (const ReceiverPixel& p : run.observers) observers.push_back({p.col, p.row, run.observer_height});
   if (!run.observers_file.empty()) {
@@ -804,11 +818,18 @@ int runViewshed(const RunArguments& run) {
   }
   for (const Observer& o : observers) {
     try {
-      validate(field, o);
+      validate(input, o);
     } catch (const InvalidArgument& error) {
       throw UsageError(std::string(error.what()) + " (" + run.input + ")");
     }
   }
+  // Compass azimuths (--fov) take row 0 as north: a south-up GeoTIFF is computed flipped
+  // north-up, its observers with it, and its results flipped back.
+  const NorthUp lit = northUp(input);
+  const HeightField& field = lit.field;
+  std::vector<Observer> placed = observers;
+  if (lit.flipped)
+    for (Observer& o : placed) o.row = field.height - 1 - o.row;
   const ComputeContext context = contextFor(run);
   const DeviceInfo& device = context.device();
   ViewshedOptions options = viewshedOptions(run);
@@ -820,8 +841,10 @@ int runViewshed(const RunArguments& run) {
   if (observers.size() == 1) {
     ViewshedOutputs outputs;
     outputs.angle = run.with_angle;
-    ViewshedResult r = computeViewshed(context, field, observers[0], options, outputs);
+    ViewshedResult r = computeViewshed(context, field, placed[0], options, outputs);
     requireResultSize(r.width, r.height, field);
+    lit.restore(r.visible);
+    lit.restore(r.angle);
     if (run.with_angle) {
       for (float& a : r.angle) a = static_cast<float>(a * (180.0 / M_PI));
       names.push_back("angle");
@@ -837,8 +860,9 @@ int runViewshed(const RunArguments& run) {
     units = run.with_angle ? "visible: 1; angle: degrees" : "1";
   } else {
     options.progress = progress.observerCallback(static_cast<int>(observers.size()));
-    CumulativeViewshed c = progress.run([&] { return computeCumulativeViewshed(context, field, observers, options); });
+    CumulativeViewshed c = progress.run([&] { return computeCumulativeViewshed(context, field, placed, options); });
     requireResultSize(c.width, c.height, field);
+    lit.restore(c.count);
     float most = 0.0f;
     for (float v : c.count)
       if (v > most) most = v;
@@ -849,7 +873,15 @@ int runViewshed(const RunArguments& run) {
     units = "observers";
   }
   const double seconds = secondsSince(start);
-  Attributes attributes = runAttributes(Command::Viewshed, run, field, device);
+  Attributes attributes = runAttributes(Command::Viewshed, run, input, device);
+  // A viewshed has no directions or sampling density.
+  attributes.erase(std::remove_if(attributes.begin(), attributes.end(),
+                                  [](const auto& a) {
+                                    return a.first == "hfvis:directions" || a.first == "hfvis:azimuth_offset_deg" ||
+                                           a.first == "hfvis:azimuth_convention" ||
+                                           a.first == "hfvis:samples_per_unit";
+                                  }),
+                   attributes.end());
   std::string where;
   for (const Observer& o : observers) {
     if (where.size() > 4000) {
@@ -868,7 +900,7 @@ int runViewshed(const RunArguments& run) {
   if (run.elevation_range)
     attributes.emplace_back("hfvis:elevation_range_deg", formatNumber(run.elevation_range->first) + " .. " +
                                                              formatNumber(run.elevation_range->second));
-  const ImageChannels image = makeImage(field, run, names, planes, attributes, quantity, units);
+  const ImageChannels image = makeImage(input, run, names, planes, attributes, quantity, units);
   StagedOutputs outputs;
   outputs.stage(run.output, [&](const std::string& path) { writeImage(path, image); });
   if (!run.preview.empty()) {
@@ -878,19 +910,19 @@ int runViewshed(const RunArguments& run) {
       float most = 0.0f;
       for (float v : seen)
         if (v > most) most = v;
-      const std::vector<float> shade = hillshade(field);
+      const std::vector<float> shade = hillshade(input);
       std::vector<float> picture(seen.size());
       for (std::size_t p = 0; p < seen.size(); ++p)
         picture[p] = std::isnan(seen[p]) ? NAN
                                          : 0.3f * shade[p] + (seen[p] > 0.0f ? 0.35f + 0.35f * seen[p] / std::max(most, 1.0f) : 0.0f);
-      writePreviewPng(path, field.width, field.height, picture, 0.0f, 1.0f);
+      writePreviewPng(path, input.width, input.height, picture, 0.0f, 1.0f);
     });
   }
   const std::vector<std::string> written = outputs.paths();
   outputs.commit();
   if (!run.quiet)
     printSummary(written, field.width, field.height, static_cast<int>(observers.size()), "exact", seconds, device.name,
-                 note, "observer");
+                 note + (lit.flipped ? " (computed north-up)" : ""), "observer");
   return 0;
 }
 

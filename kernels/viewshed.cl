@@ -52,6 +52,13 @@ inline float cell_twist(__global const float* h, int width, int4 c) {
   return h[c.y * width + c.x] - h[c.y * width + c.z] - h[c.w * width + c.x] + h[c.w * width + c.z];
 }
 
+// The t^2 coefficient of the surface along a line of steps (dx, dy) in cell c: twist * dx * dy, and
+// 0 along a grid line (dx dy = 0), where the surface is an edge's straight line even beside a
+// cell with a nodata corner.
+inline float surface_curve(__global const float* h, int width, int4 c, float dx, float dy) {
+  return dx * dy != 0.0f ? cell_twist(h, width, c) * dx * dy : 0.0f;
+}
+
 // The largest value on [0, 1] of the quadratic with ends f0, f1 and t^2 coefficient a (in the
 // segment's own parameter), or -INFINITY where it stays at or below its ends' larger one.
 inline float quadratic_bump(float f0, float f1, float a) {
@@ -63,10 +70,10 @@ inline float quadratic_bump(float f0, float f1, float a) {
 }
 
 // The parameter t where a line from e (along d, 1 / d = inv) crosses grid line g, or INFINITY when
-// g is not strictly before the line's end e + d: a crossing at the end itself would be a
-// rounded copy of t = 1.
+// g is not strictly before the line's end e + d (or the line runs along the axis, d = 0): a
+// crossing at the end itself would be a rounded copy of t = 1.
 inline float crossing(float g, float e, float d, float inv) {
-  return (d > 0.0f ? g < e + d : g > e + d) ? (g - e) * inv : INFINITY;
+  return d != 0.0f && (d > 0.0f ? g < e + d : g > e + d) ? (g - e) * inv : INFINITY;
 }
 
 // The grid lines of one axis that a line from grid point e to e + d crosses, walked in order:
@@ -128,6 +135,7 @@ int sight_blocked(__global const float* h, Field f, float ex, float ey, float dx
   Axis ax = axis_start(dx > 0.0f ? floor(ex + ta * dx) + 1.0f : ceil(ex + ta * dx) - 1.0f, ex, dx, inv_dx, dy);
   Axis ay = axis_start(dy > 0.0f ? floor(ey + ta * dy) + 1.0f : ceil(ey + ta * dy) - 1.0f, ey, dy, inv_dy, dx);
   const float drop = f.curvature * d2;
+  const float pixels = hf_max(fabs(dx), fabs(dy));
   float t0 = ta, f0 = NAN;
   if (ta == 0.0f) f0 = h[(int)ey * f.width + (int)ex] - ze;
   while (t0 < tb) {
@@ -146,8 +154,11 @@ int sight_blocked(__global const float* h, Field f, float ex, float ey, float dx
       f0 = (s0 - ze) - t0 * rise - drop * t0 * t0;
     }
     const float span = t1 - t0;
-    const float a = (cell_twist(h, f.width, c) * dx * dy - drop) * span * span;
-    if (f0 > 0.0f || f1 > 0.0f || quadratic_bump(f0, f1, a) > 0.0f) return 1;
+    const float a = (surface_curve(h, f.width, c, dx, dy) - drop) * span * span;
+    // A piece shorter than 1e-3 pixel (a march begun a rounding away from a crossing or the
+    // target) rises at most |twist| 2.5e-7 above its ends: its vertex would be rounding noise.
+    const float bump = span * pixels > 1e-3f ? quadratic_bump(f0, f1, a) : -INFINITY;
+    if (f0 > 0.0f || f1 > 0.0f || bump > 0.0f) return 1;
     f0 = f1;
     if (tx <= t1) axis_next(&ax, ex, dx, inv_dx);
     if (ty <= t1) axis_next(&ay, ey, dy, inv_dy);
@@ -200,7 +211,7 @@ int sight_blocked_pyramid(__global const float* h, __global const float* pyramid
   int k = 1;
   while (t < tb) {
     const float x = ex + t * dx, y = ey + t * dy;
-    const float line_t = ze + t * rise, fall = drop * t * t;
+    const float line_t = ze + t * rise;
     for (;;) {
       const int4 L = levels[k];
       const int size = 1 << k;
@@ -209,6 +220,9 @@ int sight_blocked_pyramid(__global const float* h, __global const float* pyramid
       const float exit_y = crossing(dy < 0.0f ? by * size : (by + 1) * size, ey, dy, inv_dy);
       float t_exit = hf_min(hf_min(exit_x, exit_y), tb);
       const float low = hf_min(line_t, ze + t_exit * rise);
+      // The least the block is lowered: at its nearest point, or its farthest where the "drop"
+      // raises (negative curvature).
+      const float fall = drop >= 0.0f ? drop * t * t : drop * t_exit * t_exit;
       if (t_exit > t && pyramid[L.z + by * L.x + bx] - fall <= low) {  // the block lies below the sight line
         t = t_exit;
         k = k < top_level ? k + 1 : top_level;
@@ -338,7 +352,7 @@ __kernel void viewshed_rays(__global const float* h, Field f, __global const flo
                                 : h[(int)end.y * f.width + (int)end.x];
     const float f1 = (s1 - ze) - drop * t1 * t1;  // height above the eye, curvature taken
     const float span = t1 - t0;
-    const float alpha = cell_twist(h, f.width, c) * dx * dy - drop;  // t^2 coefficient of f
+    const float alpha = surface_curve(h, f.width, c, dx, dy) - drop;  // t^2 coefficient of f
     const float top = hf_max(hf_max(f0, f1), quadratic_bump(f0, f1, alpha * span * span));  // NaN: no bound
     // The largest slope f / (t D) on the segment is at most its top over the nearest distance
     // (the farthest where the top is negative). On the first segment (t0 = 0, f0 = -eye

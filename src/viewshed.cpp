@@ -146,11 +146,10 @@ class ViewshedRun {
       k.setArg(a++, bounds);
       st_.launch(k, cl::NDRange(detail::roundUp(rays, detail::kLineGroup)), cl::NDRange(detail::kLineGroup));
     }
-    double az_span = 360.0;
-    if (options_.azimuth_from_deg != options_.azimuth_to_deg) {
-      az_span = std::fmod(options_.azimuth_to_deg - options_.azimuth_from_deg, 360.0);
-      if (az_span < 0.0) az_span += 360.0;
-    }
+    // The field of view's span clockwise; 0 (equal azimuths, or 0 and 360) is the whole circle.
+    double az_span = std::fmod(options_.azimuth_to_deg - options_.azimuth_from_deg, 360.0);
+    if (az_span < 0.0) az_span += 360.0;
+    if (az_span == 0.0) az_span = 360.0;
     // Classify every target; march the pending ones, listed row by row.
     cl::Kernel k(program_, "viewshed_classify");
     int a = 0;
@@ -289,6 +288,9 @@ class ViewshedRun {
 void validateViewshed(const HeightField& field, const ViewshedOptions& options) {
   validate(field);
   validate(options);
+  if (field.pixelCount() > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+    throw InvalidArgument("a viewshed takes fields of at most 2^31 - 1 points (got " +
+                          std::to_string(field.pixelCount()) + "); crop the DEM to the maximum distance");
   if (detail::hasRowSpacing(field))
     throw InvalidArgument("viewsheds on latitude / longitude grids (per-row spacing) are not supported; "
                           "reproject the DEM to a projected CRS");
@@ -332,6 +334,7 @@ ViewshedResult computeViewshed(const ComputeContext& context, const HeightField&
     ViewshedResult result;
     result.width = field.width;
     result.height = field.height;
+    result.marched = run.pendingTargets();
     if (outputs.visible) result.visible = run.read(visible);
     if (outputs.angle) result.angle = run.read(angle);
     return result;

@@ -26,9 +26,9 @@ bool inRange(const HeightField& f, const Observer& o, const ViewshedOptions& opt
   if (options.max_distance > 0.0 && dist > options.max_distance) return false;
   if (angle < options.elevation_min_deg * M_PI / 180.0 || angle > options.elevation_max_deg * M_PI / 180.0)
     return false;
-  if (options.azimuth_from_deg != options.azimuth_to_deg && dist > 0.0) {
-    double span = std::fmod(options.azimuth_to_deg - options.azimuth_from_deg, 360.0);
-    if (span < 0.0) span += 360.0;
+  double span = std::fmod(options.azimuth_to_deg - options.azimuth_from_deg, 360.0);
+  if (span < 0.0) span += 360.0;
+  if (span > 0.0 && dist > 0.0) {  // 0: the whole circle
     double from_start = std::fmod(std::atan2(gx, -gy) * 180.0 / M_PI - options.azimuth_from_deg, 360.0);
     if (from_start < 0.0) from_start += 360.0;
     if (from_start > span) return false;
@@ -93,26 +93,34 @@ SightLine referenceSightLine(const HeightField& f, const Observer& o, const View
     const double bottom = heightAt(f, cx, y1) + (heightAt(f, x1, y1) - heightAt(f, cx, y1)) * u;
     return top + (bottom - top) * v - line(t);
   };
-  double rise = -std::numeric_limits<double>::infinity();
+  double rise = -std::numeric_limits<double>::infinity(), interior = rise;
   std::vector<double> fs(merged.size());
   for (std::size_t s = 0; s < merged.size(); ++s) {
     fs[s] = atCrossing(merged[s]);
-    if (!std::isnan(fs[s])) rise = std::max(rise, fs[s]);
+    if (std::isnan(fs[s])) continue;
+    rise = std::max(rise, fs[s]);
+    if (s > 0 && s + 1 < merged.size()) interior = std::max(interior, fs[s]);
   }
   for (std::size_t s = 0; s + 1 < merged.size(); ++s) {
     const double t0 = merged[s].t, t1 = merged[s + 1].t, tm = 0.5 * (t0 + t1);
     const int cx = std::clamp(static_cast<int>(std::floor(o.col + tm * dx)), 0, std::max(f.width - 2, 0));
     const int cy = std::clamp(static_cast<int>(std::floor(o.row + tm * dy)), 0, std::max(f.height - 2, 0));
     const int x1 = std::min(cx + 1, f.width - 1), y1 = std::min(cy + 1, f.height - 1);
-    const double twist = heightAt(f, cx, cy) - heightAt(f, x1, cy) - heightAt(f, cx, y1) + heightAt(f, x1, y1);
-    if (std::isnan(twist)) continue;  // a cell with a nodata corner has no surface inside
+    // Along a grid line (dx dy = 0) the surface is the edge's straight line, beside nodata too.
+    const double twist =
+        dx * dy != 0.0 ? heightAt(f, cx, cy) - heightAt(f, x1, cy) - heightAt(f, cx, y1) + heightAt(f, x1, y1) : 0.0;
+    if (std::isnan(twist) || std::isnan(fs[s]) || std::isnan(fs[s + 1]))
+      continue;  // a cell with a nodata corner has no surface inside
     const double a = twist * dx * dy - drop;  // t^2 coefficient of f
     if (a < 0.0) {
       const double tv = -(((fs[s + 1] - fs[s]) / (t1 - t0)) - a * (t0 + t1)) / (2.0 * a);  // vertex of f
-      if (tv > t0 && tv < t1) rise = std::max(rise, inCell(cx, cy, tv));
+      if (tv > t0 && tv < t1) {
+        rise = std::max(rise, inCell(cx, cy, tv));
+        interior = std::max(interior, inCell(cx, cy, tv));
+      }
     }
   }
-  return {!(rise > 0.0), rise};
+  return {!(rise > 0.0), rise, interior};
 }
 
 ViewshedResult referenceViewshed(const HeightField& f, const Observer& o, const ViewshedOptions& options,

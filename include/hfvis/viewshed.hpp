@@ -44,7 +44,7 @@ struct ViewshedOptions {
   double curvature = 0.0;      // drop coefficient c (earthCurvature() in hfvis/sweep_options.hpp); 0 = flat
   // Horizontal field of view: targets whose compass azimuth from the observer (degrees
   // clockwise from north, north toward row 0) lies clockwise from azimuth_from to azimuth_to;
-  // both 0 and 360 ... the whole circle when they are equal.
+  // the whole circle when the two are equal or 360 apart.
   double azimuth_from_deg = 0.0, azimuth_to_deg = 0.0;
   // Vertical field of view: targets whose elevation angle from the eye lies within these
   // limits (degrees, -90 .. 90).
@@ -69,9 +69,9 @@ struct ViewshedResult {
   int width = 0, height = 0;
   std::vector<float> visible;  // width * height when asked
   std::vector<float> angle;    // width * height when asked
-  // Targets decided by the rays' bounds alone, marched over their last pixels, and marched in
-  // full (the box's targets, nodata and out-of-range ones left out of neither).
-  std::size_t targets = 0;
+  // Targets the classification left to be marched (the rest were settled by the range, nodata
+  // or the rays' lower bounds).
+  std::size_t marched = 0;
 };
 
 struct CumulativeViewshed {
@@ -90,7 +90,8 @@ void validate(const ViewshedOptions& options);
 void validate(const HeightField& field, const Observer& observer);
 
 // The viewshed of one observer. Throws InvalidArgument (bad field, observer or options, a
-// latitude / longitude grid), MemoryBudgetError, OpenClError, KernelBuildError.
+// latitude / longitude grid, a field of 2^31 points or more), MemoryBudgetError, OpenClError,
+// KernelBuildError.
 ViewshedResult computeViewshed(const ComputeContext& context, const HeightField& field, const Observer& observer,
                                const ViewshedOptions& options, const ViewshedOutputs& outputs = {});
 

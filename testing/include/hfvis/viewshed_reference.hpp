@@ -11,10 +11,13 @@
 namespace hfvis {
 
 // One sight line: visible, and how far the surface rises above the sight line at most over
-// [0, 1] (height units; <= 0 where visible), which tells how near to grazing it is.
+// [0, 1] (height units; <= 0 where visible), and the same strictly between eye and target
+// (-infinity where the line crosses no grid line): how near to grazing it is, not counting the
+// target's own point, where a target on the surface always touches its sight line.
 struct SightLine {
   bool visible = false;
   double rise = 0.0;
+  double interior_rise = 0.0;
 };
 
 // The sight line from `observer` to the target on grid point (col, row), in range or not.
