@@ -66,6 +66,7 @@ enum class Option {
   FieldOfView,
   ElevationRange,
   Angle,
+  NeededHeight,
 };
 
 struct OptionSpec {
@@ -120,6 +121,7 @@ constexpr OptionSpec kOptions[] = {
     {Option::FieldOfView, "--fov", nullptr, true},
     {Option::ElevationRange, "--elevation-range", nullptr, true},
     {Option::Angle, "--angle", nullptr, false},
+    {Option::NeededHeight, "--needed-height", nullptr, false},
 };
 
 // The options every sweep operation shares, as typed (degrees become radians).
@@ -287,6 +289,7 @@ const char* onlyFor(Option option) {
     case Option::FieldOfView:
     case Option::ElevationRange:
     case Option::Angle:
+    case Option::NeededHeight:
       return "viewshed";
     default:
       return nullptr;
@@ -564,6 +567,9 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
     case Option::Angle:
       run.with_angle = true;
       break;
+    case Option::NeededHeight:
+      run.with_needed_height = true;
+      break;
   }
 }
 
@@ -630,8 +636,9 @@ void validateRun(Command command, const RunArguments& run) {
       throw UsageError("--observer-height: an eye below the surface sees nothing; give a height >= 0 (or --absolute)");
     if (run.observers.empty() && run.observers_file.empty())
       throw UsageError("missing --observer COL,ROW or --observers FILE.csv (who looks)");
-    if (run.with_angle && (run.observers.size() > 1 || !run.observers_file.empty()))
-      throw UsageError("--angle is for one observer (several give a count)");
+    if ((run.with_angle || run.with_needed_height) && (run.observers.size() > 1 || !run.observers_file.empty()))
+      throw UsageError(std::string(run.with_angle ? "--angle" : "--needed-height") +
+                       " is for one observer (several give a count)");
     if (!run.observers_file.empty() && samePath(run.output, run.observers_file))
       throw UsageError("--observers must differ from -o, both are " + inQuotes(run.output));
     try {

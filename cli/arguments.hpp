@@ -97,6 +97,7 @@ struct RunArguments {
   bool absolute = false;
   std::optional<std::pair<double, double>> field_of_view, elevation_range;
   bool with_angle = false;
+  bool with_needed_height = false;  // --needed-height: a "needed_height" channel, one observer
   std::optional<float> nodata;               // --nodata VALUE for GeoTIFF outputs (may be NaN); none = NaN
 };
 

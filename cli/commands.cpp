@@ -841,14 +841,20 @@ int runViewshed(const RunArguments& run) {
   if (observers.size() == 1) {
     ViewshedOutputs outputs;
     outputs.angle = run.with_angle;
+    outputs.needed_height = run.with_needed_height;
     ViewshedResult r = computeViewshed(context, field, placed[0], options, outputs);
     requireResultSize(r.width, r.height, field);
     lit.restore(r.visible);
     lit.restore(r.angle);
+    lit.restore(r.needed_height);
     if (run.with_angle) {
       for (float& a : r.angle) a = static_cast<float>(a * (180.0 / M_PI));
       names.push_back("angle");
       planes.push_back(std::move(r.angle));
+    }
+    if (run.with_needed_height) {  // sorts between "angle" and "visible"
+      names.push_back("needed_height");
+      planes.push_back(std::move(r.needed_height));
     }
     std::size_t seen = 0, targets = 0;
     for (float v : r.visible) seen += v == 1.0f, targets += !std::isnan(v);
@@ -856,8 +862,12 @@ int runViewshed(const RunArguments& run) {
     names.push_back("visible");
     planes.push_back(std::move(r.visible));
     quantity = "visible: 1 where a target on the point is seen from the observer's eye, 0 where hidden or out of "
-               "range" + std::string(run.with_angle ? "; angle: the target's elevation angle from the eye" : "");
-    units = run.with_angle ? "visible: 1; angle: degrees" : "1";
+               "range" + std::string(run.with_angle ? "; angle: the target's elevation angle from the eye" : "") +
+               (run.with_needed_height ? "; needed_height: the height above the surface a target there needs to be "
+                                         "seen (NaN out of range)"
+                                       : "");
+    units = std::string("visible: 1") + (run.with_angle ? "; angle: degrees" : "") +
+            (run.with_needed_height ? "; needed_height: height units" : "");
   } else {
     options.progress = progress.observerCallback(static_cast<int>(observers.size()));
     CumulativeViewshed c = progress.run([&] { return computeCumulativeViewshed(context, field, placed, options); });

@@ -123,13 +123,40 @@ inline float surface_at_crossing(__global const float* h, int width, int x_axis,
   return lo + (hi - lo) * ((float)a->r * a->inv_den);
 }
 
+// The largest value of f(t) / t on a piece [t0, t1] of the line where f, the surface less the
+// sight line, is the quadratic with ends f0, f1 and t^2 coefficient a_t (in t): at its ends and
+// where (f / t)' = 0, t^2 = t0 t1 + f_lin(0) / a_t (a maximum only where a_t < 0). On the first
+// piece (t0 = 0) f0 is the eye's height below the surface: f / t runs to -inf (f0 < 0), to
+// f'(0) (f0 = 0) or to +inf.
+inline float excess_on_piece(float t0, float t1, float f0, float f1, float a_t) {
+  float best = f1 / t1;
+  if (t0 > 0.0f)
+    best = hf_max(best, f0 / t0);
+  else if (f0 > 0.0f)
+    return INFINITY;
+  else if (f0 == 0.0f)
+    best = hf_max(best, (f1 - f0) / t1 - a_t * t1);
+  if (a_t < 0.0f) {
+    const float span = t1 - t0;
+    const float tt = t0 * t1 + (f0 * t1 - f1 * t0) / span / a_t;
+    const float tv = tt > 0.0f ? sqrt(tt) : 0.0f;
+    if (tv > t0 && tv < t1) {
+      const float u = (tv - t0) / span;
+      best = hf_max(best, (f0 + (f1 - f0) * u - a_t * span * span * u * (1.0f - u)) / tv);
+    }
+  }
+  return best;
+}
+
 // March of the sight line from E (ex, ey) along (dx, dy) over t in [ta, tb] (0 <= ta < tb <= 1),
 // cell by cell. rise: zt - ze; d2: D^2; target_height: the sight line's height above the surface
 // at t = 1, taken as it is rather than as the rounded difference of the two. Returns 1 where the
 // surface rises strictly above the sight line somewhere on [ta, tb]: at a grid-line crossing,
-// or inside a cell without nodata at the top of its quadratic.
-int sight_blocked(__global const float* h, Field f, float ex, float ey, float dx, float dy, float ze, float rise,
-                  float d2, float target_height, float ta, float tb) {
+// or inside a cell without nodata at the top of its quadratic. With `excess` (not null) it marches
+// all of [ta, tb] and raises *excess to the largest f(t) / t met (f the surface less the sight
+// line): a target needs max(0, target_height + that) above the surface to be seen.
+int sight_walk(__global const float* h, Field f, float ex, float ey, float dx, float dy, float ze, float rise,
+               float d2, float target_height, float ta, float tb, float* excess) {
   const float inv_dx = dx != 0.0f ? 1.0f / dx : 0.0f, inv_dy = dy != 0.0f ? 1.0f / dy : 0.0f;
   // The next grid lines crossed after ta.
   Axis ax = axis_start(dx > 0.0f ? floor(ex + ta * dx) + 1.0f : ceil(ex + ta * dx) - 1.0f, ex, dx, inv_dx, dy);
@@ -158,13 +185,24 @@ int sight_blocked(__global const float* h, Field f, float ex, float ey, float dx
     // A piece shorter than 1e-3 pixel (a march begun a rounding away from a crossing or the
     // target) rises at most |twist| 2.5e-7 above its ends: its vertex would be rounding noise.
     const float bump = span * pixels > 1e-3f ? quadratic_bump(f0, f1, a) : -INFINITY;
-    if (f0 > 0.0f || f1 > 0.0f || bump > 0.0f) return 1;
+    if (excess) {
+      if (!isnan(f1)) *excess = hf_max(*excess, f1 / t1);
+      if (!isnan(f0) && !isnan(f1) && span > 0.0f)
+        *excess = hf_max(*excess, excess_on_piece(t0, t1, f0, f1, span * pixels > 1e-3f ? a / (span * span) : 0.0f));
+    } else if (f0 > 0.0f || f1 > 0.0f || bump > 0.0f) {
+      return 1;
+    }
     f0 = f1;
     if (tx <= t1) axis_next(&ax, ex, dx, inv_dx);
     if (ty <= t1) axis_next(&ay, ey, dy, inv_dy);
     t0 = t1;
   }
   return 0;
+}
+
+inline int sight_blocked(__global const float* h, Field f, float ex, float ey, float dx, float dy, float ze, float rise,
+                         float d2, float target_height, float ta, float tb) {
+  return sight_walk(h, f, ex, ey, dx, dy, ze, rise, d2, target_height, ta, tb, 0);
 }
 
 // The maximum pyramid: level k >= 1 holds, per block of 2^k x 2^k cells, the largest height
@@ -201,9 +239,10 @@ inline int block_of(float p, float d, int size, int blocks) {
 // sight line: a block's largest height, lowered by the curvature drop at the block's nearest
 // point, at or below the sight line's lower end over the block. Where no block can be skipped,
 // the cells of one level-1 block are marched exactly.
+// With `excess`, as sight_walk's: a block is skipped where f / t cannot exceed *excess in it.
 int sight_blocked_pyramid(__global const float* h, __global const float* pyramid, __constant int4* levels,
                           int top_level, Field f, float ex, float ey, float dx, float dy, float ze, float rise,
-                          float d2, float target_height, float ta, float tb) {
+                          float d2, float target_height, float ta, float tb, float* excess) {
   const float inv_dx = dx != 0.0f ? 1.0f / dx : 0.0f, inv_dy = dy != 0.0f ? 1.0f / dy : 0.0f;
   const float drop = f.curvature * d2;
   const float pixel_t = 1.0f / fmax(fabs(dx), fabs(dy));
@@ -223,14 +262,17 @@ int sight_blocked_pyramid(__global const float* h, __global const float* pyramid
       // The least the block is lowered: at its nearest point, or its farthest where the "drop"
       // raises (negative curvature).
       const float fall = drop >= 0.0f ? drop * t * t : drop * t_exit * t_exit;
-      if (t_exit > t && pyramid[L.z + by * L.x + bx] - fall <= low) {  // the block lies below the sight line
+      const float top = pyramid[L.z + by * L.x + bx] - fall - low;  // f's bound over the block
+      const int below = excess ? (top >= 0.0f ? (t > 0.0f && top / t <= *excess) : top / t_exit <= *excess)
+                               : top <= 0.0f;
+      if (t_exit > t && below) {  // the block lies below the sight line (or adds no excess)
         t = t_exit;
         k = k < top_level ? k + 1 : top_level;
         break;
       }
       if (k == 1) {  // march the block's cells (a pixel's length where rounding put t at its exit)
         if (!(t_exit > t)) t_exit = hf_min(tb, t + pixel_t);
-        if (sight_blocked(h, f, ex, ey, dx, dy, ze, rise, d2, target_height, t, t_exit)) return 1;
+        if (sight_walk(h, f, ex, ey, dx, dy, ze, rise, d2, target_height, t, t_exit, excess)) return 1;
         t = t_exit;
         break;
       }
@@ -396,7 +438,7 @@ inline int march(__global const float* h, __global const float* pyramid, __const
                  Field f, float ex, float ey, float dx, float dy, float ze, float rise, float d2, float target_height,
                  float ta, float tb) {
   return top_level > 0 ? sight_blocked_pyramid(h, pyramid, levels, top_level, f, ex, ey, dx, dy, ze, rise, d2,
-                                               target_height, ta, tb)
+                                               target_height, ta, tb, 0)
                        : sight_blocked(h, f, ex, ey, dx, dy, ze, rise, d2, target_height, ta, tb);
 }
 
@@ -528,4 +570,43 @@ __kernel void viewshed_march(__global const float* h, Field f, int ex_i, int ey_
     blocked = march(h, pyramid, levels, top_level, f, ex, ey, s.dx, s.dy, ze, s.rise, s.d2, target_height, 0.0f, 1.0f);
   }
   put_visible(out_visible, p, blocked ? 0.0f : 1.0f, accumulate);
+}
+
+// viewshed_needed, one work-item per grid point (after the others): out_needed, the height above
+// the surface a target there needs to be seen, max(0, target_height + the largest f(t) / t along
+// its whole sight line), by a march through the pyramid; 0 at the eye's point, NaN at nodata and
+// out of range (past max_distance, outside the field of view or the elevation limits).
+__kernel void viewshed_needed(__global const float* h, Field f, int ex_i, int ey_i, float ze, float target_height,
+                              float max_distance, int az_on, float az_from, float az_span, float el_lo, float el_hi,
+                              __global const float* pyramid, __constant int4* levels, int top_level,
+                              __global float* out_needed) {
+  const int x = get_global_id(0), y = get_global_id(1);
+  if (x >= f.width || y >= f.height) return;
+  const size_t p = (size_t)y * f.width + x;
+  const float ht = h[p];
+  const float dx = x - ex_i, dy = y - ey_i;
+  const float gdx = dx * f.cell_x, gdy = dy * f.cell_y;
+  const float d2 = gdx * gdx + gdy * gdy, dist = sqrt(d2);
+  const float rise = (ht + target_height - f.curvature * d2) - ze;
+  int in_range = !isnan(ht) && !(max_distance > 0.0f && dist > max_distance);
+  if (el_lo > -M_PI_2_F || el_hi < M_PI_2_F) {
+    const float angle = dist > 0.0f ? hf_atan(rise / dist) : (rise >= 0.0f ? M_PI_2_F : -M_PI_2_F);
+    in_range = in_range && angle >= el_lo && angle <= el_hi;
+  }
+  if (az_on && dist > 0.0f) {
+    const float from_start = degrees(atan2(gdx, -gdy)) - az_from;
+    in_range = in_range && from_start - 360.0f * floor(from_start / 360.0f) <= az_span;
+  }
+  if (!in_range) {
+    out_needed[p] = NAN;
+    return;
+  }
+  if (dist == 0.0f) {
+    out_needed[p] = 0.0f;
+    return;
+  }
+  float excess = -INFINITY;
+  sight_blocked_pyramid(h, pyramid, levels, top_level, f, ex_i, ey_i, dx, dy, ze, rise, d2, target_height, 0.0f, 1.0f,
+                        &excess);
+  out_needed[p] = hf_max(0.0f, target_height + excess);
 }

@@ -91,7 +91,8 @@ class ViewshedRun {
   }
 
   // One observer's targets into `visible` (added to it when `accumulate`) and, if given, `angle`.
-  void observe(const Observer& o, cl::Buffer& visible, bool accumulate, cl::Buffer* angle) {
+  void observe(const Observer& o, cl::Buffer& visible, bool accumulate, cl::Buffer* angle,
+               cl::Buffer* needed = nullptr) {
     const float ze = static_cast<float>(options_.absolute ? o.height
                                                           : heights_[static_cast<std::size_t>(o.row) * field_.width + o.col] + o.height);
     const cl_int4 box = targetBox(field_, o, options_.max_distance);
@@ -226,6 +227,28 @@ class ViewshedRun {
       m.setArg(a++, accumulate ? 1 : 0);
       st_.launch(m, cl::NDRange(detail::roundUp(total, detail::kLineGroup)), cl::NDRange(detail::kLineGroup));
     }
+    if (needed) {
+      cl::Kernel n(program_, "viewshed_needed");
+      a = 0;
+      n.setArg(a++, heights_buffer_);
+      n.setArg(a++, device_);
+      n.setArg(a++, o.col);
+      n.setArg(a++, o.row);
+      n.setArg(a++, ze);
+      n.setArg(a++, static_cast<float>(options_.target_height));
+      n.setArg(a++, static_cast<float>(options_.max_distance));
+      n.setArg(a++, az_span < 360.0 ? 1 : 0);
+      n.setArg(a++, static_cast<float>(options_.azimuth_from_deg));
+      n.setArg(a++, static_cast<float>(az_span));
+      n.setArg(a++, static_cast<float>(options_.elevation_min_deg * kDegree));
+      n.setArg(a++, static_cast<float>(options_.elevation_max_deg * kDegree));
+      n.setArg(a++, pyramid_);
+      n.setArg(a++, levels_);
+      n.setArg(a++, top_);
+      n.setArg(a++, *needed);
+      st_.launch(n, cl::NDRange(detail::roundUp(field_.width, detail::kTileX), detail::roundUp(field_.height, detail::kTileY)),
+                 cl::NDRange(detail::kTileX, detail::kTileY));
+    }
     st_.queue.finish();  // before this observer's ray buffers go
   }
 
@@ -324,19 +347,21 @@ ViewshedResult computeViewshed(const ComputeContext& context, const HeightField&
                                const ViewshedOptions& options, const ViewshedOutputs& outputs) {
   validateViewshed(field, options);
   validate(field, observer);
-  if (!outputs.visible && !outputs.angle) throw InvalidArgument("no viewshed output requested");
+  if (!outputs.visible && !outputs.angle && !outputs.needed_height) throw InvalidArgument("no viewshed output requested");
   return detail::translateOpenClErrors([&] {
     detail::ContextState& st = detail::stateOf(context);
     ViewshedRun run(st, field, options);
     cl::Buffer visible = run.output();
     cl::Buffer angle = outputs.angle ? run.output() : cl::Buffer();
-    run.observe(observer, visible, false, outputs.angle ? &angle : nullptr);
+    cl::Buffer needed = outputs.needed_height ? run.output() : cl::Buffer();
+    run.observe(observer, visible, false, outputs.angle ? &angle : nullptr, outputs.needed_height ? &needed : nullptr);
     ViewshedResult result;
     result.width = field.width;
     result.height = field.height;
     result.marched = run.pendingTargets();
     if (outputs.visible) result.visible = run.read(visible);
     if (outputs.angle) result.angle = run.read(angle);
+    if (outputs.needed_height) result.needed_height = run.read(needed);
     return result;
   });
 }

@@ -93,13 +93,14 @@ SightLine referenceSightLine(const HeightField& f, const Observer& o, const View
     const double bottom = heightAt(f, cx, y1) + (heightAt(f, x1, y1) - heightAt(f, cx, y1)) * u;
     return top + (bottom - top) * v - line(t);
   };
-  double rise = -std::numeric_limits<double>::infinity(), interior = rise;
+  double rise = -std::numeric_limits<double>::infinity(), interior = rise, excess = rise;
   std::vector<double> fs(merged.size());
   for (std::size_t s = 0; s < merged.size(); ++s) {
     fs[s] = atCrossing(merged[s]);
     if (std::isnan(fs[s])) continue;
     rise = std::max(rise, fs[s]);
     if (s > 0 && s + 1 < merged.size()) interior = std::max(interior, fs[s]);
+    if (s > 0) excess = std::max(excess, fs[s] / merged[s].t);
   }
   for (std::size_t s = 0; s + 1 < merged.size(); ++s) {
     const double t0 = merged[s].t, t1 = merged[s + 1].t, tm = 0.5 * (t0 + t1);
@@ -112,6 +113,15 @@ SightLine referenceSightLine(const HeightField& f, const Observer& o, const View
     if (std::isnan(twist) || std::isnan(fs[s]) || std::isnan(fs[s + 1]))
       continue;  // a cell with a nodata corner has no surface inside
     const double a = twist * dx * dy - drop;  // t^2 coefficient of f
+    if (s == 0) {  // f / t next to the eye
+      if (fs[0] > 0.0) excess = std::numeric_limits<double>::infinity();
+      if (fs[0] == 0.0) excess = std::max(excess, (fs[1] - fs[0]) / t1 - a * t1);
+    }
+    if (a < 0.0) {  // where (f / t)' = 0: t^2 = t0 t1 + f_lin(0) / a
+      const double tt = t0 * t1 + (fs[s] * t1 - fs[s + 1] * t0) / (t1 - t0) / a;
+      const double tv = tt > 0.0 ? std::sqrt(tt) : 0.0;
+      if (tv > t0 && tv < t1) excess = std::max(excess, inCell(cx, cy, tv) / tv);
+    }
     if (a < 0.0) {
       const double tv = -(((fs[s + 1] - fs[s]) / (t1 - t0)) - a * (t0 + t1)) / (2.0 * a);  // vertex of f
       if (tv > t0 && tv < t1) {
@@ -120,7 +130,7 @@ SightLine referenceSightLine(const HeightField& f, const Observer& o, const View
       }
     }
   }
-  return {!(rise > 0.0), rise, interior};
+  return {!(rise > 0.0), rise, interior, excess};
 }
 
 ViewshedResult referenceViewshed(const HeightField& f, const Observer& o, const ViewshedOptions& options,
@@ -130,6 +140,7 @@ ViewshedResult referenceViewshed(const HeightField& f, const Observer& o, const 
   r.height = f.height;
   r.visible.assign(f.pixelCount(), 0.0f);
   r.angle.assign(f.pixelCount(), 0.0f);
+  r.needed_height.assign(f.pixelCount(), std::numeric_limits<float>::quiet_NaN());
   if (rises) rises->assign(f.pixelCount(), kNaN);
   const double ze = eyeHeight(f, o, options);
   for (int row = 0; row < f.height; ++row)
@@ -148,10 +159,12 @@ ViewshedResult referenceViewshed(const HeightField& f, const Observer& o, const 
       if (!inRange(f, o, options, col, row, angle)) continue;
       if (dist == 0.0) {
         r.visible[p] = 1.0f;
+        r.needed_height[p] = 0.0f;
         continue;
       }
       const SightLine s = referenceSightLine(f, o, options, col, row);
       r.visible[p] = s.visible ? 1.0f : 0.0f;
+      r.needed_height[p] = static_cast<float>(std::max(0.0, options.target_height + s.excess));
       if (rises) (*rises)[p] = s.rise;
     }
   return r;

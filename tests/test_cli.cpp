@@ -1641,6 +1641,13 @@ TEST_F(Cli, ViewshedSeesOverAWall) {
   EXPECT_EQ(v.at(8, 3, 1), 1.0f);   // the wall's top
   EXPECT_EQ(v.at(12, 3, 1), 0.0f);  // behind it
   EXPECT_NEAR(v.at(8, 3, 0), std::atan2(3.0, 6.0) * 180.0 / M_PI, 1e-4);  // degrees above the eye's horizontal
+  // Behind the wall a target needs the sight line over the wall's top: 2 + 10 * 3 / 6 = 7.
+  ASSERT_EQ(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("n.exr")) +
+                " --observer 2,3 --needed-height -q").status, 0);
+  const ReadBack needed = readBack(out("n.exr"));
+  ASSERT_EQ(needed.channels, (std::vector<std::string>{"needed_height", "visible"}));
+  EXPECT_NEAR(needed.at(12, 3, 0), 7.0f, 1e-4);
+  EXPECT_EQ(needed.at(5, 3, 0), 0.0f);
   // A target 7 high behind the wall is seen over it; an eye 10 up sees the ground behind it.
   ASSERT_EQ(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("t.exr")) +
                 " --observer 2,3 --target-height 7 -q").status, 0);

@@ -116,6 +116,30 @@ TEST(Viewshed, RoughTerrainMatchesBruteForce) {
   });
 }
 
+TEST(Viewshed, NeededHeightMatchesBruteForce) {
+  const HeightField f = roughTerrain();
+  for (const Observer& o : {Observer{48, 41, 2.0}, Observer{10, 70, 0.5}}) {
+    ViewshedOptions options;
+    options.target_height = 0.5;
+    const ViewshedResult want = referenceViewshed(f, o, options);
+    ViewshedOutputs outputs;
+    outputs.needed_height = true;
+    forEachLayout([&](const ComputeContext& context) {
+      const ViewshedResult got = computeViewshed(context, f, o, options, outputs);
+      std::size_t positive = 0;
+      for (std::size_t p = 0; p < want.needed_height.size(); ++p) {
+        ASSERT_NEAR(got.needed_height[p], want.needed_height[p], 1e-3 + 1e-4 * want.needed_height[p]) << "at " << p;
+        positive += want.needed_height[p] > 0.5;
+        // Seen exactly where the target's own height is enough.
+        if (std::fabs(want.needed_height[p] - 0.5) > 1e-3) {
+          EXPECT_EQ(want.visible[p] == 1.0f, want.needed_height[p] <= 0.5) << "at " << p;
+        }
+      }
+      EXPECT_GT(positive, want.needed_height.size() / 10);
+    });
+  }
+}
+
 TEST(Viewshed, EveryTargetMarchedAgrees) {
   // The rays' bounds only skip marches: marching every target gives the same visible set.
   const HeightField f = roughTerrain(120, 110);

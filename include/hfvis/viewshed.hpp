@@ -63,12 +63,17 @@ struct ViewshedOptions {
 struct ViewshedOutputs {
   bool visible = true;  // 1 / 0, NaN at nodata
   bool angle = false;   // the target's elevation angle from the eye, radians (NaN at nodata)
+  // The height above the surface a target needs to be seen (0 where one on the surface is; NaN
+  // at nodata and out of range). Every target's whole sight line is marched (through the
+  // maximum pyramid): much slower than `visible`.
+  bool needed_height = false;
 };
 
 struct ViewshedResult {
   int width = 0, height = 0;
   std::vector<float> visible;  // width * height when asked
   std::vector<float> angle;    // width * height when asked
+  std::vector<float> needed_height;  // width * height when asked
   // Targets the classification left to be marched (the rest were settled by the range, nodata
   // or the rays' lower bounds).
   std::size_t marched = 0;

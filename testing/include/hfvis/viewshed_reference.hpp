@@ -18,14 +18,15 @@ struct SightLine {
   bool visible = false;
   double rise = 0.0;
   double interior_rise = 0.0;
+  double excess = 0.0;  // the largest f(t) / t over (0, 1], f the surface less the sight line
 };
 
 // The sight line from `observer` to the target on grid point (col, row), in range or not.
 SightLine referenceSightLine(const HeightField& field, const Observer& observer, const ViewshedOptions& options,
                              int col, int row);
 
-// Every target as computeViewshed decides them (visible and angle), in double; `rise`, when
-// given, gets each in-range target's SightLine::rise (NaN elsewhere).
+// Every target as computeViewshed decides them (visible, angle and needed height), in double;
+// `rise`, when given, gets each in-range target's SightLine::rise (NaN elsewhere).
 ViewshedResult referenceViewshed(const HeightField& field, const Observer& observer, const ViewshedOptions& options,
                                  std::vector<double>* rise = nullptr);
 
