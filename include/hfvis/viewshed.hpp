@@ -6,8 +6,9 @@
 // point, `target_height` above the surface. The sight line is the straight segment between
 // eye and target; the target is visible when no point of the surface strictly between them
 // rises strictly above it (a sight line that only touches the surface sees). The surface is the
-// bilinear interpolation of the heights; a cell with a nodata corner has no surface and hides
-// nothing (nodata targets are NaN). With curvature, a point at ground distance d from the eye
+// bilinear interpolation of the heights; a cell with a nodata corner has no surface inside and
+// hides nothing there, though an edge between two valid heights is surface (nodata targets are
+// NaN). With curvature, a point at ground distance d from the eye
 // counts c d^2 lower (SweepOptions::curvature's convention), the target too.
 //
 // How it is computed (kernels/viewshed.cl): the surface along a sight line is a quadratic
@@ -17,10 +18,12 @@
 // distance, lower and upper bounds on the largest elevation slope met so far, widened by a
 // bound on the surface's slope times the angle to the next ray, so that they bound the slope
 // met by every sight line between the two rays (rigorous while that angle spans at most a
-// pixel). A target is then decided by the bounds of the two rays around its sight line and an
-// exact march of its last pixels; only targets whose slope falls between the bounds are
-// marched in full. The rounding of single precision is the only difference from the exact
-// decision: sight lines that graze the surface within it may go either way.
+// pixel). A target whose slope lies below the lower bound of a ray around its sight line is
+// hidden; the others are marched exactly over their last pixels, and over the rest of the line
+// (skipping the blocks of a maximum pyramid that lie below it) unless the upper bounds settle
+// them. The kernels decide in single precision: sight lines that graze the surface within its
+// rounding may go either way, and pieces of a line shorter than 1e-3 pixel skip their vertex
+// test.
 #pragma once
 
 #include <functional>
