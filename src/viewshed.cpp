@@ -130,7 +130,9 @@ class ViewshedRun {
       }
       offsets = cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, offset.size() * sizeof(cl_uint),
                            offset.data());
-      bounds = detail::deviceBuffer(st_, std::max<std::size_t>(entries, 1) * sizeof(cl_float2));
+      // Kept by the context: a cumulative viewshed's observers need about the same, and on a CPU
+      // a fresh buffer of this size costs its first touch every time.
+      bounds = st_.reusableBuffer("viewshed ray bounds", std::max<std::size_t>(entries, 1) * sizeof(cl_float2));
       cl::Kernel k(program_, "viewshed_rays");
       int a = 0;
       k.setArg(a++, heights_buffer_);
