@@ -9,10 +9,13 @@
 // a quadratic in t, so the test "does s rise strictly above the sight line" is decided per cell
 // from the two ends and the vertex. A cell with a nodata corner has no surface.
 //
-// Three kernels: viewshed_lipschitz (a bound on the surface's slope around each cell),
-// viewshed_rays (one work-item per ray from E to a point of the box's border: bounds on the
-// largest elevation slope met within each distance), viewshed_targets (one work-item per
-// target: the bounds of the two rays around its sight line decide it, or an exact march does).
+// The kernels, in the order they run: viewshed_slopes and viewshed_lipschitz (a bound on the
+// surface's slope around each cell) and the maximum pyramid, once per field; per observer,
+// viewshed_cull (the culling pyramid's query, with one), viewshed_rays (one work-item per ray
+// from E to a point of the box's border: bounds on the largest elevation slope met within each
+// distance), viewshed_classify (one work-item per target: what the range, the culling and the
+// rays' lower bounds settle), the pending targets' list, and viewshed_march (one work-item per
+// pending target: an exact march, cut short by the rays' upper bounds where they settle it).
 #pragma OPENCL FP_CONTRACT OFF
 
 #include "fast_math.cl"
@@ -426,6 +429,66 @@ __kernel void viewshed_rays(__global const float* h, Field f, __global const flo
 }
 
 
+// The culling pyramid's query (ViewshedPyramid in hfvis/viewshed.hpp), one work-item per node of
+// one level (level: nodes across, down, first node's index, k: nodes of 2^k x 2^k grid points),
+// the coarsest level first: culled[node] = 1 where its parent (in level `parent`, when
+// has_parent) is culled, or where for every sector (spans: start, width, radians) that its
+// points can see the eye in, the eye lies farther than the sector's d from each of them and below
+// its bound (regions: per node and sector, d then the bound at the breakpoints `breaks`) at
+// both ends of the range of their distances. The bound is concave, so it is least over that
+// range at an end; the curvature term c r^2 is taken at the range's nearer end (farther for
+// c < 0). Every comparison that meets a NaN keeps the node.
+#define CULL_BREAKS 5
+#define CULL_FLOATS (1 + CULL_BREAKS)
+
+inline float cull_bound(__global const float* region, __constant float* breaks, float r) {
+  for (int i = 0; i + 1 < CULL_BREAKS; ++i)
+    if (r <= breaks[i + 1]) {
+      const float a = region[1 + i], b = region[2 + i];
+      if (a == b) return a;  // an empty node's FLT_MAX
+      return a + (b - a) * ((r - breaks[i]) / (breaks[i + 1] - breaks[i]));
+    }
+  return NAN;  // past the reach
+}
+
+__kernel void viewshed_cull(__global const float* regions, int4 level, int4 parent, int has_parent, int sectors,
+                            __constant float2* spans, __constant float* breaks, Field f, float ex, float ey,
+                            float ze, __global uchar* culled) {
+  const int nx = get_global_id(0), ny = get_global_id(1);
+  if (nx >= level.x || ny >= level.y) return;
+  const size_t node = (size_t)level.z + (size_t)ny * level.x + nx;
+  if (has_parent && culled[(size_t)parent.z + (size_t)(ny >> 1) * parent.x + (nx >> 1)]) {
+    culled[node] = 1;
+    return;
+  }
+  const int side = 1 << level.w;
+  const int x0 = nx * side, y0 = ny * side;
+  const int x1 = min(x0 + side, f.width) - 1, y1 = min(y0 + side, f.height) - 1;
+  const float hx = 0.5f * (x1 - x0) * f.cell_x, hy = 0.5f * (y1 - y0) * f.cell_y;
+  const float gx = (ex - 0.5f * (x0 + x1)) * f.cell_x, gy = (ey - 0.5f * (y0 + y1)) * f.cell_y;
+  const float rc = sqrt(gx * gx + gy * gy), rho = sqrt(hx * hx + hy * hy);
+  // The points' distances to the eye, widened past the rounding of these few operations.
+  const float r_lo = rc * (1.0f - 1e-5f) - rho * (1.0f + 1e-5f), r_hi = (rc + rho) * (1.0f + 1e-5f);
+  int cull = r_lo > 0.0f;
+  // The eye's azimuth from the node's points lies within alpha of that from its centre.
+  const float alpha = cull ? asin(fmin(1.0f, rho * (1.0f + 1e-5f) / rc)) + 1e-4f : 0.0f;
+  const float phi = atan2(gy, gx);
+  const float two_pi = 2.0f * M_PI_F;
+  const float curve = f.curvature * (f.curvature >= 0.0f ? r_lo * r_lo : r_hi * r_hi);
+  const float lhs = ze - curve;
+  for (int s = 0; cull && s < sectors; ++s) {
+    const float2 span = spans[s];
+    float rel = phi - alpha - span.x;  // from the sector's start to the range's, counter-clockwise
+    rel -= two_pi * floor(rel / two_pi);
+    if (!(rel <= span.y || rel + 2.0f * alpha >= two_pi)) continue;  // the sector is not met
+    __global const float* region = regions + (node * sectors + s) * CULL_FLOATS;
+    const float bound = fmin(cull_bound(region, breaks, r_lo), cull_bound(region, breaks, r_hi));
+    const float margin = 4e-6f * (fabs(ze) + fabs(curve) + fabs(bound) + fabs(region[1])) + 1e-6f;
+    cull = r_lo > region[0] && lhs < bound - margin;
+  }
+  culled[node] = cull ? 1 : 0;
+}
+
 inline void put_visible(__global float* out, size_t p, float v, int accumulate) {
   if (accumulate)
     out[p] += v;
@@ -486,8 +549,9 @@ inline SightLine sight_line(__global const float* h, Field f, int x, int y, int 
 __kernel void viewshed_classify(__global const float* h, Field f, int ex_i, int ey_i, float ze, float target_height,
                                 int4 box, float max_distance, int az_on, float az_from, float az_span, float el_lo,
                                 float el_hi, int rays, __global const uint* offsets, int ray_major, float spacing,
-                                __global const float2* bounds, __global float* out_visible, int accumulate,
-                                int want_angle, __global float* out_angle, __global uchar* pending) {
+                                __global const float2* bounds, __global const uchar* culled, int4 cull_level,
+                                __global float* out_visible, int accumulate, int want_angle,
+                                __global float* out_angle, __global uchar* pending) {
   const int x = get_global_id(0), y = get_global_id(1);
   if (x >= f.width || y >= f.height) return;
   const size_t p = (size_t)y * f.width + x;
@@ -495,6 +559,14 @@ __kernel void viewshed_classify(__global const float* h, Field f, int ex_i, int 
   if (isnan(ht)) {
     out_visible[p] = NAN;  // accumulated too: nodata stays NaN
     if (want_angle) out_angle[p] = NAN;
+    pending[p] = 0;
+    return;
+  }
+  // Culled by the pyramid (cull_level.x > 0): hidden.
+  const int culled_here =
+      cull_level.x > 0 && culled[(size_t)cull_level.z + (size_t)(y >> cull_level.w) * cull_level.x + (x >> cull_level.w)];
+  if (culled_here && !want_angle) {
+    put_visible(out_visible, p, 0.0f, accumulate);
     pending[p] = 0;
     return;
   }
@@ -515,7 +587,7 @@ __kernel void viewshed_classify(__global const float* h, Field f, int ex_i, int 
   const int q = s.use ? s.q : 0;
   const float lo_a = bounds[s.use ? bound_index(offsets, rays, ray_major, s.a, q) : 0].x;
   const float lo_b = bounds[s.use ? bound_index(offsets, rays, ray_major, s.b, q) : 0].x;
-  const int hidden = !in_range || (s.use && s.slope < hf_max(lo_a, lo_b));  // something nearer rises above it
+  const int hidden = culled_here || !in_range || (s.use && s.slope < hf_max(lo_a, lo_b));  // something nearer rises above it
   const int settled = hidden || s.dist == 0.0f;
   if (settled) put_visible(out_visible, p, hidden ? 0.0f : 1.0f, accumulate);
   pending[p] = settled ? 0 : 1;

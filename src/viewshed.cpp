@@ -85,6 +85,7 @@ class ViewshedRun {
     st.launch(k, cell_range, cl::NDRange(detail::kTileX, detail::kTileY));
     budget_ = options.memory_budget ? options.memory_budget : detail::defaultMemoryBudget(st.info);
     buildPyramid(cells_x, cells_y);
+    if (options.pyramid) uploadCulling(*options.pyramid);
     pending_ = detail::deviceBuffer(st, pixels);
     pending_list_ = detail::deviceBuffer(st, pixels * sizeof(cl_uint));
     row_counts_ = detail::deviceBuffer(st, static_cast<std::size_t>(field.height) * sizeof(cl_uint));
@@ -149,6 +150,7 @@ class ViewshedRun {
       k.setArg(a++, bounds);
       st_.launch(k, cl::NDRange(detail::roundUp(rays, detail::kLineGroup)), cl::NDRange(detail::kLineGroup));
     }
+    const cl_int4 cull_leaf = cull(o, ze);
     // The field of view's span clockwise; 0 (equal azimuths, or 0 and 360) is the whole circle.
     double az_span = std::fmod(options_.azimuth_to_deg - options_.azimuth_from_deg, 360.0);
     if (az_span < 0.0) az_span += 360.0;
@@ -174,6 +176,8 @@ class ViewshedRun {
     k.setArg(a++, ray_major ? 1 : 0);
     k.setArg(a++, spacing);
     k.setArg(a++, bounds);
+    k.setArg(a++, cull_levels_.empty() ? pending_ : culled_);
+    k.setArg(a++, cull_leaf);
     k.setArg(a++, visible);
     k.setArg(a++, accumulate ? 1 : 0);
     k.setArg(a++, angle ? 1 : 0);
@@ -254,8 +258,81 @@ class ViewshedRun {
     st_.queue.finish();  // before this observer's ray buffers go
   }
 
-  // Targets marched so far (the rest were settled by classification).
+  // Targets marched so far (the rest were settled by classification), and valid targets culled.
   std::size_t pendingTargets() const { return pending_targets_; }
+  std::size_t culledTargets() const { return culled_targets_; }
+
+  // The last observer's culled points: 1 / 0, NaN at nodata.
+  std::vector<float> culledMask() const {
+    std::vector<float> mask(field_.pixelCount(), 0.0f);
+    const int k = cull_levels_.empty() ? 0 : cull_levels_.back().s[3], nx = cull_levels_.empty() ? 0 : cull_levels_.back().s[0];
+    for (int y = 0; y < field_.height; ++y)
+      for (int x = 0; x < field_.width; ++x) {
+        const std::size_t p = static_cast<std::size_t>(y) * field_.width + x;
+        if (std::isnan(heights_[p]))
+          mask[p] = std::numeric_limits<float>::quiet_NaN();
+        else if (!leaf_flags_.empty() && leaf_flags_[static_cast<std::size_t>(y >> k) * nx + (x >> k)])
+          mask[p] = 1.0f;
+      }
+    return mask;
+  }
+
+  // The culling pyramid on the device: every level's regions (coarsest first), their table, the
+  // sectors and the breakpoints; one flag per node for the query.
+  void uploadCulling(const ViewshedPyramid& pyramid) {
+    std::vector<float> regions;
+    std::size_t nodes = 0;
+    for (auto level = pyramid.levels.rbegin(); level != pyramid.levels.rend(); ++level) {
+      cull_levels_.push_back(cl_int4{{level->nodes_x, level->nodes_y, static_cast<int>(nodes), level->k}});
+      nodes += static_cast<std::size_t>(level->nodes_x) * level->nodes_y;
+      regions.insert(regions.end(), level->regions.begin(), level->regions.end());
+    }
+    cull_regions_ = cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, regions.size() * sizeof(float),
+                               regions.data());
+    std::vector<cl_float2> spans(pyramid.sectors);
+    for (int s = 0; s < pyramid.sectors; ++s) spans[s] = cl_float2{{pyramid.sector_start[s], pyramid.sector_width[s]}};
+    cull_spans_ = cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, spans.size() * sizeof(cl_float2),
+                             spans.data());
+    std::vector<float> breaks(ViewshedPyramid::kBreakpoints);
+    for (int i = 0; i < ViewshedPyramid::kBreakpoints; ++i)
+      breaks[i] = static_cast<float>(pyramid.reach * ViewshedPyramid::breakFraction(i));
+    cull_breaks_ = cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, breaks.size() * sizeof(float),
+                              breaks.data());
+    culled_ = detail::deviceBuffer(st_, nodes);
+    cull_sectors_ = pyramid.sectors;
+    valid_points_ = &pyramid.valid_points;
+  }
+
+  // The culling pyramid's query for eye o at height ze, level by level from the coarsest: the
+  // finest level's table entry (nodes across 0: no pyramid), its flags at its first node.
+  cl_int4 cull(const Observer& o, float ze) {
+    if (cull_levels_.empty()) return cl_int4{{0, 0, 0, 0}};
+    for (std::size_t l = 0; l < cull_levels_.size(); ++l) {
+      const cl_int4 level = cull_levels_[l];
+      cl::Kernel k(program_, "viewshed_cull");
+      int a = 0;
+      k.setArg(a++, cull_regions_);
+      k.setArg(a++, level);
+      k.setArg(a++, l > 0 ? cull_levels_[l - 1] : level);
+      k.setArg(a++, l > 0 ? 1 : 0);
+      k.setArg(a++, cull_sectors_);
+      k.setArg(a++, cull_spans_);
+      k.setArg(a++, cull_breaks_);
+      k.setArg(a++, device_);
+      k.setArg(a++, static_cast<float>(o.col));
+      k.setArg(a++, static_cast<float>(o.row));
+      k.setArg(a++, ze);
+      k.setArg(a++, culled_);
+      st_.launch(k, cl::NDRange(detail::roundUp(level.s[0], detail::kTileX), detail::roundUp(level.s[1], detail::kTileY)),
+                 cl::NDRange(detail::kTileX, detail::kTileY));
+    }
+    const cl_int4 leaf = cull_levels_.back();
+    std::vector<unsigned char> flags(static_cast<std::size_t>(leaf.s[0]) * leaf.s[1]);
+    st_.queue.enqueueReadBuffer(culled_, CL_TRUE, static_cast<std::size_t>(leaf.s[2]), flags.size(), flags.data());
+    for (std::size_t i = 0; i < flags.size(); ++i) culled_targets_ += flags[i] ? (*valid_points_)[i] : 0;
+    leaf_flags_ = std::move(flags);
+    return leaf;
+  }
 
   // The maximum pyramid's levels 1 .. top_ (kernels/viewshed.cl), up to blocks of 4096 cells or one
   // block over the field.
@@ -306,6 +383,13 @@ class ViewshedRun {
   cl::Buffer heights_buffer_, lipschitz_, pyramid_, levels_;
   cl::Buffer pending_, pending_list_, row_counts_;  // the targets classification leaves to viewshed_march
   std::size_t pending_targets_ = 0;
+  // The culling pyramid (uploadCulling): its levels' table, coarsest first.
+  std::vector<cl_int4> cull_levels_;
+  cl::Buffer cull_regions_, cull_spans_, cull_breaks_, culled_;
+  int cull_sectors_ = 0;
+  const std::vector<std::uint32_t>* valid_points_ = nullptr;
+  std::size_t culled_targets_ = 0;
+  std::vector<unsigned char> leaf_flags_;  // the last query's finest level
   int top_ = 0;
   std::size_t budget_ = 0;
 };
@@ -319,6 +403,18 @@ void validateViewshed(const HeightField& field, const ViewshedOptions& options) 
   if (detail::hasRowSpacing(field))
     throw InvalidArgument("viewsheds on latitude / longitude grids (per-row spacing) are not supported; "
                           "reproject the DEM to a projected CRS");
+  if (const ViewshedPyramid* p = options.pyramid) {
+    if (p->width != field.width || p->height != field.height || p->cell_size_x != field.cell_size_x ||
+        p->cell_size_y != field.cell_size_y || p->z_scale != field.z_scale ||
+        p->heights_fingerprint != heightsFingerprint(field))
+      throw InvalidArgument("the culling pyramid was built for another field (size, cell size, z-scale or heights)");
+    if (p->target_height != options.target_height)
+      throw InvalidArgument("the culling pyramid was built for target height " + std::to_string(p->target_height) +
+                            ", the viewshed asks " + std::to_string(options.target_height));
+    if (p->curvature != options.curvature)
+      throw InvalidArgument("the culling pyramid was built for another curvature coefficient");
+    if (p->levels.empty() || p->sectors <= 0) throw InvalidArgument("the culling pyramid is empty");
+  }
 }
 
 }  // namespace
@@ -349,7 +445,9 @@ ViewshedResult computeViewshed(const ComputeContext& context, const HeightField&
                                const ViewshedOptions& options, const ViewshedOutputs& outputs) {
   validateViewshed(field, options);
   validate(field, observer);
-  if (!outputs.visible && !outputs.angle && !outputs.needed_height) throw InvalidArgument("no viewshed output requested");
+  if (!outputs.visible && !outputs.angle && !outputs.needed_height && !outputs.culled_mask)
+    throw InvalidArgument("no viewshed output requested");
+  if (outputs.culled_mask && !options.pyramid) throw InvalidArgument("the culled mask needs a culling pyramid");
   return detail::translateOpenClErrors([&] {
     detail::ContextState& st = detail::stateOf(context);
     ViewshedRun run(st, field, options);
@@ -361,9 +459,11 @@ ViewshedResult computeViewshed(const ComputeContext& context, const HeightField&
     result.width = field.width;
     result.height = field.height;
     result.marched = run.pendingTargets();
+    result.culled = run.culledTargets();
     if (outputs.visible) result.visible = run.read(visible);
     if (outputs.angle) result.angle = run.read(angle);
     if (outputs.needed_height) result.needed_height = run.read(needed);
+    if (outputs.culled_mask) result.culled_mask = run.culledMask();
     return result;
   });
 }

@@ -170,4 +170,65 @@ ViewshedResult referenceViewshed(const HeightField& f, const Observer& o, const 
   return r;
 }
 
+std::vector<float> referenceCulledMask(const HeightField& f, const ViewshedPyramid& pyramid, const Observer& o,
+                                       const ViewshedOptions& options) {
+  const double ze = eyeHeight(f, o, options), c = pyramid.curvature;
+  constexpr int kFloats = ViewshedPyramid::kRegionFloats;
+  // The bound of a region at distance r: linear between the breakpoints; NaN past the reach.
+  auto bound = [&](const float* region, double r) {
+    for (int i = 0; i + 1 < ViewshedPyramid::kBreakpoints; ++i) {
+      const double b0 = pyramid.reach * ViewshedPyramid::breakFraction(i);
+      const double b1 = pyramid.reach * ViewshedPyramid::breakFraction(i + 1);
+      if (r <= b1) {
+        const double a = region[1 + i], b = region[2 + i];
+        return a == b ? a : a + (b - a) * (r - b0) / (b1 - b0);
+      }
+    }
+    return std::numeric_limits<double>::quiet_NaN();
+  };
+  auto culls = [&](const ViewshedPyramid::Level& level, int nx, int ny) {
+    const int side = 1 << level.k;
+    const int x0 = nx * side, y0 = ny * side;
+    const int x1 = std::min(x0 + side, f.width) - 1, y1 = std::min(y0 + side, f.height) - 1;
+    const double hx = 0.5 * (x1 - x0) * f.cell_size_x, hy = 0.5 * (y1 - y0) * f.cell_size_y;
+    const double gx = (o.col - 0.5 * (x0 + x1)) * f.cell_size_x, gy = (o.row - 0.5 * (y0 + y1)) * f.cell_size_y;
+    const double rc = std::hypot(gx, gy), rho = std::hypot(hx, hy);
+    const double r_lo = rc - rho, r_hi = rc + rho;
+    if (!(r_lo > 0.0)) return false;
+    const double alpha = std::asin(std::min(1.0, rho / rc)), phi = std::atan2(gy, gx);
+    const double lhs = ze - c * (c >= 0.0 ? r_lo * r_lo : r_hi * r_hi);
+    for (int s = 0; s < pyramid.sectors; ++s) {
+      // Does [phi - alpha, phi + alpha] meet [start, start + width] (modulo 2 pi)?
+      const double start = pyramid.sector_start[s], width = pyramid.sector_width[s];
+      double rel = std::fmod(phi - alpha - start, 2.0 * M_PI);
+      if (rel < 0.0) rel += 2.0 * M_PI;
+      if (!(rel <= width || rel + 2.0 * alpha >= 2.0 * M_PI)) continue;
+      const float* region = &level.regions[((std::size_t(ny) * level.nodes_x + nx) * pyramid.sectors + s) * kFloats];
+      if (!(r_lo > region[0] && lhs < std::min(bound(region, r_lo), bound(region, r_hi)))) return false;
+    }
+    return true;
+  };
+  // From the coarsest level down: a node is culled when its parent is or when it passes.
+  std::vector<unsigned char> parent;
+  int parent_nx = 0;
+  for (auto level = pyramid.levels.rbegin(); level != pyramid.levels.rend(); ++level) {
+    std::vector<unsigned char> flags(std::size_t(level->nodes_x) * level->nodes_y);
+    for (int ny = 0; ny < level->nodes_y; ++ny)
+      for (int nx = 0; nx < level->nodes_x; ++nx)
+        flags[std::size_t(ny) * level->nodes_x + nx] =
+            (!parent.empty() && parent[std::size_t(ny >> 1) * parent_nx + (nx >> 1)]) || culls(*level, nx, ny);
+    parent = std::move(flags);
+    parent_nx = level->nodes_x;
+  }
+  const int k = pyramid.levels.front().k;
+  std::vector<float> mask(f.pixelCount());
+  for (int y = 0; y < f.height; ++y)
+    for (int x = 0; x < f.width; ++x) {
+      const std::size_t p = std::size_t(y) * f.width + x;
+      mask[p] = !std::isfinite(f.heights[p]) ? std::numeric_limits<float>::quiet_NaN()
+                                              : parent[std::size_t(y >> k) * parent_nx + (x >> k)] ? 1.0f : 0.0f;
+    }
+  return mask;
+}
+
 }  // namespace hfvis

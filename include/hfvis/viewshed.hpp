@@ -24,8 +24,14 @@
 // them. The kernels decide in single precision: sight lines that graze the surface within its
 // rounding may go either way, and pieces of a line shorter than 1e-3 pixel skip their vertex
 // test.
+//
+// A culling pyramid (ViewshedPyramid, after Stewart 1997, "Hierarchical visibility in
+// terrains") lets a viewshed skip whole blocks of targets hidden from the eye: built once per
+// field and target height from horizons swept in many directions, it is queried per observer
+// and never changes a result (see buildViewshedPyramid).
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <vector>
 
@@ -39,6 +45,8 @@ struct Observer {
   int row = 0;
   double height = 2.0;  // the eye above the surface (or absolute, ViewshedOptions::absolute)
 };
+
+struct ViewshedPyramid;
 
 struct ViewshedOptions {
   bool absolute = false;       // Observer::height is an absolute (z-scaled) height
@@ -61,6 +69,10 @@ struct ViewshedOptions {
   std::size_t memory_budget = 0;
   // Cumulative viewsheds: called after each observer with (done, total).
   std::function<void(int, int)> progress;
+  // A culling pyramid built for this field, target height and curvature (buildViewshedPyramid),
+  // or null: the targets of the blocks it shows hidden are hidden without further work. The same
+  // results either way. Must outlive the call.
+  const ViewshedPyramid* pyramid = nullptr;
 };
 
 struct ViewshedOutputs {
@@ -70,6 +82,9 @@ struct ViewshedOutputs {
   // at nodata and out of range). Every target's whole sight line is marched (through the
   // maximum pyramid): much slower than `visible`.
   bool needed_height = false;
+  // 1 where the culling pyramid (ViewshedOptions::pyramid, required) culled the point, else 0;
+  // NaN at nodata.
+  bool culled_mask = false;
 };
 
 struct ViewshedResult {
@@ -77,9 +92,12 @@ struct ViewshedResult {
   std::vector<float> visible;  // width * height when asked
   std::vector<float> angle;    // width * height when asked
   std::vector<float> needed_height;  // width * height when asked
-  // Targets the classification left to be marched (the rest were settled by the range, nodata
-  // or the rays' lower bounds).
+  std::vector<float> culled_mask;    // width * height when asked
+  // Targets the classification left to be marched (the rest were settled by the range, nodata,
+  // the culling pyramid or the rays' lower bounds).
   std::size_t marched = 0;
+  // Valid targets in the blocks the culling pyramid culled (0 without one).
+  std::size_t culled = 0;
 };
 
 struct CumulativeViewshed {
@@ -87,6 +105,80 @@ struct CumulativeViewshed {
   int observers = 0;
   std::vector<float> count;  // observers that see each grid point; NaN at nodata
 };
+
+// Stewart's culling pyramid. For every grid point P (a target standing target_height above the
+// surface there) and every sector of azimuths, an occlusion region: eyes that P's horizon in
+// that sector hides it from. The horizons come from the sweep (computeHorizons) in
+// `sectors * directions_per_sector` directions, each giving a surface point B at ground distance
+// d and slope s (curvature taken) from P. An eye at ground distance r > d in a direction within
+// angle delta of B's, whose slope from P, (z_eye - c r^2 - z_P) / r, is below
+// s - L delta - margin / d, is hidden from P: the sight line passes under the surface near B
+// (L bounds the surface's slope within d delta of B; the margin keeps the exact test's rounding
+// clear of the decision). Horizons nearer than 2 pixels (a slope's own) give no region. Between
+// two neighbouring directions an eye lies within half the gap of one and within the whole gap
+// of either: the better of the two regions stands for the gap, and a sector's region is the
+// intersection of its gaps' (the farthest d, the least bound).
+//
+// The regions of the points of a quadtree node (2^k x 2^k grid points) are intersected: the
+// node keeps, per sector, the farthest d and a lower bound on min_P (z_P + s_P r) as a concave
+// piecewise-linear function of r (kBreakpoints vertices at fixed distances shared by every
+// node), so that a parent's region is the intersection of its children's with the same bounded
+// vertex count. A query culls a node when, for every sector its points can see the eye in, the
+// eye lies farther than d from all of them and below the bound over the range of their
+// distances; a node holding the eye never passes. Levels finest_level .. the one node over the
+// field are kept; the query walks them from the coarsest down.
+//
+// The regions are conservative: a node is culled only when every point of it is, so rough
+// terrain, whose hidden points are interleaved with points on convex slopes (their horizons are
+// their own slope), culls few coarse nodes (README, "Viewsheds", gives the fractions measured).
+struct ViewshedPyramidOptions {
+  double target_height = 0.0;  // the height above the surface of the targets it culls
+  double curvature = 0.0;      // as ViewshedOptions::curvature; queries must use the same
+  int sectors = 16;            // sectors of azimuth, 4 .. 256
+  int directions_per_sector = 8;  // horizon directions per sector (2 .. 64; shared at the sectors' edges)
+  int finest_level = 2;        // the finest nodes kept: 2^finest_level points a side, 1 .. 12
+  std::size_t memory_budget = 0;  // for the horizon sweeps, as SweepOptions::memory_budget_bytes
+  std::function<void(int, int)> progress;  // (directions done, directions in all)
+};
+
+struct ViewshedPyramid {
+  static constexpr int kBreakpoints = 5;  // the bound's vertices, at reach * {0, 1/64, 1/16, 1/4, 1}
+  static constexpr int kRegionFloats = 1 + kBreakpoints;  // per node and sector: d, then the bound
+  static constexpr double breakFraction(int i) {
+    return i == 0 ? 0.0 : i == 1 ? 1.0 / 64.0 : i == 2 ? 1.0 / 16.0 : i == 3 ? 0.25 : 1.0;
+  }
+  // What it was built for: queries check these.
+  int width = 0, height = 0;
+  double cell_size_x = 1.0, cell_size_y = 1.0, z_scale = 1.0;
+  std::uint64_t heights_fingerprint = 0;
+  double target_height = 0.0, curvature = 0.0;
+  int directions = 0;        // horizon directions swept
+  int finest_level = 0;
+  int sectors = 0;
+  // Sector s covers the ground azimuths (SweepOptions's convention, radians) from
+  // sector_start[s] over sector_width[s], counter-clockwise in (column, row) axes.
+  std::vector<float> sector_start, sector_width;
+  double reach = 0.0;  // ground distance of the last breakpoint; farther eyes are never culled
+  struct Level {
+    int k = 0;  // nodes of 2^k x 2^k grid points
+    int nodes_x = 0, nodes_y = 0;
+    // Per node (row-major), per sector: kRegionFloats floats. An empty node (only nodata) has
+    // d = 0 and the bound FLT_MAX.
+    std::vector<float> regions;
+  };
+  std::vector<Level> levels;                // finest_level first, up to one node
+  std::vector<std::uint32_t> valid_points;  // per node of the finest level: its valid grid points
+  double build_seconds = 0.0;               // wall time of buildViewshedPyramid
+  std::size_t bytes() const;                // the regions' memory
+};
+
+// Builds the pyramid. Throws InvalidArgument (bad field or options, a latitude / longitude
+// grid, a field of 2^31 points or more), MemoryBudgetError, OpenClError, KernelBuildError.
+ViewshedPyramid buildViewshedPyramid(const ComputeContext& context, const HeightField& field,
+                                     const ViewshedPyramidOptions& options);
+
+// The fingerprint queries compare: FNV-1a over the heights' bytes.
+std::uint64_t heightsFingerprint(const HeightField& field);
 
 // Throws InvalidArgument for a negative or non-finite target height or maximum distance, a
 // non-finite curvature, azimuths outside [0, 360], or elevation limits outside [-90, 90] or
@@ -98,7 +190,8 @@ void validate(const ViewshedOptions& options);
 void validate(const HeightField& field, const Observer& observer);
 
 // The viewshed of one observer. Throws InvalidArgument (bad field, observer or options, a
-// latitude / longitude grid, a field of 2^31 points or more), MemoryBudgetError, OpenClError,
+// latitude / longitude grid, a field of 2^31 points or more, a pyramid built for another field,
+// target height or curvature), MemoryBudgetError, OpenClError,
 // KernelBuildError.
 ViewshedResult computeViewshed(const ComputeContext& context, const HeightField& field, const Observer& observer,
                                const ViewshedOptions& options, const ViewshedOutputs& outputs = {});

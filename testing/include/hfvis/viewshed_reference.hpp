@@ -30,4 +30,10 @@ SightLine referenceSightLine(const HeightField& field, const Observer& observer,
 ViewshedResult referenceViewshed(const HeightField& field, const Observer& observer, const ViewshedOptions& options,
                                  std::vector<double>* rise = nullptr);
 
+// The culling pyramid's query (viewshed_cull in kernels/viewshed.cl) in double, without the
+// kernel's widening for its float rounding: 1 where a point's node is culled, 0 elsewhere, NaN
+// at nodata.
+std::vector<float> referenceCulledMask(const HeightField& field, const ViewshedPyramid& pyramid,
+                                       const Observer& observer, const ViewshedOptions& options);
+
 }  // namespace hfvis

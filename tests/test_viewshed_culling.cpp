@@ -1,0 +1,292 @@
+// test_viewshed_culling.cpp: Stewart's culling pyramid (buildViewshedPyramid): every point it
+// culls is hidden by brute force (hfvis/viewshed_reference.hpp), clear of grazing; a viewshed
+// with it equals one without, bit for bit; on rough terrain, a wall whose shadow lies across
+// azimuth 0 (sector ranges that wrap), notched ridges, the hard cases, curvature, target
+// heights and both layouts; bad input.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <string>
+
+#include "hfvis/errors.hpp"
+#include "hfvis/image_io.hpp"
+#include "hfvis/synthetic_fields.hpp"
+#include "hfvis/viewshed.hpp"
+#include "hfvis/viewshed_reference.hpp"
+#include "test_support.hpp"
+
+namespace hfvis {
+namespace {
+
+using testing::forEachLayout;
+using testing::testContext;
+
+HeightField fractalCrop(int x0, int y0, int w, int h) {
+  static const HeightField fractal = readHeightField(std::string(HFVIS_DATA_DIR) + "/fractal_256.exr");
+  HeightField out = fractal;
+  out.width = w;
+  out.height = h;
+  out.heights.resize(static_cast<std::size_t>(w) * h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) out.heights[static_cast<std::size_t>(y) * w + x] = fractal.at(x0 + x, y0 + y);
+  return out;
+}
+
+struct Culling {
+  std::size_t targets = 0, culled = 0, hidden = 0;
+};
+
+// The viewshed with the pyramid against the one without (bit for bit, the culled count with
+// them) and every culled point against brute force: hidden, the surface rising at least
+// `clear` above its sight line.
+Culling checkCulling(const ComputeContext& context, const HeightField& f, const Observer& o,
+                     const ViewshedOptions& plain, const ViewshedPyramid& pyramid, double clear) {
+  ViewshedOptions culled = plain;
+  culled.pyramid = &pyramid;
+  ViewshedOutputs outputs;
+  outputs.angle = true;
+  const ViewshedResult exact = computeViewshed(context, f, o, plain, outputs);
+  outputs.culled_mask = true;
+  const ViewshedResult got = computeViewshed(context, f, o, culled, outputs);
+  // The kernel's query against the scalar one: it culls nothing the scalar one keeps (its float
+  // rounding is widened the conservative way) and keeps few that it culls.
+  const std::vector<float> want = referenceCulledMask(f, pyramid, o, plain);
+  std::size_t extra = 0, kept = 0, wanted = 0;
+  for (std::size_t p = 0; p < f.pixelCount(); ++p) {
+    wanted += want[p] == 1.0f;
+    extra += got.culled_mask[p] == 1.0f && want[p] != 1.0f;
+    kept += want[p] == 1.0f && got.culled_mask[p] != 1.0f;
+  }
+  EXPECT_EQ(extra, 0u) << "points culled that the scalar query keeps";
+  EXPECT_LE(kept, wanted / 100 + 16) << "points the scalar query culls, of " << wanted;
+  Culling c;
+  std::size_t mismatches = 0;
+  for (std::size_t p = 0; p < f.pixelCount(); ++p) {
+    const bool same = exact.visible[p] == got.visible[p] || (std::isnan(exact.visible[p]) && std::isnan(got.visible[p]));
+    if (!same && ++mismatches <= 5)
+      ADD_FAILURE() << "point " << p % f.width << "," << p / f.width << ": culled " << got.visible[p] << ", exact "
+                    << exact.visible[p];
+    EXPECT_TRUE(got.angle[p] == exact.angle[p] || (std::isnan(got.angle[p]) && std::isnan(exact.angle[p])));
+    if (std::isnan(got.culled_mask[p])) {
+      EXPECT_FALSE(std::isfinite(f.heights[p]));
+      continue;
+    }
+    ++c.targets;
+    c.hidden += exact.visible[p] == 0.0f;
+    if (got.culled_mask[p] != 1.0f) continue;
+    ++c.culled;
+    const int col = static_cast<int>(p % f.width), row = static_cast<int>(p / f.width);
+    const SightLine s = referenceSightLine(f, o, plain, col, row);
+    if (s.visible || !(s.interior_rise > clear))
+      ADD_FAILURE() << "culled " << col << "," << row << " but brute force finds it "
+                    << (s.visible ? "visible" : "hidden") << ", the surface " << s.interior_rise
+                    << " above the sight line at most";
+  }
+  EXPECT_EQ(mismatches, 0u);
+  EXPECT_EQ(got.culled, c.culled);
+  return c;
+}
+
+ViewshedPyramid pyramidFor(const ComputeContext& context, const HeightField& f, double target_height = 0.0,
+                           double curvature = 0.0, int finest_level = 2) {
+  ViewshedPyramidOptions options;
+  options.target_height = target_height;
+  options.curvature = curvature;
+  options.finest_level = finest_level;
+  return buildViewshedPyramid(context, f, options);
+}
+
+TEST(ViewshedCulling, RoughTerrainCullsOnlyHiddenPoints) {
+  const HeightField f = fractalCrop(40, 60, 97, 83);
+  forEachLayout([&](const ComputeContext& context) {
+    const ViewshedPyramid pyramid = pyramidFor(context, f, 0.0, 0.0, 1);
+    EXPECT_EQ(pyramid.levels.front().k, 1);
+    EXPECT_EQ(pyramid.levels.back().nodes_x, 1);
+    EXPECT_EQ(pyramid.levels.back().nodes_y, 1);
+    std::size_t culled = 0, hidden = 0;
+    for (const Observer& o : std::vector<Observer>{{48, 41, 2.0}, {10, 70, 0.0}, {48, 41, 60.0}, {0, 0, 2.0},
+                                                   {96, 40, 5.0}, {50, 82, 1.0}, {20, 20, 0.5}}) {
+      SCOPED_TRACE(std::to_string(o.col) + "," + std::to_string(o.row) + " at " + std::to_string(o.height));
+      const Culling c = checkCulling(context, f, o, {}, pyramid, 0.0);
+      culled += c.culled;
+      hidden += c.hidden;
+    }
+    // The pyramid culls a share of what is hidden (not a stub that culls nothing).
+    EXPECT_GT(culled, hidden / 50) << culled << " culled of " << hidden << " hidden";
+    std::printf("rough terrain: %zu culled of %zu hidden\n", culled, hidden);
+    // Wide sectors, wide nodes: a node's azimuth range often begins in one sector and runs into
+    // the next, which must be checked too.
+    ViewshedPyramidOptions wide;
+    wide.sectors = 4;
+    wide.directions_per_sector = 16;
+    wide.finest_level = 1;
+    const ViewshedPyramid coarse = buildViewshedPyramid(context, f, wide);
+    for (const Observer& o : std::vector<Observer>{{48, 41, 2.0}, {10, 70, 0.0}, {20, 20, 0.5}, {90, 10, 1.0}})
+      checkCulling(context, f, o, {}, coarse, 0.0);
+  });
+}
+
+TEST(ViewshedCulling, RealTerrainCullsAShareOfTheHiddenPoints) {
+  const HeightField dem = readHeightField(std::string(HFVIS_DATA_DIR) + "/jacksboro_fault_dem.exr");
+  const ViewshedPyramid pyramid = pyramidFor(testContext(), dem);
+  std::size_t culled = 0, hidden = 0;
+  for (const Observer& o : std::vector<Observer>{{100, 100, 2.0}, {20, 20, 0.0}, {300, 250, 30.0}}) {
+    SCOPED_TRACE(std::to_string(o.col) + "," + std::to_string(o.row));
+    const Culling c = checkCulling(testContext(), dem, o, {}, pyramid, 0.0);
+    culled += c.culled;
+    hidden += c.hidden;
+  }
+  EXPECT_GT(culled, hidden / 20) << culled << " culled of " << hidden << " hidden";
+}
+
+// Flat ground at 0 with a wall of height 50 along column `wall` (every row but the notch's).
+HeightField wallField(int width, int height, int wall, int notch_row = -1, int notch_rows = 0) {
+  HeightField f;
+  f.width = width;
+  f.height = height;
+  f.heights.assign(static_cast<std::size_t>(width) * height, 0.0f);
+  for (int y = 0; y < height; ++y)
+    if (y < notch_row || y >= notch_row + notch_rows) f.heights[static_cast<std::size_t>(y) * width + wall] = 50.0f;
+  return f;
+}
+
+TEST(ViewshedCulling, SectorRangesWrappingAzimuthZero) {
+  // The eye east of the wall: the targets west of it see it at azimuth about 0, where the first
+  // sector begins, so the nodes on the eye's rows meet the last sector and the first.
+  const HeightField f = wallField(80, 61, 30);
+  forEachLayout([&](const ComputeContext& context) {
+    const ViewshedPyramid pyramid = pyramidFor(context, f);
+    for (const Observer& o : std::vector<Observer>{{60, 30, 2.0}, {5, 30, 2.0}}) {
+      SCOPED_TRACE(std::to_string(o.col));
+      const Culling c = checkCulling(context, f, o, {}, pyramid, 0.0);
+      ViewshedOptions options;
+      options.pyramid = &pyramid;
+      ViewshedOutputs outputs;
+      outputs.culled_mask = true;
+      const ViewshedResult r = computeViewshed(context, f, o, options, outputs);
+      // Behind the wall on the eye's own rows (their nodes' azimuth ranges wrap for the eye in
+      // the east) the targets are culled.
+      std::size_t behind = 0, culled = 0;
+      for (int y = 26; y < 34; ++y)
+        for (int x = 0; x < f.width; ++x)
+          if (o.col > 30 ? x < 26 : x > 34) {
+            ++behind;
+            culled += r.culled_mask[static_cast<std::size_t>(y) * f.width + x] == 1.0f;
+          }
+      EXPECT_GT(culled, behind / 2) << culled << " of " << behind;
+      EXPECT_GT(c.culled, c.hidden / 2);
+    }
+  });
+}
+
+TEST(ViewshedCulling, NotchedRidgesAreNotCulledThrough) {
+  // A wall with narrow notches (1 and 2 grid points): targets far behind them see the eye
+  // through a gap narrower than the spacing of the horizons' directions there.
+  HeightField f = wallField(150, 90, 100, 40, 1);
+  for (int y : {60, 61}) f.heights[static_cast<std::size_t>(y) * f.width + 100] = 0.0f;
+  forEachLayout([&](const ComputeContext& context) {
+    ViewshedPyramidOptions coarse;
+    coarse.sectors = 8;
+    coarse.directions_per_sector = 4;
+    coarse.finest_level = 1;
+    const ViewshedPyramid pyramid = buildViewshedPyramid(context, f, coarse);
+    std::size_t culled = 0;
+    for (const Observer& o : std::vector<Observer>{{103, 40, 1.0}, {104, 61, 1.0}, {110, 50, 3.0}}) {
+      SCOPED_TRACE(std::to_string(o.col) + "," + std::to_string(o.row));
+      const Culling c = checkCulling(context, f, o, {}, pyramid, 0.0);
+      culled += c.culled;
+      EXPECT_LT(c.hidden, c.targets);  // targets behind the notch are seen
+    }
+    EXPECT_GT(culled, 0u);
+  });
+}
+
+TEST(ViewshedCulling, HardCases) {
+  forEachLayout([&](const ComputeContext& context) {
+    for (const std::string& name : syntheticFieldNames()) {
+      SCOPED_TRACE(name);
+      const HeightField f = makeSyntheticField(name, 61, 53);
+      const ViewshedPyramid pyramid = pyramidFor(context, f, 0.0, 0.0, 1);
+      for (Observer o : std::vector<Observer>{{30, 26, 1.5}, {3, 50, 0.0}}) {
+        if (!std::isfinite(f.at(o.col, o.row))) continue;
+        checkCulling(context, f, o, {}, pyramid, 0.0);
+      }
+    }
+  });
+}
+
+TEST(ViewshedCulling, TargetHeightCurvatureAndOptions) {
+  HeightField f = fractalCrop(100, 20, 90, 70);
+  f.cell_size_x = 2.0;
+  f.cell_size_y = 1.5;
+  f.heights[33 * 90 + 12] = NAN;
+  forEachLayout([&](const ComputeContext& context) {
+    ViewshedOptions options;
+    options.target_height = 1.5;
+    options.curvature = 0.002;
+    const ViewshedPyramid pyramid = pyramidFor(context, f, 1.5, 0.002, 1);
+    for (const Observer& o : std::vector<Observer>{{45, 35, 2.0}, {5, 60, 20.0}}) checkCulling(context, f, o, options, pyramid, 0.0);
+    options.max_distance = 60.0;
+    options.azimuth_from_deg = 300.0;
+    options.azimuth_to_deg = 100.0;
+    options.elevation_max_deg = 10.0;
+    checkCulling(context, f, {45, 35, 2.0}, options, pyramid, 0.0);
+    // Negative curvature (refraction beyond 1) raises far terrain.
+    ViewshedOptions raised;
+    raised.curvature = -0.003;
+    checkCulling(context, f, {45, 35, 2.0}, raised, pyramidFor(context, f, 0.0, -0.003, 1), 0.0);
+  });
+}
+
+TEST(ViewshedCulling, CumulativeEqualsWithout) {
+  const HeightField f = fractalCrop(10, 10, 70, 64);
+  const ViewshedPyramid pyramid = pyramidFor(testContext(), f);
+  const std::vector<Observer> observers = {{3, 3, 2.0}, {35, 30, 2.0}, {69, 63, 10.0}};
+  ViewshedOptions culled;
+  culled.pyramid = &pyramid;
+  EXPECT_EQ(computeCumulativeViewshed(testContext(), f, observers, culled).count,
+            computeCumulativeViewshed(testContext(), f, observers, {}).count);
+}
+
+TEST(ViewshedCulling, BadInputIsRefused) {
+  const HeightField f = fractalCrop(0, 0, 40, 30);
+  const ViewshedPyramid pyramid = pyramidFor(testContext(), f, 1.0);
+  const Observer o{20, 15, 2.0};
+  ViewshedOptions options;
+  options.pyramid = &pyramid;
+  EXPECT_THROW(computeViewshed(testContext(), f, o, options), InvalidArgument);  // built for target height 1
+  options.target_height = 1.0;
+  EXPECT_NO_THROW(computeViewshed(testContext(), f, o, options));
+  options.curvature = 0.001;
+  EXPECT_THROW(computeViewshed(testContext(), f, o, options), InvalidArgument);
+  options.curvature = 0.0;
+  HeightField other = f;
+  other.heights[7] += 1.0f;
+  EXPECT_THROW(computeViewshed(testContext(), other, o, options), InvalidArgument);
+  other = f;
+  other.z_scale = 2.0;
+  EXPECT_THROW(computeViewshed(testContext(), other, o, options), InvalidArgument);
+  EXPECT_THROW(computeCumulativeViewshed(testContext(), other, {o}, options), InvalidArgument);
+  ViewshedOutputs mask;
+  mask.culled_mask = true;
+  EXPECT_THROW(computeViewshed(testContext(), f, o, {}, mask), InvalidArgument);  // no pyramid
+  for (auto bad : std::vector<std::function<void(ViewshedPyramidOptions&)>>{
+           [](ViewshedPyramidOptions& p) { p.sectors = 3; }, [](ViewshedPyramidOptions& p) { p.sectors = 257; },
+           [](ViewshedPyramidOptions& p) { p.directions_per_sector = 1; },
+           [](ViewshedPyramidOptions& p) { p.finest_level = 0; }, [](ViewshedPyramidOptions& p) { p.finest_level = 13; },
+           [](ViewshedPyramidOptions& p) { p.target_height = -1.0; },
+           [](ViewshedPyramidOptions& p) { p.target_height = NAN; }, [](ViewshedPyramidOptions& p) { p.curvature = INFINITY; }}) {
+    ViewshedPyramidOptions p;
+    bad(p);
+    EXPECT_THROW(buildViewshedPyramid(testContext(), f, p), InvalidArgument);
+  }
+  HeightField lat = f;
+  lat.row_cell_size_x.assign(f.height, 1.0);
+  lat.row_cell_size_y.assign(f.height, 1.0);
+  EXPECT_THROW(buildViewshedPyramid(testContext(), lat, {}), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace hfvis
