@@ -20,8 +20,9 @@ namespace hfvis {
 namespace {
 
 constexpr double kTwoPi = 2.0 * M_PI;
-// The horizon planes one sweep call may hand back at once (three calls' are held).
-constexpr std::size_t kPlaneBytes = std::size_t(1) << 29;
+// The horizon planes one sweep call may hand back at once (three calls' horizon points, 1.5
+// times as large, are held).
+constexpr std::size_t kPlaneBytes = std::size_t(1) << 28;
 
 // Rounded toward -inf / +inf: a stored bound never claims more than the double it came from.
 float roundDown(double v) {
@@ -186,38 +187,86 @@ ViewshedPyramid buildViewshedPyramid(const ComputeContext& context, const Height
   const unsigned threads = std::max(1u, std::min(8u, std::thread::hardware_concurrency()));
   const std::size_t plane = field.pixelCount();
   const int per_call = directions / calls;
-  // The blocker a point's horizon in direction k of sweep result r gives for eyes within `delta`
-  // of that direction: the bound on their slope (-inf: none) and the distance they must lie
-  // beyond. A blocker nearer than 2 pixels is too near the target for the exact test's rounding
-  // to show it reliably.
+  const double c_drop = options.curvature;
+
+  // Horizon points: per direction and receiver, where the receiver's horizon point B lies from
+  // it (pixels) and B's height (NaN: no horizon point, or a slope's own at the receiver).
+  struct HorizonPoints {
+    double azimuth = 0.0;
+    std::vector<float> ox, oy, zb;
+  };
+  auto horizonPoints = [&](const HorizonResult& r) {
+    std::vector<HorizonPoints> out(per_call);
+    for (int k = 0; k < per_call; ++k) {
+      HorizonPoints& hp = out[k];
+      hp.azimuth = r.azimuths[k];
+      hp.ox.resize(plane);
+      hp.oy.resize(plane);
+      hp.zb.resize(plane);
+      const double ux = std::cos(hp.azimuth) / cx, uy = std::sin(hp.azimuth) / cy;
+      for (std::size_t at = 0; at < plane; ++at) {
+        const double dn = r.distances[k * plane + at], theta = r.angles[k * plane + at];
+        const float h = field.heights[at];
+        const bool valid = dn > 0.0 && std::isfinite(theta) && std::fabs(theta) < 0.5 * M_PI && std::isfinite(h);
+        hp.ox[at] = static_cast<float>(dn * ux);
+        hp.oy[at] = static_cast<float>(dn * uy);
+        hp.zb[at] = valid ? static_cast<float>(h * field.z_scale + std::tan(theta) * dn + c_drop * dn * dn) : NAN;
+      }
+    }
+    return out;
+  };
+  // The best blocker for eyes near direction `hp` from point (x, y) (height zp), for eyes within
+  // half the gap and within all of it of that direction. Candidates: the horizon points of the
+  // point and of its 8 neighbours (any surface point whose height is known blocks: a
+  // neighbour's horizon point often stands where the point's own horizon is its own slope),
+  // each taken where it lies from the point, its azimuth `off` from the direction's. An eye
+  // within `spread` of B's azimuth at ground distance r > d, its slope from P below
+  // slope(B) - L spread - margin / d, is hidden: the sight line passes within d spread of B,
+  // where the surface lies at most L d spread lower. A blocker nearer than 2 pixels is too
+  // near the target for the exact test's rounding to show it reliably.
   struct Blocker {
     double sigma = -INFINITY, d = 0.0;
   };
-  auto blocker = [&](const HorizonResult& r, int k, int x, int y, double delta) {
-    Blocker b;
-    const std::size_t at = std::size_t(y) * width + x;
-    const double d = r.distances[k * plane + at], theta = r.angles[k * plane + at];
-    if (!(d >= 2.0 * most_cell && std::isfinite(theta) && std::fabs(theta) < 0.5 * M_PI)) return b;
-    const double az = r.azimuths[k], t = std::tan(theta);
-    const double L = slopes.around(x + d * std::cos(az) / cx, y + d * std::sin(az) / cy, d * delta / least_cell + 1.0);
-    if (!std::isfinite(L)) return b;
-    // The margin: the heights' rounding, the exact test's (its vertex test skipped on pieces
-    // under 1e-3 pixel) and the float angle's.
-    const double margin = z_margin + 2e-3 * most_cell * (L + std::fabs(t) + 1.0) + 4e-7 * d * (1.0 + t * t);
-    b.sigma = (t * d - target - margin) / d - L * delta;
-    b.d = d + most_cell;
-    return b;
+  struct Blockers {
+    Blocker half, whole;
   };
-  // Folds the gaps from the directions of sweep result a (call ca) to their neighbours
-  // counter-clockwise in result b (call cb; next: b's direction k + 1 follows a's k) into the
-  // finest nodes. An eye in the gap is within half of it of one of its two directions and
-  // within all of it of either: the gap's region is the better of "both, half the gap each"
-  // and "one of them, the whole gap".
-  auto foldGaps = [&](const HorizonResult& a, int ca, const HorizonResult& b, bool next, int band_first, int band_last) {
+  auto blockers = [&](const HorizonPoints& hp, int x, int y, double zp, double gap) {
+    Blockers best;
+    const double ca = std::cos(hp.azimuth), sa = std::sin(hp.azimuth);
+    for (int j = std::max(0, y - 1); j <= std::min(height - 1, y + 1); ++j)
+      for (int i = std::max(0, x - 1); i <= std::min(width - 1, x + 1); ++i) {
+        const std::size_t at = std::size_t(j) * width + i;
+        const double zb = hp.zb[at];
+        if (!std::isfinite(zb)) continue;
+        const double bx = i + hp.ox[at], by = j + hp.oy[at];
+        const double gx = (bx - x) * cx, gy = (by - y) * cy;
+        const double d = std::sqrt(gx * gx + gy * gy);
+        if (!(d >= 2.0 * most_cell) || ca * gx + sa * gy <= 0.0) continue;
+        const double sine = std::min(1.0, std::fabs(ca * gy - sa * gx) / d);
+        const double off = sine <= 0.5 ? sine + 0.2 * sine * sine * sine : std::asin(sine);  // >= asin(sine)
+        const double L = slopes.around(bx, by, d * (gap + off) / least_cell + 1.0);
+        if (!std::isfinite(L)) continue;
+        const double slope = (zb - c_drop * d * d - zp) / d;
+        // The margin: the heights' rounding, the exact test's (its vertex test skipped on
+        // pieces under 1e-3 pixel) and the float angle's.
+        const double margin = z_margin + 2e-3 * most_cell * (L + std::fabs(slope) + 1.0) + 4e-7 * d * (1.0 + slope * slope);
+        const double base = slope - margin / d - L * off;
+        const Blocker half{base - L * 0.5 * gap, d + most_cell}, whole{base - L * gap, d + most_cell};
+        if (half.sigma > best.half.sigma) best.half = half;
+        if (whole.sigma > best.whole.sigma) best.whole = whole;
+      }
+    return best;
+  };
+  // Folds the gaps from the directions of call ca (a) to their neighbours counter-clockwise (b;
+  // next: b's direction k + 1 follows a's k) into the finest nodes. An eye in the gap is within
+  // half of it of one of its two directions and within all of it of either: the gap's region
+  // is the better of "both, half the gap each" and "one of them, the whole gap".
+  auto foldGaps = [&](const std::vector<HorizonPoints>& a, int ca, const std::vector<HorizonPoints>& b, bool next,
+                      int band_first, int band_last) {
     for (int k = 0; k < per_call; ++k) {
       const int j = k * calls + ca, kb = next ? (k + 1) % per_call : k;
       const int s = j / per;
-      double gap = std::fmod(b.azimuths[kb] - a.azimuths[k], kTwoPi);
+      double gap = std::fmod(b[kb].azimuth - a[k].azimuth, kTwoPi);
       if (gap < 0.0) gap += kTwoPi;
       for (int y = band_first << k0; y < std::min(height, (band_last + 1) << k0); ++y)
         for (int x = 0; x < width; ++x) {
@@ -226,9 +275,9 @@ ViewshedPyramid buildViewshedPyramid(const ComputeContext& context, const Height
           const double zp = h * field.z_scale + target;
           float* region = &regions[((std::size_t(y >> k0) * nodes_x + (x >> k0)) * sectors + s) * kFloats];
           region[1] = std::min(region[1], roundDown(zp));
-          const Blocker half_a = blocker(a, k, x, y, 0.5 * gap), half_b = blocker(b, kb, x, y, 0.5 * gap);
-          Blocker best{std::min(half_a.sigma, half_b.sigma), std::max(half_a.d, half_b.d)};
-          for (const Blocker& one : {blocker(a, k, x, y, gap), blocker(b, kb, x, y, gap)})
+          const Blockers from_a = blockers(a[k], x, y, zp, gap), from_b = blockers(b[kb], x, y, zp, gap);
+          Blocker best{std::min(from_a.half.sigma, from_b.half.sigma), std::max(from_a.half.d, from_b.half.d)};
+          for (const Blocker& one : {from_a.whole, from_b.whole})
             if (one.sigma > best.sigma) best = one;
           if (std::isfinite(best.sigma)) region[0] = std::max(region[0], roundUp(best.d));
           for (int i = 1; i < ViewshedPyramid::kBreakpoints; ++i)
@@ -237,7 +286,7 @@ ViewshedPyramid buildViewshedPyramid(const ComputeContext& context, const Height
         }
     }
   };
-  auto parallelFold = [&](const HorizonResult& a, int ca, const HorizonResult& b, bool next) {
+  auto parallelFold = [&](const std::vector<HorizonPoints>& a, int ca, const std::vector<HorizonPoints>& b, bool next) {
     std::vector<std::thread> pool;
     const int bands = static_cast<int>(threads);
     for (int band = 0; band < bands; ++band) {
@@ -247,12 +296,12 @@ ViewshedPyramid buildViewshedPyramid(const ComputeContext& context, const Height
     for (std::thread& t : pool) t.join();
   };
   // Call c holds directions k * calls + c: the gaps run from call c - 1 to call c, and from the
-  // last call to the first's next direction. The first call's planes are kept to the end.
-  HorizonResult first, previous;
+  // last call to the first's next direction. The first call's points are kept to the end.
+  std::vector<HorizonPoints> first, previous;
   for (int c = 0; c < calls; ++c) {
     horizon.azimuth_offset = kTwoPi * c / directions;
-    HorizonResult r = computeHorizons(context, field, horizon, outputs);
-    for (int k = 0; k < per_call; ++k) azimuth[k * calls + c] = r.azimuths[k];
+    std::vector<HorizonPoints> r = horizonPoints(computeHorizons(context, field, horizon, outputs));
+    for (int k = 0; k < per_call; ++k) azimuth[k * calls + c] = r[k].azimuth;
     if (c > 0) parallelFold(c == 1 ? first : previous, c - 1, r, false);
     if (c == calls - 1) parallelFold(r, c, c == 0 ? r : first, true);
     if (c == 0)

@@ -90,7 +90,7 @@ Culling checkCulling(const ComputeContext& context, const HeightField& f, const 
 }
 
 ViewshedPyramid pyramidFor(const ComputeContext& context, const HeightField& f, double target_height = 0.0,
-                           double curvature = 0.0, int finest_level = 2) {
+                           double curvature = 0.0, int finest_level = ViewshedPyramidOptions{}.finest_level) {
   ViewshedPyramidOptions options;
   options.target_height = target_height;
   options.curvature = curvature;
@@ -114,7 +114,7 @@ TEST(ViewshedCulling, RoughTerrainCullsOnlyHiddenPoints) {
       hidden += c.hidden;
     }
     // The pyramid culls a share of what is hidden (not a stub that culls nothing).
-    EXPECT_GT(culled, hidden / 50) << culled << " culled of " << hidden << " hidden";
+    EXPECT_GT(culled, hidden / 4) << culled << " culled of " << hidden << " hidden";
     std::printf("rough terrain: %zu culled of %zu hidden\n", culled, hidden);
     // Wide sectors, wide nodes: a node's azimuth range often begins in one sector and runs into
     // the next, which must be checked too.
@@ -129,16 +129,24 @@ TEST(ViewshedCulling, RoughTerrainCullsOnlyHiddenPoints) {
 }
 
 TEST(ViewshedCulling, RealTerrainCullsAShareOfTheHiddenPoints) {
-  const HeightField dem = readHeightField(std::string(HFVIS_DATA_DIR) + "/jacksboro_fault_dem.exr");
+  // The bundled DEM cropped to 200 x 160, nodes of 4 x 4 points (the default).
+  const HeightField full = readHeightField(std::string(HFVIS_DATA_DIR) + "/jacksboro_fault_dem.exr");
+  HeightField dem = full;
+  dem.width = 200;
+  dem.height = 160;
+  dem.heights.resize(200 * 160);
+  for (int y = 0; y < 160; ++y)
+    for (int x = 0; x < 200; ++x) dem.heights[y * 200 + x] = full.at(100 + x, 80 + y);
   const ViewshedPyramid pyramid = pyramidFor(testContext(), dem);
   std::size_t culled = 0, hidden = 0;
-  for (const Observer& o : std::vector<Observer>{{100, 100, 2.0}, {20, 20, 0.0}, {300, 250, 30.0}}) {
+  for (const Observer& o : std::vector<Observer>{{100, 80, 2.0}, {10, 10, 0.0}, {150, 120, 30.0}}) {
     SCOPED_TRACE(std::to_string(o.col) + "," + std::to_string(o.row));
     const Culling c = checkCulling(testContext(), dem, o, {}, pyramid, 0.0);
     culled += c.culled;
     hidden += c.hidden;
   }
-  EXPECT_GT(culled, hidden / 20) << culled << " culled of " << hidden << " hidden";
+  EXPECT_GT(culled, hidden / 5) << culled << " culled of " << hidden << " hidden";
+  std::printf("DEM: %zu culled of %zu hidden\n", culled, hidden);
 }
 
 // Flat ground at 0 with a wall of height 50 along column `wall` (every row but the notch's).
