@@ -67,6 +67,7 @@ enum class Option {
   ElevationRange,
   Angle,
   NeededHeight,
+  CullLevel,
 };
 
 struct OptionSpec {
@@ -122,6 +123,7 @@ constexpr OptionSpec kOptions[] = {
     {Option::ElevationRange, "--elevation-range", nullptr, true},
     {Option::Angle, "--angle", nullptr, false},
     {Option::NeededHeight, "--needed-height", nullptr, false},
+    {Option::CullLevel, "--cull-level", nullptr, true},
 };
 
 // The options every sweep operation shares, as typed (degrees become radians).
@@ -290,6 +292,7 @@ const char* onlyFor(Option option) {
     case Option::ElevationRange:
     case Option::Angle:
     case Option::NeededHeight:
+    case Option::CullLevel:
       return "viewshed";
     default:
       return nullptr;
@@ -371,9 +374,9 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
       if (command == Command::ViewCount) {
         run.visibility_method = parseVisibilityMethod(typed, value);
       } else if (command == Command::Viewshed) {
-        if (value == "culled")
-          throw UsageError(typed + " culled: Stewart's culling pyramid is not built yet; use --method exact");
-        if (value != "exact") throw UsageError(typed + ": expected 'exact', got " + inQuotes(value));
+        if (value != "exact" && value != "culled")
+          throw UsageError(typed + ": expected 'exact' or 'culled', got " + inQuotes(value));
+        run.culled = value == "culled";
       } else {
         run.method = parseMethod(typed, value);
       }
@@ -570,6 +573,14 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
     case Option::NeededHeight:
       run.with_needed_height = true;
       break;
+    case Option::CullLevel: {
+      const double k = parseNumber(typed, value);
+      if (!(k >= 1.0 && k <= 12.0 && k == std::floor(k)))
+        throw UsageError(typed + ": expected a whole number 1 .. 12 (nodes of 2^K x 2^K points), got " + inQuotes(value));
+      run.cull_level = static_cast<int>(k);
+      run.cull_level_given = true;
+      break;
+    }
   }
 }
 
@@ -639,6 +650,7 @@ void validateRun(Command command, const RunArguments& run) {
     if ((run.with_angle || run.with_needed_height) && (run.observers.size() > 1 || !run.observers_file.empty()))
       throw UsageError(std::string(run.with_angle ? "--angle" : "--needed-height") +
                        " is for one observer (several give a count)");
+    if (run.cull_level_given && !run.culled) throw UsageError("--cull-level is for --method culled");
     if (!run.observers_file.empty() && samePath(run.output, run.observers_file))
       throw UsageError("--observers must differ from -o, both are " + inQuotes(run.output));
     try {

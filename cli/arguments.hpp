@@ -98,6 +98,9 @@ struct RunArguments {
   std::optional<std::pair<double, double>> field_of_view, elevation_range;
   bool with_angle = false;
   bool with_needed_height = false;  // --needed-height: a "needed_height" channel, one observer
+  bool culled = false;              // --method culled: through Stewart's culling pyramid
+  int cull_level = ViewshedPyramidOptions{}.finest_level;  // --cull-level K: its finest nodes, 2^K points a side
+  bool cull_level_given = false;
   std::optional<float> nodata;               // --nodata VALUE for GeoTIFF outputs (may be NaN); none = NaN
 };
 

@@ -20,6 +20,7 @@
 #include <iomanip>
 #include <iostream>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <system_error>
@@ -247,7 +248,7 @@ const char* methodName(Command command, const RunArguments& run) {
     case Command::Bounce:
       return "tree";
     case Command::Viewshed:
-      return "exact";
+      return run.culled ? "culled" : "exact";
     default:
       return run.method == HorizonMethod::Naive ? "naive" : "sweep";
   }
@@ -396,11 +397,11 @@ class Progress {
     };
   }
 
-  // A callback for a run over observers: "done/total observers".
-  std::function<void(int, int)> observerCallback(int total) {
+  // A callback for a run over other things than directions: "done/total <unit>".
+  std::function<void(int, int)> callback(int total, const char* unit) {
     if (!enabled_) return nullptr;
     total_ = total;
-    unit_ = "observers";
+    unit_ = unit;
     return [this](int done, int all) {
       done_ = done;
       total_ = all;
@@ -835,6 +836,22 @@ int runViewshed(const RunArguments& run) {
   ViewshedOptions options = viewshedOptions(run);
   Progress progress(run.quiet || observers.size() == 1);
   const auto start = std::chrono::steady_clock::now();
+  // --method culled: the pyramid first, for this field, target height and curvature.
+  std::optional<ViewshedPyramid> pyramid;
+  std::string cull_note;
+  if (run.culled) {
+    ViewshedPyramidOptions p;
+    p.target_height = options.target_height;
+    p.curvature = options.curvature;
+    p.finest_level = run.cull_level;
+    p.memory_budget = run.memory_budget_bytes;
+    Progress building(run.quiet);
+    p.progress = building.callback(p.sectors * p.directions_per_sector, "pyramid directions");
+    pyramid = building.run([&] { return buildViewshedPyramid(context, field, p); });
+    options.pyramid = &*pyramid;
+    cull_note = "; culling pyramid " + formatFixed(pyramid->build_seconds, 2) + " s, " +
+                formatFixed(pyramid->bytes() / (1024.0 * 1024.0), 1) + " MiB";
+  }
   std::vector<std::string> names;
   std::vector<std::vector<float>> planes;
   std::string quantity, units, note;
@@ -859,6 +876,9 @@ int runViewshed(const RunArguments& run) {
     std::size_t seen = 0, targets = 0;
     for (float v : r.visible) seen += v == 1.0f, targets += !std::isnan(v);
     note = "; " + formatFixed(100.0 * seen / std::max<std::size_t>(targets, 1), 2) + " % of the points visible";
+    if (pyramid)
+      note += cull_note + "; " + formatFixed(100.0 * r.culled / std::max<std::size_t>(targets, 1), 2) +
+              " % of the points culled";
     names.push_back("visible");
     planes.push_back(std::move(r.visible));
     quantity = "visible: 1 where a target on the point is seen from the observer's eye, 0 where hidden or out of "
@@ -869,14 +889,15 @@ int runViewshed(const RunArguments& run) {
     units = std::string("visible: 1") + (run.with_angle ? "; angle: degrees" : "") +
             (run.with_needed_height ? "; needed_height: height units" : "");
   } else {
-    options.progress = progress.observerCallback(static_cast<int>(observers.size()));
+    options.progress = progress.callback(static_cast<int>(observers.size()), "observers");
     CumulativeViewshed c = progress.run([&] { return computeCumulativeViewshed(context, field, placed, options); });
     requireResultSize(c.width, c.height, field);
     lit.restore(c.count);
     float most = 0.0f;
     for (float v : c.count)
       if (v > most) most = v;
-    note = "; " + std::to_string(observers.size()) + " observers, at most " + formatNumber(most) + " see one point";
+    note = "; " + std::to_string(observers.size()) + " observers, at most " + formatNumber(most) + " see one point" +
+           cull_note;
     names.push_back("count");
     planes.push_back(std::move(c.count));
     quantity = "count: how many of the observers see a target on the point (a cumulative viewshed)";
@@ -931,7 +952,8 @@ int runViewshed(const RunArguments& run) {
   const std::vector<std::string> written = outputs.paths();
   outputs.commit();
   if (!run.quiet)
-    printSummary(written, field.width, field.height, static_cast<int>(observers.size()), "exact", seconds, device.name,
+    printSummary(written, field.width, field.height, static_cast<int>(observers.size()), methodName(Command::Viewshed, run),
+                 seconds, device.name,
                  note + (lit.flipped ? " (computed north-up)" : ""), "observer");
   return 0;
 }

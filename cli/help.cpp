@@ -323,7 +323,7 @@ std::string commandHelp(Command command) {
                  "hfvis viewshed IN -o OUT.exr --observer COL,ROW [--observer COL,ROW ...] [--observers FILE.csv]\n"
                  "               [--observer-height H] [--target-height T] [--absolute] [--max-distance D]\n"
                  "               [--curvature] [--refraction K] [--fov FROM,TO] [--elevation-range LO,HI]\n"
-                 "               [--angle] [--needed-height] [--method exact] [options]\n\n"
+                 "               [--angle] [--needed-height] [--method exact|culled] [--cull-level K] [options]\n\n"
                  "What an observer standing on grid point COL,ROW (zero-based) sees: channel \"visible\" is 1\n"
                  "where a target standing T (default 0) above the surface is seen from the eye H (default 2)\n"
                  "above the surface (--absolute: at height H), 0 where it is hidden or out of range, NaN at\n"
@@ -340,7 +340,11 @@ std::string commandHelp(Command command) {
                  "Several observers (--observer repeated, and / or --observers FILE.csv with columns\n"
                  "col,row[,height], a header line allowed): channel \"count\", how many of them see each\n"
                  "point (a cumulative viewshed); a row's height replaces --observer-height. An observer\n"
-                 "outside the field or on nodata is an error. --method exact is the only method so far.\n"
+                 "outside the field or on nodata is an error.\n"
+                 "--method culled first builds Stewart's culling pyramid (horizons swept in 128 directions,\n"
+                 "occlusion regions per point and sector combined up a quadtree, nodes of 2^K x 2^K points\n"
+                 "from --cull-level K, default 2) and skips the targets of every node it shows hidden: the\n"
+                 "same result as --method exact; worth it for many observers, where one pyramid serves all.\n"
                  "The preview shows the visible points (or the count) bright over a dimmed hillshade.\n") +
              kOptions + kConventions + kExitStatus;
     case Command::SunPosition:

@@ -364,12 +364,56 @@ inline size_t bound_index(__global const uint* offsets, int rays, int ray_major,
 // The widening is L * angle, L the surface's slope bound around the cell
 // (|s difference| <= L * arc between two lines at one distance, arc = distance * angle), valid
 // while the arc stays within one pixel of the ray.
+// viewshed_ray_need, one work-item per node of the culling pyramid's finest level (leaf: nodes
+// across, down, first node's index, k): where the pyramid culled nodes, the rays need not reach
+// them. need[r] (from -1) is raised to the last entry of ray r that a target of a kept node may
+// read: the targets' rays lie on either side of their sight lines, within the border positions
+// of the node's corners (a rectangle's angular extent from an eye outside it, less than a half
+// turn), and read entries below their distance / spacing. A node holding the eye needs every
+// ray whole.
+__kernel void viewshed_ray_need(__global const uchar* culled, int4 leaf, Field f, int ex_i, int ey_i, int4 box,
+                                int rays, float spacing, __global int* need) {
+  const int nx = get_global_id(0), ny = get_global_id(1);
+  if (nx >= leaf.x || ny >= leaf.y) return;
+  if (culled[(size_t)leaf.z + (size_t)ny * leaf.x + nx]) return;
+  const int side = 1 << leaf.w;
+  const int x0 = max(nx * side, box.x), y0 = max(ny * side, box.y);
+  const int x1 = min(min(nx * side + side, f.width) - 1, box.z), y1 = min(min(ny * side + side, f.height) - 1, box.w);
+  if (x0 > x1 || y0 > y1) return;  // outside the box: out of range
+  const float far_x = fmax(fabs((float)(x0 - ex_i)), fabs((float)(x1 - ex_i))) * f.cell_x;
+  const float far_y = fmax(fabs((float)(y0 - ey_i)), fabs((float)(y1 - ey_i))) * f.cell_y;
+  const int q = (int)(sqrt(far_x * far_x + far_y * far_y) / spacing) + 1;
+  if (ex_i >= x0 && ex_i <= x1 && ey_i >= y0 && ey_i <= y1) {
+    for (int r = 0; r < rays; ++r) atomic_max(&need[r], q);
+    return;
+  }
+  float pos[4];
+  pos[0] = border_position(ex_i, ey_i, x0 - ex_i, y0 - ey_i, box);
+  pos[1] = border_position(ex_i, ey_i, x1 - ex_i, y0 - ey_i, box);
+  pos[2] = border_position(ex_i, ey_i, x0 - ex_i, y1 - ey_i, box);
+  pos[3] = border_position(ex_i, ey_i, x1 - ex_i, y1 - ey_i, box);
+  // The corners' positions span the node's: the least circular extent from one of them.
+  float start = pos[0], extent = (float)rays;
+  for (int i = 0; i < 4; ++i) {
+    float e = 0.0f;
+    for (int j = 0; j < 4; ++j) {
+      float d = pos[j] - pos[i];
+      if (d < 0.0f) d += rays;
+      e = fmax(e, d);
+    }
+    if (e < extent) start = pos[i], extent = e;
+  }
+  const int first = (int)floor(start), last = (int)floor(start + extent) + 1;
+  for (int r = first; r <= last; ++r) atomic_max(&need[((r % rays) + rays) % rays], q);
+}
+
 __kernel void viewshed_rays(__global const float* h, Field f, __global const float* lipschitz, float ex, float ey,
                             float ze, int4 box, int rays, __global const uint* offsets, int ray_major, float spacing,
-                            __global float2* bounds) {
+                            __global const int* need, int use_need, __global float2* bounds) {
   const int r = get_global_id(0);
   if (r >= rays) return;
-  const int count = offsets[r + 1] - offsets[r];
+  // With the culling pyramid, only the entries the kept nodes' targets read.
+  const int count = use_need ? min((int)(offsets[r + 1] - offsets[r]), need[r] + 1) : offsets[r + 1] - offsets[r];
   if (count <= 0) return;
   const float angle = fmax(ray_angle(ex, ey, (r + rays - 1) % rays, r, box, f), ray_angle(ex, ey, r, (r + 1) % rays, box, f));
   const float2 end = border_point(r, box);

@@ -97,6 +97,7 @@ class ViewshedRun {
     const float ze = static_cast<float>(options_.absolute ? o.height
                                                           : heights_[static_cast<std::size_t>(o.row) * field_.width + o.col] + o.height);
     const cl_int4 box = targetBox(field_, o, options_.max_distance);
+    const cl_int4 cull_leaf = cull(o, ze);
     const int w1 = box.s[2] - box.s[0], h1 = box.s[3] - box.s[1];
     int rays = 0;
     float spacing = 0.0f;
@@ -134,6 +135,25 @@ class ViewshedRun {
       // Kept by the context: a cumulative viewshed's observers need about the same, and on a CPU
       // a fresh buffer of this size costs its first touch every time.
       bounds = st_.reusableBuffer("viewshed ray bounds", std::max<std::size_t>(entries, 1) * sizeof(cl_float2));
+      // With the culling pyramid: how far each ray must go to serve the kept nodes' targets.
+      cl::Buffer need = detail::deviceBuffer(st_, sizeof(cl_int));
+      if (cull_leaf.s[0] > 0) {
+        need = detail::deviceBuffer(st_, rays * sizeof(cl_int));
+        st_.queue.enqueueFillBuffer(need, cl_int(-1), 0, rays * sizeof(cl_int));
+        cl::Kernel n(program_, "viewshed_ray_need");
+        int a = 0;
+        n.setArg(a++, culled_);
+        n.setArg(a++, cull_leaf);
+        n.setArg(a++, device_);
+        n.setArg(a++, o.col);
+        n.setArg(a++, o.row);
+        n.setArg(a++, box);
+        n.setArg(a++, rays);
+        n.setArg(a++, spacing);
+        n.setArg(a++, need);
+        st_.launch(n, cl::NDRange(detail::roundUp(cull_leaf.s[0], detail::kTileX), detail::roundUp(cull_leaf.s[1], detail::kTileY)),
+                   cl::NDRange(detail::kTileX, detail::kTileY));
+      }
       cl::Kernel k(program_, "viewshed_rays");
       int a = 0;
       k.setArg(a++, heights_buffer_);
@@ -147,10 +167,11 @@ class ViewshedRun {
       k.setArg(a++, offsets);
       k.setArg(a++, ray_major ? 1 : 0);
       k.setArg(a++, spacing);
+      k.setArg(a++, need);
+      k.setArg(a++, cull_leaf.s[0] > 0 ? 1 : 0);
       k.setArg(a++, bounds);
       st_.launch(k, cl::NDRange(detail::roundUp(rays, detail::kLineGroup)), cl::NDRange(detail::kLineGroup));
     }
-    const cl_int4 cull_leaf = cull(o, ze);
     // The field of view's span clockwise; 0 (equal azimuths, or 0 and 360) is the whole circle.
     double az_span = std::fmod(options_.azimuth_to_deg - options_.azimuth_from_deg, 360.0);
     if (az_span < 0.0) az_span += 360.0;

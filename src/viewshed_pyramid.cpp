@@ -8,6 +8,7 @@
 #include <cfloat>
 #include <cmath>
 #include <limits>
+#include <functional>
 #include <string>
 #include <thread>
 
@@ -20,8 +21,8 @@ namespace hfvis {
 namespace {
 
 constexpr double kTwoPi = 2.0 * M_PI;
-// The horizon planes one sweep call may hand back at once (three calls' horizon points, 1.5
-// times as large, are held).
+// The horizon planes one sweep call may hand back at once (three calls' blockers, twice as
+// large, are held).
 constexpr std::size_t kPlaneBytes = std::size_t(1) << 28;
 
 // Rounded toward -inf / +inf: a stored bound never claims more than the double it came from.
@@ -78,8 +79,8 @@ class SlopePyramid {
     const int cx1 = std::clamp(static_cast<int>(std::floor(x + radius)), 0, cells_x_ - 1);
     const int cy0 = std::clamp(static_cast<int>(std::floor(y - radius)), 0, cells_y_ - 1);
     const int cy1 = std::clamp(static_cast<int>(std::floor(y + radius)), 0, cells_y_ - 1);
-    std::size_t k = 0;
-    while (k + 1 < levels_.size() && (1 << k) <= radius) ++k;  // at most 3 blocks a side
+    // The level whose blocks are longer than the radius: at most 3 blocks a side.
+    const std::size_t k = std::min(levels_.size() - 1, radius < 1.0 ? std::size_t(0) : std::size_t(std::ilogb(radius) + 1));
     const int w = (cells_x_ + (1 << k) - 1) >> k;
     float m = 0.0f;
     for (int j = cy0 >> k; j <= cy1 >> k; ++j)
@@ -189,121 +190,138 @@ ViewshedPyramid buildViewshedPyramid(const ComputeContext& context, const Height
   const int per_call = directions / calls;
   const double c_drop = options.curvature;
 
-  // Horizon points: per direction and receiver, where the receiver's horizon point B lies from
-  // it (pixels) and B's height (NaN: no horizon point, or a slope's own at the receiver).
+  // Every gap between neighbouring directions is at most the nominal spacing plus twice the
+  // sweep's azimuth tolerance (checked below).
+  const double gap_bound = kTwoPi / directions + 2.0 * horizon.azimuth_tolerance;
+
+  // Horizon points of one direction: per receiver, where its horizon point B lies from it
+  // (pixels) and B's height (NaN: no horizon point, or a slope's own at the receiver).
   struct HorizonPoints {
-    double azimuth = 0.0;
     std::vector<float> ox, oy, zb;
   };
-  auto horizonPoints = [&](const HorizonResult& r) {
-    std::vector<HorizonPoints> out(per_call);
-    for (int k = 0; k < per_call; ++k) {
-      HorizonPoints& hp = out[k];
-      hp.azimuth = r.azimuths[k];
-      hp.ox.resize(plane);
-      hp.oy.resize(plane);
-      hp.zb.resize(plane);
-      const double ux = std::cos(hp.azimuth) / cx, uy = std::sin(hp.azimuth) / cy;
-      for (std::size_t at = 0; at < plane; ++at) {
-        const double dn = r.distances[k * plane + at], theta = r.angles[k * plane + at];
-        const float h = field.heights[at];
-        const bool valid = dn > 0.0 && std::isfinite(theta) && std::fabs(theta) < 0.5 * M_PI && std::isfinite(h);
-        hp.ox[at] = static_cast<float>(dn * ux);
-        hp.oy[at] = static_cast<float>(dn * uy);
-        hp.zb[at] = valid ? static_cast<float>(h * field.z_scale + std::tan(theta) * dn + c_drop * dn * dn) : NAN;
+  auto horizonPoints = [&](const HorizonResult& r, int k, HorizonPoints& hp) {
+    hp.ox.resize(plane);
+    hp.oy.resize(plane);
+    hp.zb.resize(plane);
+    const double ux = std::cos(r.azimuths[k]) / cx, uy = std::sin(r.azimuths[k]) / cy;
+    for (std::size_t at = 0; at < plane; ++at) {
+      const double dn = r.distances[k * plane + at], theta = r.angles[k * plane + at];
+      const float h = field.heights[at];
+      const bool valid = dn > 0.0 && std::isfinite(theta) && std::fabs(theta) < 0.5 * M_PI && std::isfinite(h);
+      hp.ox[at] = static_cast<float>(dn * ux);
+      hp.oy[at] = static_cast<float>(dn * uy);
+      hp.zb[at] = valid ? static_cast<float>(h * field.z_scale + std::tan(theta) * dn + c_drop * dn * dn) : NAN;
+    }
+  };
+  // The blockers of one direction, per point P: for eyes within half a gap of the direction and
+  // within a whole gap, the bound on their slope from P (-inf: none) and the distance they must
+  // lie beyond. Candidates: the horizon points of P and of its 8 neighbours (any surface point
+  // whose height is known blocks, and a neighbour's horizon point often stands where P's own
+  // horizon is its own slope), each taken where it lies from P, its azimuth `off` from the
+  // direction's. An eye within `spread` of B's azimuth at ground distance r > d, its slope from
+  // P below slope(B) - L spread - margin / d, is hidden: the sight line passes within
+  // d spread of B, where the surface lies at most L d spread lower. A blocker nearer than 2
+  // pixels is too near the target for the exact test's rounding to show it reliably.
+  struct Blockers {
+    double azimuth = 0.0;
+    std::vector<float> half_sigma, half_d, whole_sigma, whole_d;
+  };
+  auto blockersOf = [&](const HorizonPoints& hp, double azimuth, Blockers& out, int y0, int y1) {
+    const double ca = std::cos(azimuth), sa = std::sin(azimuth);
+    for (int y = y0; y < y1; ++y)
+      for (int x = 0; x < width; ++x) {
+        const std::size_t p = std::size_t(y) * width + x;
+        double half = -INFINITY, half_d = 0.0, whole = -INFINITY, whole_d = 0.0;
+        const double zp = field.heights[p] * field.z_scale + target;
+        if (std::isfinite(zp))
+          for (int j = std::max(0, y - 1); j <= std::min(height - 1, y + 1); ++j)
+            for (int i = std::max(0, x - 1); i <= std::min(width - 1, x + 1); ++i) {
+              const std::size_t at = std::size_t(j) * width + i;
+              const double zb = hp.zb[at];
+              if (!std::isfinite(zb)) continue;
+              const double bx = i + hp.ox[at], by = j + hp.oy[at];
+              const double gx = (bx - x) * cx, gy = (by - y) * cy;
+              const double d = std::sqrt(gx * gx + gy * gy);
+              if (!(d >= 2.0 * most_cell) || ca * gx + sa * gy <= 0.0) continue;
+              const double slope = (zb - c_drop * d * d - zp) / d;
+              if (slope <= whole) continue;  // its bounds lie below slope: it cannot do better
+              const double sine = std::min(1.0, std::fabs(ca * gy - sa * gx) / d);
+              const double off = sine <= 0.5 ? sine + 0.2 * sine * sine * sine : std::asin(sine);  // >= asin(sine)
+              const double L = slopes.around(bx, by, d * (gap_bound + off) / least_cell + 1.0);
+              if (!std::isfinite(L)) continue;
+              // The margin: the heights' rounding, the exact test's (its vertex test skipped on
+              // pieces under 1e-3 pixel) and the float angle's.
+              const double margin =
+                  z_margin + 2e-3 * most_cell * (L + std::fabs(slope) + 1.0) + 4e-7 * d * (1.0 + slope * slope);
+              const double base = slope - margin / d - L * off;
+              if (base - L * 0.5 * gap_bound > half) half = base - L * 0.5 * gap_bound, half_d = d + most_cell;
+              if (base - L * gap_bound > whole) whole = base - L * gap_bound, whole_d = d + most_cell;
+            }
+        out.half_sigma[p] = roundDown(half);
+        out.half_d[p] = roundUp(half_d);
+        out.whole_sigma[p] = roundDown(whole);
+        out.whole_d[p] = roundUp(whole_d);
       }
+  };
+  // Runs body(first, last) over bands of rows (or of the finest nodes' rows) on the threads.
+  auto parallel = [&](int count, const std::function<void(int, int)>& body) {
+    std::vector<std::thread> pool;
+    for (unsigned t = 0; t < threads; ++t) {
+      const int first = static_cast<int>(count * t / threads), last = static_cast<int>(count * (t + 1) / threads);
+      if (first < last) pool.emplace_back(body, first, last);
+    }
+    for (std::thread& t : pool) t.join();
+  };
+  auto blockers = [&](const HorizonResult& r) {
+    std::vector<Blockers> out(per_call);
+    HorizonPoints hp;
+    for (int k = 0; k < per_call; ++k) {
+      horizonPoints(r, k, hp);
+      Blockers& b = out[k];
+      b.azimuth = r.azimuths[k];
+      for (auto* v : {&b.half_sigma, &b.half_d, &b.whole_sigma, &b.whole_d}) v->resize(plane);
+      parallel(height, [&](int y0, int y1) { blockersOf(hp, b.azimuth, b, y0, y1); });
     }
     return out;
-  };
-  // The best blocker for eyes near direction `hp` from point (x, y) (height zp), for eyes within
-  // half the gap and within all of it of that direction. Candidates: the horizon points of the
-  // point and of its 8 neighbours (any surface point whose height is known blocks: a
-  // neighbour's horizon point often stands where the point's own horizon is its own slope),
-  // each taken where it lies from the point, its azimuth `off` from the direction's. An eye
-  // within `spread` of B's azimuth at ground distance r > d, its slope from P below
-  // slope(B) - L spread - margin / d, is hidden: the sight line passes within d spread of B,
-  // where the surface lies at most L d spread lower. A blocker nearer than 2 pixels is too
-  // near the target for the exact test's rounding to show it reliably.
-  struct Blocker {
-    double sigma = -INFINITY, d = 0.0;
-  };
-  struct Blockers {
-    Blocker half, whole;
-  };
-  auto blockers = [&](const HorizonPoints& hp, int x, int y, double zp, double gap) {
-    Blockers best;
-    const double ca = std::cos(hp.azimuth), sa = std::sin(hp.azimuth);
-    for (int j = std::max(0, y - 1); j <= std::min(height - 1, y + 1); ++j)
-      for (int i = std::max(0, x - 1); i <= std::min(width - 1, x + 1); ++i) {
-        const std::size_t at = std::size_t(j) * width + i;
-        const double zb = hp.zb[at];
-        if (!std::isfinite(zb)) continue;
-        const double bx = i + hp.ox[at], by = j + hp.oy[at];
-        const double gx = (bx - x) * cx, gy = (by - y) * cy;
-        const double d = std::sqrt(gx * gx + gy * gy);
-        if (!(d >= 2.0 * most_cell) || ca * gx + sa * gy <= 0.0) continue;
-        const double sine = std::min(1.0, std::fabs(ca * gy - sa * gx) / d);
-        const double off = sine <= 0.5 ? sine + 0.2 * sine * sine * sine : std::asin(sine);  // >= asin(sine)
-        const double L = slopes.around(bx, by, d * (gap + off) / least_cell + 1.0);
-        if (!std::isfinite(L)) continue;
-        const double slope = (zb - c_drop * d * d - zp) / d;
-        // The margin: the heights' rounding, the exact test's (its vertex test skipped on
-        // pieces under 1e-3 pixel) and the float angle's.
-        const double margin = z_margin + 2e-3 * most_cell * (L + std::fabs(slope) + 1.0) + 4e-7 * d * (1.0 + slope * slope);
-        const double base = slope - margin / d - L * off;
-        const Blocker half{base - L * 0.5 * gap, d + most_cell}, whole{base - L * gap, d + most_cell};
-        if (half.sigma > best.half.sigma) best.half = half;
-        if (whole.sigma > best.whole.sigma) best.whole = whole;
-      }
-    return best;
   };
   // Folds the gaps from the directions of call ca (a) to their neighbours counter-clockwise (b;
   // next: b's direction k + 1 follows a's k) into the finest nodes. An eye in the gap is within
   // half of it of one of its two directions and within all of it of either: the gap's region
   // is the better of "both, half the gap each" and "one of them, the whole gap".
-  auto foldGaps = [&](const std::vector<HorizonPoints>& a, int ca, const std::vector<HorizonPoints>& b, bool next,
-                      int band_first, int band_last) {
-    for (int k = 0; k < per_call; ++k) {
-      const int j = k * calls + ca, kb = next ? (k + 1) % per_call : k;
-      const int s = j / per;
-      double gap = std::fmod(b[kb].azimuth - a[k].azimuth, kTwoPi);
-      if (gap < 0.0) gap += kTwoPi;
-      for (int y = band_first << k0; y < std::min(height, (band_last + 1) << k0); ++y)
-        for (int x = 0; x < width; ++x) {
-          const float h = field.heights[std::size_t(y) * width + x];
-          if (!std::isfinite(h)) continue;
-          const double zp = h * field.z_scale + target;
-          float* region = &regions[((std::size_t(y >> k0) * nodes_x + (x >> k0)) * sectors + s) * kFloats];
-          region[1] = std::min(region[1], roundDown(zp));
-          const Blockers from_a = blockers(a[k], x, y, zp, gap), from_b = blockers(b[kb], x, y, zp, gap);
-          Blocker best{std::min(from_a.half.sigma, from_b.half.sigma), std::max(from_a.half.d, from_b.half.d)};
-          for (const Blocker& one : {from_a.whole, from_b.whole})
-            if (one.sigma > best.sigma) best = one;
-          if (std::isfinite(best.sigma)) region[0] = std::max(region[0], roundUp(best.d));
-          for (int i = 1; i < ViewshedPyramid::kBreakpoints; ++i)
-            region[1 + i] = std::min(region[1 + i], std::isfinite(best.sigma) ? roundDown(zp + best.sigma * breaks[i])
-                                                                           : -INFINITY);
-        }
-    }
-  };
-  auto parallelFold = [&](const std::vector<HorizonPoints>& a, int ca, const std::vector<HorizonPoints>& b, bool next) {
-    std::vector<std::thread> pool;
-    const int bands = static_cast<int>(threads);
-    for (int band = 0; band < bands; ++band) {
-      const int first = nodes_y * band / bands, last = nodes_y * (band + 1) / bands - 1;
-      if (first <= last) pool.emplace_back(foldGaps, std::cref(a), ca, std::cref(b), next, first, last);
-    }
-    for (std::thread& t : pool) t.join();
+  auto foldGaps = [&](const std::vector<Blockers>& a, int ca, const std::vector<Blockers>& b, bool next) {
+    parallel(nodes_y, [&](int band_first, int band_last) {
+      for (int k = 0; k < per_call; ++k) {
+        const int j = k * calls + ca, kb = next ? (k + 1) % per_call : k;
+        const int s = j / per;
+        const Blockers &from_a = a[k], &from_b = b[kb];
+        for (int y = band_first << k0; y < std::min(height, band_last << k0); ++y)
+          for (int x = 0; x < width; ++x) {
+            const std::size_t p = std::size_t(y) * width + x;
+            const float h = field.heights[p];
+            if (!std::isfinite(h)) continue;
+            const double zp = h * field.z_scale + target;
+            float* region = &regions[((std::size_t(y >> k0) * nodes_x + (x >> k0)) * sectors + s) * kFloats];
+            region[1] = std::min(region[1], roundDown(zp));
+            double sigma = std::min(from_a.half_sigma[p], from_b.half_sigma[p]);
+            double d = std::max(from_a.half_d[p], from_b.half_d[p]);
+            for (const Blockers* one : {&from_a, &from_b})
+              if (one->whole_sigma[p] > sigma) sigma = one->whole_sigma[p], d = one->whole_d[p];
+            if (std::isfinite(sigma)) region[0] = std::max(region[0], static_cast<float>(d));
+            for (int i = 1; i < ViewshedPyramid::kBreakpoints; ++i)
+              region[1 + i] = std::min(region[1 + i], std::isfinite(sigma) ? roundDown(zp + sigma * breaks[i]) : -INFINITY);
+          }
+      }
+    });
   };
   // Call c holds directions k * calls + c: the gaps run from call c - 1 to call c, and from the
-  // last call to the first's next direction. The first call's points are kept to the end.
-  std::vector<HorizonPoints> first, previous;
+  // last call to the first's next direction. The first call's blockers are kept to the end.
+  std::vector<Blockers> first, previous;
   for (int c = 0; c < calls; ++c) {
     horizon.azimuth_offset = kTwoPi * c / directions;
-    std::vector<HorizonPoints> r = horizonPoints(computeHorizons(context, field, horizon, outputs));
+    std::vector<Blockers> r = blockers(computeHorizons(context, field, horizon, outputs));
     for (int k = 0; k < per_call; ++k) azimuth[k * calls + c] = r[k].azimuth;
-    if (c > 0) parallelFold(c == 1 ? first : previous, c - 1, r, false);
-    if (c == calls - 1) parallelFold(r, c, c == 0 ? r : first, true);
+    if (c > 0) foldGaps(c == 1 ? first : previous, c - 1, r, false);
+    if (c == calls - 1) foldGaps(r, c, c == 0 ? r : first, true);
     if (c == 0)
       first = std::move(r);
     else
@@ -312,6 +330,11 @@ ViewshedPyramid buildViewshedPyramid(const ComputeContext& context, const Height
   }
   // The sectors: from the azimuth of their first direction to that of their last (the next
   // sector's first).
+  for (int j = 0; j < directions; ++j) {
+    double g = std::fmod(azimuth[(j + 1) % directions] - azimuth[j], kTwoPi);
+    if (g < 0.0) g += kTwoPi;
+    if (g > gap_bound) throw InvalidArgument("the sweep's azimuths lie farther apart than its tolerance allows (internal error)");
+  }
   for (int s = 0; s < sectors; ++s) {
     const double a0 = azimuth[s * per];
     double w = std::fmod(azimuth[((s + 1) * per) % directions] - a0, kTwoPi);

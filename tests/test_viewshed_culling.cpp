@@ -47,9 +47,12 @@ Culling checkCulling(const ComputeContext& context, const HeightField& f, const 
   culled.pyramid = &pyramid;
   ViewshedOutputs outputs;
   outputs.angle = true;
-  const ViewshedResult exact = computeViewshed(context, f, o, plain, outputs);
   outputs.culled_mask = true;
+  // The culled one first: the rays' bounds buffer the context keeps then holds another
+  // observer's, which the culled viewshed must not read (its rays stop short where it culls).
   const ViewshedResult got = computeViewshed(context, f, o, culled, outputs);
+  outputs.culled_mask = false;
+  const ViewshedResult exact = computeViewshed(context, f, o, plain, outputs);
   // The kernel's query against the scalar one: it culls nothing the scalar one keeps (its float
   // rounding is widened the conservative way) and keeps few that it culls.
   const std::vector<float> want = referenceCulledMask(f, pyramid, o, plain);
