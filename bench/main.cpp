@@ -25,6 +25,10 @@
 //                                  [--samples N] [--seed S] RASTER...
 //       viewshed rasters (visible where > 0) against the exact sight-line test at N random targets:
 //       the Jaccard index of the visible sets and the disagreements that graze
+//   hfvis_bench viewshed-culling [--levels 1,2,3,4] [--reps N] FIELD...
+//       Stewart's culling pyramid per field: preprocessing time, memory per finest level kept, and
+//       for valley, ground-level and high observers the culled shares and the exact and culled
+//       viewsheds' times (interleaved, the fastest of N)
 //   hfvis_bench inputs [--quick]
 //       the generated fields both suites read, one "<content> <N>" per line
 //   hfvis_bench check-truth
@@ -58,6 +62,7 @@
 #include "suite.hpp"
 #include "suite_support.hpp"
 #include "viewshed_agreement.hpp"
+#include "viewshed_culling.hpp"
 
 namespace {
 
@@ -77,6 +82,7 @@ constexpr const char* kUsage =
     "                           [--zone-steps S] [--reps N]\n"
     "       hfvis_bench viewshed-agreement DEM --observer COL,ROW [--observer-height H] [--target-height T]\n"
     "                                      [--samples N] [--seed S] RASTER...\n"
+    "       hfvis_bench viewshed-culling [--levels 1,2,3,4] [--reps N] FIELD...\n"
     "       hfvis_bench inputs [--quick]\n"
     "       hfvis_bench check-truth\n"
     "       hfvis_bench vectorize-report\n"
@@ -393,6 +399,18 @@ int main(int argc, char** argv) {
     if (command == "lighting-time") return lightingTime(args);
     if (command == "lighting-error") return lightingError(args);
     if (command == "viewshed-agreement") return viewshedAgreementCommand(args);
+    if (command == "viewshed-culling") {
+      const std::vector<int> levels = intList(args.get("--levels", "1,2,3,4"));
+      const int reps = std::stoi(args.get("--reps", "3"));
+      const std::vector<std::string> fields = args.positional();
+      args.rejectUnused();
+      if (fields.empty()) throw Usage("viewshed-culling needs FIELD...");
+      for (int k : levels)
+        if (k < 1 || k > 12) throw Usage("--levels: finest levels are 1 .. 12");
+      const ComputeContext context = ComputeContext::create(ContextOptions::fromEnvironment());
+      for (const std::string& path : fields) viewshedCullingReport(context, path, levels, reps);
+      return 0;
+    }
     if (command == "inputs") {
       const std::string mode = args.flag("--quick") ? "quick" : "full";
       std::set<std::pair<std::string, int>> inputs;
