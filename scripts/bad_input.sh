@@ -163,7 +163,9 @@ try "viewshed observer not a pair" "" -- viewshed field.exr -o out/o.exr --obser
 try "viewshed observers file missing" "" -- viewshed field.exr -o out/o.exr --observers nowhere.csv
 try "viewshed observers file not CSV" "" -- viewshed field.exr -o out/o.exr --observers garbage.exr
 try "viewshed target below the surface" "" -- viewshed field.exr -o out/o.exr --observer 3,3 --target-height -1
-try "viewshed culled (not built yet)" "" -- viewshed field.exr -o out/o.exr --observer 3,3 --method culled
+try "viewshed method unknown" "" -- viewshed field.exr -o out/o.exr --observer 3,3 --method stewart
+try "viewshed cull level 0" "" -- viewshed field.exr -o out/o.exr --observer 3,3 --method culled --cull-level 0
+try "viewshed cull level without culling" "" -- viewshed field.exr -o out/o.exr --observer 3,3 --cull-level 3
 try "viewshed angle for several observers" "" -- viewshed field.exr -o out/o.exr --observer 3,3 --observer 4,4 --angle
 try "sun position without a time" "" -- sunpos --lat 45 --lon 7
 try "sun position at a time without a zone" "" -- sunpos --lat 45 --lon 7 --at 2026-06-21T12:00:00

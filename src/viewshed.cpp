@@ -434,7 +434,20 @@ void validateViewshed(const HeightField& field, const ViewshedOptions& options) 
                             ", the viewshed asks " + std::to_string(options.target_height));
     if (p->curvature != options.curvature)
       throw InvalidArgument("the culling pyramid was built for another curvature coefficient");
-    if (p->levels.empty() || p->sectors <= 0) throw InvalidArgument("the culling pyramid is empty");
+    // Its shape, as buildViewshedPyramid makes it (the kernels index by it).
+    bool shaped = p->sectors > 0 && p->sector_start.size() == static_cast<std::size_t>(p->sectors) &&
+                  p->sector_width.size() == p->sector_start.size() && !p->levels.empty() && p->reach > 0.0;
+    for (std::size_t l = 0; shaped && l < p->levels.size(); ++l) {
+      const ViewshedPyramid::Level& level = p->levels[l];
+      const int k = level.k, side = 1 << std::clamp(k, 0, 30);
+      shaped = k >= 1 && k <= 30 && (l == 0 || k == p->levels[l - 1].k + 1) &&
+               level.nodes_x == (field.width + side - 1) / side && level.nodes_y == (field.height + side - 1) / side &&
+               level.regions.size() == static_cast<std::size_t>(level.nodes_x) * level.nodes_y * p->sectors *
+                                           ViewshedPyramid::kRegionFloats;
+    }
+    shaped = shaped && p->levels.back().nodes_x == 1 && p->levels.back().nodes_y == 1 &&
+             p->valid_points.size() == static_cast<std::size_t>(p->levels.front().nodes_x) * p->levels.front().nodes_y;
+    if (!shaped) throw InvalidArgument("the culling pyramid is malformed (its levels, sectors or regions)");
   }
 }
 

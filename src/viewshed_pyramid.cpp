@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cfloat>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <functional>
 #include <string>
@@ -113,9 +114,10 @@ std::size_t ViewshedPyramid::bytes() const {
 
 std::uint64_t heightsFingerprint(const HeightField& field) {
   std::uint64_t hash = 1469598103934665603ull;
-  const auto* bytes = reinterpret_cast<const unsigned char*>(field.heights.data());
-  for (std::size_t i = 0, n = field.heights.size() * sizeof(float); i < n; ++i) {
-    hash ^= bytes[i];
+  for (float h : field.heights) {
+    std::uint32_t bits;
+    std::memcpy(&bits, &h, sizeof bits);
+    hash ^= bits;
     hash *= 1099511628211ull;
   }
   return hash;

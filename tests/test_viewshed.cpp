@@ -212,8 +212,6 @@ TEST(Viewshed, OptionsMatchBruteForce) {
   ViewshedOptions tiny;
   tiny.memory_budget = 16;
   EXPECT_EQ(computeViewshed(testContext(), f, o, tiny).visible, computeViewshed(testContext(), f, o, {}).visible);
-  forEachLayout([&](const ComputeContext&) {
-  });
 }
 
 TEST(Viewshed, CurvatureHidesFlatGroundBeyondTheHorizon) {

@@ -280,6 +280,18 @@ TEST(ViewshedCulling, BadInputIsRefused) {
   other.z_scale = 2.0;
   EXPECT_THROW(computeViewshed(testContext(), other, o, options), InvalidArgument);
   EXPECT_THROW(computeCumulativeViewshed(testContext(), other, {o}, options), InvalidArgument);
+  // A pyramid altered out of the shape buildViewshedPyramid gives it.
+  for (auto alter : std::vector<std::function<void(ViewshedPyramid&)>>{
+           [](ViewshedPyramid& p) { p.levels.front().regions.pop_back(); },
+           [](ViewshedPyramid& p) { p.sector_start.pop_back(); }, [](ViewshedPyramid& p) { p.levels.pop_back(); },
+           [](ViewshedPyramid& p) { p.levels.front().nodes_x += 1; }, [](ViewshedPyramid& p) { p.valid_points.clear(); },
+           [](ViewshedPyramid& p) { p.sectors = 0; }, [](ViewshedPyramid& p) { p.levels.clear(); }}) {
+    ViewshedPyramid bad = pyramid;
+    alter(bad);
+    ViewshedOptions with = options;
+    with.pyramid = &bad;
+    EXPECT_THROW(computeViewshed(testContext(), f, o, with), InvalidArgument);
+  }
   ViewshedOutputs mask;
   mask.culled_mask = true;
   EXPECT_THROW(computeViewshed(testContext(), f, o, {}, mask), InvalidArgument);  // no pyramid

@@ -177,7 +177,7 @@ struct ViewshedPyramid {
 ViewshedPyramid buildViewshedPyramid(const ComputeContext& context, const HeightField& field,
                                      const ViewshedPyramidOptions& options);
 
-// The fingerprint queries compare: FNV-1a over the heights' bytes.
+// The fingerprint queries compare: FNV-1a over the heights, 32 bits at a time.
 std::uint64_t heightsFingerprint(const HeightField& field);
 
 // Throws InvalidArgument for a negative or non-finite target height or maximum distance, a
@@ -191,7 +191,7 @@ void validate(const HeightField& field, const Observer& observer);
 
 // The viewshed of one observer. Throws InvalidArgument (bad field, observer or options, a
 // latitude / longitude grid, a field of 2^31 points or more, a pyramid built for another field,
-// target height or curvature), MemoryBudgetError, OpenClError,
+// target height or curvature, or malformed), MemoryBudgetError, OpenClError,
 // KernelBuildError.
 ViewshedResult computeViewshed(const ComputeContext& context, const HeightField& field, const Observer& observer,
                                const ViewshedOptions& options, const ViewshedOutputs& outputs = {});
