@@ -1670,6 +1670,29 @@ TEST_F(Cli, ViewshedSeesOverAWall) {
   EXPECT_EQ(count.at(12, 3, 0), 2.0f);
 }
 
+TEST_F(Cli, ViewshedCulledEqualsExact) {
+  // Walls on flat ground: much lies in their shadows, which the pyramid culls.
+  const std::string field = writeField("walls.exr", 48, 40, [](int col, int row) {
+    return (col == 20 && row > 4) || (row == 30 && col < 40) ? 6.0f : 0.1f * ((col * 7 + row * 3) % 5);
+  });
+  const CliResult exact = run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("e.exr")) + " --observer 30,10");
+  ASSERT_EQ(exact.status, 0) << exact.err;
+  const CliResult culled = run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("c.exr")) +
+                               " --observer 30,10 --method culled --cull-level 1");
+  ASSERT_EQ(culled.status, 0) << culled.err;
+  EXPECT_NE(culled.out.find("culled"), std::string::npos) << culled.out;
+  EXPECT_NE(culled.out.find("% of the points culled"), std::string::npos) << culled.out;
+  const ReadBack e = readBack(out("e.exr")), c = readBack(out("c.exr"));
+  EXPECT_EQ(e.pixels, c.pixels);
+  EXPECT_EQ(c.spec.get_string_attribute("hfvis:method"), "culled");
+  // Several observers share one pyramid.
+  ASSERT_EQ(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("ce.exr")) +
+                " --observer 30,10 --observer 5,35 -q").status, 0);
+  ASSERT_EQ(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("cc.exr")) +
+                " --observer 30,10 --observer 5,35 --method culled -q").status, 0);
+  EXPECT_EQ(readBack(out("ce.exr")).pixels, readBack(out("cc.exr")).pixels);
+}
+
 TEST_F(Cli, ViewshedRefusesBadObservers) {
   const std::string field = flat();
   expectFailure(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr"))), 2, "--observer");
@@ -1679,8 +1702,11 @@ TEST_F(Cli, ViewshedRefusesBadObservers) {
                     " --observer 1,2 --observer 3,4 --angle"),
                 2, "--angle");
   expectFailure(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) +
-                    " --observer 1,2 --method culled"),
-                2, "culled");
+                    " --observer 1,2 --cull-level 2"),
+                2, "--method culled");
+  expectFailure(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) +
+                    " --observer 1,2 --method culled --cull-level 13"),
+                2, "--cull-level");
   expectFailure(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) +
                     " --observer 1,2 --target-height -1"),
                 2, "--target-height");
