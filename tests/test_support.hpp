@@ -46,6 +46,17 @@ void forEachLayout(Body&& body) {
 // none where the device divides correctly rounded (as C++ does), else a few ulp.
 inline float divisionTolerance() { return testContext().device().correctly_rounded_divide ? 0.0f : 2e-6f; }
 
+// The w x h points of f from (x0, y0), with f's cell size and z-scale.
+inline HeightField cropField(const HeightField& f, int x0, int y0, int w, int h) {
+  HeightField out = f;
+  out.width = w;
+  out.height = h;
+  out.heights.resize(static_cast<std::size_t>(w) * h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) out.heights[static_cast<std::size_t>(y) * w + x] = f.at(x0 + x, y0 + y);
+  return out;
+}
+
 // Awkward sizes (CLBlast style): 1x1, 1xN, Nx1, odd, non-square.
 inline const std::vector<std::pair<int, int>>& awkwardSizes() {
   static const std::vector<std::pair<int, int>> sizes = {{1, 1}, {1, 9}, {9, 1}, {7, 13}, {33, 20}, {40, 41}};

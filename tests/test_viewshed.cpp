@@ -22,19 +22,9 @@ namespace {
 using testing::forEachLayout;
 using testing::testContext;
 
-HeightField crop(const HeightField& f, int x0, int y0, int w, int h) {
-  HeightField out = f;
-  out.width = w;
-  out.height = h;
-  out.heights.resize(static_cast<std::size_t>(w) * h);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) out.heights[static_cast<std::size_t>(y) * w + x] = f.at(x0 + x, y0 + y);
-  return out;
-}
-
 HeightField roughTerrain(int w = 97, int h = 83) {
   static const HeightField fractal = readHeightField(std::string(HFVIS_DATA_DIR) + "/fractal_256.exr");
-  return crop(fractal, 40, 60, w, h);
+  return testing::cropField(fractal, 40, 60, w, h);
 }
 
 // Where the field is lowest, highest (ridge / peak) and at its middle.

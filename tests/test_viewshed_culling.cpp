@@ -25,13 +25,7 @@ using testing::testContext;
 
 HeightField fractalCrop(int x0, int y0, int w, int h) {
   static const HeightField fractal = readHeightField(std::string(HFVIS_DATA_DIR) + "/fractal_256.exr");
-  HeightField out = fractal;
-  out.width = w;
-  out.height = h;
-  out.heights.resize(static_cast<std::size_t>(w) * h);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) out.heights[static_cast<std::size_t>(y) * w + x] = fractal.at(x0 + x, y0 + y);
-  return out;
+  return testing::cropField(fractal, x0, y0, w, h);
 }
 
 struct Culling {
@@ -133,13 +127,8 @@ TEST(ViewshedCulling, RoughTerrainCullsOnlyHiddenPoints) {
 
 TEST(ViewshedCulling, RealTerrainCullsAShareOfTheHiddenPoints) {
   // The bundled DEM cropped to 200 x 160, nodes of 4 x 4 points (the default).
-  const HeightField full = readHeightField(std::string(HFVIS_DATA_DIR) + "/jacksboro_fault_dem.exr");
-  HeightField dem = full;
-  dem.width = 200;
-  dem.height = 160;
-  dem.heights.resize(200 * 160);
-  for (int y = 0; y < 160; ++y)
-    for (int x = 0; x < 200; ++x) dem.heights[y * 200 + x] = full.at(100 + x, 80 + y);
+  const HeightField dem =
+      testing::cropField(readHeightField(std::string(HFVIS_DATA_DIR) + "/jacksboro_fault_dem.exr"), 100, 80, 200, 160);
   const ViewshedPyramid pyramid = pyramidFor(testContext(), dem);
   std::size_t culled = 0, hidden = 0;
   for (const Observer& o : std::vector<Observer>{{100, 80, 2.0}, {10, 10, 0.0}, {150, 120, 30.0}}) {
