@@ -606,10 +606,12 @@ __kernel void viewshed_classify(__global const float* h, Field f, int ex_i, int 
     pending[p] = 0;
     return;
   }
-  // Culled by the pyramid (cull_level.x > 0): hidden.
-  const int culled_here =
-      cull_level.x > 0 && culled[(size_t)cull_level.z + (size_t)(y >> cull_level.w) * cull_level.x + (x >> cull_level.w)];
-  if (culled_here && !want_angle) {
+  // Culled by the pyramid (cull_level.x > 0), or outside the box (past the maximum distance):
+  // hidden.
+  const int hidden_at_once =
+      (cull_level.x > 0 && culled[(size_t)cull_level.z + (size_t)(y >> cull_level.w) * cull_level.x + (x >> cull_level.w)]) ||
+      x < box.x || x > box.z || y < box.y || y > box.w;
+  if (hidden_at_once && !want_angle) {
     put_visible(out_visible, p, 0.0f, accumulate);
     pending[p] = 0;
     return;
@@ -631,7 +633,7 @@ __kernel void viewshed_classify(__global const float* h, Field f, int ex_i, int 
   const int q = s.use ? s.q : 0;
   const float lo_a = bounds[s.use ? bound_index(offsets, rays, ray_major, s.a, q) : 0].x;
   const float lo_b = bounds[s.use ? bound_index(offsets, rays, ray_major, s.b, q) : 0].x;
-  const int hidden = culled_here || !in_range || (s.use && s.slope < hf_max(lo_a, lo_b));  // something nearer rises above it
+  const int hidden = hidden_at_once || !in_range || (s.use && s.slope < hf_max(lo_a, lo_b));  // something nearer rises above it
   const int settled = hidden || s.dist == 0.0f;
   if (settled) put_visible(out_visible, p, hidden ? 0.0f : 1.0f, accumulate);
   pending[p] = settled ? 0 : 1;
