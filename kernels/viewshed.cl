@@ -387,23 +387,22 @@ __kernel void viewshed_ray_need(__global const uchar* culled, int4 leaf, Field f
     for (int r = 0; r < rays; ++r) atomic_max(&need[r], q);
     return;
   }
-  float pos[4];
-  pos[0] = border_position(ex_i, ey_i, x0 - ex_i, y0 - ey_i, box);
-  pos[1] = border_position(ex_i, ey_i, x1 - ex_i, y0 - ey_i, box);
-  pos[2] = border_position(ex_i, ey_i, x0 - ex_i, y1 - ey_i, box);
-  pos[3] = border_position(ex_i, ey_i, x1 - ex_i, y1 - ey_i, box);
-  // The corners' positions span the node's: the least circular extent from one of them.
-  float start = pos[0], extent = (float)rays;
+  // The node subtends less than a half turn from the eye, and border positions grow with the
+  // angle clockwise: its rays run from the most counter-clockwise corner's position to the most
+  // clockwise one's (angles measured from the direction to its centre), widened by a ray on each
+  // side for the rounding of targets in line with a corner.
+  const float cx = 0.5f * (x0 + x1) - ex_i, cy = 0.5f * (y0 + y1) - ey_i;
+  float lo_angle = INFINITY, hi_angle = -INFINITY, start = 0.0f, end = 0.0f;
   for (int i = 0; i < 4; ++i) {
-    float e = 0.0f;
-    for (int j = 0; j < 4; ++j) {
-      float d = pos[j] - pos[i];
-      if (d < 0.0f) d += rays;
-      e = fmax(e, d);
-    }
-    if (e < extent) start = pos[i], extent = e;
+    const float vx = (i & 1 ? x1 : x0) - ex_i, vy = (i & 2 ? y1 : y0) - ey_i;
+    const float angle = atan2(cx * vy - cy * vx, cx * vx + cy * vy);
+    const float pos = border_position(ex_i, ey_i, vx, vy, box);
+    if (angle < lo_angle) lo_angle = angle, start = pos;
+    if (angle > hi_angle) hi_angle = angle, end = pos;
   }
-  const int first = (int)floor(start), last = (int)floor(start + extent) + 1;
+  float extent = end - start;
+  if (extent < 0.0f) extent += rays;
+  const int first = (int)floor(start) - 1, last = (int)floor(start + extent) + 2;
   for (int r = first; r <= last; ++r) atomic_max(&need[((r % rays) + rays) % rays], q);
 }
 
@@ -526,9 +525,10 @@ __kernel void viewshed_cull(__global const float* regions, int4 level, int4 pare
     rel -= two_pi * floor(rel / two_pi);
     if (!(rel <= span.y || rel + 2.0f * alpha >= two_pi)) continue;  // the sector is not met
     __global const float* region = regions + (node * sectors + s) * CULL_FLOATS;
-    const float bound = fmin(cull_bound(region, breaks, r_lo), cull_bound(region, breaks, r_hi));
+    const float b_lo = cull_bound(region, breaks, r_lo), b_hi = cull_bound(region, breaks, r_hi);
+    const float bound = b_lo < b_hi ? b_lo : b_hi;  // NaN (past the reach) when either is
     const float margin = 4e-6f * (fabs(ze) + fabs(curve) + fabs(bound) + fabs(region[1])) + 1e-6f;
-    cull = r_lo > region[0] && lhs < bound - margin;
+    cull = !isnan(b_lo) && !isnan(b_hi) && r_lo > region[0] && lhs < bound - margin;
   }
   culled[node] = cull ? 1 : 0;
 }

@@ -445,6 +445,16 @@ void validateViewshed(const HeightField& field, const ViewshedOptions& options) 
                level.regions.size() == static_cast<std::size_t>(level.nodes_x) * level.nodes_y * p->sectors *
                                            ViewshedPyramid::kRegionFloats;
     }
+    // The sectors follow one another around the circle.
+    double around = 0.0;
+    for (int s = 0; shaped && s < p->sectors; ++s) {
+      const double next = p->sector_start[(s + 1) % p->sectors];
+      double step = std::fmod(next - p->sector_start[s], 2.0 * M_PI);
+      if (step < 0.0) step += 2.0 * M_PI;
+      shaped = p->sector_width[s] >= 0.0f && std::fabs(step - p->sector_width[s]) < 1e-5;
+      around += p->sector_width[s];
+    }
+    shaped = shaped && std::fabs(around - 2.0 * M_PI) < 1e-4;
     shaped = shaped && p->levels.back().nodes_x == 1 && p->levels.back().nodes_y == 1 &&
              p->valid_points.size() == static_cast<std::size_t>(p->levels.front().nodes_x) * p->levels.front().nodes_y;
     if (!shaped) throw InvalidArgument("the culling pyramid is malformed (its levels, sectors or regions)");

@@ -17,6 +17,7 @@
 #include "hfvis/horizon.hpp"
 #include "hfvis/viewshed.hpp"
 #include "horizon_common.hpp"
+#include "lattice_geometry.hpp"
 
 namespace hfvis {
 namespace {
@@ -192,19 +193,33 @@ ViewshedPyramid buildViewshedPyramid(const ComputeContext& context, const Height
   const int per_call = directions / calls;
   const double c_drop = options.curvature;
 
-  // Every gap between neighbouring directions is at most the nominal spacing plus twice the
-  // sweep's azimuth tolerance (checked below).
-  const double gap_bound = kTwoPi / directions + 2.0 * horizon.azimuth_tolerance;
+  // The sweep's azimuths (its steps depend on the cell sizes alone, so they are known before it
+  // runs; each call's are checked against them), and per direction the wider of its two gaps:
+  // its blockers serve the gaps on both sides.
+  for (int c = 0; c < calls; ++c) {
+    horizon.azimuth_offset = kTwoPi * c / directions;
+    const std::vector<detail::LatticeDirection> steps =
+        detail::latticeDirections(field, horizon, true, horizon.azimuth_tolerance);
+    for (int k = 0; k < per_call; ++k) azimuth[k * calls + c] = steps[k].azimuth;
+  }
+  std::vector<double> gap(directions), spread(directions);  // gap[j]: from direction j to j + 1
+  for (int j = 0; j < directions; ++j) {
+    gap[j] = std::fmod(azimuth[(j + 1) % directions] - azimuth[j], kTwoPi);
+    if (gap[j] < 0.0) gap[j] += kTwoPi;
+  }
+  for (int j = 0; j < directions; ++j) spread[j] = std::max(gap[j], gap[(j + directions - 1) % directions]) * (1.0 + 1e-9);
 
   // Horizon points of one direction: per receiver, where its horizon point B lies from it
   // (pixels) and B's height (NaN: no horizon point, or a slope's own at the receiver).
   struct HorizonPoints {
     std::vector<float> ox, oy, zb;
+    std::vector<float> zb_error;  // a bound on zb's error from the float angle and distance
   };
   auto horizonPoints = [&](const HorizonResult& r, int k, HorizonPoints& hp) {
     hp.ox.resize(plane);
     hp.oy.resize(plane);
     hp.zb.resize(plane);
+    hp.zb_error.resize(plane);
     const double ux = std::cos(r.azimuths[k]) / cx, uy = std::sin(r.azimuths[k]) / cy;
     for (std::size_t at = 0; at < plane; ++at) {
       const double dn = r.distances[k * plane + at], theta = r.angles[k * plane + at];
@@ -212,11 +227,13 @@ ViewshedPyramid buildViewshedPyramid(const ComputeContext& context, const Height
       const bool valid = dn > 0.0 && std::isfinite(theta) && std::fabs(theta) < 0.5 * M_PI && std::isfinite(h);
       hp.ox[at] = static_cast<float>(dn * ux);
       hp.oy[at] = static_cast<float>(dn * uy);
-      hp.zb[at] = valid ? static_cast<float>(h * field.z_scale + std::tan(theta) * dn + c_drop * dn * dn) : NAN;
+      const double t = valid ? std::tan(theta) : 0.0;
+      hp.zb[at] = valid ? static_cast<float>(h * field.z_scale + t * dn + c_drop * dn * dn) : NAN;
+      hp.zb_error[at] = static_cast<float>(4e-7 * dn * (1.0 + t * t));
     }
   };
-  // The blockers of one direction, per point P: for eyes within half a gap of the direction and
-  // within a whole gap, the bound on their slope from P (-inf: none) and the distance they must
+  // The blockers of one direction, per point P: for eyes within half of `gap` (the wider of the
+  // direction's two gaps) of the direction and within all of it, the bound on their slope from P (-inf: none) and the distance they must
   // lie beyond. Candidates: the horizon points of P and of its 8 neighbours (any surface point
   // whose height is known blocks, and a neighbour's horizon point often stands where P's own
   // horizon is its own slope), each taken where it lies from P, its azimuth `off` from the
@@ -228,7 +245,7 @@ ViewshedPyramid buildViewshedPyramid(const ComputeContext& context, const Height
     double azimuth = 0.0;
     std::vector<float> half_sigma, half_d, whole_sigma, whole_d;
   };
-  auto blockersOf = [&](const HorizonPoints& hp, double azimuth, Blockers& out, int y0, int y1) {
+  auto blockersOf = [&](const HorizonPoints& hp, double azimuth, double gap, Blockers& out, int y0, int y1) {
     const double ca = std::cos(azimuth), sa = std::sin(azimuth);
     for (int y = y0; y < y1; ++y)
       for (int x = 0; x < width; ++x) {
@@ -249,15 +266,14 @@ ViewshedPyramid buildViewshedPyramid(const ComputeContext& context, const Height
               if (slope <= whole) continue;  // its bounds lie below slope: it cannot do better
               const double sine = std::min(1.0, std::fabs(ca * gy - sa * gx) / d);
               const double off = sine <= 0.5 ? sine + 0.2 * sine * sine * sine : std::asin(sine);  // >= asin(sine)
-              const double L = slopes.around(bx, by, d * (gap_bound + off) / least_cell + 1.0);
+              const double L = slopes.around(bx, by, d * (gap + off) / least_cell + 1.0);
               if (!std::isfinite(L)) continue;
               // The margin: the heights' rounding, the exact test's (its vertex test skipped on
-              // pieces under 1e-3 pixel) and the float angle's.
-              const double margin =
-                  z_margin + 2e-3 * most_cell * (L + std::fabs(slope) + 1.0) + 4e-7 * d * (1.0 + slope * slope);
+              // pieces under 1e-3 pixel) and zb's, from the receiver's float angle and distance.
+              const double margin = z_margin + 2e-3 * most_cell * (L + std::fabs(slope) + 1.0) + hp.zb_error[at];
               const double base = slope - margin / d - L * off;
-              if (base - L * 0.5 * gap_bound > half) half = base - L * 0.5 * gap_bound, half_d = d + most_cell;
-              if (base - L * gap_bound > whole) whole = base - L * gap_bound, whole_d = d + most_cell;
+              if (base - L * 0.5 * gap > half) half = base - L * 0.5 * gap, half_d = d + most_cell;
+              if (base - L * gap > whole) whole = base - L * gap, whole_d = d + most_cell;
             }
         out.half_sigma[p] = roundDown(half);
         out.half_d[p] = roundUp(half_d);
@@ -274,15 +290,18 @@ ViewshedPyramid buildViewshedPyramid(const ComputeContext& context, const Height
     }
     for (std::thread& t : pool) t.join();
   };
-  auto blockers = [&](const HorizonResult& r) {
+  auto blockers = [&](const HorizonResult& r, int c) {
     std::vector<Blockers> out(per_call);
     HorizonPoints hp;
     for (int k = 0; k < per_call; ++k) {
+      const int j = k * calls + c;
+      if (std::fabs(r.azimuths[k] - azimuth[j]) > 1e-12)
+        throw InvalidArgument("the sweep's azimuths differ from its steps' (internal error)");
       horizonPoints(r, k, hp);
       Blockers& b = out[k];
       b.azimuth = r.azimuths[k];
       for (auto* v : {&b.half_sigma, &b.half_d, &b.whole_sigma, &b.whole_d}) v->resize(plane);
-      parallel(height, [&](int y0, int y1) { blockersOf(hp, b.azimuth, b, y0, y1); });
+      parallel(height, [&](int y0, int y1) { blockersOf(hp, b.azimuth, spread[j], b, y0, y1); });
     }
     return out;
   };
@@ -320,8 +339,7 @@ ViewshedPyramid buildViewshedPyramid(const ComputeContext& context, const Height
   std::vector<Blockers> first, previous;
   for (int c = 0; c < calls; ++c) {
     horizon.azimuth_offset = kTwoPi * c / directions;
-    std::vector<Blockers> r = blockers(computeHorizons(context, field, horizon, outputs));
-    for (int k = 0; k < per_call; ++k) azimuth[k * calls + c] = r[k].azimuth;
+    std::vector<Blockers> r = blockers(computeHorizons(context, field, horizon, outputs), c);
     if (c > 0) foldGaps(c == 1 ? first : previous, c - 1, r, false);
     if (c == calls - 1) foldGaps(r, c, c == 0 ? r : first, true);
     if (c == 0)
@@ -332,11 +350,6 @@ ViewshedPyramid buildViewshedPyramid(const ComputeContext& context, const Height
   }
   // The sectors: from the azimuth of their first direction to that of their last (the next
   // sector's first).
-  for (int j = 0; j < directions; ++j) {
-    double g = std::fmod(azimuth[(j + 1) % directions] - azimuth[j], kTwoPi);
-    if (g < 0.0) g += kTwoPi;
-    if (g > gap_bound) throw InvalidArgument("the sweep's azimuths lie farther apart than its tolerance allows (internal error)");
-  }
   for (int s = 0; s < sectors; ++s) {
     const double a0 = azimuth[s * per];
     double w = std::fmod(azimuth[((s + 1) * per) % directions] - a0, kTwoPi);

@@ -204,7 +204,8 @@ std::vector<float> referenceCulledMask(const HeightField& f, const ViewshedPyram
       if (rel < 0.0) rel += 2.0 * M_PI;
       if (!(rel <= width || rel + 2.0 * alpha >= 2.0 * M_PI)) continue;
       const float* region = &level.regions[((std::size_t(ny) * level.nodes_x + nx) * pyramid.sectors + s) * kFloats];
-      if (!(r_lo > region[0] && lhs < std::min(bound(region, r_lo), bound(region, r_hi)))) return false;
+      const double b_lo = bound(region, r_lo), b_hi = bound(region, r_hi);
+      if (std::isnan(b_lo) || std::isnan(b_hi) || !(r_lo > region[0] && lhs < std::min(b_lo, b_hi))) return false;
     }
     return true;
   };
