@@ -38,16 +38,19 @@ std::size_t defaultMemoryBudget(const DeviceInfo& device) {
   // (Other CPU runtimes may refuse to allocate beyond their reported global memory: then the
   // budget is an error they report, not a crash.)
   if (device.type == "CPU") {
-    const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
-    if (pages > 0 && page > 0) {
-      std::size_t host = static_cast<std::size_t>(pages) * static_cast<std::size_t>(page);
-      std::ifstream limit("/sys/fs/cgroup/memory.max");
-      std::size_t bytes = 0;
-      if (limit >> bytes && bytes > 0) host = std::min(host, bytes);  // "max" (no limit) fails to parse
-      return host / 2;
-    }
+    if (const std::size_t host = hostMemoryBudget()) return host;
   }
   return device.global_memory_bytes / 2;
+}
+
+std::size_t hostMemoryBudget() {
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+  if (pages <= 0 || page <= 0) return 0;
+  std::size_t host = static_cast<std::size_t>(pages) * static_cast<std::size_t>(page);
+  std::ifstream limit("/sys/fs/cgroup/memory.max");
+  std::size_t bytes = 0;
+  if (limit >> bytes && bytes > 0) host = std::min(host, bytes);  // "max" (no limit) fails to parse
+  return host / 2;
 }
 
 cl::Buffer deviceBuffer(ContextState& st, std::size_t bytes) {

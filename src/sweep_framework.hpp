@@ -27,6 +27,9 @@ bool lineMajorLayout(const ContextState& st);
 // memory is the host's, half the host's physical memory).
 std::size_t defaultMemoryBudget(const DeviceInfo& device);
 
+// Half the host's physical memory (or of its cgroup's limit, where lower); 0 when unknown.
+std::size_t hostMemoryBudget();
+
 std::string mebibytes(std::size_t bytes);
 
 // A read-write buffer of at least `bytes` (never zero-sized, so it can always be bound).

@@ -18,6 +18,7 @@
 #include "hfvis/viewshed.hpp"
 #include "horizon_common.hpp"
 #include "lattice_geometry.hpp"
+#include "sweep_framework.hpp"
 
 namespace hfvis {
 namespace {
@@ -178,6 +179,16 @@ ViewshedPyramid buildViewshedPyramid(const ComputeContext& context, const Height
   while (calls < directions &&
          (directions % calls != 0 || std::size_t(directions / calls) * field.pixelCount() * 2 * sizeof(float) > kPlaneBytes))
     ++calls;
+  // What the build holds on the host at once: the finest regions (and a third more for the
+  // levels above), three calls' blockers, one call's planes and horizon points, the slopes.
+  const std::size_t per_call_directions = static_cast<std::size_t>(directions / calls);
+  const double host_bytes = 4.0 / 3.0 * finest_nodes * sectors * kFloats * sizeof(float) +
+                            double(field.pixelCount()) * (3.0 * per_call_directions * 16.0 + per_call_directions * 8.0 + 16.0 + 6.0);
+  const std::size_t budget = options.memory_budget ? options.memory_budget : detail::hostMemoryBudget();
+  if (budget > 0 && host_bytes > budget)
+    throw MemoryBudgetError("the culling pyramid would hold " + detail::mebibytes(static_cast<std::size_t>(host_bytes)) +
+                            " on the host, beyond the budget (" + detail::mebibytes(budget) +
+                            "); keep fewer levels (a larger finest level) or crop the DEM");
   std::vector<double> azimuth(directions);
   HorizonOptions horizon;
   horizon.method = HorizonMethod::Sweep;

@@ -325,6 +325,10 @@ TEST(ViewshedCulling, BadInputIsRefused) {
   many.sectors = 128;
   many.directions_per_sector = 8;
   EXPECT_NO_THROW(buildViewshedPyramid(testContext(), fractalCrop(0, 0, 20, 16), many));
+  // A build that would hold more than its budget on the host is refused before it starts.
+  ViewshedPyramidOptions small;
+  small.memory_budget = 64 * 1024;
+  EXPECT_THROW(buildViewshedPyramid(testContext(), f, small), MemoryBudgetError);
   HeightField lat = f;
   lat.row_cell_size_x.assign(f.height, 1.0);
   lat.row_cell_size_y.assign(f.height, 1.0);

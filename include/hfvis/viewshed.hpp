@@ -137,7 +137,10 @@ struct ViewshedPyramidOptions {
   int sectors = 16;            // sectors of azimuth, 4 .. 256
   int directions_per_sector = 8;  // horizon directions per sector (2 .. 64; shared at the sectors' edges)
   int finest_level = 2;        // the finest nodes kept: 2^finest_level points a side, 1 .. 12
-  std::size_t memory_budget = 0;  // for the horizon sweeps, as SweepOptions::memory_budget_bytes
+  // Bytes the build may use: on the device for the horizon sweeps (SweepOptions::
+  // memory_budget_bytes) and on the host for its planes and regions; 0 = half the device's
+  // memory and half the host's.
+  std::size_t memory_budget = 0;
   std::function<void(int, int)> progress;  // (directions done, directions in all)
 };
 
@@ -173,7 +176,8 @@ struct ViewshedPyramid {
 };
 
 // Builds the pyramid. Throws InvalidArgument (bad field or options, a latitude / longitude
-// grid, a field of 2^31 points or more), MemoryBudgetError, OpenClError, KernelBuildError.
+// grid, a field of 2^31 points or more), MemoryBudgetError (also when the build would hold more
+// on the host than the budget), OpenClError, KernelBuildError.
 ViewshedPyramid buildViewshedPyramid(const ComputeContext& context, const HeightField& field,
                                      const ViewshedPyramidOptions& options);
 
