@@ -33,10 +33,10 @@ struct Culling {
 };
 
 // The viewshed with the pyramid against the one without (bit for bit, the culled count with
-// them) and every culled point against brute force: hidden, the surface rising at least
-// `clear` above its sight line.
+// them) and every culled point against brute force: hidden, the surface rising strictly above
+// its sight line between eye and target.
 Culling checkCulling(const ComputeContext& context, const HeightField& f, const Observer& o,
-                     const ViewshedOptions& plain, const ViewshedPyramid& pyramid, double clear) {
+                     const ViewshedOptions& plain, const ViewshedPyramid& pyramid) {
   ViewshedOptions culled = plain;
   culled.pyramid = &pyramid;
   ViewshedOutputs outputs;
@@ -77,7 +77,7 @@ Culling checkCulling(const ComputeContext& context, const HeightField& f, const 
     ++c.culled;
     const int col = static_cast<int>(p % f.width), row = static_cast<int>(p / f.width);
     const SightLine s = referenceSightLine(f, o, plain, col, row);
-    if (s.visible || !(s.interior_rise > clear))
+    if (s.visible || !(s.interior_rise > 0.0))
       ADD_FAILURE() << "culled " << col << "," << row << " but brute force finds it "
                     << (s.visible ? "visible" : "hidden") << ", the surface " << s.interior_rise
                     << " above the sight line at most";
@@ -96,6 +96,14 @@ ViewshedPyramid pyramidFor(const ComputeContext& context, const HeightField& f, 
   return buildViewshedPyramid(context, f, options);
 }
 
+ViewshedPyramidOptions sectorsOf(int sectors, int directions_per_sector, int finest_level) {
+  ViewshedPyramidOptions options;
+  options.sectors = sectors;
+  options.directions_per_sector = directions_per_sector;
+  options.finest_level = finest_level;
+  return options;
+}
+
 TEST(ViewshedCulling, RoughTerrainCullsOnlyHiddenPoints) {
   const HeightField f = fractalCrop(40, 60, 97, 83);
   forEachLayout([&](const ComputeContext& context) {
@@ -107,7 +115,7 @@ TEST(ViewshedCulling, RoughTerrainCullsOnlyHiddenPoints) {
     for (const Observer& o : std::vector<Observer>{{48, 41, 2.0}, {10, 70, 0.0}, {48, 41, 60.0}, {0, 0, 2.0},
                                                    {96, 40, 5.0}, {50, 82, 1.0}, {20, 20, 0.5}}) {
       SCOPED_TRACE(std::to_string(o.col) + "," + std::to_string(o.row) + " at " + std::to_string(o.height));
-      const Culling c = checkCulling(context, f, o, {}, pyramid, 0.0);
+      const Culling c = checkCulling(context, f, o, {}, pyramid);
       culled += c.culled;
       hidden += c.hidden;
     }
@@ -116,14 +124,10 @@ TEST(ViewshedCulling, RoughTerrainCullsOnlyHiddenPoints) {
     std::printf("rough terrain: %zu culled of %zu hidden\n", culled, hidden);
     // Wide sectors, wide nodes: a node's azimuth range often begins in one sector and runs into
     // the next, which must be checked too.
-    ViewshedPyramidOptions wide;
-    wide.sectors = 4;
-    wide.directions_per_sector = 16;
-    wide.finest_level = 1;
-    const ViewshedPyramid coarse = buildViewshedPyramid(context, f, wide);
+    const ViewshedPyramid coarse = buildViewshedPyramid(context, f, sectorsOf(4, 16, 1));
     std::size_t wide_culled = 0;
     for (const Observer& o : std::vector<Observer>{{48, 41, 2.0}, {10, 70, 0.0}, {20, 20, 0.5}, {90, 10, 1.0}})
-      wide_culled += checkCulling(context, f, o, {}, coarse, 0.0).culled;
+      wide_culled += checkCulling(context, f, o, {}, coarse).culled;
     EXPECT_GT(wide_culled, 0u);
   });
 }
@@ -138,10 +142,10 @@ TEST(ViewshedCulling, CoarseNodesAndEyesNearTheBorder) {
     const ViewshedPyramid pyramid = pyramidFor(testContext(), f, 0.0, 0.0, level);
     for (const Observer& o : std::vector<Observer>{{9, 3, 1.0}, {33, 3, 0.5}, {3, 40, 2.0}, {60, 55, 0.0}, {63, 20, 1.0}}) {
       SCOPED_TRACE(std::to_string(o.col) + "," + std::to_string(o.row));
-      culled += checkCulling(testContext(), f, o, {}, pyramid, 0.0).culled;
+      culled += checkCulling(testContext(), f, o, {}, pyramid).culled;
       ViewshedOptions near;  // a box within the field
       near.max_distance = 25.0;
-      culled += checkCulling(testContext(), f, o, near, pyramid, 0.0).culled;
+      culled += checkCulling(testContext(), f, o, near, pyramid).culled;
     }
   }
   EXPECT_GT(culled, 0u);
@@ -155,7 +159,7 @@ TEST(ViewshedCulling, RealTerrainCullsAShareOfTheHiddenPoints) {
   std::size_t culled = 0, hidden = 0;
   for (const Observer& o : std::vector<Observer>{{100, 80, 2.0}, {10, 10, 0.0}, {150, 120, 30.0}}) {
     SCOPED_TRACE(std::to_string(o.col) + "," + std::to_string(o.row));
-    const Culling c = checkCulling(testContext(), dem, o, {}, pyramid, 0.0);
+    const Culling c = checkCulling(testContext(), dem, o, {}, pyramid);
     culled += c.culled;
     hidden += c.hidden;
   }
@@ -182,7 +186,7 @@ TEST(ViewshedCulling, SectorRangesWrappingAzimuthZero) {
     const ViewshedPyramid pyramid = pyramidFor(context, f);
     for (const Observer& o : std::vector<Observer>{{60, 30, 2.0}, {5, 30, 2.0}}) {
       SCOPED_TRACE(std::to_string(o.col));
-      const Culling c = checkCulling(context, f, o, {}, pyramid, 0.0);
+      const Culling c = checkCulling(context, f, o, {}, pyramid);
       ViewshedOptions options;
       options.pyramid = &pyramid;
       ViewshedOutputs outputs;
@@ -209,15 +213,11 @@ TEST(ViewshedCulling, NotchedRidgesAreNotCulledThrough) {
   HeightField f = wallField(150, 90, 100, 40, 1);
   for (int y : {60, 61}) f.heights[static_cast<std::size_t>(y) * f.width + 100] = 0.0f;
   forEachLayout([&](const ComputeContext& context) {
-    ViewshedPyramidOptions coarse;
-    coarse.sectors = 8;
-    coarse.directions_per_sector = 4;
-    coarse.finest_level = 1;
-    const ViewshedPyramid pyramid = buildViewshedPyramid(context, f, coarse);
+    const ViewshedPyramid pyramid = buildViewshedPyramid(context, f, sectorsOf(8, 4, 1));
     std::size_t culled = 0;
     for (const Observer& o : std::vector<Observer>{{103, 40, 1.0}, {104, 61, 1.0}, {110, 50, 3.0}}) {
       SCOPED_TRACE(std::to_string(o.col) + "," + std::to_string(o.row));
-      const Culling c = checkCulling(context, f, o, {}, pyramid, 0.0);
+      const Culling c = checkCulling(context, f, o, {}, pyramid);
       culled += c.culled;
       EXPECT_LT(c.hidden, c.targets);  // targets behind the notch are seen
     }
@@ -234,7 +234,7 @@ TEST(ViewshedCulling, HardCases) {
       const ViewshedPyramid pyramid = pyramidFor(context, f, 0.0, 0.0, 1);
       for (Observer o : std::vector<Observer>{{30, 26, 1.5}, {3, 50, 0.0}}) {
         if (!std::isfinite(f.at(o.col, o.row))) continue;
-        culled += checkCulling(context, f, o, {}, pyramid, 0.0).culled;
+        culled += checkCulling(context, f, o, {}, pyramid).culled;
       }
     }
     EXPECT_GT(culled, 0u);
@@ -251,16 +251,16 @@ TEST(ViewshedCulling, TargetHeightCurvatureAndOptions) {
     options.target_height = 1.5;
     options.curvature = 0.002;
     const ViewshedPyramid pyramid = pyramidFor(context, f, 1.5, 0.002, 1);
-    for (const Observer& o : std::vector<Observer>{{45, 35, 2.0}, {5, 60, 20.0}}) checkCulling(context, f, o, options, pyramid, 0.0);
+    for (const Observer& o : std::vector<Observer>{{45, 35, 2.0}, {5, 60, 20.0}}) checkCulling(context, f, o, options, pyramid);
     options.max_distance = 60.0;
     options.azimuth_from_deg = 300.0;
     options.azimuth_to_deg = 100.0;
     options.elevation_max_deg = 10.0;
-    checkCulling(context, f, {45, 35, 2.0}, options, pyramid, 0.0);
+    checkCulling(context, f, {45, 35, 2.0}, options, pyramid);
     // Negative curvature (refraction beyond 1) raises far terrain.
     ViewshedOptions raised;
     raised.curvature = -0.003;
-    checkCulling(context, f, {45, 35, 2.0}, raised, pyramidFor(context, f, 0.0, -0.003, 1), 0.0);
+    checkCulling(context, f, {45, 35, 2.0}, raised, pyramidFor(context, f, 0.0, -0.003, 1));
   });
 }
 
@@ -321,10 +321,7 @@ TEST(ViewshedCulling, BadInputIsRefused) {
   }
   // Many directions: the sweep's steps near the axes lie farther apart than its tolerance; the
   // gaps are measured, not assumed.
-  ViewshedPyramidOptions many;
-  many.sectors = 128;
-  many.directions_per_sector = 8;
-  EXPECT_NO_THROW(buildViewshedPyramid(testContext(), fractalCrop(0, 0, 20, 16), many));
+  EXPECT_NO_THROW(buildViewshedPyramid(testContext(), fractalCrop(0, 0, 20, 16), sectorsOf(128, 8, 2)));
   // A build that would hold more than its budget on the host is refused before it starts.
   ViewshedPyramidOptions small;
   small.memory_budget = 64 * 1024;
