@@ -181,9 +181,9 @@ ViewshedPyramid buildViewshedPyramid(const ComputeContext& context, const Height
     ++calls;
   // What the build holds on the host at once: the finest regions (and a third more for the
   // levels above), three calls' blockers, one call's planes and horizon points, the slopes.
-  const std::size_t per_call_directions = static_cast<std::size_t>(directions / calls);
+  const int per_call = directions / calls;
   const double host_bytes = 4.0 / 3.0 * finest_nodes * sectors * kFloats * sizeof(float) +
-                            double(field.pixelCount()) * (3.0 * per_call_directions * 16.0 + per_call_directions * 8.0 + 16.0 + 6.0);
+                            double(field.pixelCount()) * (3.0 * per_call * 16.0 + per_call * 8.0 + 16.0 + 6.0);
   const std::size_t budget = options.memory_budget ? options.memory_budget : detail::hostMemoryBudget();
   if (budget > 0 && host_bytes > budget)
     throw MemoryBudgetError("the culling pyramid would hold " + detail::mebibytes(static_cast<std::size_t>(host_bytes)) +
@@ -192,7 +192,7 @@ ViewshedPyramid buildViewshedPyramid(const ComputeContext& context, const Height
   std::vector<double> azimuth(directions);
   HorizonOptions horizon;
   horizon.method = HorizonMethod::Sweep;
-  horizon.directions = directions / calls;
+  horizon.directions = per_call;
   horizon.samples_per_unit = 1.0;
   horizon.curvature = options.curvature;
   horizon.memory_budget_bytes = options.memory_budget;
@@ -201,7 +201,6 @@ ViewshedPyramid buildViewshedPyramid(const ComputeContext& context, const Height
   outputs.horizon_distances = true;
   const unsigned threads = std::max(1u, std::min(8u, std::thread::hardware_concurrency()));
   const std::size_t plane = field.pixelCount();
-  const int per_call = directions / calls;
   const double c_drop = options.curvature;
 
   // The sweep's azimuths (its steps depend on the cell sizes alone, so they are known before it
