@@ -274,7 +274,9 @@ int sight_blocked_pyramid(__global const float* h, __global const float* pyramid
         break;
       }
       if (k == 1) {  // march the block's cells (a pixel's length where rounding put t at its exit)
-        if (!(t_exit > t)) t_exit = hf_min(tb, t + pixel_t);
+        // Within half a pixel of tb, tb itself: t + pixel_t may round short of it (0.99999994 for
+        // the target, whose own point would then be marched as surface).
+        if (!(t_exit > t)) t_exit = t + pixel_t < tb - 0.5f * pixel_t ? t + pixel_t : tb;
         if (sight_walk(h, f, ex, ey, dx, dy, ze, rise, d2, target_height, t, t_exit, excess)) return 1;
         t = t_exit;
         break;
@@ -351,28 +353,99 @@ inline float ray_angle(float ex, float ey, int a, int b, int4 box, Field f) {
   return atan2(fabs(ax * by - ay * bx), ax * bx + ay * by);
 }
 
-// Index of entry q (0-based) of ray r in the bounds buffer: ray-major (each ray's entries
-// together, from offsets[r]) or step-major (entry q of every ray together, rays apart by 1).
-inline size_t bound_index(__global const uint* offsets, int rays, int ray_major, int r, int q) {
-  return ray_major ? (size_t)offsets[r] + q : (size_t)q * rays + r;
+inline void put_visible(__global float* out, size_t p, float v, int accumulate) {
+  if (accumulate)
+    out[p] += v;
+  else
+    out[p] = v;
 }
 
-// Ray r from E to border point r, marched cell by cell. Entry q (q = 0 .. count - 1, count =
-// offsets[r + 1] - offsets[r]) bounds the largest slope (s(t) - ze) / (t D) met on the ray within
-// ground distance (q + 1) * spacing, widened so that it also bounds that of every sight line
-// within the angle to the next border point on either side: (lo, hi) with lo <= that slope <= hi.
-// The widening is L * angle, L the surface's slope bound around the cell
-// (|s difference| <= L * arc between two lines at one distance, arc = distance * angle), valid
-// while the arc stays within one pixel of the ray.
+// A target's sight line, from the eye (ex_i, ey_i, height ze) to grid point (x, y): its steps in
+// pixels, squared ground length and length, its rise (the target's height, lowered for the
+// curvature, less the eye's) and elevation slope. viewshed_rays and viewshed_march compute it
+// alike, so that the part of the line a ray's bounds cover is the part the march leaves out.
+typedef struct {
+  float dx, dy, d2, dist, rise, slope;
+} SightLine;
+
+inline SightLine sight_line(__global const float* h, Field f, int x, int y, int ex_i, int ey_i, float ze,
+                            float target_height) {
+  SightLine s;
+  s.dx = x - ex_i;
+  s.dy = y - ey_i;
+  const float gdx = s.dx * f.cell_x, gdy = s.dy * f.cell_y;
+  s.d2 = gdx * gdx + gdy * gdy;
+  s.dist = native_sqrt(s.d2);
+  s.rise = (h[(size_t)y * f.width + x] + target_height - f.curvature * s.d2) - ze;
+  s.slope = native_divide(s.rise, s.dist);
+  return s;
+}
+
+// The ground distance from the eye where viewshed_march's exact part of a sight line of length
+// dist begins: 2.5 pixels short of the target (0 or less: the whole line is marched), where the
+// bounds of a ray two grid lines short of the target reach along an axis (one along a diagonal).
+inline float split_distance(float dist, Field f) { return dist - 2.5f * hf_max(f.cell_x, f.cell_y); }
+
+// Whether the direction v from the eye lies in the wedge from a (included) clockwise to b
+// (excluded), both directions from the eye to border points (a x b > 0: rows grow downward, so
+// clockwise on the map is a positive cross product). The wedges of consecutive border points
+// partition the directions around an eye inside the box, exactly (integers).
+inline int in_wedge(int2 a, int2 b, long vx, long vy) {
+  return (long)a.x * vy - (long)a.y * vx >= 0 && (long)b.x * vy - (long)b.y * vx < 0;
+}
+
+// The targets of ray r's wedge (a, b: its border points less the eye) on grid line m of the ray's
+// major axis (a column where the ray runs at most 45 degrees from the x axis, else a row), for
+// every sight line of which the ray holds, over its prefix so far (d_ray from the eye), bounds
+// lo <= the largest slope met <= hi, and hi_back over a shorter prefix (d_back). A target
+// still pending (left open by viewshed_classify) is hidden where its slope lies below lo and the
+// prefix ends short of it; else the bound over the shorter prefix that reaches its split
+// distance is kept for viewshed_march, which marches the rest exactly. Targets neither settles
+// keep ray_hi = INFINITY (a whole march). Ray r crosses line m at e_minor + qa + ra / den
+// (exactly; side a of the wedge), side b (b_along: where it runs the same way along the axis)
+// at e_minor + (m - e_major) * slope_b; the wedge meets the line in at most about a pixel.
+inline void settle_targets(__global const float* h, Field f, int ex_i, int ey_i, float ze, float target_height,
+                           int4 box, int x_major, int m, int qa, int ra, int den, int b_along, float slope_b, int2 a,
+                           int2 b, float lo, float hi, float d_ray, float hi_back, float d_back,
+                           __global uchar* pending, __global float* ray_hi, __global float* out_visible,
+                           int accumulate) {
+  if (m < (x_major ? box.x : box.y) || m > (x_major ? box.z : box.w)) return;
+  const int e_major = x_major ? ex_i : ey_i, e_minor = x_major ? ey_i : ex_i;
+  const float ma = e_minor + qa + (float)ra / den;
+  const float mb = b_along ? e_minor + (m - e_major) * slope_b : ma;
+  // The grid points between the sides: a's is exact, so none on side a is missed (b's side is
+  // not in the wedge).
+  const int minor_lo = x_major ? box.y : box.x, minor_hi = x_major ? box.w : box.z;
+  const int first = max(ma <= mb ? e_minor + qa + (ra > 0) : (int)ceil(mb), minor_lo);
+  const int last = min(min(ma <= mb ? (int)floor(mb) : e_minor + qa, minor_hi), first + 3);
+  const float cell_min = hf_min(f.cell_x, f.cell_y);
+  for (int n = first; n <= last; ++n) {
+    const int x = x_major ? m : n, y = x_major ? n : m;
+    if (!in_wedge(a, b, x - ex_i, y - ey_i)) continue;
+    const size_t p = (size_t)y * f.width + x;
+    if (!pending[p]) continue;
+    const SightLine s = sight_line(h, f, x, y, ex_i, ey_i, ze, target_height);
+    // Margins far above the rounding of the distances.
+    const float split = split_distance(s.dist, f) + 1e-5f * s.dist + 1e-3f * cell_min;
+    if (d_ray < s.dist - 0.25f * cell_min && s.slope < lo) {  // something nearer rises above the sight line
+      put_visible(out_visible, p, 0.0f, accumulate);
+      pending[p] = 0;
+    } else if (d_back >= split) {
+      ray_hi[p] = hi_back;
+    } else if (d_ray >= split) {
+      ray_hi[p] = hi;
+    }
+  }
+}
+
 // viewshed_ray_need, one work-item per node of the culling pyramid's finest level (leaf: nodes
 // across, down, first node's index, k): where the pyramid culled nodes, the rays need not reach
-// them. need[r] (from -1) is raised to the last entry of ray r that a target of a kept node may
-// read: the targets' rays lie on either side of their sight lines, within the border positions
-// of the node's corners (a rectangle's angular extent from an eye outside it, less than a half
-// turn), and read entries below their distance / spacing. A node holding the eye needs every
-// ray whole.
+// them. need[r] (from -1) is raised to how far (in units of `unit`) ray r must go to settle the
+// targets of a kept node: the wedges that meet the node lie within the border positions of its
+// corners (a rectangle's angular extent from an eye outside it, less than a half turn). A node
+// holding the eye needs every ray whole.
 __kernel void viewshed_ray_need(__global const uchar* culled, int4 leaf, Field f, int ex_i, int ey_i, int4 box,
-                                int rays, float spacing, __global int* need) {
+                                int rays, float unit, __global int* need) {
   const int nx = get_global_id(0), ny = get_global_id(1);
   if (nx >= leaf.x || ny >= leaf.y) return;
   if (culled[(size_t)leaf.z + (size_t)ny * leaf.x + nx]) return;
@@ -382,7 +455,7 @@ __kernel void viewshed_ray_need(__global const uchar* culled, int4 leaf, Field f
   if (x0 > x1 || y0 > y1) return;  // outside the box: out of range
   const float far_x = fmax(fabs((float)(x0 - ex_i)), fabs((float)(x1 - ex_i))) * f.cell_x;
   const float far_y = fmax(fabs((float)(y0 - ey_i)), fabs((float)(y1 - ey_i))) * f.cell_y;
-  const int q = (int)(sqrt(far_x * far_x + far_y * far_y) / spacing) + 1;
+  const int q = (int)(sqrt(far_x * far_x + far_y * far_y) / unit) + 1;
   if (ex_i >= x0 && ex_i <= x1 && ey_i >= y0 && ey_i <= y1) {
     for (int r = 0; r < rays; ++r) atomic_max(&need[r], q);
     return;
@@ -406,37 +479,53 @@ __kernel void viewshed_ray_need(__global const uchar* culled, int4 leaf, Field f
   for (int r = first; r <= last; ++r) atomic_max(&need[((r % rays) + rays) % rays], q);
 }
 
-__kernel void viewshed_rays(__global const float* h, Field f, __global const float* lipschitz, float ex, float ey,
-                            float ze, int4 box, int rays, __global const uint* offsets, int ray_major, float spacing,
-                            __global const int* need, int use_need, __global float2* bounds) {
+// viewshed_rays, one work-item per ray from the eye E to border point r, marched cell by cell.
+// It keeps bounds on the largest slope (s(t) - ze) / (t D) met so far, widened so that they
+// also bound that of every sight line of its wedge (to border point r + 1, at distances the
+// ray has reached): lo <= that slope <= hi. The widening is L * angle, L the surface's slope
+// bound around the cell (|s difference| <= L * arc between two lines at one distance, arc =
+// distance * angle), valid while the arc stays within one pixel of the ray. Each time the ray
+// crosses a grid line of its major axis it settles the wedge's targets on the next one
+// (settle_targets), and at its end those one line past it.
+__kernel void viewshed_rays(__global const float* h, Field f, __global const float* lipschitz, int ex_i, int ey_i,
+                            float ze, float target_height, int4 box, int rays, __global const int* need,
+                            int use_need, float unit, __global uchar* pending, __global float* ray_hi,
+                            __global float* out_visible, int accumulate) {
   const int r = get_global_id(0);
   if (r >= rays) return;
-  // With the culling pyramid, only the entries the kept nodes' targets read.
-  const int count = use_need ? min((int)(offsets[r + 1] - offsets[r]), need[r] + 1) : offsets[r + 1] - offsets[r];
-  if (count <= 0) return;
-  const float angle = fmax(ray_angle(ex, ey, (r + rays - 1) % rays, r, box, f), ray_angle(ex, ey, r, (r + 1) % rays, box, f));
-  const float2 end = border_point(r, box);
-  const float dx = end.x - ex, dy = end.y - ey;
+  // With the culling pyramid, only as far as the kept nodes' targets.
+  const float reach = use_need ? (need[r] + 1) * unit : INFINITY;
+  if (!(reach > 0.0f)) return;
+  const float ex = ex_i, ey = ey_i;
+  const float2 end = border_point(r, box), next_end = border_point(r + 1 == rays ? 0 : r + 1, box);
+  const int2 a = (int2)((int)end.x - ex_i, (int)end.y - ey_i), b = (int2)((int)next_end.x - ex_i, (int)next_end.y - ey_i);
+  if ((long)a.x * b.y - (long)a.y * b.x <= 0) return;  // an empty wedge (an eye on the box's border)
+  // The wedge's angle, widened past the rounding of its few operations.
+  const float angle = ray_angle(ex, ey, r, r + 1 == rays ? 0 : r + 1, box, f) * (1.0f + 1e-5f);
+  const float dx = a.x, dy = a.y;
+  const int x_major = fabs(dx) >= fabs(dy);
   const float gdx = dx * f.cell_x, gdy = dy * f.cell_y;
   const float length = sqrt(gdx * gdx + gdy * gdy);
-  const float inv_length = 1.0f / length;
   const float arc_limit = fmin(f.cell_x, f.cell_y) / angle;  // distance where the arc reaches a pixel
   const int cells_x = max(f.width - 1, 1);
   const float inv_dx = dx != 0.0f ? 1.0f / dx : 0.0f, inv_dy = dy != 0.0f ? 1.0f / dy : 0.0f;
   Axis ax = axis_start(dx > 0.0f ? ex + 1.0f : ex - 1.0f, ex, dx, inv_dx, dy);
   Axis ay = axis_start(dy > 0.0f ? ey + 1.0f : ey - 1.0f, ey, dy, inv_dy, dx);
+  // Side b of the wedge across the major axis, where it runs the same way along it.
+  const int a_major = x_major ? a.x : a.y, b_major = x_major ? b.x : b.y;
+  const int b_along = b_major != 0 && (b_major > 0) == (a_major > 0);
+  const float slope_b = b_along ? (float)(x_major ? b.y : b.x) / b_major : 0.0f;
+  float hi_back = INFINITY, d_back = 0.0f;  // the bound at the previous crossing of the major axis
   const float drop = f.curvature * length * length;
   float lo = -INFINITY, hi = -INFINITY;
-  float t0 = 0.0f, f0 = h[(int)ey * f.width + (int)ex] - ze;
-  int q = 0;
-  float next = spacing * inv_length;  // t of entry q's distance
-  while (q < count) {
+  float t0 = 0.0f, f0 = h[ey_i * f.width + ex_i] - ze;
+  for (;;) {
     const float tx = ax.t, ty = ay.t;
     const float t1 = hf_min(hf_min(tx, ty), 1.0f);
     const float tm = 0.5f * (t0 + t1);
     const int4 c = cell_of(ex + tm * dx, ey + tm * dy, f.width, f.height);
-    const float s1 = t1 == tx   ? surface_at_crossing(h, f.width, 1, &ax, (int)ex, (int)ey)
-                     : t1 == ty ? surface_at_crossing(h, f.width, 0, &ay, (int)ex, (int)ey)
+    const float s1 = t1 == tx   ? surface_at_crossing(h, f.width, 1, &ax, ex_i, ey_i)
+                     : t1 == ty ? surface_at_crossing(h, f.width, 0, &ay, ex_i, ey_i)
                                 : h[(int)end.y * f.width + (int)end.x];
     const float f1 = (s1 - ze) - drop * t1 * t1;  // height above the eye, curvature taken
     const float span = t1 - t0;
@@ -456,21 +545,26 @@ __kernel void viewshed_rays(__global const float* h, Field f, __global const flo
     const float widen = t1 * length <= arc_limit ? lipschitz[c.y * cells_x + c.x] * angle : INFINITY;
     seg_hi = isnan(seg_hi) || isnan(widen) ? INFINITY : seg_hi + widen;
     hi = hf_max(hi, seg_hi);
-    while (q < count && next <= t1) {
-      bounds[bound_index(offsets, rays, ray_major, r, q)] = (float2)(lo, hi);
-      ++q;
-      next = (q + 1) * spacing * inv_length;
-    }
     if (!isnan(seg_lo)) lo = hf_max(lo, seg_lo - widen);  // a surface point the sight lines pass near
+    const float d_ray = t1 * length;
+    const int crossed = x_major ? tx <= t1 : ty <= t1;  // a grid line of the major axis, at t1
     f0 = f1;
     if (tx <= t1) axis_next(&ax, ex, dx, inv_dx);
     if (ty <= t1) axis_next(&ay, ey, dy, inv_dy);
     t0 = t1;
-    if (t1 >= 1.0f) break;
+    // Past a crossing of the major axis the next grid line's targets (the axis now holds that
+    // line), at the end the line past it.
+    if (crossed || t1 >= 1.0f) {
+      Axis major = x_major ? ax : ay;
+      if (!crossed) axis_next(&major, x_major ? ex : ey, x_major ? dx : dy, x_major ? inv_dx : inv_dy);
+      settle_targets(h, f, ex_i, ey_i, ze, target_height, box, x_major, (int)major.g, major.q, major.r, major.den,
+                     b_along, slope_b, a, b, lo, hi, d_ray, hi_back, d_back, pending, ray_hi, out_visible, accumulate);
+      hi_back = hi;
+      d_back = d_ray;
+    }
+    if (t1 >= 1.0f || d_ray > reach) break;
   }
-  for (; q < count; ++q) bounds[bound_index(offsets, rays, ray_major, r, q)] = (float2)(lo, INFINITY);
 }
-
 
 // The culling pyramid's query (ViewshedPyramid in hfvis/viewshed.hpp), one work-item per node of
 // one level (level: nodes across, down, first node's index, k: nodes of 2^k x 2^k grid points),
@@ -533,13 +627,6 @@ __kernel void viewshed_cull(__global const float* regions, int4 level, int4 pare
   culled[node] = cull ? 1 : 0;
 }
 
-inline void put_visible(__global float* out, size_t p, float v, int accumulate) {
-  if (accumulate)
-    out[p] += v;
-  else
-    out[p] = v;
-}
-
 // sight_blocked over [ta, tb], through the pyramid where there is one (top_level >= 1).
 inline int march(__global const float* h, __global const float* pyramid, __constant int4* levels, int top_level,
                  Field f, float ex, float ey, float dx, float dy, float ze, float rise, float d2, float target_height,
@@ -549,53 +636,20 @@ inline int march(__global const float* h, __global const float* pyramid, __const
                        : sight_blocked(h, f, ex, ey, dx, dy, ze, rise, d2, target_height, ta, tb);
 }
 
-// A target's sight line and where the rays' bounds apply to it.
-typedef struct {
-  float dx, dy, d2, dist, rise, slope;
-  int q;     // the entry of the rays' bounds for the part of the sight line before t_split
-  int a, b;  // the rays on either side of it
-  int use;   // whether the bounds apply (rays, and both rays long enough)
-  float t_split;
-} SightLine;
-
-inline SightLine sight_line(__global const float* h, Field f, int x, int y, int ex_i, int ey_i, float ze,
-                            float target_height, int4 box, int rays, __global const uint* offsets, float spacing) {
-  SightLine s;
-  s.dx = x - ex_i;
-  s.dy = y - ey_i;
-  const float gdx = s.dx * f.cell_x, gdy = s.dy * f.cell_y;
-  s.d2 = gdx * gdx + gdy * gdy;
-  s.dist = native_sqrt(s.d2);
-  s.rise = (h[(size_t)y * f.width + x] + target_height - f.curvature * s.d2) - ze;
-  s.slope = native_divide(s.rise, s.dist);
-  // Entry q covers distances up to (q + 1) spacing, at least 1.5 pixels short of the target.
-  s.q = (int)floor(native_divide(s.dist - 1.5f * hf_max(f.cell_x, f.cell_y), spacing)) - 1;
-  s.a = 0;
-  s.b = 0;
-  s.use = 0;
-  if (rays > 0 && s.dist > 0.0f) {
-    const int a = clamp_int((int)floor(border_position(ex_i, ey_i, s.dx, s.dy, box)) % rays, 0, rays - 1);
-    s.a = a;
-    s.b = a + 1 == rays ? 0 : a + 1;
-    s.use = s.q >= 0 && s.q < (int)(offsets[s.a + 1] - offsets[s.a]) && s.q < (int)(offsets[s.b + 1] - offsets[s.b]);
-  }
-  s.t_split = native_divide((s.q + 1) * spacing, s.dist);
-  return s;
-}
-
-// viewshed_classify, one work-item per grid point: what needs no march. Writes out_visible 1 / 0
-// (NaN at nodata; added to it with accumulate, a cumulative viewshed) and out_angle (radians; NaN
-// at nodata; only with want_angle) where that settles it, else marks the target in `pending`
-// for viewshed_march. Settled: nodata; targets past max_distance (> 0; the box holds every
-// other), outside the azimuth range (compass degrees clockwise from az_from over az_span, when
-// az_on) or outside elevation angles [el_lo, el_hi] (not visible); the eye's own point (visible);
-// targets the rays' bounds show hidden (rays = 0: none).
+// viewshed_classify, one work-item per grid point, before the rays: what needs no sight line.
+// Writes out_visible 1 / 0 (NaN at nodata; added to it with accumulate, a cumulative viewshed)
+// and out_angle (radians; NaN at nodata; only with want_angle) where that settles it, else
+// marks the target pending (for the rays, then viewshed_march) with ray_hi = INFINITY (with
+// rays_on; without, ray_hi is not read). Settled:
+// nodata; targets past max_distance (> 0; the box holds every other), outside the azimuth range
+// (compass degrees clockwise from az_from over az_span, when az_on), outside elevation angles
+// [el_lo, el_hi] or culled by the pyramid (not visible); the eye's own point (visible).
 __kernel void viewshed_classify(__global const float* h, Field f, int ex_i, int ey_i, float ze, float target_height,
                                 int4 box, float max_distance, int az_on, float az_from, float az_span, float el_lo,
-                                float el_hi, int rays, __global const uint* offsets, int ray_major, float spacing,
-                                __global const float2* bounds, __global const uchar* culled, int4 cull_level,
+                                float el_hi, __global const uchar* culled, int4 cull_level,
                                 __global float* out_visible, int accumulate, int want_angle,
-                                __global float* out_angle, __global uchar* pending) {
+                                __global float* out_angle, __global uchar* pending, int rays_on,
+                                __global float* ray_hi) {
   const int x = get_global_id(0), y = get_global_id(1);
   if (x >= f.width || y >= f.height) return;
   const size_t p = (size_t)y * f.width + x;
@@ -616,7 +670,7 @@ __kernel void viewshed_classify(__global const float* h, Field f, int ex_i, int 
     pending[p] = 0;
     return;
   }
-  const SightLine s = sight_line(h, f, x, y, ex_i, ey_i, ze, target_height, box, rays, offsets, spacing);
+  const SightLine s = sight_line(h, f, x, y, ex_i, ey_i, ze, target_height);
   int in_range = !(max_distance > 0.0f && s.dist > max_distance);
   if (want_angle || el_lo > -M_PI_2_F || el_hi < M_PI_2_F) {  // a library atan2 costs more than the rest
     const float angle = s.dist > 0.0f ? hf_atan(s.slope) : (s.rise >= 0.0f ? M_PI_2_F : -M_PI_2_F);
@@ -628,15 +682,11 @@ __kernel void viewshed_classify(__global const float* h, Field f, int ex_i, int 
     const float from_start = compass - az_from;
     in_range = in_range && from_start - 360.0f * floor(from_start / 360.0f) <= az_span;
   }
-  // The bounds are read unconditionally (index 0 where they do not apply), so that the work-items
-  // run alike.
-  const int q = s.use ? s.q : 0;
-  const float lo_a = bounds[s.use ? bound_index(offsets, rays, ray_major, s.a, q) : 0].x;
-  const float lo_b = bounds[s.use ? bound_index(offsets, rays, ray_major, s.b, q) : 0].x;
-  const int hidden = hidden_at_once || !in_range || (s.use && s.slope < hf_max(lo_a, lo_b));  // something nearer rises above it
+  const int hidden = hidden_at_once || !in_range;
   const int settled = hidden || s.dist == 0.0f;
   if (settled) put_visible(out_visible, p, hidden ? 0.0f : 1.0f, accumulate);
   pending[p] = settled ? 0 : 1;
+  if (!settled && rays_on) ray_hi[p] = INFINITY;
 }
 
 // counts[row]: the pending targets of each row; with offsets[row] (their running sum, from the
@@ -658,32 +708,31 @@ __kernel void viewshed_pending_list(__global const uchar* pending, int width, in
     if (pending[(size_t)row * width + x]) list[n++] = (uint)(row * width + x);
 }
 
-// viewshed_march, one work-item per pending target (list[0 .. count - 1]): where the rays'
-// bounds apply, an exact march of the sight line's last pixels (past t_split); if it is clear,
-// the bounds' upper ends, and if they do not settle it a march of the rest; elsewhere a march of
-// the whole sight line. Marches skip what the maximum pyramid (levels 1 .. top_level; none when
-// top_level = 0) shows to lie below the sight line.
+// viewshed_march, one work-item per pending target (list[0 .. count - 1]): where a ray kept an
+// upper bound for it (ray_hi finite), an exact march of the sight line past its split distance;
+// if that is clear, the bound, and if it does not settle the target a march of the rest;
+// elsewhere a march of the whole sight line. Marches skip what the maximum pyramid (levels
+// 1 .. top_level; none when top_level = 0) shows to lie below the sight line.
 __kernel void viewshed_march(__global const float* h, Field f, int ex_i, int ey_i, float ze, float target_height,
-                             int4 box, int rays, __global const uint* offsets, int ray_major, float spacing,
-                             __global const float2* bounds, __global const float* pyramid, __constant int4* levels,
+                             int rays_on, __global const float* ray_hi, __global const float* pyramid,
+                             __constant int4* levels,
                              int top_level, __global const uint* list, uint count, __global float* out_visible,
                              int accumulate) {
   const uint i = get_global_id(0);
   if (i >= count) return;
   const uint p = list[i];
   const int x = p % f.width, y = p / f.width;
-  const SightLine s = sight_line(h, f, x, y, ex_i, ey_i, ze, target_height, box, rays, offsets, spacing);
+  const SightLine s = sight_line(h, f, x, y, ex_i, ey_i, ze, target_height);
   const float ex = ex_i, ey = ey_i;
+  const float hi = rays_on ? ray_hi[p] : INFINITY;
+  const float split = split_distance(s.dist, f);
   int blocked;
-  if (s.use) {
-    blocked = sight_blocked(h, f, ex, ey, s.dx, s.dy, ze, s.rise, s.d2, target_height, s.t_split, 1.0f);
-    if (!blocked) {
-      const float hi = hf_min(bounds[bound_index(offsets, rays, ray_major, s.a, s.q)].y,
-                              bounds[bound_index(offsets, rays, ray_major, s.b, s.q)].y);
-      if (!(s.slope >= hi))  // nothing nearer is known to stay below the sight line: march it
-        blocked = march(h, pyramid, levels, top_level, f, ex, ey, s.dx, s.dy, ze, s.rise, s.d2, target_height, 0.0f,
-                        s.t_split);
-    }
+  if (hi < INFINITY && split > 0.0f) {
+    const float t_split = native_divide(split, s.dist);
+    blocked = sight_blocked(h, f, ex, ey, s.dx, s.dy, ze, s.rise, s.d2, target_height, t_split, 1.0f);
+    if (!blocked && !(s.slope >= hi))  // nothing nearer is known to stay below the sight line: march it
+      blocked = march(h, pyramid, levels, top_level, f, ex, ey, s.dx, s.dy, ze, s.rise, s.d2, target_height, 0.0f,
+                      t_split);
   } else {
     blocked = march(h, pyramid, levels, top_level, f, ex, ey, s.dx, s.dy, ze, s.rise, s.d2, target_height, 0.0f, 1.0f);
   }

@@ -42,18 +42,6 @@ cl_int4 targetBox(const HeightField& field, const Observer& o, double max_distan
   return box;
 }
 
-// Border point p of the box, as border_point in kernels/viewshed.cl counts.
-std::pair<int, int> borderPoint(int p, const cl_int4& box) {
-  const int w1 = box.s[2] - box.s[0], h1 = box.s[3] - box.s[1];
-  if (p <= w1) return {box.s[0] + p, box.s[1]};
-  p -= w1;
-  if (p <= h1) return {box.s[2], box.s[1] + p};
-  p -= h1;
-  if (p <= w1) return {box.s[2] - p, box.s[3]};
-  p -= w1;
-  return {box.s[0], box.s[3] - p};
-}
-
 // The device side of one field, kept for every observer of a call.
 class ViewshedRun {
  public:
@@ -83,9 +71,13 @@ class ViewshedRun {
     k.setArg(1, device_);
     k.setArg(2, lipschitz_);
     st.launch(k, cell_range, cl::NDRange(detail::kTileX, detail::kTileY));
-    budget_ = options.memory_budget ? options.memory_budget : detail::defaultMemoryBudget(st.info);
     buildPyramid(cells_x, cells_y);
     if (options.pyramid) uploadCulling(*options.pyramid);
+    // The rays' upper bounds, a float per point, where the budget leaves room for them (else
+    // every target is marched).
+    const std::size_t budget = options.memory_budget ? options.memory_budget : detail::defaultMemoryBudget(st.info);
+    ray_hi_budgeted_ = pixels * sizeof(float) <= budget / 2;
+    ray_hi_ = detail::deviceBuffer(st, ray_hi_budgeted_ ? pixels * sizeof(float) : sizeof(float));
     pending_ = detail::deviceBuffer(st, pixels);
     pending_list_ = detail::deviceBuffer(st, pixels * sizeof(cl_uint));
     row_counts_ = detail::deviceBuffer(st, static_cast<std::size_t>(field.height) * sizeof(cl_uint));
@@ -99,84 +91,14 @@ class ViewshedRun {
     const cl_int4 box = targetBox(field_, o, options_.max_distance);
     const cl_int4 cull_leaf = cull(o, ze);
     const int w1 = box.s[2] - box.s[0], h1 = box.s[3] - box.s[1];
-    int rays = 0;
-    float spacing = 0.0f;
-    cl::Buffer offsets = detail::deviceBuffer(st_, sizeof(cl_uint)), bounds = detail::deviceBuffer(st_, 8);
-    const bool ray_major = detail::lineMajorLayout(st_);
     const double far_pixels = std::max({o.col - box.s[0], box.s[2] - o.col, o.row - box.s[1], box.s[3] - o.row});
-    if (!options_.march_every_target && w1 >= 1 && h1 >= 1 && far_pixels >= kLeastRayPixels) {
-      rays = 2 * w1 + 2 * h1;
-      std::vector<double> lengths(rays);
-      for (int r = 0; r < rays; ++r) {
-        const auto [x, y] = borderPoint(r, box);
-        lengths[r] = std::hypot((x - o.col) * field_.cell_size_x, (y - o.row) * field_.cell_size_y);
-      }
-      const double least_cell = std::min(field_.cell_size_x, field_.cell_size_y);
-      std::vector<cl_uint> offset(rays + 1);
-      std::size_t entries = 0;
-      for (double step = 2.0;; step *= 2.0) {
-        spacing = static_cast<float>(step * least_cell);
-        std::size_t total = 0, longest = 0;
-        for (int r = 0; r < rays; ++r) {
-          const std::size_t n = static_cast<std::size_t>(std::floor(lengths[r] / spacing));
-          offset[r] = static_cast<cl_uint>(total);
-          total += n;
-          longest = std::max(longest, n);
-        }
-        offset[rays] = static_cast<cl_uint>(total);
-        entries = ray_major ? total : longest * rays;
-        if (entries * sizeof(cl_float2) <= budget_ / 2 && total < std::numeric_limits<cl_uint>::max()) break;
-        if (step >= 64.0)
-          throw MemoryBudgetError("the viewshed's ray bounds need " + detail::mebibytes(entries * sizeof(cl_float2)) +
-                                  " even 64 pixels apart, but the budget is " + detail::mebibytes(budget_));
-      }
-      offsets = cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, offset.size() * sizeof(cl_uint),
-                           offset.data());
-      // Kept by the context: a cumulative viewshed's observers need about the same, and on a CPU
-      // a fresh buffer of this size costs its first touch every time.
-      bounds = st_.reusableBuffer("viewshed ray bounds", std::max<std::size_t>(entries, 1) * sizeof(cl_float2));
-      // With the culling pyramid: how far each ray must go to serve the kept nodes' targets.
-      cl::Buffer need = detail::deviceBuffer(st_, sizeof(cl_int));
-      if (cull_leaf.s[0] > 0) {
-        need = detail::deviceBuffer(st_, rays * sizeof(cl_int));
-        st_.queue.enqueueFillBuffer(need, cl_int(-1), 0, rays * sizeof(cl_int));
-        cl::Kernel n(program_, "viewshed_ray_need");
-        int a = 0;
-        n.setArg(a++, culled_);
-        n.setArg(a++, cull_leaf);
-        n.setArg(a++, device_);
-        n.setArg(a++, o.col);
-        n.setArg(a++, o.row);
-        n.setArg(a++, box);
-        n.setArg(a++, rays);
-        n.setArg(a++, spacing);
-        n.setArg(a++, need);
-        st_.launch(n, cl::NDRange(detail::roundUp(cull_leaf.s[0], detail::kTileX), detail::roundUp(cull_leaf.s[1], detail::kTileY)),
-                   cl::NDRange(detail::kTileX, detail::kTileY));
-      }
-      cl::Kernel k(program_, "viewshed_rays");
-      int a = 0;
-      k.setArg(a++, heights_buffer_);
-      k.setArg(a++, device_);
-      k.setArg(a++, lipschitz_);
-      k.setArg(a++, static_cast<float>(o.col));
-      k.setArg(a++, static_cast<float>(o.row));
-      k.setArg(a++, ze);
-      k.setArg(a++, box);
-      k.setArg(a++, rays);
-      k.setArg(a++, offsets);
-      k.setArg(a++, ray_major ? 1 : 0);
-      k.setArg(a++, spacing);
-      k.setArg(a++, need);
-      k.setArg(a++, cull_leaf.s[0] > 0 ? 1 : 0);
-      k.setArg(a++, bounds);
-      st_.launch(k, cl::NDRange(detail::roundUp(rays, detail::kLineGroup)), cl::NDRange(detail::kLineGroup));
-    }
+    const bool use_rays = ray_hi_budgeted_ && !options_.march_every_target && w1 >= 1 && h1 >= 1 &&
+                          far_pixels >= kLeastRayPixels;
     // The field of view's span clockwise; 0 (equal azimuths, or 0 and 360) is the whole circle.
     double az_span = std::fmod(options_.azimuth_to_deg - options_.azimuth_from_deg, 360.0);
     if (az_span < 0.0) az_span += 360.0;
     if (az_span == 0.0) az_span = 360.0;
-    // Classify every target; march the pending ones, listed row by row.
+    // Settle what needs no sight line; the rest is pending, for the rays and then the march.
     cl::Kernel k(program_, "viewshed_classify");
     int a = 0;
     k.setArg(a++, heights_buffer_);
@@ -192,11 +114,6 @@ class ViewshedRun {
     k.setArg(a++, static_cast<float>(az_span));
     k.setArg(a++, static_cast<float>(options_.elevation_min_deg * kDegree));
     k.setArg(a++, static_cast<float>(options_.elevation_max_deg * kDegree));
-    k.setArg(a++, rays);
-    k.setArg(a++, offsets);
-    k.setArg(a++, ray_major ? 1 : 0);
-    k.setArg(a++, spacing);
-    k.setArg(a++, bounds);
     k.setArg(a++, cull_levels_.empty() ? pending_ : culled_);
     k.setArg(a++, cull_leaf);
     k.setArg(a++, visible);
@@ -204,8 +121,54 @@ class ViewshedRun {
     k.setArg(a++, angle ? 1 : 0);
     k.setArg(a++, angle ? *angle : visible);
     k.setArg(a++, pending_);
+    k.setArg(a++, use_rays ? 1 : 0);
+    k.setArg(a++, ray_hi_);
     st_.launch(k, cl::NDRange(detail::roundUp(field_.width, detail::kTileX), detail::roundUp(field_.height, detail::kTileY)),
                cl::NDRange(detail::kTileX, detail::kTileY));
+    // The rays settle most pending targets, or leave them an upper bound for the march.
+    if (use_rays) {
+      const int rays = 2 * w1 + 2 * h1;
+      const float unit = static_cast<float>(std::min(field_.cell_size_x, field_.cell_size_y));
+      // With the culling pyramid: how far each ray must go to serve the kept nodes' targets.
+      cl::Buffer need = detail::deviceBuffer(st_, sizeof(cl_int));
+      if (cull_leaf.s[0] > 0) {
+        need = detail::deviceBuffer(st_, rays * sizeof(cl_int));
+        st_.queue.enqueueFillBuffer(need, cl_int(-1), 0, rays * sizeof(cl_int));
+        cl::Kernel n(program_, "viewshed_ray_need");
+        a = 0;
+        n.setArg(a++, culled_);
+        n.setArg(a++, cull_leaf);
+        n.setArg(a++, device_);
+        n.setArg(a++, o.col);
+        n.setArg(a++, o.row);
+        n.setArg(a++, box);
+        n.setArg(a++, rays);
+        n.setArg(a++, unit);
+        n.setArg(a++, need);
+        st_.launch(n, cl::NDRange(detail::roundUp(cull_leaf.s[0], detail::kTileX), detail::roundUp(cull_leaf.s[1], detail::kTileY)),
+                   cl::NDRange(detail::kTileX, detail::kTileY));
+      }
+      cl::Kernel r(program_, "viewshed_rays");
+      a = 0;
+      r.setArg(a++, heights_buffer_);
+      r.setArg(a++, device_);
+      r.setArg(a++, lipschitz_);
+      r.setArg(a++, o.col);
+      r.setArg(a++, o.row);
+      r.setArg(a++, ze);
+      r.setArg(a++, static_cast<float>(options_.target_height));
+      r.setArg(a++, box);
+      r.setArg(a++, rays);
+      r.setArg(a++, need);
+      r.setArg(a++, cull_leaf.s[0] > 0 ? 1 : 0);
+      r.setArg(a++, unit);
+      r.setArg(a++, pending_);
+      r.setArg(a++, ray_hi_);
+      r.setArg(a++, visible);
+      r.setArg(a++, accumulate ? 1 : 0);
+      st_.launch(r, cl::NDRange(detail::roundUp(rays, detail::kLineGroup)), cl::NDRange(detail::kLineGroup));
+    }
+    // March the pending targets, listed row by row.
     const cl::NDRange row_range(detail::roundUp(field_.height, detail::kLineGroup));
     cl::Kernel count(program_, "viewshed_pending_count");
     count.setArg(0, pending_);
@@ -239,12 +202,8 @@ class ViewshedRun {
       m.setArg(a++, o.row);
       m.setArg(a++, ze);
       m.setArg(a++, static_cast<float>(options_.target_height));
-      m.setArg(a++, box);
-      m.setArg(a++, rays);
-      m.setArg(a++, offsets);
-      m.setArg(a++, ray_major ? 1 : 0);
-      m.setArg(a++, spacing);
-      m.setArg(a++, bounds);
+      m.setArg(a++, use_rays ? 1 : 0);
+      m.setArg(a++, ray_hi_);
       m.setArg(a++, pyramid_);
       m.setArg(a++, levels_);
       m.setArg(a++, top_);
@@ -403,6 +362,8 @@ class ViewshedRun {
   DeviceField device_{};
   cl::Buffer heights_buffer_, lipschitz_, pyramid_, levels_;
   cl::Buffer pending_, pending_list_, row_counts_;  // the targets classification leaves to viewshed_march
+  cl::Buffer ray_hi_;                               // per target, the rays' upper bound for the march
+  bool ray_hi_budgeted_ = false;                    // whether ray_hi_ holds a float per point
   std::size_t pending_targets_ = 0;
   // The culling pyramid (uploadCulling): its levels' table, coarsest first.
   std::vector<cl_int4> cull_levels_;
@@ -412,7 +373,6 @@ class ViewshedRun {
   std::size_t culled_targets_ = 0;
   std::vector<unsigned char> leaf_flags_;  // the last query's finest level
   int top_ = 0;
-  std::size_t budget_ = 0;
 };
 
 void validateViewshed(const HeightField& field, const ViewshedOptions& options) {

@@ -167,12 +167,14 @@ TEST(Viewshed, OptionsMatchBruteForce) {
     ViewshedOptions options;
     options.max_distance = 30.5;
     options.target_height = 1.5;
+    SCOPED_TRACE("maximum distance, target height");
     compare(context, f, o, options, 1e-4);
     options = {};
     options.azimuth_from_deg = 300.0;  // across north
     options.azimuth_to_deg = 45.0;
     options.elevation_min_deg = -10.0;
     options.elevation_max_deg = 5.0;
+    SCOPED_TRACE("field of view");
     const Agreement a = compare(context, f, o, options, 1e-4);
     EXPECT_GT(a.visible, 0u);
     options = {};
@@ -182,23 +184,33 @@ TEST(Viewshed, OptionsMatchBruteForce) {
     anisotropic.cell_size_y = 0.5;
     anisotropic.z_scale = 0.3;
     options.curvature = 0.01;
+    SCOPED_TRACE("anisotropic cells, absolute eye, curvature");
     compare(context, anisotropic, {10, 70, 40.0}, options, 1e-4);
+    {
+      // Every sight line marched whole through the maximum pyramid: its rounding fallback near
+      // the target (a pixel's step that once rounded short of t = 1) is met here.
+      SCOPED_TRACE("the same, every target marched");
+      ViewshedOptions m = options;
+      m.march_every_target = true;
+      compare(context, anisotropic, {10, 70, 40.0}, m, 1e-4);
+    }
     // A negative drop (refraction beyond 1) raises far terrain, for the pyramid's skips too.
     options = {};
     options.curvature = -0.004;
+    SCOPED_TRACE("negative curvature");
     compare(context, f, o, options, 1e-4);
     options.march_every_target = true;
     compare(context, f, o, options, 1e-4);
-    // Bounds kept farther apart under a small budget.
+    // A budget that just holds the rays' upper bounds (a float per point, half the budget).
     options = {};
-    options.memory_budget = 64 * 1024;
+    options.memory_budget = 2 * sizeof(float) * f.pixelCount();
     compare(context, f, o, options, 1e-4);
   });
   // Azimuths 0 and 360 are the whole circle.
   ViewshedOptions circle;
   circle.azimuth_to_deg = 360.0;
   EXPECT_EQ(computeViewshed(testContext(), f, o, circle).visible, computeViewshed(testContext(), f, o, {}).visible);
-  // A budget that leaves no room for bounds: every target is marched.
+  // A budget that leaves no room for the rays' bounds: every target is marched.
   ViewshedOptions tiny;
   tiny.memory_budget = 16;
   EXPECT_EQ(computeViewshed(testContext(), f, o, tiny).visible, computeViewshed(testContext(), f, o, {}).visible);

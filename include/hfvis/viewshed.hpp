@@ -14,16 +14,17 @@
 // How it is computed (kernels/viewshed.cl): the surface along a sight line is a quadratic
 // within each cell, so one sight line is decided exactly by marching it cell by cell. Marching
 // every target is O(N^3), so rays are first marched from the eye to every grid point on the
-// border of the box analysed (the field clipped to the maximum distance), each keeping, per
-// distance, lower and upper bounds on the largest elevation slope met so far, widened by a
-// bound on the surface's slope times the angle to the next ray, so that they bound the slope
-// met by every sight line between the two rays (rigorous while that angle spans at most a
-// pixel). A target whose slope lies below the lower bound of a ray around its sight line is
-// hidden; the others are marched exactly over their last pixels, and over the rest of the line
-// (skipping the blocks of a maximum pyramid that lie below it) unless the upper bounds settle
-// them. The kernels decide in single precision: sight lines that graze the surface within its
-// rounding may go either way, and pieces of a line shorter than 1e-3 pixel skip their vertex
-// test.
+// border of the box analysed (the field clipped to the maximum distance). Each ray keeps lower
+// and upper bounds on the largest elevation slope met so far, widened by a bound on the
+// surface's slope times the angle to the next ray, so that they bound the slope met by every
+// sight line of its wedge (the directions from its border point up to the next one; rigorous
+// while that angle spans at most a pixel). The wedges partition the directions around the eye
+// exactly (integer cross products), and each ray settles its wedge's targets as it passes them:
+// a target whose slope lies below the lower bound is hidden; the others keep the upper bound and
+// are marched exactly over their last 2.5 pixels, and over the rest of the line (skipping the
+// blocks of a maximum pyramid that lie below it) unless that bound settles them. The kernels
+// decide in single precision: sight lines that graze the surface within its rounding may go
+// either way, and pieces of a line shorter than 1e-3 pixel skip their vertex test.
 //
 // A culling pyramid (ViewshedPyramid, after Stewart 1997, "Hierarchical visibility in
 // terrains") lets a viewshed skip whole blocks of targets hidden from the eye: built once per
@@ -64,8 +65,9 @@ struct ViewshedOptions {
   // of deciding most from the rays' bounds: the same decisions, more slowly (tests and the
   // benchmark compare the two).
   bool march_every_target = false;
-  // Device memory for the rays' bounds; 0 = half the device memory. When the rays' bounds at
-  // every 2 pixels do not fit, they are kept farther apart (more of every sight line is marched).
+  // Device memory for the rays' upper bounds (a float per grid point); 0 = half the device
+  // memory. When they take more than half of it, every target is marched (the same decisions,
+  // more slowly).
   std::size_t memory_budget = 0;
   // Cumulative viewsheds: called after each observer with (done, total).
   std::function<void(int, int)> progress;
@@ -195,8 +197,7 @@ void validate(const HeightField& field, const Observer& observer);
 
 // The viewshed of one observer. Throws InvalidArgument (bad field, observer or options, a
 // latitude / longitude grid, a field of 2^31 points or more, a pyramid built for another field,
-// target height or curvature, or malformed), MemoryBudgetError, OpenClError,
-// KernelBuildError.
+// target height or curvature, or malformed), OpenClError, KernelBuildError.
 ViewshedResult computeViewshed(const ComputeContext& context, const HeightField& field, const Observer& observer,
                                const ViewshedOptions& options, const ViewshedOutputs& outputs = {});
 
