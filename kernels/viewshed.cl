@@ -381,10 +381,10 @@ inline SightLine sight_line(__global const float* h, Field f, int x, int y, int 
   return s;
 }
 
-// The ground distance from the eye where viewshed_march's exact part of a sight line of length
-// dist begins: 2.5 pixels short of the target (0 or less: the whole line is marched), where the
-// bounds of a ray two grid lines short of the target reach along an axis (one along a diagonal).
-inline float split_distance(float dist, Field f) { return dist - 2.5f * hf_max(f.cell_x, f.cell_y); }
+// How far short of the target viewshed_march's exact part of a sight line begins: 2.5 pixels,
+// where the bounds of a ray two grid lines short of the target reach along an axis (one along a
+// diagonal). A line no longer is marched whole.
+inline float split_length(Field f) { return 2.5f * hf_max(f.cell_x, f.cell_y); }
 
 // Whether the direction v from the eye lies in the wedge from a (included) clockwise to b
 // (excluded), both directions from the eye to border points (a x b > 0: rows grow downward, so
@@ -402,39 +402,49 @@ inline int in_wedge(int2 a, int2 b, long vx, long vy) {
 // prefix ends short of it; else the bound over the shorter prefix that reaches its split
 // distance is kept for viewshed_march, which marches the rest exactly. Targets neither settles
 // keep ray_hi = INFINITY (a whole march). Ray r crosses line m at e_minor + qa + ra / den
-// (exactly; side a of the wedge), side b (b_along: where it runs the same way along the axis)
-// at e_minor + (m - e_major) * slope_b; the wedge meets the line in at most about a pixel.
-inline void settle_targets(__global const float* h, Field f, int ex_i, int ey_i, float ze, float target_height,
-                           int4 box, int x_major, int m, int qa, int ra, int den, int b_along, float slope_b, int2 a,
+// (exactly; side a of the wedge; inv_den = 1 / den), side b (b_along: where it runs the same
+// way along the axis) at e_minor + (m - e_major) * slope_b; the wedge meets the line in at
+// most about a pixel.
+HFVIS_INLINE void settle_targets(__global const float* h, Field f, int ex_i, int ey_i, float ze, float target_height,
+                           int4 box, int x_major, int m, int qa, int ra, float inv_den, int b_along, float slope_b, int2 a,
                            int2 b, float lo, float hi, float d_ray, float hi_back, float d_back,
                            __global uchar* pending, __global float* ray_hi, __global float* out_visible,
                            int accumulate) {
   if (m < (x_major ? box.x : box.y) || m > (x_major ? box.z : box.w)) return;
   const int e_major = x_major ? ex_i : ey_i, e_minor = x_major ? ey_i : ex_i;
-  const float ma = e_minor + qa + (float)ra / den;
+  const float ma = e_minor + qa + ra * inv_den;
   const float mb = b_along ? e_minor + (m - e_major) * slope_b : ma;
   // The grid points between the sides: a's is exact, so none on side a is missed (b's side is
   // not in the wedge).
   const int minor_lo = x_major ? box.y : box.x, minor_hi = x_major ? box.w : box.z;
   const int first = max(ma <= mb ? e_minor + qa + (ra > 0) : (int)ceil(mb), minor_lo);
   const int last = min(min(ma <= mb ? (int)floor(mb) : e_minor + qa, minor_hi), first + 3);
+  // Distances compared in squares, with margins far above their rounding: the prefix ends a
+  // quarter pixel short of a target (for lo), or reaches its split distance dist - split_length
+  // (for hi): dist <= (d + split_length - margin) (1 - 1e-5), which the march's own root of d2
+  // keeps within its rounding.
   const float cell_min = hf_min(f.cell_x, f.cell_y);
+  const float near = d_ray + 0.25f * cell_min;
+  const float reach_back = (d_back + split_length(f) - 1e-3f * cell_min) * (1.0f - 1e-5f);
+  const float reach_now = (d_ray + split_length(f) - 1e-3f * cell_min) * (1.0f - 1e-5f);
   for (int n = first; n <= last; ++n) {
     const int x = x_major ? m : n, y = x_major ? n : m;
     if (!in_wedge(a, b, x - ex_i, y - ey_i)) continue;
     const size_t p = (size_t)y * f.width + x;
     if (!pending[p]) continue;
-    const SightLine s = sight_line(h, f, x, y, ex_i, ey_i, ze, target_height);
-    // Margins far above the rounding of the distances.
-    const float split = split_distance(s.dist, f) + 1e-5f * s.dist + 1e-3f * cell_min;
-    if (d_ray < s.dist - 0.25f * cell_min && s.slope < lo) {  // something nearer rises above the sight line
+    // The target's squared distance and rise as sight_line has them.
+    const float gx = (x - ex_i) * f.cell_x, gy = (y - ey_i) * f.cell_y;
+    const float d2 = gx * gx + gy * gy;
+    const float rise = (h[p] + target_height - f.curvature * d2) - ze;
+    if (near * near < d2 && rise < lo * native_sqrt(d2)) {  // something nearer rises above the sight line
       put_visible(out_visible, p, 0.0f, accumulate);
       pending[p] = 0;
-    } else if (d_back >= split) {
-      ray_hi[p] = hi_back;
-    } else if (d_ray >= split) {
-      ray_hi[p] = hi;
+      continue;
     }
+    if (d2 <= reach_back * reach_back)
+      ray_hi[p] = hi_back;
+    else if (d2 <= reach_now * reach_now)
+      ray_hi[p] = hi;
   }
 }
 
@@ -557,7 +567,7 @@ __kernel void viewshed_rays(__global const float* h, Field f, __global const flo
     if (crossed || t1 >= 1.0f) {
       Axis major = x_major ? ax : ay;
       if (!crossed) axis_next(&major, x_major ? ex : ey, x_major ? dx : dy, x_major ? inv_dx : inv_dy);
-      settle_targets(h, f, ex_i, ey_i, ze, target_height, box, x_major, (int)major.g, major.q, major.r, major.den,
+      settle_targets(h, f, ex_i, ey_i, ze, target_height, box, x_major, (int)major.g, major.q, major.r, major.inv_den,
                      b_along, slope_b, a, b, lo, hi, d_ray, hi_back, d_back, pending, ray_hi, out_visible, accumulate);
       hi_back = hi;
       d_back = d_ray;
@@ -725,7 +735,7 @@ __kernel void viewshed_march(__global const float* h, Field f, int ex_i, int ey_
   const SightLine s = sight_line(h, f, x, y, ex_i, ey_i, ze, target_height);
   const float ex = ex_i, ey = ey_i;
   const float hi = rays_on ? ray_hi[p] : INFINITY;
-  const float split = split_distance(s.dist, f);
+  const float split = s.dist - split_length(f);
   int blocked;
   if (hi < INFINITY && split > 0.0f) {
     const float t_split = native_divide(split, s.dist);
