@@ -495,12 +495,15 @@ namespace {
 // Lighting assumes row 0 is north (compass azimuth = hfvis azimuth + 90 degrees). A raster whose
 // geotransform runs south-up (t[5] > 0) is lit flipped north-up, and its results flipped back.
 struct NorthUp {
-  HeightField field;
+  const HeightField* input = nullptr;
+  HeightField flipped_copy;  // the input flipped north-up, when it runs south-up
   bool flipped = false;
+  // The field to compute on: the input itself (no copy), or its flipped copy.
+  const HeightField& field() const { return flipped ? flipped_copy : *input; }
   // A plane of the field's size (or several, one after another) back in the input's row order.
   void restore(std::vector<float>& planes) const {
     if (!flipped) return;
-    const std::size_t width = field.width, rows = field.height, plane = width * rows;
+    const std::size_t width = input->width, rows = input->height, plane = width * rows;
     for (std::size_t at = 0; at + plane <= planes.size(); at += plane)
       for (std::size_t r = 0; r < rows / 2; ++r)
         std::swap_ranges(planes.begin() + at + r * width, planes.begin() + at + (r + 1) * width,
@@ -508,14 +511,17 @@ struct NorthUp {
   }
 };
 
+// `field` must outlive the result.
 NorthUp northUp(const HeightField& field) {
-  NorthUp out{field, false};
+  NorthUp out;
+  out.input = &field;
   const auto& t = field.georeference.geotransform;
   if (!t || !((*t)[5] > 0.0)) return out;
   out.flipped = true;
-  out.restore(out.field.heights);  // the flip is its own inverse
-  std::reverse(out.field.row_cell_size_x.begin(), out.field.row_cell_size_x.end());
-  std::reverse(out.field.row_cell_size_y.begin(), out.field.row_cell_size_y.end());
+  out.flipped_copy = field;
+  out.restore(out.flipped_copy.heights);  // the flip is its own inverse
+  std::reverse(out.flipped_copy.row_cell_size_x.begin(), out.flipped_copy.row_cell_size_x.end());
+  std::reverse(out.flipped_copy.row_cell_size_y.begin(), out.flipped_copy.row_cell_size_y.end());
   return out;
 }
 
@@ -560,8 +566,9 @@ int runShade(const RunArguments& run) {
     for (const std::string& output : paths)
       if (!input.empty() && sameFile(input, output))
         throw UsageError("output '" + output + "' is the input '" + input + "': outputs never replace an input");
-  const NorthUp lit = northUp(readValidField(run));
-  const HeightField& field = lit.field;
+  const HeightField input = readValidField(run);
+  const NorthUp lit = northUp(input);
+  const HeightField& field = lit.field();
   std::optional<EnvironmentMap> environment;
   if (!run.environment.empty()) {
     environment = readEnvironmentMap(run.environment);
@@ -686,8 +693,9 @@ int runShade(const RunArguments& run) {
 
 int runInsolation(const RunArguments& run) {
   requireOutputs(run, outputPaths(run));
-  const NorthUp lit = northUp(readValidField(run));
-  const HeightField& field = lit.field;
+  const HeightField input = readValidField(run);
+  const NorthUp lit = northUp(input);
+  const HeightField& field = lit.field();
   const ComputeContext context = contextFor(run);
   const DeviceInfo& device = context.device();
   const InsolationOptions options = insolationOptions(run);
@@ -827,7 +835,7 @@ int runViewshed(const RunArguments& run) {
   // Compass azimuths (--fov) take row 0 as north: a south-up GeoTIFF is computed flipped
   // north-up, its observers with it, and its results flipped back.
   const NorthUp lit = northUp(input);
-  const HeightField& field = lit.field;
+  const HeightField& field = lit.field();
   std::vector<Observer> placed = observers;
   if (lit.flipped)
     for (Observer& o : placed) o.row = field.height - 1 - o.row;
@@ -931,13 +939,13 @@ int runViewshed(const RunArguments& run) {
   if (run.elevation_range)
     attributes.emplace_back("hfvis:elevation_range_deg", formatNumber(run.elevation_range->first) + " .. " +
                                                              formatNumber(run.elevation_range->second));
-  const ImageChannels image = makeImage(input, run, names, planes, attributes, quantity, units);
+  const ImageChannels image = makeImage(input, run, names, std::move(planes), attributes, quantity, units);
   StagedOutputs outputs;
   outputs.stage(run.output, [&](const std::string& path) { writeImage(path, image); });
   if (!run.preview.empty()) {
     outputs.stage(run.preview, [&](const std::string& path) {
       // Visible points (or the count) bright over a dimmed hillshade; nodata black.
-      const std::vector<float>& seen = planes.back();
+      const std::vector<float>& seen = image.planes.back();
       float most = 0.0f;
       for (float v : seen)
         if (v > most) most = v;

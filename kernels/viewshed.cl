@@ -11,11 +11,12 @@
 //
 // The kernels, in the order they run: viewshed_slopes and viewshed_lipschitz (a bound on the
 // surface's slope around each cell) and the maximum pyramid, once per field; per observer,
-// viewshed_cull (the culling pyramid's query, with one), viewshed_rays (one work-item per ray
-// from E to a point of the box's border: bounds on the largest elevation slope met within each
-// distance), viewshed_classify (one work-item per target: what the range, the culling and the
-// rays' lower bounds settle), the pending targets' list, and viewshed_march (one work-item per
-// pending target: an exact march, cut short by the rays' upper bounds where they settle it).
+// viewshed_cull (the culling pyramid's query, with one), viewshed_classify (one work-item per
+// target: what the range, nodata and the culling settle), viewshed_ray_need (with culling: how
+// far the rays must go), viewshed_rays (one work-item per ray from E to a point of the box's
+// border: bounds on the largest elevation slope met, with which it settles the targets of its
+// wedge as it passes them), the pending targets' list, and viewshed_march (one work-item per
+// pending target: an exact march, cut short by its ray's upper bound where that settles it).
 #pragma OPENCL FP_CONTRACT OFF
 
 #include "fast_math.cl"
