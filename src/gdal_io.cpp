@@ -305,6 +305,16 @@ bool hasGeoTiffWriter() {
   return GDALGetDriverByName("GTiff") != nullptr;
 }
 
+namespace {
+// Whether every value of every plane is a whole number or NaN.
+bool wholeNumbers(const ImageChannels& image) {
+  for (const std::vector<float>& plane : image.planes)
+    for (float v : plane)
+      if (!std::isnan(v) && v != std::nearbyint(v)) return false;
+  return true;
+}
+}  // namespace
+
 void writeGeoTiff(const std::string& file, const std::string& path, const ImageChannels& image) {
   if (!hasGeoTiffWriter()) throw IoError(path, "this GDAL has no GTiff driver to write a GeoTIFF");
   // Everything must go into the TIFF itself: with PAM on, GDAL puts what no TIFF tag holds into
@@ -316,7 +326,12 @@ void writeGeoTiff(const std::string& file, const std::string& path, const ImageC
   options = CSLSetNameValue(options, "BLOCKXSIZE", std::to_string(kTileSize).c_str());
   options = CSLSetNameValue(options, "BLOCKYSIZE", std::to_string(kTileSize).c_str());
   options = CSLSetNameValue(options, "COMPRESS", "DEFLATE");
-  options = CSLSetNameValue(options, "PREDICTOR", "3");  // floating-point predictor
+  // Level 1: about half the time of the default 6 for 1-2 % more bytes (a 4096^2 float32 DEM
+  // here: 0.46 s and 42.2 MB against 1.01 s and 41.5 MB). The floating-point predictor helps
+  // continuous values and only costs where every value is a whole number (visible 0 / 1, counts):
+  // 0.19 s and 0.42 MB without it, 0.32 s and 0.64 MB with it, on a 4096^2 viewshed.
+  options = CSLSetNameValue(options, "ZLEVEL", "1");
+  options = CSLSetNameValue(options, "PREDICTOR", wholeNumbers(image) ? "1" : "3");
   // Band by band: each plane is written whole, so each compressed tile is written once (pixel
   // interleaving would recompress every tile for every band).
   options = CSLSetNameValue(options, "INTERLEAVE", "BAND");

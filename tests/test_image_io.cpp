@@ -727,6 +727,31 @@ TEST(ImageWriters, GeoTiffNamesGoThroughGdal) {
     EXPECT_FALSE(writesGeoTiff(name)) << name;
 }
 
+TEST_F(ImageIoTest, GeoTiffOfWholeNumbersSkipsTheFloatingPointPredictor) {
+  // Visible 0 / 1 and counts (NaN at nodata) compress better and faster without it; one
+  // fractional value anywhere brings it back.
+  ImageChannels image;
+  image.width = 9;
+  image.height = 4;
+  image.names = {"visible", "count"};
+  image.planes = {std::vector<float>(36, 1.0f), std::vector<float>(36, 7.0f)};
+  image.planes[0][3] = 0.0f;
+  image.planes[1][5] = kNaN;
+  const std::string whole = path("whole.tif"), fractional = path("fractional.tif");
+  writeImage(whole, image);
+  image.planes[1][8] = 2.5f;
+  writeImage(fractional, image);
+  const GdalRaster a = readGdalRaster(whole), b = readGdalRaster(fractional);
+  EXPECT_EQ(a.image_structure.at("COMPRESSION"), "DEFLATE");
+  EXPECT_EQ(a.image_structure.count("PREDICTOR"), 0u);  // none
+  EXPECT_EQ(b.image_structure.at("PREDICTOR"), "3");
+  ASSERT_EQ(a.bands.size(), 2u);
+  EXPECT_EQ(a.bands[0][3], 0.0f);
+  EXPECT_EQ(a.bands[0][4], 1.0f);
+  EXPECT_TRUE(std::isnan(a.bands[1][5]));
+  EXPECT_EQ(b.bands[1][8], 2.5f);
+}
+
 TEST_F(ImageIoTest, GeoTiffOutputKeepsBandsGeoreferenceAndNodata) {
   ImageChannels image = horizonImage(7, 5, 3);
   image.planes[0][4] = kNaN;
