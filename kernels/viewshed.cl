@@ -20,6 +20,7 @@
 #pragma OPENCL FP_CONTRACT OFF
 
 #include "fast_math.cl"
+#include "lanes.cl"
 
 // Divisions and square roots in the bounds and the classification are native_ ones: the program
 // is built for correctly rounded ones (which the exact marches' few divisions keep), whose
@@ -490,91 +491,307 @@ __kernel void viewshed_ray_need(__global const uchar* culled, int4 leaf, Field f
   for (int r = first; r <= last; ++r) atomic_max(&need[((r % rays) + rays) % rays], q);
 }
 
-// viewshed_rays, one work-item per ray from the eye E to border point r, marched cell by cell.
-// It keeps bounds on the largest slope (s(t) - ze) / (t D) met so far, widened so that they
-// also bound that of every sight line of its wedge (to border point r + 1, at distances the
-// ray has reached): lo <= that slope <= hi. The widening is L * angle, L the surface's slope
-// bound around the cell (|s difference| <= L * arc between two lines at one distance, arc =
-// distance * angle), valid while the arc stays within one pixel of the ray. Each time the ray
-// crosses a grid line of its major axis it settles the wedge's targets on the next one
-// (settle_targets), and at its end those one line past it.
-__kernel void viewshed_rays(__global const float* h, Field f, __global const float* lipschitz, int ex_i, int ey_i,
-                            float ze, float target_height, int4 box, int rays, __global const int* need,
-                            int use_need, float unit, __global uchar* pending, __global float* ray_hi,
-                            __global float* out_visible, int accumulate) {
-  const int r = get_global_id(0);
-  if (r >= rays) return;
-  // With the culling pyramid, only as far as the kept nodes' targets.
-  const float reach = use_need ? (need[r] + 1) * unit : INFINITY;
-  if (!(reach > 0.0f)) return;
+// A ray from E to border point r, as viewshed_rays marches it: its wedge (a, b: its border point
+// and the next one, less E), its step in pixels and ground length, its wedge's angle and the
+// distance where the arc between them reaches a pixel, the curvature drop at its end, its
+// grid-line crossings, and how far it must go (the culling's reach). ok: a ray to march (a
+// non-empty wedge, an eye inside the box's border, within the reach).
+typedef struct {
+  int ok, x_major, b_along;
+  int2 a, b;
+  float2 end;
+  float dx, dy, inv_dx, inv_dy, length, angle, arc_limit, drop, reach, slope_b;
+  Axis ax, ay;
+} Ray;
+
+HFVIS_INLINE Ray ray_setup(int r, int rays, Field f, int ex_i, int ey_i, int4 box, __global const int* need,
+                           int use_need, float unit) {
+  Ray y;
   const float ex = ex_i, ey = ey_i;
-  const float2 end = border_point(r, box), next_end = border_point(r + 1 == rays ? 0 : r + 1, box);
-  const int2 a = (int2)((int)end.x - ex_i, (int)end.y - ey_i), b = (int2)((int)next_end.x - ex_i, (int)next_end.y - ey_i);
-  if ((long)a.x * b.y - (long)a.y * b.x <= 0) return;  // an empty wedge (an eye on the box's border)
+  y.reach = use_need ? (need[r] + 1) * unit : INFINITY;  // with culling, as far as the kept nodes' targets
+  y.end = border_point(r, box);
+  const float2 next_end = border_point(r + 1 == rays ? 0 : r + 1, box);
+  y.a = (int2)((int)y.end.x - ex_i, (int)y.end.y - ey_i);
+  y.b = (int2)((int)next_end.x - ex_i, (int)next_end.y - ey_i);
+  y.ok = y.reach > 0.0f && (long)y.a.x * y.b.y - (long)y.a.y * y.b.x > 0;  // else an empty wedge
   // The wedge's angle, widened past the rounding of its few operations.
-  const float angle = ray_angle(ex, ey, r, r + 1 == rays ? 0 : r + 1, box, f) * (1.0f + 1e-5f);
-  const float dx = a.x, dy = a.y;
-  const int x_major = fabs(dx) >= fabs(dy);
-  const float gdx = dx * f.cell_x, gdy = dy * f.cell_y;
-  const float length = sqrt(gdx * gdx + gdy * gdy);
-  const float arc_limit = fmin(f.cell_x, f.cell_y) / angle;  // distance where the arc reaches a pixel
-  const int cells_x = max(f.width - 1, 1);
-  const float inv_dx = dx != 0.0f ? 1.0f / dx : 0.0f, inv_dy = dy != 0.0f ? 1.0f / dy : 0.0f;
-  Axis ax = axis_start(dx > 0.0f ? ex + 1.0f : ex - 1.0f, ex, dx, inv_dx, dy);
-  Axis ay = axis_start(dy > 0.0f ? ey + 1.0f : ey - 1.0f, ey, dy, inv_dy, dx);
+  y.angle = ray_angle(ex, ey, r, r + 1 == rays ? 0 : r + 1, box, f) * (1.0f + 1e-5f);
+  y.dx = y.a.x;
+  y.dy = y.a.y;
+  y.x_major = fabs(y.dx) >= fabs(y.dy);
+  const float gdx = y.dx * f.cell_x, gdy = y.dy * f.cell_y;
+  y.length = sqrt(gdx * gdx + gdy * gdy);
+  y.arc_limit = fmin(f.cell_x, f.cell_y) / y.angle;  // distance where the arc reaches a pixel
+  y.inv_dx = y.dx != 0.0f ? 1.0f / y.dx : 0.0f;
+  y.inv_dy = y.dy != 0.0f ? 1.0f / y.dy : 0.0f;
+  y.ax = axis_start(y.dx > 0.0f ? ex + 1.0f : ex - 1.0f, ex, y.dx, y.inv_dx, y.dy);
+  y.ay = axis_start(y.dy > 0.0f ? ey + 1.0f : ey - 1.0f, ey, y.dy, y.inv_dy, y.dx);
+  y.drop = f.curvature * y.length * y.length;
   // Side b of the wedge across the major axis, where it runs the same way along it.
-  const int a_major = x_major ? a.x : a.y, b_major = x_major ? b.x : b.y;
-  const int b_along = b_major != 0 && (b_major > 0) == (a_major > 0);
-  const float slope_b = b_along ? (float)(x_major ? b.y : b.x) / b_major : 0.0f;
-  float hi_back = INFINITY, d_back = 0.0f;  // the bound at the previous crossing of the major axis
-  const float drop = f.curvature * length * length;
+  const int a_major = y.x_major ? y.a.x : y.a.y, b_major = y.x_major ? y.b.x : y.b.y;
+  y.b_along = b_major != 0 && (b_major > 0) == (a_major > 0);
+  y.slope_b = y.b_along ? (float)(y.x_major ? y.b.y : y.b.x) / b_major : 0.0f;
+  return y;
+}
+
+// A ray's bounds over one piece [t0, t1] of it within one cell, where f (the surface's height
+// above the eye, curvature taken) runs from f0 to f1 with t^2 coefficient alpha, lip the
+// surface's slope bound around the cell: *lo and *hi raised where `live`. The largest slope
+// f / (t D) on the piece is at most its top over the nearest distance (the farthest where the
+// top is negative); on the first piece (t0 = 0, f0 = -eye height <= 0) f / t <= (f - f0) / t,
+// which is linear in t: at most its value at an end. The widening is lip * angle while t D
+// stays within arc_limit. For scalars and lane vectors alike.
+#define HF_MAX(a, b) ((a) > (b) ? (a) : (b))
+#define HFVIS_RAY_BOUNDS(F, I)                                                                                    \
+  HFVIS_INLINE HFVIS_OVERLOADABLE F bump_top(F f0, F f1, F a) { /* quadratic_bump, branch-free */               \
+    const F bump = -a;                                                                                          \
+    const F s = 0.5f + native_divide(f1 - f0, 2.0f * bump);                                                     \
+    return (a < 0.0f) & (s > 0.0f) & (s < 1.0f) ? f0 + (f1 - f0) * s + bump * s * (1.0f - s) : (F)(-INFINITY);  \
+  }                                                                                                             \
+  HFVIS_INLINE HFVIS_OVERLOADABLE void ray_bounds(F t0, F t1, F f0, F f1, F alpha, F length, F arc_limit, F lip, \
+                                                  F angle, I live, F* lo, F* hi) {                              \
+    const F span = t1 - t0;                                                                                     \
+    const F top = HF_MAX(HF_MAX(f0, f1), bump_top(f0, f1, alpha * span * span)); /* NaN: no bound */           \
+    const F rise = (f1 - f0) / t1;                                                                              \
+    const F first = f0 > 0.0f ? (F)INFINITY : HF_MAX(rise - alpha * t1, rise) / length;                         \
+    F seg_hi = t0 > 0.0f ? native_divide(top, (top >= 0.0f ? t0 : t1) * length) : first;                        \
+    const F seg_lo = native_divide(f1, t1 * length);                                                            \
+    const F widen = t1 * length <= arc_limit ? lip * angle : (F)INFINITY;                                       \
+    seg_hi = isnan(seg_hi) | isnan(widen) ? (F)INFINITY : seg_hi + widen;                                       \
+    *hi = live ? HF_MAX(*hi, seg_hi) : *hi;                                                                     \
+    /* a surface point the sight lines pass near */                                                             \
+    *lo = live & !isnan(seg_lo) ? HF_MAX(*lo, seg_lo - widen) : *lo;                                            \
+  }
+HFVIS_RAY_BOUNDS(float, int)
+#if HFVIS_LANES > 1
+HFVIS_RAY_BOUNDS(lane_float, lane_int)
+#endif
+
+// Ray r marched alone, event by event (grid-line crossings in order); it settles the targets of
+// its wedge as viewshed_rays describes.
+HFVIS_INLINE void one_ray(int r, __global const float* h, Field f, __global const float* lipschitz, int ex_i,
+                          int ey_i, float ze, float target_height, int4 box, int rays, __global const int* need,
+                          int use_need, float unit, __global uchar* pending, __global float* ray_hi,
+                          __global float* out_visible, int accumulate) {
+  Ray y = ray_setup(r, rays, f, ex_i, ey_i, box, need, use_need, unit);
+  if (!y.ok) return;
+  const float ex = ex_i, ey = ey_i;
+  const int cells_x = max(f.width - 1, 1);
   float lo = -INFINITY, hi = -INFINITY;
+  float hi_back = INFINITY, d_back = 0.0f;  // the bound at the previous crossing of the major axis
   float t0 = 0.0f, f0 = h[ey_i * f.width + ex_i] - ze;
   for (;;) {
-    const float tx = ax.t, ty = ay.t;
+    const float tx = y.ax.t, ty = y.ay.t;
     const float t1 = hf_min(hf_min(tx, ty), 1.0f);
     const float tm = 0.5f * (t0 + t1);
-    const int4 c = cell_of(ex + tm * dx, ey + tm * dy, f.width, f.height);
-    const float s1 = t1 == tx   ? surface_at_crossing(h, f.width, 1, &ax, ex_i, ey_i)
-                     : t1 == ty ? surface_at_crossing(h, f.width, 0, &ay, ex_i, ey_i)
-                                : h[(int)end.y * f.width + (int)end.x];
-    const float f1 = (s1 - ze) - drop * t1 * t1;  // height above the eye, curvature taken
-    const float span = t1 - t0;
-    const float alpha = surface_curve(h, f.width, c, dx, dy) - drop;  // t^2 coefficient of f
-    const float top = hf_max(hf_max(f0, f1), quadratic_bump(f0, f1, alpha * span * span));  // NaN: no bound
-    // The largest slope f / (t D) on the segment is at most its top over the nearest distance
-    // (the farthest where the top is negative). On the first segment (t0 = 0, f0 = -eye
-    // height <= 0) f / t <= (f - f0) / t, which is linear in t: at most its value at an end.
-    float seg_hi;
-    if (t0 > 0.0f)
-      seg_hi = native_divide(top, (top >= 0.0f ? t0 : t1) * length);
-    else if (f0 > 0.0f)
-      seg_hi = INFINITY;  // the eye below the surface
-    else
-      seg_hi = hf_max((f1 - f0) / t1 - alpha * t1, (f1 - f0) / t1) / length;
-    const float seg_lo = native_divide(f1, t1 * length);
-    const float widen = t1 * length <= arc_limit ? lipschitz[c.y * cells_x + c.x] * angle : INFINITY;
-    seg_hi = isnan(seg_hi) || isnan(widen) ? INFINITY : seg_hi + widen;
-    hi = hf_max(hi, seg_hi);
-    if (!isnan(seg_lo)) lo = hf_max(lo, seg_lo - widen);  // a surface point the sight lines pass near
-    const float d_ray = t1 * length;
-    const int crossed = x_major ? tx <= t1 : ty <= t1;  // a grid line of the major axis, at t1
+    const int4 c = cell_of(ex + tm * y.dx, ey + tm * y.dy, f.width, f.height);
+    const float s1 = t1 == tx   ? surface_at_crossing(h, f.width, 1, &y.ax, ex_i, ey_i)
+                     : t1 == ty ? surface_at_crossing(h, f.width, 0, &y.ay, ex_i, ey_i)
+                                : h[(int)y.end.y * f.width + (int)y.end.x];
+    const float f1 = (s1 - ze) - y.drop * t1 * t1;
+    const float alpha = surface_curve(h, f.width, c, y.dx, y.dy) - y.drop;  // t^2 coefficient of f
+    ray_bounds(t0, t1, f0, f1, alpha, y.length, y.arc_limit, lipschitz[c.y * cells_x + c.x], y.angle, 1, &lo, &hi);
+    const float d_ray = t1 * y.length;
+    const int crossed = y.x_major ? tx <= t1 : ty <= t1;  // a grid line of the major axis, at t1
     f0 = f1;
-    if (tx <= t1) axis_next(&ax, ex, dx, inv_dx);
-    if (ty <= t1) axis_next(&ay, ey, dy, inv_dy);
+    if (tx <= t1) axis_next(&y.ax, ex, y.dx, y.inv_dx);
+    if (ty <= t1) axis_next(&y.ay, ey, y.dy, y.inv_dy);
     t0 = t1;
     // Past a crossing of the major axis the next grid line's targets (the axis now holds that
     // line), at the end the line past it.
     if (crossed || t1 >= 1.0f) {
-      Axis major = x_major ? ax : ay;
-      if (!crossed) axis_next(&major, x_major ? ex : ey, x_major ? dx : dy, x_major ? inv_dx : inv_dy);
-      settle_targets(h, f, ex_i, ey_i, ze, target_height, box, x_major, (int)major.g, major.q, major.r, major.inv_den,
-                     b_along, slope_b, a, b, lo, hi, d_ray, hi_back, d_back, pending, ray_hi, out_visible, accumulate);
+      Axis major = y.x_major ? y.ax : y.ay;
+      if (!crossed) axis_next(&major, y.x_major ? ex : ey, y.x_major ? y.dx : y.dy, y.x_major ? y.inv_dx : y.inv_dy);
+      settle_targets(h, f, ex_i, ey_i, ze, target_height, box, y.x_major, (int)major.g, major.q, major.r,
+                     major.inv_den, y.b_along, y.slope_b, y.a, y.b, lo, hi, d_ray, hi_back, d_back, pending, ray_hi,
+                     out_visible, accumulate);
       hi_back = hi;
       d_back = d_ray;
     }
-    if (t1 >= 1.0f || d_ray > reach) break;
+    if (t1 >= 1.0f || d_ray > y.reach) break;
   }
+}
+
+#if HFVIS_LANES > 1
+// Axis (above) in lanes.
+typedef struct {
+  lane_float g, t, inv_den;
+  lane_int q, r, den, dq, dr;
+} LaneAxis;
+
+HFVIS_INLINE void lane_axis_put(LaneAxis* v, int l, Axis a) {
+  LANE(v->g, l) = a.g, LANE(v->t, l) = a.t, LANE(v->inv_den, l) = a.inv_den;
+  ILANE(v->q, l) = a.q, ILANE(v->r, l) = a.r, ILANE(v->den, l) = a.den, ILANE(v->dq, l) = a.dq, ILANE(v->dr, l) = a.dr;
+}
+
+HFVIS_INLINE Axis lane_axis_get(const LaneAxis* v, int l) {
+  Axis a;
+  a.g = LANE(v->g, l), a.t = LANE(v->t, l), a.inv_den = LANE(v->inv_den, l);
+  a.q = ILANE(v->q, l), a.r = ILANE(v->r, l), a.den = ILANE(v->den, l), a.dq = ILANE(v->dq, l), a.dr = ILANE(v->dr, l);
+  return a;
+}
+
+// axis_next where `go`.
+HFVIS_INLINE void lane_axis_next(LaneAxis* a, float e_along, lane_float d_along, lane_float inv_along, lane_int go) {
+  const lane_float g = a->g + sign(d_along);
+  const lane_int before = (d_along != 0.0f) & (d_along > 0.0f ? g < e_along + d_along : g > e_along + d_along);
+  const lane_float t = before ? (g - e_along) * inv_along : (lane_float)INFINITY;
+  lane_int q = a->q + a->dq, r = a->r + a->dr;
+  const lane_int carry = r >= a->den;
+  r = carry ? r - a->den : r;
+  q = carry ? q + 1 : q;
+  a->g = go ? g : a->g;
+  a->t = go ? t : a->t;
+  a->q = go ? q : a->q;
+  a->r = go ? r : a->r;
+}
+
+HFVIS_INLINE lane_float gather(__global const float* p, lane_int at) {
+  lane_float v;
+#pragma unroll
+  for (int l = 0; l < HFVIS_LANES; ++l) LANE(v, l) = p[ILANE(at, l)];
+  return v;
+}
+
+// surface_at_crossing in lanes (lanes not `live` read the first height).
+HFVIS_INLINE lane_float lane_surface_at_crossing(__global const float* h, int width, int x_axis, const LaneAxis* a,
+                                                 int ex, int ey, lane_int live) {
+  const lane_int g = convert_int8(a->g);
+  const lane_int at = live ? (x_axis ? (ey + a->q) * width + g : g * width + (ex + a->q)) : (lane_int)0;
+  const lane_int next = a->r != 0 ? at + (x_axis ? width : 1) : at;
+  const lane_float lo = gather(h, at), hi = gather(h, next);
+  return a->r == 0 ? lo : lo + (hi - lo) * (convert_float8(a->r) * a->inv_den);
+}
+
+// The bounds over the piece [t0, t1] of the lanes' rays (t1 where `live`), from its cell (at the
+// piece's middle) and f1 at its end.
+HFVIS_INLINE void lane_piece(__global const float* h, Field f, __global const float* lipschitz, float ex, float ey,
+                             lane_float dx, lane_float dy, lane_float drop, lane_float length, lane_float arc_limit,
+                             lane_float angle, lane_float t0, lane_float t1, lane_float f0, lane_float f1,
+                             lane_int live, lane_float* lo, lane_float* hi) {
+  const lane_float tm = 0.5f * (t0 + t1);
+  const lane_int cx = clamp(convert_int8(floor(ex + tm * dx)), 0, f.width > 2 ? f.width - 2 : 0);
+  const lane_int cy = clamp(convert_int8(floor(ey + tm * dy)), 0, f.height > 2 ? f.height - 2 : 0);
+  const lane_int cz = cx + 1 < f.width ? cx + 1 : cx, cw = cy + 1 < f.height ? cy + 1 : cy;
+  const lane_int y0 = live ? cy * f.width : (lane_int)0, y1 = live ? cw * f.width : (lane_int)0;
+  const lane_int x0 = live ? cx : (lane_int)0, x1 = live ? cz : (lane_int)0;
+  const lane_float twist = gather(h, y0 + x0) - gather(h, y0 + x1) - gather(h, y1 + x0) + gather(h, y1 + x1);
+  const lane_float alpha = (dx * dy != 0.0f ? twist * dx * dy : (lane_float)0.0f) - drop;  // t^2 coefficient of f
+  const lane_float lip = gather(lipschitz, live ? cy * max(f.width - 1, 1) + cx : (lane_int)0);
+  ray_bounds(t0, t1, f0, f1, alpha, length, arc_limit, lip, angle, live, lo, hi);
+}
+
+// Rays r0 .. r0 + 7 in lanes, column by column (row by row for rays nearer the y axis): one step
+// per grid line of the major axis, with the minor axis's crossing before it where there is one
+// (at most one: the rays run at most 45 degrees from the major axis). Returns 0, marching
+// nothing, where the rays to march do not all share the major axis and its direction.
+HFVIS_INLINE int rays_in_lanes(int r0, __global const float* h, Field f, __global const float* lipschitz, int ex_i,
+                               int ey_i, float ze, float target_height, int4 box, int rays, __global const int* need,
+                               int use_need, float unit, __global uchar* pending, __global float* ray_hi,
+                               __global float* out_visible, int accumulate) {
+  Ray ray[HFVIS_LANES];
+  int x_major = -1, forward = 0;
+  for (int l = 0; l < HFVIS_LANES; ++l) {
+    ray[l] = ray_setup(min(r0 + l, rays - 1), rays, f, ex_i, ey_i, box, need, use_need, unit);
+    ray[l].ok = ray[l].ok && r0 + l < rays;
+    if (!ray[l].ok) continue;
+    const int fwd = (ray[l].x_major ? ray[l].dx : ray[l].dy) > 0.0f;
+    if (x_major < 0) x_major = ray[l].x_major, forward = fwd;
+    if (ray[l].x_major != x_major || fwd != forward) return 0;
+  }
+  if (x_major < 0) return 1;  // nothing to march
+  const float ex = ex_i, ey = ey_i;
+  lane_int live;
+  lane_float dx, dy, inv_dx, inv_dy, length, angle, arc_limit, drop, reach, h_end;
+  LaneAxis ax, ay;
+  for (int l = 0; l < HFVIS_LANES; ++l) {
+    const Ray y = ray[l];
+    ILANE(live, l) = y.ok ? -1 : 0;
+    LANE(dx, l) = y.dx, LANE(dy, l) = y.dy, LANE(inv_dx, l) = y.inv_dx, LANE(inv_dy, l) = y.inv_dy;
+    LANE(length, l) = y.length, LANE(angle, l) = y.angle, LANE(arc_limit, l) = y.arc_limit;
+    LANE(drop, l) = y.drop, LANE(reach, l) = y.reach;
+    LANE(h_end, l) = h[(int)y.end.y * f.width + (int)y.end.x];
+    lane_axis_put(&ax, l, y.ax);
+    lane_axis_put(&ay, l, y.ay);
+  }
+  lane_float lo = -INFINITY, hi = -INFINITY, hi_back = INFINITY, d_back = 0.0f;
+  lane_float t0 = 0.0f, f0 = h[ey_i * f.width + ex_i] - ze;
+  LaneAxis* major = x_major ? &ax : &ay;
+  LaneAxis* minor = x_major ? &ay : &ax;
+  const lane_float d_major = x_major ? dx : dy, d_minor = x_major ? dy : dx;
+  const lane_float inv_major = x_major ? inv_dx : inv_dy, inv_minor = x_major ? inv_dy : inv_dx;
+  const float e_major = x_major ? ex : ey, e_minor = x_major ? ey : ex;
+  while (ANY_LANE(live)) {
+    const lane_float t_major = major->t, t_minor = minor->t;
+    const lane_float t_end = t_major < 1.0f ? t_major : (lane_float)1.0f;  // the next major line, or the end
+    const lane_int minor_first = t_minor < t_end;
+    const lane_int at_major = t_end == t_major;  // else the end
+    const lane_float s_major = lane_surface_at_crossing(h, f.width, x_major, major, ex_i, ey_i, live & at_major);
+    const lane_float f_end = ((at_major ? s_major : h_end) - ze) - drop * t_end * t_end;
+    // The minor line's crossing first, where there is one.
+    if (ANY_LANE(live & minor_first)) {
+      const lane_int go = live & minor_first;
+      const lane_float s_minor = lane_surface_at_crossing(h, f.width, !x_major, minor, ex_i, ey_i, go);
+      const lane_float f_minor = (s_minor - ze) - drop * t_minor * t_minor;
+      lane_piece(h, f, lipschitz, ex, ey, dx, dy, drop, length, arc_limit, angle, t0, t_minor, f0, f_minor, go, &lo,
+                 &hi);
+      t0 = go ? t_minor : t0;
+      f0 = go ? f_minor : f0;
+      lane_axis_next(minor, e_minor, d_minor, inv_minor, go);
+    }
+    lane_piece(h, f, lipschitz, ex, ey, dx, dy, drop, length, arc_limit, angle, t0, t_end, f0, f_end, live, &lo, &hi);
+    // A crossing of both axes at once (a grid point) moves both on.
+    lane_axis_next(minor, e_minor, d_minor, inv_minor, live & (minor->t <= t_end));
+    lane_axis_next(major, e_major, d_major, inv_major, live & at_major);
+    t0 = live ? t_end : t0;
+    f0 = live ? f_end : f0;
+    const lane_float d_ray = t_end * length;
+    // Past a crossing of the major axis the next grid line's targets, at the end the line past it.
+    for (int l = 0; l < HFVIS_LANES; ++l) {
+      if (!ILANE(live, l)) continue;
+      Axis m = lane_axis_get(major, l);
+      if (!ILANE(at_major, l)) axis_next(&m, e_major, LANE(d_major, l), LANE(inv_major, l));
+      const Ray y = ray[l];
+      settle_targets(h, f, ex_i, ey_i, ze, target_height, box, x_major, (int)m.g, m.q, m.r, m.inv_den, y.b_along,
+                     y.slope_b, y.a, y.b, LANE(lo, l), LANE(hi, l), LANE(d_ray, l), LANE(hi_back, l),
+                     LANE(d_back, l), pending, ray_hi, out_visible, accumulate);
+    }
+    hi_back = live ? hi : hi_back;
+    d_back = live ? d_ray : d_back;
+    live = live & at_major & (d_ray <= reach);
+  }
+  return 1;
+}
+#endif
+
+// viewshed_rays, one work-item per ray from the eye E to border point r (HFVIS_LANES rays in
+// SIMD lanes on a CPU), marched cell by cell. A ray keeps bounds on the largest slope
+// (s(t) - ze) / (t D) met so far, widened so that they also bound that of every sight line of
+// its wedge (to border point r + 1, at distances the ray has reached): lo <= that slope <= hi.
+// The widening is L * angle, L the surface's slope bound around the cell (|s difference| <= L *
+// arc between two lines at one distance, arc = distance * angle), valid while the arc stays
+// within one pixel of the ray. Each time the ray crosses a grid line of its major axis it
+// settles the wedge's targets on the next one (settle_targets), and at its end those one line
+// past it.
+__kernel void viewshed_rays(__global const float* h, Field f, __global const float* lipschitz, int ex_i, int ey_i,
+                            float ze, float target_height, int4 box, int rays, __global const int* need,
+                            int use_need, float unit, __global uchar* pending, __global float* ray_hi,
+                            __global float* out_visible, int accumulate) {
+#if HFVIS_LANES == 1
+  const int r = get_global_id(0);
+  if (r < rays)
+    one_ray(r, h, f, lipschitz, ex_i, ey_i, ze, target_height, box, rays, need, use_need, unit, pending, ray_hi,
+            out_visible, accumulate);
+#else
+  // Lanes whose rays do not run alike (around a diagonal or a corner of the box) go one by one.
+  const int r0 = get_global_id(0) * HFVIS_LANES;
+  if (r0 >= rays) return;
+  if (!rays_in_lanes(r0, h, f, lipschitz, ex_i, ey_i, ze, target_height, box, rays, need, use_need, unit, pending,
+                     ray_hi, out_visible, accumulate))
+    for (int r = r0; r < min(r0 + HFVIS_LANES, rays); ++r)
+      one_ray(r, h, f, lipschitz, ex_i, ey_i, ze, target_height, box, rays, need, use_need, unit, pending, ray_hi,
+              out_visible, accumulate);
+#endif
 }
 
 // The culling pyramid's query (ViewshedPyramid in hfvis/viewshed.hpp), one work-item per node of

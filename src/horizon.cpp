@@ -24,12 +24,6 @@ namespace {
 
 constexpr std::size_t kStackEntryBytes = 2 * sizeof(float);  // (height, position)
 
-// Lines one work-item of horizon_lattice sweeps side by side (HFVIS_LANES): SIMD lanes
-// where a work-item runs on a CPU core in the line-major layout; one line per work-item on
-// GPUs (whatever the layout: a lane-wide work-item would run alone in its group there) and in
-// the step-major layout, whose neighbouring work-items read neighbouring stack entries.
-int sweepLanes(const ContextState& st) { return lineMajorLayout(st) && st.info.type == "CPU" ? 8 : 1; }
-
 std::string programOptions(const HorizonOutputs& outputs, bool has_nodata, int lanes, bool curvature,
                            bool max_distance, bool row_spacing) {
   std::ostringstream s;
@@ -252,7 +246,7 @@ class HorizonRoutine : public SweepRoutine {
       : SweepRoutine(st, field, options),
         horizon_(options),
         outputs_(outputs),
-        lanes_(sweepLanes(st)),
+        lanes_(simdLanes(st)),
         directions_(runDirectionsOf(field, options, outputs)),
         plan_(planRun(field, options, outputs, directions_, st.info)) {
     // A window's blocks are per line, so its strips, and with per-row spacing its whole sweep

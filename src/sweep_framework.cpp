@@ -17,6 +17,8 @@ std::string mebibytes(std::size_t bytes) {
   return s.str();
 }
 
+int simdLanes(const ContextState& st) { return lineMajorLayout(st) && st.info.type == "CPU" ? 8 : 1; }
+
 bool lineMajorLayout(const ContextState& st) {
   switch (st.options.line_layout) {
     case LineLayout::LineMajor:

@@ -23,6 +23,12 @@ inline std::size_t roundUp(std::size_t n, std::size_t m) { return (n + m - 1) / 
 // automatically line-major on CPUs and step-major elsewhere.
 bool lineMajorLayout(const ContextState& st);
 
+// Lines (or rays) one work-item runs side by side (HFVIS_LANES, kernels/lanes.cl): SIMD lanes
+// where a work-item runs on a CPU core in the line-major layout; one per work-item on GPUs
+// (whatever the layout: a lane-wide work-item would run alone in its group there) and in the
+// step-major layout, whose neighbouring work-items read neighbouring entries.
+int simdLanes(const ContextState& st);
+
 // The budget when the caller gives none: half the device memory (for a CPU device, whose
 // memory is the host's, half the host's physical memory).
 std::size_t defaultMemoryBudget(const DeviceInfo& device);

@@ -46,7 +46,11 @@ cl_int4 targetBox(const HeightField& field, const Observer& o, double max_distan
 class ViewshedRun {
  public:
   ViewshedRun(detail::ContextState& st, const HeightField& field, const ViewshedOptions& options)
-      : st_(st), field_(field), options_(options), program_(st.program("viewshed.cl", "")) {
+      : st_(st),
+        field_(field),
+        options_(options),
+        lanes_(detail::simdLanes(st)),
+        program_(st.program("viewshed.cl", "-DHFVIS_LANES=" + std::to_string(lanes_))) {
     const std::size_t pixels = field.pixelCount();
     heights_.resize(pixels);
     for (std::size_t p = 0; p < pixels; ++p)
@@ -166,7 +170,8 @@ class ViewshedRun {
       r.setArg(a++, ray_hi_);
       r.setArg(a++, visible);
       r.setArg(a++, accumulate ? 1 : 0);
-      st_.launch(r, cl::NDRange(detail::roundUp(rays, detail::kLineGroup)), cl::NDRange(detail::kLineGroup));
+      const std::size_t items = (static_cast<std::size_t>(rays) + lanes_ - 1) / lanes_;  // lanes_ rays each
+      st_.launch(r, cl::NDRange(detail::roundUp(items, detail::kLineGroup)), cl::NDRange(detail::kLineGroup));
     }
     // March the pending targets, listed row by row.
     const cl::NDRange row_range(detail::roundUp(field_.height, detail::kLineGroup));
@@ -357,6 +362,7 @@ class ViewshedRun {
   detail::ContextState& st_;
   const HeightField& field_;
   const ViewshedOptions& options_;
+  int lanes_;  // rays per work-item (HFVIS_LANES)
   cl::Program program_;
   std::vector<float> heights_;
   DeviceField device_{};
