@@ -399,17 +399,19 @@ inline int in_wedge(int2 a, int2 b, long vx, long vy) {
 // The targets of ray r's wedge (a, b: its border points less the eye) on grid line m of the ray's
 // major axis (a column where the ray runs at most 45 degrees from the x axis, else a row), for
 // every sight line of which the ray holds, over its prefix so far (d_ray from the eye), bounds
-// lo <= the largest slope met <= hi, and hi_back over a shorter prefix (d_back). A target
-// still pending (left open by viewshed_classify) is hidden where its slope lies below lo and the
-// prefix ends short of it; else the bound over the shorter prefix that reaches its split
-// distance is kept for viewshed_march, which marches the rest exactly. Targets neither settles
+// lo <= the largest slope met <= an upper bound, and that bound over a shorter prefix (d_back):
+// hi and hi_back hold it along the ray itself (x) and for a sight line at the wedge's far side
+// (y; see ray_bounds). A target still pending (left open by viewshed_classify) is hidden where
+// its slope lies below lo and the prefix ends short of it; else the bound over the shorter
+// prefix that reaches its split distance, at the target's angle from the ray, is kept for
+// viewshed_march, which marches the rest exactly. Targets neither settles
 // keep ray_hi = INFINITY (a whole march). Ray r crosses line m at e_minor + qa + ra / den
 // (exactly; side a of the wedge; inv_den = 1 / den), side b (b_along: where it runs the same
 // way along the axis) at e_minor + (m - e_major) * slope_b; the wedge meets the line in at
 // most about a pixel.
 HFVIS_INLINE void settle_targets(__global const float* h, Field f, int ex_i, int ey_i, float ze, float target_height,
                            int4 box, int x_major, int m, int qa, int ra, float inv_den, int b_along, float slope_b, int2 a,
-                           int2 b, float lo, float hi, float d_ray, float hi_back, float d_back,
+                           int2 b, float b_length, float lo, float2 hi, float d_ray, float2 hi_back, float d_back,
                            __global uchar* pending, __global float* ray_hi, __global float* out_visible,
                            int accumulate) {
   if (m < (x_major ? box.x : box.y) || m > (x_major ? box.z : box.w)) return;
@@ -443,10 +445,17 @@ HFVIS_INLINE void settle_targets(__global const float* h, Field f, int ex_i, int
       pending[p] = 0;
       continue;
     }
-    if (d2 <= reach_back * reach_back)
-      ray_hi[p] = hi_back;
-    else if (d2 <= reach_now * reach_now)
-      ray_hi[p] = hi;
+    const int back = d2 <= reach_back * reach_back;
+    if (back || d2 <= reach_now * reach_now) {
+      // The bound is convex in the angle from the ray (a maximum of linear functions), so below
+      // the chord between its two ends: at the angle's share of the wedge's, whose ratio of sines
+      // (a x v |b| over a x b |v|, ground lengths) bounds it from above.
+      const float2 bound = back ? hi_back : hi;
+      const float cross_v = (float)((long)a.x * (y - ey_i) - (long)a.y * (x - ex_i));
+      const float cross_b = (float)((long)a.x * b.y - (long)a.y * b.x);
+      const float share = hf_min(1.0f, cross_v * b_length / (cross_b * native_sqrt(d2)) * (1.0f + 1e-5f));
+      ray_hi[p] = share == 0.0f ? bound.x : bound.y == INFINITY ? INFINITY : bound.x + share * (bound.y - bound.x);
+    }
   }
 }
 
@@ -500,7 +509,7 @@ typedef struct {
   int ok, x_major, b_along;
   int2 a, b;
   float2 end;
-  float dx, dy, inv_dx, inv_dy, length, angle, arc_limit, drop, reach, slope_b;
+  float dx, dy, inv_dx, inv_dy, length, angle, arc_limit, drop, reach, slope_b, b_length;
   Axis ax, ay;
 } Ray;
 
@@ -521,6 +530,8 @@ HFVIS_INLINE Ray ray_setup(int r, int rays, Field f, int ex_i, int ey_i, int4 bo
   y.x_major = fabs(y.dx) >= fabs(y.dy);
   const float gdx = y.dx * f.cell_x, gdy = y.dy * f.cell_y;
   y.length = sqrt(gdx * gdx + gdy * gdy);
+  const float bx = y.b.x * f.cell_x, by = y.b.y * f.cell_y;
+  y.b_length = sqrt(bx * bx + by * by);
   y.arc_limit = fmin(f.cell_x, f.cell_y) / y.angle;  // distance where the arc reaches a pixel
   y.inv_dx = y.dx != 0.0f ? 1.0f / y.dx : 0.0f;
   y.inv_dy = y.dy != 0.0f ? 1.0f / y.dy : 0.0f;
@@ -536,11 +547,14 @@ HFVIS_INLINE Ray ray_setup(int r, int rays, Field f, int ex_i, int ey_i, int4 bo
 
 // A ray's bounds over one piece [t0, t1] of it within one cell, where f (the surface's height
 // above the eye, curvature taken) runs from f0 to f1 with t^2 coefficient alpha, lip the
-// surface's slope bound around the cell: *lo and *hi raised where `live`. The largest slope
+// surface's slope bound around the cell: *lo, *hi_ray (along the ray itself) and *hi (for every
+// sight line of the wedge) raised where `live`. The largest slope
 // f / (t D) on the piece is at most its top over the nearest distance (the farthest where the
 // top is negative); on the first piece (t0 = 0, f0 = -eye height <= 0) f / t <= (f - f0) / t,
 // which is linear in t: at most its value at an end. The widening is lip * angle while t D
-// stays within arc_limit. For scalars and lane vectors alike.
+// stays within arc_limit; a sight line at a smaller angle delta from the ray needs only lip *
+// delta, so the bound over the prefix is a maximum of linear functions of delta, from *hi_ray at
+// 0 to *hi at the wedge's angle. For scalars and lane vectors alike.
 #define HF_MAX(a, b) ((a) > (b) ? (a) : (b))
 #define HFVIS_RAY_BOUNDS(F, I)                                                                                    \
   HFVIS_INLINE HFVIS_OVERLOADABLE F bump_top(F f0, F f1, F a) { /* quadratic_bump, branch-free */               \
@@ -549,7 +563,7 @@ HFVIS_INLINE Ray ray_setup(int r, int rays, Field f, int ex_i, int ey_i, int4 bo
     return (a < 0.0f) & (s > 0.0f) & (s < 1.0f) ? f0 + (f1 - f0) * s + bump * s * (1.0f - s) : (F)(-INFINITY);  \
   }                                                                                                             \
   HFVIS_INLINE HFVIS_OVERLOADABLE void ray_bounds(F t0, F t1, F f0, F f1, F alpha, F length, F arc_limit, F lip, \
-                                                  F angle, I live, F* lo, F* hi) {                              \
+                                                  F angle, I live, F* lo, F* hi_ray, F* hi) {                   \
     const F span = t1 - t0;                                                                                     \
     const F top = HF_MAX(HF_MAX(f0, f1), bump_top(f0, f1, alpha * span * span)); /* NaN: no bound */           \
     const F rise = (f1 - f0) / t1;                                                                              \
@@ -557,8 +571,9 @@ HFVIS_INLINE Ray ray_setup(int r, int rays, Field f, int ex_i, int ey_i, int4 bo
     F seg_hi = t0 > 0.0f ? native_divide(top, (top >= 0.0f ? t0 : t1) * length) : first;                        \
     const F seg_lo = native_divide(f1, t1 * length);                                                            \
     const F widen = t1 * length <= arc_limit ? lip * angle : (F)INFINITY;                                       \
-    seg_hi = isnan(seg_hi) | isnan(widen) ? (F)INFINITY : seg_hi + widen;                                       \
-    *hi = live ? HF_MAX(*hi, seg_hi) : *hi;                                                                     \
+    seg_hi = isnan(seg_hi) ? (F)INFINITY : seg_hi;                                                              \
+    *hi_ray = live ? HF_MAX(*hi_ray, seg_hi) : *hi_ray;                                                         \
+    *hi = live ? HF_MAX(*hi, isnan(widen) ? (F)INFINITY : seg_hi + widen) : *hi;                                \
     /* a surface point the sight lines pass near */                                                             \
     *lo = live & !isnan(seg_lo) ? HF_MAX(*lo, seg_lo - widen) : *lo;                                            \
   }
@@ -577,8 +592,9 @@ HFVIS_INLINE void one_ray(int r, __global const float* h, Field f, __global cons
   if (!y.ok) return;
   const float ex = ex_i, ey = ey_i;
   const int cells_x = max(f.width - 1, 1);
-  float lo = -INFINITY, hi = -INFINITY;
-  float hi_back = INFINITY, d_back = 0.0f;  // the bound at the previous crossing of the major axis
+  float lo = -INFINITY, hi_ray = -INFINITY, hi = -INFINITY;
+  float2 hi_back = INFINITY;  // the bounds at the previous crossing of the major axis, d_back along
+  float d_back = 0.0f;
   float t0 = 0.0f, f0 = h[ey_i * f.width + ex_i] - ze;
   for (;;) {
     const float tx = y.ax.t, ty = y.ay.t;
@@ -590,7 +606,8 @@ HFVIS_INLINE void one_ray(int r, __global const float* h, Field f, __global cons
                                 : h[(int)y.end.y * f.width + (int)y.end.x];
     const float f1 = (s1 - ze) - y.drop * t1 * t1;
     const float alpha = surface_curve(h, f.width, c, y.dx, y.dy) - y.drop;  // t^2 coefficient of f
-    ray_bounds(t0, t1, f0, f1, alpha, y.length, y.arc_limit, lipschitz[c.y * cells_x + c.x], y.angle, 1, &lo, &hi);
+    ray_bounds(t0, t1, f0, f1, alpha, y.length, y.arc_limit, lipschitz[c.y * cells_x + c.x], y.angle, 1, &lo,
+               &hi_ray, &hi);
     const float d_ray = t1 * y.length;
     const int crossed = y.x_major ? tx <= t1 : ty <= t1;  // a grid line of the major axis, at t1
     f0 = f1;
@@ -603,9 +620,9 @@ HFVIS_INLINE void one_ray(int r, __global const float* h, Field f, __global cons
       Axis major = y.x_major ? y.ax : y.ay;
       if (!crossed) axis_next(&major, y.x_major ? ex : ey, y.x_major ? y.dx : y.dy, y.x_major ? y.inv_dx : y.inv_dy);
       settle_targets(h, f, ex_i, ey_i, ze, target_height, box, y.x_major, (int)major.g, major.q, major.r,
-                     major.inv_den, y.b_along, y.slope_b, y.a, y.b, lo, hi, d_ray, hi_back, d_back, pending, ray_hi,
-                     out_visible, accumulate);
-      hi_back = hi;
+                     major.inv_den, y.b_along, y.slope_b, y.a, y.b, y.b_length, lo, (float2)(hi_ray, hi), d_ray,
+                     hi_back, d_back, pending, ray_hi, out_visible, accumulate);
+      hi_back = (float2)(hi_ray, hi);
       d_back = d_ray;
     }
     if (t1 >= 1.0f || d_ray > y.reach) break;
@@ -668,7 +685,7 @@ HFVIS_INLINE lane_float lane_surface_at_crossing(__global const float* h, int wi
 HFVIS_INLINE void lane_piece(__global const float* h, Field f, __global const float* lipschitz, float ex, float ey,
                              lane_float dx, lane_float dy, lane_float drop, lane_float length, lane_float arc_limit,
                              lane_float angle, lane_float t0, lane_float t1, lane_float f0, lane_float f1,
-                             lane_int live, lane_float* lo, lane_float* hi) {
+                             lane_int live, lane_float* lo, lane_float* hi_ray, lane_float* hi) {
   const lane_float tm = 0.5f * (t0 + t1);
   const lane_int cx = clamp(convert_int8(floor(ex + tm * dx)), 0, f.width > 2 ? f.width - 2 : 0);
   const lane_int cy = clamp(convert_int8(floor(ey + tm * dy)), 0, f.height > 2 ? f.height - 2 : 0);
@@ -678,7 +695,7 @@ HFVIS_INLINE void lane_piece(__global const float* h, Field f, __global const fl
   const lane_float twist = gather(h, y0 + x0) - gather(h, y0 + x1) - gather(h, y1 + x0) + gather(h, y1 + x1);
   const lane_float alpha = (dx * dy != 0.0f ? twist * dx * dy : (lane_float)0.0f) - drop;  // t^2 coefficient of f
   const lane_float lip = gather(lipschitz, live ? cy * max(f.width - 1, 1) + cx : (lane_int)0);
-  ray_bounds(t0, t1, f0, f1, alpha, length, arc_limit, lip, angle, live, lo, hi);
+  ray_bounds(t0, t1, f0, f1, alpha, length, arc_limit, lip, angle, live, lo, hi_ray, hi);
 }
 
 // Rays r0 .. r0 + 7 in lanes, column by column (row by row for rays nearer the y axis): one step
@@ -714,7 +731,8 @@ HFVIS_INLINE int rays_in_lanes(int r0, __global const float* h, Field f, __globa
     lane_axis_put(&ax, l, y.ax);
     lane_axis_put(&ay, l, y.ay);
   }
-  lane_float lo = -INFINITY, hi = -INFINITY, hi_back = INFINITY, d_back = 0.0f;
+  lane_float lo = -INFINITY, hi_ray = -INFINITY, hi = -INFINITY;
+  lane_float hi_ray_back = INFINITY, hi_back = INFINITY, d_back = 0.0f;
   lane_float t0 = 0.0f, f0 = h[ey_i * f.width + ex_i] - ze;
   LaneAxis* major = x_major ? &ax : &ay;
   LaneAxis* minor = x_major ? &ay : &ax;
@@ -734,12 +752,13 @@ HFVIS_INLINE int rays_in_lanes(int r0, __global const float* h, Field f, __globa
       const lane_float s_minor = lane_surface_at_crossing(h, f.width, !x_major, minor, ex_i, ey_i, go);
       const lane_float f_minor = (s_minor - ze) - drop * t_minor * t_minor;
       lane_piece(h, f, lipschitz, ex, ey, dx, dy, drop, length, arc_limit, angle, t0, t_minor, f0, f_minor, go, &lo,
-                 &hi);
+                 &hi_ray, &hi);
       t0 = go ? t_minor : t0;
       f0 = go ? f_minor : f0;
       lane_axis_next(minor, e_minor, d_minor, inv_minor, go);
     }
-    lane_piece(h, f, lipschitz, ex, ey, dx, dy, drop, length, arc_limit, angle, t0, t_end, f0, f_end, live, &lo, &hi);
+    lane_piece(h, f, lipschitz, ex, ey, dx, dy, drop, length, arc_limit, angle, t0, t_end, f0, f_end, live, &lo,
+               &hi_ray, &hi);
     // A crossing of both axes at once (a grid point) moves both on.
     lane_axis_next(minor, e_minor, d_minor, inv_minor, live & (minor->t <= t_end));
     lane_axis_next(major, e_major, d_major, inv_major, live & at_major);
@@ -753,9 +772,11 @@ HFVIS_INLINE int rays_in_lanes(int r0, __global const float* h, Field f, __globa
       if (!ILANE(at_major, l)) axis_next(&m, e_major, LANE(d_major, l), LANE(inv_major, l));
       const Ray y = ray[l];
       settle_targets(h, f, ex_i, ey_i, ze, target_height, box, x_major, (int)m.g, m.q, m.r, m.inv_den, y.b_along,
-                     y.slope_b, y.a, y.b, LANE(lo, l), LANE(hi, l), LANE(d_ray, l), LANE(hi_back, l),
-                     LANE(d_back, l), pending, ray_hi, out_visible, accumulate);
+                     y.slope_b, y.a, y.b, y.b_length, LANE(lo, l), (float2)(LANE(hi_ray, l), LANE(hi, l)),
+                     LANE(d_ray, l), (float2)(LANE(hi_ray_back, l), LANE(hi_back, l)), LANE(d_back, l), pending,
+                     ray_hi, out_visible, accumulate);
     }
+    hi_ray_back = live ? hi_ray : hi_ray_back;
     hi_back = live ? hi : hi_back;
     d_back = live ? d_ray : d_back;
     live = live & at_major & (d_ray <= reach);
