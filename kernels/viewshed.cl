@@ -396,68 +396,125 @@ inline int in_wedge(int2 a, int2 b, long vx, long vy) {
   return (long)a.x * vy - (long)a.y * vx >= 0 && (long)b.x * vy - (long)b.y * vx < 0;
 }
 
-// The targets of ray r's wedge (a, b: its border points less the eye) on grid line m of the ray's
-// major axis (a column where the ray runs at most 45 degrees from the x axis, else a row), for
-// every sight line of which the ray holds, over its prefix so far (d_ray from the eye), bounds
-// lo <= the largest slope met <= an upper bound, and that bound over a shorter prefix (d_back):
-// hi and hi_back hold it along the ray itself (x) and for a sight line at the wedge's far side
-// (y; see ray_bounds). A target still pending (left open by viewshed_classify) is hidden where
-// its slope lies below lo and the prefix ends short of it; else the bound over the shorter
-// prefix that reaches its split distance, at the target's angle from the ray, is kept for
-// viewshed_march, which marches the rest exactly. Targets neither settles
-// keep ray_hi = INFINITY (a whole march). Ray r crosses line m at e_minor + qa + ra / den
-// (exactly; side a of the wedge; inv_den = 1 / den), side b (b_along: where it runs the same
-// way along the axis) at e_minor + (m - e_major) * slope_b; the wedge meets the line in at
-// most about a pixel.
-HFVIS_INLINE void settle_targets(__global const float* h, Field f, int ex_i, int ey_i, float ze, float target_height,
-                           int4 box, int x_major, int m, int qa, int ra, float inv_den, int b_along, float slope_b, int2 a,
-                           int2 b, float b_length, float lo, float2 hi, float d_ray, float2 hi_back, float d_back,
-                           __global uchar* pending, __global float* ray_hi, __global float* out_visible,
-                           int accumulate) {
-  if (m < (x_major ? box.x : box.y) || m > (x_major ? box.z : box.w)) return;
-  const int e_major = x_major ? ex_i : ey_i, e_minor = x_major ? ey_i : ex_i;
-  const float ma = e_minor + qa + ra * inv_den;
-  const float mb = b_along ? e_minor + (m - e_major) * slope_b : ma;
-  // The grid points between the sides: a's is exact, so none on side a is missed (b's side is
-  // not in the wedge).
-  const int minor_lo = x_major ? box.y : box.x, minor_hi = x_major ? box.w : box.z;
-  const int first = max(ma <= mb ? e_minor + qa + (ra > 0) : (int)ceil(mb), minor_lo);
-  const int last = min(min(ma <= mb ? (int)floor(mb) : e_minor + qa, minor_hi), first + 3);
-  // Distances compared in squares, with margins far above their rounding: the prefix ends a
-  // quarter pixel short of a target (for lo), or reaches its split distance dist - split_length
-  // (for hi): dist <= (d + split_length - margin) (1 - 1e-5), which the march's own root of d2
-  // keeps within its rounding.
-  const float cell_min = hf_min(f.cell_x, f.cell_y);
-  const float near = d_ray + 0.25f * cell_min;
-  const float reach_back = (d_back + split_length(f) - 1e-3f * cell_min) * (1.0f - 1e-5f);
-  const float reach_now = (d_ray + split_length(f) - 1e-3f * cell_min) * (1.0f - 1e-5f);
-  for (int n = first; n <= last; ++n) {
-    const int x = x_major ? m : n, y = x_major ? n : m;
-    if (!in_wedge(a, b, x - ex_i, y - ey_i)) continue;
-    const size_t p = (size_t)y * f.width + x;
-    if (!pending[p]) continue;
-    // The target's squared distance and rise as sight_line has them.
-    const float gx = (x - ex_i) * f.cell_x, gy = (y - ey_i) * f.cell_y;
-    const float d2 = gx * gx + gy * gy;
-    const float rise = (h[p] + target_height - f.curvature * d2) - ze;
-    if (near * near < d2 && rise < lo * native_sqrt(d2)) {  // something nearer rises above the sight line
-      put_visible(out_visible, p, 0.0f, accumulate);
-      pending[p] = 0;
-      continue;
-    }
-    const int back = d2 <= reach_back * reach_back;
-    if (back || d2 <= reach_now * reach_now) {
-      // The bound is convex in the angle from the ray (a maximum of linear functions), so below
-      // the chord between its two ends: at the angle's share of the wedge's, whose ratio of sines
-      // (a x v |b| over a x b |v|, ground lengths) bounds it from above.
-      const float2 bound = back ? hi_back : hi;
-      const float cross_v = (float)((long)a.x * (y - ey_i) - (long)a.y * (x - ex_i));
-      const float cross_b = (float)((long)a.x * b.y - (long)a.y * b.x);
-      const float share = hf_min(1.0f, cross_v * b_length / (cross_b * native_sqrt(d2)) * (1.0f + 1e-5f));
-      ray_hi[p] = share == 0.0f ? bound.x : bound.y == INFINITY ? INFINITY : bound.x + share * (bound.y - bound.x);
-    }
+// Memory access for settle_targets, for scalars and lanes (a lane not `go` reads the first entry,
+// and writes nothing).
+HFVIS_INLINE HFVIS_OVERLOADABLE int lanes_any(int m) { return m != 0; }
+HFVIS_INLINE HFVIS_OVERLOADABLE int load_pending(__global const uchar* pending, int p, int go) {
+  return go ? pending[p] : 0;
+}
+HFVIS_INLINE HFVIS_OVERLOADABLE float load_height(__global const float* h, int p, int go) { return h[go ? p : 0]; }
+HFVIS_INLINE HFVIS_OVERLOADABLE void store_settled(__global uchar* pending, __global float* ray_hi,
+                                                   __global float* out_visible, int accumulate, int p, int hidden,
+                                                   int keep, float bound) {
+  if (hidden) {
+    put_visible(out_visible, p, 0.0f, accumulate);
+    pending[p] = 0;
+  } else if (keep) {
+    ray_hi[p] = bound;
   }
 }
+#if HFVIS_LANES > 1
+HFVIS_INLINE lane_float gather(__global const float* p, lane_int at) {
+  lane_float v;
+#pragma unroll
+  for (int l = 0; l < HFVIS_LANES; ++l) LANE(v, l) = p[ILANE(at, l)];
+  return v;
+}
+
+HFVIS_INLINE HFVIS_OVERLOADABLE int lanes_any(lane_int m) { return any_lane(m); }
+HFVIS_INLINE HFVIS_OVERLOADABLE lane_int load_pending(__global const uchar* pending, lane_int p, lane_int go) {
+  lane_int v;
+#pragma unroll
+  for (int l = 0; l < HFVIS_LANES; ++l) ILANE(v, l) = ILANE(go, l) ? pending[ILANE(p, l)] : 0;
+  return v;
+}
+HFVIS_INLINE HFVIS_OVERLOADABLE lane_float load_height(__global const float* h, lane_int p, lane_int go) {
+  return gather(h, go ? p : (lane_int)0);
+}
+HFVIS_INLINE HFVIS_OVERLOADABLE void store_settled(__global uchar* pending, __global float* ray_hi,
+                                                   __global float* out_visible, int accumulate, lane_int p,
+                                                   lane_int hidden, lane_int keep, lane_float bound) {
+#pragma unroll
+  for (int l = 0; l < HFVIS_LANES; ++l)
+    store_settled(pending, ray_hi, out_visible, accumulate, ILANE(p, l), ILANE(hidden, l), ILANE(keep, l),
+                  LANE(bound, l));
+}
+#endif
+
+// The targets of ray r's wedge (a, b: its border point and the next one, less the eye) on grid
+// line m of the ray's major axis (a column where the ray runs at most 45 degrees from the x
+// axis, else a row), where `live`; for every sight line of the wedge the ray holds, over its
+// prefix so far (d_ray from the eye), bounds lo <= the largest slope met <= an upper bound,
+// and that bound over a shorter prefix (d_back): hi_ray / hi_ray_back along the ray itself,
+// hi / hi_back for a sight line at the wedge's far side (see ray_bounds). A target still
+// pending (left open by viewshed_classify) is hidden where its slope lies below lo and the
+// prefix ends short of it; else the bound over the shorter prefix that reaches its split
+// distance, at the target's angle from the ray, is kept for viewshed_march, which marches the
+// rest exactly. Targets neither settles keep ray_hi = INFINITY (a whole march). Ray r crosses
+// line m at e_minor + qa + ra / den (exactly; side a of the wedge; inv_den = 1 / den), side b
+// (b_along: where it runs the same way along the axis) at e_minor + (m - e_major) * slope_b;
+// the wedge meets the line in at most about a pixel. For scalars and lanes alike (L the long
+// type, CL / CI / CF conversions to it, to int and to float).
+#define HF_MIN(a, b) ((a) < (b) ? (a) : (b))
+#define HFVIS_SETTLE(F, I, L, CL, CI, CF)                                                                           \
+  HFVIS_INLINE HFVIS_OVERLOADABLE void settle_targets(                                                              \
+      __global const float* h, Field f, int ex_i, int ey_i, float ze, float target_height, int4 box, int x_major,   \
+      I live, I m, I qa, I ra, F inv_den, I b_along, F slope_b, I a_x, I a_y, I b_x, I b_y, F b_length, F lo,       \
+      F hi_ray, F hi, F d_ray, F hi_ray_back, F hi_back, F d_back, __global uchar* pending, __global float* ray_hi, \
+      __global float* out_visible, int accumulate) {                                                                \
+    const int e_major = x_major ? ex_i : ey_i, e_minor = x_major ? ey_i : ex_i;                                     \
+    live = live & (m >= (x_major ? box.x : box.y)) & (m <= (x_major ? box.z : box.w));                              \
+    const F ma = e_minor + CF(qa) + CF(ra) * inv_den;                                                               \
+    const F mb = b_along ? e_minor + CF(m - e_major) * slope_b : ma;                                                \
+    /* The grid points between the sides: a's is exact, so none on side a is missed (b's side is */               \
+    /* not in the wedge). */                                                                                        \
+    const int minor_lo = x_major ? box.y : box.x, minor_hi = x_major ? box.w : box.z;                               \
+    const I a_below = ma <= mb;                                                                                     \
+    const I first = max(a_below ? e_minor + qa + (ra > 0 ? (I)1 : (I)0) : CI(ceil(mb)), minor_lo);                  \
+    const I last = min(min(a_below ? CI(floor(mb)) : e_minor + qa, minor_hi), first + 3);                           \
+    /* Distances compared in squares, with margins far above their rounding: the prefix ends a */                  \
+    /* quarter pixel short of a target (for lo), or reaches its split distance dist - split_length */              \
+    /* (for hi): dist <= (d + split_length - margin) (1 - 1e-5), which the march's own root of d2 */                \
+    /* keeps within its rounding. */                                                                                \
+    const float cell_min = hf_min(f.cell_x, f.cell_y);                                                              \
+    const F near = d_ray + 0.25f * cell_min;                                                                        \
+    const F reach_back = (d_back + split_length(f) - 1e-3f * cell_min) * (1.0f - 1e-5f);                            \
+    const F reach_now = (d_ray + split_length(f) - 1e-3f * cell_min) * (1.0f - 1e-5f);                              \
+    const F cross_b = CF(CL(a_x) * CL(b_y) - CL(a_y) * CL(b_x));                                                    \
+    for (int j = 0; j < 4; ++j) {                                                                                   \
+      const I n = first + j;                                                                                        \
+      I go = live & (n <= last);                                                                                    \
+      if (!lanes_any(go)) break;                                                                                    \
+      const I vx = (x_major ? m : n) - ex_i, vy = (x_major ? n : m) - ey_i;                                         \
+      /* In the wedge: a x v >= 0 > b x v. */                                                                       \
+      const L cross_a = CL(a_x) * CL(vy) - CL(a_y) * CL(vx);                                                        \
+      go = go & CI(cross_a >= 0) & CI(CL(b_x) * CL(vy) - CL(b_y) * CL(vx) < 0);                                     \
+      const I p = (vy + ey_i) * f.width + (vx + ex_i);                                                              \
+      go = go & (load_pending(pending, p, go) != 0);                                                                \
+      if (!lanes_any(go)) continue;                                                                                 \
+      /* The target's squared distance and rise as sight_line has them. */                                          \
+      const F gx = CF(vx) * f.cell_x, gy = CF(vy) * f.cell_y;                                                       \
+      const F d2 = gx * gx + gy * gy, dist = native_sqrt(d2);                                                       \
+      const F rise = (load_height(h, p, go) + target_height - f.curvature * d2) - ze;                               \
+      /* Something nearer rises above the sight line. */                                                            \
+      const I hidden = go & (near * near < d2) & (rise < lo * dist);                                                \
+      const I back = d2 <= reach_back * reach_back;                                                                 \
+      const I keep = go & !hidden & (back | (d2 <= reach_now * reach_now));                                         \
+      /* The bound is convex in the angle from the ray (a maximum of linear functions), so below */                 \
+      /* the chord between its two ends: at the angle's share of the wedge's, whose ratio of */                     \
+      /* sines (a x v |b| over a x b |v|, ground lengths) bounds it from above. */                                  \
+      const F near_side = back ? hi_ray_back : hi_ray, far_side = back ? hi_back : hi;                              \
+      const F share = HF_MIN(1.0f, CF(cross_a) * b_length / (cross_b * dist) * (1.0f + 1e-5f));                     \
+      const F bound = share == 0.0f                 ? near_side                                                     \
+                      : far_side == (F)INFINITY ? (F)INFINITY                                                       \
+                                                    : near_side + share * (far_side - near_side);                   \
+      store_settled(pending, ray_hi, out_visible, accumulate, p, hidden, keep, bound);                              \
+    }                                                                                                               \
+  }
+HFVIS_SETTLE(float, int, long, (long), (int), (float))
+#if HFVIS_LANES > 1
+HFVIS_SETTLE(lane_float, lane_int, long8, convert_long8, convert_int8, convert_float8)
+#endif
 
 // viewshed_ray_need, one work-item per node of the culling pyramid's finest level (leaf: nodes
 // across, down, first node's index, k): where the pyramid culled nodes, the rays need not reach
@@ -593,8 +650,7 @@ HFVIS_INLINE void one_ray(int r, __global const float* h, Field f, __global cons
   const float ex = ex_i, ey = ey_i;
   const int cells_x = max(f.width - 1, 1);
   float lo = -INFINITY, hi_ray = -INFINITY, hi = -INFINITY;
-  float2 hi_back = INFINITY;  // the bounds at the previous crossing of the major axis, d_back along
-  float d_back = 0.0f;
+  float hi_ray_back = INFINITY, hi_back = INFINITY, d_back = 0.0f;  // at the previous major crossing
   float t0 = 0.0f, f0 = h[ey_i * f.width + ex_i] - ze;
   for (;;) {
     const float tx = y.ax.t, ty = y.ay.t;
@@ -619,10 +675,11 @@ HFVIS_INLINE void one_ray(int r, __global const float* h, Field f, __global cons
     if (crossed || t1 >= 1.0f) {
       Axis major = y.x_major ? y.ax : y.ay;
       if (!crossed) axis_next(&major, y.x_major ? ex : ey, y.x_major ? y.dx : y.dy, y.x_major ? y.inv_dx : y.inv_dy);
-      settle_targets(h, f, ex_i, ey_i, ze, target_height, box, y.x_major, (int)major.g, major.q, major.r,
-                     major.inv_den, y.b_along, y.slope_b, y.a, y.b, y.b_length, lo, (float2)(hi_ray, hi), d_ray,
-                     hi_back, d_back, pending, ray_hi, out_visible, accumulate);
-      hi_back = (float2)(hi_ray, hi);
+      settle_targets(h, f, ex_i, ey_i, ze, target_height, box, y.x_major, 1, (int)major.g, major.q, major.r,
+                     major.inv_den, y.b_along, y.slope_b, y.a.x, y.a.y, y.b.x, y.b.y, y.b_length, lo, hi_ray, hi,
+                     d_ray, hi_ray_back, hi_back, d_back, pending, ray_hi, out_visible, accumulate);
+      hi_ray_back = hi_ray;
+      hi_back = hi;
       d_back = d_ray;
     }
     if (t1 >= 1.0f || d_ray > y.reach) break;
@@ -661,13 +718,6 @@ HFVIS_INLINE void lane_axis_next(LaneAxis* a, float e_along, lane_float d_along,
   a->t = go ? t : a->t;
   a->q = go ? q : a->q;
   a->r = go ? r : a->r;
-}
-
-HFVIS_INLINE lane_float gather(__global const float* p, lane_int at) {
-  lane_float v;
-#pragma unroll
-  for (int l = 0; l < HFVIS_LANES; ++l) LANE(v, l) = p[ILANE(at, l)];
-  return v;
 }
 
 // surface_at_crossing in lanes (lanes not `live` read the first height).
@@ -718,8 +768,8 @@ HFVIS_INLINE int rays_in_lanes(int r0, __global const float* h, Field f, __globa
   }
   if (x_major < 0) return 1;  // nothing to march
   const float ex = ex_i, ey = ey_i;
-  lane_int live;
-  lane_float dx, dy, inv_dx, inv_dy, length, angle, arc_limit, drop, reach, h_end;
+  lane_int live, b_along, a_x, a_y, b_x, b_y;
+  lane_float dx, dy, inv_dx, inv_dy, length, angle, arc_limit, drop, reach, h_end, slope_b, b_length;
   LaneAxis ax, ay;
   for (int l = 0; l < HFVIS_LANES; ++l) {
     const Ray y = ray[l];
@@ -728,6 +778,8 @@ HFVIS_INLINE int rays_in_lanes(int r0, __global const float* h, Field f, __globa
     LANE(length, l) = y.length, LANE(angle, l) = y.angle, LANE(arc_limit, l) = y.arc_limit;
     LANE(drop, l) = y.drop, LANE(reach, l) = y.reach;
     LANE(h_end, l) = h[(int)y.end.y * f.width + (int)y.end.x];
+    ILANE(b_along, l) = y.b_along ? -1 : 0, LANE(slope_b, l) = y.slope_b, LANE(b_length, l) = y.b_length;
+    ILANE(a_x, l) = y.a.x, ILANE(a_y, l) = y.a.y, ILANE(b_x, l) = y.b.x, ILANE(b_y, l) = y.b.y;
     lane_axis_put(&ax, l, y.ax);
     lane_axis_put(&ay, l, y.ay);
   }
@@ -765,17 +817,13 @@ HFVIS_INLINE int rays_in_lanes(int r0, __global const float* h, Field f, __globa
     t0 = live ? t_end : t0;
     f0 = live ? f_end : f0;
     const lane_float d_ray = t_end * length;
-    // Past a crossing of the major axis the next grid line's targets, at the end the line past it.
-    for (int l = 0; l < HFVIS_LANES; ++l) {
-      if (!ILANE(live, l)) continue;
-      Axis m = lane_axis_get(major, l);
-      if (!ILANE(at_major, l)) axis_next(&m, e_major, LANE(d_major, l), LANE(inv_major, l));
-      const Ray y = ray[l];
-      settle_targets(h, f, ex_i, ey_i, ze, target_height, box, x_major, (int)m.g, m.q, m.r, m.inv_den, y.b_along,
-                     y.slope_b, y.a, y.b, y.b_length, LANE(lo, l), (float2)(LANE(hi_ray, l), LANE(hi, l)),
-                     LANE(d_ray, l), (float2)(LANE(hi_ray_back, l), LANE(hi_back, l)), LANE(d_back, l), pending,
-                     ray_hi, out_visible, accumulate);
-    }
+    // Past a crossing of the major axis the next grid line's targets (the axis now holds that
+    // line), at the end the line past it.
+    LaneAxis next = *major;
+    lane_axis_next(&next, e_major, d_major, inv_major, live & !at_major);
+    settle_targets(h, f, ex_i, ey_i, ze, target_height, box, x_major, live, convert_int8(next.g), next.q, next.r,
+                   next.inv_den, b_along, slope_b, a_x, a_y, b_x, b_y, b_length, lo, hi_ray, hi, d_ray, hi_ray_back,
+                   hi_back, d_back, pending, ray_hi, out_visible, accumulate);
     hi_ray_back = live ? hi_ray : hi_ray_back;
     hi_back = live ? hi : hi_back;
     d_back = live ? d_ray : d_back;
