@@ -1,0 +1,282 @@
+// oiio_images.cpp: EXR, PNG and the other images GDAL does not take, through OpenImageIO
+// (oiio_images.hpp): reading channels as stored values, and writing rows to a file.
+#include "oiio_images.hpp"
+
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <new>
+#include <string>
+#include <vector>
+
+#include "hfvis/errors.hpp"
+
+namespace hfvis::detail {
+namespace {
+
+std::string joinNames(const std::vector<std::string>& names) {
+  std::string joined;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (i > 0) joined += ", ";
+    joined += "'" + names[i] + "'";
+  }
+  return joined;
+}
+
+// OpenImageIO's error strings sometimes end in a newline; a reason reads better without it.
+std::string trimmed(std::string text) {
+  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
+  return text;
+}
+
+std::string withDetail(const std::string& reason, const std::string& detail) {
+  const std::string d = trimmed(detail);
+  return d.empty() ? reason : reason + " (" + d + ")";
+}
+
+// ---------------------------------------------------------------------------------------------
+// Reading pixels.
+
+int selectChannel(const std::string& path, const OIIO::ImageSpec& spec, const std::string& choice) {
+  const std::vector<std::string>& names = spec.channelnames;
+  const std::string available = std::to_string(spec.nchannels) + " channels: " + joinNames(names);
+  if (choice.empty()) {
+    if (spec.nchannels == 1) return 0;
+    throw IoError(path,
+                  "image has " + available + "; choose one by name or zero-based index (hfvis --channel)");
+  }
+  for (int c = 0; c < spec.nchannels && c < static_cast<int>(names.size()); ++c) {
+    if (names[c] == choice) return c;
+  }
+  if (choice.size() <= 9 &&
+      std::all_of(choice.begin(), choice.end(), [](char ch) { return ch >= '0' && ch <= '9'; })) {
+    const int index = std::stoi(choice);
+    if (index < spec.nchannels) return index;
+  }
+  throw IoError(path, "no channel '" + choice + "' (image has " + available + ")");
+}
+
+template <typename T>
+void convertIntegers(const std::vector<unsigned char>& raw, double rescale, std::vector<float>* out) {
+  const T* values = reinterpret_cast<const T*>(raw.data());
+  for (std::size_t i = 0; i < out->size(); ++i) {
+    const double v = static_cast<double>(values[i]);
+    (*out)[i] = static_cast<float>(rescale == 1.0 ? v : std::round(v * rescale));
+  }
+}
+
+// Reads channel `ch` of subimage 0 as type `as` (T: float, or bytes for other types) in
+// blocks of rows, the buffer growing with the rows read: a header that claims more pixels
+// than the file holds fails at its first missing rows, not after allocating the whole claim.
+// Tiled files are read whole (OpenImageIO reads them a tile row at a time internally).
+template <typename T>
+std::vector<T> readRows(const std::string& path, OIIO::ImageInput& in, int ch, OIIO::TypeDesc as) {
+  const OIIO::ImageSpec& spec = in.spec();
+  const std::size_t row_values = static_cast<std::size_t>(spec.width) * as.size() / sizeof(T);
+  const auto fail = [&] {
+    throw IoError(path,
+                  withDetail("cannot read pixel data; the file is truncated or corrupt", in.geterror()));
+  };
+  std::vector<T> values;
+  if (spec.tile_width > 0) {
+    values.resize(row_values * static_cast<std::size_t>(spec.height));
+    if (!in.read_image(0, 0, ch, ch + 1, as, values.data())) fail();
+    return values;
+  }
+  const int block = static_cast<int>(std::clamp<std::size_t>(
+      (std::size_t(16) << 20) / (row_values * sizeof(T)), 1, static_cast<std::size_t>(spec.height)));
+  for (int y = 0; y < spec.height; y += block) {
+    const int y_end = std::min(spec.height, y + block);
+    values.resize(row_values * static_cast<std::size_t>(y_end));
+    if (!in.read_scanlines(0, 0, spec.y + y, spec.y + y_end, 0, ch, ch + 1, as,
+                           values.data() + row_values * static_cast<std::size_t>(y)))
+      fail();
+  }
+  return values;
+}
+
+// Reads channel `ch` of subimage 0 as the stored values (integers are not normalised).
+std::vector<float> readChannel(const std::string& path, OIIO::ImageInput& in, int ch) {
+  const OIIO::ImageSpec& spec = in.spec();
+  const OIIO::TypeDesc type = spec.channelformat(ch);
+  switch (type.basetype) {
+    case OIIO::TypeDesc::HALF:
+    case OIIO::TypeDesc::FLOAT:
+    case OIIO::TypeDesc::DOUBLE:
+      return readRows<float>(path, in, ch, OIIO::TypeDesc::FLOAT);
+    case OIIO::TypeDesc::UINT8:
+    case OIIO::TypeDesc::INT8:
+    case OIIO::TypeDesc::UINT16:
+    case OIIO::TypeDesc::INT16:
+    case OIIO::TypeDesc::UINT32:
+    case OIIO::TypeDesc::INT32:
+    case OIIO::TypeDesc::UINT64:
+    case OIIO::TypeDesc::INT64:
+      break;
+    default:
+      throw IoError(path, "unsupported pixel type '" + std::string(type.c_str()) + "'");
+  }
+  // Integers: read in their own type, since OpenImageIO's conversion to float would
+  // normalise them to [0, 1]. Files with fewer bits than the type (a 12-bit TIFF) are
+  // delivered scaled up to the type's full range; scale them back to the stored values.
+  const std::vector<unsigned char> raw = readRows<unsigned char>(
+      path, in, ch, OIIO::TypeDesc(static_cast<OIIO::TypeDesc::BASETYPE>(type.basetype)));
+  std::vector<float> heights(raw.size() / type.size());
+  double rescale = 1.0;
+  const int bits = spec.get_int_attribute("oiio:BitsPerSample", 0);
+  const int type_bits = static_cast<int>(8 * type.size());
+  if (bits > 0 && bits < type_bits && bits < 64 && type_bits < 64 && !type.is_signed()) {
+    rescale = (std::ldexp(1.0, bits) - 1.0) / (std::ldexp(1.0, type_bits) - 1.0);
+  }
+  switch (type.basetype) {
+    case OIIO::TypeDesc::UINT8:
+      convertIntegers<std::uint8_t>(raw, rescale, &heights);
+      break;
+    case OIIO::TypeDesc::INT8:
+      convertIntegers<std::int8_t>(raw, rescale, &heights);
+      break;
+    case OIIO::TypeDesc::UINT16:
+      convertIntegers<std::uint16_t>(raw, rescale, &heights);
+      break;
+    case OIIO::TypeDesc::INT16:
+      convertIntegers<std::int16_t>(raw, rescale, &heights);
+      break;
+    case OIIO::TypeDesc::UINT32:
+      convertIntegers<std::uint32_t>(raw, rescale, &heights);
+      break;
+    case OIIO::TypeDesc::INT32:
+      convertIntegers<std::int32_t>(raw, rescale, &heights);
+      break;
+    case OIIO::TypeDesc::UINT64:
+      convertIntegers<std::uint64_t>(raw, rescale, &heights);
+      break;
+    default:
+      convertIntegers<std::int64_t>(raw, rescale, &heights);
+      break;
+  }
+  return heights;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Reading and writing.
+
+// Opens an image for reading, with the checks every reader shares: the file exists, is not
+// empty, and holds a 2D, non-deep image with pixels.
+constexpr std::uint64_t kDefaultMaxImageBytes = std::uint64_t(64) << 30;
+
+std::unique_ptr<OIIO::ImageInput> openImage(const std::string& path, std::uint64_t max_image_bytes) {
+  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(path);
+  if (!in) throw IoError(path, withDetail("cannot read as an image", OIIO::geterror()));
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0) {
+    throw IoError(path, "image is empty (" + std::to_string(spec.width) + " x " +
+                            std::to_string(spec.height) + " pixels, " + std::to_string(spec.nchannels) +
+                            " channels)");
+  }
+  // The kernels index pixels with 32-bit integers (computeHorizons refuses larger fields), so
+  // a larger image is refused before any of it is read.
+  if (static_cast<std::uint64_t>(spec.width) * static_cast<std::uint64_t>(spec.height) >=
+      (std::uint64_t(1) << 31)) {
+    throw IoError(path, "image is " + std::to_string(spec.width) + " x " + std::to_string(spec.height) +
+                            " pixels; hfvis reads fields below 2^31 pixels (split it into tiles)");
+  }
+  // What the header claims, before the readers allocate for it (a damaged or hostile header
+  // can claim terabytes in a few bytes).
+  // A TIFF's strips may claim more rows than the image has; OpenImageIO buffers a whole strip.
+  const std::uint64_t limit = max_image_bytes ? max_image_bytes : kDefaultMaxImageBytes;
+  const std::uint64_t rows =
+      std::max<std::uint64_t>(spec.height, std::max(0, spec.get_int_attribute("tiff:RowsPerStrip", 0)));
+  const std::uint64_t scanline = static_cast<std::uint64_t>(spec.width) * spec.pixel_bytes(true);
+  if (scanline / std::max<std::uint64_t>(spec.width, 1) != spec.pixel_bytes(true) ||
+      scanline * rows / rows != scanline || scanline * rows > limit) {
+    throw IoError(path, "image claims " + std::to_string(spec.width) + " x " + std::to_string(spec.height) +
+                            " pixels of " + std::to_string(spec.nchannels) + " channels, more than the " +
+                            std::to_string(limit >> 20) + " MiB read at most");
+  }
+  if (spec.depth > 1) throw IoError(path, "volume images (depth > 1) are not supported");
+  if (spec.deep) throw IoError(path, "deep images are not supported");
+  return in;
+}
+
+ImageChannels read(const std::string& path, std::uint64_t max_image_bytes, const std::string* channel) {
+  std::unique_ptr<OIIO::ImageInput> in = openImage(path, max_image_bytes);
+  const OIIO::ImageSpec& spec = in->spec();
+  ImageChannels image;
+  image.width = spec.width;
+  image.height = spec.height;
+  try {
+    if (channel) {
+      const int c = selectChannel(path, spec, *channel);
+      image.names.push_back(c < static_cast<int>(spec.channelnames.size()) ? spec.channelnames[c] : "");
+      image.planes.push_back(readChannel(path, *in, c));
+    } else {
+      for (int c = 0; c < spec.nchannels; ++c) {
+        const bool named = c < static_cast<int>(spec.channelnames.size()) && !spec.channelnames[c].empty();
+        image.names.push_back(named ? spec.channelnames[c] : "channel" + std::to_string(c));
+        image.planes.push_back(readChannel(path, *in, c));
+      }
+    }
+  } catch (const std::bad_alloc&) {
+    throw IoError(path, "image is too large to hold in memory (" + std::to_string(spec.width) + " x " +
+                            std::to_string(spec.height) + " pixels" +
+                            (channel ? std::string() : ", " + std::to_string(spec.nchannels) + " channels") + ")");
+  }
+  for (const char* name : {"hfvis:cell_size_x", "hfvis:cell_size_y"}) {
+    const std::string value = spec.get_string_attribute(name);
+    if (!value.empty()) image.attributes.emplace_back(name, value);
+  }
+  in->close();
+  return image;
+}
+
+bool canWrite(const std::string& path) {
+  if (OIIO::ImageOutput::create(path)) return true;
+  OIIO::geterror();  // clear OpenImageIO's message: the caller says what to do instead
+  return false;
+}
+
+void write(const std::string& file, const std::string& path, int width, int height,
+           const std::vector<std::string>& names, bool bytes,
+           const std::vector<std::pair<std::string, std::string>>& attributes,
+           const std::function<void(int, int, void*)>& fill_rows) {
+  const int channels = static_cast<int>(names.size());
+  OIIO::ImageSpec spec(width, height, channels, bytes ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
+  spec.channelnames = names;
+  spec.alpha_channel = -1;  // every channel is data; none may be treated as alpha
+  spec.z_channel = -1;
+  for (const auto& [name, value] : attributes) spec.attribute(name, value);
+  std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create(file);
+  if (!out) throw IoError(path, withDetail("no image writer for this file", OIIO::geterror()));
+  if (!out->open(file, spec)) throw IoError(path, withDetail("cannot write the image", out->geterror()));
+  // Rows go out in chunks so a large many-channel image never needs a second full copy.
+  const std::size_t row_values = static_cast<std::size_t>(width) * channels;
+  const int rows_per_chunk = static_cast<int>(std::clamp<std::size_t>((std::size_t(1) << 22) / row_values, 1, 256));
+  std::vector<unsigned char> buffer(row_values * (bytes ? 1 : sizeof(float)) *
+                                    static_cast<std::size_t>(std::min(rows_per_chunk, height)));
+  for (int y = 0; y < height; y += rows_per_chunk) {
+    const int y_end = std::min(height, y + rows_per_chunk);
+    fill_rows(y, y_end, buffer.data());
+    if (!out->write_scanlines(y, y_end, 0, spec.format, buffer.data())) {
+      const std::string error = out->geterror();
+      out->close();
+      throw IoError(path, withDetail("cannot write the image", error));
+    }
+  }
+  if (!out->close()) throw IoError(path, withDetail("cannot finish writing the image", out->geterror()));
+}
+
+}  // namespace
+
+const OiioImages& oiioImages() {
+  static const OiioImages table{read, canWrite, write};
+  return table;
+}
+
+}  // namespace hfvis::detail
+
+extern "C" __attribute__((visibility("default"))) const hfvis::detail::OiioImages* hfvis_oiio_images() {
+  return &hfvis::detail::oiioImages();
+}
