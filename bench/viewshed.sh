@@ -111,6 +111,15 @@ for spec in "centre,$c,$c,2" "high,$c,$c,100" "corner,64,64,2"; do
 done
 echo "$agreements" >> "$out.tmp"
 
+# The floor of a whole command: a process that starts and stops (the dynamic loader, no OpenCL).
+floor() {
+  for _ in 1 2 3 4 5; do seconds "$@"; done | sort -g | head -1
+}
+{
+  echo "Start-up alone, the fastest of 5: \`hfvis --help\` $(printf '%.3f' "$(floor "$cli" --help)") s,"
+  echo "\`gdalinfo --version\` $(printf '%.3f' "$(floor gdalinfo --version)") s."
+} >> "$out.tmp"
+
 # Cumulative viewshed.
 small=$(tiff 1024)
 /usr/bin/python3 - "$observers" > "$work/observers.csv" <<'EOF'

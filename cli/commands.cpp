@@ -566,8 +566,9 @@ int runShade(const RunArguments& run) {
     for (const std::string& output : paths)
       if (!input.empty() && sameFile(input, output))
         throw UsageError("output '" + output + "' is the input '" + input + "': outputs never replace an input");
-  const HeightField input = readValidField(run);
+  HeightField input = readValidField(run);
   const NorthUp lit = northUp(input);
+  if (lit.flipped) input.heights = {};  // only its size is read from here on (restore)
   const HeightField& field = lit.field();
   std::optional<EnvironmentMap> environment;
   if (!run.environment.empty()) {
@@ -693,8 +694,9 @@ int runShade(const RunArguments& run) {
 
 int runInsolation(const RunArguments& run) {
   requireOutputs(run, outputPaths(run));
-  const HeightField input = readValidField(run);
+  HeightField input = readValidField(run);
   const NorthUp lit = northUp(input);
+  if (lit.flipped) input.heights = {};  // only its size is read from here on (restore)
   const HeightField& field = lit.field();
   const ComputeContext context = contextFor(run);
   const DeviceInfo& device = context.device();

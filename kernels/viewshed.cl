@@ -388,14 +388,6 @@ inline SightLine sight_line(__global const float* h, Field f, int x, int y, int 
 // diagonal). A line no longer is marched whole.
 inline float split_length(Field f) { return 2.5f * hf_max(f.cell_x, f.cell_y); }
 
-// Whether the direction v from the eye lies in the wedge from a (included) clockwise to b
-// (excluded), both directions from the eye to border points (a x b > 0: rows grow downward, so
-// clockwise on the map is a positive cross product). The wedges of consecutive border points
-// partition the directions around an eye inside the box, exactly (integers).
-inline int in_wedge(int2 a, int2 b, long vx, long vy) {
-  return (long)a.x * vy - (long)a.y * vx >= 0 && (long)b.x * vy - (long)b.y * vx < 0;
-}
-
 // Memory access for settle_targets, for scalars and lanes (a lane not `go` reads the first entry,
 // and writes nothing).
 HFVIS_INLINE HFVIS_OVERLOADABLE int lanes_any(int m) { return m != 0; }
@@ -506,7 +498,7 @@ HFVIS_INLINE HFVIS_OVERLOADABLE void store_settled(__global uchar* pending, __gl
       const F near_side = back ? hi_ray_back : hi_ray, far_side = back ? hi_back : hi;                              \
       const F share = HF_MIN(1.0f, CF(cross_a) * b_length / (cross_b * dist) * (1.0f + 1e-5f));                     \
       const F bound = share == 0.0f                 ? near_side                                                     \
-                      : far_side == (F)INFINITY ? (F)INFINITY                                                       \
+                      : !(far_side < INFINITY) ? (F)INFINITY                                                        \
                                                     : near_side + share * (far_side - near_side);                   \
       store_settled(pending, ray_hi, out_visible, accumulate, p, hidden, keep, bound);                              \
     }                                                                                                               \
@@ -622,7 +614,8 @@ HFVIS_INLINE Ray ray_setup(int r, int rays, Field f, int ex_i, int ey_i, int4 bo
   HFVIS_INLINE HFVIS_OVERLOADABLE void ray_bounds(F t0, F t1, F f0, F f1, F alpha, F length, F arc_limit, F lip, \
                                                   F angle, I live, F* lo, F* hi_ray, F* hi) {                   \
     const F span = t1 - t0;                                                                                     \
-    const F top = HF_MAX(HF_MAX(f0, f1), bump_top(f0, f1, alpha * span * span)); /* NaN: no bound */           \
+    /* With a nodata end (f NaN) HF_MAX keeps the other: -INFINITY past a nodata crossing. */                      \
+    const F top = HF_MAX(HF_MAX(f0, f1), bump_top(f0, f1, alpha * span * span));                                  \
     const F rise = (f1 - f0) / t1;                                                                              \
     const F first = f0 > 0.0f ? (F)INFINITY : HF_MAX(rise - alpha * t1, rise) / length;                         \
     F seg_hi = t0 > 0.0f ? native_divide(top, (top >= 0.0f ? t0 : t1) * length) : first;                        \
@@ -630,7 +623,9 @@ HFVIS_INLINE Ray ray_setup(int r, int rays, Field f, int ex_i, int ey_i, int4 bo
     const F widen = t1 * length <= arc_limit ? lip * angle : (F)INFINITY;                                       \
     seg_hi = isnan(seg_hi) ? (F)INFINITY : seg_hi;                                                              \
     *hi_ray = live ? HF_MAX(*hi_ray, seg_hi) : *hi_ray;                                                         \
-    *hi = live ? HF_MAX(*hi, isnan(widen) ? (F)INFINITY : seg_hi + widen) : *hi;                                \
+    /* No bound for the wedge where the widening has none (a nodata cell near, or past the arc */               \
+    /* limit), whatever the ray itself meets (-INFINITY in a nodata cell). */                                      \
+    *hi = live ? HF_MAX(*hi, !(widen < INFINITY) ? (F)INFINITY : seg_hi + widen) : *hi;                          \
     /* a surface point the sight lines pass near */                                                             \
     *lo = live & !isnan(seg_lo) ? HF_MAX(*lo, seg_lo - widen) : *lo;                                            \
   }
@@ -640,7 +635,7 @@ HFVIS_RAY_BOUNDS(lane_float, lane_int)
 #endif
 
 // Ray r marched alone, event by event (grid-line crossings in order); it settles the targets of
-// its wedge as viewshed_rays describes.
+// its wedge (viewshed_rays).
 HFVIS_INLINE void one_ray(int r, __global const float* h, Field f, __global const float* lipschitz, int ex_i,
                           int ey_i, float ze, float target_height, int4 box, int rays, __global const int* need,
                           int use_need, float unit, __global uchar* pending, __global float* ray_hi,
@@ -671,10 +666,10 @@ HFVIS_INLINE void one_ray(int r, __global const float* h, Field f, __global cons
     if (ty <= t1) axis_next(&y.ay, ey, y.dy, y.inv_dy);
     t0 = t1;
     // Past a crossing of the major axis the next grid line's targets (the axis now holds that
-    // line), at the end the line past it.
-    if (crossed || t1 >= 1.0f) {
-      Axis major = y.x_major ? y.ax : y.ay;
-      if (!crossed) axis_next(&major, y.x_major ? ex : ey, y.x_major ? y.dx : y.dy, y.x_major ? y.inv_dx : y.inv_dy);
+    // line). Past the ray's end the wedge meets the next line only outside the box or at the next
+    // border point, which is not its own.
+    if (crossed) {
+      const Axis major = y.x_major ? y.ax : y.ay;
       settle_targets(h, f, ex_i, ey_i, ze, target_height, box, y.x_major, 1, (int)major.g, major.q, major.r,
                      major.inv_den, y.b_along, y.slope_b, y.a.x, y.a.y, y.b.x, y.b.y, y.b_length, lo, hi_ray, hi,
                      d_ray, hi_ray_back, hi_back, d_back, pending, ray_hi, out_visible, accumulate);
@@ -749,8 +744,9 @@ HFVIS_INLINE void lane_piece(__global const float* h, Field f, __global const fl
 }
 
 // Rays r0 .. r0 + 7 in lanes, column by column (row by row for rays nearer the y axis): one step
-// per grid line of the major axis, with the minor axis's crossing before it where there is one
-// (at most one: the rays run at most 45 degrees from the major axis). Returns 0, marching
+// per grid line of the major axis, with the minor axis's crossings before it where there are
+// (one at most, as the rays run at most 45 degrees from the major axis, but for a rounding that
+// puts the next one just before instead of just after it). Returns 0, marching
 // nothing, where the rays to march do not all share the major axis and its direction.
 HFVIS_INLINE int rays_in_lanes(int r0, __global const float* h, Field f, __global const float* lipschitz, int ex_i,
                                int ey_i, float ze, float target_height, int4 box, int rays, __global const int* need,
@@ -792,15 +788,14 @@ HFVIS_INLINE int rays_in_lanes(int r0, __global const float* h, Field f, __globa
   const lane_float inv_major = x_major ? inv_dx : inv_dy, inv_minor = x_major ? inv_dy : inv_dx;
   const float e_major = x_major ? ex : ey, e_minor = x_major ? ey : ex;
   while (ANY_LANE(live)) {
-    const lane_float t_major = major->t, t_minor = minor->t;
+    const lane_float t_major = major->t;
     const lane_float t_end = t_major < 1.0f ? t_major : (lane_float)1.0f;  // the next major line, or the end
-    const lane_int minor_first = t_minor < t_end;
     const lane_int at_major = t_end == t_major;  // else the end
     const lane_float s_major = lane_surface_at_crossing(h, f.width, x_major, major, ex_i, ey_i, live & at_major);
     const lane_float f_end = ((at_major ? s_major : h_end) - ze) - drop * t_end * t_end;
-    // The minor line's crossing first, where there is one.
-    if (ANY_LANE(live & minor_first)) {
-      const lane_int go = live & minor_first;
+    // The minor lines' crossings first, where there are: one at most, but for rounding.
+    for (lane_int go = live & (minor->t < t_end); ANY_LANE(go); go = live & (minor->t < t_end)) {
+      const lane_float t_minor = minor->t;
       const lane_float s_minor = lane_surface_at_crossing(h, f.width, !x_major, minor, ex_i, ey_i, go);
       const lane_float f_minor = (s_minor - ze) - drop * t_minor * t_minor;
       lane_piece(h, f, lipschitz, ex, ey, dx, dy, drop, length, arc_limit, angle, t0, t_minor, f0, f_minor, go, &lo,
@@ -818,11 +813,9 @@ HFVIS_INLINE int rays_in_lanes(int r0, __global const float* h, Field f, __globa
     f0 = live ? f_end : f0;
     const lane_float d_ray = t_end * length;
     // Past a crossing of the major axis the next grid line's targets (the axis now holds that
-    // line), at the end the line past it.
-    LaneAxis next = *major;
-    lane_axis_next(&next, e_major, d_major, inv_major, live & !at_major);
-    settle_targets(h, f, ex_i, ey_i, ze, target_height, box, x_major, live, convert_int8(next.g), next.q, next.r,
-                   next.inv_den, b_along, slope_b, a_x, a_y, b_x, b_y, b_length, lo, hi_ray, hi, d_ray, hi_ray_back,
+    // line; none past the end, as one_ray says).
+    settle_targets(h, f, ex_i, ey_i, ze, target_height, box, x_major, live & at_major, convert_int8(major->g),
+                   major->q, major->r, major->inv_den, b_along, slope_b, a_x, a_y, b_x, b_y, b_length, lo, hi_ray, hi, d_ray, hi_ray_back,
                    hi_back, d_back, pending, ray_hi, out_visible, accumulate);
     hi_ray_back = live ? hi_ray : hi_ray_back;
     hi_back = live ? hi : hi_back;
@@ -840,8 +833,21 @@ HFVIS_INLINE int rays_in_lanes(int r0, __global const float* h, Field f, __globa
 // The widening is L * angle, L the surface's slope bound around the cell (|s difference| <= L *
 // arc between two lines at one distance, arc = distance * angle), valid while the arc stays
 // within one pixel of the ray. Each time the ray crosses a grid line of its major axis it
-// settles the wedge's targets on the next one (settle_targets), and at its end those one line
-// past it.
+// settles the wedge's targets on the next one (settle_targets).
+//
+// The wedge of ray r holds the directions v from the eye from border point r's, a (included),
+// clockwise to r + 1's, b (excluded): a x v >= 0 > b x v, in integers (a x b > 0: rows grow
+// downward, so clockwise on the map is a positive cross product). For an eye strictly inside
+// the box these wedges partition the directions around it, so no two rays settle one target;
+// an eye on the box's border leaves the wedges along that border empty (a x b <= 0), and rays
+// with them settle nothing. The targets no ray settles (those beside the eye, on the border
+// line through an eye on it, where a wedge's side b runs against the major axis, or past the
+// few grid points a line's test takes) keep ray_hi = INFINITY: viewshed_march marches them
+// whole.
+//
+// The margins of the distance tests (1e-5 relative) take native_sqrt and native_divide within
+// a few ulp, as PoCL and the GPU drivers give them; the exact marches use correctly rounded
+// operations.
 __kernel void viewshed_rays(__global const float* h, Field f, __global const float* lipschitz, int ex_i, int ey_i,
                             float ze, float target_height, int4 box, int rays, __global const int* need,
                             int use_need, float unit, __global uchar* pending, __global float* ray_hi,

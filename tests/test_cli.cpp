@@ -540,6 +540,40 @@ TEST_F(Cli, NoOpenClPlatformSaysWhichPackageProvidesOne) {
   }
 }
 
+TEST_F(Cli, OpenImageIoIsLoadedOnlyForTheImagesThatNeedIt) {
+  // The program itself does not link OpenImageIO (a start loads none of its libraries)...
+  const fs::path ldd_out = root_ / "ldd.txt";
+  ASSERT_EQ(std::system(("ldd " + shellQuoted(HFVIS_CLI_PATH) + " >" + shellQuoted(ldd_out.string())).c_str()), 0);
+  const std::string libraries = readText(ldd_out);
+  EXPECT_NE(libraries.find("libgdal"), std::string::npos) << libraries;
+  EXPECT_EQ(libraries.find("libOpenImageIO"), std::string::npos) << libraries;
+  // ...and a copy of it without the module beside it still runs on GeoTIFFs, while an EXR
+  // says what is missing and writes nothing.
+  const fs::path bare = root_ / "bare";
+  fs::create_directories(bare);
+  fs::copy_file(HFVIS_CLI_PATH, bare / "hfvis");
+  const std::string tif = in("dem.tif");
+  std::vector<float> values;
+  for (int i = 0; i < 20 * 16; ++i) values.push_back(static_cast<float>((i * 7) % 13));
+  hfvis::testing::writeGdalGeoTiff(tif, 20, 16, values, hfvis::testing::kUtmGeotransform,
+                                   hfvis::testing::crsWkt("EPSG:32633"), -9999.0);
+  const auto run_bare = [&](const std::string& args) {
+    const fs::path err_file = root_ / "bare_stderr.txt";
+    const int raw = std::system((shellQuoted((bare / "hfvis").string()) + " " + args + " >/dev/null 2>" +
+                                 shellQuoted(err_file.string()) + " </dev/null")
+                                    .c_str());
+    return std::make_pair(raw != -1 && WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, readText(err_file));
+  };
+  const auto geotiff = run_bare("viewshed " + shellQuoted(tif) + " -o " + shellQuoted(out("v.tif")) +
+                                " --observer 10,8 -q");
+  EXPECT_EQ(geotiff.first, 0) << geotiff.second;
+  EXPECT_TRUE(fs::exists(out("v.tif")));
+  const auto exr = run_bare("svf " + shellQuoted(ramp()) + " -o " + shellQuoted(out("s.exr")) + " -k 4 -q");
+  EXPECT_EQ(exr.first, 1);
+  EXPECT_NE(exr.second.find("libhfvis_oiio.so"), std::string::npos) << exr.second;
+  EXPECT_FALSE(fs::exists(out("s.exr")));
+}
+
 // ---- successful runs ----
 
 TEST_F(Cli, HorizonWritesOneChannelPerDirection) {
