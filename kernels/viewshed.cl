@@ -609,7 +609,7 @@ HFVIS_INLINE Ray ray_setup(int r, int rays, Field f, int ex_i, int ey_i, int4 bo
   HFVIS_INLINE HFVIS_OVERLOADABLE F bump_top(F f0, F f1, F a) { /* quadratic_bump, branch-free */               \
     const F bump = -a;                                                                                          \
     const F s = 0.5f + native_divide(f1 - f0, 2.0f * bump);                                                     \
-    return (a < 0.0f) & (s > 0.0f) & (s < 1.0f) ? f0 + (f1 - f0) * s + bump * s * (1.0f - s) : (F)(-INFINITY);  \
+    return ((a < 0.0f) & (s > 0.0f) & (s < 1.0f)) ? f0 + (f1 - f0) * s + bump * s * (1.0f - s) : (F)(-INFINITY);\
   }                                                                                                             \
   HFVIS_INLINE HFVIS_OVERLOADABLE void ray_bounds(F t0, F t1, F f0, F f1, F alpha, F length, F arc_limit, F lip, \
                                                   F angle, I live, F* lo, F* hi_ray, F* hi) {                   \
@@ -627,7 +627,7 @@ HFVIS_INLINE Ray ray_setup(int r, int rays, Field f, int ex_i, int ey_i, int4 bo
     /* limit), whatever the ray itself meets (-INFINITY in a nodata cell). */                                      \
     *hi = live ? HF_MAX(*hi, !(widen < INFINITY) ? (F)INFINITY : seg_hi + widen) : *hi;                          \
     /* a surface point the sight lines pass near */                                                             \
-    *lo = live & !isnan(seg_lo) ? HF_MAX(*lo, seg_lo - widen) : *lo;                                            \
+    *lo = (live & !isnan(seg_lo)) ? HF_MAX(*lo, seg_lo - widen) : *lo;                                          \
   }
 HFVIS_RAY_BOUNDS(float, int)
 #if HFVIS_LANES > 1
