@@ -30,7 +30,8 @@ std::string programDirectory() {
 const OiioImages* loadModule() {
   const std::string dir = programDirectory();
   std::string reasons;
-  for (const std::string& candidate : {dir + "/libhfvis_oiio.so", dir + "/" HFVIS_OIIO_MODULE_DIR "/libhfvis_oiio.so"}) {
+  for (const std::string& candidate :
+       {dir + "/libhfvis_oiio.so", dir + "/" HFVIS_OIIO_MODULE_DIR "/libhfvis_oiio.so"}) {
     void* module = ::dlopen(candidate.c_str(), RTLD_NOW | RTLD_LOCAL);
     if (!module) {
       reasons += std::string(reasons.empty() ? "" : "; ") + ::dlerror();
@@ -40,9 +41,11 @@ const OiioImages* loadModule() {
     if (const auto entry = reinterpret_cast<Entry>(::dlsym(module, "hfvis_oiio_images"))) return entry();
     reasons += std::string(reasons.empty() ? "" : "; ") + candidate + " has no hfvis_oiio_images";
   }
-  throw Error("EXR, PNG and the other images GDAL does not read need OpenImageIO through the module "
-              "libhfvis_oiio.so, beside the hfvis program or in " HFVIS_OIIO_MODULE_DIR
-              " from it, which could not be loaded (" + reasons + ")");
+  throw Error(
+      "EXR, PNG and the other images GDAL does not read need OpenImageIO through the module "
+      "libhfvis_oiio.so, beside the hfvis program or in " HFVIS_OIIO_MODULE_DIR
+      " from it, which could not be loaded (" +
+      reasons + ")");
 }
 
 }  // namespace

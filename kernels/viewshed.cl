@@ -815,8 +815,8 @@ HFVIS_INLINE int rays_in_lanes(int r0, __global const float* h, Field f, __globa
     // Past a crossing of the major axis the next grid line's targets (the axis now holds that
     // line; none past the end, as one_ray says).
     settle_targets(h, f, ex_i, ey_i, ze, target_height, box, x_major, live & at_major, convert_int8(major->g),
-                   major->q, major->r, major->inv_den, b_along, slope_b, a_x, a_y, b_x, b_y, b_length, lo, hi_ray, hi, d_ray, hi_ray_back,
-                   hi_back, d_back, pending, ray_hi, out_visible, accumulate);
+                   major->q, major->r, major->inv_den, b_along, slope_b, a_x, a_y, b_x, b_y, b_length, lo, hi_ray,
+                   hi, d_ray, hi_ray_back, hi_back, d_back, pending, ray_hi, out_visible, accumulate);
     hi_ray_back = live ? hi_ray : hi_ray_back;
     hi_back = live ? hi : hi_back;
     d_back = live ? d_ray : d_back;

@@ -88,10 +88,9 @@ template <typename Pixel, typename FillRows>
 void writeAtomically(const std::string& path, int width, int height, const std::vector<std::string>& names,
                      const std::vector<std::pair<std::string, std::string>>& attributes, FillRows fill_rows) {
   TemporaryFile temporary = temporaryBeside(path);
-  detail::oiioImages().write(temporary.path(), path, width, height, names, sizeof(Pixel) == 1, attributes,
-                             [&](int y_begin, int y_end, void* rows) {
-                               fill_rows(y_begin, y_end, static_cast<Pixel*>(rows));
-                             });
+  detail::oiioImages().write(
+      temporary.path(), path, width, height, names, sizeof(Pixel) == 1, attributes,
+      [&](int y_begin, int y_end, void* rows) { fill_rows(y_begin, y_end, static_cast<Pixel*>(rows)); });
   temporary.commitTo(path);
 }
 
@@ -205,16 +204,17 @@ void writeImage(const std::string& path, const ImageChannels& image) {
   }
 
   const int channels = static_cast<int>(image.planes.size());
-  writeAtomically<float>(path, image.width, image.height, image.names, image.attributes,
-                         [&](int y_begin, int y_end, float* rows) {
-                           for (int y = y_begin; y < y_end; ++y) {
-                             for (int x = 0; x < image.width; ++x) {
-                               const std::size_t src = static_cast<std::size_t>(y) * image.width + x;
-                               float* pixel = rows + (static_cast<std::size_t>(y - y_begin) * image.width + x) * channels;
-                               for (int c = 0; c < channels; ++c) pixel[c] = image.planes[c][src];
-                             }
-                           }
-                         });
+  writeAtomically<float>(
+      path, image.width, image.height, image.names, image.attributes,
+      [&](int y_begin, int y_end, float* rows) {
+        for (int y = y_begin; y < y_end; ++y) {
+          for (int x = 0; x < image.width; ++x) {
+            const std::size_t src = static_cast<std::size_t>(y) * image.width + x;
+            float* pixel = rows + (static_cast<std::size_t>(y - y_begin) * image.width + x) * channels;
+            for (int c = 0; c < channels; ++c) pixel[c] = image.planes[c][src];
+          }
+        }
+      });
 }
 
 void writePreviewPng(const std::string& path, int width, int height, const std::vector<float>& plane,
@@ -252,11 +252,12 @@ void writePreviewPng(const std::string& path, int width, int height, const std::
     return static_cast<std::uint8_t>(std::clamp(g, 0.0, 255.0));
   };
 
-  writeAtomically<std::uint8_t>(path, width, height, {"Y"}, {}, [&](int y_begin, int y_end, std::uint8_t* rows) {
-    const std::size_t begin = static_cast<std::size_t>(y_begin) * width;
-    const std::size_t end = static_cast<std::size_t>(y_end) * width;
-    for (std::size_t i = begin; i < end; ++i) rows[i - begin] = grey(plane[i]);
-  });
+  writeAtomically<std::uint8_t>(path, width, height, {"Y"}, {},
+                                [&](int y_begin, int y_end, std::uint8_t* rows) {
+                                  const std::size_t begin = static_cast<std::size_t>(y_begin) * width;
+                                  const std::size_t end = static_cast<std::size_t>(y_end) * width;
+                                  for (std::size_t i = begin; i < end; ++i) rows[i - begin] = grey(plane[i]);
+                                });
 }
 
 std::pair<float, float> quantileRange(const std::vector<float>& plane, double lo_q, double hi_q) {
@@ -305,17 +306,19 @@ void writeToneMappedPng(const std::string& path, int width, int height, const st
     return static_cast<std::uint8_t>(std::lround(255.0 * s));
   };
   const int channels = rgb ? 3 : 1;
-  const std::vector<std::string> names = rgb ? std::vector<std::string>{"R", "G", "B"} : std::vector<std::string>{"Y"};
-  writeAtomically<std::uint8_t>(path, width, height, names, {}, [&](int y_begin, int y_end, std::uint8_t* rows) {
-    const std::size_t begin = static_cast<std::size_t>(y_begin) * width;
-    const std::size_t end = static_cast<std::size_t>(y_end) * width;
-    for (std::size_t i = begin; i < end; ++i) {
-      for (int c = 0; c < channels; ++c) {
-        const double v = planes[c][i] * scale;
-        rows[(i - begin) * channels + c] = std::isfinite(v) ? encode(filmic(std::max(0.0, v))) : 0;
-      }
-    }
-  });
+  const std::vector<std::string> names =
+      rgb ? std::vector<std::string>{"R", "G", "B"} : std::vector<std::string>{"Y"};
+  writeAtomically<std::uint8_t>(
+      path, width, height, names, {}, [&](int y_begin, int y_end, std::uint8_t* rows) {
+        const std::size_t begin = static_cast<std::size_t>(y_begin) * width;
+        const std::size_t end = static_cast<std::size_t>(y_end) * width;
+        for (std::size_t i = begin; i < end; ++i) {
+          for (int c = 0; c < channels; ++c) {
+            const double v = planes[c][i] * scale;
+            rows[(i - begin) * channels + c] = std::isfinite(v) ? encode(filmic(std::max(0.0, v))) : 0;
+          }
+        }
+      });
 }
 
 std::vector<std::string> directionChannelNames(const std::string& prefix, int count) {

@@ -222,7 +222,8 @@ ImageChannels read(const std::string& path, std::uint64_t max_image_bytes, const
   } catch (const std::bad_alloc&) {
     throw IoError(path, "image is too large to hold in memory (" + std::to_string(spec.width) + " x " +
                             std::to_string(spec.height) + " pixels" +
-                            (channel ? std::string() : ", " + std::to_string(spec.nchannels) + " channels") + ")");
+                            (channel ? std::string() : ", " + std::to_string(spec.nchannels) + " channels") +
+                            ")");
   }
   for (const char* name : {"hfvis:cell_size_x", "hfvis:cell_size_y"}) {
     const std::string value = spec.get_string_attribute(name);
@@ -253,7 +254,8 @@ void write(const std::string& file, const std::string& path, int width, int heig
   if (!out->open(file, spec)) throw IoError(path, withDetail("cannot write the image", out->geterror()));
   // Rows go out in chunks so a large many-channel image never needs a second full copy.
   const std::size_t row_values = static_cast<std::size_t>(width) * channels;
-  const int rows_per_chunk = static_cast<int>(std::clamp<std::size_t>((std::size_t(1) << 22) / row_values, 1, 256));
+  const int rows_per_chunk =
+      static_cast<int>(std::clamp<std::size_t>((std::size_t(1) << 22) / row_values, 1, 256));
   std::vector<unsigned char> buffer(row_values * (bytes ? 1 : sizeof(float)) *
                                     static_cast<std::size_t>(std::min(rows_per_chunk, height)));
   for (int y = 0; y < height; y += rows_per_chunk) {

@@ -79,7 +79,8 @@ class ViewshedRun {
     if (options.pyramid) uploadCulling(*options.pyramid);
     // The rays' upper bounds, a float per point, where the budget leaves room for them (else
     // every target is marched).
-    const std::size_t budget = options.memory_budget ? options.memory_budget : detail::defaultMemoryBudget(st.info);
+    const std::size_t budget =
+        options.memory_budget ? options.memory_budget : detail::defaultMemoryBudget(st.info);
     ray_hi_budgeted_ = pixels * sizeof(float) <= budget / 2;
     ray_hi_ = detail::deviceBuffer(st, ray_hi_budgeted_ ? pixels * sizeof(float) : sizeof(float));
     pending_ = detail::deviceBuffer(st, pixels);
@@ -149,7 +150,9 @@ class ViewshedRun {
         n.setArg(a++, rays);
         n.setArg(a++, unit);
         n.setArg(a++, need);
-        st_.launch(n, cl::NDRange(detail::roundUp(cull_leaf.s[0], detail::kTileX), detail::roundUp(cull_leaf.s[1], detail::kTileY)),
+        st_.launch(n,
+                   cl::NDRange(detail::roundUp(cull_leaf.s[0], detail::kTileX),
+                               detail::roundUp(cull_leaf.s[1], detail::kTileY)),
                    cl::NDRange(detail::kTileX, detail::kTileY));
       }
       cl::Kernel r(program_, "viewshed_rays");

@@ -543,7 +543,8 @@ TEST_F(Cli, NoOpenClPlatformSaysWhichPackageProvidesOne) {
 TEST_F(Cli, OpenImageIoIsLoadedOnlyForTheImagesThatNeedIt) {
   // The program itself does not link OpenImageIO (a start loads none of its libraries)...
   const fs::path ldd_out = root_ / "ldd.txt";
-  ASSERT_EQ(std::system(("ldd " + shellQuoted(HFVIS_CLI_PATH) + " >" + shellQuoted(ldd_out.string())).c_str()), 0);
+  ASSERT_EQ(
+      std::system(("ldd " + shellQuoted(HFVIS_CLI_PATH) + " >" + shellQuoted(ldd_out.string())).c_str()), 0);
   const std::string libraries = readText(ldd_out);
   EXPECT_NE(libraries.find("libgdal"), std::string::npos) << libraries;
   EXPECT_EQ(libraries.find("libOpenImageIO"), std::string::npos) << libraries;
@@ -564,8 +565,8 @@ TEST_F(Cli, OpenImageIoIsLoadedOnlyForTheImagesThatNeedIt) {
                                     .c_str());
     return std::make_pair(raw != -1 && WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, readText(err_file));
   };
-  const auto geotiff = run_bare("viewshed " + shellQuoted(tif) + " -o " + shellQuoted(out("v.tif")) +
-                                " --observer 10,8 -q");
+  const auto geotiff =
+      run_bare("viewshed " + shellQuoted(tif) + " -o " + shellQuoted(out("v.tif")) + " --observer 10,8 -q");
   EXPECT_EQ(geotiff.first, 0) << geotiff.second;
   EXPECT_TRUE(fs::exists(out("v.tif")));
   const auto exr = run_bare("svf " + shellQuoted(ramp()) + " -o " + shellQuoted(out("s.exr")) + " -k 4 -q");
