@@ -18,11 +18,13 @@
 // and upper bounds on the largest elevation slope met so far, widened by a bound on the
 // surface's slope times the angle to the next ray, so that they bound the slope met by every
 // sight line of its wedge (the directions from its border point up to the next one; rigorous
-// while that angle spans at most a pixel). The wedges partition the directions around the eye
-// exactly (integer cross products), and each ray settles its wedge's targets as it passes them:
-// a target whose slope lies below the lower bound is hidden; the others keep the upper bound and
-// are marched exactly over their last 2.5 pixels, and over the rest of the line (skipping the
-// blocks of a maximum pyramid that lie below it) unless that bound settles them. The kernels
+// while that angle spans at most a pixel). For an eye inside the box the wedges partition the
+// directions around it exactly (integer cross products), and each ray settles its wedge's
+// targets as it passes them: a target whose slope lies below the lower bound is hidden; the
+// others keep an upper bound at their own angle from the ray and are marched exactly over their
+// last 2.5 pixels, and over the rest of the line (skipping the blocks of a maximum pyramid that
+// lie below it) unless that bound settles them. The few targets no ray settles (beside the eye,
+// along the border through an eye on it) are marched whole. The kernels
 // decide in single precision: sight lines that graze the surface within its rounding may go
 // either way, and pieces of a line shorter than 1e-3 pixel skip their vertex test.
 //
