@@ -65,14 +65,18 @@ inline float surface_curve(__global const float* h, int width, int4 c, float dx,
 }
 
 // The largest value on [0, 1] of the quadratic with ends f0, f1 and t^2 coefficient a (in the
-// segment's own parameter), or -INFINITY where it stays at or below its ends' larger one.
-inline float quadratic_bump(float f0, float f1, float a) {
-  if (!(a < 0.0f)) return -INFINITY;
-  const float bump = -a;  // f(s) = f0 + (f1 - f0) s + bump s (1 - s)
-  const float s = 0.5f + native_divide(f1 - f0, 2.0f * bump);
-  if (!(s > 0.0f && s < 1.0f)) return -INFINITY;
-  return f0 + (f1 - f0) * s + bump * s * (1.0f - s);
-}
+// segment's own parameter), or -INFINITY where it stays at or below its ends' larger one:
+// f(s) = f0 + (f1 - f0) s + bump s (1 - s), bump = -a. Branch-free, for scalars and lanes.
+#define HFVIS_QUADRATIC_BUMP(F)                                                                                  \
+  HFVIS_INLINE HFVIS_OVERLOADABLE F quadratic_bump(F f0, F f1, F a) {                                             \
+    const F bump = -a;                                                                                           \
+    const F s = 0.5f + native_divide(f1 - f0, 2.0f * bump);                                                      \
+    return ((a < 0.0f) & (s > 0.0f) & (s < 1.0f)) ? f0 + (f1 - f0) * s + bump * s * (1.0f - s) : (F)(-INFINITY); \
+  }
+HFVIS_QUADRATIC_BUMP(float)
+#if HFVIS_LANES > 1
+HFVIS_QUADRATIC_BUMP(lane_float)
+#endif
 
 // The parameter t where a line from e (along d, 1 / d = inv) crosses grid line g, or INFINITY when
 // g is not strictly before the line's end e + d (or the line runs along the axis, d = 0): a
@@ -606,16 +610,11 @@ HFVIS_INLINE Ray ray_setup(int r, int rays, Field f, int ex_i, int ey_i, int4 bo
 // 0 to *hi at the wedge's angle. For scalars and lane vectors alike.
 #define HF_MAX(a, b) ((a) > (b) ? (a) : (b))
 #define HFVIS_RAY_BOUNDS(F, I)                                                                                    \
-  HFVIS_INLINE HFVIS_OVERLOADABLE F bump_top(F f0, F f1, F a) { /* quadratic_bump, branch-free */               \
-    const F bump = -a;                                                                                          \
-    const F s = 0.5f + native_divide(f1 - f0, 2.0f * bump);                                                     \
-    return ((a < 0.0f) & (s > 0.0f) & (s < 1.0f)) ? f0 + (f1 - f0) * s + bump * s * (1.0f - s) : (F)(-INFINITY);\
-  }                                                                                                             \
   HFVIS_INLINE HFVIS_OVERLOADABLE void ray_bounds(F t0, F t1, F f0, F f1, F alpha, F length, F arc_limit, F lip, \
                                                   F angle, I live, F* lo, F* hi_ray, F* hi) {                   \
     const F span = t1 - t0;                                                                                     \
     /* With a nodata end (f NaN) HF_MAX keeps the other: -INFINITY past a nodata crossing. */                      \
-    const F top = HF_MAX(HF_MAX(f0, f1), bump_top(f0, f1, alpha * span * span));                                  \
+    const F top = HF_MAX(HF_MAX(f0, f1), quadratic_bump(f0, f1, alpha * span * span));                                  \
     const F rise = (f1 - f0) / t1;                                                                              \
     const F first = f0 > 0.0f ? (F)INFINITY : HF_MAX(rise - alpha * t1, rise) / length;                         \
     F seg_hi = t0 > 0.0f ? native_divide(top, (top >= 0.0f ? t0 : t1) * length) : first;                        \
@@ -691,13 +690,6 @@ typedef struct {
 HFVIS_INLINE void lane_axis_put(LaneAxis* v, int l, Axis a) {
   LANE(v->g, l) = a.g, LANE(v->t, l) = a.t, LANE(v->inv_den, l) = a.inv_den;
   ILANE(v->q, l) = a.q, ILANE(v->r, l) = a.r, ILANE(v->den, l) = a.den, ILANE(v->dq, l) = a.dq, ILANE(v->dr, l) = a.dr;
-}
-
-HFVIS_INLINE Axis lane_axis_get(const LaneAxis* v, int l) {
-  Axis a;
-  a.g = LANE(v->g, l), a.t = LANE(v->t, l), a.inv_den = LANE(v->inv_den, l);
-  a.q = ILANE(v->q, l), a.r = ILANE(v->r, l), a.den = ILANE(v->den, l), a.dq = ILANE(v->dq, l), a.dr = ILANE(v->dr, l);
-  return a;
 }
 
 // axis_next where `go`.
