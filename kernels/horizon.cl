@@ -322,6 +322,54 @@ HFVIS_INLINE lane_float lane_sample_height(__global const float* heights, int wi
   return h;
 }
 
+// The piece of a line between two consecutive samples (src/lattice_geometry.hpp, struct
+// CellSegment): nine 4-byte members, read field by field.
+typedef struct {
+  float tau_far, tau_near;  // its ends, pixels from the period's receiver toward +(a, b)
+  int ox, oy;               // its cell's lower corner, relative to the receiver
+  float fx, fy, dx, dy;     // cell fractions at the far end, and their change to the near end
+  int curved;               // off the grid lines: the surface along it is a quadratic
+} CellSegment;
+
+// The maximum of the bilinear surface inside segment g of the lanes' period receivers at
+// (c, r), where it lies strictly inside the segment: *valid there (for lanes `ok`, inside the
+// field where `edge`, with four finite corners), its tau in *tau and its height returned. The
+// caller also requires its position to fall strictly between those of the segment's ends (as
+// the sweep rounds them), so that positions grow strictly along the sweep. Along
+// the segment, at u in [0, 1] from the far end, the cell fractions are (fx + u dx, fy + u dy)
+// and the surface h00 + gx x + gy y + e x y (e the cell's twist) is A + B u + C u^2 with
+// C = e dx dy: it peaks inside where C < 0 and 0 < -B / 2C < 1, at height A + B u / 2. A
+// convex or flat piece (C >= 0) has its maximum at an end, which is a sample already. Lanes
+// without the segment read the buffer's first height alone.
+HFVIS_INLINE lane_float segment_peak(__global const float* heights, int width, int height, int row0,
+                                     __global const CellSegment* g, lane_int c, lane_int r, lane_int ok, int edge,
+                                     lane_float* tau, lane_int* valid) {
+  const lane_int x0 = c + g->ox, y0 = r + g->oy;
+  if (edge) ok = ok & (x0 >= 0) & (x0 + 1 <= width - 1) & (y0 >= 0) & (y0 + 1 <= height - 1);
+  const lane_int at = select((lane_int)0, (y0 - row0) * width + x0, ok);
+  const lane_int right = select((lane_int)0, (lane_int)1, ok), down = select((lane_int)0, (lane_int)width, ok);
+  lane_float h00, h10, h01, h11;
+#pragma unroll
+  for (int l = 0; l < HFVIS_LANES; ++l) {
+    const int k = ILANE(at, l);
+    LANE(h00, l) = heights[k];
+    LANE(h10, l) = heights[k + ILANE(right, l)];
+    LANE(h01, l) = heights[k + ILANE(down, l)];
+    LANE(h11, l) = heights[k + ILANE(down, l) + ILANE(right, l)];
+  }
+  const float fx = g->fx, fy = g->fy, dx = g->dx, dy = g->dy, tau_far = g->tau_far, tau_near = g->tau_near;
+  const lane_float gx = h10 - h00, gy = h01 - h00;
+  const lane_float e = (h11 - h01) - gx;
+  const lane_float A = h00 + gx * fx + gy * fy + e * (fx * fy);
+  const lane_float B = gx * dx + gy * dy + e * (fx * dy + fy * dx);
+  const lane_float C = e * (dx * dy);
+  const lane_float u = B / (-2.0f * C);
+  *tau = tau_far - u * (tau_far - tau_near);
+  // A is finite only where all four corners are (no nodata, no infinite height).
+  *valid = ok & (C < 0.0f) & (B > 0.0f) & (B < -2.0f * C) & isfinite(A);
+  return A + 0.5f * B * u;
+}
+
 // One step of Algorithm 1 (Timonen & Westerholm 2010) on the lanes' hull stacks: the sample
 // (hs, here) arrives beyond every entry, on the side `toward` (+1: positions grow, the
 // forward sweep; -1: they shrink, the backward pass of a window). Pop while the entry below
@@ -374,13 +422,14 @@ HFVIS_INLINE void hull_step(__global float2* stacks, lane_int stack, int entry, 
   *n = select(*n, *n + 1, valid);
 }
 
-#if HFVIS_MAX_DISTANCE
 // The sample's height as the stack holds it: lowered by the Earth's drop (see horizon_lattice).
 #if HFVIS_CURVATURE
 #define HFVIS_STACK_HEIGHT(h, here) ((h) - drop * (here) * (here))
 #else
 #define HFVIS_STACK_HEIGHT(h, here) (h)
 #endif
+
+#if HFVIS_MAX_DISTANCE
 
 #if HFVIS_STRIPS
 // The block of the sample `tau` before receiver `index` of a line, computed as horizon_lattice's
@@ -426,7 +475,8 @@ HFVIS_INLINE int block_of_row(int j, float tau, int c, int r, int a, int b, floa
 // sweep and by x - here <= window here, so a sample within rounding of the window's length
 // (relative 1e-7) may go either way.
 HFVIS_INLINE void window_pass(__global const float* heights, int width, int height, int row0, int out_row0,
-                              __global const LatticeSample* samples, int n_samples, int a, int b, float period,
+                              __global const LatticeSample* samples, __global const CellSegment* segments,
+                              int n_samples, int a, int b, float period,
                               float window, float inv_window, float drop, lane_int c, lane_int r,
                               lane_int receivers, lane_int stack, int entry, int i, int q, int k, int trips,
                               int offset, float base, float inv_period, __global const float* row_length,
@@ -453,6 +503,9 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
   while (end < trips && (int)floor((float)(offset + end) * period * inv_window) == k) ++end;
 #endif
   int ci = q > 0 ? i : i - 1, cq = q > 0 ? q - 1 : n_samples - 1;  // the nearest sample before (i, q)
+  // Backwards, the peak inside the segment from sample (ci, cq) to the one after it comes just
+  // before (ci, cq): it is taken with it, once (ci, cq) is within the window and in block k - 1,
+  // and where it lies in block k - 1 itself (as the forward sweep takes it).
   lane_int n = 0;
   lane_float top_h = 0.0f, top_p = 0.0f, below_h = 0.0f, below_p = 0.0f, rise = 0.0f, run = 0.0f;
   for (int j = end - 1; j >= max(i, 0); --j) {
@@ -473,6 +526,28 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
       const float here = (float)(offset + ci) * period - s->tau;
 #endif
       if ((int)floor(here * inv_window) != k - 1 || x - here > window) break;
+      const int gq = cq + 1 < n_samples ? cq + 1 : 0, gi = cq + 1 < n_samples ? ci : ci + 1;
+      __global const CellSegment* g = segments + gq;
+      if (g->curved) {
+#if HFVIS_ROW_SPACING
+        const int gr = r - (gi - i) * b;
+        const float segment_base = receiver_base[(gr - row0) * width + (c - (gi - i) * a)];
+        const float segment_scale = row_length[gr] * inv_period;
+#else
+        const float segment_base = (float)(offset + gi) * period, segment_scale = 1.0f;
+#endif
+        const float here_near = segment_base - samples[gq].tau * segment_scale;
+        lane_int valid;
+        lane_float tau_peak;
+        const lane_float h_peak = segment_peak(heights, width, height, row0, g, c - (gi - i) * a, r - (gi - i) * b,
+                                               gi < receivers, offset + gi == 0, &tau_peak, &valid);
+        const lane_float here_peak = segment_base - tau_peak * segment_scale;
+        valid = valid & (here_peak > here) & (here_peak < here_near) &
+                (LANE_INT(floor(here_peak * inv_window)) == k - 1);
+        if (ANY_LANE(valid))
+          hull_step(stacks, stack, entry, valid, HFVIS_STACK_HEIGHT(h_peak, here_peak), here_peak, -1.0f, &n,
+                    &top_h, &top_p, &below_h, &below_p, &rise, &run);
+      }
       lane_int valid;
       const lane_float h = lane_sample_height(heights, width, height, row0, s, c - (ci - i) * a, r - (ci - i) * b,
                                               ci < receivers, offset + ci == 0, &valid);
@@ -556,7 +631,7 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
 // count (step-major). Global size: ceil(n_lines / HFVIS_LANES) rounded up to the local size.
 __kernel void horizon_lattice(__global const float* heights, int width, int height, int row0, int out_row0,
                               __global const int4* lines, int n_lines, __global const LatticeSample* samples,
-                              int n_samples, int a, int b, float period, float ground_per_pixel,
+                              __global const CellSegment* segments, int n_samples, int a, int b, float period, float ground_per_pixel,
                               float period_ground, float drop, float window, float inv_window,
                               __global const float* row_length, __global const float4* row_terms,
                               float cos_azimuth,
@@ -647,7 +722,7 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
         ib = pi;
         qb = pq;
       }
-      window_pass(heights, width, height, row0, out_row0, samples, n_samples, a, b, period, window, inv_window,
+      window_pass(heights, width, height, row0, out_row0, samples, segments, n_samples, a, b, period, window, inv_window,
                   drop, c - ib * a, r - ib * b, receivers, stack + n * entry, entry, ib, qb, block,
                   trips, start, RESUME_BASE, inv_period, row_length, receiver_base, stacks, window_far);
     }
@@ -657,6 +732,16 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 #else
 #define LINE_OFFSET 0
 #endif
+#endif
+  // The position of the sample before the next one: the last receiver before this launch (a
+  // resumed line), or any value for a line's first period, whose first segment always ends
+  // outside the field.
+#if HFVIS_ROW_SPACING
+  lane_float here_before = base;
+#elif HFVIS_STRIPS
+  lane_float here_before = LANE_FLOAT(start - 1) * period;
+#else
+  lane_float here_before = -period;
 #endif
   for (int i = 0; i < trips; ++i, c -= a, r -= b) {
     const lane_int live = i < receivers;
@@ -703,12 +788,35 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 #else
       const float here = base - s->tau;
 #endif
+      const __global CellSegment* g = segments + q;
+      if (g->curved) {
+        // The surface's peak inside the segment from the sample before (at here_before) to this
+        // one, a sample of its own, in the block of the sample before (window_pass).
+        lane_int peak;
+        lane_float tau_peak;
+        const lane_float h_peak = segment_peak(heights, width, height, row0, g, c, r, live, i == 0, &tau_peak, &peak);
+#if HFVIS_ROW_SPACING
+        const lane_float here_peak = base - tau_peak * tau_scale;
+#else
+        const lane_float here_peak = base - tau_peak;
+#endif
+        peak = peak & (here_peak > here_before) & (here_peak < here);
+#if HFVIS_MAX_DISTANCE
+        peak = peak & (LANE_INT(floor(here_peak * inv_window)) == block);
+#endif
+        if (ANY_LANE(peak)) {
+          lane_float unused_rise = 0.0f, unused_run = 0.0f;
+          hull_step(stacks, stack, entry, peak, HFVIS_STACK_HEIGHT(h_peak, here_peak), here_peak, 1.0f, &n, &top_h,
+                    &top_p, &below_h, &below_p, &unused_rise, &unused_run);
+        }
+      }
+      here_before = here;
 #if HFVIS_MAX_DISTANCE
       const int sample_block = (int)floor(here * inv_window);
       if (sample_block != block) {
         far_part = block != INT_MIN;
         if (far_part)
-          window_pass(heights, width, height, row0, out_row0, samples, n_samples, a, b, period, window,
+          window_pass(heights, width, height, row0, out_row0, samples, segments, n_samples, a, b, period, window,
                       inv_window, drop, c, r, receivers, stack, entry, i, q, sample_block, trips, LINE_OFFSET,
                       base, inv_period, row_length, receiver_base, stacks, window_far);
         block = sample_block;

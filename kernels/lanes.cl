@@ -21,6 +21,7 @@ typedef int lane_int;
 #define ILANE(v, l) (v)
 #define ANY_LANE(m) ((m) != 0)
 #define LANE_FLOAT(v) ((float)(v))
+#define LANE_INT(v) ((int)(v))
 #elif HFVIS_LANES == 8
 typedef float8 lane_float;
 typedef int8 lane_int;
@@ -29,6 +30,7 @@ typedef int8 lane_int;
 HFVIS_INLINE int any_lane(int8 m) { return as_ulong(convert_char8(m)) != 0; }
 #define ANY_LANE(m) any_lane(m)
 #define LANE_FLOAT(v) convert_float8(v)
+#define LANE_INT(v) convert_int8(v)
 #else
 #error "HFVIS_LANES must be 1 or 8"
 #endif

@@ -42,6 +42,8 @@ struct RunDirection {
   LatticeDirection lattice;  // sweep (azimuth and weight for both methods)
   SweepDirection ray;        // naive march
   std::vector<LatticeSample> samples;
+  std::vector<CellSegment> segments;  // sweep: the segment ending at each sample
+  std::size_t stack_per_period = 0;   // sweep: hull-stack entries a period can push
   float cos_azimuth = 1.0f, sin_azimuth = 0.0f;  // as the scalar reference rounds them
   std::vector<LatticeLine> lines;                // sweep: the direction's lines over the field
   LatticeWindow window;                          // sweep: the maximum distance along its lines
@@ -151,7 +153,7 @@ RunPlan planRun(const HeightField& field, const HorizonOptions& options, const H
     for (const RunDirection& d : directions) {
       std::size_t total = 0;
       for (const LatticeLine& line : d.lines) {
-        const std::size_t capacity = lineCapacity(line, d.samples.size());
+        const std::size_t capacity = lineCapacity(line, d.stack_per_period);
         total += capacity;
         longest = std::max(longest, capacity);
       }
@@ -197,7 +199,9 @@ std::vector<RunDirection> runDirectionsOf(const HeightField& field, const Horizo
     if (hasRowSpacing(field)) rows = latticeRowTables(field, directions, !exactAzimuths(outputs));
     for (std::size_t k = 0; k < directions.size(); ++k) {
       const LatticeDirection& d = directions[k];
-      out.push_back({d, SweepDirection{}, latticeSamples(d, options.samples_per_unit),
+      std::vector<CellSegment> segments = cellSegments(d, options.samples_per_unit);
+      const std::size_t per_period = stackEntriesPerPeriod(segments);
+      out.push_back({d, SweepDirection{}, latticeSamples(d, options.samples_per_unit), std::move(segments), per_period,
                      static_cast<float>(std::cos(d.azimuth)), static_cast<float>(std::sin(d.azimuth)),
                      latticeLines(d, field.width, field.height), latticeWindow(field, d, options.max_distance),
                      kAllSteps, {}, {}, static_cast<int>(k)});
@@ -537,8 +541,8 @@ class HorizonRoutine : public SweepRoutine {
   }
 
   // horizon_lattice's arguments where the chunks (and strips) differ.
-  enum SweepArgument { kRow0 = 3, kOutRow0 = 4, kLines = 5, kLineCount = 6, kStride = 25, kLineState = 26,
-                       kCarryIn = 27 };
+  enum SweepArgument { kRow0 = 3, kOutRow0 = 4, kLines = 5, kLineCount = 6, kStride = 26, kLineState = 27,
+                       kCarryIn = 28 };
 
   // horizon_lattice for direction d with everything but the chunk's lines set (rows from 0 on,
   // no line states); `keep` holds the buffers it takes until the launch.
@@ -552,18 +556,21 @@ class HorizonRoutine : public SweepRoutine {
     kernel.setArg(kRow0, 0);
     kernel.setArg(kOutRow0, 0);
     kernel.setArg(7, keep.back());
-    kernel.setArg(8, static_cast<int>(d.samples.size()));
-    kernel.setArg(9, d.lattice.a);
-    kernel.setArg(10, d.lattice.b);
-    kernel.setArg(11, static_cast<float>(d.lattice.period));
+    keep.emplace_back(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, d.segments.size() * sizeof(CellSegment),
+                      const_cast<CellSegment*>(d.segments.data()));
+    kernel.setArg(8, keep.back());
+    kernel.setArg(9, static_cast<int>(d.samples.size()));
+    kernel.setArg(10, d.lattice.a);
+    kernel.setArg(11, d.lattice.b);
+    kernel.setArg(12, static_cast<float>(d.lattice.period));
     const double unit = positionUnit(d.lattice.ground_per_pixel);
-    kernel.setArg(12, static_cast<float>(unit));
-    kernel.setArg(13, static_cast<float>(d.lattice.period * d.lattice.ground_per_pixel));
-    kernel.setArg(14, curvatureDrop(unit));
-    kernel.setArg(15, d.window.window);
-    kernel.setArg(16, d.window.inv_window);
-    for (cl::Buffer& table : setRowTables(kernel, 17, d)) keep.push_back(table);
-    setOutputs(kernel, 19, d, plane_offset);
+    kernel.setArg(13, static_cast<float>(unit));
+    kernel.setArg(14, static_cast<float>(d.lattice.period * d.lattice.ground_per_pixel));
+    kernel.setArg(15, curvatureDrop(unit));
+    kernel.setArg(16, d.window.window);
+    kernel.setArg(17, d.window.inv_window);
+    for (cl::Buffer& table : setRowTables(kernel, 18, d)) keep.push_back(table);
+    setOutputs(kernel, 20, d, plane_offset);
     return kernel;
   }
 
@@ -578,7 +585,7 @@ class HorizonRoutine : public SweepRoutine {
     chunk.lines = kLines;
     chunk.count = kLineCount;
     chunk.stride = kStride;
-    launchLineChunks(st_, kernel, d.lines, d.samples.size(), plan_.stack_entries, chunk, lanes_, sweepGroup());
+    launchLineChunks(st_, kernel, d.lines, d.stack_per_period, plan_.stack_entries, chunk, lanes_, sweepGroup());
   }
 
   // Direction k over a field in strips: the strips in the order its lines run through them
@@ -588,7 +595,7 @@ class HorizonRoutine : public SweepRoutine {
   void sweepInStrips(const RunDirection& d, int k) {
     const int rows = plan_.strip_rows, strips = (field_.height + rows - 1) / rows;
     const int a = d.lattice.a, b = d.lattice.b;
-    const std::size_t per_period = d.samples.size();
+    const std::size_t per_period = d.stack_per_period;
     // Within a maximum distance the window's pass pushes the samples of the block before, up to a
     // window and two periods of them, above a resumed line's stack.
     // (With per-row spacing the window is a ground length: so many of the shortest periods.)

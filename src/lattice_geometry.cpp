@@ -173,15 +173,17 @@ void setQuadratureWeights(std::vector<LatticeDirection>& directions) {
   }
 }
 
-std::vector<LatticeSample> latticeSamples(const LatticeDirection& d, double samples_per_unit) {
+namespace {
+
+// The fractions of the period at which the horizon sweep's samples of direction d lie,
+// farthest first, the receiver's 0 last (latticeSamples).
+std::vector<double> sampleFractions(const LatticeDirection& d, double samples_per_unit) {
   // Crossings as fractions of the period: columns at i / |a|, rows at j / |b|.
   std::vector<double> crossings = {0.0, 1.0};
   for (int i = 1; i < std::abs(d.a); ++i) crossings.push_back(double(i) / std::abs(d.a));
   for (int j = 1; j < std::abs(d.b); ++j) crossings.push_back(double(j) / std::abs(d.b));
   std::sort(crossings.begin(), crossings.end());
-  // Fractions of the period at which samples lie (the receiver's 0 included, the next
-  // receiver's 1 not).
-  std::vector<double> fractions;
+  std::vector<double> fractions;  // the receiver's 0 included, the next receiver's 1 not
   // Along a grid line the bilinear surface is linear between pixel centres: the centres are
   // the whole surface's hull there, and points between them would only add ties.
   const bool along_grid_line = d.a == 0 || d.b == 0;
@@ -191,9 +193,46 @@ std::vector<LatticeSample> latticeSamples(const LatticeDirection& d, double samp
     const int parts = std::max(1, static_cast<int>(std::lround(samples_per_unit * span * d.period)));
     for (int s = 0; s < parts; ++s) fractions.push_back(crossings[q] + span * s / parts);
   }
+  std::reverse(fractions.begin(), fractions.end());
+  return fractions;
+}
+
+}  // namespace
+
+std::vector<LatticeSample> latticeSamples(const LatticeDirection& d, double samples_per_unit) {
   std::vector<LatticeSample> samples;
-  for (auto it = fractions.rbegin(); it != fractions.rend(); ++it) samples.push_back(sampleAt(d, *it));
+  for (double f : sampleFractions(d, samples_per_unit)) samples.push_back(sampleAt(d, f));
   return samples;
+}
+
+std::vector<CellSegment> cellSegments(const LatticeDirection& d, double samples_per_unit) {
+  const std::vector<double> fractions = sampleFractions(d, samples_per_unit);
+  std::vector<CellSegment> segments;
+  double far = 1.0;  // the next receiver along +(a, b)
+  for (double near : fractions) {
+    CellSegment g{};
+    g.tau_far = static_cast<float>(far * d.period);
+    g.tau_near = sampleAt(d, near).tau;
+    // The cell holds the piece's middle (its ends may lie on the cell's edges).
+    const double mx = d.a * 0.5 * (far + near), my = d.b * 0.5 * (far + near);
+    const double ox = std::floor(mx), oy = std::floor(my);
+    g.ox = static_cast<std::int32_t>(ox);
+    g.oy = static_cast<std::int32_t>(oy);
+    g.fx = static_cast<float>(d.a * far - ox);
+    g.fy = static_cast<float>(d.b * far - oy);
+    g.dx = static_cast<float>(d.a * (near - far));
+    g.dy = static_cast<float>(d.b * (near - far));
+    g.curved = d.a != 0 && d.b != 0;  // along a grid line the surface is linear
+    segments.push_back(g);
+    far = near;
+  }
+  return segments;
+}
+
+std::size_t stackEntriesPerPeriod(const std::vector<CellSegment>& segments) {
+  std::size_t entries = segments.size();
+  for (const CellSegment& g : segments) entries += g.curved != 0;
+  return entries;
 }
 
 int samplesPerPeriod(const LatticeDirection& d, double samples_per_unit) {

@@ -70,6 +70,33 @@ static_assert(sizeof(LatticeSample) == 36, "LatticeSample must match the kernel 
 // their pixel centres: the surface is linear between them.
 std::vector<LatticeSample> latticeSamples(const LatticeDirection& d, double samples_per_unit);
 
+// The piece of a line between two consecutive samples of the horizon sweep (CellSegment q
+// runs from the sample before sample q, farther along +(a, b), to sample q; segment 0 from the
+// next receiver along +(a, b), at tau = period). Such a piece lies inside one cell, where the
+// bilinear surface is a quadratic in the distance along the line: off the grid lines (`curved`)
+// it can peak strictly inside the piece, above both samples (two high corners off a diagonal:
+// roofs that touch at a corner, a one-pixel wall, a street canyon seen diagonally). The kernel
+// adds that maximum as a sample of its own where it lies strictly inside (horizon_lattice's
+// segment_peak). The cell's lower corner is (ox, oy) from the receiver; along the piece its
+// cell fractions run from (fx, fy) at the far end (tau_far) by (dx, dy) to the near end
+// (tau_near, the sample's own tau). Nine 4-byte members, uploaded as is; must match
+// CellSegment in kernels/horizon.cl.
+struct CellSegment {
+  float tau_far, tau_near;
+  std::int32_t ox, oy;
+  float fx, fy, dx, dy;
+  std::int32_t curved;
+};
+static_assert(sizeof(CellSegment) == 36, "CellSegment must match the kernel struct");
+
+// The segments that end at each of latticeSamples(d, samples_per_unit) (the same count and
+// order).
+std::vector<CellSegment> cellSegments(const LatticeDirection& d, double samples_per_unit);
+
+// Hull-stack entries one period of the horizon sweep can push: its samples and the peaks
+// inside its curved segments.
+std::size_t stackEntriesPerPeriod(const std::vector<CellSegment>& segments);
+
 // The hull tree's samples (the intervisibility sweep): `per_period` equally spaced samples
 // of one period, farthest first, the receiver last, so steps along a line are uniform
 // (period / per_period pixels) and the tree's geometry stays in exact integer steps.

@@ -215,7 +215,6 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
     const LatticeDirection& d = directions[k];
     if (d.weight == 0.0 && result.angles.empty() && result.distances.empty()) continue;  // merged step
     DirectionOutputs out = withEnvironment(outputsOf(d, k), outputs, env_tables);
-    const auto samples = latticeSamples(d, options.samples_per_unit);
     const double unit = rows ? 1.0 : d.ground_per_pixel;
     const RowTable* table = rows ? &tables[k] : nullptr;
     const float gpp = static_cast<float>(unit);
@@ -224,7 +223,7 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
     const LatticeWindow window = latticeWindow(field, d, options.max_distance);
     for (const LatticeLine& line : latticeLines(d, width, height)) {
       for (const LatticeLineSample& s :
-           latticeLineSamples(field, h, d, samples, line, drop, window, table)) {
+           latticeLineSamples(field, h, d, options.samples_per_unit, line, drop, window, table)) {
         if (s.receiver < 0) continue;
         const std::size_t pixel = static_cast<std::size_t>(s.receiver);
         if (std::isnan(s.height)) {
@@ -335,25 +334,30 @@ void naiveReference(const HeightField& field, const PreparedHeights& prepared, c
 }  // namespace
 
 std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, const std::vector<float>& h,
-                                                  const LatticeDirection& d,
-                                                  const std::vector<LatticeSample>& samples,
+                                                  const LatticeDirection& d, double samples_per_unit,
                                                   const LatticeLine& line, float drop, const LatticeWindow& window,
                                                   const RowTable* rows) {
   const int width = field.width, height = field.height;
+  const std::vector<LatticeSample> samples = latticeSamples(d, samples_per_unit);
+  const std::vector<CellSegment> segments = cellSegments(d, samples_per_unit);
   const float period = static_cast<float>(d.period);
   const float inv_period = 1.0f / period;
   float row_base = 0.0f;  // per-row spacing: the receiver's ground position
   const bool windowed = window.window > 0.0f;
   // Every sample of the line in sweep order (height NaN where it is absent: outside the field
   // or without height), with its block (horizon_lattice's window_pass) and its height as the
-  // stack holds it (the kernel's curvature transform, an exact no-op at drop 0).
+  // stack holds it (the kernel's curvature transform, an exact no-op at drop 0). Before each
+  // sample the peak inside the segment that ends at it (segment_peak), present where the
+  // kernel takes one.
   struct Raw {
     LatticeLineSample sample;
     int block = 0;
     float stacked = 0.0f;
+    bool is_receiver = false;
   };
   std::vector<Raw> raw;
   int c = line.col, r = line.row;
+  float here_before = 0.0f;
   for (int i = 0; i < line.receivers; ++i, c -= d.a, r -= d.b) {
     float base = static_cast<float>(i) * period, tau_scale = 1.0f;
     if (rows) {  // horizon_lattice with HFVIS_ROW_SPACING
@@ -364,15 +368,47 @@ std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, cons
     }
     for (std::size_t q = 0; q < samples.size(); ++q) {
       const LatticeSample& s = samples[q];
+      const float here = rows ? base - s.tau * tau_scale : base - s.tau;
+      const CellSegment& g = segments[q];
+      if (g.curved) {
+        Raw e;
+        e.sample.peak = true;
+        e.sample.height = kNaN;
+        const int x0 = c + g.ox, y0 = r + g.oy;
+        if (x0 >= 0 && x0 + 1 <= width - 1 && y0 >= 0 && y0 + 1 <= height - 1) {
+          const std::size_t at = static_cast<std::size_t>(y0) * width + x0;
+          const float h00 = h[at], h10 = h[at + 1], h01 = h[at + width], h11 = h[at + width + 1];
+          const float fx = g.fx, fy = g.fy, dx = g.dx, dy = g.dy;
+          const float gx = h10 - h00, gy = h01 - h00;
+          const float twist = (h11 - h01) - gx;
+          const float A = h00 + gx * fx + gy * fy + twist * (fx * fy);
+          const float B = gx * dx + gy * dy + twist * (fx * dy + fy * dx);
+          const float C = twist * (dx * dy);
+          const float u = B / (-2.0f * C);
+          const float tau = g.tau_far - u * (g.tau_far - g.tau_near);
+          const float position = rows ? base - tau * tau_scale : base - tau;
+          if (C < 0.0f && B > 0.0f && B < -2.0f * C && std::isfinite(A) && position > here_before && position < here) {
+            e.sample.height = A + 0.5f * B * u;
+            e.sample.position = position;
+          }
+        }
+        e.block = windowed && !std::isnan(e.sample.height)
+                      ? static_cast<int>(std::floor(e.sample.position * window.inv_window))
+                      : 0;
+        e.stacked = e.sample.height - drop * e.sample.position * e.sample.position;
+        raw.push_back(e);
+      }
+      here_before = here;
       Raw e;
-      e.sample.position = rows ? base - s.tau * tau_scale : base - s.tau;
+      e.sample.position = here;
       e.sample.height = kNaN;
       e.block = windowed ? static_cast<int>(std::floor(e.sample.position * window.inv_window)) : 0;
+      e.is_receiver = q + 1 == samples.size();
       const int x0 = c + s.ox, y0 = r + s.oy;
       if (x0 >= 0 && x0 + s.ex <= width - 1 && y0 >= 0 && y0 + s.ey <= height - 1) {
         const std::size_t at = static_cast<std::size_t>(y0) * width + x0;
         e.sample.height = latticeHeight(h, at, s.ex, static_cast<std::size_t>(s.ey) * width, s);
-        e.sample.receiver = q + 1 == samples.size() ? static_cast<long>(at) : -1;
+        e.sample.receiver = e.is_receiver ? static_cast<long>(at) : -1;
       }
       e.stacked = e.sample.height - drop * e.sample.position * e.sample.position;
       raw.push_back(e);
@@ -404,26 +440,44 @@ std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, cons
     stack.emplace_back(hs, here);
     return depth;
   };
-  // The forward sweep, restarted at every block.
+  // The forward sweep, restarted at every block (at samples: a peak goes with the sample before
+  // it, and is taken only where it lies in that sample's block).
   std::vector<Entry> stack;
   std::vector<Entry> far(raw.size(), Entry(0.0f, 0.0f));  // window_pass's (rise, run) per receiver
-  int block = raw.empty() ? 0 : raw.front().block;
+  int block = 0;
+  for (const Raw& e : raw) {
+    if (!e.sample.peak) {
+      block = e.block;
+      break;
+    }
+  }
   for (std::size_t t = 0; t < raw.size(); ++t) {
-    if (raw[t].block != block) {
+    if (!raw[t].sample.peak && raw[t].block != block) {
       // window_pass for the new block: its receivers nearest first, the block before's samples
-      // pushed backwards once within the window, the tangent by binary search.
+      // pushed backwards once within the window (a peak with the sample before it, under that
+      // sample's test), the tangent by binary search.
       const int k = raw[t].block;
       std::size_t end = t;
-      while (end < raw.size() && raw[end].block == k) ++end;
+      while (end < raw.size() && (raw[end].sample.peak || raw[end].block == k)) ++end;
       std::vector<Entry> back;
       std::size_t cursor = t;  // samples [0, cursor) not pushed yet
       float unused_rise = 0.0f, unused_run = 0.0f;
+      auto push = [&](const Raw& e) {
+        if (!std::isnan(e.sample.height)) hullStep(back, e.stacked, e.sample.position, -1.0f, &unused_rise, &unused_run);
+      };
       for (std::size_t j = end; j-- > t;) {
-        if (j % samples.size() != samples.size() - 1) continue;  // not a period's receiver
+        if (!raw[j].is_receiver) continue;
         const float x = raw[j].sample.position;
-        while (cursor > 0 && raw[cursor - 1].block == k - 1 && !(x - raw[cursor - 1].sample.position > window.window)) {
-          const Raw& e = raw[--cursor];
-          if (!std::isnan(e.sample.height)) hullStep(back, e.stacked, e.sample.position, -1.0f, &unused_rise, &unused_run);
+        for (;;) {
+          if (cursor == 0 || (cursor == 1 && raw[0].sample.peak)) break;  // (the line's first peak is never present)
+          const std::size_t next = raw[cursor - 1].sample.peak ? cursor - 2 : cursor - 1;  // the sample tested
+          if (raw[next].block != k - 1 || x - raw[next].sample.position > window.window) break;
+          if (raw[cursor - 1].sample.peak) {
+            const Raw& p = raw[cursor - 1];
+            if (p.block == k - 1) push(p);
+            --cursor;
+          }
+          push(raw[--cursor]);
         }
         const float hs = raw[j].stacked;
         std::size_t lo = 0, hi = back.empty() ? 0 : back.size() - 1;
@@ -443,6 +497,10 @@ std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, cons
     }
     Raw& e = raw[t];
     if (std::isnan(e.sample.height)) continue;
+    if (e.sample.peak && e.block != block) {  // beyond the block of the sample before
+      e.sample.height = kNaN;
+      continue;
+    }
     e.sample.occluder = hullStep(stack, e.stacked, e.sample.position, 1.0f, &e.sample.occluder_rise,
                                  &e.sample.occluder_run);
     // The steeper of the block's own occluder and the block before's (which wins ties).

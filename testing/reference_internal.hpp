@@ -22,10 +22,12 @@ struct LatticeLineSample {
   long receiver = -1;
   long occluder = -1;
   float occluder_rise = 0.0f, occluder_run = 0.0f;
+  bool peak = false;  // the surface's maximum inside the segment before the next sample
 };
 
 // The samples of one line of direction d (prepared heights h), with Algorithm 1 run over
-// them exactly as horizon_lattice runs it; with `drop` (curvature per pixel squared along the
+// them exactly as horizon_lattice runs it (latticeSamples and the peaks inside cellSegments at
+// samples_per_unit); with `drop` (curvature per pixel squared along the
 // line) the stack holds the heights lowered by drop * position^2, and occluder_rise is that
 // stack's (the receiver adds -2 drop position run). With a window (a maximum distance), as
 // horizon_lattice with HFVIS_MAX_DISTANCE: the receivers' occluders are the steepest samples
@@ -34,8 +36,7 @@ struct LatticeLineSample {
 // direction's latticeRowTables entry) positions are ground lengths, as HFVIS_ROW_SPACING makes
 // them.
 std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, const std::vector<float>& h,
-                                                  const LatticeDirection& d,
-                                                  const std::vector<LatticeSample>& samples,
+                                                  const LatticeDirection& d, double samples_per_unit,
                                                   const LatticeLine& line, float drop = 0.0f,
                                                   const LatticeWindow& window = {},
                                                   const RowTable* rows = nullptr);

@@ -45,9 +45,8 @@ TEST(HorizonSweepLine, StackEqualsBruteForceMaximumOnEveryHardCase) {
         for (const auto& d : detail::latticeDirections(field, options, true, options.azimuth_tolerance)) {
           SCOPED_TRACE(name + " " + std::to_string(w) + "x" + std::to_string(h) + " step (" +
                        std::to_string(d.a) + ", " + std::to_string(d.b) + ") spu " + std::to_string(spu));
-          const auto table = detail::latticeSamples(d, spu);
           for (const auto& line : detail::latticeLines(d, w, h)) {
-            const auto samples = detail::latticeLineSamples(field, prepared.heights, d, table, line);
+            const auto samples = detail::latticeLineSamples(field, prepared.heights, d, spu, line);
             for (std::size_t q = 0; q < samples.size(); ++q) {
               const auto& s = samples[q];
               if (std::isnan(s.height)) continue;
@@ -97,15 +96,17 @@ TEST(HorizonSweepLine, WindowedStackEqualsBruteForceWithinTheWindow) {
             SCOPED_TRACE(name + " " + std::to_string(w) + "x" + std::to_string(h) + " step (" +
                          std::to_string(d.a) + ", " + std::to_string(d.b) + ") spu " + std::to_string(spu) +
                          " window " + std::to_string(window));
-            const auto table = detail::latticeSamples(d, spu);
             for (const auto& line : detail::latticeLines(d, w, h)) {
-              const auto samples = detail::latticeLineSamples(field, prepared.heights, d, table, line, 0.0f, cut);
+              const auto samples = detail::latticeLineSamples(field, prepared.heights, d, spu, line, 0.0f, cut);
               for (std::size_t q = 0; q < samples.size(); ++q) {
                 const auto& s = samples[q];
                 if (std::isnan(s.height) || s.receiver < 0) continue;
                 double brute = -M_PI;  // steepest farther sample within the window
                 for (std::size_t k = 0; k < q; ++k) {
-                  if (std::isnan(samples[k].height) || s.position - samples[k].position > window) continue;
+                  // A peak inside a segment counts once the segment's far end (the sample before
+                  // it) is within the window.
+                  const float gate = samples[k].peak && k > 0 ? samples[k - 1].position : samples[k].position;
+                  if (std::isnan(samples[k].height) || s.position - gate > window) continue;
                   brute = std::max(brute, std::atan2(double(samples[k].height) - s.height,
                                                      double(s.position) - samples[k].position));
                 }
