@@ -11,8 +11,11 @@
 
 namespace hfvis {
 
-// Names: flat, tilted_plane (8848 + 0.001 x), terraces, cliff (1e6 high), spikes, sine,
-// bowl, dome, noise, nan_holes, infinities, denormals, negative. Deterministic for a seed.
+// Names: city (a city DSM: flat ground, flat roofs of many heights, one-pixel streets and
+// walls, buildings touching only at a corner, courtyards, towers, a street grid along the axes
+// and one rotated off them), flat, tilted_plane (8848 + 0.001 x), terraces, cliff (1e6 high),
+// spikes, sine, bowl, dome, noise, nan_holes, infinities, denormals, negative. Deterministic
+// for a seed.
 HeightField makeSyntheticField(const std::string& name, int width, int height, std::uint32_t seed = 1);
 
 // Every name makeSyntheticField accepts.
