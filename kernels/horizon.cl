@@ -273,12 +273,14 @@ HFVIS_INLINE lane_float near_rise(__global const float* heights, int width, int 
 
 // The height of lattice sample s for the lanes' period receivers at (c, r): `ok` are the lanes
 // that take it (live, and inside the field where `edge`: only the first period of a line can
-// reach outside it); *valid: those with a height. Lanes without the sample read the buffer's
+// reach outside it); *valid: those with a height. A crossing (or the receiver) also gives the
+// heights of the corners it lies between, at (ox, oy) and (ox + ex, oy + ey), in *corner0 and
+// *corner1 (the segment peaks reuse them); a sample inside a cell leaves them as they are. Lanes without the sample read the buffer's
 // first height alone (their cell may lie outside the field). `heights` holds the field's rows
 // from row0 on.
 HFVIS_INLINE lane_float lane_sample_height(__global const float* heights, int width, int height, int row0,
                                            __global const LatticeSample* s, lane_int c, lane_int r, lane_int ok,
-                                           int edge, lane_int* valid) {
+                                           int edge, lane_int* valid, lane_float* corner0, lane_float* corner1) {
   const int ex = s->ex, ey = s->ey;
   const float w00 = s->w00, w10 = s->w10, w01 = s->w01, w11 = s->w11;
   const lane_int x0 = c + s->ox, y0 = r + s->oy;
@@ -300,6 +302,8 @@ HFVIS_INLINE lane_float lane_sample_height(__global const float* heights, int wi
     // The receiver (ex = ey = 0, weight 1) is its pixel's height as it is (1 h + 0 h would
     // turn an infinite height into NaN).
     h = ex + ey == 0 ? h0 : w00 * h0 + (ex ? w10 : w01) * h1;
+    *corner0 = h0;
+    *corner1 = h1;
 #if HFVIS_HAS_NODATA
 #pragma unroll
     for (int l = 0; l < HFVIS_LANES; ++l) {
@@ -323,12 +327,15 @@ HFVIS_INLINE lane_float lane_sample_height(__global const float* heights, int wi
 }
 
 // The piece of a line between two consecutive samples (src/lattice_geometry.hpp, struct
-// CellSegment): nine 4-byte members, read field by field.
+// CellSegment): thirteen 4-byte members, read field by field.
 typedef struct {
   float tau_far, tau_near;  // its ends, pixels from the period's receiver toward +(a, b)
   int ox, oy;               // its cell's lower corner, relative to the receiver
   float fx, fy, dx, dy;     // cell fractions at the far end, and their change to the near end
   int curved;               // off the grid lines: the surface along it is a quadratic
+  // Where the cell's corners (00, 10, 01, 11) were read already: 0 and 1 the far end's two
+  // corners, 2 and 3 the near end's (lane_sample_height's corner0 and corner1), 4 nowhere.
+  int from00, from10, from01, from11;
 } CellSegment;
 
 // The maximum of the bilinear surface inside segment g of the lanes' period receivers at
@@ -341,22 +348,30 @@ typedef struct {
 // C = e dx dy: it peaks inside where C < 0 and 0 < -B / 2C < 1, at height A + B u / 2. A
 // convex or flat piece (C >= 0) has its maximum at an end, which is a sample already. Lanes
 // without the segment read the buffer's first height alone.
+//
+// `known` holds the corners the segment's ends read (far end's corner0, corner1, near end's
+// corner0, corner1); where `reuse`, the corners g names there are taken from it, the others
+// read (where the far end was not read in this launch, all four are read).
+HFVIS_INLINE lane_float segment_corner(__global const float* heights, int from, int reuse, const lane_float* known,
+                                       lane_int at) {
+  if (reuse && from < 4) return known[from];
+  lane_float h;
+#pragma unroll
+  for (int l = 0; l < HFVIS_LANES; ++l) LANE(h, l) = heights[ILANE(at, l)];
+  return h;
+}
+
 HFVIS_INLINE lane_float segment_peak(__global const float* heights, int width, int height, int row0,
                                      __global const CellSegment* g, lane_int c, lane_int r, lane_int ok, int edge,
-                                     lane_float* tau, lane_int* valid) {
+                                     int reuse, const lane_float* known, lane_float* tau, lane_int* valid) {
   const lane_int x0 = c + g->ox, y0 = r + g->oy;
   if (edge) ok = ok & (x0 >= 0) & (x0 + 1 <= width - 1) & (y0 >= 0) & (y0 + 1 <= height - 1);
   const lane_int at = select((lane_int)0, (y0 - row0) * width + x0, ok);
   const lane_int right = select((lane_int)0, (lane_int)1, ok), down = select((lane_int)0, (lane_int)width, ok);
-  lane_float h00, h10, h01, h11;
-#pragma unroll
-  for (int l = 0; l < HFVIS_LANES; ++l) {
-    const int k = ILANE(at, l);
-    LANE(h00, l) = heights[k];
-    LANE(h10, l) = heights[k + ILANE(right, l)];
-    LANE(h01, l) = heights[k + ILANE(down, l)];
-    LANE(h11, l) = heights[k + ILANE(down, l) + ILANE(right, l)];
-  }
+  const lane_float h00 = segment_corner(heights, g->from00, reuse, known, at);
+  const lane_float h10 = segment_corner(heights, g->from10, reuse, known, at + right);
+  const lane_float h01 = segment_corner(heights, g->from01, reuse, known, at + down);
+  const lane_float h11 = segment_corner(heights, g->from11, reuse, known, at + down + right);
   const float fx = g->fx, fy = g->fy, dx = g->dx, dy = g->dy, tau_far = g->tau_far, tau_near = g->tau_near;
   const lane_float gx = h10 - h00, gy = h01 - h00;
   const lane_float e = (h11 - h01) - gx;
@@ -540,7 +555,7 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
         lane_int valid;
         lane_float tau_peak;
         const lane_float h_peak = segment_peak(heights, width, height, row0, g, c - (gi - i) * a, r - (gi - i) * b,
-                                               gi < receivers, offset + gi == 0, &tau_peak, &valid);
+                                               gi < receivers, offset + gi == 0, 0, 0, &tau_peak, &valid);
         const lane_float here_peak = segment_base - tau_peak * segment_scale;
         valid = valid & (here_peak > here) & (here_peak < here_near) &
                 (LANE_INT(floor(here_peak * inv_window)) == k - 1);
@@ -549,8 +564,9 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
                     &top_h, &top_p, &below_h, &below_p, &rise, &run);
       }
       lane_int valid;
+      lane_float unused0, unused1;
       const lane_float h = lane_sample_height(heights, width, height, row0, s, c - (ci - i) * a, r - (ci - i) * b,
-                                              ci < receivers, offset + ci == 0, &valid);
+                                              ci < receivers, offset + ci == 0, &valid, &unused0, &unused1);
       hull_step(stacks, stack, entry, valid, HFVIS_STACK_HEIGHT(h, here), (lane_float)here, -1.0f, &n, &top_h,
                 &top_p, &below_h, &below_p, &rise, &run);
       if (--cq < 0) cq = n_samples - 1, --ci;
@@ -743,6 +759,7 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 #else
   lane_float here_before = -period;
 #endif
+  lane_float known[4] = {0.0f, 0.0f, 0.0f, 0.0f};  // corners the last two samples read (segment_peak)
   for (int i = 0; i < trips; ++i, c -= a, r -= b) {
     const lane_int live = i < receivers;
     const lane_int along = start + i;  // the receivers' index along their whole lines
@@ -788,29 +805,6 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 #else
       const float here = base - s->tau;
 #endif
-      const __global CellSegment* g = segments + q;
-      if (g->curved) {
-        // The surface's peak inside the segment from the sample before (at here_before) to this
-        // one, a sample of its own, in the block of the sample before (window_pass).
-        lane_int peak;
-        lane_float tau_peak;
-        const lane_float h_peak = segment_peak(heights, width, height, row0, g, c, r, live, i == 0, &tau_peak, &peak);
-#if HFVIS_ROW_SPACING
-        const lane_float here_peak = base - tau_peak * tau_scale;
-#else
-        const lane_float here_peak = base - tau_peak;
-#endif
-        peak = peak & (here_peak > here_before) & (here_peak < here);
-#if HFVIS_MAX_DISTANCE
-        peak = peak & (LANE_INT(floor(here_peak * inv_window)) == block);
-#endif
-        if (ANY_LANE(peak)) {
-          lane_float unused_rise = 0.0f, unused_run = 0.0f;
-          hull_step(stacks, stack, entry, peak, HFVIS_STACK_HEIGHT(h_peak, here_peak), here_peak, 1.0f, &n, &top_h,
-                    &top_p, &below_h, &below_p, &unused_rise, &unused_run);
-        }
-      }
-      here_before = here;
 #if HFVIS_MAX_DISTANCE
       const int sample_block = (int)floor(here * inv_window);
       if (sample_block != block) {
@@ -826,7 +820,7 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
       lane_int valid;
       // Only a line's first period can reach outside the field (a later one lies between two
       // receivers); testing every lane's first period here costs the same and changes nothing.
-      h = lane_sample_height(heights, width, height, row0, s, c, r, live, i == 0, &valid);
+      h = lane_sample_height(heights, width, height, row0, s, c, r, live, i == 0, &valid, &known[2], &known[3]);
 #if HFVIS_CURVATURE
       // The Earth's drop below the receiver p, drop (p - here)^2, is a parabola along the line:
       // subtracting drop * here^2 from every sample instead changes every slope from p by the
@@ -835,8 +829,61 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 #else
       const lane_float hs = h;
 #endif
+      // The surface's peak inside the segment from the sample before (at here_before) to this
+      // one, where it lies strictly inside (segment_peak), from the corners the two samples read
+      // (known) and those they did not. With a maximum distance, in this sample's block only
+      // (one in the block before, when this sample starts a block, is window_pass's).
+      const __global CellSegment* g = segments + q;
+      lane_int peak = 0;
+      lane_float h_peak = 0.0f, here_peak = 0.0f;
+      if (g->curved) {
+        lane_float tau_peak;
+        h_peak = segment_peak(heights, width, height, row0, g, c, r, live, i == 0, i > 0 || q > 0, known, &tau_peak,
+                              &peak);
+#if HFVIS_ROW_SPACING
+        here_peak = base - tau_peak * tau_scale;
+#else
+        here_peak = base - tau_peak;
+#endif
+        peak = peak & (here_peak > here_before) & (here_peak < here);
+#if HFVIS_MAX_DISTANCE
+        peak = peak & (LANE_INT(floor(here_peak * inv_window)) == block);
+#endif
+      }
+      here_before = here;
+      known[0] = known[2];
+      known[1] = known[3];
       hull_step(stacks, stack, entry, valid, hs, (lane_float)here, 1.0f, &n, &top_h, &top_p, &below_h, &below_p,
                 &rise, &run);
+      {
+        // The peak lies between the sample before (the stack's top before this push) and this
+        // sample, so it belongs to the hull of all samples so far exactly where it is steeper
+        // seen from this sample than this sample's occluder (rise, run); elsewhere this sample's
+        // push would pop it at once, and the stack is already what pushing both would leave.
+        // Pushing after the fact costs a comparison where the peak is not on the hull, which is
+        // most of the time: where it is, this sample's push is undone, the peak pushed, and
+        // this sample pushed again (its occluder is then the peak).
+        const lane_float hs_peak = HFVIS_STACK_HEIGHT(h_peak, here_peak);
+        const lane_int on_hull = peak & valid & ((run <= 0.0f) | ((hs_peak - hs) * run > rise * (here - here_peak)));
+        if (ANY_LANE(on_hull)) {
+          n = select(n, n - 1, on_hull);
+          top_h = select(top_h, below_h, on_hull);
+          top_p = select(top_p, below_p, on_hull);
+#pragma unroll
+          for (int l = 0; l < HFVIS_LANES; ++l) {
+            if (ILANE(on_hull, l)) {
+              const float2 e = stacks[max(ILANE(stack, l) + (ILANE(n, l) - 2) * entry, ILANE(stack, l))];
+              LANE(below_h, l) = e.x;
+              LANE(below_p, l) = e.y;
+            }
+          }
+          lane_float unused_rise = 0.0f, unused_run = 0.0f;
+          hull_step(stacks, stack, entry, on_hull, hs_peak, here_peak, 1.0f, &n, &top_h, &top_p, &below_h, &below_p,
+                    &unused_rise, &unused_run);
+          hull_step(stacks, stack, entry, on_hull, hs, (lane_float)here, 1.0f, &n, &top_h, &top_p, &below_h,
+                    &below_p, &rise, &run);
+        }
+      }
     }
 #if HFVIS_MAX_DISTANCE
     if (far_part) {

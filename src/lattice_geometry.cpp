@@ -208,11 +208,23 @@ std::vector<LatticeSample> latticeSamples(const LatticeDirection& d, double samp
 std::vector<CellSegment> cellSegments(const LatticeDirection& d, double samples_per_unit) {
   const std::vector<double> fractions = sampleFractions(d, samples_per_unit);
   std::vector<CellSegment> segments;
-  double far = 1.0;  // the next receiver along +(a, b)
+  // The corners a sample reads itself (lane_sample_height): a crossing or a receiver the two at
+  // (ox, oy) and (ox + ex, oy + ey); a sample inside a cell none that it passes on.
+  using Corner = std::pair<int, int>;
+  auto cornersOf = [&](const LatticeSample& s, int shift_x, int shift_y) {
+    if (s.ex + s.ey == 2) return std::vector<Corner>{{INT32_MIN, INT32_MIN}, {INT32_MIN, INT32_MIN}};
+    return std::vector<Corner>{{s.ox + shift_x, s.oy + shift_y}, {s.ox + s.ex + shift_x, s.oy + s.ey + shift_y}};
+  };
+  // Segment 0's far end is the next receiver along +(a, b): the last sample of the period
+  // before, whose receiver sits (a, b) from this one.
+  std::vector<Corner> far_corners = cornersOf(sampleAt(d, 0.0), d.a, d.b);
+  double far = 1.0;
   for (double near : fractions) {
+    const LatticeSample near_sample = sampleAt(d, near);
+    const std::vector<Corner> near_corners = cornersOf(near_sample, 0, 0);
     CellSegment g{};
     g.tau_far = static_cast<float>(far * d.period);
-    g.tau_near = sampleAt(d, near).tau;
+    g.tau_near = near_sample.tau;
     // The cell holds the piece's middle (its ends may lie on the cell's edges).
     const double mx = d.a * 0.5 * (far + near), my = d.b * 0.5 * (far + near);
     const double ox = std::floor(mx), oy = std::floor(my);
@@ -223,8 +235,21 @@ std::vector<CellSegment> cellSegments(const LatticeDirection& d, double samples_
     g.dx = static_cast<float>(d.a * (near - far));
     g.dy = static_cast<float>(d.b * (near - far));
     g.curved = d.a != 0 && d.b != 0;  // along a grid line the surface is linear
+    auto from = [&](int cx, int cy) {
+      const Corner corner{g.ox + cx, g.oy + cy};
+      for (int k = 0; k < 2; ++k)
+        if (far_corners[k] == corner) return k;
+      for (int k = 0; k < 2; ++k)
+        if (near_corners[k] == corner) return 2 + k;
+      return 4;
+    };
+    g.from00 = from(0, 0);
+    g.from10 = from(1, 0);
+    g.from01 = from(0, 1);
+    g.from11 = from(1, 1);
     segments.push_back(g);
     far = near;
+    far_corners = near_corners;
   }
   return segments;
 }

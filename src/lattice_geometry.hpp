@@ -79,15 +79,19 @@ std::vector<LatticeSample> latticeSamples(const LatticeDirection& d, double samp
 // adds that maximum as a sample of its own where it lies strictly inside (horizon_lattice's
 // segment_peak). The cell's lower corner is (ox, oy) from the receiver; along the piece its
 // cell fractions run from (fx, fy) at the far end (tau_far) by (dx, dy) to the near end
-// (tau_near, the sample's own tau). Nine 4-byte members, uploaded as is; must match
-// CellSegment in kernels/horizon.cl.
+// (tau_near, the sample's own tau). A crossing (or a receiver) reads the two corners it lies
+// between, so the kernel takes what it can of the cell's four corners from its ends: from00 ..
+// from11 say where corner (0, 0) .. (1, 1) of the cell is, 0 and 1 the far end's first and
+// second corner, 2 and 3 the near end's, 4 at neither (read it). Thirteen 4-byte members,
+// uploaded as is; must match CellSegment in kernels/horizon.cl.
 struct CellSegment {
   float tau_far, tau_near;
   std::int32_t ox, oy;
   float fx, fy, dx, dy;
   std::int32_t curved;
+  std::int32_t from00, from10, from01, from11;
 };
-static_assert(sizeof(CellSegment) == 36, "CellSegment must match the kernel struct");
+static_assert(sizeof(CellSegment) == 52, "CellSegment must match the kernel struct");
 
 // The segments that end at each of latticeSamples(d, samples_per_unit) (the same count and
 // order).

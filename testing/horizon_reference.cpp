@@ -452,7 +452,8 @@ std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, cons
     }
   }
   for (std::size_t t = 0; t < raw.size(); ++t) {
-    if (!raw[t].sample.peak && raw[t].block != block) {
+    if (raw[t].sample.peak) continue;  // taken with the sample after it, below
+    if (raw[t].block != block) {
       // window_pass for the new block: its receivers nearest first, the block before's samples
       // pushed backwards once within the window (a peak with the sample before it, under that
       // sample's test), the tangent by binary search.
@@ -497,12 +498,24 @@ std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, cons
     }
     Raw& e = raw[t];
     if (std::isnan(e.sample.height)) continue;
-    if (e.sample.peak && e.block != block) {  // beyond the block of the sample before
-      e.sample.height = kNaN;
-      continue;
-    }
     e.sample.occluder = hullStep(stack, e.stacked, e.sample.position, 1.0f, &e.sample.occluder_rise,
                                  &e.sample.occluder_run);
+    // The peak before the sample (horizon_lattice): on the hull where it is steeper from the
+    // sample than the sample's occluder; then the sample's push is undone, the peak pushed and
+    // the sample pushed again. Only a peak in the sample's block (one before a sample that
+    // starts a block may lie in the block before: window_pass takes it).
+    if (t > 0 && raw[t - 1].sample.peak && !std::isnan(raw[t - 1].sample.height) && raw[t - 1].block == block) {
+      Raw& p = raw[t - 1];
+      const bool on_hull = e.sample.occluder < 0 || (p.stacked - e.stacked) * e.sample.occluder_run >
+                                                        e.sample.occluder_rise * (e.sample.position - p.sample.position);
+      if (on_hull) {
+        stack.pop_back();
+        p.sample.occluder = hullStep(stack, p.stacked, p.sample.position, 1.0f, &p.sample.occluder_rise,
+                                     &p.sample.occluder_run);
+        e.sample.occluder = hullStep(stack, e.stacked, e.sample.position, 1.0f, &e.sample.occluder_rise,
+                                     &e.sample.occluder_run);
+      }
+    }
     // The steeper of the block's own occluder and the block before's (which wins ties).
     const auto [rise2, run2] = far[t];
     if (run2 > 0.0f && (e.sample.occluder_run <= 0.0f || rise2 * e.sample.occluder_run >= e.sample.occluder_rise * run2)) {
