@@ -366,12 +366,21 @@ HFVIS_INLINE lane_float segment_peak(__global const float* heights, int width, i
                                      int reuse, const lane_float* known, lane_float* tau, lane_int* valid) {
   const lane_int x0 = c + g->ox, y0 = r + g->oy;
   if (edge) ok = ok & (x0 >= 0) & (x0 + 1 <= width - 1) & (y0 >= 0) & (y0 + 1 <= height - 1);
-  const lane_int at = select((lane_int)0, (y0 - row0) * width + x0, ok);
-  const lane_int right = select((lane_int)0, (lane_int)1, ok), down = select((lane_int)0, (lane_int)width, ok);
-  const lane_float h00 = segment_corner(heights, g->from00, reuse, known, at);
-  const lane_float h10 = segment_corner(heights, g->from10, reuse, known, at + right);
-  const lane_float h01 = segment_corner(heights, g->from01, reuse, known, at + down);
-  const lane_float h11 = segment_corner(heights, g->from11, reuse, known, at + down + right);
+  const int from00 = g->from00, from10 = g->from10, from01 = g->from01, from11 = g->from11;
+  lane_float h00, h10, h01, h11;
+  if (reuse && (from00 | from10 | from01 | from11) < 4) {  // every corner read already (no code has bit 2 but 4)
+    h00 = known[from00];
+    h10 = known[from10];
+    h01 = known[from01];
+    h11 = known[from11];
+  } else {
+    const lane_int at = select((lane_int)0, (y0 - row0) * width + x0, ok);
+    const lane_int right = select((lane_int)0, (lane_int)1, ok), down = select((lane_int)0, (lane_int)width, ok);
+    h00 = segment_corner(heights, from00, reuse, known, at);
+    h10 = segment_corner(heights, from10, reuse, known, at + right);
+    h01 = segment_corner(heights, from01, reuse, known, at + down);
+    h11 = segment_corner(heights, from11, reuse, known, at + down + right);
+  }
   const float fx = g->fx, fy = g->fy, dx = g->dx, dy = g->dy, tau_far = g->tau_far, tau_near = g->tau_near;
   const lane_float gx = h10 - h00, gy = h01 - h00;
   const lane_float e = (h11 - h01) - gx;
