@@ -17,11 +17,25 @@ double snap(double v) { return std::abs(v) < 1e-12 ? 0.0 : v; }
 
 struct Ray {
   double dx, dy;  // one pixel length along the ray, in pixel axes
+  double weight;
 };
 
 }  // namespace
 
 std::vector<double> denseVisibleCounts(const HeightField& field, const SweepOptions& options, int per_unit) {
+  std::vector<DenseRay> rays;
+  for (int k = 0; k < options.directions; ++k) rays.push_back({directionAzimuth(k, options), 1.0});
+  return denseVisibleCounts(field, rays, per_unit);
+}
+
+std::vector<DenseRay> azimuthDenseRays(int n) {
+  std::vector<DenseRay> rays;
+  for (int k = 0; k < n; ++k) rays.push_back({2.0 * M_PI * k / n, 1.0 / n});
+  return rays;
+}
+
+std::vector<double> denseVisibleCounts(const HeightField& field, const std::vector<DenseRay>& directions,
+                                       int per_unit) {
   const int w = field.width, h = field.height;
   double lowest = std::numeric_limits<double>::max(), highest = std::numeric_limits<double>::lowest();
   for (float v : field.heights) lowest = std::min(lowest, double(v)), highest = std::max(highest, double(v));
@@ -32,11 +46,10 @@ std::vector<double> denseVisibleCounts(const HeightField& field, const SweepOpti
   const double tolerance = kDenseTieTolerance * (highest - lowest) * field.z_scale;
 
   std::vector<Ray> rays;
-  for (int k = 0; k < options.directions; ++k) {
-    const double az = directionAzimuth(k, options);
-    double px = snap(std::cos(az)) / field.cell_size_x, py = snap(std::sin(az)) / field.cell_size_y;
+  for (const DenseRay& d : directions) {
+    double px = snap(std::cos(d.azimuth)) / field.cell_size_x, py = snap(std::sin(d.azimuth)) / field.cell_size_y;
     const double norm = std::hypot(px, py);
-    rays.push_back({px / norm, py / norm});
+    rays.push_back({px / norm, py / norm, d.weight});
   }
   const double step = 1.0 / per_unit;
   // Bilinear height at (x, y) inside the domain, as a + (b - a) f (exact where the corners
@@ -61,8 +74,9 @@ std::vector<double> denseVisibleCounts(const HeightField& field, const SweepOpti
     for (int r = next_row++; r < h; r = next_row++) {
       for (int c = 0; c < w; ++c) {
         const double h0 = z[static_cast<std::size_t>(r) * w + c];
-        long visible = 0;
+        double total = 0.0;
         for (const Ray& ray : rays) {
+          long visible = 0;
           // The ray leaves [0, W-1] x [0, H-1] at t_max; samples at j / D <= t_max (within
           // 1e-9 pixel) are inside.
           const double inf = std::numeric_limits<double>::infinity();
@@ -76,8 +90,9 @@ std::vector<double> denseVisibleCounts(const HeightField& field, const SweepOpti
             if (rise >= best * t - tolerance) ++visible;
             best = std::max(best, rise / t);
           }
+          total += ray.weight * double(visible);
         }
-        counts[static_cast<std::size_t>(r) * w + c] = double(visible) / per_unit;
+        counts[static_cast<std::size_t>(r) * w + c] = total / per_unit;
       }
     }
   };

@@ -34,12 +34,28 @@ namespace hfvis::bench {
 
 constexpr double kDenseTieTolerance = 1e-9;
 
-// Reference visible counts, width * height, in samples at one per pixel length (visible length
-// in pixel lengths, summed over options.directions directions at options.azimuth_offset), from
-// a march of `per_unit` samples per pixel length (D). Multithreaded over rows (std::thread,
+// One direction of the reference: its ground azimuth (radians, the library's convention) and
+// the weight its visible length is summed with.
+struct DenseRay {
+  double azimuth = 0.0;
+  double weight = 1.0;
+};
+
+// Reference visible counts, width * height, in samples at one per pixel length: per pixel the
+// sum over `rays` of weight x (visible length along the ray in pixel lengths), from a march of
+// `per_unit` samples per pixel length (D). Multithreaded over rows (std::thread,
 // hardware_concurrency threads). With per_unit = 1 it is a host unit march: the library's
 // naive march's samples, decided in double with the tolerance above.
+std::vector<double> denseVisibleCounts(const HeightField& field, const std::vector<DenseRay>& rays, int per_unit);
+
+// The same over the K directions of `options` (phi_k = 2 pi k / K + azimuth_offset), weight 1
+// each: what the naive march's count estimates.
 std::vector<double> denseVisibleCounts(const HeightField& field, const SweepOptions& options, int per_unit);
+
+// `n` directions evenly spaced from azimuth 0, each of weight 1 / n: dense in azimuth, their sum
+// estimates the visible length's mean over the azimuth, 1 / (2 pi) times its integral. A
+// K-direction count estimates K times that, whatever its directions.
+std::vector<DenseRay> azimuthDenseRays(int n);
 
 // A city-like surface model, width x height, cell size 1, z_scale 1, heights in pixel
 // lengths: a street grid (streets 4-6 pixels wide, city blocks 30-60 pixels) on a gently

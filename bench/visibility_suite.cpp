@@ -26,6 +26,8 @@
 #include "dense_visibility.hpp"
 #include "environment.hpp"
 #include "hfvis/intervisibility.hpp"
+#include "hfvis/synthetic_fields.hpp"
+#include "lattice_geometry.hpp"
 #include "metrics.hpp"
 #include "suite_support.hpp"
 
@@ -46,13 +48,15 @@ struct VisibilityConfig {
   int rounds = 3;             // vis_time: timed runs of each tree tuning ...
   int naive_rounds = 2;       // ... and of the naive march (interleaved)
   TimingPolicy policy;        // vis_zone
-  // vis_accuracy: n x n crops (the DEM's centre; the city generated at that size), K
-  // directions, the dense reference at dense_per_unit samples per pixel length, the tree and
-  // the naive march timed accuracy_rounds times each, interleaved.
-  std::vector<std::string> accuracy_contents = {"fractal", "bricks", "sine", "blocks", "dem", "city"};
+  // vis_accuracy: n x n crops (the DEM's centre; the cities generated at that size), each K of
+  // accuracy_ks, the dense references at dense_per_unit samples per pixel length (the one dense
+  // in azimuth with azimuth_dense_dirs directions), the tree and the naive march timed
+  // accuracy_rounds times each, interleaved.
+  std::vector<std::string> accuracy_contents = {"fractal", "bricks", "sine", "blocks", "dem", "city", "city_dsm"};
   int accuracy_n = 256;
-  int accuracy_k = 16;
-  int dense_per_unit = 16;
+  std::vector<int> accuracy_ks = {16, 64, 256};
+  int dense_per_unit = 8;
+  int azimuth_dense_dirs = 256;
   int accuracy_rounds = 2;
 };
 
@@ -65,7 +69,7 @@ VisibilityConfig visibilityConfigFor(const std::string& mode) {
     c.n = 256;
     c.time_k = 8;
     c.accuracy_n = 128;
-    c.accuracy_k = 8;
+    c.accuracy_ks = {16, 64};
     c.stats_k = 16;
     c.zone_steps = {1, 16, 256};
     c.rounds = c.naive_rounds = 2;
@@ -81,10 +85,10 @@ VisibilityConfig visibilityConfigFor(const std::string& mode) {
     c.scale_ns = {16, 32, 64};
     c.scale_lines = 4;
     c.rounds = c.naive_rounds = 1;
-    c.accuracy_contents = {"sine", "fractal", "dem", "city"};
+    c.accuracy_contents = {"sine", "fractal", "dem", "city", "city_dsm"};
     c.accuracy_n = 40;
-    c.accuracy_k = 8;  // diagonals too (K = 4 runs along the axes, where the tree is exact)
-    c.dense_per_unit = 8;
+    c.accuracy_ks = {8, 64};  // diagonals too (K = 4 runs along the axes, where the tree is exact)
+    c.azimuth_dense_dirs = 128;
     c.policy = {1, 1, 0.0};
   }
   return c;
@@ -97,7 +101,8 @@ const std::vector<std::string> kVisibilityColumns = {
     "receivers", "lines", "m_a", "t_a", "visible_a", "naive_a", "skip_fraction", "lines_over_bound", "n",
     "t_per_line", "m_per_line", "dense_per_unit", "ref_mean", "count_mean", "rel_err_mean", "rel_err_agg",
     "rel_err_p99", "rel_err_max", "rel_bias_mean", "err_pixels", "ref_seconds", "differ_pixels",
-    "offset_differ_pixels", "note"};
+    "offset_differ_pixels", "azd_dirs", "azd_ref_mean", "azd_rel_err_mean", "azd_rel_err_agg", "azd_rel_err_p99",
+    "azd_rel_bias_mean", "note"};
 // clang-format on
 
 struct NamedTuning {
@@ -349,23 +354,36 @@ class VisibilitySuite {
     }
   }
 
-  // Issue 8, target (e): visible counts against the dense reference (see the file's head and
-  // bench/dense_visibility.hpp). Per content: the reference at D samples per pixel length, the
-  // host unit march (the reference's code at D = 1: the naive march's samples in double), then
-  // the hull tree (default options, HullTree) and the naive march (IntervisibilityMethod::Naive),
-  // both at samples_per_unit 1 and the same K, timed accuracy_rounds times each, interleaved
-  // (tree, naive, tree, naive); the counts of their last runs are compared with the reference.
+  // Issue 8, target (e), and issue 25's count target: visible counts against the dense
+  // references (see the file's head and bench/dense_visibility.hpp). Per content: the reference
+  // dense in azimuth (azimuth_dense_dirs directions, D samples per pixel length), then per K the
+  // references along each method's own directions (the naive march's phi_k, the tree's lattice
+  // steps with their quadrature weights), the host unit march (the reference's code at D = 1:
+  // the naive march's samples in double), the hull tree (default options, HullTree) and the
+  // naive march (IntervisibilityMethod::Naive), both at samples_per_unit 1, timed
+  // accuracy_rounds times each, interleaved (tree, naive, tree, naive); the counts of their
+  // last runs are compared with the references.
   void accuracy() {
-    for (const auto& name : config_.accuracy_contents) accuracyOf(accuracyContent(name));
+    for (const auto& name : config_.accuracy_contents) {
+      const Content content = accuracyContent(name);
+      const auto start = std::chrono::steady_clock::now();
+      const std::vector<double> dense =
+          denseVisibleCounts(content.field, azimuthDenseRays(config_.azimuth_dense_dirs), config_.dense_per_unit);
+      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      say("[vis_accuracy] %s: reference dense in azimuth (%d directions, D = %d) in %.1f s", content.label.c_str(),
+          config_.azimuth_dense_dirs, config_.dense_per_unit, seconds);
+      for (int k : config_.accuracy_ks) accuracyOf(content, k, dense, seconds);
+    }
   }
 
   Content accuracyContent(const std::string& name) const {
     const int n = config_.accuracy_n;
-    if (name != "city") return loadContent(options_, name, n);
+    if (name != "city" && name != "city_dsm") return loadContent(options_, name, n);
     Content c;
     c.name = name;
     // Tiny mode: odd, non-square, as the other tiny stand-ins.
-    c.field = options_.mode == "tiny" ? makeCityField(n + 3, n - 2, 2013) : makeCityField(n, n, 2013);
+    const int w = options_.mode == "tiny" ? n + 3 : n, h = options_.mode == "tiny" ? n - 2 : n;
+    c.field = name == "city" ? makeCityField(w, h, 2013) : makeSyntheticField("city", w, h, 2013);
     c.label = name + "_" + std::to_string(c.field.width) + "x" + std::to_string(c.field.height);
     return c;
   }
@@ -412,7 +430,9 @@ class VisibilitySuite {
     return e;
   }
 
-  void addErrors(Row& row, const CountErrors& e, double ref_seconds) const {
+  // The same-direction errors (rel_err_*, against `ref` along the method's own directions) and,
+  // where given, those against the reference dense in azimuth (azd_*).
+  void addErrors(Row& row, const CountErrors& e, double ref_seconds, const CountErrors* dense = nullptr) const {
     row["dense_per_unit"] = std::to_string(config_.dense_per_unit);
     row["ref_mean"] = num(e.ref_mean);
     row["count_mean"] = num(e.count_mean);
@@ -423,16 +443,38 @@ class VisibilitySuite {
     row["rel_bias_mean"] = num(e.bias);
     row["err_pixels"] = std::to_string(e.pixels);
     row["ref_seconds"] = num(ref_seconds);
-    if (e.ref_zero) row["note"] = std::to_string(e.ref_zero) + " pixels with reference 0 left out";
+    std::string note;
+    if (e.ref_zero) note = std::to_string(e.ref_zero) + " pixels with reference 0 left out";
+    if (dense) {
+      row["azd_dirs"] = std::to_string(config_.azimuth_dense_dirs);
+      row["azd_ref_mean"] = num(dense->ref_mean);
+      row["azd_rel_err_mean"] = num(dense->mean);
+      row["azd_rel_err_agg"] = num(dense->aggregate);
+      row["azd_rel_err_p99"] = num(dense->p99);
+      row["azd_rel_bias_mean"] = num(dense->bias);
+      if (dense->ref_zero)
+        note += (note.empty() ? "" : "; ") + std::to_string(dense->ref_zero) +
+                " pixels with reference 0 (dense in azimuth) left out";
+    }
+    if (!note.empty()) row["note"] = note;
   }
 
-  void accuracyOf(const Content& content) {
+  // One content at K directions; `dense` is its reference dense in azimuth, the mean over the
+  // azimuth (scaled by K here), computed in `dense_seconds`.
+  void accuracyOf(const Content& content, int k, const std::vector<double>& dense, double dense_seconds) {
     const HeightField& field = content.field;
-    const int k = config_.accuracy_k;
     SweepOptions sweep;
     sweep.directions = k;
+    std::vector<double> azimuth_dense = dense;
+    for (double& v : azimuth_dense) v *= k;
+    // The naive march's directions, phi_k with weight 1 each; the tree's lattice steps with
+    // their quadrature weights (times K: the count's scale), as computeIntervisibility takes them.
+    std::vector<DenseRay> tree_rays;
+    for (const detail::LatticeDirection& d : detail::latticeDirections(field, sweep, false, 0.0))
+      if (d.weight > 0) tree_rays.push_back({d.azimuth, k * d.weight});
     const auto start = std::chrono::steady_clock::now();
     const std::vector<double> ref = denseVisibleCounts(field, sweep, config_.dense_per_unit);
+    const std::vector<double> tree_ref = denseVisibleCounts(field, tree_rays, config_.dense_per_unit);
     const double ref_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const std::vector<double> unit = denseVisibleCounts(field, sweep, 1);
@@ -458,13 +500,15 @@ class VisibilitySuite {
       }
     }
 
-    const CountErrors tree_e = countErrors(tree_counts, ref), naive_e = countErrors(naive_counts, ref);
+    const CountErrors tree_e = countErrors(tree_counts, tree_ref), naive_e = countErrors(naive_counts, ref);
+    const CountErrors tree_d = countErrors(tree_counts, azimuth_dense),
+                      naive_d = countErrors(naive_counts, azimuth_dense);
     Row row = timingRow("vis_accuracy", content, "tree", "default", 0, k, tree_time);
     addStatistics(row, statisticsOf(field, k, tree.tree));
-    addErrors(row, tree_e, ref_seconds);
+    addErrors(row, tree_e, ref_seconds + dense_seconds, &tree_d);
     out_.write(row);
     row = timingRow("vis_accuracy", content, "naive", "", 0, k, naive_time);
-    addErrors(row, naive_e, ref_seconds);
+    addErrors(row, naive_e, ref_seconds + dense_seconds, &naive_d);
     out_.write(row);
     // The host unit march: the reference's code at D = 1, i.e. the naive march's samples
     // decided in double (ties within the tolerance). Where it differs from the library's naive
@@ -505,12 +549,12 @@ class VisibilitySuite {
                   " samples; at azimuth offset " + num(kCheckOffset) + " rad at " +
                   std::to_string(offset_differ) + " pixels, mean |difference| " + num(offset_diff_mean);
     out_.write(row);
-    say("[vis_accuracy] %s K=%d D=%d: reference mean count %.2f (%.2f s); mean relative error tree %.4f, "
-        "naive %.4f (tree / naive %.2f); aggregate tree %.4f, naive %.4f; time tree %.3f s, naive %.3f s; "
-        "host unit march differs from naive at %zu pixels (%zu at an azimuth offset)",
-        content.label.c_str(), k, config_.dense_per_unit, tree_e.ref_mean, ref_seconds, tree_e.mean,
-        naive_e.mean, naive_e.mean > 0 ? tree_e.mean / naive_e.mean : 0.0, tree_e.aggregate,
-        naive_e.aggregate, tree_time.min(), naive_time.min(), differ, offset_differ);
+    say("[vis_accuracy] %s K=%d D=%d: mean relative error, same directions: tree %.4f, naive %.4f; dense in "
+        "azimuth: tree %.4f, naive %.4f (tree / naive %.2f); time tree %.3f s, naive %.3f s; host unit march "
+        "differs from naive at %zu pixels (%zu at an azimuth offset)",
+        content.label.c_str(), k, config_.dense_per_unit, tree_e.mean, naive_e.mean, tree_d.mean, naive_d.mean,
+        naive_d.mean > 0 ? tree_d.mean / naive_d.mean : 0.0, tree_time.min(), naive_time.min(), differ,
+        offset_differ);
   }
 
   const ComputeContext& context_;
@@ -533,7 +577,7 @@ std::vector<std::pair<std::string, int>> visibilityInputs(const std::string& mod
   for (const auto& name : c.contents)
     if (name != "dem") inputs.emplace_back(name, c.n);
   for (const auto& name : c.accuracy_contents)
-    if (name != "dem" && name != "city") inputs.emplace_back(name, c.accuracy_n);
+    if (name != "dem" && name != "city" && name != "city_dsm") inputs.emplace_back(name, c.accuracy_n);
   return inputs;
 }
 
