@@ -29,6 +29,9 @@
 //       Stewart's culling pyramid per field: preprocessing time, memory per finest level kept, and
 //       for valley, ground-level and high observers the culled shares and the exact and culled
 //       viewsheds' times (interleaved, the fastest of N)
+//   hfvis_bench field NAME N OUT
+//       writes the synthetic field NAME (testing's hard cases: city, sine, ...) of N x N pixels
+//       to OUT (EXR or GeoTIFF), for timing the CLI on it (bench/cost_against.sh)
 //   hfvis_bench inputs [--quick]
 //       the generated fields both suites read, one "<content> <N>" per line
 //   hfvis_bench check-truth
@@ -57,6 +60,7 @@
 #include "hfvis/errors.hpp"
 #include "hfvis/image_io.hpp"
 #include "hfvis/intervisibility.hpp"
+#include "hfvis/synthetic_fields.hpp"
 #include "methods.hpp"
 #include "metrics.hpp"
 #include "suite.hpp"
@@ -83,6 +87,7 @@ constexpr const char* kUsage =
     "       hfvis_bench viewshed-agreement DEM --observer COL,ROW [--observer-height H] [--target-height T]\n"
     "                                      [--samples N] [--seed S] RASTER...\n"
     "       hfvis_bench viewshed-culling [--levels 1,2,3,4] [--reps N] FIELD...\n"
+    "       hfvis_bench field NAME N OUT\n"
     "       hfvis_bench inputs [--quick]\n"
     "       hfvis_bench check-truth\n"
     "       hfvis_bench vectorize-report\n"
@@ -409,6 +414,20 @@ int main(int argc, char** argv) {
         if (k < 1 || k > 12) throw Usage("--levels: finest levels are 1 .. 12");
       const ComputeContext context = ComputeContext::create(ContextOptions::fromEnvironment());
       for (const std::string& path : fields) viewshedCullingReport(context, path, levels, reps);
+      return 0;
+    }
+    if (command == "field") {
+      const std::vector<std::string> p = args.positional();
+      args.rejectUnused();
+      if (p.size() != 3) throw Usage("field needs NAME N OUT");
+      const int n = std::stoi(p[1]);
+      if (n < 1 || n > 16384) throw Usage("field: N is 1 .. 16384");
+      const HeightField field = makeSyntheticField(p[0], n, n, 1);
+      ImageChannels image;
+      image.width = image.height = n;
+      image.names = {"height"};
+      image.planes = {field.heights};
+      writeImage(p[2], image);
       return 0;
     }
     if (command == "inputs") {

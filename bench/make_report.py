@@ -27,7 +27,9 @@ CONTENT_TITLES = {
     "noise": "random noise",
     "dem": "real DEM (Jacksboro fault)",
     "city": "city (flat-roofed blocks on a tilted plane)",
+    "city_dsm": "city DSM (one-pixel streets and walls, roofs touching at corners, a rotated grid)",
 }
+URBAN = ("city", "city_dsm")
 APPROXIMATIONS = ("radius_", "pyramid_")
 
 
@@ -895,6 +897,94 @@ def issue8_targets(res, d):
     return rows, detail
 
 
+def cost_rows(d):
+    """Rows of issue 25's cost target from cost_against.md (bench/cost_against.sh) in the report
+    directory: each command's current / base ratio of median whole-command times."""
+    path = os.path.join(d, "cost_against.md")
+    target = "Cost: default `hfvis svf` and `hfvis viewcount` at 1024^2, K = 64, at most 1.15 x bad9286's time"
+    if not os.path.exists(path):
+        return [(target, "no cost_against.md in the report directory (run bench/cost_against.sh and copy "
+                 "bench/out/cost_against.md here)", "not measured")]
+    with open(path) as f:
+        text = f.read()
+    title = next((line[2:] for line in text.splitlines() if line.startswith("# ")), "")
+    rows = []
+    for line in text.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) != 5 or not cells[0].startswith("hfvis "):
+            continue
+        r = float(cells[4])
+        rows.append(("Cost: default `%s` on %s, current / base whole-command time <= 1.15" % (cells[0], cells[1]),
+                     "%s s against %s s: %.3f x (%s)" % (cells[3], cells[2], r, title.replace("Whole-command cost: ", "")),
+                     "met" if r <= 1.15 else "not met"))
+    return rows or [(target, "cost_against.md has no rows", "not measured")]
+
+
+def issue25_targets(res, d):
+    """Rows (target, measured, verdict) of issue 25's horizon and cost targets from this run's
+    results.csv (speed/error plane, error against samples per unit) and cost_against.md."""
+    rows = []
+    plane = res.select("plane")
+    contents = []
+    for r in plane:
+        if r["content"] not in contents:
+            contents.append(r["content"])
+
+    def plane_row(c, method, kk, spu="1"):
+        return next((r for r in plane if r["content"] == c and r["method"] == method and r["K"] == kk
+                     and r["spu"] == spu and r["outputs"] == "angles" and r["err_mean_deg"] != ""), None)
+
+    failures, urban_failures, pairs, urban = [], [], 0, []
+    for c in contents:
+        for kk in sorted({r["K"] for r in plane if r["content"] == c}, key=int):
+            sw, nv = plane_row(c, "sweep", kk), plane_row(c, "naive", kk)
+            if not sw or not nv:
+                continue
+            pairs += 1
+            sm, nm = num(sw, "err_mean_deg"), num(nv, "err_mean_deg")
+            sp, np_ = num(sw, "err_p99_deg"), num(nv, "err_p99_deg")
+            if sm > nm + EXACT_DEG or sp > np_ + EXACT_DEG:
+                failures.append("%s K = %s (mean %s vs %s, p99 %s vs %s deg)" % (c, kk, fmt(sm), fmt(nm), fmt(sp),
+                                                                              fmt(np_)))
+            if c in URBAN:
+                urban.append("K = %s: %s vs %s" % (kk, fmt(sm), fmt(nm)))
+                if sm > 0.5 * nm:
+                    urban_failures.append(kk)
+    name = "Horizons, every content (%s), every K: the default sweep's mean and p99 error <= the unit naive " \
+           "march's" % ", ".join(contents)
+    if pairs:
+        rows.append((name, "%d content-K pairs; %s" % (pairs, "larger at: " + "; ".join(failures) if failures
+                                                         else "none larger"), "met" if not failures else "not met"))
+    else:
+        rows.append((name, "no plane rows with both methods", "not measured"))
+    name = "Horizons, urban content: the default sweep's mean error <= 0.5 x the unit naive march's"
+    if urban:
+        rows.append((name, "mean error, sweep vs naive (deg): " + "; ".join(urban),
+                     "met" if not urban_failures else "not met at K = " + ", ".join(urban_failures)))
+    else:
+        rows.append((name, "no urban content in the speed/error plane", "not measured"))
+
+    # Samples per unit: S = 1 at least as accurate as the unit march; the sweep's error falls as S grows.
+    src = [r for r in res.select("sources") if r["err_mean_deg"] != ""]
+    name = "Samples per unit keep their meaning: the sweep at S = 1 <= the unit march; its error does not grow with S"
+    parts, bad = [], []
+    for c in sorted({r["content"] for r in src}):
+        sweep = sorted(((float(r["spu"]), num(r, "err_mean_deg")) for r in src
+                        if r["content"] == c and r["method"] == "sweep"))
+        naive1 = next((num(r, "err_mean_deg") for r in src if r["content"] == c and r["method"] == "naive"
+                       and float(r["spu"]) == 1.0), None)
+        if not sweep or naive1 is None:
+            continue
+        parts.append("%s: sweep %s, unit march %s" % (c, ", ".join("S=%g %s" % (spu, fmt(e)) for spu, e in sweep),
+                                                      fmt(naive1)))
+        if sweep[0][1] > naive1 + EXACT_DEG or any(b[1] > a[1] * 1.05 + EXACT_DEG for a, b in zip(sweep, sweep[1:])):
+            bad.append(c)
+    rows.append((name, "mean error (deg): " + "; ".join(parts) if parts else "no sources rows",
+                 ("met" if not bad else "not met on " + ", ".join(bad)) if parts else "not measured"))
+    rows += cost_rows(d)
+    return rows
+
+
 # ------------------------------------------------------------------------------------------
 # Report
 
@@ -1429,10 +1519,17 @@ def main(argv=None):
     out[at:at] = ["## Issue 8 targets (receiver-exact horizons)", "",
                   "From this run's `results.csv` (mode **%s**); sizes and K as each row says." % env.get("mode", "?"),
                   "", table(["target", "measured", "verdict"], targets8), ""] + (detail8 + [""] if detail8 else [])
+    # Issue 25's table above them all.
+    targets25 = issue25_targets(res, d) + issue25_count_targets(d)
+    at = next((i for i, line in enumerate(out) if line.startswith("## ")), 2)
+    out[at:at] = ["## Issue 25 targets (sharp-edged surfaces: city DSMs)", "",
+                  "From this run's `results.csv` (mode **%s**; the speed/error plane and the error against samples "
+                  "per unit) and `cost_against.md` (bench/cost_against.sh, a separate run on the same machine)."
+                  % env.get("mode", "?"), "", table(["target", "measured", "verdict"], targets25), ""]
 
     with open(os.path.join(d, "REPORT.md"), "w") as f:
         f.write("\n".join(out) + "\n")
-    for name, measured, outcome in targets8 + targets + targets4:
+    for name, measured, outcome in targets25 + targets8 + targets + targets4:
         print("%-80s %s -> %s" % (name, measured, outcome))
     return 0
 

@@ -74,7 +74,7 @@ struct Config {
 Config configFor(const std::string& mode) {
   Config c;
   if (mode == "full") {
-    c.contents = {"fractal", "bricks", "sine", "blocks"};
+    c.contents = {"fractal", "bricks", "sine", "blocks", "city_dsm"};
     c.plane_n = 256;
     c.naive_ks = {8, 16, 32, 64, 128, 256};
     c.headline_n = 1024;
@@ -86,7 +86,7 @@ Config configFor(const std::string& mode) {
     c.azimuth_reference_k = 1024;
     c.policy = {2, 5, 2.0};
   } else if (mode == "quick") {
-    c.contents = {"fractal", "bricks", "sine", "blocks"};
+    c.contents = {"fractal", "bricks", "sine", "blocks", "city_dsm"};
     c.plane_n = 128;
     c.ks = {8, 32, 128};
     c.naive_ks = {8, 32, 128};
@@ -100,7 +100,7 @@ Config configFor(const std::string& mode) {
     c.policy = {2, 3, 0.3};
     c.max_scale_run_seconds = 20.0;
   } else {  // tiny: the smoke test; every code path on fields of a few thousand pixels
-    c.contents = {"sine", "noise"};
+    c.contents = {"sine", "noise", "city_dsm"};
     c.plane_n = 40;
     c.ks = {4, 8};
     c.naive_ks = {4, 8};
@@ -394,12 +394,13 @@ class Suite {
     }
   }
 
-  // Error against samples per unit, on the fractal terrain and the DEM at K = 64 (tiny: 8):
+  // Error against samples per unit, on the fractal terrain, the DEM and the city DSM at K = 64
+  // (tiny: 8):
   // the naive march (its sampling error alone: steps of 1/S pixel) and the sweep (the exact
   // grid crossings, and with S > 1 about S samples per pixel between them).
   void sources() {
     const int k = options_.mode == "tiny" ? 8 : 64;
-    for (const std::string name : {"fractal", "dem"}) {
+    for (const std::string name : {"fractal", "dem", "city_dsm"}) {
       const Content c = loadContent(options_, name, config_.plane_n);
       const GroundTruth truth = truthFor(c, *std::max_element(config_.ks.begin(), config_.ks.end()));
       for (double spu : config_.source_spus) {
@@ -503,7 +504,7 @@ class Suite {
     std::vector<int> ks = config_.ks;
     if (!std::count(ks.begin(), ks.end(), config_.headline_k)) ks.push_back(config_.headline_k);
     std::sort(ks.begin(), ks.end());
-    for (const std::string name : {"fractal", "dem"}) {
+    for (const std::string name : {"fractal", "dem", "city_dsm"}) {
       const Content c = loadContent(options_, name, config_.plane_n);
       for (int k : ks) {
         for (const bool angles : {true, false}) {
@@ -672,7 +673,8 @@ std::string vectorizationRemarks(const std::string& self_path) {
 std::vector<std::pair<std::string, int>> requiredInputs(const std::string& mode) {
   const Config c = configFor(mode);
   std::set<std::pair<std::string, int>> inputs;
-  for (const auto& name : c.contents) inputs.emplace(name, c.plane_n);
+  for (const auto& name : c.contents)
+    if (name != "city_dsm") inputs.emplace(name, c.plane_n);  // generated in loadContent
   inputs.emplace("fractal", c.plane_n);  // the error sources study
   inputs.emplace("fractal", c.headline_n);
   inputs.emplace("fractal", c.scale_k_n);

@@ -68,8 +68,12 @@ Content loadContent(const SuiteOptions& options, const std::string& name, int n)
       c.field = makeSyntheticField("dome", n + 5, n - 1, 3);
       c.field.cell_size_x = 1.5, c.field.cell_size_y = 0.75;
     } else {
-      c.field = makeSyntheticField(name == "fractal" ? "noise" : name, n, n - 3, 3);
+      c.field = makeSyntheticField(name == "fractal" ? "noise" : name == "city_dsm" ? "city" : name, n, n - 3, 3);
     }
+  } else if (name == "city_dsm") {
+    // The city DSM hard case (testing's synthetic "city"): one-pixel streets and walls, roofs
+    // touching at corners, courtyards, towers, an axis grid and a rotated one, generated here.
+    c.field = makeSyntheticField("city", n, n, 1);
   } else if (name == "dem") {
     // The central n x n of the DEM (all of it when smaller), so that every content of the
     // speed/error plane has the same size.

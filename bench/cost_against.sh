@@ -1,0 +1,116 @@
+#!/usr/bin/env bash
+# bench/cost_against.sh: what a change costs, as a user pays it: the whole `hfvis svf` and
+# `hfvis viewcount` commands (default options: the sweep and the hull tree at their default
+# sampling) of this checkout's build against a baseline commit's, on the same N x N inputs,
+# run in turn (base, current, current, base, ...) so that a drift of the machine's speed
+# falls on both alike. Prints each command's median over the rounds and the ratio of the
+# medians, and writes the table to bench/out/cost_against.md.
+#
+#   bench/cost_against.sh [--base COMMIT] [--size N] [-k K] [--rounds R] [--contents "fractal city"]
+#     defaults: --base bad9286 (before the segment peaks), N = 1024, K = 64, R = 5, both contents
+#   BUILD_DIR=... this checkout's build (default build/); the baseline is built in
+#   bench/out/base-COMMIT/ (a git worktree, git-ignored).
+# Contents: "fractal" (data/make_data.py's terrain) and "city" (the city DSM hard case, written
+# by hfvis_bench field).
+set -euo pipefail
+
+root=$(cd "$(dirname "$0")/.." && pwd)
+base=bad9286
+size=1024
+k=64
+rounds=5
+contents="fractal city"
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --base) base=$2; shift ;;
+    --size) size=$2; shift ;;
+    -k) k=$2; shift ;;
+    --rounds) rounds=$2; shift ;;
+    --contents) contents=$2; shift ;;
+    -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
+    *) echo "cost_against.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
+  esac
+  shift
+done
+build_dir=${BUILD_DIR:-$root/build}
+export POCL_CACHE_DIR=${POCL_CACHE_DIR:-$root/bench/out/pocl-cache}
+out=$root/bench/out/cost_against
+data=$root/bench/out/data
+mkdir -p "$out" "$data"
+
+base_sha=$(git -C "$root" rev-parse --short "$base")
+base_dir=$root/bench/out/base-$base_sha
+if [[ ! -d $base_dir ]]; then
+  git -C "$root" worktree add --detach "$base_dir" "$base_sha" > /dev/null
+fi
+echo "== building $base_sha in $base_dir/build and this checkout in $build_dir"
+for dir in "$base_dir" "$root"; do
+  b=$base_dir/build
+  [[ $dir == "$root" ]] && b=$build_dir
+  cmake -S "$dir" -B "$b" -DCMAKE_BUILD_TYPE=Release > /dev/null
+  cmake --build "$b" -j "$(nproc)" --target hfvis_cli hfvis_bench > /dev/null
+done
+
+inputs=()
+for content in $contents; do
+  file=$data/${content}_$size.exr
+  if [[ ! -f $file ]]; then
+    if [[ $content == city ]]; then
+      "$build_dir/bench/hfvis_bench" field city "$size" "$file" > /dev/null
+    else
+      /usr/bin/python3 "$root/data/make_data.py" --size "$size" --out "$data" --no-dem --fields "$content" > /dev/null
+    fi
+  fi
+  inputs+=("$file")
+done
+
+current=$(git -C "$root" rev-parse --short HEAD)
+git -C "$root" diff --quiet HEAD -- kernels src include cli || current="$current (with uncommitted changes)"
+echo "commit: $current against $base_sha, $(date -u +%Y-%m-%dT%H:%M:%SZ), load average $(cut -d' ' -f1-3 /proc/loadavg)"
+
+# seconds of one whole command
+run() {
+  local start end
+  start=$(date +%s.%N)
+  "$@" -q > /dev/null
+  end=$(date +%s.%N)
+  echo "$end - $start" | bc -l
+}
+median() { sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR + 1) / 2] : (a[NR / 2] + a[NR / 2 + 1]) / 2}'; }
+
+table=$out/../cost_against.md
+{
+  echo "# Whole-command cost: $current against $base_sha"
+  echo
+  echo "${size}x${size}, K = $k, default options, $rounds rounds in turn (base and current alternate which runs first);"
+  echo "median seconds of each. Written by bench/cost_against.sh on $(uname -n), $(nproc) cores,"
+  echo "$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')."
+  echo
+  echo "| command | input | base (s) | current (s) | current / base |"
+  echo "| --- | --- | --- | --- | --- |"
+} > "$table"
+for op in svf viewcount; do
+  for input in "${inputs[@]}"; do
+    name=$(basename "$input" .exr)
+    for b in "$base_dir/build" "$build_dir"; do  # warm-up: PoCL compiles and caches the kernels
+      "$b/hfvis" "$op" "$input" -o "$out/warm.tif" -k "$k" -q > /dev/null
+    done
+    base_times=() current_times=()
+    for ((i = 0; i < rounds; ++i)); do
+      if ((i % 2 == 0)); then
+        base_times+=("$(run "$base_dir/build/hfvis" "$op" "$input" -o "$out/base.tif" -k "$k")")
+        current_times+=("$(run "$build_dir/hfvis" "$op" "$input" -o "$out/current.tif" -k "$k")")
+      else
+        current_times+=("$(run "$build_dir/hfvis" "$op" "$input" -o "$out/current.tif" -k "$k")")
+        base_times+=("$(run "$base_dir/build/hfvis" "$op" "$input" -o "$out/base.tif" -k "$k")")
+      fi
+    done
+    tb=$(printf '%s\n' "${base_times[@]}" | median)
+    tc=$(printf '%s\n' "${current_times[@]}" | median)
+    ratio=$(echo "$tc / $tb" | bc -l)
+    printf 'hfvis %-9s %-14s base %.2f s, current %.2f s, current / base %.3f\n' "$op" "$name" "$tb" "$tc" "$ratio"
+    printf '| hfvis %s | %s | %.2f | %.2f | %.3f |\n' "$op" "$name" "$tb" "$tc" "$ratio" >> "$table"
+  done
+done
+rm -f "$out"/*.tif
+echo "table: $table"
