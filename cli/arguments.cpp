@@ -1,9 +1,11 @@
 // cli/arguments.cpp: parsing and validating the hfvis command line.
 #include "arguments.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <limits>
@@ -164,6 +166,19 @@ const OptionSpec* findOption(const std::string& name) {
 
 std::string inQuotes(const std::string& text) { return "'" + text + "'"; }
 
+// A value as a message shows it: at most 40 characters of what was typed.
+std::string shortened(const std::string& text) {
+  return text.size() > 40 ? text.substr(0, 40) + "... (" + std::to_string(text.size()) + " characters)"
+                          : text;
+}
+
+// A number in a message: 6 significant digits, never 300 of them.
+std::string formatShort(double value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%g", value);
+  return text;
+}
+
 // Strict number parsing: the whole text must be a finite number.
 double parseNumber(const std::string& option, const std::string& text) {
   const char* begin = text.c_str();
@@ -171,7 +186,7 @@ double parseNumber(const std::string& option, const std::string& text) {
   errno = 0;
   const double value = std::strtod(begin, &end);
   if (text.empty() || end != begin + text.size() || errno == ERANGE || !std::isfinite(value)) {
-    throw UsageError(option + ": expected a number, got " + inQuotes(text));
+    throw UsageError(option + ": expected a number, got " + inQuotes(shortened(text)));
   }
   return value;
 }
@@ -201,6 +216,25 @@ double parsePositive(const std::string& option, const std::string& text) {
   if (!(value > 0.0)) throw UsageError(option + ": must be greater than 0, got " + inQuotes(text));
   return value;
 }
+
+// A number within [lo, hi]: what single precision and the method hold (the kernels compute in
+// float32; a value beyond them gives NaN or infinite results, not an error).
+double parseBounded(const std::string& option, const std::string& text, double lo, double hi,
+                    const char* why) {
+  const double value = parseNumber(option, text);
+  if (!(value >= lo && value <= hi))
+    throw UsageError(option + ": must be in " + formatShort(lo) + " .. " + formatShort(hi) + " (" + why +
+                     "), got " + inQuotes(shortened(text)));
+  return value;
+}
+
+// Limits of the ground and height values (ground units): within them, distances, their squares
+// and areas over a field of 2^31 pixels stay inside float32's range with room for the sums.
+constexpr double kLeastCellSize = 1e-6, kMostCellSize = 1e9, kMostLength = 1e12;
+// The sweep's largest azimuth tolerance, 0.1 radian (computeHorizons), in degrees as the help
+// gives it (rounded up: the conversion to radians clamps it to 0.1).
+constexpr double kMostAzimuthTolerance = 5.72958;
+constexpr const char* kFloatRange = "what the kernels' single precision holds";
 
 int parseDirectionCount(const std::string& option, const std::string& text) {
   const char* begin = text.c_str();
@@ -329,11 +363,15 @@ bool notFor(Option option, Command command) {
 // "X" or "X,Y", ground units per pixel along columns and rows.
 void parseCellSize(const std::string& option, const std::string& text, RunArguments& run) {
   const std::size_t comma = text.find(',');
+  const auto size = [&](const std::string& part) {
+    parsePositive(option, part);
+    return parseBounded(option, part, kLeastCellSize, kMostCellSize, kFloatRange);
+  };
   if (comma == std::string::npos) {
-    run.cell_size_x = run.cell_size_y = parsePositive(option, text);
+    run.cell_size_x = run.cell_size_y = size(text);
   } else {
-    run.cell_size_x = parsePositive(option, text.substr(0, comma));
-    run.cell_size_y = parsePositive(option, text.substr(comma + 1));
+    run.cell_size_x = size(text.substr(0, comma));
+    run.cell_size_y = size(text.substr(comma + 1));
   }
 }
 
@@ -382,7 +420,8 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
       }
       break;
     case Option::AzimuthOffset:
-      run.azimuth_offset_deg = parseNumber(typed, value);
+      run.azimuth_offset_deg =
+          parseBounded(typed, value, -360.0, 360.0, "every direction has an offset in it");
       run.sweep_options_given = true;
       break;
     case Option::SamplesPerUnit:
@@ -393,6 +432,7 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
       break;
     case Option::ZScale:
       run.z_scale = parsePositive(typed, value);
+      run.z_scale = parseBounded(typed, value, 1e-12, 1e12, kFloatRange);
       break;
     case Option::Channel:
       requireNonEmpty(typed, value);
@@ -419,6 +459,8 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
       break;
     case Option::AzimuthTolerance:
       run.azimuth_tolerance_deg = parsePositive(typed, value);
+      run.azimuth_tolerance_deg =
+          parseBounded(typed, value, 0.0, kMostAzimuthTolerance, "0.1 radian at most");
       break;
     case Option::Statistics:
       run.statistics = true;
@@ -455,8 +497,11 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
       break;
     }
     case Option::SunSize:
-      run.sun_size_deg = parsePositive(typed, value);
-      if (run.sun_size_deg > 10.0) throw UsageError(typed + ": at most 10 degrees, got " + inQuotes(value));
+      run.sun_size_deg = parseNumber(typed, value);
+      if (!(run.sun_size_deg >= 0.0 && run.sun_size_deg <= 10.0))
+        throw UsageError(typed +
+                         ": the sun's diameter must be in 0 (a point: hard shadows) .. 10 degrees, got " +
+                         inQuotes(value));
       break;
     case Option::Latitude:
       run.latitude = parseNumber(typed, value);
@@ -477,7 +522,8 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
       run.environment = value;
       break;
     case Option::EnvironmentRotation:
-      run.environment_rotation_deg = parseNumber(typed, value);
+      run.environment_rotation_deg =
+          parseBounded(typed, value, -360.0, 360.0, "every rotation has an angle in it");
       break;
     case Option::EnvironmentRows: {
       const double rows = parsePositive(typed, value);
@@ -492,6 +538,7 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
       break;
     case Option::SunIrradiance:
       run.sun_irradiance = parsePositive(typed, value);
+      run.sun_irradiance = parseBounded(typed, value, 0.0, 1e12, kFloatRange);
       break;
     case Option::From:
     case Option::To: {
@@ -529,6 +576,7 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
       break;
     case Option::MaxDistance:
       run.max_distance = parsePositive(typed, value);
+      run.max_distance = parseBounded(typed, value, 0.0, kMostLength, kFloatRange);
       break;
     case Option::Nodata:
       run.nodata = parseNodata(typed, value);
@@ -542,11 +590,12 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
       run.observers_file = value;
       break;
     case Option::ObserverHeight:
-      run.observer_height = parseNumber(typed, value);
+      run.observer_height = parseBounded(typed, value, -kMostLength, kMostLength, kFloatRange);
       break;
     case Option::TargetHeight:
       run.target_height = parseNumber(typed, value);
       if (run.target_height < 0.0) throw UsageError(typed + ": must be >= 0, got " + inQuotes(value));
+      run.target_height = parseBounded(typed, value, 0.0, kMostLength, kFloatRange);
       break;
     case Option::Absolute:
       run.absolute = true;
@@ -685,6 +734,18 @@ void validateRun(Command command, const RunArguments& run) {
     throw UsageError(
         "--nodata: only GeoTIFF outputs (.tif, .tiff) hold a nodata value, and no output is one; "
         "other outputs keep NaN");
+  }
+  // A nodata value the outputs can hold as data would make those cells nodata for every reader
+  // (a viewshed's hidden 0 or visible 1): it must lie below every value the command writes.
+  if (run.nodata && !std::isnan(*run.nodata)) {
+    const double lowest = command == Command::Horizon                      ? -kPi / 2.0
+                          : command == Command::Viewshed && run.with_angle ? -90.0
+                                                                           : 0.0;
+    if (*run.nodata >= lowest)
+      throw UsageError("--nodata " + formatShort(*run.nodata) + ": 'hfvis " + name +
+                       "' writes data values from " + formatShort(lowest) +
+                       " up, so a reader could not tell those cells from nodata; give a value below " +
+                       formatShort(lowest) + " (such as -9999) or nan");
   }
   if (command == Command::ViewCount && !run.hull_tree_name.empty() &&
       run.visibility_method != IntervisibilityMethod::HullTree) {
@@ -916,7 +977,8 @@ HorizonOptions horizonOptions(const RunArguments& run) {
   HorizonOptions options;
   setSweepOptions(run, options);
   options.method = run.method;
-  options.azimuth_tolerance = run.azimuth_tolerance_deg * (kPi / 180.0);
+  // (the largest tolerance in degrees may round to a hair above 0.1 radian)
+  options.azimuth_tolerance = std::min(0.1, run.azimuth_tolerance_deg * (kPi / 180.0));
   return options;
 }
 

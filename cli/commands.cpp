@@ -40,6 +40,7 @@
 #include "hfvis/sun.hpp"
 #include "hfvis/viewshed.hpp"
 #include "horizon_list_files.hpp"
+#include "output_files.hpp"
 
 namespace hfvis::cli {
 namespace {
@@ -62,86 +63,6 @@ std::string formatMemory(std::uint64_t bytes) {
   const double gib = static_cast<double>(bytes) / (1024.0 * 1024.0 * 1024.0);
   if (gib >= 1.0) return formatFixed(gib, 1) + " GiB";
   return formatFixed(static_cast<double>(bytes) / (1024.0 * 1024.0), 0) + " MiB";
-}
-
-// The files of one run appear together or not at all. Each is first written completely
-// under a temporary name beside its destination (same extension, so the format is kept);
-// commit() renames them all into place. Whatever is not committed is removed, and if a
-// rename fails, the files this run already renamed are removed too, so no mismatched set
-// (a new OUT.exr beside an old preview) is left behind.
-class StagedOutputs {
- public:
-  StagedOutputs() = default;
-  StagedOutputs(const StagedOutputs&) = delete;
-  StagedOutputs& operator=(const StagedOutputs&) = delete;
-  ~StagedOutputs() { discard(); }
-
-  void stage(const std::string& path, const std::function<void(const std::string&)>& write) {
-    const std::string temp = temporaryPath(path);
-    staged_.push_back({path, temp});
-    try {
-      write(temp);
-    } catch (const IoError& error) {  // name the file the user asked for, not our temporary
-      throw IoError(path, error.reason());
-    }
-  }
-
-  void commit() {
-    std::vector<std::string> committed;
-    for (const Entry& entry : staged_) {
-      std::error_code error;
-      fs::rename(entry.temp_path, entry.final_path, error);
-      if (error) {
-        for (const std::string& path : committed) removeQuietly(path);
-        discard();
-        throw IoError(entry.final_path, "cannot move the finished file into place: " + error.message());
-      }
-      committed.push_back(entry.final_path);
-    }
-    staged_.clear();
-  }
-
-  std::vector<std::string> paths() const {
-    std::vector<std::string> result;
-    for (const Entry& entry : staged_) result.push_back(entry.final_path);
-    return result;
-  }
-
- private:
-  struct Entry {
-    std::string final_path;
-    std::string temp_path;
-  };
-
-  static std::string temporaryPath(const std::string& path) {
-    const fs::path target(path);
-    const std::string name = "." + target.stem().string() + ".hfvis-tmp-" + std::to_string(::getpid()) +
-                             target.extension().string();
-    return (target.parent_path() / name).string();
-  }
-
-  static void removeQuietly(const std::string& path) {
-    std::error_code ignored;
-    fs::remove(path, ignored);
-  }
-
-  void discard() {
-    for (const Entry& entry : staged_) removeQuietly(entry.temp_path);
-    staged_.clear();
-  }
-
-  std::vector<Entry> staged_;
-};
-
-// Fails early (before reading or computing) when an output cannot possibly be written.
-void requireOutputLocation(const std::string& path) {
-  const fs::path target(path);
-  const fs::path directory = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  std::error_code error;
-  if (!fs::is_directory(directory, error)) {
-    throw IoError(path, "cannot write here: the directory '" + directory.string() + "' does not exist");
-  }
-  if (fs::is_directory(target, error)) throw IoError(path, "cannot write here: it is a directory");
 }
 
 std::vector<std::string> outputPaths(const RunArguments& run) {
@@ -170,8 +91,9 @@ void requireOutputs(const RunArguments& run, const std::vector<std::string>& out
   std::vector<std::string> inputs{run.input};
   if (!run.radiance.empty()) inputs.push_back(run.radiance);
   for (std::size_t i = 0; i < outputs.size(); ++i) {
-    requireOutputLocation(outputs[i]);
-    if (images) requireImageWriter(outputs[i]);
+    requireReplaceable(outputs[i]);
+    if (images && outputs[i] != run.preview)
+      requireImageWriter(outputs[i]);  // (the preview: a .png, checked)
     for (const std::string& input : inputs) {
       if (sameFile(outputs[i], input))
         throw UsageError("output '" + outputs[i] + "' is the input '" + input +
@@ -471,15 +393,6 @@ void printSummary(const std::vector<std::string>& written, int width, int height
             << "\n";
 }
 
-// Writes `text` to `path` completely or throws IoError.
-void writeTextFile(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) throw IoError(path, std::string("cannot open for writing: ") + std::strerror(errno));
-  out << text;
-  out.flush();
-  if (!out) throw IoError(path, std::string("cannot write: ") + std::strerror(errno));
-}
-
 // The context of a run: the HFVIS_* environment variables (ContextOptions::fromEnvironment),
 // --device taking precedence over HFVIS_DEVICE.
 ComputeContext contextFor(const RunArguments& run) {
@@ -492,22 +405,33 @@ ComputeContext contextFor(const RunArguments& run) {
 
 namespace {
 
-// Lighting assumes row 0 is north (compass azimuth = hfvis azimuth + 90 degrees). A raster whose
-// geotransform runs south-up (t[5] > 0) is lit flipped north-up, and its results flipped back.
+// Lighting assumes row 0 is north and column 0 west (compass azimuth = hfvis azimuth + 90
+// degrees). A raster whose geotransform runs south-up (t[5] > 0) or west-up (t[1] < 0: column 0
+// is east), or both, is lit flipped north-up and east-right, and its results flipped back.
 struct NorthUp {
   const HeightField* input = nullptr;
-  HeightField flipped_copy;  // the input flipped north-up, when it runs south-up
-  bool flipped = false;
+  HeightField flipped_copy;  // the input flipped, when it needs it
+  bool flip_rows = false, flip_columns = false;
+  bool flipped() const { return flip_rows || flip_columns; }
   // The field to compute on: the input itself (no copy), or its flipped copy.
-  const HeightField& field() const { return flipped ? flipped_copy : *input; }
-  // A plane of the field's size (or several, one after another) back in the input's row order.
+  const HeightField& field() const { return flipped() ? flipped_copy : *input; }
+  // A plane of the field's size (or several, one after another) back in the input's order.
   void restore(std::vector<float>& planes) const {
-    if (!flipped) return;
     const std::size_t width = input->width, rows = input->height, plane = width * rows;
-    for (std::size_t at = 0; at + plane <= planes.size(); at += plane)
-      for (std::size_t r = 0; r < rows / 2; ++r)
-        std::swap_ranges(planes.begin() + at + r * width, planes.begin() + at + (r + 1) * width,
-                         planes.begin() + at + (rows - 1 - r) * width);
+    for (std::size_t at = 0; at + plane <= planes.size(); at += plane) {
+      if (flip_rows)
+        for (std::size_t r = 0; r < rows / 2; ++r)
+          std::swap_ranges(planes.begin() + at + r * width, planes.begin() + at + (r + 1) * width,
+                           planes.begin() + at + (rows - 1 - r) * width);
+      if (flip_columns)
+        for (std::size_t r = 0; r < rows; ++r)
+          std::reverse(planes.begin() + at + r * width, planes.begin() + at + (r + 1) * width);
+    }
+  }
+  // A pixel of the input, where it lies in the field computed on.
+  void place(Observer& o) const {
+    if (flip_rows) o.row = input->height - 1 - o.row;
+    if (flip_columns) o.col = input->width - 1 - o.col;
   }
 };
 
@@ -516,12 +440,16 @@ NorthUp northUp(const HeightField& field) {
   NorthUp out;
   out.input = &field;
   const auto& t = field.georeference.geotransform;
-  if (!t || !((*t)[5] > 0.0)) return out;
-  out.flipped = true;
+  if (!t) return out;
+  out.flip_rows = (*t)[5] > 0.0;
+  out.flip_columns = (*t)[1] < 0.0;
+  if (!out.flipped()) return out;
   out.flipped_copy = field;
-  out.restore(out.flipped_copy.heights);  // the flip is its own inverse
-  std::reverse(out.flipped_copy.row_cell_size_x.begin(), out.flipped_copy.row_cell_size_x.end());
-  std::reverse(out.flipped_copy.row_cell_size_y.begin(), out.flipped_copy.row_cell_size_y.end());
+  out.restore(out.flipped_copy.heights);  // each flip is its own inverse
+  if (out.flip_rows) {
+    std::reverse(out.flipped_copy.row_cell_size_x.begin(), out.flipped_copy.row_cell_size_x.end());
+    std::reverse(out.flipped_copy.row_cell_size_y.begin(), out.flipped_copy.row_cell_size_y.end());
+  }
   return out;
 }
 
@@ -568,7 +496,7 @@ int runShade(const RunArguments& run) {
         throw UsageError("output '" + output + "' is the input '" + input + "': outputs never replace an input");
   HeightField input = readValidField(run);
   const NorthUp lit = northUp(input);
-  if (lit.flipped) input.heights = {};  // only its size is read from here on (restore)
+  if (lit.flipped()) input.heights = {};  // only its size is read from here on (restore)
   const HeightField& field = lit.field();
   std::optional<EnvironmentMap> environment;
   if (!run.environment.empty()) {
@@ -663,20 +591,19 @@ int runShade(const RunArguments& run) {
                 "irradiance)";
     units += "radiance: per steradian";
   }
-  StagedOutputs outputs;
+  OutputFiles outputs;
   const ImageChannels image = makeImage(field, run, names, planes, attributes, quantity, units);
-  outputs.stage(run.output, [&](const std::string& path) { writeImage(path, image); });
+  outputs.image(run.output, image);
   if (!run.preview.empty()) {
-    outputs.stage(run.preview, [&](const std::string& path) {
-      if (!radiance.empty()) {
-        writeToneMappedPng(path, field.width, field.height, radiance);
-      } else if (environment) {
-        writeToneMappedPng(path, field.width, field.height, splitPlanes(env.irradiance, pixels, environment->channels));
-      } else {  // a hillshade with cast shadows: the direct light, 0 .. its largest value
-        writePreviewPng(path, field.width, field.height, direct.direct, 0.0f,
-                        std::max(1e-6f, quantileRange(direct.direct, 0.0, 1.0).second));
-      }
-    });
+    if (!radiance.empty()) {
+      outputs.toneMappedPng(run.preview, field.width, field.height, radiance);
+    } else if (environment) {
+      outputs.toneMappedPng(run.preview, field.width, field.height,
+                            splitPlanes(env.irradiance, pixels, environment->channels));
+    } else {  // a hillshade with cast shadows: the direct light, 0 .. its largest value
+      outputs.previewPng(run.preview, field.width, field.height, direct.direct, 0.0f,
+                         std::max(1e-6f, quantileRange(direct.direct, 0.0, 1.0).second));
+    }
   }
   const std::vector<std::string> written = outputs.paths();
   outputs.commit();
@@ -687,7 +614,8 @@ int runShade(const RunArguments& run) {
       note += "; sun at " + formatFixed(sun->position.azimuth_deg, 2) + " deg, " +
               formatFixed(sun->position.elevation_deg, 2) + " deg up; mean sun " + formatFixed(finiteMean(direct.sun), 3);
     printSummary(written, field.width, field.height, environment ? run.directions : 1,
-                 methodName(Command::Shade, run), seconds, device.name, note + (lit.flipped ? " (lit north-up)" : ""));
+                 methodName(Command::Shade, run), seconds, device.name,
+                 note + (lit.flipped() ? " (lit north-up)" : ""));
   }
   return 0;
 }
@@ -696,7 +624,7 @@ int runInsolation(const RunArguments& run) {
   requireOutputs(run, outputPaths(run));
   HeightField input = readValidField(run);
   const NorthUp lit = northUp(input);
-  if (lit.flipped) input.heights = {};  // only its size is read from here on (restore)
+  if (lit.flipped()) input.heights = {};  // only its size is read from here on (restore)
   const HeightField& field = lit.field();
   const ComputeContext context = contextFor(run);
   const DeviceInfo& device = context.device();
@@ -723,26 +651,25 @@ int runInsolation(const RunArguments& run) {
   attributes.emplace_back("hfvis:refraction", options.apparent ? "apparent (refracted) elevations" : "geometric");
   attributes.emplace_back("hfvis:steps_with_sun", std::to_string(result.steps));
   attributes.emplace_back("hfvis:sweeps", std::to_string(result.sweeps));
-  StagedOutputs outputs;
+  OutputFiles outputs;
   // "direct" sorts before "sun_hours": channel 0 in the EXR.
   const ImageChannels image = makeImage(
       field, run, {"direct", "sun_hours"}, {result.direct, result.sun_hours}, attributes,
       "sun_hours: hours with the sun's centre above the pixel's horizon (and elevation 0); direct: the sum over "
       "steps of hours * the disc's part seen * max(0, n . s), the irradiation from a sun of normal irradiance 1",
       "sun_hours: hours; direct: hours times the sun's normal irradiance (W/m^2 gives Wh/m^2)");
-  outputs.stage(run.output, [&](const std::string& path) { writeImage(path, image); });
+  outputs.image(run.output, image);
   if (!run.preview.empty()) {
-    outputs.stage(run.preview, [&](const std::string& path) {
-      const auto [lo, hi] = quantileRange(result.direct);
-      writePreviewPng(path, field.width, field.height, result.direct, lo, hi);
-    });
+    const auto [lo, hi] = quantileRange(result.direct);
+    outputs.previewPng(run.preview, field.width, field.height, result.direct, lo, hi);
   }
   const std::vector<std::string> written = outputs.paths();
   outputs.commit();
   if (!run.quiet) {
     printSummary(written, field.width, field.height, result.sweeps, "sweep", seconds, device.name,
                  "; " + std::to_string(result.steps) + " steps with the sun up, mean sun " +
-                     formatFixed(finiteMean(result.sun_hours), 2) + " h" + (lit.flipped ? " (lit north-up)" : ""));
+                     formatFixed(finiteMean(result.sun_hours), 2) + " h" +
+                     (lit.flipped() ? " (lit north-up)" : ""));
   }
   return 0;
 }
@@ -752,9 +679,26 @@ namespace {
 // --observers FILE.csv: "col,row[,height]" per line; blank lines, lines starting with '#' and
 // one header line before the first observer (fields that start with letters) are skipped. A
 // malformed line is the file's fault.
-std::vector<Observer> readObserverFile(const std::string& path, double default_height) {
-  std::ifstream in(path);
+std::vector<Observer> readObserverFile(const std::string& path, double default_height, bool absolute) {
+  detail::requireInputFile(path);
+  std::ifstream in(path, std::ios::binary);
   if (!in) throw IoError(path, std::string("cannot open: ") + std::strerror(errno));
+  // A line as a message shows it: its start, control and non-ASCII bytes escaped (a NUL or
+  // UTF-16 byte would garble a terminal, and a 10 MB line would flood it).
+  const auto shown = [](const std::string& line) {
+    std::string text;
+    for (std::size_t i = 0; i < line.size() && i < 60; ++i) {
+      const unsigned char c = static_cast<unsigned char>(line[i]);
+      if (c >= 0x20 && c < 0x7f) {
+        text += static_cast<char>(c);
+      } else {
+        char escaped[8];
+        std::snprintf(escaped, sizeof(escaped), "\\x%02x", c);
+        text += escaped;
+      }
+    }
+    return line.size() > 60 ? text + "... (" + std::to_string(line.size()) + " bytes)" : text;
+  };
   std::vector<Observer> observers;
   std::string line;
   bool header_seen = false;
@@ -773,6 +717,8 @@ std::vector<Observer> readObserverFile(const std::string& path, double default_h
       value = std::strtod(t.c_str(), &end);
       return end == t.c_str() + t.size() && std::isfinite(value);
     };
+    if (number == 1 && (line.rfind("\xFF\xFE", 0) == 0 || line.rfind("\xFE\xFF", 0) == 0))
+      throw IoError(path, "is UTF-16 text; save it as UTF-8 (or ASCII) with lines col,row[,height]");
     if (observers.empty() && fields[0].rfind("\xEF\xBB\xBF", 0) == 0) fields[0].erase(0, 3);  // a UTF-8 BOM
     double col = 0, row_index = 0, height = default_height;
     const bool numbers = fields.size() >= 2 && number_in(fields[0], col) && number_in(fields[1], row_index);
@@ -789,8 +735,14 @@ std::vector<Observer> readObserverFile(const std::string& path, double default_h
     if (!numbers || fields.size() > 3 || (fields.size() == 3 && !number_in(fields[2], height)) ||
         col != std::floor(col) || row_index != std::floor(row_index) || std::fabs(col) > 1e9 ||
         std::fabs(row_index) > 1e9)
-      throw IoError(path, "line " + std::to_string(number) + ": expected col,row[,height] (whole column and row), got '" +
-                              line + "'");
+      throw IoError(path, "line " + std::to_string(number) +
+                              ": expected col,row[,height] (whole column and row), got '" + shown(line) +
+                              "'");
+    if (!absolute && height < 0.0)
+      throw IoError(path,
+                    "line " + std::to_string(number) + ": the height " + formatNumber(height) +
+                        " puts the eye below the surface, where it sees nothing; give a height >= 0 (or "
+                        "--absolute)");
     observers.push_back({static_cast<int>(col), static_cast<int>(row_index), height});
   }
   if (observers.empty()) throw IoError(path, "no observers (lines col,row[,height])");
@@ -824,7 +776,8 @@ int runViewshed(const RunArguments& run) {
   std::vector<Observer> observers;
   for (const ReceiverPixel& p : run.observers) observers.push_back({p.col, p.row, run.observer_height});
   if (!run.observers_file.empty()) {
-    const std::vector<Observer> listed = readObserverFile(run.observers_file, run.observer_height);
+    const std::vector<Observer> listed =
+        readObserverFile(run.observers_file, run.observer_height, run.absolute);
     observers.insert(observers.end(), listed.begin(), listed.end());
   }
   for (const Observer& o : observers) {
@@ -834,13 +787,12 @@ int runViewshed(const RunArguments& run) {
       throw UsageError(std::string(error.what()) + " (" + run.input + ")");
     }
   }
-  // Compass azimuths (--fov) take row 0 as north: a south-up GeoTIFF is computed flipped
-  // north-up, its observers with it, and its results flipped back.
+  // Compass azimuths (--fov) take row 0 as north and column 0 as west: a south-up or west-up
+  // GeoTIFF is computed flipped, its observers with it, and its results flipped back.
   const NorthUp lit = northUp(input);
   const HeightField& field = lit.field();
   std::vector<Observer> placed = observers;
-  if (lit.flipped)
-    for (Observer& o : placed) o.row = field.height - 1 - o.row;
+  for (Observer& o : placed) lit.place(o);
   const ComputeContext context = contextFor(run);
   const DeviceInfo& device = context.device();
   ViewshedOptions options = viewshedOptions(run);
@@ -942,29 +894,29 @@ int runViewshed(const RunArguments& run) {
     attributes.emplace_back("hfvis:elevation_range_deg", formatNumber(run.elevation_range->first) + " .. " +
                                                              formatNumber(run.elevation_range->second));
   const ImageChannels image = makeImage(input, run, names, std::move(planes), attributes, quantity, units);
-  StagedOutputs outputs;
-  outputs.stage(run.output, [&](const std::string& path) { writeImage(path, image); });
+  OutputFiles outputs;
+  outputs.image(run.output, image);
   if (!run.preview.empty()) {
-    outputs.stage(run.preview, [&](const std::string& path) {
-      // Visible points (or the count) bright over a dimmed hillshade; nodata black.
-      const std::vector<float>& seen = image.planes.back();
-      float most = 0.0f;
-      for (float v : seen)
-        if (v > most) most = v;
-      const std::vector<float> shade = hillshade(input);
-      std::vector<float> picture(seen.size());
-      for (std::size_t p = 0; p < seen.size(); ++p)
-        picture[p] = std::isnan(seen[p]) ? NAN
-                                         : 0.3f * shade[p] + (seen[p] > 0.0f ? 0.35f + 0.35f * seen[p] / std::max(most, 1.0f) : 0.0f);
-      writePreviewPng(path, input.width, input.height, picture, 0.0f, 1.0f);
-    });
+    // Visible points (or the count) bright over a dimmed hillshade; nodata black.
+    const std::vector<float>& seen = image.planes.back();
+    float most = 0.0f;
+    for (float v : seen)
+      if (v > most) most = v;
+    const std::vector<float> shade = hillshade(input);
+    std::vector<float> picture(seen.size());
+    for (std::size_t p = 0; p < seen.size(); ++p)
+      picture[p] =
+          std::isnan(seen[p])
+              ? NAN
+              : 0.3f * shade[p] + (seen[p] > 0.0f ? 0.35f + 0.35f * seen[p] / std::max(most, 1.0f) : 0.0f);
+    outputs.previewPng(run.preview, input.width, input.height, picture, 0.0f, 1.0f);
   }
   const std::vector<std::string> written = outputs.paths();
   outputs.commit();
   if (!run.quiet)
-    printSummary(written, field.width, field.height, static_cast<int>(observers.size()), methodName(Command::Viewshed, run),
-                 seconds, device.name,
-                 note + (lit.flipped ? " (computed north-up)" : ""), "observer");
+    printSummary(written, field.width, field.height, static_cast<int>(observers.size()),
+                 methodName(Command::Viewshed, run), seconds, device.name,
+                 note + (lit.flipped() ? " (computed north-up)" : ""), "observer");
   return 0;
 }
 
@@ -1050,7 +1002,7 @@ int runCompute(Command command, const RunArguments& run) {
   attributes.emplace_back("hfvis:azimuths_deg", used);
 
   // Everything is computed; now stage every file, then move them all into place.
-  StagedOutputs outputs;
+  OutputFiles outputs;
   std::string mean_note;
   if (command == Command::Horizon) {
     const std::size_t values = pixels * static_cast<std::size_t>(directions);
@@ -1059,7 +1011,7 @@ int runCompute(Command command, const RunArguments& run) {
         field, run, directionChannelNames("h", directions), splitPlanes(result.angles, pixels, directions),
         attributes, "horizon elevation angle per direction (channel k = direction k)",
         "radians above the horizontal; -pi/2 where the ray leaves the field at once");
-    outputs.stage(run.output, [&](const std::string& path) { writeImage(path, angles); });
+    outputs.image(run.output, angles);
     if (!run.distance_output.empty()) {
       requireSize(result.distances, values, "horizon distances");
       const ImageChannels distances =
@@ -1068,13 +1020,11 @@ int runCompute(Command command, const RunArguments& run) {
                     "ground distance to the point casting the horizon, per direction",
                     "ground units (pixels times cell size); 0 where no point casts a horizon or the "
                     "surface's own slope at the receiver is the horizon");
-      outputs.stage(run.distance_output, [&](const std::string& path) { writeImage(path, distances); });
+      outputs.image(run.distance_output, distances);
     }
     if (!run.preview.empty()) {
       const std::vector<float> mean = meanInFieldElevation(result.angles, pixels, directions);
-      outputs.stage(run.preview, [&](const std::string& path) {
-        writePreviewPng(path, result.width, result.height, mean);  // stretched min..max
-      });
+      outputs.previewPng(run.preview, result.width, result.height, mean);  // stretched min..max
     }
   } else {
     const bool svf = command == Command::SkyViewFactor;
@@ -1086,14 +1036,12 @@ int runCompute(Command command, const RunArguments& run) {
                   svf ? "sky-view factor 1 - mean_k sin(max(0, elevation_k))"
                       : "ambient occlusion, uniform sky of radiance 1 (Timonen & Westerholm 2010, Eq. 5)",
                   svf ? "fraction of the sky visible, 0..1" : "0..1, a flat unoccluded plane gives 1");
-    outputs.stage(run.output, [&](const std::string& path) { writeImage(path, image); });
+    outputs.image(run.output, image);
     mean_note = "; mean " + channel + " " + formatFixed(finiteMean(plane), 4);
     if (!run.preview.empty()) {
       // Stretched over the 1st to 99th percentile: most of a DEM's svf lies within 0.85 .. 1.
       const auto [lo, hi] = quantileRange(plane);
-      outputs.stage(run.preview, [&, lo = lo, hi = hi](const std::string& path) {
-        writePreviewPng(path, result.width, result.height, plane, lo, hi);
-      });
+      outputs.previewPng(run.preview, result.width, result.height, plane, lo, hi);
       mean_note += "; preview black at " + formatFixed(lo, 3) + ", white at " + formatFixed(hi, 3);
     }
   }
@@ -1147,7 +1095,7 @@ int runViewCount(const RunArguments& run) {
                  " line samples, " + std::to_string(stats.lines_over_bound) + " lines over t <= 2m + n)";
   }
 
-  StagedOutputs outputs;
+  OutputFiles outputs;
   // "count" sorts before "visible_area", so the count is channel 0 in the EXR, whose
   // channels are stored sorted by name.
   const ImageChannels image = makeImage(
@@ -1156,11 +1104,9 @@ int runViewCount(const RunArguments& run) {
       "(total viewshed), each visible sample at ground distance rho standing for (2*pi/K) * rho * drho",
       "count: samples (one per 1/S pixel lengths along each direction, S = samples per unit); "
       "visible_area: ground units squared");
-  outputs.stage(run.output, [&](const std::string& path) { writeImage(path, image); });
+  outputs.image(run.output, image);
   if (!run.preview.empty()) {
-    outputs.stage(run.preview, [&](const std::string& path) {
-      writePreviewPng(path, field.width, field.height, result.visible_count);  // stretched min..max
-    });
+    outputs.previewPng(run.preview, field.width, field.height, result.visible_count);  // stretched min..max
   }
   const std::vector<std::string> written = outputs.paths();
   outputs.commit();
@@ -1195,8 +1141,8 @@ int runHorizonLists(const RunArguments& run) {
   std::string ext = fs::path(run.output).extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   const std::string text = ext == ".csv" ? horizonListsCsv(lists) : horizonListsJson(run, field, lists);
-  StagedOutputs outputs;
-  outputs.stage(run.output, [&](const std::string& path) { writeTextFile(path, text); });
+  OutputFiles outputs;
+  outputs.text(run.output, text);
   const std::vector<std::string> written = outputs.paths();
   outputs.commit();
   if (!run.quiet) {
@@ -1251,7 +1197,7 @@ int runBounce(const RunArguments& run) {
 
   Attributes attributes = runAttributes(Command::Bounce, run, field, device);
   attributes.emplace_back("hfvis:radiance", run.radiance);
-  StagedOutputs outputs;
+  OutputFiles outputs;
   // The radiance's channel names, so that R, G, B stay R, G, B.
   const ImageChannels image = makeImage(
       field, run, radiance_image.names, result.irradiance, attributes,
@@ -1260,15 +1206,13 @@ int runBounce(const RunArguments& run) {
       "sum over directions and visible samples of radiance times projected solid angle",
       "radiance units times steradians (W/m^2 for W m^-2 sr^-1); a Lambertian surface of albedo rho "
       "re-emits rho * E / pi");
-  outputs.stage(run.output, [&](const std::string& path) { writeImage(path, image); });
+  outputs.image(run.output, image);
   if (!run.preview.empty()) {
     std::vector<float> mean(field.pixelCount(), 0.0f);
     for (const auto& plane : result.irradiance)
       for (std::size_t p = 0; p < mean.size(); ++p)
         mean[p] += plane[p] / static_cast<float>(result.irradiance.size());
-    outputs.stage(run.preview, [&](const std::string& path) {
-      writePreviewPng(path, field.width, field.height, mean);  // stretched min..max
-    });
+    outputs.previewPng(run.preview, field.width, field.height, mean);  // stretched min..max
   }
   const std::vector<std::string> written = outputs.paths();
   outputs.commit();

@@ -95,8 +95,9 @@ Horizon only:
   --distance-out FILE      also write K channels d000.. of ground distance to the
                            horizon point (ground units), computed in the same run
   --azimuth-tolerance DEG  the sweep's direction k is the cheapest integer pixel step within
-                           DEG of phi_k (default 0.25; at most 5.73). Smaller is closer to
-                           phi_k and slower: steps with more grid crossings per pixel
+                           DEG of phi_k (default 0.25; at most 5.72958, 0.1 radian). Smaller
+                           is closer to phi_k and slower: steps with more grid crossings per
+                           pixel
   Its preview shows the mean horizon elevation over the directions whose ray stays in
   the field (low = dark, high = bright), stretched from its minimum to its maximum; the
   svf and ao previews stretch their 1st to 99th percentile over black..white (the summary

@@ -1,5 +1,6 @@
 // cli/main.cpp: the hfvis command line tool: dispatch, and the one place where errors
 // become a message and an exit status (0 success, 1 runtime error, 2 usage error).
+#include <csignal>
 #include <exception>
 #include <iostream>
 #include <new>
@@ -10,6 +11,7 @@
 #include "commands.hpp"
 #include "help.hpp"
 #include "hfvis/errors.hpp"
+#include "hfvis/image_io.hpp"
 
 namespace {
 
@@ -60,6 +62,10 @@ std::string helpHint(const std::vector<std::string>& args) {
 
 int main(int argc, char** argv) {
   const std::vector<std::string> args(argv + 1, argv + argc);
+  // An interrupted run leaves no temporary files; and a write past the file size limit (ulimit
+  // -f) fails with EFBIG and is reported like a full disk, instead of killing the process.
+  hfvis::removeTemporaryOutputsOnSignals();
+  std::signal(SIGXFSZ, SIG_IGN);
   try {
     return run(args);
   } catch (const hfvis::cli::UsageError& error) {

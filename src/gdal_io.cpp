@@ -11,6 +11,7 @@
 #include <array>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <limits>
@@ -22,6 +23,7 @@
 #include <vector>
 
 #include "hfvis/errors.hpp"
+#include "output_files.hpp"
 
 namespace hfvis::detail {
 namespace {
@@ -50,7 +52,7 @@ using Dataset = std::unique_ptr<void, DatasetCloser>;
 
 Dataset openRaster(const std::string& path) {
   registerOnce();
-  if (!std::filesystem::exists(path)) throw IoError(path, "no such file");
+  requireInputFile(path);
   Dataset dataset(GDALOpen(path.c_str(), GA_ReadOnly));
   if (!dataset) throw IoError(path, lastError());
   if (GDALGetRasterXSize(dataset.get()) <= 0 || GDALGetRasterYSize(dataset.get()) <= 0 ||
@@ -140,9 +142,16 @@ class ErrorCollector {
   ErrorCollector& operator=(const ErrorCollector&) = delete;
 
   bool failed() const { return !first_failure_.empty(); }
-  // `what`, with GDAL's first failure message when there was one.
-  std::string reason(const std::string& what) const {
-    return first_failure_.empty() ? what : what + " (" + first_failure_ + ")";
+  // `what`, with the cause where it can be told (a full disk, the file size limit) and GDAL's
+  // first failure message, the temporary `file` in it named as the output `path`.
+  std::string reason(const std::string& what, const std::string& file = "",
+                     const std::string& path = "") const {
+    std::string detail = first_failure_;
+    for (std::size_t at; !file.empty() && (at = detail.find(file)) != std::string::npos;)
+      detail.replace(at, file.size(), path);
+    const int cause = file.empty() ? 0 : likelyWriteError(file);
+    const std::string head = cause ? what + ": " + writeFailure(cause) : what;
+    return detail.empty() ? head : head + " (" + detail + ")";
   }
 
  private:
@@ -187,16 +196,27 @@ void metresPerDegree(double lat_deg, double* along_meridian, double* along_paral
   *along_parallel = n * std::cos(lat) * M_PI / 180.0;
 }
 
-std::optional<std::pair<double, double>> storedCellSize(const char* x, const char* y) {
-  auto number = [](const char* text) -> double {
-    if (!text || !*text) return 0.0;
+namespace {
+std::string shortNumber(double value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%g", value);
+  return text;
+}
+}  // namespace
+
+std::optional<std::pair<double, double>> storedCellSize(const std::string& path, const char* x,
+                                                        const char* y) {
+  if ((!x || !*x) && (!y || !*y)) return std::nullopt;
+  auto number = [&](const char* name, const char* text) {
     char* end = nullptr;
-    const double v = std::strtod(text, &end);
-    return (end && *end == '\0' && std::isfinite(v) && v > 0.0) ? v : 0.0;
+    const double v = text ? std::strtod(text, &end) : 0.0;
+    if (!text || !*text || *end != '\0' || !std::isfinite(v) || !(v > 0.0) || v > 1e9)
+      throw IoError(path, std::string("the attribute ") + name + " is '" +
+                              (text ? std::string(text).substr(0, 40) : "") +
+                              "', not a cell size (a positive number); give --cell-size");
+    return v;
   };
-  const double sx = number(x), sy = number(y);
-  if (sx > 0.0 && sy > 0.0) return std::make_pair(sx, sy);
-  return std::nullopt;
+  return std::make_pair(number("hfvis:cell_size_x", x), number("hfvis:cell_size_y", y));
 }
 
 std::string lowercaseExtension(const std::string& path) {
@@ -237,19 +257,26 @@ HeightField readGdalHeightField(const std::string& path, const HeightFieldReadOp
   field.height = GDALGetRasterYSize(dataset.get());
   field.heights = readBand(path, dataset.get(), band_index);
   field.georeference = georeferenceOf(dataset.get());
+  // A rotated or sheared grid is refused whatever the cell size: the outputs would keep its
+  // geotransform while every direction and distance was computed on an axis-aligned one.
+  if (const auto& gt = field.georeference.geotransform; gt && ((*gt)[2] != 0.0 || (*gt)[4] != 0.0))
+    throw IoError(path, "rotated or sheared geotransforms are not supported (terms " +
+                            std::to_string((*gt)[2]) + ", " + std::to_string((*gt)[4]) +
+                            "); warp the raster north-up first (gdalwarp)");
   // Cell sizes: given, else from the geotransform (north-up or south-up only), else as hfvis
   // stored them.
   if (options.cell_size_x > 0.0 || options.cell_size_y > 0.0) {
     field.cell_size_x = options.cell_size_x > 0.0 ? options.cell_size_x : options.cell_size_y;
     field.cell_size_y = options.cell_size_y > 0.0 ? options.cell_size_y : options.cell_size_x;
   } else if (const auto& gt = field.georeference.geotransform) {
-    if ((*gt)[2] != 0.0 || (*gt)[4] != 0.0)
-      throw IoError(path, "rotated or sheared geotransforms are not supported (terms " +
-                              std::to_string((*gt)[2]) + ", " + std::to_string((*gt)[4]) +
-                              "); warp the raster north-up first (gdalwarp)");
     field.cell_size_x = std::fabs((*gt)[1]);
     field.cell_size_y = std::fabs((*gt)[5]);
     if (isGeographic(dataset.get())) {
+      const double first = (*gt)[3], last = (*gt)[3] + (*gt)[5] * field.height;
+      if (!(std::fabs(first) <= 90.0 && std::fabs(last) <= 90.0))
+        throw IoError(path, "a geographic raster whose rows span latitudes " + shortNumber(first) + " .. " +
+                                shortNumber(last) +
+                                " degrees, beyond the poles: its geotransform or CRS is wrong");
       // Degrees to metres on the ellipsoid at each row's latitude (its pixel centres); the
       // field's cell sizes are those at its centre latitude.
       const double degrees_x = field.cell_size_x, degrees_y = field.cell_size_y;
@@ -264,7 +291,7 @@ HeightField readGdalHeightField(const std::string& path, const HeightFieldReadOp
       field.cell_size_y = degrees_y * per_deg_y;
     }
   } else if (const auto stored =
-                 storedCellSize(GDALGetMetadataItem(dataset.get(), "hfvis_cell_size_x", nullptr),
+                 storedCellSize(path, GDALGetMetadataItem(dataset.get(), "hfvis_cell_size_x", nullptr),
                                 GDALGetMetadataItem(dataset.get(), "hfvis_cell_size_y", nullptr))) {
     field.cell_size_x = stored->first;
     field.cell_size_y = stored->second;
@@ -278,6 +305,25 @@ HeightField readGdalHeightField(const std::string& path, const HeightFieldReadOp
   return field;
 }
 
+namespace {
+// A band without a description: R, G, B or A where the raster says it holds that colour (a
+// standard RGB GeoTIFF), else "channel<b>".
+std::string colourName(GDALRasterBandH band, int b) {
+  switch (GDALGetRasterColorInterpretation(band)) {
+    case GCI_RedBand:
+      return "R";
+    case GCI_GreenBand:
+      return "G";
+    case GCI_BlueBand:
+      return "B";
+    case GCI_AlphaBand:
+      return "A";
+    default:
+      return "channel" + std::to_string(b);
+  }
+}
+}  // namespace
+
 ImageChannels readGdalImage(const std::string& path) {
   const Dataset dataset = openRaster(path);
   const int bands = GDALGetRasterCount(dataset.get());
@@ -286,8 +332,9 @@ ImageChannels readGdalImage(const std::string& path) {
   image.width = GDALGetRasterXSize(dataset.get());
   image.height = GDALGetRasterYSize(dataset.get());
   for (int b = 0; b < bands; ++b) {
-    const std::string description = GDALGetDescription(GDALGetRasterBand(dataset.get(), b + 1));
-    image.names.push_back(description.empty() ? "channel" + std::to_string(b) : description);
+    GDALRasterBandH band = GDALGetRasterBand(dataset.get(), b + 1);
+    const std::string description = GDALGetDescription(band);
+    image.names.push_back(description.empty() ? colourName(band, b) : description);
     image.planes.push_back(readBand(path, dataset.get(), b));
   }
   for (char** item = GDALGetMetadata(dataset.get(), nullptr); item && *item; ++item) {
@@ -343,7 +390,7 @@ void writeGeoTiff(const std::string& file, const std::string& path, const ImageC
   Dataset dataset(GDALCreate(GDALGetDriverByName("GTiff"), file.c_str(), image.width, image.height, bands,
                              GDT_Float32, options));
   CSLDestroy(options);
-  if (!dataset) throw IoError(path, errors.reason("cannot create the GeoTIFF"));
+  if (!dataset) throw IoError(path, errors.reason("cannot create the GeoTIFF", file, path));
 
   const Georeference& georeference = image.georeference;
   if (georeference.geotransform) {
@@ -378,12 +425,12 @@ void writeGeoTiff(const std::string& file, const std::string& path, const ImageC
       }
       if (GDALRasterIO(band, GF_Write, 0, y, image.width, count, const_cast<float*>(source), image.width,
                        count, GDT_Float32, 0, 0) != CE_None)
-        throw IoError(path, errors.reason("cannot write the pixels"));
+        throw IoError(path, errors.reason("cannot write the pixels", file, path));
     }
   }
   GDALFlushCache(dataset.get());
   dataset.reset();  // closing writes the last tiles and the directory
-  if (errors.failed()) throw IoError(path, errors.reason("cannot write the GeoTIFF"));
+  if (errors.failed()) throw IoError(path, errors.reason("cannot write the GeoTIFF", file, path));
 }
 
 }  // namespace hfvis::detail

@@ -16,9 +16,11 @@ namespace hfvis::detail {
 // meridian and along a parallel (both readers convert geographic spacing with it).
 void metresPerDegree(double lat_deg, double* along_meridian, double* along_parallel);
 
-// The cell sizes in the texts of the hfvis:cell_size_x/y attributes (null: absent), when both
-// parse as finite positive numbers (both readers take them from files hfvis wrote).
-std::optional<std::pair<double, double>> storedCellSize(const char* x, const char* y);
+// The cell sizes in the texts of the hfvis:cell_size_x/y attributes (null: absent) of the file
+// `path` (both readers take them from files hfvis wrote): none when both are absent, else both,
+// or an IoError when either is not a positive number (a damaged file must not fall back to 1).
+std::optional<std::pair<double, double>> storedCellSize(const std::string& path, const char* x,
+                                                        const char* y);
 
 // The extension of `path` in lower case, with its dot ("" when it has none).
 std::string lowercaseExtension(const std::string& path);

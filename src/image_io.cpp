@@ -23,91 +23,28 @@
 #include "gdal_io.hpp"
 #include "hfvis/errors.hpp"
 #include "oiio_images.hpp"
+#include "output_files.hpp"
 
 namespace hfvis {
 namespace {
 
 namespace fs = std::filesystem;
 
-// ---------------------------------------------------------------------------------------------
-// Atomic writing: everything goes to a temporary file beside the target, which is renamed
-// into place only after a successful close. The temporary keeps the target's extension so
-// the same writer (OpenImageIO's, by extension, or the GeoTIFF one) takes it.
-
-std::string temporaryPathFor(const std::string& path) {
-  static std::atomic<unsigned> counter{0};
-  const fs::path target(path);
-  const std::string name = "." + target.stem().string() + ".tmp" + std::to_string(::getpid()) + "_" +
-                           std::to_string(counter.fetch_add(1)) + target.extension().string();
-  return (target.parent_path() / name).string();
-}
-
-class TemporaryFile {
- public:
-  explicit TemporaryFile(std::string path) : path_(std::move(path)) {}
-  ~TemporaryFile() {
-    if (!committed_) {
-      std::error_code ignored;
-      fs::remove(path_, ignored);
-    }
-  }
-  TemporaryFile(const TemporaryFile&) = delete;
-  TemporaryFile& operator=(const TemporaryFile&) = delete;
-  const std::string& path() const { return path_; }
-  void commitTo(const std::string& target) {
-    if (std::rename(path_.c_str(), target.c_str()) != 0) {
-      throw IoError(target, "cannot rename the finished temporary file '" + path_ + "' into place (" +
-                                std::strerror(errno) + ")");
-    }
-    committed_ = true;
-  }
-
- private:
-  std::string path_;
-  bool committed_ = false;
-};
-
-// The checks every writer makes before it creates anything, and the temporary file beside
-// `path` that it writes.
-TemporaryFile temporaryBeside(const std::string& path) {
-  requireImageWriter(path);
-  const fs::path target(path);
-  if (target.filename().empty()) throw IoError(path, "not a file name");
-  const fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
-  std::error_code ec;
-  if (!fs::is_directory(dir, ec)) {
-    throw IoError(path, "directory '" + dir.string() + "' does not exist");
-  }
-  return TemporaryFile(temporaryPathFor(path));
-}
-
-// Writes an image through OpenImageIO (oiio_images.hpp) to a temporary file beside `path`,
-// renamed into place once whole: width x height pixels of names.size() channels, Pixel float
-// or 8-bit, the rows from fill_rows(y_begin, y_end, Pixel* buffer).
+// Writes an image through OpenImageIO (oiio_images.hpp) to `file`, naming `path` in errors:
+// width x height pixels of names.size() channels, Pixel float or 8-bit, the rows from
+// fill_rows(y_begin, y_end, Pixel* buffer).
 template <typename Pixel, typename FillRows>
-void writeAtomically(const std::string& path, int width, int height, const std::vector<std::string>& names,
-                     const std::vector<std::pair<std::string, std::string>>& attributes, FillRows fill_rows) {
-  TemporaryFile temporary = temporaryBeside(path);
+void writeOiioFile(const std::string& file, const std::string& path, int width, int height,
+                   const std::vector<std::string>& names,
+                   const std::vector<std::pair<std::string, std::string>>& attributes, FillRows fill_rows) {
   detail::oiioImages().write(
-      temporary.path(), path, width, height, names, sizeof(Pixel) == 1, attributes,
+      file, path, width, height, names, sizeof(Pixel) == 1, attributes,
       [&](int y_begin, int y_end, void* rows) { fill_rows(y_begin, y_end, static_cast<Pixel*>(rows)); });
-  temporary.commitTo(path);
 }
 
 }  // namespace
 
 namespace {
-
-// The checks every reader of a file makes first: it exists, is not a directory, and is not empty.
-void requireImageFile(const std::string& path) {
-  std::error_code ec;
-  const fs::file_status status = fs::status(path, ec);
-  if (!fs::exists(status)) throw IoError(path, "no such file");
-  if (fs::is_directory(status)) throw IoError(path, "is a directory, not an image file");
-  if (fs::is_regular_file(status) && fs::file_size(path, ec) == 0 && !ec) {
-    throw IoError(path, "file is empty (0 bytes)");
-  }
-}
 
 std::string attributeOf(const ImageChannels& image, const std::string& name) {
   for (const auto& [key, value] : image.attributes)
@@ -119,21 +56,21 @@ std::string attributeOf(const ImageChannels& image, const std::string& name) {
 
 HeightField readHeightField(const std::string& path, const HeightFieldReadOptions& options) {
   if (detail::isGdalRaster(path)) return detail::readGdalHeightField(path, options);
-  requireImageFile(path);
+  detail::requireInputFile(path);
   ImageChannels image = detail::oiioImages().read(path, options.max_image_bytes, &options.channel);
   HeightField field;
   field.width = image.width;
   field.height = image.height;
   field.heights = std::move(image.planes.front());
-  // Cell size stored by hfvis itself (data/make_data.py and hfvis outputs write the string
-  // attributes "hfvis:cell_size_x" and "hfvis:cell_size_y"); both must parse as positive.
-  const auto stored_cell_size = detail::storedCellSize(attributeOf(image, "hfvis:cell_size_x").c_str(),
-                                                       attributeOf(image, "hfvis:cell_size_y").c_str());
   if (options.cell_size_x > 0.0 || options.cell_size_y > 0.0) {
     // One given size applies to both axes.
     field.cell_size_x = options.cell_size_x > 0.0 ? options.cell_size_x : options.cell_size_y;
     field.cell_size_y = options.cell_size_y > 0.0 ? options.cell_size_y : options.cell_size_x;
-  } else if (stored_cell_size) {
+  } else if (const auto stored_cell_size =
+                 // Cell size stored by hfvis itself (data/make_data.py and hfvis outputs write the
+                 // string attributes "hfvis:cell_size_x" and "hfvis:cell_size_y").
+             detail::storedCellSize(path, attributeOf(image, "hfvis:cell_size_x").c_str(),
+                                    attributeOf(image, "hfvis:cell_size_y").c_str())) {
     field.cell_size_x = stored_cell_size->first;
     field.cell_size_y = stored_cell_size->second;
   }
@@ -143,7 +80,7 @@ HeightField readHeightField(const std::string& path, const HeightFieldReadOption
 
 ImageChannels readImage(const std::string& path) {
   if (detail::isGdalRaster(path)) return detail::readGdalImage(path);
-  requireImageFile(path);
+  detail::requireInputFile(path);
   ImageChannels image = detail::oiioImages().read(path, 0, nullptr);
   image.attributes.clear();
   return image;
@@ -159,13 +96,24 @@ void requireImageWriter(const std::string& path) {
     if (detail::hasGeoTiffWriter()) return;
     throw IoError(path, "this GDAL has no GTiff driver to write a GeoTIFF (write .exr)");
   }
-  if (detail::oiioImages().can_write(path)) return;
+  // Data are float32: an 8-bit format (PNG, JPEG, ...) would clip and round them silently.
+  if (detail::lowercaseExtension(path) == ".exr") return;
   const std::string extension = fs::path(path).extension().string();
-  throw IoError(path,
-                "no image writer for the extension '" + extension + "' (write .exr, or .tif for a GeoTIFF)");
+  throw IoError(path, "no image writer for the extension '" + extension +
+                          "' (write .exr, or .tif for a GeoTIFF: outputs hold float32 data; 8-bit "
+                          "images only through --preview)");
 }
 
-void writeImage(const std::string& path, const ImageChannels& image) {
+namespace {
+
+// The 8-bit previews: PNG, or what else OpenImageIO writes by extension.
+void requirePreviewWriter(const std::string& path) {
+  if (detail::oiioImages().can_write(path)) return;
+  throw IoError(path, "no image writer for the extension '" + fs::path(path).extension().string() +
+                          "' (a preview is a .png)");
+}
+
+void requireConsistent(const std::string& path, const ImageChannels& image) {
   if (image.width <= 0 || image.height <= 0) {
     throw InvalidArgument("image to write to '" + path + "' is empty (" + std::to_string(image.width) +
                           " x " + std::to_string(image.height) + " pixels)");
@@ -191,34 +139,82 @@ void writeImage(const std::string& path, const ImageChannels& image) {
     throw InvalidArgument("the nodata value to write to '" + path + "' must be finite or NaN (got " +
                           std::to_string(image.nodata) + ")");
   }
+  // A data value equal to the nodata value would be read back as nodata.
+  if (writesGeoTiff(path) && !std::isnan(image.nodata)) {
+    for (std::size_t c = 0; c < image.planes.size(); ++c) {
+      const auto at = std::find(image.planes[c].begin(), image.planes[c].end(), image.nodata);
+      if (at == image.planes[c].end()) continue;
+      const std::size_t i = static_cast<std::size_t>(at - image.planes[c].begin());
+      char value[32];
+      std::snprintf(value, sizeof(value), "%.9g", image.nodata);
+      throw InvalidArgument("the nodata value " + std::string(value) + " is also a data value of '" + path +
+                            "' (channel " + image.names[c] + ", column " + std::to_string(i % image.width) +
+                            ", row " + std::to_string(i / image.width) +
+                            "): a reader would take it for nodata; choose a value the data never hold, "
+                            "such as -9999, or nan");
+    }
+  }
   if (const auto& transform = image.georeference.geotransform) {
     if (!std::all_of(transform->begin(), transform->end(), [](double t) { return std::isfinite(t); }))
       throw InvalidArgument("the geotransform to write to '" + path + "' is not finite");
   }
+}
 
+void writeImageFile(const std::string& file, const std::string& path, const ImageChannels& image) {
   if (writesGeoTiff(path)) {
-    TemporaryFile temporary = temporaryBeside(path);
-    detail::writeGeoTiff(temporary.path(), path, image);
-    temporary.commitTo(path);
+    detail::writeGeoTiff(file, path, image);
+    detail::syncFile(file, path);
     return;
   }
-
   const int channels = static_cast<int>(image.planes.size());
-  writeAtomically<float>(
-      path, image.width, image.height, image.names, image.attributes,
-      [&](int y_begin, int y_end, float* rows) {
-        for (int y = y_begin; y < y_end; ++y) {
-          for (int x = 0; x < image.width; ++x) {
-            const std::size_t src = static_cast<std::size_t>(y) * image.width + x;
-            float* pixel = rows + (static_cast<std::size_t>(y - y_begin) * image.width + x) * channels;
-            for (int c = 0; c < channels; ++c) pixel[c] = image.planes[c][src];
-          }
-        }
-      });
+  writeOiioFile<float>(file, path, image.width, image.height, image.names, image.attributes,
+                       [&](int y_begin, int y_end, float* rows) {
+                         for (int y = y_begin; y < y_end; ++y) {
+                           for (int x = 0; x < image.width; ++x) {
+                             const std::size_t src = static_cast<std::size_t>(y) * image.width + x;
+                             float* pixel =
+                                 rows + (static_cast<std::size_t>(y - y_begin) * image.width + x) * channels;
+                             for (int c = 0; c < channels; ++c) pixel[c] = image.planes[c][src];
+                           }
+                         }
+                       });
+}
+
+}  // namespace
+
+void OutputFiles::image(const std::string& path, const ImageChannels& image) {
+  requireConsistent(path, image);
+  requireImageWriter(path);
+  stage(path, [&](const std::string& file) { writeImageFile(file, path, image); });
+}
+
+void OutputFiles::text(const std::string& path, const std::string& text) {
+  stage(path,
+        [&](const std::string& file) { detail::writeFileChecked(file, path, text.data(), text.size()); });
+}
+
+void writeImage(const std::string& path, const ImageChannels& image) {
+  OutputFiles files;
+  files.image(path, image);
+  files.commit();
 }
 
 void writePreviewPng(const std::string& path, int width, int height, const std::vector<float>& plane,
                      float lo, float hi) {
+  OutputFiles files;
+  files.previewPng(path, width, height, plane, lo, hi);
+  files.commit();
+}
+
+void writeToneMappedPng(const std::string& path, int width, int height,
+                        const std::vector<std::vector<float>>& planes, double exposure) {
+  OutputFiles files;
+  files.toneMappedPng(path, width, height, planes, exposure);
+  files.commit();
+}
+
+void OutputFiles::previewPng(const std::string& path, int width, int height, const std::vector<float>& plane,
+                             float lo, float hi) {
   if (width <= 0 || height <= 0) {
     throw InvalidArgument("preview '" + path + "' is empty (" + std::to_string(width) + " x " +
                           std::to_string(height) + " pixels)");
@@ -252,12 +248,15 @@ void writePreviewPng(const std::string& path, int width, int height, const std::
     return static_cast<std::uint8_t>(std::clamp(g, 0.0, 255.0));
   };
 
-  writeAtomically<std::uint8_t>(path, width, height, {"Y"}, {},
+  requirePreviewWriter(path);
+  stage(path, [&](const std::string& file) {
+    writeOiioFile<std::uint8_t>(file, path, width, height, {"Y"}, {},
                                 [&](int y_begin, int y_end, std::uint8_t* rows) {
                                   const std::size_t begin = static_cast<std::size_t>(y_begin) * width;
                                   const std::size_t end = static_cast<std::size_t>(y_end) * width;
                                   for (std::size_t i = begin; i < end; ++i) rows[i - begin] = grey(plane[i]);
                                 });
+  });
 }
 
 std::pair<float, float> quantileRange(const std::vector<float>& plane, double lo_q, double hi_q) {
@@ -274,8 +273,8 @@ std::pair<float, float> quantileRange(const std::vector<float>& plane, double lo
   return {lo, hi};
 }
 
-void writeToneMappedPng(const std::string& path, int width, int height, const std::vector<std::vector<float>>& planes,
-                        double exposure) {
+void OutputFiles::toneMappedPng(const std::string& path, int width, int height,
+                                const std::vector<std::vector<float>>& planes, double exposure) {
   const std::size_t count = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   if (width <= 0 || height <= 0 || (planes.size() != 1 && planes.size() != 3))
     throw InvalidArgument("preview '" + path + "' needs one or three planes of a non-empty image");
@@ -308,17 +307,20 @@ void writeToneMappedPng(const std::string& path, int width, int height, const st
   const int channels = rgb ? 3 : 1;
   const std::vector<std::string> names =
       rgb ? std::vector<std::string>{"R", "G", "B"} : std::vector<std::string>{"Y"};
-  writeAtomically<std::uint8_t>(
-      path, width, height, names, {}, [&](int y_begin, int y_end, std::uint8_t* rows) {
-        const std::size_t begin = static_cast<std::size_t>(y_begin) * width;
-        const std::size_t end = static_cast<std::size_t>(y_end) * width;
-        for (std::size_t i = begin; i < end; ++i) {
-          for (int c = 0; c < channels; ++c) {
-            const double v = planes[c][i] * scale;
-            rows[(i - begin) * channels + c] = std::isfinite(v) ? encode(filmic(std::max(0.0, v))) : 0;
+  requirePreviewWriter(path);
+  stage(path, [&](const std::string& file) {
+    writeOiioFile<std::uint8_t>(
+        file, path, width, height, names, {}, [&](int y_begin, int y_end, std::uint8_t* rows) {
+          const std::size_t begin = static_cast<std::size_t>(y_begin) * width;
+          const std::size_t end = static_cast<std::size_t>(y_end) * width;
+          for (std::size_t i = begin; i < end; ++i) {
+            for (int c = 0; c < channels; ++c) {
+              const double v = planes[c][i] * scale;
+              rows[(i - begin) * channels + c] = std::isfinite(v) ? encode(filmic(std::max(0.0, v))) : 0;
+            }
           }
-        }
-      });
+        });
+  });
 }
 
 std::vector<std::string> directionChannelNames(const std::string& prefix, int count) {

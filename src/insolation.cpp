@@ -26,8 +26,9 @@ void validate(const InsolationOptions& o) {
     throw InvalidArgument("the span of time must run forward: from before to");
   if (!(o.step_minutes > 0.0 && o.step_minutes <= 1440.0))
     throw InvalidArgument("the step must be in (0, 1440] minutes (got " + std::to_string(o.step_minutes) + ")");
-  if (!(o.size_deg > 0.0 && o.size_deg <= 10.0))
-    throw InvalidArgument("the sun's size must be in (0, 10] degrees (got " + std::to_string(o.size_deg) + ")");
+  if (!(o.size_deg >= 0.0 && o.size_deg <= 10.0))
+    throw InvalidArgument("the sun's size must be in [0, 10] degrees (got " + std::to_string(o.size_deg) +
+                          ")");
   if (!(o.azimuth_bucket_deg > 0.0 && o.azimuth_bucket_deg <= 10.0))
     throw InvalidArgument("the azimuth bucket must be in (0, 10] degrees (got " +
                           std::to_string(o.azimuth_bucket_deg) + ")");
@@ -53,7 +54,9 @@ Insolation computeInsolation(const ComputeContext& context, const HeightField& f
   validate(field);
   validate(options);
   validate(sweep);
-  const double radius = 0.5 * options.size_deg * kDegree;
+  // A point sun (size 0) as a disc far below a float's resolution of the elevations, so that
+  // the kernel's disc_above never divides by 0.
+  const double radius = std::max(0.5 * options.size_deg * kDegree, 1e-12);
   // The steps with some of the disc above elevation 0, by azimuth bucket.
   std::map<long, std::vector<SunStep>> buckets;
   Insolation out;

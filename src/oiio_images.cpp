@@ -2,9 +2,14 @@
 // (oiio_images.hpp): reading channels as stored values, and writing rows to a file.
 #include "oiio_images.hpp"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <memory>
@@ -13,6 +18,7 @@
 #include <vector>
 
 #include "hfvis/errors.hpp"
+#include "output_files.hpp"
 
 namespace hfvis::detail {
 namespace {
@@ -239,6 +245,60 @@ bool canWrite(const std::string& path) {
   return false;
 }
 
+// The file an image is written to, through a descriptor whose every write, flush and close is
+// checked: OpenImageIO's own files drop the errors of a buffered write (a small EXR or PNG on a
+// full disk came out empty with no error), and a writer may ignore a short write.
+class CheckedFile final : public OIIO::Filesystem::IOProxy {
+ public:
+  explicit CheckedFile(const std::string& file) : IOProxy(file, Write) {
+    fd_ = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    if (fd_ < 0) error_ = errno;
+  }
+  ~CheckedFile() override { close(); }
+  CheckedFile(const CheckedFile&) = delete;
+  CheckedFile& operator=(const CheckedFile&) = delete;
+
+  const char* proxytype() const override { return "hfvis-checked-file"; }
+  bool opened() const override { return fd_ >= 0; }
+  size_t write(const void* buf, size_t size) override {
+    const size_t written = pwrite(buf, size, m_pos);
+    m_pos += static_cast<int64_t>(written);
+    return written;
+  }
+  size_t pwrite(const void* buf, size_t size, int64_t offset) override {
+    const char* bytes = static_cast<const char*>(buf);
+    size_t done = 0;
+    while (done < size && fd_ >= 0 && error_ == 0) {
+      const ssize_t n = ::pwrite(fd_, bytes + done, size - done, offset + static_cast<int64_t>(done));
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        error_ = n < 0 ? errno : ENOSPC;
+        break;
+      }
+      done += static_cast<size_t>(n);
+    }
+    return done;
+  }
+  size_t size() const override {
+    struct stat status {};
+    return fd_ >= 0 && ::fstat(fd_, &status) == 0 ? static_cast<size_t>(status.st_size) : 0;
+  }
+  // Flushed to the disk before it is closed: a delayed write error (NFS, a quota) shows here.
+  void close() override {
+    if (fd_ < 0) return;
+    if (::fsync(fd_) != 0 && error_ == 0) error_ = errno;
+    if (::close(fd_) != 0 && error_ == 0) error_ = errno;
+    fd_ = -1;
+    m_mode = Closed;
+  }
+  // The first failure's error number, 0 for none.
+  int failure() const { return error_; }
+
+ private:
+  int fd_ = -1;
+  int error_ = 0;
+};
+
 void write(const std::string& file, const std::string& path, int width, int height,
            const std::vector<std::string>& names, bool bytes,
            const std::vector<std::pair<std::string, std::string>>& attributes,
@@ -251,7 +311,16 @@ void write(const std::string& file, const std::string& path, int width, int heig
   for (const auto& [name, value] : attributes) spec.attribute(name, value);
   std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create(file);
   if (!out) throw IoError(path, withDetail("no image writer for this file", OIIO::geterror()));
-  if (!out->open(file, spec)) throw IoError(path, withDetail("cannot write the image", out->geterror()));
+  if (!out->supports("ioproxy"))
+    throw IoError(path, "this OpenImageIO cannot write the format through a checked file");
+  CheckedFile checked(file);
+  if (checked.failure()) throw IoError(path, "cannot create the file: " + writeFailure(checked.failure()));
+  // The system's reason for a failed write, where there is one, over the writer's own words.
+  const auto fail = [&](const std::string& what, const std::string& detail) {
+    if (checked.failure()) throw IoError(path, what + ": " + writeFailure(checked.failure()));
+    throw IoError(path, withDetail(what, detail));
+  };
+  if (!out->set_ioproxy(&checked) || !out->open(file, spec)) fail("cannot write the image", out->geterror());
   // Rows go out in chunks so a large many-channel image never needs a second full copy.
   const std::size_t row_values = static_cast<std::size_t>(width) * channels;
   const int rows_per_chunk =
@@ -264,10 +333,12 @@ void write(const std::string& file, const std::string& path, int width, int heig
     if (!out->write_scanlines(y, y_end, 0, spec.format, buffer.data())) {
       const std::string error = out->geterror();
       out->close();
-      throw IoError(path, withDetail("cannot write the image", error));
+      fail("cannot write the image", error);
     }
   }
-  if (!out->close()) throw IoError(path, withDetail("cannot finish writing the image", out->geterror()));
+  if (!out->close()) fail("cannot finish writing the image", out->geterror());
+  checked.close();
+  if (checked.failure()) fail("cannot finish writing the image", "");
 }
 
 }  // namespace

@@ -1,10 +1,16 @@
 // opencl_context.cpp: device discovery and selection, context creation, program cache.
 #include "opencl_context.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -41,7 +47,56 @@ struct FoundDevice {
   cl::Device device;
 };
 
+// Whether `path` is, or could be made (as PoCL would make it), a directory this user may
+// create files in. Made, not judged by permissions: the superuser passes every access check,
+// and still cannot create a directory in /proc or on a read-only file system.
+bool usableDirectory(const std::string& path) {
+  std::error_code error;
+  std::filesystem::create_directories(path, error);
+  return std::filesystem::is_directory(path, error) &&
+         ::faccessat(AT_FDCWD, path.c_str(), W_OK | X_OK, AT_EACCESS) == 0;
+}
+
+// PoCL (the CPU driver) compiles kernels into a cache directory: POCL_CACHE_DIR, else
+// $XDG_CACHE_HOME/pocl/kcache, else $HOME/.cache/pocl/kcache. Where that cannot be written it
+// reports no device at all (or aborts, for an empty POCL_CACHE_DIR), which reads as a missing
+// driver. So: a POCL_CACHE_DIR that cannot be used is an error that says so; a default one that
+// cannot be written (the user nobody, a read-only home) is replaced by a private directory of
+// this user's under $TMPDIR (or /tmp), kept between runs so kernels are compiled once.
+void preparePoclCache() {
+  const std::string fix =
+      ": PoCL, the CPU OpenCL driver, keeps its compiled kernels there; point it at a "
+      "writable directory or unset it";
+  if (const char* set = std::getenv("POCL_CACHE_DIR")) {
+    if (!*set) throw Error("POCL_CACHE_DIR is set but empty" + fix);
+    if (!usableDirectory(set))
+      throw Error(std::string("POCL_CACHE_DIR='") + set + "' is not a directory this user can write" + fix);
+    return;
+  }
+  const char* xdg = std::getenv("XDG_CACHE_HOME");
+  const char* home = std::getenv("HOME");
+  const std::string standard = xdg && *xdg == '/' ? std::string(xdg) + "/pocl/kcache"
+                               : home && *home    ? std::string(home) + "/.cache/pocl/kcache"
+                                                  : std::string();
+  if (!standard.empty() && usableDirectory(standard)) return;
+  const char* tmp = std::getenv("TMPDIR");
+  const std::string own =
+      std::string(tmp && *tmp == '/' ? tmp : "/tmp") + "/hfvis-pocl-cache-" + std::to_string(::geteuid());
+  ::mkdir(own.c_str(), 0700);
+  // Only a directory of this user's that nobody else can write: another user's directory (or a
+  // link to one) there could feed PoCL compiled kernels.
+  struct stat status {};
+  if (::lstat(own.c_str(), &status) != 0 || !S_ISDIR(status.st_mode) || status.st_uid != ::geteuid() ||
+      (status.st_mode & 0022) != 0)
+    throw Error("the OpenCL kernel cache cannot be written at '" + standard +
+                "' (HOME or XDG_CACHE_HOME) nor at '" + own +
+                "': set POCL_CACHE_DIR to a writable directory");
+  ::setenv("POCL_CACHE_DIR", own.c_str(), 1);
+}
+
 std::vector<FoundDevice> findDevices() {
+  static std::once_flag cache_once;
+  std::call_once(cache_once, preparePoclCache);
   std::vector<cl::Platform> platforms;
   try {
     cl::Platform::get(&platforms);

@@ -34,6 +34,7 @@ std::vector<float> unitNormals(const HeightField& field) {
 }  // namespace detail
 
 double discAboveHorizon(double above, double radius) {
+  if (radius <= 0.0) return above > 0.0 ? 1.0 : above < 0.0 ? 0.0 : 0.5;  // a point sun
   const double t = std::clamp(above / radius, -1.0, 1.0);
   return 1.0 - (std::acos(t) - t * std::sqrt(1.0 - t * t)) / M_PI;
 }
@@ -41,8 +42,9 @@ double discAboveHorizon(double above, double radius) {
 SunShading computeSunShading(const ComputeContext& context, const HeightField& field, const SunLight& sun,
                              const SweepOptions& options) {
   validate(field);
-  if (!(sun.size_deg > 0.0 && sun.size_deg <= 10.0))
-    throw InvalidArgument("the sun's size must be in (0, 10] degrees (got " + std::to_string(sun.size_deg) + ")");
+  if (!(sun.size_deg >= 0.0 && sun.size_deg <= 10.0))
+    throw InvalidArgument("the sun's size must be in [0, 10] degrees (got " + std::to_string(sun.size_deg) +
+                          ")");
   if (!std::isfinite(sun.position.azimuth_deg) || !(std::fabs(sun.position.elevation_deg) <= 90.0))
     throw InvalidArgument("the sun's azimuth must be finite and its elevation in -90 .. 90 degrees");
   constexpr double kDegree = M_PI / 180.0;
@@ -70,7 +72,9 @@ SunShading computeSunShading(const ComputeContext& context, const HeightField& f
   for (std::size_t p = 0; p < plane; ++p) {
     const float* n = &normals[4 * p];
     if (std::isnan(n[0])) continue;
-    const double seen = discAboveHorizon(elevation - horizons.angles[p], radius);
+    // Terrain beyond the field is taken as level, as computeInsolation takes it: a sun below
+    // elevation 0 lights nothing, not even a pixel whose own horizon lies lower.
+    const double seen = discAboveHorizon(elevation - std::max(0.0, double(horizons.angles[p])), radius);
     const double cosine = n[0] * s.x + n[1] * s.y + n[2] * s.z;
     out.sun[p] = static_cast<float>(seen);
     out.direct[p] = static_cast<float>(seen * std::max(0.0, cosine));

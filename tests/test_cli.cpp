@@ -3,6 +3,7 @@
 // after a failure.
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -10,12 +11,13 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <limits>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <optional>
 #include <random>
@@ -264,11 +266,12 @@ class Cli : public ::testing::Test {
   std::string in(const std::string& name) const { return (inputs() / name).string(); }
   std::string out(const std::string& name) const { return (outputs() / name).string(); }
 
-  // Runs `hfvis ARGS` (ARGS already shell-quoted where needed), capturing both streams.
-  CliResult run(const std::string& args) const {
+  // Runs `hfvis ARGS` (ARGS already shell-quoted where needed), capturing both streams; `prefix`
+  // goes before the program ("env NAME=VALUE").
+  CliResult run(const std::string& args, const std::string& prefix = "") const {
     const fs::path out_file = root_ / "stdout.txt";
     const fs::path err_file = root_ / "stderr.txt";
-    const std::string command = shellQuoted(HFVIS_CLI_PATH) + " " + args + " >" +
+    const std::string command = prefix + " " + shellQuoted(HFVIS_CLI_PATH) + " " + args + " >" +
                                 shellQuoted(out_file.string()) + " 2>" + shellQuoted(err_file.string()) +
                                 " </dev/null";
     const int raw = std::system(command.c_str());
@@ -1767,4 +1770,312 @@ TEST_F(Cli, ViewshedRefusesBadObservers) {
   expectFailure(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) + " --observers " +
                     shellQuoted(in("bad.csv"))),
                 1, "line 3");
+}
+
+// ---- issue 26: no data loss, no silent garbage ----
+
+namespace {
+
+// Starts `hfvis ARGS` as a child process (its output to files under the test's directory) and
+// returns its process id, so that a test can act while it runs.
+pid_t startCli(const fs::path& root, const std::vector<std::string>& args) {
+  const pid_t child = ::fork();
+  if (child == 0) {
+    std::freopen((root / "stdout.txt").c_str(), "w", stdout);
+    std::freopen((root / "stderr.txt").c_str(), "w", stderr);
+    std::vector<char*> argv{const_cast<char*>(HFVIS_CLI_PATH)};
+    for (const std::string& arg : args) argv.push_back(const_cast<char*>(arg.c_str()));
+    argv.push_back(nullptr);
+    ::execv(HFVIS_CLI_PATH, argv.data());
+    ::_exit(127);
+  }
+  return child;
+}
+
+// Waits until `directory` holds an entry whose name starts with `prefix` (a temporary file being
+// written), or the process has ended, or 60 s have passed. Whether it appeared.
+bool awaitEntry(const fs::path& directory, const std::string& prefix, pid_t process) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (std::chrono::steady_clock::now() < end) {
+    for (const std::string& name : listDirectory(directory))
+      if (name.rfind(prefix, 0) == 0) return true;
+    if (::waitpid(process, nullptr, WNOHANG) == process) return false;
+    ::usleep(200);
+  }
+  return false;
+}
+
+}  // namespace
+
+// Item 2: a later output that cannot be put in place (a directory appeared at its path while the
+// run computed) used to take the earlier output's new file away with the file it had replaced.
+// Every file that was there stays as it was.
+TEST_F(Cli, ALaterOutputThatFailsLeavesTheEarlierOnesAsTheyWere) {
+  const std::string field = writeField("busy.exr", 256, 256, [](int col, int row) {
+    return static_cast<float>(10.0 * std::sin(0.11 * col) * std::cos(0.07 * row));
+  });
+  { std::ofstream(out("h.tif")) << "previous horizons"; }
+  const pid_t hfvis = startCli(
+      root_, {"horizon", field, "-o", out("h.tif"), "--distance-out", out("d.tif"), "-k", "16", "-q"});
+  // Once h.tif's temporary file is being written, the run is past its first checks.
+  const bool staged = awaitEntry(outputs(), ".h.", hfvis);
+  fs::create_directory(out("d.tif"));
+  int status = 0;
+  ::waitpid(hfvis, &status, 0);
+  ASSERT_TRUE(staged) << "the run ended before writing its outputs: " << readText(root_ / "stderr.txt");
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 1) << "the directory came too late to test anything";
+  const std::string err = readText(root_ / "stderr.txt");
+  EXPECT_NE(err.find(out("d.tif")), std::string::npos) << err;
+  EXPECT_EQ(readText(out("h.tif")), "previous horizons");
+  std::vector<std::string> left = listDirectory(outputs());
+  std::sort(left.begin(), left.end());
+  EXPECT_EQ(left, (std::vector<std::string>{"d.tif", "h.tif"}));
+}
+
+// Item 6: renaming a new file over a write-protected one would bypass the protection (and leave
+// the file writable): it is refused before anything is computed, and stays as it was.
+TEST_F(Cli, AWriteProtectedOutputIsRefusedAndKept) {
+  { std::ofstream(out("prot.tif")) << "protected"; }
+  fs::permissions(out("prot.tif"), fs::perms::owner_read | fs::perms::group_read | fs::perms::others_read);
+  const CliResult result =
+      run("svf " + shellQuoted(ramp()) + " -o " + shellQuoted(out("prot.tif")) + " -k 4");
+  EXPECT_EQ(result.status, 1) << result.err;
+  EXPECT_NE(result.err.find("write-protected"), std::string::npos) << result.err;
+  EXPECT_EQ(readText(out("prot.tif")), "protected");
+  EXPECT_EQ(fs::status(out("prot.tif")).permissions() & fs::perms::all,
+            fs::perms::owner_read | fs::perms::group_read | fs::perms::others_read);
+  EXPECT_EQ(listDirectory(outputs()), std::vector<std::string>{"prot.tif"});
+}
+
+// Item 6: an output at a symbolic link replaces the file the link names; the link stays a link.
+TEST_F(Cli, AnOutputAtASymbolicLinkReplacesWhatItNames) {
+  fs::create_directories(outputs() / "store");
+  { std::ofstream(out("store/svf.exr")) << "old"; }
+  fs::create_symlink("store/svf.exr", out("svf.exr"));
+  const CliResult result =
+      run("svf " + shellQuoted(flat()) + " -o " + shellQuoted(out("svf.exr")) + " -k 4 -q");
+  ASSERT_EQ(result.status, 0) << result.err;
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(out("svf.exr"))));
+  const ReadBack image = readBack(out("store/svf.exr"));
+  EXPECT_EQ(image.channels, std::vector<std::string>{"svf"});
+}
+
+// Item 7: SIGINT, SIGTERM and SIGHUP during the write phase leave no temporary file behind, and
+// the earlier result stays.
+TEST_F(Cli, AnInterruptedRunLeavesNoTemporaryFiles) {
+  const std::string field = writeField("busy.exr", 256, 256, [](int col, int row) {
+    return static_cast<float>(10.0 * std::sin(0.11 * col) * std::cos(0.07 * row));
+  });
+  for (const int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
+    SCOPED_TRACE(signal_number);
+    { std::ofstream(out("h.exr")) << "previous horizons"; }
+    const pid_t hfvis = startCli(
+        root_, {"horizon", field, "-o", out("h.exr"), "--distance-out", out("d.exr"), "-k", "16", "-q"});
+    const bool staged = awaitEntry(outputs(), ".h.", hfvis);
+    ::kill(hfvis, signal_number);
+    int status = 0;
+    ::waitpid(hfvis, &status, 0);
+    ASSERT_TRUE(staged) << "the run ended before writing its outputs: " << readText(root_ / "stderr.txt");
+    EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == signal_number) << "status " << status;
+    EXPECT_EQ(listDirectory(outputs()), std::vector<std::string>{"h.exr"});
+    EXPECT_EQ(readText(out("h.exr")), "previous horizons");
+  }
+}
+
+// Item 11: a device, FIFO or directory given as a file is refused at once, with what it is
+// (/dev/zero was read forever; a FIFO would block the open).
+TEST_F(Cli, NonRegularFilesAreRefusedAtOnce) {
+  const std::string fifo = in("pipe.exr");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::string field = flat();
+  const std::string o = " -o " + shellQuoted(out("o.tif"));
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {"svf /dev/zero" + o + " -k 4", "character device"},
+      {"svf " + shellQuoted(fifo) + o + " -k 4", "FIFO"},
+      {"svf " + shellQuoted(inputs().string()) + o, "directory"},
+      {"svf /dev/null" + o, "character device"},
+      {"viewshed " + shellQuoted(field) + o + " --observers /dev/zero", "character device"},
+      {"shade " + shellQuoted(field) + o + " --env /dev/zero", "character device"},
+      {"shade " + shellQuoted(field) + o + " --sun 180,30 --albedo " + shellQuoted(fifo), "FIFO"},
+      {"bounce " + shellQuoted(field) + o + " --radiance /dev/zero", "character device"},
+  };
+  for (const auto& [args, named] : cases) {
+    SCOPED_TRACE(args);
+    const auto start = std::chrono::steady_clock::now();
+    const CliResult result = run(args);
+    EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(30));
+    expectFailure(result, 1, named);
+  }
+}
+
+// Item 4: data outputs are float32 (EXR or GeoTIFF); an 8-bit format would clip negative angles
+// to 0 and saturate counts at 255 without a word.
+TEST_F(Cli, DataOutputsAreNeverEightBitImages) {
+  for (const char* name : {"o.png", "o.jpg", "o.bmp", "o.PNG"}) {
+    SCOPED_TRACE(name);
+    const CliResult result =
+        run("horizon " + shellQuoted(ramp()) + " -o " + shellQuoted(out(name)) + " -k 4");
+    expectFailure(result, 1, "--preview");
+  }
+}
+
+// Item 8: a --nodata value the output can hold as data (a viewshed's hidden 0 or visible 1, an
+// svf of 1) is refused: readers would take those cells for nodata.
+TEST_F(CliGeoTiff, NodataThatTheDataCanHoldIsRefused) {
+  const std::string tif = geoTiffInput();
+  for (const char* args :
+       {"viewshed --observer 5,5 --nodata 0", "viewshed --observer 5,5 --nodata 1", "svf -k 4 --nodata 1",
+        "horizon -k 4 --nodata -1", "viewshed --observer 5,5 --angle --nodata -45"}) {
+    SCOPED_TRACE(args);
+    const std::string command(args);
+    const std::size_t space = command.find(' ');
+    const CliResult result = run(command.substr(0, space) + " " + shellQuoted(tif) + " -o " +
+                                 shellQuoted(out("o.tif")) + command.substr(space));
+    expectFailure(result, 2, "--nodata");
+  }
+  const CliResult fine = run("viewshed " + shellQuoted(tif) + " -o " + shellQuoted(out("v.tif")) +
+                             " --observer 5,5 --nodata -1 -q");
+  ASSERT_EQ(fine.status, 0) << fine.err;
+  const hfvis::testing::GdalRaster raster = hfvis::testing::readGdalRaster(out("v.tif"));
+  ASSERT_TRUE(raster.nodata[0].has_value());
+  EXPECT_EQ(*raster.nodata[0], -1.0);
+  for (float v : raster.bands[0]) EXPECT_TRUE(v == 0.0f || v == 1.0f || v == -1.0f) << v;
+}
+
+// Item 9: numbers the single-precision kernels cannot hold are refused instead of giving NaN,
+// infinite or meaningless results with exit status 0; messages never print 300 digits.
+TEST_F(Cli, NumbersBeyondWhatTheMethodHoldsAreRefused) {
+  const std::string field = flat();
+  const std::string o = " -o " + shellQuoted(out("o.exr"));
+  for (const std::string& args :
+       {"svf " + shellQuoted(field) + o + " --azimuth-offset 1e20",
+        "svf " + shellQuoted(field) + o + " --cell-size 1e-300",
+        "svf " + shellQuoted(field) + o + " --cell-size 1e300",
+        "viewcount " + shellQuoted(field) + o + " --cell-size 1e18",
+        "shade " + shellQuoted(field) + o + " --sun 180,30 --sun-irradiance 1e300",
+        "viewshed " + shellQuoted(field) + o + " --observer 1,1 --observer-height 1e300",
+        "svf " + shellQuoted(field) + o + " --max-distance 1e300",
+        "svf " + shellQuoted(field) + o + " --z-scale 1e-300",
+        "horizon " + shellQuoted(field) + o + " --azimuth-tolerance 5.73"}) {
+    SCOPED_TRACE(args);
+    const CliResult result = run(args);
+    expectFailure(result, 2, "must be in");
+    EXPECT_LT(result.err.size(), 400u) << result.err;
+  }
+  // The environment's rotation, whose every value has an equal one within a turn.
+  const CliResult rotated =
+      run("shade " + shellQuoted(field) + o + " --env " + shellQuoted(field) + " --env-rotate 1e308");
+  expectFailure(rotated, 2, "--env-rotate");
+  // The largest tolerance the help gives is accepted.
+  const CliResult widest = run("horizon " + shellQuoted(field) + o + " -k 4 -q --azimuth-tolerance 5.72958");
+  EXPECT_EQ(widest.status, 0) << widest.err;
+}
+
+// Items 10 and 13: shade agrees with insolation that a sun below elevation 0 lights nothing, and
+// takes a point sun (--sun-size 0: hard shadows).
+TEST_F(Cli, ShadeWithTheSunDownOrAPointSun) {
+  const std::string field = flat();
+  const CliResult down =
+      run("shade " + shellQuoted(field) + " -o " + shellQuoted(out("down.exr")) + " --sun 180,-30 -q");
+  ASSERT_EQ(down.status, 0) << down.err;
+  for (float v : readBack(out("down.exr")).pixels) EXPECT_EQ(v, 0.0f);
+  // At midnight at 45 N in June the sun is 21 degrees down: no pixel sees it, not even at the border.
+  const CliResult night = run("shade " + shellQuoted(ramp()) + " -o " + shellQuoted(out("night.exr")) +
+                              " --at 2026-06-21T00:00:00Z --lat 45 --lon 7 -q");
+  ASSERT_EQ(night.status, 0) << night.err;
+  for (float v : readBack(out("night.exr")).pixels) EXPECT_EQ(v, 0.0f);
+  const CliResult point = run("shade " + shellQuoted(field) + " -o " + shellQuoted(out("point.exr")) +
+                              " --sun 200,30 --sun-size 0 -q");
+  ASSERT_EQ(point.status, 0) << point.err;
+  const ReadBack p = readBack(out("point.exr"));
+  for (int y = 0; y < p.height; ++y)
+    for (int x = 0; x < p.width; ++x) EXPECT_EQ(p.at(x, y, 1), 1.0f);
+  EXPECT_EQ(p.spec.get_string_attribute("hfvis:sun_size_deg"), "0");
+}
+
+// Item 5: where PoCL's kernel cache cannot be written (the user nobody, a read-only home), hfvis
+// uses a private one instead of reporting no OpenCL device; a POCL_CACHE_DIR that cannot be used
+// is named as the problem, instead of PoCL's assertion (exit 134) or a failed build.
+TEST_F(Cli, AnUnwritableKernelCacheIsNotAMissingDriver) {
+  const std::string field = flat();
+  // /proc takes no new directories, even from the superuser.
+  const CliResult homeless =
+      run("svf " + shellQuoted(field) + " -o " + shellQuoted(out("o.exr")) + " -k 4 -q",
+          "env -u POCL_CACHE_DIR HOME=/proc/hfvis-no-home XDG_CACHE_HOME=");
+  EXPECT_EQ(homeless.status, 0) << homeless.err;
+  const std::string file = in("not_a_directory");
+  { std::ofstream(file) << "x"; }
+  for (const std::string& setting : {std::string("POCL_CACHE_DIR="), "POCL_CACHE_DIR=" + shellQuoted(file),
+                                     std::string("POCL_CACHE_DIR=/proc/hfvis-cache")}) {
+    SCOPED_TRACE(setting);
+    for (const std::string& args :
+         {"svf " + shellQuoted(field) + " -o " + shellQuoted(out("p.exr")) + " -k 4",
+          std::string("devices")}) {
+      const CliResult result = run(args, "env " + setting);
+      EXPECT_EQ(result.status, 1) << result.err;
+      EXPECT_NE(result.err.find("POCL_CACHE_DIR"), std::string::npos) << result.err;
+    }
+  }
+  EXPECT_FALSE(fs::exists(out("p.exr")));
+}
+
+// Item 3: a raster whose columns run east to west (negative pixel width), or whose rows run south
+// to north, or both (an ESRI grid with a negative cell size), is lit and looked at as it lies:
+// each gives, cell for cell, what the same ground stored north-up gives.
+TEST_F(CliGeoTiff, EveryFlipOfTheGridIsLitAsItLies) {
+  const int w = kWidth, h = kHeight;
+  std::vector<float> north_up;
+  for (int row = 0; row < h; ++row)
+    for (int col = 0; col < w; ++col) north_up.push_back(height(col, row));
+  const double west = 500000.0, east = west + 30.0 * w, north = 4100000.0, south = north - 30.0 * h;
+  struct Layout {
+    const char* name;
+    bool mirror_columns, mirror_rows;
+    std::array<double, 6> transform;
+  };
+  const std::vector<Layout> layouts{{"north_up", false, false, {west, 30.0, 0.0, north, 0.0, -30.0}},
+                                    {"west_up", true, false, {east, -30.0, 0.0, north, 0.0, -30.0}},
+                                    {"south_up", false, true, {west, 30.0, 0.0, south, 0.0, 30.0}},
+                                    {"upside_down", true, true, {east, -30.0, 0.0, south, 0.0, 30.0}}};
+  const auto stored = [&](const Layout& l, int col, int row) {
+    return (l.mirror_rows ? h - 1 - row : row) * w + (l.mirror_columns ? w - 1 - col : col);
+  };
+  std::map<std::string, std::vector<std::vector<float>>> results;  // per layout, per run, north-up order
+  for (const Layout& l : layouts) {
+    SCOPED_TRACE(l.name);
+    std::vector<float> values(north_up.size());
+    for (int row = 0; row < h; ++row)
+      for (int col = 0; col < w; ++col) values[stored(l, col, row)] = north_up[row * w + col];
+    const std::string tif = in(std::string(l.name) + ".tif");
+    hfvis::testing::writeGdalGeoTiff(tif, w, h, values, l.transform, "EPSG:32633", std::nullopt);
+    // The observer on the same ground cell (column 5, row 7 north-up).
+    const int col = l.mirror_columns ? w - 1 - 5 : 5, row = l.mirror_rows ? h - 1 - 7 : 7;
+    for (const std::string& args :
+         {std::string("shade --sun 135,20"),
+          std::string("insolation --lat 45 --lon 7 --from 2026-06-21T04:00:00Z "
+                      "--to 2026-06-21T10:00:00Z --step 60"),
+          "viewshed --fov 0,90 --observer " + std::to_string(col) + "," + std::to_string(row)}) {
+      const std::size_t space = args.find(' ');
+      const CliResult result =
+          run(args.substr(0, space) + " " + shellQuoted(tif) + " -o " +
+              shellQuoted(out(std::string(l.name) + ".tif")) + args.substr(space) + " -q");
+      ASSERT_EQ(result.status, 0) << args << ": " << result.err;
+      const hfvis::testing::GdalRaster raster =
+          hfvis::testing::readGdalRaster(out(std::string(l.name) + ".tif"));
+      for (const std::vector<float>& band : raster.bands) {
+        std::vector<float> ordered(band.size());
+        for (int r = 0; r < h; ++r)
+          for (int c = 0; c < w; ++c) ordered[r * w + c] = band[stored(l, c, r)];
+        results[l.name].push_back(ordered);
+      }
+    }
+  }
+  for (const Layout& l : layouts) {
+    ASSERT_EQ(results[l.name].size(), results["north_up"].size()) << l.name;
+    for (std::size_t i = 0; i < results[l.name].size(); ++i)
+      for (std::size_t p = 0; p < results[l.name][i].size(); ++p)
+        EXPECT_NEAR(results[l.name][i][p], results["north_up"][i][p], 1e-4)
+            << l.name << ", band " << i << ", column " << p % w << ", row " << p / w;
+  }
 }

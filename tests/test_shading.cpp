@@ -91,10 +91,52 @@ TEST(SunShading, AWallsShadowAndItsSoftEdge) {
   for (int c = 0; c < wall; ++c) EXPECT_EQ(s.sun[4 * w + c], 1.0f) << "column " << c;
 }
 
+// Issue 26, item 13: a point sun (size 0) is a legitimate request: hard shadows, every pixel
+// wholly lit or wholly in shadow, as the wall's top stands below or above the sun.
+TEST(SunShading, APointSunCastsHardShadows) {
+  const int w = 80, h = 9, wall = 20;
+  std::vector<float> heights(w * h, 0.0f);
+  for (int r = 0; r < h; ++r) heights[r * w + wall] = 10.0f;
+  HeightField field = fieldFrom(w, h, heights);
+  SunLight sun;
+  sun.position = {270.0, 20.0};
+  sun.size_deg = 0.0;
+  const SunShading s = computeSunShading(testContext(), field, sun);
+  for (int c = wall + 1; c < w; ++c) {
+    const double top = std::atan(10.0 / (c - wall));
+    if (std::fabs(top - 20.0 * kDegree) < 1e-3) continue;  // the shadow's edge itself
+    EXPECT_EQ(s.sun[4 * w + c], top > 20.0 * kDegree ? 0.0f : 1.0f) << "column " << c;
+  }
+  EXPECT_DOUBLE_EQ(discAboveHorizon(1e-9, 0.0), 1.0);
+  EXPECT_DOUBLE_EQ(discAboveHorizon(-1e-9, 0.0), 0.0);
+}
+
+// Issue 26, item 10: a sun below the astronomical horizon lights nothing, as in computeInsolation
+// (terrain beyond the field is level): not flat ground, not a border pixel whose rays leave the
+// field, not a peak whose own horizon lies lower.
+TEST(SunShading, ASunBelowElevationZeroLightsNothing) {
+  std::vector<float> heights(15 * 15, 0.0f);
+  for (int r = 0; r < 15; ++r)
+    for (int c = 0; c < 15; ++c) heights[r * 15 + c] = 20.0f - 2.0f * std::hypot(c - 7.0, r - 7.0);  // a cone
+  for (const HeightField& field : {makeSyntheticField("flat", 12, 10), fieldFrom(15, 15, heights)}) {
+    for (const double elevation : {-30.0, -1.0}) {
+      SunLight sun;
+      sun.position = {180.0, elevation};
+      const SunShading s = computeSunShading(testContext(), field, sun);
+      for (std::size_t p = 0; p < s.sun.size(); ++p) {
+        EXPECT_EQ(s.sun[p], 0.0f) << "pixel " << p << ", sun at " << elevation << " degrees";
+        EXPECT_EQ(s.direct[p], 0.0f) << "pixel " << p;
+      }
+    }
+  }
+}
+
 TEST(SunShading, RefusesBadSuns) {
   const HeightField flat = makeSyntheticField("flat", 5, 5);
   SunLight sun;
-  sun.size_deg = 0.0;
+  sun.size_deg = -0.1;
+  EXPECT_THROW(computeSunShading(testContext(), flat, sun), InvalidArgument);
+  sun.size_deg = 10.5;
   EXPECT_THROW(computeSunShading(testContext(), flat, sun), InvalidArgument);
   sun.size_deg = 0.53;
   sun.position.elevation_deg = 91.0;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <string>
 #include <utility>
@@ -71,8 +72,64 @@ bool writesGeoTiff(const std::string& path);
 // to refuse an output before computing it.
 void requireImageWriter(const std::string& path);
 
-// Writes `image` atomically: to a temporary file beside `path`, renamed into place only when
-// complete (a failure leaves nothing behind and an existing `path` as it was).
+// Throws IoError naming `path` when hfvis must not write an output there, before anything is
+// computed: its directory is missing or takes no new files for this user, or a file is there that
+// is a directory or not a regular file, or that is protected: one the effective user may not
+// write (access(2) with AT_EACCESS), one with no write permission for anybody (mode 0444; the
+// superuser may write anything, so the mode bits are the owner's statement), or one marked
+// immutable or append-only (chattr +i, +a). Replacing a file by renaming a new one over it
+// would otherwise bypass every one of these. A symbolic link at `path` is followed: what it
+// names is checked (and replaced; the link stays).
+void requireReplaceable(const std::string& path);
+
+// Outputs written all together or not at all. Each is written whole to a temporary file beside
+// its target (the file a symbolic link names, for a link), every write, the flush to the disk
+// and the close checked; commit() then checks every target again (requireReplaceable) and
+// renames each file into place, keeping the mode of the file it replaces. When a rename fails,
+// the files already renamed are put back as they were (the previous files restored, new ones
+// removed), so a failure leaves every file that existed before exactly as it was. Whatever is
+// not committed is removed by the destructor, and by SIGINT, SIGTERM or SIGHUP where
+// removeTemporaryOutputsOnSignals() is in force (a signal during commit() waits for its end).
+class OutputFiles {
+ public:
+  OutputFiles() = default;
+  OutputFiles(const OutputFiles&) = delete;
+  OutputFiles& operator=(const OutputFiles&) = delete;
+  ~OutputFiles();
+
+  // What writeImage, writePreviewPng, writeToneMappedPng write, staged; text: the bytes as
+  // they are. Each throws as those do (and InvalidArgument for a file staged twice).
+  void image(const std::string& path, const ImageChannels& image);
+  void previewPng(const std::string& path, int width, int height, const std::vector<float>& plane,
+                  float lo = 0.0f, float hi = 0.0f);
+  void toneMappedPng(const std::string& path, int width, int height,
+                     const std::vector<std::vector<float>>& planes, double exposure = 0.0);
+  void text(const std::string& path, const std::string& text);
+
+  // The paths staged so far, in order.
+  std::vector<std::string> paths() const;
+  // Moves every staged file into place, or none (see above); throws IoError naming the output
+  // that could not be.
+  void commit();
+
+ private:
+  struct Entry {
+    std::string path, target, temp;
+  };
+  // Stages `path`: write(temp) writes the file's contents to the temporary path.
+  void stage(const std::string& path, const std::function<void(const std::string&)>& write);
+  void discard() noexcept;
+  std::vector<Entry> entries_;
+};
+
+// Installs handlers of SIGINT, SIGTERM and SIGHUP (those not ignored, so nohup keeps working)
+// that remove the temporary files of unfinished outputs, then end the process of the same
+// signal as before. For programs (the hfvis CLI installs them); a library never sets handlers.
+void removeTemporaryOutputsOnSignals();
+
+// Writes `image` as a single OutputFiles output: to a temporary file beside `path`, renamed
+// into place only when complete (a failure leaves nothing behind and an existing `path` as it
+// was; a protected `path` is refused, as requireReplaceable).
 // - .tif/.tiff: a GeoTIFF through GDAL: one float32 band per channel, its description the
 //   channel's name; the georeference's geotransform and CRS where it has them; every band's
 //   nodata value `image.nodata`, written into the NaN cells; DEFLATE with the floating-point

@@ -22,7 +22,7 @@ namespace hfvis {
 
 struct SunLight {
   SunPosition position;   // compass azimuth and elevation, degrees
-  double size_deg = 0.53;  // the disc's angular diameter, degrees, > 0 and <= 10
+  double size_deg = 0.53;  // the disc's angular diameter, degrees, 0 (a point: hard shadows) to 10
 };
 
 struct SunShading {
@@ -35,13 +35,15 @@ struct SunShading {
 
 // The fraction of a disc of angular radius `radius` whose centre stands `above` (radians)
 // above a straight horizon line: 1 - (acos(t) - t sqrt(1 - t^2)) / pi, t = above / radius
-// clamped to [-1, 1].
+// clamped to [-1, 1]. A point sun (radius 0): 1 above, 0 below, 1/2 on the line.
 double discAboveHorizon(double above, double radius);
 
 // Sweeps the sun's azimuth over `field` (options: samples_per_unit, curvature, max_distance,
 // memory budget and progress; directions and azimuth_offset are set by the sun). Normals are
-// those of ambient occlusion (each row's cell sizes on latitude / longitude grids). Throws
-// InvalidArgument for a bad field, options or sun (size outside (0, 10] degrees, a non-finite
+// those of ambient occlusion (each row's cell sizes on latitude / longitude grids). The disc is
+// seen above the pixel's horizon and above elevation 0 (terrain beyond the field taken as level,
+// as computeInsolation takes it), so a sun below the astronomical horizon lights nothing. Throws
+// InvalidArgument for a bad field, options or sun (size outside [0, 10] degrees, a non-finite
 // position), and what computeHorizons throws.
 SunShading computeSunShading(const ComputeContext& context, const HeightField& field, const SunLight& sun,
                              const SweepOptions& options = {});

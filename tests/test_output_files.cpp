@@ -1,0 +1,253 @@
+// test_output_files.cpp: writing outputs safely (hfvis::OutputFiles and the writers built on it):
+// a full disk, write-protected and immutable targets, symbolic links, several outputs committed
+// all together or not at all, and the temporary files a signal leaves.
+#include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "hfvis/errors.hpp"
+#include "hfvis/image_io.hpp"
+
+namespace hfvis {
+namespace {
+
+namespace fs = std::filesystem;
+
+class OutputFilesTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::path(HFVIS_TEST_TMP_DIR) / "output_files" /
+           (std::string(info->name()) + "_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    if (!HasFailure()) fs::remove_all(dir_);
+  }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  std::vector<std::string> filesInDir() const {
+    std::vector<std::string> names;
+    for (const auto& entry : fs::directory_iterator(dir_)) names.push_back(entry.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+  }
+  static std::string readText(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  void writeText(const std::string& name, const std::string& text) const {
+    std::ofstream(path(name), std::ios::binary) << text;
+  }
+  fs::path dir_;
+};
+
+// A one-channel image of noise (it does not compress): 16 x 16 floats, about 1 KB as an EXR,
+// far below a stdio buffer, so that a writer that buffers writes sees their failure only at close.
+ImageChannels noiseImage(int size = 16) {
+  std::mt19937 random(7);
+  std::uniform_real_distribution<float> uniform(0.0f, 100.0f);
+  ImageChannels image;
+  image.width = image.height = size;
+  image.names = {"Y"};
+  image.planes.emplace_back();
+  for (int i = 0; i < size * size; ++i) image.planes[0].push_back(uniform(random));
+  return image;
+}
+
+// The writes AFullDiskIsAnErrorAndKeepsThePreviousFile makes under a file size limit, in a
+// fresh process (a fork of this one would inherit OpenEXR's and GDAL's thread pools without their
+// threads, and hang): the test program, started with HFVIS_TEST_WRITE=KIND:PATH, writes one
+// output before main() and exits 0 (written), 1 (an IoError naming the size limit) or 2.
+[[maybe_unused]] const bool kWriteJobDone = [] {
+  const char* job = std::getenv("HFVIS_TEST_WRITE");
+  if (!job) return false;
+  const std::string spec(job), kind = spec.substr(0, spec.find(':')), path = spec.substr(spec.find(':') + 1);
+  try {
+    const ImageChannels image = noiseImage();
+    if (kind == "png") {
+      writePreviewPng(path, image.width, image.height, image.planes[0]);
+    } else if (kind == "text") {
+      OutputFiles files;
+      files.text(path, std::string(5000, 'x'));
+      files.commit();
+    } else {
+      writeImage(path, image);
+    }
+  } catch (const IoError& error) {
+    std::fprintf(stderr, "%s\n", error.what());
+    ::_exit(std::string(error.what()).find("file size limit") != std::string::npos ? 1 : 2);
+  } catch (...) {
+    ::_exit(2);
+  }
+  ::_exit(0);
+}();
+
+// Writes `path` as `kind` (exr, png, tif, text) in a child process whose files may not grow
+// beyond `limit` bytes (RLIMIT_FSIZE, as `ulimit -f`; SIGXFSZ ignored, as the CLI does, so a write
+// past it fails with EFBIG as one on a full disk does). Returns the child's exit status.
+int writeUnderFileSizeLimit(const std::string& kind, const std::string& path, rlim_t limit) {
+  const pid_t child = ::fork();
+  if (child == 0) {
+    std::signal(SIGXFSZ, SIG_IGN);
+    const rlimit small{limit, limit};
+    ::setenv("HFVIS_TEST_WRITE", (kind + ":" + path).c_str(), 1);
+    if (::setrlimit(RLIMIT_FSIZE, &small) == 0)
+      ::execl("/proc/self/exe", "hfvis_tests", "--gtest_list_tests", nullptr);
+    ::_exit(3);
+  }
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// Issue 26, item 1: on a full disk a small EXR or PNG came out empty, "written", replacing the
+// previous file: the writers dropped the error of the buffered write, reported only at close.
+TEST_F(OutputFilesTest, AFullDiskIsAnErrorAndKeepsThePreviousFile) {
+  // Text outputs (the horizon lists) too.
+  for (const std::string kind : {"exr", "png", "tif", "text"}) {
+    SCOPED_TRACE(kind);
+    const std::string name = "small." + kind;
+    writeText(name, "the previous result");
+    EXPECT_EQ(writeUnderFileSizeLimit(kind, path(name), 200), 1)
+        << "0: reported success; 2: another error than the size limit";
+    EXPECT_EQ(readText(path(name)), "the previous result");
+    EXPECT_EQ(filesInDir(), std::vector<std::string>{name}) << "a temporary file was left";
+    fs::remove(path(name));
+  }
+}
+
+// Issue 26, item 6: a rename over a file bypasses its write protection, so protection is
+// checked: a file nobody may write (mode 0444, which the superuser's access(2) would allow) is
+// refused, and stays as it was.
+TEST_F(OutputFilesTest, AWriteProtectedFileIsRefused) {
+  writeText("prot.exr", "protected");
+  fs::permissions(path("prot.exr"), fs::perms::owner_read | fs::perms::group_read | fs::perms::others_read);
+  try {
+    writeImage(path("prot.exr"), noiseImage());
+    ADD_FAILURE() << "a write-protected file was replaced";
+  } catch (const IoError& error) {
+    EXPECT_EQ(error.path(), path("prot.exr"));
+    EXPECT_NE(error.reason().find("write-protected (mode 0444)"), std::string::npos) << error.what();
+  }
+  EXPECT_EQ(readText(path("prot.exr")), "protected");
+  EXPECT_EQ(fs::status(path("prot.exr")).permissions() & fs::perms::all,
+            fs::perms::owner_read | fs::perms::group_read | fs::perms::others_read);
+  EXPECT_THROW(requireReplaceable(path("prot.exr")), IoError);
+  EXPECT_EQ(filesInDir(), std::vector<std::string>{"prot.exr"});
+}
+
+// An immutable file (chattr +i) cannot be replaced by anyone; it is refused before anything is
+// written. Setting the attribute needs CAP_LINUX_IMMUTABLE and a file system that keeps it, which
+// a container may lack: the test says so and is skipped then.
+TEST_F(OutputFilesTest, AnImmutableFileIsRefused) {
+  writeText("fixed.exr", "immutable");
+  if (std::system(("chattr +i '" + path("fixed.exr") + "' 2>/dev/null").c_str()) != 0)
+    GTEST_SKIP()
+        << "chattr +i is not possible here (needs CAP_LINUX_IMMUTABLE on a file system with the attribute)";
+  bool refused = false;
+  try {
+    writeImage(path("fixed.exr"), noiseImage());
+  } catch (const IoError& error) {
+    refused = std::string(error.what()).find("immutable") != std::string::npos;
+    EXPECT_TRUE(refused) << error.what();
+  }
+  std::system(("chattr -i '" + path("fixed.exr") + "'").c_str());
+  EXPECT_TRUE(refused);
+  EXPECT_EQ(readText(path("fixed.exr")), "immutable");
+  EXPECT_EQ(filesInDir(), std::vector<std::string>{"fixed.exr"});
+}
+
+// Issue 26, item 6: an output at a symbolic link replaces what the link names (in that file's
+// directory) and keeps the link; the replaced file's permissions stay.
+TEST_F(OutputFilesTest, ASymbolicLinkIsWrittenThrough) {
+  fs::create_directories(dir_ / "data");
+  writeText("data/real.exr", "old");
+  fs::permissions(path("data/real.exr"), fs::perms::owner_read | fs::perms::owner_write);
+  fs::create_symlink("data/real.exr", dir_ / "link.exr");
+  const ImageChannels image = noiseImage();
+  writeImage(path("link.exr"), image);
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(dir_ / "link.exr")));
+  EXPECT_EQ(readHeightField(path("data/real.exr")).heights, image.planes[0]);
+  EXPECT_EQ(fs::status(path("data/real.exr")).permissions() & fs::perms::all,
+            fs::perms::owner_read | fs::perms::owner_write);
+  EXPECT_EQ(filesInDir(), (std::vector<std::string>{"data", "link.exr"}));
+  // A dangling link: the file it names is created.
+  fs::create_symlink("data/new.exr", dir_ / "dangling.exr");
+  writeImage(path("dangling.exr"), image);
+  EXPECT_EQ(readHeightField(path("data/new.exr")).heights, image.planes[0]);
+}
+
+// Outputs appear together or not at all: a later output that cannot be written leaves the earlier
+// ones' previous files as they were (and removes every temporary file).
+TEST_F(OutputFilesTest, AFailedOutputLeavesEveryPreviousFile) {
+  writeText("a.exr", "previous a");
+  writeText("b.tif", "previous b");
+  fs::create_directories(dir_ / "c.png");  // a directory where the preview should go
+  const ImageChannels image = noiseImage();
+  {
+    OutputFiles files;
+    files.image(path("a.exr"), image);
+    files.image(path("b.tif"), image);
+    EXPECT_THROW(files.previewPng(path("c.png"), image.width, image.height, image.planes[0]), IoError);
+  }
+  EXPECT_EQ(readText(path("a.exr")), "previous a");
+  EXPECT_EQ(readText(path("b.tif")), "previous b");
+  EXPECT_EQ(filesInDir(), (std::vector<std::string>{"a.exr", "b.tif", "c.png"}));
+
+  // A target that changes between staging and commit is checked again there: a directory now
+  // at the second output stops the commit before the first file is replaced.
+  {
+    OutputFiles files;
+    files.image(path("a.exr"), image);
+    files.image(path("d.exr"), image);
+    fs::create_directories(dir_ / "d.exr");
+    EXPECT_THROW(files.commit(), IoError);
+  }
+  EXPECT_EQ(readText(path("a.exr")), "previous a");
+  EXPECT_EQ(filesInDir(), (std::vector<std::string>{"a.exr", "b.tif", "c.png", "d.exr"}));
+  EXPECT_TRUE(fs::is_directory(dir_ / "d.exr"));
+
+  // The same file twice would replace the first output with the second.
+  OutputFiles twice;
+  twice.image(path("e.exr"), image);
+  EXPECT_THROW(twice.image(path("./e.exr"), image), InvalidArgument);
+}
+
+// Issue 26, item 7: SIGINT, SIGTERM and SIGHUP remove the temporary files of unfinished outputs
+// (removeTemporaryOutputsOnSignals), and the process still ends of the signal.
+TEST_F(OutputFilesTest, SignalsRemoveTemporaryFiles) {
+  for (const int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
+    SCOPED_TRACE(signal_number);
+    const pid_t child = ::fork();
+    if (child == 0) {
+      std::signal(signal_number, SIG_DFL);
+      removeTemporaryOutputsOnSignals();
+      OutputFiles files;  // (text: no image library's threads in a forked process)
+      files.text(path("staged.json"), "{}");
+      ::raise(signal_number);  // between staging and commit, as a user's Ctrl-C
+      ::_exit(0);
+    }
+    int status = 0;
+    ::waitpid(child, &status, 0);
+    EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == signal_number) << "status " << status;
+    EXPECT_EQ(filesInDir(), std::vector<std::string>{});
+  }
+}
+
+}  // namespace
+}  // namespace hfvis
