@@ -17,7 +17,6 @@ double snap(double v) { return std::abs(v) < 1e-12 ? 0.0 : v; }
 
 struct Ray {
   double dx, dy;  // one pixel length along the ray, in pixel axes
-  double weight;
 };
 
 }  // namespace
@@ -34,8 +33,16 @@ std::vector<DenseRay> azimuthDenseRays(int n) {
   return rays;
 }
 
-std::vector<double> denseVisibleCounts(const HeightField& field, const std::vector<DenseRay>& directions,
-                                       int per_unit) {
+std::vector<double> denseVisibleCounts(const HeightField& field, const std::vector<DenseRay>& rays, int per_unit) {
+  const auto lengths = denseVisibleLengths(field, rays, per_unit);
+  std::vector<double> counts(field.pixelCount(), 0.0);
+  for (std::size_t j = 0; j < rays.size(); ++j)
+    for (std::size_t i = 0; i < counts.size(); ++i) counts[i] += rays[j].weight * lengths[j][i];
+  return counts;
+}
+
+std::vector<std::vector<double>> denseVisibleLengths(const HeightField& field, const std::vector<DenseRay>& directions,
+                                                     int per_unit) {
   const int w = field.width, h = field.height;
   double lowest = std::numeric_limits<double>::max(), highest = std::numeric_limits<double>::lowest();
   for (float v : field.heights) lowest = std::min(lowest, double(v)), highest = std::max(highest, double(v));
@@ -49,7 +56,7 @@ std::vector<double> denseVisibleCounts(const HeightField& field, const std::vect
   for (const DenseRay& d : directions) {
     double px = snap(std::cos(d.azimuth)) / field.cell_size_x, py = snap(std::sin(d.azimuth)) / field.cell_size_y;
     const double norm = std::hypot(px, py);
-    rays.push_back({px / norm, py / norm, d.weight});
+    rays.push_back({px / norm, py / norm});
   }
   const double step = 1.0 / per_unit;
   // Bilinear height at (x, y) inside the domain, as a + (b - a) f (exact where the corners
@@ -68,14 +75,14 @@ std::vector<double> denseVisibleCounts(const HeightField& field, const std::vect
     return top + (bottom - top) * fy;
   };
 
-  std::vector<double> counts(field.pixelCount(), 0.0);
+  std::vector<std::vector<double>> lengths(rays.size(), std::vector<double>(field.pixelCount(), 0.0));
   std::atomic<int> next_row{0};
   auto worker = [&] {
     for (int r = next_row++; r < h; r = next_row++) {
       for (int c = 0; c < w; ++c) {
         const double h0 = z[static_cast<std::size_t>(r) * w + c];
-        double total = 0.0;
-        for (const Ray& ray : rays) {
+        for (std::size_t k = 0; k < rays.size(); ++k) {
+          const Ray& ray = rays[k];
           long visible = 0;
           // The ray leaves [0, W-1] x [0, H-1] at t_max; samples at j / D <= t_max (within
           // 1e-9 pixel) are inside.
@@ -90,9 +97,8 @@ std::vector<double> denseVisibleCounts(const HeightField& field, const std::vect
             if (rise >= best * t - tolerance) ++visible;
             best = std::max(best, rise / t);
           }
-          total += ray.weight * double(visible);
+          lengths[k][static_cast<std::size_t>(r) * w + c] = double(visible) / per_unit;
         }
-        counts[static_cast<std::size_t>(r) * w + c] = total / per_unit;
       }
     }
   };
@@ -100,7 +106,7 @@ std::vector<double> denseVisibleCounts(const HeightField& field, const std::vect
   std::vector<std::thread> pool;
   for (int i = 0; i < n_threads; ++i) pool.emplace_back(worker);
   for (auto& t : pool) t.join();
-  return counts;
+  return lengths;
 }
 
 namespace {

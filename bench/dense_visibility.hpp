@@ -1,5 +1,6 @@
-// bench/dense_visibility.hpp: the dense reference of the visible counts (issue 8, target e)
-// and the "city" surface model the intervisibility suite measures them on.
+// bench/dense_visibility.hpp: the dense references of the visible counts (issue 8, target e;
+// issue 25: also dense in azimuth) and the "city" surface model the intervisibility suite
+// measures them on.
 //
 // What the library's count is (hfvis/intervisibility.hpp): per pixel, the visible samples
 // summed over the K directions, at samples_per_unit S samples per pixel length along each
@@ -47,6 +48,10 @@ struct DenseRay {
 // hardware_concurrency threads). With per_unit = 1 it is a host unit march: the library's
 // naive march's samples, decided in double with the tolerance above.
 std::vector<double> denseVisibleCounts(const HeightField& field, const std::vector<DenseRay>& rays, int per_unit);
+
+// The same per ray, unweighted: element [j][pixel] is ray j's visible length from that pixel.
+std::vector<std::vector<double>> denseVisibleLengths(const HeightField& field, const std::vector<DenseRay>& rays,
+                                                     int per_unit);
 
 // The same over the K directions of `options` (phi_k = 2 pi k / K + azimuth_offset), weight 1
 // each: what the naive march's count estimates.

@@ -154,37 +154,63 @@ TEST_F(BenchSmoke, TinySuiteMeasuresEveryMethodInEverySection) {
   EXPECT_TRUE(fs::exists(dir_ / "report" / "environment.txt"));
 }
 
-// The vis_accuracy rows of a visibility.csv (issue 8, target e): for every content the tree,
-// the naive march and the host unit march, with finite errors against a reference whose mean
-// count is positive; where there are no exact ties (every content but the city's flat roofs
+// The vis_accuracy rows of a visibility.csv (issues 8 and 25): for every content and every K (8
+// and 64 in tiny mode) the tree, the naive march and the host unit march, with finite errors
+// against a reference whose mean count is positive, the tree and the naive march also against
+// the reference dense in azimuth (azd_*: 128 directions in tiny mode). That reference is one
+// mean over the azimuth scaled by K, so its mean count at K = 64 is 8 times that at K = 8, the
+// same for both methods. Where there are no exact ties (every content but the cities' flat roofs
 // and tilted ground), the host unit march (the dense reference's code at one sample per unit)
-// gives the library's naive counts at an azimuth offset, which checks the reference's
+// gives the library's naive counts at an azimuth offset at K = 8, which checks the reference's
 // directions (azimuth sign and origin, cell sizes) and conventions.
 // Returns the contents seen.
 std::set<std::string> checkAccuracyRows(const CsvTable& csv) {
   const std::size_t section = csv.column("section"), method = csv.column("method"),
-                    content = csv.column("content");
+                    content = csv.column("content"), k = csv.column("K");
   const std::size_t ref = csv.column("ref_mean"), mean = csv.column("rel_err_mean"),
                     agg = csv.column("rel_err_agg");
   const std::size_t differ = csv.column("offset_differ_pixels"), pixels = csv.column("err_pixels");
-  std::map<std::string, std::set<std::string>> methods;  // content -> methods
+  const std::size_t azd_dirs = csv.column("azd_dirs"), azd_ref = csv.column("azd_ref_mean"),
+                    azd_mean = csv.column("azd_rel_err_mean"), azd_p99 = csv.column("azd_rel_err_p99");
+  std::map<std::string, std::set<std::string>> methods;  // content -> "method K"
+  std::map<std::string, double> azd_refs;                 // "content method K" -> azd_ref_mean
   for (const auto& f : csv.rows) {
     if (f.size() != csv.columns.size() || f[section] != "vis_accuracy") continue;
-    const std::string line = f[content] + "," + f[method];
-    methods[f[content]].insert(f[method]);
+    const std::string line = f[content] + "," + f[method] + ",K=" + f[k];
+    methods[f[content]].insert(f[method] + " " + f[k]);
     EXPECT_GT(std::stod(f[ref]), 0.0) << line;
     EXPECT_TRUE(std::isfinite(std::stod(f[mean]))) << line;
     EXPECT_TRUE(std::isfinite(std::stod(f[agg]))) << line;
     EXPECT_GT(std::stoi(f[pixels]), 0) << line;
-    if (f[method] == "host_unit" && f[content] != "city") {
-      EXPECT_LE(std::stod(f[differ]), 0.01 * std::stod(f[pixels])) << line;
+    if (f[method] == "host_unit") {
+      EXPECT_TRUE(f[azd_mean].empty()) << line;
+      if (f[content].rfind("city", 0) != 0 && f[k] == "8") {
+        EXPECT_LE(std::stod(f[differ]), 0.01 * std::stod(f[pixels])) << line;
+      }
+      continue;
     }
+    EXPECT_EQ(f[azd_dirs], "128") << line;
+    if (f[azd_mean].empty() || f[azd_ref].empty()) {
+      ADD_FAILURE() << "no error against the reference dense in azimuth: " << line;
+      continue;
+    }
+    EXPECT_GT(std::stod(f[azd_ref]), 0.0) << line;
+    EXPECT_TRUE(std::isfinite(std::stod(f[azd_mean]))) << line;
+    EXPECT_TRUE(std::isfinite(std::stod(f[azd_p99]))) << line;
+    azd_refs[f[content] + " " + f[method] + " " + f[k]] = std::stod(f[azd_ref]);
   }
   std::set<std::string> contents;
   for (const auto& [c, m] : methods) {
     contents.insert(c);
     for (const char* name : {"tree", "naive", "host_unit"})
-      EXPECT_TRUE(m.count(name)) << c << " has no " << name;
+      for (const char* kk : {"8", "64"})
+        EXPECT_TRUE(m.count(std::string(name) + " " + kk)) << c << " has no " << name << " at K = " << kk;
+    for (const char* name : {"tree", "naive"}) {
+      const auto at8 = azd_refs.find(c + " " + name + " 8"), at64 = azd_refs.find(c + " " + name + " 64");
+      if (at8 == azd_refs.end() || at64 == azd_refs.end()) continue;
+      EXPECT_NEAR(at64->second, 8.0 * at8->second, 1e-4 * at64->second) << c << " " << name;
+      EXPECT_EQ(at8->second, azd_refs[c + " tree 8"]) << c << ": one reference dense in azimuth for both methods";
+    }
   }
   return contents;
 }
@@ -217,7 +243,9 @@ TEST_F(BenchSmoke, TinyVisibilitySuiteMeasuresEverySection) {
   }
   for (const char* s : {"vis_time", "vis_stats", "vis_zone", "vis_scale", "vis_accuracy"})
     EXPECT_TRUE(sections.count(s)) << "no rows for section " << s;
-  EXPECT_TRUE(checkAccuracyRows(csv).count("city"));
+  const std::set<std::string> accuracy_contents = checkAccuracyRows(csv);
+  EXPECT_TRUE(accuracy_contents.count("city"));
+  EXPECT_TRUE(accuracy_contents.count("city_dsm"));
   EXPECT_TRUE(methods.count("naive"));
   for (const char* t : {"plain", "deferred", "default", "zone"}) EXPECT_TRUE(tunings.count(t)) << t;
   EXPECT_TRUE(fs::exists(dir_ / "report" / "visibility_environment.txt"));
@@ -236,7 +264,7 @@ TEST_F(BenchSmoke, VisibilitySectionsRunsOnlyThoseNamed) {
       EXPECT_EQ(f[section], "vis_accuracy");
     }
   }
-  EXPECT_EQ(checkAccuracyRows(csv).size(), 4u);  // sine, fractal, the dome for the DEM, city
+  EXPECT_EQ(checkAccuracyRows(csv).size(), 5u);  // sine, fractal, the dome for the DEM, city, city_dsm
   EXPECT_EQ(runBench("visibility --tiny --sections accuracy,nonsense --out '" + (dir_ / "bad").string() + "'",
                      dir_ / "bad.log"),
             2);
