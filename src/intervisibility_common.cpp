@@ -132,11 +132,21 @@ void followRows(TreeDirection& d, const HeightField& field, const RowTable& rows
 }
 
 std::vector<TreeDirection> treeDirections(const HeightField& field, const SweepOptions& options, bool follow_rows) {
-  const std::vector<LatticeDirection> lattice = latticeDirections(field, options, false, 0.0);
+  std::vector<LatticeDirection> lattice = latticeDirections(field, options, false, 0.0);
+  // Each step stands for the wedge of its phi_k, 1 / K of the circle (a merged step for each
+  // phi_k it took), not for the half gaps to its neighbours' azimuths: see treeDirections' note.
+  const int K = options.directions;
+  std::vector<double> wedges(lattice.size(), 0.0);
+  for (std::size_t k = 0; k < lattice.size(); ++k) {
+    std::size_t m = 0;  // the step that sweeps for phi_k: the first equal one (setQuadratureWeights)
+    while (lattice[m].a != lattice[k].a || lattice[m].b != lattice[k].b || lattice[m].weight == 0.0) ++m;
+    wedges[m] += 1.0 / K;
+  }
+  for (std::size_t k = 0; k < lattice.size(); ++k) lattice[k].weight = wedges[k];
   std::vector<RowTable> rows;
   double unit = 0.0;
   if (follow_rows && hasRowSpacing(field)) {
-    rows = latticeRowTables(field, lattice, true);
+    rows = latticeRowTables(field, lattice, false);
     unit = groundUnit(field);
   }
   std::vector<TreeDirection> out;

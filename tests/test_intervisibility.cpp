@@ -791,6 +791,76 @@ TEST(IntervisibilityKernels, TreeAsCloseToDenseReferenceAsTheNaiveMarch) {
   }
 }
 
+// Issue 25's count target on the city DSM hard case (one-pixel streets and walls, roofs touching
+// at corners, an axis grid and a rotated one) at K = 64, against the same reference dense in
+// azimuth (256 directions): the tree no worse than the naive unit march.
+TEST(IntervisibilityKernels, TreeNoWorseThanTheNaiveMarchOnACityAtK64) {
+  const HeightField field = makeSyntheticField("city", 64, 63, 5);
+  IntervisibilityOptions options;
+  options.directions = 64;
+  IntervisibilityOutputs outputs;
+  outputs.visible_count = true;
+  const auto tree = computeIntervisibility(testContext(), field, options, outputs);
+  options.method = IntervisibilityMethod::Naive;
+  const auto naive = computeIntervisibility(testContext(), field, options, outputs);
+  const auto dense = denseVisibleCounts(field, options);
+  const double tree_error = relativeError(tree.visible_count, dense),
+               naive_error = relativeError(naive.visible_count, dense);
+  std::printf("city, K = 64: relative error against the dense reference: tree %.4f, naive %.4f\n", tree_error,
+              naive_error);
+  EXPECT_LE(tree_error, naive_error);
+}
+
+// Each tree step stands for the wedge of azimuth of its phi_k, 1 / K, as each ray of the naive
+// march does (a step that several phi_k share, at large K, for each of them): the weights are
+// whole multiples of 1 / K that sum to 1, whatever the steps' own azimuths.
+TEST(IntervisibilityDirections, EachTreeStepStandsForItsPhiKWedge) {
+  HeightField field = makeSyntheticField("flat", 300, 200);
+  for (int k : {16, 64, 1000, 4096}) {
+    SCOPED_TRACE(k);
+    SweepOptions options;
+    options.directions = k;
+    const auto lattice = detail::latticeDirections(field, options, false, 0.0);
+    const auto tree = detail::treeDirections(field, options);
+    double total = 0.0;
+    std::size_t shared = 0;
+    for (const detail::TreeDirection& d : tree) {
+      int sweeps_for = 0;  // the phi_k whose lattice step is d's
+      for (const auto& l : lattice) sweeps_for += l.a == d.lattice.a && l.b == d.lattice.b;
+      EXPECT_NEAR(d.lattice.weight, double(sweeps_for) / k, 1e-12) << d.lattice.a << "," << d.lattice.b;
+      shared += sweeps_for > 1;
+      total += d.lattice.weight;
+    }
+    EXPECT_NEAR(total, 1.0, 1e-9);
+    if (k == 4096) {
+      EXPECT_GT(shared, 0u);  // the merged steps are covered
+    }
+  }
+}
+
+// A one-pixel street along the columns between walls 1000 high, seen from its west end: only
+// the axis direction sees far (the street's 128 pixels); the others climb a wall within a few
+// pixels. The count is about the street's length once, as the naive march's (170 here): the axis
+// step stands for its wedge, 1 / K, not for the half gaps to the cheapest steps next to it (at
+// K = 64, (7, 1) and (7, -1) at 8.1 deg against phi_1 = 5.6 deg: 1.45 / K, which counted the
+// street's 128 pixels 1.45 times, 57 too many).
+TEST(IntervisibilityAnalytic, AStreetAlongAnAxisCountsItsLengthOnce) {
+  const int w = 129, h = 9;
+  HeightField field = makeSyntheticField("flat", w, h);
+  for (int r = 0; r < h; ++r)
+    for (int c = 0; c < w; ++c) field.heights[static_cast<std::size_t>(r) * w + c] = r == 4 ? 0.0f : 1000.0f;
+  IntervisibilityOptions options;
+  options.directions = 64;
+  IntervisibilityOutputs outputs;
+  outputs.visible_count = true;
+  const float tree = computeIntervisibility(testContext(), field, options, outputs).visible_count[4 * w];
+  options.method = IntervisibilityMethod::Naive;
+  const float naive = computeIntervisibility(testContext(), field, options, outputs).visible_count[4 * w];
+  std::printf("street end: tree %.2f, naive %.2f\n", tree, naive);
+  EXPECT_GE(tree, 128.0f);
+  EXPECT_NEAR(tree, naive, 0.1f * naive);
+}
+
 // Analytic: on a flat plane every sample is visible. On the axes a pixel sees the rest of
 // its row and column; with many directions the area seen from the centre tends to the
 // field's area.

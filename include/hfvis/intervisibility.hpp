@@ -7,9 +7,10 @@
 // surface samples q = p + i * step * d_k, i >= 1, inside the field (bilinear heights,
 // nodata samples absent). The naive march takes d_k at phi_k and step 1 / S (S =
 // samples_per_unit). The hull tree runs on lattice lines through the pixel centres: d_k is
-// the cheapest integer step (a, b) within half the spacing 2 pi / K of phi_k, weighted by the
-// azimuths it stands for, and the step |(a, b)| / ceil(|(a, b)| S), at most 1 / S, so every
-// receiver is a sample of its own line at its own height (README.md, "How the sweep works"). Tie rule: q is visible when its
+// the cheapest integer step (a, b) within half the spacing 2 pi / K of phi_k, standing for
+// phi_k's wedge of azimuth (weight 1 / K, as the naive march's rays), and the step
+// |(a, b)| / ceil(|(a, b)| S), at most 1 / S, so every receiver is a sample of its own line at
+// its own height (README.md, "How the sweep works"). Tie rule: q is visible when its
 // slope from p is >= the slope of every sample strictly between them (grazing samples are
 // visible; on a flat plane every sample is). Decided exactly, so the sweep, the naive
 // march and brute force agree sample for sample on identical samples.
@@ -81,8 +82,9 @@ struct IntervisibilityOutputs {
   bool visible_count = false;
   // Visible ground area, in ground units squared: each visible sample at ground distance
   // rho stands for D * rho * drho, drho the ground step along the direction and D its wedge
-  // of azimuth (2*pi/K for the naive march, 2*pi times the quadrature weight of the tree's
-  // step): the ring sector it represents around the receiver.
+  // of azimuth (2*pi/K, for the naive march and the tree; a tree step that K' of the phi_k
+  // share, at very large K, stands for K' wedges): the ring sector it represents around the
+  // receiver.
   bool visible_area = false;
   // Horizon and iteration totals of the hull tree (HullTree only).
   bool statistics = false;
