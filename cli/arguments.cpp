@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <limits>
+#include <set>
 #include <tuple>
 
 #include "hfvis/errors.hpp"
@@ -459,8 +460,8 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
       break;
     case Option::AzimuthTolerance:
       run.azimuth_tolerance_deg = parsePositive(typed, value);
-      run.azimuth_tolerance_deg =
-          parseBounded(typed, value, 0.0, kMostAzimuthTolerance, "0.1 radian at most");
+      run.azimuth_tolerance_deg = parseBounded(typed, value, 0.0, kMostAzimuthTolerance,
+                                               "the azimuth tolerance is 0.1 radian at most");
       break;
     case Option::Statistics:
       run.statistics = true;
@@ -475,7 +476,6 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
       break;
     case Option::At:
       if (command == Command::Shade) {
-        if (run.sun_time) throw UsageError(typed + " given twice");
         try {
           run.sun_time = parseUtcTime(value);
         } catch (const InvalidArgument& error) {
@@ -543,7 +543,6 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
     case Option::From:
     case Option::To: {
       std::optional<double>& time = spec.option == Option::From ? run.from_time : run.to_time;
-      if (time) throw UsageError(typed + " given twice");
       try {
         time = parseUtcTime(value);
       } catch (const InvalidArgument& error) {
@@ -586,7 +585,6 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
       break;
     case Option::Observers:
       requireNonEmpty(typed, value);
-      if (!run.observers_file.empty()) throw UsageError(typed + " given twice");
       run.observers_file = value;
       break;
     case Option::ObserverHeight:
@@ -668,6 +666,10 @@ void validateRun(Command command, const RunArguments& run) {
     if (run.environment.empty() && (run.environment_rotation_deg != 0.0 || run.environment_rows != 0))
       throw UsageError("--env-rotate and --env-rows need --env ENV.exr");
     if (!sun && run.sun_irradiance != 1.0) throw UsageError("--sun-irradiance needs the sun");
+    if (run.albedo.empty() && run.sun_irradiance != 1.0)
+      throw UsageError(
+          "--sun-irradiance needs --albedo (it scales the sun's light in the radiance; 'direct' is "
+          "for a normal irradiance of 1)");
     if (!sun && run.sun_size_deg != 0.53) throw UsageError("--sun-size needs the sun");
     if (!run.environment.empty() && samePath(run.output, run.environment))
       throw UsageError("--env must differ from -o, both are " + inQuotes(run.output));
@@ -786,6 +788,7 @@ void validateRun(Command command, const RunArguments& run) {
 RunArguments parseRunArguments(Command command, const std::vector<std::string>& args) {
   RunArguments run;
   std::vector<std::string> positional;
+  std::set<Option> given;
   bool options_ended = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& arg = args[i];
@@ -816,6 +819,12 @@ RunArguments parseRunArguments(Command command, const std::vector<std::string>& 
       const std::string shown = attached && typed.size() > 2 ? typed : arg;
       throw UsageError("unknown option " + inQuotes(shown) + " for 'hfvis " + commandName(command) + "'");
     }
+    // One rule for every option: once, but for those that add one more of a list (a second -o
+    // or -k silently replacing the first would hide a typo).
+    const bool adds =
+        spec->option == Option::Observer || (spec->option == Option::At && command == Command::HorizonLists);
+    if (!adds && !given.insert(spec->option).second)
+      throw UsageError(typed + " given twice (only --observer and the receivers' --at may repeat)");
     if (!spec->takes_value) {
       if (attached) throw UsageError(typed + " takes no value, got " + inQuotes(arg));
       applyOption(*spec, typed, "", command, run);

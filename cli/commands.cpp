@@ -162,6 +162,21 @@ void requireSize(const std::vector<float>& values, std::size_t expected, const c
   }
 }
 
+// A result that is not finite where the height is (the planes of a multi-plane result one after
+// another): the numbers went beyond what the kernels' single precision holds somewhere no bound
+// on the options caught. An error, rather than NaN or infinity written as data.
+void requireFiniteResult(const std::vector<float>& planes, const HeightField& field, const char* what) {
+  const std::size_t pixels = field.pixelCount();
+  for (std::size_t i = 0; i < planes.size(); ++i) {
+    const std::size_t p = i % pixels;
+    if (std::isfinite(planes[i]) || !std::isfinite(field.heights[p])) continue;
+    throw Error(std::string("the computed ") + what + " at column " + std::to_string(p % field.width) +
+                ", row " + std::to_string(p / field.width) + " is " + formatNumber(planes[i]) +
+                " although the height there is finite: the heights, cell size and z-scale go beyond what the "
+                "kernels' single precision holds; rescale them (--z-scale, --cell-size)");
+  }
+}
+
 const char* methodName(Command command, const RunArguments& run) {
   switch (command) {
     case Command::ViewCount:
@@ -526,6 +541,7 @@ int runShade(const RunArguments& run) {
     outputs.environment = &*environment;
     env = progress.run([&] { return computeHorizons(context, field, options, outputs); });
     requireSize(env.irradiance, pixels * environment->channels, "irradiances");
+    requireFiniteResult(env.irradiance, field, "irradiance");
     lit.restore(env.irradiance);
   }
   SunShading direct;
@@ -533,6 +549,7 @@ int runShade(const RunArguments& run) {
     direct = progress.run([&] { return computeSunShading(context, field, *sun, options); });
     requireSize(direct.sun, pixels, "sun fractions");
     requireSize(direct.direct, pixels, "direct irradiances");
+    requireFiniteResult(direct.direct, field, "direct irradiance");
     lit.restore(direct.sun);
     lit.restore(direct.direct);
   }
@@ -638,6 +655,7 @@ int runInsolation(const RunArguments& run) {
   requireResultSize(result.width, result.height, field);
   requireSize(result.sun_hours, field.pixelCount(), "sun hours");
   requireSize(result.direct, field.pixelCount(), "direct irradiations");
+  requireFiniteResult(result.direct, field, "direct irradiation");
   lit.restore(result.sun_hours);
   lit.restore(result.direct);
   Attributes attributes = runAttributes(Command::Insolation, run, field, device);
@@ -1007,6 +1025,7 @@ int runCompute(Command command, const RunArguments& run) {
   if (command == Command::Horizon) {
     const std::size_t values = pixels * static_cast<std::size_t>(directions);
     requireSize(result.angles, values, "horizon angles");
+    requireFiniteResult(result.angles, field, "horizon angle");
     const ImageChannels angles = makeImage(
         field, run, directionChannelNames("h", directions), splitPlanes(result.angles, pixels, directions),
         attributes, "horizon elevation angle per direction (channel k = direction k)",
@@ -1014,6 +1033,7 @@ int runCompute(Command command, const RunArguments& run) {
     outputs.image(run.output, angles);
     if (!run.distance_output.empty()) {
       requireSize(result.distances, values, "horizon distances");
+      requireFiniteResult(result.distances, field, "horizon distance");
       const ImageChannels distances =
           makeImage(field, run, directionChannelNames("d", directions),
                     splitPlanes(result.distances, pixels, directions), attributes,
@@ -1031,6 +1051,7 @@ int runCompute(Command command, const RunArguments& run) {
     const std::vector<float>& plane = svf ? result.sky_view_factor : result.ambient_occlusion;
     const std::string channel = svf ? "svf" : "ao";
     requireSize(plane, pixels, svf ? "sky-view factor" : "ambient occlusion");
+    requireFiniteResult(plane, field, svf ? "sky-view factor" : "ambient occlusion");
     const ImageChannels image =
         makeImage(field, run, {channel}, {plane}, attributes,
                   svf ? "sky-view factor 1 - mean_k sin(max(0, elevation_k))"
@@ -1072,6 +1093,8 @@ int runViewCount(const RunArguments& run) {
   const std::size_t pixels = field.pixelCount();
   requireSize(result.visible_count, pixels, "visible counts");
   requireSize(result.visible_area, pixels, "visible areas");
+  requireFiniteResult(result.visible_count, field, "visible count");
+  requireFiniteResult(result.visible_area, field, "visible area");
 
   Attributes attributes = runAttributes(Command::ViewCount, run, field, device);
   attributes.emplace_back("hfvis:tie_rule",
@@ -1193,7 +1216,10 @@ int runBounce(const RunArguments& run) {
     throw Error("internal error: the bounce returned " + std::to_string(result.irradiance.size()) +
                 " channels for " + std::to_string(radiance.channels.size()));
   }
-  for (const auto& plane : result.irradiance) requireSize(plane, field.pixelCount(), "irradiance");
+  for (const auto& plane : result.irradiance) {
+    requireSize(plane, field.pixelCount(), "irradiance");
+    requireFiniteResult(plane, field, "irradiance");
+  }
 
   Attributes attributes = runAttributes(Command::Bounce, run, field, device);
   attributes.emplace_back("hfvis:radiance", run.radiance);

@@ -61,9 +61,10 @@ Options:
                            the Earth's drop d^2 (1 - K) / (2 R), R = 6370997 m, K = 1/7 (GRASS and
                            GDAL's convention; cell sizes must be in metres)
   --refraction K           the same with refraction coefficient K in -1 .. 1 (implies --curvature)
-  --max-distance D         horizon, svf, ao, viewcount: only terrain within D ground units of the
-                           receiver counts (farther terrain neither casts a horizon nor hides
-                           anything nearer; r.horizon's maxdistance, RVT's svf_r_max)
+  --max-distance D         horizon, svf, ao, viewcount, shade, viewshed: only terrain within D
+                           ground units of the receiver counts (farther terrain neither casts a
+                           horizon nor hides anything nearer; r.horizon's maxdistance, RVT's
+                           svf_r_max); viewshed: only targets within D
   --samples-per-unit S     naive, viewcount, bounce: height samples per pixel length along a
                            line or ray; sweep: every grid-line crossing of the ray (exact heights)
                            and, for S > 1, about S points per pixel length between crossings
@@ -87,7 +88,9 @@ Options:
   -h, --help               show help
   (horizons takes only -o, -k, --azimuth-offset, --samples-per-unit, --cell-size, --z-scale,
   --channel, --curvature, --refraction and --quiet: it runs on the host, one ray per receiver
-  and direction, and writes text.)
+  and direction, and writes text. viewshed and insolation take none of -k, --azimuth-offset,
+  --samples-per-unit or --method sweep|naive (viewshed's --method is exact|culled); shade takes
+  -k, --method and --azimuth-offset with --env only.)
 )";
 
 const char* const kHorizonOnly = R"(
@@ -140,8 +143,9 @@ Horizons:
   -o OUT.json|OUT.csv      JSON: every receiver, direction and horizon, with the conventions
                            spelled out; CSV: one row per horizon with the columns
                            col,row,direction,azimuth_rad,horizon,sample,distance,elevation_rad,
-                           segment_begin,segment_end,near_distance,visible_samples
-                           (a direction without horizons: one row with the horizon fields empty).
+                           segment_begin,segment_end,near_distance,visible_samples,nodata
+                           (a direction without horizons: one row with the horizon fields empty;
+                           nodata 1 where the receiver's height is nodata).
   Along direction k the receiver's own ray is sampled at i = 1, 2, ... (i/S pixel lengths,
   the naive method's samples; tie rule as viewcount). Horizons are listed nearest first: each
   is the farthest visible sample of its segment (distance in ground units, elevation in

@@ -123,7 +123,7 @@ std::string horizonListsJson(const RunArguments& run, const HeightField& field,
 
 const char* horizonListsCsvHeader() {
   return "col,row,direction,azimuth_rad,horizon,sample,distance,elevation_rad,segment_begin,segment_end,"
-         "near_distance,visible_samples";
+         "near_distance,visible_samples,nodata";
 }
 
 std::string horizonListsCsv(const std::vector<ReceiverHorizons>& lists) {
@@ -134,12 +134,14 @@ std::string horizonListsCsv(const std::vector<ReceiverHorizons>& lists) {
       const std::string prefix = std::to_string(receiver.pixel.col) + "," +
                                  std::to_string(receiver.pixel.row) + "," + std::to_string(d.direction) +
                                  "," + number(d.azimuth) + ",";
-      if (d.horizons.empty()) out << prefix << ",,,,,,,0\n";  // no horizon: nodata, or a ray leaving at once
+      // No horizon: a ray leaving the field at once, or a nodata receiver (the last column
+      // tells them apart).
+      if (d.horizons.empty()) out << prefix << ",,,,,,,0," << (receiver.nodata ? 1 : 0) << "\n";
       for (std::size_t h = 0; h < d.horizons.size(); ++h) {
         const VisibilityHorizon& z = d.horizons[h];
         out << prefix << h << "," << z.sample << "," << number(z.distance) << "," << number(z.elevation)
             << "," << z.segment_begin << "," << z.segment_end << "," << number(z.near_distance) << ","
-            << z.visible_samples << "\n";
+            << z.visible_samples << ",0\n";
       }
     }
   }

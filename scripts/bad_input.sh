@@ -68,7 +68,13 @@ make_data.write_exr_builtin("nan.exr", nan, {})
 PY
 # A GeoTIFF of the field (no georeference: only its name matters here).
 "$hfvis" svf field.exr -o field.tif -k 1 -q
-sum_before=$(cat field.exr field.tif | md5sum)
+mkfifo pipe.exr
+printf '1,1\n2,2,-5\n' > negative_height.csv
+printf '1,1\n%s\n' "$(head -c 5000 /dev/zero | tr '\0' 'x')" > long_line.csv
+# An earlier result, write-protected by its owner (mode 0444).
+cp field.tif protected.tif
+chmod 444 protected.tif
+sum_before=$(cat field.exr field.tif protected.tif | md5sum)
 
 echo "| case | command | status | error (first line) | input intact, nothing written |"
 echo "| --- | --- | ---: | --- | --- |"
@@ -85,7 +91,7 @@ try() {
   message=$(head -1 stderr.txt | sed 's/^hfvis: error: //; s/|/\\|/g')
   [[ $status == 0 ]] && message="(none: it runs)"
   local clean=yes
-  [[ "$(cat field.exr field.tif | md5sum)" == "$sum_before" ]] || clean="NO: input changed"
+  [[ "$(cat field.exr field.tif protected.tif | md5sum)" == "$sum_before" ]] || clean="NO: input changed"
   if [[ $status != 0 && -n "$(ls -A out)" ]]; then clean="NO: wrote $(ls -A out | tr '\n' ' ')"; fi
   local shown="hfvis${*:+ $*}"
   [[ -n $env ]] && shown="$env $shown"
@@ -106,6 +112,10 @@ try "output is the input by another path" "" -- svf field.exr -o ./out/../field.
 try "GeoTIFF output is the GeoTIFF input" "" -- svf field.tif -o field.tif
 try "GeoTIFF output is the input by another path" "" -- horizon field.tif -o out/h.tif --distance-out out/../field.tif
 try "output format unknown" "" -- svf field.exr -o out/o.xyz
+try "output an 8-bit image" "" -- horizon field.exr -o out/o.png -k 4
+try "output write-protected" "" -- svf field.exr -o protected.tif -k 4
+try "input is a device" "" -- svf /dev/zero -o out/o.exr -k 4
+try "input is a FIFO" "" -- svf pipe.exr -o out/o.exr -k 4
 try "preview not a PNG" "" -- svf field.exr -o out/o.exr --preview out/p.jpg
 # Arguments.
 try "no arguments" "" --
@@ -131,6 +141,10 @@ try "nodata infinite" "" -- svf field.exr -o out/o.tif --nodata inf
 try "nodata beyond float32" "" -- svf field.exr -o out/o.tif --nodata 1e39
 try "nodata without a GeoTIFF output" "" -- svf field.exr -o out/o.exr --nodata -9999
 try "nodata for the horizon lists (text)" "" -- horizons field.exr --at 3,3 -o out/h.json --nodata 0
+try "nodata a value the output holds" "" -- viewshed field.tif -o out/o.tif --observer 3,3 --nodata 0
+try "azimuth offset beyond a turn" "" -- svf field.exr -o out/o.exr --azimuth-offset 1e20
+try "cell size beyond single precision" "" -- svf field.exr -o out/o.exr --cell-size 1e300
+try "sun size negative" "" -- shade field.exr -o out/o.exr --sun 180,30 --sun-size -1
 try "cell size zero" "" -- svf field.exr -o out/o.exr --cell-size 0
 try "cell size negative" "" -- svf field.exr -o out/o.exr --cell-size 1,-2
 try "cell size not a number" "" -- svf field.exr -o out/o.exr --cell-size 1,abc
@@ -163,6 +177,9 @@ try "viewshed observer not a pair" "" -- viewshed field.exr -o out/o.exr --obser
 try "viewshed observers file missing" "" -- viewshed field.exr -o out/o.exr --observers nowhere.csv
 try "viewshed observers file not CSV" "" -- viewshed field.exr -o out/o.exr --observers garbage.exr
 try "viewshed target below the surface" "" -- viewshed field.exr -o out/o.exr --observer 3,3 --target-height -1
+try "viewshed observers file with an eye below the surface" "" -- viewshed field.exr -o out/o.exr --observers negative_height.csv
+try "viewshed observers file with a 5000-byte line" "" -- viewshed field.exr -o out/o.exr --observers long_line.csv
+try "viewshed observers file is a device" "" -- viewshed field.exr -o out/o.exr --observers /dev/zero
 try "viewshed method unknown" "" -- viewshed field.exr -o out/o.exr --observer 3,3 --method stewart
 try "viewshed cull level 0" "" -- viewshed field.exr -o out/o.exr --observer 3,3 --method culled --cull-level 0
 try "viewshed cull level without culling" "" -- viewshed field.exr -o out/o.exr --observer 3,3 --cull-level 3
@@ -176,3 +193,5 @@ try "sun position beyond its years" "" -- sunpos --lat 45 --lon 7 --at 1700-06-2
 try "HFVIS_LINE_LAYOUT not line or step" HFVIS_LINE_LAYOUT=diagonal -- svf field.exr -o out/o.exr
 try "HFVIS_PROFILE not 0 or 1" HFVIS_PROFILE=yes -- svf field.exr -o out/o.exr
 try "HFVIS_KERNEL_DIR without the kernels" HFVIS_KERNEL_DIR=/nonexistent -- svf field.exr -o out/o.exr
+try "POCL_CACHE_DIR empty" POCL_CACHE_DIR= -- svf field.exr -o out/o.exr
+try "POCL_CACHE_DIR a file" POCL_CACHE_DIR=field.tif -- devices

@@ -13,6 +13,8 @@
 
 namespace hfvis {
 
+constexpr float kMostRadiance = 1e30f;
+
 void validate(const EnvironmentMap& map) {
   if (!(map.height > 0 && map.width == 2 * map.height))
     throw InvalidArgument("an environment map must be equirectangular, twice as wide as tall (got " +
@@ -26,11 +28,13 @@ void validate(const EnvironmentMap& map) {
                           std::to_string(plane * map.channels));
   for (std::size_t i = 0; i < map.radiance.size(); ++i) {
     const float v = map.radiance[i];
-    if (!(std::isfinite(v) && v >= 0.0f)) {
+    // The tables sum radiance times solid angle over up to millions of pixels in single
+    // precision: 1e30 leaves room for that below float's 3.4e38.
+    if (!(std::isfinite(v) && v >= 0.0f && v <= kMostRadiance)) {
       const std::size_t p = i % plane;
       std::ostringstream s;
-      s << "the environment's radiance must be finite and >= 0; channel " << map.names[i / plane] << " at column "
-        << p % map.width << ", row " << p / map.width << " is " << v;
+      s << "the environment's radiance must be finite, >= 0 and at most " << kMostRadiance << "; channel "
+        << map.names[i / plane] << " at column " << p % map.width << ", row " << p / map.width << " is " << v;
       throw InvalidArgument(s.str());
     }
   }

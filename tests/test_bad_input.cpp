@@ -143,5 +143,19 @@ TEST(BadInput, ContextsAndFiles) {
                        "no image writer");
 }
 
+// Issue 26, item 9: a radiance single precision cannot sum over the sky (3e38 gave every
+// irradiance infinite) is refused, naming the pixel.
+TEST(BadInput, EnvironmentRadianceBeyondSinglePrecision) {
+  EnvironmentMap map;
+  map.width = 8;
+  map.height = 4;
+  map.channels = 1;
+  map.names = {"Y"};
+  map.radiance.assign(32, 1.0f);
+  map.radiance[9] = 3e38f;
+  expectError<InvalidArgument>([&] { validate(map); }, "at most 1e+30");
+  expectError<InvalidArgument>([&] { validate(map); }, "column 1, row 1");
+}
+
 }  // namespace
 }  // namespace hfvis

@@ -971,9 +971,12 @@ TEST_F(Cli, ShadeLightsWithAnEnvironment) {
   std::ofstream(garbage) << "not an image";
   fs::remove_all(outputs());
   fs::create_directories(outputs());
-  for (const auto& [map, named] : std::vector<std::pair<std::string, std::string>>{
-           {narrow, "twice as wide"}, {negative, "radiance must be finite and >= 0"},
-           {infinite, "radiance must be finite"}, {two, "one channel or R, G, B"}, {garbage, "garbage.exr"}}) {
+  for (const auto& [map, named] :
+       std::vector<std::pair<std::string, std::string>>{{narrow, "twice as wide"},
+                                                        {negative, "radiance must be finite, >= 0"},
+                                                        {infinite, "radiance must be finite"},
+                                                        {two, "one channel or R, G, B"},
+                                                        {garbage, "garbage.exr"}}) {
     const CliResult r = run("shade " + shellQuoted(field) + " -o " + shellQuoted(out("bad.exr")) + " --env " +
                             shellQuoted(map) + " -q");
     expectFailure(r, 1, named);
@@ -1198,14 +1201,15 @@ TEST_F(Cli, HorizonsCsvIsWellFormed) {
   ASSERT_EQ(lines.back(), "");
   lines.pop_back();
   const std::vector<std::string> header = splitText(lines[0], ',');
-  ASSERT_EQ(header.size(), 12u) << lines[0];
+  ASSERT_EQ(header.size(), 13u) << lines[0];
+  EXPECT_EQ(header[12], "nodata");
   EXPECT_EQ(header[0], "col");
   EXPECT_EQ(header[7], "elevation_rad");
   int rows_without = 0;
   bool wall_seen = false;
   for (std::size_t i = 1; i < lines.size(); ++i) {
     const std::vector<std::string> fields = splitText(lines[i], ',');
-    ASSERT_EQ(fields.size(), 12u) << lines[i];
+    ASSERT_EQ(fields.size(), 13u) << lines[i];
     if (fields[4].empty()) {  // a direction without horizons: (20, 2) looking out of the field
       ++rows_without;
       EXPECT_EQ(fields[0], "20");
@@ -1538,7 +1542,8 @@ TEST_F(CliGeoTiff, BadNodataValuesAreUsageErrors) {
   expectFailure(
       run("horizons " + shellQuoted(tif) + " --at 1,1 -o " + shellQuoted(out("h.json")) + " --nodata 0"), 2,
       "--nodata");
-  for (const char* value : {"nan", "NaN", "0", "-3.4e38"}) {
+  // (0 and above are svf values: refused, CliGeoTiff.NodataThatTheDataCanHoldIsRefused)
+  for (const char* value : {"nan", "NaN", "-1", "-3.4e38"}) {
     SCOPED_TRACE(value);
     const CliResult good = run(base + shellQuoted(value) + " -q");
     EXPECT_EQ(good.status, 0) << good.err;
@@ -2078,4 +2083,25 @@ TEST_F(CliGeoTiff, EveryFlipOfTheGridIsLitAsItLies) {
         EXPECT_NEAR(results[l.name][i][p], results["north_up"][i][p], 1e-4)
             << l.name << ", band " << i << ", column " << p % w << ", row " << p / w;
   }
+}
+
+// Item 12: in the horizon lists' CSV a nodata receiver is told apart from one without horizons.
+TEST_F(Cli, HorizonsCsvMarksANodataReceiver) {
+  const std::string field = writeField("hole.exr", 8, 8, [](int col, int row) {
+    return col == 3 && row == 3 ? std::numeric_limits<float>::quiet_NaN() : 1.0f;
+  });
+  const CliResult result =
+      run("horizons " + shellQuoted(field) + " --at 3,3 --at 0,0 -k 4 -q -o " + shellQuoted(out("h.csv")));
+  ASSERT_EQ(result.status, 0) << result.err;
+  const std::vector<std::string> lines = splitText(readText(out("h.csv")), '\n');
+  int nodata = 0, data = 0;
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    if (lines[i].empty()) continue;
+    const std::vector<std::string> fields = splitText(lines[i], ',');
+    ASSERT_EQ(fields.size(), 13u) << lines[i];
+    (fields[0] == "3" ? nodata : data) += 1;
+    EXPECT_EQ(fields[12], fields[0] == "3" ? "1" : "0") << lines[i];
+  }
+  EXPECT_EQ(nodata, 4);
+  EXPECT_GE(data, 4);
 }
