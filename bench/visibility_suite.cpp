@@ -30,7 +30,7 @@
 #include "environment.hpp"
 #include "hfvis/intervisibility.hpp"
 #include "hfvis/synthetic_fields.hpp"
-#include "lattice_geometry.hpp"
+#include "intervisibility_internal.hpp"
 #include "metrics.hpp"
 #include "suite_support.hpp"
 
@@ -474,10 +474,10 @@ class VisibilitySuite {
     for (const auto& lengths : dense)
       for (std::size_t i = 0; i < lengths.size(); ++i) azimuth_dense[i] += lengths[i] * k / n;
     // The naive march's directions, phi_k with weight 1 each; the tree's lattice steps with
-    // their quadrature weights (times K: the count's scale), as computeIntervisibility takes them.
+    // their weights (times K: the count's scale), as computeIntervisibility takes them.
     std::vector<DenseRay> tree_rays;
-    for (const detail::LatticeDirection& d : detail::latticeDirections(field, sweep, false, 0.0))
-      if (d.weight > 0) tree_rays.push_back({d.azimuth, k * d.weight});
+    for (const detail::TreeDirection& d : detail::treeDirections(field, sweep))
+      tree_rays.push_back({d.lattice.azimuth, k * d.lattice.weight});
     const auto start = std::chrono::steady_clock::now();
     // The naive march's azimuths 2 pi i / K are every (n / K)-th of the dense ones where K divides n.
     std::vector<double> ref(field.pixelCount(), 0.0);
