@@ -2,11 +2,22 @@
 #include "hfvis/height_field.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "hfvis/errors.hpp"
 
 namespace hfvis {
+namespace {
+
+// A number in a message: 6 significant digits (std::to_string gives 1e300 all its 301).
+std::string shortNumber(double value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%g", value);
+  return text;
+}
+
+}  // namespace
 
 std::size_t HeightField::nodataCount() const {
   std::size_t count = 0;
@@ -26,9 +37,8 @@ void validate(const HeightField& field) {
   }
   auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
   if (!positive(field.cell_size_x) || !positive(field.cell_size_y)) {
-    throw InvalidArgument("cell size must be finite and positive (got " +
-                          std::to_string(field.cell_size_x) + ", " +
-                          std::to_string(field.cell_size_y) + ")");
+    throw InvalidArgument("cell size must be finite and positive (got " + shortNumber(field.cell_size_x) +
+                          ", " + shortNumber(field.cell_size_y) + ")");
   }
   if (!field.row_cell_size_x.empty() || !field.row_cell_size_y.empty()) {
     if (field.row_cell_size_x.size() != static_cast<std::size_t>(field.height) ||
@@ -43,7 +53,7 @@ void validate(const HeightField& field) {
     }
   }
   if (!positive(field.z_scale)) {
-    throw InvalidArgument("z-scale must be finite and positive (got " + std::to_string(field.z_scale) + ")");
+    throw InvalidArgument("z-scale must be finite and positive (got " + shortNumber(field.z_scale) + ")");
   }
   if (field.nodataCount() == field.pixelCount()) {
     throw InvalidArgument("every height is nodata (NaN or infinite)");

@@ -157,5 +157,18 @@ TEST(BadInput, EnvironmentRadianceBeyondSinglePrecision) {
   expectError<InvalidArgument>([&] { validate(map); }, "column 1, row 1");
 }
 
+// Issue 26, item 12: a huge number in a message is printed short, not with its 300 digits.
+TEST(BadInput, HugeNumbersInMessagesAreShort) {
+  HeightField field = makeSyntheticField("noise", 9, 7, 1);
+  field.z_scale = -1e300;
+  try {
+    validate(field);
+    ADD_FAILURE() << "a negative z-scale passed";
+  } catch (const InvalidArgument& error) {
+    EXPECT_NE(std::string(error.what()).find("-1e+300"), std::string::npos) << error.what();
+    EXPECT_LT(std::string(error.what()).size(), 100u) << error.what();
+  }
+}
+
 }  // namespace
 }  // namespace hfvis
