@@ -12,7 +12,9 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
+#include <vector>
 
 namespace hfvis {
 namespace detail {
@@ -57,12 +59,32 @@ bool usableDirectory(const std::string& path) {
          ::faccessat(AT_FDCWD, path.c_str(), W_OK | X_OK, AT_EACCESS) == 0;
 }
 
+// Whether the ICD loader will load PoCL: an .icd file naming it in OCL_ICD_VENDORS (a directory
+// or one file) or /etc/OpenCL/vendors.
+bool poclRegistered() {
+  const char* vendors = std::getenv("OCL_ICD_VENDORS");
+  const std::filesystem::path where = vendors && *vendors ? vendors : "/etc/OpenCL/vendors";
+  std::error_code error;
+  std::vector<std::filesystem::path> files;
+  if (std::filesystem::is_directory(where, error)) {
+    for (const auto& entry : std::filesystem::directory_iterator(where, error)) files.push_back(entry.path());
+  } else {
+    files.push_back(where);
+  }
+  for (const auto& file : files) {
+    std::ifstream in(file);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (lower(text).find("pocl") != std::string::npos) return true;
+  }
+  return false;
+}
+
 // PoCL (the CPU driver) compiles kernels into a cache directory: POCL_CACHE_DIR, else
 // $XDG_CACHE_HOME/pocl/kcache, else $HOME/.cache/pocl/kcache. Where that cannot be written it
 // reports no device at all (or aborts, for an empty POCL_CACHE_DIR), which reads as a missing
-// driver. So: a POCL_CACHE_DIR that cannot be used is an error that says so; a default one that
-// cannot be written (the user nobody, a read-only home) is replaced by a private directory of
-// this user's under $TMPDIR (or /tmp), kept between runs so kernels are compiled once.
+// driver. So: a POCL_CACHE_DIR that cannot be used is an error that says so; where PoCL is
+// registered, a default one that cannot be written (the user nobody, a read-only home) is replaced by a
+// private directory of this user's under $TMPDIR (or /tmp), kept between runs so kernels are compiled once.
 void preparePoclCache() {
   const std::string fix =
       ": PoCL, the CPU OpenCL driver, keeps its compiled kernels there; point it at a "
@@ -73,6 +95,7 @@ void preparePoclCache() {
       throw Error(std::string("POCL_CACHE_DIR='") + set + "' is not a directory this user can write" + fix);
     return;
   }
+  if (!poclRegistered()) return;  // no PoCL: its cache is nobody's business
   const char* xdg = std::getenv("XDG_CACHE_HOME");
   const char* home = std::getenv("HOME");
   const std::string standard = xdg && *xdg == '/' ? std::string(xdg) + "/pocl/kcache"

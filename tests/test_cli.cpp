@@ -2105,3 +2105,83 @@ TEST_F(Cli, HorizonsCsvMarksANodataReceiver) {
   EXPECT_EQ(nodata, 4);
   EXPECT_GE(data, 4);
 }
+
+// Item 12: an RGB GeoTIFF (bands without descriptions, colour interpretation Red, Green, Blue) is
+// an albedo of three channels, as the help says; --sun-irradiance without --albedo, which changed
+// nothing, is a usage error.
+TEST_F(CliGeoTiff, AnRgbGeoTiffIsAnAlbedo) {
+  const std::string tif = geoTiffInput();
+  const std::string rgb = in("albedo.tif");
+  hfvis::testing::registerGdal();
+  char** options = CSLSetNameValue(nullptr, "PHOTOMETRIC", "RGB");
+  GDALDatasetH dataset =
+      GDALCreate(GDALGetDriverByName("GTiff"), rgb.c_str(), kWidth, kHeight, 3, GDT_Byte, options);
+  CSLDestroy(options);
+  ASSERT_NE(dataset, nullptr);
+  std::array<double, 6> transform = hfvis::testing::kUtmGeotransform;
+  GDALSetGeoTransform(dataset, transform.data());
+  for (int b = 0; b < 3; ++b) {
+    std::vector<unsigned char> values(kWidth * kHeight, static_cast<unsigned char>(b == 0 ? 0 : 1));
+    EXPECT_EQ(GDALRasterIO(GDALGetRasterBand(dataset, b + 1), GF_Write, 0, 0, kWidth, kHeight, values.data(),
+                           kWidth, kHeight, GDT_Byte, 0, 0),
+              CE_None);
+  }
+  GDALClose(dataset);
+  const CliResult result = run("shade " + shellQuoted(tif) + " -o " + shellQuoted(out("s.tif")) +
+                               " --sun 180,40 --albedo " + shellQuoted(rgb) + " -q");
+  ASSERT_EQ(result.status, 0) << result.err;
+  const hfvis::testing::GdalRaster raster = hfvis::testing::readGdalRaster(out("s.tif"));
+  EXPECT_EQ(raster.descriptions,
+            (std::vector<std::string>{"direct", "sun", "radiance.R", "radiance.G", "radiance.B"}));
+  fs::remove(out("s.tif"));
+  expectFailure(run("shade " + shellQuoted(tif) + " -o " + shellQuoted(out("t.tif")) +
+                    " --sun 180,40 --sun-irradiance 3"),
+                2, "--albedo");
+}
+
+// Item 12: one rule for repeated options: each once, but --observer and the receivers' --at,
+// which add to a list (a second -o, -k or --method used to replace the first silently).
+TEST_F(Cli, EachOptionIsGivenOnce) {
+  const std::string field = flat();
+  const std::string o = " -o " + shellQuoted(out("a.exr"));
+  for (const std::string& twice : {o + " -k 4 -k 8", o + " -o " + shellQuoted(out("b.exr")),
+                                   o + " --method sweep --method naive", o + " -q -q"}) {
+    SCOPED_TRACE(twice);
+    expectFailure(run("svf " + shellQuoted(field) + twice), 2, "given twice");
+  }
+  expectFailure(
+      run("viewshed " + shellQuoted(field) + o + " --observer 1,1 --observers a.csv --observers b.csv"), 2,
+      "given twice");
+  const CliResult lists =
+      run("horizons " + shellQuoted(field) + " --at 1,1 --at 2,2 -k 4 -q -o " + shellQuoted(out("h.json")));
+  EXPECT_EQ(lists.status, 0) << lists.err;
+}
+
+// Item 12: a file whose georeference or cell size cannot be right is refused with what is wrong
+// (a rotated grid even with --cell-size, latitudes beyond the poles, a damaged
+// hfvis:cell_size_x), where it used to run with a wrong or default spacing.
+TEST_F(CliGeoTiff, ImpossibleGeoreferencesAndCellSizesAreRefused) {
+  std::vector<float> values(kWidth * kHeight, 1.0f);
+  hfvis::testing::writeGdalGeoTiff(in("rotated.tif"), kWidth, kHeight, values,
+                                   {500000.0, 30.0, 5.0, 4100000.0, 5.0, -30.0}, "EPSG:32633", std::nullopt);
+  expectFailure(run("svf " + shellQuoted(in("rotated.tif")) + " -o " + shellQuoted(out("o.tif")) +
+                    " -k 4 --cell-size 30"),
+                1, "rotated");
+  hfvis::testing::writeGdalGeoTiff(in("polar.tif"), kWidth, kHeight, values,
+                                   {10.0, 0.5, 0.0, 95.0, 0.0, -0.5}, "EPSG:4326", std::nullopt);
+  expectFailure(run("svf " + shellQuoted(in("polar.tif")) + " -o " + shellQuoted(out("o.tif")) + " -k 4"), 1,
+                "beyond the poles");
+  hfvis::ImageChannels image;
+  image.width = kWidth;
+  image.height = kHeight;
+  image.names = {"Y"};
+  image.planes = {values};
+  image.attributes = {{"hfvis:cell_size_x", "abc"}, {"hfvis:cell_size_y", "30"}};
+  hfvis::writeImage(in("damaged.exr"), image);
+  expectFailure(run("svf " + shellQuoted(in("damaged.exr")) + " -o " + shellQuoted(out("o.exr")) + " -k 4"),
+                1, "hfvis:cell_size_x");
+  // With --cell-size the attributes are not read.
+  const CliResult given = run("svf " + shellQuoted(in("damaged.exr")) + " -o " + shellQuoted(out("o.exr")) +
+                              " -k 4 -q --cell-size 30");
+  EXPECT_EQ(given.status, 0) << given.err;
+}

@@ -72,7 +72,8 @@ ImageChannels noiseImage(int size = 16) {
 // The writes AFullDiskIsAnErrorAndKeepsThePreviousFile makes under a file size limit, in a
 // fresh process (a fork of this one would inherit OpenEXR's and GDAL's thread pools without their
 // threads, and hang): the test program, started with HFVIS_TEST_WRITE=KIND:PATH, writes one
-// output before main() and exits 0 (written), 1 (an IoError naming the size limit) or 2.
+// output before main() and exits 0 (written), 1 (an IoError naming the size limit and no
+// temporary file) or 2.
 [[maybe_unused]] const bool kWriteJobDone = [] {
   const char* job = std::getenv("HFVIS_TEST_WRITE");
   if (!job) return false;
@@ -90,7 +91,12 @@ ImageChannels noiseImage(int size = 16) {
     }
   } catch (const IoError& error) {
     std::fprintf(stderr, "%s\n", error.what());
-    ::_exit(std::string(error.what()).find("file size limit") != std::string::npos ? 1 : 2);
+    // The cause in words, and the output's name, not the temporary file's.
+    const std::string message = error.what();
+    ::_exit(message.find("file size limit") != std::string::npos &&
+                    message.find("hfvis-tmp") == std::string::npos
+                ? 1
+                : 2);
   } catch (...) {
     ::_exit(2);
   }
