@@ -40,8 +40,8 @@ struct Slot {
 };
 Slot slots[kSlots];
 
-// Set while OutputFiles::commit() renames files into place: a signal then only records itself
-// here, and the commit ends the process once every file is where it belongs.
+// How many OutputFiles::commit() calls are renaming files into place: a signal then only records
+// itself here, and the last commit to end ends the process once every file is where it belongs.
 std::atomic<int> committing{0};
 std::atomic<int> pending_signal{0};
 
@@ -62,9 +62,9 @@ void onSignal(int signal_number) {
 // The signals held back for the length of a commit (in every thread: any may take the signal).
 class CommitWindow {
  public:
-  CommitWindow() { committing.store(1); }
+  CommitWindow() { committing.fetch_add(1); }
   ~CommitWindow() {
-    committing.store(0);
+    if (committing.fetch_sub(1) != 1) return;
     if (const int signal_number = pending_signal.exchange(0)) endOfSignal(signal_number);
   }
   CommitWindow(const CommitWindow&) = delete;
@@ -300,9 +300,10 @@ void OutputFiles::commit() {
     }
   };
   const auto fail = [&](const Entry& entry, const std::string& reason) {
+    const std::string path = entry.path;  // (discard() takes the entries)
     for (auto it = placed.rbegin(); it != placed.rend(); ++it) restore(*it->entry, it->backup);
     discard();
-    throw IoError(entry.path, reason);
+    throw IoError(path, reason);
   };
   for (const Entry& entry : entries_) {
     std::string backup;

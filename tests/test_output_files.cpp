@@ -228,6 +228,32 @@ TEST_F(OutputFilesTest, AFailedOutputLeavesEveryPreviousFile) {
   EXPECT_EQ(filesInDir(), (std::vector<std::string>{"a.exr", "b.tif", "c.png", "d.exr"}));
   EXPECT_TRUE(fs::is_directory(dir_ / "d.exr"));
 
+  // A rename that fails after the first output is in place (here b's finished file is gone)
+  // puts the first output's previous file back.
+  writeText("b.exr", "previous b");
+  {
+    OutputFiles files;
+    files.image(path("a.exr"), image);
+    files.image(path("b.exr"), image);
+    for (const std::string& name : filesInDir())
+      if (name.rfind(".b.hfvis-tmp-", 0) == 0) fs::remove(dir_ / name);
+    EXPECT_THROW(files.commit(), IoError);
+  }
+  EXPECT_EQ(readText(path("a.exr")), "previous a");
+  EXPECT_EQ(readText(path("b.exr")), "previous b");
+  EXPECT_EQ(filesInDir(), (std::vector<std::string>{"a.exr", "b.exr", "b.tif", "c.png", "d.exr"}));
+  // And where nothing was there before, the new first output is removed again.
+  {
+    OutputFiles files;
+    files.image(path("new.exr"), image);
+    files.image(path("b.exr"), image);
+    for (const std::string& name : filesInDir())
+      if (name.rfind(".b.hfvis-tmp-", 0) == 0) fs::remove(dir_ / name);
+    EXPECT_THROW(files.commit(), IoError);
+  }
+  EXPECT_FALSE(fs::exists(path("new.exr")));
+  EXPECT_EQ(readText(path("b.exr")), "previous b");
+
   // The same file twice would replace the first output with the second.
   OutputFiles twice;
   twice.image(path("e.exr"), image);
