@@ -11,12 +11,13 @@ command -v clang++ > /dev/null || { echo "fuzz.sh: needs clang++ (scripts/instal
 CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DHFVIS_BUILD_FUZZERS=ON \
   -DHFVIS_BUILD_TESTS=OFF -DHFVIS_BUILD_BENCH=OFF -DHFVIS_BUILD_CLI=OFF -DHFVIS_INSTALL=OFF \
   -DCMAKE_CXX_FLAGS="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined" > /dev/null
-cmake --build build-fuzz -j "$(nproc)" --target height_field_fuzzer arguments_fuzzer
+cmake --build build-fuzz -j "$(nproc)" --target height_field_fuzzer arguments_fuzzer observers_fuzzer \
+  environment_fuzzer
 # fast_unwind_on_malloc=0: leaks inside uninstrumented libraries get full stacks, which the
 # suppressions (fuzz/lsan.supp, each with its reason) match.
 export ASAN_OPTIONS=detect_leaks=1:fast_unwind_on_malloc=0
 export LSAN_OPTIONS=suppressions=$PWD/fuzz/lsan.supp
-for target in height_field arguments; do
+for target in height_field arguments observers environment; do
   fuzzer=build-fuzz/fuzz/${target}_fuzzer
   regressions=(fuzz/regressions/$target/*)
   if [[ -e ${regressions[0]} ]]; then
