@@ -3,11 +3,14 @@
 # `hfvis viewcount` commands (default options: the sweep and the hull tree at their default
 # sampling) of this checkout's build against a baseline commit's, on the same N x N inputs,
 # run in turn (base, current, current, base, ...) so that a drift of the machine's speed
-# falls on both alike. Prints each command's median over the rounds and the ratio of the
-# medians, and writes the table to bench/out/cost_against.md.
+# falls on both alike. Prints each command's median wall and CPU (user + system) seconds over
+# the rounds and the ratios of the medians, and writes the table to bench/out/cost_against.md.
+# On a machine shared with other work the CPU time is the steadier figure.
 #
 #   bench/cost_against.sh [--base COMMIT] [--size N] [-k K] [--rounds R] [--contents "fractal city"]
-#     defaults: --base bad9286 (before the segment peaks), N = 1024, K = 64, R = 5, both contents
+#                         [--ops "svf viewcount"]
+#     defaults: --base bad9286 (before the segment peaks), N = 1024, K = 64, R = 5, both contents,
+#     both commands
 #   BUILD_DIR=... this checkout's build (default build/); the baseline is built in
 #   bench/out/base-COMMIT/ (a git worktree, git-ignored).
 # Contents: "fractal" (data/make_data.py's terrain) and "city" (the city DSM hard case, written
@@ -20,6 +23,7 @@ size=1024
 k=64
 rounds=5
 contents="fractal city"
+ops="svf viewcount"
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --base) base=$2; shift ;;
@@ -27,7 +31,8 @@ while [[ $# -gt 0 ]]; do
     -k) k=$2; shift ;;
     --rounds) rounds=$2; shift ;;
     --contents) contents=$2; shift ;;
-    -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
+    --ops) ops=$2; shift ;;
+    -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
     *) echo "cost_against.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
   shift
@@ -68,13 +73,10 @@ current=$(git -C "$root" rev-parse --short HEAD)
 git -C "$root" diff --quiet HEAD -- kernels src include cli || current="$current (with uncommitted changes)"
 echo "commit: $current against $base_sha, $(date -u +%Y-%m-%dT%H:%M:%SZ), load average $(cut -d' ' -f1-3 /proc/loadavg)"
 
-# seconds of one whole command
+# "wall cpu" seconds of one whole command (cpu: user + system, of the command and its threads)
 run() {
-  local start end
-  start=$(date +%s.%N)
-  "$@" -q > /dev/null
-  end=$(date +%s.%N)
-  echo "$end - $start" | bc -l
+  /usr/bin/time -f '%e %U %S' -o "$out/time.txt" "$@" -q > /dev/null
+  awk '{printf "%s %.3f\n", $1, $2 + $3}' "$out/time.txt"
 }
 median() { sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR + 1) / 2] : (a[NR / 2] + a[NR / 2 + 1]) / 2}'; }
 
@@ -86,10 +88,10 @@ table=$out/../cost_against.md
   echo "median seconds of each. Written by bench/cost_against.sh on $(uname -n), $(nproc) cores,"
   echo "$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')."
   echo
-  echo "| command | input | base (s) | current (s) | current / base |"
-  echo "| --- | --- | --- | --- | --- |"
+  echo "| command | input | base wall (s) | current wall (s) | wall current / base | base CPU (s) | current CPU (s) | CPU current / base |"
+  echo "| --- | --- | --- | --- | --- | --- | --- | --- |"
 } > "$table"
-for op in svf viewcount; do
+for op in $ops; do
   for input in "${inputs[@]}"; do
     name=$(basename "$input" .exr)
     for b in "$base_dir/build" "$build_dir"; do  # warm-up: PoCL compiles and caches the kernels
@@ -105,11 +107,16 @@ for op in svf viewcount; do
         base_times+=("$(run "$base_dir/build/hfvis" "$op" "$input" -o "$out/base.tif" -k "$k")")
       fi
     done
-    tb=$(printf '%s\n' "${base_times[@]}" | median)
-    tc=$(printf '%s\n' "${current_times[@]}" | median)
+    tb=$(printf '%s\n' "${base_times[@]}" | cut -d' ' -f1 | median)
+    tc=$(printf '%s\n' "${current_times[@]}" | cut -d' ' -f1 | median)
+    cb=$(printf '%s\n' "${base_times[@]}" | cut -d' ' -f2 | median)
+    cc=$(printf '%s\n' "${current_times[@]}" | cut -d' ' -f2 | median)
     ratio=$(echo "$tc / $tb" | bc -l)
-    printf 'hfvis %-9s %-14s base %.2f s, current %.2f s, current / base %.3f\n' "$op" "$name" "$tb" "$tc" "$ratio"
-    printf '| hfvis %s | %s | %.2f | %.2f | %.3f |\n' "$op" "$name" "$tb" "$tc" "$ratio" >> "$table"
+    cpu_ratio=$(echo "$cc / $cb" | bc -l)
+    printf 'hfvis %-9s %-14s wall: base %.2f s, current %.2f s (%.3f x); cpu: base %.2f s, current %.2f s (%.3f x)\n' \
+      "$op" "$name" "$tb" "$tc" "$ratio" "$cb" "$cc" "$cpu_ratio"
+    printf '| hfvis %s | %s | %.2f | %.2f | %.3f | %.2f | %.2f | %.3f |\n' "$op" "$name" "$tb" "$tc" "$ratio" "$cb" "$cc" \
+      "$cpu_ratio" >> "$table"
   done
 done
 rm -f "$out"/*.tif

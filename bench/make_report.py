@@ -911,12 +911,15 @@ def cost_rows(d):
     rows = []
     for line in text.splitlines():
         cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        if len(cells) != 5 or not cells[0].startswith("hfvis "):
+        if len(cells) != 8 or not cells[0].startswith("hfvis "):
             continue
-        r = float(cells[4])
-        rows.append(("Cost: default `%s` on %s, current / base whole-command time <= 1.15" % (cells[0], cells[1]),
-                     "%s s against %s s: %.3f x (%s)" % (cells[3], cells[2], r, title.replace("Whole-command cost: ", "")),
-                     "met" if r <= 1.15 else "not met"))
+        wall, cpu = float(cells[4]), float(cells[7])
+        rows.append(("Cost: default `%s` on %s, current / base whole-command time <= 1.15 (CPU time: the machine "
+                     "is shared; wall time beside it)" % (cells[0], cells[1]),
+                     "CPU %s s against %s s: %.3f x; wall %s s against %s s: %.3f x (%s)" % (
+                         cells[6], cells[5], cpu, cells[3], cells[2], wall,
+                         title.replace("Whole-command cost: ", "")),
+                     "met" if cpu <= 1.15 else "not met"))
     return rows or [(target, "cost_against.md has no rows", "not measured")]
 
 

@@ -349,68 +349,99 @@ typedef struct {
 // convex or flat piece (C >= 0) has its maximum at an end, which is a sample already. Lanes
 // without the segment read the buffer's first height alone.
 //
-// `known` holds the corners the segment's ends read (far end's corner0, corner1, near end's
-// corner0, corner1); where `reuse`, the corners g names there are taken from it, the others
-// read (where the far end was not read in this launch, all four are read).
-HFVIS_INLINE lane_float segment_corner(__global const float* heights, int from, int reuse, const lane_float* known,
-                                       lane_int at) {
-  if (reuse && from < 4) return known[from];
+// far0, far1, near0, near1 are the corners the segment's ends read (the far end's corner0 and
+// corner1, the near end's); where `reuse`, the corners g names there are taken from them, the
+// others read (where the far end was not read in this launch, all four are read).
+HFVIS_INLINE lane_float segment_corner(__global const float* heights, int from, int reuse, lane_float far0,
+                                       lane_float far1, lane_float near0, lane_float near1, lane_int at) {
+  // (Named values, not an array: an array indexed at run time would live in memory.)
+  if (reuse && from < 4) return from == 0 ? far0 : from == 1 ? far1 : from == 2 ? near0 : near1;
   lane_float h;
 #pragma unroll
   for (int l = 0; l < HFVIS_LANES; ++l) LANE(h, l) = heights[ILANE(at, l)];
   return h;
 }
 
-HFVIS_INLINE lane_float segment_peak(__global const float* heights, int width, int height, int row0,
-                                     __global const CellSegment* g, lane_int c, lane_int r, lane_int ok, int edge,
-                                     int reuse, const lane_float* known, lane_float* tau, lane_int* valid) {
+// The quadratic along segment g (segment_peak): its far end's corner and slopes, the cell's
+// twist, B and C, and the lanes where it peaks strictly inside (candidate; NaN corners fail the
+// comparisons, infinite ones isfinite(A) in segment_peak_height).
+typedef struct {
+  lane_float h00, gx, gy, e, B, C;
+  lane_int candidate;
+} SegmentQuadratic;
+
+HFVIS_INLINE SegmentQuadratic segment_quadratic(__global const float* heights, int width, int height, int row0,
+                                                __global const CellSegment* g, lane_int c, lane_int r, lane_int ok,
+                                                int edge, int reuse, lane_float far0, lane_float far1,
+                                                lane_float near0, lane_float near1) {
   const lane_int x0 = c + g->ox, y0 = r + g->oy;
   if (edge) ok = ok & (x0 >= 0) & (x0 + 1 <= width - 1) & (y0 >= 0) & (y0 + 1 <= height - 1);
   const int from00 = g->from00, from10 = g->from10, from01 = g->from01, from11 = g->from11;
   lane_float h00, h10, h01, h11;
   if (reuse && (from00 | from10 | from01 | from11) < 4) {  // every corner read already (no code has bit 2 but 4)
-    h00 = known[from00];
-    h10 = known[from10];
-    h01 = known[from01];
-    h11 = known[from11];
+    h00 = from00 == 0 ? far0 : from00 == 1 ? far1 : from00 == 2 ? near0 : near1;
+    h10 = from10 == 0 ? far0 : from10 == 1 ? far1 : from10 == 2 ? near0 : near1;
+    h01 = from01 == 0 ? far0 : from01 == 1 ? far1 : from01 == 2 ? near0 : near1;
+    h11 = from11 == 0 ? far0 : from11 == 1 ? far1 : from11 == 2 ? near0 : near1;
   } else {
     const lane_int at = select((lane_int)0, (y0 - row0) * width + x0, ok);
     const lane_int right = select((lane_int)0, (lane_int)1, ok), down = select((lane_int)0, (lane_int)width, ok);
-    h00 = segment_corner(heights, from00, reuse, known, at);
-    h10 = segment_corner(heights, from10, reuse, known, at + right);
-    h01 = segment_corner(heights, from01, reuse, known, at + down);
-    h11 = segment_corner(heights, from11, reuse, known, at + down + right);
+    h00 = segment_corner(heights, from00, reuse, far0, far1, near0, near1, at);
+    h10 = segment_corner(heights, from10, reuse, far0, far1, near0, near1, at + right);
+    h01 = segment_corner(heights, from01, reuse, far0, far1, near0, near1, at + down);
+    h11 = segment_corner(heights, from11, reuse, far0, far1, near0, near1, at + down + right);
   }
-  const float fx = g->fx, fy = g->fy, dx = g->dx, dy = g->dy, tau_far = g->tau_far, tau_near = g->tau_near;
-  const lane_float gx = h10 - h00, gy = h01 - h00;
-  const lane_float e = (h11 - h01) - gx;
-  const lane_float A = h00 + gx * fx + gy * fy + e * (fx * fy);
-  const lane_float B = gx * dx + gy * dy + e * (fx * dy + fy * dx);
-  const lane_float C = e * (dx * dy);
-  const lane_float u = B / (-2.0f * C);
-  *tau = tau_far - u * (tau_far - tau_near);
-  // A is finite only where all four corners are (no nodata, no infinite height).
-  *valid = ok & (C < 0.0f) & (B > 0.0f) & (B < -2.0f * C) & isfinite(A);
-  return A + 0.5f * B * u;
+  const float fx = g->fx, fy = g->fy, dx = g->dx, dy = g->dy;
+  SegmentQuadratic w;
+  w.h00 = h00;
+  w.gx = h10 - h00;
+  w.gy = h01 - h00;
+  w.e = (h11 - h01) - w.gx;
+  w.B = w.gx * dx + w.gy * dy + w.e * (fx * dy + fy * dx);
+  w.C = w.e * (dx * dy);
+  w.candidate = ok & (w.C < 0.0f) & (w.B > 0.0f) & (w.B < -2.0f * w.C);
+  return w;
 }
 
-// One step of Algorithm 1 (Timonen & Westerholm 2010) on the lanes' hull stacks: the sample
-// (hs, here) arrives beyond every entry, on the side `toward` (+1: positions grow, the
-// forward sweep; -1: they shrink, the backward pass of a window). Pop while the entry below
-// the top casts at least as steep a slope on the sample as the top (so the farther wins
-// ties); (rise, run) become the remaining top's rise above the sample and its distance
-// (run 0: no entry) where `valid`; push the sample. Entry k of a lane's stack is at
+// The peak of a candidate: its tau in *tau, its height returned; *valid: the candidates whose
+// four corners are finite (A, the far end's height, is finite only where all four are).
+HFVIS_INLINE lane_float segment_peak_height(__global const CellSegment* g, SegmentQuadratic w, lane_float* tau,
+                                            lane_int* valid) {
+  const float fx = g->fx, fy = g->fy, tau_far = g->tau_far, tau_near = g->tau_near;
+  const lane_float A = w.h00 + w.gx * fx + w.gy * fy + w.e * (fx * fy);
+  const lane_float u = w.B / (-2.0f * w.C);
+  *tau = tau_far - u * (tau_far - tau_near);
+  *valid = w.candidate & isfinite(A);
+  return A + 0.5f * w.B * u;
+}
+
+HFVIS_INLINE lane_float segment_peak(__global const float* heights, int width, int height, int row0,
+                                     __global const CellSegment* g, lane_int c, lane_int r, lane_int ok, int edge,
+                                     int reuse, lane_float far0, lane_float far1, lane_float near0,
+                                     lane_float near1, lane_float* tau, lane_int* valid) {
+  const SegmentQuadratic w =
+      segment_quadratic(heights, width, height, row0, g, c, r, ok, edge, reuse, far0, far1, near0, near1);
+  return segment_peak_height(g, w, tau, valid);
+}
+
+// One step of Algorithm 1 (Timonen & Westerholm 2010) on the lanes' hull stacks, in two halves:
+// hull_pop finds the sample's occluder, hull_push then pushes the sample (horizon_lattice puts
+// a segment's peak between the two). The sample (hs, here) arrives beyond every entry, on the
+// side `toward` (+1: positions grow, the forward sweep; -1: they shrink, the backward pass of
+// a window). Pop while the entry below the top casts at least as steep a slope on the sample
+// as the top (so the farther wins ties); (rise, run) become the remaining top's rise above the
+// sample and its distance (run 0: no entry) where `valid`. Entry k of a lane's stack is at
 // stacks[stack + k entry]; the top two entries are in registers as well (below: valid where
-// n >= 2). Every pop loads the next entry down before it is known to be needed, so the load
-// does not wait for the comparison (it is used only where a lane pops).
-HFVIS_INLINE void hull_step(__global float2* stacks, lane_int stack, int entry, lane_int valid, lane_float hs,
-                            lane_float here, float toward, lane_int* n, lane_float* top_h, lane_float* top_p,
-                            lane_float* below_h, lane_float* below_p, lane_float* rise, lane_float* run) {
+// n >= 2). A step that pops nothing (the common case: a peak's push, a sample on a rising
+// slope) reads no entry; each pop loads the next entry down.
+HFVIS_INLINE void hull_pop(__global float2* stacks, lane_int stack, int entry, lane_int valid, lane_float hs,
+                           lane_float here, float toward, lane_int* n, lane_float* top_h, lane_float* top_p,
+                           lane_float* below_h, lane_float* below_p, lane_float* rise, lane_float* run) {
   lane_float v1h = *top_h - hs, v1d = toward * (here - *top_p), v2h = *below_h - hs,
              v2d = toward * (here - *below_p);
-  lane_int popping = valid & (*n > 1);
+  lane_int pop = valid & (*n > 1) & (v2h * v1d >= v1h * v2d);
   lane_int deeper = stack + (*n - 3) * entry;  // entry n - 3, below `below`
-  while (ANY_LANE(popping)) {
+  while (ANY_LANE(pop)) {
     lane_float next_h, next_p;
 #pragma unroll
     for (int l = 0; l < HFVIS_LANES; ++l) {
@@ -419,7 +450,6 @@ HFVIS_INLINE void hull_step(__global float2* stacks, lane_int stack, int entry, 
       LANE(next_h, l) = e.x;
       LANE(next_p, l) = e.y;
     }
-    const lane_int pop = popping & (v2h * v1d >= v1h * v2d);
     v1h = select(v1h, v2h, pop);
     v1d = select(v1d, v2d, pop);
     *top_h = select(*top_h, *below_h, pop);
@@ -429,21 +459,33 @@ HFVIS_INLINE void hull_step(__global float2* stacks, lane_int stack, int entry, 
     v2h = *below_h - hs;
     v2d = toward * (here - *below_p);
     *n = select(*n, *n - 1, pop);
-    popping = pop & (*n > 1);
+    pop = pop & (*n > 1) & (v2h * v1d >= v1h * v2d);
     deeper -= entry;
   }
+  *rise = select(*rise, v1h, valid);
+  *run = select(*run, select((lane_float)0.0f, v1d, *n > 0), valid);  // 0: no occluder
+}
+
+HFVIS_INLINE void hull_push(__global float2* stacks, lane_int stack, int entry, lane_int valid, lane_float hs,
+                            lane_float here, lane_int* n, lane_float* top_h, lane_float* top_p,
+                            lane_float* below_h, lane_float* below_p) {
   const lane_int push = stack + *n * entry;
 #pragma unroll
   for (int l = 0; l < HFVIS_LANES; ++l) {
     if (ILANE(valid, l)) stacks[ILANE(push, l)] = (float2)(LANE(hs, l), LANE(here, l));
   }
-  *rise = select(*rise, v1h, valid);
-  *run = select(*run, select((lane_float)0.0f, v1d, *n > 0), valid);  // 0: no occluder
   *below_h = select(*below_h, *top_h, valid);
   *below_p = select(*below_p, *top_p, valid);
   *top_h = select(*top_h, hs, valid);
   *top_p = select(*top_p, here, valid);
   *n = select(*n, *n + 1, valid);
+}
+
+HFVIS_INLINE void hull_step(__global float2* stacks, lane_int stack, int entry, lane_int valid, lane_float hs,
+                            lane_float here, float toward, lane_int* n, lane_float* top_h, lane_float* top_p,
+                            lane_float* below_h, lane_float* below_p, lane_float* rise, lane_float* run) {
+  hull_pop(stacks, stack, entry, valid, hs, here, toward, n, top_h, top_p, below_h, below_p, rise, run);
+  hull_push(stacks, stack, entry, valid, hs, here, n, top_h, top_p, below_h, below_p);
 }
 
 // The sample's height as the stack holds it: lowered by the Earth's drop (see horizon_lattice).
@@ -564,7 +606,8 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
         lane_int valid;
         lane_float tau_peak;
         const lane_float h_peak = segment_peak(heights, width, height, row0, g, c - (gi - i) * a, r - (gi - i) * b,
-                                               gi < receivers, offset + gi == 0, 0, 0, &tau_peak, &valid);
+                                               gi < receivers, offset + gi == 0, 0, 0.0f, 0.0f, 0.0f, 0.0f, &tau_peak,
+                                               &valid);
         const lane_float here_peak = segment_base - tau_peak * segment_scale;
         valid = valid & (here_peak > here) & (here_peak < here_near) &
                 (LANE_INT(floor(here_peak * inv_window)) == k - 1);
@@ -768,7 +811,8 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 #else
   lane_float here_before = -period;
 #endif
-  lane_float known[4] = {0.0f, 0.0f, 0.0f, 0.0f};  // corners the last two samples read (segment_peak)
+  // The corners the last two samples read (lane_sample_height), for segment_peak.
+  lane_float far0 = 0.0f, far1 = 0.0f, near0 = 0.0f, near1 = 0.0f;
   for (int i = 0; i < trips; ++i, c -= a, r -= b) {
     const lane_int live = i < receivers;
     const lane_int along = start + i;  // the receivers' index along their whole lines
@@ -829,7 +873,7 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
       lane_int valid;
       // Only a line's first period can reach outside the field (a later one lies between two
       // receivers); testing every lane's first period here costs the same and changes nothing.
-      h = lane_sample_height(heights, width, height, row0, s, c, r, live, i == 0, &valid, &known[2], &known[3]);
+      h = lane_sample_height(heights, width, height, row0, s, c, r, live, i == 0, &valid, &near0, &near1);
 #if HFVIS_CURVATURE
       // The Earth's drop below the receiver p, drop (p - here)^2, is a parabola along the line:
       // subtracting drop * here^2 from every sample instead changes every slope from p by the
@@ -840,59 +884,71 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 #endif
       // The surface's peak inside the segment from the sample before (at here_before) to this
       // one, where it lies strictly inside (segment_peak), from the corners the two samples read
-      // (known) and those they did not. With a maximum distance, in this sample's block only
-      // (one in the block before, when this sample starts a block, is window_pass's).
+      // (far0, far1, near0, near1) and those they did not. It lies between the sample before
+      // (the stack's top before this sample) and this sample, so it belongs to the hull of all
+      // samples so far exactly where it is steeper seen from this sample than this sample's
+      // occluder (rise, run, which hull_pop finds); elsewhere this sample's push would pop it at
+      // once, and the stack is already what pushing both would leave. So the peak is decided
+      // between the two halves of the sample's step: where it is on the hull it is pushed (its
+      // own pops start where the sample's stopped: what they popped lies below the line from
+      // the sample to its occluder, hence below the peak's view too, as pushing the peak first
+      // would have popped it), and the sample then goes on top of it with the peak as its
+      // occluder (the peak is steeper from it than the steepest sample, so no pop). With a
+      // maximum distance, only a peak in this sample's block (one in the block before, when
+      // this sample starts a block, is window_pass's).
+      const lane_float here_lanes = here;
+      hull_pop(stacks, stack, entry, valid, hs, here_lanes, 1.0f, &n, &top_h, &top_p, &below_h, &below_p, &rise,
+               &run);
       const __global CellSegment* g = segments + q;
-      lane_int peak = 0;
-      lane_float h_peak = 0.0f, here_peak = 0.0f;
       if (g->curved) {
-        lane_float tau_peak;
-        h_peak = segment_peak(heights, width, height, row0, g, c, r, live, i == 0, i > 0 || q > 0, known, &tau_peak,
-                              &peak);
+        const SegmentQuadratic w = segment_quadratic(heights, width, height, row0, g, c, r, live, i == 0,
+                                                     i > 0 || q > 0, far0, far1, near0, near1);
+        // Seen from this sample, the peak (at u = -B / 2C of the segment's span) rises
+        // -(B / 2 + C) over (1 - u) span: a slope of -(B / 2 + C) / span, compared with the
+        // occluder's rise / run without a division (both runs are positive), and without the
+        // peak's height and position, which only a peak on the hull needs (a peak on the hull
+        // is rare: most segments are convex or flat along the line, or their peak is hidden).
+        // With the Earth's drop the slope grows by drop (here + here_peak).
 #if HFVIS_ROW_SPACING
-        here_peak = base - tau_peak * tau_scale;
+        const lane_float span = (g->tau_far - g->tau_near) * tau_scale;
 #else
-        here_peak = base - tau_peak;
+        const float span = g->tau_far - g->tau_near;
 #endif
-        peak = peak & (here_peak > here_before) & (here_peak < here);
-#if HFVIS_MAX_DISTANCE
-        peak = peak & (LANE_INT(floor(here_peak * inv_window)) == block);
+#if HFVIS_CURVATURE
+        const lane_float u = w.B / (-2.0f * w.C);
+        const lane_float peak_rise = -(0.5f * w.B + w.C) + drop * (here + (here - (1.0f - u) * span)) * span;
+#else
+        const lane_float peak_rise = -(0.5f * w.B + w.C);
 #endif
-      }
-      here_before = here;
-      known[0] = known[2];
-      known[1] = known[3];
-      hull_step(stacks, stack, entry, valid, hs, (lane_float)here, 1.0f, &n, &top_h, &top_p, &below_h, &below_p,
-                &rise, &run);
-      {
-        // The peak lies between the sample before (the stack's top before this push) and this
-        // sample, so it belongs to the hull of all samples so far exactly where it is steeper
-        // seen from this sample than this sample's occluder (rise, run); elsewhere this sample's
-        // push would pop it at once, and the stack is already what pushing both would leave.
-        // Pushing after the fact costs a comparison where the peak is not on the hull, which is
-        // most of the time: where it is, this sample's push is undone, the peak pushed, and
-        // this sample pushed again (its occluder is then the peak).
-        const lane_float hs_peak = HFVIS_STACK_HEIGHT(h_peak, here_peak);
-        const lane_int on_hull = peak & valid & ((run <= 0.0f) | ((hs_peak - hs) * run > rise * (here - here_peak)));
+        lane_int on_hull = w.candidate & valid & ((run <= 0.0f) | (peak_rise * run > rise * span));
         if (ANY_LANE(on_hull)) {
-          n = select(n, n - 1, on_hull);
-          top_h = select(top_h, below_h, on_hull);
-          top_p = select(top_p, below_p, on_hull);
-#pragma unroll
-          for (int l = 0; l < HFVIS_LANES; ++l) {
-            if (ILANE(on_hull, l)) {
-              const float2 e = stacks[max(ILANE(stack, l) + (ILANE(n, l) - 2) * entry, ILANE(stack, l))];
-              LANE(below_h, l) = e.x;
-              LANE(below_p, l) = e.y;
-            }
+          lane_int finite;
+          lane_float tau_peak;
+          const lane_float h_peak = segment_peak_height(g, w, &tau_peak, &finite);
+#if HFVIS_ROW_SPACING
+          const lane_float here_peak = base - tau_peak * tau_scale;
+#else
+          const lane_float here_peak = base - tau_peak;
+#endif
+          // Strictly between the two samples (u may round to an end).
+          on_hull = on_hull & finite & (here_peak > here_before) & (here_peak < here);
+#if HFVIS_MAX_DISTANCE
+          on_hull = on_hull & (LANE_INT(floor(here_peak * inv_window)) == block);
+#endif
+          if (ANY_LANE(on_hull)) {
+            const lane_float hs_peak = HFVIS_STACK_HEIGHT(h_peak, here_peak);
+            lane_float unused_rise = 0.0f, unused_run = 0.0f;
+            hull_step(stacks, stack, entry, on_hull, hs_peak, here_peak, 1.0f, &n, &top_h, &top_p, &below_h,
+                      &below_p, &unused_rise, &unused_run);
+            rise = select(rise, top_h - hs, on_hull);
+            run = select(run, here_lanes - top_p, on_hull);
           }
-          lane_float unused_rise = 0.0f, unused_run = 0.0f;
-          hull_step(stacks, stack, entry, on_hull, hs_peak, here_peak, 1.0f, &n, &top_h, &top_p, &below_h, &below_p,
-                    &unused_rise, &unused_run);
-          hull_step(stacks, stack, entry, on_hull, hs, (lane_float)here, 1.0f, &n, &top_h, &top_p, &below_h,
-                    &below_p, &rise, &run);
         }
       }
+      hull_push(stacks, stack, entry, valid, hs, here_lanes, &n, &top_h, &top_p, &below_h, &below_p);
+      here_before = here;
+      far0 = near0;
+      far1 = near1;
     }
 #if HFVIS_MAX_DISTANCE
     if (far_part) {

@@ -354,6 +354,9 @@ std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, cons
     int block = 0;
     float stacked = 0.0f;
     bool is_receiver = false;
+    // A present peak: -(B / 2 + C), its rise over (1 - u) span seen from the sample after it
+    // (horizon_lattice's on-hull test), and the span.
+    float peak_rise = 0.0f, span = 0.0f;
   };
   std::vector<Raw> raw;
   int c = line.col, r = line.row;
@@ -390,6 +393,9 @@ std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, cons
           if (C < 0.0f && B > 0.0f && B < -2.0f * C && std::isfinite(A) && position > here_before && position < here) {
             e.sample.height = A + 0.5f * B * u;
             e.sample.position = position;
+            e.span = rows ? (g.tau_far - g.tau_near) * tau_scale : g.tau_far - g.tau_near;
+            e.peak_rise = -(0.5f * B + C);
+            if (drop != 0.0f) e.peak_rise = e.peak_rise + drop * (here + (here - (1.0f - u) * e.span)) * e.span;
           }
         }
         e.block = windowed && !std::isnan(e.sample.height)
@@ -502,18 +508,22 @@ std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, cons
                                  &e.sample.occluder_run);
     // The peak before the sample (horizon_lattice): on the hull where it is steeper from the
     // sample than the sample's occluder; then the sample's push is undone, the peak pushed and
-    // the sample pushed again. Only a peak in the sample's block (one before a sample that
-    // starts a block may lie in the block before: window_pass takes it).
+    // the sample pushed on top of it, with the peak as its occluder (horizon_lattice decides
+    // the peak between the halves of the sample's step and pushes the sample without a pop).
+    // Only a peak in the sample's block (one before a sample that starts a block may lie in the
+    // block before: window_pass takes it).
     if (t > 0 && raw[t - 1].sample.peak && !std::isnan(raw[t - 1].sample.height) && raw[t - 1].block == block) {
       Raw& p = raw[t - 1];
-      const bool on_hull = e.sample.occluder < 0 || (p.stacked - e.stacked) * e.sample.occluder_run >
-                                                        e.sample.occluder_rise * (e.sample.position - p.sample.position);
+      const bool on_hull =
+          e.sample.occluder < 0 || p.peak_rise * e.sample.occluder_run > e.sample.occluder_rise * p.span;
       if (on_hull) {
         stack.pop_back();
         p.sample.occluder = hullStep(stack, p.stacked, p.sample.position, 1.0f, &p.sample.occluder_rise,
                                      &p.sample.occluder_run);
-        e.sample.occluder = hullStep(stack, e.stacked, e.sample.position, 1.0f, &e.sample.occluder_rise,
-                                     &e.sample.occluder_run);
+        e.sample.occluder = static_cast<long>(stack.size()) - 1;
+        e.sample.occluder_rise = p.stacked - e.stacked;
+        e.sample.occluder_run = e.sample.position - p.sample.position;
+        stack.emplace_back(e.stacked, e.sample.position);
       }
     }
     // The steeper of the block's own occluder and the block before's (which wins ties).
