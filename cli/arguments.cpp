@@ -489,7 +489,8 @@ void applyOption(const OptionSpec& spec, const std::string& typed, const std::st
       const std::size_t comma = value.find(',');
       if (comma == std::string::npos)
         throw UsageError(typed + ": expected AZ,EL (compass azimuth and elevation, degrees), got " + inQuotes(value));
-      const double azimuth = parseNumber(typed, value.substr(0, comma));
+      const double azimuth =
+          parseBounded(typed, value.substr(0, comma), -360.0, 360.0, "every azimuth has an equal one in it");
       const double elevation = parseNumber(typed, value.substr(comma + 1));
       if (elevation < -90.0 || elevation > 90.0)
         throw UsageError(typed + ": the elevation must be in -90 .. 90 degrees, got " + inQuotes(value));
