@@ -309,7 +309,11 @@ void OutputFiles::commit() {
     std::string backup;
     struct stat previous {};
     if (::lstat(entry.target.c_str(), &previous) == 0) {
-      ::chmod(entry.temp.c_str(), previous.st_mode & 07777);  // the replaced file's permissions stay
+      // The replaced file's owner (where this user may give it, as the superuser may; else the
+      // new file is this user's, as any file it writes) and permissions stay, as they would for
+      // a write in place.
+      [[maybe_unused]] const int owned = ::chown(entry.temp.c_str(), previous.st_uid, previous.st_gid);
+      ::chmod(entry.temp.c_str(), previous.st_mode & 07777);
       backup = detail::temporaryPathFor(entry.target);
       // A hard link keeps the previous file at its name until the rename replaces it; where the
       // file system has none, it is moved aside instead.

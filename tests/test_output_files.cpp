@@ -184,6 +184,8 @@ TEST_F(OutputFilesTest, ASymbolicLinkIsWrittenThrough) {
   fs::create_directories(dir_ / "data");
   writeText("data/real.exr", "old");
   fs::permissions(path("data/real.exr"), fs::perms::owner_read | fs::perms::owner_write);
+  // Another user's file, where this test may give it away (as the superuser): it stays theirs.
+  const bool given_away = ::chown(path("data/real.exr").c_str(), 65534, 65534) == 0;
   fs::create_symlink("data/real.exr", dir_ / "link.exr");
   const ImageChannels image = noiseImage();
   writeImage(path("link.exr"), image);
@@ -191,6 +193,9 @@ TEST_F(OutputFilesTest, ASymbolicLinkIsWrittenThrough) {
   EXPECT_EQ(readHeightField(path("data/real.exr")).heights, image.planes[0]);
   EXPECT_EQ(fs::status(path("data/real.exr")).permissions() & fs::perms::all,
             fs::perms::owner_read | fs::perms::owner_write);
+  struct stat status {};
+  ASSERT_EQ(::stat(path("data/real.exr").c_str(), &status), 0);
+  if (given_away) EXPECT_EQ(status.st_uid, 65534u);
   EXPECT_EQ(filesInDir(), (std::vector<std::string>{"data", "link.exr"}));
   // A dangling link: the file it names is created.
   fs::create_symlink("data/new.exr", dir_ / "dangling.exr");
