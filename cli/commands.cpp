@@ -7,13 +7,11 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -41,7 +39,6 @@
 #include "hfvis/viewshed.hpp"
 #include "horizon_list_files.hpp"
 #include "observer_files.hpp"
-#include "output_files.hpp"
 
 namespace hfvis::cli {
 namespace {

@@ -2,19 +2,11 @@
 // outputs are handed to gdal_io.cpp, EXR and other images to OpenImageIO (oiio_images.hpp).
 #include "hfvis/image_io.hpp"
 
-#include <unistd.h>
-
 #include <algorithm>
-#include <atomic>
-#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
-#include <memory>
-#include <new>
-#include <optional>
 #include <set>
 #include <string>
 #include <utility>
