@@ -223,7 +223,10 @@ void writeFileChecked(const std::string& file, const std::string& path, const vo
 
 int likelyWriteError(const std::string& file) {
   struct statvfs space {};
-  if (::statvfs(directoryOf(file).c_str(), &space) == 0 && space.f_bavail == 0) return ENOSPC;
+  // (a write that failed for want of space may still leave a few blocks that a smaller write took)
+  if (::statvfs(directoryOf(file).c_str(), &space) == 0 &&
+      static_cast<double>(space.f_bavail) * static_cast<double>(space.f_frsize) < 1048576.0)
+    return ENOSPC;
   rlimit limit{};
   struct stat status {};
   if (::getrlimit(RLIMIT_FSIZE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY &&

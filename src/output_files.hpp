@@ -40,8 +40,8 @@ void requireInputFile(const std::string& path);
 void writeFileChecked(const std::string& file, const std::string& path, const void* data, std::size_t size);
 
 // Why a write to `file` that a library reported in its own words failed, where that can be told
-// afterwards: ENOSPC when its file system has no space left, EFBIG when the file reached the file
-// size limit; 0 otherwise.
+// afterwards: ENOSPC when its file system has less than 1 MiB left, EFBIG when the file reached
+// the file size limit; 0 otherwise.
 int likelyWriteError(const std::string& file);
 
 // Flushes an already written file to the disk (fsync), or throws IoError naming `path`.
