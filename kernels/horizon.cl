@@ -893,7 +893,8 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
       // own pops start where the sample's stopped: what they popped lies below the line from
       // the sample to its occluder, hence below the peak's view too, as pushing the peak first
       // would have popped it), and the sample then goes on top of it with the peak as its
-      // occluder (the peak is steeper from it than the steepest sample, so no pop). With a
+      // occluder (the peak is steeper from it than the steepest sample, so its pops, which read
+      // no entry where nothing pops, find nothing to pop but in a tie). With a
       // maximum distance, only a peak in this sample's block (one in the block before, when
       // this sample starts a block, is window_pass's).
       const lane_float here_lanes = here;
@@ -940,8 +941,11 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
             lane_float unused_rise = 0.0f, unused_run = 0.0f;
             hull_step(stacks, stack, entry, on_hull, hs_peak, here_peak, 1.0f, &n, &top_h, &top_p, &below_h,
                       &below_p, &unused_rise, &unused_run);
-            rise = select(rise, top_h - hs, on_hull);
-            run = select(run, here_lanes - top_p, on_hull);
+            // The sample's pops again, now from the peak: none, but where rounding decides the
+            // peak's slope against its occluder otherwise than the slope above did (then the
+            // peak goes, and the stack stays convex as its comparisons see it).
+            hull_pop(stacks, stack, entry, on_hull, hs, here_lanes, 1.0f, &n, &top_h, &top_p, &below_h, &below_p,
+                     &rise, &run);
           }
         }
       }

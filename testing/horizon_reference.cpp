@@ -507,9 +507,9 @@ std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, cons
     e.sample.occluder = hullStep(stack, e.stacked, e.sample.position, 1.0f, &e.sample.occluder_rise,
                                  &e.sample.occluder_run);
     // The peak before the sample (horizon_lattice): on the hull where it is steeper from the
-    // sample than the sample's occluder; then the sample's push is undone, the peak pushed and
-    // the sample pushed on top of it, with the peak as its occluder (horizon_lattice decides
-    // the peak between the halves of the sample's step and pushes the sample without a pop).
+    // sample than the sample's occluder (by -(B/2 + C)/span, as horizon_lattice decides it
+    // between the halves of the sample's step); then the sample's push is undone, the peak
+    // pushed and the sample pushed again.
     // Only a peak in the sample's block (one before a sample that starts a block may lie in the
     // block before: window_pass takes it).
     if (t > 0 && raw[t - 1].sample.peak && !std::isnan(raw[t - 1].sample.height) && raw[t - 1].block == block) {
@@ -520,10 +520,8 @@ std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, cons
         stack.pop_back();
         p.sample.occluder = hullStep(stack, p.stacked, p.sample.position, 1.0f, &p.sample.occluder_rise,
                                      &p.sample.occluder_run);
-        e.sample.occluder = static_cast<long>(stack.size()) - 1;
-        e.sample.occluder_rise = p.stacked - e.stacked;
-        e.sample.occluder_run = e.sample.position - p.sample.position;
-        stack.emplace_back(e.stacked, e.sample.position);
+        e.sample.occluder = hullStep(stack, e.stacked, e.sample.position, 1.0f, &e.sample.occluder_rise,
+                                     &e.sample.occluder_run);
       }
     }
     // The steeper of the block's own occluder and the block before's (which wins ties).
