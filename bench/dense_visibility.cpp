@@ -33,7 +33,8 @@ std::vector<DenseRay> azimuthDenseRays(int n) {
   return rays;
 }
 
-std::vector<double> denseVisibleCounts(const HeightField& field, const std::vector<DenseRay>& rays, int per_unit) {
+std::vector<double> denseVisibleCounts(const HeightField& field, const std::vector<DenseRay>& rays,
+                                       int per_unit) {
   const auto lengths = denseVisibleLengths(field, rays, per_unit);
   std::vector<double> counts(field.pixelCount(), 0.0);
   for (std::size_t j = 0; j < rays.size(); ++j)
@@ -41,8 +42,8 @@ std::vector<double> denseVisibleCounts(const HeightField& field, const std::vect
   return counts;
 }
 
-std::vector<std::vector<double>> denseVisibleLengths(const HeightField& field, const std::vector<DenseRay>& directions,
-                                                     int per_unit) {
+std::vector<std::vector<double>> denseVisibleLengths(const HeightField& field,
+                                                     const std::vector<DenseRay>& directions, int per_unit) {
   const int w = field.width, h = field.height;
   double lowest = std::numeric_limits<double>::max(), highest = std::numeric_limits<double>::lowest();
   for (float v : field.heights) lowest = std::min(lowest, double(v)), highest = std::max(highest, double(v));
@@ -54,7 +55,8 @@ std::vector<std::vector<double>> denseVisibleLengths(const HeightField& field, c
 
   std::vector<Ray> rays;
   for (const DenseRay& d : directions) {
-    double px = snap(std::cos(d.azimuth)) / field.cell_size_x, py = snap(std::sin(d.azimuth)) / field.cell_size_y;
+    double px = snap(std::cos(d.azimuth)) / field.cell_size_x,
+           py = snap(std::sin(d.azimuth)) / field.cell_size_y;
     const double norm = std::hypot(px, py);
     rays.push_back({px / norm, py / norm});
   }

@@ -47,11 +47,12 @@ struct DenseRay {
 // `per_unit` samples per pixel length (D). Multithreaded over rows (std::thread,
 // hardware_concurrency threads). With per_unit = 1 it is a host unit march: the library's
 // naive march's samples, decided in double with the tolerance above.
-std::vector<double> denseVisibleCounts(const HeightField& field, const std::vector<DenseRay>& rays, int per_unit);
+std::vector<double> denseVisibleCounts(const HeightField& field, const std::vector<DenseRay>& rays,
+                                       int per_unit);
 
 // The same per ray, unweighted: element [j][pixel] is ray j's visible length from that pixel.
-std::vector<std::vector<double>> denseVisibleLengths(const HeightField& field, const std::vector<DenseRay>& rays,
-                                                     int per_unit);
+std::vector<std::vector<double>> denseVisibleLengths(const HeightField& field,
+                                                     const std::vector<DenseRay>& rays, int per_unit);
 
 // The same over the K directions of `options` (phi_k = 2 pi k / K + azimuth_offset), weight 1
 // each: what the naive march's count estimates.

@@ -55,7 +55,8 @@ struct VisibilityConfig {
   // accuracy_ks, the dense references at dense_per_unit samples per pixel length (the one dense
   // in azimuth with azimuth_dense_dirs directions), the tree and the naive march timed
   // accuracy_rounds times each, interleaved.
-  std::vector<std::string> accuracy_contents = {"fractal", "bricks", "sine", "blocks", "dem", "city", "city_dsm"};
+  std::vector<std::string> accuracy_contents = {"fractal", "bricks", "sine",    "blocks",
+                                                "dem",     "city",   "city_dsm"};
   int accuracy_n = 256;
   std::vector<int> accuracy_ks = {16, 64, 128};
   int dense_per_unit = 8;
@@ -373,8 +374,8 @@ class VisibilitySuite {
       const int n = config_.azimuth_dense_dirs;
       const auto lengths = denseVisibleLengths(content.field, azimuthDenseRays(n), config_.dense_per_unit);
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      say("[vis_accuracy] %s: reference dense in azimuth (%d directions, D = %d) in %.1f s", content.label.c_str(), n,
-          config_.dense_per_unit, seconds);
+      say("[vis_accuracy] %s: reference dense in azimuth (%d directions, D = %d) in %.1f s",
+          content.label.c_str(), n, config_.dense_per_unit, seconds);
       for (int k : config_.accuracy_ks) accuracyOf(content, k, lengths, seconds);
     }
   }
@@ -435,7 +436,8 @@ class VisibilitySuite {
 
   // The same-direction errors (rel_err_*, against `ref` along the method's own directions) and,
   // where given, those against the reference dense in azimuth (azd_*).
-  void addErrors(Row& row, const CountErrors& e, double ref_seconds, const CountErrors* dense = nullptr) const {
+  void addErrors(Row& row, const CountErrors& e, double ref_seconds,
+                 const CountErrors* dense = nullptr) const {
     row["dense_per_unit"] = std::to_string(config_.dense_per_unit);
     row["ref_mean"] = num(e.ref_mean);
     row["count_mean"] = num(e.count_mean);
@@ -565,9 +567,9 @@ class VisibilitySuite {
     say("[vis_accuracy] %s K=%d D=%d: mean relative error, same directions: tree %.4f, naive %.4f; dense in "
         "azimuth: tree %.4f, naive %.4f (tree / naive %.2f); time tree %.3f s, naive %.3f s; host unit march "
         "differs from naive at %zu pixels (%zu at an azimuth offset)",
-        content.label.c_str(), k, config_.dense_per_unit, tree_e.mean, naive_e.mean, tree_d.mean, naive_d.mean,
-        naive_d.mean > 0 ? tree_d.mean / naive_d.mean : 0.0, tree_time.min(), naive_time.min(), differ,
-        offset_differ);
+        content.label.c_str(), k, config_.dense_per_unit, tree_e.mean, naive_e.mean, tree_d.mean,
+        naive_d.mean, naive_d.mean > 0 ? tree_d.mean / naive_d.mean : 0.0, tree_time.min(), naive_time.min(),
+        differ, offset_differ);
   }
 
   const ComputeContext& context_;

@@ -173,7 +173,7 @@ std::set<std::string> checkAccuracyRows(const CsvTable& csv) {
   const std::size_t azd_dirs = csv.column("azd_dirs"), azd_ref = csv.column("azd_ref_mean"),
                     azd_mean = csv.column("azd_rel_err_mean"), azd_p99 = csv.column("azd_rel_err_p99");
   std::map<std::string, std::set<std::string>> methods;  // content -> "method K"
-  std::map<std::string, double> azd_refs;                 // "content method K" -> azd_ref_mean
+  std::map<std::string, double> azd_refs;                // "content method K" -> azd_ref_mean
   for (const auto& f : csv.rows) {
     if (f.size() != csv.columns.size() || f[section] != "vis_accuracy") continue;
     const std::string line = f[content] + "," + f[method] + ",K=" + f[k];
@@ -209,7 +209,8 @@ std::set<std::string> checkAccuracyRows(const CsvTable& csv) {
       const auto at8 = azd_refs.find(c + " " + name + " 8"), at64 = azd_refs.find(c + " " + name + " 64");
       if (at8 == azd_refs.end() || at64 == azd_refs.end()) continue;
       EXPECT_NEAR(at64->second, 8.0 * at8->second, 1e-4 * at64->second) << c << " " << name;
-      EXPECT_EQ(at8->second, azd_refs[c + " tree 8"]) << c << ": one reference dense in azimuth for both methods";
+      EXPECT_EQ(at8->second, azd_refs[c + " tree 8"])
+          << c << ": one reference dense in azimuth for both methods";
     }
   }
   return contents;
