@@ -500,11 +500,12 @@ def issue25_count_targets(d):
                  "in visibility.csv (`hfvis_bench visibility --sections accuracy`, quick or full mode)"
                  % COUNT_TARGET_K, "not measured")]
     rows = []
+    source = "visibility.csv, commit %s" % vis.env.get("commit", "?")
     for c, runs in per_content.items():
         measured = "; ".join("K = %d: tree %s vs naive %s" % (
             k, fmt(num(tree, "azd_rel_err_mean")), fmt(num(naive, "azd_rel_err_mean"))) for k, tree, naive in runs)
-        rows.append(("%s: %s" % (target, CONTENT_TITLES.get(c, c)), "%sx%s, %s azimuths (visibility.csv): %s" % (
-            runs[0][1]["width"], runs[0][1]["height"], runs[0][1]["azd_dirs"], measured),
+        rows.append(("%s: %s" % (target, CONTENT_TITLES.get(c, c)), "%sx%s, %s azimuths (%s): %s" % (
+            runs[0][1]["width"], runs[0][1]["height"], runs[0][1]["azd_dirs"], source, measured),
             "met" if all(count_target_met(tree, naive) for _, tree, naive in runs) else "not met"))
     return rows
 
@@ -1523,7 +1524,14 @@ def main(argv=None):
                   "From this run's `results.csv` (mode **%s**); sizes and K as each row says." % env.get("mode", "?"),
                   "", table(["target", "measured", "verdict"], targets8), ""] + (detail8 + [""] if detail8 else [])
     # Issue 25's table above them all.
-    targets25 = issue25_targets(res, d) + issue25_count_targets(d)
+    # The counts from this directory's visibility.csv, or else from a run of the accuracy section
+    # alone kept in visibility_accuracy/ (`hfvis_bench visibility --sections accuracy`).
+    counts25 = issue25_count_targets(d)
+    alone = os.path.join(d, "visibility_accuracy")
+    if counts25[0][2] == "not measured" and os.path.exists(os.path.join(alone, "visibility.csv")):
+        counts25 = [(t, m.replace("visibility.csv", "visibility_accuracy/visibility.csv"), v)
+                    for t, m, v in issue25_count_targets(alone)]
+    targets25 = issue25_targets(res, d) + counts25
     at = next((i for i, line in enumerate(out) if line.startswith("## ")), 2)
     out[at:at] = ["## Issue 25 targets (sharp-edged surfaces: city DSMs)", "",
                   "From this run's `results.csv` (mode **%s**; the speed/error plane and the error against samples "
