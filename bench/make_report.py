@@ -695,10 +695,9 @@ def heman_figures(d):
     return None
 
 
-def issue8_targets(res, d):
-    """Rows (target, measured, verdict) of issue 8's targets from this run's results.csv, and the
-    lines of the per-content detail table."""
-    rows, detail = [], []
+def plane_lookup(res):
+    """The speed/error plane's rows, its contents in run order, and a finder of the row of one
+    content, method, K and samples per unit with the angle planes and their errors."""
     plane = res.select("plane")
     contents = []
     for r in plane:
@@ -708,6 +707,15 @@ def issue8_targets(res, d):
     def plane_row(c, method, kk, spu="1"):
         return next((r for r in plane if r["content"] == c and r["method"] == method and r["K"] == kk
                      and r["spu"] == spu and r["outputs"] == "angles" and r["err_mean_deg"] != ""), None)
+
+    return plane, contents, plane_row
+
+
+def issue8_targets(res, d):
+    """Rows (target, measured, verdict) of issue 8's targets from this run's results.csv, and the
+    lines of the per-content detail table."""
+    rows, detail = [], []
+    plane, contents, plane_row = plane_lookup(res)
 
     # a. sweep (spu 1) mean and p99 no larger than the naive march's (spu 1), every content and K.
     pairs, failures, per_content = 0, [], {}
@@ -928,15 +936,7 @@ def issue25_targets(res, d):
     """Rows (target, measured, verdict) of issue 25's horizon and cost targets from this run's
     results.csv (speed/error plane, error against samples per unit) and cost_against.md."""
     rows = []
-    plane = res.select("plane")
-    contents = []
-    for r in plane:
-        if r["content"] not in contents:
-            contents.append(r["content"])
-
-    def plane_row(c, method, kk, spu="1"):
-        return next((r for r in plane if r["content"] == c and r["method"] == method and r["K"] == kk
-                     and r["spu"] == spu and r["outputs"] == "angles" and r["err_mean_deg"] != ""), None)
+    plane, contents, plane_row = plane_lookup(res)
 
     failures, urban_failures, pairs, urban = [], [], 0, []
     for c in contents:
