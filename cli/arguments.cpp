@@ -15,6 +15,7 @@
 #include "hfvis/errors.hpp"
 #include "hfvis/shading.hpp"
 #include "hfvis/sun.hpp"
+#include "message_numbers.hpp"
 
 namespace hfvis::cli {
 namespace {
@@ -173,12 +174,6 @@ std::string shortened(const std::string& text) {
                           : text;
 }
 
-// A number in a message: 6 significant digits, never 300 of them.
-std::string formatShort(double value) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%g", value);
-  return text;
-}
 
 // Strict number parsing: the whole text must be a finite number.
 double parseNumber(const std::string& option, const std::string& text) {
@@ -224,7 +219,7 @@ double parseBounded(const std::string& option, const std::string& text, double l
                     const char* why) {
   const double value = parseNumber(option, text);
   if (!(value >= lo && value <= hi))
-    throw UsageError(option + ": must be in " + formatShort(lo) + " .. " + formatShort(hi) + " (" + why +
+    throw UsageError(option + ": must be in " + detail::shortNumber(lo) + " .. " + detail::shortNumber(hi) + " (" + why +
                      "), got " + inQuotes(shortened(text)));
   return value;
 }
@@ -745,10 +740,10 @@ void validateRun(Command command, const RunArguments& run) {
                           : command == Command::Viewshed && run.with_angle ? -90.0
                                                                            : 0.0;
     if (*run.nodata >= lowest)
-      throw UsageError("--nodata " + formatShort(*run.nodata) + ": 'hfvis " + name +
-                       "' writes data values from " + formatShort(lowest) +
+      throw UsageError("--nodata " + detail::shortNumber(*run.nodata) + ": 'hfvis " + name +
+                       "' writes data values from " + detail::shortNumber(lowest) +
                        " up, so a reader could not tell those cells from nodata; give a value below " +
-                       formatShort(lowest) + " (such as -9999) or nan");
+                       detail::shortNumber(lowest) + " (such as -9999) or nan");
   }
   if (command == Command::ViewCount && !run.hull_tree_name.empty() &&
       run.visibility_method != IntervisibilityMethod::HullTree) {

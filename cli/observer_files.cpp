@@ -12,18 +12,11 @@
 #include <sstream>
 
 #include "hfvis/errors.hpp"
+#include "message_numbers.hpp"
 #include "output_files.hpp"
 
 namespace hfvis::cli {
-namespace {
-
-std::string shortNumber(double value) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%g", value);
-  return text;
-}
-
-}  // namespace
+using detail::shortNumber;
 
 std::vector<Observer> parseObservers(const std::string& path, std::istream& in, double default_height,
                                      bool absolute) {

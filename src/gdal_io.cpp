@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "hfvis/errors.hpp"
+#include "message_numbers.hpp"
 #include "output_files.hpp"
 
 namespace hfvis::detail {
@@ -196,13 +197,7 @@ void metresPerDegree(double lat_deg, double* along_meridian, double* along_paral
   *along_parallel = n * std::cos(lat) * M_PI / 180.0;
 }
 
-namespace {
-std::string shortNumber(double value) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%g", value);
-  return text;
-}
-}  // namespace
+using detail::shortNumber;
 
 std::optional<std::pair<double, double>> storedCellSize(const std::string& path, const char* x,
                                                         const char* y) {

@@ -6,18 +6,10 @@
 #include <string>
 
 #include "hfvis/errors.hpp"
+#include "message_numbers.hpp"
 
 namespace hfvis {
-namespace {
-
-// A number in a message: 6 significant digits (std::to_string gives 1e300 all its 301).
-std::string shortNumber(double value) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%g", value);
-  return text;
-}
-
-}  // namespace
+using detail::shortNumber;
 
 std::size_t HeightField::nodataCount() const {
   std::size_t count = 0;
