@@ -77,11 +77,16 @@ void convertIntegers(const std::vector<unsigned char>& raw, double rescale, std:
 // Reads channel `ch` of subimage 0 as type `as` (T: float, or bytes for other types) in
 // blocks of rows, the buffer growing with the rows read: a header that claims more pixels
 // than the file holds fails at its first missing rows, not after allocating the whole claim.
+// Rows are read in the file's own format and converted here: OpenImageIO's converting
+// read_scanlines buffers at least 256 rows of every channel whatever it is asked for (16 GB
+// for a 422-byte EXR claiming 16 million columns); a block here holds about 16 MiB of rows
+// of every channel (what a reader may buffer for a channel subset), one row at least.
 // Tiled files are read whole (OpenImageIO reads them a tile row at a time internally).
 template <typename T>
 std::vector<T> readRows(const std::string& path, OIIO::ImageInput& in, int ch, OIIO::TypeDesc as) {
   const OIIO::ImageSpec& spec = in.spec();
-  const std::size_t row_values = static_cast<std::size_t>(spec.width) * as.size() / sizeof(T);
+  const std::size_t width = static_cast<std::size_t>(spec.width);
+  const std::size_t row_values = width * as.size() / sizeof(T);
   const auto fail = [&] {
     throw IoError(path,
                   withDetail("cannot read pixel data; the file is truncated or corrupt", in.geterror()));
@@ -92,13 +97,24 @@ std::vector<T> readRows(const std::string& path, OIIO::ImageInput& in, int ch, O
     if (!in.read_image(0, 0, ch, ch + 1, as, values.data())) fail();
     return values;
   }
-  const int block = static_cast<int>(std::clamp<std::size_t>(
-      (std::size_t(16) << 20) / (row_values * sizeof(T)), 1, static_cast<std::size_t>(spec.height)));
+  const OIIO::TypeDesc native = spec.channelformat(ch);
+  const std::size_t widest_row =
+      std::max({spec.scanline_bytes(true), width * native.size(), row_values * sizeof(T)});
+  const int block = static_cast<int>(std::clamp<std::size_t>((std::size_t(16) << 20) / std::max<std::size_t>(widest_row, 1),
+                                                             1, static_cast<std::size_t>(spec.height)));
+  std::vector<unsigned char> rows;  // one block in the file's format, where it differs from `as`
   for (int y = 0; y < spec.height; y += block) {
     const int y_end = std::min(spec.height, y + block);
+    const std::size_t n = width * static_cast<std::size_t>(y_end - y);
     values.resize(row_values * static_cast<std::size_t>(y_end));
-    if (!in.read_scanlines(0, 0, spec.y + y, spec.y + y_end, 0, ch, ch + 1, as,
-                           values.data() + row_values * static_cast<std::size_t>(y)))
+    void* out = values.data() + row_values * static_cast<std::size_t>(y);
+    if (native == as) {
+      if (!in.read_native_scanlines(0, 0, spec.y + y, spec.y + y_end, 0, ch, ch + 1, out)) fail();
+      continue;
+    }
+    rows.resize(n * native.size());
+    if (!in.read_native_scanlines(0, 0, spec.y + y, spec.y + y_end, 0, ch, ch + 1, rows.data()) ||
+        !OIIO::convert_pixel_values(native, rows.data(), as, out, static_cast<int>(n)))
       fail();
   }
   return values;
@@ -191,10 +207,13 @@ std::unique_ptr<OIIO::ImageInput> openImage(const std::string& path, std::uint64
   }
   // What the header claims, before the readers allocate for it (a damaged or hostile header
   // can claim terabytes in a few bytes).
-  // A TIFF's strips may claim more rows than the image has; OpenImageIO buffers a whole strip.
+  // A TIFF's strips and a tiled file's tiles may claim more rows than the image has;
+  // OpenImageIO buffers a whole strip or row of tiles.
   const std::uint64_t limit = max_image_bytes ? max_image_bytes : kDefaultMaxImageBytes;
-  const std::uint64_t rows =
-      std::max<std::uint64_t>(spec.height, std::max(0, spec.get_int_attribute("tiff:RowsPerStrip", 0)));
+  const std::uint64_t rows = std::max<std::uint64_t>(
+      {static_cast<std::uint64_t>(spec.height),
+       static_cast<std::uint64_t>(std::max(0, spec.get_int_attribute("tiff:RowsPerStrip", 0))),
+       static_cast<std::uint64_t>(std::max(0, spec.tile_height))});
   const std::uint64_t scanline = static_cast<std::uint64_t>(spec.width) * spec.pixel_bytes(true);
   if (scanline / std::max<std::uint64_t>(spec.width, 1) != spec.pixel_bytes(true) ||
       scanline * rows / rows != scanline || scanline * rows > limit) {
