@@ -1,4 +1,4 @@
-// cli/help.cpp: the help texts. The conventions here are the contract of README.md ("Conventions")
+// cli/help.cpp: the help texts. The conventions here are the contract of docs/CONVENTIONS.md
 // stated for users; keep them in step with include/hfvis/horizon.hpp, intervisibility.hpp,
 // horizon_lists.hpp and bounce.hpp.
 #include "help.hpp"

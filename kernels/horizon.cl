@@ -24,8 +24,8 @@
 //   HFVIS_CURVATURE                          lower every sample by the Earth's drop (argument
 //                                            `drop`: c times the ground length of a unit of
 //                                            position along the line or ray, squared: a pixel,
-//                                            or a ground unit with HFVIS_ROW_SPACING; README
-//                                            "Conventions")
+//                                            or a ground unit with HFVIS_ROW_SPACING;
+//                                            docs/CONVENTIONS.md)
 //   HFVIS_MAX_DISTANCE                       only samples within `window` pixels along the line
 //                                            count (horizon_lattice: blocks and a backward
 //                                            pass, below; horizon_naive: `max_steps`)

@@ -17,7 +17,7 @@
 //
 // Compile-time parameters, besides those of sweep_framework.cl:
 //   HFVIS_WANT_COUNT        add the visible counts to count_sum
-//   HFVIS_CURVATURE         lower every sample by the Earth's drop (README "Conventions")
+//   HFVIS_CURVATURE         lower every sample by the Earth's drop (docs/CONVENTIONS.md)
 //   HFVIS_WANT_AREA         sum the distances of the visible samples (for the area estimate)
 //   HFVIS_WANT_STATS        per-line totals of receivers, horizons, iterations, ...
 //   HFVIS_WANT_ENTRY_STATS  per-entry (horizons, iterations, horizon hash) for the tests

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# scripts/make_pictures.sh: the pictures README.md shows, made by the CLI from the bundled data
+# scripts/make_pictures.sh: the pictures README.md and docs/ show, made by the CLI from the bundled data
 # into docs/pictures/ (or DIR): the Jacksboro DEM lit by the clear sky (environment and sun,
 # tonemapped), a hillshade with cast shadows, the sky-view factor and ambient occlusion with a
 # contrast stretch, a winter day's direct sunlight, and the fractal field under the sky.

@@ -1,4 +1,4 @@
-// synthetic_fields.cpp: generated hard-case height fields (README, Tests).
+// synthetic_fields.cpp: generated hard-case height fields (docs/TESTING.md).
 #include "hfvis/synthetic_fields.hpp"
 
 #include <algorithm>

@@ -655,7 +655,7 @@ TEST_F(Cli, NaiveMethodAndOptionsRun) {
   EXPECT_EQ(horizons.spec.get_string_attribute("hfvis:cell_size_y"), "1");
 }
 
-// ---- options change the results as the conventions (README) say ----
+// ---- options change the results as the conventions (docs/CONVENTIONS.md) say ----
 
 // On the ramp h = 0.5 col + 0.25 row (pixel units, cell size 1) an inner pixel's horizon
 // toward +columns (h000) is the ramp's slope along columns, toward +rows (h001) along rows:

@@ -1,5 +1,5 @@
 // test_horizon_analytic.cpp: horizons, sky-view factor and ambient occlusion on fields
-// with a closed-form answer (README, Tests: "analytic cases"), for both methods.
+// with a closed-form answer (docs/TESTING.md: "analytic cases"), for both methods.
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -234,7 +234,7 @@ TEST(HorizonLists, AgreeWithTheNaiveKernelAndTheTreeOnTheAxes) {
   expectListsAgreeWithTheKernels(0.004, true);
 }
 
-// The farthest horizon is the horizon of README's conventions (the largest elevation, the farther on
+// The farthest horizon is the horizon of docs/CONVENTIONS.md (the largest elevation, the farther on
 // ties): it equals the naive horizon march's elevation (up to its fast atan).
 TEST(HorizonLists, FarthestHorizonIsTheHorizon) {
   const HeightField field = makeSyntheticField("sine", 40, 41, 1);

@@ -148,7 +148,7 @@ TEST(SunShading, RefusesBadSuns) {
 // The sun's sweep takes the cheapest integer step within 0.02 degree of its azimuth: of up to 64
 // pixels where one is, else a longer one (next to the axes, where the nearest short steps are up
 // to half of atan(1/64) = 0.448 degree away). Over azimuths 0.1 degree apart: how far, and how
-// long the steps get (shading.hpp and README quote these figures).
+// long the steps get (shading.hpp and docs/COMMAND_LINE.md quote these figures).
 TEST(SunShading, SweptStepIsCloseToTheSun) {
   const HeightField field = makeSyntheticField("flat", 8, 8);
   double worst = 0.0;

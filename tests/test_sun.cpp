@@ -45,7 +45,7 @@ TEST(SunPosition, MatchesTheSpaWorkedExample) {
   const double geocentric = e + 8.794 / 3600.0 * std::cos(e * M_PI / 180.0);
   EXPECT_NEAR(p.elevation_deg, geocentric, 0.005);
   EXPECT_NEAR(p.azimuth_deg, 194.34024, 0.005);
-  // The figures README.md quotes.
+  // The figures docs/COMMAND_LINE.md quotes.
   std::printf("SPA worked example: elevation off by %.4f deg, azimuth by %.4f deg\n", p.elevation_deg - geocentric,
               p.azimuth_deg - 194.34024);
   // Asked for, the apparent elevation adds the standard atmosphere's refraction.

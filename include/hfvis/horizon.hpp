@@ -22,7 +22,7 @@ enum class HorizonMethod {
 struct HorizonOptions : SweepOptions {
   HorizonMethod method = HorizonMethod::Sweep;
   // Sweep only. The sweep runs along primitive integer steps (a, b), so that every receiver
-  // lies on a line through its own centre (see README, "How the sweep works"). When the
+  // lies on a line through its own centre (see docs/ALGORITHMS.md). When the
   // per-direction planes are requested, direction k is the cheapest step whose azimuth is
   // within this many radians of phi_k (the closest one when none is; steps up to 64
   // pixels, and for a single direction, K = 1, up to 4096 where no shorter one is within);

@@ -4,7 +4,7 @@
 //
 // Direction k of K has azimuth phi_k = 2*pi*k/K + azimuth_offset, measured on the ground
 // in the (column, row) axes, so the ground direction is (cos phi_k, sin phi_k); with square
-// cells this is the pixel-axes direction itself (README.md, "Conventions"). Compass azimuth
+// cells this is the pixel-axes direction itself (docs/CONVENTIONS.md). Compass azimuth
 // (clockwise from north = row -1) is 90 deg + phi in degrees when rows run south.
 #pragma once
 

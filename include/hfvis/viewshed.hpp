@@ -134,7 +134,7 @@ struct CumulativeViewshed {
 //
 // The regions are conservative: a node is culled only when every point of it is, so rough
 // terrain, whose hidden points are interleaved with points on convex slopes (their horizons are
-// their own slope), culls few coarse nodes (README, "Viewsheds", gives the fractions measured).
+// their own slope), culls few coarse nodes (docs/ALGORITHMS.md gives the fractions measured).
 struct ViewshedPyramidOptions {
   double target_height = 0.0;  // the height above the surface of the targets it culls
   double curvature = 0.0;      // as ViewshedOptions::curvature; queries must use the same
