@@ -1,22 +1,27 @@
-# Embeds every kernels/*.cl into a C++ source as raw strings, expanding
-# #include "name.cl" lines (each file once), so kernels stay valid standalone OpenCL C
-# (compile them alone with -I kernels) and the library needs no files at run time.
+# Embeds every kernels/*.cl (the operations' programs; kernels/shared/ holds the pieces they
+# include) into a C++ source as raw strings, expanding #include "name.cl" lines (each file
+# once), so kernels stay valid standalone OpenCL C (compile them alone with -I kernels) and the
+# library needs no files at run time.
 # Usage: cmake -DKERNEL_DIR=... -DOUTPUT=... -P EmbedKernels.cmake
 
 cmake_minimum_required(VERSION 3.18)
 
+# Quoted includes resolve as the OpenCL and C++ compilers resolve them: from the including
+# file's directory (kernels/ for the kernels, kernels/shared/ for the shared pieces).
 function(expand_includes path out_var seen_var)
   file(READ ${path} text)
+  get_filename_component(dir ${path} DIRECTORY)
   set(seen ${${seen_var}})
-  string(REGEX MATCHALL "#include \"[A-Za-z0-9_]+\\.cl\"" includes "${text}")
+  string(REGEX MATCHALL "#include \"[A-Za-z0-9_/]+\\.cl\"" includes "${text}")
   foreach(inc IN LISTS includes)
-    string(REGEX REPLACE "#include \"([A-Za-z0-9_]+\\.cl)\"" "\\1" name "${inc}")
-    if(name IN_LIST seen)
+    string(REGEX REPLACE "#include \"([A-Za-z0-9_/]+\\.cl)\"" "\\1" name "${inc}")
+    get_filename_component(included ${dir}/${name} ABSOLUTE)
+    if(included IN_LIST seen)
       set(body "")
     else()
-      list(APPEND seen ${name})
+      list(APPEND seen ${included})
       set(${seen_var} ${seen})
-      expand_includes(${KERNEL_DIR}/${name} body ${seen_var})
+      expand_includes(${included} body ${seen_var})
       set(seen ${${seen_var}})
     endif()
     string(REPLACE "${inc}" "${body}" text "${text}")
@@ -33,7 +38,7 @@ string(APPEND out "const std::map<std::string, std::string>& embeddedKernelSourc
 string(APPEND out "  static const std::map<std::string, std::string> sources = {\n")
 foreach(path IN LISTS kernel_files)
   get_filename_component(name ${path} NAME)
-  set(seen ${name})
+  get_filename_component(seen ${path} ABSOLUTE)
   expand_includes(${path} text seen)
   # Raw string literals are limited in length by some compilers: split into chunks.
   string(LENGTH "${text}" len)

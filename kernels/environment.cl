@@ -13,7 +13,7 @@
 #ifndef HFVIS_ENVIRONMENT_CL
 #define HFVIS_ENVIRONMENT_CL
 
-#include "fast_math.cl"
+#include "shared/fast_math.cl"
 
 #ifdef __OPENCL_VERSION__
 #define HFVIS_GLOBAL __global

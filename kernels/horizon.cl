@@ -35,10 +35,10 @@
 //                                            per-row tables `row_length` and `row_terms`
 //   HFVIS_STRIPS                             horizon_lattice resumes lines part-way (a field in
 //                                            strips of rows, see there)
-#include "direction_terms.cl"
+#include "shared/direction_terms.cl"
 #include "environment.cl"
-#include "fast_math.cl"
-#include "sweep_framework.cl"
+#include "shared/fast_math.cl"
+#include "shared/sweep_framework.cl"
 
 #ifndef HFVIS_WANT_ANGLES
 #define HFVIS_WANT_ANGLES 1
@@ -142,7 +142,7 @@ __kernel void occlusion_scale(__global const float2* normals, uint pixels, int p
 // time, 16 lanes 1.26 s, 4 lanes 1.45 s, one line per work-item 2.09 s. On GPUs
 // (step-major layout) each work-item runs one line (HFVIS_LANES 1), so that neighbouring
 // work-items read neighbouring stack entries.
-#include "lanes.cl"
+#include "shared/lanes.cl"
 
 HFVIS_DIRECTION_TERMS(float, int)
 #if HFVIS_LANES > 1

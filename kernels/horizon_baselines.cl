@@ -14,7 +14,7 @@
 //   HFVIS_PYRAMID_NEAR   the pyramid march takes this many unit steps on the full-resolution
 //                        surface, then HFVIS_PYRAMID_NEAR / 2 steps per octave of distance on
 //                        ever coarser levels (step and texel size 2^level); even, >= 2
-#include "sweep_framework.cl"
+#include "shared/sweep_framework.cl"
 
 #ifndef HFVIS_EDGE_EPS  // as in sweep_framework.cl: tolerance of "inside the field", pixels
 #define HFVIS_EDGE_EPS 1e-3f

@@ -41,9 +41,9 @@
 //                           strips; not with the bounce)
 // Every combination builds the same trees (tests/test_intervisibility.cpp): the options
 // change the work (iterations t, memory traffic), never a result.
-#include "chord_side.cl"
-#include "fast_math.cl"
-#include "sweep_framework.cl"
+#include "shared/chord_side.cl"
+#include "shared/fast_math.cl"
+#include "shared/sweep_framework.cl"
 
 #ifndef HFVIS_WANT_COUNT
 #define HFVIS_WANT_COUNT 1

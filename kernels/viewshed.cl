@@ -19,8 +19,8 @@
 // pending target: an exact march, cut short by its ray's upper bound where that settles it).
 #pragma OPENCL FP_CONTRACT OFF
 
-#include "fast_math.cl"
-#include "lanes.cl"
+#include "shared/fast_math.cl"
+#include "shared/lanes.cl"
 
 // Divisions and square roots in the bounds and the classification are native_ ones: the program
 // is built for correctly rounded ones (which the exact marches' few divisions keep), whose

@@ -1,5 +1,5 @@
 // chord_side.hpp: the exact chord predicate of the hull tree for C++ (the scalar
-// references, the horizon lists, the tests): kernels/chord_side.cl itself, the source the
+// references, the horizon lists, the tests): kernels/shared/chord_side.cl itself, the source the
 // kernels compile, included here so the two cannot drift.
 #pragma once
 
@@ -9,7 +9,7 @@ namespace hfvis::detail {
 
 using std::fabs;
 using std::fma;
-#include "../kernels/chord_side.cl"
+#include "../kernels/shared/chord_side.cl"
 
 // Sign of sample b relative to the chord from a to c on one line (a, b, c in line order,
 // b - a = dab > 0 and c - b = dbc > 0 steps, integers below 2^24; finite heights with

@@ -1,5 +1,5 @@
 // direction_terms.hpp: the horizon operation's per-direction terms (elevation, sky view,
-// ambient occlusion) for C++: kernels/direction_terms.cl itself, included here so the scalar
+// ambient occlusion) for C++: kernels/shared/direction_terms.cl itself, included here so the scalar
 // references and the kernels cannot drift.
 #pragma once
 
@@ -10,7 +10,7 @@
 namespace hfvis::detail {
 
 using std::sqrt;
-#include "../kernels/direction_terms.cl"
+#include "../kernels/shared/direction_terms.cl"
 HFVIS_DIRECTION_TERMS(float, int)
 
 }  // namespace hfvis::detail

@@ -1,5 +1,5 @@
 // fast_math.hpp: the kernels' polynomial atan and sin for C++ (the scalar references):
-// kernels/fast_math.cl itself, included here so the two cannot drift.
+// kernels/shared/fast_math.cl itself, included here so the two cannot drift.
 #pragma once
 
 #include <cmath>
@@ -8,7 +8,7 @@ namespace hfvis::detail {
 
 using std::fabs;
 using std::rint;
-#include "../kernels/fast_math.cl"
+#include "../kernels/shared/fast_math.cl"
 
 constexpr float kPiF = HFVIS_PI_F;
 

@@ -1,5 +1,5 @@
 // sweep_framework.hpp: host side of the sweep framework every sweep kernel shares
-// (kernels/sweep_framework.cl): the scratch layout of a context, memory budgets,
+// (kernels/shared/sweep_framework.cl): the scratch layout of a context, memory budgets,
 // buffers, the naive marches' direction uploads, and launch shapes.
 #pragma once
 
@@ -23,7 +23,7 @@ inline std::size_t roundUp(std::size_t n, std::size_t m) { return (n + m - 1) / 
 // automatically line-major on CPUs and step-major elsewhere.
 bool lineMajorLayout(const ContextState& st);
 
-// Lines (or rays) one work-item runs side by side (HFVIS_LANES, kernels/lanes.cl): SIMD lanes
+// Lines (or rays) one work-item runs side by side (HFVIS_LANES, kernels/shared/lanes.cl): SIMD lanes
 // where a work-item runs on a CPU core in the line-major layout; one per work-item on GPUs
 // (whatever the layout: a lane-wide work-item would run alone in its group there) and in the
 // step-major layout, whose neighbouring work-items read neighbouring entries.

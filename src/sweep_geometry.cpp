@@ -1,5 +1,5 @@
 // sweep_geometry.cpp: prepared heights, the ray geometry of a sweep direction and the scalar
-// mirrors of the kernels' sampling helpers (kernels/sweep_framework.cl).
+// mirrors of the kernels' sampling helpers (kernels/shared/sweep_framework.cl).
 #include "sweep_geometry.hpp"
 
 #include <algorithm>

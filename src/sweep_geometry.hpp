@@ -1,6 +1,6 @@
 // sweep_geometry.hpp: the host side of the sweep framework that every operation and the
 // scalar references share without OpenCL: the heights as the kernels see them, the ray
-// geometry of one direction (mirrors `SweepDirection` in kernels/sweep_framework.cl) and the
+// geometry of one direction (mirrors `SweepDirection` in kernels/shared/sweep_framework.cl) and the
 // scalar mirrors of the kernels' sampling helpers, so both sample the very same points.
 #pragma once
 
@@ -14,7 +14,7 @@
 
 namespace hfvis::detail {
 
-// Sixteen 4-byte members, no padding: uploaded as is (see kernels/sweep_framework.cl).
+// Sixteen 4-byte members, no padding: uploaded as is (see kernels/shared/sweep_framework.cl).
 struct SweepDirection {
   float dir_x, dir_y;    // unit line direction in pixel axes (x = column, y = row)
   float perp_x, perp_y;  // (-dir_y, dir_x)

@@ -1,5 +1,5 @@
 // test_fast_math.cpp: accuracy of the polynomial atan/sin that the reductions use
-// (kernels/fast_math.cl, mirrored by src/fast_math.hpp), against the C library in double.
+// (kernels/shared/fast_math.cl, mirrored by src/fast_math.hpp), against the C library in double.
 #include <gtest/gtest.h>
 
 #include <cmath>
