@@ -60,7 +60,7 @@
 #include "hfvis/errors.hpp"
 #include "hfvis/image_io.hpp"
 #include "hfvis/intervisibility.hpp"
-#include "hfvis/synthetic_fields.hpp"
+#include "hfvis_testing/synthetic_fields.hpp"
 #include "methods.hpp"
 #include "metrics.hpp"
 #include "suite.hpp"

@@ -36,7 +36,7 @@
 #include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
 #include "hfvis/image_io.hpp"
-#include "hfvis/synthetic_fields.hpp"
+#include "hfvis_testing/synthetic_fields.hpp"
 #include "lattice_geometry.hpp"
 #include "opencl_context.hpp"
 #include "suite_support.hpp"

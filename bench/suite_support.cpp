@@ -10,7 +10,7 @@
 
 #include "hfvis/errors.hpp"
 #include "hfvis/image_io.hpp"
-#include "hfvis/synthetic_fields.hpp"
+#include "hfvis_testing/synthetic_fields.hpp"
 
 namespace hfvis::bench {
 

@@ -7,7 +7,7 @@
 #include <thread>
 
 #include "hfvis/image_io.hpp"
-#include "hfvis/viewshed_reference.hpp"
+#include "hfvis_testing/viewshed_reference.hpp"
 
 namespace hfvis::bench {
 

@@ -1,5 +1,5 @@
 // bench/viewshed_agreement.hpp: how well viewshed rasters (hfvis's, gdal_viewshed's) agree with
-// the exact sight-line test on the bilinear surface (hfvis/viewshed_reference.hpp), on a random
+// the exact sight-line test on the bilinear surface (hfvis_testing/viewshed_reference.hpp), on a random
 // sample of targets.
 #pragma once
 

@@ -29,7 +29,7 @@
 #include "dense_visibility.hpp"
 #include "environment.hpp"
 #include "hfvis/intervisibility.hpp"
-#include "hfvis/synthetic_fields.hpp"
+#include "hfvis_testing/synthetic_fields.hpp"
 #include "intervisibility_internal.hpp"
 #include "metrics.hpp"
 #include "suite_support.hpp"

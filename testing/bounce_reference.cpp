@@ -2,7 +2,7 @@
 // and their exit radiance sampled as intervisibility_lattice samples them, the gather inside
 // the hull-tree sweep (src/scalar_hull_tree.cpp), and each receiver's irradiance added to
 // its pixel.
-#include "hfvis/bounce_reference.hpp"
+#include "hfvis_testing/bounce_reference.hpp"
 
 #include <cmath>
 #include <limits>

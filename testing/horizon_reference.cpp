@@ -10,7 +10,7 @@
 #include "environment_swaths.hpp"
 #include "environment_terms.hpp"
 #include "fast_math.hpp"
-#include "hfvis/reference.hpp"
+#include "hfvis_testing/horizon_reference.hpp"
 #include "horizon_common.hpp"
 #include "lattice_geometry.hpp"
 #include "reference_internal.hpp"

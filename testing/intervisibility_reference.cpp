@@ -3,7 +3,7 @@
 // (src/scalar_hull_tree.cpp, the mirror of the kernel's), each receiver's results added to
 // its pixel, and the naive visibility march, in the kernels' order, so every per-sample
 // result matches exactly.
-#include "hfvis/intervisibility_reference.hpp"
+#include "hfvis_testing/intervisibility_reference.hpp"
 
 #include <cmath>
 #include <cstdint>

@@ -1,5 +1,5 @@
 // synthetic_fields.cpp: generated hard-case height fields (docs/TESTING.md).
-#include "hfvis/synthetic_fields.hpp"
+#include "hfvis_testing/synthetic_fields.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,5 @@
-// viewshed_reference.cpp: see hfvis/viewshed_reference.hpp.
-#include "hfvis/viewshed_reference.hpp"
+// viewshed_reference.cpp: see hfvis_testing/viewshed_reference.hpp.
+#include "hfvis_testing/viewshed_reference.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "hfvis/hfvis.hpp"
-#include "hfvis/synthetic_fields.hpp"
+#include "hfvis_testing/synthetic_fields.hpp"
 #include "test_support.hpp"
 
 namespace hfvis {

@@ -12,11 +12,11 @@
 #include "bounce_internal.hpp"
 #include "chord_side.hpp"
 #include "hfvis/bounce.hpp"
-#include "hfvis/bounce_reference.hpp"
+#include "hfvis_testing/bounce_reference.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
 #include "hfvis/image_io.hpp"
-#include "hfvis/synthetic_fields.hpp"
+#include "hfvis_testing/synthetic_fields.hpp"
 #include "lattice_geometry.hpp"
 #include "test_support.hpp"
 

@@ -8,7 +8,7 @@
 
 #include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
-#include "hfvis/synthetic_fields.hpp"
+#include "hfvis_testing/synthetic_fields.hpp"
 #include "test_support.hpp"
 
 namespace hfvis {

@@ -14,9 +14,9 @@
 #include "hfvis/environment.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
-#include "hfvis/reference.hpp"
+#include "hfvis_testing/horizon_reference.hpp"
 #include "hfvis/shading.hpp"
-#include "hfvis/synthetic_fields.hpp"
+#include "hfvis_testing/synthetic_fields.hpp"
 #include "test_support.hpp"
 
 namespace hfvis {

@@ -8,8 +8,8 @@
 
 #include "hfvis/horizon.hpp"
 #include "hfvis/image_io.hpp"
-#include "hfvis/reference.hpp"
-#include "hfvis/synthetic_fields.hpp"
+#include "hfvis_testing/horizon_reference.hpp"
+#include "hfvis_testing/synthetic_fields.hpp"
 #include "lattice_geometry.hpp"
 #include "test_support.hpp"
 

@@ -13,7 +13,7 @@
 #include "hfvis/horizon.hpp"
 #include "hfvis/horizon_lists.hpp"
 #include "hfvis/intervisibility.hpp"
-#include "hfvis/synthetic_fields.hpp"
+#include "hfvis_testing/synthetic_fields.hpp"
 #include "horizon_common.hpp"
 #include "sweep_geometry.hpp"
 #include "test_support.hpp"

@@ -10,8 +10,8 @@
 
 #include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
-#include "hfvis/reference.hpp"
-#include "hfvis/synthetic_fields.hpp"
+#include "hfvis_testing/horizon_reference.hpp"
+#include "hfvis_testing/synthetic_fields.hpp"
 #include "horizon_common.hpp"
 #include "reference_internal.hpp"
 #include "test_support.hpp"

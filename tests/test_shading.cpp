@@ -7,9 +7,9 @@
 #include <vector>
 
 #include "hfvis/errors.hpp"
-#include "hfvis/reference.hpp"
+#include "hfvis_testing/horizon_reference.hpp"
 #include "hfvis/shading.hpp"
-#include "hfvis/synthetic_fields.hpp"
+#include "hfvis_testing/synthetic_fields.hpp"
 #include "lattice_geometry.hpp"
 #include "test_support.hpp"
 

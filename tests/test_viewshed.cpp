@@ -11,9 +11,9 @@
 #include "hfvis/errors.hpp"
 #include "hfvis/image_io.hpp"
 #include "hfvis/sweep_options.hpp"
-#include "hfvis/synthetic_fields.hpp"
+#include "hfvis_testing/synthetic_fields.hpp"
 #include "hfvis/viewshed.hpp"
-#include "hfvis/viewshed_reference.hpp"
+#include "hfvis_testing/viewshed_reference.hpp"
 #include "test_support.hpp"
 
 namespace hfvis {

@@ -1,5 +1,5 @@
 // test_viewshed_culling.cpp: Stewart's culling pyramid (buildViewshedPyramid): every point it
-// culls is hidden by brute force (hfvis/viewshed_reference.hpp), clear of grazing; a viewshed
+// culls is hidden by brute force (hfvis_testing/viewshed_reference.hpp), clear of grazing; a viewshed
 // with it equals one without, bit for bit; on rough terrain, a wall whose shadow lies across
 // azimuth 0 (sector ranges that wrap), notched ridges, the hard cases, curvature, target
 // heights and both layouts; bad input.
@@ -12,9 +12,9 @@
 
 #include "hfvis/errors.hpp"
 #include "hfvis/image_io.hpp"
-#include "hfvis/synthetic_fields.hpp"
+#include "hfvis_testing/synthetic_fields.hpp"
 #include "hfvis/viewshed.hpp"
-#include "hfvis/viewshed_reference.hpp"
+#include "hfvis_testing/viewshed_reference.hpp"
 #include "test_support.hpp"
 
 namespace hfvis {

@@ -1,4 +1,4 @@
-// hfvis/bounce_reference.hpp: the scalar C++ reference of computeBounce (test support; not
+// hfvis_testing/bounce_reference.hpp: the scalar C++ reference of computeBounce (test support; not
 // installed).
 #pragma once
 

@@ -1,4 +1,4 @@
-// hfvis/intervisibility_reference.hpp: scalar C++ references of the intervisibility
+// hfvis_testing/intervisibility_reference.hpp: scalar C++ references of the intervisibility
 // kernels: the same convex hull tree, the same samples, the same exact predicate, one line
 // or pixel at a time on the host. The oracles of the tests and baselines of the benchmark
 // (test support library hfvis_testing; not installed).

@@ -1,4 +1,4 @@
-// hfvis/reference.hpp: scalar C++ references of the horizon kernels. Same algorithm, same
+// hfvis_testing/horizon_reference.hpp: scalar C++ references of the horizon kernels. Same algorithm, same
 // sample points, same predicates and operation order as the OpenCL kernels, one pixel or
 // line at a time on the host: the oracles of the tests and the baselines of the benchmark
 // (test support library hfvis_testing; not installed).

@@ -1,4 +1,4 @@
-// hfvis/synthetic_fields.hpp: the hard cases (docs/TESTING.md) as generated height fields,
+// hfvis_testing/synthetic_fields.hpp: the hard cases (docs/TESTING.md) as generated height fields,
 // shared by the tests and the benchmark so both exercise the same inputs (test support
 // library hfvis_testing; not installed).
 #pragma once

@@ -1,4 +1,4 @@
-// hfvis/viewshed_reference.hpp: the viewshed by brute force in double precision: every sight
+// hfvis_testing/viewshed_reference.hpp: the viewshed by brute force in double precision: every sight
 // line decided exactly, cell by cell, on the bilinear surface (hfvis/viewshed.hpp's
 // definition). The oracle of the viewshed tests and the reference of its benchmark (test
 // support library hfvis_testing; not installed).
