@@ -1,6 +1,7 @@
-// oiio_module.cpp: the CLI's OpenImageIO (src/oiio_images.hpp), loaded on its first EXR, PNG or
-// other image that GDAL does not take: the module libhfvis_oiio.so beside the program (the build
-// tree) or in the installed library directory. A run on GeoTIFFs alone never loads it.
+// oiio_module.cpp: the CLI's OpenImageIO (src/oiio_images.hpp), loaded on its first PNG preview
+// or other image that neither GDAL nor OpenEXR takes: the module libhfvis_oiio.so beside the
+// program (the build tree) or in the installed library directory. A run on GeoTIFFs and EXRs
+// never loads it.
 #include <dlfcn.h>
 #include <unistd.h>
 
@@ -42,8 +43,8 @@ const OiioImages* loadModule() {
     reasons += std::string(reasons.empty() ? "" : "; ") + candidate + " has no hfvis_oiio_images";
   }
   throw Error(
-      "EXR, PNG and the other images GDAL does not read need OpenImageIO through the module "
-      "libhfvis_oiio.so, beside the hfvis program or in " HFVIS_OIIO_MODULE_DIR
+      "PNG previews and the images neither GDAL nor OpenEXR reads need OpenImageIO through the "
+      "module libhfvis_oiio.so, beside the hfvis program or in " HFVIS_OIIO_MODULE_DIR
       " from it, which could not be loaded (" +
       reasons + ")");
 }

@@ -1,5 +1,6 @@
 // image_io.cpp: reading height fields and writing results: georeferenced rasters and GeoTIFF
-// outputs are handed to gdal_io.cpp, EXR and other images to OpenImageIO (oiio_images.hpp).
+// outputs are handed to gdal_io.cpp, EXR inputs (by their magic number) and .exr outputs to
+// OpenEXR (exr_images.hpp), PNG previews and the other images to OpenImageIO (oiio_images.hpp).
 #include "hfvis/image_io.hpp"
 
 #include <algorithm>
@@ -12,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "exr_images.hpp"
 #include "gdal_io.hpp"
 #include "hfvis/errors.hpp"
 #include "oiio_images.hpp"
@@ -22,21 +24,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Writes an image through OpenImageIO (oiio_images.hpp) to `file`, naming `path` in errors:
-// width x height pixels of names.size() channels, Pixel float or 8-bit, the rows from
-// fill_rows(y_begin, y_end, Pixel* buffer).
-template <typename Pixel, typename FillRows>
-void writeOiioFile(const std::string& file, const std::string& path, int width, int height,
-                   const std::vector<std::string>& names,
-                   const std::vector<std::pair<std::string, std::string>>& attributes, FillRows fill_rows) {
-  detail::oiioImages().write(
-      file, path, width, height, names, sizeof(Pixel) == 1, attributes,
-      [&](int y_begin, int y_end, void* rows) { fill_rows(y_begin, y_end, static_cast<Pixel*>(rows)); });
+// Reads an image GDAL does not take: an EXR (by its magic number, whatever its name) through
+// OpenEXR, anything else through OpenImageIO.
+ImageChannels readOtherImage(const std::string& path, std::uint64_t max_image_bytes,
+                             const std::string* channel) {
+  detail::requireInputFile(path);
+  if (detail::isExrFile(path)) return detail::readExr(path, max_image_bytes, channel);
+  return detail::oiioImages().read(path, max_image_bytes, channel);
 }
-
-}  // namespace
-
-namespace {
 
 std::string attributeOf(const ImageChannels& image, const std::string& name) {
   for (const auto& [key, value] : image.attributes)
@@ -48,8 +43,7 @@ std::string attributeOf(const ImageChannels& image, const std::string& name) {
 
 HeightField readHeightField(const std::string& path, const HeightFieldReadOptions& options) {
   if (detail::isGdalRaster(path)) return detail::readGdalHeightField(path, options);
-  detail::requireInputFile(path);
-  ImageChannels image = detail::oiioImages().read(path, options.max_image_bytes, &options.channel);
+  ImageChannels image = readOtherImage(path, options.max_image_bytes, &options.channel);
   HeightField field;
   field.width = image.width;
   field.height = image.height;
@@ -72,8 +66,7 @@ HeightField readHeightField(const std::string& path, const HeightFieldReadOption
 
 ImageChannels readImage(const std::string& path) {
   if (detail::isGdalRaster(path)) return detail::readGdalImage(path);
-  detail::requireInputFile(path);
-  ImageChannels image = detail::oiioImages().read(path, 0, nullptr);
+  ImageChannels image = readOtherImage(path, 0, nullptr);
   image.attributes.clear();
   return image;
 }
@@ -158,18 +151,7 @@ void writeImageFile(const std::string& file, const std::string& path, const Imag
     detail::syncFile(file, path);
     return;
   }
-  const int channels = static_cast<int>(image.planes.size());
-  writeOiioFile<float>(file, path, image.width, image.height, image.names, image.attributes,
-                       [&](int y_begin, int y_end, float* rows) {
-                         for (int y = y_begin; y < y_end; ++y) {
-                           for (int x = 0; x < image.width; ++x) {
-                             const std::size_t src = static_cast<std::size_t>(y) * image.width + x;
-                             float* pixel =
-                                 rows + (static_cast<std::size_t>(y - y_begin) * image.width + x) * channels;
-                             for (int c = 0; c < channels; ++c) pixel[c] = image.planes[c][src];
-                           }
-                         }
-                       });
+  detail::writeExr(file, path, image);  // requireImageWriter let only .exr through
 }
 
 }  // namespace
@@ -242,12 +224,12 @@ void OutputFiles::previewPng(const std::string& path, int width, int height, con
 
   requirePreviewWriter(path);
   stage(path, [&](const std::string& file) {
-    writeOiioFile<std::uint8_t>(file, path, width, height, {"Y"}, {},
-                                [&](int y_begin, int y_end, std::uint8_t* rows) {
-                                  const std::size_t begin = static_cast<std::size_t>(y_begin) * width;
-                                  const std::size_t end = static_cast<std::size_t>(y_end) * width;
-                                  for (std::size_t i = begin; i < end; ++i) rows[i - begin] = grey(plane[i]);
-                                });
+    detail::oiioImages().write(file, path, width, height, {"Y"},
+                               [&](int y_begin, int y_end, std::uint8_t* rows) {
+                                 const std::size_t begin = static_cast<std::size_t>(y_begin) * width;
+                                 const std::size_t end = static_cast<std::size_t>(y_end) * width;
+                                 for (std::size_t i = begin; i < end; ++i) rows[i - begin] = grey(plane[i]);
+                               });
   });
 }
 
@@ -301,8 +283,8 @@ void OutputFiles::toneMappedPng(const std::string& path, int width, int height,
       rgb ? std::vector<std::string>{"R", "G", "B"} : std::vector<std::string>{"Y"};
   requirePreviewWriter(path);
   stage(path, [&](const std::string& file) {
-    writeOiioFile<std::uint8_t>(
-        file, path, width, height, names, {}, [&](int y_begin, int y_end, std::uint8_t* rows) {
+    detail::oiioImages().write(
+        file, path, width, height, names, [&](int y_begin, int y_end, std::uint8_t* rows) {
           const std::size_t begin = static_cast<std::size_t>(y_begin) * width;
           const std::size_t end = static_cast<std::size_t>(y_end) * width;
           for (std::size_t i = begin; i < end; ++i) {

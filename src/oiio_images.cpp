@@ -1,5 +1,6 @@
-// oiio_images.cpp: EXR, PNG and the other images GDAL does not take, through OpenImageIO
-// (oiio_images.hpp): reading channels as stored values, and writing rows to a file.
+// oiio_images.cpp: PNG, TIFF bytes under another extension and the other images neither GDAL nor
+// OpenEXR (exr_images.cpp) takes, through OpenImageIO (oiio_images.hpp): reading channels as
+// stored values, and writing 8-bit previews.
 #include "oiio_images.hpp"
 
 #include <OpenImageIO/filesystem.h>
@@ -18,52 +19,14 @@
 #include <vector>
 
 #include "hfvis/errors.hpp"
+#include "image_reading.hpp"
 #include "output_files.hpp"
 
 namespace hfvis::detail {
 namespace {
 
-std::string joinNames(const std::vector<std::string>& names) {
-  std::string joined;
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    if (i > 0) joined += ", ";
-    joined += "'" + names[i] + "'";
-  }
-  return joined;
-}
-
-// OpenImageIO's error strings sometimes end in a newline; a reason reads better without it.
-std::string trimmed(std::string text) {
-  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
-  return text;
-}
-
-std::string withDetail(const std::string& reason, const std::string& detail) {
-  const std::string d = trimmed(detail);
-  return d.empty() ? reason : reason + " (" + d + ")";
-}
-
 // ---------------------------------------------------------------------------------------------
 // Reading pixels.
-
-int selectChannel(const std::string& path, const OIIO::ImageSpec& spec, const std::string& choice) {
-  const std::vector<std::string>& names = spec.channelnames;
-  const std::string available = std::to_string(spec.nchannels) + " channels: " + joinNames(names);
-  if (choice.empty()) {
-    if (spec.nchannels == 1) return 0;
-    throw IoError(path,
-                  "image has " + available + "; choose one by name or zero-based index (hfvis --channel)");
-  }
-  for (int c = 0; c < spec.nchannels && c < static_cast<int>(names.size()); ++c) {
-    if (names[c] == choice) return c;
-  }
-  if (choice.size() <= 9 &&
-      std::all_of(choice.begin(), choice.end(), [](char ch) { return ch >= '0' && ch <= '9'; })) {
-    const int index = std::stoi(choice);
-    if (index < spec.nchannels) return index;
-  }
-  throw IoError(path, "no channel '" + choice + "' (image has " + available + ")");
-}
 
 template <typename T>
 void convertIntegers(const std::vector<unsigned char>& raw, double rescale, std::vector<float>* out) {
@@ -78,9 +41,10 @@ void convertIntegers(const std::vector<unsigned char>& raw, double rescale, std:
 // blocks of rows, the buffer growing with the rows read: a header that claims more pixels
 // than the file holds fails at its first missing rows, not after allocating the whole claim.
 // Rows are read in the file's own format and converted here: OpenImageIO's converting
-// read_scanlines buffers at least 256 rows of every channel whatever it is asked for (16 GB
-// for a 422-byte EXR claiming 16 million columns); a block here holds about 16 MiB of rows
-// of every channel (what a reader may buffer for a channel subset), one row at least.
+// read_scanlines buffers at least 256 rows of every channel whatever it is asked for (it took
+// 16 GB for a 422-byte EXR claiming 16 million columns, when EXRs came this way); a block here
+// holds about 16 MiB of rows of every channel (what a reader may buffer for a channel subset),
+// one row at least.
 // Tiled files are read whole (OpenImageIO reads them a tile row at a time internally).
 template <typename T>
 std::vector<T> readRows(const std::string& path, OIIO::ImageInput& in, int ch, OIIO::TypeDesc as) {
@@ -185,42 +149,21 @@ std::vector<float> readChannel(const std::string& path, OIIO::ImageInput& in, in
 // ---------------------------------------------------------------------------------------------
 // Reading and writing.
 
-// Opens an image for reading, with the checks every reader shares: the file exists, is not
-// empty, and holds a 2D, non-deep image with pixels.
-constexpr std::uint64_t kDefaultMaxImageBytes = std::uint64_t(64) << 30;
-
+// Opens an image for reading, with the checks every reader shares (image_reading.hpp): a 2D,
+// non-deep image with pixels, below 2^31 of them, whose header claims no more than the limit.
 std::unique_ptr<OIIO::ImageInput> openImage(const std::string& path, std::uint64_t max_image_bytes) {
   std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(path);
   if (!in) throw IoError(path, withDetail("cannot read as an image", OIIO::geterror()));
   const OIIO::ImageSpec& spec = in->spec();
-  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0) {
-    throw IoError(path, "image is empty (" + std::to_string(spec.width) + " x " +
-                            std::to_string(spec.height) + " pixels, " + std::to_string(spec.nchannels) +
-                            " channels)");
-  }
-  // The kernels index pixels with 32-bit integers (computeHorizons refuses larger fields), so
-  // a larger image is refused before any of it is read.
-  if (static_cast<std::uint64_t>(spec.width) * static_cast<std::uint64_t>(spec.height) >=
-      (std::uint64_t(1) << 31)) {
-    throw IoError(path, "image is " + std::to_string(spec.width) + " x " + std::to_string(spec.height) +
-                            " pixels; hfvis reads fields below 2^31 pixels (split it into tiles)");
-  }
-  // What the header claims, before the readers allocate for it (a damaged or hostile header
-  // can claim terabytes in a few bytes).
+  requirePixelCount(path, spec.width, spec.height, spec.nchannels);
   // A TIFF's strips and a tiled file's tiles may claim more rows than the image has;
   // OpenImageIO buffers a whole strip or row of tiles.
-  const std::uint64_t limit = max_image_bytes ? max_image_bytes : kDefaultMaxImageBytes;
   const std::uint64_t rows = std::max<std::uint64_t>(
       {static_cast<std::uint64_t>(spec.height),
        static_cast<std::uint64_t>(std::max(0, spec.get_int_attribute("tiff:RowsPerStrip", 0))),
        static_cast<std::uint64_t>(std::max(0, spec.tile_height))});
-  const std::uint64_t scanline = static_cast<std::uint64_t>(spec.width) * spec.pixel_bytes(true);
-  if (scanline / std::max<std::uint64_t>(spec.width, 1) != spec.pixel_bytes(true) ||
-      scanline * rows / rows != scanline || scanline * rows > limit) {
-    throw IoError(path, "image claims " + std::to_string(spec.width) + " x " + std::to_string(spec.height) +
-                            " pixels of " + std::to_string(spec.nchannels) + " channels, more than the " +
-                            std::to_string(limit >> 20) + " MiB read at most");
-  }
+  requireClaimWithin(path, max_image_bytes, spec.width, spec.height, spec.nchannels,
+                     static_cast<std::uint64_t>(spec.width) * spec.pixel_bytes(true), rows);
   if (spec.depth > 1) throw IoError(path, "volume images (depth > 1) are not supported");
   if (spec.deep) throw IoError(path, "deep images are not supported");
   return in;
@@ -234,8 +177,10 @@ ImageChannels read(const std::string& path, std::uint64_t max_image_bytes, const
   image.height = spec.height;
   try {
     if (channel) {
-      const int c = selectChannel(path, spec, *channel);
-      image.names.push_back(c < static_cast<int>(spec.channelnames.size()) ? spec.channelnames[c] : "");
+      std::vector<std::string> names = spec.channelnames;
+      names.resize(static_cast<std::size_t>(spec.nchannels));
+      const int c = chooseChannel(path, names, *channel);
+      image.names.push_back(names[c]);
       image.planes.push_back(readChannel(path, *in, c));
     } else {
       for (int c = 0; c < spec.nchannels; ++c) {
@@ -265,8 +210,8 @@ bool canWrite(const std::string& path) {
 }
 
 // The file an image is written to, through a descriptor whose every write, flush and close is
-// checked: OpenImageIO's own files drop the errors of a buffered write (a small EXR or PNG on a
-// full disk came out empty with no error), and a writer may ignore a short write.
+// checked: OpenImageIO's own files drop the errors of a buffered write (a small PNG on a full
+// disk came out empty with no error), and a writer may ignore a short write.
 class CheckedFile final : public OIIO::Filesystem::IOProxy {
  public:
   explicit CheckedFile(const std::string& file) : IOProxy(file, Write) {
@@ -319,15 +264,13 @@ class CheckedFile final : public OIIO::Filesystem::IOProxy {
 };
 
 void write(const std::string& file, const std::string& path, int width, int height,
-           const std::vector<std::string>& names, bool bytes,
-           const std::vector<std::pair<std::string, std::string>>& attributes,
-           const std::function<void(int, int, void*)>& fill_rows) {
+           const std::vector<std::string>& names,
+           const std::function<void(int, int, std::uint8_t*)>& fill_rows) {
   const int channels = static_cast<int>(names.size());
-  OIIO::ImageSpec spec(width, height, channels, bytes ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
+  OIIO::ImageSpec spec(width, height, channels, OIIO::TypeDesc::UINT8);
   spec.channelnames = names;
   spec.alpha_channel = -1;  // every channel is data; none may be treated as alpha
   spec.z_channel = -1;
-  for (const auto& [name, value] : attributes) spec.attribute(name, value);
   std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create(file);
   if (!out) throw IoError(path, withDetail("no image writer for this file", OIIO::geterror()));
   if (!out->supports("ioproxy"))
@@ -344,8 +287,7 @@ void write(const std::string& file, const std::string& path, int width, int heig
   const std::size_t row_values = static_cast<std::size_t>(width) * channels;
   const int rows_per_chunk =
       static_cast<int>(std::clamp<std::size_t>((std::size_t(1) << 22) / row_values, 1, 256));
-  std::vector<unsigned char> buffer(row_values * (bytes ? 1 : sizeof(float)) *
-                                    static_cast<std::size_t>(std::min(rows_per_chunk, height)));
+  std::vector<std::uint8_t> buffer(row_values * static_cast<std::size_t>(std::min(rows_per_chunk, height)));
   for (int y = 0; y < height; y += rows_per_chunk) {
     const int y_end = std::min(height, y + rows_per_chunk);
     fill_rows(y, y_end, buffer.data());

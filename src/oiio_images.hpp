@@ -1,14 +1,15 @@
-// oiio_images.hpp: what image_io.cpp asks of OpenImageIO (EXR, PNG and the other images GDAL
-// does not take), as a table of functions. The library links them (oiio_images.cpp); the CLI
-// loads the same code as a module on its first such image (cli/oiio_module.cpp), so that a run
-// on GeoTIFFs never loads OpenImageIO and the ~250 shared libraries it pulls in (a quarter of a
-// second at every start, measured on the test machines).
+// oiio_images.hpp: what image_io.cpp asks of OpenImageIO, as a table of functions: reading PNG,
+// TIFF bytes under another extension and the other images neither GDAL (gdal_io.hpp) nor
+// OpenEXR (exr_images.hpp) takes, and writing 8-bit previews. The library links them
+// (oiio_images.cpp); the CLI loads the same code as a module on its first such image
+// (cli/oiio_module.cpp), so that a run on GeoTIFFs and EXRs never loads OpenImageIO and the ~250
+// shared libraries it pulls in (a quarter of a second at every start, measured on the test
+// machines).
 #pragma once
 
 #include <cstdint>
 #include <functional>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "hfvis/image_io.hpp"
@@ -25,13 +26,11 @@ struct OiioImages {
   ImageChannels (*read)(const std::string& path, std::uint64_t max_image_bytes, const std::string* channel);
   // Whether OpenImageIO has a writer for the extension of `path`.
   bool (*can_write)(const std::string& path);
-  // Writes width x height pixels of names.size() channels (float, or 8-bit where `bytes`) with
-  // `attributes` to `file`, the rows from fill_rows(y_begin, y_end, buffer) in chunks. Throws
-  // IoError naming `path`.
+  // Writes width x height pixels of names.size() 8-bit channels to `file`, the rows from
+  // fill_rows(y_begin, y_end, buffer) in chunks. Throws IoError naming `path`.
   void (*write)(const std::string& file, const std::string& path, int width, int height,
-                const std::vector<std::string>& names, bool bytes,
-                const std::vector<std::pair<std::string, std::string>>& attributes,
-                const std::function<void(int, int, void*)>& fill_rows);
+                const std::vector<std::string>& names,
+                const std::function<void(int, int, std::uint8_t*)>& fill_rows);
 };
 
 // The table: oiio_images.cpp's own functions in the library, the module's in the CLI.

@@ -544,15 +544,17 @@ TEST_F(Cli, NoOpenClPlatformSaysWhichPackageProvidesOne) {
 }
 
 TEST_F(Cli, OpenImageIoIsLoadedOnlyForTheImagesThatNeedIt) {
-  // The program itself does not link OpenImageIO (a start loads none of its libraries)...
+  // The program itself does not link OpenImageIO (a start loads none of its libraries); it
+  // links OpenEXR, which reads and writes every EXR...
   const fs::path ldd_out = root_ / "ldd.txt";
   ASSERT_EQ(
       std::system(("ldd " + shellQuoted(HFVIS_CLI_PATH) + " >" + shellQuoted(ldd_out.string())).c_str()), 0);
   const std::string libraries = readText(ldd_out);
   EXPECT_NE(libraries.find("libgdal"), std::string::npos) << libraries;
+  EXPECT_NE(libraries.find("libOpenEXR"), std::string::npos) << libraries;
   EXPECT_EQ(libraries.find("libOpenImageIO"), std::string::npos) << libraries;
-  // ...and a copy of it without the module beside it still runs on GeoTIFFs, while an EXR
-  // says what is missing and writes nothing.
+  // ...so a copy of it without the module beside it still runs on GeoTIFFs and EXRs, while a PNG
+  // preview says what is missing and writes nothing.
   const fs::path bare = root_ / "bare";
   fs::create_directories(bare);
   fs::copy_file(HFVIS_CLI_PATH, bare / "hfvis");
@@ -573,9 +575,14 @@ TEST_F(Cli, OpenImageIoIsLoadedOnlyForTheImagesThatNeedIt) {
   EXPECT_EQ(geotiff.first, 0) << geotiff.second;
   EXPECT_TRUE(fs::exists(out("v.tif")));
   const auto exr = run_bare("svf " + shellQuoted(ramp()) + " -o " + shellQuoted(out("s.exr")) + " -k 4 -q");
-  EXPECT_EQ(exr.first, 1);
-  EXPECT_NE(exr.second.find("libhfvis_oiio.so"), std::string::npos) << exr.second;
-  EXPECT_FALSE(fs::exists(out("s.exr")));
+  EXPECT_EQ(exr.first, 0) << exr.second;
+  EXPECT_EQ(readBack(out("s.exr")).channels, std::vector<std::string>{"svf"});
+  const auto png = run_bare("svf " + shellQuoted(ramp()) + " -o " + shellQuoted(out("p.exr")) +
+                            " -k 4 -q --preview " + shellQuoted(out("p.png")));
+  EXPECT_EQ(png.first, 1);
+  EXPECT_NE(png.second.find("libhfvis_oiio.so"), std::string::npos) << png.second;
+  EXPECT_FALSE(fs::exists(out("p.exr")));
+  EXPECT_FALSE(fs::exists(out("p.png")));
 }
 
 // ---- successful runs ----

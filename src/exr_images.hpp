@@ -1,0 +1,34 @@
+// exr_images.hpp: EXR files through OpenEXR's own library (exr_images.cpp), which image_io.cpp
+// uses for every EXR input (found by its magic number) and .exr output. OpenEXR's few libraries
+// load in milliseconds, so the library and the CLI link them directly; OpenImageIO
+// (oiio_images.hpp) is left to PNG previews and the other images.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "hfvis/image_io.hpp"
+
+namespace hfvis::detail {
+
+// Whether the file at `path` begins with OpenEXR's magic number (0x762f3101, "v/1\x01"); false
+// for a file that cannot be read.
+bool isExrFile(const std::string& path);
+
+// Part 0 of the EXR `path` as float32 planes (half and float channels as they are, unsigned
+// integer channels as their values, not normalised; the data window's pixels, wherever it lies):
+// the channel `*channel` names (a name or a zero-based index; "" where the image has one
+// channel), or every channel where `channel` is null, in the order OpenImageIO gave them before
+// (see channel_order in exr_images.cpp). attributes: the string attributes hfvis:cell_size_x and
+// hfvis:cell_size_y where the part has them. Throws IoError (unreadable, empty, a deep image, a
+// subsampled channel, 2^31 pixels or more, a header claiming more than max_image_bytes, 0 =
+// 64 GiB, or attributes larger than the file; a channel it lacks; truncated or corrupt pixels).
+ImageChannels readExr(const std::string& path, std::uint64_t max_image_bytes, const std::string* channel);
+
+// Writes `image` (checked by the caller: consistent, unique channel names) to `file` as a
+// one-part scanline EXR: float32 channels, ZIP compression, the data window at (0, 0), the
+// attributes as string attributes. Every write, the flush to the disk and the close are checked.
+// Throws IoError naming `path`.
+void writeExr(const std::string& file, const std::string& path, const ImageChannels& image);
+
+}  // namespace hfvis::detail

@@ -1,0 +1,410 @@
+// test_exr_images.cpp: EXR inputs and outputs through OpenEXR (src/exr_images.cpp): files written
+// here with OpenEXR's own API (half, float and unsigned channels, tiles and mipmaps, a data window
+// away from the origin, several parts, deep and subsampled images) read back as the OpenImageIO
+// path read them, channel order included; hostile headers refused quickly without allocating
+// what they claim; outputs as OpenImageIO wrote them (float32, ZIP, string attributes).
+#include <ImfChannelList.h>
+#include <ImfDeepFrameBuffer.h>
+#include <ImfDeepScanLineOutputFile.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfMultiPartOutputFile.h>
+#include <ImfOutputFile.h>
+#include <ImfOutputPart.h>
+#include <ImfPartType.h>
+#include <ImfStringAttribute.h>
+#include <ImfTiledOutputFile.h>
+#include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "hfvis/environment.hpp"
+#include "hfvis/errors.hpp"
+#include "hfvis/image_io.hpp"
+
+namespace hfvis {
+namespace {
+
+namespace fs = std::filesystem;
+
+class ImageIoExrTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::path(HFVIS_TEST_TMP_DIR) / "exr_images" / info->name();
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  fs::path dir_;
+};
+
+// Expects `call` to throw IoError naming `path` whose message holds `part`.
+template <typename Call>
+void expectIoError(const std::string& path, Call call, const std::string& part) {
+  try {
+    call();
+    ADD_FAILURE() << "no IoError for " << path;
+  } catch (const IoError& e) {
+    EXPECT_EQ(e.path(), path);
+    EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+  }
+}
+
+// Distinct values per channel and pixel: channel c, pixel i holds c * 1000 + i.
+float valueOf(std::size_t c, std::size_t i) { return static_cast<float>(c * 1000 + i); }
+
+// A scanline EXR of `names` (all `type`), each channel filled by valueOf in the order given,
+// over `window` (display window the same).
+void writeScanlineExr(const std::string& file, const std::vector<std::string>& names, Imf::PixelType type,
+                      const Imath::Box2i& window, Imf::Compression compression = Imf::ZIP_COMPRESSION) {
+  Imf::Header header(window, window);
+  header.compression() = compression;
+  const int width = window.max.x - window.min.x + 1, height = window.max.y - window.min.y + 1;
+  const std::size_t n = static_cast<std::size_t>(width) * height;
+  std::vector<std::vector<float>> floats(names.size(), std::vector<float>(n));
+  std::vector<std::vector<half>> halves(names.size(), std::vector<half>(n));
+  std::vector<std::vector<unsigned>> uints(names.size(), std::vector<unsigned>(n));
+  Imf::FrameBuffer frame;
+  for (std::size_t c = 0; c < names.size(); ++c) {
+    header.channels().insert(names[c], Imf::Channel(type));
+    for (std::size_t i = 0; i < n; ++i) {
+      floats[c][i] = valueOf(c, i);
+      halves[c][i] = half(valueOf(c, i));
+      uints[c][i] = static_cast<unsigned>(valueOf(c, i));
+    }
+    char* base = type == Imf::FLOAT  ? reinterpret_cast<char*>(floats[c].data())
+                 : type == Imf::HALF ? reinterpret_cast<char*>(halves[c].data())
+                                     : reinterpret_cast<char*>(uints[c].data());
+    const std::size_t size = type == Imf::HALF ? 2 : 4;
+    frame.insert(names[c], Imf::Slice::Make(type, base, window.min, width, height, size, size * width));
+  }
+  Imf::OutputFile out(file.c_str(), header);
+  out.setFrameBuffer(frame);
+  out.writePixels(height);
+}
+
+Imath::Box2i windowOf(int width, int height, int x0 = 0, int y0 = 0) {
+  return Imath::Box2i(Imath::V2i(x0, y0), Imath::V2i(x0 + width - 1, y0 + height - 1));
+}
+
+std::vector<std::string> oiioChannelNames(const std::string& file) {
+  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(file);
+  if (!in) {
+    ADD_FAILURE() << OIIO::geterror();
+    return {};
+  }
+  return in->spec().channelnames;
+}
+
+TEST_F(ImageIoExrTest, ChannelsComeInTheOrderOpenImageIoGaveThem) {
+  // In the file (sorted by name): A B G R Y Z albedo diffuse.G diffuse.R normal.X normal.Y
+  // normal.Z zeta; as OpenImageIO gave them: layers apart, colours, Y and alpha first, X Y Z of
+  // a position or normal layer in that order.
+  const std::vector<std::string> names = {"Z",         "A",        "B",        "G",        "R",
+                                          "albedo",    "normal.X", "normal.Y", "normal.Z", "diffuse.R",
+                                          "diffuse.G", "zeta",     "Y"};
+  const std::string file = path("layers.exr");
+  writeScanlineExr(file, names, Imf::FLOAT, windowOf(3, 2));
+  const ImageChannels image = readImage(file);
+  const std::vector<std::string> expected = {"R",        "G",        "B",       "Y",         "A",
+                                             "Z",        "albedo",   "zeta",    "diffuse.R", "diffuse.G",
+                                             "normal.X", "normal.Y", "normal.Z"};
+  EXPECT_EQ(image.names, expected);
+  EXPECT_EQ(image.names, oiioChannelNames(file));
+  ASSERT_EQ(image.planes.size(), names.size());
+  for (std::size_t c = 0; c < image.names.size(); ++c) {
+    const std::size_t written = std::find(names.begin(), names.end(), image.names[c]) - names.begin();
+    for (std::size_t i = 0; i < 6; ++i) EXPECT_EQ(image.planes[c][i], valueOf(written, i)) << image.names[c];
+  }
+  // A channel by index counts in that order.
+  HeightFieldReadOptions options;
+  options.channel = "3";
+  EXPECT_EQ(readHeightField(file, options).heights, image.planes[3]);
+}
+
+TEST_F(ImageIoExrTest, HalfAndUnsignedChannelsReadAsTheirValues) {
+  const std::string halves = path("half.exr"), uints = path("uint.exr");
+  writeScanlineExr(halves, {"Y"}, Imf::HALF, windowOf(5, 3));
+  writeScanlineExr(uints, {"U", "V"}, Imf::UINT, windowOf(5, 3));
+  const HeightField field = readHeightField(halves);
+  for (std::size_t i = 0; i < 15; ++i) EXPECT_EQ(field.heights[i], valueOf(0, i));  // exact in half
+  const ImageChannels image = readImage(uints);
+  ASSERT_EQ(image.names, (std::vector<std::string>{"U", "V"}));
+  for (std::size_t i = 0; i < 15; ++i) EXPECT_EQ(image.planes[1][i], valueOf(1, i));  // not normalised
+}
+
+TEST_F(ImageIoExrTest, TiledMipmappedFileReadsItsFullResolution) {
+  const int width = 37, height = 23;
+  const Imath::Box2i window = windowOf(width, height, -5, 9);  // the data window anywhere
+  Imf::Header header(window, window);
+  header.setTileDescription(Imf::TileDescription(8, 4, Imf::MIPMAP_LEVELS));
+  header.channels().insert("height", Imf::Channel(Imf::FLOAT));
+  const std::string file = path("tiled.exr");
+  std::vector<float> heights(static_cast<std::size_t>(width) * height);
+  for (std::size_t i = 0; i < heights.size(); ++i) heights[i] = valueOf(0, i) - 500.0f;
+  {
+    Imf::TiledOutputFile out(file.c_str(), header);
+    for (int level = 0; level < out.numLevels(); ++level) {
+      const int w = out.levelWidth(level), h = out.levelHeight(level);
+      std::vector<float> pixels(static_cast<std::size_t>(w) * h);
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+          pixels[static_cast<std::size_t>(y) * w + x] =
+              level == 0 ? heights[static_cast<std::size_t>(y) * w + x] : -1.0f;
+      Imf::FrameBuffer frame;
+      frame.insert("height", Imf::Slice::Make(Imf::FLOAT, pixels.data(), window.min, w, h));
+      out.setFrameBuffer(frame);
+      out.writeTiles(0, out.numXTiles(level) - 1, 0, out.numYTiles(level) - 1, level);
+    }
+  }
+  const HeightField field = readHeightField(file);
+  EXPECT_EQ(field.width, width);
+  EXPECT_EQ(field.height, height);
+  EXPECT_EQ(field.heights, heights);
+}
+
+TEST_F(ImageIoExrTest, DataWindowAwayFromTheOriginIsTheImage) {
+  const std::string file = path("window.exr");
+  const Imath::Box2i window = windowOf(6, 40, 1000, -300);  // three ZIP chunks of 16 rows
+  Imf::Header header(windowOf(4, 4), window);               // a display window elsewhere
+  header.channels().insert("Y", Imf::Channel(Imf::FLOAT));
+  std::vector<float> pixels(6 * 40);
+  for (std::size_t i = 0; i < pixels.size(); ++i) pixels[i] = valueOf(0, i);
+  {
+    Imf::OutputFile out(file.c_str(), header);
+    Imf::FrameBuffer frame;
+    frame.insert("Y", Imf::Slice::Make(Imf::FLOAT, pixels.data(), window.min, 6, 40));
+    out.setFrameBuffer(frame);
+    out.writePixels(40);
+  }
+  const HeightField field = readHeightField(file);
+  EXPECT_EQ(field.width, 6);
+  EXPECT_EQ(field.height, 40);
+  EXPECT_EQ(field.heights, pixels);
+}
+
+TEST_F(ImageIoExrTest, MultiPartFileReadsItsFirstPart) {
+  const std::string file = path("parts.exr");
+  std::vector<Imf::Header> headers(2, Imf::Header(3, 2));
+  headers[0].setName("first");
+  headers[0].channels().insert("Y", Imf::Channel(Imf::FLOAT));
+  headers[1] = Imf::Header(windowOf(3, 2), windowOf(5, 5));  // parts share their display window
+  headers[1].setName("second");
+  headers[1].channels().insert("R", Imf::Channel(Imf::FLOAT));
+  headers[1].channels().insert("G", Imf::Channel(Imf::FLOAT));
+  for (Imf::Header& h : headers) h.setType(Imf::SCANLINEIMAGE);
+  headers[0].insert("hfvis:cell_size_x", Imf::StringAttribute("2.5"));
+  headers[0].insert("hfvis:cell_size_y", Imf::StringAttribute("4"));
+  {
+    Imf::MultiPartOutputFile out(file.c_str(), headers.data(), 2);
+    std::vector<float> first = {1, 2, 3, 4, 5, 6}, second(25, 9.0f);
+    Imf::OutputPart part0(out, 0), part1(out, 1);
+    Imf::FrameBuffer frame0, frame1;
+    frame0.insert("Y", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(first.data()), 4, 12));
+    for (const char* name : {"R", "G"})
+      frame1.insert(name, Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(second.data()), 4, 20));
+    part0.setFrameBuffer(frame0);
+    part0.writePixels(2);
+    part1.setFrameBuffer(frame1);
+    part1.writePixels(5);
+  }
+  const HeightField field = readHeightField(file);
+  EXPECT_EQ(field.width, 3);
+  EXPECT_EQ(field.heights, (std::vector<float>{1, 2, 3, 4, 5, 6}));
+  EXPECT_EQ(field.cell_size_x, 2.5);
+  EXPECT_EQ(field.cell_size_y, 4.0);
+}
+
+TEST_F(ImageIoExrTest, ExrUnderAnotherExtensionIsReadByItsContent) {
+  const std::string file = path("field.png");
+  writeScanlineExr(file, {"Y"}, Imf::FLOAT, windowOf(4, 2));
+  EXPECT_EQ(readHeightField(file).heights, (std::vector<float>{0, 1, 2, 3, 4, 5, 6, 7}));
+}
+
+TEST_F(ImageIoExrTest, DeepAndSubsampledImagesAreRefused) {
+  const std::string deep = path("deep.exr");
+  {
+    Imf::Header header(2, 2);
+    header.setType(Imf::DEEPSCANLINE);
+    header.compression() = Imf::ZIPS_COMPRESSION;
+    header.channels().insert("Z", Imf::Channel(Imf::FLOAT));
+    Imf::DeepScanLineOutputFile out(deep.c_str(), header);
+    std::vector<unsigned> counts(4, 1);
+    std::vector<float> depth = {1, 2, 3, 4};
+    std::vector<float*> samples = {&depth[0], &depth[1], &depth[2], &depth[3]};
+    Imf::DeepFrameBuffer frame;
+    frame.insertSampleCountSlice(Imf::Slice(Imf::UINT, reinterpret_cast<char*>(counts.data()), 4, 8));
+    frame.insert("Z", Imf::DeepSlice(Imf::FLOAT, reinterpret_cast<char*>(samples.data()), sizeof(float*),
+                                     2 * sizeof(float*), sizeof(float)));
+    out.setFrameBuffer(frame);
+    out.writePixels(2);
+  }
+  expectIoError(
+      deep, [&] { readHeightField(deep); }, "deep images are not supported");
+
+  const std::string subsampled = path("subsampled.exr");
+  {
+    Imf::Header header(4, 4);
+    header.channels().insert("Y", Imf::Channel(Imf::FLOAT));
+    header.channels().insert("C", Imf::Channel(Imf::FLOAT, 2, 2));
+    std::vector<float> y(16, 1.0f), c(4, 2.0f);
+    Imf::FrameBuffer frame;
+    frame.insert("Y", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(y.data()), 4, 16));
+    frame.insert("C", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(c.data()), 4, 8, 2, 2));
+    Imf::OutputFile out(subsampled.c_str(), header);
+    out.setFrameBuffer(frame);
+    out.writePixels(4);
+  }
+  expectIoError(
+      subsampled, [&] { readImage(subsampled); }, "subsampled");
+}
+
+// The bytes of `file`.
+std::string bytesOf(const std::string& file) {
+  std::ifstream in(file, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+void writeBytes(const std::string& file, const std::string& bytes) {
+  std::ofstream(file, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+// The peak resident memory of this process since the last resetPeakMemory(), in bytes (0 where
+// /proc cannot tell).
+void resetPeakMemory() { std::ofstream("/proc/self/clear_refs") << "5"; }
+std::uint64_t peakMemory() {
+  std::ifstream status("/proc/self/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind("VmHWM:", 0) == 0) return std::stoull(line.substr(6)) << 10;
+  return 0;
+}
+
+TEST_F(ImageIoExrTest, HostileHeadersAreRefusedQuicklyWithoutTheirClaims) {
+  // fuzz/regressions/environment/oom-wide-zip-exr less its first byte (the fuzzer's choice of
+  // extension): 421 bytes claiming 15990792 x 4 float pixels in one ZIP chunk of 16 rows, which
+  // once took 16 GB through OpenImageIO. Its screenWindowWidth (a float) claims 1296891908
+  // bytes, past the end of the file: refused from the header (OpenEXR 3.1 reads a float's four
+  // bytes whatever the size says; later versions refuse the size too).
+  const std::string fuzzed = path("fuzzed.exr"), wide = path("wide.exr");
+  std::string bytes =
+      bytesOf(std::string(HFVIS_DATA_DIR) + "/../fuzz/regressions/environment/oom-wide-zip-exr").substr(1);
+  ASSERT_EQ(bytes.size(), 421u);
+  writeBytes(fuzzed, bytes);
+  expectIoError(
+      fuzzed, [&] { readEnvironmentMap(fuzzed); }, "attribute 'screenWindowWidth' claims 1296891908 bytes");
+  // With that size mended to 4, the header passes; OpenEXR reserves its buffers for a chunk
+  // (untouched), the reader one 64 MB row of the plane, and the missing data stops it.
+  const std::string width_key = std::string("screenWindowWidth") + '\0' + "float" + '\0';
+  const std::size_t width_at = bytes.find(width_key);
+  ASSERT_NE(width_at, std::string::npos);
+  bytes.replace(width_at + width_key.size(), 4, std::string("\x04\0\0\0", 4));
+  writeBytes(wide, bytes);
+  resetPeakMemory();
+  const std::uint64_t before = peakMemory();
+  const auto start = std::chrono::steady_clock::now();
+  expectIoError(
+      wide, [&] { readEnvironmentMap(wide); }, "truncated or corrupt");
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5.0);
+  if (before > 0) {
+    EXPECT_LT(peakMemory() - before, std::uint64_t(256) << 20);
+  }
+  // With the height-field fuzzer's 64 MiB limit it is refused from the header alone.
+  HeightFieldReadOptions small;
+  small.max_image_bytes = std::uint64_t(64) << 20;
+  expectIoError(
+      wide, [&] { readHeightField(wide, small); }, "image claims 15990792 x 4 pixels of 1 channels");
+
+  // An attribute claiming 2 GiB in a small file (OpenEXR would fill a 2 GiB string first).
+  const std::string good = path("good.exr"), claims = path("claims.exr");
+  ImageChannels image;
+  image.width = image.height = 2;
+  image.names = {"Y"};
+  image.planes = {{1, 2, 3, 4}};
+  image.attributes = {{"hfvis:note", "abc"}};
+  writeImage(good, image);
+  bytes = bytesOf(good);
+  const std::string key = std::string("hfvis:note") + '\0' + "string" + '\0';
+  const std::size_t at = bytes.find(key);
+  ASSERT_NE(at, std::string::npos);
+  const std::uint32_t size = 0x7fffff00u;
+  std::memcpy(&bytes[at + key.size()], &size, 4);  // little-endian, as the file
+  writeBytes(claims, bytes);
+  resetPeakMemory();
+  const std::uint64_t before_claims = peakMemory();
+  expectIoError(
+      claims, [&] { readHeightField(claims); }, "attribute 'hfvis:note' claims 2147483392 bytes");
+  if (before_claims > 0) {
+    EXPECT_LT(peakMemory() - before_claims, std::uint64_t(64) << 20);
+  }
+
+  // 2^31 pixels or more, from the header alone (a file of a few kilobytes).
+  const std::string huge = path("huge.exr");
+  {
+    Imf::Header header(65536, 32768);
+    header.channels().insert("Y", Imf::Channel(Imf::HALF));
+    Imf::OutputFile out(huge.c_str(), header);  // no pixels written
+  }
+  expectIoError(
+      huge, [&] { readHeightField(huge); }, "below 2^31 pixels");
+}
+
+TEST_F(ImageIoExrTest, OutputsAreFloatZipWithStringAttributes) {
+  // Several chunks of rows and channels (OpenEXR's threads, where there are cores for them).
+  const int width = 257, height = 255;
+  ImageChannels image;
+  image.width = width;
+  image.height = height;
+  image.names = {"slope", "aspect", "h000", "curvature"};
+  for (std::size_t c = 0; c < image.names.size(); ++c) {
+    image.planes.emplace_back(static_cast<std::size_t>(width) * height);
+    for (std::size_t i = 0; i < image.planes[c].size(); ++i) image.planes[c][i] = valueOf(c, i) * 0.5f;
+  }
+  image.attributes = {{"hfvis:cell_size_x", "30"}, {"hfvis:cell_size_y", "20"}, {"hfvis:units", "metres"}};
+  const std::string file = path("out.exr");
+  writeImage(file, image);
+
+  Imf::InputFile in(file.c_str());
+  const Imf::Header& header = in.header();
+  EXPECT_EQ(header.compression(), Imf::ZIP_COMPRESSION);
+  EXPECT_EQ(header.dataWindow(), windowOf(width, height));
+  EXPECT_EQ(header.displayWindow(), windowOf(width, height));
+  std::vector<std::string> stored;
+  for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
+    stored.push_back(it.name());
+    EXPECT_EQ(it.channel().type, Imf::FLOAT) << it.name();
+  }
+  // EXR sorts them by name (and so does readImage, none being R, G, B, A, ...).
+  EXPECT_EQ(stored, (std::vector<std::string>{"aspect", "curvature", "h000", "slope"}));
+  for (const auto& [name, value] : image.attributes) {
+    const auto* attribute = header.findTypedAttribute<Imf::StringAttribute>(name);
+    ASSERT_NE(attribute, nullptr) << name;
+    EXPECT_EQ(attribute->value(), value);
+  }
+  const ImageChannels back = readImage(file);
+  ASSERT_EQ(back.names, stored);
+  for (std::size_t c = 0; c < back.names.size(); ++c) {
+    const std::size_t written =
+        std::find(image.names.begin(), image.names.end(), back.names[c]) - image.names.begin();
+    EXPECT_EQ(back.planes[c], image.planes[written]) << back.names[c];
+  }
+  EXPECT_TRUE(back.attributes.empty());  // readImage keeps none; readHeightField reads the cell size
+  HeightFieldReadOptions options;
+  options.channel = "h000";
+  EXPECT_EQ(readHeightField(file, options).cell_size_x, 30.0);
+  EXPECT_EQ(readHeightField(file, options).cell_size_y, 20.0);
+}
+
+}  // namespace
+}  // namespace hfvis
