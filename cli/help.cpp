@@ -173,8 +173,8 @@ Bounce:
 const char* const kConventions = R"(
 Conventions and units:
   Input      one band of a raster GDAL reads (GeoTIFF/COG .tif/.tiff, .hgt, .asc, .vrt, .img,
-             .bil, .dem, .grd, .adf) or one channel of an image OpenImageIO reads (EXR, PNG,
-             ...), row-major, row 0 first as stored. Pixel (col, row) lies at ground position
+             .bil, .dem, .grd, .adf) or one channel of an EXR (OpenEXR) or of another image
+             OpenImageIO reads (PNG, ...), row-major, row 0 first as stored. Pixel (col, row) lies at ground position
              (col*X, row*Y); the surface is bilinear between pixels; height = value * Z.
              Integer pixels are read as their stored values (16-bit PNG: 0..65535).
   Directions direction k of K has azimuth phi_k = 360*k/K deg + offset, measured on the
@@ -192,8 +192,8 @@ Conventions and units:
              2010, Eq. 5), normalised so that a flat plane gives 1.
   Nodata     non-finite heights (NaN, +-inf) are nodata: they neither cast nor receive;
              every output is NaN there, and holes do not spread into valid neighbours.
-  Outputs    float32 EXR (any float format OpenImageIO writes, by extension), with the run
-             described in string attributes hfvis:*; GeoTIFF for .tif/.tiff (horizons: JSON
+  Outputs    float32 EXR (ZIP-compressed, through OpenEXR), with the run described in
+             string attributes hfvis:*; GeoTIFF for .tif/.tiff (horizons: JSON
              or CSV text). Files are written to a temporary name and renamed only once every
              output of the run is complete, so a failed run leaves no partial or mismatched
              output behind.

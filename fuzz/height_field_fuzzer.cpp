@@ -1,6 +1,7 @@
 // height_field_fuzzer: libFuzzer over the height-field loader. The input's first byte picks
-// the file type (EXR, PNG, TIFF through GDAL, or an extension OpenImageIO guesses the format of
-// from the bytes), the rest is the file. Reading must either give a valid field or throw hfvis::Error: any other
+// the file's extension (.exr, .png, .tif through GDAL, or .hdr), the rest is the file: EXR bytes
+// go to OpenEXR under any of the others, the rest to OpenImageIO, which guesses the format from
+// the bytes. Reading must either give a valid field or throw hfvis::Error: any other
 // exception, a crash or a sanitizer report is a bug.
 #include <unistd.h>
 

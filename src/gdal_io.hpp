@@ -1,7 +1,7 @@
 // gdal_io.hpp: georeferenced rasters through GDAL (GeoTIFF, COG, HGT, AAIGrid, VRT, ...):
 // reading heights and bands with their nodata value (those cells become NaN), geotransform and
-// CRS, and writing results as GeoTIFF. OpenImageIO keeps EXR, PNG and other images
-// (image_io.cpp decides by extension).
+// CRS, and writing results as GeoTIFF. OpenEXR keeps EXR, OpenImageIO PNG and other images
+// (image_io.cpp decides by extension, then an EXR by its magic number).
 #pragma once
 
 #include <optional>
@@ -25,7 +25,7 @@ std::optional<std::pair<double, double>> storedCellSize(const std::string& path,
 // The extension of `path` in lower case, with its dot ("" when it has none).
 std::string lowercaseExtension(const std::string& path);
 
-// Whether `path` names a raster format that GDAL reads rather than OpenImageIO.
+// Whether `path` names a raster format that GDAL reads rather than OpenEXR or OpenImageIO.
 bool isGdalRaster(const std::string& path);
 
 // Reads band `options.channel` ("" = the only band; an index "0".. or a band description) as

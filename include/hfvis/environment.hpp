@@ -52,9 +52,9 @@ struct EnvironmentMap {
 // such pixel), a non-finite rotation or a table_rows outside 0 .. 65536.
 void validate(const EnvironmentMap& map);
 
-// Reads an environment through OpenImageIO (EXR, HDR, ...): one channel, or R, G, B (an alpha
-// channel A beside them is ignored). Throws IoError naming the file for what readImage refuses,
-// for a map with other channels, and for what validate refuses.
+// Reads an environment map (an EXR, a Radiance HDR, ..., as readImage does): one channel, or R,
+// G, B (an alpha channel A beside them is ignored). Throws IoError naming the file for what
+// readImage refuses, for a map with other channels, and for what validate refuses.
 EnvironmentMap readEnvironmentMap(const std::string& path);
 
 // The bands of zenith angle in the map's tables: table_rows, or the map's rows when 0.

@@ -1,5 +1,5 @@
 // hfvis/image_io.hpp: reading height fields and writing results: GeoTIFF and the other
-// georeferenced rasters through GDAL, EXR and other images through OpenImageIO.
+// georeferenced rasters through GDAL, EXR through OpenEXR, other images through OpenImageIO.
 #pragma once
 
 #include <cstdint>
@@ -34,12 +34,13 @@ struct HeightFieldReadOptions {
 // description) is read, its nodata value becomes NaN, the cell size comes from the
 // geotransform (geographic degrees in metres on WGS84: per row in row_cell_size_x/y, at the
 // centre latitude in cell_size_x/y), the geotransform and CRS
-// fill `georeference`, and a rotated or sheared geotransform is an IoError. Everything else
-// (EXR, PNG 8/16-bit, ...) goes through OpenImageIO, without georeference; TIFF bytes under
-// another extension too (no GeoTIFF tags are read then). Integer pixels are converted to their
-// stored integer values (a 16-bit PNG holds heights 0..65535), not normalised. Throws IoError
-// naming the file and reason (missing, unreadable, truncated, zero-sized, multi-channel without
-// a channel choice, unknown channel).
+// fill `georeference`, and a rotated or sheared geotransform is an IoError. Everything else is
+// read without georeference: an EXR (known by its magic number, whatever its name; part 0 of a
+// multi-part file, its data window) through OpenEXR, other images (PNG 8/16-bit, ...) through
+// OpenImageIO, TIFF bytes under another extension too (no GeoTIFF tags are read then). Integer
+// pixels are converted to their stored integer values (a 16-bit PNG holds heights 0..65535), not
+// normalised. Throws IoError naming the file and reason (missing, unreadable, truncated,
+// zero-sized, multi-channel without a channel choice, unknown channel).
 HeightField readHeightField(const std::string& path, const HeightFieldReadOptions& options = {});
 
 // One float32 image to write (or read by readImage): planar channels of width*height values each.
@@ -59,8 +60,9 @@ struct ImageChannels {
 // extensions of readHeightField) give their bands in order, named by their descriptions
 // ("channel<i>" where a band has none), nodata cells as NaN, the dataset's metadata items as
 // attributes (hfvis_NAME back as hfvis:NAME, see writeImage) and their georeference. Other
-// images give their channels in the order OpenImageIO reports them (for EXR: R, G, B, A first,
-// then the others sorted by name). Integer pixels are read as their stored values, as
+// images give their channels in the order OpenImageIO reports them; for EXR the same order
+// (layers sorted; within each R, G, B, Y, A, Z and their kin first, then the others sorted by
+// name). Integer pixels are read as their stored values, as
 // readHeightField. Throws IoError as readHeightField.
 ImageChannels readImage(const std::string& path);
 
@@ -136,8 +138,8 @@ void removeTemporaryOutputsOnSignals();
 //   predictor, 256 x 256 tiles, bands stored one after another, BigTIFF when the size needs
 //   it. Attributes become the dataset's metadata items, each ':' of a name written as '_'
 //   (GDAL's name=value lists take ':' for a separator): hfvis:units becomes hfvis_units.
-// - otherwise an EXR (or any float format OpenImageIO writes, by extension) with the
-//   attributes as string attributes; no georeference, NaN in nodata cells.
+// - .exr: an EXR through OpenEXR: float32 channels, ZIP compression, the attributes as string
+//   attributes; no georeference, NaN in nodata cells.
 // Throws InvalidArgument for an inconsistent image, IoError when writing fails.
 void writeImage(const std::string& path, const ImageChannels& image);
 
