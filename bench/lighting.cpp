@@ -19,7 +19,7 @@
 
 #include "hfvis/environment.hpp"
 #include "hfvis/horizon.hpp"
-#include "shading_internal.hpp"
+#include "ops/shading_internal.hpp"
 #include "suite_support.hpp"
 
 namespace hfvis::bench {

@@ -9,9 +9,9 @@
 #include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
 #include "metrics.hpp"
-#include "opencl_context.hpp"
-#include "sweep_framework.hpp"
-#include "sweep_geometry.hpp"
+#include "core/opencl_context.hpp"
+#include "core/sweep_framework.hpp"
+#include "core/sweep_geometry.hpp"
 
 namespace hfvis::bench {
 namespace {

@@ -10,7 +10,7 @@
 #include <limits>
 
 #include "hfvis/errors.hpp"
-#include "lattice_geometry.hpp"
+#include "core/lattice_geometry.hpp"
 
 namespace hfvis::bench {
 namespace {

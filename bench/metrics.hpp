@@ -88,7 +88,7 @@ struct PlaneDifference {
 PlaneDifference planeDifference(const std::vector<float>& a, const std::vector<float>& b);
 
 // The hull stack of Algorithm 1 (Timonen & Westerholm 2010) run on the host over every line
-// of the library's lattice sweep (src/lattice_geometry.hpp) in `directions` directions as an
+// of the library's lattice sweep (src/core/lattice_geometry.hpp) in `directions` directions as an
 // SVF / AO run takes them (quadrature directions), one sample per unit (the default),
 // counting what the kernel horizon_lattice does per sample: the samples of each line's
 // periods farthest first, then the receiver.

@@ -37,8 +37,8 @@
 #include "hfvis/horizon.hpp"
 #include "hfvis/image_io.hpp"
 #include "hfvis_testing/synthetic_fields.hpp"
-#include "lattice_geometry.hpp"
-#include "opencl_context.hpp"
+#include "core/lattice_geometry.hpp"
+#include "core/opencl_context.hpp"
 #include "suite_support.hpp"
 
 namespace hfvis::bench {

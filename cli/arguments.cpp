@@ -15,7 +15,7 @@
 #include "hfvis/errors.hpp"
 #include "hfvis/shading.hpp"
 #include "hfvis/sun.hpp"
-#include "message_numbers.hpp"
+#include "core/message_numbers.hpp"
 
 namespace hfvis::cli {
 namespace {

@@ -12,8 +12,8 @@
 #include <sstream>
 
 #include "hfvis/errors.hpp"
-#include "message_numbers.hpp"
-#include "output_files.hpp"
+#include "core/message_numbers.hpp"
+#include "io/output_files.hpp"
 
 namespace hfvis::cli {
 using detail::shortNumber;

@@ -1,4 +1,4 @@
-// oiio_module.cpp: the CLI's OpenImageIO (src/oiio_images.hpp), loaded on its first PNG preview
+// oiio_module.cpp: the CLI's OpenImageIO (src/io/oiio_images.hpp), loaded on its first PNG preview
 // or other image that neither GDAL nor OpenEXR takes: the module libhfvis_oiio.so beside the
 // program (the build tree) or in the installed library directory. A run on GeoTIFFs and EXRs
 // never loads it.
@@ -9,7 +9,7 @@
 #include <string>
 
 #include "hfvis/errors.hpp"
-#include "oiio_images.hpp"
+#include "io/oiio_images.hpp"
 
 #ifndef HFVIS_OIIO_MODULE_DIR
 #define HFVIS_OIIO_MODULE_DIR "../lib/hfvis"

@@ -9,7 +9,7 @@
 // and its components toward the direction and across it (+90 degrees of azimuth).
 //
 // environment_add is written once in the common subset of OpenCL C and C++: kernels/horizon.cl
-// includes it, and so does src/environment_terms.hpp for the scalar reference.
+// includes it, and so does src/ops/environment_terms.hpp for the scalar reference.
 #ifndef HFVIS_ENVIRONMENT_CL
 #define HFVIS_ENVIRONMENT_CL
 

@@ -7,7 +7,7 @@
 // a sample of the line through its own centre, and the hull stack gives the horizon of the
 // receiver's own ray from its own height. The line's samples between consecutive pixel
 // centres (receivers) are where it crosses grid columns and rows, exact heights of the
-// bilinear surface, and points between crossings; src/lattice_geometry.hpp builds the
+// bilinear surface, and points between crossings; src/core/lattice_geometry.hpp builds the
 // per-period table. Each receiver also takes the exact limit of its ray's elevation at
 // t -> 0 (the surface's slope along the ray in its first cell): along a ray from a grid
 // point the bilinear surface is a quadratic in the first cell, so (h(t) - h0) / t is linear
@@ -326,7 +326,7 @@ HFVIS_INLINE lane_float lane_sample_height(__global const float* heights, int wi
   return h;
 }
 
-// The piece of a line between two consecutive samples (src/lattice_geometry.hpp, struct
+// The piece of a line between two consecutive samples (src/core/lattice_geometry.hpp, struct
 // CellSegment): thirteen 4-byte members, read field by field.
 typedef struct {
   float tau_far, tau_near;  // its ends, pixels from the period's receiver toward +(a, b)
@@ -678,7 +678,7 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
 // capacity is every sample of its periods here plus the entries it arrives with.
 // period_ground = period * ground_per_pixel, the ground length of a period.
 //
-// Strips (a field beyond the device's memory, src/horizon.cpp): `heights` holds the field's rows
+// Strips (a field beyond the device's memory, src/ops/horizon.cpp): `heights` holds the field's rows
 // from row0 on and the outputs (normals, planes, sums, window_far, receiver_base) its rows from
 // out_row0 on. With HFVIS_STRIPS, line j resumes its whole line's sweep: line_state[j] = (index of
 // its first receiver here along the whole line, entries of the stack it arrives with, their offset

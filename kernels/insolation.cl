@@ -1,5 +1,5 @@
 // insolation.cl: the steps of one sun-azimuth bucket added to every pixel's sunshine hours and
-// direct irradiation (computeInsolation in src/insolation.cpp, which sweeps the bucket's
+// direct irradiation (computeInsolation in src/ops/insolation.cpp, which sweeps the bucket's
 // horizon). Global size: pixels rounded up to the group.
 #pragma OPENCL FP_CONTRACT OFF
 

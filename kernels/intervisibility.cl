@@ -11,7 +11,7 @@
 // sample in between. Grazing samples are visible, so on a flat plane everything is. Only
 // present samples count (outside the field or without a valid corner: absent). Every
 // geometric decision is chord_side(), an exact sign, so the tree, the scalar reference and
-// the brute-force oracles agree exactly (see src/chord_side.hpp for why).
+// the brute-force oracles agree exactly (see src/core/chord_side.hpp for why).
 //
 // Heights arrive offset and z-scaled (see prepareHeights); NaN = nodata.
 //
@@ -298,7 +298,7 @@ typedef struct {
   int zone_valid, zone_first, zone_last;
   float h_prev, h_prev2, p_prev, p_prev2, tail_h, zone_z1, zone_z2, zone_margin;
 } TreeLineState;
-// The host allocates kTreeLineStateBytes (src/intervisibility_device.hpp) per line.
+// The host allocates kTreeLineStateBytes (src/ops/intervisibility_device.hpp) per line.
 typedef char tree_line_state_is_136_bytes[sizeof(TreeLineState) == 136 ? 1 : -1];
 // The registers saved and restored, X(register, its TreeLineState field), those of per-row
 // spacing and of the safe zone where compiled in.
@@ -323,7 +323,7 @@ typedef char tree_line_state_is_136_bytes[sizeof(TreeLineState) == 136 ? 1 : -1]
 #define HFVIS_RESTORE(reg, field) reg = st.field;
 #define HFVIS_SAVE(reg, field) st.field = reg;
 
-// The sweep of one direction (a, b) on lattice lines (src/lattice_geometry.hpp): every pixel
+// The sweep of one direction (a, b) on lattice lines (src/core/lattice_geometry.hpp): every pixel
 // centre lies on exactly one line of the direction, so every receiver is a sample of the
 // line through its own centre, at its own height, and its tree gives the visible samples
 // of its own ray. One work-item per line, from its far end toward -(a, b). Line j's

@@ -1,5 +1,5 @@
 // viewshed.cl: what one observer sees on the bilinear surface (computeViewshed in
-// src/viewshed.cpp; the method is described in hfvis/viewshed.hpp).
+// src/ops/viewshed.cpp; the method is described in hfvis/viewshed.hpp).
 //
 // Coordinates are pixels (column x, row y); heights are z-scaled and NaN at nodata. A sight
 // line runs from the eye E (a grid point, height ze) to the target T (a grid point, height

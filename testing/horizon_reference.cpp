@@ -1,18 +1,18 @@
 // horizon_reference.cpp: scalar mirrors of kernels/horizon.cl (the lattice sweep with its
 // per-receiver outputs, and the naive march); the per-direction terms are the kernels' own
-// (src/direction_terms.hpp). Keep every expression in the kernels' order: the build disables
+// (src/core/direction_terms.hpp). Keep every expression in the kernels' order: the build disables
 // FP contraction on both sides so the predicates decide identically.
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "direction_terms.hpp"
-#include "environment_swaths.hpp"
-#include "environment_terms.hpp"
-#include "fast_math.hpp"
+#include "core/direction_terms.hpp"
+#include "ops/environment_swaths.hpp"
+#include "ops/environment_terms.hpp"
+#include "core/fast_math.hpp"
 #include "hfvis_testing/horizon_reference.hpp"
-#include "horizon_common.hpp"
-#include "lattice_geometry.hpp"
+#include "core/horizon_common.hpp"
+#include "core/lattice_geometry.hpp"
 #include "reference_internal.hpp"
 
 namespace hfvis {

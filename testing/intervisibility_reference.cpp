@@ -1,6 +1,6 @@
 // intervisibility_reference.cpp: the scalar reference of the intervisibility operation:
 // the lattice lines sampled as the kernel samples them, the hull tree sweep
-// (src/scalar_hull_tree.cpp, the mirror of the kernel's), each receiver's results added to
+// (src/ops/scalar_hull_tree.cpp, the mirror of the kernel's), each receiver's results added to
 // its pixel, and the naive visibility march, in the kernels' order, so every per-sample
 // result matches exactly.
 #include "hfvis_testing/intervisibility_reference.hpp"
@@ -9,10 +9,10 @@
 #include <cstdint>
 #include <limits>
 
-#include "chord_side.hpp"
+#include "core/chord_side.hpp"
 #include "hfvis/errors.hpp"
-#include "horizon_common.hpp"
-#include "intervisibility_internal.hpp"
+#include "core/horizon_common.hpp"
+#include "ops/intervisibility_internal.hpp"
 #include "reference_internal.hpp"
 
 namespace hfvis {

@@ -5,9 +5,9 @@
 #include <vector>
 
 #include "hfvis/height_field.hpp"
-#include "horizon_common.hpp"
-#include "intervisibility_internal.hpp"
-#include "lattice_geometry.hpp"
+#include "core/horizon_common.hpp"
+#include "ops/intervisibility_internal.hpp"
+#include "core/lattice_geometry.hpp"
 
 namespace hfvis::detail {
 

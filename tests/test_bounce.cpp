@@ -9,15 +9,15 @@
 #include <cmath>
 #include <random>
 
-#include "bounce_internal.hpp"
-#include "chord_side.hpp"
+#include "ops/bounce_internal.hpp"
+#include "core/chord_side.hpp"
 #include "hfvis/bounce.hpp"
 #include "hfvis_testing/bounce_reference.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
 #include "hfvis/image_io.hpp"
 #include "hfvis_testing/synthetic_fields.hpp"
-#include "lattice_geometry.hpp"
+#include "core/lattice_geometry.hpp"
 #include "test_support.hpp"
 
 namespace hfvis {

@@ -1,4 +1,4 @@
-// test_exr_images.cpp: EXR inputs and outputs through OpenEXR (src/exr_images.cpp): files written
+// test_exr_images.cpp: EXR inputs and outputs through OpenEXR (src/io/exr_images.cpp): files written
 // here with OpenEXR's own API (half, float and unsigned channels, tiles and mipmaps, a data window
 // away from the origin, several parts, deep and subsampled images) read back as the OpenImageIO
 // path read them, channel order included; hostile headers refused quickly without allocating

@@ -1,11 +1,11 @@
 // test_fast_math.cpp: accuracy of the polynomial atan/sin that the reductions use
-// (kernels/shared/fast_math.cl, mirrored by src/fast_math.hpp), against the C library in double.
+// (kernels/shared/fast_math.cl, mirrored by src/core/fast_math.hpp), against the C library in double.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
 
-#include "fast_math.hpp"
+#include "core/fast_math.hpp"
 
 namespace hfvis::detail {
 namespace {

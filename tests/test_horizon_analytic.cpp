@@ -10,7 +10,7 @@
 #include "hfvis/image_io.hpp"
 #include "hfvis_testing/horizon_reference.hpp"
 #include "hfvis_testing/synthetic_fields.hpp"
-#include "lattice_geometry.hpp"
+#include "core/lattice_geometry.hpp"
 #include "test_support.hpp"
 
 namespace hfvis {

@@ -8,14 +8,14 @@
 #include <cmath>
 #include <set>
 
-#include "chord_side.hpp"
+#include "core/chord_side.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
 #include "hfvis/horizon_lists.hpp"
 #include "hfvis/intervisibility.hpp"
 #include "hfvis_testing/synthetic_fields.hpp"
-#include "horizon_common.hpp"
-#include "sweep_geometry.hpp"
+#include "core/horizon_common.hpp"
+#include "core/sweep_geometry.hpp"
 #include "test_support.hpp"
 
 namespace hfvis {

@@ -12,7 +12,7 @@
 #include "hfvis/horizon.hpp"
 #include "hfvis_testing/horizon_reference.hpp"
 #include "hfvis_testing/synthetic_fields.hpp"
-#include "horizon_common.hpp"
+#include "core/horizon_common.hpp"
 #include "reference_internal.hpp"
 #include "test_support.hpp"
 

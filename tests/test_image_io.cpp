@@ -18,7 +18,7 @@
 #include <utility>
 #include <vector>
 
-#include "gdal_io.hpp"
+#include "io/gdal_io.hpp"
 #include "geotiff_support.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/environment.hpp"

@@ -16,15 +16,15 @@
 #include <random>
 #include <set>
 
-#include "chord_side.hpp"
+#include "core/chord_side.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/image_io.hpp"
 #include "hfvis/intervisibility.hpp"
 #include "hfvis_testing/intervisibility_reference.hpp"
 #include "hfvis_testing/synthetic_fields.hpp"
-#include "horizon_common.hpp"
-#include "intervisibility_internal.hpp"
-#include "lattice_geometry.hpp"
+#include "core/horizon_common.hpp"
+#include "ops/intervisibility_internal.hpp"
+#include "core/lattice_geometry.hpp"
 #include "reference_internal.hpp"
 #include "test_support.hpp"
 

@@ -30,7 +30,7 @@ std::vector<DeviceInfo> listDevices();
 class ComputeContext;
 namespace detail {
 struct ContextState;
-// The library's access to a context's OpenCL state (src/opencl_context.hpp defines the type).
+// The library's access to a context's OpenCL state (src/core/opencl_context.hpp defines the type).
 ContextState& stateOf(const ComputeContext& context);
 }  // namespace detail
 

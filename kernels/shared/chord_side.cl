@@ -1,7 +1,7 @@
 // chord_side.cl: the one geometric predicate of the convex hull tree and the visibility
 // marches, decided exactly: on which side of the chord from sample a to sample c a sample b
 // lies. Written once in the common subset of OpenCL C and C++: kernels/intervisibility.cl
-// includes it, and so does src/chord_side.hpp (inside namespace hfvis::detail, with fma and
+// includes it, and so does src/core/chord_side.hpp (inside namespace hfvis::detail, with fma and
 // fabs from <cmath>), so the kernels, the scalar references and the tests' oracles run the
 // very same operations.
 //

@@ -1,7 +1,7 @@
 // direction_terms.cl: what one direction of the horizon operation contributes at a receiver
 // (its elevation, sky-view and ambient-occlusion terms), as a macro that defines them for a
 // scalar or lane-vector type. Written once in the common subset of OpenCL C and C++:
-// kernels/horizon.cl instantiates it for floats and lane vectors, src/direction_terms.hpp for
+// kernels/horizon.cl instantiates it for floats and lane vectors, src/core/direction_terms.hpp for
 // the C++ references' floats.
 #ifndef HFVIS_DIRECTION_TERMS_CL
 #define HFVIS_DIRECTION_TERMS_CL

@@ -1,7 +1,7 @@
 // fast_math.cl: the few transcendental functions the reductions need, as straight-line
 // polynomials. Library atan2/sin calls are not vectorised by PoCL and cost ~100 ns each
 // there; these vectorise. Written once in the common subset of OpenCL C and C++: the
-// kernels include it, and so does src/fast_math.hpp (inside namespace hfvis::detail, with
+// kernels include it, and so does src/core/fast_math.hpp (inside namespace hfvis::detail, with
 // fabs and rint from <cmath>), so the scalar references round exactly as the kernels do.
 // Accuracy: |error| < 2e-7 rad for hf_atan, < 1e-7 for hf_sin on |x| <= 2 pi (measured by
 // tests/test_fast_math.cpp).

@@ -3,7 +3,7 @@
 // the lattice lines that the horizon and hull-tree sweeps run on.
 //
 // Pixel axes: x = column, y = row; pixel (c, r) at (c, r). The lattice sweeps' scratch
-// (hull stacks, tree nodes) is laid out by the host (src/lattice_geometry.hpp, chunkLines):
+// (hull stacks, tree nodes) is laid out by the host (src/core/lattice_geometry.hpp, chunkLines):
 // line-major for CPUs, whose work-item runs one line serially, step-major for GPUs, whose
 // neighbouring work-items then touch neighbouring entries; the kernels see only each line's
 // first entry and the stride between its entries.
@@ -33,7 +33,7 @@
 #endif
 
 // One direction's ray geometry (the naive visibility march reads dir, step and ground
-// lengths). Must match struct SweepDirection in src/sweep_geometry.hpp: sixteen 4-byte
+// lengths). Must match struct SweepDirection in src/core/sweep_geometry.hpp: sixteen 4-byte
 // members, no padding.
 typedef struct {
   float dir_x, dir_y;    // unit line direction in pixel axes
@@ -141,7 +141,7 @@ HFVIS_INLINE float sample_height(__global const float* heights, int width, int h
 #endif
 }
 
-// One sample of a period (src/lattice_geometry.hpp, struct LatticeSample): nine 4-byte
+// One sample of a period (src/core/lattice_geometry.hpp, struct LatticeSample): nine 4-byte
 // members, read field by field.
 typedef struct {
   float tau;                 // pixels from the period's receiver toward +(a, b)

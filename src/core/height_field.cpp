@@ -1,0 +1,55 @@
+// height_field.cpp: HeightField helpers and validation.
+#include "hfvis/height_field.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "hfvis/errors.hpp"
+#include "core/message_numbers.hpp"
+
+namespace hfvis {
+using detail::shortNumber;
+
+std::size_t HeightField::nodataCount() const {
+  std::size_t count = 0;
+  for (float h : heights) count += std::isfinite(h) ? 0 : 1;
+  return count;
+}
+
+void validate(const HeightField& field) {
+  if (field.width <= 0 || field.height <= 0) {
+    throw InvalidArgument("height field is empty (" + std::to_string(field.width) + " x " +
+                          std::to_string(field.height) + " pixels)");
+  }
+  if (field.heights.size() != field.pixelCount()) {
+    throw InvalidArgument("height field holds " + std::to_string(field.heights.size()) +
+                          " heights for " + std::to_string(field.width) + " x " +
+                          std::to_string(field.height) + " pixels");
+  }
+  auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  if (!positive(field.cell_size_x) || !positive(field.cell_size_y)) {
+    throw InvalidArgument("cell size must be finite and positive (got " + shortNumber(field.cell_size_x) +
+                          ", " + shortNumber(field.cell_size_y) + ")");
+  }
+  if (!field.row_cell_size_x.empty() || !field.row_cell_size_y.empty()) {
+    if (field.row_cell_size_x.size() != static_cast<std::size_t>(field.height) ||
+        field.row_cell_size_y.size() != static_cast<std::size_t>(field.height)) {
+      throw InvalidArgument("per-row cell sizes need one entry per row (" + std::to_string(field.height) +
+                            "), got " + std::to_string(field.row_cell_size_x.size()) + " and " +
+                            std::to_string(field.row_cell_size_y.size()));
+    }
+    for (std::size_t r = 0; r < field.row_cell_size_x.size(); ++r) {
+      if (!positive(field.row_cell_size_x[r]) || !positive(field.row_cell_size_y[r]))
+        throw InvalidArgument("the cell size of row " + std::to_string(r) + " must be finite and positive");
+    }
+  }
+  if (!positive(field.z_scale)) {
+    throw InvalidArgument("z-scale must be finite and positive (got " + shortNumber(field.z_scale) + ")");
+  }
+  if (field.nodataCount() == field.pixelCount()) {
+    throw InvalidArgument("every height is nodata (NaN or infinite)");
+  }
+}
+
+}  // namespace hfvis

@@ -1,0 +1,139 @@
+// horizon_common.cpp: pieces shared by the horizon device path and its reference.
+#include "core/horizon_common.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "core/fast_math.hpp"
+#include "hfvis/errors.hpp"
+
+namespace hfvis {
+
+void validate(const HorizonOptions& options, const HorizonOutputs& outputs) {
+  validate(static_cast<const SweepOptions&>(options));
+  if (!(options.azimuth_tolerance > 0.0) || !(options.azimuth_tolerance <= 0.1)) {
+    throw InvalidArgument("the azimuth tolerance must be in (0, 0.1] radians, (0, 5.73] degrees (got " +
+                          std::to_string(options.azimuth_tolerance * 180.0 / M_PI) + " degrees)");
+  }
+  if (!outputs.horizon_angles && !outputs.horizon_distances && !outputs.sky_view_factor &&
+      !outputs.ambient_occlusion && !outputs.environment) {
+    throw InvalidArgument("no output requested");
+  }
+  if (options.strip_rows < 0)
+    throw InvalidArgument("the rows per strip must be 0 (automatic) or positive (got " +
+                          std::to_string(options.strip_rows) + ")");
+  if (options.strip_rows > 0 && options.method == HorizonMethod::Naive)
+    throw InvalidArgument("the naive method does not run in strips (each ray reads the whole field)");
+  if (outputs.environment) validate(*outputs.environment);
+}
+
+namespace detail {
+
+bool hasRowSpacing(const HeightField& field) { return !field.row_cell_size_x.empty(); }
+
+namespace {
+
+// One row of a table: the ground length, and the terms of ground azimuth `azimuth` and weight.
+void appendRow(RowTable& t, double length, double azimuth, double weight) {
+  const float w = static_cast<float>(weight);
+  t.length.push_back(static_cast<float>(length));
+  t.terms.insert(t.terms.end(),
+                 {static_cast<float>(std::cos(azimuth)), static_cast<float>(std::sin(azimuth)), w, swathFactor(w)});
+}
+
+}  // namespace
+
+std::vector<RowTable> latticeRowTables(const HeightField& field, const std::vector<LatticeDirection>& directions,
+                                       bool quadrature) {
+  const std::size_t K = directions.size();
+  std::vector<RowTable> tables(K);
+  std::vector<LatticeDirection> at_row = directions;
+  for (int r = 0; r < field.height; ++r) {
+    std::vector<double> lengths(K);
+    for (std::size_t k = 0; k < K; ++k) {
+      const LatticeDirection& d = directions[k];
+      double cell_x = 0.0, cell_y = 0.0;
+      cellSizeAtRow(field, r + 0.5 * d.b, &cell_x, &cell_y);
+      const double gx = d.a * cell_x, gy = d.b * cell_y;
+      lengths[k] = std::hypot(gx, gy);
+      // The step's ground azimuth here, next to the one it has at the centre latitude.
+      at_row[k].azimuth = d.azimuth + angleDifference(std::atan2(gy, gx), d.azimuth);
+      at_row[k].weight = d.weight;
+    }
+    if (quadrature && K > 1) setQuadratureWeights(at_row);
+    for (std::size_t k = 0; k < K; ++k) appendRow(tables[k], lengths[k], at_row[k].azimuth, at_row[k].weight);
+  }
+  return tables;
+}
+
+std::vector<RowTable> rayRowTables(const HeightField& field, const std::vector<SweepDirection>& rays) {
+  const std::size_t K = rays.size();
+  std::vector<RowTable> tables(K);
+  for (int r = 0; r < field.height; ++r) {
+    std::vector<double> lengths(K), azimuths(K);
+    for (std::size_t k = 0; k < K; ++k) {
+      const double gx = rays[k].dir_x * field.row_cell_size_x[r], gy = rays[k].dir_y * field.row_cell_size_y[r];
+      lengths[k] = std::hypot(gx, gy);
+      azimuths[k] = std::atan2(gy, gx);
+    }
+    const std::vector<double> weights = halfGapWeights(azimuths);
+    for (std::size_t k = 0; k < K; ++k) appendRow(tables[k], lengths[k], azimuths[k], weights[k]);
+  }
+  return tables;
+}
+
+HorizonResult allocateResult(const HeightField& field, const HorizonOptions& options,
+                             const HorizonOutputs& outputs) {
+  HorizonResult result;
+  result.width = field.width;
+  result.height = field.height;
+  result.directions = options.directions;
+  for (int k = 0; k < options.directions; ++k) result.azimuths.push_back(directionAzimuth(k, options));
+  const std::size_t plane = field.pixelCount();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  if (outputs.horizon_angles) result.angles.assign(plane * options.directions, nan);
+  if (outputs.horizon_distances) result.distances.assign(plane * options.directions, nan);
+  if (outputs.sky_view_factor) result.sky_view_factor.assign(plane, 0.0f);
+  if (outputs.ambient_occlusion) result.ambient_occlusion.assign(plane, 0.0f);
+  if (outputs.environment) result.irradiance.assign(plane * outputs.environment->channels, 0.0f);
+  return result;
+}
+
+bool exactAzimuths(const HorizonOutputs& outputs) { return outputs.horizon_angles || outputs.horizon_distances; }
+
+std::vector<LatticeDirection> horizonDirections(const HeightField& field, const HorizonOptions& options,
+                                                const HorizonOutputs& outputs) {
+  return latticeDirections(field, options, exactAzimuths(outputs), options.azimuth_tolerance);
+}
+
+void pixelNormal(const std::vector<float>& h, int width, int height, int c, int r, float cell_x, float cell_y,
+                 float* n) {
+  const float hp = h[static_cast<std::size_t>(r) * width + c];
+  float sx_sum = 0.0f, sy_sum = 0.0f, sz_sum = 0.0f;
+  for (int q = 0; q < 4; ++q) {
+    const int sx = (q & 1) ? 1 : -1, sy = (q & 2) ? 1 : -1;
+    const int cx = c + sx, ry = r + sy;
+    if (cx < 0 || cx >= width || ry < 0 || ry >= height) continue;
+    const float hx = h[static_cast<std::size_t>(r) * width + cx],
+                hy = h[static_cast<std::size_t>(ry) * width + c];
+    if (std::isnan(hx) || std::isnan(hy)) continue;
+    sx_sum += -(hx - hp) / (static_cast<float>(sx) * cell_x);
+    sy_sum += -(hy - hp) / (static_cast<float>(sy) * cell_y);
+    sz_sum += 1.0f;
+  }
+  if (!(sz_sum > 0.0f)) {
+    n[0] = 0.0f, n[1] = 0.0f, n[2] = 1.0f;
+    return;
+  }
+  const float length = std::sqrt(sx_sum * sx_sum + sy_sum * sy_sum + sz_sum * sz_sum);
+  n[0] = sx_sum / length, n[1] = sy_sum / length, n[2] = sz_sum / length;
+}
+
+float swathFactor(float weight) { return hfSin(kPiF * weight) / kPiF; }
+
+void finishReduction(HorizonResult& result) {
+  for (float& v : result.sky_view_factor) v = 1.0f - v;
+}
+
+}  // namespace detail
+}  // namespace hfvis

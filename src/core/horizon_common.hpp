@@ -1,0 +1,65 @@
+// horizon_common.hpp: what the device path and the scalar reference of the horizon
+// operation share: direction geometry and the final reduction step.
+#pragma once
+
+#include <vector>
+
+#include "hfvis/horizon.hpp"
+#include "core/lattice_geometry.hpp"
+#include "core/sweep_geometry.hpp"
+
+namespace hfvis::detail {
+
+// Whether a run's directions are exact azimuths (per-direction planes requested) rather than
+// quadrature directions.
+bool exactAzimuths(const HorizonOutputs& outputs);
+
+// The sweep directions of a run: exact azimuths (within options.azimuth_tolerance) when
+// per-direction planes are requested, quadrature directions otherwise.
+std::vector<LatticeDirection> horizonDirections(const HeightField& field, const HorizonOptions& options,
+                                                const HorizonOutputs& outputs);
+
+// The unit normal (x along +column, y along +row, z up) of the (up to) four quads around
+// pixel (c, r) of prepared heights h, in ground units; quads touching nodata or the border are
+// left out, (0, 0, 1) when none is left. The same normal as ambient occlusion's
+// (surface_slopes in kernels/horizon.cl).
+void pixelNormal(const std::vector<float>& h, int width, int height, int c, int r, float cell_x, float cell_y,
+                 float* n);
+
+// sin(pi weight) / pi: the factor of the ambient-occlusion swath of a direction of that
+// weight (ambient_term in kernels/horizon.cl), computed once per direction on the host.
+float swathFactor(float weight);
+
+// Turns the accumulated sums into the outputs: svf = 1 - weighted sum; ao is the sum itself.
+void finishReduction(HorizonResult& result);
+
+// Whether the field has per-row spacing (HeightField::row_cell_size_x/y): positions along the
+// sweep's lines and the naive march's rays are then ground lengths summed step by step.
+bool hasRowSpacing(const HeightField& field);
+
+
+// A field with per-row spacing (HeightField::row_cell_size_x/y), as horizon_lattice takes it
+// (HFVIS_ROW_SPACING), one table per direction: per row r, the ground length of the period
+// from a receiver in row r to the next one along +(a, b) (the cell sizes at its middle row
+// r + b / 2, linear between rows), and its terms: unit ground direction (x, y), quadrature
+// weight and swath factor there. The step's ground azimuth turns with the spacing, so with
+// `quadrature` (sky-view factor, occlusion) the weights are the half gaps between the steps'
+// azimuths at that row (setQuadratureWeights); otherwise each keeps its own (1/K). Both the
+// kernel and the reference get these floats.
+struct RowTable {
+  std::vector<float> length;  // one per row
+  std::vector<float> terms;   // four per row: cos, sin, weight, swath
+};
+std::vector<RowTable> latticeRowTables(const HeightField& field, const std::vector<LatticeDirection>& directions,
+                                       bool quadrature);
+
+// The same for the naive march (horizon_naive with HFVIS_ROW_SPACING), one table per ray
+// direction: per row r, the ground length per pixel along the ray with row r's cell sizes, and
+// its terms there (its weight the half gaps between the rays' azimuths at that row).
+std::vector<RowTable> rayRowTables(const HeightField& field, const std::vector<SweepDirection>& rays);
+
+// An empty result with the requested planes allocated (NaN-filled).
+HorizonResult allocateResult(const HeightField& field, const HorizonOptions& options,
+                             const HorizonOutputs& outputs);
+
+}  // namespace hfvis::detail

@@ -1,0 +1,61 @@
+// sweep_framework.hpp: host side of the sweep framework every sweep kernel shares
+// (kernels/shared/sweep_framework.cl): the scratch layout of a context, memory budgets,
+// buffers, the naive marches' direction uploads, and launch shapes.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "core/lattice_geometry.hpp"
+#include "core/opencl_context.hpp"
+#include "core/sweep_geometry.hpp"
+
+namespace hfvis::detail {
+
+constexpr std::size_t kLineGroup = 64;          // work-items per group along lines
+constexpr std::size_t kTileX = 16, kTileY = 4;  // pixel tile of per-pixel kernels
+constexpr int kMaxDirectionsPerBatch = 32;      // bounds kernel time, paces progress
+
+inline std::size_t roundUp(std::size_t n, std::size_t m) { return (n + m - 1) / m * m; }
+
+// Scratch layout of a context's lattice sweeps (chunkLines): its options' line_layout,
+// automatically line-major on CPUs and step-major elsewhere.
+bool lineMajorLayout(const ContextState& st);
+
+// Lines (or rays) one work-item runs side by side (HFVIS_LANES, kernels/shared/lanes.cl): SIMD lanes
+// where a work-item runs on a CPU core in the line-major layout; one per work-item on GPUs
+// (whatever the layout: a lane-wide work-item would run alone in its group there) and in the
+// step-major layout, whose neighbouring work-items read neighbouring entries.
+int simdLanes(const ContextState& st);
+
+// The budget when the caller gives none: half the device memory (for a CPU device, whose
+// memory is the host's, half the host's physical memory).
+std::size_t defaultMemoryBudget(const DeviceInfo& device);
+
+// Half the host's physical memory (or of its cgroup's limit, where lower); 0 when unknown.
+std::size_t hostMemoryBudget();
+
+std::string mebibytes(std::size_t bytes);
+
+// A read-write buffer of at least `bytes` (never zero-sized, so it can always be bound).
+cl::Buffer deviceBuffer(ContextState& st, std::size_t bytes);
+
+cl::Buffer uploadDirections(ContextState& st, const std::vector<SweepDirection>& directions);
+
+// Where a lattice sweep kernel takes its chunk of lines: argument indices of the line table,
+// the chunk's line count, the scratch stride and (if >= 0) the chunk's first line.
+struct LineChunkArguments {
+  int lines = 0, count = 0, stride = 0, first_line = -1;
+};
+
+// Runs a lattice sweep kernel (its other arguments set) over the lines of one direction, in
+// chunks whose scratch fits `scratch_entries` (chunkLines, in the context's layout): per
+// chunk it sets a copy of the chunk's line table (sub-buffer offsets must be aligned on some
+// devices), the count, stride and first line, and launches ceil(count / lanes) work-items in
+// groups of `group`.
+void launchLineChunks(ContextState& st, cl::Kernel& kernel, std::vector<LatticeLine> lines,
+                      std::size_t samples_per_period, std::size_t scratch_entries, const LineChunkArguments& at,
+                      int lanes, std::size_t group);
+
+}  // namespace hfvis::detail

@@ -1,0 +1,129 @@
+// sweep_geometry.cpp: prepared heights, the ray geometry of a sweep direction and the scalar
+// mirrors of the kernels' sampling helpers (kernels/shared/sweep_framework.cl).
+#include "core/sweep_geometry.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <string>
+
+#include "hfvis/errors.hpp"
+
+namespace hfvis::detail {
+
+namespace {
+// Components this small are rounding noise of an axis-aligned direction: snap them to 0
+// so that axis-aligned sweeps sample exactly the pixel centres.
+double snap(double v) { return std::abs(v) < 1e-12 ? 0.0 : v; }
+}  // namespace
+
+SweepDirection makeSweepDirection(const HeightField& field, double azimuth, double samples_per_unit) {
+  const double lines_per_unit = 1.0;
+  SweepDirection d{};
+  const double cos_az = snap(std::cos(azimuth)), sin_az = snap(std::sin(azimuth));
+  // The ground direction (cos, sin) seen in pixel axes, where cells may not be square.
+  double px = cos_az / field.cell_size_x, py = sin_az / field.cell_size_y;
+  const double norm = std::hypot(px, py);
+  px /= norm;
+  py /= norm;
+  d.dir_x = static_cast<float>(px);
+  d.dir_y = static_cast<float>(py);
+  d.perp_x = -d.dir_y;
+  d.perp_y = d.dir_x;
+  d.line_spacing = static_cast<float>(1.0 / lines_per_unit);
+  d.lines_per_unit = static_cast<float>(lines_per_unit);
+  d.step_length = static_cast<float>(1.0 / samples_per_unit);
+  d.samples_per_unit = static_cast<float>(samples_per_unit);
+  d.ground_per_pixel = static_cast<float>(std::hypot(px * field.cell_size_x, py * field.cell_size_y));
+  d.cos_azimuth = static_cast<float>(cos_az);
+  d.sin_azimuth = static_cast<float>(sin_az);
+
+  // Offsets of the field's corners across (s) and along (t) the lines.
+  double s_lo = std::numeric_limits<double>::max(), s_hi = -s_lo, t_lo = s_lo, t_hi = -s_lo;
+  for (double x : {0.0, double(field.width - 1)}) {
+    for (double y : {0.0, double(field.height - 1)}) {
+      const double s = x * d.perp_x + y * d.perp_y, t = x * d.dir_x + y * d.dir_y;
+      s_lo = std::min(s_lo, s), s_hi = std::max(s_hi, s), t_lo = std::min(t_lo, t), t_hi = std::max(t_hi, t);
+    }
+  }
+  d.line_first = static_cast<std::int32_t>(std::floor(s_lo * lines_per_unit)) - 1;
+  d.n_lines = static_cast<std::int32_t>(std::ceil(s_hi * lines_per_unit)) + 1 - d.line_first + 1;
+  d.step_top = static_cast<std::int32_t>(std::ceil(t_hi * samples_per_unit)) + 1;
+  d.n_steps = d.step_top - (static_cast<std::int32_t>(std::floor(t_lo * samples_per_unit)) - 1) + 1;
+  return d;
+}
+
+bool insideField(Point2 p, int width, int height) {
+  return p.x >= -kEdgeEpsilon && p.x <= static_cast<float>(width - 1) + kEdgeEpsilon &&
+         p.y >= -kEdgeEpsilon && p.y <= static_cast<float>(height - 1) + kEdgeEpsilon;
+}
+
+float sampleHeight(const std::vector<float>& heights, int width, int height, Point2 p) {
+  const float x = std::clamp(p.x, 0.0f, static_cast<float>(width - 1));
+  const float y = std::clamp(p.y, 0.0f, static_cast<float>(height - 1));
+  const int x0 = std::min(static_cast<int>(std::floor(x)), std::max(width - 2, 0));
+  const int y0 = std::min(static_cast<int>(std::floor(y)), std::max(height - 2, 0));
+  const int x1 = std::min(x0 + 1, width - 1), y1 = std::min(y0 + 1, height - 1);
+  const float fx = x - static_cast<float>(x0), fy = y - static_cast<float>(y0);
+  const float h00 = heights[y0 * width + x0], h10 = heights[y0 * width + x1];
+  const float h01 = heights[y1 * width + x0], h11 = heights[y1 * width + x1];
+  const float w00 = (1.0f - fx) * (1.0f - fy), w10 = fx * (1.0f - fy);
+  const float w01 = (1.0f - fx) * fy, w11 = fx * fy;
+  if (std::isnan(h00) || std::isnan(h10) || std::isnan(h01) || std::isnan(h11)) {
+    float sum = 0.0f, weight = 0.0f;
+    if (!std::isnan(h00)) sum += w00 * h00, weight += w00;
+    if (!std::isnan(h10)) sum += w10 * h10, weight += w10;
+    if (!std::isnan(h01)) sum += w01 * h01, weight += w01;
+    if (!std::isnan(h11)) sum += w11 * h11, weight += w11;
+    return weight > 0.0f ? sum / weight : std::numeric_limits<float>::quiet_NaN();
+  }
+  return w00 * h00 + w10 * h10 + w01 * h01 + w11 * h11;
+}
+
+PreparedHeights prepareHeights(const HeightField& field) {
+  double lowest = std::numeric_limits<double>::max(), highest = std::numeric_limits<double>::lowest();
+  for (float h : field.heights) {
+    if (std::isfinite(h)) {
+      lowest = std::min(lowest, static_cast<double>(h));
+      highest = std::max(highest, static_cast<double>(h));
+    }
+  }
+  // The kernels multiply height differences by distances in float: keep the products finite.
+  if (highest >= lowest && (highest - lowest) * field.z_scale > kMaxPreparedHeight) {
+    std::ostringstream message;
+    message << "the heights span " << lowest << " .. " << highest << ", a rise of "
+            << (highest - lowest) * field.z_scale << " with the z-scale " << field.z_scale
+            << ": more than the " << kMaxPreparedHeight << " the kernels' float arithmetic holds";
+    throw InvalidArgument(message.str());
+  }
+  PreparedHeights prepared;
+  prepared.heights.resize(field.heights.size());
+  for (std::size_t i = 0; i < field.heights.size(); ++i) {
+    const float h = field.heights[i];
+    if (std::isfinite(h)) {
+      prepared.heights[i] = static_cast<float>((static_cast<double>(h) - lowest) * field.z_scale);
+    } else {
+      prepared.heights[i] = std::numeric_limits<float>::quiet_NaN();
+      prepared.has_nodata = true;
+    }
+  }
+  return prepared;
+}
+
+void checkPixelIndexing(const HeightField& field, int planes) {
+  const std::size_t pixels = field.pixelCount();
+  if (pixels >= (std::size_t(1) << 31) || pixels * static_cast<std::size_t>(planes) >= (std::size_t(1) << 32)) {
+    throw InvalidArgument("fields of 2^31 pixels or more (or planes of them beyond 2^32 values) are not supported "
+                          "yet (got " + std::to_string(field.width) + " x " + std::to_string(field.height) +
+                          "); split the field into tiles");
+  }
+}
+
+int stepsWithin(double max_distance, double step_ground) {
+  if (max_distance <= 0.0) return kAllSteps;
+  return static_cast<int>(std::min<double>(kAllSteps, std::floor(max_distance / step_ground)));
+}
+
+
+}  // namespace hfvis::detail

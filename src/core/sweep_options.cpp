@@ -1,0 +1,48 @@
+// sweep_options.cpp: direction azimuths and validation of the options every sweep shares.
+#include "hfvis/sweep_options.hpp"
+
+#include <cmath>
+#include <string>
+
+#include "hfvis/errors.hpp"
+#include "core/sweep_geometry.hpp"
+
+namespace hfvis {
+
+double directionAzimuth(int k, const SweepOptions& options) {
+  return 2.0 * M_PI * k / options.directions + options.azimuth_offset;
+}
+
+void validate(const SweepOptions& options) {
+  if (options.directions < 1 || options.directions > kMaxDirections) {
+    throw InvalidArgument("the number of directions K must be in 1 .. " + std::to_string(kMaxDirections) +
+                          " (got " + std::to_string(options.directions) + ")");
+  }
+  auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  if (!positive(options.samples_per_unit) || options.samples_per_unit > 64.0) {
+    throw InvalidArgument("samples per unit must be in (0, 64] (got " +
+                          std::to_string(options.samples_per_unit) + ")");
+  }
+  if (!std::isfinite(options.azimuth_offset)) throw InvalidArgument("the azimuth offset must be finite");
+  if (!std::isfinite(options.curvature) || std::abs(options.curvature) > 1.0) {
+    throw InvalidArgument("the curvature coefficient must be finite and at most 1 per ground unit (got " +
+                          std::to_string(options.curvature) + "); earthCurvature() gives the Earth's in 1/m");
+  }
+  if (!std::isfinite(options.max_distance) || options.max_distance < 0.0) {
+    throw InvalidArgument("the maximum distance must be finite and >= 0 ground units, 0 for the whole field (got " +
+                          std::to_string(options.max_distance) + ")");
+  }
+}
+
+namespace detail {
+
+std::vector<SweepDirection> runDirections(const HeightField& field, const SweepOptions& options) {
+  std::vector<SweepDirection> directions;
+  for (int k = 0; k < options.directions; ++k) {
+    directions.push_back(makeSweepDirection(field, directionAzimuth(k, options), options.samples_per_unit));
+  }
+  return directions;
+}
+
+}  // namespace detail
+}  // namespace hfvis

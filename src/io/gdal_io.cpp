@@ -1,0 +1,431 @@
+// gdal_io.cpp: georeferenced rasters through GDAL (see gdal_io.hpp).
+#include "io/gdal_io.hpp"
+
+#include <cpl_conv.h>
+#include <cpl_error.h>
+#include <cpl_string.h>
+#include <gdal.h>
+#include <ogr_srs_api.h>
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <new>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "hfvis/errors.hpp"
+#include "core/message_numbers.hpp"
+#include "io/output_files.hpp"
+
+namespace hfvis::detail {
+namespace {
+
+constexpr std::uint64_t kDefaultMaxImageBytes = std::uint64_t(64) << 30;
+// GeoTIFF blocks: square tiles, what GIS tools read windows and overviews from fastest.
+constexpr int kTileSize = 256;
+
+void registerOnce() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    GDALAllRegister();
+    CPLSetErrorHandler(CPLQuietErrorHandler);  // errors are reported through IoError
+  });
+}
+
+std::string lastError() {
+  const char* message = CPLGetLastErrorMsg();
+  return message && *message ? message : "GDAL cannot read it";
+}
+
+struct DatasetCloser {
+  void operator()(void* dataset) const { GDALClose(dataset); }
+};
+using Dataset = std::unique_ptr<void, DatasetCloser>;
+
+Dataset openRaster(const std::string& path) {
+  registerOnce();
+  requireInputFile(path);
+  Dataset dataset(GDALOpen(path.c_str(), GA_ReadOnly));
+  if (!dataset) throw IoError(path, lastError());
+  if (GDALGetRasterXSize(dataset.get()) <= 0 || GDALGetRasterYSize(dataset.get()) <= 0 ||
+      GDALGetRasterCount(dataset.get()) <= 0)
+    throw IoError(path, "the raster has no pixels");
+  return dataset;
+}
+
+// Refuses, before reading, a raster of more than `limit` bytes as float32 (0 = 64 GiB).
+void requireReadable(const std::string& path, GDALDatasetH dataset, int bands, std::uint64_t limit) {
+  limit = limit ? limit : kDefaultMaxImageBytes;
+  const std::uint64_t width = GDALGetRasterXSize(dataset), height = GDALGetRasterYSize(dataset);
+  if (width * height * std::uint64_t(bands) * sizeof(float) > limit)
+    throw IoError(path, "raster of " + std::to_string(width) + " x " + std::to_string(height) +
+                            " pixels and " + std::to_string(bands) + (bands == 1 ? " band" : " bands") +
+                            " is more than the " + std::to_string(limit >> 20) + " MiB read at most");
+}
+
+// Band `band_index` (zero-based) as float32, its nodata cells NaN.
+std::vector<float> readBand(const std::string& path, GDALDatasetH dataset, int band_index) {
+  const int width = GDALGetRasterXSize(dataset), height = GDALGetRasterYSize(dataset);
+  GDALRasterBandH band = GDALGetRasterBand(dataset, band_index + 1);
+  std::vector<float> values;
+  try {
+    values.resize(std::size_t(width) * height);
+  } catch (const std::bad_alloc&) {
+    throw IoError(path, "raster is too large to hold in memory (" + std::to_string(width) + " x " +
+                            std::to_string(height) + " pixels)");
+  }
+  if (GDALRasterIO(band, GF_Read, 0, 0, width, height, values.data(), width, height, GDT_Float32, 0, 0) !=
+      CE_None)
+    throw IoError(path, lastError());
+  int has_nodata = 0;
+  const double nodata = GDALGetRasterNoDataValue(band, &has_nodata);
+  if (has_nodata && !std::isnan(nodata)) {
+    const float value = static_cast<float>(nodata);
+    for (float& v : values)
+      if (v == value) v = std::numeric_limits<float>::quiet_NaN();
+  }
+  return values;
+}
+
+Georeference georeferenceOf(GDALDatasetH dataset) {
+  Georeference georeference;
+  std::array<double, 6> transform;
+  // Without a geotransform GDAL answers CE_Failure (and fills in the identity).
+  if (GDALGetGeoTransform(dataset, transform.data()) == CE_None) georeference.geotransform = transform;
+  if (OGRSpatialReferenceH srs = GDALGetSpatialRef(dataset)) {
+    // WKT2 keeps every detail of the CRS; WKT1 cannot hold some (datum ensembles, ...).
+    const char* const options[] = {"FORMAT=WKT2_2019", nullptr};
+    char* wkt = nullptr;
+    if (OSRExportToWktEx(srs, &wkt, options) == OGRERR_NONE && wkt) georeference.crs_wkt = wkt;
+    CPLFree(wkt);
+  }
+  return georeference;
+}
+
+bool isGeographic(GDALDatasetH dataset) {
+  OGRSpatialReferenceH srs = GDALGetSpatialRef(dataset);
+  return srs && OSRIsGeographic(srs);
+}
+
+// Metadata names: GDAL's name=value lists also split at ':', so hfvis:units is stored as
+// hfvis_units (and read back as hfvis:units).
+constexpr const char* kStoredPrefix = "hfvis_";
+constexpr const char* kAttributePrefix = "hfvis:";
+
+std::string storedName(std::string name) {
+  std::replace(name.begin(), name.end(), ':', '_');
+  return name;
+}
+
+std::string attributeName(const std::string& stored) {
+  if (stored.rfind(kStoredPrefix, 0) == 0)
+    return kAttributePrefix + stored.substr(std::string(kStoredPrefix).size());
+  return stored;
+}
+
+// Collects the errors GDAL reports on this thread while it lives: the GeoTIFF writer reports a
+// failed write (disk full, ...) only that way, and a later warning would hide it from
+// CPLGetLastErrorMsg.
+class ErrorCollector {
+ public:
+  ErrorCollector() { CPLPushErrorHandlerEx(&ErrorCollector::handle, this); }
+  ~ErrorCollector() { CPLPopErrorHandler(); }
+  ErrorCollector(const ErrorCollector&) = delete;
+  ErrorCollector& operator=(const ErrorCollector&) = delete;
+
+  bool failed() const { return !first_failure_.empty(); }
+  // `what`, with the cause where it can be told (a full disk, the file size limit) and GDAL's
+  // first failure message, the temporary `file` in it named as the output `path`.
+  std::string reason(const std::string& what, const std::string& file = "",
+                     const std::string& path = "") const {
+    std::string detail = first_failure_;
+    for (std::size_t at; !file.empty() && (at = detail.find(file)) != std::string::npos;)
+      detail.replace(at, file.size(), path);
+    const int cause = file.empty() ? 0 : likelyWriteError(file);
+    const std::string head = cause ? what + ": " + writeFailure(cause) : what;
+    return detail.empty() ? head : head + " (" + detail + ")";
+  }
+
+ private:
+  static void CPL_STDCALL handle(CPLErr level, CPLErrorNum, const char* message) {
+    auto* self = static_cast<ErrorCollector*>(CPLGetErrorHandlerUserData());
+    if ((level == CE_Failure || level == CE_Fatal) && self->first_failure_.empty())
+      self->first_failure_ = message && *message ? message : "GDAL reported a failure";
+  }
+  std::string first_failure_;
+};
+
+// A GDAL configuration option set on this thread while it lives, then restored.
+class ScopedThreadConfig {
+ public:
+  ScopedThreadConfig(const char* key, const char* value) : key_(key) {
+    if (const char* old = CPLGetThreadLocalConfigOption(key, nullptr)) old_ = std::string(old);
+    CPLSetThreadLocalConfigOption(key, value);
+  }
+  ~ScopedThreadConfig() { CPLSetThreadLocalConfigOption(key_, old_ ? old_->c_str() : nullptr); }
+  ScopedThreadConfig(const ScopedThreadConfig&) = delete;
+  ScopedThreadConfig& operator=(const ScopedThreadConfig&) = delete;
+
+ private:
+  const char* key_;
+  std::optional<std::string> old_;
+};
+
+}  // namespace
+
+// Ground metres per degree on the WGS84 ellipsoid at geodetic latitude `lat_deg`:
+// along a meridian (radius of curvature M) and along a parallel (N cos(lat)).
+void metresPerDegree(double lat_deg, double* along_meridian, double* along_parallel) {
+  const double a = 6378137.0;
+  const double f = 1.0 / 298.257223563;
+  const double e2 = f * (2.0 - f);
+  const double lat = lat_deg * M_PI / 180.0;
+  const double s = std::sin(lat);
+  const double w = 1.0 - e2 * s * s;
+  const double m = a * (1.0 - e2) / (w * std::sqrt(w));
+  const double n = a / std::sqrt(w);
+  *along_meridian = m * M_PI / 180.0;
+  *along_parallel = n * std::cos(lat) * M_PI / 180.0;
+}
+
+using detail::shortNumber;
+
+std::optional<std::pair<double, double>> storedCellSize(const std::string& path, const char* x,
+                                                        const char* y) {
+  if ((!x || !*x) && (!y || !*y)) return std::nullopt;
+  auto number = [&](const char* name, const char* text) {
+    char* end = nullptr;
+    const double v = text ? std::strtod(text, &end) : 0.0;
+    if (!text || !*text || *end != '\0' || !std::isfinite(v) || !(v > 0.0) || v > 1e9)
+      throw IoError(path, std::string("the attribute ") + name + " is '" +
+                              (text ? std::string(text).substr(0, 40) : "") +
+                              "', not a cell size (a positive number); give --cell-size");
+    return v;
+  };
+  return std::make_pair(number("hfvis:cell_size_x", x), number("hfvis:cell_size_y", y));
+}
+
+std::string lowercaseExtension(const std::string& path) {
+  std::string extension = std::filesystem::path(path).extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return extension;
+}
+
+bool isGdalRaster(const std::string& path) {
+  const std::string extension = lowercaseExtension(path);
+  for (const char* gdal : {".tif", ".tiff", ".hgt", ".asc", ".vrt", ".img", ".bil", ".dem", ".grd", ".adf"})
+    if (extension == gdal) return true;
+  return false;
+}
+
+HeightField readGdalHeightField(const std::string& path, const HeightFieldReadOptions& options) {
+  const Dataset dataset = openRaster(path);
+  const int bands = GDALGetRasterCount(dataset.get());
+  // The band: the only one, an index, or a description.
+  int band_index = 0;
+  if (options.channel.empty()) {
+    if (bands != 1)
+      throw IoError(path, "the raster has " + std::to_string(bands) + " bands: choose one with --channel");
+  } else if (options.channel.size() <= 9 &&
+             std::all_of(options.channel.begin(), options.channel.end(), ::isdigit)) {
+    band_index = std::stoi(options.channel);
+    if (band_index >= bands) throw IoError(path, "no band " + options.channel);
+  } else {
+    band_index = -1;
+    for (int b = 0; b < bands; ++b)
+      if (options.channel == GDALGetDescription(GDALGetRasterBand(dataset.get(), b + 1))) band_index = b;
+    if (band_index < 0) throw IoError(path, "no band named '" + options.channel + "'");
+  }
+  requireReadable(path, dataset.get(), 1, options.max_image_bytes);
+  HeightField field;
+  field.width = GDALGetRasterXSize(dataset.get());
+  field.height = GDALGetRasterYSize(dataset.get());
+  field.heights = readBand(path, dataset.get(), band_index);
+  field.georeference = georeferenceOf(dataset.get());
+  // A rotated or sheared grid is refused whatever the cell size: the outputs would keep its
+  // geotransform while every direction and distance was computed on an axis-aligned one.
+  if (const auto& gt = field.georeference.geotransform; gt && ((*gt)[2] != 0.0 || (*gt)[4] != 0.0))
+    throw IoError(path, "rotated or sheared geotransforms are not supported (terms " +
+                            std::to_string((*gt)[2]) + ", " + std::to_string((*gt)[4]) +
+                            "); warp the raster north-up first (gdalwarp)");
+  // Cell sizes: given, else from the geotransform (north-up or south-up only), else as hfvis
+  // stored them.
+  if (options.cell_size_x > 0.0 || options.cell_size_y > 0.0) {
+    field.cell_size_x = options.cell_size_x > 0.0 ? options.cell_size_x : options.cell_size_y;
+    field.cell_size_y = options.cell_size_y > 0.0 ? options.cell_size_y : options.cell_size_x;
+  } else if (const auto& gt = field.georeference.geotransform) {
+    field.cell_size_x = std::fabs((*gt)[1]);
+    field.cell_size_y = std::fabs((*gt)[5]);
+    if (isGeographic(dataset.get())) {
+      const double first = (*gt)[3], last = (*gt)[3] + (*gt)[5] * field.height;
+      if (!(std::fabs(first) <= 90.0 && std::fabs(last) <= 90.0))
+        throw IoError(path, "a geographic raster whose rows span latitudes " + shortNumber(first) + " .. " +
+                                shortNumber(last) +
+                                " degrees, beyond the poles: its geotransform or CRS is wrong");
+      // Degrees to metres on the ellipsoid at each row's latitude (its pixel centres); the
+      // field's cell sizes are those at its centre latitude.
+      const double degrees_x = field.cell_size_x, degrees_y = field.cell_size_y;
+      double per_deg_y, per_deg_x;
+      for (int r = 0; r < field.height; ++r) {
+        metresPerDegree((*gt)[3] + (*gt)[5] * (r + 0.5), &per_deg_y, &per_deg_x);
+        field.row_cell_size_x.push_back(degrees_x * per_deg_x);
+        field.row_cell_size_y.push_back(degrees_y * per_deg_y);
+      }
+      metresPerDegree((*gt)[3] + (*gt)[5] * 0.5 * field.height, &per_deg_y, &per_deg_x);
+      field.cell_size_x = degrees_x * per_deg_x;
+      field.cell_size_y = degrees_y * per_deg_y;
+    }
+  } else if (const auto stored =
+                 storedCellSize(path, GDALGetMetadataItem(dataset.get(), "hfvis_cell_size_x", nullptr),
+                                GDALGetMetadataItem(dataset.get(), "hfvis_cell_size_y", nullptr))) {
+    field.cell_size_x = stored->first;
+    field.cell_size_y = stored->second;
+  } else if (isGeographic(dataset.get())) {
+    // No geotransform: a geographic raster's spacing in metres cannot be known.
+    throw IoError(path,
+                  "a geographic raster without a geotransform (no tiepoint) has no cell size in "
+                  "metres; give one with --cell-size");
+  }
+  field.z_scale = options.z_scale;
+  return field;
+}
+
+namespace {
+// A band without a description: R, G, B or A where the raster says it holds that colour (a
+// standard RGB GeoTIFF), else "channel<b>".
+std::string colourName(GDALRasterBandH band, int b) {
+  switch (GDALGetRasterColorInterpretation(band)) {
+    case GCI_RedBand:
+      return "R";
+    case GCI_GreenBand:
+      return "G";
+    case GCI_BlueBand:
+      return "B";
+    case GCI_AlphaBand:
+      return "A";
+    default:
+      return "channel" + std::to_string(b);
+  }
+}
+}  // namespace
+
+ImageChannels readGdalImage(const std::string& path) {
+  const Dataset dataset = openRaster(path);
+  const int bands = GDALGetRasterCount(dataset.get());
+  requireReadable(path, dataset.get(), bands, 0);
+  ImageChannels image;
+  image.width = GDALGetRasterXSize(dataset.get());
+  image.height = GDALGetRasterYSize(dataset.get());
+  for (int b = 0; b < bands; ++b) {
+    GDALRasterBandH band = GDALGetRasterBand(dataset.get(), b + 1);
+    const std::string description = GDALGetDescription(band);
+    image.names.push_back(description.empty() ? colourName(band, b) : description);
+    image.planes.push_back(readBand(path, dataset.get(), b));
+  }
+  for (char** item = GDALGetMetadata(dataset.get(), nullptr); item && *item; ++item) {
+    char* name = nullptr;
+    const char* value = CPLParseNameValue(*item, &name);
+    if (name && value) image.attributes.emplace_back(attributeName(name), value);
+    CPLFree(name);
+  }
+  image.georeference = georeferenceOf(dataset.get());
+  return image;
+}
+
+bool hasGeoTiffWriter() {
+  registerOnce();
+  return GDALGetDriverByName("GTiff") != nullptr;
+}
+
+namespace {
+// Whether every value of every plane is a whole number or NaN.
+bool wholeNumbers(const ImageChannels& image) {
+  for (const std::vector<float>& plane : image.planes)
+    for (float v : plane)
+      if (!std::isnan(v) && v != std::nearbyint(v)) return false;
+  return true;
+}
+}  // namespace
+
+void writeGeoTiff(const std::string& file, const std::string& path, const ImageChannels& image) {
+  if (!hasGeoTiffWriter()) throw IoError(path, "this GDAL has no GTiff driver to write a GeoTIFF");
+  // Everything must go into the TIFF itself: with PAM on, GDAL puts what no TIFF tag holds into
+  // a side file FILE.aux.xml, which the rename into place would leave behind.
+  const ScopedThreadConfig no_side_file("GDAL_PAM_ENABLED", "NO");
+  const ErrorCollector errors;
+  char** options = nullptr;
+  options = CSLSetNameValue(options, "TILED", "YES");
+  options = CSLSetNameValue(options, "BLOCKXSIZE", std::to_string(kTileSize).c_str());
+  options = CSLSetNameValue(options, "BLOCKYSIZE", std::to_string(kTileSize).c_str());
+  options = CSLSetNameValue(options, "COMPRESS", "DEFLATE");
+  // Level 1: about half the time of the default 6 for 1-2 % more bytes (a 4096^2 float32 DEM,
+  // timed once with GDAL's writer alone on the 2-core test machine: 0.46 s and 42.2 MB against
+  // 1.01 s and 41.5 MB). The floating-point predictor helps continuous values and only costs
+  // where every value is a whole number (visible 0 / 1, counts): 0.19 s and 0.42 MB without it,
+  // 0.32 s and 0.64 MB with it, on a 4096^2 viewshed timed the same way.
+  options = CSLSetNameValue(options, "ZLEVEL", "1");
+  options = CSLSetNameValue(options, "PREDICTOR", wholeNumbers(image) ? "1" : "3");
+  // Band by band: each plane is written whole, so each compressed tile is written once (pixel
+  // interleaving would recompress every tile for every band).
+  options = CSLSetNameValue(options, "INTERLEAVE", "BAND");
+  options = CSLSetNameValue(options, "BIGTIFF", "IF_SAFER");
+  // DEFLATE is most of the writing time of a large output; the tiles compress independently.
+  options = CSLSetNameValue(options, "NUM_THREADS", "ALL_CPUS");
+  const int bands = static_cast<int>(image.planes.size());
+  Dataset dataset(GDALCreate(GDALGetDriverByName("GTiff"), file.c_str(), image.width, image.height, bands,
+                             GDT_Float32, options));
+  CSLDestroy(options);
+  if (!dataset) throw IoError(path, errors.reason("cannot create the GeoTIFF", file, path));
+
+  const Georeference& georeference = image.georeference;
+  if (georeference.geotransform) {
+    std::array<double, 6> transform = *georeference.geotransform;
+    if (GDALSetGeoTransform(dataset.get(), transform.data()) != CE_None)
+      throw IoError(path, errors.reason("cannot write the geotransform"));
+  }
+  if (!georeference.crs_wkt.empty() &&
+      GDALSetProjection(dataset.get(), georeference.crs_wkt.c_str()) != CE_None)
+    throw IoError(path, errors.reason("cannot write the CRS"));
+  for (const auto& [name, value] : image.attributes) {
+    if (GDALSetMetadataItem(dataset.get(), storedName(name).c_str(), value.c_str(), nullptr) != CE_None)
+      throw IoError(path, errors.reason("cannot write the metadata item '" + name + "'"));
+  }
+
+  const bool replace_nan = !std::isnan(image.nodata);
+  // NaN cells become the nodata value a tile row at a time, so no plane is copied whole.
+  std::vector<float> rows(replace_nan ? std::size_t(image.width) * std::min(kTileSize, image.height) : 0);
+  for (int b = 0; b < bands; ++b) {
+    GDALRasterBandH band = GDALGetRasterBand(dataset.get(), b + 1);
+    GDALSetDescription(band, image.names[b].c_str());
+    if (GDALSetRasterNoDataValue(band, image.nodata) != CE_None)
+      throw IoError(path, errors.reason("cannot write the nodata value"));
+    const std::vector<float>& plane = image.planes[b];
+    for (int y = 0; y < image.height; y += kTileSize) {
+      const int count = std::min(kTileSize, image.height - y);
+      const float* source = plane.data() + std::size_t(y) * image.width;
+      if (replace_nan) {
+        std::transform(source, source + std::size_t(count) * image.width, rows.begin(),
+                       [&](float v) { return std::isnan(v) ? image.nodata : v; });
+        source = rows.data();
+      }
+      if (GDALRasterIO(band, GF_Write, 0, y, image.width, count, const_cast<float*>(source), image.width,
+                       count, GDT_Float32, 0, 0) != CE_None)
+        throw IoError(path, errors.reason("cannot write the pixels", file, path));
+    }
+  }
+  GDALFlushCache(dataset.get());
+  dataset.reset();  // closing writes the last tiles and the directory
+  if (errors.failed()) throw IoError(path, errors.reason("cannot write the GeoTIFF", file, path));
+}
+
+}  // namespace hfvis::detail

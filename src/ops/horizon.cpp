@@ -1,0 +1,816 @@
+// horizon.cpp: the horizon operation on the device. Per direction, one launch of the
+// lattice sweep (receiver-exact hull stacks, reduced straight into the requested outputs)
+// or of the naive march; per batch of directions, the requested planes are downloaded.
+#include "hfvis/horizon.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "ops/environment_swaths.hpp"
+#include "core/fast_math.hpp"
+#include "hfvis/errors.hpp"
+#include "core/horizon_common.hpp"
+#include "core/lattice_geometry.hpp"
+#include "core/opencl_context.hpp"
+#include "core/sweep_framework.hpp"
+#include "core/sweep_routine.hpp"
+
+namespace hfvis {
+namespace detail {
+namespace {
+
+constexpr std::size_t kStackEntryBytes = 2 * sizeof(float);  // (height, position)
+
+std::string programOptions(const HorizonOutputs& outputs, bool has_nodata, int lanes, bool curvature,
+                           bool max_distance, bool row_spacing) {
+  std::ostringstream s;
+  s << "-DHFVIS_LANES=" << lanes << " -DHFVIS_HAS_NODATA=" << has_nodata << " -DHFVIS_CURVATURE=" << curvature
+    << " -DHFVIS_MAX_DISTANCE=" << max_distance << " -DHFVIS_ROW_SPACING=" << row_spacing
+    << " -DHFVIS_WANT_ANGLES=" << outputs.horizon_angles
+    << " -DHFVIS_WANT_DISTANCES=" << outputs.horizon_distances
+    << " -DHFVIS_WANT_SVF=" << outputs.sky_view_factor << " -DHFVIS_WANT_AO=" << outputs.ambient_occlusion
+    << " -DHFVIS_WANT_ENV=" << (outputs.environment != nullptr)
+    << " -DHFVIS_ENV_CHANNELS=" << (outputs.environment ? outputs.environment->channels : 1);
+  return s.str();
+}
+
+// One direction of a run, whichever method: what the kernels and the outputs need.
+struct RunDirection {
+  LatticeDirection lattice;  // sweep (azimuth and weight for both methods)
+  SweepDirection ray;        // naive march
+  std::vector<LatticeSample> samples;
+  std::vector<CellSegment> segments;  // sweep: the segment ending at each sample
+  std::size_t stack_per_period = 0;   // sweep: hull-stack entries a period can push
+  float cos_azimuth = 1.0f, sin_azimuth = 0.0f;  // as the scalar reference rounds them
+  std::vector<LatticeLine> lines;                // sweep: the direction's lines over the field
+  LatticeWindow window;                          // sweep: the maximum distance along its lines
+  int max_steps = kAllSteps;                     // naive march: the steps within the maximum distance
+  // Per-row spacing: ground length and terms by row (latticeRowTables, rayRowTables).
+  std::vector<float> row_length, row_terms;
+  int index = 0;  // k
+};
+
+// Planes per pixel an environment's sums take (one per channel), and the bytes of its map and of
+// the tables of `directions` directions.
+std::size_t environmentPlanes(const HorizonOutputs& outputs) {
+  return outputs.environment ? outputs.environment->channels : 0;
+}
+std::size_t environmentBytes(const HorizonOutputs& outputs, std::size_t directions) {
+  if (!outputs.environment) return 0;
+  const EnvironmentMap& map = *outputs.environment;
+  return (map.radiance.size() + directions * tableRows(map) * map.channels * kEnvTerms) * sizeof(float);
+}
+
+// How a run uses its device memory budget: directions per downloaded batch of planes, the
+// hull-stack scratch (entries) every launch of the sweep shares, and the strips.
+struct RunPlan {
+  int directions_per_batch = 1;
+  std::size_t stack_entries = 0;
+  int strip_rows = 0;             // rows per strip: the field's height when it runs in one piece
+  int halo_rows = 0;              // strips: rows of heights on each side beyond a strip's own
+  std::size_t carry_entries = 0;  // strips: entries the two buffers of carried stacks may take together
+  std::size_t budget = 0, per_row = 0, halo_bytes = 0;  // strips: what they were planned from
+};
+
+// A field beyond the budget (or asked to): strips of as many rows as half the budget holds, the
+// rest for the hull stacks.
+RunPlan planStrips(const HeightField& field, const HorizonOptions& options, const HorizonOutputs& outputs,
+                   const std::vector<RunDirection>& directions, std::size_t budget, std::size_t max_alloc) {
+  RunPlan plan;
+  // A receiver's period reaches a step (|b| rows) away, the normals one row; within a maximum
+  // distance the window's pass reaches back to the start of the block before, up to two
+  // windows and a period along the line.
+  // With per-row spacing the window is a ground length: so many of the shortest periods.
+  const bool window = options.max_distance > 0.0, positions = window && hasRowSpacing(field);
+  plan.halo_rows = 1;
+  for (const RunDirection& d : directions) {
+    double periods = 1.0;
+    if (positions) {
+      const double shortest = *std::min_element(d.row_length.begin(), d.row_length.end());
+      const double longest = *std::max_element(d.row_length.begin(), d.row_length.end());
+      periods = (2.0 * d.window.window + 2.0 * longest) / shortest;
+    } else if (window) {
+      periods = (2.0 * d.window.window + 2.0 * d.lattice.period) / d.lattice.period;
+    }
+    plan.halo_rows = std::max(plan.halo_rows, static_cast<int>(std::ceil(periods * std::abs(d.lattice.b))) + 1);
+  }
+  const std::size_t halo_rows = plan.halo_rows;
+  const std::size_t row = field.width * sizeof(float);
+  // Per row of a strip: heights, the sums, the normals' two slopes, one direction's planes, the
+  // window's float2 (and with per-row spacing the receivers' positions, which also take the
+  // halo's rows).
+  const std::size_t per_row =
+      row * (1 + outputs.sky_view_factor + (outputs.ambient_occlusion || outputs.environment) * 2 +
+             outputs.ambient_occlusion + environmentPlanes(outputs) + outputs.horizon_angles +
+             outputs.horizon_distances + window * 2 + positions);
+  // The halo's rows, and the environment's map and tables.
+  const std::size_t halo = 2 * halo_rows * row * (1 + positions) + environmentBytes(outputs, directions.size());
+  std::size_t rows = budget / 2 > halo ? (budget / 2 - halo) / per_row : 0;
+  // The largest buffers: a strip's heights with its halo, and its normals.
+  rows = std::min({rows, max_alloc / row > 2 * halo_rows ? max_alloc / row - 2 * halo_rows : 0,
+                   max_alloc / (2 * row)});
+  if (options.strip_rows > 0) rows = std::min<std::size_t>(rows, options.strip_rows);
+  if (rows < 1)
+    throw MemoryBudgetError("a strip of one row needs " + mebibytes(2 * (per_row + halo)) +
+                            " of device memory but the budget is " + mebibytes(budget) +
+                            " (largest single buffer " + mebibytes(max_alloc) + "); raise the memory budget");
+  plan.strip_rows = static_cast<int>(std::min<std::size_t>(rows, field.height));
+  plan.budget = budget;
+  plan.per_row = per_row;
+  plan.halo_bytes = halo;
+  const std::size_t rest = budget - (plan.strip_rows * per_row + halo);
+  // An eighth for the scratch (lines run in chunks of it), the rest for the two buffers of
+  // carried stacks (those a strip starts with and those it hands on), which must hold every
+  // line under way at once: smooth terrain keeps a hundred or more samples of a line on its
+  // hull (the sine field at 4096^2: 190 entries per line crossing a strip's edge).
+  plan.stack_entries = std::min(rest / 8, max_alloc) / kStackEntryBytes;
+  plan.carry_entries = rest / 8 * 7 / kStackEntryBytes;
+  return plan;
+}
+
+RunPlan planRun(const HeightField& field, const HorizonOptions& options, const HorizonOutputs& outputs,
+                const std::vector<RunDirection>& directions, const DeviceInfo& device) {
+  const bool sweep = options.method == HorizonMethod::Sweep;
+  const std::size_t budget =
+      options.memory_budget_bytes ? options.memory_budget_bytes : defaultMemoryBudget(device);
+  const std::size_t max_alloc = device.max_allocation_bytes ? device.max_allocation_bytes : budget;
+  const std::size_t plane = field.pixelCount() * sizeof(float);
+  // Heights, the sums, the normals' two slopes, the window's float2 per pixel (and with per-row
+  // spacing the receivers' positions).
+  const bool window = sweep && options.max_distance > 0.0;
+  const std::size_t fixed =
+      plane * (1 + outputs.sky_view_factor + (outputs.ambient_occlusion || outputs.environment) * 2 +
+               outputs.ambient_occlusion + environmentPlanes(outputs) + window * 2 +
+               (window && hasRowSpacing(field))) +
+      environmentBytes(outputs, directions.size());
+  const std::size_t per_direction = plane * (outputs.horizon_angles + outputs.horizon_distances);
+  // Scratch: all of a direction's stacks in one launch when it fits; one line at a time at least.
+  std::size_t whole = 0, longest = 0;
+  if (sweep) {
+    for (const RunDirection& d : directions) {
+      std::size_t total = 0;
+      for (const LatticeLine& line : d.lines) {
+        const std::size_t capacity = lineCapacity(line, d.stack_per_period);
+        total += capacity;
+        longest = std::max(longest, capacity);
+      }
+      whole = std::max(whole, total);
+    }
+  }
+  const std::size_t least = fixed + per_direction + longest * kStackEntryBytes;
+  const bool fits = least <= budget && per_direction <= max_alloc && longest * kStackEntryBytes <= max_alloc;
+  if (!fits || (options.strip_rows > 0 && options.strip_rows < field.height)) {
+    if (sweep) return planStrips(field, options, outputs, directions, budget, max_alloc);
+    throw MemoryBudgetError("one direction needs " + mebibytes(least) + " of device memory but the budget is " +
+                            mebibytes(budget) + " (largest single buffer " + mebibytes(max_alloc) +
+                            "), and the naive method needs the whole field at once (no strips); raise the memory "
+                            "budget or use a smaller field");
+  }
+  const std::size_t available = budget - fixed;
+  RunPlan plan;
+  plan.strip_rows = field.height;
+  // Planes of up to kMaxDirectionsPerBatch directions, leaving the scratch at least half.
+  const std::size_t stack_bytes = std::min(whole * kStackEntryBytes, max_alloc);
+  const std::size_t for_planes =
+      available - std::min(stack_bytes, std::max(available / 2, longest * kStackEntryBytes));
+  plan.directions_per_batch = static_cast<int>(
+      std::min<std::size_t>({static_cast<std::size_t>(std::min(options.directions, kMaxDirectionsPerBatch)),
+                             per_direction ? std::max<std::size_t>(1, for_planes / per_direction)
+                                           : std::size_t(kMaxDirectionsPerBatch),
+                             per_direction ? std::max<std::size_t>(1, max_alloc / per_direction)
+                                           : std::size_t(kMaxDirectionsPerBatch)}));
+  // Plane offsets within a batch are 32-bit in the kernels.
+  plan.directions_per_batch = static_cast<int>(std::min<std::size_t>(
+      plan.directions_per_batch, std::max<std::size_t>(1, std::size_t(0xffffffffu) / field.pixelCount())));
+  plan.stack_entries = std::min(
+      whole, std::min(available - plan.directions_per_batch * per_direction, max_alloc) / kStackEntryBytes);
+  return plan;
+}
+
+std::vector<RunDirection> runDirectionsOf(const HeightField& field, const HorizonOptions& options,
+                                          const HorizonOutputs& outputs) {
+  std::vector<RunDirection> out;
+  if (options.method == HorizonMethod::Sweep) {
+    const std::vector<LatticeDirection> directions = horizonDirections(field, options, outputs);
+    std::vector<RowTable> rows;
+    if (hasRowSpacing(field)) rows = latticeRowTables(field, directions, !exactAzimuths(outputs));
+    for (std::size_t k = 0; k < directions.size(); ++k) {
+      const LatticeDirection& d = directions[k];
+      std::vector<CellSegment> segments = cellSegments(d, options.samples_per_unit);
+      const std::size_t per_period = stackEntriesPerPeriod(segments);
+      out.push_back({d, SweepDirection{}, latticeSamples(d, options.samples_per_unit), std::move(segments), per_period,
+                     static_cast<float>(std::cos(d.azimuth)), static_cast<float>(std::sin(d.azimuth)),
+                     latticeLines(d, field.width, field.height), latticeWindow(field, d, options.max_distance),
+                     kAllSteps, {}, {}, static_cast<int>(k)});
+      if (!rows.empty()) {
+        out.back().row_length = std::move(rows[k].length);
+        out.back().row_terms = std::move(rows[k].terms);
+      }
+    }
+  } else {
+    const std::vector<SweepDirection> rays = runDirections(field, options);
+    std::vector<RowTable> rows;
+    if (hasRowSpacing(field)) rows = rayRowTables(field, rays);
+    for (int k = 0; k < options.directions; ++k) {
+      const SweepDirection& d = rays[k];
+      RunDirection r;
+      r.index = k;
+      r.ray = d;
+      r.lattice.azimuth = directionAzimuth(k, options);
+      r.lattice.weight = 1.0 / options.directions;
+      r.cos_azimuth = d.cos_azimuth;
+      r.sin_azimuth = d.sin_azimuth;
+      // With per-row spacing the march cuts at the ground length itself (horizon_naive's max_ground).
+      r.max_steps = hasRowSpacing(field) ? kAllSteps
+                                         : stepsWithin(options.max_distance, double(d.step_length) * d.ground_per_pixel);
+      if (!rows.empty()) {
+        r.row_length = std::move(rows[k].length);
+        r.row_terms = std::move(rows[k].terms);
+      }
+      out.push_back(r);
+    }
+  }
+  return out;
+}
+
+// Hull stacks that outgrow what the budget leaves beside the strips; `rows`: thinner strips that
+// leave room for them (computeHorizons retries with those), 0 when none do.
+struct StacksBeyondStrips : MemoryBudgetError {
+  StacksBeyondStrips(const std::string& message, int strip_rows) : MemoryBudgetError(message), rows(strip_rows) {}
+  int rows;
+};
+
+class HorizonRoutine : public SweepRoutine {
+ public:
+  HorizonRoutine(ContextState& st, const HeightField& field, const HorizonOptions& options,
+                 const HorizonOutputs& outputs)
+      : SweepRoutine(st, field, options),
+        horizon_(options),
+        outputs_(outputs),
+        lanes_(simdLanes(st)),
+        directions_(runDirectionsOf(field, options, outputs)),
+        plan_(planRun(field, options, outputs, directions_, st.info)) {
+    // A window's blocks are per line, so its strips, and with per-row spacing its whole sweep
+    // (positions differ by line there), run one line per work-item.
+    if ((inStrips() || hasRowSpacing(field)) && options.max_distance > 0.0) lanes_ = 1;
+  }
+
+  HorizonResult take() { return std::move(result_); }
+
+ private:
+  std::string programFile() const override { return "horizon.cl"; }
+  std::string programOptions() const override {
+    return detail::programOptions(outputs_, prepared_.has_nodata, lanes_, horizon_.curvature != 0.0,
+                                  horizon_.max_distance > 0.0, hasRowSpacing(field_)) +
+           " -DHFVIS_STRIPS=" + std::to_string(inStrips());
+  }
+  bool heightsResident() const override { return !inStrips(); }
+  bool needsNormals() const { return outputs_.ambient_occlusion || outputs_.environment; }
+  int environmentChannels() const { return static_cast<int>(environmentPlanes(outputs_)); }
+  bool inStrips() const { return plan_.strip_rows < field_.height; }
+
+  void allocate() override {
+    result_ = allocateResult(field_, horizon_, outputs_);
+    for (int k = 0; k < horizon_.directions; ++k) result_.azimuths[k] = directions_[k].lattice.azimuth;
+    // Device planes and sums cover a strip's rows (all of them in one piece).
+    const std::size_t plane = static_cast<std::size_t>(plan_.strip_rows) * field_.width;
+    const std::size_t planes_bytes = plan_.directions_per_batch * plane * sizeof(float);
+    angles_ = st_.reusableBuffer("horizon angles", outputs_.horizon_angles ? planes_bytes : 0);
+    distances_ = st_.reusableBuffer("horizon distances", outputs_.horizon_distances ? planes_bytes : 0);
+    svf_ = zeros(outputs_.sky_view_factor ? plane : 0);
+    ao_ = zeros(outputs_.ambient_occlusion ? plane : 0);
+    env_sum_ = zeros(environmentChannels() * plane);
+    normals_ = deviceBuffer(st_, needsNormals() ? 2 * plane * sizeof(float) : 0);
+    env_tables_ = environmentTables();
+    stacks_ = st_.reusableBuffer("lattice stacks", plan_.stack_entries * kStackEntryBytes);
+    const bool window = horizon_.method == HorizonMethod::Sweep && horizon_.max_distance > 0.0;
+    window_far_ = deviceBuffer(st_, window ? 2 * plane * sizeof(float) : 0);
+    // Per-row spacing within a maximum distance: the receivers' positions, over the heights' rows
+    // (in strips the halo's too: those of earlier strips come from the host, which holds them all).
+    const bool positions = window && hasRowSpacing(field_);
+    const std::size_t position_rows =
+        inStrips() ? std::min<std::size_t>(plan_.strip_rows + 2 * plan_.halo_rows, field_.height) : field_.height;
+    receiver_base_ = deviceBuffer(st_, positions ? position_rows * field_.width * sizeof(float) : 0);
+    if (positions && inStrips()) receiver_positions_.assign(field_.pixelCount(), 0.0f);
+    placeholder_ = deviceBuffer(st_, 0);
+    row_cells_ = rowCells();
+    if (inStrips()) {
+      heights_ = deviceBuffer(
+          st_, std::min<std::size_t>(plan_.strip_rows + 2 * plan_.halo_rows, field_.height) * field_.width *
+                   sizeof(float));
+    } else if (needsNormals()) {
+      computeNormals(0, 0, field_.height);
+    }
+  }
+
+  // Every direction's table of the environment (environment_tables), in one buffer: direction
+  // k's from k * envTableFloats() on. A placeholder without an environment.
+  cl::Buffer environmentTables() {
+    if (!outputs_.environment) return deviceBuffer(st_, 0);
+    const EnvironmentMap& map = *outputs_.environment;
+    std::vector<LatticeDirection> directions;
+    for (const RunDirection& d : directions_) directions.push_back(d.lattice);
+    const EnvironmentSwaths swaths = environmentSwaths(map, directions);
+    // The tables are one buffer, each direction's found at a 32-bit offset.
+    const std::size_t table_bytes = directions_.size() * envTableFloats() * sizeof(float);
+    const std::size_t max_alloc = st_.info.max_allocation_bytes ? st_.info.max_allocation_bytes : table_bytes;
+    if (directions_.size() * envTableFloats() >= (std::size_t(1) << 32) || table_bytes > max_alloc)
+      throw MemoryBudgetError("the environment's tables take " + mebibytes(table_bytes) +
+                              ", beyond the device's largest buffer or 2^32 values; take fewer directions or "
+                              "fewer table rows (EnvironmentMap::table_rows, --env-rows)");
+    auto upload = [&](const void* data, std::size_t bytes) {
+      return cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes, const_cast<void*>(data));
+    };
+    const cl::Buffer env = upload(map.radiance.data(), map.radiance.size() * sizeof(float));
+    const cl::Buffer bins = upload(swaths.bins.data(), swaths.bins.size() * sizeof(swaths.bins[0]));
+    const cl::Buffer spans = upload(swaths.spans.data(), swaths.spans.size() * sizeof(swaths.spans[0]));
+    cl::Buffer tables = deviceBuffer(st_, table_bytes);
+    cl::Kernel kernel(program_, "environment_tables");
+    kernel.setArg(0, env);
+    kernel.setArg(1, map.width);
+    kernel.setArg(2, map.height);
+    kernel.setArg(3, map.channels);
+    kernel.setArg(4, tableRows(map));
+    kernel.setArg(5, static_cast<int>(directions_.size()));
+    kernel.setArg(6, bins);
+    kernel.setArg(7, spans);
+    kernel.setArg(8, tables);
+    st_.launch(kernel, cl::NDRange(roundUp(directions_.size(), kLineGroup)), cl::NDRange(kLineGroup));
+    st_.queue.finish();  // before the map, bins and spans go
+    return tables;
+  }
+
+  // Floats of one direction's table.
+  std::size_t envTableFloats() const {
+    return outputs_.environment ? std::size_t(tableRows(*outputs_.environment)) * outputs_.environment->channels * kEnvTerms
+                                : 0;
+  }
+
+  int directionCount() const override { return horizon_.directions; }
+  int batchSize() const override { return plan_.directions_per_batch; }
+
+  void sweep(int k, int slot) override {
+    const RunDirection& d = directions_[k];
+    const bool planes = outputs_.horizon_angles || outputs_.horizon_distances;
+    if (d.lattice.weight == 0.0 && !planes) return;  // merged into an equal step (latticeDirections)
+    const cl_uint plane_offset = static_cast<cl_uint>(slot * field_.pixelCount());
+    if (horizon_.method == HorizonMethod::Naive) {
+      launchNaive(d, plane_offset);
+    } else if (inStrips()) {
+      sweepInStrips(d, k);
+    } else {
+      launchSweep(d, plane_offset);
+    }
+  }
+
+  void endBatch(int first, int count) override {
+    if (inStrips()) return;  // each strip's planes came back with it
+    const std::size_t plane = field_.pixelCount();
+    const std::size_t batch_bytes = count * plane * sizeof(float), at = first * plane;
+    if (outputs_.horizon_angles) st_.queue.enqueueReadBuffer(angles_, CL_TRUE, 0, batch_bytes, &result_.angles[at]);
+    if (outputs_.horizon_distances)
+      st_.queue.enqueueReadBuffer(distances_, CL_TRUE, 0, batch_bytes, &result_.distances[at]);
+  }
+
+  void finish() override {
+    if (inStrips()) {
+      // The sums are on the host; the last pass of occlusion and irradiance runs strip by strip.
+      if (needsNormals()) {
+        for (int s0 = 0; s0 < field_.height; s0 += plan_.strip_rows) {
+          const int s1 = std::min(field_.height, s0 + plan_.strip_rows);
+          loadStrip(s0, s1);
+          scaleByNormals(s1 - s0);
+          if (outputs_.ambient_occlusion) readRows(ao_, result_.ambient_occlusion, s0, s1);
+          copyEnvironmentRows(s0, s1);
+        }
+      }
+    } else {
+      const std::size_t bytes = field_.pixelCount() * sizeof(float);
+      if (outputs_.sky_view_factor)
+        st_.queue.enqueueReadBuffer(svf_, CL_TRUE, 0, bytes, result_.sky_view_factor.data());
+      if (needsNormals()) scaleByNormals(field_.height);
+      if (outputs_.ambient_occlusion)
+        st_.queue.enqueueReadBuffer(ao_, CL_TRUE, 0, bytes, result_.ambient_occlusion.data());
+      if (outputs_.environment)
+        st_.queue.enqueueReadBuffer(env_sum_, CL_TRUE, 0, environmentChannels() * bytes, result_.irradiance.data());
+    }
+    finishReduction(result_);
+  }
+
+  // The occlusion and irradiance sums of the rows on the device made those of unit normals
+  // (occlusion_scale).
+  void scaleByNormals(int rows) {
+    const std::size_t pixels = static_cast<std::size_t>(rows) * field_.width;
+    auto scale = [&](const cl::Buffer& sums, int planes) {
+      cl::Kernel kernel(program_, "occlusion_scale");
+      kernel.setArg(0, normals_);
+      kernel.setArg(1, static_cast<cl_uint>(pixels));
+      kernel.setArg(2, planes);
+      kernel.setArg(3, sumStride());
+      kernel.setArg(4, sums);
+      st_.launch(kernel, cl::NDRange(roundUp(pixels, kLineGroup)), cl::NDRange(kLineGroup));
+    };
+    if (outputs_.ambient_occlusion) scale(ao_, 1);
+    if (outputs_.environment) scale(env_sum_, environmentChannels());
+  }
+
+  // Between the planes of the environment's sums on the device: a strip's pixels (the field's
+  // in one piece).
+  cl_uint sumStride() const { return static_cast<cl_uint>(static_cast<std::size_t>(plan_.strip_rows) * field_.width); }
+
+  // Strips: the irradiance sums of rows [s0, s1) from the device (or to it, `to_device`).
+  void copyEnvironmentRows(int s0, int s1, bool to_device = false) {
+    const std::size_t width = field_.width, bytes = (s1 - s0) * width * sizeof(float);
+    for (int c = 0; c < environmentChannels(); ++c) {
+      float* host = &result_.irradiance[c * field_.pixelCount() + s0 * width];
+      const std::size_t at = c * sumStride() * sizeof(float);
+      if (to_device)
+        st_.queue.enqueueWriteBuffer(env_sum_, CL_FALSE, at, bytes, host);
+      else
+        st_.queue.enqueueReadBuffer(env_sum_, CL_TRUE, at, bytes, host);
+    }
+  }
+
+  // The normals of rows [s0, s1) from heights_, which holds the field's rows from row0 on.
+  void computeNormals(int row0, int s0, int s1) {
+    cl::Kernel normals(program_, "pixel_normals");
+    normals.setArg(0, heights_);
+    normals.setArg(1, field_.width);
+    normals.setArg(2, field_.height);
+    normals.setArg(3, row0);
+    normals.setArg(4, s0);
+    normals.setArg(5, s1 - s0);
+    normals.setArg(6, static_cast<float>(field_.cell_size_x));
+    normals.setArg(7, static_cast<float>(field_.cell_size_y));
+    normals.setArg(8, row_cells_);
+    normals.setArg(9, normals_);
+    st_.launch(normals, cl::NDRange(roundUp(field_.width, kTileX), roundUp(s1 - s0, kTileY)),
+               cl::NDRange(kTileX, kTileY));
+  }
+
+  // Strips: puts rows [s0, s1) on the device (their heights with the halo's rows around, their
+  // sums so far, their normals); returns the first row of the heights there.
+  int loadStrip(int s0, int s1) {
+    const std::size_t width = field_.width;
+    const int row0 = std::max(0, s0 - plan_.halo_rows), row1 = std::min(field_.height, s1 + plan_.halo_rows);
+    st_.queue.enqueueWriteBuffer(heights_, CL_FALSE, 0, (row1 - row0) * width * sizeof(float),
+                                 &prepared_.heights[row0 * width]);
+    if (!receiver_positions_.empty())
+      st_.queue.enqueueWriteBuffer(receiver_base_, CL_FALSE, 0, (row1 - row0) * width * sizeof(float),
+                                   &receiver_positions_[row0 * width]);
+    const std::size_t bytes = (s1 - s0) * width * sizeof(float);
+    if (outputs_.sky_view_factor)
+      st_.queue.enqueueWriteBuffer(svf_, CL_FALSE, 0, bytes, &result_.sky_view_factor[s0 * width]);
+    if (outputs_.ambient_occlusion)
+      st_.queue.enqueueWriteBuffer(ao_, CL_FALSE, 0, bytes, &result_.ambient_occlusion[s0 * width]);
+    copyEnvironmentRows(s0, s1, true);
+    if (needsNormals()) computeNormals(row0, s0, s1);
+    return row0;
+  }
+
+  // Rows [s0, s1) of the device's `rows` (a strip's) into `host` from `at` on.
+  void readRows(const cl::Buffer& rows, std::vector<float>& host, int s0, int s1, std::size_t at = 0) {
+    const std::size_t width = field_.width;
+    st_.queue.enqueueReadBuffer(rows, CL_TRUE, 0, (s1 - s0) * width * sizeof(float), &host[at + s0 * width]);
+  }
+
+  // The Earth's drop per pixel length squared along a direction of that ground length per pixel.
+  float curvatureDrop(double ground_per_pixel) const {
+    return static_cast<float>(horizon_.curvature * ground_per_pixel * ground_per_pixel);
+  }
+
+  // Per-row spacing: every row's cell sizes (x, y) as floats, for the normals (a placeholder
+  // without).
+  cl::Buffer rowCells() {
+    if (!hasRowSpacing(field_)) return deviceBuffer(st_, 0);
+    std::vector<float> cells;
+    for (int r = 0; r < field_.height; ++r) {
+      cells.push_back(static_cast<float>(field_.row_cell_size_x[r]));
+      cells.push_back(static_cast<float>(field_.row_cell_size_y[r]));
+    }
+    return cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, cells.size() * sizeof(float),
+                      cells.data());
+  }
+
+  // The unit of positions along lines and rays: pixels of that ground length, or (per-row
+  // spacing) ground units.
+  double positionUnit(double ground_per_pixel) const { return hasRowSpacing(field_) ? 1.0 : ground_per_pixel; }
+
+  // The per-row tables of a direction (placeholders without per-row spacing), set as the
+  // kernel's arguments `arg` and `arg + 1`; the caller keeps them until the launch.
+  std::array<cl::Buffer, 2> setRowTables(cl::Kernel& kernel, int arg, const RunDirection& d) {
+    auto table = [&](const std::vector<float>& values) {
+      if (values.empty()) return deviceBuffer(st_, 0);
+      return cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, values.size() * sizeof(float),
+                        const_cast<float*>(values.data()));
+    };
+    std::array<cl::Buffer, 2> tables{table(d.row_length), table(d.row_terms)};
+    kernel.setArg(arg, tables[0]);
+    kernel.setArg(arg + 1, tables[1]);
+    return tables;
+  }
+
+  // The arguments every direction's kernel ends with: its outputs.
+  void setOutputs(cl::Kernel& kernel, int arg, const RunDirection& d, cl_uint plane_offset) {
+    kernel.setArg(arg++, d.cos_azimuth);
+    kernel.setArg(arg++, d.sin_azimuth);
+    kernel.setArg(arg++, static_cast<float>(d.lattice.weight));
+    kernel.setArg(arg++, swathFactor(static_cast<float>(d.lattice.weight)));
+    kernel.setArg(arg++, plane_offset);
+    if (horizon_.method == HorizonMethod::Sweep) {
+      kernel.setArg(arg++, stacks_);
+      arg++;  // stride: set per chunk
+      kernel.setArg(arg++, placeholder_);  // line_state and carry_in, used in strips
+      kernel.setArg(arg++, placeholder_);
+      kernel.setArg(arg++, window_far_);
+      kernel.setArg(arg++, receiver_base_);
+    }
+    kernel.setArg(arg++, normals_);
+    kernel.setArg(arg++, angles_);
+    kernel.setArg(arg++, distances_);
+    kernel.setArg(arg++, svf_);
+    kernel.setArg(arg++, ao_);
+    kernel.setArg(arg++, env_tables_);
+    kernel.setArg(arg++, static_cast<cl_uint>(d.index * envTableFloats()));
+    kernel.setArg(arg++, outputs_.environment ? tableRows(*outputs_.environment) : 0);
+    kernel.setArg(arg++, env_sum_);
+    kernel.setArg(arg++, sumStride());
+  }
+
+  // horizon_lattice's arguments where the chunks (and strips) differ.
+  enum SweepArgument { kRow0 = 3, kOutRow0 = 4, kLines = 5, kLineCount = 6, kStride = 26, kLineState = 27,
+                       kCarryIn = 28 };
+
+  // horizon_lattice for direction d with everything but the chunk's lines set (rows from 0 on,
+  // no line states); `keep` holds the buffers it takes until the launch.
+  cl::Kernel sweepKernel(const RunDirection& d, cl_uint plane_offset, std::vector<cl::Buffer>& keep) {
+    keep.emplace_back(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, d.samples.size() * sizeof(LatticeSample),
+                      const_cast<LatticeSample*>(d.samples.data()));
+    cl::Kernel kernel(program_, "horizon_lattice");
+    kernel.setArg(0, heights_);
+    kernel.setArg(1, field_.width);
+    kernel.setArg(2, field_.height);
+    kernel.setArg(kRow0, 0);
+    kernel.setArg(kOutRow0, 0);
+    kernel.setArg(7, keep.back());
+    keep.emplace_back(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, d.segments.size() * sizeof(CellSegment),
+                      const_cast<CellSegment*>(d.segments.data()));
+    kernel.setArg(8, keep.back());
+    kernel.setArg(9, static_cast<int>(d.samples.size()));
+    kernel.setArg(10, d.lattice.a);
+    kernel.setArg(11, d.lattice.b);
+    kernel.setArg(12, static_cast<float>(d.lattice.period));
+    const double unit = positionUnit(d.lattice.ground_per_pixel);
+    kernel.setArg(13, static_cast<float>(unit));
+    kernel.setArg(14, static_cast<float>(d.lattice.period * d.lattice.ground_per_pixel));
+    kernel.setArg(15, curvatureDrop(unit));
+    kernel.setArg(16, d.window.window);
+    kernel.setArg(17, d.window.inv_window);
+    for (cl::Buffer& table : setRowTables(kernel, 18, d)) keep.push_back(table);
+    setOutputs(kernel, 20, d, plane_offset);
+    return kernel;
+  }
+
+  // Work-items per group of horizon_lattice. With lanes, groups of one work-item: 64
+  // work-items of 8 lines would put all of a 512-line direction in one group, on one core.
+  std::size_t sweepGroup() const { return lanes_ > 1 ? 1 : kLineGroup; }
+
+  void launchSweep(const RunDirection& d, cl_uint plane_offset) {
+    std::vector<cl::Buffer> keep;
+    cl::Kernel kernel = sweepKernel(d, plane_offset, keep);
+    LineChunkArguments chunk;
+    chunk.lines = kLines;
+    chunk.count = kLineCount;
+    chunk.stride = kStride;
+    launchLineChunks(st_, kernel, d.lines, d.stack_per_period, plan_.stack_entries, chunk, lanes_, sweepGroup());
+  }
+
+  // Direction k over a field in strips: the strips in the order its lines run through them
+  // (toward -(a, b)), each line's part in a strip resuming its sweep with the stack it left the
+  // strip before with (horizon_lattice, HFVIS_STRIPS), which carry_stacks moves from the scratch
+  // into a compact buffer between strips. The sums go up and down with each strip.
+  void sweepInStrips(const RunDirection& d, int k) {
+    const int rows = plan_.strip_rows, strips = (field_.height + rows - 1) / rows;
+    const int a = d.lattice.a, b = d.lattice.b;
+    const std::size_t per_period = d.stack_per_period;
+    // Within a maximum distance the window's pass pushes the samples of the block before, up to a
+    // window and two periods of them, above a resumed line's stack.
+    // (With per-row spacing the window is a ground length: so many of the shortest periods.)
+    const double shortest_period =
+        d.row_length.empty() ? d.lattice.period : *std::min_element(d.row_length.begin(), d.row_length.end());
+    const std::size_t window_periods =
+        horizon_.max_distance > 0.0 ? static_cast<std::size_t>(std::ceil(d.window.window / shortest_period)) + 2 : 0;
+    // Each line's sweep so far: (unused, its stack's size, the stack's offset in carry_in,
+    // its ground position's float bits).
+    std::vector<cl_int4> resume(d.lines.size(), cl_int4{{0, 0, 0, 0}});
+    std::vector<char> waiting(d.lines.size(), 0);  // whether its stack waits in carry_in
+    cl::Buffer carry_in = placeholder_;
+    std::size_t carried_in = 0;  // entries in carry_in
+    std::vector<cl::Buffer> keep;
+    cl::Kernel kernel = sweepKernel(d, 0, keep);  // the strip's rows and lines set per strip
+    for (int step = 0; step < strips; ++step) {
+      const int s = b > 0 ? strips - 1 - step : step;  // rows fall along a line when b > 0
+      const int s0 = s * rows, s1 = std::min(field_.height, s0 + rows);
+      const int row0 = loadStrip(s0, s1);
+      kernel.setArg(kRow0, row0);
+      kernel.setArg(kOutRow0, s0);
+      kernel.setArg(kCarryIn, carry_in);
+      // The strip's part of every line that has receivers in it.
+      std::vector<LatticeLine> lines;
+      std::vector<cl_int4> states;
+      std::vector<std::size_t> capacities, owner;
+      for (std::size_t j = 0; j < d.lines.size(); ++j) {
+        const LatticeLine& line = d.lines[j];
+        const auto [first, end] = receiversInRows(line, b, s0, s1);
+        if (first == end) continue;
+        lines.push_back({line.col - first * a, line.row - first * b, end - first, 0});
+        cl_int4 state = resume[j];
+        state.s[0] = first;
+        states.push_back(state);
+        capacities.push_back(static_cast<std::size_t>(state.s[1]) + (end - first + window_periods) * per_period);
+        if (capacities.back() > plan_.stack_entries)  // the scratch is an eighth of the rest
+          failCarry("one line's hull stack", capacities.back(), capacities.back() * kStackEntryBytes * 8);
+        owner.push_back(j);
+      }
+      std::size_t carried = 0, capacity = 0;  // entries in carry_out
+      cl::Buffer carry_out;
+      // Stacks from `source` (entry k of line i at lines[i].w + k stride, states[i].y entries) into
+      // carry_out at `offsets` (from `carried` on; -1: none).
+      auto carryOut = [&](const cl::Buffer& lines_buffer, const cl::Buffer& states_buffer,
+                          const std::vector<cl_int>& offsets, const cl::Buffer& source, cl_uint stride) {
+        if (carried > capacity) {
+          if (carried_in + carried > plan_.carry_entries || carried > maxAllocationEntries() ||
+              carried >= (std::size_t(1) << 31))
+            failCarry("the hull stacks carried into the next strip", carried_in + carried,
+                      (carried_in + carried) * kStackEntryBytes / 7 * 8);
+          const std::size_t grown =
+              std::min({std::max(carried, 2 * capacity), plan_.carry_entries - carried_in, maxAllocationEntries()});
+          cl::Buffer bigger = deviceBuffer(st_, grown * kStackEntryBytes);
+          if (capacity) st_.queue.enqueueCopyBuffer(carry_out, bigger, 0, 0, capacity * kStackEntryBytes);
+          carry_out = bigger;
+          capacity = grown;
+        }
+        if (std::none_of(offsets.begin(), offsets.end(), [](cl_int o) { return o >= 0; })) return;
+        const cl::Buffer offsets_buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                        offsets.size() * sizeof(cl_int), const_cast<cl_int*>(offsets.data()));
+        cl::Kernel move(program_, "carry_stacks");
+        move.setArg(0, lines_buffer);
+        move.setArg(1, states_buffer);
+        move.setArg(2, offsets_buffer);
+        move.setArg(3, static_cast<int>(offsets.size()));
+        move.setArg(4, source);
+        move.setArg(5, stride);
+        move.setArg(6, carry_out);
+        st_.launch(move, cl::NDRange(roundUp(offsets.size(), kLineGroup)), cl::NDRange(kLineGroup));
+        st_.queue.finish();  // before the caller's buffers go
+      };
+      std::vector<char> next_waiting(d.lines.size(), 0);
+      for (const LineChunk& chunk : chunkLines(lines, capacities, plan_.stack_entries, lineMajorLayout(st_))) {
+        const cl::Buffer chunk_lines(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                     chunk.count * sizeof(LatticeLine), lines.data() + chunk.first);
+        const cl::Buffer chunk_states(st_.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR,
+                                      chunk.count * sizeof(cl_int4), states.data() + chunk.first);
+        kernel.setArg(kLines, chunk_lines);
+        kernel.setArg(kLineCount, static_cast<int>(chunk.count));
+        kernel.setArg(kStride, static_cast<cl_uint>(chunk.stride));
+        kernel.setArg(kLineState, chunk_states);
+        const std::size_t items = (chunk.count + lanes_ - 1) / lanes_;
+        st_.launch(kernel, cl::NDRange(roundUp(items, sweepGroup())), cl::NDRange(sweepGroup()));
+        st_.queue.enqueueReadBuffer(chunk_states, CL_TRUE, 0, chunk.count * sizeof(cl_int4),
+                                    states.data() + chunk.first);
+        // Where the stacks of the lines that go on into the next strip wait for it.
+        std::vector<cl_int> offsets(chunk.count, -1);
+        for (std::size_t i = 0; i < chunk.count; ++i) {
+          const std::size_t at = chunk.first + i, j = owner[at];
+          cl_int4& state = states[at];
+          if (state.s[0] + lines[at].receivers == d.lines[j].receivers) continue;  // the line ends here
+          offsets[i] = static_cast<cl_int>(carried);
+          state.s[2] = offsets[i];
+          resume[j] = state;
+          next_waiting[j] = 1;
+          carried += state.s[1];
+        }
+        carryOut(chunk_lines, chunk_states, offsets, stacks_, static_cast<cl_uint>(chunk.stride));
+      }
+      // Lines with no receiver in this strip (a step of more rows than a strip has) that are
+      // under way: their stacks move on from carry_in as they are.
+      std::vector<LatticeLine> passing;
+      std::vector<cl_int4> passing_states;
+      std::vector<cl_int> offsets;
+      for (std::size_t j = 0; j < d.lines.size(); ++j) {
+        if (!waiting[j] || next_waiting[j]) continue;
+        const auto [first, end] = receiversInRows(d.lines[j], b, s0, s1);
+        if (first != end) continue;  // it ended in this strip
+        passing.push_back({0, 0, 0, resume[j].s[2]});
+        passing_states.push_back(resume[j]);
+        offsets.push_back(static_cast<cl_int>(carried));
+        resume[j].s[2] = offsets.back();
+        next_waiting[j] = 1;
+        carried += resume[j].s[1];
+      }
+      if (!passing.empty()) {
+        const cl::Buffer passing_lines(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                       passing.size() * sizeof(LatticeLine), passing.data());
+        const cl::Buffer states_buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                       passing_states.size() * sizeof(cl_int4), passing_states.data());
+        carryOut(passing_lines, states_buffer, offsets, carry_in, 1);
+      }
+      waiting.swap(next_waiting);
+      const std::size_t plane = field_.pixelCount();
+      if (outputs_.horizon_angles) readRows(angles_, result_.angles, s0, s1, k * plane);
+      if (outputs_.horizon_distances) readRows(distances_, result_.distances, s0, s1, k * plane);
+      if (outputs_.sky_view_factor) readRows(svf_, result_.sky_view_factor, s0, s1);
+      if (outputs_.ambient_occlusion) readRows(ao_, result_.ambient_occlusion, s0, s1);
+      copyEnvironmentRows(s0, s1);
+      if (!receiver_positions_.empty()) {  // the strip's receivers' positions, for the strips after
+        const std::size_t width = field_.width;
+        st_.queue.enqueueReadBuffer(receiver_base_, CL_TRUE, (s0 - row0) * width * sizeof(float),
+                                    (s1 - s0) * width * sizeof(float), &receiver_positions_[s0 * width]);
+      }
+      carry_in = carried ? carry_out : placeholder_;
+      carried_in = carried;
+      if (horizon_.strip_progress) horizon_.strip_progress(step + 1, strips);
+    }
+  }
+
+  // Stack entries the device's largest single buffer holds.
+  std::size_t maxAllocationEntries() const {
+    return (st_.info.max_allocation_bytes ? st_.info.max_allocation_bytes : plan_.budget) / kStackEntryBytes;
+  }
+
+  // Stacks of `entries` do not fit beside the strips, which would need to leave `rest` bytes: the
+  // strips to try instead (at most half as tall, leaving 1.25 times that), 0 when none would do.
+  [[noreturn]] void failCarry(const std::string& what, std::size_t entries, std::size_t rest) const {
+    const std::size_t room = rest / 4 * 5;
+    const std::size_t fitting =
+        plan_.budget > plan_.halo_bytes + room ? (plan_.budget - plan_.halo_bytes - room) / plan_.per_row : 0;
+    throw StacksBeyondStrips(what + " needs " + mebibytes(entries * kStackEntryBytes) +
+                                 " of device memory, more than the budget leaves beside strips of " +
+                                 std::to_string(plan_.strip_rows) + " rows; raise the memory budget",
+                             static_cast<int>(std::min<std::size_t>(plan_.strip_rows / 2, fitting)));
+  }
+
+  void launchNaive(const RunDirection& d, cl_uint plane_offset) {
+    cl::Kernel kernel(program_, "horizon_naive");
+    kernel.setArg(0, heights_);
+    kernel.setArg(1, field_.width);
+    kernel.setArg(2, field_.height);
+    kernel.setArg(3, d.ray.dir_x);
+    kernel.setArg(4, d.ray.dir_y);
+    kernel.setArg(5, d.ray.step_length);
+    kernel.setArg(6, d.ray.ground_per_pixel);
+    kernel.setArg(7, curvatureDrop(positionUnit(d.ray.ground_per_pixel)));
+    kernel.setArg(8, d.max_steps);
+    kernel.setArg(9, hasRowSpacing(field_) && horizon_.max_distance > 0.0 ? static_cast<float>(horizon_.max_distance)
+                                                                         : std::numeric_limits<float>::infinity());
+    const auto row_tables = setRowTables(kernel, 10, d);
+    setOutputs(kernel, 12, d, plane_offset);
+    st_.launch(kernel, cl::NDRange(roundUp(field_.width, kTileX), roundUp(field_.height, kTileY)),
+               cl::NDRange(kTileX, kTileY));
+  }
+
+  const HorizonOptions& horizon_;  // options_ as the horizon operation's
+  const HorizonOutputs& outputs_;
+  int lanes_ = 1;  // HFVIS_LANES of the program
+  std::vector<RunDirection> directions_;
+  RunPlan plan_;
+  HorizonResult result_;
+  std::vector<float> receiver_positions_;  // strips, per-row spacing and a maximum distance: receiver_base's
+  cl::Buffer angles_, distances_, svf_, ao_, normals_, stacks_, window_far_, receiver_base_, row_cells_,
+      placeholder_, env_sum_, env_tables_;
+};
+
+}  // namespace
+}  // namespace detail
+
+HorizonResult computeHorizons(const ComputeContext& context, const HeightField& field,
+                              const HorizonOptions& options, const HorizonOutputs& outputs) {
+  validate(field);
+  validate(options, outputs);
+  // The environment's sums: a plane per channel, indexed in 32 bits in the kernels.
+  detail::checkPixelIndexing(field, outputs.environment ? outputs.environment->channels : 1);
+  if (outputs.environment && detail::hasRowSpacing(field))
+    throw InvalidArgument(
+        "environment lighting takes a field of one cell size: this latitude / longitude grid's spacing differs "
+        "by row (reproject it, or give the cell size)");
+  return detail::translateOpenClErrors([&] {
+    // Hull stacks too deep for the room strips leave: again from the start with thinner strips
+    // (StacksBeyondStrips::rows), as the sums of the strips done cannot be taken back.
+    HorizonOptions attempt = options;
+    for (;;) {
+      try {
+        detail::HorizonRoutine routine(detail::stateOf(context), field, attempt, outputs);
+        routine.run();
+        return routine.take();
+      } catch (const detail::StacksBeyondStrips& error) {
+        if (error.rows < 1) throw MemoryBudgetError(error.what());
+        attempt.strip_rows = error.rows;
+      }
+    }
+  });
+}
+
+}  // namespace hfvis

@@ -1,0 +1,139 @@
+// insolation.cpp: sunshine hours and direct irradiation over a span of time (see
+// hfvis/shading.hpp): the sun's positions step by step, grouped into buckets of azimuth; per
+// bucket one horizon sweep, and insolation_add (kernels/insolation.cl) adds its steps to every
+// pixel's sums on the device.
+#include <cmath>
+#include <limits>
+#include <map>
+#include <string>
+
+#include "hfvis/errors.hpp"
+#include "hfvis/horizon.hpp"
+#include "hfvis/shading.hpp"
+#include "core/opencl_context.hpp"
+#include "ops/shading_internal.hpp"
+#include "core/sweep_framework.hpp"
+
+namespace hfvis {
+namespace {
+
+constexpr double kDegree = M_PI / 180.0;
+
+}  // namespace
+
+void validate(const InsolationOptions& o) {
+  if (!(std::isfinite(o.from_utc) && std::isfinite(o.to_utc) && o.from_utc < o.to_utc))
+    throw InvalidArgument("the span of time must run forward: from before to");
+  if (!(o.step_minutes > 0.0 && o.step_minutes <= 1440.0))
+    throw InvalidArgument("the step must be in (0, 1440] minutes (got " + std::to_string(o.step_minutes) + ")");
+  if (!(o.size_deg >= 0.0 && o.size_deg <= 10.0))
+    throw InvalidArgument("the sun's size must be in [0, 10] degrees (got " + std::to_string(o.size_deg) +
+                          ")");
+  if (!(o.azimuth_bucket_deg > 0.0 && o.azimuth_bucket_deg <= 10.0))
+    throw InvalidArgument("the azimuth bucket must be in (0, 10] degrees (got " +
+                          std::to_string(o.azimuth_bucket_deg) + ")");
+  const double steps = std::ceil((o.to_utc - o.from_utc) / (60.0 * o.step_minutes));
+  if (steps > 1e7) throw InvalidArgument("the span holds more than 10 million steps; take a longer step");
+  // The ends of the span: sunPosition refuses a place or year beyond its range.
+  sunPosition(o.from_utc, o.latitude_deg, o.longitude_deg);
+  sunPosition(o.to_utc, o.latitude_deg, o.longitude_deg);
+}
+
+namespace {
+
+// One step with the sun up: its direction (x, y, z, elevation in radians) and hours.
+struct SunStep {
+  cl_float4 sun;
+  float hours;
+};
+
+}  // namespace
+
+Insolation computeInsolation(const ComputeContext& context, const HeightField& field, const InsolationOptions& options,
+                             const SweepOptions& sweep) {
+  validate(field);
+  validate(options);
+  validate(sweep);
+  // A point sun (size 0) as a disc far below a float's resolution of the elevations, so that
+  // the kernel's disc_above never divides by 0.
+  const double radius = std::max(0.5 * options.size_deg * kDegree, 1e-12);
+  // The steps with some of the disc above elevation 0, by azimuth bucket.
+  std::map<long, std::vector<SunStep>> buckets;
+  Insolation out;
+  const double step = 60.0 * options.step_minutes;
+  for (double t0 = options.from_utc; t0 < options.to_utc; t0 += step) {
+    const double t1 = std::min(options.to_utc, t0 + step);
+    const SunPosition p = sunPosition(0.5 * (t0 + t1), options.latitude_deg, options.longitude_deg, options.apparent);
+    if (p.elevation_deg * kDegree <= -radius) continue;
+    const glm::dvec3 s = sunDirection(p);
+    const long bucket = std::lround(p.azimuth_deg / options.azimuth_bucket_deg);
+    buckets[bucket].push_back({cl_float4{{static_cast<float>(s.x), static_cast<float>(s.y), static_cast<float>(s.z),
+                                          static_cast<float>(p.elevation_deg * kDegree)}},
+                               static_cast<float>((t1 - t0) / 3600.0)});
+    ++out.steps;
+  }
+  out.width = field.width;
+  out.height = field.height;
+  const std::size_t pixels = field.pixelCount();
+  const std::vector<float> normals = detail::unitNormals(field);  // x, y, z, 0 per pixel
+  return detail::translateOpenClErrors([&] {
+    detail::ContextState& st = detail::stateOf(context);
+    const cl::Program program = st.program("insolation.cl", "");
+    auto zeros = [&]() {
+      cl::Buffer b = detail::deviceBuffer(st, pixels * sizeof(float));
+      st.queue.enqueueFillBuffer(b, 0.0f, 0, pixels * sizeof(float));
+      return b;
+    };
+    const cl::Buffer normal_buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, normals.size() * sizeof(float),
+                                   const_cast<float*>(normals.data()));
+    cl::Buffer sun_hours = zeros(), direct = zeros();
+    cl::Buffer horizon = detail::deviceBuffer(st, pixels * sizeof(float));
+    int done = 0;
+    for (const auto& [bucket, steps] : buckets) {
+      HorizonOptions horizon_options;
+      static_cast<SweepOptions&>(horizon_options) = sweep;
+      horizon_options.progress = nullptr;
+      horizon_options.directions = 1;
+      horizon_options.azimuth_offset =
+          std::remainder((bucket * options.azimuth_bucket_deg - 90.0) * kDegree, 2.0 * M_PI);
+      // A step within half a bucket of its centre: every step of the bucket within a bucket of it.
+      horizon_options.azimuth_tolerance = std::min(0.1, 0.5 * options.azimuth_bucket_deg * kDegree);
+      HorizonOutputs outputs;
+      outputs.horizon_angles = true;
+      const HorizonResult h = computeHorizons(context, field, horizon_options, outputs);
+      st.queue.enqueueWriteBuffer(horizon, CL_FALSE, 0, pixels * sizeof(float), h.angles.data());
+      std::vector<cl_float4> suns;
+      std::vector<float> hours;
+      for (const SunStep& s : steps) suns.push_back(s.sun), hours.push_back(s.hours);
+      const cl::Buffer sun_buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, suns.size() * sizeof(cl_float4),
+                                  suns.data());
+      const cl::Buffer hour_buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, hours.size() * sizeof(float),
+                                   hours.data());
+      cl::Kernel add(program, "insolation_add");
+      add.setArg(0, horizon);
+      add.setArg(1, normal_buffer);
+      add.setArg(2, static_cast<cl_uint>(pixels));
+      add.setArg(3, sun_buffer);
+      add.setArg(4, hour_buffer);
+      add.setArg(5, static_cast<int>(suns.size()));
+      add.setArg(6, static_cast<float>(radius));
+      add.setArg(7, sun_hours);
+      add.setArg(8, direct);
+      st.launch(add, cl::NDRange(detail::roundUp(pixels, detail::kLineGroup)), cl::NDRange(detail::kLineGroup));
+      st.queue.finish();  // before this bucket's buffers go
+      ++out.sweeps;
+      if (sweep.progress) sweep.progress(++done, static_cast<int>(buckets.size()));
+    }
+    out.sun_hours.resize(pixels);
+    out.direct.resize(pixels);
+    st.queue.enqueueReadBuffer(sun_hours, CL_TRUE, 0, pixels * sizeof(float), out.sun_hours.data());
+    st.queue.enqueueReadBuffer(direct, CL_TRUE, 0, pixels * sizeof(float), out.direct.data());
+    // No step with the sun up: nodata is still nodata.
+    if (buckets.empty())
+      for (std::size_t p = 0; p < pixels; ++p)
+        if (std::isnan(normals[4 * p])) out.sun_hours[p] = out.direct[p] = std::numeric_limits<float>::quiet_NaN();
+    return out;
+  });
+}
+
+}  // namespace hfvis

@@ -1,0 +1,240 @@
+// intervisibility_common.cpp: option validation, the tree sweep's directions and the limits
+// that the intervisibility and bounce device paths and their scalar references share.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "hfvis/errors.hpp"
+#include "core/horizon_common.hpp"
+#include "ops/intervisibility_internal.hpp"
+
+namespace hfvis {
+
+std::optional<HullTreeTuning> hullTreeTuningNamed(const std::string& name) {
+  HullTreeTuning t;
+  if (name == "plain") {
+    t.deferred_writes = t.replacement_check = false;
+  } else if (name == "deferred") {
+    t.replacement_check = false;
+  } else if (name == "zone") {
+    t.safe_zone = true;
+  } else if (name != "default") {
+    return std::nullopt;
+  }
+  return t;
+}
+
+void validate(const HullTreeTuning& tuning) {
+  if (tuning.replacement_check && !tuning.deferred_writes) {
+    throw InvalidArgument("the replacement check needs the deferred-writes walk (it works inside it)");
+  }
+  if (tuning.safe_zone && !tuning.replacement_check) {
+    throw InvalidArgument("the safe zone needs the replacement check");
+  }
+  const int z = tuning.safe_zone_steps;
+  if (z < 1 || z > 4096 || (z & (z - 1)) != 0) {
+    throw InvalidArgument("the safe zone's steps must be a power of two in 1 .. 4096, not " + std::to_string(z));
+  }
+}
+
+void validate(const IntervisibilityOptions& options, const IntervisibilityOutputs& outputs) {
+  validate(static_cast<const SweepOptions&>(options));
+  validate(options.tree);
+  if (!outputs.visible_count && !outputs.visible_area && !outputs.statistics) {
+    throw InvalidArgument("no output requested");
+  }
+  if (outputs.statistics && options.method != IntervisibilityMethod::HullTree) {
+    throw InvalidArgument("statistics (horizons and iterations) exist only for the hull-tree method");
+  }
+  if (options.strip_rows < 0)
+    throw InvalidArgument("the rows per strip must be 0 (automatic) or positive (got " +
+                          std::to_string(options.strip_rows) + ")");
+  if (options.strip_rows > 0 && options.method == IntervisibilityMethod::Naive)
+    throw InvalidArgument("the naive method does not run in strips (each ray reads the whole field)");
+}
+
+namespace detail {
+
+float intervisibilitySector(const IntervisibilityOptions& options) {
+  return static_cast<float>(2.0 * M_PI / options.directions);
+}
+
+std::size_t TreeDirection::longestLine() const {
+  std::size_t longest = 0;
+  for (const LatticeLine& line : lines) longest = std::max(longest, lineCapacity(line, samples.size()));
+  return longest;
+}
+
+TreeDirection makeTreeDirection(const HeightField& field, const LatticeDirection& lattice, double samples_per_unit,
+                                int directions, double curvature, double max_distance) {
+  TreeDirection d;
+  d.lattice = lattice;
+  d.per_period = samplesPerPeriod(lattice, samples_per_unit);
+  d.samples = uniformLatticeSamples(lattice, d.per_period);
+  d.lines = latticeLines(lattice, field.width, field.height);
+  const double step = lattice.period / d.per_period, ground = step * lattice.ground_per_pixel;
+  d.step_length = static_cast<float>(step);
+  d.step_ground = static_cast<float>(ground);
+  d.count_factor = static_cast<float>(directions * lattice.weight * step * samples_per_unit);
+  d.area_factor = static_cast<float>(2.0 * M_PI * lattice.weight * ground * ground);
+  d.drop = static_cast<float>(curvature * ground * ground);
+  d.max_steps = stepsWithin(max_distance, ground);
+  d.half_sector = static_cast<float>(M_PI * lattice.weight);
+  d.wedge = static_cast<float>(2.0 * std::sin(M_PI * lattice.weight));
+  d.cos_azimuth = static_cast<float>(std::cos(lattice.azimuth));
+  d.sin_azimuth = static_cast<float>(std::sin(lattice.azimuth));
+  return d;
+}
+
+std::int32_t stepUnits(const HeightField& field, double y, double dx, double dy, double unit) {
+  double cell_x = 0.0, cell_y = 0.0;
+  cellSizeAtRow(field, y, &cell_x, &cell_y);
+  return static_cast<std::int32_t>(std::max<long long>(1, std::llround(std::hypot(dx * cell_x, dy * cell_y) / unit)));
+}
+
+NaiveRowTables naiveRowTables(const HeightField& field, const std::vector<SweepDirection>& rays, double unit) {
+  NaiveRowTables t;
+  const std::vector<RowTable> rows = rayRowTables(field, rays);
+  const double K = static_cast<double>(rays.size());
+  for (std::size_t k = 0; k < rays.size(); ++k) {
+    const SweepDirection& d = rays[k];
+    for (int half = 0; half < 2 * field.height - 1; ++half)
+      t.units.push_back(stepUnits(field, 0.5 * half, double(d.step_length) * d.dir_x, double(d.step_length) * d.dir_y,
+                                  unit));
+    for (int r = 0; r < field.height; ++r) {
+      const double weight = rows[k].terms[4 * static_cast<std::size_t>(r) + 2];
+      t.factors.push_back(static_cast<float>(K * weight));
+      t.factors.push_back(static_cast<float>(2.0 * M_PI * weight * unit * unit));
+    }
+  }
+  return t;
+}
+
+double groundUnit(const HeightField& field) {
+  const double longest_period = std::hypot(double(kMaxLatticeStep), double(kMaxLatticeStep));
+  const double largest_cell = std::max(*std::max_element(field.row_cell_size_x.begin(), field.row_cell_size_x.end()),
+                                       *std::max_element(field.row_cell_size_y.begin(), field.row_cell_size_y.end()));
+  return (double(field.width) + field.height + 2.0 * longest_period) * largest_cell / double(1 << 23);
+}
+
+void followRows(TreeDirection& d, const HeightField& field, const RowTable& rows, double unit,
+                double samples_per_unit, int directions, double curvature, double max_distance) {
+  const double n = d.per_period, step = d.lattice.period / n;
+  for (int r = 0; r < field.height; ++r) {
+    d.row_units.push_back(stepUnits(field, r + 0.5 * d.lattice.b, d.lattice.a / n, d.lattice.b / n, unit));
+    const double weight = rows.terms[4 * static_cast<std::size_t>(r) + 2];
+    d.row_factors.push_back(static_cast<float>(directions * weight * step * samples_per_unit));
+    d.row_factors.push_back(static_cast<float>(2.0 * M_PI * weight * unit * unit));
+  }
+  d.drop = static_cast<float>(curvature * unit * unit);
+  d.max_steps = stepsWithin(max_distance, unit);
+}
+
+std::vector<TreeDirection> treeDirections(const HeightField& field, const SweepOptions& options, bool follow_rows) {
+  std::vector<LatticeDirection> lattice = latticeDirections(field, options, false, 0.0);
+  // Each step stands for the wedge of its phi_k, 1 / K of the circle (a merged step for each
+  // phi_k it took), not for the half gaps to its neighbours' azimuths: see treeDirections' note.
+  const int K = options.directions;
+  std::vector<double> wedges(lattice.size(), 0.0);
+  for (std::size_t k = 0; k < lattice.size(); ++k) {
+    std::size_t m = 0;  // the step that sweeps for phi_k: the first equal one (setQuadratureWeights)
+    while (lattice[m].a != lattice[k].a || lattice[m].b != lattice[k].b || lattice[m].weight == 0.0) ++m;
+    wedges[m] += 1.0 / K;
+  }
+  for (std::size_t k = 0; k < lattice.size(); ++k) lattice[k].weight = wedges[k];
+  std::vector<RowTable> rows;
+  double unit = 0.0;
+  if (follow_rows && hasRowSpacing(field)) {
+    rows = latticeRowTables(field, lattice, false);
+    unit = groundUnit(field);
+  }
+  std::vector<TreeDirection> out;
+  for (std::size_t k = 0; k < lattice.size(); ++k) {
+    if (lattice[k].weight == 0.0) continue;  // merged into an equal step
+    out.push_back(makeTreeDirection(field, lattice[k], options.samples_per_unit, options.directions,
+                                    options.curvature, options.max_distance));
+    if (!rows.empty())
+      followRows(out.back(), field, rows[k], unit, options.samples_per_unit, options.directions,
+                 options.curvature, options.max_distance);
+  }
+  return out;
+}
+
+void IntervisibilityLines::resetResults(bool keep_horizons) {
+  const std::size_t entries = samples.size();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  counts.assign(entries, nan);
+  distance_sums.assign(entries, nan);
+  horizons.assign(entries, 0);
+  iterations.assign(entries, 0);
+  horizon_hashes.assign(entries, 0);
+  walks_skipped.assign(entries, 0);
+  horizon_steps.assign(keep_horizons ? entries : 0, {});
+  horizon_run_ends.assign(keep_horizons ? entries : 0, {});
+}
+
+IntervisibilityLines canonicalTreeLines(const TreeDirection& d) {
+  IntervisibilityLines out;
+  const std::size_t longest = d.longestLine();
+  out.geometry.n_lines = static_cast<int>(d.lines.size());
+  out.geometry.n_steps = static_cast<int>(longest);
+  out.geometry.step_length = d.step_length;
+  out.geometry.ground_per_pixel = static_cast<float>(d.lattice.ground_per_pixel);
+  out.geometry.cos_azimuth = d.cos_azimuth;
+  out.geometry.sin_azimuth = d.sin_azimuth;
+  out.receiver_every = static_cast<int>(d.samples.size());
+  out.max_steps = d.max_steps;
+  out.samples.assign(longest * d.lines.size(), std::numeric_limits<float>::quiet_NaN());
+  if (d.rowSpacing()) {
+    // As the kernel sums them: step 0 at 0, then each step of period i the units of the row
+    // of receiver i (the first period's: receiver 0's). A sample's ring units are those of
+    // its step toward the receivers (the next one). Padding entries keep the last.
+    const std::size_t n_lines = d.lines.size(), per_period = d.samples.size();
+    out.positions.assign(out.samples.size(), 0);
+    out.step_units.assign(out.samples.size(), 0);
+    for (std::size_t j = 0; j < n_lines; ++j) {
+      const LatticeLine& line = d.lines[j];
+      const std::size_t steps = lineCapacity(line, per_period);
+      auto units_of = [&](std::size_t s) {  // of the step into s (s < steps)
+        return d.row_units[line.row - static_cast<int>(s / per_period) * d.lattice.b];
+      };
+      std::int32_t position = 0;
+      for (std::size_t s = 0; s < longest; ++s) {
+        if (s > 0 && s < steps) position += units_of(s);
+        out.positions[s * n_lines + j] = position;
+        out.step_units[s * n_lines + j] = units_of(std::min(s + 1, steps - 1));
+      }
+    }
+  }
+  return out;
+}
+
+void checkTreeLimits(const std::vector<TreeDirection>& directions, const std::vector<float>& prepared_heights) {
+  std::size_t longest = 0;
+  for (const auto& d : directions) {
+    longest = std::max(longest, d.longestLine());
+    if (!d.rowSpacing()) continue;
+    // Positions in units: the line's steps times the most units a step has.
+    const std::size_t most = *std::max_element(d.row_units.begin(), d.row_units.end());
+    longest = std::max(longest, d.longestLine() * most);
+  }
+  checkStepLimits(longest, prepared_heights);
+}
+
+void checkStepLimits(std::size_t longest, const std::vector<float>& prepared_heights) {
+  if (longest >= (std::size_t(1) << 24)) {
+    throw InvalidArgument("a sweep line would have " + std::to_string(longest) +
+                          " samples; at most 2^24 are supported: lower the samples per unit");
+  }
+  float highest = 0.0f;  // prepared heights are >= 0 (offset by the lowest one)
+  for (float h : prepared_heights)
+    if (!std::isnan(h)) highest = std::max(highest, std::fabs(h));
+  if (!(static_cast<double>(highest) * 4.0 * static_cast<double>(longest) < 1e37)) {
+    throw InvalidArgument("the height range times the z-scale is too large for single precision (" +
+                          std::to_string(highest) + "): lower the z-scale");
+  }
+}
+
+}  // namespace detail
+}  // namespace hfvis

@@ -1,0 +1,449 @@
+// scalar_hull_tree.cpp: the convex hull tree sweep (Timonen 2013) of sampled lines on
+// the host, a scalar mirror of kernels/intervisibility.cl's sweep (same tree layout, same
+// walk, same exact predicate, in the kernel's order, with the bounce gather): the horizon
+// lists run it, and the scalar references of the tests build on it.
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <optional>
+
+#include "core/chord_side.hpp"
+#include "core/fast_math.hpp"
+#include "hfvis/bounce.hpp"
+#include "hfvis/errors.hpp"
+#include "core/horizon_common.hpp"
+#include "ops/intervisibility_internal.hpp"
+
+namespace hfvis {
+namespace detail {
+namespace {
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+constexpr int kNone = -1;
+constexpr int kConcave = 0, kConvex = 1;
+
+// A tree node as the kernel's int4: (height, rank * 2 + leaf flag, first child, next
+// sibling); the node of step k in slot k, links by slot.
+struct Node {
+  float h = 0.0f;
+  int rank = 0;  // present samples before this one
+  bool leaf = false;
+  int first = kNone;
+  int next = kNone;
+};
+
+// The sampled heights of one line and their positions, indexed by step.
+struct LineView {
+  const IntervisibilityLines& lines;
+  std::size_t offset;  // entry of step 0 of this line
+  std::size_t stride;  // n_lines
+  std::size_t entry(int step) const { return offset + static_cast<std::size_t>(step) * stride; }
+  float height(int step) const { return lines.samples[entry(step)]; }
+  // Position along the line: the step, or its units with per-row spacing (exact in a float).
+  float position(int step) const {
+    return lines.positions.empty() ? static_cast<float>(step) : static_cast<float>(lines.positions[entry(step)]);
+  }
+};
+
+bool seenOver(const LineView& line, float hx, int x, float hn, int n, float hr, int r) {
+  const float px = line.position(x), pn = line.position(n), pr = line.position(r);
+  return chordSide(hx, hn, hr, pn - px, pr - pn) <= 0;
+}
+
+// Mirror of run_end().
+int runEnd(const LineView& line, int start, int next, float h_next, int receiver, float h_receiver,
+           bool holes) {
+  if (!holes) {
+    int lo = start, hi = next, jump = 1;
+    while (lo + jump < hi) {
+      const int x = lo + jump;
+      if (seenOver(line, line.height(x), x, h_next, next, h_receiver, receiver)) {
+        lo = x;
+        jump *= 2;
+      } else {
+        hi = x;
+        break;
+      }
+    }
+    while (hi - lo > 1) {
+      const int mid = lo + (hi - lo) / 2;
+      if (seenOver(line, line.height(mid), mid, h_next, next, h_receiver, receiver))
+        lo = mid;
+      else
+        hi = mid;
+    }
+    return hi;
+  }
+  for (int x = start + 1; x < next; ++x) {
+    const float hx = line.height(x);
+    if (!std::isnan(hx) && !seenOver(line, hx, x, h_next, next, h_receiver, receiver)) return x;
+  }
+  return next;
+}
+
+// Mirror of the bounce gather of kernels/intervisibility.cl (BounceGather and its helpers):
+// the visible samples of one receiver, visited farthest first, each adding its radiance
+// times the projected solid angle of its elevation band.
+class BounceGather {
+ public:
+  BounceGather(const BounceLines& in, const SweepDirection& d, std::size_t receiver_entry, float h, int step)
+      : in_(in), h_(h), step_(step), ground_(in.step_ground) {
+    const float* normal = &in.attributes[receiver_entry * (in.channels + kBounceNormalFloats) + in.channels];
+    const float toward = normal[0] * d.cos_azimuth + normal[1] * d.sin_azimuth;
+    nz_term_ = normal[2] * in.half_sector;
+    nh_term_ = toward * in.wedge;
+    tangent_ = std::atan2(-nh_term_, 2.0f * nz_term_);
+  }
+
+  // Visible sample x at height hx; nearer than every sample visited before it.
+  void visit(float hx, int x, std::size_t entry) {
+    const float theta = std::atan2(hx - h_, static_cast<float>(step_ - x) * ground_);
+    float g_hi;
+    if (!have_prev_) {
+      g_hi = g(theta);
+    } else {
+      const float edge = adjacent_ ? 0.5f * (prev_theta_ + theta) : theta;
+      const float g_edge = g(edge);
+      for (int c = 0; c < in_.channels; ++c) sum_[c] += prev_radiance_[c] * (prev_g_hi_ - g_edge);
+      g_hi = g_edge;
+    }
+    prev_theta_ = theta;
+    prev_g_hi_ = g_hi;
+    const float* radiance = &in_.attributes[entry * (in_.channels + kBounceNormalFloats)];
+    for (int c = 0; c < in_.channels; ++c) prev_radiance_[c] = radiance[c];
+    have_prev_ = true;
+    adjacent_ = true;
+  }
+
+  // Whether the next sample visited is adjacent to the last one (no hidden sample between).
+  void setAdjacent(bool adjacent) { adjacent_ = adjacent; }
+
+  void finish(float* irradiance) {
+    if (have_prev_) {
+      const float g_lo = g(prev_theta_);
+      for (int c = 0; c < in_.channels; ++c) sum_[c] += prev_radiance_[c] * (prev_g_hi_ - g_lo);
+    }
+    for (int c = 0; c < in_.channels; ++c) irradiance[c] = sum_[c];
+  }
+
+ private:
+  float g(float theta) const {
+    const float t = hfMax(theta, tangent_);
+    const float s = std::sin(t), c = std::cos(t);
+    return nz_term_ * (s * s) + nh_term_ * (0.5f * (t + s * c));
+  }
+
+  const BounceLines& in_;
+  float h_;
+  int step_;
+  float ground_;
+  float nz_term_ = 0.0f, nh_term_ = 0.0f, tangent_ = 0.0f;
+  bool have_prev_ = false, adjacent_ = false;
+  float prev_theta_ = 0.0f, prev_g_hi_ = 0.0f;
+  float prev_radiance_[kMaxBounceChannels] = {};
+  float sum_[kMaxBounceChannels] = {};
+};
+
+// Mirror of RootList / root_append(): the root's new child list; `tail_next` is what the
+// last child's `next` holds in the tree, so deferred writes skip links already right.
+struct RootList {
+  int head = kNone, tail = kNone, tail_next = kNone;
+  float tail_h = 0.0f;
+  void append(std::vector<Node>& tree, bool deferred, int x, float hx, int x_next_in_tree) {
+    if (tail == kNone)
+      head = x;
+    else if (!deferred || tail_next != x)
+      tree[tail].next = x;
+    tail = x;
+    tail_next = x_next_in_tree;
+    tail_h = hx;
+  }
+};
+
+// Mirror of hull_tree_walk(): Algorithm 1 below `top`; returns the convexity checks.
+std::uint32_t hullTreeWalk(const LineView& line, std::vector<Node>& tree, bool deferred, int top, Node node, float h,
+                           int step, RootList& list) {
+  std::uint32_t t = 0;
+  int cur = top;
+  for (;;) {
+    const int c = node.first;
+    if (c != kNone) {
+      Node child = tree[c];
+      ++t;
+      const int side = chordSide(child.h, node.h, h, line.position(cur) - line.position(c),
+                                 line.position(step) - line.position(cur));
+      if (side <= 0) {
+        tree[cur].first = child.next;
+        tree[c].next = cur;
+        child.next = cur;
+        cur = c;
+        node = child;
+        continue;
+      }
+    }
+    if (c != kNone || node.leaf) list.append(tree, deferred, cur, node.h, node.next);
+    if (cur == top) break;
+    cur = node.next;
+    node = tree[cur];
+  }
+  return t;
+}
+
+// Mirror of SafeZone and its helpers, the same float operations in the same order.
+struct SafeZone {
+  int first = 0, last = 0, steps = 16;
+  float z1 = 0.0f, z2 = 0.0f, margin = 0.0f;
+  void begin(int receiver) {
+    first = receiver + 1;
+    last = receiver + 1 + steps;
+    z1 = z2 = std::numeric_limits<float>::max();
+    margin = 0.0f;
+  }
+  void add(float hc, int c, float hg, int g) {
+    const float slope = (hc - hg) / static_cast<float>(c - g);
+    const float at1 = hc + slope * static_cast<float>(first - c);
+    const float at2 = hc + slope * static_cast<float>(last - c);
+    z1 = hfMin(z1, at1);
+    z2 = hfMin(z2, at2);
+    margin = hfMax(margin, std::fabs(hc) + std::fabs(slope) * static_cast<float>(last - c));
+  }
+  void end() { margin = margin * 0x1p-16f + 0x1p-100f; }
+  bool inside(int step, float h) const {
+    const float bound = z1 + (z2 - z1) * (static_cast<float>(step - first) / static_cast<float>(steps));
+    return step <= last && h < bound - margin;
+  }
+};
+
+// Mirror of intervisibility_sweep() for line j.
+void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, IntervisibilityLines& out,
+               bool keep_horizons, BounceLines* bounce) {
+  const bool deferred = tuning.deferred_writes;
+  const std::size_t stride = static_cast<std::size_t>(d.n_lines);
+  const LineView line{out, static_cast<std::size_t>(j), stride};
+  const bool row_spacing = !out.positions.empty();
+  std::vector<Node> tree(static_cast<std::size_t>(d.n_steps));
+  std::vector<int> ranks(static_cast<std::size_t>(d.n_steps));
+  std::vector<std::uint64_t> step_sums(static_cast<std::size_t>(d.n_steps));
+  // With per-row spacing, over the present samples before each step: the sum of their step
+  // units and of position * units (the kernel's positions[].y and prefix[]).
+  std::vector<std::uint64_t> unit_sums(step_sums.size()), weighted_sums(step_sums.size());
+
+  int rank = 0;
+  std::uint64_t step_sum = 0, unit_sum = 0, weighted_sum = 0;
+  int root = kNone, prev = kNone, prev2 = kNone;
+  float h_prev = 0.0f, h_prev2 = 0.0f;
+  int class_last = kConvex;
+  int head = kNone, tail = kNone;  // the root's first and last child
+  float tail_h = 0.0f;
+  SafeZone zone;
+  zone.steps = tuning.safe_zone_steps;
+  bool zone_valid = false;
+  for (int step = 0; step < d.n_steps; ++step) {
+    const std::size_t e = static_cast<std::size_t>(j) + static_cast<std::size_t>(step) * stride;
+    const float h = out.samples[e];
+    ranks[step] = rank;
+    step_sums[step] = step_sum;
+    unit_sums[step] = unit_sum;
+    weighted_sums[step] = weighted_sum;
+    if (std::isnan(h)) continue;  // outputs stay NaN / zero
+    const float p = line.position(step);
+    std::uint32_t m = 0, t = 0, hash = kHorizonHashSeed;
+    int count = 0;
+    std::uint64_t distance_sum = 0;
+    std::vector<int> horizons, run_ends;
+    const bool receiver = step % out.receiver_every == out.receiver_every - 1;
+    const bool visit = receiver || out.horizons_at_every_sample;
+    std::optional<BounceGather> gather;
+    if (bounce && receiver) gather.emplace(*bounce, d, e, h, step);
+    if (root == kNone) {
+      tree[step] = {h, 0, true, kNone, kNone};
+      head = tail = kNone;
+    } else {
+      // 1. Algorithm 1 for the new root (see the kernel for the variants).
+      RootList list;
+      const Node old_root = tree[root];
+      bool walk = true;
+      bool replaced = false;
+      if (tuning.replacement_check && tail != kNone) {
+        ++t;
+        replaced = chordSide(tail_h, h_prev, h, line.position(root) - line.position(tail), p - line.position(root)) <= 0;
+      }
+      if (tuning.safe_zone) {
+        zone_valid = zone_valid && replaced && zone.inside(step, h);
+        if (zone_valid) {
+          walk = false;
+          out.walks_skipped[e] = 1;
+          list.head = head;
+          list.tail = tail;
+          list.tail_h = tail_h;
+        }
+      }
+      if (walk) {
+        if (deferred) {
+          int c = old_root.first;
+          while (c != kNone) {
+            const Node child = tree[c];
+            if (!replaced) {
+              if (tuning.replacement_check && c == tail) break;
+              ++t;
+              if (chordSide(child.h, h_prev, h, line.position(root) - line.position(c), p - line.position(root)) > 0)
+                break;
+            }
+            t += hullTreeWalk(line, tree, deferred, c, child, h, step, list);
+            c = child.next;
+          }
+          if (c != kNone || old_root.leaf) {
+            if (c != old_root.first) tree[root].first = c;
+            list.append(tree, deferred, root, h_prev, kNone);
+          }
+        } else {
+          t += hullTreeWalk(line, tree, deferred, root, old_root, h, step, list);
+        }
+      }
+
+      // 2. Eq. 1 for the old root; a segment start's node becomes (or is re-created as) a
+      // leaf, the root's last child.
+      if (prev2 != kNone) {
+        const int side = chordSide(h_prev2, h_prev, h, line.position(prev) - line.position(prev2), p - line.position(prev));
+        const int cls = side > 0 ? kConvex : side < 0 ? kConcave : class_last;
+        if (cls == kConvex && class_last == kConcave) {
+          if (list.tail == prev) {
+            tree[prev].leaf = true;
+          } else {
+            tree[prev] = {h_prev, rank - 1, true, kNone, kNone};
+            list.append(tree, deferred, prev, h_prev, kNone);
+          }
+        }
+        class_last = cls;
+      }
+      if (!deferred || list.tail_next != kNone) tree[list.tail].next = kNone;
+      tree[step] = {h, rank, false, list.head, kNone};
+      head = list.head;
+      tail = list.tail;
+      tail_h = list.tail_h;
+
+      // 3. Visible samples from the horizons, farthest first (closed forms without holes);
+      // at receivers, or at every sample when asked (statistics).
+      if (visit) {
+      // Within the maximum distance: the first step within max_steps (units) of this one.
+      int cut = step - out.max_steps;
+      if (row_spacing) {
+        cut = 0;
+        while (static_cast<std::int64_t>(out.positions[line.entry(step)]) - out.positions[line.entry(cut)] >
+               out.max_steps)
+          ++cut;
+      }
+      const bool refresh_zone = tuning.safe_zone && !zone_valid;
+      if (refresh_zone) zone.begin(step);
+      int hp = head;
+      Node hz = tree[hp];
+      int hp_rank = hz.rank;
+      for (;;) {
+        const int np = hz.next;
+        ++m;
+        if (refresh_zone && hz.first != kNone) zone.add(hz.h, hp, tree[hz.first].h, hz.first);
+        hash = hashHorizon(hash, hp);
+        if (keep_horizons) horizons.push_back(hp);
+        int end = step, end_rank = rank, np_rank = rank;
+        Node nz = hz;
+        if (np != kNone) {
+          nz = tree[np];
+          np_rank = nz.rank;
+          end = np;
+          end_rank = np_rank;
+        }
+        const bool holes = end_rank - hp_rank != end - hp;
+        if (np != kNone) {
+          end = runEnd(line, hp, np, nz.h, step, h, holes);
+          end_rank = end == np ? np_rank : holes ? ranks[end] : hp_rank + (end - hp);
+        }
+        if (keep_horizons) run_ends.push_back(end);
+        if (gather) {
+          for (int x = hp; x < end; ++x) {
+            const float hx = line.height(x);
+            if (!std::isnan(hx))
+              gather->visit(hx, x, static_cast<std::size_t>(j) + static_cast<std::size_t>(x) * stride);
+          }
+          gather->setAdjacent(end == np);
+        }
+        // Within the maximum distance: the run's samples from `first` on.
+        const int first = std::max(hp, cut);
+        const int first_rank = first == hp ? hp_rank : holes ? ranks[first] : hp_rank + (first - hp);
+        const int run = first < end ? end_rank - first_rank : 0;
+        count += run;
+        std::uint64_t steps_sum = 0;
+        if (run == 0) {
+        } else if (row_spacing) {  // sum of (p - position) * units over the run (sums at `step`: before it)
+          const std::uint64_t units = unit_sums[end] - unit_sums[first];
+          distance_sum += static_cast<std::uint64_t>(out.positions[line.entry(step)]) * units -
+                          (weighted_sums[end] - weighted_sums[first]);
+        } else if (!holes) {
+          steps_sum = static_cast<std::uint64_t>(run) * static_cast<std::uint64_t>(first + end - 1) / 2;
+        } else {
+          const std::uint64_t end_sum = end == step ? step_sum : step_sums[end];
+          steps_sum = end_sum - step_sums[first];
+        }
+        if (!row_spacing) distance_sum += static_cast<std::uint64_t>(step) * static_cast<std::uint64_t>(run) - steps_sum;
+        if (np == kNone) break;
+        hz = nz;
+        hp = np;
+        hp_rank = np_rank;
+      }
+      if (refresh_zone) {
+        zone.end();
+        zone_valid = true;
+      }
+      }
+    }
+    out.counts[e] = visit ? static_cast<float>(count) : kNaN;
+    out.distance_sums[e] = visit ? static_cast<float>(distance_sum) : kNaN;
+    out.horizons[e] = m;
+    out.iterations[e] = t;
+    out.horizon_hashes[e] = hash;
+    if (keep_horizons) {
+      out.horizon_steps[e] = std::move(horizons);
+      out.horizon_run_ends[e] = std::move(run_ends);
+    }
+    if (gather) gather->finish(&bounce->irradiance[e * bounce->channels]);
+    prev2 = prev;
+    h_prev2 = h_prev;
+    prev = step;
+    h_prev = h;
+    root = step;
+    ++rank;
+    step_sum += static_cast<std::uint64_t>(step);
+    if (row_spacing) {
+      const std::uint64_t units = static_cast<std::uint64_t>(out.step_units[e]);
+      unit_sum += units;
+      weighted_sum += static_cast<std::uint64_t>(out.positions[e]) * units;
+    }
+  }
+}
+
+}  // namespace
+
+void sweepPresampledLines(IntervisibilityLines& lines, const HullTreeTuning& requested, bool keep_horizons,
+                          BounceLines* bounce) {
+  validate(requested);
+  const HullTreeTuning tuning = tuningFor(requested, !lines.positions.empty());
+  if (bounce && !lines.positions.empty()) throw InvalidArgument("internal error: the bounce takes uniform steps");
+  const SweepDirection& d = lines.geometry;
+  const std::size_t entries = d.entries();
+  if (lines.samples.size() != entries)
+    throw InvalidArgument("internal error: line samples do not fit the geometry");
+  lines.resetResults(keep_horizons);
+  if (bounce) {
+    if (bounce->channels < 1 || bounce->channels > kMaxBounceChannels ||
+        bounce->attributes.size() != entries * (bounce->channels + kBounceNormalFloats)) {
+      throw InvalidArgument("internal error: bounce attributes do not fit the lines");
+    }
+    bounce->irradiance.assign(entries * bounce->channels, kNaN);
+  }
+  for (int j = 0; j < d.n_lines; ++j) sweepLine(d, j, tuning, lines, keep_horizons, bounce);
+}
+
+}  // namespace detail
+
+}  // namespace hfvis

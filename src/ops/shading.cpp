@@ -1,0 +1,85 @@
+// shading.cpp: the sun's light on a height field (see hfvis/shading.hpp): one horizon sweep in
+// the sun's azimuth, then per pixel the visible part of the disc and the direct irradiance.
+#include "hfvis/shading.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "hfvis/errors.hpp"
+#include "hfvis/horizon.hpp"
+#include "core/horizon_common.hpp"
+#include "ops/shading_internal.hpp"
+
+namespace hfvis {
+namespace detail {
+
+std::vector<float> unitNormals(const HeightField& field) {
+  const PreparedHeights prepared = prepareHeights(field);
+  const bool rows = hasRowSpacing(field);
+  std::vector<float> normals(4 * field.pixelCount(), std::numeric_limits<float>::quiet_NaN());
+  for (int r = 0; r < field.height; ++r) {
+    const float cell_x = static_cast<float>(rows ? field.row_cell_size_x[r] : field.cell_size_x);
+    const float cell_y = static_cast<float>(rows ? field.row_cell_size_y[r] : field.cell_size_y);
+    for (int c = 0; c < field.width; ++c) {
+      const std::size_t p = static_cast<std::size_t>(r) * field.width + c;
+      if (std::isnan(prepared.heights[p])) continue;
+      pixelNormal(prepared.heights, field.width, field.height, c, r, cell_x, cell_y, &normals[4 * p]);
+      normals[4 * p + 3] = 0.0f;
+    }
+  }
+  return normals;
+}
+
+}  // namespace detail
+
+double discAboveHorizon(double above, double radius) {
+  if (radius <= 0.0) return above > 0.0 ? 1.0 : above < 0.0 ? 0.0 : 0.5;  // a point sun
+  const double t = std::clamp(above / radius, -1.0, 1.0);
+  return 1.0 - (std::acos(t) - t * std::sqrt(1.0 - t * t)) / M_PI;
+}
+
+SunShading computeSunShading(const ComputeContext& context, const HeightField& field, const SunLight& sun,
+                             const SweepOptions& options) {
+  validate(field);
+  if (!(sun.size_deg >= 0.0 && sun.size_deg <= 10.0))
+    throw InvalidArgument("the sun's size must be in [0, 10] degrees (got " + std::to_string(sun.size_deg) +
+                          ")");
+  if (!std::isfinite(sun.position.azimuth_deg) || !(std::fabs(sun.position.elevation_deg) <= 90.0))
+    throw InvalidArgument("the sun's azimuth must be finite and its elevation in -90 .. 90 degrees");
+  constexpr double kDegree = M_PI / 180.0;
+  // The sun's azimuth alone, at an exact step: hfvis azimuth = compass - 90 degrees.
+  HorizonOptions horizon;
+  static_cast<SweepOptions&>(horizon) = options;
+  horizon.directions = 1;
+  horizon.azimuth_offset = std::remainder((sun.position.azimuth_deg - 90.0) * kDegree, 2.0 * M_PI);
+  horizon.azimuth_tolerance = 0.02 * kDegree;
+  HorizonOutputs outputs;
+  outputs.horizon_angles = true;
+  const HorizonResult horizons = computeHorizons(context, field, horizon, outputs);
+
+  SunShading out;
+  out.width = field.width;
+  out.height = field.height;
+  out.azimuth = horizons.azimuths.at(0);
+  const std::size_t plane = field.pixelCount();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  out.sun.assign(plane, nan);
+  out.direct.assign(plane, nan);
+  const double elevation = sun.position.elevation_deg * kDegree, radius = 0.5 * sun.size_deg * kDegree;
+  const glm::dvec3 s = sunDirection(sun.position);
+  const std::vector<float> normals = detail::unitNormals(field);
+  for (std::size_t p = 0; p < plane; ++p) {
+    const float* n = &normals[4 * p];
+    if (std::isnan(n[0])) continue;
+    // Terrain beyond the field is taken as level, as computeInsolation takes it: a sun below
+    // elevation 0 lights nothing, not even a pixel whose own horizon lies lower.
+    const double seen = discAboveHorizon(elevation - std::max(0.0, double(horizons.angles[p])), radius);
+    const double cosine = n[0] * s.x + n[1] * s.y + n[2] * s.z;
+    out.sun[p] = static_cast<float>(seen);
+    out.direct[p] = static_cast<float>(seen * std::max(0.0, cosine));
+  }
+  return out;
+}
+
+}  // namespace hfvis
