@@ -19,7 +19,7 @@ bool isExrFile(const std::string& path);
 // integer channels as their values, not normalised; the data window's pixels, wherever it lies):
 // the channel `*channel` names (a name or a zero-based index; "" where the image has one
 // channel), or every channel where `channel` is null, in the order OpenImageIO gave them before
-// (see channel_order in exr_images.cpp). attributes: the string attributes hfvis:cell_size_x and
+// (see channelOrder in exr_images.cpp). attributes: the string attributes hfvis:cell_size_x and
 // hfvis:cell_size_y where the part has them. Throws IoError (unreadable, empty, a deep image, a
 // subsampled channel, 2^31 pixels or more, a header claiming more than max_image_bytes, 0 =
 // 64 GiB, or attributes larger than the file; a channel it lacks; truncated or corrupt pixels).
