@@ -19,7 +19,7 @@
 
 #include "hfvis/environment.hpp"
 #include "hfvis/horizon.hpp"
-#include "ops/shading_internal.hpp"
+#include "core/unit_normals.hpp"
 #include "suite_support.hpp"
 
 namespace hfvis::bench {

@@ -13,7 +13,8 @@
 #include <tuple>
 
 #include "hfvis/errors.hpp"
-#include "hfvis/shading.hpp"
+#include "hfvis/insolation.hpp"
+#include "hfvis/sun_shading.hpp"
 #include "hfvis/sun.hpp"
 #include "core/message_numbers.hpp"
 
@@ -1049,7 +1050,7 @@ ViewshedOptions viewshedOptions(const RunArguments& run) {
   options.curvature = run.curvature ? earthCurvature(run.refraction) : 0.0;
   if (run.field_of_view) std::tie(options.azimuth_from_deg, options.azimuth_to_deg) = *run.field_of_view;
   if (run.elevation_range) std::tie(options.elevation_min_deg, options.elevation_max_deg) = *run.elevation_range;
-  options.memory_budget = run.memory_budget_bytes;
+  options.memory_budget_bytes = run.memory_budget_bytes;
   return options;
 }
 

@@ -14,7 +14,8 @@
 #include "hfvis/horizon_lists.hpp"
 #include "hfvis/image_io.hpp"
 #include "hfvis/intervisibility.hpp"
-#include "hfvis/shading.hpp"
+#include "hfvis/insolation.hpp"
+#include "hfvis/sun_shading.hpp"
 #include "hfvis/viewshed.hpp"
 
 namespace hfvis::cli {

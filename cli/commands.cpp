@@ -34,7 +34,8 @@
 #include "hfvis/horizon_lists.hpp"
 #include "hfvis/image_io.hpp"
 #include "hfvis/intervisibility.hpp"
-#include "hfvis/shading.hpp"
+#include "hfvis/insolation.hpp"
+#include "hfvis/sun_shading.hpp"
 #include "hfvis/sun.hpp"
 #include "hfvis/viewshed.hpp"
 #include "horizon_list_files.hpp"
@@ -542,7 +543,7 @@ int runShade(const RunArguments& run) {
     requireFiniteResult(env.irradiance, field, "irradiance");
     lit.restore(env.irradiance);
   }
-  SunShading direct;
+  SunShadingResult direct;
   if (sun) {
     direct = progress.run([&] { return computeSunShading(context, field, *sun, options); });
     requireSize(direct.sun, pixels, "sun fractions");
@@ -648,7 +649,7 @@ int runInsolation(const RunArguments& run) {
   Progress progress(run.quiet);
   progress.attach(sweep);
   const auto start = std::chrono::steady_clock::now();
-  Insolation result = progress.run([&] { return computeInsolation(context, field, options, sweep); });
+  InsolationResult result = progress.run([&] { return computeInsolation(context, field, options, sweep); });
   const double seconds = secondsSince(start);
   requireResultSize(result.width, result.height, field);
   requireSize(result.sun_hours, field.pixelCount(), "sun hours");
@@ -749,7 +750,7 @@ int runViewshed(const RunArguments& run) {
     p.target_height = options.target_height;
     p.curvature = options.curvature;
     p.finest_level = run.cull_level;
-    p.memory_budget = run.memory_budget_bytes;
+    p.memory_budget_bytes = run.memory_budget_bytes;
     Progress building(run.quiet);
     p.progress = building.callback(p.sectors * p.directions_per_sector, "pyramid directions");
     pyramid = building.run([&] { return buildViewshedPyramid(context, field, p); });

@@ -15,7 +15,8 @@
 #include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
 #include "hfvis_testing/horizon_reference.hpp"
-#include "hfvis/shading.hpp"
+#include "hfvis/insolation.hpp"
+#include "hfvis/sun_shading.hpp"
 #include "hfvis_testing/synthetic_fields.hpp"
 #include "test_support.hpp"
 
@@ -246,12 +247,12 @@ TEST(Environment, ASmallBrightPatchActsAsTheSun) {
     HorizonOptions options;
     options.directions = 720;  // swaths of half a degree
     const HorizonResult env = computeHorizons(testContext(), field, options, environmentOutputs(map));
-    const SunShading direct = computeSunShading(testContext(), field, sun);
+    const SunShadingResult direct = computeSunShading(testContext(), field, sun);
     // Where a sun of 3 degrees is wholly seen or hidden: the horizon clear of the patch in every
     // azimuth the patch spans (at the cone's foot the ground's own slope grazes the sun).
     SunLight wide = sun;
     wide.size_deg = 3.0;
-    const SunShading margin = computeSunShading(testContext(), field, wide);
+    const SunShadingResult margin = computeSunShading(testContext(), field, wide);
     int lit = 0, shadow = 0;
     for (std::size_t p = 0; p < field.pixelCount(); ++p) {
       // Not the border rows and columns: rays a step off the sun's azimuth leave the field there

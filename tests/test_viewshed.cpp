@@ -203,7 +203,7 @@ TEST(Viewshed, OptionsMatchBruteForce) {
     compare(context, f, o, options, 1e-4);
     // A budget that just holds the rays' upper bounds (a float per point, half the budget).
     options = {};
-    options.memory_budget = 2 * sizeof(float) * f.pixelCount();
+    options.memory_budget_bytes = 2 * sizeof(float) * f.pixelCount();
     compare(context, f, o, options, 1e-4);
   });
   // Azimuths 0 and 360 are the whole circle.
@@ -212,7 +212,7 @@ TEST(Viewshed, OptionsMatchBruteForce) {
   EXPECT_EQ(computeViewshed(testContext(), f, o, circle).visible, computeViewshed(testContext(), f, o, {}).visible);
   // A budget that leaves no room for the rays' bounds: every target is marched.
   ViewshedOptions tiny;
-  tiny.memory_budget = 16;
+  tiny.memory_budget_bytes = 16;
   EXPECT_EQ(computeViewshed(testContext(), f, o, tiny).visible, computeViewshed(testContext(), f, o, {}).visible);
 }
 

@@ -324,7 +324,7 @@ TEST(ViewshedCulling, BadInputIsRefused) {
   EXPECT_NO_THROW(buildViewshedPyramid(testContext(), fractalCrop(0, 0, 20, 16), sectorsOf(128, 8, 2)));
   // A build that would hold more than its budget on the host is refused before it starts.
   ViewshedPyramidOptions small;
-  small.memory_budget = 64 * 1024;
+  small.memory_budget_bytes = 64 * 1024;
   EXPECT_THROW(buildViewshedPyramid(testContext(), f, small), MemoryBudgetError);
   HeightField lat = f;
   lat.row_cell_size_x.assign(f.height, 1.0);

@@ -10,7 +10,8 @@
 //   hfvis/horizon_lists.hpp    the visibility horizons of chosen receivers
 //   hfvis/intervisibility.hpp  computeIntervisibility: visible counts and areas (hull tree)
 //   hfvis/bounce.hpp           one diffuse bounce over the visible surface
-//   hfvis/shading.hpp          the sun's light with cast shadows, insolation over a span of time
+//   hfvis/sun_shading.hpp      computeSunShading: the sun's light with cast shadows
+//   hfvis/insolation.hpp       computeInsolation: sunshine hours and irradiation over a span of time
 //   hfvis/sun.hpp              where the sun stands at a time and place
 //   hfvis/viewshed.hpp         computeViewshed, computeCumulativeViewshed: what observers see
 //   hfvis/image_io.hpp         reading height fields, writing float EXRs and PNG previews
@@ -26,8 +27,9 @@
 #include "hfvis/horizon.hpp"
 #include "hfvis/horizon_lists.hpp"
 #include "hfvis/image_io.hpp"
+#include "hfvis/insolation.hpp"
 #include "hfvis/intervisibility.hpp"
-#include "hfvis/shading.hpp"
+#include "hfvis/sun_shading.hpp"
 #include "hfvis/sun.hpp"
 #include "hfvis/sweep_options.hpp"
 #include "hfvis/viewshed.hpp"

@@ -70,7 +70,7 @@ struct ViewshedOptions {
   // Device memory for the rays' upper bounds (a float per grid point); 0 = half the device
   // memory. When they take more than half of it, every target is marched (the same decisions,
   // more slowly).
-  std::size_t memory_budget = 0;
+  std::size_t memory_budget_bytes = 0;
   // Cumulative viewsheds: called after each observer with (done, total).
   std::function<void(int, int)> progress;
   // A culling pyramid built for this field, target height and curvature (buildViewshedPyramid),
@@ -144,7 +144,7 @@ struct ViewshedPyramidOptions {
   // Bytes the build may use: on the device for the horizon sweeps (SweepOptions::
   // memory_budget_bytes) and on the host for its planes and regions; 0 = half the device's
   // memory and half the host's.
-  std::size_t memory_budget = 0;
+  std::size_t memory_budget_bytes = 0;
   std::function<void(int, int)> progress;  // (directions done, directions in all)
 };
 

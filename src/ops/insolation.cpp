@@ -1,5 +1,5 @@
 // insolation.cpp: sunshine hours and direct irradiation over a span of time (see
-// hfvis/shading.hpp): the sun's positions step by step, grouped into buckets of azimuth; per
+// hfvis/insolation.hpp): the sun's positions step by step, grouped into buckets of azimuth; per
 // bucket one horizon sweep, and insolation_add (kernels/insolation.cl) adds its steps to every
 // pixel's sums on the device.
 #include <cmath>
@@ -9,9 +9,10 @@
 
 #include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
-#include "hfvis/shading.hpp"
+#include "hfvis/insolation.hpp"
+#include "hfvis/sun.hpp"
 #include "core/opencl_context.hpp"
-#include "ops/shading_internal.hpp"
+#include "core/unit_normals.hpp"
 #include "core/sweep_framework.hpp"
 
 namespace hfvis {
@@ -49,8 +50,8 @@ struct SunStep {
 
 }  // namespace
 
-Insolation computeInsolation(const ComputeContext& context, const HeightField& field, const InsolationOptions& options,
-                             const SweepOptions& sweep) {
+InsolationResult computeInsolation(const ComputeContext& context, const HeightField& field,
+                                   const InsolationOptions& options, const SweepOptions& sweep) {
   validate(field);
   validate(options);
   validate(sweep);
@@ -59,7 +60,7 @@ Insolation computeInsolation(const ComputeContext& context, const HeightField& f
   const double radius = std::max(0.5 * options.size_deg * kDegree, 1e-12);
   // The steps with some of the disc above elevation 0, by azimuth bucket.
   std::map<long, std::vector<SunStep>> buckets;
-  Insolation out;
+  InsolationResult out;
   const double step = 60.0 * options.step_minutes;
   for (double t0 = options.from_utc; t0 < options.to_utc; t0 += step) {
     const double t1 = std::min(options.to_utc, t0 + step);

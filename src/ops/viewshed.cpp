@@ -80,7 +80,7 @@ class ViewshedRun {
     // The rays' upper bounds, a float per point, where the budget leaves room for them (else
     // every target is marched).
     const std::size_t budget =
-        options.memory_budget ? options.memory_budget : detail::defaultMemoryBudget(st.info);
+        options.memory_budget_bytes ? options.memory_budget_bytes : detail::defaultMemoryBudget(st.info);
     ray_hi_budgeted_ = pixels * sizeof(float) <= budget / 2;
     ray_hi_ = detail::deviceBuffer(st, ray_hi_budgeted_ ? pixels * sizeof(float) : sizeof(float));
     pending_ = detail::deviceBuffer(st, pixels);

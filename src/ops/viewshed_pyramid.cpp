@@ -184,7 +184,7 @@ ViewshedPyramid buildViewshedPyramid(const ComputeContext& context, const Height
   const int per_call = directions / calls;
   const double host_bytes = 4.0 / 3.0 * finest_nodes * sectors * kFloats * sizeof(float) +
                             double(field.pixelCount()) * (3.0 * per_call * 16.0 + per_call * 8.0 + 16.0 + 6.0);
-  const std::size_t budget = options.memory_budget ? options.memory_budget : detail::hostMemoryBudget();
+  const std::size_t budget = options.memory_budget_bytes ? options.memory_budget_bytes : detail::hostMemoryBudget();
   if (budget > 0 && host_bytes > budget)
     throw MemoryBudgetError("the culling pyramid would hold " + detail::mebibytes(static_cast<std::size_t>(host_bytes)) +
                             " on the host, beyond the budget (" + detail::mebibytes(budget) +
@@ -195,7 +195,7 @@ ViewshedPyramid buildViewshedPyramid(const ComputeContext& context, const Height
   horizon.directions = per_call;
   horizon.samples_per_unit = 1.0;
   horizon.curvature = options.curvature;
-  horizon.memory_budget_bytes = options.memory_budget;
+  horizon.memory_budget_bytes = options.memory_budget_bytes;
   HorizonOutputs outputs;
   outputs.horizon_angles = true;
   outputs.horizon_distances = true;

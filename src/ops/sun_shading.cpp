@@ -1,6 +1,6 @@
-// shading.cpp: the sun's light on a height field (see hfvis/shading.hpp): one horizon sweep in
+// sun_shading.cpp: the sun's light on a height field (see hfvis/sun_shading.hpp): one horizon sweep in
 // the sun's azimuth, then per pixel the visible part of the disc and the direct irradiance.
-#include "hfvis/shading.hpp"
+#include "hfvis/sun_shading.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,38 +9,17 @@
 #include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
 #include "core/horizon_common.hpp"
-#include "ops/shading_internal.hpp"
+#include "core/unit_normals.hpp"
 
 namespace hfvis {
-namespace detail {
-
-std::vector<float> unitNormals(const HeightField& field) {
-  const PreparedHeights prepared = prepareHeights(field);
-  const bool rows = hasRowSpacing(field);
-  std::vector<float> normals(4 * field.pixelCount(), std::numeric_limits<float>::quiet_NaN());
-  for (int r = 0; r < field.height; ++r) {
-    const float cell_x = static_cast<float>(rows ? field.row_cell_size_x[r] : field.cell_size_x);
-    const float cell_y = static_cast<float>(rows ? field.row_cell_size_y[r] : field.cell_size_y);
-    for (int c = 0; c < field.width; ++c) {
-      const std::size_t p = static_cast<std::size_t>(r) * field.width + c;
-      if (std::isnan(prepared.heights[p])) continue;
-      pixelNormal(prepared.heights, field.width, field.height, c, r, cell_x, cell_y, &normals[4 * p]);
-      normals[4 * p + 3] = 0.0f;
-    }
-  }
-  return normals;
-}
-
-}  // namespace detail
-
 double discAboveHorizon(double above, double radius) {
   if (radius <= 0.0) return above > 0.0 ? 1.0 : above < 0.0 ? 0.0 : 0.5;  // a point sun
   const double t = std::clamp(above / radius, -1.0, 1.0);
   return 1.0 - (std::acos(t) - t * std::sqrt(1.0 - t * t)) / M_PI;
 }
 
-SunShading computeSunShading(const ComputeContext& context, const HeightField& field, const SunLight& sun,
-                             const SweepOptions& options) {
+SunShadingResult computeSunShading(const ComputeContext& context, const HeightField& field, const SunLight& sun,
+                                   const SweepOptions& options) {
   validate(field);
   if (!(sun.size_deg >= 0.0 && sun.size_deg <= 10.0))
     throw InvalidArgument("the sun's size must be in [0, 10] degrees (got " + std::to_string(sun.size_deg) +
@@ -58,7 +37,7 @@ SunShading computeSunShading(const ComputeContext& context, const HeightField& f
   outputs.horizon_angles = true;
   const HorizonResult horizons = computeHorizons(context, field, horizon, outputs);
 
-  SunShading out;
+  SunShadingResult out;
   out.width = field.width;
   out.height = field.height;
   out.azimuth = horizons.azimuths.at(0);

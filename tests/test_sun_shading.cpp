@@ -1,4 +1,4 @@
-// test_shading.cpp: the sun's light on a height field: the disc's visible part, a flat plane
+// test_sun_shading.cpp: the sun's light on a height field: the disc's visible part, a flat plane
 // (every point sees the whole sun; direct = sin(elevation)), a wall's shadow with its soft
 // edge (the disc partly above the wall's top), the swept azimuth, and bad suns.
 #include <gtest/gtest.h>
@@ -8,7 +8,7 @@
 
 #include "hfvis/errors.hpp"
 #include "hfvis_testing/horizon_reference.hpp"
-#include "hfvis/shading.hpp"
+#include "hfvis/sun_shading.hpp"
 #include "hfvis_testing/synthetic_fields.hpp"
 #include "core/lattice_geometry.hpp"
 #include "test_support.hpp"
@@ -45,13 +45,13 @@ TEST(SunShading, FlatPlane) {
   for (double azimuth : {0.0, 37.0, 90.0, 200.0, 359.0}) {
     SunLight sun;
     sun.position = {azimuth, 30.0};
-    const SunShading s = computeSunShading(testContext(), flat, sun);
+    const SunShadingResult s = computeSunShading(testContext(), flat, sun);
     for (std::size_t p = 0; p < s.sun.size(); ++p) {
       ASSERT_EQ(s.sun[p], 1.0f) << azimuth;
       ASSERT_NEAR(s.direct[p], 0.5f, 1e-6f) << azimuth;
     }
     sun.position.elevation_deg = 0.0;
-    const SunShading low = computeSunShading(testContext(), flat, sun);
+    const SunShadingResult low = computeSunShading(testContext(), flat, sun);
     EXPECT_FLOAT_EQ(low.sun[8 * 23 + 11], 0.5f);
     EXPECT_EQ(low.direct[8 * 23 + 11], 0.0f);
   }
@@ -70,7 +70,7 @@ TEST(SunShading, AWallsShadowAndItsSoftEdge) {
   SunLight sun;
   sun.position = {270.0, 20.0};
   sun.size_deg = 2.0;  // a wide disc: several pixels of penumbra
-  const SunShading s = computeSunShading(testContext(), field, sun);
+  const SunShadingResult s = computeSunShading(testContext(), field, sun);
   EXPECT_NEAR(s.azimuth, M_PI, 1e-9);
   const double radius = 1.0 * kDegree, elevation = 20.0 * kDegree;
   int shadow = 0, penumbra = 0, lit = 0;
@@ -101,7 +101,7 @@ TEST(SunShading, APointSunCastsHardShadows) {
   SunLight sun;
   sun.position = {270.0, 20.0};
   sun.size_deg = 0.0;
-  const SunShading s = computeSunShading(testContext(), field, sun);
+  const SunShadingResult s = computeSunShading(testContext(), field, sun);
   for (int c = wall + 1; c < w; ++c) {
     const double top = std::atan(10.0 / (c - wall));
     if (std::fabs(top - 20.0 * kDegree) < 1e-3) continue;  // the shadow's edge itself
@@ -122,7 +122,7 @@ TEST(SunShading, ASunBelowElevationZeroLightsNothing) {
     for (const double elevation : {-30.0, -1.0}) {
       SunLight sun;
       sun.position = {180.0, elevation};
-      const SunShading s = computeSunShading(testContext(), field, sun);
+      const SunShadingResult s = computeSunShading(testContext(), field, sun);
       for (std::size_t p = 0; p < s.sun.size(); ++p) {
         EXPECT_EQ(s.sun[p], 0.0f) << "pixel " << p << ", sun at " << elevation << " degrees";
         EXPECT_EQ(s.direct[p], 0.0f) << "pixel " << p;
@@ -201,86 +201,6 @@ TEST(SunShading, LongStepsMatchTheReference) {
   }
 }
 
-// Insolation: the buckets' shared sweeps against one exact sweep per step (computeSunShading),
-// over three summer days at 47 N on a wall and cone field (the days' steps share buckets). A bucket sweeps its centre azimuth, up to
-// half a bucket from a step's, so pixels at a shadow's edge may gain or lose a step: the hours
-// agree within a step a day at nearly every pixel and within 0.05 h on the mean, and the
-// irradiation within 1 % on the mean. Nodata stays NaN.
-TEST(Insolation, BucketsAgreeWithASweepPerStep) {
-  const int w = 64, h = 48;
-  std::vector<float> heights(w * h, 0.0f);
-  for (int r = 0; r < h; ++r)
-    for (int c = 0; c < w; ++c) {
-      heights[r * w + c] = std::max(0.0f, 12.0f - 0.8f * std::hypot(c - 40.0f, r - 20.0f));
-      if (c == 15 && r > 5 && r < 40) heights[r * w + c] = 8.0f;  // a wall
-    }
-  heights[3 * w + 3] = std::nanf("");
-  const HeightField field = fieldFrom(w, h, heights);
-  InsolationOptions options;
-  options.latitude_deg = 47.0;
-  options.longitude_deg = 8.0;
-  options.from_utc = parseUtcTime("2026-06-21T00:00:00Z");
-  options.to_utc = parseUtcTime("2026-06-24T00:00:00Z");
-  options.step_minutes = 20.0;
-  options.azimuth_bucket_deg = 1.0;  // wide buckets: the test of sharing
-  const Insolation got = computeInsolation(testContext(), field, options);
-  std::vector<double> hours(w * h, 0.0), direct(w * h, 0.0);
-  int steps = 0;
-  for (double t = options.from_utc; t < options.to_utc; t += 1200.0) {
-    SunLight sun;
-    sun.position = sunPosition(t + 600.0, options.latitude_deg, options.longitude_deg);
-    if (sun.position.elevation_deg <= -0.265) continue;
-    ++steps;
-    const SunShading s = computeSunShading(testContext(), field, sun);
-    const double elevation = sun.position.elevation_deg * kDegree;
-    for (std::size_t p = 0; p < field.pixelCount(); ++p) {
-      // computeSunShading's sun is seen against the horizon alone; insolation's also against
-      // elevation 0: its direct is discAboveHorizon(e - max(h, 0)) max(0, n . s).
-      const float n_dot = s.sun[p] > 0.0f ? s.direct[p] / s.sun[p] : 0.0f;
-      const double seen = std::min<double>(s.sun[p], discAboveHorizon(elevation, 0.265 * kDegree));
-      hours[p] += (s.sun[p] > 0.5f && elevation > 0.0) ? 1.0 / 3.0 : 0.0;
-      direct[p] += seen * n_dot / 3.0;
-    }
-  }
-  EXPECT_EQ(got.steps, steps);
-  EXPECT_LT(got.sweeps, steps);
-  std::printf("insolation: %d steps with the sun up in %d sweeps\n", got.steps, got.sweeps);
-  int off = 0;
-  double sum = 0.0, expected_sum = 0.0, hours_off = 0.0;
-  for (std::size_t p = 0; p < field.pixelCount(); ++p) {
-    if (std::isnan(heights[p])) {
-      EXPECT_TRUE(std::isnan(got.sun_hours[p]) && std::isnan(got.direct[p]));
-      continue;
-    }
-    off += std::fabs(got.sun_hours[p] - hours[p]) > 1.0 + 1e-4;  // a step a day
-    hours_off += std::fabs(got.sun_hours[p] - hours[p]);
-    sum += got.direct[p];
-    expected_sum += direct[p];
-  }
-  std::printf("insolation: sun hours %.4f h off on the mean, %d pixels more than a step a day off\n",
-              hours_off / (field.pixelCount() - 1), off);
-  EXPECT_LE(off, static_cast<int>(field.pixelCount() / 100)) << "pixels more than a step a day off";
-  EXPECT_LT(hours_off / (field.pixelCount() - 1), 0.05);
-  EXPECT_NEAR(sum / expected_sum, 1.0, 0.01);
-  EXPECT_GT(expected_sum / field.pixelCount(), 15.0);  // hours of unit sun: three long summer days
-}
-
-TEST(Insolation, RefusesBadOptions) {
-  const HeightField flat = makeSyntheticField("flat", 5, 5);
-  InsolationOptions o;
-  o.from_utc = parseUtcTime("2026-06-21T00:00:00Z");
-  o.to_utc = o.from_utc;  // empty span
-  EXPECT_THROW(computeInsolation(testContext(), flat, o), InvalidArgument);
-  o.to_utc = o.from_utc + 3600.0;
-  o.step_minutes = 0.0;
-  EXPECT_THROW(computeInsolation(testContext(), flat, o), InvalidArgument);
-  o.step_minutes = 10.0;
-  o.azimuth_bucket_deg = 20.0;
-  EXPECT_THROW(computeInsolation(testContext(), flat, o), InvalidArgument);
-  o.azimuth_bucket_deg = 0.25;
-  o.latitude_deg = 91.0;
-  EXPECT_THROW(computeInsolation(testContext(), flat, o), InvalidArgument);
-}
-
 }  // namespace
+
 }  // namespace hfvis

@@ -1,4 +1,5 @@
-// shading_internal.hpp: what the sun's shading and insolation share.
+// unit_normals.hpp: every pixel's unit normal, for the operations that light the surface
+// (sun shading, insolation, the lighting benchmark).
 #pragma once
 
 #include <vector>
