@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "test_support.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -92,11 +94,7 @@ class BenchSmoke : public ::testing::Test {
  protected:
   void SetUp() override {
     if (!fs::exists(benchBinary())) GTEST_SKIP() << benchBinary() << " is not built (HFVIS_BUILD_BENCH=OFF?)";
-    // One directory per test: CTest runs the tests of this fixture in parallel processes.
-    dir_ = fs::path(HFVIS_TEST_TMP_DIR) /
-           (std::string("bench_smoke_") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = hfvis::testing::freshTestDirectory("bench_smoke");
   }
   fs::path dir_;
 };

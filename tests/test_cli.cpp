@@ -29,6 +29,7 @@
 #include "geotiff_support.hpp"
 #include "hfvis/horizon_lists.hpp"
 #include "hfvis/image_io.hpp"
+#include "test_support.hpp"
 
 namespace {
 
@@ -246,12 +247,7 @@ std::vector<std::string> splitText(const std::string& text, char separator) {
 class Cli : public ::testing::Test {
  protected:
   void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    // The process id keeps concurrent runs of the suite (ctest -j, two build trees' users)
-    // out of each other's directories.
-    root_ = fs::path(HFVIS_TEST_TMP_DIR) /
-            ("cli_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
-    fs::remove_all(root_);
+    root_ = hfvis::testing::freshTestDirectory("cli");
     fs::create_directories(inputs());
     fs::create_directories(outputs());
   }

@@ -32,6 +32,7 @@
 #include "hfvis/environment.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/image_io.hpp"
+#include "test_support.hpp"
 
 namespace hfvis {
 namespace {
@@ -41,10 +42,7 @@ namespace fs = std::filesystem;
 class ImageIoExrTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::path(HFVIS_TEST_TMP_DIR) / "exr_images" / info->name();
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = testing::freshTestDirectory("exr_images");
   }
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
   fs::path dir_;

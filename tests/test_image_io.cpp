@@ -23,6 +23,7 @@
 #include "hfvis/errors.hpp"
 #include "hfvis/environment.hpp"
 #include "hfvis/image_io.hpp"
+#include "test_support.hpp"
 
 namespace hfvis {
 namespace {
@@ -40,10 +41,7 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 class ImageIoTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::path(HFVIS_TEST_TMP_DIR) / "image_io" / info->name();
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = testing::freshTestDirectory("image_io");
   }
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
   std::vector<std::string> filesInDir() const {

@@ -21,6 +21,7 @@
 
 #include "hfvis/errors.hpp"
 #include "hfvis/image_io.hpp"
+#include "test_support.hpp"
 
 namespace hfvis {
 namespace {
@@ -30,11 +31,7 @@ namespace fs = std::filesystem;
 class OutputFilesTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::path(HFVIS_TEST_TMP_DIR) / "output_files" /
-           (std::string(info->name()) + "_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = testing::freshTestDirectory("output_files");
   }
   void TearDown() override {
     if (!HasFailure()) fs::remove_all(dir_);
@@ -195,7 +192,9 @@ TEST_F(OutputFilesTest, ASymbolicLinkIsWrittenThrough) {
             fs::perms::owner_read | fs::perms::owner_write);
   struct stat status {};
   ASSERT_EQ(::stat(path("data/real.exr").c_str(), &status), 0);
-  if (given_away) EXPECT_EQ(status.st_uid, 65534u);
+  if (given_away) {
+    EXPECT_EQ(status.st_uid, 65534u);
+  }
   EXPECT_EQ(filesInDir(), (std::vector<std::string>{"data", "link.exr"}));
   // A dangling link: the file it names is created.
   fs::create_symlink("data/new.exr", dir_ / "dangling.exr");

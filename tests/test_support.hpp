@@ -4,8 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <map>
 #include <random>
 #include <string>
@@ -16,6 +19,18 @@
 #include "hfvis/height_field.hpp"
 
 namespace hfvis::testing {
+
+// A fresh, empty directory for the running test: HFVIS_TEST_TMP_DIR/<area>/<test>_<pid>. One per
+// test and process, so CTest's parallel processes and two build trees' runs never share one, and
+// what a failed test leaves stays there to look at.
+inline std::filesystem::path freshTestDirectory(const std::string& area) {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  const std::filesystem::path dir = std::filesystem::path(HFVIS_TEST_TMP_DIR) / area /
+                                    (std::string(info->name()) + "_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
 
 // A context on the device every test runs on (HFVIS_DEVICE, else automatic: the HFVIS_*
 // variables as ContextOptions::fromEnvironment reads them), in `layout` (Automatic: the
