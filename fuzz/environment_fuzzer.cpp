@@ -2,31 +2,22 @@
 // input's first byte picks the file type (EXR, Radiance HDR, PNG, TIFF through GDAL), the rest is
 // the file. Reading must give a map that passes validate() or throw hfvis::Error: any other
 // exception, a crash or a sanitizer report is a bug.
-#include <unistd.h>
-
 #include <cstdint>
-#include <cstdio>
-#include <string>
 
+#include "fuzz_input_file.hpp"
 #include "hfvis/environment.hpp"
 #include "hfvis/errors.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;
   static const char* const kExtensions[] = {".exr", ".hdr", ".png", ".tif"};
-  const std::string path = "/tmp/hfvis_fuzz_env_" + std::to_string(::getpid()) + kExtensions[data[0] % 4];
-  if (std::FILE* f = std::fopen(path.c_str(), "wb")) {
-    std::fwrite(data + 1, 1, size - 1, f);
-    std::fclose(f);
-  } else {
-    return 0;
-  }
+  const FuzzInputFile file("env", data, size, kExtensions);
+  if (!file.written()) return 0;
   try {
-    const hfvis::EnvironmentMap map = hfvis::readEnvironmentMap(path);
+    const hfvis::EnvironmentMap map = hfvis::readEnvironmentMap(file.path());
     hfvis::validate(map);  // what the reader returns must pass the library's own checks
   } catch (const hfvis::Error&) {
     // a clear error: what bad files get
   }
-  std::remove(path.c_str());
   return 0;
 }
