@@ -17,7 +17,7 @@
 #include <thread>
 #include <vector>
 
-#include "hfvis/environment.hpp"
+#include "hfvis/environment_light.hpp"
 #include "hfvis/horizon.hpp"
 #include "core/unit_normals.hpp"
 #include "suite_support.hpp"

@@ -4,7 +4,7 @@
 #include <vector>
 
 #include "hfvis/device.hpp"
-#include "hfvis/environment.hpp"
+#include "hfvis/environment_light.hpp"
 #include "hfvis/height_field.hpp"
 
 namespace hfvis::bench {

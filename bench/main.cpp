@@ -54,7 +54,7 @@
 #include <vector>
 
 #include "ground_truth.hpp"
-#include "hfvis/environment.hpp"
+#include "hfvis/environment_light.hpp"
 #include "hfvis/horizon.hpp"
 #include "lighting.hpp"
 #include "hfvis/errors.hpp"

@@ -27,7 +27,7 @@
 
 #include "hfvis/bounce.hpp"
 #include "hfvis/device.hpp"
-#include "hfvis/environment.hpp"
+#include "hfvis/environment_light.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/height_field.hpp"
 #include "hfvis/horizon.hpp"

@@ -19,9 +19,7 @@
 // keeps the compiled kernels and the scratch buffers.
 std::vector<float> skyViewFactor(const hfvis::ComputeContext& context, const hfvis::HeightField& field) {
   hfvis::HorizonOptions options;  // 64 directions, 1 sample per pixel length, ...
-  hfvis::HorizonOutputs outputs;
-  outputs.sky_view_factor = true;  // only what is asked for is computed and stored
-  return hfvis::computeHorizons(context, field, options, outputs).sky_view_factor;
+  return hfvis::computeSkyViewFactor(context, field, options).values;
 }
 // [/readme]
 

@@ -20,7 +20,7 @@
 //   HFVIS_WANT_ANGLES, HFVIS_WANT_DISTANCES  write the direction's planes
 //   HFVIS_WANT_SVF, HFVIS_WANT_AO            accumulate sky-view / ambient occlusion terms
 //   HFVIS_WANT_ENV, HFVIS_ENV_CHANNELS       accumulate the irradiance from an environment's
-//                                            tables (environment.cl), of 1 or 3 channels
+//                                            tables (environment_light.cl), of 1 or 3 channels
 //   HFVIS_CURVATURE                          lower every sample by the Earth's drop (argument
 //                                            `drop`: c times the ground length of a unit of
 //                                            position along the line or ray, squared: a pixel,
@@ -36,7 +36,7 @@
 //   HFVIS_STRIPS                             horizon_lattice resumes lines part-way (a field in
 //                                            strips of rows, see there)
 #include "shared/direction_terms.cl"
-#include "environment.cl"
+#include "environment_light.cl"
 #include "shared/fast_math.cl"
 #include "shared/sweep_framework.cl"
 

@@ -7,8 +7,8 @@
 #include <limits>
 
 #include "core/direction_terms.hpp"
-#include "ops/environment_swaths.hpp"
-#include "ops/environment_terms.hpp"
+#include "ops/environment_light_swaths.hpp"
+#include "ops/environment_light_terms.hpp"
 #include "core/fast_math.hpp"
 #include "hfvis_testing/horizon_reference.hpp"
 #include "core/horizon_common.hpp"
@@ -62,7 +62,7 @@ std::vector<Slopes> pixelNormals(const HeightField& field, const std::vector<flo
   return normals;
 }
 
-// The environment's tables (environment_tables in kernels/environment.cl) computed here on
+// The environment's tables (environment_tables in kernels/environment_light.cl) computed here on
 // their own, in double: per direction, band and channel (KA, LA, KB, LB, KC, LC).
 std::vector<float> environmentTables(const EnvironmentMap& map, const std::vector<LatticeDirection>& directions) {
   const EnvironmentSwaths swaths = environmentSwaths(map, directions);

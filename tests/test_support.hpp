@@ -17,6 +17,7 @@
 
 #include "hfvis/device.hpp"
 #include "hfvis/height_field.hpp"
+#include "hfvis_testing/synthetic_fields.hpp"
 
 namespace hfvis::testing {
 
@@ -76,6 +77,35 @@ inline HeightField cropField(const HeightField& f, int x0, int y0, int w, int h)
 inline const std::vector<std::pair<int, int>>& awkwardSizes() {
   static const std::vector<std::pair<int, int>> sizes = {{1, 1}, {1, 9}, {9, 1}, {7, 13}, {33, 20}, {40, 41}};
   return sizes;
+}
+
+// Runs `body(name, field)` on every hard case (synthetic_fields.hpp) at every awkward size,
+// with cells 1.5 wide (so x and y differ), the case and size named in any failure.
+template <typename Body>
+void forEachHardCase(Body&& body) {
+  for (const auto& name : syntheticFieldNames()) {
+    for (auto [w, h] : awkwardSizes()) {
+      SCOPED_TRACE(name + " " + std::to_string(w) + "x" + std::to_string(h));
+      HeightField field = makeSyntheticField(name, w, h, 3);
+      field.cell_size_x = 1.5;
+      body(name, field);
+    }
+  }
+}
+
+// A street canyon: ground at 0 in the columns within half_width - 1 of the centre column
+// width / 2, walls of height `depth` on both sides out to the field's edges (flat roofs), so a
+// receiver on the centre column sees the walls' top edges half_width pixels away across the
+// street and nothing along it. Closed-form horizons in the axis and diagonal directions.
+inline HeightField streetCanyon(int width, int height, int half_width, float depth) {
+  HeightField field;
+  field.width = width;
+  field.height = height;
+  field.heights.assign(static_cast<std::size_t>(width) * height, 0.0f);
+  for (int row = 0; row < height; ++row)
+    for (int c = 0; c < width; ++c)
+      if (std::abs(c - width / 2) >= half_width) field.heights[static_cast<std::size_t>(row) * width + c] = depth;
+  return field;
 }
 
 // Element-wise comparison: NaN must match NaN, otherwise |a - b| <= tolerance. Reports the

@@ -5,8 +5,10 @@
 //   hfvis/device.hpp           listDevices(), ComputeContext
 //   hfvis/height_field.hpp     HeightField (heights, cell size, nodata)
 //   hfvis/sweep_options.hpp    directions, samples per unit, memory budget, progress
-//   hfvis/horizon.hpp          computeHorizons: horizon angles and distances, sky-view factor,
-//                              ambient occlusion
+//   hfvis/horizon.hpp          computeHorizons: horizon angles and distances (and any of the
+//                              outputs below that share the sweep, in one run)
+//   hfvis/sky_view_factor.hpp  computeSkyViewFactor: the share of the sky each point sees
+//   hfvis/ambient_occlusion.hpp computeAmbientOcclusion: the light of a uniform sky
 //   hfvis/horizon_lists.hpp    the visibility horizons of chosen receivers
 //   hfvis/intervisibility.hpp  computeIntervisibility: visible counts and areas (hull tree)
 //   hfvis/bounce.hpp           one diffuse bounce over the visible surface
@@ -20,6 +22,7 @@
 // library (testing/, hfvis_testing), which is not installed.
 #pragma once
 
+#include "hfvis/ambient_occlusion.hpp"
 #include "hfvis/bounce.hpp"
 #include "hfvis/device.hpp"
 #include "hfvis/errors.hpp"
@@ -29,6 +32,7 @@
 #include "hfvis/image_io.hpp"
 #include "hfvis/insolation.hpp"
 #include "hfvis/intervisibility.hpp"
+#include "hfvis/sky_view_factor.hpp"
 #include "hfvis/sun_shading.hpp"
 #include "hfvis/sun.hpp"
 #include "hfvis/sweep_options.hpp"

@@ -1,4 +1,7 @@
-// hfvis/horizon.hpp: horizon maps, sky-view factor and ambient occlusion.
+// hfvis/horizon.hpp: horizon maps (elevation angles and distances per direction), and in the
+// same sweep any of the outputs that integrate them over azimuth: the sky-view factor, ambient
+// occlusion (hfvis/sky_view_factor.hpp and hfvis/ambient_occlusion.hpp ask for one alone) and
+// an environment's irradiance.
 //
 // Directions follow hfvis/sweep_options.hpp. The horizon of receiver p in direction k
 // is the largest elevation angle atan2(h(q) - h(p), ground distance) over surface
@@ -8,7 +11,7 @@
 #include <vector>
 
 #include "hfvis/device.hpp"
-#include "hfvis/environment.hpp"
+#include "hfvis/environment_light.hpp"
 #include "hfvis/height_field.hpp"
 #include "hfvis/sweep_options.hpp"
 
@@ -48,7 +51,7 @@ struct HorizonOutputs {
   bool sky_view_factor = false;    // 1 - sum_k w_k sin(max(0, elevation_k)), w_k the directions' weights
   bool ambient_occlusion = false;  // Eq. 5 of Timonen & Westerholm 2010, uniform sky of
                                    // radiance 1, normalised so a flat plane gives 1
-  // The irradiance from this environment (hfvis/environment.hpp), one plane per channel; null:
+  // The irradiance from this environment (hfvis/environment_light.hpp), one plane per channel; null:
   // none. The map must outlive the call. Not on latitude / longitude grids (per-row spacing).
   const EnvironmentMap* environment = nullptr;
 };

@@ -1,46 +1,22 @@
-// direction_terms.cl: what one direction of the horizon operation contributes at a receiver
-// (its elevation, sky-view and ambient-occlusion terms), as a macro that defines them for a
-// scalar or lane-vector type. Written once in the common subset of OpenCL C and C++:
-// kernels/horizon.cl instantiates it for floats and lane vectors, src/core/direction_terms.hpp for
-// the C++ references' floats.
+// direction_terms.cl: what one direction of the horizon operation contributes at a receiver:
+// its elevation, and the sky-view (sky_view_factor.cl) and ambient-occlusion
+// (ambient_occlusion.cl) terms, as one macro that defines them for a scalar or lane-vector
+// type. Written once in the common subset of OpenCL C and C++: kernels/horizon.cl instantiates
+// it for floats and lane vectors, src/core/direction_terms.hpp for the C++ references' floats.
 #ifndef HFVIS_DIRECTION_TERMS_CL
 #define HFVIS_DIRECTION_TERMS_CL
 
+#include "ambient_occlusion.cl"
 #include "fast_math.cl"
+#include "sky_view_factor.cl"
 
 // What one direction contributes at a receiver whose horizon has slope rise / run (run > 0;
-// found 0 when no point casts one: elevation -pi/2), for scalars and lane vectors alike
-// (HFVIS_DIRECTION_TERMS below). The sky-view term sin(max(0, elevation)) is
-// rise / sqrt(rise^2 + run^2) for a rising horizon, so the angle itself is only computed
-// where an output needs it.
-//
-// ambient_term: uniform-sky irradiance of one azimuthal swath (Eq. 5 of Timonen &
-// Westerholm 2010) of width 2 pi * weight, normalised so that a flat plane sums to 1 over a
-// run's swaths, at a receiver of unit normal (nx, ny, nz); linear in the normal (a multiple
-// of it scales the term: x and `behind` are ratios). With elevation e and zenith
-// angle z = pi/2 - e, Eq. 5's sin^2 z = cos^2 e = 1 / (1 + x^2) and sin 2z / 2 = x cos^2 e for
-// x = tan e, so only e itself needs an arctangent. The sky behind the surface (N . e < 0)
-// does not count: the horizon is at least the tangent plane's slope -toward / nz in this
-// azimuth. swath = sin(pi weight) / pi, per direction.
-// lower_limit: the slope tan(e) of that lowest elevation that counts, the horizon's or the
-// tangent plane's, for the normal's component `toward` the direction and its nz.
-#define HFVIS_DIRECTION_TERMS(T, IT)                                                                      \
-  HFVIS_INLINE HFVIS_OVERLOADABLE T elevation_term(IT found, T rise, T run) {                  \
-    return found ? hf_atan(rise / run) : (T)(-0.5f * HFVIS_PI_F);                                         \
-  }                                                                                                       \
-  HFVIS_INLINE HFVIS_OVERLOADABLE T sky_term(IT found, T rise, T run) {                        \
-    return (found & (rise > 0.0f)) ? rise / sqrt(rise * rise + run * run) : (T)0.0f;                      \
-  }                                                                                                       \
-  HFVIS_INLINE HFVIS_OVERLOADABLE T lower_limit(IT found, T rise, T run, T toward, T nz) {     \
-    IT behind = !found | (rise * nz < -toward * run);                                                     \
-    return behind ? -toward / nz : rise / run;                                                            \
-  }                                                                                                       \
-  HFVIS_INLINE HFVIS_OVERLOADABLE T ambient_term(                                              \
-      IT found, T rise, T run, T nx, T ny, T nz, T cos_az, T sin_az, T weight, T swath) {                 \
-    T toward = nx * cos_az + ny * sin_az;                                                                 \
-    T x = lower_limit(found, rise, run, toward, nz);                                                      \
-    T cos2 = 1.0f / (1.0f + x * x);                                                                       \
-    return nz * weight * cos2 + swath * (0.5f * HFVIS_PI_F - hf_atan(x) - x * cos2) * toward;             \
-  }
+// found 0 when no point casts one: elevation -pi/2), for scalars and lane vectors alike.
+#define HFVIS_DIRECTION_TERMS(T, IT)                                                             \
+  HFVIS_INLINE HFVIS_OVERLOADABLE T elevation_term(IT found, T rise, T run) {                    \
+    return found ? hf_atan(rise / run) : (T)(-0.5f * HFVIS_PI_F);                                \
+  }                                                                                              \
+  HFVIS_SKY_VIEW_FACTOR_TERM(T, IT)                                                              \
+  HFVIS_AMBIENT_OCCLUSION_TERM(T, IT)
 
 #endif  // HFVIS_DIRECTION_TERMS_CL

@@ -1,5 +1,5 @@
-// environment.cl: irradiance from an HDR environment through the horizons (Timonen &
-// Westerholm 2010, Sec. 6.2; hfvis/environment.hpp has the derivation). Per direction k of a
+// environment_light.cl: irradiance from an HDR environment through the horizons (Timonen &
+// Westerholm 2010, Sec. 6.2; hfvis/environment_light.hpp has the derivation). Per direction k of a
 // run, a table of `rows` bands of zenith angle theta (band i from i pi / rows to
 // (i + 1) pi / rows), each holding per channel six floats (KA, LA, KB, LB, KC, LC): the swath's
 // integrals down to a zenith angle theta inside band i are
@@ -9,7 +9,7 @@
 // and its components toward the direction and across it (+90 degrees of azimuth).
 //
 // environment_add is written once in the common subset of OpenCL C and C++: kernels/horizon.cl
-// includes it, and so does src/ops/environment_terms.hpp for the scalar reference.
+// includes it, and so does src/ops/environment_light_terms.hpp for the scalar reference.
 #ifndef HFVIS_ENVIRONMENT_CL
 #define HFVIS_ENVIRONMENT_CL
 

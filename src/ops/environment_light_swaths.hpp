@@ -1,4 +1,4 @@
-// environment_swaths.hpp: what the environment's tables need from a run's directions (the
+// environment_light_swaths.hpp: what the environment's tables need from a run's directions (the
 // device path and the scalar reference share it): per direction, the swaths of azimuth it
 // integrates, relative to its own azimuth, and where they fall among the map's columns.
 #pragma once
@@ -6,15 +6,15 @@
 #include <array>
 #include <vector>
 
-#include "hfvis/environment.hpp"
+#include "hfvis/environment_light.hpp"
 #include "core/lattice_geometry.hpp"
 
 namespace hfvis::detail {
 
-// Floats per band and channel of a table (HFVIS_ENV_TERMS in kernels/environment.cl).
+// Floats per band and channel of a table (HFVIS_ENV_TERMS in kernels/environment_light.cl).
 constexpr int kEnvTerms = 6;
 
-// As environment_tables in kernels/environment.cl takes them: bins (lo, hi, edge, column) as
+// As environment_tables in kernels/environment_light.cl takes them: bins (lo, hi, edge, column) as
 // float4, spans (first bin, bins) as int2 per direction.
 struct EnvironmentSwaths {
   std::vector<std::array<float, 4>> bins;

@@ -1,4 +1,4 @@
-// hfvis/environment.hpp: distant HDR light environments, and the irradiance they give a
+// hfvis/environment_light.hpp: distant HDR light environments, and the irradiance they give a
 // height field through its horizons (Timonen & Westerholm 2010, Sec. 6.2).
 //
 // An environment is an equirectangular (latitude / longitude) image: row 0 at the zenith, the

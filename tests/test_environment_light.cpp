@@ -1,4 +1,4 @@
-// test_environment.cpp: irradiance from HDR environments through the horizons (Timonen &
+// test_environment_light.cpp: irradiance from HDR environments through the horizons (Timonen &
 // Westerholm 2010, Sec. 6.2): the kernels against the scalar reference (whose tables are built
 // on their own, in double) on the hard cases in both layouts; a uniform environment against
 // pi times the ambient occlusion; flat and tilted planes against a quadrature of the map done
@@ -11,7 +11,7 @@
 #include <random>
 #include <vector>
 
-#include "hfvis/environment.hpp"
+#include "hfvis/environment_light.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
 #include "hfvis_testing/horizon_reference.hpp"

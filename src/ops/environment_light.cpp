@@ -1,12 +1,12 @@
-// environment.cpp: environment maps (hfvis/environment.hpp): checks, reading, and the swaths of
-// azimuth that each direction of a run integrates (environment_swaths.hpp).
-#include "hfvis/environment.hpp"
+// environment_light.cpp: environment maps (hfvis/environment_light.hpp): checks, reading, and the swaths of
+// azimuth that each direction of a run integrates (environment_light_swaths.hpp).
+#include "hfvis/environment_light.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 
-#include "ops/environment_swaths.hpp"
+#include "ops/environment_light_swaths.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/image_io.hpp"
 #include "core/lattice_geometry.hpp"
