@@ -5,7 +5,7 @@
 #include <cstdint>
 
 #include "fuzz_input_file.hpp"
-#include "hfvis/environment_light.hpp"
+#include "hfvis/environment_map.hpp"
 #include "hfvis/errors.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

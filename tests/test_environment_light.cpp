@@ -14,6 +14,7 @@
 #include "hfvis/environment_light.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
+#include "hfvis_testing/environment_light_reference.hpp"
 #include "hfvis_testing/horizon_reference.hpp"
 #include "hfvis/insolation.hpp"
 #include "hfvis/sun_shading.hpp"
@@ -99,15 +100,16 @@ TEST(Environment, KernelsMatchTheReference) {
   map.rotation_deg = 33.0;
   for (int rows : {0, 11}) {
     map.table_rows = rows;
-    for (const char* name : {"sine", "cliff", "spikes", "terraces", "nan_holes", "bowl", "noise"}) {
+    for (const char* name : {"sine", "cliff", "spikes", "terraces", "nan_holes", "bowl", "noise", "city"}) {
       const HeightField field = makeSyntheticField(name, 29, 23);
       for (HorizonMethod method : {HorizonMethod::Sweep, HorizonMethod::Naive}) {
         HorizonOptions options;
         options.directions = 12;
         options.method = method;
-        const HorizonResult expected = referenceHorizons(field, options, environmentOutputs(map));
+        const EnvironmentLightResult expected = referenceEnvironmentLight(field, map, options);
         forEachLayout([&](const ComputeContext& context) {
-          const HorizonResult got = computeHorizons(context, field, options, environmentOutputs(map));
+          const EnvironmentLightResult got = computeEnvironmentLight(context, field, map, options);
+          EXPECT_EQ(got.names, map.names);
           ASSERT_EQ(got.irradiance.size(), expected.irradiance.size());
           int nan = 0;
           for (std::size_t i = 0; i < got.irradiance.size(); ++i) {

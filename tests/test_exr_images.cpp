@@ -29,7 +29,7 @@
 #include <string>
 #include <vector>
 
-#include "hfvis/environment_light.hpp"
+#include "hfvis/environment_map.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/image_io.hpp"
 #include "test_support.hpp"

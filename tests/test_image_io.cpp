@@ -21,7 +21,7 @@
 #include "io/gdal_io.hpp"
 #include "geotiff_support.hpp"
 #include "hfvis/errors.hpp"
-#include "hfvis/environment_light.hpp"
+#include "hfvis/environment_map.hpp"
 #include "hfvis/image_io.hpp"
 #include "test_support.hpp"
 

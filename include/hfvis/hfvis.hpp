@@ -12,6 +12,8 @@
 //   hfvis/horizon_lists.hpp    the visibility horizons of chosen receivers
 //   hfvis/intervisibility.hpp  computeIntervisibility: visible counts and areas (hull tree)
 //   hfvis/bounce.hpp           one diffuse bounce over the visible surface
+//   hfvis/environment_map.hpp  EnvironmentMap: an HDR sky as an equirectangular image
+//   hfvis/environment_light.hpp computeEnvironmentLight: the irradiance from an HDR sky
 //   hfvis/sun_shading.hpp      computeSunShading: the sun's light with cast shadows
 //   hfvis/insolation.hpp       computeInsolation: sunshine hours and irradiation over a span of time
 //   hfvis/sun.hpp              where the sun stands at a time and place
@@ -25,6 +27,8 @@
 #include "hfvis/ambient_occlusion.hpp"
 #include "hfvis/bounce.hpp"
 #include "hfvis/device.hpp"
+#include "hfvis/environment_light.hpp"
+#include "hfvis/environment_map.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/height_field.hpp"
 #include "hfvis/horizon.hpp"

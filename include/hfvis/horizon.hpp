@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "hfvis/device.hpp"
-#include "hfvis/environment_light.hpp"
+#include "hfvis/environment_map.hpp"
 #include "hfvis/height_field.hpp"
 #include "hfvis/sweep_options.hpp"
 

@@ -6,7 +6,7 @@
 #include <array>
 #include <vector>
 
-#include "hfvis/environment_light.hpp"
+#include "hfvis/environment_map.hpp"
 #include "core/lattice_geometry.hpp"
 
 namespace hfvis::detail {

@@ -14,6 +14,7 @@
 #include "core/opencl_context.hpp"
 #include "core/unit_normals.hpp"
 #include "core/sweep_framework.hpp"
+#include "ops/insolation_steps.hpp"
 
 namespace hfvis {
 namespace {
@@ -40,27 +41,13 @@ void validate(const InsolationOptions& o) {
   sunPosition(o.to_utc, o.latitude_deg, o.longitude_deg);
 }
 
-namespace {
+namespace detail {
 
-// One step with the sun up: its direction (x, y, z, elevation in radians) and hours.
-struct SunStep {
-  cl_float4 sun;
-  float hours;
-};
+double sunDiscRadius(const InsolationOptions& options) { return std::max(0.5 * options.size_deg * kDegree, 1e-12); }
 
-}  // namespace
-
-InsolationResult computeInsolation(const ComputeContext& context, const HeightField& field,
-                                   const InsolationOptions& options, const SweepOptions& sweep) {
-  validate(field);
-  validate(options);
-  validate(sweep);
-  // A point sun (size 0) as a disc far below a float's resolution of the elevations, so that
-  // the kernel's disc_above never divides by 0.
-  const double radius = std::max(0.5 * options.size_deg * kDegree, 1e-12);
-  // The steps with some of the disc above elevation 0, by azimuth bucket.
+std::map<long, std::vector<SunStep>> sunStepsByBucket(const InsolationOptions& options) {
+  const double radius = sunDiscRadius(options);
   std::map<long, std::vector<SunStep>> buckets;
-  InsolationResult out;
   const double step = 60.0 * options.step_minutes;
   for (double t0 = options.from_utc; t0 < options.to_utc; t0 += step) {
     const double t1 = std::min(options.to_utc, t0 + step);
@@ -68,11 +55,34 @@ InsolationResult computeInsolation(const ComputeContext& context, const HeightFi
     if (p.elevation_deg * kDegree <= -radius) continue;
     const glm::dvec3 s = sunDirection(p);
     const long bucket = std::lround(p.azimuth_deg / options.azimuth_bucket_deg);
-    buckets[bucket].push_back({cl_float4{{static_cast<float>(s.x), static_cast<float>(s.y), static_cast<float>(s.z),
-                                          static_cast<float>(p.elevation_deg * kDegree)}},
-                               static_cast<float>((t1 - t0) / 3600.0)});
-    ++out.steps;
+    buckets[bucket].push_back({static_cast<float>(s.x), static_cast<float>(s.y), static_cast<float>(s.z),
+                               static_cast<float>(p.elevation_deg * kDegree), static_cast<float>((t1 - t0) / 3600.0)});
   }
+  return buckets;
+}
+
+HorizonOptions bucketSweep(long bucket, const InsolationOptions& options, const SweepOptions& sweep) {
+  HorizonOptions horizon;
+  static_cast<SweepOptions&>(horizon) = sweep;
+  horizon.progress = nullptr;
+  horizon.directions = 1;
+  horizon.azimuth_offset = std::remainder((bucket * options.azimuth_bucket_deg - 90.0) * kDegree, 2.0 * M_PI);
+  // A step within half a bucket of its centre: every step of the bucket within a bucket of it.
+  horizon.azimuth_tolerance = std::min(0.1, 0.5 * options.azimuth_bucket_deg * kDegree);
+  return horizon;
+}
+
+}  // namespace detail
+
+InsolationResult computeInsolation(const ComputeContext& context, const HeightField& field,
+                                   const InsolationOptions& options, const SweepOptions& sweep) {
+  validate(field);
+  validate(options);
+  validate(sweep);
+  const double radius = detail::sunDiscRadius(options);
+  const std::map<long, std::vector<detail::SunStep>> buckets = detail::sunStepsByBucket(options);
+  InsolationResult out;
+  for (const auto& bucket : buckets) out.steps += static_cast<int>(bucket.second.size());
   out.width = field.width;
   out.height = field.height;
   const std::size_t pixels = field.pixelCount();
@@ -91,21 +101,13 @@ InsolationResult computeInsolation(const ComputeContext& context, const HeightFi
     cl::Buffer horizon = detail::deviceBuffer(st, pixels * sizeof(float));
     int done = 0;
     for (const auto& [bucket, steps] : buckets) {
-      HorizonOptions horizon_options;
-      static_cast<SweepOptions&>(horizon_options) = sweep;
-      horizon_options.progress = nullptr;
-      horizon_options.directions = 1;
-      horizon_options.azimuth_offset =
-          std::remainder((bucket * options.azimuth_bucket_deg - 90.0) * kDegree, 2.0 * M_PI);
-      // A step within half a bucket of its centre: every step of the bucket within a bucket of it.
-      horizon_options.azimuth_tolerance = std::min(0.1, 0.5 * options.azimuth_bucket_deg * kDegree);
       HorizonOutputs outputs;
       outputs.horizon_angles = true;
-      const HorizonResult h = computeHorizons(context, field, horizon_options, outputs);
+      const HorizonResult h = computeHorizons(context, field, detail::bucketSweep(bucket, options, sweep), outputs);
       st.queue.enqueueWriteBuffer(horizon, CL_FALSE, 0, pixels * sizeof(float), h.angles.data());
       std::vector<cl_float4> suns;
       std::vector<float> hours;
-      for (const SunStep& s : steps) suns.push_back(s.sun), hours.push_back(s.hours);
+      for (const detail::SunStep& s : steps) suns.push_back(cl_float4{{s.x, s.y, s.z, s.elevation}}), hours.push_back(s.hours);
       const cl::Buffer sun_buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, suns.size() * sizeof(cl_float4),
                                   suns.data());
       const cl::Buffer hour_buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, hours.size() * sizeof(float),
