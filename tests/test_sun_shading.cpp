@@ -1,14 +1,16 @@
 // test_sun_shading.cpp: the sun's light on a height field: the disc's visible part, a flat plane
 // (every point sees the whole sun; direct = sin(elevation)), a wall's shadow with its soft
-// edge (the disc partly above the wall's top), the swept azimuth, and bad suns.
+// edge (the disc partly above the wall's top), the swept azimuth, bad suns, and the device
+// against the scalar reference on every hard case in both layouts.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <vector>
 
 #include "hfvis/errors.hpp"
-#include "hfvis_testing/horizon_reference.hpp"
 #include "hfvis/sun_shading.hpp"
+#include "hfvis_testing/horizon_reference.hpp"
+#include "hfvis_testing/sun_shading_reference.hpp"
 #include "hfvis_testing/synthetic_fields.hpp"
 #include "core/lattice_geometry.hpp"
 #include "test_support.hpp"
@@ -171,6 +173,25 @@ TEST(SunShading, SweptStepIsCloseToTheSun) {
               worst, 100.0 * long_steps / n, longest);
   EXPECT_LE(worst, 0.02);
   EXPECT_LT(long_steps, n / 4);
+}
+
+// The device against the scalar reference (the horizon reference, then the same per-pixel
+// step): equal where the device divides correctly rounded; elsewhere the horizons' few-ulp
+// differences, times the disc's steepest rate of change (about 140 per radian for the 0.53
+// degree sun).
+TEST(SunShading, MatchesTheScalarReferenceOnEveryHardCase) {
+  SunLight sun;
+  sun.position = {123.4, 15.0};
+  const float tolerance = 200.0f * testing::divisionTolerance();
+  testing::forEachLayout([&](const ComputeContext& context) {
+    testing::forEachHardCase([&](const std::string&, const HeightField& field) {
+      const SunShadingResult got = computeSunShading(context, field, sun);
+      const SunShadingResult expected = referenceSunShading(field, sun);
+      EXPECT_EQ(got.azimuth, expected.azimuth);
+      EXPECT_TRUE(testing::nearlyEqual(got.sun, expected.sun, tolerance));
+      EXPECT_TRUE(testing::nearlyEqual(got.direct, expected.direct, tolerance));
+    });
+  });
 }
 
 // A long step (the sun 0.3 degree from an axis: a step of over 64 pixels) runs through the same kernel: its
