@@ -7,7 +7,7 @@
 #include <limits>
 
 #include "core/direction_terms.hpp"
-#include "ops/environment_light_swaths.hpp"
+#include "core/environment_swaths.hpp"
 #include "ops/environment_light_terms.hpp"
 #include "core/fast_math.hpp"
 #include "hfvis_testing/horizon_reference.hpp"

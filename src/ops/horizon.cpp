@@ -9,7 +9,7 @@
 #include <limits>
 #include <sstream>
 
-#include "ops/environment_light_swaths.hpp"
+#include "core/environment_swaths.hpp"
 #include "core/fast_math.hpp"
 #include "hfvis/errors.hpp"
 #include "core/horizon_common.hpp"

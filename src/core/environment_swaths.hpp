@@ -1,6 +1,7 @@
-// environment_light_swaths.hpp: what the environment's tables need from a run's directions (the
-// device path and the scalar reference share it): per direction, the swaths of azimuth it
-// integrates, relative to its own azimuth, and where they fall among the map's columns.
+// environment_swaths.hpp: what an environment's tables need from a run's directions (the horizon
+// routine, which computes environment light in its sweep, and the scalar reference share it):
+// per direction, the swaths of azimuth it integrates, relative to its own azimuth, and where
+// they fall among the map's columns.
 #pragma once
 
 #include <array>
