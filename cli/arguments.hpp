@@ -33,17 +33,14 @@ enum class Command {
   Horizon,
   SkyViewFactor,
   AmbientOcclusion,
-  ViewCount,     // visible samples and ground area per pixel (intervisibility)
-  HorizonLists,  // "horizons": visibility horizons of chosen receivers, JSON or CSV
+  Intervisibility,  // visible samples and ground area per pixel (was "viewcount")
+  HorizonLists,  // (was "horizons"): visibility horizons of chosen receivers, JSON or CSV
   Bounce,        // one diffuse bounce of a given exit radiance
-  SunPosition,   // "sunpos": the sun's azimuth and elevation at a time and place
+  SunPosition,   // (was "sunpos"): the sun's azimuth and elevation at a time and place
   Shade,         // the surface lit by an environment and / or the sun
   Insolation,    // sunshine hours and direct irradiation over a span of time
   Viewshed,      // what one observer sees, or how many of several see each point
 };
-
-// The subcommand's name as typed ("horizon", "svf", ...).
-const char* commandName(Command command);
 
 // Everything a compute command's run needs, already validated.
 struct RunArguments {
@@ -114,6 +111,8 @@ struct SunArguments {
 
 struct CommandLine {
   Command command = Command::Help;
+  // The command's name as typed (its canonical name or its alias), for messages.
+  std::string name;
   // For Command::Help: the subcommand whose help was asked for, if any.
   std::optional<Command> help_topic;
   RunArguments run;
