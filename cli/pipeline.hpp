@@ -18,6 +18,7 @@
 #include "hfvis/height_field.hpp"
 #include "hfvis/image_io.hpp"
 #include "hfvis/viewshed.hpp"
+#include "image_outputs.hpp"
 #include "table.hpp"
 
 namespace hfvis::cli {
@@ -96,9 +97,10 @@ using Attributes = std::vector<std::pair<std::string, std::string>>;
 
 // The summary line: "wrote FILES (WxH, COUNT UNITs, METHOD, T s on DEVICE)NOTE".
 struct Summary {
-  int count = 0;
-  std::string unit = "direction";
-  std::string note;
+  Summary(int count, std::string note = "", std::string unit = "direction")
+      : count(count), note(std::move(note)), unit(std::move(unit)) {}
+  int count;
+  std::string note, unit;
   std::string always;  // a line printed after it, even with --quiet ("" = none)
 };
 

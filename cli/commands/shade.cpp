@@ -65,7 +65,8 @@ class Shade : public Computation {
   Summary write(Job& job, OutputFiles& outputs) override {
     const HeightField& field = lit_.field();
     const std::size_t pixels = field.pixelCount();
-    LitOutput lit{job.attributes(field)};
+    LitOutput lit;
+    lit.attributes = job.attributes(field);
     if (environment_.given()) environment_.describe(lit, pixels);
     if (sun_.given()) sun_.describe(lit);
     // --albedo: the radiance a Lambertian surface of that albedo sends out, albedo / pi times the
@@ -111,8 +112,7 @@ class Shade : public Computation {
                            std::max(1e-6f, quantileRange(sun_.direct(), 0.0, 1.0).second));
       }
     }
-    return {environment_.given() ? run_.directions : 1, "direction",
-            lit.note + (lit_.flipped() ? " (lit north-up)" : "")};
+    return {environment_.given() ? run_.directions : 1, lit.note + (lit_.flipped() ? " (lit north-up)" : "")};
   }
 
  private:

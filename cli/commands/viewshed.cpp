@@ -175,7 +175,7 @@ class Viewshed : public Computation {
                 : 0.3f * shade[p] + (seen[p] > 0.0f ? 0.35f + 0.35f * seen[p] / std::max(most, 1.0f) : 0.0f);
       outputs.previewPng(run_.preview, input.width, input.height, picture, 0.0f, 1.0f);
     }
-    return {static_cast<int>(observers_.size()), "observer", note_ + (lit_.flipped() ? " (computed north-up)" : "")};
+    return {static_cast<int>(observers_.size()), note_ + (lit_.flipped() ? " (computed north-up)" : ""), "observer"};
   }
 
  private:
