@@ -37,7 +37,11 @@ void setSweepOptions(const RunArguments& run, Options& options) {
 
 bool isHelpFlag(const std::string& arg) { return arg == "-h" || arg == "--help"; }
 
+}  // namespace
+
 std::string inQuotes(const std::string& text) { return "'" + text + "'"; }
+
+namespace {
 
 // A value as a message shows it: at most 40 characters of what was typed.
 std::string shortened(const std::string& text) {
@@ -155,11 +159,15 @@ ReceiverPixel parseReceiver(const std::string& option, const std::string& text) 
   return pixel;
 }
 
+}  // namespace
+
 bool hasExtension(const std::string& path, const char* wanted) {
   std::string extension = std::filesystem::path(path).extension().string();
   for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return extension == wanted;
 }
+
+namespace {
 
 // "X" or "X,Y", ground units per pixel along columns and rows.
 void parseCellSize(const std::string& option, const std::string& text, RunArguments& run) {
@@ -524,98 +532,20 @@ const std::vector<OptionSpec>& optionTable() {
 #undef HFVIS_FLAG
 #undef HFVIS_TEXT
 
-namespace {
-
-
 bool samePath(const std::string& a, const std::string& b) {
   return std::filesystem::path(a).lexically_normal() == std::filesystem::path(b).lexically_normal();
 }
 
-// Checks that involve more than one option, and the library's own argument checks.
-void validateRun(Command command, const std::string& name, const RunArguments& run) {
-  const std::string out = command == Command::HorizonLists ? "OUT.json|OUT.csv" : "OUT.exr";
+namespace {
+
+// Checks that involve more than one option: every command's, and its own (CommandSpec::check).
+void validateRun(const CommandSpec& command, const std::string& name, const RunArguments& run) {
+  const std::string out = command.id == Command::HorizonLists ? "OUT.json|OUT.csv" : "OUT.exr";
   if (run.input.empty())
     throw UsageError("missing the input height field (hfvis " + name + " IN -o " + out + ")");
   if (run.output.empty())
     throw UsageError("missing -o " + out + " (the output file of 'hfvis " + name + "')");
-  if (command == Command::HorizonLists) {
-    if (!hasExtension(run.output, ".json") && !hasExtension(run.output, ".csv")) {
-      throw UsageError(
-          "-o: the horizon lists are written as JSON or CSV; the name must end in .json or .csv, got " +
-          inQuotes(run.output));
-    }
-    if (run.receivers.empty())
-      throw UsageError("missing --at COL,ROW (the receivers whose horizons to list)");
-  }
-  if (command == Command::Shade) {
-    const bool placed = run.sun_time || run.latitude || run.longitude;
-    if (run.sun && placed)
-      throw UsageError("--sun AZ,EL or --at TIME --lat LAT --lon LON: give the sun one way, not both");
-    const bool sun = run.sun || (run.sun_time && run.latitude && run.longitude);
-    if (!sun && (placed || run.environment.empty()))
-      throw UsageError(
-          "missing the light: --env ENV.exr and / or the sun, --sun AZ,EL (compass azimuth, elevation) or --at TIME "
-          "--lat LAT --lon LON");
-    if (run.environment.empty() && run.sweep_options_given)
-      throw UsageError("-k, --method and --azimuth-offset need --env (the sun alone sweeps its own azimuth)");
-    if (run.environment.empty() && (run.environment_rotation_deg != 0.0 || run.environment_rows != 0))
-      throw UsageError("--env-rotate and --env-rows need --env ENV.exr");
-    if (!sun && run.sun_irradiance != 1.0) throw UsageError("--sun-irradiance needs the sun");
-    if (run.albedo.empty() && run.sun_irradiance != 1.0)
-      throw UsageError(
-          "--sun-irradiance needs --albedo (it scales the sun's light in the radiance; 'direct' is "
-          "for a normal irradiance of 1)");
-    if (!sun && run.sun_size_deg != 0.53) throw UsageError("--sun-size needs the sun");
-    if (!run.environment.empty() && samePath(run.output, run.environment))
-      throw UsageError("--env must differ from -o, both are " + inQuotes(run.output));
-    if (!run.albedo.empty() && samePath(run.output, run.albedo))
-      throw UsageError("--albedo must differ from -o, both are " + inQuotes(run.output));
-    if (run.sun_time) {
-      try {  // the solar position's range of years
-        sunPosition(*run.sun_time, *run.latitude, *run.longitude);
-      } catch (const InvalidArgument& error) {
-        throw UsageError(std::string("--at: ") + error.what());
-      }
-    }
-  }
-  if (command == Command::Insolation) {
-    if (!run.latitude || !run.longitude || !run.from_time || !run.to_time)
-      throw UsageError("missing the place or the span: --lat LAT --lon LON --from TIME --to TIME");
-    if (!(*run.from_time < *run.to_time)) throw UsageError("--from must come before --to");
-    try {
-      validate(insolationOptions(run));
-    } catch (const InvalidArgument& error) {
-      throw UsageError(error.what());
-    }
-  }
-  if (command == Command::Viewshed) {
-    if (!run.absolute && run.observer_height < 0.0)
-      throw UsageError("--observer-height: an eye below the surface sees nothing; give a height >= 0 (or --absolute)");
-    if (run.observers.empty() && run.observers_file.empty())
-      throw UsageError("missing --observer COL,ROW or --observers FILE.csv (who looks)");
-    if ((run.with_angle || run.with_needed_height) && (run.observers.size() > 1 || !run.observers_file.empty()))
-      throw UsageError(std::string(run.with_angle ? "--angle" : "--needed-height") +
-                       " is for one observer (several give a count)");
-    if (run.cull_level_given && !run.culled) throw UsageError("--cull-level is for --method culled");
-    if (!run.observers_file.empty() && samePath(run.output, run.observers_file))
-      throw UsageError("--observers must differ from -o, both are " + inQuotes(run.output));
-    try {
-      validate(viewshedOptions(run));
-    } catch (const InvalidArgument& error) {
-      throw UsageError(error.what());
-    }
-  }
-  if (command == Command::Bounce) {
-    if (run.radiance.empty()) {
-      throw UsageError("missing --radiance RAD.exr (the exit radiance to bounce, same size as the input)");
-    }
-    if (samePath(run.output, run.radiance)) {
-      throw UsageError("--radiance must differ from -o, both are " + inQuotes(run.output));
-    }
-    if (!run.preview.empty() && samePath(run.preview, run.radiance)) {
-      throw UsageError("--preview must differ from --radiance, both are " + inQuotes(run.preview));
-    }
-  }
+  if (command.check) command.check(name, run);
   if (!run.distance_output.empty() && samePath(run.output, run.distance_output)) {
     throw UsageError("--distance-out must differ from -o, both are " + inQuotes(run.output));
   }
@@ -635,48 +565,12 @@ void validateRun(Command command, const std::string& name, const RunArguments& r
   // A nodata value the outputs can hold as data would make those cells nodata for every reader
   // (a viewshed's hidden 0 or visible 1): it must lie below every value the command writes.
   if (run.nodata && !std::isnan(*run.nodata)) {
-    const double lowest = command == Command::Horizon                      ? -kPi / 2.0
-                          : command == Command::Viewshed && run.with_angle ? -90.0
-                                                                           : 0.0;
+    const double lowest = command.lowest_value ? command.lowest_value(run) : 0.0;
     if (*run.nodata >= lowest)
       throw UsageError("--nodata " + detail::shortNumber(*run.nodata) + ": 'hfvis " + name +
                        "' writes data values from " + detail::shortNumber(lowest) +
                        " up, so a reader could not tell those cells from nodata; give a value below " +
                        detail::shortNumber(lowest) + " (such as -9999) or nan");
-  }
-  if (command == Command::Intervisibility && !run.hull_tree_name.empty() &&
-      run.visibility_method != IntervisibilityMethod::HullTree) {
-    throw UsageError("--hull-tree needs --method tree (the naive method builds no tree)");
-  }
-  try {
-    switch (command) {
-      case Command::Intervisibility:
-        validate(intervisibilityOptions(run), intervisibilityOutputs(run));
-        break;
-      case Command::HorizonLists:
-        validate(horizonListOptions(run));
-        break;
-      case Command::Bounce:
-        validate(bounceOptions(run));
-        break;
-      case Command::Shade:
-      case Command::Insolation:
-        validate(static_cast<const SweepOptions&>(horizonOptions(run)));
-        break;
-      case Command::Viewshed:
-        break;  // above
-      default:
-        validate(horizonOptions(run), horizonOutputs(command, run));
-        break;
-    }
-  } catch (const InvalidArgument& error) {
-    // "statistics ... only for the hull-tree method" reads better in the CLI's words.
-    if (command == Command::Intervisibility && run.statistics &&
-        run.visibility_method != IntervisibilityMethod::HullTree) {
-      throw UsageError(
-          "--stats needs --method tree (the naive method has no horizons or iterations to count)");
-    }
-    throw UsageError(error.what());
   }
 }
 
@@ -765,7 +659,7 @@ RunArguments parseRunArguments(const CommandSpec& command, const std::string& na
                      "' reads one input file)");
   }
   if (!positional.empty()) run.input = positional[0];
-  validateRun(command.id, name, run);
+  validateRun(command, name, run);
   return run;
 }
 

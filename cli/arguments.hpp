@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "hfvis/bounce.hpp"
+#include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
 #include "hfvis/horizon_lists.hpp"
 #include "hfvis/image_io.hpp"
@@ -118,6 +119,23 @@ struct CommandLine {
   RunArguments run;
   SunArguments sun;  // Command::SunPosition
 };
+
+// For the commands' own checks (CommandSpec::check, cli/commands/):
+// 'text', as the messages quote what was typed.
+std::string inQuotes(const std::string& text);
+// The same path once written plainly ("a/../b" is "b"; links are not followed).
+bool samePath(const std::string& a, const std::string& b);
+// `path` ends in `wanted` (".json"), in any case.
+bool hasExtension(const std::string& path, const char* wanted);
+// Runs the library's own checks of options (`check`), their InvalidArgument a UsageError.
+template <typename Check>
+void asUsageError(Check&& check) {
+  try {
+    check();
+  } catch (const InvalidArgument& error) {
+    throw UsageError(error.what());
+  }
+}
 
 // Parses argv (without argv[0]). Throws UsageError naming the offending argument.
 CommandLine parseCommandLine(const std::vector<std::string>& args);

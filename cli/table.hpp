@@ -39,6 +39,8 @@ enum OptionGroup : unsigned {
 
 // The groups every command that reads a height field and writes images takes.
 constexpr unsigned kImageCommandGroups = kOutputGroup | kInputGroup | kImageGroup | kDeviceGroup;
+// And those of the commands that sweep directions over the whole field.
+constexpr unsigned kSweptFieldGroups = kImageCommandGroups | kSweepGroup | kSamplingGroup | kEarthGroup | kReachGroup;
 
 // One option: parsed, checked and described from here alone.
 struct OptionSpec {
@@ -65,6 +67,11 @@ struct CommandSpec {
   const char* description;  // its help: what it writes, in which units
   const char* notes;        // its method and conventions, in its help and the overview; or nullptr
   unsigned groups;          // the OptionGroups it takes
+  // Its checks across its options and the library's of its options, after parsing; throws
+  // UsageError, naming the command as typed (`name`). nullptr: only the shared ones.
+  void (*check)(const std::string& name, const RunArguments& run);
+  // The lowest value its outputs hold, which a --nodata value must lie below; nullptr: 0.
+  double (*lowest_value)(const RunArguments& run);
   int (*run)(const CommandLine& line);
   // The name its outputs record in hfvis:command: the name they have always recorded (the alias
   // where there is one), so that readers of earlier outputs see the same value.

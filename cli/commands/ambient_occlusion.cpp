@@ -19,6 +19,10 @@ class AmbientOcclusion : public HorizonQuantityComputation {
   explicit AmbientOcclusion(const RunArguments& run) : HorizonQuantityComputation(run, kAmbientOcclusion) {}
 };
 
+void checkAmbientOcclusion(const std::string&, const RunArguments& run) {
+  asUsageError([&] { validate(horizonOptions(run), horizonOutputs(Command::AmbientOcclusion, run)); });
+}
+
 }  // namespace
 
 const CommandSpec kAmbientOcclusionCommand{
@@ -32,7 +36,9 @@ const CommandSpec kAmbientOcclusionCommand{
     "The preview (--preview) stretches its 1st to 99th percentile over black..white (the\n"
     "summary line prints both ends); NaN (nodata) is black.\n",
     nullptr,
-    kImageCommandGroups | kSweepGroup | kSamplingGroup | kEarthGroup | kReachGroup | kSweepMethodGroup,
+    kSweptFieldGroups | kSweepMethodGroup,
+    checkAmbientOcclusion,
+    nullptr,
     pipelined<AmbientOcclusion>,
 };
 

@@ -99,6 +99,16 @@ class Bounce : public Computation {
   BounceResult result_;
 };
 
+void checkBounce(const std::string&, const RunArguments& run) {
+  if (run.radiance.empty())
+    throw UsageError("missing --radiance RAD.exr (the exit radiance to bounce, same size as the input)");
+  if (samePath(run.output, run.radiance))
+    throw UsageError("--radiance must differ from -o, both are " + inQuotes(run.output));
+  if (!run.preview.empty() && samePath(run.preview, run.radiance))
+    throw UsageError("--preview must differ from --radiance, both are " + inQuotes(run.preview));
+  asUsageError([&] { validate(bounceOptions(run)); });
+}
+
 }  // namespace
 
 const CommandSpec kBounceCommand{
@@ -120,6 +130,8 @@ const CommandSpec kBounceCommand{
     "radiance. A flat plane receives 0. The preview stretches the mean over the channels from\n"
     "its minimum to its maximum.\n",
     kImageCommandGroups | kSweepGroup | kSamplingGroup | kHullTreeGroup | kBounceGroup,
+    checkBounce,
+    nullptr,
     pipelined<Bounce>,
 };
 

@@ -76,6 +76,8 @@ const CommandSpec kDevicesCommand{
     "index, a type (gpu, cpu) or part of the name with --device or HFVIS_DEVICE.\n",
     nullptr,
     0,  // no arguments
+    nullptr,
+    nullptr,
     runDevices,
 };
 

@@ -86,23 +86,22 @@ class Horizon : public Computation {
     const std::size_t pixels = field.pixelCount();
     const int directions = run_.directions;
     const Attributes attributes = sweptAttributes(job, result_);
-    const std::size_t values = pixels * static_cast<std::size_t>(directions);
-    requireSize(result_.angles, values, "horizon angles");
-    requireFiniteResult(result_.angles, field, "horizon angle");
-    outputs.image(run_.output,
-                  job.image(field, directionChannelNames("h", directions),
-                            splitPlanes(result_.angles, pixels, directions), attributes,
-                            "horizon elevation angle per direction (channel k = direction k)",
-                            "radians above the horizontal; -pi/2 where the ray leaves the field at once"));
+    // K channels, one per direction, named `prefix` and the direction's number.
+    const auto stage = [&](const std::string& path, const std::vector<float>& planes, const char* prefix,
+                           const std::string& what, const char* quantity, const char* units) {
+      requireSize(planes, pixels * static_cast<std::size_t>(directions), (what + "s").c_str());
+      requireFiniteResult(planes, field, what.c_str());
+      outputs.image(path, job.image(field, directionChannelNames(prefix, directions),
+                                    splitPlanes(planes, pixels, directions), attributes, quantity, units));
+    };
+    stage(run_.output, result_.angles, "h", "horizon angle",
+          "horizon elevation angle per direction (channel k = direction k)",
+          "radians above the horizontal; -pi/2 where the ray leaves the field at once");
     if (!run_.distance_output.empty()) {
-      requireSize(result_.distances, values, "horizon distances");
-      requireFiniteResult(result_.distances, field, "horizon distance");
-      outputs.image(run_.distance_output,
-                    job.image(field, directionChannelNames("d", directions),
-                              splitPlanes(result_.distances, pixels, directions), attributes,
-                              "ground distance to the point casting the horizon, per direction",
-                              "ground units (pixels times cell size); 0 where no point casts a horizon or the "
-                              "surface's own slope at the receiver is the horizon"));
+      stage(run_.distance_output, result_.distances, "d", "horizon distance",
+            "ground distance to the point casting the horizon, per direction",
+            "ground units (pixels times cell size); 0 where no point casts a horizon or the surface's own slope "
+            "at the receiver is the horizon");
     }
     if (!run_.preview.empty()) {
       const std::vector<float> mean = meanInFieldElevation(result_.angles, pixels, directions);
@@ -114,6 +113,13 @@ class Horizon : public Computation {
  private:
   HorizonResult result_;
 };
+
+void checkHorizon(const std::string&, const RunArguments& run) {
+  asUsageError([&] { validate(horizonOptions(run), horizonOutputs(Command::Horizon, run)); });
+}
+
+// Horizon angles reach down to -pi/2, a ray that leaves the field at once.
+double lowestAngle(const RunArguments&) { return -M_PI / 2.0; }
 
 }  // namespace
 
@@ -129,8 +135,9 @@ const CommandSpec kHorizonCommand{
     "the field (low = dark, high = bright), stretched from its minimum to its maximum; the\n"
     "sky-view-factor and ambient-occlusion previews stretch their 1st to 99th percentile over\n"
     "black..white (the summary line prints both ends). Nodata is black in every preview.\n",
-    kImageCommandGroups | kSweepGroup | kSamplingGroup | kEarthGroup | kReachGroup | kSweepMethodGroup |
-        kHorizonGroup,
+    kSweptFieldGroups | kSweepMethodGroup | kHorizonGroup,
+    checkHorizon,
+    lowestAngle,
     pipelined<Horizon>,
 };
 

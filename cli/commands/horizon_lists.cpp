@@ -50,6 +50,15 @@ class HorizonLists : public Computation {
   std::vector<ReceiverHorizons> lists_;
 };
 
+void checkHorizonLists(const std::string&, const RunArguments& run) {
+  if (!hasExtension(run.output, ".json") && !hasExtension(run.output, ".csv")) {
+    throw UsageError("-o: the horizon lists are written as JSON or CSV; the name must end in .json or .csv, got " +
+                     inQuotes(run.output));
+  }
+  if (run.receivers.empty()) throw UsageError("missing --at COL,ROW (the receivers whose horizons to list)");
+  asUsageError([&] { validate(horizonListOptions(run)); });
+}
+
 }  // namespace
 
 const CommandSpec kHorizonListsCommand{
@@ -73,6 +82,8 @@ const CommandSpec kHorizonListsCommand{
     "radians); its visible segment is the samples [segment_begin, segment_end) toward the\n"
     "receiver, from near_distance up to distance. The segments hold every visible sample once.\n",
     kOutputGroup | kInputGroup | kSweepGroup | kSamplingGroup | kEarthGroup | kHorizonListsGroup,
+    checkHorizonLists,
+    nullptr,
     pipelined<HorizonLists>,
 };
 

@@ -64,6 +64,16 @@ class Insolation : public Computation {
   InsolationResult result_;
 };
 
+void checkInsolation(const std::string&, const RunArguments& run) {
+  if (!run.latitude || !run.longitude || !run.from_time || !run.to_time)
+    throw UsageError("missing the place or the span: --lat LAT --lon LON --from TIME --to TIME");
+  if (!(*run.from_time < *run.to_time)) throw UsageError("--from must come before --to");
+  asUsageError([&] {
+    validate(insolationOptions(run));
+    validate(static_cast<const SweepOptions&>(horizonOptions(run)));
+  });
+}
+
 }  // namespace
 
 const CommandSpec kInsolationCommand{
@@ -85,6 +95,8 @@ const CommandSpec kInsolationCommand{
     "99th percentile. NaN at nodata pixels.\n",
     nullptr,
     kImageCommandGroups | kSamplingGroup | kEarthGroup | kSunPlaceGroup | kInsolationGroup,
+    checkInsolation,
+    nullptr,
     pipelined<Insolation>,
 };
 

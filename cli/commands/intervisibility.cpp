@@ -71,6 +71,16 @@ class Intervisibility : public Computation {
   IntervisibilityResult result_;
 };
 
+void checkIntervisibility(const std::string&, const RunArguments& run) {
+  const bool naive = run.visibility_method != IntervisibilityMethod::HullTree;
+  if (naive && !run.hull_tree_name.empty())
+    throw UsageError("--hull-tree needs --method tree (the naive method builds no tree)");
+  // (the library's "statistics ... only for the hull-tree method", in the CLI's words)
+  if (naive && run.statistics)
+    throw UsageError("--stats needs --method tree (the naive method has no horizons or iterations to count)");
+  asUsageError([&] { validate(intervisibilityOptions(run), intervisibilityOutputs(run)); });
+}
+
 }  // namespace
 
 const CommandSpec kIntervisibilityCommand{
@@ -97,8 +107,9 @@ const CommandSpec kIntervisibilityCommand{
     "           step) times rho * drho, drho the ground step: ground units squared; it tends to\n"
     "           the area seen as K grows.\n"
     "The preview stretches the count from its minimum to its maximum.\n",
-    kImageCommandGroups | kSweepGroup | kSamplingGroup | kEarthGroup | kReachGroup | kHullTreeGroup |
-        kIntervisibilityGroup,
+    kSweptFieldGroups | kHullTreeGroup | kIntervisibilityGroup,
+    checkIntervisibility,
+    nullptr,
     pipelined<Intervisibility>,
 };
 

@@ -6,6 +6,7 @@
 #include <cstdlib>
 
 #include "hfvis/errors.hpp"
+#include "hfvis/sun.hpp"
 #include "light_parts.hpp"
 
 namespace hfvis::cli {
@@ -122,6 +123,40 @@ class Shade : public Computation {
   std::vector<std::vector<float>> albedo_;
 };
 
+// The light, given one way, and the options each light needs given with it.
+void checkShade(const std::string&, const RunArguments& run) {
+  const bool placed = run.sun_time || run.latitude || run.longitude;
+  if (run.sun && placed)
+    throw UsageError("--sun AZ,EL or --at TIME --lat LAT --lon LON: give the sun one way, not both");
+  const bool sun = run.sun || (run.sun_time && run.latitude && run.longitude);
+  if (!sun && (placed || run.environment.empty()))
+    throw UsageError(
+        "missing the light: --env ENV.exr and / or the sun, --sun AZ,EL (compass azimuth, elevation) or --at TIME "
+        "--lat LAT --lon LON");
+  if (run.environment.empty() && run.sweep_options_given)
+    throw UsageError("-k, --method and --azimuth-offset need --env (the sun alone sweeps its own azimuth)");
+  if (run.environment.empty() && (run.environment_rotation_deg != 0.0 || run.environment_rows != 0))
+    throw UsageError("--env-rotate and --env-rows need --env ENV.exr");
+  if (!sun && run.sun_irradiance != 1.0) throw UsageError("--sun-irradiance needs the sun");
+  if (run.albedo.empty() && run.sun_irradiance != 1.0)
+    throw UsageError(
+        "--sun-irradiance needs --albedo (it scales the sun's light in the radiance; 'direct' is "
+        "for a normal irradiance of 1)");
+  if (!sun && run.sun_size_deg != 0.53) throw UsageError("--sun-size needs the sun");
+  if (!run.environment.empty() && samePath(run.output, run.environment))
+    throw UsageError("--env must differ from -o, both are " + inQuotes(run.output));
+  if (!run.albedo.empty() && samePath(run.output, run.albedo))
+    throw UsageError("--albedo must differ from -o, both are " + inQuotes(run.output));
+  if (run.sun_time) {
+    try {  // the solar position's range of years
+      sunPosition(*run.sun_time, *run.latitude, *run.longitude);
+    } catch (const InvalidArgument& error) {
+      throw UsageError(std::string("--at: ") + error.what());
+    }
+  }
+  asUsageError([&] { validate(static_cast<const SweepOptions&>(horizonOptions(run))); });
+}
+
 }  // namespace
 
 const CommandSpec kShadeCommand{
@@ -162,8 +197,9 @@ const CommandSpec kShadeCommand{
     "hillshade with cast shadows: direct from 0 (black) to its largest value (white). NaN at\n"
     "nodata pixels.\n",
     nullptr,
-    kImageCommandGroups | kSweepGroup | kSamplingGroup | kEarthGroup | kReachGroup | kSweepMethodGroup |
-        kSunPlaceGroup | kEnvironmentLightGroup | kSunShadingGroup,
+    kSweptFieldGroups | kSweepMethodGroup | kSunPlaceGroup | kEnvironmentLightGroup | kSunShadingGroup,
+    checkShade,
+    nullptr,
     pipelined<Shade>,
 };
 

@@ -19,6 +19,10 @@ class SkyViewFactor : public HorizonQuantityComputation {
   explicit SkyViewFactor(const RunArguments& run) : HorizonQuantityComputation(run, kSkyViewFactor) {}
 };
 
+void checkSkyViewFactor(const std::string&, const RunArguments& run) {
+  asUsageError([&] { validate(horizonOptions(run), horizonOutputs(Command::SkyViewFactor, run)); });
+}
+
 }  // namespace
 
 const CommandSpec kSkyViewFactorCommand{
@@ -32,7 +36,9 @@ const CommandSpec kSkyViewFactorCommand{
     "The preview (--preview) stretches its 1st to 99th percentile over black..white (the\n"
     "summary line prints both ends); NaN (nodata) is black.\n",
     nullptr,
-    kImageCommandGroups | kSweepGroup | kSamplingGroup | kEarthGroup | kReachGroup | kSweepMethodGroup,
+    kSweptFieldGroups | kSweepMethodGroup,
+    checkSkyViewFactor,
+    nullptr,
     pipelined<SkyViewFactor>,
 };
 

@@ -36,6 +36,8 @@ const CommandSpec kSunPositionCommand{
     "its worked example; years 1800 - 2200 (the range it accepts).\n",
     nullptr,
     0,  // its four options are its own (parseCommandLine)
+    nullptr,
+    nullptr,
     runSunPosition,
 };
 

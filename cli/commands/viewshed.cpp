@@ -186,6 +186,23 @@ class Viewshed : public Computation {
   std::string quantity_, units_, note_;
 };
 
+void checkViewshed(const std::string&, const RunArguments& run) {
+  if (!run.absolute && run.observer_height < 0.0)
+    throw UsageError("--observer-height: an eye below the surface sees nothing; give a height >= 0 (or --absolute)");
+  if (run.observers.empty() && run.observers_file.empty())
+    throw UsageError("missing --observer COL,ROW or --observers FILE.csv (who looks)");
+  if ((run.with_angle || run.with_needed_height) && (run.observers.size() > 1 || !run.observers_file.empty()))
+    throw UsageError(std::string(run.with_angle ? "--angle" : "--needed-height") +
+                     " is for one observer (several give a count)");
+  if (run.cull_level_given && !run.culled) throw UsageError("--cull-level is for --method culled");
+  if (!run.observers_file.empty() && samePath(run.output, run.observers_file))
+    throw UsageError("--observers must differ from -o, both are " + inQuotes(run.output));
+  asUsageError([&] { validate(viewshedOptions(run)); });
+}
+
+// The angle channel (--angle) reaches down to -90 degrees; "visible" and "count" start at 0.
+double lowestValue(const RunArguments& run) { return run.with_angle ? -90.0 : 0.0; }
+
 }  // namespace
 
 const CommandSpec kViewshedCommand{
@@ -221,6 +238,8 @@ const CommandSpec kViewshedCommand{
     "The preview shows the visible points (or the count) bright over a dimmed hillshade.\n",
     nullptr,
     kImageCommandGroups | kEarthGroup | kReachGroup | kViewshedGroup,
+    checkViewshed,
+    lowestValue,
     pipelined<Viewshed>,
 };
 
