@@ -12,11 +12,11 @@
 #include <set>
 #include <tuple>
 
+#include "core/message_numbers.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/insolation.hpp"
-#include "hfvis/sun_shading.hpp"
 #include "hfvis/sun.hpp"
-#include "core/message_numbers.hpp"
+#include "hfvis/sun_shading.hpp"
 #include "table.hpp"
 
 namespace hfvis::cli {
@@ -217,10 +217,10 @@ void parseUtcTimeInto(const std::string& typed, const std::string& value, std::o
 // A flag that sets one bool field.
 #define HFVIS_FLAG(field) [](const std::string&, const std::string&, RunArguments& run) { run.field = true; }
 // A path or name: any non-empty text.
-#define HFVIS_TEXT(field)                                                        \
+#define HFVIS_TEXT(field)                                                     \
   [](const std::string& typed, const std::string& value, RunArguments& run) { \
-    requireNonEmpty(typed, value);                                               \
-    run.field = value;                                                           \
+    requireNonEmpty(typed, value);                                            \
+    run.field = value;                                                        \
   }
 
 }  // namespace
@@ -288,7 +288,8 @@ const std::vector<OptionSpec>& optionTable() {
       {"--azimuth-offset", nullptr, "DEG", kSweepGroup, false,
        "added to every direction's azimuth, degrees (default 0)",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
-         run.azimuth_offset_deg = parseBounded(typed, value, -360.0, 360.0, "every direction has an offset in it");
+         run.azimuth_offset_deg =
+             parseBounded(typed, value, -360.0, 360.0, "every direction has an offset in it");
          run.sweep_options_given = true;
        }},
       {"--samples-per-unit", nullptr, "S", kSamplingGroup, false,
@@ -309,7 +310,8 @@ const std::vector<OptionSpec>& optionTable() {
        [](const std::string& typed, const std::string& value, RunArguments& run) {
          run.refraction = parseNumber(typed, value);
          if (!(run.refraction >= -1.0 && run.refraction <= 1.0))
-           throw UsageError(typed + ": the refraction coefficient must be in -1 .. 1, got " + inQuotes(value));
+           throw UsageError(typed + ": the refraction coefficient must be in -1 .. 1, got " +
+                            inQuotes(value));
          run.curvature = true;  // refraction bends rays over the curved Earth
        }},
       {"--max-distance", nullptr, "D", kReachGroup, false,
@@ -340,7 +342,8 @@ const std::vector<OptionSpec>& optionTable() {
        "(Algorithm 3) (default: default)",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
          const auto tuning = hullTreeTuningNamed(value);
-         if (!tuning) throw UsageError(typed + ": expected plain, deferred, default or zone, got " + inQuotes(value));
+         if (!tuning)
+           throw UsageError(typed + ": expected plain, deferred, default or zone, got " + inQuotes(value));
          run.hull_tree = *tuning;
          run.hull_tree_name = value;
        }},
@@ -361,7 +364,8 @@ const std::vector<OptionSpec>& optionTable() {
        [](const std::string& typed, const std::string& value, RunArguments& run) {
          run.sun_size_deg = parseNumber(typed, value);
          if (!(run.sun_size_deg >= 0.0 && run.sun_size_deg <= 10.0))
-           throw UsageError(typed + ": the sun's diameter must be in 0 (a point: hard shadows) .. 10 degrees, got " +
+           throw UsageError(typed +
+                            ": the sun's diameter must be in 0 (a point: hard shadows) .. 10 degrees, got " +
                             inQuotes(value));
        }},
       {"--distance-out", nullptr, "FILE", kHorizonGroup, false,
@@ -404,19 +408,20 @@ const std::vector<OptionSpec>& optionTable() {
        "height is valid. The output has the same channel names.",
        HFVIS_TEXT(radiance)},
       {"--env", nullptr, "ENV.exr", kEnvironmentLightGroup, false,
-       "an HDR environment, equirectangular (latitude / longitude, 2:1)",
-       HFVIS_TEXT(environment)},
+       "an HDR environment, equirectangular (latitude / longitude, 2:1)", HFVIS_TEXT(environment)},
       {"--env-rotate", nullptr, "DEG", kEnvironmentLightGroup, false,
        "the environment's left edge looks toward compass azimuth DEG (default 0)",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
-         run.environment_rotation_deg = parseBounded(typed, value, -360.0, 360.0, "every rotation has an angle in it");
+         run.environment_rotation_deg =
+             parseBounded(typed, value, -360.0, 360.0, "every rotation has an angle in it");
        }},
       {"--env-rows", nullptr, "N", kEnvironmentLightGroup, false,
        "bands of zenith angle in the tables (default the map's rows)",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
          const double rows = parsePositive(typed, value);
          if (rows != std::floor(rows) || rows > 65536)
-           throw UsageError(typed + ": expected a whole number of bands in 1 .. 65536, got " + inQuotes(value));
+           throw UsageError(typed + ": expected a whole number of bands in 1 .. 65536, got " +
+                            inQuotes(value));
          run.environment_rows = static_cast<int>(rows);
        }},
       {"--sun", nullptr, "AZ,EL", kSunShadingGroup, false,
@@ -424,7 +429,8 @@ const std::vector<OptionSpec>& optionTable() {
        [](const std::string& typed, const std::string& value, RunArguments& run) {
          const auto [az, el] =
              splitPair(typed, value, ": expected AZ,EL (compass azimuth and elevation, degrees), got ");
-         const double azimuth = parseBounded(typed, az, -360.0, 360.0, "every azimuth has an equal one in it");
+         const double azimuth =
+             parseBounded(typed, az, -360.0, 360.0, "every azimuth has an equal one in it");
          const double elevation = parseNumber(typed, el);
          if (elevation < -90.0 || elevation > 90.0)
            throw UsageError(typed + ": the elevation must be in -90 .. 90 degrees, got " + inQuotes(value));
@@ -456,14 +462,16 @@ const std::vector<OptionSpec>& optionTable() {
       {"--step", nullptr, "MINUTES", kInsolationGroup, false, "the time step (default 10, at most 1440)",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
          run.step_minutes = parsePositive(typed, value);
-         if (run.step_minutes > 1440.0) throw UsageError(typed + ": at most 1440 minutes, got " + inQuotes(value));
+         if (run.step_minutes > 1440.0)
+           throw UsageError(typed + ": at most 1440 minutes, got " + inQuotes(value));
        }},
       {"--azimuth-bucket", nullptr, "DEG", kInsolationGroup, false,
        "steps whose sun azimuths fall in one bucket share one sweep\n"
        "(default 0.25, at most 10)",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
          run.azimuth_bucket_deg = parsePositive(typed, value);
-         if (run.azimuth_bucket_deg > 10.0) throw UsageError(typed + ": at most 10 degrees, got " + inQuotes(value));
+         if (run.azimuth_bucket_deg > 10.0)
+           throw UsageError(typed + ": at most 10 degrees, got " + inQuotes(value));
        }},
       {"--apparent", nullptr, nullptr, kInsolationGroup, false, "lift the sun by the atmosphere's refraction",
        HFVIS_FLAG(apparent)},
@@ -472,16 +480,17 @@ const std::vector<OptionSpec>& optionTable() {
          run.observers.push_back(parseReceiver(typed, value));
        }},
       {"--observers", nullptr, "FILE.csv", kViewshedGroup, false,
-       "observers, one col,row[,height] a line (a header line allowed)",
-       HFVIS_TEXT(observers_file)},
+       "observers, one col,row[,height] a line (a header line allowed)", HFVIS_TEXT(observers_file)},
       {"--observer-height", nullptr, "H", kViewshedGroup, false,
        "the eye's height above the surface (default 2)",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
          run.observer_height = parseBounded(typed, value, -kMostLength, kMostLength, kFloatRange);
        }},
-      {"--target-height", nullptr, "T", kViewshedGroup, false, "the target's height above the surface (default 0)",
+      {"--target-height", nullptr, "T", kViewshedGroup, false,
+       "the target's height above the surface (default 0)",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
-         if (parseNumber(typed, value) < 0.0) throw UsageError(typed + ": must be >= 0, got " + inQuotes(value));
+         if (parseNumber(typed, value) < 0.0)
+           throw UsageError(typed + ": must be >= 0, got " + inQuotes(value));
          run.target_height = parseBounded(typed, value, 0.0, kMostLength, kFloatRange);
        }},
       {"--absolute", nullptr, nullptr, kViewshedGroup, false, "the eye at height H, not H above the surface",
@@ -507,8 +516,8 @@ const std::vector<OptionSpec>& optionTable() {
        }},
       {"--angle", nullptr, nullptr, kViewshedGroup, false, "also channel \"angle\" (one observer)",
        HFVIS_FLAG(with_angle)},
-      {"--needed-height", nullptr, nullptr, kViewshedGroup, false, "also channel \"needed_height\" (one observer)",
-       HFVIS_FLAG(with_needed_height)},
+      {"--needed-height", nullptr, nullptr, kViewshedGroup, false,
+       "also channel \"needed_height\" (one observer)", HFVIS_FLAG(with_needed_height)},
       {"--method", nullptr, "exact|culled", kViewshedGroup, false,
        "culled: through Stewart's culling pyramid, the same result (default exact)",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
@@ -516,7 +525,8 @@ const std::vector<OptionSpec>& optionTable() {
            throw UsageError(typed + ": expected 'exact' or 'culled', got " + inQuotes(value));
          run.culled = value == "culled";
        }},
-      {"--cull-level", nullptr, "K", kViewshedGroup, false, "the pyramid's finest nodes, 2^K points a side (default 2)",
+      {"--cull-level", nullptr, "K", kViewshedGroup, false,
+       "the pyramid's finest nodes, 2^K points a side (default 2)",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
          const double k = parseNumber(typed, value);
          if (!(k >= 1.0 && k <= 12.0 && k == std::floor(k)))
@@ -591,7 +601,8 @@ const OptionSpec* findOption(const std::string& typed, const CommandSpec& comman
   std::vector<const char*> takers;
   for (const CommandSpec* command : commandTable())
     for (const OptionSpec& spec : optionTable())
-      if ((typed == spec.name || (spec.short_name && typed == spec.short_name)) && (command->groups & spec.group)) {
+      if ((typed == spec.name || (spec.short_name && typed == spec.short_name)) &&
+          (command->groups & spec.group)) {
         takers.push_back(command->name);
         break;
       }
@@ -725,7 +736,8 @@ CommandLine parseCommandLine(const std::vector<std::string>& args) {
     if (rest.size() > 1) throw UsageError("unexpected argument " + inQuotes(rest[1]) + " after 'help'");
     if (!rest.empty() && rest[0] != "help") {
       const CommandSpec* topic = findCommand(rest[0]);
-      if (!topic) throw UsageError("unknown command " + inQuotes(rest[0]) + " (expected " + commandList() + ")");
+      if (!topic)
+        throw UsageError("unknown command " + inQuotes(rest[0]) + " (expected " + commandList() + ")");
       line.help_topic = topic->id;
     }
     return line;

@@ -14,8 +14,8 @@
 #include "hfvis/horizon.hpp"
 #include "hfvis/horizon_lists.hpp"
 #include "hfvis/image_io.hpp"
-#include "hfvis/intervisibility.hpp"
 #include "hfvis/insolation.hpp"
+#include "hfvis/intervisibility.hpp"
 #include "hfvis/sun_shading.hpp"
 #include "hfvis/viewshed.hpp"
 
@@ -35,12 +35,12 @@ enum class Command {
   SkyViewFactor,
   AmbientOcclusion,
   Intervisibility,  // visible samples and ground area per pixel (was "viewcount")
-  HorizonLists,  // (was "horizons"): visibility horizons of chosen receivers, JSON or CSV
-  Bounce,        // one diffuse bounce of a given exit radiance
-  SunPosition,   // (was "sunpos"): the sun's azimuth and elevation at a time and place
-  Shade,         // the surface lit by an environment and / or the sun
-  Insolation,    // sunshine hours and direct irradiation over a span of time
-  Viewshed,      // what one observer sees, or how many of several see each point
+  HorizonLists,     // (was "horizons"): visibility horizons of chosen receivers, JSON or CSV
+  Bounce,           // one diffuse bounce of a given exit radiance
+  SunPosition,      // (was "sunpos"): the sun's azimuth and elevation at a time and place
+  Shade,            // the surface lit by an environment and / or the sun
+  Insolation,       // sunshine hours and direct irradiation over a span of time
+  Viewshed,         // what one observer sees, or how many of several see each point
 };
 
 // Everything a compute command's run needs, already validated.

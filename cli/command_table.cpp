@@ -5,9 +5,10 @@ namespace hfvis::cli {
 
 const std::vector<const CommandSpec*>& commandTable() {
   static const std::vector<const CommandSpec*> table{
-      &kHorizonCommand,     &kSkyViewFactorCommand, &kAmbientOcclusionCommand, &kIntervisibilityCommand,
-      &kHorizonListsCommand, &kBounceCommand,        &kShadeCommand,            &kInsolationCommand,
-      &kViewshedCommand,    &kSunPositionCommand,   &kDevicesCommand,
+      &kHorizonCommand,         &kSkyViewFactorCommand, &kAmbientOcclusionCommand,
+      &kIntervisibilityCommand, &kHorizonListsCommand,  &kBounceCommand,
+      &kShadeCommand,           &kInsolationCommand,    &kViewshedCommand,
+      &kSunPositionCommand,     &kDevicesCommand,
   };
   return table;
 }

@@ -108,7 +108,8 @@ std::string optionHelp(const OptionSpec& option) {
   std::string flags = option.short_name ? std::string(option.short_name) + ", " + option.name : option.name;
   if (option.value) flags += std::string(" ") + option.value;
   const std::string column(27, ' ');
-  return indented(option.help, column, "  " + flags + std::string(flags.size() < 23 ? 25 - flags.size() : 2, ' '));
+  return indented(option.help, column,
+                  "  " + flags + std::string(flags.size() < 23 ? 25 - flags.size() : 2, ' '));
 }
 
 // The options of the groups in `groups`, under a heading per group naming the commands taking it.
@@ -163,15 +164,18 @@ std::string generalHelp() {
     const std::string name = named(*command);
     commands += indented(command->summary, std::string(named_width + 4, ' '),
                          "  " + name + std::string(named_width + 2 - name.size(), ' '));
-    if (command->notes) notes += "\n" + std::string(command->name) + ":\n" + indented(command->notes, "  ", "  ");
+    if (command->notes)
+      notes += "\n" + std::string(command->name) + ":\n" + indented(command->notes, "  ", "  ");
     groups |= command->groups;
   }
   usage += "  hfvis --help | hfvis COMMAND --help\n";
   return std::string(
-             "hfvis: horizons, sky-view factor, ambient occlusion, intervisibility, one-bounce light, and lighting by "
+             "hfvis: horizons, sky-view factor, ambient occlusion, intervisibility, one-bounce light, and "
+             "lighting by "
              "HDR environments and the sun on height fields (OpenCL)\n\n") +
-         usage + commands + "\nOptions, by group (the commands that take each in brackets):\n" + optionsHelp(groups) +
-         "\n  -h, --help               show help\n" + notes + kConventions + kExitStatus;
+         usage + commands + "\nOptions, by group (the commands that take each in brackets):\n" +
+         optionsHelp(groups) + "\n  -h, --help               show help\n" + notes + kConventions +
+         kExitStatus;
 }
 
 std::string commandHelp(Command id) {

@@ -15,6 +15,7 @@ std::vector<std::string> directionChannelNames(const std::string& prefix, int co
 // The q-quantiles of a plane's finite values for q = lo_q and hi_q (nearest rank), to stretch a
 // preview's contrast over the values most pixels hold: a sky-view factor of 0.85 .. 1 over most
 // of a DEM reads as grey on 0 .. 1. (0, 0) when no value is finite.
-std::pair<float, float> quantileRange(const std::vector<float>& plane, double lo_q = 0.01, double hi_q = 0.99);
+std::pair<float, float> quantileRange(const std::vector<float>& plane, double lo_q = 0.01,
+                                      double hi_q = 0.99);
 
 }  // namespace hfvis::cli

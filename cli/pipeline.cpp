@@ -120,7 +120,8 @@ void Progress::report(bool finished_batch) {
   last_ = now;
   line_open_ = !last;
   // Directions done, and the share of the one under way in strips.
-  const double fraction = total_ > 0 ? (done_ + (strips_ > 0 ? double(strip_) / strips_ : 0.0)) / total_ : 0.0;
+  const double fraction =
+      total_ > 0 ? (done_ + (strips_ > 0 ? double(strip_) / strips_ : 0.0)) / total_ : 0.0;
   std::string strip, left;
   if (strip_ > 0 && !last) strip = ", strip " + std::to_string(strip_) + "/" + std::to_string(strips_);
   if (fraction > 0.0 && !last) {
@@ -195,16 +196,16 @@ Attributes Job::attributes(const HeightField& field) const {
   if (!run.channel.empty()) attributes.emplace_back("hfvis:channel", run.channel);
   if (run.max_distance > 0.0) attributes.emplace_back("hfvis:max_distance", formatNumber(run.max_distance));
   if (run.curvature) {
-    attributes.emplace_back("hfvis:curvature", "drop = d^2 (1 - K) / (2 R), R = " + formatNumber(kEarthRadius) +
-                                                   " m, K = " + formatNumber(run.refraction) +
-                                                   " (ground units taken as metres)");
+    attributes.emplace_back(
+        "hfvis:curvature", "drop = d^2 (1 - K) / (2 R), R = " + formatNumber(kEarthRadius) +
+                               " m, K = " + formatNumber(run.refraction) + " (ground units taken as metres)");
   }
   return attributes;
 }
 
 ImageChannels Job::image(const HeightField& field, std::vector<std::string> names,
-                         std::vector<std::vector<float>> planes, Attributes attributes, const std::string& quantity,
-                         const std::string& units) const {
+                         std::vector<std::vector<float>> planes, Attributes attributes,
+                         const std::string& quantity, const std::string& units) const {
   ImageChannels image;
   image.width = field.width;
   image.height = field.height;
@@ -301,7 +302,8 @@ int runPipeline(const CommandLine& line, Computation& computation) {
   std::optional<ComputeContext> context;
   if (computation.writesImages()) context.emplace(contextFor(run));
   Progress progress(run.quiet);
-  Job job{commandSpec(line.command), run, input, context ? &*context : nullptr, progress, computation.method()};
+  Job job{commandSpec(line.command),     run,      input,
+          context ? &*context : nullptr, progress, computation.method()};
   const auto start = std::chrono::steady_clock::now();
   computation.compute(job);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -313,9 +315,9 @@ int runPipeline(const CommandLine& line, Computation& computation) {
   outputs.commit();
   if (!run.quiet) {
     std::cout << "wrote " << joinPaths(written) << " (" << input.width << "x" << input.height << ", "
-              << summary.count << " " << summary.unit << (summary.count == 1 ? ", " : "s, ") << job.method << ", "
-              << formatFixed(seconds, 2) << " s" << (context ? " on " + context->device().name : "") << ")"
-              << summary.note << "\n";
+              << summary.count << " " << summary.unit << (summary.count == 1 ? ", " : "s, ") << job.method
+              << ", " << formatFixed(seconds, 2) << " s" << (context ? " on " + context->device().name : "")
+              << ")" << summary.note << "\n";
   }
   if (!summary.always.empty()) std::cout << summary.always << "\n";
   return 0;

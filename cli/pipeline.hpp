@@ -108,7 +108,7 @@ struct Summary {
 struct Job {
   const CommandSpec& command;
   const RunArguments& run;
-  const HeightField& input;      // as read
+  const HeightField& input;       // as read
   const ComputeContext* context;  // nullptr for a command that runs on the host
   Progress& progress;
   std::string method;  // hfvis:method and the summary's
@@ -118,8 +118,9 @@ struct Job {
   Attributes attributes(const HeightField& field) const;
   // An output of the field's size. A GeoTIFF output also carries the field's georeference, so
   // that it overlays its input, and the --nodata value.
-  ImageChannels image(const HeightField& field, std::vector<std::string> names, std::vector<std::vector<float>> planes,
-                      Attributes attributes, const std::string& quantity, const std::string& units) const;
+  ImageChannels image(const HeightField& field, std::vector<std::string> names,
+                      std::vector<std::vector<float>> planes, Attributes attributes,
+                      const std::string& quantity, const std::string& units) const;
 };
 
 // One command's steps of the pipeline.

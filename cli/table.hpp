@@ -15,18 +15,18 @@ namespace hfvis::cli {
 // The groups of options; a command takes a set of them (CommandSpec::groups), an option belongs
 // to one (OptionSpec::group). The shared groups come first, then the groups of one command.
 enum OptionGroup : unsigned {
-  kOutputGroup = 1u << 0,          // -o, --quiet
-  kInputGroup = 1u << 1,           // how the input is read: --channel, --cell-size, --z-scale
-  kImageGroup = 1u << 2,           // image outputs: --preview, --nodata
-  kDeviceGroup = 1u << 3,          // --device, --memory-budget
-  kSweepGroup = 1u << 4,           // the sweep's directions: -k, --azimuth-offset
-  kSamplingGroup = 1u << 5,        // --samples-per-unit
-  kEarthGroup = 1u << 6,           // --curvature, --refraction
-  kReachGroup = 1u << 7,           // --max-distance
-  kSweepMethodGroup = 1u << 8,     // --method sweep|naive
-  kHullTreeGroup = 1u << 9,        // --hull-tree
-  kSunPlaceGroup = 1u << 10,       // --lat, --lon, --sun-size
-  kHorizonGroup = 1u << 11,        // the groups of one command each, from here on
+  kOutputGroup = 1u << 0,       // -o, --quiet
+  kInputGroup = 1u << 1,        // how the input is read: --channel, --cell-size, --z-scale
+  kImageGroup = 1u << 2,        // image outputs: --preview, --nodata
+  kDeviceGroup = 1u << 3,       // --device, --memory-budget
+  kSweepGroup = 1u << 4,        // the sweep's directions: -k, --azimuth-offset
+  kSamplingGroup = 1u << 5,     // --samples-per-unit
+  kEarthGroup = 1u << 6,        // --curvature, --refraction
+  kReachGroup = 1u << 7,        // --max-distance
+  kSweepMethodGroup = 1u << 8,  // --method sweep|naive
+  kHullTreeGroup = 1u << 9,     // --hull-tree
+  kSunPlaceGroup = 1u << 10,    // --lat, --lon, --sun-size
+  kHorizonGroup = 1u << 11,     // the groups of one command each, from here on
   kIntervisibilityGroup = 1u << 12,
   kHorizonListsGroup = 1u << 13,
   kBounceGroup = 1u << 14,
@@ -40,7 +40,8 @@ enum OptionGroup : unsigned {
 // The groups every command that reads a height field and writes images takes.
 constexpr unsigned kImageCommandGroups = kOutputGroup | kInputGroup | kImageGroup | kDeviceGroup;
 // And those of the commands that sweep directions over the whole field.
-constexpr unsigned kSweptFieldGroups = kImageCommandGroups | kSweepGroup | kSamplingGroup | kEarthGroup | kReachGroup;
+constexpr unsigned kSweptFieldGroups =
+    kImageCommandGroups | kSweepGroup | kSamplingGroup | kEarthGroup | kReachGroup;
 
 // One option: parsed, checked and described from here alone.
 struct OptionSpec {
@@ -48,8 +49,8 @@ struct OptionSpec {
   const char* short_name;  // "-o", or nullptr
   const char* value;       // what the help calls its value ("FILE"); nullptr: a flag
   OptionGroup group;
-  bool repeats;            // each use adds one more (--observer); else once at most
-  const char* help;        // lines; the help indents the second and later ones
+  bool repeats;      // each use adds one more (--observer); else once at most
+  const char* help;  // lines; the help indents the second and later ones
   // Parses `value` (typed after the flag `typed`) into the field it binds; throws UsageError.
   void (*bind)(const std::string& typed, const std::string& value, RunArguments& run);
 };

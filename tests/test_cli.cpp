@@ -532,15 +532,18 @@ TEST_F(Cli, AnAliasAndItsCommandWriteTheSameFiles) {
     for (const char* typed : {command.alias, command.name}) {
       std::string args = command.args;
       const std::string preview = out(std::string(typed) + ".png");
-      if (const std::size_t at = args.find("PNG"); at != std::string::npos) args.replace(at, 3, shellQuoted(preview));
+      if (const std::size_t at = args.find("PNG"); at != std::string::npos)
+        args.replace(at, 3, shellQuoted(preview));
       const std::string output = out(std::string(typed) + command.extension);
-      const CliResult result = run(std::string(typed) + " " + shellQuoted(field) + " -o " + shellQuoted(output) + " " + args);
+      const CliResult result =
+          run(std::string(typed) + " " + shellQuoted(field) + " -o " + shellQuoted(output) + " " + args);
       ASSERT_EQ(result.status, 0) << result.err;
       written.push_back(readText(output));
       if (args.find(".png") != std::string::npos) written.push_back(readText(preview));
     }
     ASSERT_EQ(written.size() % 2, 0u);
-    for (std::size_t i = 0; i < written.size() / 2; ++i) EXPECT_EQ(written[i], written[i + written.size() / 2]);
+    for (std::size_t i = 0; i < written.size() / 2; ++i)
+      EXPECT_EQ(written[i], written[i + written.size() / 2]);
     EXPECT_FALSE(written[0].empty());
   }
   const std::string when = " --lat 45 --lon 7 --at 2026-06-21T12:00:00Z";
@@ -555,12 +558,12 @@ TEST_F(Cli, AnAliasAndItsCommandWriteTheSameFiles) {
 TEST_F(Cli, HelpListsEveryCommandByItsNameAndItsAlias) {
   const CliResult general = run("--help");
   ASSERT_EQ(general.status, 0) << general.err;
-  for (const auto& [name, alias] : std::vector<std::pair<std::string, std::string>>{
-           {"sky-view-factor", "svf"},
-           {"ambient-occlusion", "ao"},
-           {"intervisibility", "viewcount"},
-           {"horizon-lists", "horizons"},
-           {"sun-position", "sunpos"}}) {
+  for (const auto& [name, alias] :
+       std::vector<std::pair<std::string, std::string>>{{"sky-view-factor", "svf"},
+                                                        {"ambient-occlusion", "ao"},
+                                                        {"intervisibility", "viewcount"},
+                                                        {"horizon-lists", "horizons"},
+                                                        {"sun-position", "sunpos"}}) {
     SCOPED_TRACE(name);
     EXPECT_NE(general.out.find("hfvis " + name + " "), std::string::npos) << general.out;
     EXPECT_NE(general.out.find(name + " (" + alias + ")"), std::string::npos) << general.out;

@@ -18,12 +18,12 @@
 #include <utility>
 #include <vector>
 
-#include "io/gdal_io.hpp"
 #include "geotiff_support.hpp"
-#include "hfvis/errors.hpp"
 #include "hfvis/environment.hpp"
+#include "hfvis/errors.hpp"
 #include "hfvis/image_io.hpp"
 #include "image_outputs.hpp"
+#include "io/gdal_io.hpp"
 #include "test_support.hpp"
 
 namespace hfvis {

@@ -1,11 +1,12 @@
 // cli/commands/bounce.cpp: "hfvis bounce": the irradiance of one diffuse bounce of a given exit
 // radiance (hfvis/bounce.hpp).
+#include "hfvis/bounce.hpp"
+
 #include <algorithm>
 #include <iomanip>
 #include <iostream>
 
 #include "../pipeline.hpp"
-#include "hfvis/bounce.hpp"
 #include "hfvis/errors.hpp"
 
 namespace hfvis::cli {
@@ -24,22 +25,24 @@ class Bounce : public Computation {
     if (!field.row_cell_size_x.empty()) {
       const auto [narrowest, widest] =
           std::minmax_element(field.row_cell_size_x.begin(), field.row_cell_size_x.end());
-      std::cerr << std::setprecision(6) << "hfvis: warning: bounce takes the centre latitude's cell size ("
-                << field.cell_size_x << " x " << field.cell_size_y << ") for the whole field; its rows range from "
-                << *narrowest << " to " << *widest
-                << " along columns (per-row spacing of latitude / longitude grids is followed by horizon, svf, "
-                   "ao, viewcount and horizons; not by bounce)\n";
+      std::cerr
+          << std::setprecision(6) << "hfvis: warning: bounce takes the centre latitude's cell size ("
+          << field.cell_size_x << " x " << field.cell_size_y << ") for the whole field; its rows range from "
+          << *narrowest << " to " << *widest
+          << " along columns (per-row spacing of latitude / longitude grids is followed by horizon, svf, "
+             "ao, viewcount and horizons; not by bounce)\n";
     }
     radiance_image_ = readImage(run_.radiance);
     if (radiance_image_.width != field.width || radiance_image_.height != field.height) {
       throw IoError(run_.radiance, "is " + std::to_string(radiance_image_.width) + "x" +
-                                       std::to_string(radiance_image_.height) + ", the height field " + run_.input +
-                                       " is " + std::to_string(field.width) + "x" + std::to_string(field.height) +
+                                       std::to_string(radiance_image_.height) + ", the height field " +
+                                       run_.input + " is " + std::to_string(field.width) + "x" +
+                                       std::to_string(field.height) +
                                        ": the exit radiance needs one value per height");
     }
     if (radiance_image_.planes.size() > static_cast<std::size_t>(kMaxBounceChannels)) {
-      throw IoError(run_.radiance, "has " + std::to_string(radiance_image_.planes.size()) + " channels; at most " +
-                                       std::to_string(kMaxBounceChannels) +
+      throw IoError(run_.radiance, "has " + std::to_string(radiance_image_.planes.size()) +
+                                       " channels; at most " + std::to_string(kMaxBounceChannels) +
                                        " are gathered in one run (split the channels into several files)");
     }
     radiance_.width = radiance_image_.width;
@@ -72,13 +75,14 @@ class Bounce : public Computation {
     Attributes attributes = job.attributes(field);
     attributes.emplace_back("hfvis:radiance", run_.radiance);
     // The radiance's channel names, so that R, G, B stay R, G, B.
-    outputs.image(run_.output,
-                  job.image(field, radiance_image_.names, result_.irradiance, attributes,
-                            "incident indirect irradiance of one diffuse bounce of the exit radiance "
-                            "(hfvis:radiance), per channel: sum over directions and visible samples of radiance "
-                            "times projected solid angle",
-                            "radiance units times steradians (W/m^2 for W m^-2 sr^-1); a Lambertian surface of "
-                            "albedo rho re-emits rho * E / pi"));
+    outputs.image(
+        run_.output,
+        job.image(field, radiance_image_.names, result_.irradiance, attributes,
+                  "incident indirect irradiance of one diffuse bounce of the exit radiance "
+                  "(hfvis:radiance), per channel: sum over directions and visible samples of radiance "
+                  "times projected solid angle",
+                  "radiance units times steradians (W/m^2 for W m^-2 sr^-1); a Lambertian surface of "
+                  "albedo rho re-emits rho * E / pi"));
     if (!run_.preview.empty()) {
       std::vector<float> mean(field.pixelCount(), 0.0f);
       for (const auto& plane : result_.irradiance)
@@ -89,7 +93,8 @@ class Bounce : public Computation {
     Summary summary{run_.directions};
     summary.note = "; mean irradiance";
     for (std::size_t c = 0; c < result_.irradiance.size(); ++c)
-      summary.note += (c ? ", " : " ") + radiance_image_.names[c] + " " + formatNumber(finiteMean(result_.irradiance[c]));
+      summary.note +=
+          (c ? ", " : " ") + radiance_image_.names[c] + " " + formatNumber(finiteMean(result_.irradiance[c]));
     return summary;
   }
 

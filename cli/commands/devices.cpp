@@ -33,8 +33,8 @@ int runDevices(const CommandLine&) {
   const std::vector<std::string> header{"index", "type", "name", "platform", "driver", "memory"};
   std::vector<std::vector<std::string>> rows;
   for (const DeviceInfo& device : devices) {
-    rows.push_back({std::to_string(device.index), device.type, device.name, device.platform, device.driver_version,
-                    formatMemory(device.global_memory_bytes)});
+    rows.push_back({std::to_string(device.index), device.type, device.name, device.platform,
+                    device.driver_version, formatMemory(device.global_memory_bytes)});
   }
   std::vector<std::size_t> widths(header.size());
   for (std::size_t c = 0; c < header.size(); ++c) {
@@ -50,11 +50,13 @@ int runDevices(const CommandLine&) {
     std::cout << line << "\n";
   };
   printRow("  ", header);
-  for (std::size_t i = 0; i < rows.size(); ++i) printRow(devices[i].index == automatic ? "* " : "  ", rows[i]);
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    printRow(devices[i].index == automatic ? "* " : "  ", rows[i]);
   if (automatic >= 0) {
     std::cout << "* = automatic selection"
-              << (std::getenv("HFVIS_DEVICE") ? " (HFVIS_DEVICE=" + std::string(std::getenv("HFVIS_DEVICE")) + ")"
-                                              : std::string(" (HFVIS_DEVICE not set)"))
+              << (std::getenv("HFVIS_DEVICE")
+                      ? " (HFVIS_DEVICE=" + std::string(std::getenv("HFVIS_DEVICE")) + ")"
+                      : std::string(" (HFVIS_DEVICE not set)"))
               << "\n";
   } else {
     std::cerr << "hfvis: warning: automatic device selection failed: " << automatic_error << "\n";

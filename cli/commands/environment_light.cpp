@@ -22,7 +22,8 @@ void EnvironmentLight::compute(Job& job, const NorthUp& lit, const HorizonOption
 
 void EnvironmentLight::describe(LitOutput& output, std::size_t pixels) const {
   output.attributes.emplace_back("hfvis:environment", run_.environment);
-  output.attributes.emplace_back("hfvis:environment_rotation_deg", formatNumber(run_.environment_rotation_deg));
+  output.attributes.emplace_back("hfvis:environment_rotation_deg",
+                                 formatNumber(run_.environment_rotation_deg));
   output.attributes.emplace_back("hfvis:environment_table_rows", std::to_string(tableRows(map_)));
   output.names = map_.names;
   output.planes = splitPlanes(result_.irradiance, pixels, map_.channels);

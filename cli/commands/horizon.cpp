@@ -1,5 +1,7 @@
 // cli/commands/horizon.cpp: "hfvis horizon": the horizon elevation angle (and distance) per
 // direction, K channels (hfvis/horizon.hpp).
+#include "hfvis/horizon.hpp"
+
 #include <unistd.h>
 
 #include <cmath>
@@ -9,7 +11,6 @@
 
 #include "../pipeline.hpp"
 #include "hfvis/errors.hpp"
-#include "hfvis/horizon.hpp"
 #include "swept_horizons.hpp"
 
 namespace hfvis::cli {
@@ -31,7 +32,8 @@ double availableHostBytes() {
 // The horizon preview: per pixel, the mean elevation over the directions whose ray stays
 // in the field (-pi/2 marks a ray that leaves it at once; averaging those in would make the
 // border dominate the stretch). NaN where every direction is NaN (nodata) or leaves at once.
-std::vector<float> meanInFieldElevation(const std::vector<float>& planes, std::size_t pixels, int directions) {
+std::vector<float> meanInFieldElevation(const std::vector<float>& planes, std::size_t pixels,
+                                        int directions) {
   constexpr float kLeavesAtOnce = -1.57079632679489661923f;
   std::vector<double> sum(pixels, 0.0);
   std::vector<int> count(pixels, 0);
@@ -64,13 +66,14 @@ class Horizon : public Computation {
     const double need = 3.0 * planes, available = availableHostBytes();
     if (need <= available) return;
     std::ostringstream message;
-    message << std::fixed << std::setprecision(1) << "the " << run_.directions << "-channel horizon map"
-            << (run_.distance_output.empty() ? "" : " and its distances") << " of this " << field.width << " x "
-            << field.height << " field need about " << need / 1073741824.0 << " GiB of host memory ("
-            << planes / 1073741824.0 << " GiB of planes, held about three times while written) but "
-            << available / 1073741824.0
-            << " GiB is available: ask for svf or ao (one channel each), fewer directions (-k), or a crop of the "
-               "field";
+    message
+        << std::fixed << std::setprecision(1) << "the " << run_.directions << "-channel horizon map"
+        << (run_.distance_output.empty() ? "" : " and its distances") << " of this " << field.width << " x "
+        << field.height << " field need about " << need / 1073741824.0 << " GiB of host memory ("
+        << planes / 1073741824.0 << " GiB of planes, held about three times while written) but "
+        << available / 1073741824.0
+        << " GiB is available: ask for svf or ao (one channel each), fewer directions (-k), or a crop of the "
+           "field";
     throw Error(message.str());
   }
 
@@ -100,7 +103,8 @@ class Horizon : public Computation {
     if (!run_.distance_output.empty()) {
       stage(run_.distance_output, result_.distances, "d", "horizon distance",
             "ground distance to the point casting the horizon, per direction",
-            "ground units (pixels times cell size); 0 where no point casts a horizon or the surface's own slope "
+            "ground units (pixels times cell size); 0 where no point casts a horizon or the surface's own "
+            "slope "
             "at the receiver is the horizon");
     }
     if (!run_.preview.empty()) {

@@ -1,11 +1,12 @@
 // cli/commands/horizon_lists.cpp: "hfvis horizon-lists" (also "horizons"): the visibility
 // horizons of chosen receivers, as JSON or CSV (hfvis/horizon_lists.hpp).
+#include "hfvis/horizon_lists.hpp"
+
 #include <cctype>
 #include <filesystem>
 
 #include "../horizon_list_files.hpp"
 #include "../pipeline.hpp"
-#include "hfvis/horizon_lists.hpp"
 
 namespace hfvis::cli {
 namespace {
@@ -23,15 +24,18 @@ class HorizonLists : public Computation {
   void prepare(const HeightField& field) override {
     for (const ReceiverPixel& p : run_.receivers) {
       if (p.col >= field.width || p.row >= field.height) {
-        throw UsageError("--at " + std::to_string(p.col) + "," + std::to_string(p.row) + ": outside the field " +
-                         run_.input + ", which is " + std::to_string(field.width) + "x" +
-                         std::to_string(field.height) + " (columns 0.." + std::to_string(field.width - 1) +
-                         ", rows 0.." + std::to_string(field.height - 1) + ")");
+        throw UsageError("--at " + std::to_string(p.col) + "," + std::to_string(p.row) +
+                         ": outside the field " + run_.input + ", which is " + std::to_string(field.width) +
+                         "x" + std::to_string(field.height) + " (columns 0.." +
+                         std::to_string(field.width - 1) + ", rows 0.." + std::to_string(field.height - 1) +
+                         ")");
       }
     }
   }
 
-  void compute(Job& job) override { lists_ = computeHorizonLists(job.input, horizonListOptions(run_), run_.receivers); }
+  void compute(Job& job) override {
+    lists_ = computeHorizonLists(job.input, horizonListOptions(run_), run_.receivers);
+  }
 
   Summary write(Job& job, OutputFiles& outputs) override {
     std::size_t horizons = 0;
@@ -39,10 +43,12 @@ class HorizonLists : public Computation {
       for (const auto& direction : receiver.directions) horizons += direction.horizons.size();
     std::string ext = std::filesystem::path(run_.output).extension().string();
     for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    outputs.text(run_.output, ext == ".csv" ? horizonListsCsv(lists_) : horizonListsJson(run_, job.input, lists_));
+    outputs.text(run_.output,
+                 ext == ".csv" ? horizonListsCsv(lists_) : horizonListsJson(run_, job.input, lists_));
     Summary summary{run_.directions};
-    summary.note = "; " + std::to_string(lists_.size()) + (lists_.size() == 1 ? " receiver, " : " receivers, ") +
-                   std::to_string(horizons) + " horizons";
+    summary.note = "; " + std::to_string(lists_.size()) +
+                   (lists_.size() == 1 ? " receiver, " : " receivers, ") + std::to_string(horizons) +
+                   " horizons";
     return summary;
   }
 
@@ -52,8 +58,9 @@ class HorizonLists : public Computation {
 
 void checkHorizonLists(const std::string&, const RunArguments& run) {
   if (!hasExtension(run.output, ".json") && !hasExtension(run.output, ".csv")) {
-    throw UsageError("-o: the horizon lists are written as JSON or CSV; the name must end in .json or .csv, got " +
-                     inQuotes(run.output));
+    throw UsageError(
+        "-o: the horizon lists are written as JSON or CSV; the name must end in .json or .csv, got " +
+        inQuotes(run.output));
   }
   if (run.receivers.empty()) throw UsageError("missing --at COL,ROW (the receivers whose horizons to list)");
   asUsageError([&] { validate(horizonListOptions(run)); });

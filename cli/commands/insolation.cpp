@@ -1,7 +1,8 @@
 // cli/commands/insolation.cpp: "hfvis insolation": sunshine hours and direct irradiation over a
 // span of time (hfvis/insolation.hpp).
-#include "../pipeline.hpp"
 #include "hfvis/insolation.hpp"
+
+#include "../pipeline.hpp"
 
 namespace hfvis::cli {
 namespace {
@@ -18,7 +19,8 @@ class Insolation : public Computation {
     const HeightField& field = lit_.field();
     HorizonOptions sweep = horizonOptions(run_);
     job.progress.attach(sweep);
-    result_ = job.progress.run([&] { return computeInsolation(*job.context, field, insolationOptions(run_), sweep); });
+    result_ = job.progress.run(
+        [&] { return computeInsolation(*job.context, field, insolationOptions(run_), sweep); });
   }
 
   Summary write(Job& job, OutputFiles& outputs) override {
@@ -38,24 +40,27 @@ class Insolation : public Computation {
     attributes.emplace_back("hfvis:step_minutes", formatNumber(options.step_minutes));
     attributes.emplace_back("hfvis:sun_size_deg", formatNumber(options.size_deg));
     attributes.emplace_back("hfvis:azimuth_bucket_deg", formatNumber(options.azimuth_bucket_deg));
-    attributes.emplace_back("hfvis:refraction", options.apparent ? "apparent (refracted) elevations" : "geometric");
+    attributes.emplace_back("hfvis:refraction",
+                            options.apparent ? "apparent (refracted) elevations" : "geometric");
     attributes.emplace_back("hfvis:steps_with_sun", std::to_string(result_.steps));
     attributes.emplace_back("hfvis:sweeps", std::to_string(result_.sweeps));
     // "direct" sorts before "sun_hours": channel 0 in the EXR.
     outputs.image(
         run_.output,
-        job.image(field, {"direct", "sun_hours"}, {result_.direct, result_.sun_hours}, attributes,
-                  "sun_hours: hours with the sun's centre above the pixel's horizon (and elevation 0); direct: the "
-                  "sum over steps of hours * the disc's part seen * max(0, n . s), the irradiation from a sun of "
-                  "normal irradiance 1",
-                  "sun_hours: hours; direct: hours times the sun's normal irradiance (W/m^2 gives Wh/m^2)"));
+        job.image(
+            field, {"direct", "sun_hours"}, {result_.direct, result_.sun_hours}, attributes,
+            "sun_hours: hours with the sun's centre above the pixel's horizon (and elevation 0); direct: the "
+            "sum over steps of hours * the disc's part seen * max(0, n . s), the irradiation from a sun of "
+            "normal irradiance 1",
+            "sun_hours: hours; direct: hours times the sun's normal irradiance (W/m^2 gives Wh/m^2)"));
     if (!run_.preview.empty()) {
       const auto [lo, hi] = quantileRange(result_.direct);
       outputs.previewPng(run_.preview, field.width, field.height, result_.direct, lo, hi);
     }
     Summary summary{result_.sweeps};
     summary.note = "; " + std::to_string(result_.steps) + " steps with the sun up, mean sun " +
-                   formatFixed(finiteMean(result_.sun_hours), 2) + " h" + (lit_.flipped() ? " (lit north-up)" : "");
+                   formatFixed(finiteMean(result_.sun_hours), 2) + " h" +
+                   (lit_.flipped() ? " (lit north-up)" : "");
     return summary;
   }
 

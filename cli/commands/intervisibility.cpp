@@ -1,7 +1,8 @@
 // cli/commands/intervisibility.cpp: "hfvis intervisibility" (also "viewcount"): the visible
 // samples and ground area of every pixel (hfvis/intervisibility.hpp).
-#include "../pipeline.hpp"
 #include "hfvis/intervisibility.hpp"
+
+#include "../pipeline.hpp"
 
 namespace hfvis::cli {
 namespace {
@@ -17,8 +18,9 @@ class Intervisibility : public Computation {
   void compute(Job& job) override {
     IntervisibilityOptions options = intervisibilityOptions(run_);
     job.progress.attach(options);
-    result_ = job.progress.run(
-        [&] { return computeIntervisibility(*job.context, job.input, options, intervisibilityOutputs(run_)); });
+    result_ = job.progress.run([&] {
+      return computeIntervisibility(*job.context, job.input, options, intervisibilityOutputs(run_));
+    });
   }
 
   Summary write(Job& job, OutputFiles& outputs) override {
@@ -41,28 +43,32 @@ class Intervisibility : public Computation {
       attributes.emplace_back("hfvis:stats_m_a", formatNumber(stats.meanHorizons()));
       attributes.emplace_back("hfvis:stats_t_a", formatNumber(stats.meanIterations()));
       attributes.emplace_back("hfvis:stats_visible_per_point", formatNumber(stats.meanVisible()));
-      attributes.emplace_back("hfvis:stats_naive_iterations_per_point", formatNumber(stats.meanNaiveIterations()));
+      attributes.emplace_back("hfvis:stats_naive_iterations_per_point",
+                              formatNumber(stats.meanNaiveIterations()));
       attributes.emplace_back("hfvis:stats_receivers", std::to_string(stats.receivers));
       // Asked for explicitly: printed even with --quiet.
-      summary.always = "statistics per point and direction (Timonen 2013, Table 2): m_a " +
-                       formatFixed(stats.meanHorizons(), 3) + ", t_a " + formatFixed(stats.meanIterations(), 3) +
-                       " (--hull-tree " + (run_.hull_tree_name.empty() ? "default" : run_.hull_tree_name) + ")" +
-                       ", visible " + formatFixed(stats.meanVisible(), 3) + ", naive iterations " +
-                       formatFixed(stats.meanNaiveIterations(), 3) + " (" + std::to_string(stats.receivers) +
-                       " line samples, " + std::to_string(stats.lines_over_bound) + " lines over t <= 2m + n)";
+      summary.always =
+          "statistics per point and direction (Timonen 2013, Table 2): m_a " +
+          formatFixed(stats.meanHorizons(), 3) + ", t_a " + formatFixed(stats.meanIterations(), 3) +
+          " (--hull-tree " + (run_.hull_tree_name.empty() ? "default" : run_.hull_tree_name) + ")" +
+          ", visible " + formatFixed(stats.meanVisible(), 3) + ", naive iterations " +
+          formatFixed(stats.meanNaiveIterations(), 3) + " (" + std::to_string(stats.receivers) +
+          " line samples, " + std::to_string(stats.lines_over_bound) + " lines over t <= 2m + n)";
     }
     // "count" sorts before "visible_area", so the count is channel 0 in the EXR, whose
     // channels are stored sorted by name.
     outputs.image(
         run_.output,
-        job.image(field, {"count", "visible_area"}, {result_.visible_count, result_.visible_area}, attributes,
-                  "count: visible surface samples summed over the K directions; visible_area: the visible ground "
-                  "area (total viewshed), each visible sample at ground distance rho standing for (2*pi/K) * rho * "
-                  "drho",
-                  "count: samples (one per 1/S pixel lengths along each direction, S = samples per unit); "
-                  "visible_area: ground units squared"));
+        job.image(
+            field, {"count", "visible_area"}, {result_.visible_count, result_.visible_area}, attributes,
+            "count: visible surface samples summed over the K directions; visible_area: the visible ground "
+            "area (total viewshed), each visible sample at ground distance rho standing for (2*pi/K) * rho * "
+            "drho",
+            "count: samples (one per 1/S pixel lengths along each direction, S = samples per unit); "
+            "visible_area: ground units squared"));
     if (!run_.preview.empty())
-      outputs.previewPng(run_.preview, field.width, field.height, result_.visible_count);  // stretched min..max
+      outputs.previewPng(run_.preview, field.width, field.height,
+                         result_.visible_count);  // stretched min..max
     summary.note = "; mean count " + formatFixed(finiteMean(result_.visible_count), 2);
     return summary;
   }

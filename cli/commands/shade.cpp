@@ -25,9 +25,9 @@ std::vector<std::vector<float>> readAlbedo(const RunArguments& run, const Height
   }
   ImageChannels image = readImage(run.albedo);
   if (image.width != field.width || image.height != field.height)
-    throw IoError(run.albedo, "the albedo is " + std::to_string(image.width) + "x" + std::to_string(image.height) +
-                                  ", the height field " + std::to_string(field.width) + "x" +
-                                  std::to_string(field.height));
+    throw IoError(run.albedo, "the albedo is " + std::to_string(image.width) + "x" +
+                                  std::to_string(image.height) + ", the height field " +
+                                  std::to_string(field.width) + "x" + std::to_string(field.height));
   std::vector<std::vector<float>> planes;
   for (const char* name : {"R", "G", "B"})
     for (std::size_t i = 0; i < image.names.size(); ++i)
@@ -82,7 +82,8 @@ class Shade : public Computation {
         for (std::size_t p = 0; p < pixels; ++p) {
           double e = 0.0;
           if (environment_.given())
-            e += environment_.irradiance()[std::min<std::size_t>(c, environment_.channels() - 1) * pixels + p];
+            e +=
+                environment_.irradiance()[std::min<std::size_t>(c, environment_.channels() - 1) * pixels + p];
           if (sun_.given()) e += run_.sun_irradiance * sun_.direct()[p];
           out[p] = static_cast<float>(a[p] / M_PI * e);
         }
@@ -101,7 +102,8 @@ class Shade : public Computation {
           "irradiance)";
       lit.units += "radiance: per steradian";
     }
-    outputs.image(run_.output, job.image(field, lit.names, lit.planes, lit.attributes, lit.quantity, lit.units));
+    outputs.image(run_.output,
+                  job.image(field, lit.names, lit.planes, lit.attributes, lit.quantity, lit.units));
     if (!run_.preview.empty()) {
       if (!radiance.empty()) {
         outputs.toneMappedPng(run_.preview, field.width, field.height, radiance);
@@ -131,7 +133,8 @@ void checkShade(const std::string&, const RunArguments& run) {
   const bool sun = run.sun || (run.sun_time && run.latitude && run.longitude);
   if (!sun && (placed || run.environment.empty()))
     throw UsageError(
-        "missing the light: --env ENV.exr and / or the sun, --sun AZ,EL (compass azimuth, elevation) or --at TIME "
+        "missing the light: --env ENV.exr and / or the sun, --sun AZ,EL (compass azimuth, elevation) or --at "
+        "TIME "
         "--lat LAT --lon LON");
   if (run.environment.empty() && run.sweep_options_given)
     throw UsageError("-k, --method and --azimuth-offset need --env (the sun alone sweeps its own azimuth)");

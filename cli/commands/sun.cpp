@@ -1,10 +1,11 @@
 // cli/commands/sun.cpp: "hfvis sun-position" (also "sunpos"): the sun's compass azimuth and
 // elevation at a time and place (hfvis/sun.hpp).
+#include "hfvis/sun.hpp"
+
 #include <iomanip>
 #include <iostream>
 
 #include "../table.hpp"
-#include "hfvis/sun.hpp"
 
 namespace hfvis::cli {
 namespace {
@@ -13,8 +14,8 @@ namespace {
 int runSunPosition(const CommandLine& line) {
   const SunArguments& sun = line.sun;
   const SunPosition p = sunPosition(sun.utc_seconds, sun.latitude_deg, sun.longitude_deg, sun.apparent);
-  std::cout << std::fixed << std::setprecision(4) << "azimuth=" << p.azimuth_deg << " elevation=" << p.elevation_deg
-            << "\n";
+  std::cout << std::fixed << std::setprecision(4) << "azimuth=" << p.azimuth_deg
+            << " elevation=" << p.elevation_deg << "\n";
   return 0;
 }
 

@@ -17,7 +17,8 @@ HorizonResult computeSweptHorizons(Job& job, const HorizonOutputs& wanted) {
 Attributes sweptAttributes(const Job& job, const HorizonResult& result) {
   Attributes attributes = job.attributes(job.input);
   std::string used;
-  for (double azimuth : result.azimuths) used += (used.empty() ? "" : ",") + formatNumber(azimuth * 180.0 / M_PI);
+  for (double azimuth : result.azimuths)
+    used += (used.empty() ? "" : ",") + formatNumber(azimuth * 180.0 / M_PI);
   attributes.emplace_back("hfvis:azimuths_deg", used);
   return attributes;
 }

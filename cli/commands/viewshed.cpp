@@ -1,5 +1,7 @@
 // cli/commands/viewshed.cpp: "hfvis viewshed": what one observer sees, or how many of several see
 // each point (hfvis/viewshed.hpp).
+#include "hfvis/viewshed.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -8,7 +10,6 @@
 #include "../observer_files.hpp"
 #include "../pipeline.hpp"
 #include "hfvis/errors.hpp"
-#include "hfvis/viewshed.hpp"
 
 namespace hfvis::cli {
 namespace {
@@ -27,7 +28,8 @@ std::vector<float> hillshade(const HeightField& f) {
       const double gy = (at(x, y + 1) - at(x, y - 1)) / (2.0 * f.cell_size_y);
       const double n = std::sqrt(gx * gx + gy * gy + 1.0);
       const double lit = (-gx * lx - gy * ly + lz) / n;
-      shade[static_cast<std::size_t>(y) * f.width + x] = std::isfinite(lit) ? static_cast<float>(std::max(lit, 0.0)) : 0.0f;
+      shade[static_cast<std::size_t>(y) * f.width + x] =
+          std::isfinite(lit) ? static_cast<float>(std::max(lit, 0.0)) : 0.0f;
     }
   return shade;
 }
@@ -42,7 +44,8 @@ class Viewshed : public Computation {
   void prepare(const HeightField& field) override {
     for (const ReceiverPixel& p : run_.observers) observers_.push_back({p.col, p.row, run_.observer_height});
     if (!run_.observers_file.empty()) {
-      const std::vector<Observer> listed = readObserverFile(run_.observers_file, run_.observer_height, run_.absolute);
+      const std::vector<Observer> listed =
+          readObserverFile(run_.observers_file, run_.observer_height, run_.absolute);
       observers_.insert(observers_.end(), listed.begin(), listed.end());
     }
     for (const Observer& o : observers_) {
@@ -98,17 +101,20 @@ class Viewshed : public Computation {
       }
       std::size_t seen = 0, targets = 0;
       for (float v : r.visible) seen += v == 1.0f, targets += !std::isnan(v);
-      note_ = "; " + formatFixed(100.0 * seen / std::max<std::size_t>(targets, 1), 2) + " % of the points visible";
+      note_ = "; " + formatFixed(100.0 * seen / std::max<std::size_t>(targets, 1), 2) +
+              " % of the points visible";
       if (pyramid)
         note_ += cull_note + "; " + formatFixed(100.0 * r.culled / std::max<std::size_t>(targets, 1), 2) +
                  " % of the points culled";
       names_.push_back("visible");
       planes_.push_back(std::move(r.visible));
-      quantity_ = "visible: 1 where a target on the point is seen from the observer's eye, 0 where hidden or out of "
-                  "range" + std::string(run_.with_angle ? "; angle: the target's elevation angle from the eye" : "") +
-                  (run_.with_needed_height ? "; needed_height: the height above the surface a target there needs to "
-                                             "be seen (NaN out of range)"
-                                           : "");
+      quantity_ =
+          "visible: 1 where a target on the point is seen from the observer's eye, 0 where hidden or out of "
+          "range" +
+          std::string(run_.with_angle ? "; angle: the target's elevation angle from the eye" : "") +
+          (run_.with_needed_height ? "; needed_height: the height above the surface a target there needs to "
+                                     "be seen (NaN out of range)"
+                                   : "");
       units_ = std::string("visible: 1") + (run_.with_angle ? "; angle: degrees" : "") +
                (run_.with_needed_height ? "; needed_height: height units" : "");
     } else {
@@ -135,7 +141,8 @@ class Viewshed : public Computation {
     // A viewshed has no directions or sampling density.
     attributes.erase(std::remove_if(attributes.begin(), attributes.end(),
                                     [](const auto& a) {
-                                      return a.first == "hfvis:directions" || a.first == "hfvis:azimuth_offset_deg" ||
+                                      return a.first == "hfvis:directions" ||
+                                             a.first == "hfvis:azimuth_offset_deg" ||
                                              a.first == "hfvis:azimuth_convention" ||
                                              a.first == "hfvis:samples_per_unit";
                                     }),
@@ -156,8 +163,9 @@ class Viewshed : public Computation {
       attributes.emplace_back("hfvis:field_of_view_deg", formatNumber(run_.field_of_view->first) + " .. " +
                                                              formatNumber(run_.field_of_view->second));
     if (run_.elevation_range)
-      attributes.emplace_back("hfvis:elevation_range_deg", formatNumber(run_.elevation_range->first) + " .. " +
-                                                               formatNumber(run_.elevation_range->second));
+      attributes.emplace_back(
+          "hfvis:elevation_range_deg",
+          formatNumber(run_.elevation_range->first) + " .. " + formatNumber(run_.elevation_range->second));
     const ImageChannels image = job.image(input, names_, std::move(planes_), attributes, quantity_, units_);
     outputs.image(run_.output, image);
     if (!run_.preview.empty()) {
@@ -175,7 +183,8 @@ class Viewshed : public Computation {
                 : 0.3f * shade[p] + (seen[p] > 0.0f ? 0.35f + 0.35f * seen[p] / std::max(most, 1.0f) : 0.0f);
       outputs.previewPng(run_.preview, input.width, input.height, picture, 0.0f, 1.0f);
     }
-    return {static_cast<int>(observers_.size()), note_ + (lit_.flipped() ? " (computed north-up)" : ""), "observer"};
+    return {static_cast<int>(observers_.size()), note_ + (lit_.flipped() ? " (computed north-up)" : ""),
+            "observer"};
   }
 
  private:
@@ -188,7 +197,8 @@ class Viewshed : public Computation {
 
 void checkViewshed(const std::string&, const RunArguments& run) {
   if (!run.absolute && run.observer_height < 0.0)
-    throw UsageError("--observer-height: an eye below the surface sees nothing; give a height >= 0 (or --absolute)");
+    throw UsageError(
+        "--observer-height: an eye below the surface sees nothing; give a height >= 0 (or --absolute)");
   if (run.observers.empty() && run.observers_file.empty())
     throw UsageError("missing --observer COL,ROW or --observers FILE.csv (who looks)");
   if ((run.with_angle || run.with_needed_height) && (run.observers.size() > 1 || !run.observers_file.empty()))
