@@ -35,7 +35,7 @@ Conventions and units:
   Nodata     non-finite heights (NaN, +-inf) are nodata: they neither cast nor receive;
              every output is NaN there, and holes do not spread into valid neighbours.
   Outputs    float32 EXR (ZIP-compressed, through OpenEXR), with the run described in
-             string attributes hfvis:*; GeoTIFF for .tif/.tiff (horizons: JSON
+             string attributes hfvis:*; GeoTIFF for .tif/.tiff (horizon-lists: JSON
              or CSV text). Files are written to a temporary name and renamed only once every
              output of the run is complete, so a failed run leaves no partial or mismatched
              output behind.
@@ -90,7 +90,7 @@ const char* groupTitle(unsigned group) {
     case kSunShadingGroup:
       return "Sun shading";
     default:
-      return "Options";  // a command's own group
+      return "";  // a command's own group
   }
 }
 
@@ -112,8 +112,9 @@ std::string optionHelp(const OptionSpec& option) {
                   "  " + flags + std::string(flags.size() < 23 ? 25 - flags.size() : 2, ' '));
 }
 
-// The options of the groups in `groups`, under a heading per group naming the commands taking it.
-std::string optionsHelp(unsigned groups) {
+// The options of the groups in `groups`, under a heading per group (naming the commands that take it
+// where `name_takers`).
+std::string optionsHelp(unsigned groups, bool name_takers) {
   std::string out;
   for (unsigned group = 1; group <= kLastGroup; group <<= 1) {
     if (!(groups & group)) continue;
@@ -125,7 +126,11 @@ std::string optionsHelp(unsigned groups) {
     std::string named;
     for (const std::string& name : by_others ? others : takers) named += (named.empty() ? "" : ", ") + name;
     if (by_others) named = others.empty() ? "every command that reads a height field" : "all but " + named;
-    out += std::string("\n") + groupTitle(group) + " (" + named + "):\n";
+    const std::string title = groupTitle(group);
+    if (title.empty())  // a command's own group
+      out += "\nOptions of " + named + ":\n";
+    else
+      out += "\n" + title + (name_takers ? " (" + named + ")" : "") + ":\n";
     for (const OptionSpec& option : optionTable())
       if (option.group == group) out += optionHelp(option);
   }
@@ -174,7 +179,7 @@ std::string generalHelp() {
              "lighting by "
              "HDR environments and the sun on height fields (OpenCL)\n\n") +
          usage + commands + "\nOptions, by group (the commands that take each in brackets):\n" +
-         optionsHelp(groups) + "\n  -h, --help               show help\n" + notes + kConventions +
+         optionsHelp(groups, true) + "\n  -h, --help               show help\n" + notes + kConventions +
          kExitStatus;
 }
 
@@ -182,7 +187,7 @@ std::string commandHelp(Command id) {
   const CommandSpec& command = commandSpec(id);
   std::string help = usageLine(command, 0) + aliasLine(command) + "\n" + command.description;
   if (!command.groups) return help;  // (devices, sun-position: no options of the table, no outputs)
-  help += "\nOptions:" + optionsHelp(command.groups) + "\n  -h, --help               show help\n";
+  help += optionsHelp(command.groups, false) + "\n  -h, --help               show help\n";
   if (command.notes) help += "\n" + std::string(command.notes);
   return help + kConventions + kExitStatus;
 }

@@ -296,7 +296,7 @@ std::string joinPaths(const std::vector<std::string>& paths) {
 int runPipeline(const CommandLine& line, Computation& computation) {
   const RunArguments& run = line.run;
   requireOutputs(run, computation);
-  const HeightField input = readValidField(run);
+  HeightField input = readValidField(run);
   computation.prepare(input);
   // (a command on the host, writing text, opens no device)
   std::optional<ComputeContext> context;

@@ -138,8 +138,9 @@ class Computation {
   // hfvis:method and the summary's method.
   virtual std::string method() const;
   // After the height field is read, before the device is set up: the command's own inputs read
-  // and checked against the field.
-  virtual void prepare(const HeightField& /*field*/) {}
+  // and checked against the field. A command that computes on a copy of the field may drop the
+  // field's heights here (its size and cell size stay).
+  virtual void prepare(HeightField& /*field*/) {}
   // The computation (timed).
   virtual void compute(Job& job) = 0;
   // Stages every output into `outputs` (committed all together by the pipeline).

@@ -19,7 +19,7 @@ class Bounce : public Computation {
   std::vector<std::string> otherInputs() const override { return {run_.radiance}; }
   std::string method() const override { return "tree"; }
 
-  void prepare(const HeightField& field) override {
+  void prepare(HeightField& field) override {
     // A latitude / longitude grid has a spacing per row, which every operation follows but the
     // bounce: it takes the centre latitude's for the whole field, and says so.
     if (!field.row_cell_size_x.empty()) {

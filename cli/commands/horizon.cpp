@@ -60,7 +60,7 @@ class Horizon : public Computation {
   // K-channel horizon maps of a huge field outgrow the host before anything is computed: the
   // planes are held about three times (the result, its channels, the writer's buffer). Refused
   // then, saying what to ask for instead.
-  void prepare(const HeightField& field) override {
+  void prepare(HeightField& field) override {
     const double plane = static_cast<double>(field.pixelCount()) * sizeof(float);
     const double planes = plane * run_.directions * (run_.distance_output.empty() ? 1 : 2);
     const double need = 3.0 * planes, available = availableHostBytes();

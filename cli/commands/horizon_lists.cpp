@@ -21,7 +21,7 @@ class HorizonLists : public Computation {
   std::string method() const override { return "tree on the receivers' rays"; }
 
   // A receiver outside the field is a usage error, found once the field's size is known.
-  void prepare(const HeightField& field) override {
+  void prepare(HeightField& field) override {
     for (const ReceiverPixel& p : run_.receivers) {
       if (p.col >= field.width || p.row >= field.height) {
         throw UsageError("--at " + std::to_string(p.col) + "," + std::to_string(p.row) +

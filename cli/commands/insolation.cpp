@@ -13,9 +13,14 @@ class Insolation : public Computation {
 
   std::string method() const override { return "sweep"; }
 
+  // Row 0 is taken as north: a south-up or west-up field is computed flipped (and only the
+  // input's size is read from here on).
+  void prepare(HeightField& field) override {
+    lit_ = northUp(field);
+    if (lit_.flipped()) field.heights = {};
+  }
+
   void compute(Job& job) override {
-    // Row 0 is taken as north: a south-up or west-up field is computed flipped.
-    lit_ = northUp(job.input);
     const HeightField& field = lit_.field();
     HorizonOptions sweep = horizonOptions(run_);
     job.progress.attach(sweep);

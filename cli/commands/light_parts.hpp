@@ -52,7 +52,6 @@ class SunShading {
   const std::vector<float>& direct() const { return result_.direct; }
 
  private:
-  const RunArguments& run_;
   std::optional<SunLight> sun_;
   SunShadingResult result_;
 };

@@ -49,9 +49,11 @@ class Shade : public Computation {
 
   std::vector<std::string> otherInputs() const override { return {run_.environment, run_.albedo}; }
 
-  // Row 0 is taken as north: a south-up or west-up field is lit flipped.
-  void prepare(const HeightField& field) override {
+  // Row 0 is taken as north: a south-up or west-up field is lit flipped (and only the input's size
+  // is read from here on).
+  void prepare(HeightField& field) override {
     lit_ = northUp(field);
+    if (lit_.flipped()) field.heights = {};
     if (environment_.given()) environment_.read();
     if (!run_.albedo.empty()) albedo_ = readAlbedo(run_, lit_.field());
   }

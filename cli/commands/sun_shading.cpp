@@ -7,7 +7,7 @@
 
 namespace hfvis::cli {
 
-SunShading::SunShading(const RunArguments& run) : run_(run) {
+SunShading::SunShading(const RunArguments& run) {
   if (!run.sun && !run.sun_time) return;
   sun_.emplace();
   sun_->size_deg = run.sun_size_deg;

@@ -41,7 +41,7 @@ class Viewshed : public Computation {
   std::string method() const override { return run_.culled ? "culled" : "exact"; }
 
   // The observers: --observer's, then the --observers file's, each checked against the field.
-  void prepare(const HeightField& field) override {
+  void prepare(HeightField& field) override {
     for (const ReceiverPixel& p : run_.observers) observers_.push_back({p.col, p.row, run_.observer_height});
     if (!run_.observers_file.empty()) {
       const std::vector<Observer> listed =
