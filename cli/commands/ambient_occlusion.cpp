@@ -6,6 +6,7 @@ namespace hfvis::cli {
 namespace {
 
 const HorizonQuantity kAmbientOcclusion{
+    Command::AmbientOcclusion,
     "ao",
     "ambient occlusion",
     "ambient occlusion, uniform sky of radiance 1 (Timonen & Westerholm 2010, Eq. 5)",
@@ -13,15 +14,6 @@ const HorizonQuantity kAmbientOcclusion{
     &HorizonOutputs::ambient_occlusion,
     &HorizonResult::ambient_occlusion,
 };
-
-class AmbientOcclusion : public HorizonQuantityComputation {
- public:
-  explicit AmbientOcclusion(const RunArguments& run) : HorizonQuantityComputation(run, kAmbientOcclusion) {}
-};
-
-void checkAmbientOcclusion(const std::string&, const RunArguments& run) {
-  asUsageError([&] { validate(horizonOptions(run), horizonOutputs(Command::AmbientOcclusion, run)); });
-}
 
 }  // namespace
 
@@ -37,9 +29,9 @@ const CommandSpec kAmbientOcclusionCommand{
     "summary line prints both ends); NaN (nodata) is black.\n",
     nullptr,
     kSweptFieldGroups | kSweepMethodGroup,
-    checkAmbientOcclusion,
+    checkHorizonQuantity<kAmbientOcclusion>,
     nullptr,
-    pipelined<AmbientOcclusion>,
+    runHorizonQuantity<kAmbientOcclusion>,
 };
 
 }  // namespace hfvis::cli

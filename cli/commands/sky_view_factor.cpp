@@ -6,6 +6,7 @@ namespace hfvis::cli {
 namespace {
 
 const HorizonQuantity kSkyViewFactor{
+    Command::SkyViewFactor,
     "svf",
     "sky-view factor",
     "sky-view factor 1 - mean_k sin(max(0, elevation_k))",
@@ -13,15 +14,6 @@ const HorizonQuantity kSkyViewFactor{
     &HorizonOutputs::sky_view_factor,
     &HorizonResult::sky_view_factor,
 };
-
-class SkyViewFactor : public HorizonQuantityComputation {
- public:
-  explicit SkyViewFactor(const RunArguments& run) : HorizonQuantityComputation(run, kSkyViewFactor) {}
-};
-
-void checkSkyViewFactor(const std::string&, const RunArguments& run) {
-  asUsageError([&] { validate(horizonOptions(run), horizonOutputs(Command::SkyViewFactor, run)); });
-}
 
 }  // namespace
 
@@ -37,9 +29,9 @@ const CommandSpec kSkyViewFactorCommand{
     "summary line prints both ends); NaN (nodata) is black.\n",
     nullptr,
     kSweptFieldGroups | kSweepMethodGroup,
-    checkSkyViewFactor,
+    checkHorizonQuantity<kSkyViewFactor>,
     nullptr,
-    pipelined<SkyViewFactor>,
+    runHorizonQuantity<kSkyViewFactor>,
 };
 
 }  // namespace hfvis::cli

@@ -18,6 +18,7 @@ Attributes sweptAttributes(const Job& job, const HorizonResult& result);
 
 // One channel computed from the horizons.
 struct HorizonQuantity {
+  Command command;
   const char* channel;  // its name, "svf"
   const char* what;     // in messages, "sky-view factor"
   const char* quantity;
@@ -37,5 +38,16 @@ class HorizonQuantityComputation : public Computation {
   const HorizonQuantity& quantity_;
   HorizonResult result_;
 };
+
+// The CommandSpec::check and ::run of a command that writes `quantity`.
+template <const HorizonQuantity& quantity>
+void checkHorizonQuantity(const std::string&, const RunArguments& run) {
+  asUsageError([&] { validate(horizonOptions(run), horizonOutputs(quantity.command, run)); });
+}
+template <const HorizonQuantity& quantity>
+int runHorizonQuantity(const CommandLine& line) {
+  HorizonQuantityComputation computation(line.run, quantity);
+  return runPipeline(line, computation);
+}
 
 }  // namespace hfvis::cli
