@@ -1,4 +1,6 @@
-// cli/arguments.cpp: parsing and validating the hfvis command line.
+// cli/arguments.cpp: parsing and validating the hfvis command line: every option declared once
+// (optionTable(): its flag, value, help, group and the field it binds), the parser that reads
+// the option and command tables (cli/table.hpp), and the library options a run asks for.
 #include "arguments.hpp"
 
 #include <algorithm>
