@@ -1,4 +1,6 @@
-// cli/arguments.cpp: parsing and validating the hfvis command line.
+// cli/arguments.cpp: parsing and validating the hfvis command line: every option declared once
+// (optionTable(): its flag, value, help, group and the field it binds), the parser that reads
+// the option and command tables (cli/table.hpp), and the library options a run asks for.
 #include "arguments.hpp"
 
 #include <algorithm>
@@ -12,124 +14,17 @@
 #include <set>
 #include <tuple>
 
+#include "core/message_numbers.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/insolation.hpp"
-#include "hfvis/sun_shading.hpp"
 #include "hfvis/sun.hpp"
-#include "core/message_numbers.hpp"
+#include "hfvis/sun_shading.hpp"
+#include "table.hpp"
 
 namespace hfvis::cli {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr const char* kCommandList =
-    "horizon, svf, ao, viewcount, horizons, bounce, shade, insolation, viewshed, sunpos or devices";
-
-// One option of the compute commands (horizon, svf, ao, viewcount, horizons, bounce).
-enum class Option {
-  Output,
-  Directions,
-  Method,
-  AzimuthOffset,
-  SamplesPerUnit,
-  CellSize,
-  ZScale,
-  Channel,
-  Device,
-  MemoryBudget,
-  Preview,
-  DistanceOutput,
-  AzimuthTolerance,
-  Statistics,
-  HullTree,
-  At,
-  Radiance,
-  Quiet,
-  Curvature,
-  Refraction,
-  MaxDistance,
-  Nodata,
-  Sun,
-  SunSize,
-  Latitude,
-  Longitude,
-  Environment,
-  EnvironmentRotation,
-  EnvironmentRows,
-  Albedo,
-  SunIrradiance,
-  From,
-  To,
-  Step,
-  AzimuthBucket,
-  Apparent,
-  Observer,
-  Observers,
-  ObserverHeight,
-  TargetHeight,
-  Absolute,
-  FieldOfView,
-  ElevationRange,
-  Angle,
-  NeededHeight,
-  CullLevel,
-};
-
-struct OptionSpec {
-  Option option;
-  const char* long_name;   // "--output"
-  const char* short_name;  // "-o", or nullptr
-  bool takes_value;
-};
-
-constexpr OptionSpec kOptions[] = {
-    {Option::Output, "--output", "-o", true},
-    {Option::Directions, "--directions", "-k", true},
-    {Option::Method, "--method", nullptr, true},
-    {Option::AzimuthOffset, "--azimuth-offset", nullptr, true},
-    {Option::SamplesPerUnit, "--samples-per-unit", nullptr, true},
-    {Option::CellSize, "--cell-size", nullptr, true},
-    {Option::ZScale, "--z-scale", nullptr, true},
-    {Option::Channel, "--channel", nullptr, true},
-    {Option::Device, "--device", nullptr, true},
-    {Option::MemoryBudget, "--memory-budget", nullptr, true},
-    {Option::Preview, "--preview", nullptr, true},
-    {Option::DistanceOutput, "--distance-out", nullptr, true},
-    {Option::AzimuthTolerance, "--azimuth-tolerance", nullptr, true},
-    {Option::Statistics, "--stats", nullptr, false},
-    {Option::HullTree, "--hull-tree", nullptr, true},
-    {Option::At, "--at", nullptr, true},
-    {Option::Radiance, "--radiance", nullptr, true},
-    {Option::Quiet, "--quiet", "-q", false},
-    {Option::Curvature, "--curvature", nullptr, false},
-    {Option::Refraction, "--refraction", nullptr, true},
-    {Option::MaxDistance, "--max-distance", nullptr, true},
-    {Option::Nodata, "--nodata", nullptr, true},
-    {Option::Sun, "--sun", nullptr, true},
-    {Option::SunSize, "--sun-size", nullptr, true},
-    {Option::Latitude, "--lat", nullptr, true},
-    {Option::Longitude, "--lon", nullptr, true},
-    {Option::Environment, "--env", nullptr, true},
-    {Option::EnvironmentRotation, "--env-rotate", nullptr, true},
-    {Option::EnvironmentRows, "--env-rows", nullptr, true},
-    {Option::Albedo, "--albedo", nullptr, true},
-    {Option::SunIrradiance, "--sun-irradiance", nullptr, true},
-    {Option::From, "--from", nullptr, true},
-    {Option::To, "--to", nullptr, true},
-    {Option::Step, "--step", nullptr, true},
-    {Option::AzimuthBucket, "--azimuth-bucket", nullptr, true},
-    {Option::Apparent, "--apparent", nullptr, false},
-    {Option::Observer, "--observer", nullptr, true},
-    {Option::Observers, "--observers", nullptr, true},
-    {Option::ObserverHeight, "--observer-height", nullptr, true},
-    {Option::TargetHeight, "--target-height", nullptr, true},
-    {Option::Absolute, "--absolute", nullptr, false},
-    {Option::FieldOfView, "--fov", nullptr, true},
-    {Option::ElevationRange, "--elevation-range", nullptr, true},
-    {Option::Angle, "--angle", nullptr, false},
-    {Option::NeededHeight, "--needed-height", nullptr, false},
-    {Option::CullLevel, "--cull-level", nullptr, true},
-};
 
 // The options every sweep operation shares, as typed (degrees become radians).
 template <typename Options>
@@ -144,30 +39,11 @@ void setSweepOptions(const RunArguments& run, Options& options) {
 
 bool isHelpFlag(const std::string& arg) { return arg == "-h" || arg == "--help"; }
 
-std::optional<Command> findCommand(const std::string& name) {
-  if (name == "horizon") return Command::Horizon;
-  if (name == "svf") return Command::SkyViewFactor;
-  if (name == "ao") return Command::AmbientOcclusion;
-  if (name == "viewcount") return Command::ViewCount;
-  if (name == "horizons") return Command::HorizonLists;
-  if (name == "bounce") return Command::Bounce;
-  if (name == "devices") return Command::Devices;
-  if (name == "sunpos") return Command::SunPosition;
-  if (name == "shade") return Command::Shade;
-  if (name == "insolation") return Command::Insolation;
-  if (name == "viewshed") return Command::Viewshed;
-  if (name == "help") return Command::Help;
-  return std::nullopt;
-}
-
-const OptionSpec* findOption(const std::string& name) {
-  for (const OptionSpec& spec : kOptions) {
-    if (name == spec.long_name || (spec.short_name && name == spec.short_name)) return &spec;
-  }
-  return nullptr;
-}
+}  // namespace
 
 std::string inQuotes(const std::string& text) { return "'" + text + "'"; }
+
+namespace {
 
 // A value as a message shows it: at most 40 characters of what was typed.
 std::string shortened(const std::string& text) {
@@ -285,77 +161,15 @@ ReceiverPixel parseReceiver(const std::string& option, const std::string& text) 
   return pixel;
 }
 
+}  // namespace
+
 bool hasExtension(const std::string& path, const char* wanted) {
   std::string extension = std::filesystem::path(path).extension().string();
   for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return extension == wanted;
 }
 
-// Which commands take an option; nullptr = every compute command.
-const char* onlyFor(Option option) {
-  switch (option) {
-    case Option::DistanceOutput:
-    case Option::AzimuthTolerance:
-      return "horizon";
-    case Option::Statistics:
-      return "viewcount";
-    case Option::Sun:
-    case Option::Environment:
-    case Option::EnvironmentRotation:
-    case Option::EnvironmentRows:
-    case Option::Albedo:
-    case Option::SunIrradiance:
-      return "shade";
-    case Option::From:
-    case Option::To:
-    case Option::Step:
-    case Option::AzimuthBucket:
-    case Option::Apparent:
-      return "insolation";
-    case Option::Radiance:
-      return "bounce";
-    case Option::Observer:
-    case Option::Observers:
-    case Option::ObserverHeight:
-    case Option::TargetHeight:
-    case Option::Absolute:
-    case Option::FieldOfView:
-    case Option::ElevationRange:
-    case Option::Angle:
-    case Option::NeededHeight:
-    case Option::CullLevel:
-      return "viewshed";
-    default:
-      return nullptr;
-  }
-}
-
-// Options that make no sense for a command (the horizon lists are computed on the host,
-// one ray per receiver and direction, and written as text).
-bool notFor(Option option, Command command) {
-  // --at: receivers for the horizon lists, the sun's time for shade.
-  if (option == Option::At) return command != Command::HorizonLists && command != Command::Shade;
-  // The sun's place and size: shade and insolation.
-  if (option == Option::Latitude || option == Option::Longitude || option == Option::SunSize)
-    return command != Command::Shade && command != Command::Insolation;
-  // A viewshed marches sight lines: no directions, sampling density or hull tree.
-  if (command == Command::Viewshed)
-    return option == Option::Directions || option == Option::AzimuthOffset || option == Option::SamplesPerUnit ||
-           option == Option::HullTree;
-  // insolation sweeps the sun's azimuths alone, by the sweep; shade takes directions for --env.
-  if (command == Command::Insolation)
-    return option == Option::Directions || option == Option::Method || option == Option::AzimuthOffset ||
-           option == Option::MaxDistance;
-  if (command == Command::HorizonLists) {
-    return option == Option::Method || option == Option::Device || option == Option::MemoryBudget ||
-           option == Option::Preview || option == Option::MaxDistance || option == Option::Nodata;
-  }
-  if (option == Option::HullTree) return command != Command::ViewCount && command != Command::Bounce;
-  if (option == Option::MaxDistance) return command == Command::Bounce;
-  // Earth curvature: not for the bounce (a rendering operation) so far.
-  if (option == Option::Curvature || option == Option::Refraction) return command == Command::Bounce;
-  return command == Command::Bounce && option == Option::Method;
-}
+namespace {
 
 // "X" or "X,Y", ground units per pixel along columns and rows.
 void parseCellSize(const std::string& option, const std::string& text, RunArguments& run) {
@@ -381,343 +195,369 @@ std::size_t parseMemoryBudget(const std::string& option, const std::string& text
   return static_cast<std::size_t>(bytes);
 }
 
-bool hasPngExtension(const std::string& path) { return hasExtension(path, ".png"); }
-
+// A path value: any text but empty.
 void requireNonEmpty(const std::string& option, const std::string& value) {
   if (value.empty()) throw UsageError(option + ": the value must not be empty");
 }
 
-void applyOption(const OptionSpec& spec, const std::string& typed, const std::string& value, Command command,
-                 RunArguments& run) {
-  if (const char* only = onlyFor(spec.option); only && commandName(command) != std::string(only)) {
-    throw UsageError(typed + " is only available with 'hfvis " + only + "'");
-  }
-  if (notFor(spec.option, command)) {
-    throw UsageError(typed + " is not available with 'hfvis " + commandName(command) + "'");
-  }
-  switch (spec.option) {
-    case Option::Output:
-      requireNonEmpty(typed, value);
-      run.output = value;
-      break;
-    case Option::Directions:
-      run.directions = parseDirectionCount(typed, value);
-      run.sweep_options_given = true;
-      break;
-    case Option::Method:
-      run.sweep_options_given = true;
-      if (command == Command::ViewCount) {
-        run.visibility_method = parseVisibilityMethod(typed, value);
-      } else if (command == Command::Viewshed) {
-        if (value != "exact" && value != "culled")
-          throw UsageError(typed + ": expected 'exact' or 'culled', got " + inQuotes(value));
-        run.culled = value == "culled";
-      } else {
-        run.method = parseMethod(typed, value);
-      }
-      break;
-    case Option::AzimuthOffset:
-      run.azimuth_offset_deg =
-          parseBounded(typed, value, -360.0, 360.0, "every direction has an offset in it");
-      run.sweep_options_given = true;
-      break;
-    case Option::SamplesPerUnit:
-      run.samples_per_unit = parsePositive(typed, value);
-      break;
-    case Option::CellSize:
-      parseCellSize(typed, value, run);
-      break;
-    case Option::ZScale:
-      run.z_scale = parsePositive(typed, value);
-      run.z_scale = parseBounded(typed, value, 1e-12, 1e12, kFloatRange);
-      break;
-    case Option::Channel:
-      requireNonEmpty(typed, value);
-      run.channel = value;
-      break;
-    case Option::Device:
-      requireNonEmpty(typed, value);
-      run.device = value;
-      break;
-    case Option::MemoryBudget:
-      run.memory_budget_bytes = parseMemoryBudget(typed, value);
-      break;
-    case Option::Preview:
-      requireNonEmpty(typed, value);
-      if (!hasPngExtension(value)) {
-        throw UsageError(typed + ": the preview is a PNG file; its name must end in .png, got " +
-                         inQuotes(value));
-      }
-      run.preview = value;
-      break;
-    case Option::DistanceOutput:
-      requireNonEmpty(typed, value);
-      run.distance_output = value;
-      break;
-    case Option::AzimuthTolerance:
-      run.azimuth_tolerance_deg = parsePositive(typed, value);
-      run.azimuth_tolerance_deg = parseBounded(typed, value, 0.0, kMostAzimuthTolerance,
-                                               "the azimuth tolerance is 0.1 radian at most");
-      break;
-    case Option::Statistics:
-      run.statistics = true;
-      break;
-    case Option::HullTree:
-      if (const auto tuning = hullTreeTuningNamed(value)) {
-        run.hull_tree = *tuning;
-        run.hull_tree_name = value;
-      } else {
-        throw UsageError(typed + ": expected plain, deferred, default or zone, got " + inQuotes(value));
-      }
-      break;
-    case Option::At:
-      if (command == Command::Shade) {
-        try {
-          run.sun_time = parseUtcTime(value);
-        } catch (const InvalidArgument& error) {
-          throw UsageError(typed + ": " + error.what());
-        }
-      } else {
-        run.receivers.push_back(parseReceiver(typed, value));
-      }
-      break;
-    case Option::Sun: {
-      const std::size_t comma = value.find(',');
-      if (comma == std::string::npos)
-        throw UsageError(typed + ": expected AZ,EL (compass azimuth and elevation, degrees), got " + inQuotes(value));
-      const double azimuth =
-          parseBounded(typed, value.substr(0, comma), -360.0, 360.0, "every azimuth has an equal one in it");
-      const double elevation = parseNumber(typed, value.substr(comma + 1));
-      if (elevation < -90.0 || elevation > 90.0)
-        throw UsageError(typed + ": the elevation must be in -90 .. 90 degrees, got " + inQuotes(value));
-      run.sun = std::make_pair(azimuth, elevation);
-      break;
-    }
-    case Option::SunSize:
-      run.sun_size_deg = parseNumber(typed, value);
-      if (!(run.sun_size_deg >= 0.0 && run.sun_size_deg <= 10.0))
-        throw UsageError(typed +
-                         ": the sun's diameter must be in 0 (a point: hard shadows) .. 10 degrees, got " +
-                         inQuotes(value));
-      break;
-    case Option::Latitude:
-      run.latitude = parseNumber(typed, value);
-      if (*run.latitude < -90.0 || *run.latitude > 90.0)
-        throw UsageError(typed + ": expected a latitude in -90 .. 90 degrees, got " + inQuotes(value));
-      break;
-    case Option::Longitude:
-      run.longitude = parseNumber(typed, value);
-      if (*run.longitude < -180.0 || *run.longitude > 360.0)
-        throw UsageError(typed + ": expected a longitude in -180 .. 360 degrees, got " + inQuotes(value));
-      break;
-    case Option::Radiance:
-      requireNonEmpty(typed, value);
-      run.radiance = value;
-      break;
-    case Option::Environment:
-      requireNonEmpty(typed, value);
-      run.environment = value;
-      break;
-    case Option::EnvironmentRotation:
-      run.environment_rotation_deg =
-          parseBounded(typed, value, -360.0, 360.0, "every rotation has an angle in it");
-      break;
-    case Option::EnvironmentRows: {
-      const double rows = parsePositive(typed, value);
-      if (rows != std::floor(rows) || rows > 65536)
-        throw UsageError(typed + ": expected a whole number of bands in 1 .. 65536, got " + inQuotes(value));
-      run.environment_rows = static_cast<int>(rows);
-      break;
-    }
-    case Option::Albedo:
-      requireNonEmpty(typed, value);
-      run.albedo = value;
-      break;
-    case Option::SunIrradiance:
-      run.sun_irradiance = parsePositive(typed, value);
-      run.sun_irradiance = parseBounded(typed, value, 0.0, 1e12, kFloatRange);
-      break;
-    case Option::From:
-    case Option::To: {
-      std::optional<double>& time = spec.option == Option::From ? run.from_time : run.to_time;
-      try {
-        time = parseUtcTime(value);
-      } catch (const InvalidArgument& error) {
-        throw UsageError(typed + ": " + error.what());
-      }
-      break;
-    }
-    case Option::Step:
-      run.step_minutes = parsePositive(typed, value);
-      if (run.step_minutes > 1440.0) throw UsageError(typed + ": at most 1440 minutes, got " + inQuotes(value));
-      break;
-    case Option::AzimuthBucket:
-      run.azimuth_bucket_deg = parsePositive(typed, value);
-      if (run.azimuth_bucket_deg > 10.0) throw UsageError(typed + ": at most 10 degrees, got " + inQuotes(value));
-      break;
-    case Option::Apparent:
-      run.apparent = true;
-      break;
-    case Option::Quiet:
-      run.quiet = true;
-      break;
-    case Option::Curvature:
-      run.curvature = true;
-      break;
-    case Option::Refraction:
-      run.refraction = parseNumber(typed, value);
-      if (!(run.refraction >= -1.0 && run.refraction <= 1.0))
-        throw UsageError(typed + ": the refraction coefficient must be in -1 .. 1, got " + inQuotes(value));
-      run.curvature = true;  // refraction bends rays over the curved Earth
-      break;
-    case Option::MaxDistance:
-      run.max_distance = parsePositive(typed, value);
-      run.max_distance = parseBounded(typed, value, 0.0, kMostLength, kFloatRange);
-      break;
-    case Option::Nodata:
-      run.nodata = parseNodata(typed, value);
-      break;
-    case Option::Observer:
-      run.observers.push_back(parseReceiver(typed, value));
-      break;
-    case Option::Observers:
-      requireNonEmpty(typed, value);
-      run.observers_file = value;
-      break;
-    case Option::ObserverHeight:
-      run.observer_height = parseBounded(typed, value, -kMostLength, kMostLength, kFloatRange);
-      break;
-    case Option::TargetHeight:
-      run.target_height = parseNumber(typed, value);
-      if (run.target_height < 0.0) throw UsageError(typed + ": must be >= 0, got " + inQuotes(value));
-      run.target_height = parseBounded(typed, value, 0.0, kMostLength, kFloatRange);
-      break;
-    case Option::Absolute:
-      run.absolute = true;
-      break;
-    case Option::FieldOfView:
-    case Option::ElevationRange: {
-      const bool fov = spec.option == Option::FieldOfView;
-      const std::size_t comma = value.find(',');
-      if (comma == std::string::npos)
-        throw UsageError(typed + (fov ? ": expected FROM,TO (compass degrees, clockwise from FROM), got "
-                                      : ": expected LO,HI (elevation degrees), got ") +
-                         inQuotes(value));
-      const double a = parseNumber(typed, value.substr(0, comma)), b = parseNumber(typed, value.substr(comma + 1));
-      if (fov && !(a >= 0.0 && a <= 360.0 && b >= 0.0 && b <= 360.0))
-        throw UsageError(typed + ": compass azimuths are in 0 .. 360 degrees, got " + inQuotes(value));
-      if (!fov && !(a >= -90.0 && b <= 90.0 && a <= b))
-        throw UsageError(typed + ": expected -90 <= LO <= HI <= 90 degrees, got " + inQuotes(value));
-      (fov ? run.field_of_view : run.elevation_range) = std::make_pair(a, b);
-      break;
-    }
-    case Option::Angle:
-      run.with_angle = true;
-      break;
-    case Option::NeededHeight:
-      run.with_needed_height = true;
-      break;
-    case Option::CullLevel: {
-      const double k = parseNumber(typed, value);
-      if (!(k >= 1.0 && k <= 12.0 && k == std::floor(k)))
-        throw UsageError(typed + ": expected a whole number 1 .. 12 (nodes of 2^K x 2^K points), got " + inQuotes(value));
-      run.cull_level = static_cast<int>(k);
-      run.cull_level_given = true;
-      break;
-    }
+// "AZ,EL"-like pairs: "FIRST,SECOND" split at the first comma, or `expected` thrown.
+std::pair<std::string, std::string> splitPair(const std::string& typed, const std::string& value,
+                                              const std::string& expected) {
+  const std::size_t comma = value.find(',');
+  if (comma == std::string::npos) throw UsageError(typed + expected + inQuotes(value));
+  return {value.substr(0, comma), value.substr(comma + 1)};
+}
+
+void parseUtcTimeInto(const std::string& typed, const std::string& value, std::optional<double>& time) {
+  try {
+    time = parseUtcTime(value);
+  } catch (const InvalidArgument& error) {
+    throw UsageError(typed + ": " + error.what());
   }
 }
+
+// A flag that sets one bool field.
+#define HFVIS_FLAG(field) [](const std::string&, const std::string&, RunArguments& run) { run.field = true; }
+// A path or name: any non-empty text.
+#define HFVIS_TEXT(field)                                                     \
+  [](const std::string& typed, const std::string& value, RunArguments& run) { \
+    requireNonEmpty(typed, value);                                            \
+    run.field = value;                                                        \
+  }
+
+}  // namespace
+
+// The options, one line each where they take what they say; the help lists them in this order.
+const std::vector<OptionSpec>& optionTable() {
+  static const std::vector<OptionSpec> table{
+      {"--output", "-o", "FILE", kOutputGroup, false,
+       "output image (required): float32 EXR, or a float32 GeoTIFF when the\n"
+       "name ends in .tif or .tiff (the input's georeference kept; see\n"
+       "Conventions, GIS); horizon-lists: OUT.json or OUT.csv",
+       HFVIS_TEXT(output)},
+      {"--quiet", "-q", nullptr, kOutputGroup, false, "print neither progress nor the summary line",
+       HFVIS_FLAG(quiet)},
+      {"--channel", nullptr, "NAME|INDEX", kInputGroup, false,
+       "input channel (a raster's band: its description or zero-based index)\n"
+       "to read; needed for multi-channel images",
+       HFVIS_TEXT(channel)},
+      {"--cell-size", nullptr, "X[,Y]", kInputGroup, false,
+       "ground units per pixel along columns (X) and rows (Y)\n"
+       "(default: from the file (a raster's geotransform, the\n"
+       "hfvis:cell_size_x/y attributes), else 1)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         parseCellSize(typed, value, run);
+       }},
+      {"--z-scale", nullptr, "Z", kInputGroup, false,
+       "multiplies every height, e.g. 0.3048 for feet over metre cells (default 1)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         parsePositive(typed, value);
+         run.z_scale = parseBounded(typed, value, 1e-12, 1e12, kFloatRange);
+       }},
+      {"--preview", nullptr, "PNG", kImageGroup, false, "also write an 8-bit PNG preview",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         requireNonEmpty(typed, value);
+         if (!hasExtension(value, ".png"))
+           throw UsageError(typed + ": the preview is a PNG file; its name must end in .png, got " +
+                            inQuotes(value));
+         run.preview = value;
+       }},
+      {"--nodata", nullptr, "VALUE", kImageGroup, false,
+       "GeoTIFF outputs: write VALUE (a finite float32 number, or nan) in\n"
+       "nodata cells and declare it as every band's nodata value (default\n"
+       "nan); EXR outputs keep NaN. Needs a .tif/.tiff output",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.nodata = parseNodata(typed, value);
+       }},
+      {"--device", nullptr, "SEL", kDeviceGroup, false,
+       "device index, \"gpu\", \"cpu\" or part of a device/platform name\n"
+       "(default: env HFVIS_DEVICE, else a GPU, else the first CPU)",
+       HFVIS_TEXT(device)},
+      {"--memory-budget", nullptr, "MB", kDeviceGroup, false,
+       "device memory for one batch of directions, MiB (default: half the\n"
+       "device's memory; on a CPU device half the host's); horizon,\n"
+       "sky-view-factor and ambient-occlusion run a field beyond it in strips\n"
+       "of rows, with the same result",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.memory_budget_bytes = parseMemoryBudget(typed, value);
+       }},
+      {"--directions", "-k", "K", kSweepGroup, false,
+       "number of azimuth directions, K >= 1 (default 64); shade: with --env only",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.directions = parseDirectionCount(typed, value);
+         run.sweep_options_given = true;
+       }},
+      {"--azimuth-offset", nullptr, "DEG", kSweepGroup, false,
+       "added to every direction's azimuth, degrees (default 0)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.azimuth_offset_deg =
+             parseBounded(typed, value, -360.0, 360.0, "every direction has an offset in it");
+         run.sweep_options_given = true;
+       }},
+      {"--samples-per-unit", nullptr, "S", kSamplingGroup, false,
+       "naive, intervisibility, bounce: height samples per pixel length along a\n"
+       "line or ray; sweep: every grid-line crossing of the ray (exact heights)\n"
+       "and, for S > 1, about S points per pixel length between crossings\n"
+       "(default 1: the crossings alone)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.samples_per_unit = parsePositive(typed, value);
+       }},
+      {"--curvature", nullptr, nullptr, kEarthGroup, false,
+       "lower every point at ground distance d by the Earth's drop\n"
+       "d^2 (1 - K) / (2 R), R = 6370997 m, K = 1/7 (GRASS and GDAL's\n"
+       "convention; cell sizes must be in metres)",
+       HFVIS_FLAG(curvature)},
+      {"--refraction", nullptr, "K", kEarthGroup, false,
+       "the same with refraction coefficient K in -1 .. 1 (implies --curvature)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.refraction = parseNumber(typed, value);
+         if (!(run.refraction >= -1.0 && run.refraction <= 1.0))
+           throw UsageError(typed + ": the refraction coefficient must be in -1 .. 1, got " +
+                            inQuotes(value));
+         run.curvature = true;  // refraction bends rays over the curved Earth
+       }},
+      {"--max-distance", nullptr, "D", kReachGroup, false,
+       "only terrain within D ground units of the receiver counts (farther\n"
+       "terrain neither casts a horizon nor hides anything nearer; r.horizon's\n"
+       "maxdistance, RVT's svf_r_max); viewshed: only targets within D",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         parsePositive(typed, value);
+         run.max_distance = parseBounded(typed, value, 0.0, kMostLength, kFloatRange);
+       }},
+      {"--method", nullptr, "sweep|naive", kSweepMethodGroup, false,
+       "sweep = convex-hull-stack sweep along lines through every pixel\n"
+       "centre, linear time per direction, exact over the samples of each\n"
+       "receiver's own ray; naive = per-pixel ray march, slow reference\n"
+       "(default sweep). The sweep's directions are integer pixel steps:\n"
+       "within 0.25 deg of phi_k for horizon, within half the spacing\n"
+       "(weighted) for sky-view-factor and ambient-occlusion; the\n"
+       "hfvis:azimuths_deg attribute lists those used",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.method = parseMethod(typed, value);
+         run.sweep_options_given = true;
+       }},
+      {"--hull-tree", nullptr, "T", kHullTreeGroup, false,
+       "how the convex hull tree does its work; the results are the same for\n"
+       "every T: plain = Algorithm 1 as written, deferred = link writes only\n"
+       "where a link changes (Algorithm 2's aim), default = deferred + the old\n"
+       "root's last child checked first, zone = default + the safe zone\n"
+       "(Algorithm 3) (default: default)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         const auto tuning = hullTreeTuningNamed(value);
+         if (!tuning)
+           throw UsageError(typed + ": expected plain, deferred, default or zone, got " + inQuotes(value));
+         run.hull_tree = *tuning;
+         run.hull_tree_name = value;
+       }},
+      {"--lat", nullptr, "LAT", kSunPlaceGroup, false, "the place's latitude, degrees (north positive)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.latitude = parseNumber(typed, value);
+         if (*run.latitude < -90.0 || *run.latitude > 90.0)
+           throw UsageError(typed + ": expected a latitude in -90 .. 90 degrees, got " + inQuotes(value));
+       }},
+      {"--lon", nullptr, "LON", kSunPlaceGroup, false, "the place's longitude, degrees (east positive)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.longitude = parseNumber(typed, value);
+         if (*run.longitude < -180.0 || *run.longitude > 360.0)
+           throw UsageError(typed + ": expected a longitude in -180 .. 360 degrees, got " + inQuotes(value));
+       }},
+      {"--sun-size", nullptr, "DEG", kSunPlaceGroup, false,
+       "the sun's angular diameter (default 0.53; 0 = a point sun, hard shadows)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.sun_size_deg = parseNumber(typed, value);
+         if (!(run.sun_size_deg >= 0.0 && run.sun_size_deg <= 10.0))
+           throw UsageError(typed +
+                            ": the sun's diameter must be in 0 (a point: hard shadows) .. 10 degrees, got " +
+                            inQuotes(value));
+       }},
+      {"--distance-out", nullptr, "FILE", kHorizonGroup, false,
+       "also write K channels d000.. of ground distance to the\n"
+       "horizon point (ground units), computed in the same run",
+       HFVIS_TEXT(distance_output)},
+      {"--azimuth-tolerance", nullptr, "DEG", kHorizonGroup, false,
+       "the sweep's direction k is the cheapest integer pixel step within\n"
+       "DEG of phi_k (default 0.25; at most 5.72958, 0.1 radian). Smaller\n"
+       "is closer to phi_k and slower: steps with more grid crossings per\n"
+       "pixel",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         parsePositive(typed, value);
+         run.azimuth_tolerance_deg = parseBounded(typed, value, 0.0, kMostAzimuthTolerance,
+                                                  "the azimuth tolerance is 0.1 radian at most");
+       }},
+      {"--method", nullptr, "tree|naive", kIntervisibilityGroup, false,
+       "tree = convex hull tree sweep (Timonen 2013); naive = per-pixel\n"
+       "visibility march, slow reference (default tree)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.visibility_method = parseVisibilityMethod(typed, value);
+       }},
+      {"--stats", nullptr, nullptr, kIntervisibilityGroup, false,
+       "also print, for the tree method, the statistics of Timonen (2013)'s\n"
+       "Table 2 per point and direction: m_a (visibility horizons), t_a\n"
+       "(convexity checks made), visible samples and naive iterations (the\n"
+       "samples the naive method tests); also stored as hfvis:stats_* EXR\n"
+       "attributes. Printed even with --quiet. Table 2's t_a is Algorithm\n"
+       "1's: add --hull-tree plain.",
+       HFVIS_FLAG(statistics)},
+      {"--at", nullptr, "COL,ROW", kHorizonListsGroup, true,
+       "a receiver pixel (zero-based column, row); repeat for more. A pixel\n"
+       "outside the field is a usage error (status 2).",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.receivers.push_back(parseReceiver(typed, value));
+       }},
+      {"--radiance", nullptr, "RAD.exr", kBounceGroup, false,
+       "exit radiance of every surface point: an image of the input's size\n"
+       "with 1 to 4 channels (grey, RGB, ...), finite and >= 0 where the\n"
+       "height is valid. The output has the same channel names.",
+       HFVIS_TEXT(radiance)},
+      {"--env", nullptr, "ENV.exr", kEnvironmentLightGroup, false,
+       "an HDR environment, equirectangular (latitude / longitude, 2:1)", HFVIS_TEXT(environment)},
+      {"--env-rotate", nullptr, "DEG", kEnvironmentLightGroup, false,
+       "the environment's left edge looks toward compass azimuth DEG (default 0)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.environment_rotation_deg =
+             parseBounded(typed, value, -360.0, 360.0, "every rotation has an angle in it");
+       }},
+      {"--env-rows", nullptr, "N", kEnvironmentLightGroup, false,
+       "bands of zenith angle in the tables (default the map's rows)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         const double rows = parsePositive(typed, value);
+         if (rows != std::floor(rows) || rows > 65536)
+           throw UsageError(typed + ": expected a whole number of bands in 1 .. 65536, got " +
+                            inQuotes(value));
+         run.environment_rows = static_cast<int>(rows);
+       }},
+      {"--sun", nullptr, "AZ,EL", kSunShadingGroup, false,
+       "the sun's compass azimuth (degrees clockwise from north) and elevation",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         const auto [az, el] =
+             splitPair(typed, value, ": expected AZ,EL (compass azimuth and elevation, degrees), got ");
+         const double azimuth =
+             parseBounded(typed, az, -360.0, 360.0, "every azimuth has an equal one in it");
+         const double elevation = parseNumber(typed, el);
+         if (elevation < -90.0 || elevation > 90.0)
+           throw UsageError(typed + ": the elevation must be in -90 .. 90 degrees, got " + inQuotes(value));
+         run.sun = std::make_pair(azimuth, elevation);
+       }},
+      {"--at", nullptr, "TIME", kSunShadingGroup, false,
+       "the sun where it stands at TIME (ISO 8601 with a zone), with --lat, --lon",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         parseUtcTimeInto(typed, value, run.sun_time);
+       }},
+      {"--albedo", nullptr, "A|FILE", kSunShadingGroup, false,
+       "also the radiance a Lambertian surface of albedo A (0..1, or an image)\n"
+       "sends out",
+       HFVIS_TEXT(albedo)},
+      {"--sun-irradiance", nullptr, "E", kSunShadingGroup, false,
+       "the sun's normal irradiance in the radiance (default 1; needs --albedo)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         parsePositive(typed, value);
+         run.sun_irradiance = parseBounded(typed, value, 0.0, 1e12, kFloatRange);
+       }},
+      {"--from", nullptr, "TIME", kInsolationGroup, false, "the span's start (ISO 8601 with a zone)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         parseUtcTimeInto(typed, value, run.from_time);
+       }},
+      {"--to", nullptr, "TIME", kInsolationGroup, false, "the span's end",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         parseUtcTimeInto(typed, value, run.to_time);
+       }},
+      {"--step", nullptr, "MINUTES", kInsolationGroup, false, "the time step (default 10, at most 1440)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.step_minutes = parsePositive(typed, value);
+         if (run.step_minutes > 1440.0)
+           throw UsageError(typed + ": at most 1440 minutes, got " + inQuotes(value));
+       }},
+      {"--azimuth-bucket", nullptr, "DEG", kInsolationGroup, false,
+       "steps whose sun azimuths fall in one bucket share one sweep\n"
+       "(default 0.25, at most 10)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.azimuth_bucket_deg = parsePositive(typed, value);
+         if (run.azimuth_bucket_deg > 10.0)
+           throw UsageError(typed + ": at most 10 degrees, got " + inQuotes(value));
+       }},
+      {"--apparent", nullptr, nullptr, kInsolationGroup, false, "lift the sun by the atmosphere's refraction",
+       HFVIS_FLAG(apparent)},
+      {"--observer", nullptr, "COL,ROW", kViewshedGroup, true, "an observer's grid point; repeat for more",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.observers.push_back(parseReceiver(typed, value));
+       }},
+      {"--observers", nullptr, "FILE.csv", kViewshedGroup, false,
+       "observers, one col,row[,height] a line (a header line allowed)", HFVIS_TEXT(observers_file)},
+      {"--observer-height", nullptr, "H", kViewshedGroup, false,
+       "the eye's height above the surface (default 2)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.observer_height = parseBounded(typed, value, -kMostLength, kMostLength, kFloatRange);
+       }},
+      {"--target-height", nullptr, "T", kViewshedGroup, false,
+       "the target's height above the surface (default 0)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         if (parseNumber(typed, value) < 0.0)
+           throw UsageError(typed + ": must be >= 0, got " + inQuotes(value));
+         run.target_height = parseBounded(typed, value, 0.0, kMostLength, kFloatRange);
+       }},
+      {"--absolute", nullptr, nullptr, kViewshedGroup, false, "the eye at height H, not H above the surface",
+       HFVIS_FLAG(absolute)},
+      {"--fov", nullptr, "FROM,TO", kViewshedGroup, false,
+       "targets whose compass azimuth lies clockwise from FROM to TO",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         const auto [from, to] =
+             splitPair(typed, value, ": expected FROM,TO (compass degrees, clockwise from FROM), got ");
+         const double a = parseNumber(typed, from), b = parseNumber(typed, to);
+         if (!(a >= 0.0 && a <= 360.0 && b >= 0.0 && b <= 360.0))
+           throw UsageError(typed + ": compass azimuths are in 0 .. 360 degrees, got " + inQuotes(value));
+         run.field_of_view = std::make_pair(a, b);
+       }},
+      {"--elevation-range", nullptr, "LO,HI", kViewshedGroup, false,
+       "targets seen between LO and HI degrees above the eye's horizontal",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         const auto [lo, hi] = splitPair(typed, value, ": expected LO,HI (elevation degrees), got ");
+         const double a = parseNumber(typed, lo), b = parseNumber(typed, hi);
+         if (!(a >= -90.0 && b <= 90.0 && a <= b))
+           throw UsageError(typed + ": expected -90 <= LO <= HI <= 90 degrees, got " + inQuotes(value));
+         run.elevation_range = std::make_pair(a, b);
+       }},
+      {"--angle", nullptr, nullptr, kViewshedGroup, false, "also channel \"angle\" (one observer)",
+       HFVIS_FLAG(with_angle)},
+      {"--needed-height", nullptr, nullptr, kViewshedGroup, false,
+       "also channel \"needed_height\" (one observer)", HFVIS_FLAG(with_needed_height)},
+      {"--method", nullptr, "exact|culled", kViewshedGroup, false,
+       "culled: through Stewart's culling pyramid, the same result (default exact)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         if (value != "exact" && value != "culled")
+           throw UsageError(typed + ": expected 'exact' or 'culled', got " + inQuotes(value));
+         run.culled = value == "culled";
+       }},
+      {"--cull-level", nullptr, "K", kViewshedGroup, false,
+       "the pyramid's finest nodes, 2^K points a side (default 2)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         const double k = parseNumber(typed, value);
+         if (!(k >= 1.0 && k <= 12.0 && k == std::floor(k)))
+           throw UsageError(typed + ": expected a whole number 1 .. 12 (nodes of 2^K x 2^K points), got " +
+                            inQuotes(value));
+         run.cull_level = static_cast<int>(k);
+         run.cull_level_given = true;
+       }},
+  };
+  return table;
+}
+
+#undef HFVIS_FLAG
+#undef HFVIS_TEXT
 
 bool samePath(const std::string& a, const std::string& b) {
   return std::filesystem::path(a).lexically_normal() == std::filesystem::path(b).lexically_normal();
 }
 
-// Checks that involve more than one option, and the library's own argument checks.
-void validateRun(Command command, const RunArguments& run) {
-  const std::string name = commandName(command);
-  const std::string out = command == Command::HorizonLists ? "OUT.json|OUT.csv" : "OUT.exr";
+namespace {
+
+// Checks that involve more than one option: every command's, and its own (CommandSpec::check).
+void validateRun(const CommandSpec& command, const std::string& name, const RunArguments& run) {
+  const std::string out = command.id == Command::HorizonLists ? "OUT.json|OUT.csv" : "OUT.exr";
   if (run.input.empty())
     throw UsageError("missing the input height field (hfvis " + name + " IN -o " + out + ")");
   if (run.output.empty())
     throw UsageError("missing -o " + out + " (the output file of 'hfvis " + name + "')");
-  if (command == Command::HorizonLists) {
-    if (!hasExtension(run.output, ".json") && !hasExtension(run.output, ".csv")) {
-      throw UsageError(
-          "-o: the horizon lists are written as JSON or CSV; the name must end in .json or .csv, got " +
-          inQuotes(run.output));
-    }
-    if (run.receivers.empty())
-      throw UsageError("missing --at COL,ROW (the receivers whose horizons to list)");
-  }
-  if (command == Command::Shade) {
-    const bool placed = run.sun_time || run.latitude || run.longitude;
-    if (run.sun && placed)
-      throw UsageError("--sun AZ,EL or --at TIME --lat LAT --lon LON: give the sun one way, not both");
-    const bool sun = run.sun || (run.sun_time && run.latitude && run.longitude);
-    if (!sun && (placed || run.environment.empty()))
-      throw UsageError(
-          "missing the light: --env ENV.exr and / or the sun, --sun AZ,EL (compass azimuth, elevation) or --at TIME "
-          "--lat LAT --lon LON");
-    if (run.environment.empty() && run.sweep_options_given)
-      throw UsageError("-k, --method and --azimuth-offset need --env (the sun alone sweeps its own azimuth)");
-    if (run.environment.empty() && (run.environment_rotation_deg != 0.0 || run.environment_rows != 0))
-      throw UsageError("--env-rotate and --env-rows need --env ENV.exr");
-    if (!sun && run.sun_irradiance != 1.0) throw UsageError("--sun-irradiance needs the sun");
-    if (run.albedo.empty() && run.sun_irradiance != 1.0)
-      throw UsageError(
-          "--sun-irradiance needs --albedo (it scales the sun's light in the radiance; 'direct' is "
-          "for a normal irradiance of 1)");
-    if (!sun && run.sun_size_deg != 0.53) throw UsageError("--sun-size needs the sun");
-    if (!run.environment.empty() && samePath(run.output, run.environment))
-      throw UsageError("--env must differ from -o, both are " + inQuotes(run.output));
-    if (!run.albedo.empty() && samePath(run.output, run.albedo))
-      throw UsageError("--albedo must differ from -o, both are " + inQuotes(run.output));
-    if (run.sun_time) {
-      try {  // the solar position's range of years
-        sunPosition(*run.sun_time, *run.latitude, *run.longitude);
-      } catch (const InvalidArgument& error) {
-        throw UsageError(std::string("--at: ") + error.what());
-      }
-    }
-  }
-  if (command == Command::Insolation) {
-    if (!run.latitude || !run.longitude || !run.from_time || !run.to_time)
-      throw UsageError("missing the place or the span: --lat LAT --lon LON --from TIME --to TIME");
-    if (!(*run.from_time < *run.to_time)) throw UsageError("--from must come before --to");
-    try {
-      validate(insolationOptions(run));
-    } catch (const InvalidArgument& error) {
-      throw UsageError(error.what());
-    }
-  }
-  if (command == Command::Viewshed) {
-    if (!run.absolute && run.observer_height < 0.0)
-      throw UsageError("--observer-height: an eye below the surface sees nothing; give a height >= 0 (or --absolute)");
-    if (run.observers.empty() && run.observers_file.empty())
-      throw UsageError("missing --observer COL,ROW or --observers FILE.csv (who looks)");
-    if ((run.with_angle || run.with_needed_height) && (run.observers.size() > 1 || !run.observers_file.empty()))
-      throw UsageError(std::string(run.with_angle ? "--angle" : "--needed-height") +
-                       " is for one observer (several give a count)");
-    if (run.cull_level_given && !run.culled) throw UsageError("--cull-level is for --method culled");
-    if (!run.observers_file.empty() && samePath(run.output, run.observers_file))
-      throw UsageError("--observers must differ from -o, both are " + inQuotes(run.output));
-    try {
-      validate(viewshedOptions(run));
-    } catch (const InvalidArgument& error) {
-      throw UsageError(error.what());
-    }
-  }
-  if (command == Command::Bounce) {
-    if (run.radiance.empty()) {
-      throw UsageError("missing --radiance RAD.exr (the exit radiance to bounce, same size as the input)");
-    }
-    if (samePath(run.output, run.radiance)) {
-      throw UsageError("--radiance must differ from -o, both are " + inQuotes(run.output));
-    }
-    if (!run.preview.empty() && samePath(run.preview, run.radiance)) {
-      throw UsageError("--preview must differ from --radiance, both are " + inQuotes(run.preview));
-    }
-  }
+  if (command.check) command.check(name, run);
   if (!run.distance_output.empty() && samePath(run.output, run.distance_output)) {
     throw UsageError("--distance-out must differ from -o, both are " + inQuotes(run.output));
   }
@@ -737,55 +577,46 @@ void validateRun(Command command, const RunArguments& run) {
   // A nodata value the outputs can hold as data would make those cells nodata for every reader
   // (a viewshed's hidden 0 or visible 1): it must lie below every value the command writes.
   if (run.nodata && !std::isnan(*run.nodata)) {
-    const double lowest = command == Command::Horizon                      ? -kPi / 2.0
-                          : command == Command::Viewshed && run.with_angle ? -90.0
-                                                                           : 0.0;
+    const double lowest = command.lowest_value ? command.lowest_value(run) : 0.0;
     if (*run.nodata >= lowest)
       throw UsageError("--nodata " + detail::shortNumber(*run.nodata) + ": 'hfvis " + name +
                        "' writes data values from " + detail::shortNumber(lowest) +
                        " up, so a reader could not tell those cells from nodata; give a value below " +
                        detail::shortNumber(lowest) + " (such as -9999) or nan");
   }
-  if (command == Command::ViewCount && !run.hull_tree_name.empty() &&
-      run.visibility_method != IntervisibilityMethod::HullTree) {
-    throw UsageError("--hull-tree needs --method tree (the naive method builds no tree)");
-  }
-  try {
-    switch (command) {
-      case Command::ViewCount:
-        validate(intervisibilityOptions(run), intervisibilityOutputs(run));
-        break;
-      case Command::HorizonLists:
-        validate(horizonListOptions(run));
-        break;
-      case Command::Bounce:
-        validate(bounceOptions(run));
-        break;
-      case Command::Shade:
-      case Command::Insolation:
-        validate(static_cast<const SweepOptions&>(horizonOptions(run)));
-        break;
-      case Command::Viewshed:
-        break;  // above
-      default:
-        validate(horizonOptions(run), horizonOutputs(command, run));
-        break;
-    }
-  } catch (const InvalidArgument& error) {
-    // "statistics ... only for the hull-tree method" reads better in the CLI's words.
-    if (command == Command::ViewCount && run.statistics &&
-        run.visibility_method != IntervisibilityMethod::HullTree) {
-      throw UsageError(
-          "--stats needs --method tree (the naive method has no horizons or iterations to count)");
-    }
-    throw UsageError(error.what());
-  }
 }
 
-RunArguments parseRunArguments(Command command, const std::vector<std::string>& args) {
+// The options called `typed` (a flag may stand for one option of some commands and another of
+// others, as --method and --at): the one `command` takes, else the first (to report).
+const OptionSpec* findOption(const std::string& typed, const CommandSpec& command) {
+  const OptionSpec* found = nullptr;
+  for (const OptionSpec& spec : optionTable()) {
+    if (typed != spec.name && !(spec.short_name && typed == spec.short_name)) continue;
+    if (command.groups & spec.group) return &spec;
+    if (!found) found = &spec;
+  }
+  return found;
+}
+
+// `typed` is an option, but not one of `command`'s: say which command takes it where one does.
+[[noreturn]] void throwNotTaken(const std::string& typed, const std::string& name) {
+  std::vector<const char*> takers;
+  for (const CommandSpec* command : commandTable())
+    for (const OptionSpec& spec : optionTable())
+      if ((typed == spec.name || (spec.short_name && typed == spec.short_name)) &&
+          (command->groups & spec.group)) {
+        takers.push_back(command->name);
+        break;
+      }
+  if (takers.size() == 1) throw UsageError(typed + " is only available with 'hfvis " + takers[0] + "'");
+  throw UsageError(typed + " is not available with 'hfvis " + name + "'");
+}
+
+RunArguments parseRunArguments(const CommandSpec& command, const std::string& name,
+                               const std::vector<std::string>& args) {
   RunArguments run;
   std::vector<std::string> positional;
-  std::set<Option> given;
+  std::set<const OptionSpec*> given;
   bool options_ended = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& arg = args[i];
@@ -810,25 +641,20 @@ RunArguments parseRunArguments(Command command, const std::vector<std::string>& 
       typed = arg.substr(0, 2);
       attached = arg.substr(2);
     }
-    const OptionSpec* spec = findOption(typed);
+    const OptionSpec* spec = findOption(typed, command);
     if (!spec) {
       // Name what was typed ("-foo", not "-f") unless it was "--name=value".
       const std::string shown = attached && typed.size() > 2 ? typed : arg;
-      throw UsageError("unknown option " + inQuotes(shown) + " for 'hfvis " + commandName(command) + "'");
+      throw UsageError("unknown option " + inQuotes(shown) + " for 'hfvis " + name + "'");
     }
     // One rule for every option: once, but for those that add one more of a list (a second -o
     // or -k silently replacing the first would hide a typo).
-    const bool adds =
-        spec->option == Option::Observer || (spec->option == Option::At && command == Command::HorizonLists);
-    if (!adds && !given.insert(spec->option).second)
+    if (!spec->repeats && !given.insert(spec).second)
       throw UsageError(typed + " given twice (only --observer and the receivers' --at may repeat)");
-    if (!spec->takes_value) {
-      if (attached) throw UsageError(typed + " takes no value, got " + inQuotes(arg));
-      applyOption(*spec, typed, "", command, run);
-      continue;
-    }
     std::string value;
-    if (attached) {
+    if (!spec->value) {
+      if (attached) throw UsageError(typed + " takes no value, got " + inQuotes(arg));
+    } else if (attached) {
       value = *attached;
     } else {
       // A following option ("-o --quiet") is a forgotten value, not a file name; a
@@ -838,53 +664,20 @@ RunArguments parseRunArguments(Command command, const std::vector<std::string>& 
       }
       value = args[++i];
     }
-    applyOption(*spec, typed, value, command, run);
+    if (!(command.groups & spec->group)) throwNotTaken(typed, name);
+    spec->bind(typed, value, run);
   }
   if (positional.size() > 1) {
-    throw UsageError("unexpected argument " + inQuotes(positional[1]) + " ('hfvis " + commandName(command) +
+    throw UsageError("unexpected argument " + inQuotes(positional[1]) + " ('hfvis " + name +
                      "' reads one input file)");
   }
   if (!positional.empty()) run.input = positional[0];
-  validateRun(command, run);
+  validateRun(command, name, run);
   return run;
 }
 
-}  // namespace
-
-const char* commandName(Command command) {
-  switch (command) {
-    case Command::Help:
-      return "help";
-    case Command::Devices:
-      return "devices";
-    case Command::SunPosition:
-      return "sunpos";
-    case Command::Shade:
-      return "shade";
-    case Command::Insolation:
-      return "insolation";
-    case Command::Viewshed:
-      return "viewshed";
-    case Command::Horizon:
-      return "horizon";
-    case Command::SkyViewFactor:
-      return "svf";
-    case Command::AmbientOcclusion:
-      return "ao";
-    case Command::ViewCount:
-      return "viewcount";
-    case Command::HorizonLists:
-      return "horizons";
-    case Command::Bounce:
-      return "bounce";
-  }
-  return "?";
-}
-
-namespace {
-
 // "hfvis sunpos --lat LAT --lon LON --at TIME [--apparent]": each once, all but --apparent required.
-SunArguments parseSunArguments(const std::vector<std::string>& args) {
+SunArguments parseSunArguments(const std::string& name, const std::vector<std::string>& args) {
   SunArguments sun;
   bool lat = false, lon = false, at = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
@@ -918,10 +711,10 @@ SunArguments parseSunArguments(const std::vector<std::string>& args) {
       if (sun.apparent) throw UsageError("--apparent given twice");
       sun.apparent = true;
     } else {
-      throw UsageError("'hfvis sunpos' takes --lat, --lon, --at and --apparent, not " + inQuotes(arg));
+      throw UsageError("'hfvis " + name + "' takes --lat, --lon, --at and --apparent, not " + inQuotes(arg));
     }
   }
-  if (!lat || !lon || !at) throw UsageError("'hfvis sunpos' needs --lat LAT --lon LON --at TIME");
+  if (!lat || !lon || !at) throw UsageError("'hfvis " + name + "' needs --lat LAT --lon LON --at TIME");
   try {  // the algorithm's range of years
     sunPosition(sun.utc_seconds, sun.latitude_deg, sun.longitude_deg);
   } catch (const InvalidArgument& error) {
@@ -934,48 +727,46 @@ SunArguments parseSunArguments(const std::vector<std::string>& args) {
 
 CommandLine parseCommandLine(const std::vector<std::string>& args) {
   CommandLine line;
-  if (args.empty()) throw UsageError(std::string("no command given (") + kCommandList + ")");
+  if (args.empty()) throw UsageError("no command given (" + commandList() + ")");
   const std::string& first = args[0];
   if (isHelpFlag(first)) return line;  // Command::Help, no topic
   if (!first.empty() && first[0] == '-') {
-    throw UsageError("unknown option " + inQuotes(first) + " (give a command first: " + kCommandList + ")");
-  }
-  const std::optional<Command> command = findCommand(first);
-  if (!command) {
-    throw UsageError("unknown command " + inQuotes(first) + " (expected " + kCommandList + ")");
+    throw UsageError("unknown option " + inQuotes(first) + " (give a command first: " + commandList() + ")");
   }
   const std::vector<std::string> rest(args.begin() + 1, args.end());
-
-  if (*command == Command::Help) {  // "hfvis help [COMMAND]"
+  if (first == "help") {  // "hfvis help [COMMAND]"
     if (rest.size() > 1) throw UsageError("unexpected argument " + inQuotes(rest[1]) + " after 'help'");
-    if (!rest.empty()) {
-      const std::optional<Command> topic = findCommand(rest[0]);
+    if (!rest.empty() && rest[0] != "help") {
+      const CommandSpec* topic = findCommand(rest[0]);
       if (!topic)
-        throw UsageError("unknown command " + inQuotes(rest[0]) + " (expected " + kCommandList + ")");
-      if (*topic != Command::Help) line.help_topic = topic;
+        throw UsageError("unknown command " + inQuotes(rest[0]) + " (expected " + commandList() + ")");
+      line.help_topic = topic->id;
     }
     return line;
   }
+  const CommandSpec* command = findCommand(first);
+  if (!command) throw UsageError("unknown command " + inQuotes(first) + " (expected " + commandList() + ")");
 
   // "--help" anywhere before "--" wins over everything else on the line.
   for (const std::string& arg : rest) {
     if (arg == "--") break;
     if (isHelpFlag(arg)) {
-      line.help_topic = command;
+      line.help_topic = command->id;
       return line;
     }
   }
 
-  line.command = *command;
-  if (*command == Command::Devices) {
-    if (!rest.empty()) throw UsageError("'hfvis devices' takes no arguments, got " + inQuotes(rest[0]));
+  line.command = command->id;
+  line.name = first;
+  if (command->id == Command::Devices) {
+    if (!rest.empty()) throw UsageError("'hfvis " + first + "' takes no arguments, got " + inQuotes(rest[0]));
     return line;
   }
-  if (*command == Command::SunPosition) {
-    line.sun = parseSunArguments(rest);
+  if (command->id == Command::SunPosition) {
+    line.sun = parseSunArguments(first, rest);
     return line;
   }
-  line.run = parseRunArguments(*command, rest);
+  line.run = parseRunArguments(*command, first, rest);
   return line;
 }
 

@@ -10,11 +10,12 @@
 #include <vector>
 
 #include "hfvis/bounce.hpp"
+#include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
 #include "hfvis/horizon_lists.hpp"
 #include "hfvis/image_io.hpp"
-#include "hfvis/intervisibility.hpp"
 #include "hfvis/insolation.hpp"
+#include "hfvis/intervisibility.hpp"
 #include "hfvis/sun_shading.hpp"
 #include "hfvis/viewshed.hpp"
 
@@ -33,17 +34,14 @@ enum class Command {
   Horizon,
   SkyViewFactor,
   AmbientOcclusion,
-  ViewCount,     // visible samples and ground area per pixel (intervisibility)
-  HorizonLists,  // "horizons": visibility horizons of chosen receivers, JSON or CSV
-  Bounce,        // one diffuse bounce of a given exit radiance
-  SunPosition,   // "sunpos": the sun's azimuth and elevation at a time and place
-  Shade,         // the surface lit by an environment and / or the sun
-  Insolation,    // sunshine hours and direct irradiation over a span of time
-  Viewshed,      // what one observer sees, or how many of several see each point
+  Intervisibility,  // visible samples and ground area per pixel (was "viewcount")
+  HorizonLists,     // (was "horizons"): visibility horizons of chosen receivers, JSON or CSV
+  Bounce,           // one diffuse bounce of a given exit radiance
+  SunPosition,      // (was "sunpos"): the sun's azimuth and elevation at a time and place
+  Shade,            // the surface lit by an environment and / or the sun
+  Insolation,       // sunshine hours and direct irradiation over a span of time
+  Viewshed,         // what one observer sees, or how many of several see each point
 };
-
-// The subcommand's name as typed ("horizon", "svf", ...).
-const char* commandName(Command command);
 
 // Everything a compute command's run needs, already validated.
 struct RunArguments {
@@ -114,11 +112,30 @@ struct SunArguments {
 
 struct CommandLine {
   Command command = Command::Help;
+  // The command's name as typed (its canonical name or its alias), for messages.
+  std::string name;
   // For Command::Help: the subcommand whose help was asked for, if any.
   std::optional<Command> help_topic;
   RunArguments run;
   SunArguments sun;  // Command::SunPosition
 };
+
+// For the commands' own checks (CommandSpec::check, cli/commands/):
+// 'text', as the messages quote what was typed.
+std::string inQuotes(const std::string& text);
+// The same path once written plainly ("a/../b" is "b"; links are not followed).
+bool samePath(const std::string& a, const std::string& b);
+// `path` ends in `wanted` (".json"), in any case.
+bool hasExtension(const std::string& path, const char* wanted);
+// Runs the library's own checks of options (`check`), their InvalidArgument a UsageError.
+template <typename Check>
+void asUsageError(Check&& check) {
+  try {
+    check();
+  } catch (const InvalidArgument& error) {
+    throw UsageError(error.what());
+  }
+}
 
 // Parses argv (without argv[0]). Throws UsageError naming the offending argument.
 CommandLine parseCommandLine(const std::vector<std::string>& args);

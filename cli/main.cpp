@@ -8,10 +8,10 @@
 #include <vector>
 
 #include "arguments.hpp"
-#include "commands.hpp"
 #include "help.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/image_io.hpp"
+#include "table.hpp"
 
 namespace {
 
@@ -21,40 +21,16 @@ constexpr int kExitUsageError = 2;
 int run(const std::vector<std::string>& args) {
   using namespace hfvis::cli;
   const CommandLine line = parseCommandLine(args);
-  switch (line.command) {
-    case Command::Help:
-      std::cout << (line.help_topic ? commandHelp(*line.help_topic) : generalHelp());
-      return 0;
-    case Command::Devices:
-      return runDevices();
-    case Command::Horizon:
-    case Command::SkyViewFactor:
-    case Command::AmbientOcclusion:
-      return runCompute(line.command, line.run);
-    case Command::ViewCount:
-      return runViewCount(line.run);
-    case Command::HorizonLists:
-      return runHorizonLists(line.run);
-    case Command::Bounce:
-      return runBounce(line.run);
-    case Command::SunPosition:
-      return runSunPosition(line.sun);
-    case Command::Shade:
-      return runShade(line.run);
-    case Command::Insolation:
-      return runInsolation(line.run);
-    case Command::Viewshed:
-      return runViewshed(line.run);
+  if (line.command == Command::Help) {
+    std::cout << (line.help_topic ? commandHelp(*line.help_topic) : generalHelp());
+    return 0;
   }
-  return kExitUsageError;
+  return commandSpec(line.command).run(line);
 }
 
 // "hfvis horizon --help" when the command is known, else "hfvis --help".
 std::string helpHint(const std::vector<std::string>& args) {
-  for (const char* command : {"horizon", "svf", "ao", "viewcount", "horizons", "bounce", "shade", "insolation", "viewshed", "sunpos",
-                              "devices"}) {
-    if (!args.empty() && args[0] == command) return "hfvis " + args[0] + " --help";
-  }
+  if (!args.empty() && hfvis::cli::findCommand(args[0])) return "hfvis " + args[0] + " --help";
   return "hfvis --help";
 }
 

@@ -29,7 +29,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       case hfvis::cli::Command::AmbientOcclusion:
         hfvis::validate(hfvis::cli::horizonOptions(run), hfvis::cli::horizonOutputs(command.command, run));
         break;
-      case hfvis::cli::Command::ViewCount:
+      case hfvis::cli::Command::Intervisibility:
         hfvis::validate(hfvis::cli::intervisibilityOptions(run), hfvis::cli::intervisibilityOutputs(run));
         break;
       default:

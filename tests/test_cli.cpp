@@ -29,6 +29,7 @@
 #include "geotiff_support.hpp"
 #include "hfvis/horizon_lists.hpp"
 #include "hfvis/image_io.hpp"
+#include "image_outputs.hpp"
 #include "test_support.hpp"
 
 namespace {
@@ -512,6 +513,83 @@ TEST_F(Cli, HelpDocumentsTheConventions) {
   EXPECT_NE(run("horizon -h").out.find("h000"), std::string::npos);
 }
 
+// Issue 27: each command's name is the library's word; its earlier name stays an alias that
+// keeps working. Both write the same files, byte for byte.
+TEST_F(Cli, AnAliasAndItsCommandWriteTheSameFiles) {
+  const std::string field = ramp();
+  struct Named {
+    const char* alias;
+    const char* name;
+    const char* args;
+    const char* extension;
+  };
+  for (const Named& command : {Named{"svf", "sky-view-factor", "-k 4 --preview PNG", ".exr"},
+                               Named{"ao", "ambient-occlusion", "-k 4", ".tif"},
+                               Named{"viewcount", "intervisibility", "-k 4 --stats", ".exr"},
+                               Named{"horizons", "horizon-lists", "-k 4 --at 3,3 --at 10,5", ".json"}}) {
+    SCOPED_TRACE(command.name);
+    std::vector<std::string> written;
+    for (const char* typed : {command.alias, command.name}) {
+      std::string args = command.args;
+      const std::string preview = out(std::string(typed) + ".png");
+      if (const std::size_t at = args.find("PNG"); at != std::string::npos)
+        args.replace(at, 3, shellQuoted(preview));
+      const std::string output = out(std::string(typed) + command.extension);
+      const CliResult result =
+          run(std::string(typed) + " " + shellQuoted(field) + " -o " + shellQuoted(output) + " " + args);
+      ASSERT_EQ(result.status, 0) << result.err;
+      written.push_back(readText(output));
+      if (args.find(".png") != std::string::npos) written.push_back(readText(preview));
+    }
+    ASSERT_EQ(written.size() % 2, 0u);
+    for (std::size_t i = 0; i < written.size() / 2; ++i)
+      EXPECT_EQ(written[i], written[i + written.size() / 2]);
+    EXPECT_FALSE(written[0].empty());
+  }
+  const std::string when = " --lat 45 --lon 7 --at 2026-06-21T12:00:00Z";
+  const CliResult alias = run("sunpos" + when), name = run("sun-position" + when);
+  EXPECT_EQ(alias.status, 0) << alias.err;
+  EXPECT_NE(alias.out.find("azimuth="), std::string::npos) << alias.out;
+  EXPECT_EQ(alias.out, name.out);
+}
+
+// The help lists every command by its name and its alias, each gives the same help, and a
+// command's help lists the options it takes and no other.
+TEST_F(Cli, HelpListsEveryCommandByItsNameAndItsAlias) {
+  const CliResult general = run("--help");
+  ASSERT_EQ(general.status, 0) << general.err;
+  for (const auto& [name, alias] :
+       std::vector<std::pair<std::string, std::string>>{{"sky-view-factor", "svf"},
+                                                        {"ambient-occlusion", "ao"},
+                                                        {"intervisibility", "viewcount"},
+                                                        {"horizon-lists", "horizons"},
+                                                        {"sun-position", "sunpos"}}) {
+    SCOPED_TRACE(name);
+    EXPECT_NE(general.out.find("hfvis " + name + " "), std::string::npos) << general.out;
+    EXPECT_NE(general.out.find(name + " (" + alias + ")"), std::string::npos) << general.out;
+    const CliResult by_name = run(name + " --help"), by_alias = run(alias + " --help");
+    EXPECT_EQ(by_name.status, 0) << by_name.err;
+    EXPECT_EQ(by_alias.out, by_name.out);
+    EXPECT_EQ(run("help " + alias).out, by_name.out);
+    EXPECT_EQ(by_name.out.rfind("hfvis " + name + " ", 0), 0u) << by_name.out;
+    EXPECT_NE(by_name.out.find("'hfvis " + alias + "'"), std::string::npos) << by_name.out;
+  }
+  for (const char* name : {"horizon", "bounce", "shade", "insolation", "viewshed", "devices"})
+    EXPECT_NE(general.out.find(std::string("hfvis ") + name), std::string::npos) << name;
+  // horizon-lists runs on the host and writes text: no device, no preview; the parser agrees.
+  const std::string lists = run("horizon-lists --help").out;
+  EXPECT_EQ(lists.find("--preview"), std::string::npos) << lists;
+  EXPECT_EQ(lists.find("--device"), std::string::npos) << lists;
+  EXPECT_NE(lists.find("--at COL,ROW"), std::string::npos) << lists;
+  expectFailure(run("horizons " + shellQuoted(ramp()) + " --at 1,1 -o " + shellQuoted(out("h.json")) +
+                    " --preview " + shellQuoted(out("h.png"))),
+                2, "--preview is not available with 'hfvis horizons'");
+  const std::string counts = run("intervisibility --help").out;
+  EXPECT_NE(counts.find("--stats"), std::string::npos) << counts;
+  EXPECT_NE(counts.find("--hull-tree T"), std::string::npos) << counts;
+  EXPECT_EQ(counts.find("--distance-out"), std::string::npos) << counts;
+}
+
 TEST_F(Cli, DevicesListsAndMarksTheAutomaticChoice) {
   const CliResult result = run("devices");
   EXPECT_EQ(result.status, 0) << result.err;
@@ -593,7 +671,7 @@ TEST_F(Cli, HorizonWritesOneChannelPerDirection) {
   const ReadBack horizons = readBack(out("h.exr"));
   ASSERT_EQ(horizons.width, 16);
   ASSERT_EQ(horizons.height, 12);
-  EXPECT_EQ(horizons.channels, hfvis::directionChannelNames("h", 8));
+  EXPECT_EQ(horizons.channels, hfvis::cli::directionChannelNames("h", 8));
   EXPECT_EQ(horizons.channels.front(), "h000");
   EXPECT_EQ(horizons.channels.back(), "h007");
   EXPECT_EQ(horizons.spec.format, OIIO::TypeDesc::FLOAT);
@@ -613,7 +691,7 @@ TEST_F(Cli, HorizonWritesOneChannelPerDirection) {
   EXPECT_EQ(horizons.spec.get_string_attribute("hfvis:azimuths_deg"), "0,45,90,135,180,225,270,315");
 
   const ReadBack distances = readBack(out("d.exr"));
-  EXPECT_EQ(distances.channels, hfvis::directionChannelNames("d", 8));
+  EXPECT_EQ(distances.channels, hfvis::cli::directionChannelNames("d", 8));
   for (const float value : distances.pixels) {
     ASSERT_TRUE(std::isfinite(value));
     ASSERT_GE(value, 0.0f);
@@ -651,7 +729,7 @@ TEST_F(Cli, NaiveMethodAndOptionsRun) {
           " --z-scale 0.5 --channel Y --memory-budget 64");
   ASSERT_EQ(result.status, 0) << result.err;
   const ReadBack horizons = readBack(out("h.exr"));
-  EXPECT_EQ(horizons.channels, hfvis::directionChannelNames("h", 4));
+  EXPECT_EQ(horizons.channels, hfvis::cli::directionChannelNames("h", 4));
   EXPECT_EQ(horizons.spec.get_string_attribute("hfvis:method"), "naive");
   EXPECT_EQ(horizons.spec.get_string_attribute("hfvis:azimuth_offset_deg"), "45");
   EXPECT_EQ(horizons.spec.get_string_attribute("hfvis:cell_size_x"), "2");
@@ -1414,7 +1492,7 @@ TEST_F(CliGeoTiff, EveryRasterCommandCarriesTheGeoreferenceAndTheNodata) {
       {"ao", "-k 8", {"ao"}, ""},
       {"viewcount", "-k 4", {"count", "visible_area"}, ""},
       {"bounce", "-k 4 --radiance " + shellQuoted(in("radiance.exr")), {"Y"}, ""},
-      {"horizon", "-k 4", hfvis::directionChannelNames("h", 4), "--distance-out"},
+      {"horizon", "-k 4", hfvis::cli::directionChannelNames("h", 4), "--distance-out"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.command);
@@ -1434,7 +1512,7 @@ TEST_F(CliGeoTiff, EveryRasterCommandCarriesTheGeoreferenceAndTheNodata) {
     std::vector<std::vector<std::string>> names = {c.bands};
     if (!c.distance_option.empty()) {
       pairs.emplace_back(tif_distance, exr_distance);
-      names.push_back(hfvis::directionChannelNames("d", 4));
+      names.push_back(hfvis::cli::directionChannelNames("d", 4));
     }
     for (std::size_t p = 0; p < pairs.size(); ++p) {
       const hfvis::testing::GdalRaster raster = checkGeoTiffOutput(pairs[p].first, names[p], c.command);
@@ -1503,7 +1581,7 @@ TEST_F(CliGeoTiff, NodataValueIsWrittenAndDeclared) {
                               " --distance-out " + shellQuoted(out("d.exr")) + " -k 4 -q --nodata -32768");
   ASSERT_EQ(mixed.status, 0) << mixed.err;
   const hfvis::testing::GdalRaster angles =
-      checkGeoTiffOutput(out("h.tif"), hfvis::directionChannelNames("h", 4), "horizon");
+      checkGeoTiffOutput(out("h.tif"), hfvis::cli::directionChannelNames("h", 4), "horizon");
   EXPECT_EQ(angles.nodata[3], std::optional<double>(-32768.0));
   EXPECT_EQ(angles.bands[3][0], -32768.0f);
   EXPECT_TRUE(std::isnan(readBack(out("d.exr")).at(0, 0, 0)));

@@ -18,11 +18,12 @@
 #include <utility>
 #include <vector>
 
-#include "io/gdal_io.hpp"
 #include "geotiff_support.hpp"
-#include "hfvis/errors.hpp"
 #include "hfvis/environment_map.hpp"
+#include "hfvis/errors.hpp"
 #include "hfvis/image_io.hpp"
+#include "image_outputs.hpp"
+#include "io/gdal_io.hpp"
 #include "test_support.hpp"
 
 namespace hfvis {
@@ -35,6 +36,14 @@ using testing::readGdalRaster;
 using testing::sameCrs;
 
 namespace fs = std::filesystem;
+
+// One preview written on its own, as OutputFiles stages and commits it.
+void writePreviewPng(const std::string& path, int width, int height, const std::vector<float>& plane,
+                     float lo = 0.0f, float hi = 0.0f) {
+  OutputFiles files;
+  files.previewPng(path, width, height, plane, lo, hi);
+  files.commit();
+}
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
 // A fresh, empty directory per test, so tests can run in parallel and leftovers are visible.
@@ -577,6 +586,9 @@ TEST_F(ImageIoTest, DirectoryIsAnIoError) {
 
 // ---------------------------------------------------------------------------------------------
 // Writing.
+
+// The CLI's channel names (cli/image_outputs.hpp), which the image tests write with.
+using cli::directionChannelNames;
 
 TEST(DirectionChannelNames, ZeroPaddedInDirectionOrder) {
   EXPECT_EQ(directionChannelNames("h", 1), (std::vector<std::string>{"h000"}));

@@ -77,11 +77,10 @@ ImageChannels noiseImage(int size = 16) {
   const std::string spec(job), kind = spec.substr(0, spec.find(':')), path = spec.substr(spec.find(':') + 1);
   try {
     const ImageChannels image = noiseImage();
-    if (kind == "png") {
-      writePreviewPng(path, image.width, image.height, image.planes[0]);
-    } else if (kind == "text") {
+    if (kind == "png" || kind == "text") {
       OutputFiles files;
-      files.text(path, std::string(5000, 'x'));
+      if (kind == "png") files.previewPng(path, image.width, image.height, image.planes[0]);
+      if (kind == "text") files.text(path, std::string(5000, 'x'));
       files.commit();
     } else {
       writeImage(path, image);

@@ -99,13 +99,20 @@ class OutputFiles {
   OutputFiles& operator=(const OutputFiles&) = delete;
   ~OutputFiles();
 
-  // What writeImage, writePreviewPng, writeToneMappedPng write, staged; text: the bytes as
-  // they are. Each throws as those do (and InvalidArgument for a file staged twice).
+  // Each stages one file, and throws as writeImage does (and InvalidArgument for a file staged
+  // twice). image: what writeImage writes.
   void image(const std::string& path, const ImageChannels& image);
+  // An 8-bit PNG preview of one plane, linearly mapped from [lo, hi] to [0, 255] (lo == hi: the
+  // plane's finite min and max); NaN pixels are drawn black.
   void previewPng(const std::string& path, int width, int height, const std::vector<float>& plane,
                   float lo = 0.0f, float hi = 0.0f);
+  // An 8-bit PNG preview of HDR planes (one grey, or three R, G, B of width*height values):
+  // exposed so that the log-average luminance (Reinhard et al. 2002's key) maps to 0.3 (`exposure`
+  // stops more or less), through the ACES filmic curve per channel (Narkowicz's 2015 fit), then
+  // the sRGB transfer curve. NaN pixels are drawn black.
   void toneMappedPng(const std::string& path, int width, int height,
                      const std::vector<std::vector<float>>& planes, double exposure = 0.0);
+  // The bytes as they are.
   void text(const std::string& path, const std::string& text);
 
   // The paths staged so far, in order.
@@ -142,25 +149,5 @@ void removeTemporaryOutputsOnSignals();
 //   attributes; no georeference, NaN in nodata cells.
 // Throws InvalidArgument for an inconsistent image, IoError when writing fails.
 void writeImage(const std::string& path, const ImageChannels& image);
-
-// Writes an 8-bit PNG preview of one plane, linearly mapped from [lo, hi] to [0, 255]
-// (lo == hi: the plane's finite min and max); NaN pixels are drawn black. Atomic as above.
-void writePreviewPng(const std::string& path, int width, int height, const std::vector<float>& plane,
-                     float lo = 0.0f, float hi = 0.0f);
-
-// The q-quantiles of a plane's finite values for q = lo_q and hi_q (nearest rank), to stretch a
-// preview's contrast over the values most pixels hold: a sky-view factor of 0.85 .. 1 over most
-// of a DEM reads as grey on 0 .. 1. (0, 0) when no value is finite.
-std::pair<float, float> quantileRange(const std::vector<float>& plane, double lo_q = 0.01, double hi_q = 0.99);
-
-// Writes an 8-bit PNG preview of HDR planes (one grey, or three R, G, B of width*height values):
-// exposed so that the log-average luminance (Reinhard et al. 2002's key) maps to 0.3 (`exposure`
-// stops more or less), through the ACES filmic curve per channel (Narkowicz's 2015 fit), then
-// the sRGB transfer curve. NaN pixels are drawn black. Atomic as writeImage.
-void writeToneMappedPng(const std::string& path, int width, int height, const std::vector<std::vector<float>>& planes,
-                        double exposure = 0.0);
-
-// Zero-padded channel names whose sorted order is the direction order: h000, h001, ...
-std::vector<std::string> directionChannelNames(const std::string& prefix, int count);
 
 }  // namespace hfvis

@@ -173,20 +173,6 @@ void writeImage(const std::string& path, const ImageChannels& image) {
   files.commit();
 }
 
-void writePreviewPng(const std::string& path, int width, int height, const std::vector<float>& plane,
-                     float lo, float hi) {
-  OutputFiles files;
-  files.previewPng(path, width, height, plane, lo, hi);
-  files.commit();
-}
-
-void writeToneMappedPng(const std::string& path, int width, int height,
-                        const std::vector<std::vector<float>>& planes, double exposure) {
-  OutputFiles files;
-  files.toneMappedPng(path, width, height, planes, exposure);
-  files.commit();
-}
-
 void OutputFiles::previewPng(const std::string& path, int width, int height, const std::vector<float>& plane,
                              float lo, float hi) {
   if (width <= 0 || height <= 0) {
@@ -231,20 +217,6 @@ void OutputFiles::previewPng(const std::string& path, int width, int height, con
                                  for (std::size_t i = begin; i < end; ++i) rows[i - begin] = grey(plane[i]);
                                });
   });
-}
-
-std::pair<float, float> quantileRange(const std::vector<float>& plane, double lo_q, double hi_q) {
-  std::vector<float> finite;
-  for (float v : plane)
-    if (std::isfinite(v)) finite.push_back(v);
-  if (finite.empty()) return {0.0f, 0.0f};
-  auto at = [&](double q) {
-    const std::size_t rank = static_cast<std::size_t>(std::clamp(q, 0.0, 1.0) * (finite.size() - 1) + 0.5);
-    std::nth_element(finite.begin(), finite.begin() + rank, finite.end());
-    return finite[rank];
-  };
-  const float lo = at(lo_q), hi = at(hi_q);
-  return {lo, hi};
 }
 
 void OutputFiles::toneMappedPng(const std::string& path, int width, int height,
@@ -295,20 +267,6 @@ void OutputFiles::toneMappedPng(const std::string& path, int width, int height,
           }
         });
   });
-}
-
-std::vector<std::string> directionChannelNames(const std::string& prefix, int count) {
-  if (count < 0)
-    throw InvalidArgument("direction count must not be negative (got " + std::to_string(count) + ")");
-  const int digits = static_cast<int>(std::to_string(std::max(count - 1, 0)).size());
-  const int width = std::max(3, digits);
-  std::vector<std::string> names;
-  names.reserve(static_cast<std::size_t>(count));
-  for (int k = 0; k < count; ++k) {
-    const std::string index = std::to_string(k);
-    names.push_back(prefix + std::string(static_cast<std::size_t>(width) - index.size(), '0') + index);
-  }
-  return names;
 }
 
 }  // namespace hfvis

@@ -1,0 +1,326 @@
+// cli/pipeline.cpp: the pipeline every command that reads a height field runs, and its helpers.
+#include "pipeline.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+#include <system_error>
+
+#include "hfvis/errors.hpp"
+#include "hfvis/horizon.hpp"
+
+namespace hfvis::cli {
+
+namespace fs = std::filesystem;
+
+std::string formatNumber(double value) {
+  std::ostringstream out;
+  out << std::setprecision(10) << value;
+  return out.str();
+}
+
+std::string formatFixed(double value, int digits) {
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(digits) << value;
+  return out.str();
+}
+
+double finiteMean(const std::vector<float>& values) {
+  double sum = 0.0;
+  std::size_t count = 0;
+  for (const float value : values) {
+    if (std::isfinite(value)) {
+      sum += value;
+      ++count;
+    }
+  }
+  return count ? sum / static_cast<double>(count) : std::nan("");
+}
+
+std::vector<std::vector<float>> splitPlanes(const std::vector<float>& planes, std::size_t pixels, int count) {
+  std::vector<std::vector<float>> result;
+  result.reserve(count);
+  for (int k = 0; k < count; ++k) {
+    const auto begin = planes.begin() + static_cast<std::ptrdiff_t>(k * pixels);
+    result.emplace_back(begin, begin + static_cast<std::ptrdiff_t>(pixels));
+  }
+  return result;
+}
+
+void requireSize(const std::vector<float>& values, std::size_t expected, const char* what) {
+  if (values.size() != expected) {
+    throw Error(std::string("internal error: the computed ") + what + " holds " +
+                std::to_string(values.size()) + " values, expected " + std::to_string(expected));
+  }
+}
+
+void requireResultSize(int width, int height, const HeightField& field) {
+  if (width != field.width || height != field.height) {
+    throw Error("internal error: the result is " + std::to_string(width) + "x" + std::to_string(height) +
+                ", the height field " + std::to_string(field.width) + "x" + std::to_string(field.height));
+  }
+}
+
+void requireFiniteResult(const std::vector<float>& planes, const HeightField& field, const char* what) {
+  const std::size_t pixels = field.pixelCount();
+  for (std::size_t i = 0; i < planes.size(); ++i) {
+    const std::size_t p = i % pixels;
+    if (std::isfinite(planes[i]) || !std::isfinite(field.heights[p])) continue;
+    throw Error(std::string("the computed ") + what + " at column " + std::to_string(p % field.width) +
+                ", row " + std::to_string(p / field.width) + " is " + formatNumber(planes[i]) +
+                " although the height there is finite: the heights, cell size and z-scale go beyond what the "
+                "kernels' single precision holds; rescale them (--z-scale, --cell-size)");
+  }
+}
+
+Progress::Progress(bool quiet)
+    : enabled_(!quiet && ::isatty(::fileno(stderr))), start_(std::chrono::steady_clock::now()) {}
+
+void Progress::attach(SweepOptions& options) {
+  if (!enabled_) return;
+  total_ = options.directions;
+  options.progress = [this](int done, int total) {
+    done_ = done;
+    total_ = total;
+    strip_ = 0;
+    report();
+  };
+  options.strip_progress = [this](int strip, int strips) {
+    strip_ = strip;
+    strips_ = strips;
+    report(false);
+  };
+}
+
+std::function<void(int, int)> Progress::callback(int total, const char* unit) {
+  if (!enabled_) return nullptr;
+  total_ = total;
+  unit_ = unit;
+  return [this](int done, int all) {
+    done_ = done;
+    total_ = all;
+    report();
+  };
+}
+
+void Progress::endLine() {
+  if (line_open_) std::fputc('\n', stderr);
+}
+
+void Progress::report(bool finished_batch) {
+  const auto now = std::chrono::steady_clock::now();
+  const bool last = finished_batch && total_ > 0 && done_ >= total_;
+  if (!last && now - last_ < std::chrono::milliseconds(250)) return;
+  last_ = now;
+  line_open_ = !last;
+  // Directions done, and the share of the one under way in strips.
+  const double fraction =
+      total_ > 0 ? (done_ + (strips_ > 0 ? double(strip_) / strips_ : 0.0)) / total_ : 0.0;
+  std::string strip, left;
+  if (strip_ > 0 && !last) strip = ", strip " + std::to_string(strip_) + "/" + std::to_string(strips_);
+  if (fraction > 0.0 && !last) {
+    const double elapsed = std::chrono::duration<double>(now - start_).count();
+    const long seconds = std::lround(elapsed * (1.0 - fraction) / fraction);
+    left = ", about " + (seconds >= 60 ? std::to_string(seconds / 60) + " min " : std::string()) +
+           std::to_string(seconds % 60) + " s left";
+  }
+  // \033[K clears what a longer line before left behind.
+  std::fprintf(stderr, "\rhfvis: %d/%d %s%s%s\033[K%s", done_, total_, unit_, strip.c_str(), left.c_str(),
+               line_open_ ? "" : "\n");
+  std::fflush(stderr);
+}
+
+void NorthUp::restore(std::vector<float>& planes) const {
+  const std::size_t width = input->width, rows = input->height, plane = width * rows;
+  for (std::size_t at = 0; at + plane <= planes.size(); at += plane) {
+    if (flip_rows)
+      for (std::size_t r = 0; r < rows / 2; ++r)
+        std::swap_ranges(planes.begin() + at + r * width, planes.begin() + at + (r + 1) * width,
+                         planes.begin() + at + (rows - 1 - r) * width);
+    if (flip_columns)
+      for (std::size_t r = 0; r < rows; ++r)
+        std::reverse(planes.begin() + at + r * width, planes.begin() + at + (r + 1) * width);
+  }
+}
+
+void NorthUp::place(Observer& o) const {
+  if (flip_rows) o.row = input->height - 1 - o.row;
+  if (flip_columns) o.col = input->width - 1 - o.col;
+}
+
+NorthUp northUp(const HeightField& field) {
+  NorthUp out;
+  out.input = &field;
+  const auto& t = field.georeference.geotransform;
+  if (!t) return out;
+  out.flip_rows = (*t)[5] > 0.0;
+  out.flip_columns = (*t)[1] < 0.0;
+  if (!out.flipped()) return out;
+  out.flipped_copy = field;
+  out.restore(out.flipped_copy.heights);  // each flip is its own inverse
+  if (out.flip_rows) {
+    std::reverse(out.flipped_copy.row_cell_size_x.begin(), out.flipped_copy.row_cell_size_x.end());
+    std::reverse(out.flipped_copy.row_cell_size_y.begin(), out.flipped_copy.row_cell_size_y.end());
+  }
+  return out;
+}
+
+Attributes Job::attributes(const HeightField& field) const {
+  const DeviceInfo& device = context->device();
+  Attributes attributes{
+      {"hfvis:command", command.recordedName()},
+      {"hfvis:input", run.input},
+      {"hfvis:directions", std::to_string(run.directions)},
+      {"hfvis:azimuth_offset_deg", formatNumber(run.azimuth_offset_deg)},
+      {"hfvis:azimuth_convention",
+       "phi_k = 360*k/K deg + offset, on the ground from the +column axis toward +row; "
+       "compass azimuth = 90 + phi_k deg when row 0 is north"},
+      {"hfvis:method", method},
+      {"hfvis:samples_per_unit", formatNumber(run.samples_per_unit)},
+      // Read back by readHeightField, so an output keeps the input's ground spacing.
+      {"hfvis:cell_size_x", formatNumber(field.cell_size_x)},
+      {"hfvis:cell_size_y", formatNumber(field.cell_size_y)},
+      {"hfvis:z_scale", formatNumber(field.z_scale)},
+      {"hfvis:nodata", run.nodata && !std::isnan(*run.nodata)
+                           ? "where the input height is not finite: " + formatNumber(*run.nodata) +
+                                 " (the bands' nodata value) in GeoTIFF outputs, NaN in others"
+                           : std::string("NaN where the input height is not finite")},
+      {"hfvis:device", device.name + " (" + device.platform + ")"},
+  };
+  if (!run.channel.empty()) attributes.emplace_back("hfvis:channel", run.channel);
+  if (run.max_distance > 0.0) attributes.emplace_back("hfvis:max_distance", formatNumber(run.max_distance));
+  if (run.curvature) {
+    attributes.emplace_back(
+        "hfvis:curvature", "drop = d^2 (1 - K) / (2 R), R = " + formatNumber(kEarthRadius) +
+                               " m, K = " + formatNumber(run.refraction) + " (ground units taken as metres)");
+  }
+  return attributes;
+}
+
+ImageChannels Job::image(const HeightField& field, std::vector<std::string> names,
+                         std::vector<std::vector<float>> planes, Attributes attributes,
+                         const std::string& quantity, const std::string& units) const {
+  ImageChannels image;
+  image.width = field.width;
+  image.height = field.height;
+  image.georeference = field.georeference;
+  if (run.nodata) image.nodata = *run.nodata;
+  image.names = std::move(names);
+  image.planes = std::move(planes);
+  image.attributes = std::move(attributes);
+  image.attributes.emplace_back("hfvis:quantity", quantity);
+  image.attributes.emplace_back("hfvis:units", units);
+  return image;
+}
+
+std::vector<std::string> Computation::outputs() const {
+  std::vector<std::string> paths{run_.output};
+  if (!run_.distance_output.empty()) paths.push_back(run_.distance_output);
+  if (!run_.preview.empty()) paths.push_back(run_.preview);
+  return paths;
+}
+
+std::string Computation::method() const { return run_.method == HorizonMethod::Naive ? "naive" : "sweep"; }
+
+namespace {
+
+// The same file, whether or not it exists yet (links and relative paths resolved).
+bool sameFile(const std::string& a, const std::string& b) {
+  std::error_code error;
+  if (fs::exists(a, error) && fs::exists(b, error)) return fs::equivalent(a, b, error);
+  std::error_code error_a, error_b;
+  const fs::path canonical_a = fs::weakly_canonical(a, error_a),
+                 canonical_b = fs::weakly_canonical(b, error_b);
+  if (error_a || error_b)  // (an error gives empty paths, which would compare equal)
+    return fs::absolute(a, error).lexically_normal() == fs::absolute(b, error).lexically_normal();
+  return canonical_a == canonical_b;
+}
+
+// Every output can be written, none is an input (an output never replaces an input), and no
+// two outputs are the same file (the second would replace the first). Checked before the
+// input is read.
+void requireOutputs(const RunArguments& run, const Computation& computation) {
+  const std::vector<std::string> outputs = computation.outputs();
+  std::vector<std::string> inputs{run.input};
+  for (const std::string& input : computation.otherInputs())
+    if (!input.empty()) inputs.push_back(input);
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    requireReplaceable(outputs[i]);
+    if (computation.writesImages() && outputs[i] != run.preview)
+      requireImageWriter(outputs[i]);  // (the preview: a .png, checked)
+    for (const std::string& input : inputs) {
+      if (sameFile(outputs[i], input))
+        throw UsageError("output '" + outputs[i] + "' is the input '" + input +
+                         "': outputs never replace an input");
+    }
+    for (std::size_t j = 0; j < i; ++j) {
+      if (sameFile(outputs[i], outputs[j]))
+        throw UsageError("outputs '" + outputs[j] + "' and '" + outputs[i] + "' are the same file");
+    }
+  }
+}
+
+// Reads the input height field and checks it (a bad field is the input file's fault).
+HeightField readValidField(const RunArguments& run) {
+  HeightField field = readHeightField(run.input, readOptions(run));
+  try {
+    validate(field);
+  } catch (const InvalidArgument& error) {
+    throw Error(run.input + ": " + error.what());
+  }
+  return field;
+}
+
+// The context of a run: the HFVIS_* environment variables (ContextOptions::fromEnvironment),
+// --device taking precedence over HFVIS_DEVICE.
+ComputeContext contextFor(const RunArguments& run) {
+  ContextOptions options = ContextOptions::fromEnvironment();
+  if (!run.device.empty()) options.device = run.device;
+  return ComputeContext::create(options);
+}
+
+std::string joinPaths(const std::vector<std::string>& paths) {
+  std::string joined;
+  for (const std::string& path : paths) joined += (joined.empty() ? "" : ", ") + path;
+  return joined;
+}
+
+}  // namespace
+
+int runPipeline(const CommandLine& line, Computation& computation) {
+  const RunArguments& run = line.run;
+  requireOutputs(run, computation);
+  HeightField input = readValidField(run);
+  computation.prepare(input);
+  // (a command on the host, writing text, opens no device)
+  std::optional<ComputeContext> context;
+  if (computation.writesImages()) context.emplace(contextFor(run));
+  Progress progress(run.quiet);
+  Job job{commandSpec(line.command),     run,      input,
+          context ? &*context : nullptr, progress, computation.method()};
+  const auto start = std::chrono::steady_clock::now();
+  computation.compute(job);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  // Everything is computed; now stage every file, then move them all into place.
+  OutputFiles outputs;
+  const Summary summary = computation.write(job, outputs);
+  const std::vector<std::string> written = outputs.paths();
+  outputs.commit();
+  if (!run.quiet) {
+    std::cout << "wrote " << joinPaths(written) << " (" << input.width << "x" << input.height << ", "
+              << summary.count << " " << summary.unit << (summary.count == 1 ? ", " : "s, ") << job.method
+              << ", " << formatFixed(seconds, 2) << " s" << (context ? " on " + context->device().name : "")
+              << ")" << summary.note << "\n";
+  }
+  if (!summary.always.empty()) std::cout << summary.always << "\n";
+  return 0;
+}
+
+}  // namespace hfvis::cli
