@@ -342,6 +342,39 @@ TEST(RegionVisibility, SamplesAreStratifiedAndDeterministic) {
   EXPECT_NEAR(points[0].height, 0.5 * (field.at(2, 3) + field.at(3, 3)) + 1.0, 1e-4);
 }
 
+TEST(RegionVisibility, ManySamplesAndDecorrelation) {
+  // 1030 samples: 33 words, the last holding 6 bits; the bits past S stay zero.
+  HeightField field = makeSyntheticField("city", 23, 17);
+  field.cell_size_y = 0.75;
+  RegionSampling sources;
+  sources.rectangle = {2, 2, 12, 9};
+  sources.samples = 1030;
+  sources.height = 8.0;
+  RegionVisibilityOptions options;
+  options.target_height = 1.0;
+  options.seed = 11;
+  std::vector<std::uint32_t> shared;
+  for (bool decorrelate : {false, true}) {
+    options.decorrelate = decorrelate;
+    forEachLayout([&](const ComputeContext& context) {
+      const RegionVisibilityResult got = computeRegionVisibility(context, field, sources, options);
+      ASSERT_EQ(got.words, 33);
+      expectSame(got, referenceRegionVisibility(field, sources, options));
+      for (std::size_t p = 0; p < field.pixelCount(); ++p) EXPECT_EQ(got.bits[p * 33 + 32] >> 6, 0u) << p;
+      // The same run again: the same bits (the jitter is a hash, not a random state).
+      EXPECT_EQ(computeRegionVisibility(context, field, sources, options).bits, got.bits);
+      if (!decorrelate) {
+        shared = got.bits;
+        return;
+      }
+      // Each receiver its own samples: other bits where a receiver sees part of the sources.
+      std::size_t differ = 0;
+      for (std::size_t i = 0; i < got.bits.size(); ++i) differ += got.bits[i] != shared[i];
+      EXPECT_GT(differ, got.bits.size() / 10);
+    });
+  }
+}
+
 TEST(RegionVisibility, BadInputIsRefused) {
   HeightField field = makeSyntheticField("noise", 20, 10);
   field.heights[5 * 20 + 5] = std::numeric_limits<float>::quiet_NaN();
