@@ -23,8 +23,8 @@ typedef struct {
 
 __kernel void region_visibility_bits(__global const float* h, RegionField f, __global const float* sources,
                                      int source_absolute, int samples, int pixel_receivers,
-                                     __global const float* receivers,
-                                     int receiver_absolute, int receiver_count, float target_height, unsigned int seed,
+                                     __global const float* receivers, int receiver_absolute,
+                                     int receiver_count, float target_height, unsigned int seed,
                                      int decorrelate, int words, int receiver_major, int first,
                                      __global unsigned int* bits) {
   const int r = first + (int)get_global_id(0), w = get_global_id(1);
@@ -44,8 +44,8 @@ __kernel void region_visibility_bits(__global const float* h, RegionField f, __g
     for (int s = 32 * w; s < end; ++s) {
       float xs, ys, zs;
       region_sample(sources, h, f.width, f.height, source_absolute, seed, key, s, &xs, &ys, &zs);
-      if (region_sight_visible(h, f.width, f.height, f.cell_x, f.cell_y, f.curvature, f.max_d2, xs, ys, zs, xr, yr,
-                               zr))
+      if (region_sight_visible(h, f.width, f.height, f.cell_x, f.cell_y, f.curvature, f.max_d2, xs, ys, zs,
+                               xr, yr, zr))
         word |= 1U << (s - 32 * w);
     }
   }

@@ -19,14 +19,16 @@ struct Pairs {
   // The bits of a receiver at (x, y, z) with source stream `key`; none where z is NaN.
   void receiverBits(float x, float y, float z, unsigned key, std::uint32_t* words) const {
     const int samples = detail::regionTableSamples(sources);
-    const float max_d2 = options.max_distance > 0.0 ? float(options.max_distance * options.max_distance) : 0.0f;
+    const float max_d2 =
+        options.max_distance > 0.0 ? float(options.max_distance * options.max_distance) : 0.0f;
     for (int s = 0; s < samples; ++s) {
       if (std::isnan(z)) break;
       float xs, ys, zs;
-      detail::region_sample(sources.data(), heights.data(), field.width, field.height, source_absolute, options.seed,
-                            key, s, &xs, &ys, &zs);
+      detail::region_sample(sources.data(), heights.data(), field.width, field.height, source_absolute,
+                            options.seed, key, s, &xs, &ys, &zs);
       if (detail::region_sight_visible(heights.data(), field.width, field.height, float(field.cell_size_x),
-                                       float(field.cell_size_y), float(options.curvature), max_d2, xs, ys, zs, x, y, z))
+                                       float(field.cell_size_y), float(options.curvature), max_d2, xs, ys, zs,
+                                       x, y, z))
         words[s / 32] |= 1u << (s % 32);
     }
   }
@@ -63,7 +65,8 @@ RegionVisibilityResult referenceRegionVisibility(const HeightField& field, const
   return out;
 }
 
-RegionPairVisibilityResult referenceRegionPairVisibility(const HeightField& field, const RegionSampling& sources,
+RegionPairVisibilityResult referenceRegionPairVisibility(const HeightField& field,
+                                                         const RegionSampling& sources,
                                                          const RegionSampling& receivers,
                                                          const RegionVisibilityOptions& options) {
   validate(field);
@@ -85,9 +88,10 @@ RegionPairVisibilityResult referenceRegionPairVisibility(const HeightField& fiel
   std::vector<int> seen_by(out.source_samples, 0);
   for (int r = 0; r < out.receiver_samples; ++r) {
     float x, y, z;
-    detail::region_sample(receiver_table.data(), heights.data(), field.width, field.height, receivers.absolute,
-                          options.seed, 0u, r, &x, &y, &z);
-    pairs.receiverBits(x, y, z, options.decorrelate ? unsigned(r) + 1u : 0u, &out.bits[std::size_t(r) * out.words]);
+    detail::region_sample(receiver_table.data(), heights.data(), field.width, field.height,
+                          receivers.absolute, options.seed, 0u, r, &x, &y, &z);
+    pairs.receiverBits(x, y, z, options.decorrelate ? unsigned(r) + 1u : 0u,
+                       &out.bits[std::size_t(r) * out.words]);
     int seen = 0;
     for (int s = 0; s < out.source_samples; ++s)
       if (out.visible(r, s)) ++seen, ++seen_by[s];

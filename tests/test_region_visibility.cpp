@@ -35,7 +35,8 @@ RegionSampling sourcesIn(const HeightField& f, int samples, double height, bool 
   try {
     validate(f, s);
   } catch (const InvalidArgument&) {
-    const auto it = std::find_if(f.heights.begin(), f.heights.end(), [](float v) { return std::isfinite(v); });
+    const auto it =
+        std::find_if(f.heights.begin(), f.heights.end(), [](float v) { return std::isfinite(v); });
     const int p = static_cast<int>(it - f.heights.begin());
     s.rectangle = {p % f.width, p / f.width, p % f.width, p / f.width};
   }
@@ -62,7 +63,8 @@ void expectSame(const RegionVisibilityResult& got, const RegionVisibilityResult&
   EXPECT_LE(differ, got.bits.size() * 32 / 1000);
   if (!exact) return;
   for (std::size_t p = 0; p < got.fraction.size(); ++p)
-    if (!(got.fraction[p] == want.fraction[p] || (std::isnan(got.fraction[p]) && std::isnan(want.fraction[p])))) {
+    if (!(got.fraction[p] == want.fraction[p] ||
+          (std::isnan(got.fraction[p]) && std::isnan(want.fraction[p])))) {
       ADD_FAILURE() << "fraction at " << p << ": " << got.fraction[p] << " vs " << want.fraction[p];
       break;
     }
@@ -116,8 +118,10 @@ TEST(RegionVisibility, PairMatchesTheReference) {
     try {
       validate(field, a), validate(field, b);
     } catch (const InvalidArgument&) {  // nan_holes: its first and last valid points
-      const auto first = std::find_if(field.heights.begin(), field.heights.end(), [](float v) { return std::isfinite(v); });
-      const auto last = std::find_if(field.heights.rbegin(), field.heights.rend(), [](float v) { return std::isfinite(v); });
+      const auto first =
+          std::find_if(field.heights.begin(), field.heights.end(), [](float v) { return std::isfinite(v); });
+      const auto last = std::find_if(field.heights.rbegin(), field.heights.rend(),
+                                     [](float v) { return std::isfinite(v); });
       const int p = static_cast<int>(first - field.heights.begin());
       const int q = static_cast<int>(field.heights.rend() - last) - 1;
       a.rectangle = {p % 40, p / 40, p % 40, p / 40};
@@ -333,7 +337,8 @@ TEST(RegionVisibility, SamplesAreStratifiedAndDeterministic) {
   region.samples = 10;
   const std::vector<RegionPoint> strip = regionSamplePoints(field, region, 1);
   ASSERT_EQ(strip.size(), 10u);
-  for (const RegionPoint& p : strip) EXPECT_TRUE(p.col >= 0.0 && p.col <= 8.0 && p.row >= 0.0 && p.row <= 1.0);
+  for (const RegionPoint& p : strip)
+    EXPECT_TRUE(p.col >= 0.0 && p.col <= 8.0 && p.row >= 0.0 && p.row <= 1.0);
   // Heights above the surface under the sample.
   region.points = {{2.5, 3.0, 1.0}, {0.0, 0.0, 2.0}};
   const std::vector<RegionPoint> points = regionSamplePoints(field, region, 1);

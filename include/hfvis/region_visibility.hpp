@@ -81,9 +81,9 @@ struct RegionVisibilityOptions {
 // Per receiver a bitmask of the source samples it sees: bit s % 32 of word s / 32 (words per
 // receiver: ceil(S / 32), the bits past S zero).
 struct RegionVisibilityResult {
-  int width = 0, height = 0;  // the field: receivers are its grid points, row-major
-  int samples = 0;            // S
-  int words = 0;              // per receiver
+  int width = 0, height = 0;        // the field: receivers are its grid points, row-major
+  int samples = 0;                  // S
+  int words = 0;                    // per receiver
   std::vector<std::uint32_t> bits;  // width * height * words
   std::vector<float> fraction;      // visible samples / S per receiver; NaN at nodata
   // Receiver p's sample s is visible.
@@ -92,13 +92,15 @@ struct RegionVisibilityResult {
 
 struct RegionPairVisibilityResult {
   int source_samples = 0, receiver_samples = 0;
-  int words = 0;  // per receiver sample: ceil(source_samples / 32)
+  int words = 0;                                // per receiver sample: ceil(source_samples / 32)
   std::vector<RegionPoint> sources, receivers;  // the samples, heights absolute (z-scaled)
   std::vector<std::uint32_t> bits;              // receiver_samples * words
   std::uint64_t clear_pairs = 0, pairs = 0;
   std::vector<float> source_fraction;    // per source sample: the receiver samples it sees / their count
   std::vector<float> receiver_fraction;  // per receiver sample: the source samples it sees / S
-  bool visible(int receiver, int source) const { return (bits[std::size_t(receiver) * words + source / 32] >> (source % 32)) & 1u; }
+  bool visible(int receiver, int source) const {
+    return (bits[std::size_t(receiver) * words + source / 32] >> (source % 32)) & 1u;
+  }
 };
 
 // Throws InvalidArgument for a negative or non-finite target height or maximum distance, a
@@ -119,12 +121,15 @@ std::vector<RegionPoint> regionSamplePoints(const HeightField& field, const Regi
 // options, a latitude / longitude grid, a field of 2^31 points or more), OpenClError,
 // KernelBuildError.
 RegionVisibilityResult computeRegionVisibility(const ComputeContext& context, const HeightField& field,
-                                               const RegionSampling& sources, const RegionVisibilityOptions& options);
+                                               const RegionSampling& sources,
+                                               const RegionVisibilityOptions& options);
 
 // Which source samples every receiver sample sees, between two regions (options.target_height is
 // not used: the receivers' own height is). Throws as computeRegionVisibility.
-RegionPairVisibilityResult computeRegionPairVisibility(const ComputeContext& context, const HeightField& field,
-                                                       const RegionSampling& sources, const RegionSampling& receivers,
+RegionPairVisibilityResult computeRegionPairVisibility(const ComputeContext& context,
+                                                       const HeightField& field,
+                                                       const RegionSampling& sources,
+                                                       const RegionSampling& receivers,
                                                        const RegionVisibilityOptions& options);
 
 }  // namespace hfvis

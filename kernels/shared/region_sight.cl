@@ -75,9 +75,9 @@ inline float region_rise(float s, float t, float za, float dz, float cdd) {
 // any). A cell with a nodata corner has no surface inside; an edge or grid point between valid
 // heights is surface. Pieces shorter than 1e-3 pixel skip their inside test, as the viewshed's
 // do (their top would be rounding noise).
-inline int region_sight_visible(HFVIS_GLOBAL const float* h, int width, int height, float cell_x, float cell_y,
-                                float curvature, float max_d2, float xa, float ya, float za, float xb, float yb,
-                                float zb) {
+inline int region_sight_visible(HFVIS_GLOBAL const float* h, int width, int height, float cell_x,
+                                float cell_y, float curvature, float max_d2, float xa, float ya, float za,
+                                float xb, float yb, float zb) {
   // The canonical order: from the smaller end in (x, y, z), so that the test is symmetric.
   if (xb < xa || (xb == xa && (yb < ya || (yb == ya && zb < za)))) {
     float s = xa;
@@ -169,7 +169,8 @@ inline float region_jitter(unsigned int seed, unsigned int key, unsigned int s, 
 // corner plus the jitter times the size, kept inside the rectangle (a rounding may step past).
 // *z: its absolute height (NaN over a nodata surface).
 inline void region_sample(HFVIS_GLOBAL const float* table, HFVIS_GLOBAL const float* h, int width, int height,
-                          int absolute, unsigned int seed, unsigned int key, int s, float* x, float* y, float* z) {
+                          int absolute, unsigned int seed, unsigned int key, int s, float* x, float* y,
+                          float* z) {
   HFVIS_GLOBAL const float* e = table + 4 + 5 * s;
   const float vx = e[0] + region_jitter(seed, key, (unsigned int)s, 0U) * e[2];
   const float vy = e[1] + region_jitter(seed, key, (unsigned int)s, 1U) * e[3];

@@ -23,6 +23,8 @@ std::vector<float> regionHeights(const HeightField& field);
 std::vector<float> regionSampleTable(const HeightField& field, const RegionSampling& sampling);
 
 // The samples a table holds.
-inline int regionTableSamples(const std::vector<float>& table) { return static_cast<int>((table.size() - 4) / 5); }
+inline int regionTableSamples(const std::vector<float>& table) {
+  return static_cast<int>((table.size() - 4) / 5);
+}
 
 }  // namespace hfvis::detail

@@ -8,10 +8,10 @@
 #include <limits>
 #include <string>
 
-#include "hfvis/errors.hpp"
 #include "core/horizon_common.hpp"
 #include "core/opencl_context.hpp"
 #include "core/sweep_framework.hpp"
+#include "hfvis/errors.hpp"
 #include "ops/region_sight.hpp"
 
 namespace hfvis {
@@ -36,8 +36,9 @@ void validateField(const HeightField& field) {
     throw InvalidArgument("region visibility takes fields of at most 2^31 - 1 points (got " +
                           std::to_string(field.pixelCount()) + ")");
   if (detail::hasRowSpacing(field))
-    throw InvalidArgument("region visibility on latitude / longitude grids (per-row spacing) is not supported; "
-                          "reproject the DEM to a projected CRS");
+    throw InvalidArgument(
+        "region visibility on latitude / longitude grids (per-row spacing) is not supported; "
+        "reproject the DEM to a projected CRS");
 }
 
 int popcount(std::uint32_t v) { return __builtin_popcount(v); }
@@ -45,8 +46,9 @@ int popcount(std::uint32_t v) { return __builtin_popcount(v); }
 // The bits of `count` receivers from the device, receiver-major.
 std::vector<std::uint32_t> runBits(const ComputeContext& context, const HeightField& field,
                                    const std::vector<float>& heights, const std::vector<float>& sources,
-                                   bool source_absolute, const std::vector<float>* receivers, bool receiver_absolute,
-                                   int count, const RegionVisibilityOptions& options) {
+                                   bool source_absolute, const std::vector<float>* receivers,
+                                   bool receiver_absolute, int count,
+                                   const RegionVisibilityOptions& options) {
   const int samples = detail::regionTableSamples(sources);
   const int words = (samples + 31) / 32;
   return detail::translateOpenClErrors([&] {
@@ -55,12 +57,12 @@ std::vector<std::uint32_t> runBits(const ComputeContext& context, const HeightFi
     const cl::Program program = st.program("region_visibility.cl", "");
     const cl::Buffer h(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, heights.size() * sizeof(float),
                        const_cast<float*>(heights.data()));
-    const cl::Buffer source_table(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sources.size() * sizeof(float),
-                                  const_cast<float*>(sources.data()));
+    const cl::Buffer source_table(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                  sources.size() * sizeof(float), const_cast<float*>(sources.data()));
     // A pixel run binds the source table in the receivers' place (never read).
     const cl::Buffer receiver_table =
-        receivers ? cl::Buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, receivers->size() * sizeof(float),
-                               const_cast<float*>(receivers->data()))
+        receivers ? cl::Buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                               receivers->size() * sizeof(float), const_cast<float*>(receivers->data()))
                   : source_table;
     const std::size_t entries = static_cast<std::size_t>(count) * words;
     const cl::Buffer bits = detail::deviceBuffer(st, entries * sizeof(std::uint32_t));
@@ -90,7 +92,8 @@ std::vector<std::uint32_t> runBits(const ComputeContext& context, const HeightFi
     for (int first = 0; first < count; first += kReceiversPerLaunch) {
       const int chunk = std::min(kReceiversPerLaunch, count - first);
       k.setArg(14, cl_int(first));
-      st.launch(k, cl::NDRange(detail::roundUp(chunk, detail::kLineGroup), words), cl::NDRange(detail::kLineGroup, 1));
+      st.launch(k, cl::NDRange(detail::roundUp(chunk, detail::kLineGroup), words),
+                cl::NDRange(detail::kLineGroup, 1));
     }
     std::vector<std::uint32_t> out(entries);
     st.queue.enqueueReadBuffer(bits, CL_TRUE, 0, entries * sizeof(std::uint32_t), out.data());
@@ -149,7 +152,8 @@ std::vector<float> regionSampleTable(const HeightField& field, const RegionSampl
     const int j = s / n, i = s % n;
     const int in_row = j == rows - 1 ? s_count - (rows - 1) * n : n;
     const double sx = ex / in_row, sy = ey / rows;
-    table.insert(table.end(), {float(x0 + sx * i), float(y0 + sy * j), float(sx), float(sy), float(sampling.height)});
+    table.insert(table.end(),
+                 {float(x0 + sx * i), float(y0 + sy * j), float(sx), float(sy), float(sampling.height)});
   }
   return table;
 }
@@ -162,7 +166,8 @@ void validate(const RegionVisibilityOptions& options) {
   if (!std::isfinite(options.max_distance) || options.max_distance < 0.0)
     throw InvalidArgument("the maximum distance must be finite and at least 0 (0: no limit)");
   if (!std::isfinite(options.curvature)) throw InvalidArgument("the curvature must be finite");
-  if (options.method != RegionVisibilityMethod::Exact) throw InvalidArgument("unknown region visibility method");
+  if (options.method != RegionVisibilityMethod::Exact)
+    throw InvalidArgument("unknown region visibility method");
 }
 
 void validate(const HeightField& field, const RegionSampling& sampling) {
@@ -175,10 +180,11 @@ void validate(const HeightField& field, const RegionSampling& sampling) {
     for (const RegionPoint& p : sampling.points) {
       const std::string at = std::to_string(p.col) + "," + std::to_string(p.row);
       if (!(p.col >= 0.0 && p.col <= field.width - 1.0 && p.row >= 0.0 && p.row <= field.height - 1.0))
-        throw InvalidArgument("region point " + at + " is outside the " + std::to_string(field.width) + " x " +
-                              std::to_string(field.height) + " field");
+        throw InvalidArgument("region point " + at + " is outside the " + std::to_string(field.width) +
+                              " x " + std::to_string(field.height) + " field");
       if (!std::isfinite(p.height)) throw InvalidArgument("region point " + at + " has a non-finite height");
-      const float s = detail::region_surface_at(heights.data(), field.width, field.height, float(p.col), float(p.row));
+      const float s =
+          detail::region_surface_at(heights.data(), field.width, field.height, float(p.col), float(p.row));
       if (std::isnan(s)) throw InvalidArgument("region point " + at + " lies over nodata");
     }
     return;
@@ -210,15 +216,16 @@ std::vector<RegionPoint> regionSamplePoints(const HeightField& field, const Regi
   std::vector<RegionPoint> points;
   for (int s = 0; s < detail::regionTableSamples(table); ++s) {
     float x, y, z;
-    detail::region_sample(table.data(), heights.data(), field.width, field.height, sampling.absolute, seed, 0u, s, &x,
-                          &y, &z);
+    detail::region_sample(table.data(), heights.data(), field.width, field.height, sampling.absolute, seed,
+                          0u, s, &x, &y, &z);
     points.push_back({x, y, z});
   }
   return points;
 }
 
 RegionVisibilityResult computeRegionVisibility(const ComputeContext& context, const HeightField& field,
-                                               const RegionSampling& sources, const RegionVisibilityOptions& options) {
+                                               const RegionSampling& sources,
+                                               const RegionVisibilityOptions& options) {
   validateField(field);
   validate(options);
   const std::vector<float> table = detail::regionSampleTable(field, sources);
@@ -240,8 +247,10 @@ RegionVisibilityResult computeRegionVisibility(const ComputeContext& context, co
   return out;
 }
 
-RegionPairVisibilityResult computeRegionPairVisibility(const ComputeContext& context, const HeightField& field,
-                                                       const RegionSampling& sources, const RegionSampling& receivers,
+RegionPairVisibilityResult computeRegionPairVisibility(const ComputeContext& context,
+                                                       const HeightField& field,
+                                                       const RegionSampling& sources,
+                                                       const RegionSampling& receivers,
                                                        const RegionVisibilityOptions& options) {
   validateField(field);
   validate(options);
@@ -254,8 +263,8 @@ RegionPairVisibilityResult computeRegionPairVisibility(const ComputeContext& con
   out.words = (out.source_samples + 31) / 32;
   out.sources = regionSamplePoints(field, sources, options.seed);
   out.receivers = regionSamplePoints(field, receivers, options.seed);
-  out.bits = runBits(context, field, heights, source_table, sources.absolute, &receiver_table, receivers.absolute,
-                     out.receiver_samples, options);
+  out.bits = runBits(context, field, heights, source_table, sources.absolute, &receiver_table,
+                     receivers.absolute, out.receiver_samples, options);
   out.pairs = static_cast<std::uint64_t>(out.source_samples) * out.receiver_samples;
   out.source_fraction.assign(out.source_samples, 0.0f);
   out.receiver_fraction.assign(out.receiver_samples, 0.0f);

@@ -13,7 +13,8 @@ RegionVisibilityResult referenceRegionVisibility(const HeightField& field, const
                                                  const RegionVisibilityOptions& options);
 
 // computeRegionPairVisibility, scalar.
-RegionPairVisibilityResult referenceRegionPairVisibility(const HeightField& field, const RegionSampling& sources,
+RegionPairVisibilityResult referenceRegionPairVisibility(const HeightField& field,
+                                                         const RegionSampling& sources,
                                                          const RegionSampling& receivers,
                                                          const RegionVisibilityOptions& options);
 
