@@ -93,7 +93,9 @@ struct RegionVisibilityResult {
 struct RegionPairVisibilityResult {
   int source_samples = 0, receiver_samples = 0;
   int words = 0;                                // per receiver sample: ceil(source_samples / 32)
-  std::vector<RegionPoint> sources, receivers;  // the samples, heights absolute (z-scaled)
+  // The samples, heights absolute (z-scaled); the sources are stream 0's (decorrelated, each
+  // receiver sample drew its own).
+  std::vector<RegionPoint> sources, receivers;
   std::vector<std::uint32_t> bits;              // receiver_samples * words
   std::uint64_t clear_pairs = 0, pairs = 0;
   std::vector<float> source_fraction;    // per source sample: the receiver samples it sees / their count
@@ -118,8 +120,8 @@ std::vector<RegionPoint> regionSamplePoints(const HeightField& field, const Regi
                                             std::uint32_t seed);
 
 // Which source samples every grid point sees. Throws InvalidArgument (bad field, sources or
-// options, a latitude / longitude grid, a field of 2^31 points or more), OpenClError,
-// KernelBuildError.
+// options, a latitude / longitude grid, a field of 2^31 points or more), MemoryBudgetError
+// (bitmasks beyond half the device's memory), OpenClError, KernelBuildError.
 RegionVisibilityResult computeRegionVisibility(const ComputeContext& context, const HeightField& field,
                                                const RegionSampling& sources,
                                                const RegionVisibilityOptions& options);

@@ -65,6 +65,13 @@ std::vector<std::uint32_t> runBits(const ComputeContext& context, const HeightFi
                                receivers->size() * sizeof(float), const_cast<float*>(receivers->data()))
                   : source_table;
     const std::size_t entries = static_cast<std::size_t>(count) * words;
+    // The bitmasks live whole on the device and the host: refuse what half the device's memory
+    // cannot hold rather than fail in the allocation.
+    const std::size_t budget = detail::defaultMemoryBudget(st.info);
+    if (entries * sizeof(std::uint32_t) > budget)
+      throw MemoryBudgetError("the bitmasks need " + detail::mebibytes(entries * sizeof(std::uint32_t)) +
+                              " but half the device's memory is " + detail::mebibytes(budget) +
+                              "; take fewer samples or a smaller field");
     const cl::Buffer bits = detail::deviceBuffer(st, entries * sizeof(std::uint32_t));
     const double max_d2 = options.max_distance * options.max_distance;
     const DeviceField device{field.width,
