@@ -92,11 +92,11 @@ struct RegionVisibilityResult {
 
 struct RegionPairVisibilityResult {
   int source_samples = 0, receiver_samples = 0;
-  int words = 0;                                // per receiver sample: ceil(source_samples / 32)
+  int words = 0;  // per receiver sample: ceil(source_samples / 32)
   // The samples, heights absolute (z-scaled); the sources are stream 0's (decorrelated, each
   // receiver sample drew its own).
   std::vector<RegionPoint> sources, receivers;
-  std::vector<std::uint32_t> bits;              // receiver_samples * words
+  std::vector<std::uint32_t> bits;  // receiver_samples * words
   std::uint64_t clear_pairs = 0, pairs = 0;
   std::vector<float> source_fraction;    // per source sample: the receiver samples it sees / their count
   std::vector<float> receiver_fraction;  // per receiver sample: the source samples it sees / S
