@@ -28,9 +28,10 @@
 // runs in single precision, the pair in a canonical order (so that A sees B exactly when B sees
 // A): segments that graze the surface within its rounding may go either way, as the viewshed's.
 //
-// Methods: only the exact one exists yet, one line-of-sight march per (receiver, source sample)
-// pair on the device (kernels/region_visibility.cl): O(receivers * S * (W + H)). Not yet: one
-// viewshed per source sample, and Eisemann & Décoret's bitmask scatter.
+// Methods: the exact one, one line-of-sight march per (receiver, source sample) pair on the
+// device (kernels/region_visibility.cl): O(receivers * S * (W + H)); one viewshed per source
+// sample, for sources on grid points (RegionVisibilityMethod::Viewsheds). Not yet: Eisemann &
+// Décoret's bitmask scatter.
 #pragma once
 
 #include <cstdint>
@@ -66,7 +67,14 @@ struct RegionSampling {
 };
 
 enum class RegionVisibilityMethod {
-  Exact,  // one line-of-sight march per pair (the reference of the other methods, when they come)
+  Exact,  // one line-of-sight march per pair (the reference of the other methods)
+  // One viewshed per source sample (computeViewshed, hfvis/viewshed.hpp), its visible targets
+  // gathered into the bits. Only for sources on grid points (a one-point rectangle, or points at
+  // whole columns and rows), shared samples and every-pixel receivers (InvalidArgument
+  // otherwise). The viewshed walks the same sight lines in its own float operations, from the
+  // source's end: it decides some grazing lines the other way (not bit for bit: up to about
+  // 0.1 % of the pairs on the hard cases, every one grazing).
+  Viewsheds,
 };
 
 struct RegionVisibilityOptions {

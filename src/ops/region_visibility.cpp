@@ -12,6 +12,7 @@
 #include "core/opencl_context.hpp"
 #include "core/sweep_framework.hpp"
 #include "hfvis/errors.hpp"
+#include "hfvis/viewshed.hpp"
 #include "ops/region_sight.hpp"
 
 namespace hfvis {
@@ -113,6 +114,36 @@ std::vector<std::uint32_t> runBits(const ComputeContext& context, const HeightFi
   });
 }
 
+// The viewsheds method: one viewshed per source sample from its own eye height (absolute), the
+// visible targets' bits set, receiver-major.
+std::vector<std::uint32_t> viewshedBits(const ComputeContext& context, const HeightField& field,
+                                        const std::vector<RegionPoint>& samples,
+                                        const RegionVisibilityOptions& options) {
+  if (options.decorrelate)
+    throw InvalidArgument(
+        "the viewsheds method takes shared samples (no decorrelation): a viewshed per sample");
+  for (const RegionPoint& p : samples)
+    if (p.col != std::floor(p.col) || p.row != std::floor(p.row))
+      throw InvalidArgument(
+          "the viewsheds method needs sources on grid points (a one-point rectangle or points at "
+          "whole columns and rows); sample " +
+          std::to_string(p.col) + "," + std::to_string(p.row) + " is not");
+  const int words = (static_cast<int>(samples.size()) + 31) / 32;
+  std::vector<std::uint32_t> bits(field.pixelCount() * words, 0u);
+  ViewshedOptions vo;
+  vo.absolute = true;
+  vo.target_height = options.target_height;
+  vo.max_distance = options.max_distance;
+  vo.curvature = options.curvature;
+  for (std::size_t s = 0; s < samples.size(); ++s) {
+    const Observer o{static_cast<int>(samples[s].col), static_cast<int>(samples[s].row), samples[s].height};
+    const ViewshedResult v = computeViewshed(context, field, o, vo);
+    for (std::size_t p = 0; p < v.visible.size(); ++p)
+      if (v.visible[p] == 1.0f) bits[p * words + s / 32] |= 1u << (s % 32);
+  }
+  return bits;
+}
+
 }  // namespace
 
 namespace detail {
@@ -173,7 +204,7 @@ void validate(const RegionVisibilityOptions& options) {
   if (!std::isfinite(options.max_distance) || options.max_distance < 0.0)
     throw InvalidArgument("the maximum distance must be finite and at least 0 (0: no limit)");
   if (!std::isfinite(options.curvature)) throw InvalidArgument("the curvature must be finite");
-  if (options.method != RegionVisibilityMethod::Exact)
+  if (options.method != RegionVisibilityMethod::Exact && options.method != RegionVisibilityMethod::Viewsheds)
     throw InvalidArgument("unknown region visibility method");
 }
 
@@ -243,7 +274,10 @@ RegionVisibilityResult computeRegionVisibility(const ComputeContext& context, co
   out.samples = detail::regionTableSamples(table);
   out.words = (out.samples + 31) / 32;
   const int count = static_cast<int>(field.pixelCount());
-  out.bits = runBits(context, field, heights, table, sources.absolute, nullptr, false, count, options);
+  if (options.method == RegionVisibilityMethod::Viewsheds)
+    out.bits = viewshedBits(context, field, regionSamplePoints(field, sources, options.seed), options);
+  else
+    out.bits = runBits(context, field, heights, table, sources.absolute, nullptr, false, count, options);
   out.fraction.resize(field.pixelCount());
   for (int p = 0; p < count; ++p) {
     int seen = 0;
@@ -261,6 +295,8 @@ RegionPairVisibilityResult computeRegionPairVisibility(const ComputeContext& con
                                                        const RegionVisibilityOptions& options) {
   validateField(field);
   validate(options);
+  if (options.method == RegionVisibilityMethod::Viewsheds)
+    throw InvalidArgument("the viewsheds method takes every-pixel receivers, not a region pair");
   const std::vector<float> source_table = detail::regionSampleTable(field, sources);
   const std::vector<float> receiver_table = detail::regionSampleTable(field, receivers);
   const std::vector<float> heights = detail::regionHeights(field);
