@@ -8,8 +8,9 @@
 // spanned by their pixel centres, so a one-pixel rectangle is a point), each `height` above the
 // bilinear surface under it, or at that absolute (z-scaled) height (an area light in a
 // horizontal plane); or an explicit list of points. A rectangle's samples are stratified: rows of
-// ceil(sqrt(S)) strata (the last row holds the rest, its strata wider), each sample jittered
-// uniformly inside its stratum by a hash of (seed, stream, sample), so results are
+// about sqrt(S * width / height) strata, so that they are about square (all in one row or column
+// for a rectangle one point thick; the last row holds the rest, its strata wider), each sample
+// jittered uniformly inside its stratum by a hash of (seed, stream, sample), so results are
 // deterministic. With `decorrelate`, each receiver draws its own jitter of the sources (stream
 // receiver + 1), trading the banding of shared samples for noise; else every receiver sees the
 // same samples (stream 0).
@@ -20,7 +21,8 @@
 //
 // A pair is visible as in the viewshed (hfvis/viewshed.hpp): the segment between the two points
 // sees when no point of the bilinear surface strictly between them rises strictly above it (a
-// segment that only touches the surface sees); a cell with a nodata corner has no surface inside
+// segment that only touches the surface sees; an end below the surface is hidden, the surface
+// rising above the segment beside it); a cell with a nodata corner has no surface inside
 // and hides nothing, though an edge between two valid heights is surface. With curvature c, the
 // surface at ground distance d from one end and D - d from the other lies c d (D - d) lower
 // relative to the straight segment (the viewshed's c d^2 drop from an eye, the target lowered
