@@ -36,6 +36,7 @@
 #include "hfvis/image_io.hpp"
 #include "hfvis/insolation.hpp"
 #include "hfvis/intervisibility.hpp"
+#include "hfvis/region_visibility.hpp"
 #include "hfvis/sky_view_factor.hpp"
 #include "hfvis/sun_shading.hpp"
 #include "hfvis/sun.hpp"

@@ -1,0 +1,147 @@
+// hfvis/region_visibility.hpp: visibility between regions: per receiver, which samples of a
+// source region (an area light, a wind farm, an antenna site) it sees, as a bitmask, and the
+// fraction seen. After Eisemann & Décoret (2007, "Visibility sampling on GPU and
+// applications"), who sample a source region and keep, per receiver sample, a bitmask of the
+// visible source samples (soft shadows, region-to-region visibility).
+//
+// Sources: S samples of a rectangle of grid points (inclusive corners, in any order: the region
+// spanned by their pixel centres, so a one-pixel rectangle is a point), each `height` above the
+// bilinear surface under it, or at that absolute (z-scaled) height (an area light in a
+// horizontal plane); or an explicit list of points. A rectangle's samples are stratified: rows of
+// about sqrt(S * width / height) strata, so that they are about square (all in one row or column
+// for a rectangle one point thick; the last row holds the rest, its strata wider), each sample
+// jittered uniformly inside its stratum by a hash of (seed, stream, sample), so results are
+// deterministic. With `decorrelate`, each receiver draws its own jitter of the sources (stream
+// receiver + 1), trading the banding of shared samples for noise; else every receiver sees the
+// same samples (stream 0).
+//
+// Receivers: every grid point, `target_height` above the surface (a pixel's height: nodata
+// pixels receive nothing, their fraction NaN); or a second rectangle, sampled the same way with
+// its own stream 0 (a region pair).
+//
+// A pair is visible as in the viewshed (hfvis/viewshed.hpp): the segment between the two points
+// sees when no point of the bilinear surface strictly between them rises strictly above it (a
+// segment that only touches the surface sees; an end below the surface is hidden, the surface
+// rising above the segment beside it); a cell with a nodata corner has no surface inside
+// and hides nothing, though an edge between two valid heights is surface. With curvature c, the
+// surface at ground distance d from one end and D - d from the other lies c d (D - d) lower
+// relative to the straight segment (the viewshed's c d^2 drop from an eye, the target lowered
+// c D^2, written symmetrically). Pairs farther apart than max_distance are not visible. The test
+// runs in single precision, the pair in a canonical order (so that A sees B exactly when B sees
+// A): segments that graze the surface within its rounding may go either way, as the viewshed's.
+//
+// Methods: the exact one, one line-of-sight march per (receiver, source sample) pair on the
+// device (kernels/region_visibility.cl): O(receivers * S * (W + H)); one viewshed per source
+// sample, for sources on grid points (RegionVisibilityMethod::Viewsheds). Not yet: Eisemann &
+// Décoret's bitmask scatter.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "hfvis/device.hpp"
+#include "hfvis/height_field.hpp"
+
+namespace hfvis {
+
+// The most samples on either side of a region visibility (the bitmasks' bits).
+constexpr int kMaxRegionSamples = 4096;
+
+// A rectangle of grid points, corners included, in any order.
+struct PixelRectangle {
+  int col0 = 0, row0 = 0, col1 = 0, row1 = 0;
+};
+
+// A sample: pixel position (column, row; fractional between pixel centres) and height.
+struct RegionPoint {
+  double col = 0.0, row = 0.0;
+  double height = 0.0;
+};
+
+struct RegionSampling {
+  PixelRectangle rectangle;
+  int samples = 16;       // S, 1 .. kMaxRegionSamples
+  double height = 2.0;    // above the surface under each sample, or absolute (z-scaled units)
+  bool absolute = false;  // `height` (and the points' heights) absolute
+  // When not empty: these points are the samples (col, row inside the field; height as
+  // `height` above, per point), and rectangle and samples are ignored.
+  std::vector<RegionPoint> points;
+};
+
+enum class RegionVisibilityMethod {
+  Exact,  // one line-of-sight march per pair (the reference of the other methods)
+  // One viewshed per source sample (computeViewshed, hfvis/viewshed.hpp), its visible targets
+  // gathered into the bits. Only for sources on grid points (a one-point rectangle, or points at
+  // whole columns and rows), shared samples and every-pixel receivers (InvalidArgument
+  // otherwise). The viewshed walks the same sight lines in its own float operations, from the
+  // source's end: it decides some grazing lines the other way (not bit for bit: up to about
+  // 0.1 % of the pairs on the hard cases, every one grazing).
+  Viewsheds,
+};
+
+struct RegionVisibilityOptions {
+  RegionVisibilityMethod method = RegionVisibilityMethod::Exact;
+  double target_height = 0.0;  // every-pixel receivers stand this high above the surface
+  double max_distance = 0.0;   // ground units; 0 = no limit. Farther pairs are not visible.
+  double curvature = 0.0;      // drop coefficient c (earthCurvature() in hfvis/sweep_options.hpp); 0 = flat
+  std::uint32_t seed = 1;      // the jitter's
+  bool decorrelate = false;    // each receiver its own jitter of the sources
+};
+
+// Per receiver a bitmask of the source samples it sees: bit s % 32 of word s / 32 (words per
+// receiver: ceil(S / 32), the bits past S zero).
+struct RegionVisibilityResult {
+  int width = 0, height = 0;        // the field: receivers are its grid points, row-major
+  int samples = 0;                  // S
+  int words = 0;                    // per receiver
+  std::vector<std::uint32_t> bits;  // width * height * words
+  std::vector<float> fraction;      // visible samples / S per receiver; NaN at nodata
+  // Receiver p's sample s is visible.
+  bool visible(std::size_t p, int s) const { return (bits[p * words + s / 32] >> (s % 32)) & 1u; }
+};
+
+struct RegionPairVisibilityResult {
+  int source_samples = 0, receiver_samples = 0;
+  int words = 0;  // per receiver sample: ceil(source_samples / 32)
+  // The samples, heights absolute (z-scaled); the sources are stream 0's (decorrelated, each
+  // receiver sample drew its own).
+  std::vector<RegionPoint> sources, receivers;
+  std::vector<std::uint32_t> bits;  // receiver_samples * words
+  std::uint64_t clear_pairs = 0, pairs = 0;
+  std::vector<float> source_fraction;    // per source sample: the receiver samples it sees / their count
+  std::vector<float> receiver_fraction;  // per receiver sample: the source samples it sees / S
+  bool visible(int receiver, int source) const {
+    return (bits[std::size_t(receiver) * words + source / 32] >> (source % 32)) & 1u;
+  }
+};
+
+// Throws InvalidArgument for a negative or non-finite target height or maximum distance, a
+// non-finite curvature.
+void validate(const RegionVisibilityOptions& options);
+
+// Throws InvalidArgument for a rectangle outside the field, S outside 1 .. kMaxRegionSamples, a
+// non-finite height, a rectangle holding a nodata point (or a relative height over one), or a
+// point outside the field or over a cell whose surface there takes a nodata height.
+void validate(const HeightField& field, const RegionSampling& sampling);
+
+// The samples of a region (stream 0 of `seed`), heights absolute (z-scaled), as the kernels
+// place them. Throws as validate.
+std::vector<RegionPoint> regionSamplePoints(const HeightField& field, const RegionSampling& sampling,
+                                            std::uint32_t seed);
+
+// Which source samples every grid point sees. Throws InvalidArgument (bad field, sources or
+// options, a latitude / longitude grid, a field of 2^31 points or more), MemoryBudgetError
+// (bitmasks beyond half the device's memory), OpenClError, KernelBuildError.
+RegionVisibilityResult computeRegionVisibility(const ComputeContext& context, const HeightField& field,
+                                               const RegionSampling& sources,
+                                               const RegionVisibilityOptions& options);
+
+// Which source samples every receiver sample sees, between two regions (options.target_height is
+// not used: the receivers' own height is). Throws as computeRegionVisibility.
+RegionPairVisibilityResult computeRegionPairVisibility(const ComputeContext& context,
+                                                       const HeightField& field,
+                                                       const RegionSampling& sources,
+                                                       const RegionSampling& receivers,
+                                                       const RegionVisibilityOptions& options);
+
+}  // namespace hfvis

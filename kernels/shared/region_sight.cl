@@ -1,0 +1,182 @@
+// region_sight.cl: the line-of-sight test between two arbitrary points over the bilinear
+// surface, and the stratified, jittered sample positions of a region (hfvis/
+// region_visibility.hpp). Written once in the common subset of OpenCL C and C++:
+// kernels/region_visibility.cl includes it, and so does src/ops/region_sight.hpp (inside
+// namespace hfvis::detail), so the kernel and the scalar reference run the very same float
+// operations and agree bit for bit (no contraction into fma on either side, no math library
+// call but the correctly rounded division).
+//
+// The test is the viewshed's (kernels/viewshed.cl, sight_walk): the surface along a segment
+// is a quadratic within each cell, so the segment is decided from the values at the grid-line
+// crossings and, inside each cell, the top of the quadratic. It differs in three ways, each for
+// the region contract: the end points are any points of the field, not grid points; the pair is
+// put in a canonical order first, so that the answer from A to B is the answer from B to A
+// bit for bit (a float march rounds differently from its two ends); and the curvature is taken
+// in its symmetric form c D^2 t (1 - t) (the sight line's rise over the surface lowered by
+// c (t D)^2 from one end, which is the same function from either end).
+#ifndef HFVIS_REGION_SIGHT_CL
+#define HFVIS_REGION_SIGHT_CL
+
+#ifdef __OPENCL_VERSION__
+#pragma OPENCL FP_CONTRACT OFF
+#define HFVIS_GLOBAL __global
+#else
+#define HFVIS_GLOBAL
+#endif
+
+// The surface on the column line x = cx (an integer) at row coordinate y: the interpolation
+// between the line's two heights around y, or the height itself at a grid point, so that a
+// point of an edge between two valid heights is surface beside a nodata cell too.
+inline float region_column_value(HFVIS_GLOBAL const float* h, int width, int height, int cx, float y) {
+  const int cy = (int)y < height - 1 ? (int)y : height - 1;
+  const float v = y - (float)cy;
+  const float h0 = h[cy * width + cx];
+  if (v == 0.0f) return h0;
+  const float h1 = h[(cy + 1) * width + cx];
+  return h0 + (h1 - h0) * v;
+}
+
+// The bilinear surface at (x, y), clamped into the field: NaN where it takes a nodata height
+// (a point on an edge or a grid point takes only the heights of that edge or point).
+inline float region_surface_at(HFVIS_GLOBAL const float* h, int width, int height, float x, float y) {
+  x = x < 0.0f ? 0.0f : (x > (float)(width - 1) ? (float)(width - 1) : x);
+  y = y < 0.0f ? 0.0f : (y > (float)(height - 1) ? (float)(height - 1) : y);
+  const int cx = (int)x < width - 1 ? (int)x : width - 1;  // x >= 0: truncation is floor
+  const float u = x - (float)cx;
+  const float a = region_column_value(h, width, height, cx, y);
+  if (u == 0.0f) return a;
+  const float b = region_column_value(h, width, height, cx + 1, y);
+  return a + (b - a) * u;
+}
+
+// The twist h00 - h10 - h01 + h11 of the cell under (x, y) (clamped to the field; a field one
+// pixel wide or high has none): the t^2 coefficient of the surface along a segment of steps
+// (dx, dy) through it is twist dx dy. NaN where a corner is nodata.
+inline float region_cell_twist(HFVIS_GLOBAL const float* h, int width, int height, float x, float y) {
+  if (width < 2 || height < 2) return 0.0f;
+  int cx = (int)(x < 0.0f ? 0.0f : x), cy = (int)(y < 0.0f ? 0.0f : y);
+  cx = cx > width - 2 ? width - 2 : cx;
+  cy = cy > height - 2 ? height - 2 : cy;
+  const int p = cy * width + cx;
+  return h[p] - h[p + 1] - h[p + width] + h[p + width + 1];
+}
+
+// The segment's height above the surface at t, negated: f(t) = s(t) - (za + t (zb - za)) +
+// c D^2 t (1 - t), s the surface at the point over t (given).
+inline float region_rise(float s, float t, float za, float dz, float cdd) {
+  return (s - (za + t * dz)) + cdd * t * (1.0f - t);
+}
+
+// Whether the point (xb, yb, zb) is visible from (xa, ya, za) (pixel positions inside the field,
+// heights z-scaled and finite): 1 when no point of the surface strictly between them rises
+// strictly above the segment (an end below the surface counts: the surface rises above the
+// segment right beside it), the surface lowered by the curvature (cell_x, cell_y: ground units
+// per pixel; curvature: c of a drop c d^2; max_d2: the largest squared ground distance seen, 0 =
+// any). A cell with a nodata corner has no surface inside; an edge or grid point between valid
+// heights is surface. Pieces shorter than 1e-3 pixel skip their inside test, as the viewshed's
+// do (their top would be rounding noise).
+inline int region_sight_visible(HFVIS_GLOBAL const float* h, int width, int height, float cell_x,
+                                float cell_y, float curvature, float max_d2, float xa, float ya, float za,
+                                float xb, float yb, float zb) {
+  // The canonical order: from the smaller end in (x, y, z), so that the test is symmetric.
+  if (xb < xa || (xb == xa && (yb < ya || (yb == ya && zb < za)))) {
+    float s = xa;
+    xa = xb, xb = s;
+    s = ya;
+    ya = yb, yb = s;
+    s = za;
+    za = zb, zb = s;
+  }
+  const float dx = xb - xa, dy = yb - ya, dz = zb - za;  // dx >= 0
+  if (dx == 0.0f && dy == 0.0f) return 1;
+  const float gx = dx * cell_x, gy = dy * cell_y;
+  const float d2 = gx * gx + gy * gy;
+  if (max_d2 > 0.0f && d2 > max_d2) return 0;
+  const float cdd = curvature * d2;
+  const float pixels = dx > (dy < 0.0f ? -dy : dy) ? dx : (dy < 0.0f ? -dy : dy);
+  // On a grid line the surface is that edge's straight line, beside a nodata cell too.
+  const int on_grid_line = (dx == 0.0f && xa == (float)(int)xa) || (dy == 0.0f && ya == (float)(int)ya);
+  // The next column line after xa and the next row line after ya (toward yb).
+  float gxl = (float)((int)xa + 1);
+  float gyl = dy > 0.0f ? (float)((int)ya + 1) : ((float)(int)ya == ya ? ya - 1.0f : (float)(int)ya);
+  float t0 = 0.0f;
+  // An end below the surface has surface above the segment right beside it (the viewshed's
+  // eye below its own ground sees nothing).
+  float f0 = region_surface_at(h, width, height, xa, ya) - za;
+  if (f0 > 0.0f) return 0;
+  for (;;) {
+    const float tx = dx > 0.0f && gxl < xb ? (gxl - xa) / dx : INFINITY;
+    const float ty = dy > 0.0f ? (gyl < yb ? (gyl - ya) / dy : INFINITY)
+                               : (dy < 0.0f && gyl > yb ? (gyl - ya) / dy : INFINITY);
+    const int x_first = tx <= ty;
+    float t1 = x_first ? tx : ty;
+    float f1;
+    if (t1 >= 1.0f) {  // no crossing left before the far end
+      t1 = 1.0f;
+      f1 = region_surface_at(h, width, height, xb, yb) - zb;
+      if (f1 > 0.0f) return 0;
+    } else {
+      // A crossing: on a column line x = gxl exactly, or on a row line y = gyl.
+      const float s = x_first ? region_surface_at(h, width, height, gxl, ya + t1 * dy)
+                              : region_surface_at(h, width, height, xa + t1 * dx, gyl);
+      f1 = region_rise(s, t1, za, dz, cdd);
+      if (f1 > 0.0f) return 0;  // NaN (nodata) hides nothing
+    }
+    const float span = t1 - t0;
+    if (span > 0.0f && span * pixels > 1e-3f && !isnan(f0) && !isnan(f1)) {
+      const float tm = 0.5f * (t0 + t1);
+      const float twist = region_cell_twist(h, width, height, xa + tm * dx, ya + tm * dy);
+      if (!isnan(twist) || on_grid_line) {
+        // f over the piece in its own parameter s: f0 + (f1 - f0) s + bump s (1 - s).
+        const float bump = -((dx * dy != 0.0f ? twist * dx * dy : 0.0f) - cdd) * span * span;
+        if (bump > 0.0f) {
+          const float s = 0.5f + (f1 - f0) / (2.0f * bump);
+          if (s > 0.0f && s < 1.0f && f0 + (f1 - f0) * s + bump * s * (1.0f - s) > 0.0f) return 0;
+        }
+      }
+    }
+    if (t1 == 1.0f) return 1;
+    if (x_first)
+      gxl += 1.0f;
+    else
+      gyl += dy > 0.0f ? 1.0f : -1.0f;
+    t0 = t1;
+    f0 = f1;
+  }
+}
+
+// A 32-bit integer hash (Wellons' lowbias32): the jitter of the samples.
+inline unsigned int region_hash(unsigned int x) {
+  x ^= x >> 16;
+  x *= 0x7feb352dU;
+  x ^= x >> 15;
+  x *= 0x846ca68bU;
+  x ^= x >> 16;
+  return x;
+}
+
+// The jitter in [0, 1) of coordinate `axis` (0 or 1) of sample s of the stream `key` (0 for a
+// region's own samples, receiver + 1 for the sources decorrelated per receiver): 24 bits, exact
+// in float.
+inline float region_jitter(unsigned int seed, unsigned int key, unsigned int s, unsigned int axis) {
+  const unsigned int v = region_hash(seed ^ region_hash(key ^ region_hash(2U * s + axis)));
+  return (float)(v >> 8) * 0x1p-24f;
+}
+
+// Sample s of a region's table, drawn from stream `key` of `seed`: the table holds the
+// rectangle (lo_x, lo_y, hi_x, hi_y), then per sample its stratum's corner (x, y), its size
+// (x, y) and the height (above the surface, or absolute when `absolute`). The sample is the
+// corner plus the jitter times the size, kept inside the rectangle (a rounding may step past).
+// *z: its absolute height (NaN over a nodata surface).
+inline void region_sample(HFVIS_GLOBAL const float* table, HFVIS_GLOBAL const float* h, int width, int height,
+                          int absolute, unsigned int seed, unsigned int key, int s, float* x, float* y,
+                          float* z) {
+  HFVIS_GLOBAL const float* e = table + 4 + 5 * s;
+  const float vx = e[0] + region_jitter(seed, key, (unsigned int)s, 0U) * e[2];
+  const float vy = e[1] + region_jitter(seed, key, (unsigned int)s, 1U) * e[3];
+  *x = vx < table[0] ? table[0] : (vx > table[2] ? table[2] : vx);
+  *y = vy < table[1] ? table[1] : (vy > table[3] ? table[3] : vy);
+  *z = absolute ? e[4] : region_surface_at(h, width, height, *x, *y) + e[4];
+}
+
+#endif  // HFVIS_REGION_SIGHT_CL

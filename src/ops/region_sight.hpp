@@ -1,0 +1,30 @@
+// region_sight.hpp: the region visibility's line-of-sight test and sample placement for C++
+// (the host and the scalar reference): kernels/shared/region_sight.cl itself, the source the
+// kernel compiles, included here so the two cannot drift; and the sample tables the kernel
+// takes.
+#pragma once
+
+#include <cmath>
+#include <vector>
+
+#include "hfvis/height_field.hpp"
+#include "hfvis/region_visibility.hpp"
+
+namespace hfvis::detail {
+
+using std::isnan;
+#include "../../kernels/shared/region_sight.cl"
+
+// The heights as the kernels take them: z-scaled floats, NaN at nodata.
+std::vector<float> regionHeights(const HeightField& field);
+
+// A region's table for region_sample(): the rectangle (lo_x, lo_y, hi_x, hi_y), then per sample
+// its stratum's corner, size and height (explicit points: the point, size 0). Validates.
+std::vector<float> regionSampleTable(const HeightField& field, const RegionSampling& sampling);
+
+// The samples a table holds.
+inline int regionTableSamples(const std::vector<float>& table) {
+  return static_cast<int>((table.size() - 4) / 5);
+}
+
+}  // namespace hfvis::detail

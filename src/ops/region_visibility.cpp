@@ -1,0 +1,327 @@
+// region_visibility.cpp: visibility between regions (see hfvis/region_visibility.hpp): the
+// samples' tables and the field go to the device once; kernels/region_visibility.cl writes the
+// bitmasks, the fractions are counted here.
+#include "hfvis/region_visibility.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "core/horizon_common.hpp"
+#include "core/opencl_context.hpp"
+#include "core/sweep_framework.hpp"
+#include "hfvis/errors.hpp"
+#include "hfvis/viewshed.hpp"
+#include "ops/region_sight.hpp"
+
+namespace hfvis {
+namespace {
+
+// Receivers per launch: bounds a launch's time (a GPU's watchdog) on large fields.
+constexpr int kReceiversPerLaunch = 1 << 16;
+
+// The kernel's RegionField struct.
+struct DeviceField {
+  cl_int width, height;
+  cl_float cell_x, cell_y;
+  cl_float curvature;
+  cl_float max_d2;
+};
+
+std::string corner(int col, int row) { return std::to_string(col) + "," + std::to_string(row); }
+
+void validateField(const HeightField& field) {
+  validate(field);
+  if (field.pixelCount() > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+    throw InvalidArgument("region visibility takes fields of at most 2^31 - 1 points (got " +
+                          std::to_string(field.pixelCount()) + ")");
+  if (detail::hasRowSpacing(field))
+    throw InvalidArgument(
+        "region visibility on latitude / longitude grids (per-row spacing) is not supported; "
+        "reproject the DEM to a projected CRS");
+}
+
+int popcount(std::uint32_t v) { return __builtin_popcount(v); }
+
+// The bits of `count` receivers from the device, receiver-major.
+std::vector<std::uint32_t> runBits(const ComputeContext& context, const HeightField& field,
+                                   const std::vector<float>& heights, const std::vector<float>& sources,
+                                   bool source_absolute, const std::vector<float>* receivers,
+                                   bool receiver_absolute, int count,
+                                   const RegionVisibilityOptions& options) {
+  const int samples = detail::regionTableSamples(sources);
+  const int words = (samples + 31) / 32;
+  return detail::translateOpenClErrors([&] {
+    detail::ContextState& st = detail::stateOf(context);
+    const bool receiver_major = detail::lineMajorLayout(st);
+    const cl::Program program = st.program("region_visibility.cl", "");
+    const cl::Buffer h(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, heights.size() * sizeof(float),
+                       const_cast<float*>(heights.data()));
+    const cl::Buffer source_table(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                  sources.size() * sizeof(float), const_cast<float*>(sources.data()));
+    // A pixel run binds the source table in the receivers' place (never read).
+    const cl::Buffer receiver_table =
+        receivers ? cl::Buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                               receivers->size() * sizeof(float), const_cast<float*>(receivers->data()))
+                  : source_table;
+    const std::size_t entries = static_cast<std::size_t>(count) * words;
+    // The bitmasks live whole on the device and the host: refuse what half the device's memory
+    // cannot hold rather than fail in the allocation.
+    const std::size_t budget = detail::defaultMemoryBudget(st.info);
+    if (entries * sizeof(std::uint32_t) > budget)
+      throw MemoryBudgetError("the bitmasks need " + detail::mebibytes(entries * sizeof(std::uint32_t)) +
+                              " but half the device's memory is " + detail::mebibytes(budget) +
+                              "; take fewer samples or a smaller field");
+    const cl::Buffer bits = detail::deviceBuffer(st, entries * sizeof(std::uint32_t));
+    const double max_d2 = options.max_distance * options.max_distance;
+    const DeviceField device{field.width,
+                             field.height,
+                             static_cast<float>(field.cell_size_x),
+                             static_cast<float>(field.cell_size_y),
+                             static_cast<float>(options.curvature),
+                             options.max_distance > 0.0 ? static_cast<float>(max_d2) : 0.0f};
+    cl::Kernel k(program, "region_visibility_bits");
+    k.setArg(0, h);
+    k.setArg(1, device);
+    k.setArg(2, source_table);
+    k.setArg(3, cl_int(source_absolute));
+    k.setArg(4, cl_int(samples));
+    k.setArg(5, cl_int(receivers == nullptr));
+    k.setArg(6, receiver_table);
+    k.setArg(7, cl_int(receiver_absolute));
+    k.setArg(8, cl_int(count));
+    k.setArg(9, static_cast<float>(options.target_height));
+    k.setArg(10, cl_uint(options.seed));
+    k.setArg(11, cl_int(options.decorrelate));
+    k.setArg(12, cl_int(words));
+    k.setArg(13, cl_int(receiver_major));
+    k.setArg(15, bits);
+    for (int first = 0; first < count; first += kReceiversPerLaunch) {
+      const int chunk = std::min(kReceiversPerLaunch, count - first);
+      k.setArg(14, cl_int(first));
+      st.launch(k, cl::NDRange(detail::roundUp(chunk, detail::kLineGroup), words),
+                cl::NDRange(detail::kLineGroup, 1));
+    }
+    std::vector<std::uint32_t> out(entries);
+    st.queue.enqueueReadBuffer(bits, CL_TRUE, 0, entries * sizeof(std::uint32_t), out.data());
+    if (receiver_major) return out;
+    std::vector<std::uint32_t> transposed(entries);
+    for (int r = 0; r < count; ++r)
+      for (int w = 0; w < words; ++w)
+        transposed[std::size_t(r) * words + w] = out[std::size_t(w) * count + r];
+    return transposed;
+  });
+}
+
+// The viewsheds method: one viewshed per source sample from its own eye height (absolute), the
+// visible targets' bits set, receiver-major.
+std::vector<std::uint32_t> viewshedBits(const ComputeContext& context, const HeightField& field,
+                                        const std::vector<RegionPoint>& samples,
+                                        const RegionVisibilityOptions& options) {
+  if (options.decorrelate)
+    throw InvalidArgument(
+        "the viewsheds method takes shared samples (no decorrelation): a viewshed per sample");
+  for (const RegionPoint& p : samples)
+    if (p.col != std::floor(p.col) || p.row != std::floor(p.row))
+      throw InvalidArgument(
+          "the viewsheds method needs sources on grid points (a one-point rectangle or points at "
+          "whole columns and rows); sample " +
+          std::to_string(p.col) + "," + std::to_string(p.row) + " is not");
+  const int words = (static_cast<int>(samples.size()) + 31) / 32;
+  std::vector<std::uint32_t> bits(field.pixelCount() * words, 0u);
+  ViewshedOptions vo;
+  vo.absolute = true;
+  vo.target_height = options.target_height;
+  vo.max_distance = options.max_distance;
+  vo.curvature = options.curvature;
+  for (std::size_t s = 0; s < samples.size(); ++s) {
+    const Observer o{static_cast<int>(samples[s].col), static_cast<int>(samples[s].row), samples[s].height};
+    const ViewshedResult v = computeViewshed(context, field, o, vo);
+    for (std::size_t p = 0; p < v.visible.size(); ++p)
+      if (v.visible[p] == 1.0f) bits[p * words + s / 32] |= 1u << (s % 32);
+  }
+  return bits;
+}
+
+}  // namespace
+
+namespace detail {
+
+std::vector<float> regionHeights(const HeightField& field) {
+  std::vector<float> h(field.pixelCount());
+  for (std::size_t p = 0; p < h.size(); ++p)
+    h[p] = std::isfinite(field.heights[p]) ? static_cast<float>(field.heights[p] * field.z_scale)
+                                           : std::numeric_limits<float>::quiet_NaN();
+  return h;
+}
+
+std::vector<float> regionSampleTable(const HeightField& field, const RegionSampling& sampling) {
+  validate(field, sampling);
+  std::vector<float> table;
+  if (!sampling.points.empty()) {
+    float lo_x = std::numeric_limits<float>::max(), lo_y = lo_x, hi_x = -lo_x, hi_y = -lo_x;
+    for (const RegionPoint& p : sampling.points) {
+      lo_x = std::min(lo_x, float(p.col)), hi_x = std::max(hi_x, float(p.col));
+      lo_y = std::min(lo_y, float(p.row)), hi_y = std::max(hi_y, float(p.row));
+    }
+    table = {lo_x, lo_y, hi_x, hi_y};
+    for (const RegionPoint& p : sampling.points)
+      table.insert(table.end(), {float(p.col), float(p.row), 0.0f, 0.0f, float(p.height)});
+    return table;
+  }
+  const PixelRectangle& r = sampling.rectangle;
+  const int x0 = std::min(r.col0, r.col1), x1 = std::max(r.col0, r.col1);
+  const int y0 = std::min(r.row0, r.row1), y1 = std::max(r.row0, r.row1);
+  const double ex = x1 - x0, ey = y1 - y0;
+  const int s_count = sampling.samples;
+  // Rows of n strata, n chosen so that the strata are about square; the last row holds the rest.
+  int n = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(s_count))));
+  if (ex == 0.0)
+    n = 1;
+  else if (ey == 0.0)
+    n = s_count;
+  else
+    n = static_cast<int>(std::ceil(std::sqrt(s_count * ex / ey)));
+  n = std::clamp(n, 1, s_count);
+  const int rows = (s_count + n - 1) / n;
+  table = {float(x0), float(y0), float(x1), float(y1)};
+  for (int s = 0; s < s_count; ++s) {
+    const int j = s / n, i = s % n;
+    const int in_row = j == rows - 1 ? s_count - (rows - 1) * n : n;
+    const double sx = ex / in_row, sy = ey / rows;
+    table.insert(table.end(),
+                 {float(x0 + sx * i), float(y0 + sy * j), float(sx), float(sy), float(sampling.height)});
+  }
+  return table;
+}
+
+}  // namespace detail
+
+void validate(const RegionVisibilityOptions& options) {
+  if (!std::isfinite(options.target_height) || options.target_height < 0.0)
+    throw InvalidArgument("the target height must be finite and at least 0");
+  if (!std::isfinite(options.max_distance) || options.max_distance < 0.0)
+    throw InvalidArgument("the maximum distance must be finite and at least 0 (0: no limit)");
+  if (!std::isfinite(options.curvature)) throw InvalidArgument("the curvature must be finite");
+  if (options.method != RegionVisibilityMethod::Exact && options.method != RegionVisibilityMethod::Viewsheds)
+    throw InvalidArgument("unknown region visibility method");
+}
+
+void validate(const HeightField& field, const RegionSampling& sampling) {
+  if (!std::isfinite(sampling.height)) throw InvalidArgument("a region's height must be finite");
+  if (!sampling.points.empty()) {
+    if (sampling.points.size() > static_cast<std::size_t>(kMaxRegionSamples))
+      throw InvalidArgument("a region takes at most " + std::to_string(kMaxRegionSamples) + " points (got " +
+                            std::to_string(sampling.points.size()) + ")");
+    const std::vector<float> heights = detail::regionHeights(field);
+    for (const RegionPoint& p : sampling.points) {
+      const std::string at = std::to_string(p.col) + "," + std::to_string(p.row);
+      if (!(p.col >= 0.0 && p.col <= field.width - 1.0 && p.row >= 0.0 && p.row <= field.height - 1.0))
+        throw InvalidArgument("region point " + at + " is outside the " + std::to_string(field.width) +
+                              " x " + std::to_string(field.height) + " field");
+      if (!std::isfinite(p.height)) throw InvalidArgument("region point " + at + " has a non-finite height");
+      const float s =
+          detail::region_surface_at(heights.data(), field.width, field.height, float(p.col), float(p.row));
+      if (std::isnan(s)) throw InvalidArgument("region point " + at + " lies over nodata");
+    }
+    return;
+  }
+  const PixelRectangle& r = sampling.rectangle;
+  const std::string rect = corner(r.col0, r.row0) + " .. " + corner(r.col1, r.row1);
+  for (const auto& [c, w] : {std::pair{r.col0, field.width}, {r.col1, field.width}})
+    if (c < 0 || c >= w)
+      throw InvalidArgument("region " + rect + " is outside the " + std::to_string(field.width) + " x " +
+                            std::to_string(field.height) + " field");
+  for (int row : {r.row0, r.row1})
+    if (row < 0 || row >= field.height)
+      throw InvalidArgument("region " + rect + " is outside the " + std::to_string(field.width) + " x " +
+                            std::to_string(field.height) + " field");
+  if (sampling.samples < 1 || sampling.samples > kMaxRegionSamples)
+    throw InvalidArgument("a region takes 1 .. " + std::to_string(kMaxRegionSamples) + " samples (got " +
+                          std::to_string(sampling.samples) + ")");
+  for (int row = std::min(r.row0, r.row1); row <= std::max(r.row0, r.row1); ++row)
+    for (int col = std::min(r.col0, r.col1); col <= std::max(r.col0, r.col1); ++col)
+      if (!std::isfinite(field.at(col, row)))
+        throw InvalidArgument("region " + rect + " holds nodata (at " + corner(col, row) + ")");
+}
+
+std::vector<RegionPoint> regionSamplePoints(const HeightField& field, const RegionSampling& sampling,
+                                            std::uint32_t seed) {
+  validate(field);
+  const std::vector<float> table = detail::regionSampleTable(field, sampling);
+  const std::vector<float> heights = detail::regionHeights(field);
+  std::vector<RegionPoint> points;
+  for (int s = 0; s < detail::regionTableSamples(table); ++s) {
+    float x, y, z;
+    detail::region_sample(table.data(), heights.data(), field.width, field.height, sampling.absolute, seed,
+                          0u, s, &x, &y, &z);
+    points.push_back({x, y, z});
+  }
+  return points;
+}
+
+RegionVisibilityResult computeRegionVisibility(const ComputeContext& context, const HeightField& field,
+                                               const RegionSampling& sources,
+                                               const RegionVisibilityOptions& options) {
+  validateField(field);
+  validate(options);
+  const std::vector<float> table = detail::regionSampleTable(field, sources);
+  const std::vector<float> heights = detail::regionHeights(field);
+  RegionVisibilityResult out;
+  out.width = field.width;
+  out.height = field.height;
+  out.samples = detail::regionTableSamples(table);
+  out.words = (out.samples + 31) / 32;
+  const int count = static_cast<int>(field.pixelCount());
+  if (options.method == RegionVisibilityMethod::Viewsheds)
+    out.bits = viewshedBits(context, field, regionSamplePoints(field, sources, options.seed), options);
+  else
+    out.bits = runBits(context, field, heights, table, sources.absolute, nullptr, false, count, options);
+  out.fraction.resize(field.pixelCount());
+  for (int p = 0; p < count; ++p) {
+    int seen = 0;
+    for (int w = 0; w < out.words; ++w) seen += popcount(out.bits[std::size_t(p) * out.words + w]);
+    out.fraction[p] = std::isnan(heights[p]) ? std::numeric_limits<float>::quiet_NaN()
+                                             : static_cast<float>(static_cast<double>(seen) / out.samples);
+  }
+  return out;
+}
+
+RegionPairVisibilityResult computeRegionPairVisibility(const ComputeContext& context,
+                                                       const HeightField& field,
+                                                       const RegionSampling& sources,
+                                                       const RegionSampling& receivers,
+                                                       const RegionVisibilityOptions& options) {
+  validateField(field);
+  validate(options);
+  if (options.method == RegionVisibilityMethod::Viewsheds)
+    throw InvalidArgument("the viewsheds method takes every-pixel receivers, not a region pair");
+  const std::vector<float> source_table = detail::regionSampleTable(field, sources);
+  const std::vector<float> receiver_table = detail::regionSampleTable(field, receivers);
+  const std::vector<float> heights = detail::regionHeights(field);
+  RegionPairVisibilityResult out;
+  out.source_samples = detail::regionTableSamples(source_table);
+  out.receiver_samples = detail::regionTableSamples(receiver_table);
+  out.words = (out.source_samples + 31) / 32;
+  out.sources = regionSamplePoints(field, sources, options.seed);
+  out.receivers = regionSamplePoints(field, receivers, options.seed);
+  out.bits = runBits(context, field, heights, source_table, sources.absolute, &receiver_table,
+                     receivers.absolute, out.receiver_samples, options);
+  out.pairs = static_cast<std::uint64_t>(out.source_samples) * out.receiver_samples;
+  out.source_fraction.assign(out.source_samples, 0.0f);
+  out.receiver_fraction.assign(out.receiver_samples, 0.0f);
+  std::vector<int> seen_by(out.source_samples, 0);
+  for (int r = 0; r < out.receiver_samples; ++r) {
+    int seen = 0;
+    for (int s = 0; s < out.source_samples; ++s)
+      if (out.visible(r, s)) ++seen, ++seen_by[s];
+    out.clear_pairs += seen;
+    out.receiver_fraction[r] = static_cast<float>(static_cast<double>(seen) / out.source_samples);
+  }
+  for (int s = 0; s < out.source_samples; ++s)
+    out.source_fraction[s] = static_cast<float>(static_cast<double>(seen_by[s]) / out.receiver_samples);
+  return out;
+}
+
+}  // namespace hfvis

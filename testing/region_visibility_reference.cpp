@@ -1,0 +1,106 @@
+// region_visibility_reference.cpp: see hfvis_testing/region_visibility_reference.hpp.
+#include "hfvis_testing/region_visibility_reference.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "ops/region_sight.hpp"
+
+namespace hfvis {
+namespace {
+
+struct Pairs {
+  const HeightField& field;
+  const std::vector<float>& heights;
+  const RegionVisibilityOptions& options;
+  const std::vector<float>& sources;
+  bool source_absolute;
+
+  // The bits of a receiver at (x, y, z) with source stream `key`; none where z is NaN.
+  void receiverBits(float x, float y, float z, unsigned key, std::uint32_t* words) const {
+    const int samples = detail::regionTableSamples(sources);
+    const float max_d2 =
+        options.max_distance > 0.0 ? float(options.max_distance * options.max_distance) : 0.0f;
+    for (int s = 0; s < samples; ++s) {
+      if (std::isnan(z)) break;
+      float xs, ys, zs;
+      detail::region_sample(sources.data(), heights.data(), field.width, field.height, source_absolute,
+                            options.seed, key, s, &xs, &ys, &zs);
+      if (detail::region_sight_visible(heights.data(), field.width, field.height, float(field.cell_size_x),
+                                       float(field.cell_size_y), float(options.curvature), max_d2, xs, ys, zs,
+                                       x, y, z))
+        words[s / 32] |= 1u << (s % 32);
+    }
+  }
+};
+
+int popcount(std::uint32_t v) { return __builtin_popcount(v); }
+
+}  // namespace
+
+RegionVisibilityResult referenceRegionVisibility(const HeightField& field, const RegionSampling& sources,
+                                                 const RegionVisibilityOptions& options) {
+  validate(field);
+  validate(options);
+  const std::vector<float> table = detail::regionSampleTable(field, sources);
+  const std::vector<float> heights = detail::regionHeights(field);
+  RegionVisibilityResult out;
+  out.width = field.width;
+  out.height = field.height;
+  out.samples = detail::regionTableSamples(table);
+  out.words = (out.samples + 31) / 32;
+  out.bits.assign(field.pixelCount() * out.words, 0u);
+  out.fraction.resize(field.pixelCount());
+  const Pairs pairs{field, heights, options, table, sources.absolute};
+  for (std::size_t p = 0; p < field.pixelCount(); ++p) {
+    const float x = float(p % field.width), y = float(p / field.width);
+    const float z = heights[p] + float(options.target_height);
+    std::uint32_t* words = &out.bits[p * out.words];
+    pairs.receiverBits(x, y, z, options.decorrelate ? unsigned(p) + 1u : 0u, words);
+    int seen = 0;
+    for (int w = 0; w < out.words; ++w) seen += popcount(words[w]);
+    out.fraction[p] = std::isnan(heights[p]) ? std::numeric_limits<float>::quiet_NaN()
+                                             : static_cast<float>(static_cast<double>(seen) / out.samples);
+  }
+  return out;
+}
+
+RegionPairVisibilityResult referenceRegionPairVisibility(const HeightField& field,
+                                                         const RegionSampling& sources,
+                                                         const RegionSampling& receivers,
+                                                         const RegionVisibilityOptions& options) {
+  validate(field);
+  validate(options);
+  const std::vector<float> source_table = detail::regionSampleTable(field, sources);
+  const std::vector<float> receiver_table = detail::regionSampleTable(field, receivers);
+  const std::vector<float> heights = detail::regionHeights(field);
+  RegionPairVisibilityResult out;
+  out.source_samples = detail::regionTableSamples(source_table);
+  out.receiver_samples = detail::regionTableSamples(receiver_table);
+  out.words = (out.source_samples + 31) / 32;
+  out.sources = regionSamplePoints(field, sources, options.seed);
+  out.receivers = regionSamplePoints(field, receivers, options.seed);
+  out.bits.assign(std::size_t(out.receiver_samples) * out.words, 0u);
+  const Pairs pairs{field, heights, options, source_table, sources.absolute};
+  out.pairs = std::uint64_t(out.source_samples) * out.receiver_samples;
+  out.source_fraction.assign(out.source_samples, 0.0f);
+  out.receiver_fraction.assign(out.receiver_samples, 0.0f);
+  std::vector<int> seen_by(out.source_samples, 0);
+  for (int r = 0; r < out.receiver_samples; ++r) {
+    float x, y, z;
+    detail::region_sample(receiver_table.data(), heights.data(), field.width, field.height,
+                          receivers.absolute, options.seed, 0u, r, &x, &y, &z);
+    pairs.receiverBits(x, y, z, options.decorrelate ? unsigned(r) + 1u : 0u,
+                       &out.bits[std::size_t(r) * out.words]);
+    int seen = 0;
+    for (int s = 0; s < out.source_samples; ++s)
+      if (out.visible(r, s)) ++seen, ++seen_by[s];
+    out.clear_pairs += seen;
+    out.receiver_fraction[r] = static_cast<float>(static_cast<double>(seen) / out.source_samples);
+  }
+  for (int s = 0; s < out.source_samples; ++s)
+    out.source_fraction[s] = static_cast<float>(static_cast<double>(seen_by[s]) / out.receiver_samples);
+  return out;
+}
+
+}  // namespace hfvis

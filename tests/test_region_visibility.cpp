@@ -1,0 +1,525 @@
+// test_region_visibility.cpp: region visibility (hfvis/region_visibility.hpp): the kernel
+// against the scalar reference bit for bit on the hard cases in both layouts; A to B against the
+// transpose of B to A; closed cases (flat ground, a wall, a tall light); one source against the
+// viewshed; the samples' placement; bad input.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <string>
+
+#include "hfvis/errors.hpp"
+#include "hfvis/region_visibility.hpp"
+#include "hfvis/viewshed.hpp"
+#include "hfvis_testing/region_visibility_reference.hpp"
+#include "hfvis_testing/synthetic_fields.hpp"
+#include "hfvis_testing/viewshed_reference.hpp"
+#include "test_support.hpp"
+
+namespace hfvis {
+namespace {
+
+using testing::fieldFrom;
+using testing::forEachLayout;
+using testing::testContext;
+
+// A rectangle of up to 5 x 4 points around the field's centre, or the first valid point alone
+// where that one holds nodata.
+RegionSampling sourcesIn(const HeightField& f, int samples, double height, bool absolute) {
+  RegionSampling s;
+  s.samples = samples;
+  s.height = height;
+  s.absolute = absolute;
+  s.rectangle = {f.width / 2, f.height / 2, std::max(0, f.width / 2 - 4), std::max(0, f.height / 2 - 3)};
+  try {
+    validate(f, s);
+  } catch (const InvalidArgument&) {
+    const auto it =
+        std::find_if(f.heights.begin(), f.heights.end(), [](float v) { return std::isfinite(v); });
+    const int p = static_cast<int>(it - f.heights.begin());
+    s.rectangle = {p % f.width, p / f.width, p % f.width, p / f.width};
+  }
+  return s;
+}
+
+// Equal bitmasks and fractions (NaN where NaN), the first differing receiver reported. The
+// kernel and the reference run the same float operations; only a device without correctly
+// rounded division (the crossings' parameters) may round a grazing pair the other way, on at
+// most one pair in a thousand.
+void expectSame(const RegionVisibilityResult& got, const RegionVisibilityResult& want) {
+  ASSERT_EQ(got.words, want.words);
+  ASSERT_EQ(got.bits.size(), want.bits.size());
+  const bool exact = testContext().device().correctly_rounded_divide;
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < got.bits.size(); ++i) {
+    differ += __builtin_popcount(got.bits[i] ^ want.bits[i]);
+    if (exact && got.bits[i] != want.bits[i]) {
+      ADD_FAILURE() << "receiver " << i / got.words << " word " << i % got.words << ": device " << std::hex
+                    << got.bits[i] << ", reference " << want.bits[i];
+      return;
+    }
+  }
+  EXPECT_LE(differ, got.bits.size() * 32 / 1000);
+  if (!exact) return;
+  for (std::size_t p = 0; p < got.fraction.size(); ++p)
+    if (!(got.fraction[p] == want.fraction[p] ||
+          (std::isnan(got.fraction[p]) && std::isnan(want.fraction[p])))) {
+      ADD_FAILURE() << "fraction at " << p << ": " << got.fraction[p] << " vs " << want.fraction[p];
+      break;
+    }
+}
+
+TEST(RegionVisibility, KernelMatchesTheReferenceOnEveryHardCase) {
+  std::size_t visible = 0, bits = 0;
+  forEachLayout([&](const ComputeContext& context) {
+    testing::forEachHardCase([&](const std::string& name, const HeightField& field) {
+      // 40 samples: a second, partly filled word. Relative and absolute heights, shared and
+      // decorrelated jitter, curvature and a maximum distance.
+      RegionVisibilityOptions options;
+      options.target_height = 0.5;
+      options.seed = 7;
+      const RegionSampling above = sourcesIn(field, 40, 1.5, false);
+      expectSame(computeRegionVisibility(context, field, above, options),
+                 referenceRegionVisibility(field, above, options));
+      options.decorrelate = true;
+      options.curvature = 0.002;
+      options.max_distance = 20.0;
+      const RegionVisibilityResult got = computeRegionVisibility(context, field, above, options);
+      expectSame(got, referenceRegionVisibility(field, above, options));
+      for (float f : got.fraction)
+        if (std::isfinite(f)) visible += static_cast<std::size_t>(std::lround(f * 40)), bits += 40;
+      options = {};
+      RegionSampling light = sourcesIn(field, 33, 4.0, true);
+      // A plane near the heights (the cliff's are 1e6).
+      for (float v : field.heights)
+        if (std::isfinite(v)) light.height = std::max(light.height, double(v) * field.z_scale + 0.5);
+      expectSame(computeRegionVisibility(context, field, light, options),
+                 referenceRegionVisibility(field, light, options));
+      (void)name;
+    });
+  });
+  // Both answers occur often: the comparison is not between two all-clear results.
+  EXPECT_GT(visible, bits / 10);
+  EXPECT_LT(visible, bits * 9 / 10);
+}
+
+TEST(RegionVisibility, PairMatchesTheReference) {
+  for (const char* name : {"city", "noise", "nan_holes"}) {
+    SCOPED_TRACE(name);
+    const HeightField field = makeSyntheticField(name, 40, 41, 3);
+    RegionSampling a, b;
+    a.rectangle = {2, 3, 8, 6};
+    a.samples = 45;
+    a.height = 1.0;
+    b.rectangle = {35, 37, 30, 28};
+    b.samples = 20;
+    b.height = 3.0;
+    try {
+      validate(field, a), validate(field, b);
+    } catch (const InvalidArgument&) {  // nan_holes: its first and last valid points
+      const auto first =
+          std::find_if(field.heights.begin(), field.heights.end(), [](float v) { return std::isfinite(v); });
+      const auto last = std::find_if(field.heights.rbegin(), field.heights.rend(),
+                                     [](float v) { return std::isfinite(v); });
+      const int p = static_cast<int>(first - field.heights.begin());
+      const int q = static_cast<int>(field.heights.rend() - last) - 1;
+      a.rectangle = {p % 40, p / 40, p % 40, p / 40};
+      b.rectangle = {q % 40, q / 40, q % 40, q / 40};
+    }
+    for (bool decorrelate : {false, true}) {
+      RegionVisibilityOptions options;
+      options.decorrelate = decorrelate;
+      forEachLayout([&](const ComputeContext& context) {
+        const RegionPairVisibilityResult got = computeRegionPairVisibility(context, field, a, b, options);
+        const RegionPairVisibilityResult want = referenceRegionPairVisibility(field, a, b, options);
+        EXPECT_EQ(got.pairs, want.pairs);
+        // Bit for bit where the device divides correctly rounded (see expectSame).
+        if (!context.device().correctly_rounded_divide) return;
+        EXPECT_EQ(got.bits, want.bits);
+        EXPECT_EQ(got.clear_pairs, want.clear_pairs);
+        EXPECT_EQ(got.pairs, std::uint64_t(a.samples) * b.samples);
+        EXPECT_EQ(got.source_fraction, want.source_fraction);
+        EXPECT_EQ(got.receiver_fraction, want.receiver_fraction);
+      });
+    }
+  }
+}
+
+TEST(RegionVisibility, AToBIsTheTransposeOfBToA) {
+  std::uint64_t clear = 0, pairs = 0;
+  for (const char* name : {"city", "noise", "sine", "terraces"}) {
+    SCOPED_TRACE(name);
+    HeightField field = makeSyntheticField(name, 40, 41, 3);
+    field.cell_size_x = 1.5;
+    RegionSampling a, b;
+    a.rectangle = {1, 2, 12, 9};
+    a.samples = 70;
+    a.height = 12.0;
+    b.rectangle = {38, 39, 25, 20};
+    b.samples = 50;
+    b.height = 0.5;
+    RegionVisibilityOptions options;
+    options.curvature = 0.001;
+    const RegionPairVisibilityResult ab = computeRegionPairVisibility(testContext(), field, a, b, options);
+    const RegionPairVisibilityResult ba = computeRegionPairVisibility(testContext(), field, b, a, options);
+    // The same samples on both sides.
+    ASSERT_EQ(ab.sources.size(), ba.receivers.size());
+    for (std::size_t s = 0; s < ab.sources.size(); ++s) {
+      EXPECT_EQ(ab.sources[s].col, ba.receivers[s].col);
+      EXPECT_EQ(ab.sources[s].height, ba.receivers[s].height);
+    }
+    std::size_t differ = 0;
+    for (int r = 0; r < ab.receiver_samples; ++r)
+      for (int s = 0; s < ab.source_samples; ++s) differ += ab.visible(r, s) != ba.visible(s, r);
+    EXPECT_EQ(differ, 0u);
+    EXPECT_EQ(ab.clear_pairs, ba.clear_pairs);
+    EXPECT_EQ(ab.source_fraction, ba.receiver_fraction);
+    clear += ab.clear_pairs, pairs += ab.pairs;
+    std::printf("%s: %llu of %llu pairs clear\n", name, static_cast<unsigned long long>(ab.clear_pairs),
+                static_cast<unsigned long long>(ab.pairs));
+  }
+  EXPECT_GT(clear, pairs / 20);
+  EXPECT_LT(clear, pairs * 19 / 20);
+}
+
+TEST(RegionVisibility, FlatGroundIsAllClear) {
+  // Sight lines lying on the ground only touch it: every pair sees, at any height.
+  HeightField field = fieldFrom(31, 17, std::vector<float>(31 * 17, 12.5f));
+  field.cell_size_y = 2.0;
+  for (double height : {0.0, 0.25, 3.0}) {
+    RegionSampling sources;
+    sources.rectangle = {3, 2, 9, 14};
+    sources.samples = 64;
+    sources.height = height;
+    forEachLayout([&](const ComputeContext& context) {
+      const RegionVisibilityResult r = computeRegionVisibility(context, field, sources, {});
+      for (std::size_t p = 0; p < r.fraction.size(); ++p) ASSERT_EQ(r.fraction[p], 1.0f) << "at " << p;
+      for (std::uint32_t w : r.bits) ASSERT_EQ(w, 0xffffffffu);
+    });
+  }
+}
+
+TEST(RegionVisibility, AWallBlocksEveryPair) {
+  // Two regions on flat ground either side of a wall across the whole field.
+  const int w = 41, h = 23;
+  std::vector<float> heights(w * h, 0.0f);
+  HeightField open = fieldFrom(w, h, heights);
+  for (int row = 0; row < h; ++row) heights[row * w + 20] = 30.0f;
+  const HeightField walled = fieldFrom(w, h, heights);
+  RegionSampling a, b;
+  a.rectangle = {2, 1, 12, 21};
+  a.samples = 50;
+  a.height = 5.0;
+  b.rectangle = {28, 0, 39, 22};
+  b.samples = 30;
+  b.height = 5.0;
+  forEachLayout([&](const ComputeContext& context) {
+    const RegionPairVisibilityResult blocked = computeRegionPairVisibility(context, walled, a, b, {});
+    EXPECT_EQ(blocked.clear_pairs, 0u);
+    EXPECT_EQ(blocked.pairs, 1500u);
+    const RegionPairVisibilityResult clear = computeRegionPairVisibility(context, open, a, b, {});
+    EXPECT_EQ(clear.clear_pairs, 1500u);
+    // Every pixel: the wall's far side sees none of a (the wall's top, 30 high, hides the
+    // ground behind it from lights 5 high), a's own side all of it.
+    const RegionVisibilityResult pixels = computeRegionVisibility(context, walled, a, {});
+    for (int row = 0; row < h; ++row) {
+      EXPECT_EQ(pixels.fraction[row * w + 25], 0.0f) << row;
+      EXPECT_EQ(pixels.fraction[row * w + 5], 1.0f) << row;
+    }
+  });
+}
+
+TEST(RegionVisibility, ATallLightLightsFlatGround) {
+  HeightField field = fieldFrom(37, 29, std::vector<float>(37 * 29, -3.0f));
+  field.z_scale = 2.0;
+  RegionSampling light;
+  light.rectangle = {10, 10, 20, 15};
+  light.samples = 100;
+  light.height = 500.0;
+  light.absolute = true;
+  const RegionVisibilityResult r = computeRegionVisibility(testContext(), field, light, {});
+  for (float f : r.fraction) ASSERT_EQ(f, 1.0f);
+  // A light below the ground (absolute: -7 under ground at -6, z-scaled) lights only the
+  // point it stands under.
+  light.height = -7.0;
+  light.samples = 1;
+  light.rectangle = {18, 12, 18, 12};
+  const RegionVisibilityResult under = computeRegionVisibility(testContext(), field, light, {});
+  for (std::size_t p = 0; p < under.fraction.size(); ++p)
+    EXPECT_EQ(under.fraction[p], p == 12 * 37 + 18 ? 1.0f : 0.0f) << p;
+}
+
+// Agreement with the viewshed: exact, but where the sight line grazes the surface within `graze`
+// (both decide in single precision, marching from different ends), on at most 1 % of the
+// targets.
+void expectViewshed(const ComputeContext& context, const HeightField& field, const Observer& o,
+                    const ViewshedOptions& vo, int samples, double graze) {
+  RegionSampling one;
+  one.rectangle = {o.col, o.row, o.col, o.row};
+  one.samples = samples;  // every sample on the one point
+  one.height = o.height;
+  one.absolute = vo.absolute;
+  RegionVisibilityOptions options;
+  options.target_height = vo.target_height;
+  options.curvature = vo.curvature;
+  options.max_distance = vo.max_distance;
+  const RegionVisibilityResult got = computeRegionVisibility(context, field, one, options);
+  const ViewshedResult want = computeViewshed(context, field, o, vo);
+  std::size_t targets = 0, grazing = 0, visible = 0;
+  for (std::size_t p = 0; p < want.visible.size(); ++p) {
+    if (std::isnan(want.visible[p])) {
+      EXPECT_TRUE(std::isnan(got.fraction[p])) << p;
+      continue;
+    }
+    ++targets;
+    visible += want.visible[p] == 1.0f;
+    for (int s = 0; s < samples; ++s) ASSERT_EQ(got.visible(p, s), got.visible(p, 0));
+    if (float(got.fraction[p]) == want.visible[p]) continue;
+    const int col = static_cast<int>(p % field.width), row = static_cast<int>(p / field.width);
+    const double clearance = referenceSightLine(field, o, vo, col, row).interior_rise;
+    if (std::fabs(clearance) <= graze)
+      ++grazing;
+    else
+      ADD_FAILURE() << "target " << col << "," << row << ": region " << got.fraction[p] << ", viewshed "
+                    << want.visible[p] << ", the surface " << clearance << " above the sight line at most";
+  }
+  EXPECT_LE(grazing, targets / 100);
+  EXPECT_GT(visible, 0u);
+  std::printf("%zu targets, %zu visible, %zu grazing disagreements\n", targets, visible, grazing);
+}
+
+TEST(RegionVisibility, OneSourceIsTheViewshed) {
+  forEachLayout([&](const ComputeContext& context) {
+    for (const char* name : {"city", "noise", "sine", "bowl", "nan_holes", "terraces", "spikes"}) {
+      SCOPED_TRACE(name);
+      HeightField field = makeSyntheticField(name, 61, 53);
+      field.cell_size_x = 1.5;
+      Observer o{30, 26, 1.5};
+      if (!std::isfinite(field.at(o.col, o.row))) o.col = 31;
+      if (!std::isfinite(field.at(o.col, o.row))) o.row = 27;
+      ViewshedOptions vo;
+      vo.target_height = 0.5;
+      expectViewshed(context, field, o, vo, 1, 1e-4);
+      vo.curvature = 0.003;
+      vo.max_distance = 25.3;
+      expectViewshed(context, field, {5, 7, 4.0}, vo, 3, 1e-4);
+    }
+  });
+}
+
+// The viewsheds method against the exact one: the same bits, but where the sight line grazes
+// the surface, coming within 1e-5 of the field's height scale of it (the viewshed walks the
+// line from the source's end, in its own float operations), on at most 1 % of the pairs, as
+// the viewshed's own tests allow against brute force (the bowl and the terraces graze on
+// about 0.1 %).
+void expectSameBarGrazing(const HeightField& field, const RegionSampling& sources,
+                          const RegionVisibilityResult& exact, const RegionVisibilityResult& viewsheds,
+                          const RegionVisibilityOptions& options) {
+  ASSERT_EQ(exact.bits.size(), viewsheds.bits.size());
+  double scale = 1.0;
+  for (float v : field.heights)
+    if (std::isfinite(v)) scale = std::max(scale, std::fabs(double(v) * field.z_scale));
+  const std::vector<RegionPoint> samples = regionSamplePoints(field, sources, options.seed);
+  ViewshedOptions vo;
+  vo.absolute = true;
+  vo.target_height = options.target_height;
+  vo.curvature = options.curvature;
+  std::size_t differ = 0;
+  for (std::size_t p = 0; p < field.pixelCount(); ++p)
+    for (int s = 0; s < exact.samples; ++s) {
+      if (exact.visible(p, s) == viewsheds.visible(p, s)) continue;
+      ++differ;
+      const Observer o{int(samples[s].col), int(samples[s].row), samples[s].height};
+      const double rise =
+          referenceSightLine(field, o, vo, int(p % field.width), int(p / field.width)).interior_rise;
+      EXPECT_LE(std::fabs(rise), 1e-5 * scale)
+          << "target " << p % field.width << "," << p / field.width << " from sample " << s << ": exact "
+          << exact.visible(p, s) << ", viewshed " << viewsheds.visible(p, s);
+    }
+  EXPECT_LE(differ, field.pixelCount() * exact.samples / 100);
+}
+
+TEST(RegionVisibility, TheViewshedsMethodAgreesWithTheExactOne) {
+  // Sources on grid points: up to 12 valid points spread over the field, then a one-point
+  // rectangle (all its samples on the point).
+  std::size_t visible = 0, bits = 0;
+  forEachLayout([&](const ComputeContext& context) {
+    testing::forEachHardCase([&](const std::string&, const HeightField& field) {
+      RegionSampling points;
+      points.height = 1.5;
+      const std::size_t step = std::max<std::size_t>(1, field.pixelCount() / 12);
+      for (std::size_t p = step / 2; p < field.pixelCount(); p += step)
+        if (std::isfinite(field.heights[p]))
+          points.points.push_back({double(p % field.width), double(p / field.width), 0.5 + 0.25 * (p % 5)});
+      if (points.points.empty()) return;
+      RegionVisibilityOptions exact, viewsheds;
+      exact.target_height = viewsheds.target_height = 0.5;
+      viewsheds.method = RegionVisibilityMethod::Viewsheds;
+      const RegionVisibilityResult a = computeRegionVisibility(context, field, points, exact);
+      const RegionVisibilityResult b = computeRegionVisibility(context, field, points, viewsheds);
+      expectSameBarGrazing(field, points, a, b, exact);
+      for (float f : a.fraction)
+        if (std::isfinite(f)) visible += std::lround(f * a.samples), bits += a.samples;
+      // Curvature and a maximum distance, absolute heights, a one-point rectangle.
+      RegionSampling one;
+      const RegionPoint& q = points.points.front();
+      one.rectangle = {int(q.col), int(q.row), int(q.col), int(q.row)};
+      one.samples = 3;
+      one.absolute = true;
+      one.height = field.at(int(q.col), int(q.row)) * field.z_scale + 2.0;
+      exact.curvature = viewsheds.curvature = 0.004;
+      exact.max_distance = viewsheds.max_distance = 17.3;
+      expectSameBarGrazing(field, one, computeRegionVisibility(context, field, one, exact),
+                           computeRegionVisibility(context, field, one, viewsheds), exact);
+    });
+  });
+  EXPECT_GT(visible, bits / 10);
+  EXPECT_LT(visible, bits * 9 / 10);
+  // What it cannot take.
+  const HeightField field = makeSyntheticField("sine", 20, 20);
+  RegionSampling jittered;
+  jittered.rectangle = {2, 2, 6, 6};
+  RegionVisibilityOptions viewsheds;
+  viewsheds.method = RegionVisibilityMethod::Viewsheds;
+  EXPECT_THROW(computeRegionVisibility(testContext(), field, jittered, viewsheds), InvalidArgument);
+  RegionSampling on_point;
+  on_point.rectangle = {3, 3, 3, 3};
+  EXPECT_NO_THROW(computeRegionVisibility(testContext(), field, on_point, viewsheds));
+  EXPECT_THROW(computeRegionPairVisibility(testContext(), field, on_point, on_point, viewsheds),
+               InvalidArgument);
+  viewsheds.decorrelate = true;
+  EXPECT_THROW(computeRegionVisibility(testContext(), field, on_point, viewsheds), InvalidArgument);
+}
+
+TEST(RegionVisibility, SamplesAreStratifiedAndDeterministic) {
+  const HeightField field = makeSyntheticField("sine", 30, 30);
+  RegionSampling region;
+  region.rectangle = {20, 4, 4, 20};  // corners in any order: 16 x 16 pixels
+  region.samples = 64;                // 8 x 8 strata of 2 x 2 pixels
+  region.height = 1.0;
+  const std::vector<RegionPoint> a = regionSamplePoints(field, region, 3);
+  const std::vector<RegionPoint> b = regionSamplePoints(field, region, 3);
+  const std::vector<RegionPoint> c = regionSamplePoints(field, region, 4);
+  ASSERT_EQ(a.size(), 64u);
+  std::set<std::pair<int, int>> strata;
+  std::size_t moved = 0;
+  for (std::size_t s = 0; s < a.size(); ++s) {
+    EXPECT_EQ(a[s].col, b[s].col);
+    EXPECT_EQ(a[s].row, b[s].row);
+    moved += a[s].col != c[s].col;
+    EXPECT_GE(a[s].col, 4.0);
+    EXPECT_LE(a[s].col, 20.0);
+    EXPECT_GE(a[s].row, 4.0);
+    EXPECT_LE(a[s].row, 20.0);
+    strata.insert({std::min(7, int((a[s].col - 4.0) / 2.0)), std::min(7, int((a[s].row - 4.0) / 2.0))});
+  }
+  EXPECT_EQ(strata.size(), 64u);  // one sample in every stratum
+  EXPECT_GT(moved, 60u);          // another seed, other jitter
+  // 10 samples over a 9 x 1 strip: rows of 4 + 4 + 2 wider strata, still one per stratum.
+  region.rectangle = {0, 0, 8, 1};
+  region.samples = 10;
+  const std::vector<RegionPoint> strip = regionSamplePoints(field, region, 1);
+  ASSERT_EQ(strip.size(), 10u);
+  for (const RegionPoint& p : strip)
+    EXPECT_TRUE(p.col >= 0.0 && p.col <= 8.0 && p.row >= 0.0 && p.row <= 1.0);
+  // Heights above the surface under the sample.
+  region.points = {{2.5, 3.0, 1.0}, {0.0, 0.0, 2.0}};
+  const std::vector<RegionPoint> points = regionSamplePoints(field, region, 1);
+  ASSERT_EQ(points.size(), 2u);
+  EXPECT_NEAR(points[1].height, field.at(0, 0) + 2.0, 1e-5);
+  EXPECT_NEAR(points[0].height, 0.5 * (field.at(2, 3) + field.at(3, 3)) + 1.0, 1e-4);
+}
+
+TEST(RegionVisibility, ManySamplesAndDecorrelation) {
+  // 1030 samples: 33 words, the last holding 6 bits; the bits past S stay zero.
+  HeightField field = makeSyntheticField("city", 23, 17);
+  field.cell_size_y = 0.75;
+  RegionSampling sources;
+  sources.rectangle = {2, 2, 12, 9};
+  sources.samples = 1030;
+  sources.height = 8.0;
+  RegionVisibilityOptions options;
+  options.target_height = 1.0;
+  options.seed = 11;
+  std::vector<std::uint32_t> shared;
+  for (bool decorrelate : {false, true}) {
+    options.decorrelate = decorrelate;
+    forEachLayout([&](const ComputeContext& context) {
+      const RegionVisibilityResult got = computeRegionVisibility(context, field, sources, options);
+      ASSERT_EQ(got.words, 33);
+      expectSame(got, referenceRegionVisibility(field, sources, options));
+      for (std::size_t p = 0; p < field.pixelCount(); ++p) EXPECT_EQ(got.bits[p * 33 + 32] >> 6, 0u) << p;
+      // The same run again: the same bits (the jitter is a hash, not a random state).
+      EXPECT_EQ(computeRegionVisibility(context, field, sources, options).bits, got.bits);
+      if (!decorrelate) {
+        shared = got.bits;
+        return;
+      }
+      // Each receiver its own samples: other bits where a receiver sees part of the sources.
+      std::size_t differ = 0;
+      for (std::size_t i = 0; i < got.bits.size(); ++i) differ += got.bits[i] != shared[i];
+      EXPECT_GT(differ, got.bits.size() / 10);
+    });
+  }
+}
+
+TEST(RegionVisibility, BadInputIsRefused) {
+  HeightField field = makeSyntheticField("noise", 20, 10);
+  field.heights[5 * 20 + 5] = std::numeric_limits<float>::quiet_NaN();
+  const ComputeContext& context = testContext();
+  auto refused = [&](RegionSampling s, RegionVisibilityOptions o, const std::string& says) {
+    try {
+      computeRegionVisibility(context, field, s, o);
+      ADD_FAILURE() << "accepted; expected an error saying " << says;
+    } catch (const InvalidArgument& e) {
+      EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+    }
+  };
+  RegionSampling good;
+  good.rectangle = {0, 0, 3, 3};
+  RegionVisibilityOptions options;
+  EXPECT_NO_THROW(computeRegionVisibility(context, field, good, options));
+  RegionSampling s = good;
+  s.rectangle = {0, 0, 20, 3};
+  refused(s, options, "outside");
+  s.rectangle = {-1, 0, 3, 3};
+  refused(s, options, "outside");
+  s = good;
+  s.samples = 0;
+  refused(s, options, "samples");
+  s.samples = kMaxRegionSamples + 1;
+  refused(s, options, "samples");
+  s = good;
+  s.rectangle = {4, 4, 8, 6};
+  refused(s, options, "nodata");
+  s = good;
+  s.height = std::numeric_limits<double>::infinity();
+  refused(s, options, "finite");
+  s = good;
+  s.points = {{5.5, 4.5, 1.0}};
+  refused(s, options, "nodata");
+  s.points = {{19.5, 2.0, 1.0}};
+  refused(s, options, "outside");
+  s.points = {{1.0, 2.0, std::numeric_limits<double>::quiet_NaN()}};
+  refused(s, options, "finite");
+  RegionVisibilityOptions o = options;
+  o.max_distance = -1.0;
+  refused(good, o, "maximum distance");
+  o = options;
+  o.target_height = std::numeric_limits<double>::quiet_NaN();
+  refused(good, o, "target height");
+  o = options;
+  o.curvature = std::numeric_limits<double>::infinity();
+  refused(good, o, "curvature");
+  HeightField latlon = field;
+  latlon.row_cell_size_x.assign(field.height, 1.0);
+  latlon.row_cell_size_y.assign(field.height, 1.0);
+  EXPECT_THROW(computeRegionVisibility(context, latlon, good, options), InvalidArgument);
+  // A region pair checks both regions.
+  EXPECT_THROW(computeRegionPairVisibility(context, field, good, s, options), InvalidArgument);
+  EXPECT_THROW(computeRegionPairVisibility(context, field, s, good, options), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace hfvis
