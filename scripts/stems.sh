@@ -13,7 +13,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 files=$(git ls-files)
 status=0
-# stem | kernel (- for none, with the reason) | reference (- for none, with the reason)
+# stem | kernel (- for none, with the reason) | reference (- likewise) [| CLI: - and why, when it has none yet]
 stems=(
   "horizon|kernels/horizon.cl|testing/horizon_reference.cpp"
   "sky_view_factor|kernels/shared/sky_view_factor.cl|testing/sky_view_factor_reference.cpp"
@@ -26,6 +26,7 @@ stems=(
   "bounce|kernels/bounce.cl|testing/bounce_reference.cpp"
   "viewshed|kernels/viewshed.cl|testing/viewshed_reference.cpp"
   "sun|- (host arithmetic)|- (published positions: Reda & Andreas 2004, the USNO)"
+  "region_visibility|kernels/region_visibility.cl|testing/region_visibility_reference.cpp|- (not yet: the library's exact and viewsheds methods only)"
 )
 has() { grep -qx "$1" <<< "$files"; }
 show() {  # label, path or "- reason"
@@ -39,7 +40,7 @@ show() {  # label, path or "- reason"
   fi
 }
 for entry in "${stems[@]}"; do
-  IFS='|' read -r stem kernel reference <<< "$entry"
+  IFS='|' read -r stem kernel reference cli <<< "$entry"
   echo "$stem"
   show header "include/hfvis/$stem.hpp"
   show host "src/ops/$stem.cpp"
@@ -53,7 +54,7 @@ for entry in "${stems[@]}"; do
     ((other)) || tests+="$t "
   done
   if [[ -n $tests ]]; then printf '  %-10s %s\n' tests "$tests"; else show tests "tests/test_$stem.cpp"; fi
-  show cli "cli/commands/$stem.cpp"
+  show cli "${cli:-cli/commands/$stem.cpp}"
 done
 # Internal headers by operation: src/ops/STEM.hpp or src/ops/STEM_*.hpp, the longest stem that fits.
 stem_of() {
