@@ -110,16 +110,16 @@ InsolationResult computeInsolation(const ComputeContext& context, const HeightFi
                                   suns.data());
       const cl::Buffer hour_buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, hours.size() * sizeof(float),
                                    hours.data());
-      cl::Kernel add(program, "insolation_add");
-      add.setArg(0, horizon);
-      add.setArg(1, normal_buffer);
-      add.setArg(2, static_cast<cl_uint>(pixels));
-      add.setArg(3, sun_buffer);
-      add.setArg(4, hour_buffer);
-      add.setArg(5, static_cast<int>(suns.size()));
-      add.setArg(6, static_cast<float>(radius));
-      add.setArg(7, sun_hours);
-      add.setArg(8, direct);
+      detail::NamedKernel add(st, program, "insolation_add");
+      add.set("horizon", horizon);
+      add.set("normals", normal_buffer);
+      add.set("pixels", static_cast<cl_uint>(pixels));
+      add.set("steps", sun_buffer);
+      add.set("hours", hour_buffer);
+      add.set("n_steps", static_cast<int>(suns.size()));
+      add.set("radius", static_cast<float>(radius));
+      add.set("sun_hours", sun_hours);
+      add.set("direct", direct);
       st.launch(add, cl::NDRange(detail::roundUp(pixels, detail::kLineGroup)), cl::NDRange(detail::kLineGroup));
       st.queue.finish();  // before this bucket's buffers go
       ++out.sweeps;

@@ -101,54 +101,48 @@ TreeKernel treeKernel(ContextState& st, cl::Program& program, const TreeDirectio
   k.row_units = table(d.row_units.data(), d.row_units.size() * sizeof(std::int32_t));
   k.row_factors = table(d.row_factors.data(), d.row_factors.size() * sizeof(float));
   k.no_strips = deviceBuffer(st, 0);
-  k.kernel = cl::Kernel(program, "intervisibility_lattice");
-  cl::Kernel& kernel = k.kernel;
-  int arg = 0;
-  kernel.setArg(arg++, b.heights);
-  kernel.setArg(arg++, width);
-  kernel.setArg(arg++, height);
-  k.chunk.lines = arg++;
-  k.chunk.count = arg++;
-  kernel.setArg(arg++, k.samples);
-  kernel.setArg(arg++, static_cast<int>(d.samples.size()));
-  kernel.setArg(arg++, d.lattice.a);
-  kernel.setArg(arg++, d.lattice.b);
-  kernel.setArg(arg++, d.count_factor);
-  kernel.setArg(arg++, d.area_factor);
-  kernel.setArg(arg++, d.drop);
-  kernel.setArg(arg++, d.max_steps);
-  kernel.setArg(arg++, k.row_units);
-  kernel.setArg(arg++, k.row_factors);
-  kernel.setArg(arg++, b.trees);
-  kernel.setArg(arg++, b.prefix);
-  kernel.setArg(arg++, b.positions);
-  k.chunk.stride = arg++;
-  kernel.setArg(arg++, b.visible);
-  kernel.setArg(arg++, b.entry_stats);
-  kernel.setArg(arg++, b.line_totals);
-  k.chunk.first_line = arg++;
-  kernel.setArg(arg++, b.count_sum);
-  kernel.setArg(arg++, b.area_sum);
-  kernel.setArg(arg++, b.radiance);
-  kernel.setArg(arg++, b.normals);
-  kernel.setArg(arg++, d.cos_azimuth);
-  kernel.setArg(arg++, d.sin_azimuth);
-  kernel.setArg(arg++, d.step_ground);
-  kernel.setArg(arg++, d.half_sector);
-  kernel.setArg(arg++, d.wedge);
-  kernel.setArg(arg++, b.irradiance);
-  k.strip = arg;
-  kernel.setArg(arg++, 0);  // row0
-  kernel.setArg(arg++, 0);  // out_row0
-  kernel.setArg(arg++, k.no_strips);
-  kernel.setArg(arg++, k.no_strips);
+  k.kernel = NamedKernel(st, program, "intervisibility_lattice");  // the chunk's lines set per chunk
+  NamedKernel& kernel = k.kernel;
+  kernel.set("heights", b.heights);
+  kernel.set("width", width);
+  kernel.set("height", height);
+  kernel.set("samples", k.samples);
+  kernel.set("n_samples", static_cast<int>(d.samples.size()));
+  kernel.set("a", d.lattice.a);
+  kernel.set("b", d.lattice.b);
+  kernel.set("count_factor", d.count_factor);
+  kernel.set("area_factor", d.area_factor);
+  kernel.set("drop", d.drop);
+  kernel.set("max_steps", d.max_steps);
+  kernel.set("row_units", k.row_units);
+  kernel.set("row_factors", k.row_factors);
+  kernel.set("trees", b.trees);
+  kernel.set("prefix", b.prefix);
+  kernel.set("positions", b.positions);
+  kernel.set("visible", b.visible);
+  kernel.set("entry_stats", b.entry_stats);
+  kernel.set("line_totals", b.line_totals);
+  kernel.set("count_sum", b.count_sum);
+  kernel.set("area_sum", b.area_sum);
+  kernel.set("radiance", b.radiance);
+  kernel.set("normals", b.normals);
+  kernel.set("cos_azimuth", d.cos_azimuth);
+  kernel.set("sin_azimuth", d.sin_azimuth);
+  kernel.set("step_ground", d.step_ground);
+  kernel.set("half_sector", d.half_sector);
+  kernel.set("wedge", d.wedge);
+  kernel.set("irradiance", b.irradiance);
+  kernel.set("row0", 0);
+  kernel.set("out_row0", 0);
+  kernel.set("strip_receivers", k.no_strips);
+  kernel.set("states", k.no_strips);
   return k;
 }
 
 void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDirection& d, int width, int height,
                           const TreeBuffers& b) {
   TreeKernel k = treeKernel(st, program, d, width, height, b);
-  launchLineChunks(st, k.kernel, d.lines, d.samples.size(), b.scratch_entries, k.chunk, 1, kLineGroup);
+  launchLineChunks(st, k.kernel, d.lines, d.samples.size(), b.scratch_entries, 1, kLineGroup);
 }
 
 std::string TreeRoutine::programOptions() const {
@@ -336,11 +330,11 @@ class CountRoutine : public TreeRoutine {
       const LineChunk& chunk = chunks[c];
       const cl::Buffer chunk_lines(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
                                    chunk.count * sizeof(LatticeLine), lines.data() + chunk.first);
-      k.kernel.setArg(k.chunk.lines, chunk_lines);
-      k.kernel.setArg(k.chunk.count, static_cast<int>(chunk.count));
-      k.kernel.setArg(k.chunk.stride, static_cast<cl_uint>(chunk.stride));
-      k.kernel.setArg(k.chunk.first_line, static_cast<int>(chunk.first));
-      k.kernel.setArg(k.strip + 3, states_);
+      k.kernel.set("lines", chunk_lines);
+      k.kernel.set("n_lines", static_cast<int>(chunk.count));
+      k.kernel.set("stride", static_cast<cl_uint>(chunk.stride));
+      k.kernel.set("first_line", static_cast<int>(chunk.first));
+      k.kernel.set("states", states_);
       // The strips in the order the lines run through them (receiver i in row row - i b).
       for (int t = 0; t < strips; ++t) {
         const int s = b > 0 ? strips - 1 - t : t;
@@ -368,9 +362,9 @@ class CountRoutine : public TreeRoutine {
       st_.queue.enqueueWriteBuffer(buffers_.area_sum, CL_FALSE, 0, sums, &result_.visible_area[s0 * width]);
     const cl::Buffer ranges_buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
                                    ranges.size() * sizeof(cl_int2), const_cast<cl_int2*>(ranges.data()));
-    k.kernel.setArg(k.strip, h0);
-    k.kernel.setArg(k.strip + 1, s0);
-    k.kernel.setArg(k.strip + 2, ranges_buffer);
+    k.kernel.set("row0", h0);
+    k.kernel.set("out_row0", s0);
+    k.kernel.set("strip_receivers", ranges_buffer);
     st_.launch(k.kernel, cl::NDRange(roundUp(ranges.size(), kLineGroup)), cl::NDRange(kLineGroup));
     st_.queue.enqueueReadBuffer(buffers_.count_sum, CL_FALSE, 0, sums, &result_.visible_count[s0 * width]);
     if (outputs_.visible_area)
@@ -456,17 +450,16 @@ class NaiveCountRoutine : public SweepRoutine {
   void endBatch(int first, int count) override {
     const std::vector<SweepDirection> batch(rays_.begin() + first, rays_.begin() + first + count);
     const cl::Buffer directions = uploadDirections(st_, batch);
-    cl::Kernel naive(program_, "intervisibility_naive");
-    int arg = 0;
-    naive.setArg(arg++, heights_);
-    naive.setArg(arg++, field_.width);
-    naive.setArg(arg++, field_.height);
-    naive.setArg(arg++, directions);
-    naive.setArg(arg++, count);
-    naive.setArg(arg++, intervisibilitySector(visibility_));
+    NamedKernel naive(st_, program_, "intervisibility_naive");
+    naive.set("heights", heights_);
+    naive.set("width", field_.width);
+    naive.set("height", field_.height);
+    naive.set("directions", directions);
+    naive.set("batch_size", count);
+    naive.set("sector", intervisibilitySector(visibility_));
     // With per-row spacing positions are units: the drop per unit squared, distances in units.
     const double per_unit = unit_ * unit_;
-    naive.setArg(arg++, static_cast<float>(visibility_.curvature * (unit_ > 0.0 ? per_unit : 1.0)));
+    naive.set("curvature", static_cast<float>(visibility_.curvature * (unit_ > 0.0 ? per_unit : 1.0)));
     std::vector<cl_int> max_steps;
     for (const SweepDirection& d : batch)
       max_steps.push_back(stepsWithin(visibility_.max_distance,
@@ -476,17 +469,17 @@ class NaiveCountRoutine : public SweepRoutine {
       return cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes, const_cast<void*>(data));
     };
     const cl::Buffer max_steps_buffer = upload(max_steps.data(), max_steps.size() * sizeof(cl_int));
-    naive.setArg(arg++, max_steps_buffer);
+    naive.set("max_steps", max_steps_buffer);
     // This batch's slices of the row tables.
     const std::size_t half_rows = 2 * static_cast<std::size_t>(field_.height) - 1, rows = 2 * field_.height;
     const cl::Buffer units = upload(rows_.units.empty() ? nullptr : &rows_.units[first * half_rows],
                                     rows_.units.empty() ? 0 : count * half_rows * sizeof(cl_int));
     const cl::Buffer factors = upload(rows_.factors.empty() ? nullptr : &rows_.factors[first * rows],
                                       rows_.factors.empty() ? 0 : count * rows * sizeof(float));
-    naive.setArg(arg++, units);
-    naive.setArg(arg++, factors);
-    naive.setArg(arg++, count_sum_);
-    naive.setArg(arg++, area_sum_);
+    naive.set("row_units", units);
+    naive.set("row_factors", factors);
+    naive.set("count_sum", count_sum_);
+    naive.set("area_sum", area_sum_);
     st_.launch(naive, cl::NDRange(roundUp(field_.width, kTileX), roundUp(field_.height, kTileY)),
                cl::NDRange(kTileX, kTileY));
   }

@@ -78,14 +78,12 @@ void allocateTreeScratch(ContextState& st, const TreeProgramFlags& flags, const 
                          std::size_t entries, TreeBuffers& b);
 
 // intervisibility_lattice set up for direction d over the buffers b, with the tables it reads
-// (kept alive with it); `chunk` names the arguments each chunk of lines sets, `strip` the first
-// of those a strip sets (row0, out_row0, strip_receivers, states; without strips 0, 0 and
-// empty buffers).
+// (kept alive with it): every argument but the chunk's lines (lines, n_lines, stride,
+// first_line); a strip sets row0, out_row0, strip_receivers and states, which are 0, 0 and
+// empty buffers without strips.
 struct TreeKernel {
-  cl::Kernel kernel;
+  NamedKernel kernel;
   cl::Buffer samples, row_units, row_factors, no_strips;
-  LineChunkArguments chunk;
-  int strip = 0;
 };
 TreeKernel treeKernel(ContextState& st, cl::Program& program, const TreeDirection& d, int width, int height,
                       const TreeBuffers& b);

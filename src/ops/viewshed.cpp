@@ -65,15 +65,15 @@ class ViewshedRun {
     const cl::NDRange cell_range(detail::roundUp(cells_x, detail::kTileX), detail::roundUp(cells_y, detail::kTileY));
     const cl::Buffer slopes = detail::deviceBuffer(st, cells * sizeof(float));
     lipschitz_ = detail::deviceBuffer(st, cells * sizeof(float));
-    cl::Kernel slope(program_, "viewshed_slopes");
-    slope.setArg(0, heights_buffer_);
-    slope.setArg(1, device_);
-    slope.setArg(2, slopes);
+    detail::NamedKernel slope(st, program_, "viewshed_slopes");
+    slope.set("h", heights_buffer_);
+    slope.set("f", device_);
+    slope.set("slopes", slopes);
     st.launch(slope, cell_range, cl::NDRange(detail::kTileX, detail::kTileY));
-    cl::Kernel k(program_, "viewshed_lipschitz");
-    k.setArg(0, slopes);
-    k.setArg(1, device_);
-    k.setArg(2, lipschitz_);
+    detail::NamedKernel k(st, program_, "viewshed_lipschitz");
+    k.set("slopes", slopes);
+    k.set("f", device_);
+    k.set("lipschitz", lipschitz_);
     st.launch(k, cell_range, cl::NDRange(detail::kTileX, detail::kTileY));
     buildPyramid(cells_x, cells_y);
     if (options.pyramid) uploadCulling(*options.pyramid);
@@ -104,30 +104,29 @@ class ViewshedRun {
     if (az_span < 0.0) az_span += 360.0;
     if (az_span == 0.0) az_span = 360.0;
     // Settle what needs no sight line; the rest is pending, for the rays and then the march.
-    cl::Kernel k(program_, "viewshed_classify");
-    int a = 0;
-    k.setArg(a++, heights_buffer_);
-    k.setArg(a++, device_);
-    k.setArg(a++, o.col);
-    k.setArg(a++, o.row);
-    k.setArg(a++, ze);
-    k.setArg(a++, static_cast<float>(options_.target_height));
-    k.setArg(a++, box);
-    k.setArg(a++, static_cast<float>(options_.max_distance));
-    k.setArg(a++, az_span < 360.0 ? 1 : 0);
-    k.setArg(a++, static_cast<float>(options_.azimuth_from_deg));
-    k.setArg(a++, static_cast<float>(az_span));
-    k.setArg(a++, static_cast<float>(options_.elevation_min_deg * kDegree));
-    k.setArg(a++, static_cast<float>(options_.elevation_max_deg * kDegree));
-    k.setArg(a++, cull_levels_.empty() ? pending_ : culled_);
-    k.setArg(a++, cull_leaf);
-    k.setArg(a++, visible);
-    k.setArg(a++, accumulate ? 1 : 0);
-    k.setArg(a++, angle ? 1 : 0);
-    k.setArg(a++, angle ? *angle : visible);
-    k.setArg(a++, pending_);
-    k.setArg(a++, use_rays ? 1 : 0);
-    k.setArg(a++, ray_hi_);
+    detail::NamedKernel k(st_, program_, "viewshed_classify");
+    k.set("h", heights_buffer_);
+    k.set("f", device_);
+    k.set("ex_i", o.col);
+    k.set("ey_i", o.row);
+    k.set("ze", ze);
+    k.set("target_height", static_cast<float>(options_.target_height));
+    k.set("box", box);
+    k.set("max_distance", static_cast<float>(options_.max_distance));
+    k.set("az_on", az_span < 360.0 ? 1 : 0);
+    k.set("az_from", static_cast<float>(options_.azimuth_from_deg));
+    k.set("az_span", static_cast<float>(az_span));
+    k.set("el_lo", static_cast<float>(options_.elevation_min_deg * kDegree));
+    k.set("el_hi", static_cast<float>(options_.elevation_max_deg * kDegree));
+    k.set("culled", cull_levels_.empty() ? pending_ : culled_);
+    k.set("cull_level", cull_leaf);
+    k.set("out_visible", visible);
+    k.set("accumulate", accumulate ? 1 : 0);
+    k.set("want_angle", angle ? 1 : 0);
+    k.set("out_angle", angle ? *angle : visible);
+    k.set("pending", pending_);
+    k.set("rays_on", use_rays ? 1 : 0);
+    k.set("ray_hi", ray_hi_);
     st_.launch(k, cl::NDRange(detail::roundUp(field_.width, detail::kTileX), detail::roundUp(field_.height, detail::kTileY)),
                cl::NDRange(detail::kTileX, detail::kTileY));
     // The rays settle most pending targets, or leave them an upper bound for the march.
@@ -139,50 +138,48 @@ class ViewshedRun {
       if (cull_leaf.s[0] > 0) {
         need = detail::deviceBuffer(st_, rays * sizeof(cl_int));
         st_.queue.enqueueFillBuffer(need, cl_int(-1), 0, rays * sizeof(cl_int));
-        cl::Kernel n(program_, "viewshed_ray_need");
-        a = 0;
-        n.setArg(a++, culled_);
-        n.setArg(a++, cull_leaf);
-        n.setArg(a++, device_);
-        n.setArg(a++, o.col);
-        n.setArg(a++, o.row);
-        n.setArg(a++, box);
-        n.setArg(a++, rays);
-        n.setArg(a++, unit);
-        n.setArg(a++, need);
+        detail::NamedKernel n(st_, program_, "viewshed_ray_need");
+        n.set("culled", culled_);
+        n.set("leaf", cull_leaf);
+        n.set("f", device_);
+        n.set("ex_i", o.col);
+        n.set("ey_i", o.row);
+        n.set("box", box);
+        n.set("rays", rays);
+        n.set("unit", unit);
+        n.set("need", need);
         st_.launch(n,
                    cl::NDRange(detail::roundUp(cull_leaf.s[0], detail::kTileX),
                                detail::roundUp(cull_leaf.s[1], detail::kTileY)),
                    cl::NDRange(detail::kTileX, detail::kTileY));
       }
-      cl::Kernel r(program_, "viewshed_rays");
-      a = 0;
-      r.setArg(a++, heights_buffer_);
-      r.setArg(a++, device_);
-      r.setArg(a++, lipschitz_);
-      r.setArg(a++, o.col);
-      r.setArg(a++, o.row);
-      r.setArg(a++, ze);
-      r.setArg(a++, static_cast<float>(options_.target_height));
-      r.setArg(a++, box);
-      r.setArg(a++, rays);
-      r.setArg(a++, need);
-      r.setArg(a++, cull_leaf.s[0] > 0 ? 1 : 0);
-      r.setArg(a++, unit);
-      r.setArg(a++, pending_);
-      r.setArg(a++, ray_hi_);
-      r.setArg(a++, visible);
-      r.setArg(a++, accumulate ? 1 : 0);
+      detail::NamedKernel r(st_, program_, "viewshed_rays");
+      r.set("h", heights_buffer_);
+      r.set("f", device_);
+      r.set("lipschitz", lipschitz_);
+      r.set("ex_i", o.col);
+      r.set("ey_i", o.row);
+      r.set("ze", ze);
+      r.set("target_height", static_cast<float>(options_.target_height));
+      r.set("box", box);
+      r.set("rays", rays);
+      r.set("need", need);
+      r.set("use_need", cull_leaf.s[0] > 0 ? 1 : 0);
+      r.set("unit", unit);
+      r.set("pending", pending_);
+      r.set("ray_hi", ray_hi_);
+      r.set("out_visible", visible);
+      r.set("accumulate", accumulate ? 1 : 0);
       const std::size_t items = (static_cast<std::size_t>(rays) + lanes_ - 1) / lanes_;  // lanes_ rays each
       st_.launch(r, cl::NDRange(detail::roundUp(items, detail::kLineGroup)), cl::NDRange(detail::kLineGroup));
     }
     // March the pending targets, listed row by row.
     const cl::NDRange row_range(detail::roundUp(field_.height, detail::kLineGroup));
-    cl::Kernel count(program_, "viewshed_pending_count");
-    count.setArg(0, pending_);
-    count.setArg(1, field_.width);
-    count.setArg(2, field_.height);
-    count.setArg(3, row_counts_);
+    detail::NamedKernel count(st_, program_, "viewshed_pending_count");
+    count.set("pending", pending_);
+    count.set("width", field_.width);
+    count.set("height", field_.height);
+    count.set("counts", row_counts_);
     st_.launch(count, row_range, cl::NDRange(detail::kLineGroup));
     std::vector<cl_uint> rows(field_.height);
     st_.queue.enqueueReadBuffer(row_counts_, CL_TRUE, 0, rows.size() * sizeof(cl_uint), rows.data());
@@ -195,51 +192,49 @@ class ViewshedRun {
     pending_targets_ += total;
     if (total > 0) {
       st_.queue.enqueueWriteBuffer(row_counts_, CL_FALSE, 0, rows.size() * sizeof(cl_uint), rows.data());
-      cl::Kernel list(program_, "viewshed_pending_list");
-      list.setArg(0, pending_);
-      list.setArg(1, field_.width);
-      list.setArg(2, field_.height);
-      list.setArg(3, row_counts_);
-      list.setArg(4, pending_list_);
+      detail::NamedKernel list(st_, program_, "viewshed_pending_list");
+      list.set("pending", pending_);
+      list.set("width", field_.width);
+      list.set("height", field_.height);
+      list.set("offsets", row_counts_);
+      list.set("list", pending_list_);
       st_.launch(list, row_range, cl::NDRange(detail::kLineGroup));
-      cl::Kernel m(program_, "viewshed_march");
-      a = 0;
-      m.setArg(a++, heights_buffer_);
-      m.setArg(a++, device_);
-      m.setArg(a++, o.col);
-      m.setArg(a++, o.row);
-      m.setArg(a++, ze);
-      m.setArg(a++, static_cast<float>(options_.target_height));
-      m.setArg(a++, use_rays ? 1 : 0);
-      m.setArg(a++, ray_hi_);
-      m.setArg(a++, pyramid_);
-      m.setArg(a++, levels_);
-      m.setArg(a++, top_);
-      m.setArg(a++, pending_list_);
-      m.setArg(a++, total);
-      m.setArg(a++, visible);
-      m.setArg(a++, accumulate ? 1 : 0);
+      detail::NamedKernel m(st_, program_, "viewshed_march");
+      m.set("h", heights_buffer_);
+      m.set("f", device_);
+      m.set("ex_i", o.col);
+      m.set("ey_i", o.row);
+      m.set("ze", ze);
+      m.set("target_height", static_cast<float>(options_.target_height));
+      m.set("rays_on", use_rays ? 1 : 0);
+      m.set("ray_hi", ray_hi_);
+      m.set("pyramid", pyramid_);
+      m.set("levels", levels_);
+      m.set("top_level", top_);
+      m.set("list", pending_list_);
+      m.set("count", total);
+      m.set("out_visible", visible);
+      m.set("accumulate", accumulate ? 1 : 0);
       st_.launch(m, cl::NDRange(detail::roundUp(total, detail::kLineGroup)), cl::NDRange(detail::kLineGroup));
     }
     if (needed) {
-      cl::Kernel n(program_, "viewshed_needed");
-      a = 0;
-      n.setArg(a++, heights_buffer_);
-      n.setArg(a++, device_);
-      n.setArg(a++, o.col);
-      n.setArg(a++, o.row);
-      n.setArg(a++, ze);
-      n.setArg(a++, static_cast<float>(options_.target_height));
-      n.setArg(a++, static_cast<float>(options_.max_distance));
-      n.setArg(a++, az_span < 360.0 ? 1 : 0);
-      n.setArg(a++, static_cast<float>(options_.azimuth_from_deg));
-      n.setArg(a++, static_cast<float>(az_span));
-      n.setArg(a++, static_cast<float>(options_.elevation_min_deg * kDegree));
-      n.setArg(a++, static_cast<float>(options_.elevation_max_deg * kDegree));
-      n.setArg(a++, pyramid_);
-      n.setArg(a++, levels_);
-      n.setArg(a++, top_);
-      n.setArg(a++, *needed);
+      detail::NamedKernel n(st_, program_, "viewshed_needed");
+      n.set("h", heights_buffer_);
+      n.set("f", device_);
+      n.set("ex_i", o.col);
+      n.set("ey_i", o.row);
+      n.set("ze", ze);
+      n.set("target_height", static_cast<float>(options_.target_height));
+      n.set("max_distance", static_cast<float>(options_.max_distance));
+      n.set("az_on", az_span < 360.0 ? 1 : 0);
+      n.set("az_from", static_cast<float>(options_.azimuth_from_deg));
+      n.set("az_span", static_cast<float>(az_span));
+      n.set("el_lo", static_cast<float>(options_.elevation_min_deg * kDegree));
+      n.set("el_hi", static_cast<float>(options_.elevation_max_deg * kDegree));
+      n.set("pyramid", pyramid_);
+      n.set("levels", levels_);
+      n.set("top_level", top_);
+      n.set("out_needed", *needed);
       st_.launch(n, cl::NDRange(detail::roundUp(field_.width, detail::kTileX), detail::roundUp(field_.height, detail::kTileY)),
                  cl::NDRange(detail::kTileX, detail::kTileY));
     }
@@ -297,20 +292,19 @@ class ViewshedRun {
     if (cull_levels_.empty()) return cl_int4{{0, 0, 0, 0}};
     for (std::size_t l = 0; l < cull_levels_.size(); ++l) {
       const cl_int4 level = cull_levels_[l];
-      cl::Kernel k(program_, "viewshed_cull");
-      int a = 0;
-      k.setArg(a++, cull_regions_);
-      k.setArg(a++, level);
-      k.setArg(a++, l > 0 ? cull_levels_[l - 1] : level);
-      k.setArg(a++, l > 0 ? 1 : 0);
-      k.setArg(a++, cull_sectors_);
-      k.setArg(a++, cull_spans_);
-      k.setArg(a++, cull_breaks_);
-      k.setArg(a++, device_);
-      k.setArg(a++, static_cast<float>(o.col));
-      k.setArg(a++, static_cast<float>(o.row));
-      k.setArg(a++, ze);
-      k.setArg(a++, culled_);
+      detail::NamedKernel k(st_, program_, "viewshed_cull");
+      k.set("regions", cull_regions_);
+      k.set("level", level);
+      k.set("parent", l > 0 ? cull_levels_[l - 1] : level);
+      k.set("has_parent", l > 0 ? 1 : 0);
+      k.set("sectors", cull_sectors_);
+      k.set("spans", cull_spans_);
+      k.set("breaks", cull_breaks_);
+      k.set("f", device_);
+      k.set("ex", static_cast<float>(o.col));
+      k.set("ey", static_cast<float>(o.row));
+      k.set("ze", ze);
+      k.set("culled", culled_);
       st_.launch(k, cl::NDRange(detail::roundUp(level.s[0], detail::kTileX), detail::roundUp(level.s[1], detail::kTileY)),
                  cl::NDRange(detail::kTileX, detail::kTileY));
     }
@@ -339,15 +333,15 @@ class ViewshedRun {
     pyramid_ = detail::deviceBuffer(st_, total * sizeof(float));
     for (int k = 1; k <= top_; ++k) {
       const cl_int4 level = levels[k];
-      cl::Kernel kernel(program_, k == 1 ? "viewshed_pyramid_first" : "viewshed_pyramid_next");
+      detail::NamedKernel kernel(st_, program_, k == 1 ? "viewshed_pyramid_first" : "viewshed_pyramid_next");
       if (k == 1) {
-        kernel.setArg(0, heights_buffer_);
-        kernel.setArg(1, device_);
+        kernel.set("h", heights_buffer_);
+        kernel.set("f", device_);
       } else {
-        kernel.setArg(0, levels[k - 1]);
+        kernel.set("below", levels[k - 1]);
       }
-      kernel.setArg(k == 1 ? 2 : 1, level);
-      kernel.setArg(k == 1 ? 3 : 2, pyramid_);
+      kernel.set("level", level);
+      kernel.set("pyramid", pyramid_);
       st_.launch(kernel, cl::NDRange(detail::roundUp(level.s[0], detail::kTileX), detail::roundUp(level.s[1], detail::kTileY)),
                  cl::NDRange(detail::kTileX, detail::kTileY));
     }
