@@ -31,8 +31,8 @@ bool lineMajorLayout(const ContextState& st) {
   return st.info.type == "CPU";
 }
 
-
-std::size_t defaultMemoryBudget(const DeviceInfo& device) {
+std::size_t memoryBudget(std::size_t budget_bytes, const DeviceInfo& device) {
+  if (budget_bytes) return budget_bytes;
   // A CPU device's memory is the host's: PoCL reports a fraction of it as its global memory
   // (4.8 to 6.2 GiB on the 24 GB test machine) and allocates from the host beyond that, so the
   // budget is half the host's physical memory (its largest single buffer still applies).

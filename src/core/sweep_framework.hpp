@@ -29,9 +29,10 @@ bool lineMajorLayout(const ContextState& st);
 // step-major layout, whose neighbouring work-items read neighbouring entries.
 int simdLanes(const ContextState& st);
 
-// The budget when the caller gives none: half the device memory (for a CPU device, whose
-// memory is the host's, half the host's physical memory).
-std::size_t defaultMemoryBudget(const DeviceInfo& device);
+// The device memory an operation may plan with: the caller's `budget_bytes`, or when that is 0
+// half the device memory (for a CPU device, whose memory is the host's, half the host's
+// physical memory).
+std::size_t memoryBudget(std::size_t budget_bytes, const DeviceInfo& device);
 
 // Half the host's physical memory (or of its cgroup's limit, where lower); 0 when unknown.
 std::size_t hostMemoryBudget();

@@ -134,8 +134,7 @@ RunPlan planStrips(const HeightField& field, const HorizonOptions& options, cons
 RunPlan planRun(const HeightField& field, const HorizonOptions& options, const HorizonOutputs& outputs,
                 const std::vector<RunDirection>& directions, const DeviceInfo& device) {
   const bool sweep = options.method == HorizonMethod::Sweep;
-  const std::size_t budget =
-      options.memory_budget_bytes ? options.memory_budget_bytes : defaultMemoryBudget(device);
+  const std::size_t budget = memoryBudget(options.memory_budget_bytes, device);
   const std::size_t max_alloc = device.max_allocation_bytes ? device.max_allocation_bytes : budget;
   const std::size_t plane = field.pixelCount() * sizeof(float);
   // Heights, the sums, the normals' two slopes, the window's float2 per pixel (and with per-row

@@ -65,7 +65,7 @@ TreeScratchNeeds treeScratchNeeds(const std::vector<TreeDirection>& directions, 
 std::size_t planTreeScratch(const std::vector<TreeDirection>& directions, std::size_t fixed_bytes,
                             std::size_t entry_bytes, std::size_t budget_bytes, const DeviceInfo& device,
                             bool line_major) {
-  const std::size_t budget = budget_bytes ? budget_bytes : defaultMemoryBudget(device);
+  const std::size_t budget = memoryBudget(budget_bytes, device);
   const std::size_t max_alloc = device.max_allocation_bytes ? device.max_allocation_bytes : budget;
   const TreeScratchNeeds needs = treeScratchNeeds(directions, line_major);
   const std::size_t least = fixed_bytes + needs.longest * entry_bytes;
@@ -214,7 +214,7 @@ struct CountPlan {
 CountPlan planCount(const HeightField& field, const std::vector<TreeDirection>& directions,
                     const TreeProgramFlags& flags, const IntervisibilityOptions& options, const DeviceInfo& device,
                     bool line_major) {
-  const std::size_t budget = options.memory_budget_bytes ? options.memory_budget_bytes : defaultMemoryBudget(device);
+  const std::size_t budget = memoryBudget(options.memory_budget_bytes, device);
   const std::size_t max_alloc = device.max_allocation_bytes ? device.max_allocation_bytes : budget;
   const TreeScratchNeeds needs = treeScratchNeeds(directions, line_major);
   const std::size_t entry = treeEntryBytes(flags), row = field.width * sizeof(float);
