@@ -77,7 +77,7 @@ MethodOutput runBaseline(const ComputeContext& context, const HeightField& field
   return detail::translateOpenClErrors([&] {
     detail::ContextState& st = detail::stateOf(context);
     cl::Program program = st.program("horizon_baselines.cl", programOptions(spec));
-    const std::vector<float> prepared = preparedHeights(field);
+    const std::vector<float> prepared = detail::prepareHeights(field).heights;
     const std::size_t plane = field.pixelCount();
     cl::Buffer heights(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, plane * sizeof(float),
                        const_cast<float*>(prepared.data()));

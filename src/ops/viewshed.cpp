@@ -66,13 +66,7 @@ class ViewshedRoutine : public detail::DeviceRoutine {
 
   // Heights as the observers' and targets' heights are given: scaled, not moved to the lowest.
   detail::PreparedHeights prepare() override {
-    detail::PreparedHeights prepared;
-    prepared.heights.resize(field_.pixelCount());
-    for (std::size_t p = 0; p < prepared.heights.size(); ++p)
-      prepared.heights[p] = std::isfinite(field_.heights[p])
-                                ? static_cast<float>(field_.heights[p] * field_.z_scale)
-                                : std::numeric_limits<float>::quiet_NaN();
-    return prepared;
+    return detail::prepareHeights(field_, detail::HeightOrigin::Zero);
   }
   std::string programFile() const override { return "viewshed.cl"; }
   std::string programOptions() const override { return "-DHFVIS_LANES=" + std::to_string(lanes_); }
