@@ -128,32 +128,38 @@ class ViewshedRoutine : public detail::DeviceRoutine {
     st_.queue.finish();  // before this observer's ray buffers go
   }
 
-  // The field of view's span clockwise in degrees; 360 (equal azimuths, or 0 and 360) is the
-  // whole circle.
-  double azimuthSpan() const {
-    double az_span = std::fmod(options_.azimuth_to_deg - options_.azimuth_from_deg, 360.0);
-    if (az_span < 0.0) az_span += 360.0;
-    return az_span == 0.0 ? 360.0 : az_span;
-  }
-
-  // Settles what needs no sight line; the rest is pending, for the rays and then the march.
-  void classify(const Observer& o, float ze, const cl_int4& box, const cl_int4& cull_leaf, bool use_rays) {
-    const double az_span = azimuthSpan();
-    const bool angle = !counting() && outputs_->angle;
-    detail::NamedKernel k = kernel("viewshed_classify");
+  // The arguments of the kernels that follow sight lines from eye o at height ze: the field,
+  // the eye and the targets' height above the ground.
+  void setEye(detail::NamedKernel& k, const Observer& o, float ze) const {
     k.set("h", heights_);
     k.set("f", device_);
     k.set("ex_i", o.col);
     k.set("ey_i", o.row);
     k.set("ze", ze);
     k.set("target_height", static_cast<float>(options_.target_height));
-    k.set("box", box);
+  }
+
+  // The field of view's arguments: the maximum distance, the azimuths (their span clockwise in
+  // degrees; 360, equal azimuths or 0 and 360, is the whole circle) and the elevations.
+  void setFieldOfView(detail::NamedKernel& k) const {
+    double az_span = std::fmod(options_.azimuth_to_deg - options_.azimuth_from_deg, 360.0);
+    if (az_span < 0.0) az_span += 360.0;
+    if (az_span == 0.0) az_span = 360.0;
     k.set("max_distance", static_cast<float>(options_.max_distance));
     k.set("az_on", az_span < 360.0 ? 1 : 0);
     k.set("az_from", static_cast<float>(options_.azimuth_from_deg));
     k.set("az_span", static_cast<float>(az_span));
     k.set("el_lo", static_cast<float>(options_.elevation_min_deg * kDegree));
     k.set("el_hi", static_cast<float>(options_.elevation_max_deg * kDegree));
+  }
+
+  // Settles what needs no sight line; the rest is pending, for the rays and then the march.
+  void classify(const Observer& o, float ze, const cl_int4& box, const cl_int4& cull_leaf, bool use_rays) {
+    const bool angle = !counting() && outputs_->angle;
+    detail::NamedKernel k = kernel("viewshed_classify");
+    setEye(k, o, ze);
+    k.set("box", box);
+    setFieldOfView(k);
     k.set("culled", cull_levels_.empty() ? pending_ : culled_);
     k.set("cull_level", cull_leaf);
     k.set("out_visible", visible_);
@@ -190,13 +196,8 @@ class ViewshedRoutine : public detail::DeviceRoutine {
                  pixelGroup());
     }
     detail::NamedKernel r = kernel("viewshed_rays");
-    r.set("h", heights_);
-    r.set("f", device_);
+    setEye(r, o, ze);
     r.set("lipschitz", lipschitz_);
-    r.set("ex_i", o.col);
-    r.set("ey_i", o.row);
-    r.set("ze", ze);
-    r.set("target_height", static_cast<float>(options_.target_height));
     r.set("box", box);
     r.set("rays", rays);
     r.set("need", need);
@@ -239,12 +240,7 @@ class ViewshedRoutine : public detail::DeviceRoutine {
     list.set("list", pending_list_);
     st_.launch(list, row_range, cl::NDRange(detail::kLineGroup));
     detail::NamedKernel m = kernel("viewshed_march");
-    m.set("h", heights_);
-    m.set("f", device_);
-    m.set("ex_i", o.col);
-    m.set("ey_i", o.row);
-    m.set("ze", ze);
-    m.set("target_height", static_cast<float>(options_.target_height));
+    setEye(m, o, ze);
     m.set("rays_on", use_rays ? 1 : 0);
     m.set("ray_hi", ray_hi_);
     m.set("pyramid", pyramid_);
@@ -258,20 +254,9 @@ class ViewshedRoutine : public detail::DeviceRoutine {
   }
 
   void markNeeded(const Observer& o, float ze) {
-    const double az_span = azimuthSpan();
     detail::NamedKernel n = kernel("viewshed_needed");
-    n.set("h", heights_);
-    n.set("f", device_);
-    n.set("ex_i", o.col);
-    n.set("ey_i", o.row);
-    n.set("ze", ze);
-    n.set("target_height", static_cast<float>(options_.target_height));
-    n.set("max_distance", static_cast<float>(options_.max_distance));
-    n.set("az_on", az_span < 360.0 ? 1 : 0);
-    n.set("az_from", static_cast<float>(options_.azimuth_from_deg));
-    n.set("az_span", static_cast<float>(az_span));
-    n.set("el_lo", static_cast<float>(options_.elevation_min_deg * kDegree));
-    n.set("el_hi", static_cast<float>(options_.elevation_max_deg * kDegree));
+    setEye(n, o, ze);
+    setFieldOfView(n);
     n.set("pyramid", pyramid_);
     n.set("levels", levels_);
     n.set("top_level", top_);
