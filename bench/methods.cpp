@@ -51,22 +51,21 @@ cl::Buffer buildPyramid(detail::ContextState& st, cl::Program& program, const cl
     if (w == 1 && h == 1) break;
   }
   cl::Buffer pyramid = detail::deviceBuffer(st, total * sizeof(float));
-  cl::Kernel level(program, "pyramid_level");
+  detail::NamedKernel level(st, program, "pyramid_level");
   for (std::size_t l = 1; l < levels.size(); ++l) {
     const cl_int4 src = levels[l - 1], dst = levels[l];
-    level.setArg(0, l == 1 ? heights : pyramid);
-    level.setArg(1, static_cast<cl_uint>(l == 1 ? 0 : src.s[0]));
-    level.setArg(2, src.s[1]);
-    level.setArg(3, src.s[2]);
-    level.setArg(4, pyramid);
-    level.setArg(5, static_cast<cl_uint>(dst.s[0]));
-    level.setArg(6, dst.s[1]);
-    level.setArg(7, dst.s[2]);
-    level.setArg(8, l == 1 ? 2 : 1);
+    level.set("src", l == 1 ? heights : pyramid);
+    level.set("src_offset", static_cast<cl_uint>(l == 1 ? 0 : src.s[0]));
+    level.set("src_w", src.s[1]);
+    level.set("src_h", src.s[2]);
+    level.set("dst", pyramid);
+    level.set("dst_offset", static_cast<cl_uint>(dst.s[0]));
+    level.set("dst_w", dst.s[1]);
+    level.set("dst_h", dst.s[2]);
+    level.set("span", l == 1 ? 2 : 1);
     // A fixed local size: PoCL compiles a kernel once per local size it is launched with.
-    st.queue.enqueueNDRangeKernel(level, cl::NullRange,
-                                  cl::NDRange(detail::roundUp(dst.s[1], 8), detail::roundUp(dst.s[2], 8)),
-                                  cl::NDRange(8, 8));
+    st.launch(level, cl::NDRange(detail::roundUp(dst.s[1], 8), detail::roundUp(dst.s[2], 8)),
+              cl::NDRange(8, 8));
   }
   return pyramid;
 }
@@ -78,7 +77,7 @@ MethodOutput runBaseline(const ComputeContext& context, const HeightField& field
   return detail::translateOpenClErrors([&] {
     detail::ContextState& st = detail::stateOf(context);
     cl::Program program = st.program("horizon_baselines.cl", programOptions(spec));
-    const std::vector<float> prepared = preparedHeights(field);
+    const std::vector<float> prepared = detail::prepareHeights(field).heights;
     const std::size_t plane = field.pixelCount();
     cl::Buffer heights(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, plane * sizeof(float),
                        const_cast<float*>(prepared.data()));
@@ -96,7 +95,7 @@ MethodOutput runBaseline(const ComputeContext& context, const HeightField& field
     const char* name = spec.kind == MethodKind::Pyramid ? "pyramid_march"
                        : spec.kind == MethodKind::Floor ? "bandwidth_floor"
                                                         : "radius_march";
-    cl::Kernel kernel(program, name);
+    detail::NamedKernel kernel(st, program, name);
     // The marches run in the library's pixel tiles (their trip count is the tile's longest
     // ray); the floor has one work-item per 16 pixels of a row.
     const bool floor = spec.kind == MethodKind::Floor;
@@ -111,34 +110,33 @@ MethodOutput runBaseline(const ComputeContext& context, const HeightField& field
         cl::Buffer directions(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
                               count * sizeof(detail::SweepDirection),
                               const_cast<detail::SweepDirection*>(&all[first]));
-        kernel.setArg(0, heights);
-        kernel.setArg(1, field.width);
-        kernel.setArg(2, field.height);
-        kernel.setArg(3, directions);
-        kernel.setArg(4, count);
-        kernel.setArg(5, planes);
-        st.queue.enqueueNDRangeKernel(kernel, cl::NullRange, global, local);
+        kernel.set("heights", heights);
+        kernel.set("width", field.width);
+        kernel.set("height", field.height);
+        kernel.set("directions", directions);
+        kernel.set("batch_size", count);
+        kernel.set("angles", planes);
+        st.launch(kernel, global, local);
       } else {
         // One launch per direction, the geometry as arguments (see radius_march).
         for (int b = 0; b < count; ++b) {
           const detail::SweepDirection& d = all[first + b];
-          int arg = 0;
-          kernel.setArg(arg++, heights);
-          kernel.setArg(arg++, field.width);
-          kernel.setArg(arg++, field.height);
+          kernel.set("heights", heights);
+          kernel.set("width", field.width);
+          kernel.set("height", field.height);
           if (spec.kind == MethodKind::Pyramid) {
-            kernel.setArg(arg++, pyramid);
-            kernel.setArg(arg++, level_table);
-            kernel.setArg(arg++, static_cast<int>(levels.size()));
+            kernel.set("pyramid", pyramid);
+            kernel.set("levels", level_table);
+            kernel.set("level_count", static_cast<int>(levels.size()));
           }
-          kernel.setArg(arg++, d.dir_x);
-          kernel.setArg(arg++, d.dir_y);
-          kernel.setArg(arg++, d.step_length);
-          kernel.setArg(arg++, d.samples_per_unit);
-          kernel.setArg(arg++, d.ground_per_pixel);
-          kernel.setArg(arg++, planes);
-          kernel.setArg(arg++, static_cast<cl_uint>(b * plane));
-          st.queue.enqueueNDRangeKernel(kernel, cl::NullRange, global, local);
+          kernel.set("dir_x", d.dir_x);
+          kernel.set("dir_y", d.dir_y);
+          kernel.set("step_length", d.step_length);
+          kernel.set("samples_per_unit", d.samples_per_unit);
+          kernel.set("ground_per_pixel", d.ground_per_pixel);
+          kernel.set("angles", planes);
+          kernel.set("plane_offset", static_cast<cl_uint>(b * plane));
+          st.launch(kernel, global, local);
         }
       }
       if (spec.angles)

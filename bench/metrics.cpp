@@ -11,6 +11,7 @@
 
 #include "hfvis/errors.hpp"
 #include "core/lattice_geometry.hpp"
+#include "core/sweep_geometry.hpp"
 
 namespace hfvis::bench {
 namespace {
@@ -137,18 +138,6 @@ Timing timeRepeated(const std::function<void()>& run, const TimingPolicy& policy
   return timing;
 }
 
-std::vector<float> preparedHeights(const HeightField& field) {
-  double lowest = std::numeric_limits<double>::max();
-  for (float h : field.heights)
-    if (std::isfinite(h)) lowest = std::min(lowest, static_cast<double>(h));
-  std::vector<float> prepared(field.heights.size());
-  for (std::size_t i = 0; i < prepared.size(); ++i)
-    prepared[i] = std::isfinite(field.heights[i])
-                      ? static_cast<float>((static_cast<double>(field.heights[i]) - lowest) * field.z_scale)
-                      : std::numeric_limits<float>::quiet_NaN();
-  return prepared;
-}
-
 Normal surfaceNormal(const HeightField& field, int c, int r) {
   // The sum of the normals of the (up to) four quads around the pixel, as surface_normal
   // in kernels/horizon.cl, with heights times z_scale and lengths in ground units.
@@ -246,7 +235,7 @@ PlaneDifference planeDifference(const std::vector<float>& a, const std::vector<f
 }
 
 StackStats hullStackStatistics(const HeightField& field, int directions) {
-  const std::vector<float> heights = preparedHeights(field);
+  const std::vector<float> heights = detail::prepareHeights(field).heights;
   const int w = field.width, h = field.height;
   SweepOptions options;
   options.directions = directions;

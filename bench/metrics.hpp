@@ -33,9 +33,6 @@ struct Timing {
 // caller's business.
 Timing timeRepeated(const std::function<void()>& run, const TimingPolicy& policy);
 
-// Heights as the kernels see them: (h - lowest) * z_scale, as the library prepares them.
-std::vector<float> preparedHeights(const HeightField& field);
-
 // The library's formulas (kernels/horizon.cl surface_normal, ambient_term; svf = 1 - mean
 // sin(max(0, elevation))), in double, for one receiver from its K elevation angles, each
 // direction weighted 1/K (the library's weights when it computes the K angle planes).

@@ -30,7 +30,7 @@
 #include "environment.hpp"
 #include "hfvis/intervisibility.hpp"
 #include "hfvis_testing/synthetic_fields.hpp"
-#include "ops/intervisibility_internal.hpp"
+#include "core/hull_tree.hpp"
 #include "metrics.hpp"
 #include "suite_support.hpp"
 

@@ -2,7 +2,7 @@
 // include/hfvis/bounce.hpp states the formula), included by intervisibility.cl when
 // HFVIS_WANT_BOUNCE is set: the lattice sweep visits each receiver's visible samples, and
 // these helpers turn them into the receiver's irradiance. Mirrored by BounceGather in
-// src/ops/scalar_hull_tree.cpp.
+// src/core/scalar_hull_tree.cpp.
 //
 // For one receiver, the visible samples are visited farthest first (the runs of the
 // horizons, each from its horizon toward the receiver). A sample's elevation band reaches

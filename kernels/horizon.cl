@@ -39,6 +39,7 @@
 #include "environment_light.cl"
 #include "shared/fast_math.cl"
 #include "shared/sweep_framework.cl"
+#include "shared/surface_normal.cl"
 
 #ifndef HFVIS_WANT_ANGLES
 #define HFVIS_WANT_ANGLES 1
@@ -77,29 +78,15 @@
 #error "a maximum distance in strips needs one line per work-item (a window's blocks are per line)"
 #endif
 
-// The normal at pixel (c, r), the sum of the unnormalised normals of the (up to) four quads
-// around it (Timonen & Westerholm 2010, Sec. 7) in ground units, divided by its z: the normal
-// is (x, y, 1) / |(x, y, 1)|, and (x, y) its slopes. Quads touching nodata or the border are
-// left out; (0, 0) when none is left. `heights` holds the field's rows from row0 on.
+// The normal at pixel (c, r) (surface_normal_sum, shared/surface_normal.cl) divided by its z:
+// the normal is (x, y, 1) / |(x, y, 1)|, and (x, y) its slopes; (0, 0) when no quad is left.
+// `heights` holds the field's rows from row0 on.
 HFVIS_INLINE float2 surface_slopes(__global const float* heights, int width, int height, int row0, int c, int r,
                                    float h, float cell_x, float cell_y) {
-  // Straight-line scalar code (clamped reads, masked sums) so that PoCL vectorises callers.
-  float sx_sum = 0.0f, sy_sum = 0.0f, sz_sum = 0.0f;
-  for (int q = 0; q < 4; ++q) {
-    int sx = (q & 1) ? 1 : -1, sy = (q & 2) ? 1 : -1;
-    int cx = c + sx, ry = r + sy;
-    int inside = cx >= 0 && cx < width && ry >= 0 && ry < height;
-    float hx = heights[(r - row0) * width + clamp(cx, 0, width - 1)];
-    float hy = heights[(clamp(ry, 0, height - 1) - row0) * width + c];
-    float gx = (hx - h) / ((float)sx * cell_x);
-    float gy = (hy - h) / ((float)sy * cell_y);
-    int use = inside && !isnan(hx) && !isnan(hy);
-    sx_sum += use ? -gx : 0.0f;
-    sy_sum += use ? -gy : 0.0f;
-    sz_sum += use ? 1.0f : 0.0f;
-  }
-  int any = sz_sum > 0.0f;
-  return (float2)(any ? sx_sum / sz_sum : 0.0f, any ? sy_sum / sz_sum : 0.0f);
+  float sum[3];
+  surface_normal_sum(heights, width, height, row0, c, r, h, cell_x, cell_y, sum);
+  int any = sum[2] > 0.0f;
+  return (float2)(any ? sum[0] / sum[2] : 0.0f, any ? sum[1] / sum[2] : 0.0f);
 }
 
 // Every pixel's normal as its slopes (surface_slopes), 8 bytes per pixel, for ambient

@@ -298,7 +298,7 @@ typedef struct {
   int zone_valid, zone_first, zone_last;
   float h_prev, h_prev2, p_prev, p_prev2, tail_h, zone_z1, zone_z2, zone_margin;
 } TreeLineState;
-// The host allocates kTreeLineStateBytes (src/ops/intervisibility_device.hpp) per line.
+// The host allocates kTreeLineStateBytes (src/core/hull_tree_device.hpp) per line.
 typedef char tree_line_state_is_136_bytes[sizeof(TreeLineState) == 136 ? 1 : -1];
 // The registers saved and restored, X(register, its TreeLineState field), those of per-row
 // spacing and of the safe zone where compiled in.

@@ -1,6 +1,6 @@
 // bounce_reference.cpp: the scalar reference of the one-bounce gather: the lattice lines
 // and their exit radiance sampled as intervisibility_lattice samples them, the gather inside
-// the hull-tree sweep (src/ops/scalar_hull_tree.cpp), and each receiver's irradiance added to
+// the hull-tree sweep (src/core/scalar_hull_tree.cpp), and each receiver's irradiance added to
 // its pixel.
 #include "hfvis_testing/bounce_reference.hpp"
 

@@ -13,6 +13,7 @@
 #include "hfvis_testing/horizon_reference.hpp"
 #include "core/horizon_common.hpp"
 #include "core/lattice_geometry.hpp"
+#include "core/surface_normal.hpp"
 #include "reference_internal.hpp"
 
 namespace hfvis {
@@ -28,20 +29,10 @@ struct Slopes {
 
 Slopes surfaceSlopes(const std::vector<float>& h, int width, int height, int c, int r, float hp, float cell_x,
                      float cell_y) {
-  float nx = 0.0f, ny = 0.0f, nz = 0.0f;
-  for (int sy = -1; sy <= 1; sy += 2) {
-    for (int sx = -1; sx <= 1; sx += 2) {
-      const int cx = c + sx, ry = r + sy;
-      if (cx < 0 || cx >= width || ry < 0 || ry >= height) continue;
-      const float hx = h[r * width + cx], hy = h[ry * width + c];
-      if (std::isnan(hx) || std::isnan(hy)) continue;
-      const float gx = (hx - hp) / (static_cast<float>(sx) * cell_x);
-      const float gy = (hy - hp) / (static_cast<float>(sy) * cell_y);
-      nx += -gx, ny += -gy, nz += 1.0f;
-    }
-  }
-  if (!(nz > 0.0f)) return {};
-  return {nx / nz, ny / nz};
+  float sum[3];
+  surface_normal_sum(h.data(), width, height, 0, c, r, hp, cell_x, cell_y, sum);
+  if (!(sum[2] > 0.0f)) return {};
+  return {sum[0] / sum[2], sum[1] / sum[2]};
 }
 
 // Every pixel's normal, as the kernels compute it (only needed for ambient occlusion), with

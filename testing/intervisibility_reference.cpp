@@ -1,6 +1,6 @@
 // intervisibility_reference.cpp: the scalar reference of the intervisibility operation:
 // the lattice lines sampled as the kernel samples them, the hull tree sweep
-// (src/ops/scalar_hull_tree.cpp, the mirror of the kernel's), each receiver's results added to
+// (src/core/scalar_hull_tree.cpp, the mirror of the kernel's), each receiver's results added to
 // its pixel, and the naive visibility march, in the kernels' order, so every per-sample
 // result matches exactly.
 #include "hfvis_testing/intervisibility_reference.hpp"
@@ -12,7 +12,7 @@
 #include "core/chord_side.hpp"
 #include "hfvis/errors.hpp"
 #include "core/horizon_common.hpp"
-#include "ops/intervisibility_internal.hpp"
+#include "core/hull_tree.hpp"
 #include "reference_internal.hpp"
 
 namespace hfvis {

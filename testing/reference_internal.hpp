@@ -6,7 +6,7 @@
 
 #include "hfvis/height_field.hpp"
 #include "core/horizon_common.hpp"
-#include "ops/intervisibility_internal.hpp"
+#include "core/hull_tree.hpp"
 #include "core/lattice_geometry.hpp"
 
 namespace hfvis::detail {

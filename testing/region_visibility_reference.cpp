@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/sweep_geometry.hpp"
 #include "ops/region_sight.hpp"
 
 namespace hfvis {
@@ -43,7 +44,7 @@ RegionVisibilityResult referenceRegionVisibility(const HeightField& field, const
   validate(field);
   validate(options);
   const std::vector<float> table = detail::regionSampleTable(field, sources);
-  const std::vector<float> heights = detail::regionHeights(field);
+  const std::vector<float> heights = detail::prepareHeights(field, detail::HeightOrigin::Zero).heights;
   RegionVisibilityResult out;
   out.width = field.width;
   out.height = field.height;
@@ -73,7 +74,7 @@ RegionPairVisibilityResult referenceRegionPairVisibility(const HeightField& fiel
   validate(options);
   const std::vector<float> source_table = detail::regionSampleTable(field, sources);
   const std::vector<float> receiver_table = detail::regionSampleTable(field, receivers);
-  const std::vector<float> heights = detail::regionHeights(field);
+  const std::vector<float> heights = detail::prepareHeights(field, detail::HeightOrigin::Zero).heights;
   RegionPairVisibilityResult out;
   out.source_samples = detail::regionTableSamples(source_table);
   out.receiver_samples = detail::regionTableSamples(receiver_table);
@@ -82,24 +83,14 @@ RegionPairVisibilityResult referenceRegionPairVisibility(const HeightField& fiel
   out.receivers = regionSamplePoints(field, receivers, options.seed);
   out.bits.assign(std::size_t(out.receiver_samples) * out.words, 0u);
   const Pairs pairs{field, heights, options, source_table, sources.absolute};
-  out.pairs = std::uint64_t(out.source_samples) * out.receiver_samples;
-  out.source_fraction.assign(out.source_samples, 0.0f);
-  out.receiver_fraction.assign(out.receiver_samples, 0.0f);
-  std::vector<int> seen_by(out.source_samples, 0);
   for (int r = 0; r < out.receiver_samples; ++r) {
     float x, y, z;
     detail::region_sample(receiver_table.data(), heights.data(), field.width, field.height,
                           receivers.absolute, options.seed, 0u, r, &x, &y, &z);
     pairs.receiverBits(x, y, z, options.decorrelate ? unsigned(r) + 1u : 0u,
                        &out.bits[std::size_t(r) * out.words]);
-    int seen = 0;
-    for (int s = 0; s < out.source_samples; ++s)
-      if (out.visible(r, s)) ++seen, ++seen_by[s];
-    out.clear_pairs += seen;
-    out.receiver_fraction[r] = static_cast<float>(static_cast<double>(seen) / out.source_samples);
   }
-  for (int s = 0; s < out.source_samples; ++s)
-    out.source_fraction[s] = static_cast<float>(static_cast<double>(seen_by[s]) / out.receiver_samples);
+  detail::countPairFractions(out);  // the bits are what the reference decides; the counts are arithmetic
   return out;
 }
 

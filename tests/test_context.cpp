@@ -9,6 +9,8 @@
 #include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
 #include "hfvis_testing/synthetic_fields.hpp"
+#include "core/opencl_context.hpp"
+#include "core/sweep_framework.hpp"
 #include "test_support.hpp"
 
 namespace hfvis {
@@ -108,6 +110,35 @@ TEST(ComputeContext, UnknownDeviceListsTheDevices) {
     EXPECT_NE(std::string(error.what()).find(testing::testContext().device().name), std::string::npos)
         << error.what();
   }
+}
+
+// Kernel arguments go by the names the kernel source gives them: a name the kernel lacks, and a
+// launch with an argument unset, are errors that name it (rather than a device error, or a
+// kernel reading whatever the slot held).
+TEST(NamedKernel, NamesAnUnknownOrUnsetArgument) {
+  detail::ContextState& st = detail::stateOf(testing::testContext());
+  const cl::Program program = st.program("insolation.cl", "");
+  detail::NamedKernel kernel(st, program, "insolation_add");
+  EXPECT_TRUE(kernel.has("sun_hours"));
+  EXPECT_FALSE(kernel.has("sunshine"));
+  try {
+    kernel.set("sunshine", 1.0f);
+    FAIL() << "an argument the kernel lacks was set";
+  } catch (const Error& error) {
+    EXPECT_NE(std::string(error.what()).find("'sunshine'"), std::string::npos) << error.what();
+  }
+  const cl::Buffer buffer = detail::deviceBuffer(st, 4 * sizeof(float));
+  kernel.set("horizon", buffer).set("normals", buffer).set("pixels", cl_uint(1)).set("steps", buffer);
+  kernel.set("hours", buffer).set("n_steps", 0).set("radius", 0.1f).set("direct", buffer);
+  try {
+    st.launch(kernel, cl::NDRange(1), cl::NDRange(1));
+    FAIL() << "a launch with an argument unset";
+  } catch (const Error& error) {
+    EXPECT_NE(std::string(error.what()).find("'sun_hours'"), std::string::npos) << error.what();
+  }
+  kernel.set("sun_hours", buffer);
+  EXPECT_NO_THROW(st.launch(kernel, cl::NDRange(1), cl::NDRange(1)));
+  st.queue.finish();
 }
 
 }  // namespace

@@ -23,7 +23,7 @@
 #include "hfvis_testing/intervisibility_reference.hpp"
 #include "hfvis_testing/synthetic_fields.hpp"
 #include "core/horizon_common.hpp"
-#include "ops/intervisibility_internal.hpp"
+#include "core/hull_tree.hpp"
 #include "core/lattice_geometry.hpp"
 #include "reference_internal.hpp"
 #include "test_support.hpp"

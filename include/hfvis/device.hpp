@@ -27,13 +27,6 @@ struct DeviceInfo {
 // Every device of every platform. Throws NoDeviceError when no platform is installed.
 std::vector<DeviceInfo> listDevices();
 
-class ComputeContext;
-namespace detail {
-struct ContextState;
-// The library's access to a context's OpenCL state (src/core/opencl_context.hpp defines the type).
-ContextState& stateOf(const ComputeContext& context);
-}  // namespace detail
-
 // How the sweep kernels lay out their per-line scratch (hull stacks, tree nodes).
 enum class LineLayout {
   Automatic,  // line-major on CPUs (and the horizon sweep in SIMD lanes), step-major elsewhere
@@ -77,9 +70,12 @@ class ComputeContext {
   const ContextOptions& options() const;
 
  private:
-  friend detail::ContextState& detail::stateOf(const ComputeContext& context);
+  // The OpenCL state, opaque here: the library defines it and reaches it through
+  // ContextAccess (src/core/opencl_context.hpp).
+  struct State;
+  friend class ContextAccess;
   ComputeContext() = default;
-  std::shared_ptr<detail::ContextState> state_;
+  std::shared_ptr<State> state_;
 };
 
 }  // namespace hfvis

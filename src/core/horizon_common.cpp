@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/fast_math.hpp"
+#include "core/surface_normal.hpp"
 #include "hfvis/errors.hpp"
 
 namespace hfvis {
@@ -108,25 +109,15 @@ std::vector<LatticeDirection> horizonDirections(const HeightField& field, const 
 
 void pixelNormal(const std::vector<float>& h, int width, int height, int c, int r, float cell_x, float cell_y,
                  float* n) {
-  const float hp = h[static_cast<std::size_t>(r) * width + c];
-  float sx_sum = 0.0f, sy_sum = 0.0f, sz_sum = 0.0f;
-  for (int q = 0; q < 4; ++q) {
-    const int sx = (q & 1) ? 1 : -1, sy = (q & 2) ? 1 : -1;
-    const int cx = c + sx, ry = r + sy;
-    if (cx < 0 || cx >= width || ry < 0 || ry >= height) continue;
-    const float hx = h[static_cast<std::size_t>(r) * width + cx],
-                hy = h[static_cast<std::size_t>(ry) * width + c];
-    if (std::isnan(hx) || std::isnan(hy)) continue;
-    sx_sum += -(hx - hp) / (static_cast<float>(sx) * cell_x);
-    sy_sum += -(hy - hp) / (static_cast<float>(sy) * cell_y);
-    sz_sum += 1.0f;
-  }
-  if (!(sz_sum > 0.0f)) {
+  float sum[3];
+  surface_normal_sum(h.data(), width, height, 0, c, r, h[static_cast<std::size_t>(r) * width + c], cell_x,
+                     cell_y, sum);
+  if (!(sum[2] > 0.0f)) {
     n[0] = 0.0f, n[1] = 0.0f, n[2] = 1.0f;
     return;
   }
-  const float length = std::sqrt(sx_sum * sx_sum + sy_sum * sy_sum + sz_sum * sz_sum);
-  n[0] = sx_sum / length, n[1] = sy_sum / length, n[2] = sz_sum / length;
+  const float length = std::sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
+  n[0] = sum[0] / length, n[1] = sum[1] / length, n[2] = sum[2] / length;
 }
 
 float swathFactor(float weight) { return hfSin(kPiF * weight) / kPiF; }

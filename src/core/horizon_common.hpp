@@ -19,10 +19,9 @@ bool exactAzimuths(const HorizonOutputs& outputs);
 std::vector<LatticeDirection> horizonDirections(const HeightField& field, const HorizonOptions& options,
                                                 const HorizonOutputs& outputs);
 
-// The unit normal (x along +column, y along +row, z up) of the (up to) four quads around
-// pixel (c, r) of prepared heights h, in ground units; quads touching nodata or the border are
-// left out, (0, 0, 1) when none is left. The same normal as ambient occlusion's
-// (surface_slopes in kernels/horizon.cl).
+// The unit normal (x along +column, y along +row, z up) at pixel (c, r) of prepared heights h:
+// surface_normal_sum (kernels/shared/surface_normal.cl, ambient occlusion's normal) normalised;
+// (0, 0, 1) when no quad is left.
 void pixelNormal(const std::vector<float>& h, int width, int height, int c, int r, float cell_x, float cell_y,
                  float* n);
 

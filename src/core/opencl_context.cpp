@@ -205,7 +205,7 @@ std::string kernelSource(const std::string& file, const std::string& kernel_dir,
 cl::Program ContextState::program(const std::string& file, const std::string& defines) {
   std::string include_dir;
   const std::string source = kernelSource(file, options.kernel_dir, &include_dir);
-  std::string build_options = "-cl-std=CL1.2 " + defines;
+  std::string build_options = "-cl-std=CL1.2 -cl-kernel-arg-info " + defines;
   if (info.correctly_rounded_divide) build_options += " -cl-fp32-correctly-rounded-divide-sqrt";
   if (!include_dir.empty()) build_options += " -I " + include_dir;
   const std::string key = file + '\n' + build_options + '\n' + source;
@@ -227,18 +227,35 @@ cl::Program ContextState::program(const std::string& file, const std::string& de
   return program;
 }
 
-void ContextState::launch(const cl::Kernel& kernel, const cl::NDRange& global, const cl::NDRange& local) {
+std::shared_ptr<const NamedKernel::Names> ContextState::argumentNames(const cl::Program& program,
+                                                                      const cl::Kernel& kernel,
+                                                                      const std::string& name) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto& entry = argument_names_[{program(), name}];
+  if (!entry) {
+    auto names = std::make_shared<NamedKernel::Names>();
+    names->kernel = name;
+    const cl_uint count = kernel.getInfo<CL_KERNEL_NUM_ARGS>();
+    for (cl_uint i = 0; i < count; ++i)
+      names->arguments.push_back(trim(kernel.getArgInfo<CL_KERNEL_ARG_NAME>(i)));
+    entry = std::move(names);
+  }
+  return entry;
+}
+
+void ContextState::launch(const NamedKernel& kernel, const cl::NDRange& global, const cl::NDRange& local) {
+  const cl::Kernel& ready = kernel.ready();
   if (!options.profile) {
-    queue.enqueueNDRangeKernel(kernel, cl::NullRange, global, local);
+    queue.enqueueNDRangeKernel(ready, cl::NullRange, global, local);
     return;
   }
   cl::Event event;
-  queue.enqueueNDRangeKernel(kernel, cl::NullRange, global, local, nullptr, &event);
+  queue.enqueueNDRangeKernel(ready, cl::NullRange, global, local, nullptr, &event);
   event.wait();
   const double seconds = (event.getProfilingInfo<CL_PROFILING_COMMAND_END>() -
                           event.getProfilingInfo<CL_PROFILING_COMMAND_START>()) *
                          1e-9;
-  auto& entry = kernel_seconds[kernel.getInfo<CL_KERNEL_FUNCTION_NAME>()];
+  auto& entry = kernel_seconds[kernel.name()];
   entry.first += seconds;
   entry.second += 1;
 }
@@ -297,7 +314,7 @@ ComputeContext ComputeContext::create(const ContextOptions& options) {
   const auto devices = detail::findDevices();
   const auto& found = detail::selectDevice(devices, options.device);
   ComputeContext context;
-  context.state_ = std::make_shared<detail::ContextState>();
+  context.state_ = std::make_shared<State>();
   context.state_->options = options;
   detail::translateOpenClErrors([&] {
     context.state_->info = found.info;
@@ -311,8 +328,6 @@ ComputeContext ComputeContext::create(const ContextOptions& options) {
 }
 
 const DeviceInfo& ComputeContext::device() const { return state_->info; }
-
-detail::ContextState& detail::stateOf(const ComputeContext& context) { return *context.state_; }
 
 const ContextOptions& ComputeContext::options() const { return state_->options; }
 

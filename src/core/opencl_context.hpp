@@ -4,12 +4,14 @@
 
 #include <CL/opencl.hpp>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <utility>
 
 #include "hfvis/device.hpp"
 #include "hfvis/errors.hpp"
+#include "core/kernel_args.hpp"
 
 namespace hfvis::detail {
 
@@ -22,13 +24,18 @@ struct ContextState {
 
   // The program built from kernels/<file> with `defines` (e.g. "-DHFVIS_WANT_AO=1"),
   // built once per (device, options, source) and cached. Throws KernelBuildError with the
-  // device's build log.
+  // device's build log. Built with -cl-kernel-arg-info, for NamedKernel.
   cl::Program program(const std::string& file, const std::string& defines);
 
-  // Enqueues `kernel`. With options.profile (queue created with profiling), waits for it
-  // and adds its device time to kernel_seconds, which is printed to stderr when the context
-  // is destroyed: per-kernel statistics of a run.
-  void launch(const cl::Kernel& kernel, const cl::NDRange& global, const cl::NDRange& local);
+  // The argument names of `kernel`, kernel `name` of `program`: read once per program and
+  // kernel (a cached program lives as long as the context, so its handle identifies it).
+  std::shared_ptr<const NamedKernel::Names> argumentNames(const cl::Program& program,
+                                                          const cl::Kernel& kernel, const std::string& name);
+
+  // Enqueues `kernel` (throws Error naming an argument not set). With options.profile (queue
+  // created with profiling), waits for it and adds its device time to kernel_seconds, which
+  // is printed to stderr when the context is destroyed: per-kernel statistics of a run.
+  void launch(const NamedKernel& kernel, const cl::NDRange& global, const cl::NDRange& local);
 
   // A device buffer of at least `bytes` (at most twice that) for `role` ("lattice
   // stacks", ...), kept between calls: large scratch buffers are allocated (and, on CPUs,
@@ -42,6 +49,7 @@ struct ContextState {
  private:
   std::mutex mutex_;
   std::map<std::string, cl::Program> programs_;
+  std::map<std::pair<cl_program, std::string>, std::shared_ptr<const NamedKernel::Names>> argument_names_;
   std::map<std::string, std::pair<cl::Buffer, std::size_t>> buffers_;
 };
 
@@ -60,3 +68,20 @@ auto translateOpenClErrors(Body&& body) -> decltype(body()) {
 }
 
 }  // namespace hfvis::detail
+
+namespace hfvis {
+
+// A context's opaque state (include/hfvis/device.hpp) is the library's ContextState.
+struct ComputeContext::State : detail::ContextState {};
+
+// The library's access to a context's OpenCL state, kept out of the public header.
+class ContextAccess {
+ public:
+  static detail::ContextState& state(const ComputeContext& context) { return *context.state_; }
+};
+
+namespace detail {
+inline ContextState& stateOf(const ComputeContext& context) { return ContextAccess::state(context); }
+}  // namespace detail
+
+}  // namespace hfvis

@@ -31,8 +31,8 @@ bool lineMajorLayout(const ContextState& st) {
   return st.info.type == "CPU";
 }
 
-
-std::size_t defaultMemoryBudget(const DeviceInfo& device) {
+std::size_t memoryBudget(std::size_t budget_bytes, const DeviceInfo& device) {
+  if (budget_bytes) return budget_bytes;
   // A CPU device's memory is the host's: PoCL reports a fraction of it as its global memory
   // (4.8 to 6.2 GiB on the 24 GB test machine) and allocates from the host beyond that, so the
   // budget is half the host's physical memory (its largest single buffer still applies).
@@ -65,17 +65,18 @@ cl::Buffer uploadDirections(ContextState& st, const std::vector<SweepDirection>&
                     const_cast<SweepDirection*>(directions.data()));
 }
 
-void launchLineChunks(ContextState& st, cl::Kernel& kernel, std::vector<LatticeLine> lines,
-                      std::size_t samples_per_period, std::size_t scratch_entries, const LineChunkArguments& at,
-                      int lanes, std::size_t group) {
+void launchLineChunks(ContextState& st, NamedKernel& kernel, std::vector<LatticeLine> lines,
+                      std::size_t samples_per_period, std::size_t scratch_entries, int lanes,
+                      std::size_t group) {
   if (lines.empty()) return;
+  const bool first_line = kernel.has("first_line");
   for (const LineChunk& chunk : chunkLines(lines, samples_per_period, scratch_entries, lineMajorLayout(st))) {
     const cl::Buffer chunk_lines(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
                                  chunk.count * sizeof(LatticeLine), lines.data() + chunk.first);
-    kernel.setArg(at.lines, chunk_lines);
-    kernel.setArg(at.count, static_cast<int>(chunk.count));
-    kernel.setArg(at.stride, static_cast<cl_uint>(chunk.stride));
-    if (at.first_line >= 0) kernel.setArg(at.first_line, static_cast<int>(chunk.first));
+    kernel.set("lines", chunk_lines);
+    kernel.set("n_lines", static_cast<int>(chunk.count));
+    kernel.set("stride", static_cast<cl_uint>(chunk.stride));
+    if (first_line) kernel.set("first_line", static_cast<int>(chunk.first));
     const std::size_t items = (chunk.count + lanes - 1) / lanes;
     st.launch(kernel, cl::NDRange(roundUp(items, group)), cl::NDRange(group));
   }

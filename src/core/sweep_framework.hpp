@@ -29,9 +29,10 @@ bool lineMajorLayout(const ContextState& st);
 // step-major layout, whose neighbouring work-items read neighbouring entries.
 int simdLanes(const ContextState& st);
 
-// The budget when the caller gives none: half the device memory (for a CPU device, whose
-// memory is the host's, half the host's physical memory).
-std::size_t defaultMemoryBudget(const DeviceInfo& device);
+// The device memory an operation may plan with: the caller's `budget_bytes`, or when that is 0
+// half the device memory (for a CPU device, whose memory is the host's, half the host's
+// physical memory).
+std::size_t memoryBudget(std::size_t budget_bytes, const DeviceInfo& device);
 
 // Half the host's physical memory (or of its cgroup's limit, where lower); 0 when unknown.
 std::size_t hostMemoryBudget();
@@ -43,19 +44,13 @@ cl::Buffer deviceBuffer(ContextState& st, std::size_t bytes);
 
 cl::Buffer uploadDirections(ContextState& st, const std::vector<SweepDirection>& directions);
 
-// Where a lattice sweep kernel takes its chunk of lines: argument indices of the line table,
-// the chunk's line count, the scratch stride and (if >= 0) the chunk's first line.
-struct LineChunkArguments {
-  int lines = 0, count = 0, stride = 0, first_line = -1;
-};
-
 // Runs a lattice sweep kernel (its other arguments set) over the lines of one direction, in
 // chunks whose scratch fits `scratch_entries` (chunkLines, in the context's layout): per
-// chunk it sets a copy of the chunk's line table (sub-buffer offsets must be aligned on some
-// devices), the count, stride and first line, and launches ceil(count / lanes) work-items in
-// groups of `group`.
-void launchLineChunks(ContextState& st, cl::Kernel& kernel, std::vector<LatticeLine> lines,
-                      std::size_t samples_per_period, std::size_t scratch_entries, const LineChunkArguments& at,
-                      int lanes, std::size_t group);
+// chunk it sets the kernel's arguments `lines` (a copy of the chunk's line table: sub-buffer
+// offsets must be aligned on some devices), `n_lines`, `stride` and, where the kernel takes
+// it, `first_line`, and launches ceil(count / lanes) work-items in groups of `group`.
+void launchLineChunks(ContextState& st, NamedKernel& kernel, std::vector<LatticeLine> lines,
+                      std::size_t samples_per_period, std::size_t scratch_entries, int lanes,
+                      std::size_t group);
 
 }  // namespace hfvis::detail

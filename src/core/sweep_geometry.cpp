@@ -81,7 +81,7 @@ float sampleHeight(const std::vector<float>& heights, int width, int height, Poi
   return w00 * h00 + w10 * h10 + w01 * h01 + w11 * h11;
 }
 
-PreparedHeights prepareHeights(const HeightField& field) {
+PreparedHeights prepareHeights(const HeightField& field, HeightOrigin origin) {
   double lowest = std::numeric_limits<double>::max(), highest = std::numeric_limits<double>::lowest();
   for (float h : field.heights) {
     if (std::isfinite(h)) {
@@ -90,19 +90,21 @@ PreparedHeights prepareHeights(const HeightField& field) {
     }
   }
   // The kernels multiply height differences by distances in float: keep the products finite.
-  if (highest >= lowest && (highest - lowest) * field.z_scale > kMaxPreparedHeight) {
+  if (origin == HeightOrigin::Lowest && highest >= lowest &&
+      (highest - lowest) * field.z_scale > kMaxPreparedHeight) {
     std::ostringstream message;
     message << "the heights span " << lowest << " .. " << highest << ", a rise of "
             << (highest - lowest) * field.z_scale << " with the z-scale " << field.z_scale
             << ": more than the " << kMaxPreparedHeight << " the kernels' float arithmetic holds";
     throw InvalidArgument(message.str());
   }
+  const double base = origin == HeightOrigin::Lowest ? lowest : 0.0;  // h - 0.0 is h exactly
   PreparedHeights prepared;
   prepared.heights.resize(field.heights.size());
   for (std::size_t i = 0; i < field.heights.size(); ++i) {
     const float h = field.heights[i];
     if (std::isfinite(h)) {
-      prepared.heights[i] = static_cast<float>((static_cast<double>(h) - lowest) * field.z_scale);
+      prepared.heights[i] = static_cast<float>((static_cast<double>(h) - base) * field.z_scale);
     } else {
       prepared.heights[i] = std::numeric_limits<float>::quiet_NaN();
       prepared.has_nodata = true;

@@ -57,13 +57,15 @@ float sampleHeight(const std::vector<float>& heights, int width, int height, Poi
 // a plane at 8848 m keeps its millimetres; every non-finite height becomes NaN. Throws
 // InvalidArgument when a prepared height would exceed kMaxPreparedHeight: the kernels
 // multiply height differences by distances (up to 2^31 pixels) in float, which must stay
-// finite.
+// finite. HeightOrigin::Zero keeps the heights where they are (h * z_scale, unchecked): the
+// viewshed, whose observers and targets may stand at absolute heights.
 constexpr double kMaxPreparedHeight = 1e28;
 struct PreparedHeights {
   std::vector<float> heights;
   bool has_nodata = false;
 };
-PreparedHeights prepareHeights(const HeightField& field);
+enum class HeightOrigin { Lowest, Zero };
+PreparedHeights prepareHeights(const HeightField& field, HeightOrigin origin = HeightOrigin::Lowest);
 
 // The kernels index pixels with 32-bit arithmetic: signed within a plane, unsigned across the
 // `planes` planes of one buffer. Throws InvalidArgument for fields beyond that.

@@ -6,7 +6,7 @@
 
 #include "ops/bounce_internal.hpp"
 #include "hfvis/errors.hpp"
-#include "ops/intervisibility_device.hpp"
+#include "core/hull_tree_device.hpp"
 #include "core/opencl_context.hpp"
 #include "core/sweep_framework.hpp"
 

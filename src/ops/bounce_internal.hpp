@@ -6,20 +6,11 @@
 #include <vector>
 
 #include "hfvis/bounce.hpp"
-#include "ops/intervisibility_internal.hpp"
+#include "core/hull_tree.hpp"
 
 namespace hfvis::detail {
 
-// The inputs as both paths see them: prepared heights (see prepareHeights), the unit
-// normals of the four quads around each pixel (ambient occlusion's, in ground units) as
-// three planes x, y, z, and the radiance planes; normals and radiance NaN at nodata pixels.
-struct BounceInputs {
-  std::vector<float> heights;
-  bool has_nodata = false;
-  std::vector<std::vector<float>> normals;   // 3 planes
-  std::vector<std::vector<float>> radiance;  // 1..4 planes
-  int channels() const { return static_cast<int>(radiance.size()); }
-};
+// The inputs as both paths see them (BounceInputs in core/hull_tree.hpp).
 BounceInputs prepareBounce(const HeightField& field, const ExitRadiance& radiance);
 
 // One direction's sweep and gather: `lines` as the intervisibility line view (samples,

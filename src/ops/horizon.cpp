@@ -134,8 +134,7 @@ RunPlan planStrips(const HeightField& field, const HorizonOptions& options, cons
 RunPlan planRun(const HeightField& field, const HorizonOptions& options, const HorizonOutputs& outputs,
                 const std::vector<RunDirection>& directions, const DeviceInfo& device) {
   const bool sweep = options.method == HorizonMethod::Sweep;
-  const std::size_t budget =
-      options.memory_budget_bytes ? options.memory_budget_bytes : defaultMemoryBudget(device);
+  const std::size_t budget = memoryBudget(options.memory_budget_bytes, device);
   const std::size_t max_alloc = device.max_allocation_bytes ? device.max_allocation_bytes : budget;
   const std::size_t plane = field.pixelCount() * sizeof(float);
   // Heights, the sums, the normals' two slopes, the window's float2 per pixel (and with per-row
@@ -328,16 +327,16 @@ class HorizonRoutine : public SweepRoutine {
     const cl::Buffer bins = upload(swaths.bins.data(), swaths.bins.size() * sizeof(swaths.bins[0]));
     const cl::Buffer spans = upload(swaths.spans.data(), swaths.spans.size() * sizeof(swaths.spans[0]));
     cl::Buffer tables = deviceBuffer(st_, table_bytes);
-    cl::Kernel kernel(program_, "environment_tables");
-    kernel.setArg(0, env);
-    kernel.setArg(1, map.width);
-    kernel.setArg(2, map.height);
-    kernel.setArg(3, map.channels);
-    kernel.setArg(4, tableRows(map));
-    kernel.setArg(5, static_cast<int>(directions_.size()));
-    kernel.setArg(6, bins);
-    kernel.setArg(7, spans);
-    kernel.setArg(8, tables);
+    NamedKernel kernel(st_, program_, "environment_tables");
+    kernel.set("env", env);
+    kernel.set("env_width", map.width);
+    kernel.set("env_height", map.height);
+    kernel.set("channels", map.channels);
+    kernel.set("rows", tableRows(map));
+    kernel.set("directions", static_cast<int>(directions_.size()));
+    kernel.set("bins", bins);
+    kernel.set("spans", spans);
+    kernel.set("tables", tables);
     st_.launch(kernel, cl::NDRange(roundUp(directions_.size(), kLineGroup)), cl::NDRange(kLineGroup));
     st_.queue.finish();  // before the map, bins and spans go
     return tables;
@@ -405,12 +404,12 @@ class HorizonRoutine : public SweepRoutine {
   void scaleByNormals(int rows) {
     const std::size_t pixels = static_cast<std::size_t>(rows) * field_.width;
     auto scale = [&](const cl::Buffer& sums, int planes) {
-      cl::Kernel kernel(program_, "occlusion_scale");
-      kernel.setArg(0, normals_);
-      kernel.setArg(1, static_cast<cl_uint>(pixels));
-      kernel.setArg(2, planes);
-      kernel.setArg(3, sumStride());
-      kernel.setArg(4, sums);
+      NamedKernel kernel(st_, program_, "occlusion_scale");
+      kernel.set("normals", normals_);
+      kernel.set("pixels", static_cast<cl_uint>(pixels));
+      kernel.set("planes", planes);
+      kernel.set("stride", sumStride());
+      kernel.set("sums", sums);
       st_.launch(kernel, cl::NDRange(roundUp(pixels, kLineGroup)), cl::NDRange(kLineGroup));
     };
     if (outputs_.ambient_occlusion) scale(ao_, 1);
@@ -436,17 +435,17 @@ class HorizonRoutine : public SweepRoutine {
 
   // The normals of rows [s0, s1) from heights_, which holds the field's rows from row0 on.
   void computeNormals(int row0, int s0, int s1) {
-    cl::Kernel normals(program_, "pixel_normals");
-    normals.setArg(0, heights_);
-    normals.setArg(1, field_.width);
-    normals.setArg(2, field_.height);
-    normals.setArg(3, row0);
-    normals.setArg(4, s0);
-    normals.setArg(5, s1 - s0);
-    normals.setArg(6, static_cast<float>(field_.cell_size_x));
-    normals.setArg(7, static_cast<float>(field_.cell_size_y));
-    normals.setArg(8, row_cells_);
-    normals.setArg(9, normals_);
+    NamedKernel normals(st_, program_, "pixel_normals");
+    normals.set("heights", heights_);
+    normals.set("width", field_.width);
+    normals.set("height", field_.height);
+    normals.set("row0", row0);
+    normals.set("out_row0", s0);
+    normals.set("rows", s1 - s0);
+    normals.set("cell_x", static_cast<float>(field_.cell_size_x));
+    normals.set("cell_y", static_cast<float>(field_.cell_size_y));
+    normals.set("row_cells", row_cells_);
+    normals.set("normals", normals_);
     st_.launch(normals, cl::NDRange(roundUp(field_.width, kTileX), roundUp(s1 - s0, kTileY)),
                cl::NDRange(kTileX, kTileY));
   }
@@ -500,77 +499,72 @@ class HorizonRoutine : public SweepRoutine {
   double positionUnit(double ground_per_pixel) const { return hasRowSpacing(field_) ? 1.0 : ground_per_pixel; }
 
   // The per-row tables of a direction (placeholders without per-row spacing), set as the
-  // kernel's arguments `arg` and `arg + 1`; the caller keeps them until the launch.
-  std::array<cl::Buffer, 2> setRowTables(cl::Kernel& kernel, int arg, const RunDirection& d) {
+  // kernel's row_length and row_terms; the caller keeps them until the launch.
+  std::array<cl::Buffer, 2> setRowTables(NamedKernel& kernel, const RunDirection& d) {
     auto table = [&](const std::vector<float>& values) {
       if (values.empty()) return deviceBuffer(st_, 0);
       return cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, values.size() * sizeof(float),
                         const_cast<float*>(values.data()));
     };
     std::array<cl::Buffer, 2> tables{table(d.row_length), table(d.row_terms)};
-    kernel.setArg(arg, tables[0]);
-    kernel.setArg(arg + 1, tables[1]);
+    kernel.set("row_length", tables[0]);
+    kernel.set("row_terms", tables[1]);
     return tables;
   }
 
   // The arguments every direction's kernel ends with: its outputs.
-  void setOutputs(cl::Kernel& kernel, int arg, const RunDirection& d, cl_uint plane_offset) {
-    kernel.setArg(arg++, d.cos_azimuth);
-    kernel.setArg(arg++, d.sin_azimuth);
-    kernel.setArg(arg++, static_cast<float>(d.lattice.weight));
-    kernel.setArg(arg++, swathFactor(static_cast<float>(d.lattice.weight)));
-    kernel.setArg(arg++, plane_offset);
-    if (horizon_.method == HorizonMethod::Sweep) {
-      kernel.setArg(arg++, stacks_);
-      arg++;  // stride: set per chunk
-      kernel.setArg(arg++, placeholder_);  // line_state and carry_in, used in strips
-      kernel.setArg(arg++, placeholder_);
-      kernel.setArg(arg++, window_far_);
-      kernel.setArg(arg++, receiver_base_);
+  void setOutputs(NamedKernel& kernel, const RunDirection& d, cl_uint plane_offset) {
+    kernel.set("cos_azimuth", d.cos_azimuth);
+    kernel.set("sin_azimuth", d.sin_azimuth);
+    kernel.set("weight", static_cast<float>(d.lattice.weight));
+    kernel.set("swath", swathFactor(static_cast<float>(d.lattice.weight)));
+    kernel.set("plane", plane_offset);
+    if (horizon_.method == HorizonMethod::Sweep) {  // the stride is set per chunk
+      kernel.set("stacks", stacks_);
+      kernel.set("line_state", placeholder_);  // line_state and carry_in, used in strips
+      kernel.set("carry_in", placeholder_);
+      kernel.set("window_far", window_far_);
+      kernel.set("receiver_base", receiver_base_);
     }
-    kernel.setArg(arg++, normals_);
-    kernel.setArg(arg++, angles_);
-    kernel.setArg(arg++, distances_);
-    kernel.setArg(arg++, svf_);
-    kernel.setArg(arg++, ao_);
-    kernel.setArg(arg++, env_tables_);
-    kernel.setArg(arg++, static_cast<cl_uint>(d.index * envTableFloats()));
-    kernel.setArg(arg++, outputs_.environment ? tableRows(*outputs_.environment) : 0);
-    kernel.setArg(arg++, env_sum_);
-    kernel.setArg(arg++, sumStride());
+    kernel.set("normals", normals_);
+    kernel.set("angles", angles_);
+    kernel.set("distances", distances_);
+    kernel.set("svf_sum", svf_);
+    kernel.set("ao_sum", ao_);
+    kernel.set("env_tables", env_tables_);
+    kernel.set("env_offset", static_cast<cl_uint>(d.index * envTableFloats()));
+    kernel.set("env_rows", outputs_.environment ? tableRows(*outputs_.environment) : 0);
+    kernel.set("env_sum", env_sum_);
+    kernel.set("env_stride", sumStride());
   }
-
-  // horizon_lattice's arguments where the chunks (and strips) differ.
-  enum SweepArgument { kRow0 = 3, kOutRow0 = 4, kLines = 5, kLineCount = 6, kStride = 26, kLineState = 27,
-                       kCarryIn = 28 };
 
   // horizon_lattice for direction d with everything but the chunk's lines set (rows from 0 on,
   // no line states); `keep` holds the buffers it takes until the launch.
-  cl::Kernel sweepKernel(const RunDirection& d, cl_uint plane_offset, std::vector<cl::Buffer>& keep) {
+  NamedKernel sweepKernel(const RunDirection& d, cl_uint plane_offset, std::vector<cl::Buffer>& keep) {
     keep.emplace_back(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, d.samples.size() * sizeof(LatticeSample),
                       const_cast<LatticeSample*>(d.samples.data()));
-    cl::Kernel kernel(program_, "horizon_lattice");
-    kernel.setArg(0, heights_);
-    kernel.setArg(1, field_.width);
-    kernel.setArg(2, field_.height);
-    kernel.setArg(kRow0, 0);
-    kernel.setArg(kOutRow0, 0);
-    kernel.setArg(7, keep.back());
+    NamedKernel kernel(st_, program_, "horizon_lattice");
+    kernel.set("heights", heights_);
+    kernel.set("width", field_.width);
+    kernel.set("height", field_.height);
+    kernel.set("row0", 0);
+    kernel.set("out_row0", 0);
+    kernel.set("samples", keep.back());
     keep.emplace_back(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, d.segments.size() * sizeof(CellSegment),
                       const_cast<CellSegment*>(d.segments.data()));
-    kernel.setArg(8, keep.back());
-    kernel.setArg(9, static_cast<int>(d.samples.size()));
-    kernel.setArg(10, d.lattice.a);
-    kernel.setArg(11, d.lattice.b);
-    kernel.setArg(12, static_cast<float>(d.lattice.period));
+    kernel.set("segments", keep.back());
+    kernel.set("n_samples", static_cast<int>(d.samples.size()));
+    kernel.set("a", d.lattice.a);
+    kernel.set("b", d.lattice.b);
+    kernel.set("period", static_cast<float>(d.lattice.period));
     const double unit = positionUnit(d.lattice.ground_per_pixel);
-    kernel.setArg(13, static_cast<float>(unit));
-    kernel.setArg(14, static_cast<float>(d.lattice.period * d.lattice.ground_per_pixel));
-    kernel.setArg(15, curvatureDrop(unit));
-    kernel.setArg(16, d.window.window);
-    kernel.setArg(17, d.window.inv_window);
-    for (cl::Buffer& table : setRowTables(kernel, 18, d)) keep.push_back(table);
-    setOutputs(kernel, 20, d, plane_offset);
+    kernel.set("ground_per_pixel", static_cast<float>(unit));
+    kernel.set("period_ground", static_cast<float>(d.lattice.period * d.lattice.ground_per_pixel));
+    kernel.set("drop", curvatureDrop(unit));
+    kernel.set("window", d.window.window);
+    kernel.set("inv_window", d.window.inv_window);
+    for (cl::Buffer& table : setRowTables(kernel, d)) keep.push_back(table);
+    setOutputs(kernel, d, plane_offset);
     return kernel;
   }
 
@@ -580,12 +574,8 @@ class HorizonRoutine : public SweepRoutine {
 
   void launchSweep(const RunDirection& d, cl_uint plane_offset) {
     std::vector<cl::Buffer> keep;
-    cl::Kernel kernel = sweepKernel(d, plane_offset, keep);
-    LineChunkArguments chunk;
-    chunk.lines = kLines;
-    chunk.count = kLineCount;
-    chunk.stride = kStride;
-    launchLineChunks(st_, kernel, d.lines, d.stack_per_period, plan_.stack_entries, chunk, lanes_, sweepGroup());
+    NamedKernel kernel = sweepKernel(d, plane_offset, keep);
+    launchLineChunks(st_, kernel, d.lines, d.stack_per_period, plan_.stack_entries, lanes_, sweepGroup());
   }
 
   // Direction k over a field in strips: the strips in the order its lines run through them
@@ -610,14 +600,14 @@ class HorizonRoutine : public SweepRoutine {
     cl::Buffer carry_in = placeholder_;
     std::size_t carried_in = 0;  // entries in carry_in
     std::vector<cl::Buffer> keep;
-    cl::Kernel kernel = sweepKernel(d, 0, keep);  // the strip's rows and lines set per strip
+    NamedKernel kernel = sweepKernel(d, 0, keep);  // the strip's rows and lines set per strip
     for (int step = 0; step < strips; ++step) {
       const int s = b > 0 ? strips - 1 - step : step;  // rows fall along a line when b > 0
       const int s0 = s * rows, s1 = std::min(field_.height, s0 + rows);
       const int row0 = loadStrip(s0, s1);
-      kernel.setArg(kRow0, row0);
-      kernel.setArg(kOutRow0, s0);
-      kernel.setArg(kCarryIn, carry_in);
+      kernel.set("row0", row0);
+      kernel.set("out_row0", s0);
+      kernel.set("carry_in", carry_in);
       // The strip's part of every line that has receivers in it.
       std::vector<LatticeLine> lines;
       std::vector<cl_int4> states;
@@ -656,14 +646,14 @@ class HorizonRoutine : public SweepRoutine {
         if (std::none_of(offsets.begin(), offsets.end(), [](cl_int o) { return o >= 0; })) return;
         const cl::Buffer offsets_buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
                                         offsets.size() * sizeof(cl_int), const_cast<cl_int*>(offsets.data()));
-        cl::Kernel move(program_, "carry_stacks");
-        move.setArg(0, lines_buffer);
-        move.setArg(1, states_buffer);
-        move.setArg(2, offsets_buffer);
-        move.setArg(3, static_cast<int>(offsets.size()));
-        move.setArg(4, source);
-        move.setArg(5, stride);
-        move.setArg(6, carry_out);
+        NamedKernel move(st_, program_, "carry_stacks");
+        move.set("lines", lines_buffer);
+        move.set("line_state", states_buffer);
+        move.set("offsets", offsets_buffer);
+        move.set("n_lines", static_cast<int>(offsets.size()));
+        move.set("stacks", source);
+        move.set("stride", stride);
+        move.set("carry_out", carry_out);
         st_.launch(move, cl::NDRange(roundUp(offsets.size(), kLineGroup)), cl::NDRange(kLineGroup));
         st_.queue.finish();  // before the caller's buffers go
       };
@@ -673,10 +663,10 @@ class HorizonRoutine : public SweepRoutine {
                                      chunk.count * sizeof(LatticeLine), lines.data() + chunk.first);
         const cl::Buffer chunk_states(st_.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR,
                                       chunk.count * sizeof(cl_int4), states.data() + chunk.first);
-        kernel.setArg(kLines, chunk_lines);
-        kernel.setArg(kLineCount, static_cast<int>(chunk.count));
-        kernel.setArg(kStride, static_cast<cl_uint>(chunk.stride));
-        kernel.setArg(kLineState, chunk_states);
+        kernel.set("lines", chunk_lines);
+        kernel.set("n_lines", static_cast<int>(chunk.count));
+        kernel.set("stride", static_cast<cl_uint>(chunk.stride));
+        kernel.set("line_state", chunk_states);
         const std::size_t items = (chunk.count + lanes_ - 1) / lanes_;
         st_.launch(kernel, cl::NDRange(roundUp(items, sweepGroup())), cl::NDRange(sweepGroup()));
         st_.queue.enqueueReadBuffer(chunk_states, CL_TRUE, 0, chunk.count * sizeof(cl_int4),
@@ -754,20 +744,21 @@ class HorizonRoutine : public SweepRoutine {
   }
 
   void launchNaive(const RunDirection& d, cl_uint plane_offset) {
-    cl::Kernel kernel(program_, "horizon_naive");
-    kernel.setArg(0, heights_);
-    kernel.setArg(1, field_.width);
-    kernel.setArg(2, field_.height);
-    kernel.setArg(3, d.ray.dir_x);
-    kernel.setArg(4, d.ray.dir_y);
-    kernel.setArg(5, d.ray.step_length);
-    kernel.setArg(6, d.ray.ground_per_pixel);
-    kernel.setArg(7, curvatureDrop(positionUnit(d.ray.ground_per_pixel)));
-    kernel.setArg(8, d.max_steps);
-    kernel.setArg(9, hasRowSpacing(field_) && horizon_.max_distance > 0.0 ? static_cast<float>(horizon_.max_distance)
-                                                                         : std::numeric_limits<float>::infinity());
-    const auto row_tables = setRowTables(kernel, 10, d);
-    setOutputs(kernel, 12, d, plane_offset);
+    NamedKernel kernel(st_, program_, "horizon_naive");
+    kernel.set("heights", heights_);
+    kernel.set("width", field_.width);
+    kernel.set("height", field_.height);
+    kernel.set("dir_x", d.ray.dir_x);
+    kernel.set("dir_y", d.ray.dir_y);
+    kernel.set("step_length", d.ray.step_length);
+    kernel.set("ground_per_pixel", d.ray.ground_per_pixel);
+    kernel.set("drop", curvatureDrop(positionUnit(d.ray.ground_per_pixel)));
+    kernel.set("max_steps", d.max_steps);
+    kernel.set("max_ground", hasRowSpacing(field_) && horizon_.max_distance > 0.0
+                                 ? static_cast<float>(horizon_.max_distance)
+                                 : std::numeric_limits<float>::infinity());
+    const auto row_tables = setRowTables(kernel, d);
+    setOutputs(kernel, d, plane_offset);
     st_.launch(kernel, cl::NDRange(roundUp(field_.width, kTileX), roundUp(field_.height, kTileY)),
                cl::NDRange(kTileX, kTileY));
   }

@@ -11,7 +11,7 @@
 
 #include "hfvis/errors.hpp"
 #include "core/horizon_common.hpp"
-#include "ops/intervisibility_internal.hpp"
+#include "core/hull_tree.hpp"
 
 namespace hfvis {
 namespace {

@@ -14,6 +14,7 @@
 #include "core/opencl_context.hpp"
 #include "core/unit_normals.hpp"
 #include "core/sweep_framework.hpp"
+#include "core/sweep_routine.hpp"
 #include "ops/insolation_steps.hpp"
 
 namespace hfvis {
@@ -74,67 +75,111 @@ HorizonOptions bucketSweep(long bucket, const InsolationOptions& options, const 
 
 }  // namespace detail
 
+namespace {
+
+using detail::SunStep;
+
+// One routine item per azimuth bucket: the horizon sweep in its azimuth, then insolation_add adds
+// its steps to every pixel's sums on the device.
+class InsolationRoutine : public detail::DeviceRoutine {
+ public:
+  InsolationRoutine(detail::ContextState& st, const ComputeContext& context, const HeightField& field,
+                    const InsolationOptions& options, const SweepOptions& sweep,
+                    std::vector<std::pair<long, std::vector<SunStep>>> buckets, double radius,
+                    InsolationResult& out)
+      : DeviceRoutine(st, field, sweep.progress, sweep.memory_budget_bytes),
+        context_(context),
+        options_(options),
+        sweep_(sweep),
+        buckets_(std::move(buckets)),
+        radius_(radius),
+        out_(out) {}
+
+ private:
+  // The kernel reads the horizons and normals, not the heights (the sweeps prepare their own).
+  detail::PreparedHeights prepare() override { return {}; }
+  bool heightsResident() const override { return false; }
+  std::string programFile() const override { return "insolation.cl"; }
+
+  void allocate() override {
+    const std::size_t pixels = field_.pixelCount();
+    normals_ = detail::unitNormals(field_);  // x, y, z, 0 per pixel
+    normal_buffer_ = upload(normals_);
+    sun_hours_ = zeros(pixels);
+    direct_ = zeros(pixels);
+    horizon_ = detail::deviceBuffer(st_, pixels * sizeof(float));
+  }
+
+  int itemCount() const override { return static_cast<int>(buckets_.size()); }
+
+  void runItem(int item, int) override {
+    const auto& [bucket, steps] = buckets_[item];
+    HorizonOutputs outputs;
+    outputs.horizon_angles = true;
+    // Kept until the base's queue.finish() after the item, as the buffers below: the write reads it.
+    angles_ = computeHorizons(context_, field_, detail::bucketSweep(bucket, options_, sweep_), outputs).angles;
+    const std::size_t pixels = field_.pixelCount();
+    st_.queue.enqueueWriteBuffer(horizon_, CL_FALSE, 0, pixels * sizeof(float), angles_.data());
+    std::vector<cl_float4> suns;
+    std::vector<float> hours;
+    for (const SunStep& s : steps) suns.push_back(cl_float4{{s.x, s.y, s.z, s.elevation}}), hours.push_back(s.hours);
+    sun_buffer_ = upload(suns);
+    hour_buffer_ = upload(hours);
+    detail::NamedKernel add = kernel("insolation_add");
+    add.set("horizon", horizon_);
+    add.set("normals", normal_buffer_);
+    add.set("pixels", static_cast<cl_uint>(pixels));
+    add.set("steps", sun_buffer_);
+    add.set("hours", hour_buffer_);
+    add.set("n_steps", static_cast<int>(suns.size()));
+    add.set("radius", static_cast<float>(radius_));
+    add.set("sun_hours", sun_hours_);
+    add.set("direct", direct_);
+    st_.launch(add, cl::NDRange(detail::roundUp(pixels, detail::kLineGroup)),
+               cl::NDRange(detail::kLineGroup));
+    ++out_.sweeps;
+  }
+
+  void finish() override {
+    const std::size_t pixels = field_.pixelCount();
+    out_.sun_hours.resize(pixels);
+    out_.direct.resize(pixels);
+    st_.queue.enqueueReadBuffer(sun_hours_, CL_TRUE, 0, pixels * sizeof(float), out_.sun_hours.data());
+    st_.queue.enqueueReadBuffer(direct_, CL_TRUE, 0, pixels * sizeof(float), out_.direct.data());
+    // No step with the sun up: nodata is still nodata.
+    if (buckets_.empty())
+      for (std::size_t p = 0; p < pixels; ++p)
+        if (std::isnan(normals_[4 * p]))
+          out_.sun_hours[p] = out_.direct[p] = std::numeric_limits<float>::quiet_NaN();
+  }
+
+  const ComputeContext& context_;
+  const InsolationOptions& options_;
+  const SweepOptions& sweep_;
+  std::vector<std::pair<long, std::vector<SunStep>>> buckets_;  // by azimuth bucket
+  double radius_;
+  InsolationResult& out_;
+  std::vector<float> normals_, angles_;
+  cl::Buffer normal_buffer_, sun_hours_, direct_, horizon_, sun_buffer_, hour_buffer_;
+};
+
+}  // namespace
+
 InsolationResult computeInsolation(const ComputeContext& context, const HeightField& field,
                                    const InsolationOptions& options, const SweepOptions& sweep) {
   validate(field);
   validate(options);
   validate(sweep);
   const double radius = detail::sunDiscRadius(options);
-  const std::map<long, std::vector<detail::SunStep>> buckets = detail::sunStepsByBucket(options);
+  const std::map<long, std::vector<SunStep>> buckets = detail::sunStepsByBucket(options);
   InsolationResult out;
   for (const auto& bucket : buckets) out.steps += static_cast<int>(bucket.second.size());
   out.width = field.width;
   out.height = field.height;
-  const std::size_t pixels = field.pixelCount();
-  const std::vector<float> normals = detail::unitNormals(field);  // x, y, z, 0 per pixel
   return detail::translateOpenClErrors([&] {
-    detail::ContextState& st = detail::stateOf(context);
-    const cl::Program program = st.program("insolation.cl", "");
-    auto zeros = [&]() {
-      cl::Buffer b = detail::deviceBuffer(st, pixels * sizeof(float));
-      st.queue.enqueueFillBuffer(b, 0.0f, 0, pixels * sizeof(float));
-      return b;
-    };
-    const cl::Buffer normal_buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, normals.size() * sizeof(float),
-                                   const_cast<float*>(normals.data()));
-    cl::Buffer sun_hours = zeros(), direct = zeros();
-    cl::Buffer horizon = detail::deviceBuffer(st, pixels * sizeof(float));
-    int done = 0;
-    for (const auto& [bucket, steps] : buckets) {
-      HorizonOutputs outputs;
-      outputs.horizon_angles = true;
-      const HorizonResult h = computeHorizons(context, field, detail::bucketSweep(bucket, options, sweep), outputs);
-      st.queue.enqueueWriteBuffer(horizon, CL_FALSE, 0, pixels * sizeof(float), h.angles.data());
-      std::vector<cl_float4> suns;
-      std::vector<float> hours;
-      for (const detail::SunStep& s : steps) suns.push_back(cl_float4{{s.x, s.y, s.z, s.elevation}}), hours.push_back(s.hours);
-      const cl::Buffer sun_buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, suns.size() * sizeof(cl_float4),
-                                  suns.data());
-      const cl::Buffer hour_buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, hours.size() * sizeof(float),
-                                   hours.data());
-      cl::Kernel add(program, "insolation_add");
-      add.setArg(0, horizon);
-      add.setArg(1, normal_buffer);
-      add.setArg(2, static_cast<cl_uint>(pixels));
-      add.setArg(3, sun_buffer);
-      add.setArg(4, hour_buffer);
-      add.setArg(5, static_cast<int>(suns.size()));
-      add.setArg(6, static_cast<float>(radius));
-      add.setArg(7, sun_hours);
-      add.setArg(8, direct);
-      st.launch(add, cl::NDRange(detail::roundUp(pixels, detail::kLineGroup)), cl::NDRange(detail::kLineGroup));
-      st.queue.finish();  // before this bucket's buffers go
-      ++out.sweeps;
-      if (sweep.progress) sweep.progress(++done, static_cast<int>(buckets.size()));
-    }
-    out.sun_hours.resize(pixels);
-    out.direct.resize(pixels);
-    st.queue.enqueueReadBuffer(sun_hours, CL_TRUE, 0, pixels * sizeof(float), out.sun_hours.data());
-    st.queue.enqueueReadBuffer(direct, CL_TRUE, 0, pixels * sizeof(float), out.direct.data());
-    // No step with the sun up: nodata is still nodata.
-    if (buckets.empty())
-      for (std::size_t p = 0; p < pixels; ++p)
-        if (std::isnan(normals[4 * p])) out.sun_hours[p] = out.direct[p] = std::numeric_limits<float>::quiet_NaN();
+    InsolationRoutine routine(detail::stateOf(context), context, field, options, sweep,
+                              {buckets.begin(), buckets.end()}, radius, out);
+    routine.run();
     return out;
   });
 }

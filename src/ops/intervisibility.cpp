@@ -10,172 +10,32 @@
 #include <limits>
 #include <sstream>
 
-#include "ops/bounce_internal.hpp"
 #include "hfvis/errors.hpp"
 #include "core/horizon_common.hpp"
-#include "ops/intervisibility_device.hpp"
-#include "ops/intervisibility_internal.hpp"
+#include "core/hull_tree_device.hpp"
+#include "core/hull_tree.hpp"
 #include "core/opencl_context.hpp"
 #include "core/sweep_framework.hpp"
 
 namespace hfvis {
+
+void validate(const IntervisibilityOptions& options, const IntervisibilityOutputs& outputs) {
+  validate(static_cast<const SweepOptions&>(options));
+  validate(options.tree);
+  if (!outputs.visible_count && !outputs.visible_area && !outputs.statistics) {
+    throw InvalidArgument("no output requested");
+  }
+  if (outputs.statistics && options.method != IntervisibilityMethod::HullTree) {
+    throw InvalidArgument("statistics (horizons and iterations) exist only for the hull-tree method");
+  }
+  if (options.strip_rows < 0)
+    throw InvalidArgument("the rows per strip must be 0 (automatic) or positive (got " +
+                          std::to_string(options.strip_rows) + ")");
+  if (options.strip_rows > 0 && options.method == IntervisibilityMethod::Naive)
+    throw InvalidArgument("the naive method does not run in strips (each ray reads the whole field)");
+}
+
 namespace detail {
-
-std::string treeProgramOptions(const TreeProgramFlags& f) {
-  std::ostringstream s;
-  s << "-DHFVIS_HAS_NODATA=" << f.has_nodata << " -DHFVIS_WANT_COUNT=" << f.count
-    << " -DHFVIS_WANT_AREA=" << f.area
-    << " -DHFVIS_WANT_STATS=" << f.stats << " -DHFVIS_WANT_ENTRY_STATS=" << f.entry_stats;
-  s << " -DHFVIS_CURVATURE=" << f.curvature << " -DHFVIS_ROW_SPACING=" << f.row_spacing
-    << " -DHFVIS_STRIPS=" << f.strips;
-  const HullTreeTuning tuning = tuningFor(f.tuning, f.row_spacing);
-  s << " -DHFVIS_DEFERRED_WRITES=" << tuning.deferred_writes
-    << " -DHFVIS_REPLACEMENT_CHECK=" << tuning.replacement_check
-    << " -DHFVIS_SAFE_ZONE=" << tuning.safe_zone << " -DHFVIS_SAFE_ZONE_STEPS=" << tuning.safe_zone_steps;
-  if (f.bounce_channels > 0) s << " -DHFVIS_WANT_BOUNCE=1 -DHFVIS_CHANNELS=" << f.bounce_channels;
-  return s.str();
-}
-
-namespace {
-bool needsPrefix(const TreeProgramFlags& f) { return f.area && (f.has_nodata || f.row_spacing); }
-}  // namespace
-
-std::size_t treeEntryBytes(const TreeProgramFlags& f) {
-  return kTreeNodeBytes + (needsPrefix(f) ? kTreePrefixBytes : 0) + (f.row_spacing ? kTreePositionBytes : 0) +
-         (f.entry_stats ? kTreeVisibleBytes + kTreeEntryStatsBytes : 0);
-}
-
-TreeScratchNeeds treeScratchNeeds(const std::vector<TreeDirection>& directions, bool line_major) {
-  TreeScratchNeeds needs;
-  for (const TreeDirection& d : directions) {
-    std::size_t total = 0, direction_longest = 0;
-    for (const LatticeLine& line : d.lines) {
-      const std::size_t capacity = lineCapacity(line, d.samples.size());
-      total += capacity;
-      direction_longest = std::max(direction_longest, capacity);
-    }
-    // Step-major chunks pad every line to the chunk's longest (chunkLines).
-    if (!line_major) total = std::max(total, direction_longest * d.lines.size());
-    needs.whole = std::max(needs.whole, total);
-    needs.longest = std::max(needs.longest, direction_longest);
-  }
-  return needs;
-}
-
-std::size_t planTreeScratch(const std::vector<TreeDirection>& directions, std::size_t fixed_bytes,
-                            std::size_t entry_bytes, std::size_t budget_bytes, const DeviceInfo& device,
-                            bool line_major) {
-  const std::size_t budget = budget_bytes ? budget_bytes : defaultMemoryBudget(device);
-  const std::size_t max_alloc = device.max_allocation_bytes ? device.max_allocation_bytes : budget;
-  const TreeScratchNeeds needs = treeScratchNeeds(directions, line_major);
-  const std::size_t least = fixed_bytes + needs.longest * entry_bytes;
-  if (least > budget || needs.longest * kTreeNodeBytes > max_alloc) {
-    throw MemoryBudgetError("one direction needs " + mebibytes(least) + " of device memory but the budget is " +
-                            mebibytes(budget) + " (largest single buffer " + mebibytes(max_alloc) +
-                            "); raise the memory budget or use a smaller field");
-  }
-  return std::min({needs.whole, (budget - fixed_bytes) / entry_bytes, max_alloc / kTreeNodeBytes});
-}
-
-void allocateTreeScratch(ContextState& st, const TreeProgramFlags& flags, const std::vector<TreeDirection>& all,
-                         std::size_t entries, TreeBuffers& b) {
-  b.scratch_entries = entries;
-  b.trees = st.reusableBuffer("tree nodes", entries * kTreeNodeBytes);
-  b.prefix = deviceBuffer(st, needsPrefix(flags) ? entries * kTreePrefixBytes : 0);
-  b.positions = deviceBuffer(st, flags.row_spacing ? entries * kTreePositionBytes : 0);
-  b.visible = deviceBuffer(st, flags.entry_stats ? entries * kTreeVisibleBytes : 0);
-  b.entry_stats = deviceBuffer(st, flags.entry_stats ? entries * kTreeEntryStatsBytes : 0);
-  std::size_t max_lines = 0;
-  for (const TreeDirection& d : all) max_lines = std::max(max_lines, d.lines.size());
-  b.line_totals = deviceBuffer(st, flags.stats ? max_lines * kTreeLineTotals * sizeof(cl_ulong) : 0);
-}
-
-TreeKernel treeKernel(ContextState& st, cl::Program& program, const TreeDirection& d, int width, int height,
-                      const TreeBuffers& b) {
-  auto table = [&](const void* data, std::size_t bytes) {
-    if (!bytes) return deviceBuffer(st, 0);
-    return cl::Buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes, const_cast<void*>(data));
-  };
-  TreeKernel k;
-  k.samples = table(d.samples.data(), d.samples.size() * sizeof(LatticeSample));
-  k.row_units = table(d.row_units.data(), d.row_units.size() * sizeof(std::int32_t));
-  k.row_factors = table(d.row_factors.data(), d.row_factors.size() * sizeof(float));
-  k.no_strips = deviceBuffer(st, 0);
-  k.kernel = cl::Kernel(program, "intervisibility_lattice");
-  cl::Kernel& kernel = k.kernel;
-  int arg = 0;
-  kernel.setArg(arg++, b.heights);
-  kernel.setArg(arg++, width);
-  kernel.setArg(arg++, height);
-  k.chunk.lines = arg++;
-  k.chunk.count = arg++;
-  kernel.setArg(arg++, k.samples);
-  kernel.setArg(arg++, static_cast<int>(d.samples.size()));
-  kernel.setArg(arg++, d.lattice.a);
-  kernel.setArg(arg++, d.lattice.b);
-  kernel.setArg(arg++, d.count_factor);
-  kernel.setArg(arg++, d.area_factor);
-  kernel.setArg(arg++, d.drop);
-  kernel.setArg(arg++, d.max_steps);
-  kernel.setArg(arg++, k.row_units);
-  kernel.setArg(arg++, k.row_factors);
-  kernel.setArg(arg++, b.trees);
-  kernel.setArg(arg++, b.prefix);
-  kernel.setArg(arg++, b.positions);
-  k.chunk.stride = arg++;
-  kernel.setArg(arg++, b.visible);
-  kernel.setArg(arg++, b.entry_stats);
-  kernel.setArg(arg++, b.line_totals);
-  k.chunk.first_line = arg++;
-  kernel.setArg(arg++, b.count_sum);
-  kernel.setArg(arg++, b.area_sum);
-  kernel.setArg(arg++, b.radiance);
-  kernel.setArg(arg++, b.normals);
-  kernel.setArg(arg++, d.cos_azimuth);
-  kernel.setArg(arg++, d.sin_azimuth);
-  kernel.setArg(arg++, d.step_ground);
-  kernel.setArg(arg++, d.half_sector);
-  kernel.setArg(arg++, d.wedge);
-  kernel.setArg(arg++, b.irradiance);
-  k.strip = arg;
-  kernel.setArg(arg++, 0);  // row0
-  kernel.setArg(arg++, 0);  // out_row0
-  kernel.setArg(arg++, k.no_strips);
-  kernel.setArg(arg++, k.no_strips);
-  return k;
-}
-
-void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDirection& d, int width, int height,
-                          const TreeBuffers& b) {
-  TreeKernel k = treeKernel(st, program, d, width, height, b);
-  launchLineChunks(st, k.kernel, d.lines, d.samples.size(), b.scratch_entries, k.chunk, 1, kLineGroup);
-}
-
-std::string TreeRoutine::programOptions() const {
-  TreeProgramFlags flags = flags_;
-  flags.has_nodata = prepared_.has_nodata;
-  return treeProgramOptions(flags);
-}
-
-void TreeRoutine::allocateScratch(std::size_t fixed_bytes) {
-  flags_.has_nodata = prepared_.has_nodata;
-  directions_ = treeDirections(field_, options_, flags_.row_spacing);
-  checkTreeLimits(directions_, prepared_.heights);
-  // The per-line totals of the statistics count beside the operation's own buffers.
-  std::size_t max_lines = 0;
-  for (const TreeDirection& d : directions_) max_lines = std::max(max_lines, d.lines.size());
-  if (flags_.stats) fixed_bytes += max_lines * kTreeLineTotals * sizeof(cl_ulong);
-  allocateTreeScratch(st_, flags_, directions_,
-                      planTreeScratch(directions_, fixed_bytes, treeEntryBytes(flags_), options_.memory_budget_bytes,
-                                      st_.info, lineMajorLayout(st_)),
-                      buffers_);
-  buffers_.heights = heights_;
-}
-
-void TreeRoutine::sweep(int direction, int) {
-  enqueueTreeDirection(st_, program_, directions_[direction], field_.width, field_.height, buffers_);
-}
-
 namespace {
 
 // Adds one direction's per-line totals (receivers, m, t, naive, visible, skips).
@@ -220,7 +80,7 @@ struct CountPlan {
 CountPlan planCount(const HeightField& field, const std::vector<TreeDirection>& directions,
                     const TreeProgramFlags& flags, const IntervisibilityOptions& options, const DeviceInfo& device,
                     bool line_major) {
-  const std::size_t budget = options.memory_budget_bytes ? options.memory_budget_bytes : defaultMemoryBudget(device);
+  const std::size_t budget = memoryBudget(options.memory_budget_bytes, device);
   const std::size_t max_alloc = device.max_allocation_bytes ? device.max_allocation_bytes : budget;
   const TreeScratchNeeds needs = treeScratchNeeds(directions, line_major);
   const std::size_t entry = treeEntryBytes(flags), row = field.width * sizeof(float);
@@ -336,11 +196,11 @@ class CountRoutine : public TreeRoutine {
       const LineChunk& chunk = chunks[c];
       const cl::Buffer chunk_lines(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
                                    chunk.count * sizeof(LatticeLine), lines.data() + chunk.first);
-      k.kernel.setArg(k.chunk.lines, chunk_lines);
-      k.kernel.setArg(k.chunk.count, static_cast<int>(chunk.count));
-      k.kernel.setArg(k.chunk.stride, static_cast<cl_uint>(chunk.stride));
-      k.kernel.setArg(k.chunk.first_line, static_cast<int>(chunk.first));
-      k.kernel.setArg(k.strip + 3, states_);
+      k.kernel.set("lines", chunk_lines);
+      k.kernel.set("n_lines", static_cast<int>(chunk.count));
+      k.kernel.set("stride", static_cast<cl_uint>(chunk.stride));
+      k.kernel.set("first_line", static_cast<int>(chunk.first));
+      k.kernel.set("states", states_);
       // The strips in the order the lines run through them (receiver i in row row - i b).
       for (int t = 0; t < strips; ++t) {
         const int s = b > 0 ? strips - 1 - t : t;
@@ -368,9 +228,9 @@ class CountRoutine : public TreeRoutine {
       st_.queue.enqueueWriteBuffer(buffers_.area_sum, CL_FALSE, 0, sums, &result_.visible_area[s0 * width]);
     const cl::Buffer ranges_buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
                                    ranges.size() * sizeof(cl_int2), const_cast<cl_int2*>(ranges.data()));
-    k.kernel.setArg(k.strip, h0);
-    k.kernel.setArg(k.strip + 1, s0);
-    k.kernel.setArg(k.strip + 2, ranges_buffer);
+    k.kernel.set("row0", h0);
+    k.kernel.set("out_row0", s0);
+    k.kernel.set("strip_receivers", ranges_buffer);
     st_.launch(k.kernel, cl::NDRange(roundUp(ranges.size(), kLineGroup)), cl::NDRange(kLineGroup));
     st_.queue.enqueueReadBuffer(buffers_.count_sum, CL_FALSE, 0, sums, &result_.visible_count[s0 * width]);
     if (outputs_.visible_area)
@@ -456,17 +316,16 @@ class NaiveCountRoutine : public SweepRoutine {
   void endBatch(int first, int count) override {
     const std::vector<SweepDirection> batch(rays_.begin() + first, rays_.begin() + first + count);
     const cl::Buffer directions = uploadDirections(st_, batch);
-    cl::Kernel naive(program_, "intervisibility_naive");
-    int arg = 0;
-    naive.setArg(arg++, heights_);
-    naive.setArg(arg++, field_.width);
-    naive.setArg(arg++, field_.height);
-    naive.setArg(arg++, directions);
-    naive.setArg(arg++, count);
-    naive.setArg(arg++, intervisibilitySector(visibility_));
+    NamedKernel naive(st_, program_, "intervisibility_naive");
+    naive.set("heights", heights_);
+    naive.set("width", field_.width);
+    naive.set("height", field_.height);
+    naive.set("directions", directions);
+    naive.set("batch_size", count);
+    naive.set("sector", intervisibilitySector(visibility_));
     // With per-row spacing positions are units: the drop per unit squared, distances in units.
     const double per_unit = unit_ * unit_;
-    naive.setArg(arg++, static_cast<float>(visibility_.curvature * (unit_ > 0.0 ? per_unit : 1.0)));
+    naive.set("curvature", static_cast<float>(visibility_.curvature * (unit_ > 0.0 ? per_unit : 1.0)));
     std::vector<cl_int> max_steps;
     for (const SweepDirection& d : batch)
       max_steps.push_back(stepsWithin(visibility_.max_distance,
@@ -476,17 +335,17 @@ class NaiveCountRoutine : public SweepRoutine {
       return cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes, const_cast<void*>(data));
     };
     const cl::Buffer max_steps_buffer = upload(max_steps.data(), max_steps.size() * sizeof(cl_int));
-    naive.setArg(arg++, max_steps_buffer);
+    naive.set("max_steps", max_steps_buffer);
     // This batch's slices of the row tables.
     const std::size_t half_rows = 2 * static_cast<std::size_t>(field_.height) - 1, rows = 2 * field_.height;
     const cl::Buffer units = upload(rows_.units.empty() ? nullptr : &rows_.units[first * half_rows],
                                     rows_.units.empty() ? 0 : count * half_rows * sizeof(cl_int));
     const cl::Buffer factors = upload(rows_.factors.empty() ? nullptr : &rows_.factors[first * rows],
                                       rows_.factors.empty() ? 0 : count * rows * sizeof(float));
-    naive.setArg(arg++, units);
-    naive.setArg(arg++, factors);
-    naive.setArg(arg++, count_sum_);
-    naive.setArg(arg++, area_sum_);
+    naive.set("row_units", units);
+    naive.set("row_factors", factors);
+    naive.set("count_sum", count_sum_);
+    naive.set("area_sum", area_sum_);
     st_.launch(naive, cl::NDRange(roundUp(field_.width, kTileX), roundUp(field_.height, kTileY)),
                cl::NDRange(kTileX, kTileY));
   }
@@ -506,89 +365,6 @@ class NaiveCountRoutine : public SweepRoutine {
 };
 
 }  // namespace
-
-IntervisibilityLines treeLinesOnDevice(ContextState& st, const TreeProgramFlags& program_flags,
-                                       const HeightField& field, const std::vector<float>& prepared_heights,
-                                       const TreeDirection& d, const BounceInputs* bounce,
-                                       std::vector<float>* irradiance) {
-  TreeProgramFlags flags = program_flags;
-  flags.entry_stats = true;
-  flags.row_spacing = d.rowSpacing();
-  cl::Program program = st.program("intervisibility.cl", treeProgramOptions(flags));
-  const std::size_t plane = field.pixelCount();
-  const std::size_t per_period = d.samples.size(), longest = d.longestLine();
-  std::size_t entries = 0;
-  for (const LatticeLine& line : d.lines) entries += lineCapacity(line, per_period);
-  // Scratch for all lines in one launch; the step-major layout pads every line to the longest.
-  entries = std::max(entries, longest * d.lines.size());
-  TreeBuffers b;
-  allocateTreeScratch(st, flags, {d}, entries, b);
-  auto upload = [&](const std::vector<float>& values) {
-    return cl::Buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, values.size() * sizeof(float),
-                      const_cast<float*>(values.data()));
-  };
-  auto joined = [](const std::vector<std::vector<float>>& planes) {
-    std::vector<float> all;
-    for (const auto& p : planes) all.insert(all.end(), p.begin(), p.end());
-    return all;
-  };
-  const int channels = bounce ? bounce->channels() : 0;
-  b.heights = upload(prepared_heights);
-  b.count_sum = deviceBuffer(st, plane * sizeof(float));
-  b.area_sum = deviceBuffer(st, plane * sizeof(float));
-  b.radiance = bounce ? upload(joined(bounce->radiance)) : deviceBuffer(st, 0);
-  b.normals = bounce ? upload(joined(bounce->normals)) : deviceBuffer(st, 0);
-  b.irradiance = deviceBuffer(st, channels * plane * sizeof(float));
-  const float zero = 0.0f;
-  st.queue.enqueueFillBuffer(b.count_sum, zero, 0, plane * sizeof(float));
-  st.queue.enqueueFillBuffer(b.area_sum, zero, 0, plane * sizeof(float));
-  if (channels) st.queue.enqueueFillBuffer(b.irradiance, zero, 0, channels * plane * sizeof(float));
-  enqueueTreeDirection(st, program, d, field.width, field.height, b);
-  std::vector<cl_int> nodes(entries * 4);
-  std::vector<float> visible(entries * 2);
-  std::vector<std::uint32_t> stats(entries * 4);
-  st.queue.enqueueReadBuffer(b.trees, CL_TRUE, 0, nodes.size() * sizeof(cl_int), nodes.data());
-  st.queue.enqueueReadBuffer(b.visible, CL_TRUE, 0, visible.size() * sizeof(float), visible.data());
-  st.queue.enqueueReadBuffer(b.entry_stats, CL_TRUE, 0, stats.size() * sizeof(std::uint32_t), stats.data());
-  if (irradiance) {
-    irradiance->resize(channels * plane);
-    st.queue.enqueueReadBuffer(b.irradiance, CL_TRUE, 0, irradiance->size() * sizeof(float), irradiance->data());
-  }
-
-  // Back to the canonical step-major order, as the launch laid the lines out.
-  std::vector<LatticeLine> lines = d.lines;
-  const auto chunks = chunkLines(lines, per_period, entries, lineMajorLayout(st));
-  IntervisibilityLines out = canonicalTreeLines(d);
-  out.resetResults();
-  for (const LineChunk& chunk : chunks) {
-    for (std::size_t j = chunk.first; j < chunk.first + chunk.count; ++j) {
-      const std::size_t steps = lineCapacity(lines[j], per_period);
-      for (std::size_t i = 0; i < steps; ++i) {
-        const std::size_t e = static_cast<std::size_t>(lines[j].stack) + i * chunk.stride;
-        const std::size_t c = i * lines.size() + j;
-        std::memcpy(&out.samples[c], &nodes[4 * e], sizeof(float));
-        out.counts[c] = visible[2 * e];
-        out.distance_sums[c] = visible[2 * e + 1];
-        out.horizons[c] = stats[4 * e];
-        out.iterations[c] = stats[4 * e + 1];
-        out.horizon_hashes[c] = stats[4 * e + 2];
-        out.walks_skipped[c] = stats[4 * e + 3];
-      }
-    }
-  }
-  return out;
-}
-
-IntervisibilityLines intervisibilityLinesOnDevice(const ComputeContext& context, const HeightField& field,
-                                                  const std::vector<float>& prepared_heights,
-                                                  const TreeDirection& d, const HullTreeTuning& tuning) {
-  validate(tuning);
-  return translateOpenClErrors([&] {
-    TreeProgramFlags flags;
-    flags.tuning = tuning;
-    return treeLinesOnDevice(stateOf(context), flags, field, prepared_heights, d, nullptr, nullptr);
-  });
-}
 
 }  // namespace detail
 

@@ -15,12 +15,13 @@ namespace hfvis::detail {
 using std::isnan;
 #include "../../kernels/shared/region_sight.cl"
 
-// The heights as the kernels take them: z-scaled floats, NaN at nodata.
-std::vector<float> regionHeights(const HeightField& field);
-
 // A region's table for region_sample(): the rectangle (lo_x, lo_y, hi_x, hi_y), then per sample
 // its stratum's corner, size and height (explicit points: the point, size 0). Validates.
 std::vector<float> regionSampleTable(const HeightField& field, const RegionSampling& sampling);
+
+// Fills a pair result's clear_pairs, pairs and per-sample fractions from its bits (the samples'
+// counts and words set).
+void countPairFractions(RegionPairVisibilityResult& out);
 
 // The samples a table holds.
 inline int regionTableSamples(const std::vector<float>& table) {

@@ -10,6 +10,8 @@
 
 #include "core/horizon_common.hpp"
 #include "core/opencl_context.hpp"
+#include "core/sweep_geometry.hpp"
+#include "core/sweep_routine.hpp"
 #include "core/sweep_framework.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/viewshed.hpp"
@@ -44,73 +46,112 @@ void validateField(const HeightField& field) {
 
 int popcount(std::uint32_t v) { return __builtin_popcount(v); }
 
-// The bits of `count` receivers from the device, receiver-major.
-std::vector<std::uint32_t> runBits(const ComputeContext& context, const HeightField& field,
-                                   const std::vector<float>& heights, const std::vector<float>& sources,
-                                   bool source_absolute, const std::vector<float>* receivers,
-                                   bool receiver_absolute, int count,
-                                   const RegionVisibilityOptions& options) {
-  const int samples = detail::regionTableSamples(sources);
-  const int words = (samples + 31) / 32;
-  return detail::translateOpenClErrors([&] {
-    detail::ContextState& st = detail::stateOf(context);
-    const bool receiver_major = detail::lineMajorLayout(st);
-    const cl::Program program = st.program("region_visibility.cl", "");
-    const cl::Buffer h(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, heights.size() * sizeof(float),
-                       const_cast<float*>(heights.data()));
-    const cl::Buffer source_table(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                                  sources.size() * sizeof(float), const_cast<float*>(sources.data()));
-    // A pixel run binds the source table in the receivers' place (never read).
-    const cl::Buffer receiver_table =
-        receivers ? cl::Buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                               receivers->size() * sizeof(float), const_cast<float*>(receivers->data()))
-                  : source_table;
-    const std::size_t entries = static_cast<std::size_t>(count) * words;
-    // The bitmasks live whole on the device and the host: refuse what half the device's memory
-    // cannot hold rather than fail in the allocation.
-    const std::size_t budget = detail::defaultMemoryBudget(st.info);
+// The bits of `count` receivers from the device, receiver-major: one routine item per launch
+// of up to kReceiversPerLaunch receivers.
+class RegionBitsRoutine : public detail::DeviceRoutine {
+ public:
+  RegionBitsRoutine(detail::ContextState& st, const HeightField& field, const std::vector<float>& sources,
+                    bool source_absolute, const std::vector<float>* receivers, bool receiver_absolute, int count,
+                    const RegionVisibilityOptions& options)
+      : DeviceRoutine(st, field, nullptr, 0),
+        sources_(sources),
+        source_absolute_(source_absolute),
+        receivers_(receivers),
+        receiver_absolute_(receiver_absolute),
+        count_(count),
+        options_(options),
+        samples_(detail::regionTableSamples(sources)),
+        words_((samples_ + 31) / 32) {}
+
+  std::vector<std::uint32_t> bits;  // after run(): receiver-major
+
+ private:
+  // The viewshed's heights (z-scaled, from 0), so both decide the same sight lines.
+  detail::PreparedHeights prepare() override { return detail::prepareHeights(field_, detail::HeightOrigin::Zero); }
+  std::string programFile() const override { return "region_visibility.cl"; }
+
+  void allocate() override {
+    receiver_major_ = detail::lineMajorLayout(st_);
+    const std::size_t entries = static_cast<std::size_t>(count_) * words_;
+    // The bitmasks live whole on the device and the host: refuse what the budget (half the
+    // device's memory) cannot hold rather than fail in the allocation.
+    const std::size_t budget = memoryBudget();
     if (entries * sizeof(std::uint32_t) > budget)
       throw MemoryBudgetError("the bitmasks need " + detail::mebibytes(entries * sizeof(std::uint32_t)) +
                               " but half the device's memory is " + detail::mebibytes(budget) +
                               "; take fewer samples or a smaller field");
-    const cl::Buffer bits = detail::deviceBuffer(st, entries * sizeof(std::uint32_t));
-    const double max_d2 = options.max_distance * options.max_distance;
-    const DeviceField device{field.width,
-                             field.height,
-                             static_cast<float>(field.cell_size_x),
-                             static_cast<float>(field.cell_size_y),
-                             static_cast<float>(options.curvature),
-                             options.max_distance > 0.0 ? static_cast<float>(max_d2) : 0.0f};
-    cl::Kernel k(program, "region_visibility_bits");
-    k.setArg(0, h);
-    k.setArg(1, device);
-    k.setArg(2, source_table);
-    k.setArg(3, cl_int(source_absolute));
-    k.setArg(4, cl_int(samples));
-    k.setArg(5, cl_int(receivers == nullptr));
-    k.setArg(6, receiver_table);
-    k.setArg(7, cl_int(receiver_absolute));
-    k.setArg(8, cl_int(count));
-    k.setArg(9, static_cast<float>(options.target_height));
-    k.setArg(10, cl_uint(options.seed));
-    k.setArg(11, cl_int(options.decorrelate));
-    k.setArg(12, cl_int(words));
-    k.setArg(13, cl_int(receiver_major));
-    k.setArg(15, bits);
-    for (int first = 0; first < count; first += kReceiversPerLaunch) {
-      const int chunk = std::min(kReceiversPerLaunch, count - first);
-      k.setArg(14, cl_int(first));
-      st.launch(k, cl::NDRange(detail::roundUp(chunk, detail::kLineGroup), words),
-                cl::NDRange(detail::kLineGroup, 1));
-    }
+    source_table_ = upload(sources_);
+    // A pixel run binds the source table in the receivers' place (never read).
+    receiver_table_ = receivers_ ? upload(*receivers_) : source_table_;
+    bits_ = detail::deviceBuffer(st_, entries * sizeof(std::uint32_t));
+    const double max_d2 = options_.max_distance * options_.max_distance;
+    const DeviceField device{field_.width,
+                             field_.height,
+                             static_cast<float>(field_.cell_size_x),
+                             static_cast<float>(field_.cell_size_y),
+                             static_cast<float>(options_.curvature),
+                             options_.max_distance > 0.0 ? static_cast<float>(max_d2) : 0.0f};
+    kernel_ = kernel("region_visibility_bits");
+    kernel_.set("h", heights_)
+        .set("f", device)
+        .set("sources", source_table_)
+        .set("source_absolute", cl_int(source_absolute_))
+        .set("samples", cl_int(samples_))
+        .set("pixel_receivers", cl_int(receivers_ == nullptr))
+        .set("receivers", receiver_table_)
+        .set("receiver_absolute", cl_int(receiver_absolute_))
+        .set("receiver_count", cl_int(count_))
+        .set("target_height", static_cast<float>(options_.target_height))
+        .set("seed", cl_uint(options_.seed))
+        .set("decorrelate", cl_int(options_.decorrelate))
+        .set("words", cl_int(words_))
+        .set("receiver_major", cl_int(receiver_major_))
+        .set("bits", bits_);
+  }
+
+  int itemCount() const override { return (count_ + kReceiversPerLaunch - 1) / kReceiversPerLaunch; }
+
+  void runItem(int item, int) override {
+    const int first = item * kReceiversPerLaunch, chunk = std::min(kReceiversPerLaunch, count_ - first);
+    kernel_.set("first", cl_int(first));
+    st_.launch(kernel_, cl::NDRange(detail::roundUp(chunk, detail::kLineGroup), words_),
+               cl::NDRange(detail::kLineGroup, 1));
+  }
+
+  void finish() override {
+    const std::size_t entries = static_cast<std::size_t>(count_) * words_;
     std::vector<std::uint32_t> out(entries);
-    st.queue.enqueueReadBuffer(bits, CL_TRUE, 0, entries * sizeof(std::uint32_t), out.data());
-    if (receiver_major) return out;
-    std::vector<std::uint32_t> transposed(entries);
-    for (int r = 0; r < count; ++r)
-      for (int w = 0; w < words; ++w)
-        transposed[std::size_t(r) * words + w] = out[std::size_t(w) * count + r];
-    return transposed;
+    st_.queue.enqueueReadBuffer(bits_, CL_TRUE, 0, entries * sizeof(std::uint32_t), out.data());
+    if (receiver_major_) {
+      bits = std::move(out);
+      return;
+    }
+    bits.resize(entries);
+    for (int r = 0; r < count_; ++r)
+      for (int w = 0; w < words_; ++w) bits[std::size_t(r) * words_ + w] = out[std::size_t(w) * count_ + r];
+  }
+
+  const std::vector<float>& sources_;
+  const bool source_absolute_;
+  const std::vector<float>* receivers_;
+  const bool receiver_absolute_;
+  const int count_;
+  const RegionVisibilityOptions& options_;
+  const int samples_, words_;
+  bool receiver_major_ = true;
+  cl::Buffer source_table_, receiver_table_, bits_;
+  detail::NamedKernel kernel_;
+};
+
+std::vector<std::uint32_t> runBits(const ComputeContext& context, const HeightField& field,
+                                   const std::vector<float>& sources, bool source_absolute,
+                                   const std::vector<float>* receivers, bool receiver_absolute, int count,
+                                   const RegionVisibilityOptions& options) {
+  return detail::translateOpenClErrors([&] {
+    RegionBitsRoutine routine(detail::stateOf(context), field, sources, source_absolute, receivers, receiver_absolute,
+                              count, options);
+    routine.run();
+    return std::move(routine.bits);
   });
 }
 
@@ -148,12 +189,21 @@ std::vector<std::uint32_t> viewshedBits(const ComputeContext& context, const Hei
 
 namespace detail {
 
-std::vector<float> regionHeights(const HeightField& field) {
-  std::vector<float> h(field.pixelCount());
-  for (std::size_t p = 0; p < h.size(); ++p)
-    h[p] = std::isfinite(field.heights[p]) ? static_cast<float>(field.heights[p] * field.z_scale)
-                                           : std::numeric_limits<float>::quiet_NaN();
-  return h;
+void countPairFractions(RegionPairVisibilityResult& out) {
+  out.pairs = static_cast<std::uint64_t>(out.source_samples) * out.receiver_samples;
+  out.clear_pairs = 0;
+  out.source_fraction.assign(out.source_samples, 0.0f);
+  out.receiver_fraction.assign(out.receiver_samples, 0.0f);
+  std::vector<int> seen_by(out.source_samples, 0);
+  for (int r = 0; r < out.receiver_samples; ++r) {
+    int seen = 0;
+    for (int s = 0; s < out.source_samples; ++s)
+      if (out.visible(r, s)) ++seen, ++seen_by[s];
+    out.clear_pairs += seen;
+    out.receiver_fraction[r] = static_cast<float>(static_cast<double>(seen) / out.source_samples);
+  }
+  for (int s = 0; s < out.source_samples; ++s)
+    out.source_fraction[s] = static_cast<float>(static_cast<double>(seen_by[s]) / out.receiver_samples);
 }
 
 std::vector<float> regionSampleTable(const HeightField& field, const RegionSampling& sampling) {
@@ -214,7 +264,7 @@ void validate(const HeightField& field, const RegionSampling& sampling) {
     if (sampling.points.size() > static_cast<std::size_t>(kMaxRegionSamples))
       throw InvalidArgument("a region takes at most " + std::to_string(kMaxRegionSamples) + " points (got " +
                             std::to_string(sampling.points.size()) + ")");
-    const std::vector<float> heights = detail::regionHeights(field);
+    const std::vector<float> heights = detail::prepareHeights(field, detail::HeightOrigin::Zero).heights;
     for (const RegionPoint& p : sampling.points) {
       const std::string at = std::to_string(p.col) + "," + std::to_string(p.row);
       if (!(p.col >= 0.0 && p.col <= field.width - 1.0 && p.row >= 0.0 && p.row <= field.height - 1.0))
@@ -250,7 +300,7 @@ std::vector<RegionPoint> regionSamplePoints(const HeightField& field, const Regi
                                             std::uint32_t seed) {
   validate(field);
   const std::vector<float> table = detail::regionSampleTable(field, sampling);
-  const std::vector<float> heights = detail::regionHeights(field);
+  const std::vector<float> heights = detail::prepareHeights(field, detail::HeightOrigin::Zero).heights;
   std::vector<RegionPoint> points;
   for (int s = 0; s < detail::regionTableSamples(table); ++s) {
     float x, y, z;
@@ -267,7 +317,7 @@ RegionVisibilityResult computeRegionVisibility(const ComputeContext& context, co
   validateField(field);
   validate(options);
   const std::vector<float> table = detail::regionSampleTable(field, sources);
-  const std::vector<float> heights = detail::regionHeights(field);
+  const std::vector<float> heights = detail::prepareHeights(field, detail::HeightOrigin::Zero).heights;
   RegionVisibilityResult out;
   out.width = field.width;
   out.height = field.height;
@@ -277,7 +327,7 @@ RegionVisibilityResult computeRegionVisibility(const ComputeContext& context, co
   if (options.method == RegionVisibilityMethod::Viewsheds)
     out.bits = viewshedBits(context, field, regionSamplePoints(field, sources, options.seed), options);
   else
-    out.bits = runBits(context, field, heights, table, sources.absolute, nullptr, false, count, options);
+    out.bits = runBits(context, field, table, sources.absolute, nullptr, false, count, options);
   out.fraction.resize(field.pixelCount());
   for (int p = 0; p < count; ++p) {
     int seen = 0;
@@ -299,28 +349,16 @@ RegionPairVisibilityResult computeRegionPairVisibility(const ComputeContext& con
     throw InvalidArgument("the viewsheds method takes every-pixel receivers, not a region pair");
   const std::vector<float> source_table = detail::regionSampleTable(field, sources);
   const std::vector<float> receiver_table = detail::regionSampleTable(field, receivers);
-  const std::vector<float> heights = detail::regionHeights(field);
+  const std::vector<float> heights = detail::prepareHeights(field, detail::HeightOrigin::Zero).heights;
   RegionPairVisibilityResult out;
   out.source_samples = detail::regionTableSamples(source_table);
   out.receiver_samples = detail::regionTableSamples(receiver_table);
   out.words = (out.source_samples + 31) / 32;
   out.sources = regionSamplePoints(field, sources, options.seed);
   out.receivers = regionSamplePoints(field, receivers, options.seed);
-  out.bits = runBits(context, field, heights, source_table, sources.absolute, &receiver_table,
+  out.bits = runBits(context, field, source_table, sources.absolute, &receiver_table,
                      receivers.absolute, out.receiver_samples, options);
-  out.pairs = static_cast<std::uint64_t>(out.source_samples) * out.receiver_samples;
-  out.source_fraction.assign(out.source_samples, 0.0f);
-  out.receiver_fraction.assign(out.receiver_samples, 0.0f);
-  std::vector<int> seen_by(out.source_samples, 0);
-  for (int r = 0; r < out.receiver_samples; ++r) {
-    int seen = 0;
-    for (int s = 0; s < out.source_samples; ++s)
-      if (out.visible(r, s)) ++seen, ++seen_by[s];
-    out.clear_pairs += seen;
-    out.receiver_fraction[r] = static_cast<float>(static_cast<double>(seen) / out.source_samples);
-  }
-  for (int s = 0; s < out.source_samples; ++s)
-    out.source_fraction[s] = static_cast<float>(static_cast<double>(seen_by[s]) / out.receiver_samples);
+  detail::countPairFractions(out);
   return out;
 }
 

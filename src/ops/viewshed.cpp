@@ -11,6 +11,7 @@
 #include "core/horizon_common.hpp"
 #include "core/opencl_context.hpp"
 #include "core/sweep_framework.hpp"
+#include "core/sweep_routine.hpp"
 
 namespace hfvis {
 namespace {
@@ -42,149 +43,185 @@ cl_int4 targetBox(const HeightField& field, const Observer& o, double max_distan
   return box;
 }
 
-// The device side of one field, kept for every observer of a call.
-class ViewshedRun {
+// The viewsheds of a call, one routine item per observer, over one field whose device side
+// (the heights, the rays' slope bounds, the maximum pyramid, the culling pyramid) is set up
+// once: one observer's outputs, or (counting) per point the number of observers that see it.
+class ViewshedRoutine : public detail::DeviceRoutine {
  public:
-  ViewshedRun(detail::ContextState& st, const HeightField& field, const ViewshedOptions& options)
-      : st_(st),
-        field_(field),
+  // `outputs` null: count (the cumulative viewshed, which reports progress per observer).
+  ViewshedRoutine(detail::ContextState& st, const HeightField& field, const ViewshedOptions& options,
+                  const std::vector<Observer>& observers, const ViewshedOutputs* outputs)
+      : DeviceRoutine(st, field, outputs ? nullptr : options.progress, options.memory_budget_bytes),
         options_(options),
-        lanes_(detail::simdLanes(st)),
-        program_(st.program("viewshed.cl", "-DHFVIS_LANES=" + std::to_string(lanes_))) {
-    const std::size_t pixels = field.pixelCount();
-    heights_.resize(pixels);
-    for (std::size_t p = 0; p < pixels; ++p)
-      heights_[p] = std::isfinite(field.heights[p]) ? static_cast<float>(field.heights[p] * field.z_scale)
-                                                    : std::numeric_limits<float>::quiet_NaN();
-    device_ = {field.width, field.height, static_cast<float>(field.cell_size_x), static_cast<float>(field.cell_size_y),
-               static_cast<float>(options.curvature)};
-    heights_buffer_ = cl::Buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, pixels * sizeof(float),
-                                 heights_.data());
-    const int cells_x = std::max(field.width - 1, 1), cells_y = std::max(field.height - 1, 1);
-    const std::size_t cells = static_cast<std::size_t>(cells_x) * cells_y;
-    const cl::NDRange cell_range(detail::roundUp(cells_x, detail::kTileX), detail::roundUp(cells_y, detail::kTileY));
-    const cl::Buffer slopes = detail::deviceBuffer(st, cells * sizeof(float));
-    lipschitz_ = detail::deviceBuffer(st, cells * sizeof(float));
-    cl::Kernel slope(program_, "viewshed_slopes");
-    slope.setArg(0, heights_buffer_);
-    slope.setArg(1, device_);
-    slope.setArg(2, slopes);
-    st.launch(slope, cell_range, cl::NDRange(detail::kTileX, detail::kTileY));
-    cl::Kernel k(program_, "viewshed_lipschitz");
-    k.setArg(0, slopes);
-    k.setArg(1, device_);
-    k.setArg(2, lipschitz_);
-    st.launch(k, cell_range, cl::NDRange(detail::kTileX, detail::kTileY));
-    buildPyramid(cells_x, cells_y);
-    if (options.pyramid) uploadCulling(*options.pyramid);
+        observers_(observers),
+        outputs_(outputs),
+        lanes_(detail::simdLanes(st)) {}
+
+  // After run(): the outputs asked for (visible holds the counts when counting) and the
+  // statistics.
+  ViewshedResult take() { return std::move(result_); }
+
+ private:
+  bool counting() const { return outputs_ == nullptr; }
+
+  // Heights as the observers' and targets' heights are given: scaled, not moved to the lowest.
+  detail::PreparedHeights prepare() override {
+    return detail::prepareHeights(field_, detail::HeightOrigin::Zero);
+  }
+  std::string programFile() const override { return "viewshed.cl"; }
+  std::string programOptions() const override { return "-DHFVIS_LANES=" + std::to_string(lanes_); }
+
+  // The plan (whether the rays' bounds fit the budget), the per-field bounds and pyramids,
+  // the per-observer scratch and the outputs.
+  void allocate() override {
+    device_ = {field_.width, field_.height, static_cast<float>(field_.cell_size_x),
+               static_cast<float>(field_.cell_size_y), static_cast<float>(options_.curvature)};
+    const std::size_t pixels = field_.pixelCount();
     // The rays' upper bounds, a float per point, where the budget leaves room for them (else
     // every target is marched).
-    const std::size_t budget =
-        options.memory_budget_bytes ? options.memory_budget_bytes : detail::defaultMemoryBudget(st.info);
-    ray_hi_budgeted_ = pixels * sizeof(float) <= budget / 2;
-    ray_hi_ = detail::deviceBuffer(st, ray_hi_budgeted_ ? pixels * sizeof(float) : sizeof(float));
-    pending_ = detail::deviceBuffer(st, pixels);
-    pending_list_ = detail::deviceBuffer(st, pixels * sizeof(cl_uint));
-    row_counts_ = detail::deviceBuffer(st, static_cast<std::size_t>(field.height) * sizeof(cl_uint));
+    ray_hi_budgeted_ = pixels * sizeof(float) <= memoryBudget() / 2;
+    boundSlopes();
+    buildPyramid();
+    if (options_.pyramid) uploadCulling(*options_.pyramid);
+    ray_hi_ = detail::deviceBuffer(st_, ray_hi_budgeted_ ? pixels * sizeof(float) : sizeof(float));
+    pending_ = detail::deviceBuffer(st_, pixels);
+    pending_list_ = detail::deviceBuffer(st_, pixels * sizeof(cl_uint));
+    row_counts_ = detail::deviceBuffer(st_, static_cast<std::size_t>(field_.height) * sizeof(cl_uint));
+    visible_ = counting() ? zeros(pixels) : output();
+    if (!counting() && outputs_->angle) angle_ = output();
+    if (!counting() && outputs_->needed_height) needed_ = output();
   }
 
-  // One observer's targets into `visible` (added to it when `accumulate`) and, if given, `angle`.
-  void observe(const Observer& o, cl::Buffer& visible, bool accumulate, cl::Buffer* angle,
-               cl::Buffer* needed = nullptr) {
-    const float ze = static_cast<float>(options_.absolute ? o.height
-                                                          : heights_[static_cast<std::size_t>(o.row) * field_.width + o.col] + o.height);
+  int itemCount() const override { return static_cast<int>(observers_.size()); }
+  void runItem(int item, int) override { observe(observers_[item]); }
+
+  void finish() override {
+    result_.width = field_.width;
+    result_.height = field_.height;
+    result_.marched = pending_targets_;
+    result_.culled = culled_targets_;
+    if (counting() || outputs_->visible) result_.visible = read(visible_);
+    if (counting()) return;
+    if (outputs_->angle) result_.angle = read(angle_);
+    if (outputs_->needed_height) result_.needed_height = read(needed_);
+    if (outputs_->culled_mask) result_.culled_mask = culledMask();
+  }
+
+  // One observer: what needs no sight line settled, the rays, the march of what they leave, and
+  // the needed heights.
+  void observe(const Observer& o) {
+    const float ze = static_cast<float>(
+        options_.absolute
+            ? o.height
+            : prepared_.heights[static_cast<std::size_t>(o.row) * field_.width + o.col] + o.height);
     const cl_int4 box = targetBox(field_, o, options_.max_distance);
     const cl_int4 cull_leaf = cull(o, ze);
     const int w1 = box.s[2] - box.s[0], h1 = box.s[3] - box.s[1];
     const double far_pixels = std::max({o.col - box.s[0], box.s[2] - o.col, o.row - box.s[1], box.s[3] - o.row});
     const bool use_rays = ray_hi_budgeted_ && !options_.march_every_target && w1 >= 1 && h1 >= 1 &&
                           far_pixels >= kLeastRayPixels;
-    // The field of view's span clockwise; 0 (equal azimuths, or 0 and 360) is the whole circle.
+    classify(o, ze, box, cull_leaf, use_rays);
+    // The rays settle most pending targets, or leave them an upper bound for the march.
+    if (use_rays) castRays(o, ze, box, cull_leaf);
+    marchPending(o, ze, use_rays);
+    if (!counting() && outputs_->needed_height) markNeeded(o, ze);
+    st_.queue.finish();  // before this observer's ray buffers go
+  }
+
+  // The arguments of the kernels that follow sight lines from eye o at height ze: the field,
+  // the eye and the targets' height above the ground.
+  void setEye(detail::NamedKernel& k, const Observer& o, float ze) const {
+    k.set("h", heights_);
+    k.set("f", device_);
+    k.set("ex_i", o.col);
+    k.set("ey_i", o.row);
+    k.set("ze", ze);
+    k.set("target_height", static_cast<float>(options_.target_height));
+  }
+
+  // The field of view's arguments: the maximum distance, the azimuths (their span clockwise in
+  // degrees; 360, equal azimuths or 0 and 360, is the whole circle) and the elevations.
+  void setFieldOfView(detail::NamedKernel& k) const {
     double az_span = std::fmod(options_.azimuth_to_deg - options_.azimuth_from_deg, 360.0);
     if (az_span < 0.0) az_span += 360.0;
     if (az_span == 0.0) az_span = 360.0;
-    // Settle what needs no sight line; the rest is pending, for the rays and then the march.
-    cl::Kernel k(program_, "viewshed_classify");
-    int a = 0;
-    k.setArg(a++, heights_buffer_);
-    k.setArg(a++, device_);
-    k.setArg(a++, o.col);
-    k.setArg(a++, o.row);
-    k.setArg(a++, ze);
-    k.setArg(a++, static_cast<float>(options_.target_height));
-    k.setArg(a++, box);
-    k.setArg(a++, static_cast<float>(options_.max_distance));
-    k.setArg(a++, az_span < 360.0 ? 1 : 0);
-    k.setArg(a++, static_cast<float>(options_.azimuth_from_deg));
-    k.setArg(a++, static_cast<float>(az_span));
-    k.setArg(a++, static_cast<float>(options_.elevation_min_deg * kDegree));
-    k.setArg(a++, static_cast<float>(options_.elevation_max_deg * kDegree));
-    k.setArg(a++, cull_levels_.empty() ? pending_ : culled_);
-    k.setArg(a++, cull_leaf);
-    k.setArg(a++, visible);
-    k.setArg(a++, accumulate ? 1 : 0);
-    k.setArg(a++, angle ? 1 : 0);
-    k.setArg(a++, angle ? *angle : visible);
-    k.setArg(a++, pending_);
-    k.setArg(a++, use_rays ? 1 : 0);
-    k.setArg(a++, ray_hi_);
-    st_.launch(k, cl::NDRange(detail::roundUp(field_.width, detail::kTileX), detail::roundUp(field_.height, detail::kTileY)),
-               cl::NDRange(detail::kTileX, detail::kTileY));
-    // The rays settle most pending targets, or leave them an upper bound for the march.
-    if (use_rays) {
-      const int rays = 2 * w1 + 2 * h1;
-      const float unit = static_cast<float>(std::min(field_.cell_size_x, field_.cell_size_y));
-      // With the culling pyramid: how far each ray must go to serve the kept nodes' targets.
-      cl::Buffer need = detail::deviceBuffer(st_, sizeof(cl_int));
-      if (cull_leaf.s[0] > 0) {
-        need = detail::deviceBuffer(st_, rays * sizeof(cl_int));
-        st_.queue.enqueueFillBuffer(need, cl_int(-1), 0, rays * sizeof(cl_int));
-        cl::Kernel n(program_, "viewshed_ray_need");
-        a = 0;
-        n.setArg(a++, culled_);
-        n.setArg(a++, cull_leaf);
-        n.setArg(a++, device_);
-        n.setArg(a++, o.col);
-        n.setArg(a++, o.row);
-        n.setArg(a++, box);
-        n.setArg(a++, rays);
-        n.setArg(a++, unit);
-        n.setArg(a++, need);
-        st_.launch(n,
-                   cl::NDRange(detail::roundUp(cull_leaf.s[0], detail::kTileX),
-                               detail::roundUp(cull_leaf.s[1], detail::kTileY)),
-                   cl::NDRange(detail::kTileX, detail::kTileY));
-      }
-      cl::Kernel r(program_, "viewshed_rays");
-      a = 0;
-      r.setArg(a++, heights_buffer_);
-      r.setArg(a++, device_);
-      r.setArg(a++, lipschitz_);
-      r.setArg(a++, o.col);
-      r.setArg(a++, o.row);
-      r.setArg(a++, ze);
-      r.setArg(a++, static_cast<float>(options_.target_height));
-      r.setArg(a++, box);
-      r.setArg(a++, rays);
-      r.setArg(a++, need);
-      r.setArg(a++, cull_leaf.s[0] > 0 ? 1 : 0);
-      r.setArg(a++, unit);
-      r.setArg(a++, pending_);
-      r.setArg(a++, ray_hi_);
-      r.setArg(a++, visible);
-      r.setArg(a++, accumulate ? 1 : 0);
-      const std::size_t items = (static_cast<std::size_t>(rays) + lanes_ - 1) / lanes_;  // lanes_ rays each
-      st_.launch(r, cl::NDRange(detail::roundUp(items, detail::kLineGroup)), cl::NDRange(detail::kLineGroup));
+    k.set("max_distance", static_cast<float>(options_.max_distance));
+    k.set("az_on", az_span < 360.0 ? 1 : 0);
+    k.set("az_from", static_cast<float>(options_.azimuth_from_deg));
+    k.set("az_span", static_cast<float>(az_span));
+    k.set("el_lo", static_cast<float>(options_.elevation_min_deg * kDegree));
+    k.set("el_hi", static_cast<float>(options_.elevation_max_deg * kDegree));
+  }
+
+  // Settles what needs no sight line; the rest is pending, for the rays and then the march.
+  void classify(const Observer& o, float ze, const cl_int4& box, const cl_int4& cull_leaf, bool use_rays) {
+    const bool angle = !counting() && outputs_->angle;
+    detail::NamedKernel k = kernel("viewshed_classify");
+    setEye(k, o, ze);
+    k.set("box", box);
+    setFieldOfView(k);
+    k.set("culled", cull_levels_.empty() ? pending_ : culled_);
+    k.set("cull_level", cull_leaf);
+    k.set("out_visible", visible_);
+    k.set("accumulate", counting() ? 1 : 0);
+    k.set("want_angle", angle ? 1 : 0);
+    k.set("out_angle", angle ? angle_ : visible_);
+    k.set("pending", pending_);
+    k.set("rays_on", use_rays ? 1 : 0);
+    k.set("ray_hi", ray_hi_);
+    st_.launch(k, pixelRange(), pixelGroup());
+  }
+
+  void castRays(const Observer& o, float ze, const cl_int4& box, const cl_int4& cull_leaf) {
+    const int rays = 2 * (box.s[2] - box.s[0]) + 2 * (box.s[3] - box.s[1]);
+    const float unit = static_cast<float>(std::min(field_.cell_size_x, field_.cell_size_y));
+    // With the culling pyramid: how far each ray must go to serve the kept nodes' targets.
+    cl::Buffer need = detail::deviceBuffer(st_, sizeof(cl_int));
+    if (cull_leaf.s[0] > 0) {
+      need = detail::deviceBuffer(st_, rays * sizeof(cl_int));
+      st_.queue.enqueueFillBuffer(need, cl_int(-1), 0, rays * sizeof(cl_int));
+      detail::NamedKernel n = kernel("viewshed_ray_need");
+      n.set("culled", culled_);
+      n.set("leaf", cull_leaf);
+      n.set("f", device_);
+      n.set("ex_i", o.col);
+      n.set("ey_i", o.row);
+      n.set("box", box);
+      n.set("rays", rays);
+      n.set("unit", unit);
+      n.set("need", need);
+      st_.launch(n,
+                 cl::NDRange(detail::roundUp(cull_leaf.s[0], detail::kTileX),
+                             detail::roundUp(cull_leaf.s[1], detail::kTileY)),
+                 pixelGroup());
     }
-    // March the pending targets, listed row by row.
+    detail::NamedKernel r = kernel("viewshed_rays");
+    setEye(r, o, ze);
+    r.set("lipschitz", lipschitz_);
+    r.set("box", box);
+    r.set("rays", rays);
+    r.set("need", need);
+    r.set("use_need", cull_leaf.s[0] > 0 ? 1 : 0);
+    r.set("unit", unit);
+    r.set("pending", pending_);
+    r.set("ray_hi", ray_hi_);
+    r.set("out_visible", visible_);
+    r.set("accumulate", counting() ? 1 : 0);
+    const std::size_t items = (static_cast<std::size_t>(rays) + lanes_ - 1) / lanes_;  // lanes_ rays each
+    st_.launch(r, cl::NDRange(detail::roundUp(items, detail::kLineGroup)), cl::NDRange(detail::kLineGroup));
+  }
+
+  // Marches the pending targets, listed row by row.
+  void marchPending(const Observer& o, float ze, bool use_rays) {
     const cl::NDRange row_range(detail::roundUp(field_.height, detail::kLineGroup));
-    cl::Kernel count(program_, "viewshed_pending_count");
-    count.setArg(0, pending_);
-    count.setArg(1, field_.width);
-    count.setArg(2, field_.height);
-    count.setArg(3, row_counts_);
+    detail::NamedKernel count = kernel("viewshed_pending_count");
+    count.set("pending", pending_);
+    count.set("width", field_.width);
+    count.set("height", field_.height);
+    count.set("counts", row_counts_);
     st_.launch(count, row_range, cl::NDRange(detail::kLineGroup));
-    std::vector<cl_uint> rows(field_.height);
+    std::vector<cl_uint>& rows = row_offsets_;
+    rows.resize(field_.height);
     st_.queue.enqueueReadBuffer(row_counts_, CL_TRUE, 0, rows.size() * sizeof(cl_uint), rows.data());
     cl_uint total = 0;
     for (cl_uint& r : rows) {
@@ -193,62 +230,39 @@ class ViewshedRun {
       total += n;
     }
     pending_targets_ += total;
-    if (total > 0) {
-      st_.queue.enqueueWriteBuffer(row_counts_, CL_FALSE, 0, rows.size() * sizeof(cl_uint), rows.data());
-      cl::Kernel list(program_, "viewshed_pending_list");
-      list.setArg(0, pending_);
-      list.setArg(1, field_.width);
-      list.setArg(2, field_.height);
-      list.setArg(3, row_counts_);
-      list.setArg(4, pending_list_);
-      st_.launch(list, row_range, cl::NDRange(detail::kLineGroup));
-      cl::Kernel m(program_, "viewshed_march");
-      a = 0;
-      m.setArg(a++, heights_buffer_);
-      m.setArg(a++, device_);
-      m.setArg(a++, o.col);
-      m.setArg(a++, o.row);
-      m.setArg(a++, ze);
-      m.setArg(a++, static_cast<float>(options_.target_height));
-      m.setArg(a++, use_rays ? 1 : 0);
-      m.setArg(a++, ray_hi_);
-      m.setArg(a++, pyramid_);
-      m.setArg(a++, levels_);
-      m.setArg(a++, top_);
-      m.setArg(a++, pending_list_);
-      m.setArg(a++, total);
-      m.setArg(a++, visible);
-      m.setArg(a++, accumulate ? 1 : 0);
-      st_.launch(m, cl::NDRange(detail::roundUp(total, detail::kLineGroup)), cl::NDRange(detail::kLineGroup));
-    }
-    if (needed) {
-      cl::Kernel n(program_, "viewshed_needed");
-      a = 0;
-      n.setArg(a++, heights_buffer_);
-      n.setArg(a++, device_);
-      n.setArg(a++, o.col);
-      n.setArg(a++, o.row);
-      n.setArg(a++, ze);
-      n.setArg(a++, static_cast<float>(options_.target_height));
-      n.setArg(a++, static_cast<float>(options_.max_distance));
-      n.setArg(a++, az_span < 360.0 ? 1 : 0);
-      n.setArg(a++, static_cast<float>(options_.azimuth_from_deg));
-      n.setArg(a++, static_cast<float>(az_span));
-      n.setArg(a++, static_cast<float>(options_.elevation_min_deg * kDegree));
-      n.setArg(a++, static_cast<float>(options_.elevation_max_deg * kDegree));
-      n.setArg(a++, pyramid_);
-      n.setArg(a++, levels_);
-      n.setArg(a++, top_);
-      n.setArg(a++, *needed);
-      st_.launch(n, cl::NDRange(detail::roundUp(field_.width, detail::kTileX), detail::roundUp(field_.height, detail::kTileY)),
-                 cl::NDRange(detail::kTileX, detail::kTileY));
-    }
-    st_.queue.finish();  // before this observer's ray buffers go
+    if (total == 0) return;
+    st_.queue.enqueueWriteBuffer(row_counts_, CL_FALSE, 0, rows.size() * sizeof(cl_uint), rows.data());
+    detail::NamedKernel list = kernel("viewshed_pending_list");
+    list.set("pending", pending_);
+    list.set("width", field_.width);
+    list.set("height", field_.height);
+    list.set("offsets", row_counts_);
+    list.set("list", pending_list_);
+    st_.launch(list, row_range, cl::NDRange(detail::kLineGroup));
+    detail::NamedKernel m = kernel("viewshed_march");
+    setEye(m, o, ze);
+    m.set("rays_on", use_rays ? 1 : 0);
+    m.set("ray_hi", ray_hi_);
+    m.set("pyramid", pyramid_);
+    m.set("levels", levels_);
+    m.set("top_level", top_);
+    m.set("list", pending_list_);
+    m.set("count", total);
+    m.set("out_visible", visible_);
+    m.set("accumulate", counting() ? 1 : 0);
+    st_.launch(m, cl::NDRange(detail::roundUp(total, detail::kLineGroup)), cl::NDRange(detail::kLineGroup));
   }
 
-  // Targets marched so far (the rest were settled by classification), and valid targets culled.
-  std::size_t pendingTargets() const { return pending_targets_; }
-  std::size_t culledTargets() const { return culled_targets_; }
+  void markNeeded(const Observer& o, float ze) {
+    detail::NamedKernel n = kernel("viewshed_needed");
+    setEye(n, o, ze);
+    setFieldOfView(n);
+    n.set("pyramid", pyramid_);
+    n.set("levels", levels_);
+    n.set("top_level", top_);
+    n.set("out_needed", needed_);
+    st_.launch(n, pixelRange(), pixelGroup());
+  }
 
   // The last observer's culled points: 1 / 0, NaN at nodata.
   std::vector<float> culledMask() const {
@@ -257,7 +271,7 @@ class ViewshedRun {
     for (int y = 0; y < field_.height; ++y)
       for (int x = 0; x < field_.width; ++x) {
         const std::size_t p = static_cast<std::size_t>(y) * field_.width + x;
-        if (std::isnan(heights_[p]))
+        if (std::isnan(prepared_.heights[p]))
           mask[p] = std::numeric_limits<float>::quiet_NaN();
         else if (!leaf_flags_.empty() && leaf_flags_[static_cast<std::size_t>(y >> k) * nx + (x >> k)])
           mask[p] = 1.0f;
@@ -275,17 +289,14 @@ class ViewshedRun {
       nodes += static_cast<std::size_t>(level->nodes_x) * level->nodes_y;
       regions.insert(regions.end(), level->regions.begin(), level->regions.end());
     }
-    cull_regions_ = cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, regions.size() * sizeof(float),
-                               regions.data());
+    cull_regions_ = upload(regions);
     std::vector<cl_float2> spans(pyramid.sectors);
     for (int s = 0; s < pyramid.sectors; ++s) spans[s] = cl_float2{{pyramid.sector_start[s], pyramid.sector_width[s]}};
-    cull_spans_ = cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, spans.size() * sizeof(cl_float2),
-                             spans.data());
+    cull_spans_ = upload(spans);
     std::vector<float> breaks(ViewshedPyramid::kBreakpoints);
     for (int i = 0; i < ViewshedPyramid::kBreakpoints; ++i)
       breaks[i] = static_cast<float>(pyramid.reach * ViewshedPyramid::breakFraction(i));
-    cull_breaks_ = cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, breaks.size() * sizeof(float),
-                              breaks.data());
+    cull_breaks_ = upload(breaks);
     culled_ = detail::deviceBuffer(st_, nodes);
     cull_sectors_ = pyramid.sectors;
     valid_points_ = &pyramid.valid_points;
@@ -297,22 +308,23 @@ class ViewshedRun {
     if (cull_levels_.empty()) return cl_int4{{0, 0, 0, 0}};
     for (std::size_t l = 0; l < cull_levels_.size(); ++l) {
       const cl_int4 level = cull_levels_[l];
-      cl::Kernel k(program_, "viewshed_cull");
-      int a = 0;
-      k.setArg(a++, cull_regions_);
-      k.setArg(a++, level);
-      k.setArg(a++, l > 0 ? cull_levels_[l - 1] : level);
-      k.setArg(a++, l > 0 ? 1 : 0);
-      k.setArg(a++, cull_sectors_);
-      k.setArg(a++, cull_spans_);
-      k.setArg(a++, cull_breaks_);
-      k.setArg(a++, device_);
-      k.setArg(a++, static_cast<float>(o.col));
-      k.setArg(a++, static_cast<float>(o.row));
-      k.setArg(a++, ze);
-      k.setArg(a++, culled_);
-      st_.launch(k, cl::NDRange(detail::roundUp(level.s[0], detail::kTileX), detail::roundUp(level.s[1], detail::kTileY)),
-                 cl::NDRange(detail::kTileX, detail::kTileY));
+      detail::NamedKernel k = kernel("viewshed_cull");
+      k.set("regions", cull_regions_);
+      k.set("level", level);
+      k.set("parent", l > 0 ? cull_levels_[l - 1] : level);
+      k.set("has_parent", l > 0 ? 1 : 0);
+      k.set("sectors", cull_sectors_);
+      k.set("spans", cull_spans_);
+      k.set("breaks", cull_breaks_);
+      k.set("f", device_);
+      k.set("ex", static_cast<float>(o.col));
+      k.set("ey", static_cast<float>(o.row));
+      k.set("ze", ze);
+      k.set("culled", culled_);
+      st_.launch(k,
+                 cl::NDRange(detail::roundUp(level.s[0], detail::kTileX),
+                             detail::roundUp(level.s[1], detail::kTileY)),
+                 pixelGroup());
     }
     const cl_int4 leaf = cull_levels_.back();
     std::vector<unsigned char> flags(static_cast<std::size_t>(leaf.s[0]) * leaf.s[1]);
@@ -322,36 +334,64 @@ class ViewshedRun {
     return leaf;
   }
 
+  // The rays' slope bounds: each cell's steepest slope, and its Lipschitz bound (kernels/viewshed.cl).
+  void boundSlopes() {
+    const std::size_t cells = static_cast<std::size_t>(cellsX()) * cellsY();
+    const cl::NDRange cell_range(detail::roundUp(cellsX(), detail::kTileX),
+                                 detail::roundUp(cellsY(), detail::kTileY));
+    const cl::Buffer slopes = detail::deviceBuffer(st_, cells * sizeof(float));
+    lipschitz_ = detail::deviceBuffer(st_, cells * sizeof(float));
+    detail::NamedKernel slope = kernel("viewshed_slopes");
+    slope.set("h", heights_);
+    slope.set("f", device_);
+    slope.set("slopes", slopes);
+    st_.launch(slope, cell_range, pixelGroup());
+    detail::NamedKernel k = kernel("viewshed_lipschitz");
+    k.set("slopes", slopes);
+    k.set("f", device_);
+    k.set("lipschitz", lipschitz_);
+    st_.launch(k, cell_range, pixelGroup());
+  }
+
   // The maximum pyramid's levels 1 .. top_ (kernels/viewshed.cl), up to blocks of 4096 cells or one
   // block over the field.
-  void buildPyramid(int cells_x, int cells_y) {
+  void buildPyramid() {
     std::vector<cl_int4> levels(1, cl_int4{{0, 0, 0, 0}});
     std::size_t total = 0;
     for (int k = 1; k <= 12; ++k) {
-      const int bx = (cells_x + (1 << k) - 1) >> k, by = (cells_y + (1 << k) - 1) >> k;
+      const int bx = (cellsX() + (1 << k) - 1) >> k, by = (cellsY() + (1 << k) - 1) >> k;
       levels.push_back(cl_int4{{bx, by, static_cast<int>(total), 0}});
       total += static_cast<std::size_t>(bx) * by;
       if (bx == 1 && by == 1) break;
     }
     top_ = static_cast<int>(levels.size()) - 1;
-    levels_ = cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, levels.size() * sizeof(cl_int4),
-                         levels.data());
+    levels_ = upload(levels);
     pyramid_ = detail::deviceBuffer(st_, total * sizeof(float));
     for (int k = 1; k <= top_; ++k) {
       const cl_int4 level = levels[k];
-      cl::Kernel kernel(program_, k == 1 ? "viewshed_pyramid_first" : "viewshed_pyramid_next");
+      detail::NamedKernel next = kernel(k == 1 ? "viewshed_pyramid_first" : "viewshed_pyramid_next");
       if (k == 1) {
-        kernel.setArg(0, heights_buffer_);
-        kernel.setArg(1, device_);
+        next.set("h", heights_);
+        next.set("f", device_);
       } else {
-        kernel.setArg(0, levels[k - 1]);
+        next.set("below", levels[k - 1]);
       }
-      kernel.setArg(k == 1 ? 2 : 1, level);
-      kernel.setArg(k == 1 ? 3 : 2, pyramid_);
-      st_.launch(kernel, cl::NDRange(detail::roundUp(level.s[0], detail::kTileX), detail::roundUp(level.s[1], detail::kTileY)),
-                 cl::NDRange(detail::kTileX, detail::kTileY));
+      next.set("level", level);
+      next.set("pyramid", pyramid_);
+      st_.launch(next,
+                 cl::NDRange(detail::roundUp(level.s[0], detail::kTileX),
+                             detail::roundUp(level.s[1], detail::kTileY)),
+                 pixelGroup());
     }
   }
+
+  int cellsX() const { return std::max(field_.width - 1, 1); }
+  int cellsY() const { return std::max(field_.height - 1, 1); }
+  cl::NDRange pixelRange() const {
+    return cl::NDRange(detail::roundUp(field_.width, detail::kTileX),
+                       detail::roundUp(field_.height, detail::kTileY));
+  }
+  static cl::NDRange pixelGroup() { return cl::NDRange(detail::kTileX, detail::kTileY); }
 
   cl::Buffer output() { return detail::deviceBuffer(st_, field_.pixelCount() * sizeof(float)); }
 
@@ -361,16 +401,16 @@ class ViewshedRun {
     return out;
   }
 
- private:
-  detail::ContextState& st_;
-  const HeightField& field_;
   const ViewshedOptions& options_;
-  int lanes_;  // rays per work-item (HFVIS_LANES)
-  cl::Program program_;
-  std::vector<float> heights_;
+  const std::vector<Observer>& observers_;
+  const ViewshedOutputs* outputs_;  // null: counting
+  int lanes_;                       // rays per work-item (HFVIS_LANES)
   DeviceField device_{};
-  cl::Buffer heights_buffer_, lipschitz_, pyramid_, levels_;
+  cl::Buffer lipschitz_, pyramid_, levels_;
+  cl::Buffer visible_, angle_, needed_;             // the outputs (visible_: the counts when counting)
   cl::Buffer pending_, pending_list_, row_counts_;  // the targets classification leaves to viewshed_march
+  std::vector<cl_uint>
+      row_offsets_;  // the rows' first entries in pending_list_, read until the observer ends
   cl::Buffer ray_hi_;                               // per target, the rays' upper bound for the march
   bool ray_hi_budgeted_ = false;                    // whether ray_hi_ holds a float per point
   std::size_t pending_targets_ = 0;
@@ -382,6 +422,7 @@ class ViewshedRun {
   std::size_t culled_targets_ = 0;
   std::vector<unsigned char> leaf_flags_;  // the last query's finest level
   int top_ = 0;
+  ViewshedResult result_;
 };
 
 void validateViewshed(const HeightField& field, const ViewshedOptions& options) {
@@ -462,22 +503,10 @@ ViewshedResult computeViewshed(const ComputeContext& context, const HeightField&
     throw InvalidArgument("no viewshed output requested");
   if (outputs.culled_mask && !options.pyramid) throw InvalidArgument("the culled mask needs a culling pyramid");
   return detail::translateOpenClErrors([&] {
-    detail::ContextState& st = detail::stateOf(context);
-    ViewshedRun run(st, field, options);
-    cl::Buffer visible = run.output();
-    cl::Buffer angle = outputs.angle ? run.output() : cl::Buffer();
-    cl::Buffer needed = outputs.needed_height ? run.output() : cl::Buffer();
-    run.observe(observer, visible, false, outputs.angle ? &angle : nullptr, outputs.needed_height ? &needed : nullptr);
-    ViewshedResult result;
-    result.width = field.width;
-    result.height = field.height;
-    result.marched = run.pendingTargets();
-    result.culled = run.culledTargets();
-    if (outputs.visible) result.visible = run.read(visible);
-    if (outputs.angle) result.angle = run.read(angle);
-    if (outputs.needed_height) result.needed_height = run.read(needed);
-    if (outputs.culled_mask) result.culled_mask = run.culledMask();
-    return result;
+    const std::vector<Observer> observers{observer};
+    ViewshedRoutine routine(detail::stateOf(context), field, options, observers, &outputs);
+    routine.run();
+    return routine.take();
   });
 }
 
@@ -487,19 +516,13 @@ CumulativeViewshed computeCumulativeViewshed(const ComputeContext& context, cons
   if (observers.empty()) throw InvalidArgument("a cumulative viewshed needs at least one observer");
   for (const Observer& o : observers) validate(field, o);
   return detail::translateOpenClErrors([&] {
-    detail::ContextState& st = detail::stateOf(context);
-    ViewshedRun run(st, field, options);
-    cl::Buffer count = run.output();
-    st.queue.enqueueFillBuffer(count, 0.0f, 0, field.pixelCount() * sizeof(float));
-    for (std::size_t i = 0; i < observers.size(); ++i) {
-      run.observe(observers[i], count, true, nullptr);
-      if (options.progress) options.progress(static_cast<int>(i + 1), static_cast<int>(observers.size()));
-    }
+    ViewshedRoutine routine(detail::stateOf(context), field, options, observers, nullptr);
+    routine.run();
     CumulativeViewshed result;
     result.width = field.width;
     result.height = field.height;
     result.observers = static_cast<int>(observers.size());
-    result.count = run.read(count);
+    result.count = routine.take().visible;
     return result;
   });
 }

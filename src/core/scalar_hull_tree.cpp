@@ -14,7 +14,7 @@
 #include "hfvis/bounce.hpp"
 #include "hfvis/errors.hpp"
 #include "core/horizon_common.hpp"
-#include "ops/intervisibility_internal.hpp"
+#include "core/hull_tree.hpp"
 
 namespace hfvis {
 namespace detail {

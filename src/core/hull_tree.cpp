@@ -1,5 +1,6 @@
-// intervisibility_common.cpp: option validation, the tree sweep's directions and the limits
-// that the intervisibility and bounce device paths and their scalar references share.
+// hull_tree.cpp: what every operation on the convex hull tree sweep (intervisibility, the
+// bounce, the horizon lists) and their scalar references share: the tree's tunings, its
+// directions and lines, and the limits of its exact arithmetic.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -7,7 +8,7 @@
 
 #include "hfvis/errors.hpp"
 #include "core/horizon_common.hpp"
-#include "ops/intervisibility_internal.hpp"
+#include "core/hull_tree.hpp"
 
 namespace hfvis {
 
@@ -36,22 +37,6 @@ void validate(const HullTreeTuning& tuning) {
   if (z < 1 || z > 4096 || (z & (z - 1)) != 0) {
     throw InvalidArgument("the safe zone's steps must be a power of two in 1 .. 4096, not " + std::to_string(z));
   }
-}
-
-void validate(const IntervisibilityOptions& options, const IntervisibilityOutputs& outputs) {
-  validate(static_cast<const SweepOptions&>(options));
-  validate(options.tree);
-  if (!outputs.visible_count && !outputs.visible_area && !outputs.statistics) {
-    throw InvalidArgument("no output requested");
-  }
-  if (outputs.statistics && options.method != IntervisibilityMethod::HullTree) {
-    throw InvalidArgument("statistics (horizons and iterations) exist only for the hull-tree method");
-  }
-  if (options.strip_rows < 0)
-    throw InvalidArgument("the rows per strip must be 0 (automatic) or positive (got " +
-                          std::to_string(options.strip_rows) + ")");
-  if (options.strip_rows > 0 && options.method == IntervisibilityMethod::Naive)
-    throw InvalidArgument("the naive method does not run in strips (each ray reads the whole field)");
 }
 
 namespace detail {

@@ -1,4 +1,4 @@
-// intervisibility_device.hpp: the convex hull tree sweep on lattice lines that the
+// hull_tree_device.hpp: the convex hull tree sweep on lattice lines on the device, which the
 // intervisibility operation and the bounce share: its directions, program options, device
 // buffers, scratch planning and the launch of one direction (kernel intervisibility_lattice in
 // kernels/intervisibility.cl; the bounce's gather in kernels/bounce.cl).
@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "hfvis/intervisibility.hpp"
-#include "ops/intervisibility_internal.hpp"
+#include "core/hull_tree.hpp"
 #include "core/opencl_context.hpp"
 #include "core/sweep_framework.hpp"
 #include "core/sweep_routine.hpp"
@@ -78,14 +78,12 @@ void allocateTreeScratch(ContextState& st, const TreeProgramFlags& flags, const 
                          std::size_t entries, TreeBuffers& b);
 
 // intervisibility_lattice set up for direction d over the buffers b, with the tables it reads
-// (kept alive with it); `chunk` names the arguments each chunk of lines sets, `strip` the first
-// of those a strip sets (row0, out_row0, strip_receivers, states; without strips 0, 0 and
-// empty buffers).
+// (kept alive with it): every argument but the chunk's lines (lines, n_lines, stride,
+// first_line); a strip sets row0, out_row0, strip_receivers and states, which are 0, 0 and
+// empty buffers without strips.
 struct TreeKernel {
-  cl::Kernel kernel;
+  NamedKernel kernel;
   cl::Buffer samples, row_units, row_factors, no_strips;
-  LineChunkArguments chunk;
-  int strip = 0;
 };
 TreeKernel treeKernel(ContextState& st, cl::Program& program, const TreeDirection& d, int width, int height,
                       const TreeBuffers& b);
@@ -114,7 +112,6 @@ class TreeRoutine : public SweepRoutine {
   TreeBuffers buffers_;
 };
 
-struct BounceInputs;
 
 // One direction's sweep with per-entry statistics (and with `bounce`, its gather: the
 // per-pixel irradiance of that direction into `irradiance`, channel planes), read back as

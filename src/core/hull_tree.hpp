@@ -1,7 +1,7 @@
-// intervisibility_internal.hpp: what the intervisibility device path, its scalar reference,
-// the horizon lists, the bounce and the tests share: direction geometry and the line-level
-// view of one direction's sweep (per-sample counts, horizons, iterations and the bounce
-// gather), to compare a sweep line by line.
+// hull_tree.hpp: what every operation on the convex hull tree sweep (Timonen 2013) shares, on
+// the device and in the scalar references (intervisibility, the bounce, the horizon lists, the
+// tests): direction geometry, and the line-level view of one direction's sweep (per-sample
+// counts, horizons, iterations and the bounce gather), to compare a sweep line by line.
 #pragma once
 
 #include <algorithm>
@@ -179,6 +179,18 @@ struct BounceLines {
   std::vector<float> irradiance;  // output: channels floats per entry; NaN where absent
 };
 constexpr int kBounceNormalFloats = 3;
+
+// The bounce gather's inputs as the device and the reference see them (prepareBounce):
+// prepared heights (see prepareHeights), the unit normals of the four quads around each pixel
+// (ambient occlusion's, in ground units) as three planes x, y, z, and the radiance planes;
+// normals and radiance NaN at nodata pixels.
+struct BounceInputs {
+  std::vector<float> heights;
+  bool has_nodata = false;
+  std::vector<std::vector<float>> normals;   // 3 planes
+  std::vector<std::vector<float>> radiance;  // 1..4 planes
+  int channels() const { return static_cast<int>(radiance.size()); }
+};
 
 // Runs the reference hull-tree sweep over lines whose `geometry` (n_lines, n_steps, and
 // the step's ground length) and `samples` are set: fills every other per-entry vector;

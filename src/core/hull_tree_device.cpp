@@ -1,0 +1,255 @@
+// hull_tree_device.cpp: the convex hull tree sweep on the device (see hull_tree_device.hpp):
+// program options, scratch planning, the kernel's arguments for a direction, its launch in
+// chunks of lines, the routine the tree's operations derive from, and the line views the tests
+// compare with the scalar sweep.
+#include "core/hull_tree_device.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <sstream>
+
+#include "hfvis/errors.hpp"
+#include "core/horizon_common.hpp"
+#include "core/hull_tree.hpp"
+#include "core/opencl_context.hpp"
+#include "core/sweep_framework.hpp"
+
+namespace hfvis {
+namespace detail {
+
+std::string treeProgramOptions(const TreeProgramFlags& f) {
+  std::ostringstream s;
+  s << "-DHFVIS_HAS_NODATA=" << f.has_nodata << " -DHFVIS_WANT_COUNT=" << f.count
+    << " -DHFVIS_WANT_AREA=" << f.area
+    << " -DHFVIS_WANT_STATS=" << f.stats << " -DHFVIS_WANT_ENTRY_STATS=" << f.entry_stats;
+  s << " -DHFVIS_CURVATURE=" << f.curvature << " -DHFVIS_ROW_SPACING=" << f.row_spacing
+    << " -DHFVIS_STRIPS=" << f.strips;
+  const HullTreeTuning tuning = tuningFor(f.tuning, f.row_spacing);
+  s << " -DHFVIS_DEFERRED_WRITES=" << tuning.deferred_writes
+    << " -DHFVIS_REPLACEMENT_CHECK=" << tuning.replacement_check
+    << " -DHFVIS_SAFE_ZONE=" << tuning.safe_zone << " -DHFVIS_SAFE_ZONE_STEPS=" << tuning.safe_zone_steps;
+  if (f.bounce_channels > 0) s << " -DHFVIS_WANT_BOUNCE=1 -DHFVIS_CHANNELS=" << f.bounce_channels;
+  return s.str();
+}
+
+namespace {
+bool needsPrefix(const TreeProgramFlags& f) { return f.area && (f.has_nodata || f.row_spacing); }
+}  // namespace
+
+std::size_t treeEntryBytes(const TreeProgramFlags& f) {
+  return kTreeNodeBytes + (needsPrefix(f) ? kTreePrefixBytes : 0) + (f.row_spacing ? kTreePositionBytes : 0) +
+         (f.entry_stats ? kTreeVisibleBytes + kTreeEntryStatsBytes : 0);
+}
+
+TreeScratchNeeds treeScratchNeeds(const std::vector<TreeDirection>& directions, bool line_major) {
+  TreeScratchNeeds needs;
+  for (const TreeDirection& d : directions) {
+    std::size_t total = 0, direction_longest = 0;
+    for (const LatticeLine& line : d.lines) {
+      const std::size_t capacity = lineCapacity(line, d.samples.size());
+      total += capacity;
+      direction_longest = std::max(direction_longest, capacity);
+    }
+    // Step-major chunks pad every line to the chunk's longest (chunkLines).
+    if (!line_major) total = std::max(total, direction_longest * d.lines.size());
+    needs.whole = std::max(needs.whole, total);
+    needs.longest = std::max(needs.longest, direction_longest);
+  }
+  return needs;
+}
+
+std::size_t planTreeScratch(const std::vector<TreeDirection>& directions, std::size_t fixed_bytes,
+                            std::size_t entry_bytes, std::size_t budget_bytes, const DeviceInfo& device,
+                            bool line_major) {
+  const std::size_t budget = memoryBudget(budget_bytes, device);
+  const std::size_t max_alloc = device.max_allocation_bytes ? device.max_allocation_bytes : budget;
+  const TreeScratchNeeds needs = treeScratchNeeds(directions, line_major);
+  const std::size_t least = fixed_bytes + needs.longest * entry_bytes;
+  if (least > budget || needs.longest * kTreeNodeBytes > max_alloc) {
+    throw MemoryBudgetError("one direction needs " + mebibytes(least) + " of device memory but the budget is " +
+                            mebibytes(budget) + " (largest single buffer " + mebibytes(max_alloc) +
+                            "); raise the memory budget or use a smaller field");
+  }
+  return std::min({needs.whole, (budget - fixed_bytes) / entry_bytes, max_alloc / kTreeNodeBytes});
+}
+
+void allocateTreeScratch(ContextState& st, const TreeProgramFlags& flags, const std::vector<TreeDirection>& all,
+                         std::size_t entries, TreeBuffers& b) {
+  b.scratch_entries = entries;
+  b.trees = st.reusableBuffer("tree nodes", entries * kTreeNodeBytes);
+  b.prefix = deviceBuffer(st, needsPrefix(flags) ? entries * kTreePrefixBytes : 0);
+  b.positions = deviceBuffer(st, flags.row_spacing ? entries * kTreePositionBytes : 0);
+  b.visible = deviceBuffer(st, flags.entry_stats ? entries * kTreeVisibleBytes : 0);
+  b.entry_stats = deviceBuffer(st, flags.entry_stats ? entries * kTreeEntryStatsBytes : 0);
+  std::size_t max_lines = 0;
+  for (const TreeDirection& d : all) max_lines = std::max(max_lines, d.lines.size());
+  b.line_totals = deviceBuffer(st, flags.stats ? max_lines * kTreeLineTotals * sizeof(cl_ulong) : 0);
+}
+
+TreeKernel treeKernel(ContextState& st, cl::Program& program, const TreeDirection& d, int width, int height,
+                      const TreeBuffers& b) {
+  auto table = [&](const void* data, std::size_t bytes) {
+    if (!bytes) return deviceBuffer(st, 0);
+    return cl::Buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes, const_cast<void*>(data));
+  };
+  TreeKernel k;
+  k.samples = table(d.samples.data(), d.samples.size() * sizeof(LatticeSample));
+  k.row_units = table(d.row_units.data(), d.row_units.size() * sizeof(std::int32_t));
+  k.row_factors = table(d.row_factors.data(), d.row_factors.size() * sizeof(float));
+  k.no_strips = deviceBuffer(st, 0);
+  k.kernel = NamedKernel(st, program, "intervisibility_lattice");  // the chunk's lines set per chunk
+  NamedKernel& kernel = k.kernel;
+  kernel.set("heights", b.heights);
+  kernel.set("width", width);
+  kernel.set("height", height);
+  kernel.set("samples", k.samples);
+  kernel.set("n_samples", static_cast<int>(d.samples.size()));
+  kernel.set("a", d.lattice.a);
+  kernel.set("b", d.lattice.b);
+  kernel.set("count_factor", d.count_factor);
+  kernel.set("area_factor", d.area_factor);
+  kernel.set("drop", d.drop);
+  kernel.set("max_steps", d.max_steps);
+  kernel.set("row_units", k.row_units);
+  kernel.set("row_factors", k.row_factors);
+  kernel.set("trees", b.trees);
+  kernel.set("prefix", b.prefix);
+  kernel.set("positions", b.positions);
+  kernel.set("visible", b.visible);
+  kernel.set("entry_stats", b.entry_stats);
+  kernel.set("line_totals", b.line_totals);
+  kernel.set("count_sum", b.count_sum);
+  kernel.set("area_sum", b.area_sum);
+  kernel.set("radiance", b.radiance);
+  kernel.set("normals", b.normals);
+  kernel.set("cos_azimuth", d.cos_azimuth);
+  kernel.set("sin_azimuth", d.sin_azimuth);
+  kernel.set("step_ground", d.step_ground);
+  kernel.set("half_sector", d.half_sector);
+  kernel.set("wedge", d.wedge);
+  kernel.set("irradiance", b.irradiance);
+  kernel.set("row0", 0);
+  kernel.set("out_row0", 0);
+  kernel.set("strip_receivers", k.no_strips);
+  kernel.set("states", k.no_strips);
+  return k;
+}
+
+void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDirection& d, int width, int height,
+                          const TreeBuffers& b) {
+  TreeKernel k = treeKernel(st, program, d, width, height, b);
+  launchLineChunks(st, k.kernel, d.lines, d.samples.size(), b.scratch_entries, 1, kLineGroup);
+}
+
+std::string TreeRoutine::programOptions() const {
+  TreeProgramFlags flags = flags_;
+  flags.has_nodata = prepared_.has_nodata;
+  return treeProgramOptions(flags);
+}
+
+void TreeRoutine::allocateScratch(std::size_t fixed_bytes) {
+  flags_.has_nodata = prepared_.has_nodata;
+  directions_ = treeDirections(field_, options_, flags_.row_spacing);
+  checkTreeLimits(directions_, prepared_.heights);
+  // The per-line totals of the statistics count beside the operation's own buffers.
+  std::size_t max_lines = 0;
+  for (const TreeDirection& d : directions_) max_lines = std::max(max_lines, d.lines.size());
+  if (flags_.stats) fixed_bytes += max_lines * kTreeLineTotals * sizeof(cl_ulong);
+  allocateTreeScratch(st_, flags_, directions_,
+                      planTreeScratch(directions_, fixed_bytes, treeEntryBytes(flags_), options_.memory_budget_bytes,
+                                      st_.info, lineMajorLayout(st_)),
+                      buffers_);
+  buffers_.heights = heights_;
+}
+
+void TreeRoutine::sweep(int direction, int) {
+  enqueueTreeDirection(st_, program_, directions_[direction], field_.width, field_.height, buffers_);
+}
+
+IntervisibilityLines treeLinesOnDevice(ContextState& st, const TreeProgramFlags& program_flags,
+                                       const HeightField& field, const std::vector<float>& prepared_heights,
+                                       const TreeDirection& d, const BounceInputs* bounce,
+                                       std::vector<float>* irradiance) {
+  TreeProgramFlags flags = program_flags;
+  flags.entry_stats = true;
+  flags.row_spacing = d.rowSpacing();
+  cl::Program program = st.program("intervisibility.cl", treeProgramOptions(flags));
+  const std::size_t plane = field.pixelCount();
+  const std::size_t per_period = d.samples.size(), longest = d.longestLine();
+  std::size_t entries = 0;
+  for (const LatticeLine& line : d.lines) entries += lineCapacity(line, per_period);
+  // Scratch for all lines in one launch; the step-major layout pads every line to the longest.
+  entries = std::max(entries, longest * d.lines.size());
+  TreeBuffers b;
+  allocateTreeScratch(st, flags, {d}, entries, b);
+  auto upload = [&](const std::vector<float>& values) {
+    return cl::Buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, values.size() * sizeof(float),
+                      const_cast<float*>(values.data()));
+  };
+  auto joined = [](const std::vector<std::vector<float>>& planes) {
+    std::vector<float> all;
+    for (const auto& p : planes) all.insert(all.end(), p.begin(), p.end());
+    return all;
+  };
+  const int channels = bounce ? bounce->channels() : 0;
+  b.heights = upload(prepared_heights);
+  b.count_sum = deviceBuffer(st, plane * sizeof(float));
+  b.area_sum = deviceBuffer(st, plane * sizeof(float));
+  b.radiance = bounce ? upload(joined(bounce->radiance)) : deviceBuffer(st, 0);
+  b.normals = bounce ? upload(joined(bounce->normals)) : deviceBuffer(st, 0);
+  b.irradiance = deviceBuffer(st, channels * plane * sizeof(float));
+  const float zero = 0.0f;
+  st.queue.enqueueFillBuffer(b.count_sum, zero, 0, plane * sizeof(float));
+  st.queue.enqueueFillBuffer(b.area_sum, zero, 0, plane * sizeof(float));
+  if (channels) st.queue.enqueueFillBuffer(b.irradiance, zero, 0, channels * plane * sizeof(float));
+  enqueueTreeDirection(st, program, d, field.width, field.height, b);
+  std::vector<cl_int> nodes(entries * 4);
+  std::vector<float> visible(entries * 2);
+  std::vector<std::uint32_t> stats(entries * 4);
+  st.queue.enqueueReadBuffer(b.trees, CL_TRUE, 0, nodes.size() * sizeof(cl_int), nodes.data());
+  st.queue.enqueueReadBuffer(b.visible, CL_TRUE, 0, visible.size() * sizeof(float), visible.data());
+  st.queue.enqueueReadBuffer(b.entry_stats, CL_TRUE, 0, stats.size() * sizeof(std::uint32_t), stats.data());
+  if (irradiance) {
+    irradiance->resize(channels * plane);
+    st.queue.enqueueReadBuffer(b.irradiance, CL_TRUE, 0, irradiance->size() * sizeof(float), irradiance->data());
+  }
+
+  // Back to the canonical step-major order, as the launch laid the lines out.
+  std::vector<LatticeLine> lines = d.lines;
+  const auto chunks = chunkLines(lines, per_period, entries, lineMajorLayout(st));
+  IntervisibilityLines out = canonicalTreeLines(d);
+  out.resetResults();
+  for (const LineChunk& chunk : chunks) {
+    for (std::size_t j = chunk.first; j < chunk.first + chunk.count; ++j) {
+      const std::size_t steps = lineCapacity(lines[j], per_period);
+      for (std::size_t i = 0; i < steps; ++i) {
+        const std::size_t e = static_cast<std::size_t>(lines[j].stack) + i * chunk.stride;
+        const std::size_t c = i * lines.size() + j;
+        std::memcpy(&out.samples[c], &nodes[4 * e], sizeof(float));
+        out.counts[c] = visible[2 * e];
+        out.distance_sums[c] = visible[2 * e + 1];
+        out.horizons[c] = stats[4 * e];
+        out.iterations[c] = stats[4 * e + 1];
+        out.horizon_hashes[c] = stats[4 * e + 2];
+        out.walks_skipped[c] = stats[4 * e + 3];
+      }
+    }
+  }
+  return out;
+}
+
+IntervisibilityLines intervisibilityLinesOnDevice(const ComputeContext& context, const HeightField& field,
+                                                  const std::vector<float>& prepared_heights,
+                                                  const TreeDirection& d, const HullTreeTuning& tuning) {
+  validate(tuning);
+  return translateOpenClErrors([&] {
+    TreeProgramFlags flags;
+    flags.tuning = tuning;
+    return treeLinesOnDevice(stateOf(context), flags, field, prepared_heights, d, nullptr, nullptr);
+  });
+}
+
+}  // namespace detail
+}  // namespace hfvis
