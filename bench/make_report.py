@@ -1462,7 +1462,7 @@ def main(argv=None):
         "barrier, so PoCL runs every step as one region over the group's work-items, which LLVM vectorises. "
         "PoCL's remarks therefore list the step loop itself as not vectorised (it is not innermost) and the "
         "vectorised loops as PoCL-generated work-item loops or at a line inside the step. `radius_R` runs the "
-        "baselines' kernel `radius_march` (`kernels/horizon_baselines.cl`), the same march cut off after R "
+        "baselines' kernel `radius_march` (`bench/kernels/horizon_baselines.cl`), the same march cut off after R "
         "pixels; the checks below compare it, with a radius past every ray's end, against the library's march. "
         "The table gives the cost per executed ray step (every lane runs its tile's longest ray: samples past a "
         "pixel's own exit included)%s." % (", from the speed/error plane at K = %s" % step_k if step_k else ""))

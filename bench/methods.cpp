@@ -1,5 +1,5 @@
 // bench/methods.cpp: runs the library's methods and the baselines of
-// kernels/horizon_baselines.cl (host side: pyramid build, batching, downloads).
+// bench/kernels/horizon_baselines.cl (host side: pyramid build, batching, downloads).
 #include "methods.hpp"
 
 #include <algorithm>
@@ -76,7 +76,8 @@ MethodOutput runBaseline(const ComputeContext& context, const HeightField& field
   if (field.nodataCount() > 0) throw InvalidArgument("the baselines do not handle nodata heights");
   return detail::translateOpenClErrors([&] {
     detail::ContextState& st = detail::stateOf(context);
-    cl::Program program = st.program("horizon_baselines.cl", programOptions(spec));
+    cl::Program program = st.programFromSource("horizon_baselines.cl", detail::benchKernelSources().at("horizon_baselines.cl"), "",
+                                                 programOptions(spec));
     const std::vector<float> prepared = detail::prepareHeights(field).heights;
     const std::size_t plane = field.pixelCount();
     cl::Buffer heights(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, plane * sizeof(float),
@@ -208,7 +209,7 @@ MarchSteps naiveMarchSteps(const HeightField& field, int directions, double samp
   MarchSteps steps;
   const int w = field.width, h = field.height;
   // The exit distance of pixel (c, r) is min(column term, row term), as in horizon_naive
-  // (kernels/horizon.cl) and bl_tile_reach (kernels/horizon_baselines.cl).
+  // (kernels/horizon.cl) and bl_tile_reach (bench/kernels/horizon_baselines.cl).
   auto reach = [&](double dir, int coordinate, int size) {
     return dir > 0.0 ? (size - 1 - coordinate) / dir : dir < 0.0 ? coordinate / -dir : double(w + h);
   };

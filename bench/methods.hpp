@@ -1,14 +1,21 @@
 // bench/methods.hpp: every horizon method the benchmark runs, behind one call: the
 // library's sweep and naive kernels (through computeHorizons; the library's naive march is
 // the report's naive baseline) and the approximations and floor of
-// kernels/horizon_baselines.cl (launched here on the library's context and queue).
+// bench/kernels/horizon_baselines.cl (launched here on the library's context and queue).
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
 #include "hfvis/device.hpp"
 #include "hfvis/height_field.hpp"
+
+namespace hfvis::detail {
+// The benchmark's own kernels (bench/kernels/*.cl) by file name, embedded into hfvis_bench at
+// build time (cmake/EmbedKernels.cmake), not into the library.
+const std::map<std::string, std::string>& benchKernelSources();
+}  // namespace hfvis::detail
 
 namespace hfvis::bench {
 

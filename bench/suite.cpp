@@ -567,10 +567,13 @@ class Suite {
   Results& results_;
 };
 
-// Source lines (1-based) of `file` as embedded; for naming the loops PoCL remarks on.
+// Source lines (1-based) of `file` as embedded (the library's kernels, or the benchmark's own);
+// for naming the loops PoCL remarks on.
 std::vector<std::string> embeddedLines(const std::string& file) {
   std::string include_dir;
-  std::istringstream in(detail::kernelSource(file, "", &include_dir));
+  const auto& bench = detail::benchKernelSources();
+  const auto own = bench.find(file);
+  std::istringstream in(own != bench.end() ? own->second : detail::kernelSource(file, "", &include_dir));
   std::vector<std::string> lines;
   for (std::string line; std::getline(in, line);) lines.push_back(line);
   return lines;

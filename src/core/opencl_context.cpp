@@ -205,6 +205,11 @@ std::string kernelSource(const std::string& file, const std::string& kernel_dir,
 cl::Program ContextState::program(const std::string& file, const std::string& defines) {
   std::string include_dir;
   const std::string source = kernelSource(file, options.kernel_dir, &include_dir);
+  return programFromSource(file, source, include_dir, defines);
+}
+
+cl::Program ContextState::programFromSource(const std::string& file, const std::string& source,
+                                            const std::string& include_dir, const std::string& defines) {
   std::string build_options = "-cl-std=CL1.2 -cl-kernel-arg-info " + defines;
   if (info.correctly_rounded_divide) build_options += " -cl-fp32-correctly-rounded-divide-sqrt";
   if (!include_dir.empty()) build_options += " -I " + include_dir;

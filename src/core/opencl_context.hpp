@@ -26,6 +26,10 @@ struct ContextState {
   // built once per (device, options, source) and cached. Throws KernelBuildError with the
   // device's build log. Built with -cl-kernel-arg-info, for NamedKernel.
   cl::Program program(const std::string& file, const std::string& defines);
+  // The same for a source of the caller's (the benchmark's own kernels), named `name` in errors;
+  // `include_dir` is passed as -I when not empty.
+  cl::Program programFromSource(const std::string& name, const std::string& source, const std::string& include_dir,
+                                const std::string& defines);
 
   // The argument names of `kernel`, kernel `name` of `program`: read once per program and
   // kernel (a cached program lives as long as the context, so its handle identifies it).

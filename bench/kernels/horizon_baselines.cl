@@ -6,6 +6,10 @@
 // one value per pixel and direction. All write horizon elevation angles (radians) into
 // per-direction planes of the batch, as horizon.cl does with HFVIS_WANT_ANGLES.
 //
+// Not part of the library: bench/CMakeLists.txt embeds it into hfvis_bench alone, which builds
+// it on the library's context (ContextState::programFromSource). It includes the library's
+// sweep framework by its path, so it compiles standalone with no -I.
+//
 // Preconditions: no nodata (every height finite; the benchmark's fields have none), width
 // and height >= 2, heights offset and z-scaled as the library prepares them.
 //
@@ -14,7 +18,7 @@
 //   HFVIS_PYRAMID_NEAR   the pyramid march takes this many unit steps on the full-resolution
 //                        surface, then HFVIS_PYRAMID_NEAR / 2 steps per octave of distance on
 //                        ever coarser levels (step and texel size 2^level); even, >= 2
-#include "shared/sweep_framework.cl"
+#include "../../kernels/shared/sweep_framework.cl"
 
 #ifndef HFVIS_EDGE_EPS  // as in sweep_framework.cl: tolerance of "inside the field", pixels
 #define HFVIS_EDGE_EPS 1e-3f
