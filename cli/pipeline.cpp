@@ -300,7 +300,7 @@ int runPipeline(const CommandLine& line, Computation& computation) {
   computation.prepare(input);
   // (a command on the host, writing text, opens no device)
   std::optional<ComputeContext> context;
-  if (computation.writesImages()) context.emplace(contextFor(run));
+  if (computation.usesDevice()) context.emplace(contextFor(run));
   Progress progress(run.quiet);
   Job job{commandSpec(line.command),     run,      input,
           context ? &*context : nullptr, progress, computation.method()};
