@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iomanip>
+#include <limits>
 #include <sstream>
 
 #include "../image_outputs.hpp"
@@ -172,8 +174,15 @@ std::string jsonString(const std::string& text) {
   return out + "\"";
 }
 
-// A number for JSON and CSV: shortest round-trip-ish (10 digits), NaN as null.
+// A number for JSON: 10 significant digits (as the other outputs' numbers), NaN as null.
 std::string jsonNumber(double value) { return std::isfinite(value) ? formatNumber(value) : "null"; }
+
+// A ratio in full: a reader recomputing clear_pairs / pairs gets the same double.
+std::string exactNumber(double value) {
+  std::ostringstream out;
+  out << std::setprecision(std::numeric_limits<double>::max_digits10) << value;
+  return out.str();
+}
 
 // Map coordinates of a pixel position (grid points are pixel centres: column c lies at c + 0.5 in
 // the geotransform of pixel corners).
@@ -247,7 +256,7 @@ class Region : public Computation {
          << "  \"to\": " << region(*run_.to_region, run_.to_height, r.receiver_samples) << ",\n"
          << "  \"pairs\": " << r.pairs << ",\n"
          << "  \"clear_pairs\": " << r.clear_pairs << ",\n"
-         << "  \"visible_fraction\": " << jsonNumber(fraction) << ",\n"
+         << "  \"visible_fraction\": " << exactNumber(fraction) << ",\n"
          << "  \"conventions\": " << jsonString(
                 "col, row: pixel columns and rows (grid points at whole numbers, samples between them); "
                 "height: absolute, z-scaled height units; x, y: map coordinates of a georeferenced input; "
