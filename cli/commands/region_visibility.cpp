@@ -38,8 +38,7 @@ void validateRegion(const HeightField& field, const RegionSampling& sampling, co
   try {
     validate(field, sampling);
   } catch (const InvalidArgument& error) {
-    throw UsageError(what + ": " + error.what() + " (" + input + ", " + std::to_string(field.width) + " x " +
-                     std::to_string(field.height) + ")");
+    throw UsageError(what + ": " + error.what() + " (" + input + ")");
   }
 }
 
