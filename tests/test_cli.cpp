@@ -2493,3 +2493,36 @@ TEST_F(Cli, RegionVisibilityRefusesBadInput) {
                 2, ".json");
   expectFailure(run(region + " --from 1,1,2,2 --to 3,3,4,4 --decorrelate"), 2, "--decorrelate");
 }
+
+TEST_F(CliGeoTiff, RegionVisibilityOnAGeoreferencedField) {
+  const std::string dem = geoTiffInput();
+  // arealight's GeoTIFF: the georeference kept, the --nodata value at nodata.
+  ASSERT_EQ(run("arealight " + shellQuoted(dem) + " -o " + shellQuoted(out("a.tif")) +
+                " --light 1,1,4,4 --light-height 30 --nodata -9999 -q")
+                .status,
+            0);
+  const hfvis::testing::GdalRaster light = checkGeoTiffOutput(out("a.tif"), {"visible"}, "arealight");
+  EXPECT_EQ(light.bands[0][0], -9999.0f);  // nodata at (0, 0)
+  for (std::size_t p = 1; p < light.bands[0].size(); ++p)
+    if (light.bands[0][p] != -9999.0f) ASSERT_TRUE(light.bands[0][p] >= 0.0f && light.bands[0][p] <= 1.0f) << p;
+  // region's rays: map coordinates of the pixel centres through the geotransform.
+  const CliResult r = run("region " + shellQuoted(dem) + " --from 1,1,4,4 --to 15,10,20,14 --from-height 50 -o " +
+                          shellQuoted(out("r.json")) + " --rays " + shellQuoted(out("r.csv")) + " -q");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const Json j = JsonParser::parse(readText(out("r.json")));
+  const std::array<double, 6>& t = hfvis::testing::kUtmGeotransform;
+  for (const Json& s : j["from_samples"].items) {
+    EXPECT_NEAR(s["x"].number, t[0] + (s["col"].number + 0.5) * t[1], 1e-3);
+    EXPECT_NEAR(s["y"].number, t[3] + (s["row"].number + 0.5) * t[5], 1e-3);
+  }
+  const std::vector<std::string> lines = splitText(readText(out("r.csv")), '\n');
+  EXPECT_GT(j["clear_pairs"].number, 0.0);
+  EXPECT_EQ(lines[0], "from_col,from_row,from_height,to_col,to_row,to_height,from_x,from_y,to_x,to_y");
+  EXPECT_EQ(static_cast<double>(lines.size() - 2), j["clear_pairs"].number);
+  for (std::size_t i = 1; i + 1 < lines.size(); ++i) {
+    const std::vector<std::string> f = splitText(lines[i], ',');
+    ASSERT_EQ(f.size(), 10u);
+    EXPECT_NEAR(std::stod(f[8]), t[0] + (std::stod(f[3]) + 0.5) * t[1], 1e-2);
+    EXPECT_NEAR(std::stod(f[9]), t[3] + (std::stod(f[4]) + 0.5) * t[5], 1e-2);
+  }
+}
