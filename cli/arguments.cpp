@@ -220,19 +220,21 @@ void parseUtcTimeInto(const std::string& typed, const std::string& value, std::o
 // orders them). Whether it lies inside the field is checked once the field's size is known.
 PixelRectangle parseRectangle(const std::string& typed, const std::string& value) {
   const std::string expected =
-      typed + ": expected C0,R0,C1,R1 (two corner pixels' zero-based columns and rows, e.g. 10,0,20,5), got " +
+      typed +
+      ": expected C0,R0,C1,R1 (two corner pixels' zero-based columns and rows, e.g. 10,0,20,5), got " +
       inQuotes(shortened(value));
   std::vector<int> corners;
   std::size_t begin = 0;
   while (true) {
     const std::size_t comma = value.find(',', begin);
-    const std::string part = value.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin);
+    const std::string part =
+        value.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin);
     const char* start = part.c_str();
     char* end = nullptr;
     errno = 0;
     const long number = std::strtol(start, &end, 10);
-    if (part.empty() || end != start + part.size() || errno == ERANGE || number > std::numeric_limits<int>::max() ||
-        number < std::numeric_limits<int>::min())
+    if (part.empty() || end != start + part.size() || errno == ERANGE ||
+        number > std::numeric_limits<int>::max() || number < std::numeric_limits<int>::min())
       throw UsageError(expected);
     corners.push_back(static_cast<int>(number));
     if (comma == std::string::npos) break;

@@ -110,9 +110,9 @@ std::vector<CsvPoint> parsePoints(const std::string& path, std::istream& in, dou
 const PointKind kObserverKind{true, "col,row[,height] (whole column and row)",
                               "puts the eye below the surface, where it sees nothing",
                               "no observers (lines col,row[,height])"};
-const PointKind kSourceKind{false, "col,row[,height] (numbers: column and row, fractional between pixel centres)",
-                            "puts the sample below the surface, where nothing sees it",
-                            "no sources (lines col,row[,height])"};
+const PointKind kSourceKind{
+    false, "col,row[,height] (numbers: column and row, fractional between pixel centres)",
+    "puts the sample below the surface, where nothing sees it", "no sources (lines col,row[,height])"};
 
 // The file `path`, which must be a regular file (not a device or FIFO), open for reading.
 std::ifstream openCsv(const std::string& path) {

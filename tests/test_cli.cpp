@@ -2279,8 +2279,8 @@ float wallHeight(int col, int) { return col == 8 ? 5.0f : 0.0f; }
 TEST_F(Cli, AreaLightOnFlatGroundSeesEverySample) {
   const std::string field = writeField("flat1.exr", 16, 12, [](int, int) { return 1.0f; });
   const CliResult r = run("arealight " + shellQuoted(field) + " -o " + shellQuoted(out("a.exr")) +
-                          " --light 2,2,5,4 --samples 20 --masks " + shellQuoted(out("m.exr")) + " --preview " +
-                          shellQuoted(out("a.png")));
+                          " --light 2,2,5,4 --samples 20 --masks " + shellQuoted(out("m.exr")) +
+                          " --preview " + shellQuoted(out("a.png")));
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("20 light samples"), std::string::npos) << r.out;
   const ReadBack a = readBack(out("a.exr"));
@@ -2302,9 +2302,9 @@ TEST_F(Cli, AreaLightOnFlatGroundSeesEverySample) {
 TEST_F(Cli, AreaLightBehindAWallIsHiddenAndAgreesWithTheLibrary) {
   const std::string field = writeField("wall.exr", kWallWidth, kWallHeight, wallHeight);
   // The light on the ground's near side, 1 above it: the wall hides it from the ground behind.
-  const CliResult r = run("arealight " + shellQuoted(field) + " -o " + shellQuoted(out("a.exr")) +
-                          " --light 1,2,3,9 --light-height 1 --samples 37 --masks " + shellQuoted(out("m.tif")) +
-                          " -q");
+  const CliResult r =
+      run("arealight " + shellQuoted(field) + " -o " + shellQuoted(out("a.exr")) +
+          " --light 1,2,3,9 --light-height 1 --samples 37 --masks " + shellQuoted(out("m.tif")) + " -q");
   ASSERT_EQ(r.status, 0) << r.err;
   const ReadBack a = readBack(out("a.exr"));
   ASSERT_EQ(a.channels, (std::vector<std::string>{"visible"}));
@@ -2318,10 +2318,11 @@ TEST_F(Cli, AreaLightBehindAWallIsHiddenAndAgreesWithTheLibrary) {
   light.rectangle = {1, 2, 3, 9};
   light.height = 1.0;
   light.samples = 37;
-  const hfvis::RegionVisibilityResult lib =
-      hfvis::computeRegionVisibility(hfvis::testing::testContext(), f, light, hfvis::RegionVisibilityOptions{});
+  const hfvis::RegionVisibilityResult lib = hfvis::computeRegionVisibility(
+      hfvis::testing::testContext(), f, light, hfvis::RegionVisibilityOptions{});
   ASSERT_EQ(lib.fraction.size(), a.pixels.size());
-  for (std::size_t p = 0; p < lib.fraction.size(); ++p) ASSERT_EQ(a.pixels[p], lib.fraction[p]) << "pixel " << p;
+  for (std::size_t p = 0; p < lib.fraction.size(); ++p)
+    ASSERT_EQ(a.pixels[p], lib.fraction[p]) << "pixel " << p;
   // The masks, bit for bit: 37 samples in three 16-bit channels, read back from the GeoTIFF.
   const ReadBack m = readBack(out("m.tif"));
   ASSERT_EQ(m.channels.size(), 3u);
@@ -2347,20 +2348,22 @@ TEST_F(Cli, AreaLightFromASourcesFile) {
   // A UTF-8 BOM, a header, CRLF, a comment, a fractional column and a row without a height.
   {
     std::ofstream csv(in("sources.csv"), std::ios::binary);
-    csv << "\xEF\xBB\xBF" "col,row,height\r\n2,3,1\r\n# behind the wall\r\n12.5,6\r\n";
+    csv << "\xEF\xBB\xBF"
+           "col,row,height\r\n2,3,1\r\n# behind the wall\r\n12.5,6\r\n";
   }
-  const CliResult r = run("arealight " + shellQuoted(field) + " -o " + shellQuoted(out("a.exr")) + " --sources " +
-                          shellQuoted(in("sources.csv")) + " --light-height 4 -q");
+  const CliResult r = run("arealight " + shellQuoted(field) + " -o " + shellQuoted(out("a.exr")) +
+                          " --sources " + shellQuoted(in("sources.csv")) + " --light-height 4 -q");
   ASSERT_EQ(r.status, 0) << r.err;
   const hfvis::HeightField f = hfvis::readHeightField(field);
   hfvis::RegionSampling sources;
   sources.points = {{2.0, 3.0, 1.0}, {12.5, 6.0, 4.0}};
   sources.samples = 2;
-  const hfvis::RegionVisibilityResult lib =
-      hfvis::computeRegionVisibility(hfvis::testing::testContext(), f, sources, hfvis::RegionVisibilityOptions{});
+  const hfvis::RegionVisibilityResult lib = hfvis::computeRegionVisibility(
+      hfvis::testing::testContext(), f, sources, hfvis::RegionVisibilityOptions{});
   const ReadBack a = readBack(out("a.exr"));
   ASSERT_EQ(a.pixels.size(), lib.fraction.size());
-  for (std::size_t p = 0; p < lib.fraction.size(); ++p) ASSERT_EQ(a.pixels[p], lib.fraction[p]) << "pixel " << p;
+  for (std::size_t p = 0; p < lib.fraction.size(); ++p)
+    ASSERT_EQ(a.pixels[p], lib.fraction[p]) << "pixel " << p;
   // Each side of the wall sees its own source only.
   EXPECT_EQ(a.at(4, 3, 0), 0.5f);
   EXPECT_EQ(a.at(13, 6, 0), 0.5f);
@@ -2382,10 +2385,11 @@ TEST_F(Cli, AreaLightFromASourcesFile) {
 TEST_F(Cli, RegionWritesConsistentJsonAndItsClearRays) {
   // The wall stands in rows 0 .. 5 only: from the left rectangle to the right one, the pairs in
   // the lower rows see past its end, the others not.
-  const std::string field =
-      writeField("half_wall.exr", kWallWidth, kWallHeight, [](int col, int row) { return col == 8 && row <= 5 ? 9.0f : 0.0f; });
-  const CliResult r = run("region " + shellQuoted(field) + " --from 1,0,3,11 --to 12,0,14,11 --samples 24 -o " +
-                          shellQuoted(out("r.json")) + " --rays " + shellQuoted(out("rays.csv")));
+  const std::string field = writeField("half_wall.exr", kWallWidth, kWallHeight,
+                                       [](int col, int row) { return col == 8 && row <= 5 ? 9.0f : 0.0f; });
+  const CliResult r =
+      run("region " + shellQuoted(field) + " --from 1,0,3,11 --to 12,0,14,11 --samples 24 -o " +
+          shellQuoted(out("r.json")) + " --rays " + shellQuoted(out("rays.csv")));
   ASSERT_EQ(r.status, 0) << r.err;
   const Json j = JsonParser::parse(readText(out("r.json")));
   const double pairs = j["pairs"].number, clear = j["clear_pairs"].number;
@@ -2433,8 +2437,8 @@ TEST_F(Cli, RegionWritesConsistentJsonAndItsClearRays) {
   EXPECT_EQ(static_cast<double>(lib.clear_pairs), clear);
   // A wall across every row: no clear pair, and a rays file with its header only.
   const std::string wall = writeField("wall.exr", kWallWidth, kWallHeight, wallHeight);
-  ASSERT_EQ(run("region " + shellQuoted(wall) + " --from 1,0,3,11 --to 12,0,14,11 -o " + shellQuoted(out("w.json")) +
-                " --rays " + shellQuoted(out("w.csv")) + " -q")
+  ASSERT_EQ(run("region " + shellQuoted(wall) + " --from 1,0,3,11 --to 12,0,14,11 -o " +
+                shellQuoted(out("w.json")) + " --rays " + shellQuoted(out("w.csv")) + " -q")
                 .status,
             0);
   EXPECT_EQ(JsonParser::parse(readText(out("w.json")))["clear_pairs"].number, 0.0);
@@ -2482,8 +2486,9 @@ TEST_F(Cli, RegionVisibilityRefusesBadInput) {
   expectFailure(run("arealight " + shellQuoted(holes) + " -o " + shellQuoted(out("a.exr")) + " --sources " +
                     shellQuoted(in("on_hole.csv"))),
                 2, "nodata");
-  expectFailure(run("arealight " + shellQuoted(holes) + " -o " + shellQuoted(out("a.exr")) + " --light 2,2,4,4"),
-                2, "nodata");
+  expectFailure(
+      run("arealight " + shellQuoted(holes) + " -o " + shellQuoted(out("a.exr")) + " --light 2,2,4,4"), 2,
+      "nodata");
   expectFailure(run(region + " --from 1,1,2,2"), 2, "missing --to");
   expectFailure(run(region + " --from 1,1,2,2 --to 3,3,4,12"), 2, "--to 3,3,4,12");
   expectFailure(run(region + " --from 1,1,2,2 --to 3,3,4,4 --method viewsheds"), 2, "--method");
@@ -2504,10 +2509,12 @@ TEST_F(CliGeoTiff, RegionVisibilityOnAGeoreferencedField) {
   const hfvis::testing::GdalRaster light = checkGeoTiffOutput(out("a.tif"), {"visible"}, "arealight");
   EXPECT_EQ(light.bands[0][0], -9999.0f);  // nodata at (0, 0)
   for (std::size_t p = 1; p < light.bands[0].size(); ++p)
-    if (light.bands[0][p] != -9999.0f) ASSERT_TRUE(light.bands[0][p] >= 0.0f && light.bands[0][p] <= 1.0f) << p;
+    if (light.bands[0][p] != -9999.0f)
+      ASSERT_TRUE(light.bands[0][p] >= 0.0f && light.bands[0][p] <= 1.0f) << p;
   // region's rays: map coordinates of the pixel centres through the geotransform.
-  const CliResult r = run("region " + shellQuoted(dem) + " --from 1,1,4,4 --to 15,10,20,14 --from-height 50 -o " +
-                          shellQuoted(out("r.json")) + " --rays " + shellQuoted(out("r.csv")) + " -q");
+  const CliResult r =
+      run("region " + shellQuoted(dem) + " --from 1,1,4,4 --to 15,10,20,14 --from-height 50 -o " +
+          shellQuoted(out("r.json")) + " --rays " + shellQuoted(out("r.csv")) + " -q");
   ASSERT_EQ(r.status, 0) << r.err;
   const Json j = JsonParser::parse(readText(out("r.json")));
   const std::array<double, 6>& t = hfvis::testing::kUtmGeotransform;

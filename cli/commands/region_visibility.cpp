@@ -47,7 +47,8 @@ Attributes regionAttributes(const Job& job) {
   Attributes attributes = job.attributes(job.input);
   attributes.erase(std::remove_if(attributes.begin(), attributes.end(),
                                   [](const auto& a) {
-                                    return a.first == "hfvis:directions" || a.first == "hfvis:azimuth_offset_deg" ||
+                                    return a.first == "hfvis:directions" ||
+                                           a.first == "hfvis:azimuth_offset_deg" ||
                                            a.first == "hfvis:azimuth_convention" ||
                                            a.first == "hfvis:samples_per_unit";
                                   }),
@@ -79,16 +80,16 @@ class AreaLight : public Computation {
     } else {
       sources_.points = readRegionPointFile(run_.sources_file, run_.light_height, run_.absolute);
       if (sources_.points.size() > static_cast<std::size_t>(kMaxRegionSamples))
-        throw UsageError("--sources: " + run_.sources_file + " lists " + std::to_string(sources_.points.size()) +
-                         " points, more than the " + std::to_string(kMaxRegionSamples) +
-                         " samples a bitmask holds");
+        throw UsageError("--sources: " + run_.sources_file + " lists " +
+                         std::to_string(sources_.points.size()) + " points, more than the " +
+                         std::to_string(kMaxRegionSamples) + " samples a bitmask holds");
       sources_.samples = static_cast<int>(sources_.points.size());
       // (the viewsheds method stands one viewshed's eye on each; the library would refuse later)
       if (run_.region_method == RegionVisibilityMethod::Viewsheds)
         for (const RegionPoint& p : sources_.points)
           if (p.col != std::floor(p.col) || p.row != std::floor(p.row))
-            throw UsageError("--method viewsheds: the source " + formatNumber(p.col) + "," + formatNumber(p.row) +
-                             " of " + run_.sources_file +
+            throw UsageError("--method viewsheds: the source " + formatNumber(p.col) + "," +
+                             formatNumber(p.row) + " of " + run_.sources_file +
                              " lies between grid points; the viewsheds method needs whole columns and rows "
                              "(or --method exact)");
     }
@@ -115,8 +116,9 @@ class AreaLight : public Computation {
     attributes.emplace_back("hfvis:light", light);
     attributes.emplace_back("hfvis:light_samples", std::to_string(result_.samples));
     if (run_.light)
-      attributes.emplace_back("hfvis:light_height", formatNumber(run_.light_height) +
-                                                        (run_.absolute ? " absolute (z-scaled)" : " above the surface"));
+      attributes.emplace_back(
+          "hfvis:light_height",
+          formatNumber(run_.light_height) + (run_.absolute ? " absolute (z-scaled)" : " above the surface"));
     attributes.emplace_back("hfvis:target_height", formatNumber(run_.target_height));
     attributes.emplace_back("hfvis:decorrelate", run_.decorrelate ? "1" : "0");
     outputs.image(run_.output,
@@ -228,8 +230,8 @@ class Region : public Computation {
       std::string out = "[";
       for (std::size_t i = 0; i < points.size(); ++i) {
         const RegionPoint& p = points[i];
-        out += std::string(i ? "," : "") + "\n    {\"col\": " + jsonNumber(p.col) + ", \"row\": " +
-               jsonNumber(p.row) + ", \"height\": " + jsonNumber(p.height);
+        out += std::string(i ? "," : "") + "\n    {\"col\": " + jsonNumber(p.col) +
+               ", \"row\": " + jsonNumber(p.row) + ", \"height\": " + jsonNumber(p.height);
         if (transform) {
           const auto [x, y] = mapPosition(*transform, p.col, p.row);
           out += ", \"x\": " + jsonNumber(x) + ", \"y\": " + jsonNumber(y);
@@ -256,7 +258,8 @@ class Region : public Computation {
          << "  \"pairs\": " << r.pairs << ",\n"
          << "  \"clear_pairs\": " << r.clear_pairs << ",\n"
          << "  \"visible_fraction\": " << exactNumber(fraction) << ",\n"
-         << "  \"conventions\": " << jsonString(
+         << "  \"conventions\": "
+         << jsonString(
                 "col, row: pixel columns and rows (grid points at whole numbers, samples between them); "
                 "height: absolute, z-scaled height units; x, y: map coordinates of a georeferenced input; "
                 "a from sample's visible_fraction: the to samples it sees / their count, a to sample's: the "
@@ -280,14 +283,16 @@ class Region : public Computation {
           if (transform) {
             const auto [ax, ay] = mapPosition(*transform, a.col, a.row);
             const auto [bx, by] = mapPosition(*transform, b.col, b.row);
-            csv += "," + formatNumber(ax) + "," + formatNumber(ay) + "," + formatNumber(bx) + "," + formatNumber(by);
+            csv += "," + formatNumber(ax) + "," + formatNumber(ay) + "," + formatNumber(bx) + "," +
+                   formatNumber(by);
           }
           csv += "\n";
         }
       outputs.text(run_.rays_output, csv);
     }
-    return {r.source_samples, "; " + std::to_string(r.clear_pairs) + " of " + std::to_string(r.pairs) +
-                                  " pairs clear (" + formatFixed(100.0 * fraction, 2) + " %)",
+    return {r.source_samples,
+            "; " + std::to_string(r.clear_pairs) + " of " + std::to_string(r.pairs) + " pairs clear (" +
+                formatFixed(100.0 * fraction, 2) + " %)",
             "sample"};
   }
 
@@ -308,8 +313,9 @@ class Region : public Computation {
 // A height below the surface is hidden (the surface rises above every segment beside it).
 void requireAboveSurface(const RunArguments& run, const char* option, double height) {
   if (!run.absolute && height < 0.0)
-    throw UsageError(std::string(option) +
-                     ": a sample below the surface is hidden from everything; give a height >= 0 (or --absolute)");
+    throw UsageError(
+        std::string(option) +
+        ": a sample below the surface is hidden from everything; give a height >= 0 (or --absolute)");
 }
 
 void checkAreaLight(const std::string&, const RunArguments& run) {
@@ -335,7 +341,8 @@ void checkAreaLight(const std::string&, const RunArguments& run) {
 
 void checkRegion(const std::string&, const RunArguments& run) {
   if (!hasExtension(run.output, ".json"))
-    throw UsageError("-o: 'hfvis region' writes JSON; the name must end in .json, got " + inQuotes(run.output));
+    throw UsageError("-o: 'hfvis region' writes JSON; the name must end in .json, got " +
+                     inQuotes(run.output));
   if (!run.from_region || !run.to_region)
     throw UsageError(std::string("missing ") + (run.from_region ? "--to" : "--from") +
                      " C0,R0,C1,R1 (region pairs need --from and --to rectangles)");
