@@ -2508,9 +2508,11 @@ TEST_F(CliGeoTiff, RegionVisibilityOnAGeoreferencedField) {
             0);
   const hfvis::testing::GdalRaster light = checkGeoTiffOutput(out("a.tif"), {"visible"}, "arealight");
   EXPECT_EQ(light.bands[0][0], -9999.0f);  // nodata at (0, 0)
-  for (std::size_t p = 1; p < light.bands[0].size(); ++p)
-    if (light.bands[0][p] != -9999.0f)
+  for (std::size_t p = 1; p < light.bands[0].size(); ++p) {
+    if (light.bands[0][p] != -9999.0f) {
       ASSERT_TRUE(light.bands[0][p] >= 0.0f && light.bands[0][p] <= 1.0f) << p;
+    }
+  }
   // region's rays: map coordinates of the pixel centres through the geotransform.
   const CliResult r =
       run("region " + shellQuoted(dem) + " --from 1,1,4,4 --to 15,10,20,14 --from-height 50 -o " +
