@@ -575,7 +575,8 @@ TEST_F(Cli, HelpListsEveryCommandByItsNameAndItsAlias) {
     EXPECT_EQ(by_name.out.rfind("hfvis " + name + " ", 0), 0u) << by_name.out;
     EXPECT_NE(by_name.out.find("'hfvis " + alias + "'"), std::string::npos) << by_name.out;
   }
-  for (const char* name : {"horizon", "bounce", "shade", "insolation", "viewshed", "devices"})
+  for (const char* name :
+       {"horizon", "bounce", "shade", "insolation", "viewshed", "arealight", "region", "devices"})
     EXPECT_NE(general.out.find(std::string("hfvis ") + name), std::string::npos) << name;
   // horizon-lists runs on the host and writes text: no device, no preview; the parser agrees.
   const std::string lists = run("horizon-lists --help").out;
@@ -2334,6 +2335,12 @@ TEST_F(Cli, AreaLightBehindAWallIsHiddenAndAgreesWithTheLibrary) {
         ASSERT_EQ((bits >> (s % 16)) & 1u, lib.visible(p, s) ? 1u : 0u) << x << "," << y << " sample " << s;
       }
     }
+  // The corners in any order: the same rectangle, the same samples.
+  ASSERT_EQ(run("arealight " + shellQuoted(field) + " -o " + shellQuoted(out("r.exr")) +
+                " --light 3,9,1,2 --light-height 1 --samples 37 -q")
+                .status,
+            0);
+  EXPECT_EQ(readBack(out("r.exr")).pixels, a.pixels);
   // A light in the plane 20 high (--absolute): every line from it to the ground at column 12
   // passes column 8 above 7, over the wall.
   ASSERT_EQ(run("arealight " + shellQuoted(field) + " -o " + shellQuoted(out("h.exr")) +
