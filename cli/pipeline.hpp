@@ -132,7 +132,8 @@ class Computation {
   virtual std::vector<std::string> outputs() const;
   // Inputs besides the height field, which no output may replace.
   virtual std::vector<std::string> otherInputs() const { return {}; }
-  // false: text outputs (no image writer needed), computed on the host (no device).
+  // false: text outputs (no image writer needed), computed on the host (no device) unless
+  // usesDevice() says otherwise.
   virtual bool writesImages() const { return true; }
   // Whether it computes on the device: those that write images, and text outputs computed there
   // (region's JSON).
