@@ -216,6 +216,41 @@ void parseUtcTimeInto(const std::string& typed, const std::string& value, std::o
   }
 }
 
+// "C0,R0,C1,R1": a rectangle of grid points, its corners included, in any order (the library
+// orders them). Whether it lies inside the field is checked once the field's size is known.
+PixelRectangle parseRectangle(const std::string& typed, const std::string& value) {
+  const std::string expected =
+      typed +
+      ": expected C0,R0,C1,R1 (two corner pixels' zero-based columns and rows, e.g. 10,0,20,5), got " +
+      inQuotes(shortened(value));
+  std::vector<int> corners;
+  std::size_t begin = 0;
+  while (true) {
+    const std::size_t comma = value.find(',', begin);
+    const std::string part =
+        value.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin);
+    const char* start = part.c_str();
+    char* end = nullptr;
+    errno = 0;
+    const long number = std::strtol(start, &end, 10);
+    if (part.empty() || end != start + part.size() || errno == ERANGE ||
+        number > std::numeric_limits<int>::max() || number < std::numeric_limits<int>::min())
+      throw UsageError(expected);
+    corners.push_back(static_cast<int>(number));
+    if (comma == std::string::npos) break;
+    begin = comma + 1;
+  }
+  if (corners.size() != 4) throw UsageError(expected);
+  for (const int c : corners)
+    if (c < 0) throw UsageError(typed + " " + value + ": outside the field (columns and rows count from 0)");
+  return {corners[0], corners[1], corners[2], corners[3]};
+}
+
+// A height of a region's samples, as --observer-height: what single precision holds.
+double parseRegionHeight(const std::string& typed, const std::string& value) {
+  return parseBounded(typed, value, -kMostLength, kMostLength, kFloatRange);
+}
+
 // A flag that sets one bool field.
 #define HFVIS_FLAG(field) [](const std::string&, const std::string&, RunArguments& run) { run.field = true; }
 // A path or name: any non-empty text.
@@ -233,7 +268,7 @@ const std::vector<OptionSpec>& optionTable() {
       {"--output", "-o", "FILE", kOutputGroup, false,
        "output image (required): float32 EXR, or a float32 GeoTIFF when the\n"
        "name ends in .tif or .tiff (the input's georeference kept; see\n"
-       "Conventions, GIS); horizon-lists: OUT.json or OUT.csv",
+       "Conventions, GIS); horizon-lists: OUT.json or OUT.csv; region: OUT.json",
        HFVIS_TEXT(output)},
       {"--quiet", "-q", nullptr, kOutputGroup, false, "print neither progress nor the summary line",
        HFVIS_FLAG(quiet)},
@@ -537,6 +572,96 @@ const std::vector<OptionSpec>& optionTable() {
          run.cull_level = static_cast<int>(k);
          run.cull_level_given = true;
        }},
+      {"--samples", nullptr, "N", kRegionSamplingGroup, false,
+       "samples of each region, 1 .. 4096 (default 16): stratified over the\n"
+       "rectangle, each jittered in its stratum",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         const double n = parseNumber(typed, value);
+         if (!(n >= 1.0 && n <= kMaxRegionSamples && n == std::floor(n)))
+           throw UsageError(typed + ": expected a whole number of samples in 1 .. " +
+                            std::to_string(kMaxRegionSamples) + " (the bitmasks' bits), got " +
+                            inQuotes(shortened(value)));
+         run.region_samples = static_cast<int>(n);
+         run.region_samples_given = true;
+       }},
+      {"--method", nullptr, "exact|viewsheds", kRegionSamplingGroup, false,
+       "exact: one sight line per pair (default); viewsheds: one viewshed\n"
+       "per source sample, for sources on grid points (--sources, or a\n"
+       "one-pixel --light), shared samples; may decide grazing lines the\n"
+       "other way",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         if (value != "exact" && value != "viewsheds")
+           throw UsageError(typed + ": expected 'exact' or 'viewsheds', got " + inQuotes(shortened(value)));
+         run.region_method =
+             value == "exact" ? RegionVisibilityMethod::Exact : RegionVisibilityMethod::Viewsheds;
+       }},
+      {"--absolute", nullptr, nullptr, kRegionSamplingGroup, false,
+       "the regions' heights absolute (z-scaled), not above the surface", HFVIS_FLAG(absolute)},
+      {"--seed", nullptr, "N", kRegionSamplingGroup, false,
+       "the jitter's seed, 0 .. 4294967295 (default 1): the same seed, the\n"
+       "same samples",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         const double n = parseNumber(typed, value);
+         if (!(n >= 0.0 && n <= 4294967295.0 && n == std::floor(n)))
+           throw UsageError(typed + ": expected a whole number in 0 .. 4294967295, got " +
+                            inQuotes(shortened(value)));
+         run.seed = static_cast<std::uint32_t>(n);
+       }},
+      {"--light", nullptr, "C0,R0,C1,R1", kAreaLightGroup, false,
+       "the light: the rectangle of grid points between two corner pixels\n"
+       "(columns and rows, inclusive, in any order)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.light = parseRectangle(typed, value);
+       }},
+      {"--light-height", nullptr, "H", kAreaLightGroup, false,
+       "the light's samples H above the surface under each (--absolute: at\n"
+       "height H); the default height of --sources rows (default 2)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.light_height = parseRegionHeight(typed, value);
+       }},
+      {"--sources", nullptr, "FILE.csv", kAreaLightGroup, false,
+       "the light's samples, one col,row[,height] a line (a header line\n"
+       "allowed; fractional columns and rows lie between pixel centres)",
+       HFVIS_TEXT(sources_file)},
+      {"--target-height", nullptr, "T", kAreaLightGroup, false,
+       "every pixel receives T above the surface (default 0)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         if (parseNumber(typed, value) < 0.0)
+           throw UsageError(typed + ": must be >= 0, got " + inQuotes(value));
+         run.target_height = parseBounded(typed, value, 0.0, kMostLength, kFloatRange);
+       }},
+      {"--decorrelate", nullptr, nullptr, kAreaLightGroup, false,
+       "each pixel draws its own jitter of the light's samples: noise\n"
+       "instead of the banding of shared samples (--method exact)",
+       HFVIS_FLAG(decorrelate)},
+      {"--masks", nullptr, "FILE", kAreaLightGroup, false,
+       "also the bitmasks of the samples each pixel sees, lossless: float32\n"
+       "channels m000.., channel k holding samples 16k .. 16k+15 as the\n"
+       "whole number sum of 2^b for each visible sample 16k+b (.exr, .tif)",
+       HFVIS_TEXT(masks_output)},
+      {"--from", nullptr, "C0,R0,C1,R1", kRegionPairGroup, false,
+       "the source rectangle of grid points (inclusive corners, any order)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.from_region = parseRectangle(typed, value);
+       }},
+      {"--to", nullptr, "C0,R0,C1,R1", kRegionPairGroup, false, "the receiving rectangle",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.to_region = parseRectangle(typed, value);
+       }},
+      {"--from-height", nullptr, "H", kRegionPairGroup, false,
+       "the source samples' height above the surface (default 2)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.from_height = parseRegionHeight(typed, value);
+       }},
+      {"--to-height", nullptr, "H", kRegionPairGroup, false,
+       "the receiving samples' height above the surface (default 2)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.to_height = parseRegionHeight(typed, value);
+       }},
+      {"--rays", nullptr, "RAYS.csv", kRegionPairGroup, false,
+       "also every clear ray's end points, one a line (pixel columns and\n"
+       "rows, heights; map x, y for a georeferenced input)",
+       HFVIS_TEXT(rays_output)},
   };
   return table;
 }
@@ -552,7 +677,9 @@ namespace {
 
 // Checks that involve more than one option: every command's, and its own (CommandSpec::check).
 void validateRun(const CommandSpec& command, const std::string& name, const RunArguments& run) {
-  const std::string out = command.id == Command::HorizonLists ? "OUT.json|OUT.csv" : "OUT.exr";
+  const std::string out = command.id == Command::HorizonLists ? "OUT.json|OUT.csv"
+                          : command.id == Command::Region     ? "OUT.json"
+                                                              : "OUT.exr";
   if (run.input.empty())
     throw UsageError("missing the input height field (hfvis " + name + " IN -o " + out + ")");
   if (run.output.empty())
@@ -842,6 +969,17 @@ ViewshedOptions viewshedOptions(const RunArguments& run) {
   if (run.field_of_view) std::tie(options.azimuth_from_deg, options.azimuth_to_deg) = *run.field_of_view;
   if (run.elevation_range) std::tie(options.elevation_min_deg, options.elevation_max_deg) = *run.elevation_range;
   options.memory_budget_bytes = run.memory_budget_bytes;
+  return options;
+}
+
+RegionVisibilityOptions regionVisibilityOptions(const RunArguments& run) {
+  RegionVisibilityOptions options;
+  options.method = run.region_method;
+  options.target_height = run.target_height;
+  options.max_distance = run.max_distance;
+  options.curvature = run.curvature ? earthCurvature(run.refraction) : 0.0;
+  options.seed = run.seed;
+  options.decorrelate = run.decorrelate;
   return options;
 }
 

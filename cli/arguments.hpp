@@ -16,6 +16,7 @@
 #include "hfvis/image_io.hpp"
 #include "hfvis/insolation.hpp"
 #include "hfvis/intervisibility.hpp"
+#include "hfvis/region_visibility.hpp"
 #include "hfvis/sun_shading.hpp"
 #include "hfvis/viewshed.hpp"
 
@@ -41,6 +42,8 @@ enum class Command {
   Shade,            // the surface lit by an environment and / or the sun
   Insolation,       // sunshine hours and direct irradiation over a span of time
   Viewshed,         // what one observer sees, or how many of several see each point
+  AreaLight,        // the fraction of an area light's (a region's) samples each pixel sees
+  Region,           // visibility between two rectangles: the share of clear sample pairs
 };
 
 // Everything a compute command's run needs, already validated.
@@ -101,6 +104,20 @@ struct RunArguments {
   int cull_level = ViewshedPyramidOptions{}.finest_level;  // --cull-level K: its finest nodes, 2^K points a side
   bool cull_level_given = false;
   std::optional<float> nodata;               // --nodata VALUE for GeoTIFF outputs (may be NaN); none = NaN
+  // arealight and region (hfvis/region_visibility.hpp): --samples N per region, --method
+  // exact|viewsheds, --seed of the jitter; arealight's light, --light C0,R0,C1,R1 at
+  // --light-height (or --sources FILE.csv), --decorrelate, --masks FILE; region's --from and --to
+  // rectangles at --from-height and --to-height, --rays FILE.csv. (--absolute and --target-height
+  // set the viewshed's fields above.)
+  int region_samples = RegionSampling{}.samples;
+  bool region_samples_given = false;
+  RegionVisibilityMethod region_method = RegionVisibilityMethod::Exact;
+  std::uint32_t seed = RegionVisibilityOptions{}.seed;
+  std::optional<PixelRectangle> light, from_region, to_region;
+  double light_height = RegionSampling{}.height;
+  double from_height = RegionSampling{}.height, to_height = RegionSampling{}.height;
+  std::string sources_file, masks_output, rays_output;
+  bool decorrelate = false;
 };
 
 // What "hfvis sunpos" is asked.
@@ -149,6 +166,7 @@ SweepOptions horizonListOptions(const RunArguments& run);
 BounceOptions bounceOptions(const RunArguments& run);
 InsolationOptions insolationOptions(const RunArguments& run);
 ViewshedOptions viewshedOptions(const RunArguments& run);
+RegionVisibilityOptions regionVisibilityOptions(const RunArguments& run);
 HeightFieldReadOptions readOptions(const RunArguments& run);
 
 }  // namespace hfvis::cli

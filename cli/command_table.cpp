@@ -8,7 +8,8 @@ const std::vector<const CommandSpec*>& commandTable() {
       &kHorizonCommand,         &kSkyViewFactorCommand, &kAmbientOcclusionCommand,
       &kIntervisibilityCommand, &kHorizonListsCommand,  &kBounceCommand,
       &kShadeCommand,           &kInsolationCommand,    &kViewshedCommand,
-      &kSunPositionCommand,     &kDevicesCommand,
+      &kAreaLightCommand,       &kRegionCommand,        &kSunPositionCommand,
+      &kDevicesCommand,
   };
   return table;
 }

@@ -89,6 +89,8 @@ const char* groupTitle(unsigned group) {
       return "Environment light";
     case kSunShadingGroup:
       return "Sun shading";
+    case kRegionSamplingGroup:
+      return "Region sampling";
     default:
       return "";  // a command's own group
   }

@@ -1,5 +1,5 @@
-// cli/observer_files.cpp: the observers of "hfvis viewshed --observers FILE.csv"
-// (observer_files.hpp).
+// cli/observer_files.cpp: the observers of "hfvis viewshed --observers FILE.csv" and the light's
+// samples of "hfvis arealight --sources FILE.csv" (observer_files.hpp).
 #include "observer_files.hpp"
 
 #include <cctype>
@@ -18,8 +18,29 @@
 namespace hfvis::cli {
 using detail::shortNumber;
 
-std::vector<Observer> parseObservers(const std::string& path, std::istream& in, double default_height,
-                                     bool absolute) {
+namespace {
+
+// A point of a CSV line: column, row (whole, or fractional where `whole` is false) and height.
+struct CsvPoint {
+  double col = 0.0, row = 0.0, height = 0.0;
+};
+
+// How the two files' lines differ: what a point is called and whether its column and row must be
+// whole (an observer stands on a grid point; a light's sample may lie between them).
+struct PointKind {
+  bool whole;
+  const char* expected;  // the line's form, for the message
+  const char* below;     // why a negative height is refused
+  const char* none;      // the message for a file without points
+};
+
+// "col,row[,height]" per line; blank lines, lines starting with '#' and one header line before
+// the first point (fields that start with letters) are skipped; a missing height is
+// `default_height`. Throws IoError naming `path`, the line and its first 60 bytes (control and
+// non-ASCII bytes escaped) for a malformed line, a UTF-16 file, a negative height unless
+// `absolute`, or no point at all.
+std::vector<CsvPoint> parsePoints(const std::string& path, std::istream& in, double default_height,
+                                  bool absolute, const PointKind& kind) {
   // A line as a message shows it: its start, control and non-ASCII bytes escaped (a NUL or
   // UTF-16 byte would garble a terminal, and a 10 MB line would flood it).
   const auto shown = [](const std::string& line) {
@@ -36,7 +57,7 @@ std::vector<Observer> parseObservers(const std::string& path, std::istream& in, 
     }
     return line.size() > 60 ? text + "... (" + std::to_string(line.size()) + " bytes)" : text;
   };
-  std::vector<Observer> observers;
+  std::vector<CsvPoint> points;
   std::string line;
   bool header_seen = false;
   for (int number = 1; std::getline(in, line); ++number) {
@@ -56,43 +77,76 @@ std::vector<Observer> parseObservers(const std::string& path, std::istream& in, 
     };
     if (number == 1 && (line.rfind("\xFF\xFE", 0) == 0 || line.rfind("\xFE\xFF", 0) == 0))
       throw IoError(path, "is UTF-16 text; save it as UTF-8 (or ASCII) with lines col,row[,height]");
-    if (observers.empty() && fields[0].rfind("\xEF\xBB\xBF", 0) == 0) fields[0].erase(0, 3);  // a UTF-8 BOM
+    if (points.empty() && fields[0].rfind("\xEF\xBB\xBF", 0) == 0) fields[0].erase(0, 3);  // a UTF-8 BOM
     double col = 0, row_index = 0, height = default_height;
     const bool numbers = fields.size() >= 2 && number_in(fields[0], col) && number_in(fields[1], row_index);
-    // A header: before any observer, a line whose fields all start with a letter.
+    // A header: before any point, a line whose fields all start with a letter.
     bool words = true;
     for (const std::string& f : fields) {
       const std::size_t a = f.find_first_not_of(" \t");
       words = words && a != std::string::npos && std::isalpha(static_cast<unsigned char>(f[a]));
     }
-    if (!numbers && observers.empty() && !header_seen && words) {
+    if (!numbers && points.empty() && !header_seen && words) {
       header_seen = true;
       continue;
     }
     if (!numbers || fields.size() > 3 || (fields.size() == 3 && !number_in(fields[2], height)) ||
-        col != std::floor(col) || row_index != std::floor(row_index) || std::fabs(col) > 1e9 ||
-        std::fabs(row_index) > 1e9)
-      throw IoError(path, "line " + std::to_string(number) +
-                              ": expected col,row[,height] (whole column and row), got '" + shown(line) +
-                              "'");
+        (kind.whole && (col != std::floor(col) || row_index != std::floor(row_index))) ||
+        std::fabs(col) > 1e9 || std::fabs(row_index) > 1e9)
+      throw IoError(path, "line " + std::to_string(number) + ": expected " + kind.expected + ", got '" +
+                              shown(line) + "'");
     if (!absolute && height < 0.0)
-      throw IoError(path,
-                    "line " + std::to_string(number) + ": the height " + shortNumber(height) +
-                        " puts the eye below the surface, where it sees nothing; give a height >= 0 (or "
-                        "--absolute)");
+      throw IoError(path, "line " + std::to_string(number) + ": the height " + shortNumber(height) + " " +
+                              kind.below + "; give a height >= 0 (or --absolute)");
     if (std::fabs(height) > 1e12)  // as --observer-height: what the kernels' single precision holds
       throw IoError(path, "line " + std::to_string(number) + ": the height " + shortNumber(height) +
                               " is beyond 1e+12, more than the kernels' single precision holds");
-    observers.push_back({static_cast<int>(col), static_cast<int>(row_index), height});
+    points.push_back({col, row_index, height});
   }
-  if (observers.empty()) throw IoError(path, "no observers (lines col,row[,height])");
-  return observers;
+  if (points.empty()) throw IoError(path, kind.none);
+  return points;
 }
 
-std::vector<Observer> readObserverFile(const std::string& path, double default_height, bool absolute) {
+const PointKind kObserverKind{true, "col,row[,height] (whole column and row)",
+                              "puts the eye below the surface, where it sees nothing",
+                              "no observers (lines col,row[,height])"};
+const PointKind kSourceKind{
+    false, "col,row[,height] (numbers: column and row, fractional between pixel centres)",
+    "puts the sample below the surface, where nothing sees it", "no sources (lines col,row[,height])"};
+
+// The file `path`, which must be a regular file (not a device or FIFO), open for reading.
+std::ifstream openCsv(const std::string& path) {
   detail::requireInputFile(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw IoError(path, std::string("cannot open: ") + std::strerror(errno));
+  return in;
+}
+
+}  // namespace
+
+std::vector<Observer> parseObservers(const std::string& path, std::istream& in, double default_height,
+                                     bool absolute) {
+  std::vector<Observer> observers;
+  for (const CsvPoint& p : parsePoints(path, in, default_height, absolute, kObserverKind))
+    observers.push_back({static_cast<int>(p.col), static_cast<int>(p.row), p.height});
+  return observers;
+}
+
+std::vector<RegionPoint> parseRegionPoints(const std::string& path, std::istream& in, double default_height,
+                                           bool absolute) {
+  std::vector<RegionPoint> points;
+  for (const CsvPoint& p : parsePoints(path, in, default_height, absolute, kSourceKind))
+    points.push_back({p.col, p.row, p.height});
+  return points;
+}
+
+std::vector<RegionPoint> readRegionPointFile(const std::string& path, double default_height, bool absolute) {
+  std::ifstream in = openCsv(path);
+  return parseRegionPoints(path, in, default_height, absolute);
+}
+
+std::vector<Observer> readObserverFile(const std::string& path, double default_height, bool absolute) {
+  std::ifstream in = openCsv(path);
   return parseObservers(path, in, default_height, absolute);
 }
 

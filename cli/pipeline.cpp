@@ -298,9 +298,9 @@ int runPipeline(const CommandLine& line, Computation& computation) {
   requireOutputs(run, computation);
   HeightField input = readValidField(run);
   computation.prepare(input);
-  // (a command on the host, writing text, opens no device)
+  // (a command on the host, writing text, opens no device; region writes text from the device)
   std::optional<ComputeContext> context;
-  if (computation.writesImages()) context.emplace(contextFor(run));
+  if (computation.usesDevice()) context.emplace(contextFor(run));
   Progress progress(run.quiet);
   Job job{commandSpec(line.command),     run,      input,
           context ? &*context : nullptr, progress, computation.method()};

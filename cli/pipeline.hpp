@@ -132,8 +132,12 @@ class Computation {
   virtual std::vector<std::string> outputs() const;
   // Inputs besides the height field, which no output may replace.
   virtual std::vector<std::string> otherInputs() const { return {}; }
-  // false: text outputs (no image writer needed), computed on the host (no device).
+  // false: text outputs (no image writer needed), computed on the host (no device) unless
+  // usesDevice() says otherwise.
   virtual bool writesImages() const { return true; }
+  // Whether it computes on the device: those that write images, and text outputs computed there
+  // (region's JSON).
+  virtual bool usesDevice() const { return writesImages(); }
   // hfvis:method and the summary's method.
   virtual std::string method() const;
   // After the height field is read, before the device is set up: the command's own inputs read

@@ -34,7 +34,12 @@ enum OptionGroup : unsigned {
   kSunShadingGroup = 1u << 16,
   kInsolationGroup = 1u << 17,
   kViewshedGroup = 1u << 18,
-  kLastGroup = kViewshedGroup,
+  // Region visibility (hfvis/region_visibility.hpp): what arealight and region share (--samples,
+  // --method exact|viewsheds, --absolute, --seed), then each one's own.
+  kRegionSamplingGroup = 1u << 19,
+  kAreaLightGroup = 1u << 20,
+  kRegionPairGroup = 1u << 21,
+  kLastGroup = kRegionPairGroup,
 };
 
 // The groups every command that reads a height field and writes images takes.
@@ -90,6 +95,6 @@ std::string commandList();
 // The entries, each defined in its command's file under cli/commands/.
 extern const CommandSpec kHorizonCommand, kSkyViewFactorCommand, kAmbientOcclusionCommand,
     kIntervisibilityCommand, kHorizonListsCommand, kBounceCommand, kShadeCommand, kInsolationCommand,
-    kViewshedCommand, kSunPositionCommand, kDevicesCommand;
+    kViewshedCommand, kAreaLightCommand, kRegionCommand, kSunPositionCommand, kDevicesCommand;
 
 }  // namespace hfvis::cli

@@ -71,6 +71,9 @@ PY
 mkfifo pipe.exr
 printf '1,1\n2,2,-5\n' > negative_height.csv
 printf '1,1\n%s\n' "$(head -c 5000 /dev/zero | tr '\0' 'x')" > long_line.csv
+printf 'col,row,height\n1,1,2\n3,x,2\n' > bad_sources.csv
+printf '1,1\n300,2\n' > outside_sources.csv
+printf '5,3\n' > nodata_source.csv  # nan.exr's NaN
 # An earlier result, write-protected by its owner (mode 0444).
 cp field.tif protected.tif
 chmod 444 protected.tif
@@ -184,6 +187,20 @@ try "viewshed method unknown" "" -- viewshed field.exr -o out/o.exr --observer 3
 try "viewshed cull level 0" "" -- viewshed field.exr -o out/o.exr --observer 3,3 --method culled --cull-level 0
 try "viewshed cull level without culling" "" -- viewshed field.exr -o out/o.exr --observer 3,3 --cull-level 3
 try "viewshed angle for several observers" "" -- viewshed field.exr -o out/o.exr --observer 3,3 --observer 4,4 --angle
+try "arealight without a light" "" -- arealight field.exr -o out/o.exr
+try "arealight with --light and --sources" "" -- arealight field.exr -o out/o.exr --light 1,1,4,4 --sources bad_sources.csv
+try "arealight light outside the field" "" -- arealight field.exr -o out/o.exr --light 250,0,256,4
+try "arealight light not four numbers" "" -- arealight field.exr -o out/o.exr --light 1,1,4
+try "arealight samples over the maximum" "" -- arealight field.exr -o out/o.exr --light 1,1,4,4 --samples 4097
+try "arealight sources file with a bad line" "" -- arealight field.exr -o out/o.exr --sources bad_sources.csv
+try "arealight source outside the field" "" -- arealight field.exr -o out/o.exr --sources outside_sources.csv
+try "arealight source on nodata" "" -- arealight nan.exr -o out/o.exr --sources nodata_source.csv
+try "arealight viewsheds for a jittered light" "" -- arealight field.exr -o out/o.exr --light 1,1,4,4 --method viewsheds
+try "arealight masks an 8-bit image" "" -- arealight field.exr -o out/o.exr --light 1,1,4,4 --masks out/m.png
+try "region without --to" "" -- region field.exr -o out/r.json --from 1,1,4,4
+try "region rectangle outside the field" "" -- region field.exr -o out/r.json --from 1,1,4,4 --to 200,200,300,210
+try "region output not JSON" "" -- region field.exr -o out/r.exr --from 1,1,4,4 --to 8,8,9,9
+try "region rays not CSV" "" -- region field.exr -o out/r.json --from 1,1,4,4 --to 8,8,9,9 --rays out/r.txt
 try "sun position without a time" "" -- sunpos --lat 45 --lon 7
 try "sun position at a time without a zone" "" -- sunpos --lat 45 --lon 7 --at 2026-06-21T12:00:00
 try "sun position at a day that does not exist" "" -- sunpos --lat 45 --lon 7 --at 2026-02-30T12:00:00Z

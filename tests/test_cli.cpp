@@ -29,6 +29,7 @@
 #include "geotiff_support.hpp"
 #include "hfvis/horizon_lists.hpp"
 #include "hfvis/image_io.hpp"
+#include "hfvis/region_visibility.hpp"
 #include "image_outputs.hpp"
 #include "test_support.hpp"
 
@@ -574,7 +575,8 @@ TEST_F(Cli, HelpListsEveryCommandByItsNameAndItsAlias) {
     EXPECT_EQ(by_name.out.rfind("hfvis " + name + " ", 0), 0u) << by_name.out;
     EXPECT_NE(by_name.out.find("'hfvis " + alias + "'"), std::string::npos) << by_name.out;
   }
-  for (const char* name : {"horizon", "bounce", "shade", "insolation", "viewshed", "devices"})
+  for (const char* name :
+       {"horizon", "bounce", "shade", "insolation", "viewshed", "arealight", "region", "devices"})
     EXPECT_NE(general.out.find(std::string("hfvis ") + name), std::string::npos) << name;
   // horizon-lists runs on the host and writes text: no device, no preview; the parser agrees.
   const std::string lists = run("horizon-lists --help").out;
@@ -2265,4 +2267,278 @@ TEST_F(CliGeoTiff, ImpossibleGeoreferencesAndCellSizesAreRefused) {
   const CliResult given = run("svf " + shellQuoted(in("damaged.exr")) + " -o " + shellQuoted(out("o.exr")) +
                               " -k 4 -q --cell-size 30");
   EXPECT_EQ(given.status, 0) << given.err;
+}
+
+// ---- arealight and region (hfvis/region_visibility.hpp) ----
+
+namespace {
+// A 16 x 12 field: ground at 0, a wall 5 high across column 8 (every row).
+constexpr int kWallWidth = 16, kWallHeight = 12;
+float wallHeight(int col, int) { return col == 8 ? 5.0f : 0.0f; }
+}  // namespace
+
+TEST_F(Cli, AreaLightOnFlatGroundSeesEverySample) {
+  const std::string field = writeField("flat1.exr", 16, 12, [](int, int) { return 1.0f; });
+  const CliResult r = run("arealight " + shellQuoted(field) + " -o " + shellQuoted(out("a.exr")) +
+                          " --light 2,2,5,4 --samples 20 --masks " + shellQuoted(out("m.exr")) +
+                          " --preview " + shellQuoted(out("a.png")));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("20 light samples"), std::string::npos) << r.out;
+  const ReadBack a = readBack(out("a.exr"));
+  ASSERT_EQ(a.channels, (std::vector<std::string>{"visible"}));
+  for (float v : a.pixels) ASSERT_EQ(v, 1.0f);
+  EXPECT_EQ(a.spec.get_string_attribute("hfvis:command"), "arealight");
+  EXPECT_EQ(a.spec.get_string_attribute("hfvis:light_samples"), "20");
+  // 20 samples: channel m000 all 16 bits, m001 the 4 bits of samples 16 .. 19.
+  const ReadBack m = readBack(out("m.exr"));
+  ASSERT_EQ(m.channels, (std::vector<std::string>{"m000", "m001"}));
+  for (int y = 0; y < m.height; ++y)
+    for (int x = 0; x < m.width; ++x) {
+      ASSERT_EQ(m.at(x, y, 0), 65535.0f);
+      ASSERT_EQ(m.at(x, y, 1), 15.0f);
+    }
+  EXPECT_TRUE(fs::exists(out("a.png")));
+}
+
+TEST_F(Cli, AreaLightBehindAWallIsHiddenAndAgreesWithTheLibrary) {
+  const std::string field = writeField("wall.exr", kWallWidth, kWallHeight, wallHeight);
+  // The light on the ground's near side, 1 above it: the wall hides it from the ground behind.
+  const CliResult r =
+      run("arealight " + shellQuoted(field) + " -o " + shellQuoted(out("a.exr")) +
+          " --light 1,2,3,9 --light-height 1 --samples 37 --masks " + shellQuoted(out("m.tif")) + " -q");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const ReadBack a = readBack(out("a.exr"));
+  ASSERT_EQ(a.channels, (std::vector<std::string>{"visible"}));
+  for (int y = 0; y < kWallHeight; ++y) {
+    EXPECT_EQ(a.at(5, y, 0), 1.0f) << "row " << y;   // in front of the wall
+    EXPECT_EQ(a.at(12, y, 0), 0.0f) << "row " << y;  // behind it
+  }
+  // The same numbers as the library's own call.
+  const hfvis::HeightField f = hfvis::readHeightField(field);
+  hfvis::RegionSampling light;
+  light.rectangle = {1, 2, 3, 9};
+  light.height = 1.0;
+  light.samples = 37;
+  const hfvis::RegionVisibilityResult lib = hfvis::computeRegionVisibility(
+      hfvis::testing::testContext(), f, light, hfvis::RegionVisibilityOptions{});
+  ASSERT_EQ(lib.fraction.size(), a.pixels.size());
+  for (std::size_t p = 0; p < lib.fraction.size(); ++p)
+    ASSERT_EQ(a.pixels[p], lib.fraction[p]) << "pixel " << p;
+  // The masks, bit for bit: 37 samples in three 16-bit channels, read back from the GeoTIFF.
+  const ReadBack m = readBack(out("m.tif"));
+  ASSERT_EQ(m.channels.size(), 3u);
+  for (int y = 0; y < kWallHeight; ++y)
+    for (int x = 0; x < kWallWidth; ++x) {
+      const std::size_t p = std::size_t(y) * kWallWidth + x;
+      for (int s = 0; s < 37; ++s) {
+        const auto bits = static_cast<std::uint32_t>(m.at(x, y, s / 16));
+        ASSERT_EQ((bits >> (s % 16)) & 1u, lib.visible(p, s) ? 1u : 0u) << x << "," << y << " sample " << s;
+      }
+    }
+  // The corners in any order: the same rectangle, the same samples.
+  ASSERT_EQ(run("arealight " + shellQuoted(field) + " -o " + shellQuoted(out("r.exr")) +
+                " --light 3,9,1,2 --light-height 1 --samples 37 -q")
+                .status,
+            0);
+  EXPECT_EQ(readBack(out("r.exr")).pixels, a.pixels);
+  // A light in the plane 20 high (--absolute): every line from it to the ground at column 12
+  // passes column 8 above 7, over the wall.
+  ASSERT_EQ(run("arealight " + shellQuoted(field) + " -o " + shellQuoted(out("h.exr")) +
+                " --light 1,2,3,9 --light-height 20 --absolute -q")
+                .status,
+            0);
+  EXPECT_EQ(readBack(out("h.exr")).at(12, 5, 0), 1.0f);
+}
+
+TEST_F(Cli, AreaLightFromASourcesFile) {
+  const std::string field = writeField("wall.exr", kWallWidth, kWallHeight, wallHeight);
+  // A UTF-8 BOM, a header, CRLF, a comment, a fractional column and a row without a height.
+  {
+    std::ofstream csv(in("sources.csv"), std::ios::binary);
+    csv << "\xEF\xBB\xBF"
+           "col,row,height\r\n2,3,1\r\n# behind the wall\r\n12.5,6\r\n";
+  }
+  const CliResult r = run("arealight " + shellQuoted(field) + " -o " + shellQuoted(out("a.exr")) +
+                          " --sources " + shellQuoted(in("sources.csv")) + " --light-height 4 -q");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const hfvis::HeightField f = hfvis::readHeightField(field);
+  hfvis::RegionSampling sources;
+  sources.points = {{2.0, 3.0, 1.0}, {12.5, 6.0, 4.0}};
+  sources.samples = 2;
+  const hfvis::RegionVisibilityResult lib = hfvis::computeRegionVisibility(
+      hfvis::testing::testContext(), f, sources, hfvis::RegionVisibilityOptions{});
+  const ReadBack a = readBack(out("a.exr"));
+  ASSERT_EQ(a.pixels.size(), lib.fraction.size());
+  for (std::size_t p = 0; p < lib.fraction.size(); ++p)
+    ASSERT_EQ(a.pixels[p], lib.fraction[p]) << "pixel " << p;
+  // Each side of the wall sees its own source only.
+  EXPECT_EQ(a.at(4, 3, 0), 0.5f);
+  EXPECT_EQ(a.at(13, 6, 0), 0.5f);
+  // The viewsheds method takes sources on grid points and agrees away from grazing lines.
+  {
+    std::ofstream csv(in("grid.csv"));
+    csv << "2,3,1\n12,6,4\n";
+  }
+  ASSERT_EQ(run("arealight " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) + " --sources " +
+                shellQuoted(in("grid.csv")) + " --method viewsheds -q")
+                .status,
+            0);
+  const ReadBack v = readBack(out("v.exr"));
+  EXPECT_EQ(v.at(4, 3, 0), 0.5f);
+  EXPECT_EQ(v.at(13, 6, 0), 0.5f);
+  EXPECT_EQ(v.spec.get_string_attribute("hfvis:method"), "viewsheds");
+}
+
+TEST_F(Cli, RegionWritesConsistentJsonAndItsClearRays) {
+  // The wall stands in rows 0 .. 5 only: from the left rectangle to the right one, the pairs in
+  // the lower rows see past its end, the others not.
+  const std::string field = writeField("half_wall.exr", kWallWidth, kWallHeight,
+                                       [](int col, int row) { return col == 8 && row <= 5 ? 9.0f : 0.0f; });
+  const CliResult r =
+      run("region " + shellQuoted(field) + " --from 1,0,3,11 --to 12,0,14,11 --samples 24 -o " +
+          shellQuoted(out("r.json")) + " --rays " + shellQuoted(out("rays.csv")));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const Json j = JsonParser::parse(readText(out("r.json")));
+  const double pairs = j["pairs"].number, clear = j["clear_pairs"].number;
+  EXPECT_EQ(pairs, 24.0 * 24.0);
+  EXPECT_GT(clear, 0.0);
+  EXPECT_LT(clear, pairs);
+  EXPECT_DOUBLE_EQ(j["visible_fraction"].number, clear / pairs);
+  ASSERT_EQ(j["from_samples"].items.size(), 24u);
+  ASSERT_EQ(j["to_samples"].items.size(), 24u);
+  // Each sample's fraction is its share of the clear pairs: they sum to clear / 24 on each side.
+  double from_sum = 0.0, to_sum = 0.0;
+  for (const Json& s : j["from_samples"].items) {
+    EXPECT_GE(s["col"].number, 1.0);
+    EXPECT_LE(s["col"].number, 3.0);
+    from_sum += s["visible_fraction"].number;
+  }
+  for (const Json& s : j["to_samples"].items) to_sum += s["visible_fraction"].number;
+  EXPECT_NEAR(from_sum, clear / 24.0, 1e-4);
+  EXPECT_NEAR(to_sum, clear / 24.0, 1e-4);
+  // One ray a line, after the header: as many as the clear pairs, each from the left to the right.
+  const std::vector<std::string> lines = splitText(readText(out("rays.csv")), '\n');
+  ASSERT_GE(lines.size(), 2u);
+  EXPECT_EQ(lines[0], "from_col,from_row,from_height,to_col,to_row,to_height");
+  EXPECT_EQ(lines.back(), "");
+  EXPECT_EQ(static_cast<double>(lines.size() - 2), clear);
+  for (std::size_t i = 1; i + 1 < lines.size(); ++i) {
+    const std::vector<std::string> fields = splitText(lines[i], ',');
+    ASSERT_EQ(fields.size(), 6u) << lines[i];
+    EXPECT_LE(std::stod(fields[0]), 3.0);
+    EXPECT_GE(std::stod(fields[3]), 12.0);
+    // Where it crosses the wall's column: past the wall's end (row 5; the bilinear surface falls
+    // from 9 to 0 between rows 5 and 6).
+    const double c0 = std::stod(fields[0]), r0 = std::stod(fields[1]), c1 = std::stod(fields[3]),
+                 r1 = std::stod(fields[4]);
+    EXPECT_GT(r0 + (8.0 - c0) / (c1 - c0) * (r1 - r0), 5.0) << "a ray through the wall: " << lines[i];
+  }
+  // The library's own count.
+  const hfvis::HeightField f = hfvis::readHeightField(field);
+  hfvis::RegionSampling from, to;
+  from.rectangle = {1, 0, 3, 11};
+  to.rectangle = {12, 0, 14, 11};
+  from.samples = to.samples = 24;
+  const hfvis::RegionPairVisibilityResult lib = hfvis::computeRegionPairVisibility(
+      hfvis::testing::testContext(), f, from, to, hfvis::RegionVisibilityOptions{});
+  EXPECT_EQ(static_cast<double>(lib.clear_pairs), clear);
+  // A wall across every row: no clear pair, and a rays file with its header only.
+  const std::string wall = writeField("wall.exr", kWallWidth, kWallHeight, wallHeight);
+  ASSERT_EQ(run("region " + shellQuoted(wall) + " --from 1,0,3,11 --to 12,0,14,11 -o " +
+                shellQuoted(out("w.json")) + " --rays " + shellQuoted(out("w.csv")) + " -q")
+                .status,
+            0);
+  EXPECT_EQ(JsonParser::parse(readText(out("w.json")))["clear_pairs"].number, 0.0);
+  EXPECT_EQ(splitText(readText(out("w.csv")), '\n').size(), 2u);
+}
+
+TEST_F(Cli, RegionVisibilityRefusesBadInput) {
+  const std::string field = flat();  // 16 x 12
+  const std::string light = "arealight " + shellQuoted(field) + " -o " + shellQuoted(out("a.exr"));
+  const std::string region = "region " + shellQuoted(field) + " -o " + shellQuoted(out("r.json"));
+  expectFailure(run(light), 2, "missing --light");
+  expectFailure(run(light + " --light 1,1,2,2 --sources " + shellQuoted(in("s.csv"))), 2, "give one");
+  expectFailure(run(light + " --light 1,1,16,2"), 2, "--light 1,1,16,2");
+  expectFailure(run(light + " --light 1,1,2"), 2, "C0,R0,C1,R1");
+  expectFailure(run(light + " --light 1,1,2,2 --samples 4097"), 2, "4096");
+  expectFailure(run(light + " --light 1,1,2,2 --samples 0"), 2, "--samples");
+  expectFailure(run(light + " --light 1,1,2,2 --method viewsheds"), 2, "grid points");
+  expectFailure(run(light + " --light 1,1,1,1 --method viewsheds --decorrelate"), 2, "--decorrelate");
+  expectFailure(run(light + " --light 1,1,2,2 --light-height -1"), 2, "--light-height");
+  expectFailure(run(light + " --light 1,1,2,2 --masks " + shellQuoted(out("m.png"))), 1, "m.png");
+  expectFailure(run(light + " --light 1,1,2,2 --masks " + shellQuoted(field)), 2, "input");
+  {
+    std::ofstream csv(in("bad.csv"));
+    csv << "col,row,height\n1,2,1\n3,x,1\n";
+  }
+  expectFailure(run(light + " --sources " + shellQuoted(in("bad.csv"))), 1, "line 3");
+  {
+    std::ofstream csv(in("outside.csv"));
+    csv << "1,2\n30,2\n";
+  }
+  expectFailure(run(light + " --sources " + shellQuoted(in("outside.csv"))), 2, "--sources");
+  {
+    std::ofstream csv(in("s.csv"));
+    csv << "1,2\n";
+  }
+  expectFailure(run(light + " --sources " + shellQuoted(in("s.csv")) + " --samples 4"), 2, "--samples");
+  // A source on nodata.
+  const std::string holes = writeField("holes.exr", 8, 8, [](int col, int row) {
+    return col == 3 && row == 3 ? std::numeric_limits<float>::quiet_NaN() : 1.0f;
+  });
+  {
+    std::ofstream csv(in("on_hole.csv"));
+    csv << "3,3\n";
+  }
+  expectFailure(run("arealight " + shellQuoted(holes) + " -o " + shellQuoted(out("a.exr")) + " --sources " +
+                    shellQuoted(in("on_hole.csv"))),
+                2, "nodata");
+  expectFailure(
+      run("arealight " + shellQuoted(holes) + " -o " + shellQuoted(out("a.exr")) + " --light 2,2,4,4"), 2,
+      "nodata");
+  expectFailure(run(region + " --from 1,1,2,2"), 2, "missing --to");
+  expectFailure(run(region + " --from 1,1,2,2 --to 3,3,4,12"), 2, "--to 3,3,4,12");
+  expectFailure(run(region + " --from 1,1,2,2 --to 3,3,4,4 --method viewsheds"), 2, "--method");
+  expectFailure(run(region + " --from 1,1,2,2 --to 3,3,4,4 --rays " + shellQuoted(out("r.txt"))), 2, ".csv");
+  expectFailure(run("region " + shellQuoted(field) + " -o " + shellQuoted(out("r.exr")) +
+                    " --from 1,1,2,2 --to 3,3,4,4"),
+                2, ".json");
+  expectFailure(run(region + " --from 1,1,2,2 --to 3,3,4,4 --decorrelate"), 2, "--decorrelate");
+}
+
+TEST_F(CliGeoTiff, RegionVisibilityOnAGeoreferencedField) {
+  const std::string dem = geoTiffInput();
+  // arealight's GeoTIFF: the georeference kept, the --nodata value at nodata.
+  ASSERT_EQ(run("arealight " + shellQuoted(dem) + " -o " + shellQuoted(out("a.tif")) +
+                " --light 1,1,4,4 --light-height 30 --nodata -9999 -q")
+                .status,
+            0);
+  const hfvis::testing::GdalRaster light = checkGeoTiffOutput(out("a.tif"), {"visible"}, "arealight");
+  EXPECT_EQ(light.bands[0][0], -9999.0f);  // nodata at (0, 0)
+  for (std::size_t p = 1; p < light.bands[0].size(); ++p) {
+    if (light.bands[0][p] != -9999.0f) {
+      ASSERT_TRUE(light.bands[0][p] >= 0.0f && light.bands[0][p] <= 1.0f) << p;
+    }
+  }
+  // region's rays: map coordinates of the pixel centres through the geotransform.
+  const CliResult r =
+      run("region " + shellQuoted(dem) + " --from 1,1,4,4 --to 15,10,20,14 --from-height 50 -o " +
+          shellQuoted(out("r.json")) + " --rays " + shellQuoted(out("r.csv")) + " -q");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const Json j = JsonParser::parse(readText(out("r.json")));
+  const std::array<double, 6>& t = hfvis::testing::kUtmGeotransform;
+  for (const Json& s : j["from_samples"].items) {
+    EXPECT_NEAR(s["x"].number, t[0] + (s["col"].number + 0.5) * t[1], 1e-3);
+    EXPECT_NEAR(s["y"].number, t[3] + (s["row"].number + 0.5) * t[5], 1e-3);
+  }
+  const std::vector<std::string> lines = splitText(readText(out("r.csv")), '\n');
+  EXPECT_GT(j["clear_pairs"].number, 0.0);
+  EXPECT_EQ(lines[0], "from_col,from_row,from_height,to_col,to_row,to_height,from_x,from_y,to_x,to_y");
+  EXPECT_EQ(static_cast<double>(lines.size() - 2), j["clear_pairs"].number);
+  for (std::size_t i = 1; i + 1 < lines.size(); ++i) {
+    const std::vector<std::string> f = splitText(lines[i], ',');
+    ASSERT_EQ(f.size(), 10u);
+    EXPECT_NEAR(std::stod(f[8]), t[0] + (std::stod(f[3]) + 0.5) * t[1], 1e-2);
+    EXPECT_NEAR(std::stod(f[9]), t[3] + (std::stod(f[4]) + 0.5) * t[5], 1e-2);
+  }
 }

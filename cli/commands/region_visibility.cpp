@@ -1,0 +1,430 @@
+// cli/commands/region_visibility.cpp: "hfvis arealight" (the fraction of an area light's samples
+// every pixel sees, and their bitmasks) and "hfvis region" (visibility between two rectangles, as
+// JSON), the command line of hfvis/region_visibility.hpp.
+#include "hfvis/region_visibility.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <iomanip>
+#include <limits>
+#include <sstream>
+
+#include "../image_outputs.hpp"
+#include "../observer_files.hpp"
+#include "../pipeline.hpp"
+#include "hfvis/errors.hpp"
+
+namespace hfvis::cli {
+namespace {
+
+// Bits per --masks channel: float32 holds every whole number up to 2^24 exactly, so 16 bits a
+// channel keep the masks lossless in any float reader (the EXR writer has no UINT channels).
+constexpr int kMaskBitsPerChannel = 16;
+
+std::string methodName(RegionVisibilityMethod method) {
+  return method == RegionVisibilityMethod::Viewsheds ? "viewsheds" : "exact";
+}
+
+std::string rectangleText(const PixelRectangle& r) {
+  return std::to_string(r.col0) + "," + std::to_string(r.row0) + "," + std::to_string(r.col1) + "," +
+         std::to_string(r.row1);
+}
+
+// The library's checks of a region against the field: a usage error naming the option and the
+// input, as the viewshed's observers.
+void validateRegion(const HeightField& field, const RegionSampling& sampling, const std::string& what,
+                    const std::string& input) {
+  try {
+    validate(field, sampling);
+  } catch (const InvalidArgument& error) {
+    throw UsageError(what + ": " + error.what() + " (" + input + ")");
+  }
+}
+
+// The attributes of a run without directions or sampling density (as the viewshed's).
+Attributes regionAttributes(const Job& job) {
+  Attributes attributes = job.attributes(job.input);
+  attributes.erase(std::remove_if(attributes.begin(), attributes.end(),
+                                  [](const auto& a) {
+                                    return a.first == "hfvis:directions" ||
+                                           a.first == "hfvis:azimuth_offset_deg" ||
+                                           a.first == "hfvis:azimuth_convention" ||
+                                           a.first == "hfvis:samples_per_unit";
+                                  }),
+                   attributes.end());
+  attributes.emplace_back("hfvis:seed", std::to_string(job.run.seed));
+  return attributes;
+}
+
+class AreaLight : public Computation {
+ public:
+  using Computation::Computation;
+
+  std::vector<std::string> outputs() const override {
+    std::vector<std::string> paths{run_.output};
+    if (!run_.masks_output.empty()) paths.push_back(run_.masks_output);
+    if (!run_.preview.empty()) paths.push_back(run_.preview);
+    return paths;
+  }
+  std::vector<std::string> otherInputs() const override { return {run_.sources_file}; }
+  std::string method() const override { return methodName(run_.region_method); }
+
+  // The light: --light's rectangle, or the --sources file's points, checked against the field.
+  void prepare(HeightField& field) override {
+    sources_.height = run_.light_height;
+    sources_.absolute = run_.absolute;
+    sources_.samples = run_.region_samples;
+    if (run_.light) {
+      sources_.rectangle = *run_.light;
+    } else {
+      sources_.points = readRegionPointFile(run_.sources_file, run_.light_height, run_.absolute);
+      if (sources_.points.size() > static_cast<std::size_t>(kMaxRegionSamples))
+        throw UsageError("--sources: " + run_.sources_file + " lists " +
+                         std::to_string(sources_.points.size()) + " points, more than the " +
+                         std::to_string(kMaxRegionSamples) + " samples a bitmask holds");
+      sources_.samples = static_cast<int>(sources_.points.size());
+      // (the viewsheds method stands one viewshed's eye on each; the library would refuse later)
+      if (run_.region_method == RegionVisibilityMethod::Viewsheds)
+        for (const RegionPoint& p : sources_.points)
+          if (p.col != std::floor(p.col) || p.row != std::floor(p.row))
+            throw UsageError("--method viewsheds: the source " + formatNumber(p.col) + "," +
+                             formatNumber(p.row) + " of " + run_.sources_file +
+                             " lies between grid points; the viewsheds method needs whole columns and rows "
+                             "(or --method exact)");
+    }
+    validateRegion(field, sources_, run_.light ? "--light " + rectangleText(*run_.light) : "--sources",
+                   run_.input);
+  }
+
+  void compute(Job& job) override {
+    result_ = computeRegionVisibility(*job.context, job.input, sources_, regionVisibilityOptions(run_));
+  }
+
+  Summary write(Job& job, OutputFiles& outputs) override {
+    const HeightField& input = job.input;
+    requireResultSize(result_.width, result_.height, input);
+    const std::size_t pixels = input.pixelCount();
+    requireSize(result_.fraction, pixels, "visible fractions");
+    if (result_.bits.size() != pixels * static_cast<std::size_t>(result_.words))
+      throw Error("internal error: the computed bitmasks hold " + std::to_string(result_.bits.size()) +
+                  " words, expected " + std::to_string(pixels * result_.words));
+    Attributes attributes = regionAttributes(job);
+    const std::string light =
+        run_.light ? "rectangle " + rectangleText(*run_.light) + " (inclusive pixel corners)"
+                   : std::to_string(sources_.points.size()) + " points from " + run_.sources_file;
+    attributes.emplace_back("hfvis:light", light);
+    attributes.emplace_back("hfvis:light_samples", std::to_string(result_.samples));
+    if (run_.light)
+      attributes.emplace_back(
+          "hfvis:light_height",
+          formatNumber(run_.light_height) + (run_.absolute ? " absolute (z-scaled)" : " above the surface"));
+    attributes.emplace_back("hfvis:target_height", formatNumber(run_.target_height));
+    attributes.emplace_back("hfvis:decorrelate", run_.decorrelate ? "1" : "0");
+    outputs.image(run_.output,
+                  job.image(input, {"visible"}, {result_.fraction}, attributes,
+                            "visible: the fraction of the light's samples seen from a receiver standing the "
+                            "target height above each grid point",
+                            "visible: 1 (0 .. 1)"));
+    if (!run_.masks_output.empty()) {
+      // Channel k: samples 16k .. 16k+15, bit b (2^b) for sample 16k+b; NaN at nodata.
+      const int channels = (result_.samples + kMaskBitsPerChannel - 1) / kMaskBitsPerChannel;
+      std::vector<std::vector<float>> planes(channels, std::vector<float>(pixels));
+      for (std::size_t p = 0; p < pixels; ++p)
+        for (int k = 0; k < channels; ++k) {
+          const std::uint32_t word = result_.bits[p * result_.words + k / 2];
+          planes[k][p] = std::isnan(result_.fraction[p])
+                             ? NAN
+                             : static_cast<float>((word >> (kMaskBitsPerChannel * (k % 2))) & 0xFFFFu);
+        }
+      Attributes mask_attributes = attributes;
+      mask_attributes.emplace_back("hfvis:mask_bits_per_channel", std::to_string(kMaskBitsPerChannel));
+      outputs.image(run_.masks_output,
+                    job.image(input, directionChannelNames("m", channels), std::move(planes), mask_attributes,
+                              "mNNN: the light's samples 16*NNN .. 16*NNN+15 a receiver sees, as the whole "
+                              "number sum of 2^b over each visible sample 16*NNN+b",
+                              "bit patterns (whole numbers 0 .. 65535)"));
+    }
+    if (!run_.preview.empty())
+      outputs.previewPng(run_.preview, input.width, input.height, result_.fraction, 0.0f, 1.0f);
+    return {result_.samples, "; mean visible fraction " + formatFixed(finiteMean(result_.fraction), 4),
+            "light sample"};
+  }
+
+ private:
+  RegionSampling sources_;
+  RegionVisibilityResult result_;
+};
+
+// JSON's string: quoted, with its escapes.
+std::string jsonString(const std::string& text) {
+  std::string out = "\"";
+  for (const char ch : text) {
+    const unsigned char c = static_cast<unsigned char>(ch);
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += ch;
+    } else if (c < 0x20) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\u%04x", c);
+      out += escaped;
+    } else {
+      out += ch;
+    }
+  }
+  return out + "\"";
+}
+
+// A number for JSON: 10 significant digits (as the other outputs' numbers), NaN as null.
+std::string jsonNumber(double value) { return std::isfinite(value) ? formatNumber(value) : "null"; }
+
+// A ratio in full: a reader recomputing clear_pairs / pairs gets the same double.
+std::string exactNumber(double value) {
+  std::ostringstream out;
+  out << std::setprecision(std::numeric_limits<double>::max_digits10) << value;
+  return out.str();
+}
+
+// Map coordinates of a pixel position (grid points are pixel centres: column c lies at c + 0.5 in
+// the geotransform of pixel corners).
+std::pair<double, double> mapPosition(const std::array<double, 6>& t, double col, double row) {
+  return {t[0] + (col + 0.5) * t[1] + (row + 0.5) * t[2], t[3] + (col + 0.5) * t[4] + (row + 0.5) * t[5]};
+}
+
+class Region : public Computation {
+ public:
+  using Computation::Computation;
+
+  std::vector<std::string> outputs() const override {
+    std::vector<std::string> paths{run_.output};
+    if (!run_.rays_output.empty()) paths.push_back(run_.rays_output);
+    return paths;
+  }
+  // Text outputs, computed on the device.
+  bool writesImages() const override { return false; }
+  bool usesDevice() const override { return true; }
+  std::string method() const override { return methodName(run_.region_method); }
+
+  void prepare(HeightField& field) override {
+    from_ = sampling(*run_.from_region, run_.from_height);
+    to_ = sampling(*run_.to_region, run_.to_height);
+    validateRegion(field, from_, "--from " + rectangleText(*run_.from_region), run_.input);
+    validateRegion(field, to_, "--to " + rectangleText(*run_.to_region), run_.input);
+  }
+
+  void compute(Job& job) override {
+    result_ = computeRegionPairVisibility(*job.context, job.input, from_, to_, regionVisibilityOptions(run_));
+  }
+
+  Summary write(Job& job, OutputFiles& outputs) override {
+    const RegionPairVisibilityResult& r = result_;
+    if (r.sources.size() != static_cast<std::size_t>(r.source_samples) ||
+        r.receivers.size() != static_cast<std::size_t>(r.receiver_samples) ||
+        r.bits.size() != static_cast<std::size_t>(r.receiver_samples) * r.words)
+      throw Error("internal error: the region pair's samples or bitmasks are not of the sizes asked for");
+    const auto& transform = job.input.georeference.geotransform;
+    const double fraction = r.pairs ? double(r.clear_pairs) / double(r.pairs) : 0.0;
+    std::ostringstream json;
+    // A sample: where it lies (pixel and, georeferenced, map), its height and the share it sees.
+    const auto samples = [&](const std::vector<RegionPoint>& points, const std::vector<float>& fractions) {
+      std::string out = "[";
+      for (std::size_t i = 0; i < points.size(); ++i) {
+        const RegionPoint& p = points[i];
+        out += std::string(i ? "," : "") + "\n    {\"col\": " + jsonNumber(p.col) +
+               ", \"row\": " + jsonNumber(p.row) + ", \"height\": " + jsonNumber(p.height);
+        if (transform) {
+          const auto [x, y] = mapPosition(*transform, p.col, p.row);
+          out += ", \"x\": " + jsonNumber(x) + ", \"y\": " + jsonNumber(y);
+        }
+        out += ", \"visible_fraction\": " + jsonNumber(fractions[i]) + "}";
+      }
+      return out + "\n  ]";
+    };
+    const auto region = [&](const PixelRectangle& rect, double height, int count) {
+      return "{\"rectangle\": [" + rectangleText(rect) + "], \"height\": " + jsonNumber(height) +
+             ", \"height_is\": " + jsonString(run_.absolute ? "absolute (z-scaled)" : "above the surface") +
+             ", \"samples\": " + std::to_string(count) + "}";
+    };
+    json << "{\n"
+         << "  \"command\": \"region\",\n"
+         << "  \"input\": " << jsonString(run_.input) << ",\n"
+         << "  \"method\": " << jsonString(job.method) << ",\n"
+         << "  \"seed\": " << run_.seed << ",\n"
+         << "  \"max_distance\": " << jsonNumber(run_.max_distance) << ",\n"
+         << "  \"curvature\": "
+         << (run_.curvature ? jsonNumber(regionVisibilityOptions(run_).curvature) : std::string("0")) << ",\n"
+         << "  \"from\": " << region(*run_.from_region, run_.from_height, r.source_samples) << ",\n"
+         << "  \"to\": " << region(*run_.to_region, run_.to_height, r.receiver_samples) << ",\n"
+         << "  \"pairs\": " << r.pairs << ",\n"
+         << "  \"clear_pairs\": " << r.clear_pairs << ",\n"
+         << "  \"visible_fraction\": " << exactNumber(fraction) << ",\n"
+         << "  \"conventions\": "
+         << jsonString(
+                "col, row: pixel columns and rows (grid points at whole numbers, samples between them); "
+                "height: absolute, z-scaled height units; x, y: map coordinates of a georeferenced input; "
+                "a from sample's visible_fraction: the to samples it sees / their count, a to sample's: the "
+                "from samples it sees / their count; a pair is clear when no point of the bilinear surface "
+                "strictly between its ends rises above the segment")
+         << ",\n"
+         << "  \"from_samples\": " << samples(r.sources, r.source_fraction) << ",\n"
+         << "  \"to_samples\": " << samples(r.receivers, r.receiver_fraction) << "\n"
+         << "}\n";
+    outputs.text(run_.output, json.str());
+    if (!run_.rays_output.empty()) {
+      std::string csv = "from_col,from_row,from_height,to_col,to_row,to_height";
+      if (transform) csv += ",from_x,from_y,to_x,to_y";
+      csv += "\n";
+      for (int t = 0; t < r.receiver_samples; ++t)
+        for (int s = 0; s < r.source_samples; ++s) {
+          if (!r.visible(t, s)) continue;
+          const RegionPoint &a = r.sources[s], &b = r.receivers[t];
+          csv += formatNumber(a.col) + "," + formatNumber(a.row) + "," + formatNumber(a.height) + "," +
+                 formatNumber(b.col) + "," + formatNumber(b.row) + "," + formatNumber(b.height);
+          if (transform) {
+            const auto [ax, ay] = mapPosition(*transform, a.col, a.row);
+            const auto [bx, by] = mapPosition(*transform, b.col, b.row);
+            csv += "," + formatNumber(ax) + "," + formatNumber(ay) + "," + formatNumber(bx) + "," +
+                   formatNumber(by);
+          }
+          csv += "\n";
+        }
+      outputs.text(run_.rays_output, csv);
+    }
+    return {r.source_samples,
+            "; " + std::to_string(r.clear_pairs) + " of " + std::to_string(r.pairs) + " pairs clear (" +
+                formatFixed(100.0 * fraction, 2) + " %)",
+            "sample"};
+  }
+
+ private:
+  RegionSampling sampling(const PixelRectangle& rectangle, double height) const {
+    RegionSampling s;
+    s.rectangle = rectangle;
+    s.samples = run_.region_samples;
+    s.height = height;
+    s.absolute = run_.absolute;
+    return s;
+  }
+
+  RegionSampling from_, to_;
+  RegionPairVisibilityResult result_;
+};
+
+// A height below the surface is hidden (the surface rises above every segment beside it).
+void requireAboveSurface(const RunArguments& run, const char* option, double height) {
+  if (!run.absolute && height < 0.0)
+    throw UsageError(
+        std::string(option) +
+        ": a sample below the surface is hidden from everything; give a height >= 0 (or --absolute)");
+}
+
+void checkAreaLight(const std::string&, const RunArguments& run) {
+  if (run.light && !run.sources_file.empty())
+    throw UsageError("--light and --sources both give the light; give one of them");
+  if (!run.light && run.sources_file.empty())
+    throw UsageError("missing --light C0,R0,C1,R1 or --sources FILE.csv (the area light)");
+  if (!run.sources_file.empty() && run.region_samples_given)
+    throw UsageError("--samples is for --light: the --sources file's points are the samples");
+  requireAboveSurface(run, "--light-height", run.light_height);
+  if (run.region_method == RegionVisibilityMethod::Viewsheds) {
+    if (run.decorrelate)
+      throw UsageError("--decorrelate needs --method exact (the viewsheds method shares the samples)");
+    if (run.light && (run.light->col0 != run.light->col1 || run.light->row0 != run.light->row1))
+      throw UsageError(
+          "--method viewsheds needs the light's samples on grid points: a one-pixel --light or --sources "
+          "FILE.csv (a larger rectangle's samples are jittered between them); or --method exact");
+  }
+  if (!run.masks_output.empty() && samePath(run.output, run.masks_output))
+    throw UsageError("--masks must differ from -o, both are " + inQuotes(run.output));
+  asUsageError([&] { validate(regionVisibilityOptions(run)); });
+}
+
+void checkRegion(const std::string&, const RunArguments& run) {
+  if (!hasExtension(run.output, ".json"))
+    throw UsageError("-o: 'hfvis region' writes JSON; the name must end in .json, got " +
+                     inQuotes(run.output));
+  if (!run.from_region || !run.to_region)
+    throw UsageError(std::string("missing ") + (run.from_region ? "--to" : "--from") +
+                     " C0,R0,C1,R1 (region pairs need --from and --to rectangles)");
+  if (!run.rays_output.empty() && !hasExtension(run.rays_output, ".csv"))
+    throw UsageError("--rays: the rays are written as CSV; the name must end in .csv, got " +
+                     inQuotes(run.rays_output));
+  if (run.region_method == RegionVisibilityMethod::Viewsheds)
+    throw UsageError(
+        "--method viewsheds is for 'hfvis arealight' (every pixel a receiver); region pairs take --method "
+        "exact");
+  requireAboveSurface(run, "--from-height", run.from_height);
+  requireAboveSurface(run, "--to-height", run.to_height);
+  asUsageError([&] { validate(regionVisibilityOptions(run)); });
+}
+
+}  // namespace
+
+const CommandSpec kAreaLightCommand{
+    Command::AreaLight,
+    "arealight",
+    nullptr,
+    "\"visible\": the fraction (0..1) of an area light's samples each pixel sees",
+    "IN -o OUT.exr|OUT.tif (--light C0,R0,C1,R1 [--light-height H] | --sources FILE.csv)\n"
+    "[--absolute] [--samples N] [--target-height T] [--decorrelate] [--method exact|viewsheds]\n"
+    "[--seed N] [--max-distance D] [--curvature] [--refraction K] [--masks MASKS.exr]\n"
+    "[--preview P.png] [options]",
+    "Region visibility with every pixel a receiver (Eisemann & Decoret 2007's sampled\n"
+    "visibility): channel \"visible\" is the fraction (0..1) of the light's samples seen from a\n"
+    "receiver T (default 0) above each grid point; NaN at nodata (a GeoTIFF's --nodata value).\n"
+    "The light: --light C0,R0,C1,R1, the rectangle of grid points between two corner pixels\n"
+    "(zero-based columns and rows, inclusive, in any order), sampled N times (--samples,\n"
+    "default 16, at most 4096): about square strata, each sample jittered in its stratum by a\n"
+    "hash of (--seed, sample), H (--light-height, default 2) above the bilinear surface under it,\n"
+    "or at height H with --absolute (an area light in a horizontal plane); or --sources FILE.csv,\n"
+    "the samples themselves, one col,row[,height] a line (a header line, a UTF-8 BOM, CRLF and\n"
+    "'#' comments allowed; fractional columns and rows lie between pixel centres; a missing\n"
+    "height is --light-height). Every pixel sees the same samples, unless --decorrelate (each\n"
+    "its own jitter: noise instead of banding). A pair sees as in the viewshed: no point of the\n"
+    "bilinear surface strictly between them rises above the segment (grazing sees; cells with a\n"
+    "nodata corner hide nothing); --max-distance D: farther pairs are hidden; --curvature and\n"
+    "--refraction lower the surface between them by the Earth's drop.\n"
+    "--masks FILE (.exr or .tif) also writes which samples each pixel sees, losslessly: float32\n"
+    "channels m000, m001, ..., channel k holding samples 16k .. 16k+15 as the whole number sum\n"
+    "of 2^b over each visible sample 16k+b (0 .. 65535, exact in float32; NaN at nodata).\n"
+    "--method exact (default) marches one sight line per pixel and sample; --method viewsheds\n"
+    "runs one viewshed per sample, for samples on grid points (a one-pixel --light, --sources\n"
+    "with whole columns and rows), not with --decorrelate; it may decide grazing lines the other\n"
+    "way. A light outside the field, or on nodata, is an error. Not yet: a textured light\n"
+    "(--light-image).\n"
+    "The preview shows the fraction from black (0) to white (1).\n",
+    nullptr,
+    kImageCommandGroups | kEarthGroup | kReachGroup | kRegionSamplingGroup | kAreaLightGroup,
+    checkAreaLight,
+    nullptr,
+    pipelined<AreaLight>,
+};
+
+const CommandSpec kRegionCommand{
+    Command::Region,
+    "region",
+    nullptr,
+    "visibility between two rectangles: the share of clear sample pairs, as JSON",
+    "IN --from C0,R0,C1,R1 --to C0,R0,C1,R1 -o OUT.json [--from-height H] [--to-height H]\n"
+    "[--absolute] [--samples N] [--seed N] [--method exact] [--max-distance D] [--curvature]\n"
+    "[--refraction K] [--rays RAYS.csv] [options]",
+    "Visibility between two regions: N samples of each rectangle (--samples, default 16, at most\n"
+    "4096; sampled as arealight's --light), H above the surface (--from-height, --to-height,\n"
+    "default 2; --absolute: at height H), every sample of --from against every sample of --to.\n"
+    "Writes JSON: pairs (N * N), clear_pairs (the pairs whose segment the surface does not\n"
+    "block), visible_fraction = clear_pairs / pairs; the rectangles and options; and each\n"
+    "sample (from_samples, to_samples) with its col, row, absolute z-scaled height, map x, y\n"
+    "(a georeferenced input) and visible_fraction, the share of the other region's samples it\n"
+    "sees. --rays RAYS.csv also lists every clear pair, one a line:\n"
+    "from_col,from_row,from_height,to_col,to_row,to_height (and from_x,from_y,to_x,to_y for a\n"
+    "georeferenced input; map coordinates of the pixel centres). A rectangle outside the field\n"
+    "or holding nodata is an error. Computed on the device, --method exact only.\n",
+    nullptr,
+    kOutputGroup | kInputGroup | kDeviceGroup | kEarthGroup | kReachGroup | kRegionSamplingGroup |
+        kRegionPairGroup,
+    checkRegion,
+    nullptr,
+    pipelined<Region>,
+};
+
+}  // namespace hfvis::cli
