@@ -2,7 +2,7 @@
 // computeRegionPairVisibility in src/ops/region_visibility.cpp; the contract in
 // hfvis/region_visibility.hpp). One work-item per (receiver, word of 32 source samples): it
 // places its receiver and the word's source samples and marches each pair
-// (shared/region_sight.cl), then writes the word, so no two work-items write one word and no
+// (shared/region_visibility_sight.cl), then writes the word, so no two work-items write one word and no
 // atomics are needed.
 //
 // Receivers are the grid points (`pixel_receivers`) or the samples of a second region (the
@@ -12,7 +12,7 @@
 // The host launches the receivers in chunks from `first`, to bound each launch's time.
 #pragma OPENCL FP_CONTRACT OFF
 
-#include "shared/region_sight.cl"
+#include "shared/region_visibility_sight.cl"
 
 typedef struct {
   int width, height;     // the field

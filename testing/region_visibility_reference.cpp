@@ -5,7 +5,7 @@
 #include <limits>
 
 #include "core/sweep_geometry.hpp"
-#include "ops/region_sight.hpp"
+#include "ops/region_visibility_sight.hpp"
 
 namespace hfvis {
 namespace {

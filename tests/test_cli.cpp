@@ -440,7 +440,8 @@ TEST_F(Cli, MissingOutputDirectory) {
 }
 
 // An output never replaces an input: the same path, the same file through another path or a
-// symbolic link, or the bounce's radiance input; refused before anything is read or written.
+// symbolic link, the bounce's radiance input or the viewshed's observers file; refused before
+// anything is read or written.
 TEST_F(Cli, OutputNeverReplacesAnInput) {
   const std::string field = ramp();
   const std::string before = readText(field);
@@ -466,6 +467,22 @@ TEST_F(Cli, OutputNeverReplacesAnInput) {
   EXPECT_EQ(bounce.status, 2) << bounce.err;
   EXPECT_NE(bounce.err.find("outputs never replace an input"), std::string::npos) << bounce.err;
   EXPECT_EQ(readText(radiance), radiance_before);
+  // The viewshed's observers file (a CSV whatever its name: here one a preview's name fits), as
+  // the preview or through a link to it as -o.
+  const std::string observers = in("observers.png");
+  { std::ofstream(observers) << "col,row\n3,4\n"; }
+  const std::string observers_before = readText(observers);
+  const std::string observers_link = in("observers_link.tif");
+  fs::create_symlink(observers, observers_link);
+  for (const std::string& outputs_part : {"-o " + shellQuoted(out("seen.exr")) + " --preview " + shellQuoted(observers),
+                                          "-o " + shellQuoted(observers_link)}) {
+    SCOPED_TRACE(outputs_part);
+    const CliResult viewshed = run("viewshed " + shellQuoted(field) + " --observers " + shellQuoted(observers) + " " +
+                                   outputs_part);
+    EXPECT_EQ(viewshed.status, 2) << viewshed.err;
+    EXPECT_NE(viewshed.err.find("outputs never replace an input"), std::string::npos) << viewshed.err;
+    EXPECT_EQ(readText(observers), observers_before);
+  }
   EXPECT_EQ(readText(field), before);
   EXPECT_TRUE(listDirectory(outputs()).empty());
 }

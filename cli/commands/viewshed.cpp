@@ -39,6 +39,9 @@ class Viewshed : public Computation {
   using Computation::Computation;
 
   std::string method() const override { return run_.culled ? "culled" : "exact"; }
+  // The observers file is an input too: no output (-o, --preview, through a link or not) may
+  // replace it.
+  std::vector<std::string> otherInputs() const override { return {run_.observers_file}; }
 
   // The observers: --observer's, then the --observers file's, each checked against the field.
   void prepare(HeightField& field) override {

@@ -17,6 +17,7 @@
 //   hfvis/sun_shading.hpp      computeSunShading: the sun's light with cast shadows
 //   hfvis/insolation.hpp       computeInsolation: sunshine hours and irradiation over a span of time
 //   hfvis/sun.hpp              where the sun stands at a time and place
+//   hfvis/region_visibility.hpp computeRegionVisibility: which samples of a region each point sees
 //   hfvis/viewshed.hpp         computeViewshed, computeCumulativeViewshed: what observers see
 //   hfvis/image_io.hpp         reading height fields, writing float EXRs and PNG previews
 //

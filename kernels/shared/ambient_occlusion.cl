@@ -1,8 +1,8 @@
 // ambient_occlusion.cl: one direction's term of ambient occlusion (hfvis/ambient_occlusion.hpp),
 // as a macro that defines it for a scalar or lane-vector type. Written in the common subset of
 // OpenCL C and C++: kernels/horizon.cl and the C++ references (src/core/direction_terms.hpp)
-// instantiate it through HFVIS_DIRECTION_TERMS (direction_terms.cl); environment.cl takes the
-// same lower limit.
+// instantiate it through HFVIS_DIRECTION_TERMS (direction_terms.cl); environment_light.cl takes
+// the same lower limit.
 //
 // ambient_term: uniform-sky irradiance of one azimuthal swath (Eq. 5 of Timonen &
 // Westerholm 2010) of width 2 pi * weight, normalised so that a flat plane sums to 1 over a

@@ -15,7 +15,7 @@
 #include "core/sweep_framework.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/viewshed.hpp"
-#include "ops/region_sight.hpp"
+#include "ops/region_visibility_sight.hpp"
 
 namespace hfvis {
 namespace {
@@ -73,12 +73,14 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
   void allocate() override {
     receiver_major_ = detail::lineMajorLayout(st_);
     const std::size_t entries = static_cast<std::size_t>(count_) * words_;
-    // The bitmasks live whole on the device and the host: refuse what the budget (half the
-    // device's memory) cannot hold rather than fail in the allocation.
+    // The bitmasks live whole on the device and on the host, twice there in the word-major
+    // layout (read back, then transposed): refuse what the budget (half the device's memory; on a
+    // CPU device, the host's) cannot hold rather than fail in an allocation.
+    const std::size_t copies = receiver_major_ ? 2 : 3, bytes = copies * entries * sizeof(std::uint32_t);
     const std::size_t budget = memoryBudget();
-    if (entries * sizeof(std::uint32_t) > budget)
-      throw MemoryBudgetError("the bitmasks need " + detail::mebibytes(entries * sizeof(std::uint32_t)) +
-                              " but half the device's memory is " + detail::mebibytes(budget) +
+    if (bytes > budget)
+      throw MemoryBudgetError("the bitmasks and their host copies need " + detail::mebibytes(bytes) +
+                              " but the memory budget is " + detail::mebibytes(budget) +
                               "; take fewer samples or a smaller field");
     source_table_ = upload(sources_);
     // A pixel run binds the source table in the receivers' place (never read).

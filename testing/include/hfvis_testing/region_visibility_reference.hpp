@@ -1,6 +1,6 @@
 // hfvis_testing/region_visibility_reference.hpp: region visibility on the host, one pair at a
 // time: the same sample positions and the same line-of-sight test as the kernel
-// (kernels/shared/region_sight.cl, compiled here as C++), so the two agree bit for bit; the
+// (kernels/shared/region_visibility_sight.cl, compiled here as C++), so the two agree bit for bit; the
 // oracle of the region visibility tests (test support library hfvis_testing; not installed).
 #pragma once
 

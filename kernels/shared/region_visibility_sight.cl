@@ -1,7 +1,7 @@
-// region_sight.cl: the line-of-sight test between two arbitrary points over the bilinear
-// surface, and the stratified, jittered sample positions of a region (hfvis/
+// region_visibility_sight.cl: the line-of-sight test between two arbitrary points over the
+// bilinear surface, and the stratified, jittered sample positions of a region (hfvis/
 // region_visibility.hpp). Written once in the common subset of OpenCL C and C++:
-// kernels/region_visibility.cl includes it, and so does src/ops/region_sight.hpp (inside
+// kernels/region_visibility.cl includes it, and so does src/ops/region_visibility_sight.hpp (inside
 // namespace hfvis::detail), so the kernel and the scalar reference run the very same float
 // operations and agree bit for bit (no contraction into fma on either side, no math library
 // call but the correctly rounded division).

@@ -1,7 +1,7 @@
-// region_sight.hpp: the region visibility's line-of-sight test and sample placement for C++
-// (the host and the scalar reference): kernels/shared/region_sight.cl itself, the source the
-// kernel compiles, included here so the two cannot drift; and the sample tables the kernel
-// takes.
+// region_visibility_sight.hpp: the region visibility's line-of-sight test and sample placement
+// for C++ (the host and the scalar reference): kernels/shared/region_visibility_sight.cl itself,
+// the source the kernel compiles, included here so the two cannot drift; and the sample tables
+// the kernel takes.
 #pragma once
 
 #include <cmath>
@@ -13,7 +13,7 @@
 namespace hfvis::detail {
 
 using std::isnan;
-#include "../../kernels/shared/region_sight.cl"
+#include "../../kernels/shared/region_visibility_sight.cl"
 
 // A region's table for region_sample(): the rectangle (lo_x, lo_y, hi_x, hi_y), then per sample
 // its stratum's corner, size and height (explicit points: the point, size 0). Validates.
