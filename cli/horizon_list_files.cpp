@@ -6,6 +6,8 @@
 #include <iomanip>
 #include <sstream>
 
+#include "pipeline.hpp"
+
 namespace hfvis::cli {
 namespace {
 
@@ -34,24 +36,6 @@ std::string number(float value) {
   std::ostringstream out;
   out << std::setprecision(9) << value;
   return out.str();
-}
-
-std::string jsonString(const std::string& text) {
-  std::string out = "\"";
-  for (const char ch : text) {
-    const auto c = static_cast<unsigned char>(ch);
-    if (ch == '"' || ch == '\\') {
-      out += '\\';
-      out += ch;
-    } else if (c < 0x20) {
-      char escaped[8];
-      std::snprintf(escaped, sizeof escaped, "\\u%04x", c);
-      out += escaped;
-    } else {
-      out += ch;
-    }
-  }
-  return out + "\"";
 }
 
 constexpr const char* kAzimuthConvention =

@@ -25,6 +25,24 @@ std::string formatNumber(double value) {
   return out.str();
 }
 
+std::string jsonString(const std::string& text) {
+  std::string out = "\"";
+  for (const char ch : text) {
+    const unsigned char c = static_cast<unsigned char>(ch);
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += ch;
+    } else if (c < 0x20) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\u%04x", c);
+      out += escaped;
+    } else {
+      out += ch;
+    }
+  }
+  return out + "\"";
+}
+
 std::string formatFixed(double value, int digits) {
   std::ostringstream out;
   out << std::fixed << std::setprecision(digits) << value;
@@ -171,28 +189,28 @@ NorthUp northUp(const HeightField& field) {
   return out;
 }
 
-Attributes Job::attributes(const HeightField& field) const {
+Attributes Job::attributes(const HeightField& field, bool swept) const {
   const DeviceInfo& device = context->device();
-  Attributes attributes{
-      {"hfvis:command", command.recordedName()},
-      {"hfvis:input", run.input},
-      {"hfvis:directions", std::to_string(run.directions)},
-      {"hfvis:azimuth_offset_deg", formatNumber(run.azimuth_offset_deg)},
-      {"hfvis:azimuth_convention",
-       "phi_k = 360*k/K deg + offset, on the ground from the +column axis toward +row; "
-       "compass azimuth = 90 + phi_k deg when row 0 is north"},
-      {"hfvis:method", method},
-      {"hfvis:samples_per_unit", formatNumber(run.samples_per_unit)},
-      // Read back by readHeightField, so an output keeps the input's ground spacing.
-      {"hfvis:cell_size_x", formatNumber(field.cell_size_x)},
-      {"hfvis:cell_size_y", formatNumber(field.cell_size_y)},
-      {"hfvis:z_scale", formatNumber(field.z_scale)},
-      {"hfvis:nodata", run.nodata && !std::isnan(*run.nodata)
-                           ? "where the input height is not finite: " + formatNumber(*run.nodata) +
-                                 " (the bands' nodata value) in GeoTIFF outputs, NaN in others"
-                           : std::string("NaN where the input height is not finite")},
-      {"hfvis:device", device.name + " (" + device.platform + ")"},
-  };
+  Attributes attributes{{"hfvis:command", command.recordedName()}, {"hfvis:input", run.input}};
+  if (swept) {
+    attributes.emplace_back("hfvis:directions", std::to_string(run.directions));
+    attributes.emplace_back("hfvis:azimuth_offset_deg", formatNumber(run.azimuth_offset_deg));
+    attributes.emplace_back("hfvis:azimuth_convention",
+                            "phi_k = 360*k/K deg + offset, on the ground from the +column axis toward +row; "
+                            "compass azimuth = 90 + phi_k deg when row 0 is north");
+  }
+  attributes.emplace_back("hfvis:method", method);
+  if (swept) attributes.emplace_back("hfvis:samples_per_unit", formatNumber(run.samples_per_unit));
+  // Read back by readHeightField, so an output keeps the input's ground spacing.
+  attributes.emplace_back("hfvis:cell_size_x", formatNumber(field.cell_size_x));
+  attributes.emplace_back("hfvis:cell_size_y", formatNumber(field.cell_size_y));
+  attributes.emplace_back("hfvis:z_scale", formatNumber(field.z_scale));
+  attributes.emplace_back("hfvis:nodata",
+                          run.nodata && !std::isnan(*run.nodata)
+                              ? "where the input height is not finite: " + formatNumber(*run.nodata) +
+                                    " (the bands' nodata value) in GeoTIFF outputs, NaN in others"
+                              : std::string("NaN where the input height is not finite"));
+  attributes.emplace_back("hfvis:device", device.name + " (" + device.platform + ")");
   if (!run.channel.empty()) attributes.emplace_back("hfvis:channel", run.channel);
   if (run.max_distance > 0.0) attributes.emplace_back("hfvis:max_distance", formatNumber(run.max_distance));
   if (run.curvature) {

@@ -24,6 +24,8 @@ namespace hfvis::cli {
 
 std::string formatNumber(double value);
 std::string formatFixed(double value, int digits);
+// A JSON string: quoted, with its escapes (the JSON outputs of horizon-lists and region).
+std::string jsonString(const std::string& text);
 // Mean over the finite values (nodata pixels are NaN and do not count).
 double finiteMean(const std::vector<float>& values);
 // `count` planes of `pixels` values, one after another, as separate planes.
@@ -113,8 +115,9 @@ struct Job {
   std::string method;  // hfvis:method and the summary's
 
   // The string attributes describing the run, written into every output (EXR attributes,
-  // GeoTIFF metadata items); `field` gives the cell size.
-  Attributes attributes(const HeightField& field) const;
+  // GeoTIFF metadata items); `field` gives the cell size. `swept` false: the run has no
+  // directions or sampling density (a viewshed, region visibility), so none are recorded.
+  Attributes attributes(const HeightField& field, bool swept = true) const;
   // An output of the field's size. A GeoTIFF output also carries the field's georeference, so
   // that it overlays its input, and the --nodata value.
   ImageChannels image(const HeightField& field, std::vector<std::string> names,

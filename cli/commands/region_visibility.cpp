@@ -44,15 +44,7 @@ void validateRegion(const HeightField& field, const RegionSampling& sampling, co
 
 // The attributes of a run without directions or sampling density (as the viewshed's).
 Attributes regionAttributes(const Job& job) {
-  Attributes attributes = job.attributes(job.input);
-  attributes.erase(std::remove_if(attributes.begin(), attributes.end(),
-                                  [](const auto& a) {
-                                    return a.first == "hfvis:directions" ||
-                                           a.first == "hfvis:azimuth_offset_deg" ||
-                                           a.first == "hfvis:azimuth_convention" ||
-                                           a.first == "hfvis:samples_per_unit";
-                                  }),
-                   attributes.end());
+  Attributes attributes = job.attributes(job.input, /*swept=*/false);
   attributes.emplace_back("hfvis:seed", std::to_string(job.run.seed));
   return attributes;
 }
@@ -155,25 +147,6 @@ class AreaLight : public Computation {
   RegionSampling sources_;
   RegionVisibilityResult result_;
 };
-
-// JSON's string: quoted, with its escapes.
-std::string jsonString(const std::string& text) {
-  std::string out = "\"";
-  for (const char ch : text) {
-    const unsigned char c = static_cast<unsigned char>(ch);
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += ch;
-    } else if (c < 0x20) {
-      char escaped[8];
-      std::snprintf(escaped, sizeof escaped, "\\u%04x", c);
-      out += escaped;
-    } else {
-      out += ch;
-    }
-  }
-  return out + "\"";
-}
 
 // A number for JSON: 10 significant digits (as the other outputs' numbers), NaN as null.
 std::string jsonNumber(double value) { return std::isfinite(value) ? formatNumber(value) : "null"; }

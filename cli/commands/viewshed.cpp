@@ -140,16 +140,7 @@ class Viewshed : public Computation {
 
   Summary write(Job& job, OutputFiles& outputs) override {
     const HeightField& input = job.input;
-    Attributes attributes = job.attributes(input);
-    // A viewshed has no directions or sampling density.
-    attributes.erase(std::remove_if(attributes.begin(), attributes.end(),
-                                    [](const auto& a) {
-                                      return a.first == "hfvis:directions" ||
-                                             a.first == "hfvis:azimuth_offset_deg" ||
-                                             a.first == "hfvis:azimuth_convention" ||
-                                             a.first == "hfvis:samples_per_unit";
-                                    }),
-                     attributes.end());
+    Attributes attributes = job.attributes(input, /*swept=*/false);
     std::string where;
     for (const Observer& o : observers_) {
       if (where.size() > 4000) {
