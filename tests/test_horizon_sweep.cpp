@@ -707,6 +707,13 @@ TEST(HorizonKernels, InvalidOptionsAreRejectedBeforeLaunch) {
   options.samples_per_unit = 0.0;
   EXPECT_THROW(computeHorizons(testContext(), field, options, allOutputs()), InvalidArgument);
   options.samples_per_unit = 1.0;
+  options.strip_rows = -1;
+  EXPECT_THROW(computeHorizons(testContext(), field, options, allOutputs()), InvalidArgument);
+  options.strip_rows = 2;
+  options.method = HorizonMethod::Naive;
+  EXPECT_THROW(computeHorizons(testContext(), field, options, allOutputs()), InvalidArgument);
+  options.strip_rows = 0;
+  options.method = HorizonMethod::Sweep;
   options.azimuth_tolerance = 0.0;
   EXPECT_THROW(computeHorizons(testContext(), field, options, allOutputs()), InvalidArgument);
   HeightField empty;

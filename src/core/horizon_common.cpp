@@ -20,11 +20,7 @@ void validate(const HorizonOptions& options, const HorizonOutputs& outputs) {
       !outputs.ambient_occlusion && !outputs.environment) {
     throw InvalidArgument("no output requested");
   }
-  if (options.strip_rows < 0)
-    throw InvalidArgument("the rows per strip must be 0 (automatic) or positive (got " +
-                          std::to_string(options.strip_rows) + ")");
-  if (options.strip_rows > 0 && options.method == HorizonMethod::Naive)
-    throw InvalidArgument("the naive method does not run in strips (each ray reads the whole field)");
+  detail::validateStripRows(options.strip_rows, options.method == HorizonMethod::Naive);
   if (outputs.environment) validate(*outputs.environment);
 }
 

@@ -44,6 +44,10 @@ SweepDirection makeSweepDirection(const HeightField& field, double azimuth, doub
 // The sweep geometry of every direction of a run (buffer offsets left at 0).
 std::vector<SweepDirection> runDirections(const HeightField& field, const SweepOptions& options);
 
+// Checks an operation's rows per strip: 0 (automatic) or positive, and 0 for a naive method, whose
+// rays read the whole field.
+void validateStripRows(int strip_rows, bool naive);
+
 // A point in pixel axes.
 struct Point2 {
   float x, y;

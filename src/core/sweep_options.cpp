@@ -44,5 +44,13 @@ std::vector<SweepDirection> runDirections(const HeightField& field, const SweepO
   return directions;
 }
 
+void validateStripRows(int strip_rows, bool naive) {
+  if (strip_rows < 0)
+    throw InvalidArgument("the rows per strip must be 0 (automatic) or positive (got " + std::to_string(strip_rows) +
+                          ")");
+  if (strip_rows > 0 && naive)
+    throw InvalidArgument("the naive method does not run in strips (each ray reads the whole field)");
+}
+
 }  // namespace detail
 }  // namespace hfvis

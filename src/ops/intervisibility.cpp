@@ -28,11 +28,7 @@ void validate(const IntervisibilityOptions& options, const IntervisibilityOutput
   if (outputs.statistics && options.method != IntervisibilityMethod::HullTree) {
     throw InvalidArgument("statistics (horizons and iterations) exist only for the hull-tree method");
   }
-  if (options.strip_rows < 0)
-    throw InvalidArgument("the rows per strip must be 0 (automatic) or positive (got " +
-                          std::to_string(options.strip_rows) + ")");
-  if (options.strip_rows > 0 && options.method == IntervisibilityMethod::Naive)
-    throw InvalidArgument("the naive method does not run in strips (each ray reads the whole field)");
+  detail::validateStripRows(options.strip_rows, options.method == IntervisibilityMethod::Naive);
 }
 
 namespace detail {
