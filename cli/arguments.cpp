@@ -320,7 +320,7 @@ const std::vector<OptionSpec>& optionTable() {
        "number of azimuth directions, K >= 1 (default 64); shade: with --env only",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
          run.directions = parseDirectionCount(typed, value);
-         run.sweep_options_given = true;
+         run.directions_given = run.sweep_options_given = true;
        }},
       {"--azimuth-offset", nullptr, "DEG", kSweepGroup, false,
        "added to every direction's azimuth, degrees (default 0)",
@@ -405,6 +405,25 @@ const std::vector<OptionSpec>& optionTable() {
                             ": the sun's diameter must be in 0 (a point: hard shadows) .. 10 degrees, got " +
                             inQuotes(value));
        }},
+      {"--max-error", nullptr, "E", kErrorTargetGroup, false,
+       "choose K for this error instead of taking -k: the 99th percentile over\n"
+       "the pixels of the error estimate (see --error-out) at most E, in the\n"
+       "output's unit (absolute: 0 < E < 1); a first run at 16 directions\n"
+       "predicts the K needed, refused when beyond 4096; the K chosen and the\n"
+       "estimate go into the summary and the hfvis:directions and\n"
+       "hfvis:estimated_error attributes",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.max_error = parseNumber(typed, value);
+         if (!(run.max_error > 0.0 && run.max_error < 1.0))
+           throw UsageError(typed + ": the maximum error must lie in (0, 1) (the output lies in 0..1), got " +
+                            inQuotes(value));
+       }},
+      {"--error-out", nullptr, "FILE", kErrorTargetGroup, false,
+       "also write the per-pixel error estimate (channel \"error\"): half the\n"
+       "difference between the results of the even- and of the odd-numbered\n"
+       "directions alone, which lies above the error against the dense\n"
+       "azimuthal integral on the benchmark's contents; with -k or --max-error",
+       HFVIS_TEXT(error_output)},
       {"--distance-out", nullptr, "FILE", kHorizonGroup, false,
        "also write K channels d000.. of ground distance to the\n"
        "horizon point (ground units), computed in the same run",
@@ -685,18 +704,20 @@ void validateRun(const CommandSpec& command, const std::string& name, const RunA
   if (run.output.empty())
     throw UsageError("missing -o " + out + " (the output file of 'hfvis " + name + "')");
   if (command.check) command.check(name, run);
-  if (!run.distance_output.empty() && samePath(run.output, run.distance_output)) {
-    throw UsageError("--distance-out must differ from -o, both are " + inQuotes(run.output));
-  }
-  if (!run.preview.empty() && samePath(run.output, run.preview)) {
-    throw UsageError("--preview must differ from -o, both are " + inQuotes(run.output));
-  }
-  if (!run.preview.empty() && !run.distance_output.empty() && samePath(run.preview, run.distance_output)) {
-    throw UsageError("--preview must differ from --distance-out, both are " + inQuotes(run.preview));
-  }
+  // Each output file once: -o, then the others in the order the help lists them.
+  const std::vector<std::pair<const char*, const std::string*>> files{{"-o", &run.output},
+                                                                      {"--distance-out", &run.distance_output},
+                                                                      {"--error-out", &run.error_output},
+                                                                      {"--preview", &run.preview}};
+  for (std::size_t j = 1; j < files.size(); ++j)
+    for (std::size_t i = 0; i < j; ++i)
+      if (!files[i].second->empty() && !files[j].second->empty() && samePath(*files[i].second, *files[j].second))
+        throw UsageError(std::string(files[j].first) + " must differ from " + files[i].first + ", both are " +
+                         inQuotes(*files[j].second));
   // Only a GeoTIFF declares a nodata value; other outputs keep NaN, so the option would do nothing.
   if (run.nodata && !writesGeoTiff(run.output) &&
-      (run.distance_output.empty() || !writesGeoTiff(run.distance_output))) {
+      (run.distance_output.empty() || !writesGeoTiff(run.distance_output)) &&
+      (run.error_output.empty() || !writesGeoTiff(run.error_output))) {
     throw UsageError(
         "--nodata: only GeoTIFF outputs (.tif, .tiff) hold a nodata value, and no output is one; "
         "other outputs keep NaN");
@@ -903,6 +924,7 @@ HorizonOptions horizonOptions(const RunArguments& run) {
   options.method = run.method;
   // (the largest tolerance in degrees may round to a hair above 0.1 radian)
   options.azimuth_tolerance = std::min(0.1, run.azimuth_tolerance_deg * (kPi / 180.0));
+  options.max_error = run.max_error;
   return options;
 }
 
@@ -915,9 +937,11 @@ HorizonOutputs horizonOutputs(Command command, const RunArguments& run) {
       break;
     case Command::SkyViewFactor:
       outputs.sky_view_factor = true;
+      outputs.error_estimate = !run.error_output.empty();
       break;
     case Command::AmbientOcclusion:
       outputs.ambient_occlusion = true;
+      outputs.error_estimate = !run.error_output.empty();
       break;
     default:
       break;

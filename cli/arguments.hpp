@@ -54,6 +54,11 @@ struct RunArguments {
   double azimuth_tolerance_deg = 0.25;  // horizon only: the sweep's directions within this of phi_k
   std::string preview;                  // "" = no preview
   int directions = 64;
+  bool directions_given = false;  // -k typed (--max-error chooses K instead)
+  // sky-view-factor and ambient-occlusion: --max-error E (0 = not asked: K as given) and
+  // --error-out FILE, the per-pixel error estimate ("" = not asked for).
+  double max_error = 0.0;
+  std::string error_output;
   double azimuth_offset_deg = 0.0;
   double samples_per_unit = 1.0;
   HorizonMethod method = HorizonMethod::Sweep;                                // horizon, svf, ao

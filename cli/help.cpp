@@ -91,6 +91,8 @@ const char* groupTitle(unsigned group) {
       return "Sun shading";
     case kRegionSamplingGroup:
       return "Region sampling";
+    case kErrorTargetGroup:
+      return "Error target";
     default:
       return "";  // a command's own group
   }

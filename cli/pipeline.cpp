@@ -240,6 +240,7 @@ ImageChannels Job::image(const HeightField& field, std::vector<std::string> name
 std::vector<std::string> Computation::outputs() const {
   std::vector<std::string> paths{run_.output};
   if (!run_.distance_output.empty()) paths.push_back(run_.distance_output);
+  if (!run_.error_output.empty()) paths.push_back(run_.error_output);
   if (!run_.preview.empty()) paths.push_back(run_.preview);
   return paths;
 }

@@ -39,7 +39,8 @@ enum OptionGroup : unsigned {
   kRegionSamplingGroup = 1u << 19,
   kAreaLightGroup = 1u << 20,
   kRegionPairGroup = 1u << 21,
-  kLastGroup = kRegionPairGroup,
+  kErrorTargetGroup = 1u << 22,  // sky-view-factor and ambient-occlusion: --max-error, --error-out
+  kLastGroup = kErrorTargetGroup,
 };
 
 // The groups every command that reads a height field and writes images takes.

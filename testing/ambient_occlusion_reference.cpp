@@ -11,7 +11,7 @@ AmbientOcclusionResult referenceAmbientOcclusion(const HeightField& field, const
   HorizonOutputs outputs;
   outputs.ambient_occlusion = true;
   HorizonResult horizons = referenceHorizons(field, options, outputs);
-  return {horizons.width, horizons.height, horizons.directions, std::move(horizons.ambient_occlusion)};
+  return {horizons.width, horizons.height, horizons.directions, std::move(horizons.ambient_occlusion), {}, 0.0};
 }
 
 }  // namespace hfvis

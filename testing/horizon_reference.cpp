@@ -13,6 +13,7 @@
 #include "hfvis_testing/horizon_reference.hpp"
 #include "core/horizon_common.hpp"
 #include "core/lattice_geometry.hpp"
+#include "hfvis/errors.hpp"
 #include "core/surface_normal.hpp"
 #include "reference_internal.hpp"
 
@@ -190,8 +191,9 @@ float nearRise(const std::vector<float>& h, int width, int height, int c, int r,
   return (hx - hp) * static_cast<float>(std::abs(a)) + (hy - hp) * static_cast<float>(std::abs(b));
 }
 
+// Directions of `parity` only (k mod 2; -1: all), for the error estimate's halves.
 void sweepReference(const HeightField& field, const PreparedHeights& prepared, const HorizonOptions& options,
-                    const HorizonOutputs& outputs, HorizonResult& result) {
+                    const HorizonOutputs& outputs, HorizonResult& result, int parity) {
   const int width = field.width, height = field.height;
   const auto& h = prepared.heights;
   const auto normals = pixelNormals(field, h, outputs.ambient_occlusion || outputs.environment);
@@ -205,6 +207,7 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
   for (int k = 0; k < options.directions; ++k) {
     const LatticeDirection& d = directions[k];
     if (d.weight == 0.0 && result.angles.empty() && result.distances.empty()) continue;  // merged step
+    if (parity >= 0 && k % 2 != parity) continue;
     DirectionOutputs out = withEnvironment(outputsOf(d, k), outputs, env_tables);
     const double unit = rows ? 1.0 : d.ground_per_pixel;
     const RowTable* table = rows ? &tables[k] : nullptr;
@@ -243,8 +246,9 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
   scaleOcclusion(result, normals);
 }
 
+// Directions of `parity` only (k mod 2; -1: all), for the error estimate's halves.
 void naiveReference(const HeightField& field, const PreparedHeights& prepared, const HorizonOptions& options,
-                    const HorizonOutputs& outputs, HorizonResult& result) {
+                    const HorizonOutputs& outputs, HorizonResult& result, int parity) {
   const int width = field.width, height = field.height;
   const auto& h = prepared.heights;
   const auto normals = pixelNormals(field, h, outputs.ambient_occlusion || outputs.environment);
@@ -259,6 +263,7 @@ void naiveReference(const HeightField& field, const PreparedHeights& prepared, c
   const std::vector<RowTable> tables =
       hasRowSpacing(field) ? rayRowTables(field, directions) : std::vector<RowTable>(1);
   for (int k = 0; k < options.directions; ++k) {
+    if (parity >= 0 && k % 2 != parity) continue;
     const SweepDirection& d = directions[k];
     DirectionOutputs out = withEnvironment(
         {d.cos_azimuth, d.sin_azimuth, static_cast<float>(1.0 / options.directions), k}, outputs, env_tables);
@@ -537,13 +542,34 @@ HorizonResult referenceHorizons(const HeightField& field, const HorizonOptions& 
   validate(field);
   validate(options, outputs);
   const detail::PreparedHeights prepared = detail::prepareHeights(field);
+  if (options.max_error != 0.0)
+    throw InvalidArgument("the reference takes K; HorizonOptions::max_error chooses it on the device alone");
+  const bool sweep = options.method == HorizonMethod::Sweep;
+  std::vector<double> weights(options.directions, 1.0 / options.directions);
   HorizonResult result = detail::allocateResult(field, options, outputs);
-  if (options.method == HorizonMethod::Sweep) {
+  if (sweep) {
     const auto directions = detail::horizonDirections(field, options, outputs);
-    for (int k = 0; k < options.directions; ++k) result.azimuths[k] = directions[k].azimuth;
-    detail::sweepReference(field, prepared, options, outputs, result);
+    for (int k = 0; k < options.directions; ++k) {
+      result.azimuths[k] = directions[k].azimuth;
+      weights[k] = directions[k].weight;
+    }
+  }
+  const auto run = [&](HorizonResult& into, int parity) {
+    if (sweep)
+      detail::sweepReference(field, prepared, options, outputs, into, parity);
+    else
+      detail::naiveReference(field, prepared, options, outputs, into, parity);
+  };
+  if (outputs.error_estimate) {
+    // The even directions' sums in `result`, the odd ones' apart, as the device keeps them.
+    HorizonResult odd = detail::allocateResult(field, options, outputs);
+    run(result, 0);
+    run(odd, 1);
+    double even_weight = 0.0, odd_weight = 0.0;
+    for (int k = 0; k < options.directions; ++k) (k % 2 ? odd_weight : even_weight) += weights[k];
+    detail::splitErrorHalves(result, odd.sky_view_factor, odd.ambient_occlusion, even_weight, odd_weight);
   } else {
-    detail::naiveReference(field, prepared, options, outputs, result);
+    run(result, -1);
   }
   detail::finishReduction(result);
   return result;

@@ -11,7 +11,7 @@ SkyViewFactorResult referenceSkyViewFactor(const HeightField& field, const Horiz
   HorizonOutputs outputs;
   outputs.sky_view_factor = true;
   HorizonResult horizons = referenceHorizons(field, options, outputs);
-  return {horizons.width, horizons.height, horizons.directions, std::move(horizons.sky_view_factor)};
+  return {horizons.width, horizons.height, horizons.directions, std::move(horizons.sky_view_factor), {}, 0.0};
 }
 
 }  // namespace hfvis

@@ -28,7 +28,7 @@ const CommandSpec kSkyViewFactorCommand{
     "The preview (--preview) stretches its 1st to 99th percentile over black..white (the\n"
     "summary line prints both ends); NaN (nodata) is black.\n",
     nullptr,
-    kSweptFieldGroups | kSweepMethodGroup,
+    kSweptFieldGroups | kSweepMethodGroup | kErrorTargetGroup,
     checkHorizonQuantity<kSkyViewFactor>,
     nullptr,
     runHorizonQuantity<kSkyViewFactor>,

@@ -20,6 +20,12 @@ Attributes sweptAttributes(const Job& job, const HorizonResult& result) {
   for (double azimuth : result.azimuths)
     used += (used.empty() ? "" : ",") + formatNumber(azimuth * 180.0 / M_PI);
   attributes.emplace_back("hfvis:azimuths_deg", used);
+  // The K run, which --max-error chooses, and the error estimate when there is one.
+  for (auto& [name, value] : attributes)
+    if (name == "hfvis:directions") value = std::to_string(result.directions);
+  if (job.run.max_error > 0.0) attributes.emplace_back("hfvis:max_error", formatNumber(job.run.max_error));
+  if (!result.error_estimate.empty())
+    attributes.emplace_back("hfvis:estimated_error", formatNumber(result.estimated_error));
   return attributes;
 }
 
@@ -34,10 +40,21 @@ Summary HorizonQuantityComputation::write(Job& job, OutputFiles& outputs) {
   const std::vector<float>& plane = result_.*quantity_.plane;
   requireSize(plane, field.pixelCount(), quantity_.what);
   requireFiniteResult(plane, field, quantity_.what);
-  outputs.image(run_.output, job.image(field, {quantity_.channel}, {plane}, sweptAttributes(job, result_),
-                                       quantity_.quantity, quantity_.units));
-  Summary summary{run_.directions};
+  const Attributes attributes = sweptAttributes(job, result_);
+  outputs.image(run_.output, job.image(field, {quantity_.channel}, {plane}, attributes, quantity_.quantity,
+                                       quantity_.units));
+  if (!run_.error_output.empty()) {
+    requireSize(result_.error_estimate, field.pixelCount(), "error estimate");
+    outputs.image(run_.error_output,
+                  job.image(field, {"error"}, {result_.error_estimate}, attributes,
+                            std::string("estimated error of the ") + quantity_.what,
+                            "absolute, in the output's unit; NaN at nodata"));
+  }
+  Summary summary{result_.directions};
   summary.note = "; mean " + std::string(quantity_.channel) + " " + formatFixed(finiteMean(plane), 4);
+  if (!result_.error_estimate.empty())
+    summary.note += "; estimated error (99th percentile) " + formatFixed(result_.estimated_error, 4) +
+                    (run_.max_error > 0.0 ? " for --max-error " + formatNumber(run_.max_error) : "");
   if (!run_.preview.empty()) {
     // Stretched over the 1st to 99th percentile: most of a DEM's svf lies within 0.85 .. 1.
     const auto [lo, hi] = quantileRange(plane);

@@ -41,7 +41,9 @@ class HorizonQuantityComputation : public Computation {
 
 // The CommandSpec::check and ::run of a command that writes `quantity`.
 template <const HorizonQuantity& quantity>
-void checkHorizonQuantity(const std::string&, const RunArguments& run) {
+void checkHorizonQuantity(const std::string& name, const RunArguments& run) {
+  if (run.max_error > 0.0 && run.directions_given)
+    throw UsageError(name + ": --max-error chooses K itself; give either it or -k");
   asUsageError([&] { validate(horizonOptions(run), horizonOutputs(quantity.command, run)); });
 }
 template <const HorizonQuantity& quantity>

@@ -42,7 +42,18 @@ struct HorizonOptions : SweepOptions {
   // else as many rows as half the budget holds; fewer rows than the field's force strips.
   // The naive method needs the whole field.
   int strip_rows = 0;
+  // Ask for an error, not a direction count: when > 0, the sky-view factor and occlusion (alone,
+  // no planes or environment) choose K themselves (options.directions is ignored), so that the
+  // 99th percentile of the error estimate (HorizonResult::estimated_error) is at most max_error,
+  // in their own unit (absolute, both lie in 0..1); HorizonResult::directions says which K. A
+  // first run at 16 directions predicts the K needed (the estimate falls about as 1 / K); more
+  // runs follow until the estimate is met. Throws InvalidArgument, naming the K it would take,
+  // when a run predicts more than kMaxAutoDirections. The samples per unit stay as given.
+  double max_error = 0.0;
 };
+
+// The most directions max_error may choose.
+constexpr int kMaxAutoDirections = 4096;
 
 // What to compute; only what is asked for is stored or reduced.
 struct HorizonOutputs {
@@ -54,6 +65,10 @@ struct HorizonOutputs {
   // The irradiance from this environment (hfvis/environment_light.hpp), one plane per channel; null:
   // none. The map must outlive the call. Not on latitude / longitude grids (per-row spacing).
   const EnvironmentMap* environment = nullptr;
+  // With the sky-view factor or occlusion alone (no planes, no environment; K >= 2): an estimate of
+  // their error against the azimuthal integral they approximate (HorizonResult::error_estimate),
+  // from the same run at the cost of one more sum per pixel.
+  bool error_estimate = false;
 };
 
 struct HorizonResult {
@@ -67,6 +82,13 @@ struct HorizonResult {
   std::vector<float> sky_view_factor;    // width*height, if asked
   std::vector<float> ambient_occlusion;  // width*height, if asked
   std::vector<float> irradiance;         // the environment's channels' planes of width*height, if asked
+  // With HorizonOutputs::error_estimate or HorizonOptions::max_error, per pixel: half the difference
+  // between the results of the even- and the odd-numbered directions alone (each half's sum over
+  // its own weights: two interleaved quadratures of K / 2 directions), the larger of the sky-view
+  // factor's and occlusion's; NaN at nodata. Measured against the dense azimuthal integral on the
+  // benchmark's contents it lies above the full K's error (bench/report/error_target.md).
+  std::vector<float> error_estimate;
+  double estimated_error = 0.0;  // its 99th percentile over the pixels with data; 0 without it
 };
 
 // Throws InvalidArgument for bad sweep options (see sweep_options.hpp) or when no output

@@ -23,8 +23,12 @@ namespace hfvis {
 struct SkyViewFactorResult {
   int width = 0;
   int height = 0;
-  int directions = 0;         // K
+  int directions = 0;         // K: as given, or as options.max_error chose it
   std::vector<float> values;  // width * height, 0 .. 1; NaN at nodata
+  // With options.max_error: the per-pixel error estimate and its 99th percentile
+  // (HorizonResult::error_estimate, ::estimated_error); else empty and 0.
+  std::vector<float> error_estimate;
+  double estimated_error = 0.0;
 };
 
 // Runs options.method (the sweep by default) on the device of `context`. Throws what

@@ -1,6 +1,7 @@
 // horizon_common.cpp: pieces shared by the horizon device path and its reference.
 #include "core/horizon_common.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -21,6 +22,17 @@ void validate(const HorizonOptions& options, const HorizonOutputs& outputs) {
     throw InvalidArgument("no output requested");
   }
   detail::validateStripRows(options.strip_rows, options.method == HorizonMethod::Naive);
+  if (options.max_error != 0.0 || outputs.error_estimate) {
+    if (outputs.horizon_angles || outputs.horizon_distances || outputs.environment ||
+        (!outputs.sky_view_factor && !outputs.ambient_occlusion))
+      throw InvalidArgument(
+          "an error estimate and a maximum error apply to the sky-view factor and ambient occlusion alone");
+    if (!(options.max_error >= 0.0 && options.max_error < 1.0))
+      throw InvalidArgument("the maximum error must be in (0, 1): the sky-view factor and occlusion lie in 0..1 (got " +
+                            std::to_string(options.max_error) + ")");
+    if (options.max_error == 0.0 && options.directions < 2)
+      throw InvalidArgument("an error estimate needs K >= 2 (it compares the even and the odd directions)");
+  }
   if (outputs.environment) validate(*outputs.environment);
 }
 
@@ -120,6 +132,39 @@ float swathFactor(float weight) { return hfSin(kPiF * weight) / kPiF; }
 
 void finishReduction(HorizonResult& result) {
   for (float& v : result.sky_view_factor) v = 1.0f - v;
+}
+
+void splitErrorHalves(HorizonResult& result, const std::vector<float>& odd_svf, const std::vector<float>& odd_ao,
+                      double even_weight, double odd_weight) {
+  std::vector<float>& estimate = result.error_estimate;
+  estimate.assign(static_cast<std::size_t>(result.width) * result.height, 0.0f);
+  const auto split = [&](std::vector<float>& sum, const std::vector<float>& odd) {
+    for (std::size_t p = 0; p < sum.size(); ++p) {
+      // SVF = 1 - sum and AO = sum: either way half the halves' difference of the sums.
+      const double half_difference = 0.5 * std::abs(sum[p] / even_weight - odd[p] / odd_weight);
+      estimate[p] = std::isnan(sum[p]) ? sum[p] : std::max(estimate[p], static_cast<float>(half_difference));
+      sum[p] += odd[p];
+    }
+  };
+  split(result.sky_view_factor, odd_svf);
+  split(result.ambient_occlusion, odd_ao);
+  result.estimated_error = estimatedError(estimate);
+}
+
+double estimatedError(const std::vector<float>& estimate) {
+  std::vector<float> values;
+  for (float v : estimate)
+    if (!std::isnan(v)) values.push_back(v);
+  if (values.empty()) return 0.0;
+  const std::size_t at = std::min(values.size() - 1, static_cast<std::size_t>(0.99 * values.size()));
+  std::nth_element(values.begin(), values.begin() + at, values.end());
+  return values[at];
+}
+
+int directionsForError(int directions, double estimated, double max_error) {
+  const double wanted = std::ceil(directions * (estimated / max_error) * 1.05 / 8.0) * 8.0;
+  // Beyond kMaxAutoDirections, capped where an int holds it: the caller refuses it.
+  return static_cast<int>(std::max<double>(directions + 8, std::min<double>(wanted, 2.0 * kMaxAutoDirections)));
 }
 
 }  // namespace detail

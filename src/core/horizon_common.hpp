@@ -32,6 +32,25 @@ float swathFactor(float weight);
 // Turns the accumulated sums into the outputs: svf = 1 - weighted sum; ao is the sum itself.
 void finishReduction(HorizonResult& result);
 
+// The directions of HorizonOptions::max_error's first run.
+constexpr int kFirstAutoDirections = 16;
+
+// The error estimate (HorizonOutputs::error_estimate) from the sums of the even-numbered
+// directions in `result` (sky-view factor and occlusion, before finishReduction) and those of the
+// odd-numbered ones, the directions' weights summed by half: fills error_estimate and
+// estimated_error, and leaves the two sums' total in `result`.
+void splitErrorHalves(HorizonResult& result, const std::vector<float>& odd_svf, const std::vector<float>& odd_ao,
+                      double even_weight, double odd_weight);
+
+// HorizonResult::estimated_error of a per-pixel error estimate: its 99th percentile over the
+// pixels with data (not NaN), 0 when none has.
+double estimatedError(const std::vector<float>& estimate);
+
+// The directions HorizonOptions::max_error asks for after a run at `directions` whose estimate
+// was `estimated`: the estimate falls about as 1 / K (bench/report/error_target.md), so
+// K * estimated / max_error, 5 % more, rounded up to a multiple of 8, and at least 8 more.
+int directionsForError(int directions, double estimated, double max_error);
+
 // Whether the field has per-row spacing (HeightField::row_cell_size_x/y): positions along the
 // sweep's lines and the naive march's rays are then ground lengths summed step by step.
 bool hasRowSpacing(const HeightField& field);

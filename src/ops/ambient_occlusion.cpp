@@ -12,7 +12,12 @@ AmbientOcclusionResult computeAmbientOcclusion(const ComputeContext& context, co
   HorizonOutputs outputs;
   outputs.ambient_occlusion = true;
   HorizonResult horizons = computeHorizons(context, field, options, outputs);
-  return {horizons.width, horizons.height, horizons.directions, std::move(horizons.ambient_occlusion)};
+  return {horizons.width,
+          horizons.height,
+          horizons.directions,
+          std::move(horizons.ambient_occlusion),
+          std::move(horizons.error_estimate),
+          horizons.estimated_error};
 }
 
 }  // namespace hfvis

@@ -58,6 +58,12 @@ struct RunDirection {
 std::size_t environmentPlanes(const HorizonOutputs& outputs) {
   return outputs.environment ? outputs.environment->channels : 0;
 }
+
+// Planes per pixel the sky-view factor's and occlusion's sums take: two each with the error
+// estimate (HorizonOutputs::error_estimate), the odd directions' sums apart.
+std::size_t skySumPlanes(const HorizonOutputs& outputs) {
+  return (std::size_t{outputs.sky_view_factor} + outputs.ambient_occlusion) * (1 + outputs.error_estimate);
+}
 std::size_t environmentBytes(const HorizonOutputs& outputs, std::size_t directions) {
   if (!outputs.environment) return 0;
   const EnvironmentMap& map = *outputs.environment;
@@ -103,8 +109,8 @@ RunPlan planStrips(const HeightField& field, const HorizonOptions& options, cons
   // window's float2 (and with per-row spacing the receivers' positions, which also take the
   // halo's rows).
   const std::size_t per_row =
-      row * (1 + outputs.sky_view_factor + (outputs.ambient_occlusion || outputs.environment) * 2 +
-             outputs.ambient_occlusion + environmentPlanes(outputs) + outputs.horizon_angles +
+      row * (1 + skySumPlanes(outputs) + (outputs.ambient_occlusion || outputs.environment) * 2 +
+             environmentPlanes(outputs) + outputs.horizon_angles +
              outputs.horizon_distances + window * 2 + positions);
   // The halo's rows, and the environment's map and tables.
   const std::size_t halo = 2 * halo_rows * row * (1 + positions) + environmentBytes(outputs, directions.size());
@@ -141,8 +147,8 @@ RunPlan planRun(const HeightField& field, const HorizonOptions& options, const H
   // spacing the receivers' positions).
   const bool window = sweep && options.max_distance > 0.0;
   const std::size_t fixed =
-      plane * (1 + outputs.sky_view_factor + (outputs.ambient_occlusion || outputs.environment) * 2 +
-               outputs.ambient_occlusion + environmentPlanes(outputs) + window * 2 +
+      plane * (1 + skySumPlanes(outputs) + (outputs.ambient_occlusion || outputs.environment) * 2 +
+               environmentPlanes(outputs) + window * 2 +
                (window && hasRowSpacing(field))) +
       environmentBytes(outputs, directions.size());
   const std::size_t per_direction = plane * (outputs.horizon_angles + outputs.horizon_distances);
@@ -281,6 +287,12 @@ class HorizonRoutine : public SweepRoutine {
     distances_ = st_.reusableBuffer("horizon distances", outputs_.horizon_distances ? planes_bytes : 0);
     svf_ = zeros(outputs_.sky_view_factor ? plane : 0);
     ao_ = zeros(outputs_.ambient_occlusion ? plane : 0);
+    svf_odd_ = zeros(outputs_.sky_view_factor && outputs_.error_estimate ? plane : 0);
+    ao_odd_ = zeros(outputs_.ambient_occlusion && outputs_.error_estimate ? plane : 0);
+    if (inStrips() && outputs_.error_estimate) {
+      if (outputs_.sky_view_factor) svf_odd_host_.assign(field_.pixelCount(), 0.0f);
+      if (outputs_.ambient_occlusion) ao_odd_host_.assign(field_.pixelCount(), 0.0f);
+    }
     env_sum_ = zeros(environmentChannels() * plane);
     normals_ = deviceBuffer(st_, needsNormals() ? 2 * plane * sizeof(float) : 0);
     env_tables_ = environmentTables();
@@ -382,21 +394,47 @@ class HorizonRoutine : public SweepRoutine {
           const int s1 = std::min(field_.height, s0 + plan_.strip_rows);
           loadStrip(s0, s1);
           scaleByNormals(s1 - s0);
-          if (outputs_.ambient_occlusion) readRows(ao_, result_.ambient_occlusion, s0, s1);
+          readSkySumRows(s0, s1);
           copyEnvironmentRows(s0, s1);
         }
       }
     } else {
       const std::size_t bytes = field_.pixelCount() * sizeof(float);
-      if (outputs_.sky_view_factor)
-        st_.queue.enqueueReadBuffer(svf_, CL_TRUE, 0, bytes, result_.sky_view_factor.data());
       if (needsNormals()) scaleByNormals(field_.height);
-      if (outputs_.ambient_occlusion)
-        st_.queue.enqueueReadBuffer(ao_, CL_TRUE, 0, bytes, result_.ambient_occlusion.data());
+      if (outputs_.error_estimate) {
+        if (outputs_.sky_view_factor) svf_odd_host_.resize(field_.pixelCount());
+        if (outputs_.ambient_occlusion) ao_odd_host_.resize(field_.pixelCount());
+      }
+      readSkySumRows(0, field_.height);
       if (outputs_.environment)
         st_.queue.enqueueReadBuffer(env_sum_, CL_TRUE, 0, environmentChannels() * bytes, result_.irradiance.data());
     }
+    if (outputs_.error_estimate) splitHalves();
     finishReduction(result_);
+  }
+
+  // The sky-view factor's and occlusion's sums of rows [s0, s1) from the device (the odd
+  // directions' apart with the halves' difference); writes them back with `to_device`.
+  void readSkySumRows(int s0, int s1, bool to_device = false) {
+    const auto copy = [&](const cl::Buffer& rows, std::vector<float>& host) {
+      if (host.empty()) return;
+      const std::size_t width = field_.width, bytes = (s1 - s0) * width * sizeof(float);
+      if (to_device)
+        st_.queue.enqueueWriteBuffer(rows, CL_FALSE, 0, bytes, &host[s0 * width]);
+      else
+        readRows(rows, host, s0, s1);
+    };
+    copy(svf_, result_.sky_view_factor);
+    copy(ao_, result_.ambient_occlusion);
+    copy(svf_odd_, svf_odd_host_);
+    copy(ao_odd_, ao_odd_host_);
+  }
+
+  // The error estimate (HorizonOutputs::error_estimate) from the halves' sums.
+  void splitHalves() {
+    double even_weight = 0.0, odd_weight = 0.0;
+    for (const RunDirection& d : directions_) (d.index % 2 ? odd_weight : even_weight) += d.lattice.weight;
+    splitErrorHalves(result_, svf_odd_host_, ao_odd_host_, even_weight, odd_weight);
   }
 
   // The occlusion and irradiance sums of the rows on the device made those of unit normals
@@ -413,6 +451,7 @@ class HorizonRoutine : public SweepRoutine {
       st_.launch(kernel, cl::NDRange(roundUp(pixels, kLineGroup)), cl::NDRange(kLineGroup));
     };
     if (outputs_.ambient_occlusion) scale(ao_, 1);
+    if (outputs_.ambient_occlusion && outputs_.error_estimate) scale(ao_odd_, 1);
     if (outputs_.environment) scale(env_sum_, environmentChannels());
   }
 
@@ -460,11 +499,7 @@ class HorizonRoutine : public SweepRoutine {
     if (!receiver_positions_.empty())
       st_.queue.enqueueWriteBuffer(receiver_base_, CL_FALSE, 0, (row1 - row0) * width * sizeof(float),
                                    &receiver_positions_[row0 * width]);
-    const std::size_t bytes = (s1 - s0) * width * sizeof(float);
-    if (outputs_.sky_view_factor)
-      st_.queue.enqueueWriteBuffer(svf_, CL_FALSE, 0, bytes, &result_.sky_view_factor[s0 * width]);
-    if (outputs_.ambient_occlusion)
-      st_.queue.enqueueWriteBuffer(ao_, CL_FALSE, 0, bytes, &result_.ambient_occlusion[s0 * width]);
+    readSkySumRows(s0, s1, true);
     copyEnvironmentRows(s0, s1, true);
     if (needsNormals()) computeNormals(row0, s0, s1);
     return row0;
@@ -529,8 +564,9 @@ class HorizonRoutine : public SweepRoutine {
     kernel.set("normals", normals_);
     kernel.set("angles", angles_);
     kernel.set("distances", distances_);
-    kernel.set("svf_sum", svf_);
-    kernel.set("ao_sum", ao_);
+    const bool odd = outputs_.error_estimate && d.index % 2 == 1;
+    kernel.set("svf_sum", odd ? svf_odd_ : svf_);
+    kernel.set("ao_sum", odd ? ao_odd_ : ao_);
     kernel.set("env_tables", env_tables_);
     kernel.set("env_offset", static_cast<cl_uint>(d.index * envTableFloats()));
     kernel.set("env_rows", outputs_.environment ? tableRows(*outputs_.environment) : 0);
@@ -712,8 +748,7 @@ class HorizonRoutine : public SweepRoutine {
       const std::size_t plane = field_.pixelCount();
       if (outputs_.horizon_angles) readRows(angles_, result_.angles, s0, s1, k * plane);
       if (outputs_.horizon_distances) readRows(distances_, result_.distances, s0, s1, k * plane);
-      if (outputs_.sky_view_factor) readRows(svf_, result_.sky_view_factor, s0, s1);
-      if (outputs_.ambient_occlusion) readRows(ao_, result_.ambient_occlusion, s0, s1);
+      readSkySumRows(s0, s1);
       copyEnvironmentRows(s0, s1);
       if (!receiver_positions_.empty()) {  // the strip's receivers' positions, for the strips after
         const std::size_t width = field_.width;
@@ -770,6 +805,9 @@ class HorizonRoutine : public SweepRoutine {
   RunPlan plan_;
   HorizonResult result_;
   std::vector<float> receiver_positions_;  // strips, per-row spacing and a maximum distance: receiver_base's
+  // With the error estimate: the odd directions' sums (device, and the host's in strips).
+  cl::Buffer svf_odd_, ao_odd_;
+  std::vector<float> svf_odd_host_, ao_odd_host_;
   cl::Buffer angles_, distances_, svf_, ao_, normals_, stacks_, window_far_, receiver_base_, row_cells_,
       placeholder_, env_sum_, env_tables_;
 };
@@ -791,15 +829,34 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
     // Hull stacks too deep for the room strips leave: again from the start with thinner strips
     // (StacksBeyondStrips::rows), as the sums of the strips done cannot be taken back.
     HorizonOptions attempt = options;
-    for (;;) {
-      try {
-        detail::HorizonRoutine routine(detail::stateOf(context), field, attempt, outputs);
-        routine.run();
-        return routine.take();
-      } catch (const detail::StacksBeyondStrips& error) {
-        if (error.rows < 1) throw MemoryBudgetError(error.what());
-        attempt.strip_rows = error.rows;
+    const auto run = [&](const HorizonOutputs& wanted) {
+      for (;;) {
+        try {
+          detail::HorizonRoutine routine(detail::stateOf(context), field, attempt, wanted);
+          routine.run();
+          return routine.take();
+        } catch (const detail::StacksBeyondStrips& error) {
+          if (error.rows < 1) throw MemoryBudgetError(error.what());
+          attempt.strip_rows = error.rows;
+        }
       }
+    };
+    if (options.max_error == 0.0) return run(outputs);
+    // Ask for an error: runs at growing K until the estimate meets it (HorizonOptions::max_error).
+    HorizonOutputs estimated = outputs;
+    estimated.error_estimate = true;
+    attempt.directions = detail::kFirstAutoDirections;
+    for (;;) {
+      HorizonResult result = run(estimated);
+      if (result.estimated_error <= options.max_error) return result;
+      const int next = detail::directionsForError(attempt.directions, result.estimated_error, options.max_error);
+      if (next > kMaxAutoDirections)
+        throw InvalidArgument("a maximum error of " + std::to_string(options.max_error) + " needs about " +
+                              std::to_string(next) + " directions (the estimate at K = " +
+                              std::to_string(attempt.directions) + " is " + std::to_string(result.estimated_error) +
+                              "), beyond the " + std::to_string(kMaxAutoDirections) +
+                              " a run may choose: ask for a larger error, or give K");
+      attempt.directions = next;
     }
   });
 }

@@ -12,7 +12,12 @@ SkyViewFactorResult computeSkyViewFactor(const ComputeContext& context, const He
   HorizonOutputs outputs;
   outputs.sky_view_factor = true;
   HorizonResult horizons = computeHorizons(context, field, options, outputs);
-  return {horizons.width, horizons.height, horizons.directions, std::move(horizons.sky_view_factor)};
+  return {horizons.width,
+          horizons.height,
+          horizons.directions,
+          std::move(horizons.sky_view_factor),
+          std::move(horizons.error_estimate),
+          horizons.estimated_error};
 }
 
 }  // namespace hfvis

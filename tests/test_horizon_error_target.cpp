@@ -1,0 +1,168 @@
+// test_horizon_error_target.cpp: the sky-view factor's and occlusion's error estimate
+// (HorizonOutputs::error_estimate) and the runs that choose K for a maximum error
+// (HorizonOptions::max_error): the kernels against the scalar reference in both buffer layouts,
+// a closed form, strips, the estimate against a dense run, and bad requests.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "hfvis/ambient_occlusion.hpp"
+#include "hfvis/errors.hpp"
+#include "hfvis/horizon.hpp"
+#include "hfvis/sky_view_factor.hpp"
+#include "hfvis_testing/horizon_reference.hpp"
+#include "hfvis_testing/synthetic_fields.hpp"
+#include "test_support.hpp"
+
+namespace hfvis {
+namespace {
+
+using testing::nearlyEqual;
+using testing::testContext;
+
+HorizonOutputs estimated() {
+  HorizonOutputs outputs;
+  outputs.sky_view_factor = outputs.ambient_occlusion = outputs.error_estimate = true;
+  return outputs;
+}
+
+// The 99th percentile of |a - b| over the pixels with data.
+double p99Difference(const std::vector<float>& a, const std::vector<float>& b) {
+  std::vector<double> d;
+  for (std::size_t p = 0; p < a.size(); ++p)
+    if (!std::isnan(a[p])) d.push_back(std::abs(static_cast<double>(a[p]) - b[p]));
+  std::sort(d.begin(), d.end());
+  return d.empty() ? 0.0 : d[std::min(d.size() - 1, static_cast<std::size_t>(0.99 * d.size()))];
+}
+
+// Odd K too: the halves then differ by one direction, each normalised by its own weights.
+TEST(HorizonErrorEstimate, KernelsMatchTheScalarReferenceOnEveryHardCase) {
+  testing::forEachLayout([](const ComputeContext& context) {
+    for (HorizonMethod method : {HorizonMethod::Sweep, HorizonMethod::Naive}) {
+      for (int K : {7, 8}) {
+        HorizonOptions options;
+        options.method = method;
+        options.directions = K;
+        options.azimuth_offset = 0.1;
+        testing::forEachHardCase([&](const std::string&, const HeightField& field) {
+          const HorizonResult device = computeHorizons(context, field, options, estimated());
+          const HorizonResult reference = referenceHorizons(field, options, estimated());
+          const float tolerance = std::max(testing::divisionTolerance(), 2e-6f);
+          EXPECT_TRUE(nearlyEqual(device.sky_view_factor, reference.sky_view_factor, tolerance));
+          EXPECT_TRUE(nearlyEqual(device.ambient_occlusion, reference.ambient_occlusion, tolerance));
+          EXPECT_TRUE(nearlyEqual(device.error_estimate, reference.error_estimate, tolerance));
+          EXPECT_NEAR(device.estimated_error, reference.estimated_error, tolerance);
+        });
+      }
+    }
+  });
+}
+
+// The estimate leaves the outputs as a run without it (up to the order the sums are added in),
+// and a field in strips gives the same estimate as in one piece, bit for bit.
+TEST(HorizonErrorEstimate, OutputsUnchangedAndStripsEqualTheWholeField) {
+  const HeightField field = makeSyntheticField("city", 48, 45);
+  HorizonOptions options;
+  options.directions = 24;
+  HorizonOutputs plain;
+  plain.sky_view_factor = plain.ambient_occlusion = true;
+  const HorizonResult without = computeHorizons(testContext(), field, options, plain);
+  const HorizonResult whole = computeHorizons(testContext(), field, options, estimated());
+  EXPECT_TRUE(nearlyEqual(whole.sky_view_factor, without.sky_view_factor, 1e-5f));
+  EXPECT_TRUE(nearlyEqual(whole.ambient_occlusion, without.ambient_occlusion, 1e-5f));
+  EXPECT_GT(whole.estimated_error, 0.0);
+  options.strip_rows = 7;
+  const HorizonResult strips = computeHorizons(testContext(), field, options, estimated());
+  EXPECT_TRUE(nearlyEqual(strips.sky_view_factor, whole.sky_view_factor, 0.0f));
+  EXPECT_TRUE(nearlyEqual(strips.ambient_occlusion, whole.ambient_occlusion, 0.0f));
+  EXPECT_TRUE(nearlyEqual(strips.error_estimate, whole.error_estimate, 0.0f));
+}
+
+// Street canyon (test_sky_view_factor.cpp): with K = 4 the even directions look across the street
+// at the walls (sin of their elevation 4 / 5: SVF 0.2), the odd ones along it (level: SVF 1), so
+// the estimate is half their difference, 0.4; flat ground estimates 0.
+TEST(HorizonErrorEstimate, StreetCanyonAndFlatGroundHaveTheClosedForm) {
+  const HeightField canyon = testing::streetCanyon(41, 61, 3, 4.0f);
+  HorizonOptions options;
+  options.directions = 4;
+  for (HorizonMethod method : {HorizonMethod::Sweep, HorizonMethod::Naive}) {
+    options.method = method;
+    const HorizonResult r = computeHorizons(testContext(), canyon, options, estimated());
+    for (int row = 20; row <= 40; ++row) {
+      EXPECT_NEAR(r.sky_view_factor[row * canyon.width + 20], 0.6, 1e-5) << row;
+      EXPECT_NEAR(r.error_estimate[row * canyon.width + 20], 0.4, 1e-5) << row;
+    }
+  }
+  const HorizonResult flat = computeHorizons(testContext(), makeSyntheticField("flat", 20, 17), options, estimated());
+  for (float e : flat.error_estimate) ASSERT_EQ(e, 0.0f);
+  EXPECT_EQ(flat.estimated_error, 0.0);
+}
+
+// A maximum error: the K chosen meets it by the estimate, the estimate lies above the error
+// against a dense run (K = 1024) at the pixels' 99th percentile, a smaller error never takes
+// fewer directions, and the estimate falls with it.
+TEST(HorizonMaxError, MeetsTheTargetAgainstADenseRun) {
+  for (const char* name : {"noise", "city"}) {
+    SCOPED_TRACE(name);
+    const HeightField field = makeSyntheticField(name, 64, 60);
+    HorizonOptions dense;
+    dense.directions = 1024;
+    const SkyViewFactorResult truth = computeSkyViewFactor(testContext(), field, dense);
+    int last_directions = 0;
+    double last_estimate = 1.0;
+    for (double E : {0.05, 0.02, 0.01, 0.005}) {
+      SCOPED_TRACE(E);
+      HorizonOptions options;
+      options.max_error = E;
+      const SkyViewFactorResult r = computeSkyViewFactor(testContext(), field, options);
+      EXPECT_LE(r.estimated_error, E);
+      EXPECT_LE(p99Difference(r.values, truth.values), E);
+      EXPECT_GE(r.directions, last_directions);
+      EXPECT_LE(r.estimated_error, last_estimate);
+      EXPECT_EQ(r.error_estimate.size(), field.pixelCount());
+      last_directions = r.directions;
+      last_estimate = r.estimated_error;
+    }
+    HorizonOptions options;
+    options.max_error = 0.01;
+    const AmbientOcclusionResult ao = computeAmbientOcclusion(testContext(), field, options);
+    HorizonOutputs ao_only;
+    ao_only.ambient_occlusion = true;
+    EXPECT_LE(ao.estimated_error, 0.01);
+    EXPECT_LE(p99Difference(ao.values, computeHorizons(testContext(), field, dense, ao_only).ambient_occlusion), 0.01);
+  }
+}
+
+TEST(HorizonMaxError, BadRequestsAreRefused) {
+  const HeightField field = makeSyntheticField("noise", 16, 16);
+  HorizonOutputs svf;
+  svf.sky_view_factor = true;
+  HorizonOptions options;
+  for (double E : {-0.01, 1.0, 2.0, std::numeric_limits<double>::quiet_NaN(),
+                   std::numeric_limits<double>::infinity()}) {
+    options.max_error = E;
+    EXPECT_THROW(computeHorizons(testContext(), field, options, svf), InvalidArgument) << E;
+  }
+  options.max_error = 0.01;
+  HorizonOutputs angles = svf;
+  angles.horizon_angles = true;
+  EXPECT_THROW(computeHorizons(testContext(), field, options, angles), InvalidArgument);
+  // Beyond kMaxAutoDirections by the first run's estimate: refused after that run alone.
+  options.max_error = 1e-7;
+  try {
+    computeHorizons(testContext(), field, options, svf);
+    ADD_FAILURE() << "an error of 1e-7 was accepted";
+  } catch (const InvalidArgument& error) {
+    EXPECT_NE(std::string(error.what()).find("directions"), std::string::npos) << error.what();
+  }
+  options.max_error = 0.0;
+  options.directions = 1;
+  HorizonOutputs one = svf;
+  one.error_estimate = true;
+  EXPECT_THROW(computeHorizons(testContext(), field, options, one), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace hfvis
