@@ -53,6 +53,7 @@
 #include <string>
 #include <vector>
 
+#include "error_target.hpp"
 #include "ground_truth.hpp"
 #include "hfvis/environment_light.hpp"
 #include "hfvis/horizon.hpp"
@@ -87,6 +88,8 @@ constexpr const char* kUsage =
     "       hfvis_bench viewshed-agreement DEM --observer COL,ROW [--observer-height H] [--target-height T]\n"
     "                                      [--samples N] [--seed S] RASTER...\n"
     "       hfvis_bench viewshed-culling [--levels 1,2,3,4] [--reps N] FIELD...\n"
+    "       hfvis_bench error-target [--data DIR] [--dem FILE] [--size N] [--errors E,...] [--contents A,B]\n"
+    "                                [--reference-k K] [--reps N]\n"
     "       hfvis_bench field NAME N OUT\n"
     "       hfvis_bench inputs [--quick]\n"
     "       hfvis_bench check-truth\n"
@@ -249,15 +252,22 @@ int checkTruth() {
 
 }  // namespace
 
+// "A,B,C" as its items.
+std::vector<std::string> textList(const std::string& text) {
+  std::vector<std::string> out;
+  for (std::size_t at = 0; at < text.size();) {
+    const std::size_t end = std::min(text.find(',', at), text.size());
+    out.push_back(text.substr(at, end - at));
+    at = end + 1;
+  }
+  if (out.empty()) throw Usage("expected a comma-separated list, got '" + text + "'");
+  return out;
+}
+
 // "A,B,C" as whole numbers.
 std::vector<int> intList(const std::string& text) {
   std::vector<int> out;
-  for (std::size_t at = 0; at < text.size();) {
-    const std::size_t end = std::min(text.find(',', at), text.size());
-    out.push_back(std::stoi(text.substr(at, end - at)));
-    at = end + 1;
-  }
-  if (out.empty()) throw Usage("expected a list of whole numbers, got '" + text + "'");
+  for (const std::string& item : textList(text)) out.push_back(std::stoi(item));
   return out;
 }
 
@@ -436,6 +446,40 @@ int main(int argc, char** argv) {
       for (const auto& input : requiredInputs(mode)) inputs.insert(input);
       for (const auto& input : visibilityInputs(mode)) inputs.insert(input);
       for (const auto& [name, n] : inputs) std::printf("%s %d\n", name.c_str(), n);
+      return 0;
+    }
+    if (command == "error-target") {
+      SuiteOptions options;
+      options.data_dir = args.get("--data", "data");
+      options.dem_path = args.get("--dem", "data/jacksboro_fault_dem.exr");
+      // The top-left N x N of the 256^2 contents (N <= 256), so that data/ holds every input.
+      const int n = std::stoi(args.get("--size", "256"));
+      if (n < 16 || n > 256) throw Usage("error-target: --size is 16 .. 256");
+      std::vector<double> errors;
+      for (const std::string& e : textList(args.get("--errors", "0.001,0.002,0.005,0.01,0.02,0.05")))
+        errors.push_back(std::stod(e));
+      const int reference = std::stoi(args.get("--reference-k", "2048"));
+      const int reps = std::stoi(args.get("--reps", "3"));
+      const std::vector<std::string> names =
+          textList(args.get("--contents", "fractal,bricks,sine,blocks,city_dsm,dem,mixed"));
+      args.rejectUnused();
+      std::vector<ErrorTargetField> fields;
+      for (const std::string& name : names) {
+        const auto content = [&](const std::string& which) { return crop(loadContent(options, which, 256).field, n, n); };
+        if (name != "mixed") {
+          fields.push_back({name, content(name)});
+          continue;
+        }
+        // Open and dense parts in one field: the city DSM's left half beside the fractal terrain's
+        // right half (heights times 40, the city's range).
+        HeightField mixed = content("city_dsm");
+        const HeightField terrain = content("fractal");
+        for (int r = 0; r < mixed.height; ++r)
+          for (int c = mixed.width / 2; c < mixed.width; ++c)
+            mixed.heights[static_cast<std::size_t>(r) * mixed.width + c] = 40.0f * terrain.at(c, r);
+        fields.push_back({"mixed", mixed});
+      }
+      errorTargetReport(ComputeContext::create(ContextOptions::fromEnvironment()), fields, errors, reference, reps);
       return 0;
     }
     if (command == "check-truth") return checkTruth();

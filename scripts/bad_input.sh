@@ -133,6 +133,13 @@ try "directions beyond the limit" "" -- svf field.exr -o out/o.exr -k 100000000
 try "samples per unit zero" "" -- svf field.exr -o out/o.exr --samples-per-unit 0
 try "samples per unit NaN" "" -- svf field.exr -o out/o.exr --samples-per-unit nan
 try "samples per unit infinite" "" -- svf field.exr -o out/o.exr --samples-per-unit inf
+try "maximum error zero" "" -- svf field.exr -o out/o.exr --max-error 0
+try "maximum error of 1 or more (SVF lies in 0..1)" "" -- ao field.exr -o out/o.exr --max-error 1
+try "maximum error with -k" "" -- svf field.exr -o out/o.exr --max-error 0.01 -k 16
+try "maximum error beyond 4096 directions" "" -- svf field.exr -o out/o.exr --max-error 1e-7
+try "error estimate output is the output" "" -- svf field.exr -o out/o.exr --error-out out/o.exr
+try "error estimate output is the input" "" -- ao field.exr -o out/o.exr -k 8 --error-out field.exr
+try "error estimate with one direction" "" -- svf field.exr -o out/o.exr -k 1 --error-out out/e.exr
 try "lines per unit (removed: every sweep runs one line through each pixel centre)" "" -- viewcount field.exr -o out/o.exr --lines-per-unit 2
 try "refraction out of range" "" -- svf field.exr -o out/o.exr --refraction 2
 try "curvature for the bounce (not supported)" "" -- bounce field.exr --radiance field.exr -o out/b.exr --curvature

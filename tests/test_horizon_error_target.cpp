@@ -95,7 +95,8 @@ TEST(HorizonErrorEstimate, StreetCanyonAndFlatGroundHaveTheClosedForm) {
       EXPECT_NEAR(r.error_estimate[row * canyon.width + 20], 0.4, 1e-5) << row;
     }
   }
-  const HorizonResult flat = computeHorizons(testContext(), makeSyntheticField("flat", 20, 17), options, estimated());
+  const HorizonResult flat =
+      computeHorizons(testContext(), makeSyntheticField("flat", 20, 17), options, estimated());
   for (float e : flat.error_estimate) ASSERT_EQ(e, 0.0f);
   EXPECT_EQ(flat.estimated_error, 0.0);
 }
@@ -131,7 +132,9 @@ TEST(HorizonMaxError, MeetsTheTargetAgainstADenseRun) {
     HorizonOutputs ao_only;
     ao_only.ambient_occlusion = true;
     EXPECT_LE(ao.estimated_error, 0.01);
-    EXPECT_LE(p99Difference(ao.values, computeHorizons(testContext(), field, dense, ao_only).ambient_occlusion), 0.01);
+    EXPECT_LE(
+        p99Difference(ao.values, computeHorizons(testContext(), field, dense, ao_only).ambient_occlusion),
+        0.01);
   }
 }
 
@@ -140,8 +143,8 @@ TEST(HorizonMaxError, BadRequestsAreRefused) {
   HorizonOutputs svf;
   svf.sky_view_factor = true;
   HorizonOptions options;
-  for (double E : {-0.01, 1.0, 2.0, std::numeric_limits<double>::quiet_NaN(),
-                   std::numeric_limits<double>::infinity()}) {
+  for (double E :
+       {-0.01, 1.0, 2.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
     options.max_error = E;
     EXPECT_THROW(computeHorizons(testContext(), field, options, svf), InvalidArgument) << E;
   }

@@ -850,12 +850,13 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
       HorizonResult result = run(estimated);
       if (result.estimated_error <= options.max_error) return result;
       const int next = detail::directionsForError(attempt.directions, result.estimated_error, options.max_error);
-      if (next > kMaxAutoDirections)
-        throw InvalidArgument("a maximum error of " + std::to_string(options.max_error) + " needs about " +
-                              std::to_string(next) + " directions (the estimate at K = " +
-                              std::to_string(attempt.directions) + " is " + std::to_string(result.estimated_error) +
-                              "), beyond the " + std::to_string(kMaxAutoDirections) +
-                              " a run may choose: ask for a larger error, or give K");
+      if (next > kMaxAutoDirections) {
+        std::ostringstream message;
+        message << "a maximum error of " << options.max_error << " needs about " << next
+                << " directions (the estimate at K = " << attempt.directions << " is " << result.estimated_error
+                << "), beyond the " << kMaxAutoDirections << " a run may choose: ask for a larger error, or give K";
+        throw InvalidArgument(message.str());
+      }
       attempt.directions = next;
     }
   });

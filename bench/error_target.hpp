@@ -1,0 +1,26 @@
+// bench/error_target.hpp: "ask for an error, not a direction count" (HorizonOptions::max_error)
+// measured: for each content and each asked error E of the sky-view factor or ambient occlusion,
+// the K it chose, its estimate, the error it achieved against an azimuthally dense run of the
+// same sweep, its time, and the cheapest fixed K (a multiple of 8) that meets E on that field,
+// found by search, with its time measured interleaved with the chosen run's.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "hfvis/device.hpp"
+#include "hfvis/height_field.hpp"
+
+namespace hfvis::bench {
+
+struct ErrorTargetField {
+  std::string name;
+  HeightField field;
+};
+
+// Markdown on stdout: one table per output (SVF, AO) with a row per (field, E), and the share
+// of rows where the achieved error is at most E. `reference_directions`: the dense run's K.
+void errorTargetReport(const ComputeContext& context, const std::vector<ErrorTargetField>& fields,
+                       const std::vector<double>& errors, int reference_directions, int reps);
+
+}  // namespace hfvis::bench
