@@ -82,3 +82,28 @@ def test_progress_callback_errors_stop_the_run(small):
     with pytest.raises(RuntimeError, match="stop here"):
         hfvis.sky_view_factor(small, directions=16, progress=fail)
     assert np.isfinite(hfvis.sky_view_factor(small, directions=16)).all()  # the context still works
+
+
+def test_ctrl_c_stops_a_run():
+    """SIGINT during a long run: KeyboardInterrupt at the next batch of directions, not a hang or
+    a crash."""
+    import signal
+    import subprocess
+    import sys
+
+    script = ("import sys, numpy as np, hfvis\n"
+              "h = np.random.default_rng(3).random((64, 64), dtype=np.float32)\n"
+              "def tell(done, total):\n"
+              "    print('progress', done, flush=True)\n"
+              "try:\n"
+              "    hfvis.sky_view_factor(h, directions=4096, progress=tell)\n"
+              "except KeyboardInterrupt:\n"
+              "    print('interrupted', flush=True)\n"
+              "    sys.exit(3)\n")
+    child = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+    assert child.stdout.readline().startswith("progress")
+    child.send_signal(signal.SIGINT)
+    out, _ = child.communicate(timeout=120)
+    assert child.returncode == 3 and "interrupted" in out
+    done = [int(line.split()[1]) for line in out.splitlines() if line.startswith("progress")]
+    assert max(done, default=0) < 4096, "stopped at a batch, not run to the end"
