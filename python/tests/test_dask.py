@@ -47,9 +47,10 @@ def _random_chunks(rng, total):
 EXACT = {
     "intervisibility": lambda a: hfvis.intervisibility(a, directions=8, max_distance=MAX_DISTANCE),
 }
-# Within rounding, not bit for bit (a known defect, docs/python.md): the horizon sweep places a
-# line's samples at (offset + j) * period from the line's start at the field's edge, so a chunk's
-# lines round differently. The bounds are those measured on these chunkings, with some room.
+# Not bit for bit (a known defect, docs/python.md): the horizon sweep places a line's samples at
+# (offset + j) * period from the line's start at the field's edge, so a chunk's lines round
+# differently (and a sample exactly at the maximum distance may be cut or kept). The bounds are
+# those measured on these chunkings, with some room; other fields and distances can exceed them.
 WITHIN = {
     "sky_view_factor": (lambda a: hfvis.sky_view_factor(a, directions=8, max_distance=MAX_DISTANCE), 2e-6),
     "ambient_occlusion": (lambda a: hfvis.ambient_occlusion(a, directions=8, max_distance=MAX_DISTANCE), 2e-6),
