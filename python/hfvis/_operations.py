@@ -64,7 +64,7 @@ def _run(operation, heights, options, common):
                              "(xarray.DataArray(array, dims=('y', 'x')))")
     if not _is_dataarray(heights):
         h = _arrays.heights_array(heights, common["nodata"])
-        g = _arrays.geometry(common["cell_size"], common["z_scale"], common.get("row_cell_sizes"))
+        g = _arrays.geometry(common["cell_size"], common["z_scale"])
         return _arrays.compute(operation, h, g, options, common["device"], common["progress"]), None
     from . import _xarray
 

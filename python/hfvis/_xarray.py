@@ -46,8 +46,7 @@ class Grid:
         if not self.geographic:
             return _arrays.geometry((abs(t[1]), abs(t[5])), z_scale)
         cx, cy, rows_x, rows_y = _core.geographic_cell_sizes(list(t), self.array.shape[0])
-        g = _arrays.geometry((cx, cy), z_scale, (rows_x, rows_y))
-        return g
+        return _arrays.geometry((cx, cy), z_scale, (rows_x, rows_y))
 
     def flips(self):
         """(rows, columns): lighting and fields of view take row 0 as north and column 0 as west;
@@ -92,7 +91,7 @@ class Grid:
 def _has_rio(array):
     try:
         return array.rio.crs is not None
-    except (AttributeError, Exception):  # no rioxarray, or no CRS it can read
+    except Exception:  # no rioxarray (no .rio), or no CRS it can read
         return False
 
 

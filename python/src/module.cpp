@@ -323,13 +323,8 @@ NB_MODULE(_core, m) {
   nb::register_exception_translator(translateErrors);
   bindOptions(m);
 
-  nb::class_<HeightField>(m, "HeightField")
-      .def_ro("width", &HeightField::width)
-      .def_ro("height", &HeightField::height)
-      .def_ro("cell_size_x", &HeightField::cell_size_x)
-      .def_ro("cell_size_y", &HeightField::cell_size_y)
-      .def_ro("row_cell_size_x", &HeightField::row_cell_size_x)
-      .def_ro("row_cell_size_y", &HeightField::row_cell_size_y);
+  // Made by height_field() and passed back to the operations; Python reads nothing of them.
+  nb::class_<HeightField>(m, "HeightField");
   m.def("height_field", &makeField, "heights"_a, "cell_size_x"_a, "cell_size_y"_a, "row_cell_size_x"_a,
         "row_cell_size_y"_a, "z_scale"_a);
   m.def(
@@ -360,10 +355,7 @@ NB_MODULE(_core, m) {
       },
       "path"_a, "channel"_a);
 
-  nb::class_<EnvironmentMap>(m, "EnvironmentMap")
-      .def_ro("names", &EnvironmentMap::names)
-      .def_ro("width", &EnvironmentMap::width)
-      .def_ro("height", &EnvironmentMap::height);
+  nb::class_<EnvironmentMap>(m, "EnvironmentMap");
   m.def("environment_map", &environmentFromArray, "radiance"_a, "names"_a, "rotation_deg"_a, "table_rows"_a);
   m.def(
       "read_environment_map",
@@ -396,8 +388,5 @@ NB_MODULE(_core, m) {
       "utc"_a, "latitude_deg"_a, "longitude_deg"_a, "apparent"_a);
   m.def("parse_utc_time", &parseUtcTime, "text"_a);
   m.def("devices", &devices);
-  m.def(
-      "warm_up", [](const std::string& device) { onDevice(device, [](const ComputeContext&) { return 0; }); },
-      "device"_a, "makes the device's context now (the first call otherwise does)");
   m.attr("__version__") = versionString();
 }
