@@ -112,8 +112,8 @@ def _rio(array):
 
 
 def _geotransform(array):
-    """GDAL's geotransform: rioxarray's (its stored GeoTransform, as GDAL read it) where it has
-    one, else from the 1-D coordinates (which must be evenly spaced), else None."""
+    """GDAL's geotransform: rioxarray's (its stored GeoTransform, as GDAL read it) where the array
+    has a spatial_ref, else from the 1-D coordinates (which must be evenly spaced), else None."""
     y_dim, x_dim = array.dims
     from_coords = None
     if x_dim in array.coords and y_dim in array.coords:
@@ -122,11 +122,16 @@ def _geotransform(array):
             dx, dy = _spacing(xs, x_dim), _spacing(ys, y_dim)
             from_coords = (xs[0] - dx / 2, dx, 0.0, ys[0] - dy / 2, 0.0, dy)
     rio = _rio(array)
-    if rio is not None and (from_coords is not None or "spatial_ref" in array.coords):
-        try:
-            return tuple(float(v) for v in rio.transform(recalc=False).to_gdal())
-        except Exception:  # rioxarray finds no spatial dims or transform: the coordinates'
-            pass
+    if rio is None or "spatial_ref" not in array.coords:
+        return from_coords
+    try:
+        stored = tuple(float(v) for v in rio.transform(recalc=False).to_gdal())
+    except Exception:  # rioxarray finds no spatial dims or transform: the coordinates'
+        return from_coords
+    # rioxarray's where it describes these coordinates (it falls back to the identity for dims it
+    # does not know), with GDAL's exact numbers rather than ones recomputed from the coordinates.
+    if from_coords is None or np.allclose(stored, from_coords, rtol=1e-6, atol=1e-9 * max(map(abs, from_coords))):
+        return stored
     return from_coords
 
 

@@ -122,3 +122,23 @@ def test_local_cluster_with_two_worker_processes(field):
     whole = hfvis.intervisibility(field, directions=4, max_distance=MAX_DISTANCE).visible_count
     np.testing.assert_array_equal(computed_counts, whole.values)
     np.testing.assert_array_equal(computed_seen, hfvis.cumulative_viewshed(field, observers).values)
+
+
+def test_latitude_longitude_grid_takes_each_blocks_rows():
+    """60 to 70 degrees north in 0.1 degree cells: a row's east-west spacing shrinks by a third
+    over the field, so a block computed with other rows' spacing would be off by about 1e-2."""
+    rng = np.random.default_rng(5)
+    heights = (np.cumsum(np.cumsum(rng.normal(size=(100, 120)), 0), 1) * 20).astype(np.float32)
+    lat, lon = 70 - 0.1 * (np.arange(100) + 0.5), 10 + 0.1 * (np.arange(120) + 0.5)
+    field = xr.DataArray(heights, dims=("lat", "lon"), coords={"lat": lat, "lon": lon})
+    whole = hfvis.sky_view_factor(field, directions=8, max_distance=30000)
+    centre_spacing = hfvis.sky_view_factor(heights, directions=8, max_distance=30000,
+                                           cell_size=(0.1 * 111320 * np.cos(np.radians(65)), 0.1 * 111320))
+    assert np.nanmax(np.abs(centre_spacing - whole.values)) > 1e-3  # the rows' spacing matters here
+    for chunks in [(37, 53), (16, 120), (100, 9)]:
+        chunked = hfvis.sky_view_factor(field.chunk({"lat": chunks[0], "lon": chunks[1]}), directions=8,
+                                        max_distance=30000)
+        np.testing.assert_allclose(chunked.values, whole.values, rtol=0, atol=1e-6, err_msg=str(chunks))
+    counts = hfvis.intervisibility(field, directions=8, max_distance=30000).visible_count
+    chunked = hfvis.intervisibility(field.chunk({"lat": 37, "lon": 53}), directions=8, max_distance=30000)
+    np.testing.assert_array_equal(chunked.visible_count.values, counts.values)
