@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds, runs the whole test suite (CTest + GoogleTest), then
+# Installs what is missing, builds, runs the whole test suite (CTest + GoogleTest), builds the
+# Python package and runs its tests (scripts/python_test.sh), then
 # installs hfvis into build/install and builds and runs examples/ against that package, as a
 # downstream project would (find_package(hfvis CONFIG), no source tree), runs the suite again
 # built with AddressSanitizer and UndefinedBehaviorSanitizer (scripts/sanitize.sh), and
@@ -10,6 +11,8 @@ cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 bash scripts/build.sh
 (cd build && ctest --output-on-failure -j "$(nproc)")
+echo "== the Python package: pip install . into build/python-venv, then its tests (pytest)"
+bash scripts/python_test.sh
 echo "== examples/ against the installed package (build/install)"
 rm -rf build/install build/examples
 cmake --install build --prefix "$PWD/build/install" > /dev/null

@@ -2,6 +2,7 @@
 // georeferenced rasters through GDAL, EXR through OpenEXR, other images through OpenImageIO.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <limits>
@@ -42,6 +43,13 @@ struct HeightFieldReadOptions {
 // normalised. Throws IoError naming the file and reason (missing, unreadable, truncated,
 // zero-sized, multi-channel without a channel choice, unknown channel).
 HeightField readHeightField(const std::string& path, const HeightFieldReadOptions& options = {});
+
+// The cell sizes readHeightField gives a latitude / longitude raster of geotransform
+// `geotransform` (degrees, north-up or south-up): each row's in metres on the WGS84 ellipsoid at
+// its pixel centres' latitude (row_cell_size_x/y, field.height entries), and cell_size_x/y those
+// at the centre latitude. For fields made in memory (the Python package's DataArrays). Throws
+// InvalidArgument when the rows reach beyond the poles.
+void setGeographicCellSizes(HeightField& field, const std::array<double, 6>& geotransform);
 
 // One float32 image to write (or read by readImage): planar channels of width*height values each.
 struct ImageChannels {

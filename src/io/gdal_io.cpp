@@ -22,8 +22,8 @@
 #include <string>
 #include <vector>
 
-#include "hfvis/errors.hpp"
 #include "core/message_numbers.hpp"
+#include "hfvis/errors.hpp"
 #include "io/output_files.hpp"
 
 namespace hfvis::detail {
@@ -197,6 +197,36 @@ void metresPerDegree(double lat_deg, double* along_meridian, double* along_paral
   *along_parallel = n * std::cos(lat) * M_PI / 180.0;
 }
 
+}  // namespace hfvis::detail
+
+namespace hfvis {
+
+void setGeographicCellSizes(HeightField& field, const std::array<double, 6>& geotransform) {
+  const double first = geotransform[3], last = geotransform[3] + geotransform[5] * field.height;
+  if (!(std::fabs(first) <= 90.0 && std::fabs(last) <= 90.0))
+    throw InvalidArgument("a geographic raster whose rows span latitudes " + detail::shortNumber(first) +
+                          " .. " + detail::shortNumber(last) +
+                          " degrees, beyond the poles: its geotransform or CRS is wrong");
+  // Degrees to metres on the ellipsoid at each row's latitude (its pixel centres); the field's
+  // cell sizes are those at its centre latitude.
+  const double degrees_x = std::fabs(geotransform[1]), degrees_y = std::fabs(geotransform[5]);
+  double per_deg_y, per_deg_x;
+  field.row_cell_size_x.clear();
+  field.row_cell_size_y.clear();
+  for (int r = 0; r < field.height; ++r) {
+    detail::metresPerDegree(geotransform[3] + geotransform[5] * (r + 0.5), &per_deg_y, &per_deg_x);
+    field.row_cell_size_x.push_back(degrees_x * per_deg_x);
+    field.row_cell_size_y.push_back(degrees_y * per_deg_y);
+  }
+  detail::metresPerDegree(geotransform[3] + geotransform[5] * 0.5 * field.height, &per_deg_y, &per_deg_x);
+  field.cell_size_x = degrees_x * per_deg_x;
+  field.cell_size_y = degrees_y * per_deg_y;
+}
+
+}  // namespace hfvis
+
+namespace hfvis::detail {
+
 using detail::shortNumber;
 
 std::optional<std::pair<double, double>> storedCellSize(const std::string& path, const char* x,
@@ -267,23 +297,11 @@ HeightField readGdalHeightField(const std::string& path, const HeightFieldReadOp
     field.cell_size_x = std::fabs((*gt)[1]);
     field.cell_size_y = std::fabs((*gt)[5]);
     if (isGeographic(dataset.get())) {
-      const double first = (*gt)[3], last = (*gt)[3] + (*gt)[5] * field.height;
-      if (!(std::fabs(first) <= 90.0 && std::fabs(last) <= 90.0))
-        throw IoError(path, "a geographic raster whose rows span latitudes " + shortNumber(first) + " .. " +
-                                shortNumber(last) +
-                                " degrees, beyond the poles: its geotransform or CRS is wrong");
-      // Degrees to metres on the ellipsoid at each row's latitude (its pixel centres); the
-      // field's cell sizes are those at its centre latitude.
-      const double degrees_x = field.cell_size_x, degrees_y = field.cell_size_y;
-      double per_deg_y, per_deg_x;
-      for (int r = 0; r < field.height; ++r) {
-        metresPerDegree((*gt)[3] + (*gt)[5] * (r + 0.5), &per_deg_y, &per_deg_x);
-        field.row_cell_size_x.push_back(degrees_x * per_deg_x);
-        field.row_cell_size_y.push_back(degrees_y * per_deg_y);
+      try {
+        setGeographicCellSizes(field, *gt);
+      } catch (const InvalidArgument& error) {
+        throw IoError(path, error.what());
       }
-      metresPerDegree((*gt)[3] + (*gt)[5] * 0.5 * field.height, &per_deg_y, &per_deg_x);
-      field.cell_size_x = degrees_x * per_deg_x;
-      field.cell_size_y = degrees_y * per_deg_y;
     }
   } else if (const auto stored =
                  storedCellSize(path, GDALGetMetadataItem(dataset.get(), "hfvis_cell_size_x", nullptr),

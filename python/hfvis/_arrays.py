@@ -1,0 +1,205 @@
+"""numpy in, numpy out: heights checked and converted, the library's options filled from keyword
+arguments, and one operation run on hfvis._core. compute() takes and returns only plain values
+(arrays, dicts, strings, numbers), so that a Dask graph can carry its calls to other processes."""
+
+import datetime
+import math
+
+import numpy as np
+
+from . import _core
+from ._errors import InputTypeError, InvalidArgumentError
+
+# The operations whose options include a maximum distance that bounds what a point's result
+# depends on (Dask runs them chunk by chunk with a halo), and each one's planes.
+HORIZON_OPERATIONS = ("horizon_angles", "horizon_distances", "sky_view_factor", "ambient_occlusion")
+DISTANCE_LIMITED = HORIZON_OPERATIONS + ("intervisibility", "sun_shading", "insolation")
+OUTPUTS = {
+    "horizon_angles": ("angles",),
+    "horizon_distances": ("distances",),
+    "sky_view_factor": ("sky_view_factor",),
+    "ambient_occlusion": ("ambient_occlusion",),
+    "intervisibility": ("visible_count", "visible_area"),
+    "sun_shading": ("sun", "direct"),
+    "insolation": ("sun_hours", "direct"),
+    "viewshed": ("visible",),
+    "cumulative_viewshed": ("count",),
+}
+
+
+def heights_array(heights, nodata=None):
+    """The heights as a new or unmodified C-contiguous native float32 2-D array, nodata (and
+    `nodata`'s value) as NaN. Any real dtype (float16..float128, integers), either byte order,
+    any strides; refused: other dimensions, complex, bool, object."""
+    a = np.asarray(heights)
+    if a.ndim != 2:
+        raise InputTypeError(f"heights must be a 2-D array (rows, columns), got {a.ndim} dimension(s) {a.shape}")
+    if a.dtype.kind not in "fiu":
+        raise InputTypeError(f"heights must hold real numbers (a float or integer dtype), got dtype {a.dtype}")
+    if a.shape[0] == 0 or a.shape[1] == 0:
+        raise InvalidArgumentError(f"heights are empty ({a.shape[0]} x {a.shape[1]})")
+    with np.errstate(over="ignore"):  # refused just below, with a message
+        converted = np.ascontiguousarray(a, dtype=np.float32)
+    if a.dtype.kind == "f" and a.dtype.itemsize > 4:
+        # Heights beyond float32's range would turn into infinities, that is nodata, unseen.
+        overflow = np.isinf(converted) & np.isfinite(a)
+        if overflow.any():
+            raise InvalidArgumentError("heights beyond float32's range (about 3.4e38): scale them first")
+    if nodata is not None and not (isinstance(nodata, float) and math.isnan(nodata)):
+        holes = a == nodata
+        if holes.any():
+            converted = np.where(holes, np.float32(np.nan), converted)  # a new array: the input stays
+    return converted
+
+
+def geometry(cell_size=None, z_scale=1.0, row_cell_sizes=None):
+    """The field's cell sizes and z-scale as hfvis._core.height_field takes them. cell_size: a
+    number (square cells), a pair (x, y), or None (1). row_cell_sizes: None, or a pair of
+    per-row sequences (x, y) for latitude / longitude grids."""
+    if cell_size is None:
+        cx = cy = 1.0
+    elif np.ndim(cell_size) == 0:
+        cx = cy = float(cell_size)
+    else:
+        pair = tuple(cell_size)
+        if len(pair) != 2:
+            raise InvalidArgumentError(f"cell_size must be a number or a pair (x, y), got {cell_size!r}")
+        cx, cy = float(pair[0]), float(pair[1])
+    rows_x, rows_y = ([], []) if row_cell_sizes is None else (list(map(float, row_cell_sizes[0])),
+                                                               list(map(float, row_cell_sizes[1])))
+    return {"cell_size_x": cx, "cell_size_y": cy, "row_cell_size_x": rows_x, "row_cell_size_y": rows_y,
+            "z_scale": float(z_scale)}
+
+
+def _set(target, options, names):
+    for name in names:
+        value = options.get(name)
+        if value is not None:
+            setattr(target, name, value)
+
+
+_SWEEP = ("directions", "azimuth_offset", "samples_per_unit", "curvature", "max_distance", "memory_budget_bytes")
+
+
+def _sweep_options(options):
+    o = _core.SweepOptions()
+    _set(o, options, _SWEEP)
+    return o
+
+
+def _horizon_options(options):
+    o = _core.HorizonOptions()
+    _set(o, options, _SWEEP + ("azimuth_tolerance", "strip_rows"))
+    o.method = _enum(_core.HorizonMethod, options.get("method", "sweep"), "method")
+    return o
+
+
+def _enum(kind, name, what):
+    try:
+        return getattr(kind, name)
+    except (AttributeError, TypeError):
+        choices = ", ".join(k for k in dir(kind) if not k.startswith("_") and k.islower())
+        raise InvalidArgumentError(f"{what} must be one of {choices}, got {name!r}") from None
+
+
+def _viewshed_options(options):
+    o = _core.ViewshedOptions()
+    _set(o, options, ("absolute", "target_height", "max_distance", "curvature", "azimuth_from_deg",
+                      "azimuth_to_deg", "elevation_min_deg", "elevation_max_deg", "memory_budget_bytes"))
+    return o
+
+
+def utc_seconds(when):
+    """Seconds since 1970 (UTC) from an ISO 8601 text with a zone (the library parses it), an
+    aware datetime, a numpy datetime64 (taken as UTC) or a number."""
+    if isinstance(when, str):
+        return _core.parse_utc_time(when)
+    if isinstance(when, datetime.datetime):
+        if when.tzinfo is None:
+            raise InvalidArgumentError(f"the time {when} has no time zone: give an aware datetime")
+        return when.timestamp()
+    if isinstance(when, np.datetime64):
+        return float((when - np.datetime64(0, "s")) / np.timedelta64(1, "s"))
+    if isinstance(when, (int, float)):
+        return float(when)
+    raise InputTypeError(f"a time must be an ISO 8601 text, an aware datetime, a datetime64 or seconds, got {when!r}")
+
+
+def planes_of(operation, options):
+    """How many planes each output of `operation` has: K for horizon maps, else 1."""
+    return options["directions"] if operation in ("horizon_angles", "horizon_distances") else 1
+
+
+def compute(operation, heights, geometry, options, device="", progress=None):
+    """Runs `operation` on C-contiguous float32 heights (heights_array). Returns its outputs by
+    name (OUTPUTS): (H, W) planes, K x H x W for horizon maps, and extras (azimuths, ...)."""
+    field = _core.height_field(heights, **geometry)
+    if operation in HORIZON_OPERATIONS:
+        r = _core.horizons(field, _horizon_options(options), angles=operation == "horizon_angles",
+                           distances=operation == "horizon_distances",
+                           sky_view_factor=operation == "sky_view_factor",
+                           ambient_occlusion=operation == "ambient_occlusion", device=device, progress=progress)
+        r["azimuths"] = np.asarray(r["azimuths"])
+        return r
+    if operation == "intervisibility":
+        o = _core.IntervisibilityOptions()
+        _set(o, options, _SWEEP + ("strip_rows",))
+        o.method = _enum(_core.IntervisibilityMethod, options.get("method", "hull_tree"), "method")
+        r = _core.intervisibility(field, o, device=device, progress=progress)
+        r["azimuths"] = np.asarray(r["azimuths"])
+        return r
+    if operation == "sun_shading":
+        return _core.sun_shading(field, float(options["azimuth_deg"]), float(options["elevation_deg"]),
+                                 float(options["size_deg"]), _sweep_options(options), device=device,
+                                 progress=progress)
+    if operation == "insolation":
+        o = _core.InsolationOptions()
+        _set(o, options, ("latitude_deg", "longitude_deg", "step_minutes", "size_deg", "azimuth_bucket_deg",
+                          "apparent"))
+        o.from_utc = utc_seconds(options["start"])
+        o.to_utc = utc_seconds(options["end"])
+        return _core.insolation(field, o, _sweep_options(options), device=device, progress=progress)
+    if operation == "environment_light":
+        environment = options["environment"]
+        if isinstance(environment, str):
+            env = _core.read_environment_map(environment, float(options["rotation_deg"]), int(options["table_rows"]))
+        else:
+            radiance = np.asarray(environment)
+            if radiance.ndim == 2:
+                radiance = radiance[np.newaxis]
+            if radiance.ndim != 3 or radiance.dtype.kind not in "fiu":
+                raise InputTypeError("environment must be a path, or radiance as a 2-D (rows, columns) or 3-D "
+                                     f"(channels, rows, columns) real array, got shape {radiance.shape}")
+            names = ["Y"] if radiance.shape[0] == 1 else ["R", "G", "B"][: radiance.shape[0]]
+            env = _core.environment_map(np.ascontiguousarray(radiance, dtype=np.float32), names,
+                                        float(options["rotation_deg"]), int(options["table_rows"]))
+        irradiance, names = _core.environment_light(field, env, _horizon_options(options), device=device,
+                                                    progress=progress)
+        return {"irradiance": irradiance, "channels": names}
+    if operation == "viewshed":
+        col, row = observer_pixel(options["observer"])
+        return {"visible": _core.viewshed(field, col, row, float(options["observer_height"]),
+                                          _viewshed_options(options), device=device)}
+    if operation == "cumulative_viewshed":
+        cols, rows, eyes = observer_pixels(options["observers"], options["observer_height"])
+        return {"count": _core.cumulative_viewshed(field, cols, rows, eyes, _viewshed_options(options),
+                                                   device=device, progress=progress)}
+    raise InvalidArgumentError(f"no operation {operation!r}")
+
+
+def observer_pixel(observer):
+    pair = np.asarray(observer)
+    if pair.shape != (2,) or pair.dtype.kind not in "iu":
+        raise InvalidArgumentError(f"an observer is a pixel (column, row) of two integers, got {observer!r}")
+    return int(pair[0]), int(pair[1])
+
+
+def observer_pixels(observers, observer_height):
+    """Columns, rows and eye heights of an N x 2 integer array of pixels (column, row); the
+    height a number or one per observer."""
+    pixels = np.asarray(observers)
+    if pixels.ndim != 2 or pixels.shape[1] != 2 or pixels.dtype.kind not in "iu" or len(pixels) == 0:
+        raise InvalidArgumentError(f"observers must be an N x 2 array of integer pixels (column, row), N >= 1, "
+                                   f"got shape {pixels.shape} and dtype {pixels.dtype}")
+    eyes = np.broadcast_to(np.asarray(observer_height, dtype=np.float64), (len(pixels),))
+    return pixels[:, 0].tolist(), pixels[:, 1].tolist(), eyes.tolist()

@@ -1,0 +1,106 @@
+"""Dask-backed DataArrays: the distance-limited operations chunk by chunk through
+dask.array.map_overlap with a halo of the maximum distance, and cumulative viewsheds split into
+groups of observers summed. The graph carries module-level functions and plain values only (the
+operation's name, its options, the geometry), so that distributed workers can unpickle it; each
+worker process makes its own OpenCL context (hfvis._core keeps one per process)."""
+
+import functools
+import math
+
+import numpy as np
+
+from . import _arrays
+from ._errors import InvalidArgumentError
+
+# Beyond the maximum distance, what a point's result reads: the bilinear surface's cell around a
+# sample at that distance (one more pixel) and the receiver's own normal (its neighbours).
+SURFACE_PIXELS = 2
+
+
+def halo(geometry, max_distance, operation):
+    """The halo in pixels that holds everything the results of a chunk depend on."""
+    if not max_distance or max_distance <= 0:
+        raise InvalidArgumentError(
+            f"{operation} on a Dask array needs max_distance > 0 (ground units): each chunk is computed with a halo "
+            "of that distance around it, and without one every point depends on the whole field. Pass "
+            "max_distance=..., or .compute() the array to run it in memory")
+    sizes = [geometry["cell_size_x"], geometry["cell_size_y"], *geometry["row_cell_size_x"],
+             *geometry["row_cell_size_y"]]
+    return int(math.ceil(max_distance / min(sizes))) + SURFACE_PIXELS
+
+
+def _block(block, operation, geometry, options, device, depth, chunks, block_id=None):
+    """One chunk with its halo (map_overlap, boundary 'none': no halo beyond the field's own edges,
+    which stay edges) -> its planes, the halo trimmed, stacked along a leading axis."""
+    i, j = block_id[-2], block_id[-1]
+    top = depth if i > 0 else 0
+    left = depth if j > 0 else 0
+    bottom = depth if i < len(chunks[0]) - 1 else 0
+    right = depth if j < len(chunks[1]) - 1 else 0
+    first_row = sum(chunks[0][:i]) - top
+    g = dict(geometry)
+    if g["row_cell_size_x"]:  # a latitude / longitude grid: the block's own rows' spacing
+        g["row_cell_size_x"] = g["row_cell_size_x"][first_row:first_row + block.shape[0]]
+        g["row_cell_size_y"] = g["row_cell_size_y"][first_row:first_row + block.shape[0]]
+    planes = _arrays.planes_of(operation, options)
+    names = _arrays.OUTPUTS[operation]
+    heights = np.ascontiguousarray(block, dtype=np.float32)
+    if not np.isfinite(heights).any():  # all nodata: NaN, as the whole field's run gives there
+        out = np.full((len(names) * planes,) + heights.shape, np.nan, np.float32)
+    else:
+        result = _arrays.compute(operation, heights, g, options, device)
+        out = np.concatenate([result[name].reshape((-1,) + heights.shape) for name in names])
+    return out[:, top:out.shape[1] - bottom, left:out.shape[2] - right]
+
+
+def chunked(operation, heights, geometry, options, device=""):
+    """`operation` over the 2-D Dask array `heights` (float32, nodata NaN): its outputs by name,
+    Dask arrays chunked as the input (rechunked where a chunk is smaller than the halo)."""
+    import dask.array as da
+    from dask.array.overlap import ensure_minimum_chunksize
+
+    depth = halo(geometry, options.get("max_distance"), operation)
+    # Every chunk at least the halo deep, so that each block's halo comes from its neighbours alone.
+    chunks = tuple(c if len(c) == 1 else (sum(c),) if sum(c) <= depth else ensure_minimum_chunksize(depth, c)
+                   for c in heights.chunks)
+    if chunks != heights.chunks:
+        heights = heights.rechunk(chunks)
+    names = _arrays.OUTPUTS[operation]
+    planes = _arrays.planes_of(operation, options)
+    body = functools.partial(_block, operation=operation, geometry=geometry, options=options, device=device,
+                             depth=depth, chunks=chunks)
+    stacked = da.map_overlap(body, heights, depth={0: depth, 1: depth}, boundary="none", trim=False,
+                             dtype=np.float32, new_axis=0, chunks=((len(names) * planes,),) + chunks,
+                             meta=np.empty((0, 0, 0), np.float32))
+    out = {}
+    for n, name in enumerate(names):
+        part = stacked[n * planes:(n + 1) * planes]
+        out[name] = part if planes > 1 or operation in ("horizon_angles", "horizon_distances") else part[0]
+    return out
+
+
+def _observer_group(heights, geometry, options, device, group):
+    o = dict(options, observers=group[0], observer_height=group[1])
+    return _arrays.compute("cumulative_viewshed", np.ascontiguousarray(heights, dtype=np.float32), geometry, o,
+                           device)["count"]
+
+
+def cumulative_viewshed(heights, geometry, options, device="", group_size=None):
+    """The cumulative viewshed of many observers over a Dask array: groups of observers, each a
+    task over the whole field, and their counts summed (whole numbers: the sum is exact)."""
+    import dask
+    import dask.array as da
+
+    cols, rows, eyes = _arrays.observer_pixels(options["observers"], options["observer_height"])
+    pixels = np.stack([cols, rows], axis=1)
+    eyes = np.asarray(eyes)
+    if group_size is None:
+        group_size = max(1, math.ceil(len(pixels) / 8))
+    whole = heights.rechunk(-1)
+    counts = []
+    for start in range(0, len(pixels), group_size):
+        group = (pixels[start:start + group_size], eyes[start:start + group_size])
+        task = dask.delayed(_observer_group)(whole, geometry, options, device, group)
+        counts.append(da.from_delayed(task, shape=heights.shape, dtype=np.float32))
+    total = functools.reduce(lambda a, b: a + b, counts)
+    return total.rechunk(heights.chunks)

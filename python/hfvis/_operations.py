@@ -1,0 +1,369 @@
+"""The public functions, one per operation, each taking a 2-D numpy array (pixels, cell_size in
+ground units) or an xarray DataArray (georeferenced; Dask-backed ones chunk by chunk). Keyword
+arguments are named as the C++ library's options (docs/python.md lists them)."""
+
+import collections
+import math
+
+import numpy as np
+
+from . import _arrays, _core
+from ._errors import InputTypeError, InvalidArgumentError
+
+Horizons = collections.namedtuple("Horizons", "values azimuths")
+Intervisibility = collections.namedtuple("Intervisibility", "visible_count visible_area")
+SunShading = collections.namedtuple("SunShading", "sun direct")
+Insolation = collections.namedtuple("Insolation", "sun_hours direct")
+
+# Lighting and fields of view take row 0 as north: a DataArray whose rows run south-up (or
+# columns west) is computed flipped.
+_LIT = ("sun_shading", "insolation", "environment_light", "viewshed", "cumulative_viewshed")
+
+_UNITS = {
+    "angles": "radians above the horizontal; -pi/2 where the ray leaves the field at once",
+    "distances": "ground units (of the cell size); 0 where no point casts a horizon or the surface's own slope "
+                 "is the horizon",
+    "sky_view_factor": "1 (fraction of the sky visible, 0..1)",
+    "ambient_occlusion": "1 (irradiance from a uniform sky of radiance 1, flat ground 1)",
+    "visible_count": "visible samples summed over the directions, in 1/samples_per_unit pixel lengths",
+    "visible_area": "ground units squared",
+    "sun": "1 (fraction of the sun's disc above the horizon)",
+    "direct": "1 (irradiance from a sun of normal irradiance 1)",
+    "sun_hours": "hours",
+    "visible": "1 (1 seen, 0 hidden or out of range)",
+    "count": "observers",
+    "irradiance": "radiance units times steradians (pi on open flat ground under radiance 1)",
+}
+_INSOLATION_DIRECT = "hours (direct irradiation from a sun of normal irradiance 1; times W/m^2 it is Wh/m^2)"
+
+
+def _is_dataarray(value):
+    try:
+        import xarray as xr
+    except ImportError:
+        return False
+    return isinstance(value, xr.DataArray)
+
+
+def _is_dask(value):
+    return type(value).__module__.startswith("dask.")
+
+
+def _method(operation, options):
+    if operation in ("viewshed", "cumulative_viewshed"):
+        return "exact sight lines on the bilinear surface"
+    if operation == "intervisibility":
+        return options.get("method") or "hull_tree"
+    return options.get("method") or "sweep"
+
+
+def _run(operation, heights, options, common):
+    """The outputs of `operation` (a dict by output name) and, for a DataArray, its Grid."""
+    if _is_dask(heights):
+        raise InputTypeError("a Dask array needs its grid: wrap it in an xarray DataArray "
+                             "(xarray.DataArray(array, dims=('y', 'x')))")
+    if not _is_dataarray(heights):
+        h = _arrays.heights_array(heights, common["nodata"])
+        g = _arrays.geometry(common["cell_size"], common["z_scale"])
+        return _arrays.compute(operation, h, g, options, common["device"], common["progress"]), None
+    from . import _xarray
+
+    grid = _xarray.Grid(heights)
+    g = grid.geometry(common["cell_size"], common["z_scale"])
+    flip_rows, flip_cols = grid.flips() if operation in _LIT else (False, False)
+    options = _observers_as_pixels(operation, options, grid, flip_rows, flip_cols, common["pixels"])
+    if flip_rows:
+        g = dict(g, row_cell_size_x=g["row_cell_size_x"][::-1], row_cell_size_y=g["row_cell_size_y"][::-1])
+    nodata = common["nodata"] if common["nodata"] is not None else grid.nodata
+    data = grid.array.data
+    if _is_dask(data):
+        from . import _dask
+
+        if data.dtype.kind not in "fiu":
+            raise InputTypeError(f"heights must hold real numbers (a float or integer dtype), got dtype {data.dtype}")
+        if nodata is not None and not (isinstance(nodata, float) and math.isnan(nodata)):
+            data = data.map_blocks(_nodata_as_nan, nodata, dtype=np.float32)
+        data = _flipped(data.astype(np.float32), flip_rows, flip_cols)
+        if operation == "cumulative_viewshed":
+            out = {"count": _dask.cumulative_viewshed(data, g, options, common["device"])}
+        elif operation in _arrays.DISTANCE_LIMITED:
+            out = _dask.chunked(operation, data, g, options, common["device"])
+        else:
+            raise InvalidArgumentError(f"{operation} does not run chunk by chunk: .compute() the Dask array first")
+    else:
+        h = _arrays.heights_array(data, nodata)
+        h = np.ascontiguousarray(_flipped(h, flip_rows, flip_cols))
+        out = _arrays.compute(operation, h, g, options, common["device"], common["progress"])
+    for name in _arrays.OUTPUTS.get(operation, ("irradiance",)):
+        out[name] = _flipped(out[name], flip_rows, flip_cols)
+    return out, grid
+
+
+def _nodata_as_nan(block, value):
+    return np.where(block == value, np.float32(np.nan), block).astype(np.float32)
+
+
+def _flipped(a, rows, cols):
+    if rows:
+        a = a[..., ::-1, :]
+    if cols:
+        a = a[..., :, ::-1]
+    return a
+
+
+def _observers_as_pixels(operation, options, grid, flip_rows, flip_cols, pixels):
+    """A DataArray's observers, given as map coordinates (x, y) unless `pixels`, as the pixels of
+    the field computed on (flipped with it)."""
+    if operation not in ("viewshed", "cumulative_viewshed"):
+        return options
+    height, width = grid.array.shape
+
+    def place(col, row):
+        return (width - 1 - col if flip_cols else col), (height - 1 - row if flip_rows else row)
+
+    options = dict(options)
+    if operation == "viewshed":
+        x, y = options["observer"]
+        col, row = (int(x), int(y)) if pixels else grid.pixel(float(x), float(y))
+        options["observer"] = np.array(place(col, row))
+    else:
+        points = np.asarray(options["observers"])
+        if points.ndim != 2 or points.shape[1] != 2:
+            raise InvalidArgumentError(f"observers must be an N x 2 array, got shape {points.shape}")
+        placed = [place(*((int(x), int(y)) if pixels else grid.pixel(float(x), float(y)))) for x, y in points]
+        options["observers"] = np.array(placed, dtype=np.int64).reshape(-1, 2)
+    return options
+
+
+def _attrs(operation, name, options, grid):
+    attrs = {"units": _UNITS[name], "hfvis_operation": operation, "hfvis_method": _method(operation, options)}
+    if operation == "insolation" and name == "direct":
+        attrs["units"] = _INSOLATION_DIRECT
+    if name in ("distances", "visible_area") and grid.geographic:
+        attrs["units"] = attrs["units"].replace("ground units", "metres")
+    for key, value in options.items():
+        if key in ("observers", "environment", "progress"):
+            continue
+        if isinstance(value, (bool, np.bool_)):
+            value = int(value)
+        if isinstance(value, (int, float, str)):
+            attrs["hfvis_" + key] = value
+    return attrs
+
+
+def _single(operation, name, heights, options, common):
+    out, grid = _run(operation, heights, options, common)
+    if grid is None:
+        return out[name]
+    return grid.result(out[name], name, _attrs(operation, name, options, grid))
+
+
+def _pair(operation, kind, heights, options, common):
+    out, grid = _run(operation, heights, options, common)
+    names = _arrays.OUTPUTS[operation]
+    if grid is None:
+        return kind(*(out[n] for n in names))
+    import xarray as xr
+
+    return xr.Dataset({n: grid.result(out[n], n, _attrs(operation, n, options, grid)) for n in names})
+
+
+def _common(cell_size, z_scale, nodata, device, progress, pixels=False):
+    return {"cell_size": cell_size, "z_scale": z_scale, "nodata": nodata, "device": device or "",
+            "progress": progress, "pixels": pixels}
+
+
+def _horizon(directions, azimuth_offset, samples_per_unit, curvature, max_distance, memory_budget_bytes, method,
+             azimuth_tolerance, strip_rows):
+    return {"directions": int(directions), "azimuth_offset": float(azimuth_offset),
+            "samples_per_unit": float(samples_per_unit), "curvature": float(curvature),
+            "max_distance": float(max_distance), "memory_budget_bytes": int(memory_budget_bytes),
+            "method": method, "azimuth_tolerance": azimuth_tolerance, "strip_rows": int(strip_rows)}
+
+
+def _horizon_maps(operation, name, heights, options, common):
+    out, grid = _run(operation, heights, options, common)
+    if grid is None:
+        return Horizons(out[name], out["azimuths"])
+    azimuths = np.degrees(np.asarray(out["azimuths"])) if "azimuths" in out else \
+        _azimuths_deg(options)
+    attrs = _attrs(operation, name, options, grid)
+    attrs["azimuth_convention"] = _xarray_convention()
+    result = grid.result(out[name], "horizon_" + name, attrs, leading=("azimuth", azimuths))
+    result["azimuth"].attrs.update(units="degrees", long_name="azimuth as computed",
+                                   convention=_xarray_convention())
+    return result
+
+
+def _xarray_convention():
+    from ._xarray import AZIMUTH_CONVENTION
+
+    return AZIMUTH_CONVENTION
+
+
+def _azimuths_deg(options):
+    """The azimuths a chunked run computes (each chunk takes the same ones: they depend on K and
+    the tolerance alone), from a one-pixel field's sweep."""
+    probe = _arrays.compute("horizon_angles", np.zeros((2, 2), np.float32), _arrays.geometry(), options)
+    return np.degrees(np.asarray(probe["azimuths"]))
+
+
+def horizon_angles(heights, *, directions=64, azimuth_offset=0.0, samples_per_unit=1.0, curvature=0.0,
+                   max_distance=0.0, method="sweep", azimuth_tolerance=None, strip_rows=0, memory_budget_bytes=0,
+                   cell_size=None, z_scale=1.0, nodata=None, device="", progress=None):
+    """The horizon elevation angle (radians) of every pixel in K directions. numpy: Horizons(values
+    K x H x W, azimuths in radians); DataArray: dims (azimuth, y, x), azimuth in degrees."""
+    options = _horizon(directions, azimuth_offset, samples_per_unit, curvature, max_distance, memory_budget_bytes,
+                       method, azimuth_tolerance, strip_rows)
+    return _horizon_maps("horizon_angles", "angles", heights, options,
+                         _common(cell_size, z_scale, nodata, device, progress))
+
+
+def horizon_distances(heights, *, directions=64, azimuth_offset=0.0, samples_per_unit=1.0, curvature=0.0,
+                      max_distance=0.0, method="sweep", azimuth_tolerance=None, strip_rows=0, memory_budget_bytes=0,
+                      cell_size=None, z_scale=1.0, nodata=None, device="", progress=None):
+    """The ground distance to the point casting each horizon (as horizon_angles)."""
+    options = _horizon(directions, azimuth_offset, samples_per_unit, curvature, max_distance, memory_budget_bytes,
+                       method, azimuth_tolerance, strip_rows)
+    return _horizon_maps("horizon_distances", "distances", heights, options,
+                         _common(cell_size, z_scale, nodata, device, progress))
+
+
+def sky_view_factor(heights, *, directions=64, azimuth_offset=0.0, samples_per_unit=1.0, curvature=0.0,
+                    max_distance=0.0, method="sweep", azimuth_tolerance=None, strip_rows=0, memory_budget_bytes=0,
+                    cell_size=None, z_scale=1.0, nodata=None, device="", progress=None):
+    """The sky-view factor 1 - sum_k w_k sin(max(0, e_k)) (Zaksek, Ostir & Kokalj 2011), 0..1."""
+    options = _horizon(directions, azimuth_offset, samples_per_unit, curvature, max_distance, memory_budget_bytes,
+                       method, azimuth_tolerance, strip_rows)
+    return _single("sky_view_factor", "sky_view_factor", heights, options,
+                   _common(cell_size, z_scale, nodata, device, progress))
+
+
+def ambient_occlusion(heights, *, directions=64, azimuth_offset=0.0, samples_per_unit=1.0, curvature=0.0,
+                      max_distance=0.0, method="sweep", azimuth_tolerance=None, strip_rows=0, memory_budget_bytes=0,
+                      cell_size=None, z_scale=1.0, nodata=None, device="", progress=None):
+    """Ambient occlusion under a uniform sky (Timonen & Westerholm 2010, Eq. 5), flat ground 1."""
+    options = _horizon(directions, azimuth_offset, samples_per_unit, curvature, max_distance, memory_budget_bytes,
+                       method, azimuth_tolerance, strip_rows)
+    return _single("ambient_occlusion", "ambient_occlusion", heights, options,
+                   _common(cell_size, z_scale, nodata, device, progress))
+
+
+def intervisibility(heights, *, directions=64, azimuth_offset=0.0, samples_per_unit=1.0, curvature=0.0,
+                    max_distance=0.0, method="hull_tree", strip_rows=0, memory_budget_bytes=0, cell_size=None,
+                    z_scale=1.0, nodata=None, device="", progress=None):
+    """How much of the surface each point sees (Timonen 2013's convex hull tree): visible samples
+    and visible ground area. numpy: Intervisibility(visible_count, visible_area); DataArray: a
+    Dataset of the two."""
+    options = _horizon(directions, azimuth_offset, samples_per_unit, curvature, max_distance, memory_budget_bytes,
+                       method, None, strip_rows)
+    del options["azimuth_tolerance"]
+    return _pair("intervisibility", Intervisibility, heights, options,
+                 _common(cell_size, z_scale, nodata, device, progress))
+
+
+def viewshed(heights, observer, *, observer_height=2.0, absolute=False, target_height=0.0, max_distance=0.0,
+             curvature=0.0, azimuth_from_deg=0.0, azimuth_to_deg=0.0, elevation_min_deg=-90.0,
+             elevation_max_deg=90.0, memory_budget_bytes=0, pixels=False, cell_size=None, z_scale=1.0, nodata=None,
+             device=""):
+    """What an observer sees: 1 visible, 0 hidden or out of range, NaN at nodata. `observer`: a
+    pixel (column, row) for a numpy array; map coordinates (x, y) for a DataArray (a pixel with
+    pixels=True)."""
+    options = {"observer": observer, "observer_height": float(observer_height), "absolute": bool(absolute),
+               "target_height": float(target_height), "max_distance": float(max_distance),
+               "curvature": float(curvature), "azimuth_from_deg": float(azimuth_from_deg),
+               "azimuth_to_deg": float(azimuth_to_deg), "elevation_min_deg": float(elevation_min_deg),
+               "elevation_max_deg": float(elevation_max_deg), "memory_budget_bytes": int(memory_budget_bytes)}
+    if _is_dataarray(heights) and _is_dask(heights.data):
+        heights = heights.compute()  # one observer: the field in one piece
+    return _single("viewshed", "visible", heights, options, _common(cell_size, z_scale, nodata, device, None, pixels))
+
+
+def cumulative_viewshed(heights, observers, *, observer_height=2.0, absolute=False, target_height=0.0,
+                        max_distance=0.0, curvature=0.0, azimuth_from_deg=0.0, azimuth_to_deg=0.0,
+                        elevation_min_deg=-90.0, elevation_max_deg=90.0, memory_budget_bytes=0, pixels=False,
+                        cell_size=None, z_scale=1.0, nodata=None, device="", progress=None):
+    """How many of the observers (an N x 2 array: pixels (column, row), or map coordinates (x, y)
+    for a DataArray) see each point; observer_height a number or one per observer. A Dask-backed
+    DataArray splits the observers into groups computed as separate tasks and sums them."""
+    options = {"observers": observers, "observer_height": observer_height, "absolute": bool(absolute),
+               "target_height": float(target_height), "max_distance": float(max_distance),
+               "curvature": float(curvature), "azimuth_from_deg": float(azimuth_from_deg),
+               "azimuth_to_deg": float(azimuth_to_deg), "elevation_min_deg": float(elevation_min_deg),
+               "elevation_max_deg": float(elevation_max_deg), "memory_budget_bytes": int(memory_budget_bytes)}
+    return _single("cumulative_viewshed", "count", heights, options,
+                   _common(cell_size, z_scale, nodata, device, progress, pixels))
+
+
+def sun_shading(heights, azimuth_deg, elevation_deg, *, size_deg=0.53, samples_per_unit=1.0, curvature=0.0,
+                max_distance=0.0, memory_budget_bytes=0, cell_size=None, z_scale=1.0, nodata=None, device="",
+                progress=None):
+    """The sun's light with cast shadows: the fraction of its disc each point sees (sun) and the
+    direct irradiance that brings (direct). The sun at compass azimuth and elevation (degrees),
+    row 0 north. numpy: SunShading(sun, direct); DataArray: a Dataset."""
+    options = {"azimuth_deg": float(azimuth_deg), "elevation_deg": float(elevation_deg), "size_deg": float(size_deg),
+               "samples_per_unit": float(samples_per_unit), "curvature": float(curvature),
+               "max_distance": float(max_distance), "memory_budget_bytes": int(memory_budget_bytes)}
+    return _pair("sun_shading", SunShading, heights, options, _common(cell_size, z_scale, nodata, device, progress))
+
+
+def insolation(heights, latitude_deg, longitude_deg, start, end, *, step_minutes=10.0, size_deg=0.53,
+               azimuth_bucket_deg=0.25, apparent=False, samples_per_unit=1.0, curvature=0.0, max_distance=0.0,
+               memory_budget_bytes=0, cell_size=None, z_scale=1.0, nodata=None, device="", progress=None):
+    """Hours of sun and direct irradiation from `start` to `end` (ISO 8601 texts with a zone, aware
+    datetimes, or seconds since 1970) at a place. numpy: Insolation(sun_hours, direct)."""
+    options = {"latitude_deg": float(latitude_deg), "longitude_deg": float(longitude_deg),
+               "start": start if isinstance(start, str) else _arrays.utc_seconds(start),
+               "end": end if isinstance(end, str) else _arrays.utc_seconds(end),
+               "step_minutes": float(step_minutes), "size_deg": float(size_deg),
+               "azimuth_bucket_deg": float(azimuth_bucket_deg), "apparent": bool(apparent),
+               "samples_per_unit": float(samples_per_unit), "curvature": float(curvature),
+               "max_distance": float(max_distance), "memory_budget_bytes": int(memory_budget_bytes)}
+    return _pair("insolation", Insolation, heights, options, _common(cell_size, z_scale, nodata, device, progress))
+
+
+def environment_light(heights, environment, *, rotation_deg=0.0, table_rows=0, directions=64, azimuth_offset=0.0,
+                      samples_per_unit=1.0, curvature=0.0, max_distance=0.0, method="sweep", azimuth_tolerance=None,
+                      memory_budget_bytes=0, cell_size=None, z_scale=1.0, nodata=None, device="", progress=None):
+    """The irradiance an HDR environment gives each point through its horizons (Timonen &
+    Westerholm 2010, Sec. 6.2). `environment`: a file (EXR, HDR, ...) or radiance as an
+    equirectangular (rows, 2 rows) or (channels, rows, 2 rows) array, row 0 at the zenith, the
+    left edge north. Returns (channels, H, W), or (H, W) for one channel."""
+    options = _horizon(directions, azimuth_offset, samples_per_unit, curvature, max_distance, memory_budget_bytes,
+                       method, azimuth_tolerance, 0)
+    options.update(environment=environment, rotation_deg=float(rotation_deg), table_rows=int(table_rows))
+    common = _common(cell_size, z_scale, nodata, device, progress)
+    if _is_dataarray(heights) and _is_dask(heights.data):
+        heights = heights.compute()  # a sky's light has no maximum distance here: the field in one piece
+    out, grid = _run("environment_light", heights, options, common)
+    irradiance, channels = out["irradiance"], list(out["channels"])
+    if grid is None:
+        return irradiance[0] if len(channels) == 1 else irradiance
+    attrs = _attrs("environment_light", "irradiance", options, grid)
+    if len(channels) == 1:
+        return grid.result(irradiance[0], "irradiance", attrs)
+    return grid.result(irradiance, "irradiance", attrs, leading=("channel", channels))
+
+
+def sun_position(time, latitude_deg, longitude_deg, *, apparent=False):
+    """Where the sun stands (Meeus 1998, ch. 25): (compass azimuth, elevation) in degrees, at a
+    time (ISO 8601 text with a zone, aware datetime, or seconds since 1970) and place."""
+    return _core.sun_position(_arrays.utc_seconds(time), float(latitude_deg), float(longitude_deg), bool(apparent))
+
+
+def devices():
+    """The OpenCL devices: a list of dicts (index, platform, name, type, memory, ...)."""
+    return _core.devices()
+
+
+HeightFieldFile = collections.namedtuple("HeightFieldFile", "heights cell_size row_cell_sizes geotransform crs_wkt")
+
+
+def read_height_field(path, *, channel=""):
+    """Reads a height field as the CLI does (GeoTIFF and the rasters GDAL reads, EXR, PNG, ...),
+    through the library (no Python GDAL): HeightFieldFile(heights (H x W float32, nodata NaN),
+    cell_size (x, y) in ground units, row_cell_sizes ((x, y) per row on latitude / longitude
+    grids, else None), geotransform (GDAL's 6 numbers or None), crs_wkt ("" when none))."""
+    heights, cx, cy, rows_x, rows_y, transform, wkt = _core.read_height_field(str(path), channel)
+    rows = (np.asarray(rows_x), np.asarray(rows_y)) if rows_x else None
+    return HeightFieldFile(heights, (cx, cy), rows, None if transform is None else tuple(transform), wkt)

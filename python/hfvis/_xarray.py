@@ -1,0 +1,180 @@
+"""DataArrays in and out: a DataArray's georeferencing as the library's field (cell sizes from its
+coordinates or rioxarray's transform, latitude / longitude grids converted row by row as the
+CLI's GeoTIFF reader does, nodata as NaN), and results that carry the input's coordinates,
+spatial_ref and CRS, with units and method in their attributes."""
+
+import math
+
+import numpy as np
+import xarray as xr
+
+from . import _arrays, _core
+from ._errors import InputTypeError, InvalidArgumentError
+
+AZIMUTH_CONVENTION = ("phi_k = 360*k/K deg + azimuth_offset, on the ground from the +x (column) axis toward "
+                      "+row; compass azimuth = 90 + phi_k deg when row 0 is north")
+
+
+class Grid:
+    """A DataArray's 2-D grid: its dims, geotransform (GDAL's order: x0, dx, 0, y0, 0, dy, of the
+    pixel corners; None without coordinates or a transform), whether its CRS is geographic, and
+    its nodata value."""
+
+    def __init__(self, array):
+        if "band" in array.dims and array.sizes["band"] == 1 and array.ndim == 3:
+            array = array.squeeze("band", drop=True)  # rioxarray's open_rasterio: (band, y, x)
+        if array.ndim != 2:
+            raise InputTypeError(f"a DataArray of heights must be 2-D (y, x), got dims {array.dims}")
+        self.array = array
+        self.y_dim, self.x_dim = array.dims
+        self.transform = _geotransform(array)
+        if self.transform is not None and (self.transform[2] != 0.0 or self.transform[4] != 0.0):
+            raise InvalidArgumentError(f"rotated or sheared transforms are not supported (terms {self.transform[2]}, "
+                                       f"{self.transform[4]}); warp the raster north-up first")
+        self.geographic = _is_geographic(array)
+        self.nodata = _nodata(array)
+
+    def geometry(self, cell_size, z_scale):
+        """The field's cell sizes: given, else from the transform (degrees to metres per row on a
+        geographic CRS, by the library's own conversion), else 1."""
+        if cell_size is not None or self.transform is None:
+            if cell_size is None and self.geographic:
+                raise InvalidArgumentError("a geographic DataArray without coordinates or a transform has no cell "
+                                           "size in metres; give cell_size")
+            return _arrays.geometry(cell_size, z_scale)
+        t = self.transform
+        if not self.geographic:
+            return _arrays.geometry((abs(t[1]), abs(t[5])), z_scale)
+        cx, cy, rows_x, rows_y = _core.geographic_cell_sizes(list(t), self.array.shape[0])
+        return _arrays.geometry((cx, cy), z_scale, (rows_x, rows_y))
+
+    def flips(self):
+        """(rows, columns): lighting and fields of view take row 0 as north and column 0 as west;
+        a south-up or west-up grid is computed flipped and flipped back, as the CLI does."""
+        if self.transform is None:
+            return False, False
+        return self.transform[5] > 0.0, self.transform[1] < 0.0
+
+    def pixel(self, x, y):
+        """The pixel (column, row) whose centre is nearest the map coordinates (x, y)."""
+        if self.transform is None:
+            raise InvalidArgumentError("observers as map coordinates need a DataArray with x / y coordinates or a "
+                                       "transform; give pixels (column, row) with pixels=True")
+        t = self.transform
+        return int(math.floor((x - t[0]) / t[1])), int(math.floor((y - t[3]) / t[5]))
+
+    def heights(self):
+        return _arrays.heights_array(self.array.values, self.nodata)
+
+    def coords(self):
+        """The input's coordinates along y and x (and scalar ones such as spatial_ref)."""
+        keep = {self.y_dim, self.x_dim}
+        return {name: c for name, c in self.array.coords.items() if set(c.dims) <= keep}
+
+    def result(self, values, name, attrs, leading=None):
+        """A DataArray of `values` on the input's grid: (y, x), or (leading[0], y, x) with
+        leading = (dim, coordinate values)."""
+        dims = (self.y_dim, self.x_dim)
+        coords = self.coords()
+        if leading is not None:
+            dims = (leading[0],) + dims
+            coords[leading[0]] = leading[1]
+        out = xr.DataArray(values, dims=dims, coords=coords, name=name)
+        if "grid_mapping" in self.array.attrs:
+            out.attrs["grid_mapping"] = self.array.attrs["grid_mapping"]
+        out.attrs.update(attrs)
+        if "spatial_ref" in self.array.coords or _has_rio(self.array):
+            _copy_crs(self.array, out)
+        return out
+
+
+def _has_rio(array):
+    try:
+        return array.rio.crs is not None
+    except Exception:  # no rioxarray (no .rio), or no CRS it can read
+        return False
+
+
+def _copy_crs(source, out):
+    try:
+        crs = source.rio.crs
+        if crs is not None and out.rio.crs is None:
+            out.rio.write_crs(crs, inplace=True)
+    except AttributeError:  # rioxarray absent: the spatial_ref coordinate came with the coords
+        pass
+
+
+def _rio(array):
+    try:
+        return array.rio
+    except AttributeError:
+        return None
+
+
+def _geotransform(array):
+    """GDAL's geotransform: rioxarray's (its stored GeoTransform, as GDAL read it) where the array
+    has a spatial_ref, else from the 1-D coordinates (which must be evenly spaced), else None."""
+    y_dim, x_dim = array.dims
+    from_coords = None
+    if x_dim in array.coords and y_dim in array.coords:
+        xs, ys = np.asarray(array[x_dim].values, float), np.asarray(array[y_dim].values, float)
+        if len(xs) >= 2 and len(ys) >= 2:
+            dx, dy = _spacing(xs, x_dim), _spacing(ys, y_dim)
+            from_coords = (xs[0] - dx / 2, dx, 0.0, ys[0] - dy / 2, 0.0, dy)
+    rio = _rio(array)
+    if rio is None or "spatial_ref" not in array.coords:
+        return from_coords
+    try:
+        stored = tuple(float(v) for v in rio.transform(recalc=False).to_gdal())
+    except Exception:  # rioxarray finds no spatial dims or transform: the coordinates'
+        return from_coords
+    # rioxarray's where it describes these coordinates (it falls back to the identity for dims it
+    # does not know), with GDAL's exact numbers rather than ones recomputed from the coordinates.
+    if from_coords is None or np.allclose(stored, from_coords, rtol=1e-6, atol=1e-9 * max(map(abs, from_coords))):
+        return stored
+    return from_coords
+
+
+def _spacing(values, dim):
+    steps = np.diff(values)
+    step = (values[-1] - values[0]) / (len(values) - 1)
+    if step == 0 or not np.allclose(steps, step, rtol=1e-6, atol=0):
+        raise InvalidArgumentError(f"the {dim} coordinates are not evenly spaced: hfvis needs a regular grid")
+    return step
+
+
+def _is_geographic(array):
+    rio = _rio(array)
+    if rio is not None:
+        try:
+            crs = rio.crs
+            if crs is not None:
+                return bool(crs.is_geographic)
+        except Exception:
+            pass
+    # Without rioxarray: CF's grid mapping, or the coordinates' names.
+    ref = array.coords.get("spatial_ref")
+    if ref is not None:
+        wkt = ref.attrs.get("crs_wkt") or ref.attrs.get("spatial_ref") or ""
+        if wkt:
+            return wkt.lstrip().upper().startswith(("GEOGCS", "GEOGCRS", "GEODCRS"))
+        if ref.attrs.get("grid_mapping_name") == "latitude_longitude":
+            return True
+    return array.dims[-1] in ("lon", "longitude") and array.dims[-2] in ("lat", "latitude")
+
+
+def _nodata(array):
+    """The value that marks nodata: rioxarray's nodata, else _FillValue or nodata in the attributes
+    or encoding; None when there is none (NaN is nodata anyway)."""
+    rio = _rio(array)
+    if rio is not None:
+        try:
+            if rio.nodata is not None:
+                return rio.nodata
+        except Exception:
+            pass
+    for where in (array.attrs, array.encoding):
+        for key in ("_FillValue", "nodata", "missing_value"):
+            if key in where and where[key] is not None:
+                return where[key]
+    return None

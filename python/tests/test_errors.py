@@ -1,0 +1,109 @@
+"""Bad input: Python exceptions under hfvis.Error (ValueError, TypeError, OSError), a clear
+message, never a crash; the input untouched."""
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import hfvis
+
+
+@pytest.fixture()
+def small():
+    return np.random.default_rng(2).random((24, 20), dtype=np.float32)
+
+
+@pytest.mark.parametrize("bad, kind, words", [
+    (np.zeros(10, np.float32), TypeError, "2-D"),
+    (np.zeros((2, 3, 4), np.float32), TypeError, "2-D"),
+    (np.zeros((4, 4), complex), TypeError, "real numbers"),
+    (np.zeros((4, 4), bool), TypeError, "real numbers"),
+    (np.array([["a", "b"], ["c", "d"]]), TypeError, "real numbers"),
+    (np.zeros((0, 4), np.float32), ValueError, "empty"),
+    (np.full((4, 4), np.nan, np.float32), ValueError, "nodata"),
+    (np.full((4, 4), 1e300), ValueError, "float32"),
+])
+def test_bad_heights(bad, kind, words):
+    with pytest.raises(kind, match=words) as caught:
+        hfvis.sky_view_factor(bad, directions=4)
+    assert isinstance(caught.value, hfvis.Error)
+
+
+@pytest.mark.parametrize("call, words", [
+    (lambda h: hfvis.sky_view_factor(h, directions=0), "K"),
+    (lambda h: hfvis.sky_view_factor(h, cell_size=-1.0), "cell size"),
+    (lambda h: hfvis.sky_view_factor(h, cell_size=(1.0, 2.0, 3.0)), "pair"),
+    (lambda h: hfvis.sky_view_factor(h, z_scale=0.0), "z-scale"),
+    (lambda h: hfvis.sky_view_factor(h, max_distance=-5.0), "distance"),
+    (lambda h: hfvis.sky_view_factor(h, method="ray"), "method"),
+    (lambda h: hfvis.viewshed(h, (20, 3)), "outside"),
+    (lambda h: hfvis.viewshed(h, (-1, 3)), "outside"),
+    (lambda h: hfvis.viewshed(h, (1.5, 3)), "integers"),
+    (lambda h: hfvis.cumulative_viewshed(h, np.array([[1, 2], [30, 2]])), "outside"),
+    (lambda h: hfvis.cumulative_viewshed(h, np.zeros((0, 2), int)), "N x 2"),
+    (lambda h: hfvis.sun_shading(h, 100, 20, size_deg=20), "size"),
+    (lambda h: hfvis.insolation(h, 46, 8, "2026-06-21T00:00", "2026-06-22T00:00Z"), "zone"),
+    (lambda h: hfvis.insolation(h, 46, 8, "2026-06-22T00:00Z", "2026-06-21T00:00Z"), "forward"),
+    (lambda h: hfvis.environment_light(h, np.ones((4, 5), np.float32)), "twice as wide"),
+    (lambda h: hfvis.sun_position("yesterday", 46, 8), "ISO|time"),
+])
+def test_bad_arguments_are_value_errors(small, call, words):
+    before = small.copy()
+    with pytest.raises(ValueError, match=words) as caught:
+        call(small)
+    assert isinstance(caught.value, hfvis.InvalidArgumentError)
+    np.testing.assert_array_equal(small, before)
+
+
+def test_files_are_os_errors(tmp_path, small):
+    with pytest.raises(OSError, match="missing.exr") as caught:
+        hfvis.read_height_field(tmp_path / "missing.exr")
+    assert isinstance(caught.value, hfvis.IoError)
+    with pytest.raises(hfvis.IoError):
+        hfvis.environment_light(small, str(tmp_path / "no_sky.exr"))
+
+
+def test_dataarrays(small):
+    with pytest.raises(TypeError, match="2-D"):
+        hfvis.sky_view_factor(xr.DataArray(np.zeros((2, 3, 4)), dims=("a", "y", "x")))
+    uneven = xr.DataArray(small, dims=("y", "x"), coords={"y": np.arange(24.0) ** 2, "x": np.arange(20.0)})
+    with pytest.raises(ValueError, match="evenly spaced"):
+        hfvis.sky_view_factor(uneven)
+    import dask.array as da
+
+    with pytest.raises(TypeError, match="DataArray"):
+        hfvis.sky_view_factor(da.from_array(small))
+
+
+def test_progress_callback_errors_stop_the_run(small):
+    def fail(done, total):
+        raise RuntimeError("stop here")
+
+    with pytest.raises(RuntimeError, match="stop here"):
+        hfvis.sky_view_factor(small, directions=16, progress=fail)
+    assert np.isfinite(hfvis.sky_view_factor(small, directions=16)).all()  # the context still works
+
+
+def test_ctrl_c_stops_a_run():
+    """SIGINT during a long run: KeyboardInterrupt at the next batch of directions, not a hang or
+    a crash."""
+    import signal
+    import subprocess
+    import sys
+
+    script = ("import sys, numpy as np, hfvis\n"
+              "h = np.random.default_rng(3).random((64, 64), dtype=np.float32)\n"
+              "def tell(done, total):\n"
+              "    print('progress', done, flush=True)\n"
+              "try:\n"
+              "    hfvis.sky_view_factor(h, directions=4096, progress=tell)\n"
+              "except KeyboardInterrupt:\n"
+              "    print('interrupted', flush=True)\n"
+              "    sys.exit(3)\n")
+    child = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+    assert child.stdout.readline().startswith("progress")
+    child.send_signal(signal.SIGINT)
+    out, _ = child.communicate(timeout=120)
+    assert child.returncode == 3 and "interrupted" in out
+    done = [int(line.split()[1]) for line in out.splitlines() if line.startswith("progress")]
+    assert max(done, default=0) < 4096, "stopped at a batch, not run to the end"
