@@ -203,7 +203,7 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
   // Positions in pixels of the direction's ground length, or (per-row spacing) ground units.
   const bool rows = hasRowSpacing(field);
   const std::vector<RowTable> tables =
-      rows ? latticeRowTables(field, directions, !exactAzimuths(outputs)) : std::vector<RowTable>{};
+      rows ? latticeRowTables(field, directions, !exactAzimuths(outputs), outputs.error_estimate) : std::vector<RowTable>{};
   for (int k = 0; k < options.directions; ++k) {
     const LatticeDirection& d = directions[k];
     if (d.weight == 0.0 && result.angles.empty() && result.distances.empty()) continue;  // merged step

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/lattice_geometry.hpp"
 #include "hfvis/ambient_occlusion.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
@@ -99,6 +100,30 @@ TEST(HorizonErrorEstimate, StreetCanyonAndFlatGroundHaveTheClosedForm) {
       computeHorizons(testContext(), makeSyntheticField("flat", 20, 17), options, estimated());
   for (float e : flat.error_estimate) ASSERT_EQ(e, 0.0f);
   EXPECT_EQ(flat.estimated_error, 0.0);
+}
+
+// Beyond the lattice's angular resolution (K = 2048: neighbouring phi_k fall back to one step) the
+// quadrature merges coinciding steps; for the estimate only within a parity, so that each half
+// keeps the share of the circle its azimuths stand for (else one half loses the merged slots'
+// weight and the halves differ by far more than the result's error).
+TEST(HorizonErrorEstimate, MergedStepsStayInTheirHalf) {
+  const HeightField field = makeSyntheticField("flat", 8, 8);
+  HorizonOptions options;
+  options.directions = 2048;
+  for (bool parity_apart : {false, true}) {
+    const auto directions = detail::latticeDirections(field, options, false, 0.0, parity_apart);
+    double even = 0.0, odd = 0.0, largest_imbalance = 0.0;
+    for (int k = 0; k < options.directions; ++k) {
+      (k % 2 ? odd : even) += directions[k].weight;
+      if (k % 64 == 63) largest_imbalance = std::max(largest_imbalance, std::abs(even - odd)), even = odd = 0.0;
+    }
+    // Over every 64 neighbouring directions the halves' weights agree to 5 % of their sum
+    // (1/32) with parity_apart; without it some merged run puts the weight all on one side.
+    if (parity_apart)
+      EXPECT_LT(largest_imbalance, 0.05 / 32);
+    else
+      EXPECT_GT(largest_imbalance, 0.1 / 32);
+  }
 }
 
 // A maximum error: the K chosen meets it by the estimate, the estimate lies above the error

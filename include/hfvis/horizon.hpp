@@ -46,8 +46,8 @@ struct HorizonOptions : SweepOptions {
   // no planes or environment) choose K themselves (options.directions is ignored), so that the
   // 99th percentile of the error estimate (HorizonResult::estimated_error) is at most max_error,
   // in their own unit (absolute, both lie in 0..1); HorizonResult::directions says which K. A
-  // first run at 16 directions predicts the K needed (the estimate falls about as 1 / K); more
-  // runs follow until the estimate is met. Throws InvalidArgument, naming the K it would take,
+  // first run at 16 directions and each one after it predicts the K needed (the estimate falls
+  // as K^-p, p measured from the last two runs), until the estimate is met. Throws InvalidArgument, naming the K it would take,
   // when a run predicts more than kMaxAutoDirections. The samples per unit stay as given.
   double max_error = 0.0;
 };

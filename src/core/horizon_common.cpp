@@ -53,7 +53,7 @@ void appendRow(RowTable& t, double length, double azimuth, double weight) {
 }  // namespace
 
 std::vector<RowTable> latticeRowTables(const HeightField& field, const std::vector<LatticeDirection>& directions,
-                                       bool quadrature) {
+                                       bool quadrature, bool parity_apart) {
   const std::size_t K = directions.size();
   std::vector<RowTable> tables(K);
   std::vector<LatticeDirection> at_row = directions;
@@ -69,7 +69,7 @@ std::vector<RowTable> latticeRowTables(const HeightField& field, const std::vect
       at_row[k].azimuth = d.azimuth + angleDifference(std::atan2(gy, gx), d.azimuth);
       at_row[k].weight = d.weight;
     }
-    if (quadrature && K > 1) setQuadratureWeights(at_row);
+    if (quadrature && K > 1) setQuadratureWeights(at_row, parity_apart);
     for (std::size_t k = 0; k < K; ++k) appendRow(tables[k], lengths[k], at_row[k].azimuth, at_row[k].weight);
   }
   return tables;
@@ -112,7 +112,7 @@ bool exactAzimuths(const HorizonOutputs& outputs) { return outputs.horizon_angle
 
 std::vector<LatticeDirection> horizonDirections(const HeightField& field, const HorizonOptions& options,
                                                 const HorizonOutputs& outputs) {
-  return latticeDirections(field, options, exactAzimuths(outputs), options.azimuth_tolerance);
+  return latticeDirections(field, options, exactAzimuths(outputs), options.azimuth_tolerance, outputs.error_estimate);
 }
 
 void pixelNormal(const std::vector<float>& h, int width, int height, int c, int r, float cell_x, float cell_y,
@@ -161,8 +161,13 @@ double estimatedError(const std::vector<float>& estimate) {
   return values[at];
 }
 
-int directionsForError(int directions, double estimated, double max_error) {
-  const double wanted = std::ceil(directions * (estimated / max_error) * 1.05 / 8.0) * 8.0;
+int directionsForError(int directions, double estimated, int earlier, double earlier_estimate, double max_error) {
+  double order = 1.0, factor = 0.0;
+  if (earlier > 0 && earlier_estimate > estimated && estimated > 0.0)
+    order = std::clamp(std::log(earlier_estimate / estimated) / std::log(double(directions) / earlier), 0.5, 3.0);
+  factor = std::pow(estimated / max_error, 1.0 / order) * 1.05;
+  if (earlier == 0) factor = std::min(factor, 4.0);
+  const double wanted = std::ceil(directions * factor / 8.0) * 8.0;
   // Beyond kMaxAutoDirections, capped where an int holds it: the caller refuses it.
   return static_cast<int>(std::max<double>(directions + 8, std::min<double>(wanted, 2.0 * kMaxAutoDirections)));
 }

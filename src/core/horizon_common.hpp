@@ -47,9 +47,11 @@ void splitErrorHalves(HorizonResult& result, const std::vector<float>& odd_svf, 
 double estimatedError(const std::vector<float>& estimate);
 
 // The directions HorizonOptions::max_error asks for after a run at `directions` whose estimate
-// was `estimated`: the estimate falls about as 1 / K (bench/report/error_target.md), so
-// K * estimated / max_error, 5 % more, rounded up to a multiple of 8, and at least 8 more.
-int directionsForError(int directions, double estimated, double max_error);
+// was `estimated`, the run before it at `earlier` directions with `earlier_estimate` (0 for none):
+// the estimate falls as K^-p, p measured from the two runs (within 0.5 .. 3; from one run 1, and
+// then at most 4 times the directions: smooth fields fall much faster, bench/report/error_target.md),
+// so K (estimated / max_error)^(1/p), 5 % more, rounded up to a multiple of 8, and at least 8 more.
+int directionsForError(int directions, double estimated, int earlier, double earlier_estimate, double max_error);
 
 // Whether the field has per-row spacing (HeightField::row_cell_size_x/y): positions along the
 // sweep's lines and the naive march's rays are then ground lengths summed step by step.
@@ -69,7 +71,7 @@ struct RowTable {
   std::vector<float> terms;   // four per row: cos, sin, weight, swath
 };
 std::vector<RowTable> latticeRowTables(const HeightField& field, const std::vector<LatticeDirection>& directions,
-                                       bool quadrature);
+                                       bool quadrature, bool parity_apart = false);
 
 // The same for the naive march (horizon_naive with HFVIS_ROW_SPACING), one table per ray
 // direction: per row r, the ground length per pixel along the ray with row r's cell sizes, and

@@ -109,7 +109,7 @@ LatticeDirection latticeStep(const HeightField& field, int a, int b) {
 }
 
 std::vector<LatticeDirection> latticeDirections(const HeightField& field, const SweepOptions& options,
-                                                bool exact_azimuths, double tolerance) {
+                                                bool exact_azimuths, double tolerance, bool parity_apart) {
   const std::vector<Candidate> all = candidates(field);
   const int K = options.directions;
   // Quadrature windows are strictly inside each direction's half-spacing.
@@ -136,7 +136,7 @@ std::vector<LatticeDirection> latticeDirections(const HeightField& field, const 
     for (auto& d : out) d.weight = 1.0 / K;
     return out;
   }
-  setQuadratureWeights(out);
+  setQuadratureWeights(out, parity_apart);
   return out;
 }
 
@@ -153,17 +153,30 @@ std::vector<double> halfGapWeights(const std::vector<double>& azimuths) {
   return weights;
 }
 
-void setQuadratureWeights(std::vector<LatticeDirection>& directions) {
+void setQuadratureWeights(std::vector<LatticeDirection>& directions, bool parity_apart) {
   std::vector<double> azimuths;
   for (const LatticeDirection& d : directions) azimuths.push_back(d.azimuth);
   const std::vector<double> weights = halfGapWeights(azimuths);
   const std::size_t K = directions.size();
   for (std::size_t k = 0; k < K; ++k) directions[k].weight = weights[k];
+  // Coinciding neighbours share their half gaps unevenly (the run's inner ones get none); for the
+  // error estimate's halves every slot of a run takes an equal share, so that each parity keeps
+  // the share of the circle its azimuths stand for.
+  const auto same = [&](std::size_t i, std::size_t j) {
+    return directions[i].a == directions[j].a && directions[i].b == directions[j].b;
+  };
+  for (std::size_t k = 0; parity_apart && k < K;) {
+    std::size_t end = k + 1;
+    double total = directions[k].weight;
+    for (; end < K && same(end, k); ++end) total += directions[end].weight;
+    for (std::size_t i = k; i < end; ++i) directions[i].weight = total / double(end - k);
+    k = end;
+  }
   // Where no step lies inside a window (K beyond the lattice's angular resolution near
   // the axes: atan(1/64) = 0.9 deg) neighbours can fall back to the same step: the first
   // one takes their weight and the others get 0, so the sweep runs each step once.
   for (std::size_t k = 1; k < K; ++k) {
-    for (std::size_t m = 0; m < k; ++m) {
+    for (std::size_t m = parity_apart ? k % 2 : 0; m < k; m += parity_apart ? 2 : 1) {
       if (directions[m].a == directions[k].a && directions[m].b == directions[k].b && directions[m].weight > 0.0) {
         directions[m].weight += directions[k].weight;
         directions[k].weight = 0.0;

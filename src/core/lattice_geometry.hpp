@@ -40,11 +40,13 @@ struct LatticeDirection {
 // that no such step comes within `tolerance` of takes the cheapest longer one that does, of up to
 // kMaxExactStep pixels (about 0.014 degree from an axis: a step's cost, its crossings per
 // receiver, is paid once). Quadrature directions that fall back to the same step (very large K)
-// are merged: one carries their weight, the others have weight 0 and are not swept.
+// are merged: one carries their weight, the others have weight 0 and are not swept; with
+// `parity_apart` (the error estimate's halves, HorizonOutputs::error_estimate) only those of
+// the same parity of k, so that each half keeps the azimuths it stands for.
 constexpr int kMaxLatticeStep = 64;
 constexpr int kMaxExactStep = 4096;
 std::vector<LatticeDirection> latticeDirections(const HeightField& field, const SweepOptions& options,
-                                                bool exact_azimuths, double tolerance);
+                                                bool exact_azimuths, double tolerance, bool parity_apart = false);
 
 // The direction of primitive step (a, b) over a field (azimuth and ground length from its
 // cell sizes; weight left 0).
@@ -166,8 +168,9 @@ double angleDifference(double x, double y);
 std::vector<double> halfGapWeights(const std::vector<double>& azimuths);
 
 // Sets the directions' weights from their azimuths (halfGapWeights); steps that coincide
-// are merged: the first takes their weight, the others get 0 and are not swept.
-void setQuadratureWeights(std::vector<LatticeDirection>& directions);
+// are merged: the first takes their weight, the others get 0 and are not swept (with
+// `parity_apart`, only steps whose indices have the same parity).
+void setQuadratureWeights(std::vector<LatticeDirection>& directions, bool parity_apart = false);
 
 // The cell sizes at row y (fractional), linear between the rows' per-row sizes, clamped.
 void cellSizeAtRow(const HeightField& field, double y, double* cell_x, double* cell_y);

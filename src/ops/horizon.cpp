@@ -201,7 +201,7 @@ std::vector<RunDirection> runDirectionsOf(const HeightField& field, const Horizo
   if (options.method == HorizonMethod::Sweep) {
     const std::vector<LatticeDirection> directions = horizonDirections(field, options, outputs);
     std::vector<RowTable> rows;
-    if (hasRowSpacing(field)) rows = latticeRowTables(field, directions, !exactAzimuths(outputs));
+    if (hasRowSpacing(field)) rows = latticeRowTables(field, directions, !exactAzimuths(outputs), outputs.error_estimate);
     for (std::size_t k = 0; k < directions.size(); ++k) {
       const LatticeDirection& d = directions[k];
       std::vector<CellSegment> segments = cellSegments(d, options.samples_per_unit);
@@ -846,10 +846,15 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
     HorizonOutputs estimated = outputs;
     estimated.error_estimate = true;
     attempt.directions = detail::kFirstAutoDirections;
+    int earlier = 0;
+    double earlier_estimate = 0.0;
     for (;;) {
       HorizonResult result = run(estimated);
       if (result.estimated_error <= options.max_error) return result;
-      const int next = detail::directionsForError(attempt.directions, result.estimated_error, options.max_error);
+      const int next = detail::directionsForError(attempt.directions, result.estimated_error, earlier,
+                                                  earlier_estimate, options.max_error);
+      earlier = attempt.directions;
+      earlier_estimate = result.estimated_error;
       if (next > kMaxAutoDirections) {
         std::ostringstream message;
         message << "a maximum error of " << options.max_error << " needs about " << next
