@@ -7,12 +7,13 @@
 # the rounds and the ratios of the medians, and writes the table to bench/out/cost_against.md.
 # On a machine shared with other work the CPU time is the steadier figure.
 #
-#   bench/cost_against.sh [--base COMMIT] [--size N] [-k K] [--rounds R] [--contents "fractal city"]
-#                         [--ops "svf viewcount"]
+#   bench/cost_against.sh [--base COMMIT] [--base-build DIR] [--size N] [-k K] [--rounds R]
+#                         [--contents "fractal city"] [--ops "svf viewcount"]
 #     defaults: --base bad9286 (before the segment peaks), N = 1024, K = 64, R = 5, both contents,
 #     both commands
 #   BUILD_DIR=... this checkout's build (default build/); the baseline is built in
-#   bench/out/base-COMMIT/ (a git worktree, git-ignored).
+#   bench/out/base-COMMIT/ (a git worktree, git-ignored), or --base-build names an existing build
+#   of COMMIT (its hfvis), which is only run, never rebuilt.
 # Contents: "fractal" (data/make_data.py's terrain) and "city" (the city DSM hard case, written
 # by hfvis_bench field).
 set -euo pipefail
@@ -24,15 +25,17 @@ k=64
 rounds=5
 contents="fractal city"
 ops="svf viewcount"
+base_build=
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --base) base=$2; shift ;;
+    --base-build) base_build=$2; shift ;;
     --size) size=$2; shift ;;
     -k) k=$2; shift ;;
     --rounds) rounds=$2; shift ;;
     --contents) contents=$2; shift ;;
     --ops) ops=$2; shift ;;
-    -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,19p' "$0"; exit 0 ;;
     *) echo "cost_against.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
   shift
@@ -44,13 +47,22 @@ data=$root/bench/out/data
 mkdir -p "$out" "$data"
 
 base_sha=$(git -C "$root" rev-parse --short "$base")
-base_dir=$root/bench/out/base-$base_sha
-if [[ ! -d $base_dir ]]; then
-  git -C "$root" worktree add --detach "$base_dir" "$base_sha" > /dev/null
+if [[ -n $base_build ]]; then
+  base_bin=$base_build/hfvis
+  [[ -x $base_bin ]] || { echo "cost_against.sh: no hfvis in $base_build" >&2; exit 2; }
+  echo "== building this checkout in $build_dir (the base: $base_bin as it is)"
+  dirs=("$root")
+else
+  base_dir=$root/bench/out/base-$base_sha
+  if [[ ! -d $base_dir ]]; then
+    git -C "$root" worktree add --detach "$base_dir" "$base_sha" > /dev/null
+  fi
+  base_bin=$base_dir/build/hfvis
+  echo "== building $base_sha in $base_dir/build and this checkout in $build_dir"
+  dirs=("$base_dir" "$root")
 fi
-echo "== building $base_sha in $base_dir/build and this checkout in $build_dir"
-for dir in "$base_dir" "$root"; do
-  b=$base_dir/build
+for dir in "${dirs[@]}"; do
+  b=$dir/build
   [[ $dir == "$root" ]] && b=$build_dir
   cmake -S "$dir" -B "$b" -DCMAKE_BUILD_TYPE=Release > /dev/null
   cmake --build "$b" -j "$(nproc)" --target hfvis_cli hfvis_bench > /dev/null
@@ -94,17 +106,17 @@ table=$out/../cost_against.md
 for op in $ops; do
   for input in "${inputs[@]}"; do
     name=$(basename "$input" .exr)
-    for b in "$base_dir/build" "$build_dir"; do  # warm-up: PoCL compiles and caches the kernels
-      "$b/hfvis" "$op" "$input" -o "$out/warm.tif" -k "$k" -q > /dev/null
+    for bin in "$base_bin" "$build_dir/hfvis"; do  # warm-up: PoCL compiles and caches the kernels
+      "$bin" "$op" "$input" -o "$out/warm.tif" -k "$k" -q > /dev/null
     done
     base_times=() current_times=()
     for ((i = 0; i < rounds; ++i)); do
       if ((i % 2 == 0)); then
-        base_times+=("$(run "$base_dir/build/hfvis" "$op" "$input" -o "$out/base.tif" -k "$k")")
+        base_times+=("$(run "$base_bin" "$op" "$input" -o "$out/base.tif" -k "$k")")
         current_times+=("$(run "$build_dir/hfvis" "$op" "$input" -o "$out/current.tif" -k "$k")")
       else
         current_times+=("$(run "$build_dir/hfvis" "$op" "$input" -o "$out/current.tif" -k "$k")")
-        base_times+=("$(run "$base_dir/build/hfvis" "$op" "$input" -o "$out/base.tif" -k "$k")")
+        base_times+=("$(run "$base_bin" "$op" "$input" -o "$out/base.tif" -k "$k")")
       fi
     done
     tb=$(printf '%s\n' "${base_times[@]}" | cut -d' ' -f1 | median)

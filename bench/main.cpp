@@ -9,10 +9,12 @@
 //       one method on one field: min and median time and core-ns per pixel-direction
 //       (methods: sweep, naive, radius, pyramid, floor)
 //   hfvis_bench visibility [--quick | --tiny] --out DIR [--data DIR] [--dem FILE] [--commit TEXT]
-//                          [--sections LIST]
+//                          [--sections LIST] [--accuracy-contents LIST] [--accuracy-ks LIST]
 //       the intervisibility suite: writes DIR/visibility.csv and DIR/visibility_environment.txt;
 //       --sections runs some of its sections (comma-separated: time, stats, zone, scale,
-//       accuracy; default all)
+//       accuracy; default all); --accuracy-contents and --accuracy-ks (comma-separated) narrow
+//       the accuracy section to those contents (fractal, bricks, sine, blocks, dem, city,
+//       city_dsm) and K
 //   hfvis_bench vis-run FIELD [--method tree|naive] [-k K] [--tuning plain|deferred|default|zone]
 //                       [--zone-steps S] [--reps N]
 //       visible counts by one method on one field: min and median time, statistics
@@ -81,6 +83,7 @@ constexpr const char* kUsage =
     "                   [--outputs angles|svf|ao|device] [--max-distance D] [--reps N]\n"
     "       hfvis_bench visibility [--quick | --tiny] --out DIR [--data DIR] [--dem FILE] [--commit TEXT]\n"
     "                              [--sections time,stats,zone,scale,accuracy]\n"
+    "                              [--accuracy-contents LIST] [--accuracy-ks LIST]\n"
     "       hfvis_bench lighting-time --env ENV [-k K[,K...]] [--reps N] FIELD...\n"
     "       hfvis_bench lighting-error FIELD --env ENV [--samples M] [-k K[,K...]] [--rows R[,R...]]\n"
     "       hfvis_bench vis-run FIELD [--method tree|naive] [-k K] [--tuning plain|deferred|default|zone]\n"
@@ -252,7 +255,7 @@ int checkTruth() {
 
 }  // namespace
 
-// "A,B,C" as its items.
+// "A,B,C" as its items (none for "").
 std::vector<std::string> textList(const std::string& text) {
   std::vector<std::string> out;
   for (std::size_t at = 0; at < text.size();) {
@@ -260,7 +263,6 @@ std::vector<std::string> textList(const std::string& text) {
     out.push_back(text.substr(at, end - at));
     at = end + 1;
   }
-  if (out.empty()) throw Usage("expected a comma-separated list, got '" + text + "'");
   return out;
 }
 
@@ -268,6 +270,7 @@ std::vector<std::string> textList(const std::string& text) {
 std::vector<int> intList(const std::string& text) {
   std::vector<int> out;
   for (const std::string& item : textList(text)) out.push_back(std::stoi(item));
+  if (out.empty()) throw Usage("expected a list of whole numbers, got '" + text + "'");
   return out;
 }
 
@@ -391,16 +394,15 @@ int main(int argc, char** argv) {
       options.commit = args.get("--commit", "unknown");
       options.self_path = std::filesystem::canonical("/proc/self/exe").string();
       if (command == "visibility") {
-        const std::string list = args.get("--sections");
-        for (std::size_t at = 0; at < list.size();) {
-          const std::size_t end = std::min(list.find(',', at), list.size());
-          const std::string name = list.substr(at, end - at);
+        for (const std::string& name : textList(args.get("--sections"))) {
           const auto& known = visibilitySections();
           if (std::find(known.begin(), known.end(), name) == known.end())
             throw Usage("--sections: unknown section '" + name + "' (time, stats, zone, scale, accuracy)");
           options.sections.push_back(name);
-          at = end + 1;
         }
+        options.accuracy_contents = textList(args.get("--accuracy-contents"));
+        const std::string ks = args.get("--accuracy-ks");
+        if (!ks.empty()) options.accuracy_ks = intList(ks);
       }
       args.rejectUnused();
       if (options.out_dir.empty()) throw Usage("suite needs --out DIR");

@@ -1536,7 +1536,10 @@ def main(argv=None):
     out[at:at] = ["## Issue 25 targets (sharp-edged surfaces: city DSMs)", "",
                   "From this run's `results.csv` (mode **%s**; the speed/error plane and the error against samples "
                   "per unit) and `cost_against.md` (bench/cost_against.sh, a separate run on the same machine)."
-                  % env.get("mode", "?"), "", table(["target", "measured", "verdict"], targets25), ""]
+                  % env.get("mode", "?"), "", table(["target", "measured", "verdict"], targets25), "",
+                  "Item 1 for the hull tree (counts, area, the bounce): each interval's peak between two samples "
+                  "enters the tree as an occluder alone; its accuracy and cost: [tree_peaks.md](tree_peaks.md) "
+                  "(not yet on latitude / longitude grids nor for the horizon lists).", ""]
 
     with open(os.path.join(d, "REPORT.md"), "w") as f:
         f.write("\n".join(out) + "\n")

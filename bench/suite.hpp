@@ -24,6 +24,9 @@ struct SuiteOptions {
   std::string self_path;      // this program, re-run for the vectorisation remarks
   // The intervisibility suite's sections to run (visibilitySections()); empty = all.
   std::vector<std::string> sections;
+  // Its accuracy section's contents and K (empty: the mode's).
+  std::vector<std::string> accuracy_contents;
+  std::vector<int> accuracy_ks;
 };
 
 // The generated fields a mode reads from data_dir: (content, N) pairs, N x N each, for

@@ -135,7 +135,10 @@ class VisibilitySuite {
         options_(options),
         config_(visibilityConfigFor(options.mode)),
         out_(out),
-        cores_(std::max(1, context.device().compute_units)) {}
+        cores_(std::max(1, context.device().compute_units)) {
+    if (!options.accuracy_contents.empty()) config_.accuracy_contents = options.accuracy_contents;
+    if (!options.accuracy_ks.empty()) config_.accuracy_ks = options.accuracy_ks;
+  }
 
   // Runs the sections options.sections names (all when empty); records each part's seconds
   // in `environment`.

@@ -39,11 +39,16 @@
 //   HFVIS_STRIPS            intervisibility_lattice sweeps the receivers of one strip of rows
 //                           and resumes each line where the strip before left it (a field in
 //                           strips; not with the bounce)
+//   HFVIS_TREE_PEAKS        between consecutive samples, the surface's highest point where it
+//                           rises above both (kernels/shared/tree_peaks.cl) enters the tree as an
+//                           occluder alone: two slots per step, positions in fixed point
+//                           (position_shift bits below the step); not with per-row spacing
 // Every combination builds the same trees (tests/test_intervisibility.cpp): the options
 // change the work (iterations t, memory traffic), never a result.
 #include "shared/chord_side.cl"
 #include "shared/fast_math.cl"
 #include "shared/sweep_framework.cl"
+#include "shared/tree_peaks.cl"
 
 #ifndef HFVIS_WANT_COUNT
 #define HFVIS_WANT_COUNT 1
@@ -90,6 +95,12 @@
 #if HFVIS_STRIPS && HFVIS_WANT_BOUNCE
 #error "the bounce reads the radiance of every earlier sample: it needs the whole field"
 #endif
+#ifndef HFVIS_TREE_PEAKS
+#define HFVIS_TREE_PEAKS 0
+#endif
+#if HFVIS_TREE_PEAKS && HFVIS_ROW_SPACING
+#error "the peaks' fixed-point positions do not take per-row spacing"
+#endif
 // Statistics need every sample's horizons (Table 2 and Section 6's bound count them all);
 // otherwise only receivers (pixel centres) read theirs.
 #define HFVIS_ALL_HORIZONS (HFVIS_WANT_STATS || HFVIS_WANT_ENTRY_STATS)
@@ -128,14 +139,57 @@
 
 #define HFVIS_LEAF 1  // bit 0 of node.y
 
-// The position of step k of a line (its positions[] from the line's first entry): the step
-// itself, or with per-row spacing its units (whole numbers below 2^24: exact in a float, and
-// so are their differences).
-#if HFVIS_ROW_SPACING
-#define LINE_POSITION(positions, stride, k) ((float)(positions)[(uint)(k) * (stride)].x)
+// Tree slots. With peaks a line has two per step: 2 s for the peak between steps s - 1 and s
+// (an occluder alone; most are never inserted), 2 s + 1 for step s's sample; without, slot s
+// is step s. SAMPLE_OF: the step of a slot's sample or peak; SLOT_OF: a step's sample.
+#if HFVIS_TREE_PEAKS
+#define SAMPLE_OF(slot) ((slot) >> 1)
+#define IS_SAMPLE(slot) ((slot)&1)
+#define SLOT_OF(step) (2 * (step) + 1)
+#define PEAK_SLOT(step) (2 * (step))
 #else
-#define LINE_POSITION(positions, stride, k) ((float)(k))
+#define SAMPLE_OF(slot) (slot)
+#define IS_SAMPLE(slot) 1
+#define SLOT_OF(step) (step)
+#define PEAK_SLOT(step) (step)
 #endif
+
+// One piece of an interval between two samples inside one cell (src/core/lattice_geometry.hpp,
+// TreePiece): ten 4-byte members, read field by field.
+typedef struct {
+  int ox, oy;
+  float fx, fy, dx, dy, t_far, t_near, inv_span;
+  int far_crossing;
+} TreePiece;
+
+// The position of step k's sample (its positions[] from the line's first entry): the step in
+// units of 2^-shift step (shift 0 without peaks), or with per-row spacing its units (whole
+// numbers below 2^24: exact in a float, and so are their differences).
+HFVIS_INLINE float sample_position(__global const int2* positions, uint stride, int shift, int k) {
+#if HFVIS_ROW_SPACING
+  return (float)positions[(uint)k * stride].x;
+#else
+  return (float)(k << shift);
+#endif
+}
+
+// The position of the node in `slot`: a peak's node keeps its position in place of a rank
+// (node.y = position * 2 + leaf flag).
+HFVIS_INLINE float node_position(__global const int2* positions, uint stride, int shift, int slot, int4 node) {
+#if HFVIS_TREE_PEAKS
+  if (!IS_SAMPLE(slot)) return (float)(node.y >> 1);
+#endif
+  return sample_position(positions, stride, shift, SAMPLE_OF(slot));
+}
+
+// The rank of the node in `slot` (present samples before it): a peak's is that of the sample
+// after it, which shares its rank.
+HFVIS_INLINE int node_rank(__global const int4* tree, uint stride, int slot, int4 node) {
+#if HFVIS_TREE_PEAKS
+  if (!IS_SAMPLE(slot)) return tree[(uint)(slot | 1) * stride].y >> 1;
+#endif
+  return node.y >> 1;
+}
 
 // Whether sample x at position px (farther than the next horizon n) is seen over n from
 // receiver r.
@@ -143,21 +197,23 @@ inline int seen_over(float hx, float px, float hn, float pn, float hr, float pr)
   return chord_side(hx, hn, hr, pn - px, pr - pn) <= 0;
 }
 
-// The visible samples between horizon `start` and the next horizon `next` form a prefix
-// (every start of a visible run is a horizon), and are exactly those seen over `next`.
-// Returns the step that ends the prefix: the first present sample hidden behind `next`,
-// or `next`. Heights are read from the tree slots (a slot keeps its sample's height for
-// good; absent samples' slots hold NaN). Without absent samples in between, galloping then
-// bisection (O(log run)); otherwise a scan.
-inline int run_end(__global const int4* tree, __global const int2* positions, uint stride, int start, int next,
-                   float h_next, float p_receiver, float h_receiver, int holes) {
-  const float p_next = LINE_POSITION(positions, stride, next);
+// The visible nodes between horizon `start` and the next horizon `next` (slots) form a
+// prefix (every start of a visible run is a horizon), and are exactly those seen over `next`;
+// so do the samples among them, which are all a run counts (peaks are occluders alone), so
+// only samples are searched. Returns the slot that ends the prefix: the first present sample
+// hidden behind `next`, or `next`. Heights are read from the tree slots (a slot keeps its
+// sample's height for good; absent samples' slots hold NaN). Without absent samples in
+// between, galloping then bisection (O(log run)); otherwise a scan.
+inline int run_end(__global const int4* tree, __global const int2* positions, uint stride, int shift, int start,
+                   int next, float h_next, float p_next, float p_receiver, float h_receiver, int holes) {
+  int lo = SAMPLE_OF(start) - (IS_SAMPLE(start) ? 0 : 1);  // the last sample known visible
+  const int last = SAMPLE_OF(next);
   if (!holes) {
-    int lo = start, hi = next, jump = 1;
+    int hi = last, jump = 1;
     while (lo + jump < hi) {
       int x = lo + jump;
-      if (seen_over(as_float(tree[(uint)x * stride].x), LINE_POSITION(positions, stride, x), h_next, p_next,
-                    h_receiver, p_receiver)) {
+      if (seen_over(as_float(tree[(uint)SLOT_OF(x) * stride].x), sample_position(positions, stride, shift, x), h_next,
+                    p_next, h_receiver, p_receiver)) {
         lo = x;
         jump *= 2;
       } else {
@@ -167,18 +223,19 @@ inline int run_end(__global const int4* tree, __global const int2* positions, ui
     }
     while (hi - lo > 1) {
       int mid = lo + (hi - lo) / 2;
-      if (seen_over(as_float(tree[(uint)mid * stride].x), LINE_POSITION(positions, stride, mid), h_next, p_next,
-                    h_receiver, p_receiver))
+      if (seen_over(as_float(tree[(uint)SLOT_OF(mid) * stride].x), sample_position(positions, stride, shift, mid),
+                    h_next, p_next, h_receiver, p_receiver))
         lo = mid;
       else
         hi = mid;
     }
-    return hi;
+    return hi == last ? next : SLOT_OF(hi);
   }
-  for (int x = start + 1; x < next; ++x) {
-    float hx = as_float(tree[(uint)x * stride].x);
-    if (!isnan(hx) && !seen_over(hx, LINE_POSITION(positions, stride, x), h_next, p_next, h_receiver, p_receiver))
-      return x;
+  for (int x = lo + 1; x < last; ++x) {
+    float hx = as_float(tree[(uint)SLOT_OF(x) * stride].x);
+    if (!isnan(hx) &&
+        !seen_over(hx, sample_position(positions, stride, shift, x), h_next, p_next, h_receiver, p_receiver))
+      return SLOT_OF(x);
   }
   return next;
 }
@@ -193,10 +250,10 @@ inline int run_end(__global const int4* tree, __global const int2* positions, ui
 // their old order, the common case) is not written again.
 typedef struct {
   int head, tail, tail_next;
-  float tail_h;  // the last child's height (the replacement check reads it)
+  float tail_h, tail_p;  // the last child's height and position (the replacement check reads them)
 } RootList;
 
-HFVIS_INLINE void root_append(__global int4* tree, uint stride, RootList* list, int x, float hx,
+HFVIS_INLINE void root_append(__global int4* tree, uint stride, RootList* list, int x, float hx, float px,
                               int x_next_in_memory) {
   if (list->tail == HFVIS_NONE)
     list->head = x;
@@ -205,6 +262,7 @@ HFVIS_INLINE void root_append(__global int4* tree, uint stride, RootList* list, 
   list->tail = x;
   list->tail_next = x_next_in_memory;
   list->tail_h = hx;
+  list->tail_p = px;
 }
 
 // Algorithm 1 below node `top` (the old root, or with deferred writes a child of it already
@@ -214,8 +272,8 @@ HFVIS_INLINE void root_append(__global int4* tree, uint stride, RootList* list, 
 // root's new children in order; its stack is threaded through the `next` links of the
 // nodes on it (a detached child's sibling link is free until it is appended), and `top`
 // returns to the caller. Returns the convexity checks made.
-HFVIS_INLINE uint hull_tree_walk(__global int4* tree, __global const int2* positions, uint stride, int top, int4 node,
-                                 float h, float p, RootList* list) {
+HFVIS_INLINE uint hull_tree_walk(__global int4* tree, __global const int2* positions, uint stride, int shift, int top,
+                                 int4 node, float h, float p, RootList* list) {
   uint t = 0;
   int cur = top;
   for (;;) {
@@ -224,9 +282,9 @@ HFVIS_INLINE uint hull_tree_walk(__global int4* tree, __global const int2* posit
       int4 child = tree[(uint)c * stride];
       ++t;
       // Convex when the parent lies strictly above the chord from the child to the root.
-      const float p_cur = LINE_POSITION(positions, stride, cur);
-      const int side = chord_side(as_float(child.x), as_float(node.x), h, p_cur - LINE_POSITION(positions, stride, c),
-                                  p - p_cur);
+      const float p_cur = node_position(positions, stride, shift, cur, node);
+      const int side = chord_side(as_float(child.x), as_float(node.x), h,
+                                  p_cur - node_position(positions, stride, shift, c, child), p - p_cur);
       if (side <= 0) {
         tree[(uint)cur * stride].z = child.w;  // the next child becomes the first
         tree[(uint)c * stride].w = cur;        // back link to resume the parent
@@ -237,7 +295,9 @@ HFVIS_INLINE uint hull_tree_walk(__global int4* tree, __global const int2* posit
       }
     }
     // A node keeps its `next` in memory: the back link on the walk, the sibling for `top`.
-    if (c != HFVIS_NONE || (node.y & HFVIS_LEAF)) root_append(tree, stride, list, cur, as_float(node.x), node.w);
+    if (c != HFVIS_NONE || (node.y & HFVIS_LEAF))
+      root_append(tree, stride, list, cur, as_float(node.x), node_position(positions, stride, shift, cur, node),
+                  node.w);
     if (cur == top) break;
     cur = node.w;
     node = tree[(uint)cur * stride];
@@ -255,25 +315,27 @@ HFVIS_INLINE uint hull_tree_walk(__global int4* tree, __global const int2* posit
 // second holds for every child (the lowest of lines is concave). The zone holds while the
 // children and their first children stay: until the walk runs, or the receiver passes b2.
 typedef struct {
-  int first, last;  // steps it covers, b1 .. b2 = b1 + HFVIS_SAFE_ZONE_STEPS
-  float z1, z2;     // bound at b1 and b2
-  float margin;     // covers the rounding of the bound: inside only below bound - margin
+  float first, last;  // positions it covers, b1 .. b2 = b1 + HFVIS_SAFE_ZONE_STEPS steps
+  float z1, z2;       // bound at b1 and b2
+  float margin;       // covers the rounding of the bound: inside only below bound - margin
 } SafeZone;
 
-// One root child c (at step c, height hc) with first child g: lowers the bound.
-HFVIS_INLINE void safe_zone_add(SafeZone* z, float hc, int c, float hg, int g) {
-  const float slope = (hc - hg) / (float)(c - g);
-  const float at1 = hc + slope * (float)(z->first - c);
-  const float at2 = hc + slope * (float)(z->last - c);
+// One root child at position c, height hc, with first child at g, height hg: lowers the bound.
+HFVIS_INLINE void safe_zone_add(SafeZone* z, float hc, float c, float hg, float g) {
+  const float slope = (hc - hg) / (c - g);
+  const float at1 = hc + slope * (z->first - c);
+  const float at2 = hc + slope * (z->last - c);
   z->z1 = hf_min(z->z1, at1);
   z->z2 = hf_min(z->z2, at2);
   // |rounding| of at1, at2 and of the interpolation stays within a few ulps of this.
-  z->margin = hf_max(z->margin, fabs(hc) + fabs(slope) * (float)(z->last - c));
+  z->margin = hf_max(z->margin, fabs(hc) + fabs(slope) * (z->last - c));
 }
 
-HFVIS_INLINE void safe_zone_begin(SafeZone* z, int receiver) {
-  z->first = receiver + 1;
-  z->last = receiver + 1 + HFVIS_SAFE_ZONE_STEPS;
+// From just past the receiver at position p (a peak may follow it within the step) over
+// HFVIS_SAFE_ZONE_STEPS steps of `unit` (2^position_shift) positions.
+HFVIS_INLINE void safe_zone_begin(SafeZone* z, float p, float unit) {
+  z->first = p + 1.0f;
+  z->last = z->first + unit * (float)HFVIS_SAFE_ZONE_STEPS;
   z->z1 = z->z2 = FLT_MAX;  // no first grandchild: nothing to stay convex
   z->margin = 0.0f;
 }
@@ -282,10 +344,10 @@ HFVIS_INLINE void safe_zone_begin(SafeZone* z, int receiver) {
 // rounding is absolute, up to 2^-149 per operation).
 HFVIS_INLINE void safe_zone_end(SafeZone* z) { z->margin = z->margin * 0x1p-16f + 0x1p-100f; }
 
-// Whether a sample at `step`, height h is inside (the zone must not have expired).
-HFVIS_INLINE int safe_zone_inside(const SafeZone* z, int step, float h) {
-  const float bound = z->z1 + (z->z2 - z->z1) * ((float)(step - z->first) / (float)HFVIS_SAFE_ZONE_STEPS);
-  return step <= z->last && h < bound - z->margin;
+// Whether a node at position p, height h is inside (the zone must not have expired).
+HFVIS_INLINE int safe_zone_inside(const SafeZone* z, float p, float h) {
+  const float bound = z->z1 + (z->z2 - z->z1) * ((p - z->first) / (z->last - z->first));
+  return p <= z->last && h < bound - z->margin;
 }
 #endif
 
@@ -295,11 +357,12 @@ typedef struct {
   ulong step_sum, weighted_sum, total_m, total_t, total_naive, total_visible;
   int rank, root, prev, prev2, class_last, head, tail, position;
   uint unit_sum, zone_skips;
-  int zone_valid, zone_first, zone_last;
-  float h_prev, h_prev2, p_prev, p_prev2, tail_h, zone_z1, zone_z2, zone_margin;
+  int zone_valid, y_prev, total_peaks;
+  float h_prev, h_prev2, p_prev, p_prev2, tail_h, tail_p, h_sample_prev, zone_first, zone_last, zone_z1, zone_z2,
+      zone_margin;
 } TreeLineState;
 // The host allocates kTreeLineStateBytes (src/core/hull_tree_device.hpp) per line.
-typedef char tree_line_state_is_136_bytes[sizeof(TreeLineState) == 136 ? 1 : -1];
+typedef char tree_line_state_is_152_bytes[sizeof(TreeLineState) == 152 ? 1 : -1];
 // The registers saved and restored, X(register, its TreeLineState field), those of per-row
 // spacing and of the safe zone where compiled in.
 #if HFVIS_ROW_SPACING
@@ -318,7 +381,8 @@ typedef char tree_line_state_is_136_bytes[sizeof(TreeLineState) == 136 ? 1 : -1]
   X(step_sum, step_sum) X(total_m, total_m) X(total_t, total_t) X(total_naive, total_naive)            \
   X(total_visible, total_visible) X(rank, rank) X(root, root) X(prev, prev) X(prev2, prev2)            \
   X(class_last, class_last) X(head, head) X(tail, tail) X(zone_skips, zone_skips) X(h_prev, h_prev)    \
-  X(h_prev2, h_prev2) X(p_prev, p_prev) X(p_prev2, p_prev2) X(tail_h, tail_h) HFVIS_ROW_REGISTERS(X) \
+  X(h_prev2, h_prev2) X(p_prev, p_prev) X(p_prev2, p_prev2) X(tail_h, tail_h) X(tail_p, tail_p)        \
+  X(y_prev, y_prev) X(h_sample_prev, h_sample_prev) X(total_peaks, total_peaks) HFVIS_ROW_REGISTERS(X) \
   HFVIS_ZONE_REGISTERS(X)
 #define HFVIS_RESTORE(reg, field) reg = st.field;
 #define HFVIS_SAVE(reg, field) st.field = reg;
@@ -374,6 +438,7 @@ __kernel void intervisibility_lattice(
     __global const float* heights, int width, int height, __global const int4* lines, int n_lines,
     __global const LatticeSample* samples, int n_samples, int a, int b, float count_factor, float area_factor,
     float drop, int max_steps, __global const int* row_units, __global const float2* row_factors,
+    __global const TreePiece* pieces, __global const int* interval_first, int position_shift,
     __global int4* trees, __global ulong* prefix, __global int2* positions, uint stride, __global float2* visible,
     __global uint4* entry_stats, __global ulong* line_totals, int first_line, __global float* count_sum,
     __global float* area_sum, __global const float* radiance, __global const float* normals,
@@ -395,13 +460,17 @@ __kernel void intervisibility_lattice(
   __global int4* tree = trees + base;
   __global int2* line_positions = positions + base;
   const uint plane = (uint)(width * height);
+  // Positions are in units of 2^-position_shift step: back to steps (exactly) for the drop.
+  const float inv_scale = 1.0f / (float)(1 << position_shift);
 
   int rank = 0;        // present samples before `step`
   ulong step_sum = 0;  // the sum of their steps
   int root = HFVIS_NONE;
-  int prev = HFVIS_NONE, prev2 = HFVIS_NONE;  // the two latest present samples
+  int prev = HFVIS_NONE, prev2 = HFVIS_NONE;  // the two latest present nodes (slots)
   float h_prev = 0.0f, h_prev2 = 0.0f;
   float p_prev = 0.0f, p_prev2 = 0.0f;  // and their positions
+  int y_prev = 0;                       // prev's node.y without the leaf flag
+  float h_sample_prev = NAN;            // the step before's sample (a peak must rise above it)
 #if HFVIS_ROW_SPACING
   int position = 0;        // the current step's, in units
   uint unit_sum = 0;       // over the present samples before it: their steps' units,
@@ -409,13 +478,14 @@ __kernel void intervisibility_lattice(
 #endif
   int class_last = HFVIS_CONVEX;  // Eq. 1 class of prev2 (the first sample is convex)
   int head = HFVIS_NONE, tail = HFVIS_NONE;  // the root's first and last child
-  float tail_h = 0.0f;                       // the last child's height
+  float tail_h = 0.0f, tail_p = 0.0f;        // the last child's height and position
 #if HFVIS_SAFE_ZONE
   SafeZone zone;
   int zone_valid = 0;
 #endif
   uint zone_skips = 0;  // walks the safe zone skipped
   ulong total_m = 0, total_t = 0, total_naive = 0, total_visible = 0;
+  int total_peaks = 0;  // peaks inserted
 #if HFVIS_STRIPS
   __global TreeLineState* state = states + j;
   if (i_begin > 0) {
@@ -432,36 +502,86 @@ __kernel void intervisibility_lattice(
     const int units = row_units[row];  // each step of this period
 #endif
     for (int q = 0; q < n_samples; ++q, ++step) {
-      const uint e = (uint)step * stride;
 #if HFVIS_ROW_SPACING
       if (step > 0) position += units;
-      line_positions[e] = (int2)(position, (int)unit_sum);
-      const float p = (float)position;
+      line_positions[(uint)step * stride] = (int2)(position, (int)unit_sum);
+      const float p_sample = (float)position;
 #else
-      const float p = (float)step;
+      const float p_sample = (float)(step << position_shift);
 #endif
-      const int receiver = q == n_samples - 1;
       __global const LatticeSample* s = samples + q;
       const int x0 = col + s->ox, y0 = row + s->oy, ex = s->ex, ey = s->ey;
-      float h = NAN;
+      float h_sample = NAN;
       if (i > 0 || (x0 >= 0 && x0 + ex <= width - 1 && y0 >= 0 && y0 + ey <= height - 1)) {
         const uint at = (uint)((y0 - row0) * width + x0);
         // The receiver is its pixel's height as it is (1 h + 0 h would make an infinity NaN).
-        h = ex + ey == 0 ? heights[at]
-                         : lattice_height(heights, at, (uint)ex, (uint)(ey * width), s->w00, s->w10, s->w01, s->w11);
+        h_sample = ex + ey == 0
+                       ? heights[at]
+                       : lattice_height(heights, at, (uint)ex, (uint)(ey * width), s->w00, s->w10, s->w01, s->w11);
       }
 #if HFVIS_CURVATURE
       // The Earth's drop from any receiver p, drop (p - step)^2 (drop per step squared), differs
       // from drop step^2 by a term linear in step: every slope seen from p shifts alike, so
       // every visibility decision (and the tree) is that of the heights lowered by drop step^2
       // (positions with per-row spacing).
-      h = h - drop * p * p;
+      const float d_sample = p_sample * inv_scale;
+      h_sample = h_sample - drop * d_sample * d_sample;
 #endif
+#if HFVIS_TREE_PEAKS
+      // The peak between the step before and this one: of the interval's crossings and concave
+      // pieces, the point that stands farthest above the chord of its two samples, where it
+      // stands strictly above it.
+      float h_peak = NAN;
+      int peak_position = 0;
+      if (step > 0 && !isnan(h_sample_prev) && !isnan(h_sample)) {
+        float best_h = -INFINITY, best_excess = 0.0f;
+        int offset = 0;
+        TreePieceCurve curve;  // the piece before (set by the first piece, which has no crossing)
+        const float rise = h_sample - h_sample_prev;
+        for (int k = interval_first[q]; k < interval_first[q + 1]; ++k) {
+          __global const TreePiece* g = pieces + k;
+          const int px = col + g->ox, py = row + g->oy;
+          if (i == 0 && (px < 0 || px + 1 > width - 1 || py < 0 || py + 1 > height - 1)) {
+            best_h = NAN;
+            break;
+          }
+          const uint at = (uint)((py - row0) * width + px);
+          tree_piece_peak(heights[at], heights[at + 1], heights[at + (uint)width], heights[at + (uint)width + 1], g->fx,
+                          g->fy, g->dx, g->dy, g->t_far, g->t_near, g->inv_span, g->far_crossing, h_sample_prev, rise,
+                          position_shift, &curve, &best_h, &offset, &best_excess);
+        }
+        if (best_h > -INFINITY) {  // (not NaN)
+          peak_position = ((step - 1) << position_shift) + offset;
+#if HFVIS_CURVATURE
+          const float d_peak = (float)peak_position * inv_scale;
+          best_h = best_h - drop * d_peak * d_peak;
+#endif
+          if (tree_peak_inserted(h_sample_prev, best_h, h_sample, offset, position_shift)) h_peak = best_h;
+        }
+      }
+#endif
+      uint t = 0, skipped = 0;  // the step's convexity checks and skipped walks, its peak's included
+      // The step's nodes: its peak (where there is one), then its sample.
+#if HFVIS_TREE_PEAKS
+      for (int part = 0; part < 2; ++part) {
+        const int is_peak = part == 0, slot = 2 * step + part;
+        const float h = is_peak ? h_peak : h_sample;
+        const float p = is_peak ? (float)peak_position : p_sample;
+        if (is_peak && isnan(h)) continue;
+#else
+      for (int part = 1; part < 2; ++part) {
+        const int is_peak = 0, slot = step, peak_position = 0;
+        const float h = h_sample, p = p_sample;
+#endif
+      const uint e = (uint)slot * stride;
+      const int receiver = !is_peak && q == n_samples - 1;
+      if (!is_peak) {
 #if HFVIS_ROW_SPACING && HFVIS_WANT_AREA
-      prefix[base + e] = weighted_sum;
+        prefix[base + e] = weighted_sum;
 #elif HFVIS_HAS_NODATA && HFVIS_WANT_AREA  // step sums serve runs with holes only
-      prefix[base + e] = step_sum;
+        prefix[base + e] = step_sum;
 #endif
+      }
       if (isnan(h)) {
         tree[e] = (int4)(as_int(NAN), rank * 2, HFVIS_NONE, HFVIS_NONE);  // its rank, for clipped runs
 #if HFVIS_WANT_ENTRY_STATS
@@ -481,7 +601,9 @@ __kernel void intervisibility_lattice(
         }
         continue;
       }
-      uint m = 0, t = 0, hash = 2166136261u, skipped = 0;
+      // A sample's node.y holds its rank, a peak's its position (it counts nothing).
+      const int y_node = is_peak ? peak_position * 2 : rank * 2;
+      uint m = 0, hash = 2166136261u;
       int count = 0;
       ulong distance_sum = 0;
 #if HFVIS_WANT_BOUNCE
@@ -496,7 +618,7 @@ __kernel void intervisibility_lattice(
       } else {
         // 1. Algorithm 1 for the new root: the old root is its only child; the walk gives the
         // root's children in order.
-        RootList list = {HFVIS_NONE, HFVIS_NONE, HFVIS_NONE, 0.0f};
+        RootList list = {HFVIS_NONE, HFVIS_NONE, HFVIS_NONE, 0.0f, 0.0f};
         const int4 old_root = tree[(uint)root * stride];
         int walk = 1;
 #if HFVIS_REPLACEMENT_CHECK
@@ -507,19 +629,20 @@ __kernel void intervisibility_lattice(
         int replaced = 0;
         if (tail != HFVIS_NONE) {
           ++t;
-          replaced = chord_side(tail_h, h_prev, h, p_prev - LINE_POSITION(line_positions, stride, tail), p - p_prev) <= 0;
+          replaced = chord_side(tail_h, h_prev, h, p_prev - tail_p, p - p_prev) <= 0;
         }
 #endif
 #if HFVIS_SAFE_ZONE
-        zone_valid = zone_valid && replaced && safe_zone_inside(&zone, step, h);
+        zone_valid = zone_valid && replaced && safe_zone_inside(&zone, p, h);
         if (zone_valid) {
           // The old root's children are the new root's, and the old root is deleted (it is
           // no leaf: only a line's first sample is a leaf as root, and it has no children).
           walk = 0;
-          skipped = 1;
+          ++skipped;
           list.head = head;
           list.tail = tail;
           list.tail_h = tail_h;
+          list.tail_p = tail_p;
         }
 #endif
 #if !HFVIS_REPLACEMENT_CHECK
@@ -536,47 +659,49 @@ __kernel void intervisibility_lattice(
             if (!replaced) {
               if (HFVIS_REPLACEMENT_CHECK && c == tail) break;  // known to pass
               ++t;
-              if (chord_side(as_float(child.x), h_prev, h, p_prev - LINE_POSITION(line_positions, stride, c),
-                             p - p_prev) > 0)
+              if (chord_side(as_float(child.x), h_prev, h,
+                             p_prev - node_position(line_positions, stride, position_shift, c, child), p - p_prev) > 0)
                 break;
             }
-            t += hull_tree_walk(tree, line_positions, stride, c, child, h, p, &list);
+            t += hull_tree_walk(tree, line_positions, stride, position_shift, c, child, h, p, &list);
             c = child.w;
           }
           if (c != HFVIS_NONE || (old_root.y & HFVIS_LEAF)) {  // it stays, as the last child
             if (c != old_root.z) tree[(uint)root * stride].z = c;
-            root_append(tree, stride, &list, root, h_prev, HFVIS_NONE);
+            root_append(tree, stride, &list, root, h_prev, p_prev, HFVIS_NONE);
           }
 #else
-          t += hull_tree_walk(tree, line_positions, stride, root, old_root, h, p, &list);
+          t += hull_tree_walk(tree, line_positions, stride, position_shift, root, old_root, h, p, &list);
 #endif
         }
 
-        // 2. Now that the old root's next sample is known, classify it (Eq. 1). A convex
-        // sample after a concave one starts a segment: if its node survived it is the root's
-        // last child and becomes a leaf; otherwise a new leaf becomes the last child.
+        // 2. Now that the old root's next node is known, classify it (Eq. 1). A convex node
+        // after a concave one starts a segment: if its node survived it is the root's last
+        // child and becomes a leaf; otherwise a new leaf becomes the last child.
         if (prev2 != HFVIS_NONE) {
           const int side = chord_side(h_prev2, h_prev, h, p_prev - p_prev2, p - p_prev);
           const int cls = side > 0 ? HFVIS_CONVEX : side < 0 ? HFVIS_CONCAVE : class_last;
           if (cls == HFVIS_CONVEX && class_last == HFVIS_CONCAVE) {
             if (list.tail == prev) {
-              tree[(uint)prev * stride].y = (rank - 1) * 2 + HFVIS_LEAF;
+              tree[(uint)prev * stride].y = y_prev + HFVIS_LEAF;
             } else {
-              tree[(uint)prev * stride] = (int4)(as_int(h_prev), (rank - 1) * 2 + HFVIS_LEAF, HFVIS_NONE, HFVIS_NONE);
-              root_append(tree, stride, &list, prev, h_prev, HFVIS_NONE);
+              tree[(uint)prev * stride] = (int4)(as_int(h_prev), y_prev + HFVIS_LEAF, HFVIS_NONE, HFVIS_NONE);
+              root_append(tree, stride, &list, prev, h_prev, p_prev, HFVIS_NONE);
             }
           }
           class_last = cls;
         }
         if (!HFVIS_DEFERRED_WRITES || list.tail_next != HFVIS_NONE) tree[(uint)list.tail * stride].w = HFVIS_NONE;
-        tree[e] = (int4)(as_int(h), rank * 2, list.head, HFVIS_NONE);
+        tree[e] = (int4)(as_int(h), y_node, list.head, HFVIS_NONE);
         head = list.head;
         tail = list.tail;
         tail_h = list.tail_h;
+        tail_p = list.tail_p;
 
         // 3. At a receiver (at every sample for statistics), the visible samples from the
         // horizons, farthest first: the run of horizon hp ends at run_end() before the next
-        // horizon np, or at the sample.
+        // horizon np, or at the sample. Runs are slots; what they count are the samples among
+        // them (SAMPLE_OF), never the peaks.
         // Without absent samples in between, ranks and distance sums follow from the steps
         // alone. The safe zone for the next samples is refreshed here, where the root's
         // children (the horizons) are visited anyway.
@@ -599,49 +724,59 @@ __kernel void intervisibility_lattice(
 #endif
 #if HFVIS_SAFE_ZONE
           const int refresh_zone = !zone_valid;
-          if (refresh_zone) safe_zone_begin(&zone, step);
+          if (refresh_zone) safe_zone_begin(&zone, p, (float)(1 << position_shift));
 #endif
           int hp = head;
           int4 hz = tree[(uint)hp * stride];
-          int hp_rank = hz.y >> 1;
+          int hp_rank = node_rank(tree, stride, hp, hz);
           for (;;) {
             const int np = hz.w;
             ++m;
 #if HFVIS_SAFE_ZONE
-            if (refresh_zone && hz.z != HFVIS_NONE)
-              safe_zone_add(&zone, as_float(hz.x), hp, as_float(tree[(uint)hz.z * stride].x), hz.z);
+            if (refresh_zone && hz.z != HFVIS_NONE) {
+              const int4 g = tree[(uint)hz.z * stride];
+              safe_zone_add(&zone, as_float(hz.x), node_position(line_positions, stride, position_shift, hp, hz),
+                            as_float(g.x), node_position(line_positions, stride, position_shift, hz.z, g));
+            }
 #endif
             hash = (hash ^ (uint)hp) * 16777619u;
-            int end = step, end_rank = rank, np_rank = rank;
+            int end = slot, end_rank = rank, np_rank = rank;
             int4 nz = hz;
             if (np != HFVIS_NONE) {
               nz = tree[(uint)np * stride];
-              np_rank = nz.y >> 1;
+              np_rank = node_rank(tree, stride, np, nz);
               end = np;
               end_rank = np_rank;
             }
             // Absent samples lie between present ones only where heights are missing: a line
             // enters the (convex) field once, and leaves it at its last receiver.
-            const int holes = HFVIS_HAS_NODATA && end_rank - hp_rank != end - hp;
+            const int holes = HFVIS_HAS_NODATA && end_rank - hp_rank != SAMPLE_OF(end) - SAMPLE_OF(hp);
             if (np != HFVIS_NONE) {
-              end = run_end(tree, line_positions, stride, hp, np, as_float(nz.x), p, h, holes);
-              end_rank = end == np ? np_rank : holes ? tree[(uint)end * stride].y >> 1 : hp_rank + (end - hp);
+              end = run_end(tree, line_positions, stride, position_shift, hp, np, as_float(nz.x),
+                            node_position(line_positions, stride, position_shift, np, nz), p, h, holes);
+              end_rank = end == np ? np_rank
+                         : holes   ? tree[(uint)end * stride].y >> 1
+                                   : hp_rank + (SAMPLE_OF(end) - SAMPLE_OF(hp));
             }
 #if HFVIS_WANT_BOUNCE
             for (int x = hp; receiver && x < end; ++x) {
+              if (!IS_SAMPLE(x)) continue;  // peaks carry no radiance
               const float hx = as_float(tree[(uint)x * stride].x);
               if (!isnan(hx)) {
                 float emitted[HFVIS_CHANNELS];
-                lattice_radiance(radiance, width, plane, line, samples, n_samples, a, b, x, emitted);
-                bounce_visit(&gather, hx, x, emitted);
+                lattice_radiance(radiance, width, plane, line, samples, n_samples, a, b, SAMPLE_OF(x), emitted);
+                bounce_visit(&gather, hx, SAMPLE_OF(x), emitted);
               }
             }
-            gather.adjacent = end == np;
+            gather.adjacent = end == np;  // no hidden node before the next visible one
 #endif
             // Within the maximum distance only the run's samples from `first` on count (terrain
-            // farther away neither counts nor hides anything nearer). Every slot holds its rank.
-            const int first = max(hp, cut);
-            const int first_rank = first == hp ? hp_rank : holes ? tree[(uint)first * stride].y >> 1 : hp_rank + (first - hp);
+            // farther away neither counts nor hides anything nearer): from the slot of the first
+            // step within it (its peak's). Every sample's slot holds its rank.
+            const int first = cut > SAMPLE_OF(hp) ? PEAK_SLOT(cut) : hp;
+            const int first_rank = first == hp ? hp_rank
+                                   : holes     ? tree[(uint)SLOT_OF(SAMPLE_OF(first)) * stride].y >> 1
+                                               : hp_rank + (SAMPLE_OF(first) - SAMPLE_OF(hp));
             const int run = first < end ? end_rank - first_rank : 0;
             count += run;
 #if HFVIS_WANT_AREA
@@ -658,10 +793,10 @@ __kernel void intervisibility_lattice(
             ulong steps_sum = 0;
             if (run == 0) {
             } else if (!holes) {  // x = first .. end - 1
-              steps_sum = (ulong)run * (ulong)(first + end - 1) / 2;
+              steps_sum = (ulong)run * (ulong)(SAMPLE_OF(first) + SAMPLE_OF(end) - 1) / 2;
             } else {
-              const ulong end_sum = end == step ? step_sum : prefix[base + (uint)end * stride];
-              steps_sum = end_sum - prefix[base + (uint)first * stride];
+              const ulong end_sum = end == slot ? step_sum : prefix[base + (uint)SLOT_OF(SAMPLE_OF(end)) * stride];
+              steps_sum = end_sum - prefix[base + (uint)SLOT_OF(SAMPLE_OF(first)) * stride];
             }
             distance_sum += (ulong)step * (ulong)run - steps_sum;
 #endif
@@ -697,6 +832,19 @@ __kernel void intervisibility_lattice(
         for (int ch = 0; ch < HFVIS_CHANNELS; ++ch) irradiance[(uint)ch * plane + pixel] += gathered[ch];
 #endif
       }
+      prev2 = prev;
+      h_prev2 = h_prev;
+      p_prev2 = p_prev;
+      prev = slot;
+      h_prev = h;
+      p_prev = p;
+      y_prev = y_node;
+      root = slot;
+      if (is_peak) {  // (its horizons count in the statistics' bound, t <= 2 m + n, n its nodes)
+        ++total_peaks;
+        total_m += m;
+        continue;
+      }
 #if HFVIS_WANT_ENTRY_STATS
       visible[base + e] = (float2)((float)count, (float)distance_sum);
       entry_stats[base + e] = (uint4)(m, t, hash, skipped);
@@ -704,15 +852,6 @@ __kernel void intervisibility_lattice(
       total_m += m;
       total_naive += (ulong)rank;
       total_visible += (ulong)count;
-      total_t += t;
-      zone_skips += skipped;
-      prev2 = prev;
-      h_prev2 = h_prev;
-      p_prev2 = p_prev;
-      prev = step;
-      h_prev = h;
-      p_prev = p;
-      root = step;
       ++rank;
       step_sum += (ulong)step;
 #if HFVIS_ROW_SPACING
@@ -722,6 +861,10 @@ __kernel void intervisibility_lattice(
       unit_sum += (uint)ring;
       weighted_sum += (ulong)position * (ulong)ring;
 #endif
+      }
+      total_t += t;
+      zone_skips += skipped;
+      h_sample_prev = h_sample;
     }
   }
 #if HFVIS_STRIPS
@@ -737,7 +880,7 @@ __kernel void intervisibility_lattice(
   totals[3] = total_naive;
   totals[4] = total_visible;
   totals[5] = (ulong)zone_skips;
-  totals[6] = 0;
+  totals[6] = (ulong)total_peaks;
   totals[7] = 0;
 #endif
 }

@@ -10,9 +10,10 @@
 #include <limits>
 
 #include "core/chord_side.hpp"
-#include "hfvis/errors.hpp"
 #include "core/horizon_common.hpp"
 #include "core/hull_tree.hpp"
+#include "core/tree_peaks.hpp"
+#include "hfvis/errors.hpp"
 #include "reference_internal.hpp"
 
 namespace hfvis {
@@ -45,24 +46,20 @@ void sweepReference(const HeightField& field, const std::vector<float>& h,
   std::vector<PixelSums> sums(field.pixelCount());
   auto& stats = result.statistics;
   for (const TreeDirection& d : treeDirections(field, options)) {
-    IntervisibilityLines lines = latticeTreeLines(field, h, d);
-    // The kernel's curvature transform: every sample lowered by drop * position^2 (the step,
-    // or its units with per-row spacing).
-    if (options.curvature != 0.0) {
-      for (int i = 0; i < lines.geometry.n_steps; ++i)
-        for (int j = 0; j < lines.geometry.n_lines; ++j) {
-          const std::size_t e = static_cast<std::size_t>(i) * lines.geometry.n_lines + j;
-          const float p = lines.positions.empty() ? static_cast<float>(i) : static_cast<float>(lines.positions[e]);
-          lines.samples[e] = lines.samples[e] - d.drop * p * p;
-        }
-    }
+    IntervisibilityLines lines = latticeTreeLines(field, h, d, options.curvature != 0.0);
     lines.horizons_at_every_sample = statistics;  // as the kernel without statistics
     sweepPresampledLines(lines, options.tree, false);
     const auto& g = lines.geometry;
     for (int j = 0; j < g.n_lines; ++j) {
-      std::uint64_t n = 0, m = 0, t = 0;
+      std::uint64_t n = 0, m = 0, t = 0, peaks = 0;
       for (int i = 0; i < g.n_steps; ++i) {
         const std::size_t e = static_cast<std::size_t>(i) * g.n_lines + j;
+        if (i > 0 && d.peaks() &&  // inserted where it rises above the chord of the samples
+            tree_peak_inserted(lines.samples[e - g.n_lines], lines.peaks[e], lines.samples[e],
+                               lines.peak_offsets[e], d.position_shift)) {
+          ++peaks;
+          m += lines.peak_horizons[e];
+        }
         if (std::isnan(lines.samples[e])) continue;
         stats.naive_iterations += n;
         ++n;
@@ -75,7 +72,7 @@ void sweepReference(const HeightField& field, const std::vector<float>& h,
       stats.horizons += m;
       stats.iterations += t;
       stats.lines += n > 0;
-      stats.lines_over_bound += t > 2 * m + n;
+      stats.lines_over_bound += t > 2 * m + n + peaks;  // nodes: samples and peaks
       // Receivers add their counts to their pixels, as intervisibility_lattice.
       for (int i = lines.receiver_every - 1; i < d.lines[j].receivers * lines.receiver_every;
            i += lines.receiver_every) {
@@ -164,7 +161,7 @@ void naiveReference(const HeightField& field, const std::vector<float>& h,
 }  // namespace
 
 IntervisibilityLines latticeTreeLines(const HeightField& field, const std::vector<float>& prepared_heights,
-                                      const TreeDirection& d) {
+                                      const TreeDirection& d, bool curvature) {
   const int width = field.width, height = field.height;
   const std::size_t per_period = d.samples.size();
   IntervisibilityLines out = canonicalTreeLines(d);
@@ -184,7 +181,61 @@ IntervisibilityLines latticeTreeLines(const HeightField& field, const std::vecto
       }
     }
   }
+  // The kernel's curvature transform: every sample lowered by drop * position^2 (the step,
+  // or its units with per-row spacing).
+  if (curvature) {
+    for (std::size_t e = 0; e < out.samples.size(); ++e) {
+      const float p = out.positions.empty() ? static_cast<float>(e / d.lines.size())
+                                            : static_cast<float>(out.positions[e]);
+      out.samples[e] = out.samples[e] - d.drop * p * p;
+    }
+  }
+  if (d.peaks()) addTreePeaks(field, prepared_heights, d, curvature, out);
   return out;
+}
+
+void addTreePeaks(const HeightField& field, const std::vector<float>& heights, const TreeDirection& d,
+                  bool curvature, IntervisibilityLines& lines) {
+  const int width = field.width, height = field.height;
+  const std::size_t per_period = d.samples.size();
+  for (std::size_t j = 0; j < d.lines.size(); ++j) {
+    const LatticeLine& line = d.lines[j];
+    int c = line.col, r = line.row;
+    std::size_t step = 0;
+    for (int i = 0; i < line.receivers; ++i, c -= d.lattice.a, r -= d.lattice.b) {
+      for (std::size_t q = 0; q < per_period; ++q, ++step) {
+        const std::size_t e = step * d.lines.size() + j;
+        if (step == 0) continue;  // no step before it
+        // As intervisibility_lattice: of the interval's crossings and concave pieces, the point
+        // farthest above the chord of its samples.
+        const float far = lines.samples[e - d.lines.size()], near = lines.samples[e];
+        if (std::isnan(far) || std::isnan(near)) continue;
+        float best_h = -INFINITY, best_excess = 0.0f;
+        int offset = 0;
+        TreePieceCurve curve{};
+        for (int k = d.intervals.first[q]; k < d.intervals.first[q + 1]; ++k) {
+          const TreePiece& g = d.intervals.pieces[k];
+          const int x0 = c + g.ox, y0 = r + g.oy;
+          if (i == 0 && (x0 < 0 || x0 + 1 > width - 1 || y0 < 0 || y0 + 1 > height - 1)) {
+            best_h = NAN;
+            break;
+          }
+          const std::size_t at = static_cast<std::size_t>(y0) * width + x0;
+          tree_piece_peak(heights[at], heights[at + 1], heights[at + width], heights[at + width + 1], g.fx,
+                          g.fy, g.dx, g.dy, g.t_far, g.t_near, g.inv_span, g.far_crossing, far, near - far,
+                          d.position_shift, &curve, &best_h, &offset, &best_excess);
+        }
+        if (!(best_h > -INFINITY)) continue;  // none, or NaN
+        lines.peak_offsets[e] = offset;
+        lines.peaks[e] = best_h;
+        if (curvature) {  // at its own position, in steps
+          const float q = static_cast<float>((static_cast<int>(step - 1) << d.position_shift) + offset) /
+                          static_cast<float>(1 << d.position_shift);
+          lines.peaks[e] = best_h - d.drop * q * q;
+        }
+      }
+    }
+  }
 }
 
 std::size_t receiverPixel(const TreeDirection& d, int width, int j, int i) {

@@ -47,10 +47,14 @@ float latticeHeight(const std::vector<float>& h, std::size_t at, std::size_t rig
                     const LatticeSample& s);
 
 // The canonical lines of tree direction d over prepared heights (or any plane sampled like
-// them), as intervisibility_lattice samples them: geometry, receiver_every and samples set,
-// nothing swept yet.
+// them), as intervisibility_lattice samples them: geometry, receiver_every, samples and peaks
+// set (with `curvature`, lowered by d.drop times their position squared), nothing swept yet.
 IntervisibilityLines latticeTreeLines(const HeightField& field, const std::vector<float>& prepared_heights,
-                                      const TreeDirection& d);
+                                      const TreeDirection& d, bool curvature = false);
+// Sets the peaks of lines (canonical lines of d, d.peaks(), samples set) from the heights, as
+// intervisibility_lattice computes them (kernels/shared/tree_peaks.cl).
+void addTreePeaks(const HeightField& field, const std::vector<float>& heights, const TreeDirection& d,
+                  bool curvature, IntervisibilityLines& lines);
 
 // The pixel of the receiver at step i (a receiver step) of line j of d.
 std::size_t receiverPixel(const TreeDirection& d, int width, int j, int i);

@@ -9,15 +9,16 @@
 #include <cmath>
 #include <random>
 
-#include "ops/bounce_internal.hpp"
 #include "core/chord_side.hpp"
+#include "core/lattice_geometry.hpp"
+#include "core/tree_peaks.hpp"
 #include "hfvis/bounce.hpp"
-#include "hfvis_testing/bounce_reference.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
 #include "hfvis/image_io.hpp"
+#include "hfvis_testing/bounce_reference.hpp"
 #include "hfvis_testing/synthetic_fields.hpp"
-#include "core/lattice_geometry.hpp"
+#include "ops/bounce_internal.hpp"
 #include "test_support.hpp"
 
 namespace hfvis {
@@ -92,48 +93,70 @@ Wedge wedgeFor(const float* normal, double cos_az, double sin_az, double sector)
 }
 
 // Expected irradiance of every present receiver entry of line j: for receiver r, sample x
-// (farther) is visible when no present sample strictly between lies strictly above the chord
+// (farther) is visible when no present node (a sample, or a peak between two samples, an
+// occluder alone: detail::IntervisibilityLines) strictly between lies strictly above the chord
 // x-r. The visible samples' elevations split into bands: at the mean elevation between two
-// visible samples with no hidden present sample between them, else at the nearer one's
-// elevation. `sector`: the direction's wedge of azimuth.
+// visible samples with no hidden node between them, else at the nearer one's elevation.
+// `sector`: the direction's wedge of azimuth.
 void expectBruteForceGather(const detail::BounceLineView& view, double sector) {
   const auto& d = view.lines.geometry;
   const int channels = view.bounce.channels, stride = channels + detail::kBounceNormalFloats;
   const int every = view.lines.receiver_every;
   const double ground = view.bounce.step_ground;
+  const int shift = view.lines.position_shift;
   for (int j = 0; j < d.n_lines; ++j) {
-    std::vector<int> steps;
-    for (int i = 0; i < d.n_steps; ++i)
-      if (!std::isnan(view.lines.samples[std::size_t(i) * d.n_lines + j])) steps.push_back(i);
-    auto height = [&](int k) { return view.lines.samples[std::size_t(steps[k]) * d.n_lines + j]; };
-    for (int r = 0; r < static_cast<int>(steps.size()); ++r) {
-      if (steps[r] % every != every - 1) continue;  // not a receiver
-      const std::size_t er = std::size_t(steps[r]) * d.n_lines + j;
-      // Visible flags, nearest first, keeping the steepest sample so far.
+    struct Node {
+      int step;           // of the sample, or of the sample after the peak
+      float h, position;  // position in 2^-shift steps
+      bool peak;
+    };
+    std::vector<Node> nodes;
+    for (int i = 0; i < d.n_steps; ++i) {
+      const std::size_t e = std::size_t(i) * d.n_lines + j;
+      const float h = view.lines.samples[e];
+      if (shift > 0 && i > 0 &&
+          detail::tree_peak_inserted(view.lines.samples[e - d.n_lines], view.lines.peaks[e], h,
+                                     view.lines.peak_offsets[e], shift))
+        nodes.push_back(
+            {i, view.lines.peaks[e], float(((i - 1) << shift) + view.lines.peak_offsets[e]), true});
+      if (!std::isnan(h)) nodes.push_back({i, h, float(i << shift), false});
+    }
+    auto height = [&](int k) { return nodes[k].h; };
+    for (int r = 0; r < static_cast<int>(nodes.size()); ++r) {
+      if (nodes[r].peak || nodes[r].step % every != every - 1) continue;  // not a receiver
+      const std::size_t er = std::size_t(nodes[r].step) * d.n_lines + j;
+      // Visible flags, nearest first, keeping the steepest node so far.
       std::vector<bool> visible(r, false);
       int best = -1;
       for (int x = r - 1; x >= 0; --x) {
-        const bool hidden =
-            best >= 0 && detail::chordSide(height(x), height(best), height(r), float(steps[best] - steps[x]),
-                                           float(steps[r] - steps[best])) > 0;
+        const bool hidden = best >= 0 && detail::chordSide(height(x), height(best), height(r),
+                                                           nodes[best].position - nodes[x].position,
+                                                           nodes[r].position - nodes[best].position) > 0;
         if (!hidden) visible[x] = true, best = x;
       }
+      auto adjacent = [&](int a, int b) {  // no hidden node between visible samples a < b
+        for (int k = a + 1; k < b; ++k)
+          if (!visible[k]) return false;
+        return true;
+      };
+      std::vector<int> seen;  // visible samples, farthest first
+      for (int x = 0; x < r; ++x)
+        if (visible[x] && !nodes[x].peak) seen.push_back(x);
+      std::vector<int> steps(nodes.size());
+      for (std::size_t k = 0; k < nodes.size(); ++k) steps[k] = nodes[k].step;
       const Wedge w =
           wedgeFor(&view.bounce.attributes[er * stride + channels], d.cos_azimuth, d.sin_azimuth, sector);
-      std::vector<int> seen;  // farthest first
-      for (int x = 0; x < r; ++x)
-        if (visible[x]) seen.push_back(x);
       std::vector<double> theta(seen.size());
       for (std::size_t v = 0; v < seen.size(); ++v)
         theta[v] = std::atan2(double(height(seen[v])) - height(r), (steps[r] - steps[seen[v]]) * ground);
       std::vector<double> expected(channels, 0.0);
       for (std::size_t v = 0; v < seen.size(); ++v) {
         // Neighbours in the visible order: farther (v - 1) and nearer (v + 1); adjacent
-        // when no present sample between them (they are consecutive present samples).
+        // when no hidden node lies between them.
         double hi = theta[v], lo = theta[v];
-        if (v > 0 && seen[v - 1] == seen[v] - 1) hi = 0.5 * (theta[v - 1] + theta[v]);
+        if (v > 0 && adjacent(seen[v - 1], seen[v])) hi = 0.5 * (theta[v - 1] + theta[v]);
         if (v + 1 < seen.size())
-          lo = seen[v + 1] == seen[v] + 1 ? 0.5 * (theta[v] + theta[v + 1]) : theta[v + 1];
+          lo = adjacent(seen[v], seen[v + 1]) ? 0.5 * (theta[v] + theta[v + 1]) : theta[v + 1];
         const std::size_t ex = std::size_t(steps[seen[v]]) * d.n_lines + j;
         for (int c = 0; c < channels; ++c)
           expected[c] += view.bounce.attributes[ex * stride + c] * (w.g(hi) - w.g(lo));
@@ -141,7 +164,7 @@ void expectBruteForceGather(const detail::BounceLineView& view, double sector) {
       for (int c = 0; c < channels; ++c) {
         const float actual = view.bounce.irradiance[er * channels + c];
         ASSERT_NEAR(actual, expected[c], 2e-5 * (1.0 + std::abs(expected[c])))
-            << "line " << j << " receiver step " << steps[r] << " channel " << c;
+            << "line " << j << " receiver step " << nodes[r].step << " channel " << c;
       }
     }
   }

@@ -17,14 +17,15 @@
 #include <set>
 
 #include "core/chord_side.hpp"
+#include "core/horizon_common.hpp"
+#include "core/hull_tree.hpp"
+#include "core/lattice_geometry.hpp"
+#include "core/tree_peaks.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/image_io.hpp"
 #include "hfvis/intervisibility.hpp"
 #include "hfvis_testing/intervisibility_reference.hpp"
 #include "hfvis_testing/synthetic_fields.hpp"
-#include "core/horizon_common.hpp"
-#include "core/hull_tree.hpp"
-#include "core/lattice_geometry.hpp"
 #include "reference_internal.hpp"
 #include "test_support.hpp"
 
@@ -169,24 +170,37 @@ TEST(IntervisibilityPredicate, ChordSideIsExactOnRandomAndNearCollinearTriples) 
 // from the receiver among samples j .. receiver - 1, per segment start j).
 
 struct LineSample {
-  int step;
+  int step;  // its tree slot: the step, or with peaks 2 step + 1 (a peak: 2 step)
   float h;
-  float position;  // the step, or its units with per-row spacing
+  float position;  // the step, or its units with per-row spacing, or with peaks in 2^-shift steps
+  float distance;  // the step, or its units with per-row spacing (what distance sums add)
   float ring;      // 1, or the units of its step toward the receivers (its ring width)
+  bool peak;       // an occluder alone: never counted
 };
 
-// The present samples of line j, in sweep order (far end first).
+// The present nodes of line j, in sweep order (far end first): its samples and, with peaks,
+// those that rise above both samples around them.
 std::vector<LineSample> presentSamples(const detail::IntervisibilityLines& lines, int j) {
   std::vector<LineSample> present;
   const auto& d = lines.geometry;
+  const int shift = lines.position_shift;
   for (int i = 0; i < d.n_steps; ++i) {
     const std::size_t e = static_cast<std::size_t>(i) * d.n_lines + j;
     const float h = lines.samples[e];
+    if (shift > 0 && i > 0) {
+      const float peak = lines.peaks[e];
+      if (detail::tree_peak_inserted(lines.samples[e - d.n_lines], peak, h, lines.peak_offsets[e], shift))
+        present.push_back(
+            {2 * i, peak, float(((i - 1) << shift) + lines.peak_offsets[e]), float(i), 1.0f, true});
+    }
     if (std::isnan(h)) continue;
-    if (lines.positions.empty())
-      present.push_back({i, h, float(i), 1.0f});
+    if (shift > 0)
+      present.push_back({2 * i + 1, h, float(i << shift), float(i), 1.0f, false});
+    else if (lines.positions.empty())
+      present.push_back({i, h, float(i), float(i), 1.0f, false});
     else
-      present.push_back({i, h, float(lines.positions[e]), float(lines.step_units[e])});
+      present.push_back(
+          {i, h, float(lines.positions[e]), float(lines.positions[e]), float(lines.step_units[e]), false});
   }
   return present;
 }
@@ -283,7 +297,12 @@ void expectTreeEqualsBruteForce(const HeightField& field, const detail::TreeDire
     const auto starts = segmentStarts(s);
     std::uint64_t m = 0, t = 0;
     for (int r = 0; r < static_cast<int>(s.size()); ++r) {
-      const std::size_t e = static_cast<std::size_t>(s[r].step) * d.n_lines + j;
+      if (s[r].peak) {  // no receiver; its horizons count in the bound below
+        m += ref.peak_horizons[static_cast<std::size_t>(s[r].step / 2) * d.n_lines + j];
+        continue;
+      }
+      const std::size_t e =
+          static_cast<std::size_t>(ref.position_shift > 0 ? s[r].step / 2 : s[r].step) * d.n_lines + j;
       const BruteForce brute = bruteForce(s, starts, r);
       SCOPED_TRACE("line " + std::to_string(j) + " receiver step " + std::to_string(s[r].step));
       // The horizons are Eq. 2's, distinct and farthest first.
@@ -292,10 +311,15 @@ void expectTreeEqualsBruteForce(const HeightField& field, const detail::TreeDire
       for (int step : brute.horizons) hash = detail::hashHorizon(hash, step);
       ASSERT_EQ(ref.horizon_hashes[e], hash);
       ASSERT_EQ(ref.horizons[e], brute.horizons.size());
-      // Visible counts and distances equal the enumeration.
-      ASSERT_EQ(ref.counts[e], float(brute.visible.size()));
+      // Visible counts and distances equal the enumeration (samples alone: peaks occlude).
+      int counted = 0;
       double distance = 0.0;
-      for (int x : brute.visible) distance += double(s[r].position - s[x].position) * s[x].ring;
+      for (int x : brute.visible) {
+        if (s[x].peak) continue;
+        ++counted;
+        distance += double(s[r].distance - s[x].distance) * s[x].ring;
+      }
+      ASSERT_EQ(ref.counts[e], float(counted));
       ASSERT_EQ(ref.distance_sums[e], float(distance));
       // Every start of a visible run (a visible sample whose farther neighbour is hidden)
       // is a horizon, and every horizon is visible.
@@ -403,15 +427,13 @@ TEST(IntervisibilityLine, TuningsChangeTheWorkNotTheResult) {
         std::uint64_t skipped = 0;
         for (auto x : v.walks_skipped) skipped += x;
         for (std::size_t e = 0; e < v.iterations.size(); ++e) {
-          if (variant.tuning.replacement_check) {
-            ASSERT_LE(v.iterations[e], plain.iterations[e] + 1) << e;
+          if (variant.tuning.replacement_check) {  // one more check per node: the sample, its peak
+            ASSERT_LE(v.iterations[e], plain.iterations[e] + 2) << e;
           }
           if (variant.tuning.safe_zone) {
             ASSERT_LE(v.iterations[e], no_zone.iterations[e]) << e;
           }
-          if (v.walks_skipped[e]) {
-            ASSERT_EQ(v.iterations[e], 1u) << e;
-          }
+          ASSERT_GE(v.iterations[e], v.walks_skipped[e]) << e;  // a skipped walk costs its check
         }
         if (!variant.tuning.safe_zone) {
           EXPECT_EQ(skipped, 0u);
@@ -899,6 +921,107 @@ TEST(IntervisibilityAnalytic, WallHidesWhatIsBehindIt) {
       EXPECT_EQ(lines.counts[e], float(expected)) << "column " << column;
     }
   }
+}
+
+// The visible counts of lines' receivers by the exact line of sight on the bilinear surface
+// (the viewshed's definition, checked densely: 64 points per step in double precision): a
+// sample is hidden where the surface rises more than `tolerance` above the sight line strictly
+// between it and the receiver, or a sample in between lies strictly above it (decided as the
+// tree decides it, on the samples' rounded heights: a slope's samples are collinear only up to
+// their rounding).
+std::vector<int> exactCounts(const HeightField& field, const std::vector<float>& heights,
+                             const detail::TreeDirection& d, const detail::IntervisibilityLines& lines, int j,
+                             double tolerance) {
+  const int n = static_cast<int>(d.samples.size()), steps = lines.geometry.n_steps;
+  const detail::LatticeLine& line = d.lines[j];
+  auto surface = [&](double u) {  // the surface at step position u of line j (NaN outside)
+    const double x = line.col + (n - 1 - u) / n * d.lattice.a, y = line.row + (n - 1 - u) / n * d.lattice.b;
+    const int x0 = std::min(static_cast<int>(std::floor(x)), field.width - 2);
+    const int y0 = std::min(static_cast<int>(std::floor(y)), field.height - 2);
+    if (x0 < 0 || y0 < 0) return std::nan("");
+    const double fx = x - x0, fy = y - y0;
+    auto at = [&](int c, int r) { return double(heights[static_cast<std::size_t>(r) * field.width + c]); };
+    return at(x0, y0) * (1 - fx) * (1 - fy) + at(x0 + 1, y0) * fx * (1 - fy) +
+           at(x0, y0 + 1) * (1 - fx) * fy + at(x0 + 1, y0 + 1) * fx * fy;
+  };
+  std::vector<int> counts(steps, -1);
+  for (int r = 0; r < steps; ++r) {
+    const float hr = lines.samples[static_cast<std::size_t>(r) * lines.geometry.n_lines + j];
+    if (std::isnan(hr) || r % n != n - 1) continue;
+    int count = 0;
+    for (int x = 0; x < r; ++x) {
+      const float hx = lines.samples[static_cast<std::size_t>(x) * lines.geometry.n_lines + j];
+      if (std::isnan(hx)) continue;
+      // The samples in between as the tree decides them (exactly, on their rounded heights),
+      // and the surface between them.
+      bool hidden = false;
+      for (int y = x + 1; y < r && !hidden; ++y) {
+        const float hy = lines.samples[static_cast<std::size_t>(y) * lines.geometry.n_lines + j];
+        hidden = !std::isnan(hy) && detail::chordSide(hx, hy, hr, float(y - x), float(r - y)) > 0;
+      }
+      for (int k = 1; k < 64 * (r - x) && !hidden; ++k) {
+        const double u = x + k / 64.0, sight = hx + (double(hr) - hx) * (u - x) / (r - x);
+        hidden = surface(u) > sight + tolerance;
+      }
+      count += !hidden;
+    }
+    counts[r] = count;
+  }
+  return counts;
+}
+
+// Roofs that touch at a corner and one-pixel walls, seen off the axes: between two of the
+// tree's samples the bilinear surface rises above both (at a crossing, or at the vertex of a
+// concave cell piece), and the samples alone see past it. Against the exact line of sight on
+// the bilinear surface, the peaks as occluders put right the receivers the samples alone (the
+// same lines, peaks dropped) get wrong, and break next to none.
+TEST(IntervisibilityAnalytic, RoofsTouchingAtACornerHideWhatIsBehindThem) {
+  const int w = 40, h = 40;
+  std::vector<float> heights(static_cast<std::size_t>(w) * h, 0.0f);
+  for (int r = 0; r < h; ++r)
+    for (int c = 0; c < w; ++c) {
+      float& z = heights[static_cast<std::size_t>(r) * w + c];
+      if ((c <= 19 && r >= 20 && r < 26 && c > 13) || (c >= 20 && r <= 19 && c < 26 && r > 13))
+        z = 12.0f;                      // roofs
+      if (c == 30 && r > 4) z = 9.0f;   // a one-pixel wall
+      if (c > 33) z = 1.5f * (c - 33);  // a slope beyond: its samples rise
+    }
+  const HeightField field = fieldFrom(w, h, heights);
+  const auto prepared = detail::prepareHeights(field);
+  std::int64_t with_error = 0, without_error = 0, receivers = 0, fixed = 0, broken = 0;
+  for (auto step : {std::pair<int, int>{2, 1}, {3, 1}, {3, 2}, {1, 2}, {-2, -1}, {2, -3}}) {
+    const auto d = treeStep(field, step);
+    ASSERT_TRUE(d.peaks());
+    const auto with = referenceLines(field, prepared.heights, d);
+    auto without = detail::latticeTreeLines(field, prepared.heights, d);
+    without.position_shift = 0;
+    without.peaks.clear();
+    without.peak_offsets.clear();
+    detail::sweepPresampledLines(without, {}, false);
+    for (int j = 0; j < with.geometry.n_lines; ++j) {
+      const auto exact = exactCounts(field, prepared.heights, d, with, j, 1e-4);
+      for (int r = 0; r < with.geometry.n_steps; ++r) {
+        if (exact[r] < 0) continue;
+        const std::size_t e = static_cast<std::size_t>(r) * with.geometry.n_lines + j;
+        ASSERT_LE(with.counts[e], without.counts[e]) << "peaks only hide";
+        with_error += std::llabs(static_cast<long long>(with.counts[e]) - exact[r]);
+        without_error += std::llabs(static_cast<long long>(without.counts[e]) - exact[r]);
+        fixed += with.counts[e] == exact[r] && without.counts[e] != exact[r];
+        broken += with.counts[e] != exact[r] && without.counts[e] == exact[r];
+        ++receivers;
+      }
+    }
+  }
+  // One occluder per interval is not the whole upper hull of the surface between two samples
+  // (two walls in one interval, a concave piece's curve): a few receivers keep an error.
+  EXPECT_GT(receivers, 1000);
+  EXPECT_GT(without_error, 1000) << "the case should need the peaks";
+  EXPECT_LT(with_error * 10, without_error);
+  // A peak hides what the surface does not only at the rounding of the samples' heights (a
+  // roof's foot seen from the ground: the sample on the roof's edge comes out an ulp below the
+  // straight line from the receiver through the peak on the slope).
+  EXPECT_GT(fixed, 500);
+  EXPECT_LE(broken * 50, fixed) << broken << " receivers see less than the surface allows";
 }
 
 TEST(IntervisibilityKernels, BatchingUnderATinyMemoryBudgetChangesNothing) {

@@ -10,10 +10,12 @@
 // the cheapest integer step (a, b) within half the spacing 2 pi / K of phi_k, standing for
 // phi_k's wedge of azimuth (weight 1 / K, as the naive march's rays), and the step
 // |(a, b)| / ceil(|(a, b)| S), at most 1 / S, so every receiver is a sample of its own line at
-// its own height (docs/ALGORITHMS.md). Tie rule: q is visible when its
-// slope from p is >= the slope of every sample strictly between them (grazing samples are
-// visible; on a flat plane every sample is). Decided exactly, so the sweep, the naive
-// march and brute force agree sample for sample on identical samples.
+// its own height (docs/ALGORITHMS.md); between two of its samples, the surface's point that
+// rises farthest above their chord (a crossing or a concave cell piece's, where it rises above
+// it: a one-pixel wall, roofs touching at a corner) hides too, but is not counted. Tie rule: q
+// is visible when its slope from p is >= the slope of every sample (and such peak) strictly
+// between them (grazing samples are visible; on a flat plane every sample is). Decided exactly,
+// so the sweep, the naive march and brute force agree sample for sample on identical samples.
 #pragma once
 
 #include <cstdint>

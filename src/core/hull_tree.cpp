@@ -69,7 +69,15 @@ TreeDirection makeTreeDirection(const HeightField& field, const LatticeDirection
   d.wedge = static_cast<float>(2.0 * std::sin(M_PI * lattice.weight));
   d.cos_azimuth = static_cast<float>(std::cos(lattice.azimuth));
   d.sin_azimuth = static_cast<float>(std::sin(lattice.azimuth));
+  d.intervals = treeIntervals(lattice, d.per_period);
+  d.position_shift = treePositionShift(d.longestLine());
   return d;
+}
+
+int treePositionShift(std::size_t steps) {
+  int bits = 0;
+  while ((std::size_t(1) << bits) <= steps) ++bits;
+  return std::clamp(23 - bits, 1, 8);
 }
 
 std::int32_t stepUnits(const HeightField& field, double y, double dx, double dy, double unit) {
@@ -114,6 +122,7 @@ void followRows(TreeDirection& d, const HeightField& field, const RowTable& rows
   }
   d.drop = static_cast<float>(curvature * unit * unit);
   d.max_steps = stepsWithin(max_distance, unit);
+  d.position_shift = 0;  // positions are whole units: no peaks
 }
 
 std::vector<TreeDirection> treeDirections(const HeightField& field, const SweepOptions& options, bool follow_rows) {
@@ -155,6 +164,7 @@ void IntervisibilityLines::resetResults(bool keep_horizons) {
   iterations.assign(entries, 0);
   horizon_hashes.assign(entries, 0);
   walks_skipped.assign(entries, 0);
+  peak_horizons.assign(position_shift > 0 ? entries : 0, 0);
   horizon_steps.assign(keep_horizons ? entries : 0, {});
   horizon_run_ends.assign(keep_horizons ? entries : 0, {});
 }
@@ -171,6 +181,11 @@ IntervisibilityLines canonicalTreeLines(const TreeDirection& d) {
   out.receiver_every = static_cast<int>(d.samples.size());
   out.max_steps = d.max_steps;
   out.samples.assign(longest * d.lines.size(), std::numeric_limits<float>::quiet_NaN());
+  out.position_shift = d.position_shift;
+  if (d.peaks()) {
+    out.peaks.assign(out.samples.size(), std::numeric_limits<float>::quiet_NaN());
+    out.peak_offsets.assign(out.samples.size(), 0);
+  }
   if (d.rowSpacing()) {
     // As the kernel sums them: step 0 at 0, then each step of period i the units of the row
     // of receiver i (the first period's: receiver 0's). A sample's ring units are those of
@@ -198,7 +213,8 @@ IntervisibilityLines canonicalTreeLines(const TreeDirection& d) {
 void checkTreeLimits(const std::vector<TreeDirection>& directions, const std::vector<float>& prepared_heights) {
   std::size_t longest = 0;
   for (const auto& d : directions) {
-    longest = std::max(longest, d.longestLine());
+    // With peaks, positions in fixed point: the line's steps << position_shift (at least 1).
+    longest = std::max(longest, d.longestLine() << d.position_shift);
     if (!d.rowSpacing()) continue;
     // Positions in units: the line's steps times the most units a step has.
     const std::size_t most = *std::max_element(d.row_units.begin(), d.row_units.end());

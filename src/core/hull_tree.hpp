@@ -53,7 +53,22 @@ struct TreeDirection {
   std::vector<float> row_factors;
   bool rowSpacing() const { return !row_units.empty(); }
   std::size_t longestLine() const;  // entries (steps) of its longest line
+  // The occluder-only peaks between consecutive samples (kernels/shared/tree_peaks.cl): the
+  // pieces of each interval of a period, and the fixed point of positions along a line: a
+  // sample at step s lies at s << position_shift, a peak between steps s - 1 and s at
+  // (s - 1) << position_shift plus its offset. 0 = no peaks (per-row spacing, whose positions
+  // are whole units of ground length: not built there). With peaks a line has two tree slots
+  // per step: 2 s for the peak before step s, 2 s + 1 for the sample.
+  TreeIntervals intervals;
+  int position_shift = 0;
+  bool peaks() const { return position_shift > 0; }
+  std::size_t slotsPerPeriod() const { return samples.size() * (peaks() ? 2 : 1); }
 };
+
+// The position shift of a direction whose longest line has `steps` steps: sub-step positions
+// as fine as 2^-8 step where the line is short enough, always at least 1 bit (checkTreeLimits
+// keeps lines below 2^23 steps), positions below 2^23.
+int treePositionShift(std::size_t steps);
 
 // The tuning a sweep runs: `requested`, without the safe zone on lines of per-row spacing
 // (its bound interpolates over uniform steps).
@@ -145,6 +160,16 @@ struct IntervisibilityLines {
   // distance sums are then sums of (receiver position - position) * units. Without, both
   // are the step.
   std::vector<std::int32_t> positions, step_units;
+  // Peaks (TreeDirection::position_shift > 0): per entry, the highest point of the surface
+  // between the step before and this one (NaN where none: no curved piece, a cell outside the
+  // field or with nodata) and its offset from the step before, in units of 2^-position_shift
+  // step. The sweep inserts it before the sample, as an occluder alone, where it is strictly
+  // higher than both samples. Tree slots (horizon_steps, hashes) are then 2 s + 1 for step s's
+  // sample and 2 s for its peak.
+  int position_shift = 0;
+  std::vector<float> peaks;
+  std::vector<std::int32_t> peak_offsets;
+  std::vector<std::uint32_t> peak_horizons;  // output: an inserted peak's m (statistics' bound)
   bool horizons_at_every_sample = true;  // else only receivers read theirs (the kernels without statistics)
   std::vector<float> samples;                 // sampled heights
   std::vector<float> counts;                  // visible samples (farther along the line)

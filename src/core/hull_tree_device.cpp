@@ -25,7 +25,7 @@ std::string treeProgramOptions(const TreeProgramFlags& f) {
     << " -DHFVIS_WANT_AREA=" << f.area
     << " -DHFVIS_WANT_STATS=" << f.stats << " -DHFVIS_WANT_ENTRY_STATS=" << f.entry_stats;
   s << " -DHFVIS_CURVATURE=" << f.curvature << " -DHFVIS_ROW_SPACING=" << f.row_spacing
-    << " -DHFVIS_STRIPS=" << f.strips;
+    << " -DHFVIS_STRIPS=" << f.strips << " -DHFVIS_TREE_PEAKS=" << !f.row_spacing;
   const HullTreeTuning tuning = tuningFor(f.tuning, f.row_spacing);
   s << " -DHFVIS_DEFERRED_WRITES=" << tuning.deferred_writes
     << " -DHFVIS_REPLACEMENT_CHECK=" << tuning.replacement_check
@@ -48,7 +48,7 @@ TreeScratchNeeds treeScratchNeeds(const std::vector<TreeDirection>& directions, 
   for (const TreeDirection& d : directions) {
     std::size_t total = 0, direction_longest = 0;
     for (const LatticeLine& line : d.lines) {
-      const std::size_t capacity = lineCapacity(line, d.samples.size());
+      const std::size_t capacity = lineCapacity(line, d.slotsPerPeriod());
       total += capacity;
       direction_longest = std::max(direction_longest, capacity);
     }
@@ -98,6 +98,8 @@ TreeKernel treeKernel(ContextState& st, cl::Program& program, const TreeDirectio
   k.samples = table(d.samples.data(), d.samples.size() * sizeof(LatticeSample));
   k.row_units = table(d.row_units.data(), d.row_units.size() * sizeof(std::int32_t));
   k.row_factors = table(d.row_factors.data(), d.row_factors.size() * sizeof(float));
+  k.pieces = table(d.intervals.pieces.data(), d.intervals.pieces.size() * sizeof(TreePiece));
+  k.interval_first = table(d.intervals.first.data(), d.intervals.first.size() * sizeof(std::int32_t));
   k.no_strips = deviceBuffer(st, 0);
   k.kernel = NamedKernel(st, program, "intervisibility_lattice");  // the chunk's lines set per chunk
   NamedKernel& kernel = k.kernel;
@@ -114,6 +116,9 @@ TreeKernel treeKernel(ContextState& st, cl::Program& program, const TreeDirectio
   kernel.set("max_steps", d.max_steps);
   kernel.set("row_units", k.row_units);
   kernel.set("row_factors", k.row_factors);
+  kernel.set("pieces", k.pieces);
+  kernel.set("interval_first", k.interval_first);
+  kernel.set("position_shift", d.position_shift);
   kernel.set("trees", b.trees);
   kernel.set("prefix", b.prefix);
   kernel.set("positions", b.positions);
@@ -140,7 +145,7 @@ TreeKernel treeKernel(ContextState& st, cl::Program& program, const TreeDirectio
 void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDirection& d, int width, int height,
                           const TreeBuffers& b) {
   TreeKernel k = treeKernel(st, program, d, width, height, b);
-  launchLineChunks(st, k.kernel, d.lines, d.samples.size(), b.scratch_entries, 1, kLineGroup);
+  launchLineChunks(st, k.kernel, d.lines, d.slotsPerPeriod(), b.scratch_entries, 1, kLineGroup);
 }
 
 std::string TreeRoutine::programOptions() const {
@@ -177,11 +182,12 @@ IntervisibilityLines treeLinesOnDevice(ContextState& st, const TreeProgramFlags&
   flags.row_spacing = d.rowSpacing();
   cl::Program program = st.program("intervisibility.cl", treeProgramOptions(flags));
   const std::size_t plane = field.pixelCount();
-  const std::size_t per_period = d.samples.size(), longest = d.longestLine();
+  // Scratch entries are tree slots: two per step with peaks (the sample's the second).
+  const std::size_t slots_per_period = d.slotsPerPeriod(), slots_per_step = d.peaks() ? 2 : 1;
   std::size_t entries = 0;
-  for (const LatticeLine& line : d.lines) entries += lineCapacity(line, per_period);
+  for (const LatticeLine& line : d.lines) entries += lineCapacity(line, slots_per_period);
   // Scratch for all lines in one launch; the step-major layout pads every line to the longest.
-  entries = std::max(entries, longest * d.lines.size());
+  entries = std::max(entries, d.longestLine() * slots_per_step * d.lines.size());
   TreeBuffers b;
   allocateTreeScratch(st, flags, {d}, entries, b);
   auto upload = [&](const std::vector<float>& values) {
@@ -218,14 +224,15 @@ IntervisibilityLines treeLinesOnDevice(ContextState& st, const TreeProgramFlags&
 
   // Back to the canonical step-major order, as the launch laid the lines out.
   std::vector<LatticeLine> lines = d.lines;
-  const auto chunks = chunkLines(lines, per_period, entries, lineMajorLayout(st));
+  const auto chunks = chunkLines(lines, slots_per_period, entries, lineMajorLayout(st));
   IntervisibilityLines out = canonicalTreeLines(d);
   out.resetResults();
   for (const LineChunk& chunk : chunks) {
     for (std::size_t j = chunk.first; j < chunk.first + chunk.count; ++j) {
-      const std::size_t steps = lineCapacity(lines[j], per_period);
+      const std::size_t steps = lineCapacity(lines[j], d.samples.size());
       for (std::size_t i = 0; i < steps; ++i) {
-        const std::size_t e = static_cast<std::size_t>(lines[j].stack) + i * chunk.stride;
+        const std::size_t slot = i * slots_per_step + slots_per_step - 1;
+        const std::size_t e = static_cast<std::size_t>(lines[j].stack) + slot * chunk.stride;
         const std::size_t c = i * lines.size() + j;
         std::memcpy(&out.samples[c], &nodes[4 * e], sizeof(float));
         out.counts[c] = visible[2 * e];

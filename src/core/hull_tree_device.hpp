@@ -23,7 +23,7 @@ constexpr std::size_t kTreePositionBytes = 2 * sizeof(std::int32_t);  // (positi
 constexpr std::size_t kTreeVisibleBytes = 2 * sizeof(float);  // (count, distance sum), per-entry tests only
 constexpr std::size_t kTreeEntryStatsBytes = 4 * sizeof(std::uint32_t);
 constexpr std::size_t kTreeLineTotals = 8;  // ulongs per line (HFVIS_LINE_TOTALS)
-constexpr std::size_t kTreeLineStateBytes = 136;  // TreeLineState, per line in strips
+constexpr std::size_t kTreeLineStateBytes = 152;  // TreeLineState, per line in strips
 
 // What the program computes besides the sweep itself (the HFVIS_WANT_* of the kernels).
 struct TreeProgramFlags {
@@ -83,7 +83,7 @@ void allocateTreeScratch(ContextState& st, const TreeProgramFlags& flags, const 
 // empty buffers without strips.
 struct TreeKernel {
   NamedKernel kernel;
-  cl::Buffer samples, row_units, row_factors, no_strips;
+  cl::Buffer samples, row_units, row_factors, pieces, interval_first, no_strips;
 };
 TreeKernel treeKernel(ContextState& st, cl::Program& program, const TreeDirection& d, int width, int height,
                       const TreeBuffers& b);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <numeric>
 #include <optional>
@@ -281,6 +282,46 @@ std::vector<LatticeSample> uniformLatticeSamples(const LatticeDirection& d, int 
   std::vector<LatticeSample> samples;
   for (int q = per_period - 1; q >= 0; --q) samples.push_back(sampleAt(d, double(q) / per_period));
   return samples;
+}
+
+TreeIntervals treeIntervals(const LatticeDirection& d, int per_period) {
+  TreeIntervals out;
+  auto snapped = [](double v) { return std::abs(v - std::round(v)) < 1e-9 ? std::round(v) : v; };
+  const bool along_grid_line = d.a == 0 || d.b == 0;
+  for (int q = 0; q < per_period; ++q) {
+    out.first.push_back(static_cast<std::int32_t>(out.pieces.size()));
+    if (along_grid_line) continue;
+    // Interval q runs from fraction f_far of the period down to f_near (its samples'), and is
+    // cut where it crosses a column (i / |a|) or a row (j / |b|) strictly between them.
+    const double f_near = double(per_period - 1 - q) / per_period,
+                 f_far = double(per_period - q) / per_period;
+    std::vector<double> cuts = {f_far};
+    for (int i = 1; i < std::abs(d.a); ++i) cuts.push_back(double(i) / std::abs(d.a));
+    for (int i = 1; i < std::abs(d.b); ++i) cuts.push_back(double(i) / std::abs(d.b));
+    cuts.erase(std::remove_if(cuts.begin() + 1, cuts.end(),
+                              [&](double f) { return !(f < f_far - 1e-12 && f > f_near + 1e-12); }),
+               cuts.end());
+    std::sort(cuts.begin(), cuts.end(), std::greater<double>());
+    cuts.push_back(f_near);
+    for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
+      const double far = cuts[k], near = cuts[k + 1];
+      const double ox = std::floor(d.a * 0.5 * (far + near)), oy = std::floor(d.b * 0.5 * (far + near));
+      TreePiece g{};
+      g.ox = static_cast<std::int32_t>(ox);
+      g.oy = static_cast<std::int32_t>(oy);
+      g.fx = static_cast<float>(snapped(d.a * far) - ox);
+      g.fy = static_cast<float>(snapped(d.b * far) - oy);
+      g.dx = static_cast<float>(d.a * (near - far));
+      g.dy = static_cast<float>(d.b * (near - far));
+      g.t_far = static_cast<float>((f_far - far) * per_period);
+      g.t_near = static_cast<float>((f_far - near) * per_period);
+      g.inv_span = static_cast<float>(1.0 / ((far - near) * per_period));
+      g.far_crossing = k > 0;
+      out.pieces.push_back(g);
+    }
+  }
+  out.first.push_back(static_cast<std::int32_t>(out.pieces.size()));
+  return out;
 }
 
 std::vector<LatticeLine> latticeLines(const LatticeDirection& d, int width, int height) {

@@ -110,6 +110,31 @@ std::size_t stackEntriesPerPeriod(const std::vector<CellSegment>& segments);
 int samplesPerPeriod(const LatticeDirection& d, double samples_per_unit);
 std::vector<LatticeSample> uniformLatticeSamples(const LatticeDirection& d, int per_period);
 
+// A piece of the line between two consecutive hull-tree samples, inside one cell
+// (kernels/shared/tree_peaks.cl says what the tree makes of them): the cell's lower corner
+// (ox, oy) from the period's receiver, the cell fractions (fx, fy) at the piece's far end and
+// their change (dx, dy) to its near end, where its ends lie in the interval (t_far, t_near: 0
+// at the far sample, 1 at the near one) and 1 / (t_near - t_far), and whether its far end is a
+// grid-line crossing (the interval's far sample is not). Ten 4-byte members, uploaded as is;
+// the kernel reads them field by field.
+struct TreePiece {
+  std::int32_t ox, oy;
+  float fx, fy, dx, dy, t_far, t_near, inv_span;
+  std::int32_t far_crossing;
+};
+static_assert(sizeof(TreePiece) == 40, "TreePiece must match the kernel's reads");
+
+// The pieces of the intervals of one period of direction d sampled per_period times
+// (uniformLatticeSamples): interval q ends at sample q (its far end is sample q - 1, or for q = 0
+// the receiver of the period before); its pieces are pieces[first[q] .. first[q + 1]), farthest
+// first. None on lines along a grid row or column (the surface is linear between pixel
+// centres there, so no point between samples rises above both).
+struct TreeIntervals {
+  std::vector<TreePiece> pieces;
+  std::vector<std::int32_t> first;  // per_period + 1 entries
+};
+TreeIntervals treeIntervals(const LatticeDirection& d, int per_period);
+
 // One line of a direction: its farthest receiver (along +(a, b)) and how many receivers it
 // has; receiver i sits at (col - i a, row - i b). `stack` is the first entry of its hull
 // stack in the scratch buffer (entries at stack + depth * stride).

@@ -11,10 +11,11 @@
 
 #include "core/chord_side.hpp"
 #include "core/fast_math.hpp"
-#include "hfvis/bounce.hpp"
-#include "hfvis/errors.hpp"
 #include "core/horizon_common.hpp"
 #include "core/hull_tree.hpp"
+#include "core/tree_peaks.hpp"
+#include "hfvis/bounce.hpp"
+#include "hfvis/errors.hpp"
 
 namespace hfvis {
 namespace detail {
@@ -25,25 +26,34 @@ constexpr int kNone = -1;
 constexpr int kConcave = 0, kConvex = 1;
 
 // A tree node as the kernel's int4: (height, rank * 2 + leaf flag, first child, next
-// sibling); the node of step k in slot k, links by slot.
+// sibling); the node of slot k in tree[k], links by slot. (The kernel's rank is ranks[k] here.)
 struct Node {
   float h = 0.0f;
-  int rank = 0;  // present samples before this one
   bool leaf = false;
   int first = kNone;
   int next = kNone;
 };
 
-// The sampled heights of one line and their positions, indexed by step.
+// The sampled heights of one line, their peaks and their positions, by tree slot: with peaks
+// (shift > 0) slot 2 s + 1 is step s's sample and 2 s the peak before it, else slot s is step s.
 struct LineView {
   const IntervisibilityLines& lines;
   std::size_t offset;  // entry of step 0 of this line
   std::size_t stride;  // n_lines
+  int shift;           // position_shift
+  bool peaks() const { return shift > 0; }
+  int sampleOf(int slot) const { return peaks() ? slot >> 1 : slot; }  // the step of a slot's sample or peak
+  bool isSample(int slot) const { return !peaks() || (slot & 1) != 0; }
+  int slotOf(int step) const { return peaks() ? 2 * step + 1 : step; }  // a step's sample
   std::size_t entry(int step) const { return offset + static_cast<std::size_t>(step) * stride; }
-  float height(int step) const { return lines.samples[entry(step)]; }
-  // Position along the line: the step, or its units with per-row spacing (exact in a float).
-  float position(int step) const {
-    return lines.positions.empty() ? static_cast<float>(step) : static_cast<float>(lines.positions[entry(step)]);
+  float sampleHeight(int step) const { return lines.samples[entry(step)]; }
+  // Position along the line: the step, or its units with per-row spacing (exact in a float);
+  // with peaks in units of 2^-shift step.
+  float position(int slot) const {
+    if (!lines.positions.empty()) return static_cast<float>(lines.positions[entry(slot)]);
+    const int s = sampleOf(slot);
+    if (isSample(slot)) return static_cast<float>(s << shift);
+    return static_cast<float>(((s - 1) << shift) + lines.peak_offsets[entry(s)]);
   }
 };
 
@@ -52,14 +62,22 @@ bool seenOver(const LineView& line, float hx, int x, float hn, int n, float hr, 
   return chordSide(hx, hn, hr, pn - px, pr - pn) <= 0;
 }
 
-// Mirror of run_end().
+// Mirror of run_end(): over the samples between horizon `start` and the next horizon `next`
+// (slots), the first hidden one's slot, or `next`. Peaks are never counted, so only samples
+// are searched: the visible nodes between two horizons are a prefix, the samples among them too.
 int runEnd(const LineView& line, int start, int next, float h_next, int receiver, float h_receiver,
            bool holes) {
+  // The last sample known visible: the horizon's own, or the step before a peak's.
+  int lo = line.sampleOf(start) - (line.isSample(start) ? 0 : 1);
+  const int last = line.sampleOf(next);
+  auto seen = [&](int x) {
+    return seenOver(line, line.sampleHeight(x), line.slotOf(x), h_next, next, h_receiver, receiver);
+  };
   if (!holes) {
-    int lo = start, hi = next, jump = 1;
+    int hi = last, jump = 1;
     while (lo + jump < hi) {
       const int x = lo + jump;
-      if (seenOver(line, line.height(x), x, h_next, next, h_receiver, receiver)) {
+      if (seen(x)) {
         lo = x;
         jump *= 2;
       } else {
@@ -69,17 +87,15 @@ int runEnd(const LineView& line, int start, int next, float h_next, int receiver
     }
     while (hi - lo > 1) {
       const int mid = lo + (hi - lo) / 2;
-      if (seenOver(line, line.height(mid), mid, h_next, next, h_receiver, receiver))
+      if (seen(mid))
         lo = mid;
       else
         hi = mid;
     }
-    return hi;
+    return hi == last ? next : line.slotOf(hi);
   }
-  for (int x = start + 1; x < next; ++x) {
-    const float hx = line.height(x);
-    if (!std::isnan(hx) && !seenOver(line, hx, x, h_next, next, h_receiver, receiver)) return x;
-  }
+  for (int x = lo + 1; x < last; ++x)
+    if (!std::isnan(line.sampleHeight(x)) && !seen(x)) return line.slotOf(x);
   return next;
 }
 
@@ -163,8 +179,8 @@ struct RootList {
 };
 
 // Mirror of hull_tree_walk(): Algorithm 1 below `top`; returns the convexity checks.
-std::uint32_t hullTreeWalk(const LineView& line, std::vector<Node>& tree, bool deferred, int top, Node node, float h,
-                           int step, RootList& list) {
+std::uint32_t hullTreeWalk(const LineView& line, std::vector<Node>& tree, bool deferred, int top, Node node,
+                           float h, int slot, RootList& list) {
   std::uint32_t t = 0;
   int cur = top;
   for (;;) {
@@ -173,7 +189,7 @@ std::uint32_t hullTreeWalk(const LineView& line, std::vector<Node>& tree, bool d
       Node child = tree[c];
       ++t;
       const int side = chordSide(child.h, node.h, h, line.position(cur) - line.position(c),
-                                 line.position(step) - line.position(cur));
+                                 line.position(slot) - line.position(cur));
       if (side <= 0) {
         tree[cur].first = child.next;
         tree[c].next = cur;
@@ -193,47 +209,51 @@ std::uint32_t hullTreeWalk(const LineView& line, std::vector<Node>& tree, bool d
 
 // Mirror of SafeZone and its helpers, the same float operations in the same order.
 struct SafeZone {
-  int first = 0, last = 0, steps = 16;
+  int steps = 16;
+  float first = 0.0f, last = 0.0f;  // positions
   float z1 = 0.0f, z2 = 0.0f, margin = 0.0f;
-  void begin(int receiver) {
-    first = receiver + 1;
-    last = receiver + 1 + steps;
+  void begin(float p, float unit) {
+    first = p + 1.0f;
+    last = first + unit * static_cast<float>(steps);
     z1 = z2 = std::numeric_limits<float>::max();
     margin = 0.0f;
   }
-  void add(float hc, int c, float hg, int g) {
-    const float slope = (hc - hg) / static_cast<float>(c - g);
-    const float at1 = hc + slope * static_cast<float>(first - c);
-    const float at2 = hc + slope * static_cast<float>(last - c);
+  void add(float hc, float c, float hg, float g) {
+    const float slope = (hc - hg) / (c - g);
+    const float at1 = hc + slope * (first - c);
+    const float at2 = hc + slope * (last - c);
     z1 = hfMin(z1, at1);
     z2 = hfMin(z2, at2);
-    margin = hfMax(margin, std::fabs(hc) + std::fabs(slope) * static_cast<float>(last - c));
+    margin = hfMax(margin, std::fabs(hc) + std::fabs(slope) * (last - c));
   }
   void end() { margin = margin * 0x1p-16f + 0x1p-100f; }
-  bool inside(int step, float h) const {
-    const float bound = z1 + (z2 - z1) * (static_cast<float>(step - first) / static_cast<float>(steps));
-    return step <= last && h < bound - margin;
+  bool inside(float p, float h) const {
+    const float bound = z1 + (z2 - z1) * ((p - first) / (last - first));
+    return p <= last && h < bound - margin;
   }
 };
 
-// Mirror of intervisibility_sweep() for line j.
+// Mirror of intervisibility_lattice()'s sweep of line j: per step, its peak (an occluder alone,
+// where there is one) and then its sample.
 void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, IntervisibilityLines& out,
                bool keep_horizons, BounceLines* bounce) {
   const bool deferred = tuning.deferred_writes;
   const std::size_t stride = static_cast<std::size_t>(d.n_lines);
-  const LineView line{out, static_cast<std::size_t>(j), stride};
+  const LineView line{out, static_cast<std::size_t>(j), stride, out.position_shift};
   const bool row_spacing = !out.positions.empty();
-  std::vector<Node> tree(static_cast<std::size_t>(d.n_steps));
-  std::vector<int> ranks(static_cast<std::size_t>(d.n_steps));
-  std::vector<std::uint64_t> step_sums(static_cast<std::size_t>(d.n_steps));
-  // With per-row spacing, over the present samples before each step: the sum of their step
-  // units and of position * units (the kernel's positions[].y and prefix[]).
-  std::vector<std::uint64_t> unit_sums(step_sums.size()), weighted_sums(step_sums.size());
+  const std::size_t slots = static_cast<std::size_t>(d.n_steps) * (line.peaks() ? 2 : 1);
+  std::vector<Node> tree(slots);
+  // Per slot, over the present samples before it: their count (rank), the sum of their steps,
+  // and with per-row spacing the sum of their step units and of position * units (the kernel's
+  // positions[].y and prefix[]).
+  std::vector<int> ranks(slots);
+  std::vector<std::uint64_t> step_sums(slots), unit_sums(slots), weighted_sums(slots);
 
   int rank = 0;
   std::uint64_t step_sum = 0, unit_sum = 0, weighted_sum = 0;
   int root = kNone, prev = kNone, prev2 = kNone;
   float h_prev = 0.0f, h_prev2 = 0.0f;
+  float h_sample_prev = kNaN;  // the step before's sample (a peak must rise above its chord)
   int class_last = kConvex;
   int head = kNone, tail = kNone;  // the root's first and last child
   float tail_h = 0.0f;
@@ -241,184 +261,212 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
   zone.steps = tuning.safe_zone_steps;
   bool zone_valid = false;
   for (int step = 0; step < d.n_steps; ++step) {
-    const std::size_t e = static_cast<std::size_t>(j) + static_cast<std::size_t>(step) * stride;
-    const float h = out.samples[e];
-    ranks[step] = rank;
-    step_sums[step] = step_sum;
-    unit_sums[step] = unit_sum;
-    weighted_sums[step] = weighted_sum;
-    if (std::isnan(h)) continue;  // outputs stay NaN / zero
-    const float p = line.position(step);
-    std::uint32_t m = 0, t = 0, hash = kHorizonHashSeed;
-    int count = 0;
-    std::uint64_t distance_sum = 0;
-    std::vector<int> horizons, run_ends;
-    const bool receiver = step % out.receiver_every == out.receiver_every - 1;
-    const bool visit = receiver || out.horizons_at_every_sample;
-    std::optional<BounceGather> gather;
-    if (bounce && receiver) gather.emplace(*bounce, d, e, h, step);
-    if (root == kNone) {
-      tree[step] = {h, 0, true, kNone, kNone};
-      head = tail = kNone;
-    } else {
-      // 1. Algorithm 1 for the new root (see the kernel for the variants).
-      RootList list;
-      const Node old_root = tree[root];
-      bool walk = true;
-      bool replaced = false;
-      if (tuning.replacement_check && tail != kNone) {
-        ++t;
-        replaced = chordSide(tail_h, h_prev, h, line.position(root) - line.position(tail), p - line.position(root)) <= 0;
-      }
-      if (tuning.safe_zone) {
-        zone_valid = zone_valid && replaced && zone.inside(step, h);
-        if (zone_valid) {
-          walk = false;
-          out.walks_skipped[e] = 1;
-          list.head = head;
-          list.tail = tail;
-          list.tail_h = tail_h;
+    const std::size_t e = line.entry(step);
+    const float h_sample = out.samples[e];
+    std::uint32_t t = 0;  // the step's convexity checks, its peak's included
+    for (int part = line.peaks() ? 0 : 1; part < 2; ++part) {
+      const bool peak = part == 0;
+      const int slot = line.peaks() ? 2 * step + part : step;
+      ranks[slot] = rank;
+      step_sums[slot] = step_sum;
+      unit_sums[slot] = unit_sum;
+      weighted_sums[slot] = weighted_sum;
+      const float h = peak ? out.peaks[e] : h_sample;
+      if (peak ? !tree_peak_inserted(h_sample_prev, h, h_sample, out.peak_offsets[e], out.position_shift)
+               : std::isnan(h))
+        continue;  // outputs stay NaN / zero
+      const float p = line.position(slot);
+      std::uint32_t m = 0, hash = kHorizonHashSeed;
+      int count = 0;
+      std::uint64_t distance_sum = 0;
+      std::vector<int> horizons, run_ends;
+      const bool receiver = !peak && step % out.receiver_every == out.receiver_every - 1;
+      const bool visit = receiver || out.horizons_at_every_sample;  // a peak's only for the statistics
+      std::optional<BounceGather> gather;
+      if (bounce && receiver) gather.emplace(*bounce, d, e, h, step);
+      if (root == kNone) {
+        tree[slot] = {h, true, kNone, kNone};
+        head = tail = kNone;
+      } else {
+        // 1. Algorithm 1 for the new root (see the kernel for the variants).
+        RootList list;
+        const Node old_root = tree[root];
+        bool walk = true;
+        bool replaced = false;
+        if (tuning.replacement_check && tail != kNone) {
+          ++t;
+          replaced = chordSide(tail_h, h_prev, h, line.position(root) - line.position(tail),
+                               p - line.position(root)) <= 0;
         }
-      }
-      if (walk) {
-        if (deferred) {
-          int c = old_root.first;
-          while (c != kNone) {
-            const Node child = tree[c];
-            if (!replaced) {
-              if (tuning.replacement_check && c == tail) break;
-              ++t;
-              if (chordSide(child.h, h_prev, h, line.position(root) - line.position(c), p - line.position(root)) > 0)
-                break;
+        if (tuning.safe_zone) {
+          zone_valid = zone_valid && replaced && zone.inside(p, h);
+          if (zone_valid) {
+            walk = false;
+            ++out.walks_skipped[e];  // (its peak's and its sample's)
+            list.head = head;
+            list.tail = tail;
+            list.tail_h = tail_h;
+          }
+        }
+        if (walk) {
+          if (deferred) {
+            int c = old_root.first;
+            while (c != kNone) {
+              const Node child = tree[c];
+              if (!replaced) {
+                if (tuning.replacement_check && c == tail) break;
+                ++t;
+                if (chordSide(child.h, h_prev, h, line.position(root) - line.position(c),
+                              p - line.position(root)) > 0)
+                  break;
+              }
+              t += hullTreeWalk(line, tree, deferred, c, child, h, slot, list);
+              c = child.next;
             }
-            t += hullTreeWalk(line, tree, deferred, c, child, h, step, list);
-            c = child.next;
-          }
-          if (c != kNone || old_root.leaf) {
-            if (c != old_root.first) tree[root].first = c;
-            list.append(tree, deferred, root, h_prev, kNone);
-          }
-        } else {
-          t += hullTreeWalk(line, tree, deferred, root, old_root, h, step, list);
-        }
-      }
-
-      // 2. Eq. 1 for the old root; a segment start's node becomes (or is re-created as) a
-      // leaf, the root's last child.
-      if (prev2 != kNone) {
-        const int side = chordSide(h_prev2, h_prev, h, line.position(prev) - line.position(prev2), p - line.position(prev));
-        const int cls = side > 0 ? kConvex : side < 0 ? kConcave : class_last;
-        if (cls == kConvex && class_last == kConcave) {
-          if (list.tail == prev) {
-            tree[prev].leaf = true;
+            if (c != kNone || old_root.leaf) {
+              if (c != old_root.first) tree[root].first = c;
+              list.append(tree, deferred, root, h_prev, kNone);
+            }
           } else {
-            tree[prev] = {h_prev, rank - 1, true, kNone, kNone};
-            list.append(tree, deferred, prev, h_prev, kNone);
+            t += hullTreeWalk(line, tree, deferred, root, old_root, h, slot, list);
           }
         }
-        class_last = cls;
-      }
-      if (!deferred || list.tail_next != kNone) tree[list.tail].next = kNone;
-      tree[step] = {h, rank, false, list.head, kNone};
-      head = list.head;
-      tail = list.tail;
-      tail_h = list.tail_h;
 
-      // 3. Visible samples from the horizons, farthest first (closed forms without holes);
-      // at receivers, or at every sample when asked (statistics).
-      if (visit) {
-      // Within the maximum distance: the first step within max_steps (units) of this one.
-      int cut = step - out.max_steps;
-      if (row_spacing) {
-        cut = 0;
-        while (static_cast<std::int64_t>(out.positions[line.entry(step)]) - out.positions[line.entry(cut)] >
-               out.max_steps)
-          ++cut;
-      }
-      const bool refresh_zone = tuning.safe_zone && !zone_valid;
-      if (refresh_zone) zone.begin(step);
-      int hp = head;
-      Node hz = tree[hp];
-      int hp_rank = hz.rank;
-      for (;;) {
-        const int np = hz.next;
-        ++m;
-        if (refresh_zone && hz.first != kNone) zone.add(hz.h, hp, tree[hz.first].h, hz.first);
-        hash = hashHorizon(hash, hp);
-        if (keep_horizons) horizons.push_back(hp);
-        int end = step, end_rank = rank, np_rank = rank;
-        Node nz = hz;
-        if (np != kNone) {
-          nz = tree[np];
-          np_rank = nz.rank;
-          end = np;
-          end_rank = np_rank;
-        }
-        const bool holes = end_rank - hp_rank != end - hp;
-        if (np != kNone) {
-          end = runEnd(line, hp, np, nz.h, step, h, holes);
-          end_rank = end == np ? np_rank : holes ? ranks[end] : hp_rank + (end - hp);
-        }
-        if (keep_horizons) run_ends.push_back(end);
-        if (gather) {
-          for (int x = hp; x < end; ++x) {
-            const float hx = line.height(x);
-            if (!std::isnan(hx))
-              gather->visit(hx, x, static_cast<std::size_t>(j) + static_cast<std::size_t>(x) * stride);
+        // 2. Eq. 1 for the old root; a segment start's node becomes (or is re-created as) a
+        // leaf, the root's last child.
+        if (prev2 != kNone) {
+          const int side = chordSide(h_prev2, h_prev, h, line.position(prev) - line.position(prev2),
+                                     p - line.position(prev));
+          const int cls = side > 0 ? kConvex : side < 0 ? kConcave : class_last;
+          if (cls == kConvex && class_last == kConcave) {
+            if (list.tail == prev) {
+              tree[prev].leaf = true;
+            } else {
+              tree[prev] = {h_prev, true, kNone, kNone};
+              list.append(tree, deferred, prev, h_prev, kNone);
+            }
           }
-          gather->setAdjacent(end == np);
+          class_last = cls;
         }
-        // Within the maximum distance: the run's samples from `first` on.
-        const int first = std::max(hp, cut);
-        const int first_rank = first == hp ? hp_rank : holes ? ranks[first] : hp_rank + (first - hp);
-        const int run = first < end ? end_rank - first_rank : 0;
-        count += run;
-        std::uint64_t steps_sum = 0;
-        if (run == 0) {
-        } else if (row_spacing) {  // sum of (p - position) * units over the run (sums at `step`: before it)
-          const std::uint64_t units = unit_sums[end] - unit_sums[first];
-          distance_sum += static_cast<std::uint64_t>(out.positions[line.entry(step)]) * units -
-                          (weighted_sums[end] - weighted_sums[first]);
-        } else if (!holes) {
-          steps_sum = static_cast<std::uint64_t>(run) * static_cast<std::uint64_t>(first + end - 1) / 2;
-        } else {
-          const std::uint64_t end_sum = end == step ? step_sum : step_sums[end];
-          steps_sum = end_sum - step_sums[first];
+        if (!deferred || list.tail_next != kNone) tree[list.tail].next = kNone;
+        tree[slot] = {h, false, list.head, kNone};
+        head = list.head;
+        tail = list.tail;
+        tail_h = list.tail_h;
+
+        // 3. Visible samples from the horizons, farthest first (closed forms without holes);
+        // at receivers, or at every sample when asked (statistics). Runs are slots; what they
+        // count are the samples among them (sampleOf), never the peaks.
+        if (visit) {
+          // Within the maximum distance: the first step within max_steps (units) of this one.
+          int cut = step - out.max_steps;
+          if (row_spacing) {
+            cut = 0;
+            while (static_cast<std::int64_t>(out.positions[line.entry(step)]) -
+                       out.positions[line.entry(cut)] >
+                   out.max_steps)
+              ++cut;
+          }
+          const bool refresh_zone = tuning.safe_zone && !zone_valid;
+          if (refresh_zone) zone.begin(p, static_cast<float>(1 << line.shift));
+          int hp = head;
+          Node hz = tree[hp];
+          int hp_rank = ranks[hp];
+          for (;;) {
+            const int np = hz.next;
+            ++m;
+            if (refresh_zone && hz.first != kNone)
+              zone.add(hz.h, line.position(hp), tree[hz.first].h, line.position(hz.first));
+            hash = hashHorizon(hash, hp);
+            if (keep_horizons) horizons.push_back(hp);
+            int end = slot, end_rank = rank, np_rank = rank;
+            Node nz = hz;
+            if (np != kNone) {
+              nz = tree[np];
+              np_rank = ranks[np];
+              end = np;
+              end_rank = np_rank;
+            }
+            const bool holes = end_rank - hp_rank != line.sampleOf(end) - line.sampleOf(hp);
+            if (np != kNone) {
+              end = runEnd(line, hp, np, nz.h, slot, h, holes);
+              end_rank = end == np ? np_rank
+                         : holes   ? ranks[end]
+                                   : hp_rank + (line.sampleOf(end) - line.sampleOf(hp));
+            }
+            if (keep_horizons) run_ends.push_back(end);
+            if (gather) {
+              for (int x = hp; x < end; ++x) {
+                if (!line.isSample(x)) continue;
+                const int xs = line.sampleOf(x);
+                const float hx = line.sampleHeight(xs);
+                if (!std::isnan(hx)) gather->visit(hx, xs, line.entry(xs));
+              }
+              gather->setAdjacent(end == np);
+            }
+            // Within the maximum distance: the run's samples from `first` on (the slot of the
+            // first step within it, its peak's with peaks).
+            const int first = cut > line.sampleOf(hp) ? (line.peaks() ? 2 * cut : cut) : hp;
+            const int first_rank = first == hp ? hp_rank
+                                   : holes     ? ranks[first]
+                                               : hp_rank + (line.sampleOf(first) - line.sampleOf(hp));
+            const int run = first < end ? end_rank - first_rank : 0;
+            count += run;
+            std::uint64_t steps_sum = 0;
+            if (run == 0) {
+            } else if (row_spacing) {
+              // Sum of (p - position) * units over the run (the sums at `step`: before it).
+              const std::uint64_t units = unit_sums[end] - unit_sums[first];
+              distance_sum += static_cast<std::uint64_t>(out.positions[line.entry(step)]) * units -
+                              (weighted_sums[end] - weighted_sums[first]);
+            } else if (!holes) {
+              steps_sum = static_cast<std::uint64_t>(run) *
+                          static_cast<std::uint64_t>(line.sampleOf(first) + line.sampleOf(end) - 1) / 2;
+            } else {
+              const std::uint64_t end_sum = end == slot ? step_sum : step_sums[end];
+              steps_sum = end_sum - step_sums[first];
+            }
+            if (!row_spacing)
+              distance_sum += static_cast<std::uint64_t>(step) * static_cast<std::uint64_t>(run) - steps_sum;
+            if (np == kNone) break;
+            hz = nz;
+            hp = np;
+            hp_rank = np_rank;
+          }
+          if (refresh_zone) {
+            zone.end();
+            zone_valid = true;
+          }
         }
-        if (!row_spacing) distance_sum += static_cast<std::uint64_t>(step) * static_cast<std::uint64_t>(run) - steps_sum;
-        if (np == kNone) break;
-        hz = nz;
-        hp = np;
-        hp_rank = np_rank;
       }
-      if (refresh_zone) {
-        zone.end();
-        zone_valid = true;
+      if (peak) out.peak_horizons[e] = m;
+      if (!peak) {
+        out.counts[e] = visit ? static_cast<float>(count) : kNaN;
+        out.distance_sums[e] = visit ? static_cast<float>(distance_sum) : kNaN;
+        out.horizons[e] = m;
+        out.iterations[e] = t;
+        out.horizon_hashes[e] = hash;
+        if (keep_horizons) {
+          out.horizon_steps[e] = std::move(horizons);
+          out.horizon_run_ends[e] = std::move(run_ends);
+        }
+        if (gather) gather->finish(&bounce->irradiance[e * bounce->channels]);
       }
+      prev2 = prev;
+      h_prev2 = h_prev;
+      prev = slot;
+      h_prev = h;
+      root = slot;
+      if (peak) continue;
+      ++rank;
+      step_sum += static_cast<std::uint64_t>(step);
+      if (row_spacing) {
+        const std::uint64_t units = static_cast<std::uint64_t>(out.step_units[e]);
+        unit_sum += units;
+        weighted_sum += static_cast<std::uint64_t>(out.positions[e]) * units;
       }
     }
-    out.counts[e] = visit ? static_cast<float>(count) : kNaN;
-    out.distance_sums[e] = visit ? static_cast<float>(distance_sum) : kNaN;
-    out.horizons[e] = m;
-    out.iterations[e] = t;
-    out.horizon_hashes[e] = hash;
-    if (keep_horizons) {
-      out.horizon_steps[e] = std::move(horizons);
-      out.horizon_run_ends[e] = std::move(run_ends);
-    }
-    if (gather) gather->finish(&bounce->irradiance[e * bounce->channels]);
-    prev2 = prev;
-    h_prev2 = h_prev;
-    prev = step;
-    h_prev = h;
-    root = step;
-    ++rank;
-    step_sum += static_cast<std::uint64_t>(step);
-    if (row_spacing) {
-      const std::uint64_t units = static_cast<std::uint64_t>(out.step_units[e]);
-      unit_sum += units;
-      weighted_sum += static_cast<std::uint64_t>(out.positions[e]) * units;
-    }
+    h_sample_prev = h_sample;
   }
 }
 
@@ -431,7 +479,8 @@ void sweepPresampledLines(IntervisibilityLines& lines, const HullTreeTuning& req
   if (bounce && !lines.positions.empty()) throw InvalidArgument("internal error: the bounce takes uniform steps");
   const SweepDirection& d = lines.geometry;
   const std::size_t entries = d.entries();
-  if (lines.samples.size() != entries)
+  if (lines.samples.size() != entries ||
+      (lines.position_shift > 0 && (lines.peaks.size() != entries || lines.peak_offsets.size() != entries)))
     throw InvalidArgument("internal error: line samples do not fit the geometry");
   lines.resetResults(keep_horizons);
   if (bounce) {

@@ -45,7 +45,7 @@ void addLineTotals(const std::vector<cl_ulong>& totals, std::size_t lines, Inter
     s.naive_iterations += t[3];
     s.visible_samples += t[4];
     s.safe_zone_skips += t[5];
-    s.lines_over_bound += t[2] > 2 * t[1] + t[0];
+    s.lines_over_bound += t[2] > 2 * t[1] + t[0] + t[6];  // nodes: samples and peaks
   }
 }
 
@@ -187,7 +187,7 @@ class CountRoutine : public TreeRoutine {
     const int b = d.lattice.b, strips = (field_.height + plan_.strip_rows - 1) / plan_.strip_rows;
     const std::size_t row = field_.width * sizeof(float);
     std::vector<LatticeLine> lines = d.lines;
-    const auto chunks = chunkLines(lines, d.samples.size(), buffers_.scratch_entries, lineMajorLayout(st_));
+    const auto chunks = chunkLines(lines, d.slotsPerPeriod(), buffers_.scratch_entries, lineMajorLayout(st_));
     for (std::size_t c = 0; c < chunks.size(); ++c) {
       const LineChunk& chunk = chunks[c];
       const cl::Buffer chunk_lines(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
