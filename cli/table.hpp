@@ -39,7 +39,8 @@ enum OptionGroup : unsigned {
   kRegionSamplingGroup = 1u << 19,
   kAreaLightGroup = 1u << 20,
   kRegionPairGroup = 1u << 21,
-  kLastGroup = kRegionPairGroup,
+  kPvsGroup = 1u << 22,  // pvs's view cells, tiles, sampler and budgets
+  kLastGroup = kPvsGroup,
 };
 
 // The groups every command that reads a height field and writes images takes.
@@ -95,6 +96,6 @@ std::string commandList();
 // The entries, each defined in its command's file under cli/commands/.
 extern const CommandSpec kHorizonCommand, kSkyViewFactorCommand, kAmbientOcclusionCommand,
     kIntervisibilityCommand, kHorizonListsCommand, kBounceCommand, kShadeCommand, kInsolationCommand,
-    kViewshedCommand, kAreaLightCommand, kRegionCommand, kSunPositionCommand, kDevicesCommand;
+    kViewshedCommand, kAreaLightCommand, kRegionCommand, kPvsCommand, kSunPositionCommand, kDevicesCommand;
 
 }  // namespace hfvis::cli
