@@ -2,8 +2,8 @@
 # bench/pvs.sh: potentially visible sets (issue 29): the ray caster's rays per second on 1024^2
 # fields, and recall against the dense reference and the pixel error (estimated and measured)
 # against samples for AGVS, SGVS and per-cell sampling on a city, a rough terrain and the
-# bundled DEM (`hfvis_bench pvs-rays`, `hfvis_bench pvs-recall`). Writes bench/report/pvs.md (or
-# --out FILE), the tables after a header saying where they ran.
+# bundled DEM (`hfvis_bench pvs-rays`, `hfvis_bench pvs-recall`). Writes bench/report/pvs_tables.md (or
+# --out FILE), the tables after a line saying how and when they ran.
 #
 #   bench/pvs.sh [--size 128] [--samples 10000,30000,100000,300000,1000000] [--rays 1000000] [--out FILE]
 #   BUILD_DIR=... selects the build (default build/).
@@ -12,7 +12,7 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 size=128
 samples=10000,30000,100000,300000,1000000
 rays=1000000
-out=$root/bench/report/pvs.md
+out=$root/bench/report/pvs_tables.md
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --size) size=$2; shift ;;
@@ -42,5 +42,5 @@ trap 'rm -f "$tmp"' EXIT
 {
   echo "<!-- bench/pvs.sh --size $size --samples $samples --rays $rays; $(date -u +%Y-%m-%dT%H:%MZ), commit $(git -C "$root" rev-parse --short HEAD) -->"
   cat "$tmp"
-} > "$out.tables"
-echo "pvs.sh: wrote $out.tables (bench/report/pvs.md quotes it)"
+} > "$out"
+echo "pvs.sh: wrote $out (bench/report/pvs.md discusses it)"
