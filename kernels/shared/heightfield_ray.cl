@@ -34,15 +34,13 @@ inline int hf_ray_cell_of(float p, float d, int cells) {
 // The ray parameter where coordinate o + t d reaches `line` (INFINITY when d = 0).
 inline float hf_ray_crossing(float line, float o, float d) { return d != 0.0f ? (line - o) / d : INFINITY; }
 
-// The bilinear surface of cell (cx, cy) at (x, y), the point clamped into the cell; NaN where a
-// corner is nodata.
-inline float hf_ray_surface(HFVIS_GLOBAL const float* h, int width, int cx, int cy, float x, float y) {
-  float u = x - (float)cx, v = y - (float)cy;
+// The bilinear surface of a cell with corners h00 (its lower corner), h10, h01, h11 at (u, v)
+// from its lower corner, clamped into the cell; NaN where a corner is nodata.
+inline float hf_ray_bilinear(float h00, float h10, float h01, float h11, float u, float v) {
   u = u < 0.0f ? 0.0f : (u > 1.0f ? 1.0f : u);
   v = v < 0.0f ? 0.0f : (v > 1.0f ? 1.0f : v);
-  const int p = cy * width + cx;
-  const float a = h[p] + (h[p + 1] - h[p]) * u;
-  const float b = h[p + width] + (h[p + width + 1] - h[p + width]) * u;
+  const float a = h00 + (h10 - h00) * u;
+  const float b = h01 + (h11 - h01) * u;
   return a + (b - a) * v;
 }
 
@@ -139,6 +137,12 @@ inline float hf_ray_cast(HFVIS_GLOBAL const float* h, int width, int height,
   int last_view = -1;
   float t = t_lo;
   int k = top > 0 ? 1 : 0;
+  // Where the last level-1 block that could not be skipped ends: its cells are marched one
+  // after another up to there, without testing the block again.
+  float march_to = t_lo;
+  // The surface minus the ray where the last marched cell ended, carried into the next cell
+  // when it follows at once (NaN: none).
+  float carried = NAN;
   for (;;) {
     const float x = ox + t * dx, y = oy + t * dy;
     if (k > 0) {
@@ -155,7 +159,9 @@ inline float hf_ray_cast(HFVIS_GLOBAL const float* h, int width, int height,
         if (te >= t_hi) return t_hi;
         t = te;
         k = k < top ? k + 1 : top;
+        carried = NAN;
       } else {
+        if (k == 1) march_to = te;
         --k;
       }
       continue;
@@ -176,13 +182,18 @@ inline float hf_ray_cast(HFVIS_GLOBAL const float* h, int width, int height,
     }
     float t1 = tx < ty ? tx : ty;
     t1 = t1 < t_hi ? t1 : t_hi;
-    const float s0 = hf_ray_surface(h, width, cx, cy, x, y);
-    const float s1 = hf_ray_surface(h, width, cx, cy, ox + t1 * dx, oy + t1 * dy);
-    if (!isnan(s0) && !isnan(s1)) {
-      const float f0 = s0 - (oz + t * dz), f1 = s1 - (oz + t1 * dz);
+    const int p = cy * width + cx;
+    const float h00 = h[p], h10 = h[p + 1], h01 = h[p + width], h11 = h[p + width + 1];
+    const float s1 = hf_ray_bilinear(h00, h10, h01, h11, ox + t1 * dx - (float)cx, oy + t1 * dy - (float)cy);
+    // The surface at the cell's entry: the last cell's exit where the march goes on into this
+    // one (the same point of the continuous surface), else evaluated here.
+    const float f0 = !isnan(carried) ? carried
+                                     : hf_ray_bilinear(h00, h10, h01, h11, x - (float)cx, y - (float)cy) - (oz + t * dz);
+    const float f1 = s1 - (oz + t1 * dz);
+    carried = NAN;
+    if (!isnan(f0) && !isnan(f1)) {
       const float span = t1 - t;
-      const int p = cy * width + cx;
-      const float twist = h[p] - h[p + 1] - h[p + width] + h[p + width + 1];
+      const float twist = h00 - h10 - h01 + h11;
       const float bump = -(twist * dx * dy) * span * span;
       // g's vertex (its top where bump > 0, its bottom where bump < 0; -1 for none).
       const float sv = bump != 0.0f ? 0.5f + (f1 - f0) / (2.0f * bump) : -1.0f;
@@ -226,7 +237,12 @@ inline float hf_ray_cast(HFVIS_GLOBAL const float* h, int width, int height,
     }
     if (t1 >= t_hi) return t_hi;
     t = t1;
-    k = top > 0 ? 1 : 0;
+    // On through the block that could not be skipped; past it, test blocks again.
+    if (t1 < march_to) {
+      carried = f1;
+    } else {
+      k = top > 0 ? 1 : 0;
+    }
   }
 }
 
