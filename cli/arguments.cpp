@@ -285,7 +285,7 @@ const std::vector<OptionSpec>& optionTable() {
       {"--output", "-o", "FILE", kOutputGroup, false,
        "output image (required): float32 EXR, or a float32 GeoTIFF when the\n"
        "name ends in .tif or .tiff (the input's georeference kept; see\n"
-       "Conventions, GIS); horizon-lists: OUT.json or OUT.csv; region: OUT.json",
+       "Conventions, GIS); horizon-lists: OUT.json or OUT.csv; region, pvs: OUT.json",
        HFVIS_TEXT(output)},
       {"--quiet", "-q", nullptr, kOutputGroup, false, "print neither progress nor the summary line",
        HFVIS_FLAG(quiet)},

@@ -240,6 +240,25 @@ TEST(PvsRayCaster, AgreesWithBruteForceOnCityAndTerrain) {
   }
 }
 
+// A memory budget splits the rays into more launches, with the same results; one that does not
+// hold a single ray is refused.
+TEST(PvsRayCaster, MemoryBudgetSplitsLaunchesWithTheSameResults) {
+  const HeightField field = makeSyntheticField("city", 40, 30, 4);
+  RayCastOptions options;
+  options.view_cells = true;
+  options.grid.view_cell = 4;
+  const std::vector<HeightRay> in = raysOver(field, 500, 3);
+  const RayCastResult whole = castHeightFieldRays(testContext(), field, in, options);
+  options.memory_budget_bytes = 8192;  // about 50 rays per launch
+  const RayCastResult split = castHeightFieldRays(testContext(), field, in, options);
+  EXPECT_EQ(split.cell, whole.cell);
+  EXPECT_EQ(split.count, whole.count);
+  EXPECT_EQ(split.view_cell, whole.view_cell);
+  for (std::size_t r = 0; r < in.size(); ++r) EXPECT_TRUE(sameFloat(split.t[r], whole.t[r])) << r;
+  options.memory_budget_bytes = 16;
+  EXPECT_THROW(castHeightFieldRays(testContext(), field, in, options), MemoryBudgetError);
+}
+
 // A flat field sees everything; a tall wall across the middle hides the far side's ground.
 TEST(PvsDense, ClosedCases) {
   HeightField flat;
@@ -398,6 +417,18 @@ TEST(Pvs, PixelErrorBudgetStopsTheRun) {
   EXPECT_LE(pvs.pixel_error, 2000.0);
   ASSERT_GE(pvs.history.size(), 2u);
   EXPECT_GT(pvs.history.front().pixel_error, pvs.pixel_error);
+}
+
+// A time budget alone ends the run (after whole batches).
+TEST(Pvs, SecondsBudgetEndsTheRun) {
+  PvsOptions options;
+  options.method = PvsMethod::Sgvs;
+  options.seconds = 0.05;
+  options.batch = 1000;
+  const PvsResult pvs = computePvs(testContext(), smallCity(), smallGrid(), options);
+  EXPECT_GT(pvs.samples, 0u);
+  EXPECT_EQ(pvs.samples % 1000, 0u);
+  EXPECT_EQ(pvs.history.size(), pvs.samples / 1000);
 }
 
 TEST(Pvs, FilterOnlyAdds) {

@@ -79,6 +79,7 @@ class Pvs : public Computation {
   void compute(Job& job) override {
     PvsOptions options = run_.pvs;
     options.seed = run_.seed;
+    options.memory_budget_bytes = run_.memory_budget_bytes;
     result_ = computePvs(*job.context, job.input, grid_, options);
   }
 

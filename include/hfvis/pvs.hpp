@@ -74,6 +74,9 @@ struct RayCastOptions {
   // Also list the view cells of `grid` whose volume each ray passes through before its hit.
   bool view_cells = false;
   PvsGrid grid;
+  // Device memory for one launch's rays and lists; 0 = half the device's memory. Rays are cast
+  // in launches that fit it (MemoryBudgetError when one ray does not).
+  std::size_t memory_budget_bytes = 0;
 };
 
 struct RayCastResult {
@@ -116,7 +119,8 @@ struct PvsOptions {
   // every tile within k 2 d / sqrt(n) of a visible tile, d its distance from the view cell, n the
   // samples per view cell; counted in PvsResult::filtered, with no witness.
   double filter = 0.0;
-  bool witnesses = false;  // keep each entry's witness (PvsResult::witnesses)
+  bool witnesses = false;               // keep each entry's witness (PvsResult::witnesses)
+  std::size_t memory_budget_bytes = 0;  // as RayCastOptions::memory_budget_bytes
   // Called after each batch with the samples cast so far and the estimated pixel error.
   std::function<void(std::uint64_t, double)> progress;
 };

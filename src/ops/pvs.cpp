@@ -129,8 +129,11 @@ constexpr int kRaysPerLaunch = 1 << 16;
 class RayCastRoutine : public DeviceRoutine, public RayCaster {
  public:
   RayCastRoutine(ContextState& st, const HeightField& field, const PvsGrid& grid,
-                 const std::function<void(RayCaster&)>& body)
-      : DeviceRoutine(st, field, nullptr, 0), grid_(grid), layout_(pvsLayout(field, grid)), body_(body) {}
+                 std::size_t memory_budget_bytes, const std::function<void(RayCaster&)>& body)
+      : DeviceRoutine(st, field, nullptr, memory_budget_bytes),
+        grid_(grid),
+        layout_(pvsLayout(field, grid)),
+        body_(body) {}
 
   RayCastResult cast(const std::vector<HeightRay>& rays, bool view_cells) override {
     for (const HeightRay& r : rays)
@@ -147,8 +150,10 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
     out.view_t.resize(rays.size() * out.cap);
     // Per ray on the device: 8 floats in, t, cell, count and cap (view cell, t) pairs out.
     const std::size_t per_ray = (8 + 3 + 2 * std::size_t(out.cap)) * 4;
-    const int chunk = static_cast<int>(
-        std::max<std::size_t>(1, std::min<std::size_t>(kRaysPerLaunch, memoryBudget() / per_ray)));
+    if (per_ray > memoryBudget())
+      throw MemoryBudgetError("one ray and its view-cell list need " + mebibytes(per_ray) +
+                              " but the memory budget is " + mebibytes(memoryBudget()));
+    const int chunk = static_cast<int>(std::min<std::size_t>(kRaysPerLaunch, memoryBudget() / per_ray));
     for (int first = 0; first < n; first += chunk) launch(rays, first, std::min(chunk, n - first), out);
     return out;
   }
@@ -232,9 +237,9 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
 }  // namespace
 
 void withRayCaster(const ComputeContext& context, const HeightField& field, const PvsGrid& grid,
-                   const std::function<void(RayCaster&)>& body) {
+                   std::size_t memory_budget_bytes, const std::function<void(RayCaster&)>& body) {
   translateOpenClErrors([&] {
-    RayCastRoutine routine(stateOf(context), field, grid, body);
+    RayCastRoutine routine(stateOf(context), field, grid, memory_budget_bytes, body);
     routine.run();
   });
 }
@@ -244,7 +249,7 @@ void withRayCaster(const ComputeContext& context, const HeightField& field, cons
 RayCastResult castHeightFieldRays(const ComputeContext& context, const HeightField& field,
                                   const std::vector<HeightRay>& rays, const RayCastOptions& options) {
   RayCastResult out;
-  detail::withRayCaster(context, field, options.grid,
+  detail::withRayCaster(context, field, options.grid, options.memory_budget_bytes,
                         [&](detail::RayCaster& caster) { out = caster.cast(rays, options.view_cells); });
   return out;
 }

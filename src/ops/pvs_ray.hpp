@@ -45,8 +45,9 @@ class RayCaster {
   virtual RayCastResult cast(const std::vector<HeightRay>& rays, bool view_cells) = 0;
 };
 
-// Runs `body` with a caster of `field` and `grid` (validated) on the device.
+// Runs `body` with a caster of `field` and `grid` (validated) on the device, its launches within
+// `memory_budget_bytes` (0: the default budget).
 void withRayCaster(const ComputeContext& context, const HeightField& field, const PvsGrid& grid,
-                   const std::function<void(RayCaster&)>& body);
+                   std::size_t memory_budget_bytes, const std::function<void(RayCaster&)>& body);
 
 }  // namespace hfvis::detail

@@ -575,7 +575,8 @@ PvsResult computePvs(const ComputeContext& context, const HeightField& field, co
   validate(options);
   PvsResult out;
   Sampler sampler(field, grid, options, out);
-  detail::withRayCaster(context, field, grid, [&](detail::RayCaster& caster) { sampler.run(caster); });
+  detail::withRayCaster(context, field, grid, options.memory_budget_bytes,
+                        [&](detail::RayCaster& caster) { sampler.run(caster); });
   return out;
 }
 
