@@ -28,6 +28,7 @@
 //       viewshed rasters (visible where > 0) against the exact sight-line test at N random targets:
 //       the Jaccard index of the visible sets and the disagreements that graze
 //   hfvis_bench viewshed-culling [--levels 1,2,3,4] [--reps N] FIELD...
+//   hfvis_bench pvs-rays | pvs-recall ... city noise dem: the PVS ray caster and samplers (bench/pvs.sh)
 //       Stewart's culling pyramid per field: preprocessing time, memory per finest level kept, and
 //       for valley, ground-level and high observers the culled shares and the exact and culled
 //       viewsheds' times (interleaved, the fastest of N)
@@ -70,6 +71,7 @@
 #include "suite_support.hpp"
 #include "viewshed_agreement.hpp"
 #include "viewshed_culling.hpp"
+#include "pvs_bench.hpp"
 
 namespace {
 
@@ -93,6 +95,9 @@ constexpr const char* kUsage =
     "       hfvis_bench viewshed-culling [--levels 1,2,3,4] [--reps N] FIELD...\n"
     "       hfvis_bench error-target [--data DIR] [--dem FILE] [--size N] [--errors E,...] [--contents A,B]\n"
     "                                [--reference-k K] [--reps N]\n"
+    "       hfvis_bench pvs-rays [--size N] [--rays R] [--reps K] [--dem FILE] FIELD...\n"
+    "       hfvis_bench pvs-recall [--size N] [--view-cell C] [--tile T] [--samples N,N,...]\n"
+    "                              [--check-rays R] [--dem FILE] FIELD...   (FIELD: city, noise, dem)\n"
     "       hfvis_bench field NAME N OUT\n"
     "       hfvis_bench inputs [--quick]\n"
     "       hfvis_bench check-truth\n"
@@ -426,6 +431,26 @@ int main(int argc, char** argv) {
         if (k < 1 || k > 12) throw Usage("--levels: finest levels are 1 .. 12");
       const ComputeContext context = ComputeContext::create(ContextOptions::fromEnvironment());
       for (const std::string& path : fields) viewshedCullingReport(context, path, levels, reps);
+      return 0;
+    }
+    if (command == "pvs-rays" || command == "pvs-recall") {
+      const int size = std::stoi(args.get("--size", command == "pvs-rays" ? "1024" : "128"));
+      const std::string dem = args.get("--dem", "data/jacksboro_fault_dem.exr");
+      const ComputeContext context = ComputeContext::create(ContextOptions::fromEnvironment());
+      if (command == "pvs-rays") {
+        const int rays = std::stoi(args.get("--rays", "1000000")), reps = std::stoi(args.get("--reps", "3"));
+        const std::vector<std::string> fields = args.positional();
+        args.rejectUnused();
+        pvsRaysReport(context, fields, size, dem, rays, reps);
+        return 0;
+      }
+      const int view_cell = std::stoi(args.get("--view-cell", "16")), tile = std::stoi(args.get("--tile", "8"));
+      std::vector<std::uint64_t> samples;
+      for (int n : intList(args.get("--samples", "10000,30000,100000,300000,1000000"))) samples.push_back(std::uint64_t(n));
+      const int check = std::stoi(args.get("--check-rays", "1000000"));
+      const std::vector<std::string> fields = args.positional();
+      args.rejectUnused();
+      pvsRecallReport(context, fields, size, dem, view_cell, tile, samples, check);
       return 0;
     }
     if (command == "field") {

@@ -251,6 +251,23 @@ double parseRegionHeight(const std::string& typed, const std::string& value) {
   return parseBounded(typed, value, -kMostLength, kMostLength, kFloatRange);
 }
 
+// A sampling seed: a whole number that 32 bits hold.
+std::uint32_t parseSeed(const std::string& typed, const std::string& value) {
+  const double n = parseNumber(typed, value);
+  if (!(n >= 0.0 && n <= 4294967295.0 && n == std::floor(n)))
+    throw UsageError(typed + ": expected a whole number in 0 .. 4294967295, got " + inQuotes(shortened(value)));
+  return static_cast<std::uint32_t>(n);
+}
+
+// A count of cells a side (pvs's --view-cell and --tile): a whole number >= 1 (the field's size
+// bounds it once read).
+int parseCellCount(const std::string& typed, const std::string& value) {
+  const double n = parseNumber(typed, value);
+  if (!(n >= 1.0 && n <= 1e9 && n == std::floor(n)))
+    throw UsageError(typed + ": expected a whole number of cells >= 1, got " + inQuotes(shortened(value)));
+  return static_cast<int>(n);
+}
+
 // A flag that sets one bool field.
 #define HFVIS_FLAG(field) [](const std::string&, const std::string&, RunArguments& run) { run.field = true; }
 // A path or name: any non-empty text.
@@ -268,7 +285,7 @@ const std::vector<OptionSpec>& optionTable() {
       {"--output", "-o", "FILE", kOutputGroup, false,
        "output image (required): float32 EXR, or a float32 GeoTIFF when the\n"
        "name ends in .tif or .tiff (the input's georeference kept; see\n"
-       "Conventions, GIS); horizon-lists: OUT.json or OUT.csv; region: OUT.json",
+       "Conventions, GIS); horizon-lists: OUT.json or OUT.csv; region, pvs: OUT.json",
        HFVIS_TEXT(output)},
       {"--quiet", "-q", nullptr, kOutputGroup, false, "print neither progress nor the summary line",
        HFVIS_FLAG(quiet)},
@@ -619,13 +636,7 @@ const std::vector<OptionSpec>& optionTable() {
       {"--seed", nullptr, "N", kRegionSamplingGroup, false,
        "the jitter's seed, 0 .. 4294967295 (default 1): the same seed, the\n"
        "same samples",
-       [](const std::string& typed, const std::string& value, RunArguments& run) {
-         const double n = parseNumber(typed, value);
-         if (!(n >= 0.0 && n <= 4294967295.0 && n == std::floor(n)))
-           throw UsageError(typed + ": expected a whole number in 0 .. 4294967295, got " +
-                            inQuotes(shortened(value)));
-         run.seed = static_cast<std::uint32_t>(n);
-       }},
+       [](const std::string& typed, const std::string& value, RunArguments& run) { run.seed = parseSeed(typed, value); }},
       {"--light", nullptr, "C0,R0,C1,R1", kAreaLightGroup, false,
        "the light: the rectangle of grid points between two corner pixels\n"
        "(columns and rows, inclusive, in any order)",
@@ -681,6 +692,75 @@ const std::vector<OptionSpec>& optionTable() {
        "also every clear ray's end points, one a line (pixel columns and\n"
        "rows, heights; map x, y for a georeferenced input)",
        HFVIS_TEXT(rays_output)},
+      {"--view-cell", nullptr, "C", kPvsGroup, false,
+       "view cells of C x C cells (squares between grid points), 1 .. the\n"
+       "field's larger side - 1 (default 32)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.pvs_grid.view_cell = parseCellCount(typed, value);
+       }},
+      {"--view-height", nullptr, "H0[,H1]", kPvsGroup, false,
+       "the viewer's eye H0 above the surface, or anywhere in the band\n"
+       "H0 .. H1 (z-scaled units; default 1.7)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         const std::size_t comma = value.find(',');
+         const double lo = parseBounded(typed, value.substr(0, comma), 0.0, kMostLength, kFloatRange);
+         const double hi =
+             comma == std::string::npos ? lo : parseBounded(typed, value.substr(comma + 1), 0.0, kMostLength, kFloatRange);
+         if (hi < lo) throw UsageError(typed + ": H1 below H0 in " + inQuotes(value) + " (the band is H0 .. H1)");
+         run.pvs_grid.band_low = lo;
+         run.pvs_grid.band_high = hi;
+       }},
+      {"--view-mask", nullptr, "MASK", kPvsGroup, false,
+       "compute only the view cells holding a non-zero pixel of MASK, a\n"
+       "raster of the field's size (a trail, a site)",
+       HFVIS_TEXT(pvs_mask)},
+      {"--tile", nullptr, "T", kPvsGroup, false, "tiles (the objects) of T x T cells (default 16)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.pvs_grid.tile = parseCellCount(typed, value);
+       }},
+      {"--method", nullptr, "agvs|sgvs|per-cell", kPvsGroup, false,
+       "agvs: adaptive global sampling (default); sgvs: stationary global\n"
+       "sampling; per-cell: random rays from each view cell in turn",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         if (value == "agvs")
+           run.pvs.method = PvsMethod::Agvs;
+         else if (value == "sgvs")
+           run.pvs.method = PvsMethod::Sgvs;
+         else if (value == "per-cell")
+           run.pvs.method = PvsMethod::PerCell;
+         else
+           throw UsageError(typed + ": expected 'agvs', 'sgvs' or 'per-cell', got " + inQuotes(shortened(value)));
+       }},
+      {"--samples", nullptr, "N", kPvsGroup, false, "stop after N visibility samples",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         const double n = parseNumber(typed, value);
+         if (!(n >= 1.0 && n <= 1e15 && n == std::floor(n)))
+           throw UsageError(typed + ": expected a whole number of samples, 1 .. 1e15, got " +
+                            inQuotes(shortened(value)));
+         run.pvs.samples = static_cast<std::uint64_t>(n);
+       }},
+      {"--pixel-error", nullptr, "E", kPvsGroup, false,
+       "stop once the estimated pixel error is at most E (pixels per\n"
+       "million-pixel camera)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.pvs.pixel_error = parsePositive(typed, value);
+       }},
+      {"--seconds", nullptr, "S", kPvsGroup, false, "stop after S seconds",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.pvs.seconds = parsePositive(typed, value);
+       }},
+      {"--filter", nullptr, "K", kPvsGroup, false,
+       "the visibility filter: add the tiles within K times the sampling's\n"
+       "gap of a visible tile (no witness; default 0, none)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.pvs.filter = parseBounded(typed, value, 0.0, 1e6, "1e6");
+       }},
+      {"--seed", nullptr, "N", kPvsGroup, false,
+       "the sampling's seed, 0 .. 4294967295 (default 1): the same seed and\n"
+       "budget of samples, the same sets",
+       [](const std::string& typed, const std::string& value, RunArguments& run) { run.seed = parseSeed(typed, value); }},
+      {"--bitset", nullptr, "OUT.bin", kPvsGroup, false,
+       "also the sets as one bitset per view cell (docs/PVS.md, byte by byte)", HFVIS_TEXT(bitset_output)},
   };
   return table;
 }
@@ -697,7 +777,7 @@ namespace {
 // Checks that involve more than one option: every command's, and its own (CommandSpec::check).
 void validateRun(const CommandSpec& command, const std::string& name, const RunArguments& run) {
   const std::string out = command.id == Command::HorizonLists ? "OUT.json|OUT.csv"
-                          : command.id == Command::Region     ? "OUT.json"
+                          : command.id == Command::Region || command.id == Command::Pvs ? "OUT.json"
                                                               : "OUT.exr";
   if (run.input.empty())
     throw UsageError("missing the input height field (hfvis " + name + " IN -o " + out + ")");

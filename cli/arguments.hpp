@@ -16,6 +16,7 @@
 #include "hfvis/image_io.hpp"
 #include "hfvis/insolation.hpp"
 #include "hfvis/intervisibility.hpp"
+#include "hfvis/pvs.hpp"
 #include "hfvis/region_visibility.hpp"
 #include "hfvis/sun_shading.hpp"
 #include "hfvis/viewshed.hpp"
@@ -44,6 +45,7 @@ enum class Command {
   Viewshed,         // what one observer sees, or how many of several see each point
   AreaLight,        // the fraction of an area light's (a region's) samples each pixel sees
   Region,           // visibility between two rectangles: the share of clear sample pairs
+  Pvs,              // the potentially visible sets of a field's view cells, as JSON
 };
 
 // Everything a compute command's run needs, already validated.
@@ -123,6 +125,13 @@ struct RunArguments {
   double from_height = RegionSampling{}.height, to_height = RegionSampling{}.height;
   std::string sources_file, masks_output, rays_output;
   bool decorrelate = false;
+  // pvs (hfvis/pvs.hpp): the view cells (--view-cell C, --view-height H0[,H1], --view-mask FILE)
+  // and tiles (--tile T); the sampler (--method agvs|sgvs|per-cell) and its budgets (--samples N,
+  // --pixel-error E, --seconds S), --filter K, --bitset OUT.bin. (--seed sets `seed` above.)
+  PvsGrid pvs_grid;
+  std::string pvs_mask;
+  PvsOptions pvs;
+  std::string bitset_output;
 };
 
 // What "hfvis sunpos" is asked.

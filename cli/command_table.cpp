@@ -8,7 +8,8 @@ const std::vector<const CommandSpec*>& commandTable() {
       &kHorizonCommand,         &kSkyViewFactorCommand, &kAmbientOcclusionCommand,
       &kIntervisibilityCommand, &kHorizonListsCommand,  &kBounceCommand,
       &kShadeCommand,           &kInsolationCommand,    &kViewshedCommand,
-      &kAreaLightCommand,       &kRegionCommand,        &kSunPositionCommand,
+      &kAreaLightCommand,       &kRegionCommand,        &kPvsCommand,
+      &kSunPositionCommand,
       &kDevicesCommand,
   };
   return table;

@@ -6,6 +6,8 @@
 #include <utility>
 #include <vector>
 
+#include "hfvis/height_field.hpp"
+
 namespace hfvis::cli {
 
 // Zero-padded channel names whose sorted order is the direction order: h000, h001, ...
@@ -17,5 +19,9 @@ std::vector<std::string> directionChannelNames(const std::string& prefix, int co
 // of a DEM reads as grey on 0 .. 1. (0, 0) when no value is finite.
 std::pair<float, float> quantileRange(const std::vector<float>& plane, double lo_q = 0.01,
                                       double hi_q = 0.99);
+
+// A hillshade in 0 .. 1 (light from the north-west, 45 degrees up), under the previews of what
+// an observer sees (viewshed, pvs).
+std::vector<float> hillshade(const HeightField& field);
 
 }  // namespace hfvis::cli

@@ -40,7 +40,8 @@ enum OptionGroup : unsigned {
   kAreaLightGroup = 1u << 20,
   kRegionPairGroup = 1u << 21,
   kErrorTargetGroup = 1u << 22,  // sky-view-factor and ambient-occlusion: --max-error, --error-out
-  kLastGroup = kErrorTargetGroup,
+  kPvsGroup = 1u << 23,          // pvs's view cells, tiles, sampler and budgets
+  kLastGroup = kPvsGroup,
 };
 
 // The groups every command that reads a height field and writes images takes.
@@ -96,6 +97,6 @@ std::string commandList();
 // The entries, each defined in its command's file under cli/commands/.
 extern const CommandSpec kHorizonCommand, kSkyViewFactorCommand, kAmbientOcclusionCommand,
     kIntervisibilityCommand, kHorizonListsCommand, kBounceCommand, kShadeCommand, kInsolationCommand,
-    kViewshedCommand, kAreaLightCommand, kRegionCommand, kSunPositionCommand, kDevicesCommand;
+    kViewshedCommand, kAreaLightCommand, kRegionCommand, kPvsCommand, kSunPositionCommand, kDevicesCommand;
 
 }  // namespace hfvis::cli

@@ -54,6 +54,7 @@ def png(path, w, h, channels, rows):
         f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 16, color, 0, 0, 0))
                 + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
 png("two_channels.png", 4, 3, 2, [[1, 2] * 4 for _ in range(3)])
+png("mask_small.png", 4, 3, 1, [[1] * 4 for _ in range(3)])  # a pvs --view-mask of the wrong size
 PY
 # Environment maps with a negative and a non-finite radiance (2:1, one channel).
 /usr/bin/python3 - "$root/data" << 'PY'
@@ -208,6 +209,15 @@ try "region without --to" "" -- region field.exr -o out/r.json --from 1,1,4,4
 try "region rectangle outside the field" "" -- region field.exr -o out/r.json --from 1,1,4,4 --to 200,200,300,210
 try "region output not JSON" "" -- region field.exr -o out/r.exr --from 1,1,4,4 --to 8,8,9,9
 try "region rays not CSV" "" -- region field.exr -o out/r.json --from 1,1,4,4 --to 8,8,9,9 --rays out/r.txt
+try "pvs view cell 0" "" -- pvs field.exr -o out/p.json --samples 10 --view-cell 0
+try "pvs view cell larger than the field" "" -- pvs field.exr -o out/p.json --samples 10 --view-cell 256
+try "pvs tile larger than the field" "" -- pvs field.exr -o out/p.json --samples 10 --tile 1000
+try "pvs band with H1 below H0" "" -- pvs field.exr -o out/p.json --samples 10 --view-height 3,1
+try "pvs mask of the wrong size" "" -- pvs field.exr -o out/p.json --samples 10 --view-mask mask_small.png
+try "pvs budget of 0" "" -- pvs field.exr -o out/p.json --samples 0
+try "pvs without a budget" "" -- pvs field.exr -o out/p.json
+try "pvs output not JSON" "" -- pvs field.exr -o out/p.exr --samples 10
+try "pvs bitset is the output" "" -- pvs field.exr -o out/p.json --samples 10 --bitset out/p.json
 try "sun position without a time" "" -- sunpos --lat 45 --lon 7
 try "sun position at a time without a zone" "" -- sunpos --lat 45 --lon 7 --at 2026-06-21T12:00:00
 try "sun position at a day that does not exist" "" -- sunpos --lat 45 --lon 7 --at 2026-02-30T12:00:00Z

@@ -24,3 +24,4 @@ run insolation "$dem" -o "$tmp/sun.exr" --lat 36.4 --lon -84.2 --from 2026-12-21
   --to 2026-12-22T00:00:00-05:00 --step 10 --preview "$out/jacksboro_december_sun.png"
 run shade "$root/data/fractal_256.exr" -o "$tmp/fractal.exr" --z-scale 2 --env "$sky" --albedo 0.6 -k 128 \
   --preview "$out/fractal_clear_sky.png"
+run pvs "$dem" -o "$tmp/pvs.json" --samples 1000000 --view-cell 32 --tile 16 --preview "$out/jacksboro_pvs_size.png"

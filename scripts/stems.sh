@@ -27,6 +27,7 @@ stems=(
   "viewshed|kernels/viewshed.cl|testing/viewshed_reference.cpp"
   "sun|- (host arithmetic)|- (published positions: Reda & Andreas 2004, the USNO)"
   "region_visibility|kernels/region_visibility.cl|testing/region_visibility_reference.cpp"
+  "pvs|kernels/pvs.cl|testing/pvs_reference.cpp"
 )
 has() { grep -qx "$1" <<< "$files"; }
 show() {  # label, path or "- reason"

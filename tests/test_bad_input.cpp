@@ -124,6 +124,38 @@ TEST(BadInput, Options) {
                                "one value per height");
 }
 
+TEST(BadInput, PotentiallyVisibleSets) {
+  const HeightField field = makeSyntheticField("noise", 9, 7, 1);
+  PvsOptions options;
+  options.samples = 10;
+  auto pvs = [&](const PvsGrid& grid) { computePvs(testContext(), field, grid, options); };
+  PvsGrid grid;
+  grid.view_cell = 4;
+  grid.tile = 2;
+  PvsGrid bad = grid;
+  bad.view_cell = 9;
+  expectError<InvalidArgument>([&] { pvs(bad); }, "view cell size must be 1 .. 8");
+  bad = grid;
+  bad.tile = 0;
+  expectError<InvalidArgument>([&] { pvs(bad); }, "tile size");
+  bad = grid;
+  bad.band_low = 2.0;
+  bad.band_high = 1.0;
+  expectError<InvalidArgument>([&] { pvs(bad); }, "0 <= H0 <= H1");
+  bad = grid;
+  bad.mask.assign(3, 1);
+  expectError<InvalidArgument>([&] { pvs(bad); }, "mask has 3 entries");
+  bad.mask.assign(4, 0);
+  expectError<InvalidArgument>([&] { pvs(bad); }, "selects no view cell");
+  options.samples = 0;
+  expectError<InvalidArgument>([&] { pvs(grid); }, "needs a budget");
+  options.samples = 10;
+  options.pixel_error = -1.0;
+  expectError<InvalidArgument>([&] { pvs(grid); }, "finite and >= 0");
+  const HeightField line = makeSyntheticField("noise", 9, 1, 1);
+  expectError<InvalidArgument>([&] { computeDensePvs(testContext(), line, grid); }, "at least 2 x 2");
+}
+
 TEST(BadInput, ContextsAndFiles) {
   ContextOptions unknown;
   unknown.device = "a device nobody has";

@@ -29,6 +29,7 @@
 #include "geotiff_support.hpp"
 #include "hfvis/horizon_lists.hpp"
 #include "hfvis/image_io.hpp"
+#include "hfvis/pvs.hpp"
 #include "hfvis/region_visibility.hpp"
 #include "image_outputs.hpp"
 #include "test_support.hpp"
@@ -2467,6 +2468,81 @@ TEST_F(Cli, RegionWritesConsistentJsonAndItsClearRays) {
             0);
   EXPECT_EQ(JsonParser::parse(readText(out("w.json")))["clear_pairs"].number, 0.0);
   EXPECT_EQ(splitText(readText(out("w.csv")), '\n').size(), 2u);
+}
+
+// hfvis pvs: the JSON's sets and the bitset file (docs/PVS.md's layout) are the library's for the
+// same seed and budget; a mask limits the view cells computed.
+TEST_F(Cli, PvsWritesTheLibrarysSetsAsJsonAndBits) {
+  const std::string field = writeField("hills.exr", 30, 22, [](int col, int row) {
+    return 4.0f * std::sin(0.4f * col) * std::cos(0.3f * row) + (col == 15 ? 12.0f : 0.0f);
+  });
+  const CliResult result = run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out("p.json")) +
+                               " --view-cell 8 --tile 4 --samples 6000 --method sgvs --seed 3 --bitset " +
+                               shellQuoted(out("p.bin")) + " --preview " + shellQuoted(out("p.png")) + " --quiet");
+  ASSERT_EQ(result.status, 0) << result.err;
+  hfvis::PvsGrid grid;
+  grid.view_cell = 8;
+  grid.tile = 4;
+  hfvis::PvsOptions options;
+  options.method = hfvis::PvsMethod::Sgvs;
+  options.samples = 6000;
+  options.seed = 3;
+  const hfvis::PvsResult want = hfvis::computePvs(hfvis::testing::testContext(), hfvis::readHeightField(field), grid, options);
+  const std::string json = readText(out("p.json"));
+  // The sets: "pvs": [ [t, t, ...], ... ] one line per view cell.
+  const std::size_t sets = json.find("\"pvs\": [");
+  ASSERT_NE(sets, std::string::npos);
+  std::istringstream lines(json.substr(sets));
+  std::string line;
+  std::getline(lines, line);
+  for (int v = 0; v < want.layout.viewCells(); ++v) {
+    ASSERT_TRUE(std::getline(lines, line));
+    std::string expected = "    [";
+    int n = 0;
+    for (int t = 0; t < want.layout.tiles(); ++t)
+      if (want.visible(v, t)) expected += (n++ ? "," : "") + std::to_string(t);
+    expected += "]";
+    EXPECT_EQ(line.substr(0, line.find_last_of(']') + 1), expected) << "view cell " << v;
+  }
+  EXPECT_NE(json.find("\"samples\": 6000,"), std::string::npos);
+  // The bitset: header, flags padded to 4 bytes, words little-endian.
+  const std::string bits = readText(out("p.bin"));
+  auto u32 = [&](std::size_t at) {
+    std::uint32_t v = 0;
+    for (int i = 0; i < 4; ++i) v |= std::uint32_t(static_cast<unsigned char>(bits[at + i])) << (8 * i);
+    return v;
+  };
+  ASSERT_GE(bits.size(), 40u);
+  EXPECT_EQ(bits.substr(0, 8), std::string("HFVPVS1", 8));
+  EXPECT_EQ(u32(8), 1u);
+  EXPECT_EQ(u32(12), std::uint32_t(want.layout.view_x));
+  EXPECT_EQ(u32(16), std::uint32_t(want.layout.view_y));
+  EXPECT_EQ(u32(20), std::uint32_t(want.layout.tiles_x));
+  EXPECT_EQ(u32(24), std::uint32_t(want.layout.tiles_y));
+  EXPECT_EQ(u32(28), std::uint32_t(want.words));
+  EXPECT_EQ(u32(32), 8u);
+  EXPECT_EQ(u32(36), 4u);
+  const std::size_t words_at = 40 + (want.layout.viewCells() + 3) / 4 * 4;
+  ASSERT_EQ(bits.size(), words_at + 4 * want.bits.size());
+  for (int v = 0; v < want.layout.viewCells(); ++v) EXPECT_EQ(bits[40 + v], 1);
+  for (std::size_t i = 0; i < want.bits.size(); ++i) EXPECT_EQ(u32(words_at + 4 * i), want.bits[i]) << i;
+  EXPECT_TRUE(fs::exists(out("p.png")));
+  // A mask of the field's size selecting one corner: only view cell 0 computed.
+  const std::string mask = writeField("mask.exr", 30, 22, [](int col, int row) { return col < 3 && row < 3 ? 1.0f : 0.0f; });
+  const CliResult masked = run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out("m.json")) +
+                               " --view-cell 8 --tile 4 --samples 500 --view-mask " + shellQuoted(mask) + " --quiet");
+  ASSERT_EQ(masked.status, 0) << masked.err;
+  const std::string mjson = readText(out("m.json"));
+  const std::size_t msets = mjson.find("\"pvs\": [");
+  ASSERT_NE(msets, std::string::npos);
+  std::istringstream mlines(mjson.substr(msets));
+  std::getline(mlines, line);
+  std::getline(mlines, line);
+  EXPECT_NE(line.find('['), std::string::npos) << line;
+  for (int v = 1; v < want.layout.viewCells(); ++v) {
+    ASSERT_TRUE(std::getline(mlines, line));
+    EXPECT_NE(line.find("null"), std::string::npos) << "view cell " << v << ": " << line;
+  }
 }
 
 TEST_F(Cli, RegionVisibilityRefusesBadInput) {

@@ -7,32 +7,13 @@
 #include <limits>
 #include <optional>
 
+#include "../image_outputs.hpp"
 #include "../observer_files.hpp"
 #include "../pipeline.hpp"
 #include "hfvis/errors.hpp"
 
 namespace hfvis::cli {
 namespace {
-
-// A hillshade in 0 .. 1 (light from the north-west, 45 degrees up), under the viewshed's preview.
-std::vector<float> hillshade(const HeightField& f) {
-  std::vector<float> shade(f.pixelCount(), 0.0f);
-  const double lx = -0.5, ly = -0.5, lz = std::sqrt(0.5);  // toward -column, -row (north-west), up
-  auto at = [&](int x, int y) {
-    const float v = f.at(std::clamp(x, 0, f.width - 1), std::clamp(y, 0, f.height - 1));
-    return std::isfinite(v) ? v * f.z_scale : std::numeric_limits<double>::quiet_NaN();
-  };
-  for (int y = 0; y < f.height; ++y)
-    for (int x = 0; x < f.width; ++x) {
-      const double gx = (at(x + 1, y) - at(x - 1, y)) / (2.0 * f.cell_size_x);
-      const double gy = (at(x, y + 1) - at(x, y - 1)) / (2.0 * f.cell_size_y);
-      const double n = std::sqrt(gx * gx + gy * gy + 1.0);
-      const double lit = (-gx * lx - gy * ly + lz) / n;
-      shade[static_cast<std::size_t>(y) * f.width + x] =
-          std::isfinite(lit) ? static_cast<float>(std::max(lit, 0.0)) : 0.0f;
-    }
-  return shade;
-}
 
 class Viewshed : public Computation {
  public:

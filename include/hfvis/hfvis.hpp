@@ -18,6 +18,7 @@
 //   hfvis/insolation.hpp       computeInsolation: sunshine hours and irradiation over a span of time
 //   hfvis/sun.hpp              where the sun stands at a time and place
 //   hfvis/region_visibility.hpp computeRegionVisibility: which samples of a region each point sees
+//   hfvis/pvs.hpp              computePvs: the tiles each view cell can see (potentially visible sets)
 //   hfvis/viewshed.hpp         computeViewshed, computeCumulativeViewshed: what observers see
 //   hfvis/image_io.hpp         reading height fields, writing float EXRs and PNG previews
 //
@@ -38,6 +39,7 @@
 #include "hfvis/insolation.hpp"
 #include "hfvis/intervisibility.hpp"
 #include "hfvis/region_visibility.hpp"
+#include "hfvis/pvs.hpp"
 #include "hfvis/sky_view_factor.hpp"
 #include "hfvis/sun_shading.hpp"
 #include "hfvis/sun.hpp"

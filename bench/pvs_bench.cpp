@@ -1,0 +1,185 @@
+// bench/pvs_bench.cpp: see pvs_bench.hpp.
+#include "pvs_bench.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <random>
+#include <stdexcept>
+
+#include "hfvis/image_io.hpp"
+#include "hfvis/pvs.hpp"
+#include "hfvis_testing/synthetic_fields.hpp"
+
+namespace hfvis::bench {
+namespace {
+
+double seconds(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+// Random rays from the view band (uniform over the valid cells' squares, at H0 .. H1 above the
+// surface) in uniform directions (ground units), unbounded.
+std::vector<HeightRay> viewRays(const HeightField& f, const PvsGrid& grid, int count, std::uint32_t seed) {
+  std::mt19937_64 gen(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<HeightRay> rays;
+  rays.reserve(count);
+  while (static_cast<int>(rays.size()) < count) {
+    const double x = u(gen) * (f.width - 1), y = u(gen) * (f.height - 1);
+    const int cx = std::min(int(x), f.width - 2), cy = std::min(int(y), f.height - 2);
+    const double a = u(gen), b = u(gen);
+    const double h00 = f.at(cx, cy), h10 = f.at(cx + 1, cy), h01 = f.at(cx, cy + 1),
+                 h11 = f.at(cx + 1, cy + 1);
+    const double s = (h00 * (1 - (x - cx)) * (1 - (y - cy)) + h10 * (x - cx) * (1 - (y - cy)) +
+                      h01 * (1 - (x - cx)) * (y - cy) + h11 * (x - cx) * (y - cy)) *
+                     f.z_scale;
+    if (!std::isfinite(s)) continue;
+    const double phi = 2.0 * M_PI * a, c = 1.0 - 2.0 * b, r = std::sqrt(std::max(0.0, 1.0 - c * c));
+    HeightRay ray;
+    ray.ox = float(x), ray.oy = float(y);
+    ray.oz = float(s + grid.band_low + (grid.band_high - grid.band_low) * u(gen));
+    ray.dx = float(r * std::cos(phi) / f.cell_size_x);
+    ray.dy = float(r * std::sin(phi) / f.cell_size_y);
+    ray.dz = float(c);
+    ray.t_max = INFINITY;
+    rays.push_back(ray);
+  }
+  return rays;
+}
+
+// The measured pixel error (Bittner et al. 2009, Sec. 4.5's definition): of random view rays,
+// those whose hit tile is missing from the PVS of the view cell they start in, per `resolution`.
+double measuredPixelError(const HeightField& f, const PvsResult& pvs, const std::vector<HeightRay>& rays,
+                          const RayCastResult& hits, double resolution) {
+  std::size_t wrong = 0;
+  const PvsLayout& l = pvs.layout;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    if (hits.cell[i] < 0) continue;
+    const int cx = std::min(int(rays[i].ox), f.width - 2), cy = std::min(int(rays[i].oy), f.height - 2);
+    const int v = l.viewOfCell(cy * l.cells_x + cx);
+    wrong += !pvs.visible(v, l.tileOfCell(hits.cell[i]));
+  }
+  return resolution * double(wrong) / double(rays.size());
+}
+
+const char* methodName(PvsMethod m) {
+  return m == PvsMethod::Agvs ? "AGVS" : m == PvsMethod::Sgvs ? "SGVS" : "per-cell (REF)";
+}
+
+}  // namespace
+
+HeightField pvsBenchField(const std::string& name, int size, const std::string& dem_path) {
+  if (name != "dem") {
+    HeightField f = makeSyntheticField(name, size, size, 7);
+    return f;
+  }
+  const HeightField dem = readHeightField(dem_path);
+  if (dem.width < size || dem.height < size)
+    throw std::runtime_error("the DEM is smaller than " + std::to_string(size) + " x " +
+                             std::to_string(size));
+  HeightField f = dem;
+  f.width = f.height = size;
+  f.heights.resize(std::size_t(size) * size);
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) f.heights[std::size_t(y) * size + x] = dem.at(x, y);
+  f.georeference = {};
+  return f;
+}
+
+void pvsRaysReport(const ComputeContext& context, const std::vector<std::string>& fields, int size,
+                   const std::string& dem_path, int rays, int reps) {
+  std::printf(
+      "| field | rays | hits | rays/s (hit only) | rays/s (with view cells) | rays per CPU second (hit only) "
+      "| "
+      "(with view cells) |\n| --- | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+  for (const std::string& name : fields) {
+    const HeightField f = pvsBenchField(name, size, dem_path);
+    RayCastOptions plain, listed;
+    listed.view_cells = true;
+    const std::vector<HeightRay> in = viewRays(f, plain.grid, rays, 5);
+    castHeightFieldRays(context, f, std::vector<HeightRay>(in.begin(), in.begin() + 1024), listed);  // build
+    // Wall time, and the process's CPU time (host and PoCL's threads), which a machine shared
+    // with other work inflates less.
+    double best_plain = 1e30, best_listed = 1e30, cpu_plain = 1e30, cpu_listed = 1e30;
+    std::size_t hits = 0;
+    for (int r = 0; r < reps; ++r) {
+      auto t0 = std::chrono::steady_clock::now();
+      std::clock_t c0 = std::clock();
+      const RayCastResult a = castHeightFieldRays(context, f, in, plain);
+      best_plain = std::min(best_plain, seconds(t0));
+      cpu_plain = std::min(cpu_plain, double(std::clock() - c0) / CLOCKS_PER_SEC);
+      t0 = std::chrono::steady_clock::now();
+      c0 = std::clock();
+      castHeightFieldRays(context, f, in, listed);
+      best_listed = std::min(best_listed, seconds(t0));
+      cpu_listed = std::min(cpu_listed, double(std::clock() - c0) / CLOCKS_PER_SEC);
+      hits = std::size_t(std::count_if(a.cell.begin(), a.cell.end(), [](int c) { return c >= 0; }));
+    }
+    std::printf("| %s %dx%d | %d | %.1f %% | %.2fM | %.2fM | %.2fM | %.2fM |\n", name.c_str(), f.width,
+                f.height, rays, 100.0 * double(hits) / rays, rays / best_plain / 1e6,
+                rays / best_listed / 1e6, rays / cpu_plain / 1e6, rays / cpu_listed / 1e6);
+    std::fflush(stdout);
+  }
+  std::printf(
+      "\n(view-band rays at 1.7 above the surface in uniform directions, unbounded; the fastest of %d "
+      "calls, each with its upload and pyramid; %s)\n",
+      reps, context.device().name.c_str());
+}
+
+void pvsRecallReport(const ComputeContext& context, const std::vector<std::string>& fields, int size,
+                     const std::string& dem_path, int view_cell, int tile,
+                     const std::vector<std::uint64_t>& samples, int check_rays) {
+  PvsGrid grid;
+  grid.view_cell = view_cell;
+  grid.tile = tile;
+  for (const std::string& name : fields) {
+    const HeightField f = pvsBenchField(name, size, dem_path);
+    auto t0 = std::chrono::steady_clock::now();
+    const PvsResult dense = computeDensePvs(context, f, grid);
+    const double dense_seconds = seconds(t0);
+    const std::vector<HeightRay> check = viewRays(f, grid, check_rays, 99);
+    const RayCastResult check_hits = castHeightFieldRays(context, f, check);
+    std::printf("\n### %s %d x %d (view cells %d x %d cells, tiles %d x %d)\n\n", name.c_str(), f.width,
+                f.height, view_cell, view_cell, tile, tile);
+    std::printf("Dense reference: %zu of %d entries (%.1f %%), %.1f s.\n\n", dense.entries(),
+                dense.layout.viewCells() * dense.layout.tiles(),
+                100.0 * double(dense.entries()) / (dense.layout.viewCells() * dense.layout.tiles()),
+                dense_seconds);
+    std::printf(
+        "| sampler | samples | rays | recall | estimated pixel error | measured pixel error | seconds |\n"
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+    PvsResult last_agvs;
+    for (PvsMethod method : {PvsMethod::Agvs, PvsMethod::Sgvs, PvsMethod::PerCell}) {
+      for (std::uint64_t n : samples) {
+        PvsOptions options;
+        options.method = method;
+        options.samples = n;
+        const PvsResult pvs = computePvs(context, f, grid, options);
+        std::printf("| %s | %llu | %llu | %.4f | %.0f | %.0f | %.2f |\n", methodName(method),
+                    static_cast<unsigned long long>(n), static_cast<unsigned long long>(pvs.rays),
+                    pvsRecall(pvs, dense), pvs.pixel_error,
+                    measuredPixelError(f, pvs, check, check_hits, options.resolution), pvs.seconds);
+        std::fflush(stdout);
+        if (method == PvsMethod::Agvs) last_agvs = pvs;
+      }
+    }
+    std::printf("\nAGVS's mixture over its %llu-sample run (per batch of 65536 samples):\n\n| samples |",
+                static_cast<unsigned long long>(samples.back()));
+    for (int d = 0; d < kPvsDistributions; ++d) std::printf(" %s |", pvsDistributionName(d));
+    std::printf("\n| ---: |");
+    for (int d = 0; d < kPvsDistributions; ++d) std::printf(" ---: |");
+    std::printf("\n");
+    for (const PvsProgress& p : last_agvs.history) {
+      std::printf("| %llu |", static_cast<unsigned long long>(p.samples));
+      for (double q : p.probability) std::printf(" %.3f |", q);
+      std::printf("\n");
+    }
+  }
+  std::printf("\n(pixel errors per million rays; measured with %d random view rays; %s)\n", check_rays,
+              context.device().name.c_str());
+}
+
+}  // namespace hfvis::bench

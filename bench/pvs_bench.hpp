@@ -1,0 +1,32 @@
+// bench/pvs_bench.hpp: the potentially visible sets (hfvis/pvs.hpp) measured: the ray caster's
+// rays per second, and per sampler the recall against the dense reference and the pixel error
+// (estimated, and measured with random view rays) against samples and time.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "hfvis/device.hpp"
+#include "hfvis/height_field.hpp"
+
+namespace hfvis::bench {
+
+// The benchmark surfaces, `size` x `size`: "city" and "noise" (hfvis_testing's synthetic city DSM
+// and rough terrain) and "dem" (the bundled Jacksboro DEM, its top-left corner; `dem_path`).
+HeightField pvsBenchField(const std::string& name, int size, const std::string& dem_path);
+
+// Markdown on stdout: rays per second of castHeightFieldRays on each field, `rays` random rays
+// from the view band in uniform directions, with and without the view-cell lists (the fastest of
+// `reps` calls, the two interleaved).
+void pvsRaysReport(const ComputeContext& context, const std::vector<std::string>& fields, int size,
+                   const std::string& dem_path, int rays, int reps);
+
+// Markdown on stdout: per field, the dense reference's size and time, then for each sampler and
+// budget in `samples` the recall, the estimated and measured pixel error (`check_rays` random
+// view rays), entries and seconds; and AGVS's mixture over its last run.
+void pvsRecallReport(const ComputeContext& context, const std::vector<std::string>& fields, int size,
+                     const std::string& dem_path, int view_cell, int tile,
+                     const std::vector<std::uint64_t>& samples, int check_rays);
+
+}  // namespace hfvis::bench

@@ -1,0 +1,183 @@
+// hfvis/pvs.hpp: potentially visible sets (PVS) of a height field's view cells: for every region
+// a viewer can stand in, the terrain tiles that can be seen from somewhere in it. After Bittner,
+// Mattausch, Wonka, Havran & Wimmer (2009, "Adaptive global visibility sampling"): a
+// visibility sample is a maximal free segment (a ray and its reverse from one point), whose end
+// tiles are added to every view cell the segment passes through.
+//
+// Geometry. Positions are in pixels (x along columns, y along rows), heights z-scaled; the surface
+// is the bilinear one of the viewshed (hfvis/viewshed.hpp), a cell being the square between four
+// neighbouring grid points (W - 1 x H - 1 of them). View cell (a, b) is the square of C x C cells
+// [a C, a C + C] x [b C, b C + C] (the last row and column of view cells fewer, clipped to the
+// field), as a volume: the points whose height above the surface under them lies in the band
+// [H0, H1] (H0 = H1: a sheet at eye height, a walker; a band for flight). Tile (a, b) is the
+// surface over the T x T cells [a T, a T + T] x [b T, b T + T], likewise clipped. View cells and
+// tiles are numbered row-major. A cell with a nodata corner has no surface and belongs to no view
+// cell's volume.
+//
+// Visibility. Tile t is in view cell v's PVS when some point of v's volume sees some point of t's
+// surface by the line-of-sight test of the region visibility (hfvis/region_visibility.hpp: no
+// point of the surface strictly between them rises strictly above the segment). Sampling finds a
+// subset: every entry it adds has a witness, an eye in v's volume and a surface point of t
+// whose segment passes that test (checked when the entry is added: a sample whose witness fails
+// through rounding adds nothing). The dense reference (computeDensePvs) decides the eyes on v's
+// grid points at heights H0, (H0 + H1) / 2 and H1 (one height when H0 = H1) against the targets
+// on t's grid points (its closed square: a grid point on a tile border counts for every tile
+// around it) by exact viewsheds: tile visible when any of its grid points is visible from any
+// of those eyes. No curvature; projected grids only.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "hfvis/device.hpp"
+#include "hfvis/height_field.hpp"
+
+namespace hfvis {
+
+// A ray o + t d, t in [0, t_max]: pixels and z-scaled heights (d need not be unit length).
+struct HeightRay {
+  float ox = 0, oy = 0, oz = 0;
+  float dx = 0, dy = 0, dz = 0;
+  float t_max = 0;
+};
+
+// The view cells and tiles.
+struct PvsGrid {
+  int view_cell = 32;                      // C, cells per view cell side, 1 .. max(W, H) - 1
+  double band_low = 1.7, band_high = 1.7;  // H0 <= H1, z-scaled units above the surface, finite, >= 0
+  int tile = 16;                           // T, cells per tile side, 1 .. max(W, H) - 1
+  // One byte per view cell (row-major over the view-cell grid), non-zero = computed; empty = all.
+  std::vector<std::uint8_t> mask;
+};
+
+// The sizes a grid takes on a field.
+struct PvsLayout {
+  int view_x = 0, view_y = 0;    // view cells across and down
+  int tiles_x = 0, tiles_y = 0;  // tiles across and down
+  int cells_x = 0, cells_y = 0;  // W - 1, H - 1
+  int viewCells() const { return view_x * view_y; }
+  int tiles() const { return tiles_x * tiles_y; }
+  int tileOfCell(int cell) const;  // the tile holding cell cy * cells_x + cx
+  int viewOfCell(int cell) const;  // the view cell holding it
+  int view_cell = 1, tile = 1;
+};
+
+// Throws InvalidArgument for a field under 2 x 2 points, a latitude / longitude grid, C or T
+// below 1 or past max(W, H) - 1, a band not finite, negative or with H1 < H0, a mask of the wrong
+// size or computing no view cell.
+PvsLayout pvsLayout(const HeightField& field, const PvsGrid& grid);
+
+// ---- The ray caster
+
+struct RayCastOptions {
+  // Also list the view cells of `grid` whose volume each ray passes through before its hit.
+  bool view_cells = false;
+  PvsGrid grid;
+  // Device memory for one launch's rays and lists; 0 = half the device's memory. Rays are cast
+  // in launches that fit it (MemoryBudgetError when one ray does not).
+  std::size_t memory_budget_bytes = 0;
+};
+
+struct RayCastResult {
+  std::vector<float> t;    // per ray: the hit, or where the ray leaves the field's box or ends
+  std::vector<int> cell;   // per ray: the hit cell (cy (W - 1) + cx), -1 for none
+  int cap = 0;             // view cells listed per ray at most (view_x + view_y), 0 without
+  std::vector<int> count;  // per ray: view cells listed
+  // Ray r's view cell j at r * cap + j (j < count[r]), in order along the ray, and a t where the
+  // ray lies in that view cell's volume (to rounding).
+  std::vector<int> view_cell;
+  std::vector<float> view_t;
+};
+
+// Casts the rays on the device: the first point where each passes strictly below the bilinear
+// surface (a ray starting below it hits at t = 0; one only touching it goes on), exact to the
+// float rounding of the per-cell quadratic's root. Throws InvalidArgument (bad field or grid, a
+// ray not finite), MemoryBudgetError, OpenClError, KernelBuildError.
+RayCastResult castHeightFieldRays(const ComputeContext& context, const HeightField& field,
+                                  const std::vector<HeightRay>& rays, const RayCastOptions& options = {});
+
+// ---- Potentially visible sets
+
+enum class PvsMethod {
+  Agvs,     // adaptive global sampling: the mixture of distributions and mutations (see PvsOptions)
+  Sgvs,     // stationary global sampling: view space-direction samples alone
+  PerCell,  // per view cell random sampling (the paper's REF): rays from a view cell feed it alone
+};
+
+struct PvsOptions {
+  PvsMethod method = PvsMethod::Agvs;
+  // Budgets: the run stops at the first one reached (0 = none); at least one must be set.
+  std::uint64_t samples = 0;  // visibility samples (a global sample is two rays, a per-cell one one)
+  double pixel_error = 0.0;   // the estimated pixel error (Sec. 4.5) at or below this
+  double seconds = 0.0;       // wall time
+  int batch = 1 << 16;        // samples per device launch (the mixture adapts once per batch)
+  std::uint32_t seed = 1;     // a run is a function of the inputs and the seed
+  // The pixel error's camera resolution (rays per camera; Sec. 4.5's `resolution`).
+  double resolution = 1e6;
+  // The visibility filter's k (Sec. 5's object-space filter, global extension; 0 = none): adds
+  // every tile within k 2 d / sqrt(n) of a visible tile, d its distance from the view cell, n the
+  // samples per view cell; counted in PvsResult::filtered, with no witness.
+  double filter = 0.0;
+  bool witnesses = false;               // keep each entry's witness (PvsResult::witnesses)
+  std::size_t memory_budget_bytes = 0;  // as RayCastOptions::memory_budget_bytes
+  // Called after each batch with the samples cast so far and the estimated pixel error.
+  std::function<void(std::uint64_t, double)> progress;
+};
+
+// Why an entry is in a PVS: an eye in the view cell's volume and a surface point of the tile
+// that sees it.
+struct PvsWitness {
+  int view_cell = 0, tile = 0;
+  float eye[3] = {0, 0, 0};
+  float target[3] = {0, 0, 0};
+};
+
+// One row per batch: how the run went.
+struct PvsProgress {
+  std::uint64_t samples = 0, rays = 0, entries = 0;
+  double seconds = 0.0;
+  double pixel_error = 0.0;         // the estimate after the batch
+  std::vector<double> probability;  // per distribution (kPvsDistributions), the mixture's
+};
+
+// The distributions of AGVS, in PvsProgress::probability's order.
+constexpr int kPvsDistributions = 5;
+const char* pvsDistributionName(int index);  // "view-direction", "object-direction", "two-point",
+                                             // "two-point-mutation", "silhouette-mutation"
+
+struct PvsResult {
+  PvsLayout layout;
+  int words = 0;                       // per view cell: ceil(tiles / 32)
+  std::vector<std::uint32_t> bits;     // view cell v's tile j: bit j % 32 of word v * words + j / 32
+  std::vector<std::uint8_t> computed;  // per view cell: the grid's mask (all 1 without one)
+  std::uint64_t samples = 0, rays = 0;
+  std::uint64_t rejected = 0;  // candidate entries whose witness failed the line-of-sight test
+  std::uint64_t filtered = 0;  // entries the visibility filter added (no witness)
+  double pixel_error = 0.0;    // the estimate at the end (NaN before any estimate)
+  double seconds = 0.0;
+  std::vector<PvsWitness> witnesses;  // with PvsOptions::witnesses: one per sampled entry
+  std::vector<PvsProgress> history;
+  bool visible(int view_cell, int tile) const {
+    return (bits[std::size_t(view_cell) * words + tile / 32] >> (tile % 32)) & 1u;
+  }
+  std::size_t entries() const;  // set bits
+};
+
+// Throws InvalidArgument for no budget, a negative or non-finite budget, a batch below 1, a
+// negative or non-finite filter or resolution below 1.
+void validate(const PvsOptions& options);
+
+// The sampled PVS of every computed view cell. Throws InvalidArgument (bad field, grid or
+// options), MemoryBudgetError, OpenClError, KernelBuildError.
+PvsResult computePvs(const ComputeContext& context, const HeightField& field, const PvsGrid& grid,
+                     const PvsOptions& options);
+
+// The dense reference (see above): (C + 1)^2 x (1 or 3) viewsheds per view cell, for small
+// fields. Throws as computePvs.
+PvsResult computeDensePvs(const ComputeContext& context, const HeightField& field, const PvsGrid& grid);
+
+// Entries of `got` that `want` holds, over `want`'s entries (1 when `want` has none).
+double pvsRecall(const PvsResult& got, const PvsResult& want);
+
+}  // namespace hfvis

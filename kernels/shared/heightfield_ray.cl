@@ -1,0 +1,249 @@
+// heightfield_ray.cl: the first hit of the bilinear surface along a 3D ray, and the view cells
+// (hfvis/pvs.hpp) the free part of the ray passes through. Written once in the common subset of
+// OpenCL C and C++, as shared/region_visibility_sight.cl is: kernels/pvs.cl includes it, and so
+// does src/ops/pvs_ray.hpp (inside namespace hfvis::detail), so the kernel and the scalar
+// reference run the very same float operations (no contraction into fma on either side, no math
+// library call but the correctly rounded division and square root).
+//
+// Positions are in pixels (x along columns, y along rows) and heights z-scaled; a ray is
+// o + t d for t in [0, t_max]. The surface is the bilinear one of the viewshed and the region
+// visibility: inside each cell between four grid points h(x, y) = h00 + (h10 - h00) u +
+// (h01 - h00) v + twist u v, so along a ray the height over the surface is a quadratic in t
+// within a cell: the hit is its root, solved per cell. The ray hits where it first passes
+// strictly below the surface (the line-of-sight test's "rises strictly above": a ray that only
+// touches the surface goes on); a ray starting below it hits at once. A cell with a nodata
+// corner has no surface: the ray passes through it.
+//
+// Empty space is skipped with a maximum pyramid over the grid points (the viewshed's layout:
+// level k >= 1 holds, per block of 2^k x 2^k cells, the largest of its (2^k + 1)^2 heights, NaN
+// where all are nodata; level k is levels[4k] blocks wide, levels[4k + 1] high, from
+// levels[4k + 2]): a block is skipped where the ray over it stays above its largest height by
+// more than `clearance` (0 for the hit alone; the view band's top when view cells are wanted).
+#ifndef HFVIS_HEIGHTFIELD_RAY_CL
+#define HFVIS_HEIGHTFIELD_RAY_CL
+
+#include "region_visibility_sight.cl"
+
+// The cell (or block of `size` cells: pass p / size) holding coordinate p of a point moving by d:
+// a point on a boundary belongs to the cell the ray enters there.
+inline int hf_ray_cell_of(float p, float d, int cells) {
+  const float c = d < 0.0f ? ceil(p) - 1.0f : floor(p);
+  return c < 0.0f ? 0 : (c > (float)(cells - 1) ? cells - 1 : (int)c);
+}
+
+// The ray parameter where coordinate o + t d reaches `line` (INFINITY when d = 0).
+inline float hf_ray_crossing(float line, float o, float d) { return d != 0.0f ? (line - o) / d : INFINITY; }
+
+// The bilinear surface of a cell with corners h00 (its lower corner), h10, h01, h11 at (u, v)
+// from its lower corner, clamped into the cell; NaN where a corner is nodata.
+inline float hf_ray_bilinear(float h00, float h10, float h01, float h11, float u, float v) {
+  u = u < 0.0f ? 0.0f : (u > 1.0f ? 1.0f : u);
+  v = v < 0.0f ? 0.0f : (v > 1.0f ? 1.0f : v);
+  const float a = h00 + (h10 - h00) * u;
+  const float b = h01 + (h11 - h01) * u;
+  return a + (b - a) * v;
+}
+
+// g(s) = f0 + (f1 - f0) s + bump s (1 - s): the surface minus the ray over one cell's piece,
+// in the piece's own parameter s in [0, 1].
+inline float hf_ray_piece(float f0, float f1, float bump, float s) {
+  return f0 + (f1 - f0) * s + bump * s * (1.0f - s);
+}
+
+// The least s in [0, s_end] where g turns positive, given g(0) <= 0 < g somewhere in
+// (0, s_end]: the smaller root where g is concave (bump > 0), the larger where convex.
+inline float hf_ray_entry(float f0, float f1, float bump, float s_end) {
+  // g(s) = A s^2 + B s + C.
+  const float A = -bump, B = f1 - f0 + bump, C = f0;
+  float s;
+  if (A == 0.0f) {
+    s = -C / B;
+  } else {
+    float disc = B * B - 4.0f * A * C;
+    disc = disc < 0.0f ? 0.0f : disc;  // a tangent rounded below zero
+    const float root = sqrt(disc);
+    const float q = -0.5f * (B < 0.0f ? B - root : B + root);
+    const float r1 = q / A, r2 = q != 0.0f ? C / q : r1;
+    const float lo = r1 < r2 ? r1 : r2, hi = r1 < r2 ? r2 : r1;
+    s = A < 0.0f ? lo : hi;
+  }
+  if (isnan(s)) return s_end;
+  return s < 0.0f ? 0.0f : (s > s_end ? s_end : s);
+}
+
+// A point of [0, s_end] where g lies in [lo, hi] (the view band, g being minus the height over the
+// surface), given that g's range over [0, s_end] (its ends and its vertex sv) meets it: an end or
+// the vertex where it lies in the band, else a bisection between a point below and one above.
+inline float hf_ray_band_point(float f0, float f1, float bump, float s_end, float sv, float lo, float hi) {
+  const float ge = hf_ray_piece(f0, f1, bump, s_end);
+  if (f0 >= lo && f0 <= hi) return 0.0f;
+  if (ge >= lo && ge <= hi) return s_end;
+  float s_low = f0 < lo ? 0.0f : s_end, s_high = f0 > hi ? 0.0f : s_end;
+  if (sv > 0.0f && sv < s_end) {
+    const float gv = hf_ray_piece(f0, f1, bump, sv);
+    if (gv >= lo && gv <= hi) return sv;
+    if (gv < lo) s_low = sv;
+    if (gv > hi) s_high = sv;
+  }
+  float s = 0.5f * (s_low + s_high);
+  for (int i = 0; i < 40; ++i) {
+    s = 0.5f * (s_low + s_high);
+    const float g = hf_ray_piece(f0, f1, bump, s);
+    if (g >= lo && g <= hi) break;
+    if (g < lo)
+      s_low = s;
+    else
+      s_high = s;
+  }
+  return s;
+}
+
+// Casts the ray o + t d, t in [0, t_max], through the field's box [0, width - 1] x [0, height - 1]
+// (a ray starting outside it enters first). Returns the hit's t, *cell = its cell (cy (width - 1)
+// + cx); or where the ray leaves the box or reaches t_max, *cell = -1.
+//
+// With `cap` > 0, also the view cells (squares of `view` x `view` cells, view_x across) whose band
+// the ray passes through before the hit: the points whose height above the surface lies in
+// [band_lo, band_hi]; each one once, in order along the ray, entry j at pierced[j * stride] with
+// a t of such a point at pierced_t[j * stride]; *count of them (at most cap: a segment meets at
+// most view_x + view_y - 1 squares).
+inline float hf_ray_cast(HFVIS_GLOBAL const float* h, int width, int height,
+                         HFVIS_GLOBAL const float* pyramid, HFVIS_GLOBAL const int* levels, int top, float ox,
+                         float oy, float oz, float dx, float dy, float dz, float t_max, int view, int view_x,
+                         float band_lo, float band_hi, int cap, HFVIS_GLOBAL int* pierced,
+                         HFVIS_GLOBAL float* pierced_t, int stride, int* count, int* cell) {
+  const int cells_x = width - 1, cells_y = height - 1;
+  *cell = -1;
+  *count = 0;
+  // Clip to the box.
+  float t_lo = 0.0f, t_hi = t_max;
+  if (dx != 0.0f) {
+    const float a = (0.0f - ox) / dx, b = ((float)cells_x - ox) / dx;
+    t_lo = (a < b ? a : b) > t_lo ? (a < b ? a : b) : t_lo;
+    t_hi = (a < b ? b : a) < t_hi ? (a < b ? b : a) : t_hi;
+  } else if (ox < 0.0f || ox > (float)cells_x) {
+    return 0.0f;
+  }
+  if (dy != 0.0f) {
+    const float a = (0.0f - oy) / dy, b = ((float)cells_y - oy) / dy;
+    t_lo = (a < b ? a : b) > t_lo ? (a < b ? a : b) : t_lo;
+    t_hi = (a < b ? b : a) < t_hi ? (a < b ? b : a) : t_hi;
+  } else if (oy < 0.0f || oy > (float)cells_y) {
+    return 0.0f;
+  }
+  if (!(t_lo <= t_hi)) return t_lo < t_max ? t_lo : t_max;
+  const float clearance = cap > 0 ? band_hi : 0.0f;
+  const int sx = dx < 0.0f ? -1 : 1, sy = dy < 0.0f ? -1 : 1;
+  int last_view = -1;
+  float t = t_lo;
+  int k = top > 0 ? 1 : 0;
+  // Where the last level-1 block that could not be skipped ends: its cells are marched one
+  // after another up to there, without testing the block again.
+  float march_to = t_lo;
+  // The surface minus the ray where the last marched cell ended, carried into the next cell
+  // when it follows at once (NaN: none).
+  float carried = NAN;
+  for (;;) {
+    const float x = ox + t * dx, y = oy + t * dy;
+    if (k > 0) {
+      const int size = 1 << k, bw = levels[4 * k], bh = levels[4 * k + 1];
+      const int bx = hf_ray_cell_of(x / (float)size, dx, bw), by = hf_ray_cell_of(y / (float)size, dy, bh);
+      const float ex = hf_ray_crossing((float)((dx < 0.0f ? bx : bx + 1) * size), ox, dx);
+      const float ey = hf_ray_crossing((float)((dy < 0.0f ? by : by + 1) * size), oy, dy);
+      float te = ex < ey ? ex : ey;
+      te = te < t_hi ? te : t_hi;
+      const float za = oz + t * dz, zb = oz + te * dz;
+      const float low = za < zb ? za : zb;
+      const float top_height = pyramid[levels[4 * k + 2] + by * bw + bx];
+      if (te > t && !(low - top_height <= clearance)) {  // above the block (or the block all nodata)
+        if (te >= t_hi) return t_hi;
+        t = te;
+        k = k < top ? k + 1 : top;
+        carried = NAN;
+      } else {
+        if (k == 1) march_to = te;
+        --k;
+      }
+      continue;
+    }
+    // One cell: the one holding the point, stepped past the cells whose exit rounding put behind t.
+    int cx = hf_ray_cell_of(x, dx, cells_x), cy = hf_ray_cell_of(y, dy, cells_y);
+    float tx = hf_ray_crossing((float)(dx < 0.0f ? cx : cx + 1), ox, dx);
+    float ty = hf_ray_crossing((float)(dy < 0.0f ? cy : cy + 1), oy, dy);
+    while (tx <= t || ty <= t) {
+      if (tx <= t) {
+        cx += sx;
+        tx = hf_ray_crossing((float)(dx < 0.0f ? cx : cx + 1), ox, dx);
+      } else {
+        cy += sy;
+        ty = hf_ray_crossing((float)(dy < 0.0f ? cy : cy + 1), oy, dy);
+      }
+      if (cx < 0 || cx >= cells_x || cy < 0 || cy >= cells_y) return t_hi;
+    }
+    float t1 = tx < ty ? tx : ty;
+    t1 = t1 < t_hi ? t1 : t_hi;
+    const int p = cy * width + cx;
+    const float h00 = h[p], h10 = h[p + 1], h01 = h[p + width], h11 = h[p + width + 1];
+    const float s1 = hf_ray_bilinear(h00, h10, h01, h11, ox + t1 * dx - (float)cx, oy + t1 * dy - (float)cy);
+    // The surface at the cell's entry: the last cell's exit where the march goes on into this
+    // one (the same point of the continuous surface), else evaluated here.
+    const float f0 = !isnan(carried) ? carried
+                                     : hf_ray_bilinear(h00, h10, h01, h11, x - (float)cx, y - (float)cy) - (oz + t * dz);
+    const float f1 = s1 - (oz + t1 * dz);
+    carried = NAN;
+    if (!isnan(f0) && !isnan(f1)) {
+      const float span = t1 - t;
+      const float twist = h00 - h10 - h01 + h11;
+      const float bump = -(twist * dx * dy) * span * span;
+      // g's vertex (its top where bump > 0, its bottom where bump < 0; -1 for none).
+      const float sv = bump != 0.0f ? 0.5f + (f1 - f0) / (2.0f * bump) : -1.0f;
+      // Where the piece turns positive, if it does: s_end.
+      float s_end = 1.0f;
+      int hit = 0;
+      if (f0 > 0.0f) {
+        s_end = 0.0f;
+        hit = 1;
+      } else if (f1 > 0.0f) {
+        s_end = hf_ray_entry(f0, f1, bump, 1.0f);
+        hit = 1;
+      } else if (bump > 0.0f && sv > 0.0f && sv < 1.0f && hf_ray_piece(f0, f1, bump, sv) > 0.0f) {
+        s_end = hf_ray_entry(f0, f1, bump, sv);
+        hit = 1;
+      }
+      if (cap > 0) {
+        const int vc = (cy / view) * view_x + cx / view;
+        if (vc != last_view && *count < cap) {
+          // g's range over [0, s_end] against the band -band_hi <= g <= -band_lo.
+          const float ge = hf_ray_piece(f0, f1, bump, s_end);
+          float g_min = f0 < ge ? f0 : ge, g_max = f0 < ge ? ge : f0;
+          if (sv > 0.0f && sv < s_end) {
+            const float gv = hf_ray_piece(f0, f1, bump, sv);
+            g_max = gv > g_max ? gv : g_max;
+            g_min = gv < g_min ? gv : g_min;
+          }
+          if (g_max >= -band_hi && g_min <= -band_lo) {
+            const float s = hf_ray_band_point(f0, f1, bump, s_end, sv, -band_hi, -band_lo);
+            pierced[*count * stride] = vc;
+            pierced_t[*count * stride] = t + s * span;
+            ++*count;
+            last_view = vc;
+          }
+        }
+      }
+      if (hit) {
+        *cell = cy * cells_x + cx;
+        return t + s_end * span;
+      }
+    }
+    if (t1 >= t_hi) return t_hi;
+    t = t1;
+    // On through the block that could not be skipped; past it, test blocks again.
+    if (t1 < march_to) {
+      carried = f1;
+    } else {
+      k = top > 0 ? 1 : 0;
+    }
+  }
+}
+
+#endif  // HFVIS_HEIGHTFIELD_RAY_CL

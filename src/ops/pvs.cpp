@@ -1,0 +1,298 @@
+// pvs.cpp: the potentially visible sets' geometry (hfvis/pvs.hpp), the device ray caster
+// (kernels/pvs.cl) and the dense reference; the samplers are in pvs_sampling.cpp.
+#include "hfvis/pvs.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "core/horizon_common.hpp"
+#include "core/opencl_context.hpp"
+#include "core/sweep_framework.hpp"
+#include "core/sweep_geometry.hpp"
+#include "core/sweep_routine.hpp"
+#include "hfvis/errors.hpp"
+#include "hfvis/viewshed.hpp"
+#include "ops/pvs_ray.hpp"
+
+namespace hfvis {
+
+int PvsLayout::tileOfCell(int cell) const {
+  return (cell / cells_x / tile) * tiles_x + (cell % cells_x) / tile;
+}
+
+int PvsLayout::viewOfCell(int cell) const {
+  return (cell / cells_x / view_cell) * view_x + (cell % cells_x) / view_cell;
+}
+
+PvsLayout pvsLayout(const HeightField& field, const PvsGrid& grid) {
+  validate(field);
+  if (field.width < 2 || field.height < 2)
+    throw InvalidArgument("potentially visible sets need a field of at least 2 x 2 points (got " +
+                          std::to_string(field.width) + " x " + std::to_string(field.height) + ")");
+  if (field.pixelCount() > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+    throw InvalidArgument("potentially visible sets take fields of at most 2^31 - 1 points");
+  if (detail::hasRowSpacing(field))
+    throw InvalidArgument(
+        "potentially visible sets on latitude / longitude grids (per-row spacing) are not supported; "
+        "reproject the DEM to a projected CRS");
+  PvsLayout l;
+  l.cells_x = field.width - 1;
+  l.cells_y = field.height - 1;
+  const int most = std::max(l.cells_x, l.cells_y);
+  if (grid.view_cell < 1 || grid.view_cell > most)
+    throw InvalidArgument("the view cell size must be 1 .. " + std::to_string(most) + " cells (got " +
+                          std::to_string(grid.view_cell) + ")");
+  if (grid.tile < 1 || grid.tile > most)
+    throw InvalidArgument("the tile size must be 1 .. " + std::to_string(most) + " cells (got " +
+                          std::to_string(grid.tile) + ")");
+  if (!std::isfinite(grid.band_low) || !std::isfinite(grid.band_high) || grid.band_low < 0.0 ||
+      grid.band_high < grid.band_low)
+    throw InvalidArgument("the view band needs finite heights 0 <= H0 <= H1 (got " +
+                          std::to_string(grid.band_low) + ", " + std::to_string(grid.band_high) + ")");
+  l.view_cell = grid.view_cell;
+  l.tile = grid.tile;
+  l.view_x = (l.cells_x + grid.view_cell - 1) / grid.view_cell;
+  l.view_y = (l.cells_y + grid.view_cell - 1) / grid.view_cell;
+  l.tiles_x = (l.cells_x + grid.tile - 1) / grid.tile;
+  l.tiles_y = (l.cells_y + grid.tile - 1) / grid.tile;
+  if (!grid.mask.empty()) {
+    if (grid.mask.size() != static_cast<std::size_t>(l.viewCells()))
+      throw InvalidArgument("the view-cell mask has " + std::to_string(grid.mask.size()) +
+                            " entries, not the " + std::to_string(l.view_x) + " x " +
+                            std::to_string(l.view_y) + " view cells");
+    if (std::none_of(grid.mask.begin(), grid.mask.end(), [](std::uint8_t m) { return m != 0; }))
+      throw InvalidArgument("the view-cell mask selects no view cell");
+  }
+  return l;
+}
+
+std::size_t PvsResult::entries() const {
+  std::size_t n = 0;
+  for (std::uint32_t w : bits) n += static_cast<std::size_t>(__builtin_popcount(w));
+  return n;
+}
+
+double pvsRecall(const PvsResult& got, const PvsResult& want) {
+  if (got.bits.size() != want.bits.size()) throw InvalidArgument("recall of two PVSs of different grids");
+  std::size_t both = 0, wanted = 0;
+  for (std::size_t i = 0; i < want.bits.size(); ++i) {
+    both += static_cast<std::size_t>(__builtin_popcount(got.bits[i] & want.bits[i]));
+    wanted += static_cast<std::size_t>(__builtin_popcount(want.bits[i]));
+  }
+  return wanted ? double(both) / double(wanted) : 1.0;
+}
+
+namespace detail {
+
+std::vector<float> rayHeights(const HeightField& field) {
+  return prepareHeights(field, HeightOrigin::Zero).heights;
+}
+
+RayPyramid buildRayPyramid(const std::vector<float>& heights, int width, int height) {
+  RayPyramid p;
+  p.levels.assign(4, 0);
+  const int cells_x = width - 1, cells_y = height - 1;
+  // fmax-like: NaN (nodata) left out.
+  auto larger = [](float a, float b) { return std::isnan(a) ? b : (std::isnan(b) ? a : std::max(a, b)); };
+  for (int k = 1; k <= 12; ++k) {
+    const int bx = (cells_x + (1 << k) - 1) >> k, by = (cells_y + (1 << k) - 1) >> k;
+    const int first = static_cast<int>(p.values.size());
+    p.levels.insert(p.levels.end(), {bx, by, first, 0});
+    for (int y = 0; y < by; ++y)
+      for (int x = 0; x < bx; ++x) {
+        float m = NAN;
+        if (k == 1) {
+          for (int j = 2 * y; j <= std::min(2 * y + 2, height - 1); ++j)
+            for (int i = 2 * x; i <= std::min(2 * x + 2, width - 1); ++i)
+              m = larger(m, heights[std::size_t(j) * width + i]);
+        } else {
+          const int* below = &p.levels[4 * (k - 1)];
+          for (int j = 2 * y; j <= std::min(2 * y + 1, below[1] - 1); ++j)
+            for (int i = 2 * x; i <= std::min(2 * x + 1, below[0] - 1); ++i)
+              m = larger(m, p.values[std::size_t(below[2]) + std::size_t(j) * below[0] + i]);
+        }
+        p.values.push_back(m);
+      }
+    p.top = k;
+    if (bx == 1 && by == 1) break;
+  }
+  return p;
+}
+
+namespace {
+
+// Rays per launch: bounds a launch's time (a GPU's watchdog) and its buffers.
+constexpr int kRaysPerLaunch = 1 << 16;
+
+class RayCastRoutine : public DeviceRoutine, public RayCaster {
+ public:
+  RayCastRoutine(ContextState& st, const HeightField& field, const PvsGrid& grid,
+                 std::size_t memory_budget_bytes, const std::function<void(RayCaster&)>& body)
+      : DeviceRoutine(st, field, nullptr, memory_budget_bytes),
+        grid_(grid),
+        layout_(pvsLayout(field, grid)),
+        body_(body) {}
+
+  RayCastResult cast(const std::vector<HeightRay>& rays, bool view_cells) override {
+    for (const HeightRay& r : rays)
+      if (!std::isfinite(r.ox) || !std::isfinite(r.oy) || !std::isfinite(r.oz) || !std::isfinite(r.dx) ||
+          !std::isfinite(r.dy) || !std::isfinite(r.dz) || std::isnan(r.t_max))
+        throw InvalidArgument("a ray with a non-finite origin or direction, or a NaN length");
+    RayCastResult out;
+    const int n = static_cast<int>(rays.size());
+    out.cap = view_cells ? layout_.view_x + layout_.view_y : 0;
+    out.t.resize(rays.size());
+    out.cell.resize(rays.size());
+    out.count.assign(rays.size(), 0);
+    out.view_cell.resize(rays.size() * out.cap);
+    out.view_t.resize(rays.size() * out.cap);
+    // Per ray on the device: 8 floats in, t, cell, count and cap (view cell, t) pairs out.
+    const std::size_t per_ray = (8 + 3 + 2 * std::size_t(out.cap)) * 4;
+    if (per_ray > memoryBudget())
+      throw MemoryBudgetError("one ray and its view-cell list need " + mebibytes(per_ray) +
+                              " but the memory budget is " + mebibytes(memoryBudget()));
+    const int chunk = static_cast<int>(std::min<std::size_t>(kRaysPerLaunch, memoryBudget() / per_ray));
+    for (int first = 0; first < n; first += chunk) launch(rays, first, std::min(chunk, n - first), out);
+    return out;
+  }
+
+ private:
+  PreparedHeights prepare() override { return prepareHeights(field_, HeightOrigin::Zero); }
+  std::string programFile() const override { return "pvs.cl"; }
+
+  void allocate() override {
+    line_major_ = lineMajorLayout(st_);
+    const RayPyramid pyramid = buildRayPyramid(prepared_.heights, field_.width, field_.height);
+    pyramid_ = upload(pyramid.values);
+    levels_ = upload(pyramid.levels);
+    kernel_ = kernel("pvs_cast");
+    kernel_.set("h", heights_)
+        .set("width", cl_int(field_.width))
+        .set("height", cl_int(field_.height))
+        .set("pyramid", pyramid_)
+        .set("levels", levels_)
+        .set("top", cl_int(pyramid.top))
+        .set("line_major", cl_int(line_major_))
+        .set("view", cl_int(grid_.view_cell))
+        .set("view_x", cl_int(layout_.view_x))
+        .set("band_lo", static_cast<float>(grid_.band_low))
+        .set("band_hi", static_cast<float>(grid_.band_high));
+  }
+
+  int itemCount() const override { return 1; }
+  void runItem(int, int) override { body_(*this); }
+  void finish() override {}
+
+  // Rays [first, first + n) into `out`.
+  void launch(const std::vector<HeightRay>& rays, int first, int n, RayCastResult& out) {
+    const int cap = out.cap;
+    std::vector<float> packed(std::size_t(n) * 8, 0.0f);
+    for (int r = 0; r < n; ++r) {
+      const HeightRay& ray = rays[std::size_t(first) + r];
+      const float values[7] = {ray.ox, ray.oy, ray.oz, ray.dx, ray.dy, ray.dz, ray.t_max};
+      for (int c = 0; c < 7; ++c)
+        packed[line_major_ ? std::size_t(r) * 8 + c : std::size_t(c) * n + r] = values[c];
+    }
+    cl::Buffer ray_buffer = upload(packed);
+    cl::Buffer t = deviceBuffer(st_, std::size_t(n) * 4), cell = deviceBuffer(st_, std::size_t(n) * 4),
+               count = deviceBuffer(st_, std::size_t(n) * 4);
+    const std::size_t list = std::max<std::size_t>(1, std::size_t(n) * cap) * 4;
+    cl::Buffer pierced = deviceBuffer(st_, list), pierced_t = deviceBuffer(st_, list);
+    kernel_.set("rays", ray_buffer)
+        .set("n", cl_int(n))
+        .set("cap", cl_int(cap))
+        .set("hit_t", t)
+        .set("hit_cell", cell)
+        .set("counts", count)
+        .set("pierced", pierced)
+        .set("pierced_t", pierced_t);
+    st_.launch(kernel_, cl::NDRange(roundUp(n, kLineGroup)), cl::NDRange(kLineGroup));
+    st_.queue.enqueueReadBuffer(t, CL_FALSE, 0, std::size_t(n) * 4, out.t.data() + first);
+    st_.queue.enqueueReadBuffer(cell, CL_FALSE, 0, std::size_t(n) * 4, out.cell.data() + first);
+    st_.queue.enqueueReadBuffer(count, CL_TRUE, 0, std::size_t(n) * 4, out.count.data() + first);
+    if (cap == 0) return;
+    std::vector<int> cells(std::size_t(n) * cap);
+    std::vector<float> ts(std::size_t(n) * cap);
+    st_.queue.enqueueReadBuffer(pierced, CL_FALSE, 0, cells.size() * 4, cells.data());
+    st_.queue.enqueueReadBuffer(pierced_t, CL_TRUE, 0, ts.size() * 4, ts.data());
+    for (int r = 0; r < n; ++r)
+      for (int j = 0; j < out.count[std::size_t(first) + r]; ++j) {
+        const std::size_t from = line_major_ ? std::size_t(r) * cap + j : std::size_t(j) * n + r;
+        const std::size_t to = (std::size_t(first) + r) * cap + j;
+        out.view_cell[to] = cells[from];
+        out.view_t[to] = ts[from];
+      }
+  }
+
+  const PvsGrid& grid_;
+  const PvsLayout layout_;
+  const std::function<void(RayCaster&)>& body_;
+  bool line_major_ = true;
+  cl::Buffer pyramid_, levels_;
+  NamedKernel kernel_;
+};
+
+}  // namespace
+
+void withRayCaster(const ComputeContext& context, const HeightField& field, const PvsGrid& grid,
+                   std::size_t memory_budget_bytes, const std::function<void(RayCaster&)>& body) {
+  translateOpenClErrors([&] {
+    RayCastRoutine routine(stateOf(context), field, grid, memory_budget_bytes, body);
+    routine.run();
+  });
+}
+
+}  // namespace detail
+
+RayCastResult castHeightFieldRays(const ComputeContext& context, const HeightField& field,
+                                  const std::vector<HeightRay>& rays, const RayCastOptions& options) {
+  RayCastResult out;
+  detail::withRayCaster(context, field, options.grid, options.memory_budget_bytes,
+                        [&](detail::RayCaster& caster) { out = caster.cast(rays, options.view_cells); });
+  return out;
+}
+
+PvsResult computeDensePvs(const ComputeContext& context, const HeightField& field, const PvsGrid& grid) {
+  PvsResult out;
+  out.layout = pvsLayout(field, grid);
+  const PvsLayout& l = out.layout;
+  out.words = (l.tiles() + 31) / 32;
+  out.bits.assign(std::size_t(l.viewCells()) * out.words, 0u);
+  out.computed = grid.mask.empty() ? std::vector<std::uint8_t>(l.viewCells(), 1) : grid.mask;
+  std::vector<double> heights{grid.band_low};
+  if (grid.band_high > grid.band_low)
+    heights = {grid.band_low, 0.5 * (grid.band_low + grid.band_high), grid.band_high};
+  ViewshedOptions vo;
+  vo.target_height = 0.0;
+  for (int v = 0; v < l.viewCells(); ++v) {
+    if (!out.computed[v]) continue;
+    const int x0 = (v % l.view_x) * l.view_cell, y0 = (v / l.view_x) * l.view_cell;
+    const int x1 = std::min(x0 + l.view_cell, l.cells_x), y1 = std::min(y0 + l.view_cell, l.cells_y);
+    for (double eye : heights) {
+      std::vector<Observer> eyes;
+      for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x)
+          if (std::isfinite(field.at(x, y))) eyes.push_back(Observer{x, y, eye});
+      if (eyes.empty()) continue;
+      const CumulativeViewshed seen = computeCumulativeViewshed(context, field, eyes, vo);
+      std::uint32_t* words = &out.bits[std::size_t(v) * out.words];
+      for (int y = 0; y < field.height; ++y)
+        for (int x = 0; x < field.width; ++x) {
+          if (!(seen.count[std::size_t(y) * field.width + x] > 0.0f)) continue;
+          // Every tile whose closed square holds (x, y).
+          for (int ty = std::max(0, (y - 1) / l.tile); ty <= std::min(l.tiles_y - 1, y / l.tile); ++ty)
+            for (int tx = std::max(0, (x - 1) / l.tile); tx <= std::min(l.tiles_x - 1, x / l.tile); ++tx) {
+              if (x < tx * l.tile || x > tx * l.tile + l.tile || y < ty * l.tile || y > ty * l.tile + l.tile)
+                continue;
+              const int t = ty * l.tiles_x + tx;
+              words[t / 32] |= 1u << (t % 32);
+            }
+        }
+    }
+  }
+  return out;
+}
+
+}  // namespace hfvis

@@ -1,0 +1,53 @@
+// pvs_ray.hpp: the height-field ray caster for C++ (the host and the scalar reference):
+// kernels/shared/heightfield_ray.cl itself, the source the kernel compiles, included here so the
+// two cannot drift; the maximum pyramid it skips empty space with; and what the samplers share.
+#pragma once
+
+#include <cmath>
+#include <functional>
+#include <vector>
+
+#include "hfvis/height_field.hpp"
+#include "hfvis/pvs.hpp"
+
+namespace hfvis::detail {
+
+using std::ceil;
+using std::floor;
+using std::isnan;
+using std::sqrt;
+#include "../../kernels/shared/heightfield_ray.cl"
+
+// The maximum pyramid of heightfield_ray.cl over the (z-scaled) heights: levels 1 .. top, up to
+// one block over the field; `levels` 4 ints per level (blocks across, down, first value, 0),
+// level 0 unused.
+struct RayPyramid {
+  std::vector<float> values;
+  std::vector<int> levels;
+  int top = 0;
+};
+RayPyramid buildRayPyramid(const std::vector<float>& heights, int width, int height);
+
+// The heights the ray caster reads: z-scaled, from zero (the viewshed's and the region
+// visibility's, so the witnesses' line-of-sight test sees the same surface).
+std::vector<float> rayHeights(const HeightField& field);
+
+}  // namespace hfvis::detail
+
+namespace hfvis::detail {
+
+// The device ray caster, set up once (heights and pyramid uploaded, program built) for many
+// batches: a sampler's whole run.
+class RayCaster {
+ public:
+  virtual ~RayCaster() = default;
+  // Casts `rays` (view cells listed when `view_cells`), in launches that fit the memory budget.
+  virtual RayCastResult cast(const std::vector<HeightRay>& rays, bool view_cells) = 0;
+};
+
+// Runs `body` with a caster of `field` and `grid` (validated) on the device, its launches within
+// `memory_budget_bytes` (0: the default budget).
+void withRayCaster(const ComputeContext& context, const HeightField& field, const PvsGrid& grid,
+                   std::size_t memory_budget_bytes, const std::function<void(RayCaster&)>& body);
+
+}  // namespace hfvis::detail

@@ -1,0 +1,583 @@
+// pvs_sampling.cpp: the samplers of the potentially visible sets (hfvis/pvs.hpp): per view cell
+// random sampling, stationary global sampling and adaptive global visibility sampling (Bittner
+// et al. 2009, Sec. 4), the pixel-error estimate (Sec. 4.5) and the object-space visibility
+// filter (Sec. 5). Samples are drawn on the host in batches from one seeded generator, cast on
+// the device (pvs.cpp's ray caster) and folded in in sample order, so a run is a function of its
+// inputs and seed. Geometry here is in ground units (x cell_x, y cell_y, z), rays in pixels.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <limits>
+#include <string>
+
+#include "hfvis/errors.hpp"
+#include "hfvis/pvs.hpp"
+#include "ops/pvs_ray.hpp"
+
+namespace hfvis {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+// Every distribution keeps at least this probability (Sec. 4.2 recalibrates now and then;
+// this keeps a distribution that was poor early from never being tried again).
+constexpr double kMinProbability = 0.02;
+// Mutation candidates kept (Sec. 4.4: the highest mutation count is dropped when full).
+constexpr std::size_t kMutationCandidates = 1 << 16;
+// Discovery rays per silhouette mutation (Sec. 4.4: a search along the perpendicular).
+constexpr int kDiscoveryRays = 4;
+// The pixel-error window (Sec. 4.5, Eq. 5): P = 0.9, k = 0.5.
+constexpr double kWindowP = 0.9, kWindowK = 0.5;
+
+enum Distribution { kViewDirection, kObjectDirection, kTwoPoint, kTwoPointMutation, kSilhouetteMutation };
+
+struct Vec {
+  double x = 0, y = 0, z = 0;
+};
+Vec operator+(Vec a, Vec b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+Vec operator-(Vec a, Vec b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+Vec operator*(double s, Vec a) { return {s * a.x, s * a.y, s * a.z}; }
+double dot(Vec a, Vec b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+Vec cross(Vec a, Vec b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+Vec unit(Vec a) { return (1.0 / std::sqrt(dot(a, a))) * a; }
+
+// SplitMix64: small, fast, and the same sequence on every platform.
+class Random {
+ public:
+  explicit Random(std::uint64_t seed) : state_(seed * 0x9e3779b97f4a7c15ULL + 0x632be59bd9b4e019ULL) {}
+  std::uint64_t next() {
+    std::uint64_t z = (state_ += 0x9e3779b97f4a7c15ULL);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+  }
+  double uniform() { return double(next() >> 11) * 0x1p-53; }  // [0, 1)
+  std::size_t below(std::size_t n) { return std::size_t(uniform() * double(n)) % n; }
+  double gaussian() {  // Box-Muller, one of the pair
+    const double u = 1.0 - uniform(), v = uniform();
+    return std::sqrt(-2.0 * std::log(u)) * std::cos(2.0 * kPi * v);
+  }
+  Vec sphere() {  // uniform direction: phi = 2 pi psi1, theta = acos(1 - 2 psi2)
+    const double phi = 2.0 * kPi * uniform(), c = 1.0 - 2.0 * uniform(),
+                 s = std::sqrt(std::max(0.0, 1.0 - c * c));
+    return {s * std::cos(phi), s * std::sin(phi), c};
+  }
+
+ private:
+  std::uint64_t state_;
+};
+
+// A point of a sample: ground position, and what it is (a tile hit, or a point in view space).
+struct MutationCandidate {
+  Vec origin, target;  // s_o, s_t
+  double origin_radius = 0, target_radius = 0;
+  int tile = 0;  // the object at s_t
+};
+
+// Candidates by mutation count: the least mutated first (Sec. 4.4).
+class MutationBuffer {
+ public:
+  bool empty() const { return size_ == 0; }
+  void add(const MutationCandidate& c) {
+    if (size_ == kMutationCandidates) drop();
+    if (buckets_.empty()) buckets_.emplace_back();
+    buckets_[0].push_back(c);
+    ++size_;
+  }
+  // The least mutated candidate, its count raised by one.
+  MutationCandidate take() {
+    std::size_t b = 0;
+    while (buckets_[b].empty()) ++b;
+    MutationCandidate c = buckets_[b].front();
+    buckets_[b].pop_front();
+    if (b + 1 == buckets_.size()) buckets_.emplace_back();
+    buckets_[b + 1].push_back(c);
+    return c;
+  }
+
+ private:
+  void drop() {
+    std::size_t b = buckets_.size();
+    while (buckets_[b - 1].empty()) --b;
+    buckets_[b - 1].pop_back();
+    --size_;
+  }
+  std::vector<std::deque<MutationCandidate>> buckets_;
+  std::size_t size_ = 0;
+};
+
+// One visibility sample to cast: a ray (both ways when global), its distribution.
+struct Sample {
+  Vec origin, direction;  // ground units
+  int distribution = kViewDirection;
+  int view_cell = -1;  // per-cell samples: the view cell fed
+};
+
+class Sampler {
+ public:
+  Sampler(const HeightField& field, const PvsGrid& grid, const PvsOptions& options, PvsResult& out)
+      : field_(field), grid_(grid), options_(options), out_(out), random_(options.seed) {
+    out_.layout = pvsLayout(field, grid);
+    const PvsLayout& l = out_.layout;
+    out_.words = (l.tiles() + 31) / 32;
+    out_.bits.assign(std::size_t(l.viewCells()) * out_.words, 0u);
+    out_.computed = grid.mask.empty() ? std::vector<std::uint8_t>(l.viewCells(), 1) : grid.mask;
+    out_.pixel_error = std::numeric_limits<double>::quiet_NaN();
+    heights_ = detail::rayHeights(field);
+    cx_ = field.cell_size_x;
+    cy_ = field.cell_size_y;
+    // Valid cells by view cell (view space) and by tile (objects).
+    view_cells_.resize(l.viewCells());
+    tile_cells_.resize(l.tiles());
+    for (int cy = 0; cy < l.cells_y; ++cy)
+      for (int cx = 0; cx < l.cells_x; ++cx) {
+        const std::size_t p = std::size_t(cy) * field.width + cx;
+        if (!std::isfinite(heights_[p]) || !std::isfinite(heights_[p + 1]) ||
+            !std::isfinite(heights_[p + field.width]) || !std::isfinite(heights_[p + field.width + 1]))
+          continue;
+        const int cell = cy * l.cells_x + cx, v = l.viewOfCell(cell);
+        if (out_.computed[v]) view_cells_[v].push_back(cell), view_space_.push_back(cell);
+        tile_cells_[l.tileOfCell(cell)].push_back(cell);
+      }
+    for (int v = 0; v < l.viewCells(); ++v)
+      if (!view_cells_[v].empty()) sampled_views_.push_back(v);
+    for (int t = 0; t < l.tiles(); ++t)
+      if (!tile_cells_[t].empty()) objects_.push_back(t);
+    if (view_space_.empty()) throw InvalidArgument("the computed view cells hold no valid cell (all nodata)");
+    tile_radius_ = 0.5 * l.tile * std::hypot(cx_, cy_);
+    view_radius_ = 0.5 * l.view_cell * std::hypot(cx_, cy_);
+    probability_.assign(kPvsDistributions, 0.0);
+    if (options.method == PvsMethod::Agvs)
+      for (int d = 0; d < 3; ++d) probability_[d] = 1.0 / 3.0;  // mutations join once seeded
+    else
+      probability_[kViewDirection] = 1.0;
+  }
+
+  void run(detail::RayCaster& caster) {
+    const auto start = std::chrono::steady_clock::now();
+    for (;;) {
+      std::uint64_t n = std::uint64_t(options_.batch);
+      if (options_.samples) n = std::min(n, options_.samples - out_.samples);
+      if (n == 0) break;
+      batch(caster, static_cast<int>(n));
+      out_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      PvsProgress row;
+      row.samples = out_.samples;
+      row.rays = out_.rays;
+      row.entries = out_.entries();
+      row.seconds = out_.seconds;
+      row.pixel_error = out_.pixel_error;
+      row.probability = probability_;
+      out_.history.push_back(row);
+      if (options_.progress) options_.progress(out_.samples, out_.pixel_error);
+      if (options_.pixel_error > 0.0 && out_.pixel_error <= options_.pixel_error) break;
+      if (options_.seconds > 0.0 && out_.seconds >= options_.seconds) break;
+    }
+    if (options_.filter > 0.0) filter();
+  }
+
+ private:
+  // ---- Geometry
+
+  float surface(double x, double y) const {  // pixels
+    return detail::region_surface_at(heights_.data(), field_.width, field_.height, float(x), float(y));
+  }
+  Vec ground(double x, double y, double z) const { return {x * cx_, y * cy_, z}; }
+  HeightRay ray(Vec o, Vec d) const {
+    HeightRay r;
+    r.ox = float(o.x / cx_), r.oy = float(o.y / cy_), r.oz = float(o.z);
+    r.dx = float(d.x / cx_), r.dy = float(d.y / cy_), r.dz = float(d.z);
+    r.t_max = INFINITY;
+    return r;
+  }
+  // A uniform point of a cell (pixels), and the cell's corner.
+  void inCell(int cell, double& x, double& y) {
+    const PvsLayout& l = out_.layout;
+    x = cell % l.cells_x + random_.uniform();
+    y = cell / l.cells_x + random_.uniform();
+  }
+  // A uniform point of view space (of view cell v when v >= 0): its volume over valid cells.
+  Vec viewPoint(int v = -1) {
+    const std::vector<int>& cells = v < 0 ? view_space_ : view_cells_[v];
+    double x, y;
+    inCell(cells[random_.below(cells.size())], x, y);
+    const double band = grid_.band_low + (grid_.band_high - grid_.band_low) * random_.uniform();
+    return ground(x, y, surface(x, y) + band);
+  }
+  // A uniform point on a random object's surface, and its cell.
+  Vec objectPoint(int& cell) {
+    const std::vector<int>& cells = tile_cells_[objects_[random_.below(objects_.size())]];
+    cell = cells[random_.below(cells.size())];
+    double x, y;
+    inCell(cell, x, y);
+    return ground(x, y, surface(x, y));
+  }
+  // A cosine-weighted direction about the surface normal of cell `cell` at p (Sec. 4.3:
+  // phi = 2 pi psi1, theta = acos sqrt(psi2)).
+  Vec cosineDirection(int cell, Vec p) {
+    const PvsLayout& l = out_.layout;
+    const int x0 = cell % l.cells_x, y0 = cell / l.cells_x;
+    const std::size_t q = std::size_t(y0) * field_.width + x0;
+    const double h00 = heights_[q], h10 = heights_[q + 1], h01 = heights_[q + field_.width],
+                 h11 = heights_[q + field_.width + 1];
+    const double u = p.x / cx_ - x0, v = p.y / cy_ - y0, twist = h00 - h10 - h01 + h11;
+    const Vec n = unit({-((h10 - h00) + twist * v) / cx_, -((h01 - h00) + twist * u) / cy_, 1.0});
+    const Vec a = unit(std::fabs(n.x) < 0.9 ? cross(n, Vec{1, 0, 0}) : cross(n, Vec{0, 1, 0})),
+              b = cross(n, a);
+    const double phi = 2.0 * kPi * random_.uniform(), c = std::sqrt(random_.uniform());
+    const double s = std::sqrt(std::max(0.0, 1.0 - c * c));
+    return (s * std::cos(phi)) * a + (s * std::sin(phi)) * b + c * n;
+  }
+  // A point of the plane through p perpendicular to `axis`, Gaussian about p with deviation sigma.
+  Vec perpendicularGaussian(Vec p, Vec axis, double sigma) {
+    const Vec n = unit(axis);
+    const Vec a = unit(std::fabs(n.x) < 0.9 ? cross(n, Vec{1, 0, 0}) : cross(n, Vec{0, 1, 0})),
+              b = cross(n, a);
+    return p + (sigma * random_.gaussian()) * a + (sigma * random_.gaussian()) * b;
+  }
+
+  // ---- Drawing samples
+
+  int pick() {
+    double u = random_.uniform(), sum = 0.0;
+    for (int d = 0; d < kPvsDistributions; ++d) {
+      sum += probability_[d];
+      if (u < sum) return d;
+    }
+    return kViewDirection;
+  }
+
+  Sample draw() {
+    Sample s;
+    if (options_.method == PvsMethod::PerCell) {
+      s.view_cell = sampled_views_[per_cell_next_++ % sampled_views_.size()];
+      s.origin = viewPoint(s.view_cell);
+      s.direction = random_.sphere();
+      return s;
+    }
+    s.distribution = pick();
+    if ((s.distribution == kTwoPointMutation || s.distribution == kSilhouetteMutation) && mutations_.empty())
+      s.distribution = kViewDirection;
+    switch (s.distribution) {
+      case kObjectDirection: {
+        int cell;
+        s.origin = objectPoint(cell);
+        s.direction = cosineDirection(cell, s.origin);
+        break;
+      }
+      case kTwoPoint: {
+        int cell;
+        const Vec v = viewPoint(), o = objectPoint(cell);
+        s.origin = v;
+        s.direction = o - v;
+        break;
+      }
+      case kTwoPointMutation: {
+        const MutationCandidate c = mutations_.take();
+        const Vec axis = c.target - c.origin;
+        const Vec so = perpendicularGaussian(c.origin, axis, c.origin_radius);
+        const Vec st = perpendicularGaussian(c.target, axis, c.target_radius);
+        s.origin = 0.5 * (so + st);
+        s.direction = st - so;
+        break;
+      }
+      case kSilhouetteMutation: {
+        // The discovery rays are cast first (silhouette()); here the candidate and the direction.
+        const MutationCandidate c = mutations_.take();
+        const Vec axis = c.target - c.origin;
+        const Vec off = perpendicularGaussian(Vec{}, axis, 1.0);
+        silhouettes_.push_back({c, unit(off.x == 0 && off.y == 0 && off.z == 0 ? Vec{1, 0, 0} : off)});
+        s.origin = c.origin;
+        s.direction = axis;
+        break;
+      }
+      default:
+        s.origin = viewPoint();
+        s.direction = random_.sphere();
+    }
+    if (!(dot(s.direction, s.direction) > 0.0)) s.direction = random_.sphere();
+    return s;
+  }
+
+  // Sec. 4.4's silhouette search: from s_o toward s_t + lambda r(o) d, lambda = 1/4 .. 1, the
+  // least lambda whose ray misses the object becomes the sample's target (lambda = 1 when all hit).
+  void silhouettes(detail::RayCaster& caster, std::vector<Sample>& samples) {
+    if (silhouettes_.empty()) return;
+    std::vector<HeightRay> rays;
+    for (const Silhouette& s : silhouettes_)
+      for (int i = 1; i <= kDiscoveryRays; ++i) {
+        const Vec end = s.candidate.target + (s.candidate.target_radius * i / kDiscoveryRays) * s.direction;
+        rays.push_back(ray(s.candidate.origin, end - s.candidate.origin));
+      }
+    const RayCastResult hits = caster.cast(rays, false);
+    out_.rays += rays.size();
+    std::size_t next = 0;
+    for (Sample& sample : samples) {
+      if (sample.distribution != kSilhouetteMutation) continue;
+      const Silhouette& s = silhouettes_[next];
+      int chosen = kDiscoveryRays;
+      for (int i = 1; i <= kDiscoveryRays; ++i) {
+        const int cell = hits.cell[next * kDiscoveryRays + i - 1];
+        if (cell < 0 || out_.layout.tileOfCell(cell) != s.candidate.tile) {
+          chosen = i;
+          break;
+        }
+      }
+      const Vec end =
+          s.candidate.target + (s.candidate.target_radius * chosen / kDiscoveryRays) * s.direction;
+      sample.origin = 0.5 * (s.candidate.origin + end);
+      sample.direction = end - s.candidate.origin;
+      ++next;
+    }
+    silhouettes_.clear();
+  }
+
+  // ---- Folding results in
+
+  // Adds tile `tile` to view cell v with the witness (eye, target) when it is new and the witness
+  // passes the exact line-of-sight test; 1 when added.
+  int add(int v, int tile, float ex, float ey, float ez, float tx, float ty) {
+    if (!out_.computed[v] || out_.visible(v, tile)) return 0;
+    // The eye into the band over its point (the caster's t puts it there to rounding).
+    const float s = surface(ex, ey), tz = surface(tx, ty);
+    if (std::isnan(s) || std::isnan(tz)) return 0;
+    const float lo = s + float(grid_.band_low), hi = s + float(grid_.band_high);
+    ez = ez < lo ? lo : (ez > hi ? hi : ez);
+    if (!detail::region_sight_visible(heights_.data(), field_.width, field_.height, float(cx_), float(cy_),
+                                      0.0f, 0.0f, ex, ey, ez, tx, ty, tz)) {
+      ++out_.rejected;
+      return 0;
+    }
+    out_.bits[std::size_t(v) * out_.words + tile / 32] |= 1u << (tile % 32);
+    if (options_.witnesses) {
+      PvsWitness w;
+      w.view_cell = v;
+      w.tile = tile;
+      w.eye[0] = ex, w.eye[1] = ey, w.eye[2] = ez;
+      w.target[0] = tx, w.target[1] = ty, w.target[2] = tz;
+      out_.witnesses.push_back(w);
+    }
+    return 1;
+  }
+
+  void batch(detail::RayCaster& caster, int n) {
+    std::vector<Sample> samples(n);
+    for (Sample& s : samples) s = draw();
+    silhouettes(caster, samples);
+    const bool global = options_.method != PvsMethod::PerCell;
+    std::vector<HeightRay> rays;
+    rays.reserve(std::size_t(n) * (global ? 2 : 1));
+    for (const Sample& s : samples) {
+      rays.push_back(ray(s.origin, s.direction));
+      if (global) rays.push_back(ray(s.origin, -1.0 * s.direction));
+    }
+    const RayCastResult r = caster.cast(rays, global);
+    out_.rays += rays.size();
+    out_.samples += std::uint64_t(n);
+    const PvsLayout& l = out_.layout;
+    std::vector<double> contribution(kPvsDistributions, 0.0), drawn(kPvsDistributions, 0.0);
+    std::uint64_t window_rays = 0, window_contributing = 0;
+    for (int i = 0; i < n; ++i) {
+      const Sample& s = samples[i];
+      drawn[s.distribution] += 1.0;
+      if (!global) {
+        const std::size_t k = std::size_t(i);
+        const HeightRay& q = rays[k];
+        int c = 0;
+        if (r.cell[k] >= 0)
+          c = add(s.view_cell, l.tileOfCell(r.cell[k]), q.ox, q.oy, q.oz, q.ox + r.t[k] * q.dx,
+                  q.oy + r.t[k] * q.dy);
+        ++window_rays;
+        window_contributing += std::uint64_t(c);
+        continue;
+      }
+      // The segment's two ends: ray k = 2i forward, 2i + 1 reverse.
+      int total = 0, end_contribution[2] = {0, 0};
+      const int origin_view = l.viewOfCell(std::min(int(s.origin.y / cy_), l.cells_y - 1) * l.cells_x +
+                                           std::min(int(s.origin.x / cx_), l.cells_x - 1));
+      for (int end = 0; end < 2; ++end) {
+        const std::size_t k = 2 * std::size_t(i) + end;
+        if (r.cell[k] < 0) continue;
+        const int tile = l.tileOfCell(r.cell[k]);
+        const HeightRay& q = rays[k];
+        const float tx = q.ox + r.t[k] * q.dx, ty = q.oy + r.t[k] * q.dy;
+        // The origin's view cell, when the origin lies in view space (the caster may round a
+        // point at the band's very edge out of it), then every view cell of both rays' lists:
+        // each sees this end through the origin.
+        if (s.distribution == kViewDirection || s.distribution == kTwoPoint) {
+          const HeightRay& o = rays[2 * std::size_t(i)];
+          const int c = add(origin_view, tile, o.ox, o.oy, o.oz, tx, ty);
+          end_contribution[end] += c;
+          total += c;
+          // The pixel error's contributing rays: a view-direction ray whose own view cell (the
+          // origin's) gained its hit.
+          if (s.distribution == kViewDirection) window_contributing += std::uint64_t(c);
+        }
+        for (int side = 0; side < 2; ++side) {
+          const std::size_t m = 2 * std::size_t(i) + side;
+          const HeightRay& p = rays[m];
+          for (int j = 0; j < r.count[m]; ++j) {
+            const int v = r.view_cell[m * r.cap + j];
+            const float t = r.view_t[m * r.cap + j];
+            const int c = add(v, tile, p.ox + t * p.dx, p.oy + t * p.dy, p.oz + t * p.dz, tx, ty);
+            end_contribution[end] += c;
+            total += c;
+          }
+        }
+      }
+      if (s.distribution == kViewDirection) window_rays += 2;
+      contribution[s.distribution] += total;
+      // Mutation candidates (Sec. 4.4): each end that contributed, the other end its origin.
+      if (options_.method == PvsMethod::Agvs)
+        for (int end = 0; end < 2; ++end) {
+          if (!end_contribution[end]) continue;
+          const std::size_t k = 2 * std::size_t(i) + end, o = 2 * std::size_t(i) + 1 - end;
+          MutationCandidate c;
+          c.target = hitPoint(rays[k], r.t[k]);
+          c.tile = l.tileOfCell(r.cell[k]);
+          c.target_radius = tile_radius_;
+          if (r.cell[o] >= 0) {
+            c.origin = hitPoint(rays[o], r.t[o]);
+            c.origin_radius = tile_radius_;
+          } else {
+            c.origin = s.origin;
+            c.origin_radius = view_radius_;
+          }
+          mutations_.add(c);
+        }
+    }
+    updateError(window_rays, window_contributing);
+    if (options_.method == PvsMethod::Agvs) updateMixture(contribution, drawn);
+  }
+
+  Vec hitPoint(const HeightRay& q, float t) const {
+    const double x = q.ox + double(t) * q.dx, y = q.oy + double(t) * q.dy;
+    return ground(x, y, q.oz + double(t) * q.dz);
+  }
+
+  // Sec. 4.5: the error from the newest batches' view-direction rays, as many as Eq. 5 asks for
+  // the error they give.
+  void updateError(std::uint64_t rays, std::uint64_t contributing) {
+    if (rays == 0) return;
+    window_.push_front({rays, contributing});
+    std::uint64_t n = 0, c = 0;
+    std::size_t used = 0;
+    for (const auto& w : window_) {
+      n += w.first;
+      c += w.second;
+      ++used;
+      const double e = double(c) / double(n);
+      if (e > 0.0 && double(n) >= (1.0 - e) / (kWindowK * kWindowK * e * (1.0 - kWindowP))) break;
+    }
+    window_.resize(used);
+    out_.pixel_error = options_.resolution * double(c) / double(n);
+  }
+
+  // Sec. 4.2 with the window one batch: weight = contribution per sample per cost, the cost
+  // counted in rays (a silhouette mutation casts kDiscoveryRays more), so that a seed reproduces
+  // the run exactly (a wall-clock cost would not).
+  void updateMixture(const std::vector<double>& contribution, const std::vector<double>& drawn) {
+    std::vector<double> weight(kPvsDistributions, 0.0);
+    double sum = 0.0;
+    for (int d = 0; d < kPvsDistributions; ++d) {
+      const bool available = d < kTwoPointMutation || !mutations_.empty();
+      if (!available) continue;
+      const double cost = d == kSilhouetteMutation ? 2.0 + kDiscoveryRays : 2.0;
+      // A distribution not drawn this batch keeps its last weight.
+      weight[d] = drawn[d] > 0.0 ? contribution[d] / drawn[d] / cost : last_weight_[d];
+      if (!(weight[d] > 0.0)) weight[d] = 1e-12;
+      last_weight_[d] = weight[d];
+      sum += weight[d];
+    }
+    int available = 0;
+    for (int d = 0; d < kPvsDistributions; ++d) available += weight[d] > 0.0;
+    for (int d = 0; d < kPvsDistributions; ++d)
+      probability_[d] =
+          weight[d] > 0.0 ? kMinProbability + (1.0 - kMinProbability * available) * weight[d] / sum : 0.0;
+  }
+
+  // Sec. 5's object-space filter with the global extension e = k 2 d / sqrt(n_v): n_v the
+  // samples that reached view cell v (counted while sampling), d the distance between v's and
+  // the tile's centres; every tile within e of a visible tile is added (no witness).
+  void filter() {
+    const PvsLayout& l = out_.layout;
+    std::vector<std::uint32_t> bits = out_.bits;
+    const double samples_per_cell =
+        double(out_.samples) / double(std::max<std::size_t>(1, sampled_views_.size()));
+    for (int v = 0; v < l.viewCells(); ++v) {
+      if (!out_.computed[v]) continue;
+      const double vx = ((v % l.view_x) + 0.5) * l.view_cell * cx_,
+                   vy = ((v / l.view_x) + 0.5) * l.view_cell * cy_;
+      for (int t = 0; t < l.tiles(); ++t) {
+        if (!out_.visible(v, t)) continue;
+        const double tx = ((t % l.tiles_x) + 0.5) * l.tile * cx_, ty = ((t / l.tiles_x) + 0.5) * l.tile * cy_;
+        const double e = options_.filter * 2.0 * std::hypot(tx - vx, ty - vy) / std::sqrt(samples_per_cell);
+        const int rx = int(std::ceil(e / (l.tile * cx_))), ry = int(std::ceil(e / (l.tile * cy_)));
+        for (int y = std::max(0, t / l.tiles_x - ry); y <= std::min(l.tiles_y - 1, t / l.tiles_x + ry); ++y)
+          for (int x = std::max(0, t % l.tiles_x - rx); x <= std::min(l.tiles_x - 1, t % l.tiles_x + rx);
+               ++x) {
+            const int u = y * l.tiles_x + x;
+            bits[std::size_t(v) * out_.words + u / 32] |= 1u << (u % 32);
+          }
+      }
+    }
+    out_.filtered = 0;
+    for (std::size_t i = 0; i < bits.size(); ++i)
+      out_.filtered += __builtin_popcount(bits[i] & ~out_.bits[i]);
+    out_.bits = std::move(bits);
+  }
+
+  struct Silhouette {
+    MutationCandidate candidate;
+    Vec direction;
+  };
+
+  const HeightField& field_;
+  const PvsGrid& grid_;
+  const PvsOptions& options_;
+  PvsResult& out_;
+  Random random_;
+  std::vector<float> heights_;
+  double cx_ = 1, cy_ = 1, tile_radius_ = 0, view_radius_ = 0;
+  std::vector<std::vector<int>> view_cells_, tile_cells_;
+  std::vector<int> view_space_, sampled_views_, objects_;
+  std::size_t per_cell_next_ = 0;
+  std::vector<double> probability_;
+  double last_weight_[kPvsDistributions] = {0, 0, 0, 0, 0};
+  MutationBuffer mutations_;
+  std::vector<Silhouette> silhouettes_;
+  std::deque<std::pair<std::uint64_t, std::uint64_t>> window_;
+};
+
+}  // namespace
+
+const char* pvsDistributionName(int index) {
+  static const char* names[kPvsDistributions] = {"view-direction", "object-direction", "two-point",
+                                                 "two-point-mutation", "silhouette-mutation"};
+  return index >= 0 && index < kPvsDistributions ? names[index] : "";
+}
+
+void validate(const PvsOptions& options) {
+  if (!std::isfinite(options.pixel_error) || options.pixel_error < 0.0 || !std::isfinite(options.seconds) ||
+      options.seconds < 0.0)
+    throw InvalidArgument("the pixel error and seconds budgets must be finite and >= 0");
+  if (options.samples == 0 && options.pixel_error == 0.0 && options.seconds == 0.0)
+    throw InvalidArgument("a PVS run needs a budget above 0: samples, pixel error or seconds");
+  if (options.batch < 1) throw InvalidArgument("the batch must hold at least 1 sample");
+  if (!std::isfinite(options.filter) || options.filter < 0.0)
+    throw InvalidArgument("the visibility filter's k must be finite and >= 0");
+  if (!std::isfinite(options.resolution) || options.resolution < 1.0)
+    throw InvalidArgument("the pixel error's resolution must be at least 1 ray");
+}
+
+PvsResult computePvs(const ComputeContext& context, const HeightField& field, const PvsGrid& grid,
+                     const PvsOptions& options) {
+  validate(options);
+  PvsResult out;
+  Sampler sampler(field, grid, options, out);
+  detail::withRayCaster(context, field, grid, options.memory_budget_bytes,
+                        [&](detail::RayCaster& caster) { sampler.run(caster); });
+  return out;
+}
+
+}  // namespace hfvis

@@ -1,0 +1,71 @@
+// pvs_reference.cpp: see hfvis_testing/pvs_reference.hpp.
+#include "hfvis_testing/pvs_reference.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "ops/pvs_ray.hpp"
+
+namespace hfvis {
+
+RayCastResult referenceCastHeightFieldRays(const HeightField& field, const std::vector<HeightRay>& rays,
+                                           const RayCastOptions& options) {
+  const PvsLayout layout = pvsLayout(field, options.grid);
+  const std::vector<float> heights = detail::rayHeights(field);
+  const detail::RayPyramid pyramid = detail::buildRayPyramid(heights, field.width, field.height);
+  RayCastResult out;
+  out.cap = options.view_cells ? layout.view_x + layout.view_y : 0;
+  out.t.resize(rays.size());
+  out.cell.resize(rays.size());
+  out.count.resize(rays.size());
+  out.view_cell.assign(rays.size() * out.cap, 0);
+  out.view_t.assign(rays.size() * out.cap, 0.0f);
+  for (std::size_t r = 0; r < rays.size(); ++r) {
+    const HeightRay& q = rays[r];
+    out.t[r] = detail::hf_ray_cast(
+        heights.data(), field.width, field.height, pyramid.values.data(), pyramid.levels.data(), pyramid.top,
+        q.ox, q.oy, q.oz, q.dx, q.dy, q.dz, q.t_max, options.grid.view_cell, layout.view_x,
+        float(options.grid.band_low), float(options.grid.band_high), out.cap,
+        out.view_cell.data() + r * out.cap, out.view_t.data() + r * out.cap, 1, &out.count[r], &out.cell[r]);
+  }
+  return out;
+}
+
+double rayClearance(const HeightField& field, const HeightRay& ray, double t) {
+  double x = ray.ox + t * double(ray.dx), y = ray.oy + t * double(ray.dy);
+  const double z = ray.oz + t * double(ray.dz);
+  // Within 1e-4 pixel of the box: on its edge (the caster's float rounding).
+  if (!(x >= -1e-4 && y >= -1e-4 && x <= field.width - 1 + 1e-4 && y <= field.height - 1 + 1e-4)) return NAN;
+  x = std::clamp(x, 0.0, double(field.width - 1));
+  y = std::clamp(y, 0.0, double(field.height - 1));
+  // The cell holding the point; within 1e-4 pixel of a grid line (the caster's rounding), any
+  // valid cell beside it (the surface is continuous across a line between valid cells).
+  const int fx = std::min(int(x), field.width - 2), fy = std::min(int(y), field.height - 2);
+  for (int cy = fy - 1; cy <= fy + 1; ++cy)
+    for (int cx = fx - 1; cx <= fx + 1; ++cx) {
+      if (cx < 0 || cy < 0 || cx > field.width - 2 || cy > field.height - 2) continue;
+      if (x < cx - 1e-4 || x > cx + 1 + 1e-4 || y < cy - 1e-4 || y > cy + 1 + 1e-4) continue;
+      const double u = std::clamp(x - cx, 0.0, 1.0), v = std::clamp(y - cy, 0.0, 1.0), zs = field.z_scale;
+      const double h00 = double(field.at(cx, cy)) * zs, h10 = double(field.at(cx + 1, cy)) * zs,
+                   h01 = double(field.at(cx, cy + 1)) * zs, h11 = double(field.at(cx + 1, cy + 1)) * zs;
+      const double s = h00 * (1 - u) * (1 - v) + h10 * u * (1 - v) + h01 * (1 - u) * v + h11 * u * v;
+      if (std::isfinite(s)) return z - s;
+    }
+  return NAN;  // over nodata
+}
+
+double bruteForceRayHit(const HeightField& field, const HeightRay& ray, double step) {
+  // Samples midway between the steps: never exactly on the grid point a ray may start from.
+  for (double t = 0.5 * step; t <= double(ray.t_max); t += step) {
+    const double c = rayClearance(field, ray, t);
+    if (c < 0.0) return t;
+    const double x = ray.ox + t * double(ray.dx), y = ray.oy + t * double(ray.dy);
+    // Once out of the box moving away, nothing more.
+    if ((x < 0 && ray.dx <= 0) || (y < 0 && ray.dy <= 0) || (x > field.width - 1 && ray.dx >= 0) ||
+        (y > field.height - 1 && ray.dy >= 0))
+      break;
+  }
+  return INFINITY;
+}
+
+}  // namespace hfvis
