@@ -29,6 +29,10 @@
 //       Stewart's culling pyramid per field: preprocessing time, memory per finest level kept, and
 //       for valley, ground-level and high observers the culled shares and the exact and culled
 //       viewsheds' times (interleaved, the fastest of N)
+//   hfvis_bench region [--sections arealight,pair,error] [--reps N] FIELD...
+//       region visibility's backends timed interleaved: area lights against S, the light's size
+//       and height; region pairs against their size and distance; the visible fraction's error
+//       against a Monte-Carlo reference
 //   hfvis_bench field NAME N OUT
 //       writes the synthetic field NAME (testing's hard cases: city, sine, ...) of N x N pixels
 //       to OUT (EXR or GeoTIFF), for timing the CLI on it (bench/cost_against.sh)
@@ -57,6 +61,7 @@
 #include "hfvis/environment_light.hpp"
 #include "hfvis/horizon.hpp"
 #include "lighting.hpp"
+#include "region_visibility.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/image_io.hpp"
 #include "hfvis/intervisibility.hpp"
@@ -87,6 +92,7 @@ constexpr const char* kUsage =
     "       hfvis_bench viewshed-agreement DEM --observer COL,ROW [--observer-height H] [--target-height T]\n"
     "                                      [--samples N] [--seed S] RASTER...\n"
     "       hfvis_bench viewshed-culling [--levels 1,2,3,4] [--reps N] FIELD...\n"
+    "       hfvis_bench region [--sections arealight,pair,error] [--reps N] FIELD...\n"
     "       hfvis_bench field NAME N OUT\n"
     "       hfvis_bench inputs [--quick]\n"
     "       hfvis_bench check-truth\n"
@@ -414,6 +420,24 @@ int main(int argc, char** argv) {
         if (k < 1 || k > 12) throw Usage("--levels: finest levels are 1 .. 12");
       const ComputeContext context = ComputeContext::create(ContextOptions::fromEnvironment());
       for (const std::string& path : fields) viewshedCullingReport(context, path, levels, reps);
+      return 0;
+    }
+    if (command == "region") {
+      const std::string list = args.get("--sections", "arealight,pair,error");
+      const int reps = std::stoi(args.get("--reps", "3"));
+      const std::vector<std::string> fields = args.positional();
+      args.rejectUnused();
+      if (fields.empty()) throw Usage("region needs FIELD...");
+      std::vector<std::string> sections;
+      for (std::size_t at = 0; at <= list.size();) {
+        const std::size_t comma = std::min(list.find(',', at), list.size());
+        sections.push_back(list.substr(at, comma - at));
+        if (sections.back() != "arealight" && sections.back() != "pair" && sections.back() != "error")
+          throw Usage("--sections: arealight, pair, error (comma-separated)");
+        at = comma + 1;
+      }
+      const ComputeContext context = ComputeContext::create(ContextOptions::fromEnvironment());
+      for (const std::string& path : fields) regionVisibilityReport(context, path, sections, reps);
       return 0;
     }
     if (command == "field") {

@@ -2,7 +2,8 @@
 // computeRegionPairVisibility in src/ops/region_visibility.cpp; the contract in
 // hfvis/region_visibility.hpp). One work-item per (receiver, word of 32 source samples): it
 // places its receiver and the word's source samples and marches each pair
-// (shared/region_visibility_sight.cl), then writes the word, so no two work-items write one word and no
+// (shared/region_visibility_sight.cl; with a culling pyramid, `levels` > 0, the march leaps
+// over the blocks of cells far below the segment), then writes the word, so no two work-items write one word and no
 // atomics are needed.
 //
 // Receivers are the grid points (`pixel_receivers`) or the samples of a second region (the
@@ -21,7 +22,8 @@ typedef struct {
   float max_d2;          // the largest squared ground distance of a visible pair; 0 = any
 } RegionField;
 
-__kernel void region_visibility_bits(__global const float* h, RegionField f, __global const float* sources,
+__kernel void region_visibility_bits(__global const float* h, __global const float* pyramid, int levels,
+                                     float margin, RegionField f, __global const float* sources,
                                      int source_absolute, int samples, int pixel_receivers,
                                      __global const float* receivers, int receiver_absolute,
                                      int receiver_count, float target_height, unsigned int seed,
@@ -44,8 +46,8 @@ __kernel void region_visibility_bits(__global const float* h, RegionField f, __g
     for (int s = 32 * w; s < end; ++s) {
       float xs, ys, zs;
       region_sample(sources, h, f.width, f.height, source_absolute, seed, key, s, &xs, &ys, &zs);
-      if (region_sight_visible(h, f.width, f.height, f.cell_x, f.cell_y, f.curvature, f.max_d2, xs, ys, zs,
-                               xr, yr, zr))
+      if (region_sight_visible_culled(h, f.width, f.height, f.cell_x, f.cell_y, f.curvature, f.max_d2, pyramid,
+                                      levels, margin, xs, ys, zs, xr, yr, zr))
         word |= 1U << (s - 32 * w);
     }
   }

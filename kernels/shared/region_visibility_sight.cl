@@ -61,6 +61,40 @@ inline float region_cell_twist(HFVIS_GLOBAL const float* h, int width, int heigh
   return h[p] - h[p + 1] - h[p + width] + h[p + width + 1];
 }
 
+// The culling pyramid (a max pyramid over the cells): level k holds, per block of 2^k x 2^k cells
+// (the last ones in a row or column cut by the field), the highest point of the surface over the
+// block's closed square, +INFINITY where the march's values there can run unbounded (an infinite
+// height in or beside the block), -INFINITY where it has no surface; levels are stored one after
+// another, rows of region_cull_width blocks.
+inline int region_cull_width(int width, int k) { return ((width - 1) + (1 << k) - 1) >> k; }
+
+inline int region_cull_offset(int width, int height, int k) {
+  int offset = 0;
+  for (int j = 0; j < k; ++j) offset += region_cull_width(width, j) * region_cull_width(height, j);
+  return offset;
+}
+
+// The first grid line (an integer of the coordinate from `a` in steps of `d`) whose crossing
+// parameter (line - a) / d, as the march computes it, comes after t (`at_too`: at or after t).
+inline float region_cull_next_line(float a, float d, float t, int at_too) {
+  float g = d > 0.0f ? floor(a + t * d) : ceil(a + t * d);
+  const float step = d > 0.0f ? 1.0f : -1.0f;
+  // Forward past the lines before t, then back over lines still after it (never behind a).
+  for (;;) {
+    const float tg = (g - a) / d;
+    if (at_too ? tg >= t : tg > t) break;
+    g += step;
+  }
+  for (;;) {
+    const float back = g - step;
+    if (!(d > 0.0f ? back > a : back < a)) break;
+    const float tb = (back - a) / d;
+    if (!(at_too ? tb >= t : tb > t)) break;
+    g = back;
+  }
+  return g;
+}
+
 // The segment's height above the surface at t, negated: f(t) = s(t) - (za + t (zb - za)) +
 // c D^2 t (1 - t), s the surface at the point over t (given).
 inline float region_rise(float s, float t, float za, float dz, float cdd) {
@@ -75,9 +109,15 @@ inline float region_rise(float s, float t, float za, float dz, float cdd) {
 // any). A cell with a nodata corner has no surface inside; an edge or grid point between valid
 // heights is surface. Pieces shorter than 1e-3 pixel skip their inside test, as the viewshed's
 // do (their top would be rounding noise).
-inline int region_sight_visible(HFVIS_GLOBAL const float* h, int width, int height, float cell_x,
-                                float cell_y, float curvature, float max_d2, float xa, float ya, float za,
-                                float xb, float yb, float zb) {
+//
+// With a culling pyramid (`levels` > 0: region_cull_* below), the march leaps over every block of
+// cells that provably cannot reach the segment: it resumes at the crossing where the segment leaves
+// the block, in the state the step-by-step march would have there, so that the answer is the same
+// bit for bit, only sooner.
+inline int region_sight_visible_culled(HFVIS_GLOBAL const float* h, int width, int height, float cell_x,
+                                       float cell_y, float curvature, float max_d2,
+                                       HFVIS_GLOBAL const float* pyramid, int levels, float margin,
+                                       float xa, float ya, float za, float xb, float yb, float zb) {
   // The canonical order: from the smaller end in (x, y, z), so that the test is symmetric.
   if (xb < xa || (xb == xa && (yb < ya || (yb == ya && zb < za)))) {
     float s = xa;
@@ -104,10 +144,60 @@ inline int region_sight_visible(HFVIS_GLOBAL const float* h, int width, int heig
   // eye below its own ground sees nothing).
   float f0 = region_surface_at(h, width, height, xa, ya) - za;
   if (f0 > 0.0f) return 0;
+  // The culling: the clearance a block must leave below the segment (the rounding of the march's
+  // values, region_cull_margin, and the curvature's largest rise c D^2 / 4), and the level tried
+  // next (one up after a leap, one down after a refusal).
+  const float clearance = margin + 1e-5f * (2.0f * (fabs(za) + fabs(zb)) + fabs(cdd)) + (cdd > 0.0f ? 0.25f * cdd : 0.0f);
+  int level = 0;
   for (;;) {
     const float tx = dx > 0.0f && gxl < xb ? (gxl - xa) / dx : INFINITY;
     const float ty = dy > 0.0f ? (gyl < yb ? (gyl - ya) / dy : INFINITY)
                                : (dy < 0.0f && gyl > yb ? (gyl - ya) / dy : INFINITY);
+    if (levels > 0) {
+      // The cell of the next piece (its middle), and the blocks above it from `level` down.
+      const float tn = tx < ty ? (tx < 1.0f ? tx : 1.0f) : (ty < 1.0f ? ty : 1.0f), tm = 0.5f * (t0 + tn);
+      int cx = (int)(xa + tm * dx), cy = (int)(ya + tm * dy);
+      cx = cx < 0 ? 0 : (cx > width - 2 ? width - 2 : cx);
+      cy = cy < 0 ? 0 : (cy > height - 2 ? height - 2 : cy);
+      int leapt = 0;
+      for (int k = level; k >= 0 && !leapt; --k) {
+        const int bx = cx >> k, by = cy >> k;
+        const float top = pyramid[region_cull_offset(width, height, k) + by * region_cull_width(width, k) + bx];
+        // Where the segment leaves the block: its column line on the right or its row line ahead,
+        // each crossing's parameter as the march computes it.
+        const int right = (bx + 1) << k, ahead = dy > 0.0f ? (by + 1) << k : by << k;
+        const float lx = (float)(right < width - 1 ? right : width - 1);
+        const float ly = (float)(dy > 0.0f ? (ahead < height - 1 ? ahead : height - 1) : ahead);
+        const float tX = dx > 0.0f && lx < xb ? (lx - xa) / dx : INFINITY;
+        const float tY = dy > 0.0f ? (ly < yb ? (ly - ya) / dy : INFINITY)
+                                   : (dy < 0.0f && ly > yb ? (ly - ya) / dy : INFINITY);
+        const int leave_x = tX <= tY;
+        const float tC = leave_x ? tX : tY, tE = tC < 1.0f ? tC : 1.0f;
+        const float z0 = za + t0 * dz, zE = za + tE * dz;
+        if (!(tE > t0 && top + clearance < (z0 < zE ? z0 : zE))) continue;
+        if (tC >= 1.0f) return 1;  // the block holds the rest of the segment, its end too
+        // Resume at the crossing C where the segment leaves: the march's value there, its next
+        // column line the first after C, its next row line the first at or after C (x first on
+        // a tie, as the march orders them).
+        float s;
+        if (leave_x) {
+          s = region_surface_at(h, width, height, lx, ya + tC * dy);
+          gxl = lx + 1.0f;
+          if (dy != 0.0f) gyl = region_cull_next_line(ya, dy, tC, 1);
+        } else {
+          s = region_surface_at(h, width, height, xa + tC * dx, ly);
+          gyl = dy > 0.0f ? ly + 1.0f : ly - 1.0f;
+          if (dx > 0.0f) gxl = region_cull_next_line(xa, dx, tC, 0);
+        }
+        t0 = tC;
+        f0 = region_rise(s, tC, za, dz, cdd);
+        if (f0 > 0.0f) return 0;
+        level = k + 1 < levels ? k + 1 : k;
+        leapt = 1;
+      }
+      if (leapt) continue;
+      level = 0;
+    }
     const int x_first = tx <= ty;
     float t1 = x_first ? tx : ty;
     float f1;
@@ -143,6 +233,14 @@ inline int region_sight_visible(HFVIS_GLOBAL const float* h, int width, int heig
     t0 = t1;
     f0 = f1;
   }
+}
+
+// The march without culling (the exact method and the scalar reference).
+inline int region_sight_visible(HFVIS_GLOBAL const float* h, int width, int height, float cell_x,
+                                float cell_y, float curvature, float max_d2, float xa, float ya, float za,
+                                float xb, float yb, float zb) {
+  return region_sight_visible_culled(h, width, height, cell_x, cell_y, curvature, max_d2, h, 0, 0.0f, xa, ya,
+                                     za, xb, yb, zb);
 }
 
 // A 32-bit integer hash (Wellons' lowbias32): the jitter of the samples.

@@ -12,6 +12,9 @@
 
 namespace hfvis::detail {
 
+using std::ceil;
+using std::fabs;
+using std::floor;
 using std::isnan;
 #include "../../kernels/shared/region_visibility_sight.cl"
 
