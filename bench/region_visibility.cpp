@@ -190,6 +190,7 @@ void errorSection(const ComputeContext& context, const HeightField& full, int) {
 
 void regionVisibilityReport(const ComputeContext& context, const std::string& path,
                             const std::vector<std::string>& sections, int reps) {
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);  // each row as it is measured (long sections)
   const HeightField field = readHeightField(path);
   std::printf("\n### %s (%d x %d)\n", path.c_str(), field.width, field.height);
   for (const std::string& s : sections) {

@@ -56,6 +56,7 @@ struct CullPyramid {
   std::vector<float> top;
   int levels = 0;
   float margin = 0.0f;
+  float gradient = 0.0f;  // the surface's steepest slope per pixel, at most (region_cull_hides)
 };
 
 CullPyramid cullPyramid(const std::vector<float>& h, int width, int height) {
@@ -83,6 +84,7 @@ CullPyramid cullPyramid(const std::vector<float>& h, int width, int height) {
     }
   const double position_ulp = std::ldexp(double(std::max(width, height)), -23);
   out.margin = static_cast<float>(8e-5 * largest + 4.0 * position_ulp * (step + twist));
+  out.gradient = static_cast<float>(step + twist);
   // Level 0: per cell its corners' highest valid height; +INFINITY where an infinite height lies
   // on the cell or a cell beside it (the march's values there are unbounded or NaN).
   int w = width - 1, hh = height - 1;
@@ -167,6 +169,7 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
           detail::prepareHeights(field_, detail::HeightOrigin::Zero).heights, field_.width, field_.height);
       levels_ = pyramid.levels;
       margin_ = pyramid.margin;
+      gradient_ = pyramid.gradient;
       if (levels_ > 0) pyramid_ = upload(pyramid.top);
     }
     kernel_ = kernel("region_visibility_bits");
@@ -174,6 +177,7 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
         .set("pyramid", levels_ > 0 ? pyramid_ : heights_)
         .set("levels", cl_int(levels_))
         .set("margin", margin_)
+        .set("gradient", gradient_)
         .set("f", device)
         .set("sources", source_table_)
         .set("source_absolute", cl_int(source_absolute_))
@@ -221,7 +225,7 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
   const int samples_, words_;
   bool receiver_major_ = true;
   int levels_ = 0;  // the culling pyramid's (0: the exact march)
-  cl_float margin_ = 0.0f;
+  cl_float margin_ = 0.0f, gradient_ = 0.0f;
   cl::Buffer source_table_, receiver_table_, bits_, pyramid_;
   detail::NamedKernel kernel_;
 };
