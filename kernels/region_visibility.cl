@@ -50,10 +50,13 @@ int region_shaft_clear(__global const float* h, __global const float* pyramid, i
   // The march's clearance for the longest segment, its slope's rounding allowed for (1e-5
   // relative, as the rest).
   const float cdd = f.curvature * far * far;
-  const float clearance = margin + 1e-5f * (4.0f * zabs + fabs(cdd) + fabs(slope) * far) + fmax(cdd, 0.0f) * 0.25f;
+  const float clearance =
+      margin + 1e-5f * (4.0f * zabs + fabs(cdd) + fabs(slope) * far) + fmax(cdd, 0.0f) * 0.25f;
   const float rx = floor(xr), ry = floor(yr);
-  box[0] = fmax(0.0f, rx - REGION_NEAR_CELLS), box[2] = fmin((float)(f.width - 1), ceil(xr) + REGION_NEAR_CELLS);
-  box[1] = fmax(0.0f, ry - REGION_NEAR_CELLS), box[3] = fmin((float)(f.height - 1), ceil(yr) + REGION_NEAR_CELLS);
+  box[0] = fmax(0.0f, rx - REGION_NEAR_CELLS),
+  box[2] = fmin((float)(f.width - 1), ceil(xr) + REGION_NEAR_CELLS);
+  box[1] = fmax(0.0f, ry - REGION_NEAR_CELLS),
+  box[3] = fmin((float)(f.height - 1), ceil(yr) + REGION_NEAR_CELLS);
   // The footprint: its bounding box, and (receiver outside the samples' box) the wedge's two
   // edges, toward the samples' corners most counter-clockwise and most clockwise.
   const float fx0 = fmin(xr, sx0), fx1 = fmax(xr, sx1), fy0 = fmin(yr, sy0), fy1 = fmax(yr, sy1);
@@ -80,7 +83,8 @@ int region_shaft_clear(__global const float* h, __global const float* pyramid, i
     --top;
     const int k = stack_k[top], bx = stack_x[top], by = stack_y[top];
     const float x0 = (float)(bx << k), y0 = (float)(by << k);
-    const float x1 = fmin((float)((bx + 1) << k), (float)(f.width - 1)), y1 = fmin((float)((by + 1) << k), (float)(f.height - 1));
+    const float x1 = fmin((float)((bx + 1) << k), (float)(f.width - 1)),
+                y1 = fmin((float)((by + 1) << k), (float)(f.height - 1));
     if (x1 < fx0 || x0 > fx1 || y1 < fy0 || y0 > fy1) continue;
     if (x0 >= box[0] && x1 <= box[2] && y0 >= box[1] && y1 <= box[3]) continue;
     if (wedge) {
@@ -92,10 +96,12 @@ int region_shaft_clear(__global const float* h, __global const float* pyramid, i
       }
       if (left == 4 || right == 4) continue;
     }
-    const float ddx = fmax(0.0f, fmax(x0 - xr, xr - x1)) * f.cell_x, ddy = fmax(0.0f, fmax(y0 - yr, yr - y1)) * f.cell_y;
+    const float ddx = fmax(0.0f, fmax(x0 - xr, xr - x1)) * f.cell_x,
+                ddy = fmax(0.0f, fmax(y0 - yr, yr - y1)) * f.cell_y;
     const float near = sqrt(ddx * ddx + ddy * ddy);
     const float lowest = zr + slope * (slope >= 0.0f ? near : far);
-    const float highest = pyramid[region_cull_offset(f.width, f.height, k) + by * region_cull_width(f.width, k) + bx];
+    const float highest =
+        pyramid[region_cull_offset(f.width, f.height, k) + by * region_cull_width(f.width, k) + bx];
     if (highest + clearance < lowest) continue;
     if (k == 0 || top + 4 > 64) return 0;
     for (int c = 0; c < 4; ++c) {
@@ -108,12 +114,12 @@ int region_shaft_clear(__global const float* h, __global const float* pyramid, i
 }
 
 __kernel void region_visibility_bits(__global const float* h, __global const float* pyramid, int levels,
-                                     float margin, float gradient, RegionField f, __global const float* sources,
-                                     int source_absolute, int samples, int pixel_receivers,
-                                     __global const float* receivers, int receiver_absolute,
-                                     int receiver_count, float target_height, unsigned int seed,
-                                     int decorrelate, int words, int receiver_major, int first,
-                                     __global unsigned int* bits) {
+                                     float margin, float gradient, RegionField f,
+                                     __global const float* sources, int source_absolute, int samples,
+                                     int pixel_receivers, __global const float* receivers,
+                                     int receiver_absolute, int receiver_count, float target_height,
+                                     unsigned int seed, int decorrelate, int words, int receiver_major,
+                                     int first, __global unsigned int* bits) {
   const int r = first + (int)get_global_id(0), w = get_global_id(1);
   if (r >= receiver_count || w >= words) return;
   float xr, yr, zr;
@@ -136,7 +142,8 @@ __kernel void region_visibility_bits(__global const float* h, __global const flo
     // samples is clear beyond them (else a box that holds nothing), and the cell that hid the
     // last hidden sample tried first.
     float box[4] = {1.0f, 0.0f, 0.0f, 0.0f};
-    if (levels > 0 && !region_shaft_clear(h, pyramid, levels, margin, f, xr, yr, zr, xs, ys, zs, end - 32 * w, box))
+    if (levels > 0 &&
+        !region_shaft_clear(h, pyramid, levels, margin, f, xr, yr, zr, xs, ys, zs, end - 32 * w, box))
       box[0] = 1.0f, box[2] = 0.0f;
     int blocker = -1;
     for (int i = 0; i < end - 32 * w; ++i) {
@@ -144,9 +151,9 @@ __kernel void region_visibility_bits(__global const float* h, __global const flo
                                             margin, gradient, blocker, xs[i], ys[i], zs[i], xr, yr, zr))
         continue;
       int blocked_at = -1;
-      if (region_sight_visible_culled(h, f.width, f.height, f.cell_x, f.cell_y, f.curvature, f.max_d2, pyramid,
-                                      levels, margin, box[0], box[1], box[2], box[3], xs[i], ys[i], zs[i], xr,
-                                      yr, zr, &blocked_at))
+      if (region_sight_visible_culled(h, f.width, f.height, f.cell_x, f.cell_y, f.curvature, f.max_d2,
+                                      pyramid, levels, margin, box[0], box[1], box[2], box[3], xs[i], ys[i],
+                                      zs[i], xr, yr, zr, &blocked_at))
         word |= 1U << i;
       else if (levels > 0 && blocked_at >= 0)
         blocker = blocked_at;

@@ -76,7 +76,8 @@ class RegionMethods : public ::testing::TestWithParam<RegionVisibilityMethod> {}
 INSTANTIATE_TEST_SUITE_P(RegionVisibility, RegionMethods,
                          ::testing::Values(RegionVisibilityMethod::Exact, RegionVisibilityMethod::Culled),
                          [](const auto& info) {
-                           return std::string(info.param == RegionVisibilityMethod::Exact ? "Exact" : "Culled");
+                           return std::string(info.param == RegionVisibilityMethod::Exact ? "Exact"
+                                                                                          : "Culled");
                          });
 
 TEST_P(RegionMethods, KernelMatchesTheReferenceOnEveryHardCase) {
@@ -166,8 +167,8 @@ TEST_P(RegionMethods, PairMatchesTheReference) {
 // infinite heights, a cliff of 1e6 and a plane 8848 high, where the rounding margin matters.
 TEST(RegionVisibility, TheCulledMarchIsTheExactOne) {
   std::size_t clear = 0, total = 0;
-  for (const char* name : {"city", "noise", "sine", "bowl", "nan_holes", "infinities", "cliff", "tilted_plane",
-                           "terraces", "spikes", "dome"}) {
+  for (const char* name : {"city", "noise", "sine", "bowl", "nan_holes", "infinities", "cliff",
+                           "tilted_plane", "terraces", "spikes", "dome"}) {
     SCOPED_TRACE(name);
     HeightField field = makeSyntheticField(name, 101, 77, 5);
     field.cell_size_y = 1.25;

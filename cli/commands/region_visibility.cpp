@@ -303,7 +303,8 @@ void checkAreaLight(const std::string&, const RunArguments& run) {
   requireAboveSurface(run, "--light-height", run.light_height);
   if (run.region_method == RegionVisibilityMethod::Viewsheds) {
     if (run.decorrelate)
-      throw UsageError("--decorrelate needs --method exact or culled (the viewsheds method shares the samples)");
+      throw UsageError(
+          "--decorrelate needs --method exact or culled (the viewsheds method shares the samples)");
     if (run.light && (run.light->col0 != run.light->col1 || run.light->row0 != run.light->row1))
       throw UsageError(
           "--method viewsheds needs the light's samples on grid points: a one-pixel --light or --sources "

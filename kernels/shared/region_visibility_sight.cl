@@ -130,7 +130,6 @@ inline int region_cell_at(int width, int height, float x, float y) {
   return cx < 0 || cy < 0 ? -1 : cy * width + cx;
 }
 
-
 // Whether the point (xb, yb, zb) is visible from (xa, ya, za) (pixel positions inside the field,
 // heights z-scaled and finite): 1 when no point of the surface strictly between them rises
 // strictly above the segment (an end below the surface counts: the surface rises above the
@@ -178,7 +177,8 @@ inline int region_sight_visible_culled(HFVIS_GLOBAL const float* h, int width, i
   // The culling: the clearance a block must leave below the segment (the rounding of the march's
   // values, region_cull_margin, and the curvature's largest rise c D^2 / 4), and the level tried
   // next (one up after a leap, one down after a refusal).
-  const float clearance = margin + 1e-5f * (2.0f * (fabs(za) + fabs(zb)) + fabs(cdd)) + (cdd > 0.0f ? 0.25f * cdd : 0.0f);
+  const float clearance =
+      margin + 1e-5f * (2.0f * (fabs(za) + fabs(zb)) + fabs(cdd)) + (cdd > 0.0f ? 0.25f * cdd : 0.0f);
   int level = 0;
   // Outside the box of grid lines (box_x0 <= x <= box_x1, box_y0 <= y <= box_y1; none when
   // box_x0 > box_x1), which holds one end, the caller has shown the segment clear by the same
@@ -193,14 +193,14 @@ inline int region_sight_visible_culled(HFVIS_GLOBAL const float* h, int width, i
       const float tC = on_column ? tX : tY;
       if (tC > 0.0f && tC < 1.0f) {
         t0 = tC;
-        f0 = region_cull_resume(h, width, height, xa, ya, za, dx, dy, dz, cdd, on_column, box_x0, ly, tC, &gxl,
-                                &gyl);
+        f0 = region_cull_resume(h, width, height, xa, ya, za, dx, dy, dz, cdd, on_column, box_x0, ly, tC,
+                                &gxl, &gyl);
         if (f0 > 0.0f) return 0;
       }
     }
     const float tX = xb > box_x1 ? (box_x1 - xa) / dx : INFINITY;
     const float tY = dy > 0.0f && yb > box_y1 ? (box_y1 - ya) / dy
-                                               : (dy < 0.0f && yb < box_y0 ? (box_y0 - ya) / dy : INFINITY);
+                                              : (dy < 0.0f && yb < box_y0 ? (box_y0 - ya) / dy : INFINITY);
     t_out = tX < tY ? tX : tY;
   }
   for (;;) {
@@ -217,7 +217,8 @@ inline int region_sight_visible_culled(HFVIS_GLOBAL const float* h, int width, i
       int leapt = 0;
       for (int k = level; k >= 0 && !leapt; --k) {
         const int bx = cx >> k, by = cy >> k;
-        const float top = pyramid[region_cull_offset(width, height, k) + by * region_cull_width(width, k) + bx];
+        const float top =
+            pyramid[region_cull_offset(width, height, k) + by * region_cull_width(width, k) + bx];
         // Where the segment leaves the block: its column line on the right or its row line ahead,
         // each crossing's parameter as the march computes it.
         const int right = (bx + 1) << k, ahead = dy > 0.0f ? (by + 1) << k : by << k;
@@ -233,7 +234,8 @@ inline int region_sight_visible_culled(HFVIS_GLOBAL const float* h, int width, i
         if (tC >= 1.0f) return 1;  // the block holds the rest of the segment, its end too
         // Resume at the crossing C where the segment leaves.
         t0 = tC;
-        f0 = region_cull_resume(h, width, height, xa, ya, za, dx, dy, dz, cdd, leave_x, lx, ly, tC, &gxl, &gyl);
+        f0 = region_cull_resume(h, width, height, xa, ya, za, dx, dy, dz, cdd, leave_x, lx, ly, tC, &gxl,
+                                &gyl);
         if (f0 > 0.0f) return 0;
         level = k + 1 < levels ? k + 1 : k;
         leapt = 1;
@@ -289,8 +291,8 @@ inline int region_sight_visible(HFVIS_GLOBAL const float* h, int width, int heig
                                 float cell_y, float curvature, float max_d2, float xa, float ya, float za,
                                 float xb, float yb, float zb) {
   int blocked_at;
-  return region_sight_visible_culled(h, width, height, cell_x, cell_y, curvature, max_d2, h, 0, 0.0f, 1.0f, 0.0f,
-                                     0.0f, 0.0f, xa, ya, za, xb, yb, zb, &blocked_at);
+  return region_sight_visible_culled(h, width, height, cell_x, cell_y, curvature, max_d2, h, 0, 0.0f, 1.0f,
+                                     0.0f, 0.0f, 0.0f, xa, ya, za, xb, yb, zb, &blocked_at);
 }
 
 // Whether the surface over cell `cell` (the index of its first corner) rises above the segment

@@ -10,9 +10,9 @@
 
 #include "core/horizon_common.hpp"
 #include "core/opencl_context.hpp"
+#include "core/sweep_framework.hpp"
 #include "core/sweep_geometry.hpp"
 #include "core/sweep_routine.hpp"
-#include "core/sweep_framework.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/viewshed.hpp"
 #include "ops/region_visibility_sight.hpp"
@@ -75,8 +75,10 @@ CullPyramid cullPyramid(const std::vector<float>& h, int width, int height) {
       infinite[std::size_t(r) * width + c] = std::isinf(v);
       if (!std::isfinite(v)) continue;
       largest = std::max(largest, double(std::fabs(v)));
-      if (c + 1 < width && std::isfinite(at(c + 1, r))) step = std::max(step, double(std::fabs(at(c + 1, r) - v)));
-      if (r + 1 < height && std::isfinite(at(c, r + 1))) step = std::max(step, double(std::fabs(at(c, r + 1) - v)));
+      if (c + 1 < width && std::isfinite(at(c + 1, r)))
+        step = std::max(step, double(std::fabs(at(c + 1, r) - v)));
+      if (r + 1 < height && std::isfinite(at(c, r + 1)))
+        step = std::max(step, double(std::fabs(at(c, r + 1) - v)));
       if (c + 1 < width && r + 1 < height) {
         const double t = double(v) - at(c + 1, r) - at(c, r + 1) + at(c + 1, r + 1);
         if (std::isfinite(t)) twist = std::max(twist, std::fabs(t));
@@ -122,8 +124,8 @@ CullPyramid cullPyramid(const std::vector<float>& h, int width, int height) {
 class RegionBitsRoutine : public detail::DeviceRoutine {
  public:
   RegionBitsRoutine(detail::ContextState& st, const HeightField& field, const std::vector<float>& sources,
-                    bool source_absolute, const std::vector<float>* receivers, bool receiver_absolute, int count,
-                    const RegionVisibilityOptions& options)
+                    bool source_absolute, const std::vector<float>* receivers, bool receiver_absolute,
+                    int count, const RegionVisibilityOptions& options)
       : DeviceRoutine(st, field, nullptr, 0),
         sources_(sources),
         source_absolute_(source_absolute),
@@ -138,7 +140,9 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
 
  private:
   // The viewshed's heights (z-scaled, from 0), so both decide the same sight lines.
-  detail::PreparedHeights prepare() override { return detail::prepareHeights(field_, detail::HeightOrigin::Zero); }
+  detail::PreparedHeights prepare() override {
+    return detail::prepareHeights(field_, detail::HeightOrigin::Zero);
+  }
   std::string programFile() const override { return "region_visibility.cl"; }
 
   void allocate() override {
@@ -235,8 +239,8 @@ std::vector<std::uint32_t> runBits(const ComputeContext& context, const HeightFi
                                    const std::vector<float>* receivers, bool receiver_absolute, int count,
                                    const RegionVisibilityOptions& options) {
   return detail::translateOpenClErrors([&] {
-    RegionBitsRoutine routine(detail::stateOf(context), field, sources, source_absolute, receivers, receiver_absolute,
-                              count, options);
+    RegionBitsRoutine routine(detail::stateOf(context), field, sources, source_absolute, receivers,
+                              receiver_absolute, count, options);
     routine.run();
     return std::move(routine.bits);
   });
@@ -341,8 +345,8 @@ void validate(const RegionVisibilityOptions& options) {
   if (!std::isfinite(options.max_distance) || options.max_distance < 0.0)
     throw InvalidArgument("the maximum distance must be finite and at least 0 (0: no limit)");
   if (!std::isfinite(options.curvature)) throw InvalidArgument("the curvature must be finite");
-  if (options.method != RegionVisibilityMethod::Exact && options.method != RegionVisibilityMethod::Viewsheds &&
-      options.method != RegionVisibilityMethod::Culled)
+  if (options.method != RegionVisibilityMethod::Exact &&
+      options.method != RegionVisibilityMethod::Viewsheds && options.method != RegionVisibilityMethod::Culled)
     throw InvalidArgument("unknown region visibility method");
 }
 
@@ -444,8 +448,8 @@ RegionPairVisibilityResult computeRegionPairVisibility(const ComputeContext& con
   out.words = (out.source_samples + 31) / 32;
   out.sources = regionSamplePoints(field, sources, options.seed);
   out.receivers = regionSamplePoints(field, receivers, options.seed);
-  out.bits = runBits(context, field, source_table, sources.absolute, &receiver_table,
-                     receivers.absolute, out.receiver_samples, options);
+  out.bits = runBits(context, field, source_table, sources.absolute, &receiver_table, receivers.absolute,
+                     out.receiver_samples, options);
   detail::countPairFractions(out);
   return out;
 }
