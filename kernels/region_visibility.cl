@@ -113,6 +113,32 @@ int region_shaft_clear(__global const float* h, __global const float* pyramid, i
   return 1;
 }
 
+// The cell to try first against the word's next sight lines, after the line from the receiver
+// (xr, yr, zr) to (xs, ys, zs) was found hidden by the march at cell `found`: the first cell from
+// the receiver, within 8, that region_cull_hides shows hiding it (lines to a word's samples
+// spread apart from the receiver: the nearer the hiding cell, the more of them it hides), else
+// `found`.
+int region_near_hider(__global const float* h, RegionField f, float margin, float gradient, int found, float xr,
+                      float yr, float zr, float xs, float ys, float zs) {
+  const float dx = xs - xr, dy = ys - yr;
+  int cx = (int)xr < f.width - 2 ? (int)xr : f.width - 2, cy = (int)yr < f.height - 2 ? (int)yr : f.height - 2;
+  for (int n = 0; n < 8 && cx >= 0 && cy >= 0 && cx <= f.width - 2 && cy <= f.height - 2; ++n) {
+    const int cell = cy * f.width + cx;
+    if (cell == found) break;
+    if (region_cull_hides(h, f.width, f.height, f.cell_x, f.cell_y, f.curvature, f.max_d2, margin, gradient, cell,
+                          xs, ys, zs, xr, yr, zr))
+      return cell;
+    const float tX = dx != 0.0f ? ((float)(dx > 0.0f ? cx + 1 : cx) - xr) / dx : INFINITY;
+    const float tY = dy != 0.0f ? ((float)(dy > 0.0f ? cy + 1 : cy) - yr) / dy : INFINITY;
+    if (fmin(tX, tY) >= 1.0f) break;
+    if (tX < tY)
+      cx += dx > 0.0f ? 1 : -1;
+    else
+      cy += dy > 0.0f ? 1 : -1;
+  }
+  return found;
+}
+
 __kernel void region_visibility_bits(__global const float* h, __global const float* pyramid, int levels,
                                      float margin, float gradient, RegionField f,
                                      __global const float* sources, int source_absolute, int samples,
@@ -156,7 +182,7 @@ __kernel void region_visibility_bits(__global const float* h, __global const flo
                                       zs[i], xr, yr, zr, &blocked_at))
         word |= 1U << i;
       else if (levels > 0 && blocked_at >= 0)
-        blocker = blocked_at;
+        blocker = region_near_hider(h, f, margin, gradient, blocked_at, xr, yr, zr, xs[i], ys[i], zs[i]);
     }
   }
   bits[receiver_major ? (size_t)r * words + w : (size_t)w * receiver_count + r] = word;
