@@ -179,7 +179,8 @@ void errorSection(const ComputeContext& context, const HeightField& full, int) {
   std::printf(
       "\n#### The visible fraction against a Monte-Carlo reference (%d x %d pixels of the field's centre,"
       " a 32 x 32 px light 20 above the highest point, jittered; the reference: 4 x 4096 samples)\n\n"
-      "| S | decorrelated | mean absolute error | largest error |\n|---|---|---|---|\n",
+      "| S | decorrelated | mean absolute error | largest error | penumbra pixels (0 < reference < 1) | "
+      "their mean absolute error |\n|---|---|---|---|---|---|\n",
       n, n);
   for (int samples : {256, 1024})
     for (bool decorrelate : {false, true}) {
@@ -187,13 +188,15 @@ void errorSection(const ComputeContext& context, const HeightField& full, int) {
       RegionVisibilityOptions o;
       o.decorrelate = decorrelate;
       const RegionVisibilityResult r = computeRegionVisibility(context, f, light, o);
-      double sum = 0.0, worst = 0.0;
+      double sum = 0.0, worst = 0.0, penumbra_sum = 0.0;
+      std::size_t penumbra = 0;
       for (std::size_t p = 0; p < f.pixelCount(); ++p) {
         const double e = std::fabs(r.fraction[p] - reference[p]);
         sum += e, worst = std::max(worst, e);
+        if (reference[p] > 0.0 && reference[p] < 1.0) penumbra_sum += e, ++penumbra;
       }
-      std::printf("| %d | %s | %.4f | %.4f |\n", samples, decorrelate ? "yes" : "no", sum / f.pixelCount(),
-                  worst);
+      std::printf("| %d | %s | %.4f | %.4f | %zu | %.4f |\n", samples, decorrelate ? "yes" : "no",
+                  sum / f.pixelCount(), worst, penumbra, penumbra ? penumbra_sum / penumbra : 0.0);
     }
 }
 
