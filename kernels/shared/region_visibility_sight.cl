@@ -175,8 +175,9 @@ inline int region_sight_visible_culled(HFVIS_GLOBAL const float* h, int width, i
   float f0 = region_surface_at(h, width, height, xa, ya) - za;
   if (f0 > 0.0f) return 0;
   // The culling: the clearance a block must leave below the segment (the rounding of the march's
-  // values, region_cull_margin, and the curvature's largest rise c D^2 / 4), and the level tried
-  // next (one up after a leap, one down after a refusal).
+  // values: `margin`, the field's part from the host's cullPyramid, and the segment's; and the
+  // curvature's largest rise c D^2 / 4), and the level tried next (one up after a leap, down to
+  // the cell after a refusal).
   const float clearance =
       margin + 1e-5f * (2.0f * (fabs(za) + fabs(zb)) + fabs(cdd)) + (cdd > 0.0f ? 0.25f * cdd : 0.0f);
   int level = 0;
@@ -298,7 +299,7 @@ inline int region_sight_visible(HFVIS_GLOBAL const float* h, int width, int heig
 // Whether the surface over cell `cell` (the index of its first corner) rises above the segment
 // from (xa, ya, za) to (xb, yb, zb) by so much that the march (region_sight_visible) must find it
 // hidden: at the middle of the segment's stretch over the cell, by more than the march's
-// rounding (`margin`, region_cull_margin's, and the segment's own) and more than its values can
+// rounding (`margin`, the field's part, and the segment's own) and more than its values can
 // change over the 1e-3 pixel of a piece whose inside it skips (`gradient`: a bound of the
 // surface's slope per pixel). Only over a cell whose 4 x 4 heights around are finite, so that
 // every value the march takes near there is a number. The cheap test of a sight line against the
