@@ -32,6 +32,10 @@
 //       Stewart's culling pyramid per field: preprocessing time, memory per finest level kept, and
 //       for valley, ground-level and high observers the culled shares and the exact and culled
 //       viewsheds' times (interleaved, the fastest of N)
+//   hfvis_bench region [--sections arealight,pair,error] [--reps N] FIELD...
+//       region visibility's backends timed interleaved: area lights against S, the light's size
+//       and height; region pairs against their size and distance; the visible fraction's error
+//       against a Monte-Carlo reference
 //   hfvis_bench field NAME N OUT
 //       writes the synthetic field NAME (testing's hard cases: city, sine, ...) of N x N pixels
 //       to OUT (EXR or GeoTIFF), for timing the CLI on it (bench/cost_against.sh)
@@ -61,6 +65,7 @@
 #include "hfvis/environment_light.hpp"
 #include "hfvis/horizon.hpp"
 #include "lighting.hpp"
+#include "region_visibility.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/image_io.hpp"
 #include "hfvis/intervisibility.hpp"
@@ -98,6 +103,7 @@ constexpr const char* kUsage =
     "       hfvis_bench pvs-rays [--size N] [--rays R] [--reps K] [--dem FILE] FIELD...\n"
     "       hfvis_bench pvs-recall [--size N] [--view-cell C] [--tile T] [--samples N,N,...]\n"
     "                              [--check-rays R] [--dem FILE] FIELD...   (FIELD: city, noise, dem)\n"
+    "       hfvis_bench region [--sections arealight,pair,error] [--reps N] FIELD...\n"
     "       hfvis_bench field NAME N OUT\n"
     "       hfvis_bench inputs [--quick]\n"
     "       hfvis_bench check-truth\n"
@@ -451,6 +457,19 @@ int main(int argc, char** argv) {
       const std::vector<std::string> fields = args.positional();
       args.rejectUnused();
       pvsRecallReport(context, fields, size, dem, view_cell, tile, samples, check);
+      return 0;
+    }
+    if (command == "region") {
+      const std::vector<std::string> sections = textList(args.get("--sections", "arealight,pair,error"));
+      const int reps = std::stoi(args.get("--reps", "3"));
+      const std::vector<std::string> fields = args.positional();
+      args.rejectUnused();
+      if (fields.empty()) throw Usage("region needs FIELD...");
+      for (const std::string& section : sections)
+        if (section != "arealight" && section != "pair" && section != "error")
+          throw Usage("--sections: arealight, pair, error (comma-separated)");
+      const ComputeContext context = ComputeContext::create(ContextOptions::fromEnvironment());
+      for (const std::string& path : fields) regionVisibilityReport(context, path, sections, reps);
       return 0;
     }
     if (command == "field") {

@@ -620,16 +620,19 @@ const std::vector<OptionSpec>& optionTable() {
          run.region_samples = static_cast<int>(n);
          run.region_samples_given = true;
        }},
-      {"--method", nullptr, "exact|viewsheds", kRegionSamplingGroup, false,
-       "exact: one sight line per pair (default); viewsheds: one viewshed\n"
-       "per source sample, for sources on grid points (--sources, or a\n"
-       "one-pixel --light), shared samples; may decide grazing lines the\n"
-       "other way",
+      {"--method", nullptr, "exact|culled|viewsheds", kRegionSamplingGroup, false,
+       "exact: one sight line per pair (the reference); culled: the same\n"
+       "sight lines leaping over blocks of cells far below them, the exact\n"
+       "bits sooner (default); viewsheds: one viewshed per source sample,\n"
+       "for sources on grid points (--sources, or a one-pixel --light),\n"
+       "shared samples; may decide grazing lines the other way",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
-         if (value != "exact" && value != "viewsheds")
-           throw UsageError(typed + ": expected 'exact' or 'viewsheds', got " + inQuotes(shortened(value)));
-         run.region_method =
-             value == "exact" ? RegionVisibilityMethod::Exact : RegionVisibilityMethod::Viewsheds;
+         if (value != "exact" && value != "culled" && value != "viewsheds")
+           throw UsageError(typed + ": expected 'exact', 'culled' or 'viewsheds', got " +
+                            inQuotes(shortened(value)));
+         run.region_method = value == "exact"    ? RegionVisibilityMethod::Exact
+                             : value == "culled" ? RegionVisibilityMethod::Culled
+                                                 : RegionVisibilityMethod::Viewsheds;
        }},
       {"--absolute", nullptr, nullptr, kRegionSamplingGroup, false,
        "the regions' heights absolute (z-scaled), not above the surface", HFVIS_FLAG(absolute)},

@@ -112,13 +112,13 @@ struct RunArguments {
   bool cull_level_given = false;
   std::optional<float> nodata;               // --nodata VALUE for GeoTIFF outputs (may be NaN); none = NaN
   // arealight and region (hfvis/region_visibility.hpp): --samples N per region, --method
-  // exact|viewsheds, --seed of the jitter; arealight's light, --light C0,R0,C1,R1 at
+  // exact|culled|viewsheds, --seed of the jitter; arealight's light, --light C0,R0,C1,R1 at
   // --light-height (or --sources FILE.csv), --decorrelate, --masks FILE; region's --from and --to
   // rectangles at --from-height and --to-height, --rays FILE.csv. (--absolute and --target-height
   // set the viewshed's fields above.)
   int region_samples = RegionSampling{}.samples;
   bool region_samples_given = false;
-  RegionVisibilityMethod region_method = RegionVisibilityMethod::Exact;
+  RegionVisibilityMethod region_method = RegionVisibilityOptions{}.method;
   std::uint32_t seed = RegionVisibilityOptions{}.seed;
   std::optional<PixelRectangle> light, from_region, to_region;
   double light_height = RegionSampling{}.height;

@@ -35,7 +35,7 @@ enum OptionGroup : unsigned {
   kInsolationGroup = 1u << 17,
   kViewshedGroup = 1u << 18,
   // Region visibility (hfvis/region_visibility.hpp): what arealight and region share (--samples,
-  // --method exact|viewsheds, --absolute, --seed), then each one's own.
+  // --method exact|culled|viewsheds, --absolute, --seed), then each one's own.
   kRegionSamplingGroup = 1u << 19,
   kAreaLightGroup = 1u << 20,
   kRegionPairGroup = 1u << 21,

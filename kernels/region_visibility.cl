@@ -2,7 +2,9 @@
 // computeRegionPairVisibility in src/ops/region_visibility.cpp; the contract in
 // hfvis/region_visibility.hpp). One work-item per (receiver, word of 32 source samples): it
 // places its receiver and the word's source samples and marches each pair
-// (shared/region_visibility_sight.cl), then writes the word, so no two work-items write one word and no
+// (shared/region_visibility_sight.cl; with a culling pyramid, `levels` > 0, the march leaps
+// over the blocks of cells far below the segment, and tries each sight line first against the
+// cell that hid the word's last hidden one), then writes the word, so no two work-items write one word and no
 // atomics are needed.
 //
 // Receivers are the grid points (`pixel_receivers`) or the samples of a second region (the
@@ -21,12 +23,129 @@ typedef struct {
   float max_d2;          // the largest squared ground distance of a visible pair; 0 = any
 } RegionField;
 
-__kernel void region_visibility_bits(__global const float* h, RegionField f, __global const float* sources,
-                                     int source_absolute, int samples, int pixel_receivers,
-                                     __global const float* receivers, int receiver_absolute,
-                                     int receiver_count, float target_height, unsigned int seed,
-                                     int decorrelate, int words, int receiver_major, int first,
-                                     __global unsigned int* bits) {
+// The cells around the receiver's point, each side, that its sight lines march exactly when the
+// shaft to a word's samples is shown clear beyond them (region_shaft_clear).
+#define REGION_NEAR_CELLS 2
+
+// Whether every segment from the receiver (xr, yr, zr) to the n samples (xs, ys, zs) is clear of
+// the surface outside the box of grid lines around the receiver (REGION_NEAR_CELLS cells each
+// side of its point, *box: x0, y0, x1, y1), by the margins of the culled march: every block of
+// the pyramid over the shaft's footprint (the wedge from the receiver to the samples' bounding
+// box) lies below the lowest the shaft can be over it (the receiver's height plus the smallest
+// slope to a sample times the block's ground distance) by the march's clearance. Blocks within
+// the box are left to the segments' own marches; 0 when a cell outside it may reach the shaft.
+int region_shaft_clear(__global const float* h, __global const float* pyramid, int levels, float margin,
+                       RegionField f, float xr, float yr, float zr, const float* xs, const float* ys,
+                       const float* zs, int n, float* box) {
+  float slope = INFINITY, far = 0.0f, zabs = fabs(zr);
+  float sx0 = INFINITY, sy0 = INFINITY, sx1 = -INFINITY, sy1 = -INFINITY;
+  for (int i = 0; i < n; ++i) {
+    const float gx = (xs[i] - xr) * f.cell_x, gy = (ys[i] - yr) * f.cell_y, d = sqrt(gx * gx + gy * gy);
+    if (!(d > 0.0f) || isnan(zs[i])) return 0;
+    slope = fmin(slope, (zs[i] - zr) / d);
+    far = fmax(far, d);
+    zabs = fmax(zabs, fabs(zs[i]));
+    sx0 = fmin(sx0, xs[i]), sx1 = fmax(sx1, xs[i]), sy0 = fmin(sy0, ys[i]), sy1 = fmax(sy1, ys[i]);
+  }
+  // The march's clearance for the longest segment, its slope's rounding allowed for (1e-5
+  // relative, as the rest).
+  const float cdd = f.curvature * far * far;
+  const float clearance =
+      margin + 1e-5f * (4.0f * zabs + fabs(cdd) + fabs(slope) * far) + fmax(cdd, 0.0f) * 0.25f;
+  const float rx = floor(xr), ry = floor(yr);
+  box[0] = fmax(0.0f, rx - REGION_NEAR_CELLS),
+  box[2] = fmin((float)(f.width - 1), ceil(xr) + REGION_NEAR_CELLS);
+  box[1] = fmax(0.0f, ry - REGION_NEAR_CELLS),
+  box[3] = fmin((float)(f.height - 1), ceil(yr) + REGION_NEAR_CELLS);
+  // The footprint: its bounding box, and (receiver outside the samples' box) the wedge's two
+  // edges, toward the samples' corners most counter-clockwise and most clockwise.
+  const float fx0 = fmin(xr, sx0), fx1 = fmax(xr, sx1), fy0 = fmin(yr, sy0), fy1 = fmax(yr, sy1);
+  const int wedge = xr < sx0 || xr > sx1 || yr < sy0 || yr > sy1;
+  float lx = 0.0f, ly = 0.0f, rxe = 0.0f, rye = 0.0f;
+  if (wedge) {
+    const float cx = 0.5f * (sx0 + sx1) - xr, cy = 0.5f * (sy0 + sy1) - yr;
+    float most = -INFINITY, least = INFINITY;
+    for (int c = 0; c < 4; ++c) {
+      const float vx = (c & 1 ? sx1 : sx0) - xr, vy = (c & 2 ? sy1 : sy0) - yr;
+      const float sine = (cx * vy - cy * vx) / sqrt(vx * vx + vy * vy);
+      if (sine > most) most = sine, lx = vx, ly = vy;
+      if (sine < least) least = sine, rxe = vx, rye = vy;
+    }
+  }
+  int stack_k[64], stack_x[64], stack_y[64], top = 0;
+  const int last = levels - 1;
+  for (int by = 0; by < region_cull_width(f.height, last); ++by)
+    for (int bx = 0; bx < region_cull_width(f.width, last); ++bx) {
+      if (top == 64) return 0;
+      stack_k[top] = last, stack_x[top] = bx, stack_y[top] = by, ++top;
+    }
+  while (top > 0) {
+    --top;
+    const int k = stack_k[top], bx = stack_x[top], by = stack_y[top];
+    const float x0 = (float)(bx << k), y0 = (float)(by << k);
+    const float x1 = fmin((float)((bx + 1) << k), (float)(f.width - 1)),
+                y1 = fmin((float)((by + 1) << k), (float)(f.height - 1));
+    if (x1 < fx0 || x0 > fx1 || y1 < fy0 || y0 > fy1) continue;
+    if (x0 >= box[0] && x1 <= box[2] && y0 >= box[1] && y1 <= box[3]) continue;
+    if (wedge) {
+      int left = 0, right = 0;
+      for (int c = 0; c < 4; ++c) {
+        const float qx = (c & 1 ? x1 : x0) - xr, qy = (c & 2 ? y1 : y0) - yr;
+        left += lx * qy - ly * qx > 0.0f;
+        right += rxe * qy - rye * qx < 0.0f;
+      }
+      if (left == 4 || right == 4) continue;
+    }
+    const float ddx = fmax(0.0f, fmax(x0 - xr, xr - x1)) * f.cell_x,
+                ddy = fmax(0.0f, fmax(y0 - yr, yr - y1)) * f.cell_y;
+    const float near = sqrt(ddx * ddx + ddy * ddy);
+    const float lowest = zr + slope * (slope >= 0.0f ? near : far);
+    const float highest =
+        pyramid[region_cull_offset(f.width, f.height, k) + by * region_cull_width(f.width, k) + bx];
+    if (highest + clearance < lowest) continue;
+    if (k == 0 || top + 4 > 64) return 0;
+    for (int c = 0; c < 4; ++c) {
+      const int cx = 2 * bx + (c & 1), cy = 2 * by + (c >> 1);
+      if (cx < region_cull_width(f.width, k - 1) && cy < region_cull_width(f.height, k - 1))
+        stack_k[top] = k - 1, stack_x[top] = cx, stack_y[top] = cy, ++top;
+    }
+  }
+  return 1;
+}
+
+// The cell to try first against the word's next sight lines, after the line from the receiver
+// (xr, yr, zr) to (xs, ys, zs) was found hidden by the march at cell `found`: the first cell from
+// the receiver, within 8, that region_cull_hides shows hiding it (lines to a word's samples
+// spread apart from the receiver: the nearer the hiding cell, the more of them it hides), else
+// `found`.
+int region_near_hider(__global const float* h, RegionField f, float margin, float gradient, int found, float xr,
+                      float yr, float zr, float xs, float ys, float zs) {
+  const float dx = xs - xr, dy = ys - yr;
+  int cx = (int)xr < f.width - 2 ? (int)xr : f.width - 2, cy = (int)yr < f.height - 2 ? (int)yr : f.height - 2;
+  for (int n = 0; n < 8 && cx >= 0 && cy >= 0 && cx <= f.width - 2 && cy <= f.height - 2; ++n) {
+    const int cell = cy * f.width + cx;
+    if (cell == found) break;
+    if (region_cull_hides(h, f.width, f.height, f.cell_x, f.cell_y, f.curvature, f.max_d2, margin, gradient, cell,
+                          xs, ys, zs, xr, yr, zr))
+      return cell;
+    const float tX = dx != 0.0f ? ((float)(dx > 0.0f ? cx + 1 : cx) - xr) / dx : INFINITY;
+    const float tY = dy != 0.0f ? ((float)(dy > 0.0f ? cy + 1 : cy) - yr) / dy : INFINITY;
+    if (fmin(tX, tY) >= 1.0f) break;
+    if (tX < tY)
+      cx += dx > 0.0f ? 1 : -1;
+    else
+      cy += dy > 0.0f ? 1 : -1;
+  }
+  return found;
+}
+
+__kernel void region_visibility_bits(__global const float* h, __global const float* pyramid, int levels,
+                                     float margin, float gradient, RegionField f,
+                                     __global const float* sources, int source_absolute, int samples,
+                                     int pixel_receivers, __global const float* receivers,
+                                     int receiver_absolute, int receiver_count, float target_height,
+                                     unsigned int seed, int decorrelate, int words, int receiver_major,
+                                     int first, __global unsigned int* bits) {
   const int r = first + (int)get_global_id(0), w = get_global_id(1);
   if (r >= receiver_count || w >= words) return;
   float xr, yr, zr;
@@ -41,12 +160,29 @@ __kernel void region_visibility_bits(__global const float* h, RegionField f, __g
   if (!isnan(zr)) {
     const unsigned int key = decorrelate ? (unsigned int)r + 1U : 0U;
     const int end = 32 * w + 32 < samples ? 32 * w + 32 : samples;
-    for (int s = 32 * w; s < end; ++s) {
-      float xs, ys, zs;
-      region_sample(sources, h, f.width, f.height, source_absolute, seed, key, s, &xs, &ys, &zs);
-      if (region_sight_visible(h, f.width, f.height, f.cell_x, f.cell_y, f.curvature, f.max_d2, xs, ys, zs,
-                               xr, yr, zr))
-        word |= 1U << (s - 32 * w);
+    float xs[32], ys[32], zs[32];
+    for (int s = 32 * w; s < end; ++s)
+      region_sample(sources, h, f.width, f.height, source_absolute, seed, key, s, &xs[s - 32 * w],
+                    &ys[s - 32 * w], &zs[s - 32 * w]);
+    // Culled: the marches confined to the receiver's surroundings where the shaft to the word's
+    // samples is clear beyond them (else a box that holds nothing), and the cell that hid the
+    // last hidden sample tried first.
+    float box[4] = {1.0f, 0.0f, 0.0f, 0.0f};
+    if (levels > 0 &&
+        !region_shaft_clear(h, pyramid, levels, margin, f, xr, yr, zr, xs, ys, zs, end - 32 * w, box))
+      box[0] = 1.0f, box[2] = 0.0f;
+    int blocker = -1;
+    for (int i = 0; i < end - 32 * w; ++i) {
+      if (blocker >= 0 && region_cull_hides(h, f.width, f.height, f.cell_x, f.cell_y, f.curvature, f.max_d2,
+                                            margin, gradient, blocker, xs[i], ys[i], zs[i], xr, yr, zr))
+        continue;
+      int blocked_at = -1;
+      if (region_sight_visible_culled(h, f.width, f.height, f.cell_x, f.cell_y, f.curvature, f.max_d2,
+                                      pyramid, levels, margin, box[0], box[1], box[2], box[3], xs[i], ys[i],
+                                      zs[i], xr, yr, zr, &blocked_at))
+        word |= 1U << i;
+      else if (levels > 0 && blocked_at >= 0)
+        blocker = region_near_hider(h, f, margin, gradient, blocked_at, xr, yr, zr, xs[i], ys[i], zs[i]);
     }
   }
   bits[receiver_major ? (size_t)r * words + w : (size_t)w * receiver_count + r] = word;

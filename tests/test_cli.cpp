@@ -2366,6 +2366,17 @@ TEST_F(Cli, AreaLightBehindAWallIsHiddenAndAgreesWithTheLibrary) {
                 .status,
             0);
   EXPECT_EQ(readBack(out("h.exr")).at(12, 5, 0), 1.0f);
+  // The culled method (the default) and the exact one write the same picture, each naming itself.
+  for (const char* method : {"exact", "culled"})
+    ASSERT_EQ(run("arealight " + shellQuoted(field) + " -o " + shellQuoted(out(std::string(method) + ".exr")) +
+                  " --light 1,2,3,9 --light-height 20 --absolute --method " + method + " -q")
+                  .status,
+              0);
+  const ReadBack exact = readBack(out("exact.exr")), culled = readBack(out("culled.exr"));
+  EXPECT_EQ(exact.pixels, culled.pixels);
+  EXPECT_EQ(exact.spec.get_string_attribute("hfvis:method"), "exact");
+  EXPECT_EQ(culled.spec.get_string_attribute("hfvis:method"), "culled");
+  EXPECT_EQ(readBack(out("h.exr")).spec.get_string_attribute("hfvis:method"), "culled");
 }
 
 TEST_F(Cli, AreaLightFromASourcesFile) {

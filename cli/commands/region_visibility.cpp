@@ -23,7 +23,9 @@ namespace {
 constexpr int kMaskBitsPerChannel = 16;
 
 std::string methodName(RegionVisibilityMethod method) {
-  return method == RegionVisibilityMethod::Viewsheds ? "viewsheds" : "exact";
+  return method == RegionVisibilityMethod::Viewsheds ? "viewsheds"
+         : method == RegionVisibilityMethod::Culled  ? "culled"
+                                                     : "exact";
 }
 
 std::string rectangleText(const PixelRectangle& r) {
@@ -301,11 +303,12 @@ void checkAreaLight(const std::string&, const RunArguments& run) {
   requireAboveSurface(run, "--light-height", run.light_height);
   if (run.region_method == RegionVisibilityMethod::Viewsheds) {
     if (run.decorrelate)
-      throw UsageError("--decorrelate needs --method exact (the viewsheds method shares the samples)");
+      throw UsageError(
+          "--decorrelate needs --method exact or culled (the viewsheds method shares the samples)");
     if (run.light && (run.light->col0 != run.light->col1 || run.light->row0 != run.light->row1))
       throw UsageError(
           "--method viewsheds needs the light's samples on grid points: a one-pixel --light or --sources "
-          "FILE.csv (a larger rectangle's samples are jittered between them); or --method exact");
+          "FILE.csv (a larger rectangle's samples are jittered between them); or --method exact or culled");
   }
   if (!run.masks_output.empty() && samePath(run.output, run.masks_output))
     throw UsageError("--masks must differ from -o, both are " + inQuotes(run.output));
@@ -325,7 +328,7 @@ void checkRegion(const std::string&, const RunArguments& run) {
   if (run.region_method == RegionVisibilityMethod::Viewsheds)
     throw UsageError(
         "--method viewsheds is for 'hfvis arealight' (every pixel a receiver); region pairs take --method "
-        "exact");
+        "exact or culled");
   requireAboveSurface(run, "--from-height", run.from_height);
   requireAboveSurface(run, "--to-height", run.to_height);
   asUsageError([&] { validate(regionVisibilityOptions(run)); });
@@ -339,7 +342,7 @@ const CommandSpec kAreaLightCommand{
     nullptr,
     "\"visible\": the fraction (0..1) of an area light's samples each pixel sees",
     "IN -o OUT.exr|OUT.tif (--light C0,R0,C1,R1 [--light-height H] | --sources FILE.csv)\n"
-    "[--absolute] [--samples N] [--target-height T] [--decorrelate] [--method exact|viewsheds]\n"
+    "[--absolute] [--samples N] [--target-height T] [--decorrelate] [--method exact|culled|viewsheds]\n"
     "[--seed N] [--max-distance D] [--curvature] [--refraction K] [--masks MASKS.exr]\n"
     "[--preview P.png] [options]",
     "Region visibility with every pixel a receiver (Eisemann & Decoret 2007's sampled\n"

@@ -23,8 +23,8 @@
 // sees when no point of the bilinear surface strictly between them rises strictly above it (a
 // segment that only touches the surface sees; an end below the surface is hidden, the surface
 // rising above the segment beside it, except from a point straight above or below it: a vertical
-// segment has no surface strictly between its ends and sees); a cell with a nodata corner has no surface inside
-// and hides nothing, though an edge between two valid heights is surface. With curvature c, the
+// segment has no surface strictly between its ends and sees); a cell with a nodata corner has no surface
+// inside and hides nothing, though an edge between two valid heights is surface. With curvature c, the
 // surface at ground distance d from one end and D - d from the other lies c d (D - d) lower
 // relative to the straight segment (the viewshed's c d^2 drop from an eye, the target lowered
 // c D^2, written symmetrically). Pairs farther apart than max_distance are not visible. The test
@@ -32,9 +32,13 @@
 // A): segments that graze the surface within its rounding may go either way, as the viewshed's.
 //
 // Methods: the exact one, one line-of-sight march per (receiver, source sample) pair on the
-// device (kernels/region_visibility.cl): O(receivers * S * (W + H)); one viewshed per source
-// sample, for sources on grid points (RegionVisibilityMethod::Viewsheds). Not yet: Eisemann &
-// Décoret's bitmask scatter.
+// device (kernels/region_visibility.cl): O(receivers * S * (W + H)); the same march culled by a
+// max pyramid (the default: the same bits, sooner); one viewshed per source sample, for sources
+// on grid points (RegionVisibilityMethod::Viewsheds). Eisemann & Décoret's bitmask scatter
+// (occluders back-projected onto a planar source through a table of edge bitmasks) is not
+// built: its polygonal back-projections decide on a triangulated surface, not on this bilinear
+// one, and differ from the exact bits beyond the table's resolution (bench/report/
+// region_visibility.md gives the measurements behind the choice).
 #pragma once
 
 #include <cstdint>
@@ -78,10 +82,15 @@ enum class RegionVisibilityMethod {
   // source's end: it decides some grazing lines the other way (not bit for bit: up to about
   // 0.1 % of the pairs on the hard cases, every one grazing).
   Viewsheds,
+  // The exact march, culled: it leaps over every block of cells (a max pyramid, blocks of
+  // 2^k x 2^k cells) whose highest point lies below the segment by more than the march's
+  // rounding, resuming where the segment leaves the block in the march's own state, so its bits
+  // are the exact method's, bit for bit, at a fraction of the steps.
+  Culled,
 };
 
 struct RegionVisibilityOptions {
-  RegionVisibilityMethod method = RegionVisibilityMethod::Exact;
+  RegionVisibilityMethod method = RegionVisibilityMethod::Culled;
   double target_height = 0.0;  // every-pixel receivers stand this high above the surface
   double max_distance = 0.0;   // ground units; 0 = no limit. Farther pairs are not visible.
   double curvature = 0.0;      // drop coefficient c (earthCurvature() in hfvis/sweep_options.hpp); 0 = flat

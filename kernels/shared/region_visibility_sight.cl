@@ -67,6 +67,69 @@ inline float region_rise(float s, float t, float za, float dz, float cdd) {
   return (s - (za + t * dz)) + cdd * t * (1.0f - t);
 }
 
+// The culling pyramid (a max pyramid over the cells): level k holds, per block of 2^k x 2^k cells
+// (the last ones in a row or column cut by the field), the highest point of the surface over the
+// block's closed square, +INFINITY where the march's values there can run unbounded (an infinite
+// height in or beside the block), -INFINITY where it has no surface; levels are stored one after
+// another, rows of region_cull_width blocks.
+inline int region_cull_width(int width, int k) { return ((width - 1) + (1 << k) - 1) >> k; }
+
+inline int region_cull_offset(int width, int height, int k) {
+  int offset = 0;
+  for (int j = 0; j < k; ++j) offset += region_cull_width(width, j) * region_cull_width(height, j);
+  return offset;
+}
+
+// The first grid line (an integer of the coordinate from `a` in steps of `d`) whose crossing
+// parameter (line - a) / d, as the march computes it, comes after t (`at_too`: at or after t).
+inline float region_cull_next_line(float a, float d, float t, int at_too) {
+  float g = d > 0.0f ? floor(a + t * d) : ceil(a + t * d);
+  const float step = d > 0.0f ? 1.0f : -1.0f;
+  // Forward past the lines before t, then back over lines still after it (never behind a).
+  for (;;) {
+    const float tg = (g - a) / d;
+    if (at_too ? tg >= t : tg > t) break;
+    g += step;
+  }
+  for (;;) {
+    const float back = g - step;
+    if (!(d > 0.0f ? back > a : back < a)) break;
+    const float tb = (back - a) / d;
+    if (!(at_too ? tb >= t : tb > t)) break;
+    g = back;
+  }
+  return g;
+}
+
+// Resumes a march (region_sight_visible_culled) at the crossing C = tC of the segment from
+// (xa, ya, za) by (dx, dy, dz) with the column line lx (`on_column`) or the row line ly: the
+// march's next column line becomes the first after C, its next row line the first at or after C
+// (x first on a tie, as the march orders them); returns the march's value there.
+inline float region_cull_resume(HFVIS_GLOBAL const float* h, int width, int height, float xa, float ya,
+                                float za, float dx, float dy, float dz, float cdd, int on_column, float lx,
+                                float ly, float tC, float* gxl, float* gyl) {
+  float s;
+  if (on_column) {
+    s = region_surface_at(h, width, height, lx, ya + tC * dy);
+    *gxl = lx + 1.0f;
+    if (dy != 0.0f) *gyl = region_cull_next_line(ya, dy, tC, 1);
+  } else {
+    s = region_surface_at(h, width, height, xa + tC * dx, ly);
+    *gyl = dy > 0.0f ? ly + 1.0f : ly - 1.0f;
+    if (dx > 0.0f) *gxl = region_cull_next_line(xa, dx, tC, 0);
+  }
+  return region_rise(s, tC, za, dz, cdd);
+}
+
+// The index of the first corner of the cell under (x, y), clamped into the field (for
+// region_cull_hides).
+inline int region_cell_at(int width, int height, float x, float y) {
+  int cx = (int)(x < 0.0f ? 0.0f : x), cy = (int)(y < 0.0f ? 0.0f : y);
+  cx = cx > width - 2 ? width - 2 : cx;
+  cy = cy > height - 2 ? height - 2 : cy;
+  return cx < 0 || cy < 0 ? -1 : cy * width + cx;
+}
+
 // Whether the point (xb, yb, zb) is visible from (xa, ya, za) (pixel positions inside the field,
 // heights z-scaled and finite): 1 when no point of the surface strictly between them rises
 // strictly above the segment (an end below the surface counts: the surface rises above the
@@ -75,9 +138,16 @@ inline float region_rise(float s, float t, float za, float dz, float cdd) {
 // any). A cell with a nodata corner has no surface inside; an edge or grid point between valid
 // heights is surface. Pieces shorter than 1e-3 pixel skip their inside test, as the viewshed's
 // do (their top would be rounding noise).
-inline int region_sight_visible(HFVIS_GLOBAL const float* h, int width, int height, float cell_x,
-                                float cell_y, float curvature, float max_d2, float xa, float ya, float za,
-                                float xb, float yb, float zb) {
+//
+// With a culling pyramid (`levels` > 0: region_cull_* below), the march leaps over every block of
+// cells that provably cannot reach the segment: it resumes at the crossing where the segment leaves
+// the block, in the state the step-by-step march would have there, so that the answer is the same
+// bit for bit, only sooner.
+inline int region_sight_visible_culled(HFVIS_GLOBAL const float* h, int width, int height, float cell_x,
+                                       float cell_y, float curvature, float max_d2,
+                                       HFVIS_GLOBAL const float* pyramid, int levels, float margin,
+                                       float box_x0, float box_y0, float box_x1, float box_y1, float xa,
+                                       float ya, float za, float xb, float yb, float zb, int* blocked_at) {
   // The canonical order: from the smaller end in (x, y, z), so that the test is symmetric.
   if (xb < xa || (xb == xa && (yb < ya || (yb == ya && zb < za)))) {
     float s = xa;
@@ -104,10 +174,76 @@ inline int region_sight_visible(HFVIS_GLOBAL const float* h, int width, int heig
   // eye below its own ground sees nothing).
   float f0 = region_surface_at(h, width, height, xa, ya) - za;
   if (f0 > 0.0f) return 0;
+  // The culling: the clearance a block must leave below the segment (the rounding of the march's
+  // values: `margin`, the field's part from the host's cullPyramid, and the segment's; and the
+  // curvature's largest rise c D^2 / 4), and the level tried next (one up after a leap, down to
+  // the cell after a refusal).
+  const float clearance =
+      margin + 1e-5f * (2.0f * (fabs(za) + fabs(zb)) + fabs(cdd)) + (cdd > 0.0f ? 0.25f * cdd : 0.0f);
+  int level = 0;
+  // Outside the box of grid lines (box_x0 <= x <= box_x1, box_y0 <= y <= box_y1; none when
+  // box_x0 > box_x1), which holds one end, the caller has shown the segment clear by the same
+  // margins: the march starts where the segment enters the box and ends where it leaves.
+  float t_out = INFINITY;
+  if (box_x0 <= box_x1) {
+    if (xa < box_x0 || xa > box_x1 || ya < box_y0 || ya > box_y1) {
+      const float tX = xa < box_x0 ? (box_x0 - xa) / dx : -INFINITY;
+      const float ly = dy > 0.0f ? box_y0 : box_y1;
+      const float tY = (dy > 0.0f && ya < box_y0) || (dy < 0.0f && ya > box_y1) ? (ly - ya) / dy : -INFINITY;
+      const int on_column = tX >= tY;
+      const float tC = on_column ? tX : tY;
+      if (tC > 0.0f && tC < 1.0f) {
+        t0 = tC;
+        f0 = region_cull_resume(h, width, height, xa, ya, za, dx, dy, dz, cdd, on_column, box_x0, ly, tC,
+                                &gxl, &gyl);
+        if (f0 > 0.0f) return 0;
+      }
+    }
+    const float tX = xb > box_x1 ? (box_x1 - xa) / dx : INFINITY;
+    const float tY = dy > 0.0f && yb > box_y1 ? (box_y1 - ya) / dy
+                                              : (dy < 0.0f && yb < box_y0 ? (box_y0 - ya) / dy : INFINITY);
+    t_out = tX < tY ? tX : tY;
+  }
   for (;;) {
+    if (t0 >= t_out) return 1;
     const float tx = dx > 0.0f && gxl < xb ? (gxl - xa) / dx : INFINITY;
     const float ty = dy > 0.0f ? (gyl < yb ? (gyl - ya) / dy : INFINITY)
                                : (dy < 0.0f && gyl > yb ? (gyl - ya) / dy : INFINITY);
+    if (levels > 0) {
+      // The cell of the next piece (its middle), and the blocks above it from `level` down.
+      const float tn = tx < ty ? (tx < 1.0f ? tx : 1.0f) : (ty < 1.0f ? ty : 1.0f), tm = 0.5f * (t0 + tn);
+      int cx = (int)(xa + tm * dx), cy = (int)(ya + tm * dy);
+      cx = cx < 0 ? 0 : (cx > width - 2 ? width - 2 : cx);
+      cy = cy < 0 ? 0 : (cy > height - 2 ? height - 2 : cy);
+      int leapt = 0;
+      for (int k = level; k >= 0 && !leapt; --k) {
+        const int bx = cx >> k, by = cy >> k;
+        const float top =
+            pyramid[region_cull_offset(width, height, k) + by * region_cull_width(width, k) + bx];
+        // Where the segment leaves the block: its column line on the right or its row line ahead,
+        // each crossing's parameter as the march computes it.
+        const int right = (bx + 1) << k, ahead = dy > 0.0f ? (by + 1) << k : by << k;
+        const float lx = (float)(right < width - 1 ? right : width - 1);
+        const float ly = (float)(dy > 0.0f ? (ahead < height - 1 ? ahead : height - 1) : ahead);
+        const float tX = dx > 0.0f && lx < xb ? (lx - xa) / dx : INFINITY;
+        const float tY = dy > 0.0f ? (ly < yb ? (ly - ya) / dy : INFINITY)
+                                   : (dy < 0.0f && ly > yb ? (ly - ya) / dy : INFINITY);
+        const int leave_x = tX <= tY;
+        const float tC = leave_x ? tX : tY, tE = tC < 1.0f ? tC : 1.0f;
+        const float z0 = za + t0 * dz, zE = za + tE * dz;
+        if (!(tE > t0 && top + clearance < (z0 < zE ? z0 : zE))) continue;
+        if (tC >= 1.0f) return 1;  // the block holds the rest of the segment, its end too
+        // Resume at the crossing C where the segment leaves.
+        t0 = tC;
+        f0 = region_cull_resume(h, width, height, xa, ya, za, dx, dy, dz, cdd, leave_x, lx, ly, tC, &gxl,
+                                &gyl);
+        if (f0 > 0.0f) return 0;
+        level = k + 1 < levels ? k + 1 : k;
+        leapt = 1;
+      }
+      if (leapt) continue;
+      level = 0;
+    }
     const int x_first = tx <= ty;
     float t1 = x_first ? tx : ty;
     float f1;
@@ -120,7 +256,10 @@ inline int region_sight_visible(HFVIS_GLOBAL const float* h, int width, int heig
       const float s = x_first ? region_surface_at(h, width, height, gxl, ya + t1 * dy)
                               : region_surface_at(h, width, height, xa + t1 * dx, gyl);
       f1 = region_rise(s, t1, za, dz, cdd);
-      if (f1 > 0.0f) return 0;  // NaN (nodata) hides nothing
+      if (f1 > 0.0f) {  // NaN (nodata) hides nothing
+        *blocked_at = region_cell_at(width, height, xa + 0.5f * (t0 + t1) * dx, ya + 0.5f * (t0 + t1) * dy);
+        return 0;
+      }
     }
     const float span = t1 - t0;
     if (span > 0.0f && span * pixels > 1e-3f && !isnan(f0) && !isnan(f1)) {
@@ -131,7 +270,10 @@ inline int region_sight_visible(HFVIS_GLOBAL const float* h, int width, int heig
         const float bump = -((dx * dy != 0.0f ? twist * dx * dy : 0.0f) - cdd) * span * span;
         if (bump > 0.0f) {
           const float s = 0.5f + (f1 - f0) / (2.0f * bump);
-          if (s > 0.0f && s < 1.0f && f0 + (f1 - f0) * s + bump * s * (1.0f - s) > 0.0f) return 0;
+          if (s > 0.0f && s < 1.0f && f0 + (f1 - f0) * s + bump * s * (1.0f - s) > 0.0f) {
+            *blocked_at = region_cell_at(width, height, xa + tm * dx, ya + tm * dy);
+            return 0;
+          }
         }
       }
     }
@@ -143,6 +285,63 @@ inline int region_sight_visible(HFVIS_GLOBAL const float* h, int width, int heig
     t0 = t1;
     f0 = f1;
   }
+}
+
+// The march without culling (the exact method and the scalar reference).
+inline int region_sight_visible(HFVIS_GLOBAL const float* h, int width, int height, float cell_x,
+                                float cell_y, float curvature, float max_d2, float xa, float ya, float za,
+                                float xb, float yb, float zb) {
+  int blocked_at;
+  return region_sight_visible_culled(h, width, height, cell_x, cell_y, curvature, max_d2, h, 0, 0.0f, 1.0f,
+                                     0.0f, 0.0f, 0.0f, xa, ya, za, xb, yb, zb, &blocked_at);
+}
+
+// Whether the surface over cell `cell` (the index of its first corner) rises above the segment
+// from (xa, ya, za) to (xb, yb, zb) by so much that the march (region_sight_visible) must find it
+// hidden: at the middle of the segment's stretch over the cell, by more than the march's
+// rounding (`margin`, the field's part, and the segment's own) and more than its values can
+// change over the 1e-3 pixel of a piece whose inside it skips (`gradient`: a bound of the
+// surface's slope per pixel). Only over a cell whose 4 x 4 heights around are finite, so that
+// every value the march takes near there is a number. The cheap test of a sight line against the
+// cell that hid the previous one (sight lines to neighbouring samples are often hidden by the
+// same cell); 0 decides nothing.
+inline int region_cull_hides(HFVIS_GLOBAL const float* h, int width, int height, float cell_x, float cell_y,
+                             float curvature, float max_d2, float margin, float gradient, int cell, float xa,
+                             float ya, float za, float xb, float yb, float zb) {
+  const int cx = cell % width, cy = cell / width;
+  const float dx = xb - xa, dy = yb - ya, dz = zb - za;
+  const float pixels = fabs(dx) > fabs(dy) ? fabs(dx) : fabs(dy);
+  if (pixels == 0.0f) return 0;
+  float lo = 0.0f, hi = 1.0f;
+  if (dx != 0.0f) {
+    const float t1 = ((float)cx - xa) / dx, t2 = ((float)(cx + 1) - xa) / dx;
+    lo = fmax(lo, fmin(t1, t2)), hi = fmin(hi, fmax(t1, t2));
+  } else if (xa < (float)cx || xa > (float)(cx + 1)) {
+    return 0;
+  }
+  if (dy != 0.0f) {
+    const float t1 = ((float)cy - ya) / dy, t2 = ((float)(cy + 1) - ya) / dy;
+    lo = fmax(lo, fmin(t1, t2)), hi = fmin(hi, fmax(t1, t2));
+  } else if (ya < (float)cy || ya > (float)(cy + 1)) {
+    return 0;
+  }
+  if (!(hi > lo)) return 0;
+  for (int y = (cy > 0 ? cy - 1 : 0); y <= (cy + 2 < height ? cy + 2 : height - 1); ++y)
+    for (int x = (cx > 0 ? cx - 1 : 0); x <= (cx + 2 < width ? cx + 2 : width - 1); ++x)
+      if (!isfinite(h[y * width + x])) return 0;
+  const float gx = dx * cell_x, gy = dy * cell_y, d2 = gx * gx + gy * gy;
+  if (max_d2 > 0.0f && d2 > max_d2) return 1;  // out of reach: the march says hidden too
+  const float cdd = curvature * d2, tm = 0.5f * (lo + hi);
+  float u = xa + tm * dx - (float)cx, v = ya + tm * dy - (float)cy;
+  u = u < 0.0f ? 0.0f : (u > 1.0f ? 1.0f : u);
+  v = v < 0.0f ? 0.0f : (v > 1.0f ? 1.0f : v);
+  const int p = cy * width + cx;
+  const float h00 = h[p], h10 = h[p + 1], h01 = h[p + width], h11 = h[p + width + 1];
+  const float s = h00 + (h10 - h00) * u + (h01 - h00) * v + (h00 - h10 - h01 + h11) * u * v;
+  const float f = region_rise(s, tm, za, dz, cdd);
+  const float slack = margin + 1e-5f * (2.0f * (fabs(za) + fabs(zb)) + fabs(cdd)) +
+                      1.5e-3f * (1.5f * gradient + (fabs(dz) + fabs(cdd)) / pixels);
+  return f > slack;
 }
 
 // A 32-bit integer hash (Wellons' lowbias32): the jitter of the samples.

@@ -10,9 +10,9 @@
 
 #include "core/horizon_common.hpp"
 #include "core/opencl_context.hpp"
+#include "core/sweep_framework.hpp"
 #include "core/sweep_geometry.hpp"
 #include "core/sweep_routine.hpp"
-#include "core/sweep_framework.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/viewshed.hpp"
 #include "ops/region_visibility_sight.hpp"
@@ -22,6 +22,9 @@ namespace {
 
 // Receivers per launch: bounds a launch's time (a GPU's watchdog) on large fields.
 constexpr int kReceiversPerLaunch = 1 << 16;
+
+// The culling pyramid's levels at most: blocks of up to 2^15 cells a side.
+constexpr int kCullLevels = 16;
 
 // The kernel's RegionField struct.
 struct DeviceField {
@@ -46,13 +49,83 @@ void validateField(const HeightField& field) {
 
 int popcount(std::uint32_t v) { return __builtin_popcount(v); }
 
+// The culling pyramid of kernels/shared/region_visibility_sight.cl (region_cull_*) over the
+// z-scaled heights, and the part of the march's rounding that a block's height must clear which
+// depends on the field alone (region_sight_visible_culled adds the segment's own).
+struct CullPyramid {
+  std::vector<float> top;
+  int levels = 0;
+  float margin = 0.0f;
+  float gradient = 0.0f;  // the surface's steepest slope per pixel, at most (region_cull_hides)
+};
+
+CullPyramid cullPyramid(const std::vector<float>& h, int width, int height) {
+  CullPyramid out;
+  if (width < 2 || height < 2) return out;  // no cells: the march runs uncut
+  const auto at = [&](int c, int r) { return h[std::size_t(r) * width + c]; };
+  // The field's largest finite height, step between neighbours and cell twist: the march's
+  // values over a block stray from its corners' range by rounding relative to the heights, and
+  // by a step or a twist times a position's rounding (a crossing a rounding outside the block, a
+  // piece's middle a rounding into the next cell): at most ulp(max(width, height)) each.
+  double largest = 0.0, step = 0.0, twist = 0.0;
+  std::vector<char> infinite(h.size(), 0);
+  for (int r = 0; r < height; ++r)
+    for (int c = 0; c < width; ++c) {
+      const float v = at(c, r);
+      infinite[std::size_t(r) * width + c] = std::isinf(v);
+      if (!std::isfinite(v)) continue;
+      largest = std::max(largest, double(std::fabs(v)));
+      if (c + 1 < width && std::isfinite(at(c + 1, r)))
+        step = std::max(step, double(std::fabs(at(c + 1, r) - v)));
+      if (r + 1 < height && std::isfinite(at(c, r + 1)))
+        step = std::max(step, double(std::fabs(at(c, r + 1) - v)));
+      if (c + 1 < width && r + 1 < height) {
+        const double t = double(v) - at(c + 1, r) - at(c, r + 1) + at(c + 1, r + 1);
+        if (std::isfinite(t)) twist = std::max(twist, std::fabs(t));
+      }
+    }
+  const double position_ulp = std::ldexp(double(std::max(width, height)), -23);
+  out.margin = static_cast<float>(8e-5 * largest + 4.0 * position_ulp * (step + twist));
+  out.gradient = static_cast<float>(step + twist);
+  // Level 0: per cell its corners' highest valid height; +INFINITY where an infinite height lies
+  // on the cell or a cell beside it (the march's values there are unbounded or NaN).
+  int w = width - 1, hh = height - 1;
+  std::vector<float> level(std::size_t(w) * hh);
+  for (int r = 0; r < hh; ++r)
+    for (int c = 0; c < w; ++c) {
+      bool unbounded = false;
+      for (int y = std::max(0, r - 1); y <= std::min(height - 1, r + 2) && !unbounded; ++y)
+        for (int x = std::max(0, c - 1); x <= std::min(width - 1, c + 2); ++x)
+          if (infinite[std::size_t(y) * width + x]) unbounded = true;
+      float top = -std::numeric_limits<float>::infinity();
+      for (const float v : {at(c, r), at(c + 1, r), at(c, r + 1), at(c + 1, r + 1)})
+        if (!std::isnan(v)) top = std::max(top, v);
+      level[std::size_t(r) * w + c] = unbounded ? std::numeric_limits<float>::infinity() : top;
+    }
+  for (;;) {
+    out.top.insert(out.top.end(), level.begin(), level.end());
+    ++out.levels;
+    if ((w == 1 && hh == 1) || out.levels == kCullLevels) break;
+    const int pw = (w + 1) / 2, ph = (hh + 1) / 2;
+    std::vector<float> parent(std::size_t(pw) * ph, -std::numeric_limits<float>::infinity());
+    for (int r = 0; r < hh; ++r)
+      for (int c = 0; c < w; ++c) {
+        float& p = parent[std::size_t(r / 2) * pw + c / 2];
+        p = std::max(p, level[std::size_t(r) * w + c]);
+      }
+    level = std::move(parent);
+    w = pw, hh = ph;
+  }
+  return out;
+}
+
 // The bits of `count` receivers from the device, receiver-major: one routine item per launch
 // of up to kReceiversPerLaunch receivers.
 class RegionBitsRoutine : public detail::DeviceRoutine {
  public:
   RegionBitsRoutine(detail::ContextState& st, const HeightField& field, const std::vector<float>& sources,
-                    bool source_absolute, const std::vector<float>* receivers, bool receiver_absolute, int count,
-                    const RegionVisibilityOptions& options)
+                    bool source_absolute, const std::vector<float>* receivers, bool receiver_absolute,
+                    int count, const RegionVisibilityOptions& options)
       : DeviceRoutine(st, field, nullptr, 0),
         sources_(sources),
         source_absolute_(source_absolute),
@@ -67,7 +140,9 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
 
  private:
   // The viewshed's heights (z-scaled, from 0), so both decide the same sight lines.
-  detail::PreparedHeights prepare() override { return detail::prepareHeights(field_, detail::HeightOrigin::Zero); }
+  detail::PreparedHeights prepare() override {
+    return detail::prepareHeights(field_, detail::HeightOrigin::Zero);
+  }
   std::string programFile() const override { return "region_visibility.cl"; }
 
   void allocate() override {
@@ -93,8 +168,20 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
                              static_cast<float>(field_.cell_size_y),
                              static_cast<float>(options_.curvature),
                              options_.max_distance > 0.0 ? static_cast<float>(max_d2) : 0.0f};
+    if (options_.method == RegionVisibilityMethod::Culled) {
+      const CullPyramid pyramid = cullPyramid(
+          detail::prepareHeights(field_, detail::HeightOrigin::Zero).heights, field_.width, field_.height);
+      levels_ = pyramid.levels;
+      margin_ = pyramid.margin;
+      gradient_ = pyramid.gradient;
+      if (levels_ > 0) pyramid_ = upload(pyramid.top);
+    }
     kernel_ = kernel("region_visibility_bits");
     kernel_.set("h", heights_)
+        .set("pyramid", levels_ > 0 ? pyramid_ : heights_)
+        .set("levels", cl_int(levels_))
+        .set("margin", margin_)
+        .set("gradient", gradient_)
         .set("f", device)
         .set("sources", source_table_)
         .set("source_absolute", cl_int(source_absolute_))
@@ -141,7 +228,9 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
   const RegionVisibilityOptions& options_;
   const int samples_, words_;
   bool receiver_major_ = true;
-  cl::Buffer source_table_, receiver_table_, bits_;
+  int levels_ = 0;  // the culling pyramid's (0: the exact march)
+  cl_float margin_ = 0.0f, gradient_ = 0.0f;
+  cl::Buffer source_table_, receiver_table_, bits_, pyramid_;
   detail::NamedKernel kernel_;
 };
 
@@ -150,8 +239,8 @@ std::vector<std::uint32_t> runBits(const ComputeContext& context, const HeightFi
                                    const std::vector<float>* receivers, bool receiver_absolute, int count,
                                    const RegionVisibilityOptions& options) {
   return detail::translateOpenClErrors([&] {
-    RegionBitsRoutine routine(detail::stateOf(context), field, sources, source_absolute, receivers, receiver_absolute,
-                              count, options);
+    RegionBitsRoutine routine(detail::stateOf(context), field, sources, source_absolute, receivers,
+                              receiver_absolute, count, options);
     routine.run();
     return std::move(routine.bits);
   });
@@ -256,7 +345,8 @@ void validate(const RegionVisibilityOptions& options) {
   if (!std::isfinite(options.max_distance) || options.max_distance < 0.0)
     throw InvalidArgument("the maximum distance must be finite and at least 0 (0: no limit)");
   if (!std::isfinite(options.curvature)) throw InvalidArgument("the curvature must be finite");
-  if (options.method != RegionVisibilityMethod::Exact && options.method != RegionVisibilityMethod::Viewsheds)
+  if (options.method != RegionVisibilityMethod::Exact &&
+      options.method != RegionVisibilityMethod::Viewsheds && options.method != RegionVisibilityMethod::Culled)
     throw InvalidArgument("unknown region visibility method");
 }
 
@@ -358,8 +448,8 @@ RegionPairVisibilityResult computeRegionPairVisibility(const ComputeContext& con
   out.words = (out.source_samples + 31) / 32;
   out.sources = regionSamplePoints(field, sources, options.seed);
   out.receivers = regionSamplePoints(field, receivers, options.seed);
-  out.bits = runBits(context, field, source_table, sources.absolute, &receiver_table,
-                     receivers.absolute, out.receiver_samples, options);
+  out.bits = runBits(context, field, source_table, sources.absolute, &receiver_table, receivers.absolute,
+                     out.receiver_samples, options);
   detail::countPairFractions(out);
   return out;
 }

@@ -12,6 +12,12 @@
 
 namespace hfvis::detail {
 
+using std::ceil;
+using std::fabs;
+using std::floor;
+using std::fmax;
+using std::fmin;
+using std::isfinite;
 using std::isnan;
 #include "../../kernels/shared/region_visibility_sight.cl"
 

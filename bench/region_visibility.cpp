@@ -1,0 +1,218 @@
+// bench/region_visibility.cpp: see region_visibility.hpp.
+#include "region_visibility.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <limits>
+
+#include "hfvis/image_io.hpp"
+#include "hfvis/region_visibility.hpp"
+
+namespace hfvis::bench {
+namespace {
+
+double secondsOf(const std::function<void()>& body) {
+  const auto start = std::chrono::steady_clock::now();
+  body();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// The fastest of `reps` runs of each body, the bodies interleaved round by round (the machine is
+// shared: interleaving exposes each to the same load).
+std::vector<double> fastestInterleaved(const std::vector<std::function<void()>>& bodies, int reps) {
+  std::vector<double> best(bodies.size(), std::numeric_limits<double>::infinity());
+  for (int r = 0; r < reps; ++r)
+    for (std::size_t i = 0; i < bodies.size(); ++i) best[i] = std::min(best[i], secondsOf(bodies[i]));
+  return best;
+}
+
+const char* name(RegionVisibilityMethod m) {
+  return m == RegionVisibilityMethod::Exact    ? "exact"
+         : m == RegionVisibilityMethod::Culled ? "culled"
+                                               : "viewsheds";
+}
+
+double highest(const HeightField& f) {
+  double top = -std::numeric_limits<double>::infinity();
+  for (float v : f.heights)
+    if (std::isfinite(v)) top = std::max(top, double(v) * f.z_scale);
+  return top;
+}
+
+// S grid points (whole columns and rows, so that every backend takes them, the viewsheds' too)
+// spread over a side x side square centred on the field, at absolute height z: columns of
+// ceil(sqrt(S)) points, the last row partly filled.
+RegionSampling gridLight(const HeightField& f, int side, int samples, double z) {
+  RegionSampling s;
+  s.absolute = true;
+  const int n = static_cast<int>(std::ceil(std::sqrt(double(samples))));
+  const int c0 = f.width / 2 - side / 2, r0 = f.height / 2 - side / 2;
+  for (int i = 0; i < samples; ++i)
+    s.points.push_back({double(c0 + (i % n) * side / n), double(r0 + (i / n) * side / n), z});
+  s.samples = samples;
+  return s;
+}
+
+std::size_t differingBits(const std::vector<std::uint32_t>& a, const std::vector<std::uint32_t>& b) {
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) n += __builtin_popcount(a[i] ^ b[i]);
+  return n;
+}
+
+// Area lights over every pixel: the viewsheds and the culled march at S = 32 and 128 (the
+// viewsheds' cost grows linearly with S; the exact march, a full walk per pair, is left to the
+// pairs), and the culled one at S = 256 against the light's size and height, with the viewsheds'
+// time at that S projected from S = 32 and 128. One round each (a viewshed per sample is slow).
+// (S = 1024 takes about four times S = 256's time in both: the culled march's work-items are
+// words of 32 samples, each the same kind of work.)
+void arealightSection(const ComputeContext& context, const HeightField& f) {
+  const double top = highest(f);
+  const double pixels = double(f.pixelCount());
+  std::printf(
+      "\n#### Area light over every pixel (light 64 x 64 px at the field's centre, %.1f above its "
+      "highest point; sources on grid points, absolute)\n\n",
+      20.0);
+  std::printf(
+      "| S | method | time (s) | Mrays/s | speed-up of culled | bits differing from culled |\n"
+      "|---|---|---|---|---|---|\n");
+  double viewshed_per_sample = 0.0;
+  for (int samples : {32, 128}) {
+    const RegionSampling light = gridLight(f, 64, samples, top + 20.0);
+    const std::vector<RegionVisibilityMethod> methods = {RegionVisibilityMethod::Viewsheds,
+                                                         RegionVisibilityMethod::Culled};
+    std::vector<RegionVisibilityResult> results(methods.size());
+    std::vector<std::function<void()>> bodies;
+    for (std::size_t i = 0; i < methods.size(); ++i)
+      bodies.push_back([&, i] {
+        RegionVisibilityOptions o;
+        o.method = methods[i];
+        results[i] = computeRegionVisibility(context, f, light, o);
+      });
+    const std::vector<double> t = fastestInterleaved(bodies, 1);
+    viewshed_per_sample = std::max(viewshed_per_sample, t[0] / samples);
+    for (std::size_t i = 0; i < methods.size(); ++i)
+      std::printf("| %d | %s | %.3f | %.2f | %.1f | %zu of %.0f |\n", samples, name(methods[i]), t[i],
+                  pixels * samples / t[i] * 1e-6, t[i] / t[1],
+                  differingBits(results[i].bits, results[1].bits), pixels * samples);
+  }
+  std::printf(
+      "\nThe viewsheds backend: %.3f s per sample (the larger of S = 32 and 128), %.0f s projected at "
+      "S = 1024.\n\n",
+      viewshed_per_sample, viewshed_per_sample * 1024);
+  std::printf(
+      "| S | light side (px) | light above the highest point | culled time (s) | Mrays/s | "
+      "projected speed-up over viewsheds | mean visible fraction |\n|---|---|---|---|---|---|---|\n");
+  struct Case {
+    int samples, side;
+    double above;
+  };
+  for (const Case c : {Case{256, 64, 20.0}, Case{256, 16, 20.0}, Case{256, 64, 400.0}}) {
+    const RegionSampling light = gridLight(f, c.side, c.samples, top + c.above);
+    RegionVisibilityResult r;
+    const double t = fastestInterleaved({[&] { r = computeRegionVisibility(context, f, light, {}); }}, 1)[0];
+    double mean = 0.0;
+    for (float v : r.fraction)
+      if (std::isfinite(v)) mean += v;
+    std::printf("| %d | %d | %.0f | %.2f | %.2f | %.1f | %.3f |\n", c.samples, c.side, c.above, t,
+                pixels * c.samples / t * 1e-6, viewshed_per_sample * c.samples / t, mean / pixels);
+  }
+}
+
+// Region pairs: two squares of `side` pixels (32 x 32 samples each, 2 above the surface), their
+// centres `distance` apart along a row through the field's centre.
+void pairSection(const ComputeContext& context, const HeightField& f, int reps) {
+  std::printf(
+      "\n#### Region pairs (32 x 32 samples each, 2 above the surface, the squares' centres on one row)"
+      "\n\n| side (px) | distance (px) | exact (ms) | culled (ms) | culled Mrays/s | speed-up | "
+      "visible fraction | bits differing |\n|---|---|---|---|---|---|---|---|\n");
+  struct Case {
+    int side, distance;
+  };
+  for (const Case c : {Case{32, 64}, Case{32, 256}, Case{32, 768}, Case{8, 256}, Case{128, 256}}) {
+    RegionSampling a, b;
+    a.samples = b.samples = 1024;
+    a.height = b.height = 2.0;
+    const int row = f.height / 2 - c.side / 2, left = f.width / 2 - c.distance / 2 - c.side / 2;
+    a.rectangle = {left, row, left + c.side - 1, row + c.side - 1};
+    b.rectangle = {left + c.distance, row, left + c.distance + c.side - 1, row + c.side - 1};
+    RegionPairVisibilityResult exact, culled;
+    RegionVisibilityOptions oe, oc;
+    oe.method = RegionVisibilityMethod::Exact;
+    oc.method = RegionVisibilityMethod::Culled;
+    const std::vector<double> t =
+        fastestInterleaved({[&] { exact = computeRegionPairVisibility(context, f, a, b, oe); },
+                            [&] { culled = computeRegionPairVisibility(context, f, a, b, oc); }},
+                           reps);
+    std::printf("| %d | %d | %.1f | %.1f | %.1f | %.1f | %.3f | %zu |\n", c.side, c.distance, t[0] * 1e3,
+                t[1] * 1e3, 1024.0 * 1024.0 / t[1] * 1e-6, t[0] / t[1],
+                double(culled.clear_pairs) / double(culled.pairs), differingBits(exact.bits, culled.bits));
+  }
+}
+
+// The visible fraction at S = 1024 (and 256) against a reference of 16384 samples (four seeds of
+// 4096, averaged) under a jittered 32 x 32 light 20 above the highest point, on the field's
+// central 128 x 128 pixels.
+void errorSection(const ComputeContext& context, const HeightField& full, int) {
+  const int n = std::min({128, full.width, full.height});
+  HeightField f = full;
+  f.width = f.height = n;
+  f.heights.assign(std::size_t(n) * n, 0.0f);
+  const int c0 = full.width / 2 - n / 2, r0 = full.height / 2 - n / 2;
+  for (int r = 0; r < n; ++r)
+    for (int c = 0; c < n; ++c) f.heights[std::size_t(r) * n + c] = full.at(c0 + c, r0 + r);
+  f.georeference = {};
+  RegionSampling light;
+  light.absolute = true;
+  light.height = highest(f) + 20.0;
+  light.rectangle = {n / 2 - 16, n / 2 - 16, n / 2 + 15, n / 2 + 15};
+  std::vector<double> reference(f.pixelCount(), 0.0);
+  for (std::uint32_t seed = 101; seed <= 104; ++seed) {
+    light.samples = kMaxRegionSamples;
+    RegionVisibilityOptions o;
+    o.seed = seed;
+    const RegionVisibilityResult r = computeRegionVisibility(context, f, light, o);
+    for (std::size_t p = 0; p < f.pixelCount(); ++p) reference[p] += r.fraction[p] / 4.0;
+  }
+  std::printf(
+      "\n#### The visible fraction against a Monte-Carlo reference (%d x %d pixels of the field's centre,"
+      " a 32 x 32 px light 20 above the highest point, jittered; the reference: 4 x 4096 samples)\n\n"
+      "| S | decorrelated | mean absolute error | largest error | penumbra pixels (0 < reference < 1) | "
+      "their mean absolute error |\n|---|---|---|---|---|---|\n",
+      n, n);
+  for (int samples : {256, 1024})
+    for (bool decorrelate : {false, true}) {
+      light.samples = samples;
+      RegionVisibilityOptions o;
+      o.decorrelate = decorrelate;
+      const RegionVisibilityResult r = computeRegionVisibility(context, f, light, o);
+      double sum = 0.0, worst = 0.0, penumbra_sum = 0.0;
+      std::size_t penumbra = 0;
+      for (std::size_t p = 0; p < f.pixelCount(); ++p) {
+        const double e = std::fabs(r.fraction[p] - reference[p]);
+        sum += e, worst = std::max(worst, e);
+        if (reference[p] > 0.0 && reference[p] < 1.0) penumbra_sum += e, ++penumbra;
+      }
+      std::printf("| %d | %s | %.4f | %.4f | %zu | %.4f |\n", samples, decorrelate ? "yes" : "no",
+                  sum / f.pixelCount(), worst, penumbra, penumbra ? penumbra_sum / penumbra : 0.0);
+    }
+}
+
+}  // namespace
+
+void regionVisibilityReport(const ComputeContext& context, const std::string& path,
+                            const std::vector<std::string>& sections, int reps) {
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);  // each row as it is measured (long sections)
+  const HeightField field = readHeightField(path);
+  std::printf("\n### %s (%d x %d)\n", path.c_str(), field.width, field.height);
+  for (const std::string& s : sections) {
+    if (s == "arealight") arealightSection(context, field);
+    if (s == "pair") pairSection(context, field, reps);
+    if (s == "error") errorSection(context, field, reps);
+    std::fflush(stdout);
+  }
+}
+
+}  // namespace hfvis::bench

@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# bench/region_visibility.sh: region visibility's backends (issue 28) on data/make_data.py's
+# fractal at N = 1024: area lights (viewsheds against the culled march, S = 32 and 128; the culled
+# march at S = 256 against the light's size and height), region pairs of 32 x 32 samples each
+# (exact against culled, against the squares' size and distance) and the visible fraction's error
+# against a Monte-Carlo reference of 16384 samples (`hfvis_bench region`: library calls, the
+# backends interleaved, the fastest of --reps). Writes the tables to bench/out/region_visibility.md
+# (or --out FILE); bench/report/region_visibility.md quotes a run.
+#
+#   bench/region_visibility.sh [--size 1024] [--sections pair,arealight,error] [--reps 2] [--out FILE]
+#   BUILD_DIR=... selects the build (default build/); inputs go to bench/out/data/.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+size=1024
+sections=pair,arealight,error
+reps=2
+out=$root/bench/out/region_visibility.md
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --size) size=$2; shift ;;
+    --sections) sections=$2; shift ;;
+    --reps) reps=$2; shift ;;
+    --out) out=$2; shift ;;
+    -h|--help) sed -n '2,11p' "$0"; exit 0 ;;
+    *) echo "region_visibility.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
+  esac
+  shift
+done
+build=${BUILD_DIR:-$root/build}
+bench=$build/bench/hfvis_bench
+[[ -x $bench ]] || { echo "region_visibility.sh: no hfvis_bench in $build (build it first)" >&2; exit 1; }
+export POCL_CACHE_DIR=${POCL_CACHE_DIR:-$root/bench/out/pocl-cache}
+data=$root/bench/out/data
+mkdir -p "$data" "$(dirname "$out")"
+[[ -f $data/fractal_$size.exr ]] ||
+  /usr/bin/python3 "$root/data/make_data.py" --size "$size" --out "$data" --no-dem --no-env --fields fractal > /dev/null
+"$bench" region --sections "$sections" --reps "$reps" "$data/fractal_$size.exr" | tee "$out"
