@@ -13,7 +13,11 @@
 namespace hfvis::detail {
 
 using std::ceil;
+using std::fabs;
 using std::floor;
+using std::fmax;
+using std::fmin;
+using std::isfinite;
 using std::isnan;
 using std::sqrt;
 #include "../../kernels/shared/heightfield_ray.cl"
