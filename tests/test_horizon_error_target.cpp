@@ -232,7 +232,7 @@ TEST(HorizonMaxError, BadRequestsAreRefused) {
   HorizonOutputs angles = svf;
   angles.horizon_angles = true;
   EXPECT_THROW(computeHorizons(testContext(), field, options, angles), InvalidArgument);
-  // Beyond kMaxAutoDirections by the first run's estimate: refused after that run alone.
+  // Beyond kMaxAutoDirections by a run's prediction (the second's: the first predicts at most 64).
   options.max_error = 1e-7;
   try {
     computeHorizons(testContext(), field, options, svf);
