@@ -554,9 +554,10 @@ __kernel void intervisibility_lattice(
             break;
           }
           const uint at = (uint)((py - row0) * width + px);
-          tree_piece_peak(heights[at], heights[at + 1], heights[at + (uint)width], heights[at + (uint)width + 1], g->fx,
-                          g->fy, g->dx, g->dy, g->t_far, g->t_near, g->inv_span, g->far_crossing, chord_far, rise,
-                          position_shift, &curve, &best_h, &offset, &best_excess);
+          tree_piece_peak(heights[at], heights[at + 1], heights[at + (uint)width],
+                          heights[at + (uint)width + 1], g->fx, g->fy, g->dx, g->dy, g->t_far, g->t_near,
+                          g->inv_span, g->far_crossing, chord_far, rise, position_shift, &curve, &best_h,
+                          &offset, &best_excess);
         }
         if (best_h > -INFINITY) {  // (not NaN)
           peak_position = ((step - 1) << position_shift) + offset;

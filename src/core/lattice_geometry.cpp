@@ -174,7 +174,8 @@ void setQuadratureWeights(std::vector<LatticeDirection>& directions, bool parity
     const std::size_t k = (start + n) % K;
     std::size_t length = 1;
     double total = directions[k].weight;
-    for (; n + length < K && same((k + length) % K, k); ++length) total += directions[(k + length) % K].weight;
+    for (; n + length < K && same((k + length) % K, k); ++length)
+      total += directions[(k + length) % K].weight;
     for (std::size_t i = 0; i < length; ++i) directions[(k + i) % K].weight = total / double(length);
     n += length;
   }

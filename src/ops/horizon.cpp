@@ -860,8 +860,9 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
         // (directionsForError caps its answer at twice the most: beyond that, a bound)
         message << "a maximum error of " << options.max_error << " needs "
                 << (next >= 2 * kMaxAutoDirections ? "at least " : "about ") << next
-                << " directions (the estimate at K = " << attempt.directions << " is " << result.estimated_error
-                << "), beyond the " << kMaxAutoDirections << " a run may choose: ask for a larger error, or give K";
+                << " directions (the estimate at K = " << attempt.directions << " is "
+                << result.estimated_error << "), beyond the " << kMaxAutoDirections
+                << " a run may choose: ask for a larger error, or give K";
         throw InvalidArgument(message.str());
       }
       attempt.directions = next;
