@@ -537,7 +537,15 @@ __kernel void intervisibility_lattice(
         float best_h = -INFINITY, best_excess = 0.0f;
         int offset = 0;
         TreePieceCurve curve;  // the piece before (set by the first piece, which has no crossing)
-        const float rise = h_sample - h_sample_prev;
+        float chord_far = h_sample_prev, rise = h_sample - h_sample_prev;
+#if HFVIS_CURVATURE
+        // The candidates are points of the surface before the drop (theirs comes after): so is
+        // the chord they are measured against, else the drop's growth along the interval (2 drop
+        // step per step) would favour the near end's candidates far out on a line.
+        const float d_far = (float)((step - 1) << position_shift) * inv_scale;
+        chord_far = h_sample_prev + drop * d_far * d_far;
+        rise = (h_sample + drop * d_sample * d_sample) - chord_far;
+#endif
         for (int k = interval_first[q]; k < interval_first[q + 1]; ++k) {
           __global const TreePiece* g = pieces + k;
           const int px = col + g->ox, py = row + g->oy;
@@ -546,9 +554,10 @@ __kernel void intervisibility_lattice(
             break;
           }
           const uint at = (uint)((py - row0) * width + px);
-          tree_piece_peak(heights[at], heights[at + 1], heights[at + (uint)width], heights[at + (uint)width + 1], g->fx,
-                          g->fy, g->dx, g->dy, g->t_far, g->t_near, g->inv_span, g->far_crossing, h_sample_prev, rise,
-                          position_shift, &curve, &best_h, &offset, &best_excess);
+          tree_piece_peak(heights[at], heights[at + 1], heights[at + (uint)width],
+                          heights[at + (uint)width + 1], g->fx, g->fy, g->dx, g->dy, g->t_far, g->t_near,
+                          g->inv_span, g->far_crossing, chord_far, rise, position_shift, &curve, &best_h,
+                          &offset, &best_excess);
         }
         if (best_h > -INFINITY) {  // (not NaN)
           peak_position = ((step - 1) << position_shift) + offset;

@@ -210,6 +210,13 @@ void addTreePeaks(const HeightField& field, const std::vector<float>& heights, c
         // farthest above the chord of its samples.
         const float far = lines.samples[e - d.lines.size()], near = lines.samples[e];
         if (std::isnan(far) || std::isnan(near)) continue;
+        // With curvature, against the samples' chord before the drop, as the kernel.
+        float chord_far = far, rise = near - far;
+        if (curvature) {
+          const float q_far = static_cast<float>(step - 1), q_near = static_cast<float>(step);
+          chord_far = far + d.drop * q_far * q_far;
+          rise = (near + d.drop * q_near * q_near) - chord_far;
+        }
         float best_h = -INFINITY, best_excess = 0.0f;
         int offset = 0;
         TreePieceCurve curve{};
@@ -222,7 +229,7 @@ void addTreePeaks(const HeightField& field, const std::vector<float>& heights, c
           }
           const std::size_t at = static_cast<std::size_t>(y0) * width + x0;
           tree_piece_peak(heights[at], heights[at + 1], heights[at + width], heights[at + width + 1], g.fx,
-                          g.fy, g.dx, g.dy, g.t_far, g.t_near, g.inv_span, g.far_crossing, far, near - far,
+                          g.fy, g.dx, g.dy, g.t_far, g.t_near, g.inv_span, g.far_crossing, chord_far, rise,
                           d.position_shift, &curve, &best_h, &offset, &best_excess);
         }
         if (!(best_h > -INFINITY)) continue;  // none, or NaN

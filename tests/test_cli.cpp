@@ -31,6 +31,7 @@
 #include "hfvis/image_io.hpp"
 #include "hfvis/pvs.hpp"
 #include "hfvis/region_visibility.hpp"
+#include "hfvis/sky_view_factor.hpp"
 #include "image_outputs.hpp"
 #include "test_support.hpp"
 
@@ -680,6 +681,44 @@ TEST_F(Cli, OpenImageIoIsLoadedOnlyForTheImagesThatNeedIt) {
 }
 
 // ---- successful runs ----
+
+// --max-error chooses K and --error-out writes the estimate: the same K, values and estimate as the
+// library's call (hfvis:directions the K run, not -k's default), in both files' attributes; a
+// refused E (beyond 4096 directions) writes neither file.
+TEST_F(Cli, MaxErrorWritesTheChosenKAndTheEstimate) {
+  const std::string field = writeField("bumps.exr", 40, 33, [](int col, int row) {
+    return 3.0f * std::sin(0.7f * col) * std::cos(0.5f * row) + ((col / 5 + row / 4) % 3 == 0 ? 4.0f : 0.0f);
+  });
+  const CliResult r = run("svf " + shellQuoted(field) + " -o " + shellQuoted(out("s.exr")) +
+                          " --max-error 0.02 --error-out " + shellQuoted(out("e.exr")));
+  ASSERT_EQ(r.status, 0) << r.err;
+  hfvis::HorizonOptions options;
+  options.max_error = 0.02;
+  const hfvis::SkyViewFactorResult lib =
+      hfvis::computeSkyViewFactor(hfvis::testing::testContext(), hfvis::readHeightField(field), options);
+  ASSERT_NE(lib.directions, 64);  // (else the attribute could not tell -k's default from the K run)
+  EXPECT_NE(r.out.find(std::to_string(lib.directions) + " directions"), std::string::npos) << r.out;
+  const ReadBack svf = readBack(out("s.exr")), estimate = readBack(out("e.exr"));
+  ASSERT_EQ(estimate.channels, (std::vector<std::string>{"error"}));
+  ASSERT_EQ(svf.pixels.size(), lib.values.size());
+  ASSERT_EQ(estimate.pixels.size(), lib.error_estimate.size());
+  for (std::size_t p = 0; p < lib.values.size(); ++p) {
+    ASSERT_EQ(svf.pixels[p], lib.values[p]) << p;
+    ASSERT_EQ(estimate.pixels[p], lib.error_estimate[p]) << p;
+  }
+  for (const ReadBack* image : {&svf, &estimate}) {
+    EXPECT_EQ(image->spec.get_string_attribute("hfvis:directions"), std::to_string(lib.directions));
+    EXPECT_EQ(image->spec.get_string_attribute("hfvis:max_error"), "0.02");
+    EXPECT_NEAR(std::stod(image->spec.get_string_attribute("hfvis:estimated_error")), lib.estimated_error,
+                1e-9);
+  }
+  EXPECT_LE(lib.estimated_error, 0.02);
+  fs::remove(out("s.exr"));
+  fs::remove(out("e.exr"));
+  expectFailure(run("svf " + shellQuoted(field) + " -o " + shellQuoted(out("s.exr")) +
+                    " --max-error 1e-7 --error-out " + shellQuoted(out("e.exr"))),
+                1, "directions");
+}
 
 TEST_F(Cli, HorizonWritesOneChannelPerDirection) {
   const CliResult result = run("horizon " + shellQuoted(ramp()) + " -o " + shellQuoted(out("h.exr")) +

@@ -61,6 +61,48 @@ TEST(HorizonErrorEstimate, KernelsMatchTheScalarReferenceOnEveryHardCase) {
   });
 }
 
+// The paths the hard cases above do not take: a maximum distance (the window's pass), a latitude /
+// longitude grid (per-row spacing: each row's own quadrature weights), both at once, and strips of
+// each, with nodata holes and odd K, against the scalar reference in both layouts.
+TEST(HorizonErrorEstimate, WindowsRowSpacingAndStripsMatchTheScalarReference) {
+  testing::forEachLayout([](const ComputeContext& context) {
+    for (const char* name : {"city", "nan_holes"}) {
+      HeightField field = makeSyntheticField(name, 37, 29, 5);
+      HeightField rows = field;
+      for (int r = 0; r < rows.height; ++r) {
+        rows.row_cell_size_x.push_back(1.0 + 0.03 * r);
+        rows.row_cell_size_y.push_back(1.1);
+      }
+      rows.cell_size_x = rows.row_cell_size_x[rows.height / 2];
+      rows.cell_size_y = 1.1;
+      for (const HeightField* f : {&field, &rows}) {
+        for (double max_distance : {0.0, 6.5}) {
+          for (int K : {9, 16}) {
+            SCOPED_TRACE(std::string(name) + (f == &rows ? " per-row spacing" : "") + " max distance " +
+                         std::to_string(max_distance) + " K " + std::to_string(K));
+            HorizonOptions options;
+            options.directions = K;
+            options.max_distance = max_distance;
+            const HorizonResult reference = referenceHorizons(*f, options, estimated());
+            for (int strip_rows : {0, 6}) {
+              options.strip_rows = strip_rows;
+              const HorizonResult device = computeHorizons(context, *f, options, estimated());
+              const float tolerance = std::max(testing::divisionTolerance(), 2e-6f);
+              EXPECT_TRUE(nearlyEqual(device.sky_view_factor, reference.sky_view_factor, tolerance))
+                  << strip_rows;
+              EXPECT_TRUE(nearlyEqual(device.ambient_occlusion, reference.ambient_occlusion, tolerance))
+                  << strip_rows;
+              EXPECT_TRUE(nearlyEqual(device.error_estimate, reference.error_estimate, tolerance))
+                  << strip_rows;
+              EXPECT_NEAR(device.estimated_error, reference.estimated_error, tolerance) << strip_rows;
+            }
+          }
+        }
+      }
+    }
+  });
+}
+
 // The estimate leaves the outputs as a run without it (up to the order the sums are added in),
 // and a field in strips gives the same estimate as in one piece, bit for bit.
 TEST(HorizonErrorEstimate, OutputsUnchangedAndStripsEqualTheWholeField) {
@@ -115,7 +157,8 @@ TEST(HorizonErrorEstimate, MergedStepsStayInTheirHalf) {
     double even = 0.0, odd = 0.0, largest_imbalance = 0.0;
     for (int k = 0; k < options.directions; ++k) {
       (k % 2 ? odd : even) += directions[k].weight;
-      if (k % 64 == 63) largest_imbalance = std::max(largest_imbalance, std::abs(even - odd)), even = odd = 0.0;
+      if (k % 64 == 63)
+        largest_imbalance = std::max(largest_imbalance, std::abs(even - odd)), even = odd = 0.0;
     }
     // Over every 64 neighbouring directions the halves' weights agree to 5 % of their sum
     // (1/32) with parity_apart; without it some merged run puts the weight all on one side.
@@ -124,6 +167,18 @@ TEST(HorizonErrorEstimate, MergedStepsStayInTheirHalf) {
     else
       EXPECT_GT(largest_imbalance, 0.1 / 32);
   }
+  // The run on the axis at azimuth 0 goes on from k = K - 1 to k = 0: with the azimuths turned by
+  // 0.3 degree, k = 2045 .. 2048 fall on step (1, 0). Its slots share equally across the wrap, so
+  // the 64 directions around k = 0 keep the halves' weights within 1 % of their sum (a scan from
+  // k = 0 split the run in two, and gave the even half 1.3 slots of the odd one's: 5 %).
+  options.azimuth_offset = 0.3 * M_PI / 180.0;
+  const auto turned = detail::latticeDirections(field, options, false, 0.0, true);
+  double even = 0.0, odd = 0.0;
+  for (int j = -32; j < 32; ++j) {
+    const int k = (j + options.directions) % options.directions;
+    (k % 2 ? odd : even) += turned[k].weight;
+  }
+  EXPECT_LT(std::abs(even - odd), 0.01 / 32);
 }
 
 // A maximum error: the K chosen meets it by the estimate, the estimate lies above the error
@@ -177,7 +232,7 @@ TEST(HorizonMaxError, BadRequestsAreRefused) {
   HorizonOutputs angles = svf;
   angles.horizon_angles = true;
   EXPECT_THROW(computeHorizons(testContext(), field, options, angles), InvalidArgument);
-  // Beyond kMaxAutoDirections by the first run's estimate: refused after that run alone.
+  // Beyond kMaxAutoDirections by a run's prediction (the second's: the first predicts at most 64).
   options.max_error = 1e-7;
   try {
     computeHorizons(testContext(), field, options, svf);

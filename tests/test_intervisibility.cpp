@@ -970,6 +970,34 @@ std::vector<int> exactCounts(const HeightField& field, const std::vector<float>&
   return counts;
 }
 
+// The Earth's drop lowers a peak, not which point of its interval it is: the candidates (crossings,
+// concave pieces' vertices) are points of the surface before the drop, so the chord they are
+// measured against must be too. Measured against the lowered samples' chord, the drop's growth
+// along an interval (2 drop step per step) would pick the candidate nearest the near sample far
+// out on a line. With a drop large enough to dwarf the terrain, the reference (which the kernel
+// equals) picks the same offset as without it, but for near-ties of the rounding.
+TEST(IntervisibilityLattice, CurvatureLowersThePeaksNotTheirChoice) {
+  const HeightField field = makeSyntheticField("city", 90, 70, 3);
+  const auto prepared = detail::prepareHeights(field);
+  for (const auto step :
+       {std::pair<int, int>{3, 1}, std::pair<int, int>{-4, 3}, std::pair<int, int>{5, -2}}) {
+    SCOPED_TRACE(std::to_string(step.first) + "," + std::to_string(step.second));
+    detail::TreeDirection d = treeStep(field, step);
+    ASSERT_TRUE(d.peaks());
+    const auto flat = detail::latticeTreeLines(field, prepared.heights, d);
+    d.drop = 0.05f;
+    const auto curved = detail::latticeTreeLines(field, prepared.heights, d, true);
+    std::size_t candidates = 0, moved = 0;
+    for (std::size_t e = 0; e < flat.peaks.size(); ++e) {
+      if (!std::isfinite(flat.peaks[e]) || !std::isfinite(curved.peaks[e])) continue;
+      ++candidates;
+      moved += flat.peak_offsets[e] != curved.peak_offsets[e];
+    }
+    EXPECT_GT(candidates, 1000u);
+    EXPECT_LE(moved, candidates / 100) << moved << " of " << candidates << " peaks moved";
+  }
+}
+
 // Roofs that touch at a corner and one-pixel walls, seen off the axes: between two of the
 // tree's samples the bilinear surface rises above both (at a crossing, or at the vertex of a
 // concave cell piece), and the samples alone see past it. Against the exact line of sight on

@@ -162,16 +162,22 @@ void setQuadratureWeights(std::vector<LatticeDirection>& directions, bool parity
   for (std::size_t k = 0; k < K; ++k) directions[k].weight = weights[k];
   // Coinciding neighbours share their half gaps unevenly (the run's inner ones get none); for the
   // error estimate's halves every slot of a run takes an equal share, so that each parity keeps
-  // the share of the circle its azimuths stand for.
+  // the share of the circle its azimuths stand for. Runs are circular: the one on the axis at
+  // azimuth 0 ends at k = K - 1 and goes on at k = 0, so the scan starts where a run starts.
   const auto same = [&](std::size_t i, std::size_t j) {
     return directions[i].a == directions[j].a && directions[i].b == directions[j].b;
   };
-  for (std::size_t k = 0; parity_apart && k < K;) {
-    std::size_t end = k + 1;
+  std::size_t start = 0;
+  while (parity_apart && start < K && same(start, (start + K - 1) % K)) ++start;
+  if (start == K) start = 0;  // one step all around
+  for (std::size_t n = 0; parity_apart && n < K;) {
+    const std::size_t k = (start + n) % K;
+    std::size_t length = 1;
     double total = directions[k].weight;
-    for (; end < K && same(end, k); ++end) total += directions[end].weight;
-    for (std::size_t i = k; i < end; ++i) directions[i].weight = total / double(end - k);
-    k = end;
+    for (; n + length < K && same((k + length) % K, k); ++length)
+      total += directions[(k + length) % K].weight;
+    for (std::size_t i = 0; i < length; ++i) directions[(k + i) % K].weight = total / double(length);
+    n += length;
   }
   // Where no step lies inside a window (K beyond the lattice's angular resolution near
   // the axes: atan(1/64) = 0.9 deg) neighbours can fall back to the same step: the first

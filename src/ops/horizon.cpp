@@ -857,9 +857,12 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
       earlier_estimate = result.estimated_error;
       if (next > kMaxAutoDirections) {
         std::ostringstream message;
-        message << "a maximum error of " << options.max_error << " needs about " << next
-                << " directions (the estimate at K = " << attempt.directions << " is " << result.estimated_error
-                << "), beyond the " << kMaxAutoDirections << " a run may choose: ask for a larger error, or give K";
+        // (directionsForError caps its answer at twice the most: beyond that, a bound)
+        message << "a maximum error of " << options.max_error << " needs "
+                << (next >= 2 * kMaxAutoDirections ? "at least " : "about ") << next
+                << " directions (the estimate at K = " << attempt.directions << " is "
+                << result.estimated_error << "), beyond the " << kMaxAutoDirections
+                << " a run may choose: ask for a larger error, or give K";
         throw InvalidArgument(message.str());
       }
       attempt.directions = next;
