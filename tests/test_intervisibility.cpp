@@ -979,7 +979,7 @@ std::vector<int> exactCounts(const HeightField& field, const std::vector<float>&
 TEST(IntervisibilityLattice, CurvatureLowersThePeaksNotTheirChoice) {
   const HeightField field = makeSyntheticField("city", 90, 70, 3);
   const auto prepared = detail::prepareHeights(field);
-  for (const auto step :
+  for (const auto& step :
        {std::pair<int, int>{3, 1}, std::pair<int, int>{-4, 3}, std::pair<int, int>{5, -2}}) {
     SCOPED_TRACE(std::to_string(step.first) + "," + std::to_string(step.second));
     detail::TreeDirection d = treeStep(field, step);
