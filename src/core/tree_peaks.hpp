@@ -6,14 +6,10 @@
 #include <cmath>
 
 #include "core/chord_side.hpp"
+#include "core/opencl_builtins.hpp"
 
 namespace hfvis::detail {
 
-using std::ceil;
-using std::floor;
-using std::isfinite;
-using std::isnan;
-using std::rint;
 #ifndef NAN
 #error "NAN must come from <cmath>"
 #endif

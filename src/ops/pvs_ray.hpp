@@ -9,17 +9,10 @@
 
 #include "hfvis/height_field.hpp"
 #include "hfvis/pvs.hpp"
+#include "core/opencl_builtins.hpp"
 
 namespace hfvis::detail {
 
-using std::ceil;
-using std::fabs;
-using std::floor;
-using std::fmax;
-using std::fmin;
-using std::isfinite;
-using std::isnan;
-using std::sqrt;
 #include "../../kernels/shared/heightfield_ray.cl"
 
 // The maximum pyramid of heightfield_ray.cl over the (z-scaled) heights: levels 1 .. top, up to

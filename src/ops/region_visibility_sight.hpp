@@ -9,16 +9,10 @@
 
 #include "hfvis/height_field.hpp"
 #include "hfvis/region_visibility.hpp"
+#include "core/opencl_builtins.hpp"
 
 namespace hfvis::detail {
 
-using std::ceil;
-using std::fabs;
-using std::floor;
-using std::fmax;
-using std::fmin;
-using std::isfinite;
-using std::isnan;
 #include "../../kernels/shared/region_visibility_sight.cl"
 
 // A region's table for region_sample(): the rectangle (lo_x, lo_y, hi_x, hi_y), then per sample
