@@ -32,6 +32,8 @@ Attributes sweptAttributes(const Job& job, const HorizonResult& result) {
 void HorizonQuantityComputation::compute(Job& job) {
   HorizonOutputs wanted;
   wanted.*quantity_.wanted = true;
+  // --error-out with -k: the estimate at the K given (--max-error asks the library for it anyway).
+  wanted.error_estimate = !run_.error_output.empty();
   result_ = computeSweptHorizons(job, wanted);
 }
 

@@ -9,15 +9,19 @@ made on first use and kept; the GIL is released while the kernels run. docs/pyth
 from . import _core
 from ._errors import (DeviceError, Error, InputTypeError, InvalidArgumentError, IoError, MemoryBudgetError,
                       NoDeviceError)
-from ._operations import (HeightFieldFile, Horizons, Insolation, Intervisibility, SunShading, ambient_occlusion, cumulative_viewshed,
-                          devices, environment_light, horizon_angles, horizon_distances, insolation, intervisibility,
-                          read_height_field, sky_view_factor, sun_position, sun_shading, viewshed)
+from ._operations import (ErrorEstimate, HeightFieldFile, Horizons, Insolation, Intervisibility, Pvs,
+                          RegionPairVisibility, RegionVisibility, SunShading, ambient_occlusion, bounce,
+                          cumulative_viewshed, devices, environment_light, horizon_angles, horizon_distances,
+                          horizon_lists, insolation, intervisibility, pvs, read_height_field, region_pair_visibility,
+                          region_visibility, sky_view_factor, sun_position, sun_shading, viewshed)
 
 __version__ = _core.__version__
 
 __all__ = [
     "Error", "InvalidArgumentError", "InputTypeError", "IoError", "NoDeviceError", "DeviceError", "MemoryBudgetError",
-    "HeightFieldFile", "Horizons", "Intervisibility", "SunShading", "Insolation",
+    "HeightFieldFile", "Horizons", "Intervisibility", "SunShading", "Insolation", "ErrorEstimate", "RegionVisibility",
+    "RegionPairVisibility", "Pvs",
     "horizon_angles", "horizon_distances", "sky_view_factor", "ambient_occlusion", "intervisibility", "viewshed",
-    "cumulative_viewshed", "sun_shading", "insolation", "environment_light", "sun_position", "devices", "read_height_field",
+    "cumulative_viewshed", "sun_shading", "insolation", "environment_light", "region_visibility",
+    "region_pair_visibility", "pvs", "horizon_lists", "bounce", "sun_position", "devices", "read_height_field",
 ]

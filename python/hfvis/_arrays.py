@@ -24,6 +24,8 @@ OUTPUTS = {
     "insolation": ("sun_hours", "direct"),
     "viewshed": ("visible",),
     "cumulative_viewshed": ("count",),
+    "region_visibility": ("fraction", "bits"),
+    "bounce": ("irradiance",),
 }
 
 
@@ -89,7 +91,7 @@ def _sweep_options(options):
 
 def _horizon_options(options):
     o = _core.HorizonOptions()
-    _set(o, options, _SWEEP + ("azimuth_tolerance", "strip_rows"))
+    _set(o, options, _SWEEP + ("azimuth_tolerance", "strip_rows", "max_error"))
     o.method = _enum(_core.HorizonMethod, options.get("method", "sweep"), "method")
     return o
 
@@ -138,7 +140,8 @@ def compute(operation, heights, geometry, options, device="", progress=None):
         r = _core.horizons(field, _horizon_options(options), angles=operation == "horizon_angles",
                            distances=operation == "horizon_distances",
                            sky_view_factor=operation == "sky_view_factor",
-                           ambient_occlusion=operation == "ambient_occlusion", device=device, progress=progress)
+                           ambient_occlusion=operation == "ambient_occlusion",
+                           error_estimate=bool(options.get("error_estimate")), device=device, progress=progress)
         r["azimuths"] = np.asarray(r["azimuths"])
         return r
     if operation == "intervisibility":
@@ -184,7 +187,104 @@ def compute(operation, heights, geometry, options, device="", progress=None):
         cols, rows, eyes = observer_pixels(options["observers"], options["observer_height"])
         return {"count": _core.cumulative_viewshed(field, cols, rows, eyes, _viewshed_options(options),
                                                    device=device, progress=progress)}
+    if operation == "region_visibility":
+        o = _region_options(options)
+        r = _core.region_visibility(field, region_sampling(options["sources"], options["samples"], options["height"],
+                                                           options["absolute"]), o, device=device)
+        # Plane w: the samples 32 w .. 32 w + 31 (bit s % 32), as the horizon maps' K x H x W.
+        r["bits"] = np.ascontiguousarray(np.moveaxis(r["bits"], -1, 0))
+        return r
+    if operation == "region_pair_visibility":
+        return _core.region_pair_visibility(
+            field, region_sampling(options["sources"], options["samples"], options["source_height"],
+                                   options["absolute"]),
+            region_sampling(options["receivers"], options["samples"], options["receiver_height"], options["absolute"]),
+            _region_options(options), device=device)
+    if operation == "pvs":
+        grid = _core.PvsGrid()
+        _set(grid, options, ("view_cell", "band_low", "band_high", "tile"))
+        if options.get("mask") is not None:
+            grid.mask = pvs_mask(options["mask"], heights.shape, grid.view_cell)
+        o = _core.PvsOptions()
+        _set(o, options, ("samples", "pixel_error", "seconds", "batch", "seed", "resolution", "filter", "witnesses",
+                          "memory_budget_bytes"))
+        o.method = _enum(_core.PvsMethod, str(options.get("method", "agvs")).replace("-", "_"), "method")
+        return _core.pvs(field, grid, o, device=device, progress=progress)
+    if operation == "horizon_lists":
+        cols, rows = receiver_pixels(options["receivers"])
+        return {"lists": _core.horizon_lists(field, _sweep_options(options), cols, rows)}
+    if operation == "bounce":
+        radiance = np.asarray(options["radiance"])
+        if radiance.ndim == 2:
+            radiance = radiance[np.newaxis]
+        if radiance.ndim != 3 or radiance.dtype.kind not in "fiu":
+            raise InputTypeError("radiance must be a real 2-D (rows, columns) or 3-D (channels, rows, columns) array, "
+                                 f"got shape {radiance.shape} and dtype {radiance.dtype}")
+        if radiance.shape[1:] != heights.shape:
+            raise InvalidArgumentError(f"the radiance is {radiance.shape[2]} x {radiance.shape[1]}, the heights "
+                                       f"{heights.shape[1]} x {heights.shape[0]}: it needs one value per height")
+        o = _core.BounceOptions()
+        _set(o, options, _SWEEP)
+        return _core.bounce(field, np.ascontiguousarray(radiance, dtype=np.float32), o, device=device,
+                            progress=progress)
     raise InvalidArgumentError(f"no operation {operation!r}")
+
+
+def _region_options(options):
+    o = _core.RegionVisibilityOptions()
+    _set(o, options, ("target_height", "max_distance", "curvature", "seed", "decorrelate"))
+    o.method = _enum(_core.RegionVisibilityMethod, options.get("method", "culled"), "method")
+    return o
+
+
+def region_sampling(region, samples, height, absolute):
+    """A region as hfvis._core.RegionSampling: a rectangle (col0, row0, col1, row1) of grid points,
+    corners inclusive, sampled `samples` times; or an N x 2 (col, row) or N x 3 (col, row, height)
+    array of points, the samples themselves (a missing height is `height`)."""
+    a = np.asarray(region)
+    if a.ndim == 1 and a.shape[0] == 4:
+        if a.dtype.kind not in "iu":
+            raise InvalidArgumentError(f"a rectangle is four integer pixel corners (col0, row0, col1, row1), "
+                                       f"got {region!r}")
+        return _core.region_sampling([int(v) for v in a], [], int(samples), float(height), bool(absolute))
+    if a.ndim == 2 and a.shape[1] in (2, 3) and len(a) > 0 and a.dtype.kind in "fiu":
+        points = [(float(p[0]), float(p[1]), float(p[2]) if len(p) == 3 else float(height)) for p in a]
+        return _core.region_sampling([0, 0, 0, 0], points, int(samples), float(height), bool(absolute))
+    raise InvalidArgumentError("a region is a rectangle (col0, row0, col1, row1) or an N x 2 (col, row) or N x 3 "
+                               f"(col, row, height) array of points, N >= 1; got shape {a.shape}")
+
+
+def pvs_mask(mask, shape, view_cell):
+    """The view cells to compute, one byte each (row-major): `mask` per view cell (view rows x view
+    columns), or per pixel of the field (its shape), as the CLI's --view-mask: a view cell is
+    computed when it holds a non-zero finite pixel (the last row and column count with the cells
+    before them)."""
+    m = np.asarray(mask)
+    height, width = shape
+    cells_x, cells_y = width - 1, height - 1
+    view = view_cell if view_cell >= 1 else 1
+    view_x, view_y = -(-cells_x // view), -(-cells_y // view)
+    if m.ndim == 2 and m.shape == (view_y, view_x):
+        return [int(v) for v in (np.nan_to_num(m.astype(np.float64)) != 0).ravel()]
+    if m.ndim == 2 and m.shape == (height, width):
+        on = np.isfinite(m.astype(np.float64)) & (m != 0)
+        rows = np.minimum(np.arange(height), cells_y - 1) // view
+        cols = np.minimum(np.arange(width), cells_x - 1) // view
+        out = np.zeros((view_y, view_x), np.uint8)
+        ys, xs = np.nonzero(on)
+        out[rows[ys], cols[xs]] = 1
+        return out.ravel().tolist()
+    raise InvalidArgumentError(f"mask must be per view cell ({view_y} x {view_x}) or per pixel ({height} x {width}), "
+                               f"got shape {m.shape}")
+
+
+def receiver_pixels(receivers):
+    """Columns and rows of an N x 2 integer array of pixels (column, row), N >= 1."""
+    pixels = np.asarray(receivers)
+    if pixels.ndim != 2 or pixels.shape[1] != 2 or pixels.dtype.kind not in "iu" or len(pixels) == 0:
+        raise InvalidArgumentError(f"receivers must be an N x 2 array of integer pixels (column, row), N >= 1, "
+                                   f"got shape {pixels.shape} and dtype {pixels.dtype}")
+    return pixels[:, 0].tolist(), pixels[:, 1].tolist()
 
 
 def observer_pixel(observer):

@@ -14,6 +14,13 @@ Horizons = collections.namedtuple("Horizons", "values azimuths")
 Intervisibility = collections.namedtuple("Intervisibility", "visible_count visible_area")
 SunShading = collections.namedtuple("SunShading", "sun direct")
 Insolation = collections.namedtuple("Insolation", "sun_hours direct")
+ErrorEstimate = collections.namedtuple("ErrorEstimate", "values error directions estimated_error")
+RegionVisibility = collections.namedtuple("RegionVisibility", "fraction bits")
+RegionPairVisibility = collections.namedtuple(
+    "RegionPairVisibility", "bits sources receivers source_fraction receiver_fraction clear_pairs pairs "
+    "visible_fraction sources_xy receivers_xy")
+Pvs = collections.namedtuple("Pvs", "sets bits computed layout samples rays entries rejected filtered pixel_error "
+                                    "seconds history witnesses")
 
 # Lighting and fields of view take row 0 as north: a DataArray whose rows run south-up (or
 # columns west) is computed flipped.
@@ -33,8 +40,13 @@ _UNITS = {
     "visible": "1 (1 seen, 0 hidden or out of range)",
     "count": "observers",
     "irradiance": "radiance units times steradians (pi on open flat ground under radiance 1)",
+    "fraction": "1 (the share of the source samples seen, 0..1)",
+    "bits": "bit patterns: bit s % 32 of plane s // 32 set where source sample s is seen; 0 at nodata",
+    "error": "absolute, in the output's unit (half the difference of the even- and odd-numbered directions' results)",
 }
 _INSOLATION_DIRECT = "hours (direct irradiation from a sun of normal irradiance 1; times W/m^2 it is Wh/m^2)"
+_BOUNCE_IRRADIANCE = ("radiance units times steradians (W/m^2 for W m^-2 sr^-1; flat ground receives 0); a "
+                      "Lambertian surface of albedo rho re-emits rho * E / pi")
 
 
 def _is_dataarray(value):
@@ -54,6 +66,10 @@ def _method(operation, options):
         return "exact sight lines on the bilinear surface"
     if operation == "intervisibility":
         return options.get("method") or "hull_tree"
+    if operation == "region_visibility":
+        return options.get("method") or "culled"
+    if operation == "bounce":
+        return "tree"
     return options.get("method") or "sweep"
 
 
@@ -72,6 +88,7 @@ def _run(operation, heights, options, common):
     g = grid.geometry(common["cell_size"], common["z_scale"])
     flip_rows, flip_cols = grid.flips() if operation in _LIT else (False, False)
     options = _observers_as_pixels(operation, options, grid, flip_rows, flip_cols, common["pixels"])
+    options = _places_as_pixels(operation, options, grid, common["pixels"])
     if flip_rows:
         g = dict(g, row_cell_size_x=g["row_cell_size_x"][::-1], row_cell_size_y=g["row_cell_size_y"][::-1])
     nodata = common["nodata"] if common["nodata"] is not None else grid.nodata
@@ -94,8 +111,9 @@ def _run(operation, heights, options, common):
         h = _arrays.heights_array(data, nodata)
         h = np.ascontiguousarray(_flipped(h, flip_rows, flip_cols))
         out = _arrays.compute(operation, h, g, options, common["device"], common["progress"])
-    for name in _arrays.OUTPUTS.get(operation, ("irradiance",)):
-        out[name] = _flipped(out[name], flip_rows, flip_cols)
+    if flip_rows or flip_cols:
+        for name in _arrays.OUTPUTS.get(operation, ("irradiance",)):
+            out[name] = _flipped(out[name], flip_rows, flip_cols)
     return out, grid
 
 
@@ -135,14 +153,41 @@ def _observers_as_pixels(operation, options, grid, flip_rows, flip_cols, pixels)
     return options
 
 
+def _places_as_pixels(operation, options, grid, pixels):
+    """A DataArray's regions and receivers, given as map coordinates (x, y) unless `pixels`, as
+    pixels: a rectangle's corners and receivers the nearest pixel, points their fractional pixel
+    position. These operations have no north: the field is never flipped for them."""
+    if pixels:
+        return options
+    options = dict(options)
+    for key in ("sources", "receivers"):
+        if key not in options:
+            continue
+        a = np.asarray(options[key])
+        if operation == "horizon_lists":
+            if a.ndim != 2 or a.shape[1] != 2:
+                raise InvalidArgumentError(f"receivers must be an N x 2 array, got shape {a.shape}")
+            options[key] = np.array([grid.pixel(float(x), float(y)) for x, y in a], dtype=np.int64).reshape(-1, 2)
+        elif a.ndim == 1 and a.shape == (4,):
+            options[key] = np.array(grid.pixel(float(a[0]), float(a[1])) + grid.pixel(float(a[2]), float(a[3])))
+        elif a.ndim == 2 and a.shape[1] in (2, 3):
+            placed = np.array(a, dtype=np.float64)
+            for point in placed:
+                point[0], point[1] = grid.position(point[0], point[1])
+            options[key] = placed
+    return options
+
+
 def _attrs(operation, name, options, grid):
     attrs = {"units": _UNITS[name], "hfvis_operation": operation, "hfvis_method": _method(operation, options)}
     if operation == "insolation" and name == "direct":
         attrs["units"] = _INSOLATION_DIRECT
+    if operation == "bounce":
+        attrs["units"] = _BOUNCE_IRRADIANCE
     if name in ("distances", "visible_area") and grid.geographic:
         attrs["units"] = attrs["units"].replace("ground units", "metres")
     for key, value in options.items():
-        if key in ("observers", "environment", "progress"):
+        if key in ("observers", "environment", "progress", "radiance", "mask"):
             continue
         if isinstance(value, (bool, np.bool_)):
             value = int(value)
@@ -231,22 +276,56 @@ def horizon_distances(heights, *, directions=64, azimuth_offset=0.0, samples_per
 
 def sky_view_factor(heights, *, directions=64, azimuth_offset=0.0, samples_per_unit=1.0, curvature=0.0,
                     max_distance=0.0, method="sweep", azimuth_tolerance=None, strip_rows=0, memory_budget_bytes=0,
-                    cell_size=None, z_scale=1.0, nodata=None, device="", progress=None):
-    """The sky-view factor 1 - sum_k w_k sin(max(0, e_k)) (Zaksek, Ostir & Kokalj 2011), 0..1."""
+                    max_error=0.0, error_estimate=False, cell_size=None, z_scale=1.0, nodata=None, device="",
+                    progress=None):
+    """The sky-view factor 1 - sum_k w_k sin(max(0, e_k)) (Zaksek, Ostir & Kokalj 2011), 0..1.
+    max_error=E chooses K (directions ignored) so that the 99th percentile of the error estimate
+    is at most E; with it or error_estimate=True: numpy ErrorEstimate(values, error, directions,
+    estimated_error); a DataArray with the K and the estimate in its attrs (and a Dataset with
+    the per-pixel error under error_estimate=True)."""
     options = _horizon(directions, azimuth_offset, samples_per_unit, curvature, max_distance, memory_budget_bytes,
                        method, azimuth_tolerance, strip_rows)
-    return _single("sky_view_factor", "sky_view_factor", heights, options,
-                   _common(cell_size, z_scale, nodata, device, progress))
+    return _swept_quantity("sky_view_factor", heights, options, max_error, error_estimate,
+                           _common(cell_size, z_scale, nodata, device, progress))
 
 
 def ambient_occlusion(heights, *, directions=64, azimuth_offset=0.0, samples_per_unit=1.0, curvature=0.0,
                       max_distance=0.0, method="sweep", azimuth_tolerance=None, strip_rows=0, memory_budget_bytes=0,
-                      cell_size=None, z_scale=1.0, nodata=None, device="", progress=None):
-    """Ambient occlusion under a uniform sky (Timonen & Westerholm 2010, Eq. 5), flat ground 1."""
+                      max_error=0.0, error_estimate=False, cell_size=None, z_scale=1.0, nodata=None, device="",
+                      progress=None):
+    """Ambient occlusion under a uniform sky (Timonen & Westerholm 2010, Eq. 5), flat ground 1.
+    max_error and error_estimate as sky_view_factor's."""
     options = _horizon(directions, azimuth_offset, samples_per_unit, curvature, max_distance, memory_budget_bytes,
                        method, azimuth_tolerance, strip_rows)
-    return _single("ambient_occlusion", "ambient_occlusion", heights, options,
-                   _common(cell_size, z_scale, nodata, device, progress))
+    return _swept_quantity("ambient_occlusion", heights, options, max_error, error_estimate,
+                           _common(cell_size, z_scale, nodata, device, progress))
+
+
+def _swept_quantity(operation, heights, options, max_error, error_estimate, common):
+    """The sky-view factor or occlusion; with max_error or error_estimate, the K run and the error
+    estimate too, as the CLI's --max-error and --error-out give them."""
+    if not max_error and not error_estimate:
+        return _single(operation, operation, heights, options, common)
+    if max_error:
+        options["max_error"] = float(max_error)
+    if error_estimate:
+        options["error_estimate"] = True
+    if _is_dataarray(heights) and _is_dask(heights.data):
+        heights = heights.compute()  # K and the estimate's percentile are the whole field's: in one piece
+    out, grid = _run(operation, heights, options, common)
+    if grid is None:
+        return ErrorEstimate(out[operation], out["error"], out["directions"], out["estimated_error"])
+    attrs = _attrs(operation, operation, dict(options, directions=out["directions"]), grid)
+    attrs["hfvis_estimated_error"] = out["estimated_error"]
+    values = grid.result(out[operation], operation, attrs)
+    if not error_estimate:
+        return values
+    import xarray as xr
+
+    error = grid.result(out["error"], "error", dict(_attrs(operation, "error", options, grid),
+                                                    hfvis_estimated_error=out["estimated_error"],
+                                                    hfvis_directions=out["directions"]))
+    return xr.Dataset({operation: values, "error": error})
 
 
 def intervisibility(heights, *, directions=64, azimuth_offset=0.0, samples_per_unit=1.0, curvature=0.0,
@@ -342,6 +421,142 @@ def environment_light(heights, environment, *, rotation_deg=0.0, table_rows=0, d
     attrs = _attrs("environment_light", "irradiance", options, grid)
     if len(channels) == 1:
         return grid.result(irradiance[0], "irradiance", attrs)
+    return grid.result(irradiance, "irradiance", attrs, leading=("channel", channels))
+
+
+def region_visibility(heights, sources, *, samples=16, height=2.0, absolute=False, target_height=0.0,
+                      method="culled", seed=1, decorrelate=False, max_distance=0.0, curvature=0.0, pixels=False,
+                      cell_size=None, z_scale=1.0, nodata=None, device=""):
+    """Which samples of a source region (an area light) every point sees, standing target_height
+    above the surface (after Eisemann & Decoret 2007). `sources`: a rectangle (col0, row0, col1,
+    row1) of grid points, corners inclusive, sampled `samples` times `height` above the surface
+    (absolute=True: at that height); or an N x 2 (col, row) or N x 3 (col, row, height) array of
+    points. A DataArray takes map coordinates (x0, y0, x1, y1) or (x, y[, height]) unless
+    pixels=True. numpy: RegionVisibility(fraction H x W, 0..1, NaN at nodata; bits ceil(S/32) x
+    H x W uint32, bit s % 32 of plane s // 32 for sample s); DataArray: a Dataset of the two.
+    Computed in one piece (a Dask array is computed first)."""
+    options = {"sources": sources, "samples": int(samples), "height": float(height), "absolute": bool(absolute),
+               "target_height": float(target_height), "method": method, "seed": int(seed),
+               "decorrelate": bool(decorrelate), "max_distance": float(max_distance), "curvature": float(curvature)}
+    if _is_dataarray(heights) and _is_dask(heights.data):
+        heights = heights.compute()  # the sources are shared by every point: the field in one piece
+    out, grid = _run("region_visibility", heights, options, _common(cell_size, z_scale, nodata, device, None, pixels))
+    if grid is None:
+        return RegionVisibility(out["fraction"], out["bits"])
+    import xarray as xr
+
+    fraction = grid.result(out["fraction"], "fraction", _attrs("region_visibility", "fraction", options, grid))
+    bits = grid.result(out["bits"], "bits", _attrs("region_visibility", "bits", options, grid),
+                       leading=("word", np.arange(out["bits"].shape[0])))
+    return xr.Dataset({"fraction": fraction, "bits": bits}, attrs={"hfvis_samples": out["samples"]})
+
+
+def region_pair_visibility(heights, sources, receivers, *, samples=16, source_height=2.0, receiver_height=2.0,
+                           absolute=False, method="culled", seed=1, decorrelate=False, max_distance=0.0,
+                           curvature=0.0, pixels=False, cell_size=None, z_scale=1.0, nodata=None, device=""):
+    """Visibility between two regions, each a rectangle or points as region_visibility's
+    `sources` (a rectangle sampled `samples` times): which source samples each receiver sample
+    sees. Returns RegionPairVisibility: bits (R x ceil(S/32) uint32, bit s % 32 of word s // 32),
+    sources and receivers (N x 3: col, row, absolute z-scaled height), source_fraction and
+    receiver_fraction (the share of the other region's samples each sees), clear_pairs, pairs,
+    visible_fraction, and sources_xy / receivers_xy (map coordinates of a georeferenced
+    DataArray, else None)."""
+    options = {"sources": sources, "receivers": receivers, "samples": int(samples),
+               "source_height": float(source_height), "receiver_height": float(receiver_height),
+               "absolute": bool(absolute), "method": method, "seed": int(seed), "decorrelate": bool(decorrelate),
+               "max_distance": float(max_distance), "curvature": float(curvature)}
+    if _is_dataarray(heights) and _is_dask(heights.data):
+        heights = heights.compute()
+    out, grid = _run("region_pair_visibility", heights, options,
+                     _common(cell_size, z_scale, nodata, device, None, pixels))
+
+    def xy(points):
+        if grid is None or grid.transform is None:
+            return None
+        return np.array([grid.map_position(c, r) for c, r, _ in points], dtype=np.float64).reshape(-1, 2)
+
+    pairs = int(out["pairs"])
+    return RegionPairVisibility(out["bits"], out["sources"], out["receivers"], out["source_fraction"],
+                                out["receiver_fraction"], int(out["clear_pairs"]), pairs,
+                                int(out["clear_pairs"]) / pairs if pairs else 0.0, xy(out["sources"]),
+                                xy(out["receivers"]))
+
+
+def pvs(heights, *, samples=0, pixel_error=0.0, seconds=0.0, view_cell=32, band_low=1.7, band_high=1.7, tile=16,
+        mask=None, method="agvs", batch=1 << 16, seed=1, resolution=1e6, filter=0.0, witnesses=False,
+        memory_budget_bytes=0, cell_size=None, z_scale=1.0, nodata=None, device="", progress=None):
+    """Potentially visible sets (Bittner, Mattausch, Wonka, Havran & Wimmer 2009): the tiles of
+    tile x tile cells each view cell of view_cell x view_cell cells (its volume band_low ..
+    band_high above the surface) sees, by sampling; stops at the first budget reached (samples,
+    pixel_error, seconds; one at least). mask: the view cells to compute, per view cell or per
+    pixel (as the CLI's --view-mask). method: "agvs", "sgvs", "per_cell". progress is called as
+    progress(samples, pixel_error) after each batch. Returns Pvs: sets (per view cell, row-major:
+    the visible tiles' row-major indices, None where not computed), bits (view cells x words
+    uint32), computed, layout (a dict of the grid's sizes), the run's counts, history (per
+    batch) and witnesses (with witnesses=True). DataArrays: the same (the sets are not on the
+    pixel grid); computed in one piece."""
+    options = {"samples": int(samples), "pixel_error": float(pixel_error), "seconds": float(seconds),
+               "view_cell": int(view_cell), "band_low": float(band_low), "band_high": float(band_high),
+               "tile": int(tile), "mask": None if mask is None else np.asarray(mask), "method": method,
+               "batch": int(batch), "seed": int(seed), "resolution": float(resolution), "filter": float(filter),
+               "witnesses": bool(witnesses), "memory_budget_bytes": int(memory_budget_bytes)}
+    if _is_dataarray(heights) and _is_dask(heights.data):
+        heights = heights.compute()
+    out, _ = _run("pvs", heights, options, _common(cell_size, z_scale, nodata, device, progress))
+    bits, computed = out["bits"], out["computed"]
+    tiles = out["layout"]["tiles_x"] * out["layout"]["tiles_y"]
+    sets = []
+    for v in range(len(computed)):
+        if not computed[v]:
+            sets.append(None)
+            continue
+        seen = np.unpackbits(bits[v].view(np.uint8), bitorder="little")[:tiles]
+        sets.append(np.nonzero(seen)[0])
+    return Pvs(sets, bits, computed.astype(bool), out["layout"], int(out["samples"]), int(out["rays"]),
+               int(out["entries"]), int(out["rejected"]), int(out["filtered"]), float(out["pixel_error"]),
+               float(out["seconds"]), list(out["history"]), out["witnesses"] if witnesses else None)
+
+
+def horizon_lists(heights, receivers, *, directions=64, azimuth_offset=0.0, samples_per_unit=1.0, curvature=0.0,
+                  pixels=False, cell_size=None, z_scale=1.0, nodata=None):
+    """The visibility horizons (Timonen 2013) of chosen receivers (an N x 2 array of pixels
+    (column, row), or map coordinates (x, y) for a DataArray unless pixels=True), computed on the
+    host: a list, per receiver, of dicts keyed as the CLI's JSON (`hfvis horizon-lists -o
+    OUT.json`'s "receivers"): col, row, height, nodata, directions (per direction k: azimuth_rad,
+    sample_spacing, ray_samples, visible_samples, horizons (nearest first: sample, distance,
+    elevation_rad, segment_begin, segment_end, near_distance, visible_samples))). The library's
+    lists take no maximum distance."""
+    options = {"receivers": receivers, "directions": int(directions), "azimuth_offset": float(azimuth_offset),
+               "samples_per_unit": float(samples_per_unit), "curvature": float(curvature)}
+    if _is_dataarray(heights) and _is_dask(heights.data):
+        heights = heights.compute()  # a few rays per receiver: the field in one piece
+    out, _ = _run("horizon_lists", heights, options, _common(cell_size, z_scale, nodata, "", None, pixels))
+    return list(out["lists"])
+
+
+def bounce(heights, radiance, *, directions=64, azimuth_offset=0.0, samples_per_unit=1.0, curvature=0.0,
+           memory_budget_bytes=0, cell_size=None, z_scale=1.0, nodata=None, device="", progress=None):
+    """The incident irradiance of one diffuse bounce of the exit radiance `radiance` (H x W, or C x
+    H x W for 1 to 4 channels; finite and >= 0 where the heights are valid) gathered over the
+    visible segments of each sweep line (Timonen 2013, Sec. 10.1). Returns the radiance's shape;
+    NaN at nodata. The library's bounce takes no maximum distance: a Dask array is computed in one
+    piece."""
+    options = {"directions": int(directions), "azimuth_offset": float(azimuth_offset),
+               "samples_per_unit": float(samples_per_unit), "curvature": float(curvature),
+               "memory_budget_bytes": int(memory_budget_bytes)}
+    if _is_dataarray(heights) and _is_dask(heights.data):
+        heights = heights.compute()
+    one_channel = np.ndim(radiance) == 2
+    options["radiance"] = np.asarray(radiance.values if _is_dataarray(radiance) else radiance)
+    out, grid = _run("bounce", heights, options, _common(cell_size, z_scale, nodata, device, progress))
+    irradiance = out["irradiance"]
+    if grid is None:
+        return irradiance[0] if one_channel else irradiance
+    attrs = _attrs("bounce", "irradiance", options, grid)
+    if one_channel:
+        return grid.result(irradiance[0], "irradiance", attrs)
+    channels = radiance[radiance.dims[0]].values if _is_dataarray(radiance) and radiance.dims[0] in radiance.coords \
+        else np.arange(irradiance.shape[0])
     return grid.result(irradiance, "irradiance", attrs, leading=("channel", channels))
 
 

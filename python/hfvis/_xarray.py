@@ -63,6 +63,22 @@ class Grid:
         t = self.transform
         return int(math.floor((x - t[0]) / t[1])), int(math.floor((y - t[3]) / t[5]))
 
+    def position(self, x, y):
+        """The pixel position (column, row; grid points at whole numbers, fractions between them)
+        of the map coordinates (x, y)."""
+        if self.transform is None:
+            raise InvalidArgumentError("positions as map coordinates need a DataArray with x / y coordinates or a "
+                                       "transform; give pixels (column, row) with pixels=True")
+        t = self.transform
+        return (x - t[0]) / t[1] - 0.5, (y - t[3]) / t[5] - 0.5
+
+    def map_position(self, col, row):
+        """The map coordinates (x, y) of a pixel position (column, row), None without a transform."""
+        if self.transform is None:
+            return None
+        t = self.transform
+        return t[0] + (col + 0.5) * t[1], t[3] + (row + 0.5) * t[5]
+
     def heights(self):
         return _arrays.heights_array(self.array.values, self.nodata)
 

@@ -23,7 +23,10 @@ namespace hfvis::python {
 namespace {
 
 using Heights = nb::ndarray<const float, nb::ndim<2>, nb::c_contig, nb::device::cpu>;
-using Array = nb::ndarray<nb::numpy, float>;
+using Planes = nb::ndarray<const float, nb::ndim<3>, nb::c_contig, nb::device::cpu>;
+template <typename T>
+using ArrayOf = nb::ndarray<nb::numpy, T>;
+using Array = ArrayOf<float>;
 
 // A context and the lock that keeps it to one operation at a time (ComputeContext's rule): the
 // threads of a process (Dask's threaded scheduler) share it in turn.
@@ -80,10 +83,11 @@ std::function<void(int, int)> progressHook(nb::handle callback) {
 }
 
 // A numpy array that owns `values` (no copy), of the given shape.
-Array toArray(std::vector<float>&& values, std::vector<size_t> shape) {
-  auto* owned = new std::vector<float>(std::move(values));
-  nb::capsule owner(owned, [](void* p) noexcept { delete static_cast<std::vector<float>*>(p); });
-  return Array(owned->data(), shape.size(), shape.data(), owner);
+template <typename T>
+ArrayOf<T> toArray(std::vector<T>&& values, std::vector<size_t> shape) {
+  auto* owned = new std::vector<T>(std::move(values));
+  nb::capsule owner(owned, [](void* p) noexcept { delete static_cast<std::vector<T>*>(p); });
+  return ArrayOf<T>(owned->data(), shape.size(), shape.data(), owner);
 }
 
 Array plane(std::vector<float>&& values, const HeightField& field) {
@@ -151,7 +155,8 @@ void bindOptions(nb::module_& m) {
       .def(nb::init<>())
       .def_rw("method", &HorizonOptions::method)
       .def_rw("azimuth_tolerance", &HorizonOptions::azimuth_tolerance)
-      .def_rw("strip_rows", &HorizonOptions::strip_rows);
+      .def_rw("strip_rows", &HorizonOptions::strip_rows)
+      .def_rw("max_error", &HorizonOptions::max_error);
   nb::enum_<IntervisibilityMethod>(m, "IntervisibilityMethod")
       .value("hull_tree", IntervisibilityMethod::HullTree)
       .value("naive", IntervisibilityMethod::Naive);
@@ -180,16 +185,53 @@ void bindOptions(nb::module_& m) {
       .def_rw("size_deg", &InsolationOptions::size_deg)
       .def_rw("azimuth_bucket_deg", &InsolationOptions::azimuth_bucket_deg)
       .def_rw("apparent", &InsolationOptions::apparent);
+  nb::class_<BounceOptions, SweepOptions>(m, "BounceOptions").def(nb::init<>());
+  nb::enum_<RegionVisibilityMethod>(m, "RegionVisibilityMethod")
+      .value("exact", RegionVisibilityMethod::Exact)
+      .value("viewsheds", RegionVisibilityMethod::Viewsheds)
+      .value("culled", RegionVisibilityMethod::Culled);
+  nb::class_<RegionVisibilityOptions>(m, "RegionVisibilityOptions")
+      .def(nb::init<>())
+      .def_rw("method", &RegionVisibilityOptions::method)
+      .def_rw("target_height", &RegionVisibilityOptions::target_height)
+      .def_rw("max_distance", &RegionVisibilityOptions::max_distance)
+      .def_rw("curvature", &RegionVisibilityOptions::curvature)
+      .def_rw("seed", &RegionVisibilityOptions::seed)
+      .def_rw("decorrelate", &RegionVisibilityOptions::decorrelate);
+  nb::enum_<PvsMethod>(m, "PvsMethod")
+      .value("agvs", PvsMethod::Agvs)
+      .value("sgvs", PvsMethod::Sgvs)
+      .value("per_cell", PvsMethod::PerCell);
+  nb::class_<PvsGrid>(m, "PvsGrid")
+      .def(nb::init<>())
+      .def_rw("view_cell", &PvsGrid::view_cell)
+      .def_rw("band_low", &PvsGrid::band_low)
+      .def_rw("band_high", &PvsGrid::band_high)
+      .def_rw("tile", &PvsGrid::tile)
+      .def_rw("mask", &PvsGrid::mask);
+  nb::class_<PvsOptions>(m, "PvsOptions")
+      .def(nb::init<>())
+      .def_rw("method", &PvsOptions::method)
+      .def_rw("samples", &PvsOptions::samples)
+      .def_rw("pixel_error", &PvsOptions::pixel_error)
+      .def_rw("seconds", &PvsOptions::seconds)
+      .def_rw("batch", &PvsOptions::batch)
+      .def_rw("seed", &PvsOptions::seed)
+      .def_rw("resolution", &PvsOptions::resolution)
+      .def_rw("filter", &PvsOptions::filter)
+      .def_rw("witnesses", &PvsOptions::witnesses)
+      .def_rw("memory_budget_bytes", &PvsOptions::memory_budget_bytes);
 }
 
 nb::dict horizons(const HeightField& field, HorizonOptions options, bool angles, bool distances,
-                  bool sky_view_factor, bool ambient_occlusion, const std::string& device,
-                  nb::object progress) {
+                  bool sky_view_factor, bool ambient_occlusion, bool error_estimate,
+                  const std::string& device, nb::object progress) {
   HorizonOutputs wanted;
   wanted.horizon_angles = angles;
   wanted.horizon_distances = distances;
   wanted.sky_view_factor = sky_view_factor;
   wanted.ambient_occlusion = ambient_occlusion;
+  wanted.error_estimate = error_estimate;
   options.progress = progressHook(progress);
   HorizonResult r =
       onDevice(device, [&](const ComputeContext& c) { return computeHorizons(c, field, options, wanted); });
@@ -199,6 +241,12 @@ nb::dict horizons(const HeightField& field, HorizonOptions options, bool angles,
   if (distances) out["distances"] = planes(std::move(r.distances), r.directions, field);
   if (sky_view_factor) out["sky_view_factor"] = plane(std::move(r.sky_view_factor), field);
   if (ambient_occlusion) out["ambient_occlusion"] = plane(std::move(r.ambient_occlusion), field);
+  // The K run (max_error chooses it) and, with an estimate, the estimate and its 99th percentile.
+  out["directions"] = r.directions;
+  if (!r.error_estimate.empty()) {
+    out["error"] = plane(std::move(r.error_estimate), field);
+    out["estimated_error"] = r.estimated_error;
+  }
   return out;
 }
 
@@ -295,6 +343,202 @@ nb::tuple environmentLight(const HeightField& field, const EnvironmentMap& map, 
   return nb::make_tuple(planes(std::move(r.irradiance), channels, field), r.names);
 }
 
+// A region's samples: the rectangle (inclusive corners) sampled `samples` times, or, when
+// `points` holds any, these points (column, row, height each).
+RegionSampling regionSampling(const std::array<int, 4>& rectangle,
+                              const std::vector<std::array<double, 3>>& points, int samples, double height,
+                              bool absolute) {
+  RegionSampling sampling;
+  sampling.rectangle = {rectangle[0], rectangle[1], rectangle[2], rectangle[3]};
+  sampling.samples = samples;
+  sampling.height = height;
+  sampling.absolute = absolute;
+  for (const auto& p : points) sampling.points.push_back({p[0], p[1], p[2]});
+  if (!points.empty()) sampling.samples = static_cast<int>(points.size());
+  return sampling;
+}
+
+// Sample positions as an N x 3 array: column, row, absolute (z-scaled) height.
+ArrayOf<double> regionPoints(const std::vector<RegionPoint>& points) {
+  std::vector<double> values;
+  for (const RegionPoint& p : points) values.insert(values.end(), {p.col, p.row, p.height});
+  return toArray(std::move(values), {points.size(), 3});
+}
+
+nb::dict regionVisibility(const HeightField& field, const RegionSampling& sources,
+                          const RegionVisibilityOptions& options, const std::string& device) {
+  validate(options);
+  validate(field, sources);
+  RegionVisibilityResult r = onDevice(
+      device, [&](const ComputeContext& c) { return computeRegionVisibility(c, field, sources, options); });
+  nb::dict out;
+  out["fraction"] = plane(std::move(r.fraction), field);
+  out["bits"] = toArray(std::move(r.bits), {size_t(field.height), size_t(field.width), size_t(r.words)});
+  out["samples"] = r.samples;
+  return out;
+}
+
+nb::dict regionPairVisibility(const HeightField& field, const RegionSampling& sources,
+                              const RegionSampling& receivers, const RegionVisibilityOptions& options,
+                              const std::string& device) {
+  validate(options);
+  validate(field, sources);
+  validate(field, receivers);
+  RegionPairVisibilityResult r = onDevice(device, [&](const ComputeContext& c) {
+    return computeRegionPairVisibility(c, field, sources, receivers, options);
+  });
+  nb::dict out;
+  out["bits"] = toArray(std::move(r.bits), {size_t(r.receiver_samples), size_t(r.words)});
+  out["sources"] = regionPoints(r.sources);
+  out["receivers"] = regionPoints(r.receivers);
+  out["source_fraction"] = toArray(std::move(r.source_fraction), {size_t(r.source_samples)});
+  out["receiver_fraction"] = toArray(std::move(r.receiver_fraction), {size_t(r.receiver_samples)});
+  out["clear_pairs"] = r.clear_pairs;
+  out["pairs"] = r.pairs;
+  return out;
+}
+
+// PVS progress: Ctrl-C and the user's callback, called as progress(samples, pixel_error); as
+// progressHook.
+std::function<void(std::uint64_t, double)> pvsProgressHook(nb::handle callback) {
+  PyObject* borrowed = callback.ptr();
+  return [borrowed](std::uint64_t samples, double pixel_error) {
+    nb::gil_scoped_acquire acquired;
+    if (PyErr_CheckSignals() != 0) throw nb::python_error();
+    const nb::handle user(borrowed);
+    if (!user.is_none()) user(samples, pixel_error);
+  };
+}
+
+nb::dict pvs(const HeightField& field, const PvsGrid& grid, PvsOptions options, const std::string& device,
+             nb::object progress) {
+  options.progress = pvsProgressHook(progress);
+  validate(options);
+  PvsResult r =
+      onDevice(device, [&](const ComputeContext& c) { return computePvs(c, field, grid, options); });
+  const PvsLayout& l = r.layout;
+  nb::dict layout;
+  for (const auto& [name, value] : {std::pair<const char*, int>{"view_x", l.view_x},
+                                    {"view_y", l.view_y},
+                                    {"tiles_x", l.tiles_x},
+                                    {"tiles_y", l.tiles_y},
+                                    {"cells_x", l.cells_x},
+                                    {"cells_y", l.cells_y},
+                                    {"view_cell", l.view_cell},
+                                    {"tile", l.tile}})
+    layout[name] = value;
+  nb::dict out;
+  out["layout"] = layout;
+  out["entries"] = r.entries();
+  out["bits"] = toArray(std::move(r.bits), {size_t(l.viewCells()), size_t(r.words)});
+  out["computed"] = toArray(std::move(r.computed), {size_t(l.viewCells())});
+  out["samples"] = r.samples;
+  out["rays"] = r.rays;
+  out["rejected"] = r.rejected;
+  out["filtered"] = r.filtered;
+  out["pixel_error"] = r.pixel_error;
+  out["seconds"] = r.seconds;
+  std::vector<int> view_cells, tiles;
+  std::vector<float> eyes, targets;
+  for (const PvsWitness& w : r.witnesses) {
+    view_cells.push_back(w.view_cell);
+    tiles.push_back(w.tile);
+    eyes.insert(eyes.end(), w.eye, w.eye + 3);
+    targets.insert(targets.end(), w.target, w.target + 3);
+  }
+  const size_t witnesses = r.witnesses.size();
+  nb::dict witness;
+  witness["view_cell"] = toArray(std::move(view_cells), {witnesses});
+  witness["tile"] = toArray(std::move(tiles), {witnesses});
+  witness["eye"] = toArray(std::move(eyes), {witnesses, 3});
+  witness["target"] = toArray(std::move(targets), {witnesses, 3});
+  out["witnesses"] = witness;
+  nb::list history;
+  for (const PvsProgress& p : r.history) {
+    nb::dict row;
+    row["samples"] = p.samples;
+    row["rays"] = p.rays;
+    row["entries"] = p.entries;
+    row["seconds"] = p.seconds;
+    row["pixel_error"] = p.pixel_error;
+    nb::dict mixture;
+    for (int d = 0; d < kPvsDistributions && d < int(p.probability.size()); ++d)
+      mixture[pvsDistributionName(d)] = p.probability[d];
+    row["mixture"] = mixture;
+    history.append(row);
+  }
+  out["history"] = history;
+  return out;
+}
+
+// The lists as the CLI's JSON holds them ("receivers"), key for key.
+nb::list horizonLists(const HeightField& field, const SweepOptions& options, const std::vector<int>& cols,
+                      const std::vector<int>& rows) {
+  if (cols.size() != rows.size()) throw InvalidArgument("the receivers' columns and rows differ in number");
+  std::vector<ReceiverPixel> receivers;
+  for (std::size_t i = 0; i < cols.size(); ++i) receivers.push_back({cols[i], rows[i]});
+  validateReceivers(field, receivers);
+  std::vector<ReceiverHorizons> lists = [&] {
+    nb::gil_scoped_release released;
+    return computeHorizonLists(field, options, receivers);
+  }();
+  nb::list out;
+  for (const ReceiverHorizons& receiver : lists) {
+    nb::list directions;
+    for (const DirectionHorizons& d : receiver.directions) {
+      nb::list horizons;
+      for (const VisibilityHorizon& z : d.horizons) {
+        nb::dict h;
+        h["sample"] = z.sample;
+        h["distance"] = z.distance;
+        h["elevation_rad"] = z.elevation;
+        h["segment_begin"] = z.segment_begin;
+        h["segment_end"] = z.segment_end;
+        h["near_distance"] = z.near_distance;
+        h["visible_samples"] = z.visible_samples;
+        horizons.append(h);
+      }
+      nb::dict direction;
+      direction["k"] = d.direction;
+      direction["azimuth_rad"] = d.azimuth;
+      direction["sample_spacing"] = d.sample_spacing;
+      direction["ray_samples"] = d.ray_samples;
+      direction["visible_samples"] = d.visible_samples;
+      direction["horizons"] = horizons;
+      directions.append(direction);
+    }
+    nb::dict r;
+    r["col"] = receiver.pixel.col;
+    r["row"] = receiver.pixel.row;
+    r["height"] = receiver.height;
+    r["nodata"] = receiver.nodata;
+    r["directions"] = directions;
+    out.append(r);
+  }
+  return out;
+}
+
+nb::dict bounce(const HeightField& field, Planes radiance, BounceOptions options, const std::string& device,
+                nb::object progress) {
+  ExitRadiance exit;
+  exit.width = static_cast<int>(radiance.shape(2));
+  exit.height = static_cast<int>(radiance.shape(1));
+  const std::size_t plane_size = radiance.shape(1) * radiance.shape(2);
+  for (std::size_t c = 0; c < radiance.shape(0); ++c)
+    exit.channels.emplace_back(radiance.data() + c * plane_size, radiance.data() + (c + 1) * plane_size);
+  validate(options);
+  validate(field, exit);
+  options.progress = progressHook(progress);
+  BounceResult r =
+      onDevice(device, [&](const ComputeContext& c) { return computeBounce(c, field, exit, options); });
+  std::vector<float> stacked;
+  for (auto& p : r.irradiance) stacked.insert(stacked.end(), p.begin(), p.end());
+  nb::dict out;
+  out["azimuths"] = r.azimuths;
+  out["irradiance"] = planes(std::move(stacked), static_cast<int>(r.irradiance.size()), field);
+  return out;
+}
+
 nb::list devices() {
   nb::list out;
   for (const DeviceInfo& d : listDevices()) {
@@ -369,7 +613,7 @@ NB_MODULE(_core, m) {
       "path"_a, "rotation_deg"_a, "table_rows"_a);
 
   m.def("horizons", &horizons, "field"_a, "options"_a, "angles"_a, "distances"_a, "sky_view_factor"_a,
-        "ambient_occlusion"_a, "device"_a, "progress"_a.none());
+        "ambient_occlusion"_a, "error_estimate"_a, "device"_a, "progress"_a.none());
   m.def("intervisibility", &intervisibility, "field"_a, "options"_a, "device"_a, "progress"_a.none());
   m.def("viewshed", &viewshed, "field"_a, "col"_a, "row"_a, "height"_a, "options"_a, "device"_a);
   m.def("cumulative_viewshed", &cumulativeViewshed, "field"_a, "cols"_a, "rows"_a, "heights"_a, "options"_a,
@@ -379,6 +623,14 @@ NB_MODULE(_core, m) {
   m.def("insolation", &insolation, "field"_a, "options"_a, "sweep"_a, "device"_a, "progress"_a.none());
   m.def("environment_light", &environmentLight, "field"_a, "map"_a, "options"_a, "device"_a,
         "progress"_a.none());
+  nb::class_<RegionSampling>(m, "RegionSampling");
+  m.def("region_sampling", &regionSampling, "rectangle"_a, "points"_a, "samples"_a, "height"_a, "absolute"_a);
+  m.def("region_visibility", &regionVisibility, "field"_a, "sources"_a, "options"_a, "device"_a);
+  m.def("region_pair_visibility", &regionPairVisibility, "field"_a, "sources"_a, "receivers"_a, "options"_a,
+        "device"_a);
+  m.def("pvs", &pvs, "field"_a, "grid"_a, "options"_a, "device"_a, "progress"_a.none());
+  m.def("horizon_lists", &horizonLists, "field"_a, "options"_a, "cols"_a, "rows"_a);
+  m.def("bounce", &bounce, "field"_a, "radiance"_a, "options"_a, "device"_a, "progress"_a.none());
   m.def(
       "sun_position",
       [](double utc, double latitude_deg, double longitude_deg, bool apparent) {

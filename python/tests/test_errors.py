@@ -46,6 +46,27 @@ def test_bad_heights(bad, kind, words):
     (lambda h: hfvis.insolation(h, 46, 8, "2026-06-22T00:00Z", "2026-06-21T00:00Z"), "forward"),
     (lambda h: hfvis.environment_light(h, np.ones((4, 5), np.float32)), "twice as wide"),
     (lambda h: hfvis.sun_position("yesterday", 46, 8), "ISO|time"),
+    (lambda h: hfvis.sky_view_factor(h, max_error=1e-9), "4096"),
+    (lambda h: hfvis.sky_view_factor(h, max_error=-0.1), "error"),
+    (lambda h: hfvis.region_visibility(h, (0, 0, 20, 3)), "outside"),
+    (lambda h: hfvis.region_visibility(h, (0, 0, 1.5, 3)), "integer"),
+    (lambda h: hfvis.region_visibility(h, (0, 0, 3, 3), samples=0), "samples"),
+    (lambda h: hfvis.region_visibility(h, (0, 0, 3, 3), samples=5000), "samples"),
+    (lambda h: hfvis.region_visibility(h, [(3.0, 30.0)]), "outside"),
+    (lambda h: hfvis.region_visibility(h, np.zeros((0, 2))), "rectangle"),
+    (lambda h: hfvis.region_visibility(h, (0, 0, 3, 3), method="bogus"), "method"),
+    (lambda h: hfvis.region_visibility(h, (0, 0, 3, 3), target_height=-1), "target height"),
+    (lambda h: hfvis.region_pair_visibility(h, (0, 0, 3, 3), (5, 5, 6, 6), method="viewsheds"), "viewsheds"),
+    (lambda h: hfvis.region_pair_visibility(h, (0, 0, 3, 3), (5, 5, 6, 60)), "outside"),
+    (lambda h: hfvis.pvs(h), "budget"),
+    (lambda h: hfvis.pvs(h, samples=100, view_cell=0), "view"),
+    (lambda h: hfvis.pvs(h, samples=100, mask=np.ones((3, 3))), "mask"),
+    (lambda h: hfvis.pvs(h, samples=100, method="best"), "method"),
+    (lambda h: hfvis.horizon_lists(h, [(20, 3)]), "outside"),
+    (lambda h: hfvis.horizon_lists(h, [(1.5, 3)]), "integer"),
+    (lambda h: hfvis.bounce(h, np.ones((4, 4), np.float32)), "one value per height"),
+    (lambda h: hfvis.bounce(h, -np.ones((24, 20), np.float32)), "radiance"),
+    (lambda h: hfvis.bounce(h, np.ones((5, 24, 20), np.float32)), "channel"),
 ])
 def test_bad_arguments_are_value_errors(small, call, words):
     before = small.copy()
@@ -53,6 +74,17 @@ def test_bad_arguments_are_value_errors(small, call, words):
         call(small)
     assert isinstance(caught.value, hfvis.InvalidArgumentError)
     np.testing.assert_array_equal(small, before)
+
+
+def test_region_over_nodata_and_wrong_types(small):
+    holed = small.copy()
+    holed[2, 2] = np.nan
+    with pytest.raises(hfvis.InvalidArgumentError, match="nodata"):
+        hfvis.region_visibility(holed, (0, 0, 3, 3))
+    with pytest.raises(hfvis.InputTypeError, match="radiance"):
+        hfvis.bounce(small, np.ones((24, 20), complex))
+    with pytest.raises(hfvis.InputTypeError, match="real numbers"):
+        hfvis.region_visibility(small.astype(complex), (0, 0, 3, 3))
 
 
 def test_files_are_os_errors(tmp_path, small):

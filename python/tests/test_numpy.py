@@ -130,3 +130,159 @@ def test_devices_and_context_reuse():
     equal(hfvis.sky_view_factor(small, directions=8, device="cpu"), first)
     with pytest.raises(hfvis.NoDeviceError):
         hfvis.sky_view_factor(small, device="no such device")
+
+
+def test_sky_view_factor_and_ambient_occlusion_with_max_error(tmp_path, projected_tif, dem):
+    """max_error=E chooses K as the CLI's --max-error does; error_estimate gives its --error-out."""
+    import rasterio
+
+    error_tif = tmp_path / "error.tif"
+    (svf,), _ = cli(tmp_path, projected_tif, "sky-view-factor", "--max-error", "0.01", "--max-distance", "900",
+                    "--error-out", error_tif)
+    ours = hfvis.sky_view_factor(dem, max_error=0.01, error_estimate=True, max_distance=900, cell_size=30,
+                                 nodata=NODATA)
+    assert isinstance(ours, hfvis.ErrorEstimate)
+    equal(ours.values, svf)
+    (error,), _ = read_bands(error_tif)
+    equal(ours.error, error)
+    with rasterio.open(error_tif) as f:
+        tags = f.tags()
+    assert int(tags["hfvis_directions"]) == ours.directions and ours.directions > 16
+    assert float(tags["hfvis_estimated_error"]) == float(f"{ours.estimated_error:.10g}") <= 0.01
+    (ao,), _ = cli(tmp_path, projected_tif, "ambient-occlusion", "--max-error", "0.02", "--max-distance", "900")
+    r = hfvis.ambient_occlusion(dem, max_error=0.02, max_distance=900, cell_size=30, nodata=NODATA)
+    equal(r.values, ao)
+    assert r.estimated_error <= 0.02 and r.error.shape == dem.shape
+    # Without max_error, error_estimate keeps the K given (the values are the CLI's with --error-out,
+    # whose run sums the even and odd directions apart: they may differ from a run without by an ulp).
+    (svf,), _ = cli(tmp_path, projected_tif, "sky-view-factor", "-k", "8", "--max-distance", "600",
+                    "--error-out", error_tif)
+    fixed = hfvis.sky_view_factor(dem, directions=8, error_estimate=True, max_distance=600, cell_size=30,
+                                  nodata=NODATA)
+    assert fixed.directions == 8
+    equal(fixed.values, svf)
+    equal(fixed.error, read_bands(error_tif)[0][0])
+
+
+def mask_channels(bits, samples):
+    """The CLI's --masks channels (16 samples each, as whole numbers) from (words, H, W) bits."""
+    channels = (samples + 15) // 16
+    planes = [(bits[k // 2] >> (16 * (k % 2))) & 0xFFFF for k in range(channels)]
+    return np.stack(planes).astype(np.float32)
+
+
+def test_region_visibility(tmp_path, projected_tif, dem):
+    masks_tif = tmp_path / "masks.tif"
+    (fraction,), _ = cli(tmp_path, projected_tif, "arealight", "--light", "200,170,206,175", "--light-height",
+                         "10", "--samples", "40", "--max-distance", "3000", "--masks", masks_tif)
+    r = hfvis.region_visibility(dem, (200, 170, 206, 175), samples=40, height=10, max_distance=3000, cell_size=30,
+                                nodata=NODATA)
+    assert r.fraction.dtype == np.float32 and r.bits.dtype == np.uint32 and r.bits.shape == (2,) + dem.shape
+    assert np.isnan(r.fraction[100, 150]) and 0 < np.nanmean(r.fraction) < 1
+    equal(r.fraction, fraction)
+    masks, names = read_bands(masks_tif)
+    assert names == ["m000", "m001", "m002"]
+    holes = np.isnan(r.fraction)
+    ours = mask_channels(r.bits, 40)
+    ours[:, holes] = np.nan
+    equal(ours, masks)
+    # The bits and the fraction agree: the popcount over S.
+    counts = np.unpackbits(np.moveaxis(r.bits, 0, -1).copy().view(np.uint8), axis=-1).sum(axis=-1)
+    np.testing.assert_array_equal((counts[~holes] / 40).astype(np.float32), r.fraction[~holes])
+    # Points (a CSV of the CLI's --sources), exact and decorrelated jitter.
+    sources = tmp_path / "sources.csv"
+    sources.write_text("col,row,height\n10,20,5\n300.5,200.25,12\n150,160\n")
+    (fraction,), _ = cli(tmp_path, projected_tif, "arealight", "--sources", sources, "--light-height", "3",
+                         "--method", "exact", "--target-height", "1.5")
+    points = np.array([[10, 20, 5], [300.5, 200.25, 12], [150, 160, 3]])
+    r = hfvis.region_visibility(dem, points, method="exact", target_height=1.5, cell_size=30, nodata=NODATA)
+    equal(r.fraction, fraction)
+    (fraction,), _ = cli(tmp_path, projected_tif, "arealight", "--light", "20,30,60,40", "--decorrelate",
+                         "--seed", "7", "--samples", "8", "--absolute", "--light-height", "900",
+                         "--max-distance", "2000")
+    r = hfvis.region_visibility(dem, (20, 30, 60, 40), decorrelate=True, seed=7, samples=8, absolute=True,
+                                height=900, max_distance=2000, cell_size=30, nodata=NODATA)
+    equal(r.fraction, fraction)
+
+
+def test_region_pair_visibility(tmp_path, projected_tif, dem):
+    import json
+
+    out, rays = tmp_path / "pair.json", tmp_path / "rays.csv"
+    run_cli("region", projected_tif, "--from", "200,170,210,180", "--to", "215,170,225,180", "-o", out, "--rays", rays,
+            "--samples", "24", "--from-height", "10", "--to-height", "3")
+    printed = json.loads(out.read_text())
+    r = hfvis.region_pair_visibility(dem, (200, 170, 210, 180), (215, 170, 225, 180), samples=24, source_height=10,
+                                     receiver_height=3, cell_size=30, nodata=NODATA)
+    assert (r.pairs, r.clear_pairs) == (printed["pairs"], printed["clear_pairs"]) and 0 < r.clear_pairs < r.pairs
+    assert r.visible_fraction == printed["visible_fraction"]
+    assert r.bits.shape == (24, 1) and r.sources.shape == (24, 3) and r.sources_xy is None
+
+    def text(value):  # the CLI's numbers: 10 significant digits
+        return f"{value:.10g}"
+
+    for samples, fractions, key in ((r.sources, r.source_fraction, "from_samples"),
+                                    (r.receivers, r.receiver_fraction, "to_samples")):
+        assert [[text(p["col"]), text(p["row"]), text(p["height"]), text(p["visible_fraction"])]
+                for p in printed[key]] == [[text(v) for v in (*p, f)] for p, f in zip(samples, fractions)]
+    clear = {",".join(line.split(",")[:6]) for line in rays.read_text().splitlines()[1:]}  # pixels, not map x, y
+    ours = {",".join(text(v) for v in (*r.sources[s], *r.receivers[t]))
+            for t in range(24) for s in range(24) if (r.bits[t, s // 32] >> (s % 32)) & 1}
+    assert ours == clear
+
+
+def test_pvs(tmp_path, projected_tif, dem):
+    import json
+
+    out, bitset = tmp_path / "pvs.json", tmp_path / "pvs.bin"
+    run_cli("pvs", projected_tif, "-o", out, "--bitset", bitset, "--samples", "30000", "--view-cell", "48",
+            "--tile", "32", "--view-height", "2,20", "--seed", "5")
+    printed = json.loads(out.read_text())
+    calls = []
+    r = hfvis.pvs(dem, samples=30000, view_cell=48, tile=32, band_low=2, band_high=20, seed=5, cell_size=30,
+                  nodata=NODATA, progress=lambda samples, error: calls.append(samples))
+    assert r.samples == printed["samples"] and r.rays == printed["rays"] and r.entries == printed["entries"]
+    assert r.layout["view_x"] == printed["view_cells"]["across"] and r.layout["tiles_y"] == printed["tiles"]["down"]
+    assert [None if s is None else s.tolist() for s in r.sets] == printed["pvs"]
+    assert r.entries > 0 and calls and calls[-1] == r.samples
+    words = np.frombuffer(bitset.read_bytes(), "<u4")
+    np.testing.assert_array_equal(words[-r.bits.size:], r.bits.ravel())
+    # A mask per pixel, as the CLI's --view-mask: only the view cells it touches are computed.
+    mask = np.zeros(dem.shape, np.float32)
+    mask[10, 10] = mask[300, 390] = 1
+    r = hfvis.pvs(dem, samples=5000, view_cell=48, tile=32, mask=mask, cell_size=30, nodata=NODATA)
+    assert r.computed.sum() == 2 and r.sets[0] is not None and r.sets[1] is None
+
+
+def test_horizon_lists(tmp_path, projected_tif, dem):
+    import json
+
+    out = tmp_path / "lists.json"
+    run_cli("horizon-lists", projected_tif, "--at", "200,170", "--at", "150,100", "--at", "0,0", "-k", "8",
+            "--samples-per-unit", "2", "-o", out)
+    printed = json.loads(out.read_text())["receivers"]
+    ours = hfvis.horizon_lists(dem, [(200, 170), (150, 100), (0, 0)], directions=8, samples_per_unit=2,
+                               cell_size=30, nodata=NODATA)
+    assert ours[1]["nodata"] and ours[2]["nodata"] and not ours[0]["nodata"]
+    for receiver in ours + printed:  # heights: float32, the JSON's shortest text of it (NaN: null)
+        receiver["height"] = None if receiver["height"] is None or np.isnan(receiver["height"]) else \
+            np.float32(receiver["height"])
+    assert ours == printed
+    assert sum(len(d["horizons"]) for d in ours[0]["directions"]) > 8
+
+
+def test_bounce(tmp_path, projected_tif, dem):
+    import rasterio
+
+    heights = np.where(dem == NODATA, np.nan, dem)
+    radiance = np.stack([np.nan_to_num((heights - np.nanmin(heights)) / 100.0), np.full(dem.shape, 0.5)])
+    radiance = radiance.astype(np.float32)
+    with rasterio.open(projected_tif) as f:
+        profile = dict(f.profile, count=2, nodata=None)
+    with rasterio.open(tmp_path / "radiance.tif", "w", **profile) as f:
+        f.write(radiance)
+    irradiance, _ = cli(tmp_path, projected_tif, "bounce", "--radiance", tmp_path / "radiance.tif", "-k", "8")
+    ours = hfvis.bounce(dem, radiance, directions=8, cell_size=30, nodata=NODATA)
+    assert ours.shape == (2,) + dem.shape and np.isnan(ours[0, 100, 150])
+    equal(ours, irradiance)
+    equal(hfvis.bounce(dem, radiance[1], directions=8, cell_size=30, nodata=NODATA), irradiance[1])

@@ -92,3 +92,59 @@ def test_south_up_grid_is_lit_as_the_cli(tmp_path, jacksboro):
     equal(hfvis.viewshed(dem, (x, y), azimuth_from_deg=90, azimuth_to_deg=200), seen)
     equal(hfvis.viewshed(dem, (200, 170), pixels=True, azimuth_from_deg=90, azimuth_to_deg=200), seen)
     assert hfvis.cumulative_viewshed(dem, [(x, y)], azimuth_from_deg=90, azimuth_to_deg=200).dims == ("y", "x")
+
+
+def test_region_visibility_and_pairs_take_map_coordinates(projected_tif):
+    dem = rioxarray.open_rasterio(projected_tif)
+    plain = dem.squeeze("band", drop=True).values
+    x0, y0, x1, y1 = float(dem.x[200]), float(dem.y[170]), float(dem.x[206]), float(dem.y[175])
+    lit = hfvis.region_visibility(dem, (x0, y0, x1, y1), samples=40, height=10, max_distance=3000)
+    ours = hfvis.region_visibility(plain, (200, 170, 206, 175), samples=40, height=10, max_distance=3000,
+                                   cell_size=30, nodata=-9999.0)
+    assert isinstance(lit, xr.Dataset) and set(lit) == {"fraction", "bits"} and lit.attrs["hfvis_samples"] == 40
+    assert lit.fraction.dims == ("y", "x") and lit.bits.dims == ("word", "y", "x")
+    assert lit.fraction.rio.crs == dem.rio.crs and lit.bits.rio.crs == dem.rio.crs
+    assert lit.fraction.attrs["hfvis_method"] == "culled" and lit.fraction.attrs["hfvis_height"] == 10.0
+    np.testing.assert_array_equal(lit.x, dem.x)
+    equal(lit.fraction, ours.fraction)
+    np.testing.assert_array_equal(lit.bits.values, ours.bits)
+    # A point between pixel centres, as map coordinates, and pixels=True.
+    x, y = float(dem.x[100]) + 7.5, float(dem.y[50]) - 15.0
+    a = hfvis.region_visibility(dem, [(x, y, 5.0)], max_distance=2000)
+    b = hfvis.region_visibility(plain, [(100.25, 50.5, 5.0)], max_distance=2000, cell_size=30, nodata=-9999.0)
+    equal(a.fraction, b.fraction)
+    c = hfvis.region_visibility(dem, (200, 170, 206, 175), pixels=True, samples=40, height=10, max_distance=3000)
+    equal(c.fraction, ours.fraction)
+    pair = hfvis.region_pair_visibility(dem, (x0, y0, x1, y1), [(x, y)], samples=8)
+    assert pair.receivers_xy.tolist() == [[x, y]] and pair.sources_xy.shape == (8, 2)
+    np.testing.assert_allclose(pair.receivers[0, :2], (100.25, 50.5))
+
+
+def test_max_error_on_dataarrays(projected_tif):
+    dem = rioxarray.open_rasterio(projected_tif)
+    svf = hfvis.sky_view_factor(dem, max_error=0.01, max_distance=900)
+    numpy_run = hfvis.sky_view_factor(dem.squeeze("band", drop=True).values, max_error=0.01, max_distance=900,
+                                      cell_size=30, nodata=-9999.0)
+    equal(svf, numpy_run.values)
+    assert svf.attrs["hfvis_directions"] == numpy_run.directions and svf.attrs["hfvis_max_error"] == 0.01
+    assert svf.attrs["hfvis_estimated_error"] == numpy_run.estimated_error <= 0.01
+    both = hfvis.ambient_occlusion(dem.chunk(100), max_error=0.02, error_estimate=True, max_distance=900)
+    assert isinstance(both, xr.Dataset) and set(both) == {"ambient_occlusion", "error"}
+    assert both.error.rio.crs == dem.rio.crs and both.error.attrs["hfvis_directions"] > 16
+    equal(both.ambient_occlusion, hfvis.ambient_occlusion(dem, max_error=0.02, max_distance=900))
+
+
+def test_pvs_horizon_lists_and_bounce_on_dataarrays(projected_tif):
+    dem = rioxarray.open_rasterio(projected_tif)
+    plain = dem.squeeze("band", drop=True).values
+    a = hfvis.pvs(dem.chunk(128), samples=5000, view_cell=64, tile=64)
+    b = hfvis.pvs(plain, samples=5000, view_cell=64, tile=64, cell_size=30, nodata=-9999.0)
+    assert [s.tolist() for s in a.sets] == [s.tolist() for s in b.sets] and a.entries == b.entries > 0
+    x, y = float(dem.x[200]), float(dem.y[170])
+    assert hfvis.horizon_lists(dem, [(x, y)], directions=4) == \
+        hfvis.horizon_lists(plain, [(200, 170)], directions=4, cell_size=30, nodata=-9999.0)
+    radiance = xr.full_like(dem.squeeze("band", drop=True), 1.0, dtype=np.float32)
+    lit = hfvis.bounce(dem, radiance, directions=4)
+    assert lit.dims == ("y", "x") and lit.rio.crs == dem.rio.crs and lit.attrs["hfvis_method"] == "tree"
+    assert "re-emits" in lit.attrs["units"]
+    equal(lit, hfvis.bounce(plain, np.ones(plain.shape, np.float32), directions=4, cell_size=30, nodata=-9999.0))
