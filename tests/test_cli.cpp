@@ -720,6 +720,38 @@ TEST_F(Cli, MaxErrorWritesTheChosenKAndTheEstimate) {
                 1, "directions");
 }
 
+// --error-out with -k (no --max-error): the estimate at the K given, as the library's run asking for
+// it (it once wrote nothing: the CLI never asked the library for the estimate).
+TEST_F(Cli, ErrorOutWithAFixedKWritesTheEstimate) {
+  const std::string field = writeField("bumps.exr", 40, 33, [](int col, int row) {
+    return 3.0f * std::sin(0.7f * col) * std::cos(0.5f * row) + ((col / 5 + row / 4) % 3 == 0 ? 4.0f : 0.0f);
+  });
+  for (const char* command : {"svf", "ao"}) {
+    const CliResult r = run(std::string(command) + " " + shellQuoted(field) + " -o " +
+                            shellQuoted(out("s.exr")) + " -k 8 --error-out " + shellQuoted(out("e.exr")));
+    ASSERT_EQ(r.status, 0) << r.err;
+    hfvis::HorizonOptions options;
+    options.directions = 8;
+    hfvis::HorizonOutputs wanted;
+    (command == std::string("svf") ? wanted.sky_view_factor : wanted.ambient_occlusion) = true;
+    wanted.error_estimate = true;
+    const hfvis::HorizonResult lib =
+        hfvis::computeHorizons(hfvis::testing::testContext(), hfvis::readHeightField(field), options, wanted);
+    const std::vector<float>& values = wanted.sky_view_factor ? lib.sky_view_factor : lib.ambient_occlusion;
+    const ReadBack quantity = readBack(out("s.exr")), estimate = readBack(out("e.exr"));
+    ASSERT_EQ(estimate.channels, (std::vector<std::string>{"error"}));
+    ASSERT_EQ(quantity.pixels.size(), values.size());
+    ASSERT_EQ(estimate.pixels.size(), lib.error_estimate.size());
+    for (std::size_t p = 0; p < values.size(); ++p) {
+      ASSERT_EQ(quantity.pixels[p], values[p]) << command << " " << p;
+      ASSERT_EQ(estimate.pixels[p], lib.error_estimate[p]) << command << " " << p;
+    }
+    EXPECT_EQ(estimate.spec.get_string_attribute("hfvis:directions"), "8");
+    fs::remove(out("s.exr"));
+    fs::remove(out("e.exr"));
+  }
+}
+
 TEST_F(Cli, HorizonWritesOneChannelPerDirection) {
   const CliResult result = run("horizon " + shellQuoted(ramp()) + " -o " + shellQuoted(out("h.exr")) +
                                " -k 8" + " --distance-out " + shellQuoted(out("d.exr")));

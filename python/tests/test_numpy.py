@@ -250,8 +250,14 @@ def test_pvs(tmp_path, projected_tif, dem):
     # A mask per pixel, as the CLI's --view-mask: only the view cells it touches are computed.
     mask = np.zeros(dem.shape, np.float32)
     mask[10, 10] = mask[300, 390] = 1
-    r = hfvis.pvs(dem, samples=5000, view_cell=48, tile=32, mask=mask, cell_size=30, nodata=NODATA)
+    r = hfvis.pvs(dem, samples=5000, view_cell=48, tile=32, mask=mask, witnesses=True, cell_size=30, nodata=NODATA)
     assert r.computed.sum() == 2 and r.sets[0] is not None and r.sets[1] is None
+    # One witness per sampled entry, in the view cell and tile it stands for (eyes in pixels).
+    w = r.witnesses
+    assert len(w["view_cell"]) == r.entries - r.filtered > 0 and w["eye"].shape == (len(w["tile"]), 3)
+    for v, t, eye in zip(w["view_cell"], w["tile"], w["eye"]):
+        assert t in r.sets[v] and (int(eye[0]) // 48, int(eye[1]) // 48) == (v % r.layout["view_x"],
+                                                                            v // r.layout["view_x"])
 
 
 def test_horizon_lists(tmp_path, projected_tif, dem):
