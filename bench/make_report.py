@@ -1539,7 +1539,7 @@ def main(argv=None):
                   % env.get("mode", "?"), "", table(["target", "measured", "verdict"], targets25), "",
                   "Item 1 for the hull tree (counts, area, the bounce): each interval's peak between two samples "
                   "enters the tree as an occluder alone; its accuracy and cost: [tree_peaks.md](tree_peaks.md) "
-                  "(not yet on latitude / longitude grids nor for the horizon lists).", ""]
+                  "(not yet for the horizon lists).", ""]
 
     with open(os.path.join(d, "REPORT.md"), "w") as f:
         f.write("\n".join(out) + "\n")

@@ -39,10 +39,6 @@
 //   HFVIS_STRIPS            intervisibility_lattice sweeps the receivers of one strip of rows
 //                           and resumes each line where the strip before left it (a field in
 //                           strips; not with the bounce)
-//   HFVIS_TREE_PEAKS        between consecutive samples, the surface's highest point where it
-//                           rises above both (kernels/shared/tree_peaks.cl) enters the tree as an
-//                           occluder alone: two slots per step, positions in fixed point
-//                           (position_shift bits below the step); not with per-row spacing
 // Every combination builds the same trees (tests/test_intervisibility.cpp): the options
 // change the work (iterations t, memory traffic), never a result.
 #include "shared/chord_side.cl"
@@ -95,12 +91,6 @@
 #if HFVIS_STRIPS && HFVIS_WANT_BOUNCE
 #error "the bounce reads the radiance of every earlier sample: it needs the whole field"
 #endif
-#ifndef HFVIS_TREE_PEAKS
-#define HFVIS_TREE_PEAKS 0
-#endif
-#if HFVIS_TREE_PEAKS && HFVIS_ROW_SPACING
-#error "the peaks' fixed-point positions do not take per-row spacing"
-#endif
 // Statistics need every sample's horizons (Table 2 and Section 6's bound count them all);
 // otherwise only receivers (pixel centres) read theirs.
 #define HFVIS_ALL_HORIZONS (HFVIS_WANT_STATS || HFVIS_WANT_ENTRY_STATS)
@@ -139,20 +129,16 @@
 
 #define HFVIS_LEAF 1  // bit 0 of node.y
 
-// Tree slots. With peaks a line has two per step: 2 s for the peak between steps s - 1 and s
-// (an occluder alone; most are never inserted), 2 s + 1 for step s's sample; without, slot s
-// is step s. SAMPLE_OF: the step of a slot's sample or peak; SLOT_OF: a step's sample.
-#if HFVIS_TREE_PEAKS
+// Tree slots. Between consecutive samples, the surface's highest point above their chord
+// (kernels/shared/tree_peaks.cl) enters the tree as an occluder alone, so a line has two slots
+// per step: 2 s for the peak between steps s - 1 and s (most are never inserted), 2 s + 1 for
+// step s's sample. Positions are then fixed point: position_shift bits below the step, or with
+// per-row spacing the step's whole units of ground length. SAMPLE_OF: the step of a slot's
+// sample or peak; SLOT_OF: a step's sample.
 #define SAMPLE_OF(slot) ((slot) >> 1)
 #define IS_SAMPLE(slot) ((slot)&1)
 #define SLOT_OF(step) (2 * (step) + 1)
 #define PEAK_SLOT(step) (2 * (step))
-#else
-#define SAMPLE_OF(slot) (slot)
-#define IS_SAMPLE(slot) 1
-#define SLOT_OF(step) (step)
-#define PEAK_SLOT(step) (step)
-#endif
 
 // One piece of an interval between two samples inside one cell (src/core/lattice_geometry.hpp,
 // TreePiece): ten 4-byte members, read field by field.
@@ -163,7 +149,7 @@ typedef struct {
 } TreePiece;
 
 // The position of step k's sample (its positions[] from the line's first entry): the step in
-// units of 2^-shift step (shift 0 without peaks), or with per-row spacing its units (whole
+// units of 2^-shift step, or with per-row spacing its units (whole
 // numbers below 2^24: exact in a float, and so are their differences).
 HFVIS_INLINE float sample_position(__global const int2* positions, uint stride, int shift, int k) {
 #if HFVIS_ROW_SPACING
@@ -176,18 +162,14 @@ HFVIS_INLINE float sample_position(__global const int2* positions, uint stride, 
 // The position of the node in `slot`: a peak's node keeps its position in place of a rank
 // (node.y = position * 2 + leaf flag).
 HFVIS_INLINE float node_position(__global const int2* positions, uint stride, int shift, int slot, int4 node) {
-#if HFVIS_TREE_PEAKS
   if (!IS_SAMPLE(slot)) return (float)(node.y >> 1);
-#endif
   return sample_position(positions, stride, shift, SAMPLE_OF(slot));
 }
 
 // The rank of the node in `slot` (present samples before it): a peak's is that of the sample
 // after it, which shares its rank.
 HFVIS_INLINE int node_rank(__global const int4* tree, uint stride, int slot, int4 node) {
-#if HFVIS_TREE_PEAKS
   if (!IS_SAMPLE(slot)) return tree[(uint)(slot | 1) * stride].y >> 1;
-#endif
   return node.y >> 1;
 }
 
@@ -527,13 +509,18 @@ __kernel void intervisibility_lattice(
       const float d_sample = p_sample * inv_scale;
       h_sample = h_sample - drop * d_sample * d_sample;
 #endif
-#if HFVIS_TREE_PEAKS
       // The peak between the step before and this one: of the interval's crossings and concave
       // pieces, the point that stands farthest above the chord of its two samples, where it
       // stands strictly above it.
       float h_peak = NAN;
       int peak_position = 0;
-      if (step > 0 && !isnan(h_sample_prev) && !isnan(h_sample)) {
+#if HFVIS_ROW_SPACING
+      // The step's whole units are its positions (a peak needs one strictly inside).
+      const int step_scale = units, position_far = position - units;
+#else
+      const int step_scale = 1 << position_shift, position_far = (step - 1) << position_shift;
+#endif
+      if (step > 0 && step_scale > 1 && !isnan(h_sample_prev) && !isnan(h_sample)) {
         float best_h = -INFINITY, best_excess = 0.0f;
         int offset = 0;
         TreePieceCurve curve;  // the piece before (set by the first piece, which has no crossing)
@@ -542,7 +529,7 @@ __kernel void intervisibility_lattice(
         // The candidates are points of the surface before the drop (theirs comes after): so is
         // the chord they are measured against, else the drop's growth along the interval (2 drop
         // step per step) would favour the near end's candidates far out on a line.
-        const float d_far = (float)((step - 1) << position_shift) * inv_scale;
+        const float d_far = (float)position_far * inv_scale;
         chord_far = h_sample_prev + drop * d_far * d_far;
         rise = (h_sample + drop * d_sample * d_sample) - chord_far;
 #endif
@@ -556,32 +543,25 @@ __kernel void intervisibility_lattice(
           const uint at = (uint)((py - row0) * width + px);
           tree_piece_peak(heights[at], heights[at + 1], heights[at + (uint)width],
                           heights[at + (uint)width + 1], g->fx, g->fy, g->dx, g->dy, g->t_far, g->t_near,
-                          g->inv_span, g->far_crossing, chord_far, rise, position_shift, &curve, &best_h,
+                          g->inv_span, g->far_crossing, chord_far, rise, step_scale, &curve, &best_h,
                           &offset, &best_excess);
         }
         if (best_h > -INFINITY) {  // (not NaN)
-          peak_position = ((step - 1) << position_shift) + offset;
+          peak_position = position_far + offset;
 #if HFVIS_CURVATURE
           const float d_peak = (float)peak_position * inv_scale;
           best_h = best_h - drop * d_peak * d_peak;
 #endif
-          if (tree_peak_inserted(h_sample_prev, best_h, h_sample, offset, position_shift)) h_peak = best_h;
+          if (tree_peak_inserted(h_sample_prev, best_h, h_sample, offset, step_scale)) h_peak = best_h;
         }
       }
-#endif
       uint t = 0, skipped = 0;  // the step's convexity checks and skipped walks, its peak's included
       // The step's nodes: its peak (where there is one), then its sample.
-#if HFVIS_TREE_PEAKS
       for (int part = 0; part < 2; ++part) {
         const int is_peak = part == 0, slot = 2 * step + part;
         const float h = is_peak ? h_peak : h_sample;
         const float p = is_peak ? (float)peak_position : p_sample;
         if (is_peak && isnan(h)) continue;
-#else
-      for (int part = 1; part < 2; ++part) {
-        const int is_peak = 0, slot = step, peak_position = 0;
-        const float h = h_sample, p = p_sample;
-#endif
       const uint e = (uint)slot * stride;
       const int receiver = !is_peak && q == n_samples - 1;
       if (!is_peak) {
@@ -793,10 +773,14 @@ __kernel void intervisibility_lattice(
 #if HFVIS_ROW_SPACING
             // Sum of (position - x's) * x's units over the counted present samples x (the
             // sums at `step` are those before it, written above).
+            // Positions are per step, the sums per sample slot: the counted samples are steps
+            // SAMPLE_OF(first) .. SAMPLE_OF(end) - 1 (a peak's step is that of the sample after it).
             if (run > 0) {
-              const uint units_run = (uint)line_positions[(uint)end * stride].y - (uint)line_positions[(uint)first * stride].y;
+              const uint s_first = (uint)SAMPLE_OF(first), s_end = (uint)SAMPLE_OF(end);
+              const uint units_run =
+                  (uint)line_positions[s_end * stride].y - (uint)line_positions[s_first * stride].y;
               distance_sum += (ulong)position * (ulong)units_run -
-                              (prefix[base + (uint)end * stride] - prefix[base + (uint)first * stride]);
+                              (prefix[base + (uint)SLOT_OF(s_end) * stride] - prefix[base + (uint)SLOT_OF(s_first) * stride]);
             }
 #else
             ulong steps_sum = 0;

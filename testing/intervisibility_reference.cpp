@@ -32,6 +32,17 @@ struct PixelSums {
   }
 };
 
+// The position of entry e's step along its line, as intervisibility_lattice counts it: the
+// step << position_shift, or with per-row spacing its units; and the positions of the step
+// into it (a peak's offset lies strictly inside).
+std::int32_t stepPosition(const TreeDirection& d, const IntervisibilityLines& lines, std::size_t e) {
+  return lines.positions.empty() ? static_cast<std::int32_t>(e / d.lines.size()) << d.position_shift
+                                 : lines.positions[e];
+}
+int stepScale(const TreeDirection& d, const IntervisibilityLines& lines, std::size_t e) {
+  return stepPosition(d, lines, e) - stepPosition(d, lines, e - d.lines.size());
+}
+
 void finish(IntervisibilityResult& result, const std::vector<PixelSums>& sums,
             const std::vector<float>& heights) {
   for (std::size_t p = 0; p < sums.size(); ++p) {
@@ -56,7 +67,7 @@ void sweepReference(const HeightField& field, const std::vector<float>& h,
         const std::size_t e = static_cast<std::size_t>(i) * g.n_lines + j;
         if (i > 0 && d.peaks() &&  // inserted where it rises above the chord of the samples
             tree_peak_inserted(lines.samples[e - g.n_lines], lines.peaks[e], lines.samples[e],
-                               lines.peak_offsets[e], d.position_shift)) {
+                               lines.peak_offsets[e], stepScale(d, lines, e))) {
           ++peaks;
           m += lines.peak_horizons[e];
         }
@@ -198,6 +209,7 @@ void addTreePeaks(const HeightField& field, const std::vector<float>& heights, c
                   bool curvature, IntervisibilityLines& lines) {
   const int width = field.width, height = field.height;
   const std::size_t per_period = d.samples.size();
+  const float inv_scale = 1.0f / static_cast<float>(1 << d.position_shift);  // positions to steps (or units)
   for (std::size_t j = 0; j < d.lines.size(); ++j) {
     const LatticeLine& line = d.lines[j];
     int c = line.col, r = line.row;
@@ -210,10 +222,16 @@ void addTreePeaks(const HeightField& field, const std::vector<float>& heights, c
         // farthest above the chord of its samples.
         const float far = lines.samples[e - d.lines.size()], near = lines.samples[e];
         if (std::isnan(far) || std::isnan(near)) continue;
-        // With curvature, against the samples' chord before the drop, as the kernel.
+        // A peak's offset: whole positions of the step (2^shift, or its units), strictly inside.
+        const int scale = stepScale(d, lines, e);
+        if (scale < 2) continue;
+        // With curvature, against the samples' chord before the drop, as the kernel (positions:
+        // steps, or units, in which the drop is given).
+        const float far_position = static_cast<float>(stepPosition(d, lines, e - d.lines.size()));
         float chord_far = far, rise = near - far;
         if (curvature) {
-          const float q_far = static_cast<float>(step - 1), q_near = static_cast<float>(step);
+          const float q_far = far_position * inv_scale,
+                      q_near = static_cast<float>(stepPosition(d, lines, e)) * inv_scale;
           chord_far = far + d.drop * q_far * q_far;
           rise = (near + d.drop * q_near * q_near) - chord_far;
         }
@@ -230,14 +248,13 @@ void addTreePeaks(const HeightField& field, const std::vector<float>& heights, c
           const std::size_t at = static_cast<std::size_t>(y0) * width + x0;
           tree_piece_peak(heights[at], heights[at + 1], heights[at + width], heights[at + width + 1], g.fx,
                           g.fy, g.dx, g.dy, g.t_far, g.t_near, g.inv_span, g.far_crossing, chord_far, rise,
-                          d.position_shift, &curve, &best_h, &offset, &best_excess);
+                          scale, &curve, &best_h, &offset, &best_excess);
         }
         if (!(best_h > -INFINITY)) continue;  // none, or NaN
         lines.peak_offsets[e] = offset;
         lines.peaks[e] = best_h;
-        if (curvature) {  // at its own position, in steps
-          const float q = static_cast<float>((static_cast<int>(step - 1) << d.position_shift) + offset) /
-                          static_cast<float>(1 << d.position_shift);
+        if (curvature) {  // at its own position, in steps (or units)
+          const float q = (far_position + static_cast<float>(offset)) * inv_scale;
           lines.peaks[e] = best_h - d.drop * q * q;
         }
       }

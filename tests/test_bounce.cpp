@@ -116,7 +116,7 @@ void expectBruteForceGather(const detail::BounceLineView& view, double sector) {
       const float h = view.lines.samples[e];
       if (shift > 0 && i > 0 &&
           detail::tree_peak_inserted(view.lines.samples[e - d.n_lines], view.lines.peaks[e], h,
-                                     view.lines.peak_offsets[e], shift))
+                                     view.lines.peak_offsets[e], 1 << shift))
         nodes.push_back(
             {i, view.lines.peaks[e], float(((i - 1) << shift) + view.lines.peak_offsets[e]), true});
       if (!std::isnan(h)) nodes.push_back({i, h, float(i << shift), false});

@@ -172,7 +172,7 @@ TEST(IntervisibilityPredicate, ChordSideIsExactOnRandomAndNearCollinearTriples) 
 struct LineSample {
   int step;  // its tree slot: the step, or with peaks 2 step + 1 (a peak: 2 step)
   float h;
-  float position;  // the step, or its units with per-row spacing, or with peaks in 2^-shift steps
+  float position;  // in 2^-shift steps, or its units with per-row spacing
   float distance;  // the step, or its units with per-row spacing (what distance sums add)
   float ring;      // 1, or the units of its step toward the receivers (its ring width)
   bool peak;       // an occluder alone: never counted
@@ -184,23 +184,26 @@ std::vector<LineSample> presentSamples(const detail::IntervisibilityLines& lines
   std::vector<LineSample> present;
   const auto& d = lines.geometry;
   const int shift = lines.position_shift;
+  const bool peaks = !lines.peaks.empty(), rows = !lines.positions.empty();
+  auto entry = [&](int i) { return static_cast<std::size_t>(i) * d.n_lines + j; };
+  // Positions: the step in 2^-shift steps, or its units with per-row spacing.
+  auto position = [&](int i) { return rows ? lines.positions[entry(i)] : i << shift; };
   for (int i = 0; i < d.n_steps; ++i) {
-    const std::size_t e = static_cast<std::size_t>(i) * d.n_lines + j;
+    const std::size_t e = entry(i);
     const float h = lines.samples[e];
-    if (shift > 0 && i > 0) {
+    if (peaks && i > 0) {
       const float peak = lines.peaks[e];
-      if (detail::tree_peak_inserted(lines.samples[e - d.n_lines], peak, h, lines.peak_offsets[e], shift))
-        present.push_back(
-            {2 * i, peak, float(((i - 1) << shift) + lines.peak_offsets[e]), float(i), 1.0f, true});
+      if (detail::tree_peak_inserted(lines.samples[e - d.n_lines], peak, h, lines.peak_offsets[e],
+                                     position(i) - position(i - 1)))
+        present.push_back({2 * i, peak, float(position(i - 1) + lines.peak_offsets[e]), 0.0f, 0.0f, true});
     }
     if (std::isnan(h)) continue;
-    if (shift > 0)
-      present.push_back({2 * i + 1, h, float(i << shift), float(i), 1.0f, false});
-    else if (lines.positions.empty())
-      present.push_back({i, h, float(i), float(i), 1.0f, false});
+    const int slot = peaks ? 2 * i + 1 : i;
+    if (!rows)
+      present.push_back({slot, h, float(position(i)), float(i), 1.0f, false});
     else
       present.push_back(
-          {i, h, float(lines.positions[e]), float(lines.positions[e]), float(lines.step_units[e]), false});
+          {slot, h, float(lines.positions[e]), float(lines.positions[e]), float(lines.step_units[e]), false});
   }
   return present;
 }
@@ -268,7 +271,7 @@ const NamedTuning kTunings[] = {
 
 void expectTreeEqualsBruteForce(const HeightField& field, const detail::TreeDirection& direction,
                                 bool check_device, std::uint64_t* receivers_checked,
-                                const HullTreeTuning& tuning = {}) {
+                                const HullTreeTuning& tuning = {}, std::uint64_t* peaks_inserted = nullptr) {
   const auto prepared = detail::prepareHeights(field);
   const auto ref = referenceLines(field, prepared.heights, direction, tuning);
   const auto& d = ref.geometry;
@@ -299,10 +302,11 @@ void expectTreeEqualsBruteForce(const HeightField& field, const detail::TreeDire
     for (int r = 0; r < static_cast<int>(s.size()); ++r) {
       if (s[r].peak) {  // no receiver; its horizons count in the bound below
         m += ref.peak_horizons[static_cast<std::size_t>(s[r].step / 2) * d.n_lines + j];
+        if (peaks_inserted) ++*peaks_inserted;
         continue;
       }
       const std::size_t e =
-          static_cast<std::size_t>(ref.position_shift > 0 ? s[r].step / 2 : s[r].step) * d.n_lines + j;
+          static_cast<std::size_t>(ref.peaks.empty() ? s[r].step : s[r].step / 2) * d.n_lines + j;
       const BruteForce brute = bruteForce(s, starts, r);
       SCOPED_TRACE("line " + std::to_string(j) + " receiver step " + std::to_string(s[r].step));
       // The horizons are Eq. 2's, distinct and farthest first.
@@ -366,7 +370,7 @@ TEST(IntervisibilityLine, TreeEqualsBruteForceOnEveryHardCase) {
 // still equals brute force on them, and its kernel the reference, on every hard case, in
 // every direction of kSteps and in every tuning (the safe zone is off there).
 TEST(IntervisibilityLine, TreeEqualsBruteForceOnRowsOfTheirOwnSpacing) {
-  std::uint64_t checked = 0;
+  std::uint64_t checked = 0, peaks = 0;
   for (const NamedTuning& variant : {kTunings[0], kTunings[2], kTunings[3]}) {
     for (const auto& name : syntheticFieldNames()) {
       for (auto [w, h] : awkwardSizes()) {
@@ -380,13 +384,15 @@ TEST(IntervisibilityLine, TreeEqualsBruteForceOnRowsOfTheirOwnSpacing) {
           if (step.second != 0 && h > 2) {
             ASSERT_NE(d.row_units.front(), d.row_units.back());
           }
-          expectTreeEqualsBruteForce(field, d, true, &checked, variant.tuning);
+          expectTreeEqualsBruteForce(field, d, true, &checked, variant.tuning, &peaks);
           if (::testing::Test::HasFatalFailure()) return;
         }
       }
     }
   }
   EXPECT_GT(checked, 50000u);
+  // The peaks between samples, at positions in the steps' own units, are in these trees too.
+  EXPECT_GT(peaks, checked / 100) << "peaks inserted";
 }
 
 // The tunings change the work, never the result: per receiver the same counts, distances

@@ -42,8 +42,9 @@ HFVIS_INLINE float tree_curve_at(const TreePieceCurve* c, float t) {
 // the samples is what rises above that chord; of the piece's points, the candidates are its far
 // end where that is a crossing (far_crossing) and, where the piece is concave, the point where
 // it stands farthest above the chord (its slope the chord's) where that lies strictly inside.
-// A candidate's position is rounded to the fixed point of positions (2^-shift step, strictly
-// between the samples: integers keep the exact predicate exact) and its height taken there, on
+// A candidate's position is rounded to the line's whole positions (`scale` of them per step,
+// at least 2: 2^shift, or on a latitude / longitude grid the step's units of ground length;
+// strictly between the samples: integers keep the exact predicate exact) and its height taken there, on
 // the piece that holds the rounded position (*prev: the piece before, farther, in the same
 // interval), so that a peak is a point of the surface where the tree puts it: a rounded position
 // with the unrounded height would tilt sight lines that graze a straight slope through it.
@@ -52,7 +53,7 @@ HFVIS_INLINE float tree_curve_at(const TreePieceCurve* c, float t) {
 // *best_h NaN, and the interval has no peak.
 HFVIS_INLINE void tree_piece_peak(float h00, float h10, float h01, float h11, float fx, float fy, float dx, float dy,
                                   float t_far, float t_near, float inv_span, int far_crossing, float chord_far,
-                                  float chord_rise, int shift, TreePieceCurve* prev, float* best_h, int* best_offset,
+                                  float chord_rise, int scale, TreePieceCurve* prev, float* best_h, int* best_offset,
                                   float* best_excess) {
   const float gx = h10 - h00, gy = h01 - h00, e = (h11 - h01) - gx;
   TreePieceCurve cur;
@@ -66,7 +67,6 @@ HFVIS_INLINE void tree_piece_peak(float h00, float h10, float h01, float h11, fl
     *best_excess = INFINITY;  // no later candidate either
     return;
   }
-  const int scale = 1 << shift;
   const float fscale = (float)scale;
   if (far_crossing) {
     int offset = (int)rint(t_far * fscale);
@@ -105,18 +105,18 @@ HFVIS_INLINE void tree_piece_peak(float h00, float h10, float h01, float h11, fl
   *prev = cur;
 }
 
-// Whether the peak of height h_peak at `offset` enters the tree: above the chord of its
+// Whether the peak of height h_peak at `offset` (of the step's `scale` positions) enters the tree: above the chord of its
 // interval's two samples (both present) by more than their rounding, 2^-18 of their heights
 // (a flat roof's samples come out an ulp or so below its corners, which the peaks' formula
 // reproduces exactly: without the margin the roof's own edges would hide its samples), and
 // strictly above it, decided exactly (chord_side, which must be defined before this file is
 // included). Below or on the chord a peak hides nothing the samples do not.
-HFVIS_INLINE int tree_peak_inserted(float h_far, float h_peak, float h_near, int offset, int shift) {
+HFVIS_INLINE int tree_peak_inserted(float h_far, float h_peak, float h_near, int offset, int scale) {
   if (isnan(h_far) || isnan(h_near) || isnan(h_peak)) return 0;
-  const float t = (float)offset / (float)(1 << shift);
+  const float t = (float)offset / (float)scale;
   const float excess = h_peak - (h_far + (h_near - h_far) * t);
   return excess > 0x1p-18f * (fabs(h_far) + fabs(h_near)) &&
-         chord_side(h_far, h_peak, h_near, (float)offset, (float)((1 << shift) - offset)) > 0;
+         chord_side(h_far, h_peak, h_near, (float)offset, (float)(scale - offset)) > 0;
 }
 
 #endif  // HFVIS_TREE_PEAKS_CL

@@ -122,7 +122,7 @@ void followRows(TreeDirection& d, const HeightField& field, const RowTable& rows
   }
   d.drop = static_cast<float>(curvature * unit * unit);
   d.max_steps = stepsWithin(max_distance, unit);
-  d.position_shift = 0;  // positions are whole units: no peaks
+  d.position_shift = 0;  // positions are whole units (a peak's too: a step has thousands)
 }
 
 std::vector<TreeDirection> treeDirections(const HeightField& field, const SweepOptions& options, bool follow_rows) {
@@ -164,7 +164,7 @@ void IntervisibilityLines::resetResults(bool keep_horizons) {
   iterations.assign(entries, 0);
   horizon_hashes.assign(entries, 0);
   walks_skipped.assign(entries, 0);
-  peak_horizons.assign(position_shift > 0 ? entries : 0, 0);
+  peak_horizons.assign(peaks.empty() ? 0 : entries, 0);
   horizon_steps.assign(keep_horizons ? entries : 0, {});
   horizon_run_ends.assign(keep_horizons ? entries : 0, {});
 }

@@ -56,12 +56,13 @@ struct TreeDirection {
   // The occluder-only peaks between consecutive samples (kernels/shared/tree_peaks.cl): the
   // pieces of each interval of a period, and the fixed point of positions along a line: a
   // sample at step s lies at s << position_shift, a peak between steps s - 1 and s at
-  // (s - 1) << position_shift plus its offset. 0 = no peaks (per-row spacing, whose positions
-  // are whole units of ground length: not built there). With peaks a line has two tree slots
+  // (s - 1) << position_shift plus its offset. With per-row spacing (position_shift 0) the
+  // positions are whole units of ground length, a peak's the step before's plus its offset in
+  // the step's units (groundUnit makes a step thousands of them). A line has two tree slots
   // per step: 2 s for the peak before step s, 2 s + 1 for the sample.
   TreeIntervals intervals;
   int position_shift = 0;
-  bool peaks() const { return position_shift > 0; }
+  bool peaks() const { return position_shift > 0 || rowSpacing(); }
   std::size_t slotsPerPeriod() const { return samples.size() * (peaks() ? 2 : 1); }
 };
 
@@ -160,12 +161,12 @@ struct IntervisibilityLines {
   // distance sums are then sums of (receiver position - position) * units. Without, both
   // are the step.
   std::vector<std::int32_t> positions, step_units;
-  // Peaks (TreeDirection::position_shift > 0): per entry, the highest point of the surface
+  // Peaks (TreeDirection::peaks(); empty: none): per entry, the highest point of the surface
   // between the step before and this one (NaN where none: no curved piece, a cell outside the
   // field or with nodata) and its offset from the step before, in units of 2^-position_shift
-  // step. The sweep inserts it before the sample, as an occluder alone, where it is strictly
-  // higher than both samples. Tree slots (horizon_steps, hashes) are then 2 s + 1 for step s's
-  // sample and 2 s for its peak.
+  // step (with positions: in the step's units). The sweep inserts it before the sample, as an
+  // occluder alone, where it stands above the chord of both samples (tree_peak_inserted).
+  // Tree slots (horizon_steps, hashes) are then 2 s + 1 for step s's sample and 2 s for its peak.
   int position_shift = 0;
   std::vector<float> peaks;
   std::vector<std::int32_t> peak_offsets;

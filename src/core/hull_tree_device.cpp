@@ -25,7 +25,7 @@ std::string treeProgramOptions(const TreeProgramFlags& f) {
     << " -DHFVIS_WANT_AREA=" << f.area
     << " -DHFVIS_WANT_STATS=" << f.stats << " -DHFVIS_WANT_ENTRY_STATS=" << f.entry_stats;
   s << " -DHFVIS_CURVATURE=" << f.curvature << " -DHFVIS_ROW_SPACING=" << f.row_spacing
-    << " -DHFVIS_STRIPS=" << f.strips << " -DHFVIS_TREE_PEAKS=" << !f.row_spacing;
+    << " -DHFVIS_STRIPS=" << f.strips;
   const HullTreeTuning tuning = tuningFor(f.tuning, f.row_spacing);
   s << " -DHFVIS_DEFERRED_WRITES=" << tuning.deferred_writes
     << " -DHFVIS_REPLACEMENT_CHECK=" << tuning.replacement_check

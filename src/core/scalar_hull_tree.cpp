@@ -35,25 +35,32 @@ struct Node {
 };
 
 // The sampled heights of one line, their peaks and their positions, by tree slot: with peaks
-// (shift > 0) slot 2 s + 1 is step s's sample and 2 s the peak before it, else slot s is step s.
+// (lines.peaks set) slot 2 s + 1 is step s's sample and 2 s the peak before it, else slot s is
+// step s.
 struct LineView {
   const IntervisibilityLines& lines;
   std::size_t offset;  // entry of step 0 of this line
   std::size_t stride;  // n_lines
   int shift;           // position_shift
-  bool peaks() const { return shift > 0; }
+  bool peaks() const { return !lines.peaks.empty(); }
   int sampleOf(int slot) const { return peaks() ? slot >> 1 : slot; }  // the step of a slot's sample or peak
   bool isSample(int slot) const { return !peaks() || (slot & 1) != 0; }
   int slotOf(int step) const { return peaks() ? 2 * step + 1 : step; }  // a step's sample
   std::size_t entry(int step) const { return offset + static_cast<std::size_t>(step) * stride; }
   float sampleHeight(int step) const { return lines.samples[entry(step)]; }
-  // Position along the line: the step, or its units with per-row spacing (exact in a float);
-  // with peaks in units of 2^-shift step.
+  // Position along the line of a step's sample: the step in units of 2^-shift step, or its
+  // units with per-row spacing (exact in a float).
+  std::int32_t stepPosition(int step) const {
+    return lines.positions.empty() ? step << shift : lines.positions[entry(step)];
+  }
+  // The positions of the step into `step` (> 0): 2^shift, or its units (where a peak lies
+  // strictly inside, at its offset).
+  int stepScale(int step) const { return stepPosition(step) - stepPosition(step - 1); }
+  // Position of a slot's node: its sample's, or the peak's: the step before's plus its offset.
   float position(int slot) const {
-    if (!lines.positions.empty()) return static_cast<float>(lines.positions[entry(slot)]);
     const int s = sampleOf(slot);
-    if (isSample(slot)) return static_cast<float>(s << shift);
-    return static_cast<float>(((s - 1) << shift) + lines.peak_offsets[entry(s)]);
+    if (isSample(slot)) return static_cast<float>(stepPosition(s));
+    return static_cast<float>(stepPosition(s - 1) + lines.peak_offsets[entry(s)]);
   }
 };
 
@@ -272,7 +279,7 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
       unit_sums[slot] = unit_sum;
       weighted_sums[slot] = weighted_sum;
       const float h = peak ? out.peaks[e] : h_sample;
-      if (peak ? !tree_peak_inserted(h_sample_prev, h, h_sample, out.peak_offsets[e], out.position_shift)
+      if (peak ? !tree_peak_inserted(h_sample_prev, h, h_sample, out.peak_offsets[e], line.stepScale(step))
                : std::isnan(h))
         continue;  // outputs stay NaN / zero
       const float p = line.position(slot);
@@ -480,7 +487,7 @@ void sweepPresampledLines(IntervisibilityLines& lines, const HullTreeTuning& req
   const SweepDirection& d = lines.geometry;
   const std::size_t entries = d.entries();
   if (lines.samples.size() != entries ||
-      (lines.position_shift > 0 && (lines.peaks.size() != entries || lines.peak_offsets.size() != entries)))
+      (!lines.peaks.empty() && (lines.peaks.size() != entries || lines.peak_offsets.size() != entries)))
     throw InvalidArgument("internal error: line samples do not fit the geometry");
   lines.resetResults(keep_horizons);
   if (bounce) {
