@@ -181,6 +181,13 @@ inline int region_sight_visible_culled(HFVIS_GLOBAL const float* h, int width, i
   const float clearance =
       margin + 1e-5f * (2.0f * (fabs(za) + fabs(zb)) + fabs(cdd)) + (cdd > 0.0f ? 0.25f * cdd : 0.0f);
   int level = 0;
+  // Each level's offset and row width in the pyramid (levels <= 16, the host's kCullLevels).
+  int level_offset[16], level_width[16];
+  for (int k = 0, offset = 0; k < levels; ++k) {
+    level_offset[k] = offset;
+    level_width[k] = region_cull_width(width, k);
+    offset += level_width[k] * region_cull_width(height, k);
+  }
   // Outside the box of grid lines (box_x0 <= x <= box_x1, box_y0 <= y <= box_y1; none when
   // box_x0 > box_x1), which holds one end, the caller has shown the segment clear by the same
   // margins: the march starts where the segment enters the box and ends where it leaves.
@@ -218,8 +225,7 @@ inline int region_sight_visible_culled(HFVIS_GLOBAL const float* h, int width, i
       int leapt = 0;
       for (int k = level; k >= 0 && !leapt; --k) {
         const int bx = cx >> k, by = cy >> k;
-        const float top =
-            pyramid[region_cull_offset(width, height, k) + by * region_cull_width(width, k) + bx];
+        const float top = pyramid[level_offset[k] + by * level_width[k] + bx];
         // Where the segment leaves the block: its column line on the right or its row line ahead,
         // each crossing's parameter as the march computes it.
         const int right = (bx + 1) << k, ahead = dy > 0.0f ? (by + 1) << k : by << k;

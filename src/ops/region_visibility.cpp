@@ -203,8 +203,8 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
   void runItem(int item, int) override {
     const int first = item * kReceiversPerLaunch, chunk = std::min(kReceiversPerLaunch, count_ - first);
     kernel_.set("first", cl_int(first));
-    st_.launch(kernel_, cl::NDRange(detail::roundUp(chunk, detail::kLineGroup), words_),
-               cl::NDRange(detail::kLineGroup, 1));
+    st_.launch(kernel_, cl::NDRange(detail::roundUp(chunk, detail::kLineGroup)),
+               cl::NDRange(detail::kLineGroup));
   }
 
   void finish() override {
