@@ -8,10 +8,11 @@
 // and no atomics are needed.
 //
 // Receivers are the grid points (`pixel_receivers`) or the samples of a second region (the
-// table `receivers`, stream 0). The words are stored receiver-major (word w of receiver r at
-// r * words + w: a work-item's words contiguous, for CPUs) or word-major (w * count + r:
-// neighbouring work-items write neighbouring words, for GPUs), as the context's line layout.
-// The host launches the receivers in chunks from `first`, to bound each launch's time.
+// table `receivers`, stream 0). Shared source samples (stream 0) come placed by the host
+// (`source_points`, x, y, z each, by the same region_sample); decorrelated ones are placed here. The words
+// are stored receiver-major (word w of receiver r at r * words + w: a work-item's words contiguous, for CPUs)
+// or word-major (w * count + r: neighbouring work-items write neighbouring words, for GPUs), as the context's
+// line layout. The host launches the receivers in chunks from `first`, to bound each launch's time.
 #pragma OPENCL FP_CONTRACT OFF
 
 #include "shared/region_visibility_sight.cl"
@@ -118,8 +119,8 @@ int region_shaft_clear(__global const float* h, __global const float* pyramid, i
 // the new line from the receiver as that one was of its line, or one cell before or after it,
 // the first that region_cull_hides shows hiding it (lines to neighbouring samples cross a ridge
 // at about the same fraction, in neighbouring cells); -1 when none does.
-int region_hider_along(__global const float* h, RegionField f, float margin, float gradient, float along,
-                       int tried, float xr, float yr, float zr, float xs, float ys, float zs) {
+int region_hider_along(__global const float* h, RegionField f, float margin, float gradient, int finite_field,
+                       float along, int tried, float xr, float yr, float zr, float xs, float ys, float zs) {
   const float dx = xs - xr, dy = ys - yr, pixels = fmax(fabs(dx), fabs(dy));
   if (!(pixels > 0.0f)) return -1;
   for (int k = -1; k <= 1; ++k) {
@@ -128,19 +129,20 @@ int region_hider_along(__global const float* h, RegionField f, float margin, flo
     const int cell = region_cell_at(f.width, f.height, xr + t * dx, yr + t * dy);
     if (cell >= 0 && cell != tried &&
         region_cull_hides(h, f.width, f.height, f.cell_x, f.cell_y, f.curvature, f.max_d2, margin, gradient,
-                          cell, xs, ys, zs, xr, yr, zr))
+                          finite_field, cell, xs, ys, zs, xr, yr, zr))
       return cell;
   }
   return -1;
 }
 
 __kernel void region_visibility_bits(__global const float* h, __global const float* pyramid, int levels,
-                                     float margin, float gradient, RegionField f,
-                                     __global const float* sources, int source_absolute, int samples,
-                                     int pixel_receivers, __global const float* receivers,
-                                     int receiver_absolute, int receiver_count, float target_height,
-                                     unsigned int seed, int decorrelate, int words, int receiver_major,
-                                     int first, __global unsigned int* bits) {
+                                     float margin, float gradient, int finite_field, RegionField f,
+                                     __global const float* sources, __global const float* source_points,
+                                     int source_absolute, int samples, int pixel_receivers,
+                                     __global const float* receivers, int receiver_absolute,
+                                     int receiver_count, float target_height, unsigned int seed,
+                                     int decorrelate, int words, int receiver_major, int first,
+                                     __global unsigned int* bits) {
   const int r = first + (int)get_global_id(0);
   if (r >= receiver_count) return;
   float xr, yr, zr;
@@ -165,8 +167,13 @@ __kernel void region_visibility_bits(__global const float* h, __global const flo
       const int end = 32 * w + 32 < samples ? 32 * w + 32 : samples;
       float xs[32], ys[32], zs[32];
       for (int s = 32 * w; s < end; ++s)
-        region_sample(sources, h, f.width, f.height, source_absolute, seed, key, s, &xs[s - 32 * w],
-                      &ys[s - 32 * w], &zs[s - 32 * w]);
+        if (decorrelate) {
+          region_sample(sources, h, f.width, f.height, source_absolute, seed, key, s, &xs[s - 32 * w],
+                        &ys[s - 32 * w], &zs[s - 32 * w]);
+        } else {
+          xs[s - 32 * w] = source_points[3 * s], ys[s - 32 * w] = source_points[3 * s + 1];
+          zs[s - 32 * w] = source_points[3 * s + 2];
+        }
       // The marches confined to the receiver's surroundings where the shaft to the word's samples
       // is clear beyond them (else a box that holds nothing).
       float box[4] = {1.0f, 0.0f, 0.0f, 0.0f};
@@ -176,12 +183,12 @@ __kernel void region_visibility_bits(__global const float* h, __global const flo
       for (int i = 0; i < end - 32 * w; ++i) {
         if (blocker >= 0) {
           if (region_cull_hides(h, f.width, f.height, f.cell_x, f.cell_y, f.curvature, f.max_d2, margin,
-                                gradient, blocker, xs[i], ys[i], zs[i], xr, yr, zr)) {
+                                gradient, finite_field, blocker, xs[i], ys[i], zs[i], xr, yr, zr)) {
             hidden = 1;
             continue;
           }
-          const int next =
-              region_hider_along(h, f, margin, gradient, along, blocker, xr, yr, zr, xs[i], ys[i], zs[i]);
+          const int next = region_hider_along(h, f, margin, gradient, finite_field, along, blocker, xr, yr,
+                                              zr, xs[i], ys[i], zs[i]);
           if (next >= 0) {
             blocker = next, hidden = 1;
             continue;
