@@ -34,8 +34,9 @@
 //       viewsheds' times (interleaved, the fastest of N)
 //   hfvis_bench region [--sections arealight,pair,error] [--reps N] FIELD...
 //       region visibility's backends timed interleaved: area lights against S, the light's size
-//       and height; region pairs against their size and distance; the visible fraction's error
-//       against a Monte-Carlo reference
+//       and height (arealight-quick: S = 32 interleaved, the culled march alone at S = 1024);
+//       region pairs against their size and distance; the visible fraction's error against a
+//       Monte-Carlo reference
 //   hfvis_bench field NAME N OUT
 //       writes the synthetic field NAME (testing's hard cases: city, sine, ...) of N x N pixels
 //       to OUT (EXR or GeoTIFF), for timing the CLI on it (bench/cost_against.sh)
@@ -63,20 +64,20 @@
 #include "error_target.hpp"
 #include "ground_truth.hpp"
 #include "hfvis/environment_light.hpp"
-#include "hfvis/horizon.hpp"
-#include "lighting.hpp"
-#include "region_visibility.hpp"
 #include "hfvis/errors.hpp"
+#include "hfvis/horizon.hpp"
 #include "hfvis/image_io.hpp"
 #include "hfvis/intervisibility.hpp"
 #include "hfvis_testing/synthetic_fields.hpp"
+#include "lighting.hpp"
 #include "methods.hpp"
 #include "metrics.hpp"
+#include "pvs_bench.hpp"
+#include "region_visibility.hpp"
 #include "suite.hpp"
 #include "suite_support.hpp"
 #include "viewshed_agreement.hpp"
 #include "viewshed_culling.hpp"
-#include "pvs_bench.hpp"
 
 namespace {
 
@@ -103,7 +104,7 @@ constexpr const char* kUsage =
     "       hfvis_bench pvs-rays [--size N] [--rays R] [--reps K] [--dem FILE] FIELD...\n"
     "       hfvis_bench pvs-recall [--size N] [--view-cell C] [--tile T] [--samples N,N,...]\n"
     "                              [--check-rays R] [--dem FILE] FIELD...   (FIELD: city, noise, dem)\n"
-    "       hfvis_bench region [--sections arealight,pair,error] [--reps N] FIELD...\n"
+    "       hfvis_bench region [--sections arealight,arealight-quick,pair,error] [--reps N] FIELD...\n"
     "       hfvis_bench field NAME N OUT\n"
     "       hfvis_bench inputs [--quick]\n"
     "       hfvis_bench check-truth\n"
@@ -290,7 +291,8 @@ int viewshedAgreementCommand(Arguments& args) {
   const std::size_t comma = at.find(',');
   if (comma == std::string::npos) throw Usage("viewshed-agreement needs --observer COL,ROW");
   Observer o{static_cast<int>(number(at.substr(0, comma), "--observer")),
-             static_cast<int>(number(at.substr(comma + 1), "--observer")), number(args.get("--observer-height", "2"), "--observer-height")};
+             static_cast<int>(number(at.substr(comma + 1), "--observer")),
+             number(args.get("--observer-height", "2"), "--observer-height")};
   ViewshedOptions options;
   options.target_height = number(args.get("--target-height", "0"), "--target-height");
   const std::size_t samples = static_cast<std::size_t>(number(args.get("--samples", "20000"), "--samples"));
@@ -301,8 +303,10 @@ int viewshedAgreementCommand(Arguments& args) {
   const HeightField field = readHeightField(paths[0]);
   validate(field, o);
   paths.erase(paths.begin());
-  std::printf("| raster | targets | visible (exact) | visible (raster) | Jaccard | disagreements | of them grazing |\n"
-              "|---|---|---|---|---|---|---|\n");
+  std::printf(
+      "| raster | targets | visible (exact) | visible (raster) | Jaccard | disagreements | of them grazing "
+      "|\n"
+      "|---|---|---|---|---|---|---|\n");
   for (const auto& a : viewshedAgreement(field, o, options, paths, samples, seed))
     std::printf("| %s | %zu | %.2f %% | %.2f %% | %.4f | %zu | %zu |\n", a.raster.c_str(), a.targets,
                 100.0 * a.reference_visible / std::max<std::size_t>(a.targets, 1),
@@ -325,7 +329,8 @@ int lightingTime(Arguments& args) {
     timeEnvironmentLighting(context, field, map, 1, 1);  // the program built
     for (int k : ks) {
       const double s = timeEnvironmentLighting(context, field, map, k, reps);
-      std::printf("| %d | %d | %.3f | %.1f |\n", field.width, k, s, s * 1e9 / (double(field.pixelCount()) * k));
+      std::printf("| %d | %d | %.3f | %.1f |\n", field.width, k, s,
+                  s * 1e9 / (double(field.pixelCount()) * k));
       std::fflush(stdout);
     }
   }
@@ -352,9 +357,10 @@ int lightingError(Arguments& args) {
   std::size_t lit = 0;
   for (std::size_t i = 0; i < values; ++i)
     if (ref.irradiance[i] > 0.0) noise += ref.noise[i] / ref.irradiance[i], ++lit;
-  std::printf("Reference: %d random directions per pixel, %d bright map pixels on grids, %.0f s on %d threads; "
-              "its own noise (half the difference of its halves) %.3f %% on the mean.\n\n",
-              ref.samples, ref.bright_pixels, seconds, threads(), 100.0 * noise / std::max<std::size_t>(lit, 1));
+  std::printf(
+      "Reference: %d random directions per pixel, %d bright map pixels on grids, %.0f s on %d threads; "
+      "its own noise (half the difference of its halves) %.3f %% on the mean.\n\n",
+      ref.samples, ref.bright_pixels, seconds, threads(), 100.0 * noise / std::max<std::size_t>(lit, 1));
   auto errors = [&](int k, int table_rows) {
     map.table_rows = table_rows;
     HorizonOptions options;
@@ -385,8 +391,8 @@ int lightingError(Arguments& args) {
     std::printf("| %d | %d | %.3f %% | %.2f %% |\n", ks.back(), table_rows, 100.0 * mean, 100.0 * worst);
     std::fflush(stdout);
   }
-  std::printf("\n(%s: %d x %d; the map %d x %d, %d channels; %s)\n", fields[0].c_str(), field.width, field.height,
-              map.width, map.height, map.channels, context.device().name.c_str());
+  std::printf("\n(%s: %d x %d; the map %d x %d, %d channels; %s)\n", fields[0].c_str(), field.width,
+              field.height, map.width, map.height, map.channels, context.device().name.c_str());
   return 0;
 }
 
@@ -450,9 +456,11 @@ int main(int argc, char** argv) {
         pvsRaysReport(context, fields, size, dem, rays, reps);
         return 0;
       }
-      const int view_cell = std::stoi(args.get("--view-cell", "16")), tile = std::stoi(args.get("--tile", "8"));
+      const int view_cell = std::stoi(args.get("--view-cell", "16")),
+                tile = std::stoi(args.get("--tile", "8"));
       std::vector<std::uint64_t> samples;
-      for (int n : intList(args.get("--samples", "10000,30000,100000,300000,1000000"))) samples.push_back(std::uint64_t(n));
+      for (int n : intList(args.get("--samples", "10000,30000,100000,300000,1000000")))
+        samples.push_back(std::uint64_t(n));
       const int check = std::stoi(args.get("--check-rays", "1000000"));
       const std::vector<std::string> fields = args.positional();
       args.rejectUnused();
@@ -466,8 +474,8 @@ int main(int argc, char** argv) {
       args.rejectUnused();
       if (fields.empty()) throw Usage("region needs FIELD...");
       for (const std::string& section : sections)
-        if (section != "arealight" && section != "pair" && section != "error")
-          throw Usage("--sections: arealight, pair, error (comma-separated)");
+        if (section != "arealight" && section != "arealight-quick" && section != "pair" && section != "error")
+          throw Usage("--sections: arealight, arealight-quick, pair, error (comma-separated)");
       const ComputeContext context = ComputeContext::create(ContextOptions::fromEnvironment());
       for (const std::string& path : fields) regionVisibilityReport(context, path, sections, reps);
       return 0;
@@ -511,7 +519,9 @@ int main(int argc, char** argv) {
       args.rejectUnused();
       std::vector<ErrorTargetField> fields;
       for (const std::string& name : names) {
-        const auto content = [&](const std::string& which) { return crop(loadContent(options, which, 256).field, n, n); };
+        const auto content = [&](const std::string& which) {
+          return crop(loadContent(options, which, 256).field, n, n);
+        };
         if (name != "mixed") {
           fields.push_back({name, content(name)});
           continue;
@@ -525,7 +535,8 @@ int main(int argc, char** argv) {
             mixed.heights[static_cast<std::size_t>(r) * mixed.width + c] = 40.0f * terrain.at(c, r);
         fields.push_back({"mixed", mixed});
       }
-      errorTargetReport(ComputeContext::create(ContextOptions::fromEnvironment()), fields, errors, reference, reps);
+      errorTargetReport(ComputeContext::create(ContextOptions::fromEnvironment()), fields, errors, reference,
+                        reps);
       return 0;
     }
     if (command == "check-truth") return checkTruth();

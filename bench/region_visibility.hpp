@@ -12,7 +12,7 @@
 namespace hfvis::bench {
 
 // Markdown tables on stdout for the field at `path`, the sections named in `sections` (arealight,
-// pair, error); the pairs take the fastest of `reps` interleaved runs, the area lights one.
+// arealight-quick, pair, error); the pairs take the fastest of `reps` interleaved runs, the area lights one.
 void regionVisibilityReport(const ComputeContext& context, const std::string& path,
                             const std::vector<std::string>& sections, int reps);
 

@@ -8,20 +8,29 @@
 # (or --out FILE); bench/report/region_visibility.md quotes a run.
 #
 #   bench/region_visibility.sh [--size 1024] [--sections pair,arealight,error] [--reps 2] [--out FILE]
+#                              [--base-build DIR] [--rounds 2]
 #   BUILD_DIR=... selects the build (default build/); inputs go to bench/out/data/.
+#   --base-build DIR: an existing build of an earlier commit (DIR/bench/hfvis_bench); its run and
+#   this build's alternate, --rounds times each (base, current, base, ...), so that both meet the
+#   same load; each run's tables go to the output under a heading naming its build.
+#   (arealight-quick: S = 32 interleaved and the culled march at S = 1024, in minutes.)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 size=1024
 sections=pair,arealight,error
 reps=2
 out=$root/bench/out/region_visibility.md
+base_build=
+rounds=2
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --size) size=$2; shift ;;
     --sections) sections=$2; shift ;;
     --reps) reps=$2; shift ;;
     --out) out=$2; shift ;;
-    -h|--help) sed -n '2,11p' "$0"; exit 0 ;;
+    --base-build) base_build=$2; shift ;;
+    --rounds) rounds=$2; shift ;;
+    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
     *) echo "region_visibility.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
   shift
@@ -34,4 +43,18 @@ data=$root/bench/out/data
 mkdir -p "$data" "$(dirname "$out")"
 [[ -f $data/fractal_$size.exr ]] ||
   /usr/bin/python3 "$root/data/make_data.py" --size "$size" --out "$data" --no-dem --no-env --fields fractal > /dev/null
-"$bench" region --sections "$sections" --reps "$reps" "$data/fractal_$size.exr" | tee "$out"
+if [[ -z $base_build ]]; then
+  "$bench" region --sections "$sections" --reps "$reps" "$data/fractal_$size.exr" | tee "$out"
+  exit 0
+fi
+base_bench=$base_build/bench/hfvis_bench
+[[ -x $base_bench ]] || { echo "region_visibility.sh: no hfvis_bench in $base_build" >&2; exit 1; }
+: > "$out"
+for ((round = 1; round <= rounds; ++round)); do
+  for which in base current; do
+    b=$bench
+    [[ $which == base ]] && b=$base_bench
+    echo -e "\n## round $round, $which build ($b)" | tee -a "$out"
+    "$b" region --sections "$sections" --reps "$reps" "$data/fractal_$size.exr" | tee -a "$out"
+  done
+done

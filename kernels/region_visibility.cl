@@ -1,17 +1,18 @@
 // region_visibility.cl: which source samples each receiver sees (computeRegionVisibility and
 // computeRegionPairVisibility in src/ops/region_visibility.cpp; the contract in
-// hfvis/region_visibility.hpp). One work-item per (receiver, word of 32 source samples): it
-// places its receiver and the word's source samples and marches each pair
-// (shared/region_visibility_sight.cl; with a culling pyramid, `levels` > 0, the march leaps
-// over the blocks of cells far below the segment, and tries each sight line first against the
-// cell that hid the word's last hidden one), then writes the word, so no two work-items write one word and no
-// atomics are needed.
+// hfvis/region_visibility.hpp). One work-item per receiver: it places its receiver, then per word
+// of 32 source samples places them, marches each pair (shared/region_visibility_sight.cl; with a
+// culling pyramid, `levels` > 0, the march leaps over the blocks of cells far below the segment,
+// and each sight line is tried first against the cell that hid the last hidden one, or the cell
+// at the same fraction of its own line) and writes the word, so no two work-items write one word
+// and no atomics are needed.
 //
 // Receivers are the grid points (`pixel_receivers`) or the samples of a second region (the
-// table `receivers`, stream 0). The words are stored receiver-major (word w of receiver r at
-// r * words + w: a work-item's words contiguous, for CPUs) or word-major (w * count + r:
-// neighbouring work-items write neighbouring words, for GPUs), as the context's line layout.
-// The host launches the receivers in chunks from `first`, to bound each launch's time.
+// table `receivers`, stream 0). Shared source samples (stream 0) come placed by the host
+// (`source_points`, x, y, z each, by the same region_sample); decorrelated ones are placed here. The words
+// are stored receiver-major (word w of receiver r at r * words + w: a work-item's words contiguous, for CPUs)
+// or word-major (w * count + r: neighbouring work-items write neighbouring words, for GPUs), as the context's
+// line layout. The host launches the receivers in chunks from `first`, to bound each launch's time.
 #pragma OPENCL FP_CONTRACT OFF
 
 #include "shared/region_visibility_sight.cl"
@@ -113,41 +114,37 @@ int region_shaft_clear(__global const float* h, __global const float* pyramid, i
   return 1;
 }
 
-// The cell to try first against the word's next sight lines, after the line from the receiver
-// (xr, yr, zr) to (xs, ys, zs) was found hidden by the march at cell `found`: the first cell from
-// the receiver, within 8, that region_cull_hides shows hiding it (lines to a word's samples
-// spread apart from the receiver: the nearer the hiding cell, the more of them it hides), else
-// `found`.
-int region_near_hider(__global const float* h, RegionField f, float margin, float gradient, int found, float xr,
-                      float yr, float zr, float xs, float ys, float zs) {
-  const float dx = xs - xr, dy = ys - yr;
-  int cx = (int)xr < f.width - 2 ? (int)xr : f.width - 2, cy = (int)yr < f.height - 2 ? (int)yr : f.height - 2;
-  for (int n = 0; n < 8 && cx >= 0 && cy >= 0 && cx <= f.width - 2 && cy <= f.height - 2; ++n) {
-    const int cell = cy * f.width + cx;
-    if (cell == found) break;
-    if (region_cull_hides(h, f.width, f.height, f.cell_x, f.cell_y, f.curvature, f.max_d2, margin, gradient, cell,
-                          xs, ys, zs, xr, yr, zr))
+// The cell to try against the sight line from the receiver (xr, yr, zr) to (xs, ys, zs) when the
+// cell that hid the last hidden line does not hide it: the cell at the same fraction `along` of
+// the new line from the receiver as that one was of its line, or one cell before or after it,
+// the first that region_cull_hides shows hiding it (lines to neighbouring samples cross a ridge
+// at about the same fraction, in neighbouring cells); -1 when none does.
+int region_hider_along(__global const float* h, RegionField f, float margin, float gradient, int finite_field,
+                       float along, int tried, float xr, float yr, float zr, float xs, float ys, float zs) {
+  const float dx = xs - xr, dy = ys - yr, pixels = fmax(fabs(dx), fabs(dy));
+  if (!(pixels > 0.0f)) return -1;
+  for (int k = -1; k <= 1; ++k) {
+    const float t = along + (float)k / pixels;
+    if (!(t > 0.0f && t < 1.0f)) continue;
+    const int cell = region_cell_at(f.width, f.height, xr + t * dx, yr + t * dy);
+    if (cell >= 0 && cell != tried &&
+        region_cull_hides(h, f.width, f.height, f.cell_x, f.cell_y, f.curvature, f.max_d2, margin, gradient,
+                          finite_field, cell, xs, ys, zs, xr, yr, zr))
       return cell;
-    const float tX = dx != 0.0f ? ((float)(dx > 0.0f ? cx + 1 : cx) - xr) / dx : INFINITY;
-    const float tY = dy != 0.0f ? ((float)(dy > 0.0f ? cy + 1 : cy) - yr) / dy : INFINITY;
-    if (fmin(tX, tY) >= 1.0f) break;
-    if (tX < tY)
-      cx += dx > 0.0f ? 1 : -1;
-    else
-      cy += dy > 0.0f ? 1 : -1;
   }
-  return found;
+  return -1;
 }
 
 __kernel void region_visibility_bits(__global const float* h, __global const float* pyramid, int levels,
-                                     float margin, float gradient, RegionField f,
-                                     __global const float* sources, int source_absolute, int samples,
-                                     int pixel_receivers, __global const float* receivers,
-                                     int receiver_absolute, int receiver_count, float target_height,
-                                     unsigned int seed, int decorrelate, int words, int receiver_major,
-                                     int first, __global unsigned int* bits) {
-  const int r = first + (int)get_global_id(0), w = get_global_id(1);
-  if (r >= receiver_count || w >= words) return;
+                                     float margin, float gradient, int finite_field, RegionField f,
+                                     __global const float* sources, __global const float* source_points,
+                                     int source_absolute, int samples, int pixel_receivers,
+                                     __global const float* receivers, int receiver_absolute,
+                                     int receiver_count, float target_height, unsigned int seed,
+                                     int decorrelate, int words, int receiver_major, int first,
+                                     __global unsigned int* bits) {
+  const int r = first + (int)get_global_id(0);
+  if (r >= receiver_count) return;
   float xr, yr, zr;
   if (!pixel_receivers) {
     region_sample(receivers, h, f.width, f.height, receiver_absolute, seed, 0U, r, &xr, &yr, &zr);
@@ -156,34 +153,66 @@ __kernel void region_visibility_bits(__global const float* h, __global const flo
     yr = (float)(r / f.width);
     zr = h[r] + target_height;
   }
-  unsigned int word = 0U;
-  if (!isnan(zr)) {
-    const unsigned int key = decorrelate ? (unsigned int)r + 1U : 0U;
-    const int end = 32 * w + 32 < samples ? 32 * w + 32 : samples;
-    float xs[32], ys[32], zs[32];
-    for (int s = 32 * w; s < end; ++s)
-      region_sample(sources, h, f.width, f.height, source_absolute, seed, key, s, &xs[s - 32 * w],
-                    &ys[s - 32 * w], &zs[s - 32 * w]);
-    // Culled: the marches confined to the receiver's surroundings where the shaft to the word's
-    // samples is clear beyond them (else a box that holds nothing), and the cell that hid the
-    // last hidden sample tried first.
-    float box[4] = {1.0f, 0.0f, 0.0f, 0.0f};
-    if (levels > 0 &&
-        !region_shaft_clear(h, pyramid, levels, margin, f, xr, yr, zr, xs, ys, zs, end - 32 * w, box))
-      box[0] = 1.0f, box[2] = 0.0f;
-    int blocker = -1;
-    for (int i = 0; i < end - 32 * w; ++i) {
-      if (blocker >= 0 && region_cull_hides(h, f.width, f.height, f.cell_x, f.cell_y, f.curvature, f.max_d2,
-                                            margin, gradient, blocker, xs[i], ys[i], zs[i], xr, yr, zr))
-        continue;
-      int blocked_at = -1;
-      if (region_sight_visible_culled(h, f.width, f.height, f.cell_x, f.cell_y, f.curvature, f.max_d2,
-                                      pyramid, levels, margin, box[0], box[1], box[2], box[3], xs[i], ys[i],
-                                      zs[i], xr, yr, zr, &blocked_at))
-        word |= 1U << i;
-      else if (levels > 0 && blocked_at >= 0)
-        blocker = region_near_hider(h, f, margin, gradient, blocked_at, xr, yr, zr, xs[i], ys[i], zs[i]);
+  const unsigned int key = decorrelate ? (unsigned int)r + 1U : 0U;
+  // Culled: the cell that hid the last hidden sight line (and its fraction of that line from the
+  // receiver), tried first against the next ones, across words; a word whose predecessor had a
+  // hidden line skips the shaft test (it fails where a line is hidden beyond the receiver's
+  // surroundings, and then costs more than it saves).
+  int blocker = -1, hidden_before = 0;
+  float along = 0.0f;
+  for (int w = 0; w < words; ++w) {
+    unsigned int word = 0U;
+    int hidden = 0;
+    if (!isnan(zr)) {
+      const int end = 32 * w + 32 < samples ? 32 * w + 32 : samples;
+      float xs[32], ys[32], zs[32];
+      for (int s = 32 * w; s < end; ++s)
+        if (decorrelate) {
+          region_sample(sources, h, f.width, f.height, source_absolute, seed, key, s, &xs[s - 32 * w],
+                        &ys[s - 32 * w], &zs[s - 32 * w]);
+        } else {
+          xs[s - 32 * w] = source_points[3 * s], ys[s - 32 * w] = source_points[3 * s + 1];
+          zs[s - 32 * w] = source_points[3 * s + 2];
+        }
+      // The marches confined to the receiver's surroundings where the shaft to the word's samples
+      // is clear beyond them (else a box that holds nothing).
+      float box[4] = {1.0f, 0.0f, 0.0f, 0.0f};
+      if (levels > 0 && (hidden_before || !region_shaft_clear(h, pyramid, levels, margin, f, xr, yr, zr, xs,
+                                                              ys, zs, end - 32 * w, box)))
+        box[0] = 1.0f, box[2] = 0.0f;
+      for (int i = 0; i < end - 32 * w; ++i) {
+        if (blocker >= 0) {
+          if (region_cull_hides(h, f.width, f.height, f.cell_x, f.cell_y, f.curvature, f.max_d2, margin,
+                                gradient, finite_field, blocker, xs[i], ys[i], zs[i], xr, yr, zr)) {
+            hidden = 1;
+            continue;
+          }
+          const int next = region_hider_along(h, f, margin, gradient, finite_field, along, blocker, xr, yr,
+                                              zr, xs[i], ys[i], zs[i]);
+          if (next >= 0) {
+            blocker = next, hidden = 1;
+            continue;
+          }
+        }
+        int blocked_at = -1;
+        if (region_sight_visible_culled(h, f.width, f.height, f.cell_x, f.cell_y, f.curvature, f.max_d2,
+                                        pyramid, levels, margin, box[0], box[1], box[2], box[3], xs[i], ys[i],
+                                        zs[i], xr, yr, zr, &blocked_at)) {
+          word |= 1U << i;
+        } else {
+          hidden = 1;
+          if (levels > 0 && blocked_at >= 0) {
+            // The fraction of the line from the receiver at the hiding cell's centre.
+            const float dx = xs[i] - xr, dy = ys[i] - yr;
+            const float cx = (float)(blocked_at % f.width) + 0.5f - xr,
+                        cy = (float)(blocked_at / f.width) + 0.5f - yr;
+            blocker = blocked_at;
+            along = (cx * dx + cy * dy) / (dx * dx + dy * dy);
+          }
+        }
+      }
     }
+    hidden_before = hidden;
+    bits[receiver_major ? (size_t)r * words + w : (size_t)w * receiver_count + r] = word;
   }
-  bits[receiver_major ? (size_t)r * words + w : (size_t)w * receiver_count + r] = word;
 }

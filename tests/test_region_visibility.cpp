@@ -207,6 +207,26 @@ TEST(RegionVisibility, TheCulledMarchIsTheExactOne) {
       const RegionPairVisibilityResult got = computeRegionPairVisibility(context, field, a, b, culled);
       EXPECT_EQ(got.bits, want.bits);
       clear += got.clear_pairs, total += got.pairs;
+      // Many words per receiver (the hiding cell carried from word to word, and the cell at the
+      // same fraction of the next line tried), sight lines across the whole field.
+      RegionSampling left, right;
+      left.rectangle = {0, 0, 25, 76};
+      right.rectangle = {100, 0, 75, 76};
+      left.samples = 256, right.samples = 64;
+      left.height = 0.5, right.height = 1.5;
+      try {
+        validate(field, left), validate(field, right);
+      } catch (const InvalidArgument&) {
+        return;
+      }
+      for (bool decorrelate : {false, true}) {
+        exact.decorrelate = culled.decorrelate = decorrelate;
+        const RegionPairVisibilityResult all =
+            computeRegionPairVisibility(context, field, right, left, exact);
+        EXPECT_EQ(computeRegionPairVisibility(context, field, right, left, culled).bits, all.bits);
+        clear += all.clear_pairs, total += all.pairs;
+      }
+      exact.decorrelate = culled.decorrelate = false;
     });
   }
   // Both answers occur often.

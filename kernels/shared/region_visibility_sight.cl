@@ -181,6 +181,13 @@ inline int region_sight_visible_culled(HFVIS_GLOBAL const float* h, int width, i
   const float clearance =
       margin + 1e-5f * (2.0f * (fabs(za) + fabs(zb)) + fabs(cdd)) + (cdd > 0.0f ? 0.25f * cdd : 0.0f);
   int level = 0;
+  // Each level's offset and row width in the pyramid (levels <= 16, the host's kCullLevels).
+  int level_offset[16], level_width[16];
+  for (int k = 0, offset = 0; k < levels; ++k) {
+    level_offset[k] = offset;
+    level_width[k] = region_cull_width(width, k);
+    offset += level_width[k] * region_cull_width(height, k);
+  }
   // Outside the box of grid lines (box_x0 <= x <= box_x1, box_y0 <= y <= box_y1; none when
   // box_x0 > box_x1), which holds one end, the caller has shown the segment clear by the same
   // margins: the march starts where the segment enters the box and ends where it leaves.
@@ -218,8 +225,7 @@ inline int region_sight_visible_culled(HFVIS_GLOBAL const float* h, int width, i
       int leapt = 0;
       for (int k = level; k >= 0 && !leapt; --k) {
         const int bx = cx >> k, by = cy >> k;
-        const float top =
-            pyramid[region_cull_offset(width, height, k) + by * region_cull_width(width, k) + bx];
+        const float top = pyramid[level_offset[k] + by * level_width[k] + bx];
         // Where the segment leaves the block: its column line on the right or its row line ahead,
         // each crossing's parameter as the march computes it.
         const int right = (bx + 1) << k, ahead = dy > 0.0f ? (by + 1) << k : by << k;
@@ -302,12 +308,13 @@ inline int region_sight_visible(HFVIS_GLOBAL const float* h, int width, int heig
 // rounding (`margin`, the field's part, and the segment's own) and more than its values can
 // change over the 1e-3 pixel of a piece whose inside it skips (`gradient`: a bound of the
 // surface's slope per pixel). Only over a cell whose 4 x 4 heights around are finite, so that
-// every value the march takes near there is a number. The cheap test of a sight line against the
+// every value the march takes near there is a number (not looked at where `finite_field` says
+// every height of the field is). The cheap test of a sight line against the
 // cell that hid the previous one (sight lines to neighbouring samples are often hidden by the
 // same cell); 0 decides nothing.
 inline int region_cull_hides(HFVIS_GLOBAL const float* h, int width, int height, float cell_x, float cell_y,
-                             float curvature, float max_d2, float margin, float gradient, int cell, float xa,
-                             float ya, float za, float xb, float yb, float zb) {
+                             float curvature, float max_d2, float margin, float gradient, int finite_field,
+                             int cell, float xa, float ya, float za, float xb, float yb, float zb) {
   const int cx = cell % width, cy = cell / width;
   const float dx = xb - xa, dy = yb - ya, dz = zb - za;
   const float pixels = fabs(dx) > fabs(dy) ? fabs(dx) : fabs(dy);
@@ -326,7 +333,7 @@ inline int region_cull_hides(HFVIS_GLOBAL const float* h, int width, int height,
     return 0;
   }
   if (!(hi > lo)) return 0;
-  for (int y = (cy > 0 ? cy - 1 : 0); y <= (cy + 2 < height ? cy + 2 : height - 1); ++y)
+  for (int y = (cy > 0 ? cy - 1 : 0); !finite_field && y <= (cy + 2 < height ? cy + 2 : height - 1); ++y)
     for (int x = (cx > 0 ? cx - 1 : 0); x <= (cx + 2 < width ? cx + 2 : width - 1); ++x)
       if (!isfinite(h[y * width + x])) return 0;
   const float gx = dx * cell_x, gy = dy * cell_y, d2 = gx * gx + gy * gy;

@@ -57,6 +57,7 @@ struct CullPyramid {
   int levels = 0;
   float margin = 0.0f;
   float gradient = 0.0f;  // the surface's steepest slope per pixel, at most (region_cull_hides)
+  bool finite = true;     // every height finite (region_cull_hides need not look)
 };
 
 CullPyramid cullPyramid(const std::vector<float>& h, int width, int height) {
@@ -69,10 +70,13 @@ CullPyramid cullPyramid(const std::vector<float>& h, int width, int height) {
   // piece's middle a rounding into the next cell): at most ulp(max(width, height)) each.
   double largest = 0.0, step = 0.0, twist = 0.0;
   std::vector<char> infinite(h.size(), 0);
+  bool any_infinite = false;
   for (int r = 0; r < height; ++r)
     for (int c = 0; c < width; ++c) {
       const float v = at(c, r);
       infinite[std::size_t(r) * width + c] = std::isinf(v);
+      any_infinite = any_infinite || std::isinf(v);
+      out.finite = out.finite && std::isfinite(v);
       if (!std::isfinite(v)) continue;
       largest = std::max(largest, double(std::fabs(v)));
       if (c + 1 < width && std::isfinite(at(c + 1, r)))
@@ -94,7 +98,7 @@ CullPyramid cullPyramid(const std::vector<float>& h, int width, int height) {
   for (int r = 0; r < hh; ++r)
     for (int c = 0; c < w; ++c) {
       bool unbounded = false;
-      for (int y = std::max(0, r - 1); y <= std::min(height - 1, r + 2) && !unbounded; ++y)
+      for (int y = std::max(0, r - 1); any_infinite && y <= std::min(height - 1, r + 2) && !unbounded; ++y)
         for (int x = std::max(0, c - 1); x <= std::min(width - 1, c + 2); ++x)
           if (infinite[std::size_t(y) * width + x]) unbounded = true;
       float top = -std::numeric_limits<float>::infinity();
@@ -124,10 +128,12 @@ CullPyramid cullPyramid(const std::vector<float>& h, int width, int height) {
 class RegionBitsRoutine : public detail::DeviceRoutine {
  public:
   RegionBitsRoutine(detail::ContextState& st, const HeightField& field, const std::vector<float>& sources,
-                    bool source_absolute, const std::vector<float>* receivers, bool receiver_absolute,
-                    int count, const RegionVisibilityOptions& options)
+                    const std::vector<float>& source_points, bool source_absolute,
+                    const std::vector<float>* receivers, bool receiver_absolute, int count,
+                    const RegionVisibilityOptions& options)
       : DeviceRoutine(st, field, nullptr, 0),
         sources_(sources),
+        source_points_(source_points),
         source_absolute_(source_absolute),
         receivers_(receivers),
         receiver_absolute_(receiver_absolute),
@@ -158,6 +164,7 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
                               " but the memory budget is " + detail::mebibytes(budget) +
                               "; take fewer samples or a smaller field");
     source_table_ = upload(sources_);
+    source_points_buffer_ = upload(source_points_);
     // A pixel run binds the source table in the receivers' place (never read).
     receiver_table_ = receivers_ ? upload(*receivers_) : source_table_;
     bits_ = detail::deviceBuffer(st_, entries * sizeof(std::uint32_t));
@@ -169,11 +176,11 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
                              static_cast<float>(options_.curvature),
                              options_.max_distance > 0.0 ? static_cast<float>(max_d2) : 0.0f};
     if (options_.method == RegionVisibilityMethod::Culled) {
-      const CullPyramid pyramid = cullPyramid(
-          detail::prepareHeights(field_, detail::HeightOrigin::Zero).heights, field_.width, field_.height);
+      const CullPyramid pyramid = cullPyramid(prepared_.heights, field_.width, field_.height);
       levels_ = pyramid.levels;
       margin_ = pyramid.margin;
       gradient_ = pyramid.gradient;
+      finite_ = pyramid.finite;
       if (levels_ > 0) pyramid_ = upload(pyramid.top);
     }
     kernel_ = kernel("region_visibility_bits");
@@ -182,8 +189,10 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
         .set("levels", cl_int(levels_))
         .set("margin", margin_)
         .set("gradient", gradient_)
+        .set("finite_field", cl_int(finite_))
         .set("f", device)
         .set("sources", source_table_)
+        .set("source_points", source_points_buffer_)
         .set("source_absolute", cl_int(source_absolute_))
         .set("samples", cl_int(samples_))
         .set("pixel_receivers", cl_int(receivers_ == nullptr))
@@ -203,8 +212,8 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
   void runItem(int item, int) override {
     const int first = item * kReceiversPerLaunch, chunk = std::min(kReceiversPerLaunch, count_ - first);
     kernel_.set("first", cl_int(first));
-    st_.launch(kernel_, cl::NDRange(detail::roundUp(chunk, detail::kLineGroup), words_),
-               cl::NDRange(detail::kLineGroup, 1));
+    st_.launch(kernel_, cl::NDRange(detail::roundUp(chunk, detail::kLineGroup)),
+               cl::NDRange(detail::kLineGroup));
   }
 
   void finish() override {
@@ -221,6 +230,7 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
   }
 
   const std::vector<float>& sources_;
+  const std::vector<float>& source_points_;  // stream 0's samples, x, y, z each
   const bool source_absolute_;
   const std::vector<float>* receivers_;
   const bool receiver_absolute_;
@@ -230,17 +240,19 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
   bool receiver_major_ = true;
   int levels_ = 0;  // the culling pyramid's (0: the exact march)
   cl_float margin_ = 0.0f, gradient_ = 0.0f;
-  cl::Buffer source_table_, receiver_table_, bits_, pyramid_;
+  bool finite_ = false;
+  cl::Buffer source_table_, source_points_buffer_, receiver_table_, bits_, pyramid_;
   detail::NamedKernel kernel_;
 };
 
 std::vector<std::uint32_t> runBits(const ComputeContext& context, const HeightField& field,
-                                   const std::vector<float>& sources, bool source_absolute,
-                                   const std::vector<float>* receivers, bool receiver_absolute, int count,
+                                   const std::vector<float>& sources, const std::vector<float>& source_points,
+                                   bool source_absolute, const std::vector<float>* receivers,
+                                   bool receiver_absolute, int count,
                                    const RegionVisibilityOptions& options) {
   return detail::translateOpenClErrors([&] {
-    RegionBitsRoutine routine(detail::stateOf(context), field, sources, source_absolute, receivers,
-                              receiver_absolute, count, options);
+    RegionBitsRoutine routine(detail::stateOf(context), field, sources, source_points, source_absolute,
+                              receivers, receiver_absolute, count, options);
     routine.run();
     return std::move(routine.bits);
   });
@@ -274,6 +286,26 @@ std::vector<std::uint32_t> viewshedBits(const ComputeContext& context, const Hei
       if (v.visible[p] == 1.0f) bits[p * words + s / 32] |= 1u << (s % 32);
   }
   return bits;
+}
+
+// A table's samples from stream 0 of `seed` on the z-scaled heights (region_sample, as the kernel
+// places them): x, y, z each.
+std::vector<float> tableSamplePoints(const HeightField& field, const std::vector<float>& table,
+                                     const std::vector<float>& heights, bool absolute, std::uint32_t seed) {
+  std::vector<float> points;
+  for (int s = 0; s < detail::regionTableSamples(table); ++s) {
+    float x, y, z;
+    detail::region_sample(table.data(), heights.data(), field.width, field.height, absolute, seed, 0u, s, &x,
+                          &y, &z);
+    points.insert(points.end(), {x, y, z});
+  }
+  return points;
+}
+
+std::vector<RegionPoint> regionPoints(const std::vector<float>& xyz) {
+  std::vector<RegionPoint> points;
+  for (std::size_t i = 0; i + 2 < xyz.size(); i += 3) points.push_back({xyz[i], xyz[i + 1], xyz[i + 2]});
+  return points;
 }
 
 }  // namespace
@@ -393,14 +425,7 @@ std::vector<RegionPoint> regionSamplePoints(const HeightField& field, const Regi
   validate(field);
   const std::vector<float> table = detail::regionSampleTable(field, sampling);
   const std::vector<float> heights = detail::prepareHeights(field, detail::HeightOrigin::Zero).heights;
-  std::vector<RegionPoint> points;
-  for (int s = 0; s < detail::regionTableSamples(table); ++s) {
-    float x, y, z;
-    detail::region_sample(table.data(), heights.data(), field.width, field.height, sampling.absolute, seed,
-                          0u, s, &x, &y, &z);
-    points.push_back({x, y, z});
-  }
-  return points;
+  return regionPoints(tableSamplePoints(field, table, heights, sampling.absolute, seed));
 }
 
 RegionVisibilityResult computeRegionVisibility(const ComputeContext& context, const HeightField& field,
@@ -416,10 +441,11 @@ RegionVisibilityResult computeRegionVisibility(const ComputeContext& context, co
   out.samples = detail::regionTableSamples(table);
   out.words = (out.samples + 31) / 32;
   const int count = static_cast<int>(field.pixelCount());
+  const std::vector<float> points = tableSamplePoints(field, table, heights, sources.absolute, options.seed);
   if (options.method == RegionVisibilityMethod::Viewsheds)
-    out.bits = viewshedBits(context, field, regionSamplePoints(field, sources, options.seed), options);
+    out.bits = viewshedBits(context, field, regionPoints(points), options);
   else
-    out.bits = runBits(context, field, table, sources.absolute, nullptr, false, count, options);
+    out.bits = runBits(context, field, table, points, sources.absolute, nullptr, false, count, options);
   out.fraction.resize(field.pixelCount());
   for (int p = 0; p < count; ++p) {
     int seen = 0;
@@ -446,10 +472,13 @@ RegionPairVisibilityResult computeRegionPairVisibility(const ComputeContext& con
   out.source_samples = detail::regionTableSamples(source_table);
   out.receiver_samples = detail::regionTableSamples(receiver_table);
   out.words = (out.source_samples + 31) / 32;
-  out.sources = regionSamplePoints(field, sources, options.seed);
-  out.receivers = regionSamplePoints(field, receivers, options.seed);
-  out.bits = runBits(context, field, source_table, sources.absolute, &receiver_table, receivers.absolute,
-                     out.receiver_samples, options);
+  const std::vector<float> source_points =
+      tableSamplePoints(field, source_table, heights, sources.absolute, options.seed);
+  out.sources = regionPoints(source_points);
+  out.receivers =
+      regionPoints(tableSamplePoints(field, receiver_table, heights, receivers.absolute, options.seed));
+  out.bits = runBits(context, field, source_table, source_points, sources.absolute, &receiver_table,
+                     receivers.absolute, out.receiver_samples, options);
   detail::countPairFractions(out);
   return out;
 }
