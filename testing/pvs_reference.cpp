@@ -13,20 +13,24 @@ RayCastResult referenceCastHeightFieldRays(const HeightField& field, const std::
   const PvsLayout layout = pvsLayout(field, options.grid);
   const std::vector<float> heights = detail::rayHeights(field);
   const detail::RayPyramid pyramid = detail::buildRayPyramid(heights, field.width, field.height);
+  const int cap = options.view_cells ? layout.view_x + layout.view_y : 0;
   RayCastResult out;
-  out.cap = options.view_cells ? layout.view_x + layout.view_y : 0;
   out.t.resize(rays.size());
   out.cell.resize(rays.size());
-  out.count.resize(rays.size());
-  out.view_cell.assign(rays.size() * out.cap, 0);
-  out.view_t.assign(rays.size() * out.cap, 0.0f);
+  out.first.assign(1, 0);
+  std::vector<int> cells(std::max(cap, 1));
+  std::vector<float> ts(std::max(cap, 1));
   for (std::size_t r = 0; r < rays.size(); ++r) {
     const HeightRay& q = rays[r];
-    out.t[r] = detail::hf_ray_cast(
-        heights.data(), field.width, field.height, pyramid.values.data(), pyramid.levels.data(), pyramid.top,
-        q.ox, q.oy, q.oz, q.dx, q.dy, q.dz, q.t_max, options.grid.view_cell, layout.view_x,
-        float(options.grid.band_low), float(options.grid.band_high), out.cap,
-        out.view_cell.data() + r * out.cap, out.view_t.data() + r * out.cap, 1, &out.count[r], &out.cell[r]);
+    int count = 0;
+    out.t[r] = detail::hf_ray_cast(heights.data(), field.width, field.height, pyramid.values.data(),
+                                   pyramid.levels.data(), pyramid.top, q.ox, q.oy, q.oz, q.dx, q.dy, q.dz,
+                                   q.t_max, options.grid.view_cell, layout.view_x,
+                                   float(options.grid.band_low), float(options.grid.band_high), cap,
+                                   cells.data(), ts.data(), 1, &count, &out.cell[r]);
+    out.view_cell.insert(out.view_cell.end(), cells.begin(), cells.begin() + count);
+    out.view_t.insert(out.view_t.end(), ts.begin(), ts.begin() + count);
+    out.first.push_back(out.view_cell.size());
   }
   return out;
 }

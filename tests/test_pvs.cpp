@@ -80,21 +80,21 @@ bool sameFloat(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 // without correctly rounded division and square root may round a few rays the other way.
 void expectSame(const RayCastResult& got, const RayCastResult& want) {
   ASSERT_EQ(got.t.size(), want.t.size());
-  ASSERT_EQ(got.cap, want.cap);
+  ASSERT_EQ(got.first.size(), want.first.size());
   const bool exact = testContext().device().correctly_rounded_divide;
   std::size_t differ = 0;
   for (std::size_t r = 0; r < got.t.size(); ++r) {
     bool same =
-        sameFloat(got.t[r], want.t[r]) && got.cell[r] == want.cell[r] && got.count[r] == want.count[r];
-    for (int j = 0; same && j < got.count[r]; ++j)
-      same = got.view_cell[r * got.cap + j] == want.view_cell[r * got.cap + j] &&
-             sameFloat(got.view_t[r * got.cap + j], want.view_t[r * got.cap + j]);
+        sameFloat(got.t[r], want.t[r]) && got.cell[r] == want.cell[r] && got.count(r) == want.count(r);
+    for (int j = 0; same && j < got.count(r); ++j)
+      same = got.view_cell[got.first[r] + j] == want.view_cell[want.first[r] + j] &&
+             sameFloat(got.view_t[got.first[r] + j], want.view_t[want.first[r] + j]);
     if (!same) {
       ++differ;
       if (exact) {
         ADD_FAILURE() << "ray " << r << ": device t " << got.t[r] << " cell " << got.cell[r] << " count "
-                      << got.count[r] << ", reference t " << want.t[r] << " cell " << want.cell[r]
-                      << " count " << want.count[r];
+                      << got.count(r) << ", reference t " << want.t[r] << " cell " << want.cell[r]
+                      << " count " << want.count(r);
         return;
       }
     }
@@ -121,7 +121,7 @@ TEST(PvsRayCaster, KernelMatchesTheReferenceOnEveryHardCase) {
         const RayCastResult got = castHeightFieldRays(context, field, in, options);
         const RayCastResult want = referenceCastHeightFieldRays(field, in, options);
         expectSame(got, want);
-        for (std::size_t r = 0; r < in.size(); ++r) hits += got.cell[r] >= 0, listed += got.count[r];
+        for (std::size_t r = 0; r < in.size(); ++r) hits += got.cell[r] >= 0, listed += got.count(r);
         rays += in.size();
       }
     });
@@ -192,10 +192,10 @@ void checkAgainstBruteForce(const HeightField& field) {
     }
     // The view cells: each listed at a point in its band and square; every sample of the free
     // part well inside the band lies in a listed view cell.
-    const int n = got.count[r];
-    std::vector<int> listed(got.view_cell.begin() + r * got.cap, got.view_cell.begin() + r * got.cap + n);
+    const int n = got.count(r);
+    std::vector<int> listed(got.view_cell.begin() + got.first[r], got.view_cell.begin() + got.first[r] + n);
     for (int j = 0; j < n; ++j) {
-      const double tj = got.view_t[r * got.cap + j], c = rayClearance(field, q, tj);
+      const double tj = got.view_t[got.first[r] + j], c = rayClearance(field, q, tj);
       EXPECT_TRUE(c >= 0.5 - tolerance && c <= 3.0 + tolerance)
           << "view cell " << listed[j] << " at clearance " << c << " t " << tj << " o " << q.ox << "," << q.oy
           << "," << q.oz << " d " << q.dx << "," << q.dy << "," << q.dz;
@@ -241,6 +241,27 @@ TEST(PvsRayCaster, AgreesWithBruteForceOnCityAndTerrain) {
   }
 }
 
+// The caster sorts the rays by their origins' blocks before casting and hands the results back
+// in the caller's order: on fields of many blocks, over several launches, in both layouts, each
+// ray's hit and list are the reference's for that ray.
+TEST(PvsRayCaster, RaysSortedByOriginComeBackInTheCallersOrder) {
+  forEachLayout([&](const ComputeContext& context) {
+    for (const char* name : {"city", "nan_holes", "flat"}) {
+      SCOPED_TRACE(name);
+      const HeightField field = makeSyntheticField(name, 150, 110, 9);
+      RayCastOptions options;
+      options.view_cells = true;
+      options.grid.view_cell = 8;
+      options.grid.band_low = 0.5;
+      options.grid.band_high = 2.0;
+      const std::vector<HeightRay> in = raysOver(field, 2000, 17);
+      options.memory_budget_bytes = 400 * (11 + 2 * 33) * 4;  // 400 rays per launch
+      const RayCastResult got = castHeightFieldRays(context, field, in, options);
+      expectSame(got, referenceCastHeightFieldRays(field, in, options));
+    }
+  });
+}
+
 // A memory budget splits the rays into more launches, with the same results; one that does not
 // hold a single ray is refused.
 TEST(PvsRayCaster, MemoryBudgetSplitsLaunchesWithTheSameResults) {
@@ -253,7 +274,7 @@ TEST(PvsRayCaster, MemoryBudgetSplitsLaunchesWithTheSameResults) {
   options.memory_budget_bytes = 8192;  // about 50 rays per launch
   const RayCastResult split = castHeightFieldRays(testContext(), field, in, options);
   EXPECT_EQ(split.cell, whole.cell);
-  EXPECT_EQ(split.count, whole.count);
+  EXPECT_EQ(split.first, whole.first);
   EXPECT_EQ(split.view_cell, whole.view_cell);
   for (std::size_t r = 0; r < in.size(); ++r) EXPECT_TRUE(sameFloat(split.t[r], whole.t[r])) << r;
   options.memory_budget_bytes = 16;

@@ -88,6 +88,9 @@ inline float hf_ray_band_point(float f0, float f1, float bump, float s_end, floa
   float s = 0.5f * (s_low + s_high);
   for (int i = 0; i < 40; ++i) {
     s = 0.5f * (s_low + s_high);
+    // Once the midpoint rounds to an end the bracket cannot shrink: every further step would
+    // find this s again (a band of one height, H0 = H1, is met exactly almost never).
+    if (s == s_low || s == s_high) break;
     const float g = hf_ray_piece(f0, f1, bump, s);
     if (g >= lo && g <= hi) break;
     if (g < lo)

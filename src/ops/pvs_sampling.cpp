@@ -416,9 +416,9 @@ class Sampler {
         for (int side = 0; side < 2; ++side) {
           const std::size_t m = 2 * std::size_t(i) + side;
           const HeightRay& p = rays[m];
-          for (int j = 0; j < r.count[m]; ++j) {
-            const int v = r.view_cell[m * r.cap + j];
-            const float t = r.view_t[m * r.cap + j];
+          for (std::size_t j = r.first[m]; j < r.first[m + 1]; ++j) {
+            const int v = r.view_cell[j];
+            const float t = r.view_t[j];
             const int c = add(v, tile, p.ox + t * p.dx, p.oy + t * p.dy, p.oz + t * p.dz, tx, ty);
             end_contribution[end] += c;
             total += c;
