@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 
 #include "ops/pvs_ray.hpp"
 
@@ -70,6 +71,48 @@ double bruteForceRayHit(const HeightField& field, const HeightRay& ray, double s
       break;
   }
   return INFINITY;
+}
+
+std::vector<HeightRay> randomViewRays(const HeightField& f, const PvsGrid& grid, int count,
+                                      std::uint32_t seed) {
+  std::mt19937_64 gen(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<HeightRay> rays;
+  rays.reserve(count);
+  while (static_cast<int>(rays.size()) < count) {
+    const double x = u(gen) * (f.width - 1), y = u(gen) * (f.height - 1);
+    const int cx = std::min(int(x), f.width - 2), cy = std::min(int(y), f.height - 2);
+    const double a = u(gen), b = u(gen);
+    const double h00 = f.at(cx, cy), h10 = f.at(cx + 1, cy), h01 = f.at(cx, cy + 1),
+                 h11 = f.at(cx + 1, cy + 1);
+    const double s = (h00 * (1 - (x - cx)) * (1 - (y - cy)) + h10 * (x - cx) * (1 - (y - cy)) +
+                      h01 * (1 - (x - cx)) * (y - cy) + h11 * (x - cx) * (y - cy)) *
+                     f.z_scale;
+    if (!std::isfinite(s)) continue;
+    const double phi = 2.0 * M_PI * a, c = 1.0 - 2.0 * b, r = std::sqrt(std::max(0.0, 1.0 - c * c));
+    HeightRay ray;
+    ray.ox = float(x), ray.oy = float(y);
+    ray.oz = float(s + grid.band_low + (grid.band_high - grid.band_low) * u(gen));
+    ray.dx = float(r * std::cos(phi) / f.cell_size_x);
+    ray.dy = float(r * std::sin(phi) / f.cell_size_y);
+    ray.dz = float(c);
+    ray.t_max = INFINITY;
+    rays.push_back(ray);
+  }
+  return rays;
+}
+
+double measuredPixelError(const HeightField& f, const PvsResult& pvs, const std::vector<HeightRay>& rays,
+                          const RayCastResult& hits, double resolution) {
+  std::size_t wrong = 0;
+  const PvsLayout& l = pvs.layout;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    if (hits.cell[i] < 0) continue;
+    const int cx = std::min(int(rays[i].ox), f.width - 2), cy = std::min(int(rays[i].oy), f.height - 2);
+    const int v = l.viewOfCell(cy * l.cells_x + cx);
+    wrong += !pvs.visible(v, l.tileOfCell(hits.cell[i]));
+  }
+  return resolution * double(wrong) / double(rays.size());
 }
 
 }  // namespace hfvis

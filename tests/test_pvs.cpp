@@ -457,6 +457,36 @@ TEST(Pvs, FixedSeedsReproduceInBothLayouts) {
   }
 }
 
+// Sec. 4.5's estimate against the error measured with random view rays at the end of each
+// sampler's run (the target: within a factor 2), on a city and a rough terrain, after
+// budgets that leave an error of a few hundred to a few thousand per million (a run inside one
+// batch too: the estimate must be of the run's end, not of its whole). Below about a hundred per
+// million the estimate rests on a handful of AGVS's view-direction rays (docs/PVS.md).
+TEST(Pvs, EstimatedPixelErrorWithinAFactorTwoOfTheMeasured) {
+  PvsGrid grid;
+  grid.view_cell = 16;
+  grid.tile = 8;
+  for (const char* name : {"city", "noise"}) {
+    const HeightField field = makeSyntheticField(name, 97, 97, 7);
+    const std::vector<HeightRay> check = randomViewRays(field, grid, 400000, 99);
+    const RayCastResult hits = castHeightFieldRays(testContext(), field, check);
+    for (PvsMethod method : {PvsMethod::Agvs, PvsMethod::Sgvs, PvsMethod::PerCell})
+      for (std::uint64_t samples : {30000u, 100000u}) {
+        PvsOptions options;
+        options.method = method;
+        options.samples = samples;
+        const PvsResult pvs = computePvs(testContext(), field, grid, options);
+        const double measured = measuredPixelError(field, pvs, check, hits, options.resolution);
+        SCOPED_TRACE(std::string(name) + " method " + std::to_string(int(method)) + " samples " +
+                     std::to_string(samples) + ": estimated " + std::to_string(pvs.pixel_error) +
+                     ", measured " + std::to_string(measured));
+        ASSERT_GT(measured, 300.0);  // else the check rays' own count is too small to compare
+        EXPECT_LE(pvs.pixel_error, 2.0 * measured);
+        EXPECT_GE(pvs.pixel_error, 0.5 * measured);
+      }
+  }
+}
+
 TEST(Pvs, PixelErrorBudgetStopsTheRun) {
   const HeightField field = smallCity();
   PvsOptions options;
