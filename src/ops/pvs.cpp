@@ -158,6 +158,7 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
     for (int first = 0; first < n; first += chunk)
       launch(rays, order, first, std::min(chunk, n - first), cap, out, cast_lists);
     out.first.assign(rays.size() + 1, 0);
+    if (cast_lists.cells.empty()) return out;
     for (int i = 0; i < n; ++i) out.first[order[i] + 1] = cast_lists.first[i + 1] - cast_lists.first[i];
     for (int r = 0; r < n; ++r) out.first[r + 1] += out.first[r];
     out.view_cell.resize(cast_lists.cells.size());
