@@ -282,7 +282,8 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
     }
     const int longest = n ? *std::max_element(count.begin(), count.end()) : 0;
     if (longest == 0) {
-      lists.first.insert(lists.first.end(), std::size_t(n), lists.first.back());
+      const std::size_t end = lists.first.back();
+      lists.first.insert(lists.first.end(), std::size_t(n), end);
       return;
     }
     // Only the lists' first `longest` entries: per ray (line-major) or per plane (step-major).
