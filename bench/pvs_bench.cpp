@@ -11,6 +11,7 @@
 
 #include "hfvis/image_io.hpp"
 #include "hfvis/pvs.hpp"
+#include "hfvis_testing/pvs_reference.hpp"
 #include "hfvis_testing/synthetic_fields.hpp"
 
 namespace hfvis::bench {
@@ -18,51 +19,6 @@ namespace {
 
 double seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
-}
-
-// Random rays from the view band (uniform over the valid cells' squares, at H0 .. H1 above the
-// surface) in uniform directions (ground units), unbounded.
-std::vector<HeightRay> viewRays(const HeightField& f, const PvsGrid& grid, int count, std::uint32_t seed) {
-  std::mt19937_64 gen(seed);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::vector<HeightRay> rays;
-  rays.reserve(count);
-  while (static_cast<int>(rays.size()) < count) {
-    const double x = u(gen) * (f.width - 1), y = u(gen) * (f.height - 1);
-    const int cx = std::min(int(x), f.width - 2), cy = std::min(int(y), f.height - 2);
-    const double a = u(gen), b = u(gen);
-    const double h00 = f.at(cx, cy), h10 = f.at(cx + 1, cy), h01 = f.at(cx, cy + 1),
-                 h11 = f.at(cx + 1, cy + 1);
-    const double s = (h00 * (1 - (x - cx)) * (1 - (y - cy)) + h10 * (x - cx) * (1 - (y - cy)) +
-                      h01 * (1 - (x - cx)) * (y - cy) + h11 * (x - cx) * (y - cy)) *
-                     f.z_scale;
-    if (!std::isfinite(s)) continue;
-    const double phi = 2.0 * M_PI * a, c = 1.0 - 2.0 * b, r = std::sqrt(std::max(0.0, 1.0 - c * c));
-    HeightRay ray;
-    ray.ox = float(x), ray.oy = float(y);
-    ray.oz = float(s + grid.band_low + (grid.band_high - grid.band_low) * u(gen));
-    ray.dx = float(r * std::cos(phi) / f.cell_size_x);
-    ray.dy = float(r * std::sin(phi) / f.cell_size_y);
-    ray.dz = float(c);
-    ray.t_max = INFINITY;
-    rays.push_back(ray);
-  }
-  return rays;
-}
-
-// The measured pixel error (Bittner et al. 2009, Sec. 4.5's definition): of random view rays,
-// those whose hit tile is missing from the PVS of the view cell they start in, per `resolution`.
-double measuredPixelError(const HeightField& f, const PvsResult& pvs, const std::vector<HeightRay>& rays,
-                          const RayCastResult& hits, double resolution) {
-  std::size_t wrong = 0;
-  const PvsLayout& l = pvs.layout;
-  for (std::size_t i = 0; i < rays.size(); ++i) {
-    if (hits.cell[i] < 0) continue;
-    const int cx = std::min(int(rays[i].ox), f.width - 2), cy = std::min(int(rays[i].oy), f.height - 2);
-    const int v = l.viewOfCell(cy * l.cells_x + cx);
-    wrong += !pvs.visible(v, l.tileOfCell(hits.cell[i]));
-  }
-  return resolution * double(wrong) / double(rays.size());
 }
 
 const char* methodName(PvsMethod m) {
@@ -99,7 +55,7 @@ void pvsRaysReport(const ComputeContext& context, const std::vector<std::string>
     const HeightField f = pvsBenchField(name, size, dem_path);
     RayCastOptions plain, listed;
     listed.view_cells = true;
-    const std::vector<HeightRay> in = viewRays(f, plain.grid, rays, 5);
+    const std::vector<HeightRay> in = randomViewRays(f, plain.grid, rays, 5);
     castHeightFieldRays(context, f, std::vector<HeightRay>(in.begin(), in.begin() + 1024), listed);  // build
     // Wall time, and the process's CPU time (host and PoCL's threads), which a machine shared
     // with other work inflates less.
@@ -140,7 +96,7 @@ void pvsRecallReport(const ComputeContext& context, const std::vector<std::strin
     auto t0 = std::chrono::steady_clock::now();
     const PvsResult dense = computeDensePvs(context, f, grid);
     const double dense_seconds = seconds(t0);
-    const std::vector<HeightRay> check = viewRays(f, grid, check_rays, 99);
+    const std::vector<HeightRay> check = randomViewRays(f, grid, check_rays, 99);
     const RayCastResult check_hits = castHeightFieldRays(context, f, check);
     std::printf("\n### %s %d x %d (view cells %d x %d cells, tiles %d x %d)\n\n", name.c_str(), f.width,
                 f.height, view_cell, view_cell, tile, tile);

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 
 #include "ops/pvs_ray.hpp"
 
@@ -13,20 +14,24 @@ RayCastResult referenceCastHeightFieldRays(const HeightField& field, const std::
   const PvsLayout layout = pvsLayout(field, options.grid);
   const std::vector<float> heights = detail::rayHeights(field);
   const detail::RayPyramid pyramid = detail::buildRayPyramid(heights, field.width, field.height);
+  const int cap = options.view_cells ? layout.view_x + layout.view_y : 0;
   RayCastResult out;
-  out.cap = options.view_cells ? layout.view_x + layout.view_y : 0;
   out.t.resize(rays.size());
   out.cell.resize(rays.size());
-  out.count.resize(rays.size());
-  out.view_cell.assign(rays.size() * out.cap, 0);
-  out.view_t.assign(rays.size() * out.cap, 0.0f);
+  out.first.assign(1, 0);
+  std::vector<int> cells(std::max(cap, 1));
+  std::vector<float> ts(std::max(cap, 1));
   for (std::size_t r = 0; r < rays.size(); ++r) {
     const HeightRay& q = rays[r];
-    out.t[r] = detail::hf_ray_cast(
-        heights.data(), field.width, field.height, pyramid.values.data(), pyramid.levels.data(), pyramid.top,
-        q.ox, q.oy, q.oz, q.dx, q.dy, q.dz, q.t_max, options.grid.view_cell, layout.view_x,
-        float(options.grid.band_low), float(options.grid.band_high), out.cap,
-        out.view_cell.data() + r * out.cap, out.view_t.data() + r * out.cap, 1, &out.count[r], &out.cell[r]);
+    int count = 0;
+    out.t[r] = detail::hf_ray_cast(heights.data(), field.width, field.height, pyramid.values.data(),
+                                   pyramid.levels.data(), pyramid.top, q.ox, q.oy, q.oz, q.dx, q.dy, q.dz,
+                                   q.t_max, options.grid.view_cell, layout.view_x,
+                                   float(options.grid.band_low), float(options.grid.band_high), cap,
+                                   cells.data(), ts.data(), 1, &count, &out.cell[r]);
+    out.view_cell.insert(out.view_cell.end(), cells.begin(), cells.begin() + count);
+    out.view_t.insert(out.view_t.end(), ts.begin(), ts.begin() + count);
+    out.first.push_back(out.view_cell.size());
   }
   return out;
 }
@@ -66,6 +71,48 @@ double bruteForceRayHit(const HeightField& field, const HeightRay& ray, double s
       break;
   }
   return INFINITY;
+}
+
+std::vector<HeightRay> randomViewRays(const HeightField& f, const PvsGrid& grid, int count,
+                                      std::uint32_t seed) {
+  std::mt19937_64 gen(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<HeightRay> rays;
+  rays.reserve(count);
+  while (static_cast<int>(rays.size()) < count) {
+    const double x = u(gen) * (f.width - 1), y = u(gen) * (f.height - 1);
+    const int cx = std::min(int(x), f.width - 2), cy = std::min(int(y), f.height - 2);
+    const double a = u(gen), b = u(gen);
+    const double h00 = f.at(cx, cy), h10 = f.at(cx + 1, cy), h01 = f.at(cx, cy + 1),
+                 h11 = f.at(cx + 1, cy + 1);
+    const double s = (h00 * (1 - (x - cx)) * (1 - (y - cy)) + h10 * (x - cx) * (1 - (y - cy)) +
+                      h01 * (1 - (x - cx)) * (y - cy) + h11 * (x - cx) * (y - cy)) *
+                     f.z_scale;
+    if (!std::isfinite(s)) continue;
+    const double phi = 2.0 * M_PI * a, c = 1.0 - 2.0 * b, r = std::sqrt(std::max(0.0, 1.0 - c * c));
+    HeightRay ray;
+    ray.ox = float(x), ray.oy = float(y);
+    ray.oz = float(s + grid.band_low + (grid.band_high - grid.band_low) * u(gen));
+    ray.dx = float(r * std::cos(phi) / f.cell_size_x);
+    ray.dy = float(r * std::sin(phi) / f.cell_size_y);
+    ray.dz = float(c);
+    ray.t_max = INFINITY;
+    rays.push_back(ray);
+  }
+  return rays;
+}
+
+double measuredPixelError(const HeightField& f, const PvsResult& pvs, const std::vector<HeightRay>& rays,
+                          const RayCastResult& hits, double resolution) {
+  std::size_t wrong = 0;
+  const PvsLayout& l = pvs.layout;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    if (hits.cell[i] < 0) continue;
+    const int cx = std::min(int(rays[i].ox), f.width - 2), cy = std::min(int(rays[i].oy), f.height - 2);
+    const int v = l.viewOfCell(cy * l.cells_x + cx);
+    wrong += !pvs.visible(v, l.tileOfCell(hits.cell[i]));
+  }
+  return resolution * double(wrong) / double(rays.size());
 }
 
 }  // namespace hfvis

@@ -80,14 +80,14 @@ struct RayCastOptions {
 };
 
 struct RayCastResult {
-  std::vector<float> t;    // per ray: the hit, or where the ray leaves the field's box or ends
-  std::vector<int> cell;   // per ray: the hit cell (cy (W - 1) + cx), -1 for none
-  int cap = 0;             // view cells listed per ray at most (view_x + view_y), 0 without
-  std::vector<int> count;  // per ray: view cells listed
-  // Ray r's view cell j at r * cap + j (j < count[r]), in order along the ray, and a t where the
-  // ray lies in that view cell's volume (to rounding).
+  std::vector<float> t;   // per ray: the hit, or where the ray leaves the field's box or ends
+  std::vector<int> cell;  // per ray: the hit cell (cy (W - 1) + cx), -1 for none
+  // Ray r's view cells at first[r] .. first[r + 1] - 1 (rays + 1 offsets, all 0 without view
+  // cells), in order along the ray, each with a t where the ray lies in its volume (to rounding).
+  std::vector<std::size_t> first;
   std::vector<int> view_cell;
   std::vector<float> view_t;
+  int count(std::size_t ray) const { return static_cast<int>(first[ray + 1] - first[ray]); }
 };
 
 // Casts the rays on the device: the first point where each passes strictly below the bilinear

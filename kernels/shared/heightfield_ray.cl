@@ -72,12 +72,18 @@ inline float hf_ray_entry(float f0, float f1, float bump, float s_end) {
 }
 
 // A point of [0, s_end] where g lies in [lo, hi] (the view band, g being minus the height over the
-// surface), given that g's range over [0, s_end] (its ends and its vertex sv) meets it: an end or
-// the vertex where it lies in the band, else a bisection between a point below and one above.
+// surface), given that g's range over [0, s_end] (its ends and its vertex sv) meets it: an end
+// where it lies in the band, else where g first reaches the band (the entry of g - lo from below,
+// of hi - g from above, solved as the hit is; a band of one height, H0 = H1, holds it only to
+// rounding); where rounding puts that root outside a wider band, the vertex or a bisection
+// between a point below and one above.
 inline float hf_ray_band_point(float f0, float f1, float bump, float s_end, float sv, float lo, float hi) {
   const float ge = hf_ray_piece(f0, f1, bump, s_end);
   if (f0 >= lo && f0 <= hi) return 0.0f;
   if (ge >= lo && ge <= hi) return s_end;
+  const float root = f0 < lo ? hf_ray_entry(f0 - lo, f1 - lo, bump, s_end) : hf_ray_entry(hi - f0, hi - f1, -bump, s_end);
+  const float g_root = hf_ray_piece(f0, f1, bump, root);
+  if ((g_root >= lo && g_root <= hi) || lo == hi) return root;  // a band of one height: met to rounding
   float s_low = f0 < lo ? 0.0f : s_end, s_high = f0 > hi ? 0.0f : s_end;
   if (sv > 0.0f && sv < s_end) {
     const float gv = hf_ray_piece(f0, f1, bump, sv);
@@ -88,6 +94,9 @@ inline float hf_ray_band_point(float f0, float f1, float bump, float s_end, floa
   float s = 0.5f * (s_low + s_high);
   for (int i = 0; i < 40; ++i) {
     s = 0.5f * (s_low + s_high);
+    // Once the midpoint rounds to an end the bracket cannot shrink: every further step would
+    // find this s again (a band of one height, H0 = H1, is met exactly almost never).
+    if (s == s_low || s == s_high) break;
     const float g = hf_ray_piece(f0, f1, bump, s);
     if (g >= lo && g <= hi) break;
     if (g < lo)

@@ -140,21 +140,36 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
       if (!std::isfinite(r.ox) || !std::isfinite(r.oy) || !std::isfinite(r.oz) || !std::isfinite(r.dx) ||
           !std::isfinite(r.dy) || !std::isfinite(r.dz) || std::isnan(r.t_max))
         throw InvalidArgument("a ray with a non-finite origin or direction, or a NaN length");
-    RayCastResult out;
     const int n = static_cast<int>(rays.size());
-    out.cap = view_cells ? layout_.view_x + layout_.view_y : 0;
-    out.t.resize(rays.size());
-    out.cell.resize(rays.size());
-    out.count.assign(rays.size(), 0);
-    out.view_cell.resize(rays.size() * out.cap);
-    out.view_t.resize(rays.size() * out.cap);
+    const int cap = view_cells ? layout_.view_x + layout_.view_y : 0;
     // Per ray on the device: 8 floats in, t, cell, count and cap (view cell, t) pairs out.
-    const std::size_t per_ray = (8 + 3 + 2 * std::size_t(out.cap)) * 4;
+    const std::size_t per_ray = (8 + 3 + 2 * std::size_t(cap)) * 4;
     if (per_ray > memoryBudget())
       throw MemoryBudgetError("one ray and its view-cell list need " + mebibytes(per_ray) +
                               " but the memory budget is " + mebibytes(memoryBudget()));
     const int chunk = static_cast<int>(std::min<std::size_t>(kRaysPerLaunch, memoryBudget() / per_ray));
-    for (int first = 0; first < n; first += chunk) launch(rays, first, std::min(chunk, n - first), out);
+    const std::vector<int> order = originOrder(rays);
+    RayCastResult out;
+    out.t.resize(rays.size());
+    out.cell.resize(rays.size());
+    // The lists as cast (in `order`), then in the caller's order.
+    Lists cast_lists;
+    cast_lists.first.push_back(0);
+    for (int first = 0; first < n; first += chunk)
+      launch(rays, order, first, std::min(chunk, n - first), cap, out, cast_lists);
+    out.first.assign(rays.size() + 1, 0);
+    if (cast_lists.cells.empty()) return out;
+    for (int i = 0; i < n; ++i) out.first[order[i] + 1] = cast_lists.first[i + 1] - cast_lists.first[i];
+    for (int r = 0; r < n; ++r) out.first[r + 1] += out.first[r];
+    out.view_cell.resize(cast_lists.cells.size());
+    out.view_t.resize(cast_lists.cells.size());
+    for (int i = 0; i < n; ++i) {
+      const std::size_t from = cast_lists.first[i], to = out.first[order[i]];
+      std::copy(cast_lists.cells.begin() + from, cast_lists.cells.begin() + cast_lists.first[i + 1],
+                out.view_cell.begin() + to);
+      std::copy(cast_lists.ts.begin() + from, cast_lists.ts.begin() + cast_lists.first[i + 1],
+                out.view_t.begin() + to);
+    }
     return out;
   }
 
@@ -185,45 +200,111 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
   void runItem(int, int) override { body_(*this); }
   void finish() override {}
 
-  // Rays [first, first + n) into `out`.
-  void launch(const std::vector<HeightRay>& rays, int first, int n, RayCastResult& out) {
-    const int cap = out.cap;
+  // View-cell lists, one after another: ray i's at first[i] .. first[i + 1] - 1.
+  struct Lists {
+    std::vector<std::size_t> first;
+    std::vector<int> cells;
+    std::vector<float> ts;
+  };
+
+  // The rays in the order they are cast: by the 16 x 16-cell block holding their origin (clamped
+  // into the field), blocks row by row. Rays with neighbouring origins read neighbouring heights
+  // and pyramid blocks, so a launch's work-items share their cache lines; in the callers' order
+  // (random origins all over the field) each ray's first reads miss the CPU's caches. A counting
+  // sort, stable: the order depends on the origins alone.
+  std::vector<int> originOrder(const std::vector<HeightRay>& rays) const {
+    constexpr int kBlockShift = 4;
+    const int blocks_x = (layout_.cells_x >> kBlockShift) + 1,
+              blocks_y = (layout_.cells_y >> kBlockShift) + 1;
+    auto block = [&](const HeightRay& r) {
+      const float x = std::clamp(r.ox, 0.0f, float(layout_.cells_x - 1));
+      const float y = std::clamp(r.oy, 0.0f, float(layout_.cells_y - 1));
+      return (int(y) >> kBlockShift) * blocks_x + (int(x) >> kBlockShift);
+    };
+    std::vector<int> start(std::size_t(blocks_x) * blocks_y + 1, 0);
+    for (const HeightRay& r : rays) ++start[block(r) + 1];
+    for (std::size_t b = 1; b < start.size(); ++b) start[b] += start[b - 1];
+    std::vector<int> order(rays.size());
+    for (std::size_t i = 0; i < rays.size(); ++i) order[start[block(rays[i])]++] = static_cast<int>(i);
+    return order;
+  }
+
+  // Device buffers for `n` rays with lists of `cap`, kept from launch to launch (grown, never
+  // shrunk).
+  void reserve(int n, int cap) {
+    if (n > reserved_rays_) {
+      reserved_rays_ = n;
+      const std::size_t rays = std::size_t(n);
+      ray_buffer_ = deviceBuffer(st_, rays * 8 * 4);
+      t_ = deviceBuffer(st_, rays * 4);
+      cell_ = deviceBuffer(st_, rays * 4);
+      count_ = deviceBuffer(st_, rays * 4);
+    }
+    const std::size_t list = std::max<std::size_t>(1, std::size_t(n) * cap);
+    if (list > reserved_list_) {
+      reserved_list_ = list;
+      pierced_ = deviceBuffer(st_, list * 4);
+      pierced_t_ = deviceBuffer(st_, list * 4);
+    }
+  }
+
+  // The rays order[first .. first + n) into `out` (at their own index) and their lists onto
+  // `lists` (in cast order).
+  void launch(const std::vector<HeightRay>& rays, const std::vector<int>& order, int first, int n, int cap,
+              RayCastResult& out, Lists& lists) {
+    reserve(n, cap);
     std::vector<float> packed(std::size_t(n) * 8, 0.0f);
     for (int r = 0; r < n; ++r) {
-      const HeightRay& ray = rays[std::size_t(first) + r];
+      const HeightRay& ray = rays[order[std::size_t(first) + r]];
       const float values[7] = {ray.ox, ray.oy, ray.oz, ray.dx, ray.dy, ray.dz, ray.t_max};
       for (int c = 0; c < 7; ++c)
         packed[line_major_ ? std::size_t(r) * 8 + c : std::size_t(c) * n + r] = values[c];
     }
-    cl::Buffer ray_buffer = upload(packed);
-    cl::Buffer t = deviceBuffer(st_, std::size_t(n) * 4), cell = deviceBuffer(st_, std::size_t(n) * 4),
-               count = deviceBuffer(st_, std::size_t(n) * 4);
-    const std::size_t list = std::max<std::size_t>(1, std::size_t(n) * cap) * 4;
-    cl::Buffer pierced = deviceBuffer(st_, list), pierced_t = deviceBuffer(st_, list);
-    kernel_.set("rays", ray_buffer)
+    st_.queue.enqueueWriteBuffer(ray_buffer_, CL_FALSE, 0, packed.size() * 4, packed.data());
+    kernel_.set("rays", ray_buffer_)
         .set("n", cl_int(n))
         .set("cap", cl_int(cap))
-        .set("hit_t", t)
-        .set("hit_cell", cell)
-        .set("counts", count)
-        .set("pierced", pierced)
-        .set("pierced_t", pierced_t);
+        .set("hit_t", t_)
+        .set("hit_cell", cell_)
+        .set("counts", count_)
+        .set("pierced", pierced_)
+        .set("pierced_t", pierced_t_);
     st_.launch(kernel_, cl::NDRange(roundUp(n, kLineGroup)), cl::NDRange(kLineGroup));
-    st_.queue.enqueueReadBuffer(t, CL_FALSE, 0, std::size_t(n) * 4, out.t.data() + first);
-    st_.queue.enqueueReadBuffer(cell, CL_FALSE, 0, std::size_t(n) * 4, out.cell.data() + first);
-    st_.queue.enqueueReadBuffer(count, CL_TRUE, 0, std::size_t(n) * 4, out.count.data() + first);
-    if (cap == 0) return;
-    std::vector<int> cells(std::size_t(n) * cap);
-    std::vector<float> ts(std::size_t(n) * cap);
-    st_.queue.enqueueReadBuffer(pierced, CL_FALSE, 0, cells.size() * 4, cells.data());
-    st_.queue.enqueueReadBuffer(pierced_t, CL_TRUE, 0, ts.size() * 4, ts.data());
-    for (int r = 0; r < n; ++r)
-      for (int j = 0; j < out.count[std::size_t(first) + r]; ++j) {
-        const std::size_t from = line_major_ ? std::size_t(r) * cap + j : std::size_t(j) * n + r;
-        const std::size_t to = (std::size_t(first) + r) * cap + j;
-        out.view_cell[to] = cells[from];
-        out.view_t[to] = ts[from];
+    std::vector<float> t(n);
+    std::vector<int> cell(n), count(n);
+    st_.queue.enqueueReadBuffer(t_, CL_FALSE, 0, std::size_t(n) * 4, t.data());
+    st_.queue.enqueueReadBuffer(cell_, CL_FALSE, 0, std::size_t(n) * 4, cell.data());
+    st_.queue.enqueueReadBuffer(count_, CL_TRUE, 0, std::size_t(n) * 4, count.data());
+    for (int r = 0; r < n; ++r) {
+      const int to = order[std::size_t(first) + r];
+      out.t[to] = t[r];
+      out.cell[to] = cell[r];
+    }
+    const int longest = n ? *std::max_element(count.begin(), count.end()) : 0;
+    if (longest == 0) {
+      const std::size_t end = lists.first.back();
+      lists.first.insert(lists.first.end(), std::size_t(n), end);
+      return;
+    }
+    // Only the lists' first `longest` entries: per ray (line-major) or per plane (step-major).
+    const std::size_t row = line_major_ ? std::size_t(longest) : std::size_t(n),
+                      rows = line_major_ ? std::size_t(n) : std::size_t(longest),
+                      pitch = line_major_ ? std::size_t(cap) : std::size_t(n);
+    std::vector<int> cells(row * rows);
+    std::vector<float> ts(row * rows);
+    const cl::array<cl::size_type, 3> origin{0, 0, 0}, region{row * 4, rows, 1};
+    st_.queue.enqueueReadBufferRect(pierced_, CL_FALSE, origin, origin, region, pitch * 4, 0, row * 4, 0,
+                                    cells.data());
+    st_.queue.enqueueReadBufferRect(pierced_t_, CL_TRUE, origin, origin, region, pitch * 4, 0, row * 4, 0,
+                                    ts.data());
+    for (int r = 0; r < n; ++r) {
+      for (int j = 0; j < count[r]; ++j) {
+        const std::size_t from = line_major_ ? std::size_t(r) * longest + j : std::size_t(j) * n + r;
+        lists.cells.push_back(cells[from]);
+        lists.ts.push_back(ts[from]);
       }
+      lists.first.push_back(lists.cells.size());
+    }
   }
 
   const PvsGrid& grid_;
@@ -232,6 +313,9 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
   bool line_major_ = true;
   cl::Buffer pyramid_, levels_;
   NamedKernel kernel_;
+  int reserved_rays_ = 0;
+  std::size_t reserved_list_ = 0;
+  cl::Buffer ray_buffer_, t_, cell_, count_, pierced_, pierced_t_;
 };
 
 }  // namespace

@@ -28,6 +28,14 @@ constexpr std::size_t kMutationCandidates = 1 << 16;
 constexpr int kDiscoveryRays = 4;
 // The pixel-error window (Sec. 4.5, Eq. 5): P = 0.9, k = 0.5.
 constexpr double kWindowP = 0.9, kWindowK = 0.5;
+// The window's longest reach back: this share of the run's view-direction rays, the newest.
+constexpr double kWindowRecent = 0.25;
+// Samples per entry of the window (as folded in, in order).
+constexpr int kErrorChunk = 1024;
+// The view space-direction samples' least probability in the mixture: the pixel error is
+// estimated from them alone (Sec. 4.5), and at the common floor (kMinProbability) late in a run
+// too few are cast for the window to hold a current estimate.
+constexpr double kMinViewDirection = 0.1;
 
 enum Distribution { kViewDirection, kObjectDirection, kTwoPoint, kTwoPointMutation, kSilhouetteMutation };
 
@@ -378,6 +386,10 @@ class Sampler {
     std::vector<double> contribution(kPvsDistributions, 0.0), drawn(kPvsDistributions, 0.0);
     std::uint64_t window_rays = 0, window_contributing = 0;
     for (int i = 0; i < n; ++i) {
+      if (i % kErrorChunk == 0) {
+        recordError(window_rays, window_contributing);
+        window_rays = window_contributing = 0;
+      }
       const Sample& s = samples[i];
       drawn[s.distribution] += 1.0;
       if (!global) {
@@ -416,9 +428,9 @@ class Sampler {
         for (int side = 0; side < 2; ++side) {
           const std::size_t m = 2 * std::size_t(i) + side;
           const HeightRay& p = rays[m];
-          for (int j = 0; j < r.count[m]; ++j) {
-            const int v = r.view_cell[m * r.cap + j];
-            const float t = r.view_t[m * r.cap + j];
+          for (std::size_t j = r.first[m]; j < r.first[m + 1]; ++j) {
+            const int v = r.view_cell[j];
+            const float t = r.view_t[j];
             const int c = add(v, tile, p.ox + t * p.dx, p.oy + t * p.dy, p.oz + t * p.dz, tx, ty);
             end_contribution[end] += c;
             total += c;
@@ -446,7 +458,8 @@ class Sampler {
           mutations_.add(c);
         }
     }
-    updateError(window_rays, window_contributing);
+    recordError(window_rays, window_contributing);
+    updateError();
     if (options_.method == PvsMethod::Agvs) updateMixture(contribution, drawn);
   }
 
@@ -455,21 +468,34 @@ class Sampler {
     return ground(x, y, q.oz + double(t) * q.dz);
   }
 
-  // Sec. 4.5: the error from the newest batches' view-direction rays, as many as Eq. 5 asks for
-  // the error they give.
-  void updateError(std::uint64_t rays, std::uint64_t contributing) {
+  // The view-direction rays of the newest kErrorChunk samples and those of them that contributed.
+  void recordError(std::uint64_t rays, std::uint64_t contributing) {
     if (rays == 0) return;
     window_.push_front({rays, contributing});
-    std::uint64_t n = 0, c = 0;
-    std::size_t used = 0;
+    view_rays_ += rays;
+  }
+
+  // Sec. 4.5: the error from the newest view-direction rays, as many as Eq. 5 asks for the error
+  // they give, but not past the newest kWindowRecent of the run's: the error falls as the sets
+  // fill, and a window reaching back to when they were far from complete estimates the error of
+  // then (counted in chunks of kErrorChunk samples, so that a window may end inside a batch).
+  void updateError() {
+    if (window_.empty()) return;
+    const double reach = kWindowRecent * double(view_rays_);
+    std::uint64_t n = 0, c = 0, held = 0;
+    std::size_t kept = 0;
+    bool enough = false;
     for (const auto& w : window_) {
+      if (kept > 0 && double(held + w.first) > reach) break;  // out of reach from now on
+      held += w.first;
+      ++kept;
+      if (enough) continue;
       n += w.first;
       c += w.second;
-      ++used;
       const double e = double(c) / double(n);
-      if (e > 0.0 && double(n) >= (1.0 - e) / (kWindowK * kWindowK * e * (1.0 - kWindowP))) break;
+      enough = e > 0.0 && double(n) >= (1.0 - e) / (kWindowK * kWindowK * e * (1.0 - kWindowP));
     }
-    window_.resize(used);
+    window_.resize(kept);
     out_.pixel_error = options_.resolution * double(c) / double(n);
   }
 
@@ -494,6 +520,12 @@ class Sampler {
     for (int d = 0; d < kPvsDistributions; ++d)
       probability_[d] =
           weight[d] > 0.0 ? kMinProbability + (1.0 - kMinProbability * available) * weight[d] / sum : 0.0;
+    if (probability_[kViewDirection] < kMinViewDirection) {
+      const double others = 1.0 - probability_[kViewDirection];
+      for (int d = 0; d < kPvsDistributions; ++d)
+        if (d != kViewDirection) probability_[d] *= (1.0 - kMinViewDirection) / others;
+      probability_[kViewDirection] = kMinViewDirection;
+    }
   }
 
   // Sec. 5's object-space filter with the global extension e = k 2 d / sqrt(n_v): n_v the
@@ -547,6 +579,7 @@ class Sampler {
   MutationBuffer mutations_;
   std::vector<Silhouette> silhouettes_;
   std::deque<std::pair<std::uint64_t, std::uint64_t>> window_;
+  std::uint64_t view_rays_ = 0;  // view-direction rays cast so far
 };
 
 }  // namespace

@@ -23,4 +23,15 @@ double bruteForceRayHit(const HeightField& field, const HeightRay& ray, double s
 // cell with a nodata corner).
 double rayClearance(const HeightField& field, const HeightRay& ray, double t);
 
+// Random rays from the view band (uniform over the valid cells' squares, at H0 .. H1 above the
+// surface) in uniform directions (ground units), unbounded; a seed gives the same rays.
+std::vector<HeightRay> randomViewRays(const HeightField& f, const PvsGrid& grid, int count,
+                                      std::uint32_t seed);
+
+// The measured pixel error (Bittner et al. 2009, Sec. 4.5's definition): of the view rays `rays`
+// (hit by castHeightFieldRays as `hits`), those whose hit tile is missing from the PVS of the
+// view cell they start in, per `resolution` rays.
+double measuredPixelError(const HeightField& f, const PvsResult& pvs, const std::vector<HeightRay>& rays,
+                          const RayCastResult& hits, double resolution);
+
 }  // namespace hfvis
