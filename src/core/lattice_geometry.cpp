@@ -358,6 +358,18 @@ std::vector<LatticeLine> latticeLines(const LatticeDirection& d, int width, int 
   return lines;
 }
 
+int receiverIndex(const HeightField& field, int a, int b, int col, int row) {
+  const FieldOrigin& o = field.origin;
+  const int width = o.present() ? o.whole_width : field.width, height = o.present() ? o.whole_height : field.height;
+  const int c = col + o.col, r = row + o.row;
+  int m = std::numeric_limits<int>::max();
+  if (a > 0) m = std::min(m, (width - 1 - c) / a);
+  if (a < 0) m = std::min(m, c / -a);
+  if (b > 0) m = std::min(m, (height - 1 - r) / b);
+  if (b < 0) m = std::min(m, r / -b);
+  return m;
+}
+
 std::pair<int, int> receiversInRows(const LatticeLine& line, int b, int first_row, int end_row) {
   // Receiver i sits in row line.row - i b.
   auto floorDiv = [](long x, long y) { return x / y - ((x % y != 0) && ((x < 0) != (y < 0))); };
@@ -424,7 +436,11 @@ LatticeWindow latticeWindow(const HeightField& field, const LatticeDirection& d,
   if (max_distance <= 0.0) return w;
   // Positions along a line are pixels, or ground lengths with per-row spacing; they stay below
   // 2 (W + H) pixels, times the largest cell size.
-  double unit = d.ground_per_pixel, longest = 2.0 * (static_cast<double>(field.width) + field.height);
+  // (A field cut from a larger one places them along the larger field's lines.)
+  const bool larger = field.origin.present();
+  double unit = d.ground_per_pixel,
+         longest = 2.0 * (static_cast<double>(larger ? field.origin.whole_width : field.width) +
+                          (larger ? field.origin.whole_height : field.height));
   if (!field.row_cell_size_x.empty()) {
     unit = 1.0;
     longest *= std::max(*std::max_element(field.row_cell_size_x.begin(), field.row_cell_size_x.end()),

@@ -165,6 +165,13 @@ std::vector<LineChunk> chunkLines(std::vector<LatticeLine>& lines, std::size_t s
 std::vector<LineChunk> chunkLines(std::vector<LatticeLine>& lines, const std::vector<std::size_t>& capacities,
                                   std::size_t max_entries, bool line_major);
 
+// The index of receiver (col, row) of this field along its line of step (a, b) through the larger
+// field it was cut from (HeightField::origin; without one, this field): how many receivers of
+// that line lie beyond it along +(a, b). The horizon sweep places sample positions from it
+// (receiver_index in kernels/horizon.cl: the same integer arithmetic), so that a field cut out
+// of a larger one meets every sample where the larger field does.
+int receiverIndex(const HeightField& field, int a, int b, int col, int row);
+
 // The receivers [first, end) of a line of a direction with row step b that lie in rows
 // [first_row, end_row) (a strip); first == end when none do.
 std::pair<int, int> receiversInRows(const LatticeLine& line, int b, int first_row, int end_row);

@@ -261,6 +261,8 @@ class HorizonRoutine : public SweepRoutine {
     // A window's blocks are per line, so its strips, and with per-row spacing its whole sweep
     // (positions differ by line there), run one line per work-item.
     if ((inStrips() || hasRowSpacing(field)) && options.max_distance > 0.0) lanes_ = 1;
+    // A field cut from a larger one: each line's positions count from its own place there.
+    if (shiftedPositions()) lanes_ = 1;
   }
 
   HorizonResult take() { return std::move(result_); }
@@ -270,8 +272,10 @@ class HorizonRoutine : public SweepRoutine {
   std::string programOptions() const override {
     return detail::programOptions(outputs_, prepared_.has_nodata, lanes_, horizon_.curvature != 0.0,
                                   horizon_.max_distance > 0.0, hasRowSpacing(field_)) +
-           " -DHFVIS_STRIPS=" + std::to_string(inStrips());
+           " -DHFVIS_STRIPS=" + std::to_string(inStrips()) + " -DHFVIS_ORIGIN=" + std::to_string(shiftedPositions());
   }
+  // Positions along a larger field's lines (HeightField::origin; not with per-row spacing).
+  bool shiftedPositions() const { return field_.origin.present() && !hasRowSpacing(field_); }
   bool heightsResident() const override { return !inStrips(); }
   bool needsNormals() const { return outputs_.ambient_occlusion || outputs_.environment; }
   int environmentChannels() const { return static_cast<int>(environmentPlanes(outputs_)); }
@@ -599,6 +603,11 @@ class HorizonRoutine : public SweepRoutine {
     kernel.set("drop", curvatureDrop(unit));
     kernel.set("window", d.window.window);
     kernel.set("inv_window", d.window.inv_window);
+    const FieldOrigin& origin = field_.origin;
+    kernel.set("origin_col", origin.col);
+    kernel.set("origin_row", origin.row);
+    kernel.set("whole_width", origin.present() ? origin.whole_width : field_.width);
+    kernel.set("whole_height", origin.present() ? origin.whole_height : field_.height);
     for (cl::Buffer& table : setRowTables(kernel, d)) keep.push_back(table);
     setOutputs(kernel, d, plane_offset);
     return kernel;
