@@ -37,8 +37,7 @@
 //                                            strips of rows, see there)
 //   HFVIS_ORIGIN                             the field was cut from a larger one (HeightField::
 //                                            origin): horizon_lattice places positions along the
-//                                            larger field's lines (receiver_index), one line per
-//                                            work-item
+//                                            larger field's lines (receiver_index)
 #include "shared/direction_terms.cl"
 #include "environment_light.cl"
 #include "shared/fast_math.cl"
@@ -78,8 +77,8 @@
 #ifndef HFVIS_ORIGIN
 #define HFVIS_ORIGIN 0
 #endif
-#if HFVIS_ORIGIN && HFVIS_LANES != 1
-#error "positions along a larger field's lines differ by line: one line per work-item"
+#if HFVIS_ORIGIN && HFVIS_STRIPS && HFVIS_LANES != 1
+#error "a strip's lines resume at indices of their own along a larger field's lines: one line per work-item"
 #endif
 #if HFVIS_MAX_DISTANCE && HFVIS_ROW_SPACING && HFVIS_LANES != 1
 #error "a maximum distance with per-row spacing runs one line per work-item"
@@ -704,6 +703,8 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
 // the far end of the larger field's line (receiver_index), so that every sample lies where it lies
 // in the larger field's sweep, to the bit; a line still starts at this field's edge with an empty
 // stack. Not with HFVIS_ROW_SPACING, whose positions are ground lengths summed along a line.
+// Lanes share their positions: the host gives a work-item's lanes lines that start at the same
+// index there (lane 0's is taken for all).
 //
 // With HFVIS_MAX_DISTANCE only samples within `window` (pixels along the line; ground units
 // with HFVIS_ROW_SPACING) count, inv_window = 1 / window (window_pass; window_far: one (rise,
@@ -777,7 +778,9 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 #endif
 #if HFVIS_ORIGIN && !HFVIS_ROW_SPACING
   // Positions count from the larger field's line's far end: `shift` receivers more than here.
-  const int shift = receiver_index(c + origin_col, r + origin_row, a, b, whole_width, whole_height) - start;
+  const int shift =
+      receiver_index(ILANE(c, 0) + origin_col, ILANE(r, 0) + origin_row, a, b, whole_width, whole_height) -
+      ILANE(start, 0);
 #else
   const int shift = 0;
 #endif
