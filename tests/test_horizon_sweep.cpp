@@ -795,6 +795,23 @@ TEST(HorizonKernels, HeightSpanBeyondFloatArithmeticIsRefused) {
   EXPECT_NO_THROW(computeHorizons(testContext(), field, options, outputs));
 }
 
+// An origin that does not place the field inside its larger field, or whose lowest height is not
+// finite or lies above one of the field's heights, is refused.
+TEST(HorizonKernels, AnOriginOutsideItsLargerFieldOrAboveAHeightIsRefused) {
+  HeightField field = makeSyntheticField("noise", 6, 5, 1);  // heights in [0, 1)
+  HorizonOptions options;
+  options.directions = 4;
+  options.max_distance = 2.0;
+  field.origin = {2, 3, 8, 8, -1.0};
+  EXPECT_NO_THROW(computeHorizons(testContext(), field, options, allOutputs()));
+  for (FieldOrigin bad :
+       {FieldOrigin{3, 3, 8, 8, -1.0}, FieldOrigin{2, 4, 8, 8, -1.0}, FieldOrigin{-1, 0, 8, 8, -1.0},
+        FieldOrigin{0, 0, 5, 0, -1.0}, FieldOrigin{2, 3, 8, 8, 0.5}, FieldOrigin{2, 3, 8, 8, NAN}}) {
+    field.origin = bad;
+    EXPECT_THROW(computeHorizons(testContext(), field, options, allOutputs()), InvalidArgument);
+  }
+}
+
 TEST(HorizonKernels, InvalidOptionsAreRejectedBeforeLaunch) {
   const HeightField field = makeSyntheticField("flat", 5, 5);
   HorizonOptions options;
