@@ -1,5 +1,5 @@
-"""Dask-backed DataArrays: the distance-limited operations chunk by chunk through
-dask.array.map_overlap with a halo of the maximum distance, and cumulative viewsheds split into
+"""Dask-backed DataArrays: the distance-limited operations chunk by chunk with a halo of the
+maximum distance (dask.array.overlap.overlap, then map_blocks), and cumulative viewsheds split into
 groups of observers summed. The graph carries module-level functions and plain values only (the
 operation's name, its options, the geometry), so that distributed workers can unpickle it; each
 worker process makes its own OpenCL context (hfvis._core keeps one per process)."""
@@ -30,7 +30,7 @@ def halo(geometry, max_distance, operation):
 
 
 def _block(block, lowest, operation, geometry, options, device, depth, chunks, block_id=None):
-    """One chunk with its halo (map_overlap, boundary 'none': no halo beyond the field's own edges,
+    """One chunk with its halo (overlap, boundary 'none': no halo beyond the field's own edges,
     which stay edges) -> its planes, the halo trimmed, stacked along a leading axis. The library is
     told where the block lies in the whole field and the whole field's lowest height (`lowest`, a
     1 x 1 block; HeightField::origin), so that it samples every line where the whole field's run does: the
