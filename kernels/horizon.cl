@@ -35,6 +35,9 @@
 //                                            per-row tables `row_length` and `row_terms`
 //   HFVIS_STRIPS                             horizon_lattice resumes lines part-way (a field in
 //                                            strips of rows, see there)
+//   HFVIS_ORIGIN                             the field was cut from a larger one (HeightField::
+//                                            origin): horizon_lattice places positions along the
+//                                            larger field's lines (receiver_index)
 #include "shared/direction_terms.cl"
 #include "environment_light.cl"
 #include "shared/fast_math.cl"
@@ -70,6 +73,12 @@
 #endif
 #ifndef HFVIS_STRIPS
 #define HFVIS_STRIPS 0
+#endif
+#ifndef HFVIS_ORIGIN
+#define HFVIS_ORIGIN 0
+#endif
+#if HFVIS_ORIGIN && HFVIS_STRIPS && HFVIS_LANES != 1
+#error "a strip's lines resume at indices of their own along a larger field's lines: one line per work-item"
 #endif
 #if HFVIS_MAX_DISTANCE && HFVIS_ROW_SPACING && HFVIS_LANES != 1
 #error "a maximum distance with per-row spacing runs one line per work-item"
@@ -482,6 +491,19 @@ HFVIS_INLINE void hull_step(__global float2* stacks, lane_int stack, int entry, 
 #define HFVIS_STACK_HEIGHT(h, here) (h)
 #endif
 
+// The index of receiver (c, r) of the field along its line of step (a, b) through the larger field
+// it was cut from, whose pixel (c, r) is this field's (c - origin_col, r - origin_row) (without an
+// origin, the field itself): the receivers beyond it along +(a, b). As receiverIndex
+// (src/core/lattice_geometry.cpp) computes it.
+HFVIS_INLINE int receiver_index(int c, int r, int a, int b, int whole_width, int whole_height) {
+  int m = INT_MAX;
+  if (a > 0) m = min(m, (whole_width - 1 - c) / a);
+  if (a < 0) m = min(m, c / -a);
+  if (b > 0) m = min(m, (whole_height - 1 - r) / b);
+  if (b < 0) m = min(m, r / -b);
+  return m;
+}
+
 #if HFVIS_MAX_DISTANCE
 
 #if HFVIS_STRIPS
@@ -532,11 +554,13 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
                               int n_samples, int a, int b, float period,
                               float window, float inv_window, float drop, lane_int c, lane_int r,
                               lane_int receivers, lane_int stack, int entry, int i, int q, int k, int trips,
-                              int offset, float base, float inv_period, __global const float* row_length,
+                              int offset, int shift, float base, float inv_period, __global const float* row_length,
                               __global float* receiver_base, __global float2* stacks,
                               __global float2* window_far) {
   // Periods are counted from the launch's first receiver, `offset` along the whole line (a
   // strip's part of a line; 0 otherwise); receivers before it (j < 0) are another launch's.
+  // Positions count `shift` receivers more (HFVIS_ORIGIN: those of the larger field's line beyond
+  // this field; 0 otherwise).
   int end = max(i, 0);  // block k's receivers here are periods max(i, 0) .. end - 1
 #if HFVIS_ROW_SPACING
   // Positions are ground lengths, summed along the line (one line per work-item): receiver j's
@@ -553,7 +577,7 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
     receiver_base[(er - row0) * width + (c - (end - i) * a)] = x;
   }
 #else
-  while (end < trips && (int)floor((float)(offset + end) * period * inv_window) == k) ++end;
+  while (end < trips && (int)floor((float)(offset + shift + end) * period * inv_window) == k) ++end;
 #endif
   int ci = q > 0 ? i : i - 1, cq = q > 0 ? q - 1 : n_samples - 1;  // the nearest sample before (i, q)
   // Backwards, the peak inside the segment from sample (ci, cq) to the one after it comes just
@@ -565,7 +589,7 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
 #if HFVIS_ROW_SPACING
     const float x = receiver_base[(r - (j - i) * b - row0) * width + (c - (j - i) * a)];
 #else
-    const float x = (float)(offset + j) * period;
+    const float x = (float)(offset + shift + j) * period;
 #endif
     while (offset + ci >= 0) {
       __global const LatticeSample* s = samples + cq;
@@ -576,7 +600,7 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
       const float tau_scale = row_length[sr] * inv_period;
       const float here = sample_base - s->tau * tau_scale;
 #else
-      const float here = (float)(offset + ci) * period - s->tau;
+      const float here = (float)(offset + shift + ci) * period - s->tau;
 #endif
       if ((int)floor(here * inv_window) != k - 1 || x - here > window) break;
       const int gq = cq + 1 < n_samples ? cq + 1 : 0, gi = cq + 1 < n_samples ? ci : ci + 1;
@@ -587,7 +611,7 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
         const float segment_base = receiver_base[(gr - row0) * width + (c - (gi - i) * a)];
         const float segment_scale = row_length[gr] * inv_period;
 #else
-        const float segment_base = (float)(offset + gi) * period, segment_scale = 1.0f;
+        const float segment_base = (float)(offset + shift + gi) * period, segment_scale = 1.0f;
 #endif
         const float here_near = segment_base - samples[gq].tau * segment_scale;
         lane_int valid;
@@ -674,6 +698,14 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
 // the ground position into .w (carry_stacks then moves the stacks on). Without, every line starts
 // at its far end with an empty stack and line_state and carry_in are not used.
 //
+// With HFVIS_ORIGIN the field was cut from a larger one of whole_width x whole_height pixels, its
+// pixel (0, 0) at (origin_col, origin_row) there: positions (and so a window's blocks) count from
+// the far end of the larger field's line (receiver_index), so that every sample lies where it lies
+// in the larger field's sweep, to the bit; a line still starts at this field's edge with an empty
+// stack. Not with HFVIS_ROW_SPACING, whose positions are ground lengths summed along a line.
+// Lanes share their positions: the host gives a work-item's lanes lines that start at the same
+// index there (lane 0's is taken for all).
+//
 // With HFVIS_MAX_DISTANCE only samples within `window` (pixels along the line; ground units
 // with HFVIS_ROW_SPACING) count, inv_window = 1 / window (window_pass; window_far: one (rise,
 // run) per pixel; in strips one line per work-item; with HFVIS_ROW_SPACING one line per
@@ -688,6 +720,7 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
                               __global const int4* lines, int n_lines, __global const LatticeSample* samples,
                               __global const CellSegment* segments, int n_samples, int a, int b, float period, float ground_per_pixel,
                               float period_ground, float drop, float window, float inv_window,
+                              int origin_col, int origin_row, int whole_width, int whole_height,
                               __global const float* row_length, __global const float4* row_terms,
                               float cos_azimuth,
                               float sin_azimuth, float weight, float swath, uint plane, __global float2* stacks,
@@ -743,6 +776,14 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
     }
   }
 #endif
+#if HFVIS_ORIGIN && !HFVIS_ROW_SPACING
+  // Positions count from the larger field's line's far end: `shift` receivers more than here.
+  const int shift =
+      receiver_index(ILANE(c, 0) + origin_col, ILANE(r, 0) + origin_row, a, b, whole_width, whole_height) -
+      ILANE(start, 0);
+#else
+  const int shift = 0;
+#endif
 #if HFVIS_MAX_DISTANCE
   int block = INT_MIN;  // the block of the stack's samples (none yet)
   int far_part = 0;     // whether window_pass gave this block's receivers the block before
@@ -760,9 +801,9 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
     const float first_here = 0.0f - samples[0].tau * (row_length[r + start * b] * inv_period);
     const int first_block = (int)floor(first_here * inv_window);
 #else
-#define BLOCK_OF(j, tau) block_of(start + (j), tau, period, inv_window)
+#define BLOCK_OF(j, tau) block_of(start + shift + (j), tau, period, inv_window)
 #define RESUME_BASE 0.0f  // (window_pass takes positions from the index)
-    const int first_block = block_of(0, samples[0].tau, period, inv_window);
+    const int first_block = block_of(shift, samples[0].tau, period, inv_window);
 #endif
     block = BLOCK_OF(-1, samples[n_samples - 1].tau);
     far_part = block != first_block;
@@ -779,7 +820,7 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
       }
       window_pass(heights, width, height, row0, out_row0, samples, segments, n_samples, a, b, period, window, inv_window,
                   drop, c - ib * a, r - ib * b, receivers, stack + n * entry, entry, ib, qb, block,
-                  trips, start, RESUME_BASE, inv_period, row_length, receiver_base, stacks, window_far);
+                  trips, start, shift, RESUME_BASE, inv_period, row_length, receiver_base, stacks, window_far);
     }
 #undef BLOCK_OF
 #undef RESUME_BASE
@@ -794,9 +835,9 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 #if HFVIS_ROW_SPACING
   lane_float here_before = base;
 #elif HFVIS_STRIPS
-  lane_float here_before = LANE_FLOAT(start - 1) * period;
+  lane_float here_before = LANE_FLOAT(start + shift - 1) * period;
 #else
-  lane_float here_before = -period;
+  lane_float here_before = (float)(shift - 1) * period;
 #endif
   // The corners the last two samples read (lane_sample_height), for segment_peak.
   lane_float far0 = 0.0f, far1 = 0.0f, near0 = 0.0f, near1 = 0.0f;
@@ -824,11 +865,11 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
     const lane_float tau_scale = period_length * inv_period;  // ground length per pixel of tau
     const lane_float period_ground_l = period_length;
 #elif HFVIS_STRIPS
-    const lane_float base = LANE_FLOAT(along) * period;  // the receivers' position along their lines
+    const lane_float base = LANE_FLOAT(along + shift) * period;  // the receivers' position along their lines
 #else
     // Every line starts at its far end (along = i): one position for all lanes, a scalar (a
     // lane vector of positions made the whole sweep 35 % slower on the AVX-512 CPU).
-    const float base = (float)i * period;
+    const float base = (float)(shift + i) * period;
 #endif
 #if !HFVIS_ROW_SPACING
     const lane_float cos_az = (lane_float)cos_azimuth, sin_az = (lane_float)sin_azimuth;
@@ -852,7 +893,7 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
         if (far_part)
           window_pass(heights, width, height, row0, out_row0, samples, segments, n_samples, a, b, period, window,
                       inv_window, drop, c, r, receivers, stack, entry, i, q, sample_block, trips, LINE_OFFSET,
-                      base, inv_period, row_length, receiver_base, stacks, window_far);
+                      shift, base, inv_period, row_length, receiver_base, stacks, window_far);
         block = sample_block;
         n = 0;
       }

@@ -357,8 +357,11 @@ std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, cons
   std::vector<Raw> raw;
   int c = line.col, r = line.row;
   float here_before = 0.0f;
+  // Positions count from the far end of the line through the larger field (HeightField::origin;
+  // without one, this field's: 0), as horizon_lattice with HFVIS_ORIGIN counts them.
+  const int first = rows ? 0 : receiverIndex(field, d.a, d.b, line.col, line.row);
   for (int i = 0; i < line.receivers; ++i, c -= d.a, r -= d.b) {
-    float base = static_cast<float>(i) * period, tau_scale = 1.0f;
+    float base = static_cast<float>(first + i) * period, tau_scale = 1.0f;
     if (rows) {  // horizon_lattice with HFVIS_ROW_SPACING
       const float length = rows->length[r];
       if (i > 0) row_base += length;

@@ -13,7 +13,8 @@ namespace hfvis::detail {
 
 // One sample of a lattice line as the sweep meets it (farthest first): its height (NaN =
 // absent; only receivers are listed then), its position along the line (pixels from the
-// line's far end), the receiver pixel it is (-1 for samples between receivers), and what
+// line's far end; with HeightField::origin, from the far end of the line through the larger
+// field), the receiver pixel it is (-1 for samples between receivers), and what
 // the hull stack gave it: the occluder's stack depth (-1 = none), its rise above the sample
 // and its distance along the line (pixels).
 struct LatticeLineSample {

@@ -4,12 +4,15 @@
 // sample the same points.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cfloat>
 #include <cmath>
 #include <cstring>
 
 #include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
+#include "hfvis/sun_shading.hpp"
 #include "hfvis_testing/horizon_reference.hpp"
 #include "hfvis_testing/synthetic_fields.hpp"
 #include "core/horizon_common.hpp"
@@ -242,8 +245,10 @@ TEST(HorizonSweepLine, DirectionsHonourTheToleranceAndQuadratureWeightsSumToOne)
 
 // Kernel results equal the scalar reference of the same algorithm, for both methods, in
 // both buffer layouts (with row_spacing, on testing::setRowSpacing's grid).
+// With `cut`, each field is one cut out of a larger one (HeightField::origin: its positions along
+// the larger field's lines, the larger field's lowest height 2 below its own).
 void expectKernelMatchesReference(HorizonMethod method, double samples_per_unit, double curvature = 0.0,
-                                  double max_distance = 0.0, bool row_spacing = false) {
+                                  double max_distance = 0.0, bool row_spacing = false, bool cut = false) {
   testing::forEachLayout([&](const ComputeContext& context) {
     for (const auto& name : syntheticFieldNames()) {
       for (auto [w, h] : awkwardSizes()) {
@@ -251,6 +256,11 @@ void expectKernelMatchesReference(HorizonMethod method, double samples_per_unit,
         HeightField field = makeSyntheticField(name, w, h, 3);
         field.cell_size_x = 1.5;
         if (row_spacing) testing::setRowSpacing(field);
+        if (cut) {
+          float lowest = INFINITY;
+          for (float v : field.heights) lowest = std::isfinite(v) ? std::min(lowest, v) : lowest;
+          field.origin = {11, 5, w + 17, h + 9, double(lowest) - 2.0};
+        }
         HorizonOptions options;
         options.directions = 7;
         options.azimuth_offset = 0.1;
@@ -305,6 +315,17 @@ TEST(HorizonKernels, SweepMatchesScalarReferenceWithinAMaximumDistance) {
 
 TEST(HorizonKernels, SweepMatchesScalarReferenceWithinAMaximumDistanceDenserAndCurved) {
   expectKernelMatchesReference(HorizonMethod::Sweep, 2.5, 0.004, 6.1);
+}
+
+// A field cut out of a larger one, its positions along the larger field's lines: whole, within
+// maximum distances, denser and curved.
+TEST(HorizonKernels, SweepMatchesScalarReferenceOnAFieldCutFromALargerOne) {
+  expectKernelMatchesReference(HorizonMethod::Sweep, 1.0, 0.0, 0.0, false, true);
+  for (double d : {1.2, 4.3, 29.0}) {
+    SCOPED_TRACE("max distance " + std::to_string(d));
+    expectKernelMatchesReference(HorizonMethod::Sweep, 1.0, 0.0, d, false, true);
+  }
+  expectKernelMatchesReference(HorizonMethod::Sweep, 2.5, 0.004, 6.1, false, true);
 }
 
 TEST(HorizonKernels, NaiveMatchesScalarReferenceWithinAMaximumDistance) {
@@ -541,6 +562,85 @@ TEST(HorizonKernels, StripsWithinAMaximumDistanceEqualTheWholeFieldBitForBit) {
   });
 }
 
+// A field cut out of a larger one with its origin given (HeightField::origin, as the Python
+// package's Dask path cuts each chunk with its halo) equals the larger field bit for bit on the
+// cut's pixels farther than ceil(max_distance / smallest cell) + 2 pixels from its edges inside
+// the larger field (those at the larger field's own edges are edges in both): hard cases with
+// nodata, cuts smaller than that margin, at the larger field's edges and in its middle, exact
+// azimuths and quadrature directions, curvature, denser sampling, strips, sun shading; both
+// layouts.
+TEST(HorizonKernels, AFieldCutFromALargerOneEqualsItBitForBitInside) {
+  testing::forEachLayout([&](const ComputeContext& context) {
+    for (const char* name : {"nan_holes", "city", "spikes", "noise"}) {
+      HeightField whole = makeSyntheticField(name, 61, 53, 4);
+      whole.cell_size_x = 1.5;
+      float lowest = INFINITY;
+      for (float v : whole.heights) lowest = std::isfinite(v) ? std::min(lowest, v) : lowest;
+      for (int variant = 0; variant < 4; ++variant) {
+        HorizonOptions options;
+        options.directions = variant == 1 ? 24 : 8;
+        options.azimuth_offset = 0.3;
+        options.max_distance = variant == 2 ? 9.0 : 4.6;
+        options.curvature = variant == 2 ? 0.01 : 0.0;
+        options.samples_per_unit = variant == 3 ? 2.5 : 1.0;
+        const int margin = static_cast<int>(std::ceil(options.max_distance / 1.0)) + 2;  // cells 1.5 x 1
+        for (auto [x0, y0, w, h] : {std::array{0, 0, 30, 27}, std::array{17, 9, 33, 31}, std::array{40, 30, 21, 23},
+                                    std::array{5, 20, 9, 13}, std::array{0, 0, 61, 53}}) {
+          SCOPED_TRACE(std::string(name) + " variant " + std::to_string(variant) + " cut at " + std::to_string(x0) +
+                       "," + std::to_string(y0) + " " + std::to_string(w) + "x" + std::to_string(h));
+          HeightField cut = testing::cropField(whole, x0, y0, w, h);
+          if (std::all_of(cut.heights.begin(), cut.heights.end(), [](float v) { return std::isnan(v); })) continue;
+          cut.origin = {x0, y0, whole.width, whole.height, double(lowest)};
+          // `planes` planes of the cut's values against the larger field's on the pixels inside.
+          auto expectEqualInside = [&](const std::vector<float>& part, const std::vector<float>& full, int planes) {
+            ASSERT_EQ(part.size(), std::size_t(planes) * w * h);
+            int compared = 0;
+            for (int k = 0; k < planes; ++k) {
+              for (int y = 0; y < h; ++y) {
+                for (int x = 0; x < w; ++x) {
+                  if (!((x0 == 0 || x >= margin) && (y0 == 0 || y >= margin) &&
+                        (x0 + w == whole.width || x < w - margin) && (y0 + h == whole.height || y < h - margin)))
+                    continue;
+                  ++compared;
+                  const float a = part[(std::size_t(k) * h + y) * w + x];
+                  const float b = full[(std::size_t(k) * whole.height + y0 + y) * whole.width + x0 + x];
+                  ASSERT_TRUE(std::isnan(a) ? std::isnan(b) : std::memcmp(&a, &b, sizeof a) == 0)
+                      << "plane " << k << " pixel " << x << "," << y << ": " << a << " vs " << b;
+                }
+              }
+            }
+            if (planes > 0 && (w > 2 * margin || x0 == 0)) {
+              EXPECT_GT(compared, 0);
+            }
+          };
+          for (int strip_rows : {0, 4}) {  // strips of 4 rows in variant 3
+            if (strip_rows && (variant != 3 || strip_rows >= h)) continue;
+            options.strip_rows = strip_rows;
+            for (const HorizonOutputs& outputs : {allOutputs(), HorizonOutputs{false, false, true, true}}) {
+              HorizonOptions whole_options = options;
+              whole_options.strip_rows = 0;
+              const HorizonResult full = computeHorizons(context, whole, whole_options, outputs);
+              const HorizonResult part = computeHorizons(context, cut, options, outputs);
+              const int planes = outputs.horizon_angles ? options.directions : 0;
+              expectEqualInside(part.angles, full.angles, planes);
+              expectEqualInside(part.distances, full.distances, planes);
+              expectEqualInside(part.sky_view_factor, full.sky_view_factor, 1);
+              expectEqualInside(part.ambient_occlusion, full.ambient_occlusion, 1);
+            }
+          }
+          options.strip_rows = 0;
+          if (variant == 0) {  // the sun's shading: one sweep in its azimuth, then the normals
+            SunLight sun;
+            sun.position = {200.0, 15.0};
+            expectEqualInside(computeSunShading(context, cut, sun, options).direct,
+                              computeSunShading(context, whole, sun, options).direct, 1);
+          }
+        }
+      }
+    }
+  });
+}
+
 // A memory budget below the whole field's needs runs it in strips by itself, with the same
 // result; stacks too deep for what the budget leaves are a MemoryBudgetError, not a wrong answer.
 TEST(HorizonKernels, ABudgetBelowTheWholeFieldRunsItInStrips) {
@@ -693,6 +793,23 @@ TEST(HorizonKernels, HeightSpanBeyondFloatArithmeticIsRefused) {
   EXPECT_THROW(computeHorizons(testContext(), field, options, outputs), InvalidArgument);
   field.z_scale = 1e20;  // heights of noise in [0, 1): spans up to 1e20, fine
   EXPECT_NO_THROW(computeHorizons(testContext(), field, options, outputs));
+}
+
+// An origin that does not place the field inside its larger field, or whose lowest height is not
+// finite or lies above one of the field's heights, is refused.
+TEST(HorizonKernels, AnOriginOutsideItsLargerFieldOrAboveAHeightIsRefused) {
+  HeightField field = makeSyntheticField("noise", 6, 5, 1);  // heights in [0, 1)
+  HorizonOptions options;
+  options.directions = 4;
+  options.max_distance = 2.0;
+  field.origin = {2, 3, 8, 8, -1.0};
+  EXPECT_NO_THROW(computeHorizons(testContext(), field, options, allOutputs()));
+  for (FieldOrigin bad :
+       {FieldOrigin{3, 3, 8, 8, -1.0}, FieldOrigin{2, 4, 8, 8, -1.0}, FieldOrigin{-1, 0, 8, 8, -1.0},
+        FieldOrigin{0, 0, 5, 0, -1.0}, FieldOrigin{2, 3, 8, 8, 0.5}, FieldOrigin{2, 3, 8, 8, NAN}}) {
+    field.origin = bad;
+    EXPECT_THROW(computeHorizons(testContext(), field, options, allOutputs()), InvalidArgument);
+  }
 }
 
 TEST(HorizonKernels, InvalidOptionsAreRejectedBeforeLaunch) {

@@ -23,6 +23,23 @@ struct Georeference {
   bool empty() const { return !geotransform && crs_wkt.empty(); }
 };
 
+// Where a field lies within a larger one it was cut from: a tile or a chunk computed apart, with
+// a halo around the part whose results are kept (hfvis's Python package does so for Dask
+// arrays). The horizon sweep then places every line's positions as along the larger field's
+// lines and takes the larger field's lowest height as the heights' base, so that a pixel's
+// horizon, sky-view factor, occlusion and sun are the larger field's bit for bit wherever its
+// maximum distance (and the bilinear cell and normal beyond it) lies inside this field: a
+// pixel's samples and the cut at the maximum distance fall where they fall in the larger field
+// (not with per-row spacing, whose positions are ground lengths summed from a line's start).
+// The hull tree (intervisibility) is exact either way; it takes the base too.
+struct FieldOrigin {
+  int col = 0, row = 0;                  // this field's pixel (0, 0) in the larger field
+  int whole_width = 0, whole_height = 0;  // the larger field's size; 0 x 0: no larger field
+  double lowest = 0.0;                    // the larger field's lowest finite height (before z_scale)
+
+  bool present() const { return whole_width > 0 || whole_height > 0; }
+};
+
 // A W x H grid of heights, row-major, row 0 first as stored in the image.
 // Pixel (col, row) sits at ground position (col * cell_size_x, row * cell_size_y);
 // between grid points the surface is the bilinear interpolation of the four corners.
@@ -46,6 +63,7 @@ struct HeightField {
   // whole units of ground length); the bounce takes cell_size_x/y for the whole field.
   std::vector<double> row_cell_size_x, row_cell_size_y;
   double z_scale = 1.0;        // multiplies every height
+  FieldOrigin origin;          // where it lies in a larger field it was cut from; none by default
   Georeference georeference;   // from a georeferenced raster; empty for a field filled in memory
 
   float at(int col, int row) const { return heights[static_cast<std::size_t>(row) * width + col]; }
@@ -54,8 +72,9 @@ struct HeightField {
 };
 
 // Throws InvalidArgument when the field is empty, its sizes disagree, a cell size (per-row
-// ones included, one per row) or the z-scale is not finite and positive, or every height is
-// nodata.
+// ones included, one per row) or the z-scale is not finite and positive, every height is
+// nodata, or an origin does not place it inside its larger field or gives a lowest height that
+// is not finite or above one of its heights.
 void validate(const HeightField& field);
 
 }  // namespace hfvis

@@ -2,7 +2,9 @@
 maximum distance of 50 cells) of an N x N fractal in memory, then chunked on a LocalCluster of
 two worker processes of one thread each. Reports the chunk size, the halo's overhead (the pixels
 the blocks compute, halos included, over the field's), the wall times, the largest difference
-from the in-memory result and each worker's peak resident memory. Writes Markdown to stdout.
+from the in-memory result, whether it has the in-memory result's bits, and each worker's peak
+resident memory; then what telling a block where it lies costs (HeightField::origin, which makes
+the bits equal): one block with its halo computed with and without its origin, alternated. Writes Markdown to stdout.
 
     build/python-venv/bin/python python/bench/dask_cluster.py [--size 2048] [--chunk 512]
 """
@@ -61,13 +63,29 @@ def main():
             clustered = time.perf_counter() - start
             peaks = client.run(peak_rss_mib)
     diff = float(np.nanmax(np.abs(chunked.values - whole.values)))
+    holes = np.isnan(whole.values)
+    same = np.array_equal(np.isnan(chunked.values), holes) and np.array_equal(
+        chunked.values[~holes].view(np.uint32), whole.values[~holes].view(np.uint32))
     print(f"Sky-view factor, K = 16, max_distance {args.max_distance:g} cells, {n} x {n} fractal; {os.cpu_count()} "
           f"CPUs, {hfvis.devices()[0]['name']}.\n")
-    print("| run | chunks | halo | pixels computed / field | wall, s | largest difference | peak RSS per worker, MiB |")
-    print("| --- | --- | ---: | ---: | ---: | ---: | --- |")
-    print(f"| one process, in memory | 1 | 0 | 1.00 | {single:.2f} | 0 | {peak_rss_mib():.0f} (this process) |")
+    print("| run | chunks | halo | pixels computed / field | wall, s | largest difference | same bits | "
+          "peak RSS per worker, MiB |")
+    print("| --- | --- | ---: | ---: | ---: | ---: | --- | --- |")
+    print(f"| one process, in memory | 1 | 0 | 1.00 | {single:.2f} | 0 | yes | {peak_rss_mib():.0f} (this process) |")
     print(f"| LocalCluster, 2 workers x 1 thread | {args.chunk} x {args.chunk} | {depth} | {computed / n / n:.2f} | "
-          f"{clustered:.2f} | {diff:.1e} | {', '.join(f'{v:.0f}' for v in peaks.values())} |")
+          f"{clustered:.2f} | {diff:.1e} | {'yes' if same else 'no'} | {', '.join(f'{v:.0f}' for v in peaks.values())} |")
+    block = np.ascontiguousarray(heights[args.chunk - depth:2 * args.chunk + depth, args.chunk - depth:2 * args.chunk + depth])
+    geometry = _arrays.geometry()
+    placed = dict(geometry, origin=[args.chunk - depth, args.chunk - depth, n, n, float(np.nanmin(heights))])
+    times = {False: [], True: []}
+    for _ in range(5):
+        for told in (False, True):
+            start = time.perf_counter()
+            _arrays.compute("sky_view_factor", block, placed if told else geometry, options)
+            times[told].append(time.perf_counter() - start)
+    plain, told = np.median(times[False]), np.median(times[True])
+    print(f"\nOne {block.shape[0]} x {block.shape[1]} block (a chunk and its halo), median of 5 alternated: "
+          f"{plain:.3f} s without its origin, {told:.3f} s with it ({told / plain:.2f}x).")
 
 
 def _offsets(sizes):

@@ -70,7 +70,7 @@ def geometry(cell_size=None, z_scale=1.0, row_cell_sizes=None):
     rows_x, rows_y = ([], []) if row_cell_sizes is None else (list(map(float, row_cell_sizes[0])),
                                                                list(map(float, row_cell_sizes[1])))
     return {"cell_size_x": cx, "cell_size_y": cy, "row_cell_size_x": rows_x, "row_cell_size_y": rows_y,
-            "z_scale": float(z_scale)}
+            "z_scale": float(z_scale), "origin": []}
 
 
 def _set(target, options, names):

@@ -1,5 +1,5 @@
-"""Dask-backed DataArrays: the distance-limited operations chunk by chunk through
-dask.array.map_overlap with a halo of the maximum distance, and cumulative viewsheds split into
+"""Dask-backed DataArrays: the distance-limited operations chunk by chunk with a halo of the
+maximum distance (dask.array.overlap.overlap, then map_blocks), and cumulative viewsheds split into
 groups of observers summed. The graph carries module-level functions and plain values only (the
 operation's name, its options, the geometry), so that distributed workers can unpickle it; each
 worker process makes its own OpenCL context (hfvis._core keeps one per process)."""
@@ -29,16 +29,21 @@ def halo(geometry, max_distance, operation):
     return int(math.ceil(max_distance / min(sizes))) + SURFACE_PIXELS
 
 
-def _block(block, operation, geometry, options, device, depth, chunks, block_id=None):
-    """One chunk with its halo (map_overlap, boundary 'none': no halo beyond the field's own edges,
-    which stay edges) -> its planes, the halo trimmed, stacked along a leading axis."""
+def _block(block, lowest, operation, geometry, options, device, depth, chunks, block_id=None):
+    """One chunk with its halo (overlap, boundary 'none': no halo beyond the field's own edges,
+    which stay edges) -> its planes, the halo trimmed, stacked along a leading axis. The library is
+    told where the block lies in the whole field and the whole field's lowest height (`lowest`, a
+    1 x 1 block; HeightField::origin), so that it samples every line where the whole field's run does: the
+    results inside the halo are that run's bit for bit."""
     i, j = block_id[-2], block_id[-1]
     top = depth if i > 0 else 0
     left = depth if j > 0 else 0
     bottom = depth if i < len(chunks[0]) - 1 else 0
     right = depth if j < len(chunks[1]) - 1 else 0
     first_row = sum(chunks[0][:i]) - top
+    first_col = sum(chunks[1][:j]) - left
     g = dict(geometry)
+    g["origin"] = [first_col, first_row, sum(chunks[1]), sum(chunks[0]), float(lowest.flat[0])]
     if g["row_cell_size_x"]:  # a latitude / longitude grid: the block's own rows' spacing
         g["row_cell_size_x"] = g["row_cell_size_x"][first_row:first_row + block.shape[0]]
         g["row_cell_size_y"] = g["row_cell_size_y"][first_row:first_row + block.shape[0]]
@@ -69,9 +74,14 @@ def chunked(operation, heights, geometry, options, device=""):
     planes = _arrays.planes_of(operation, options)
     body = functools.partial(_block, operation=operation, geometry=geometry, options=options, device=device,
                              depth=depth, chunks=chunks)
-    stacked = da.map_overlap(body, heights, depth={0: depth, 1: depth}, boundary="none", trim=False,
-                             dtype=np.float32, new_axis=0, chunks=((len(names) * planes,),) + chunks,
-                             meta=np.empty((0, 0, 0), np.float32))
+    overlapped = da.overlap.overlap(heights, depth={0: depth, 1: depth}, boundary="none")
+    # The whole field's lowest height, the base of every block's heights: a reduction, handed to
+    # each block as a 1 x 1 block of its own (infinite where every height is nodata, and then no
+    # block reads it).
+    lowest = da.where(da.isnan(heights), np.float32(np.inf), heights).min()
+    lowest = da.broadcast_to(lowest, overlapped.numblocks, chunks=1)
+    stacked = da.map_blocks(body, overlapped, lowest, dtype=np.float32, new_axis=0,
+                            chunks=((len(names) * planes,),) + chunks, meta=np.empty((0, 0, 0), np.float32))
     out = {}
     for n, name in enumerate(names):
         part = stacked[n * planes:(n + 1) * planes]

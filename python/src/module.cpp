@@ -100,7 +100,7 @@ Array planes(std::vector<float>&& values, int count, const HeightField& field) {
 
 HeightField makeField(Heights heights, double cell_size_x, double cell_size_y,
                       std::vector<double> row_cell_size_x, std::vector<double> row_cell_size_y,
-                      double z_scale) {
+                      double z_scale, std::vector<double> origin) {
   HeightField field;
   field.height = static_cast<int>(heights.shape(0));
   field.width = static_cast<int>(heights.shape(1));
@@ -110,6 +110,13 @@ HeightField makeField(Heights heights, double cell_size_x, double cell_size_y,
   field.row_cell_size_x = std::move(row_cell_size_x);
   field.row_cell_size_y = std::move(row_cell_size_y);
   field.z_scale = z_scale;
+  // Empty, or where the field lies in a larger one (a Dask chunk with its halo): column, row,
+  // the larger field's width and height and its lowest height (HeightField::origin).
+  if (!origin.empty()) {
+    if (origin.size() != 5) throw InvalidArgument("origin must be (col, row, whole_width, whole_height, lowest)");
+    field.origin = {static_cast<int>(origin[0]), static_cast<int>(origin[1]), static_cast<int>(origin[2]),
+                    static_cast<int>(origin[3]), origin[4]};
+  }
   validate(field);
   return field;
 }
@@ -570,7 +577,7 @@ NB_MODULE(_core, m) {
   // Made by height_field() and passed back to the operations; Python reads nothing of them.
   nb::class_<HeightField>(m, "HeightField");
   m.def("height_field", &makeField, "heights"_a, "cell_size_x"_a, "cell_size_y"_a, "row_cell_size_x"_a,
-        "row_cell_size_y"_a, "z_scale"_a);
+        "row_cell_size_y"_a, "z_scale"_a, "origin"_a = std::vector<double>{});
   m.def(
       "geographic_cell_sizes",
       [](const std::array<double, 6>& geotransform, int height) {

@@ -50,6 +50,21 @@ void validate(const HeightField& field) {
   if (field.nodataCount() == field.pixelCount()) {
     throw InvalidArgument("every height is nodata (NaN or infinite)");
   }
+  const FieldOrigin& o = field.origin;
+  if (o.present()) {
+    if (o.col < 0 || o.row < 0 || long(o.col) + field.width > o.whole_width ||
+        long(o.row) + field.height > o.whole_height) {
+      throw InvalidArgument("the origin places the " + std::to_string(field.width) + " x " +
+                            std::to_string(field.height) + " field at (" + std::to_string(o.col) + ", " +
+                            std::to_string(o.row) + "), not inside its larger field of " +
+                            std::to_string(o.whole_width) + " x " + std::to_string(o.whole_height));
+    }
+    bool above = std::isfinite(o.lowest);
+    for (float h : field.heights) above = above && !(std::isfinite(h) && double(h) < o.lowest);
+    if (!above)
+      throw InvalidArgument("the origin's lowest height (" + shortNumber(o.lowest) +
+                            ") must be finite and at most every height of the field");
+  }
 }
 
 }  // namespace hfvis

@@ -358,6 +358,18 @@ std::vector<LatticeLine> latticeLines(const LatticeDirection& d, int width, int 
   return lines;
 }
 
+int receiverIndex(const HeightField& field, int a, int b, int col, int row) {
+  const FieldOrigin& o = field.origin;
+  const int width = o.present() ? o.whole_width : field.width, height = o.present() ? o.whole_height : field.height;
+  const int c = col + o.col, r = row + o.row;
+  int m = std::numeric_limits<int>::max();
+  if (a > 0) m = std::min(m, (width - 1 - c) / a);
+  if (a < 0) m = std::min(m, c / -a);
+  if (b > 0) m = std::min(m, (height - 1 - r) / b);
+  if (b < 0) m = std::min(m, r / -b);
+  return m;
+}
+
 std::pair<int, int> receiversInRows(const LatticeLine& line, int b, int first_row, int end_row) {
   // Receiver i sits in row line.row - i b.
   auto floorDiv = [](long x, long y) { return x / y - ((x % y != 0) && ((x < 0) != (y < 0))); };
@@ -380,15 +392,15 @@ std::size_t lineCapacity(const LatticeLine& line, std::size_t samples_per_period
 }
 
 std::vector<LineChunk> chunkLines(std::vector<LatticeLine>& lines, std::size_t samples_per_period,
-                                  std::size_t max_entries, bool line_major) {
+                                  std::size_t max_entries, bool line_major, std::size_t align) {
   std::vector<std::size_t> capacities;
   capacities.reserve(lines.size());
   for (const LatticeLine& line : lines) capacities.push_back(lineCapacity(line, samples_per_period));
-  return chunkLines(lines, capacities, max_entries, line_major);
+  return chunkLines(lines, capacities, max_entries, line_major, align);
 }
 
 std::vector<LineChunk> chunkLines(std::vector<LatticeLine>& lines, const std::vector<std::size_t>& capacities,
-                                  std::size_t max_entries, bool line_major) {
+                                  std::size_t max_entries, bool line_major, std::size_t align) {
   std::vector<LineChunk> chunks;
   LineChunk chunk;
   std::size_t longest = 0;  // largest capacity in the chunk (step-major)
@@ -402,17 +414,24 @@ std::vector<LineChunk> chunkLines(std::vector<LatticeLine>& lines, const std::ve
     chunks.push_back(chunk);
   };
   for (std::size_t j = 0; j < lines.size(); ++j) {
-    const std::size_t capacity = capacities[j];
+    // A chunk may close before the `align` lines from j (all of them must fit).
+    std::size_t capacity = 0, count = 0;
+    if (j % align == 0) {
+      for (std::size_t u = j; u < std::min(lines.size(), j + align); ++u) {
+        capacity = line_major ? capacity + capacities[u] : std::max(capacity, capacities[u]);
+        ++count;
+      }
+    }
     const std::size_t need =
-        line_major ? chunk.stack_entries + capacity : std::max(longest, capacity) * (chunk.count + 1);
-    if (chunk.count > 0 && (need > max_entries || need >= (std::size_t(1) << 31))) {
+        line_major ? chunk.stack_entries + capacity : std::max(longest, capacity) * (chunk.count + count);
+    if (count > 0 && chunk.count > 0 && (need > max_entries || need >= (std::size_t(1) << 31))) {
       close();
       chunk = LineChunk{j, 0, 0, 1};
       longest = 0;
     }
     if (line_major) lines[j].stack = static_cast<std::int32_t>(chunk.stack_entries);
-    chunk.stack_entries += line_major ? capacity : 0;
-    longest = std::max(longest, capacity);
+    chunk.stack_entries += line_major ? capacities[j] : 0;
+    longest = std::max(longest, capacities[j]);
     ++chunk.count;
   }
   close();
@@ -424,7 +443,11 @@ LatticeWindow latticeWindow(const HeightField& field, const LatticeDirection& d,
   if (max_distance <= 0.0) return w;
   // Positions along a line are pixels, or ground lengths with per-row spacing; they stay below
   // 2 (W + H) pixels, times the largest cell size.
-  double unit = d.ground_per_pixel, longest = 2.0 * (static_cast<double>(field.width) + field.height);
+  // (A field cut from a larger one places them along the larger field's lines.)
+  const bool larger = field.origin.present();
+  double unit = d.ground_per_pixel,
+         longest = 2.0 * (static_cast<double>(larger ? field.origin.whole_width : field.width) +
+                          (larger ? field.origin.whole_height : field.height));
   if (!field.row_cell_size_x.empty()) {
     unit = 1.0;
     longest *= std::max(*std::max_element(field.row_cell_size_x.begin(), field.row_cell_size_x.end()),

@@ -157,13 +157,22 @@ struct LineChunk {
   std::uint32_t stride = 1;
 };
 // Splits `lines` into chunks whose scratch fits `max_entries` (at least one line each),
-// setting each line's stack offset within its chunk.
+// setting each line's stack offset within its chunk. With `align`, chunks start at multiples of
+// `align` lines only (lanes of a work-item that must come from one group of lines; a chunk then
+// holds at least `align` lines, and may need their scratch beyond `max_entries`).
 std::vector<LineChunk> chunkLines(std::vector<LatticeLine>& lines, std::size_t samples_per_period,
-                                  std::size_t max_entries, bool line_major);
+                                  std::size_t max_entries, bool line_major, std::size_t align = 1);
 // The same with each line's capacity given (a strip's part of a line: its samples there and
 // the stack it arrives with).
 std::vector<LineChunk> chunkLines(std::vector<LatticeLine>& lines, const std::vector<std::size_t>& capacities,
-                                  std::size_t max_entries, bool line_major);
+                                  std::size_t max_entries, bool line_major, std::size_t align = 1);
+
+// The index of receiver (col, row) of this field along its line of step (a, b) through the larger
+// field it was cut from (HeightField::origin; without one, this field): how many receivers of
+// that line lie beyond it along +(a, b). The horizon sweep places sample positions from it
+// (receiver_index in kernels/horizon.cl: the same integer arithmetic), so that a field cut out
+// of a larger one meets every sample where the larger field does.
+int receiverIndex(const HeightField& field, int a, int b, int col, int row);
 
 // The receivers [first, end) of a line of a direction with row step b that lie in rows
 // [first_row, end_row) (a strip); first == end when none do.

@@ -67,10 +67,11 @@ cl::Buffer uploadDirections(ContextState& st, const std::vector<SweepDirection>&
 
 void launchLineChunks(ContextState& st, NamedKernel& kernel, std::vector<LatticeLine> lines,
                       std::size_t samples_per_period, std::size_t scratch_entries, int lanes,
-                      std::size_t group) {
+                      std::size_t group, bool lanes_together) {
   if (lines.empty()) return;
   const bool first_line = kernel.has("first_line");
-  for (const LineChunk& chunk : chunkLines(lines, samples_per_period, scratch_entries, lineMajorLayout(st))) {
+  for (const LineChunk& chunk : chunkLines(lines, samples_per_period, scratch_entries, lineMajorLayout(st),
+                                           lanes_together ? static_cast<std::size_t>(lanes) : 1)) {
     const cl::Buffer chunk_lines(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
                                  chunk.count * sizeof(LatticeLine), lines.data() + chunk.first);
     kernel.set("lines", chunk_lines);

@@ -48,9 +48,11 @@ cl::Buffer uploadDirections(ContextState& st, const std::vector<SweepDirection>&
 // chunks whose scratch fits `scratch_entries` (chunkLines, in the context's layout): per
 // chunk it sets the kernel's arguments `lines` (a copy of the chunk's line table: sub-buffer
 // offsets must be aligned on some devices), `n_lines`, `stride` and, where the kernel takes
-// it, `first_line`, and launches ceil(count / lanes) work-items in groups of `group`.
+// it, `first_line`, and launches ceil(count / lanes) work-items in groups of `group`. With
+// `lanes_together`, a work-item's lanes are lines [k lanes, (k + 1) lanes) of `lines` (chunks
+// start at multiples of `lanes`).
 void launchLineChunks(ContextState& st, NamedKernel& kernel, std::vector<LatticeLine> lines,
                       std::size_t samples_per_period, std::size_t scratch_entries, int lanes,
-                      std::size_t group);
+                      std::size_t group, bool lanes_together = false);
 
 }  // namespace hfvis::detail

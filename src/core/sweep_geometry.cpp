@@ -89,6 +89,8 @@ PreparedHeights prepareHeights(const HeightField& field, HeightOrigin origin) {
       highest = std::max(highest, static_cast<double>(h));
     }
   }
+  // A field cut from a larger one takes that one's base, so that its heights are the same floats.
+  if (field.origin.present()) lowest = field.origin.lowest;
   // The kernels multiply height differences by distances in float: keep the products finite.
   if (origin == HeightOrigin::Lowest && highest >= lowest &&
       (highest - lowest) * field.z_scale > kMaxPreparedHeight) {

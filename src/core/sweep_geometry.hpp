@@ -58,11 +58,12 @@ bool insideField(Point2 p, int width, int height);
 float sampleHeight(const std::vector<float>& heights, int width, int height, Point2 p);
 
 // Heights as the kernels see them: (h - lowest finite height) * z_scale in float, so that
-// a plane at 8848 m keeps its millimetres; every non-finite height becomes NaN. Throws
-// InvalidArgument when a prepared height would exceed kMaxPreparedHeight: the kernels
-// multiply height differences by distances (up to 2^31 pixels) in float, which must stay
-// finite. HeightOrigin::Zero keeps the heights where they are (h * z_scale, unchecked): the
-// viewshed, whose observers and targets may stand at absolute heights.
+// a plane at 8848 m keeps its millimetres (a field with an origin takes its larger field's
+// lowest); every non-finite height becomes NaN. Throws InvalidArgument when a prepared height
+// would exceed kMaxPreparedHeight: the kernels multiply height differences by distances (up to
+// 2^31 pixels) in float, which must stay finite. HeightOrigin::Zero keeps the heights where
+// they are (h * z_scale, unchecked): the viewshed, whose observers and targets may stand at
+// absolute heights.
 constexpr double kMaxPreparedHeight = 1e28;
 struct PreparedHeights {
   std::vector<float> heights;

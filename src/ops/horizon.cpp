@@ -261,6 +261,11 @@ class HorizonRoutine : public SweepRoutine {
     // A window's blocks are per line, so its strips, and with per-row spacing its whole sweep
     // (positions differ by line there), run one line per work-item.
     if ((inStrips() || hasRowSpacing(field)) && options.max_distance > 0.0) lanes_ = 1;
+    // A field cut from a larger one: each line's positions count from its own place there, so a
+    // work-item's lanes take lines that start at the same index there (laneGroups): not in strips,
+    // where lines resume at indices of their own, nor where the lanes' lines together outgrow the
+    // scratch.
+    if (shiftedPositions() && (inStrips() || lanes_ * longestLineEntries() > plan_.stack_entries)) lanes_ = 1;
   }
 
   HorizonResult take() { return std::move(result_); }
@@ -270,8 +275,10 @@ class HorizonRoutine : public SweepRoutine {
   std::string programOptions() const override {
     return detail::programOptions(outputs_, prepared_.has_nodata, lanes_, horizon_.curvature != 0.0,
                                   horizon_.max_distance > 0.0, hasRowSpacing(field_)) +
-           " -DHFVIS_STRIPS=" + std::to_string(inStrips());
+           " -DHFVIS_STRIPS=" + std::to_string(inStrips()) + " -DHFVIS_ORIGIN=" + std::to_string(shiftedPositions());
   }
+  // Positions along a larger field's lines (HeightField::origin; not with per-row spacing).
+  bool shiftedPositions() const { return field_.origin.present() && !hasRowSpacing(field_); }
   bool heightsResident() const override { return !inStrips(); }
   bool needsNormals() const { return outputs_.ambient_occlusion || outputs_.environment; }
   int environmentChannels() const { return static_cast<int>(environmentPlanes(outputs_)); }
@@ -599,6 +606,11 @@ class HorizonRoutine : public SweepRoutine {
     kernel.set("drop", curvatureDrop(unit));
     kernel.set("window", d.window.window);
     kernel.set("inv_window", d.window.inv_window);
+    const FieldOrigin& origin = field_.origin;
+    kernel.set("origin_col", origin.col);
+    kernel.set("origin_row", origin.row);
+    kernel.set("whole_width", origin.present() ? origin.whole_width : field_.width);
+    kernel.set("whole_height", origin.present() ? origin.whole_height : field_.height);
     for (cl::Buffer& table : setRowTables(kernel, d)) keep.push_back(table);
     setOutputs(kernel, d, plane_offset);
     return kernel;
@@ -611,7 +623,39 @@ class HorizonRoutine : public SweepRoutine {
   void launchSweep(const RunDirection& d, cl_uint plane_offset) {
     std::vector<cl::Buffer> keep;
     NamedKernel kernel = sweepKernel(d, plane_offset, keep);
-    launchLineChunks(st_, kernel, d.lines, d.stack_per_period, plan_.stack_entries, lanes_, sweepGroup());
+    const bool grouped = shiftedPositions() && lanes_ > 1;
+    launchLineChunks(st_, kernel, grouped ? laneGroups(d) : d.lines, d.stack_per_period, plan_.stack_entries, lanes_,
+                     sweepGroup(), grouped);
+  }
+
+  // Direction d's lines ordered by the index of their first receiver along the larger field's
+  // lines (receiverIndex), each run of equal indices led by lines without receivers up to a
+  // multiple of the lanes: every work-item's lanes then start at one index and share their
+  // positions (HFVIS_ORIGIN). The empty lines take the stack of the line after them.
+  std::vector<LatticeLine> laneGroups(const RunDirection& d) const {
+    std::vector<std::pair<int, LatticeLine>> indexed;
+    for (const LatticeLine& line : d.lines)
+      indexed.emplace_back(receiverIndex(field_, d.lattice.a, d.lattice.b, line.col, line.row), line);
+    std::stable_sort(indexed.begin(), indexed.end(),
+                     [](const auto& x, const auto& y) { return x.first < y.first; });
+    const std::size_t lanes = static_cast<std::size_t>(lanes_);
+    std::vector<LatticeLine> lines;
+    for (std::size_t j = 0; j < indexed.size();) {
+      std::size_t end = j;
+      while (end < indexed.size() && indexed[end].first == indexed[j].first) ++end;
+      const LatticeLine empty{indexed[j].second.col, indexed[j].second.row, 0, 0};
+      lines.insert(lines.end(), (lanes - (end - j) % lanes) % lanes, empty);
+      for (; j < end; ++j) lines.push_back(indexed[j].second);
+    }
+    return lines;
+  }
+
+  // Scratch entries of the longest line of any direction.
+  std::size_t longestLineEntries() const {
+    std::size_t longest = 0;
+    for (const RunDirection& d : directions_)
+      for (const LatticeLine& line : d.lines) longest = std::max(longest, lineCapacity(line, d.stack_per_period));
+    return longest;
   }
 
   // Direction k over a field in strips: the strips in the order its lines run through them
