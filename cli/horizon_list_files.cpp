@@ -46,9 +46,12 @@ constexpr const char* kRayConvention =
     "lengths along direction k, bilinear heights, while inside the field (the naive method's samples)";
 constexpr const char* kVisibleConvention =
     "a sample is visible when its slope from the receiver is >= the slope of every sample between them "
-    "(grazing samples are visible; decided exactly)";
+    "and of every peak between them, the bilinear surface's highest point above the chord of two "
+    "consecutive samples where it rises above it (grazing samples are visible; decided exactly; no peaks "
+    "on a latitude / longitude grid)";
 constexpr const char* kHorizonConvention =
-    "nearest first; a horizon is the farthest visible sample of its segment; its segment is the visible "
+    "nearest first; a horizon is the farthest visible sample of its segment (a peak that is a horizon: the "
+    "sample right after it); its segment is the visible "
     "samples [segment_begin, segment_end) toward the receiver, up to the first hidden sample or the next "
     "horizon; the segments hold every visible sample once";
 constexpr const char* kUnits =

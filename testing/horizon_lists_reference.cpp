@@ -6,6 +6,7 @@
 
 #include "core/chord_side.hpp"
 #include "core/horizon_common.hpp"
+#include "core/tree_peaks.hpp"
 
 namespace hfvis {
 
@@ -22,54 +23,67 @@ std::vector<float> referenceRay(const HeightField& field, const std::vector<floa
   return ray;
 }
 
-HorizonListReference referenceHorizonList(const std::vector<float>& ray, float hr) {
+HorizonListReference referenceHorizonList(const std::vector<float>& ray, float hr, const RayPeaks& peaks) {
   const int n = static_cast<int>(ray.size());
   HorizonListReference out;
   out.visible.assign(n + 1, false);
-  // Visible: no present sample strictly between lies strictly above the chord q-receiver;
-  // keep the steepest present sample so far, nearest first.
-  int best = 0;
-  for (int i = 1; i <= n; ++i) {
-    if (std::isnan(ray[i - 1])) continue;
-    if (best == 0 || detail::chordSide(ray[i - 1], ray[best - 1], hr, float(i - best), float(best)) <= 0) {
-      out.visible[i] = true;
-      best = i;
-    }
+  // The nodes, farthest first, the receiver last: present samples and admitted peaks, at their
+  // distances from the receiver in units of 2^-shift step; `sample` is i for sample i, -1 - j
+  // for the peak of interval j.
+  struct Node {
+    float h;
+    float distance;
+    int sample;
+  };
+  std::vector<Node> nodes;
+  auto height = [&](int i) { return i == 0 ? hr : ray[i - 1]; };
+  for (int i = n; i >= 1; --i) {
+    if (!std::isnan(ray[i - 1])) nodes.push_back({ray[i - 1], float(i << peaks.shift), i});
+    const int j = i - 1;  // the interval from sample i to the next nearer one
+    if (peaks.shift > 0 &&
+        detail::tree_peak_inserted(height(i), peaks.heights[j], height(j), peaks.offsets[j], peaks.shift))
+      nodes.push_back({peaks.heights[j], float((i << peaks.shift) - peaks.offsets[j]), -1 - j});
   }
-  // Eq. 1 on the present samples in sweep order (farthest first, receiver last): the first
-  // is a segment start, then every convex sample after a concave one (class from the chord
-  // of its two neighbours; collinear keeps the previous class). Eq. 2: each start's horizon
-  // is the farthest sample of maximal slope among the start .. the receiver's neighbour.
-  std::vector<int> order;  // sample indices, farthest first; 0 = the receiver
-  std::vector<float> height;
-  for (int i = n; i >= 1; --i)
-    if (!std::isnan(ray[i - 1])) order.push_back(i), height.push_back(ray[i - 1]);
-  order.push_back(0);
-  height.push_back(hr);
+  nodes.push_back({hr, 0.0f, 0});
+  const std::size_t receiver = nodes.size() - 1;
+  // Visible: no node nearer lies strictly above the sight line from the receiver.
+  for (std::size_t x = 0; x < receiver; ++x) {
+    if (nodes[x].sample < 0) continue;
+    bool hidden = false;
+    for (std::size_t y = x + 1; y < receiver && !hidden; ++y)
+      hidden = detail::chordSide(nodes[x].h, nodes[y].h, hr, nodes[x].distance - nodes[y].distance,
+                                 nodes[y].distance) > 0;
+    out.visible[nodes[x].sample] = !hidden;
+  }
+  // Eq. 1 in sweep order: the first node is a segment start, then every convex node after a
+  // concave one (class from the chord of its two neighbours; collinear keeps the previous
+  // class). Eq. 2: each start's horizon is the farthest node of maximal slope among the start ..
+  // the receiver's neighbour.
   std::set<int> horizons;
   int class_last = 1;
-  for (std::size_t s = 0; s + 1 < order.size(); ++s) {
+  for (std::size_t s = 0; s < receiver; ++s) {
     bool start = s == 0;
     if (s > 0) {
-      const int side = detail::chordSide(height[s - 1], height[s], height[s + 1],
-                                         float(order[s - 1] - order[s]), float(order[s] - order[s + 1]));
+      const int side = detail::chordSide(nodes[s - 1].h, nodes[s].h, nodes[s + 1].h,
+                                         nodes[s - 1].distance - nodes[s].distance,
+                                         nodes[s].distance - nodes[s + 1].distance);
       const int cls = side > 0 ? 1 : side < 0 ? 0 : class_last;
       start = cls == 1 && class_last == 0;
       class_last = cls;
     }
     if (!start) continue;
-    int best_sample = -1;  // the farthest of maximal slope among order[s .. end - 1]
-    for (std::size_t x = s; x + 1 < order.size(); ++x) {
-      if (best_sample < 0) {
-        best_sample = static_cast<int>(x);
-        continue;
-      }
+    std::size_t best = s;
+    for (std::size_t x = s + 1; x < receiver; ++x) {
       // x (nearer) replaces the best only when strictly steeper: best strictly below the chord x-receiver.
-      const int b = order[best_sample], q = order[x];
-      if (detail::chordSide(height[best_sample], height[x], hr, float(b - q), float(q)) > 0)
-        best_sample = int(x);
+      if (detail::chordSide(nodes[best].h, nodes[x].h, hr, nodes[best].distance - nodes[x].distance,
+                            nodes[x].distance) > 0)
+        best = x;
     }
-    horizons.insert(order[best_sample]);
+    const int sample = nodes[best].sample;
+    if (sample > 0)
+      horizons.insert(sample);
+    else if (-1 - sample >= 1 && out.visible[-1 - sample])  // a peak: the sample after it
+      horizons.insert(-1 - sample);
   }
   out.horizons.assign(horizons.begin(), horizons.end());
   return out;

@@ -1,22 +1,27 @@
 // test_horizon_lists.cpp: the visibility horizons of chosen receivers (hfvis/horizon_lists.hpp)
-// against a brute-force enumeration on the same ray samples (visibility by definition, the
-// horizons of Eq. 1 and 2, the segments by definition), against the naive visibility kernel
-// (the same ray, sample for sample) and the tree's per-pixel counts on the axes, against the
-// horizon operation (the farthest horizon is the horizon), and on an analytic wall.
+// against a brute-force enumeration on the same ray samples with the peaks between them as
+// occluders (visibility by definition, the horizons of Eq. 1 and 2, the segments by definition),
+// the peaks against the bilinear surface sampled densely, roofs touching at a corner against the
+// exact line of sight, against the naive visibility kernel (the same ray, sample for sample, where
+// no peak rises between the samples: on the axes and on rows of their own spacing) and the tree's
+// per-pixel counts on the axes, against the horizon operation (the farthest horizon is the
+// horizon), and on an analytic wall.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <set>
 
 #include "core/chord_side.hpp"
+#include "core/horizon_common.hpp"
+#include "core/sweep_geometry.hpp"
+#include "core/tree_peaks.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
 #include "hfvis/horizon_lists.hpp"
 #include "hfvis/intervisibility.hpp"
 #include "hfvis_testing/horizon_lists_reference.hpp"
 #include "hfvis_testing/synthetic_fields.hpp"
-#include "core/horizon_common.hpp"
-#include "core/sweep_geometry.hpp"
+#include "ops/horizon_lists_ray.hpp"
 #include "test_support.hpp"
 
 namespace hfvis {
@@ -26,9 +31,26 @@ using testing::awkwardSizes;
 using testing::fieldFrom;
 using testing::testContext;
 
+// The peaks of receiver (c, r)'s ray in direction d as the lists take them.
+RayPeaks rayPeaks(const HeightField& field, const std::vector<float>& prepared,
+                  const detail::SweepDirection& d, int c, int r, const SweepOptions& options) {
+  const auto ray = detail::horizonRay(field, prepared, d, c, r, options.curvature, nullptr, 0.0,
+                                      detail::horizonRayShift(field, options));
+  return {ray.shift, ray.peaks, ray.peak_offsets};
+}
+
+// The visible samples of a list (1 = nearest), from its segments.
+std::vector<bool> listedVisible(const DirectionHorizons& list, const std::vector<float>& ray) {
+  std::vector<bool> visible(ray.size() + 1, false);
+  for (const VisibilityHorizon& h : list.horizons)
+    for (int i = h.segment_begin; i < h.segment_end; ++i) visible[i] = !std::isnan(ray[i - 1]);
+  return visible;
+}
+
 // The lists of one receiver and direction against brute force.
-void expectListEqualsBruteForce(const DirectionHorizons& list, const std::vector<float>& ray, float hr) {
-  const HorizonListReference expected = referenceHorizonList(ray, hr);
+void expectListEqualsBruteForce(const DirectionHorizons& list, const std::vector<float>& ray, float hr,
+                                const RayPeaks& peaks) {
+  const HorizonListReference expected = referenceHorizonList(ray, hr, peaks);
   ASSERT_EQ(list.ray_samples, static_cast<int>(ray.size()));
   std::vector<int> horizons;
   for (const auto& h : list.horizons) horizons.push_back(h.sample);
@@ -68,8 +90,11 @@ void expectListEqualsBruteForce(const DirectionHorizons& list, const std::vector
     ASSERT_EQ(covered[i], bool(expected.visible[i])) << "sample " << i;
 }
 
+// Every synthetic content (the city DSM's one-pixel walls, roofs touching at their corners and
+// rotated streets among them), every awkward size: the lists equal brute force on the same samples
+// with the same peaks, and the peaks change what is visible on enough of them to matter.
 TEST(HorizonLists, EqualBruteForceOnEveryHardCase) {
-  int checked = 0;
+  int checked = 0, changed = 0, city_changed = 0;
   for (const auto& name : syntheticFieldNames()) {
     for (auto [w, h] : awkwardSizes()) {
       HeightField field = makeSyntheticField(name, w, h, 5);
@@ -101,21 +126,229 @@ TEST(HorizonLists, EqualBruteForceOnEveryHardCase) {
             ASSERT_TRUE(list.horizons.empty());
             continue;
           }
-          expectListEqualsBruteForce(list, ray, hr);
+          const RayPeaks peaks = rayPeaks(field, prepared.heights, directions[k], c, r, options);
+          expectListEqualsBruteForce(list, ray, hr, peaks);
           if (::testing::Test::HasFatalFailure()) return;
+          const bool differs =
+              referenceHorizonList(ray, hr).visible != referenceHorizonList(ray, hr, peaks).visible;
+          changed += differs;
+          city_changed += differs && name == "city";
           ++checked;
         }
       }
     }
   }
   EXPECT_GT(checked, 2000);
+  EXPECT_GT(changed, 100) << "the peaks should hide samples on these contents";
+  EXPECT_GT(city_changed, 20);
 }
 
-// Every direction: the lists' visible samples equal the naive visibility kernel's count
-// for that direction alone (a run of K = 1 at that azimuth marches the same ray); on the
-// axis directions also the tree sweep's per-pixel count (lines through pixel centres). Flat
-// and over a curved Earth (a drop of several height units across the field); also on rows of
-// their own spacing (positions in ground units, as the kernels take them).
+// The peaks are the surface's: where the lists put one, the bilinear surface (in double) has that
+// height at its position, and no point of the interval, sampled densely, stands farther above the
+// chord of its two samples than it does, up to the rounding of its position to 2^-shift step
+// (the steepest slope of the cells around times that); where they put none, no point stands above
+// the chord by more than that either. On the city DSM, every direction of K = 16.
+TEST(HorizonLists, PeaksAreTheSurfacesHighestPointsAboveTheChord) {
+  const HeightField field = makeSyntheticField("city", 64, 48, 2);
+  const auto prepared = detail::prepareHeights(field);
+  SweepOptions options;
+  options.directions = 16;
+  options.azimuth_offset = 0.05;
+  const auto directions = detail::runDirections(field, options);
+  const int shift = detail::horizonRayShift(field, options);
+  ASSERT_GT(shift, 0);
+  const int w = field.width;
+  auto at = [&](int x, int y) { return double(prepared.heights[std::size_t(y) * w + x]); };
+  auto surface = [&](double x, double y) {
+    const int x0 = std::min(int(std::floor(x)), w - 2), y0 = std::min(int(std::floor(y)), field.height - 2);
+    const double fx = x - x0, fy = y - y0;
+    return at(x0, y0) * (1 - fx) * (1 - fy) + at(x0 + 1, y0) * fx * (1 - fy) +
+           at(x0, y0 + 1) * (1 - fx) * fy + at(x0 + 1, y0 + 1) * fx * fy;
+  };
+  int intervals = 0, with_peak = 0;
+  for (int r = 1; r < field.height; r += 5) {
+    for (int c = 2; c < w; c += 7) {
+      for (int k = 0; k < options.directions; ++k) {
+        const auto ray =
+            detail::horizonRay(field, prepared.heights, directions[k], c, r, 0.0, nullptr, 0.0, shift);
+        const int n = static_cast<int>(ray.heights.size());
+        for (int i = 0; i < n; ++i) {
+          SCOPED_TRACE("receiver (" + std::to_string(c) + ", " + std::to_string(r) + ") direction " +
+                       std::to_string(k) + " interval " + std::to_string(i));
+          const double xf = std::clamp(double(ray.points[i].x), 0.0, w - 1.0),
+                       yf = std::clamp(double(ray.points[i].y), 0.0, field.height - 1.0);
+          const double xn = i > 0 ? std::clamp(double(ray.points[i - 1].x), 0.0, w - 1.0) : c,
+                       yn = i > 0 ? std::clamp(double(ray.points[i - 1].y), 0.0, field.height - 1.0) : r;
+          const double h_far = ray.heights[i], h_near = i > 0 ? ray.heights[i - 1] : at(c, r);
+          // The steepest slope of the surface along the interval, per step: the largest corner
+          // difference of the cells it crosses times the interval's length in pixels.
+          double steepest = 0.0;
+          const int dense = 512;
+          double highest = -INFINITY;  // the densest excess over the chord
+          for (int m = 1; m < dense; ++m) {
+            const double t = double(m) / dense, x = xf + t * (xn - xf), y = yf + t * (yn - yf);
+            const int x0 = std::min(int(std::floor(x)), w - 2),
+                      y0 = std::min(int(std::floor(y)), field.height - 2);
+            const double corners[4] = {at(x0, y0), at(x0 + 1, y0), at(x0, y0 + 1), at(x0 + 1, y0 + 1)};
+            steepest = std::max(
+                steepest, *std::max_element(corners, corners + 4) - *std::min_element(corners, corners + 4));
+            highest = std::max(highest, surface(x, y) - (h_far + t * (h_near - h_far)));
+          }
+          steepest *= std::hypot(xn - xf, yn - yf) * 1.5;
+          const double rounding = steepest / double(1 << shift) + 1e-4 * (1.0 + std::fabs(h_far));
+          ++intervals;
+          if (std::isnan(ray.peaks[i])) {
+            EXPECT_LE(highest, rounding) << "a point above the chord was missed";
+            continue;
+          }
+          ++with_peak;
+          const double t = double(ray.peak_offsets[i]) / double(1 << shift);
+          ASSERT_GT(t, 0.0);
+          ASSERT_LT(t, 1.0);
+          const double on = surface(xf + t * (xn - xf), yf + t * (yn - yf));
+          EXPECT_NEAR(ray.peaks[i], on, 1e-4 * (1.0 + std::fabs(on))) << "the peak lies on the surface";
+          EXPECT_GE(ray.peaks[i] - (h_far + t * (h_near - h_far)), highest - rounding);
+        }
+        if (::testing::Test::HasFailure()) return;
+      }
+    }
+  }
+  EXPECT_GT(intervals, 10000);
+  EXPECT_GT(with_peak, 500);
+}
+
+// Two roofs that touch at a corner, the diagonal ray from a receiver on the ground passing the
+// vertex between them: the ray's samples straddle the cell where the surface peaks (half the
+// roofs' height, between two ground vertices), so over the samples alone the receiver sees a
+// tower behind the roofs; the bilinear surface hides it. Every sample of the lists, with the
+// peaks, is visible exactly when the exact line of sight over the surface (sampled densely, in
+// double) says so.
+TEST(HorizonLists, RoofsTouchingAtACornerHideTheTowerBehindThem) {
+  const int w = 24, h = 24;
+  const float roof = 10.0f, tower = 6.0f;
+  std::vector<float> heights(std::size_t(w) * h, 0.0f);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      float& z = heights[std::size_t(y) * w + x];
+      if ((x >= 10 && x <= 13 && y >= 6 && y <= 9) || (x >= 6 && x <= 9 && y >= 10 && y <= 13)) z = roof;
+      if (x >= 12 && x <= 16 && y >= 12 && y <= 16) z = tower;
+    }
+  const HeightField field = fieldFrom(w, h, heights);
+  SweepOptions options;
+  options.directions = 8;
+  const auto directions = detail::runDirections(field, options);
+  int k = -1;  // the diagonal toward +x, +y
+  for (int j = 0; j < options.directions; ++j)
+    if (directions[j].dir_x > 0.5f && directions[j].dir_y > 0.5f) k = j;
+  ASSERT_GE(k, 0);
+  const int c = 2, r = 2;
+  const auto lists = computeHorizonLists(field, options, {{c, r}});
+  const auto prepared = detail::prepareHeights(field);
+  const auto ray = referenceRay(field, prepared.heights, directions[k], c, r);
+  const auto listed = listedVisible(lists[0].directions[k], ray);
+  const auto samples_alone = referenceHorizonList(ray, 0.0f).visible;
+  const detail::SweepDirection& d = directions[k];
+  auto surface = [&](double x, double y) {
+    const int x0 = std::min(int(std::floor(x)), w - 2), y0 = std::min(int(std::floor(y)), h - 2);
+    const double fx = x - x0, fy = y - y0;
+    auto at = [&](int cx, int cy) { return double(heights[std::size_t(cy) * w + cx]); };
+    return at(x0, y0) * (1 - fx) * (1 - fy) + at(x0 + 1, y0) * fx * (1 - fy) +
+           at(x0, y0 + 1) * (1 - fx) * fy + at(x0 + 1, y0 + 1) * fx * fy;
+  };
+  int tower_sample = 0;  // the tower's nearest sample
+  for (int i = 1; i <= static_cast<int>(ray.size()); ++i) {
+    SCOPED_TRACE("sample " + std::to_string(i));
+    const double distance = double(i) * d.step_length;
+    bool hidden = false;
+    for (int m = 1; m < 64 * i && !hidden; ++m) {
+      const double u = distance * m / (64.0 * i);
+      hidden = surface(c + u * d.dir_x, r + u * d.dir_y) > double(ray[i - 1]) * u / distance + 1e-3;
+    }
+    EXPECT_EQ(listed[i], !hidden);
+    if (tower_sample == 0 && ray[i - 1] == tower) tower_sample = i;
+  }
+  ASSERT_GT(tower_sample, 0);
+  EXPECT_TRUE(samples_alone[tower_sample]) << "over the samples alone the tower is seen";
+  EXPECT_FALSE(listed[tower_sample]) << "the peak between the roofs hides it";
+}
+
+// On the city DSM the lists' visible samples against the exact line of sight over the bilinear
+// surface (sampled at 1/64 step in double): a sample is hidden where the surface rises more than
+// 1e-4 above its sight line, visible where it stays more than 1e-4 below it, and neither (grazing:
+// a flat roof seen along itself, whose samples come out an ulp off) is not compared. The peaks put
+// right most of the samples that the samples alone (brute force without peaks) get wrong. K = 16, a
+// receiver every 5 rows and 7 columns. Prints the counts (docs/TESTING.md quotes them).
+TEST(HorizonLists, OnACityDsmThePeaksPutRightWhatTheSamplesAloneSeePast) {
+  const HeightField field = makeSyntheticField("city", 96, 64, 7);
+  const auto prepared = detail::prepareHeights(field);
+  SweepOptions options;
+  options.directions = 16;
+  options.azimuth_offset = 0.05;
+  const auto directions = detail::runDirections(field, options);
+  std::vector<ReceiverPixel> receivers;
+  for (int r = 2; r < field.height; r += 5)
+    for (int c = 3; c < field.width; c += 7) receivers.push_back({c, r});
+  const auto lists = computeHorizonLists(field, options, receivers);
+  const int w = field.width;
+  auto at = [&](int x, int y) { return double(prepared.heights[std::size_t(y) * w + x]); };
+  auto surface = [&](double x, double y) {
+    x = std::clamp(x, 0.0, w - 1.0);
+    y = std::clamp(y, 0.0, field.height - 1.0);
+    const int x0 = std::min(int(std::floor(x)), w - 2), y0 = std::min(int(std::floor(y)), field.height - 2);
+    const double fx = x - x0, fy = y - y0;
+    return at(x0, y0) * (1 - fx) * (1 - fy) + at(x0 + 1, y0) * fx * (1 - fy) +
+           at(x0, y0 + 1) * (1 - fx) * fy + at(x0 + 1, y0 + 1) * fx * fy;
+  };
+  const double tolerance = 1e-4;
+  long compared = 0, grazing = 0, wrong_alone = 0, wrong_with_peaks = 0;
+  for (std::size_t n = 0; n < receivers.size(); ++n) {
+    const auto [c, r] = receivers[n];
+    const double hr = at(c, r);
+    for (int k = 0; k < options.directions; ++k) {
+      const detail::SweepDirection& d = directions[k];
+      const auto ray = referenceRay(field, prepared.heights, d, c, r);
+      const auto listed = listedVisible(lists[n].directions[k], ray);
+      const auto alone = referenceHorizonList(ray, float(hr)).visible;
+      // The steepest the surface rises over the dense points before each sample, from the
+      // receiver, with the surface lowered (raised) by the tolerance.
+      double steepest_low = -INFINITY, steepest_high = -INFINITY;
+      const int dense = 64;
+      for (int i = 1; i <= static_cast<int>(ray.size()); ++i) {
+        for (int m = (i - 1) * dense + (i == 1 ? 1 : 0); m < i * dense; ++m) {
+          const double u = double(m) / dense * d.step_length;
+          const double z = surface(c + u * d.dir_x, r + u * d.dir_y) - hr;
+          steepest_low = std::max(steepest_low, (z - tolerance) / u);
+          steepest_high = std::max(steepest_high, (z + tolerance) / u);
+        }
+        if (std::isnan(ray[i - 1])) continue;
+        const double slope = (double(ray[i - 1]) - hr) / (i * double(d.step_length));
+        const bool hidden = steepest_low > slope, visible = steepest_high < slope;
+        if (!hidden && !visible) {
+          ++grazing;
+          continue;
+        }
+        ++compared;
+        wrong_alone += alone[i] != visible;
+        wrong_with_peaks += listed[i] != visible;
+      }
+    }
+  }
+  std::printf(
+      "city DSM 96 x 64, K = 16, %zu receivers: of %ld samples compared with the exact line of sight "
+      "(%ld grazing left out), %ld wrong over the samples alone, %ld with the peaks\n",
+      receivers.size(), compared, grazing, wrong_alone, wrong_with_peaks);
+  EXPECT_GT(compared, 30000);
+  EXPECT_GT(wrong_alone, 1000) << "the case should need the peaks";
+  EXPECT_LT(wrong_with_peaks * 5, wrong_alone);
+}
+
+// The lists' visible samples against the naive visibility kernel run for one direction alone (a
+// run of K = 1 at that azimuth marches the same ray): equal where no peak rises between the samples
+// (the axes, where the surface is linear between pixel centres, and rows of their own spacing,
+// which take no peaks), at most its count elsewhere (peaks only hide), and there equal to brute
+// force on the same ray lowered by the drop as the naive march lowers it, with the peaks. On the axis
+// directions also the tree sweep's per-pixel count (lines through pixel centres). Flat and over a
+// curved Earth (a drop of several height units across the field).
 void expectListsAgreeWithTheKernels(double curvature, bool row_spacing = false) {
   SCOPED_TRACE("curvature " + std::to_string(curvature) + (row_spacing ? ", rows of their own spacing" : ""));
   HeightField field = makeSyntheticField("noise", 33, 20, 8);
@@ -128,9 +361,11 @@ void expectListsAgreeWithTheKernels(double curvature, bool row_spacing = false) 
   for (int r = 0; r < field.height; r += 3)
     for (int c = 0; c < field.width; c += 4) receivers.push_back({c, r});
   const auto lists = computeHorizonLists(field, options, receivers);
+  const auto prepared = detail::prepareHeights(field);
+  const auto directions = detail::runDirections(field, options);
   IntervisibilityOutputs counts;
   counts.visible_count = true;
-  std::vector<float> tree_axes(field.pixelCount(), 0.0f);
+  int hidden_by_peaks = 0;
   for (int k = 0; k < options.directions; ++k) {
     IntervisibilityOptions one;
     one.directions = 1;
@@ -138,11 +373,30 @@ void expectListsAgreeWithTheKernels(double curvature, bool row_spacing = false) 
     one.method = IntervisibilityMethod::Naive;
     one.curvature = curvature;
     const auto naive = computeIntervisibility(testContext(), field, one, counts);
+    const bool axis = k % 2 == 0;  // 0, 90, 180, 270 deg
+    const detail::SweepDirection& d = directions[k];
+    const float step_ground = d.step_length * d.ground_per_pixel;
+    const float drop = static_cast<float>(curvature) * step_ground * step_ground;
     for (std::size_t n = 0; n < receivers.size(); ++n) {
-      const std::size_t p = std::size_t(receivers[n].row) * field.width + receivers[n].col;
-      EXPECT_EQ(float(lists[n].directions[k].visible_samples), naive.visible_count[p])
-          << "receiver " << n << " direction " << k;
+      SCOPED_TRACE("receiver " + std::to_string(n) + " direction " + std::to_string(k));
+      const auto [c, r] = receivers[n];
+      const std::size_t p = std::size_t(r) * field.width + c;
+      const DirectionHorizons& list = lists[n].directions[k];
+      if (axis || row_spacing) {
+        EXPECT_EQ(float(list.visible_samples), naive.visible_count[p]);
+        continue;
+      }
+      EXPECT_LE(float(list.visible_samples), naive.visible_count[p]);
+      hidden_by_peaks += float(list.visible_samples) < naive.visible_count[p];
+      auto ray = referenceRay(field, prepared.heights, d, c, r);
+      for (std::size_t i = 1; i <= ray.size(); ++i) ray[i - 1] = ray[i - 1] - drop * float(i) * float(i);
+      expectListEqualsBruteForce(list, ray, prepared.heights[p],
+                                 rayPeaks(field, prepared.heights, d, c, r, options));
+      if (::testing::Test::HasFatalFailure()) return;
     }
+  }
+  if (!row_spacing) {
+    EXPECT_GT(hidden_by_peaks, 10);
   }
   IntervisibilityOptions axes;
   axes.directions = 4;
@@ -155,16 +409,18 @@ void expectListsAgreeWithTheKernels(double curvature, bool row_spacing = false) 
   }
 }
 
-TEST(HorizonLists, AgreeWithTheNaiveKernelAndTheTreeOnTheAxes) {
+TEST(HorizonLists, AgreeWithTheNaiveKernelWithoutPeaksAndBruteForceWithThem) {
   expectListsAgreeWithTheKernels(0.0);
   expectListsAgreeWithTheKernels(0.004);
   expectListsAgreeWithTheKernels(0.0, true);
   expectListsAgreeWithTheKernels(0.004, true);
 }
 
-// The farthest horizon is the horizon of docs/CONVENTIONS.md (the largest elevation, the farther on
-// ties): it equals the naive horizon march's elevation (up to its fast atan).
-TEST(HorizonLists, FarthestHorizonIsTheHorizon) {
+// The farthest horizon has the largest elevation of the visible samples (brute force, with the
+// peaks): where the sample of largest elevation is visible, that is the horizon of
+// docs/CONVENTIONS.md (the largest elevation, the farther on ties), and it equals the naive horizon
+// march's elevation (up to its fast atan); where a peak hides that sample, it lies below it.
+TEST(HorizonLists, FarthestHorizonIsTheHorizonWhereNoPeakHidesIt) {
   const HeightField field = makeSyntheticField("sine", 40, 41, 1);
   HorizonOptions options;
   options.directions = 12;
@@ -177,21 +433,47 @@ TEST(HorizonLists, FarthestHorizonIsTheHorizon) {
   for (int r = 1; r < 40; r += 5)
     for (int c = 2; c < 39; c += 6) receivers.push_back({c, r});
   const auto lists = computeHorizonLists(field, options, receivers);
-  int compared = 0;
+  const auto prepared = detail::prepareHeights(field);
+  const auto directions = detail::runDirections(field, options);
+  int compared = 0, hidden = 0;
   for (std::size_t n = 0; n < receivers.size(); ++n) {
+    const auto [c, r] = receivers[n];
+    const float hr = prepared.heights[std::size_t(r) * field.width + c];
     for (int k = 0; k < options.directions; ++k) {
+      SCOPED_TRACE("receiver " + std::to_string(n) + " direction " + std::to_string(k));
       const auto& list = lists[n].directions[k];
-      const std::size_t p = std::size_t(k) * field.pixelCount() +
-                            std::size_t(receivers[n].row) * field.width + receivers[n].col;
+      const std::size_t p = std::size_t(k) * field.pixelCount() + std::size_t(r) * field.width + c;
+      const auto ray = referenceRay(field, prepared.heights, directions[k], c, r);
+      const auto visible =
+          referenceHorizonList(ray, hr, rayPeaks(field, prepared.heights, directions[k], c, r, options))
+              .visible;
+      double highest = -M_PI / 2, highest_visible = -M_PI / 2;
+      for (std::size_t i = 1; i <= ray.size(); ++i) {
+        const double elevation = std::atan2(double(ray[i - 1]) - hr, i * list.sample_spacing);
+        if (std::isnan(ray[i - 1])) continue;
+        highest = std::max(highest, elevation);
+        if (visible[i]) highest_visible = std::max(highest_visible, elevation);
+      }
       if (list.horizons.empty()) {
-        EXPECT_FLOAT_EQ(horizons.angles[p], -M_PI / 2);
+        EXPECT_EQ(highest_visible, -M_PI / 2);
+        EXPECT_LE(horizons.angles[p], highest + 2e-6);
+        hidden += highest > -M_PI / 2;
         continue;
       }
-      EXPECT_NEAR(list.horizons.back().elevation, horizons.angles[p], 2e-6) << n << " " << k;
-      ++compared;
+      EXPECT_DOUBLE_EQ(list.horizons.back().elevation, highest_visible);
+      if (highest_visible == highest) {
+        EXPECT_NEAR(list.horizons.back().elevation, horizons.angles[p], 2e-6);
+        ++compared;
+      } else {
+        EXPECT_LT(list.horizons.back().elevation, horizons.angles[p]);
+        ++hidden;
+      }
     }
   }
-  EXPECT_GT(compared, 500);
+  // Of 672 lists, 388 compared: on a ridge the samples beyond its tangent point are hidden by the
+  // surface between them, and so is the highest one when it lies there.
+  EXPECT_GT(compared, 300);
+  EXPECT_GT(hidden, 100) << "on this surface peaks hide the highest sample behind a ridge";
 }
 
 // Analytic: level ground with a wall 100 high at column 10. From column 3 looking toward

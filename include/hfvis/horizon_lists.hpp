@@ -6,19 +6,33 @@
 // Which samples: the receiver's own ray, exactly the samples of the naive method: from the
 // pixel centre p, q_i = p + i * step * d_k for i = 1, 2, ... while inside the field
 // (bilinear heights, nodata samples absent), step = 1 / samples_per_unit pixel lengths along
-// d_k (directions as in hfvis/sweep_options.hpp), at phi_k exactly. The lists equal the naive
-// method's visible set sample for sample in every direction; the hull-tree sweep's counts
-// come from each receiver's own lattice line, a step close to phi_k (hfvis/intervisibility.hpp).
+// d_k (directions as in hfvis/sweep_options.hpp), at phi_k exactly. Between two consecutive
+// samples (and between sample 1 and the receiver) the bilinear surface can rise above both (a
+// one-pixel wall, two roofs touching at a corner seen along a diagonal): there the interval's
+// peak, its point farthest above the chord of the two samples (at a grid crossing or inside a
+// cell, where the surface along the ray is a quadratic), stands as an occluder, as in the hull
+// tree's lattice lines (docs/ALGORITHMS.md): it hides what lies behind it but is no sample. So
+// the lists no longer equal the naive method's visible set: a sample is listed visible when no
+// sample and no peak nearer than it lies strictly above its sight line from the receiver, each
+// decided exactly (peak positions in fixed point, 2^-shift of a step). Where the surface is
+// linear between the samples (rays along the axes, a whole number of samples per pixel) that is
+// the naive method's set. On latitude / longitude grids (per-row spacing) the rays take no peaks
+// (their positions are whole units of ground length) and the lists equal the naive method's
+// visible set. The hull-tree sweep's counts come from each receiver's own lattice line, a step
+// close to phi_k (hfvis/intervisibility.hpp).
 //
 // Visibility and tie rule as in hfvis/intervisibility.hpp (grazing samples are visible).
 // A visibility horizon is the farthest sample of maximal slope from the receiver among the
-// samples from one segment start (Eq. 1 of the paper) to the receiver; its visible segment
-// runs from it toward the receiver up to the first hidden sample or the next horizon. The
-// segments together hold every visible sample, each once; on a flat plane there is one
-// horizon, the farthest sample, whose segment is the whole ray.
+// samples (and peaks) from one segment start (Eq. 1 of the paper) to the receiver; its visible
+// segment runs from it toward the receiver up to the first hidden sample or the next horizon. A
+// horizon that is a peak is listed by the sample right after it (nearer), the farthest of its
+// segment, and not at all where that sample is hidden. The segments together hold every visible
+// sample, each once; on a flat plane there is one horizon, the farthest sample, whose segment is
+// the whole ray.
 //
 // Computed on the host by the scalar hull-tree sweep (the mirror of the device kernel, the
-// same exact predicate) on the receiver's ray: a few receivers cost microseconds each.
+// same exact predicate, the same peaks: kernels/shared/tree_peaks.cl) on the receiver's ray: a
+// few receivers cost microseconds each.
 #pragma once
 
 #include <vector>
@@ -69,7 +83,8 @@ struct ReceiverHorizons {
 void validateReceivers(const HeightField& field, const std::vector<ReceiverPixel>& receivers);
 
 // The lists for every receiver, in the order given (options.curvature lowers each sample by
-// its drop, as the naive march does). options.memory_budget_bytes and
+// its drop, as the naive march does, and each peak by its own: the peak is chosen on the surface
+// before the drop, as the lattice lines choose it). options.memory_budget_bytes and
 // progress are not used (one ray per receiver and direction).
 // Throws InvalidArgument for a bad field, bad options or a receiver outside the field.
 std::vector<ReceiverHorizons> computeHorizonLists(const HeightField& field, const SweepOptions& options,

@@ -28,6 +28,9 @@ double angleDifference(double x, double y) {
 
 namespace {
 
+// A coordinate a crossing puts on a grid line, snapped onto it (its rounding undone).
+double snapped(double v) { return std::abs(v - std::round(v)) < 1e-9 ? std::round(v) : v; }
+
 struct Candidate {
   int a, b;
   int cost;        // crossings of one period: |a| + |b| - 1, or 1 on the axes
@@ -86,7 +89,6 @@ LatticeDirection makeDirection(const HeightField& field, const Candidate& c) {
 // The sample at fraction f of the period from the receiver toward +(a, b).
 LatticeSample sampleAt(const LatticeDirection& d, double f) {
   // Offsets from the receiver; crossings fall exactly on grid lines (snap the rounding).
-  auto snapped = [](double v) { return std::abs(v - std::round(v)) < 1e-9 ? std::round(v) : v; };
   const double x = snapped(d.a * f), y = snapped(d.b * f);
   const double ox = std::floor(x), oy = std::floor(y);
   const float fx = static_cast<float>(x - ox), fy = static_cast<float>(y - oy);
@@ -290,9 +292,30 @@ std::vector<LatticeSample> uniformLatticeSamples(const LatticeDirection& d, int 
   return samples;
 }
 
+namespace {
+
+// A piece in the cell whose lower corner is (ox, oy): its far end at (x_far, y_far), its change
+// (dx, dy) to the near end, where its ends lie in the interval, and the interval's length it spans.
+TreePiece treePiece(double ox, double oy, double x_far, double y_far, double dx, double dy, double t_far,
+                    double t_near, double span, bool far_crossing) {
+  TreePiece g{};
+  g.ox = static_cast<std::int32_t>(ox);
+  g.oy = static_cast<std::int32_t>(oy);
+  g.fx = static_cast<float>(snapped(x_far) - ox);
+  g.fy = static_cast<float>(snapped(y_far) - oy);
+  g.dx = static_cast<float>(dx);
+  g.dy = static_cast<float>(dy);
+  g.t_far = static_cast<float>(t_far);
+  g.t_near = static_cast<float>(t_near);
+  g.inv_span = static_cast<float>(1.0 / span);
+  g.far_crossing = far_crossing;
+  return g;
+}
+
+}  // namespace
+
 TreeIntervals treeIntervals(const LatticeDirection& d, int per_period) {
   TreeIntervals out;
-  auto snapped = [](double v) { return std::abs(v - std::round(v)) < 1e-9 ? std::round(v) : v; };
   const bool along_grid_line = d.a == 0 || d.b == 0;
   for (int q = 0; q < per_period; ++q) {
     out.first.push_back(static_cast<std::int32_t>(out.pieces.size()));
@@ -312,22 +335,43 @@ TreeIntervals treeIntervals(const LatticeDirection& d, int per_period) {
     for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
       const double far = cuts[k], near = cuts[k + 1];
       const double ox = std::floor(d.a * 0.5 * (far + near)), oy = std::floor(d.b * 0.5 * (far + near));
-      TreePiece g{};
-      g.ox = static_cast<std::int32_t>(ox);
-      g.oy = static_cast<std::int32_t>(oy);
-      g.fx = static_cast<float>(snapped(d.a * far) - ox);
-      g.fy = static_cast<float>(snapped(d.b * far) - oy);
-      g.dx = static_cast<float>(d.a * (near - far));
-      g.dy = static_cast<float>(d.b * (near - far));
-      g.t_far = static_cast<float>((f_far - far) * per_period);
-      g.t_near = static_cast<float>((f_far - near) * per_period);
-      g.inv_span = static_cast<float>(1.0 / ((far - near) * per_period));
-      g.far_crossing = k > 0;
-      out.pieces.push_back(g);
+      out.pieces.push_back(treePiece(ox, oy, d.a * far, d.b * far, d.a * (near - far), d.b * (near - far),
+                                     (f_far - far) * per_period, (f_far - near) * per_period,
+                                     (far - near) * per_period, k > 0));
     }
   }
   out.first.push_back(static_cast<std::int32_t>(out.pieces.size()));
   return out;
+}
+
+std::vector<TreePiece> segmentTreePieces(double x_far, double y_far, double x_near, double y_near, int width,
+                                         int height) {
+  // The cuts by their parameter t along the segment (0 at the far end, 1 at the near one).
+  std::vector<double> cuts;
+  auto cross = [&](double from, double to) {
+    if (from == to) return;
+    for (double g = std::floor(std::min(from, to)) + 1.0; g < std::max(from, to); ++g)
+      cuts.push_back((g - from) / (to - from));
+  };
+  cross(x_far, x_near);
+  cross(y_far, y_near);
+  std::sort(cuts.begin(), cuts.end());
+  std::vector<double> ends = {0.0};  // a vertex is a column and a row crossing at once: one cut
+  for (double t : cuts)
+    if (t > ends.back() + 1e-9 && t < 1.0 - 1e-9) ends.push_back(t);
+  ends.push_back(1.0);
+  std::vector<TreePiece> pieces;
+  const double ex = x_near - x_far, ey = y_near - y_far;
+  for (std::size_t k = 0; k + 1 < ends.size(); ++k) {
+    const double t_far = ends[k], t_near = ends[k + 1];
+    const double xf = x_far + t_far * ex, yf = y_far + t_far * ey;
+    const double xm = x_far + 0.5 * (t_far + t_near) * ex, ym = y_far + 0.5 * (t_far + t_near) * ey;
+    const double ox = std::clamp(std::floor(xm), 0.0, double(width - 2));
+    const double oy = std::clamp(std::floor(ym), 0.0, double(height - 2));
+    pieces.push_back(treePiece(ox, oy, xf, yf, (t_near - t_far) * ex, (t_near - t_far) * ey, t_far, t_near,
+                               t_near - t_far, k > 0));
+  }
+  return pieces;
 }
 
 std::vector<LatticeLine> latticeLines(const LatticeDirection& d, int width, int height) {

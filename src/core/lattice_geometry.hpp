@@ -135,6 +135,14 @@ struct TreeIntervals {
 };
 TreeIntervals treeIntervals(const LatticeDirection& d, int per_period);
 
+// The pieces of one interval of an arbitrary line (the horizon lists' rays, whose samples are
+// not on a lattice): the segment from (x_far, y_far) to (x_near, y_near), in pixel axes inside
+// a width x height field (at least 2 x 2), cut where it crosses a column or a row strictly
+// between its ends (a vertex once), farthest first. Cell origins are absolute, kept within the
+// field's cells (a piece along the last column or row lies on its cell's far edge).
+std::vector<TreePiece> segmentTreePieces(double x_far, double y_far, double x_near, double y_near, int width,
+                                         int height);
+
 // One line of a direction: its farthest receiver (along +(a, b)) and how many receivers it
 // has; receiver i sits at (col - i a, row - i b). `stack` is the first entry of its hull
 // stack in the scratch buffer (entries at stack + depth * stride).

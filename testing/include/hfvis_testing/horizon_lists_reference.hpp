@@ -1,14 +1,15 @@
 // hfvis_testing/horizon_lists_reference.hpp: the brute-force reference of the horizon lists
 // (hfvis/horizon_lists.hpp): one receiver's ray sampled as the naive method samples it, and on
 // it every sample's visibility and the visibility horizons by their definitions (Timonen 2013,
-// Eq. 1 and 2), each decided by the exact chord_side predicate, in O(n^2). Test support
-// library hfvis_testing; not installed.
+// Eq. 1 and 2), with the peaks between samples as occluders, each decided by the exact
+// chord_side predicate, in O(n^2). Test support library hfvis_testing; not installed.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
-#include "hfvis/height_field.hpp"
 #include "core/sweep_geometry.hpp"
+#include "hfvis/height_field.hpp"
 
 namespace hfvis {
 
@@ -22,7 +23,21 @@ struct HorizonListReference {
   std::vector<int> horizons;  // sample indices, nearest first
 };
 
-// Brute force on the ray (sample i at ray[i - 1], receiver height hr at distance 0).
-HorizonListReference referenceHorizonList(const std::vector<float>& ray, float hr);
+// The peaks between a ray's samples (src/ops/horizon_lists_ray.hpp): per interval i, between
+// sample i + 1 and sample i (interval 0 ends at the receiver), a height (NaN: none) and its
+// offset from sample i + 1 toward sample i in units of 2^-shift step. shift 0: no peaks.
+struct RayPeaks {
+  int shift = 0;
+  std::vector<float> heights;
+  std::vector<std::int32_t> offsets;
+};
+
+// Brute force on the ray (sample i at ray[i - 1], receiver height hr at distance 0): a sample is
+// visible when it is present and no present sample and no peak nearer than it (one that
+// tree_peak_inserted admits: strictly above the chord of its interval's samples) lies strictly
+// above the sight line. Horizons by Eq. 1 and 2 over the samples and those peaks alike; a peak
+// that is a horizon is listed by the sample right after it (nearer) where that one is visible.
+HorizonListReference referenceHorizonList(const std::vector<float>& ray, float hr,
+                                          const RayPeaks& peaks = {});
 
 }  // namespace hfvis
