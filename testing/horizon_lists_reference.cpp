@@ -41,7 +41,7 @@ HorizonListReference referenceHorizonList(const std::vector<float>& ray, float h
     if (!std::isnan(ray[i - 1])) nodes.push_back({ray[i - 1], float(i << peaks.shift), i});
     const int j = i - 1;  // the interval from sample i to the next nearer one
     if (peaks.shift > 0 &&
-        detail::tree_peak_inserted(height(i), peaks.heights[j], height(j), peaks.offsets[j], peaks.shift))
+        detail::tree_peak_inserted(height(i), peaks.heights[j], height(j), peaks.offsets[j], 1 << peaks.shift))
       nodes.push_back({peaks.heights[j], float((i << peaks.shift) - peaks.offsets[j]), -1 - j});
   }
   nodes.push_back({hr, 0.0f, 0});

@@ -806,7 +806,8 @@ TEST(HorizonKernels, AnOriginOutsideItsLargerFieldOrAboveAHeightIsRefused) {
   EXPECT_NO_THROW(computeHorizons(testContext(), field, options, allOutputs()));
   for (FieldOrigin bad :
        {FieldOrigin{3, 3, 8, 8, -1.0}, FieldOrigin{2, 4, 8, 8, -1.0}, FieldOrigin{-1, 0, 8, 8, -1.0},
-        FieldOrigin{0, 0, 5, 0, -1.0}, FieldOrigin{2, 3, 8, 8, 0.5}, FieldOrigin{2, 3, 8, 8, NAN}}) {
+        FieldOrigin{0, 0, 5, 0, -1.0}, FieldOrigin{2, 3, 8, 8, 0.5}, FieldOrigin{2, 3, 8, 8, NAN},
+        FieldOrigin{2, 3, 8, 8, -1.0, -1.0}, FieldOrigin{2, 3, 8, 8, -1.0, INFINITY}}) {
     field.origin = bad;
     EXPECT_THROW(computeHorizons(testContext(), field, options, allOutputs()), InvalidArgument);
   }

@@ -31,11 +31,16 @@ struct Georeference {
 // maximum distance (and the bilinear cell and normal beyond it) lies inside this field: a
 // pixel's samples and the cut at the maximum distance fall where they fall in the larger field
 // (not with per-row spacing, whose positions are ground lengths summed from a line's start).
-// The hull tree (intervisibility) is exact either way; it takes the base too.
+// The hull tree (intervisibility, the horizon lists) is exact either way; it takes the base
+// too, and with per-row spacing the larger field's unit of ground length (groundUnit: its
+// size and largest cell), so that its positions differ from the larger field's by a constant.
 struct FieldOrigin {
   int col = 0, row = 0;                  // this field's pixel (0, 0) in the larger field
   int whole_width = 0, whole_height = 0;  // the larger field's size; 0 x 0: no larger field
   double lowest = 0.0;                    // the larger field's lowest finite height (before z_scale)
+  // With per-row spacing: the larger field's largest per-row cell size (ground units), at
+  // least this field's; 0: this field's own.
+  double largest_cell = 0.0;
 
   bool present() const { return whole_width > 0 || whole_height > 0; }
 };

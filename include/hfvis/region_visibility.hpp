@@ -42,6 +42,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "hfvis/device.hpp"
@@ -96,6 +97,9 @@ struct RegionVisibilityOptions {
   double curvature = 0.0;      // drop coefficient c (earthCurvature() in hfvis/sweep_options.hpp); 0 = flat
   std::uint32_t seed = 1;      // the jitter's
   bool decorrelate = false;    // each receiver its own jitter of the sources
+  // Hears (done, in all) after each launch of receivers (with the viewsheds method: after each
+  // source sample's viewshed); may be empty. An exception thrown from it stops the run.
+  std::function<void(int, int)> progress;
 };
 
 // Per receiver a bitmask of the source samples it sees: bit s % 32 of word s / 32 (words per

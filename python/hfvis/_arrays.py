@@ -190,7 +190,8 @@ def compute(operation, heights, geometry, options, device="", progress=None):
     if operation == "region_visibility":
         o = _region_options(options)
         r = _core.region_visibility(field, region_sampling(options["sources"], options["samples"], options["height"],
-                                                           options["absolute"]), o, device=device)
+                                                           options["absolute"]), o, device=device,
+                                    progress=progress)
         # Plane w: the samples 32 w .. 32 w + 31 (bit s % 32), as the horizon maps' K x H x W.
         r["bits"] = np.ascontiguousarray(np.moveaxis(r["bits"], -1, 0))
         return r
@@ -199,7 +200,7 @@ def compute(operation, heights, geometry, options, device="", progress=None):
             field, region_sampling(options["sources"], options["samples"], options["source_height"],
                                    options["absolute"]),
             region_sampling(options["receivers"], options["samples"], options["receiver_height"], options["absolute"]),
-            _region_options(options), device=device)
+            _region_options(options), device=device, progress=progress)
     if operation == "pvs":
         grid = _core.PvsGrid()
         _set(grid, options, ("view_cell", "band_low", "band_high", "tile"))

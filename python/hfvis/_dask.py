@@ -43,7 +43,9 @@ def _block(block, lowest, operation, geometry, options, device, depth, chunks, b
     first_row = sum(chunks[0][:i]) - top
     first_col = sum(chunks[1][:j]) - left
     g = dict(geometry)
-    g["origin"] = [first_col, first_row, sum(chunks[1]), sum(chunks[0]), float(lowest.flat[0])]
+    # (The largest row cell size: the whole field's unit of positions on a latitude / longitude grid.)
+    largest = max(g["row_cell_size_x"] + g["row_cell_size_y"], default=0.0)
+    g["origin"] = [first_col, first_row, sum(chunks[1]), sum(chunks[0]), float(lowest.flat[0]), float(largest)]
     if g["row_cell_size_x"]:  # a latitude / longitude grid: the block's own rows' spacing
         g["row_cell_size_x"] = g["row_cell_size_x"][first_row:first_row + block.shape[0]]
         g["row_cell_size_y"] = g["row_cell_size_y"][first_row:first_row + block.shape[0]]
@@ -78,7 +80,7 @@ def chunked(operation, heights, geometry, options, device=""):
     # The whole field's lowest height, the base of every block's heights: a reduction, handed to
     # each block as a 1 x 1 block of its own (infinite where every height is nodata, and then no
     # block reads it).
-    lowest = da.where(da.isnan(heights), np.float32(np.inf), heights).min()
+    lowest = da.where(da.isfinite(heights), heights, np.float32(np.inf)).min()
     lowest = da.broadcast_to(lowest, overlapped.numblocks, chunks=1)
     stacked = da.map_blocks(body, overlapped, lowest, dtype=np.float32, new_axis=0,
                             chunks=((len(names) * planes,),) + chunks, meta=np.empty((0, 0, 0), np.float32))

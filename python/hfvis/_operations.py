@@ -426,7 +426,7 @@ def environment_light(heights, environment, *, rotation_deg=0.0, table_rows=0, d
 
 def region_visibility(heights, sources, *, samples=16, height=2.0, absolute=False, target_height=0.0,
                       method="culled", seed=1, decorrelate=False, max_distance=0.0, curvature=0.0, pixels=False,
-                      cell_size=None, z_scale=1.0, nodata=None, device=""):
+                      cell_size=None, z_scale=1.0, nodata=None, device="", progress=None):
     """Which samples of a source region (an area light) every point sees, standing target_height
     above the surface (after Eisemann & Decoret 2007). `sources`: a rectangle (col0, row0, col1,
     row1) of grid points, corners inclusive, sampled `samples` times `height` above the surface
@@ -434,13 +434,15 @@ def region_visibility(heights, sources, *, samples=16, height=2.0, absolute=Fals
     points. A DataArray takes map coordinates (x0, y0, x1, y1) or (x, y[, height]) unless
     pixels=True. numpy: RegionVisibility(fraction H x W, 0..1, NaN at nodata; bits ceil(S/32) x
     H x W uint32, bit s % 32 of plane s // 32 for sample s); DataArray: a Dataset of the two.
-    Computed in one piece (a Dask array is computed first)."""
+    Computed in one piece (a Dask array is computed first). progress(done, total) hears each launch
+    of receivers (method "viewsheds": each source sample)."""
     options = {"sources": sources, "samples": int(samples), "height": float(height), "absolute": bool(absolute),
                "target_height": float(target_height), "method": method, "seed": int(seed),
                "decorrelate": bool(decorrelate), "max_distance": float(max_distance), "curvature": float(curvature)}
     if _is_dataarray(heights) and _is_dask(heights.data):
         heights = heights.compute()  # the sources are shared by every point: the field in one piece
-    out, grid = _run("region_visibility", heights, options, _common(cell_size, z_scale, nodata, device, None, pixels))
+    out, grid = _run("region_visibility", heights, options,
+                     _common(cell_size, z_scale, nodata, device, progress, pixels))
     if grid is None:
         return RegionVisibility(out["fraction"], out["bits"])
     import xarray as xr
@@ -453,14 +455,15 @@ def region_visibility(heights, sources, *, samples=16, height=2.0, absolute=Fals
 
 def region_pair_visibility(heights, sources, receivers, *, samples=16, source_height=2.0, receiver_height=2.0,
                            absolute=False, method="culled", seed=1, decorrelate=False, max_distance=0.0,
-                           curvature=0.0, pixels=False, cell_size=None, z_scale=1.0, nodata=None, device=""):
+                           curvature=0.0, pixels=False, cell_size=None, z_scale=1.0, nodata=None, device="",
+                           progress=None):
     """Visibility between two regions, each a rectangle or points as region_visibility's
     `sources` (a rectangle sampled `samples` times): which source samples each receiver sample
     sees. Returns RegionPairVisibility: bits (R x ceil(S/32) uint32, bit s % 32 of word s // 32),
     sources and receivers (N x 3: col, row, absolute z-scaled height), source_fraction and
     receiver_fraction (the share of the other region's samples each sees), clear_pairs, pairs,
     visible_fraction, and sources_xy / receivers_xy (map coordinates of a georeferenced
-    DataArray, else None)."""
+    DataArray, else None). progress as region_visibility's."""
     options = {"sources": sources, "receivers": receivers, "samples": int(samples),
                "source_height": float(source_height), "receiver_height": float(receiver_height),
                "absolute": bool(absolute), "method": method, "seed": int(seed), "decorrelate": bool(decorrelate),
@@ -468,7 +471,7 @@ def region_pair_visibility(heights, sources, receivers, *, samples=16, source_he
     if _is_dataarray(heights) and _is_dask(heights.data):
         heights = heights.compute()
     out, grid = _run("region_pair_visibility", heights, options,
-                     _common(cell_size, z_scale, nodata, device, None, pixels))
+                     _common(cell_size, z_scale, nodata, device, progress, pixels))
 
     def xy(points):
         if grid is None or grid.transform is None:

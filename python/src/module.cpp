@@ -111,11 +111,13 @@ HeightField makeField(Heights heights, double cell_size_x, double cell_size_y,
   field.row_cell_size_y = std::move(row_cell_size_y);
   field.z_scale = z_scale;
   // Empty, or where the field lies in a larger one (a Dask chunk with its halo): column, row,
-  // the larger field's width and height and its lowest height (HeightField::origin).
+  // the larger field's width and height, its lowest height and its largest per-row cell size
+  // (HeightField::origin).
   if (!origin.empty()) {
-    if (origin.size() != 5) throw InvalidArgument("origin must be (col, row, whole_width, whole_height, lowest)");
+    if (origin.size() != 6)
+      throw InvalidArgument("origin must be (col, row, whole_width, whole_height, lowest, largest_cell)");
     field.origin = {static_cast<int>(origin[0]), static_cast<int>(origin[1]), static_cast<int>(origin[2]),
-                    static_cast<int>(origin[3]), origin[4]};
+                    static_cast<int>(origin[3]), origin[4], origin[5]};
   }
   validate(field);
   return field;
@@ -372,8 +374,9 @@ ArrayOf<double> regionPoints(const std::vector<RegionPoint>& points) {
   return toArray(std::move(values), {points.size(), 3});
 }
 
-nb::dict regionVisibility(const HeightField& field, const RegionSampling& sources,
-                          const RegionVisibilityOptions& options, const std::string& device) {
+nb::dict regionVisibility(const HeightField& field, const RegionSampling& sources, RegionVisibilityOptions options,
+                          const std::string& device, nb::object progress) {
+  options.progress = progressHook(progress);
   validate(options);
   validate(field, sources);
   RegionVisibilityResult r = onDevice(
@@ -386,8 +389,9 @@ nb::dict regionVisibility(const HeightField& field, const RegionSampling& source
 }
 
 nb::dict regionPairVisibility(const HeightField& field, const RegionSampling& sources,
-                              const RegionSampling& receivers, const RegionVisibilityOptions& options,
-                              const std::string& device) {
+                              const RegionSampling& receivers, RegionVisibilityOptions options,
+                              const std::string& device, nb::object progress) {
+  options.progress = progressHook(progress);
   validate(options);
   validate(field, sources);
   validate(field, receivers);
@@ -632,9 +636,10 @@ NB_MODULE(_core, m) {
         "progress"_a.none());
   nb::class_<RegionSampling>(m, "RegionSampling");
   m.def("region_sampling", &regionSampling, "rectangle"_a, "points"_a, "samples"_a, "height"_a, "absolute"_a);
-  m.def("region_visibility", &regionVisibility, "field"_a, "sources"_a, "options"_a, "device"_a);
+  m.def("region_visibility", &regionVisibility, "field"_a, "sources"_a, "options"_a, "device"_a,
+        "progress"_a.none());
   m.def("region_pair_visibility", &regionPairVisibility, "field"_a, "sources"_a, "receivers"_a, "options"_a,
-        "device"_a);
+        "device"_a, "progress"_a.none());
   m.def("pvs", &pvs, "field"_a, "grid"_a, "options"_a, "device"_a, "progress"_a.none());
   m.def("horizon_lists", &horizonLists, "field"_a, "options"_a, "cols"_a, "rows"_a);
   m.def("bounce", &bounce, "field"_a, "radiance"_a, "options"_a, "device"_a, "progress"_a.none());

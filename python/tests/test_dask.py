@@ -82,6 +82,16 @@ def test_chunked_equals_in_memory_bit_for_bit(field, operation):
                 np.testing.assert_array_equal(got[name], coord)
 
 
+def test_infinite_heights_are_nodata_as_in_memory(field):
+    """+-inf are nodata (as NaN): the base of every block's heights is the lowest finite one."""
+    holes = field.copy()
+    holes.values[10, 10] = -np.inf
+    holes.values[100, 150] = np.inf
+    whole = hfvis.sky_view_factor(holes, directions=4, max_distance=MAX_DISTANCE)
+    chunked = hfvis.sky_view_factor(holes.chunk(40), directions=4, max_distance=MAX_DISTANCE)
+    np.testing.assert_array_equal(chunked.values, whole.values)
+
+
 def test_chunks_smaller_than_the_halo_are_rechunked(field):
     svf = hfvis.sky_view_factor(field.chunk({"y": 5, "x": 5}), directions=4, max_distance=MAX_DISTANCE)
     assert min(min(c) for c in svf.chunks) >= 12  # the halo: ceil(300 / 30) + 2 pixels

@@ -116,6 +116,25 @@ def test_progress_callback_errors_stop_the_run(small):
     assert np.isfinite(hfvis.sky_view_factor(small, directions=16)).all()  # the context still works
 
 
+def test_region_visibility_reports_progress_and_stops_on_an_error(small):
+    calls = []
+    hfvis.region_visibility(small, (2, 2, 6, 6), samples=8, progress=lambda done, total: calls.append((done, total)))
+    assert calls and calls[-1][0] == calls[-1][1], calls  # the last launch's receivers: all of them
+    calls = []
+    points = np.array([[3, 4], [10, 5], [15, 20]])
+    hfvis.region_visibility(small, points, method="viewsheds", progress=lambda done, total: calls.append((done, total)))
+    assert calls == [(1, 3), (2, 3), (3, 3)]  # one viewshed per source sample
+
+    def fail(done, total):
+        raise RuntimeError("stop here")
+
+    with pytest.raises(RuntimeError, match="stop here"):
+        hfvis.region_visibility(small, (2, 2, 6, 6), samples=8, progress=fail)
+    with pytest.raises(RuntimeError, match="stop here"):
+        hfvis.region_pair_visibility(small, (2, 2, 6, 6), (10, 10, 14, 14), samples=8, progress=fail)
+    assert np.isfinite(hfvis.region_visibility(small, (2, 2, 6, 6), samples=8).fraction).all()
+
+
 def test_ctrl_c_stops_a_run():
     """SIGINT during a long run: KeyboardInterrupt at the next batch of directions, not a hang or
     a crash."""

@@ -64,6 +64,12 @@ void validate(const HeightField& field) {
     if (!above)
       throw InvalidArgument("the origin's lowest height (" + shortNumber(o.lowest) +
                             ") must be finite and at most every height of the field");
+    double largest = 0.0;  // of this field's rows
+    for (const auto* sizes : {&field.row_cell_size_x, &field.row_cell_size_y})
+      for (double s : *sizes) largest = std::max(largest, s);
+    if (!(std::isfinite(o.largest_cell) && (o.largest_cell == 0.0 || o.largest_cell >= largest)))
+      throw InvalidArgument("the origin's largest cell size (" + shortNumber(o.largest_cell) +
+                            ") must be 0 or at least the field's largest row cell size (" + shortNumber(largest) + ")");
   }
 }
 

@@ -279,7 +279,8 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
       unit_sums[slot] = unit_sum;
       weighted_sums[slot] = weighted_sum;
       const float h = peak ? out.peaks[e] : h_sample;
-      if (peak ? !tree_peak_inserted(h_sample_prev, h, h_sample, out.peak_offsets[e], line.stepScale(step))
+      // (Step 0 has no step before it, nor a peak.)
+      if (peak ? step == 0 || !tree_peak_inserted(h_sample_prev, h, h_sample, out.peak_offsets[e], line.stepScale(step))
                : std::isnan(h))
         continue;  // outputs stay NaN / zero
       const float p = line.position(slot);

@@ -81,7 +81,7 @@ HorizonRay horizonRay(const HeightField& field, const std::vector<float>& height
     for (const TreePiece& g : segmentTreePieces(far.x, far.y, near.x, near.y, field.width, field.height)) {
       const std::size_t at = static_cast<std::size_t>(g.oy) * w + g.ox;
       tree_piece_peak(heights[at], heights[at + 1], heights[at + w], heights[at + w + 1], g.fx, g.fy, g.dx,
-                      g.dy, g.t_far, g.t_near, g.inv_span, g.far_crossing, h_far, h_near - h_far, ray.shift,
+                      g.dy, g.t_far, g.t_near, g.inv_span, g.far_crossing, h_far, h_near - h_far, 1 << ray.shift,
                       &curve, &best_h, &offset, &best_excess);
     }
     if (!(best_h > -INFINITY)) continue;  // none, or NaN (a corner at nodata)

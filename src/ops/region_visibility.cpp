@@ -20,8 +20,8 @@
 namespace hfvis {
 namespace {
 
-// Receivers per launch: bounds a launch's time (a GPU's watchdog) on large fields.
-constexpr int kReceiversPerLaunch = 1 << 16;
+// Receiver words (32 samples each) per launch: bounds a launch's time (a GPU's watchdog) on large fields.
+constexpr int kWordsPerLaunch = 1 << 16;
 
 // The culling pyramid's levels at most: blocks of up to 2^15 cells a side.
 constexpr int kCullLevels = 16;
@@ -124,14 +124,15 @@ CullPyramid cullPyramid(const std::vector<float>& h, int width, int height) {
 }
 
 // The bits of `count` receivers from the device, receiver-major: one routine item per launch
-// of up to kReceiversPerLaunch receivers.
+// of up to kWordsPerLaunch / words receivers (a work-item marches all its receiver's words:
+// a launch's work stays bounded whatever S).
 class RegionBitsRoutine : public detail::DeviceRoutine {
  public:
   RegionBitsRoutine(detail::ContextState& st, const HeightField& field, const std::vector<float>& sources,
                     const std::vector<float>& source_points, bool source_absolute,
                     const std::vector<float>* receivers, bool receiver_absolute, int count,
                     const RegionVisibilityOptions& options)
-      : DeviceRoutine(st, field, nullptr, 0),
+      : DeviceRoutine(st, field, options.progress, 0),
         sources_(sources),
         source_points_(source_points),
         source_absolute_(source_absolute),
@@ -207,10 +208,11 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
         .set("bits", bits_);
   }
 
-  int itemCount() const override { return (count_ + kReceiversPerLaunch - 1) / kReceiversPerLaunch; }
+  int receiversPerLaunch() const { return std::max(1, kWordsPerLaunch / words_); }
+  int itemCount() const override { return (count_ + receiversPerLaunch() - 1) / receiversPerLaunch(); }
 
   void runItem(int item, int) override {
-    const int first = item * kReceiversPerLaunch, chunk = std::min(kReceiversPerLaunch, count_ - first);
+    const int first = item * receiversPerLaunch(), chunk = std::min(receiversPerLaunch(), count_ - first);
     kernel_.set("first", cl_int(first));
     st_.launch(kernel_, cl::NDRange(detail::roundUp(chunk, detail::kLineGroup)),
                cl::NDRange(detail::kLineGroup));
@@ -284,6 +286,7 @@ std::vector<std::uint32_t> viewshedBits(const ComputeContext& context, const Hei
     const ViewshedResult v = computeViewshed(context, field, o, vo);
     for (std::size_t p = 0; p < v.visible.size(); ++p)
       if (v.visible[p] == 1.0f) bits[p * words + s / 32] |= 1u << (s % 32);
+    if (options.progress) options.progress(static_cast<int>(s) + 1, static_cast<int>(samples.size()));
   }
   return bits;
 }
