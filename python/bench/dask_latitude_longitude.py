@@ -1,6 +1,7 @@
-"""How far a chunked (Dask) run is from the in-memory one on a latitude / longitude grid, where
-positions along a line are ground lengths summed from where the line enters each block (the one
-case HeightField::origin does not make exact, docs/python.md): the bundled Jacksboro DEM on its 3
+"""How far a chunked (Dask) run is from the in-memory one on a latitude / longitude grid, where the
+horizon sweep's positions along a line are ground lengths summed from where the line enters each
+block (the one case HeightField::origin does not make exact, docs/python.md; intervisibility's
+whole units are): the bundled Jacksboro DEM on its 3
 arc-second grid, chunked, sky-view factor and intervisibility (K = 16) within a maximum distance.
 Reports the pixels that differ and the largest difference. Writes Markdown to stdout.
 
