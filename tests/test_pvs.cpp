@@ -264,8 +264,8 @@ TEST(PvsRayCaster, RaysSortedByOriginComeBackInTheCallersOrder) {
   });
 }
 
-// A memory budget splits the rays into more launches, with the same results; one that does not
-// hold a single ray is refused.
+// A memory budget splits the rays into more launches (two in flight at a time), with the same
+// results, lists or hits alone; one that does not hold a single ray is refused.
 TEST(PvsRayCaster, MemoryBudgetSplitsLaunchesWithTheSameResults) {
   const HeightField field = makeSyntheticField("city", 40, 30, 4);
   RayCastOptions options;
@@ -279,6 +279,11 @@ TEST(PvsRayCaster, MemoryBudgetSplitsLaunchesWithTheSameResults) {
   EXPECT_EQ(split.first, whole.first);
   EXPECT_EQ(split.view_cell, whole.view_cell);
   for (std::size_t r = 0; r < in.size(); ++r) EXPECT_TRUE(sameFloat(split.t[r], whole.t[r])) << r;
+  // Hits alone: about 90 rays per launch, two launches in flight (their buffers apart).
+  options.view_cells = false;
+  const RayCastResult hits = castHeightFieldRays(testContext(), field, in, options);
+  EXPECT_EQ(hits.cell, whole.cell);
+  for (std::size_t r = 0; r < in.size(); ++r) EXPECT_TRUE(sameFloat(hits.t[r], whole.t[r])) << r;
   options.memory_budget_bytes = 16;
   EXPECT_THROW(castHeightFieldRays(testContext(), field, in, options), MemoryBudgetError);
 }

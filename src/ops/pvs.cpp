@@ -142,11 +142,13 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
         throw InvalidArgument("a ray with a non-finite origin or direction, or a NaN length");
     const int n = static_cast<int>(rays.size());
     const int cap = view_cells ? layout_.view_x + layout_.view_y : 0;
-    // Per ray on the device: 8 floats in, t, cell, count and cap (view cell, t) pairs out.
-    const std::size_t per_ray = (8 + 3 + 2 * std::size_t(cap)) * 4;
+    // Per ray on the device: 8 floats in, t, cell, count and cap (view cell, t) pairs out; twice,
+    // since two launches are in flight (their buffers apart): the host packs the next launch's
+    // rays and unpacks the previous one's results while the device casts.
+    const std::size_t per_ray = 2 * (8 + 3 + 2 * std::size_t(cap)) * 4;
     if (per_ray > memoryBudget())
-      throw MemoryBudgetError("one ray and its view-cell list need " + mebibytes(per_ray) +
-                              " but the memory budget is " + mebibytes(memoryBudget()));
+      throw MemoryBudgetError("one ray and its view-cell list, in each of two launches in flight, need " +
+                              mebibytes(per_ray) + " but the memory budget is " + mebibytes(memoryBudget()));
     const int chunk = static_cast<int>(std::min<std::size_t>(kRaysPerLaunch, memoryBudget() / per_ray));
     const std::vector<int> order = originOrder(rays);
     RayCastResult out;
@@ -155,8 +157,15 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
     // The lists as cast (in `order`), then in the caller's order.
     Lists cast_lists;
     cast_lists.first.push_back(0);
-    for (int first = 0; first < n; first += chunk)
-      launch(rays, order, first, std::min(chunk, n - first), cap, out, cast_lists);
+    const int launches = (n + chunk - 1) / chunk;
+    if (launches > 0) enqueue(rays, order, 0, std::min(chunk, n), cap, slots_[0]);
+    for (int c = 0; c < launches; ++c) {
+      if (c + 1 < launches) {
+        const int next = (c + 1) * chunk;
+        enqueue(rays, order, next, std::min(chunk, n - next), cap, slots_[(c + 1) % 2]);
+      }
+      collect(order, cap, slots_[c % 2], out, cast_lists);
+    }
     out.first.assign(rays.size() + 1, 0);
     if (cast_lists.cells.empty()) return out;
     for (int i = 0; i < n; ++i) out.first[order[i] + 1] = cast_lists.first[i + 1] - cast_lists.first[i];
@@ -229,58 +238,79 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
     return order;
   }
 
-  // Device buffers for `n` rays with lists of `cap`, kept from launch to launch (grown, never
-  // shrunk).
-  void reserve(int n, int cap) {
-    if (n > reserved_rays_) {
-      reserved_rays_ = n;
+  // One launch's buffers, kept from launch to launch (grown, never shrunk), and what it cast.
+  struct Slot {
+    int reserved_rays = 0;
+    std::size_t reserved_list = 0;
+    cl::Buffer rays, t, cell, count, pierced, pierced_t;
+    std::vector<float> packed, hit_t;
+    std::vector<int> hit_cell, counts;
+    cl::Event read;  // its last non-blocking read
+    int first = 0, n = 0;
+  };
+
+  // Device buffers for `n` rays with lists of `cap`.
+  void reserve(Slot& s, int n, int cap) {
+    if (n > s.reserved_rays) {
+      s.reserved_rays = n;
       const std::size_t rays = std::size_t(n);
-      ray_buffer_ = deviceBuffer(st_, rays * 8 * 4);
-      t_ = deviceBuffer(st_, rays * 4);
-      cell_ = deviceBuffer(st_, rays * 4);
-      count_ = deviceBuffer(st_, rays * 4);
+      s.rays = deviceBuffer(st_, rays * 8 * 4);
+      s.t = deviceBuffer(st_, rays * 4);
+      s.cell = deviceBuffer(st_, rays * 4);
+      s.count = deviceBuffer(st_, rays * 4);
     }
     const std::size_t list = std::max<std::size_t>(1, std::size_t(n) * cap);
-    if (list > reserved_list_) {
-      reserved_list_ = list;
-      pierced_ = deviceBuffer(st_, list * 4);
-      pierced_t_ = deviceBuffer(st_, list * 4);
+    if (list > s.reserved_list) {
+      s.reserved_list = list;
+      s.pierced = deviceBuffer(st_, list * 4);
+      s.pierced_t = deviceBuffer(st_, list * 4);
     }
   }
 
-  // The rays order[first .. first + n) into `out` (at their own index) and their lists onto
-  // `lists` (in cast order).
-  void launch(const std::vector<HeightRay>& rays, const std::vector<int>& order, int first, int n, int cap,
-              RayCastResult& out, Lists& lists) {
-    reserve(n, cap);
-    std::vector<float> packed(std::size_t(n) * 8, 0.0f);
+  // Packs the rays order[first .. first + n) into `s`, and queues their upload, the cast and the
+  // reads of its hits and list lengths (not waited for).
+  void enqueue(const std::vector<HeightRay>& rays, const std::vector<int>& order, int first, int n, int cap,
+               Slot& s) {
+    reserve(s, n, cap);
+    s.first = first;
+    s.n = n;
+    s.packed.assign(std::size_t(n) * 8, 0.0f);
     for (int r = 0; r < n; ++r) {
       const HeightRay& ray = rays[order[std::size_t(first) + r]];
       const float values[7] = {ray.ox, ray.oy, ray.oz, ray.dx, ray.dy, ray.dz, ray.t_max};
       for (int c = 0; c < 7; ++c)
-        packed[line_major_ ? std::size_t(r) * 8 + c : std::size_t(c) * n + r] = values[c];
+        s.packed[line_major_ ? std::size_t(r) * 8 + c : std::size_t(c) * n + r] = values[c];
     }
-    st_.queue.enqueueWriteBuffer(ray_buffer_, CL_FALSE, 0, packed.size() * 4, packed.data());
-    kernel_.set("rays", ray_buffer_)
+    st_.queue.enqueueWriteBuffer(s.rays, CL_FALSE, 0, s.packed.size() * 4, s.packed.data());
+    kernel_.set("rays", s.rays)
         .set("n", cl_int(n))
         .set("cap", cl_int(cap))
-        .set("hit_t", t_)
-        .set("hit_cell", cell_)
-        .set("counts", count_)
-        .set("pierced", pierced_)
-        .set("pierced_t", pierced_t_);
+        .set("hit_t", s.t)
+        .set("hit_cell", s.cell)
+        .set("counts", s.count)
+        .set("pierced", s.pierced)
+        .set("pierced_t", s.pierced_t);
     st_.launch(kernel_, cl::NDRange(roundUp(n, kLineGroup)), cl::NDRange(kLineGroup));
-    std::vector<float> t(n);
-    std::vector<int> cell(n), count(n);
-    st_.queue.enqueueReadBuffer(t_, CL_FALSE, 0, std::size_t(n) * 4, t.data());
-    st_.queue.enqueueReadBuffer(cell_, CL_FALSE, 0, std::size_t(n) * 4, cell.data());
-    st_.queue.enqueueReadBuffer(count_, CL_TRUE, 0, std::size_t(n) * 4, count.data());
+    s.hit_t.resize(std::size_t(n));
+    s.hit_cell.resize(std::size_t(n));
+    s.counts.resize(std::size_t(n));
+    st_.queue.enqueueReadBuffer(s.t, CL_FALSE, 0, std::size_t(n) * 4, s.hit_t.data());
+    st_.queue.enqueueReadBuffer(s.cell, CL_FALSE, 0, std::size_t(n) * 4, s.hit_cell.data());
+    st_.queue.enqueueReadBuffer(s.count, CL_FALSE, 0, std::size_t(n) * 4, s.counts.data(), nullptr, &s.read);
+    st_.queue.flush();
+  }
+
+  // Waits for the launch in `s` and puts its hits into `out` (at their rays' own index) and its
+  // lists onto `lists` (in cast order).
+  void collect(const std::vector<int>& order, int cap, Slot& s, RayCastResult& out, Lists& lists) {
+    s.read.wait();
+    const int n = s.n;
     for (int r = 0; r < n; ++r) {
-      const int to = order[std::size_t(first) + r];
-      out.t[to] = t[r];
-      out.cell[to] = cell[r];
+      const int to = order[std::size_t(s.first) + r];
+      out.t[to] = s.hit_t[r];
+      out.cell[to] = s.hit_cell[r];
     }
-    const int longest = n ? *std::max_element(count.begin(), count.end()) : 0;
+    const int longest = n ? *std::max_element(s.counts.begin(), s.counts.end()) : 0;
     if (longest == 0) {
       const std::size_t end = lists.first.back();
       lists.first.insert(lists.first.end(), std::size_t(n), end);
@@ -293,12 +323,12 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
     std::vector<int> cells(row * rows);
     std::vector<float> ts(row * rows);
     const cl::array<cl::size_type, 3> origin{0, 0, 0}, region{row * 4, rows, 1};
-    st_.queue.enqueueReadBufferRect(pierced_, CL_FALSE, origin, origin, region, pitch * 4, 0, row * 4, 0,
+    st_.queue.enqueueReadBufferRect(s.pierced, CL_FALSE, origin, origin, region, pitch * 4, 0, row * 4, 0,
                                     cells.data());
-    st_.queue.enqueueReadBufferRect(pierced_t_, CL_TRUE, origin, origin, region, pitch * 4, 0, row * 4, 0,
+    st_.queue.enqueueReadBufferRect(s.pierced_t, CL_TRUE, origin, origin, region, pitch * 4, 0, row * 4, 0,
                                     ts.data());
     for (int r = 0; r < n; ++r) {
-      for (int j = 0; j < count[r]; ++j) {
+      for (int j = 0; j < s.counts[r]; ++j) {
         const std::size_t from = line_major_ ? std::size_t(r) * longest + j : std::size_t(j) * n + r;
         lists.cells.push_back(cells[from]);
         lists.ts.push_back(ts[from]);
@@ -313,9 +343,7 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
   bool line_major_ = true;
   cl::Buffer pyramid_, levels_;
   NamedKernel kernel_;
-  int reserved_rays_ = 0;
-  std::size_t reserved_list_ = 0;
-  cl::Buffer ray_buffer_, t_, cell_, count_, pierced_, pierced_t_;
+  Slot slots_[2];
 };
 
 }  // namespace

@@ -1,0 +1,112 @@
+#!/usr/bin/env bash
+# bench/tree_peaks_cost_parts.sh: where the hull tree's peaks between samples spend their time.
+# Runs `hfvis viewcount` (default options) with four programs in turn on each input, R rounds:
+#   base        a build of bad9286 (before the peaks), as given by --base-build
+#   structure   this build with the peaks' code in place but no interval evaluated (two tree
+#               slots per step, the peak branches; no piece read, no peak inserted)
+#   pieces      every interval's pieces evaluated and the peak's test made, none inserted
+#   current     this build as it is (the peaks evaluated and inserted)
+# The two middle ones are the kernel of this checkout edited by sed into bench/out/ (loaded
+# through HFVIS_KERNEL_DIR; their results differ from the current one's by design, and the script
+# stops if the lines it edits have changed). Prints the median CPU (user + system) seconds of
+# each and its ratio to the base, and writes the table to bench/out/tree_peaks_cost_parts.md.
+#
+#   bench/tree_peaks_cost_parts.sh --base-build DIR [--size N] [-k K] [--rounds R] [--contents "fractal city"]
+#     defaults: N = 512, K = 64, R = 3
+# Inputs as bench/cost_against.sh makes them (bench/out/data/{fractal,city}_N.exr).
+set -euo pipefail
+
+root=$(cd "$(dirname "$0")/.." && pwd)
+size=512
+k=64
+rounds=3
+contents="fractal city"
+base_build=
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --base-build) base_build=$2; shift ;;
+    --size) size=$2; shift ;;
+    -k) k=$2; shift ;;
+    --rounds) rounds=$2; shift ;;
+    --contents) contents=$2; shift ;;
+    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
+    *) echo "tree_peaks_cost_parts.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
+  esac
+  shift
+done
+[[ -x $base_build/hfvis ]] || { echo "tree_peaks_cost_parts.sh: --base-build DIR must hold a build of bad9286 (DIR/hfvis)" >&2; exit 2; }
+build_dir=${BUILD_DIR:-$root/build}
+export POCL_CACHE_DIR=${POCL_CACHE_DIR:-$root/bench/out/pocl-cache}
+out=$root/bench/out/tree_peaks_cost_parts
+data=$root/bench/out/data
+mkdir -p "$out" "$data"
+
+# The variants' kernels: the peak's branch never taken (structure), or its result never inserted (pieces).
+edit() {  # VARIANT FROM TO
+  rm -rf "$out/$1"
+  cp -r "$root/kernels" "$out/$1"
+  /usr/bin/python3 - "$out/$1/intervisibility.cl" "$2" "$3" <<'EOF'
+import sys
+path, old, new = sys.argv[1:]
+text = open(path).read()
+if text.count(old) != 1:
+    sys.exit("tree_peaks_cost_parts.sh: kernels/intervisibility.cl no longer has the line: " + old)
+open(path, "w").write(text.replace(old, new))
+EOF
+}
+edit structure "if (step > 0 && step_scale > 1 && !isnan(h_sample_prev) && !isnan(h_sample)) {" \
+  "if (0 && step > 0 && step_scale > 1 && !isnan(h_sample_prev) && !isnan(h_sample)) {"
+# (the test's result kept alive, so that the compiler cannot drop the evaluation)
+edit pieces "if (tree_peak_inserted(h_sample_prev, best_h, h_sample, offset, step_scale)) h_peak = best_h;" \
+  "if (tree_peak_inserted(h_sample_prev, best_h, h_sample, offset, step_scale)) total_peaks += best_h > 1e30f;"
+
+cmake --build "$build_dir" -j "$(nproc)" --target hfvis_cli hfvis_bench > /dev/null
+inputs=()
+for content in $contents; do
+  file=$data/${content}_$size.exr
+  if [[ ! -f $file ]]; then
+    if [[ $content == city ]]; then
+      "$build_dir/bench/hfvis_bench" field city "$size" "$file" > /dev/null
+    else
+      /usr/bin/python3 "$root/data/make_data.py" --size "$size" --out "$data" --no-dem --fields "$content" > /dev/null
+    fi
+  fi
+  inputs+=("$file")
+done
+
+echo "commit $(git -C "$root" rev-parse --short HEAD), $(date -u +%Y-%m-%dT%H:%M:%SZ), load average $(cut -d' ' -f1-3 /proc/loadavg)"
+variants=(base structure pieces current)
+cpu() {  # VARIANT INPUT: CPU seconds of one run
+  local v=$1 input=$2 bin=$build_dir/hfvis env=()
+  [[ $v == base ]] && bin=$base_build/hfvis
+  [[ $v == structure || $v == pieces ]] && env=(HFVIS_KERNEL_DIR="$out/$v")
+  env "${env[@]}" /usr/bin/time -f '%U %S' -o "$out/time.txt" "$bin" viewcount "$input" -o "$out/out.exr" -k "$k" -q
+  awk '{printf "%.3f\n", $1 + $2}' "$out/time.txt"
+}
+median() { sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR + 1) / 2] : (a[NR / 2] + a[NR / 2 + 1]) / 2}'; }
+
+table=$out/../tree_peaks_cost_parts.md
+{
+  echo "| input | base CPU (s) | structure | pieces | current |"
+  echo "| --- | --- | --- | --- | --- |"
+} > "$table"
+for input in "${inputs[@]}"; do
+  for v in "${variants[@]}"; do cpu "$v" "$input" > /dev/null; done  # warm-up: PoCL compiles and caches
+  declare -A times=()
+  for ((i = 0; i < rounds; ++i)); do
+    # Each round in another order, so that a drift of the machine's speed falls on all alike.
+    for ((j = 0; j < ${#variants[@]}; ++j)); do
+      v=${variants[$(((i + j) % ${#variants[@]}))]}
+      times[$v]+="$(cpu "$v" "$input") "
+    done
+  done
+  declare -A med=()
+  for v in "${variants[@]}"; do med[$v]=$(tr ' ' '\n' <<< "${times[$v]}" | sed '/^$/d' | median); done
+  row="| $(basename "$input" .exr) | ${med[base]}"
+  for v in structure pieces current; do
+    row+=" | ${med[$v]} ($(printf '%.2f' "$(echo "${med[$v]} / ${med[base]}" | bc -l)") x)"
+  done
+  echo "$row |" | tee -a "$table"
+  unset times med
+done
+echo "table: $table"
