@@ -65,7 +65,7 @@ void sweepReference(const HeightField& field, const std::vector<float>& h,
       std::uint64_t n = 0, m = 0, t = 0, peaks = 0;
       for (int i = 0; i < g.n_steps; ++i) {
         const std::size_t e = static_cast<std::size_t>(i) * g.n_lines + j;
-        if (i > 0 && d.peaks() &&  // inserted where it rises above the chord of the samples
+        if (i > 0 &&  // inserted where it rises above the chord of the samples
             tree_peak_inserted(lines.samples[e - g.n_lines], lines.peaks[e], lines.samples[e],
                                lines.peak_offsets[e], stepScale(d, lines, e))) {
           ++peaks;
@@ -201,7 +201,7 @@ IntervisibilityLines latticeTreeLines(const HeightField& field, const std::vecto
       out.samples[e] = out.samples[e] - d.drop * p * p;
     }
   }
-  if (d.peaks()) addTreePeaks(field, prepared_heights, d, curvature, out);
+  addTreePeaks(field, prepared_heights, d, curvature, out);
   return out;
 }
 

@@ -52,7 +52,7 @@ float latticeHeight(const std::vector<float>& h, std::size_t at, std::size_t rig
 // set (with `curvature`, lowered by d.drop times their position squared), nothing swept yet.
 IntervisibilityLines latticeTreeLines(const HeightField& field, const std::vector<float>& prepared_heights,
                                       const TreeDirection& d, bool curvature = false);
-// Sets the peaks of lines (canonical lines of d, d.peaks(), samples set) from the heights, as
+// Sets the peaks of lines (canonical lines of d, samples set) from the heights, as
 // intervisibility_lattice computes them (kernels/shared/tree_peaks.cl).
 void addTreePeaks(const HeightField& field, const std::vector<float>& heights, const TreeDirection& d,
                   bool curvature, IntervisibilityLines& lines);

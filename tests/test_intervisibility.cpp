@@ -989,7 +989,6 @@ TEST(IntervisibilityLattice, CurvatureLowersThePeaksNotTheirChoice) {
        {std::pair<int, int>{3, 1}, std::pair<int, int>{-4, 3}, std::pair<int, int>{5, -2}}) {
     SCOPED_TRACE(std::to_string(step.first) + "," + std::to_string(step.second));
     detail::TreeDirection d = treeStep(field, step);
-    ASSERT_TRUE(d.peaks());
     const auto flat = detail::latticeTreeLines(field, prepared.heights, d);
     d.drop = 0.05f;
     const auto curved = detail::latticeTreeLines(field, prepared.heights, d, true);
@@ -1025,7 +1024,6 @@ TEST(IntervisibilityAnalytic, RoofsTouchingAtACornerHideWhatIsBehindThem) {
   std::int64_t with_error = 0, without_error = 0, receivers = 0, fixed = 0, broken = 0;
   for (auto step : {std::pair<int, int>{2, 1}, {3, 1}, {3, 2}, {1, 2}, {-2, -1}, {2, -3}}) {
     const auto d = treeStep(field, step);
-    ASSERT_TRUE(d.peaks());
     const auto with = referenceLines(field, prepared.heights, d);
     auto without = detail::latticeTreeLines(field, prepared.heights, d);
     without.position_shift = 0;

@@ -188,10 +188,8 @@ IntervisibilityLines canonicalTreeLines(const TreeDirection& d) {
   out.max_steps = d.max_steps;
   out.samples.assign(longest * d.lines.size(), std::numeric_limits<float>::quiet_NaN());
   out.position_shift = d.position_shift;
-  if (d.peaks()) {
-    out.peaks.assign(out.samples.size(), std::numeric_limits<float>::quiet_NaN());
-    out.peak_offsets.assign(out.samples.size(), 0);
-  }
+  out.peaks.assign(out.samples.size(), std::numeric_limits<float>::quiet_NaN());
+  out.peak_offsets.assign(out.samples.size(), 0);
   if (d.rowSpacing()) {
     // As the kernel sums them: step 0 at 0, then each step of period i the units of the row
     // of receiver i (the first period's: receiver 0's). A sample's ring units are those of

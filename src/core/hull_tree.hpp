@@ -62,8 +62,7 @@ struct TreeDirection {
   // per step: 2 s for the peak before step s, 2 s + 1 for the sample.
   TreeIntervals intervals;
   int position_shift = 0;
-  bool peaks() const { return position_shift > 0 || rowSpacing(); }
-  std::size_t slotsPerPeriod() const { return samples.size() * (peaks() ? 2 : 1); }
+  std::size_t slotsPerPeriod() const { return samples.size() * 2; }
 };
 
 // The position shift of a direction whose longest line has `steps` steps: sub-step positions
@@ -161,7 +160,7 @@ struct IntervisibilityLines {
   // distance sums are then sums of (receiver position - position) * units. Without, both
   // are the step.
   std::vector<std::int32_t> positions, step_units;
-  // Peaks (TreeDirection::peaks(); empty: none): per entry, the highest point of the surface
+  // Peaks (empty: none, as a test sweeps lines to compare): per entry, the highest point of the surface
   // between the step before and this one (NaN where none: no curved piece, a cell outside the
   // field or with nodata) and its offset from the step before, in units of 2^-position_shift
   // step (with positions: in the step's units). The sweep inserts it before the sample, as an

@@ -182,8 +182,8 @@ IntervisibilityLines treeLinesOnDevice(ContextState& st, const TreeProgramFlags&
   flags.row_spacing = d.rowSpacing();
   cl::Program program = st.program("intervisibility.cl", treeProgramOptions(flags));
   const std::size_t plane = field.pixelCount();
-  // Scratch entries are tree slots: two per step with peaks (the sample's the second).
-  const std::size_t slots_per_period = d.slotsPerPeriod(), slots_per_step = d.peaks() ? 2 : 1;
+  // Scratch entries are tree slots: two per step (the peak's, then the sample's).
+  const std::size_t slots_per_period = d.slotsPerPeriod(), slots_per_step = 2;
   std::size_t entries = 0;
   for (const LatticeLine& line : d.lines) entries += lineCapacity(line, slots_per_period);
   // Scratch for all lines in one launch; the step-major layout pads every line to the longest.
