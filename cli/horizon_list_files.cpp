@@ -47,8 +47,7 @@ constexpr const char* kRayConvention =
 constexpr const char* kVisibleConvention =
     "a sample is visible when its slope from the receiver is >= the slope of every sample between them "
     "and of every peak between them, the bilinear surface's highest point above the chord of two "
-    "consecutive samples where it rises above it (grazing samples are visible; decided exactly; no peaks "
-    "on a latitude / longitude grid)";
+    "consecutive samples where it rises above it (grazing samples are visible; decided exactly)";
 constexpr const char* kHorizonConvention =
     "nearest first; a horizon is the farthest visible sample of its segment (a peak that is a horizon: the "
     "sample right after it); its segment is the visible "

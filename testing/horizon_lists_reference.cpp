@@ -28,8 +28,8 @@ HorizonListReference referenceHorizonList(const std::vector<float>& ray, float h
   HorizonListReference out;
   out.visible.assign(n + 1, false);
   // The nodes, farthest first, the receiver last: present samples and admitted peaks, at their
-  // distances from the receiver in units of 2^-shift step; `sample` is i for sample i, -1 - j
-  // for the peak of interval j.
+  // positions (distances from the receiver); `sample` is i for sample i, -1 - j for the peak of
+  // interval j.
   struct Node {
     float h;
     float distance;
@@ -37,12 +37,17 @@ HorizonListReference referenceHorizonList(const std::vector<float>& ray, float h
   };
   std::vector<Node> nodes;
   auto height = [&](int i) { return i == 0 ? hr : ray[i - 1]; };
+  auto position = [&](int i) {
+    return i == 0 ? 0 : peaks.positions.empty() ? i << peaks.shift : peaks.positions[i - 1];
+  };
   for (int i = n; i >= 1; --i) {
-    if (!std::isnan(ray[i - 1])) nodes.push_back({ray[i - 1], float(i << peaks.shift), i});
+    if (!std::isnan(ray[i - 1])) nodes.push_back({ray[i - 1], float(position(i)), i});
     const int j = i - 1;  // the interval from sample i to the next nearer one
-    if (peaks.shift > 0 &&
-        detail::tree_peak_inserted(height(i), peaks.heights[j], height(j), peaks.offsets[j], 1 << peaks.shift))
-      nodes.push_back({peaks.heights[j], float((i << peaks.shift) - peaks.offsets[j]), -1 - j});
+    if (!peaks.heights.empty() && detail::tree_peak_inserted(height(i), peaks.heights[j], height(j),
+                                                             peaks.offsets[j], position(i) - position(j))) {
+      nodes.push_back({peaks.heights[j], float(position(i) - peaks.offsets[j]), -1 - j});
+      ++out.peaks_admitted;
+    }
   }
   nodes.push_back({hr, 0.0f, 0});
   const std::size_t receiver = nodes.size() - 1;

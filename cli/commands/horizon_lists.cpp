@@ -85,8 +85,8 @@ const CommandSpec kHorizonListsCommand{
     "           nodata 1 where the receiver's height is nodata).\n"
     "Along direction k the receiver's own ray is sampled at i = 1, 2, ... (i/S pixel lengths,\n"
     "the naive method's samples; tie rule as intervisibility); between two samples the surface's\n"
-    "highest point above their chord, where it rises above it, hides what lies behind it (not on\n"
-    "latitude / longitude grids). Horizons are listed nearest first:\n"
+    "highest point above their chord, where it rises above it, hides what lies behind it.\n"
+    "Horizons are listed nearest first:\n"
     "each is the farthest visible sample of its segment (distance in ground units, elevation in\n"
     "radians); its visible segment is the samples [segment_begin, segment_end) toward the\n"
     "receiver, from near_distance up to distance. The segments hold every visible sample once.\n",

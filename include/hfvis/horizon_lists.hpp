@@ -14,12 +14,12 @@
 // tree's lattice lines (docs/ALGORITHMS.md): it hides what lies behind it but is no sample. So
 // the lists no longer equal the naive method's visible set: a sample is listed visible when no
 // sample and no peak nearer than it lies strictly above its sight line from the receiver, each
-// decided exactly (peak positions in fixed point, 2^-shift of a step). Where the surface is
-// linear between the samples (rays along the axes, a whole number of samples per pixel) that is
-// the naive method's set. On latitude / longitude grids (per-row spacing) the rays take no peaks
-// (their positions are whole units of ground length) and the lists equal the naive method's
-// visible set. The hull-tree sweep's counts come from each receiver's own lattice line, a step
-// close to phi_k (hfvis/intervisibility.hpp).
+// decided exactly (peak positions in fixed point, 2^-shift of a step; on latitude / longitude
+// grids, per-row spacing, whole units of ground length, the step's own number of them, as the
+// hull tree's lines take them there). Where the surface is linear between the samples (rays
+// along the axes, a whole number of samples per pixel) that is the naive method's set. The
+// hull-tree sweep's counts come from each receiver's own lattice line, a step close to phi_k
+// (hfvis/intervisibility.hpp).
 //
 // Visibility and tie rule as in hfvis/intervisibility.hpp (grazing samples are visible).
 // A visibility horizon is the farthest sample of maximal slope from the receiver among the

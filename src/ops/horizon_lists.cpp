@@ -55,13 +55,15 @@ HorizonRay horizonRay(const HeightField& field, const std::vector<float>& height
     ray.heights.push_back(curvature != 0.0 ? q - drop * at * at : q);
   }
   ray.shift = units ? 0 : shift;
-  if (ray.shift == 0) return ray;
   // The peaks, as intervisibility_lattice takes them on its lines: of each interval's crossings
-  // and concave pieces, the point farthest above the chord of its two samples. With curvature the
-  // candidates and the chord are the surface's before the drop; the peak then takes the drop at its
-  // own distance (in steps: exact in float, positions stay below 2^23).
+  // and concave pieces, the point farthest above the chord of its two samples, at one of the
+  // interval's whole positions (2^shift a step, or with per-row spacing the step's units of
+  // ground length). With curvature the candidates and the chord are the surface's before the
+  // drop; the peak then takes the drop at its own distance (in steps or units: exact in float,
+  // positions stay below 2^23). None on a field narrower than a cell.
+  if (units ? field.width < 2 || field.height < 2 : ray.shift == 0) return ray;
   const int n = static_cast<int>(ray.heights.size()), w = field.width;
-  const float scale = static_cast<float>(1 << ray.shift);
+  const float inv_scale = units ? 1.0f : 1.0f / static_cast<float>(1 << ray.shift);  // positions to steps
   ray.peaks.assign(n, std::numeric_limits<float>::quiet_NaN());
   ray.peak_offsets.assign(n, 0);
   auto clamped = [&](Point2 p) {  // a sample within the edge's slack lies on the edge
@@ -69,9 +71,12 @@ HorizonRay horizonRay(const HeightField& field, const std::vector<float>& height
                   std::clamp(p.y, 0.0f, static_cast<float>(field.height - 1))};
   };
   for (int i = 0; i < n; ++i) {
+    // Interval i: from sample i + 1 (the farther, at far_position) to sample i, `scale` positions.
+    const std::int32_t far_position = units ? ray.positions[i] : (i + 1) << ray.shift;
+    const int scale = units ? ray.rings[i] : 1 << ray.shift;
     const float h_far = ray.surface[i];
     const float h_near = i > 0 ? ray.surface[i - 1] : heights[static_cast<std::size_t>(r) * w + c];
-    if (std::isnan(h_far) || std::isnan(h_near)) continue;
+    if (scale < 2 || std::isnan(h_far) || std::isnan(h_near)) continue;  // a peak lies strictly inside
     const Point2 far = clamped(ray.points[i]);
     const Point2 near =
         i > 0 ? clamped(ray.points[i - 1]) : Point2{static_cast<float>(c), static_cast<float>(r)};
@@ -81,11 +86,11 @@ HorizonRay horizonRay(const HeightField& field, const std::vector<float>& height
     for (const TreePiece& g : segmentTreePieces(far.x, far.y, near.x, near.y, field.width, field.height)) {
       const std::size_t at = static_cast<std::size_t>(g.oy) * w + g.ox;
       tree_piece_peak(heights[at], heights[at + 1], heights[at + w], heights[at + w + 1], g.fx, g.fy, g.dx,
-                      g.dy, g.t_far, g.t_near, g.inv_span, g.far_crossing, h_far, h_near - h_far, 1 << ray.shift,
+                      g.dy, g.t_far, g.t_near, g.inv_span, g.far_crossing, h_far, h_near - h_far, scale,
                       &curve, &best_h, &offset, &best_excess);
     }
     if (!(best_h > -INFINITY)) continue;  // none, or NaN (a corner at nodata)
-    const float distance = static_cast<float>(((i + 1) << ray.shift) - offset) / scale;
+    const float distance = static_cast<float>(far_position - offset) * inv_scale;
     ray.peaks[i] = curvature != 0.0 ? best_h - drop * distance * distance : best_h;
     ray.peak_offsets[i] = offset;
   }
@@ -107,9 +112,7 @@ DirectionHorizons listDirection(const HeightField& field, const std::vector<floa
   const std::vector<float>& ray = samples.heights;
   const int n = static_cast<int>(ray.size());
   // Ground distance of sample i: i steps, or its position in units with per-row spacing.
-  auto distance = [&](int i) {
-    return units ? samples.positions[i - 1] * unit : i * out.sample_spacing;
-  };
+  auto distance = [&](int i) { return units ? samples.positions[i - 1] * unit : i * out.sample_spacing; };
   out.sample_spacing = units ? (n > 0 ? samples.rings[0] * unit : 0.0)
                              : static_cast<double>(d.step_length) * d.ground_per_pixel;
   out.ray_samples = n;
@@ -126,7 +129,7 @@ DirectionHorizons listDirection(const HeightField& field, const std::vector<floa
   line.samples.resize(static_cast<std::size_t>(n) + 1);
   for (int s = 0; s < n; ++s) line.samples[s] = ray[n - 1 - s];
   line.samples[n] = h;
-  if (samples.shift > 0) {
+  if (!samples.peaks.empty()) {
     line.position_shift = samples.shift;
     line.peaks.assign(line.samples.size(), std::numeric_limits<float>::quiet_NaN());
     line.peak_offsets.assign(line.samples.size(), 0);
@@ -150,7 +153,7 @@ DirectionHorizons listDirection(const HeightField& field, const std::vector<floa
 
   // The horizons and their runs are tree slots (with peaks, 2 s + 1 for step s's sample and 2 s
   // for the peak before it): a run [slot, end) holds the samples of steps [slot >> 1, end >> 1).
-  const int slot_shift = samples.shift > 0 ? 1 : 0;
+  const int slot_shift = samples.peaks.empty() ? 0 : 1;
   const std::vector<int>& slots = line.horizon_steps[n];  // farthest first
   const std::vector<int>& ends = line.horizon_run_ends[n];
   for (std::size_t idx = slots.size(); idx-- > 0;) {  // nearest first
@@ -199,7 +202,8 @@ std::vector<ReceiverHorizons> computeHorizonLists(const HeightField& field, cons
   validate(field);
   validate(options);
   if (options.max_distance != 0.0)
-    throw InvalidArgument("a maximum distance is not supported for horizon lists yet (visible counts take it)");
+    throw InvalidArgument(
+        "a maximum distance is not supported for horizon lists yet (visible counts take it)");
   validateReceivers(field, receivers);
   const detail::PreparedHeights prepared = detail::prepareHeights(field);
   const auto directions = detail::runDirections(field, options);
@@ -211,7 +215,8 @@ std::vector<ReceiverHorizons> computeHorizonLists(const HeightField& field, cons
   // Per-row spacing: positions in units along each ray, as the naive visibility march's.
   const bool row_spacing = detail::hasRowSpacing(field);
   const double unit = row_spacing ? detail::groundUnit(field) : 0.0;
-  const detail::NaiveRowTables rows = row_spacing ? detail::naiveRowTables(field, directions, unit) : detail::NaiveRowTables{};
+  const detail::NaiveRowTables rows =
+      row_spacing ? detail::naiveRowTables(field, directions, unit) : detail::NaiveRowTables{};
   std::vector<ReceiverHorizons> lists;
   lists.reserve(receivers.size());
   for (const ReceiverPixel& p : receivers) {
@@ -221,7 +226,8 @@ std::vector<ReceiverHorizons> computeHorizonLists(const HeightField& field, cons
     receiver.nodata = std::isnan(prepared.heights[static_cast<std::size_t>(p.row) * field.width + p.col]);
     if (receiver.nodata) receiver.height = std::numeric_limits<float>::quiet_NaN();
     for (int k = 0; k < options.directions; ++k) {
-      const std::int32_t* units = row_spacing ? &rows.units[k * (2 * static_cast<std::size_t>(field.height) - 1)] : nullptr;
+      const std::int32_t* units =
+          row_spacing ? &rows.units[k * (2 * static_cast<std::size_t>(field.height) - 1)] : nullptr;
       receiver.directions.push_back(listDirection(field, prepared.heights, directions[k], k,
                                                   directionAzimuth(k, options), p.col, p.row,
                                                   options.curvature, units, unit, shift));

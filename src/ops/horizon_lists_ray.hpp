@@ -19,11 +19,14 @@ namespace hfvis::detail {
 // bilinear heights before it. With per-row spacing (units: the ray's half-row table of step
 // units, naiveRowTables) sample i lies at `positions[i - 1]` whole units of `unit` ground length,
 // its step toward the receiver `rings[i - 1]` units long, and the drop is c unit^2 position^2.
-// Peaks (shift > 0; none with per-row spacing): per interval i (between sample i + 1 and sample
-// i; interval 0 ends at the receiver), the point of the surface between them that stands farthest
-// above their chord (as the lattice lines take it: tree_piece_peak over segmentTreePieces), its
-// height lowered by its drop, NaN where none, and its offset from sample i + 1 toward sample i in
-// units of 2^-shift step. Whether it enters the tree is tree_peak_inserted's to say.
+// Peaks (shift > 0, or with per-row spacing; empty on a field narrower than a cell): per
+// interval i (between sample i + 1 and sample i; interval 0 ends at the receiver), the point of
+// the surface between them that stands farthest above their chord (as the lattice lines take it:
+// tree_piece_peak over segmentTreePieces), its height lowered by its drop, NaN where none, and
+// its offset from sample i + 1 toward sample i in units of 2^-shift step, or with per-row spacing
+// in whole units of `unit` (the step's rings[i] of them, as the tree's lines count a peak's
+// position on a latitude / longitude grid). Whether it enters the tree is tree_peak_inserted's
+// to say, with the interval's positions as its scale.
 struct HorizonRay {
   std::vector<Point2> points;
   std::vector<float> heights, surface;
@@ -37,8 +40,8 @@ HorizonRay horizonRay(const HeightField& field, const std::vector<float>& height
                       int c, int r, double curvature, const std::int32_t* units, double unit, int shift);
 
 // The most samples a ray of the run has (width + height per unit step), and the position shift
-// of its rays: treePositionShift of that, 0 with per-row spacing or on a field narrower than a
-// cell (no peaks).
+// of its rays: treePositionShift of that, 0 with per-row spacing (positions in whole units) or on
+// a field narrower than a cell (no peaks).
 std::size_t longestHorizonRay(const HeightField& field, const SweepOptions& options);
 int horizonRayShift(const HeightField& field, const SweepOptions& options);
 

@@ -21,22 +21,27 @@ std::vector<float> referenceRay(const HeightField& field, const std::vector<floa
 struct HorizonListReference {
   std::vector<bool> visible;  // by sample index i (0 unused)
   std::vector<int> horizons;  // sample indices, nearest first
+  int peaks_admitted = 0;     // the peaks among the occluders
 };
 
-// The peaks between a ray's samples (src/ops/horizon_lists_ray.hpp): per interval i, between
-// sample i + 1 and sample i (interval 0 ends at the receiver), a height (NaN: none) and its
-// offset from sample i + 1 toward sample i in units of 2^-shift step. shift 0: no peaks.
+// A ray's positions and the peaks between its samples (src/ops/horizon_lists_ray.hpp). Positions:
+// sample i at i << shift, or with per-row spacing (`positions` not empty, shift 0) at
+// positions[i - 1] whole units of ground length; the receiver at 0. Peaks (`heights` empty: none):
+// per interval i, between sample i + 1 and sample i (interval 0 ends at the receiver), a height
+// (NaN: none) and its offset from sample i + 1 toward sample i in the interval's positions.
 struct RayPeaks {
   int shift = 0;
+  std::vector<std::int32_t> positions;
   std::vector<float> heights;
   std::vector<std::int32_t> offsets;
 };
 
-// Brute force on the ray (sample i at ray[i - 1], receiver height hr at distance 0): a sample is
-// visible when it is present and no present sample and no peak nearer than it (one that
-// tree_peak_inserted admits: strictly above the chord of its interval's samples) lies strictly
-// above the sight line. Horizons by Eq. 1 and 2 over the samples and those peaks alike; a peak
-// that is a horizon is listed by the sample right after it (nearer) where that one is visible.
+// Brute force on the ray (sample i at ray[i - 1], receiver height hr at distance 0), every node
+// at its position: a sample is visible when it is present and no present sample and no peak
+// nearer than it (one that tree_peak_inserted admits: strictly above the chord of its interval's
+// samples, at its offset of the interval's positions) lies strictly above the sight line.
+// Horizons by Eq. 1 and 2 over the samples and those peaks alike; a peak that is a horizon is
+// listed by the sample right after it (nearer) where that one is visible.
 HorizonListReference referenceHorizonList(const std::vector<float>& ray, float hr,
                                           const RayPeaks& peaks = {});
 
