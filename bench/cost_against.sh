@@ -17,6 +17,7 @@
 # Contents: "fractal" (data/make_data.py's terrain) and "city" (the city DSM hard case, written
 # by hfvis_bench field).
 set -euo pipefail
+source "$(dirname "$0")/cost_inputs.sh"
 
 root=$(cd "$(dirname "$0")/.." && pwd)
 base=bad9286
@@ -69,17 +70,7 @@ for dir in "${dirs[@]}"; do
 done
 
 inputs=()
-for content in $contents; do
-  file=$data/${content}_$size.exr
-  if [[ ! -f $file ]]; then
-    if [[ $content == city ]]; then
-      "$build_dir/bench/hfvis_bench" field city "$size" "$file" > /dev/null
-    else
-      /usr/bin/python3 "$root/data/make_data.py" --size "$size" --out "$data" --no-dem --fields "$content" > /dev/null
-    fi
-  fi
-  inputs+=("$file")
-done
+for content in $contents; do inputs+=("$(cost_input "$content" "$size" "$build_dir" "$data")"); done
 
 current=$(git -C "$root" rev-parse --short HEAD)
 git -C "$root" diff --quiet HEAD -- kernels src include cli || current="$current (with uncommitted changes)"
@@ -90,7 +81,6 @@ run() {
   /usr/bin/time -f '%e %U %S' -o "$out/time.txt" "$@" -q > /dev/null
   awk '{printf "%s %.3f\n", $1, $2 + $3}' "$out/time.txt"
 }
-median() { sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR + 1) / 2] : (a[NR / 2] + a[NR / 2 + 1]) / 2}'; }
 
 table=$out/../cost_against.md
 {

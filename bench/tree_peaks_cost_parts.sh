@@ -15,6 +15,7 @@
 #     defaults: N = 512, K = 64, R = 3
 # Inputs as bench/cost_against.sh makes them (bench/out/data/{fractal,city}_N.exr).
 set -euo pipefail
+source "$(dirname "$0")/cost_inputs.sh"
 
 root=$(cd "$(dirname "$0")/.." && pwd)
 size=512
@@ -62,19 +63,12 @@ edit pieces "if (tree_peak_inserted(h_sample_prev, best_h, h_sample, offset, ste
 
 cmake --build "$build_dir" -j "$(nproc)" --target hfvis_cli hfvis_bench > /dev/null
 inputs=()
-for content in $contents; do
-  file=$data/${content}_$size.exr
-  if [[ ! -f $file ]]; then
-    if [[ $content == city ]]; then
-      "$build_dir/bench/hfvis_bench" field city "$size" "$file" > /dev/null
-    else
-      /usr/bin/python3 "$root/data/make_data.py" --size "$size" --out "$data" --no-dem --fields "$content" > /dev/null
-    fi
-  fi
-  inputs+=("$file")
-done
+for content in $contents; do inputs+=("$(cost_input "$content" "$size" "$build_dir" "$data")"); done
 
-echo "commit $(git -C "$root" rev-parse --short HEAD), $(date -u +%Y-%m-%dT%H:%M:%SZ), load average $(cut -d' ' -f1-3 /proc/loadavg)"
+header="commit $(git -C "$root" rev-parse --short HEAD), $(date -u +%Y-%m-%dT%H:%M:%SZ), $(nproc) cores,\
+ $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//'), load average $(cut -d' ' -f1-3 /proc/loadavg);\
+ ${size}x${size}, K = $k, median CPU seconds of $rounds rounds"
+echo "$header"
 variants=(base structure pieces current)
 cpu() {  # VARIANT INPUT: CPU seconds of one run
   local v=$1 input=$2 bin=$build_dir/hfvis env=()
@@ -83,10 +77,11 @@ cpu() {  # VARIANT INPUT: CPU seconds of one run
   env "${env[@]}" /usr/bin/time -f '%U %S' -o "$out/time.txt" "$bin" viewcount "$input" -o "$out/out.exr" -k "$k" -q
   awk '{printf "%.3f\n", $1 + $2}' "$out/time.txt"
 }
-median() { sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR + 1) / 2] : (a[NR / 2] + a[NR / 2 + 1]) / 2}'; }
 
 table=$out/../tree_peaks_cost_parts.md
 {
+  echo "$header"
+  echo
   echo "| input | base CPU (s) | structure | pieces | current |"
   echo "| --- | --- | --- | --- | --- |"
 } > "$table"

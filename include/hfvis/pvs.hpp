@@ -74,8 +74,9 @@ struct RayCastOptions {
   // Also list the view cells of `grid` whose volume each ray passes through before its hit.
   bool view_cells = false;
   PvsGrid grid;
-  // Device memory for one launch's rays and lists; 0 = half the device's memory. Rays are cast
-  // in launches that fit it (MemoryBudgetError when one ray does not).
+  // Device memory for the rays and lists of the two launches in flight at a time (the host
+  // packs one while the device casts the other); 0 = half the device's memory. Rays are cast in
+  // launches that fit it (MemoryBudgetError when one ray in each does not).
   std::size_t memory_budget_bytes = 0;
 };
 
