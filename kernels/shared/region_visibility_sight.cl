@@ -221,13 +221,30 @@ inline int region_sight_visible_culled(HFVIS_GLOBAL const float* h, int width, i
   }
   for (;;) {
     if (t0 >= t_out) return 1;
-    const float tx = dx > 0.0f && gxl < xb ? (gxl - xa) / dx : INFINITY;
-    const float ty = dy > 0.0f ? (gyl < yb ? (gyl - ya) / dy : INFINITY)
-                               : (dy < 0.0f && gyl > yb ? (gyl - ya) / dy : INFINITY);
+    // The next crossings (after a leap, once its resumption is taken).
+    float tx = 0.0f, ty = 0.0f;
+    if (!pending) {
+      tx = dx > 0.0f && gxl < xb ? (gxl - xa) / dx : INFINITY;
+      ty = dy > 0.0f ? (gyl < yb ? (gyl - ya) / dy : INFINITY)
+                     : (dy < 0.0f && gyl > yb ? (gyl - ya) / dy : INFINITY);
+    }
     if (levels > 0) {
-      // The cell of the next piece (its middle), and the blocks above it from `level` down.
-      const float tn = tx < ty ? (tx < 1.0f ? tx : 1.0f) : (ty < 1.0f ? ty : 1.0f), tm = 0.5f * (t0 + tn);
-      int cx = (int)(xa + tm * dx), cy = (int)(ya + tm * dy);
+      // The cell of the next piece (its middle; after a leap, the cell beyond the crossing where it
+      // ended), and the blocks above it from `level` down.
+      int cx, cy;
+      if (pending) {
+        const float beyond = pending_on_column ? ya + t0 * dy : xa + t0 * dx;
+        if (pending_on_column) {
+          cx = (int)pending_lx;
+          cy = (int)(dy < 0.0f ? ceil(beyond) - 1.0f : floor(beyond));
+        } else {
+          cx = (int)floor(beyond);
+          cy = dy > 0.0f ? (int)pending_ly : (int)pending_ly - 1;
+        }
+      } else {
+        const float tn = tx < ty ? (tx < 1.0f ? tx : 1.0f) : (ty < 1.0f ? ty : 1.0f), tm = 0.5f * (t0 + tn);
+        cx = (int)(xa + tm * dx), cy = (int)(ya + tm * dy);
+      }
       cx = cx < 0 ? 0 : (cx > width - 2 ? width - 2 : cx);
       cy = cy < 0 ? 0 : (cy > height - 2 ? height - 2 : cy);
       int leapt = 0;
@@ -247,10 +264,10 @@ inline int region_sight_visible_culled(HFVIS_GLOBAL const float* h, int width, i
         const float z0 = za + t0 * dz, zE = za + tE * dz;
         if (!(tE > t0 && top + clearance < (z0 < zE ? z0 : zE))) continue;
         if (tC >= 1.0f) return 1;  // the block holds the rest of the segment, its end too
-        // Resume at the crossing C where the segment leaves; its value waits for the next step that
-        // needs it (a run of leaps needs none: the block proved it below the segment).
+        // Resume at the crossing C where the segment leaves: the march's state there waits for the
+        // next step that needs it (a run of leaps needs none: each block proved itself below the
+        // segment, its crossings too).
         t0 = tC;
-        region_cull_resume(xa, ya, dx, dy, leave_x, lx, ly, tC, &gxl, &gyl);
         pending = 1, pending_on_column = leave_x, pending_lx = lx, pending_ly = ly;
         level = k + 1 < levels ? k + 1 : k;
         leapt = 1;
@@ -258,10 +275,14 @@ inline int region_sight_visible_culled(HFVIS_GLOBAL const float* h, int width, i
       if (leapt) continue;
       level = 0;
       if (pending) {
+        region_cull_resume(xa, ya, dx, dy, pending_on_column, pending_lx, pending_ly, t0, &gxl, &gyl);
         f0 = region_cull_crossing_rise(h, width, height, xa, ya, za, dx, dy, dz, cdd, pending_on_column,
                                        pending_lx, pending_ly, t0);
         if (f0 > 0.0f) return 0;
         pending = 0;
+        tx = dx > 0.0f && gxl < xb ? (gxl - xa) / dx : INFINITY;
+        ty = dy > 0.0f ? (gyl < yb ? (gyl - ya) / dy : INFINITY)
+                       : (dy < 0.0f && gyl > yb ? (gyl - ya) / dy : INFINITY);
       }
     }
     const int x_first = tx <= ty;

@@ -128,11 +128,12 @@ CullPyramid cullPyramid(const std::vector<float>& h, int width, int height) {
 // a launch's work stays bounded whatever S).
 class RegionBitsRoutine : public detail::DeviceRoutine {
  public:
-  RegionBitsRoutine(detail::ContextState& st, const HeightField& field, const std::vector<float>& sources,
-                    const std::vector<float>& source_points, bool source_absolute,
-                    const std::vector<float>* receivers, bool receiver_absolute, int count,
-                    const RegionVisibilityOptions& options)
+  RegionBitsRoutine(detail::ContextState& st, const HeightField& field, detail::PreparedHeights heights,
+                    const std::vector<float>& sources, const std::vector<float>& source_points,
+                    bool source_absolute, const std::vector<float>* receivers, bool receiver_absolute,
+                    int count, const RegionVisibilityOptions& options)
       : DeviceRoutine(st, field, options.progress, 0),
+        heights_prepared_(std::move(heights)),
         sources_(sources),
         source_points_(source_points),
         source_absolute_(source_absolute),
@@ -146,10 +147,9 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
   std::vector<std::uint32_t> bits;  // after run(): receiver-major
 
  private:
-  // The viewshed's heights (z-scaled, from 0), so both decide the same sight lines.
-  detail::PreparedHeights prepare() override {
-    return detail::prepareHeights(field_, detail::HeightOrigin::Zero);
-  }
+  // The viewshed's heights (z-scaled, from 0), so both decide the same sight lines: the caller's,
+  // which placed the samples on them.
+  detail::PreparedHeights prepare() override { return std::move(heights_prepared_); }
   std::string programFile() const override { return "region_visibility.cl"; }
 
   void allocate() override {
@@ -231,6 +231,7 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
       for (int w = 0; w < words_; ++w) bits[std::size_t(r) * words_ + w] = out[std::size_t(w) * count_ + r];
   }
 
+  detail::PreparedHeights heights_prepared_;  // until prepare()
   const std::vector<float>& sources_;
   const std::vector<float>& source_points_;  // stream 0's samples, x, y, z each
   const bool source_absolute_;
@@ -248,13 +249,13 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
 };
 
 std::vector<std::uint32_t> runBits(const ComputeContext& context, const HeightField& field,
-                                   const std::vector<float>& sources, const std::vector<float>& source_points,
-                                   bool source_absolute, const std::vector<float>* receivers,
-                                   bool receiver_absolute, int count,
+                                   detail::PreparedHeights heights, const std::vector<float>& sources,
+                                   const std::vector<float>& source_points, bool source_absolute,
+                                   const std::vector<float>* receivers, bool receiver_absolute, int count,
                                    const RegionVisibilityOptions& options) {
   return detail::translateOpenClErrors([&] {
-    RegionBitsRoutine routine(detail::stateOf(context), field, sources, source_points, source_absolute,
-                              receivers, receiver_absolute, count, options);
+    RegionBitsRoutine routine(detail::stateOf(context), field, std::move(heights), sources, source_points,
+                              source_absolute, receivers, receiver_absolute, count, options);
     routine.run();
     return std::move(routine.bits);
   });
@@ -437,7 +438,8 @@ RegionVisibilityResult computeRegionVisibility(const ComputeContext& context, co
   validateField(field);
   validate(options);
   const std::vector<float> table = detail::regionSampleTable(field, sources);
-  const std::vector<float> heights = detail::prepareHeights(field, detail::HeightOrigin::Zero).heights;
+  detail::PreparedHeights prepared = detail::prepareHeights(field, detail::HeightOrigin::Zero);
+  const std::vector<float>& heights = prepared.heights;
   RegionVisibilityResult out;
   out.width = field.width;
   out.height = field.height;
@@ -448,13 +450,15 @@ RegionVisibilityResult computeRegionVisibility(const ComputeContext& context, co
   if (options.method == RegionVisibilityMethod::Viewsheds)
     out.bits = viewshedBits(context, field, regionPoints(points), options);
   else
-    out.bits = runBits(context, field, table, points, sources.absolute, nullptr, false, count, options);
+    out.bits = runBits(context, field, std::move(prepared), table, points, sources.absolute, nullptr, false,
+                       count, options);
   out.fraction.resize(field.pixelCount());
   for (int p = 0; p < count; ++p) {
     int seen = 0;
     for (int w = 0; w < out.words; ++w) seen += popcount(out.bits[std::size_t(p) * out.words + w]);
-    out.fraction[p] = std::isnan(heights[p]) ? std::numeric_limits<float>::quiet_NaN()
-                                             : static_cast<float>(static_cast<double>(seen) / out.samples);
+    out.fraction[p] = !std::isfinite(field.heights[p])
+                          ? std::numeric_limits<float>::quiet_NaN()
+                          : static_cast<float>(static_cast<double>(seen) / out.samples);
   }
   return out;
 }
@@ -470,7 +474,8 @@ RegionPairVisibilityResult computeRegionPairVisibility(const ComputeContext& con
     throw InvalidArgument("the viewsheds method takes every-pixel receivers, not a region pair");
   const std::vector<float> source_table = detail::regionSampleTable(field, sources);
   const std::vector<float> receiver_table = detail::regionSampleTable(field, receivers);
-  const std::vector<float> heights = detail::prepareHeights(field, detail::HeightOrigin::Zero).heights;
+  detail::PreparedHeights prepared = detail::prepareHeights(field, detail::HeightOrigin::Zero);
+  const std::vector<float>& heights = prepared.heights;
   RegionPairVisibilityResult out;
   out.source_samples = detail::regionTableSamples(source_table);
   out.receiver_samples = detail::regionTableSamples(receiver_table);
@@ -480,8 +485,8 @@ RegionPairVisibilityResult computeRegionPairVisibility(const ComputeContext& con
   out.sources = regionPoints(source_points);
   out.receivers =
       regionPoints(tableSamplePoints(field, receiver_table, heights, receivers.absolute, options.seed));
-  out.bits = runBits(context, field, source_table, source_points, sources.absolute, &receiver_table,
-                     receivers.absolute, out.receiver_samples, options);
+  out.bits = runBits(context, field, std::move(prepared), source_table, source_points, sources.absolute,
+                     &receiver_table, receivers.absolute, out.receiver_samples, options);
   detail::countPairFractions(out);
   return out;
 }
