@@ -69,12 +69,10 @@ CullPyramid cullPyramid(const std::vector<float>& h, int width, int height) {
   // by a step or a twist times a position's rounding (a crossing a rounding outside the block, a
   // piece's middle a rounding into the next cell): at most ulp(max(width, height)) each.
   double largest = 0.0, step = 0.0, twist = 0.0;
-  std::vector<char> infinite(h.size(), 0);
   bool any_infinite = false;
   for (int r = 0; r < height; ++r)
     for (int c = 0; c < width; ++c) {
       const float v = at(c, r);
-      infinite[std::size_t(r) * width + c] = std::isinf(v);
       any_infinite = any_infinite || std::isinf(v);
       out.finite = out.finite && std::isfinite(v);
       if (!std::isfinite(v)) continue;
@@ -91,34 +89,39 @@ CullPyramid cullPyramid(const std::vector<float>& h, int width, int height) {
   const double position_ulp = std::ldexp(double(std::max(width, height)), -23);
   out.margin = static_cast<float>(8e-5 * largest + 4.0 * position_ulp * (step + twist));
   out.gradient = static_cast<float>(step + twist);
+  // The levels' sizes (as region_cull_width), then the levels in place, one after another.
+  std::vector<std::size_t> offsets = {0};
+  for (int w = width - 1, hh = height - 1;;) {
+    offsets.push_back(offsets.back() + std::size_t(w) * hh);
+    if ((w == 1 && hh == 1) || int(offsets.size()) - 1 == kCullLevels) break;
+    w = (w + 1) / 2, hh = (hh + 1) / 2;
+  }
+  out.levels = int(offsets.size()) - 1;
+  out.top.assign(offsets.back(), -std::numeric_limits<float>::infinity());
   // Level 0: per cell its corners' highest valid height; +INFINITY where an infinite height lies
   // on the cell or a cell beside it (the march's values there are unbounded or NaN).
   int w = width - 1, hh = height - 1;
-  std::vector<float> level(std::size_t(w) * hh);
   for (int r = 0; r < hh; ++r)
     for (int c = 0; c < w; ++c) {
       bool unbounded = false;
       for (int y = std::max(0, r - 1); any_infinite && y <= std::min(height - 1, r + 2) && !unbounded; ++y)
         for (int x = std::max(0, c - 1); x <= std::min(width - 1, c + 2); ++x)
-          if (infinite[std::size_t(y) * width + x]) unbounded = true;
+          if (std::isinf(at(x, y))) unbounded = true;
       float top = -std::numeric_limits<float>::infinity();
       for (const float v : {at(c, r), at(c + 1, r), at(c, r + 1), at(c + 1, r + 1)})
         if (!std::isnan(v)) top = std::max(top, v);
-      level[std::size_t(r) * w + c] = unbounded ? std::numeric_limits<float>::infinity() : top;
+      out.top[std::size_t(r) * w + c] = unbounded ? std::numeric_limits<float>::infinity() : top;
     }
-  for (;;) {
-    out.top.insert(out.top.end(), level.begin(), level.end());
-    ++out.levels;
-    if ((w == 1 && hh == 1) || out.levels == kCullLevels) break;
-    const int pw = (w + 1) / 2, ph = (hh + 1) / 2;
-    std::vector<float> parent(std::size_t(pw) * ph, -std::numeric_limits<float>::infinity());
+  for (int k = 1; k < out.levels; ++k) {
+    const float* child = out.top.data() + offsets[k - 1];
+    float* parent = out.top.data() + offsets[k];
+    const int pw = (w + 1) / 2;
     for (int r = 0; r < hh; ++r)
       for (int c = 0; c < w; ++c) {
         float& p = parent[std::size_t(r / 2) * pw + c / 2];
-        p = std::max(p, level[std::size_t(r) * w + c]);
+        p = std::max(p, child[std::size_t(r) * w + c]);
       }
-    level = std::move(parent);
-    w = pw, hh = ph;
+    w = pw, hh = (hh + 1) / 2;
   }
   return out;
 }
