@@ -104,7 +104,8 @@ constexpr const char* kUsage =
     "       hfvis_bench pvs-rays [--size N] [--rays R] [--reps K] [--dem FILE] FIELD...\n"
     "       hfvis_bench pvs-recall [--size N] [--view-cell C] [--tile T] [--samples N,N,...]\n"
     "                              [--check-rays R] [--dem FILE] FIELD...   (FIELD: city, noise, dem)\n"
-    "       hfvis_bench region [--sections arealight,arealight-quick,pair,error] [--reps N] FIELD...\n"
+    "       hfvis_bench region [--sections arealight,arealight-quick,pair,pair-quick,error] [--reps N] "
+    "FIELD...\n"
     "       hfvis_bench field NAME N OUT\n"
     "       hfvis_bench inputs [--quick]\n"
     "       hfvis_bench check-truth\n"
@@ -474,8 +475,9 @@ int main(int argc, char** argv) {
       args.rejectUnused();
       if (fields.empty()) throw Usage("region needs FIELD...");
       for (const std::string& section : sections)
-        if (section != "arealight" && section != "arealight-quick" && section != "pair" && section != "error")
-          throw Usage("--sections: arealight, arealight-quick, pair, error (comma-separated)");
+        if (section != "arealight" && section != "arealight-quick" && section != "pair" &&
+            section != "pair-quick" && section != "error")
+          throw Usage("--sections: arealight, arealight-quick, pair, pair-quick, error (comma-separated)");
       const ComputeContext context = ComputeContext::create(ContextOptions::fromEnvironment());
       for (const std::string& path : fields) regionVisibilityReport(context, path, sections, reps);
       return 0;

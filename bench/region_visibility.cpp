@@ -128,7 +128,8 @@ void arealightSection(const ComputeContext& context, const HeightField& f, bool 
 
 // Region pairs: two squares of `side` pixels (32 x 32 samples each, 2 above the surface), their
 // centres `distance` apart along a row through the field's centre.
-void pairSection(const ComputeContext& context, const HeightField& f, int reps) {
+// `quick`: the culled method alone (exact's column 0), for profiling.
+void pairSection(const ComputeContext& context, const HeightField& f, int reps, bool quick) {
   std::printf(
       "\n#### Region pairs (32 x 32 samples each, 2 above the surface, the squares' centres on one row)"
       "\n\n| side (px) | distance (px) | exact (ms) | culled (ms) | culled Mrays/s | speed-up | "
@@ -147,14 +148,24 @@ void pairSection(const ComputeContext& context, const HeightField& f, int reps) 
     RegionVisibilityOptions oe, oc;
     oe.method = RegionVisibilityMethod::Exact;
     oc.method = RegionVisibilityMethod::Culled;
-    const std::vector<double> t =
-        fastestInterleaved({[&] { exact = computeRegionPairVisibility(context, f, a, b, oe); },
-                            [&] { culled = computeRegionPairVisibility(context, f, a, b, oc); }},
-                           reps);
+    std::vector<std::function<void()>> bodies = {
+        [&] { exact = computeRegionPairVisibility(context, f, a, b, oe); },
+        [&] { culled = computeRegionPairVisibility(context, f, a, b, oc); }};
+    if (quick) bodies[0] = [&] { exact = culled; };
+    const std::vector<double> t = fastestInterleaved(bodies, reps);
     std::printf("| %d | %d | %.1f | %.1f | %.1f | %.1f | %.3f | %zu |\n", c.side, c.distance, t[0] * 1e3,
                 t[1] * 1e3, 1024.0 * 1024.0 / t[1] * 1e-6, t[0] / t[1],
                 double(culled.clear_pairs) / double(culled.pairs), differingBits(exact.bits, culled.bits));
   }
+  // The call's cost outside the marches: one sample each side.
+  RegionSampling a, b;
+  a.samples = b.samples = 1;
+  a.rectangle = {f.width / 2 - 40, f.height / 2, f.width / 2 - 40, f.height / 2};
+  b.rectangle = {f.width / 2 + 40, f.height / 2, f.width / 2 + 40, f.height / 2};
+  const double fixed =
+      fastestInterleaved({[&] { computeRegionPairVisibility(context, f, a, b, {}); }}, reps)[0];
+  std::printf("\nA 1 x 1 pair (the call's fixed cost: the field's upload, the pyramid): %.1f ms.\n",
+              fixed * 1e3);
 }
 
 // The visible fraction at S = 1024 (and 256) against a reference of 16384 samples (four seeds of
@@ -214,7 +225,7 @@ void regionVisibilityReport(const ComputeContext& context, const std::string& pa
   std::printf("\n### %s (%d x %d)\n", path.c_str(), field.width, field.height);
   for (const std::string& s : sections) {
     if (s == "arealight" || s == "arealight-quick") arealightSection(context, field, s == "arealight-quick");
-    if (s == "pair") pairSection(context, field, reps);
+    if (s == "pair" || s == "pair-quick") pairSection(context, field, reps, s == "pair-quick");
     if (s == "error") errorSection(context, field, reps);
     std::fflush(stdout);
   }

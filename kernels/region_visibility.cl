@@ -155,10 +155,11 @@ __kernel void region_visibility_bits(__global const float* h, __global const flo
   }
   const unsigned int key = decorrelate ? (unsigned int)r + 1U : 0U;
   // Culled: the cell that hid the last hidden sight line (and its fraction of that line from the
-  // receiver), tried first against the next ones, across words; a word whose predecessor had a
-  // hidden line skips the shaft test (it fails where a line is hidden beyond the receiver's
-  // surroundings, and then costs more than it saves).
-  int blocker = -1, hidden_before = 0;
+  // receiver), tried first against the next ones, across words, while the line before was hidden
+  // (after a clear one the next is seldom hidden: the tries would cost more than they save); a
+  // word whose predecessor had a hidden line skips the shaft test (it fails where a line is hidden
+  // beyond the receiver's surroundings, and then costs more than it saves).
+  int blocker = -1, hidden_before = 0, last_hidden = 0;
   float along = 0.0f;
   for (int w = 0; w < words; ++w) {
     unsigned int word = 0U;
@@ -181,16 +182,16 @@ __kernel void region_visibility_bits(__global const float* h, __global const flo
                                                               ys, zs, end - 32 * w, box)))
         box[0] = 1.0f, box[2] = 0.0f;
       for (int i = 0; i < end - 32 * w; ++i) {
-        if (blocker >= 0) {
+        if (blocker >= 0 && last_hidden) {
           if (region_cull_hides(h, f.width, f.height, f.cell_x, f.cell_y, f.curvature, f.max_d2, margin,
                                 gradient, finite_field, blocker, xs[i], ys[i], zs[i], xr, yr, zr)) {
-            hidden = 1;
+            hidden = 1, last_hidden = 1;
             continue;
           }
           const int next = region_hider_along(h, f, margin, gradient, finite_field, along, blocker, xr, yr,
                                               zr, xs[i], ys[i], zs[i]);
           if (next >= 0) {
-            blocker = next, hidden = 1;
+            blocker = next, hidden = 1, last_hidden = 1;
             continue;
           }
         }
@@ -199,8 +200,9 @@ __kernel void region_visibility_bits(__global const float* h, __global const flo
                                         pyramid, levels, margin, box[0], box[1], box[2], box[3], xs[i], ys[i],
                                         zs[i], xr, yr, zr, &blocked_at)) {
           word |= 1U << i;
+          last_hidden = 0;
         } else {
-          hidden = 1;
+          hidden = 1, last_hidden = 1;
           if (levels > 0 && blocked_at >= 0) {
             // The fraction of the line from the receiver at the hiding cell's centre.
             const float dx = xs[i] - xr, dy = ys[i] - yr;

@@ -102,22 +102,26 @@ inline float region_cull_next_line(float a, float d, float t, int at_too) {
 }
 
 // Resumes a march (region_sight_visible_culled) at the crossing C = tC of the segment from
-// (xa, ya, za) by (dx, dy, dz) with the column line lx (`on_column`) or the row line ly: the
-// march's next column line becomes the first after C, its next row line the first at or after C
-// (x first on a tie, as the march orders them); returns the march's value there.
-inline float region_cull_resume(HFVIS_GLOBAL const float* h, int width, int height, float xa, float ya,
-                                float za, float dx, float dy, float dz, float cdd, int on_column, float lx,
-                                float ly, float tC, float* gxl, float* gyl) {
-  float s;
+// (xa, ya) by (dx, dy) with the column line lx (`on_column`) or the row line ly: the march's next
+// column line becomes the first after C, its next row line the first at or after C (x first on a
+// tie, as the march orders them).
+inline void region_cull_resume(float xa, float ya, float dx, float dy, int on_column, float lx, float ly,
+                               float tC, float* gxl, float* gyl) {
   if (on_column) {
-    s = region_surface_at(h, width, height, lx, ya + tC * dy);
     *gxl = lx + 1.0f;
     if (dy != 0.0f) *gyl = region_cull_next_line(ya, dy, tC, 1);
   } else {
-    s = region_surface_at(h, width, height, xa + tC * dx, ly);
     *gyl = dy > 0.0f ? ly + 1.0f : ly - 1.0f;
     if (dx > 0.0f) *gxl = region_cull_next_line(xa, dx, tC, 0);
   }
+}
+
+// The march's value (region_rise) at that crossing.
+inline float region_cull_crossing_rise(HFVIS_GLOBAL const float* h, int width, int height, float xa, float ya,
+                                       float za, float dx, float dy, float dz, float cdd, int on_column,
+                                       float lx, float ly, float tC) {
+  const float s = on_column ? region_surface_at(h, width, height, lx, ya + tC * dy)
+                            : region_surface_at(h, width, height, xa + tC * dx, ly);
   return region_rise(s, tC, za, dz, cdd);
 }
 
@@ -181,6 +185,9 @@ inline int region_sight_visible_culled(HFVIS_GLOBAL const float* h, int width, i
   const float clearance =
       margin + 1e-5f * (2.0f * (fabs(za) + fabs(zb)) + fabs(cdd)) + (cdd > 0.0f ? 0.25f * cdd : 0.0f);
   int level = 0;
+  // After a leap: the crossing where it ended, its value f0 not yet taken.
+  int pending = 0, pending_on_column = 0;
+  float pending_lx = 0.0f, pending_ly = 0.0f;
   // Each level's offset and row width in the pyramid (levels <= 16, the host's kCullLevels).
   int level_offset[16], level_width[16];
   for (int k = 0, offset = 0; k < levels; ++k) {
@@ -201,8 +208,9 @@ inline int region_sight_visible_culled(HFVIS_GLOBAL const float* h, int width, i
       const float tC = on_column ? tX : tY;
       if (tC > 0.0f && tC < 1.0f) {
         t0 = tC;
-        f0 = region_cull_resume(h, width, height, xa, ya, za, dx, dy, dz, cdd, on_column, box_x0, ly, tC,
-                                &gxl, &gyl);
+        region_cull_resume(xa, ya, dx, dy, on_column, box_x0, ly, tC, &gxl, &gyl);
+        f0 = region_cull_crossing_rise(h, width, height, xa, ya, za, dx, dy, dz, cdd, on_column, box_x0, ly,
+                                       tC);
         if (f0 > 0.0f) return 0;
       }
     }
@@ -213,13 +221,30 @@ inline int region_sight_visible_culled(HFVIS_GLOBAL const float* h, int width, i
   }
   for (;;) {
     if (t0 >= t_out) return 1;
-    const float tx = dx > 0.0f && gxl < xb ? (gxl - xa) / dx : INFINITY;
-    const float ty = dy > 0.0f ? (gyl < yb ? (gyl - ya) / dy : INFINITY)
-                               : (dy < 0.0f && gyl > yb ? (gyl - ya) / dy : INFINITY);
+    // The next crossings (after a leap, once its resumption is taken).
+    float tx = 0.0f, ty = 0.0f;
+    if (!pending) {
+      tx = dx > 0.0f && gxl < xb ? (gxl - xa) / dx : INFINITY;
+      ty = dy > 0.0f ? (gyl < yb ? (gyl - ya) / dy : INFINITY)
+                     : (dy < 0.0f && gyl > yb ? (gyl - ya) / dy : INFINITY);
+    }
     if (levels > 0) {
-      // The cell of the next piece (its middle), and the blocks above it from `level` down.
-      const float tn = tx < ty ? (tx < 1.0f ? tx : 1.0f) : (ty < 1.0f ? ty : 1.0f), tm = 0.5f * (t0 + tn);
-      int cx = (int)(xa + tm * dx), cy = (int)(ya + tm * dy);
+      // The cell of the next piece (its middle; after a leap, the cell beyond the crossing where it
+      // ended), and the blocks above it from `level` down.
+      int cx, cy;
+      if (pending) {
+        const float beyond = pending_on_column ? ya + t0 * dy : xa + t0 * dx;
+        if (pending_on_column) {
+          cx = (int)pending_lx;
+          cy = (int)(dy < 0.0f ? ceil(beyond) - 1.0f : floor(beyond));
+        } else {
+          cx = (int)floor(beyond);
+          cy = dy > 0.0f ? (int)pending_ly : (int)pending_ly - 1;
+        }
+      } else {
+        const float tn = tx < ty ? (tx < 1.0f ? tx : 1.0f) : (ty < 1.0f ? ty : 1.0f), tm = 0.5f * (t0 + tn);
+        cx = (int)(xa + tm * dx), cy = (int)(ya + tm * dy);
+      }
       cx = cx < 0 ? 0 : (cx > width - 2 ? width - 2 : cx);
       cy = cy < 0 ? 0 : (cy > height - 2 ? height - 2 : cy);
       int leapt = 0;
@@ -239,16 +264,26 @@ inline int region_sight_visible_culled(HFVIS_GLOBAL const float* h, int width, i
         const float z0 = za + t0 * dz, zE = za + tE * dz;
         if (!(tE > t0 && top + clearance < (z0 < zE ? z0 : zE))) continue;
         if (tC >= 1.0f) return 1;  // the block holds the rest of the segment, its end too
-        // Resume at the crossing C where the segment leaves.
+        // Resume at the crossing C where the segment leaves: the march's state there waits for the
+        // next step that needs it (a run of leaps needs none: each block proved itself below the
+        // segment, its crossings too).
         t0 = tC;
-        f0 = region_cull_resume(h, width, height, xa, ya, za, dx, dy, dz, cdd, leave_x, lx, ly, tC, &gxl,
-                                &gyl);
-        if (f0 > 0.0f) return 0;
+        pending = 1, pending_on_column = leave_x, pending_lx = lx, pending_ly = ly;
         level = k + 1 < levels ? k + 1 : k;
         leapt = 1;
       }
       if (leapt) continue;
       level = 0;
+      if (pending) {
+        region_cull_resume(xa, ya, dx, dy, pending_on_column, pending_lx, pending_ly, t0, &gxl, &gyl);
+        f0 = region_cull_crossing_rise(h, width, height, xa, ya, za, dx, dy, dz, cdd, pending_on_column,
+                                       pending_lx, pending_ly, t0);
+        if (f0 > 0.0f) return 0;
+        pending = 0;
+        tx = dx > 0.0f && gxl < xb ? (gxl - xa) / dx : INFINITY;
+        ty = dy > 0.0f ? (gyl < yb ? (gyl - ya) / dy : INFINITY)
+                       : (dy < 0.0f && gyl > yb ? (gyl - ya) / dy : INFINITY);
+      }
     }
     const int x_first = tx <= ty;
     float t1 = x_first ? tx : ty;

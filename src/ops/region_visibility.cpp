@@ -69,12 +69,10 @@ CullPyramid cullPyramid(const std::vector<float>& h, int width, int height) {
   // by a step or a twist times a position's rounding (a crossing a rounding outside the block, a
   // piece's middle a rounding into the next cell): at most ulp(max(width, height)) each.
   double largest = 0.0, step = 0.0, twist = 0.0;
-  std::vector<char> infinite(h.size(), 0);
   bool any_infinite = false;
   for (int r = 0; r < height; ++r)
     for (int c = 0; c < width; ++c) {
       const float v = at(c, r);
-      infinite[std::size_t(r) * width + c] = std::isinf(v);
       any_infinite = any_infinite || std::isinf(v);
       out.finite = out.finite && std::isfinite(v);
       if (!std::isfinite(v)) continue;
@@ -91,34 +89,39 @@ CullPyramid cullPyramid(const std::vector<float>& h, int width, int height) {
   const double position_ulp = std::ldexp(double(std::max(width, height)), -23);
   out.margin = static_cast<float>(8e-5 * largest + 4.0 * position_ulp * (step + twist));
   out.gradient = static_cast<float>(step + twist);
+  // The levels' sizes (as region_cull_width), then the levels in place, one after another.
+  std::vector<std::size_t> offsets = {0};
+  for (int w = width - 1, hh = height - 1;;) {
+    offsets.push_back(offsets.back() + std::size_t(w) * hh);
+    if ((w == 1 && hh == 1) || int(offsets.size()) - 1 == kCullLevels) break;
+    w = (w + 1) / 2, hh = (hh + 1) / 2;
+  }
+  out.levels = int(offsets.size()) - 1;
+  out.top.assign(offsets.back(), -std::numeric_limits<float>::infinity());
   // Level 0: per cell its corners' highest valid height; +INFINITY where an infinite height lies
   // on the cell or a cell beside it (the march's values there are unbounded or NaN).
   int w = width - 1, hh = height - 1;
-  std::vector<float> level(std::size_t(w) * hh);
   for (int r = 0; r < hh; ++r)
     for (int c = 0; c < w; ++c) {
       bool unbounded = false;
       for (int y = std::max(0, r - 1); any_infinite && y <= std::min(height - 1, r + 2) && !unbounded; ++y)
         for (int x = std::max(0, c - 1); x <= std::min(width - 1, c + 2); ++x)
-          if (infinite[std::size_t(y) * width + x]) unbounded = true;
+          if (std::isinf(at(x, y))) unbounded = true;
       float top = -std::numeric_limits<float>::infinity();
       for (const float v : {at(c, r), at(c + 1, r), at(c, r + 1), at(c + 1, r + 1)})
         if (!std::isnan(v)) top = std::max(top, v);
-      level[std::size_t(r) * w + c] = unbounded ? std::numeric_limits<float>::infinity() : top;
+      out.top[std::size_t(r) * w + c] = unbounded ? std::numeric_limits<float>::infinity() : top;
     }
-  for (;;) {
-    out.top.insert(out.top.end(), level.begin(), level.end());
-    ++out.levels;
-    if ((w == 1 && hh == 1) || out.levels == kCullLevels) break;
-    const int pw = (w + 1) / 2, ph = (hh + 1) / 2;
-    std::vector<float> parent(std::size_t(pw) * ph, -std::numeric_limits<float>::infinity());
+  for (int k = 1; k < out.levels; ++k) {
+    const float* child = out.top.data() + offsets[k - 1];
+    float* parent = out.top.data() + offsets[k];
+    const int pw = (w + 1) / 2;
     for (int r = 0; r < hh; ++r)
       for (int c = 0; c < w; ++c) {
         float& p = parent[std::size_t(r / 2) * pw + c / 2];
-        p = std::max(p, level[std::size_t(r) * w + c]);
+        p = std::max(p, child[std::size_t(r) * w + c]);
       }
-    level = std::move(parent);
-    w = pw, hh = ph;
+    w = pw, hh = (hh + 1) / 2;
   }
   return out;
 }
@@ -128,11 +131,12 @@ CullPyramid cullPyramid(const std::vector<float>& h, int width, int height) {
 // a launch's work stays bounded whatever S).
 class RegionBitsRoutine : public detail::DeviceRoutine {
  public:
-  RegionBitsRoutine(detail::ContextState& st, const HeightField& field, const std::vector<float>& sources,
-                    const std::vector<float>& source_points, bool source_absolute,
-                    const std::vector<float>* receivers, bool receiver_absolute, int count,
-                    const RegionVisibilityOptions& options)
+  RegionBitsRoutine(detail::ContextState& st, const HeightField& field, detail::PreparedHeights heights,
+                    const std::vector<float>& sources, const std::vector<float>& source_points,
+                    bool source_absolute, const std::vector<float>* receivers, bool receiver_absolute,
+                    int count, const RegionVisibilityOptions& options)
       : DeviceRoutine(st, field, options.progress, 0),
+        heights_prepared_(std::move(heights)),
         sources_(sources),
         source_points_(source_points),
         source_absolute_(source_absolute),
@@ -146,10 +150,9 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
   std::vector<std::uint32_t> bits;  // after run(): receiver-major
 
  private:
-  // The viewshed's heights (z-scaled, from 0), so both decide the same sight lines.
-  detail::PreparedHeights prepare() override {
-    return detail::prepareHeights(field_, detail::HeightOrigin::Zero);
-  }
+  // The viewshed's heights (z-scaled, from 0), so both decide the same sight lines: the caller's,
+  // which placed the samples on them.
+  detail::PreparedHeights prepare() override { return std::move(heights_prepared_); }
   std::string programFile() const override { return "region_visibility.cl"; }
 
   void allocate() override {
@@ -231,6 +234,7 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
       for (int w = 0; w < words_; ++w) bits[std::size_t(r) * words_ + w] = out[std::size_t(w) * count_ + r];
   }
 
+  detail::PreparedHeights heights_prepared_;  // until prepare()
   const std::vector<float>& sources_;
   const std::vector<float>& source_points_;  // stream 0's samples, x, y, z each
   const bool source_absolute_;
@@ -248,13 +252,13 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
 };
 
 std::vector<std::uint32_t> runBits(const ComputeContext& context, const HeightField& field,
-                                   const std::vector<float>& sources, const std::vector<float>& source_points,
-                                   bool source_absolute, const std::vector<float>* receivers,
-                                   bool receiver_absolute, int count,
+                                   detail::PreparedHeights heights, const std::vector<float>& sources,
+                                   const std::vector<float>& source_points, bool source_absolute,
+                                   const std::vector<float>* receivers, bool receiver_absolute, int count,
                                    const RegionVisibilityOptions& options) {
   return detail::translateOpenClErrors([&] {
-    RegionBitsRoutine routine(detail::stateOf(context), field, sources, source_points, source_absolute,
-                              receivers, receiver_absolute, count, options);
+    RegionBitsRoutine routine(detail::stateOf(context), field, std::move(heights), sources, source_points,
+                              source_absolute, receivers, receiver_absolute, count, options);
     routine.run();
     return std::move(routine.bits);
   });
@@ -437,7 +441,8 @@ RegionVisibilityResult computeRegionVisibility(const ComputeContext& context, co
   validateField(field);
   validate(options);
   const std::vector<float> table = detail::regionSampleTable(field, sources);
-  const std::vector<float> heights = detail::prepareHeights(field, detail::HeightOrigin::Zero).heights;
+  detail::PreparedHeights prepared = detail::prepareHeights(field, detail::HeightOrigin::Zero);
+  const std::vector<float>& heights = prepared.heights;
   RegionVisibilityResult out;
   out.width = field.width;
   out.height = field.height;
@@ -448,13 +453,15 @@ RegionVisibilityResult computeRegionVisibility(const ComputeContext& context, co
   if (options.method == RegionVisibilityMethod::Viewsheds)
     out.bits = viewshedBits(context, field, regionPoints(points), options);
   else
-    out.bits = runBits(context, field, table, points, sources.absolute, nullptr, false, count, options);
+    out.bits = runBits(context, field, std::move(prepared), table, points, sources.absolute, nullptr, false,
+                       count, options);
   out.fraction.resize(field.pixelCount());
   for (int p = 0; p < count; ++p) {
     int seen = 0;
     for (int w = 0; w < out.words; ++w) seen += popcount(out.bits[std::size_t(p) * out.words + w]);
-    out.fraction[p] = std::isnan(heights[p]) ? std::numeric_limits<float>::quiet_NaN()
-                                             : static_cast<float>(static_cast<double>(seen) / out.samples);
+    out.fraction[p] = !std::isfinite(field.heights[p])
+                          ? std::numeric_limits<float>::quiet_NaN()
+                          : static_cast<float>(static_cast<double>(seen) / out.samples);
   }
   return out;
 }
@@ -470,7 +477,8 @@ RegionPairVisibilityResult computeRegionPairVisibility(const ComputeContext& con
     throw InvalidArgument("the viewsheds method takes every-pixel receivers, not a region pair");
   const std::vector<float> source_table = detail::regionSampleTable(field, sources);
   const std::vector<float> receiver_table = detail::regionSampleTable(field, receivers);
-  const std::vector<float> heights = detail::prepareHeights(field, detail::HeightOrigin::Zero).heights;
+  detail::PreparedHeights prepared = detail::prepareHeights(field, detail::HeightOrigin::Zero);
+  const std::vector<float>& heights = prepared.heights;
   RegionPairVisibilityResult out;
   out.source_samples = detail::regionTableSamples(source_table);
   out.receiver_samples = detail::regionTableSamples(receiver_table);
@@ -480,8 +488,8 @@ RegionPairVisibilityResult computeRegionPairVisibility(const ComputeContext& con
   out.sources = regionPoints(source_points);
   out.receivers =
       regionPoints(tableSamplePoints(field, receiver_table, heights, receivers.absolute, options.seed));
-  out.bits = runBits(context, field, source_table, source_points, sources.absolute, &receiver_table,
-                     receivers.absolute, out.receiver_samples, options);
+  out.bits = runBits(context, field, std::move(prepared), source_table, source_points, sources.absolute,
+                     &receiver_table, receivers.absolute, out.receiver_samples, options);
   detail::countPairFractions(out);
   return out;
 }
