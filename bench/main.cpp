@@ -514,6 +514,7 @@ int main(int argc, char** argv) {
         errors.push_back(std::stod(e));
       const int reference = std::stoi(args.get("--reference-k", "2048"));
       const int reps = std::stoi(args.get("--reps", "3"));
+      const int curve = std::stoi(args.get("--curve", "0"));
       const std::vector<std::string> names =
           textList(args.get("--contents", "fractal,bricks,sine,blocks,city_dsm,dem,mixed"));
       args.rejectUnused();
@@ -534,6 +535,10 @@ int main(int argc, char** argv) {
           for (int c = mixed.width / 2; c < mixed.width; ++c)
             mixed.heights[static_cast<std::size_t>(r) * mixed.width + c] = 40.0f * terrain.at(c, r);
         fields.push_back({"mixed", mixed});
+      }
+      if (curve > 0) {
+        errorCurve(ComputeContext::create(ContextOptions::fromEnvironment()), fields, reference, curve);
+        return 0;
       }
       errorTargetReport(ComputeContext::create(ContextOptions::fromEnvironment()), fields, errors, reference,
                         reps);
