@@ -100,7 +100,7 @@ constexpr const char* kUsage =
     "                                      [--samples N] [--seed S] RASTER...\n"
     "       hfvis_bench viewshed-culling [--levels 1,2,3,4] [--reps N] FIELD...\n"
     "       hfvis_bench error-target [--data DIR] [--dem FILE] [--size N] [--errors E,...] [--contents A,B]\n"
-    "                                [--reference-k K] [--reps N]\n"
+    "                                [--reference-k K] [--reps N] [--curve KMAX]\n"
     "       hfvis_bench pvs-rays [--size N] [--rays R] [--reps K] [--dem FILE] FIELD...\n"
     "       hfvis_bench pvs-recall [--size N] [--view-cell C] [--tile T] [--samples N,N,...]\n"
     "                              [--check-rays R] [--dem FILE] FIELD...   (FIELD: city, noise, dem)\n"
