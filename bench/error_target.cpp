@@ -29,6 +29,13 @@ double seconds(const std::function<void()>& run) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// One number as `format` (printf) writes it.
+std::string formatted(const char* format, double value) {
+  char text[64];
+  std::snprintf(text, sizeof text, format, value);
+  return text;
+}
+
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v[v.size() / 2];
@@ -109,7 +116,8 @@ void errorTargetReport(const ComputeContext& context, const std::vector<ErrorTar
             cheapest = K;
             break;
           }
-        // Interleaved: the chosen run (all its runs) and the cheapest fixed K's, alternately.
+        // Interleaved: the chosen run (all its runs) and the cheapest fixed K's, alternately (none
+        // with reps = 0: the work ratio alone, free of the machine's load).
         std::vector<double> t_chosen, t_fixed;
         HorizonOptions fixed;
         fixed.directions = cheapest ? cheapest : kMaxAutoDirections;
@@ -117,7 +125,10 @@ void errorTargetReport(const ComputeContext& context, const std::vector<ErrorTar
           t_chosen.push_back(seconds([&] { computeHorizons(context, f.field, chosen, wanted); }));
           t_fixed.push_back(seconds([&] { computeHorizons(context, f.field, fixed, wanted); }));
         }
-        const double ratio = median(t_chosen) / median(t_fixed);
+        const auto time = [&](const std::vector<double>& t) {
+          return reps ? formatted("%.3f", median(t)) : "-";
+        };
+        const double ratio = reps ? median(t_chosen) / median(t_fixed) : 0.0;
         HorizonOutputs estimated = wanted;
         estimated.error_estimate = true;
         const double fixed_work = samplesPerReceiver(f.field, fixed.directions, wanted);
@@ -131,24 +142,22 @@ void errorTargetReport(const ComputeContext& context, const std::vector<ErrorTar
         ++rows;
         met += achieved <= E;
         if (cheapest) {
-          ratios.push_back(ratio);
+          if (reps) ratios.push_back(ratio);
           works.push_back(work / fixed_work);
           last_works.push_back(last_work);
         }
-        std::printf("| %s | %g | %s | %.5f | %.5f | %s | %s | %.5f | %.3f | %.3f | %.2f | %.2f | %.2f |\n",
+        std::printf("| %s | %g | %s | %.5f | %.5f | %s | %s | %.5f | %s | %s | %s | %.2f | %.2f |\n",
                     f.name.c_str(), E, runs.c_str(), result.estimated_error, achieved,
                     achieved <= E ? "yes" : "**no**", cheapest ? std::to_string(cheapest).c_str() : "none",
-                    cheapest ? errorAt(cheapest) : 0.0, median(t_chosen), median(t_fixed), ratio,
-                    work / fixed_work, last_work);
+                    cheapest ? errorAt(cheapest) : 0.0, time(t_chosen).c_str(), time(t_fixed).c_str(),
+                    reps ? formatted("%.2f", ratio).c_str() : "-", work / fixed_work, last_work);
         std::fflush(stdout);
       }
     }
     const auto spread = [](std::vector<double> v) {
       std::sort(v.begin(), v.end());
-      char text[64];
-      std::snprintf(text, sizeof text, "median %.2f, largest %.2f", v.empty() ? 0.0 : median(v),
-                    v.empty() ? 0.0 : v.back());
-      return std::string(text);
+      return v.empty() ? std::string("not measured")
+                       : formatted("median %.2f", median(v)) + formatted(", largest %.2f", v.back());
     };
     std::printf(
         "\n%s: achieved error at most E in %d of %d cases (%.0f %%); over the cheapest fixed K: time %s; "

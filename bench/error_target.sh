@@ -8,6 +8,7 @@
 # Writes bench/report/error_target.md (or --out FILE).
 #
 #   bench/error_target.sh [--size 128] [--errors 0.001,...,0.05] [--reference-k 2048] [--reps 3] [--out FILE]
+#     (--reps 0: no timing, the load-free work ratio alone)
 #   bench/error_target.sh --curve KMAX [--size 128] [--reference-k 2048] [--out FILE]
 #     instead: per content, the error and the estimate at each fixed K up to KMAX (the estimate's
 #     calibration against the dense reference), to bench/report/error_curve.md (or --out FILE).
@@ -28,7 +29,7 @@ while [[ $# -gt 0 ]]; do
     --reps) reps=$2; shift ;;
     --out) out=$2; shift ;;
     --curve) curve=$2; shift ;;
-    -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
     *) echo "error_target.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
   shift
@@ -65,8 +66,15 @@ tables=$(cd "$root" && "$bench" error-target --size "$size" --errors "$errors" -
   echo "at $commit on $(date -u +%Y-%m-%d), on $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs)"
   echo "($(nproc) cores, PoCL). Contents: the top-left ${size}x${size} of each 256^2 content. The error is the"
   echo "99th percentile over the pixels of |result - the same sweep at K = $reference| (the azimuthal"
-  echo "integral the output approximates). Times: median of $reps runs, the chosen run (all its runs)"
-  echo "and the fixed K alternately, so the ratio holds on a loaded machine."
+  echo "integral the output approximates). Work: samples per receiver (its directions' samples per"
+  echo "period summed; the sweep's cost is linear in them, free of the machine's load), of all the"
+  echo "runs --max-error made and of its last run alone, over the cheapest fixed K's."
+  if [[ $reps -gt 0 ]]; then
+    echo "Times: median of $reps runs, the chosen run (all its runs) and the fixed K alternately, so the"
+    echo "ratio holds on a loaded machine."
+  else
+    echo "Not timed (--reps 0): the work ratio stands for the time ratio."
+  fi
   echo "$tables"
 } > "$out"
 echo "wrote $out"
