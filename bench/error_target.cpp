@@ -174,8 +174,8 @@ void errorCurve(const ComputeContext& context, const std::vector<ErrorTargetFiel
       {"ambient occlusion", &HorizonOutputs::ambient_occlusion, &HorizonResult::ambient_occlusion}};
   for (const Output& output : outputs) {
     std::printf(
-        "\n### %s: error and estimate against K\n\n| field | K | samples | achieved p99 | estimate | p99 "
-        "|r(K/2)-r(K)| | time (s) |\n|---|---:|---:|---:|---:|---:|---:|\n",
+        "\n### %s: error and estimate against K\n\n| field | K | samples | achieved p99 | estimate | "
+        "p99 of r(K/2) - r(K) | time (s) |\n|---|---:|---:|---:|---:|---:|---:|\n",
         output.name);
     for (const ErrorTargetField& f : fields) {
       HorizonOutputs wanted;
