@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <functional>
 #include <map>
+#include <string>
 
 #include "core/horizon_common.hpp"
 #include "hfvis/errors.hpp"
@@ -19,13 +20,20 @@ namespace {
 double p99Difference(const std::vector<float>& a, const std::vector<float>& b) {
   std::vector<float> d(a.size());
   for (std::size_t p = 0; p < a.size(); ++p) d[p] = std::abs(a[p] - b[p]);  // NaN where either is
-  return detail::estimatedError(d);                                        // the same percentile
+  return detail::estimatedError(d);                                         // the same percentile
 }
 
 double seconds(const std::function<void()>& run) {
   const auto t0 = std::chrono::steady_clock::now();
   run();
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// One number as `format` (printf) writes it.
+std::string formatted(const char* format, double value) {
+  char text[64];
+  std::snprintf(text, sizeof text, format, value);
+  return text;
 }
 
 double median(std::vector<double> v) {
@@ -41,6 +49,17 @@ std::vector<int> fixedLadder() {
     if (k >= 8 * step) step *= 2;
   }
   return ladder;
+}
+
+// The work of a run at K per receiver: the samples of one period summed over its directions
+// (the sweep's cost is linear in them; load-free, unlike a time).
+std::size_t samplesPerReceiver(const HeightField& field, int K, const HorizonOutputs& outputs) {
+  HorizonOptions options;
+  options.directions = K;
+  std::size_t samples = 0;
+  for (const auto& d : detail::horizonDirections(field, options, outputs))
+    samples += detail::latticeSamples(d, options.samples_per_unit).size();
+  return samples;
 }
 
 struct Output {
@@ -60,11 +79,12 @@ void errorTargetReport(const ComputeContext& context, const std::vector<ErrorTar
   for (const Output& output : outputs) {
     std::printf("\n### %s\n\n", output.name);
     std::printf(
-        "| field | E | K chosen | estimate | achieved p99 | met | cheapest fixed K | its p99 | time chosen "
+        "| field | E | runs (K) | estimate | achieved p99 | met | cheapest fixed K | its p99 | time chosen "
         "(s) | "
-        "time fixed (s) | ratio |\n|---|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|\n");
+        "time fixed (s) | time ratio | work ratio | last run's work ratio |\n"
+        "|---|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|\n");
     int met = 0, rows = 0;
-    std::vector<double> ratios;
+    std::vector<double> ratios, works, last_works;
     for (const ErrorTargetField& f : fields) {
       HorizonOutputs wanted;
       wanted.*output.wanted = true;
@@ -96,7 +116,8 @@ void errorTargetReport(const ComputeContext& context, const std::vector<ErrorTar
             cheapest = K;
             break;
           }
-        // Interleaved: the chosen run (all its runs) and the cheapest fixed K's, alternately.
+        // Interleaved: the chosen run (all its runs) and the cheapest fixed K's, alternately (none
+        // with reps = 0: the work ratio alone, free of the machine's load).
         std::vector<double> t_chosen, t_fixed;
         HorizonOptions fixed;
         fixed.directions = cheapest ? cheapest : kMaxAutoDirections;
@@ -104,23 +125,80 @@ void errorTargetReport(const ComputeContext& context, const std::vector<ErrorTar
           t_chosen.push_back(seconds([&] { computeHorizons(context, f.field, chosen, wanted); }));
           t_fixed.push_back(seconds([&] { computeHorizons(context, f.field, fixed, wanted); }));
         }
-        const double ratio = median(t_chosen) / median(t_fixed);
+        const auto time = [&](const std::vector<double>& t) {
+          return reps ? formatted("%.3f", median(t)) : "-";
+        };
+        const double ratio = reps ? median(t_chosen) / median(t_fixed) : 0.0;
+        HorizonOutputs estimated = wanted;
+        estimated.error_estimate = true;
+        const double fixed_work = samplesPerReceiver(f.field, fixed.directions, wanted);
+        double work = 0.0;
+        std::string runs;
+        for (int K : result.runs) {
+          work += samplesPerReceiver(f.field, K, estimated);
+          runs += (runs.empty() ? "" : ", ") + std::to_string(K);
+        }
+        const double last_work = samplesPerReceiver(f.field, result.directions, estimated) / fixed_work;
         ++rows;
         met += achieved <= E;
-        if (cheapest) ratios.push_back(ratio);
-        std::printf("| %s | %g | %d | %.5f | %.5f | %s | %s | %.5f | %.3f | %.3f | %.2f |\n", f.name.c_str(),
-                    E, result.directions, result.estimated_error, achieved, achieved <= E ? "yes" : "**no**",
-                    cheapest ? std::to_string(cheapest).c_str() : "none", cheapest ? errorAt(cheapest) : 0.0,
-                    median(t_chosen), median(t_fixed), ratio);
+        if (cheapest) {
+          if (reps) ratios.push_back(ratio);
+          works.push_back(work / fixed_work);
+          last_works.push_back(last_work);
+        }
+        std::printf("| %s | %g | %s | %.5f | %.5f | %s | %s | %.5f | %s | %s | %s | %.2f | %.2f |\n",
+                    f.name.c_str(), E, runs.c_str(), result.estimated_error, achieved,
+                    achieved <= E ? "yes" : "**no**", cheapest ? std::to_string(cheapest).c_str() : "none",
+                    cheapest ? errorAt(cheapest) : 0.0, time(t_chosen).c_str(), time(t_fixed).c_str(),
+                    reps ? formatted("%.2f", ratio).c_str() : "-", work / fixed_work, last_work);
         std::fflush(stdout);
       }
     }
-    std::sort(ratios.begin(), ratios.end());
+    const auto spread = [](std::vector<double> v) {
+      std::sort(v.begin(), v.end());
+      return v.empty() ? std::string("not measured")
+                       : formatted("median %.2f", median(v)) + formatted(", largest %.2f", v.back());
+    };
     std::printf(
-        "\n%s: achieved error at most E in %d of %d cases (%.0f %%); time over the cheapest fixed K: "
-        "median %.2f, largest %.2f\n",
-        output.name, met, rows, rows ? 100.0 * met / rows : 0.0, ratios.empty() ? 0.0 : median(ratios),
-        ratios.empty() ? 0.0 : ratios.back());
+        "\n%s: achieved error at most E in %d of %d cases (%.0f %%); over the cheapest fixed K: time %s; "
+        "work %s; the last run's work alone %s\n",
+        output.name, met, rows, rows ? 100.0 * met / rows : 0.0, spread(ratios).c_str(),
+        spread(works).c_str(), spread(last_works).c_str());
+  }
+}
+
+void errorCurve(const ComputeContext& context, const std::vector<ErrorTargetField>& fields,
+                int reference_directions, int max_directions) {
+  const Output outputs[] = {
+      {"sky-view factor", &HorizonOutputs::sky_view_factor, &HorizonResult::sky_view_factor},
+      {"ambient occlusion", &HorizonOutputs::ambient_occlusion, &HorizonResult::ambient_occlusion}};
+  for (const Output& output : outputs) {
+    std::printf(
+        "\n### %s: error and estimate against K\n\n| field | K | samples | achieved p99 | estimate | "
+        "p99 of r(K/2) - r(K) | time (s) |\n|---|---:|---:|---:|---:|---:|---:|\n",
+        output.name);
+    for (const ErrorTargetField& f : fields) {
+      HorizonOutputs wanted;
+      wanted.*output.wanted = true;
+      HorizonOptions options;
+      options.directions = reference_directions;
+      const std::vector<float> reference = computeHorizons(context, f.field, options, wanted).*output.plane;
+      wanted.error_estimate = true;
+      std::map<int, std::vector<float>> results;
+      for (int K : fixedLadder()) {
+        if (K > max_directions) break;
+        options.directions = K;
+        HorizonResult result;
+        const double t = seconds([&] { result = computeHorizons(context, f.field, options, wanted); });
+        const std::size_t samples = samplesPerReceiver(f.field, K, wanted);
+        results[K] = result.*output.plane;
+        const auto half = results.find(K / 2);
+        std::printf("| %s | %d | %zu | %.6f | %.6f | %.6f | %.4f |\n", f.name.c_str(), K, samples,
+                    p99Difference(results[K], reference), result.estimated_error,
+                    half == results.end() || K % 2 ? -1.0 : p99Difference(half->second, results[K]), t);
+        std::fflush(stdout);
+      }
+    }
   }
 }
 

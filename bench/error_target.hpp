@@ -23,4 +23,7 @@ struct ErrorTargetField {
 void errorTargetReport(const ComputeContext& context, const std::vector<ErrorTargetField>& fields,
                        const std::vector<double>& errors, int reference_directions, int reps);
 
+void errorCurve(const ComputeContext& context, const std::vector<ErrorTargetField>& fields,
+                int reference_directions, int max_directions);
+
 }  // namespace hfvis::bench

@@ -100,7 +100,7 @@ constexpr const char* kUsage =
     "                                      [--samples N] [--seed S] RASTER...\n"
     "       hfvis_bench viewshed-culling [--levels 1,2,3,4] [--reps N] FIELD...\n"
     "       hfvis_bench error-target [--data DIR] [--dem FILE] [--size N] [--errors E,...] [--contents A,B]\n"
-    "                                [--reference-k K] [--reps N]\n"
+    "                                [--reference-k K] [--reps N] [--curve KMAX]\n"
     "       hfvis_bench pvs-rays [--size N] [--rays R] [--reps K] [--dem FILE] FIELD...\n"
     "       hfvis_bench pvs-recall [--size N] [--view-cell C] [--tile T] [--samples N,N,...]\n"
     "                              [--check-rays R] [--dem FILE] FIELD...   (FIELD: city, noise, dem)\n"
@@ -516,6 +516,7 @@ int main(int argc, char** argv) {
         errors.push_back(std::stod(e));
       const int reference = std::stoi(args.get("--reference-k", "2048"));
       const int reps = std::stoi(args.get("--reps", "3"));
+      const int curve = std::stoi(args.get("--curve", "0"));
       const std::vector<std::string> names =
           textList(args.get("--contents", "fractal,bricks,sine,blocks,city_dsm,dem,mixed"));
       args.rejectUnused();
@@ -536,6 +537,10 @@ int main(int argc, char** argv) {
           for (int c = mixed.width / 2; c < mixed.width; ++c)
             mixed.heights[static_cast<std::size_t>(r) * mixed.width + c] = 40.0f * terrain.at(c, r);
         fields.push_back({"mixed", mixed});
+      }
+      if (curve > 0) {
+        errorCurve(ComputeContext::create(ContextOptions::fromEnvironment()), fields, reference, curve);
+        return 0;
       }
       errorTargetReport(ComputeContext::create(ContextOptions::fromEnvironment()), fields, errors, reference,
                         reps);

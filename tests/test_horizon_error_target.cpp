@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 
 #include "core/lattice_geometry.hpp"
@@ -191,6 +192,8 @@ TEST(HorizonMaxError, MeetsTheTargetAgainstADenseRun) {
     HorizonOptions dense;
     dense.directions = 1024;
     const SkyViewFactorResult truth = computeSkyViewFactor(testContext(), field, dense);
+    HorizonOutputs svf_only;
+    svf_only.sky_view_factor = true;
     int last_directions = 0;
     double last_estimate = 1.0;
     for (double E : {0.05, 0.02, 0.01, 0.005}) {
@@ -203,6 +206,12 @@ TEST(HorizonMaxError, MeetsTheTargetAgainstADenseRun) {
       EXPECT_GE(r.directions, last_directions);
       EXPECT_LE(r.estimated_error, last_estimate);
       EXPECT_EQ(r.error_estimate.size(), field.pixelCount());
+      // The runs it made: from the first K up, each at more directions, the last the one returned.
+      const HorizonResult runs = computeHorizons(testContext(), field, options, svf_only);
+      ASSERT_FALSE(runs.runs.empty());
+      EXPECT_EQ(runs.runs.front(), 16);
+      EXPECT_EQ(runs.runs.back(), r.directions);
+      EXPECT_TRUE(std::is_sorted(runs.runs.begin(), runs.runs.end(), std::less_equal<int>()));
       last_directions = r.directions;
       last_estimate = r.estimated_error;
     }
@@ -215,6 +224,34 @@ TEST(HorizonMaxError, MeetsTheTargetAgainstADenseRun) {
     EXPECT_LE(
         p99Difference(ao.values, computeHorizons(testContext(), field, dense, ao_only).ambient_occlusion),
         0.01);
+  }
+}
+
+// The estimate's calibration on hard cases: as K doubles it falls, and at each K it lies at or above
+// the error against a dense run (K = 1024), the pixels' 99th percentile, for both outputs.
+TEST(HorizonErrorEstimate, FallsAsKDoublesAndBoundsTheErrorAgainstADenseRun) {
+  for (const char* name : {"noise", "city"}) {
+    SCOPED_TRACE(name);
+    const HeightField field = makeSyntheticField(name, 64, 60);
+    for (bool ao : {false, true}) {
+      SCOPED_TRACE(ao ? "occlusion" : "sky-view factor");
+      HorizonOutputs outputs;
+      (ao ? outputs.ambient_occlusion : outputs.sky_view_factor) = true;
+      const auto plane = [&](const HorizonResult& r) { return ao ? r.ambient_occlusion : r.sky_view_factor; };
+      HorizonOptions options;
+      options.directions = 1024;
+      const std::vector<float> truth = plane(computeHorizons(testContext(), field, options, outputs));
+      outputs.error_estimate = true;
+      double last = 1.0;
+      for (int K : {16, 32, 64, 128, 256}) {
+        SCOPED_TRACE(K);
+        options.directions = K;
+        const HorizonResult r = computeHorizons(testContext(), field, options, outputs);
+        EXPECT_LT(r.estimated_error, last);
+        EXPECT_GE(r.estimated_error, p99Difference(plane(r), truth));
+        last = r.estimated_error;
+      }
+    }
   }
 }
 

@@ -89,6 +89,9 @@ struct HorizonResult {
   // benchmark's contents it lies above the full K's error (bench/report/error_target.md).
   std::vector<float> error_estimate;
   double estimated_error = 0.0;  // its 99th percentile over the pixels with data; 0 without it
+  // With HorizonOptions::max_error: the K of each run it made, in order (the last is `directions`),
+  // so that its whole cost is known; empty otherwise.
+  std::vector<int> runs;
 };
 
 // Throws InvalidArgument for bad sweep options (see sweep_options.hpp) or when no output

@@ -892,9 +892,14 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
     attempt.directions = detail::kFirstAutoDirections;
     int earlier = 0;
     double earlier_estimate = 0.0;
+    std::vector<int> runs;
     for (;;) {
       HorizonResult result = run(estimated);
-      if (result.estimated_error <= options.max_error) return result;
+      runs.push_back(attempt.directions);
+      if (result.estimated_error <= options.max_error) {
+        result.runs = std::move(runs);
+        return result;
+      }
       const int next = detail::directionsForError(attempt.directions, result.estimated_error, earlier,
                                                   earlier_estimate, options.max_error);
       earlier = attempt.directions;
