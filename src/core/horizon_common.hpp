@@ -55,7 +55,7 @@ double estimatedError(const std::vector<float>& estimate);
 int directionsForError(int directions, double estimated, int earlier, double earlier_estimate, double max_error);
 
 // Whether the field has per-row spacing (HeightField::row_cell_size_x/y): positions along the
-// sweep's lines and the naive march's rays are then ground lengths summed step by step.
+// sweep's lines (in whole units) and the naive march's rays are then ground lengths summed step by step.
 bool hasRowSpacing(const HeightField& field);
 
 // A field with per-row spacing (HeightField::row_cell_size_x/y), as horizon_lattice takes it
