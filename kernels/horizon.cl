@@ -30,9 +30,11 @@
 //                                            count (horizon_lattice: blocks and a backward
 //                                            pass, below; horizon_naive: `max_steps`)
 //   HFVIS_ROW_SPACING                        the ground spacing differs per row (latitude /
-//                                            longitude grids): positions along a line or ray
-//                                            are ground lengths summed step by step, from the
-//                                            per-row tables `row_length` and `row_terms`
+//                                            longitude grids): positions along a line are
+//                                            whole units of ground length summed period by
+//                                            period (along a ray ground lengths summed step by
+//                                            step), from the per-row tables `row_length` and
+//                                            `row_terms`
 //   HFVIS_STRIPS                             horizon_lattice resumes lines part-way (a field in
 //                                            strips of rows, see there)
 //   HFVIS_ORIGIN                             the field was cut from a larger one (HeightField::
@@ -77,7 +79,7 @@
 #ifndef HFVIS_ORIGIN
 #define HFVIS_ORIGIN 0
 #endif
-#if HFVIS_ORIGIN && HFVIS_STRIPS && HFVIS_LANES != 1
+#if HFVIS_ORIGIN && !HFVIS_ROW_SPACING && HFVIS_STRIPS && HFVIS_LANES != 1
 #error "a strip's lines resume at indices of their own along a larger field's lines: one line per work-item"
 #endif
 #if HFVIS_MAX_DISTANCE && HFVIS_ROW_SPACING && HFVIS_LANES != 1
@@ -504,6 +506,27 @@ HFVIS_INLINE int receiver_index(int c, int r, int a, int b, int whole_width, int
   return m;
 }
 
+#if HFVIS_ROW_SPACING
+// The position of receiver (c, r), the first of its line in this field, along the line through
+// the larger field (HFVIS_ORIGIN; without one 0: a line starts at its far end), in units: the m
+// periods (receiver_index) from it to that line's far end, row_length[r] units each along a row
+// (b = 0), else row_beyond[R] - row_beyond[R + m b] (rows R of the larger field; modulo 2^32,
+// the difference below 2^24). Integers, exact, as lineStartPosition (src/core/horizon_common.cpp)
+// computes them.
+HFVIS_INLINE float line_start_position(int c, int r, int a, int b, int origin_col, int origin_row, int whole_width,
+                                       int whole_height, __global const float* row_length,
+                                       __global const uint* row_beyond) {
+#if HFVIS_ORIGIN
+  const int m = receiver_index(c + origin_col, r + origin_row, a, b, whole_width, whole_height);
+  if (b == 0) return (float)(m * (int)row_length[r]);
+  const int R = r + origin_row;
+  return (float)(row_beyond[R] - row_beyond[R + m * b]);
+#else
+  return 0.0f;
+#endif
+}
+#endif
+
 #if HFVIS_MAX_DISTANCE
 
 #if HFVIS_STRIPS
@@ -532,9 +555,9 @@ HFVIS_INLINE int block_of_row(int j, float tau, int c, int r, int a, int b, floa
 #endif
 #endif
 
-// Horizons within a window of `window` pixels along the line (HFVIS_MAX_DISTANCE; ground units,
-// and positions ground lengths, with HFVIS_ROW_SPACING, one line per work-item). The line's
-// positions are cut into blocks of the window's length (block = floor(position / window));
+// Horizons within a window of `window` pixels along the line (HFVIS_MAX_DISTANCE; units of
+// ground length, and positions in them, with HFVIS_ROW_SPACING, one line per work-item). The
+// line's positions are cut into blocks of the window's length (block = floor(position / window));
 // a receiver's window then lies in its own block and the one before. The forward sweep
 // restarts its stack at every block, so it gives the steepest sample of the receiver's own
 // block (all nearer than the window). This pass gives the rest, the steepest sample of the
@@ -563,8 +586,8 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
   // this field; 0 otherwise).
   int end = max(i, 0);  // block k's receivers here are periods max(i, 0) .. end - 1
 #if HFVIS_ROW_SPACING
-  // Positions are ground lengths, summed along the line (one line per work-item): receiver j's
-  // is receiver_base[its pixel] (rows from row0 on, as the heights; in strips those of earlier
+  // Positions are whole units of ground length, summed along the line (one line per work-item):
+  // receiver j's is receiver_base[its pixel] (rows from row0 on, as the heights; in strips those of earlier
   // strips come from the host), which the forward sweep stores as it reaches it. `base` is
   // receiver i's, or for i < 0 (a strip resumed inside a block) receiver -1's. Block k's
   // receivers are not reached yet: their positions are summed on here as the forward sweep
@@ -693,36 +716,37 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
 // from row0 on and the outputs (normals, planes, sums, window_far, receiver_base) its rows from
 // out_row0 on. With HFVIS_STRIPS, line j resumes its whole line's sweep: line_state[j] = (index of
 // its first receiver here along the whole line, entries of the stack it arrives with, their offset
-// in carry_in, the receivers' ground position before it as float bits (HFVIS_ROW_SPACING)); the
+// in carry_in, the receivers' position before it as float bits (HFVIS_ROW_SPACING)); the
 // kernel copies those entries into its stack, and on leaving writes the stack's size into .y and
-// the ground position into .w (carry_stacks then moves the stacks on). Without, every line starts
+// the position into .w (carry_stacks then moves the stacks on). Without, every line starts
 // at its far end with an empty stack and line_state and carry_in are not used.
 //
 // With HFVIS_ORIGIN the field was cut from a larger one of whole_width x whole_height pixels, its
 // pixel (0, 0) at (origin_col, origin_row) there: positions (and so a window's blocks) count from
 // the far end of the larger field's line (receiver_index), so that every sample lies where it lies
 // in the larger field's sweep, to the bit; a line still starts at this field's edge with an empty
-// stack. Not with HFVIS_ROW_SPACING, whose positions are ground lengths summed along a line.
-// Lanes share their positions: the host gives a work-item's lanes lines that start at the same
-// index there (lane 0's is taken for all).
+// stack. Lanes share their positions: the host gives a work-item's lanes lines that start at the
+// same index there (lane 0's is taken for all). With HFVIS_ROW_SPACING each lane's line starts at
+// its own position there instead (line_start_position, from row_beyond).
 //
-// With HFVIS_MAX_DISTANCE only samples within `window` (pixels along the line; ground units
-// with HFVIS_ROW_SPACING) count, inv_window = 1 / window (window_pass; window_far: one (rise,
+// With HFVIS_MAX_DISTANCE only samples within `window` (pixels along the line; units with
+// HFVIS_ROW_SPACING) count, inv_window = 1 / window (window_pass; window_far: one (rise,
 // run) per pixel; in strips one line per work-item; with HFVIS_ROW_SPACING one line per
-// work-item on the whole field, receiver_base the receivers' ground positions). With
-// HFVIS_ROW_SPACING positions are ground lengths: row_length[r] is the ground length of the
-// period from a receiver in row r to the next one along +(a, b), row_terms[r] that period's
-// unit ground direction (x, y), weight and swath (they replace cos_azimuth, sin_azimuth, weight
-// and swath), drop is per ground unit squared, and ground_per_pixel is 1 (period_ground is
-// unused). Preconditions: lines of this launch only; stride 1 (line-major) or the launch's line
-// count (step-major). Global size: ceil(n_lines / HFVIS_LANES) rounded up to the local size.
+// work-item on the whole field, receiver_base the receivers' positions). With
+// HFVIS_ROW_SPACING positions are whole units of ground length (sweepUnit), ground_per_pixel
+// that unit's ground length: row_length[r] is the units of the period from a receiver in row r
+// to the next one along +(a, b) (a whole number), row_terms[r] that period's unit ground
+// direction (x, y), weight and swath (they replace cos_azimuth, sin_azimuth, weight and swath),
+// row_beyond where a line starts (line_start_position), and drop is per unit squared
+// (period_ground is unused). Preconditions: lines of this launch only; stride 1 (line-major) or
+// the launch's line count (step-major). Global size: ceil(n_lines / HFVIS_LANES) rounded up to the local size.
 __kernel void horizon_lattice(__global const float* heights, int width, int height, int row0, int out_row0,
                               __global const int4* lines, int n_lines, __global const LatticeSample* samples,
                               __global const CellSegment* segments, int n_samples, int a, int b, float period, float ground_per_pixel,
                               float period_ground, float drop, float window, float inv_window,
                               int origin_col, int origin_row, int whole_width, int whole_height,
                               __global const float* row_length, __global const float4* row_terms,
-                              float cos_azimuth,
+                              __global const uint* row_beyond, float cos_azimuth,
                               float sin_azimuth, float weight, float swath, uint plane, __global float2* stacks,
                               uint stride, __global int4* line_state, __global const float2* carry_in,
                               __global float2* window_far, __global float* receiver_base,
@@ -741,7 +765,7 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
   lane_float top_h = 0.0f, top_p = 0.0f, below_h = 0.0f, below_p = 0.0f, rise = 0.0f, run = 0.0f;
 #if HFVIS_ROW_SPACING
   const float inv_period = 1.0f / period;
-  lane_float base = 0.0f;  // the receivers' ground position along their lines
+  lane_float base = 0.0f;  // the receivers' position along their lines, in units
 #else
   const float inv_period = 0.0f;  // (window_pass takes it with per-row spacing only)
 #endif
@@ -776,6 +800,14 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
     }
   }
 #endif
+#if HFVIS_ORIGIN && HFVIS_ROW_SPACING
+  // A line that starts here (not resumed) starts at its position along the larger field's line.
+#pragma unroll
+  for (int l = 0; l < HFVIS_LANES; ++l)
+    if (ILANE(start, l) == 0)
+      LANE(base, l) = line_start_position(ILANE(c, l), ILANE(r, l), a, b, origin_col, origin_row, whole_width,
+                                          whole_height, row_length, row_beyond);
+#endif
 #if HFVIS_ORIGIN && !HFVIS_ROW_SPACING
   // Positions count from the larger field's line's far end: `shift` receivers more than here.
   const int shift =
@@ -797,8 +829,10 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
 #define BLOCK_OF(j, tau) \
   block_of_row(j, tau, c, r, a, b, base, row0, width, inv_period, inv_window, row_length, receiver_base)
 #define RESUME_BASE base  // receiver -1's position
-    // The line's first sample: receiver 0 of the whole line (row r + start b) at position 0.
-    const float first_here = 0.0f - samples[0].tau * (row_length[r + start * b] * inv_period);
+    // The line's first sample: that of receiver 0 of the whole line (row r + start b).
+    const float first_here = line_start_position(c + start * a, r + start * b, a, b, origin_col, origin_row,
+                                                 whole_width, whole_height, row_length, row_beyond) -
+                             samples[0].tau * (row_length[r + start * b] * inv_period);
     const int first_block = (int)floor(first_here * inv_window);
 #else
 #define BLOCK_OF(j, tau) block_of(start + shift + (j), tau, period, inv_window)
@@ -862,8 +896,8 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
     // The window's pass reads the positions of the receivers behind (one line per work-item).
     if (live) receiver_base[(r - row0) * width + c] = base;
 #endif
-    const lane_float tau_scale = period_length * inv_period;  // ground length per pixel of tau
-    const lane_float period_ground_l = period_length;
+    const lane_float tau_scale = period_length * inv_period;  // units per pixel of tau
+    const lane_float period_ground_l = period_length * ground_per_pixel;
 #elif HFVIS_STRIPS
     const lane_float base = LANE_FLOAT(along + shift) * period;  // the receivers' position along their lines
 #else

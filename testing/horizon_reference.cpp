@@ -200,7 +200,7 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
   const auto directions = horizonDirections(field, options, outputs);
   const std::vector<float> env_tables =
       outputs.environment ? environmentTables(*outputs.environment, directions) : std::vector<float>{};
-  // Positions in pixels of the direction's ground length, or (per-row spacing) ground units.
+  // Positions in pixels of the direction's ground length, or (per-row spacing) units of sweepUnit.
   const bool rows = hasRowSpacing(field);
   const std::vector<RowTable> tables =
       rows ? latticeRowTables(field, directions, !exactAzimuths(outputs), outputs.error_estimate) : std::vector<RowTable>{};
@@ -209,7 +209,7 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
     if (d.weight == 0.0 && result.angles.empty() && result.distances.empty()) continue;  // merged step
     if (parity >= 0 && k % 2 != parity) continue;
     DirectionOutputs out = withEnvironment(outputsOf(d, k), outputs, env_tables);
-    const double unit = rows ? 1.0 : d.ground_per_pixel;
+    const double unit = rows ? sweepUnit(field) : d.ground_per_pixel;
     const RowTable* table = rows ? &tables[k] : nullptr;
     const float gpp = static_cast<float>(unit);
     const float drop = static_cast<float>(options.curvature * unit * unit);
@@ -226,7 +226,7 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
         }
         const int c = static_cast<int>(pixel % width), r = static_cast<int>(pixel / width);
         if (table) {  // the receiver's period: its ground length and terms
-          period_ground = table->length[r];
+          period_ground = table->length[r] * gpp;
           out.cos_azimuth = table->terms[4 * r];
           out.sin_azimuth = table->terms[4 * r + 1];
           out.weight = table->terms[4 * r + 2];
@@ -338,7 +338,7 @@ std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, cons
   const std::vector<CellSegment> segments = cellSegments(d, samples_per_unit);
   const float period = static_cast<float>(d.period);
   const float inv_period = 1.0f / period;
-  float row_base = 0.0f;  // per-row spacing: the receiver's ground position
+  float row_base = 0.0f;  // per-row spacing: the receiver's position, in units
   const bool windowed = window.window > 0.0f;
   // Every sample of the line in sweep order (height NaN where it is absent: outside the field
   // or without height), with its block (horizon_lattice's window_pass) and its height as the
@@ -360,6 +360,7 @@ std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, cons
   // Positions count from the far end of the line through the larger field (HeightField::origin;
   // without one, this field's: 0), as horizon_lattice with HFVIS_ORIGIN counts them.
   const int first = rows ? 0 : receiverIndex(field, d.a, d.b, line.col, line.row);
+  if (rows) row_base = lineStartPosition(field, *rows, d.a, d.b, line.col, line.row);
   for (int i = 0; i < line.receivers; ++i, c -= d.a, r -= d.b) {
     float base = static_cast<float>(first + i) * period, tau_scale = 1.0f;
     if (rows) {  // horizon_lattice with HFVIS_ROW_SPACING

@@ -34,8 +34,9 @@ struct LatticeLineSample {
 // horizon_lattice with HFVIS_MAX_DISTANCE: the receivers' occluders are the steepest samples
 // within the window (occluder 0 where it lies in the block before the receiver's); the other
 // samples' occluders are those of their own block only. With per-row spacing (`rows`, the
-// direction's latticeRowTables entry) positions are ground lengths, as HFVIS_ROW_SPACING makes
-// them.
+// direction's latticeRowTables entry) positions are whole units of sweepUnit summed period by
+// period from the line's position along the larger field's line (lineStartPosition), as
+// HFVIS_ROW_SPACING makes them.
 std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, const std::vector<float>& h,
                                                   const LatticeDirection& d, double samples_per_unit,
                                                   const LatticeLine& line, float drop = 0.0f,

@@ -246,7 +246,8 @@ TEST(HorizonSweepLine, DirectionsHonourTheToleranceAndQuadratureWeightsSumToOne)
 // Kernel results equal the scalar reference of the same algorithm, for both methods, in
 // both buffer layouts (with row_spacing, on testing::setRowSpacing's grid).
 // With `cut`, each field is one cut out of a larger one (HeightField::origin: its positions along
-// the larger field's lines, the larger field's lowest height 2 below its own).
+// the larger field's lines, the larger field's lowest height 2 below its own; with row_spacing
+// the larger field's rows setRowSpacing's over its rows, the field's rows 5 .. 5 + h of them).
 void expectKernelMatchesReference(HorizonMethod method, double samples_per_unit, double curvature = 0.0,
                                   double max_distance = 0.0, bool row_spacing = false, bool cut = false) {
   testing::forEachLayout([&](const ComputeContext& context) {
@@ -260,6 +261,16 @@ void expectKernelMatchesReference(HorizonMethod method, double samples_per_unit,
           float lowest = INFINITY;
           for (float v : field.heights) lowest = std::isfinite(v) ? std::min(lowest, v) : lowest;
           field.origin = {11, 5, w + 17, h + 9, double(lowest) - 2.0};
+          if (row_spacing) {
+            HeightField larger = makeSyntheticField("flat", 1, h + 9);
+            testing::setRowSpacing(larger);
+            field.origin.row_cell_size_x = larger.row_cell_size_x;
+            field.origin.row_cell_size_y = larger.row_cell_size_y;
+            field.row_cell_size_x.assign(larger.row_cell_size_x.begin() + 5,
+                                         larger.row_cell_size_x.begin() + 5 + h);
+            field.row_cell_size_y.assign(larger.row_cell_size_y.begin() + 5,
+                                         larger.row_cell_size_y.begin() + 5 + h);
+          }
         }
         HorizonOptions options;
         options.directions = 7;
@@ -346,6 +357,17 @@ TEST(HorizonKernels, SweepMatchesScalarReferenceWithPerRowSpacingWithinAMaximumD
     expectKernelMatchesReference(HorizonMethod::Sweep, 1.0, 0.0, d, true);
   }
   expectKernelMatchesReference(HorizonMethod::Sweep, 2.5, 0.004, 6.1, true);
+}
+
+// Per-row spacing on a field cut from a larger one: each line starts at its position along the
+// larger field's line (lineStartPosition), plain, within maximum distances, denser and curved.
+TEST(HorizonKernels, SweepMatchesScalarReferenceWithPerRowSpacingOnAFieldCutFromALargerOne) {
+  expectKernelMatchesReference(HorizonMethod::Sweep, 1.0, 0.0, 0.0, true, true);
+  for (double d : {1.2, 4.3, 29.0}) {
+    SCOPED_TRACE("max distance " + std::to_string(d));
+    expectKernelMatchesReference(HorizonMethod::Sweep, 1.0, 0.0, d, true, true);
+  }
+  expectKernelMatchesReference(HorizonMethod::Sweep, 2.5, 0.004, 6.1, true, true);
 }
 
 TEST(HorizonKernels, NaiveMatchesScalarReferenceWithPerRowSpacing) {
@@ -567,8 +589,9 @@ TEST(HorizonKernels, StripsWithinAMaximumDistanceEqualTheWholeFieldBitForBit) {
 // cut's pixels farther than ceil(max_distance / smallest cell) + 2 pixels from its edges inside
 // the larger field (those at the larger field's own edges are edges in both): hard cases with
 // nodata, cuts smaller than that margin, at the larger field's edges and in its middle, exact
-// azimuths and quadrature directions, curvature, denser sampling, strips, sun shading; both
-// layouts.
+// azimuths and quadrature directions, curvature, denser sampling, strips, sun shading, per-row
+// spacing (variants 4 to 6: a latitude / longitude grid, positions whole units of ground length
+// along the larger field's lines); both layouts.
 TEST(HorizonKernels, AFieldCutFromALargerOneEqualsItBitForBitInside) {
   testing::forEachLayout([&](const ComputeContext& context) {
     for (const char* name : {"nan_holes", "city", "spikes", "noise"}) {
@@ -576,14 +599,18 @@ TEST(HorizonKernels, AFieldCutFromALargerOneEqualsItBitForBitInside) {
       whole.cell_size_x = 1.5;
       float lowest = INFINITY;
       for (float v : whole.heights) lowest = std::isfinite(v) ? std::min(lowest, v) : lowest;
-      for (int variant = 0; variant < 4; ++variant) {
+      for (int variant = 0; variant < 7; ++variant) {
+        const bool rows = variant >= 4;  // then variants 0 .. 2's options again
+        if (variant == 4) testing::setRowSpacing(whole);
         HorizonOptions options;
-        options.directions = variant == 1 ? 24 : 8;
+        options.directions = variant % 4 == 1 ? 24 : 8;
         options.azimuth_offset = 0.3;
-        options.max_distance = variant == 2 ? 9.0 : 4.6;
-        options.curvature = variant == 2 ? 0.01 : 0.0;
+        options.max_distance = variant % 4 == 2 ? 9.0 : 4.6;
+        options.curvature = variant % 4 == 2 ? 0.01 : 0.0;
         options.samples_per_unit = variant == 3 ? 2.5 : 1.0;
-        const int margin = static_cast<int>(std::ceil(options.max_distance / 1.0)) + 2;  // cells 1.5 x 1
+        // Cells 1.5 x 1 (per-row: at least 0.75 x 1).
+        const double smallest = rows ? 0.75 : 1.0;
+        const int margin = static_cast<int>(std::ceil(options.max_distance / smallest)) + 2;
         for (auto [x0, y0, w, h] : {std::array{0, 0, 30, 27}, std::array{17, 9, 33, 31}, std::array{40, 30, 21, 23},
                                     std::array{5, 20, 9, 13}, std::array{0, 0, 61, 53}}) {
           SCOPED_TRACE(std::string(name) + " variant " + std::to_string(variant) + " cut at " + std::to_string(x0) +
@@ -591,6 +618,14 @@ TEST(HorizonKernels, AFieldCutFromALargerOneEqualsItBitForBitInside) {
           HeightField cut = testing::cropField(whole, x0, y0, w, h);
           if (std::all_of(cut.heights.begin(), cut.heights.end(), [](float v) { return std::isnan(v); })) continue;
           cut.origin = {x0, y0, whole.width, whole.height, double(lowest)};
+          if (rows) {  // the cut's rows of the larger field's spacing (its centre's cell sizes kept)
+            cut.origin.row_cell_size_x = whole.row_cell_size_x;
+            cut.origin.row_cell_size_y = whole.row_cell_size_y;
+            cut.row_cell_size_x.assign(whole.row_cell_size_x.begin() + y0,
+                                       whole.row_cell_size_x.begin() + y0 + h);
+            cut.row_cell_size_y.assign(whole.row_cell_size_y.begin() + y0,
+                                       whole.row_cell_size_y.begin() + y0 + h);
+          }
           // `planes` planes of the cut's values against the larger field's on the pixels inside.
           auto expectEqualInside = [&](const std::vector<float>& part, const std::vector<float>& full, int planes) {
             ASSERT_EQ(part.size(), std::size_t(planes) * w * h);
@@ -629,7 +664,7 @@ TEST(HorizonKernels, AFieldCutFromALargerOneEqualsItBitForBitInside) {
             }
           }
           options.strip_rows = 0;
-          if (variant == 0) {  // the sun's shading: one sweep in its azimuth, then the normals
+          if (variant % 4 == 0) {  // the sun's shading: one sweep in its azimuth, then the normals
             SunLight sun;
             sun.position = {200.0, 15.0};
             expectEqualInside(computeSunShading(context, cut, sun, options).direct,
@@ -807,7 +842,22 @@ TEST(HorizonKernels, AnOriginOutsideItsLargerFieldOrAboveAHeightIsRefused) {
   for (FieldOrigin bad :
        {FieldOrigin{3, 3, 8, 8, -1.0}, FieldOrigin{2, 4, 8, 8, -1.0}, FieldOrigin{-1, 0, 8, 8, -1.0},
         FieldOrigin{0, 0, 5, 0, -1.0}, FieldOrigin{2, 3, 8, 8, 0.5}, FieldOrigin{2, 3, 8, 8, NAN},
-        FieldOrigin{2, 3, 8, 8, -1.0, -1.0}, FieldOrigin{2, 3, 8, 8, -1.0, INFINITY}}) {
+        FieldOrigin{2, 3, 8, 8, -1.0, std::vector<double>(8, 1.0), std::vector<double>(8, 1.0)}}) {
+    field.origin = bad;
+    EXPECT_THROW(computeHorizons(testContext(), field, options, allOutputs()), InvalidArgument);
+  }
+  // With per-row spacing, the larger field's rows: one per row, this field's among them.
+  testing::setRowSpacing(field);
+  HeightField larger = makeSyntheticField("flat", 1, 8);
+  testing::setRowSpacing(larger);
+  std::vector<double> xs = larger.row_cell_size_x, ys = larger.row_cell_size_y;
+  std::copy(field.row_cell_size_x.begin(), field.row_cell_size_x.end(), xs.begin() + 3);
+  std::copy(field.row_cell_size_y.begin(), field.row_cell_size_y.end(), ys.begin() + 3);
+  field.origin = {2, 3, 8, 8, -1.0, xs, ys};
+  EXPECT_NO_THROW(computeHorizons(testContext(), field, options, allOutputs()));
+  for (FieldOrigin bad : {FieldOrigin{2, 3, 8, 8, -1.0}, FieldOrigin{2, 3, 8, 8, -1.0, xs, {}},
+                          FieldOrigin{2, 2, 8, 8, -1.0, xs, ys},
+                          FieldOrigin{2, 3, 8, 8, -1.0, std::vector<double>(xs.begin(), xs.end() - 1), ys}}) {
     field.origin = bad;
     EXPECT_THROW(computeHorizons(testContext(), field, options, allOutputs()), InvalidArgument);
   }

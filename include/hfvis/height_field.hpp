@@ -29,18 +29,18 @@ struct Georeference {
 // lines and takes the larger field's lowest height as the heights' base, so that a pixel's
 // horizon, sky-view factor, occlusion and sun are the larger field's bit for bit wherever its
 // maximum distance (and the bilinear cell and normal beyond it) lies inside this field: a
-// pixel's samples and the cut at the maximum distance fall where they fall in the larger field
-// (not with per-row spacing, whose positions are ground lengths summed from a line's start).
-// The hull tree (intervisibility, the horizon lists) is exact either way; it takes the base
-// too, and with per-row spacing the larger field's unit of ground length (groundUnit: its
-// size and largest cell), so that its positions differ from the larger field's by a constant.
+// pixel's samples and the cut at the maximum distance fall where they fall in the larger field.
+// With per-row spacing (a latitude / longitude grid) positions are whole units of ground length
+// (of the larger field's size and largest cell size) summed along the larger field's lines, so
+// the origin carries the larger field's per-row cell sizes too. The hull tree
+// (intervisibility, the horizon lists) is exact either way; it takes the base and the unit too.
 struct FieldOrigin {
   int col = 0, row = 0;                  // this field's pixel (0, 0) in the larger field
   int whole_width = 0, whole_height = 0;  // the larger field's size; 0 x 0: no larger field
   double lowest = 0.0;                    // the larger field's lowest finite height (before z_scale)
-  // With per-row spacing: the larger field's largest per-row cell size (ground units), at
-  // least this field's; 0: this field's own.
-  double largest_cell = 0.0;
+  // With per-row spacing: the larger field's per-row cell sizes (whole_height each), whose rows
+  // [row, row + height) are this field's; empty without per-row spacing.
+  std::vector<double> row_cell_size_x, row_cell_size_y;
 
   bool present() const { return whole_width > 0 || whole_height > 0; }
 };

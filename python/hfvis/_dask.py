@@ -43,10 +43,11 @@ def _block(block, lowest, operation, geometry, options, device, depth, chunks, b
     first_row = sum(chunks[0][:i]) - top
     first_col = sum(chunks[1][:j]) - left
     g = dict(geometry)
-    # (The largest row cell size: the whole field's unit of positions on a latitude / longitude grid.)
-    largest = max(g["row_cell_size_x"] + g["row_cell_size_y"], default=0.0)
-    g["origin"] = [first_col, first_row, sum(chunks[1]), sum(chunks[0]), float(lowest.flat[0]), float(largest)]
-    if g["row_cell_size_x"]:  # a latitude / longitude grid: the block's own rows' spacing
+    g["origin"] = [first_col, first_row, sum(chunks[1]), sum(chunks[0]), float(lowest.flat[0])]
+    if g["row_cell_size_x"]:  # a latitude / longitude grid: the block's own rows' spacing, and the
+        # whole field's rows, along which positions are counted
+        g["origin_row_cell_size_x"] = g["row_cell_size_x"]
+        g["origin_row_cell_size_y"] = g["row_cell_size_y"]
         g["row_cell_size_x"] = g["row_cell_size_x"][first_row:first_row + block.shape[0]]
         g["row_cell_size_y"] = g["row_cell_size_y"][first_row:first_row + block.shape[0]]
     planes = _arrays.planes_of(operation, options)

@@ -100,7 +100,8 @@ Array planes(std::vector<float>&& values, int count, const HeightField& field) {
 
 HeightField makeField(Heights heights, double cell_size_x, double cell_size_y,
                       std::vector<double> row_cell_size_x, std::vector<double> row_cell_size_y,
-                      double z_scale, std::vector<double> origin) {
+                      double z_scale, std::vector<double> origin, std::vector<double> origin_row_cell_size_x,
+                      std::vector<double> origin_row_cell_size_y) {
   HeightField field;
   field.height = static_cast<int>(heights.shape(0));
   field.width = static_cast<int>(heights.shape(1));
@@ -111,13 +112,18 @@ HeightField makeField(Heights heights, double cell_size_x, double cell_size_y,
   field.row_cell_size_y = std::move(row_cell_size_y);
   field.z_scale = z_scale;
   // Empty, or where the field lies in a larger one (a Dask chunk with its halo): column, row,
-  // the larger field's width and height, its lowest height and its largest per-row cell size
-  // (HeightField::origin).
+  // the larger field's width and height and its lowest height, and with per-row spacing its rows'
+  // cell sizes (HeightField::origin).
   if (!origin.empty()) {
-    if (origin.size() != 6)
-      throw InvalidArgument("origin must be (col, row, whole_width, whole_height, lowest, largest_cell)");
-    field.origin = {static_cast<int>(origin[0]), static_cast<int>(origin[1]), static_cast<int>(origin[2]),
-                    static_cast<int>(origin[3]), origin[4], origin[5]};
+    if (origin.size() != 5)
+      throw InvalidArgument("origin must be (col, row, whole_width, whole_height, lowest)");
+    field.origin = {static_cast<int>(origin[0]),
+                    static_cast<int>(origin[1]),
+                    static_cast<int>(origin[2]),
+                    static_cast<int>(origin[3]),
+                    origin[4],
+                    std::move(origin_row_cell_size_x),
+                    std::move(origin_row_cell_size_y)};
   }
   validate(field);
   return field;
@@ -581,7 +587,9 @@ NB_MODULE(_core, m) {
   // Made by height_field() and passed back to the operations; Python reads nothing of them.
   nb::class_<HeightField>(m, "HeightField");
   m.def("height_field", &makeField, "heights"_a, "cell_size_x"_a, "cell_size_y"_a, "row_cell_size_x"_a,
-        "row_cell_size_y"_a, "z_scale"_a, "origin"_a = std::vector<double>{});
+        "row_cell_size_y"_a, "z_scale"_a, "origin"_a = std::vector<double>{},
+        "origin_row_cell_size_x"_a = std::vector<double>{},
+        "origin_row_cell_size_y"_a = std::vector<double>{});
   m.def(
       "geographic_cell_sizes",
       [](const std::array<double, 6>& geotransform, int height) {

@@ -1,7 +1,8 @@
 """Dask-backed DataArrays: chunk by chunk with a halo of the maximum distance, against the
 in-memory run on fixed and random chunkings (chunks smaller than the halo among them) with nodata
 holes across chunk edges: bit for bit, NaN where it was (the horizon sweep's outputs,
-intervisibility, cumulative viewsheds); a LocalCluster of two worker processes."""
+intervisibility, cumulative viewsheds), on a projected grid and on a latitude / longitude one; a
+LocalCluster of two worker processes."""
 
 import dask.array as da
 import numpy as np
@@ -127,21 +128,70 @@ def test_local_cluster_with_two_worker_processes(field):
     np.testing.assert_array_equal(computed_seen, hfvis.cumulative_viewshed(field, observers).values)
 
 
-def test_latitude_longitude_grid_takes_each_blocks_rows():
-    """60 to 70 degrees north in 0.1 degree cells: a row's east-west spacing shrinks by a third
-    over the field, so a block computed with other rows' spacing would be off by about 1e-2."""
+LATITUDE_LONGITUDE_DISTANCE = 30000.0  # metres: a halo of ceil(30000 / 3807) + 2 = 10 pixels
+
+
+@pytest.fixture(scope="module")
+def latitude_longitude_field():
+    """60 to 70 degrees north in 0.1 degree cells: a row's east-west spacing (3807 m to 5663 m)
+    shrinks by a third over the field. Nodata holes across the chunk edges used below."""
     rng = np.random.default_rng(5)
     heights = (np.cumsum(np.cumsum(rng.normal(size=(100, 120)), 0), 1) * 20).astype(np.float32)
+    heights[35:39, :] = np.nan  # across the row edge at 37
+    heights[60:70, 50:57] = np.nan  # across the column edge at 53 and at 16-pixel edges
+    heights[:, 79:81] = np.nan
     lat, lon = 70 - 0.1 * (np.arange(100) + 0.5), 10 + 0.1 * (np.arange(120) + 0.5)
-    field = xr.DataArray(heights, dims=("lat", "lon"), coords={"lat": lat, "lon": lon})
-    whole = hfvis.sky_view_factor(field, directions=8, max_distance=30000)
-    centre_spacing = hfvis.sky_view_factor(heights, directions=8, max_distance=30000,
+    return xr.DataArray(heights, dims=("lat", "lon"), coords={"lat": lat, "lon": lon})
+
+
+def latitude_longitude_chunkings():
+    rng = np.random.default_rng(31)
+    fixed = [(37, 53), (16, 16), (5, 120), (100, 7)]  # 5 and 7: smaller than the halo
+    return fixed + [(tuple(_random_chunks(rng, 100)), tuple(_random_chunks(rng, 120))) for _ in range(2)]
+
+
+def _latitude_longitude(operation):
+    """EXACT's operation within LATITUDE_LONGITUDE_DISTANCE."""
+    d = LATITUDE_LONGITUDE_DISTANCE
+    return {
+        "intervisibility": lambda a: hfvis.intervisibility(a, directions=8, max_distance=d),
+        "sky_view_factor": lambda a: hfvis.sky_view_factor(a, directions=8, max_distance=d),
+        "ambient_occlusion": lambda a: hfvis.ambient_occlusion(a, directions=8, max_distance=d),
+        "horizon_angles": lambda a: hfvis.horizon_angles(a, directions=8, max_distance=d),
+        "horizon_distances": lambda a: hfvis.horizon_distances(a, directions=8, max_distance=d,
+                                                               samples_per_unit=2.5, curvature=1e-5),
+        "sun_shading": lambda a: hfvis.sun_shading(a, 200, 15, max_distance=d),
+        "insolation": lambda a: hfvis.insolation(a, 65.0, 16.0, "2024-06-21T10:00:00Z", "2024-06-21T12:00:00Z",
+                                                 step_minutes=30, max_distance=d),
+    }[operation]
+
+
+def test_latitude_longitude_grid_takes_each_blocks_rows(latitude_longitude_field):
+    """Each block's rows have their own spacing: a block computed with other rows' spacing
+    would be off by about 1e-2."""
+    field = latitude_longitude_field
+    whole = hfvis.sky_view_factor(field, directions=8, max_distance=LATITUDE_LONGITUDE_DISTANCE)
+    centre_spacing = hfvis.sky_view_factor(field.values, directions=8, max_distance=LATITUDE_LONGITUDE_DISTANCE,
                                            cell_size=(0.1 * 111320 * np.cos(np.radians(65)), 0.1 * 111320))
     assert np.nanmax(np.abs(centre_spacing - whole.values)) > 1e-3  # the rows' spacing matters here
-    for chunks in [(37, 53), (16, 120), (100, 9)]:
-        chunked = hfvis.sky_view_factor(field.chunk({"lat": chunks[0], "lon": chunks[1]}), directions=8,
-                                        max_distance=30000)
-        np.testing.assert_allclose(chunked.values, whole.values, rtol=0, atol=1e-6, err_msg=str(chunks))
-    counts = hfvis.intervisibility(field, directions=8, max_distance=30000).visible_count
-    chunked = hfvis.intervisibility(field.chunk({"lat": 37, "lon": 53}), directions=8, max_distance=30000)
-    np.testing.assert_array_equal(chunked.visible_count.values, counts.values)
+
+
+@pytest.mark.parametrize("operation", sorted(EXACT))
+def test_latitude_longitude_chunked_equals_in_memory_bit_for_bit(latitude_longitude_field, operation):
+    """On a latitude / longitude grid too: the horizon sweep's positions are whole units of ground
+    length counted along the whole field's lines, the hull tree's whole units (HeightField::origin
+    carries the whole field's rows)."""
+    run = _latitude_longitude(operation)
+    field = latitude_longitude_field
+    whole = planes(run(field))
+    assert all(np.isnan(w.values).any() and not np.isnan(w.values).all() for w in whole)  # holes, and values
+    for chunks in latitude_longitude_chunkings():
+        chunked = planes(run(field.chunk({"lat": chunks[0], "lon": chunks[1]})))
+        assert len(chunked) == len(whole)
+        for got, want in zip(chunked, whole):
+            assert got.chunks is not None
+            values, wanted = got.values, want.values
+            holes = np.isnan(wanted)
+            assert np.array_equal(np.isnan(values), holes), f"{got.name} {chunks}: nodata moved"
+            assert np.array_equal(values[~holes].view(np.uint32), wanted[~holes].view(np.uint32)), \
+                f"{got.name} {chunks}: largest difference {np.nanmax(np.abs(values - wanted))}"

@@ -64,12 +64,20 @@ void validate(const HeightField& field) {
     if (!above)
       throw InvalidArgument("the origin's lowest height (" + shortNumber(o.lowest) +
                             ") must be finite and at most every height of the field");
-    double largest = 0.0;  // of this field's rows
-    for (const auto* sizes : {&field.row_cell_size_x, &field.row_cell_size_y})
-      for (double s : *sizes) largest = std::max(largest, s);
-    if (!(std::isfinite(o.largest_cell) && (o.largest_cell == 0.0 || o.largest_cell >= largest)))
-      throw InvalidArgument("the origin's largest cell size (" + shortNumber(o.largest_cell) +
-                            ") must be 0 or at least the field's largest row cell size (" + shortNumber(largest) + ")");
+    // With per-row spacing the larger field's rows, this field's among them; none without.
+    const bool rows = !field.row_cell_size_x.empty();
+    const std::size_t whole_rows = rows ? static_cast<std::size_t>(o.whole_height) : 0;
+    bool matching = o.row_cell_size_x.size() == whole_rows && o.row_cell_size_y.size() == whole_rows;
+    for (int r = 0; matching && rows && r < field.height; ++r)
+      matching = o.row_cell_size_x[o.row + r] == field.row_cell_size_x[r] &&
+                 o.row_cell_size_y[o.row + r] == field.row_cell_size_y[r];
+    for (std::size_t r = 0; matching && r < whole_rows; ++r)
+      matching = positive(o.row_cell_size_x[r]) && positive(o.row_cell_size_y[r]);
+    if (!matching)
+      throw InvalidArgument(rows ? "the origin's per-row cell sizes must be the larger field's " +
+                                       std::to_string(o.whole_height) +
+                                       " rows (finite and positive), this field's rows among them"
+                                 : std::string("the origin has per-row cell sizes but the field has none"));
   }
 }
 

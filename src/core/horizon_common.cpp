@@ -54,25 +54,59 @@ void appendRow(RowTable& t, double length, double azimuth, double weight) {
 
 std::vector<RowTable> latticeRowTables(const HeightField& field, const std::vector<LatticeDirection>& directions,
                                        bool quadrature, bool parity_apart) {
+  // A field cut from a larger one takes the larger field's rows (cellSizeAtRow interpolates
+  // across this field's edges there) and keeps its own [first, first + height) of them.
+  const FieldOrigin& o = field.origin;
+  HeightField larger;  // only its rows are read
+  larger.height = o.whole_height;
+  larger.row_cell_size_x = o.row_cell_size_x;
+  larger.row_cell_size_y = o.row_cell_size_y;
+  const HeightField& rows_of = o.present() ? larger : field;
+  const int first = o.present() ? o.row : 0;
+  const double unit = sweepUnit(field);
   const std::size_t K = directions.size();
-  std::vector<RowTable> tables(K);
+  std::vector<RowTable> whole(K);
   std::vector<LatticeDirection> at_row = directions;
-  for (int r = 0; r < field.height; ++r) {
+  for (int r = 0; r < rows_of.height; ++r) {
     std::vector<double> lengths(K);
     for (std::size_t k = 0; k < K; ++k) {
       const LatticeDirection& d = directions[k];
       double cell_x = 0.0, cell_y = 0.0;
-      cellSizeAtRow(field, r + 0.5 * d.b, &cell_x, &cell_y);
+      cellSizeAtRow(rows_of, r + 0.5 * d.b, &cell_x, &cell_y);
       const double gx = d.a * cell_x, gy = d.b * cell_y;
-      lengths[k] = std::hypot(gx, gy);
+      lengths[k] = static_cast<double>(std::max(1LL, std::llround(std::hypot(gx, gy) / unit)));
       // The step's ground azimuth here, next to the one it has at the centre latitude.
       at_row[k].azimuth = d.azimuth + angleDifference(std::atan2(gy, gx), d.azimuth);
       at_row[k].weight = d.weight;
     }
     if (quadrature && K > 1) setQuadratureWeights(at_row, parity_apart);
-    for (std::size_t k = 0; k < K; ++k) appendRow(tables[k], lengths[k], at_row[k].azimuth, at_row[k].weight);
+    for (std::size_t k = 0; k < K; ++k) appendRow(whole[k], lengths[k], at_row[k].azimuth, at_row[k].weight);
+  }
+  std::vector<RowTable> tables(K);
+  for (std::size_t k = 0; k < K; ++k) {
+    const int b = directions[k].b, H = rows_of.height;
+    if (b != 0) {  // summed from the far edge, row R's after row R + b's (modulo 2^32)
+      whole[k].beyond.assign(H, 0);
+      for (int i = 0; i < H; ++i) {
+        const int R = b > 0 ? H - 1 - i : i;
+        whole[k].beyond[R] = static_cast<std::uint32_t>(whole[k].length[R]) +
+                             (R + b >= 0 && R + b < H ? whole[k].beyond[R + b] : 0u);
+      }
+    }
+    tables[k].length.assign(whole[k].length.begin() + first, whole[k].length.begin() + first + field.height);
+    tables[k].terms.assign(whole[k].terms.begin() + 4 * first,
+                           whole[k].terms.begin() + 4 * (first + field.height));
+    tables[k].beyond = std::move(whole[k].beyond);
   }
   return tables;
+}
+
+float lineStartPosition(const HeightField& field, const RowTable& table, int a, int b, int col, int row) {
+  if (!field.origin.present()) return 0.0f;
+  const int m = receiverIndex(field, a, b, col, row);
+  if (b == 0) return static_cast<float>(m * static_cast<std::int32_t>(table.length[row]));
+  const int R = row + field.origin.row;
+  return static_cast<float>(table.beyond[R] - table.beyond[R + m * b]);  // below 2^24: exact
 }
 
 std::vector<RowTable> rayRowTables(const HeightField& field, const std::vector<SweepDirection>& rays) {

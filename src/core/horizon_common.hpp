@@ -2,11 +2,12 @@
 // operation share: direction geometry and the final reduction step.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
-#include "hfvis/horizon.hpp"
 #include "core/lattice_geometry.hpp"
 #include "core/sweep_geometry.hpp"
+#include "hfvis/horizon.hpp"
 
 namespace hfvis::detail {
 
@@ -54,24 +55,37 @@ double estimatedError(const std::vector<float>& estimate);
 int directionsForError(int directions, double estimated, int earlier, double earlier_estimate, double max_error);
 
 // Whether the field has per-row spacing (HeightField::row_cell_size_x/y): positions along the
-// sweep's lines and the naive march's rays are then ground lengths summed step by step.
+// sweep's lines (in whole units) and the naive march's rays are then ground lengths summed step by step.
 bool hasRowSpacing(const HeightField& field);
-
 
 // A field with per-row spacing (HeightField::row_cell_size_x/y), as horizon_lattice takes it
 // (HFVIS_ROW_SPACING), one table per direction: per row r, the ground length of the period
 // from a receiver in row r to the next one along +(a, b) (the cell sizes at its middle row
-// r + b / 2, linear between rows), and its terms: unit ground direction (x, y), quadrature
-// weight and swath factor there. The step's ground azimuth turns with the spacing, so with
-// `quadrature` (sky-view factor, occlusion) the weights are the half gaps between the steps'
-// azimuths at that row (setQuadratureWeights); otherwise each keeps its own (1/K). Both the
-// kernel and the reference get these floats.
+// r + b / 2, linear between rows) in whole units of sweepUnit(field), at least 1, and its terms:
+// unit ground direction (x, y), quadrature weight and swath factor there. Positions along a line
+// are sums of whole units: exact in float (below 2^24), whichever receiver a sum starts from, so
+// a field cut from a larger one (HeightField::origin), whose rows' lengths and terms are the
+// larger field's (its rows are read), starts each line at the larger field's position
+// (lineStartPosition) and meets every sample where the larger field does. The step's ground
+// azimuth turns with the spacing, so with `quadrature` (sky-view factor, occlusion) the weights
+// are the half gaps between the steps' azimuths at that row (setQuadratureWeights); otherwise each
+// keeps its own (1/K). Both the kernel and the reference get these floats.
 struct RowTable {
-  std::vector<float> length;  // one per row
+  std::vector<float> length;  // one per row (rayRowTables: ground length per pixel along the ray)
   std::vector<float> terms;   // four per row: cos, sin, weight, swath
+  // b != 0: per row R of the larger field (of this one without an origin), the units of the
+  // periods from receivers in rows R, R + b, R + 2 b ... inside it, modulo 2^32 (a steep step
+  // sums far more than a line's: the difference of two, a line's part, is exact); empty otherwise.
+  std::vector<std::uint32_t> beyond;
 };
 std::vector<RowTable> latticeRowTables(const HeightField& field, const std::vector<LatticeDirection>& directions,
                                        bool quadrature, bool parity_apart = false);
+
+// The position, in units, of receiver (col, row) of this field, the first of its line of step
+// (a, b) here, along the line through the larger field (HeightField::origin; 0 without one: a
+// line starts at its far end): the units of the periods from it to that line's far end, as
+// horizon_lattice's line_start_position computes them (`table`: latticeRowTables').
+float lineStartPosition(const HeightField& field, const RowTable& table, int a, int b, int col, int row);
 
 // The same for the naive march (horizon_naive with HFVIS_ROW_SPACING), one table per ray
 // direction: per row r, the ground length per pixel along the ray with row r's cell sizes, and

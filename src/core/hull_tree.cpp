@@ -104,19 +104,6 @@ NaiveRowTables naiveRowTables(const HeightField& field, const std::vector<SweepD
   return t;
 }
 
-double groundUnit(const HeightField& field) {
-  const double longest_period = std::hypot(double(kMaxLatticeStep), double(kMaxLatticeStep));
-  double largest_cell = std::max(*std::max_element(field.row_cell_size_x.begin(), field.row_cell_size_x.end()),
-                                 *std::max_element(field.row_cell_size_y.begin(), field.row_cell_size_y.end()));
-  double extent = double(field.width) + field.height;
-  const FieldOrigin& o = field.origin;
-  if (o.present()) {  // the larger field's unit (a chunk sees the positions it sees, shifted)
-    extent = double(o.whole_width) + o.whole_height;
-    if (o.largest_cell > 0.0) largest_cell = o.largest_cell;
-  }
-  return (extent + 2.0 * longest_period) * largest_cell / double(1 << 23);
-}
-
 void followRows(TreeDirection& d, const HeightField& field, const RowTable& rows, double unit,
                 double samples_per_unit, int directions, double curvature, double max_distance) {
   const double n = d.per_period, step = d.lattice.period / n;

@@ -77,14 +77,6 @@ inline HullTreeTuning tuningFor(HullTreeTuning requested, bool row_spacing) {
   return requested;
 }
 
-// The ground length of one position unit on a field with per-row spacing: the field's
-// extent (W + H plus twice the longest lattice period, 64 sqrt 2, in pixels, times the largest
-// cell size) over 2^23, so a line's or ray's position, each of its steps rounded to whole
-// units, stays below 2^24 (checked: checkTreeLimits). A step's ground length is then off by
-// at most half a unit: a relative 2^-24 (W + H + 181) / (the step's pixels). Every run on the
-// field takes the same unit (the tree, the naive march, the horizon lists, any K), so where
-// they sample the same points they see the same positions.
-double groundUnit(const HeightField& field);
 // The naive march's tables on a field with per-row spacing (intervisibility_naive with
 // HFVIS_ROW_SPACING), for every ray, ray after ray: the step units by half row (2 H - 1 per
 // ray, entry k for a step whose middle is at row k / 2), and per row the count factor K w and

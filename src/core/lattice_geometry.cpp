@@ -482,30 +482,52 @@ std::vector<LineChunk> chunkLines(std::vector<LatticeLine>& lines, const std::ve
   return chunks;
 }
 
+namespace {
+
+// (W + H + extra pixels) times the largest per-row cell size, over 2^23: of the larger field
+// (HeightField::origin; a chunk sees the positions it sees).
+double unitOverExtent(const HeightField& field, double extra) {
+  const FieldOrigin& o = field.origin;
+  const bool larger = o.present();
+  const auto& rows_x = larger ? o.row_cell_size_x : field.row_cell_size_x;
+  const auto& rows_y = larger ? o.row_cell_size_y : field.row_cell_size_y;
+  const double largest = std::max(*std::max_element(rows_x.begin(), rows_x.end()),
+                                  *std::max_element(rows_y.begin(), rows_y.end()));
+  const double extent = larger ? double(o.whole_width) + o.whole_height : double(field.width) + field.height;
+  return (extent + extra) * largest / double(1 << 23);
+}
+
+}  // namespace
+
+double groundUnit(const HeightField& field) {
+  return unitOverExtent(field, 2.0 * std::hypot(double(kMaxLatticeStep), double(kMaxLatticeStep)));
+}
+
+double sweepUnit(const HeightField& field) { return unitOverExtent(field, 0.0); }
+
 LatticeWindow latticeWindow(const HeightField& field, const LatticeDirection& d, double max_distance) {
   LatticeWindow w;
   if (max_distance <= 0.0) return w;
-  // Positions along a line are pixels, or ground lengths with per-row spacing; they stay below
-  // 2 (W + H) pixels, times the largest cell size.
-  // (A field cut from a larger one places them along the larger field's lines.)
+  // Positions along a line are pixels, below 2 (W + H), or with per-row spacing units of
+  // sweepUnit, below 2^24. (A field cut from a larger one places them along the larger field's
+  // lines.)
   const bool larger = field.origin.present();
   double unit = d.ground_per_pixel,
          longest = 2.0 * (static_cast<double>(larger ? field.origin.whole_width : field.width) +
                           (larger ? field.origin.whole_height : field.height));
   if (!field.row_cell_size_x.empty()) {
-    unit = 1.0;
-    longest *= std::max(*std::max_element(field.row_cell_size_x.begin(), field.row_cell_size_x.end()),
-                        *std::max_element(field.row_cell_size_y.begin(), field.row_cell_size_y.end()));
+    unit = sweepUnit(field);
+    longest = double(1 << 24);
   }
-  const double pixels = max_distance / unit;
-  if (longest / pixels >= double(1 << 30)) {
+  const double positions = max_distance / unit;
+  if (longest / positions >= double(1 << 30)) {
     std::ostringstream message;
     message << "the maximum distance " << max_distance << " is too short for a field of this size (at least "
             << longest / double(1 << 30) * unit << " ground units)";
     throw InvalidArgument(message.str());
   }
-  w.window = static_cast<float>(pixels);
-  w.inv_window = static_cast<float>(1.0 / pixels);
+  w.window = static_cast<float>(positions);
+  w.inv_window = static_cast<float>(1.0 / positions);
   return w;
 }
 

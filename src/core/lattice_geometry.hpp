@@ -190,12 +190,32 @@ std::pair<int, int> receiversInRows(const LatticeLine& line, int b, int first_ro
 // a time.
 std::size_t lineCapacity(const LatticeLine& line, std::size_t samples_per_period);
 
+// The ground length of one position unit on a field with per-row spacing: the field's
+// extent (W + H plus twice the longest lattice period, 64 sqrt 2, in pixels, times the largest
+// cell size) over 2^23, so a line's or ray's position, each of its steps rounded to whole
+// units, stays below 2^24 (checked: checkTreeLimits). A step's ground length is then off by
+// at most half a unit: a relative 2^-24 (W + H + 181) / (the step's pixels). Every run on the
+// field takes the same unit (the tree, the naive march, the horizon lists, any K), so where they
+// sample the same points they see the same positions; a field cut from a larger one
+// (HeightField::origin) takes the larger field's.
+double groundUnit(const HeightField& field);
+
+// The horizon sweep's unit of position on a field with per-row spacing (HFVIS_ROW_SPACING,
+// latticeRowTables): W + H times the largest cell size over 2^23 (the larger field's with an
+// origin). A lattice line's periods span at most W + H - 2 pixels of columns and rows, so its
+// positions, each period's ground length rounded to whole units (off by half a unit at most),
+// stay below 2^24: exact sums in single precision. A period's ground length is then off by a
+// relative 2^-24 (W + H) (largest cell) / (its own) at most, about what single precision's
+// rounding at the far end of a line gives; finer than groundUnit, whose room for the hull tree's
+// predicate and rays the sweep does not need.
+double sweepUnit(const HeightField& field);
+
 // A maximum distance along direction d as horizon_lattice takes it (HFVIS_MAX_DISTANCE):
-// `window` pixels along the line (max_distance over the ground length per pixel; with per-row
-// spacing, whose positions are ground lengths, max_distance itself) and its
-// reciprocal, whose product with a position is the position's block. Both the kernel and the
-// reference get these very floats. Both 0 without a maximum distance. Throws InvalidArgument
-// when the window is so short that a position's block would overflow an int.
+// `window` position units along the line (pixels: max_distance over the ground length per pixel;
+// with per-row spacing, units of sweepUnit: max_distance over it) and its reciprocal, whose
+// product with a position is the position's block. Both the kernel and the reference get these
+// very floats. Both 0 without a maximum distance. Throws InvalidArgument when the window is so
+// short that a position's block would overflow an int.
 struct LatticeWindow {
   float window = 0.0f, inv_window = 0.0f;
 };

@@ -48,8 +48,10 @@ struct RunDirection {
   std::vector<LatticeLine> lines;                // sweep: the direction's lines over the field
   LatticeWindow window;                          // sweep: the maximum distance along its lines
   int max_steps = kAllSteps;                     // naive march: the steps within the maximum distance
-  // Per-row spacing: ground length and terms by row (latticeRowTables, rayRowTables).
+  // Per-row spacing: length and terms by row (latticeRowTables: units; rayRowTables: ground
+  // lengths), and where the sweep's lines start (RowTable::beyond).
   std::vector<float> row_length, row_terms;
+  std::vector<std::uint32_t> row_beyond;
   int index = 0;  // k
 };
 
@@ -89,7 +91,7 @@ RunPlan planStrips(const HeightField& field, const HorizonOptions& options, cons
   // A receiver's period reaches a step (|b| rows) away, the normals one row; within a maximum
   // distance the window's pass reaches back to the start of the block before, up to two
   // windows and a period along the line.
-  // With per-row spacing the window is a ground length: so many of the shortest periods.
+  // With per-row spacing the window is in units: so many of the shortest periods.
   const bool window = options.max_distance > 0.0, positions = window && hasRowSpacing(field);
   plan.halo_rows = 1;
   for (const RunDirection& d : directions) {
@@ -206,13 +208,24 @@ std::vector<RunDirection> runDirectionsOf(const HeightField& field, const Horizo
       const LatticeDirection& d = directions[k];
       std::vector<CellSegment> segments = cellSegments(d, options.samples_per_unit);
       const std::size_t per_period = stackEntriesPerPeriod(segments);
-      out.push_back({d, SweepDirection{}, latticeSamples(d, options.samples_per_unit), std::move(segments), per_period,
-                     static_cast<float>(std::cos(d.azimuth)), static_cast<float>(std::sin(d.azimuth)),
-                     latticeLines(d, field.width, field.height), latticeWindow(field, d, options.max_distance),
-                     kAllSteps, {}, {}, static_cast<int>(k)});
+      out.push_back({d,
+                     SweepDirection{},
+                     latticeSamples(d, options.samples_per_unit),
+                     std::move(segments),
+                     per_period,
+                     static_cast<float>(std::cos(d.azimuth)),
+                     static_cast<float>(std::sin(d.azimuth)),
+                     latticeLines(d, field.width, field.height),
+                     latticeWindow(field, d, options.max_distance),
+                     kAllSteps,
+                     {},
+                     {},
+                     {},
+                     static_cast<int>(k)});
       if (!rows.empty()) {
         out.back().row_length = std::move(rows[k].length);
         out.back().row_terms = std::move(rows[k].terms);
+        out.back().row_beyond = std::move(rows[k].beyond);
       }
     }
   } else {
@@ -261,10 +274,10 @@ class HorizonRoutine : public SweepRoutine {
     // A window's blocks are per line, so its strips, and with per-row spacing its whole sweep
     // (positions differ by line there), run one line per work-item.
     if ((inStrips() || hasRowSpacing(field)) && options.max_distance > 0.0) lanes_ = 1;
-    // A field cut from a larger one: each line's positions count from its own place there, so a
-    // work-item's lanes take lines that start at the same index there (laneGroups): not in strips,
-    // where lines resume at indices of their own, nor where the lanes' lines together outgrow the
-    // scratch.
+    // A field cut from a larger one: each line's positions count from its own place there, so
+    // (without per-row spacing, whose lanes start at positions of their own) a work-item's lanes
+    // take lines that start at the same index there (laneGroups): not in strips, where lines
+    // resume at indices of their own, nor where the lanes' lines together outgrow the scratch.
     if (shiftedPositions() && (inStrips() || lanes_ * longestLineEntries() > plan_.stack_entries)) lanes_ = 1;
   }
 
@@ -275,9 +288,11 @@ class HorizonRoutine : public SweepRoutine {
   std::string programOptions() const override {
     return detail::programOptions(outputs_, prepared_.has_nodata, lanes_, horizon_.curvature != 0.0,
                                   horizon_.max_distance > 0.0, hasRowSpacing(field_)) +
-           " -DHFVIS_STRIPS=" + std::to_string(inStrips()) + " -DHFVIS_ORIGIN=" + std::to_string(shiftedPositions());
+           " -DHFVIS_STRIPS=" + std::to_string(inStrips()) +
+           " -DHFVIS_ORIGIN=" + std::to_string(field_.origin.present());
   }
-  // Positions along a larger field's lines (HeightField::origin; not with per-row spacing).
+  // Positions along a larger field's lines shared by a work-item's lanes (HeightField::origin; with
+  // per-row spacing each lane starts at its own).
   bool shiftedPositions() const { return field_.origin.present() && !hasRowSpacing(field_); }
   bool heightsResident() const override { return !inStrips(); }
   bool needsNormals() const { return outputs_.ambient_occlusion || outputs_.environment; }
@@ -536,21 +551,31 @@ class HorizonRoutine : public SweepRoutine {
                       cells.data());
   }
 
-  // The unit of positions along lines and rays: pixels of that ground length, or (per-row
-  // spacing) ground units.
-  double positionUnit(double ground_per_pixel) const { return hasRowSpacing(field_) ? 1.0 : ground_per_pixel; }
+  // The ground length of a unit of position along the sweep's lines: pixels of that ground
+  // length, or (per-row spacing) units of sweepUnit.
+  double latticeUnit(double ground_per_pixel) const {
+    return hasRowSpacing(field_) ? sweepUnit(field_) : ground_per_pixel;
+  }
+  // The same along the naive march's rays: pixels, or (per-row spacing) ground units.
+  double rayUnit(double ground_per_pixel) const { return hasRowSpacing(field_) ? 1.0 : ground_per_pixel; }
 
   // The per-row tables of a direction (placeholders without per-row spacing), set as the
-  // kernel's row_length and row_terms; the caller keeps them until the launch.
-  std::array<cl::Buffer, 2> setRowTables(NamedKernel& kernel, const RunDirection& d) {
-    auto table = [&](const std::vector<float>& values) {
+  // kernel's row_length and row_terms (and the sweep's row_beyond); the caller keeps them until
+  // the launch.
+  std::vector<cl::Buffer> setRowTables(NamedKernel& kernel, const RunDirection& d, bool sweep) {
+    auto table = [&](const auto& values) {
       if (values.empty()) return deviceBuffer(st_, 0);
-      return cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, values.size() * sizeof(float),
-                        const_cast<float*>(values.data()));
+      return cl::Buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                        values.size() * sizeof(values[0]),
+                        const_cast<void*>(static_cast<const void*>(values.data())));
     };
-    std::array<cl::Buffer, 2> tables{table(d.row_length), table(d.row_terms)};
+    std::vector<cl::Buffer> tables{table(d.row_length), table(d.row_terms)};
     kernel.set("row_length", tables[0]);
     kernel.set("row_terms", tables[1]);
+    if (sweep) {
+      tables.push_back(table(d.row_beyond));
+      kernel.set("row_beyond", tables[2]);
+    }
     return tables;
   }
 
@@ -600,7 +625,7 @@ class HorizonRoutine : public SweepRoutine {
     kernel.set("a", d.lattice.a);
     kernel.set("b", d.lattice.b);
     kernel.set("period", static_cast<float>(d.lattice.period));
-    const double unit = positionUnit(d.lattice.ground_per_pixel);
+    const double unit = latticeUnit(d.lattice.ground_per_pixel);
     kernel.set("ground_per_pixel", static_cast<float>(unit));
     kernel.set("period_ground", static_cast<float>(d.lattice.period * d.lattice.ground_per_pixel));
     kernel.set("drop", curvatureDrop(unit));
@@ -611,7 +636,7 @@ class HorizonRoutine : public SweepRoutine {
     kernel.set("origin_row", origin.row);
     kernel.set("whole_width", origin.present() ? origin.whole_width : field_.width);
     kernel.set("whole_height", origin.present() ? origin.whole_height : field_.height);
-    for (cl::Buffer& table : setRowTables(kernel, d)) keep.push_back(table);
+    for (cl::Buffer& table : setRowTables(kernel, d, true)) keep.push_back(table);
     setOutputs(kernel, d, plane_offset);
     return kernel;
   }
@@ -668,13 +693,13 @@ class HorizonRoutine : public SweepRoutine {
     const std::size_t per_period = d.stack_per_period;
     // Within a maximum distance the window's pass pushes the samples of the block before, up to a
     // window and two periods of them, above a resumed line's stack.
-    // (With per-row spacing the window is a ground length: so many of the shortest periods.)
+    // (With per-row spacing the window is in units: so many of the shortest periods.)
     const double shortest_period =
         d.row_length.empty() ? d.lattice.period : *std::min_element(d.row_length.begin(), d.row_length.end());
     const std::size_t window_periods =
         horizon_.max_distance > 0.0 ? static_cast<std::size_t>(std::ceil(d.window.window / shortest_period)) + 2 : 0;
     // Each line's sweep so far: (unused, its stack's size, the stack's offset in carry_in,
-    // its ground position's float bits).
+    // its position's float bits).
     std::vector<cl_int4> resume(d.lines.size(), cl_int4{{0, 0, 0, 0}});
     std::vector<char> waiting(d.lines.size(), 0);  // whether its stack waits in carry_in
     cl::Buffer carry_in = placeholder_;
@@ -831,12 +856,12 @@ class HorizonRoutine : public SweepRoutine {
     kernel.set("dir_y", d.ray.dir_y);
     kernel.set("step_length", d.ray.step_length);
     kernel.set("ground_per_pixel", d.ray.ground_per_pixel);
-    kernel.set("drop", curvatureDrop(positionUnit(d.ray.ground_per_pixel)));
+    kernel.set("drop", curvatureDrop(rayUnit(d.ray.ground_per_pixel)));
     kernel.set("max_steps", d.max_steps);
     kernel.set("max_ground", hasRowSpacing(field_) && horizon_.max_distance > 0.0
                                  ? static_cast<float>(horizon_.max_distance)
                                  : std::numeric_limits<float>::infinity());
-    const auto row_tables = setRowTables(kernel, d);
+    const auto row_tables = setRowTables(kernel, d, false);
     setOutputs(kernel, d, plane_offset);
     st_.launch(kernel, cl::NDRange(roundUp(field_.width, kTileX), roundUp(field_.height, kTileY)),
                cl::NDRange(kTileX, kTileY));
