@@ -499,6 +499,29 @@ TEST(Pvs, EstimatedPixelErrorWithinAFactorTwoOfTheMeasured) {
   }
 }
 
+// Where every entry is found many times over (a flat field sees everything), no entry rests on one
+// uniform ray: the estimate is its floor, one entry in the run's uniform rays, and never 0.
+TEST(Pvs, EstimateOfCompleteSetsIsOneRayInTheRun) {
+  HeightField flat;
+  flat.width = 25;
+  flat.height = 17;
+  flat.heights.assign(std::size_t(flat.width) * flat.height, 3.0f);
+  PvsGrid grid;
+  grid.view_cell = 8;
+  grid.tile = 4;
+  for (PvsMethod method : {PvsMethod::Agvs, PvsMethod::Sgvs, PvsMethod::PerCell}) {
+    PvsOptions options;
+    options.method = method;
+    options.samples = 100000;
+    const PvsResult pvs = computePvs(testContext(), flat, grid, options);
+    ASSERT_EQ(pvs.entries(), std::size_t(pvs.layout.viewCells()) * pvs.layout.tiles()) << int(method);
+    ASSERT_GT(pvs.uniform_rays, 0u);
+    EXPECT_EQ(pvs.pixel_error, options.resolution / double(pvs.uniform_rays)) << int(method);
+    // Early in the run entries were still found by one ray alone: the estimate was above its floor.
+    EXPECT_GT(pvs.history.front().pixel_error, pvs.pixel_error) << int(method);
+  }
+}
+
 TEST(Pvs, PixelErrorBudgetStopsTheRun) {
   const HeightField field = smallCity();
   PvsOptions options;

@@ -469,8 +469,11 @@ class Sampler {
         }
     }
     out_.uniform_rays = uniform_rays_;
+    // Never below one entry found once: N rays without one do not tell an error below 1 / N from
+    // 0 (so a --pixel-error budget E asks for 1 / E uniform rays at least).
     if (uniform_rays_ > 0)
-      out_.pixel_error = options_.resolution * double(only_finders_.size()) / double(uniform_rays_);
+      out_.pixel_error = options_.resolution * double(std::max<std::size_t>(1, only_finders_.size())) /
+                         double(uniform_rays_);
     if (options_.method == PvsMethod::Agvs) updateMixture(contribution, drawn);
   }
 
