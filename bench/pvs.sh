@@ -4,8 +4,8 @@
 # reference and the pixel error (estimated and measured) against samples for AGVS, SGVS and
 # per-cell sampling on a city, a rough terrain and the bundled DEM (`hfvis_bench pvs-recall`, into
 # bench/report/pvs_recall_tables.md): at --size with the dense reference, then at --estimate-size
-# with the grid (view cells of 32 x 32 cells, tiles of 16 x 16; the DEM at 320 x 320, within its 403 x 344;
-# largest square) without it (the dense reference is out of reach there), for the estimate alone.
+# with the grid (view cells of 32 x 32 cells, tiles of 16 x 16; the DEM at 320 x 320,
+# within its 403 x 344) without it (the dense reference is out of reach there), for the estimate.
 # Each file starts with a line saying how and when it ran.
 #
 #   bench/pvs.sh [--parts rays,recall] [--size 128] [--estimate-size 1024]
@@ -61,7 +61,7 @@ recall_part() {
   "$bench" pvs-recall --check-rays 4000000 --size "$estimate_size" --view-cell 32 --tile 16 --samples "$samples" --reference no \
     --dem "$dem" city noise
   echo
-  echo "## The pixel error against samples (the DEM at 320 x 320, within its 403 x 344; largest square; no dense reference)"
+  echo "## The pixel error against samples (the DEM at 320 x 320, within its 403 x 344; no dense reference)"
   "$bench" pvs-recall --check-rays 4000000 --size 320 --view-cell 32 --tile 16 --samples "$samples" --reference no --dem "$dem" dem
 }
 for part in ${parts//,/ }; do
