@@ -488,9 +488,10 @@ class Sampler {
   // So the error of the sets now is estimated by the entries that one such ray added and no other
   // sample has found since (Good-Turing's missing mass), over all uniform rays of the run, the
   // early ones included: each is checked against the sets now, so the estimate is of the sets
-  // now, not of when it was cast (Eq. 5's window of the newest rays was: 2 - 700x the measured
-  // error where the error fell fast; bench/report/pvs.md). Found again means by a sample not
-  // descending from the finder by mutation (a mutation of it exists only because it was cast).
+  // now, not of when it was cast (Eq. 5's window of the newest rays estimated the sets' past: up
+  // to 9x the measured error where it fell fast; bench/report/pvs.md). Found again means by a
+  // sample not descending from the finder by mutation (a mutation of it exists only because it
+  // was cast).
   void foundAgain(std::size_t word, std::uint32_t bit, std::size_t entry, std::uint64_t lineage) {
     if (!(only_finder_[word] & bit)) return;
     const auto found = only_finders_.find(entry);
