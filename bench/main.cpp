@@ -103,7 +103,8 @@ constexpr const char* kUsage =
     "                                [--reference-k K] [--reps N] [--curve KMAX]\n"
     "       hfvis_bench pvs-rays [--size N] [--rays R] [--reps K] [--dem FILE] FIELD...\n"
     "       hfvis_bench pvs-recall [--size N] [--view-cell C] [--tile T] [--samples N,N,...]\n"
-    "                              [--check-rays R] [--dem FILE] FIELD...   (FIELD: city, noise, dem)\n"
+    "                              [--check-rays R] [--methods agvs,sgvs,per-cell] [--reference yes|no]\n"
+    "                              [--dem FILE] FIELD...   (FIELD: city, noise, dem)\n"
     "       hfvis_bench region [--sections arealight,arealight-quick,pair,pair-quick,error] [--reps N] "
     "FIELD...\n"
     "       hfvis_bench field NAME N OUT\n"
@@ -463,9 +464,17 @@ int main(int argc, char** argv) {
       for (int n : intList(args.get("--samples", "10000,30000,100000,300000,1000000")))
         samples.push_back(std::uint64_t(n));
       const int check = std::stoi(args.get("--check-rays", "1000000"));
+      std::vector<PvsMethod> methods;
+      for (const std::string& m : textList(args.get("--methods", "agvs,sgvs,per-cell"))) {
+        if (m != "agvs" && m != "sgvs" && m != "per-cell") throw Usage("--methods: agvs, sgvs, per-cell");
+        methods.push_back(m == "agvs" ? PvsMethod::Agvs : m == "sgvs" ? PvsMethod::Sgvs : PvsMethod::PerCell);
+      }
+      const std::string reference = args.get("--reference", "yes");
+      if (reference != "yes" && reference != "no") throw Usage("--reference: yes or no");
       const std::vector<std::string> fields = args.positional();
       args.rejectUnused();
-      pvsRecallReport(context, fields, size, dem, view_cell, tile, samples, check);
+      pvsRecallReport(context, fields, size, dem, view_cell, tile, samples, check, methods,
+                      reference == "yes");
       return 0;
     }
     if (command == "region") {

@@ -1,25 +1,31 @@
 #!/usr/bin/env bash
 # bench/pvs.sh: potentially visible sets (issue 29): the ray caster's rays per second on 1024^2
-# fields, and recall against the dense reference and the pixel error (estimated and measured)
-# against samples for AGVS, SGVS and per-cell sampling on a city, a rough terrain and the
-# bundled DEM (`hfvis_bench pvs-rays`, `hfvis_bench pvs-recall`). Writes bench/report/pvs_tables.md (or
-# --out FILE), the tables after a line saying how and when they ran.
+# fields (`hfvis_bench pvs-rays`, into bench/report/pvs_tables.md), and recall against the dense
+# reference and the pixel error (estimated and measured) against samples for AGVS, SGVS and
+# per-cell sampling on a city, a rough terrain and the bundled DEM (`hfvis_bench pvs-recall`, into
+# bench/report/pvs_recall_tables.md): at --size with the dense reference, then at --estimate-size
+# with the issue's grid (view cells of 32 x 32 cells, tiles of 16 x 16; the DEM at 320 x 320,
+# within its 403 x 344) without it (the dense reference is out of reach there), for the estimate.
+# Each file starts with a line saying how and when it ran.
 #
-#   bench/pvs.sh [--size 128] [--samples 10000,30000,100000,300000,1000000] [--rays 1000000] [--out FILE]
+#   bench/pvs.sh [--parts rays,recall] [--size 128] [--estimate-size 1024]
+#                [--samples 10000,30000,100000,300000,1000000] [--rays 1000000]
 #   BUILD_DIR=... selects the build (default build/).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
+parts=rays,recall
 size=128
+estimate_size=1024
 samples=10000,30000,100000,300000,1000000
 rays=1000000
-out=$root/bench/report/pvs_tables.md
 while [[ $# -gt 0 ]]; do
   case "$1" in
+    --parts) parts=$2; shift ;;
     --size) size=$2; shift ;;
+    --estimate-size) estimate_size=$2; shift ;;
     --samples) samples=$2; shift ;;
     --rays) rays=$2; shift ;;
-    --out) out=$2; shift ;;
-    -h|--help) sed -n '2,9p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
     *) echo "pvs.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
   shift
@@ -31,16 +37,37 @@ export POCL_CACHE_DIR=${POCL_CACHE_DIR:-$root/bench/out/pocl-cache}
 dem=$root/data/jacksboro_fault_dem.exr
 tmp=$(mktemp)
 trap 'rm -f "$tmp"' EXIT
-{
+# Runs the rest of the line into $tmp, then writes it to $1 after a line saying how and when.
+write() {
+  local out=$1
+  shift
+  "$@" > "$tmp"
+  {
+    echo "<!-- bench/pvs.sh --parts $parts --size $size --estimate-size $estimate_size --samples $samples --rays $rays; $(date -u +%Y-%m-%dT%H:%MZ), commit $(git -C "$root" rev-parse --short HEAD) -->"
+    cat "$tmp"
+  } > "$out"
+  echo "pvs.sh: wrote $out (bench/report/pvs.md discusses it)"
+}
+rays_part() {
   echo "## The ray caster"
   echo
   "$bench" pvs-rays --size 1024 --rays "$rays" --reps 2 --dem "$dem" city noise
-  echo
+}
+recall_part() {
   echo "## Recall and pixel error against samples ($size x $size fields)"
-  "$bench" pvs-recall --size "$size" --view-cell 16 --tile 8 --samples "$samples" --dem "$dem" city noise dem
-} > "$tmp"
-{
-  echo "<!-- bench/pvs.sh --size $size --samples $samples --rays $rays; $(date -u +%Y-%m-%dT%H:%MZ), commit $(git -C "$root" rev-parse --short HEAD) -->"
-  cat "$tmp"
-} > "$out"
-echo "pvs.sh: wrote $out (bench/report/pvs.md discusses it)"
+  "$bench" pvs-recall --check-rays 4000000 --size "$size" --view-cell 16 --tile 8 --samples "$samples" --dem "$dem" city noise dem
+  echo
+  echo "## The pixel error against samples ($estimate_size x $estimate_size fields, no dense reference)"
+  "$bench" pvs-recall --check-rays 4000000 --size "$estimate_size" --view-cell 32 --tile 16 --samples "$samples" --reference no \
+    --dem "$dem" city noise
+  echo
+  echo "## The pixel error against samples (the DEM at 320 x 320, within its 403 x 344; no dense reference)"
+  "$bench" pvs-recall --check-rays 4000000 --size 320 --view-cell 32 --tile 16 --samples "$samples" --reference no --dem "$dem" dem
+}
+for part in ${parts//,/ }; do
+  case "$part" in
+    rays) write "$root/bench/report/pvs_tables.md" rays_part ;;
+    recall) write "$root/bench/report/pvs_recall_tables.md" recall_part ;;
+    *) echo "pvs.sh: unknown part '$part' (rays, recall)" >&2; exit 2 ;;
+  esac
+done

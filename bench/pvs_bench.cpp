@@ -11,9 +11,9 @@
 
 #include "hfvis/image_io.hpp"
 #include "hfvis/pvs.hpp"
-#include "ops/pvs_ray.hpp"
 #include "hfvis_testing/pvs_reference.hpp"
 #include "hfvis_testing/synthetic_fields.hpp"
+#include "ops/pvs_ray.hpp"
 
 namespace hfvis::bench {
 namespace {
@@ -49,7 +49,8 @@ HeightField pvsBenchField(const std::string& name, int size, const std::string& 
 void pvsRaysReport(const ComputeContext& context, const std::vector<std::string>& fields, int size,
                    const std::string& dem_path, int rays, int reps) {
   std::printf(
-      "| field | rays | hits | rays/s (hit only) | rays/s (with view cells) | rays per CPU second (hit only) | "
+      "| field | rays | hits | rays/s (hit only) | rays/s (with view cells) | rays per CPU second (hit only) "
+      "| "
       "(with view cells) | rays/s, whole calls (hit only) |\n"
       "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
   for (const std::string& name : fields) {
@@ -84,9 +85,10 @@ void pvsRaysReport(const ComputeContext& context, const std::vector<std::string>
       castHeightFieldRays(context, f, in, plain);
       best_call = std::min(best_call, seconds(t0));
     }
-    std::printf("| %s %dx%d | %d | %.1f %% | %.2fM | %.2fM | %.2fM | %.2fM | %.2fM |\n", name.c_str(), f.width,
-                f.height, rays, 100.0 * double(hits) / rays, rays / best_plain / 1e6, rays / best_listed / 1e6,
-                rays / cpu_plain / 1e6, rays / cpu_listed / 1e6, rays / best_call / 1e6);
+    std::printf("| %s %dx%d | %d | %.1f %% | %.2fM | %.2fM | %.2fM | %.2fM | %.2fM |\n", name.c_str(),
+                f.width, f.height, rays, 100.0 * double(hits) / rays, rays / best_plain / 1e6,
+                rays / best_listed / 1e6, rays / cpu_plain / 1e6, rays / cpu_listed / 1e6,
+                rays / best_call / 1e6);
     std::fflush(stdout);
   }
   std::printf(
@@ -98,41 +100,52 @@ void pvsRaysReport(const ComputeContext& context, const std::vector<std::string>
 
 void pvsRecallReport(const ComputeContext& context, const std::vector<std::string>& fields, int size,
                      const std::string& dem_path, int view_cell, int tile,
-                     const std::vector<std::uint64_t>& samples, int check_rays) {
+                     const std::vector<std::uint64_t>& samples, int check_rays,
+                     const std::vector<PvsMethod>& methods, bool reference) {
   PvsGrid grid;
   grid.view_cell = view_cell;
   grid.tile = tile;
   for (const std::string& name : fields) {
     const HeightField f = pvsBenchField(name, size, dem_path);
     auto t0 = std::chrono::steady_clock::now();
-    const PvsResult dense = computeDensePvs(context, f, grid);
+    const PvsResult dense = reference ? computeDensePvs(context, f, grid) : PvsResult{};
     const double dense_seconds = seconds(t0);
     const std::vector<HeightRay> check = randomViewRays(f, grid, check_rays, 99);
     const RayCastResult check_hits = castHeightFieldRays(context, f, check);
     std::printf("\n### %s %d x %d (view cells %d x %d cells, tiles %d x %d)\n\n", name.c_str(), f.width,
                 f.height, view_cell, view_cell, tile, tile);
-    std::printf("Dense reference: %zu of %d entries (%.1f %%), %.1f s.\n\n", dense.entries(),
-                dense.layout.viewCells() * dense.layout.tiles(),
-                100.0 * double(dense.entries()) / (dense.layout.viewCells() * dense.layout.tiles()),
-                dense_seconds);
+    if (reference)
+      std::printf("Dense reference: %zu of %d entries (%.1f %%), %.1f s.\n\n", dense.entries(),
+                  dense.layout.viewCells() * dense.layout.tiles(),
+                  100.0 * double(dense.entries()) / (dense.layout.viewCells() * dense.layout.tiles()),
+                  dense_seconds);
+    else
+      std::printf("(no dense reference: recall not measured)\n\n");
     std::printf(
-        "| sampler | samples | rays | recall | estimated pixel error | measured pixel error | seconds |\n"
-        "| --- | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+        "| sampler | samples | rays | recall | estimated pixel error | its rays: found once / uniform | "
+        "measured "
+        "pixel error | its rays: wrong | seconds |\n"
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
     PvsResult last_agvs;
-    for (PvsMethod method : {PvsMethod::Agvs, PvsMethod::Sgvs, PvsMethod::PerCell}) {
+    for (PvsMethod method : methods) {
       for (std::uint64_t n : samples) {
         PvsOptions options;
         options.method = method;
         options.samples = n;
         const PvsResult pvs = computePvs(context, f, grid, options);
-        std::printf("| %s | %llu | %llu | %.4f | %.0f | %.0f | %.2f |\n", methodName(method),
-                    static_cast<unsigned long long>(n), static_cast<unsigned long long>(pvs.rays),
-                    pvsRecall(pvs, dense), pvs.pixel_error,
-                    measuredPixelError(f, pvs, check, check_hits, options.resolution), pvs.seconds);
+        const std::string recall = reference ? std::to_string(pvsRecall(pvs, dense)).substr(0, 6) : "-";
+        const double measured = measuredPixelError(f, pvs, check, check_hits, options.resolution);
+        std::printf("| %s | %llu | %llu | %s | %.1f | %.0f / %llu | %.1f | %.0f | %.2f |\n",
+                    methodName(method), static_cast<unsigned long long>(n),
+                    static_cast<unsigned long long>(pvs.rays), recall.c_str(), pvs.pixel_error,
+                    pvs.pixel_error * double(pvs.uniform_rays) / options.resolution,
+                    static_cast<unsigned long long>(pvs.uniform_rays), measured,
+                    measured * double(check.size()) / options.resolution, pvs.seconds);
         std::fflush(stdout);
         if (method == PvsMethod::Agvs) last_agvs = pvs;
       }
     }
+    if (last_agvs.history.empty()) continue;
     std::printf("\nAGVS's mixture over its %llu-sample run (per batch of 65536 samples):\n\n| samples |",
                 static_cast<unsigned long long>(samples.back()));
     for (int d = 0; d < kPvsDistributions; ++d) std::printf(" %s |", pvsDistributionName(d));

@@ -9,6 +9,7 @@
 
 #include "hfvis/device.hpp"
 #include "hfvis/height_field.hpp"
+#include "hfvis/pvs.hpp"
 
 namespace hfvis::bench {
 
@@ -24,9 +25,11 @@ void pvsRaysReport(const ComputeContext& context, const std::vector<std::string>
 
 // Markdown on stdout: per field, the dense reference's size and time, then for each sampler and
 // budget in `samples` the recall, the estimated and measured pixel error (`check_rays` random
-// view rays), entries and seconds; and AGVS's mixture over its last run.
+// view rays), entries and seconds; and AGVS's mixture over its last run. Only the samplers in
+// `methods`; without `reference` no dense reference and no recall (fields too large for it).
 void pvsRecallReport(const ComputeContext& context, const std::vector<std::string>& fields, int size,
                      const std::string& dem_path, int view_cell, int tile,
-                     const std::vector<std::uint64_t>& samples, int check_rays);
+                     const std::vector<std::uint64_t>& samples, int check_rays,
+                     const std::vector<PvsMethod>& methods, bool reference);
 
 }  // namespace hfvis::bench

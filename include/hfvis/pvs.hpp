@@ -156,6 +156,10 @@ struct PvsResult {
   std::uint64_t rejected = 0;  // candidate entries whose witness failed the line-of-sight test
   std::uint64_t filtered = 0;  // entries the visibility filter added (no witness)
   double pixel_error = 0.0;    // the estimate at the end (NaN before any estimate)
+  // The uniform view rays the estimate rests on (view-direction and per-cell samples' rays): it is
+  // pixel_error * uniform_rays / resolution of them that found an entry no other sample found
+  // (never below 1: N rays do not tell an error below 1 / N from 0).
+  std::uint64_t uniform_rays = 0;
   double seconds = 0.0;
   std::vector<PvsWitness> witnesses;  // with PvsOptions::witnesses: one per sampled entry
   std::vector<PvsProgress> history;

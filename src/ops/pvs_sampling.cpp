@@ -10,6 +10,7 @@
 #include <deque>
 #include <limits>
 #include <string>
+#include <unordered_map>
 
 #include "hfvis/errors.hpp"
 #include "hfvis/pvs.hpp"
@@ -26,15 +27,9 @@ constexpr double kMinProbability = 0.02;
 constexpr std::size_t kMutationCandidates = 1 << 16;
 // Discovery rays per silhouette mutation (Sec. 4.4: a search along the perpendicular).
 constexpr int kDiscoveryRays = 4;
-// The pixel-error window (Sec. 4.5, Eq. 5): P = 0.9, k = 0.5.
-constexpr double kWindowP = 0.9, kWindowK = 0.5;
-// The window's longest reach back: this share of the run's view-direction rays, the newest.
-constexpr double kWindowRecent = 0.25;
-// Samples per entry of the window (as folded in, in order).
-constexpr int kErrorChunk = 1024;
 // The view space-direction samples' least probability in the mixture: the pixel error is
-// estimated from them alone (Sec. 4.5), and at the common floor (kMinProbability) late in a run
-// too few are cast for the window to hold a current estimate.
+// estimated from them alone (Sec. 4.5), and at the common floor (kMinProbability) so few are
+// cast late in a run that an error of a few per million rests on no contributing ray at all.
 constexpr double kMinViewDirection = 0.1;
 
 enum Distribution { kViewDirection, kObjectDirection, kTwoPoint, kTwoPointMutation, kSilhouetteMutation };
@@ -79,7 +74,8 @@ class Random {
 struct MutationCandidate {
   Vec origin, target;  // s_o, s_t
   double origin_radius = 0, target_radius = 0;
-  int tile = 0;  // the object at s_t
+  int tile = 0;               // the object at s_t
+  std::uint64_t lineage = 0;  // the sample it descends from (Sampler::lineage)
 };
 
 // Candidates by mutation count: the least mutated first (Sec. 4.4).
@@ -119,6 +115,9 @@ struct Sample {
   Vec origin, direction;  // ground units
   int distribution = kViewDirection;
   int view_cell = -1;  // per-cell samples: the view cell fed
+  // The first sample of its line of mutations (itself when not a mutation): the pixel error's
+  // leave-one-out does not count a sample's own mutations as finding its entry again.
+  std::uint64_t lineage = 0;
 };
 
 class Sampler {
@@ -129,6 +128,7 @@ class Sampler {
     const PvsLayout& l = out_.layout;
     out_.words = (l.tiles() + 31) / 32;
     out_.bits.assign(std::size_t(l.viewCells()) * out_.words, 0u);
+    only_finder_ = out_.bits;
     out_.computed = grid.mask.empty() ? std::vector<std::uint8_t>(l.viewCells(), 1) : grid.mask;
     out_.pixel_error = std::numeric_limits<double>::quiet_NaN();
     heights_ = detail::rayHeights(field);
@@ -282,6 +282,7 @@ class Sampler {
       }
       case kTwoPointMutation: {
         const MutationCandidate c = mutations_.take();
+        s.lineage = c.lineage;
         const Vec axis = c.target - c.origin;
         const Vec so = perpendicularGaussian(c.origin, axis, c.origin_radius);
         const Vec st = perpendicularGaussian(c.target, axis, c.target_radius);
@@ -292,6 +293,7 @@ class Sampler {
       case kSilhouetteMutation: {
         // The discovery rays are cast first (silhouette()); here the candidate and the direction.
         const MutationCandidate c = mutations_.take();
+        s.lineage = c.lineage;
         const Vec axis = c.target - c.origin;
         const Vec off = perpendicularGaussian(Vec{}, axis, 1.0);
         silhouettes_.push_back({c, unit(off.x == 0 && off.y == 0 && off.z == 0 ? Vec{1, 0, 0} : off)});
@@ -343,9 +345,17 @@ class Sampler {
   // ---- Folding results in
 
   // Adds tile `tile` to view cell v with the witness (eye, target) when it is new and the witness
-  // passes the exact line-of-sight test; 1 when added.
-  int add(int v, int tile, float ex, float ey, float ez, float tx, float ty) {
-    if (!out_.computed[v] || out_.visible(v, tile)) return 0;
+  // passes the exact line-of-sight test; 1 when added. `lineage` is the sample's (Sample::lineage);
+  // `uniform` says that the sample is a uniform view ray from v (the pixel error's rays).
+  int add(int v, int tile, float ex, float ey, float ez, float tx, float ty, std::uint64_t lineage,
+          bool uniform) {
+    if (!out_.computed[v]) return 0;
+    const std::size_t word = std::size_t(v) * out_.words + tile / 32;
+    const std::uint32_t bit = 1u << (tile % 32);
+    if (out_.bits[word] & bit) {
+      foundAgain(word, bit, std::size_t(v) * out_.layout.tiles() + tile, lineage);
+      return 0;
+    }
     // The eye into the band over its point (the caster's t puts it there to rounding).
     const float s = surface(ex, ey), tz = surface(tx, ty);
     if (std::isnan(s) || std::isnan(tz)) return 0;
@@ -356,7 +366,11 @@ class Sampler {
       ++out_.rejected;
       return 0;
     }
-    out_.bits[std::size_t(v) * out_.words + tile / 32] |= 1u << (tile % 32);
+    out_.bits[word] |= bit;
+    if (uniform) {
+      only_finder_[word] |= bit;
+      only_finders_[std::size_t(v) * out_.layout.tiles() + tile] = lineage;
+    }
     if (options_.witnesses) {
       PvsWitness w;
       w.view_cell = v;
@@ -370,7 +384,10 @@ class Sampler {
 
   void batch(detail::RayCaster& caster, int n) {
     std::vector<Sample> samples(n);
-    for (Sample& s : samples) s = draw();
+    for (int i = 0; i < n; ++i) {
+      samples[i] = draw();
+      if (samples[i].lineage == 0) samples[i].lineage = out_.samples + std::uint64_t(i) + 1;
+    }
     silhouettes(caster, samples);
     const bool global = options_.method != PvsMethod::PerCell;
     std::vector<HeightRay> rays;
@@ -384,23 +401,16 @@ class Sampler {
     out_.samples += std::uint64_t(n);
     const PvsLayout& l = out_.layout;
     std::vector<double> contribution(kPvsDistributions, 0.0), drawn(kPvsDistributions, 0.0);
-    std::uint64_t window_rays = 0, window_contributing = 0;
     for (int i = 0; i < n; ++i) {
-      if (i % kErrorChunk == 0) {
-        recordError(window_rays, window_contributing);
-        window_rays = window_contributing = 0;
-      }
       const Sample& s = samples[i];
       drawn[s.distribution] += 1.0;
       if (!global) {
         const std::size_t k = std::size_t(i);
         const HeightRay& q = rays[k];
-        int c = 0;
         if (r.cell[k] >= 0)
-          c = add(s.view_cell, l.tileOfCell(r.cell[k]), q.ox, q.oy, q.oz, q.ox + r.t[k] * q.dx,
-                  q.oy + r.t[k] * q.dy);
-        ++window_rays;
-        window_contributing += std::uint64_t(c);
+          add(s.view_cell, l.tileOfCell(r.cell[k]), q.ox, q.oy, q.oz, q.ox + r.t[k] * q.dx,
+              q.oy + r.t[k] * q.dy, s.lineage, true);
+        ++uniform_rays_;
         continue;
       }
       // The segment's two ends: ray k = 2i forward, 2i + 1 reverse.
@@ -418,12 +428,10 @@ class Sampler {
         // each sees this end through the origin.
         if (s.distribution == kViewDirection || s.distribution == kTwoPoint) {
           const HeightRay& o = rays[2 * std::size_t(i)];
-          const int c = add(origin_view, tile, o.ox, o.oy, o.oz, tx, ty);
+          const int c =
+              add(origin_view, tile, o.ox, o.oy, o.oz, tx, ty, s.lineage, s.distribution == kViewDirection);
           end_contribution[end] += c;
           total += c;
-          // The pixel error's contributing rays: a view-direction ray whose own view cell (the
-          // origin's) gained its hit.
-          if (s.distribution == kViewDirection) window_contributing += std::uint64_t(c);
         }
         for (int side = 0; side < 2; ++side) {
           const std::size_t m = 2 * std::size_t(i) + side;
@@ -431,13 +439,14 @@ class Sampler {
           for (std::size_t j = r.first[m]; j < r.first[m + 1]; ++j) {
             const int v = r.view_cell[j];
             const float t = r.view_t[j];
-            const int c = add(v, tile, p.ox + t * p.dx, p.oy + t * p.dy, p.oz + t * p.dz, tx, ty);
+            const int c =
+                add(v, tile, p.ox + t * p.dx, p.oy + t * p.dy, p.oz + t * p.dz, tx, ty, s.lineage, false);
             end_contribution[end] += c;
             total += c;
           }
         }
       }
-      if (s.distribution == kViewDirection) window_rays += 2;
+      if (s.distribution == kViewDirection) uniform_rays_ += 2;
       contribution[s.distribution] += total;
       // Mutation candidates (Sec. 4.4): each end that contributed, the other end its origin.
       if (options_.method == PvsMethod::Agvs)
@@ -447,6 +456,7 @@ class Sampler {
           MutationCandidate c;
           c.target = hitPoint(rays[k], r.t[k]);
           c.tile = l.tileOfCell(r.cell[k]);
+          c.lineage = s.lineage;
           c.target_radius = tile_radius_;
           if (r.cell[o] >= 0) {
             c.origin = hitPoint(rays[o], r.t[o]);
@@ -458,8 +468,12 @@ class Sampler {
           mutations_.add(c);
         }
     }
-    recordError(window_rays, window_contributing);
-    updateError();
+    out_.uniform_rays = uniform_rays_;
+    // Never below one entry found once: N rays without one do not tell an error below 1 / N from
+    // 0 (so a --pixel-error budget E asks for 1 / E uniform rays at least).
+    if (uniform_rays_ > 0)
+      out_.pixel_error = options_.resolution * double(std::max<std::size_t>(1, only_finders_.size())) /
+                         double(uniform_rays_);
     if (options_.method == PvsMethod::Agvs) updateMixture(contribution, drawn);
   }
 
@@ -468,35 +482,22 @@ class Sampler {
     return ground(x, y, q.oz + double(t) * q.dz);
   }
 
-  // The view-direction rays of the newest kErrorChunk samples and those of them that contributed.
-  void recordError(std::uint64_t rays, std::uint64_t contributing) {
-    if (rays == 0) return;
-    window_.push_front({rays, contributing});
-    view_rays_ += rays;
-  }
-
-  // Sec. 4.5: the error from the newest view-direction rays, as many as Eq. 5 asks for the error
-  // they give, but not past the newest kWindowRecent of the run's: the error falls as the sets
-  // fill, and a window reaching back to when they were far from complete estimates the error of
-  // then (counted in chunks of kErrorChunk samples, so that a window may end inside a batch).
-  void updateError() {
-    if (window_.empty()) return;
-    const double reach = kWindowRecent * double(view_rays_);
-    std::uint64_t n = 0, c = 0, held = 0;
-    std::size_t kept = 0;
-    bool enough = false;
-    for (const auto& w : window_) {
-      if (kept > 0 && double(held + w.first) > reach) break;  // out of reach from now on
-      held += w.first;
-      ++kept;
-      if (enough) continue;
-      n += w.first;
-      c += w.second;
-      const double e = double(c) / double(n);
-      enough = e > 0.0 && double(n) >= (1.0 - e) / (kWindowK * kWindowK * e * (1.0 - kWindowP));
-    }
-    window_.resize(kept);
-    out_.pixel_error = options_.resolution * double(c) / double(n);
+  // Sec. 4.5's pixel error, estimated by leaving one sample out: a uniform view ray (the
+  // view-direction samples, and every per-cell sample) from view cell v that hits tile t would
+  // be a wrong pixel for the sets without it exactly when its (v, t) is in them only through it.
+  // So the error of the sets now is estimated by the entries that one such ray added and no other
+  // sample has found since (Good-Turing's missing mass), over all uniform rays of the run, the
+  // early ones included: each is checked against the sets now, so the estimate is of the sets
+  // now, not of when it was cast (Eq. 5's window of the newest rays estimated the sets' past: up
+  // to 9x the measured error where it fell fast; bench/report/pvs.md). Found again means by a
+  // sample not descending from the finder by mutation (a mutation of it exists only because it
+  // was cast).
+  void foundAgain(std::size_t word, std::uint32_t bit, std::size_t entry, std::uint64_t lineage) {
+    if (!(only_finder_[word] & bit)) return;
+    const auto found = only_finders_.find(entry);
+    if (found->second == lineage) return;
+    only_finders_.erase(found);
+    only_finder_[word] &= ~bit;
   }
 
   // Sec. 4.2 with the window one batch: weight = contribution per sample per cost, the cost
@@ -578,8 +579,11 @@ class Sampler {
   double last_weight_[kPvsDistributions] = {0, 0, 0, 0, 0};
   MutationBuffer mutations_;
   std::vector<Silhouette> silhouettes_;
-  std::deque<std::pair<std::uint64_t, std::uint64_t>> window_;
-  std::uint64_t view_rays_ = 0;  // view-direction rays cast so far
+  std::uint64_t uniform_rays_ = 0;  // uniform view rays cast so far (foundAgain)
+  // The entries only one uniform view ray has found (foundAgain): a bit per entry as out_.bits,
+  // and the finder's lineage by entry (v * tiles + t).
+  std::vector<std::uint32_t> only_finder_;
+  std::unordered_map<std::size_t, std::uint64_t> only_finders_;
 };
 
 }  // namespace
