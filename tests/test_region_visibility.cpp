@@ -651,7 +651,22 @@ TEST_P(RegionMethods, LightColoursMatchTheReference) {
       light.rectangle = {14, 30, 6, 24};  // corners in any order
       light.samples = 40;
       light.height = 6.0;
-      if (std::string(name) == "nan_holes") light = sourcesIn(field, 40, 6.0, false);
+      // nan_holes: the first 5 x 3 rectangle of valid points, scanning rows.
+      const bool holes = std::string(name) == "nan_holes";
+      for (int r = 0; holes && r + 2 < field.height; ++r)
+        for (int c = 0; c + 4 < field.width; ++c) {
+          bool valid = true;
+          for (int y = r; y <= r + 2 && valid; ++y)
+            for (int x = c; x <= c + 4; ++x) valid = valid && std::isfinite(field.at(x, y));
+          if (valid) {
+            light.rectangle = {c + 4, r + 2, c, r};
+            r = field.height;
+            break;
+          }
+        }
+      ASSERT_NO_THROW(validate(field, light));
+      ASSERT_EQ(holes, std::any_of(field.heights.begin(), field.heights.end(),
+                                   [](float v) { return std::isnan(v); }));
       RegionVisibilityOptions options;
       options.method = GetParam();
       options.seed = 3;
