@@ -375,8 +375,9 @@ ArrayOf<double> regionPoints(const std::vector<RegionPoint>& points) {
 }
 
 // light_image: None, or the light's colours as 3 x rows x columns (R, G, B planes).
-nb::dict regionVisibility(const HeightField& field, const RegionSampling& sources, RegionVisibilityOptions options,
-                          const std::string& device, nb::object progress, nb::object light_image) {
+nb::dict regionVisibility(const HeightField& field, const RegionSampling& sources,
+                          RegionVisibilityOptions options, const std::string& device, nb::object progress,
+                          nb::object light_image) {
   options.progress = progressHook(progress);
   if (!light_image.is_none()) {
     const Planes rgb = nb::cast<Planes>(light_image);
