@@ -656,6 +656,11 @@ const std::vector<OptionSpec>& optionTable() {
        "the light's samples, one col,row[,height] a line (a header line\n"
        "allowed; fractional columns and rows lie between pixel centres)",
        HFVIS_TEXT(sources_file)},
+      {"--light-image", nullptr, "FILE", kAreaLightGroup, false,
+       "colours the --light rectangle: an R, G, B image (or one grey\n"
+       "channel) stretched over it; adds channels R, G, B, the light's\n"
+       "colours each pixel sees, summed over the samples / N",
+       HFVIS_TEXT(light_image)},
       {"--target-height", nullptr, "T", kAreaLightGroup, false,
        "every pixel receives T above the surface (default 0)",
        [](const std::string& typed, const std::string& value, RunArguments& run) {

@@ -124,6 +124,7 @@ struct RunArguments {
   double light_height = RegionSampling{}.height;
   double from_height = RegionSampling{}.height, to_height = RegionSampling{}.height;
   std::string sources_file, masks_output, rays_output;
+  std::string light_image;  // arealight --light-image: the light's colours
   bool decorrelate = false;
   // pvs (hfvis/pvs.hpp): the view cells (--view-cell C, --view-height H0[,H1], --view-mask FILE)
   // and tiles (--tile T); the sampler (--method agvs|sgvs|per-cell) and its budgets (--samples N,

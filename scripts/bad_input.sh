@@ -205,6 +205,11 @@ try "arealight source outside the field" "" -- arealight field.exr -o out/o.exr 
 try "arealight source on nodata" "" -- arealight nan.exr -o out/o.exr --sources nodata_source.csv
 try "arealight viewsheds for a jittered light" "" -- arealight field.exr -o out/o.exr --light 1,1,4,4 --method viewsheds
 try "arealight masks an 8-bit image" "" -- arealight field.exr -o out/o.exr --light 1,1,4,4 --masks out/m.png
+try "arealight light image missing" "" -- arealight field.exr -o out/o.exr --light 1,1,4,4 --light-image absent.exr
+try "arealight light image with two channels" "" -- arealight field.exr -o out/o.exr --light 1,1,4,4 --light-image two_channels.png
+try "arealight light image with a negative value" "" -- arealight field.exr -o out/o.exr --light 1,1,4,4 --light-image negative.exr
+try "arealight light image with a NaN" "" -- arealight field.exr -o out/o.exr --light 1,1,4,4 --light-image nan.exr
+try "arealight light image over sources" "" -- arealight field.exr -o out/o.exr --sources outside_sources.csv --light-image field.exr
 try "region without --to" "" -- region field.exr -o out/r.json --from 1,1,4,4
 try "region rectangle outside the field" "" -- region field.exr -o out/r.json --from 1,1,4,4 --to 200,200,300,210
 try "region output not JSON" "" -- region field.exr -o out/r.exr --from 1,1,4,4 --to 8,8,9,9

@@ -1,10 +1,12 @@
 // region_visibility_reference.cpp: see hfvis_testing/region_visibility_reference.hpp.
 #include "hfvis_testing/region_visibility_reference.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "core/sweep_geometry.hpp"
+#include "hfvis/errors.hpp"
 #include "ops/region_visibility_sight.hpp"
 
 namespace hfvis {
@@ -37,6 +39,30 @@ struct Pairs {
 
 int popcount(std::uint32_t v) { return __builtin_popcount(v); }
 
+// Channel c of the light image at (x, y) over the rectangle of `table`, straight from
+// LightImage's definition: the image's texel centres spread over the rectangle, bilinear between
+// the four around (x, y), the edge texels held beyond the outermost centres.
+double lightValue(const LightImage& image, const std::vector<float>& table, int c, double x, double y) {
+  const auto axis = [](double at, double lo, double hi, int n, int& i0, int& i1, double& f) {
+    const double centre0 = lo + 0.5 * (hi - lo) / n;  // texel 0's centre
+    const double step = (hi - lo) / n;
+    double t = step > 0.0 ? (at - centre0) / step : 0.5 * n - 0.5;
+    t = std::fmax(0.0, std::fmin(t, n - 1.0));
+    i0 = static_cast<int>(std::floor(t));
+    i1 = std::min(i0 + 1, n - 1);
+    f = t - i0;
+  };
+  int i0, i1, j0, j1;
+  double fx, fy;
+  axis(x, table[0], table[2], image.width, i0, i1, fx);
+  axis(y, table[1], table[3], image.height, j0, j1, fy);
+  const auto v = [&](int i, int j) {
+    return double(image.rgb[(std::size_t(c) * image.height + j) * image.width + i]);
+  };
+  return (1 - fx) * (1 - fy) * v(i0, j0) + fx * (1 - fy) * v(i1, j0) + (1 - fx) * fy * v(i0, j1) +
+         fx * fy * v(i1, j1);
+}
+
 }  // namespace
 
 RegionVisibilityResult referenceRegionVisibility(const HeightField& field, const RegionSampling& sources,
@@ -53,6 +79,11 @@ RegionVisibilityResult referenceRegionVisibility(const HeightField& field, const
   out.bits.assign(field.pixelCount() * out.words, 0u);
   out.fraction.resize(field.pixelCount());
   const Pairs pairs{field, heights, options, table, sources.absolute};
+  const bool coloured = options.light_image.width > 0;
+  if (coloured && !sources.points.empty())
+    throw InvalidArgument("a light image lies over a rectangle light, not over explicit points");
+  if (coloured)
+    for (auto* plane : {&out.red, &out.green, &out.blue}) plane->resize(field.pixelCount());
   for (std::size_t p = 0; p < field.pixelCount(); ++p) {
     const float x = float(p % field.width), y = float(p / field.width);
     const float z = heights[p] + float(options.target_height);
@@ -62,6 +93,21 @@ RegionVisibilityResult referenceRegionVisibility(const HeightField& field, const
     for (int w = 0; w < out.words; ++w) seen += popcount(words[w]);
     out.fraction[p] = std::isnan(heights[p]) ? std::numeric_limits<float>::quiet_NaN()
                                              : static_cast<float>(static_cast<double>(seen) / out.samples);
+    if (!coloured) continue;
+    // Per channel the colours of the visible samples, at their own positions, over S.
+    std::vector<float>* planes[3] = {&out.red, &out.green, &out.blue};
+    for (int c = 0; c < 3; ++c) {
+      double sum = 0.0;
+      for (int s = 0; s < out.samples; ++s) {
+        if (!((words[s / 32] >> (s % 32)) & 1u)) continue;
+        float xs, ys, zs;
+        detail::region_sample(table.data(), heights.data(), field.width, field.height, sources.absolute,
+                              options.seed, options.decorrelate ? unsigned(p) + 1u : 0u, s, &xs, &ys, &zs);
+        sum += lightValue(options.light_image, table, c, xs, ys);
+      }
+      (*planes[c])[p] = std::isnan(heights[p]) ? std::numeric_limits<float>::quiet_NaN()
+                                               : static_cast<float>(sum / out.samples);
+    }
   }
   return out;
 }

@@ -2389,6 +2389,69 @@ TEST_F(Cli, AreaLightOnFlatGroundSeesEverySample) {
   EXPECT_TRUE(fs::exists(out("a.png")));
 }
 
+TEST_F(Cli, AreaLightImageColoursTheLight) {
+  // A 3 x 2 RGB image over the light behind the wall: channels R, G, B as the library's, and a
+  // grey image the same value in all three.
+  const std::string field = writeField("wall.exr", kWallWidth, kWallHeight, wallHeight);
+  hfvis::ImageChannels image;
+  image.width = 3;
+  image.height = 2;
+  image.names = {"R", "G", "B"};
+  image.planes = {{1, 2, 3, 4, 5, 6}, {0, 0, 1, 1, 0, 0}, {0.5f, 0.25f, 0, 0, 2, 8}};
+  hfvis::writeImage(in("light.exr"), image);
+  const CliResult r = run("arealight " + shellQuoted(field) + " -o " + shellQuoted(out("a.exr")) +
+                          " --light 1,2,3,9 --light-height 1 --samples 37 --decorrelate --light-image " +
+                          shellQuoted(in("light.exr")) + " -q");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const ReadBack a = readBack(out("a.exr"));
+  // (an EXR lists R, G, B first)
+  ASSERT_EQ(a.channels, (std::vector<std::string>{"R", "G", "B", "visible"}));
+  EXPECT_EQ(a.spec.get_string_attribute("hfvis:light_image"), in("light.exr"));
+  const hfvis::HeightField f = hfvis::readHeightField(field);
+  hfvis::RegionSampling light;
+  light.rectangle = {1, 2, 3, 9};
+  light.height = 1.0;
+  light.samples = 37;
+  hfvis::RegionVisibilityOptions options;
+  options.decorrelate = true;
+  options.light_image.width = 3;
+  options.light_image.height = 2;
+  for (const auto& plane : image.planes)
+    options.light_image.rgb.insert(options.light_image.rgb.end(), plane.begin(), plane.end());
+  const hfvis::RegionVisibilityResult lib =
+      hfvis::computeRegionVisibility(hfvis::testing::testContext(), f, light, options);
+  for (int y = 0; y < kWallHeight; ++y)
+    for (int x = 0; x < kWallWidth; ++x) {
+      const std::size_t p = std::size_t(y) * kWallWidth + x;
+      ASSERT_EQ(a.at(x, y, 0), lib.red[p]) << x << "," << y;
+      ASSERT_EQ(a.at(x, y, 1), lib.green[p]) << x << "," << y;
+      ASSERT_EQ(a.at(x, y, 2), lib.blue[p]) << x << "," << y;
+      ASSERT_EQ(a.at(x, y, 3), lib.fraction[p]) << x << "," << y;
+    }
+  EXPECT_GT(a.at(5, 5, 0), 0.0f);  // lit in front of the wall, dark behind
+  EXPECT_EQ(a.at(12, 5, 0), 0.0f);
+  // One grey channel: R = G = B.
+  hfvis::ImageChannels grey;
+  grey.width = 2;
+  grey.height = 2;
+  grey.names = {"Y"};
+  grey.planes = {{1, 3, 0.5f, 2}};
+  hfvis::writeImage(in("grey.exr"), grey);
+  ASSERT_EQ(run("arealight " + shellQuoted(field) + " -o " + shellQuoted(out("g.exr")) +
+                " --light 1,2,3,9 --light-height 1 --samples 37 --light-image " +
+                shellQuoted(in("grey.exr")) + " -q")
+                .status,
+            0);
+  const ReadBack g = readBack(out("g.exr"));
+  ASSERT_EQ(g.channels, (std::vector<std::string>{"R", "G", "B", "visible"}));
+  for (int y = 0; y < kWallHeight; ++y)
+    for (int x = 0; x < kWallWidth; ++x) {
+      ASSERT_EQ(g.at(x, y, 0), g.at(x, y, 1));
+      ASSERT_EQ(g.at(x, y, 0), g.at(x, y, 2));
+    }
+  EXPECT_GT(g.at(5, 5, 0), 0.0f);
+}
+
 TEST_F(Cli, AreaLightBehindAWallIsHiddenAndAgreesWithTheLibrary) {
   const std::string field = writeField("wall.exr", kWallWidth, kWallHeight, wallHeight);
   // The light on the ground's near side, 1 above it: the wall hides it from the ground behind.

@@ -610,6 +610,138 @@ TEST(RegionVisibility, ManySamplesAndDecorrelation) {
   }
 }
 
+// A light image of width x height texels, each channel a different pattern of positive values.
+LightImage patternImage(int width, int height) {
+  LightImage image;
+  image.width = width;
+  image.height = height;
+  for (int c = 0; c < 3; ++c)
+    for (int j = 0; j < height; ++j)
+      for (int i = 0; i < width; ++i) image.rgb.push_back(0.25f + float((i * (c + 2) + j * (3 - c)) % 7));
+  return image;
+}
+
+// Colours equal to the reference's (NaN where NaN), within the rounding of two ways of writing
+// the bilinear lookup; the bits already compared.
+void expectSameColours(const RegionVisibilityResult& got, const RegionVisibilityResult& want) {
+  const std::vector<float>* got_planes[3] = {&got.red, &got.green, &got.blue};
+  const std::vector<float>* want_planes[3] = {&want.red, &want.green, &want.blue};
+  for (int c = 0; c < 3; ++c) {
+    ASSERT_EQ(got_planes[c]->size(), got.fraction.size());
+    ASSERT_EQ(want_planes[c]->size(), got.fraction.size());
+    for (std::size_t p = 0; p < got.fraction.size(); ++p) {
+      const float a = (*got_planes[c])[p], b = (*want_planes[c])[p];
+      if (std::isnan(a) || std::isnan(b)) {
+        ASSERT_TRUE(std::isnan(a) && std::isnan(b) && std::isnan(got.fraction[p]))
+            << "channel " << c << " at " << p << ": " << a << " vs " << b;
+        continue;
+      }
+      ASSERT_NEAR(a, b, 1e-5 * (1.0 + std::fabs(b))) << "channel " << c << " at " << p;
+    }
+  }
+}
+
+TEST_P(RegionMethods, LightColoursMatchTheReference) {
+  std::size_t partial = 0;
+  forEachLayout([&](const ComputeContext& context) {
+    for (const char* name : {"city", "nan_holes"}) {
+      SCOPED_TRACE(name);
+      const HeightField field = makeSyntheticField(name, 40, 41, 3);
+      RegionSampling light;
+      light.rectangle = {14, 30, 6, 24};  // corners in any order
+      light.samples = 40;
+      light.height = 6.0;
+      // nan_holes: the first 5 x 3 rectangle of valid points, scanning rows.
+      const bool holes = std::string(name) == "nan_holes";
+      for (int r = 0; holes && r + 2 < field.height; ++r)
+        for (int c = 0; c + 4 < field.width; ++c) {
+          bool valid = true;
+          for (int y = r; y <= r + 2 && valid; ++y)
+            for (int x = c; x <= c + 4; ++x) valid = valid && std::isfinite(field.at(x, y));
+          if (valid) {
+            light.rectangle = {c + 4, r + 2, c, r};
+            r = field.height;
+            break;
+          }
+        }
+      ASSERT_NO_THROW(validate(field, light));
+      ASSERT_EQ(holes, std::any_of(field.heights.begin(), field.heights.end(),
+                                   [](float v) { return std::isnan(v); }));
+      RegionVisibilityOptions options;
+      options.method = GetParam();
+      options.seed = 3;
+      options.light_image = patternImage(5, 3);
+      for (bool decorrelate : {false, true}) {
+        options.decorrelate = decorrelate;
+        const RegionVisibilityResult got = computeRegionVisibility(context, field, light, options);
+        const RegionVisibilityResult want = referenceRegionVisibility(field, light, options);
+        expectSame(got, want);
+        expectSameColours(got, want);
+        for (float f : got.fraction) partial += f > 0.0f && f < 1.0f;
+      }
+    }
+  });
+  EXPECT_GT(partial, 100u);  // a partly seen light: colours of some samples, not all or none
+}
+
+TEST(RegionVisibility, AWhiteLightIsTheVisibleFraction) {
+  // Every method, a one-point light for the viewsheds one; nodata NaN in every channel.
+  const HeightField field = makeSyntheticField("nan_holes", 30, 31, 5);
+  RegionSampling light = sourcesIn(field, 37, 2.0, false);
+  RegionSampling point = light;
+  point.rectangle = {light.rectangle.col0, light.rectangle.row0, light.rectangle.col0, light.rectangle.row0};
+  LightImage white;
+  white.width = 3, white.height = 2;
+  white.rgb.assign(18, 1.0f);
+  forEachLayout([&](const ComputeContext& context) {
+    for (const auto method :
+         {RegionVisibilityMethod::Exact, RegionVisibilityMethod::Culled, RegionVisibilityMethod::Viewsheds}) {
+      RegionVisibilityOptions options;
+      options.method = method;
+      options.light_image = white;
+      const RegionVisibilityResult r = computeRegionVisibility(
+          context, field, method == RegionVisibilityMethod::Viewsheds ? point : light, options);
+      for (std::size_t p = 0; p < r.fraction.size(); ++p)
+        for (const auto* plane : {&r.red, &r.green, &r.blue})
+          ASSERT_TRUE((*plane)[p] == r.fraction[p] || (std::isnan((*plane)[p]) && std::isnan(r.fraction[p])))
+              << int(method) << " at " << p << ": " << (*plane)[p] << " vs " << r.fraction[p];
+    }
+  });
+}
+
+TEST(RegionVisibility, EachSampleTakesTheColourWhereItLies) {
+  // A light along row 10 of flat ground, its image red on the left half and blue on the right,
+  // and a wall across the field at column 20: a receiver left of the wall sees only the red half,
+  // one right of it only the blue. Colours given to the wrong samples (the image mirrored,
+  // looked up by sample index, by the receiver's position) would not give that.
+  const int w = 41, h = 21;
+  std::vector<float> heights(w * h, 0.0f);
+  for (int row = 0; row < h; ++row) heights[row * w + 20] = 8.0f;
+  const HeightField field = fieldFrom(w, h, heights);
+  RegionSampling light;
+  light.rectangle = {35, 10, 5, 10};
+  light.samples = 64;
+  light.height = 1.0;
+  RegionVisibilityOptions options;
+  options.light_image.width = 2, options.light_image.height = 1;
+  options.light_image.rgb = {1.0f, 0.0f, /*G*/ 0.0f, 0.0f, /*B*/ 0.0f, 1.0f};
+  forEachLayout([&](const ComputeContext& context) {
+    const RegionVisibilityResult r = computeRegionVisibility(context, field, light, options);
+    for (int row : {2, 10, 18})
+      for (int col : {1, 6, 12}) {
+        const std::size_t left = std::size_t(row) * w + col, right = std::size_t(row) * w + (w - 1 - col);
+        SCOPED_TRACE(std::to_string(col) + "," + std::to_string(row));
+        EXPECT_GT(r.fraction[left], 0.2f);
+        EXPECT_LT(r.fraction[left], 0.8f);
+        // Left of the wall: red samples (and the blended middle's red side) only.
+        EXPECT_GT(r.red[left], 2.0f * r.blue[left]);
+        EXPECT_GT(r.blue[right], 2.0f * r.red[right]);
+        EXPECT_EQ(r.green[left], 0.0f);
+        EXPECT_NEAR(r.red[left] + r.blue[left], r.fraction[left], 1e-6);  // red + blue = 1 everywhere
+      }
+  });
+}
+
 TEST(RegionVisibility, BadInputIsRefused) {
   HeightField field = makeSyntheticField("noise", 20, 10);
   field.heights[5 * 20 + 5] = std::numeric_limits<float>::quiet_NaN();
@@ -662,6 +794,22 @@ TEST(RegionVisibility, BadInputIsRefused) {
   latlon.row_cell_size_x.assign(field.height, 1.0);
   latlon.row_cell_size_y.assign(field.height, 1.0);
   EXPECT_THROW(computeRegionVisibility(context, latlon, good, options), InvalidArgument);
+  // A light image: of 3 * width * height finite values >= 0, over a rectangle, every-pixel receivers.
+  o = options;
+  o.light_image.width = 2, o.light_image.height = 2;
+  o.light_image.rgb.assign(11, 1.0f);
+  refused(good, o, "3 * width * height");
+  o.light_image.rgb.assign(12, 1.0f);
+  EXPECT_NO_THROW(computeRegionVisibility(context, field, good, o));
+  o.light_image.rgb[7] = -0.5f;
+  refused(good, o, "channel G at column 1, row 1");
+  o.light_image.rgb[7] = std::numeric_limits<float>::infinity();
+  refused(good, o, "finite");
+  o.light_image.rgb[7] = 1.0f;
+  RegionSampling points = good;
+  points.points = {{1.0, 2.0, 1.0}};
+  refused(points, o, "rectangle");
+  EXPECT_THROW(computeRegionPairVisibility(context, field, good, good, o), InvalidArgument);
   // A region pair checks both regions.
   EXPECT_THROW(computeRegionPairVisibility(context, field, good, s, options), InvalidArgument);
   EXPECT_THROW(computeRegionPairVisibility(context, field, s, good, options), InvalidArgument);

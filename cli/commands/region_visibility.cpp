@@ -14,6 +14,7 @@
 #include "../observer_files.hpp"
 #include "../pipeline.hpp"
 #include "hfvis/errors.hpp"
+#include "hfvis/image_io.hpp"
 
 namespace hfvis::cli {
 namespace {
@@ -61,7 +62,7 @@ class AreaLight : public Computation {
     if (!run_.preview.empty()) paths.push_back(run_.preview);
     return paths;
   }
-  std::vector<std::string> otherInputs() const override { return {run_.sources_file}; }
+  std::vector<std::string> otherInputs() const override { return {run_.sources_file, run_.light_image}; }
   std::string method() const override { return methodName(run_.region_method); }
 
   // The light: --light's rectangle, or the --sources file's points, checked against the field.
@@ -89,10 +90,13 @@ class AreaLight : public Computation {
     }
     validateRegion(field, sources_, run_.light ? "--light " + rectangleText(*run_.light) : "--sources",
                    run_.input);
+    if (!run_.light_image.empty()) readLightImage();
   }
 
   void compute(Job& job) override {
-    result_ = computeRegionVisibility(*job.context, job.input, sources_, regionVisibilityOptions(run_));
+    RegionVisibilityOptions options = regionVisibilityOptions(run_);
+    options.light_image = std::move(light_image_);
+    result_ = computeRegionVisibility(*job.context, job.input, sources_, options);
   }
 
   Summary write(Job& job, OutputFiles& outputs) override {
@@ -115,11 +119,28 @@ class AreaLight : public Computation {
           formatNumber(run_.light_height) + (run_.absolute ? " absolute (z-scaled)" : " above the surface"));
     attributes.emplace_back("hfvis:target_height", formatNumber(run_.target_height));
     attributes.emplace_back("hfvis:decorrelate", run_.decorrelate ? "1" : "0");
-    outputs.image(run_.output,
-                  job.image(input, {"visible"}, {result_.fraction}, attributes,
-                            "visible: the fraction of the light's samples seen from a receiver standing the "
-                            "target height above each grid point",
-                            "visible: 1 (0 .. 1)"));
+    const bool coloured = !run_.light_image.empty();
+    if (coloured) {
+      for (const auto* plane : {&result_.red, &result_.green, &result_.blue})
+        requireSize(*plane, pixels, "colours");
+      attributes.emplace_back("hfvis:light_image", run_.light_image);
+    }
+    std::vector<std::string> names{"visible"};
+    std::vector<std::vector<float>> planes{result_.fraction};
+    if (coloured) {
+      names.insert(names.end(), {"R", "G", "B"});
+      planes.insert(planes.end(), {result_.red, result_.green, result_.blue});
+    }
+    outputs.image(
+        run_.output,
+        job.image(
+            input, names, std::move(planes), attributes,
+            std::string("visible: the fraction of the light's samples seen from a receiver standing "
+                        "the target height above each grid point") +
+                (coloured ? "; R, G, B: the sum over the samples it sees of the light image's "
+                            "bilinear colour at each sample, over the samples' count"
+                          : ""),
+            coloured ? "visible: 1 (0 .. 1); R, G, B: the light image's values" : "visible: 1 (0 .. 1)"));
     if (!run_.masks_output.empty()) {
       // Channel k: samples 16k .. 16k+15, bit b (2^b) for sample 16k+b; NaN at nodata.
       const int channels = (result_.samples + kMaskBitsPerChannel - 1) / kMaskBitsPerChannel;
@@ -146,7 +167,26 @@ class AreaLight : public Computation {
   }
 
  private:
+  // --light-image: R, G, B (one grey channel: in all three), checked before any work.
+  void readLightImage() {
+    ImageChannels image = readColourImage(run_.light_image, "--light-image");
+    light_image_.width = image.width;
+    light_image_.height = image.height;
+    for (int c = 0; c < 3; ++c) {
+      const std::vector<float>& plane = image.planes[image.planes.size() == 1 ? 0 : c];
+      light_image_.rgb.insert(light_image_.rgb.end(), plane.begin(), plane.end());
+    }
+    RegionVisibilityOptions options;
+    options.light_image = light_image_;
+    try {
+      validate(options);
+    } catch (const InvalidArgument& error) {
+      throw IoError(run_.light_image, std::string("--light-image: ") + error.what());
+    }
+  }
+
   RegionSampling sources_;
+  LightImage light_image_;
   RegionVisibilityResult result_;
 };
 
@@ -298,6 +338,8 @@ void checkAreaLight(const std::string&, const RunArguments& run) {
     throw UsageError("--light and --sources both give the light; give one of them");
   if (!run.light && run.sources_file.empty())
     throw UsageError("missing --light C0,R0,C1,R1 or --sources FILE.csv (the area light)");
+  if (!run.light_image.empty() && !run.light)
+    throw UsageError("--light-image colours a --light rectangle, not --sources points");
   if (!run.sources_file.empty() && run.region_samples_given)
     throw UsageError("--samples is for --light: the --sources file's points are the samples");
   requireAboveSurface(run, "--light-height", run.light_height);
@@ -343,8 +385,8 @@ const CommandSpec kAreaLightCommand{
     "\"visible\": the fraction (0..1) of an area light's samples each pixel sees",
     "IN -o OUT.exr|OUT.tif (--light C0,R0,C1,R1 [--light-height H] | --sources FILE.csv)\n"
     "[--absolute] [--samples N] [--target-height T] [--decorrelate] [--method exact|culled|viewsheds]\n"
-    "[--seed N] [--max-distance D] [--curvature] [--refraction K] [--masks MASKS.exr]\n"
-    "[--preview P.png] [options]",
+    "[--seed N] [--light-image RGB.exr] [--max-distance D] [--curvature] [--refraction K]\n"
+    "[--masks MASKS.exr] [--preview P.png] [options]",
     "Region visibility with every pixel a receiver (Eisemann & Decoret 2007's sampled\n"
     "visibility): channel \"visible\" is the fraction (0..1) of the light's samples seen from a\n"
     "receiver T (default 0) above each grid point; NaN at nodata (a GeoTIFF's --nodata value).\n"
@@ -366,8 +408,13 @@ const CommandSpec kAreaLightCommand{
     "--method exact (default) marches one sight line per pixel and sample; --method viewsheds\n"
     "runs one viewshed per sample, for samples on grid points (a one-pixel --light, --sources\n"
     "with whole columns and rows), not with --decorrelate; it may decide grazing lines the other\n"
-    "way. A light outside the field, or on nodata, is an error. Not yet: a textured light\n"
-    "(--light-image).\n"
+    "way. A light outside the field, or on nodata, is an error.\n"
+    "--light-image FILE (an EXR or any image hfvis reads; R, G, B, or one grey channel) colours\n"
+    "the --light rectangle (Eisemann & Decoret 2007's textured light): the image stretched over\n"
+    "it, row 0 along the lowest row, each sample taking the image's bilinear colour at its own\n"
+    "jittered position; channels R, G, B are the colours of the samples a pixel sees, summed,\n"
+    "over N (a white image of 1 gives R = G = B = visible; NaN at nodata). A missing image, other\n"
+    "channels, or a negative or non-finite value is an error before any work.\n"
     "The preview shows the fraction from black (0) to white (1).\n",
     nullptr,
     kImageCommandGroups | kEarthGroup | kReachGroup | kRegionSamplingGroup | kAreaLightGroup,

@@ -74,6 +74,11 @@ struct ImageChannels {
 // readHeightField. Throws IoError as readHeightField.
 ImageChannels readImage(const std::string& path);
 
+// Reads a colour image (readImage): its R, G, B channels in that order (an alpha channel A beside
+// them ignored), or its only channel, named "Y". Throws IoError as readImage, and naming `what`
+// ("an environment map") for an image with other channels.
+ImageChannels readColourImage(const std::string& path, const std::string& what);
+
 // Whether writeImage writes `path` as a GeoTIFF through GDAL: its name ends in .tif or .tiff,
 // in any case.
 bool writesGeoTiff(const std::string& path);

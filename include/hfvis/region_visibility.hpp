@@ -90,6 +90,19 @@ enum class RegionVisibilityMethod {
   Culled,
 };
 
+// A textured light (Eisemann & Décoret 2007, Sec. 8: colours over the source): an RGB image
+// stretched over the source rectangle's extent [C0, C1] x [R0, R1] (lowest column and row first:
+// image row 0 along the rectangle's lowest row, as an image lies over the field), its texels'
+// edges on the rectangle's, texel (i, j) centred at C0 + (i + 0.5) (C1 - C0) / width (a rectangle
+// one point thick: the image's middle along that axis). A sample's colour is the image's bilinear
+// lookup at the sample's own jittered position (between the centres of the four nearest texels,
+// clamped to the edge texels: a renderer's filtered texture lookup), so a light of one colour
+// gives that colour whatever its image's size.
+struct LightImage {
+  int width = 0, height = 0;  // 0: no light image
+  std::vector<float> rgb;     // planar: the R, G, B planes, each row-major; finite, >= 0
+};
+
 struct RegionVisibilityOptions {
   RegionVisibilityMethod method = RegionVisibilityMethod::Culled;
   double target_height = 0.0;  // every-pixel receivers stand this high above the surface
@@ -100,6 +113,8 @@ struct RegionVisibilityOptions {
   // Hears (done, in all) after each launch of receivers (with the viewsheds method: after each
   // source sample's viewshed); may be empty. An exception thrown from it stops the run.
   std::function<void(int, int)> progress;
+  // With an image: the result's red, green, blue (rectangle sources and every-pixel receivers).
+  LightImage light_image;
 };
 
 // Per receiver a bitmask of the source samples it sees: bit s % 32 of word s / 32 (words per
@@ -110,6 +125,11 @@ struct RegionVisibilityResult {
   int words = 0;                    // per receiver
   std::vector<std::uint32_t> bits;  // width * height * words
   std::vector<float> fraction;      // visible samples / S per receiver; NaN at nodata
+  // With options.light_image (else empty): per receiver, the sum over its visible samples of
+  // each sample's colour (LightImage), divided by S (its irradiance from the coloured light, the
+  // light's mean colour where it sees every sample); NaN at nodata. Decorrelated, each
+  // receiver's samples lie where its own jitter put them, and so do their colours.
+  std::vector<float> red, green, blue;
   // Receiver p's sample s is visible.
   bool visible(std::size_t p, int s) const { return (bits[p * words + s / 32] >> (s % 32)) & 1u; }
 };
@@ -130,7 +150,8 @@ struct RegionPairVisibilityResult {
 };
 
 // Throws InvalidArgument for a negative or non-finite target height or maximum distance, a
-// non-finite curvature.
+// non-finite curvature, a light image not of 3 * width * height values or holding a negative or
+// non-finite one (naming the first).
 void validate(const RegionVisibilityOptions& options);
 
 // Throws InvalidArgument for a rectangle outside the field, S outside 1 .. kMaxRegionSamples, a
@@ -144,14 +165,15 @@ std::vector<RegionPoint> regionSamplePoints(const HeightField& field, const Regi
                                             std::uint32_t seed);
 
 // Which source samples every grid point sees. Throws InvalidArgument (bad field, sources or
-// options, a latitude / longitude grid, a field of 2^31 points or more), MemoryBudgetError
-// (bitmasks beyond half the device's memory), OpenClError, KernelBuildError.
+// options, a light image over explicit points, a latitude / longitude grid, a field of 2^31 points or more),
+// MemoryBudgetError (bitmasks beyond half the device's memory), OpenClError, KernelBuildError.
 RegionVisibilityResult computeRegionVisibility(const ComputeContext& context, const HeightField& field,
                                                const RegionSampling& sources,
                                                const RegionVisibilityOptions& options);
 
 // Which source samples every receiver sample sees, between two regions (options.target_height is
-// not used: the receivers' own height is). Throws as computeRegionVisibility.
+// not used: the receivers' own height is; a light image is refused). Throws as
+// computeRegionVisibility.
 RegionPairVisibilityResult computeRegionPairVisibility(const ComputeContext& context,
                                                        const HeightField& field,
                                                        const RegionSampling& sources,

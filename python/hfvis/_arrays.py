@@ -189,9 +189,18 @@ def compute(operation, heights, geometry, options, device="", progress=None):
                                                    device=device, progress=progress)}
     if operation == "region_visibility":
         o = _region_options(options)
+        light_image = options.get("light_image")
+        if light_image is not None:
+            light_image = np.asarray(light_image)
+            if light_image.ndim == 2:
+                light_image = np.broadcast_to(light_image, (3,) + light_image.shape)
+            if light_image.ndim != 3 or light_image.shape[0] != 3 or light_image.dtype.kind not in "fiu":
+                raise InputTypeError("light_image must be a real 2-D (rows, columns: grey) or 3-D (3: R, G, B, rows, "
+                                     f"columns) array, got shape {light_image.shape} and dtype {light_image.dtype}")
+            light_image = np.ascontiguousarray(light_image, dtype=np.float32)
         r = _core.region_visibility(field, region_sampling(options["sources"], options["samples"], options["height"],
                                                            options["absolute"]), o, device=device,
-                                    progress=progress)
+                                    progress=progress, light_image=light_image)
         # Plane w: the samples 32 w .. 32 w + 31 (bit s % 32), as the horizon maps' K x H x W.
         r["bits"] = np.ascontiguousarray(np.moveaxis(r["bits"], -1, 0))
         return r

@@ -15,7 +15,7 @@ Intervisibility = collections.namedtuple("Intervisibility", "visible_count visib
 SunShading = collections.namedtuple("SunShading", "sun direct")
 Insolation = collections.namedtuple("Insolation", "sun_hours direct")
 ErrorEstimate = collections.namedtuple("ErrorEstimate", "values error directions estimated_error")
-RegionVisibility = collections.namedtuple("RegionVisibility", "fraction bits")
+RegionVisibility = collections.namedtuple("RegionVisibility", "fraction bits rgb", defaults=(None,))
 RegionPairVisibility = collections.namedtuple(
     "RegionPairVisibility", "bits sources receivers source_fraction receiver_fraction clear_pairs pairs "
     "visible_fraction sources_xy receivers_xy")
@@ -42,6 +42,7 @@ _UNITS = {
     "irradiance": "radiance units times steradians (pi on open flat ground under radiance 1)",
     "fraction": "1 (the share of the source samples seen, 0..1)",
     "bits": "bit patterns: bit s % 32 of plane s // 32 set where source sample s is seen; 0 at nodata",
+    "rgb": "the light image's values (the colours of the source samples seen, summed, / S)",
     "error": "absolute, in the output's unit (half the difference of the even- and odd-numbered directions' results)",
 }
 _INSOLATION_DIRECT = "hours (direct irradiation from a sun of normal irradiance 1; times W/m^2 it is Wh/m^2)"
@@ -425,8 +426,8 @@ def environment_light(heights, environment, *, rotation_deg=0.0, table_rows=0, d
 
 
 def region_visibility(heights, sources, *, samples=16, height=2.0, absolute=False, target_height=0.0,
-                      method="culled", seed=1, decorrelate=False, max_distance=0.0, curvature=0.0, pixels=False,
-                      cell_size=None, z_scale=1.0, nodata=None, device="", progress=None):
+                      method="culled", seed=1, decorrelate=False, max_distance=0.0, curvature=0.0, light_image=None,
+                      pixels=False, cell_size=None, z_scale=1.0, nodata=None, device="", progress=None):
     """Which samples of a source region (an area light) every point sees, standing target_height
     above the surface (after Eisemann & Decoret 2007). `sources`: a rectangle (col0, row0, col1,
     row1) of grid points, corners inclusive, sampled `samples` times `height` above the surface
@@ -435,22 +436,31 @@ def region_visibility(heights, sources, *, samples=16, height=2.0, absolute=Fals
     pixels=True. numpy: RegionVisibility(fraction H x W, 0..1, NaN at nodata; bits ceil(S/32) x
     H x W uint32, bit s % 32 of plane s // 32 for sample s); DataArray: a Dataset of the two.
     Computed in one piece (a Dask array is computed first). progress(done, total) hears each launch
-    of receivers (method "viewsheds": each source sample)."""
+    of receivers (method "viewsheds": each source sample). light_image (a rectangle's light only):
+    its colours, 3 x rows x columns (R, G, B) or rows x columns (grey), finite and >= 0, stretched
+    over the rectangle (row 0 along its lowest row), each sample taking the bilinear colour at its
+    position (as arealight --light-image); then rgb (3 x H x W; DataArray: a Dataset variable
+    "rgb" over "channel" R, G, B): per point the colours of the samples it sees, summed, / S."""
     options = {"sources": sources, "samples": int(samples), "height": float(height), "absolute": bool(absolute),
                "target_height": float(target_height), "method": method, "seed": int(seed),
-               "decorrelate": bool(decorrelate), "max_distance": float(max_distance), "curvature": float(curvature)}
+               "decorrelate": bool(decorrelate), "max_distance": float(max_distance), "curvature": float(curvature),
+               "light_image": light_image}
     if _is_dataarray(heights) and _is_dask(heights.data):
         heights = heights.compute()  # the sources are shared by every point: the field in one piece
     out, grid = _run("region_visibility", heights, options,
                      _common(cell_size, z_scale, nodata, device, progress, pixels))
     if grid is None:
-        return RegionVisibility(out["fraction"], out["bits"])
+        return RegionVisibility(out["fraction"], out["bits"], out.get("rgb"))
     import xarray as xr
 
     fraction = grid.result(out["fraction"], "fraction", _attrs("region_visibility", "fraction", options, grid))
     bits = grid.result(out["bits"], "bits", _attrs("region_visibility", "bits", options, grid),
                        leading=("word", np.arange(out["bits"].shape[0])))
-    return xr.Dataset({"fraction": fraction, "bits": bits}, attrs={"hfvis_samples": out["samples"]})
+    variables = {"fraction": fraction, "bits": bits}
+    if "rgb" in out:
+        variables["rgb"] = grid.result(out["rgb"], "rgb", _attrs("region_visibility", "rgb", options, grid),
+                                       leading=("channel", ["R", "G", "B"]))
+    return xr.Dataset(variables, attrs={"hfvis_samples": out["samples"]})
 
 
 def region_pair_visibility(heights, sources, receivers, *, samples=16, source_height=2.0, receiver_height=2.0,

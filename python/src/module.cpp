@@ -380,9 +380,17 @@ ArrayOf<double> regionPoints(const std::vector<RegionPoint>& points) {
   return toArray(std::move(values), {points.size(), 3});
 }
 
-nb::dict regionVisibility(const HeightField& field, const RegionSampling& sources, RegionVisibilityOptions options,
-                          const std::string& device, nb::object progress) {
+// light_image: None, or the light's colours as 3 x rows x columns (R, G, B planes).
+nb::dict regionVisibility(const HeightField& field, const RegionSampling& sources,
+                          RegionVisibilityOptions options, const std::string& device, nb::object progress,
+                          nb::object light_image) {
   options.progress = progressHook(progress);
+  if (!light_image.is_none()) {
+    const Planes rgb = nb::cast<Planes>(light_image);
+    options.light_image.height = static_cast<int>(rgb.shape(1));
+    options.light_image.width = static_cast<int>(rgb.shape(2));
+    options.light_image.rgb.assign(rgb.data(), rgb.data() + rgb.size());
+  }
   validate(options);
   validate(field, sources);
   RegionVisibilityResult r = onDevice(
@@ -391,6 +399,12 @@ nb::dict regionVisibility(const HeightField& field, const RegionSampling& source
   out["fraction"] = plane(std::move(r.fraction), field);
   out["bits"] = toArray(std::move(r.bits), {size_t(field.height), size_t(field.width), size_t(r.words)});
   out["samples"] = r.samples;
+  if (options.light_image.width > 0) {
+    std::vector<float> rgb = std::move(r.red);
+    rgb.insert(rgb.end(), r.green.begin(), r.green.end());
+    rgb.insert(rgb.end(), r.blue.begin(), r.blue.end());
+    out["rgb"] = planes(std::move(rgb), 3, field);
+  }
   return out;
 }
 
@@ -645,7 +659,7 @@ NB_MODULE(_core, m) {
   nb::class_<RegionSampling>(m, "RegionSampling");
   m.def("region_sampling", &regionSampling, "rectangle"_a, "points"_a, "samples"_a, "height"_a, "absolute"_a);
   m.def("region_visibility", &regionVisibility, "field"_a, "sources"_a, "options"_a, "device"_a,
-        "progress"_a.none());
+        "progress"_a.none(), "light_image"_a.none() = nb::none());
   m.def("region_pair_visibility", &regionPairVisibility, "field"_a, "sources"_a, "receivers"_a, "options"_a,
         "device"_a, "progress"_a.none());
   m.def("pvs", &pvs, "field"_a, "grid"_a, "options"_a, "device"_a, "progress"_a.none());

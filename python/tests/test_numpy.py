@@ -203,6 +203,32 @@ def test_region_visibility(tmp_path, projected_tif, dem):
     r = hfvis.region_visibility(dem, (20, 30, 60, 40), decorrelate=True, seed=7, samples=8, absolute=True,
                                 height=900, max_distance=2000, cell_size=30, nodata=NODATA)
     equal(r.fraction, fraction)
+    assert r.rgb is None
+
+
+def test_region_visibility_light_image(tmp_path, projected_tif, dem):
+    import rasterio
+
+    # A grey 3 x 2 image (a one-band GeoTIFF): R = G = B, each as arealight --light-image's.
+    grey = np.array([[1, 2, 4], [0.5, 3, 0]], np.float32)
+    light = tmp_path / "light.tif"
+    with rasterio.open(light, "w", driver="GTiff", width=3, height=2, count=1, dtype="float32") as f:
+        f.write(grey, 1)
+    bands, names = cli(tmp_path, projected_tif, "arealight", "--light", "200,170,206,175", "--light-height", "10",
+                       "--samples", "40", "--max-distance", "3000", "--light-image", light)
+    r = hfvis.region_visibility(dem, (200, 170, 206, 175), samples=40, height=10, max_distance=3000, cell_size=30,
+                                nodata=NODATA, light_image=grey)
+    assert r.rgb.shape == (3,) + dem.shape and r.rgb.dtype == np.float32
+    for c, name in enumerate("RGB"):
+        equal(r.rgb[c], bands[names.index(name)])
+    assert 0 < np.nanmean(r.rgb[0]) < np.nanmean(grey)
+    # A white light: R = G = B = the fraction; an image of the wrong shape is refused.
+    white = hfvis.region_visibility(dem, (200, 170, 206, 175), samples=40, height=10, max_distance=3000,
+                                    cell_size=30, nodata=NODATA, light_image=np.ones((3, 4, 5)))
+    for c in range(3):
+        equal(white.rgb[c], white.fraction)
+    with pytest.raises(hfvis.InputTypeError):
+        hfvis.region_visibility(dem, (200, 170, 206, 175), cell_size=30, nodata=NODATA, light_image=np.ones((2, 4, 5)))
 
 
 def test_region_pair_visibility(tmp_path, projected_tif, dem):

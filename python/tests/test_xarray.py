@@ -116,6 +116,12 @@ def test_region_visibility_and_pairs_take_map_coordinates(projected_tif):
     c = hfvis.region_visibility(dem.chunk(100), (200, 170, 206, 175), pixels=True, samples=40, height=10,
                                 max_distance=3000)  # Dask: computed in one piece
     equal(c.fraction, ours.fraction)
+    colours = np.arange(12, dtype=np.float32).reshape(3, 2, 2)
+    lit = hfvis.region_visibility(dem, (x0, y0, x1, y1), samples=40, height=10, max_distance=3000, light_image=colours)
+    ours = hfvis.region_visibility(plain, (200, 170, 206, 175), samples=40, height=10, max_distance=3000,
+                                   cell_size=30, nodata=-9999.0, light_image=colours)
+    assert lit.rgb.dims == ("channel", "y", "x") and lit.rgb.channel.values.tolist() == ["R", "G", "B"]
+    equal(lit.rgb, ours.rgb)
     pair = hfvis.region_pair_visibility(dem, (x0, y0, x1, y1), [(x, y)], samples=8)
     assert pair.receivers_xy.tolist() == [[x, y]] and pair.sources_xy.shape == (8, 2)
     np.testing.assert_allclose(pair.receivers[0, :2], (100.25, 50.5))

@@ -22,8 +22,8 @@ void validate(const EnvironmentMap& map) {
                           std::to_string(map.channels) + ")");
   const std::size_t plane = static_cast<std::size_t>(map.width) * map.height;
   if (map.radiance.size() != plane * map.channels)
-    throw InvalidArgument("the environment map holds " + std::to_string(map.radiance.size()) + " values, not " +
-                          std::to_string(plane * map.channels));
+    throw InvalidArgument("the environment map holds " + std::to_string(map.radiance.size()) +
+                          " values, not " + std::to_string(plane * map.channels));
   for (std::size_t i = 0; i < map.radiance.size(); ++i) {
     const float v = map.radiance[i];
     // The tables sum radiance times solid angle over up to millions of pixels in single
@@ -43,32 +43,14 @@ void validate(const EnvironmentMap& map) {
 }
 
 EnvironmentMap readEnvironmentMap(const std::string& path) {
-  ImageChannels image = readImage(path);
-  std::vector<std::size_t> take;
-  auto find = [&](const char* name) {
-    for (std::size_t i = 0; i < image.names.size(); ++i)
-      if (image.names[i] == name) return static_cast<int>(i);
-    return -1;
-  };
-  const int r = find("R"), g = find("G"), b = find("B");
-  const bool rgb = r >= 0 && g >= 0 && b >= 0;
-  const std::size_t others = image.names.size() - (rgb ? 3 : 0) - (rgb && find("A") >= 0 ? 1 : 0);
-  if (rgb && others == 0) {
-    take = {static_cast<std::size_t>(r), static_cast<std::size_t>(g), static_cast<std::size_t>(b)};
-  } else if (image.names.size() == 1) {
-    take = {0};
-  } else {
-    std::string names;
-    for (const std::string& n : image.names) names += (names.empty() ? "" : ", ") + n;
-    throw IoError(path, "an environment map needs one channel or R, G, B (and A, ignored); it has " +
-                            (names.empty() ? std::string("none") : names));
-  }
+  ImageChannels image = readColourImage(path, "an environment map");
   EnvironmentMap map;
   map.width = image.width;
   map.height = image.height;
-  map.channels = static_cast<int>(take.size());
-  map.names = take.size() == 1 ? std::vector<std::string>{"Y"} : std::vector<std::string>{"R", "G", "B"};
-  for (std::size_t i : take) map.radiance.insert(map.radiance.end(), image.planes[i].begin(), image.planes[i].end());
+  map.channels = static_cast<int>(image.planes.size());
+  map.names = image.names;
+  for (const std::vector<float>& plane : image.planes)
+    map.radiance.insert(map.radiance.end(), plane.begin(), plane.end());
   try {
     validate(map);
   } catch (const InvalidArgument& e) {

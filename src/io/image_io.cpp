@@ -13,9 +13,9 @@
 #include <utility>
 #include <vector>
 
+#include "hfvis/errors.hpp"
 #include "io/exr_images.hpp"
 #include "io/gdal_io.hpp"
-#include "hfvis/errors.hpp"
 #include "io/oiio_images.hpp"
 #include "io/output_files.hpp"
 
@@ -69,6 +69,34 @@ ImageChannels readImage(const std::string& path) {
   ImageChannels image = readOtherImage(path, 0, nullptr);
   image.attributes.clear();
   return image;
+}
+
+ImageChannels readColourImage(const std::string& path, const std::string& what) {
+  ImageChannels image = readImage(path);
+  const auto find = [&](const char* name) {
+    for (std::size_t i = 0; i < image.names.size(); ++i)
+      if (image.names[i] == name) return static_cast<int>(i);
+    return -1;
+  };
+  const int r = find("R"), g = find("G"), b = find("B");
+  const bool rgb = r >= 0 && g >= 0 && b >= 0;
+  const std::size_t others = image.names.size() - (rgb ? 3 : 0) - (rgb && find("A") >= 0 ? 1 : 0);
+  ImageChannels out;
+  out.width = image.width;
+  out.height = image.height;
+  if (rgb && others == 0) {
+    out.names = {"R", "G", "B"};
+    for (const int i : {r, g, b}) out.planes.push_back(std::move(image.planes[i]));
+  } else if (image.names.size() == 1) {
+    out.names = {"Y"};
+    out.planes.push_back(std::move(image.planes[0]));
+  } else {
+    std::string names;
+    for (const std::string& n : image.names) names += (names.empty() ? "" : ", ") + n;
+    throw IoError(path, what + " needs one channel or R, G, B (and A, ignored); it has " +
+                            (names.empty() ? std::string("none") : names));
+  }
+  return out;
 }
 
 bool writesGeoTiff(const std::string& path) {
@@ -226,8 +254,8 @@ void OutputFiles::toneMappedPng(const std::string& path, int width, int height,
     throw InvalidArgument("preview '" + path + "' needs one or three planes of a non-empty image");
   for (const auto& plane : planes)
     if (plane.size() != count)
-      throw InvalidArgument("preview '" + path + "' has a plane of " + std::to_string(plane.size()) + " values for " +
-                            std::to_string(count) + " pixels");
+      throw InvalidArgument("preview '" + path + "' has a plane of " + std::to_string(plane.size()) +
+                            " values for " + std::to_string(count) + " pixels");
   const bool rgb = planes.size() == 3;
   auto luminance = [&](std::size_t i) {
     return rgb ? 0.2126 * planes[0][i] + 0.7152 * planes[1][i] + 0.0722 * planes[2][i] : double(planes[0][i]);

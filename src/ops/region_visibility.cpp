@@ -4,6 +4,7 @@
 #include "hfvis/region_visibility.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -315,6 +316,68 @@ std::vector<RegionPoint> regionPoints(const std::vector<float>& xyz) {
   return points;
 }
 
+// The light image's bilinear colour (hfvis::LightImage) at position (x, y) of a table's
+// rectangle.
+std::array<double, 3> lightColour(const LightImage& image, const std::vector<float>& table, float x,
+                                  float y) {
+  // The continuous texel coordinate: texel centres at whole numbers, clamped to the edge ones.
+  const auto texel = [](double at, double lo, double hi, int n) {
+    const double u = hi > lo ? (at - lo) / (hi - lo) : 0.5;
+    return std::clamp(u * n - 0.5, 0.0, n - 1.0);
+  };
+  const double tx = texel(x, table[0], table[2], image.width),
+               ty = texel(y, table[1], table[3], image.height);
+  const int i0 = static_cast<int>(tx), j0 = static_cast<int>(ty);
+  const int i1 = std::min(i0 + 1, image.width - 1), j1 = std::min(j0 + 1, image.height - 1);
+  const double fx = tx - i0, fy = ty - j0;
+  const std::size_t plane = std::size_t(image.width) * image.height;
+  std::array<double, 3> rgb{};
+  for (int c = 0; c < 3; ++c) {
+    const float* v = image.rgb.data() + c * plane;
+    const auto at = [&](int i, int j) { return double(v[std::size_t(j) * image.width + i]); };
+    // As lerps: an image of one colour gives that colour exactly.
+    const double top = at(i0, j0) + fx * (at(i1, j0) - at(i0, j0));
+    const double bottom = at(i0, j1) + fx * (at(i1, j1) - at(i0, j1));
+    rgb[c] = top + fy * (bottom - top);
+  }
+  return rgb;
+}
+
+// The result's red, green, blue: per receiver the colours of the samples it sees, over S. The
+// shared samples' colours are looked up once; decorrelated, each receiver's own (stream p + 1).
+void colourLight(RegionVisibilityResult& out, const HeightField& field, const std::vector<float>& table,
+                 const std::vector<float>& points, const RegionVisibilityOptions& options) {
+  const LightImage& image = options.light_image;
+  std::vector<std::array<double, 3>> shared;
+  for (std::size_t i = 0; i + 2 < points.size(); i += 3)
+    shared.push_back(lightColour(image, table, points[i], points[i + 1]));
+  const std::size_t count = field.pixelCount();
+  for (auto* plane : {&out.red, &out.green, &out.blue})
+    plane->assign(count, std::numeric_limits<float>::quiet_NaN());
+  for (std::size_t p = 0; p < count; ++p) {
+    if (!std::isfinite(field.heights[p])) continue;
+    std::array<double, 3> sum{};
+    for (int w = 0; w < out.words; ++w)
+      for (std::uint32_t word = out.bits[p * out.words + w]; word != 0u; word &= word - 1u) {
+        const int s = 32 * w + __builtin_ctz(word);
+        std::array<double, 3> colour;
+        if (options.decorrelate) {
+          // (only the position: absolute spares the surface lookup)
+          float x, y, z;
+          detail::region_sample(table.data(), nullptr, field.width, field.height, 1, options.seed,
+                                static_cast<unsigned>(p) + 1u, s, &x, &y, &z);
+          colour = lightColour(image, table, x, y);
+        } else {
+          colour = shared[s];
+        }
+        for (int c = 0; c < 3; ++c) sum[c] += colour[c];
+      }
+    out.red[p] = static_cast<float>(sum[0] / out.samples);
+    out.green[p] = static_cast<float>(sum[1] / out.samples);
+    out.blue[p] = static_cast<float>(sum[2] / out.samples);
+  }
+}
+
 }  // namespace
 
 namespace detail {
@@ -384,6 +447,22 @@ void validate(const RegionVisibilityOptions& options) {
   if (!std::isfinite(options.max_distance) || options.max_distance < 0.0)
     throw InvalidArgument("the maximum distance must be finite and at least 0 (0: no limit)");
   if (!std::isfinite(options.curvature)) throw InvalidArgument("the curvature must be finite");
+  const LightImage& image = options.light_image;
+  if (image.width != 0 || image.height != 0 || !image.rgb.empty()) {
+    if (image.width < 1 || image.height < 1 ||
+        image.rgb.size() !=
+            3 * static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height))
+      throw InvalidArgument("a light image needs width, height >= 1 and 3 * width * height values (got " +
+                            std::to_string(image.width) + " x " + std::to_string(image.height) + ", " +
+                            std::to_string(image.rgb.size()) + " values)");
+    const std::size_t plane = image.rgb.size() / 3;
+    for (std::size_t i = 0; i < image.rgb.size(); ++i)
+      if (!std::isfinite(image.rgb[i]) || image.rgb[i] < 0.0f)
+        throw InvalidArgument(
+            "the light image's colours must be finite and >= 0; channel " + std::string(1, "RGB"[i / plane]) +
+            " at column " + std::to_string(i % plane % image.width) + ", row " +
+            std::to_string(i % plane / image.width) + " holds " + std::to_string(image.rgb[i]));
+  }
   if (options.method != RegionVisibilityMethod::Exact &&
       options.method != RegionVisibilityMethod::Viewsheds && options.method != RegionVisibilityMethod::Culled)
     throw InvalidArgument("unknown region visibility method");
@@ -440,6 +519,9 @@ RegionVisibilityResult computeRegionVisibility(const ComputeContext& context, co
                                                const RegionVisibilityOptions& options) {
   validateField(field);
   validate(options);
+  const bool coloured = options.light_image.width > 0;
+  if (coloured && !sources.points.empty())
+    throw InvalidArgument("a light image lies over a rectangle light, not over explicit points");
   const std::vector<float> table = detail::regionSampleTable(field, sources);
   detail::PreparedHeights prepared = detail::prepareHeights(field, detail::HeightOrigin::Zero);
   const std::vector<float>& heights = prepared.heights;
@@ -463,6 +545,7 @@ RegionVisibilityResult computeRegionVisibility(const ComputeContext& context, co
                           ? std::numeric_limits<float>::quiet_NaN()
                           : static_cast<float>(static_cast<double>(seen) / out.samples);
   }
+  if (coloured) colourLight(out, field, table, points, options);
   return out;
 }
 
@@ -475,6 +558,8 @@ RegionPairVisibilityResult computeRegionPairVisibility(const ComputeContext& con
   validate(options);
   if (options.method == RegionVisibilityMethod::Viewsheds)
     throw InvalidArgument("the viewsheds method takes every-pixel receivers, not a region pair");
+  if (options.light_image.width > 0)
+    throw InvalidArgument("a light image colours every-pixel receivers, not a region pair");
   const std::vector<float> source_table = detail::regionSampleTable(field, sources);
   const std::vector<float> receiver_table = detail::regionSampleTable(field, receivers);
   detail::PreparedHeights prepared = detail::prepareHeights(field, detail::HeightOrigin::Zero);
