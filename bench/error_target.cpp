@@ -68,15 +68,27 @@ struct Output {
   std::vector<float> HorizonResult::*plane;
 };
 
+const Output kOutputs[] = {
+    {"sky-view factor", &HorizonOutputs::sky_view_factor, &HorizonResult::sky_view_factor},
+    {"ambient occlusion", &HorizonOutputs::ambient_occlusion, &HorizonResult::ambient_occlusion}};
+
+// The output at K = reference_directions: the azimuthal integral the runs' errors are measured
+// against. `wanted` and `options` are left asking for that output at that K.
+std::vector<float> referencePlane(const ComputeContext& context, const HeightField& field, const Output& output,
+                                  int reference_directions, HorizonOutputs& wanted, HorizonOptions& options) {
+  wanted = HorizonOutputs{};
+  wanted.*output.wanted = true;
+  options = HorizonOptions{};
+  options.directions = reference_directions;
+  return computeHorizons(context, field, options, wanted).*output.plane;
+}
+
 }  // namespace
 
 void errorTargetReport(const ComputeContext& context, const std::vector<ErrorTargetField>& fields,
                        const std::vector<double>& errors, int reference_directions, int reps) {
-  const Output outputs[] = {
-      {"sky-view factor", &HorizonOutputs::sky_view_factor, &HorizonResult::sky_view_factor},
-      {"ambient occlusion", &HorizonOutputs::ambient_occlusion, &HorizonResult::ambient_occlusion}};
   const std::vector<int> ladder = fixedLadder();
-  for (const Output& output : outputs) {
+  for (const Output& output : kOutputs) {
     std::printf("\n### %s\n\n", output.name);
     std::printf(
         "| field | E | runs (K) | estimate | achieved p99 | met | cheapest fixed K | its p99 | time chosen "
@@ -87,10 +99,9 @@ void errorTargetReport(const ComputeContext& context, const std::vector<ErrorTar
     std::vector<double> ratios, works, last_works;
     for (const ErrorTargetField& f : fields) {
       HorizonOutputs wanted;
-      wanted.*output.wanted = true;
       HorizonOptions options;
-      options.directions = reference_directions;
-      const std::vector<float> reference = computeHorizons(context, f.field, options, wanted).*output.plane;
+      const std::vector<float> reference =
+          referencePlane(context, f.field, output, reference_directions, wanted, options);
       std::map<int, double> fixed_error;  // K -> achieved p99 of a fixed-K run
       const auto errorAt = [&](int K) {
         auto it = fixed_error.find(K);
@@ -169,20 +180,16 @@ void errorTargetReport(const ComputeContext& context, const std::vector<ErrorTar
 
 void errorCurve(const ComputeContext& context, const std::vector<ErrorTargetField>& fields,
                 int reference_directions, int max_directions) {
-  const Output outputs[] = {
-      {"sky-view factor", &HorizonOutputs::sky_view_factor, &HorizonResult::sky_view_factor},
-      {"ambient occlusion", &HorizonOutputs::ambient_occlusion, &HorizonResult::ambient_occlusion}};
-  for (const Output& output : outputs) {
+  for (const Output& output : kOutputs) {
     std::printf(
         "\n### %s: error and estimate against K\n\n| field | K | samples | achieved p99 | estimate | "
         "p99 of r(K/2) - r(K) | time (s) |\n|---|---:|---:|---:|---:|---:|---:|\n",
         output.name);
     for (const ErrorTargetField& f : fields) {
       HorizonOutputs wanted;
-      wanted.*output.wanted = true;
       HorizonOptions options;
-      options.directions = reference_directions;
-      const std::vector<float> reference = computeHorizons(context, f.field, options, wanted).*output.plane;
+      const std::vector<float> reference =
+          referencePlane(context, f.field, output, reference_directions, wanted, options);
       wanted.error_estimate = true;
       std::map<int, std::vector<float>> results;
       for (int K : fixedLadder()) {

@@ -288,15 +288,27 @@ TEST(PvsRayCaster, MemoryBudgetSplitsLaunchesWithTheSameResults) {
   EXPECT_THROW(castHeightFieldRays(testContext(), field, in, options), MemoryBudgetError);
 }
 
-// A flat field sees everything; a tall wall across the middle hides the far side's ground.
-TEST(PvsDense, ClosedCases) {
+// A flat 25 x 17 field at height 3 (every point sees every other), and its grid: 8-cell view
+// cells, 4-cell tiles.
+HeightField flatField() {
   HeightField flat;
   flat.width = 25;
   flat.height = 17;
   flat.heights.assign(std::size_t(flat.width) * flat.height, 3.0f);
+  return flat;
+}
+
+PvsGrid flatGrid() {
   PvsGrid grid;
   grid.view_cell = 8;
   grid.tile = 4;
+  return grid;
+}
+
+// A flat field sees everything; a tall wall across the middle hides the far side's ground.
+TEST(PvsDense, ClosedCases) {
+  const HeightField flat = flatField();
+  const PvsGrid grid = flatGrid();
   const PvsResult all = computeDensePvs(testContext(), flat, grid);
   EXPECT_EQ(all.layout.view_x, 3);
   EXPECT_EQ(all.layout.tiles_x, 6);
@@ -502,13 +514,8 @@ TEST(Pvs, EstimatedPixelErrorWithinAFactorTwoOfTheMeasured) {
 // Where every entry is found many times over (a flat field sees everything), no entry rests on one
 // uniform ray: the estimate is its floor, one entry in the run's uniform rays, and never 0.
 TEST(Pvs, EstimateOfCompleteSetsIsOneRayInTheRun) {
-  HeightField flat;
-  flat.width = 25;
-  flat.height = 17;
-  flat.heights.assign(std::size_t(flat.width) * flat.height, 3.0f);
-  PvsGrid grid;
-  grid.view_cell = 8;
-  grid.tile = 4;
+  const HeightField flat = flatField();
+  const PvsGrid grid = flatGrid();
   for (PvsMethod method : {PvsMethod::Agvs, PvsMethod::Sgvs, PvsMethod::PerCell}) {
     PvsOptions options;
     options.method = method;
