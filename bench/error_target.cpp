@@ -74,8 +74,9 @@ const Output kOutputs[] = {
 
 // The output at K = reference_directions: the azimuthal integral the runs' errors are measured
 // against. `wanted` and `options` are left asking for that output at that K.
-std::vector<float> referencePlane(const ComputeContext& context, const HeightField& field, const Output& output,
-                                  int reference_directions, HorizonOutputs& wanted, HorizonOptions& options) {
+std::vector<float> referencePlane(const ComputeContext& context, const HeightField& field,
+                                  const Output& output, int reference_directions, HorizonOutputs& wanted,
+                                  HorizonOptions& options) {
   wanted = HorizonOutputs{};
   wanted.*output.wanted = true;
   options = HorizonOptions{};
