@@ -13,7 +13,7 @@ from ._errors import InputTypeError, InvalidArgumentError
 # The operations whose options include a maximum distance that bounds what a point's result
 # depends on (Dask runs them chunk by chunk with a halo), and each one's planes.
 HORIZON_OPERATIONS = ("horizon_angles", "horizon_distances", "sky_view_factor", "ambient_occlusion")
-DISTANCE_LIMITED = HORIZON_OPERATIONS + ("intervisibility", "sun_shading", "insolation")
+DISTANCE_LIMITED = HORIZON_OPERATIONS + ("intervisibility", "sun_shading", "insolation", "environment_light")
 OUTPUTS = {
     "horizon_angles": ("angles",),
     "horizon_distances": ("distances",),
@@ -26,6 +26,7 @@ OUTPUTS = {
     "cumulative_viewshed": ("count",),
     "region_visibility": ("fraction", "bits"),
     "bounce": ("irradiance",),
+    "environment_light": ("irradiance",),
 }
 
 
@@ -128,7 +129,10 @@ def utc_seconds(when):
 
 
 def planes_of(operation, options):
-    """How many planes each output of `operation` has: K for horizon maps, else 1."""
+    """How many planes each output of `operation` has: K for horizon maps, the environment's
+    channels (options["channels"], which the caller finds) for its light, else 1."""
+    if operation == "environment_light":
+        return len(options["channels"])
     return options["directions"] if operation in ("horizon_angles", "horizon_distances") else 1
 
 

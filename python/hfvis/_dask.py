@@ -88,8 +88,52 @@ def chunked(operation, heights, geometry, options, device=""):
     out = {}
     for n, name in enumerate(names):
         part = stacked[n * planes:(n + 1) * planes]
-        out[name] = part if planes > 1 or operation in ("horizon_angles", "horizon_distances") else part[0]
+        leading = operation in ("horizon_angles", "horizon_distances", "environment_light")
+        out[name] = part if planes > 1 or leading else part[0]
     return out
+
+
+def _viewshed_window(window, geometry, options, device, first_col, first_row):
+    o = dict(options)
+    col, row = _arrays.observer_pixel(options["observer"])
+    o["observer"] = np.array([col - first_col, row - first_row])
+    return _arrays.compute("viewshed", np.ascontiguousarray(window, dtype=np.float32), geometry, o, device)["visible"]
+
+
+def _viewshed_block(block, window, first_col, first_row, block_info=None):
+    """One chunk of the viewshed: 0 (out of range) and NaN at nodata, the window's values where it
+    overlaps the window."""
+    (r0, r1), (c0, c1) = block_info[0]["array-location"]
+    out = np.where(np.isfinite(block), np.float32(0), np.float32(np.nan)).astype(np.float32)
+    top, left = max(r0, first_row), max(c0, first_col)
+    bottom, right = min(r1, first_row + window.shape[0]), min(c1, first_col + window.shape[1])
+    if top < bottom and left < right:
+        out[top - r0:bottom - r0, left - c0:right - c0] = window[top - first_row:bottom - first_row,
+                                                                 left - first_col:right - first_col]
+    return out
+
+
+def viewshed(heights, geometry, options, device=""):
+    """One observer's viewshed over a Dask array, chunked as the input: within a maximum distance
+    computed on the window it reaches (a task of its own), the rest out of range (0, NaN at
+    nodata). The viewshed's heights count from zero and its rays from the observer, so the window's
+    result is the whole field's there bit for bit. Without a maximum distance, or on a latitude /
+    longitude grid (whose rows' spacing is counted from the field's first row), the window is the
+    whole field."""
+    import dask
+    import dask.array as da
+
+    col, row = _arrays.observer_pixel(options["observer"])
+    height, width = heights.shape
+    first_row, first_col, last_row, last_col = 0, 0, height, width
+    if options.get("max_distance") and not geometry["row_cell_size_x"]:
+        depth = halo(geometry, options["max_distance"], "viewshed")
+        first_row, first_col = max(0, min(row, height - 1) - depth), max(0, min(col, width - 1) - depth)
+        last_row, last_col = min(height, max(row, 0) + depth + 1), min(width, max(col, 0) + depth + 1)
+    window = dask.delayed(_viewshed_window)(heights[first_row:last_row, first_col:last_col], geometry, options,
+                                            device, first_col, first_row)
+    return da.map_blocks(_viewshed_block, heights, window, first_col, first_row, dtype=np.float32,
+                         meta=np.empty((0, 0), np.float32))
 
 
 def _observer_group(heights, geometry, options, device, group):

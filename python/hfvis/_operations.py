@@ -104,6 +104,8 @@ def _run(operation, heights, options, common):
         data = _flipped(data.astype(np.float32), flip_rows, flip_cols)
         if operation == "cumulative_viewshed":
             out = {"count": _dask.cumulative_viewshed(data, g, options, common["device"])}
+        elif operation == "viewshed":
+            out = {"visible": _dask.viewshed(data, g, options, common["device"])}
         elif operation in _arrays.DISTANCE_LIMITED:
             out = _dask.chunked(operation, data, g, options, common["device"])
         else:
@@ -354,8 +356,6 @@ def viewshed(heights, observer, *, observer_height=2.0, absolute=False, target_h
                "curvature": float(curvature), "azimuth_from_deg": float(azimuth_from_deg),
                "azimuth_to_deg": float(azimuth_to_deg), "elevation_min_deg": float(elevation_min_deg),
                "elevation_max_deg": float(elevation_max_deg), "memory_budget_bytes": int(memory_budget_bytes)}
-    if _is_dataarray(heights) and _is_dask(heights.data):
-        heights = heights.compute()  # one observer: the field in one piece
     return _single("viewshed", "visible", heights, options, _common(cell_size, z_scale, nodata, device, None, pixels))
 
 
@@ -414,9 +414,12 @@ def environment_light(heights, environment, *, rotation_deg=0.0, table_rows=0, d
     options.update(environment=environment, rotation_deg=float(rotation_deg), table_rows=int(table_rows))
     common = _common(cell_size, z_scale, nodata, device, progress)
     if _is_dataarray(heights) and _is_dask(heights.data):
-        heights = heights.compute()  # a sky's light has no maximum distance here: the field in one piece
+        # Chunk by chunk within the maximum distance: the channels, which each block's planes
+        # follow, from a one-cell field's run (they depend on the environment alone).
+        options["channels"] = list(_arrays.compute("environment_light", np.zeros((2, 2), np.float32),
+                                                   _arrays.geometry(), options)["channels"])
     out, grid = _run("environment_light", heights, options, common)
-    irradiance, channels = out["irradiance"], list(out["channels"])
+    irradiance, channels = out["irradiance"], list(out.get("channels", options.get("channels", [])))
     if grid is None:
         return irradiance[0] if len(channels) == 1 else irradiance
     attrs = _attrs("environment_light", "irradiance", options, grid)

@@ -1,8 +1,8 @@
 """Dask-backed DataArrays: chunk by chunk with a halo of the maximum distance, against the
 in-memory run on fixed and random chunkings (chunks smaller than the halo among them) with nodata
 holes across chunk edges: bit for bit, NaN where it was (the horizon sweep's outputs,
-intervisibility, cumulative viewsheds), on a projected grid and on a latitude / longitude one; a
-LocalCluster of two worker processes."""
+intervisibility, environment light, viewsheds and cumulative viewsheds), on a projected grid and on a latitude /
+longitude one; a LocalCluster of two worker processes."""
 
 import dask.array as da
 import numpy as np
@@ -13,6 +13,10 @@ import hfvis
 
 CELL = 30.0
 MAX_DISTANCE = 300.0  # 10 cells: a halo of 12 pixels
+# An RGB sky, 8 x 16 (equirectangular, row 0 at the zenith), brighter toward the zenith and in
+# the north, so that every horizon changes the light.
+SKY = np.stack([np.outer(np.linspace(3, 1, 8), np.linspace(1, 2, 16) * f) for f in (1.0, 0.7, 0.4)]).astype(
+    np.float32)
 
 
 @pytest.fixture(scope="module")
@@ -55,6 +59,7 @@ EXACT = {
     "sun_shading": lambda a: hfvis.sun_shading(a, 200, 15, max_distance=MAX_DISTANCE),
     "insolation": lambda a: hfvis.insolation(a, 32.9, -98.1, "2024-06-21T14:00:00Z", "2024-06-21T16:00:00Z",
                                              step_minutes=30, max_distance=MAX_DISTANCE),
+    "environment_light": lambda a: hfvis.environment_light(a, SKY, directions=8, max_distance=MAX_DISTANCE),
 }
 
 
@@ -101,6 +106,23 @@ def test_chunks_smaller_than_the_halo_are_rechunked(field):
 def test_no_maximum_distance_is_refused(field):
     with pytest.raises(hfvis.InvalidArgumentError, match="max_distance"):
         hfvis.sky_view_factor(field.chunk(50), directions=4)
+    with pytest.raises(hfvis.InvalidArgumentError, match="max_distance"):
+        hfvis.environment_light(field.chunk(50), SKY, directions=4)
+
+
+@pytest.mark.parametrize("max_distance", [MAX_DISTANCE, 0.0])
+def test_viewshed_on_the_window_it_reaches(field, max_distance):
+    """One observer: the window within the maximum distance is a task of its own, the rest out of
+    range (0, NaN at nodata); without a maximum distance the whole field. Bit for bit."""
+    x, y = float(field.x[100]), float(field.y[40])  # beside the holes across rows 35-38
+    whole = hfvis.viewshed(field, (x, y), max_distance=max_distance)
+    assert np.isnan(whole.values).any() and (whole.values == 1).sum() > 20
+    for chunks in chunkings():
+        got = hfvis.viewshed(field.chunk({"y": chunks[0], "x": chunks[1]}), (x, y), max_distance=max_distance)
+        assert got.chunks is not None, "a Dask input gives a Dask result"
+        values, wanted = got.values, whole.values
+        assert np.array_equal(np.isnan(values), np.isnan(wanted)), f"{chunks}: nodata moved"
+        assert np.array_equal(values[~np.isnan(wanted)], wanted[~np.isnan(wanted)]), f"{chunks}"
 
 
 def test_cumulative_viewshed_split_and_summed(field):
@@ -176,7 +198,8 @@ def test_latitude_longitude_grid_takes_each_blocks_rows(latitude_longitude_field
     assert np.nanmax(np.abs(centre_spacing - whole.values)) > 1e-3  # the rows' spacing matters here
 
 
-@pytest.mark.parametrize("operation", sorted(EXACT))
+# (environment lighting takes a field of one cell size: it refuses per-row spacing)
+@pytest.mark.parametrize("operation", sorted(set(EXACT) - {"environment_light"}))
 def test_latitude_longitude_chunked_equals_in_memory_bit_for_bit(latitude_longitude_field, operation):
     """On a latitude / longitude grid too: the horizon sweep's positions are whole units of ground
     length counted along the whole field's lines, the hull tree's whole units (HeightField::origin
