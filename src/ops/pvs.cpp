@@ -158,13 +158,22 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
     Lists cast_lists;
     cast_lists.first.push_back(0);
     const int launches = (n + chunk - 1) / chunk;
-    if (launches > 0) enqueue(rays, order, 0, std::min(chunk, n), cap, slots_[0]);
-    for (int c = 0; c < launches; ++c) {
-      if (c + 1 < launches) {
-        const int next = (c + 1) * chunk;
-        enqueue(rays, order, next, std::min(chunk, n - next), cap, slots_[(c + 1) % 2]);
+    try {
+      if (launches > 0) enqueue(rays, order, 0, std::min(chunk, n), cap, slots_[0]);
+      for (int c = 0; c < launches; ++c) {
+        if (c + 1 < launches) {
+          const int next = (c + 1) * chunk;
+          enqueue(rays, order, next, std::min(chunk, n - next), cap, slots_[(c + 1) % 2]);
+        }
+        collect(order, cap, slots_[c % 2], out, cast_lists);
       }
-      collect(order, cap, slots_[c % 2], out, cast_lists);
+    } catch (...) {
+      // A launch still in flight writes into the slots' host vectors: let it end before they go.
+      try {
+        st_.queue.finish();
+      } catch (...) {
+      }
+      throw;
     }
     out.first.assign(rays.size() + 1, 0);
     if (cast_lists.cells.empty()) return out;
