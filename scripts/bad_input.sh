@@ -141,6 +141,13 @@ try "maximum error beyond 4096 directions" "" -- svf field.exr -o out/o.exr --ma
 try "error estimate output is the output" "" -- svf field.exr -o out/o.exr --error-out out/o.exr
 try "error estimate output is the input" "" -- ao field.exr -o out/o.exr -k 8 --error-out field.exr
 try "error estimate with one direction" "" -- svf field.exr -o out/o.exr -k 1 --error-out out/e.exr
+try "viewcount: maximum error zero" "" -- viewcount field.exr -o out/o.exr --max-error 0
+try "viewcount: maximum error of 1 or more (relative)" "" -- viewcount field.exr -o out/o.exr --max-error 1
+try "viewcount: maximum error not finite" "" -- viewcount field.exr -o out/o.exr --max-error inf
+try "viewcount: maximum error with -k" "" -- viewcount field.exr -o out/o.exr --max-error 0.1 -k 16
+try "viewcount: maximum error of the naive method" "" -- viewcount field.exr -o out/o.exr --max-error 0.1 --method naive
+try "viewcount: maximum error beyond 4096 directions" "" -- viewcount field.exr -o out/o.exr --max-error 1e-7 --error-out out/e.exr
+try "viewcount: error estimate with one direction" "" -- viewcount field.exr -o out/o.exr -k 1 --error-out out/e.exr
 try "lines per unit (removed: every sweep runs one line through each pixel centre)" "" -- viewcount field.exr -o out/o.exr --lines-per-unit 2
 try "refraction out of range" "" -- svf field.exr -o out/o.exr --refraction 2
 try "curvature for the bounce (not supported)" "" -- bounce field.exr --radiance field.exr -o out/b.exr --curvature
