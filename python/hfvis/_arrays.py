@@ -150,9 +150,10 @@ def compute(operation, heights, geometry, options, device="", progress=None):
         return r
     if operation == "intervisibility":
         o = _core.IntervisibilityOptions()
-        _set(o, options, _SWEEP + ("strip_rows",))
+        _set(o, options, _SWEEP + ("strip_rows", "max_error"))
         o.method = _enum(_core.IntervisibilityMethod, options.get("method", "hull_tree"), "method")
-        r = _core.intervisibility(field, o, device=device, progress=progress)
+        r = _core.intervisibility(field, o, error_estimate=bool(options.get("error_estimate")), device=device,
+                                  progress=progress)
         r["azimuths"] = np.asarray(r["azimuths"])
         return r
     if operation == "sun_shading":
