@@ -426,7 +426,8 @@ const std::vector<OptionSpec>& optionTable() {
        "choose K for this error instead of taking -k: the 99th percentile over\n"
        "the pixels of the error estimate (see --error-out) at most E, 0 < E < 1\n"
        "(absolute for the sky-view factor and occlusion; intervisibility: of\n"
-       "the count, relative to its mean); a first run at 16 directions\n"
+       "the count, relative to its mean; shade --env: relative to the mean\n"
+       "irradiance); a first run at 16 directions\n"
        "predicts the K needed, refused when beyond 4096; the K chosen and the\n"
        "estimate go into the summary and the hfvis:directions and\n"
        "hfvis:estimated_error attributes",
@@ -435,7 +436,7 @@ const std::vector<OptionSpec>& optionTable() {
          if (!(run.max_error > 0.0 && run.max_error < 1.0))
            throw UsageError(typed +
                             ": the maximum error must lie in (0, 1) (absolute in the sky-view factor's and "
-                            "occlusion's 0..1, relative for intervisibility), got " +
+                            "occlusion's 0..1, relative for intervisibility and shade --env), got " +
                             inQuotes(value));
        }},
       {"--error-out", nullptr, "FILE", kErrorTargetGroup, false,
