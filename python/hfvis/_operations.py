@@ -435,15 +435,23 @@ def insolation(heights, latitude_deg, longitude_deg, start, end, *, step_minutes
 
 def environment_light(heights, environment, *, rotation_deg=0.0, table_rows=0, directions=64, azimuth_offset=0.0,
                       samples_per_unit=1.0, curvature=0.0, max_distance=0.0, method="sweep", azimuth_tolerance=None,
-                      memory_budget_bytes=0, cell_size=None, z_scale=1.0, nodata=None, device="", progress=None):
+                      memory_budget_bytes=0, max_error=0.0, cell_size=None, z_scale=1.0, nodata=None, device="",
+                      progress=None):
     """The irradiance an HDR environment gives each point through its horizons (Timonen &
     Westerholm 2010, Sec. 6.2). `environment`: a file (EXR, HDR, ...) or radiance as an
     equirectangular (rows, 2 rows) or (channels, rows, 2 rows) array, row 0 at the zenith, the
-    left edge north. Returns (channels, H, W), or (H, W) for one channel."""
+    left edge north. Returns (channels, H, W), or (H, W) for one channel. max_error=E chooses K
+    (directions ignored) as the CLI's shade --env --max-error (|irradiance at K - at K / 2| over
+    the mean, relative): numpy ErrorEstimate(values, error, directions, estimated_error); a
+    DataArray with the K and the estimate in its attrs."""
     options = _horizon(directions, azimuth_offset, samples_per_unit, curvature, max_distance, memory_budget_bytes,
                        method, azimuth_tolerance, 0)
     options.update(environment=environment, rotation_deg=float(rotation_deg), table_rows=int(table_rows))
     common = _common(cell_size, z_scale, nodata, device, progress)
+    if max_error:
+        options["max_error"] = float(max_error)
+        if _is_dataarray(heights) and _is_dask(heights.data):
+            heights = heights.compute()  # K and the estimate's percentile are the whole field's: in one piece
     if _is_dataarray(heights) and _is_dask(heights.data):
         # Chunk by chunk within the maximum distance: the channels, which each block's planes
         # follow, from a one-cell field's run (they depend on the environment alone).
@@ -452,8 +460,11 @@ def environment_light(heights, environment, *, rotation_deg=0.0, table_rows=0, d
     out, grid = _run("environment_light", heights, options, common)
     irradiance, channels = out["irradiance"], list(out.get("channels", options.get("channels", [])))
     if grid is None:
-        return irradiance[0] if len(channels) == 1 else irradiance
+        values = irradiance[0] if len(channels) == 1 else irradiance
+        return ErrorEstimate(values, out["error"], out["directions"], out["estimated_error"]) if max_error else values
     attrs = _attrs("environment_light", "irradiance", options, grid)
+    if max_error:
+        attrs.update(hfvis_directions=out["directions"], hfvis_estimated_error=out["estimated_error"])
     if len(channels) == 1:
         return grid.result(irradiance[0], "irradiance", attrs)
     return grid.result(irradiance, "irradiance", attrs, leading=("channel", channels))

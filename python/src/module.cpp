@@ -363,7 +363,11 @@ nb::tuple environmentLight(const HeightField& field, const EnvironmentMap& map, 
   EnvironmentLightResult r = onDevice(
       device, [&](const ComputeContext& c) { return computeEnvironmentLight(c, field, map, options); });
   const int channels = static_cast<int>(r.names.size());
-  return nb::make_tuple(planes(std::move(r.irradiance), channels, field), r.names);
+  // The K run (max_error chooses it) and, with max_error, the estimate and its 99th percentile.
+  nb::object error = nb::none();
+  if (!r.error_estimate.empty()) error = nb::cast(plane(std::move(r.error_estimate), field));
+  return nb::make_tuple(planes(std::move(r.irradiance), channels, field), r.names, r.directions, error,
+                        r.estimated_error);
 }
 
 // A region's samples: the rectangle (inclusive corners) sampled `samples` times, or, when

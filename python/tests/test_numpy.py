@@ -128,6 +128,21 @@ def test_environment_light_and_sun_position(tmp_path, projected_tif, dem):
     assert abs(float(printed["azimuth"]) - azimuth) < 1e-4 and abs(float(printed["elevation"]) - elevation) < 1e-4
 
 
+def test_environment_light_with_max_error(dem):
+    """max_error=E chooses K as shade --env --max-error does: the values are the run at that K's,
+    the estimate at most E; a DataArray carries the K and the estimate."""
+    rows = np.arange(16)[:, None]
+    azimuth = np.arange(32)[None, :] * 2 * np.pi / 32
+    sky = np.where(rows < 8, 2.0 - rows / 8 + 0.5 * np.cos(azimuth), 0.2).astype(np.float32)  # no sun
+    ours = hfvis.environment_light(dem, sky, max_error=0.05, max_distance=1500, cell_size=30, nodata=NODATA)
+    assert isinstance(ours, hfvis.ErrorEstimate)
+    assert ours.estimated_error <= 0.05 and ours.error.shape == dem.shape and ours.directions % 8 == 0
+    equal(ours.values, hfvis.environment_light(dem, sky, directions=ours.directions, max_distance=1500, cell_size=30,
+                                               nodata=NODATA))
+    with pytest.raises(hfvis.InvalidArgumentError):
+        hfvis.environment_light(dem, sky, max_error=1.5, cell_size=30, nodata=NODATA)
+
+
 def test_any_float_dtype_strides_and_byte_order_give_the_same(dem):
     heights = np.where(dem == NODATA, np.nan, dem).astype(np.float32)
     reference = hfvis.sky_view_factor(heights, directions=4, max_distance=600, cell_size=30)
