@@ -427,8 +427,8 @@ const std::vector<OptionSpec>& optionTable() {
        "the pixels of the error estimate (see --error-out) at most E, 0 < E < 1\n"
        "(absolute for the sky-view factor and occlusion; intervisibility: of\n"
        "the count, relative to its mean; shade --env: relative to the mean\n"
-       "irradiance); a first run at 16 directions\n"
-       "predicts the K needed, refused when beyond 4096; the K chosen and the\n"
+       "irradiance); a first run at 16 directions predicts the K needed,\n"
+       "refused when beyond 4096; the K chosen and the\n"
        "estimate go into the summary and the hfvis:directions and\n"
        "hfvis:estimated_error attributes",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
@@ -445,7 +445,8 @@ const std::vector<OptionSpec>& optionTable() {
        "directions alone (intervisibility: their whole difference in the\n"
        "count, over the field's mean count), which lies above the error\n"
        "against the dense azimuthal integral on the benchmark's contents;\n"
-       "with -k or --max-error",
+       "with -k or --max-error (shade --env: with --max-error only, the\n"
+       "difference from the run at K / 2 over the mean irradiance)",
        HFVIS_TEXT(error_output)},
       {"--distance-out", nullptr, "FILE", kHorizonGroup, false,
        "also write K channels d000.. of ground distance to the\n"

@@ -27,8 +27,8 @@
 #include <vector>
 
 #include "geotiff_support.hpp"
-#include "hfvis/horizon_lists.hpp"
 #include "hfvis/environment_light.hpp"
+#include "hfvis/horizon_lists.hpp"
 #include "hfvis/image_io.hpp"
 #include "hfvis/intervisibility.hpp"
 #include "hfvis/pvs.hpp"
@@ -792,8 +792,8 @@ TEST_F(Cli, ViewcountMaxErrorWritesTheChosenKAndTheEstimate) {
   // --error-out with -k: the estimate at the K given.
   fs::remove(out("v.exr"));
   fs::remove(out("e.exr"));
-  ASSERT_EQ(run("viewcount " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) + " -k 8 --error-out " +
-                shellQuoted(out("e.exr")))
+  ASSERT_EQ(run("viewcount " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) +
+                " -k 8 --error-out " + shellQuoted(out("e.exr")))
                 .status,
             0);
   options.max_error = 0.0;
@@ -829,11 +829,13 @@ TEST_F(Cli, ShadeEnvironmentMaxErrorWritesTheChosenKAndTheEstimate) {
   map.planes.emplace_back();
   for (int row = 0; row < map.height; ++row)
     for (int col = 0; col < map.width; ++col)
-      map.planes[0].push_back(row < 8 ? 2.0f - row / 8.0f + 0.5f * std::cos(col * 2.0f * float(M_PI) / 32) : 0.2f);
+      map.planes[0].push_back(row < 8 ? 2.0f - row / 8.0f + 0.5f * std::cos(col * 2.0f * float(M_PI) / 32)
+                                      : 0.2f);
   const std::string sky = in("sky.exr");
   hfvis::writeImage(sky, map);
-  const CliResult r = run("shade " + shellQuoted(field) + " --env " + shellQuoted(sky) + " -o " +
-                          shellQuoted(out("s.exr")) + " --max-error 0.1 --error-out " + shellQuoted(out("e.exr")));
+  const CliResult r =
+      run("shade " + shellQuoted(field) + " --env " + shellQuoted(sky) + " -o " + shellQuoted(out("s.exr")) +
+          " --max-error 0.1 --error-out " + shellQuoted(out("e.exr")));
   ASSERT_EQ(r.status, 0) << r.err;
   hfvis::HorizonOptions options;
   options.max_error = 0.1;
@@ -848,18 +850,20 @@ TEST_F(Cli, ShadeEnvironmentMaxErrorWritesTheChosenKAndTheEstimate) {
   ASSERT_EQ(lib.irradiance.size(), pixels * channels);
   for (std::size_t c = 0; c < channels; ++c) {
     const auto at = std::find(lib.names.begin(), lib.names.end(), lit.channels[c]) - lib.names.begin();
-    for (std::size_t p = 0; p < pixels; ++p) ASSERT_EQ(lit.pixels[p * channels + c], lib.irradiance[at * pixels + p]);
+    for (std::size_t p = 0; p < pixels; ++p)
+      ASSERT_EQ(lit.pixels[p * channels + c], lib.irradiance[at * pixels + p]);
   }
   for (std::size_t p = 0; p < pixels; ++p) ASSERT_EQ(estimate.pixels[p], lib.error_estimate[p]) << p;
   for (const ReadBack* image : {&lit, &estimate}) {
     EXPECT_EQ(image->spec.get_string_attribute("hfvis:directions"), std::to_string(lib.directions));
     EXPECT_EQ(image->spec.get_string_attribute("hfvis:max_error"), "0.1");
-    EXPECT_NEAR(std::stod(image->spec.get_string_attribute("hfvis:estimated_error")), lib.estimated_error, 1e-9);
+    EXPECT_NEAR(std::stod(image->spec.get_string_attribute("hfvis:estimated_error")), lib.estimated_error,
+                1e-9);
   }
   fs::remove(out("s.exr"));
   fs::remove(out("e.exr"));
-  expectFailure(run("shade " + shellQuoted(field) + " --env " + shellQuoted(sky) + " -o " + shellQuoted(out("s.exr")) +
-                    " --max-error 1e-9 --error-out " + shellQuoted(out("e.exr"))),
+  expectFailure(run("shade " + shellQuoted(field) + " --env " + shellQuoted(sky) + " -o " +
+                    shellQuoted(out("s.exr")) + " --max-error 1e-9 --error-out " + shellQuoted(out("e.exr"))),
                 1, "directions");
 }
 

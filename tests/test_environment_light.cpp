@@ -350,7 +350,8 @@ TEST(Environment, RefusesBadMaps) {
 
 // The environment's relative error, |irradiance at K - at K'| over the dense run's mean, the
 // largest over the channels, per pixel; its 99th percentile over the pixels with data.
-double p99RelativeDifference(const std::vector<float>& a, const std::vector<float>& dense, std::size_t pixels) {
+double p99RelativeDifference(const std::vector<float>& a, const std::vector<float>& dense,
+                             std::size_t pixels) {
   std::vector<double> errors(pixels, 0.0);
   for (std::size_t c = 0; c * pixels < dense.size(); ++c) {
     double mean = 0.0;

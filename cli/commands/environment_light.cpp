@@ -38,7 +38,8 @@ void EnvironmentLight::describe(LitOutput& output, std::size_t pixels) const {
     output.attributes.emplace_back("hfvis:max_error", formatNumber(run_.max_error));
     output.attributes.emplace_back("hfvis:estimated_error", formatNumber(result_.estimated_error));
     output.note += "; estimated error (99th percentile, relative to the mean irradiance) " +
-                   formatFixed(result_.estimated_error, 4) + " for --max-error " + formatNumber(run_.max_error);
+                   formatFixed(result_.estimated_error, 4) + " for --max-error " +
+                   formatNumber(run_.max_error);
   }
 }
 

@@ -109,11 +109,12 @@ class Shade : public Computation {
                   job.image(field, lit.names, lit.planes, lit.attributes, lit.quantity, lit.units));
     if (!run_.error_output.empty()) {
       requireSize(environment_.errorEstimate(), pixels, "error estimate");
-      outputs.image(run_.error_output,
-                    job.image(field, {"error"}, {environment_.errorEstimate()}, lit.attributes,
-                              "estimated error of the environment's irradiance: |at K - at K / 2|, the largest "
-                              "over the channels",
-                              "relative (a fraction of the field's mean irradiance); NaN at nodata"));
+      outputs.image(
+          run_.error_output,
+          job.image(field, {"error"}, {environment_.errorEstimate()}, lit.attributes,
+                    "estimated error of the environment's irradiance: |at K - at K / 2|, the largest "
+                    "over the channels",
+                    "relative (a fraction of the field's mean irradiance); NaN at nodata"));
     }
     if (!run_.preview.empty()) {
       if (!radiance.empty()) {

@@ -14,8 +14,8 @@
 namespace hfvis {
 namespace {
 
-EnvironmentLightResult runAt(const ComputeContext& context, const HeightField& field, const EnvironmentMap& map,
-                             const HorizonOptions& options) {
+EnvironmentLightResult runAt(const ComputeContext& context, const HeightField& field,
+                             const EnvironmentMap& map, const HorizonOptions& options) {
   HorizonOutputs outputs;
   outputs.environment = &map;
   HorizonResult horizons = computeHorizons(context, field, options, outputs);
@@ -44,7 +44,8 @@ void estimateFrom(EnvironmentLightResult& result, const std::vector<float>& coar
     for (std::size_t p = 0; p < pixels; ++p) {
       const double difference = std::abs(static_cast<double>(fine[p]) - coarse[c * pixels + p]);
       float& e = result.error_estimate[p];
-      e = std::isnan(fine[p]) ? fine[p] : std::max(e, static_cast<float>(mean > 0.0 ? difference / mean : 0.0));
+      e = std::isnan(fine[p]) ? fine[p]
+                              : std::max(e, static_cast<float>(mean > 0.0 ? difference / mean : 0.0));
     }
   }
   result.estimated_error = detail::estimatedError(result.error_estimate);
