@@ -10,8 +10,10 @@
 #include <string>
 
 #include "core/horizon_common.hpp"
+#include "core/hull_tree.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
+#include "hfvis/intervisibility.hpp"
 
 namespace hfvis::bench {
 namespace {
@@ -82,6 +84,40 @@ std::vector<float> referencePlane(const ComputeContext& context, const HeightFie
   options = HorizonOptions{};
   options.directions = reference_directions;
   return computeHorizons(context, field, options, wanted).*output.plane;
+}
+
+// Per pixel the error of the count (per direction: it sums K of them) of `r` against `truth`,
+// relative to the truth's mean over the field (NaN at nodata), and its 99th percentile, as
+// IntervisibilityResult::estimated_error takes the estimate's.
+double p99RelativeError(const IntervisibilityResult& r, const IntervisibilityResult& truth) {
+  double mean = 0.0;
+  std::size_t with_data = 0;
+  for (float c : truth.visible_count)
+    if (!std::isnan(c)) mean += double(c) / truth.directions, ++with_data;
+  mean /= with_data;
+  std::vector<float> errors(r.visible_count.size());
+  for (std::size_t p = 0; p < errors.size(); ++p)
+    errors[p] = static_cast<float>(std::abs(double(r.visible_count[p]) / r.directions -
+                                            double(truth.visible_count[p]) / truth.directions) /
+                                   mean);  // NaN at nodata
+  return detail::estimatedError(errors);   // the same percentile
+}
+
+// The work of a tree run at K per receiver: its directions' samples per period summed (the
+// tree's cost is linear in them); `halves`: the error estimate's directions (steps merged only
+// within a parity).
+std::size_t treeSamplesPerReceiver(const HeightField& field, int K, bool halves) {
+  IntervisibilityOptions options;
+  options.directions = K;
+  std::size_t samples = 0;
+  for (const auto& d : detail::treeDirections(field, options, true, halves)) samples += d.per_period;
+  return samples;
+}
+
+std::string spread(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? std::string("not measured")
+                   : formatted("median %.2f", median(v)) + formatted(", largest %.2f", v.back());
 }
 
 }  // namespace
@@ -166,17 +202,95 @@ void errorTargetReport(const ComputeContext& context, const std::vector<ErrorTar
         std::fflush(stdout);
       }
     }
-    const auto spread = [](std::vector<double> v) {
-      std::sort(v.begin(), v.end());
-      return v.empty() ? std::string("not measured")
-                       : formatted("median %.2f", median(v)) + formatted(", largest %.2f", v.back());
-    };
     std::printf(
         "\n%s: achieved error at most E in %d of %d cases (%.0f %%); over the cheapest fixed K: time %s; "
         "work %s; the last run's work alone %s\n",
         output.name, met, rows, rows ? 100.0 * met / rows : 0.0, spread(ratios).c_str(),
         spread(works).c_str(), spread(last_works).c_str());
   }
+}
+
+void viewcountTargetReport(const ComputeContext& context, const std::vector<ErrorTargetField>& fields,
+                           const std::vector<double>& errors, int reference_directions, int reps) {
+  const std::vector<int> ladder = fixedLadder();
+  std::printf(
+      "\n### visible count (intervisibility, relative to its mean)\n\n"
+      "| field | E | runs (K) | estimate | achieved p99 | met | cheapest fixed K | its p99 | time chosen (s) "
+      "| "
+      "time fixed (s) | time ratio | work ratio | last run's work ratio |\n"
+      "|---|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|\n");
+  IntervisibilityOutputs wanted;
+  wanted.visible_count = true;  // (the area is not estimated)
+  int met = 0, rows = 0;
+  std::vector<double> ratios, works, last_works;
+  for (const ErrorTargetField& f : fields) {
+    IntervisibilityOptions options;
+    options.directions = reference_directions;
+    const IntervisibilityResult reference = computeIntervisibility(context, f.field, options, wanted);
+    std::map<int, double> fixed_error;  // K -> achieved p99 of a fixed-K run
+    const auto errorAt = [&](int K) {
+      auto it = fixed_error.find(K);
+      if (it != fixed_error.end()) return it->second;
+      options.directions = K;
+      return fixed_error[K] =
+                 p99RelativeError(computeIntervisibility(context, f.field, options, wanted), reference);
+    };
+    for (double E : errors) {
+      IntervisibilityOptions chosen;
+      chosen.max_error = E;
+      IntervisibilityResult result;
+      try {
+        result = computeIntervisibility(context, f.field, chosen, wanted);
+      } catch (const InvalidArgument& error) {
+        std::printf("| %s | %g | refused: %s |||||||||\n", f.name.c_str(), E, error.what());
+        continue;
+      }
+      const double achieved = p99RelativeError(result, reference);
+      int cheapest = 0;
+      for (int K : ladder)
+        if (errorAt(K) <= E) {
+          cheapest = K;
+          break;
+        }
+      std::vector<double> t_chosen, t_fixed;
+      IntervisibilityOptions fixed;
+      fixed.directions = cheapest ? cheapest : kMaxAutoDirections;
+      for (int r = 0; r < reps; ++r) {
+        t_chosen.push_back(seconds([&] { computeIntervisibility(context, f.field, chosen, wanted); }));
+        t_fixed.push_back(seconds([&] { computeIntervisibility(context, f.field, fixed, wanted); }));
+      }
+      const auto time = [&](const std::vector<double>& t) {
+        return reps ? formatted("%.3f", median(t)) : "-";
+      };
+      const double ratio = reps ? median(t_chosen) / median(t_fixed) : 0.0;
+      const double fixed_work = treeSamplesPerReceiver(f.field, fixed.directions, false);
+      double work = 0.0;
+      std::string runs;
+      for (int K : result.runs) {
+        work += treeSamplesPerReceiver(f.field, K, true);
+        runs += (runs.empty() ? "" : ", ") + std::to_string(K);
+      }
+      const double last_work = treeSamplesPerReceiver(f.field, result.directions, true) / fixed_work;
+      ++rows;
+      met += achieved <= E;
+      if (cheapest) {
+        if (reps) ratios.push_back(ratio);
+        works.push_back(work / fixed_work);
+        last_works.push_back(last_work);
+      }
+      std::printf("| %s | %g | %s | %.5f | %.5f | %s | %s | %.5f | %s | %s | %s | %.2f | %.2f |\n",
+                  f.name.c_str(), E, runs.c_str(), result.estimated_error, achieved,
+                  achieved <= E ? "yes" : "**no**", cheapest ? std::to_string(cheapest).c_str() : "none",
+                  cheapest ? errorAt(cheapest) : 0.0, time(t_chosen).c_str(), time(t_fixed).c_str(),
+                  reps ? formatted("%.2f", ratio).c_str() : "-", work / fixed_work, last_work);
+      std::fflush(stdout);
+    }
+  }
+  std::printf(
+      "\nvisible count: achieved error at most E in %d of %d cases (%.0f %%); over the cheapest fixed "
+      "K: time %s; work %s; the last run's work alone %s\n",
+      met, rows, rows ? 100.0 * met / rows : 0.0, spread(ratios).c_str(), spread(works).c_str(),
+      spread(last_works).c_str());
 }
 
 void errorCurve(const ComputeContext& context, const std::vector<ErrorTargetField>& fields,

@@ -23,6 +23,13 @@ struct ErrorTargetField {
 void errorTargetReport(const ComputeContext& context, const std::vector<ErrorTargetField>& fields,
                        const std::vector<double>& errors, int reference_directions, int reps);
 
+// The same for the visible count of intervisibility (IntervisibilityOptions::max_error,
+// relative): one table, its error the 99th percentile over the pixels of the count's error (per
+// direction) against the hull tree at K = reference_directions, relative to that reference's mean
+// over the field; work: the tree's samples per receiver.
+void viewcountTargetReport(const ComputeContext& context, const std::vector<ErrorTargetField>& fields,
+                           const std::vector<double>& errors, int reference_directions, int reps);
+
 void errorCurve(const ComputeContext& context, const std::vector<ErrorTargetField>& fields,
                 int reference_directions, int max_directions);
 

@@ -101,6 +101,7 @@ constexpr const char* kUsage =
     "       hfvis_bench viewshed-culling [--levels 1,2,3,4] [--reps N] FIELD...\n"
     "       hfvis_bench error-target [--data DIR] [--dem FILE] [--size N] [--errors E,...] [--contents A,B]\n"
     "                                [--reference-k K] [--reps N] [--curve KMAX]\n"
+    "                                [--output svf-ao|viewcount]\n"
     "       hfvis_bench pvs-rays [--size N] [--rays R] [--reps K] [--dem FILE] FIELD...\n"
     "       hfvis_bench pvs-recall [--size N] [--view-cell C] [--tile T] [--samples N,N,...]\n"
     "                              [--check-rays R] [--methods agvs,sgvs,per-cell] [--reference yes|no]\n"
@@ -526,6 +527,9 @@ int main(int argc, char** argv) {
       const int reference = std::stoi(args.get("--reference-k", "2048"));
       const int reps = std::stoi(args.get("--reps", "3"));
       const int curve = std::stoi(args.get("--curve", "0"));
+      const std::string output = args.get("--output", "svf-ao");
+      if (output != "svf-ao" && output != "viewcount")
+        throw Usage("error-target: --output is svf-ao or viewcount");
       const std::vector<std::string> names =
           textList(args.get("--contents", "fractal,bricks,sine,blocks,city_dsm,dem,mixed"));
       args.rejectUnused();
@@ -546,6 +550,11 @@ int main(int argc, char** argv) {
           for (int c = mixed.width / 2; c < mixed.width; ++c)
             mixed.heights[static_cast<std::size_t>(r) * mixed.width + c] = 40.0f * terrain.at(c, r);
         fields.push_back({"mixed", mixed});
+      }
+      if (output == "viewcount") {
+        viewcountTargetReport(ComputeContext::create(ContextOptions::fromEnvironment()), fields, errors,
+                              reference, reps);
+        return 0;
       }
       if (curve > 0) {
         errorCurve(ComputeContext::create(ContextOptions::fromEnvironment()), fields, reference, curve);

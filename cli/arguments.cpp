@@ -424,22 +424,29 @@ const std::vector<OptionSpec>& optionTable() {
        }},
       {"--max-error", nullptr, "E", kErrorTargetGroup, false,
        "choose K for this error instead of taking -k: the 99th percentile over\n"
-       "the pixels of the error estimate (see --error-out) at most E, in the\n"
-       "output's unit (absolute: 0 < E < 1); a first run at 16 directions\n"
-       "predicts the K needed, refused when beyond 4096; the K chosen and the\n"
+       "the pixels of the error estimate (see --error-out) at most E, 0 < E < 1\n"
+       "(absolute for the sky-view factor and occlusion; intervisibility: of\n"
+       "the count, relative to its mean; shade --env: relative to the mean\n"
+       "irradiance); a first run at 16 directions predicts the K needed,\n"
+       "refused when beyond 4096; the K chosen and the\n"
        "estimate go into the summary and the hfvis:directions and\n"
        "hfvis:estimated_error attributes",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
          run.max_error = parseNumber(typed, value);
          if (!(run.max_error > 0.0 && run.max_error < 1.0))
-           throw UsageError(typed + ": the maximum error must lie in (0, 1) (the output lies in 0..1), got " +
+           throw UsageError(typed +
+                            ": the maximum error must lie in (0, 1) (absolute in the sky-view factor's and "
+                            "occlusion's 0..1, relative for intervisibility and shade --env), got " +
                             inQuotes(value));
        }},
       {"--error-out", nullptr, "FILE", kErrorTargetGroup, false,
        "also write the per-pixel error estimate (channel \"error\"): half the\n"
        "difference between the results of the even- and of the odd-numbered\n"
-       "directions alone, which lies above the error against the dense\n"
-       "azimuthal integral on the benchmark's contents; with -k or --max-error",
+       "directions alone (intervisibility: their whole difference in the\n"
+       "count, over the field's mean count), which lies above the error\n"
+       "against the dense azimuthal integral on the benchmark's contents;\n"
+       "with -k or --max-error (shade --env: with --max-error only, the\n"
+       "difference from the run at K / 2 over the mean irradiance)",
        HFVIS_TEXT(error_output)},
       {"--distance-out", nullptr, "FILE", kHorizonGroup, false,
        "also write K channels d000.. of ground distance to the\n"
@@ -1042,6 +1049,7 @@ IntervisibilityOptions intervisibilityOptions(const RunArguments& run) {
   setSweepOptions(run, options);
   options.method = run.visibility_method;
   options.tree = run.hull_tree;
+  options.max_error = run.max_error;
   return options;
 }
 
@@ -1050,6 +1058,7 @@ IntervisibilityOutputs intervisibilityOutputs(const RunArguments& run) {
   outputs.visible_count = true;
   outputs.visible_area = true;
   outputs.statistics = run.statistics;
+  outputs.error_estimate = !run.error_output.empty();
   return outputs;
 }
 

@@ -38,6 +38,7 @@ cd "$work"
 
 # Inputs: a good field, and bad ones.
 cp "$root/data/sine_256.exr" field.exr
+cp "$root/data/clear_sky.exr" sky.exr
 printf 'not an image' > garbage.exr
 : > empty.exr
 head -c 1000 field.exr > truncated.exr
@@ -141,6 +142,17 @@ try "maximum error beyond 4096 directions" "" -- svf field.exr -o out/o.exr --ma
 try "error estimate output is the output" "" -- svf field.exr -o out/o.exr --error-out out/o.exr
 try "error estimate output is the input" "" -- ao field.exr -o out/o.exr -k 8 --error-out field.exr
 try "error estimate with one direction" "" -- svf field.exr -o out/o.exr -k 1 --error-out out/e.exr
+try "viewcount: maximum error zero" "" -- viewcount field.exr -o out/o.exr --max-error 0
+try "viewcount: maximum error of 1 or more (relative)" "" -- viewcount field.exr -o out/o.exr --max-error 1
+try "viewcount: maximum error not finite" "" -- viewcount field.exr -o out/o.exr --max-error inf
+try "viewcount: maximum error with -k" "" -- viewcount field.exr -o out/o.exr --max-error 0.1 -k 16
+try "viewcount: maximum error of the naive method" "" -- viewcount field.exr -o out/o.exr --max-error 0.1 --method naive
+try "viewcount: maximum error beyond 4096 directions" "" -- viewcount field.exr -o out/o.exr --max-error 1e-7 --error-out out/e.exr
+try "viewcount: error estimate with one direction" "" -- viewcount field.exr -o out/o.exr -k 1 --error-out out/e.exr
+try "shade --env: maximum error zero" "" -- shade field.exr --env sky.exr -o out/o.exr --max-error 0
+try "shade --env: maximum error with -k" "" -- shade field.exr --env sky.exr -o out/o.exr --max-error 0.1 -k 16
+try "shade: maximum error without --env" "" -- shade field.exr --sun 100,30 -o out/o.exr --max-error 0.1
+try "shade --env: error estimate without a maximum error" "" -- shade field.exr --env sky.exr -o out/o.exr --error-out out/e.exr
 try "lines per unit (removed: every sweep runs one line through each pixel centre)" "" -- viewcount field.exr -o out/o.exr --lines-per-unit 2
 try "refraction out of range" "" -- svf field.exr -o out/o.exr --refraction 2
 try "curvature for the bounce (not supported)" "" -- bounce field.exr --radiance field.exr -o out/b.exr --curvature

@@ -52,11 +52,19 @@ void finish(IntervisibilityResult& result, const std::vector<PixelSums>& sums,
   }
 }
 
+// With `halves` (the error estimate) the odd-numbered directions' sums apart, split as the
+// device path splits them.
 void sweepReference(const HeightField& field, const std::vector<float>& h,
-                    const IntervisibilityOptions& options, bool statistics, IntervisibilityResult& result) {
-  std::vector<PixelSums> sums(field.pixelCount());
+                    const IntervisibilityOptions& options, bool statistics, bool halves,
+                    IntervisibilityResult& result) {
+  std::vector<PixelSums> halves_sums[2] = {std::vector<PixelSums>(field.pixelCount()),
+                                           std::vector<PixelSums>(halves ? field.pixelCount() : 0)};
+  double weights[2] = {0.0, 0.0};
   auto& stats = result.statistics;
-  for (const TreeDirection& d : treeDirections(field, options)) {
+  for (const TreeDirection& d : treeDirections(field, options, true, halves)) {
+    const int half = halves ? d.index % 2 : 0;
+    std::vector<PixelSums>& sums = halves_sums[half];
+    weights[half] += d.lattice.weight;
     IntervisibilityLines lines = latticeTreeLines(field, h, d, options.curvature != 0.0);
     lines.horizons_at_every_sample = statistics;  // as the kernel without statistics
     sweepPresampledLines(lines, options.tree, false);
@@ -98,7 +106,11 @@ void sweepReference(const HeightField& field, const std::vector<float>& h,
       }
     }
   }
-  finish(result, sums, h);
+  finish(result, halves_sums[0], h);
+  if (!halves) return;
+  std::vector<float> odd_count, odd_area;
+  for (const PixelSums& p : halves_sums[1]) odd_count.push_back(p.count), odd_area.push_back(p.area);
+  splitVisibilityHalves(result, odd_count, odd_area, weights[0], weights[1]);
 }
 
 void naiveReference(const HeightField& field, const std::vector<float>& h,
@@ -284,10 +296,12 @@ IntervisibilityResult referenceIntervisibility(const HeightField& field,
   result.directions = options.directions;
   for (int k = 0; k < options.directions; ++k) result.azimuths.push_back(directionAzimuth(k, options));
   const float nan = std::numeric_limits<float>::quiet_NaN();
-  if (outputs.visible_count) result.visible_count.assign(field.pixelCount(), nan);
+  if (outputs.visible_count || outputs.error_estimate) result.visible_count.assign(field.pixelCount(), nan);
   if (outputs.visible_area) result.visible_area.assign(field.pixelCount(), nan);
   if (options.method == IntervisibilityMethod::HullTree) {
-    detail::sweepReference(field, prepared.heights, options, outputs.statistics, result);
+    detail::sweepReference(field, prepared.heights, options, outputs.statistics, outputs.error_estimate,
+                           result);
+    if (!outputs.visible_count) result.visible_count.clear();
   } else {
     detail::naiveReference(field, prepared.heights, options, result);
   }

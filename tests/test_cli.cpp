@@ -27,8 +27,10 @@
 #include <vector>
 
 #include "geotiff_support.hpp"
+#include "hfvis/environment_light.hpp"
 #include "hfvis/horizon_lists.hpp"
 #include "hfvis/image_io.hpp"
+#include "hfvis/intervisibility.hpp"
 #include "hfvis/pvs.hpp"
 #include "hfvis/region_visibility.hpp"
 #include "hfvis/sky_view_factor.hpp"
@@ -750,6 +752,119 @@ TEST_F(Cli, ErrorOutWithAFixedKWritesTheEstimate) {
     fs::remove(out("s.exr"));
     fs::remove(out("e.exr"));
   }
+}
+
+// viewcount --max-error chooses K and --error-out writes the count's relative estimate: the same
+// K, count and estimate as the library's call, the attributes in both files; with -k, the estimate
+// at the K given; a refused E (beyond 4096 directions) writes neither file.
+TEST_F(Cli, ViewcountMaxErrorWritesTheChosenKAndTheEstimate) {
+  const std::string field = writeField("bumps.exr", 40, 33, [](int col, int row) {
+    return 3.0f * std::sin(0.7f * col) * std::cos(0.5f * row) + ((col / 5 + row / 4) % 3 == 0 ? 4.0f : 0.0f);
+  });
+  const CliResult r = run("viewcount " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) +
+                          " --max-error 0.3 --error-out " + shellQuoted(out("e.exr")));
+  ASSERT_EQ(r.status, 0) << r.err;
+  hfvis::IntervisibilityOptions options;
+  options.max_error = 0.3;
+  hfvis::IntervisibilityOutputs wanted;
+  wanted.visible_count = wanted.visible_area = true;
+  const hfvis::IntervisibilityResult lib = hfvis::computeIntervisibility(
+      hfvis::testing::testContext(), hfvis::readHeightField(field), options, wanted);
+  ASSERT_NE(lib.directions, 64);  // (else the attribute could not tell -k's default from the K run)
+  EXPECT_LE(lib.estimated_error, 0.3);
+  EXPECT_NE(r.out.find(std::to_string(lib.directions) + " directions"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("for --max-error 0.3"), std::string::npos) << r.out;
+  const ReadBack counts = readBack(out("v.exr")), estimate = readBack(out("e.exr"));
+  ASSERT_EQ(estimate.channels, (std::vector<std::string>{"error"}));
+  ASSERT_EQ(counts.channels, (std::vector<std::string>{"count", "visible_area"}));
+  ASSERT_EQ(estimate.pixels.size(), lib.error_estimate.size());
+  for (std::size_t p = 0; p < lib.visible_count.size(); ++p) {
+    ASSERT_EQ(counts.pixels[2 * p], lib.visible_count[p]) << p;
+    ASSERT_EQ(counts.pixels[2 * p + 1], lib.visible_area[p]) << p;
+    ASSERT_EQ(estimate.pixels[p], lib.error_estimate[p]) << p;
+  }
+  for (const ReadBack* image : {&counts, &estimate}) {
+    EXPECT_EQ(image->spec.get_string_attribute("hfvis:directions"), std::to_string(lib.directions));
+    EXPECT_EQ(image->spec.get_string_attribute("hfvis:max_error"), "0.3");
+    EXPECT_NEAR(std::stod(image->spec.get_string_attribute("hfvis:estimated_error")), lib.estimated_error,
+                1e-9);
+  }
+  // --error-out with -k: the estimate at the K given.
+  fs::remove(out("v.exr"));
+  fs::remove(out("e.exr"));
+  ASSERT_EQ(run("viewcount " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) +
+                " -k 8 --error-out " + shellQuoted(out("e.exr")))
+                .status,
+            0);
+  options.max_error = 0.0;
+  options.directions = 8;
+  wanted.error_estimate = true;
+  const hfvis::IntervisibilityResult fixed = hfvis::computeIntervisibility(
+      hfvis::testing::testContext(), hfvis::readHeightField(field), options, wanted);
+  const ReadBack fixed_estimate = readBack(out("e.exr"));
+  ASSERT_EQ(fixed_estimate.pixels.size(), fixed.error_estimate.size());
+  for (std::size_t p = 0; p < fixed.error_estimate.size(); ++p)
+    ASSERT_EQ(fixed_estimate.pixels[p], fixed.error_estimate[p]) << p;
+  EXPECT_EQ(fixed_estimate.spec.get_string_attribute("hfvis:directions"), "8");
+  fs::remove(out("v.exr"));
+  fs::remove(out("e.exr"));
+  expectFailure(run("viewcount " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) +
+                    " --max-error 1e-7 --error-out " + shellQuoted(out("e.exr"))),
+                1, "directions");
+}
+
+// shade --env --max-error chooses K and --error-out writes the estimate (|at K - at K / 2| over the
+// mean irradiance): the same K, irradiance and estimate as the library's call, the attributes in
+// both files; a refused E writes neither file.
+TEST_F(Cli, ShadeEnvironmentMaxErrorWritesTheChosenKAndTheEstimate) {
+  const std::string field = writeField("bumps.exr", 40, 33, [](int col, int row) {
+    return 3.0f * std::sin(0.7f * col) * std::cos(0.5f * row) + ((col / 5 + row / 4) % 3 == 0 ? 4.0f : 0.0f);
+  });
+  // A sky without a sun (a sun's shadow makes the difference jump with K: docs/COMMAND_LINE.md):
+  // brighter toward the zenith and toward one azimuth, 32 x 16.
+  hfvis::ImageChannels map;
+  map.width = 32;
+  map.height = 16;
+  map.names = {"Y"};
+  map.planes.emplace_back();
+  for (int row = 0; row < map.height; ++row)
+    for (int col = 0; col < map.width; ++col)
+      map.planes[0].push_back(row < 8 ? 2.0f - row / 8.0f + 0.5f * std::cos(col * 2.0f * float(M_PI) / 32)
+                                      : 0.2f);
+  const std::string sky = in("sky.exr");
+  hfvis::writeImage(sky, map);
+  const CliResult r =
+      run("shade " + shellQuoted(field) + " --env " + shellQuoted(sky) + " -o " + shellQuoted(out("s.exr")) +
+          " --max-error 0.1 --error-out " + shellQuoted(out("e.exr")));
+  ASSERT_EQ(r.status, 0) << r.err;
+  hfvis::HorizonOptions options;
+  options.max_error = 0.1;
+  const hfvis::EnvironmentLightResult lib = hfvis::computeEnvironmentLight(
+      hfvis::testing::testContext(), hfvis::readHeightField(field), hfvis::readEnvironmentMap(sky), options);
+  ASSERT_NE(lib.directions, 64);  // (else the attribute could not tell -k's default from the K run)
+  EXPECT_LE(lib.estimated_error, 0.1);
+  EXPECT_NE(r.out.find(std::to_string(lib.directions) + " directions"), std::string::npos) << r.out;
+  const ReadBack lit = readBack(out("s.exr")), estimate = readBack(out("e.exr"));
+  ASSERT_EQ(estimate.channels, (std::vector<std::string>{"error"}));
+  const std::size_t pixels = lib.error_estimate.size(), channels = lit.channels.size();
+  ASSERT_EQ(lib.irradiance.size(), pixels * channels);
+  for (std::size_t c = 0; c < channels; ++c) {
+    const auto at = std::find(lib.names.begin(), lib.names.end(), lit.channels[c]) - lib.names.begin();
+    for (std::size_t p = 0; p < pixels; ++p)
+      ASSERT_EQ(lit.pixels[p * channels + c], lib.irradiance[at * pixels + p]);
+  }
+  for (std::size_t p = 0; p < pixels; ++p) ASSERT_EQ(estimate.pixels[p], lib.error_estimate[p]) << p;
+  for (const ReadBack* image : {&lit, &estimate}) {
+    EXPECT_EQ(image->spec.get_string_attribute("hfvis:directions"), std::to_string(lib.directions));
+    EXPECT_EQ(image->spec.get_string_attribute("hfvis:max_error"), "0.1");
+    EXPECT_NEAR(std::stod(image->spec.get_string_attribute("hfvis:estimated_error")), lib.estimated_error,
+                1e-9);
+  }
+  fs::remove(out("s.exr"));
+  fs::remove(out("e.exr"));
+  expectFailure(run("shade " + shellQuoted(field) + " --env " + shellQuoted(sky) + " -o " +
+                    shellQuoted(out("s.exr")) + " --max-error 1e-9 --error-out " + shellQuoted(out("e.exr"))),
+                1, "directions");
 }
 
 TEST_F(Cli, HorizonWritesOneChannelPerDirection) {

@@ -6,8 +6,10 @@
 // and bad maps.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -344,6 +346,84 @@ TEST(Environment, RefusesBadMaps) {
   geographic.row_cell_size_y.assign(5, 1.0);
   const EnvironmentMap good = uniformEnvironment(1.0f, 4);
   EXPECT_THROW(computeHorizons(testContext(), geographic, options, environmentOutputs(good)), InvalidArgument);
+}
+
+// The environment's relative error, |irradiance at K - at K'| over the dense run's mean, the
+// largest over the channels, per pixel; its 99th percentile over the pixels with data.
+double p99RelativeDifference(const std::vector<float>& a, const std::vector<float>& dense,
+                             std::size_t pixels) {
+  std::vector<double> errors(pixels, 0.0);
+  for (std::size_t c = 0; c * pixels < dense.size(); ++c) {
+    double mean = 0.0;
+    std::size_t with_data = 0;
+    for (std::size_t p = 0; p < pixels; ++p)
+      if (!std::isnan(dense[c * pixels + p])) mean += dense[c * pixels + p], ++with_data;
+    mean /= with_data;
+    for (std::size_t p = 0; p < pixels; ++p)
+      errors[p] = std::max(errors[p], std::abs(double(a[c * pixels + p]) - dense[c * pixels + p]) / mean);
+  }
+  std::vector<double> with_data;
+  for (std::size_t p = 0; p < pixels; ++p)
+    if (!std::isnan(dense[p])) with_data.push_back(errors[p]);
+  std::sort(with_data.begin(), with_data.end());
+  return with_data[std::min(with_data.size() - 1, static_cast<std::size_t>(0.99 * with_data.size()))];
+}
+
+// A maximum error: the estimate is the difference from the run at half the directions, relative
+// to the mean; the K chosen meets E by it and against a dense run (K = 1024), a smaller E never
+// takes fewer directions nor gives a larger estimate, the runs go up from 16.
+TEST(EnvironmentMaxError, MeetsTheTargetAgainstADenseRun) {
+  const EnvironmentMap map = structuredEnvironment(32);
+  for (const char* name : {"noise", "city"}) {
+    SCOPED_TRACE(name);
+    const HeightField field = makeSyntheticField(name, 64, 60);
+    const std::size_t pixels = field.pixelCount();
+    HorizonOptions options;
+    options.directions = 1024;
+    const std::vector<float> dense = computeEnvironmentLight(testContext(), field, map, options).irradiance;
+    int last_directions = 0;
+    double last_estimate = 1.0;
+    for (double E : {0.05, 0.02, 0.01}) {
+      SCOPED_TRACE(E);
+      options.max_error = E;
+      const EnvironmentLightResult r = computeEnvironmentLight(testContext(), field, map, options);
+      EXPECT_LE(r.estimated_error, E);
+      EXPECT_LE(p99RelativeDifference(r.irradiance, dense, pixels), E);
+      EXPECT_GE(r.directions, last_directions);
+      EXPECT_LE(r.estimated_error, last_estimate);
+      ASSERT_FALSE(r.runs.empty());
+      EXPECT_EQ(r.runs.front(), 16);
+      EXPECT_EQ(r.runs.back(), r.directions);
+      // The estimate is the difference from the run at K / 2, and the irradiance the run at K's.
+      HorizonOptions fixed;
+      fixed.directions = r.directions;
+      const std::vector<float> at_k = computeEnvironmentLight(testContext(), field, map, fixed).irradiance;
+      fixed.directions = r.directions / 2;
+      const std::vector<float> at_half = computeEnvironmentLight(testContext(), field, map, fixed).irradiance;
+      EXPECT_TRUE(testing::nearlyEqual(r.irradiance, at_k, 0.0f));
+      EXPECT_NEAR(r.estimated_error, p99RelativeDifference(at_half, at_k, pixels), 1e-6);
+      last_directions = r.directions;
+      last_estimate = r.estimated_error;
+    }
+  }
+}
+
+TEST(EnvironmentMaxError, BadRequestsAreRefused) {
+  const EnvironmentMap map = structuredEnvironment(8);
+  const HeightField field = makeSyntheticField("noise", 16, 16);
+  HorizonOptions options;
+  for (double E :
+       {-0.01, 1.0, 2.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+    options.max_error = E;
+    EXPECT_THROW(computeEnvironmentLight(testContext(), field, map, options), InvalidArgument) << E;
+  }
+  options.max_error = 1e-9;
+  try {
+    computeEnvironmentLight(testContext(), field, map, options);
+    ADD_FAILURE() << "an error of 1e-9 was accepted";
+  } catch (const InvalidArgument& error) {
+    EXPECT_NE(std::string(error.what()).find("directions"), std::string::npos) << error.what();
+  }
 }
 
 }  // namespace

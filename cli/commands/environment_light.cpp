@@ -12,12 +12,11 @@ void EnvironmentLight::read() {
 
 void EnvironmentLight::compute(Job& job, const NorthUp& lit, const HorizonOptions& options) {
   const HeightField& field = lit.field();
-  HorizonOutputs wanted;
-  wanted.environment = &map_;
-  result_ = job.progress.run([&] { return computeHorizons(*job.context, field, options, wanted); });
+  result_ = job.progress.run([&] { return computeEnvironmentLight(*job.context, field, map_, options); });
   requireSize(result_.irradiance, field.pixelCount() * map_.channels, "irradiances");
   requireFiniteResult(result_.irradiance, field, "irradiance");
   lit.restore(result_.irradiance);
+  if (!result_.error_estimate.empty()) lit.restore(result_.error_estimate);
 }
 
 void EnvironmentLight::describe(LitOutput& output, std::size_t pixels) const {
@@ -32,6 +31,16 @@ void EnvironmentLight::describe(LitOutput& output, std::size_t pixels) const {
   output.units =
       "the environment's radiance times steradians (a uniform radiance of 1 gives pi on open flat ground); ";
   output.note += "; mean irradiance " + formatFixed(finiteMean(result_.irradiance), 4);
+  // The K run, which --max-error chooses, and the error estimate when there is one.
+  for (auto& [name, value] : output.attributes)
+    if (name == "hfvis:directions") value = std::to_string(result_.directions);
+  if (run_.max_error > 0.0) {
+    output.attributes.emplace_back("hfvis:max_error", formatNumber(run_.max_error));
+    output.attributes.emplace_back("hfvis:estimated_error", formatNumber(result_.estimated_error));
+    output.note += "; estimated error (99th percentile, relative to the mean irradiance) " +
+                   formatFixed(result_.estimated_error, 4) + " for --max-error " +
+                   formatNumber(run_.max_error);
+  }
 }
 
 }  // namespace hfvis::cli

@@ -36,7 +36,13 @@ class Intervisibility : public Computation {
     attributes.emplace_back("hfvis:tie_rule",
                             "a sample is visible when its slope from the receiver is >= the slope of every "
                             "sample between them (grazing samples are visible), decided exactly");
-    Summary summary{run_.directions};
+    // The K run, which --max-error chooses, and the error estimate when there is one.
+    for (auto& [name, value] : attributes)
+      if (name == "hfvis:directions") value = std::to_string(result_.directions);
+    if (run_.max_error > 0.0) attributes.emplace_back("hfvis:max_error", formatNumber(run_.max_error));
+    if (!result_.error_estimate.empty())
+      attributes.emplace_back("hfvis:estimated_error", formatNumber(result_.estimated_error));
+    Summary summary{result_.directions};
     if (run_.statistics) {
       const IntervisibilityStatistics& stats = result_.statistics;
       // Timonen (2013), Table 2: per receiver (line sample) and direction.
@@ -66,10 +72,22 @@ class Intervisibility : public Computation {
             "drho",
             "count: samples (one per 1/S pixel lengths along each direction, S = samples per unit); "
             "visible_area: ground units squared"));
+    if (!run_.error_output.empty()) {
+      requireSize(result_.error_estimate, pixels, "error estimate");
+      outputs.image(run_.error_output,
+                    job.image(field, {"error"}, {result_.error_estimate}, attributes,
+                              "estimated error of the visible count (not the area), relative to the "
+                              "field's mean count",
+                              "relative (a fraction of the mean count); NaN at nodata"));
+    }
     if (!run_.preview.empty())
       outputs.previewPng(run_.preview, field.width, field.height,
                          result_.visible_count);  // stretched min..max
     summary.note = "; mean count " + formatFixed(finiteMean(result_.visible_count), 2);
+    if (!result_.error_estimate.empty())
+      summary.note += "; estimated error (99th percentile, relative to the mean count) " +
+                      formatFixed(result_.estimated_error, 4) +
+                      (run_.max_error > 0.0 ? " for --max-error " + formatNumber(run_.max_error) : "");
     return summary;
   }
 
@@ -77,13 +95,18 @@ class Intervisibility : public Computation {
   IntervisibilityResult result_;
 };
 
-void checkIntervisibility(const std::string&, const RunArguments& run) {
+void checkIntervisibility(const std::string& name, const RunArguments& run) {
   const bool naive = run.visibility_method != IntervisibilityMethod::HullTree;
   if (naive && !run.hull_tree_name.empty())
     throw UsageError("--hull-tree needs --method tree (the naive method builds no tree)");
   // (the library's "statistics ... only for the hull-tree method", in the CLI's words)
   if (naive && run.statistics)
     throw UsageError("--stats needs --method tree (the naive method has no horizons or iterations to count)");
+  if (naive && (run.max_error > 0.0 || !run.error_output.empty()))
+    throw UsageError(
+        "--max-error and --error-out need --method tree (the naive method's rays are not split in halves)");
+  if (run.max_error > 0.0 && run.directions_given)
+    throw UsageError(name + ": --max-error chooses K itself; give either it or -k");
   asUsageError([&] { validate(intervisibilityOptions(run), intervisibilityOutputs(run)); });
 }
 
@@ -95,7 +118,7 @@ const CommandSpec kIntervisibilityCommand{
     "viewcount",
     "channel 0 \"count\": visible surface samples summed over the K directions;\n"
     "channel 1 \"visible_area\": the visible ground area (total viewshed), ground units^2",
-    "IN -o OUT.exr [-k K] [--method tree|naive] [--stats] [options]",
+    "IN -o OUT.exr [-k K | --max-error E] [--error-out ERR.exr] [--method tree|naive] [--stats] [options]",
     "Writes two float32 channels: channel 0 \"count\" = the number of visible surface samples\n"
     "summed over the K directions (one sample per 1/S pixel lengths along each direction, S =\n"
     "--samples-per-unit, default 1); channel 1 \"visible_area\" = the visible ground area, ground\n"
@@ -113,7 +136,7 @@ const CommandSpec kIntervisibilityCommand{
     "           step) times rho * drho, drho the ground step: ground units squared; it tends to\n"
     "           the area seen as K grows.\n"
     "The preview stretches the count from its minimum to its maximum.\n",
-    kSweptFieldGroups | kHullTreeGroup | kIntervisibilityGroup,
+    kSweptFieldGroups | kHullTreeGroup | kIntervisibilityGroup | kErrorTargetGroup,
     checkIntervisibility,
     nullptr,
     pipelined<Intervisibility>,

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "../pipeline.hpp"
+#include "hfvis/environment_light.hpp"
 #include "hfvis/environment_map.hpp"
 #include "hfvis/horizon.hpp"
 #include "hfvis/sun_shading.hpp"
@@ -34,11 +35,14 @@ class EnvironmentLight {
   int channels() const { return map_.channels; }
   // Channel c's irradiance (width * height values from c * pixels on).
   const std::vector<float>& irradiance() const { return result_.irradiance; }
+  // The K run (--max-error chooses it) and, with --max-error, the estimate (else empty).
+  int directions() const { return result_.directions; }
+  const std::vector<float>& errorEstimate() const { return result_.error_estimate; }
 
  private:
   const RunArguments& run_;
   EnvironmentMap map_;
-  HorizonResult result_;
+  EnvironmentLightResult result_;
 };
 
 // The sun, --sun AZ,EL or where it stands at --at TIME from --lat, --lon: the part of its disc

@@ -62,6 +62,7 @@ class Shade : public Computation {
     HorizonOptions options = horizonOptions(run_);
     job.progress.attach(options);
     if (environment_.given()) environment_.compute(job, lit_, options);
+    options.max_error = 0.0;  // (the environment's alone)
     if (sun_.given()) sun_.compute(job, lit_, options);
   }
 
@@ -106,6 +107,15 @@ class Shade : public Computation {
     }
     outputs.image(run_.output,
                   job.image(field, lit.names, lit.planes, lit.attributes, lit.quantity, lit.units));
+    if (!run_.error_output.empty()) {
+      requireSize(environment_.errorEstimate(), pixels, "error estimate");
+      outputs.image(
+          run_.error_output,
+          job.image(field, {"error"}, {environment_.errorEstimate()}, lit.attributes,
+                    "estimated error of the environment's irradiance: |at K - at K / 2|, the largest "
+                    "over the channels",
+                    "relative (a fraction of the field's mean irradiance); NaN at nodata"));
+    }
     if (!run_.preview.empty()) {
       if (!radiance.empty()) {
         outputs.toneMappedPng(run_.preview, field.width, field.height, radiance);
@@ -117,7 +127,8 @@ class Shade : public Computation {
                            std::max(1e-6f, quantileRange(sun_.direct(), 0.0, 1.0).second));
       }
     }
-    return {environment_.given() ? run_.directions : 1, lit.note + (lit_.flipped() ? " (lit north-up)" : "")};
+    return {environment_.given() ? environment_.directions() : 1,
+            lit.note + (lit_.flipped() ? " (lit north-up)" : "")};
   }
 
  private:
@@ -140,6 +151,12 @@ void checkShade(const std::string&, const RunArguments& run) {
         "--lat LAT --lon LON");
   if (run.environment.empty() && run.sweep_options_given)
     throw UsageError("-k, --method and --azimuth-offset need --env (the sun alone sweeps its own azimuth)");
+  if (run.environment.empty() && (run.max_error > 0.0 || !run.error_output.empty()))
+    throw UsageError("--max-error and --error-out need --env (the sun's shadow has no directions to choose)");
+  if (run.max_error > 0.0 && run.directions_given)
+    throw UsageError("shade: --max-error chooses K itself; give either it or -k");
+  if (!run.error_output.empty() && run.max_error == 0.0)
+    throw UsageError("shade: --error-out needs --max-error (the estimate compares the runs at K and K / 2)");
   if (run.environment.empty() && (run.environment_rotation_deg != 0.0 || run.environment_rows != 0))
     throw UsageError("--env-rotate and --env-rows need --env ENV.exr");
   if (!sun && run.sun_irradiance != 1.0) throw UsageError("--sun-irradiance needs the sun");
@@ -171,7 +188,8 @@ const CommandSpec kShadeCommand{
     "--env: \"R\", \"G\", \"B\" (or \"Y\"), the irradiance from an HDR environment through the\n"
     "horizons; the sun: \"sun\", the part of its disc above the horizon (0..1), and\n"
     "\"direct\", sun * max(0, n . s); --albedo: \"radiance[.R/G/B]\", what the surface sends out",
-    "IN -o OUT.exr [--env ENV.exr [--env-rotate DEG] [--env-rows N] [-k K]]\n"
+    "IN -o OUT.exr [--env ENV.exr [--env-rotate DEG] [--env-rows N] [-k K | --max-error E\n"
+    "[--error-out ERR.exr]]]\n"
     "[--sun AZ,EL | --at TIME --lat LAT --lon LON] [--sun-size DEG]\n"
     "[--albedo A|FILE [--sun-irradiance E]] [options]",
     "Lights the surface; give --env, the sun, or both.\n"
@@ -184,7 +202,9 @@ const CommandSpec kShadeCommand{
     "  open flat ground, pi times 'hfvis ambient-occlusion' everywhere). -k directions (default\n"
     "  64) and --method as for ambient-occlusion; --env-rows N bands of zenith angle in the tables\n"
     "  (default the map's rows, exact for a map constant over each pixel; fewer are faster to\n"
-    "  build, not to light). -k, --method and --azimuth-offset need --env.\n"
+    "  build, not to light). -k, --method and --azimuth-offset need --env. --max-error E (0 < E\n"
+    "  < 1): K chosen so that the 99th percentile of |irradiance at K - at K / 2| over the\n"
+    "  field's mean irradiance is at most E (every run also at K / 2); --error-out writes it.\n"
     "The sun: channel \"sun\" is the fraction of the sun's disc (--sun-size degrees across,\n"
     "  default 0.53; 0 = a point sun, hard shadows) above each pixel's horizon in the sun's\n"
     "  azimuth and above elevation 0 (level ground beyond the field); \"direct\" is sun * max(0,\n"
@@ -202,7 +222,8 @@ const CommandSpec kShadeCommand{
     "hillshade with cast shadows: direct from 0 (black) to its largest value (white). NaN at\n"
     "nodata pixels.\n",
     nullptr,
-    kSweptFieldGroups | kSweepMethodGroup | kSunPlaceGroup | kEnvironmentLightGroup | kSunShadingGroup,
+    kSweptFieldGroups | kSweepMethodGroup | kSunPlaceGroup | kEnvironmentLightGroup | kSunShadingGroup |
+        kErrorTargetGroup,
     checkShade,
     nullptr,
     pipelined<Shade>,

@@ -72,6 +72,15 @@ struct IntervisibilityOptions : SweepOptions {
   // run bit for bit. 0: the whole field when it fits, else as many rows as half the budget
   // holds; fewer rows than the field's force strips. The naive method needs the whole field.
   int strip_rows = 0;
+  // HullTree only. Ask for an error, not a direction count: when > 0 (and < 1), K is chosen
+  // (options.directions is ignored) so that the 99th percentile over the pixels of the error
+  // estimate (IntervisibilityResult::estimated_error) of the visible count, relative to the
+  // field's mean count, is at most max_error (the area is not estimated), as HorizonOptions::max_error
+  // chooses it for the sky-view factor: a first run at 16 directions, each run predicting the K the next
+  // needs, until the estimate meets it; IntervisibilityResult::directions and ::runs say which K. Throws
+  // InvalidArgument, naming the K it would take, when a run predicts more than kMaxAutoDirections
+  // (hfvis/horizon.hpp). The samples per unit stay as given.
+  double max_error = 0.0;
 };
 
 // What to compute; only what is asked for is stored or reduced.
@@ -90,6 +99,10 @@ struct IntervisibilityOutputs {
   bool visible_area = false;
   // Horizon and iteration totals of the hull tree (HullTree only).
   bool statistics = false;
+  // HullTree only, K >= 2: an estimate of the count's error against the azimuthal integral it
+  // approximates, relative to the field's mean count (IntervisibilityResult::error_estimate), from
+  // the same run: the even- and the odd-numbered directions summed apart.
+  bool error_estimate = false;
 };
 
 // Totals over every sample of every line of every direction (line samples, not pixels: a
@@ -118,7 +131,21 @@ struct IntervisibilityResult {
   std::vector<double> azimuths;          // phi_k, radians
   std::vector<float> visible_count;      // width*height if asked; NaN at nodata receivers
   std::vector<float> visible_area;       // width*height if asked; NaN at nodata receivers
-  IntervisibilityStatistics statistics;  // if asked
+  IntervisibilityStatistics statistics;  // if asked (with max_error: of the last run)
+  // With IntervisibilityOutputs::error_estimate or IntervisibilityOptions::max_error, per pixel:
+  // the difference between the even- and the odd-numbered directions' counts (each half's sum over
+  // its own wedges: two interleaved quadratures of K / 2 directions), relative to the field's mean
+  // count (not the pixel's own: in a pit or a street it can be near 0); NaN at nodata. The whole
+  // difference, not half of it as for the sky-view factor: the count's azimuthal error falls
+  // slowly (about K^-0.6 on noise and a city), so the halves' errors hardly cancel and half their
+  // difference lies at the error, not above it. Of the count only: the area, whose far samples
+  // weigh most, errs more (2-5x at the same K) and is not estimated. Measured against a dense K in
+  // bench/report/error_target.md.
+  std::vector<float> error_estimate;
+  double estimated_error = 0.0;  // its 99th percentile over the pixels with data; 0 without it
+  // With IntervisibilityOptions::max_error: the K of each run it made, in order (the last is
+  // `directions`); empty otherwise.
+  std::vector<int> runs;
 };
 
 // Throws InvalidArgument for a replacement check without deferred writes, a safe zone
@@ -126,8 +153,9 @@ struct IntervisibilityResult {
 void validate(const HullTreeTuning& tuning);
 
 // Throws InvalidArgument for bad sweep options (see sweep_options.hpp), a bad tree tuning,
-// no output requested, statistics asked of the naive method, or a negative strip_rows (or
-// strips asked of the naive method).
+// no output requested, statistics, an error estimate or a maximum error asked of the naive
+// method, a maximum error outside [0, 1) or not finite, an estimate at K < 2, or a negative
+// strip_rows (or strips asked of the naive method).
 void validate(const IntervisibilityOptions& options, const IntervisibilityOutputs& outputs);
 
 // Runs options.method on the device of `context`. Throws InvalidArgument (bad field or

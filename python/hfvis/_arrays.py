@@ -150,9 +150,10 @@ def compute(operation, heights, geometry, options, device="", progress=None):
         return r
     if operation == "intervisibility":
         o = _core.IntervisibilityOptions()
-        _set(o, options, _SWEEP + ("strip_rows",))
+        _set(o, options, _SWEEP + ("strip_rows", "max_error"))
         o.method = _enum(_core.IntervisibilityMethod, options.get("method", "hull_tree"), "method")
-        r = _core.intervisibility(field, o, device=device, progress=progress)
+        r = _core.intervisibility(field, o, error_estimate=bool(options.get("error_estimate")), device=device,
+                                  progress=progress)
         r["azimuths"] = np.asarray(r["azimuths"])
         return r
     if operation == "sun_shading":
@@ -180,9 +181,10 @@ def compute(operation, heights, geometry, options, device="", progress=None):
             names = ["Y"] if radiance.shape[0] == 1 else ["R", "G", "B"][: radiance.shape[0]]
             env = _core.environment_map(np.ascontiguousarray(radiance, dtype=np.float32), names,
                                         float(options["rotation_deg"]), int(options["table_rows"]))
-        irradiance, names = _core.environment_light(field, env, _horizon_options(options), device=device,
-                                                    progress=progress)
-        return {"irradiance": irradiance, "channels": names}
+        irradiance, names, directions, error, estimated = _core.environment_light(
+            field, env, _horizon_options(options), device=device, progress=progress)
+        return {"irradiance": irradiance, "channels": names, "directions": directions, "error": error,
+                "estimated_error": estimated}
     if operation == "viewshed":
         col, row = observer_pixel(options["observer"])
         return {"visible": _core.viewshed(field, col, row, float(options["observer_height"]),

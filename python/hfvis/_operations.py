@@ -15,6 +15,8 @@ Intervisibility = collections.namedtuple("Intervisibility", "visible_count visib
 SunShading = collections.namedtuple("SunShading", "sun direct")
 Insolation = collections.namedtuple("Insolation", "sun_hours direct")
 ErrorEstimate = collections.namedtuple("ErrorEstimate", "values error directions estimated_error")
+IntervisibilityEstimate = collections.namedtuple("IntervisibilityEstimate",
+                                                 "visible_count visible_area error directions estimated_error")
 RegionVisibility = collections.namedtuple("RegionVisibility", "fraction bits rgb", defaults=(None,))
 RegionPairVisibility = collections.namedtuple(
     "RegionPairVisibility", "bits sources receivers source_fraction receiver_fraction clear_pairs pairs "
@@ -181,6 +183,10 @@ def _places_as_pixels(operation, options, grid, pixels):
     return options
 
 
+_COUNT_ERROR = ("relative to the field's mean count (the even- and odd-numbered directions' counts' difference); "
+                "the area is not estimated")
+
+
 def _attrs(operation, name, options, grid):
     attrs = {"units": _UNITS[name], "hfvis_operation": operation, "hfvis_method": _method(operation, options)}
     if operation == "insolation" and name == "direct":
@@ -332,16 +338,41 @@ def _swept_quantity(operation, heights, options, max_error, error_estimate, comm
 
 
 def intervisibility(heights, *, directions=64, azimuth_offset=0.0, samples_per_unit=1.0, curvature=0.0,
-                    max_distance=0.0, method="hull_tree", strip_rows=0, memory_budget_bytes=0, cell_size=None,
-                    z_scale=1.0, nodata=None, device="", progress=None):
+                    max_distance=0.0, method="hull_tree", strip_rows=0, memory_budget_bytes=0, max_error=0.0,
+                    error_estimate=False, cell_size=None, z_scale=1.0, nodata=None, device="", progress=None):
     """How much of the surface each point sees (Timonen 2013's convex hull tree): visible samples
     and visible ground area. numpy: Intervisibility(visible_count, visible_area); DataArray: a
-    Dataset of the two."""
+    Dataset of the two. max_error=E (hull tree only) chooses K (directions ignored) so that the
+    99th percentile of the count's error estimate, relative to the field's mean count, is at most
+    E, as the CLI's --max-error; with it or error_estimate=True: numpy
+    IntervisibilityEstimate(visible_count, visible_area, error, directions, estimated_error); a
+    Dataset with the K and the estimate in its variables' attrs (and the per-pixel error as the
+    variable "error" under error_estimate=True)."""
     options = _horizon(directions, azimuth_offset, samples_per_unit, curvature, max_distance, memory_budget_bytes,
                        method, None, strip_rows)
     del options["azimuth_tolerance"]
-    return _pair("intervisibility", Intervisibility, heights, options,
-                 _common(cell_size, z_scale, nodata, device, progress))
+    common = _common(cell_size, z_scale, nodata, device, progress)
+    if not max_error and not error_estimate:
+        return _pair("intervisibility", Intervisibility, heights, options, common)
+    if max_error:
+        options["max_error"] = float(max_error)
+    if error_estimate:
+        options["error_estimate"] = True
+    if _is_dataarray(heights) and _is_dask(heights.data):
+        heights = heights.compute()  # K and the estimate's percentile are the whole field's: in one piece
+    out, grid = _run("intervisibility", heights, options, common)
+    if grid is None:
+        return IntervisibilityEstimate(out["visible_count"], out["visible_area"], out["error"], out["directions"],
+                                       out["estimated_error"])
+    import xarray as xr
+
+    attrs = dict(hfvis_directions=out["directions"], hfvis_estimated_error=out["estimated_error"])
+    chosen = dict(options, directions=out["directions"])
+    names = _arrays.OUTPUTS["intervisibility"] + (("error",) if error_estimate else ())
+    variables = {n: grid.result(out[n], n, dict(_attrs("intervisibility", n, chosen, grid), **attrs)) for n in names}
+    if error_estimate:
+        variables["error"].attrs["units"] = _COUNT_ERROR
+    return xr.Dataset(variables)
 
 
 def viewshed(heights, observer, *, observer_height=2.0, absolute=False, target_height=0.0, max_distance=0.0,
@@ -404,15 +435,23 @@ def insolation(heights, latitude_deg, longitude_deg, start, end, *, step_minutes
 
 def environment_light(heights, environment, *, rotation_deg=0.0, table_rows=0, directions=64, azimuth_offset=0.0,
                       samples_per_unit=1.0, curvature=0.0, max_distance=0.0, method="sweep", azimuth_tolerance=None,
-                      memory_budget_bytes=0, cell_size=None, z_scale=1.0, nodata=None, device="", progress=None):
+                      memory_budget_bytes=0, max_error=0.0, cell_size=None, z_scale=1.0, nodata=None, device="",
+                      progress=None):
     """The irradiance an HDR environment gives each point through its horizons (Timonen &
     Westerholm 2010, Sec. 6.2). `environment`: a file (EXR, HDR, ...) or radiance as an
     equirectangular (rows, 2 rows) or (channels, rows, 2 rows) array, row 0 at the zenith, the
-    left edge north. Returns (channels, H, W), or (H, W) for one channel."""
+    left edge north. Returns (channels, H, W), or (H, W) for one channel. max_error=E chooses K
+    (directions ignored) as the CLI's shade --env --max-error (|irradiance at K - at K / 2| over
+    the mean, relative): numpy ErrorEstimate(values, error, directions, estimated_error); a
+    DataArray with the K and the estimate in its attrs."""
     options = _horizon(directions, azimuth_offset, samples_per_unit, curvature, max_distance, memory_budget_bytes,
                        method, azimuth_tolerance, 0)
     options.update(environment=environment, rotation_deg=float(rotation_deg), table_rows=int(table_rows))
     common = _common(cell_size, z_scale, nodata, device, progress)
+    if max_error:
+        options["max_error"] = float(max_error)
+        if _is_dataarray(heights) and _is_dask(heights.data):
+            heights = heights.compute()  # K and the estimate's percentile are the whole field's: in one piece
     if _is_dataarray(heights) and _is_dask(heights.data):
         # Chunk by chunk within the maximum distance: the channels, which each block's planes
         # follow, from a one-cell field's run (they depend on the environment alone).
@@ -421,8 +460,11 @@ def environment_light(heights, environment, *, rotation_deg=0.0, table_rows=0, d
     out, grid = _run("environment_light", heights, options, common)
     irradiance, channels = out["irradiance"], list(out.get("channels", options.get("channels", [])))
     if grid is None:
-        return irradiance[0] if len(channels) == 1 else irradiance
+        values = irradiance[0] if len(channels) == 1 else irradiance
+        return ErrorEstimate(values, out["error"], out["directions"], out["estimated_error"]) if max_error else values
     attrs = _attrs("environment_light", "irradiance", options, grid)
+    if max_error:
+        attrs.update(hfvis_directions=out["directions"], hfvis_estimated_error=out["estimated_error"])
     if len(channels) == 1:
         return grid.result(irradiance[0], "irradiance", attrs)
     return grid.result(irradiance, "irradiance", attrs, leading=("channel", channels))

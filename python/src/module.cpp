@@ -178,7 +178,8 @@ void bindOptions(nb::module_& m) {
   nb::class_<IntervisibilityOptions, SweepOptions>(m, "IntervisibilityOptions")
       .def(nb::init<>())
       .def_rw("method", &IntervisibilityOptions::method)
-      .def_rw("strip_rows", &IntervisibilityOptions::strip_rows);
+      .def_rw("strip_rows", &IntervisibilityOptions::strip_rows)
+      .def_rw("max_error", &IntervisibilityOptions::max_error);
   nb::class_<ViewshedOptions>(m, "ViewshedOptions")
       .def(nb::init<>())
       .def_rw("absolute", &ViewshedOptions::absolute)
@@ -265,11 +266,12 @@ nb::dict horizons(const HeightField& field, HorizonOptions options, bool angles,
   return out;
 }
 
-nb::dict intervisibility(const HeightField& field, IntervisibilityOptions options, const std::string& device,
-                         nb::object progress) {
+nb::dict intervisibility(const HeightField& field, IntervisibilityOptions options, bool error_estimate,
+                         const std::string& device, nb::object progress) {
   IntervisibilityOutputs wanted;
   wanted.visible_count = true;
   wanted.visible_area = true;
+  wanted.error_estimate = error_estimate;
   options.progress = progressHook(progress);
   IntervisibilityResult r = onDevice(
       device, [&](const ComputeContext& c) { return computeIntervisibility(c, field, options, wanted); });
@@ -277,6 +279,12 @@ nb::dict intervisibility(const HeightField& field, IntervisibilityOptions option
   out["azimuths"] = r.azimuths;
   out["visible_count"] = plane(std::move(r.visible_count), field);
   out["visible_area"] = plane(std::move(r.visible_area), field);
+  // The K run (max_error chooses it) and, with an estimate, the estimate and its 99th percentile.
+  out["directions"] = r.directions;
+  if (!r.error_estimate.empty()) {
+    out["error"] = plane(std::move(r.error_estimate), field);
+    out["estimated_error"] = r.estimated_error;
+  }
   return out;
 }
 
@@ -355,7 +363,11 @@ nb::tuple environmentLight(const HeightField& field, const EnvironmentMap& map, 
   EnvironmentLightResult r = onDevice(
       device, [&](const ComputeContext& c) { return computeEnvironmentLight(c, field, map, options); });
   const int channels = static_cast<int>(r.names.size());
-  return nb::make_tuple(planes(std::move(r.irradiance), channels, field), r.names);
+  // The K run (max_error chooses it) and, with max_error, the estimate and its 99th percentile.
+  nb::object error = nb::none();
+  if (!r.error_estimate.empty()) error = nb::cast(plane(std::move(r.error_estimate), field));
+  return nb::make_tuple(planes(std::move(r.irradiance), channels, field), r.names, r.directions, error,
+                        r.estimated_error);
 }
 
 // A region's samples: the rectangle (inclusive corners) sampled `samples` times, or, when
@@ -647,7 +659,8 @@ NB_MODULE(_core, m) {
 
   m.def("horizons", &horizons, "field"_a, "options"_a, "angles"_a, "distances"_a, "sky_view_factor"_a,
         "ambient_occlusion"_a, "error_estimate"_a, "device"_a, "progress"_a.none());
-  m.def("intervisibility", &intervisibility, "field"_a, "options"_a, "device"_a, "progress"_a.none());
+  m.def("intervisibility", &intervisibility, "field"_a, "options"_a, "error_estimate"_a, "device"_a,
+        "progress"_a.none());
   m.def("viewshed", &viewshed, "field"_a, "col"_a, "row"_a, "height"_a, "options"_a, "device"_a);
   m.def("cumulative_viewshed", &cumulativeViewshed, "field"_a, "cols"_a, "rows"_a, "heights"_a, "options"_a,
         "device"_a, "progress"_a.none());

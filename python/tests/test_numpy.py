@@ -59,6 +59,32 @@ def test_intervisibility(tmp_path, projected_tif, dem):
     equal(r.visible_area, area)
 
 
+def test_intervisibility_with_max_error(tmp_path, projected_tif, dem):
+    """max_error=E chooses K as viewcount's --max-error does; error_estimate gives its --error-out."""
+    import rasterio
+
+    error_tif = tmp_path / "error.tif"
+    (count, area), _ = cli(tmp_path, projected_tif, "viewcount", "--max-error", "0.3", "--max-distance", "1500",
+                           "--error-out", error_tif)
+    ours = hfvis.intervisibility(dem, max_error=0.3, error_estimate=True, max_distance=1500, cell_size=30,
+                                 nodata=NODATA)
+    assert isinstance(ours, hfvis.IntervisibilityEstimate)
+    equal(ours.visible_count, count)
+    equal(ours.visible_area, area)
+    (error,), _ = read_bands(error_tif)
+    equal(ours.error, error)
+    with rasterio.open(error_tif) as f:
+        tags = f.tags()
+    assert int(tags["hfvis_directions"]) == ours.directions and ours.directions not in (16, 64)
+    assert float(tags["hfvis_estimated_error"]) == float(f"{ours.estimated_error:.10g}") <= 0.3
+    # Without max_error, error_estimate keeps the K given; the naive method has no estimate.
+    fixed = hfvis.intervisibility(dem, directions=8, error_estimate=True, max_distance=1500, cell_size=30,
+                                  nodata=NODATA)
+    assert fixed.directions == 8 and fixed.error.shape == dem.shape and fixed.estimated_error > 0.3
+    with pytest.raises(hfvis.InvalidArgumentError):
+        hfvis.intervisibility(dem, max_error=0.3, method="naive", cell_size=30, nodata=NODATA)
+
+
 def test_viewsheds(tmp_path, projected_tif, dem):
     (visible,), _ = cli(tmp_path, projected_tif, "viewshed", "--observer", "200,170", "--observer-height", "10")
     equal(hfvis.viewshed(dem, (200, 170), observer_height=10, cell_size=30, nodata=NODATA), visible)
@@ -100,6 +126,21 @@ def test_environment_light_and_sun_position(tmp_path, projected_tif, dem):
     done = run_cli("sun-position", "--at", "2026-06-21T12:00:00Z", "--lat", "46.6", "--lon", "8.0", quiet=False)
     printed = dict(item.split("=") for item in done.stdout.split())
     assert abs(float(printed["azimuth"]) - azimuth) < 1e-4 and abs(float(printed["elevation"]) - elevation) < 1e-4
+
+
+def test_environment_light_with_max_error(dem):
+    """max_error=E chooses K as shade --env --max-error does: the values are the run at that K's,
+    the estimate at most E; a DataArray carries the K and the estimate."""
+    rows = np.arange(16)[:, None]
+    azimuth = np.arange(32)[None, :] * 2 * np.pi / 32
+    sky = np.where(rows < 8, 2.0 - rows / 8 + 0.5 * np.cos(azimuth), 0.2).astype(np.float32)  # no sun
+    ours = hfvis.environment_light(dem, sky, max_error=0.05, max_distance=1500, cell_size=30, nodata=NODATA)
+    assert isinstance(ours, hfvis.ErrorEstimate)
+    assert ours.estimated_error <= 0.05 and ours.error.shape == dem.shape and ours.directions % 8 == 0
+    equal(ours.values, hfvis.environment_light(dem, sky, directions=ours.directions, max_distance=1500, cell_size=30,
+                                               nodata=NODATA))
+    with pytest.raises(hfvis.InvalidArgumentError):
+        hfvis.environment_light(dem, sky, max_error=1.5, cell_size=30, nodata=NODATA)
 
 
 def test_any_float_dtype_strides_and_byte_order_give_the_same(dem):

@@ -141,6 +141,21 @@ def test_max_error_on_dataarrays(projected_tif):
     equal(both.ambient_occlusion, hfvis.ambient_occlusion(dem, max_error=0.02, max_distance=900))
 
 
+def test_intervisibility_max_error_on_dataarrays(projected_tif):
+    dem = rioxarray.open_rasterio(projected_tif)
+    both = hfvis.intervisibility(dem.chunk(100), max_error=0.3, error_estimate=True, max_distance=1500)
+    numpy_run = hfvis.intervisibility(dem.squeeze("band", drop=True).values, max_error=0.3, max_distance=1500,
+                                      cell_size=30, nodata=-9999.0)
+    assert isinstance(both, xr.Dataset) and set(both) == {"visible_count", "visible_area", "error"}
+    equal(both.visible_count, numpy_run.visible_count)
+    equal(both.error, numpy_run.error)
+    assert both.error.rio.crs == dem.rio.crs
+    for name in both:
+        assert both[name].attrs["hfvis_directions"] == numpy_run.directions
+        assert both[name].attrs["hfvis_estimated_error"] == numpy_run.estimated_error <= 0.3
+    assert both.visible_count.attrs["hfvis_max_error"] == 0.3
+
+
 def test_pvs_horizon_lists_and_bounce_on_dataarrays(projected_tif):
     dem = rioxarray.open_rasterio(projected_tif)
     plain = dem.squeeze("band", drop=True).values

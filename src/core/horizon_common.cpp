@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 
 #include "core/fast_math.hpp"
 #include "core/surface_normal.hpp"
@@ -203,7 +204,18 @@ int directionsForError(int directions, double estimated, int earlier, double ear
   if (earlier == 0) factor = std::min(factor, 4.0);
   const double wanted = std::ceil(directions * factor / 8.0) * 8.0;
   // Beyond kMaxAutoDirections, capped where an int holds it: the caller refuses it.
-  return static_cast<int>(std::max<double>(directions + 8, std::min<double>(wanted, 2.0 * kMaxAutoDirections)));
+  return static_cast<int>(
+      std::max<double>(directions + 8, std::min<double>(wanted, 2.0 * kMaxAutoDirections)));
+}
+
+InvalidArgument beyondAutoDirections(double max_error, int next, int directions, double estimated) {
+  std::ostringstream message;
+  // (directionsForError caps its answer at twice the most: beyond that, a bound)
+  message << "a maximum error of " << max_error << " needs "
+          << (next >= 2 * kMaxAutoDirections ? "at least " : "about ") << next
+          << " directions (the estimate at K = " << directions << " is " << estimated << "), beyond the "
+          << kMaxAutoDirections << " a run may choose: ask for a larger error, or give K";
+  return InvalidArgument(message.str());
 }
 
 }  // namespace detail

@@ -3,10 +3,12 @@
 #pragma once
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "core/lattice_geometry.hpp"
 #include "core/sweep_geometry.hpp"
+#include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
 
 namespace hfvis::detail {
@@ -53,6 +55,36 @@ double estimatedError(const std::vector<float>& estimate);
 // then at most 4 times the directions: smooth fields fall much faster, bench/report/error_target.md),
 // so K (estimated / max_error)^(1/p), 5 % more, rounded up to a multiple of 8, and at least 8 more.
 int directionsForError(int directions, double estimated, int earlier, double earlier_estimate, double max_error);
+
+// The InvalidArgument a maximum error gets when a run at `directions` whose estimate was
+// `estimated` predicts `next` directions, beyond kMaxAutoDirections.
+InvalidArgument beyondAutoDirections(double max_error, int next, int directions, double estimated);
+
+// A maximum error's runs for an operation other than the horizon sweep's (intervisibility):
+// run(K) at K = kFirstAutoDirections, then at directionsForError's K, until a result's
+// estimated_error is at most max_error; that result with `runs` (the K of each run) set.
+// Throws beyondAutoDirections' error.
+template <class Result, class Run>
+Result runForMaxError(double max_error, const Run& run) {
+  int directions = kFirstAutoDirections, earlier = 0;
+  double earlier_estimate = 0.0;
+  std::vector<int> runs;
+  for (;;) {
+    Result result = run(directions);
+    runs.push_back(directions);
+    if (result.estimated_error <= max_error) {
+      result.runs = std::move(runs);
+      return result;
+    }
+    const int next =
+        directionsForError(directions, result.estimated_error, earlier, earlier_estimate, max_error);
+    if (next > kMaxAutoDirections)
+      throw beyondAutoDirections(max_error, next, directions, result.estimated_error);
+    earlier = directions;
+    earlier_estimate = result.estimated_error;
+    directions = next;
+  }
+}
 
 // Whether the field has per-row spacing (HeightField::row_cell_size_x/y): positions along the
 // sweep's lines (in whole units) and the naive march's rays are then ground lengths summed step by step.

@@ -118,15 +118,19 @@ void followRows(TreeDirection& d, const HeightField& field, const RowTable& rows
   d.position_shift = 0;  // positions are whole units (a peak's too: a step has thousands)
 }
 
-std::vector<TreeDirection> treeDirections(const HeightField& field, const SweepOptions& options, bool follow_rows) {
-  std::vector<LatticeDirection> lattice = latticeDirections(field, options, false, 0.0);
+std::vector<TreeDirection> treeDirections(const HeightField& field, const SweepOptions& options,
+                                          bool follow_rows, bool parity_apart) {
+  std::vector<LatticeDirection> lattice = latticeDirections(field, options, false, 0.0, parity_apart);
   // Each step stands for the wedge of its phi_k, 1 / K of the circle (a merged step for each
   // phi_k it took), not for the half gaps to its neighbours' azimuths: see treeDirections' note.
   const int K = options.directions;
   std::vector<double> wedges(lattice.size(), 0.0);
   for (std::size_t k = 0; k < lattice.size(); ++k) {
-    std::size_t m = 0;  // the step that sweeps for phi_k: the first equal one (setQuadratureWeights)
-    while (lattice[m].a != lattice[k].a || lattice[m].b != lattice[k].b || lattice[m].weight == 0.0) ++m;
+    // The step that sweeps for phi_k: the first equal one (setQuadratureWeights), of k's parity
+    // with parity_apart.
+    std::size_t m = parity_apart ? k % 2 : 0;
+    while (lattice[m].a != lattice[k].a || lattice[m].b != lattice[k].b || lattice[m].weight == 0.0)
+      m += parity_apart ? 2 : 1;
     wedges[m] += 1.0 / K;
   }
   for (std::size_t k = 0; k < lattice.size(); ++k) lattice[k].weight = wedges[k];
@@ -141,11 +145,39 @@ std::vector<TreeDirection> treeDirections(const HeightField& field, const SweepO
     if (lattice[k].weight == 0.0) continue;  // merged into an equal step
     out.push_back(makeTreeDirection(field, lattice[k], options.samples_per_unit, options.directions,
                                     options.curvature, options.max_distance));
+    out.back().index = static_cast<int>(k);
     if (!rows.empty())
       followRows(out.back(), field, rows[k], unit, options.samples_per_unit, options.directions,
                  options.curvature, options.max_distance);
   }
   return out;
+}
+
+void splitVisibilityHalves(IntervisibilityResult& result, const std::vector<float>& odd_count,
+                           const std::vector<float>& odd_area, double even_weight, double odd_weight) {
+  std::vector<float>& count = result.visible_count;
+  std::vector<float>& estimate = result.error_estimate;
+  estimate.resize(count.size());
+  double total = 0.0;
+  std::size_t with_data = 0;
+  for (std::size_t p = 0; p < count.size(); ++p) {
+    // Each half's sum over its own wedges estimates the whole count: their whole difference
+    // (see IntervisibilityResult::error_estimate for why not half of it, as the sky-view factor).
+    estimate[p] = static_cast<float>(std::abs(count[p] / even_weight - odd_count[p] / odd_weight));
+    count[p] += odd_count[p];
+    if (std::isnan(count[p])) continue;
+    total += count[p];
+    ++with_data;
+  }
+  // Relative to the field's mean count, not the pixel's own (near 0 in a pit or a street, where
+  // one far sample more would swamp the field's error).
+  const double mean = with_data ? total / with_data : 0.0;
+  for (std::size_t p = 0; p < count.size(); ++p)
+    estimate[p] = std::isnan(count[p]) ? count[p]
+                  : mean > 0.0         ? static_cast<float>(estimate[p] / mean)
+                                       : 0.0f;
+  for (std::size_t p = 0; p < result.visible_area.size(); ++p) result.visible_area[p] += odd_area[p];
+  result.estimated_error = estimatedError(estimate);
 }
 
 void IntervisibilityLines::resetResults(bool keep_horizons) {

@@ -23,6 +23,7 @@ namespace hfvis::detail {
 // what the kernels scale its results by. The same for the device path and the references.
 struct TreeDirection {
   LatticeDirection lattice;
+  int index = 0;                       // k of the (first) phi_k it sweeps for
   int per_period = 1;                  // samples per period (the receiver included)
   std::vector<LatticeSample> samples;  // uniformLatticeSamples
   std::vector<LatticeLine> lines;      // its lines over the field
@@ -115,8 +116,18 @@ std::int32_t stepUnits(const HeightField& field, double y, double dx, double dy,
 // closer quadrature on every content measured, at K = 16 to 128.
 // With per-row spacing each row gets its steps' lengths and weights there (row_units,
 // row_factors), unless `follow_rows` is false (the bounce: the centre latitude's spacing).
+// `parity_apart` (the error estimate's halves, IntervisibilityOutputs::error_estimate): steps
+// merge only with steps of the same parity of k, so that each half keeps its own wedges.
 std::vector<TreeDirection> treeDirections(const HeightField& field, const SweepOptions& options,
-                                          bool follow_rows = true);
+                                          bool follow_rows = true, bool parity_apart = false);
+// The error estimate (IntervisibilityOutputs::error_estimate) from the count's sums of the
+// even-numbered directions in `result` and those of the odd-numbered ones, the directions' wedges
+// summed by half: per pixel the halves' difference (each over its own wedges) over the field's
+// mean count. Fills error_estimate and estimated_error, and leaves the two halves' totals of the
+// count and (when result.visible_area is not empty) of the area in `result`.
+void splitVisibilityHalves(IntervisibilityResult& result, const std::vector<float>& odd_count,
+                           const std::vector<float>& odd_area, double even_weight, double odd_weight);
+
 // One of them: `lattice` (its weight set) sampled at S samples per unit, in a run of K directions.
 TreeDirection makeTreeDirection(const HeightField& field, const LatticeDirection& lattice, double samples_per_unit,
                                 int directions, double curvature = 0.0, double max_distance = 0.0);

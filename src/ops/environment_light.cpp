@@ -1,17 +1,74 @@
 // environment_light.cpp: the irradiance from an HDR environment (hfvis/environment_light.hpp):
-// the horizon operation with this output alone (its tables: src/core/environment_swaths.hpp).
+// the horizon operation with this output alone (its tables: src/core/environment_swaths.hpp), and
+// with a maximum error its runs at K and K / 2 until their difference meets it.
 #include "hfvis/environment_light.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <string>
 #include <utility>
 
-namespace hfvis {
+#include "hfvis/errors.hpp"
+#include "core/horizon_common.hpp"
 
-EnvironmentLightResult computeEnvironmentLight(const ComputeContext& context, const HeightField& field,
-                                               const EnvironmentMap& map, const HorizonOptions& options) {
+namespace hfvis {
+namespace {
+
+EnvironmentLightResult runAt(const ComputeContext& context, const HeightField& field,
+                             const EnvironmentMap& map, const HorizonOptions& options) {
   HorizonOutputs outputs;
   outputs.environment = &map;
   HorizonResult horizons = computeHorizons(context, field, options, outputs);
-  return {horizons.width, horizons.height, horizons.directions, map.names, std::move(horizons.irradiance)};
+  EnvironmentLightResult result;
+  result.width = horizons.width;
+  result.height = horizons.height;
+  result.directions = horizons.directions;
+  result.names = map.names;
+  result.irradiance = std::move(horizons.irradiance);
+  return result;
+}
+
+// The estimate (EnvironmentLightResult::error_estimate) of `result` from `coarse`, the same run at
+// half its directions.
+void estimateFrom(EnvironmentLightResult& result, const std::vector<float>& coarse) {
+  const std::size_t pixels = static_cast<std::size_t>(result.width) * result.height;
+  const std::size_t channels = pixels ? result.irradiance.size() / pixels : 0;
+  result.error_estimate.assign(pixels, 0.0f);
+  for (std::size_t c = 0; c < channels; ++c) {
+    const float* fine = &result.irradiance[c * pixels];
+    double total = 0.0;
+    std::size_t with_data = 0;
+    for (std::size_t p = 0; p < pixels; ++p)
+      if (!std::isnan(fine[p])) total += fine[p], ++with_data;
+    const double mean = with_data ? total / with_data : 0.0;
+    for (std::size_t p = 0; p < pixels; ++p) {
+      const double difference = std::abs(static_cast<double>(fine[p]) - coarse[c * pixels + p]);
+      float& e = result.error_estimate[p];
+      e = std::isnan(fine[p]) ? fine[p]
+                              : std::max(e, static_cast<float>(mean > 0.0 ? difference / mean : 0.0));
+    }
+  }
+  result.estimated_error = detail::estimatedError(result.error_estimate);
+}
+
+}  // namespace
+
+EnvironmentLightResult computeEnvironmentLight(const ComputeContext& context, const HeightField& field,
+                                               const EnvironmentMap& map, const HorizonOptions& options) {
+  if (options.max_error == 0.0) return runAt(context, field, map, options);
+  if (!(options.max_error > 0.0 && options.max_error < 1.0))
+    throw InvalidArgument("the maximum error must be in (0, 1): it is relative to the mean irradiance (got " +
+                          std::to_string(options.max_error) + ")");
+  HorizonOptions attempt = options;
+  attempt.max_error = 0.0;
+  return detail::runForMaxError<EnvironmentLightResult>(options.max_error, [&](int directions) {
+    attempt.directions = directions / 2;
+    const std::vector<float> coarse = runAt(context, field, map, attempt).irradiance;
+    attempt.directions = directions;
+    EnvironmentLightResult result = runAt(context, field, map, attempt);
+    estimateFrom(result, coarse);
+    return result;
+  });
 }
 
 }  // namespace hfvis

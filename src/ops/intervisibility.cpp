@@ -29,6 +29,15 @@ void validate(const IntervisibilityOptions& options, const IntervisibilityOutput
     throw InvalidArgument("statistics (horizons and iterations) exist only for the hull-tree method");
   }
   detail::validateStripRows(options.strip_rows, options.method == IntervisibilityMethod::Naive);
+  if (options.max_error != 0.0 || outputs.error_estimate) {
+    if (options.method != IntervisibilityMethod::HullTree)
+      throw InvalidArgument("an error estimate and a maximum error exist only for the hull-tree method");
+    if (!(options.max_error >= 0.0 && options.max_error < 1.0))
+      throw InvalidArgument("the maximum error must be in (0, 1): it is relative to the visible count (got " +
+                            std::to_string(options.max_error) + ")");
+    if (options.max_error == 0.0 && options.directions < 2)
+      throw InvalidArgument("an error estimate needs K >= 2 (it compares the even and the odd directions)");
+  }
 }
 
 namespace detail {
@@ -56,7 +65,8 @@ IntervisibilityResult allocateResult(const HeightField& field, const Intervisibi
   result.height = field.height;
   result.directions = options.directions;
   for (int k = 0; k < options.directions; ++k) result.azimuths.push_back(directionAzimuth(k, options));
-  if (outputs.visible_count) result.visible_count.resize(field.pixelCount());
+  // (the estimate needs the count even when only the area is asked for: finish clears it)
+  if (outputs.visible_count || outputs.error_estimate) result.visible_count.resize(field.pixelCount());
   if (outputs.visible_area) result.visible_area.resize(field.pixelCount());
   return result;
 }
@@ -74,19 +84,20 @@ struct CountPlan {
 };
 
 CountPlan planCount(const HeightField& field, const std::vector<TreeDirection>& directions,
-                    const TreeProgramFlags& flags, const IntervisibilityOptions& options, const DeviceInfo& device,
-                    bool line_major) {
+                    const TreeProgramFlags& flags, const IntervisibilityOptions& options,
+                    const DeviceInfo& device, bool line_major, bool halves) {
   const std::size_t budget = memoryBudget(options.memory_budget_bytes, device);
   const std::size_t max_alloc = device.max_allocation_bytes ? device.max_allocation_bytes : budget;
   const TreeScratchNeeds needs = treeScratchNeeds(directions, line_major);
   const std::size_t entry = treeEntryBytes(flags), row = field.width * sizeof(float);
   // Heights and the sums (the count also when only the area is asked for: the kernel adds both),
-  // and the statistics' per-line totals.
-  const std::size_t per_row = row * (2 + flags.area);
+  // and the statistics' per-line totals; with the error estimate's halves (`halves`) the odd
+  // directions' sums too, on the device for a whole field (in strips the host holds them).
+  const std::size_t per_row = row * (2 + flags.area), odd_per_row = halves ? row * (1 + flags.area) : 0;
   std::size_t max_lines = 0;
   for (const TreeDirection& d : directions) max_lines = std::max(max_lines, d.lines.size());
   const std::size_t totals = flags.stats ? max_lines * kTreeLineTotals * sizeof(cl_ulong) : 0;
-  const std::size_t whole = per_row * field.height + totals, least = needs.longest * entry;
+  const std::size_t whole = (per_row + odd_per_row) * field.height + totals, least = needs.longest * entry;
   const bool forced = options.strip_rows > 0 && options.strip_rows < field.height;
   CountPlan plan;
   if (!forced && whole + least <= budget && row * field.height <= max_alloc &&
@@ -148,9 +159,10 @@ class CountRoutine : public TreeRoutine {
   PreparedHeights prepare() override {
     PreparedHeights prepared = prepareHeights(field_);
     flags_.has_nodata = prepared.has_nodata;
-    directions_ = treeDirections(field_, options_, flags_.row_spacing);
+    directions_ = treeDirections(field_, options_, flags_.row_spacing, outputs_.error_estimate);
     checkTreeLimits(directions_, prepared.heights);
-    plan_ = planCount(field_, directions_, flags_, visibility_, st_.info, lineMajorLayout(st_));
+    plan_ = planCount(field_, directions_, flags_, visibility_, st_.info, lineMajorLayout(st_),
+                      outputs_.error_estimate);
     flags_.strips = inStrips();
     return prepared;
   }
@@ -161,11 +173,14 @@ class CountRoutine : public TreeRoutine {
     result_ = allocateResult(field_, visibility_, outputs_);
     allocateTreeScratch(st_, flags_, directions_, plan_.scratch_entries, buffers_);
     buffers_.radiance = buffers_.normals = buffers_.irradiance = deviceBuffer(st_, 0);
+    const bool halves = outputs_.error_estimate;
     if (!inStrips()) {
       const std::size_t plane = field_.pixelCount();
       buffers_.heights = heights_;
-      buffers_.count_sum = zeros(plane);
-      buffers_.area_sum = zeros(outputs_.visible_area ? plane : 0);
+      count_sums_[0] = zeros(plane);
+      area_sums_[0] = zeros(outputs_.visible_area ? plane : 0);
+      count_sums_[1] = halves ? zeros(plane) : count_sums_[0];
+      area_sums_[1] = halves ? zeros(outputs_.visible_area ? plane : 0) : area_sums_[0];
       return;
     }
     const std::size_t strip = static_cast<std::size_t>(plan_.strip_rows) * field_.width * sizeof(float);
@@ -178,10 +193,26 @@ class CountRoutine : public TreeRoutine {
     states_ = deviceBuffer(st_, max_lines * kTreeLineStateBytes);
     // The host holds the sums (allocateResult's zeros), a strip's rows on the device at a time.
     if (result_.visible_count.empty()) result_.visible_count.assign(field_.pixelCount(), 0.0f);
+    if (halves) {
+      odd_count_.assign(field_.pixelCount(), 0.0f);
+      if (outputs_.visible_area) odd_area_.assign(field_.pixelCount(), 0.0f);
+    }
+  }
+
+  // With the error estimate, the odd-numbered directions add into sums of their own.
+  bool oddHalf(int direction) const {
+    return outputs_.error_estimate && directions_[direction].index % 2 == 1;
   }
 
   void sweep(int direction, int) override {
-    if (!inStrips()) return TreeRoutine::sweep(direction, 0);
+    const bool odd = oddHalf(direction);
+    if (!inStrips()) {
+      buffers_.count_sum = count_sums_[odd];
+      buffers_.area_sum = area_sums_[odd];
+      return TreeRoutine::sweep(direction, 0);
+    }
+    std::vector<float>& count = odd ? odd_count_ : result_.visible_count;
+    std::vector<float>& area = odd ? odd_area_ : result_.visible_area;
     const TreeDirection& d = directions_[direction];
     TreeKernel k = treeKernel(st_, program_, d, field_.width, field_.height, buffers_);
     const int b = d.lattice.b, strips = (field_.height + plan_.strip_rows - 1) / plan_.strip_rows;
@@ -208,29 +239,33 @@ class CountRoutine : public TreeRoutine {
           ranges[i] = {{first, end}};
           any = any || first < end;
         }
-        if (any) sweepStrip(k, ranges, s0, s1, row);
-        if (options_.strip_progress) options_.strip_progress(int(c) * strips + t + 1, int(chunks.size()) * strips);
+        if (any) sweepStrip(k, ranges, s0, s1, row, count, area);
+        if (options_.strip_progress)
+          options_.strip_progress(int(c) * strips + t + 1, int(chunks.size()) * strips);
       }
     }
   }
 
-  // One strip of one chunk: its heights (with the halo) and sums up, the sweep, the sums back.
-  void sweepStrip(TreeKernel& k, const std::vector<cl_int2>& ranges, int s0, int s1, std::size_t row) {
+  // One strip of one chunk: its heights (with the halo) and sums (`count`, `area`: the host's
+  // planes of its half) up, the sweep, the sums back.
+  void sweepStrip(TreeKernel& k, const std::vector<cl_int2>& ranges, int s0, int s1, std::size_t row,
+                  std::vector<float>& count, std::vector<float>& area) {
     const int h0 = std::max(0, s0 - plan_.halo_rows), h1 = std::min(field_.height, s1 + plan_.halo_rows);
     const std::size_t width = field_.width, sums = (s1 - s0) * row;
-    st_.queue.enqueueWriteBuffer(buffers_.heights, CL_FALSE, 0, (h1 - h0) * row, &prepared_.heights[h0 * width]);
-    st_.queue.enqueueWriteBuffer(buffers_.count_sum, CL_FALSE, 0, sums, &result_.visible_count[s0 * width]);
+    st_.queue.enqueueWriteBuffer(buffers_.heights, CL_FALSE, 0, (h1 - h0) * row,
+                                 &prepared_.heights[h0 * width]);
+    st_.queue.enqueueWriteBuffer(buffers_.count_sum, CL_FALSE, 0, sums, &count[s0 * width]);
     if (outputs_.visible_area)
-      st_.queue.enqueueWriteBuffer(buffers_.area_sum, CL_FALSE, 0, sums, &result_.visible_area[s0 * width]);
+      st_.queue.enqueueWriteBuffer(buffers_.area_sum, CL_FALSE, 0, sums, &area[s0 * width]);
     const cl::Buffer ranges_buffer(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
                                    ranges.size() * sizeof(cl_int2), const_cast<cl_int2*>(ranges.data()));
     k.kernel.set("row0", h0);
     k.kernel.set("out_row0", s0);
     k.kernel.set("strip_receivers", ranges_buffer);
     st_.launch(k.kernel, cl::NDRange(roundUp(ranges.size(), kLineGroup)), cl::NDRange(kLineGroup));
-    st_.queue.enqueueReadBuffer(buffers_.count_sum, CL_FALSE, 0, sums, &result_.visible_count[s0 * width]);
+    st_.queue.enqueueReadBuffer(buffers_.count_sum, CL_FALSE, 0, sums, &count[s0 * width]);
     if (outputs_.visible_area)
-      st_.queue.enqueueReadBuffer(buffers_.area_sum, CL_FALSE, 0, sums, &result_.visible_area[s0 * width]);
+      st_.queue.enqueueReadBuffer(buffers_.area_sum, CL_FALSE, 0, sums, &area[s0 * width]);
     st_.queue.finish();  // before the ranges go
   }
 
@@ -245,18 +280,32 @@ class CountRoutine : public TreeRoutine {
   }
 
   void finish() override {
-    if (inStrips()) {  // the host holds them; the count kept only when asked for
-      if (!outputs_.visible_count) result_.visible_count.clear();
-      return;
+    if (!inStrips()) {  // else the host holds them
+      download(st_, count_sums_[0], result_.visible_count);
+      download(st_, area_sums_[0], result_.visible_area);
+      if (outputs_.error_estimate) {
+        odd_count_.resize(result_.visible_count.size());
+        odd_area_.resize(result_.visible_area.size());
+        download(st_, count_sums_[1], odd_count_);
+        download(st_, area_sums_[1], odd_area_);
+      }
     }
-    download(st_, buffers_.count_sum, result_.visible_count);
-    download(st_, buffers_.area_sum, result_.visible_area);
+    if (outputs_.error_estimate) {
+      double even_weight = 0.0, odd_weight = 0.0;
+      for (const TreeDirection& d : directions_) (d.index % 2 ? odd_weight : even_weight) += d.lattice.weight;
+      splitVisibilityHalves(result_, odd_count_, odd_area_, even_weight, odd_weight);
+    }
+    if (!outputs_.visible_count) result_.visible_count.clear();  // (the kernel adds it anyway)
   }
 
   const IntervisibilityOptions& visibility_;
   const IntervisibilityOutputs& outputs_;
   CountPlan plan_;
   cl::Buffer states_;
+  // A whole field's sums on the device: [0] the even-numbered directions' (all of them without
+  // the error estimate), [1] the odd-numbered ones' (the same buffers without it).
+  cl::Buffer count_sums_[2], area_sums_[2];
+  std::vector<float> odd_count_, odd_area_;  // the odd half's sums on the host
   IntervisibilityResult result_;
   std::vector<cl_ulong> totals_;
 };
@@ -373,9 +422,20 @@ IntervisibilityResult computeIntervisibility(const ComputeContext& context, cons
   return detail::translateOpenClErrors([&] {
     detail::ContextState& st = detail::stateOf(context);
     if (options.method == IntervisibilityMethod::HullTree) {
-      detail::CountRoutine routine(st, field, options, outputs);
-      routine.run();
-      return routine.take();
+      const auto run = [&](const IntervisibilityOptions& attempt, const IntervisibilityOutputs& wanted) {
+        detail::CountRoutine routine(st, field, attempt, wanted);
+        routine.run();
+        return routine.take();
+      };
+      if (options.max_error == 0.0) return run(options, outputs);
+      // Ask for an error: runs at growing K until the estimate meets it (the horizon sweep's steps).
+      IntervisibilityOutputs estimated = outputs;
+      estimated.error_estimate = true;
+      return detail::runForMaxError<IntervisibilityResult>(options.max_error, [&](int directions) {
+        IntervisibilityOptions attempt = options;
+        attempt.directions = directions;
+        return run(attempt, estimated);
+      });
     }
     detail::NaiveCountRoutine routine(st, field, options, outputs);
     routine.run();

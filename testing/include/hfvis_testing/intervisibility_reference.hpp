@@ -11,7 +11,8 @@ namespace hfvis {
 // options.method chooses the reference: the hull-tree sweep with its reduction, or the
 // naive per-pixel march. progress and memory_budget_bytes are ignored. Per-line results
 // equal the kernels' exactly; per-pixel sums may differ in the last bits (the kernels sum
-// a batch of directions before adding it).
+// a batch of directions before adding it). outputs.error_estimate is computed as the device
+// path computes it; options.max_error is not taken (the reference runs the K given).
 IntervisibilityResult referenceIntervisibility(const HeightField& field,
                                                const IntervisibilityOptions& options,
                                                const IntervisibilityOutputs& outputs);
