@@ -135,8 +135,22 @@ int region_hider_along(__global const float* h, RegionField f, float margin, flo
   return -1;
 }
 
+// The per-end tables (region_end_table) of the shared source samples (`source_points`), toward
+// the rectangle where the receivers lie (`other`: x0, y0, x1, y1), REGION_END_RECORD floats each.
+__kernel void region_end_tables(__global const float* pyramid, int levels, RegionField f,
+                                __global const float* source_points, int samples, float4 other,
+                                __global float* records) {
+  const int s = (int)get_global_id(0);
+  if (s >= samples) return;
+  float rec[REGION_END_RECORD];
+  region_end_table(pyramid, levels, f.width, f.height, source_points[3 * s], source_points[3 * s + 1],
+                   other.x, other.y, other.z, other.w, rec);
+  for (int i = 0; i < REGION_END_RECORD; ++i) records[(size_t)s * REGION_END_RECORD + i] = rec[i];
+}
+
 __kernel void region_visibility_bits(__global const float* h, __global const float* pyramid, int levels,
-                                     float margin, float gradient, int finite_field, RegionField f,
+                                     float margin, float gradient, int finite_field, int certify_receivers,
+                                     int certify_sources, __global const float* source_records, RegionField f,
                                      __global const float* sources, __global const float* source_points,
                                      int source_absolute, int samples, int pixel_receivers,
                                      __global const float* receivers, int receiver_absolute,
@@ -154,6 +168,12 @@ __kernel void region_visibility_bits(__global const float* h, __global const flo
     zr = h[r] + target_height;
   }
   const unsigned int key = decorrelate ? (unsigned int)r + 1U : 0U;
+  // The receiver's own per-end table toward the sources' rectangle (region_end_table), for the
+  // certification of its clear sight lines (region_end_reach): one per work-item, for all its lines.
+  float own[REGION_END_RECORD];
+  if (certify_receivers && !isnan(zr))
+    region_end_table(pyramid, levels, f.width, f.height, xr, yr, sources[0], sources[1], sources[2],
+                     sources[3], own);
   // Culled: the cell that hid the last hidden sight line (and its fraction of that line from the
   // receiver), tried first against the next ones, across words, while the line before was hidden
   // (after a clear one the next is seldom hidden: the tries would cost more than they save); a
@@ -195,10 +215,33 @@ __kernel void region_visibility_bits(__global const float* h, __global const flo
             continue;
           }
         }
+        // The stretches from both ends that their tables certify clear (the march skips them).
+        float reach_s = 0.0f, reach_r = 0.0f;
+        if (certify_receivers || (certify_sources && !decorrelate)) {
+          const float dx = xr - xs[i], dy = yr - ys[i], length = sqrt(dx * dx + dy * dy);
+          const float clearance =
+              region_end_clearance(margin, f.curvature, f.cell_x, f.cell_y, xs[i], ys[i], zs[i], xr, yr, zr);
+          if (certify_receivers && length > 0.0f) {
+            const int wedge = region_end_wedge(own[0], own[1], -dx, -dy);
+            if (wedge >= 0)
+              reach_r = region_end_reach(own + 4 + wedge * REGION_END_BANDS, (int)own[2], length, zr, zs[i],
+                                         clearance);
+          }
+          if (certify_sources && !decorrelate && length > 0.0f && reach_r < length) {
+            __global const float* rec = source_records + (size_t)(32 * w + i) * REGION_END_RECORD;
+            const int wedge = region_end_wedge(rec[0], rec[1], dx, dy);
+            if (wedge >= 0) {
+              float column[REGION_END_BANDS];
+              const int bands = (int)rec[2];
+              for (int b = 0; b < bands; ++b) column[b] = rec[4 + wedge * REGION_END_BANDS + b];
+              reach_s = region_end_reach(column, bands, length, zs[i], zr, clearance);
+            }
+          }
+        }
         int blocked_at = -1;
         if (region_sight_visible_culled(h, f.width, f.height, f.cell_x, f.cell_y, f.curvature, f.max_d2,
                                         pyramid, levels, margin, box[0], box[1], box[2], box[3], xs[i], ys[i],
-                                        zs[i], xr, yr, zr, &blocked_at)) {
+                                        zs[i], xr, yr, zr, reach_s, reach_r, &blocked_at)) {
           word |= 1U << i;
           last_hidden = 0;
         } else {

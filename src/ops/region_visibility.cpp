@@ -50,83 +50,6 @@ void validateField(const HeightField& field) {
 
 int popcount(std::uint32_t v) { return __builtin_popcount(v); }
 
-// The culling pyramid of kernels/shared/region_visibility_sight.cl (region_cull_*) over the
-// z-scaled heights, and the part of the march's rounding that a block's height must clear which
-// depends on the field alone (region_sight_visible_culled adds the segment's own).
-struct CullPyramid {
-  std::vector<float> top;
-  int levels = 0;
-  float margin = 0.0f;
-  float gradient = 0.0f;  // the surface's steepest slope per pixel, at most (region_cull_hides)
-  bool finite = true;     // every height finite (region_cull_hides need not look)
-};
-
-CullPyramid cullPyramid(const std::vector<float>& h, int width, int height) {
-  CullPyramid out;
-  if (width < 2 || height < 2) return out;  // no cells: the march runs uncut
-  const auto at = [&](int c, int r) { return h[std::size_t(r) * width + c]; };
-  // The field's largest finite height, step between neighbours and cell twist: the march's
-  // values over a block stray from its corners' range by rounding relative to the heights, and
-  // by a step or a twist times a position's rounding (a crossing a rounding outside the block, a
-  // piece's middle a rounding into the next cell): at most ulp(max(width, height)) each.
-  double largest = 0.0, step = 0.0, twist = 0.0;
-  bool any_infinite = false;
-  for (int r = 0; r < height; ++r)
-    for (int c = 0; c < width; ++c) {
-      const float v = at(c, r);
-      any_infinite = any_infinite || std::isinf(v);
-      out.finite = out.finite && std::isfinite(v);
-      if (!std::isfinite(v)) continue;
-      largest = std::max(largest, double(std::fabs(v)));
-      if (c + 1 < width && std::isfinite(at(c + 1, r)))
-        step = std::max(step, double(std::fabs(at(c + 1, r) - v)));
-      if (r + 1 < height && std::isfinite(at(c, r + 1)))
-        step = std::max(step, double(std::fabs(at(c, r + 1) - v)));
-      if (c + 1 < width && r + 1 < height) {
-        const double t = double(v) - at(c + 1, r) - at(c, r + 1) + at(c + 1, r + 1);
-        if (std::isfinite(t)) twist = std::max(twist, std::fabs(t));
-      }
-    }
-  const double position_ulp = std::ldexp(double(std::max(width, height)), -23);
-  out.margin = static_cast<float>(8e-5 * largest + 4.0 * position_ulp * (step + twist));
-  out.gradient = static_cast<float>(step + twist);
-  // The levels' sizes (as region_cull_width), then the levels in place, one after another.
-  std::vector<std::size_t> offsets = {0};
-  for (int w = width - 1, hh = height - 1;;) {
-    offsets.push_back(offsets.back() + std::size_t(w) * hh);
-    if ((w == 1 && hh == 1) || int(offsets.size()) - 1 == kCullLevels) break;
-    w = (w + 1) / 2, hh = (hh + 1) / 2;
-  }
-  out.levels = int(offsets.size()) - 1;
-  out.top.assign(offsets.back(), -std::numeric_limits<float>::infinity());
-  // Level 0: per cell its corners' highest valid height; +INFINITY where an infinite height lies
-  // on the cell or a cell beside it (the march's values there are unbounded or NaN).
-  int w = width - 1, hh = height - 1;
-  for (int r = 0; r < hh; ++r)
-    for (int c = 0; c < w; ++c) {
-      bool unbounded = false;
-      for (int y = std::max(0, r - 1); any_infinite && y <= std::min(height - 1, r + 2) && !unbounded; ++y)
-        for (int x = std::max(0, c - 1); x <= std::min(width - 1, c + 2); ++x)
-          if (std::isinf(at(x, y))) unbounded = true;
-      float top = -std::numeric_limits<float>::infinity();
-      for (const float v : {at(c, r), at(c + 1, r), at(c, r + 1), at(c + 1, r + 1)})
-        if (!std::isnan(v)) top = std::max(top, v);
-      out.top[std::size_t(r) * w + c] = unbounded ? std::numeric_limits<float>::infinity() : top;
-    }
-  for (int k = 1; k < out.levels; ++k) {
-    const float* child = out.top.data() + offsets[k - 1];
-    float* parent = out.top.data() + offsets[k];
-    const int pw = (w + 1) / 2;
-    for (int r = 0; r < hh; ++r)
-      for (int c = 0; c < w; ++c) {
-        float& p = parent[std::size_t(r / 2) * pw + c / 2];
-        p = std::max(p, child[std::size_t(r) * w + c]);
-      }
-    w = pw, hh = (hh + 1) / 2;
-  }
-  return out;
-}
-
 // The bits of `count` receivers from the device, receiver-major: one routine item per launch
 // of up to kWordsPerLaunch / words receivers (a work-item marches all its receiver's words:
 // a launch's work stays bounded whatever S).
@@ -181,12 +104,33 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
                              static_cast<float>(options_.curvature),
                              options_.max_distance > 0.0 ? static_cast<float>(max_d2) : 0.0f};
     if (options_.method == RegionVisibilityMethod::Culled) {
-      const CullPyramid pyramid = cullPyramid(prepared_.heights, field_.width, field_.height);
+      const detail::CullPyramid pyramid = detail::cullPyramid(prepared_.heights, field_.width, field_.height);
       levels_ = pyramid.levels;
       margin_ = pyramid.margin;
       gradient_ = pyramid.gradient;
       finite_ = pyramid.finite;
       if (levels_ > 0) pyramid_ = upload(pyramid.top);
+    }
+    // The per-end tables that certify clear sight lines (region_end_table): the shared sources'
+    // once here; each receiver's by its work-item, except a pixel's on the surface (target height
+    // 0), whose first band always holds its own height, so that its table would certify nothing.
+    certify_sources_ = levels_ > 0 && !options_.decorrelate;
+    certify_receivers_ = levels_ > 0 && (receivers_ != nullptr || options_.target_height > 0.0);
+    if (certify_sources_) {
+      source_records_ = detail::deviceBuffer(st_, std::size_t(samples_) * REGION_END_RECORD * sizeof(float));
+      const cl_float4 other =
+          receivers_ ? cl_float4{{(*receivers_)[0], (*receivers_)[1], (*receivers_)[2], (*receivers_)[3]}}
+                     : cl_float4{{0.0f, 0.0f, float(field_.width - 1), float(field_.height - 1)}};
+      detail::NamedKernel tables = kernel("region_end_tables");
+      tables.set("pyramid", pyramid_)
+          .set("levels", cl_int(levels_))
+          .set("f", device)
+          .set("source_points", source_points_buffer_)
+          .set("samples", cl_int(samples_))
+          .set("other", other)
+          .set("records", source_records_);
+      st_.launch(tables, cl::NDRange(detail::roundUp(samples_, detail::kLineGroup)),
+                 cl::NDRange(detail::kLineGroup));
     }
     kernel_ = kernel("region_visibility_bits");
     kernel_.set("h", heights_)
@@ -195,6 +139,9 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
         .set("margin", margin_)
         .set("gradient", gradient_)
         .set("finite_field", cl_int(finite_))
+        .set("certify_receivers", cl_int(certify_receivers_))
+        .set("certify_sources", cl_int(certify_sources_))
+        .set("source_records", certify_sources_ ? source_records_ : heights_)
         .set("f", device)
         .set("sources", source_table_)
         .set("source_points", source_points_buffer_)
@@ -248,7 +195,8 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
   int levels_ = 0;  // the culling pyramid's (0: the exact march)
   cl_float margin_ = 0.0f, gradient_ = 0.0f;
   bool finite_ = false;
-  cl::Buffer source_table_, source_points_buffer_, receiver_table_, bits_, pyramid_;
+  bool certify_sources_ = false, certify_receivers_ = false;  // per-end tables (culled only)
+  cl::Buffer source_table_, source_points_buffer_, receiver_table_, bits_, pyramid_, source_records_;
   detail::NamedKernel kernel_;
 };
 
@@ -381,6 +329,72 @@ void colourLight(RegionVisibilityResult& out, const HeightField& field, const st
 }  // namespace
 
 namespace detail {
+
+CullPyramid cullPyramid(const std::vector<float>& h, int width, int height) {
+  CullPyramid out;
+  if (width < 2 || height < 2) return out;  // no cells: the march runs uncut
+  const auto at = [&](int c, int r) { return h[std::size_t(r) * width + c]; };
+  // The field's largest finite height, step between neighbours and cell twist: the march's
+  // values over a block stray from its corners' range by rounding relative to the heights, and
+  // by a step or a twist times a position's rounding (a crossing a rounding outside the block, a
+  // piece's middle a rounding into the next cell): at most ulp(max(width, height)) each.
+  double largest = 0.0, step = 0.0, twist = 0.0;
+  bool any_infinite = false;
+  for (int r = 0; r < height; ++r)
+    for (int c = 0; c < width; ++c) {
+      const float v = at(c, r);
+      any_infinite = any_infinite || std::isinf(v);
+      out.finite = out.finite && std::isfinite(v);
+      if (!std::isfinite(v)) continue;
+      largest = std::max(largest, double(std::fabs(v)));
+      if (c + 1 < width && std::isfinite(at(c + 1, r)))
+        step = std::max(step, double(std::fabs(at(c + 1, r) - v)));
+      if (r + 1 < height && std::isfinite(at(c, r + 1)))
+        step = std::max(step, double(std::fabs(at(c, r + 1) - v)));
+      if (c + 1 < width && r + 1 < height) {
+        const double t = double(v) - at(c + 1, r) - at(c, r + 1) + at(c + 1, r + 1);
+        if (std::isfinite(t)) twist = std::max(twist, std::fabs(t));
+      }
+    }
+  const double position_ulp = std::ldexp(double(std::max(width, height)), -23);
+  out.margin = static_cast<float>(8e-5 * largest + 4.0 * position_ulp * (step + twist));
+  out.gradient = static_cast<float>(step + twist);
+  // The levels' sizes (as region_cull_width), then the levels in place, one after another.
+  std::vector<std::size_t> offsets = {0};
+  for (int w = width - 1, hh = height - 1;;) {
+    offsets.push_back(offsets.back() + std::size_t(w) * hh);
+    if ((w == 1 && hh == 1) || int(offsets.size()) - 1 == kCullLevels) break;
+    w = (w + 1) / 2, hh = (hh + 1) / 2;
+  }
+  out.levels = int(offsets.size()) - 1;
+  out.top.assign(offsets.back(), -std::numeric_limits<float>::infinity());
+  // Level 0: per cell its corners' highest valid height; +INFINITY where an infinite height lies
+  // on the cell or a cell beside it (the march's values there are unbounded or NaN).
+  int w = width - 1, hh = height - 1;
+  for (int r = 0; r < hh; ++r)
+    for (int c = 0; c < w; ++c) {
+      bool unbounded = false;
+      for (int y = std::max(0, r - 1); any_infinite && y <= std::min(height - 1, r + 2) && !unbounded; ++y)
+        for (int x = std::max(0, c - 1); x <= std::min(width - 1, c + 2); ++x)
+          if (std::isinf(at(x, y))) unbounded = true;
+      float top = -std::numeric_limits<float>::infinity();
+      for (const float v : {at(c, r), at(c + 1, r), at(c, r + 1), at(c + 1, r + 1)})
+        if (!std::isnan(v)) top = std::max(top, v);
+      out.top[std::size_t(r) * w + c] = unbounded ? std::numeric_limits<float>::infinity() : top;
+    }
+  for (int k = 1; k < out.levels; ++k) {
+    const float* child = out.top.data() + offsets[k - 1];
+    float* parent = out.top.data() + offsets[k];
+    const int pw = (w + 1) / 2;
+    for (int r = 0; r < hh; ++r)
+      for (int c = 0; c < w; ++c) {
+        float& p = parent[std::size_t(r / 2) * pw + c / 2];
+        p = std::max(p, child[std::size_t(r) * w + c]);
+      }
+    w = pw, hh = (hh + 1) / 2;
+  }
+  return out;
+}
 
 void countPairFractions(RegionPairVisibilityResult& out) {
   out.pairs = static_cast<std::uint64_t>(out.source_samples) * out.receiver_samples;
