@@ -135,22 +135,32 @@ int region_hider_along(__global const float* h, RegionField f, float margin, flo
   return -1;
 }
 
-// The per-end tables (region_end_table) of the shared source samples (`source_points`), toward
-// the rectangle where the receivers lie (`other`: x0, y0, x1, y1), REGION_END_RECORD floats each.
-__kernel void region_end_tables(__global const float* pyramid, int levels, RegionField f,
-                                __global const float* source_points, int samples, float4 other,
-                                __global float* records) {
+// The per-end tables (region_end_table) of `count` points toward the rectangle where their sight
+// lines' other ends lie (`other`: x0, y0, x1, y1), REGION_END_RECORD floats each: the shared source
+// samples (`placed`: x, y, z each in `points`, as region_visibility_bits takes them) or a pair's
+// receiver samples (drawn from `table` here, as region_visibility_bits draws them).
+__kernel void region_end_tables(__global const float* h, __global const float* pyramid, int levels,
+                                float margin, float z_bound, RegionField f, int placed,
+                                __global const float* points, __global const float* table, int absolute,
+                                unsigned int seed, int count, float4 other, __global float* records) {
   const int s = (int)get_global_id(0);
-  if (s >= samples) return;
+  if (s >= count) return;
+  float x, y, z;
+  if (placed) {
+    x = points[3 * s], y = points[3 * s + 1], z = points[3 * s + 2];
+  } else {
+    region_sample(table, h, f.width, f.height, absolute, seed, 0U, s, &x, &y, &z);
+  }
   float rec[REGION_END_RECORD];
-  region_end_table(pyramid, levels, f.width, f.height, source_points[3 * s], source_points[3 * s + 1],
-                   other.x, other.y, other.z, other.w, rec);
+  region_end_table(pyramid, levels, f.width, f.height, margin, f.curvature, f.cell_x, f.cell_y, x, y, z,
+                   z_bound, other.x, other.y, other.z, other.w, rec);
   for (int i = 0; i < REGION_END_RECORD; ++i) records[(size_t)s * REGION_END_RECORD + i] = rec[i];
 }
 
 __kernel void region_visibility_bits(__global const float* h, __global const float* pyramid, int levels,
                                      float margin, float gradient, int finite_field, int certify_receivers,
-                                     int certify_sources, __global const float* source_records, RegionField f,
+                                     int certify_sources, __global const float* receiver_records,
+                                     __global const float* source_records, RegionField f,
                                      __global const float* sources, __global const float* source_points,
                                      int source_absolute, int samples, int pixel_receivers,
                                      __global const float* receivers, int receiver_absolute,
@@ -168,12 +178,6 @@ __kernel void region_visibility_bits(__global const float* h, __global const flo
     zr = h[r] + target_height;
   }
   const unsigned int key = decorrelate ? (unsigned int)r + 1U : 0U;
-  // The receiver's own per-end table toward the sources' rectangle (region_end_table), for the
-  // certification of its clear sight lines (region_end_reach): one per work-item, for all its lines.
-  float own[REGION_END_RECORD];
-  if (certify_receivers && !isnan(zr))
-    region_end_table(pyramid, levels, f.width, f.height, xr, yr, sources[0], sources[1], sources[2],
-                     sources[3], own);
   // Culled: the cell that hid the last hidden sight line (and its fraction of that line from the
   // receiver), tried first against the next ones, across words, while the line before was hidden
   // (after a clear one the next is seldom hidden: the tries would cost more than they save); a
@@ -215,27 +219,25 @@ __kernel void region_visibility_bits(__global const float* h, __global const flo
             continue;
           }
         }
-        // The stretches from both ends that their tables certify clear (the march skips them).
+        // The stretches from both ends that their tables certify clear (the march skips them); tried
+        // after a clear line (after a hidden one the next is seldom clear: the look-ups would cost
+        // more than they save).
         float reach_s = 0.0f, reach_r = 0.0f;
-        if (certify_receivers || (certify_sources && !decorrelate)) {
+        if (!last_hidden && (certify_receivers || (certify_sources && !decorrelate))) {
           const float dx = xr - xs[i], dy = yr - ys[i], length = sqrt(dx * dx + dy * dy);
-          const float clearance =
-              region_end_clearance(margin, f.curvature, f.cell_x, f.cell_y, xs[i], ys[i], zs[i], xr, yr, zr);
           if (certify_receivers && length > 0.0f) {
-            const int wedge = region_end_wedge(own[0], own[1], -dx, -dy);
+            __global const float* rec = receiver_records + (size_t)r * REGION_END_RECORD;
+            const int wedge = region_end_wedge(rec[0], rec[1], -dx, -dy);
             if (wedge >= 0)
-              reach_r = region_end_reach(own + 4 + wedge * REGION_END_BANDS, (int)own[2], length, zr, zs[i],
-                                         clearance);
+              reach_r =
+                  region_end_reach(rec + 4 + 2 * wedge * REGION_END_BANDS, (int)rec[2], length, zr, zs[i]);
           }
           if (certify_sources && !decorrelate && length > 0.0f && reach_r < length) {
             __global const float* rec = source_records + (size_t)(32 * w + i) * REGION_END_RECORD;
             const int wedge = region_end_wedge(rec[0], rec[1], dx, dy);
-            if (wedge >= 0) {
-              float column[REGION_END_BANDS];
-              const int bands = (int)rec[2];
-              for (int b = 0; b < bands; ++b) column[b] = rec[4 + wedge * REGION_END_BANDS + b];
-              reach_s = region_end_reach(column, bands, length, zs[i], zr, clearance);
-            }
+            if (wedge >= 0)
+              reach_s =
+                  region_end_reach(rec + 4 + 2 * wedge * REGION_END_BANDS, (int)rec[2], length, zs[i], zr);
           }
         }
         int blocked_at = -1;

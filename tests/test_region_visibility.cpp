@@ -315,9 +315,12 @@ TEST(RegionVisibility, EndTablesCertifyOnlyClearLines) {
       float x, y, z;
       std::vector<float> rec;
     };
+    float surface = 0.0f;
+    for (const float v : h)
+      if (std::isfinite(v)) surface = std::max(surface, std::fabs(v));
     // Points on a grid with a fractional offset in a square, `above` the surface; records toward
-    // the rectangle `other`.
-    const auto ends = [&](float x0, float y0, float above, const float* other) {
+    // the rectangle `other` (the library's bound of the heights: the highest surface plus `above`).
+    const auto ends = [&](float x0, float y0, float above, float curvature, const float* other) {
       std::vector<End> out;
       for (int j = 0; j < 8; ++j)
         for (int i = 0; i < 8; ++i) {
@@ -325,8 +328,10 @@ TEST(RegionVisibility, EndTablesCertifyOnlyClearLines) {
           const float s = detail::region_surface_at(h.data(), field.width, field.height, e.x, e.y);
           if (!std::isfinite(s)) continue;
           e.z = s + above;
-          detail::region_end_table(pyramid.top.data(), pyramid.levels, field.width, field.height, e.x, e.y,
-                                   other[0], other[1], other[2], other[3], e.rec.data());
+          detail::region_end_table(pyramid.top.data(), pyramid.levels, field.width, field.height,
+                                   pyramid.margin, curvature, float(field.cell_size_x),
+                                   float(field.cell_size_y), e.x, e.y, e.z, surface + above, other[0],
+                                   other[1], other[2], other[3], e.rec.data());
           out.push_back(std::move(e));
         }
       return out;
@@ -334,23 +339,20 @@ TEST(RegionVisibility, EndTablesCertifyOnlyClearLines) {
     const float square_a[4] = {20.0f, 50.0f, 44.0f, 74.0f}, square_b[4] = {115.0f, 60.0f, 139.0f, 84.0f};
     for (float above : {0.5f, 2.0f, 6.0f})
       for (float curvature : {0.0f, 0.0005f}) {
-        const std::vector<End> a = ends(20.0f, 50.0f, above, square_b),
-                               b = ends(115.0f, 60.0f, above, square_a),
-                               own = ends(20.0f, 50.0f, above, square_a);
+        const std::vector<End> a = ends(20.0f, 50.0f, above, curvature, square_b),
+                               b = ends(115.0f, 60.0f, above, curvature, square_a),
+                               own = ends(20.0f, 50.0f, above, curvature, square_a);
         // The reach from e toward p, as the kernel takes it.
-        const auto reach = [&](const End& e, const End& p, float length, float clearance) {
+        const auto reach = [&](const End& e, const End& p, float length) {
           const int w = detail::region_end_wedge(e.rec[0], e.rec[1], p.x - e.x, p.y - e.y);
           return w < 0 ? 0.0f
-                       : detail::region_end_reach(e.rec.data() + 4 + w * REGION_END_BANDS, int(e.rec[2]),
-                                                  length, e.z, p.z, clearance);
+                       : detail::region_end_reach(e.rec.data() + 4 + 2 * w * REGION_END_BANDS, int(e.rec[2]),
+                                                  length, e.z, p.z);
         };
-        const auto check = [&](const End& p, const End& q, const End& q_toward_p) {
+        const auto check = [&](const End& p, const End& q) {
           const float length = std::sqrt((q.x - p.x) * (q.x - p.x) + (q.y - p.y) * (q.y - p.y));
           if (!(length > 0.0f)) return;
-          const float clearance =
-              detail::region_end_clearance(pyramid.margin, curvature, float(field.cell_size_x),
-                                           float(field.cell_size_y), p.x, p.y, p.z, q.x, q.y, q.z);
-          const float rp = reach(p, q, length, clearance), rq = reach(q_toward_p, p, length, clearance);
+          const float rp = reach(p, q, length), rq = reach(q, p, length);
           const int exact = detail::region_sight_visible(h.data(), field.width, field.height,
                                                          float(field.cell_size_x), float(field.cell_size_y),
                                                          curvature, 0.0f, p.x, p.y, p.z, q.x, q.y, q.z);
@@ -374,11 +376,11 @@ TEST(RegionVisibility, EndTablesCertifyOnlyClearLines) {
         for (const End& p : a)
           for (const End& q : b) {
             // q's record toward square a holds p's direction.
-            check(p, q, q);
+            check(p, q);
             if (HasFatalFailure()) return;
           }
         for (const End& p : own)
-          for (const End& q : own) check(p, q, q);
+          for (const End& q : own) check(p, q);
         if (HasFatalFailure()) return;
       }
   }

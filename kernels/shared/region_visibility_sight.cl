@@ -245,8 +245,6 @@ inline int region_sight_visible_culled(HFVIS_GLOBAL const float* h, int width, i
       region_cull_resume(xa, ya, dx, dy, on_column, lx, ly, tC, &gxl, &gyl);
       f0 = region_cull_crossing_rise(h, width, height, xa, ya, za, dx, dy, dz, cdd, on_column, lx, ly, tC);
       if (f0 > 0.0f) return 0;
-      // Far from a the blocks below the segment are large: the leaps start from there.
-      for (float r = 2.0f; r <= reach_a && level + 1 < levels; r *= 2.0f) ++level;
     }
   }
   if (reach_b > 0.01f) {
@@ -375,15 +373,20 @@ inline int region_sight_visible(HFVIS_GLOBAL const float* h, int width, int heig
 // end point E of many sight lines (a sample, a receiver) and the rectangle where their other ends
 // lie, the highest pyramid value (region_cull_*: a cell's highest corner, +INFINITY where the
 // march's values are unbounded, -INFINITY over no surface) over every cell that can meet a segment
-// from E by direction wedge and radial band: REGION_END_BANDS bands [0, 1], [1, 2], [2, 4], ...
+// from E, by direction wedge and radial band: REGION_END_BANDS bands [0, 1], [1, 2], [2, 4], ...
 // and REGION_END_WEDGES wedges of the cone of directions from E toward the rectangle (all
 // directions where E lies at or near it). Directions are pseudo-angles (region_pseudo_angle: a
-// monotone stand-in for the angle, 0 .. 4 a turn, one division), cheap in the per-line look-up.
-// A record: the cone's first pseudo-angle, its span, the bands filled, 0, then per wedge its
-// bands' values.
+// monotone stand-in for the angle, 0 .. 4 a turn, one division). A line from E of slope s (height
+// per pixel) clears band b when the band's value plus the clearance lies below its lowest point
+// over the band, E's height plus s times the band's inner radius (s >= 0) or its outer one (s < 0):
+// when s exceeds the band's required slope (value + clearance - E's height) / radius. The record
+// keeps per wedge the running maxima of the bands' required slopes from E outward, for rising and
+// for falling lines, so that a line's certified bands are those whose running maximum lies below
+// its slope (region_end_reach: a count). A record: the cone's first pseudo-angle, its span, the
+// bands filled, 0, then per wedge the rising maxima and the falling ones, REGION_END_BANDS each.
 #define REGION_END_WEDGES 16
 #define REGION_END_BANDS 12
-#define REGION_END_RECORD (4 + REGION_END_WEDGES * REGION_END_BANDS)
+#define REGION_END_RECORD (4 + 2 * REGION_END_WEDGES * REGION_END_BANDS)
 
 inline float region_band_edge(int b) { return b == 0 ? 0.0f : (float)(1 << (b - 1)); }
 
@@ -423,14 +426,18 @@ inline int region_end_wedge(float first, float span, float x, float y) {
   return w < REGION_END_WEDGES ? w : -1;
 }
 
-// Fills E's record (rec: REGION_END_RECORD floats) over the pyramid (`levels` > 0) for the other
-// ends in the rectangle (ox0, oy0) .. (ox1, oy1). Conservative throughout: a band is looked at in
-// blocks of the pyramid (a quarter of its inner radius a side, cells up to radius 8), and a
-// block counts for every wedge and band its box, grown by 0.01 pixel, meets in the box's ranges of
-// distance and pseudo-angle from E (which hold the box's own), the cone and the wedges grown by
-// 1e-4 (the look-up's and the box corners' roundings); a box holding E counts for every wedge.
-inline void region_end_table(HFVIS_GLOBAL const float* pyramid, int levels, int width, int height, float ex,
-                             float ey, float ox0, float oy0, float ox1, float oy1, float* rec) {
+// Fills the record (rec: REGION_END_RECORD floats) of E = (ex, ey, ez) over the pyramid (`levels` >
+// 0) for the other ends in the rectangle (ox0, oy0) .. (ox1, oy1), their heights within +-z_bound.
+// Conservative throughout: a band is looked at in blocks of the pyramid (a quarter of its inner
+// radius a side, cells up to radius 8), and a block counts for every wedge and band its box, grown
+// by 0.01 pixel, meets in the box's ranges of distance and pseudo-angle from E (which hold the
+// box's own), the cone and the wedges grown by 1e-4 (the look-up's and the box corners'
+// roundings); a box holding E counts for every wedge. The clearance is region_end_clearance's for
+// the longest line toward the rectangle and both ends' heights at their bound.
+inline void region_end_table(HFVIS_GLOBAL const float* pyramid, int levels, int width, int height,
+                             float margin, float curvature, float cell_x, float cell_y, float ex, float ey,
+                             float ez, float z_bound, float ox0, float oy0, float ox1, float oy1,
+                             float* rec) {
   const float grow = 0.01f, turn_grow = 1e-4f;
   float first = 0.0f, span = 4.0f, far2 = 0.0f;
   for (int c = 0; c < 4; ++c) {
@@ -452,6 +459,7 @@ inline void region_end_table(HFVIS_GLOBAL const float* pyramid, int levels, int 
   int bands = 1;
   while (bands < REGION_END_BANDS && region_band_edge(bands) * region_band_edge(bands) < far2) ++bands;
   rec[0] = first, rec[1] = span, rec[2] = (float)bands, rec[3] = 0.0f;
+  // The bands' values first (the rising maxima's place), the required slopes after.
   for (int i = 4; i < REGION_END_RECORD; ++i) rec[i] = -INFINITY;
   // The unit directions of the cone's edges, for the bands' bounding boxes.
   float ux0, uy0, ux1, uy1;
@@ -496,9 +504,10 @@ inline void region_end_table(HFVIS_GLOBAL const float* pyramid, int levels, int 
         const float top = pyramid[offset + by * kw + bx];
         float lo = 0.0f, hi = 4.0f;  // the box's pseudo-angles from the cone's first
         if (nx > 0.0f || ny > 0.0f) {
-          const float mid = region_pseudo_angle(0.5f * (X0 + X1), 0.5f * (Y0 + Y1));
+          // (about the first corner's: the box seen from outside spans less than half a turn)
+          const float mid = region_pseudo_angle(X0, Y0);
           float dlo = 0.0f, dhi = 0.0f;
-          for (int c = 0; c < 4; ++c) {
+          for (int c = 1; c < 4; ++c) {
             float d = region_pseudo_angle(c & 1 ? X1 : X0, c & 2 ? Y1 : Y0) - mid;
             d = d > 2.0f ? d - 4.0f : (d <= -2.0f ? d + 4.0f : d);
             dlo = fmin(dlo, d), dhi = fmax(dhi, d);
@@ -514,44 +523,45 @@ inline void region_end_table(HFVIS_GLOBAL const float* pyramid, int levels, int 
           int w1 = (int)(fmin(z, span) * ((float)REGION_END_WEDGES / span));
           w1 = w1 < REGION_END_WEDGES - 1 ? w1 : REGION_END_WEDGES - 1;
           for (int w = w0; w <= w1; ++w) {
-            float* v = rec + 4 + w * REGION_END_BANDS + b;
+            float* v = rec + 4 + 2 * w * REGION_END_BANDS + b;
             *v = fmax(*v, top);
           }
         }
       }
   }
-}
-
-// The clearance region_end_reach asks of a sight line between (xa, ya, za) and (xb, yb, zb): the
-// culled march's (margin, the segment's rounding, the curvature's largest rise), and as much again
-// of the segment's part for the rounding of the tables' own heights along it.
-inline float region_end_clearance(float margin, float curvature, float cell_x, float cell_y, float xa,
-                                  float ya, float za, float xb, float yb, float zb) {
-  const float gx = (xb - xa) * cell_x, gy = (yb - ya) * cell_y, cdd = curvature * (gx * gx + gy * gy);
-  return margin + 1e-5f * (4.0f * (fabs(za) + fabs(zb)) + fabs(cdd)) + (cdd > 0.0f ? 0.25f * cdd : 0.0f);
+  const float cell = fmax(cell_x, cell_y), cdd = curvature * far2 * cell * cell;
+  const float clearance =
+      margin + 1e-5f * (4.0f * (fabs(ez) + z_bound) + fabs(cdd)) + (cdd > 0.0f ? 0.25f * cdd : 0.0f);
+  for (int w = 0; w < REGION_END_WEDGES; ++w) {
+    float* up = rec + 4 + 2 * w * REGION_END_BANDS;
+    float* down = up + REGION_END_BANDS;
+    float up_max = -INFINITY, down_max = -INFINITY;
+    for (int b = 0; b < bands; ++b) {
+      // (a band's value is finite or infinite, never NaN: so is `need` but over a NaN height; the
+      // radii are powers of 2, their reciprocals exact)
+      const float need = isnan(ez) ? INFINITY : up[b] + clearance - ez;
+      up_max =
+          fmax(up_max, b == 0 ? (need < 0.0f ? -INFINITY : INFINITY) : need * (1.0f / region_band_edge(b)));
+      down_max = fmax(down_max, need * (1.0f / region_band_edge(b + 1)));
+      up[b] = up_max, down[b] = down_max;
+    }
+  }
 }
 
 // How far from the end E (height ze) the sight line of `length` pixels to the other end (height
-// zp) is certified clear by E's wedge `column` (its bands' values): band by band from E, while the
-// band's value lies below the line's lowest point over the band by `clearance` (the culled march's,
-// region_sight_visible_culled, with this test's own rounding: region_end_clearance). Then every
-// cell along that stretch would be leapt by the march (it lies below the segment by the march's
-// clearance over the cell's stretch: each point of the stretch lies in a band whose value holds the
-// cell's highest corner), so the march, which finds the same hits with or without leaps, finds
-// none there. 0 when the first band fails (an end on the surface always: its own corner).
-inline float region_end_reach(const float* column, int bands, float length, float ze, float zp,
-                              float clearance) {
-  float reach = 0.0f;
-  const float dz = zp - ze;
-  for (int b = 0; b < bands; ++b) {
-    const float r0 = region_band_edge(b);
-    if (r0 >= length) break;
-    const float r1 = fmin(region_band_edge(b + 1), length);
-    const float z0 = ze + dz * (r0 / length), z1 = ze + dz * (r1 / length);
-    if (!(column[b] + clearance < fmin(z0, z1))) break;
-    reach = r1;
-  }
-  return reach;
+// zp) is certified clear by E's record `wedge` (its rising maxima, then its falling ones): the
+// bands from E whose running maximum of required slopes lies below the line's slope (a count; the
+// maxima only grow outward). Then every cell along that stretch would be leapt by the march (each
+// point of the stretch lies in a band whose value holds the cell's highest corner, below the
+// segment there by the march's clearance), so the march, which finds the same hits with or without
+// leaps, finds none there. 0 when the first band fails (an end on the surface always: its own
+// corner). The slope's rounding and the required slopes' lie within the clearance's second half.
+inline float region_end_reach(HFVIS_GLOBAL const float* wedge, int bands, float length, float ze, float zp) {
+  const float slope = (zp - ze) / length;
+  HFVIS_GLOBAL const float* maxima = slope >= 0.0f ? wedge : wedge + REGION_END_BANDS;
+  int count = 0;
+  for (int b = 0; b < bands; ++b) count += maxima[b] < slope;
+  return count == 0 ? 0.0f : fmin(region_band_edge(count), length);
 }
 
 // Whether the surface over cell `cell` (the index of its first corner) rises above the segment

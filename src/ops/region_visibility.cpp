@@ -111,26 +111,50 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
       finite_ = pyramid.finite;
       if (levels_ > 0) pyramid_ = upload(pyramid.top);
     }
-    // The per-end tables that certify clear sight lines (region_end_table): the shared sources'
-    // once here; each receiver's by its work-item, except a pixel's on the surface (target height
-    // 0), whose first band always holds its own height, so that its table would certify nothing.
+    // The per-end tables that certify clear sight lines (region_end_table): the shared sources' and
+    // a pair's receivers' (an every-pixel receiver has none: a light high above certifies from its
+    // own end, and a pixel on the surface, the usual receiver, has its first band at its own height).
     certify_sources_ = levels_ > 0 && !options_.decorrelate;
-    certify_receivers_ = levels_ > 0 && (receivers_ != nullptr || options_.target_height > 0.0);
-    if (certify_sources_) {
-      source_records_ = detail::deviceBuffer(st_, std::size_t(samples_) * REGION_END_RECORD * sizeof(float));
-      const cl_float4 other =
-          receivers_ ? cl_float4{{(*receivers_)[0], (*receivers_)[1], (*receivers_)[2], (*receivers_)[3]}}
-                     : cl_float4{{0.0f, 0.0f, float(field_.width - 1), float(field_.height - 1)}};
-      detail::NamedKernel tables = kernel("region_end_tables");
-      tables.set("pyramid", pyramid_)
-          .set("levels", cl_int(levels_))
-          .set("f", device)
-          .set("source_points", source_points_buffer_)
-          .set("samples", cl_int(samples_))
-          .set("other", other)
-          .set("records", source_records_);
-      st_.launch(tables, cl::NDRange(detail::roundUp(samples_, detail::kLineGroup)),
-                 cl::NDRange(detail::kLineGroup));
+    certify_receivers_ = levels_ > 0 && receivers_ != nullptr;
+    if (certify_sources_ || certify_receivers_) {
+      // The tables' bound of the sight lines' end heights: the highest surface plus the largest
+      // height over it (an absolute height is bounded by it too).
+      float surface = 0.0f, above = float(options_.target_height);
+      for (const float v : prepared_.heights)
+        if (std::isfinite(v)) surface = std::max(surface, std::fabs(v));
+      for (const std::vector<float>* table : {&sources_, receivers_})
+        for (std::size_t i = 8; table && i < table->size(); i += 5)
+          above = std::max(above, std::fabs((*table)[i]));
+      const cl_float4 field_box{{0.0f, 0.0f, float(field_.width - 1), float(field_.height - 1)}};
+      const auto box = [](const std::vector<float>& table) {
+        return cl_float4{{table[0], table[1], table[2], table[3]}};
+      };
+      // (a pair's receivers drawn on the device, as region_visibility_bits draws them)
+      const auto records = [&](bool placed, int count, bool absolute, const cl_float4& other) {
+        cl::Buffer out = detail::deviceBuffer(st_, std::size_t(count) * REGION_END_RECORD * sizeof(float));
+        detail::NamedKernel tables = kernel("region_end_tables");
+        tables.set("h", heights_)
+            .set("pyramid", pyramid_)
+            .set("levels", cl_int(levels_))
+            .set("margin", margin_)
+            .set("z_bound", surface + above)
+            .set("f", device)
+            .set("placed", cl_int(placed))
+            .set("points", source_points_buffer_)
+            .set("table", receiver_table_)
+            .set("absolute", cl_int(absolute))
+            .set("seed", cl_uint(options_.seed))
+            .set("count", cl_int(count))
+            .set("other", other)
+            .set("records", out);
+        st_.launch(tables, cl::NDRange(detail::roundUp(count, detail::kLineGroup)),
+                   cl::NDRange(detail::kLineGroup));
+        return out;
+      };
+      if (certify_sources_)
+        source_records_ =
+            records(true, samples_, source_absolute_, receivers_ ? box(*receivers_) : field_box);
+      if (certify_receivers_) receiver_records_ = records(false, count_, receiver_absolute_, box(sources_));
     }
     kernel_ = kernel("region_visibility_bits");
     kernel_.set("h", heights_)
@@ -141,6 +165,7 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
         .set("finite_field", cl_int(finite_))
         .set("certify_receivers", cl_int(certify_receivers_))
         .set("certify_sources", cl_int(certify_sources_))
+        .set("receiver_records", certify_receivers_ ? receiver_records_ : heights_)
         .set("source_records", certify_sources_ ? source_records_ : heights_)
         .set("f", device)
         .set("sources", source_table_)
@@ -196,7 +221,8 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
   cl_float margin_ = 0.0f, gradient_ = 0.0f;
   bool finite_ = false;
   bool certify_sources_ = false, certify_receivers_ = false;  // per-end tables (culled only)
-  cl::Buffer source_table_, source_points_buffer_, receiver_table_, bits_, pyramid_, source_records_;
+  cl::Buffer source_table_, source_points_buffer_, receiver_table_, bits_, pyramid_, source_records_,
+      receiver_records_;
   detail::NamedKernel kernel_;
 };
 
