@@ -384,7 +384,7 @@ inline int region_sight_visible(HFVIS_GLOBAL const float* h, int width, int heig
 // for falling lines, so that a line's certified bands are those whose running maximum lies below
 // its slope (region_end_reach: a count). A record: the cone's first pseudo-angle, its span, the
 // bands filled, 0, then per wedge the rising maxima and the falling ones, REGION_END_BANDS each.
-#define REGION_END_WEDGES 16
+#define REGION_END_WEDGES 8
 #define REGION_END_BANDS 12
 #define REGION_END_RECORD (4 + 2 * REGION_END_WEDGES * REGION_END_BANDS)
 

@@ -103,6 +103,7 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
                              static_cast<float>(field_.cell_size_y),
                              static_cast<float>(options_.curvature),
                              options_.max_distance > 0.0 ? static_cast<float>(max_d2) : 0.0f};
+    bool some_clear = true;
     if (options_.method == RegionVisibilityMethod::Culled) {
       const detail::CullPyramid pyramid = detail::cullPyramid(prepared_.heights, field_.width, field_.height);
       levels_ = pyramid.levels;
@@ -110,12 +111,14 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
       gradient_ = pyramid.gradient;
       finite_ = pyramid.finite;
       if (levels_ > 0) pyramid_ = upload(pyramid.top);
+      if (levels_ > 0 && receivers_ && !options_.decorrelate) some_clear = probeClear(pyramid, device);
     }
     // The per-end tables that certify clear sight lines (region_end_table): the shared sources' and
     // a pair's receivers' (an every-pixel receiver has none: a light high above certifies from its
-    // own end, and a pixel on the surface, the usual receiver, has its first band at its own height).
-    certify_sources_ = levels_ > 0 && !options_.decorrelate;
-    certify_receivers_ = levels_ > 0 && receivers_ != nullptr;
+    // own end, and a pixel on the surface, the usual receiver, has its first band at its own height);
+    // none for a pair where the probe found no clear line (the tables would cost more than they save).
+    certify_sources_ = levels_ > 0 && !options_.decorrelate && some_clear;
+    certify_receivers_ = levels_ > 0 && receivers_ != nullptr && some_clear;
     if (certify_sources_ || certify_receivers_) {
       // The tables' bound of the sight lines' end heights: the highest surface plus the largest
       // height over it (an absolute height is bounded by it too).
@@ -182,6 +185,28 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
         .set("words", cl_int(words_))
         .set("receiver_major", cl_int(receiver_major_))
         .set("bits", bits_);
+  }
+
+  // Whether any of kProbeLines sight lines spread over a pair's (shared) sources and receivers,
+  // marched here, is clear: a pair hidden all but everywhere skips the certifying tables.
+  bool probeClear(const detail::CullPyramid& pyramid, const DeviceField& device) const {
+    constexpr int kProbeLines = 64;
+    const std::vector<float>& h = prepared_.heights;
+    for (int i = 0; i < kProbeLines; ++i) {
+      const int s = int(std::int64_t(i) * samples_ / kProbeLines), r = int(std::int64_t(i) * 37 % count_);
+      float xr, yr, zr;
+      detail::region_sample(receivers_->data(), h.data(), field_.width, field_.height, receiver_absolute_,
+                            options_.seed, 0u, r, &xr, &yr, &zr);
+      int blocked_at;
+      if (!std::isnan(zr) &&
+          detail::region_sight_visible_culled(h.data(), field_.width, field_.height, device.cell_x,
+                                              device.cell_y, device.curvature, device.max_d2,
+                                              pyramid.top.data(), pyramid.levels, pyramid.margin, 1.0f, 0.0f,
+                                              0.0f, 0.0f, source_points_[3 * s], source_points_[3 * s + 1],
+                                              source_points_[3 * s + 2], xr, yr, zr, 0.0f, 0.0f, &blocked_at))
+        return true;
+    }
+    return false;
   }
 
   int receiversPerLaunch() const { return std::max(1, kWordsPerLaunch / words_); }
