@@ -4,8 +4,10 @@
 // of 32 source samples places them, marches each pair (shared/region_visibility_sight.cl; with a
 // culling pyramid, `levels` > 0, the march leaps over the blocks of cells far below the segment,
 // and each sight line is tried first against the cell that hid the last hidden one, or the cell
-// at the same fraction of its own line) and writes the word, so no two work-items write one word
-// and no atomics are needed.
+// at the same fraction of its own line; after a clear line, the stretches near both ends that the
+// per-end tables of region_end_tables certify clear are skipped: `certify_sources`, the shared
+// samples' tables, `certify_receivers`, a pair's receivers') and writes the word, so no two
+// work-items write one word and no atomics are needed.
 //
 // Receivers are the grid points (`pixel_receivers`) or the samples of a second region (the
 // table `receivers`, stream 0). Shared source samples (stream 0) come placed by the host
@@ -223,7 +225,7 @@ __kernel void region_visibility_bits(__global const float* h, __global const flo
         // after a clear line (after a hidden one the next is seldom clear: the look-ups would cost
         // more than they save).
         float reach_s = 0.0f, reach_r = 0.0f;
-        if (!last_hidden && (certify_receivers || (certify_sources && !decorrelate))) {
+        if (!last_hidden && (certify_receivers || certify_sources)) {
           const float dx = xr - xs[i], dy = yr - ys[i], length = sqrt(dx * dx + dy * dy);
           if (certify_receivers && length > 0.0f) {
             __global const float* rec = receiver_records + (size_t)r * REGION_END_RECORD;
@@ -232,7 +234,7 @@ __kernel void region_visibility_bits(__global const float* h, __global const flo
               reach_r =
                   region_end_reach(rec + 4 + 2 * wedge * REGION_END_BANDS, (int)rec[2], length, zr, zs[i]);
           }
-          if (certify_sources && !decorrelate && length > 0.0f && reach_r < length) {
+          if (certify_sources && length > 0.0f && reach_r < length) {
             __global const float* rec = source_records + (size_t)(32 * w + i) * REGION_END_RECORD;
             const int wedge = region_end_wedge(rec[0], rec[1], dx, dy);
             if (wedge >= 0)

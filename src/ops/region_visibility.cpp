@@ -103,7 +103,7 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
                              static_cast<float>(field_.cell_size_y),
                              static_cast<float>(options_.curvature),
                              options_.max_distance > 0.0 ? static_cast<float>(max_d2) : 0.0f};
-    bool some_clear = true;
+    bool probed_clear = false;
     if (options_.method == RegionVisibilityMethod::Culled) {
       const detail::CullPyramid pyramid = detail::cullPyramid(prepared_.heights, field_.width, field_.height);
       levels_ = pyramid.levels;
@@ -111,14 +111,15 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
       gradient_ = pyramid.gradient;
       finite_ = pyramid.finite;
       if (levels_ > 0) pyramid_ = upload(pyramid.top);
-      if (levels_ > 0 && receivers_ && !options_.decorrelate) some_clear = probeClear(pyramid, device);
+      if (levels_ > 0 && receivers_) probed_clear = probeClear(pyramid, device);
     }
-    // The per-end tables that certify clear sight lines (region_end_table): the shared sources' and
-    // a pair's receivers' (an every-pixel receiver has none: a light high above certifies from its
-    // own end, and a pixel on the surface, the usual receiver, has its first band at its own height);
-    // none for a pair where the probe found no clear line (the tables would cost more than they save).
-    certify_sources_ = levels_ > 0 && !options_.decorrelate && some_clear;
-    certify_receivers_ = levels_ > 0 && receivers_ != nullptr && some_clear;
+    // The per-end tables that certify clear sight lines (region_end_table), a pair's only: its
+    // shared sources' and its receivers', where the probe found enough clear lines (elsewhere they
+    // cost more than they save). An area light over every pixel takes none: its receivers lie on
+    // the surface (their first band holds their own height, so nothing is certified from that end)
+    // and its sources' tables alone did not measurably speed it (bench/report/region_visibility.md).
+    certify_receivers_ = levels_ > 0 && receivers_ != nullptr && probed_clear;
+    certify_sources_ = certify_receivers_ && !options_.decorrelate;
     if (certify_sources_ || certify_receivers_) {
       // The tables' bound of the sight lines' end heights: the highest surface plus the largest
       // height over it (an absolute height is bounded by it too).
@@ -128,7 +129,6 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
       for (const std::vector<float>* table : {&sources_, receivers_})
         for (std::size_t i = 8; table && i < table->size(); i += 5)
           above = std::max(above, std::fabs((*table)[i]));
-      const cl_float4 field_box{{0.0f, 0.0f, float(field_.width - 1), float(field_.height - 1)}};
       const auto box = [](const std::vector<float>& table) {
         return cl_float4{{table[0], table[1], table[2], table[3]}};
       };
@@ -154,9 +154,7 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
                    cl::NDRange(detail::kLineGroup));
         return out;
       };
-      if (certify_sources_)
-        source_records_ =
-            records(true, samples_, source_absolute_, receivers_ ? box(*receivers_) : field_box);
+      if (certify_sources_) source_records_ = records(true, samples_, source_absolute_, box(*receivers_));
       if (certify_receivers_) receiver_records_ = records(false, count_, receiver_absolute_, box(sources_));
     }
     kernel_ = kernel("region_visibility_bits");
@@ -187,9 +185,10 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
         .set("bits", bits_);
   }
 
-  // Whether at least kProbeClear of kProbeLines sight lines spread over a pair's (shared) sources
-  // and receivers, marched here, are clear: a pair where fewer than about 1 line in 16 is clear
-  // skips the certifying tables (measured: they cost more than they save there).
+  // Whether at least kProbeClear of kProbeLines sight lines spread over a pair's sources (stream
+  // 0's, standing in for decorrelated ones too) and receivers, marched here, are clear: a pair where fewer
+  // than about 1 line in 16 is clear skips the certifying tables (measured: they cost more than they save
+  // there).
   bool probeClear(const detail::CullPyramid& pyramid, const DeviceField& device) const {
     constexpr int kProbeLines = 64, kProbeClear = 4;
     const std::vector<float>& h = prepared_.heights;
