@@ -4,8 +4,10 @@
 // of 32 source samples places them, marches each pair (shared/region_visibility_sight.cl; with a
 // culling pyramid, `levels` > 0, the march leaps over the blocks of cells far below the segment,
 // and each sight line is tried first against the cell that hid the last hidden one, or the cell
-// at the same fraction of its own line) and writes the word, so no two work-items write one word
-// and no atomics are needed.
+// at the same fraction of its own line; after a clear line, the stretches near both ends that the
+// per-end tables of region_end_tables certify clear are skipped: `certify_sources`, the shared
+// samples' tables, `certify_receivers`, a pair's receivers') and writes the word, so no two
+// work-items write one word and no atomics are needed.
 //
 // Receivers are the grid points (`pixel_receivers`) or the samples of a second region (the
 // table `receivers`, stream 0). Shared source samples (stream 0) come placed by the host
@@ -135,8 +137,32 @@ int region_hider_along(__global const float* h, RegionField f, float margin, flo
   return -1;
 }
 
+// The per-end tables (region_end_table) of `count` points toward the rectangle where their sight
+// lines' other ends lie (`other`: x0, y0, x1, y1), REGION_END_RECORD floats each: the shared source
+// samples (`placed`: x, y, z each in `points`, as region_visibility_bits takes them) or a pair's
+// receiver samples (drawn from `table` here, as region_visibility_bits draws them).
+__kernel void region_end_tables(__global const float* h, __global const float* pyramid, int levels,
+                                float margin, float z_bound, RegionField f, int placed,
+                                __global const float* points, __global const float* table, int absolute,
+                                unsigned int seed, int count, float4 other, __global float* records) {
+  const int s = (int)get_global_id(0);
+  if (s >= count) return;
+  float x, y, z;
+  if (placed) {
+    x = points[3 * s], y = points[3 * s + 1], z = points[3 * s + 2];
+  } else {
+    region_sample(table, h, f.width, f.height, absolute, seed, 0U, s, &x, &y, &z);
+  }
+  float rec[REGION_END_RECORD];
+  region_end_table(pyramid, levels, f.width, f.height, margin, f.curvature, f.cell_x, f.cell_y, x, y, z,
+                   z_bound, other.x, other.y, other.z, other.w, rec);
+  for (int i = 0; i < REGION_END_RECORD; ++i) records[(size_t)s * REGION_END_RECORD + i] = rec[i];
+}
+
 __kernel void region_visibility_bits(__global const float* h, __global const float* pyramid, int levels,
-                                     float margin, float gradient, int finite_field, RegionField f,
+                                     float margin, float gradient, int finite_field, int certify_receivers,
+                                     int certify_sources, __global const float* receiver_records,
+                                     __global const float* source_records, RegionField f,
                                      __global const float* sources, __global const float* source_points,
                                      int source_absolute, int samples, int pixel_receivers,
                                      __global const float* receivers, int receiver_absolute,
@@ -195,10 +221,31 @@ __kernel void region_visibility_bits(__global const float* h, __global const flo
             continue;
           }
         }
+        // The stretches from both ends that their tables certify clear (the march skips them); tried
+        // after a clear line (after a hidden one the next is seldom clear: the look-ups would cost
+        // more than they save).
+        float reach_s = 0.0f, reach_r = 0.0f;
+        if (!last_hidden && (certify_receivers || certify_sources)) {
+          const float dx = xr - xs[i], dy = yr - ys[i], length = sqrt(dx * dx + dy * dy);
+          if (certify_receivers && length > 0.0f) {
+            __global const float* rec = receiver_records + (size_t)r * REGION_END_RECORD;
+            const int wedge = region_end_wedge(rec[0], rec[1], -dx, -dy);
+            if (wedge >= 0)
+              reach_r =
+                  region_end_reach(rec + 4 + 2 * wedge * REGION_END_BANDS, (int)rec[2], length, zr, zs[i]);
+          }
+          if (certify_sources && length > 0.0f && reach_r < length) {
+            __global const float* rec = source_records + (size_t)(32 * w + i) * REGION_END_RECORD;
+            const int wedge = region_end_wedge(rec[0], rec[1], dx, dy);
+            if (wedge >= 0)
+              reach_s =
+                  region_end_reach(rec + 4 + 2 * wedge * REGION_END_BANDS, (int)rec[2], length, zs[i], zr);
+          }
+        }
         int blocked_at = -1;
         if (region_sight_visible_culled(h, f.width, f.height, f.cell_x, f.cell_y, f.curvature, f.max_d2,
                                         pyramid, levels, margin, box[0], box[1], box[2], box[3], xs[i], ys[i],
-                                        zs[i], xr, yr, zr, &blocked_at)) {
+                                        zs[i], xr, yr, zr, reach_s, reach_r, &blocked_at)) {
           word |= 1U << i;
           last_hidden = 0;
         } else {

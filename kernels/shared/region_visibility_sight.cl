@@ -151,10 +151,13 @@ inline int region_sight_visible_culled(HFVIS_GLOBAL const float* h, int width, i
                                        float cell_y, float curvature, float max_d2,
                                        HFVIS_GLOBAL const float* pyramid, int levels, float margin,
                                        float box_x0, float box_y0, float box_x1, float box_y1, float xa,
-                                       float ya, float za, float xb, float yb, float zb, int* blocked_at) {
+                                       float ya, float za, float xb, float yb, float zb, float reach_a,
+                                       float reach_b, int* blocked_at) {
   // The canonical order: from the smaller end in (x, y, z), so that the test is symmetric.
   if (xb < xa || (xb == xa && (yb < ya || (yb == ya && zb < za)))) {
-    float s = xa;
+    float s = reach_a;
+    reach_a = reach_b, reach_b = s;
+    s = xa;
     xa = xb, xb = s;
     s = ya;
     ya = yb, yb = s;
@@ -168,6 +171,9 @@ inline int region_sight_visible_culled(HFVIS_GLOBAL const float* h, int width, i
   if (max_d2 > 0.0f && d2 > max_d2) return 0;
   const float cdd = curvature * d2;
   const float pixels = dx > (dy < 0.0f ? -dy : dy) ? dx : (dy < 0.0f ? -dy : dy);
+  // The ends' certified stretches (region_end_reach) meet: no cell along the segment comes near it.
+  const float length = reach_a > 0.0f || reach_b > 0.0f ? sqrt(dx * dx + dy * dy) : 0.0f;
+  if (length > 0.0f && reach_a + reach_b >= length) return 1;
   // On a grid line the surface is that edge's straight line, beside a nodata cell too.
   const int on_grid_line = (dx == 0.0f && xa == (float)(int)xa) || (dy == 0.0f && ya == (float)(int)ya);
   // The next column line after xa and the next row line after ya (toward yb).
@@ -218,6 +224,32 @@ inline int region_sight_visible_culled(HFVIS_GLOBAL const float* h, int width, i
     const float tY = dy > 0.0f && yb > box_y1 ? (box_y1 - ya) / dy
                                               : (dy < 0.0f && yb < box_y0 ? (box_y0 - ya) / dy : INFINITY);
     t_out = tX < tY ? tX : tY;
+  }
+  // The stretches the ends' tables certified (reach_a from a, reach_b from b, in pixels): the march
+  // starts at the last grid crossing within a's (a crossing of the march's own, in its own state,
+  // as after a leap) and ends where b's begins; every cell of the segment outside lies below it
+  // by the march's clearance, so the march would have leapt it (region_end_reach). The 0.01 pixel
+  // taken off each covers the rounding of the stretches' parameters.
+  if (reach_a > 0.01f) {
+    const float t_in = (reach_a - 0.01f) / length;
+    // The last column line and the last row line crossed at or before t_in, after a.
+    const float lx = dx > 0.0f ? region_cull_next_line(xa, dx, t_in, 0) - 1.0f : xa;
+    const float ly = dy > 0.0f ? region_cull_next_line(ya, dy, t_in, 0) - 1.0f
+                               : (dy < 0.0f ? region_cull_next_line(ya, dy, t_in, 0) + 1.0f : ya);
+    const float tX = lx > xa ? (lx - xa) / dx : -INFINITY;
+    const float tY = (dy > 0.0f && ly > ya) || (dy < 0.0f && ly < ya) ? (ly - ya) / dy : -INFINITY;
+    const int on_column = tX >= tY;
+    const float tC = on_column ? tX : tY;
+    if (tC > t0 && tC < 1.0f) {
+      t0 = tC;
+      region_cull_resume(xa, ya, dx, dy, on_column, lx, ly, tC, &gxl, &gyl);
+      f0 = region_cull_crossing_rise(h, width, height, xa, ya, za, dx, dy, dz, cdd, on_column, lx, ly, tC);
+      if (f0 > 0.0f) return 0;
+    }
+  }
+  if (reach_b > 0.01f) {
+    const float t_end = 1.0f - (reach_b - 0.01f) / length;
+    t_out = t_out < t_end ? t_out : t_end;
   }
   for (;;) {
     if (t0 >= t_out) return 1;
@@ -334,7 +366,202 @@ inline int region_sight_visible(HFVIS_GLOBAL const float* h, int width, int heig
                                 float xb, float yb, float zb) {
   int blocked_at;
   return region_sight_visible_culled(h, width, height, cell_x, cell_y, curvature, max_d2, h, 0, 0.0f, 1.0f,
-                                     0.0f, 0.0f, 0.0f, xa, ya, za, xb, yb, zb, &blocked_at);
+                                     0.0f, 0.0f, 0.0f, xa, ya, za, xb, yb, zb, 0.0f, 0.0f, &blocked_at);
+}
+
+// Per-end tables of headroom (the certification of the culled march's clear sight lines): for an
+// end point E of many sight lines (a sample, a receiver) and the rectangle where their other ends
+// lie, the highest pyramid value (region_cull_*: a cell's highest corner, +INFINITY where the
+// march's values are unbounded, -INFINITY over no surface) over every cell that can meet a segment
+// from E, by direction wedge and radial band: REGION_END_BANDS bands [0, 1], [1, 2], [2, 4], ...
+// and REGION_END_WEDGES wedges of the cone of directions from E toward the rectangle (all
+// directions where E lies at or near it). Directions are pseudo-angles (region_pseudo_angle: a
+// monotone stand-in for the angle, 0 .. 4 a turn, one division). A line from E of slope s (height
+// per pixel) clears band b when the band's value plus the clearance lies below its lowest point
+// over the band, E's height plus s times the band's inner radius (s >= 0) or its outer one (s < 0):
+// when s exceeds the band's required slope (value + clearance - E's height) / radius. The record
+// keeps per wedge the running maxima of the bands' required slopes from E outward, for rising and
+// for falling lines, so that a line's certified bands are those whose running maximum lies below
+// its slope (region_end_reach: a count). A record: the cone's first pseudo-angle, its span, the
+// bands filled, 0, then per wedge the rising maxima and the falling ones, REGION_END_BANDS each.
+#define REGION_END_WEDGES 8
+#define REGION_END_BANDS 12
+#define REGION_END_RECORD (4 + 2 * REGION_END_WEDGES * REGION_END_BANDS)
+
+inline float region_band_edge(int b) { return b == 0 ? 0.0f : (float)(1 << (b - 1)); }
+
+// The pseudo-angle of the direction (x, y): 0 .. 4 counter-clockwise from +x, 1 per quarter turn,
+// p(-x, -y) = p(x, y) + 2 (mod 4).
+inline float region_pseudo_angle(float x, float y) {
+  if (y >= 0.0f) return x >= 0.0f ? (x + y > 0.0f ? y / (x + y) : 0.0f) : 1.0f - x / (y - x);
+  return x < 0.0f ? 2.0f - y / (-x - y) : 3.0f + x / (x - y);
+}
+
+// A pseudo-angle difference into [0, 4).
+inline float region_turn(float d) {
+  d -= 4.0f * floor(0.25f * d);
+  return d < 4.0f ? d : 0.0f;
+}
+
+// The unit direction of pseudo-angle p (0 <= p < 4), for the table's bounding boxes.
+inline void region_pseudo_direction(float p, float* x, float* y) {
+  float u, v;
+  if (p < 1.0f)
+    u = 1.0f - p, v = p;
+  else if (p < 2.0f)
+    u = 1.0f - p, v = 2.0f - p;
+  else if (p < 3.0f)
+    u = p - 3.0f, v = 2.0f - p;
+  else
+    u = p - 3.0f, v = p - 4.0f;
+  const float n = sqrt(u * u + v * v);
+  *x = u / n, *y = v / n;
+}
+
+// The wedge of the direction (x, y) in a record, -1 outside its cone.
+inline int region_end_wedge(float first, float span, float x, float y) {
+  const float u = region_turn(region_pseudo_angle(x, y) - first) * ((float)REGION_END_WEDGES / span);
+  const int w = (int)u;
+  if (span >= 4.0f) return w < REGION_END_WEDGES ? w : REGION_END_WEDGES - 1;
+  return w < REGION_END_WEDGES ? w : -1;
+}
+
+// Fills the record (rec: REGION_END_RECORD floats) of E = (ex, ey, ez) over the pyramid (`levels` >
+// 0) for the other ends in the rectangle (ox0, oy0) .. (ox1, oy1), their heights within +-z_bound.
+// Conservative throughout: a band is looked at in blocks of the pyramid (a quarter of its inner
+// radius a side, cells up to radius 8), and a block counts for every wedge and band its box, grown
+// by 0.01 pixel, meets in the box's ranges of distance and pseudo-angle from E (which hold the
+// box's own), the cone and the wedges grown by 1e-4 (the look-up's and the box corners'
+// roundings); a box holding E counts for every wedge. The clearance is region_end_clearance's for
+// the longest line toward the rectangle and both ends' heights at their bound.
+inline void region_end_table(HFVIS_GLOBAL const float* pyramid, int levels, int width, int height,
+                             float margin, float curvature, float cell_x, float cell_y, float ex, float ey,
+                             float ez, float z_bound, float ox0, float oy0, float ox1, float oy1,
+                             float* rec) {
+  const float grow = 0.01f, turn_grow = 1e-4f;
+  float first = 0.0f, span = 4.0f, far2 = 0.0f;
+  for (int c = 0; c < 4; ++c) {
+    const float vx = (c & 1 ? ox1 : ox0) - ex, vy = (c & 2 ? oy1 : oy0) - ey;
+    far2 = fmax(far2, vx * vx + vy * vy);
+  }
+  if (ex < ox0 - 0.5f || ex > ox1 + 0.5f || ey < oy0 - 0.5f || ey > oy1 + 0.5f) {
+    // E outside the rectangle: the corners' pseudo-angles about the centre's hold the cone.
+    const float mid = region_pseudo_angle(0.5f * (ox0 + ox1) - ex, 0.5f * (oy0 + oy1) - ey);
+    float lo = 0.0f, hi = 0.0f;
+    for (int c = 0; c < 4; ++c) {
+      float d = region_pseudo_angle((c & 1 ? ox1 : ox0) - ex, (c & 2 ? oy1 : oy0) - ey) - mid;
+      d = d > 2.0f ? d - 4.0f : (d <= -2.0f ? d + 4.0f : d);
+      lo = fmin(lo, d), hi = fmax(hi, d);
+    }
+    if (hi - lo + 2.0f * turn_grow < 2.0f)
+      first = region_turn(mid + lo - turn_grow), span = hi - lo + 2.0f * turn_grow;
+  }
+  int bands = 1;
+  while (bands < REGION_END_BANDS && region_band_edge(bands) * region_band_edge(bands) < far2) ++bands;
+  rec[0] = first, rec[1] = span, rec[2] = (float)bands, rec[3] = 0.0f;
+  // The bands' values first (the rising maxima's place), the required slopes after.
+  for (int i = 4; i < REGION_END_RECORD; ++i) rec[i] = -INFINITY;
+  // The unit directions of the cone's edges, for the bands' bounding boxes.
+  float ux0, uy0, ux1, uy1;
+  region_pseudo_direction(first, &ux0, &uy0);
+  region_pseudo_direction(region_turn(first + span), &ux1, &uy1);
+  for (int b = 0; b < bands; ++b) {
+    const float r0 = region_band_edge(b), r1 = region_band_edge(b + 1);
+    int k = b >= 4 ? b - 3 : 0;
+    k = k < levels - 1 ? k : levels - 1;
+    // The band's box: the cone's edges at both radii, and the axis directions within it at r1.
+    float x0 = ex - r1, x1 = ex + r1, y0 = ey - r1, y1 = ey + r1;
+    if (span < 4.0f) {
+      x0 = fmin(fmin(ex + r0 * ux0, ex + r1 * ux0), fmin(ex + r0 * ux1, ex + r1 * ux1));
+      x1 = fmax(fmax(ex + r0 * ux0, ex + r1 * ux0), fmax(ex + r0 * ux1, ex + r1 * ux1));
+      y0 = fmin(fmin(ey + r0 * uy0, ey + r1 * uy0), fmin(ey + r0 * uy1, ey + r1 * uy1));
+      y1 = fmax(fmax(ey + r0 * uy0, ey + r1 * uy0), fmax(ey + r0 * uy1, ey + r1 * uy1));
+      for (int q = 0; q < 4; ++q)
+        if (region_turn((float)q - first) <= span) {
+          if (q == 0) x1 = fmax(x1, ex + r1);
+          if (q == 1) y1 = fmax(y1, ey + r1);
+          if (q == 2) x0 = fmin(x0, ex - r1);
+          if (q == 3) y0 = fmin(y0, ey - r1);
+        }
+    }
+    const float pad = grow + 1e-4f * r1;
+    x0 -= pad, y0 -= pad, x1 += pad, y1 += pad;
+    const int kw = region_cull_width(width, k), kh = region_cull_width(height, k);
+    const int offset = region_cull_offset(width, height, k);
+    const float size = (float)(1 << k);
+    int bx0 = (int)floor(x0 / size), bx1 = (int)floor(x1 / size);
+    int by0 = (int)floor(y0 / size), by1 = (int)floor(y1 / size);
+    bx0 = bx0 < 0 ? 0 : bx0, by0 = by0 < 0 ? 0 : by0;
+    bx1 = bx1 < kw - 1 ? bx1 : kw - 1, by1 = by1 < kh - 1 ? by1 : kh - 1;
+    for (int by = by0; by <= by1; ++by)
+      for (int bx = bx0; bx <= bx1; ++bx) {
+        const float X0 = (float)bx * size - grow - ex, Y0 = (float)by * size - grow - ey;
+        const float X1 = fmin((float)(bx + 1) * size, (float)(width - 1)) + grow - ex;
+        const float Y1 = fmin((float)(by + 1) * size, (float)(height - 1)) + grow - ey;
+        const float nx = fmax(0.0f, fmax(X0, -X1)), ny = fmax(0.0f, fmax(Y0, -Y1));
+        const float fx = fmax(-X0, X1), fy = fmax(-Y0, Y1);
+        if (nx * nx + ny * ny > r1 * r1 || fx * fx + fy * fy < r0 * r0) continue;
+        const float top = pyramid[offset + by * kw + bx];
+        float lo = 0.0f, hi = 4.0f;  // the box's pseudo-angles from the cone's first
+        if (nx > 0.0f || ny > 0.0f) {
+          // (about the first corner's: the box seen from outside spans less than half a turn)
+          const float mid = region_pseudo_angle(X0, Y0);
+          float dlo = 0.0f, dhi = 0.0f;
+          for (int c = 1; c < 4; ++c) {
+            float d = region_pseudo_angle(c & 1 ? X1 : X0, c & 2 ? Y1 : Y0) - mid;
+            d = d > 2.0f ? d - 4.0f : (d <= -2.0f ? d + 4.0f : d);
+            dlo = fmin(dlo, d), dhi = fmax(dhi, d);
+          }
+          lo = region_turn(mid + dlo - first - turn_grow);
+          hi = lo + (dhi - dlo) + 2.0f * turn_grow;
+        }
+        // The wedges of [lo, hi] and of its part past a full turn, within the cone.
+        for (int part = 0; part < 2; ++part) {
+          const float a = part ? lo - 4.0f : lo, z = part ? hi - 4.0f : hi;
+          if (z < 0.0f || a > span) continue;
+          const int w0 = (int)(fmax(a, 0.0f) * ((float)REGION_END_WEDGES / span));
+          int w1 = (int)(fmin(z, span) * ((float)REGION_END_WEDGES / span));
+          w1 = w1 < REGION_END_WEDGES - 1 ? w1 : REGION_END_WEDGES - 1;
+          for (int w = w0; w <= w1; ++w) {
+            float* v = rec + 4 + 2 * w * REGION_END_BANDS + b;
+            *v = fmax(*v, top);
+          }
+        }
+      }
+  }
+  const float cell = fmax(cell_x, cell_y), cdd = curvature * far2 * cell * cell;
+  const float clearance =
+      margin + 1e-5f * (4.0f * (fabs(ez) + z_bound) + fabs(cdd)) + (cdd > 0.0f ? 0.25f * cdd : 0.0f);
+  for (int w = 0; w < REGION_END_WEDGES; ++w) {
+    float* up = rec + 4 + 2 * w * REGION_END_BANDS;
+    float* down = up + REGION_END_BANDS;
+    float up_max = -INFINITY, down_max = -INFINITY;
+    for (int b = 0; b < bands; ++b) {
+      // (a band's value is finite or infinite, never NaN: so is `need` but over a NaN height; the
+      // radii are powers of 2, their reciprocals exact)
+      const float need = isnan(ez) ? INFINITY : up[b] + clearance - ez;
+      up_max =
+          fmax(up_max, b == 0 ? (need < 0.0f ? -INFINITY : INFINITY) : need * (1.0f / region_band_edge(b)));
+      down_max = fmax(down_max, need * (1.0f / region_band_edge(b + 1)));
+      up[b] = up_max, down[b] = down_max;
+    }
+  }
+}
+
+// How far from the end E (height ze) the sight line of `length` pixels to the other end (height
+// zp) is certified clear by E's record `wedge` (its rising maxima, then its falling ones): the
+// bands from E whose running maximum of required slopes lies below the line's slope (a count; the
+// maxima only grow outward). Then every cell along that stretch would be leapt by the march (each
+// point of the stretch lies in a band whose value holds the cell's highest corner, below the
+// segment there by the march's clearance), so the march, which finds the same hits with or without
+// leaps, finds none there. 0 when the first band fails (an end on the surface always: its own
+// corner). The slope's rounding and the required slopes' lie within the clearance's second half.
+inline float region_end_reach(HFVIS_GLOBAL const float* wedge, int bands, float length, float ze, float zp) {
+  const float slope = (zp - ze) / length;
+  HFVIS_GLOBAL const float* maxima = slope >= 0.0f ? wedge : wedge + REGION_END_BANDS;
+  int count = 0;
+  for (int b = 0; b < bands; ++b) count += maxima[b] < slope;
+  return count == 0 ? 0.0f : fmin(region_band_edge(count), length);
 }
 
 // Whether the surface over cell `cell` (the index of its first corner) rises above the segment

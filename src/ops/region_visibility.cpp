@@ -50,83 +50,6 @@ void validateField(const HeightField& field) {
 
 int popcount(std::uint32_t v) { return __builtin_popcount(v); }
 
-// The culling pyramid of kernels/shared/region_visibility_sight.cl (region_cull_*) over the
-// z-scaled heights, and the part of the march's rounding that a block's height must clear which
-// depends on the field alone (region_sight_visible_culled adds the segment's own).
-struct CullPyramid {
-  std::vector<float> top;
-  int levels = 0;
-  float margin = 0.0f;
-  float gradient = 0.0f;  // the surface's steepest slope per pixel, at most (region_cull_hides)
-  bool finite = true;     // every height finite (region_cull_hides need not look)
-};
-
-CullPyramid cullPyramid(const std::vector<float>& h, int width, int height) {
-  CullPyramid out;
-  if (width < 2 || height < 2) return out;  // no cells: the march runs uncut
-  const auto at = [&](int c, int r) { return h[std::size_t(r) * width + c]; };
-  // The field's largest finite height, step between neighbours and cell twist: the march's
-  // values over a block stray from its corners' range by rounding relative to the heights, and
-  // by a step or a twist times a position's rounding (a crossing a rounding outside the block, a
-  // piece's middle a rounding into the next cell): at most ulp(max(width, height)) each.
-  double largest = 0.0, step = 0.0, twist = 0.0;
-  bool any_infinite = false;
-  for (int r = 0; r < height; ++r)
-    for (int c = 0; c < width; ++c) {
-      const float v = at(c, r);
-      any_infinite = any_infinite || std::isinf(v);
-      out.finite = out.finite && std::isfinite(v);
-      if (!std::isfinite(v)) continue;
-      largest = std::max(largest, double(std::fabs(v)));
-      if (c + 1 < width && std::isfinite(at(c + 1, r)))
-        step = std::max(step, double(std::fabs(at(c + 1, r) - v)));
-      if (r + 1 < height && std::isfinite(at(c, r + 1)))
-        step = std::max(step, double(std::fabs(at(c, r + 1) - v)));
-      if (c + 1 < width && r + 1 < height) {
-        const double t = double(v) - at(c + 1, r) - at(c, r + 1) + at(c + 1, r + 1);
-        if (std::isfinite(t)) twist = std::max(twist, std::fabs(t));
-      }
-    }
-  const double position_ulp = std::ldexp(double(std::max(width, height)), -23);
-  out.margin = static_cast<float>(8e-5 * largest + 4.0 * position_ulp * (step + twist));
-  out.gradient = static_cast<float>(step + twist);
-  // The levels' sizes (as region_cull_width), then the levels in place, one after another.
-  std::vector<std::size_t> offsets = {0};
-  for (int w = width - 1, hh = height - 1;;) {
-    offsets.push_back(offsets.back() + std::size_t(w) * hh);
-    if ((w == 1 && hh == 1) || int(offsets.size()) - 1 == kCullLevels) break;
-    w = (w + 1) / 2, hh = (hh + 1) / 2;
-  }
-  out.levels = int(offsets.size()) - 1;
-  out.top.assign(offsets.back(), -std::numeric_limits<float>::infinity());
-  // Level 0: per cell its corners' highest valid height; +INFINITY where an infinite height lies
-  // on the cell or a cell beside it (the march's values there are unbounded or NaN).
-  int w = width - 1, hh = height - 1;
-  for (int r = 0; r < hh; ++r)
-    for (int c = 0; c < w; ++c) {
-      bool unbounded = false;
-      for (int y = std::max(0, r - 1); any_infinite && y <= std::min(height - 1, r + 2) && !unbounded; ++y)
-        for (int x = std::max(0, c - 1); x <= std::min(width - 1, c + 2); ++x)
-          if (std::isinf(at(x, y))) unbounded = true;
-      float top = -std::numeric_limits<float>::infinity();
-      for (const float v : {at(c, r), at(c + 1, r), at(c, r + 1), at(c + 1, r + 1)})
-        if (!std::isnan(v)) top = std::max(top, v);
-      out.top[std::size_t(r) * w + c] = unbounded ? std::numeric_limits<float>::infinity() : top;
-    }
-  for (int k = 1; k < out.levels; ++k) {
-    const float* child = out.top.data() + offsets[k - 1];
-    float* parent = out.top.data() + offsets[k];
-    const int pw = (w + 1) / 2;
-    for (int r = 0; r < hh; ++r)
-      for (int c = 0; c < w; ++c) {
-        float& p = parent[std::size_t(r / 2) * pw + c / 2];
-        p = std::max(p, child[std::size_t(r) * w + c]);
-      }
-    w = pw, hh = (hh + 1) / 2;
-  }
-  return out;
-}
-
 // The bits of `count` receivers from the device, receiver-major: one routine item per launch
 // of up to kWordsPerLaunch / words receivers (a work-item marches all its receiver's words:
 // a launch's work stays bounded whatever S).
@@ -180,13 +103,59 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
                              static_cast<float>(field_.cell_size_y),
                              static_cast<float>(options_.curvature),
                              options_.max_distance > 0.0 ? static_cast<float>(max_d2) : 0.0f};
+    bool probed_clear = false;
     if (options_.method == RegionVisibilityMethod::Culled) {
-      const CullPyramid pyramid = cullPyramid(prepared_.heights, field_.width, field_.height);
+      const detail::CullPyramid pyramid = detail::cullPyramid(prepared_.heights, field_.width, field_.height);
       levels_ = pyramid.levels;
       margin_ = pyramid.margin;
       gradient_ = pyramid.gradient;
       finite_ = pyramid.finite;
       if (levels_ > 0) pyramid_ = upload(pyramid.top);
+      if (levels_ > 0 && receivers_) probed_clear = probeClear(pyramid, device);
+    }
+    // The per-end tables that certify clear sight lines (region_end_table), a pair's only: its
+    // shared sources' and its receivers', where the probe found enough clear lines (elsewhere they
+    // cost more than they save). An area light over every pixel takes none: its receivers lie on
+    // the surface (their first band holds their own height, so nothing is certified from that end)
+    // and its sources' tables alone did not measurably speed it (bench/report/region_visibility.md).
+    certify_receivers_ = levels_ > 0 && receivers_ != nullptr && probed_clear;
+    certify_sources_ = certify_receivers_ && !options_.decorrelate;
+    if (certify_sources_ || certify_receivers_) {
+      // The tables' bound of the sight lines' end heights: the highest surface plus the largest
+      // height over it (an absolute height is bounded by it too).
+      float surface = 0.0f, above = float(options_.target_height);
+      for (const float v : prepared_.heights)
+        if (std::isfinite(v)) surface = std::max(surface, std::fabs(v));
+      for (const std::vector<float>* table : {&sources_, receivers_})
+        for (std::size_t i = 8; table && i < table->size(); i += 5)
+          above = std::max(above, std::fabs((*table)[i]));
+      const auto box = [](const std::vector<float>& table) {
+        return cl_float4{{table[0], table[1], table[2], table[3]}};
+      };
+      // (a pair's receivers drawn on the device, as region_visibility_bits draws them)
+      const auto records = [&](bool placed, int count, bool absolute, const cl_float4& other) {
+        cl::Buffer out = detail::deviceBuffer(st_, std::size_t(count) * REGION_END_RECORD * sizeof(float));
+        detail::NamedKernel tables = kernel("region_end_tables");
+        tables.set("h", heights_)
+            .set("pyramid", pyramid_)
+            .set("levels", cl_int(levels_))
+            .set("margin", margin_)
+            .set("z_bound", surface + above)
+            .set("f", device)
+            .set("placed", cl_int(placed))
+            .set("points", source_points_buffer_)
+            .set("table", receiver_table_)
+            .set("absolute", cl_int(absolute))
+            .set("seed", cl_uint(options_.seed))
+            .set("count", cl_int(count))
+            .set("other", other)
+            .set("records", out);
+        st_.launch(tables, cl::NDRange(detail::roundUp(count, detail::kLineGroup)),
+                   cl::NDRange(detail::kLineGroup));
+        return out;
+      };
+      if (certify_sources_) source_records_ = records(true, samples_, source_absolute_, box(*receivers_));
+      if (certify_receivers_) receiver_records_ = records(false, count_, receiver_absolute_, box(sources_));
     }
     kernel_ = kernel("region_visibility_bits");
     kernel_.set("h", heights_)
@@ -195,6 +164,10 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
         .set("margin", margin_)
         .set("gradient", gradient_)
         .set("finite_field", cl_int(finite_))
+        .set("certify_receivers", cl_int(certify_receivers_))
+        .set("certify_sources", cl_int(certify_sources_))
+        .set("receiver_records", certify_receivers_ ? receiver_records_ : heights_)
+        .set("source_records", certify_sources_ ? source_records_ : heights_)
         .set("f", device)
         .set("sources", source_table_)
         .set("source_points", source_points_buffer_)
@@ -210,6 +183,31 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
         .set("words", cl_int(words_))
         .set("receiver_major", cl_int(receiver_major_))
         .set("bits", bits_);
+  }
+
+  // Whether at least kProbeClear of kProbeLines sight lines spread over a pair's sources (stream
+  // 0's, standing in for decorrelated ones too) and receivers, marched here, are clear: a pair where fewer
+  // than about 1 line in 16 is clear skips the certifying tables (measured: they cost more than they save
+  // there).
+  bool probeClear(const detail::CullPyramid& pyramid, const DeviceField& device) const {
+    constexpr int kProbeLines = 64, kProbeClear = 4;
+    const std::vector<float>& h = prepared_.heights;
+    int clear = 0;
+    for (int i = 0; i < kProbeLines; ++i) {
+      const int s = int(std::int64_t(i) * samples_ / kProbeLines), r = int(std::int64_t(i) * 37 % count_);
+      float xr, yr, zr;
+      detail::region_sample(receivers_->data(), h.data(), field_.width, field_.height, receiver_absolute_,
+                            options_.seed, 0u, r, &xr, &yr, &zr);
+      int blocked_at;
+      if (!std::isnan(zr) &&
+          detail::region_sight_visible_culled(h.data(), field_.width, field_.height, device.cell_x,
+                                              device.cell_y, device.curvature, device.max_d2,
+                                              pyramid.top.data(), pyramid.levels, pyramid.margin, 1.0f, 0.0f,
+                                              0.0f, 0.0f, source_points_[3 * s], source_points_[3 * s + 1],
+                                              source_points_[3 * s + 2], xr, yr, zr, 0.0f, 0.0f, &blocked_at))
+        ++clear;
+    }
+    return clear >= kProbeClear;
   }
 
   int receiversPerLaunch() const { return std::max(1, kWordsPerLaunch / words_); }
@@ -248,7 +246,9 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
   int levels_ = 0;  // the culling pyramid's (0: the exact march)
   cl_float margin_ = 0.0f, gradient_ = 0.0f;
   bool finite_ = false;
-  cl::Buffer source_table_, source_points_buffer_, receiver_table_, bits_, pyramid_;
+  bool certify_sources_ = false, certify_receivers_ = false;  // per-end tables (culled only)
+  cl::Buffer source_table_, source_points_buffer_, receiver_table_, bits_, pyramid_, source_records_,
+      receiver_records_;
   detail::NamedKernel kernel_;
 };
 
@@ -381,6 +381,72 @@ void colourLight(RegionVisibilityResult& out, const HeightField& field, const st
 }  // namespace
 
 namespace detail {
+
+CullPyramid cullPyramid(const std::vector<float>& h, int width, int height) {
+  CullPyramid out;
+  if (width < 2 || height < 2) return out;  // no cells: the march runs uncut
+  const auto at = [&](int c, int r) { return h[std::size_t(r) * width + c]; };
+  // The field's largest finite height, step between neighbours and cell twist: the march's
+  // values over a block stray from its corners' range by rounding relative to the heights, and
+  // by a step or a twist times a position's rounding (a crossing a rounding outside the block, a
+  // piece's middle a rounding into the next cell): at most ulp(max(width, height)) each.
+  double largest = 0.0, step = 0.0, twist = 0.0;
+  bool any_infinite = false;
+  for (int r = 0; r < height; ++r)
+    for (int c = 0; c < width; ++c) {
+      const float v = at(c, r);
+      any_infinite = any_infinite || std::isinf(v);
+      out.finite = out.finite && std::isfinite(v);
+      if (!std::isfinite(v)) continue;
+      largest = std::max(largest, double(std::fabs(v)));
+      if (c + 1 < width && std::isfinite(at(c + 1, r)))
+        step = std::max(step, double(std::fabs(at(c + 1, r) - v)));
+      if (r + 1 < height && std::isfinite(at(c, r + 1)))
+        step = std::max(step, double(std::fabs(at(c, r + 1) - v)));
+      if (c + 1 < width && r + 1 < height) {
+        const double t = double(v) - at(c + 1, r) - at(c, r + 1) + at(c + 1, r + 1);
+        if (std::isfinite(t)) twist = std::max(twist, std::fabs(t));
+      }
+    }
+  const double position_ulp = std::ldexp(double(std::max(width, height)), -23);
+  out.margin = static_cast<float>(8e-5 * largest + 4.0 * position_ulp * (step + twist));
+  out.gradient = static_cast<float>(step + twist);
+  // The levels' sizes (as region_cull_width), then the levels in place, one after another.
+  std::vector<std::size_t> offsets = {0};
+  for (int w = width - 1, hh = height - 1;;) {
+    offsets.push_back(offsets.back() + std::size_t(w) * hh);
+    if ((w == 1 && hh == 1) || int(offsets.size()) - 1 == kCullLevels) break;
+    w = (w + 1) / 2, hh = (hh + 1) / 2;
+  }
+  out.levels = int(offsets.size()) - 1;
+  out.top.assign(offsets.back(), -std::numeric_limits<float>::infinity());
+  // Level 0: per cell its corners' highest valid height; +INFINITY where an infinite height lies
+  // on the cell or a cell beside it (the march's values there are unbounded or NaN).
+  int w = width - 1, hh = height - 1;
+  for (int r = 0; r < hh; ++r)
+    for (int c = 0; c < w; ++c) {
+      bool unbounded = false;
+      for (int y = std::max(0, r - 1); any_infinite && y <= std::min(height - 1, r + 2) && !unbounded; ++y)
+        for (int x = std::max(0, c - 1); x <= std::min(width - 1, c + 2); ++x)
+          if (std::isinf(at(x, y))) unbounded = true;
+      float top = -std::numeric_limits<float>::infinity();
+      for (const float v : {at(c, r), at(c + 1, r), at(c, r + 1), at(c + 1, r + 1)})
+        if (!std::isnan(v)) top = std::max(top, v);
+      out.top[std::size_t(r) * w + c] = unbounded ? std::numeric_limits<float>::infinity() : top;
+    }
+  for (int k = 1; k < out.levels; ++k) {
+    const float* child = out.top.data() + offsets[k - 1];
+    float* parent = out.top.data() + offsets[k];
+    const int pw = (w + 1) / 2;
+    for (int r = 0; r < hh; ++r)
+      for (int c = 0; c < w; ++c) {
+        float& p = parent[std::size_t(r / 2) * pw + c / 2];
+        p = std::max(p, child[std::size_t(r) * w + c]);
+      }
+    w = pw, hh = (hh + 1) / 2;
+  }
+  return out;
+}
 
 void countPairFractions(RegionPairVisibilityResult& out) {
   out.pairs = static_cast<std::uint64_t>(out.source_samples) * out.receiver_samples;

@@ -7,9 +7,9 @@
 #include <cmath>
 #include <vector>
 
+#include "core/opencl_builtins.hpp"
 #include "hfvis/height_field.hpp"
 #include "hfvis/region_visibility.hpp"
-#include "core/opencl_builtins.hpp"
 
 namespace hfvis::detail {
 
@@ -18,6 +18,19 @@ namespace hfvis::detail {
 // A region's table for region_sample(): the rectangle (lo_x, lo_y, hi_x, hi_y), then per sample
 // its stratum's corner, size and height (explicit points: the point, size 0). Validates.
 std::vector<float> regionSampleTable(const HeightField& field, const RegionSampling& sampling);
+
+// The culling pyramid of kernels/shared/region_visibility_sight.cl (region_cull_*) over the
+// z-scaled heights, and the part of the march's rounding that a block's height must clear which
+// depends on the field alone (region_sight_visible_culled adds the segment's own).
+struct CullPyramid {
+  std::vector<float> top;
+  int levels = 0;
+  float margin = 0.0f;
+  float gradient = 0.0f;  // the surface's steepest slope per pixel, at most (region_cull_hides)
+  bool finite = true;     // every height finite (region_cull_hides need not look)
+};
+
+CullPyramid cullPyramid(const std::vector<float>& h, int width, int height);
 
 // Fills a pair result's clear_pairs, pairs and per-sample fractions from its bits (the samples'
 // counts and words set).
