@@ -218,3 +218,296 @@ __kernel void region_visibility_bits(__global const float* h, __global const flo
     bits[receiver_major ? (size_t)r * words + w : (size_t)w * receiver_count + r] = word;
   }
 }
+
+// ---------------------------------------------------------------------------------------------
+// The bitmask method (RegionVisibilityMethod::Bitmask): the scatter of Eisemann & Décoret
+// (2007, "Visibility sampling on GPU and applications") for a planar light at height `light_z`
+// over every-pixel receivers. Per receiver, each cell that may reach the shaft to the light is
+// back-projected from the receiver onto the light's plane and the samples inside come from a
+// table of edge bitmasks (`table`: per edge angle and offset, the samples on the edge's inner
+// side), ANDed per edge and ORed over the cells. The bilinear cell's back-projection has curved
+// edges, so each cell gives a conservative pair: an outer polygon (the box under the cell's
+// highest corner, raised by the march's rounding) that holds every sample the cell may hide, and
+// an inner one (the box under its lowest corner, lowered by the march's rounding and the most
+// its values can stray) whose samples it surely hides; each table edge rounded outward or
+// inward by its resolution. The receiver's own four cells, whose back-projections reach to the
+// horizon, are decided per sample from their bilinear surface along the line. Samples in some
+// outer polygon but in no inner one are uncertain: the culled march (its bits the exact
+// method's) decides them, so the bits are the exact method's, bit for bit.
+
+// The table's shape: `angles` edge normals n_i = (cos, sin)(2 pi i / angles), `offsets` + 1
+// offsets c_j = -rho + 2 rho j / offsets, a mask of `words` words per (i, j): the samples p with
+// n_i . (p - centre) >= c_j.
+typedef struct {
+  float centre_x, centre_y, rho;
+  int angles, offsets;
+} BitmaskTable;
+
+// ORs into acc the samples inside the convex hull of the n points (px, py) on the light's plane,
+// as the table gives them: `outward`, a superset (each edge moved out by the table's resolution
+// and `error`, the points' rounding, per unit of their magnitude); else a subset (moved in). An
+// outer polygon may drop an edge (a larger polygon), an inner one may not (then it is empty).
+void region_bitmask_polygon(float* px, float* py, int n, __global const unsigned int* table, BitmaskTable t,
+                            int words, int outward, float error, unsigned int* acc) {
+  // Andrew's monotone chain: sorted by x then y, the lower and upper hulls, counter-clockwise.
+  for (int i = 1; i < n; ++i)
+    for (int j = i; j > 0 && (px[j] < px[j - 1] || (px[j] == px[j - 1] && py[j] < py[j - 1])); --j) {
+      const float sx = px[j], sy = py[j];
+      px[j] = px[j - 1], py[j] = py[j - 1], px[j - 1] = sx, py[j - 1] = sy;
+    }
+  float hx[17], hy[17];
+  int m = 0;
+  for (int pass = 0; pass < 2; ++pass) {
+    const int floor_m = m;
+    for (int k = 0; k < n; ++k) {
+      const int i = pass ? n - 1 - k : k;
+      while (m >= floor_m + 2 &&
+             (hx[m - 1] - hx[m - 2]) * (py[i] - hy[m - 2]) - (hy[m - 1] - hy[m - 2]) * (px[i] - hx[m - 2]) <=
+                 0.0f)
+        --m;
+      hx[m] = px[i], hy[m] = py[i], ++m;
+    }
+    --m;  // each chain's last point starts the other
+  }
+  if (m < 3) {
+    if (!outward) return;  // a degenerate inner polygon: nothing surely hidden
+  }
+  // The magnitude the points' rounding scales with.
+  float magnitude = t.rho + fabs(t.centre_x) + fabs(t.centre_y);
+  for (int k = 0; k < m; ++k) magnitude = fmax(magnitude, fabs(hx[k]) + fabs(hy[k]));
+  const float step = 2.0f * t.rho / (float)t.offsets, half_angle = M_PI_F / (float)t.angles;
+  int column[16], edges = 0;
+  for (int k = 0; k < m; ++k) {
+    const float ax = hx[k], ay = hy[k], bx = hx[k + 1 < m ? k + 1 : 0], by = hy[k + 1 < m ? k + 1 : 0];
+    const float ex = bx - ax, ey = by - ay, len = sqrt(ex * ex + ey * ey);
+    // The inner normal of a counter-clockwise edge, and the edge's offset from the table's centre.
+    const float nx = -ey / len, ny = ex / len;
+    const float c = nx * (ax - t.centre_x) + ny * (ay - t.centre_y);
+    // The edge's rounding where it passes the samples (its direction from the points' rounding
+    // over its length), and the table's: the nearest angle's normal differs by at most half an
+    // angle step, times the samples' distance from the centre.
+    const float reach =
+        sqrt((ax - t.centre_x) * (ax - t.centre_x) + (ay - t.centre_y) * (ay - t.centre_y)) + t.rho;
+    const float slack = error * magnitude * (2.0f + reach / len) + t.rho * (half_angle + 1e-5f);
+    if (!(len > 1e-6f * magnitude) || !isfinite(slack)) {
+      if (!outward) return;
+      continue;
+    }
+    int i = (int)floor(atan2(ny, nx) / (2.0f * half_angle) + 0.5f);
+    i = ((i % t.angles) + t.angles) % t.angles;
+    const float at = (outward ? c - slack : c + slack) + t.rho;  // from c_0
+    if (outward) {
+      if (at < 0.0f) continue;        // every sample on the inner side
+      if (at > 2.0f * t.rho) return;  // none
+      column[edges++] = i * (t.offsets + 1) + min((int)floor(at / step), t.offsets);
+    } else {
+      if (at <= 0.0f) continue;
+      const int j = (int)ceil(at / step);
+      if (j > t.offsets) return;
+      column[edges++] = i * (t.offsets + 1) + j;
+    }
+  }
+  for (int w = 0; w < words; ++w) {
+    unsigned int mask = 0xffffffffU;
+    for (int e = 0; e < edges; ++e) mask &= table[(size_t)column[e] * words + w];
+    acc[w] |= mask;
+  }
+}
+
+// ORs into acc the table's samples inside the back-projection from the receiver (xr, yr, zr)
+// onto the plane z = light_z of the box [x0, x0 + 1] x [y0, y0 + 1] x [z0, z1] (zr < z0 < z1).
+void region_bitmask_box(float x0, float y0, float z0, float z1, float xr, float yr, float zr, float light_z,
+                        __global const unsigned int* table, BitmaskTable t, int words, int outward,
+                        unsigned int* acc) {
+  float px[8], py[8];
+  const float k0 = (light_z - zr) / (z0 - zr), k1 = (light_z - zr) / (z1 - zr);
+  if (!(z0 > zr) || !isfinite(k0) || !isfinite(k1)) {  // (z0 rounded onto zr): no polygon to trust
+    for (int w = 0; outward && w < words; ++w) acc[w] = 0xffffffffU;
+    return;
+  }
+  for (int c = 0; c < 8; ++c) {
+    const float k = c & 4 ? k1 : k0;
+    px[c] = xr + (x0 + (float)(c & 1) - xr) * k;
+    py[c] = yr + (y0 + (float)((c >> 1) & 1) - yr) * k;
+  }
+  // The projection's rounding, relative: the divisions' and the heights' over z0 - zr.
+  const float error = 2e-6f * (4.0f + (fabs(light_z) + fabs(z1) + 2.0f * fabs(zr)) / (z0 - zr));
+  region_bitmask_polygon(px, py, 8, table, t, words, outward, error, acc);
+}
+
+// The bilinear cell between the receiver's grid point (xr, yr) (its corner h00) and the corners
+// one step toward the sample along each axis, along the line to a sample (gx, gy) pixels away
+// whose rise over the receiver's height is dz: the surface's rise over the line, f(l) = c0 +
+// l A + l^2 B for the line's fraction l in [0, le] over the cell. *most: the most the march may
+// find there (with the start's c0 <= 0 when the top lies at or a rounding before the start,
+// which the march may take for inside); *surely: the most it takes inside the piece or at its
+// end.
+void region_bitmask_near(float h00, float h10, float h01, float h11, float zr, float ax, float ay, float dz,
+                         float* most, float* surely) {
+  const float a = h10 - h00, b = h01 - h00, tw = h00 - h10 - h01 + h11;
+  const float le = fmin(1.0f, fmin(ax > 0.0f ? 1.0f / ax : INFINITY, ay > 0.0f ? 1.0f / ay : INFINITY));
+  const float c0 = h00 - zr, A = a * ax + b * ay - dz, B = tw * ax * ay;
+  const float fe = c0 + le * (A + le * B);
+  *most = fe, *surely = fe;
+  if (B < 0.0f) {
+    const float top = -A / (2.0f * B);
+    if (top > 0.0f && top < le) {
+      const float ft = c0 + top * (A + top * B);
+      *most = fmax(*most, ft), *surely = fmax(*surely, ft);
+    }
+    if (top > -1e-4f * le * (1.0f + fabs(fe - c0) / (-B * le * le))) *most = fmax(*most, c0);
+  }
+}
+
+__kernel void region_bitmask_bits(__global const float* h, __global const float* pyramid, int levels,
+                                  float margin, float gradient, int finite_field, RegionField f,
+                                  __global const float* source_points, int samples, float light_z,
+                                  float target_height, __global const unsigned int* table, BitmaskTable t,
+                                  float lo_x, float lo_y, float hi_x, float hi_y, int words,
+                                  int receiver_count, int receiver_major, int first,
+                                  __global unsigned int* bits, __global unsigned int* tested) {
+  const int r = first + (int)get_global_id(0);
+  if (r >= receiver_count) return;
+  const int xi = r % f.width, yi = r / f.width;
+  const float xr = (float)xi, yr = (float)yi, zr = h[r] + target_height;
+  unsigned int outer[32], inner[32], near_open[32], near_hidden[32];
+  for (int w = 0; w < words; ++w) outer[w] = inner[w] = near_open[w] = near_hidden[w] = 0U;
+  const float Z = light_z, dz = Z - zr;
+  // The march's rounding (region_sight_visible_culled's clearance, doubled): a cell whose highest
+  // corner lies this far below a line cannot hide it.
+  const float out_margin = 2.0f * margin + 4e-5f * (fabs(zr) + fabs(Z));
+  // A light plane not above the receiver: every sample left to the march.
+  int all_uncertain = !(dz > 0.0f);
+  if (!isnan(zr) && !all_uncertain) {
+    // The receiver's own cells, per sample: the line's rise over their bilinear surface.
+    for (int s = 0; s < samples; ++s) {
+      const float gx = source_points[3 * s] - xr, gy = source_points[3 * s + 1] - yr;
+      if (gx == 0.0f && gy == 0.0f) continue;  // a vertical line sees
+      const float ax = fabs(gx), ay = fabs(gy);
+      const float pixels = fmax(ax, ay);
+      const float in_margin = out_margin + 1.5e-3f * (1.5f * gradient + dz / pixels);
+      int open = 0, hidden = 0;
+      // The cell toward the sample along each axis (both on a line along the axis).
+      for (int sx = gx > 0.0f ? 1 : -1; sx <= (gx < 0.0f ? -1 : 1); sx += 2)
+        for (int sy = gy > 0.0f ? 1 : -1; sy <= (gy < 0.0f ? -1 : 1); sy += 2) {
+          if (xi + sx < 0 || xi + sx >= f.width || yi + sy < 0 || yi + sy >= f.height) continue;
+          const float h10 = h[r + sx], h01 = h[r + sy * f.width], h11 = h[r + sx + sy * f.width];
+          if (!isfinite(h10) || !isfinite(h01) || !isfinite(h11)) {
+            open = 1;
+            continue;
+          }
+          float most, surely;
+          region_bitmask_near(h[r], h10, h01, h11, zr, ax, ay, dz, &most, &surely);
+          open = open || most > -out_margin;
+          hidden = hidden || surely > in_margin;
+        }
+      if (hidden)
+        near_hidden[s / 32] |= 1U << (s % 32);
+      else if (open)
+        near_open[s / 32] |= 1U << (s % 32);
+    }
+    // The farther cells: the pyramid's blocks over the footprint (the box around the receiver
+    // and the light), each left out when its highest point lies below the lowest any line can
+    // be over it (the receiver's height plus the shallowest slope to the light times the
+    // block's distance), by the march's rounding.
+    float dmax = 0.0f, pmin = 0.0f;
+    for (int c = 0; c < 4; ++c) {
+      const float gx = ((c & 1) ? hi_x : lo_x) - xr, gy = ((c & 2) ? hi_y : lo_y) - yr;
+      dmax = fmax(dmax, sqrt(gx * f.cell_x * gx * f.cell_x + gy * f.cell_y * gy * f.cell_y));
+    }
+    pmin = fmax(fmax(lo_x - xr, xr - hi_x), fmax(lo_y - yr, yr - hi_y));
+    const float in_margin = pmin > 0.0f ? out_margin + 1.5e-3f * (1.5f * gradient + dz / pmin) : INFINITY;
+    const float slope = dz / dmax;
+    const float fx0 = fmin(xr, lo_x), fx1 = fmax(xr, hi_x), fy0 = fmin(yr, lo_y), fy1 = fmax(yr, hi_y);
+    int stack_k[64], stack_x[64], stack_y[64], top = 0;
+    const int last = levels - 1;  // (no pyramid: no cells, a field one point thick)
+    for (int by = 0; levels > 0 && by < region_cull_width(f.height, last) && !all_uncertain; ++by)
+      for (int bx = 0; bx < region_cull_width(f.width, last); ++bx) {
+        if (top == 64) {
+          all_uncertain = 1;
+          break;
+        }
+        stack_k[top] = last, stack_x[top] = bx, stack_y[top] = by, ++top;
+      }
+    while (top > 0 && !all_uncertain) {
+      --top;
+      const int k = stack_k[top], bx = stack_x[top], by = stack_y[top];
+      const float x0 = (float)(bx << k), y0 = (float)(by << k);
+      const float x1 = fmin((float)((bx + 1) << k), (float)(f.width - 1)),
+                  y1 = fmin((float)((by + 1) << k), (float)(f.height - 1));
+      if (x1 < fx0 || x0 > fx1 || y1 < fy0 || y0 > fy1) continue;
+      const float ddx = fmax(0.0f, fmax(x0 - xr, xr - x1)) * f.cell_x,
+                  ddy = fmax(0.0f, fmax(y0 - yr, yr - y1)) * f.cell_y;
+      const float near = sqrt(ddx * ddx + ddy * ddy);
+      const float highest =
+          pyramid[region_cull_offset(f.width, f.height, k) + by * region_cull_width(f.width, k) + bx];
+      if (highest + out_margin < zr + slope * near) continue;
+      if (k > 0) {
+        if (top + 4 > 64) {
+          all_uncertain = 1;
+          break;
+        }
+        for (int c = 0; c < 4; ++c) {
+          const int cx = 2 * bx + (c & 1), cy = 2 * by + (c >> 1);
+          if (cx < region_cull_width(f.width, k - 1) && cy < region_cull_width(f.height, k - 1))
+            stack_k[top] = k - 1, stack_x[top] = cx, stack_y[top] = cy, ++top;
+        }
+        continue;
+      }
+      if (bx >= xi - 1 && bx <= xi && by >= yi - 1 && by <= yi) continue;  // the receiver's own
+      if (isinf(highest)) {
+        all_uncertain = 1;  // an infinite height on or beside the cell: no bound
+        break;
+      }
+      // The boxes from the lowest height a line to the light can have over the cell (below it,
+      // a point projects beyond the light's farthest corner), a little lower.
+      const float low = zr + dz * (near / dmax) * 0.999f;
+      if (highest + out_margin > low)
+        region_bitmask_box(x0, y0, low, highest + out_margin, xr, yr, zr, Z, table, t, words, 1, outer);
+      const int p = by * f.width + bx;
+      const float h00 = h[p], h10 = h[p + 1], h01 = h[p + f.width], h11 = h[p + f.width + 1];
+      int finite = isfinite(h00) && isfinite(h10) && isfinite(h01) && isfinite(h11);
+      // As region_cull_hides: the march's values near the cell are numbers only where the 4 x 4
+      // heights around it are.
+      for (int y = (by > 0 ? by - 1 : 0);
+           finite && !finite_field && y <= (by + 2 < f.height ? by + 2 : f.height - 1); ++y)
+        for (int x = (bx > 0 ? bx - 1 : 0); x <= (bx + 2 < f.width ? bx + 2 : f.width - 1); ++x)
+          finite = finite && isfinite(h[y * f.width + x]);
+      const float lowest = fmin(fmin(h00, h10), fmin(h01, h11)) - in_margin;
+      const float z1 = fmin(lowest, Z);
+      if (finite && z1 > low) region_bitmask_box(x0, y0, low, z1, xr, yr, zr, Z, table, t, words, 0, inner);
+    }
+  }
+  unsigned int uncertain_count = 0U, uncertain_visible = 0U;
+  for (int w = 0; w < words; ++w) {
+    const int end = 32 * w + 32 < samples ? 32 * w + 32 : samples;
+    const unsigned int valid = end - 32 * w == 32 ? 0xffffffffU : (1U << (end - 32 * w)) - 1U;
+    unsigned int word = 0U;
+    if (!isnan(zr)) {
+      const unsigned int hidden = inner[w] | near_hidden[w];
+      const unsigned int uncertain = all_uncertain ? valid : (outer[w] | near_open[w]) & ~hidden & valid;
+      word = all_uncertain ? 0U : ~(outer[w] | near_open[w] | hidden) & valid;
+      for (int i = 0; i < end - 32 * w; ++i) {
+        const int s = 32 * w + i;
+        const float xs = source_points[3 * s], ys = source_points[3 * s + 1], zs = source_points[3 * s + 2];
+        if (f.max_d2 > 0.0f) {  // out of reach: the march's own distance, whichever end first
+          const float gx = fabs(xs - xr) * f.cell_x, gy = (ys - yr) * f.cell_y;
+          if (gx * gx + gy * gy > f.max_d2) {
+            word &= ~(1U << i);
+            continue;
+          }
+        }
+        if (!((uncertain >> i) & 1U)) continue;
+        int blocked_at = -1;
+        ++uncertain_count;
+        if (region_sight_visible_culled(h, f.width, f.height, f.cell_x, f.cell_y, f.curvature, f.max_d2,
+                                        pyramid, levels, margin, 1.0f, 0.0f, 0.0f, 0.0f, xs, ys, zs, xr, yr,
+                                        zr, &blocked_at))
+          word |= 1U << i, ++uncertain_visible;
+      }
+    }
+    bits[receiver_major ? (size_t)r * words + w : (size_t)w * receiver_count + r] = word;
+  }
+  tested[2 * (size_t)r] = uncertain_count;
+  tested[2 * (size_t)r + 1] = uncertain_visible;
+}
