@@ -315,24 +315,74 @@ void region_bitmask_polygon(float* px, float* py, int n, __global const unsigned
 }
 
 // ORs into acc the table's samples inside the back-projection from the receiver (xr, yr, zr)
-// onto the plane z = light_z of the box [x0, x0 + 1] x [y0, y0 + 1] x [z0, z1] (zr < z0 < z1).
-void region_bitmask_box(float x0, float y0, float z0, float z1, float xr, float yr, float zr, float light_z,
-                        __global const unsigned int* table, BitmaskTable t, int words, int outward,
-                        unsigned int* acc) {
-  float px[8], py[8];
-  const float k0 = (light_z - zr) / (z0 - zr), k1 = (light_z - zr) / (z1 - zr);
-  if (!(z0 > zr) || !isfinite(k0) || !isfinite(k1)) {  // (z0 rounded onto zr): no polygon to trust
+// onto the plane z = light_z of the prism under the triangle (vx, vy, vz) (3 vertices; a plane)
+// and above z = low (zr < low): the part of the triangle where the plane lies above `low`, and
+// the volume between; a convex polytope, its projection the convex hull of its vertices'.
+void region_bitmask_prism(const float* vx, const float* vy, const float* vz, float low, float xr, float yr,
+                          float zr, float light_z, __global const unsigned int* table, BitmaskTable t,
+                          int words, int outward, unsigned int* acc) {
+  // The triangle clipped to plane >= low (Sutherland-Hodgman, one plane): at most 4 vertices.
+  float cx[4], cy[4], cz[4], top = low;
+  int n = 0;
+  for (int i = 0; i < 3; ++i) {
+    const int j = i < 2 ? i + 1 : 0;
+    const float di = vz[i] - low, dj = vz[j] - low;
+    if (di >= 0.0f) cx[n] = vx[i], cy[n] = vy[i], cz[n] = vz[i], top = fmax(top, vz[i]), ++n;
+    if ((di >= 0.0f) != (dj >= 0.0f)) {
+      const float f = di / (di - dj);
+      cx[n] = vx[i] + f * (vx[j] - vx[i]), cy[n] = vy[i] + f * (vy[j] - vy[i]), cz[n] = low, ++n;
+    }
+  }
+  if (n == 0) return;
+  const float k0 = (light_z - zr) / (low - zr);
+  if (!(low > zr) || !isfinite(k0)) {  // (low rounded onto zr): no polygon to trust
     for (int w = 0; outward && w < words; ++w) acc[w] = 0xffffffffU;
     return;
   }
-  for (int c = 0; c < 8; ++c) {
-    const float k = c & 4 ? k1 : k0;
-    px[c] = xr + (x0 + (float)(c & 1) - xr) * k;
-    py[c] = yr + (y0 + (float)((c >> 1) & 1) - yr) * k;
+  float px[8], py[8];
+  for (int c = 0; c < n; ++c) {
+    const float k = (light_z - zr) / (cz[c] - zr);
+    px[c] = xr + (cx[c] - xr) * k0, py[c] = yr + (cy[c] - yr) * k0;
+    px[n + c] = xr + (cx[c] - xr) * k, py[n + c] = yr + (cy[c] - yr) * k;
   }
-  // The projection's rounding, relative: the divisions' and the heights' over z0 - zr.
-  const float error = 2e-6f * (4.0f + (fabs(light_z) + fabs(z1) + 2.0f * fabs(zr)) / (z0 - zr));
-  region_bitmask_polygon(px, py, 8, table, t, words, outward, error, acc);
+  // The projection's rounding, relative: the divisions' and the heights' over low - zr.
+  const float error = 2e-6f * (4.0f + (fabs(light_z) + fabs(top) + 2.0f * fabs(zr)) / (low - zr));
+  region_bitmask_polygon(px, py, 2 * n, table, t, words, outward, error, acc);
+}
+
+// ORs into acc the back-projections of the prisms under the cell (x0, y0)'s triangulation along
+// its diagonal from corner 00 to 11 (`main`) or from 10 to 01, each corner's height h raised by
+// `raise` (negative: lowered), above `low`. The bilinear surface lies between the two
+// triangulations: below the one along 00-11 where its twist h00 - h10 - h01 + h11 is positive,
+// above it where negative. With `cull_front`, a triangle whose plane the receiver lies above is
+// left out: over a surface without holes whose every point lies below the light, a line that
+// passes under it leaves it upward through a triangle whose plane the receiver lies below (the
+// line's rise over the surface grows there), and passes under that triangle just before
+// (Eisemann & Décoret's front-face culling of a closed occluder).
+void region_bitmask_cell(float x0, float y0, float h00, float h10, float h01, float h11, float raise,
+                         int main, int cull_front, float low, float xr, float yr, float zr, float light_z,
+                         __global const unsigned int* table, BitmaskTable t, int words, int outward,
+                         unsigned int* acc) {
+  const float x1 = x0 + 1.0f, y1 = y0 + 1.0f;
+  const float a = h00 + raise, b = h10 + raise, c = h01 + raise, d = h11 + raise;
+  // The two triangles, counter-clockwise from a corner on the diagonal's end.
+  const float vx[2][3] = {{x0, x1, main ? x1 : x0}, {main ? x0 : x1, x1, x0}};
+  const float vy[2][3] = {{y0, y0, main ? y1 : y1}, {main ? y0 : y0, y1, y1}};
+  const float vz[2][3] = {{a, b, main ? d : c}, {main ? a : b, d, c}};
+  for (int k = 0; k < 2; ++k) {
+    if (cull_front) {
+      // The triangle's plane at the receiver.
+      const float ex1 = vx[k][1] - vx[k][0], ey1 = vy[k][1] - vy[k][0], ez1 = vz[k][1] - vz[k][0];
+      const float ex2 = vx[k][2] - vx[k][0], ey2 = vy[k][2] - vy[k][0], ez2 = vz[k][2] - vz[k][0];
+      const float det = ex1 * ey2 - ey1 * ex2;
+      const float gx = (ez1 * ey2 - ey1 * ez2) / det, gy = (ex1 * ez2 - ez1 * ex2) / det;
+      const float rx = xr - vx[k][0], ry = yr - vy[k][0];
+      const float plane = vz[k][0] + gx * rx + gy * ry;
+      if (zr > plane + 1e-5f * (fabs(zr) + fabs(vz[k][0]) + (fabs(gx) + fabs(gy)) * (fabs(rx) + fabs(ry))))
+        continue;
+    }
+    region_bitmask_prism(vx[k], vy[k], vz[k], low, xr, yr, zr, light_z, table, t, words, outward, acc);
+  }
 }
 
 // The bilinear cell between the receiver's grid point (xr, yr) (its corner h00) and the corners
@@ -360,10 +410,10 @@ void region_bitmask_near(float h00, float h10, float h01, float h11, float zr, f
 }
 
 __kernel void region_bitmask_bits(__global const float* h, __global const float* pyramid, int levels,
-                                  float margin, float gradient, int finite_field, RegionField f,
-                                  __global const float* source_points, int samples, float light_z,
-                                  float target_height, __global const unsigned int* table, BitmaskTable t,
-                                  float lo_x, float lo_y, float hi_x, float hi_y, int words,
+                                  float margin, float gradient, int finite_field, float field_top,
+                                  RegionField f, __global const float* source_points, int samples,
+                                  float light_z, float target_height, __global const unsigned int* table,
+                                  BitmaskTable t, float lo_x, float lo_y, float hi_x, float hi_y, int words,
                                   int receiver_count, int receiver_major, int first,
                                   __global unsigned int* bits, __global unsigned int* tested) {
   const int r = first + (int)get_global_id(0);
@@ -418,6 +468,9 @@ __kernel void region_bitmask_bits(__global const float* h, __global const float*
     pmin = fmax(fmax(lo_x - xr, xr - hi_x), fmax(lo_y - yr, yr - hi_y));
     const float in_margin = pmin > 0.0f ? out_margin + 1.5e-3f * (1.5f * gradient + dz / pmin) : INFINITY;
     const float slope = dz / dmax;
+    // Front faces culled only under a light above every point of the surfaces (the field's
+    // highest plus the rounding).
+    const int light_above = Z > field_top + 2.0f * out_margin;
     const float fx0 = fmin(xr, lo_x), fx1 = fmax(xr, hi_x), fy0 = fmin(yr, lo_y), fy1 = fmax(yr, hi_y);
     int stack_k[64], stack_x[64], stack_y[64], top = 0;
     const int last = levels - 1;  // (no pyramid: no cells, a field one point thick)
@@ -462,20 +515,34 @@ __kernel void region_bitmask_bits(__global const float* h, __global const float*
       // The boxes from the lowest height a line to the light can have over the cell (below it,
       // a point projects beyond the light's farthest corner), a little lower.
       const float low = zr + dz * (near / dmax) * 0.999f;
-      if (highest + out_margin > low)
-        region_bitmask_box(x0, y0, low, highest + out_margin, xr, yr, zr, Z, table, t, words, 1, outer);
       const int p = by * f.width + bx;
       const float h00 = h[p], h10 = h[p + 1], h01 = h[p + f.width], h11 = h[p + f.width + 1];
       int finite = isfinite(h00) && isfinite(h10) && isfinite(h01) && isfinite(h11);
-      // As region_cull_hides: the march's values near the cell are numbers only where the 4 x 4
-      // heights around it are.
+      const float twist = h00 - h10 - h01 + h11;
+      // The 4 x 4 heights around the cell finite: the march's values near it are numbers (as
+      // region_cull_hides), and the surfaces below are without holes there.
+      int around = finite;
       for (int y = (by > 0 ? by - 1 : 0);
-           finite && !finite_field && y <= (by + 2 < f.height ? by + 2 : f.height - 1); ++y)
+           around && !finite_field && y <= (by + 2 < f.height ? by + 2 : f.height - 1); ++y)
         for (int x = (bx > 0 ? bx - 1 : 0); x <= (bx + 2 < f.width ? bx + 2 : f.width - 1); ++x)
-          finite = finite && isfinite(h[y * f.width + x]);
-      const float lowest = fmin(fmin(h00, h10), fmin(h01, h11)) - in_margin;
-      const float z1 = fmin(lowest, Z);
-      if (finite && z1 > low) region_bitmask_box(x0, y0, low, z1, xr, yr, zr, Z, table, t, words, 0, inner);
+          around = around && isfinite(h[y * f.width + x]);
+      const int cull_front = around && light_above;
+      // Outer: the triangulation above the bilinear surface, raised by the march's rounding; a
+      // cell with a nodata corner (only its valid edges are surface), the box under its highest.
+      if (highest + out_margin > low) {
+        if (finite)
+          region_bitmask_cell(x0, y0, h00, h10, h01, h11, out_margin, twist >= 0.0f, cull_front, low, xr, yr,
+                              zr, Z, table, t, words, 1, outer);
+        else
+          region_bitmask_cell(x0, y0, highest, highest, highest, highest, out_margin, 1, 0, low, xr, yr, zr,
+                              Z, table, t, words, 1, outer);
+      }
+      // Inner: the triangulation below it, lowered by the march's rounding and the most its
+      // values change over a piece it skips; only below the light (above it, the prism's points
+      // lie beyond the line's end), where the march's values near the cell are numbers.
+      if (around && highest - in_margin <= Z && highest - in_margin > low)
+        region_bitmask_cell(x0, y0, h00, h10, h01, h11, -in_margin, twist < 0.0f, cull_front, low, xr, yr, zr,
+                            Z, table, t, words, 0, inner);
     }
   }
   unsigned int uncertain_count = 0U, uncertain_visible = 0U;

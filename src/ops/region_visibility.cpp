@@ -172,6 +172,14 @@ BitmaskTable bitmaskTable(const std::vector<float>& points, int size) {
   return t;
 }
 
+// The highest finite height (z-scaled; -infinity if none).
+float fieldTop(const std::vector<float>& heights) {
+  float top = -std::numeric_limits<float>::infinity();
+  for (const float v : heights)
+    if (std::isfinite(v)) top = std::max(top, v);
+  return top;
+}
+
 // The bits of `count` receivers from the device, receiver-major: one routine item per launch
 // of up to kWordsPerLaunch / words receivers (a work-item marches all its receiver's words:
 // a launch's work stays bounded whatever S).
@@ -247,6 +255,7 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
           .set("margin", margin_)
           .set("gradient", gradient_)
           .set("finite_field", cl_int(finite_))
+          .set("field_top", fieldTop(prepared_.heights))
           .set("f", device)
           .set("source_points", source_points_buffer_)
           .set("samples", cl_int(samples_))
