@@ -409,6 +409,16 @@ void region_bitmask_near(float h00, float h10, float h01, float h11, float zr, f
   }
 }
 
+// Whether a | b holds every one of the samples.
+int region_bitmask_all(const unsigned int* a, const unsigned int* b, int samples) {
+  for (int w = 0; 32 * w < samples; ++w) {
+    const int n = samples - 32 * w;
+    const unsigned int valid = n >= 32 ? 0xffffffffU : (1U << n) - 1U;
+    if ((a[w] | b[w]) != valid) return 0;
+  }
+  return 1;
+}
+
 __kernel void region_bitmask_bits(__global const float* h, __global const float* pyramid, int levels,
                                   float margin, float gradient, int finite_field, float field_top,
                                   RegionField f, __global const float* source_points, int samples,
@@ -474,7 +484,9 @@ __kernel void region_bitmask_bits(__global const float* h, __global const float*
     const float fx0 = fmin(xr, lo_x), fx1 = fmax(xr, hi_x), fy0 = fmin(yr, lo_y), fy1 = fmax(yr, hi_y);
     int stack_k[64], stack_x[64], stack_y[64], top = 0;
     const int last = levels - 1;  // (no pyramid: no cells, a field one point thick)
-    for (int by = 0; levels > 0 && by < region_cull_width(f.height, last) && !all_uncertain; ++by)
+    // (none where the receiver's own cells hide every sample)
+    const int visit = levels > 0 && !region_bitmask_all(near_hidden, near_hidden, samples);
+    for (int by = 0; visit && by < region_cull_width(f.height, last) && !all_uncertain; ++by)
       for (int bx = 0; bx < region_cull_width(f.width, last); ++bx) {
         if (top == 64) {
           all_uncertain = 1;
@@ -500,8 +512,12 @@ __kernel void region_bitmask_bits(__global const float* h, __global const float*
           all_uncertain = 1;
           break;
         }
-        for (int c = 0; c < 4; ++c) {
-          const int cx = 2 * bx + (c & 1), cy = 2 * by + (c >> 1);
+        // The child nearest the receiver last, so first visited: near cells hide the most
+        // samples, and once every sample is surely hidden the visit stops.
+        const int child = 1 << (k - 1);
+        const int nearest = (xr >= (float)((2 * bx + 1) * child)) | (yr >= (float)((2 * by + 1) * child)) << 1;
+        for (int c = 3; c >= 0; --c) {
+          const int q = c ^ nearest, cx = 2 * bx + (q & 1), cy = 2 * by + (q >> 1);
           if (cx < region_cull_width(f.width, k - 1) && cy < region_cull_width(f.height, k - 1))
             stack_k[top] = k - 1, stack_x[top] = cx, stack_y[top] = cy, ++top;
         }
@@ -540,9 +556,11 @@ __kernel void region_bitmask_bits(__global const float* h, __global const float*
       // Inner: the triangulation below it, lowered by the march's rounding and the most its
       // values change over a piece it skips; only below the light (above it, the prism's points
       // lie beyond the line's end), where the march's values near the cell are numbers.
-      if (around && highest - in_margin <= Z && highest - in_margin > low)
+      if (around && highest - in_margin <= Z && highest - in_margin > low) {
         region_bitmask_cell(x0, y0, h00, h10, h01, h11, -in_margin, twist < 0.0f, cull_front, low, xr, yr, zr,
                             Z, table, t, words, 0, inner);
+        if (region_bitmask_all(inner, near_hidden, samples)) break;  // nothing left to decide
+      }
     }
   }
   unsigned int uncertain_count = 0U, uncertain_visible = 0U;
