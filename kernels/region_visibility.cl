@@ -28,6 +28,35 @@ typedef struct {
 // shaft to a word's samples is shown clear beyond them (region_shaft_clear).
 #define REGION_NEAR_CELLS 2
 
+// The wedge from the receiver (xr, yr) over the samples' box [sx0, sx1] x [sy0, sy1]: its two
+// edges, toward the box's corners most counter-clockwise (wedge[0], wedge[1]) and most clockwise
+// (wedge[2], wedge[3]) seen from the receiver; 0 (no wedge) when the receiver lies in the box.
+int region_wedge(float xr, float yr, float sx0, float sy0, float sx1, float sy1, float* wedge) {
+  if (!(xr < sx0 || xr > sx1 || yr < sy0 || yr > sy1)) return 0;
+  const float cx = 0.5f * (sx0 + sx1) - xr, cy = 0.5f * (sy0 + sy1) - yr;
+  float most = -INFINITY, least = INFINITY;
+  for (int c = 0; c < 4; ++c) {
+    const float vx = (c & 1 ? sx1 : sx0) - xr, vy = (c & 2 ? sy1 : sy0) - yr;
+    const float sine = (cx * vy - cy * vx) / sqrt(vx * vx + vy * vy);
+    if (sine > most) most = sine, wedge[0] = vx, wedge[1] = vy;
+    if (sine < least) least = sine, wedge[2] = vx, wedge[3] = vy;
+  }
+  return 1;
+}
+
+// Whether the box [x0, x1] x [y0, y1] lies wholly beyond one of the wedge's edges, by more than
+// a relative 1e-5 (the marches' positions round).
+int region_outside_wedge(float xr, float yr, const float* wedge, float x0, float y0, float x1, float y1) {
+  int left = 0, right = 0;
+  const float lsize = fabs(wedge[0]) + fabs(wedge[1]), rsize = fabs(wedge[2]) + fabs(wedge[3]);
+  for (int c = 0; c < 4; ++c) {
+    const float qx = (c & 1 ? x1 : x0) - xr, qy = (c & 2 ? y1 : y0) - yr, qsize = fabs(qx) + fabs(qy);
+    left += wedge[0] * qy - wedge[1] * qx > 1e-5f * lsize * qsize;
+    right += wedge[2] * qy - wedge[3] * qx < -1e-5f * rsize * qsize;
+  }
+  return left == 4 || right == 4;
+}
+
 // Whether every segment from the receiver (xr, yr, zr) to the n samples (xs, ys, zs) is clear of
 // the surface outside the box of grid lines around the receiver (REGION_NEAR_CELLS cells each
 // side of its point, *box: x0, y0, x1, y1), by the margins of the culled march: every block of
@@ -61,18 +90,8 @@ int region_shaft_clear(__global const float* h, __global const float* pyramid, i
   // The footprint: its bounding box, and (receiver outside the samples' box) the wedge's two
   // edges, toward the samples' corners most counter-clockwise and most clockwise.
   const float fx0 = fmin(xr, sx0), fx1 = fmax(xr, sx1), fy0 = fmin(yr, sy0), fy1 = fmax(yr, sy1);
-  const int wedge = xr < sx0 || xr > sx1 || yr < sy0 || yr > sy1;
-  float lx = 0.0f, ly = 0.0f, rxe = 0.0f, rye = 0.0f;
-  if (wedge) {
-    const float cx = 0.5f * (sx0 + sx1) - xr, cy = 0.5f * (sy0 + sy1) - yr;
-    float most = -INFINITY, least = INFINITY;
-    for (int c = 0; c < 4; ++c) {
-      const float vx = (c & 1 ? sx1 : sx0) - xr, vy = (c & 2 ? sy1 : sy0) - yr;
-      const float sine = (cx * vy - cy * vx) / sqrt(vx * vx + vy * vy);
-      if (sine > most) most = sine, lx = vx, ly = vy;
-      if (sine < least) least = sine, rxe = vx, rye = vy;
-    }
-  }
+  float wedge[4];
+  const int wedged = region_wedge(xr, yr, sx0, sy0, sx1, sy1, wedge);
   int stack_k[64], stack_x[64], stack_y[64], top = 0;
   const int last = levels - 1;
   for (int by = 0; by < region_cull_width(f.height, last); ++by)
@@ -88,15 +107,7 @@ int region_shaft_clear(__global const float* h, __global const float* pyramid, i
                 y1 = fmin((float)((by + 1) << k), (float)(f.height - 1));
     if (x1 < fx0 || x0 > fx1 || y1 < fy0 || y0 > fy1) continue;
     if (x0 >= box[0] && x1 <= box[2] && y0 >= box[1] && y1 <= box[3]) continue;
-    if (wedge) {
-      int left = 0, right = 0;
-      for (int c = 0; c < 4; ++c) {
-        const float qx = (c & 1 ? x1 : x0) - xr, qy = (c & 2 ? y1 : y0) - yr;
-        left += lx * qy - ly * qx > 0.0f;
-        right += rxe * qy - rye * qx < 0.0f;
-      }
-      if (left == 4 || right == 4) continue;
-    }
+    if (wedged && region_outside_wedge(xr, yr, wedge, x0, y0, x1, y1)) continue;
     const float ddx = fmax(0.0f, fmax(x0 - xr, xr - x1)) * f.cell_x,
                 ddy = fmax(0.0f, fmax(y0 - yr, yr - y1)) * f.cell_y;
     const float near = sqrt(ddx * ddx + ddy * ddy);
@@ -482,6 +493,8 @@ __kernel void region_bitmask_bits(__global const float* h, __global const float*
     // highest plus the rounding).
     const int light_above = Z > field_top + 2.0f * out_margin;
     const float fx0 = fmin(xr, lo_x), fx1 = fmax(xr, hi_x), fy0 = fmin(yr, lo_y), fy1 = fmax(yr, hi_y);
+    float wedge[4];
+    const int wedged = region_wedge(xr, yr, lo_x, lo_y, hi_x, hi_y, wedge);
     int stack_k[64], stack_x[64], stack_y[64], top = 0;
     const int last = levels - 1;  // (no pyramid: no cells, a field one point thick)
     // (none where the receiver's own cells hide every sample)
@@ -501,6 +514,7 @@ __kernel void region_bitmask_bits(__global const float* h, __global const float*
       const float x1 = fmin((float)((bx + 1) << k), (float)(f.width - 1)),
                   y1 = fmin((float)((by + 1) << k), (float)(f.height - 1));
       if (x1 < fx0 || x0 > fx1 || y1 < fy0 || y0 > fy1) continue;
+      if (wedged && region_outside_wedge(xr, yr, wedge, x0, y0, x1, y1)) continue;
       const float ddx = fmax(0.0f, fmax(x0 - xr, xr - x1)) * f.cell_x,
                   ddy = fmax(0.0f, fmax(y0 - yr, yr - y1)) * f.cell_y;
       const float near = sqrt(ddx * ddx + ddy * ddy);
@@ -515,7 +529,8 @@ __kernel void region_bitmask_bits(__global const float* h, __global const float*
         // The child nearest the receiver last, so first visited: near cells hide the most
         // samples, and once every sample is surely hidden the visit stops.
         const int child = 1 << (k - 1);
-        const int nearest = (xr >= (float)((2 * bx + 1) * child)) | (yr >= (float)((2 * by + 1) * child)) << 1;
+        const int nearest = (xr >= (float)((2 * bx + 1) * child)) | (yr >= (float)((2 * by + 1) * child))
+                                                                        << 1;
         for (int c = 3; c >= 0; --c) {
           const int q = c ^ nearest, cx = 2 * bx + (q & 1), cy = 2 * by + (q >> 1);
           if (cx < region_cull_width(f.width, k - 1) && cy < region_cull_width(f.height, k - 1))

@@ -97,9 +97,11 @@ enum class RegionVisibilityMethod {
   // blocks below it left out) is back-projected from the receiver onto the light's plane, and
   // the samples inside come from a table of edge bitmasks (RegionVisibilityOptions::
   // bitmask_table), ANDed per edge and ORed over the cells. The bilinear cell's back-projection
-  // has curved edges, so each cell gives two polygons: one holding every sample the cell may
-  // hide (the box under its highest corner), one holding only samples it surely hides (the box
-  // under its lowest); the receiver's own four cells are decided per sample along the line. The
+  // has curved edges, so each cell gives two pairs of polygons: the prisms under the
+  // triangulation above the surface (raised by the march's rounding) hold every sample the cell
+  // may hide, those under the one below it (lowered) only samples it surely hides; triangles the
+  // receiver lies above are culled under a light above the whole surface (the terrain is closed
+  // from above); the receiver's own four cells are decided per sample along the line. The
   // samples between (and within the table's resolution of an edge) are decided by the culled
   // march: the bits are the exact method's, bit for bit; RegionVisibilityResult::exact_tested
   // counts them.
