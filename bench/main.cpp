@@ -36,7 +36,8 @@
 //       region visibility's backends timed interleaved: area lights against S, the light's size
 //       and height (arealight-quick: S = 32 interleaved, the culled march alone at S = 1024);
 //       region pairs against their size and distance; the visible fraction's error against a
-//       Monte-Carlo reference
+//       Monte-Carlo reference; bitmask: the bitmask scatter against culled and viewsheds at S = 32
+//       and 1024, and the bits its table leaves to the march against the table's size
 //   hfvis_bench field NAME N OUT
 //       writes the synthetic field NAME (testing's hard cases: city, sine, ...) of N x N pixels
 //       to OUT (EXR or GeoTIFF), for timing the CLI on it (bench/cost_against.sh)
@@ -106,8 +107,8 @@ constexpr const char* kUsage =
     "       hfvis_bench pvs-recall [--size N] [--view-cell C] [--tile T] [--samples N,N,...]\n"
     "                              [--check-rays R] [--methods agvs,sgvs,per-cell] [--reference yes|no]\n"
     "                              [--dem FILE] FIELD...   (FIELD: city, noise, dem)\n"
-    "       hfvis_bench region [--sections arealight,arealight-quick,pair,pair-quick,error] [--reps N] "
-    "FIELD...\n"
+    "       hfvis_bench region [--sections arealight,arealight-quick,pair,pair-quick,error,bitmask]\n"
+    "                          [--reps N] FIELD...\n"
     "       hfvis_bench field NAME N OUT\n"
     "       hfvis_bench inputs [--quick]\n"
     "       hfvis_bench check-truth\n"
@@ -486,8 +487,9 @@ int main(int argc, char** argv) {
       if (fields.empty()) throw Usage("region needs FIELD...");
       for (const std::string& section : sections)
         if (section != "arealight" && section != "arealight-quick" && section != "pair" &&
-            section != "pair-quick" && section != "error")
-          throw Usage("--sections: arealight, arealight-quick, pair, pair-quick, error (comma-separated)");
+            section != "pair-quick" && section != "error" && section != "bitmask")
+          throw Usage(
+              "--sections: arealight, arealight-quick, pair, pair-quick, error, bitmask (comma-separated)");
       const ComputeContext context = ComputeContext::create(ContextOptions::fromEnvironment());
       for (const std::string& path : fields) regionVisibilityReport(context, path, sections, reps);
       return 0;

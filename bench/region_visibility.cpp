@@ -30,9 +30,10 @@ std::vector<double> fastestInterleaved(const std::vector<std::function<void()>>&
 }
 
 const char* name(RegionVisibilityMethod m) {
-  return m == RegionVisibilityMethod::Exact    ? "exact"
-         : m == RegionVisibilityMethod::Culled ? "culled"
-                                               : "viewsheds";
+  return m == RegionVisibilityMethod::Exact     ? "exact"
+         : m == RegionVisibilityMethod::Culled  ? "culled"
+         : m == RegionVisibilityMethod::Bitmask ? "bitmask"
+                                                : "viewsheds";
 }
 
 double highest(const HeightField& f) {
@@ -123,6 +124,74 @@ void arealightSection(const ComputeContext& context, const HeightField& f, bool 
       if (std::isfinite(v)) mean += v;
     std::printf("| %d | %d | %.0f | %.2f | %.2f | %.1f | %.3f |\n", c.samples, c.side, c.above, t,
                 pixels * c.samples / t * 1e-6, viewshed_per_sample * c.samples / t, mean / pixels);
+  }
+}
+
+// The bitmask scatter against the culled march and the viewsheds, the light of arealightSection
+// (64 x 64 px at the centre, 20 above the highest point, samples on grid points at one absolute
+// height, so that all three take it): S = 32 (all three) and S = 1024 (culled and bitmask; the
+// viewsheds' time projected from S = 32), interleaved, the fastest of `reps`; then the bits the
+// bitmask's table leaves to the march against the table's size (S = 256). A table alone would
+// call each of those bits either visible or hidden: the march finds `visible` of them visible,
+// the rest hidden, so a table that called them hidden (the conservative outer polygons) gets
+// the visible ones wrong, one that called them visible (the inner polygons) the hidden ones.
+void bitmaskSection(const ComputeContext& context, const HeightField& f, int reps) {
+  const double top = highest(f);
+  const double pixels = double(f.pixelCount());
+  std::printf(
+      "\n#### The bitmask scatter (light 64 x 64 px at the field's centre, 20 above its highest point; "
+      "sources on grid points, absolute; the fastest of %d, interleaved)\n\n"
+      "| S | method | time (s) | Mrays/s | time / culled's | bits differing from culled | bits the "
+      "march decided (bitmask) |\n|---|---|---|---|---|---|---|\n",
+      reps);
+  double viewshed_per_sample = 0.0;
+  for (int samples : {32, 1024}) {
+    const RegionSampling light = gridLight(f, 64, samples, top + 20.0);
+    std::vector<RegionVisibilityMethod> methods = {RegionVisibilityMethod::Culled,
+                                                   RegionVisibilityMethod::Bitmask};
+    if (samples == 32) methods.push_back(RegionVisibilityMethod::Viewsheds);
+    std::vector<RegionVisibilityResult> results(methods.size());
+    std::vector<std::function<void()>> bodies;
+    for (std::size_t i = 0; i < methods.size(); ++i)
+      bodies.push_back([&, i] {
+        RegionVisibilityOptions o;
+        o.method = methods[i];
+        results[i] = computeRegionVisibility(context, f, light, o);
+      });
+    const std::vector<double> t = fastestInterleaved(bodies, reps);
+    if (samples == 32) viewshed_per_sample = t[2] / samples;
+    for (std::size_t i = 0; i < methods.size(); ++i)
+      std::printf(
+          "| %d | %s | %.3f | %.2f | %.2f | %zu of %.0f | %s |\n", samples, name(methods[i]), t[i],
+          pixels * samples / t[i] * 1e-6, t[i] / t[0], differingBits(results[i].bits, results[0].bits),
+          pixels * samples,
+          methods[i] == RegionVisibilityMethod::Bitmask
+              ? (std::to_string(results[i].exact_tested) + " (" +
+                 std::to_string(100.0 * results[i].exact_tested / (pixels * samples)).substr(0, 5) + " %)")
+                    .c_str()
+              : "");
+    if (samples == 1024)
+      std::printf("| 1024 | viewsheds (projected from S = 32) | %.1f | | %.2f | | |\n",
+                  viewshed_per_sample * 1024, viewshed_per_sample * 1024 / t[0]);
+  }
+  std::printf(
+      "\n| table (angles = offsets) | S | time (s) | bits the march decided | of them visible (a "
+      "hidden-calling table's errors) | hidden (a visible-calling table's errors) | bits differing from "
+      "culled |\n|---|---|---|---|---|---|---|\n");
+  const RegionSampling light = gridLight(f, 64, 256, top + 20.0);
+  RegionVisibilityOptions culled;
+  const RegionVisibilityResult want = computeRegionVisibility(context, f, light, culled);
+  for (int size : {16, 64, 256}) {
+    RegionVisibilityOptions o;
+    o.method = RegionVisibilityMethod::Bitmask;
+    o.bitmask_table = size;
+    RegionVisibilityResult r;
+    const double t = fastestInterleaved({[&] { r = computeRegionVisibility(context, f, light, o); }}, 1)[0];
+    std::printf("| %d | 256 | %.3f | %llu (%.2f %%) | %llu | %llu | %zu |\n", size, t,
+                (unsigned long long)r.exact_tested, 100.0 * r.exact_tested / (pixels * 256),
+                (unsigned long long)r.exact_tested_visible,
+                (unsigned long long)(r.exact_tested - r.exact_tested_visible),
+                differingBits(r.bits, want.bits));
   }
 }
 
@@ -227,6 +296,7 @@ void regionVisibilityReport(const ComputeContext& context, const std::string& pa
     if (s == "arealight" || s == "arealight-quick") arealightSection(context, field, s == "arealight-quick");
     if (s == "pair" || s == "pair-quick") pairSection(context, field, reps, s == "pair-quick");
     if (s == "error") errorSection(context, field, reps);
+    if (s == "bitmask") bitmaskSection(context, field, reps);
     std::fflush(stdout);
   }
 }

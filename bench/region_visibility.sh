@@ -14,7 +14,8 @@
 #   this build's alternate, --rounds times each (base, current, base, ...), so that both meet the
 #   same load; each run's tables go to the output under a heading naming its build.
 #   (arealight-quick: S = 32 interleaved and the culled march at S = 1024, in minutes; pair-quick:
-#   the pairs by the culled march alone, for profiling.)
+#   the pairs by the culled march alone, for profiling; bitmask: the bitmask scatter against the
+#   culled march and the viewsheds at S = 32 and 1024, and its table's size.)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 size=1024
@@ -31,7 +32,7 @@ while [[ $# -gt 0 ]]; do
     --out) out=$2; shift ;;
     --base-build) base_build=$2; shift ;;
     --rounds) rounds=$2; shift ;;
-    -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,18p' "$0"; exit 0 ;;
     *) echo "region_visibility.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
   shift

@@ -627,19 +627,22 @@ const std::vector<OptionSpec>& optionTable() {
          run.region_samples = static_cast<int>(n);
          run.region_samples_given = true;
        }},
-      {"--method", nullptr, "exact|culled|viewsheds", kRegionSamplingGroup, false,
+      {"--method", nullptr, "exact|culled|viewsheds|bitmask", kRegionSamplingGroup, false,
        "exact: one sight line per pair (the reference); culled: the same\n"
        "sight lines leaping over blocks of cells far below them, the exact\n"
        "bits sooner (default); viewsheds: one viewshed per source sample,\n"
        "for sources on grid points (--sources, or a one-pixel --light),\n"
-       "shared samples; may decide grazing lines the other way",
+       "shared samples; may decide grazing lines the other way; bitmask\n"
+       "(arealight): Eisemann & Decoret's scatter for a light at an\n"
+       "--absolute height, the exact bits",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
-         if (value != "exact" && value != "culled" && value != "viewsheds")
-           throw UsageError(typed + ": expected 'exact', 'culled' or 'viewsheds', got " +
+         if (value != "exact" && value != "culled" && value != "viewsheds" && value != "bitmask")
+           throw UsageError(typed + ": expected 'exact', 'culled', 'viewsheds' or 'bitmask', got " +
                             inQuotes(shortened(value)));
-         run.region_method = value == "exact"    ? RegionVisibilityMethod::Exact
-                             : value == "culled" ? RegionVisibilityMethod::Culled
-                                                 : RegionVisibilityMethod::Viewsheds;
+         run.region_method = value == "exact"     ? RegionVisibilityMethod::Exact
+                             : value == "culled"  ? RegionVisibilityMethod::Culled
+                             : value == "bitmask" ? RegionVisibilityMethod::Bitmask
+                                                  : RegionVisibilityMethod::Viewsheds;
        }},
       {"--absolute", nullptr, nullptr, kRegionSamplingGroup, false,
        "the regions' heights absolute (z-scaled), not above the surface", HFVIS_FLAG(absolute)},

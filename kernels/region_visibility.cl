@@ -30,6 +30,35 @@ typedef struct {
 // shaft to a word's samples is shown clear beyond them (region_shaft_clear).
 #define REGION_NEAR_CELLS 2
 
+// The wedge from the receiver (xr, yr) over the samples' box [sx0, sx1] x [sy0, sy1]: its two
+// edges, toward the box's corners most counter-clockwise (wedge[0], wedge[1]) and most clockwise
+// (wedge[2], wedge[3]) seen from the receiver; 0 (no wedge) when the receiver lies in the box.
+int region_wedge(float xr, float yr, float sx0, float sy0, float sx1, float sy1, float* wedge) {
+  if (!(xr < sx0 || xr > sx1 || yr < sy0 || yr > sy1)) return 0;
+  const float cx = 0.5f * (sx0 + sx1) - xr, cy = 0.5f * (sy0 + sy1) - yr;
+  float most = -INFINITY, least = INFINITY;
+  for (int c = 0; c < 4; ++c) {
+    const float vx = (c & 1 ? sx1 : sx0) - xr, vy = (c & 2 ? sy1 : sy0) - yr;
+    const float sine = (cx * vy - cy * vx) / sqrt(vx * vx + vy * vy);
+    if (sine > most) most = sine, wedge[0] = vx, wedge[1] = vy;
+    if (sine < least) least = sine, wedge[2] = vx, wedge[3] = vy;
+  }
+  return 1;
+}
+
+// Whether the box [x0, x1] x [y0, y1] lies wholly beyond one of the wedge's edges, by more than
+// a relative 1e-5 (the marches' positions round).
+int region_outside_wedge(float xr, float yr, const float* wedge, float x0, float y0, float x1, float y1) {
+  int left = 0, right = 0;
+  const float lsize = fabs(wedge[0]) + fabs(wedge[1]), rsize = fabs(wedge[2]) + fabs(wedge[3]);
+  for (int c = 0; c < 4; ++c) {
+    const float qx = (c & 1 ? x1 : x0) - xr, qy = (c & 2 ? y1 : y0) - yr, qsize = fabs(qx) + fabs(qy);
+    left += wedge[0] * qy - wedge[1] * qx > 1e-5f * lsize * qsize;
+    right += wedge[2] * qy - wedge[3] * qx < -1e-5f * rsize * qsize;
+  }
+  return left == 4 || right == 4;
+}
+
 // Whether every segment from the receiver (xr, yr, zr) to the n samples (xs, ys, zs) is clear of
 // the surface outside the box of grid lines around the receiver (REGION_NEAR_CELLS cells each
 // side of its point, *box: x0, y0, x1, y1), by the margins of the culled march: every block of
@@ -63,18 +92,8 @@ int region_shaft_clear(__global const float* h, __global const float* pyramid, i
   // The footprint: its bounding box, and (receiver outside the samples' box) the wedge's two
   // edges, toward the samples' corners most counter-clockwise and most clockwise.
   const float fx0 = fmin(xr, sx0), fx1 = fmax(xr, sx1), fy0 = fmin(yr, sy0), fy1 = fmax(yr, sy1);
-  const int wedge = xr < sx0 || xr > sx1 || yr < sy0 || yr > sy1;
-  float lx = 0.0f, ly = 0.0f, rxe = 0.0f, rye = 0.0f;
-  if (wedge) {
-    const float cx = 0.5f * (sx0 + sx1) - xr, cy = 0.5f * (sy0 + sy1) - yr;
-    float most = -INFINITY, least = INFINITY;
-    for (int c = 0; c < 4; ++c) {
-      const float vx = (c & 1 ? sx1 : sx0) - xr, vy = (c & 2 ? sy1 : sy0) - yr;
-      const float sine = (cx * vy - cy * vx) / sqrt(vx * vx + vy * vy);
-      if (sine > most) most = sine, lx = vx, ly = vy;
-      if (sine < least) least = sine, rxe = vx, rye = vy;
-    }
-  }
+  float wedge[4];
+  const int wedged = region_wedge(xr, yr, sx0, sy0, sx1, sy1, wedge);
   int stack_k[64], stack_x[64], stack_y[64], top = 0;
   const int last = levels - 1;
   for (int by = 0; by < region_cull_width(f.height, last); ++by)
@@ -90,15 +109,7 @@ int region_shaft_clear(__global const float* h, __global const float* pyramid, i
                 y1 = fmin((float)((by + 1) << k), (float)(f.height - 1));
     if (x1 < fx0 || x0 > fx1 || y1 < fy0 || y0 > fy1) continue;
     if (x0 >= box[0] && x1 <= box[2] && y0 >= box[1] && y1 <= box[3]) continue;
-    if (wedge) {
-      int left = 0, right = 0;
-      for (int c = 0; c < 4; ++c) {
-        const float qx = (c & 1 ? x1 : x0) - xr, qy = (c & 2 ? y1 : y0) - yr;
-        left += lx * qy - ly * qx > 0.0f;
-        right += rxe * qy - rye * qx < 0.0f;
-      }
-      if (left == 4 || right == 4) continue;
-    }
+    if (wedged && region_outside_wedge(xr, yr, wedge, x0, y0, x1, y1)) continue;
     const float ddx = fmax(0.0f, fmax(x0 - xr, xr - x1)) * f.cell_x,
                 ddy = fmax(0.0f, fmax(y0 - yr, yr - y1)) * f.cell_y;
     const float near = sqrt(ddx * ddx + ddy * ddy);
@@ -264,4 +275,386 @@ __kernel void region_visibility_bits(__global const float* h, __global const flo
     hidden_before = hidden;
     bits[receiver_major ? (size_t)r * words + w : (size_t)w * receiver_count + r] = word;
   }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The bitmask method (RegionVisibilityMethod::Bitmask): the scatter of Eisemann & Décoret
+// (2007, "Visibility sampling on GPU and applications") for a planar light at height `light_z`
+// over every-pixel receivers. Per receiver, each cell that may reach the shaft to the light is
+// back-projected from the receiver onto the light's plane and the samples inside come from a
+// table of edge bitmasks (`table`: per edge angle and offset, the samples on the edge's inner
+// side), ANDed per edge and ORed over the cells. The bilinear cell's back-projection has curved
+// edges, so each cell gives a conservative pair: an outer polygon (the box under the cell's
+// highest corner, raised by the march's rounding) that holds every sample the cell may hide, and
+// an inner one (the box under its lowest corner, lowered by the march's rounding and the most
+// its values can stray) whose samples it surely hides; each table edge rounded outward or
+// inward by its resolution. The receiver's own four cells, whose back-projections reach to the
+// horizon, are decided per sample from their bilinear surface along the line. Samples in some
+// outer polygon but in no inner one are uncertain: the culled march (its bits the exact
+// method's) decides them, so the bits are the exact method's, bit for bit.
+
+// The table's shape: `angles` edge normals n_i = (cos, sin)(2 pi i / angles), `offsets` + 1
+// offsets c_j = -rho + 2 rho j / offsets, a mask of `words` words per (i, j): the samples p with
+// n_i . (p - centre) >= c_j.
+typedef struct {
+  float centre_x, centre_y, rho;
+  int angles, offsets;
+} BitmaskTable;
+
+// ORs into acc the samples inside the convex hull of the n points (px, py) on the light's plane,
+// as the table gives them: `outward`, a superset (each edge moved out by the table's resolution
+// and `error`, the points' rounding, per unit of their magnitude); else a subset (moved in). An
+// outer polygon may drop an edge (a larger polygon), an inner one may not (then it is empty).
+void region_bitmask_polygon(float* px, float* py, int n, __global const unsigned int* table, BitmaskTable t,
+                            int words, int outward, float error, unsigned int* acc) {
+  // Andrew's monotone chain: sorted by x then y, the lower and upper hulls, counter-clockwise.
+  for (int i = 1; i < n; ++i)
+    for (int j = i; j > 0 && (px[j] < px[j - 1] || (px[j] == px[j - 1] && py[j] < py[j - 1])); --j) {
+      const float sx = px[j], sy = py[j];
+      px[j] = px[j - 1], py[j] = py[j - 1], px[j - 1] = sx, py[j - 1] = sy;
+    }
+  float hx[17], hy[17];
+  int m = 0;
+  for (int pass = 0; pass < 2; ++pass) {
+    const int floor_m = m;
+    for (int k = 0; k < n; ++k) {
+      const int i = pass ? n - 1 - k : k;
+      while (m >= floor_m + 2 &&
+             (hx[m - 1] - hx[m - 2]) * (py[i] - hy[m - 2]) - (hy[m - 1] - hy[m - 2]) * (px[i] - hx[m - 2]) <=
+                 0.0f)
+        --m;
+      hx[m] = px[i], hy[m] = py[i], ++m;
+    }
+    --m;  // each chain's last point starts the other
+  }
+  if (m < 3) {
+    if (!outward) return;  // a degenerate inner polygon: nothing surely hidden
+  }
+  // The magnitude the points' rounding scales with.
+  float magnitude = t.rho + fabs(t.centre_x) + fabs(t.centre_y);
+  for (int k = 0; k < m; ++k) magnitude = fmax(magnitude, fabs(hx[k]) + fabs(hy[k]));
+  const float step = 2.0f * t.rho / (float)t.offsets, half_angle = M_PI_F / (float)t.angles;
+  int column[16], edges = 0;
+  for (int k = 0; k < m; ++k) {
+    const float ax = hx[k], ay = hy[k], bx = hx[k + 1 < m ? k + 1 : 0], by = hy[k + 1 < m ? k + 1 : 0];
+    const float ex = bx - ax, ey = by - ay, len = sqrt(ex * ex + ey * ey);
+    // The inner normal of a counter-clockwise edge, and the edge's offset from the table's centre.
+    const float nx = -ey / len, ny = ex / len;
+    const float c = nx * (ax - t.centre_x) + ny * (ay - t.centre_y);
+    // The edge's rounding where it passes the samples (its direction from the points' rounding
+    // over its length), and the table's: the nearest angle's normal differs by at most half an
+    // angle step, times the samples' distance from the centre.
+    const float reach =
+        sqrt((ax - t.centre_x) * (ax - t.centre_x) + (ay - t.centre_y) * (ay - t.centre_y)) + t.rho;
+    const float slack = error * magnitude * (2.0f + reach / len) + t.rho * (half_angle + 1e-5f);
+    if (!(len > 1e-6f * magnitude) || !isfinite(slack)) {
+      if (!outward) return;
+      continue;
+    }
+    int i = (int)floor(atan2(ny, nx) / (2.0f * half_angle) + 0.5f);
+    i = ((i % t.angles) + t.angles) % t.angles;
+    const float at = (outward ? c - slack : c + slack) + t.rho;  // from c_0
+    if (outward) {
+      if (at < 0.0f) continue;        // every sample on the inner side
+      if (at > 2.0f * t.rho) return;  // none
+      column[edges++] = i * (t.offsets + 1) + min((int)floor(at / step), t.offsets);
+    } else {
+      if (at <= 0.0f) continue;
+      const int j = (int)ceil(at / step);
+      if (j > t.offsets) return;
+      column[edges++] = i * (t.offsets + 1) + j;
+    }
+  }
+  for (int w = 0; w < words; ++w) {
+    unsigned int mask = 0xffffffffU;
+    for (int e = 0; e < edges; ++e) mask &= table[(size_t)column[e] * words + w];
+    acc[w] |= mask;
+  }
+}
+
+// ORs into acc the table's samples inside the back-projection from the receiver (xr, yr, zr)
+// onto the plane z = light_z of the prism under the triangle (vx, vy, vz) (3 vertices; a plane)
+// and above z = low (zr < low): the part of the triangle where the plane lies above `low`, and
+// the volume between; a convex polytope, its projection the convex hull of its vertices'.
+void region_bitmask_prism(const float* vx, const float* vy, const float* vz, float low, float xr, float yr,
+                          float zr, float light_z, __global const unsigned int* table, BitmaskTable t,
+                          int words, int outward, unsigned int* acc) {
+  // The triangle clipped to plane >= low (Sutherland-Hodgman, one plane): at most 4 vertices.
+  float cx[4], cy[4], cz[4], top = low;
+  int n = 0;
+  for (int i = 0; i < 3; ++i) {
+    const int j = i < 2 ? i + 1 : 0;
+    const float di = vz[i] - low, dj = vz[j] - low;
+    if (di >= 0.0f) cx[n] = vx[i], cy[n] = vy[i], cz[n] = vz[i], top = fmax(top, vz[i]), ++n;
+    if ((di >= 0.0f) != (dj >= 0.0f)) {
+      const float f = di / (di - dj);
+      cx[n] = vx[i] + f * (vx[j] - vx[i]), cy[n] = vy[i] + f * (vy[j] - vy[i]), cz[n] = low, ++n;
+    }
+  }
+  if (n == 0) return;
+  const float k0 = (light_z - zr) / (low - zr);
+  if (!(low > zr) || !isfinite(k0)) {  // (low rounded onto zr): no polygon to trust
+    for (int w = 0; outward && w < words; ++w) acc[w] = 0xffffffffU;
+    return;
+  }
+  float px[8], py[8];
+  for (int c = 0; c < n; ++c) {
+    const float k = (light_z - zr) / (cz[c] - zr);
+    px[c] = xr + (cx[c] - xr) * k0, py[c] = yr + (cy[c] - yr) * k0;
+    px[n + c] = xr + (cx[c] - xr) * k, py[n + c] = yr + (cy[c] - yr) * k;
+  }
+  // The projection's rounding, relative: the divisions' and the heights' over low - zr.
+  const float error = 2e-6f * (4.0f + (fabs(light_z) + fabs(top) + 2.0f * fabs(zr)) / (low - zr));
+  region_bitmask_polygon(px, py, 2 * n, table, t, words, outward, error, acc);
+}
+
+// ORs into acc the back-projections of the prisms under the cell (x0, y0)'s triangulation along
+// its diagonal from corner 00 to 11 (`main`) or from 10 to 01, each corner's height h raised by
+// `raise` (negative: lowered), above `low`. The bilinear surface lies between the two
+// triangulations: below the one along 00-11 where its twist h00 - h10 - h01 + h11 is positive,
+// above it where negative. With `cull_front`, a triangle whose plane the receiver lies above is
+// left out: over a surface without holes whose every point lies below the light, a line that
+// passes under it leaves it upward through a triangle whose plane the receiver lies below (the
+// line's rise over the surface grows there), and passes under that triangle just before
+// (Eisemann & Décoret's front-face culling of a closed occluder).
+void region_bitmask_cell(float x0, float y0, float h00, float h10, float h01, float h11, float raise,
+                         int main, int cull_front, float low, float xr, float yr, float zr, float light_z,
+                         __global const unsigned int* table, BitmaskTable t, int words, int outward,
+                         unsigned int* acc) {
+  const float x1 = x0 + 1.0f, y1 = y0 + 1.0f;
+  const float a = h00 + raise, b = h10 + raise, c = h01 + raise, d = h11 + raise;
+  // The two triangles, counter-clockwise from a corner on the diagonal's end.
+  const float vx[2][3] = {{x0, x1, main ? x1 : x0}, {main ? x0 : x1, x1, x0}};
+  const float vy[2][3] = {{y0, y0, main ? y1 : y1}, {main ? y0 : y0, y1, y1}};
+  const float vz[2][3] = {{a, b, main ? d : c}, {main ? a : b, d, c}};
+  for (int k = 0; k < 2; ++k) {
+    if (cull_front) {
+      // The triangle's plane at the receiver.
+      const float ex1 = vx[k][1] - vx[k][0], ey1 = vy[k][1] - vy[k][0], ez1 = vz[k][1] - vz[k][0];
+      const float ex2 = vx[k][2] - vx[k][0], ey2 = vy[k][2] - vy[k][0], ez2 = vz[k][2] - vz[k][0];
+      const float det = ex1 * ey2 - ey1 * ex2;
+      const float gx = (ez1 * ey2 - ey1 * ez2) / det, gy = (ex1 * ez2 - ez1 * ex2) / det;
+      const float rx = xr - vx[k][0], ry = yr - vy[k][0];
+      const float plane = vz[k][0] + gx * rx + gy * ry;
+      if (zr > plane + 1e-5f * (fabs(zr) + fabs(vz[k][0]) + (fabs(gx) + fabs(gy)) * (fabs(rx) + fabs(ry))))
+        continue;
+    }
+    region_bitmask_prism(vx[k], vy[k], vz[k], low, xr, yr, zr, light_z, table, t, words, outward, acc);
+  }
+}
+
+// The bilinear cell between the receiver's grid point (xr, yr) (its corner h00) and the corners
+// one step toward the sample along each axis, along the line to a sample (gx, gy) pixels away
+// whose rise over the receiver's height is dz: the surface's rise over the line, f(l) = c0 +
+// l A + l^2 B for the line's fraction l in [0, le] over the cell. *most: the most the march may
+// find there (with the start's c0 <= 0 when the top lies at or a rounding before the start,
+// which the march may take for inside); *surely: the most it takes inside the piece or at its
+// end.
+void region_bitmask_near(float h00, float h10, float h01, float h11, float zr, float ax, float ay, float dz,
+                         float* most, float* surely) {
+  const float a = h10 - h00, b = h01 - h00, tw = h00 - h10 - h01 + h11;
+  const float le = fmin(1.0f, fmin(ax > 0.0f ? 1.0f / ax : INFINITY, ay > 0.0f ? 1.0f / ay : INFINITY));
+  const float c0 = h00 - zr, A = a * ax + b * ay - dz, B = tw * ax * ay;
+  const float fe = c0 + le * (A + le * B);
+  *most = fe, *surely = fe;
+  if (B < 0.0f) {
+    const float top = -A / (2.0f * B);
+    if (top > 0.0f && top < le) {
+      const float ft = c0 + top * (A + top * B);
+      *most = fmax(*most, ft), *surely = fmax(*surely, ft);
+    }
+    if (top > -1e-4f * le * (1.0f + fabs(fe - c0) / (-B * le * le))) *most = fmax(*most, c0);
+  }
+}
+
+// Whether a | b holds every one of the samples.
+int region_bitmask_all(const unsigned int* a, const unsigned int* b, int samples) {
+  for (int w = 0; 32 * w < samples; ++w) {
+    const int n = samples - 32 * w;
+    const unsigned int valid = n >= 32 ? 0xffffffffU : (1U << n) - 1U;
+    if ((a[w] | b[w]) != valid) return 0;
+  }
+  return 1;
+}
+
+__kernel void region_bitmask_bits(__global const float* h, __global const float* pyramid, int levels,
+                                  float margin, float gradient, int finite_field, float field_top,
+                                  RegionField f, __global const float* source_points, int samples,
+                                  float light_z, float target_height, __global const unsigned int* table,
+                                  BitmaskTable t, float lo_x, float lo_y, float hi_x, float hi_y, int words,
+                                  int receiver_count, int receiver_major, int first,
+                                  __global unsigned int* bits, __global unsigned int* tested) {
+  const int r = first + (int)get_global_id(0);
+  if (r >= receiver_count) return;
+  const int xi = r % f.width, yi = r / f.width;
+  const float xr = (float)xi, yr = (float)yi, zr = h[r] + target_height;
+  unsigned int outer[32], inner[32], near_open[32], near_hidden[32];
+  for (int w = 0; w < words; ++w) outer[w] = inner[w] = near_open[w] = near_hidden[w] = 0U;
+  const float Z = light_z, dz = Z - zr;
+  // The march's rounding (region_sight_visible_culled's clearance, doubled): a cell whose highest
+  // corner lies this far below a line cannot hide it.
+  const float out_margin = 2.0f * margin + 4e-5f * (fabs(zr) + fabs(Z));
+  // A light plane not above the receiver: every sample left to the march.
+  int all_uncertain = !(dz > 0.0f);
+  if (!isnan(zr) && !all_uncertain) {
+    // The receiver's own cells, per sample: the line's rise over their bilinear surface.
+    for (int s = 0; s < samples; ++s) {
+      const float gx = source_points[3 * s] - xr, gy = source_points[3 * s + 1] - yr;
+      if (gx == 0.0f && gy == 0.0f) continue;  // a vertical line sees
+      const float ax = fabs(gx), ay = fabs(gy);
+      const float pixels = fmax(ax, ay);
+      const float in_margin = out_margin + 1.5e-3f * (1.5f * gradient + dz / pixels);
+      int open = 0, hidden = 0;
+      // The cell toward the sample along each axis (both on a line along the axis).
+      for (int sx = gx > 0.0f ? 1 : -1; sx <= (gx < 0.0f ? -1 : 1); sx += 2)
+        for (int sy = gy > 0.0f ? 1 : -1; sy <= (gy < 0.0f ? -1 : 1); sy += 2) {
+          if (xi + sx < 0 || xi + sx >= f.width || yi + sy < 0 || yi + sy >= f.height) continue;
+          const float h10 = h[r + sx], h01 = h[r + sy * f.width], h11 = h[r + sx + sy * f.width];
+          if (!isfinite(h10) || !isfinite(h01) || !isfinite(h11)) {
+            open = 1;
+            continue;
+          }
+          float most, surely;
+          region_bitmask_near(h[r], h10, h01, h11, zr, ax, ay, dz, &most, &surely);
+          open = open || most > -out_margin;
+          hidden = hidden || surely > in_margin;
+        }
+      if (hidden)
+        near_hidden[s / 32] |= 1U << (s % 32);
+      else if (open)
+        near_open[s / 32] |= 1U << (s % 32);
+    }
+    // The farther cells: the pyramid's blocks over the footprint (the box around the receiver
+    // and the light), each left out when its highest point lies below the lowest any line can
+    // be over it (the receiver's height plus the shallowest slope to the light times the
+    // block's distance), by the march's rounding.
+    float dmax = 0.0f, pmin = 0.0f;
+    for (int c = 0; c < 4; ++c) {
+      const float gx = ((c & 1) ? hi_x : lo_x) - xr, gy = ((c & 2) ? hi_y : lo_y) - yr;
+      dmax = fmax(dmax, sqrt(gx * f.cell_x * gx * f.cell_x + gy * f.cell_y * gy * f.cell_y));
+    }
+    pmin = fmax(fmax(lo_x - xr, xr - hi_x), fmax(lo_y - yr, yr - hi_y));
+    const float in_margin = pmin > 0.0f ? out_margin + 1.5e-3f * (1.5f * gradient + dz / pmin) : INFINITY;
+    const float slope = dz / dmax;
+    // Front faces culled only under a light above every point of the surfaces (the field's
+    // highest plus the rounding).
+    const int light_above = Z > field_top + 2.0f * out_margin;
+    const float fx0 = fmin(xr, lo_x), fx1 = fmax(xr, hi_x), fy0 = fmin(yr, lo_y), fy1 = fmax(yr, hi_y);
+    float wedge[4];
+    const int wedged = region_wedge(xr, yr, lo_x, lo_y, hi_x, hi_y, wedge);
+    int stack_k[64], stack_x[64], stack_y[64], top = 0;
+    const int last = levels - 1;  // (no pyramid: no cells, a field one point thick)
+    // (none where the receiver's own cells hide every sample)
+    const int visit = levels > 0 && !region_bitmask_all(near_hidden, near_hidden, samples);
+    for (int by = 0; visit && by < region_cull_width(f.height, last) && !all_uncertain; ++by)
+      for (int bx = 0; bx < region_cull_width(f.width, last); ++bx) {
+        if (top == 64) {
+          all_uncertain = 1;
+          break;
+        }
+        stack_k[top] = last, stack_x[top] = bx, stack_y[top] = by, ++top;
+      }
+    while (top > 0 && !all_uncertain) {
+      --top;
+      const int k = stack_k[top], bx = stack_x[top], by = stack_y[top];
+      const float x0 = (float)(bx << k), y0 = (float)(by << k);
+      const float x1 = fmin((float)((bx + 1) << k), (float)(f.width - 1)),
+                  y1 = fmin((float)((by + 1) << k), (float)(f.height - 1));
+      if (x1 < fx0 || x0 > fx1 || y1 < fy0 || y0 > fy1) continue;
+      if (wedged && region_outside_wedge(xr, yr, wedge, x0, y0, x1, y1)) continue;
+      const float ddx = fmax(0.0f, fmax(x0 - xr, xr - x1)) * f.cell_x,
+                  ddy = fmax(0.0f, fmax(y0 - yr, yr - y1)) * f.cell_y;
+      const float near = sqrt(ddx * ddx + ddy * ddy);
+      const float highest =
+          pyramid[region_cull_offset(f.width, f.height, k) + by * region_cull_width(f.width, k) + bx];
+      if (highest + out_margin < zr + slope * near) continue;
+      if (k > 0) {
+        if (top + 4 > 64) {
+          all_uncertain = 1;
+          break;
+        }
+        // The child nearest the receiver last, so first visited: near cells hide the most
+        // samples, and once every sample is surely hidden the visit stops.
+        const int child = 1 << (k - 1);
+        const int nearest = (xr >= (float)((2 * bx + 1) * child)) | (yr >= (float)((2 * by + 1) * child))
+                                                                        << 1;
+        for (int c = 3; c >= 0; --c) {
+          const int q = c ^ nearest, cx = 2 * bx + (q & 1), cy = 2 * by + (q >> 1);
+          if (cx < region_cull_width(f.width, k - 1) && cy < region_cull_width(f.height, k - 1))
+            stack_k[top] = k - 1, stack_x[top] = cx, stack_y[top] = cy, ++top;
+        }
+        continue;
+      }
+      if (bx >= xi - 1 && bx <= xi && by >= yi - 1 && by <= yi) continue;  // the receiver's own
+      if (isinf(highest)) {
+        all_uncertain = 1;  // an infinite height on or beside the cell: no bound
+        break;
+      }
+      // The boxes from the lowest height a line to the light can have over the cell (below it,
+      // a point projects beyond the light's farthest corner), a little lower.
+      const float low = zr + dz * (near / dmax) * 0.999f;
+      const int p = by * f.width + bx;
+      const float h00 = h[p], h10 = h[p + 1], h01 = h[p + f.width], h11 = h[p + f.width + 1];
+      int finite = isfinite(h00) && isfinite(h10) && isfinite(h01) && isfinite(h11);
+      const float twist = h00 - h10 - h01 + h11;
+      // The 4 x 4 heights around the cell finite: the march's values near it are numbers (as
+      // region_cull_hides), and the surfaces below are without holes there.
+      int around = finite;
+      for (int y = (by > 0 ? by - 1 : 0);
+           around && !finite_field && y <= (by + 2 < f.height ? by + 2 : f.height - 1); ++y)
+        for (int x = (bx > 0 ? bx - 1 : 0); x <= (bx + 2 < f.width ? bx + 2 : f.width - 1); ++x)
+          around = around && isfinite(h[y * f.width + x]);
+      const int cull_front = around && light_above;
+      // Outer: the triangulation above the bilinear surface, raised by the march's rounding; a
+      // cell with a nodata corner (only its valid edges are surface), the box under its highest.
+      if (highest + out_margin > low) {
+        if (finite)
+          region_bitmask_cell(x0, y0, h00, h10, h01, h11, out_margin, twist >= 0.0f, cull_front, low, xr, yr,
+                              zr, Z, table, t, words, 1, outer);
+        else
+          region_bitmask_cell(x0, y0, highest, highest, highest, highest, out_margin, 1, 0, low, xr, yr, zr,
+                              Z, table, t, words, 1, outer);
+      }
+      // Inner: the triangulation below it, lowered by the march's rounding and the most its
+      // values change over a piece it skips; only below the light (above it, the prism's points
+      // lie beyond the line's end), where the march's values near the cell are numbers.
+      if (around && highest - in_margin <= Z && highest - in_margin > low) {
+        region_bitmask_cell(x0, y0, h00, h10, h01, h11, -in_margin, twist < 0.0f, cull_front, low, xr, yr, zr,
+                            Z, table, t, words, 0, inner);
+        if (region_bitmask_all(inner, near_hidden, samples)) break;  // nothing left to decide
+      }
+    }
+  }
+  unsigned int uncertain_count = 0U, uncertain_visible = 0U;
+  for (int w = 0; w < words; ++w) {
+    const int end = 32 * w + 32 < samples ? 32 * w + 32 : samples;
+    const unsigned int valid = end - 32 * w == 32 ? 0xffffffffU : (1U << (end - 32 * w)) - 1U;
+    unsigned int word = 0U;
+    if (!isnan(zr)) {
+      const unsigned int hidden = inner[w] | near_hidden[w];
+      const unsigned int uncertain = all_uncertain ? valid : (outer[w] | near_open[w]) & ~hidden & valid;
+      word = all_uncertain ? 0U : ~(outer[w] | near_open[w] | hidden) & valid;
+      for (int i = 0; i < end - 32 * w; ++i) {
+        const int s = 32 * w + i;
+        const float xs = source_points[3 * s], ys = source_points[3 * s + 1], zs = source_points[3 * s + 2];
+        if (f.max_d2 > 0.0f) {  // out of reach: the march's own distance, whichever end first
+          const float gx = fabs(xs - xr) * f.cell_x, gy = (ys - yr) * f.cell_y;
+          if (gx * gx + gy * gy > f.max_d2) {
+            word &= ~(1U << i);
+            continue;
+          }
+        }
+        if (!((uncertain >> i) & 1U)) continue;
+        int blocked_at = -1;
+        ++uncertain_count;
+        if (region_sight_visible_culled(h, f.width, f.height, f.cell_x, f.cell_y, f.curvature, f.max_d2,
+                                        pyramid, levels, margin, 1.0f, 0.0f, 0.0f, 0.0f, xs, ys, zs, xr, yr,
+                                        zr, 0.0f, 0.0f, &blocked_at))
+          word |= 1U << i, ++uncertain_visible;
+      }
+    }
+    bits[receiver_major ? (size_t)r * words + w : (size_t)w * receiver_count + r] = word;
+  }
+  tested[2 * (size_t)r] = uncertain_count;
+  tested[2 * (size_t)r + 1] = uncertain_visible;
 }

@@ -216,6 +216,8 @@ try "arealight sources file with a bad line" "" -- arealight field.exr -o out/o.
 try "arealight source outside the field" "" -- arealight field.exr -o out/o.exr --sources outside_sources.csv
 try "arealight source on nodata" "" -- arealight nan.exr -o out/o.exr --sources nodata_source.csv
 try "arealight viewsheds for a jittered light" "" -- arealight field.exr -o out/o.exr --light 1,1,4,4 --method viewsheds
+try "arealight bitmask for a light above the surface" "" -- arealight field.exr -o out/o.exr --light 1,1,4,4 --method bitmask
+try "arealight bitmask with decorrelation" "" -- arealight field.exr -o out/o.exr --light 1,1,4,4 --absolute --light-height 100 --method bitmask --decorrelate
 try "arealight masks an 8-bit image" "" -- arealight field.exr -o out/o.exr --light 1,1,4,4 --masks out/m.png
 try "arealight light image missing" "" -- arealight field.exr -o out/o.exr --light 1,1,4,4 --light-image absent.exr
 try "arealight light image with two channels" "" -- arealight field.exr -o out/o.exr --light 1,1,4,4 --light-image two_channels.png

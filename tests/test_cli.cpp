@@ -2615,14 +2615,19 @@ TEST_F(Cli, AreaLightBehindAWallIsHiddenAndAgreesWithTheLibrary) {
                 .status,
             0);
   EXPECT_EQ(readBack(out("h.exr")).at(12, 5, 0), 1.0f);
-  // The culled method (the default) and the exact one write the same picture, each naming itself.
-  for (const char* method : {"exact", "culled"})
-    ASSERT_EQ(run("arealight " + shellQuoted(field) + " -o " + shellQuoted(out(std::string(method) + ".exr")) +
-                  " --light 1,2,3,9 --light-height 20 --absolute --method " + method + " -q")
-                  .status,
-              0);
+  // The culled method (the default), the exact one and the bitmask scatter write the same
+  // picture, each naming itself.
+  for (const char* method : {"exact", "culled", "bitmask"})
+    ASSERT_EQ(
+        run("arealight " + shellQuoted(field) + " -o " + shellQuoted(out(std::string(method) + ".exr")) +
+            " --light 1,2,3,9 --light-height 20 --absolute --method " + method + " -q")
+            .status,
+        0);
   const ReadBack exact = readBack(out("exact.exr")), culled = readBack(out("culled.exr"));
   EXPECT_EQ(exact.pixels, culled.pixels);
+  const ReadBack bitmask = readBack(out("bitmask.exr"));
+  EXPECT_EQ(bitmask.pixels, exact.pixels);
+  EXPECT_EQ(bitmask.spec.get_string_attribute("hfvis:method"), "bitmask");
   EXPECT_EQ(exact.spec.get_string_attribute("hfvis:method"), "exact");
   EXPECT_EQ(culled.spec.get_string_attribute("hfvis:method"), "culled");
   EXPECT_EQ(readBack(out("h.exr")).spec.get_string_attribute("hfvis:method"), "culled");
@@ -2817,6 +2822,12 @@ TEST_F(Cli, RegionVisibilityRefusesBadInput) {
   expectFailure(run(light + " --light 1,1,2,2 --samples 0"), 2, "--samples");
   expectFailure(run(light + " --light 1,1,2,2 --method viewsheds"), 2, "grid points");
   expectFailure(run(light + " --light 1,1,1,1 --method viewsheds --decorrelate"), 2, "--decorrelate");
+  // The bitmask method: a planar light (--absolute), shared samples, no curvature, at most 1024.
+  expectFailure(run(light + " --light 1,1,2,2 --method bitmask"), 2, "--absolute");
+  expectFailure(run(light + " --light 1,1,2,2 --absolute --method bitmask --decorrelate"), 2,
+                "--decorrelate");
+  expectFailure(run(light + " --light 1,1,2,2 --absolute --method bitmask --curvature"), 2, "--curvature");
+  expectFailure(run(light + " --light 1,1,2,2 --absolute --method bitmask --samples 1025"), 2, "1024");
   expectFailure(run(light + " --light 1,1,2,2 --light-height -1"), 2, "--light-height");
   expectFailure(run(light + " --light 1,1,2,2 --masks " + shellQuoted(out("m.png"))), 1, "m.png");
   expectFailure(run(light + " --light 1,1,2,2 --masks " + shellQuoted(field)), 2, "input");
@@ -2852,6 +2863,7 @@ TEST_F(Cli, RegionVisibilityRefusesBadInput) {
   expectFailure(run(region + " --from 1,1,2,2"), 2, "missing --to");
   expectFailure(run(region + " --from 1,1,2,2 --to 3,3,4,12"), 2, "--to 3,3,4,12");
   expectFailure(run(region + " --from 1,1,2,2 --to 3,3,4,4 --method viewsheds"), 2, "--method");
+  expectFailure(run(region + " --from 1,1,2,2 --to 3,3,4,4 --method bitmask"), 2, "--method");
   expectFailure(run(region + " --from 1,1,2,2 --to 3,3,4,4 --rays " + shellQuoted(out("r.txt"))), 2, ".csv");
   expectFailure(run("region " + shellQuoted(field) + " -o " + shellQuoted(out("r.exr")) +
                     " --from 1,1,2,2 --to 3,3,4,4"),

@@ -392,6 +392,96 @@ TEST(RegionVisibility, EndTablesCertifyOnlyClearLines) {
   EXPECT_LT(clear, lines * 9 / 10);
 }
 
+// The bitmask scatter (Eisemann & Décoret 2007) decides from its table what its conservative
+// pair of back-projections decides and leaves the rest to the culled march: its bits are the
+// exact march's, bit for bit, in both layouts, on the hard cases (the city's one-pixel walls and
+// towers, flat ground, nodata holes, infinite heights, a cliff of 1e6), lights low over the
+// surface and high above it, receivers on the ground and above it, with a maximum distance and
+// without, for a coarse table and a fine one; and its table decides most bits itself.
+TEST(RegionVisibility, TheBitmaskScatterIsTheExactOne) {
+  std::uint64_t clear = 0, total = 0, tested = 0;
+  std::uint64_t tested_by_size[2] = {0, 0};
+  for (const char* name : {"city", "flat", "noise", "sine", "bowl", "nan_holes", "infinities", "cliff",
+                           "terraces", "spikes", "dome"}) {
+    SCOPED_TRACE(name);
+    HeightField field = makeSyntheticField(name, 61, 47, 5);
+    field.cell_size_y = 1.25;
+    double top = -1e30, bottom = 1e30;
+    for (float v : field.heights)
+      if (std::isfinite(v)) top = std::max(top, double(v)), bottom = std::min(bottom, double(v));
+    forEachLayout([&](const ComputeContext& context) {
+      RegionVisibilityOptions exact, bitmask;
+      exact.method = RegionVisibilityMethod::Exact;
+      bitmask.method = RegionVisibilityMethod::Bitmask;
+      for (double above : {0.5 * (top - bottom) + 0.5, 2.0 + (top - bottom)}) {
+        const RegionSampling light = sourcesIn(field, 72, bottom + above, true);
+        for (int variant = 0; variant < 2; ++variant) {
+          exact.target_height = bitmask.target_height = variant ? 0.5 : 0.0;
+          exact.max_distance = bitmask.max_distance = variant ? 25.0 : 0.0;
+          const RegionVisibilityResult want = computeRegionVisibility(context, field, light, exact);
+          for (int size : {16, 64}) {
+            bitmask.bitmask_table = size;
+            const RegionVisibilityResult got = computeRegionVisibility(context, field, light, bitmask);
+            ASSERT_EQ(got.bits.size(), want.bits.size());
+            for (std::size_t i = 0; i < got.bits.size(); ++i)
+              ASSERT_EQ(got.bits[i], want.bits[i])
+                  << "receiver " << i / got.words << " word " << i % got.words << " table " << size;
+            for (std::size_t p = 0; p < got.fraction.size(); ++p)
+              ASSERT_TRUE(got.fraction[p] == want.fraction[p] ||
+                          (std::isnan(got.fraction[p]) && std::isnan(want.fraction[p])));
+            EXPECT_LE(got.exact_tested_visible, got.exact_tested);
+            tested_by_size[size == 64] += got.exact_tested;
+            if (size == 64) {
+              tested += got.exact_tested;
+              for (std::uint32_t w : got.bits) clear += __builtin_popcount(w);
+              total += got.fraction.size() * 72;
+            }
+          }
+        }
+      }
+    });
+  }
+  // Both answers occur often; the table decides most bits, the march some.
+  EXPECT_GT(clear, total / 10);
+  EXPECT_LT(clear, total * 9 / 10);
+  EXPECT_GT(tested, 0u);
+  EXPECT_LT(tested, total / 2);
+  // A finer table leaves fewer bits to the march.
+  EXPECT_LT(tested_by_size[1], tested_by_size[0]);
+  std::printf("bitmask: %llu of %llu bits left to the march (table 64), %llu (table 16)\n",
+              (unsigned long long)tested, (unsigned long long)total, (unsigned long long)tested_by_size[0]);
+}
+
+// A wall between a light and the ground beyond it: the bitmask method's bits are the exact
+// ones, the far side sees none of the light, the near side all of it; flat ground sees all.
+TEST(RegionVisibility, TheBitmaskScatterBehindAWall) {
+  const int w = 41, h = 23;
+  std::vector<float> heights(w * h, 0.0f);
+  const HeightField open = fieldFrom(w, h, heights);
+  for (int row = 0; row < h; ++row) heights[row * w + 20] = 30.0f;
+  const HeightField walled = fieldFrom(w, h, heights);
+  RegionSampling light;
+  light.rectangle = {2, 1, 12, 21};
+  light.samples = 1024;
+  light.height = 5.0;
+  light.absolute = true;
+  RegionVisibilityOptions exact, bitmask;
+  exact.method = RegionVisibilityMethod::Exact;
+  bitmask.method = RegionVisibilityMethod::Bitmask;
+  forEachLayout([&](const ComputeContext& context) {
+    const RegionVisibilityResult got = computeRegionVisibility(context, walled, light, bitmask);
+    EXPECT_EQ(got.bits, computeRegionVisibility(context, walled, light, exact).bits);
+    for (int row = 0; row < h; ++row) {
+      EXPECT_EQ(got.fraction[row * w + 25], 0.0f) << row;
+      EXPECT_EQ(got.fraction[row * w + 5], 1.0f) << row;
+    }
+    const RegionVisibilityResult flat = computeRegionVisibility(context, open, light, bitmask);
+    for (float f : flat.fraction) ASSERT_EQ(f, 1.0f);
+    // Over flat ground the table decides every bit: nothing rises into the shaft.
+    EXPECT_EQ(flat.exact_tested, 0u);
+  });
+}
+
 TEST(RegionVisibility, AToBIsTheTransposeOfBToA) {
   std::uint64_t clear = 0, pairs = 0;
   for (const char* name : {"city", "noise", "sine", "terraces"}) {
@@ -910,6 +1000,33 @@ TEST(RegionVisibility, BadInputIsRefused) {
   points.points = {{1.0, 2.0, 1.0}};
   refused(points, o, "rectangle");
   EXPECT_THROW(computeRegionPairVisibility(context, field, good, good, o), InvalidArgument);
+  // The bitmask method: a planar light (a rectangle at an absolute height), shared samples, at
+  // most kMaxBitmaskSamples of them, no curvature, every-pixel receivers, a table of 8 .. 1024.
+  o = options;
+  o.method = RegionVisibilityMethod::Bitmask;
+  refused(good, o, "absolute height");
+  RegionSampling plane = good;
+  plane.absolute = true;
+  plane.height = 100.0;
+  EXPECT_NO_THROW(computeRegionVisibility(context, field, plane, o));
+  RegionSampling plane_points = plane;
+  plane_points.points = {{1.0, 2.0, 100.0}, {2.0, 2.0, 100.0}};
+  EXPECT_NO_THROW(computeRegionVisibility(context, field, plane_points, o));
+  plane_points.points[1].height = 101.0;
+  refused(plane_points, o, "one absolute height");
+  plane.samples = kMaxBitmaskSamples + 1;
+  refused(plane, o, "at most");
+  plane.samples = 16;
+  o.decorrelate = true;
+  refused(plane, o, "decorrelation");
+  o.decorrelate = false;
+  o.curvature = 1e-7;
+  refused(plane, o, "curvature");
+  o.curvature = 0.0;
+  o.bitmask_table = 4;
+  refused(plane, o, "table");
+  o.bitmask_table = 64;
+  EXPECT_THROW(computeRegionPairVisibility(context, field, plane, plane, o), InvalidArgument);
   // A region pair checks both regions.
   EXPECT_THROW(computeRegionPairVisibility(context, field, good, s, options), InvalidArgument);
   EXPECT_THROW(computeRegionPairVisibility(context, field, s, good, options), InvalidArgument);

@@ -26,6 +26,7 @@ constexpr int kMaskBitsPerChannel = 16;
 std::string methodName(RegionVisibilityMethod method) {
   return method == RegionVisibilityMethod::Viewsheds ? "viewsheds"
          : method == RegionVisibilityMethod::Culled  ? "culled"
+         : method == RegionVisibilityMethod::Bitmask ? "bitmask"
                                                      : "exact";
 }
 
@@ -352,6 +353,24 @@ void checkAreaLight(const std::string&, const RunArguments& run) {
           "--method viewsheds needs the light's samples on grid points: a one-pixel --light or --sources "
           "FILE.csv (a larger rectangle's samples are jittered between them); or --method exact or culled");
   }
+  if (run.region_method == RegionVisibilityMethod::Bitmask) {
+    if (!run.absolute)
+      throw UsageError(
+          "--method bitmask needs a planar light: --absolute (a --light rectangle at one height, or "
+          "--sources "
+          "points all at one height); or --method exact or culled");
+    if (run.decorrelate)
+      throw UsageError(
+          "--decorrelate needs --method exact or culled (the bitmask method shares the samples)");
+    if (run.curvature)
+      throw UsageError(
+          "--curvature and --refraction need --method exact or culled (the bitmask method's "
+          "back-projections are straight)");
+    if (run.region_samples > kMaxBitmaskSamples)
+      throw UsageError("--method bitmask takes at most " + std::to_string(kMaxBitmaskSamples) +
+                       " samples (got " + std::to_string(run.region_samples) +
+                       "); or --method exact or culled");
+  }
   if (!run.masks_output.empty() && samePath(run.output, run.masks_output))
     throw UsageError("--masks must differ from -o, both are " + inQuotes(run.output));
   asUsageError([&] { validate(regionVisibilityOptions(run)); });
@@ -367,10 +386,11 @@ void checkRegion(const std::string&, const RunArguments& run) {
   if (!run.rays_output.empty() && !hasExtension(run.rays_output, ".csv"))
     throw UsageError("--rays: the rays are written as CSV; the name must end in .csv, got " +
                      inQuotes(run.rays_output));
-  if (run.region_method == RegionVisibilityMethod::Viewsheds)
-    throw UsageError(
-        "--method viewsheds is for 'hfvis arealight' (every pixel a receiver); region pairs take --method "
-        "exact or culled");
+  if (run.region_method == RegionVisibilityMethod::Viewsheds ||
+      run.region_method == RegionVisibilityMethod::Bitmask)
+    throw UsageError("--method " + methodName(run.region_method) +
+                     " is for 'hfvis arealight' (every pixel a receiver); region pairs take --method "
+                     "exact or culled");
   requireAboveSurface(run, "--from-height", run.from_height);
   requireAboveSurface(run, "--to-height", run.to_height);
   asUsageError([&] { validate(regionVisibilityOptions(run)); });
@@ -384,7 +404,8 @@ const CommandSpec kAreaLightCommand{
     nullptr,
     "\"visible\": the fraction (0..1) of an area light's samples each pixel sees",
     "IN -o OUT.exr|OUT.tif (--light C0,R0,C1,R1 [--light-height H] | --sources FILE.csv)\n"
-    "[--absolute] [--samples N] [--target-height T] [--decorrelate] [--method exact|culled|viewsheds]\n"
+    "[--absolute] [--samples N] [--target-height T] [--decorrelate]\n"
+    "[--method exact|culled|viewsheds|bitmask]\n"
     "[--seed N] [--light-image RGB.exr] [--max-distance D] [--curvature] [--refraction K]\n"
     "[--masks MASKS.exr] [--preview P.png] [options]",
     "Region visibility with every pixel a receiver (Eisemann & Decoret 2007's sampled\n"
@@ -405,10 +426,14 @@ const CommandSpec kAreaLightCommand{
     "--masks FILE (.exr or .tif) also writes which samples each pixel sees, losslessly: float32\n"
     "channels m000, m001, ..., channel k holding samples 16k .. 16k+15 as the whole number sum\n"
     "of 2^b over each visible sample 16k+b (0 .. 65535, exact in float32; NaN at nodata).\n"
-    "--method exact (default) marches one sight line per pixel and sample; --method viewsheds\n"
-    "runs one viewshed per sample, for samples on grid points (a one-pixel --light, --sources\n"
-    "with whole columns and rows), not with --decorrelate; it may decide grazing lines the other\n"
-    "way. A light outside the field, or on nodata, is an error.\n"
+    "--method exact marches one sight line per pixel and sample, culled (default) the same\n"
+    "lines leaping over low blocks; --method viewsheds runs one viewshed per sample, for\n"
+    "samples on grid points (a one-pixel --light, --sources with whole columns and rows), not\n"
+    "with --decorrelate; it may decide grazing lines the other way. --method bitmask (a --light\n"
+    "at an --absolute height, at most 1024 samples, no --decorrelate or --curvature) scatters\n"
+    "the cells' back-projections onto the light's plane through a table of edge bitmasks and\n"
+    "marches only the samples it leaves undecided: the exact bits. A light outside the field,\n"
+    "or on nodata, is an error.\n"
     "--light-image FILE (an EXR or any image hfvis reads; R, G, B, or one grey channel) colours\n"
     "the --light rectangle (Eisemann & Decoret 2007's textured light): the image stretched over\n"
     "it, row 0 along the lowest row, each sample taking the image's bilinear colour at its own\n"

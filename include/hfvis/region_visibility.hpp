@@ -34,11 +34,11 @@
 // Methods: the exact one, one line-of-sight march per (receiver, source sample) pair on the
 // device (kernels/region_visibility.cl): O(receivers * S * (W + H)); the same march culled by a
 // max pyramid (the default: the same bits, sooner); one viewshed per source sample, for sources
-// on grid points (RegionVisibilityMethod::Viewsheds). Eisemann & Décoret's bitmask scatter
-// (occluders back-projected onto a planar source through a table of edge bitmasks) is not
-// built: its polygonal back-projections decide on a triangulated surface, not on this bilinear
-// one, and differ from the exact bits beyond the table's resolution (bench/report/
-// region_visibility.md gives the measurements behind the choice).
+// on grid points (RegionVisibilityMethod::Viewsheds); Eisemann & Décoret's bitmask scatter for
+// a planar light (RegionVisibilityMethod::Bitmask: the cells back-projected onto the light's
+// plane through a table of edge bitmasks, a conservative pair per cell, the samples between the
+// pair decided by the culled march, so the bits are the exact method's).
+// bench/report/region_visibility.md compares their speed.
 #pragma once
 
 #include <cstdint>
@@ -52,6 +52,8 @@ namespace hfvis {
 
 // The most samples on either side of a region visibility (the bitmasks' bits).
 constexpr int kMaxRegionSamples = 4096;
+// The most source samples of the bitmask method (a work-item's masks in private memory).
+constexpr int kMaxBitmaskSamples = 1024;
 
 // A rectangle of grid points, corners included, in any order.
 struct PixelRectangle {
@@ -88,6 +90,22 @@ enum class RegionVisibilityMethod {
   // rounding, resuming where the segment leaves the block in the march's own state, so its bits
   // are the exact method's, bit for bit, at a fraction of the steps.
   Culled,
+  // The bitmask scatter of Eisemann & Décoret (2007) for a planar light (a rectangle at an
+  // absolute height, or points all at one absolute height; shared samples, at most
+  // kMaxBitmaskSamples, every-pixel receivers, no curvature: InvalidArgument
+  // otherwise): per receiver, every cell that may reach the shaft to the light (a max pyramid's
+  // blocks below it left out) is back-projected from the receiver onto the light's plane, and
+  // the samples inside come from a table of edge bitmasks (RegionVisibilityOptions::
+  // bitmask_table), ANDed per edge and ORed over the cells. The bilinear cell's back-projection
+  // has curved edges, so each cell gives two pairs of polygons: the prisms under the
+  // triangulation above the surface (raised by the march's rounding) hold every sample the cell
+  // may hide, those under the one below it (lowered) only samples it surely hides; triangles the
+  // receiver lies above are culled under a light above the whole surface (the terrain is closed
+  // from above); the receiver's own four cells are decided per sample along the line. The
+  // samples between (and within the table's resolution of an edge) are decided by the culled
+  // march: the bits are the exact method's, bit for bit; RegionVisibilityResult::exact_tested
+  // counts them.
+  Bitmask,
 };
 
 // A textured light (Eisemann & Décoret 2007, Sec. 8: colours over the source): an RGB image
@@ -115,6 +133,9 @@ struct RegionVisibilityOptions {
   std::function<void(int, int)> progress;
   // With an image: the result's red, green, blue (rectangle sources and every-pixel receivers).
   LightImage light_image;
+  // The bitmask method's table: edge angles and offsets each (8 .. 1024); finer, fewer samples
+  // left to the march, a larger table (angles * (offsets + 1) * ceil(S / 32) words).
+  int bitmask_table = 64;
 };
 
 // Per receiver a bitmask of the source samples it sees: bit s % 32 of word s / 32 (words per
@@ -130,6 +151,10 @@ struct RegionVisibilityResult {
   // light's mean colour where it sees every sample); NaN at nodata. Decorrelated, each
   // receiver's samples lie where its own jitter put them, and so do their colours.
   std::vector<float> red, green, blue;
+  // The bitmask method's (else 0): the bits its table left undecided, decided by the culled
+  // march, and how many of those it found visible (a table alone would get one or the other of
+  // the two counts wrong, by its choice of side).
+  std::uint64_t exact_tested = 0, exact_tested_visible = 0;
   // Receiver p's sample s is visible.
   bool visible(std::size_t p, int s) const { return (bits[p * words + s / 32] >> (s % 32)) & 1u; }
 };

@@ -50,6 +50,59 @@ void validateField(const HeightField& field) {
 
 int popcount(std::uint32_t v) { return __builtin_popcount(v); }
 
+// The kernel's BitmaskTable struct.
+struct DeviceBitmaskTable {
+  cl_float centre_x, centre_y, rho;
+  cl_int angles, offsets;
+};
+
+// The bitmask method's table (kernels/region_visibility.cl, BitmaskTable): per edge angle i and
+// offset j, the samples p with n_i . (p - centre) >= c_j, decided in double (the kernel's lookups
+// allow for the table's own resolution around it).
+struct BitmaskTable {
+  DeviceBitmaskTable shape{};
+  float lo_x = 0, lo_y = 0, hi_x = 0, hi_y = 0;  // the samples' bounding box
+  std::vector<std::uint32_t> masks;
+};
+
+BitmaskTable bitmaskTable(const std::vector<float>& points, int size) {
+  BitmaskTable t;
+  const int samples = static_cast<int>(points.size() / 3), words = (samples + 31) / 32;
+  t.lo_x = t.hi_x = points[0], t.lo_y = t.hi_y = points[1];
+  for (int s = 0; s < samples; ++s) {
+    t.lo_x = std::min(t.lo_x, points[3 * s]), t.hi_x = std::max(t.hi_x, points[3 * s]);
+    t.lo_y = std::min(t.lo_y, points[3 * s + 1]), t.hi_y = std::max(t.hi_y, points[3 * s + 1]);
+  }
+  const double cx = 0.5 * (double(t.lo_x) + t.hi_x), cy = 0.5 * (double(t.lo_y) + t.hi_y);
+  double rho = 0.0;
+  for (int s = 0; s < samples; ++s)
+    rho = std::max(rho, std::hypot(points[3 * s] - cx, points[3 * s + 1] - cy));
+  // Slightly larger, and never 0 (a one-point light), so that offset 0 holds every sample.
+  rho = rho * (1.0 + 1e-5) + 1e-5 * (1.0 + std::fabs(cx) + std::fabs(cy));
+  t.shape = {static_cast<float>(cx), static_cast<float>(cy), static_cast<float>(rho), size, size};
+  t.masks.assign(std::size_t(size) * (size + 1) * words, 0u);
+  const double pi = std::acos(-1.0);
+  for (int i = 0; i < size; ++i) {
+    const double nx = std::cos(2.0 * pi * i / size), ny = std::sin(2.0 * pi * i / size);
+    for (int s = 0; s < samples; ++s) {
+      const double along = nx * (points[3 * s] - double(t.shape.centre_x)) +
+                           ny * (points[3 * s + 1] - double(t.shape.centre_y));
+      // Inside for offsets c_j = -rho + 2 rho j / size <= along.
+      for (int j = 0; j <= size && -double(t.shape.rho) + 2.0 * t.shape.rho * j / size <= along; ++j)
+        t.masks[(std::size_t(i) * (size + 1) + j) * words + s / 32] |= 1u << (s % 32);
+    }
+  }
+  return t;
+}
+
+// The highest finite height (z-scaled; -infinity if none).
+float fieldTop(const std::vector<float>& heights) {
+  float top = -std::numeric_limits<float>::infinity();
+  for (const float v : heights)
+    if (std::isfinite(v)) top = std::max(top, v);
+  return top;
+}
+
 // The bits of `count` receivers from the device, receiver-major: one routine item per launch
 // of up to kWordsPerLaunch / words receivers (a work-item marches all its receiver's words:
 // a launch's work stays bounded whatever S).
@@ -72,6 +125,8 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
         words_((samples_ + 31) / 32) {}
 
   std::vector<std::uint32_t> bits;  // after run(): receiver-major
+  // After run(), the bitmask method's: bits the march decided, and of those visible.
+  std::uint64_t exact_tested = 0, exact_tested_visible = 0;
 
  private:
   // The viewshed's heights (z-scaled, from 0), so both decide the same sight lines: the caller's,
@@ -104,7 +159,8 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
                              static_cast<float>(options_.curvature),
                              options_.max_distance > 0.0 ? static_cast<float>(max_d2) : 0.0f};
     bool probed_clear = false;
-    if (options_.method == RegionVisibilityMethod::Culled) {
+    const bool bitmask = options_.method == RegionVisibilityMethod::Bitmask;
+    if (options_.method == RegionVisibilityMethod::Culled || bitmask) {
       const detail::CullPyramid pyramid = detail::cullPyramid(prepared_.heights, field_.width, field_.height);
       levels_ = pyramid.levels;
       margin_ = pyramid.margin;
@@ -156,6 +212,36 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
       };
       if (certify_sources_) source_records_ = records(true, samples_, source_absolute_, box(*receivers_));
       if (certify_receivers_) receiver_records_ = records(false, count_, receiver_absolute_, box(sources_));
+    }
+    if (bitmask) {
+      const BitmaskTable table = bitmaskTable(source_points_, options_.bitmask_table);
+      table_ = upload(table.masks);
+      tested_ = detail::deviceBuffer(st_, std::size_t(count_) * 2 * sizeof(cl_uint));
+      kernel_ = kernel("region_bitmask_bits");
+      kernel_.set("h", heights_)
+          .set("pyramid", levels_ > 0 ? pyramid_ : heights_)
+          .set("levels", cl_int(levels_))
+          .set("margin", margin_)
+          .set("gradient", gradient_)
+          .set("finite_field", cl_int(finite_))
+          .set("field_top", fieldTop(prepared_.heights))
+          .set("f", device)
+          .set("source_points", source_points_buffer_)
+          .set("samples", cl_int(samples_))
+          .set("light_z", source_points_[2])
+          .set("target_height", static_cast<float>(options_.target_height))
+          .set("table", table_)
+          .set("t", table.shape)
+          .set("lo_x", table.lo_x)
+          .set("lo_y", table.lo_y)
+          .set("hi_x", table.hi_x)
+          .set("hi_y", table.hi_y)
+          .set("words", cl_int(words_))
+          .set("receiver_count", cl_int(count_))
+          .set("receiver_major", cl_int(receiver_major_))
+          .set("bits", bits_)
+          .set("tested", tested_);
+      return;
     }
     kernel_ = kernel("region_visibility_bits");
     kernel_.set("h", heights_)
@@ -224,6 +310,12 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
     const std::size_t entries = static_cast<std::size_t>(count_) * words_;
     std::vector<std::uint32_t> out(entries);
     st_.queue.enqueueReadBuffer(bits_, CL_TRUE, 0, entries * sizeof(std::uint32_t), out.data());
+    if (options_.method == RegionVisibilityMethod::Bitmask) {
+      std::vector<cl_uint> tested(std::size_t(count_) * 2);
+      st_.queue.enqueueReadBuffer(tested_, CL_TRUE, 0, tested.size() * sizeof(cl_uint), tested.data());
+      for (std::size_t i = 0; i < tested.size(); i += 2)
+        exact_tested += tested[i], exact_tested_visible += tested[i + 1];
+    }
     if (receiver_major_) {
       bits = std::move(out);
       return;
@@ -248,7 +340,7 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
   bool finite_ = false;
   bool certify_sources_ = false, certify_receivers_ = false;  // per-end tables (culled only)
   cl::Buffer source_table_, source_points_buffer_, receiver_table_, bits_, pyramid_, source_records_,
-      receiver_records_;
+      receiver_records_, table_, tested_;
   detail::NamedKernel kernel_;
 };
 
@@ -256,11 +348,16 @@ std::vector<std::uint32_t> runBits(const ComputeContext& context, const HeightFi
                                    detail::PreparedHeights heights, const std::vector<float>& sources,
                                    const std::vector<float>& source_points, bool source_absolute,
                                    const std::vector<float>* receivers, bool receiver_absolute, int count,
-                                   const RegionVisibilityOptions& options) {
+                                   const RegionVisibilityOptions& options,
+                                   RegionVisibilityResult* tested = nullptr) {
   return detail::translateOpenClErrors([&] {
     RegionBitsRoutine routine(detail::stateOf(context), field, std::move(heights), sources, source_points,
                               source_absolute, receivers, receiver_absolute, count, options);
     routine.run();
+    if (tested) {
+      tested->exact_tested = routine.exact_tested;
+      tested->exact_tested_visible = routine.exact_tested_visible;
+    }
     return std::move(routine.bits);
   });
 }
@@ -530,8 +627,12 @@ void validate(const RegionVisibilityOptions& options) {
             std::to_string(i % plane / image.width) + " holds " + std::to_string(image.rgb[i]));
   }
   if (options.method != RegionVisibilityMethod::Exact &&
-      options.method != RegionVisibilityMethod::Viewsheds && options.method != RegionVisibilityMethod::Culled)
+      options.method != RegionVisibilityMethod::Viewsheds &&
+      options.method != RegionVisibilityMethod::Culled && options.method != RegionVisibilityMethod::Bitmask)
     throw InvalidArgument("unknown region visibility method");
+  if (options.bitmask_table < 8 || options.bitmask_table > 1024)
+    throw InvalidArgument("the bitmask table takes 8 .. 1024 angles and offsets (got " +
+                          std::to_string(options.bitmask_table) + ")");
 }
 
 void validate(const HeightField& field, const RegionSampling& sampling) {
@@ -588,6 +689,23 @@ RegionVisibilityResult computeRegionVisibility(const ComputeContext& context, co
   const bool coloured = options.light_image.width > 0;
   if (coloured && !sources.points.empty())
     throw InvalidArgument("a light image lies over a rectangle light, not over explicit points");
+  if (options.method == RegionVisibilityMethod::Bitmask) {
+    // Its occluders are back-projected onto one plane, through one table of the shared samples.
+    bool planar = sources.absolute;
+    for (const RegionPoint& p : sources.points) planar = planar && p.height == sources.points[0].height;
+    if (!planar)
+      throw InvalidArgument(
+          "the bitmask method takes a planar light: a rectangle at an absolute height (--absolute), or "
+          "points all at one absolute height; not heights above the surface");
+    if (options.decorrelate)
+      throw InvalidArgument("the bitmask method takes shared samples (no decorrelation): one table of them");
+    if (options.curvature != 0.0)
+      throw InvalidArgument("the bitmask method takes no curvature: its back-projections are straight lines");
+    const std::size_t samples = sources.points.empty() ? std::size_t(sources.samples) : sources.points.size();
+    if (samples > std::size_t(kMaxBitmaskSamples))
+      throw InvalidArgument("the bitmask method takes at most " + std::to_string(kMaxBitmaskSamples) +
+                            " samples (got " + std::to_string(samples) + ")");
+  }
   const std::vector<float> table = detail::regionSampleTable(field, sources);
   detail::PreparedHeights prepared = detail::prepareHeights(field, detail::HeightOrigin::Zero);
   const std::vector<float>& heights = prepared.heights;
@@ -602,7 +720,7 @@ RegionVisibilityResult computeRegionVisibility(const ComputeContext& context, co
     out.bits = viewshedBits(context, field, regionPoints(points), options);
   else
     out.bits = runBits(context, field, std::move(prepared), table, points, sources.absolute, nullptr, false,
-                       count, options);
+                       count, options, &out);
   out.fraction.resize(field.pixelCount());
   for (int p = 0; p < count; ++p) {
     int seen = 0;
@@ -622,8 +740,11 @@ RegionPairVisibilityResult computeRegionPairVisibility(const ComputeContext& con
                                                        const RegionVisibilityOptions& options) {
   validateField(field);
   validate(options);
-  if (options.method == RegionVisibilityMethod::Viewsheds)
-    throw InvalidArgument("the viewsheds method takes every-pixel receivers, not a region pair");
+  if (options.method == RegionVisibilityMethod::Viewsheds ||
+      options.method == RegionVisibilityMethod::Bitmask)
+    throw InvalidArgument(std::string("the ") +
+                          (options.method == RegionVisibilityMethod::Bitmask ? "bitmask" : "viewsheds") +
+                          " method takes every-pixel receivers, not a region pair");
   if (options.light_image.width > 0)
     throw InvalidArgument("a light image colours every-pixel receivers, not a region pair");
   const std::vector<float> source_table = detail::regionSampleTable(field, sources);
