@@ -100,7 +100,7 @@ constexpr const char* kUsage =
     "                                      [--samples N] [--seed S] RASTER...\n"
     "       hfvis_bench viewshed-culling [--levels 1,2,3,4] [--reps N] FIELD...\n"
     "       hfvis_bench error-target [--data DIR] [--dem FILE] [--size N] [--errors E,...] [--contents A,B]\n"
-    "                                [--reference-k K] [--reps N] [--curve KMAX]\n"
+    "                                [--reference-k K] [--reps N] [--tile T] [--curve KMAX]\n"
     "       hfvis_bench pvs-rays [--size N] [--rays R] [--reps K] [--dem FILE] FIELD...\n"
     "       hfvis_bench pvs-recall [--size N] [--view-cell C] [--tile T] [--samples N,N,...]\n"
     "                              [--check-rays R] [--methods agvs,sgvs,per-cell] [--reference yes|no]\n"
@@ -526,6 +526,8 @@ int main(int argc, char** argv) {
       const int reference = std::stoi(args.get("--reference-k", "2048"));
       const int reps = std::stoi(args.get("--reps", "3"));
       const int curve = std::stoi(args.get("--curve", "0"));
+      const int tile = std::stoi(args.get("--tile", std::to_string(HorizonOptions{}.error_tile)));
+      if (tile < 1) throw Usage("error-target: --tile is a number of pixels");
       const std::vector<std::string> names =
           textList(args.get("--contents", "fractal,bricks,sine,blocks,city_dsm,dem,mixed"));
       args.rejectUnused();
@@ -552,7 +554,7 @@ int main(int argc, char** argv) {
         return 0;
       }
       errorTargetReport(ComputeContext::create(ContextOptions::fromEnvironment()), fields, errors, reference,
-                        reps);
+                        reps, tile);
       return 0;
     }
     if (command == "check-truth") return checkTruth();

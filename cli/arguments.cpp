@@ -426,9 +426,11 @@ const std::vector<OptionSpec>& optionTable() {
        "choose K for this error instead of taking -k: the 99th percentile over\n"
        "the pixels of the error estimate (see --error-out) at most E, in the\n"
        "output's unit (absolute: 0 < E < 1); a first run at 16 directions\n"
-       "predicts the K needed, refused when beyond 4096; the K chosen and the\n"
-       "estimate go into the summary and the hfvis:directions and\n"
-       "hfvis:estimated_error attributes",
+       "predicts the K needed, refused when beyond 4096; tiles of 32 x 32\n"
+       "pixels whose estimate exceeds E are run again at their own K; the\n"
+       "largest K and the estimate go into the summary and the hfvis:directions\n"
+       "and hfvis:estimated_error attributes (hfvis:directions_range: the least\n"
+       "and most K; --error-out's channel directions: each pixel's)",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
          run.max_error = parseNumber(typed, value);
          if (!(run.max_error > 0.0 && run.max_error < 1.0))

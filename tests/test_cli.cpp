@@ -699,15 +699,25 @@ TEST_F(Cli, MaxErrorWritesTheChosenKAndTheEstimate) {
   ASSERT_NE(lib.directions, 64);  // (else the attribute could not tell -k's default from the K run)
   EXPECT_NE(r.out.find(std::to_string(lib.directions) + " directions"), std::string::npos) << r.out;
   const ReadBack svf = readBack(out("s.exr")), estimate = readBack(out("e.exr"));
-  ASSERT_EQ(estimate.channels, (std::vector<std::string>{"error"}));
+  ASSERT_EQ(estimate.channels, (std::vector<std::string>{"error", "directions"}));
   ASSERT_EQ(svf.pixels.size(), lib.values.size());
-  ASSERT_EQ(estimate.pixels.size(), lib.error_estimate.size());
+  ASSERT_EQ(estimate.pixels.size(), 2 * lib.error_estimate.size());
+  hfvis::HorizonOutputs svf_only;
+  svf_only.sky_view_factor = true;
+  const std::vector<int> taken =
+      hfvis::computeHorizons(hfvis::testing::testContext(), hfvis::readHeightField(field), options, svf_only)
+          .pixel_directions;
+  ASSERT_EQ(taken.size(), lib.values.size());
   for (std::size_t p = 0; p < lib.values.size(); ++p) {
     ASSERT_EQ(svf.pixels[p], lib.values[p]) << p;
-    ASSERT_EQ(estimate.pixels[p], lib.error_estimate[p]) << p;
+    ASSERT_EQ(estimate.pixels[2 * p], lib.error_estimate[p]) << p;
+    ASSERT_EQ(estimate.pixels[2 * p + 1], static_cast<float>(taken[p])) << p;
   }
+  const auto [least, most] = std::minmax_element(taken.begin(), taken.end());
   for (const ReadBack* image : {&svf, &estimate}) {
     EXPECT_EQ(image->spec.get_string_attribute("hfvis:directions"), std::to_string(lib.directions));
+    EXPECT_EQ(image->spec.get_string_attribute("hfvis:directions_range"),
+              std::to_string(*least) + ".." + std::to_string(*most));
     EXPECT_EQ(image->spec.get_string_attribute("hfvis:max_error"), "0.02");
     EXPECT_NEAR(std::stod(image->spec.get_string_attribute("hfvis:estimated_error")), lib.estimated_error,
                 1e-9);
