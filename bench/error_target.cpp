@@ -82,10 +82,13 @@ void errorTargetReport(const ComputeContext& context, const std::vector<ErrorTar
   for (const Output& output : kOutputs) {
     std::printf("\n### %s\n\n", output.name);
     std::printf(
-        "| field | E | whole field: runs (K) | estimate | achieved p99 | met | tiles of %d: K (runs) | estimate | "
-        "achieved p99 | met | cheapest fixed K | its p99 | time whole (s) | time tiles (s) | time fixed (s) | "
+        "| field | E | whole field: runs (K) | estimate | achieved p99 | met | tiles of %d: K (runs) | "
+        "estimate | "
+        "achieved p99 | met | cheapest fixed K | its p99 | time whole (s) | time tiles (s) | time fixed (s) "
+        "| "
         "time ratio whole | time ratio tiles | work ratio whole | last run's | work ratio tiles |\n"
-        "|---|---:|---:|---:|---:|---|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+        "|---|---:|---:|---:|---:|---|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+        "\n",
         tile);
     int met = 0, tiles_met = 0, rows = 0;
     std::vector<double> ratios, tile_ratios, works, last_works, tile_works;
@@ -160,14 +163,15 @@ void errorTargetReport(const ComputeContext& context, const std::vector<ErrorTar
           tile_works.push_back(tile_work);
         }
         std::printf(
-            "| %s | %g | %s | %.5f | %.5f | %s | %s | %.5f | %.5f | %s | %s | %.5f | %s | %s | %s | %s | %s | %.2f | "
+            "| %s | %g | %s | %.5f | %.5f | %s | %s | %.5f | %.5f | %s | %s | %.5f | %s | %s | %s | %s | %s "
+            "| %.2f | "
             "%.2f | %.2f |\n",
-            f.name.c_str(), E, runs.c_str(), result.estimated_error, achieved, achieved <= E ? "yes" : "**no**",
-            tile_runs.c_str(), refined.estimated_error, tiles_achieved, tiles_achieved <= E ? "yes" : "**no**",
-            cheapest ? std::to_string(cheapest).c_str() : "none", cheapest ? errorAt(cheapest) : 0.0,
-            time(t_whole).c_str(), time(t_tiles).c_str(), time(t_fixed).c_str(),
-            reps ? formatted("%.2f", ratio).c_str() : "-", reps ? formatted("%.2f", tile_ratio).c_str() : "-", work,
-            last_work, tile_work);
+            f.name.c_str(), E, runs.c_str(), result.estimated_error, achieved,
+            achieved <= E ? "yes" : "**no**", tile_runs.c_str(), refined.estimated_error, tiles_achieved,
+            tiles_achieved <= E ? "yes" : "**no**", cheapest ? std::to_string(cheapest).c_str() : "none",
+            cheapest ? errorAt(cheapest) : 0.0, time(t_whole).c_str(), time(t_tiles).c_str(),
+            time(t_fixed).c_str(), reps ? formatted("%.2f", ratio).c_str() : "-",
+            reps ? formatted("%.2f", tile_ratio).c_str() : "-", work, last_work, tile_work);
         std::fflush(stdout);
       }
     }
@@ -177,11 +181,14 @@ void errorTargetReport(const ComputeContext& context, const std::vector<ErrorTar
                        : formatted("median %.2f", median(v)) + formatted(", largest %.2f", v.back());
     };
     std::printf(
-        "\n%s: achieved error at most E in %d of %d cases (%.0f %%) with the whole field at one K, in %d with "
-        "tiles of %d; over the cheapest fixed K: the whole field's time %s, work %s, its last run's work alone "
+        "\n%s: achieved error at most E in %d of %d cases (%.0f %%) with the whole field at one K, in %d "
+        "with "
+        "tiles of %d; over the cheapest fixed K: the whole field's time %s, work %s, its last run's work "
+        "alone "
         "%s; the tiles' time %s, work %s\n",
         output.name, met, rows, rows ? 100.0 * met / rows : 0.0, tiles_met, tile, spread(ratios).c_str(),
-        spread(works).c_str(), spread(last_works).c_str(), spread(tile_ratios).c_str(), spread(tile_works).c_str());
+        spread(works).c_str(), spread(last_works).c_str(), spread(tile_ratios).c_str(),
+        spread(tile_works).c_str());
   }
 }
 

@@ -7,7 +7,7 @@
 # that field, timed interleaved (`hfvis_bench error-target`, library calls).
 # Writes bench/report/error_target.md (or --out FILE).
 #
-#   bench/error_target.sh [--size 128] [--errors 0.001,...,0.05] [--reference-k 2048] [--reps 3] [--tile 32]
+#   bench/error_target.sh [--size 128] [--errors 0.001,...,0.05] [--reference-k 2048] [--reps 3] [--tile 64]
 #                         [--contents fractal,...,mixed] [--out FILE]
 #     (--reps 0: no timing, the load-free work ratio alone; --tile: the refined runs' tiles,
 #     HorizonOptions::error_tile, beside the whole field at one K)
@@ -21,7 +21,7 @@ size=128
 errors=0.001,0.002,0.005,0.01,0.02,0.05
 reference=2048
 reps=3
-tile=32
+tile=64
 contents=fractal,bricks,sine,blocks,city_dsm,dem,mixed
 out=$root/bench/report/error_target.md
 curve=0

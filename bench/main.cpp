@@ -536,6 +536,19 @@ int main(int argc, char** argv) {
         const auto content = [&](const std::string& which) {
           return crop(loadContent(options, which, 256).field, n, n);
         };
+        if (name == "city_plain" || name == "town") {
+          // An open plain beside a city: the city DSM with all but its left half (city_plain) or
+          // its top-left quarter (town) levelled at its lowest height; the plain's pixels still see
+          // the buildings.
+          HeightField plain = content("city_dsm");
+          const float ground = *std::min_element(plain.heights.begin(), plain.heights.end());
+          for (int r = 0; r < plain.height; ++r)
+            for (int c = 0; c < plain.width; ++c)
+              if (c >= plain.width / 2 || (name == "town" && r >= plain.height / 2))
+                plain.heights[static_cast<std::size_t>(r) * plain.width + c] = ground;
+          fields.push_back({name, plain});
+          continue;
+        }
         if (name != "mixed") {
           fields.push_back({name, content(name)});
           continue;

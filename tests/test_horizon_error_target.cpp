@@ -255,7 +255,8 @@ TEST(HorizonMaxError, RefinedTilesEqualAWholeFieldRunAtTheirK) {
   testing::forEachLayout([](const ComputeContext& context) {
     for (const char* name : {"city", "nan_holes"}) {
       const HeightField field = cityBesideFlat(name, 41, 31);
-      for (const auto& [strip_rows, max_distance] : {std::pair{0, 0.0}, std::pair{9, 0.0}, std::pair{0, 12.5}}) {
+      for (const auto& [strip_rows, max_distance] :
+           {std::pair{0, 0.0}, std::pair{9, 0.0}, std::pair{0, 12.5}}) {
         SCOPED_TRACE(std::string(name) + " strip rows " + std::to_string(strip_rows) + " max distance " +
                      std::to_string(max_distance));
         HorizonOptions options;

@@ -26,7 +26,8 @@ Attributes sweptAttributes(const Job& job, const HorizonResult& result) {
     if (name == "hfvis:directions") value = std::to_string(result.directions);
   if (job.run.max_error > 0.0) attributes.emplace_back("hfvis:max_error", formatNumber(job.run.max_error));
   if (!result.pixel_directions.empty()) {  // refined by tile: the least K a pixel took to the most
-    const auto [least, most] = std::minmax_element(result.pixel_directions.begin(), result.pixel_directions.end());
+    const auto [least, most] =
+        std::minmax_element(result.pixel_directions.begin(), result.pixel_directions.end());
     attributes.emplace_back("hfvis:directions_range", std::to_string(*least) + ".." + std::to_string(*most));
   }
   if (!result.error_estimate.empty())
@@ -58,10 +59,11 @@ Summary HorizonQuantityComputation::write(Job& job, OutputFiles& outputs) {
       names.push_back("directions");
       planes.emplace_back(result_.pixel_directions.begin(), result_.pixel_directions.end());
     }
-    outputs.image(run_.error_output,
-                  job.image(field, names, planes, attributes, std::string("estimated error of the ") + quantity_.what,
-                            "absolute, in the output's unit; NaN at nodata (channel directions: the K of the "
-                            "pixel's run)"));
+    outputs.image(
+        run_.error_output,
+        job.image(field, names, planes, attributes, std::string("estimated error of the ") + quantity_.what,
+                  "absolute, in the output's unit; NaN at nodata (channel directions: the K of the "
+                  "pixel's run)"));
   }
   Summary summary{result_.directions};
   summary.note = "; mean " + std::string(quantity_.channel) + " " + formatFixed(finiteMean(plane), 4);

@@ -47,8 +47,9 @@ struct HorizonOptions : SweepOptions {
   // 99th percentile of the error estimate (HorizonResult::estimated_error) is at most max_error,
   // in their own unit (absolute, both lie in 0..1); HorizonResult::directions says which K. A
   // first run at 16 directions and each one after it predicts the K needed (the estimate falls
-  // as K^-p, p measured from the last two runs), until the estimate is met. Throws InvalidArgument, naming the K it would take,
-  // when a run predicts more than kMaxAutoDirections. The samples per unit stay as given.
+  // as K^-p, p measured from the last two runs), until the estimate is met. Throws InvalidArgument, naming
+  // the K it would take, when a run predicts more than kMaxAutoDirections. The samples per unit stay as
+  // given.
   double max_error = 0.0;
   // With max_error, where the field needs them: after the first run (the whole field at 16
   // directions) each tile of error_tile x error_tile pixels whose estimate's 99th percentile
@@ -56,8 +57,11 @@ struct HorizonOptions : SweepOptions {
   // directionLadder), sweeping only the lines that reach it (each cut after its last receiver
   // there, the horizons still from the whole line beyond), until every tile meets it. A pixel's
   // values are those of the whole-field run at its tile's last K, bit for bit
-  // (HorizonResult::pixel_directions). 0: the whole field takes one K.
-  int error_tile = 32;
+  // (HorizonResult::pixel_directions). 0: the whole field takes one K, the default: on the
+  // benchmark's contents, which mix a city with open ground, refinement cost more than one K
+  // (bench/report/error_target.md: a tile's run also sweeps its lines' whole upstream, and each
+  // tile steps through its own runs).
+  int error_tile = 0;
 };
 
 // The most directions max_error may choose.
