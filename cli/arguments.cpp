@@ -95,8 +95,8 @@ double parseBounded(const std::string& option, const std::string& text, double l
                     const char* why) {
   const double value = parseNumber(option, text);
   if (!(value >= lo && value <= hi))
-    throw UsageError(option + ": must be in " + detail::shortNumber(lo) + " .. " + detail::shortNumber(hi) +
-                     " (" + why + "), got " + inQuotes(shortened(text)));
+    throw UsageError(option + ": must be in " + detail::shortNumber(lo) + " .. " + detail::shortNumber(hi) + " (" + why +
+                     "), got " + inQuotes(shortened(text)));
   return value;
 }
 
@@ -254,8 +254,7 @@ double parseRegionHeight(const std::string& typed, const std::string& value) {
 std::uint32_t parseSeed(const std::string& typed, const std::string& value) {
   const double n = parseNumber(typed, value);
   if (!(n >= 0.0 && n <= 4294967295.0 && n == std::floor(n)))
-    throw UsageError(typed + ": expected a whole number in 0 .. 4294967295, got " +
-                     inQuotes(shortened(value)));
+    throw UsageError(typed + ": expected a whole number in 0 .. 4294967295, got " + inQuotes(shortened(value)));
   return static_cast<std::uint32_t>(n);
 }
 
@@ -652,9 +651,7 @@ const std::vector<OptionSpec>& optionTable() {
       {"--seed", nullptr, "N", kRegionSamplingGroup, false,
        "the jitter's seed, 0 .. 4294967295 (default 1): the same seed, the\n"
        "same samples",
-       [](const std::string& typed, const std::string& value, RunArguments& run) {
-         run.seed = parseSeed(typed, value);
-       }},
+       [](const std::string& typed, const std::string& value, RunArguments& run) { run.seed = parseSeed(typed, value); }},
       {"--light", nullptr, "C0,R0,C1,R1", kAreaLightGroup, false,
        "the light: the rectangle of grid points between two corner pixels\n"
        "(columns and rows, inclusive, in any order)",
@@ -727,11 +724,9 @@ const std::vector<OptionSpec>& optionTable() {
        [](const std::string& typed, const std::string& value, RunArguments& run) {
          const std::size_t comma = value.find(',');
          const double lo = parseBounded(typed, value.substr(0, comma), 0.0, kMostLength, kFloatRange);
-         const double hi = comma == std::string::npos
-                               ? lo
-                               : parseBounded(typed, value.substr(comma + 1), 0.0, kMostLength, kFloatRange);
-         if (hi < lo)
-           throw UsageError(typed + ": H1 below H0 in " + inQuotes(value) + " (the band is H0 .. H1)");
+         const double hi =
+             comma == std::string::npos ? lo : parseBounded(typed, value.substr(comma + 1), 0.0, kMostLength, kFloatRange);
+         if (hi < lo) throw UsageError(typed + ": H1 below H0 in " + inQuotes(value) + " (the band is H0 .. H1)");
          run.pvs_grid.band_low = lo;
          run.pvs_grid.band_high = hi;
        }},
@@ -754,8 +749,7 @@ const std::vector<OptionSpec>& optionTable() {
          else if (value == "per-cell")
            run.pvs.method = PvsMethod::PerCell;
          else
-           throw UsageError(typed + ": expected 'agvs', 'sgvs' or 'per-cell', got " +
-                            inQuotes(shortened(value)));
+           throw UsageError(typed + ": expected 'agvs', 'sgvs' or 'per-cell', got " + inQuotes(shortened(value)));
        }},
       {"--samples", nullptr, "N", kPvsGroup, false, "stop after N visibility samples",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
@@ -784,9 +778,7 @@ const std::vector<OptionSpec>& optionTable() {
       {"--seed", nullptr, "N", kPvsGroup, false,
        "the sampling's seed, 0 .. 4294967295 (default 1): the same seed and\n"
        "budget of samples, the same sets",
-       [](const std::string& typed, const std::string& value, RunArguments& run) {
-         run.seed = parseSeed(typed, value);
-       }},
+       [](const std::string& typed, const std::string& value, RunArguments& run) { run.seed = parseSeed(typed, value); }},
       {"--bitset", nullptr, "OUT.bin", kPvsGroup, false,
        "also the sets as one bitset per view cell (docs/PVS.md, byte by byte)", HFVIS_TEXT(bitset_output)},
   };
@@ -804,24 +796,22 @@ namespace {
 
 // Checks that involve more than one option: every command's, and its own (CommandSpec::check).
 void validateRun(const CommandSpec& command, const std::string& name, const RunArguments& run) {
-  const std::string out = command.id == Command::HorizonLists                           ? "OUT.json|OUT.csv"
+  const std::string out = command.id == Command::HorizonLists ? "OUT.json|OUT.csv"
                           : command.id == Command::Region || command.id == Command::Pvs ? "OUT.json"
-                                                                                        : "OUT.exr";
+                                                              : "OUT.exr";
   if (run.input.empty())
     throw UsageError("missing the input height field (hfvis " + name + " IN -o " + out + ")");
   if (run.output.empty())
     throw UsageError("missing -o " + out + " (the output file of 'hfvis " + name + "')");
   if (command.check) command.check(name, run);
   // Each output file once: -o, then the others in the order the help lists them.
-  const std::vector<std::pair<const char*, const std::string*>> files{
-      {"-o", &run.output},
-      {"--distance-out", &run.distance_output},
-      {"--error-out", &run.error_output},
-      {"--preview", &run.preview}};
+  const std::vector<std::pair<const char*, const std::string*>> files{{"-o", &run.output},
+                                                                      {"--distance-out", &run.distance_output},
+                                                                      {"--error-out", &run.error_output},
+                                                                      {"--preview", &run.preview}};
   for (std::size_t j = 1; j < files.size(); ++j)
     for (std::size_t i = 0; i < j; ++i)
-      if (!files[i].second->empty() && !files[j].second->empty() &&
-          samePath(*files[i].second, *files[j].second))
+      if (!files[i].second->empty() && !files[j].second->empty() && samePath(*files[i].second, *files[j].second))
         throw UsageError(std::string(files[j].first) + " must differ from " + files[i].first + ", both are " +
                          inQuotes(*files[j].second));
   // Only a GeoTIFF declares a nodata value; other outputs keep NaN, so the option would do nothing.
@@ -1102,8 +1092,7 @@ ViewshedOptions viewshedOptions(const RunArguments& run) {
   options.max_distance = run.max_distance;
   options.curvature = run.curvature ? earthCurvature(run.refraction) : 0.0;
   if (run.field_of_view) std::tie(options.azimuth_from_deg, options.azimuth_to_deg) = *run.field_of_view;
-  if (run.elevation_range)
-    std::tie(options.elevation_min_deg, options.elevation_max_deg) = *run.elevation_range;
+  if (run.elevation_range) std::tie(options.elevation_min_deg, options.elevation_max_deg) = *run.elevation_range;
   options.memory_budget_bytes = run.memory_budget_bytes;
   return options;
 }

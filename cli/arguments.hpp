@@ -76,8 +76,8 @@ struct RunArguments {
   std::optional<std::pair<double, double>> sun;
   std::optional<double> sun_time, latitude, longitude;
   double sun_size_deg = 0.53;
-  double sun_irradiance = 1.0;  // shade --sun-irradiance: the sun's normal irradiance in --albedo's sum
-  std::string environment;      // shade --env ENV.exr
+  double sun_irradiance = 1.0;          // shade --sun-irradiance: the sun's normal irradiance in --albedo's sum
+  std::string environment;              // shade --env ENV.exr
   double environment_rotation_deg = 0.0;  // --env-rotate
   int environment_rows = 0;               // --env-rows: the tables' bands, 0 = the map's rows
   std::string albedo;                     // --albedo: a number in [0, 1] or an image; "" = none
@@ -87,16 +87,16 @@ struct RunArguments {
   double step_minutes = 10.0;
   double azimuth_bucket_deg = 0.25;
   bool apparent = false;
-  double cell_size_x = 0.0;  // <= 0: from the file, else 1
+  double cell_size_x = 0.0;              // <= 0: from the file, else 1
   double cell_size_y = 0.0;
   double z_scale = 1.0;
   std::string channel;                  // "" = the only channel
   std::string device;                   // "" = HFVIS_DEVICE, else automatic
   std::size_t memory_budget_bytes = 0;  // 0 = from the device
   bool quiet = false;
-  bool curvature = false;                  // --curvature (or --refraction): the Earth's drop
+  bool curvature = false;                    // --curvature (or --refraction): the Earth's drop
   double refraction = kDefaultRefraction;  // --refraction K
-  double max_distance = 0.0;               // --max-distance D (ground units); 0 = none
+  double max_distance = 0.0;                 // --max-distance D (ground units); 0 = none
   // viewshed: --observer COL,ROW (in order) and --observers FILE.csv (read with the field),
   // --observer-height, --target-height, --absolute, --fov FROM,TO (compass degrees),
   // --elevation-range LO,HI (degrees), --angle (an "angle" channel, one observer).
@@ -109,10 +109,9 @@ struct RunArguments {
   bool with_angle = false;
   bool with_needed_height = false;  // --needed-height: a "needed_height" channel, one observer
   bool culled = false;              // --method culled: through Stewart's culling pyramid
-  int cull_level =
-      ViewshedPyramidOptions{}.finest_level;  // --cull-level K: its finest nodes, 2^K points a side
+  int cull_level = ViewshedPyramidOptions{}.finest_level;  // --cull-level K: its finest nodes, 2^K points a side
   bool cull_level_given = false;
-  std::optional<float> nodata;  // --nodata VALUE for GeoTIFF outputs (may be NaN); none = NaN
+  std::optional<float> nodata;               // --nodata VALUE for GeoTIFF outputs (may be NaN); none = NaN
   // arealight and region (hfvis/region_visibility.hpp): --samples N per region, --method
   // exact|culled|viewsheds, --seed of the jitter; arealight's light, --light C0,R0,C1,R1 at
   // --light-height (or --sources FILE.csv), --decorrelate, --masks FILE; region's --from and --to

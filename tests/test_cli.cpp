@@ -349,8 +349,7 @@ TEST_F(Cli, DirectionsOutOfRange) {
 TEST_F(Cli, HorizonMapBeyondHostMemoryIsRefusedBeforeComputing) {
   const std::string big = writeField("big.exr", 1024, 1024, [](int x, int y) { return float(x ^ y); });
   const auto start = std::chrono::steady_clock::now();
-  const CliResult result =
-      run("horizon " + shellQuoted(big) + " -o " + shellQuoted(out("o.exr")) + " -k 65536");
+  const CliResult result = run("horizon " + shellQuoted(big) + " -o " + shellQuoted(out("o.exr")) + " -k 65536");
   expectFailure(result, 1, "GiB of host memory");
   EXPECT_NE(result.err.find("ask for svf or ao"), std::string::npos) << result.err;
   EXPECT_FALSE(fs::exists(out("o.exr")));
@@ -477,12 +476,11 @@ TEST_F(Cli, OutputNeverReplacesAnInput) {
   const std::string observers_before = readText(observers);
   const std::string observers_link = in("observers_link.tif");
   fs::create_symlink(observers, observers_link);
-  for (const std::string& outputs_part :
-       {"-o " + shellQuoted(out("seen.exr")) + " --preview " + shellQuoted(observers),
-        "-o " + shellQuoted(observers_link)}) {
+  for (const std::string& outputs_part : {"-o " + shellQuoted(out("seen.exr")) + " --preview " + shellQuoted(observers),
+                                          "-o " + shellQuoted(observers_link)}) {
     SCOPED_TRACE(outputs_part);
-    const CliResult viewshed =
-        run("viewshed " + shellQuoted(field) + " --observers " + shellQuoted(observers) + " " + outputs_part);
+    const CliResult viewshed = run("viewshed " + shellQuoted(field) + " --observers " + shellQuoted(observers) + " " +
+                                   outputs_part);
     EXPECT_EQ(viewshed.status, 2) << viewshed.err;
     EXPECT_NE(viewshed.err.find("outputs never replace an input"), std::string::npos) << viewshed.err;
     EXPECT_EQ(readText(observers), observers_before);
@@ -913,8 +911,7 @@ TEST_F(Cli, CurvatureLowersFarTerrainByTheEarthsDrop) {
                                  " -k 4 --cell-size 50 " + options);
     EXPECT_EQ(result.status, 0) << options << ": " << result.err;
     const ReadBack h = readBack(out("h.exr"));
-    EXPECT_EQ(h.spec.get_string_attribute("hfvis:curvature").empty(),
-              options.find("--") == std::string::npos);
+    EXPECT_EQ(h.spec.get_string_attribute("hfvis:curvature").empty(), options.find("--") == std::string::npos);
     return h.at(20, 2, 0);  // toward +x, 10 pixels = 500 m from the wall
   };
   const double d = 500.0, drop = d * d * (1.0 - 1.0 / 7.0) / (2.0 * 6370997.0);
@@ -1086,8 +1083,7 @@ TEST_F(Cli, ATinyMemoryBudgetRunsInStripsWithTheSameResult) {
 // at all, or with options shade does not take, is a usage error with nothing written.
 TEST_F(Cli, ShadeLightsFlatGroundWithTheSun) {
   const std::string field = flat();
-  const CliResult given =
-      run("shade " + shellQuoted(field) + " -o " + shellQuoted(out("s.exr")) + " --sun 200,30 -q");
+  const CliResult given = run("shade " + shellQuoted(field) + " -o " + shellQuoted(out("s.exr")) + " --sun 200,30 -q");
   ASSERT_EQ(given.status, 0) << given.err;
   const ReadBack s = readBack(out("s.exr"));
   ASSERT_EQ(s.channels, (std::vector<std::string>{"direct", "sun"}));
@@ -1116,8 +1112,7 @@ TEST_F(Cli, ShadeLightsFlatGroundWithTheSun) {
 // nothing written.
 TEST_F(Cli, ShadeLightsWithAnEnvironment) {
   const std::string field = flat();
-  auto writeMap = [&](const std::string& name, int width, int height, std::vector<std::string> names,
-                      float value) {
+  auto writeMap = [&](const std::string& name, int width, int height, std::vector<std::string> names, float value) {
     hfvis::ImageChannels image;
     image.width = width;
     image.height = height;
@@ -1134,18 +1129,17 @@ TEST_F(Cli, ShadeLightsWithAnEnvironment) {
   const ReadBack ry = readBack(out("y.exr"));
   ASSERT_EQ(ry.channels, (std::vector<std::string>{"Y"}));
   for (int row = 0; row < ry.height; ++row)
-    for (int col = 0; col < ry.width; ++col)
-      ASSERT_NEAR(ry.at(col, row, 0), 2.0 * M_PI, 1e-4) << col << "," << row;
+    for (int col = 0; col < ry.width; ++col) ASSERT_NEAR(ry.at(col, row, 0), 2.0 * M_PI, 1e-4) << col << "," << row;
   const std::string rgb = writeMap("rgb.exr", 16, 8, {"R", "G", "B"}, 1.0f);  // R 1, G 2, B 3
-  const CliResult c =
-      run("shade " + shellQuoted(field) + " -o " + shellQuoted(out("c.exr")) + " --env " + shellQuoted(rgb) +
-          " --sun 100,30 --albedo 0.5 --sun-irradiance 4 -q --preview " + shellQuoted(out("c.png")));
+  const CliResult c = run("shade " + shellQuoted(field) + " -o " + shellQuoted(out("c.exr")) + " --env " +
+                          shellQuoted(rgb) + " --sun 100,30 --albedo 0.5 --sun-irradiance 4 -q --preview " +
+                          shellQuoted(out("c.png")));
   ASSERT_EQ(c.status, 0) << c.err;
   const ReadBack rc = readBack(out("c.exr"));
   std::vector<std::string> names = rc.channels;
   std::sort(names.begin(), names.end());
-  ASSERT_EQ(names, (std::vector<std::string>{"B", "G", "R", "direct", "radiance.B", "radiance.G",
-                                             "radiance.R", "sun"}));
+  ASSERT_EQ(names, (std::vector<std::string>{"B", "G", "R", "direct", "radiance.B", "radiance.G", "radiance.R",
+                                             "sun"}));
   auto channel = [&](const std::string& name) {
     return static_cast<int>(std::find(rc.channels.begin(), rc.channels.end(), name) - rc.channels.begin());
   };
@@ -1153,8 +1147,7 @@ TEST_F(Cli, ShadeLightsWithAnEnvironment) {
     const std::string colour(1, "RGB"[ch]);
     EXPECT_NEAR(rc.at(5, 5, channel(colour)), M_PI * (1 + ch), 1e-4) << ch;
     // 0.5 / pi (pi (1, 2, 3) + 4 sin(30 degrees)).
-    EXPECT_NEAR(rc.at(5, 5, channel("radiance." + colour)), 0.5 / M_PI * (M_PI * (1 + ch) + 4 * 0.5), 1e-4)
-        << ch;
+    EXPECT_NEAR(rc.at(5, 5, channel("radiance." + colour)), 0.5 / M_PI * (M_PI * (1 + ch) + 4 * 0.5), 1e-4) << ch;
   }
   EXPECT_TRUE(fs::exists(out("c.png")));
   // Bad maps: not 2:1, a negative or non-finite radiance, two channels, unreadable.
@@ -1177,9 +1170,8 @@ TEST_F(Cli, ShadeLightsWithAnEnvironment) {
     expectFailure(r, 1, named);
   }
   // Usage errors: --env-rotate without --env, --albedo out of range, an environment as the output.
-  for (const std::string& bad :
-       {std::string(" --sun 100,30 --env-rotate 10"), " --env " + shellQuoted(grey) + " --albedo 1.5",
-        " --env " + shellQuoted(out("bad.exr"))}) {
+  for (const std::string& bad : {std::string(" --sun 100,30 --env-rotate 10"), " --env " + shellQuoted(grey) +
+                                     " --albedo 1.5", " --env " + shellQuoted(out("bad.exr"))}) {
     const CliResult r = run("shade " + shellQuoted(field) + " -o " + shellQuoted(out("bad.exr")) + bad);
     EXPECT_EQ(r.status, 2) << bad << ": " << r.err;
     EXPECT_TRUE(listDirectory(outputs()).empty()) << bad;
@@ -1193,9 +1185,8 @@ TEST_F(Cli, ShadeLightsWithAnEnvironment) {
 // north side at noon in the northern winter.
 TEST_F(Cli, InsolationCountsSunHours) {
   const std::string field = flat();
-  const CliResult r =
-      run("insolation " + shellQuoted(field) + " -o " + shellQuoted(out("i.exr")) +
-          " --lat 0 --lon 0 --from 2026-03-20T00:00:00Z --to 2026-03-21T00:00:00Z --step 2 -q");
+  const CliResult r = run("insolation " + shellQuoted(field) + " -o " + shellQuoted(out("i.exr")) +
+                          " --lat 0 --lon 0 --from 2026-03-20T00:00:00Z --to 2026-03-21T00:00:00Z --step 2 -q");
   ASSERT_EQ(r.status, 0) << r.err;
   const ReadBack i = readBack(out("i.exr"));
   ASSERT_EQ(i.channels, (std::vector<std::string>{"direct", "sun_hours"}));
@@ -1240,19 +1231,16 @@ TEST_F(Cli, SunPositionPrintsAzimuthAndElevation) {
   const CliResult result = run("sunpos --lat 39.742476 --lon -105.1786 --at 2003-10-17T12:30:30-07:00");
   ASSERT_EQ(result.status, 0) << result.err;
   double azimuth = 0.0, elevation = 0.0;
-  ASSERT_EQ(std::sscanf(result.out.c_str(), "azimuth=%lf elevation=%lf", &azimuth, &elevation), 2)
-      << result.out;
+  ASSERT_EQ(std::sscanf(result.out.c_str(), "azimuth=%lf elevation=%lf", &azimuth, &elevation), 2) << result.out;
   EXPECT_NEAR(azimuth, 194.34024, 0.005);
   EXPECT_NEAR(elevation, 39.874, 0.005);
-  const CliResult apparent =
-      run("sunpos --lat 39.742476 --lon -105.1786 --at 2003-10-17T12:30:30-07:00 --apparent");
+  const CliResult apparent = run("sunpos --lat 39.742476 --lon -105.1786 --at 2003-10-17T12:30:30-07:00 --apparent");
   ASSERT_EQ(apparent.status, 0) << apparent.err;
   double apparent_elevation = 0.0;
   ASSERT_EQ(std::sscanf(apparent.out.c_str(), "azimuth=%lf elevation=%lf", &azimuth, &apparent_elevation), 2);
   EXPECT_NEAR(apparent_elevation - elevation, 0.02, 0.005);  // a standard atmosphere at 40 degrees
-  for (const char* bad :
-       {"sunpos --lat 45 --lon 7", "sunpos --lat 45 --lon 7 --at noon",
-        "sunpos --lat 45 --lon 7 --at 2026-06-21T12:00:00Z --lat 46", "sunpos --lat 45 --lon 7 --at"}) {
+  for (const char* bad : {"sunpos --lat 45 --lon 7", "sunpos --lat 45 --lon 7 --at noon",
+                          "sunpos --lat 45 --lon 7 --at 2026-06-21T12:00:00Z --lat 46", "sunpos --lat 45 --lon 7 --at"}) {
     const CliResult r = run(bad);
     EXPECT_EQ(r.status, 2) << bad;
     EXPECT_TRUE(r.out.empty()) << bad;
@@ -1808,8 +1796,7 @@ TEST_F(Cli, GeographicGridTakesEachRowsSpacing) {
   const ReadBack d = readBack(out("d.exr"));
   for (int r = 0; r < height; ++r) {
     const double lat = (65.0 - r) * M_PI / 180.0, a = 6378137.0, e2 = 0.00669437999014132;
-    const double east =
-        a / std::sqrt(1.0 - e2 * std::sin(lat) * std::sin(lat)) * std::cos(lat) * M_PI / 180.0;
+    const double east = a / std::sqrt(1.0 - e2 * std::sin(lat) * std::sin(lat)) * std::cos(lat) * M_PI / 180.0;
     EXPECT_NEAR(d.at(2, r, 0), 4.0 * east, 1e-5 * 4.0 * east) << "row " << r;
   }
   fs::remove(out("h.exr"));
@@ -1823,8 +1810,7 @@ TEST_F(Cli, GeographicGridTakesEachRowsSpacing) {
   int seen = 0;
   for (int r = 0; r < height; ++r) {
     const double lat = (65.0 - r) * M_PI / 180.0, a = 6378137.0, e2 = 0.00669437999014132;
-    const double east =
-        a / std::sqrt(1.0 - e2 * std::sin(lat) * std::sin(lat)) * std::cos(lat) * M_PI / 180.0;
+    const double east = a / std::sqrt(1.0 - e2 * std::sin(lat) * std::sin(lat)) * std::cos(lat) * M_PI / 180.0;
     if (4.0 * east < 219000.0) {
       EXPECT_NEAR(h.at(2, r, 0), std::atan(1000.0 / (4.0 * east)), 1e-6) << "row " << r;
       ++seen;
@@ -1850,8 +1836,7 @@ TEST_F(Cli, GeographicGridTakesEachRowsSpacing) {
   const std::string flat = in("flat.tif");
   hfvis::testing::writeGdalGeoTiff(flat, width, height, std::vector<float>(width * height, 0.0f),
                                    {10.0, 1.0, 0.0, 65.5, 0.0, -1.0}, "EPSG:4326", std::nullopt);
-  const CliResult counts =
-      run("viewcount " + shellQuoted(flat) + " -o " + shellQuoted(out("v.exr")) + " -k 4 -q");
+  const CliResult counts = run("viewcount " + shellQuoted(flat) + " -o " + shellQuoted(out("v.exr")) + " -k 4 -q");
   ASSERT_EQ(counts.status, 0) << counts.err;
   EXPECT_EQ(counts.err.find("centre latitude"), std::string::npos) << counts.err;
   const ReadBack v = readBack(out("v.exr"));
@@ -1881,8 +1866,7 @@ TEST_F(Cli, GeographicGridTakesEachRowsSpacing) {
 
 TEST_F(Cli, ViewshedSeesOverAWall) {
   // A wall 5 high across column 8 of flat ground at 0; the eye 2 above the ground at column 2.
-  const std::string field =
-      writeField("wall.exr", 16, 6, [](int col, int) { return col == 8 ? 5.0f : 0.0f; });
+  const std::string field = writeField("wall.exr", 16, 6, [](int col, int) { return col == 8 ? 5.0f : 0.0f; });
   const CliResult r = run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) +
                           " --observer 2,3 --angle --preview " + shellQuoted(out("v.png")));
   ASSERT_EQ(r.status, 0) << r.err;
@@ -1892,27 +1876,20 @@ TEST_F(Cli, ViewshedSeesOverAWall) {
   EXPECT_EQ(v.at(5, 3, 1), 1.0f);   // before the wall
   EXPECT_EQ(v.at(8, 3, 1), 1.0f);   // the wall's top
   EXPECT_EQ(v.at(12, 3, 1), 0.0f);  // behind it
-  EXPECT_NEAR(v.at(8, 3, 0), std::atan2(3.0, 6.0) * 180.0 / M_PI,
-              1e-4);  // degrees above the eye's horizontal
+  EXPECT_NEAR(v.at(8, 3, 0), std::atan2(3.0, 6.0) * 180.0 / M_PI, 1e-4);  // degrees above the eye's horizontal
   // Behind the wall a target needs the sight line over the wall's top: 2 + 10 * 3 / 6 = 7.
   ASSERT_EQ(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("n.exr")) +
-                " --observer 2,3 --needed-height -q")
-                .status,
-            0);
+                " --observer 2,3 --needed-height -q").status, 0);
   const ReadBack needed = readBack(out("n.exr"));
   ASSERT_EQ(needed.channels, (std::vector<std::string>{"needed_height", "visible"}));
   EXPECT_NEAR(needed.at(12, 3, 0), 7.0f, 1e-4);
   EXPECT_EQ(needed.at(5, 3, 0), 0.0f);
   // A target 7 high behind the wall is seen over it; an eye 10 up sees the ground behind it.
   ASSERT_EQ(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("t.exr")) +
-                " --observer 2,3 --target-height 7 -q")
-                .status,
-            0);
+                " --observer 2,3 --target-height 7 -q").status, 0);
   EXPECT_EQ(readBack(out("t.exr")).at(12, 3, 0), 1.0f);
   ASSERT_EQ(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("a.exr")) +
-                " --observer 2,3 --observer-height 10 --absolute -q")
-                .status,
-            0);
+                " --observer 2,3 --observer-height 10 --absolute -q").status, 0);
   EXPECT_EQ(readBack(out("a.exr")).at(15, 3, 0), 1.0f);
   // Several observers, on the command line and in a CSV: how many see each point.
   {
@@ -1924,7 +1901,7 @@ TEST_F(Cli, ViewshedSeesOverAWall) {
   ASSERT_EQ(c.status, 0) << c.err;
   const ReadBack count = readBack(out("c.exr"));
   ASSERT_EQ(count.channels, (std::vector<std::string>{"count"}));
-  EXPECT_EQ(count.at(8, 3, 0), 3.0f);  // the wall's top: everyone
+  EXPECT_EQ(count.at(8, 3, 0), 3.0f);   // the wall's top: everyone
   // Behind the wall from column 2, in front of it from 14, and seen from the eye on the wall's end.
   EXPECT_EQ(count.at(12, 3, 0), 2.0f);
 }
@@ -1934,8 +1911,7 @@ TEST_F(Cli, ViewshedCulledEqualsExact) {
   const std::string field = writeField("walls.exr", 48, 40, [](int col, int row) {
     return (col == 20 && row > 4) || (row == 30 && col < 40) ? 6.0f : 0.1f * ((col * 7 + row * 3) % 5);
   });
-  const CliResult exact =
-      run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("e.exr")) + " --observer 30,10");
+  const CliResult exact = run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("e.exr")) + " --observer 30,10");
   ASSERT_EQ(exact.status, 0) << exact.err;
   const CliResult culled = run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("c.exr")) +
                                " --observer 30,10 --method culled --cull-level 1");
@@ -1947,22 +1923,17 @@ TEST_F(Cli, ViewshedCulledEqualsExact) {
   EXPECT_EQ(c.spec.get_string_attribute("hfvis:method"), "culled");
   // Several observers share one pyramid.
   ASSERT_EQ(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("ce.exr")) +
-                " --observer 30,10 --observer 5,35 -q")
-                .status,
-            0);
+                " --observer 30,10 --observer 5,35 -q").status, 0);
   ASSERT_EQ(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("cc.exr")) +
-                " --observer 30,10 --observer 5,35 --method culled -q")
-                .status,
-            0);
+                " --observer 30,10 --observer 5,35 --method culled -q").status, 0);
   EXPECT_EQ(readBack(out("ce.exr")).pixels, readBack(out("cc.exr")).pixels);
 }
 
 TEST_F(Cli, ViewshedRefusesBadObservers) {
   const std::string field = flat();
   expectFailure(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr"))), 2, "--observer");
-  expectFailure(
-      run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) + " --observer 16,2"), 2,
-      "outside");
+  expectFailure(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) + " --observer 16,2"), 2,
+                "outside");
   expectFailure(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) +
                     " --observer 1,2 --observer 3,4 --angle"),
                 2, "--angle");
@@ -1978,15 +1949,13 @@ TEST_F(Cli, ViewshedRefusesBadObservers) {
   expectFailure(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) +
                     " --observer 1,2 --fov 10,400"),
                 2, "--fov");
-  expectFailure(
-      run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) + " --observer 1,2 -k 4"), 2,
-      "-k");
+  expectFailure(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) + " --observer 1,2 -k 4"), 2,
+                "-k");
   const std::string holes = writeField("holes.exr", 8, 8, [](int col, int row) {
     return col == 3 && row == 3 ? std::numeric_limits<float>::quiet_NaN() : 1.0f;
   });
-  expectFailure(
-      run("viewshed " + shellQuoted(holes) + " -o " + shellQuoted(out("v.exr")) + " --observer 3,3"), 2,
-      "nodata");
+  expectFailure(run("viewshed " + shellQuoted(holes) + " -o " + shellQuoted(out("v.exr")) + " --observer 3,3"), 2,
+                "nodata");
   {
     std::ofstream csv(in("bad.csv"));
     csv << "col,row\n1,2\n3,x\n";
@@ -2549,11 +2518,10 @@ TEST_F(Cli, AreaLightBehindAWallIsHiddenAndAgreesWithTheLibrary) {
   EXPECT_EQ(readBack(out("h.exr")).at(12, 5, 0), 1.0f);
   // The culled method (the default) and the exact one write the same picture, each naming itself.
   for (const char* method : {"exact", "culled"})
-    ASSERT_EQ(
-        run("arealight " + shellQuoted(field) + " -o " + shellQuoted(out(std::string(method) + ".exr")) +
-            " --light 1,2,3,9 --light-height 20 --absolute --method " + method + " -q")
-            .status,
-        0);
+    ASSERT_EQ(run("arealight " + shellQuoted(field) + " -o " + shellQuoted(out(std::string(method) + ".exr")) +
+                  " --light 1,2,3,9 --light-height 20 --absolute --method " + method + " -q")
+                  .status,
+              0);
   const ReadBack exact = readBack(out("exact.exr")), culled = readBack(out("culled.exr"));
   EXPECT_EQ(exact.pixels, culled.pixels);
   EXPECT_EQ(exact.spec.get_string_attribute("hfvis:method"), "exact");
@@ -2669,10 +2637,9 @@ TEST_F(Cli, PvsWritesTheLibrarysSetsAsJsonAndBits) {
   const std::string field = writeField("hills.exr", 30, 22, [](int col, int row) {
     return 4.0f * std::sin(0.4f * col) * std::cos(0.3f * row) + (col == 15 ? 12.0f : 0.0f);
   });
-  const CliResult result =
-      run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out("p.json")) +
-          " --view-cell 8 --tile 4 --samples 6000 --method sgvs --seed 3 --bitset " +
-          shellQuoted(out("p.bin")) + " --preview " + shellQuoted(out("p.png")) + " --quiet");
+  const CliResult result = run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out("p.json")) +
+                               " --view-cell 8 --tile 4 --samples 6000 --method sgvs --seed 3 --bitset " +
+                               shellQuoted(out("p.bin")) + " --preview " + shellQuoted(out("p.png")) + " --quiet");
   ASSERT_EQ(result.status, 0) << result.err;
   hfvis::PvsGrid grid;
   grid.view_cell = 8;
@@ -2681,8 +2648,7 @@ TEST_F(Cli, PvsWritesTheLibrarysSetsAsJsonAndBits) {
   options.method = hfvis::PvsMethod::Sgvs;
   options.samples = 6000;
   options.seed = 3;
-  const hfvis::PvsResult want =
-      hfvis::computePvs(hfvis::testing::testContext(), hfvis::readHeightField(field), grid, options);
+  const hfvis::PvsResult want = hfvis::computePvs(hfvis::testing::testContext(), hfvis::readHeightField(field), grid, options);
   const std::string json = readText(out("p.json"));
   // The sets: "pvs": [ [t, t, ...], ... ] one line per view cell.
   const std::size_t sets = json.find("\"pvs\": [");
@@ -2723,11 +2689,9 @@ TEST_F(Cli, PvsWritesTheLibrarysSetsAsJsonAndBits) {
   for (std::size_t i = 0; i < want.bits.size(); ++i) EXPECT_EQ(u32(words_at + 4 * i), want.bits[i]) << i;
   EXPECT_TRUE(fs::exists(out("p.png")));
   // A mask of the field's size selecting one corner: only view cell 0 computed.
-  const std::string mask =
-      writeField("mask.exr", 30, 22, [](int col, int row) { return col < 3 && row < 3 ? 1.0f : 0.0f; });
-  const CliResult masked =
-      run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out("m.json")) +
-          " --view-cell 8 --tile 4 --samples 500 --view-mask " + shellQuoted(mask) + " --quiet");
+  const std::string mask = writeField("mask.exr", 30, 22, [](int col, int row) { return col < 3 && row < 3 ? 1.0f : 0.0f; });
+  const CliResult masked = run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out("m.json")) +
+                               " --view-cell 8 --tile 4 --samples 500 --view-mask " + shellQuoted(mask) + " --quiet");
   ASSERT_EQ(masked.status, 0) << masked.err;
   const std::string mjson = readText(out("m.json"));
   const std::size_t msets = mjson.find("\"pvs\": [");

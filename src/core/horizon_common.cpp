@@ -31,9 +31,8 @@ void validate(const HorizonOptions& options, const HorizonOutputs& outputs) {
       throw InvalidArgument(
           "an error estimate and a maximum error apply to the sky-view factor and ambient occlusion alone");
     if (!(options.max_error >= 0.0 && options.max_error < 1.0))
-      throw InvalidArgument(
-          "the maximum error must be in (0, 1): the sky-view factor and occlusion lie in 0..1 (got " +
-          std::to_string(options.max_error) + ")");
+      throw InvalidArgument("the maximum error must be in (0, 1): the sky-view factor and occlusion lie in 0..1 (got " +
+                            std::to_string(options.max_error) + ")");
     if (options.max_error == 0.0 && options.directions < 2)
       throw InvalidArgument("an error estimate needs K >= 2 (it compares the even and the odd directions)");
   }
@@ -59,15 +58,14 @@ namespace {
 void appendRow(RowTable& t, double length, double azimuth, double weight) {
   const float w = static_cast<float>(weight);
   t.length.push_back(static_cast<float>(length));
-  t.terms.insert(t.terms.end(), {static_cast<float>(std::cos(azimuth)), static_cast<float>(std::sin(azimuth)),
-                                 w, swathFactor(w)});
+  t.terms.insert(t.terms.end(),
+                 {static_cast<float>(std::cos(azimuth)), static_cast<float>(std::sin(azimuth)), w, swathFactor(w)});
 }
 
 }  // namespace
 
-std::vector<RowTable> latticeRowTables(const HeightField& field,
-                                       const std::vector<LatticeDirection>& directions, bool quadrature,
-                                       bool parity_apart) {
+std::vector<RowTable> latticeRowTables(const HeightField& field, const std::vector<LatticeDirection>& directions,
+                                       bool quadrature, bool parity_apart) {
   // A field cut from a larger one takes the larger field's rows (cellSizeAtRow interpolates
   // across this field's edges there) and keeps its own [first, first + height) of them.
   const FieldOrigin& o = field.origin;
@@ -129,8 +127,7 @@ std::vector<RowTable> rayRowTables(const HeightField& field, const std::vector<S
   for (int r = 0; r < field.height; ++r) {
     std::vector<double> lengths(K), azimuths(K);
     for (std::size_t k = 0; k < K; ++k) {
-      const double gx = rays[k].dir_x * field.row_cell_size_x[r],
-                   gy = rays[k].dir_y * field.row_cell_size_y[r];
+      const double gx = rays[k].dir_x * field.row_cell_size_x[r], gy = rays[k].dir_y * field.row_cell_size_y[r];
       lengths[k] = std::hypot(gx, gy);
       azimuths[k] = std::atan2(gy, gx);
     }
@@ -157,14 +154,11 @@ HorizonResult allocateResult(const HeightField& field, const HorizonOptions& opt
   return result;
 }
 
-bool exactAzimuths(const HorizonOutputs& outputs) {
-  return outputs.horizon_angles || outputs.horizon_distances;
-}
+bool exactAzimuths(const HorizonOutputs& outputs) { return outputs.horizon_angles || outputs.horizon_distances; }
 
 std::vector<LatticeDirection> horizonDirections(const HeightField& field, const HorizonOptions& options,
                                                 const HorizonOutputs& outputs) {
-  return latticeDirections(field, options, exactAzimuths(outputs), options.azimuth_tolerance,
-                           outputs.error_estimate);
+  return latticeDirections(field, options, exactAzimuths(outputs), options.azimuth_tolerance, outputs.error_estimate);
 }
 
 void pixelNormal(const std::vector<float>& h, int width, int height, int c, int r, float cell_x, float cell_y,
@@ -186,8 +180,8 @@ void finishReduction(HorizonResult& result) {
   for (float& v : result.sky_view_factor) v = 1.0f - v;
 }
 
-void splitErrorHalves(HorizonResult& result, const std::vector<float>& odd_svf,
-                      const std::vector<float>& odd_ao, double even_weight, double odd_weight) {
+void splitErrorHalves(HorizonResult& result, const std::vector<float>& odd_svf, const std::vector<float>& odd_ao,
+                      double even_weight, double odd_weight) {
   std::vector<float>& estimate = result.error_estimate;
   estimate.assign(static_cast<std::size_t>(result.width) * result.height, 0.0f);
   const auto split = [&](std::vector<float>& sum, const std::vector<float>& odd) {
@@ -213,18 +207,15 @@ double estimatedError(const std::vector<float>& estimate) {
   return values[at];
 }
 
-int directionsForError(int directions, double estimated, int earlier, double earlier_estimate,
-                       double max_error) {
+int directionsForError(int directions, double estimated, int earlier, double earlier_estimate, double max_error) {
   double order = 1.0, factor = 0.0;
   if (earlier > 0 && earlier_estimate > estimated && estimated > 0.0)
-    order =
-        std::clamp(std::log(earlier_estimate / estimated) / std::log(double(directions) / earlier), 0.5, 3.0);
+    order = std::clamp(std::log(earlier_estimate / estimated) / std::log(double(directions) / earlier), 0.5, 3.0);
   factor = std::pow(estimated / max_error, 1.0 / order) * 1.05;
   if (earlier == 0) factor = std::min(factor, 4.0);
   const double wanted = std::ceil(directions * factor / 8.0) * 8.0;
   // Beyond kMaxAutoDirections, capped where an int holds it: the caller refuses it.
-  return static_cast<int>(
-      std::max<double>(directions + 8, std::min<double>(wanted, 2.0 * kMaxAutoDirections)));
+  return static_cast<int>(std::max<double>(directions + 8, std::min<double>(wanted, 2.0 * kMaxAutoDirections)));
 }
 
 }  // namespace detail

@@ -45,8 +45,8 @@ struct RunDirection {
   LatticeDirection lattice;  // sweep (azimuth and weight for both methods)
   SweepDirection ray;        // naive march
   std::vector<LatticeSample> samples;
-  std::vector<CellSegment> segments;             // sweep: the segment ending at each sample
-  std::size_t stack_per_period = 0;              // sweep: hull-stack entries a period can push
+  std::vector<CellSegment> segments;  // sweep: the segment ending at each sample
+  std::size_t stack_per_period = 0;   // sweep: hull-stack entries a period can push
   float cos_azimuth = 1.0f, sin_azimuth = 0.0f;  // as the scalar reference rounds them
   std::vector<LatticeLine> lines;                // sweep: the direction's lines over the field
   LatticeWindow window;                          // sweep: the maximum distance along its lines
@@ -106,8 +106,7 @@ RunPlan planStrips(const HeightField& field, const HorizonOptions& options, cons
     } else if (window) {
       periods = (2.0 * d.window.window + 2.0 * d.lattice.period) / d.lattice.period;
     }
-    plan.halo_rows =
-        std::max(plan.halo_rows, static_cast<int>(std::ceil(periods * std::abs(d.lattice.b))) + 1);
+    plan.halo_rows = std::max(plan.halo_rows, static_cast<int>(std::ceil(periods * std::abs(d.lattice.b))) + 1);
   }
   const std::size_t halo_rows = plan.halo_rows;
   const std::size_t row = field.width * sizeof(float);
@@ -116,15 +115,14 @@ RunPlan planStrips(const HeightField& field, const HorizonOptions& options, cons
   // halo's rows).
   const std::size_t per_row =
       row * (1 + skySumPlanes(outputs) + (outputs.ambient_occlusion || outputs.environment) * 2 +
-             environmentPlanes(outputs) + outputs.horizon_angles + outputs.horizon_distances + window * 2 +
-             positions);
+             environmentPlanes(outputs) + outputs.horizon_angles +
+             outputs.horizon_distances + window * 2 + positions);
   // The halo's rows, and the environment's map and tables.
-  const std::size_t halo =
-      2 * halo_rows * row * (1 + positions) + environmentBytes(outputs, directions.size());
+  const std::size_t halo = 2 * halo_rows * row * (1 + positions) + environmentBytes(outputs, directions.size());
   std::size_t rows = budget / 2 > halo ? (budget / 2 - halo) / per_row : 0;
   // The largest buffers: a strip's heights with its halo, and its normals.
-  rows = std::min(
-      {rows, max_alloc / row > 2 * halo_rows ? max_alloc / row - 2 * halo_rows : 0, max_alloc / (2 * row)});
+  rows = std::min({rows, max_alloc / row > 2 * halo_rows ? max_alloc / row - 2 * halo_rows : 0,
+                   max_alloc / (2 * row)});
   if (options.strip_rows > 0) rows = std::min<std::size_t>(rows, options.strip_rows);
   if (rows < 1)
     throw MemoryBudgetError("a strip of one row needs " + mebibytes(2 * (per_row + halo)) +
@@ -155,7 +153,8 @@ RunPlan planRun(const HeightField& field, const HorizonOptions& options, const H
   const bool window = sweep && options.max_distance > 0.0;
   const std::size_t fixed =
       plane * (1 + skySumPlanes(outputs) + (outputs.ambient_occlusion || outputs.environment) * 2 +
-               environmentPlanes(outputs) + window * 2 + (window && hasRowSpacing(field))) +
+               environmentPlanes(outputs) + window * 2 +
+               (window && hasRowSpacing(field))) +
       environmentBytes(outputs, directions.size());
   const std::size_t per_direction = plane * (outputs.horizon_angles + outputs.horizon_distances);
   // Scratch: all of a direction's stacks in one launch when it fits; one line at a time at least.
@@ -175,11 +174,10 @@ RunPlan planRun(const HeightField& field, const HorizonOptions& options, const H
   const bool fits = least <= budget && per_direction <= max_alloc && longest * kStackEntryBytes <= max_alloc;
   if (!fits || (options.strip_rows > 0 && options.strip_rows < field.height)) {
     if (sweep) return planStrips(field, options, outputs, directions, budget, max_alloc);
-    throw MemoryBudgetError(
-        "one direction needs " + mebibytes(least) + " of device memory but the budget is " +
-        mebibytes(budget) + " (largest single buffer " + mebibytes(max_alloc) +
-        "), and the naive method needs the whole field at once (no strips); raise the memory "
-        "budget or use a smaller field");
+    throw MemoryBudgetError("one direction needs " + mebibytes(least) + " of device memory but the budget is " +
+                            mebibytes(budget) + " (largest single buffer " + mebibytes(max_alloc) +
+                            "), and the naive method needs the whole field at once (no strips); raise the memory "
+                            "budget or use a smaller field");
   }
   const std::size_t available = budget - fixed;
   RunPlan plan;
@@ -227,8 +225,7 @@ std::vector<RunDirection> runDirectionsOf(const HeightField& field, const Horizo
   if (options.method == HorizonMethod::Sweep) {
     const std::vector<LatticeDirection> directions = horizonDirections(field, options, outputs);
     std::vector<RowTable> rows;
-    if (hasRowSpacing(field))
-      rows = latticeRowTables(field, directions, !exactAzimuths(outputs), outputs.error_estimate);
+    if (hasRowSpacing(field)) rows = latticeRowTables(field, directions, !exactAzimuths(outputs), outputs.error_estimate);
     for (std::size_t k = 0; k < directions.size(); ++k) {
       const LatticeDirection& d = directions[k];
       std::vector<CellSegment> segments = cellSegments(d, options.samples_per_unit);
@@ -268,9 +265,8 @@ std::vector<RunDirection> runDirectionsOf(const HeightField& field, const Horizo
       r.cos_azimuth = d.cos_azimuth;
       r.sin_azimuth = d.sin_azimuth;
       // With per-row spacing the march cuts at the ground length itself (horizon_naive's max_ground).
-      r.max_steps = hasRowSpacing(field)
-                        ? kAllSteps
-                        : stepsWithin(options.max_distance, double(d.step_length) * d.ground_per_pixel);
+      r.max_steps = hasRowSpacing(field) ? kAllSteps
+                                         : stepsWithin(options.max_distance, double(d.step_length) * d.ground_per_pixel);
       if (!rows.empty()) {
         r.row_length = std::move(rows[k].length);
         r.row_terms = std::move(rows[k].terms);
@@ -284,8 +280,7 @@ std::vector<RunDirection> runDirectionsOf(const HeightField& field, const Horizo
 // Hull stacks that outgrow what the budget leaves beside the strips; `rows`: thinner strips that
 // leave room for them (computeHorizons retries with those), 0 when none do.
 struct StacksBeyondStrips : MemoryBudgetError {
-  StacksBeyondStrips(const std::string& message, int strip_rows)
-      : MemoryBudgetError(message), rows(strip_rows) {}
+  StacksBeyondStrips(const std::string& message, int strip_rows) : MemoryBudgetError(message), rows(strip_rows) {}
   int rows;
 };
 
@@ -354,16 +349,15 @@ class HorizonRoutine : public SweepRoutine {
     // (in strips the halo's too: those of earlier strips come from the host, which holds them all).
     const bool positions = window && hasRowSpacing(field_);
     const std::size_t position_rows =
-        inStrips() ? std::min<std::size_t>(plan_.strip_rows + 2 * plan_.halo_rows, field_.height)
-                   : field_.height;
+        inStrips() ? std::min<std::size_t>(plan_.strip_rows + 2 * plan_.halo_rows, field_.height) : field_.height;
     receiver_base_ = deviceBuffer(st_, positions ? position_rows * field_.width * sizeof(float) : 0);
     if (positions && inStrips()) receiver_positions_.assign(field_.pixelCount(), 0.0f);
     placeholder_ = deviceBuffer(st_, 0);
     row_cells_ = rowCells();
     if (inStrips()) {
-      heights_ =
-          deviceBuffer(st_, std::min<std::size_t>(plan_.strip_rows + 2 * plan_.halo_rows, field_.height) *
-                                field_.width * sizeof(float));
+      heights_ = deviceBuffer(
+          st_, std::min<std::size_t>(plan_.strip_rows + 2 * plan_.halo_rows, field_.height) * field_.width *
+                   sizeof(float));
     } else if (needsNormals()) {
       computeNormals(0, 0, field_.height);
     }
@@ -408,9 +402,8 @@ class HorizonRoutine : public SweepRoutine {
 
   // Floats of one direction's table.
   std::size_t envTableFloats() const {
-    return outputs_.environment
-               ? std::size_t(tableRows(*outputs_.environment)) * outputs_.environment->channels * kEnvTerms
-               : 0;
+    return outputs_.environment ? std::size_t(tableRows(*outputs_.environment)) * outputs_.environment->channels * kEnvTerms
+                                : 0;
   }
 
   int directionCount() const override { return horizon_.directions; }
@@ -434,8 +427,7 @@ class HorizonRoutine : public SweepRoutine {
     if (inStrips()) return;  // each strip's planes came back with it
     const std::size_t plane = field_.pixelCount();
     const std::size_t batch_bytes = count * plane * sizeof(float), at = first * plane;
-    if (outputs_.horizon_angles)
-      st_.queue.enqueueReadBuffer(angles_, CL_TRUE, 0, batch_bytes, &result_.angles[at]);
+    if (outputs_.horizon_angles) st_.queue.enqueueReadBuffer(angles_, CL_TRUE, 0, batch_bytes, &result_.angles[at]);
     if (outputs_.horizon_distances)
       st_.queue.enqueueReadBuffer(distances_, CL_TRUE, 0, batch_bytes, &result_.distances[at]);
   }
@@ -461,8 +453,7 @@ class HorizonRoutine : public SweepRoutine {
       }
       readSkySumRows(0, field_.height);
       if (outputs_.environment)
-        st_.queue.enqueueReadBuffer(env_sum_, CL_TRUE, 0, environmentChannels() * bytes,
-                                    result_.irradiance.data());
+        st_.queue.enqueueReadBuffer(env_sum_, CL_TRUE, 0, environmentChannels() * bytes, result_.irradiance.data());
     }
     if (outputs_.error_estimate) splitHalves();
     finishReduction(result_);
@@ -521,9 +512,7 @@ class HorizonRoutine : public SweepRoutine {
 
   // Between the planes of the environment's sums on the device: a strip's pixels (the field's
   // in one piece).
-  cl_uint sumStride() const {
-    return static_cast<cl_uint>(static_cast<std::size_t>(plan_.strip_rows) * field_.width);
-  }
+  cl_uint sumStride() const { return static_cast<cl_uint>(static_cast<std::size_t>(plan_.strip_rows) * field_.width); }
 
   // Strips: the irradiance sums of rows [s0, s1) from the device (or to it, `to_device`).
   void copyEnvironmentRows(int s0, int s1, bool to_device = false) {
@@ -653,8 +642,8 @@ class HorizonRoutine : public SweepRoutine {
   // horizon_lattice for direction d with everything but the chunk's lines set (rows from 0 on,
   // no line states); `keep` holds the buffers it takes until the launch.
   NamedKernel sweepKernel(const RunDirection& d, cl_uint plane_offset, std::vector<cl::Buffer>& keep) {
-    keep.emplace_back(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                      d.samples.size() * sizeof(LatticeSample), const_cast<LatticeSample*>(d.samples.data()));
+    keep.emplace_back(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, d.samples.size() * sizeof(LatticeSample),
+                      const_cast<LatticeSample*>(d.samples.data()));
     NamedKernel kernel(st_, program_, "horizon_lattice");
     kernel.set("heights", heights_);
     kernel.set("width", field_.width);
@@ -662,8 +651,8 @@ class HorizonRoutine : public SweepRoutine {
     kernel.set("row0", 0);
     kernel.set("out_row0", 0);
     kernel.set("samples", keep.back());
-    keep.emplace_back(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                      d.segments.size() * sizeof(CellSegment), const_cast<CellSegment*>(d.segments.data()));
+    keep.emplace_back(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, d.segments.size() * sizeof(CellSegment),
+                      const_cast<CellSegment*>(d.segments.data()));
     kernel.set("segments", keep.back());
     kernel.set("n_samples", static_cast<int>(d.samples.size()));
     kernel.set("a", d.lattice.a);
@@ -693,8 +682,8 @@ class HorizonRoutine : public SweepRoutine {
     std::vector<cl::Buffer> keep;
     NamedKernel kernel = sweepKernel(d, plane_offset, keep);
     const bool grouped = shiftedPositions() && lanes_ > 1;
-    launchLineChunks(st_, kernel, grouped ? laneGroups(d) : d.lines, d.stack_per_period, plan_.stack_entries,
-                     lanes_, sweepGroup(), grouped);
+    launchLineChunks(st_, kernel, grouped ? laneGroups(d) : d.lines, d.stack_per_period, plan_.stack_entries, lanes_,
+                     sweepGroup(), grouped);
   }
 
   // Direction d's lines ordered by the index of their first receiver along the larger field's
@@ -723,8 +712,7 @@ class HorizonRoutine : public SweepRoutine {
   std::size_t longestLineEntries() const {
     std::size_t longest = 0;
     for (const RunDirection& d : directions_)
-      for (const LatticeLine& line : d.lines)
-        longest = std::max(longest, lineCapacity(line, d.stack_per_period));
+      for (const LatticeLine& line : d.lines) longest = std::max(longest, lineCapacity(line, d.stack_per_period));
     return longest;
   }
 
@@ -742,9 +730,7 @@ class HorizonRoutine : public SweepRoutine {
     const double shortest_period =
         d.row_length.empty() ? d.lattice.period : *std::min_element(d.row_length.begin(), d.row_length.end());
     const std::size_t window_periods =
-        horizon_.max_distance > 0.0
-            ? static_cast<std::size_t>(std::ceil(d.window.window / shortest_period)) + 2
-            : 0;
+        horizon_.max_distance > 0.0 ? static_cast<std::size_t>(std::ceil(d.window.window / shortest_period)) + 2 : 0;
     // Each line's sweep so far: (unused, its stack's size, the stack's offset in carry_in,
     // its position's float bits).
     std::vector<cl_int4> resume(d.lines.size(), cl_int4{{0, 0, 0, 0}});
@@ -772,8 +758,7 @@ class HorizonRoutine : public SweepRoutine {
         cl_int4 state = resume[j];
         state.s[0] = first;
         states.push_back(state);
-        capacities.push_back(static_cast<std::size_t>(state.s[1]) +
-                             (end - first + window_periods) * per_period);
+        capacities.push_back(static_cast<std::size_t>(state.s[1]) + (end - first + window_periods) * per_period);
         if (capacities.back() > plan_.stack_entries)  // the scratch is an eighth of the rest
           failCarry("one line's hull stack", capacities.back(), capacities.back() * kStackEntryBytes * 8);
         owner.push_back(j);
@@ -789,8 +774,8 @@ class HorizonRoutine : public SweepRoutine {
               carried >= (std::size_t(1) << 31))
             failCarry("the hull stacks carried into the next strip", carried_in + carried,
                       (carried_in + carried) * kStackEntryBytes / 7 * 8);
-          const std::size_t grown = std::min(
-              {std::max(carried, 2 * capacity), plan_.carry_entries - carried_in, maxAllocationEntries()});
+          const std::size_t grown =
+              std::min({std::max(carried, 2 * capacity), plan_.carry_entries - carried_in, maxAllocationEntries()});
           cl::Buffer bigger = deviceBuffer(st_, grown * kStackEntryBytes);
           if (capacity) st_.queue.enqueueCopyBuffer(carry_out, bigger, 0, 0, capacity * kStackEntryBytes);
           carry_out = bigger;
@@ -811,8 +796,7 @@ class HorizonRoutine : public SweepRoutine {
         st_.queue.finish();  // before the caller's buffers go
       };
       std::vector<char> next_waiting(d.lines.size(), 0);
-      for (const LineChunk& chunk :
-           chunkLines(lines, capacities, plan_.stack_entries, lineMajorLayout(st_))) {
+      for (const LineChunk& chunk : chunkLines(lines, capacities, plan_.stack_entries, lineMajorLayout(st_))) {
         const cl::Buffer chunk_lines(st_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
                                      chunk.count * sizeof(LatticeLine), lines.data() + chunk.first);
         const cl::Buffer chunk_states(st_.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR,
