@@ -52,15 +52,16 @@ struct HorizonOptions : SweepOptions {
   // given.
   double max_error = 0.0;
   // With max_error, where the field needs them: after the first run (the whole field at 16
-  // directions) each tile of error_tile x error_tile pixels whose estimate's 99th percentile
-  // exceeds max_error is run again at the K its own estimate predicts (on the ladder of
-  // directionLadder), sweeping only the lines that reach it (each cut after its last receiver
-  // there, the horizons still from the whole line beyond), until every tile meets it. A pixel's
-  // values are those of the whole-field run at its tile's last K, bit for bit
-  // (HorizonResult::pixel_directions). 0: the whole field takes one K, the default: on the
-  // benchmark's contents, which mix a city with open ground, refinement cost more than one K
-  // (bench/report/error_target.md: a tile's run also sweeps its lines' whole upstream, and each
-  // tile steps through its own runs).
+  // directions), while the estimate's 99th percentile over the field exceeds max_error, the tiles
+  // of error_tile x error_tile pixels with the most pixels above it (until those left hold at most
+  // half the pixels the percentile lets above it) run again, each at the K its own estimate's 99th
+  // percentile predicts (rounded up to directionLadder), sweeping only the lines that reach them
+  // (each cut after its last receiver there, the horizons still from the whole line beyond). A
+  // pixel's values are those of the whole-field run at its tile's last K, bit for bit
+  // (HorizonResult::pixel_directions). 0, the default: the whole field takes one K. On the
+  // benchmark's contents refinement cost about as much as one K for the sky-view factor and more
+  // for occlusion (bench/report/error_target.md: a tile's run also sweeps its lines' whole
+  // upstream, and each tile steps through runs of its own).
   int error_tile = 0;
 };
 
