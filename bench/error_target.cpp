@@ -43,16 +43,6 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-// The fixed K the search tries, cheapest first: multiples of 8, about 12-25 % apart.
-std::vector<int> fixedLadder() {
-  std::vector<int> ladder;
-  for (int step = 8, k = 8; k <= kMaxAutoDirections; k += step) {
-    ladder.push_back(k);
-    if (k >= 8 * step) step *= 2;
-  }
-  return ladder;
-}
-
 // The work of a run at K per receiver: the samples of one period summed over its directions
 // (the sweep's cost is linear in them; load-free, unlike a time).
 std::size_t samplesPerReceiver(const HeightField& field, int K, const HorizonOutputs& outputs) {
@@ -123,17 +113,21 @@ std::string spread(std::vector<double> v) {
 }  // namespace
 
 void errorTargetReport(const ComputeContext& context, const std::vector<ErrorTargetField>& fields,
-                       const std::vector<double>& errors, int reference_directions, int reps) {
-  const std::vector<int> ladder = fixedLadder();
+                       const std::vector<double>& errors, int reference_directions, int reps, int tile) {
+  const std::vector<int> ladder = directionLadder();
   for (const Output& output : kOutputs) {
     std::printf("\n### %s\n\n", output.name);
     std::printf(
-        "| field | E | runs (K) | estimate | achieved p99 | met | cheapest fixed K | its p99 | time chosen "
-        "(s) | "
-        "time fixed (s) | time ratio | work ratio | last run's work ratio |\n"
-        "|---|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|\n");
-    int met = 0, rows = 0;
-    std::vector<double> ratios, works, last_works;
+        "| field | E | whole field: runs (K) | estimate | achieved p99 | met | tiles of %d: K (runs) | "
+        "estimate | "
+        "achieved p99 | met | cheapest fixed K | its p99 | time whole (s) | time tiles (s) | time fixed (s) "
+        "| "
+        "time ratio whole | time ratio tiles | work ratio whole | last run's | work ratio tiles |\n"
+        "|---|---:|---:|---:|---:|---|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+        "\n",
+        tile);
+    int met = 0, tiles_met = 0, rows = 0;
+    std::vector<double> ratios, tile_ratios, works, last_works, tile_works;
     for (const ErrorTargetField& f : fields) {
       HorizonOutputs wanted;
       HorizonOptions options;
@@ -148,65 +142,84 @@ void errorTargetReport(const ComputeContext& context, const std::vector<ErrorTar
                    p99Difference(computeHorizons(context, f.field, options, wanted).*output.plane, reference);
       };
       for (double E : errors) {
-        HorizonOptions chosen;
-        chosen.max_error = E;
-        HorizonResult result;
+        HorizonOptions whole, tiled;
+        whole.max_error = tiled.max_error = E;
+        whole.error_tile = 0;
+        tiled.error_tile = tile;
+        HorizonResult result, refined;
         try {
-          result = computeHorizons(context, f.field, chosen, wanted);
+          result = computeHorizons(context, f.field, whole, wanted);
+          refined = computeHorizons(context, f.field, tiled, wanted);
         } catch (const InvalidArgument& error) {
-          std::printf("| %s | %g | refused: %s |||||||||\n", f.name.c_str(), E, error.what());
+          std::printf("| %s | %g | refused: %s |||||||||||||||||\n", f.name.c_str(), E, error.what());
           continue;
         }
         const double achieved = p99Difference(result.*output.plane, reference);
+        const double tiles_achieved = p99Difference(refined.*output.plane, reference);
         int cheapest = 0;
         for (int K : ladder)
           if (errorAt(K) <= E) {
             cheapest = K;
             break;
           }
-        // Interleaved: the chosen run (all its runs) and the cheapest fixed K's, alternately (none
-        // with reps = 0: the work ratio alone, free of the machine's load).
-        std::vector<double> t_chosen, t_fixed;
+        // Interleaved: the whole field's runs, the tiles' runs and the cheapest fixed K's, in turn
+        // (none with reps = 0: the work ratios alone, free of the machine's load).
+        std::vector<double> t_whole, t_tiles, t_fixed;
         HorizonOptions fixed;
         fixed.directions = cheapest ? cheapest : kMaxAutoDirections;
         for (int r = 0; r < reps; ++r) {
-          t_chosen.push_back(seconds([&] { computeHorizons(context, f.field, chosen, wanted); }));
+          t_whole.push_back(seconds([&] { computeHorizons(context, f.field, whole, wanted); }));
+          t_tiles.push_back(seconds([&] { computeHorizons(context, f.field, tiled, wanted); }));
           t_fixed.push_back(seconds([&] { computeHorizons(context, f.field, fixed, wanted); }));
         }
         const auto time = [&](const std::vector<double>& t) {
           return reps ? formatted("%.3f", median(t)) : "-";
         };
-        const double ratio = reps ? median(t_chosen) / median(t_fixed) : 0.0;
+        const double ratio = reps ? median(t_whole) / median(t_fixed) : 0.0;
+        const double tile_ratio = reps ? median(t_tiles) / median(t_fixed) : 0.0;
         HorizonOutputs estimated = wanted;
         estimated.error_estimate = true;
         const double fixed_work = samplesPerReceiver(f.field, fixed.directions, wanted);
-        double work = 0.0;
         std::string runs;
-        for (int K : result.runs) {
-          work += samplesPerReceiver(f.field, K, estimated);
-          runs += (runs.empty() ? "" : ", ") + std::to_string(K);
-        }
+        for (int K : result.runs) runs += (runs.empty() ? "" : ", ") + std::to_string(K);
+        const double work = result.samples_per_receiver / fixed_work;
         const double last_work = samplesPerReceiver(f.field, result.directions, estimated) / fixed_work;
+        const double tile_work = refined.samples_per_receiver / fixed_work;
+        const auto [least, most] =
+            std::minmax_element(refined.pixel_directions.begin(), refined.pixel_directions.end());
+        const std::string tile_runs = std::to_string(*least) + ".." + std::to_string(*most) + " (" +
+                                      std::to_string(refined.runs.size()) + ")";
         ++rows;
         met += achieved <= E;
+        tiles_met += tiles_achieved <= E;
         if (cheapest) {
-          if (reps) ratios.push_back(ratio);
-          works.push_back(work / fixed_work);
+          if (reps) ratios.push_back(ratio), tile_ratios.push_back(tile_ratio);
+          works.push_back(work);
           last_works.push_back(last_work);
+          tile_works.push_back(tile_work);
         }
-        std::printf("| %s | %g | %s | %.5f | %.5f | %s | %s | %.5f | %s | %s | %s | %.2f | %.2f |\n",
-                    f.name.c_str(), E, runs.c_str(), result.estimated_error, achieved,
-                    achieved <= E ? "yes" : "**no**", cheapest ? std::to_string(cheapest).c_str() : "none",
-                    cheapest ? errorAt(cheapest) : 0.0, time(t_chosen).c_str(), time(t_fixed).c_str(),
-                    reps ? formatted("%.2f", ratio).c_str() : "-", work / fixed_work, last_work);
+        std::printf(
+            "| %s | %g | %s | %.5f | %.5f | %s | %s | %.5f | %.5f | %s | %s | %.5f | %s | %s | %s | %s | %s "
+            "| %.2f | "
+            "%.2f | %.2f |\n",
+            f.name.c_str(), E, runs.c_str(), result.estimated_error, achieved,
+            achieved <= E ? "yes" : "**no**", tile_runs.c_str(), refined.estimated_error, tiles_achieved,
+            tiles_achieved <= E ? "yes" : "**no**", cheapest ? std::to_string(cheapest).c_str() : "none",
+            cheapest ? errorAt(cheapest) : 0.0, time(t_whole).c_str(), time(t_tiles).c_str(),
+            time(t_fixed).c_str(), reps ? formatted("%.2f", ratio).c_str() : "-",
+            reps ? formatted("%.2f", tile_ratio).c_str() : "-", work, last_work, tile_work);
         std::fflush(stdout);
       }
     }
     std::printf(
-        "\n%s: achieved error at most E in %d of %d cases (%.0f %%); over the cheapest fixed K: time %s; "
-        "work %s; the last run's work alone %s\n",
-        output.name, met, rows, rows ? 100.0 * met / rows : 0.0, spread(ratios).c_str(),
-        spread(works).c_str(), spread(last_works).c_str());
+        "\n%s: achieved error at most E in %d of %d cases (%.0f %%) with the whole field at one K, in %d "
+        "with "
+        "tiles of %d; over the cheapest fixed K: the whole field's time %s, work %s, its last run's work "
+        "alone "
+        "%s; the tiles' time %s, work %s\n",
+        output.name, met, rows, rows ? 100.0 * met / rows : 0.0, tiles_met, tile, spread(ratios).c_str(),
+        spread(works).c_str(), spread(last_works).c_str(), spread(tile_ratios).c_str(),
+        spread(tile_works).c_str());
   }
 }
 
@@ -307,7 +320,7 @@ void errorCurve(const ComputeContext& context, const std::vector<ErrorTargetFiel
           referencePlane(context, f.field, output, reference_directions, wanted, options);
       wanted.error_estimate = true;
       std::map<int, std::vector<float>> results;
-      for (int K : fixedLadder()) {
+      for (int K : directionLadder()) {
         if (K > max_directions) break;
         options.directions = K;
         HorizonResult result;

@@ -19,9 +19,11 @@ struct ErrorTargetField {
 };
 
 // Markdown on stdout: one table per output (SVF, AO) with a row per (field, E), and the share
-// of rows where the achieved error is at most E. `reference_directions`: the dense run's K.
+// of rows where the achieved error is at most E, for the whole field at one K
+// (HorizonOptions::error_tile 0) and refined in tiles of `tile` pixels. `reference_directions`:
+// the dense run's K.
 void errorTargetReport(const ComputeContext& context, const std::vector<ErrorTargetField>& fields,
-                       const std::vector<double>& errors, int reference_directions, int reps);
+                       const std::vector<double>& errors, int reference_directions, int reps, int tile);
 
 // The same for the visible count of intervisibility (IntervisibilityOptions::max_error,
 // relative): one table, its error the 99th percentile over the pixels of the count's error (per

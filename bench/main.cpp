@@ -101,7 +101,7 @@ constexpr const char* kUsage =
     "                                      [--samples N] [--seed S] RASTER...\n"
     "       hfvis_bench viewshed-culling [--levels 1,2,3,4] [--reps N] FIELD...\n"
     "       hfvis_bench error-target [--data DIR] [--dem FILE] [--size N] [--errors E,...] [--contents A,B]\n"
-    "                                [--reference-k K] [--reps N] [--curve KMAX]\n"
+    "                                [--reference-k K] [--reps N] [--tile T] [--curve KMAX]\n"
     "                                [--output svf-ao|viewcount]\n"
     "       hfvis_bench pvs-rays [--size N] [--rays R] [--reps K] [--dem FILE] FIELD...\n"
     "       hfvis_bench pvs-recall [--size N] [--view-cell C] [--tile T] [--samples N,N,...]\n"
@@ -532,6 +532,8 @@ int main(int argc, char** argv) {
       const std::string output = args.get("--output", "svf-ao");
       if (output != "svf-ao" && output != "viewcount")
         throw Usage("error-target: --output is svf-ao or viewcount");
+      const int tile = std::stoi(args.get("--tile", std::to_string(HorizonOptions{}.error_tile)));
+      if (tile < 1) throw Usage("error-target: --tile is a number of pixels");
       const std::vector<std::string> names =
           textList(args.get("--contents", "fractal,bricks,sine,blocks,city_dsm,dem,mixed"));
       args.rejectUnused();
@@ -540,6 +542,19 @@ int main(int argc, char** argv) {
         const auto content = [&](const std::string& which) {
           return crop(loadContent(options, which, 256).field, n, n);
         };
+        if (name == "city_plain" || name == "town") {
+          // An open plain beside a city: the city DSM with all but its left half (city_plain) or
+          // its top-left quarter (town) levelled at its lowest height; the plain's pixels still see
+          // the buildings.
+          HeightField plain = content("city_dsm");
+          const float ground = *std::min_element(plain.heights.begin(), plain.heights.end());
+          for (int r = 0; r < plain.height; ++r)
+            for (int c = 0; c < plain.width; ++c)
+              if (c >= plain.width / 2 || (name == "town" && r >= plain.height / 2))
+                plain.heights[static_cast<std::size_t>(r) * plain.width + c] = ground;
+          fields.push_back({name, plain});
+          continue;
+        }
         if (name != "mixed") {
           fields.push_back({name, content(name)});
           continue;
@@ -563,7 +578,7 @@ int main(int argc, char** argv) {
         return 0;
       }
       errorTargetReport(ComputeContext::create(ContextOptions::fromEnvironment()), fields, errors, reference,
-                        reps);
+                        reps, tile);
       return 0;
     }
     if (command == "check-truth") return checkTruth();

@@ -51,7 +51,6 @@ std::string shortened(const std::string& text) {
                           : text;
 }
 
-
 // Strict number parsing: the whole text must be a finite number.
 double parseNumber(const std::string& option, const std::string& text) {
   const char* begin = text.c_str();
@@ -428,9 +427,10 @@ const std::vector<OptionSpec>& optionTable() {
        "(absolute for the sky-view factor and occlusion; intervisibility: of\n"
        "the count, relative to its mean; shade --env: relative to the mean\n"
        "irradiance); a first run at 16 directions predicts the K needed,\n"
-       "refused when beyond 4096; the K chosen and the\n"
+       "refused when beyond 4096 (see --error-tile); the largest K and the\n"
        "estimate go into the summary and the hfvis:directions and\n"
-       "hfvis:estimated_error attributes",
+       "hfvis:estimated_error attributes (hfvis:directions_range: the least\n"
+       "and most K; --error-out's channel directions: each pixel's)",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
          run.max_error = parseNumber(typed, value);
          if (!(run.max_error > 0.0 && run.max_error < 1.0))
@@ -438,6 +438,18 @@ const std::vector<OptionSpec>& optionTable() {
                             ": the maximum error must lie in (0, 1) (absolute in the sky-view factor's and "
                             "occlusion's 0..1, relative for intervisibility and shade --env), got " +
                             inQuotes(value));
+       }},
+      {"--error-tile", nullptr, "N", kErrorTargetGroup, false,
+       "with --max-error: refine in tiles of N x N pixels, each run again at its\n"
+       "own K over the lines that reach it, where the estimate asks for more\n"
+       "(default 0: the whole field takes one K, which costs less on the\n"
+       "benchmark's contents, bench/report/error_target.md)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         const double tile = parseNumber(typed, value);
+         if (!(tile >= 0.0 && tile <= 1e6 && tile == std::floor(tile)))
+           throw UsageError(typed + ": a tile is a whole number of pixels (0: the whole field), got " +
+                            inQuotes(value));
+         run.error_tile = static_cast<int>(tile);
        }},
       {"--error-out", nullptr, "FILE", kErrorTargetGroup, false,
        "also write the per-pixel error estimate (channel \"error\"): half the\n"
@@ -1023,6 +1035,7 @@ HorizonOptions horizonOptions(const RunArguments& run) {
   // (the largest tolerance in degrees may round to a hair above 0.1 radian)
   options.azimuth_tolerance = std::min(0.1, run.azimuth_tolerance_deg * (kPi / 180.0));
   options.max_error = run.max_error;
+  options.error_tile = run.error_tile;
   return options;
 }
 

@@ -60,6 +60,7 @@ struct RunArguments {
   // sky-view-factor and ambient-occlusion: --max-error E (0 = not asked: K as given) and
   // --error-out FILE, the per-pixel error estimate ("" = not asked for).
   double max_error = 0.0;
+  int error_tile = 0;  // --error-tile N: HorizonOptions::error_tile
   std::string error_output;
   double azimuth_offset_deg = 0.0;
   double samples_per_unit = 1.0;

@@ -139,6 +139,10 @@ try "maximum error zero" "" -- svf field.exr -o out/o.exr --max-error 0
 try "maximum error of 1 or more (SVF lies in 0..1)" "" -- ao field.exr -o out/o.exr --max-error 1
 try "maximum error with -k" "" -- svf field.exr -o out/o.exr --max-error 0.01 -k 16
 try "maximum error beyond 4096 directions" "" -- svf field.exr -o out/o.exr --max-error 1e-7
+try "error tile without a maximum error" "" -- svf field.exr -o out/o.exr --error-tile 32
+try "error tile not a whole number" "" -- svf field.exr -o out/o.exr --max-error 0.01 --error-tile 2.5
+try "error tile negative" "" -- ao field.exr -o out/o.exr --max-error 0.01 --error-tile -8
+try "error tile for the visible count" "" -- viewcount field.exr -o out/o.exr --max-error 0.1 --error-tile 32
 try "error estimate output is the output" "" -- svf field.exr -o out/o.exr --error-out out/o.exr
 try "error estimate output is the input" "" -- ao field.exr -o out/o.exr -k 8 --error-out field.exr
 try "error estimate with one direction" "" -- svf field.exr -o out/o.exr -k 1 --error-out out/e.exr

@@ -686,30 +686,46 @@ TEST_F(Cli, OpenImageIoIsLoadedOnlyForTheImagesThatNeedIt) {
 
 // --max-error chooses K and --error-out writes the estimate: the same K, values and estimate as the
 // library's call (hfvis:directions the K run, not -k's default), in both files' attributes; a
-// refused E (beyond 4096 directions) writes neither file.
+// refused E (beyond 4096 directions) writes neither file. With --error-tile the estimate file also
+// holds each pixel's K (channel directions), and hfvis:directions_range the least and most.
 TEST_F(Cli, MaxErrorWritesTheChosenKAndTheEstimate) {
   const std::string field = writeField("bumps.exr", 40, 33, [](int col, int row) {
     return 3.0f * std::sin(0.7f * col) * std::cos(0.5f * row) + ((col / 5 + row / 4) % 3 == 0 ? 4.0f : 0.0f);
   });
   const CliResult r = run("svf " + shellQuoted(field) + " -o " + shellQuoted(out("s.exr")) +
-                          " --max-error 0.02 --error-out " + shellQuoted(out("e.exr")));
+                          " --max-error 0.02 --error-tile 16 --error-out " + shellQuoted(out("e.exr")));
   ASSERT_EQ(r.status, 0) << r.err;
   hfvis::HorizonOptions options;
   options.max_error = 0.02;
+  options.error_tile = 16;
   const hfvis::SkyViewFactorResult lib =
       hfvis::computeSkyViewFactor(hfvis::testing::testContext(), hfvis::readHeightField(field), options);
   ASSERT_NE(lib.directions, 64);  // (else the attribute could not tell -k's default from the K run)
   EXPECT_NE(r.out.find(std::to_string(lib.directions) + " directions"), std::string::npos) << r.out;
   const ReadBack svf = readBack(out("s.exr")), estimate = readBack(out("e.exr"));
-  ASSERT_EQ(estimate.channels, (std::vector<std::string>{"error"}));
+  // (OpenEXR keeps its channels sorted by name)
+  std::vector<std::string> channels = estimate.channels;
+  std::sort(channels.begin(), channels.end());
+  ASSERT_EQ(channels, (std::vector<std::string>{"directions", "error"}));
+  const std::size_t error_channel = estimate.channels[0] == "error" ? 0 : 1;
   ASSERT_EQ(svf.pixels.size(), lib.values.size());
-  ASSERT_EQ(estimate.pixels.size(), lib.error_estimate.size());
+  ASSERT_EQ(estimate.pixels.size(), 2 * lib.error_estimate.size());
+  hfvis::HorizonOutputs svf_only;
+  svf_only.sky_view_factor = true;
+  const std::vector<int> taken =
+      hfvis::computeHorizons(hfvis::testing::testContext(), hfvis::readHeightField(field), options, svf_only)
+          .pixel_directions;
+  ASSERT_EQ(taken.size(), lib.values.size());
   for (std::size_t p = 0; p < lib.values.size(); ++p) {
     ASSERT_EQ(svf.pixels[p], lib.values[p]) << p;
-    ASSERT_EQ(estimate.pixels[p], lib.error_estimate[p]) << p;
+    ASSERT_EQ(estimate.pixels[2 * p + error_channel], lib.error_estimate[p]) << p;
+    ASSERT_EQ(estimate.pixels[2 * p + 1 - error_channel], static_cast<float>(taken[p])) << p;
   }
+  const auto [least, most] = std::minmax_element(taken.begin(), taken.end());
   for (const ReadBack* image : {&svf, &estimate}) {
     EXPECT_EQ(image->spec.get_string_attribute("hfvis:directions"), std::to_string(lib.directions));
+    EXPECT_EQ(image->spec.get_string_attribute("hfvis:directions_range"),
+              std::to_string(*least) + ".." + std::to_string(*most));
     EXPECT_EQ(image->spec.get_string_attribute("hfvis:max_error"), "0.02");
     EXPECT_NEAR(std::stod(image->spec.get_string_attribute("hfvis:estimated_error")), lib.estimated_error,
                 1e-9);

@@ -9,6 +9,7 @@
 #include <functional>
 #include <limits>
 
+#include "core/horizon_common.hpp"
 #include "core/lattice_geometry.hpp"
 #include "hfvis/ambient_occlusion.hpp"
 #include "hfvis/errors.hpp"
@@ -184,7 +185,7 @@ TEST(HorizonErrorEstimate, MergedStepsStayInTheirHalf) {
 
 // A maximum error: the K chosen meets it by the estimate, the estimate lies above the error
 // against a dense run (K = 1024) at the pixels' 99th percentile, a smaller error never takes
-// fewer directions, and the estimate falls with it.
+// fewer directions, and the estimate falls with it; refined in tiles, the error is met as well.
 TEST(HorizonMaxError, MeetsTheTargetAgainstADenseRun) {
   for (const char* name : {"noise", "city"}) {
     SCOPED_TRACE(name);
@@ -200,6 +201,7 @@ TEST(HorizonMaxError, MeetsTheTargetAgainstADenseRun) {
       SCOPED_TRACE(E);
       HorizonOptions options;
       options.max_error = E;
+      options.error_tile = 0;
       const SkyViewFactorResult r = computeSkyViewFactor(testContext(), field, options);
       EXPECT_LE(r.estimated_error, E);
       EXPECT_LE(p99Difference(r.values, truth.values), E);
@@ -212,8 +214,13 @@ TEST(HorizonMaxError, MeetsTheTargetAgainstADenseRun) {
       EXPECT_EQ(runs.runs.front(), 16);
       EXPECT_EQ(runs.runs.back(), r.directions);
       EXPECT_TRUE(std::is_sorted(runs.runs.begin(), runs.runs.end(), std::less_equal<int>()));
+      for (int K : runs.pixel_directions) ASSERT_EQ(K, r.directions);
       last_directions = r.directions;
       last_estimate = r.estimated_error;
+      options.error_tile = 16;
+      const SkyViewFactorResult tiles = computeSkyViewFactor(testContext(), field, options);
+      EXPECT_LE(tiles.estimated_error, E);
+      EXPECT_LE(p99Difference(tiles.values, truth.values), E);
     }
     HorizonOptions options;
     options.max_error = 0.01;
@@ -225,6 +232,80 @@ TEST(HorizonMaxError, MeetsTheTargetAgainstADenseRun) {
         p99Difference(ao.values, computeHorizons(testContext(), field, dense, ao_only).ambient_occlusion),
         0.01);
   }
+}
+
+// Open and dense parts in one field: the synthetic city with its right part levelled (0 there).
+HeightField cityBesideFlat(const char* name, int width, int height) {
+  HeightField field = makeSyntheticField(name, width, height);
+  for (int r = 0; r < height; ++r)
+    for (int c = width / 2; c < width; ++c) {
+      float& h = field.heights[static_cast<std::size_t>(r) * width + c];
+      if (!std::isnan(h)) h = 0.0f;
+    }
+  return field;
+}
+
+// Refinement in tiles (HorizonOptions::error_tile): every pixel's values and estimate are those of
+// a whole-field run at the K it records (HorizonResult::pixel_directions), bit for bit, though the
+// runs after the first sweep only the lines that reach their tiles (cut after them); the estimate
+// meets E; the open part stops at fewer directions than the dense one, and the runs swept fewer
+// receivers than whole-field runs at their K. On the city and nodata hard cases, in both
+// buffer layouts, in one piece and in strips, and within a maximum distance.
+TEST(HorizonMaxError, RefinedTilesEqualAWholeFieldRunAtTheirK) {
+  testing::forEachLayout([](const ComputeContext& context) {
+    for (const char* name : {"city", "nan_holes"}) {
+      const HeightField field = cityBesideFlat(name, 41, 31);
+      for (const auto& [strip_rows, max_distance] :
+           {std::pair{0, 0.0}, std::pair{9, 0.0}, std::pair{0, 12.5}}) {
+        SCOPED_TRACE(std::string(name) + " strip rows " + std::to_string(strip_rows) + " max distance " +
+                     std::to_string(max_distance));
+        HorizonOptions options;
+        options.max_error = 0.02;
+        options.error_tile = 10;
+        options.strip_rows = strip_rows;
+        options.max_distance = max_distance;
+        HorizonOutputs both;
+        both.sky_view_factor = both.ambient_occlusion = true;
+        const HorizonResult refined = computeHorizons(context, field, options, both);
+        ASSERT_EQ(refined.pixel_directions.size(), field.pixelCount());
+        std::vector<int> taken = refined.pixel_directions;
+        std::sort(taken.begin(), taken.end());
+        taken.erase(std::unique(taken.begin(), taken.end()), taken.end());
+        ASSERT_GE(taken.size(), 2u) << "no refinement to test";
+        EXPECT_EQ(taken.back(), refined.directions);
+        for (int K : taken) {
+          SCOPED_TRACE(K);
+          HorizonOptions fixed = options;
+          fixed.max_error = 0.0;
+          fixed.directions = K;
+          const HorizonResult whole = computeHorizons(context, field, fixed, estimated());
+          std::size_t compared = 0;
+          for (std::size_t p = 0; p < field.pixelCount(); ++p) {
+            if (refined.pixel_directions[p] != K) continue;
+            const auto same = [](float x, float y) { return x == y || (std::isnan(x) && std::isnan(y)); };
+            ASSERT_TRUE(same(refined.sky_view_factor[p], whole.sky_view_factor[p])) << p;
+            ASSERT_TRUE(same(refined.ambient_occlusion[p], whole.ambient_occlusion[p])) << p;
+            ASSERT_TRUE(same(refined.error_estimate[p], whole.error_estimate[p])) << p;
+            ++compared;
+          }
+          EXPECT_GT(compared, 0u);
+        }
+        // The estimate's 99th percentile over the field meets E.
+        EXPECT_LE(refined.estimated_error, options.max_error);
+        // The levelled far corner needs fewer directions than the city's.
+        EXPECT_LT(refined.pixel_directions[field.pixelCount() - 1], refined.directions);
+        // The runs after the first swept fewer receivers than whole-field runs at their K would have.
+        double whole_field_work = 0.0;
+        for (int K : refined.runs) {
+          HorizonOptions fixed = options;
+          fixed.directions = K;
+          for (const auto& d : detail::horizonDirections(field, fixed, estimated()))
+            whole_field_work += static_cast<double>(detail::latticeSamples(d, fixed.samples_per_unit).size());
+        }
+        EXPECT_LT(refined.samples_per_receiver, whole_field_work);
+      }
+    }
+  });
 }
 
 // The estimate's calibration on hard cases: as K doubles it falls, and at each K it lies at or above

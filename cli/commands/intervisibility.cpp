@@ -107,6 +107,8 @@ void checkIntervisibility(const std::string& name, const RunArguments& run) {
         "--max-error and --error-out need --method tree (the naive method's rays are not split in halves)");
   if (run.max_error > 0.0 && run.directions_given)
     throw UsageError(name + ": --max-error chooses K itself; give either it or -k");
+  if (run.error_tile > 0)
+    throw UsageError(name + ": --error-tile refines the sky-view factor and occlusion only; the whole field takes one K here");
   asUsageError([&] { validate(intervisibilityOptions(run), intervisibilityOutputs(run)); });
 }
 

@@ -155,6 +155,8 @@ void checkShade(const std::string&, const RunArguments& run) {
     throw UsageError("--max-error and --error-out need --env (the sun's shadow has no directions to choose)");
   if (run.max_error > 0.0 && run.directions_given)
     throw UsageError("shade: --max-error chooses K itself; give either it or -k");
+  if (run.error_tile > 0)
+    throw UsageError("shade: --error-tile refines the sky-view factor and occlusion only; the whole field takes one K here");
   if (!run.error_output.empty() && run.max_error == 0.0)
     throw UsageError("shade: --error-out needs --max-error (the estimate compares the runs at K and K / 2)");
   if (run.environment.empty() && (run.environment_rotation_deg != 0.0 || run.environment_rows != 0))

@@ -1,6 +1,7 @@
 // cli/commands/swept_horizons.cpp: see swept_horizons.hpp.
 #include "swept_horizons.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace hfvis::cli {
@@ -24,6 +25,11 @@ Attributes sweptAttributes(const Job& job, const HorizonResult& result) {
   for (auto& [name, value] : attributes)
     if (name == "hfvis:directions") value = std::to_string(result.directions);
   if (job.run.max_error > 0.0) attributes.emplace_back("hfvis:max_error", formatNumber(job.run.max_error));
+  if (!result.pixel_directions.empty()) {  // refined by tile: the least K a pixel took to the most
+    const auto [least, most] =
+        std::minmax_element(result.pixel_directions.begin(), result.pixel_directions.end());
+    attributes.emplace_back("hfvis:directions_range", std::to_string(*least) + ".." + std::to_string(*most));
+  }
   if (!result.error_estimate.empty())
     attributes.emplace_back("hfvis:estimated_error", formatNumber(result.estimated_error));
   return attributes;
@@ -47,10 +53,17 @@ Summary HorizonQuantityComputation::write(Job& job, OutputFiles& outputs) {
                                        quantity_.units));
   if (!run_.error_output.empty()) {
     requireSize(result_.error_estimate, field.pixelCount(), "error estimate");
-    outputs.image(run_.error_output,
-                  job.image(field, {"error"}, {result_.error_estimate}, attributes,
-                            std::string("estimated error of the ") + quantity_.what,
-                            "absolute, in the output's unit; NaN at nodata"));
+    std::vector<std::string> names{"error"};
+    std::vector<std::vector<float>> planes{result_.error_estimate};
+    if (!result_.pixel_directions.empty()) {  // --max-error: the K each pixel's values come from
+      names.push_back("directions");
+      planes.emplace_back(result_.pixel_directions.begin(), result_.pixel_directions.end());
+    }
+    outputs.image(
+        run_.error_output,
+        job.image(field, names, planes, attributes, std::string("estimated error of the ") + quantity_.what,
+                  "absolute, in the output's unit; NaN at nodata (channel directions: the K of the "
+                  "pixel's run)"));
   }
   Summary summary{result_.directions};
   summary.note = "; mean " + std::string(quantity_.channel) + " " + formatFixed(finiteMean(plane), 4);

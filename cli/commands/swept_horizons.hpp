@@ -44,6 +44,8 @@ template <const HorizonQuantity& quantity>
 void checkHorizonQuantity(const std::string& name, const RunArguments& run) {
   if (run.max_error > 0.0 && run.directions_given)
     throw UsageError(name + ": --max-error chooses K itself; give either it or -k");
+  if (run.error_tile > 0 && run.max_error == 0.0)
+    throw UsageError(name + ": --error-tile refines toward --max-error; give it with --max-error");
   asUsageError([&] { validate(horizonOptions(run), horizonOutputs(quantity.command, run)); });
 }
 template <const HorizonQuantity& quantity>

@@ -47,13 +47,31 @@ struct HorizonOptions : SweepOptions {
   // 99th percentile of the error estimate (HorizonResult::estimated_error) is at most max_error,
   // in their own unit (absolute, both lie in 0..1); HorizonResult::directions says which K. A
   // first run at 16 directions and each one after it predicts the K needed (the estimate falls
-  // as K^-p, p measured from the last two runs), until the estimate is met. Throws InvalidArgument, naming the K it would take,
-  // when a run predicts more than kMaxAutoDirections. The samples per unit stay as given.
+  // as K^-p, p measured from the last two runs), until the estimate is met. Throws InvalidArgument, naming
+  // the K it would take, when a run predicts more than kMaxAutoDirections. The samples per unit stay as
+  // given.
   double max_error = 0.0;
+  // With max_error, where the field needs them: after the first run (the whole field at 16
+  // directions), while the estimate's 99th percentile over the field exceeds max_error, the tiles
+  // of error_tile x error_tile pixels with the most pixels above it (until those left hold at most
+  // half the pixels the percentile lets above it) run again, each at the K its own estimate's 99th
+  // percentile predicts (rounded up to directionLadder), sweeping only the lines that reach them
+  // (each cut after its last receiver there, the horizons still from the whole line beyond). A
+  // pixel's values are those of the whole-field run at its tile's last K, bit for bit
+  // (HorizonResult::pixel_directions). 0, the default: the whole field takes one K. On the
+  // benchmark's contents refinement cost about as much as one K for the sky-view factor and more
+  // for occlusion (bench/report/error_target.md: a tile's run also sweeps its lines' whole
+  // upstream, and each tile steps through runs of its own).
+  int error_tile = 0;
 };
 
 // The most directions max_error may choose.
 constexpr int kMaxAutoDirections = 4096;
+
+// The K max_error's runs take, ascending: multiples of 8 about 12-25 % apart, from 8 to
+// kMaxAutoDirections (a tile's predicted K is rounded up to the next one, so that tiles of about
+// the same need share a run).
+std::vector<int> directionLadder();
 
 // What to compute; only what is asked for is stored or reduced.
 struct HorizonOutputs {
@@ -89,9 +107,16 @@ struct HorizonResult {
   // benchmark's contents it lies above the full K's error (bench/report/error_target.md).
   std::vector<float> error_estimate;
   double estimated_error = 0.0;  // its 99th percentile over the pixels with data; 0 without it
-  // With HorizonOptions::max_error: the K of each run it made, in order (the last is `directions`),
-  // so that its whole cost is known; empty otherwise.
+  // With HorizonOptions::max_error: the K of each run it made, in order, so that its whole cost
+  // is known (with error_tile, runs after the first cover only the tiles that needed them); empty
+  // otherwise. `directions` is then the largest K any pixel took, and `azimuths` that run's.
   std::vector<int> runs;
+  // With HorizonOptions::max_error, per pixel: the K of the run its values (and estimate) come from.
+  std::vector<int> pixel_directions;
+  // The sweep's work, all runs together (with max_error; else this run's): per receiver of the
+  // field, the samples of each direction's period times the receivers on the lines it swept
+  // (a whole-field run at K: its directions' samples per period summed; 0 for the naive method).
+  double samples_per_receiver = 0.0;
 };
 
 // Throws InvalidArgument for bad sweep options (see sweep_options.hpp) or when no output

@@ -23,6 +23,9 @@ void validate(const HorizonOptions& options, const HorizonOutputs& outputs) {
     throw InvalidArgument("no output requested");
   }
   detail::validateStripRows(options.strip_rows, options.method == HorizonMethod::Naive);
+  if (options.error_tile < 0)
+    throw InvalidArgument("the error tile must be 0 (the whole field) or a number of pixels (got " +
+                          std::to_string(options.error_tile) + ")");
   if (options.max_error != 0.0 || outputs.error_estimate) {
     if (outputs.horizon_angles || outputs.horizon_distances || outputs.environment ||
         (!outputs.sky_view_factor && !outputs.ambient_occlusion))
@@ -35,6 +38,15 @@ void validate(const HorizonOptions& options, const HorizonOutputs& outputs) {
       throw InvalidArgument("an error estimate needs K >= 2 (it compares the even and the odd directions)");
   }
   if (outputs.environment) validate(*outputs.environment);
+}
+
+std::vector<int> directionLadder() {
+  std::vector<int> ladder;
+  for (int step = 8, k = 8; k <= kMaxAutoDirections; k += step) {
+    ladder.push_back(k);
+    if (k >= 8 * step) step *= 2;
+  }
+  return ladder;
 }
 
 namespace detail {

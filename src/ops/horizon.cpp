@@ -6,17 +6,20 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <limits>
+#include <map>
+#include <numeric>
 #include <sstream>
 
 #include "core/environment_swaths.hpp"
 #include "core/fast_math.hpp"
-#include "hfvis/errors.hpp"
 #include "core/horizon_common.hpp"
 #include "core/lattice_geometry.hpp"
 #include "core/opencl_context.hpp"
 #include "core/sweep_framework.hpp"
 #include "core/sweep_routine.hpp"
+#include "hfvis/errors.hpp"
 
 namespace hfvis {
 namespace detail {
@@ -197,8 +200,27 @@ RunPlan planRun(const HeightField& field, const HorizonOptions& options, const H
   return plan;
 }
 
+// The lines of step (a, b) that reach a pixel of `wanted` (non-zero per pixel), each cut after its
+// last receiver there: receiver i's horizon comes from the part of its line beyond it (receivers 0
+// .. i - 1 and the samples between), which the cut leaves as it was.
+std::vector<LatticeLine> linesReaching(const std::vector<LatticeLine>& lines, int a, int b, int width,
+                                       const std::vector<char>& wanted) {
+  std::vector<LatticeLine> kept;
+  for (LatticeLine line : lines) {
+    int last = -1;
+    for (int i = 0; i < line.receivers; ++i)
+      if (wanted[static_cast<std::size_t>(line.row - i * b) * width + (line.col - i * a)]) last = i;
+    if (last < 0) continue;
+    line.receivers = last + 1;
+    kept.push_back(line);
+  }
+  return kept;
+}
+
+// `wanted` (null: every pixel): the sweep runs only the lines that reach those pixels
+// (linesReaching); the others' outputs are left unfinished.
 std::vector<RunDirection> runDirectionsOf(const HeightField& field, const HorizonOptions& options,
-                                          const HorizonOutputs& outputs) {
+                                          const HorizonOutputs& outputs, const std::vector<char>* wanted) {
   std::vector<RunDirection> out;
   if (options.method == HorizonMethod::Sweep) {
     const std::vector<LatticeDirection> directions = horizonDirections(field, options, outputs);
@@ -222,6 +244,7 @@ std::vector<RunDirection> runDirectionsOf(const HeightField& field, const Horizo
                      {},
                      {},
                      static_cast<int>(k)});
+      if (wanted) out.back().lines = linesReaching(out.back().lines, d.a, d.b, field.width, *wanted);
       if (!rows.empty()) {
         out.back().row_length = std::move(rows[k].length);
         out.back().row_terms = std::move(rows[k].terms);
@@ -263,13 +286,14 @@ struct StacksBeyondStrips : MemoryBudgetError {
 
 class HorizonRoutine : public SweepRoutine {
  public:
+  // `wanted`: as runDirectionsOf takes it.
   HorizonRoutine(ContextState& st, const HeightField& field, const HorizonOptions& options,
-                 const HorizonOutputs& outputs)
+                 const HorizonOutputs& outputs, const std::vector<char>* wanted = nullptr)
       : SweepRoutine(st, field, options),
         horizon_(options),
         outputs_(outputs),
         lanes_(simdLanes(st)),
-        directions_(runDirectionsOf(field, options, outputs)),
+        directions_(runDirectionsOf(field, options, outputs, wanted)),
         plan_(planRun(field, options, outputs, directions_, st.info)) {
     // A window's blocks are per line, so its strips, and with per-row spacing its whole sweep
     // (positions differ by line there), run one line per work-item.
@@ -433,6 +457,15 @@ class HorizonRoutine : public SweepRoutine {
     }
     if (outputs_.error_estimate) splitHalves();
     finishReduction(result_);
+    if (horizon_.method == HorizonMethod::Sweep) {
+      double samples = 0.0;
+      for (const RunDirection& d : directions_) {
+        std::size_t receivers = 0;
+        for (const LatticeLine& line : d.lines) receivers += line.receivers;
+        samples += static_cast<double>(d.samples.size()) * receivers;
+      }
+      result_.samples_per_receiver = samples / static_cast<double>(field_.pixelCount());
+    }
   }
 
   // The sky-view factor's and occlusion's sums of rows [s0, s1) from the device (the odd
@@ -881,6 +914,106 @@ class HorizonRoutine : public SweepRoutine {
       placeholder_, env_sum_, env_tables_;
 };
 
+// HorizonOptions::max_error: the whole field at kFirstAutoDirections, then, while the estimate's
+// 99th percentile over the field exceeds max_error, tiles again at the K their own estimate's 99th
+// percentile predicts, those of one K in one run over the lines that reach them: the tiles with
+// the most pixels above max_error first, until those left hold at most half the pixels the field's
+// percentile lets above it (error_tile 0: one tile, K as directionsForError predicts it, not
+// rounded to the ladder). `run(K, wanted)`: a run at K with the error estimate over the lines that
+// reach the pixels of `wanted` (null: the whole field).
+HorizonResult runToError(const HeightField& field, const HorizonOptions& options,
+                         const std::function<HorizonResult(int, const std::vector<char>*)>& run) {
+  const int width = field.width, height = field.height;
+  const int side = options.error_tile > 0 ? options.error_tile : std::max(width, height);
+  const int tiles_x = (width + side - 1) / side, tiles = tiles_x * ((height + side - 1) / side);
+  std::vector<int> tile_of(field.pixelCount());
+  for (int r = 0; r < height; ++r)
+    for (int c = 0; c < width; ++c)
+      tile_of[static_cast<std::size_t>(r) * width + c] = r / side * tiles_x + c / side;
+  HorizonResult result = run(kFirstAutoDirections, nullptr);
+  result.runs = {kFirstAutoDirections};
+  result.pixel_directions.assign(field.pixelCount(), kFirstAutoDirections);
+  double work = result.samples_per_receiver;
+  struct Tile {
+    int directions = kFirstAutoDirections, earlier = 0;
+    double earlier_estimate = 0.0;
+  };
+  std::vector<Tile> state(tiles);
+  const std::vector<int> ladder = directionLadder();
+  // Pixels with data the 99th percentile (estimatedError) lets lie above it.
+  const std::size_t with_data = static_cast<std::size_t>(std::count_if(
+      result.error_estimate.begin(), result.error_estimate.end(), [](float e) { return !std::isnan(e); }));
+  const std::size_t allowed =
+      with_data ? with_data - 1 - std::min(with_data - 1, static_cast<std::size_t>(0.99 * with_data)) : 0;
+  for (;;) {
+    std::vector<std::vector<float>> estimates(tiles);
+    std::vector<std::size_t> above(tiles, 0);
+    for (std::size_t p = 0; p < tile_of.size(); ++p) {
+      estimates[tile_of[p]].push_back(result.error_estimate[p]);
+      above[tile_of[p]] += result.error_estimate[p] > options.max_error;  // (NaN: not above)
+    }
+    std::size_t left = std::accumulate(above.begin(), above.end(), std::size_t{0});
+    if (left <= allowed) break;
+    std::vector<int> order(tiles);
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(), [&](int x, int y) { return above[x] > above[y]; });
+    std::map<int, std::vector<char>> next;  // K -> the tiles to run at it
+    for (int t : order) {
+      if (left <= allowed / 2 || above[t] == 0) break;
+      left -= above[t];
+      Tile& tile = state[t];
+      const double estimate = estimatedError(estimates[t]);
+      int directions = directionsForError(tile.directions, estimate, tile.earlier, tile.earlier_estimate,
+                                          options.max_error);
+      if (directions > kMaxAutoDirections) {
+        std::ostringstream message;
+        // (directionsForError caps its answer at twice the most: beyond that, a bound)
+        message << "a maximum error of " << options.max_error << " needs "
+                << (directions >= 2 * kMaxAutoDirections ? "at least " : "about ") << directions
+                << " directions (the estimate at K = " << tile.directions << " is " << estimate
+                << (tiles > 1 ? " in the tile of pixels from column " + std::to_string(t % tiles_x * side) +
+                                    ", row " + std::to_string(t / tiles_x * side)
+                              : std::string())
+                << "), beyond the " << kMaxAutoDirections
+                << " a run may choose: ask for a larger error, or give K";
+        throw InvalidArgument(message.str());
+      }
+      if (options.error_tile > 0) directions = *std::lower_bound(ladder.begin(), ladder.end(), directions);
+      tile.earlier = tile.directions;
+      tile.earlier_estimate = estimate;
+      tile.directions = directions;
+      std::vector<char>& chosen = next[directions];
+      chosen.resize(tiles, 0);
+      chosen[t] = 1;
+    }
+    for (const auto& [directions, chosen] : next) {
+      std::vector<char> wanted(field.pixelCount());
+      for (std::size_t p = 0; p < wanted.size(); ++p) wanted[p] = chosen[tile_of[p]];
+      const bool all = std::count(chosen.begin(), chosen.end(), 1) == tiles;
+      HorizonResult part = run(directions, all ? nullptr : &wanted);
+      result.runs.push_back(directions);
+      work += part.samples_per_receiver;
+      const auto take = [&](std::vector<float>& into, const std::vector<float>& from) {
+        if (into.empty()) return;
+        for (std::size_t p = 0; p < wanted.size(); ++p)
+          if (wanted[p]) into[p] = from[p];
+      };
+      take(result.sky_view_factor, part.sky_view_factor);
+      take(result.ambient_occlusion, part.ambient_occlusion);
+      take(result.error_estimate, part.error_estimate);
+      for (std::size_t p = 0; p < wanted.size(); ++p)
+        if (wanted[p]) result.pixel_directions[p] = directions;
+      if (directions > result.directions) {
+        result.directions = directions;
+        result.azimuths = std::move(part.azimuths);
+      }
+    }
+  }
+  result.estimated_error = estimatedError(result.error_estimate);
+  result.samples_per_receiver = work;
+  return result;
+}
+
 }  // namespace
 }  // namespace detail
 
@@ -892,16 +1025,17 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
   detail::checkPixelIndexing(field, outputs.environment ? outputs.environment->channels : 1);
   if (outputs.environment && detail::hasRowSpacing(field))
     throw InvalidArgument(
-        "environment lighting takes a field of one cell size: this latitude / longitude grid's spacing differs "
+        "environment lighting takes a field of one cell size: this latitude / longitude grid's spacing "
+        "differs "
         "by row (reproject it, or give the cell size)");
   return detail::translateOpenClErrors([&] {
     // Hull stacks too deep for the room strips leave: again from the start with thinner strips
     // (StacksBeyondStrips::rows), as the sums of the strips done cannot be taken back.
     HorizonOptions attempt = options;
-    const auto run = [&](const HorizonOutputs& wanted) {
+    const auto run = [&](const HorizonOutputs& wanted, const std::vector<char>* pixels) {
       for (;;) {
         try {
-          detail::HorizonRoutine routine(detail::stateOf(context), field, attempt, wanted);
+          detail::HorizonRoutine routine(detail::stateOf(context), field, attempt, wanted, pixels);
           routine.run();
           return routine.take();
         } catch (const detail::StacksBeyondStrips& error) {
@@ -910,37 +1044,14 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
         }
       }
     };
-    if (options.max_error == 0.0) return run(outputs);
+    if (options.max_error == 0.0) return run(outputs, nullptr);
     // Ask for an error: runs at growing K until the estimate meets it (HorizonOptions::max_error).
     HorizonOutputs estimated = outputs;
     estimated.error_estimate = true;
-    attempt.directions = detail::kFirstAutoDirections;
-    int earlier = 0;
-    double earlier_estimate = 0.0;
-    std::vector<int> runs;
-    for (;;) {
-      HorizonResult result = run(estimated);
-      runs.push_back(attempt.directions);
-      if (result.estimated_error <= options.max_error) {
-        result.runs = std::move(runs);
-        return result;
-      }
-      const int next = detail::directionsForError(attempt.directions, result.estimated_error, earlier,
-                                                  earlier_estimate, options.max_error);
-      earlier = attempt.directions;
-      earlier_estimate = result.estimated_error;
-      if (next > kMaxAutoDirections) {
-        std::ostringstream message;
-        // (directionsForError caps its answer at twice the most: beyond that, a bound)
-        message << "a maximum error of " << options.max_error << " needs "
-                << (next >= 2 * kMaxAutoDirections ? "at least " : "about ") << next
-                << " directions (the estimate at K = " << attempt.directions << " is "
-                << result.estimated_error << "), beyond the " << kMaxAutoDirections
-                << " a run may choose: ask for a larger error, or give K";
-        throw InvalidArgument(message.str());
-      }
-      attempt.directions = next;
-    }
+    return detail::runToError(field, options, [&](int directions, const std::vector<char>* wanted) {
+      attempt.directions = directions;
+      return run(estimated, wanted);
+    });
   });
 }
 
