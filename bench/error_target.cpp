@@ -225,7 +225,7 @@ void errorTargetReport(const ComputeContext& context, const std::vector<ErrorTar
 
 void viewcountTargetReport(const ComputeContext& context, const std::vector<ErrorTargetField>& fields,
                            const std::vector<double>& errors, int reference_directions, int reps) {
-  const std::vector<int> ladder = fixedLadder();
+  const std::vector<int> ladder = directionLadder();
   std::printf(
       "\n### visible count (intervisibility, relative to its mean)\n\n"
       "| field | E | runs (K) | estimate | achieved p99 | met | cheapest fixed K | its p99 | time chosen (s) "

@@ -12,7 +12,13 @@ EnvironmentLightResult referenceEnvironmentLight(const HeightField& field, const
   HorizonOutputs outputs;
   outputs.environment = &map;
   HorizonResult horizons = referenceHorizons(field, options, outputs);
-  return {horizons.width, horizons.height, horizons.directions, map.names, std::move(horizons.irradiance)};
+  EnvironmentLightResult out;
+  out.width = horizons.width;
+  out.height = horizons.height;
+  out.directions = horizons.directions;
+  out.names = map.names;
+  out.irradiance = std::move(horizons.irradiance);
+  return out;
 }
 
 }  // namespace hfvis
