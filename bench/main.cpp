@@ -37,7 +37,8 @@
 //       and height (arealight-quick: S = 32 interleaved, the culled march alone at S = 1024);
 //       region pairs against their size and distance; the visible fraction's error against a
 //       Monte-Carlo reference; bitmask: the bitmask scatter against culled and viewsheds at S = 32
-//       and 1024, and the bits its table leaves to the march against the table's size
+//       and 1024, and the bits its table leaves to the march against the table's size; crossover: the
+//       culled march against the bitmask scatter against S and the light, the default's choice
 //   hfvis_bench field NAME N OUT
 //       writes the synthetic field NAME (testing's hard cases: city, sine, ...) of N x N pixels
 //       to OUT (EXR or GeoTIFF), for timing the CLI on it (bench/cost_against.sh)
@@ -107,7 +108,8 @@ constexpr const char* kUsage =
     "       hfvis_bench pvs-recall [--size N] [--view-cell C] [--tile T] [--samples N,N,...]\n"
     "                              [--check-rays R] [--methods agvs,sgvs,per-cell] [--reference yes|no]\n"
     "                              [--dem FILE] FIELD...   (FIELD: city, noise, dem)\n"
-    "       hfvis_bench region [--sections arealight,arealight-quick,pair,pair-quick,error,bitmask]\n"
+    "       hfvis_bench region [--sections arealight,arealight-quick,pair,pair-quick,error,bitmask,\n"
+    "                          crossover]\n"
     "                          [--reps N] FIELD...\n"
     "       hfvis_bench field NAME N OUT\n"
     "       hfvis_bench inputs [--quick]\n"

@@ -195,6 +195,44 @@ void bitmaskSection(const ComputeContext& context, const HeightField& f, int rep
   }
 }
 
+// Which method the default (RegionVisibilityMethod::Auto) should take for an area light over
+// every pixel: the culled march against the bitmask scatter, interleaved (the fastest of `reps`),
+// against S and against the light's size and height above the highest point (Eisemann &
+// Decoret's variables), with the method Auto takes (bitmask from kBitmaskFromSamples samples of such
+// a light on). The bits are the same (both exact).
+void crossoverSection(const ComputeContext& context, const HeightField& f, int reps) {
+  const double top = highest(f);
+  std::printf(
+      "\n#### Culled or bitmask: the default's choice (area light at the field's centre, sources on grid "
+      "points, absolute; the fastest of %d, interleaved)\n\n"
+      "| light side (px) | above the highest point | S | culled (s) | bitmask (s) | bitmask / culled | auto "
+      "takes |\n|---|---|---|---|---|---|---|\n",
+      reps);
+  struct Case {
+    int side;
+    double above;
+    int samples;
+  };
+  std::vector<Case> cases;
+  for (int samples : {32, 48, 64, 128, 256}) cases.push_back({64, 20.0, samples});
+  for (int samples : {32, 64, 256}) cases.push_back({16, 20.0, samples});
+  for (int samples : {32, 64, 256}) cases.push_back({64, 400.0, samples});
+  for (const Case c : cases) {
+    const RegionSampling light = gridLight(f, c.side, c.samples, top + c.above);
+    RegionVisibilityResult culled, bitmask;
+    RegionVisibilityOptions oc, ob;
+    oc.method = RegionVisibilityMethod::Culled;
+    ob.method = RegionVisibilityMethod::Bitmask;
+    const std::vector<double> t = fastestInterleaved(
+        {[&] { culled = computeRegionVisibility(context, f, light, oc); },
+         [&] { bitmask = computeRegionVisibility(context, f, light, ob); }},
+        reps);
+    if (bitmask.bits != culled.bits) std::printf("(bits differ: a defect)\n");
+    std::printf("| %d | %.0f | %d | %.3f | %.3f | %.2f | %s |\n", c.side, c.above, c.samples, t[0], t[1],
+                t[1] / t[0], c.samples >= kBitmaskFromSamples ? "bitmask" : "culled");
+  }
+}
+
 // Region pairs: two squares of `side` pixels (32 x 32 samples each, 2 above the surface), their
 // centres `distance` apart along a row through the field's centre.
 // `quick`: the culled method alone (exact's column 0), for profiling.
@@ -297,6 +335,7 @@ void regionVisibilityReport(const ComputeContext& context, const std::string& pa
     if (s == "pair" || s == "pair-quick") pairSection(context, field, reps, s == "pair-quick");
     if (s == "error") errorSection(context, field, reps);
     if (s == "bitmask") bitmaskSection(context, field, reps);
+    if (s == "crossover") crossoverSection(context, field, reps);
     std::fflush(stdout);
   }
 }

@@ -15,7 +15,8 @@
 #   same load; each run's tables go to the output under a heading naming its build.
 #   (arealight-quick: S = 32 interleaved and the culled march at S = 1024, in minutes; pair-quick:
 #   the pairs by the culled march alone, for profiling; bitmask: the bitmask scatter against the
-#   culled march and the viewsheds at S = 32 and 1024, and its table's size.)
+#   culled march and the viewsheds at S = 32 and 1024, and its table's size; crossover: culled
+#   against bitmask against S and the light's size and height, the default's choice.)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 size=1024

@@ -639,21 +639,23 @@ const std::vector<OptionSpec>& optionTable() {
          run.region_samples = static_cast<int>(n);
          run.region_samples_given = true;
        }},
-      {"--method", nullptr, "exact|culled|viewsheds|bitmask", kRegionSamplingGroup, false,
+      {"--method", nullptr, "auto|exact|culled|viewsheds|bitmask", kRegionSamplingGroup, false,
        "exact: one sight line per pair (the reference); culled: the same\n"
        "sight lines leaping over blocks of cells far below them, the exact\n"
-       "bits sooner (default); viewsheds: one viewshed per source sample,\n"
-       "for sources on grid points (--sources, or a one-pixel --light),\n"
-       "shared samples; may decide grazing lines the other way; bitmask\n"
-       "(arealight): Eisemann & Decoret's scatter for a light at an\n"
-       "--absolute height, the exact bits",
+       "bits sooner; viewsheds: one viewshed per source sample, for sources\n"
+       "on grid points (--sources, or a one-pixel --light), shared samples;\n"
+       "may decide grazing lines the other way; bitmask (arealight):\n"
+       "Eisemann & Decoret's scatter for a light at an --absolute height,\n"
+       "the exact bits; auto (default): bitmask where it takes the light\n"
+       "and --samples is 64 or more (faster there), else culled",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
-         if (value != "exact" && value != "culled" && value != "viewsheds" && value != "bitmask")
-           throw UsageError(typed + ": expected 'exact', 'culled', 'viewsheds' or 'bitmask', got " +
+         if (value != "auto" && value != "exact" && value != "culled" && value != "viewsheds" && value != "bitmask")
+           throw UsageError(typed + ": expected 'auto', 'exact', 'culled', 'viewsheds' or 'bitmask', got " +
                             inQuotes(shortened(value)));
          run.region_method = value == "exact"     ? RegionVisibilityMethod::Exact
                              : value == "culled"  ? RegionVisibilityMethod::Culled
                              : value == "bitmask" ? RegionVisibilityMethod::Bitmask
+                             : value == "auto"    ? RegionVisibilityMethod::Auto
                                                   : RegionVisibilityMethod::Viewsheds;
        }},
       {"--absolute", nullptr, nullptr, kRegionSamplingGroup, false,

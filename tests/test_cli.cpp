@@ -2631,7 +2631,7 @@ TEST_F(Cli, AreaLightBehindAWallIsHiddenAndAgreesWithTheLibrary) {
                 .status,
             0);
   EXPECT_EQ(readBack(out("h.exr")).at(12, 5, 0), 1.0f);
-  // The culled method (the default), the exact one and the bitmask scatter write the same
+  // The culled method (the default's at 16 samples), the exact one and the bitmask scatter write the same
   // picture, each naming itself.
   for (const char* method : {"exact", "culled", "bitmask"})
     ASSERT_EQ(
@@ -2647,6 +2647,16 @@ TEST_F(Cli, AreaLightBehindAWallIsHiddenAndAgreesWithTheLibrary) {
   EXPECT_EQ(exact.spec.get_string_attribute("hfvis:method"), "exact");
   EXPECT_EQ(culled.spec.get_string_attribute("hfvis:method"), "culled");
   EXPECT_EQ(readBack(out("h.exr")).spec.get_string_attribute("hfvis:method"), "culled");
+  // From 64 samples of a planar light on, the default (auto) takes the bitmask scatter, and
+  // names it: the same picture as the exact method's.
+  for (const char* method : {"auto", "exact"})
+    ASSERT_EQ(run("arealight " + shellQuoted(field) + " -o " + shellQuoted(out(std::string(method) + "64.exr")) +
+                  " --light 1,2,3,9 --light-height 20 --absolute --samples 64 --method " + method + " -q")
+                  .status,
+              0);
+  const ReadBack picked = readBack(out("auto64.exr"));
+  EXPECT_EQ(picked.spec.get_string_attribute("hfvis:method"), "bitmask");
+  EXPECT_EQ(picked.pixels, readBack(out("exact64.exr")).pixels);
 }
 
 TEST_F(Cli, AreaLightFromASourcesFile) {

@@ -482,6 +482,51 @@ TEST(RegionVisibility, TheBitmaskScatterBehindAWall) {
   });
 }
 
+// The default (Auto) takes the bitmask method for a planar light of kBitmaskFromSamples or more
+// samples and the culled march otherwise (fewer samples, a light above the surface, decorrelated
+// samples, a region pair), and either way gives the exact bits.
+TEST(RegionVisibility, TheDefaultPicksTheBitmaskForALargePlanarLight) {
+  const HeightField field = makeSyntheticField("city", 37, 29, 5);
+  const auto light = [](int samples, bool absolute) {
+    RegionSampling s;
+    s.rectangle = {3, 4, 12, 10};
+    s.samples = samples;
+    s.height = absolute ? 60.0 : 8.0;
+    s.absolute = absolute;
+    return s;
+  };
+  RegionVisibilityOptions exact;
+  exact.method = RegionVisibilityMethod::Exact;
+  RegionVisibilityOptions decorrelated;
+  decorrelated.decorrelate = true;
+  struct Case {
+    RegionSampling sources;
+    RegionVisibilityOptions options;
+    RegionVisibilityMethod want;
+  };
+  const std::vector<Case> cases = {
+      {light(kBitmaskFromSamples, true), {}, RegionVisibilityMethod::Bitmask},
+      {light(kBitmaskFromSamples - 1, true), {}, RegionVisibilityMethod::Culled},
+      {light(kBitmaskFromSamples, false), {}, RegionVisibilityMethod::Culled},
+      {light(kBitmaskFromSamples, true), decorrelated, RegionVisibilityMethod::Culled},
+  };
+  forEachLayout([&](const ComputeContext& context) {
+    for (const Case& c : cases) {
+      SCOPED_TRACE(std::to_string(c.sources.samples) + (c.sources.absolute ? " absolute" : " above"));
+      ASSERT_EQ(c.options.method, RegionVisibilityMethod::Auto);
+      const RegionVisibilityResult got = computeRegionVisibility(context, field, c.sources, c.options);
+      EXPECT_EQ(got.method, c.want);
+      RegionVisibilityOptions reference = exact;
+      reference.decorrelate = c.options.decorrelate;
+      EXPECT_EQ(got.bits, computeRegionVisibility(context, field, c.sources, reference).bits);
+    }
+    // A pair takes the culled march: the same bits as the exact one.
+    const RegionPairVisibilityResult pair =
+        computeRegionPairVisibility(context, field, light(70, true), light(40, false), {});
+    EXPECT_EQ(pair.bits, computeRegionPairVisibility(context, field, light(70, true), light(40, false), exact).bits);
+  });
+}
+
 TEST(RegionVisibility, AToBIsTheTransposeOfBToA) {
   std::uint64_t clear = 0, pairs = 0;
   for (const char* name : {"city", "noise", "sine", "terraces"}) {

@@ -27,6 +27,7 @@ std::string methodName(RegionVisibilityMethod method) {
   return method == RegionVisibilityMethod::Viewsheds ? "viewsheds"
          : method == RegionVisibilityMethod::Culled  ? "culled"
          : method == RegionVisibilityMethod::Bitmask ? "bitmask"
+         : method == RegionVisibilityMethod::Auto    ? "auto"
                                                      : "exact";
 }
 
@@ -98,6 +99,7 @@ class AreaLight : public Computation {
     RegionVisibilityOptions options = regionVisibilityOptions(run_);
     options.light_image = std::move(light_image_);
     result_ = computeRegionVisibility(*job.context, job.input, sources_, options);
+    job.method = methodName(result_.method);  // the one that ran (auto picks bitmask or culled)
   }
 
   Summary write(Job& job, OutputFiles& outputs) override {
@@ -219,7 +221,10 @@ class Region : public Computation {
   // Text outputs, computed on the device.
   bool writesImages() const override { return false; }
   bool usesDevice() const override { return true; }
-  std::string method() const override { return methodName(run_.region_method); }
+  std::string method() const override {  // auto: the culled march (the bitmask method takes no pair)
+    return methodName(run_.region_method == RegionVisibilityMethod::Auto ? RegionVisibilityMethod::Culled
+                                                                         : run_.region_method);
+  }
 
   void prepare(HeightField& field) override {
     from_ = sampling(*run_.from_region, run_.from_height);

@@ -249,7 +249,7 @@ def compute(operation, heights, geometry, options, device="", progress=None):
 def _region_options(options):
     o = _core.RegionVisibilityOptions()
     _set(o, options, ("target_height", "max_distance", "curvature", "seed", "decorrelate"))
-    o.method = _enum(_core.RegionVisibilityMethod, options.get("method", "culled"), "method")
+    o.method = _enum(_core.RegionVisibilityMethod, options.get("method", "auto"), "method")
     return o
 
 

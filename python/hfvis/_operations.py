@@ -70,7 +70,7 @@ def _method(operation, options):
     if operation == "intervisibility":
         return options.get("method") or "hull_tree"
     if operation == "region_visibility":
-        return options.get("method") or "culled"
+        return options.get("method") or "auto"
     if operation == "bounce":
         return "tree"
     return options.get("method") or "sweep"
@@ -471,7 +471,7 @@ def environment_light(heights, environment, *, rotation_deg=0.0, table_rows=0, d
 
 
 def region_visibility(heights, sources, *, samples=16, height=2.0, absolute=False, target_height=0.0,
-                      method="culled", seed=1, decorrelate=False, max_distance=0.0, curvature=0.0, light_image=None,
+                      method="auto", seed=1, decorrelate=False, max_distance=0.0, curvature=0.0, light_image=None,
                       pixels=False, cell_size=None, z_scale=1.0, nodata=None, device="", progress=None):
     """Which samples of a source region (an area light) every point sees, standing target_height
     above the surface (after Eisemann & Decoret 2007). `sources`: a rectangle (col0, row0, col1,
@@ -498,6 +498,7 @@ def region_visibility(heights, sources, *, samples=16, height=2.0, absolute=Fals
         return RegionVisibility(out["fraction"], out["bits"], out.get("rgb"))
     import xarray as xr
 
+    options["method"] = out["method"]  # the one that ran ("auto" picks bitmask or culled)
     fraction = grid.result(out["fraction"], "fraction", _attrs("region_visibility", "fraction", options, grid))
     bits = grid.result(out["bits"], "bits", _attrs("region_visibility", "bits", options, grid),
                        leading=("word", np.arange(out["bits"].shape[0])))
@@ -509,7 +510,7 @@ def region_visibility(heights, sources, *, samples=16, height=2.0, absolute=Fals
 
 
 def region_pair_visibility(heights, sources, receivers, *, samples=16, source_height=2.0, receiver_height=2.0,
-                           absolute=False, method="culled", seed=1, decorrelate=False, max_distance=0.0,
+                           absolute=False, method="auto", seed=1, decorrelate=False, max_distance=0.0,
                            curvature=0.0, pixels=False, cell_size=None, z_scale=1.0, nodata=None, device="",
                            progress=None):
     """Visibility between two regions, each a rectangle or points as region_visibility's

@@ -205,7 +205,9 @@ void bindOptions(nb::module_& m) {
   nb::enum_<RegionVisibilityMethod>(m, "RegionVisibilityMethod")
       .value("exact", RegionVisibilityMethod::Exact)
       .value("viewsheds", RegionVisibilityMethod::Viewsheds)
-      .value("culled", RegionVisibilityMethod::Culled);
+      .value("culled", RegionVisibilityMethod::Culled)
+      .value("bitmask", RegionVisibilityMethod::Bitmask)
+      .value("auto", RegionVisibilityMethod::Auto);
   nb::class_<RegionVisibilityOptions>(m, "RegionVisibilityOptions")
       .def(nb::init<>())
       .def_rw("method", &RegionVisibilityOptions::method)
@@ -411,6 +413,10 @@ nb::dict regionVisibility(const HeightField& field, const RegionSampling& source
   out["fraction"] = plane(std::move(r.fraction), field);
   out["bits"] = toArray(std::move(r.bits), {size_t(field.height), size_t(field.width), size_t(r.words)});
   out["samples"] = r.samples;
+  out["method"] = r.method == RegionVisibilityMethod::Bitmask     ? "bitmask"
+                  : r.method == RegionVisibilityMethod::Culled    ? "culled"
+                  : r.method == RegionVisibilityMethod::Viewsheds ? "viewsheds"
+                                                                  : "exact";  // the one that ran
   if (options.light_image.width > 0) {
     std::vector<float> rgb = std::move(r.red);
     rgb.insert(rgb.end(), r.green.begin(), r.green.end());

@@ -628,7 +628,8 @@ void validate(const RegionVisibilityOptions& options) {
   }
   if (options.method != RegionVisibilityMethod::Exact &&
       options.method != RegionVisibilityMethod::Viewsheds &&
-      options.method != RegionVisibilityMethod::Culled && options.method != RegionVisibilityMethod::Bitmask)
+      options.method != RegionVisibilityMethod::Culled && options.method != RegionVisibilityMethod::Bitmask &&
+      options.method != RegionVisibilityMethod::Auto)
     throw InvalidArgument("unknown region visibility method");
   if (options.bitmask_table < 8 || options.bitmask_table > 1024)
     throw InvalidArgument("the bitmask table takes 8 .. 1024 angles and offsets (got " +
@@ -681,6 +682,42 @@ std::vector<RegionPoint> regionSamplePoints(const HeightField& field, const Regi
   return regionPoints(tableSamplePoints(field, table, heights, sampling.absolute, seed));
 }
 
+// S of a region: its points, or its rectangle's samples.
+std::size_t sourceSamples(const RegionSampling& sources) {
+  return sources.points.empty() ? std::size_t(sources.samples) : sources.points.size();
+}
+
+// Why the bitmask method cannot take this light ("" when it can): its occluders are
+// back-projected onto one plane, through one table of the shared samples.
+std::string bitmaskRefusal(const RegionSampling& sources, const RegionVisibilityOptions& options) {
+  bool planar = sources.absolute;
+  for (const RegionPoint& p : sources.points) planar = planar && p.height == sources.points[0].height;
+  if (!planar)
+    return "the bitmask method takes a planar light: a rectangle at an absolute height (--absolute), or "
+           "points all at one absolute height; not heights above the surface";
+  if (options.decorrelate) return "the bitmask method takes shared samples (no decorrelation): one table of them";
+  if (options.curvature != 0.0)
+    return "the bitmask method takes no curvature: its back-projections are straight lines";
+  const std::size_t samples = sourceSamples(sources);
+  if (samples > std::size_t(kMaxBitmaskSamples))
+    return "the bitmask method takes at most " + std::to_string(kMaxBitmaskSamples) + " samples (got " +
+           std::to_string(samples) + ")";
+  return "";
+}
+
+// The method an every-pixel run takes: options.method, or for Auto the bitmask method where it
+// takes the light and S is at least kBitmaskFromSamples (same bits, sooner), else the culled march.
+RegionVisibilityMethod methodFor(const RegionSampling& sources, const RegionVisibilityOptions& options) {
+  if (options.method == RegionVisibilityMethod::Bitmask) {
+    const std::string refusal = bitmaskRefusal(sources, options);
+    if (!refusal.empty()) throw InvalidArgument(refusal);
+  }
+  if (options.method != RegionVisibilityMethod::Auto) return options.method;
+  return sourceSamples(sources) >= std::size_t(kBitmaskFromSamples) && bitmaskRefusal(sources, options).empty()
+             ? RegionVisibilityMethod::Bitmask
+             : RegionVisibilityMethod::Culled;
+}
+
 RegionVisibilityResult computeRegionVisibility(const ComputeContext& context, const HeightField& field,
                                                const RegionSampling& sources,
                                                const RegionVisibilityOptions& options) {
@@ -689,23 +726,8 @@ RegionVisibilityResult computeRegionVisibility(const ComputeContext& context, co
   const bool coloured = options.light_image.width > 0;
   if (coloured && !sources.points.empty())
     throw InvalidArgument("a light image lies over a rectangle light, not over explicit points");
-  if (options.method == RegionVisibilityMethod::Bitmask) {
-    // Its occluders are back-projected onto one plane, through one table of the shared samples.
-    bool planar = sources.absolute;
-    for (const RegionPoint& p : sources.points) planar = planar && p.height == sources.points[0].height;
-    if (!planar)
-      throw InvalidArgument(
-          "the bitmask method takes a planar light: a rectangle at an absolute height (--absolute), or "
-          "points all at one absolute height; not heights above the surface");
-    if (options.decorrelate)
-      throw InvalidArgument("the bitmask method takes shared samples (no decorrelation): one table of them");
-    if (options.curvature != 0.0)
-      throw InvalidArgument("the bitmask method takes no curvature: its back-projections are straight lines");
-    const std::size_t samples = sources.points.empty() ? std::size_t(sources.samples) : sources.points.size();
-    if (samples > std::size_t(kMaxBitmaskSamples))
-      throw InvalidArgument("the bitmask method takes at most " + std::to_string(kMaxBitmaskSamples) +
-                            " samples (got " + std::to_string(samples) + ")");
-  }
+  RegionVisibilityOptions run = options;
+  run.method = methodFor(sources, options);
   const std::vector<float> table = detail::regionSampleTable(field, sources);
   detail::PreparedHeights prepared = detail::prepareHeights(field, detail::HeightOrigin::Zero);
   const std::vector<float>& heights = prepared.heights;
@@ -716,11 +738,11 @@ RegionVisibilityResult computeRegionVisibility(const ComputeContext& context, co
   out.words = (out.samples + 31) / 32;
   const int count = static_cast<int>(field.pixelCount());
   const std::vector<float> points = tableSamplePoints(field, table, heights, sources.absolute, options.seed);
-  if (options.method == RegionVisibilityMethod::Viewsheds)
-    out.bits = viewshedBits(context, field, regionPoints(points), options);
+  if (run.method == RegionVisibilityMethod::Viewsheds)
+    out.bits = viewshedBits(context, field, regionPoints(points), run);
   else
     out.bits = runBits(context, field, std::move(prepared), table, points, sources.absolute, nullptr, false,
-                       count, options, &out);
+                       count, run, &out);
   out.fraction.resize(field.pixelCount());
   for (int p = 0; p < count; ++p) {
     int seen = 0;
@@ -729,7 +751,8 @@ RegionVisibilityResult computeRegionVisibility(const ComputeContext& context, co
                           ? std::numeric_limits<float>::quiet_NaN()
                           : static_cast<float>(static_cast<double>(seen) / out.samples);
   }
-  if (coloured) colourLight(out, field, table, points, options);
+  out.method = run.method;
+  if (coloured) colourLight(out, field, table, points, run);
   return out;
 }
 
@@ -747,6 +770,8 @@ RegionPairVisibilityResult computeRegionPairVisibility(const ComputeContext& con
                           " method takes every-pixel receivers, not a region pair");
   if (options.light_image.width > 0)
     throw InvalidArgument("a light image colours every-pixel receivers, not a region pair");
+  RegionVisibilityOptions run = options;  // Auto: the culled march (the bitmask method takes no pair)
+  if (run.method == RegionVisibilityMethod::Auto) run.method = RegionVisibilityMethod::Culled;
   const std::vector<float> source_table = detail::regionSampleTable(field, sources);
   const std::vector<float> receiver_table = detail::regionSampleTable(field, receivers);
   detail::PreparedHeights prepared = detail::prepareHeights(field, detail::HeightOrigin::Zero);
@@ -761,7 +786,7 @@ RegionPairVisibilityResult computeRegionPairVisibility(const ComputeContext& con
   out.receivers =
       regionPoints(tableSamplePoints(field, receiver_table, heights, receivers.absolute, options.seed));
   out.bits = runBits(context, field, std::move(prepared), source_table, source_points, sources.absolute,
-                     &receiver_table, receivers.absolute, out.receiver_samples, options);
+                     &receiver_table, receivers.absolute, out.receiver_samples, run);
   detail::countPairFractions(out);
   return out;
 }
