@@ -489,9 +489,10 @@ int main(int argc, char** argv) {
       if (fields.empty()) throw Usage("region needs FIELD...");
       for (const std::string& section : sections)
         if (section != "arealight" && section != "arealight-quick" && section != "pair" &&
-            section != "pair-quick" && section != "error" && section != "bitmask")
+            section != "pair-quick" && section != "error" && section != "bitmask" &&
+            section != "crossover")
           throw Usage(
-              "--sections: arealight, arealight-quick, pair, pair-quick, error, bitmask (comma-separated)");
+              "--sections: arealight, arealight-quick, pair, pair-quick, error, bitmask, crossover (comma-separated)");
       const ComputeContext context = ComputeContext::create(ContextOptions::fromEnvironment());
       for (const std::string& path : fields) regionVisibilityReport(context, path, sections, reps);
       return 0;
