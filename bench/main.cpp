@@ -535,7 +535,11 @@ int main(int argc, char** argv) {
       const std::string output = args.get("--output", "svf-ao");
       if (output != "svf-ao" && output != "viewcount")
         throw Usage("error-target: --output is svf-ao or viewcount");
-      const int tile = std::stoi(args.get("--tile", std::to_string(HorizonOptions{}.error_tile)));
+      // (the refined runs' tiles beside the whole field's one K: svf-ao only)
+      const std::string tile_text = args.get("--tile");
+      if (output == "viewcount" && !tile_text.empty())
+        throw Usage("error-target: --tile refines svf-ao; the visible count takes one K");
+      const int tile = tile_text.empty() ? 64 : std::stoi(tile_text);
       if (tile < 1) throw Usage("error-target: --tile is a number of pixels");
       const std::vector<std::string> names =
           textList(args.get("--contents", "fractal,bricks,sine,blocks,city_dsm,dem,mixed"));

@@ -429,8 +429,9 @@ const std::vector<OptionSpec>& optionTable() {
        "irradiance); a first run at 16 directions predicts the K needed,\n"
        "refused when beyond 4096 (see --error-tile); the largest K and the\n"
        "estimate go into the summary and the hfvis:directions and\n"
-       "hfvis:estimated_error attributes (hfvis:directions_range: the least\n"
-       "and most K; --error-out's channel directions: each pixel's)",
+       "hfvis:estimated_error attributes (with --error-tile also\n"
+       "hfvis:directions_range, the least and most K, and --error-out's\n"
+       "channel directions, each pixel's)",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
          run.max_error = parseNumber(typed, value);
          if (!(run.max_error > 0.0 && run.max_error < 1.0))

@@ -39,7 +39,7 @@ enum OptionGroup : unsigned {
   kRegionSamplingGroup = 1u << 19,
   kAreaLightGroup = 1u << 20,
   kRegionPairGroup = 1u << 21,
-  kErrorTargetGroup = 1u << 22,  // svf, ao and intervisibility: --max-error, --error-out
+  kErrorTargetGroup = 1u << 22,  // svf, ao, intervisibility, shade: --max-error, --error-tile, --error-out
   kPvsGroup = 1u << 23,          // pvs's view cells, tiles, sampler and budgets
   kLastGroup = kPvsGroup,
 };

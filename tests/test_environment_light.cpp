@@ -424,6 +424,10 @@ TEST(EnvironmentMaxError, BadRequestsAreRefused) {
   } catch (const InvalidArgument& error) {
     EXPECT_NE(std::string(error.what()).find("directions"), std::string::npos) << error.what();
   }
+  // Refinement in tiles is the sky-view factor's and occlusion's: here it would be ignored.
+  options.max_error = 0.05;
+  options.error_tile = 8;
+  EXPECT_THROW(computeEnvironmentLight(testContext(), field, map, options), InvalidArgument);
 }
 
 }  // namespace

@@ -277,6 +277,7 @@ TEST(HorizonMaxError, RefinedTilesEqualAWholeFieldRunAtTheirK) {
           SCOPED_TRACE(K);
           HorizonOptions fixed = options;
           fixed.max_error = 0.0;
+          fixed.error_tile = 0;
           fixed.directions = K;
           const HorizonResult whole = computeHorizons(context, field, fixed, estimated());
           std::size_t compared = 0;
@@ -363,6 +364,10 @@ TEST(HorizonMaxError, BadRequestsAreRefused) {
   HorizonOutputs one = svf;
   one.error_estimate = true;
   EXPECT_THROW(computeHorizons(testContext(), field, options, one), InvalidArgument);
+  // A tile without an error to refine toward would be ignored: refused.
+  HorizonOptions tiled;
+  tiled.error_tile = 8;
+  EXPECT_THROW(computeHorizons(testContext(), field, tiled, svf), InvalidArgument);
 }
 
 }  // namespace

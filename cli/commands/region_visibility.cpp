@@ -23,13 +23,6 @@ namespace {
 // channel keep the masks lossless in any float reader (the EXR writer has no UINT channels).
 constexpr int kMaskBitsPerChannel = 16;
 
-std::string methodName(RegionVisibilityMethod method) {
-  return method == RegionVisibilityMethod::Viewsheds ? "viewsheds"
-         : method == RegionVisibilityMethod::Culled  ? "culled"
-         : method == RegionVisibilityMethod::Bitmask ? "bitmask"
-         : method == RegionVisibilityMethod::Auto    ? "auto"
-                                                     : "exact";
-}
 
 std::string rectangleText(const PixelRectangle& r) {
   return std::to_string(r.col0) + "," + std::to_string(r.row0) + "," + std::to_string(r.col1) + "," +
@@ -65,7 +58,7 @@ class AreaLight : public Computation {
     return paths;
   }
   std::vector<std::string> otherInputs() const override { return {run_.sources_file, run_.light_image}; }
-  std::string method() const override { return methodName(run_.region_method); }
+  std::string method() const override { return regionVisibilityMethodName(run_.region_method); }
 
   // The light: --light's rectangle, or the --sources file's points, checked against the field.
   void prepare(HeightField& field) override {
@@ -81,6 +74,17 @@ class AreaLight : public Computation {
                          std::to_string(sources_.points.size()) + " points, more than the " +
                          std::to_string(kMaxRegionSamples) + " samples a bitmask holds");
       sources_.samples = static_cast<int>(sources_.points.size());
+      // (what checkAreaLight cannot see before the file is read: the bitmask method's light is planar)
+      if (run_.region_method == RegionVisibilityMethod::Bitmask) {
+        if (sources_.points.size() > static_cast<std::size_t>(kMaxBitmaskSamples))
+          throw UsageError("--method bitmask takes at most " + std::to_string(kMaxBitmaskSamples) +
+                           " samples; " + run_.sources_file + " lists " + std::to_string(sources_.points.size()) +
+                           "; or --method exact or culled");
+        for (const RegionPoint& p : sources_.points)
+          if (p.height != sources_.points[0].height)
+            throw UsageError("--method bitmask needs a planar light: the points of " + run_.sources_file +
+                             " lie at different heights; or --method exact or culled");
+      }
       // (the viewsheds method stands one viewshed's eye on each; the library would refuse later)
       if (run_.region_method == RegionVisibilityMethod::Viewsheds)
         for (const RegionPoint& p : sources_.points)
@@ -99,7 +103,7 @@ class AreaLight : public Computation {
     RegionVisibilityOptions options = regionVisibilityOptions(run_);
     options.light_image = std::move(light_image_);
     result_ = computeRegionVisibility(*job.context, job.input, sources_, options);
-    job.method = methodName(result_.method);  // the one that ran (auto picks bitmask or culled)
+    job.method = regionVisibilityMethodName(result_.method);  // the one that ran (auto picks bitmask or culled)
   }
 
   Summary write(Job& job, OutputFiles& outputs) override {
@@ -222,7 +226,7 @@ class Region : public Computation {
   bool writesImages() const override { return false; }
   bool usesDevice() const override { return true; }
   std::string method() const override {  // auto: the culled march (the bitmask method takes no pair)
-    return methodName(run_.region_method == RegionVisibilityMethod::Auto ? RegionVisibilityMethod::Culled
+    return regionVisibilityMethodName(run_.region_method == RegionVisibilityMethod::Auto ? RegionVisibilityMethod::Culled
                                                                          : run_.region_method);
   }
 
@@ -393,7 +397,7 @@ void checkRegion(const std::string&, const RunArguments& run) {
                      inQuotes(run.rays_output));
   if (run.region_method == RegionVisibilityMethod::Viewsheds ||
       run.region_method == RegionVisibilityMethod::Bitmask)
-    throw UsageError("--method " + methodName(run.region_method) +
+    throw UsageError(std::string("--method ") + regionVisibilityMethodName(run.region_method) +
                      " is for 'hfvis arealight' (every pixel a receiver); region pairs take --method "
                      "exact or culled");
   requireAboveSurface(run, "--from-height", run.from_height);
@@ -410,7 +414,7 @@ const CommandSpec kAreaLightCommand{
     "\"visible\": the fraction (0..1) of an area light's samples each pixel sees",
     "IN -o OUT.exr|OUT.tif (--light C0,R0,C1,R1 [--light-height H] | --sources FILE.csv)\n"
     "[--absolute] [--samples N] [--target-height T] [--decorrelate]\n"
-    "[--method exact|culled|viewsheds|bitmask]\n"
+    "[--method auto|exact|culled|viewsheds|bitmask]\n"
     "[--seed N] [--light-image RGB.exr] [--max-distance D] [--curvature] [--refraction K]\n"
     "[--masks MASKS.exr] [--preview P.png] [options]",
     "Region visibility with every pixel a receiver (Eisemann & Decoret 2007's sampled\n"
@@ -431,14 +435,16 @@ const CommandSpec kAreaLightCommand{
     "--masks FILE (.exr or .tif) also writes which samples each pixel sees, losslessly: float32\n"
     "channels m000, m001, ..., channel k holding samples 16k .. 16k+15 as the whole number sum\n"
     "of 2^b over each visible sample 16k+b (0 .. 65535, exact in float32; NaN at nodata).\n"
-    "--method exact marches one sight line per pixel and sample, culled (default) the same\n"
-    "lines leaping over low blocks; --method viewsheds runs one viewshed per sample, for\n"
+    "--method exact marches one sight line per pixel and sample, culled the same lines\n"
+    "leaping over low blocks; --method viewsheds runs one viewshed per sample, for\n"
     "samples on grid points (a one-pixel --light, --sources with whole columns and rows), not\n"
     "with --decorrelate; it may decide grazing lines the other way. --method bitmask (a --light\n"
     "at an --absolute height, at most 1024 samples, no --decorrelate or --curvature) scatters\n"
     "the cells' back-projections onto the light's plane through a table of edge bitmasks and\n"
-    "marches only the samples it leaves undecided: the exact bits. A light outside the field,\n"
-    "or on nodata, is an error.\n"
+    "marches only the samples it leaves undecided: the exact bits. --method auto (default)\n"
+    "takes bitmask where it takes the light and N is 64 or more (faster there), else culled;\n"
+    "the summary and hfvis:method name the one that ran. A light outside the field, or on\n"
+    "nodata, is an error.\n"
     "--light-image FILE (an EXR or any image hfvis reads; R, G, B, or one grey channel) colours\n"
     "the --light rectangle (Eisemann & Decoret 2007's textured light): the image stretched over\n"
     "it, row 0 along the lowest row, each sample taking the image's bilinear colour at its own\n"
@@ -459,7 +465,7 @@ const CommandSpec kRegionCommand{
     nullptr,
     "visibility between two rectangles: the share of clear sample pairs, as JSON",
     "IN --from C0,R0,C1,R1 --to C0,R0,C1,R1 -o OUT.json [--from-height H] [--to-height H]\n"
-    "[--absolute] [--samples N] [--seed N] [--method exact] [--max-distance D] [--curvature]\n"
+    "[--absolute] [--samples N] [--seed N] [--method auto|exact|culled] [--max-distance D] [--curvature]\n"
     "[--refraction K] [--rays RAYS.csv] [options]",
     "Visibility between two regions: N samples of each rectangle (--samples, default 16, at most\n"
     "4096; sampled as arealight's --light), H above the surface (--from-height, --to-height,\n"
@@ -471,7 +477,8 @@ const CommandSpec kRegionCommand{
     "sees. --rays RAYS.csv also lists every clear pair, one a line:\n"
     "from_col,from_row,from_height,to_col,to_row,to_height (and from_x,from_y,to_x,to_y for a\n"
     "georeferenced input; map coordinates of the pixel centres). A rectangle outside the field\n"
-    "or holding nodata is an error. Computed on the device, --method exact only.\n",
+    "or holding nodata is an error. Computed on the device: --method exact, or culled (the same\n"
+    "bits sooner; auto, the default, takes it).\n",
     nullptr,
     kOutputGroup | kInputGroup | kDeviceGroup | kEarthGroup | kReachGroup | kRegionSamplingGroup |
         kRegionPairGroup,

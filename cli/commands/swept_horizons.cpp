@@ -25,7 +25,7 @@ Attributes sweptAttributes(const Job& job, const HorizonResult& result) {
   for (auto& [name, value] : attributes)
     if (name == "hfvis:directions") value = std::to_string(result.directions);
   if (job.run.max_error > 0.0) attributes.emplace_back("hfvis:max_error", formatNumber(job.run.max_error));
-  if (!result.pixel_directions.empty()) {  // refined by tile: the least K a pixel took to the most
+  if (job.run.error_tile > 0 && !result.pixel_directions.empty()) {  // refined by tile: least K to most
     const auto [least, most] =
         std::minmax_element(result.pixel_directions.begin(), result.pixel_directions.end());
     attributes.emplace_back("hfvis:directions_range", std::to_string(*least) + ".." + std::to_string(*most));
@@ -55,7 +55,7 @@ Summary HorizonQuantityComputation::write(Job& job, OutputFiles& outputs) {
     requireSize(result_.error_estimate, field.pixelCount(), "error estimate");
     std::vector<std::string> names{"error"};
     std::vector<std::vector<float>> planes{result_.error_estimate};
-    if (!result_.pixel_directions.empty()) {  // --max-error: the K each pixel's values come from
+    if (run_.error_tile > 0 && !result_.pixel_directions.empty()) {  // --error-tile: each pixel's K
       names.push_back("directions");
       planes.emplace_back(result_.pixel_directions.begin(), result_.pixel_directions.end());
     }

@@ -33,12 +33,13 @@
 //
 // Methods: the exact one, one line-of-sight march per (receiver, source sample) pair on the
 // device (kernels/region_visibility.cl): O(receivers * S * (W + H)); the same march culled by a
-// max pyramid (the default: the same bits, sooner); one viewshed per source sample, for sources
+// max pyramid (the same bits, sooner); one viewshed per source sample, for sources
 // on grid points (RegionVisibilityMethod::Viewsheds); Eisemann & Décoret's bitmask scatter for
 // a planar light (RegionVisibilityMethod::Bitmask: the cells back-projected onto the light's
 // plane through a table of edge bitmasks, a conservative pair per cell, the samples between the
-// pair decided by the culled march, so the bits are the exact method's).
-// bench/report/region_visibility.md compares their speed.
+// pair decided by the culled march, so the bits are the exact method's); and the default,
+// RegionVisibilityMethod::Auto, which takes the bitmask scatter or the culled march by the light
+// and S. bench/report/region_visibility.md compares their speed.
 #pragma once
 
 #include <cstdint>
@@ -55,10 +56,10 @@ constexpr int kMaxRegionSamples = 4096;
 // The most source samples of the bitmask method (a work-item's masks in private memory).
 constexpr int kMaxBitmaskSamples = 1024;
 // From this many source samples on, RegionVisibilityMethod::Auto takes the bitmask method where
-// it takes the light: measured on the 512^2 and 1024^2 fractal under a 64-pixel light, the
-// bitmask method's time grows about a quarter as fast with S as the culled march's and starts
-// higher (S = 32: 0.84x and 1.25x the culled march's time; S = 1024: 0.30x and 0.31x;
-// bench/report/region_visibility.md, "Which method the default takes").
+// it takes the light: on the 512^2 and 1024^2 fractal (bench/report/region_visibility.md, "Which
+// method the default takes") it took 0.14 - 0.75 of the culled march's time at every S >= 64
+// measured, for lights of 16 and 64 pixels 20 and 400 above the top; at S = 32 under the
+// 64-pixel light the two were even (1.03 - 1.07), its cost per receiver shrinking less with S.
 constexpr int kBitmaskFromSamples = 64;
 
 // A rectangle of grid points, corners included, in any order.
@@ -117,6 +118,9 @@ enum class RegionVisibilityMethod {
   // give the exact bits, so the choice changes the time alone; the result names the one taken.
   Auto,
 };
+
+// The method's name as the command line takes it: "exact", "viewsheds", "culled", "bitmask", "auto".
+const char* regionVisibilityMethodName(RegionVisibilityMethod method);
 
 // A textured light (Eisemann & Décoret 2007, Sec. 8: colours over the source): an RGB image
 // stretched over the source rectangle's extent [C0, C1] x [R0, R1] (lowest column and row first:

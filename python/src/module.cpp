@@ -413,10 +413,7 @@ nb::dict regionVisibility(const HeightField& field, const RegionSampling& source
   out["fraction"] = plane(std::move(r.fraction), field);
   out["bits"] = toArray(std::move(r.bits), {size_t(field.height), size_t(field.width), size_t(r.words)});
   out["samples"] = r.samples;
-  out["method"] = r.method == RegionVisibilityMethod::Bitmask     ? "bitmask"
-                  : r.method == RegionVisibilityMethod::Culled    ? "culled"
-                  : r.method == RegionVisibilityMethod::Viewsheds ? "viewsheds"
-                                                                  : "exact";  // the one that ran
+  out["method"] = regionVisibilityMethodName(r.method);  // the one that ran
   if (options.light_image.width > 0) {
     std::vector<float> rgb = std::move(r.red);
     rgb.insert(rgb.end(), r.green.begin(), r.green.end());

@@ -105,6 +105,14 @@ def test_region_visibility_and_pairs_take_map_coordinates(projected_tif):
     assert lit.fraction.dims == ("y", "x") and lit.bits.dims == ("word", "y", "x")
     assert lit.fraction.rio.crs == dem.rio.crs and lit.bits.rio.crs == dem.rio.crs
     assert lit.fraction.attrs["hfvis_method"] == "culled" and lit.fraction.attrs["hfvis_height"] == 10.0
+    # The default ("auto") takes the bitmask scatter for a planar light of 64 or more samples, and
+    # names it; the bits are the culled march's.
+    top = float(np.nanmax(np.where(plain == -9999.0, np.nan, plain)))
+    planar = dict(samples=64, height=top + 100, absolute=True, max_distance=3000)
+    auto = hfvis.region_visibility(dem, (x0, y0, x1, y1), **planar)
+    culled = hfvis.region_visibility(dem, (x0, y0, x1, y1), method="culled", **planar)
+    assert auto.fraction.attrs["hfvis_method"] == "bitmask" and culled.fraction.attrs["hfvis_method"] == "culled"
+    np.testing.assert_array_equal(auto.bits.values, culled.bits.values)
     np.testing.assert_array_equal(lit.x, dem.x)
     equal(lit.fraction, ours.fraction)
     np.testing.assert_array_equal(lit.bits.values, ours.bits)

@@ -26,6 +26,8 @@ void validate(const HorizonOptions& options, const HorizonOutputs& outputs) {
   if (options.error_tile < 0)
     throw InvalidArgument("the error tile must be 0 (the whole field) or a number of pixels (got " +
                           std::to_string(options.error_tile) + ")");
+  if (options.error_tile > 0 && options.max_error == 0.0)
+    throw InvalidArgument("the error tile refines toward max_error: give max_error with it");
   if (options.max_error != 0.0 || outputs.error_estimate) {
     if (outputs.horizon_angles || outputs.horizon_distances || outputs.environment ||
         (!outputs.sky_view_factor && !outputs.ambient_occlusion))
@@ -220,12 +222,13 @@ int directionsForError(int directions, double estimated, int earlier, double ear
       std::max<double>(directions + 8, std::min<double>(wanted, 2.0 * kMaxAutoDirections)));
 }
 
-InvalidArgument beyondAutoDirections(double max_error, int next, int directions, double estimated) {
+InvalidArgument beyondAutoDirections(double max_error, int next, int directions, double estimated,
+                                     const std::string& where) {
   std::ostringstream message;
   // (directionsForError caps its answer at twice the most: beyond that, a bound)
   message << "a maximum error of " << max_error << " needs "
           << (next >= 2 * kMaxAutoDirections ? "at least " : "about ") << next
-          << " directions (the estimate at K = " << directions << " is " << estimated << "), beyond the "
+          << " directions (the estimate at K = " << directions << " is " << estimated << where << "), beyond the "
           << kMaxAutoDirections << " a run may choose: ask for a larger error, or give K";
   return InvalidArgument(message.str());
 }

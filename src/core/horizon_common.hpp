@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -57,8 +58,9 @@ double estimatedError(const std::vector<float>& estimate);
 int directionsForError(int directions, double estimated, int earlier, double earlier_estimate, double max_error);
 
 // The InvalidArgument a maximum error gets when a run at `directions` whose estimate was
-// `estimated` predicts `next` directions, beyond kMaxAutoDirections.
-InvalidArgument beyondAutoDirections(double max_error, int next, int directions, double estimated);
+// `estimated` (`where`, e.g. in which tile) predicts `next` directions, beyond kMaxAutoDirections.
+InvalidArgument beyondAutoDirections(double max_error, int next, int directions, double estimated,
+                                     const std::string& where = "");
 
 // A maximum error's runs for an operation other than the horizon sweep's (intervisibility):
 // run(K) at K = kFirstAutoDirections, then at directionsForError's K, until a result's

@@ -55,6 +55,8 @@ void estimateFrom(EnvironmentLightResult& result, const std::vector<float>& coar
 
 EnvironmentLightResult computeEnvironmentLight(const ComputeContext& context, const HeightField& field,
                                                const EnvironmentMap& map, const HorizonOptions& options) {
+  if (options.error_tile != 0)
+    throw InvalidArgument("the environment light takes one K for the whole field: error_tile must be 0");
   if (options.max_error == 0.0) return runAt(context, field, map, options);
   if (!(options.max_error > 0.0 && options.max_error < 1.0))
     throw InvalidArgument("the maximum error must be in (0, 1): it is relative to the mean irradiance (got " +

@@ -965,19 +965,12 @@ HorizonResult runToError(const HeightField& field, const HorizonOptions& options
       const double estimate = estimatedError(estimates[t]);
       int directions = directionsForError(tile.directions, estimate, tile.earlier, tile.earlier_estimate,
                                           options.max_error);
-      if (directions > kMaxAutoDirections) {
-        std::ostringstream message;
-        // (directionsForError caps its answer at twice the most: beyond that, a bound)
-        message << "a maximum error of " << options.max_error << " needs "
-                << (directions >= 2 * kMaxAutoDirections ? "at least " : "about ") << directions
-                << " directions (the estimate at K = " << tile.directions << " is " << estimate
-                << (tiles > 1 ? " in the tile of pixels from column " + std::to_string(t % tiles_x * side) +
-                                    ", row " + std::to_string(t / tiles_x * side)
-                              : std::string())
-                << "), beyond the " << kMaxAutoDirections
-                << " a run may choose: ask for a larger error, or give K";
-        throw InvalidArgument(message.str());
-      }
+      if (directions > kMaxAutoDirections)
+        throw beyondAutoDirections(options.max_error, directions, tile.directions, estimate,
+                                   tiles > 1 ? " in the tile of pixels from column " +
+                                                   std::to_string(t % tiles_x * side) + ", row " +
+                                                   std::to_string(t / tiles_x * side)
+                                             : std::string());
       if (options.error_tile > 0) directions = *std::lower_bound(ladder.begin(), ladder.end(), directions);
       tile.earlier = tile.directions;
       tile.earlier_estimate = estimate;

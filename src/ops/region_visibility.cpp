@@ -140,10 +140,16 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
     // The bitmasks live whole on the device and on the host, twice there in the word-major
     // layout (read back, then transposed): refuse what the budget (half the device's memory; on a
     // CPU device, the host's) cannot hold rather than fail in an allocation.
-    const std::size_t copies = receiver_major_ ? 2 : 3, bytes = copies * entries * sizeof(std::uint32_t);
+    const std::size_t copies = receiver_major_ ? 2 : 3;
+    // (the bitmask method's table too: angles x (offsets + 1) masks of the samples, on both sides)
+    const std::size_t table_size = static_cast<std::size_t>(options_.bitmask_table);
+    const std::size_t table_bytes = options_.method == RegionVisibilityMethod::Bitmask
+                                        ? 2 * table_size * (table_size + 1) * words_ * sizeof(std::uint32_t)
+                                        : 0;
+    const std::size_t bytes = copies * entries * sizeof(std::uint32_t) + table_bytes;
     const std::size_t budget = memoryBudget();
     if (bytes > budget)
-      throw MemoryBudgetError("the bitmasks and their host copies need " + detail::mebibytes(bytes) +
+      throw MemoryBudgetError("the bitmasks (and a bitmask method's table) with their host copies need " + detail::mebibytes(bytes) +
                               " but the memory budget is " + detail::mebibytes(budget) +
                               "; take fewer samples or a smaller field");
     source_table_ = upload(sources_);
@@ -682,6 +688,19 @@ std::vector<RegionPoint> regionSamplePoints(const HeightField& field, const Regi
   return regionPoints(tableSamplePoints(field, table, heights, sampling.absolute, seed));
 }
 
+const char* regionVisibilityMethodName(RegionVisibilityMethod method) {
+  switch (method) {
+    case RegionVisibilityMethod::Exact: return "exact";
+    case RegionVisibilityMethod::Viewsheds: return "viewsheds";
+    case RegionVisibilityMethod::Culled: return "culled";
+    case RegionVisibilityMethod::Bitmask: return "bitmask";
+    case RegionVisibilityMethod::Auto: return "auto";
+  }
+  return "unknown";
+}
+
+namespace {
+
 // S of a region: its points, or its rectangle's samples.
 std::size_t sourceSamples(const RegionSampling& sources) {
   return sources.points.empty() ? std::size_t(sources.samples) : sources.points.size();
@@ -717,6 +736,8 @@ RegionVisibilityMethod methodFor(const RegionSampling& sources, const RegionVisi
              ? RegionVisibilityMethod::Bitmask
              : RegionVisibilityMethod::Culled;
 }
+
+}  // namespace
 
 RegionVisibilityResult computeRegionVisibility(const ComputeContext& context, const HeightField& field,
                                                const RegionSampling& sources,
