@@ -14,6 +14,7 @@
 #include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
 #include "hfvis/intervisibility.hpp"
+#include "hfvis_testing/intervisibility_reference.hpp"
 
 namespace hfvis::bench {
 namespace {
@@ -74,23 +75,6 @@ std::vector<float> referencePlane(const ComputeContext& context, const HeightFie
   options = HorizonOptions{};
   options.directions = reference_directions;
   return computeHorizons(context, field, options, wanted).*output.plane;
-}
-
-// Per pixel the error of the count (per direction: it sums K of them) of `r` against `truth`,
-// relative to the truth's mean over the field (NaN at nodata), and its 99th percentile, as
-// IntervisibilityResult::estimated_error takes the estimate's.
-double p99RelativeError(const IntervisibilityResult& r, const IntervisibilityResult& truth) {
-  double mean = 0.0;
-  std::size_t with_data = 0;
-  for (float c : truth.visible_count)
-    if (!std::isnan(c)) mean += double(c) / truth.directions, ++with_data;
-  mean /= with_data;
-  std::vector<float> errors(r.visible_count.size());
-  for (std::size_t p = 0; p < errors.size(); ++p)
-    errors[p] = static_cast<float>(std::abs(double(r.visible_count[p]) / r.directions -
-                                            double(truth.visible_count[p]) / truth.directions) /
-                                   mean);  // NaN at nodata
-  return detail::estimatedError(errors);   // the same percentile
 }
 
 // The work of a tree run at K per receiver: its directions' samples per period summed (the
@@ -246,7 +230,7 @@ void viewcountTargetReport(const ComputeContext& context, const std::vector<Erro
       if (it != fixed_error.end()) return it->second;
       options.directions = K;
       return fixed_error[K] =
-                 p99RelativeError(computeIntervisibility(context, f.field, options, wanted), reference);
+                 countErrorP99(computeIntervisibility(context, f.field, options, wanted), reference);
     };
     for (double E : errors) {
       IntervisibilityOptions chosen;
@@ -258,7 +242,7 @@ void viewcountTargetReport(const ComputeContext& context, const std::vector<Erro
         std::printf("| %s | %g | refused: %s |||||||||\n", f.name.c_str(), E, error.what());
         continue;
       }
-      const double achieved = p99RelativeError(result, reference);
+      const double achieved = countErrorP99(result, reference);
       int cheapest = 0;
       for (int K : ladder)
         if (errorAt(K) <= E) {

@@ -309,4 +309,18 @@ IntervisibilityResult referenceIntervisibility(const HeightField& field,
   return result;
 }
 
+double countErrorP99(const IntervisibilityResult& result, const IntervisibilityResult& truth) {
+  double mean = 0.0;
+  std::size_t with_data = 0;
+  for (float c : truth.visible_count)
+    if (!std::isnan(c)) mean += double(c) / truth.directions, ++with_data;
+  mean /= double(with_data);
+  std::vector<float> errors(result.visible_count.size());
+  for (std::size_t p = 0; p < errors.size(); ++p)
+    errors[p] = static_cast<float>(std::abs(double(result.visible_count[p]) / result.directions -
+                                            double(truth.visible_count[p]) / truth.directions) /
+                                   mean);  // NaN at nodata
+  return detail::estimatedError(errors);
+}
+
 }  // namespace hfvis

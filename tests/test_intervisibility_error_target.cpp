@@ -29,26 +29,6 @@ IntervisibilityOutputs estimated() {
   return outputs;
 }
 
-// Per pixel the error of the count of `r` against `truth` (a dense run), each taken per direction
-// (the count sums K directions), relative to the truth's mean over the field; its 99th percentile
-// over the pixels with data, as IntervisibilityResult::estimated_error takes the estimate's.
-double p99RelativeError(const IntervisibilityResult& r, const IntervisibilityResult& truth) {
-  double mean = 0.0;
-  std::size_t with_data = 0;
-  for (float c : truth.visible_count)
-    if (!std::isnan(c)) mean += double(c) / truth.directions, ++with_data;
-  mean /= with_data;
-  std::vector<double> errors;
-  for (std::size_t p = 0; p < r.visible_count.size(); ++p)
-    if (!std::isnan(r.visible_count[p]))
-      errors.push_back(std::abs(double(r.visible_count[p]) / r.directions -
-                                double(truth.visible_count[p]) / truth.directions) /
-                       mean);
-  std::sort(errors.begin(), errors.end());
-  return errors.empty() ? 0.0
-                        : errors[std::min(errors.size() - 1, static_cast<std::size_t>(0.99 * errors.size()))];
-}
-
 // The halves' arithmetic: each half over its own wedges estimates the whole count, the estimate is
 // their difference relative to the field's mean total count, NaN at nodata; the count and the area
 // are the halves' totals.
@@ -172,7 +152,7 @@ TEST(IntervisibilityErrorEstimate, FallsAsKDoublesAndBoundsTheErrorAgainstADense
       options.directions = K;
       const IntervisibilityResult r = computeIntervisibility(testContext(), field, options, estimated());
       EXPECT_LT(r.estimated_error, last);
-      EXPECT_GE(r.estimated_error, p99RelativeError(r, truth));
+      EXPECT_GE(r.estimated_error, countErrorP99(r, truth));
       last = r.estimated_error;
     }
   }
@@ -198,7 +178,7 @@ TEST(IntervisibilityMaxError, MeetsTheTargetAgainstADenseRun) {
       options.max_error = E;
       const IntervisibilityResult r = computeIntervisibility(testContext(), field, options, plain);
       EXPECT_LE(r.estimated_error, E);
-      EXPECT_LE(p99RelativeError(r, truth), E);
+      EXPECT_LE(countErrorP99(r, truth), E);
       EXPECT_GE(r.directions, last_directions);
       EXPECT_LE(r.estimated_error, last_estimate);
       EXPECT_EQ(r.error_estimate.size(), field.pixelCount());

@@ -6,10 +6,10 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
-#include <utility>
 
 #include "hfvis/errors.hpp"
 #include "core/horizon_common.hpp"
+#include "ops/environment_light_result.hpp"
 
 namespace hfvis {
 namespace {
@@ -18,14 +18,7 @@ EnvironmentLightResult runAt(const ComputeContext& context, const HeightField& f
                              const EnvironmentMap& map, const HorizonOptions& options) {
   HorizonOutputs outputs;
   outputs.environment = &map;
-  HorizonResult horizons = computeHorizons(context, field, options, outputs);
-  EnvironmentLightResult result;
-  result.width = horizons.width;
-  result.height = horizons.height;
-  result.directions = horizons.directions;
-  result.names = map.names;
-  result.irradiance = std::move(horizons.irradiance);
-  return result;
+  return detail::environmentLightResult(computeHorizons(context, field, options, outputs), map);
 }
 
 // The estimate (EnvironmentLightResult::error_estimate) of `result` from `coarse`, the same run at

@@ -17,4 +17,10 @@ IntervisibilityResult referenceIntervisibility(const HeightField& field,
                                                const IntervisibilityOptions& options,
                                                const IntervisibilityOutputs& outputs);
 
+// The error the count's estimate stands for: per pixel |count / K - truth's count / its K| (each
+// run's count sums its K directions), relative to the truth's mean over the field (NaN at
+// nodata); its 99th percentile over the pixels with data, the percentile
+// IntervisibilityResult::estimated_error takes of the estimate. `truth`: a dense run.
+double countErrorP99(const IntervisibilityResult& result, const IntervisibilityResult& truth);
+
 }  // namespace hfvis
