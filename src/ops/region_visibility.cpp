@@ -146,12 +146,19 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
     const std::size_t table_bytes = options_.method == RegionVisibilityMethod::Bitmask
                                         ? 2 * table_size * (table_size + 1) * words_ * sizeof(std::uint32_t)
                                         : 0;
-    const std::size_t bytes = copies * entries * sizeof(std::uint32_t) + table_bytes;
+    // (a pair's per-end tables, which the culled march may build: a record per sample of each side)
+    const std::size_t record_bytes =
+        receivers_ && options_.method == RegionVisibilityMethod::Culled
+            ? (static_cast<std::size_t>(count_) + samples_) * REGION_END_RECORD * sizeof(float)
+            : 0;
+    const std::size_t bytes = copies * entries * sizeof(std::uint32_t) + table_bytes + record_bytes;
     const std::size_t budget = memoryBudget();
     if (bytes > budget)
-      throw MemoryBudgetError("the bitmasks (and a bitmask method's table) with their host copies need " + detail::mebibytes(bytes) +
-                              " but the memory budget is " + detail::mebibytes(budget) +
-                              "; take fewer samples or a smaller field");
+      throw MemoryBudgetError(
+          "the bitmasks with their host copies (and a bitmask method's table, a pair's per-end tables) "
+          "need " +
+          detail::mebibytes(bytes) + " but the memory budget is " + detail::mebibytes(budget) +
+          "; take fewer samples or a smaller field");
     source_table_ = upload(sources_);
     source_points_buffer_ = upload(source_points_);
     // A pixel run binds the source table in the receivers' place (never read).
