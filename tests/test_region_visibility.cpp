@@ -294,6 +294,48 @@ TEST(RegionVisibility, TheCulledMarchIsTheExactOneNearTheGround) {
   EXPECT_LT(clear, pairs * 4 / 5);
 }
 
+// The culling pyramid over a field whose every height is finite (cullPyramid's row-by-row pass):
+// each level's block holds the highest corner of the cells in it, brute force, and the margin and
+// gradient come from the field's largest height, step and twist.
+TEST(RegionVisibility, CullPyramidHoldsEachBlocksHighestCorner) {
+  for (const char* name : {"city", "noise", "terraces", "spikes", "tilted_plane"}) {
+    SCOPED_TRACE(name);
+    const HeightField field = makeSyntheticField(name, 75, 42, 5);
+    const std::vector<float> h = detail::prepareHeights(field, detail::HeightOrigin::Zero).heights;
+    const detail::CullPyramid pyramid = detail::cullPyramid(h, field.width, field.height);
+    const int w = field.width, hh = field.height;
+    ASSERT_TRUE(pyramid.finite);
+    ASSERT_EQ(pyramid.levels, 8);  // 74 x 41 cells, 37 x 21, ..., 2 x 1, 1 x 1
+    double largest = 0.0, step = 0.0, twist = 0.0;
+    for (int r = 0; r < hh; ++r)
+      for (int c = 0; c < w; ++c) {
+        const float v = h[std::size_t(r) * w + c];
+        largest = std::max(largest, double(std::fabs(v)));
+        if (c + 1 < w) step = std::max(step, double(std::fabs(h[std::size_t(r) * w + c + 1] - v)));
+        if (r + 1 < hh) step = std::max(step, double(std::fabs(h[std::size_t(r + 1) * w + c] - v)));
+        if (c + 1 < w && r + 1 < hh)
+          twist =
+              std::max(twist, std::fabs(double(v) - h[std::size_t(r) * w + c + 1] -
+                                        h[std::size_t(r + 1) * w + c] + h[std::size_t(r + 1) * w + c + 1]));
+      }
+    EXPECT_EQ(pyramid.gradient, float(step + twist));
+    EXPECT_EQ(pyramid.margin,
+              float(8e-5 * largest + 4.0 * std::ldexp(double(std::max(w, hh)), -23) * (step + twist)));
+    for (int k = 0; k < pyramid.levels; ++k) {
+      const int kw = detail::region_cull_width(w, k), kh = detail::region_cull_width(hh, k);
+      const int offset = detail::region_cull_offset(w, hh, k);
+      for (int by = 0; by < kh; ++by)
+        for (int bx = 0; bx < kw; ++bx) {
+          float top = -std::numeric_limits<float>::infinity();
+          for (int y = by << k; y <= std::min((by + 1) << k, hh - 1); ++y)
+            for (int x = bx << k; x <= std::min((bx + 1) << k, w - 1); ++x)
+              top = std::max(top, h[std::size_t(y) * w + x]);
+          ASSERT_EQ(pyramid.top[offset + by * kw + bx], top) << "level " << k << " block " << bx << "," << by;
+        }
+    }
+  }
+}
+
 // The per-end tables (region_end_table) certify only clear sight lines, and the march over the
 // rest of a line (region_sight_visible_culled given both ends' certified stretches) gives the exact
 // march's answer, with the pyramid and without, on the host: every line the tables certify whole is

@@ -292,10 +292,12 @@ inline int region_sight_visible_culled(HFVIS_GLOBAL const float* h, int width, i
         const float tY = dy > 0.0f ? (ly < yb ? (ly - ya) / dy : INFINITY)
                                    : (dy < 0.0f && ly > yb ? (ly - ya) / dy : INFINITY);
         const int leave_x = tX <= tY;
-        const float tC = leave_x ? tX : tY, tE = tC < 1.0f ? tC : 1.0f;
+        // (past t_out the caller has shown the segment clear: the block need clear it up to there)
+        const float tL = t_out < 1.0f ? t_out : 1.0f;
+        const float tC = leave_x ? tX : tY, tE = tC < tL ? tC : tL;
         const float z0 = za + t0 * dz, zE = za + tE * dz;
         if (!(tE > t0 && top + clearance < (z0 < zE ? z0 : zE))) continue;
-        if (tC >= 1.0f) return 1;  // the block holds the rest of the segment, its end too
+        if (tC >= tL) return 1;  // the block holds the rest of the segment (to t_out), its end too
         // Resume at the crossing C where the segment leaves: the march's state there waits for the
         // next step that needs it (a run of leaps needs none: each block proved itself below the
         // segment, its crossings too).
@@ -373,7 +375,8 @@ inline int region_sight_visible(HFVIS_GLOBAL const float* h, int width, int heig
 // end point E of many sight lines (a sample, a receiver) and the rectangle where their other ends
 // lie, the highest pyramid value (region_cull_*: a cell's highest corner, +INFINITY where the
 // march's values are unbounded, -INFINITY over no surface) over every cell that can meet a segment
-// from E, by direction wedge and radial band: REGION_END_BANDS bands [0, 1], [1, 2], [2, 4], ...
+// from E, by direction wedge and radial band: REGION_END_BANDS bands [0, 1], [1, 2], ... [7, 8],
+// then four to an octave ([8, 10], [10, 12], [12, 14], [14, 16], [16, 20], ...: region_band_edge)
 // and REGION_END_WEDGES wedges of the cone of directions from E toward the rectangle (all
 // directions where E lies at or near it). Directions are pseudo-angles (region_pseudo_angle: a
 // monotone stand-in for the angle, 0 .. 4 a turn, one division). A line from E of slope s (height
@@ -385,10 +388,16 @@ inline int region_sight_visible(HFVIS_GLOBAL const float* h, int width, int heig
 // its slope (region_end_reach: a count). A record: the cone's first pseudo-angle, its span, the
 // bands filled, 0, then per wedge the rising maxima and the falling ones, REGION_END_BANDS each.
 #define REGION_END_WEDGES 8
-#define REGION_END_BANDS 12
+#define REGION_END_BANDS 40
 #define REGION_END_RECORD (4 + 2 * REGION_END_WEDGES * REGION_END_BANDS)
 
-inline float region_band_edge(int b) { return b == 0 ? 0.0f : (float)(1 << (b - 1)); }
+// The bands' radii, whole pixels: 0 .. 8, then 8, 10, 12, 14 times powers of 2 (up to 2048): bands
+// at most a quarter as wide as their inner radius, since a rising line is held to its slope at the
+// band's inner radius and a falling one at its outer (doubling bands certified 48 % of the clear
+// lines whole on the fractal pair 64 apart of bench/report/region_visibility.md, these 66 %).
+inline float region_band_edge(int b) {
+  return b <= 8 ? (float)b : (float)((8 + 2 * ((b - 8) & 3)) << ((b - 8) >> 2));
+}
 
 // The pseudo-angle of the direction (x, y): 0 .. 4 counter-clockwise from +x, 1 per quarter turn,
 // p(-x, -y) = p(x, y) + 2 (mod 4).
@@ -428,9 +437,9 @@ inline int region_end_wedge(float first, float span, float x, float y) {
 
 // Fills the record (rec: REGION_END_RECORD floats) of E = (ex, ey, ez) over the pyramid (`levels` >
 // 0) for the other ends in the rectangle (ox0, oy0) .. (ox1, oy1), their heights within +-z_bound.
-// Conservative throughout: a band is looked at in blocks of the pyramid (a quarter of its inner
-// radius a side, cells up to radius 8), and a block counts for every wedge and band its box, grown
-// by 0.01 pixel, meets in the box's ranges of distance and pseudo-angle from E (which hold the
+// Conservative throughout: a band is looked at in blocks of the pyramid (at most a quarter of its
+// inner radius a side, cells up to radius 8), and a block counts for every wedge and band its box,
+// grown by 0.01 pixel, meets in the box's ranges of distance and pseudo-angle from E (which hold the
 // box's own), the cone and the wedges grown by 1e-4 (the look-up's and the box corners'
 // roundings); a box holding E counts for every wedge. The clearance is region_end_clearance's for
 // the longest line toward the rectangle and both ends' heights at their bound.
@@ -467,8 +476,8 @@ inline void region_end_table(HFVIS_GLOBAL const float* pyramid, int levels, int 
   region_pseudo_direction(region_turn(first + span), &ux1, &uy1);
   for (int b = 0; b < bands; ++b) {
     const float r0 = region_band_edge(b), r1 = region_band_edge(b + 1);
-    int k = b >= 4 ? b - 3 : 0;
-    k = k < levels - 1 ? k : levels - 1;
+    int k = 0;
+    while (k + 1 < levels && (float)(8 << k) <= r0) ++k;
     // The band's box: the cone's edges at both radii, and the axis directions within it at r1.
     float x0 = ex - r1, x1 = ex + r1, y0 = ey - r1, y1 = ey + r1;
     if (span < 4.0f) {
@@ -538,11 +547,11 @@ inline void region_end_table(HFVIS_GLOBAL const float* pyramid, int levels, int 
     float up_max = -INFINITY, down_max = -INFINITY;
     for (int b = 0; b < bands; ++b) {
       // (a band's value is finite or infinite, never NaN: so is `need` but over a NaN height; the
-      // radii are powers of 2, their reciprocals exact)
+      // divisions by the radii round by a relative 2^-24, a height's rounding, well within the
+      // clearance's relative part)
       const float need = isnan(ez) ? INFINITY : up[b] + clearance - ez;
-      up_max =
-          fmax(up_max, b == 0 ? (need < 0.0f ? -INFINITY : INFINITY) : need * (1.0f / region_band_edge(b)));
-      down_max = fmax(down_max, need * (1.0f / region_band_edge(b + 1)));
+      up_max = fmax(up_max, b == 0 ? (need < 0.0f ? -INFINITY : INFINITY) : need / region_band_edge(b));
+      down_max = fmax(down_max, need / region_band_edge(b + 1));
       up[b] = up_max, down[b] = down_max;
     }
   }
@@ -550,17 +559,24 @@ inline void region_end_table(HFVIS_GLOBAL const float* pyramid, int levels, int 
 
 // How far from the end E (height ze) the sight line of `length` pixels to the other end (height
 // zp) is certified clear by E's record `wedge` (its rising maxima, then its falling ones): the
-// bands from E whose running maximum of required slopes lies below the line's slope (a count; the
-// maxima only grow outward). Then every cell along that stretch would be leapt by the march (each
-// point of the stretch lies in a band whose value holds the cell's highest corner, below the
-// segment there by the march's clearance), so the march, which finds the same hits with or without
-// leaps, finds none there. 0 when the first band fails (an end on the surface always: its own
+// bands from E whose running maximum of required slopes lies below the line's slope (a count, found
+// by bisection: the maxima only grow outward). Then every cell along that stretch would be leapt by
+// the march (each point of the stretch lies in a band whose value holds the cell's highest corner,
+// below the segment there by the march's clearance), so the march, which finds the same hits with
+// or without leaps, finds none there. 0 when the first band fails (an end on the surface always: its own
 // corner). The slope's rounding and the required slopes' lie within the clearance's second half.
 inline float region_end_reach(HFVIS_GLOBAL const float* wedge, int bands, float length, float ze, float zp) {
   const float slope = (zp - ze) / length;
   HFVIS_GLOBAL const float* maxima = slope >= 0.0f ? wedge : wedge + REGION_END_BANDS;
-  int count = 0;
-  for (int b = 0; b < bands; ++b) count += maxima[b] < slope;
+  // The first band whose maximum does not lie below the slope (`bands` if none).
+  int count = 0, past = bands;
+  while (count < past) {
+    const int mid = (count + past) >> 1;
+    if (maxima[mid] < slope)
+      count = mid + 1;
+    else
+      past = mid;
+  }
   return count == 0 ? 0.0f : fmin(region_band_edge(count), length);
 }
 

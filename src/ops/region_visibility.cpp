@@ -146,12 +146,19 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
     const std::size_t table_bytes = options_.method == RegionVisibilityMethod::Bitmask
                                         ? 2 * table_size * (table_size + 1) * words_ * sizeof(std::uint32_t)
                                         : 0;
-    const std::size_t bytes = copies * entries * sizeof(std::uint32_t) + table_bytes;
+    // (a pair's per-end tables, which the culled march may build: a record per sample of each side)
+    const std::size_t record_bytes =
+        receivers_ && options_.method == RegionVisibilityMethod::Culled
+            ? (static_cast<std::size_t>(count_) + samples_) * REGION_END_RECORD * sizeof(float)
+            : 0;
+    const std::size_t bytes = copies * entries * sizeof(std::uint32_t) + table_bytes + record_bytes;
     const std::size_t budget = memoryBudget();
     if (bytes > budget)
-      throw MemoryBudgetError("the bitmasks (and a bitmask method's table) with their host copies need " + detail::mebibytes(bytes) +
-                              " but the memory budget is " + detail::mebibytes(budget) +
-                              "; take fewer samples or a smaller field");
+      throw MemoryBudgetError(
+          "the bitmasks with their host copies (and a bitmask method's table, a pair's per-end tables) "
+          "need " +
+          detail::mebibytes(bytes) + " but the memory budget is " + detail::mebibytes(budget) +
+          "; take fewer samples or a smaller field");
     source_table_ = upload(sources_);
     source_points_buffer_ = upload(source_points_);
     // A pixel run binds the source table in the receivers' place (never read).
@@ -495,7 +502,41 @@ CullPyramid cullPyramid(const std::vector<float>& h, int width, int height) {
   // piece's middle a rounding into the next cell): at most ulp(max(width, height)) each.
   double largest = 0.0, step = 0.0, twist = 0.0;
   bool any_infinite = false;
-  for (int r = 0; r < height; ++r)
+  // Every height finite (most fields): the same maxima row by row without the checks (the call's
+  // fixed cost: this pass and level 0 took about half of it, bench/report/region_visibility.md).
+  bool all_finite = true;
+  for (const float v : h) all_finite &= bool(std::isfinite(v));
+  // (kLanes running maxima each, so that the maxima do not wait on one another)
+  constexpr int kLanes = 8;
+  std::array<float, kLanes> lane_largest{}, lane_step{};
+  std::array<double, kLanes> lane_twist{};
+  for (int r = 0; all_finite && r < height; ++r) {
+    const float* row = h.data() + std::size_t(r) * width;
+    const float* next = row + width;
+    for (int c = 0; c < width; ++c) {
+      float& l = lane_largest[c % kLanes];
+      l = std::max(l, std::fabs(row[c]));
+    }
+    for (int c = 0; c + 1 < width; ++c) {
+      float& l = lane_step[c % kLanes];
+      l = std::max(l, std::fabs(row[c + 1] - row[c]));
+    }
+    if (r + 1 == height) continue;
+    for (int c = 0; c < width; ++c) {
+      float& l = lane_step[c % kLanes];
+      l = std::max(l, std::fabs(next[c] - row[c]));
+    }
+    for (int c = 0; c + 1 < width; ++c) {
+      double& l = lane_twist[c % kLanes];
+      l = std::max(l, std::fabs(double(row[c]) - row[c + 1] - next[c] + next[c + 1]));
+    }
+  }
+  for (int i = 0; all_finite && i < kLanes; ++i) {
+    largest = std::max(largest, double(lane_largest[i]));
+    step = std::max(step, double(lane_step[i]));
+    twist = std::max(twist, lane_twist[i]);
+  }
+  for (int r = 0; !all_finite && r < height; ++r)
     for (int c = 0; c < width; ++c) {
       const float v = at(c, r);
       any_infinite = any_infinite || std::isinf(v);
@@ -526,7 +567,14 @@ CullPyramid cullPyramid(const std::vector<float>& h, int width, int height) {
   // Level 0: per cell its corners' highest valid height; +INFINITY where an infinite height lies
   // on the cell or a cell beside it (the march's values there are unbounded or NaN).
   int w = width - 1, hh = height - 1;
-  for (int r = 0; r < hh; ++r)
+  for (int r = 0; all_finite && r < hh; ++r) {
+    const float* row = h.data() + std::size_t(r) * width;
+    const float* next = row + width;
+    float* level = out.top.data() + std::size_t(r) * w;
+    for (int c = 0; c < w; ++c)  // (the corners in the order of the loop below: the same zeros' signs)
+      level[c] = std::max(std::max(std::max(row[c], row[c + 1]), next[c]), next[c + 1]);
+  }
+  for (int r = 0; !all_finite && r < hh; ++r)
     for (int c = 0; c < w; ++c) {
       bool unbounded = false;
       for (int y = std::max(0, r - 1); any_infinite && y <= std::min(height - 1, r + 2) && !unbounded; ++y)
@@ -540,13 +588,23 @@ CullPyramid cullPyramid(const std::vector<float>& h, int width, int height) {
   for (int k = 1; k < out.levels; ++k) {
     const float* child = out.top.data() + offsets[k - 1];
     float* parent = out.top.data() + offsets[k];
-    const int pw = (w + 1) / 2;
-    for (int r = 0; r < hh; ++r)
-      for (int c = 0; c < w; ++c) {
-        float& p = parent[std::size_t(r / 2) * pw + c / 2];
-        p = std::max(p, child[std::size_t(r) * w + c]);
+    const int pw = (w + 1) / 2, ph = (hh + 1) / 2;
+    // Per parent its children in row order (no value is NaN: the maxima of the pass they replace).
+    for (int r = 0; r < ph; ++r) {
+      const float* upper = child + std::size_t(2 * r) * w;
+      const float* lower = 2 * r + 1 < hh ? upper + w : nullptr;
+      float* p = parent + std::size_t(r) * pw;
+      for (int c = 0; c < pw; ++c) {
+        float v = upper[2 * c];
+        if (2 * c + 1 < w) v = std::max(v, upper[2 * c + 1]);
+        if (lower) {
+          v = std::max(v, lower[2 * c]);
+          if (2 * c + 1 < w) v = std::max(v, lower[2 * c + 1]);
+        }
+        p[c] = v;
       }
-    w = pw, hh = (hh + 1) / 2;
+    }
+    w = pw, hh = ph;
   }
   return out;
 }
