@@ -231,12 +231,7 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
       table_ = upload(table.masks);
       tested_ = detail::deviceBuffer(st_, std::size_t(count_) * 2 * sizeof(cl_uint));
       kernel_ = kernel("region_bitmask_bits");
-      kernel_.set("h", heights_)
-          .set("pyramid", levels_ > 0 ? pyramid_ : heights_)
-          .set("levels", cl_int(levels_))
-          .set("margin", margin_)
-          .set("gradient", gradient_)
-          .set("finite_field", cl_int(finite_))
+      setSurface(kernel_)
           .set("field_top", fieldTop(prepared_.heights))
           .set("f", device)
           .set("source_points", source_points_buffer_)
@@ -257,12 +252,7 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
       return;
     }
     kernel_ = kernel("region_visibility_bits");
-    kernel_.set("h", heights_)
-        .set("pyramid", levels_ > 0 ? pyramid_ : heights_)
-        .set("levels", cl_int(levels_))
-        .set("margin", margin_)
-        .set("gradient", gradient_)
-        .set("finite_field", cl_int(finite_))
+    setSurface(kernel_)
         .set("certify_receivers", cl_int(certify_receivers_))
         .set("certify_sources", cl_int(certify_sources_))
         .set("receiver_records", certify_receivers_ ? receiver_records_ : heights_)
@@ -282,6 +272,17 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
         .set("words", cl_int(words_))
         .set("receiver_major", cl_int(receiver_major_))
         .set("bits", bits_);
+  }
+
+  // The surface's arguments, which both kernels take first: heights, the culling pyramid (the
+  // heights stand in without one), its margin, the gradient bound and whether every height is finite.
+  detail::NamedKernel& setSurface(detail::NamedKernel& k) const {
+    return k.set("h", heights_)
+        .set("pyramid", levels_ > 0 ? pyramid_ : heights_)
+        .set("levels", cl_int(levels_))
+        .set("margin", margin_)
+        .set("gradient", gradient_)
+        .set("finite_field", cl_int(finite_));
   }
 
   // Whether at least kProbeClear of kProbeLines sight lines spread over a pair's sources (stream
