@@ -68,7 +68,7 @@ void pvsRaysReport(const ComputeContext& context, const std::vector<std::string>
       for (int r = 0; r < reps; ++r) {
         auto t0 = std::chrono::steady_clock::now();
         std::clock_t c0 = std::clock();
-        const RayCastResult a = caster.cast(in, false);
+        const detail::RayCasts a = caster.cast(in, false);
         best_plain = std::min(best_plain, seconds(t0));
         cpu_plain = std::min(cpu_plain, double(std::clock() - c0) / CLOCKS_PER_SEC);
         t0 = std::chrono::steady_clock::now();

@@ -144,6 +144,11 @@ inline float hf_ray_cast(HFVIS_GLOBAL const float* h, int width, int height,
   const float clearance = cap > 0 ? band_hi : 0.0f;
   const int sx = dx < 0.0f ? -1 : 1, sy = dy < 0.0f ? -1 : 1;
   int last_view = -1;
+  // The cells [view_x0, view_x1) x [view_y0, view_y1) of last_view (none yet): a block among them
+  // holds no view cell still to list, so it is skipped as for the hit alone (clearance 0). A ray
+  // in the band over most of its way (grazing rays, rays from the band) would otherwise be marched
+  // cell by cell through every block its view cell already listed.
+  int view_x0 = 0, view_x1 = 0, view_y0 = 0, view_y1 = 0;
   float t = t_lo;
   int k = top > 0 ? 1 : 0;
   // Where the last level-1 block that could not be skipped ends: its cells are marched one
@@ -164,7 +169,11 @@ inline float hf_ray_cast(HFVIS_GLOBAL const float* h, int width, int height,
       const float za = oz + t * dz, zb = oz + te * dz;
       const float low = za < zb ? za : zb;
       const float top_height = pyramid[levels[4 * k + 2] + by * bw + bx];
-      if (te > t && !(low - top_height <= clearance)) {  // above the block (or the block all nodata)
+      const int x0 = bx * size, y0 = by * size;
+      const int x1 = x0 + size < cells_x ? x0 + size : cells_x, y1 = y0 + size < cells_y ? y0 + size : cells_y;
+      const float above =
+          x0 >= view_x0 && x1 <= view_x1 && y0 >= view_y0 && y1 <= view_y1 ? 0.0f : clearance;
+      if (te > t && !(low - top_height <= above)) {  // above the block (or the block all nodata)
         if (te >= t_hi) return t_hi;
         t = te;
         k = k < top ? k + 1 : top;
@@ -236,6 +245,10 @@ inline float hf_ray_cast(HFVIS_GLOBAL const float* h, int width, int height,
             pierced_t[*count * stride] = t + s * span;
             ++*count;
             last_view = vc;
+            view_x0 = (cx / view) * view;
+            view_y0 = (cy / view) * view;
+            view_x1 = view_x0 + view < cells_x ? view_x0 + view : cells_x;
+            view_y1 = view_y0 + view < cells_y ? view_y0 + view : cells_y;
           }
         }
       }
