@@ -176,7 +176,6 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
       // they go.
       try {
         st_.queue.finish();
-        lists_queue_.finish();
       } catch (...) {
       }
       throw;
@@ -190,7 +189,6 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
 
   void allocate() override {
     line_major_ = lineMajorLayout(st_);
-    lists_queue_ = cl::CommandQueue(st_.context, st_.device);
     const RayPyramid pyramid = buildRayPyramid(prepared_.heights, field_.width, field_.height);
     pyramid_ = upload(pyramid.values);
     levels_ = upload(pyramid.levels);
@@ -244,7 +242,10 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
     cl::Buffer rays, t, cell, count, pierced, pierced_t, lists;
     std::vector<float> packed, hit_t;
     std::vector<int> hit_cell, counts;
-    std::vector<ViewCellPoint> packed_lists;  // the work-groups' lists as read, `widest` apart
+    // The first `read_width` pairs of each work-group's lists, read with the hits, and where a
+    // group has more, the rest (`extra_width` per group).
+    std::vector<ViewCellPoint> packed_lists, extra_lists;
+    std::size_t read_width = 0;
     cl::Event read;  // its last non-blocking read
     int first = 0, n = 0;
   };
@@ -300,6 +301,13 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
     s.hit_cell.resize(std::size_t(n));
     st_.queue.enqueueReadBuffer(s.t, CL_FALSE, 0, std::size_t(n) * 4, s.hit_t.data());
     if (cap > 0) {
+      const std::size_t groups = (std::size_t(n) + kLineGroup - 1) / kLineGroup;
+      s.read_width = std::min(read_width_, kLineGroup * std::size_t(cap));
+      s.packed_lists.resize(groups * s.read_width);
+      constexpr std::size_t pair = sizeof(ViewCellPoint);
+      const cl::array<cl::size_type, 3> origin{0, 0, 0}, region{s.read_width * pair, groups, 1};
+      st_.queue.enqueueReadBufferRect(s.lists, CL_FALSE, origin, origin, region, kLineGroup * cap * pair, 0,
+                                      s.read_width * pair, 0, s.packed_lists.data());
       s.counts.resize(std::size_t(n));
       st_.queue.enqueueReadBuffer(s.cell, CL_FALSE, 0, std::size_t(n) * 4, s.hit_cell.data());
       st_.queue.enqueueReadBuffer(s.count, CL_FALSE, 0, std::size_t(n) * 4, s.counts.data(), nullptr, &s.read);
@@ -322,9 +330,9 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
       }
       return;
     }
-    // Work-group g's lists are its rays' one after another from pair g * kLineGroup * cap: read
-    // the used part of each (the longest group's length, `widest`, from every group), then put
-    // them one after another.
+    // Work-group g's lists are its rays' one after another from pair g * kLineGroup * cap, the
+    // first read_width of them read: the rest of a longer one now (the read waits for the next
+    // launch), then all one after another.
     const int groups = (n + int(kLineGroup) - 1) / int(kLineGroup);
     std::size_t widest = 0, total = 0;
     for (int g = 0; g < groups; ++g) {
@@ -333,22 +341,25 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
       widest = std::max(widest, used);
       total += used;
     }
-    const std::size_t base = out.view_cells.size();
-    if (widest > 0) {
-      s.packed_lists.resize(widest * groups);
+    read_width_ = std::max(2 * kLineGroup, widest + widest / 4);
+    const std::size_t extra = widest > s.read_width ? widest - s.read_width : 0;
+    if (extra > 0) {
       constexpr std::size_t pair = sizeof(ViewCellPoint);
-      const cl::array<cl::size_type, 3> origin{0, 0, 0}, region{widest * pair, std::size_t(groups), 1};
-      // On the second queue: on the first it would wait for the next launch, queued behind it.
-      const std::vector<cl::Event> cast{s.read};
-      lists_queue_.enqueueReadBufferRect(s.lists, CL_TRUE, origin, origin, region, kLineGroup * cap * pair, 0,
-                                         widest * pair, 0, s.packed_lists.data(), &cast);
-      out.view_cells.resize(base + total);
-      ViewCellPoint* to = out.view_cells.data() + base;
-      for (int g = 0; g < groups; ++g) {
-        const ViewCellPoint* from = s.packed_lists.data() + std::size_t(g) * widest;
-        for (int r = g * int(kLineGroup), end = std::min(n, r + int(kLineGroup)); r < end; ++r)
-          for (int j = 0; j < s.counts[r]; ++j) *to++ = *from++;
-      }
+      s.extra_lists.resize(extra * groups);
+      const cl::array<cl::size_type, 3> from{s.read_width * pair, 0, 0}, origin{0, 0, 0},
+          region{extra * pair, std::size_t(groups), 1};
+      st_.queue.enqueueReadBufferRect(s.lists, CL_TRUE, from, origin, region, kLineGroup * cap * pair, 0,
+                                      extra * pair, 0, s.extra_lists.data());
+    }
+    const std::size_t base = out.view_cells.size();
+    out.view_cells.resize(base + total);
+    ViewCellPoint* to = out.view_cells.data() + base;
+    for (int g = 0; g < groups; ++g) {
+      std::size_t used = 0;
+      for (int r = g * int(kLineGroup), end = std::min(n, r + int(kLineGroup)); r < end; ++r) used += s.counts[r];
+      const std::size_t first = std::min(used, s.read_width);
+      to = std::copy_n(s.packed_lists.data() + std::size_t(g) * s.read_width, first, to);
+      to = std::copy_n(s.extra_lists.data() + std::size_t(g) * extra, used - first, to);
     }
     std::size_t at = base;
     for (int r = 0; r < n; ++r) {
@@ -366,8 +377,11 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
   const std::function<void(RayCaster&)>& body_;
   bool line_major_ = true;
   cl::Buffer pyramid_, levels_;
-  // The view-cell lists' reads: beside the casts, not behind the next one.
-  cl::CommandQueue lists_queue_;
+  // Pairs per work-group read with a launch's hits: a little more than the last launch's
+  // longest group needed (at least two per ray), so that the lists come with the hits: a read
+  // sized after the launch would queue behind the next launch, and the device would stand idle
+  // while the host waits for it.
+  std::size_t read_width_ = 2 * kLineGroup;
   NamedKernel hits_kernel_, lists_kernel_;
   Slot slots_[2];
 };
