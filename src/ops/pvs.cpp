@@ -228,11 +228,13 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
       return (int(y) >> kBlockShift) * blocks_x + (int(x) >> kBlockShift);
     };
     std::vector<int> start(std::size_t(blocks_x) * blocks_y + 1, 0);
-    for (const HeightRay& r : rays) ++start[block(r) + 1];
-    for (std::size_t b = 1; b < start.size(); ++b) start[b] += start[b - 1];
+    // Each ray's block, in `order` until the rays are placed.
     std::vector<int> order(rays.size());
-    for (std::size_t i = 0; i < rays.size(); ++i) order[start[block(rays[i])]++] = static_cast<int>(i);
-    return order;
+    for (std::size_t i = 0; i < rays.size(); ++i) ++start[(order[i] = block(rays[i])) + 1];
+    for (std::size_t b = 1; b < start.size(); ++b) start[b] += start[b - 1];
+    std::vector<int> placed(rays.size());
+    for (std::size_t i = 0; i < rays.size(); ++i) placed[start[order[i]]++] = static_cast<int>(i);
+    return placed;
   }
 
   // One launch's buffers, kept from launch to launch (grown, never shrunk), and what it cast.
@@ -246,6 +248,7 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
     // group has more, the rest (`extra_width` per group).
     std::vector<ViewCellPoint> packed_lists, extra_lists;
     std::size_t read_width = 0;
+    std::vector<std::size_t> group_used;  // pairs per work-group
     cl::Event read;  // its last non-blocking read
     int first = 0, n = 0;
   };
@@ -278,11 +281,16 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
     s.first = first;
     s.n = n;
     s.packed.resize(std::size_t(n) * 8);
+    const int* ray_of = order.data() + first;
     for (int r = 0; r < n; ++r) {
-      const HeightRay& ray = rays[order[std::size_t(first) + r]];
+      // The rays are read in block order, all over the callers' vector: fetched ahead.
+      constexpr int kAhead = 16;
+      if (r + kAhead < n) __builtin_prefetch(&rays[ray_of[r + kAhead]]);
+      const HeightRay& ray = rays[ray_of[r]];
       const float values[8] = {ray.ox, ray.oy, ray.oz, ray.dx, ray.dy, ray.dz, ray.t_max, 0.0f};
       if (line_major_) {
-        std::copy(values, values + 8, s.packed.begin() + std::size_t(r) * 8);
+        float* to = s.packed.data() + std::size_t(r) * 8;
+        for (int c = 0; c < 8; ++c) to[c] = values[c];
       } else {
         for (int c = 0; c < 8; ++c) s.packed[std::size_t(c) * n + r] = values[c];
       }
@@ -335,9 +343,11 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
     // launch), then all one after another.
     const int groups = (n + int(kLineGroup) - 1) / int(kLineGroup);
     std::size_t widest = 0, total = 0;
+    s.group_used.resize(std::size_t(groups));
     for (int g = 0; g < groups; ++g) {
       std::size_t used = 0;
       for (int r = g * int(kLineGroup), end = std::min(n, r + int(kLineGroup)); r < end; ++r) used += s.counts[r];
+      s.group_used[g] = used;
       widest = std::max(widest, used);
       total += used;
     }
@@ -355,9 +365,7 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
     out.view_cells.resize(base + total);
     ViewCellPoint* to = out.view_cells.data() + base;
     for (int g = 0; g < groups; ++g) {
-      std::size_t used = 0;
-      for (int r = g * int(kLineGroup), end = std::min(n, r + int(kLineGroup)); r < end; ++r) used += s.counts[r];
-      const std::size_t first = std::min(used, s.read_width);
+      const std::size_t used = s.group_used[g], first = std::min(used, s.read_width);
       to = std::copy_n(s.packed_lists.data() + std::size_t(g) * s.read_width, first, to);
       to = std::copy_n(s.extra_lists.data() + std::size_t(g) * extra, used - first, to);
     }
