@@ -85,8 +85,9 @@ inline float hf_ray_band_point(float f0, float f1, float bump, float s_end, floa
   if (f0 >= lo && f0 <= hi) return 0.0f;
   if (ge >= lo && ge <= hi) return s_end;
   const float root = f0 < lo ? hf_ray_entry(f0 - lo, f1 - lo, bump, s_end) : hf_ray_entry(hi - f0, hi - f1, -bump, s_end);
+  if (lo == hi) return root;  // a band of one height: met to rounding
   const float g_root = hf_ray_piece(f0, f1, bump, root);
-  if ((g_root >= lo && g_root <= hi) || lo == hi) return root;  // a band of one height: met to rounding
+  if (g_root >= lo && g_root <= hi) return root;
   float s_low = f0 < lo ? 0.0f : s_end, s_high = f0 > hi ? 0.0f : s_end;
   if (sv > 0.0f && sv < s_end) {
     const float gv = hf_ray_piece(f0, f1, bump, sv);
