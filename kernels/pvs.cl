@@ -13,9 +13,10 @@
 // Casts ray r (< n): its hit into hit_t[r], hit_cell[r]; with cap > 0 its view cells into
 // pierced / pierced_t in the layout's list r. Returns how many.
 inline int pvs_cast_ray(__global const float* h, int width, int height, __global const float* pyramid,
-                        __global const int* levels, int top, __global const float* rays, int n, int line_major,
-                        int view, int view_x, float band_lo, float band_hi, int cap, __global float* hit_t,
-                        __global int* hit_cell, __global int* pierced, __global float* pierced_t, int r) {
+                        __global const int* levels, int top, __global const float* rays, int n,
+                        int line_major, int view, int view_x, float band_lo, float band_hi, int cap,
+                        __global float* hit_t, __global int* hit_cell, __global int* pierced,
+                        __global float* pierced_t, int r) {
   const size_t base = line_major ? (size_t)r * 8 : (size_t)r;
   const size_t step = line_major ? 1 : (size_t)n;
   __global const float* ray = rays + base;
@@ -56,7 +57,8 @@ __kernel void pvs_cast_lists(__global const float* h, int width, int height, __g
   const int r = get_global_id(0), lid = get_local_id(0);
   // No return before the barrier: every work-item of the group reaches it.
   const int count = r < n ? pvs_cast_ray(h, width, height, pyramid, levels, top, rays, n, line_major, view,
-                                         view_x, band_lo, band_hi, cap, hit_t, hit_cell, pierced, pierced_t, r)
+                                         view_x, band_lo, band_hi, cap, hit_t, hit_cell, pierced,
+                                         pierced_t, r)
                           : 0;
   group_counts[lid] = count;
   barrier(CLK_LOCAL_MEM_FENCE);

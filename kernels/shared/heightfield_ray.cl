@@ -18,7 +18,8 @@
 // level k >= 1 holds, per block of 2^k x 2^k cells, the largest of its (2^k + 1)^2 heights, NaN
 // where all are nodata; level k is levels[4k] blocks wide, levels[4k + 1] high, from
 // levels[4k + 2]): a block is skipped where the ray over it stays above its largest height by
-// more than `clearance` (0 for the hit alone; the view band's top when view cells are wanted).
+// more than `clearance` (0 for the hit alone; the view band's top when view cells are wanted,
+// but 0 where the ray crosses the block inside the view cell it listed last).
 #ifndef HFVIS_HEIGHTFIELD_RAY_CL
 #define HFVIS_HEIGHTFIELD_RAY_CL
 
@@ -147,11 +148,11 @@ inline float hf_ray_cast(HFVIS_GLOBAL const float* h, int width, int height,
   if (!(t_lo <= t_hi)) return t_lo < t_max ? t_lo : t_max;
   const float clearance = cap > 0 ? band_hi : 0.0f;
   const int sx = dx < 0.0f ? -1 : 1, sy = dy < 0.0f ? -1 : 1;
-  // The cells [view_x0, view_x1) x [view_y0, view_y1) of the view cell listed last (none yet), and the t where
-  // the ray leaves their square: a block the ray crosses before that holds no view cell still
-  // to list, so it is skipped as for the hit alone (clearance 0), and a cell among them lists
-  // nothing. A ray in the band over most of its way (rays from the band, grazing rays) would
-  // otherwise be marched cell by cell through the blocks of the view cell it listed first.
+  // The cells [view_x0, view_x1) x [view_y0, view_y1) of the view cell listed last (none yet),
+  // and the t where the ray leaves their square: a block the ray crosses before that holds no
+  // view cell still to list, so it is skipped as for the hit alone (clearance 0), and a cell
+  // among them lists nothing. A ray in the band over most of its way (rays from the band,
+  // grazing rays) would otherwise be marched cell by cell through the view cell it listed first.
   int view_x0 = 0, view_x1 = 0, view_y0 = 0, view_y1 = 0;
   float listed_to = -INFINITY;
   float t = t_lo;

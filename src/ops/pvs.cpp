@@ -318,9 +318,11 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
                                       s.read_width * pair, 0, s.packed_lists.data());
       s.counts.resize(std::size_t(n));
       st_.queue.enqueueReadBuffer(s.cell, CL_FALSE, 0, std::size_t(n) * 4, s.hit_cell.data());
-      st_.queue.enqueueReadBuffer(s.count, CL_FALSE, 0, std::size_t(n) * 4, s.counts.data(), nullptr, &s.read);
+      st_.queue.enqueueReadBuffer(s.count, CL_FALSE, 0, std::size_t(n) * 4, s.counts.data(), nullptr,
+                                  &s.read);
     } else {
-      st_.queue.enqueueReadBuffer(s.cell, CL_FALSE, 0, std::size_t(n) * 4, s.hit_cell.data(), nullptr, &s.read);
+      st_.queue.enqueueReadBuffer(s.cell, CL_FALSE, 0, std::size_t(n) * 4, s.hit_cell.data(), nullptr,
+                                  &s.read);
     }
     st_.queue.flush();
   }
@@ -346,7 +348,8 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
     s.group_used.resize(std::size_t(groups));
     for (int g = 0; g < groups; ++g) {
       std::size_t used = 0;
-      for (int r = g * int(kLineGroup), end = std::min(n, r + int(kLineGroup)); r < end; ++r) used += s.counts[r];
+      for (int r = g * int(kLineGroup), end = std::min(n, r + int(kLineGroup)); r < end; ++r)
+        used += s.counts[r];
       s.group_used[g] = used;
       widest = std::max(widest, used);
       total += used;
@@ -417,7 +420,8 @@ RayCastResult castHeightFieldRays(const ComputeContext& context, const HeightFie
   out.first.assign(rays.size() + 1, 0);
   if (cast.list_count.empty()) return out;
   // The lists into the rays' order.
-  for (std::size_t r = 0; r < rays.size(); ++r) out.first[r + 1] = out.first[r] + std::size_t(cast.list_count[r]);
+  for (std::size_t r = 0; r < rays.size(); ++r)
+    out.first[r + 1] = out.first[r] + std::size_t(cast.list_count[r]);
   out.view_cell.resize(out.first.back());
   out.view_t.resize(out.first.back());
   for (std::size_t r = 0; r < rays.size(); ++r)

@@ -41,8 +41,8 @@ struct ViewCellPoint {
 
 // What the caster gives the samplers: RayCastResult's hits, and each ray's view cells where the
 // caster put them (launch after launch, in the order it cast the rays), found from the ray:
-// putting a million rays' lists into the callers' order took as long as a fifth of casting
-// them (bench/report/pvs.md).
+// putting a million rays' lists into the callers' order took about 0.1 s of the host's on the
+// 2-core CPU (bench/report/pvs.md).
 struct RayCasts {
   std::vector<float> t;   // per ray, as RayCastResult::t
   std::vector<int> cell;  // per ray, as RayCastResult::cell
