@@ -64,11 +64,15 @@ void pvsRaysReport(const ComputeContext& context, const std::vector<std::string>
     // The caster as the samplers use it: the field uploaded and its pyramid built once, then
     // batch after batch.
     detail::withRayCaster(context, f, plain.grid, 0, [&](detail::RayCaster& caster) {
-      caster.cast(std::vector<HeightRay>(in.begin(), in.begin() + 1024), true);  // warm-up
+      // Warm-up: two full launches each way, so that the launches' buffers are allocated (and
+      // their pages touched) before the timing, as they are after a sampler's first batch.
+      const std::vector<HeightRay> warm(in.begin(), in.begin() + std::min<std::size_t>(in.size(), 1 << 17));
+      caster.cast(warm, true);
+      caster.cast(warm, false);
       for (int r = 0; r < reps; ++r) {
         auto t0 = std::chrono::steady_clock::now();
         std::clock_t c0 = std::clock();
-        const RayCastResult a = caster.cast(in, false);
+        const detail::RayCasts a = caster.cast(in, false);
         best_plain = std::min(best_plain, seconds(t0));
         cpu_plain = std::min(cpu_plain, double(std::clock() - c0) / CLOCKS_PER_SEC);
         t0 = std::chrono::steady_clock::now();

@@ -3,21 +3,24 @@
 # city and rough terrain, rays from the view band) of this build against another hfvis_bench
 # (an earlier commit's build), the two run alternately in one go so that both see the same load
 # on a shared machine. Prints every run's rows, then per field and column the median of each and
-# their ratio (this build over the other).
+# their ratio (this build over the other). Each run is the fastest of --reps casts per mode (2: a
+# build whose warm-up does not allocate a full launch's buffers pays for that in its first cast).
 #
-#   bench/pvs_rays_against.sh OTHER_HFVIS_BENCH [--rounds 3] [--rays 1000000]
+#   bench/pvs_rays_against.sh OTHER_HFVIS_BENCH [--rounds 3] [--rays 1000000] [--reps 2]
 #   BUILD_DIR=... selects this build (default build/).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-[[ $# -ge 1 && $1 != -h && $1 != --help ]] || { sed -n '2,9p' "$0"; exit 0; }
+[[ $# -ge 1 && $1 != -h && $1 != --help ]] || { sed -n '2,10p' "$0"; exit 0; }
 other=$1
 shift
 rounds=3
 rays=1000000
+reps=2
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --rounds) rounds=$2; shift ;;
     --rays) rays=$2; shift ;;
+    --reps) reps=$2; shift ;;
     *) echo "pvs_rays_against.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
   shift
@@ -27,7 +30,7 @@ for b in "$this" "$other"; do [[ -x $b ]] || { echo "pvs_rays_against.sh: no exe
 export POCL_CACHE_DIR=${POCL_CACHE_DIR:-$root/bench/out/pocl-cache}
 rows=$(mktemp)
 trap 'rm -f "$rows"' EXIT
-echo "<!-- bench/pvs_rays_against.sh $other --rounds $rounds --rays $rays; $(date -u +%Y-%m-%dT%H:%MZ), commit $(git -C "$root" rev-parse --short HEAD) -->"
+echo "<!-- bench/pvs_rays_against.sh $other --rounds $rounds --rays $rays --reps $reps; $(date -u +%Y-%m-%dT%H:%MZ), commit $(git -C "$root" rev-parse --short HEAD) -->"
 echo
 echo "| run | build | field | rays/s (hit only) | rays/s (with view cells) | per CPU second (hit only) | (with view cells) |"
 echo "| ---: | --- | --- | ---: | ---: | ---: | ---: |"
@@ -35,7 +38,7 @@ for ((r = 1; r <= rounds; ++r)); do
   for which in this other; do
     bench=$this
     [[ $which == other ]] && bench=$other
-    "$bench" pvs-rays --size 1024 --rays "$rays" --reps 1 city noise | grep '^| [a-z]* [0-9]*x[0-9]* |' |
+    "$bench" pvs-rays --size 1024 --rays "$rays" --reps "$reps" city noise | grep '^| [a-z]* [0-9]*x[0-9]* |' |
       awk -F'|' -v r="$r" -v w="$which" '{gsub(/ /, "", $2); gsub(/[ M]/, "", $5); gsub(/[ M]/, "", $6);
         gsub(/[ M]/, "", $7); gsub(/[ M]/, "", $8); print r, w, $2, $5, $6, $7, $8}' >> "$rows"
   done
@@ -56,4 +59,4 @@ for field in $(awk '{print $3}' "$rows" | sort -u); do
   echo "$line"
 done
 echo
-echo "(each run: \`hfvis_bench pvs-rays --size 1024 --rays $rays --reps 1 city noise\`, one call per mode with its upload and pyramid)"
+echo "(each run: \`hfvis_bench pvs-rays --size 1024 --rays $rays --reps $reps city noise\`: the fastest of $reps casts per mode on one caster)"

@@ -257,7 +257,7 @@ TEST(PvsRayCaster, RaysSortedByOriginComeBackInTheCallersOrder) {
       options.grid.band_low = 0.5;
       options.grid.band_high = 2.0;
       const std::vector<HeightRay> in = raysOver(field, 2000, 17);
-      options.memory_budget_bytes = 400 * (11 + 2 * 33) * 4;  // 400 rays per launch
+      options.memory_budget_bytes = 2 * 200 * (11 + 4 * 33) * 4;  // 200 rays per launch
       const RayCastResult got = castHeightFieldRays(context, field, in, options);
       expectSame(got, referenceCastHeightFieldRays(field, in, options));
     }
@@ -273,7 +273,7 @@ TEST(PvsRayCaster, MemoryBudgetSplitsLaunchesWithTheSameResults) {
   options.grid.view_cell = 4;
   const std::vector<HeightRay> in = raysOver(field, 500, 3);
   const RayCastResult whole = castHeightFieldRays(testContext(), field, in, options);
-  options.memory_budget_bytes = 8192;  // about 50 rays per launch
+  options.memory_budget_bytes = 8192;  // 12 rays per launch (lists of 18: 2 (11 + 4 * 18) 4 bytes a ray)
   const RayCastResult split = castHeightFieldRays(testContext(), field, in, options);
   EXPECT_EQ(split.cell, whole.cell);
   EXPECT_EQ(split.first, whole.first);
@@ -286,6 +286,44 @@ TEST(PvsRayCaster, MemoryBudgetSplitsLaunchesWithTheSameResults) {
   for (std::size_t r = 0; r < in.size(); ++r) EXPECT_TRUE(sameFloat(hits.t[r], whole.t[r])) << r;
   options.memory_budget_bytes = 16;
   EXPECT_THROW(castHeightFieldRays(testContext(), field, in, options), MemoryBudgetError);
+}
+
+// Long lists: a work-group's rays list more view cells than the caster reads with the hits (it
+// reads a little more than the last launch's longest group, at least two a ray), so the rest is
+// read after them; then, launch after launch, the lists grow and shrink. Rays one cell above a
+// flat field along it, through view cells of one cell, list every cell they cross; steep ones
+// one or two.
+TEST(PvsRayCaster, ListsLongerThanReadWithTheHitsAreReadToo) {
+  forEachLayout([&](const ComputeContext& context) {
+    HeightField field;
+    field.width = 90;
+    field.height = 70;
+    field.heights.assign(std::size_t(field.width) * field.height, 3.0f);
+    RayCastOptions options;
+    options.view_cells = true;
+    options.grid.view_cell = 1;
+    options.grid.band_low = 0.5;
+    options.grid.band_high = 2.0;
+    std::mt19937 gen(23);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    std::vector<HeightRay> in;
+    for (int i = 0; i < 3000; ++i) {
+      // Blocks of 500 rays alternately along the field and steep: long lists, then short ones.
+      const bool along = (i / 500) % 2 == 0;
+      const float a = 6.2831853f * u(gen);
+      in.push_back(HeightRay{1.0f + 87.0f * u(gen), 1.0f + 67.0f * u(gen), 4.0f, std::cos(a), std::sin(a),
+                             along ? 0.0f : -1.5f, INFINITY});
+    }
+    // Lists of 89 + 69 + 1 = 159: 300 rays per launch, two in flight.
+    options.memory_budget_bytes = 2 * 300 * (11 + 4 * 159) * 4;
+    const RayCastResult got = castHeightFieldRays(context, field, in, options);
+    const RayCastResult want = referenceCastHeightFieldRays(field, in, options);
+    expectSame(got, want);
+    std::size_t longest = 0;
+    for (std::size_t r = 0; r < in.size(); ++r) longest = std::max<std::size_t>(longest, got.count(r));
+    EXPECT_GT(got.view_cell.size(), in.size() * 10);  // many more than two a ray
+    EXPECT_GT(longest, 50u);
+  });
 }
 
 // A flat 25 x 17 field at height 3 (every point sees every other), and its grid: 8-cell view

@@ -18,7 +18,8 @@
 // level k >= 1 holds, per block of 2^k x 2^k cells, the largest of its (2^k + 1)^2 heights, NaN
 // where all are nodata; level k is levels[4k] blocks wide, levels[4k + 1] high, from
 // levels[4k + 2]): a block is skipped where the ray over it stays above its largest height by
-// more than `clearance` (0 for the hit alone; the view band's top when view cells are wanted).
+// more than `clearance` (0 for the hit alone; the view band's top when view cells are wanted,
+// but 0 where the ray crosses the block inside the view cell it listed last).
 #ifndef HFVIS_HEIGHTFIELD_RAY_CL
 #define HFVIS_HEIGHTFIELD_RAY_CL
 
@@ -43,6 +44,9 @@ inline float hf_ray_bilinear(float h00, float h10, float h01, float h11, float u
   const float b = h01 + (h11 - h01) * u;
   return a + (b - a) * v;
 }
+
+// The vertex of g (below), where bump != 0.
+inline float hf_ray_vertex(float f0, float f1, float bump) { return 0.5f + (f1 - f0) / (2.0f * bump); }
 
 // g(s) = f0 + (f1 - f0) s + bump s (1 - s): the surface minus the ray over one cell's piece,
 // in the piece's own parameter s in [0, 1].
@@ -82,8 +86,9 @@ inline float hf_ray_band_point(float f0, float f1, float bump, float s_end, floa
   if (f0 >= lo && f0 <= hi) return 0.0f;
   if (ge >= lo && ge <= hi) return s_end;
   const float root = f0 < lo ? hf_ray_entry(f0 - lo, f1 - lo, bump, s_end) : hf_ray_entry(hi - f0, hi - f1, -bump, s_end);
+  if (lo == hi) return root;  // a band of one height: met to rounding
   const float g_root = hf_ray_piece(f0, f1, bump, root);
-  if ((g_root >= lo && g_root <= hi) || lo == hi) return root;  // a band of one height: met to rounding
+  if (g_root >= lo && g_root <= hi) return root;
   float s_low = f0 < lo ? 0.0f : s_end, s_high = f0 > hi ? 0.0f : s_end;
   if (sv > 0.0f && sv < s_end) {
     const float gv = hf_ray_piece(f0, f1, bump, sv);
@@ -143,7 +148,13 @@ inline float hf_ray_cast(HFVIS_GLOBAL const float* h, int width, int height,
   if (!(t_lo <= t_hi)) return t_lo < t_max ? t_lo : t_max;
   const float clearance = cap > 0 ? band_hi : 0.0f;
   const int sx = dx < 0.0f ? -1 : 1, sy = dy < 0.0f ? -1 : 1;
-  int last_view = -1;
+  // The cells [view_x0, view_x1) x [view_y0, view_y1) of the view cell listed last (none yet),
+  // and the t where the ray leaves their square: a block the ray crosses before that holds no
+  // view cell still to list, so it is skipped as for the hit alone (clearance 0), and a cell
+  // among them lists nothing. A ray in the band over most of its way (rays from the band,
+  // grazing rays) would otherwise be marched cell by cell through the view cell it listed first.
+  int view_x0 = 0, view_x1 = 0, view_y0 = 0, view_y1 = 0;
+  float listed_to = -INFINITY;
   float t = t_lo;
   int k = top > 0 ? 1 : 0;
   // Where the last level-1 block that could not be skipped ends: its cells are marched one
@@ -164,7 +175,8 @@ inline float hf_ray_cast(HFVIS_GLOBAL const float* h, int width, int height,
       const float za = oz + t * dz, zb = oz + te * dz;
       const float low = za < zb ? za : zb;
       const float top_height = pyramid[levels[4 * k + 2] + by * bw + bx];
-      if (te > t && !(low - top_height <= clearance)) {  // above the block (or the block all nodata)
+      const float above = te <= listed_to ? 0.0f : clearance;
+      if (te > t && !(low - top_height <= above)) {  // above the block (or the block all nodata)
         if (te >= t_hi) return t_hi;
         t = te;
         k = k < top ? k + 1 : top;
@@ -204,39 +216,47 @@ inline float hf_ray_cast(HFVIS_GLOBAL const float* h, int width, int height,
       const float span = t1 - t;
       const float twist = h00 - h10 - h01 + h11;
       const float bump = -(twist * dx * dy) * span * span;
-      // g's vertex (its top where bump > 0, its bottom where bump < 0; -1 for none).
-      const float sv = bump != 0.0f ? 0.5f + (f1 - f0) / (2.0f * bump) : -1.0f;
       // Where the piece turns positive, if it does: s_end.
       float s_end = 1.0f;
       int hit = 0;
+      // g's vertex (its top where bump > 0, its bottom where bump < 0; -1 for none), where needed.
+      float sv = -1.0f;
       if (f0 > 0.0f) {
         s_end = 0.0f;
         hit = 1;
       } else if (f1 > 0.0f) {
         s_end = hf_ray_entry(f0, f1, bump, 1.0f);
         hit = 1;
-      } else if (bump > 0.0f && sv > 0.0f && sv < 1.0f && hf_ray_piece(f0, f1, bump, sv) > 0.0f) {
-        s_end = hf_ray_entry(f0, f1, bump, sv);
-        hit = 1;
+      } else if (bump > 0.0f) {
+        sv = hf_ray_vertex(f0, f1, bump);
+        if (sv > 0.0f && sv < 1.0f && hf_ray_piece(f0, f1, bump, sv) > 0.0f) {
+          s_end = hf_ray_entry(f0, f1, bump, sv);
+          hit = 1;
+        }
       }
-      if (cap > 0) {
-        const int vc = (cy / view) * view_x + cx / view;
-        if (vc != last_view && *count < cap) {
-          // g's range over [0, s_end] against the band -band_hi <= g <= -band_lo.
-          const float ge = hf_ray_piece(f0, f1, bump, s_end);
-          float g_min = f0 < ge ? f0 : ge, g_max = f0 < ge ? ge : f0;
-          if (sv > 0.0f && sv < s_end) {
-            const float gv = hf_ray_piece(f0, f1, bump, sv);
-            g_max = gv > g_max ? gv : g_max;
-            g_min = gv < g_min ? gv : g_min;
-          }
-          if (g_max >= -band_hi && g_min <= -band_lo) {
-            const float s = hf_ray_band_point(f0, f1, bump, s_end, sv, -band_hi, -band_lo);
-            pierced[*count * stride] = vc;
-            pierced_t[*count * stride] = t + s * span;
-            ++*count;
-            last_view = vc;
-          }
+      // A view cell not listed last (a segment meets each view cell's square once).
+      if (cap > 0 && !(cx >= view_x0 && cx < view_x1 && cy >= view_y0 && cy < view_y1) && *count < cap) {
+        if (bump != 0.0f) sv = hf_ray_vertex(f0, f1, bump);
+        // g's range over [0, s_end] against the band -band_hi <= g <= -band_lo.
+        const float ge = hf_ray_piece(f0, f1, bump, s_end);
+        float g_min = f0 < ge ? f0 : ge, g_max = f0 < ge ? ge : f0;
+        if (sv > 0.0f && sv < s_end) {
+          const float gv = hf_ray_piece(f0, f1, bump, sv);
+          g_max = gv > g_max ? gv : g_max;
+          g_min = gv < g_min ? gv : g_min;
+        }
+        if (g_max >= -band_hi && g_min <= -band_lo) {
+          const float s = hf_ray_band_point(f0, f1, bump, s_end, sv, -band_hi, -band_lo);
+          pierced[*count * stride] = (cy / view) * view_x + cx / view;
+          pierced_t[*count * stride] = t + s * span;
+          ++*count;
+          view_x0 = (cx / view) * view;
+          view_y0 = (cy / view) * view;
+          view_x1 = view_x0 + view;
+          view_y1 = view_y0 + view;
+          const float lx = hf_ray_crossing((float)(dx < 0.0f ? view_x0 : view_x1), ox, dx);
+          const float ly = hf_ray_crossing((float)(dy < 0.0f ? view_y0 : view_y1), oy, dy);
+          listed_to = lx < ly ? lx : ly;
         }
       }
       if (hit) {

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <utility>
 
 #include "core/horizon_common.hpp"
 #include "core/opencl_context.hpp"
@@ -135,28 +136,31 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
         layout_(pvsLayout(field, grid)),
         body_(body) {}
 
-  RayCastResult cast(const std::vector<HeightRay>& rays, bool view_cells) override {
+  RayCasts cast(const std::vector<HeightRay>& rays, bool view_cells) override {
     for (const HeightRay& r : rays)
       if (!std::isfinite(r.ox) || !std::isfinite(r.oy) || !std::isfinite(r.oz) || !std::isfinite(r.dx) ||
           !std::isfinite(r.dy) || !std::isfinite(r.dz) || std::isnan(r.t_max))
         throw InvalidArgument("a ray with a non-finite origin or direction, or a NaN length");
     const int n = static_cast<int>(rays.size());
     const int cap = view_cells ? layout_.view_x + layout_.view_y : 0;
-    // Per ray on the device: 8 floats in, t, cell, count and cap (view cell, t) pairs out; twice,
-    // since two launches are in flight (their buffers apart): the host packs the next launch's
-    // rays and unpacks the previous one's results while the device casts.
-    const std::size_t per_ray = 2 * (8 + 3 + 2 * std::size_t(cap)) * 4;
+    // Per ray on the device: 8 floats in, t, cell and count out, and a list's capacity of
+    // (view cell, t) pairs twice (as cast, and packed with its work-group's); twice over, since
+    // two launches are in flight (their buffers apart): the host packs the next launch's rays
+    // and unpacks the previous one's results while the device casts.
+    const std::size_t per_ray = 2 * (8 + 3 + 4 * std::size_t(cap)) * 4;
     if (per_ray > memoryBudget())
       throw MemoryBudgetError("one ray and its view-cell list, in each of two launches in flight, need " +
                               mebibytes(per_ray) + " but the memory budget is " + mebibytes(memoryBudget()));
     const int chunk = static_cast<int>(std::min<std::size_t>(kRaysPerLaunch, memoryBudget() / per_ray));
     const std::vector<int> order = originOrder(rays);
-    RayCastResult out;
+    RayCasts out;
     out.t.resize(rays.size());
     out.cell.resize(rays.size());
-    // The lists as cast (in `order`), then in the caller's order.
-    Lists cast_lists;
-    cast_lists.first.push_back(0);
+    if (cap > 0) {
+      out.list_first.resize(rays.size());
+      out.list_count.resize(rays.size());
+      out.view_cells.reserve(rays.size() + rays.size() / 4);  // about one per ray (bench/report/pvs.md)
+    }
     const int launches = (n + chunk - 1) / chunk;
     try {
       if (launches > 0) enqueue(rays, order, 0, std::min(chunk, n), cap, slots_[0]);
@@ -165,28 +169,16 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
           const int next = (c + 1) * chunk;
           enqueue(rays, order, next, std::min(chunk, n - next), cap, slots_[(c + 1) % 2]);
         }
-        collect(order, cap, slots_[c % 2], out, cast_lists);
+        collect(order, cap, slots_[c % 2], out);
       }
     } catch (...) {
-      // A launch still in flight writes into the slots' host vectors: let it end before they go.
+      // A launch or read still in flight writes into the slots' host vectors: let it end before
+      // they go.
       try {
         st_.queue.finish();
       } catch (...) {
       }
       throw;
-    }
-    out.first.assign(rays.size() + 1, 0);
-    if (cast_lists.cells.empty()) return out;
-    for (int i = 0; i < n; ++i) out.first[order[i] + 1] = cast_lists.first[i + 1] - cast_lists.first[i];
-    for (int r = 0; r < n; ++r) out.first[r + 1] += out.first[r];
-    out.view_cell.resize(cast_lists.cells.size());
-    out.view_t.resize(cast_lists.cells.size());
-    for (int i = 0; i < n; ++i) {
-      const std::size_t from = cast_lists.first[i], to = out.first[order[i]];
-      std::copy(cast_lists.cells.begin() + from, cast_lists.cells.begin() + cast_lists.first[i + 1],
-                out.view_cell.begin() + to);
-      std::copy(cast_lists.ts.begin() + from, cast_lists.ts.begin() + cast_lists.first[i + 1],
-                out.view_t.begin() + to);
     }
     return out;
   }
@@ -200,30 +192,26 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
     const RayPyramid pyramid = buildRayPyramid(prepared_.heights, field_.width, field_.height);
     pyramid_ = upload(pyramid.values);
     levels_ = upload(pyramid.levels);
-    kernel_ = kernel("pvs_cast");
-    kernel_.set("h", heights_)
-        .set("width", cl_int(field_.width))
-        .set("height", cl_int(field_.height))
-        .set("pyramid", pyramid_)
-        .set("levels", levels_)
-        .set("top", cl_int(pyramid.top))
-        .set("line_major", cl_int(line_major_))
-        .set("view", cl_int(grid_.view_cell))
-        .set("view_x", cl_int(layout_.view_x))
-        .set("band_lo", static_cast<float>(grid_.band_low))
-        .set("band_hi", static_cast<float>(grid_.band_high));
+    for (NamedKernel* k : {&hits_kernel_, &lists_kernel_}) {
+      *k = kernel(k == &hits_kernel_ ? "pvs_cast" : "pvs_cast_lists");
+      k->set("h", heights_)
+          .set("width", cl_int(field_.width))
+          .set("height", cl_int(field_.height))
+          .set("pyramid", pyramid_)
+          .set("levels", levels_)
+          .set("top", cl_int(pyramid.top))
+          .set("line_major", cl_int(line_major_))
+          .set("view", cl_int(grid_.view_cell))
+          .set("view_x", cl_int(layout_.view_x))
+          .set("band_lo", static_cast<float>(grid_.band_low))
+          .set("band_hi", static_cast<float>(grid_.band_high));
+    }
+    lists_kernel_.set("group_counts", cl::Local(kLineGroup * sizeof(cl_int)));
   }
 
   int itemCount() const override { return 1; }
   void runItem(int, int) override { body_(*this); }
   void finish() override {}
-
-  // View-cell lists, one after another: ray i's at first[i] .. first[i + 1] - 1.
-  struct Lists {
-    std::vector<std::size_t> first;
-    std::vector<int> cells;
-    std::vector<float> ts;
-  };
 
   // The rays in the order they are cast: by the 16 x 16-cell block holding their origin (clamped
   // into the field), blocks row by row. Rays with neighbouring origins read neighbouring heights
@@ -240,20 +228,27 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
       return (int(y) >> kBlockShift) * blocks_x + (int(x) >> kBlockShift);
     };
     std::vector<int> start(std::size_t(blocks_x) * blocks_y + 1, 0);
-    for (const HeightRay& r : rays) ++start[block(r) + 1];
-    for (std::size_t b = 1; b < start.size(); ++b) start[b] += start[b - 1];
+    // Each ray's block, in `order` until the rays are placed.
     std::vector<int> order(rays.size());
-    for (std::size_t i = 0; i < rays.size(); ++i) order[start[block(rays[i])]++] = static_cast<int>(i);
-    return order;
+    for (std::size_t i = 0; i < rays.size(); ++i) ++start[(order[i] = block(rays[i])) + 1];
+    for (std::size_t b = 1; b < start.size(); ++b) start[b] += start[b - 1];
+    std::vector<int> placed(rays.size());
+    for (std::size_t i = 0; i < rays.size(); ++i) placed[start[order[i]]++] = static_cast<int>(i);
+    return placed;
   }
 
   // One launch's buffers, kept from launch to launch (grown, never shrunk), and what it cast.
   struct Slot {
     int reserved_rays = 0;
     std::size_t reserved_list = 0;
-    cl::Buffer rays, t, cell, count, pierced, pierced_t;
+    cl::Buffer rays, t, cell, count, pierced, pierced_t, lists;
     std::vector<float> packed, hit_t;
     std::vector<int> hit_cell, counts;
+    // The first `read_width` pairs of each work-group's lists, read with the hits, and where a
+    // group has more, the rest (`extra_width` per group).
+    std::vector<ViewCellPoint> packed_lists, extra_lists;
+    std::size_t read_width = 0;
+    std::vector<std::size_t> group_used;  // pairs per work-group
     cl::Event read;  // its last non-blocking read
     int first = 0, n = 0;
   };
@@ -268,11 +263,13 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
       s.cell = deviceBuffer(st_, rays * 4);
       s.count = deviceBuffer(st_, rays * 4);
     }
-    const std::size_t list = std::max<std::size_t>(1, std::size_t(n) * cap);
+    // The packed lists: every work-group's capacity, the last one's whole too.
+    const std::size_t list = std::max<std::size_t>(1, roundUp(std::size_t(n), kLineGroup) * cap);
     if (list > s.reserved_list) {
       s.reserved_list = list;
       s.pierced = deviceBuffer(st_, list * 4);
       s.pierced_t = deviceBuffer(st_, list * 4);
+      s.lists = deviceBuffer(st_, list * sizeof(ViewCellPoint));
     }
   }
 
@@ -283,66 +280,106 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
     reserve(s, n, cap);
     s.first = first;
     s.n = n;
-    s.packed.assign(std::size_t(n) * 8, 0.0f);
+    s.packed.resize(std::size_t(n) * 8);
+    const int* ray_of = order.data() + first;
     for (int r = 0; r < n; ++r) {
-      const HeightRay& ray = rays[order[std::size_t(first) + r]];
-      const float values[7] = {ray.ox, ray.oy, ray.oz, ray.dx, ray.dy, ray.dz, ray.t_max};
-      for (int c = 0; c < 7; ++c)
-        s.packed[line_major_ ? std::size_t(r) * 8 + c : std::size_t(c) * n + r] = values[c];
+      // The rays are read in block order, all over the callers' vector: fetched ahead.
+      constexpr int kAhead = 16;
+      if (r + kAhead < n) __builtin_prefetch(&rays[ray_of[r + kAhead]]);
+      const HeightRay& ray = rays[ray_of[r]];
+      const float values[8] = {ray.ox, ray.oy, ray.oz, ray.dx, ray.dy, ray.dz, ray.t_max, 0.0f};
+      if (line_major_) {
+        float* to = s.packed.data() + std::size_t(r) * 8;
+        for (int c = 0; c < 8; ++c) to[c] = values[c];
+      } else {
+        for (int c = 0; c < 8; ++c) s.packed[std::size_t(c) * n + r] = values[c];
+      }
     }
     st_.queue.enqueueWriteBuffer(s.rays, CL_FALSE, 0, s.packed.size() * 4, s.packed.data());
-    kernel_.set("rays", s.rays)
-        .set("n", cl_int(n))
-        .set("cap", cl_int(cap))
-        .set("hit_t", s.t)
-        .set("hit_cell", s.cell)
-        .set("counts", s.count)
-        .set("pierced", s.pierced)
-        .set("pierced_t", s.pierced_t);
-    st_.launch(kernel_, cl::NDRange(roundUp(n, kLineGroup)), cl::NDRange(kLineGroup));
+    NamedKernel& k = cap > 0 ? lists_kernel_ : hits_kernel_;
+    k.set("rays", s.rays).set("n", cl_int(n)).set("hit_t", s.t).set("hit_cell", s.cell);
+    if (cap > 0)
+      k.set("cap", cl_int(cap))
+          .set("counts", s.count)
+          .set("pierced", s.pierced)
+          .set("pierced_t", s.pierced_t)
+          .set("lists", s.lists);
+    st_.launch(k, cl::NDRange(roundUp(n, kLineGroup)), cl::NDRange(kLineGroup));
     s.hit_t.resize(std::size_t(n));
     s.hit_cell.resize(std::size_t(n));
-    s.counts.resize(std::size_t(n));
     st_.queue.enqueueReadBuffer(s.t, CL_FALSE, 0, std::size_t(n) * 4, s.hit_t.data());
-    st_.queue.enqueueReadBuffer(s.cell, CL_FALSE, 0, std::size_t(n) * 4, s.hit_cell.data());
-    st_.queue.enqueueReadBuffer(s.count, CL_FALSE, 0, std::size_t(n) * 4, s.counts.data(), nullptr, &s.read);
+    if (cap > 0) {
+      const std::size_t groups = (std::size_t(n) + kLineGroup - 1) / kLineGroup;
+      s.read_width = std::min(read_width_, kLineGroup * std::size_t(cap));
+      s.packed_lists.resize(groups * s.read_width);
+      constexpr std::size_t pair = sizeof(ViewCellPoint);
+      const cl::array<cl::size_type, 3> origin{0, 0, 0}, region{s.read_width * pair, groups, 1};
+      st_.queue.enqueueReadBufferRect(s.lists, CL_FALSE, origin, origin, region, kLineGroup * cap * pair, 0,
+                                      s.read_width * pair, 0, s.packed_lists.data());
+      s.counts.resize(std::size_t(n));
+      st_.queue.enqueueReadBuffer(s.cell, CL_FALSE, 0, std::size_t(n) * 4, s.hit_cell.data());
+      st_.queue.enqueueReadBuffer(s.count, CL_FALSE, 0, std::size_t(n) * 4, s.counts.data(), nullptr,
+                                  &s.read);
+    } else {
+      st_.queue.enqueueReadBuffer(s.cell, CL_FALSE, 0, std::size_t(n) * 4, s.hit_cell.data(), nullptr,
+                                  &s.read);
+    }
     st_.queue.flush();
   }
 
-  // Waits for the launch in `s` and puts its hits into `out` (at their rays' own index) and its
-  // lists onto `lists` (in cast order).
-  void collect(const std::vector<int>& order, int cap, Slot& s, RayCastResult& out, Lists& lists) {
+  // Waits for the launch in `s` and puts its hits and its rays' list places into `out` (at their
+  // rays' own index) and its lists after those already in `out` (in cast order).
+  void collect(const std::vector<int>& order, int cap, Slot& s, RayCasts& out) {
     s.read.wait();
     const int n = s.n;
-    for (int r = 0; r < n; ++r) {
-      const int to = order[std::size_t(s.first) + r];
-      out.t[to] = s.hit_t[r];
-      out.cell[to] = s.hit_cell[r];
-    }
-    const int longest = n ? *std::max_element(s.counts.begin(), s.counts.end()) : 0;
-    if (longest == 0) {
-      const std::size_t end = lists.first.back();
-      lists.first.insert(lists.first.end(), std::size_t(n), end);
+    const int* ray_of = order.data() + s.first;
+    if (cap == 0) {
+      for (int r = 0; r < n; ++r) {
+        out.t[ray_of[r]] = s.hit_t[r];
+        out.cell[ray_of[r]] = s.hit_cell[r];
+      }
       return;
     }
-    // Only the lists' first `longest` entries: per ray (line-major) or per plane (step-major).
-    const std::size_t row = line_major_ ? std::size_t(longest) : std::size_t(n),
-                      rows = line_major_ ? std::size_t(n) : std::size_t(longest),
-                      pitch = line_major_ ? std::size_t(cap) : std::size_t(n);
-    std::vector<int> cells(row * rows);
-    std::vector<float> ts(row * rows);
-    const cl::array<cl::size_type, 3> origin{0, 0, 0}, region{row * 4, rows, 1};
-    st_.queue.enqueueReadBufferRect(s.pierced, CL_FALSE, origin, origin, region, pitch * 4, 0, row * 4, 0,
-                                    cells.data());
-    st_.queue.enqueueReadBufferRect(s.pierced_t, CL_TRUE, origin, origin, region, pitch * 4, 0, row * 4, 0,
-                                    ts.data());
+    // Work-group g's lists are its rays' one after another from pair g * kLineGroup * cap, the
+    // first read_width of them read: the rest of a longer one now (the read waits for the next
+    // launch), then all one after another.
+    const int groups = (n + int(kLineGroup) - 1) / int(kLineGroup);
+    std::size_t widest = 0, total = 0;
+    s.group_used.resize(std::size_t(groups));
+    for (int g = 0; g < groups; ++g) {
+      std::size_t used = 0;
+      for (int r = g * int(kLineGroup), end = std::min(n, r + int(kLineGroup)); r < end; ++r)
+        used += s.counts[r];
+      s.group_used[g] = used;
+      widest = std::max(widest, used);
+      total += used;
+    }
+    read_width_ = std::max(2 * kLineGroup, widest + widest / 4);
+    const std::size_t extra = widest > s.read_width ? widest - s.read_width : 0;
+    if (extra > 0) {
+      constexpr std::size_t pair = sizeof(ViewCellPoint);
+      s.extra_lists.resize(extra * groups);
+      const cl::array<cl::size_type, 3> from{s.read_width * pair, 0, 0}, origin{0, 0, 0},
+          region{extra * pair, std::size_t(groups), 1};
+      st_.queue.enqueueReadBufferRect(s.lists, CL_TRUE, from, origin, region, kLineGroup * cap * pair, 0,
+                                      extra * pair, 0, s.extra_lists.data());
+    }
+    const std::size_t base = out.view_cells.size();
+    out.view_cells.resize(base + total);
+    ViewCellPoint* to = out.view_cells.data() + base;
+    for (int g = 0; g < groups; ++g) {
+      const std::size_t used = s.group_used[g], first = std::min(used, s.read_width);
+      to = std::copy_n(s.packed_lists.data() + std::size_t(g) * s.read_width, first, to);
+      to = std::copy_n(s.extra_lists.data() + std::size_t(g) * extra, used - first, to);
+    }
+    std::size_t at = base;
     for (int r = 0; r < n; ++r) {
-      for (int j = 0; j < s.counts[r]; ++j) {
-        const std::size_t from = line_major_ ? std::size_t(r) * longest + j : std::size_t(j) * n + r;
-        lists.cells.push_back(cells[from]);
-        lists.ts.push_back(ts[from]);
-      }
-      lists.first.push_back(lists.cells.size());
+      const int ray = ray_of[r];
+      out.t[ray] = s.hit_t[r];
+      out.cell[ray] = s.hit_cell[r];
+      out.list_first[ray] = at;
+      out.list_count[ray] = s.counts[r];
+      at += std::size_t(s.counts[r]);
     }
   }
 
@@ -351,7 +388,12 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
   const std::function<void(RayCaster&)>& body_;
   bool line_major_ = true;
   cl::Buffer pyramid_, levels_;
-  NamedKernel kernel_;
+  // Pairs per work-group read with a launch's hits: a little more than the last launch's
+  // longest group needed (at least two per ray), so that the lists come with the hits: a read
+  // sized after the launch would queue behind the next launch, and the device would stand idle
+  // while the host waits for it.
+  std::size_t read_width_ = 2 * kLineGroup;
+  NamedKernel hits_kernel_, lists_kernel_;
   Slot slots_[2];
 };
 
@@ -369,9 +411,25 @@ void withRayCaster(const ComputeContext& context, const HeightField& field, cons
 
 RayCastResult castHeightFieldRays(const ComputeContext& context, const HeightField& field,
                                   const std::vector<HeightRay>& rays, const RayCastOptions& options) {
-  RayCastResult out;
+  detail::RayCasts cast;
   detail::withRayCaster(context, field, options.grid, options.memory_budget_bytes,
-                        [&](detail::RayCaster& caster) { out = caster.cast(rays, options.view_cells); });
+                        [&](detail::RayCaster& caster) { cast = caster.cast(rays, options.view_cells); });
+  RayCastResult out;
+  out.t = std::move(cast.t);
+  out.cell = std::move(cast.cell);
+  out.first.assign(rays.size() + 1, 0);
+  if (cast.list_count.empty()) return out;
+  // The lists into the rays' order.
+  for (std::size_t r = 0; r < rays.size(); ++r)
+    out.first[r + 1] = out.first[r] + std::size_t(cast.list_count[r]);
+  out.view_cell.resize(out.first.back());
+  out.view_t.resize(out.first.back());
+  for (std::size_t r = 0; r < rays.size(); ++r)
+    for (int j = 0; j < cast.list_count[r]; ++j) {
+      const detail::ViewCellPoint& p = cast.view_cells[cast.list_first[r] + std::size_t(j)];
+      out.view_cell[out.first[r] + std::size_t(j)] = p.view_cell;
+      out.view_t[out.first[r] + std::size_t(j)] = p.t;
+    }
   return out;
 }
 

@@ -33,13 +33,33 @@ std::vector<float> rayHeights(const HeightField& field);
 
 namespace hfvis::detail {
 
+// A view cell a ray passes through, with a t where the ray lies in its volume (to rounding).
+struct ViewCellPoint {
+  int view_cell;
+  float t;
+};
+
+// What the caster gives the samplers: RayCastResult's hits, and each ray's view cells where the
+// caster put them (launch after launch, in the order it cast the rays), found from the ray:
+// putting a million rays' lists into the callers' order took about 0.1 s of the host's on the
+// 2-core CPU (bench/report/pvs.md).
+struct RayCasts {
+  std::vector<float> t;   // per ray, as RayCastResult::t
+  std::vector<int> cell;  // per ray, as RayCastResult::cell
+  // Ray r's view cells: view_cells[list_first[r] .. list_first[r] + list_count[r]), in order
+  // along the ray (both empty without view cells).
+  std::vector<std::size_t> list_first;
+  std::vector<int> list_count;
+  std::vector<ViewCellPoint> view_cells;
+};
+
 // The device ray caster, set up once (heights and pyramid uploaded, program built) for many
 // batches: a sampler's whole run.
 class RayCaster {
  public:
   virtual ~RayCaster() = default;
   // Casts `rays` (view cells listed when `view_cells`), in launches that fit the memory budget.
-  virtual RayCastResult cast(const std::vector<HeightRay>& rays, bool view_cells) = 0;
+  virtual RayCasts cast(const std::vector<HeightRay>& rays, bool view_cells) = 0;
 };
 
 // Runs `body` with a caster of `field` and `grid` (validated) on the device, its launches within

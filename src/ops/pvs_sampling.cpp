@@ -319,7 +319,7 @@ class Sampler {
         const Vec end = s.candidate.target + (s.candidate.target_radius * i / kDiscoveryRays) * s.direction;
         rays.push_back(ray(s.candidate.origin, end - s.candidate.origin));
       }
-    const RayCastResult hits = caster.cast(rays, false);
+    const detail::RayCasts hits = caster.cast(rays, false);
     out_.rays += rays.size();
     std::size_t next = 0;
     for (Sample& sample : samples) {
@@ -396,7 +396,7 @@ class Sampler {
       rays.push_back(ray(s.origin, s.direction));
       if (global) rays.push_back(ray(s.origin, -1.0 * s.direction));
     }
-    const RayCastResult r = caster.cast(rays, global);
+    const detail::RayCasts r = caster.cast(rays, global);
     out_.rays += rays.size();
     out_.samples += std::uint64_t(n);
     const PvsLayout& l = out_.layout;
@@ -436,9 +436,10 @@ class Sampler {
         for (int side = 0; side < 2; ++side) {
           const std::size_t m = 2 * std::size_t(i) + side;
           const HeightRay& p = rays[m];
-          for (std::size_t j = r.first[m]; j < r.first[m + 1]; ++j) {
-            const int v = r.view_cell[j];
-            const float t = r.view_t[j];
+          const detail::ViewCellPoint* list = r.view_cells.data() + r.list_first[m];
+          for (int j = 0; j < r.list_count[m]; ++j) {
+            const int v = list[j].view_cell;
+            const float t = list[j].t;
             const int c =
                 add(v, tile, p.ox + t * p.dx, p.oy + t * p.dy, p.oz + t * p.dz, tx, ty, s.lineage, false);
             end_contribution[end] += c;
