@@ -113,14 +113,12 @@ double Timing::cpuMin() const {
   return cpu_seconds.empty() ? 0.0 : *std::min_element(cpu_seconds.begin(), cpu_seconds.end());
 }
 
-namespace {
 double processCpuSeconds() {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   auto seconds = [](const timeval& t) { return t.tv_sec + t.tv_usec * 1e-6; };
   return seconds(usage.ru_utime) + seconds(usage.ru_stime);
 }
-}  // namespace
 
 Timing timeRepeated(const std::function<void()>& run, const TimingPolicy& policy) {
   Timing timing;

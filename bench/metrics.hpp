@@ -33,6 +33,10 @@ struct Timing {
 // caller's business.
 Timing timeRepeated(const std::function<void()>& run, const TimingPolicy& policy);
 
+// The process's CPU time so far (every thread's, user and system), in seconds: on a shared machine
+// a call's CPU time moves less with the load than its wall time.
+double processCpuSeconds();
+
 // The library's formulas (kernels/horizon.cl surface_normal, ambient_term; svf = 1 - mean
 // sin(max(0, elevation))), in double, for one receiver from its K elevation angles, each
 // direction weighted 1/K (the library's weights when it computes the K angle planes).

@@ -1,8 +1,6 @@
 // bench/region_visibility.cpp: see region_visibility.hpp.
 #include "region_visibility.hpp"
 
-#include <sys/resource.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -12,6 +10,7 @@
 
 #include "hfvis/image_io.hpp"
 #include "hfvis/region_visibility.hpp"
+#include "metrics.hpp"
 
 namespace hfvis::bench {
 namespace {
@@ -20,15 +19,6 @@ double secondsOf(const std::function<void()>& body) {
   const auto start = std::chrono::steady_clock::now();
   body();
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-// The process's CPU time so far (every thread's, user and system), in seconds: on a shared machine
-// a call's CPU time moves less with the load than its wall time.
-double processCpuSeconds() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
-         1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
 // The fastest of `reps` runs of each body, the bodies interleaved round by round (the machine is

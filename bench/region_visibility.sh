@@ -41,18 +41,20 @@ while [[ $# -gt 0 ]]; do
     --rounds) rounds=$2; shift ;;
     --base-kernels) base_kernels=$2; shift ;;
     --field) field=$2; shift ;;
-    -h|--help) sed -n '2,22p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,23p' "$0"; exit 0 ;;
     *) echo "region_visibility.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
   shift
 done
+[[ -n $base_build && -n $base_kernels ]] &&
+  { echo "region_visibility.sh: --base-build and --base-kernels name two different bases: give one" >&2; exit 2; }
 build=${BUILD_DIR:-$root/build}
 bench=$build/bench/hfvis_bench
 [[ -x $bench ]] || { echo "region_visibility.sh: no hfvis_bench in $build (build it first)" >&2; exit 1; }
 export POCL_CACHE_DIR=${POCL_CACHE_DIR:-$root/bench/out/pocl-cache}
 data=$root/bench/out/data
 mkdir -p "$data" "$(dirname "$out")"
-[[ -f $data/fractal_$size.exr ]] ||
+[[ -n $field || -f $data/fractal_$size.exr ]] ||
   /usr/bin/python3 "$root/data/make_data.py" --size "$size" --out "$data" --no-dem --no-env --fields fractal > /dev/null
 field=${field:-$data/fractal_$size.exr}
 if [[ -z $base_build && -z $base_kernels ]]; then

@@ -273,18 +273,23 @@ TEST(PvsRayCaster, MemoryBudgetSplitsLaunchesWithTheSameResults) {
   options.grid.view_cell = 4;
   const std::vector<HeightRay> in = raysOver(field, 500, 3);
   const RayCastResult whole = castHeightFieldRays(testContext(), field, in, options);
-  options.memory_budget_bytes = 8192;  // 12 rays per launch (lists of 18: 2 (11 + 4 * 18) 4 bytes a ray)
+  // 64 rays per launch, one work-group (lists of 18: 2 (11 + 4 * 18) 4 bytes a ray), 8 launches.
+  options.memory_budget_bytes = 64 * 2 * (11 + 4 * 18) * 4;
   const RayCastResult split = castHeightFieldRays(testContext(), field, in, options);
   EXPECT_EQ(split.cell, whole.cell);
   EXPECT_EQ(split.first, whole.first);
   EXPECT_EQ(split.view_cell, whole.view_cell);
   for (std::size_t r = 0; r < in.size(); ++r) EXPECT_TRUE(sameFloat(split.t[r], whole.t[r])) << r;
-  // Hits alone: about 90 rays per launch, two launches in flight (their buffers apart).
+  // Hits alone: 482 rays per launch, two launches in flight (their buffers apart).
   options.view_cells = false;
   const RayCastResult hits = castHeightFieldRays(testContext(), field, in, options);
   EXPECT_EQ(hits.cell, whole.cell);
   for (std::size_t r = 0; r < in.size(); ++r) EXPECT_TRUE(sameFloat(hits.t[r], whole.t[r])) << r;
   options.memory_budget_bytes = 16;
+  EXPECT_THROW(castHeightFieldRays(testContext(), field, in, options), MemoryBudgetError);
+  // With lists a launch takes a whole work-group of 64 rays: one ray's lists fit, 64 do not.
+  options.view_cells = true;
+  options.memory_budget_bytes = 63 * 2 * (11 + 4 * 18) * 4;
   EXPECT_THROW(castHeightFieldRays(testContext(), field, in, options), MemoryBudgetError);
 }
 
@@ -314,7 +319,8 @@ TEST(PvsRayCaster, ListsLongerThanReadWithTheHitsAreReadToo) {
       in.push_back(HeightRay{1.0f + 87.0f * u(gen), 1.0f + 67.0f * u(gen), 4.0f, std::cos(a), std::sin(a),
                              along ? 0.0f : -1.5f, INFINITY});
     }
-    // Lists of 89 + 69 + 1 = 159: 300 rays per launch, two in flight.
+    // Lists of at most 89 + 69 = 158 view cells: 256 rays per launch (301 fit; a launch with lists
+    // takes whole work-groups of 64), two in flight.
     options.memory_budget_bytes = 2 * 300 * (11 + 4 * 159) * 4;
     const RayCastResult got = castHeightFieldRays(context, field, in, options);
     const RayCastResult want = referenceCastHeightFieldRays(field, in, options);

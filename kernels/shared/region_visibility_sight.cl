@@ -393,8 +393,8 @@ inline int region_sight_visible(HFVIS_GLOBAL const float* h, int width, int heig
 
 // The bands' radii, whole pixels: 0 .. 8, then 8, 10, 12, 14 times powers of 2 (up to 2048): bands
 // at most a quarter as wide as their inner radius, since a rising line is held to its slope at the
-// band's inner radius and a falling one at its outer (doubling bands certified 48 % of the clear
-// lines whole on the fractal pair 64 apart of bench/report/region_visibility.md, these 66 %).
+// band's inner radius and a falling one at its outer (finer bands certify more clear lines whole
+// than doubling ones: bench/report/region_visibility.md).
 inline float region_band_edge(int b) {
   return b <= 8 ? (float)b : (float)((8 + 2 * ((b - 8) & 3)) << ((b - 8) >> 2));
 }

@@ -147,11 +147,17 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
     // (view cell, t) pairs twice (as cast, and packed with its work-group's); twice over, since
     // two launches are in flight (their buffers apart): the host packs the next launch's rays
     // and unpacks the previous one's results while the device casts.
+    // The lists are allocated by whole work-groups (the packed read of a launch's last group
+    // may reach its end), so a launch with lists takes whole groups: then the budget holds them.
     const std::size_t per_ray = 2 * (8 + 3 + 4 * std::size_t(cap)) * 4;
-    if (per_ray > memoryBudget())
-      throw MemoryBudgetError("one ray and its view-cell list, in each of two launches in flight, need " +
-                              mebibytes(per_ray) + " but the memory budget is " + mebibytes(memoryBudget()));
-    const int chunk = static_cast<int>(std::min<std::size_t>(kRaysPerLaunch, memoryBudget() / per_ray));
+    const std::size_t granule = cap > 0 ? kLineGroup : 1;
+    if (granule * per_ray > memoryBudget())
+      throw MemoryBudgetError(std::to_string(granule) + (granule > 1 ? " rays (a work-group)" : " ray") +
+                              " and their view-cell lists, in each of two launches in flight, need " +
+                              mebibytes(granule * per_ray) + " but the memory budget is " +
+                              mebibytes(memoryBudget()));
+    const int chunk = static_cast<int>(std::min<std::size_t>(kRaysPerLaunch, memoryBudget() / per_ray) /
+                                       granule * granule);
     const std::vector<int> order = originOrder(rays);
     RayCasts out;
     out.t.resize(rays.size());
@@ -388,8 +394,9 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
   const std::function<void(RayCaster&)>& body_;
   bool line_major_ = true;
   cl::Buffer pyramid_, levels_;
-  // Pairs per work-group read with a launch's hits: a little more than the last launch's
-  // longest group needed (at least two per ray), so that the lists come with the hits: a read
+  // Pairs per work-group read with a launch's hits: a little more than the longest group of the
+  // last launch collected when it was queued (the one before last: the next launch is queued
+  // before the last is collected) needed (at least two per ray), so that the lists come with the hits: a read
   // sized after the launch would queue behind the next launch, and the device would stand idle
   // while the host waits for it.
   std::size_t read_width_ = 2 * kLineGroup;
