@@ -9,9 +9,11 @@ A run between the ladder's K takes the error, estimate and samples interpolated 
 cost is its samples per receiver plus --overhead (a run's fixed costs, in samples). The cheapest
 fixed K is the ladder's first K whose error is at most E. Prints, per output, the share of cases
 meeting E and the median and largest cost over the cheapest fixed K's: for the present rule
-(detail::directionsForError), the best of a family of other stepping rules, a single run at the
-first K whose estimate meets E (the stepping's floor), and the present rule with the estimate
-scaled down."""
+(detail::nextDirectionsForError, the estimate over detail::richardsonDivisor; --max-order
+replays it with another bound on p), the earlier rule (detail::directionsForError, the raw
+estimate), the best of a family of other stepping rules, a single run at the first K whose raw
+estimate meets E (the stepping's floor), and the earlier rule with the estimate scaled down.
+--errors and --contents choose the cases (default: all E above, every content in the file)."""
 import argparse
 import math
 import re
@@ -52,6 +54,41 @@ def rule(first_cap=4.0, p_first=1.0, p_range=(0.5, 3.0), margin=1.05, target=1.0
     return next_k
 
 
+def richardson_order(runs, max_order):  # detail::estimateOrder
+    K, raw = runs[-1]
+    for k0, r0 in reversed(runs[:-1]):
+        if 2 * k0 <= K:
+            if not (r0 > 0 and raw > 0):
+                return 1.0
+            return min(max_order, max(1.0, math.log(r0 / raw) / math.log(K / k0)))
+    return 1.0
+
+
+def present(data, overhead, max_order=1.1, aim=0.9):
+    """detail::nextDirectionsForError and the estimate over detail::richardsonDivisor."""
+    cases = []
+    for (output, field), curve in sorted(data.items()):
+        for E in ERRORS:
+            fixed = next((k for k in sorted(curve) if curve[k][1] <= E), None)
+            runs, cost, K = [], 0.0, 16
+            while K <= 4096:
+                raw = at(curve, K, 2)
+                cost += at(curve, K, 0) + overhead
+                runs.append((K, raw))
+                if raw / (2 ** richardson_order(runs, max_order) - 1) <= E:
+                    break
+                q = 1.0
+                if len(runs) >= 2 and runs[-2][1] > raw > 0:
+                    q = min(2.0, max(1.0, math.log(runs[-2][1] / raw) / math.log(K / runs[-2][0])))
+                wanted = min(K * (raw / (2 ** min(q, max_order) - 1) / (aim * E)) ** (1 / q), 8192)
+                if wanted > 4 * K:
+                    wanted = min(wanted, max(2 * K, wanted / 6))
+                K = int(max(K + 8, math.ceil(wanted / 8) * 8))
+            if K <= 4096 and fixed:
+                cases.append((output, at(curve, K, 1) <= E, cost / (curve[fixed][0] + overhead)))
+    return cases
+
+
 def replay(data, next_k, overhead, first=16, scale=1.0):
     cases = []
     for (output, field), curve in sorted(data.items()):
@@ -89,12 +126,20 @@ def summary(name, cases):
 
 
 def main():
+    global ERRORS
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("curve", nargs="?", default="bench/report/error_curve.md")
     ap.add_argument("--overhead", type=float, default=30.0)
+    ap.add_argument("--max-order", type=float, default=1.1)
+    ap.add_argument("--errors", default="0.001,0.002,0.005,0.01,0.02,0.05")
+    ap.add_argument("--contents", default="")
     args = ap.parse_args()
+    ERRORS = tuple(float(e) for e in args.errors.split(","))
     data = curves(args.curve)
-    summary("present rule", replay(data, rule(), args.overhead))
+    if args.contents:
+        data = {key: curve for key, curve in data.items() if key[1] in args.contents.split(",")}
+    summary("present rule (p at most %g)" % args.max_order, present(data, args.overhead, args.max_order))
+    summary("earlier rule", replay(data, rule(), args.overhead))
     best = None
     for first in (8, 16, 24, 32):
         for cap in (2, 3, 4, 8, 100):
@@ -109,7 +154,7 @@ def main():
     summary("best other stepping (first, cap, p, p range, margin, aim) %s" % (best[2],), best[1])
     summary("one run at the first K whose estimate meets E", floor(data, args.overhead))
     for scale in (0.9, 0.8, 0.75, 0.7):
-        summary("present rule, estimate x %.2f" % scale, replay(data, rule(), args.overhead, scale=scale))
+        summary("earlier rule, estimate x %.2f" % scale, replay(data, rule(), args.overhead, scale=scale))
 
 
 if __name__ == "__main__":

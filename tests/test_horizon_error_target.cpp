@@ -8,6 +8,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <map>
 
 #include "core/horizon_common.hpp"
 #include "core/lattice_geometry.hpp"
@@ -245,8 +246,9 @@ HeightField cityBesideFlat(const char* name, int width, int height) {
   return field;
 }
 
-// Refinement in tiles (HorizonOptions::error_tile): every pixel's values and estimate are those of
-// a whole-field run at the K it records (HorizonResult::pixel_directions), bit for bit, though the
+// Refinement in tiles (HorizonOptions::error_tile): every pixel's values are those of a whole-field
+// run at the K it records (HorizonResult::pixel_directions), bit for bit, and its estimate that
+// run's over one divisor per tile (the order its tile's runs measured), though the
 // runs after the first sweep only the lines that reach their tiles (cut after them); the estimate
 // meets E; the open part stops at fewer directions than the dense one, and the runs swept fewer
 // receivers than whole-field runs at their K. On the city and nodata hard cases, in both
@@ -275,6 +277,7 @@ TEST(HorizonMaxError, RefinedTilesEqualAWholeFieldRunAtTheirK) {
         EXPECT_EQ(taken.back(), refined.directions);
         for (int K : taken) {
           SCOPED_TRACE(K);
+          std::map<int, double> divisors;  // tile -> its estimate's divisor at K
           HorizonOptions fixed = options;
           fixed.max_error = 0.0;
           fixed.error_tile = 0;
@@ -286,7 +289,21 @@ TEST(HorizonMaxError, RefinedTilesEqualAWholeFieldRunAtTheirK) {
             const auto same = [](float x, float y) { return x == y || (std::isnan(x) && std::isnan(y)); };
             ASSERT_TRUE(same(refined.sky_view_factor[p], whole.sky_view_factor[p])) << p;
             ASSERT_TRUE(same(refined.ambient_occlusion[p], whole.ambient_occlusion[p])) << p;
-            ASSERT_TRUE(same(refined.error_estimate[p], whole.error_estimate[p])) << p;
+            // The estimate: the run's raw one over its tile's divisor (richardsonDivisor: one per
+            // tile and K, 1 .. 2^1.1 - 1).
+            const int tile = static_cast<int>(p % field.width) / options.error_tile +
+                             static_cast<int>(p / field.width) / options.error_tile * 100;
+            if (std::isnan(whole.error_estimate[p]) || whole.error_estimate[p] == 0.0f) {
+              ASSERT_TRUE(same(refined.error_estimate[p], whole.error_estimate[p])) << p;
+            } else {
+              const double divisor = whole.error_estimate[p] / static_cast<double>(refined.error_estimate[p]);
+              ASSERT_GE(divisor, 1.0 - 1e-6) << p;
+              ASSERT_LE(divisor, detail::richardsonDivisor(detail::kMaxRichardsonOrder) * (1 + 1e-6)) << p;
+              const auto [at, fresh] = divisors.emplace(tile, divisor);
+              if (!fresh) {
+                ASSERT_NEAR(divisor, at->second, 1e-5 * divisor) << p;
+              }
+            }
             ++compared;
           }
           EXPECT_GT(compared, 0u);
@@ -337,6 +354,93 @@ TEST(HorizonErrorEstimate, FallsAsKDoublesAndBoundsTheErrorAgainstADenseRun) {
   }
 }
 
+// The estimate of a maximum error's run is the raw one (half the halves' difference) divided by
+// 2^p - 1, p the order its fall measures (raw ~ K^-p) between the run and the latest earlier one
+// of at most half its K, within 1 .. kMaxRichardsonOrder: a single run keeps the raw estimate, a
+// steeper fall divides by more, and the divisor never shrinks as p grows.
+TEST(HorizonMaxError, TheEstimateIsTheRawOneOverTheRichardsonDivisor) {
+  using detail::EstimateRun;
+  EXPECT_EQ(detail::estimateOrder({{16, 0.1}}), 1.0);
+  EXPECT_EQ(detail::richardsonDivisor(1.0), 1.0);
+  EXPECT_NEAR(detail::richardsonDivisor(1.1), std::pow(2.0, 1.1) - 1.0, 1e-12);
+  // K^-1.05 from 32 to 128: measured; from 96 to 128 too near (the latest at most half 128 is 32).
+  const double raw32 = 0.05, raw128 = raw32 * std::pow(4.0, -1.05);
+  EXPECT_NEAR(detail::estimateOrder({{32, raw32}, {128, raw128}}), 1.05, 1e-9);
+  EXPECT_NEAR(detail::estimateOrder({{16, 1.0}, {32, raw32}, {96, raw128 * 2}, {128, raw128}}), 1.05, 1e-9);
+  EXPECT_EQ(detail::estimateOrder({{96, raw32}, {128, raw128}}), 1.0);
+  // Clamped: slower than K^-1 (or rising) counts as 1, faster than K^-1.1 as 1.1.
+  EXPECT_EQ(detail::estimateOrder({{32, 0.05}, {128, 0.04}}), 1.0);
+  EXPECT_EQ(detail::estimateOrder({{32, 0.05}, {128, 0.06}}), 1.0);
+  EXPECT_EQ(detail::estimateOrder({{32, 0.05}, {128, 0.0001}}), detail::kMaxRichardsonOrder);
+  double last = 0.0;
+  for (double order = 1.0; order <= detail::kMaxRichardsonOrder; order += 0.02) {
+    EXPECT_GE(detail::richardsonDivisor(order), last);
+    last = detail::richardsonDivisor(order);
+  }
+  // A whole-field run: its estimate is the raw estimate of a fixed run at its last K over the
+  // divisor its runs measure, pixel by pixel.
+  const HeightField field = makeSyntheticField("city", 48, 40);
+  HorizonOptions options;
+  options.max_error = 0.01;
+  HorizonOutputs svf;
+  svf.sky_view_factor = true;
+  const HorizonResult chosen = computeHorizons(testContext(), field, options, svf);
+  ASSERT_GE(chosen.runs.size(), 2u) << "one run: nothing measured";
+  std::vector<EstimateRun> runs;
+  HorizonResult fixed;
+  HorizonOutputs raw = svf;
+  raw.error_estimate = true;
+  for (int K : chosen.runs) {
+    HorizonOptions at = options;
+    at.max_error = 0.0;
+    at.directions = K;
+    fixed = computeHorizons(testContext(), field, at, raw);
+    runs.push_back({K, fixed.estimated_error});
+  }
+  const double divisor = detail::richardsonDivisor(detail::estimateOrder(runs));
+  EXPECT_GT(divisor, 1.0) << "the city's estimate falls faster than K^-1 here";
+  for (std::size_t p = 0; p < field.pixelCount(); ++p)
+    ASSERT_NEAR(chosen.error_estimate[p], fixed.error_estimate[p] / divisor, 1e-6 * fixed.error_estimate[p]) << p;
+  EXPECT_NEAR(chosen.estimated_error, fixed.estimated_error / divisor, 1e-6 * fixed.estimated_error);
+}
+
+// The next K: more than the last, a multiple of 8; the K predicted to meet E never fewer for a
+// smaller error or a larger estimate; a far prediction takes a probe (twice the last K, or a sixth
+// of the way) below it, a near one is run at once. (The probe itself is not monotone: just past
+// four times the last K it drops to twice it.)
+TEST(HorizonMaxError, TheNextKGrowsAsTheErrorShrinks) {
+  using detail::EstimateRun;
+  for (const std::vector<EstimateRun>& before :
+       {std::vector<EstimateRun>{{16, 0.2}}, std::vector<EstimateRun>{{16, 0.2}, {32, 0.09}},
+        std::vector<EstimateRun>{{16, 0.2}, {64, 0.03}, {128, 0.02}}}) {
+    int last_predicted = 0;
+    for (double E : {0.1, 0.05, 0.02, 0.01, 0.005, 0.002, 0.001, 1e-4}) {
+      SCOPED_TRACE(std::to_string(before.size()) + " runs, E " + std::to_string(E));
+      const detail::NextErrorRun next = detail::nextDirectionsForError(before, E);
+      EXPECT_GT(next.directions, before.back().directions);
+      EXPECT_EQ(next.directions % 8, 0);
+      EXPECT_GE(next.predicted, last_predicted);
+      EXPECT_LE(next.directions, kMaxAutoDirections);
+      last_predicted = next.predicted;
+    }
+    std::vector<EstimateRun> larger = before;
+    larger.back().raw *= 1.5;
+    EXPECT_GE(detail::nextDirectionsForError(larger, 0.01).predicted,
+              detail::nextDirectionsForError(before, 0.01).predicted);
+  }
+  // K^-1.5 from 32 to 128: 0.0125 needs 128 (raw / divisor / (0.9 x 0.0125))^(1/1.5), within 4
+  // times 128: run at once; 0.002 about 6 times 128: first a probe at twice 128.
+  const double raw = 0.03;
+  const std::vector<EstimateRun> runs{{32, raw * 8.0}, {128, raw}};
+  const double divisor = detail::richardsonDivisor(detail::kMaxRichardsonOrder);
+  const double near = 128 * std::pow(raw / divisor / (detail::kErrorAim * 0.0125), 1.0 / 1.5);
+  ASSERT_LT(near, 4 * 128);
+  EXPECT_EQ(detail::nextDirectionsForError(runs, 0.0125).directions, static_cast<int>(std::ceil(near / 8) * 8));
+  const detail::NextErrorRun far = detail::nextDirectionsForError(runs, 0.002);
+  EXPECT_EQ(far.directions, 256);
+  EXPECT_GT(far.predicted, 256);
+}
+
 TEST(HorizonMaxError, BadRequestsAreRefused) {
   const HeightField field = makeSyntheticField("noise", 16, 16);
   HorizonOutputs svf;
@@ -351,7 +455,8 @@ TEST(HorizonMaxError, BadRequestsAreRefused) {
   HorizonOutputs angles = svf;
   angles.horizon_angles = true;
   EXPECT_THROW(computeHorizons(testContext(), field, options, angles), InvalidArgument);
-  // Beyond kMaxAutoDirections by a run's prediction (the second's: the first predicts at most 64).
+  // Beyond kMaxAutoDirections by a run's prediction (after the first run, when even the fastest fall
+  // it assumes, K^-2, needs more).
   options.max_error = 1e-7;
   try {
     computeHorizons(testContext(), field, options, svf);

@@ -45,11 +45,16 @@ struct HorizonOptions : SweepOptions {
   // Ask for an error, not a direction count: when > 0, the sky-view factor and occlusion (alone,
   // no planes or environment) choose K themselves (options.directions is ignored), so that the
   // 99th percentile of the error estimate (HorizonResult::estimated_error) is at most max_error,
-  // in their own unit (absolute, both lie in 0..1); HorizonResult::directions says which K. A
-  // first run at 16 directions and each one after it predicts the K needed (the estimate falls
-  // as K^-p, p measured from the last two runs), until the estimate is met. Throws InvalidArgument, naming
-  // the K it would take, when a run predicts more than kMaxAutoDirections. The samples per unit stay as
-  // given.
+  // in their own unit (absolute, both lie in 0..1); HorizonResult::directions says which K. The
+  // estimate is then that of the K result itself: the halves' difference (error_estimate below)
+  // divided by 2^p - 1 (Richardson: the difference is about |r(K/2) - r(K)|), p the order at which
+  // it fell (as K^-p) between this run and an earlier one of at most half its K, within 1 .. 1.1
+  // (1 when there is none: the difference itself). A first run at 16 directions and each one
+  // after it predicts the K where the estimate meets 0.9 max_error (the fall measured from the
+  // last two runs); a prediction more than 4 times the last K takes a probe first (twice the last
+  // K, or a sixth of the prediction), until the estimate is met. Throws InvalidArgument, naming
+  // the K it would take, when a run predicts more than kMaxAutoDirections (after the first run only
+  // when even a fall as K^-2 would). The samples per unit stay as given.
   double max_error = 0.0;
   // With max_error, where the field needs them: after the first run (the whole field at 16
   // directions), while the estimate's 99th percentile over the field exceeds max_error, the tiles
@@ -103,8 +108,12 @@ struct HorizonResult {
   // With HorizonOutputs::error_estimate or HorizonOptions::max_error, per pixel: half the difference
   // between the results of the even- and the odd-numbered directions alone (each half's sum over
   // its own weights: two interleaved quadratures of K / 2 directions), the larger of the sky-view
-  // factor's and occlusion's; NaN at nodata. Measured against the dense azimuthal integral on the
-  // benchmark's contents it lies above the full K's error (bench/report/error_target.md).
+  // factor's and occlusion's; NaN at nodata. With max_error divided by the Richardson divisor
+  // 2^p - 1 (1 .. 1.14) its runs measured, per tile (HorizonOptions::max_error); a run at a K of
+  // your own keeps the difference itself. Measured against the dense azimuthal integral, on the
+  // benchmark's contents the difference lies 1.1 to 4 times above the K result's error
+  // (bench/report/error_curve.md), on white-noise heights barely above it
+  // (tests/test_horizon_error_target.cpp): the divisor is kept that small for them.
   std::vector<float> error_estimate;
   double estimated_error = 0.0;  // its 99th percentile over the pixels with data; 0 without it
   // With HorizonOptions::max_error: the K of each run it made, in order, so that its whole cost

@@ -222,6 +222,49 @@ int directionsForError(int directions, double estimated, int earlier, double ear
       std::max<double>(directions + 8, std::min<double>(wanted, 2.0 * kMaxAutoDirections)));
 }
 
+double estimateOrder(const std::vector<EstimateRun>& runs) {
+  if (runs.size() < 2) return 1.0;
+  const EstimateRun& last = runs.back();
+  for (auto it = runs.rbegin() + 1; it != runs.rend(); ++it) {
+    if (2 * it->directions > last.directions) continue;
+    if (!(it->raw > 0.0 && last.raw > 0.0)) return 1.0;
+    const double order = std::log(it->raw / last.raw) / std::log(double(last.directions) / it->directions);
+    return std::clamp(order, 1.0, kMaxRichardsonOrder);
+  }
+  return 1.0;  // no run at half its K or fewer: nothing measured
+}
+
+double richardsonDivisor(double order) { return std::pow(2.0, order) - 1.0; }
+
+NextErrorRun nextDirectionsForError(const std::vector<EstimateRun>& runs, double max_error) {
+  const EstimateRun& last = runs.back();
+  // The fall of the raw estimate: from the last two runs, however near (within 1 .. 2); from one
+  // run K^-1 for the run, K^-2 (the fastest it assumes) for the bound.
+  double order = 1.0;
+  if (runs.size() >= 2) {
+    const EstimateRun& before = runs[runs.size() - 2];
+    if (before.raw > last.raw && last.raw > 0.0)
+      order = std::clamp(std::log(before.raw / last.raw) / std::log(double(last.directions) / before.directions),
+                         1.0, 2.0);
+  }
+  // K where the error estimate, raw (K / K')^order / divisor at K', meets `error`; beyond
+  // kMaxAutoDirections capped where an int holds it (the caller refuses it).
+  const auto meeting = [&](double fall, double error) {
+    const double divisor = richardsonDivisor(std::min(fall, kMaxRichardsonOrder));
+    return std::min(last.directions * std::pow(last.raw / divisor / error, 1.0 / fall), 2.0 * kMaxAutoDirections);
+  };
+  const auto multipleOf8 = [&](double K) {
+    return static_cast<int>(std::max<double>(last.directions + 8, std::ceil(K / 8.0) * 8.0));
+  };
+  NextErrorRun next;
+  next.predicted = multipleOf8(meeting(runs.size() >= 2 ? order : 2.0, max_error));
+  double wanted = meeting(order, kErrorAim * max_error);
+  // Far beyond the last K, a probe: twice it, or a sixth of the way when that is more.
+  if (wanted > 4.0 * last.directions) wanted = std::min(wanted, std::max(2.0 * last.directions, wanted / 6.0));
+  next.directions = std::min(multipleOf8(wanted), std::max(kMaxAutoDirections, last.directions + 8));
+  return next;
+}
+
 InvalidArgument beyondAutoDirections(double max_error, int next, int directions, double estimated,
                                      const std::string& where) {
   std::ostringstream message;

@@ -50,12 +50,59 @@ void splitErrorHalves(HorizonResult& result, const std::vector<float>& odd_svf, 
 // pixels with data (not NaN), 0 when none has.
 double estimatedError(const std::vector<float>& estimate);
 
-// The directions HorizonOptions::max_error asks for after a run at `directions` whose estimate
-// was `estimated`, the run before it at `earlier` directions with `earlier_estimate` (0 for none):
+// The directions runForMaxError (intervisibility's and the environment light's maximum error) asks
+// for after a run at `directions` whose estimate was `estimated`, the run before it at `earlier` directions with `earlier_estimate` (0 for none):
 // the estimate falls as K^-p, p measured from the two runs (within 0.5 .. 3; from one run 1, and
 // then at most 4 times the directions: smooth fields fall much faster, bench/report/error_target.md),
 // so K (estimated / max_error)^(1/p), 5 % more, rounded up to a multiple of 8, and at least 8 more.
 int directionsForError(int directions, double estimated, int earlier, double earlier_estimate, double max_error);
+
+// One run of HorizonOptions::max_error's sky-view factor and occlusion, as the choice of K sees a
+// tile (or the whole field): its K and the 99th percentile over the tile's pixels of its raw error
+// estimate (half the even and odd halves' difference, splitErrorHalves).
+struct EstimateRun {
+  int directions = 0;
+  double raw = 0.0;
+};
+
+// The order p at which the raw estimate falls with K (raw ~ K^-p), measured between the last of
+// `runs` (ascending K) and the latest earlier run of at most half its K, within
+// 1 .. kMaxRichardsonOrder; 1 when there is none (a single run, or only nearer ones: too near to
+// measure).
+double estimateOrder(const std::vector<EstimateRun>& runs);
+
+// What the raw estimate is divided by to estimate the error of the K result itself: the raw
+// estimate is about |r(K/2) - r(K)| (the even half is a K / 2 quadrature), and with an error
+// falling as K^-p, of one sign, that is (2^p - 1) times the error at K (Richardson). 1 at p = 1
+// (then the estimate stays the halves' difference). p is kept at most kMaxRichardsonOrder, a
+// divisor of 1.14: the raw estimate lies 1.1 to 4 times above the error against a dense run on
+// the benchmark's contents (bench/report/error_curve.md), but on white-noise heights barely above
+// it while falling as fast: the fall does not tell them apart, and with p allowed up to 1.5 the
+// noise field of HorizonMaxError.MeetsTheTargetAgainstADenseRun met E by the estimate and missed
+// it by the error at E = 0.05, 0.01 and 0.005.
+constexpr double kMaxRichardsonOrder = 1.1;
+double richardsonDivisor(double order);
+
+// A run's K aims at this share of the maximum error, so that a prediction a little short does not
+// take another run.
+constexpr double kErrorAim = 0.9;
+
+// The K HorizonOptions::max_error's sky-view factor and occlusion run next after `runs` (ascending,
+// the last not meeting max_error by its estimate, raw / richardsonDivisor(estimateOrder)): the K
+// where that estimate would meet kErrorAim times max_error, the raw estimate falling as K^-q, q
+// measured between the last two runs within 1 .. 2 (from the first run alone 1). Where that K is
+// more than 4 times the last run's, the next run is a probe at the larger of twice the last K and
+// a sixth of it, so that the final run is predicted from a run nearer it (the fall steepens with
+// K on the benchmark's contents: a far prediction overshoots) while the probes cost little beside
+// it (bench/error_target_replay.py replays such rules on the fixed-K curves). Rounded up to a
+// multiple of 8, at least 8 more than the last K. `predicted`: the K predicted to meet max_error
+// itself (from the first run alone at q = 2, the fastest fall it assumes: a bound), beyond
+// kMaxAutoDirections capped at twice it, which the caller refuses.
+struct NextErrorRun {
+  int directions = 0;
+  int predicted = 0;
+};
+NextErrorRun nextDirectionsForError(const std::vector<EstimateRun>& runs, double max_error);
 
 // The InvalidArgument a maximum error gets when a run at `directions` whose estimate was
 // `estimated` (`where`, e.g. in which tile) predicts `next` directions, beyond kMaxAutoDirections.

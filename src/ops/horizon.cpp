@@ -914,31 +914,48 @@ class HorizonRoutine : public SweepRoutine {
       placeholder_, env_sum_, env_tables_;
 };
 
-// HorizonOptions::max_error: the whole field at kFirstAutoDirections, then, while the estimate's
-// 99th percentile over the field exceeds max_error, tiles again at the K their own estimate's 99th
-// percentile predicts, those of one K in one run over the lines that reach them: the tiles with
-// the most pixels above max_error first, until those left hold at most half the pixels the field's
-// percentile lets above it (error_tile 0: one tile, K as directionsForError predicts it, not
-// rounded to the ladder). `run(K, wanted)`: a run at K with the error estimate over the lines that
-// reach the pixels of `wanted` (null: the whole field).
+// HorizonOptions::max_error: the whole field at kFirstAutoDirections, then, while the error
+// estimate's 99th percentile over the field exceeds max_error, tiles again at the K
+// nextDirectionsForError asks for after their own runs, those of one K in one run over the lines
+// that reach them: the tiles with the most pixels above max_error first, until those left hold at
+// most half the pixels the field's percentile lets above it (error_tile 0: one tile, K not rounded
+// to the ladder). Each pixel's estimate is its run's raw one (splitErrorHalves) divided by
+// richardsonDivisor at the order its tile's runs measure (estimateOrder). `run(K, wanted)`: a run
+// at K with the raw error estimate over the lines that reach the pixels of `wanted` (null: the
+// whole field).
 HorizonResult runToError(const HeightField& field, const HorizonOptions& options,
                          const std::function<HorizonResult(int, const std::vector<char>*)>& run) {
   const int width = field.width, height = field.height;
   const int side = options.error_tile > 0 ? options.error_tile : std::max(width, height);
   const int tiles_x = (width + side - 1) / side, tiles = tiles_x * ((height + side - 1) / side);
   std::vector<int> tile_of(field.pixelCount());
+  std::vector<std::vector<std::size_t>> pixels_of(tiles);
   for (int r = 0; r < height; ++r)
-    for (int c = 0; c < width; ++c)
-      tile_of[static_cast<std::size_t>(r) * width + c] = r / side * tiles_x + c / side;
+    for (int c = 0; c < width; ++c) {
+      const std::size_t p = static_cast<std::size_t>(r) * width + c;
+      tile_of[p] = r / side * tiles_x + c / side;
+      pixels_of[tile_of[p]].push_back(p);
+    }
+  std::vector<std::vector<EstimateRun>> history(tiles);  // per tile, the runs its pixels took
+  std::vector<double> divisor(tiles, 1.0);
+  // A run at K over the tiles of `chosen`: their raw estimates' percentiles recorded, and the
+  // divisor of their order.
+  const auto record = [&](const std::vector<float>& raw, int directions, const std::vector<char>& chosen) {
+    for (int t = 0; t < tiles; ++t) {
+      if (!chosen[t]) continue;
+      std::vector<float> values;
+      for (std::size_t p : pixels_of[t]) values.push_back(raw[p]);
+      history[t].push_back({directions, estimatedError(values)});
+      divisor[t] = richardsonDivisor(estimateOrder(history[t]));
+    }
+  };
   HorizonResult result = run(kFirstAutoDirections, nullptr);
   result.runs = {kFirstAutoDirections};
   result.pixel_directions.assign(field.pixelCount(), kFirstAutoDirections);
+  record(result.error_estimate, kFirstAutoDirections, std::vector<char>(tiles, 1));
+  for (std::size_t p = 0; p < tile_of.size(); ++p)
+    result.error_estimate[p] = static_cast<float>(result.error_estimate[p] / divisor[tile_of[p]]);
   double work = result.samples_per_receiver;
-  struct Tile {
-    int directions = kFirstAutoDirections, earlier = 0;
-    double earlier_estimate = 0.0;
-  };
-  std::vector<Tile> state(tiles);
   const std::vector<int> ladder = directionLadder();
   // Pixels with data the 99th percentile (estimatedError) lets lie above it.
   const std::size_t with_data = static_cast<std::size_t>(std::count_if(
@@ -961,20 +978,16 @@ HorizonResult runToError(const HeightField& field, const HorizonOptions& options
     for (int t : order) {
       if (left <= allowed / 2 || above[t] == 0) break;
       left -= above[t];
-      Tile& tile = state[t];
-      const double estimate = estimatedError(estimates[t]);
-      int directions = directionsForError(tile.directions, estimate, tile.earlier, tile.earlier_estimate,
-                                          options.max_error);
-      if (directions > kMaxAutoDirections)
-        throw beyondAutoDirections(options.max_error, directions, tile.directions, estimate,
+      const NextErrorRun asked = nextDirectionsForError(history[t], options.max_error);
+      if (asked.predicted > kMaxAutoDirections)
+        throw beyondAutoDirections(options.max_error, asked.predicted, history[t].back().directions,
+                                   estimatedError(estimates[t]),
                                    tiles > 1 ? " in the tile of pixels from column " +
                                                    std::to_string(t % tiles_x * side) + ", row " +
                                                    std::to_string(t / tiles_x * side)
                                              : std::string());
+      int directions = asked.directions;
       if (options.error_tile > 0) directions = *std::lower_bound(ladder.begin(), ladder.end(), directions);
-      tile.earlier = tile.directions;
-      tile.earlier_estimate = estimate;
-      tile.directions = directions;
       std::vector<char>& chosen = next[directions];
       chosen.resize(tiles, 0);
       chosen[t] = 1;
@@ -986,6 +999,7 @@ HorizonResult runToError(const HeightField& field, const HorizonOptions& options
       HorizonResult part = run(directions, all ? nullptr : &wanted);
       result.runs.push_back(directions);
       work += part.samples_per_receiver;
+      record(part.error_estimate, directions, chosen);
       const auto take = [&](std::vector<float>& into, const std::vector<float>& from) {
         if (into.empty()) return;
         for (std::size_t p = 0; p < wanted.size(); ++p)
@@ -993,9 +1007,11 @@ HorizonResult runToError(const HeightField& field, const HorizonOptions& options
       };
       take(result.sky_view_factor, part.sky_view_factor);
       take(result.ambient_occlusion, part.ambient_occlusion);
-      take(result.error_estimate, part.error_estimate);
       for (std::size_t p = 0; p < wanted.size(); ++p)
-        if (wanted[p]) result.pixel_directions[p] = directions;
+        if (wanted[p]) {
+          result.error_estimate[p] = static_cast<float>(part.error_estimate[p] / divisor[tile_of[p]]);
+          result.pixel_directions[p] = directions;
+        }
       if (directions > result.directions) {
         result.directions = directions;
         result.azimuths = std::move(part.azimuths);
