@@ -50,6 +50,18 @@ struct HorizonOptions : SweepOptions {
   // as K^-p, p measured from the last two runs), until the estimate is met. Throws InvalidArgument, naming
   // the K it would take, when a run predicts more than kMaxAutoDirections. The samples per unit stay as
   // given.
+  // With the horizon planes (angles alone, or with their distances; no sky-view factor, occlusion
+  // or environment in the same run), max_error is in radians, 0 < max_error < pi/2, and bounds the
+  // mean horizon angle error: over the pixels with data and over azimuth, |the K planes
+  // interpolated linearly in azimuth between their real azimuths (HorizonResult::azimuths) - the
+  // true horizon| (each plane is exact along its own ray for the samples per unit given, so this
+  // is the error K controls). Its estimate (HorizonResult::estimated_error, the mean; per pixel
+  // error_estimate) comes from the run's own planes: each direction against the interpolation of
+  // its neighbours in azimuth (the error of the K / 2 reconstruction at their midpoints), scaled to
+  // K by 2/3 (an interval's mean interpolation error against its midpoint's) and 2^-p, p the order
+  // the field's neighbours two places away show (within 1 .. 2). A first run at 16 directions
+  // predicts K from p, later runs from the two last estimates; one K for the whole field
+  // (error_tile refused). bench/report/error_target.md measures it against K = 2048.
   double max_error = 0.0;
   // With max_error, where the field needs them: after the first run (the whole field at 16
   // directions), while the estimate's 99th percentile over the field exceeds max_error, the tiles
@@ -85,7 +97,9 @@ struct HorizonOutputs {
   const EnvironmentMap* environment = nullptr;
   // With the sky-view factor or occlusion alone (no planes, no environment; K >= 2): an estimate of
   // their error against the azimuthal integral they approximate (HorizonResult::error_estimate),
-  // from the same run at the cost of one more sum per pixel.
+  // from the same run at the cost of one more sum per pixel. With the horizon angles alone (their
+  // distances may come along; K >= 5): the estimate of their mean error (HorizonOptions::max_error)
+  // at the K given, computed on the host from the planes.
   bool error_estimate = false;
 };
 
@@ -105,8 +119,11 @@ struct HorizonResult {
   // its own weights: two interleaved quadratures of K / 2 directions), the larger of the sky-view
   // factor's and occlusion's; NaN at nodata. Measured against the dense azimuthal integral on the
   // benchmark's contents it lies above the full K's error (bench/report/error_target.md).
+  // With the horizon angles: per pixel the estimated mean over azimuth of the K planes'
+  // interpolation error, radians (HorizonOptions::max_error).
   std::vector<float> error_estimate;
-  double estimated_error = 0.0;  // its 99th percentile over the pixels with data; 0 without it
+  double estimated_error = 0.0;  // its 99th percentile over the pixels with data (horizon angles: its
+                                 // mean); 0 without it
   // With HorizonOptions::max_error: the K of each run it made, in order, so that its whole cost
   // is known (with error_tile, runs after the first cover only the tiles that needed them); empty
   // otherwise. `directions` is then the largest K any pixel took, and `azimuths` that run's.
