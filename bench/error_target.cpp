@@ -342,10 +342,17 @@ namespace {
 
 constexpr double kDegrees = 180.0 / M_PI;
 
-// The horizon planes of `field` at K.
-HorizonResult horizonPlanes(const ComputeContext& context, const HeightField& field, int K, bool estimate) {
+// The dense reference's azimuth tolerance: 0.02 degrees, so that its K directions stay apart (at
+// the default 0.25 degrees, K = 2048's spacing of 0.18 degrees would merge neighbours into one
+// step and the reference would share the run's own azimuths).
+constexpr double kReferenceTolerance = 0.02 * M_PI / 180.0;
+
+// The horizon planes of `field` at K (`tolerance` 0: the default azimuth tolerance).
+HorizonResult horizonPlanes(const ComputeContext& context, const HeightField& field, int K, bool estimate,
+                            double tolerance = 0.0) {
   HorizonOptions options;
   options.directions = K;
+  if (tolerance > 0.0) options.azimuth_tolerance = tolerance;
   HorizonOutputs wanted;
   wanted.horizon_angles = true;
   wanted.error_estimate = estimate;
@@ -356,7 +363,6 @@ HorizonResult horizonPlanes(const ComputeContext& context, const HeightField& fi
 
 void horizonTargetReport(const ComputeContext& context, const std::vector<ErrorTargetField>& fields,
                          const std::vector<double>& errors, int reference_directions, int reps) {
-  const std::vector<int> ladder = directionLadder();
   std::printf(
       "\n### horizon angles (mean error, degrees)\n\n"
       "| field | E (deg) | runs (K) | estimate | achieved mean | met | cheapest fixed K | its mean | "
@@ -367,7 +373,8 @@ void horizonTargetReport(const ComputeContext& context, const std::vector<ErrorT
   int met = 0, rows = 0;
   std::vector<double> ratios, works, last_works;
   for (const ErrorTargetField& f : fields) {
-    const HorizonResult reference = horizonPlanes(context, f.field, reference_directions, false);
+    const HorizonResult reference =
+        horizonPlanes(context, f.field, reference_directions, false, kReferenceTolerance);
     std::map<int, double> fixed_error;  // K -> achieved mean error (degrees) of a fixed-K run
     std::map<int, double> fixed_work;   // K -> its samples per receiver
     const auto errorAt = [&](int K) {
@@ -388,15 +395,22 @@ void horizonTargetReport(const ComputeContext& context, const std::vector<ErrorT
         continue;
       }
       const double achieved = kDegrees * detail::horizonAngleErrorAgainst(result, reference);
-      // The cheapest K of the ladder meeting E, by bisection (the error falls with K).
+      // The cheapest fixed K meeting E: the least multiple of 8 that meets it, by bisection (the
+      // error falls with K), then of the multiples of 8 up to twice that the one of least work
+      // (the sweep's work is not monotone in K), if it meets E too.
       int cheapest = 0;
-      if (errorAt(ladder.back()) <= E) {
-        std::size_t lo = 0, hi = ladder.size() - 1;  // ladder[hi] meets E
+      if (errorAt(kMaxAutoDirections) <= E) {
+        int lo = 1, hi = kMaxAutoDirections / 8;  // (hi * 8 meets E)
         while (lo < hi) {
-          const std::size_t mid = (lo + hi) / 2;
-          if (errorAt(ladder[mid]) <= E) hi = mid; else lo = mid + 1;
+          const int mid = (lo + hi) / 2;
+          if (errorAt(8 * mid) <= E) hi = mid; else lo = mid + 1;
         }
-        cheapest = ladder[hi];
+        cheapest = 8 * hi;
+        double least = detail::horizonWork(f.field, HorizonOptions{}, wanted, cheapest);
+        for (int K = cheapest + 8; K <= std::min(2 * 8 * hi, kMaxAutoDirections); K += 8) {
+          const double w = detail::horizonWork(f.field, HorizonOptions{}, wanted, K);
+          if (w < least && errorAt(K) <= E) least = w, cheapest = K;
+        }
       }
       std::vector<double> t_chosen, t_fixed;
       const int fixed_k = cheapest ? cheapest : kMaxAutoDirections;
@@ -441,7 +455,8 @@ void horizonErrorCurve(const ComputeContext& context, const std::vector<ErrorTar
       "mean | estimate | achieved / estimate | skip-one | skip-two | order p | time (s) |\n"
       "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const ErrorTargetField& f : fields) {
-    const HorizonResult reference = horizonPlanes(context, f.field, reference_directions, false);
+    const HorizonResult reference =
+        horizonPlanes(context, f.field, reference_directions, false, kReferenceTolerance);
     for (int K : directionLadder()) {
       if (K > max_directions) break;
       HorizonResult result;

@@ -469,11 +469,11 @@ const std::vector<OptionSpec>& optionTable() {
        "choose K for this error instead of taking -k: the mean over the pixels\n"
        "and azimuths of the error of the K channels, interpolated linearly in\n"
        "azimuth between the directions' azimuths, against the true horizon,\n"
-       "at most E degrees (its estimate, see --error-out), 0 < E < 90; a first\n"
-       "run at 16 directions predicts the K needed, refused when beyond 4096;\n"
-       "the samples per unit stay as given. K and the estimate go into the\n"
-       "summary and the hfvis:directions and hfvis:estimated_error (degrees)\n"
-       "attributes",
+       "at most E degrees (its estimate, see --error-out), 0 < E < 90; runs at\n"
+       "8 and 16 directions predict the K needed (the least work within 1.25x\n"
+       "of it), refused when beyond 4096; the samples per unit stay as given.\n"
+       "K and the estimate go into the summary and the hfvis:directions and\n"
+       "hfvis:estimated_error (degrees) attributes",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
          run.horizon_max_error_deg = parseNumber(typed, value);
          if (!(run.horizon_max_error_deg > 0.0 && run.horizon_max_error_deg < 90.0))
@@ -485,9 +485,10 @@ const std::vector<OptionSpec>& optionTable() {
       {"--error-out", nullptr, "FILE", kHorizonGroup, false,
        "also write the per-pixel error estimate (channel \"error\", degrees):\n"
        "each direction against the interpolation of its neighbours in\n"
-       "azimuth (the error at K / 2), scaled to K by the order the field\n"
-       "shows and by 2/3 (an interval's mean against its midpoint's), averaged\n"
-       "over azimuth; with -k (K >= 5) or --max-error",
+       "azimuth (the error at K / 2), scaled to K by the order the pixel's\n"
+       "neighbours two places away show and by 0.75 (2/3, an interval's mean\n"
+       "against its midpoint's, calibrated up by 1.125), averaged over\n"
+       "azimuth; with -k (K >= 5) or --max-error",
        HFVIS_TEXT(error_output)},
       {"--azimuth-tolerance", nullptr, "DEG", kHorizonGroup, false,
        "the sweep's direction k is the cheapest integer pixel step within\n"

@@ -83,6 +83,8 @@ class Horizon : public Computation {
     HorizonOutputs wanted;
     wanted.horizon_angles = true;
     wanted.horizon_distances = !run_.distance_output.empty();
+    // --error-out with -k: the estimate at the K given (--max-error asks the library for it anyway).
+    wanted.error_estimate = !run_.error_output.empty();
     result_ = computeSweptHorizons(job, wanted);
   }
 

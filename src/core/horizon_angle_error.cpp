@@ -98,8 +98,12 @@ double horizonErrorOrder(const SkipErrors& skips) {
 
 void estimateHorizonAngleError(HorizonResult& result) {
   SkipErrors skips = horizonSkipErrors(result);
-  const double factor = kHorizonEstimateFactor * std::pow(2.0, -horizonErrorOrder(skips));
-  for (float& e : skips.skip_one) e = static_cast<float>(factor * e);
+  const double low = std::pow(2.0, -kHorizonOrderHigh), high = std::pow(2.0, -kHorizonOrderLow);
+  for (std::size_t p = 0; p < skips.skip_one.size(); ++p) {
+    const double one = skips.skip_one[p], two = skips.skip_two[p];
+    const double fall = two > 0.0 ? std::clamp(one / two, low, high) : high;
+    skips.skip_one[p] = static_cast<float>(kHorizonEstimateFactor * one * fall);  // NaN stays NaN
+  }
   result.error_estimate = std::move(skips.skip_one);
   result.estimated_error = meanWithData(result.error_estimate);
 }
@@ -130,40 +134,61 @@ double horizonAngleErrorAgainst(const HorizonResult& result, const HorizonResult
   return meanWithData(std::vector<float>(sum.begin(), sum.end()));
 }
 
-HorizonResult runHorizonAnglesToError(double max_error, const std::function<HorizonResult(int)>& run) {
-  int directions = kFirstAutoDirections, earlier = 0;
-  double earlier_estimate = 0.0, work = 0.0;
+double horizonWork(const HeightField& field, const HorizonOptions& options, const HorizonOutputs& outputs, int K) {
+  if (options.method != HorizonMethod::Sweep) return K;
+  HorizonOptions at = options;
+  at.directions = K;
+  double samples = 0.0;
+  for (const LatticeDirection& d : horizonDirections(field, at, outputs))
+    samples += static_cast<double>(latticeSamples(d, at.samples_per_unit).size());
+  return samples;
+}
+
+int cheapestDirections(int needed, const std::function<double(int)>& work) {
+  const int first = (std::max(needed, 8) + 7) / 8 * 8;
+  const int last = std::min(kMaxAutoDirections, static_cast<int>(std::ceil(first * kHorizonChoiceSpan)));
+  int best = first;
+  double least = work(first);
+  for (int K = first + 8; K <= last; K += 8) {
+    const double w = work(K);
+    if (w < least) least = w, best = K;
+  }
+  return best;
+}
+
+HorizonResult runHorizonAnglesToError(double max_error, const std::function<HorizonResult(int)>& run,
+                                      const std::function<double(int)>& work) {
+  int directions = kHorizonFirstDirections, earlier = 0;
+  double earlier_estimate = 0.0, total = 0.0;
   std::vector<int> runs;
   for (;;) {
     HorizonResult result = run(directions);
     runs.push_back(directions);
-    work += result.samples_per_receiver;
+    total += result.samples_per_receiver;
     if (result.estimated_error <= max_error) {
       result.runs = std::move(runs);
-      result.samples_per_receiver = work;
+      result.samples_per_receiver = total;
       result.pixel_directions.assign(static_cast<std::size_t>(result.width) * result.height, directions);
       return result;
     }
-    int next = 0;
-    if (earlier == 0) {
-      // From one run: the order its own skip errors show (the estimate falls as K^-p).
-      const double order = horizonErrorOrder(horizonSkipErrors(result));
-      const double wanted = directions * std::pow(result.estimated_error / max_error, 1.0 / order) * 1.05;
-      next = static_cast<int>(std::max<double>(
-          directions + 8, std::min<double>(std::ceil(wanted / 8.0) * 8.0, 2.0 * kMaxAutoDirections)));
-    } else {
-      next = directionsForError(directions, result.estimated_error, earlier, earlier_estimate, max_error);
-    }
-    if (next > kMaxAutoDirections) {
+    // The need, as the estimate falls (K^-p), 5 % more; beyond kMaxAutoDirections refused.
+    double order = 1.0;
+    if (earlier > 0 && earlier_estimate > result.estimated_error && result.estimated_error > 0.0)
+      order = std::clamp(std::log(earlier_estimate / result.estimated_error) / std::log(double(directions) / earlier),
+                         0.5, 3.0);
+    const double wanted = std::max<double>(
+        directions + 8, directions * std::pow(result.estimated_error / max_error, 1.0 / order) * 1.05);
+    if (wanted > kMaxAutoDirections) {
       // In degrees, as the command line takes it.
       std::ostringstream message;
-      message << "a maximum mean horizon angle error of " << max_error * 180.0 / M_PI << " degrees needs "
-              << (next >= 2 * kMaxAutoDirections ? "at least " : "about ") << next
-              << " directions (the estimate at K = " << directions << " is " << result.estimated_error * 180.0 / M_PI
-              << " degrees), beyond the " << kMaxAutoDirections
+      message << "a maximum mean horizon angle error of " << max_error * 180.0 / M_PI << " degrees needs about "
+              << static_cast<long long>(std::min(wanted, 1e9)) << " directions (the estimate at K = " << directions
+              << " is " << result.estimated_error * 180.0 / M_PI << " degrees), beyond the " << kMaxAutoDirections
               << " a run may choose: ask for a larger error, or give K";
       throw InvalidArgument(message.str());
     }
+    // After the first run the second (whose work is a few per cent of what follows) measures the order.
+    const int next = earlier == 0 ? kHorizonSecondDirections : cheapestDirections(static_cast<int>(std::ceil(wanted)), work);
     earlier = directions;
     earlier_estimate = result.estimated_error;
     directions = next;

@@ -14,6 +14,7 @@
 #include <functional>
 #include <vector>
 
+#include "hfvis/height_field.hpp"
 #include "hfvis/horizon.hpp"
 
 namespace hfvis::detail {
@@ -37,19 +38,23 @@ struct SkipErrors {
 };
 SkipErrors horizonSkipErrors(const HorizonResult& result);
 
-// The convergence order p the field's skip errors show (the half sets' error over the quarter
-// sets', as 2^p), within kHorizonOrderRange: what the error falls by from K / 2 to K.
+// The convergence order p the field's skip errors show (the quarter sets' error over the half
+// sets', as 2^p), within kHorizonOrderLow .. kHorizonOrderHigh: what the error falls by from K / 2
+// to K (1 where the horizon jumps between directions, 2 where it bends smoothly; below 1 before K
+// resolves the field's features).
 double horizonErrorOrder(const SkipErrors& skips);
-constexpr double kHorizonOrderLow = 1.0, kHorizonOrderHigh = 2.0;
+constexpr double kHorizonOrderLow = 0.3, kHorizonOrderHigh = 2.0;
 
 // The error estimate of a run's horizon angles (HorizonOutputs::error_estimate with
 // horizon_angles): per pixel kHorizonEstimateFactor * skip_one * 2^-p (p: horizonErrorOrder),
 // into result.error_estimate (radians, NaN at nodata), and its mean over the pixels with data
-// into result.estimated_error. The factor 2/3 is the mean of a linear interpolation's error over
-// an interval against its midpoint's, for a kink and for a jump alike (docs/ALGORITHMS.md);
-// calibrated against dense runs in bench/report/error_target.md.
+// into result.estimated_error, where 2^-p is the pixel's own skip-one error over its skip-two
+// error, clamped to the orders kHorizonOrderLow .. kHorizonOrderHigh. 2/3 is the mean of a linear
+// interpolation's error over an interval against its midpoint's, for a kink and for a jump alike;
+// the factor 1.125 beyond it is calibrated against dense runs of the benchmark's contents
+// (bench/report/error_target.md: without it the error was up to 1.09 times the estimate).
 void estimateHorizonAngleError(HorizonResult& result);
-constexpr double kHorizonEstimateFactor = 2.0 / 3.0;
+constexpr double kHorizonEstimateFactor = 2.0 / 3.0 * 1.125;
 
 // The mean over the pixels with data of a pixel's mean over azimuth of |the periodic linear
 // interpolation of `result`'s planes between its azimuths - `reference`'s planes|, at the
@@ -60,10 +65,26 @@ double horizonAngleErrorAgainst(const HorizonResult& result, const HorizonResult
 // The mean over the pixels with data of a per-pixel plane (NaN: no data); 0 when none has.
 double meanWithData(const std::vector<float>& plane);
 
-// HorizonOptions::max_error for the horizon angles: run(K) at kFirstAutoDirections with the
-// estimate, then at the K the estimates predict (the error falling as K^-p: from one run the
-// order its skip errors show, later measured between the last two runs), until the estimate's
-// mean is at most max_error. Throws beyondAutoDirections' error past kMaxAutoDirections.
-HorizonResult runHorizonAnglesToError(double max_error, const std::function<HorizonResult(int)>& run);
+// The sweep's work at K per receiver (its directions' samples per period summed, as
+// HorizonResult::samples_per_receiver counts a whole-field run; the naive method: K).
+double horizonWork(const HeightField& field, const HorizonOptions& options, const HorizonOutputs& outputs, int K);
+
+// The K to run for a need of `needed` directions: of the multiples of 8 from `needed` (rounded up)
+// to kHorizonChoiceSpan times it, the one of least work (the sweep's cost is not monotone in K:
+// directions near simple slopes take short steps, so K = 64 costs less than K = 40 at the default
+// tolerance); ties to the smallest.
+int cheapestDirections(int needed, const std::function<double(int)>& work);
+constexpr double kHorizonChoiceSpan = 1.25;
+
+// HorizonOptions::max_error for the horizon angles: run(K) with the estimate at
+// kHorizonFirstDirections, then at kHorizonSecondDirections (the two cost a few per cent of any
+// later run: the axes and diagonals, then steps of at most a few pixels), then at the K the
+// estimates predict (the error falling as K^-p, p measured between the last two runs within
+// 0.5 .. 3), 5 % more, each the cheapest by `work` within kHorizonChoiceSpan of the need, until
+// the estimate's mean is at most max_error. Throws InvalidArgument past kMaxAutoDirections (in
+// degrees).
+HorizonResult runHorizonAnglesToError(double max_error, const std::function<HorizonResult(int)>& run,
+                                      const std::function<double(int)>& work);
+constexpr int kHorizonFirstDirections = 8, kHorizonSecondDirections = 16;
 
 }  // namespace hfvis::detail

@@ -1049,7 +1049,9 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
         return result;
       };
       if (options.max_error == 0.0) return estimated(options.directions);
-      return detail::runHorizonAnglesToError(options.max_error, estimated);
+      return detail::runHorizonAnglesToError(options.max_error, estimated, [&](int directions) {
+        return detail::horizonWork(field, options, planes, directions);
+      });
     }
     if (options.max_error == 0.0) return run(outputs, nullptr);
     // Ask for an error: runs at growing K until the estimate meets it (HorizonOptions::max_error).
