@@ -178,7 +178,7 @@ HorizonResult runHorizonAnglesToError(double max_error, const std::function<Hori
                          0.5, 3.0);
     const double wanted = std::max<double>(
         directions + 8, directions * std::pow(result.estimated_error / max_error, 1.0 / order) * 1.05);
-    if (wanted > kMaxAutoDirections) {
+    if (earlier > 0 && wanted > kMaxAutoDirections) {  // (from the first run's order alone, no refusal)
       // In degrees, as the command line takes it.
       std::ostringstream message;
       message << "a maximum mean horizon angle error of " << max_error * 180.0 / M_PI << " degrees needs about "
