@@ -187,8 +187,13 @@ HorizonResult runHorizonAnglesToError(double max_error, const std::function<Hori
               << " a run may choose: ask for a larger error, or give K";
       throw InvalidArgument(message.str());
     }
-    // After the first run the second (whose work is a few per cent of what follows) measures the order.
-    const int next = earlier == 0 ? kHorizonSecondDirections : cheapestDirections(static_cast<int>(std::ceil(wanted)), work);
+    // After the first run the second (whose work is a few per cent of what follows) measures the
+    // order; later runs go at most kHorizonMostStep times as far, where the order is measured again
+    // (it rises with K on smooth fields, and the estimate's fall from 8 to 16 predicts badly far off).
+    const int next = earlier == 0 ? kHorizonSecondDirections
+                                  : cheapestDirections(static_cast<int>(std::ceil(
+                                                           std::min(wanted, kHorizonMostStep * directions))),
+                                                       work);
     earlier = directions;
     earlier_estimate = result.estimated_error;
     directions = next;

@@ -80,11 +80,13 @@ constexpr double kHorizonChoiceSpan = 1.25;
 // kHorizonFirstDirections, then at kHorizonSecondDirections (the two cost a few per cent of any
 // later run: the axes and diagonals, then steps of at most a few pixels), then at the K the
 // estimates predict (the error falling as K^-p, p measured between the last two runs within
-// 0.5 .. 3), 5 % more, each the cheapest by `work` within kHorizonChoiceSpan of the need, until
+// 0.5 .. 3), 5 % more, at most kHorizonMostStep times the last K, each the cheapest by `work`
+// within kHorizonChoiceSpan of that, until
 // the estimate's mean is at most max_error. Throws InvalidArgument past kMaxAutoDirections (in
 // degrees).
 HorizonResult runHorizonAnglesToError(double max_error, const std::function<HorizonResult(int)>& run,
                                       const std::function<double(int)>& work);
 constexpr int kHorizonFirstDirections = 8, kHorizonSecondDirections = 16;
+constexpr double kHorizonMostStep = 4.0;
 
 }  // namespace hfvis::detail
