@@ -9,6 +9,7 @@
 #include <map>
 #include <string>
 
+#include "core/horizon_angle_error.hpp"
 #include "core/horizon_common.hpp"
 #include "core/hull_tree.hpp"
 #include "hfvis/errors.hpp"
@@ -317,6 +318,141 @@ void errorCurve(const ComputeContext& context, const std::vector<ErrorTargetFiel
                     half == results.end() || K % 2 ? -1.0 : p99Difference(half->second, results[K]), t);
         std::fflush(stdout);
       }
+    }
+  }
+}
+
+namespace {
+
+constexpr double kDegrees = 180.0 / M_PI;
+
+// The dense reference's azimuth tolerance: 0.02 degrees, so that its K directions stay apart (at
+// the default 0.25 degrees, K = 2048's spacing of 0.18 degrees would merge neighbours into one
+// step and the reference would share the run's own azimuths).
+constexpr double kReferenceTolerance = 0.02 * M_PI / 180.0;
+
+// The horizon planes of `field` at K (`tolerance` 0: the default azimuth tolerance).
+HorizonResult horizonPlanes(const ComputeContext& context, const HeightField& field, int K, bool estimate,
+                            double tolerance = 0.0) {
+  HorizonOptions options;
+  options.directions = K;
+  if (tolerance > 0.0) options.azimuth_tolerance = tolerance;
+  HorizonOutputs wanted;
+  wanted.horizon_angles = true;
+  wanted.error_estimate = estimate;
+  return computeHorizons(context, field, options, wanted);
+}
+
+}  // namespace
+
+void horizonTargetReport(const ComputeContext& context, const std::vector<ErrorTargetField>& fields,
+                         const std::vector<double>& errors, int reference_directions, int reps) {
+  std::printf(
+      "\n### horizon angles (mean error, degrees)\n\n"
+      "| field | E (deg) | runs (K) | estimate | achieved mean | met | cheapest fixed K | its mean | "
+      "time chosen (s) | time fixed (s) | time ratio | work ratio | last run's work ratio |\n"
+      "|---|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|\n");
+  HorizonOutputs wanted;
+  wanted.horizon_angles = true;
+  int met = 0, rows = 0;
+  std::vector<double> ratios, works, last_works;
+  for (const ErrorTargetField& f : fields) {
+    const HorizonResult reference =
+        horizonPlanes(context, f.field, reference_directions, false, kReferenceTolerance);
+    std::map<int, double> fixed_error;  // K -> achieved mean error (degrees) of a fixed-K run
+    std::map<int, double> fixed_work;   // K -> its samples per receiver
+    const auto errorAt = [&](int K) {
+      auto it = fixed_error.find(K);
+      if (it != fixed_error.end()) return it->second;
+      const HorizonResult r = horizonPlanes(context, f.field, K, false);
+      fixed_work[K] = r.samples_per_receiver;
+      return fixed_error[K] = kDegrees * detail::horizonAngleErrorAgainst(r, reference);
+    };
+    for (double E : errors) {
+      HorizonOptions chosen;
+      chosen.max_error = E / kDegrees;
+      HorizonResult result;
+      try {
+        result = computeHorizons(context, f.field, chosen, wanted);
+      } catch (const InvalidArgument& error) {
+        std::printf("| %s | %g | refused: %s ||||||||||\n", f.name.c_str(), E, error.what());
+        continue;
+      }
+      const double achieved = kDegrees * detail::horizonAngleErrorAgainst(result, reference);
+      // The cheapest fixed K meeting E: the least multiple of 8 that meets it, by bisection (the
+      // error falls with K), then of the multiples of 8 up to twice that the one of least work
+      // (the sweep's work is not monotone in K), if it meets E too.
+      int cheapest = 0;
+      if (errorAt(kMaxAutoDirections) <= E) {
+        int lo = 1, hi = kMaxAutoDirections / 8;  // (hi * 8 meets E)
+        while (lo < hi) {
+          const int mid = (lo + hi) / 2;
+          if (errorAt(8 * mid) <= E) hi = mid; else lo = mid + 1;
+        }
+        cheapest = 8 * hi;
+        double least = detail::horizonWork(f.field, HorizonOptions{}, wanted, cheapest);
+        for (int K = cheapest + 8; K <= std::min(2 * 8 * hi, kMaxAutoDirections); K += 8) {
+          const double w = detail::horizonWork(f.field, HorizonOptions{}, wanted, K);
+          if (w < least && errorAt(K) <= E) least = w, cheapest = K;
+        }
+      }
+      std::vector<double> t_chosen, t_fixed;
+      const int fixed_k = cheapest ? cheapest : kMaxAutoDirections;
+      for (int r = 0; r < reps; ++r) {
+        t_chosen.push_back(seconds([&] { computeHorizons(context, f.field, chosen, wanted); }));
+        t_fixed.push_back(seconds([&] { horizonPlanes(context, f.field, fixed_k, false); }));
+      }
+      const auto time = [&](const std::vector<double>& t) { return reps ? formatted("%.3f", median(t)) : "-"; };
+      const double ratio = reps ? median(t_chosen) / median(t_fixed) : 0.0;
+      errorAt(fixed_k);
+      const double work = result.samples_per_receiver / fixed_work[fixed_k];
+      errorAt(result.directions);
+      const double last_work = fixed_work[result.directions] / fixed_work[fixed_k];
+      std::string runs;
+      for (int K : result.runs) runs += (runs.empty() ? "" : ", ") + std::to_string(K);
+      ++rows;
+      met += achieved <= E;
+      if (cheapest) {
+        if (reps) ratios.push_back(ratio);
+        works.push_back(work);
+        last_works.push_back(last_work);
+      }
+      std::printf("| %s | %g | %s | %.4f | %.4f | %s | %s | %.4f | %s | %s | %s | %.2f | %.2f |\n", f.name.c_str(),
+                  E, runs.c_str(), kDegrees * result.estimated_error, achieved, achieved <= E ? "yes" : "**no**",
+                  cheapest ? std::to_string(cheapest).c_str() : "none", cheapest ? errorAt(cheapest) : 0.0,
+                  time(t_chosen).c_str(), time(t_fixed).c_str(), reps ? formatted("%.2f", ratio).c_str() : "-",
+                  work, last_work);
+      std::fflush(stdout);
+    }
+  }
+  std::printf(
+      "\nhorizon angles: achieved mean error at most E in %d of %d cases (%.0f %%); over the cheapest fixed "
+      "K: time %s; work %s; the last run's work alone %s\n",
+      met, rows, rows ? 100.0 * met / rows : 0.0, spread(ratios).c_str(), spread(works).c_str(),
+      spread(last_works).c_str());
+}
+
+void horizonErrorCurve(const ComputeContext& context, const std::vector<ErrorTargetField>& fields,
+                       int reference_directions, int max_directions) {
+  std::printf(
+      "\n### horizon angles: mean error and estimate against K (degrees)\n\n| field | K | samples | achieved "
+      "mean | estimate | achieved / estimate | skip-one | skip-two | order p | time (s) |\n"
+      "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+  for (const ErrorTargetField& f : fields) {
+    const HorizonResult reference =
+        horizonPlanes(context, f.field, reference_directions, false, kReferenceTolerance);
+    for (int K : directionLadder()) {
+      if (K > max_directions) break;
+      HorizonResult result;
+      const double t = seconds([&] { result = horizonPlanes(context, f.field, K, true); });
+      const detail::SkipErrors skips = detail::horizonSkipErrors(result);
+      const double achieved = kDegrees * detail::horizonAngleErrorAgainst(result, reference);
+      const double estimate = kDegrees * result.estimated_error;
+      std::printf("| %s | %d | %.0f | %.4f | %.4f | %.2f | %.4f | %.4f | %.2f | %.4f |\n", f.name.c_str(), K,
+                  result.samples_per_receiver, achieved, estimate, estimate > 0 ? achieved / estimate : 0.0,
+                  kDegrees * detail::meanWithData(skips.skip_one), kDegrees * detail::meanWithData(skips.skip_two),
+                  detail::horizonErrorOrder(skips), t);
+      std::fflush(stdout);
     }
   }
 }

@@ -32,6 +32,18 @@ void errorTargetReport(const ComputeContext& context, const std::vector<ErrorTar
 void viewcountTargetReport(const ComputeContext& context, const std::vector<ErrorTargetField>& fields,
                            const std::vector<double>& errors, int reference_directions, int reps);
 
+// The same for the horizon angles (HorizonOptions::max_error with the horizon planes; `errors` in
+// degrees): one table, the error the mean over the pixels and azimuths of |the K planes
+// interpolated linearly in azimuth - the same sweep at K = reference_directions|
+// (detail::horizonAngleErrorAgainst), the cheapest fixed K found by bisection on the ladder.
+void horizonTargetReport(const ComputeContext& context, const std::vector<ErrorTargetField>& fields,
+                         const std::vector<double>& errors, int reference_directions, int reps);
+
+// Per content and fixed K up to max_directions: the horizon angles' error against the dense run,
+// their estimate and its parts (the skip-one and skip-two interpolation errors, the order p).
+void horizonErrorCurve(const ComputeContext& context, const std::vector<ErrorTargetField>& fields,
+                       int reference_directions, int max_directions);
+
 void errorCurve(const ComputeContext& context, const std::vector<ErrorTargetField>& fields,
                 int reference_directions, int max_directions);
 

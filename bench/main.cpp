@@ -103,7 +103,7 @@ constexpr const char* kUsage =
     "       hfvis_bench viewshed-culling [--levels 1,2,3,4] [--reps N] FIELD...\n"
     "       hfvis_bench error-target [--data DIR] [--dem FILE] [--size N] [--errors E,...] [--contents A,B]\n"
     "                                [--reference-k K] [--reps N] [--tile T] [--curve KMAX]\n"
-    "                                [--output svf-ao|viewcount]\n"
+    "                                [--output svf-ao|viewcount|horizon]   (horizon: --errors in degrees)\n"
     "       hfvis_bench pvs-rays [--size N] [--rays R] [--reps K] [--dem FILE] FIELD...\n"
     "       hfvis_bench pvs-recall [--size N] [--view-cell C] [--tile T] [--samples N,N,...]\n"
     "                              [--check-rays R] [--methods agvs,sgvs,per-cell] [--reference yes|no]\n"
@@ -533,11 +533,11 @@ int main(int argc, char** argv) {
       const int reps = std::stoi(args.get("--reps", "3"));
       const int curve = std::stoi(args.get("--curve", "0"));
       const std::string output = args.get("--output", "svf-ao");
-      if (output != "svf-ao" && output != "viewcount")
-        throw Usage("error-target: --output is svf-ao or viewcount");
+      if (output != "svf-ao" && output != "viewcount" && output != "horizon")
+        throw Usage("error-target: --output is svf-ao, viewcount or horizon (--errors in degrees)");
       // (the refined runs' tiles beside the whole field's one K: svf-ao only)
       const std::string tile_text = args.get("--tile");
-      if (output == "viewcount" && !tile_text.empty())
+      if (output != "svf-ao" && !tile_text.empty())
         throw Usage("error-target: --tile refines svf-ao; the visible count takes one K");
       const int tile = tile_text.empty() ? 64 : std::stoi(tile_text);
       if (tile < 1) throw Usage("error-target: --tile is a number of pixels");
@@ -574,6 +574,14 @@ int main(int argc, char** argv) {
           for (int c = mixed.width / 2; c < mixed.width; ++c)
             mixed.heights[static_cast<std::size_t>(r) * mixed.width + c] = 40.0f * terrain.at(c, r);
         fields.push_back({"mixed", mixed});
+      }
+      if (output == "horizon") {
+        const ComputeContext context = ComputeContext::create(ContextOptions::fromEnvironment());
+        if (curve > 0)
+          horizonErrorCurve(context, fields, reference, curve);
+        else
+          horizonTargetReport(context, fields, errors, reference, reps);
+        return 0;
       }
       if (output == "viewcount") {
         viewcountTargetReport(ComputeContext::create(ContextOptions::fromEnvironment()), fields, errors,

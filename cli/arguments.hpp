@@ -60,6 +60,8 @@ struct RunArguments {
   // sky-view-factor and ambient-occlusion: --max-error E (0 = not asked: K as given) and
   // --error-out FILE, the per-pixel error estimate ("" = not asked for).
   double max_error = 0.0;
+  // horizon: --max-error E in degrees, the mean horizon angle error (0 = not asked: K as given).
+  double horizon_max_error_deg = 0.0;
   int error_tile = 0;  // --error-tile N: HorizonOptions::error_tile
   std::string error_output;
   double azimuth_offset_deg = 0.0;

@@ -153,6 +153,13 @@ try "viewcount: maximum error with -k" "" -- viewcount field.exr -o out/o.exr --
 try "viewcount: maximum error of the naive method" "" -- viewcount field.exr -o out/o.exr --max-error 0.1 --method naive
 try "viewcount: maximum error beyond 4096 directions" "" -- viewcount field.exr -o out/o.exr --max-error 1e-7 --error-out out/e.exr
 try "viewcount: error estimate with one direction" "" -- viewcount field.exr -o out/o.exr -k 1 --error-out out/e.exr
+try "horizon: maximum error zero" "" -- horizon field.exr -o out/o.exr --max-error 0
+try "horizon: maximum error of 90 degrees or more" "" -- horizon field.exr -o out/o.exr --max-error 90
+try "horizon: maximum error not finite" "" -- horizon field.exr -o out/o.exr --max-error nan
+try "horizon: maximum error with -k" "" -- horizon field.exr -o out/o.exr --max-error 1 -k 16
+try "horizon: maximum error with an error tile" "" -- horizon field.exr -o out/o.exr --max-error 1 --error-tile 32
+try "horizon: maximum error beyond 4096 directions" "" -- horizon field.exr -o out/o.exr --max-error 1e-7 --error-out out/e.exr
+try "horizon: error estimate under 5 directions" "" -- horizon field.exr -o out/o.exr -k 4 --error-out out/e.exr
 try "shade --env: maximum error zero" "" -- shade field.exr --env sky.exr -o out/o.exr --max-error 0
 try "shade --env: maximum error with -k" "" -- shade field.exr --env sky.exr -o out/o.exr --max-error 0.1 -k 16
 try "shade: maximum error without --env" "" -- shade field.exr --sun 100,30 -o out/o.exr --max-error 0.1

@@ -42,6 +42,7 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr double kHalfPi = 1.57079632679489661923;
+constexpr double kPi = 2.0 * kHalfPi;
 
 struct CliResult {
   int status = -1;  // exit status, or -1 when the process did not exit normally
@@ -881,6 +882,74 @@ TEST_F(Cli, ShadeEnvironmentMaxErrorWritesTheChosenKAndTheEstimate) {
   expectFailure(run("shade " + shellQuoted(field) + " --env " + shellQuoted(sky) + " -o " +
                     shellQuoted(out("s.exr")) + " --max-error 1e-9 --error-out " + shellQuoted(out("e.exr"))),
                 1, "directions");
+}
+
+// horizon --max-error E (degrees) chooses K and --error-out writes the estimate (degrees): the
+// same K, planes and estimate as the library's call with E in radians, K channels of the K chosen,
+// hfvis:directions that K and hfvis:estimated_error / hfvis:max_error in degrees, and the summary
+// line saying both.
+TEST_F(Cli, HorizonMaxErrorWritesTheChosenKAndTheEstimate) {
+  const std::string field = writeField("bumps.exr", 40, 33, [](int col, int row) {
+    return 3.0f * std::sin(0.7f * col) * std::cos(0.5f * row) + ((col / 5 + row / 4) % 3 == 0 ? 4.0f : 0.0f);
+  });
+  const CliResult r = run("horizon " + shellQuoted(field) + " -o " + shellQuoted(out("h.exr")) +
+                          " --max-error 2 --error-out " + shellQuoted(out("e.exr")));
+  ASSERT_EQ(r.status, 0) << r.err;
+  hfvis::HorizonOptions options;
+  options.max_error = 2.0 * kPi / 180.0;
+  hfvis::HorizonOutputs wanted;
+  wanted.horizon_angles = true;
+  const hfvis::HorizonResult lib =
+      hfvis::computeHorizons(hfvis::testing::testContext(), hfvis::readHeightField(field), options, wanted);
+  ASSERT_NE(lib.directions, 64);  // (else the attribute could not tell -k's default from the K run)
+  ASSERT_LE(lib.estimated_error, options.max_error);
+  EXPECT_NE(r.out.find(std::to_string(lib.directions) + " directions"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("estimated mean error"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("for --max-error 2"), std::string::npos) << r.out;
+  const ReadBack horizons = readBack(out("h.exr")), estimate = readBack(out("e.exr"));
+  EXPECT_EQ(horizons.channels, hfvis::cli::directionChannelNames("h", lib.directions));
+  ASSERT_EQ(estimate.channels, std::vector<std::string>{"error"});
+  const std::size_t pixels = lib.error_estimate.size(), K = lib.directions;
+  ASSERT_EQ(horizons.pixels.size(), pixels * K);
+  ASSERT_EQ(estimate.pixels.size(), pixels);
+  for (std::size_t p = 0; p < pixels; ++p) {
+    for (std::size_t k = 0; k < K; ++k) ASSERT_EQ(horizons.pixels[p * K + k], lib.angles[k * pixels + p]) << p;
+    ASSERT_NEAR(estimate.pixels[p], lib.error_estimate[p] * 180.0 / kPi, 1e-5) << p;
+  }
+  for (const ReadBack* image : {&horizons, &estimate}) {
+    EXPECT_EQ(image->spec.get_string_attribute("hfvis:directions"), std::to_string(lib.directions));
+    EXPECT_EQ(image->spec.get_string_attribute("hfvis:max_error"), "2");
+    EXPECT_NEAR(std::stod(image->spec.get_string_attribute("hfvis:estimated_error")),
+                lib.estimated_error * 180.0 / kPi, 1e-6);
+    EXPECT_FALSE(image->spec.get_string_attribute("hfvis:samples_per_unit").empty());
+  }
+  // --error-out with -k: the estimate at the K given.
+  fs::remove(out("h.exr"));
+  fs::remove(out("e.exr"));
+  ASSERT_EQ(run("horizon " + shellQuoted(field) + " -o " + shellQuoted(out("h.exr")) + " -k 12 --error-out " +
+                shellQuoted(out("e.exr")))
+                .status,
+            0);
+  hfvis::HorizonOptions fixed;
+  fixed.directions = 12;
+  wanted.error_estimate = true;
+  const hfvis::HorizonResult at12 =
+      hfvis::computeHorizons(hfvis::testing::testContext(), hfvis::readHeightField(field), fixed, wanted);
+  EXPECT_NEAR(std::stod(readBack(out("e.exr")).spec.get_string_attribute("hfvis:estimated_error")),
+              at12.estimated_error * 180.0 / kPi, 1e-6);
+  EXPECT_EQ(readBack(out("h.exr")).spec.get_string_attribute("hfvis:directions"), "12");
+}
+
+// Bad requests: E not positive, not finite, 90 degrees or more, beyond 4096 directions, with -k,
+// --error-tile, --error-out under 5 directions: a clear error and nothing written.
+TEST_F(Cli, HorizonMaxErrorBadRequestsWriteNothing) {
+  const std::string h = "horizon " + shellQuoted(ramp()) + " -o " + shellQuoted(out("h.exr")) + " --error-out " +
+                        shellQuoted(out("e.exr"));
+  for (const char* E : {"0", "-1", "nan", "inf", "90", "1e9"}) expectFailure(run(h + " --max-error " + E), 2, "--max-error");
+  expectFailure(run(h + " --max-error 1 -k 32"), 2, "-k");
+  expectFailure(run(h + " --max-error 1 --error-tile 8"), 2, "--error-tile");
+  expectFailure(run(h + " -k 4"), 2, "-k 5");
+  expectFailure(run(h + " --max-error 1e-7"), 1, "4096");
 }
 
 TEST_F(Cli, HorizonWritesOneChannelPerDirection) {

@@ -62,12 +62,14 @@ class Horizon : public Computation {
   // then, saying what to ask for instead.
   void prepare(HeightField& field) override {
     const double plane = static_cast<double>(field.pixelCount()) * sizeof(float);
-    const double planes = plane * run_.directions * (run_.distance_output.empty() ? 1 : 2);
+    // (--max-error: K is chosen as the runs go, so checked at the first run's, 16)
+    const int directions = run_.horizon_max_error_deg > 0.0 ? 16 : run_.directions;
+    const double planes = plane * directions * (run_.distance_output.empty() ? 1 : 2);
     const double need = 3.0 * planes, available = availableHostBytes();
     if (need <= available) return;
     std::ostringstream message;
     message
-        << std::fixed << std::setprecision(1) << "the " << run_.directions << "-channel horizon map"
+        << std::fixed << std::setprecision(1) << "the " << directions << "-channel horizon map"
         << (run_.distance_output.empty() ? "" : " and its distances") << " of this " << field.width << " x "
         << field.height << " field need about " << need / 1073741824.0 << " GiB of host memory ("
         << planes / 1073741824.0 << " GiB of planes, held about three times while written) but "
@@ -81,14 +83,16 @@ class Horizon : public Computation {
     HorizonOutputs wanted;
     wanted.horizon_angles = true;
     wanted.horizon_distances = !run_.distance_output.empty();
+    // --error-out with -k: the estimate at the K given (--max-error asks the library for it anyway).
+    wanted.error_estimate = !run_.error_output.empty();
     result_ = computeSweptHorizons(job, wanted);
   }
 
   Summary write(Job& job, OutputFiles& outputs) override {
     const HeightField& field = job.input;
     const std::size_t pixels = field.pixelCount();
-    const int directions = run_.directions;
-    const Attributes attributes = sweptAttributes(job, result_);
+    const int directions = result_.directions;  // --max-error: the K it chose
+    const Attributes attributes = horizonAttributes(job);
     // K channels, one per direction, named `prefix` and the direction's number.
     const auto stage = [&](const std::string& path, const std::vector<float>& planes, const char* prefix,
                            const std::string& what, const char* quantity, const char* units) {
@@ -107,18 +111,61 @@ class Horizon : public Computation {
             "slope "
             "at the receiver is the horizon");
     }
+    Summary summary{directions};
+    if (!result_.error_estimate.empty()) {
+      // Degrees, as --max-error takes them.
+      requireSize(result_.error_estimate, pixels, "error estimate");
+      std::vector<float> degrees = result_.error_estimate;
+      for (float& e : degrees) e = static_cast<float>(e * (180.0 / M_PI));
+      if (!run_.error_output.empty())
+        outputs.image(run_.error_output,
+                      job.image(field, {"error"}, {degrees}, attributes,
+                                "estimated error of the horizon angles: mean over azimuth of the K channels' "
+                                "linear interpolation's error",
+                                "degrees; NaN at nodata"));
+      summary.note = "; estimated mean error " + formatFixed(result_.estimated_error * 180.0 / M_PI, 4) + " deg" +
+                     (run_.horizon_max_error_deg > 0.0
+                          ? " for --max-error " + formatNumber(run_.horizon_max_error_deg) + " (runs at K = " +
+                                runList() + ")"
+                          : "");
+    }
     if (!run_.preview.empty()) {
       const std::vector<float> mean = meanInFieldElevation(result_.angles, pixels, directions);
       outputs.previewPng(run_.preview, field.width, field.height, mean);  // stretched min..max
     }
-    return {directions};
+    return summary;
   }
 
  private:
+  // The run's attributes; with an error estimate it and --max-error in degrees (the library's are
+  // radians).
+  Attributes horizonAttributes(const Job& job) const {
+    Attributes attributes = sweptAttributes(job, result_);
+    for (auto& [name, value] : attributes)
+      if (name == "hfvis:estimated_error") value = formatNumber(result_.estimated_error * 180.0 / M_PI);
+    if (run_.horizon_max_error_deg > 0.0) {
+      attributes.emplace_back("hfvis:max_error", formatNumber(run_.horizon_max_error_deg));
+      attributes.emplace_back("hfvis:runs", runList());
+    }
+    if (!result_.error_estimate.empty())
+      attributes.emplace_back("hfvis:error_unit", "degrees, the mean over pixels and azimuths");
+    return attributes;
+  }
+
+  std::string runList() const {
+    std::string list;
+    for (int K : result_.runs) list += (list.empty() ? "" : ",") + std::to_string(K);
+    return list;
+  }
+
   HorizonResult result_;
 };
 
-void checkHorizon(const std::string&, const RunArguments& run) {
+void checkHorizon(const std::string& name, const RunArguments& run) {
+  if (run.horizon_max_error_deg > 0.0 && run.directions_given)
+    throw UsageError(name + ": --max-error chooses K itself; give either it or -k");
+  if (!run.error_output.empty() && run.horizon_max_error_deg == 0.0 && run.directions < 5)
+    throw UsageError(name + ": --error-out interpolates each direction from its neighbours: it needs -k 5 or more");
   asUsageError([&] { validate(horizonOptions(run), horizonOutputs(Command::Horizon, run)); });
 }
 
@@ -132,7 +179,7 @@ const CommandSpec kHorizonCommand{
     "horizon",
     nullptr,
     "K float32 channels h000..h(K-1): horizon elevation angle per direction, radians",
-    "IN -o OUT.exr [-k K] [--distance-out DIST.exr] [options]",
+    "IN -o OUT.exr [-k K | --max-error DEG] [--distance-out DIST.exr] [--error-out ERR.exr] [options]",
     "Writes K float32 channels h000..h(K-1) (zero-padded, so sorted order = direction order;\n"
     "select channels by name): channel k = horizon elevation angle in direction k, radians.\n",
     "Its preview shows the mean horizon elevation over the directions whose ray stays in\n"

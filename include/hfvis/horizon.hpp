@@ -55,6 +55,19 @@ struct HorizonOptions : SweepOptions {
   // K, or a sixth of the prediction), until the estimate is met. Throws InvalidArgument, naming
   // the K it would take, when a run predicts more than kMaxAutoDirections (after the first run only
   // when even a fall as K^-2 would). The samples per unit stay as given.
+  // With the horizon planes (angles alone, or with their distances; no sky-view factor, occlusion
+  // or environment in the same run), max_error is in radians, 0 < max_error < pi/2, and bounds the
+  // mean horizon angle error: over the pixels with data and over azimuth, |the K planes
+  // interpolated linearly in azimuth between their real azimuths (HorizonResult::azimuths) - the
+  // true horizon| (each plane is exact along its own ray for the samples per unit given, so this
+  // is the error K controls). Its estimate (HorizonResult::estimated_error, the mean; per pixel
+  // error_estimate) comes from the run's own planes: each direction against the interpolation of
+  // its neighbours in azimuth (the error of the K / 2 reconstruction at their midpoints), scaled to
+  // K by 2/3 (an interval's mean interpolation error against its midpoint's) times 1.125
+  // (calibrated) and by 2^-p, p the order the pixel's neighbours two places away show (within
+  // 0.3 .. 2; src/core/horizon_angle_error.hpp). Runs at 8 and 16 directions,
+  // then at the K the last two estimates predict (5 % more, at most 4 times the last K, the least
+  // work within 1.25 times that); one K for the whole field (error_tile refused). bench/report/error_target.md measures it against K = 2048.
   double max_error = 0.0;
   // With max_error, where the field needs them: after the first run (the whole field at 16
   // directions), while the estimate's 99th percentile over the field exceeds max_error, the tiles
@@ -90,7 +103,9 @@ struct HorizonOutputs {
   const EnvironmentMap* environment = nullptr;
   // With the sky-view factor or occlusion alone (no planes, no environment; K >= 2): an estimate of
   // their error against the azimuthal integral they approximate (HorizonResult::error_estimate),
-  // from the same run at the cost of one more sum per pixel.
+  // from the same run at the cost of one more sum per pixel. With the horizon angles alone (their
+  // distances may come along; K >= 5): the estimate of their mean error (HorizonOptions::max_error)
+  // at the K given, computed on the host from the planes.
   bool error_estimate = false;
 };
 
@@ -114,8 +129,11 @@ struct HorizonResult {
   // benchmark's contents the difference lies 1.1 to 4 times above the K result's error
   // (bench/report/error_curve.md), on white-noise heights barely above it
   // (tests/test_horizon_error_target.cpp): the divisor is kept that small for them.
+  // With the horizon angles: per pixel the estimated mean over azimuth of the K planes'
+  // interpolation error, radians (HorizonOptions::max_error).
   std::vector<float> error_estimate;
-  double estimated_error = 0.0;  // its 99th percentile over the pixels with data; 0 without it
+  double estimated_error = 0.0;  // its 99th percentile over the pixels with data (horizon angles: its
+                                 // mean); 0 without it
   // With HorizonOptions::max_error: the K of each run it made, in order, so that its whole cost
   // is known (with error_tile, runs after the first cover only the tiles that needed them); empty
   // otherwise. `directions` is then the largest K any pixel took, and `azimuths` that run's.

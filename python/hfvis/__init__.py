@@ -9,7 +9,7 @@ made on first use and kept; the GIL is released while the kernels run. docs/pyth
 from . import _core
 from ._errors import (DeviceError, Error, InputTypeError, InvalidArgumentError, IoError, MemoryBudgetError,
                       NoDeviceError)
-from ._operations import (ErrorEstimate, HeightFieldFile, Horizons, Insolation, Intervisibility,
+from ._operations import (ErrorEstimate, HeightFieldFile, HorizonEstimate, Horizons, Insolation, Intervisibility,
                           IntervisibilityEstimate, Pvs,
                           RegionPairVisibility, RegionVisibility, SunShading, ambient_occlusion, bounce,
                           cumulative_viewshed, devices, environment_light, horizon_angles, horizon_distances,
@@ -20,7 +20,7 @@ __version__ = _core.__version__
 
 __all__ = [
     "Error", "InvalidArgumentError", "InputTypeError", "IoError", "NoDeviceError", "DeviceError", "MemoryBudgetError",
-    "HeightFieldFile", "Horizons", "Intervisibility", "IntervisibilityEstimate", "SunShading", "Insolation", "ErrorEstimate", "RegionVisibility",
+    "HeightFieldFile", "Horizons", "HorizonEstimate", "Intervisibility", "IntervisibilityEstimate", "SunShading", "Insolation", "ErrorEstimate", "RegionVisibility",
     "RegionPairVisibility", "Pvs",
     "horizon_angles", "horizon_distances", "sky_view_factor", "ambient_occlusion", "intervisibility", "viewshed",
     "cumulative_viewshed", "sun_shading", "insolation", "environment_light", "region_visibility",

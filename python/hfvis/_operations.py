@@ -15,6 +15,7 @@ Intervisibility = collections.namedtuple("Intervisibility", "visible_count visib
 SunShading = collections.namedtuple("SunShading", "sun direct")
 Insolation = collections.namedtuple("Insolation", "sun_hours direct")
 ErrorEstimate = collections.namedtuple("ErrorEstimate", "values error directions estimated_error")
+HorizonEstimate = collections.namedtuple("HorizonEstimate", "values azimuths error directions estimated_error")
 IntervisibilityEstimate = collections.namedtuple("IntervisibilityEstimate",
                                                  "visible_count visible_area error directions estimated_error")
 RegionVisibility = collections.namedtuple("RegionVisibility", "fraction bits rgb", defaults=(None,))
@@ -264,13 +265,46 @@ def _azimuths_deg(options):
 
 def horizon_angles(heights, *, directions=64, azimuth_offset=0.0, samples_per_unit=1.0, curvature=0.0,
                    max_distance=0.0, method="sweep", azimuth_tolerance=None, strip_rows=0, memory_budget_bytes=0,
-                   cell_size=None, z_scale=1.0, nodata=None, device="", progress=None):
+                   max_error=0.0, error_estimate=False, cell_size=None, z_scale=1.0, nodata=None, device="",
+                   progress=None):
     """The horizon elevation angle (radians) of every pixel in K directions. numpy: Horizons(values
-    K x H x W, azimuths in radians); DataArray: dims (azimuth, y, x), azimuth in degrees."""
+    K x H x W, azimuths in radians); DataArray: dims (azimuth, y, x), azimuth in degrees.
+    max_error=E (radians) chooses K (directions ignored) so that the estimated mean horizon angle
+    error (the K planes interpolated in azimuth against the true horizon, as the CLI's horizon
+    --max-error in degrees) is at most E; with it or error_estimate=True (K >= 5): numpy
+    HorizonEstimate(values, azimuths, error, directions, estimated_error), the error per pixel in
+    radians; a DataArray with the K and the estimate in its attrs (and a Dataset with the per-pixel
+    error under error_estimate=True)."""
     options = _horizon(directions, azimuth_offset, samples_per_unit, curvature, max_distance, memory_budget_bytes,
                        method, azimuth_tolerance, strip_rows)
-    return _horizon_maps("horizon_angles", "angles", heights, options,
-                         _common(cell_size, z_scale, nodata, device, progress))
+    common = _common(cell_size, z_scale, nodata, device, progress)
+    if not max_error and not error_estimate:
+        return _horizon_maps("horizon_angles", "angles", heights, options, common)
+    if max_error:
+        options["max_error"] = float(max_error)
+    if error_estimate:
+        options["error_estimate"] = True
+    if _is_dataarray(heights) and _is_dask(heights.data):
+        heights = heights.compute()  # K and the estimate's mean are the whole field's: in one piece
+    out, grid = _run("horizon_angles", heights, options, common)
+    if grid is None:
+        return HorizonEstimate(out["angles"], out["azimuths"], out["error"], out["directions"],
+                               out["estimated_error"])
+    options = dict(options, directions=out["directions"])
+    attrs = _attrs("horizon_angles", "angles", options, grid)
+    attrs["azimuth_convention"] = _xarray_convention()
+    attrs["hfvis_estimated_error"] = out["estimated_error"]
+    values = grid.result(out["angles"], "horizon_angles", attrs,
+                         leading=("azimuth", np.degrees(np.asarray(out["azimuths"]))))
+    values["azimuth"].attrs.update(units="degrees", long_name="azimuth as computed", convention=_xarray_convention())
+    if not error_estimate:
+        return values
+    import xarray as xr
+
+    error = grid.result(out["error"], "error", dict(_attrs("horizon_angles", "error", options, grid),
+                                                    hfvis_estimated_error=out["estimated_error"],
+                                                    hfvis_directions=out["directions"]))
+    return xr.Dataset({"horizon_angles": values, "error": error})
 
 
 def horizon_distances(heights, *, directions=64, azimuth_offset=0.0, samples_per_unit=1.0, curvature=0.0,

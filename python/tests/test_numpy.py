@@ -205,6 +205,35 @@ def test_sky_view_factor_and_ambient_occlusion_with_max_error(tmp_path, projecte
     equal(fixed.error, read_bands(error_tif)[0][0])
 
 
+def test_horizon_angles_with_max_error(tmp_path, projected_tif, dem):
+    """max_error=E (radians) chooses K as the CLI's horizon --max-error (degrees) does; error_estimate
+    gives its --error-out (degrees there, radians here)."""
+    import rasterio
+
+    error_tif = tmp_path / "error.tif"
+    planes, _ = cli(tmp_path, projected_tif, "horizon", "--max-error", "0.5", "--max-distance", "900",
+                    "--error-out", error_tif)
+    ours = hfvis.horizon_angles(dem, max_error=np.radians(0.5), error_estimate=True, max_distance=900,
+                                cell_size=30, nodata=NODATA)
+    assert isinstance(ours, hfvis.HorizonEstimate)
+    assert ours.values.shape == (ours.directions,) + dem.shape and len(ours.azimuths) == ours.directions
+    equal(ours.values, planes)
+    (error,), _ = read_bands(error_tif)
+    np.testing.assert_allclose(np.degrees(ours.error), error, rtol=1e-5, atol=1e-7)
+    with rasterio.open(error_tif) as f:
+        tags = f.tags()
+    assert int(tags["hfvis_directions"]) == ours.directions > 16
+    assert ours.estimated_error <= np.radians(0.5)
+    assert abs(float(tags["hfvis_estimated_error"]) - np.degrees(ours.estimated_error)) < 1e-6
+    # Without max_error, error_estimate keeps the K given; fewer than 5 directions are refused.
+    fixed = hfvis.horizon_angles(dem, directions=12, error_estimate=True, cell_size=30, nodata=NODATA)
+    assert fixed.directions == 12 and fixed.estimated_error > 0
+    with pytest.raises(hfvis.InvalidArgumentError):
+        hfvis.horizon_angles(dem, directions=4, error_estimate=True, cell_size=30, nodata=NODATA)
+    with pytest.raises(hfvis.InvalidArgumentError):
+        hfvis.horizon_angles(dem, max_error=2.0, cell_size=30, nodata=NODATA)
+
+
 def mask_channels(bits, samples):
     """The CLI's --masks channels (16 samples each, as whole numbers) from (words, H, W) bits."""
     channels = (samples + 15) // 16

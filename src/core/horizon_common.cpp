@@ -28,11 +28,29 @@ void validate(const HorizonOptions& options, const HorizonOutputs& outputs) {
                           std::to_string(options.error_tile) + ")");
   if (options.error_tile > 0 && options.max_error == 0.0)
     throw InvalidArgument("the error tile refines toward max_error: give max_error with it");
-  if (options.max_error != 0.0 || outputs.error_estimate) {
+  const bool angles_alone = outputs.horizon_angles && !outputs.sky_view_factor && !outputs.ambient_occlusion &&
+                            !outputs.environment;
+  if ((options.max_error != 0.0 || outputs.error_estimate) && angles_alone) {
+    // The horizon angles' own error (core/horizon_angle_error.hpp), in radians.
+    if (options.error_tile > 0)
+      throw InvalidArgument(
+          "the error tile refines the sky-view factor and occlusion; horizon planes take one K for the whole "
+          "field");
+    if (!(options.max_error >= 0.0 && options.max_error < M_PI / 2.0))
+      throw InvalidArgument(
+          "the maximum error of the horizon angles must be in (0, pi/2) radians, (0, 90) degrees: the mean "
+          "error of an angle in -90 .. 90 degrees (got " +
+          std::to_string(options.max_error * 180.0 / M_PI) + " degrees)");
+    if (options.max_error == 0.0 && options.directions < 5)
+      throw InvalidArgument(
+          "an error estimate of the horizon angles needs K >= 5 (it interpolates each direction from its "
+          "neighbours one and two places away)");
+  } else if (options.max_error != 0.0 || outputs.error_estimate) {
     if (outputs.horizon_angles || outputs.horizon_distances || outputs.environment ||
         (!outputs.sky_view_factor && !outputs.ambient_occlusion))
       throw InvalidArgument(
-          "an error estimate and a maximum error apply to the sky-view factor and ambient occlusion alone");
+          "an error estimate and a maximum error apply to the sky-view factor and ambient occlusion alone, or to "
+          "the horizon angles alone (with their distances)");
     if (!(options.max_error >= 0.0 && options.max_error < 1.0))
       throw InvalidArgument("the maximum error must be in (0, 1): the sky-view factor and occlusion lie in 0..1 (got " +
                             std::to_string(options.max_error) + ")");

@@ -14,6 +14,7 @@
 
 #include "core/environment_swaths.hpp"
 #include "core/fast_math.hpp"
+#include "core/horizon_angle_error.hpp"
 #include "core/horizon_common.hpp"
 #include "core/lattice_geometry.hpp"
 #include "core/opencl_context.hpp"
@@ -1053,6 +1054,21 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
         }
       }
     };
+    if (outputs.horizon_angles && (options.max_error != 0.0 || outputs.error_estimate)) {
+      // The horizon angles' own error, from their planes on the host (core/horizon_angle_error.hpp).
+      HorizonOutputs planes = outputs;
+      planes.error_estimate = false;
+      const auto estimated = [&](int directions) {
+        attempt.directions = directions;
+        HorizonResult result = run(planes, nullptr);
+        detail::estimateHorizonAngleError(result);
+        return result;
+      };
+      if (options.max_error == 0.0) return estimated(options.directions);
+      return detail::runHorizonAnglesToError(options.max_error, estimated, [&](int directions) {
+        return detail::horizonWork(field, options, planes, directions);
+      });
+    }
     if (options.max_error == 0.0) return run(outputs, nullptr);
     // Ask for an error: runs at growing K until the estimate meets it (HorizonOptions::max_error).
     HorizonOutputs estimated = outputs;

@@ -1,0 +1,203 @@
+// horizon_angle_error.cpp: see horizon_angle_error.hpp.
+#include "core/horizon_angle_error.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <sstream>
+
+#include "core/horizon_common.hpp"
+#include "core/lattice_geometry.hpp"
+#include "hfvis/errors.hpp"
+
+namespace hfvis::detail {
+namespace {
+
+constexpr double kTwoPi = 2.0 * M_PI;
+
+// The gap from azimuth x up to y going round (radians, in [0, 2 pi)).
+double gapUp(double x, double y) {
+  const double g = y - x;
+  return g < 0.0 ? g + kTwoPi : g;
+}
+
+// The plane of direction `k` of `result`.
+const float* plane(const HorizonResult& result, int k) {
+  return result.angles.data() + static_cast<std::size_t>(k) * result.width * result.height;
+}
+
+// Per pixel the interpolation error at each direction of `order` from its neighbours `skip`
+// places away, weighted by the span it crosses over skip * 2 * 2 pi (so that, the directions
+// evenly spaced, it is the mean of those errors).
+std::vector<float> skipError(const HorizonResult& result, const AzimuthOrder& order, int skip) {
+  const int n = static_cast<int>(order.index.size());
+  const std::size_t pixels = static_cast<std::size_t>(result.width) * result.height;
+  std::vector<double> sum(pixels, 0.0);
+  for (int i = 0; i < n; ++i) {
+    const int before = (i - skip % n + n) % n, after = (i + skip) % n;
+    const double g1 = gapUp(order.azimuth[before], order.azimuth[i]),
+                 g2 = gapUp(order.azimuth[i], order.azimuth[after]);
+    const double span = g1 + g2, weight = span / (2.0 * skip * kTwoPi);
+    const float *h = plane(result, order.index[i]), *lo = plane(result, order.index[before]),
+                *hi = plane(result, order.index[after]);
+    for (std::size_t p = 0; p < pixels; ++p) {
+      const double interpolated = (double(lo[p]) * g2 + double(hi[p]) * g1) / span;
+      sum[p] += weight * std::abs(double(h[p]) - interpolated);  // NaN at nodata stays NaN
+    }
+  }
+  return std::vector<float>(sum.begin(), sum.end());
+}
+
+}  // namespace
+
+AzimuthOrder azimuthOrder(const std::vector<double>& azimuths) {
+  std::vector<std::pair<double, int>> sorted;
+  for (std::size_t k = 0; k < azimuths.size(); ++k) {
+    double a = std::fmod(azimuths[k], kTwoPi);
+    if (a < 0.0) a += kTwoPi;
+    sorted.emplace_back(a, static_cast<int>(k));
+  }
+  std::stable_sort(sorted.begin(), sorted.end(),
+                   [](const auto& x, const auto& y) { return x.first < y.first; });
+  AzimuthOrder order;
+  for (const auto& [a, k] : sorted) {
+    // One lattice step's azimuth is computed once, so its copies are equal (and 2 pi apart at most
+    // across zero: those within a hair of the first are the same step going round).
+    if (!order.azimuth.empty() && a - order.azimuth.back() < 1e-12) continue;
+    order.azimuth.push_back(a);
+    order.index.push_back(k);
+  }
+  while (order.azimuth.size() > 1 && order.azimuth.back() + 1e-12 >= order.azimuth.front() + kTwoPi) {
+    order.azimuth.pop_back();
+    order.index.pop_back();
+  }
+  return order;
+}
+
+SkipErrors horizonSkipErrors(const HorizonResult& result) {
+  const AzimuthOrder order = azimuthOrder(result.azimuths);
+  if (order.index.size() < 5)
+    throw InvalidArgument("an error estimate of the horizon angles needs at least 5 distinct azimuths (got " +
+                          std::to_string(order.index.size()) + ")");
+  return {skipError(result, order, 1), skipError(result, order, 2)};
+}
+
+double meanWithData(const std::vector<float>& plane) {
+  double sum = 0.0;
+  std::size_t count = 0;
+  for (float v : plane)
+    if (!std::isnan(v)) sum += v, ++count;
+  return count ? sum / count : 0.0;
+}
+
+double horizonErrorOrder(const SkipErrors& skips) {
+  const double one = meanWithData(skips.skip_one), two = meanWithData(skips.skip_two);
+  if (!(one > 0.0 && two > 0.0)) return kHorizonOrderLow;
+  return std::clamp(std::log2(two / one), kHorizonOrderLow, kHorizonOrderHigh);
+}
+
+void estimateHorizonAngleError(HorizonResult& result) {
+  SkipErrors skips = horizonSkipErrors(result);
+  const double low = std::pow(2.0, -kHorizonOrderHigh), high = std::pow(2.0, -kHorizonOrderLow);
+  for (std::size_t p = 0; p < skips.skip_one.size(); ++p) {
+    const double one = skips.skip_one[p], two = skips.skip_two[p];
+    const double fall = two > 0.0 ? std::clamp(one / two, low, high) : high;
+    skips.skip_one[p] = static_cast<float>(kHorizonEstimateFactor * one * fall);  // NaN stays NaN
+  }
+  result.error_estimate = std::move(skips.skip_one);
+  result.estimated_error = meanWithData(result.error_estimate);
+}
+
+double horizonAngleErrorAgainst(const HorizonResult& result, const HorizonResult& reference) {
+  if (result.width != reference.width || result.height != reference.height || result.angles.empty() ||
+      reference.angles.empty())
+    throw InvalidArgument("horizonAngleErrorAgainst: two runs' horizon angles of one field");
+  const AzimuthOrder order = azimuthOrder(result.azimuths), dense = azimuthOrder(reference.azimuths);
+  const std::vector<double> weights = halfGapWeights(dense.azimuth);
+  const std::size_t pixels = static_cast<std::size_t>(result.width) * result.height;
+  const int n = static_cast<int>(order.index.size());
+  std::vector<double> sum(pixels, 0.0);
+  for (std::size_t j = 0; j < dense.index.size(); ++j) {
+    const double psi = dense.azimuth[j];
+    // The result's directions on either side of psi, going round.
+    const int after = static_cast<int>(std::upper_bound(order.azimuth.begin(), order.azimuth.end(), psi) -
+                                       order.azimuth.begin()) % n;
+    const int before = (after + n - 1) % n;
+    const double g1 = gapUp(order.azimuth[before], psi), g2 = gapUp(psi, order.azimuth[after]);
+    const double span = g1 + g2;
+    const double t = n == 1 || span == 0.0 ? 0.0 : g1 / span;
+    const float *lo = plane(result, order.index[before]), *hi = plane(result, order.index[after]),
+                *truth = plane(reference, dense.index[j]);
+    for (std::size_t p = 0; p < pixels; ++p)
+      sum[p] += weights[j] * std::abs(double(lo[p]) * (1.0 - t) + double(hi[p]) * t - double(truth[p]));
+  }
+  return meanWithData(std::vector<float>(sum.begin(), sum.end()));
+}
+
+double horizonWork(const HeightField& field, const HorizonOptions& options, const HorizonOutputs& outputs, int K) {
+  if (options.method != HorizonMethod::Sweep) return K;
+  HorizonOptions at = options;
+  at.directions = K;
+  double samples = 0.0;
+  for (const LatticeDirection& d : horizonDirections(field, at, outputs))
+    samples += static_cast<double>(latticeSamples(d, at.samples_per_unit).size());
+  return samples;
+}
+
+int cheapestDirections(int needed, const std::function<double(int)>& work) {
+  const int first = (std::max(needed, 8) + 7) / 8 * 8;
+  const int last = std::min(kMaxAutoDirections, static_cast<int>(std::ceil(first * kHorizonChoiceSpan)));
+  int best = first;
+  double least = work(first);
+  for (int K = first + 8; K <= last; K += 8) {
+    const double w = work(K);
+    if (w < least) least = w, best = K;
+  }
+  return best;
+}
+
+HorizonResult runHorizonAnglesToError(double max_error, const std::function<HorizonResult(int)>& run,
+                                      const std::function<double(int)>& work) {
+  int directions = kHorizonFirstDirections, earlier = 0;
+  double earlier_estimate = 0.0, total = 0.0;
+  std::vector<int> runs;
+  for (;;) {
+    HorizonResult result = run(directions);
+    runs.push_back(directions);
+    total += result.samples_per_receiver;
+    if (result.estimated_error <= max_error) {
+      result.runs = std::move(runs);
+      result.samples_per_receiver = total;
+      result.pixel_directions.assign(static_cast<std::size_t>(result.width) * result.height, directions);
+      return result;
+    }
+    // The need, as the estimate falls (K^-p), 5 % more; beyond kMaxAutoDirections refused.
+    double order = 1.0;
+    if (earlier > 0 && earlier_estimate > result.estimated_error && result.estimated_error > 0.0)
+      order = std::clamp(std::log(earlier_estimate / result.estimated_error) / std::log(double(directions) / earlier),
+                         0.5, 3.0);
+    const double wanted = std::max<double>(
+        directions + 8, directions * std::pow(result.estimated_error / max_error, 1.0 / order) * 1.05);
+    if (earlier > 0 && wanted > kMaxAutoDirections) {  // (from the first run's order alone, no refusal)
+      // In degrees, as the command line takes it.
+      std::ostringstream message;
+      message << "a maximum mean horizon angle error of " << max_error * 180.0 / M_PI << " degrees needs about "
+              << static_cast<long long>(std::min(wanted, 1e9)) << " directions (the estimate at K = " << directions
+              << " is " << result.estimated_error * 180.0 / M_PI << " degrees), beyond the " << kMaxAutoDirections
+              << " a run may choose: ask for a larger error, or give K";
+      throw InvalidArgument(message.str());
+    }
+    // After the first run the second (whose work is a few per cent of what follows) measures the
+    // order; later runs go at most kHorizonMostStep times as far, where the order is measured again
+    // (it rises with K on smooth fields, and the estimate's fall from 8 to 16 predicts badly far off).
+    const int next = earlier == 0 ? kHorizonSecondDirections
+                                  : cheapestDirections(static_cast<int>(std::ceil(
+                                                           std::min(wanted, kHorizonMostStep * directions))),
+                                                       work);
+    earlier = directions;
+    earlier_estimate = result.estimated_error;
+    directions = next;
+  }
+}
+
+}  // namespace hfvis::detail
