@@ -60,6 +60,24 @@ bench=$build/bench/hfvis_bench
 [[ -x $bench ]] || { echo "error_target.sh: no hfvis_bench in $build (build it first)" >&2; exit 1; }
 export POCL_CACHE_DIR=${POCL_CACHE_DIR:-$root/bench/out/pocl-cache}
 mkdir -p "$(dirname "$out")"
+# The report's sections after the svf / ao tables, each written by its own mode: `replace_section
+# MARKER SECTION` puts SECTION in place of the one from line MARKER to the next "## " line (or at
+# the end), keeping the others; the default mode keeps them all after its own tables.
+kept_sections=("## Intervisibility (viewcount --max-error)" "## Horizon angles (horizon --max-error)")
+replace_section() {
+  local marker=$1 section=$2
+  [[ -f $out ]] || { echo "error_target.sh: $out does not exist (run without --horizon or --viewcount first)" >&2; exit 1; }
+  awk -v m="$marker" -v s="$section" '
+    $0 == m { skip = 1; done = 1; print s; print ""; next }
+    skip && /^## / { skip = 0 }
+    !skip { print }
+    END { if (!done) { print ""; print s } }' "$out" | cat -s > "$out.tmp" && mv "$out.tmp" "$out"
+}
+# What follows the first of kept_sections in $out (nothing when there is none).
+later_sections() {
+  [[ -f $out ]] || return 0
+  awk -v a="${kept_sections[0]}" -v b="${kept_sections[1]}" '$0 == a || $0 == b { on = 1 } on { print }' "$out"
+}
 commit=$(git -C "$root" rev-parse --short HEAD)  # before the run: the build it times
 if [[ $horizon -eq 1 && $curve -gt 0 ]]; then
   [[ $out == $root/bench/report/error_target.md ]] && out=$root/bench/report/error_curve_horizon.md
@@ -123,9 +141,7 @@ if [[ $horizon -eq 1 ]]; then
     [[ $reps -gt 0 ]] && echo "Times: median of $reps runs, the chosen run (all its runs) and the fixed K alternately." || echo "Not timed (--reps 0)."
     echo "$table"
   )
-  [[ -f $out ]] || { echo "error_target.sh: $out does not exist (run without --horizon first)" >&2; exit 1; }
-  kept=$(awk -v m="$marker" '$0 == m { exit } { print }' "$out")
-  printf '%s\n\n%s\n' "$kept" "$section" | cat -s > "$out.tmp" && mv "$out.tmp" "$out"
+  replace_section "$marker" "$section"
   echo "wrote $out"
   exit 0
 fi
@@ -146,12 +162,11 @@ if [[ $viewcount -eq 1 ]]; then
     [[ $reps -gt 0 ]] && echo "Times: median of $reps runs, interleaved." || echo "Not timed (--reps 0)."
     echo "$table"
   )
-  [[ -f $out ]] || { echo "error_target.sh: $out does not exist (run without --viewcount first)" >&2; exit 1; }
-  kept=$(awk -v m="$marker" '$0 == m { exit } { print }' "$out")
-  printf '%s\n\n%s\n' "$kept" "$section" | cat -s > "$out.tmp" && mv "$out.tmp" "$out"
+  replace_section "$marker" "$section"
   echo "wrote $out"
   exit 0
 fi
+later=$(later_sections)
 tables=$(cd "$root" && "$bench" error-target --size "$size" --errors "$errors" --reference-k "$reference" \
   --reps "$reps" --tile "$tile" --contents "$contents")
 {
@@ -177,5 +192,6 @@ tables=$(cd "$root" && "$bench" error-target --size "$size" --errors "$errors" -
     echo "Not timed (--reps 0): the work ratio stands for the time ratio."
   fi
   echo "$tables"
-} > "$out"
+  [[ -n $later ]] && printf '\n%s\n' "$later"
+} > "$out.tmp" && mv "$out.tmp" "$out"
 echo "wrote $out"

@@ -72,14 +72,14 @@ struct HorizonOptions : SweepOptions {
   // With max_error, where the field needs them: after the first run (the whole field at 16
   // directions), while the estimate's 99th percentile over the field exceeds max_error, the tiles
   // of error_tile x error_tile pixels with the most pixels above it (until those left hold at most
-  // half the pixels the percentile lets above it) run again, each at the K its own estimate's 99th
-  // percentile predicts (rounded up to directionLadder), sweeping only the lines that reach them
-  // (each cut after its last receiver there, the horizons still from the whole line beyond). A
-  // pixel's values are those of the whole-field run at its tile's last K, bit for bit
-  // (HorizonResult::pixel_directions). 0, the default: the whole field takes one K. On the
-  // benchmark's contents refinement cost about as much as one K for the sky-view factor and more
-  // for occlusion (bench/report/error_target.md: a tile's run also sweeps its lines' whole
-  // upstream, and each tile steps through runs of its own).
+  // half the pixels the percentile lets above it) run again, each at the next K its own runs
+  // choose as the whole field's do (the prediction, or a probe toward a far one), sweeping only
+  // the lines that reach them (each cut after its last receiver there, the horizons still from the
+  // whole line beyond). A pixel's values are those of the whole-field run at its tile's last K, bit
+  // for bit (HorizonResult::pixel_directions), its estimate over its tile's divisor. 0, the
+  // default: the whole field takes one K. On the benchmark's contents refinement cost more work
+  // than one K for the whole field (bench/report/error_target.md: a tile's run also sweeps its
+  // lines' whole upstream, and each tile steps through runs of its own).
   int error_tile = 0;
 };
 

@@ -46,7 +46,9 @@ _UNITS = {
     "fraction": "1 (the share of the source samples seen, 0..1)",
     "bits": "bit patterns: bit s % 32 of plane s // 32 set where source sample s is seen; 0 at nodata",
     "rgb": "the light image's values (the colours of the source samples seen, summed, / S)",
-    "error": "absolute, in the output's unit (half the difference of the even- and odd-numbered directions' results)",
+    "error": ("absolute, in the output's unit (sky-view factor, occlusion: half the difference of the even- and "
+              "odd-numbered directions' results, with max_error over the Richardson divisor its runs measured; "
+              "horizon angles: the estimated mean interpolation error over azimuth, radians)"),
 }
 _INSOLATION_DIRECT = "hours (direct irradiation from a sun of normal irradiance 1; times W/m^2 it is Wh/m^2)"
 _BOUNCE_IRRADIANCE = ("radiance units times steradians (W/m^2 for W m^-2 sr^-1; flat ground receives 0); a "

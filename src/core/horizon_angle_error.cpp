@@ -178,7 +178,14 @@ HorizonResult runHorizonAnglesToError(double max_error, const std::function<Hori
                          0.5, 3.0);
     const double wanted = std::max<double>(
         directions + 8, directions * std::pow(result.estimated_error / max_error, 1.0 / order) * 1.05);
-    if (earlier > 0 && wanted > kMaxAutoDirections) {  // (from the first run's order alone, no refusal)
+    // Refused only where the prediction is near enough to trust (within the step a run may take;
+    // from the first run's order alone, or from far off, the runs step toward it instead), where
+    // even a fall as K^-3 (the fastest order taken) would need more, or where the last run already
+    // took the most directions.
+    const double fastest = directions * std::pow(result.estimated_error / max_error, 1.0 / 3.0);  // as K^-3
+    if (earlier > 0 && wanted > kMaxAutoDirections &&
+        (wanted <= kHorizonMostStep * directions || directions >= kMaxAutoDirections ||
+         fastest > kMaxAutoDirections)) {
       // In degrees, as the command line takes it.
       std::ostringstream message;
       message << "a maximum mean horizon angle error of " << max_error * 180.0 / M_PI << " degrees needs about "
@@ -191,8 +198,9 @@ HorizonResult runHorizonAnglesToError(double max_error, const std::function<Hori
     // order; later runs go at most kHorizonMostStep times as far, where the order is measured again
     // (it rises with K on smooth fields, and the estimate's fall from 8 to 16 predicts badly far off).
     const int next = earlier == 0 ? kHorizonSecondDirections
-                                  : cheapestDirections(static_cast<int>(std::ceil(
-                                                           std::min(wanted, kHorizonMostStep * directions))),
+                                  : cheapestDirections(static_cast<int>(std::ceil(std::min(
+                                                           {wanted, kHorizonMostStep * directions,
+                                                            double(kMaxAutoDirections)}))),
                                                        work);
     earlier = directions;
     earlier_estimate = result.estimated_error;

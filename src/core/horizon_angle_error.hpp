@@ -46,7 +46,7 @@ double horizonErrorOrder(const SkipErrors& skips);
 constexpr double kHorizonOrderLow = 0.3, kHorizonOrderHigh = 2.0;
 
 // The error estimate of a run's horizon angles (HorizonOutputs::error_estimate with
-// horizon_angles): per pixel kHorizonEstimateFactor * skip_one * 2^-p (p: horizonErrorOrder),
+// horizon_angles): per pixel kHorizonEstimateFactor * skip_one * 2^-p (p the pixel's own order),
 // into result.error_estimate (radians, NaN at nodata), and its mean over the pixels with data
 // into result.estimated_error, where 2^-p is the pixel's own skip-one error over its skip-two
 // error, clamped to the orders kHorizonOrderLow .. kHorizonOrderHigh. 2/3 is the mean of a linear
@@ -82,8 +82,11 @@ constexpr double kHorizonChoiceSpan = 1.25;
 // estimates predict (the error falling as K^-p, p measured between the last two runs within
 // 0.5 .. 3), 5 % more, at most kHorizonMostStep times the last K, each the cheapest by `work`
 // within kHorizonChoiceSpan of that, until
-// the estimate's mean is at most max_error. Throws InvalidArgument past kMaxAutoDirections (in
-// degrees).
+// the estimate's mean is at most max_error (and never past kMaxAutoDirections). Throws
+// InvalidArgument (E in degrees) when a prediction within one such step, a fall as K^-3, or
+// the run at kMaxAutoDirections itself needs more than kMaxAutoDirections. Edge pixels count as they are:
+// the directions whose rays leave the field at once hold -pi/2, and the interpolation between
+// such a direction and its neighbours counts as error there (on small fields a visible share).
 HorizonResult runHorizonAnglesToError(double max_error, const std::function<HorizonResult(int)>& run,
                                       const std::function<double(int)>& work);
 constexpr int kHorizonFirstDirections = 8, kHorizonSecondDirections = 16;
