@@ -62,7 +62,8 @@ class Horizon : public Computation {
   // then, saying what to ask for instead.
   void prepare(HeightField& field) override {
     const double plane = static_cast<double>(field.pixelCount()) * sizeof(float);
-    // (--max-error: K is chosen as the runs go, so checked at the first run's, 16)
+    // (--max-error: K is chosen as the runs go, so checked at the second run's, 16; a later K
+    // that outgrows the host is not refused before it runs: docs/COMMAND_LINE.md says so)
     const int directions = run_.horizon_max_error_deg > 0.0 ? 16 : run_.directions;
     const double planes = plane * directions * (run_.distance_output.empty() ? 1 : 2);
     const double need = 3.0 * planes, available = availableHostBytes();
