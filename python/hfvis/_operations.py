@@ -265,6 +265,18 @@ def _azimuths_deg(options):
     return np.degrees(np.asarray(probe["azimuths"]))
 
 
+def _with_estimate(options, heights, max_error, error_estimate):
+    """Adds max_error and error_estimate to the options; a Dask-backed DataArray is computed, since
+    K and the estimate's mean or percentile are the whole field's: it runs in one piece."""
+    if max_error:
+        options["max_error"] = float(max_error)
+    if error_estimate:
+        options["error_estimate"] = True
+    if _is_dataarray(heights) and _is_dask(heights.data):
+        heights = heights.compute()
+    return heights
+
+
 def horizon_angles(heights, *, directions=64, azimuth_offset=0.0, samples_per_unit=1.0, curvature=0.0,
                    max_distance=0.0, method="sweep", azimuth_tolerance=None, strip_rows=0, memory_budget_bytes=0,
                    max_error=0.0, error_estimate=False, cell_size=None, z_scale=1.0, nodata=None, device="",
@@ -282,12 +294,7 @@ def horizon_angles(heights, *, directions=64, azimuth_offset=0.0, samples_per_un
     common = _common(cell_size, z_scale, nodata, device, progress)
     if not max_error and not error_estimate:
         return _horizon_maps("horizon_angles", "angles", heights, options, common)
-    if max_error:
-        options["max_error"] = float(max_error)
-    if error_estimate:
-        options["error_estimate"] = True
-    if _is_dataarray(heights) and _is_dask(heights.data):
-        heights = heights.compute()  # K and the estimate's mean are the whole field's: in one piece
+    heights = _with_estimate(options, heights, max_error, error_estimate)
     out, grid = _run("horizon_angles", heights, options, common)
     if grid is None:
         return HorizonEstimate(out["angles"], out["azimuths"], out["error"], out["directions"],
@@ -351,12 +358,7 @@ def _swept_quantity(operation, heights, options, max_error, error_estimate, comm
     estimate too, as the CLI's --max-error and --error-out give them."""
     if not max_error and not error_estimate:
         return _single(operation, operation, heights, options, common)
-    if max_error:
-        options["max_error"] = float(max_error)
-    if error_estimate:
-        options["error_estimate"] = True
-    if _is_dataarray(heights) and _is_dask(heights.data):
-        heights = heights.compute()  # K and the estimate's percentile are the whole field's: in one piece
+    heights = _with_estimate(options, heights, max_error, error_estimate)
     out, grid = _run(operation, heights, options, common)
     if grid is None:
         return ErrorEstimate(out[operation], out["error"], out["directions"], out["estimated_error"])
@@ -390,12 +392,7 @@ def intervisibility(heights, *, directions=64, azimuth_offset=0.0, samples_per_u
     common = _common(cell_size, z_scale, nodata, device, progress)
     if not max_error and not error_estimate:
         return _pair("intervisibility", Intervisibility, heights, options, common)
-    if max_error:
-        options["max_error"] = float(max_error)
-    if error_estimate:
-        options["error_estimate"] = True
-    if _is_dataarray(heights) and _is_dask(heights.data):
-        heights = heights.compute()  # K and the estimate's percentile are the whole field's: in one piece
+    heights = _with_estimate(options, heights, max_error, error_estimate)
     out, grid = _run("intervisibility", heights, options, common)
     if grid is None:
         return IntervisibilityEstimate(out["visible_count"], out["visible_area"], out["error"], out["directions"],
