@@ -343,12 +343,21 @@ TEST(RegionVisibility, CullPyramidHoldsEachBlocksHighestCorner) {
 // surface and higher, toward a square across the field (a cone of wedges) and toward their own
 // square (every direction), with curvature and without, on the city's walls and towers, flat ground,
 // terraces, spikes, nodata holes, infinite heights and a cliff of 1e6.
-TEST(RegionVisibility, EndTablesCertifyOnlyClearLines) {
+struct EndTableCounts {
   std::uint64_t lines = 0, whole = 0, part = 0, clear = 0;
-  for (const char* name :
-       {"city", "noise", "flat", "terraces", "spikes", "nan_holes", "infinities", "cliff", "tilted_plane"}) {
+};
+
+// On `names` fields of width x height, 8 x 8 points in squares 24 pixels a side at (ax, ay) and
+// (bx, by) (top-left corners), 3 pixels apart.
+void checkEndTables(const std::vector<const char*>& names, int width, int height, float ax, float ay, float bx,
+                    float by, EndTableCounts& counts) {
+  std::uint64_t& lines = counts.lines;
+  std::uint64_t& whole = counts.whole;
+  std::uint64_t& part = counts.part;
+  std::uint64_t& clear = counts.clear;
+  for (const char* name : names) {
     SCOPED_TRACE(name);
-    HeightField field = makeSyntheticField(name, 160, 130, 11);
+    HeightField field = makeSyntheticField(name, width, height, 11);
     field.cell_size_y = 1.25;
     const std::vector<float> h = detail::prepareHeights(field, detail::HeightOrigin::Zero).heights;
     const detail::CullPyramid pyramid = detail::cullPyramid(h, field.width, field.height);
@@ -378,12 +387,12 @@ TEST(RegionVisibility, EndTablesCertifyOnlyClearLines) {
         }
       return out;
     };
-    const float square_a[4] = {20.0f, 50.0f, 44.0f, 74.0f}, square_b[4] = {115.0f, 60.0f, 139.0f, 84.0f};
+    const float square_a[4] = {ax, ay, ax + 24.0f, ay + 24.0f}, square_b[4] = {bx, by, bx + 24.0f, by + 24.0f};
     for (float above : {0.5f, 2.0f, 6.0f})
       for (float curvature : {0.0f, 0.0005f}) {
-        const std::vector<End> a = ends(20.0f, 50.0f, above, curvature, square_b),
-                               b = ends(115.0f, 60.0f, above, curvature, square_a),
-                               own = ends(20.0f, 50.0f, above, curvature, square_a);
+        const std::vector<End> a = ends(ax, ay, above, curvature, square_b),
+                               b = ends(bx, by, above, curvature, square_a),
+                               own = ends(ax, ay, above, curvature, square_a);
         // The reach from e toward p, as the kernel takes it.
         const auto reach = [&](const End& e, const End& p, float length) {
           const int w = detail::region_end_wedge(e.rec[0], e.rec[1], p.x - e.x, p.y - e.y);
@@ -419,19 +428,38 @@ TEST(RegionVisibility, EndTablesCertifyOnlyClearLines) {
           for (const End& q : b) {
             // q's record toward square a holds p's direction.
             check(p, q);
-            if (HasFatalFailure()) return;
+            if (::testing::Test::HasFatalFailure()) return;
           }
         for (const End& p : own)
           for (const End& q : own) check(p, q);
-        if (HasFatalFailure()) return;
+        if (::testing::Test::HasFatalFailure()) return;
       }
   }
-  std::printf("%llu lines: %llu certified whole, %llu in part, %llu clear\n", (unsigned long long)lines,
-              (unsigned long long)whole, (unsigned long long)part, (unsigned long long)clear);
+}
+
+TEST(RegionVisibility, EndTablesCertifyOnlyClearLines) {
+  EndTableCounts c;
+  checkEndTables({"city", "noise", "flat", "terraces", "spikes", "nan_holes", "infinities", "cliff", "tilted_plane"},
+                 160, 130, 20.0f, 50.0f, 115.0f, 60.0f, c);
+  if (::testing::Test::HasFatalFailure()) return;
+  std::printf("%llu lines: %llu certified whole, %llu in part, %llu clear\n", (unsigned long long)c.lines,
+              (unsigned long long)c.whole, (unsigned long long)c.part, (unsigned long long)c.clear);
   // The tables certify many clear lines whole and many in part, and not every line is clear.
-  EXPECT_GT(whole, clear / 4);
-  EXPECT_GT(part, lines / 20);
-  EXPECT_LT(clear, lines * 9 / 10);
+  EXPECT_GT(c.whole, c.clear / 4);
+  EXPECT_GT(c.part, c.lines / 20);
+  EXPECT_LT(c.clear, c.lines * 9 / 10);
+}
+
+// The same far apart: squares about 1100 pixels apart reach the tables' outer bands (radii of
+// hundreds of pixels, four bands to an octave) and the pyramid's upper levels.
+TEST(RegionVisibility, EndTablesCertifyOnlyClearLinesFarApart) {
+  EndTableCounts c;
+  checkEndTables({"city", "noise", "terraces", "flat"}, 1200, 96, 20.0f, 30.0f, 1150.0f, 40.0f, c);
+  if (::testing::Test::HasFatalFailure()) return;
+  std::printf("%llu lines: %llu certified whole, %llu in part, %llu clear\n", (unsigned long long)c.lines,
+              (unsigned long long)c.whole, (unsigned long long)c.part, (unsigned long long)c.clear);
+  EXPECT_GT(c.whole + c.part, c.lines / 20);  // the far bands are used
+  EXPECT_LT(c.clear, c.lines);
 }
 
 // The bitmask scatter (Eisemann & Décoret 2007) decides from its table what its conservative
