@@ -110,7 +110,7 @@ void estimateHorizonAngleError(HorizonResult& result) {
 
 double horizonAngleErrorAgainst(const HorizonResult& result, const HorizonResult& reference) {
   if (result.width != reference.width || result.height != reference.height || result.angles.empty() ||
-      reference.angles.empty())
+      reference.angles.empty() || result.azimuths.empty() || reference.azimuths.empty())
     throw InvalidArgument("horizonAngleErrorAgainst: two runs' horizon angles of one field");
   const AzimuthOrder order = azimuthOrder(result.azimuths), dense = azimuthOrder(reference.azimuths);
   const std::vector<double> weights = halfGapWeights(dense.azimuth);
