@@ -296,7 +296,8 @@ TEST(RegionVisibility, TheCulledMarchIsTheExactOneNearTheGround) {
 
 // The culling pyramid over a field whose every height is finite (cullPyramid's row-by-row pass):
 // each level's block holds the highest corner of the cells in it, brute force, and the margin and
-// gradient come from the field's largest height, step and twist.
+// gradient come from the field's largest height, step and twist; and the checked path (for fields
+// with non-finite heights) gives the same pyramid on them.
 TEST(RegionVisibility, CullPyramidHoldsEachBlocksHighestCorner) {
   for (const char* name : {"city", "noise", "terraces", "spikes", "tilted_plane"}) {
     SCOPED_TRACE(name);
@@ -306,6 +307,13 @@ TEST(RegionVisibility, CullPyramidHoldsEachBlocksHighestCorner) {
     const int w = field.width, hh = field.height;
     ASSERT_TRUE(pyramid.finite);
     ASSERT_EQ(pyramid.levels, 8);  // 74 x 41 cells, 37 x 21, ..., 2 x 1, 1 x 1
+    // The path for fields with non-finite heights gives the same pyramid, bit for bit.
+    const detail::CullPyramid checked = detail::cullPyramid(h, field.width, field.height, true);
+    EXPECT_EQ(checked.levels, pyramid.levels);
+    EXPECT_EQ(checked.finite, pyramid.finite);
+    EXPECT_EQ(checked.margin, pyramid.margin);
+    EXPECT_EQ(checked.gradient, pyramid.gradient);
+    EXPECT_EQ(checked.top, pyramid.top);
     double largest = 0.0, step = 0.0, twist = 0.0;
     for (int r = 0; r < hh; ++r)
       for (int c = 0; c < w; ++c) {

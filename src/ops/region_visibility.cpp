@@ -493,7 +493,7 @@ void colourLight(RegionVisibilityResult& out, const HeightField& field, const st
 
 namespace detail {
 
-CullPyramid cullPyramid(const std::vector<float>& h, int width, int height) {
+CullPyramid cullPyramid(const std::vector<float>& h, int width, int height, bool checked) {
   CullPyramid out;
   if (width < 2 || height < 2) return out;  // no cells: the march runs uncut
   const auto at = [&](int c, int r) { return h[std::size_t(r) * width + c]; };
@@ -505,7 +505,7 @@ CullPyramid cullPyramid(const std::vector<float>& h, int width, int height) {
   bool any_infinite = false;
   // Every height finite (most fields): the same maxima row by row without the checks (the call's
   // fixed cost: this pass and level 0 took about half of it, bench/report/region_visibility.md).
-  bool all_finite = true;
+  bool all_finite = !checked;
   for (const float v : h) all_finite &= bool(std::isfinite(v));
   // (kLanes running maxima each, so that the maxima do not wait on one another)
   constexpr int kLanes = 8;

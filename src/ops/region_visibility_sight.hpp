@@ -30,7 +30,9 @@ struct CullPyramid {
   bool finite = true;     // every height finite (region_cull_hides need not look)
 };
 
-CullPyramid cullPyramid(const std::vector<float>& h, int width, int height);
+// `checked`: the path for fields with non-finite heights even where every height is finite (the
+// tests compare the two paths; they must give the same pyramid).
+CullPyramid cullPyramid(const std::vector<float>& h, int width, int height, bool checked = false);
 
 // Fills a pair result's clear_pairs, pairs and per-sample fractions from its bits (the samples'
 // counts and words set).
