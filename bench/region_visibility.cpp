@@ -30,6 +30,21 @@ std::vector<double> fastestInterleaved(const std::vector<std::function<void()>>&
   return best;
 }
 
+// `light` by each of `methods`, interleaved: their results and the fastest of `reps` times.
+std::vector<double> timeMethods(const ComputeContext& context, const HeightField& f, const RegionSampling& light,
+                                const std::vector<RegionVisibilityMethod>& methods, int reps,
+                                std::vector<RegionVisibilityResult>& results) {
+  results.assign(methods.size(), {});
+  std::vector<std::function<void()>> bodies;
+  for (std::size_t i = 0; i < methods.size(); ++i)
+    bodies.push_back([&, i] {
+      RegionVisibilityOptions o;
+      o.method = methods[i];
+      results[i] = computeRegionVisibility(context, f, light, o);
+    });
+  return fastestInterleaved(bodies, reps);
+}
+
 const char* name(RegionVisibilityMethod m) { return regionVisibilityMethodName(m); }
 
 double highest(const HeightField& f) {
@@ -82,15 +97,8 @@ void arealightSection(const ComputeContext& context, const HeightField& f, bool 
     const RegionSampling light = gridLight(f, 64, samples, top + 20.0);
     const std::vector<RegionVisibilityMethod> methods = {RegionVisibilityMethod::Viewsheds,
                                                          RegionVisibilityMethod::Culled};
-    std::vector<RegionVisibilityResult> results(methods.size());
-    std::vector<std::function<void()>> bodies;
-    for (std::size_t i = 0; i < methods.size(); ++i)
-      bodies.push_back([&, i] {
-        RegionVisibilityOptions o;
-        o.method = methods[i];
-        results[i] = computeRegionVisibility(context, f, light, o);
-      });
-    const std::vector<double> t = fastestInterleaved(bodies, 1);
+    std::vector<RegionVisibilityResult> results;
+    const std::vector<double> t = timeMethods(context, f, light, methods, 1, results);
     viewshed_per_sample = std::max(viewshed_per_sample, t[0] / samples);
     for (std::size_t i = 0; i < methods.size(); ++i)
       std::printf("| %d | %s | %.3f | %.2f | %.1f | %zu of %.0f |\n", samples, name(methods[i]), t[i],
@@ -148,15 +156,8 @@ void bitmaskSection(const ComputeContext& context, const HeightField& f, int rep
     std::vector<RegionVisibilityMethod> methods = {RegionVisibilityMethod::Culled,
                                                    RegionVisibilityMethod::Bitmask};
     if (samples == 32) methods.push_back(RegionVisibilityMethod::Viewsheds);
-    std::vector<RegionVisibilityResult> results(methods.size());
-    std::vector<std::function<void()>> bodies;
-    for (std::size_t i = 0; i < methods.size(); ++i)
-      bodies.push_back([&, i] {
-        RegionVisibilityOptions o;
-        o.method = methods[i];
-        results[i] = computeRegionVisibility(context, f, light, o);
-      });
-    const std::vector<double> t = fastestInterleaved(bodies, reps);
+    std::vector<RegionVisibilityResult> results;
+    const std::vector<double> t = timeMethods(context, f, light, methods, reps, results);
     if (samples == 32) viewshed_per_sample = t[2] / samples;
     for (std::size_t i = 0; i < methods.size(); ++i)
       std::printf(
