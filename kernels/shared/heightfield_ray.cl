@@ -229,24 +229,23 @@ inline float hf_ray_cast(HFVIS_GLOBAL const float* h, int width, int height,
       // Where the piece turns positive, if it does: s_end.
       float s_end = 1.0f;
       int hit = 0;
-      // g's vertex (its top where bump > 0, its bottom where bump < 0; -1 for none), where needed.
+      // g's vertex (its top where bump > 0, its bottom where bump < 0; -1 for none).
       float sv = -1.0f;
+      if (bump != 0.0f) sv = hf_ray_vertex(f0, f1, bump);
+      // The piece turns positive where it ends above the surface, or where its top is above
+      // (the first root before the vertex); whichever, one root is solved (taken without a
+      // branch per case: which case holds is a toss-up from cell to cell).
+      const int ends_above = f1 > 0.0f;
+      const int top_above = (bump > 0.0f) & (sv > 0.0f) & (sv < 1.0f) & (hf_ray_piece(f0, f1, bump, sv) > 0.0f);
       if (f0 > 0.0f) {
         s_end = 0.0f;
         hit = 1;
-      } else if (f1 > 0.0f) {
-        s_end = hf_ray_entry(f0, f1, bump, 1.0f);
+      } else if (ends_above | top_above) {
+        s_end = hf_ray_entry(f0, f1, bump, ends_above ? 1.0f : sv);
         hit = 1;
-      } else if (bump > 0.0f) {
-        sv = hf_ray_vertex(f0, f1, bump);
-        if (sv > 0.0f && sv < 1.0f && hf_ray_piece(f0, f1, bump, sv) > 0.0f) {
-          s_end = hf_ray_entry(f0, f1, bump, sv);
-          hit = 1;
-        }
       }
       // A view cell not listed last (a segment meets each view cell's square once).
       if (cap > 0 && !(cx >= view_x0 && cx < view_x1 && cy >= view_y0 && cy < view_y1) && *count < cap) {
-        if (bump != 0.0f) sv = hf_ray_vertex(f0, f1, bump);
         // g's range over [0, s_end] against the band -band_hi <= g <= -band_lo.
         const float ge = hf_ray_piece(f0, f1, bump, s_end);
         float g_min = f0 < ge ? f0 : ge, g_max = f0 < ge ? ge : f0;
