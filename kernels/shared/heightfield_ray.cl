@@ -86,7 +86,8 @@ inline float hf_ray_band_point(float f0, float f1, float bump, float s_end, floa
   // mispredicted about every other time.
   const float ge = hf_ray_piece(f0, f1, bump, s_end);
   const int below = f0 < lo;
-  const float root = hf_ray_entry(below ? f0 - lo : hi - f0, below ? f1 - lo : hi - f1, below ? bump : -bump, s_end);
+  const float root =
+      hf_ray_entry(below ? f0 - lo : hi - f0, below ? f1 - lo : hi - f1, below ? bump : -bump, s_end);
   const int f0_in = (f0 >= lo) & (f0 <= hi), ge_in = (ge >= lo) & (ge <= hi);
   const float found = f0_in ? 0.0f : (ge_in ? s_end : root);
   if (f0_in | ge_in | (lo == hi)) return found;  // a band of one height: met to rounding
@@ -236,7 +237,8 @@ inline float hf_ray_cast(HFVIS_GLOBAL const float* h, int width, int height,
       // (the first root before the vertex); whichever, one root is solved (taken without a
       // branch per case: which case holds is a toss-up from cell to cell).
       const int ends_above = f1 > 0.0f;
-      const int top_above = (bump > 0.0f) & (sv > 0.0f) & (sv < 1.0f) & (hf_ray_piece(f0, f1, bump, sv) > 0.0f);
+      const int top_above =
+          (bump > 0.0f) & (sv > 0.0f) & (sv < 1.0f) & (hf_ray_piece(f0, f1, bump, sv) > 0.0f);
       if (f0 > 0.0f) {
         s_end = 0.0f;
         hit = 1;

@@ -7,9 +7,9 @@
 #include <functional>
 #include <vector>
 
-#include "core/opencl_builtins.hpp"
 #include "hfvis/height_field.hpp"
 #include "hfvis/pvs.hpp"
+#include "core/opencl_builtins.hpp"
 
 namespace hfvis::detail {
 
