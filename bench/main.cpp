@@ -29,6 +29,8 @@
 //       the Jaccard index of the visible sets and the disagreements that graze
 //   hfvis_bench viewshed-culling [--levels 1,2,3,4] [--reps N] FIELD...
 //   hfvis_bench pvs-rays | pvs-recall ... city noise dem: the PVS ray caster and samplers (bench/pvs.sh)
+//   hfvis_bench pvs-scalar ... city noise: the caster's shared source as C++ on one core, us per ray
+//       and a checksum of every result (to compare two builds of the caster bit for bit)
 //       Stewart's culling pyramid per field: preprocessing time, memory per finest level kept, and
 //       for valley, ground-level and high observers the culled shares and the exact and culled
 //       viewsheds' times (interleaved, the fastest of N)
@@ -105,6 +107,7 @@ constexpr const char* kUsage =
     "                                [--reference-k K] [--reps N] [--tile T] [--curve KMAX]\n"
     "                                [--output svf-ao|viewcount|horizon]   (horizon: --errors in degrees)\n"
     "       hfvis_bench pvs-rays [--size N] [--rays R] [--reps K] [--dem FILE] FIELD...\n"
+    "       hfvis_bench pvs-scalar [--size N] [--rays R] [--reps K] [--dem FILE] FIELD...\n"
     "       hfvis_bench pvs-recall [--size N] [--view-cell C] [--tile T] [--samples N,N,...]\n"
     "                              [--check-rays R] [--methods agvs,sgvs,per-cell] [--reference yes|no]\n"
     "                              [--dem FILE] FIELD...   (FIELD: city, noise, dem)\n"
@@ -449,6 +452,18 @@ int main(int argc, char** argv) {
         if (k < 1 || k > 12) throw Usage("--levels: finest levels are 1 .. 12");
       const ComputeContext context = ComputeContext::create(ContextOptions::fromEnvironment());
       for (const std::string& path : fields) viewshedCullingReport(context, path, levels, reps);
+      return 0;
+    }
+    if (command == "pvs-scalar") {
+      const int size = std::stoi(args.get("--size", "1024"));
+      const std::string dem = args.get("--dem", "data/jacksboro_fault_dem.exr");
+      const int rays = std::stoi(args.get("--rays", "1000000")), reps = std::stoi(args.get("--reps", "3"));
+      const std::vector<std::string> fields = args.positional();
+      args.rejectUnused();
+      if (fields.empty()) throw Usage("pvs-scalar needs FIELD... (city, noise, dem)");
+      if (size < 2 || rays < 1 || reps < 1)
+        throw Usage("pvs-scalar: --size from 2, --rays and --reps from 1");
+      pvsScalarReport(fields, size, dem, rays, reps);
       return 0;
     }
     if (command == "pvs-rays" || command == "pvs-recall") {

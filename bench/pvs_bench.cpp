@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <random>
 #include <stdexcept>
@@ -100,6 +101,74 @@ void pvsRaysReport(const ComputeContext& context, const std::vector<std::string>
       "casts on one caster (the field uploaded and its pyramid built once, as the samplers cast), and "
       "of %d whole castHeightFieldRays calls, each with its upload and pyramid; %s)\n",
       reps, reps, context.device().name.c_str());
+}
+
+void pvsScalarReport(const std::vector<std::string>& fields, int size, const std::string& dem_path, int rays,
+                     int reps) {
+  std::printf(
+      "| field | rays | us per ray (hit only) | us per ray (with view cells) | checksum (hit only) | (with "
+      "view "
+      "cells) |\n| --- | ---: | ---: | ---: | --- | --- |\n");
+  auto thread_seconds = [] {
+    timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+  };
+  for (const std::string& name : fields) {
+    const HeightField f = pvsBenchField(name, size, dem_path);
+    const PvsGrid grid;
+    const PvsLayout l = pvsLayout(f, grid);
+    std::vector<HeightRay> in = randomViewRays(f, grid, rays, 5);
+    // The caster's order (src/ops/pvs.cpp, originOrder): by the 16 x 16-cell block holding the
+    // origin, clamped into the field, blocks row by row, stable.
+    auto block = [&](const HeightRay& r) {
+      const float x = std::clamp(r.ox, 0.0f, float(l.cells_x - 1)),
+                  y = std::clamp(r.oy, 0.0f, float(l.cells_y - 1));
+      return (int(y) >> 4) * ((l.cells_x >> 4) + 1) + (int(x) >> 4);
+    };
+    std::stable_sort(in.begin(), in.end(),
+                     [&](const HeightRay& a, const HeightRay& b) { return block(a) < block(b); });
+    const std::vector<float> h = detail::rayHeights(f);
+    const detail::RayPyramid p = detail::buildRayPyramid(h, f.width, f.height);
+    const int cap = l.view_x + l.view_y;
+    std::vector<int> pierced(std::size_t(cap) + 1);
+    std::vector<float> pierced_t(std::size_t(cap) + 1);
+    double best[2] = {1e30, 1e30};
+    unsigned long long sums[2] = {0, 0};
+    for (int r = 0; r < reps; ++r)
+      for (int lists = 0; lists < 2; ++lists) {
+        // FNV-1a over the results' words.
+        unsigned long long sum = 1469598103934665603ull;
+        auto mix = [&](std::uint32_t v) { sum = (sum ^ v) * 1099511628211ull; };
+        auto bits = [](float v) {
+          std::uint32_t b;
+          std::memcpy(&b, &v, sizeof b);
+          return b;
+        };
+        const double t0 = thread_seconds();
+        for (const HeightRay& ray : in) {
+          int count = 0, cell = -1;
+          const float t = detail::hf_ray_cast(
+              h.data(), f.width, f.height, p.values.data(), p.levels.data(), p.top, ray.ox, ray.oy, ray.oz,
+              ray.dx, ray.dy, ray.dz, ray.t_max, grid.view_cell, l.view_x, float(grid.band_low),
+              float(grid.band_high), lists ? cap : 0, pierced.data(), pierced_t.data(), 1, &count, &cell);
+          mix(bits(t));
+          mix(std::uint32_t(cell));
+          mix(std::uint32_t(count));
+          for (int j = 0; j < count; ++j) mix(std::uint32_t(pierced[j])), mix(bits(pierced_t[j]));
+        }
+        best[lists] = std::min(best[lists], thread_seconds() - t0);
+        sums[lists] = sum;
+      }
+    std::printf("| %s %dx%d | %d | %.3f | %.3f | %016llx | %016llx |\n", name.c_str(), f.width, f.height,
+                rays, 1e6 * best[0] / rays, 1e6 * best[1] / rays, sums[0], sums[1]);
+    std::fflush(stdout);
+  }
+  std::printf(
+      "\n(kernels/shared/heightfield_ray.cl compiled as C++, one core; view-band rays as pvs-rays casts, in "
+      "the "
+      "caster's order; the fastest of %d; thread CPU time)\n",
+      reps);
 }
 
 void pvsRecallReport(const ComputeContext& context, const std::vector<std::string>& fields, int size,

@@ -23,6 +23,15 @@ HeightField pvsBenchField(const std::string& name, int size, const std::string& 
 void pvsRaysReport(const ComputeContext& context, const std::vector<std::string>& fields, int size,
                    const std::string& dem_path, int rays, int reps);
 
+// Markdown on stdout: the caster's shared source compiled as C++ (kernels/shared/heightfield_ray.cl,
+// the scalar reference) on one core, on pvsRaysReport's rays in the caster's order (by the 16 x
+// 16-cell block of their origin): microseconds of the thread's CPU time per ray with and without
+// the view-cell lists (the fastest of `reps`), and a checksum of every result (t's bits, cell,
+// list entries and their t's bits), which two builds of the caster agree on where they give the
+// same results bit for bit.
+void pvsScalarReport(const std::vector<std::string>& fields, int size, const std::string& dem_path, int rays,
+                     int reps);
+
 // Markdown on stdout: per field, the dense reference's size and time, then for each sampler and
 // budget in `samples` the recall, the estimated and measured pixel error (`check_rays` random
 // view rays), entries and seconds; and AGVS's mixture over its last run. Only the samplers in

@@ -20,6 +20,7 @@
 #include "hfvis_testing/pvs_reference.hpp"
 #include "hfvis_testing/region_visibility_reference.hpp"
 #include "hfvis_testing/synthetic_fields.hpp"
+#include "ops/pvs_ray.hpp"
 #include "test_support.hpp"
 
 namespace hfvis {
@@ -297,7 +298,8 @@ TEST(PvsRayCaster, MemoryBudgetSplitsLaunchesWithTheSameResults) {
 // reads a little more than the last launch's longest group, at least two a ray), so the rest is
 // read after them; then, launch after launch, the lists grow and shrink. Rays one cell above a
 // flat field along it, through view cells of one cell, list every cell they cross; steep ones
-// one or two.
+// one or two. The caster counts the launches whose lists it read again, so the test fails if
+// none was (if it no longer tests that read).
 TEST(PvsRayCaster, ListsLongerThanReadWithTheHitsAreReadToo) {
   forEachLayout([&](const ComputeContext& context) {
     HeightField field;
@@ -329,6 +331,22 @@ TEST(PvsRayCaster, ListsLongerThanReadWithTheHitsAreReadToo) {
     for (std::size_t r = 0; r < in.size(); ++r) longest = std::max<std::size_t>(longest, got.count(r));
     EXPECT_GT(got.view_cell.size(), in.size() * 10);  // many more than two a ray
     EXPECT_GT(longest, 50u);
+    // The same cast on a caster, which says how many launches had their lists read again: the
+    // test holds only where some did (else it shows nothing about that read).
+    detail::withRayCaster(
+        context, field, options.grid, options.memory_budget_bytes, [&](detail::RayCaster& caster) {
+          const detail::RayCasts cast = caster.cast(in, true);
+          EXPECT_GT(cast.lists_read_again, 0);
+          ASSERT_EQ(cast.list_count.size(), in.size());
+          for (std::size_t r = 0; r < in.size(); ++r) {
+            ASSERT_EQ(cast.list_count[r], got.count(r)) << r;
+            for (int j = 0; j < cast.list_count[r]; ++j) {
+              const detail::ViewCellPoint& p = cast.view_cells[cast.list_first[r] + std::size_t(j)];
+              EXPECT_EQ(p.view_cell, got.view_cell[got.first[r] + j]) << r;
+              EXPECT_TRUE(sameFloat(p.t, got.view_t[got.first[r] + j])) << r;
+            }
+          }
+        });
   });
 }
 

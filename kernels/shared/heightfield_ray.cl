@@ -25,8 +25,8 @@
 
 #include "region_visibility_sight.cl"
 
-// The cell (or block of `size` cells: pass p / size) holding coordinate p of a point moving by d:
-// a point on a boundary belongs to the cell the ray enters there.
+// The cell holding coordinate p of a point moving by d: a point on a boundary belongs to the cell
+// the ray enters there.
 inline int hf_ray_cell_of(float p, float d, int cells) {
   const float c = d < 0.0f ? ceil(p) - 1.0f : floor(p);
   return c < 0.0f ? 0 : (c > (float)(cells - 1) ? cells - 1 : (int)c);
@@ -57,20 +57,19 @@ inline float hf_ray_piece(float f0, float f1, float bump, float s) {
 // The least s in [0, s_end] where g turns positive, given g(0) <= 0 < g somewhere in
 // (0, s_end]: the smaller root where g is concave (bump > 0), the larger where convex.
 inline float hf_ray_entry(float f0, float f1, float bump, float s_end) {
-  // g(s) = A s^2 + B s + C.
+  // g(s) = A s^2 + B s + C. The root of the line (A = 0) and those of the quadratic are both
+  // computed and the one that applies taken: a branch on A, which is 0 on every planar cell
+  // (most of a city's), would be mispredicted often (a division by A = 0 gives an infinity or a
+  // NaN, not taken).
   const float A = -bump, B = f1 - f0 + bump, C = f0;
-  float s;
-  if (A == 0.0f) {
-    s = -C / B;
-  } else {
-    float disc = B * B - 4.0f * A * C;
-    disc = disc < 0.0f ? 0.0f : disc;  // a tangent rounded below zero
-    const float root = sqrt(disc);
-    const float q = -0.5f * (B < 0.0f ? B - root : B + root);
-    const float r1 = q / A, r2 = q != 0.0f ? C / q : r1;
-    const float lo = r1 < r2 ? r1 : r2, hi = r1 < r2 ? r2 : r1;
-    s = A < 0.0f ? lo : hi;
-  }
+  const float s_line = -C / B;
+  float disc = B * B - 4.0f * A * C;
+  disc = disc < 0.0f ? 0.0f : disc;  // a tangent rounded below zero
+  const float root = sqrt(disc);
+  const float q = -0.5f * (B < 0.0f ? B - root : B + root);
+  const float r1 = q / A, r2 = q != 0.0f ? C / q : r1;
+  const float lo = r1 < r2 ? r1 : r2, hi = r1 < r2 ? r2 : r1;
+  const float s = A == 0.0f ? s_line : (A < 0.0f ? lo : hi);
   if (isnan(s)) return s_end;
   return s < 0.0f ? 0.0f : (s > s_end ? s_end : s);
 }
@@ -82,11 +81,16 @@ inline float hf_ray_entry(float f0, float f1, float bump, float s_end) {
 // rounding); where rounding puts that root outside a wider band, the vertex or a bisection
 // between a point below and one above.
 inline float hf_ray_band_point(float f0, float f1, float bump, float s_end, float sv, float lo, float hi) {
+  // The ends and the root are all computed and the answer selected: whether an end lies in a
+  // band of one height (H0 = H1) is a matter of rounding, and a branch on it would be
+  // mispredicted about every other time.
   const float ge = hf_ray_piece(f0, f1, bump, s_end);
-  if (f0 >= lo && f0 <= hi) return 0.0f;
-  if (ge >= lo && ge <= hi) return s_end;
-  const float root = f0 < lo ? hf_ray_entry(f0 - lo, f1 - lo, bump, s_end) : hf_ray_entry(hi - f0, hi - f1, -bump, s_end);
-  if (lo == hi) return root;  // a band of one height: met to rounding
+  const int below = f0 < lo;
+  const float root =
+      hf_ray_entry(below ? f0 - lo : hi - f0, below ? f1 - lo : hi - f1, below ? bump : -bump, s_end);
+  const int f0_in = (f0 >= lo) & (f0 <= hi), ge_in = (ge >= lo) & (ge <= hi);
+  const float found = f0_in ? 0.0f : (ge_in ? s_end : root);
+  if (f0_in | ge_in | (lo == hi)) return found;  // a band of one height: met to rounding
   const float g_root = hf_ray_piece(f0, f1, bump, root);
   if (g_root >= lo && g_root <= hi) return root;
   float s_low = f0 < lo ? 0.0f : s_end, s_high = f0 > hi ? 0.0f : s_end;
@@ -163,11 +167,15 @@ inline float hf_ray_cast(HFVIS_GLOBAL const float* h, int width, int height,
   // The surface minus the ray where the last marched cell ended, carried into the next cell
   // when it follows at once (NaN: none).
   float carried = NAN;
+  // The point at t and the cell holding it (cx, cy): a block of 2^k x 2^k cells holds it where
+  // it holds that cell, block (cx >> k, cy >> k) (the cell of x / 2^k, x / 2^k being exact), so
+  // the point's cell is found once per t, not once per level.
+  float x = ox + t * dx, y = oy + t * dy;
+  int cx = hf_ray_cell_of(x, dx, cells_x), cy = hf_ray_cell_of(y, dy, cells_y);
   for (;;) {
-    const float x = ox + t * dx, y = oy + t * dy;
     if (k > 0) {
-      const int size = 1 << k, bw = levels[4 * k], bh = levels[4 * k + 1];
-      const int bx = hf_ray_cell_of(x / (float)size, dx, bw), by = hf_ray_cell_of(y / (float)size, dy, bh);
+      const int size = 1 << k, bw = levels[4 * k];
+      const int bx = cx >> k, by = cy >> k;
       const float ex = hf_ray_crossing((float)((dx < 0.0f ? bx : bx + 1) * size), ox, dx);
       const float ey = hf_ray_crossing((float)((dy < 0.0f ? by : by + 1) * size), oy, dy);
       float te = ex < ey ? ex : ey;
@@ -179,6 +187,10 @@ inline float hf_ray_cast(HFVIS_GLOBAL const float* h, int width, int height,
       if (te > t && !(low - top_height <= above)) {  // above the block (or the block all nodata)
         if (te >= t_hi) return t_hi;
         t = te;
+        x = ox + t * dx;
+        y = oy + t * dy;
+        cx = hf_ray_cell_of(x, dx, cells_x);
+        cy = hf_ray_cell_of(y, dy, cells_y);
         k = k < top ? k + 1 : top;
         carried = NAN;
       } else {
@@ -188,7 +200,6 @@ inline float hf_ray_cast(HFVIS_GLOBAL const float* h, int width, int height,
       continue;
     }
     // One cell: the one holding the point, stepped past the cells whose exit rounding put behind t.
-    int cx = hf_ray_cell_of(x, dx, cells_x), cy = hf_ray_cell_of(y, dy, cells_y);
     float tx = hf_ray_crossing((float)(dx < 0.0f ? cx : cx + 1), ox, dx);
     float ty = hf_ray_crossing((float)(dy < 0.0f ? cy : cy + 1), oy, dy);
     while (tx <= t || ty <= t) {
@@ -219,24 +230,24 @@ inline float hf_ray_cast(HFVIS_GLOBAL const float* h, int width, int height,
       // Where the piece turns positive, if it does: s_end.
       float s_end = 1.0f;
       int hit = 0;
-      // g's vertex (its top where bump > 0, its bottom where bump < 0; -1 for none), where needed.
+      // g's vertex (its top where bump > 0, its bottom where bump < 0; -1 for none).
       float sv = -1.0f;
+      if (bump != 0.0f) sv = hf_ray_vertex(f0, f1, bump);
+      // The piece turns positive where it ends above the surface, or where its top is above
+      // (the first root before the vertex); whichever, one root is solved (taken without a
+      // branch per case: which case holds is a toss-up from cell to cell).
+      const int ends_above = f1 > 0.0f;
+      const int top_above =
+          (bump > 0.0f) & (sv > 0.0f) & (sv < 1.0f) & (hf_ray_piece(f0, f1, bump, sv) > 0.0f);
       if (f0 > 0.0f) {
         s_end = 0.0f;
         hit = 1;
-      } else if (f1 > 0.0f) {
-        s_end = hf_ray_entry(f0, f1, bump, 1.0f);
+      } else if (ends_above | top_above) {
+        s_end = hf_ray_entry(f0, f1, bump, ends_above ? 1.0f : sv);
         hit = 1;
-      } else if (bump > 0.0f) {
-        sv = hf_ray_vertex(f0, f1, bump);
-        if (sv > 0.0f && sv < 1.0f && hf_ray_piece(f0, f1, bump, sv) > 0.0f) {
-          s_end = hf_ray_entry(f0, f1, bump, sv);
-          hit = 1;
-        }
       }
       // A view cell not listed last (a segment meets each view cell's square once).
       if (cap > 0 && !(cx >= view_x0 && cx < view_x1 && cy >= view_y0 && cy < view_y1) && *count < cap) {
-        if (bump != 0.0f) sv = hf_ray_vertex(f0, f1, bump);
         // g's range over [0, s_end] against the band -band_hi <= g <= -band_lo.
         const float ge = hf_ray_piece(f0, f1, bump, s_end);
         float g_min = f0 < ge ? f0 : ge, g_max = f0 < ge ? ge : f0;
@@ -266,6 +277,10 @@ inline float hf_ray_cast(HFVIS_GLOBAL const float* h, int width, int height,
     }
     if (t1 >= t_hi) return t_hi;
     t = t1;
+    x = ox + t * dx;
+    y = oy + t * dy;
+    cx = hf_ray_cell_of(x, dx, cells_x);
+    cy = hf_ray_cell_of(y, dy, cells_y);
     // On through the block that could not be skipped; past it, test blocks again.
     if (t1 < march_to) {
       carried = f1;

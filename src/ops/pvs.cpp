@@ -369,6 +369,7 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
           region{extra * pair, std::size_t(groups), 1};
       st_.queue.enqueueReadBufferRect(s.lists, CL_TRUE, from, origin, region, kLineGroup * cap * pair, 0,
                                       extra * pair, 0, s.extra_lists.data());
+      ++out.lists_read_again;
     }
     const std::size_t base = out.view_cells.size();
     out.view_cells.resize(base + total);

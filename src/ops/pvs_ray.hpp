@@ -51,6 +51,9 @@ struct RayCasts {
   std::vector<std::size_t> list_first;
   std::vector<int> list_count;
   std::vector<ViewCellPoint> view_cells;
+  // Launches whose lists did not all come with the hits: a work-group listed more pairs than the
+  // first read took, and the rest was read after (a statistic, for the tests to see that it ran).
+  int lists_read_again = 0;
 };
 
 // The device ray caster, set up once (heights and pyramid uploaded, program built) for many
