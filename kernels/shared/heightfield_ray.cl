@@ -59,15 +59,16 @@ inline float hf_ray_piece(float f0, float f1, float bump, float s) {
 inline float hf_ray_entry(float f0, float f1, float bump, float s_end) {
   // g(s) = A s^2 + B s + C. The root of the line (A = 0) and those of the quadratic are both
   // computed and the one that applies taken: a branch on A, which is 0 on every planar cell
-  // (most of a city's), would be mispredicted often (a division by A = 0 gives an infinity or a
-  // NaN, not taken).
+  // (most of a city's), would be mispredicted often. Where A = 0 the quadratic's roots are
+  // computed with a divisor of 1 instead (not taken; no division by zero in the C++ reference).
+  // B = 0 with A = 0 is the old code's case too: its infinity or NaN is what the line gives.
   const float A = -bump, B = f1 - f0 + bump, C = f0;
   const float s_line = -C / B;
   float disc = B * B - 4.0f * A * C;
   disc = disc < 0.0f ? 0.0f : disc;  // a tangent rounded below zero
   const float root = sqrt(disc);
   const float q = -0.5f * (B < 0.0f ? B - root : B + root);
-  const float r1 = q / A, r2 = q != 0.0f ? C / q : r1;
+  const float r1 = q / (A == 0.0f ? 1.0f : A), r2 = q != 0.0f ? C / q : r1;
   const float lo = r1 < r2 ? r1 : r2, hi = r1 < r2 ? r2 : r1;
   const float s = A == 0.0f ? s_line : (A < 0.0f ? lo : hi);
   if (isnan(s)) return s_end;
