@@ -111,20 +111,31 @@ struct RegionSurface {
   const HeightField* field = nullptr;
   detail::PreparedHeights prepared;
   detail::CullPyramid pyramid;       // levels 0: none built (the exact march, a field one point thick)
-  float largest = 0.0f;              // the largest finite |height|, 0 if none
-  float top = 0.0f;                  // the highest finite height, -infinity if none
+  // The heights' bounds (`bounded`; a one-shot call leaves them to the routine, which takes them
+  // only where it needs them): the largest finite |height| (0 if none), the highest finite height
+  // (-infinity if none).
+  bool bounded = false;
+  float largest = 0.0f, top = 0.0f;
   cl::Buffer heights, pyramid_top;   // on the device (`device`)
 };
 
-// `field` validated (validateField). `pyramid`: build the culling pyramid; `device`: upload.
-RegionSurface prepareSurface(detail::ContextState& st, const HeightField& field, bool pyramid, bool device) {
+// The largest finite |height| of `h`, 0 if none.
+float largestHeight(const std::vector<float>& h) {
+  float largest = 0.0f;
+  for (const float v : h)
+    if (std::isfinite(v)) largest = std::max(largest, std::fabs(v));
+  return largest;
+}
+
+// `field` validated (validateField). `pyramid`: build the culling pyramid; `device`: upload;
+// `bounded`: take the heights' bounds.
+RegionSurface prepareSurface(detail::ContextState& st, const HeightField& field, bool pyramid, bool device,
+                             bool bounded) {
   RegionSurface out;
   out.field = &field;
   out.prepared = detail::prepareHeights(field, detail::HeightOrigin::Zero);
   const std::vector<float>& h = out.prepared.heights;
-  out.top = fieldTop(h);
-  for (const float v : h)
-    if (std::isfinite(v)) out.largest = std::max(out.largest, std::fabs(v));
+  if (bounded) out.bounded = true, out.largest = largestHeight(h), out.top = fieldTop(h);
   if (pyramid) out.pyramid = detail::cullPyramid(h, field.width, field.height);
   if (!device) return out;
   const auto upload = [&](const std::vector<float>& values) {
@@ -228,7 +239,7 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
     if (certify_sources_ || certify_receivers_) {
       // The tables' bound of the sight lines' end heights: the highest surface plus the largest
       // height over it (an absolute height is bounded by it too).
-      const float surface = surface_.largest;
+      const float surface = surface_.bounded ? surface_.largest : largestHeight(surface_.prepared.heights);
       float above = float(options_.target_height);
       for (const std::vector<float>* table : {&sources_, receivers_})
         for (std::size_t i = 8; table && i < table->size(); i += 5)
@@ -267,7 +278,7 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
       tested_ = detail::deviceBuffer(st_, std::size_t(count_) * 2 * sizeof(cl_uint));
       kernel_ = kernel("region_bitmask_bits");
       setSurface(kernel_)
-          .set("field_top", surface_.top)
+          .set("field_top", surface_.bounded ? surface_.top : fieldTop(surface_.prepared.heights))
           .set("f", device)
           .set("source_points", source_points_buffer_)
           .set("samples", cl_int(samples_))
@@ -866,7 +877,7 @@ RegionVisibilityResult regionVisibility(const ComputeContext& context, const Hei
     own = detail::translateOpenClErrors([&] {
       return prepareSurface(detail::stateOf(context), field,
                             run.method == RegionVisibilityMethod::Culled || run.method == RegionVisibilityMethod::Bitmask,
-                            !viewsheds);
+                            !viewsheds, false);
     });
   const RegionSurface& surface = prepared ? *prepared : own;
   const std::vector<float>& heights = surface.prepared.heights;
@@ -915,7 +926,8 @@ RegionPairVisibilityResult regionPairVisibility(const ComputeContext& context, c
   RegionSurface own;
   if (!prepared)
     own = detail::translateOpenClErrors([&] {
-      return prepareSurface(detail::stateOf(context), field, run.method == RegionVisibilityMethod::Culled, true);
+      return prepareSurface(detail::stateOf(context), field, run.method == RegionVisibilityMethod::Culled, true,
+                            false);
     });
   const RegionSurface& surface = prepared ? *prepared : own;
   const std::vector<float>& heights = surface.prepared.heights;
@@ -952,7 +964,7 @@ RegionField::RegionField(const ComputeContext& context, const HeightField& field
   validateField(field);
   auto state = std::make_shared<State>(context, field);
   state->surface = detail::translateOpenClErrors(
-      [&] { return prepareSurface(detail::stateOf(context), state->field, true, true); });
+      [&] { return prepareSurface(detail::stateOf(context), state->field, true, true, true); });
   state_ = std::move(state);
 }
 
