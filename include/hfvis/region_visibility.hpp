@@ -210,15 +210,17 @@ std::vector<RegionPoint> regionSamplePoints(const HeightField& field, const Regi
 // heights prepared as the kernels take them (z-scaled), the culling pyramid (the culled march's
 // and the bitmask method's) built, both uploaded to the context's device, once. Each call on it
 // then costs only its own samples, tables, marches and results: the one-shot calls below do the
-// same preparation every call (about 9 - 14 ms on a 1024^2 field on a 2-core CPU, most of a hidden
-// region pair's time: bench/report/region_visibility.md). The bits and fractions are the one-shot
-// calls', bit for bit (the one-shot calls prepare the same way and run the same code).
+// same preparation every call (about 9 ms of CPU on a 1024^2 field on a 2-core CPU, a fifth to a
+// quarter of a hidden region pair's: bench/report/region_visibility.md). The bits and fractions
+// are the one-shot calls', bit for bit (the one-shot calls prepare the same way and run the same
+// code).
 //
 // It holds a copy of the field (its heights: later changes to the caller's field are not seen) and
 // of the context (a shared handle: the device buffers live as long as the prepared field); copies
 // of a RegionField share the prepared state. Its device memory (the heights and the pyramid, about
-// 2.3 floats a point: 9.3 MiB for 1024^2) stays held while it lives, besides each call's memory budget. Calls on it
-// run on its context, one at a time as every call on a context (hfvis/device.hpp).
+// 2.3 floats a point: 9.3 MiB for 1024^2) stays held while it lives, besides each call's memory
+// budget. Calls on it run on its context, one at a time as every call on a context
+// (hfvis/device.hpp).
 class RegionField {
  public:
   // Throws InvalidArgument (an empty or inconsistent field, a latitude / longitude grid, a field
