@@ -246,7 +246,8 @@ void pairSection(const ComputeContext& context, const HeightField& f, int reps, 
   const double prepare = fastestInterleaved({[&] {
                                               const double start = processCpuSeconds();
                                               prepared = std::make_unique<RegionField>(context, f);
-                                              prepare_cpu = std::min(prepare_cpu, processCpuSeconds() - start);
+                                              prepare_cpu =
+                                                  std::min(prepare_cpu, processCpuSeconds() - start);
                                             }},
                                             reps)[0];
   std::printf(

@@ -75,7 +75,8 @@ typedef struct {
 
 // A walk from (xr, yr) over the footprint of the far ends' box [sx0, sx1] x [sy0, sy1], nothing
 // pushed yet.
-inline void region_walk_init(RegionBlockWalk* w, float xr, float yr, float sx0, float sy0, float sx1, float sy1) {
+inline void region_walk_init(RegionBlockWalk* w, float xr, float yr, float sx0, float sy0, float sx1,
+                             float sy1) {
   w->top = 0;
   w->xr = xr, w->yr = yr;
   w->fx0 = fmin(xr, sx0), w->fx1 = fmax(xr, sx1), w->fy0 = fmin(yr, sy0), w->fy1 = fmax(yr, sy1);
@@ -124,7 +125,8 @@ inline int region_walk_next(RegionBlockWalk* w, __global const float* pyramid, R
 inline int region_walk_descend(RegionBlockWalk* w, RegionField f, int k, int bx, int by) {
   if (w->top + 4 > REGION_WALK_STACK) return 0;
   const int child = 1 << (k - 1);
-  const int nearest = (w->xr >= (float)((2 * bx + 1) * child)) | (w->yr >= (float)((2 * by + 1) * child)) << 1;
+  const int nearest =
+      (w->xr >= (float)((2 * bx + 1) * child)) | (w->yr >= (float)((2 * by + 1) * child)) << 1;
   for (int c = 3; c >= 0; --c) {
     const int q = c ^ nearest, cx = 2 * bx + (q & 1), cy = 2 * by + (q >> 1);
     if (cx < region_cull_width(f.width, k - 1) && cy < region_cull_width(f.height, k - 1))
@@ -597,7 +599,8 @@ __kernel void region_bitmask_bits(__global const float* h, __global const float*
     if (visit && !all_uncertain && !region_walk_start(&walk, levels, f.width, f.height)) all_uncertain = 1;
     int k, bx, by;
     float x0, y0, near, highest;
-    while (!all_uncertain && region_walk_next(&walk, pyramid, f, 0, &k, &bx, &by, &x0, &y0, &near, &highest)) {
+    while (!all_uncertain &&
+           region_walk_next(&walk, pyramid, f, 0, &k, &bx, &by, &x0, &y0, &near, &highest)) {
       if (highest + out_margin < zr + slope * near) continue;
       if (k > 0) {
         if (!region_walk_descend(&walk, f, k, bx, by)) all_uncertain = 1;

@@ -1108,7 +1108,8 @@ TEST(RegionVisibility, APreparedFieldGivesTheOneShotBits) {
       for (RegionVisibilityMethod method :
            {RegionVisibilityMethod::Exact, RegionVisibilityMethod::Culled, RegionVisibilityMethod::Auto})
         for (int variant = 0; variant < 3; ++variant) {
-          SCOPED_TRACE(std::string(regionVisibilityMethodName(method)) + " variant " + std::to_string(variant));
+          SCOPED_TRACE(std::string(regionVisibilityMethodName(method)) + " variant " +
+                       std::to_string(variant));
           RegionVisibilityOptions options;
           options.method = method;
           options.decorrelate = variant == 1;

@@ -875,9 +875,9 @@ RegionVisibilityResult regionVisibility(const ComputeContext& context, const Hei
   RegionSurface own;
   if (!prepared)
     own = detail::translateOpenClErrors([&] {
-      return prepareSurface(detail::stateOf(context), field,
-                            run.method == RegionVisibilityMethod::Culled || run.method == RegionVisibilityMethod::Bitmask,
-                            !viewsheds, false);
+      const bool pyramid =
+          run.method == RegionVisibilityMethod::Culled || run.method == RegionVisibilityMethod::Bitmask;
+      return prepareSurface(detail::stateOf(context), field, pyramid, !viewsheds, false);
     });
   const RegionSurface& surface = prepared ? *prepared : own;
   const std::vector<float>& heights = surface.prepared.heights;
@@ -926,8 +926,8 @@ RegionPairVisibilityResult regionPairVisibility(const ComputeContext& context, c
   RegionSurface own;
   if (!prepared)
     own = detail::translateOpenClErrors([&] {
-      return prepareSurface(detail::stateOf(context), field, run.method == RegionVisibilityMethod::Culled, true,
-                            false);
+      return prepareSurface(detail::stateOf(context), field, run.method == RegionVisibilityMethod::Culled,
+                            true, false);
     });
   const RegionSurface& surface = prepared ? *prepared : own;
   const std::vector<float>& heights = surface.prepared.heights;

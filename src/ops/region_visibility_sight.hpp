@@ -23,7 +23,8 @@ std::vector<float> regionSampleTable(const HeightField& field, const RegionSampl
 
 // validate(field, sampling) (hfvis/region_visibility.hpp), explicit points checked against
 // `heights` (the field's prepared as HeightOrigin::Zero; nullptr: prepared here).
-void validateSampling(const HeightField& field, const RegionSampling& sampling, const std::vector<float>* heights);
+void validateSampling(const HeightField& field, const RegionSampling& sampling,
+                      const std::vector<float>* heights);
 
 // The culling pyramid of kernels/shared/region_visibility_sight.cl (region_cull_*) over the
 // z-scaled heights, and the part of the march's rounding that a block's height must clear which
