@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <functional>
 #include <limits>
+#include <memory>
 
 #include "hfvis/image_io.hpp"
 #include "hfvis/region_visibility.hpp"
@@ -234,13 +235,31 @@ void crossoverSection(const ComputeContext& context, const HeightField& f, int r
 }
 
 // Region pairs: two squares of `side` pixels (32 x 32 samples each, 2 above the surface), their
-// centres `distance` apart along a row through the field's centre.
+// centres `distance` apart along a row through the field's centre, by the one-shot library call
+// (the field prepared every call) and by the call on a field prepared once (RegionField, as a
+// renderer or a loop over sites calls it; its preparation timed apart), interleaved.
 // `quick`: the culled method alone (exact's column 0), for profiling.
 void pairSection(const ComputeContext& context, const HeightField& f, int reps, bool quick) {
+  // (the preparation's wall and CPU time: the fastest of `reps`)
+  double prepare_cpu = std::numeric_limits<double>::infinity();
+  std::unique_ptr<RegionField> prepared;
+  const double prepare = fastestInterleaved({[&] {
+                                              const double start = processCpuSeconds();
+                                              prepared = std::make_unique<RegionField>(context, f);
+                                              prepare_cpu =
+                                                  std::min(prepare_cpu, processCpuSeconds() - start);
+                                            }},
+                                            reps)[0];
   std::printf(
       "\n#### Region pairs (32 x 32 samples each, 2 above the surface, the squares' centres on one row)"
-      "\n\n| side (px) | distance (px) | exact (ms) | culled (ms) | culled CPU (ms) | culled Mrays/s | "
-      "speed-up | visible fraction | bits differing |\n|---|---|---|---|---|---|---|---|---|\n");
+      "\n\nculled: the one-shot call (computeRegionPairVisibility on the HeightField: the field prepared "
+      "every call); prepared: the call on a RegionField prepared once before the rows (%.1f ms, CPU %.1f "
+      "ms, not in the rows); the three calls interleaved, the fastest of %d; CPU: every thread's, the "
+      "fewest of the runs.\n\n| side (px) | distance (px) | exact (ms) | culled (ms) | culled CPU (ms) | "
+      "culled Mrays/s | speed-up | visible fraction | bits differing | prepared (ms) | prepared CPU (ms) "
+      "| prepared speed-up | prepared bits differing |\n|---|---|---|---|---|---|---|---|---|---|---|---|"
+      "---|\n",
+      prepare * 1e3, prepare_cpu * 1e3, reps);
   struct Case {
     int side, distance;
   };
@@ -251,40 +270,54 @@ void pairSection(const ComputeContext& context, const HeightField& f, int reps, 
     const int row = f.height / 2 - c.side / 2, left = f.width / 2 - c.distance / 2 - c.side / 2;
     a.rectangle = {left, row, left + c.side - 1, row + c.side - 1};
     b.rectangle = {left + c.distance, row, left + c.distance + c.side - 1, row + c.side - 1};
-    RegionPairVisibilityResult exact, culled;
+    RegionPairVisibilityResult exact, culled, on_prepared;
     RegionVisibilityOptions oe, oc;
     oe.method = RegionVisibilityMethod::Exact;
     oc.method = RegionVisibilityMethod::Culled;
-    // (the culled call's CPU time: the fewest seconds of its runs, all threads)
-    double culled_cpu = std::numeric_limits<double>::infinity();
+    // (the culled calls' CPU time: the fewest seconds of their runs, all threads)
+    double culled_cpu = std::numeric_limits<double>::infinity(), prepared_cpu = culled_cpu;
     std::vector<std::function<void()>> bodies = {
         [&] { exact = computeRegionPairVisibility(context, f, a, b, oe); },
         [&] {
           const double start = processCpuSeconds();
           culled = computeRegionPairVisibility(context, f, a, b, oc);
           culled_cpu = std::min(culled_cpu, processCpuSeconds() - start);
+        },
+        [&] {
+          const double start = processCpuSeconds();
+          on_prepared = computeRegionPairVisibility(*prepared, a, b, oc);
+          prepared_cpu = std::min(prepared_cpu, processCpuSeconds() - start);
         }};
     if (quick) bodies[0] = [&] { exact = culled; };
     const std::vector<double> t = fastestInterleaved(bodies, reps);
-    std::printf("| %d | %d | %.1f | %.1f | %.1f | %.1f | %.1f | %.3f | %zu |\n", c.side, c.distance,
-                t[0] * 1e3, t[1] * 1e3, culled_cpu * 1e3, 1024.0 * 1024.0 / t[1] * 1e-6, t[0] / t[1],
-                double(culled.clear_pairs) / double(culled.pairs), differingBits(exact.bits, culled.bits));
+    std::printf("| %d | %d | %.1f | %.1f | %.1f | %.1f | %.1f | %.3f | %zu | %.1f | %.1f | %.1f | %zu |\n",
+                c.side, c.distance, t[0] * 1e3, t[1] * 1e3, culled_cpu * 1e3, 1024.0 * 1024.0 / t[1] * 1e-6,
+                t[0] / t[1], double(culled.clear_pairs) / double(culled.pairs),
+                differingBits(exact.bits, culled.bits), t[2] * 1e3, prepared_cpu * 1e3, t[0] / t[2],
+                differingBits(exact.bits, on_prepared.bits));
   }
   // The call's cost outside the marches: one sample each side.
   RegionSampling a, b;
   a.samples = b.samples = 1;
   a.rectangle = {f.width / 2 - 40, f.height / 2, f.width / 2 - 40, f.height / 2};
   b.rectangle = {f.width / 2 + 40, f.height / 2, f.width / 2 + 40, f.height / 2};
-  double fixed_cpu = std::numeric_limits<double>::infinity();
-  const double fixed = fastestInterleaved({[&] {
-                                            const double start = processCpuSeconds();
-                                            computeRegionPairVisibility(context, f, a, b, {});
-                                            fixed_cpu = std::min(fixed_cpu, processCpuSeconds() - start);
-                                          }},
-                                          reps)[0];
+  double fixed_cpu = std::numeric_limits<double>::infinity(), fixed_prepared_cpu = fixed_cpu;
+  const std::vector<double> fixed = fastestInterleaved(
+      {[&] {
+         const double start = processCpuSeconds();
+         computeRegionPairVisibility(context, f, a, b, {});
+         fixed_cpu = std::min(fixed_cpu, processCpuSeconds() - start);
+       },
+       [&] {
+         const double start = processCpuSeconds();
+         computeRegionPairVisibility(*prepared, a, b, {});
+         fixed_prepared_cpu = std::min(fixed_prepared_cpu, processCpuSeconds() - start);
+       }},
+      reps);
   std::printf(
-      "\nA 1 x 1 pair (the call's fixed cost: the field's upload, the pyramid): %.1f ms (CPU %.1f ms).\n",
-      fixed * 1e3, fixed_cpu * 1e3);
+      "\nA 1 x 1 pair (the call's fixed cost: the field's upload, the pyramid): %.1f ms (CPU %.1f ms); on "
+      "the prepared field: %.1f ms (CPU %.1f ms).\n",
+      fixed[0] * 1e3, fixed_cpu * 1e3, fixed[1] * 1e3, fixed_prepared_cpu * 1e3);
 }
 
 // The visible fraction at S = 1024 (and 256) against a reference of 16384 samples (four seeds of

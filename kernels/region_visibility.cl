@@ -59,6 +59,82 @@ int region_outside_wedge(float xr, float yr, const float* wedge, float x0, float
   return left == 4 || right == 4;
 }
 
+// A depth-first walk over the pyramid's blocks that may reach a shaft from the receiver (xr, yr):
+// the blocks meeting the footprint (the box fx0, fy0 .. fx1, fy1 around the receiver and the far
+// ends) and, when `wedged`, not wholly beyond one of the wedge's edges (region_wedge). The shaft
+// test (region_shaft_clear) and the bitmask scatter (region_bitmask_bits) both walk the blocks
+// this way; each decides per block whether to descend (region_walk_descend).
+#define REGION_WALK_STACK 64
+typedef struct {
+  int k[REGION_WALK_STACK], x[REGION_WALK_STACK], y[REGION_WALK_STACK];
+  int top;
+  float xr, yr, fx0, fy0, fx1, fy1;
+  int wedged;
+  float wedge[4];
+} RegionBlockWalk;
+
+// A walk from (xr, yr) over the footprint of the far ends' box [sx0, sx1] x [sy0, sy1], nothing
+// pushed yet.
+inline void region_walk_init(RegionBlockWalk* w, float xr, float yr, float sx0, float sy0, float sx1,
+                             float sy1) {
+  w->top = 0;
+  w->xr = xr, w->yr = yr;
+  w->fx0 = fmin(xr, sx0), w->fx1 = fmax(xr, sx1), w->fy0 = fmin(yr, sy0), w->fy1 = fmax(yr, sy1);
+  w->wedged = region_wedge(xr, yr, sx0, sy0, sx1, sy1, w->wedge);
+}
+
+// Pushes the top level's blocks (`levels` > 0); 0 when the stack cannot hold them (the caller
+// then decides nothing from the walk).
+inline int region_walk_start(RegionBlockWalk* w, int levels, int width, int height) {
+  const int last = levels - 1;
+  for (int by = 0; by < region_cull_width(height, last); ++by)
+    for (int bx = 0; bx < region_cull_width(width, last); ++bx) {
+      if (w->top == REGION_WALK_STACK) return 0;
+      w->k[w->top] = last, w->x[w->top] = bx, w->y[w->top] = by, ++w->top;
+    }
+  return 1;
+}
+
+// The next block of the walk: its level *k and indices (*bx, *by), its box's first corner (*x0,
+// *y0), its ground distance from the receiver (*near) and its pyramid value (*highest); blocks
+// wholly inside `skip` (x0, y0, x1, y1; 0: none) are passed over. 0 when the walk is done.
+inline int region_walk_next(RegionBlockWalk* w, __global const float* pyramid, RegionField f,
+                            const float* skip, int* k, int* bx, int* by, float* x0, float* y0, float* near,
+                            float* highest) {
+  while (w->top > 0) {
+    --w->top;
+    const int kk = w->k[w->top], ix = w->x[w->top], iy = w->y[w->top];
+    const float bx0 = (float)(ix << kk), by0 = (float)(iy << kk);
+    const float bx1 = fmin((float)((ix + 1) << kk), (float)(f.width - 1)),
+                by1 = fmin((float)((iy + 1) << kk), (float)(f.height - 1));
+    if (bx1 < w->fx0 || bx0 > w->fx1 || by1 < w->fy0 || by0 > w->fy1) continue;
+    if (skip && bx0 >= skip[0] && bx1 <= skip[2] && by0 >= skip[1] && by1 <= skip[3]) continue;
+    if (w->wedged && region_outside_wedge(w->xr, w->yr, w->wedge, bx0, by0, bx1, by1)) continue;
+    const float ddx = fmax(0.0f, fmax(bx0 - w->xr, w->xr - bx1)) * f.cell_x,
+                ddy = fmax(0.0f, fmax(by0 - w->yr, w->yr - by1)) * f.cell_y;
+    *near = sqrt(ddx * ddx + ddy * ddy);
+    *highest = pyramid[region_cull_offset(f.width, f.height, kk) + iy * region_cull_width(f.width, kk) + ix];
+    *k = kk, *bx = ix, *by = iy, *x0 = bx0, *y0 = by0;
+    return 1;
+  }
+  return 0;
+}
+
+// Pushes the children of block (k > 0, bx, by) that lie inside their level, the one nearest the
+// receiver last, so visited first (near cells decide the most); 0 when the stack cannot hold them.
+inline int region_walk_descend(RegionBlockWalk* w, RegionField f, int k, int bx, int by) {
+  if (w->top + 4 > REGION_WALK_STACK) return 0;
+  const int child = 1 << (k - 1);
+  const int nearest =
+      (w->xr >= (float)((2 * bx + 1) * child)) | (w->yr >= (float)((2 * by + 1) * child)) << 1;
+  for (int c = 3; c >= 0; --c) {
+    const int q = c ^ nearest, cx = 2 * bx + (q & 1), cy = 2 * by + (q >> 1);
+    if (cx < region_cull_width(f.width, k - 1) && cy < region_cull_width(f.height, k - 1))
+      w->k[w->top] = k - 1, w->x[w->top] = cx, w->y[w->top] = cy, ++w->top;
+  }
+  return 1;
+}
+
 // Whether every segment from the receiver (xr, yr, zr) to the n samples (xs, ys, zs) is clear of
 // the surface outside the box of grid lines around the receiver (REGION_NEAR_CELLS cells each
 // side of its point, *box: x0, y0, x1, y1), by the margins of the culled march: every block of
@@ -91,38 +167,15 @@ int region_shaft_clear(__global const float* h, __global const float* pyramid, i
   box[3] = fmin((float)(f.height - 1), ceil(yr) + REGION_NEAR_CELLS);
   // The footprint: its bounding box, and (receiver outside the samples' box) the wedge's two
   // edges, toward the samples' corners most counter-clockwise and most clockwise.
-  const float fx0 = fmin(xr, sx0), fx1 = fmax(xr, sx1), fy0 = fmin(yr, sy0), fy1 = fmax(yr, sy1);
-  float wedge[4];
-  const int wedged = region_wedge(xr, yr, sx0, sy0, sx1, sy1, wedge);
-  int stack_k[64], stack_x[64], stack_y[64], top = 0;
-  const int last = levels - 1;
-  for (int by = 0; by < region_cull_width(f.height, last); ++by)
-    for (int bx = 0; bx < region_cull_width(f.width, last); ++bx) {
-      if (top == 64) return 0;
-      stack_k[top] = last, stack_x[top] = bx, stack_y[top] = by, ++top;
-    }
-  while (top > 0) {
-    --top;
-    const int k = stack_k[top], bx = stack_x[top], by = stack_y[top];
-    const float x0 = (float)(bx << k), y0 = (float)(by << k);
-    const float x1 = fmin((float)((bx + 1) << k), (float)(f.width - 1)),
-                y1 = fmin((float)((by + 1) << k), (float)(f.height - 1));
-    if (x1 < fx0 || x0 > fx1 || y1 < fy0 || y0 > fy1) continue;
-    if (x0 >= box[0] && x1 <= box[2] && y0 >= box[1] && y1 <= box[3]) continue;
-    if (wedged && region_outside_wedge(xr, yr, wedge, x0, y0, x1, y1)) continue;
-    const float ddx = fmax(0.0f, fmax(x0 - xr, xr - x1)) * f.cell_x,
-                ddy = fmax(0.0f, fmax(y0 - yr, yr - y1)) * f.cell_y;
-    const float near = sqrt(ddx * ddx + ddy * ddy);
+  RegionBlockWalk walk;
+  region_walk_init(&walk, xr, yr, sx0, sy0, sx1, sy1);
+  if (!region_walk_start(&walk, levels, f.width, f.height)) return 0;
+  int k, bx, by;
+  float x0, y0, near, highest;
+  while (region_walk_next(&walk, pyramid, f, box, &k, &bx, &by, &x0, &y0, &near, &highest)) {
     const float lowest = zr + slope * (slope >= 0.0f ? near : far);
-    const float highest =
-        pyramid[region_cull_offset(f.width, f.height, k) + by * region_cull_width(f.width, k) + bx];
     if (highest + clearance < lowest) continue;
-    if (k == 0 || top + 4 > 64) return 0;
-    for (int c = 0; c < 4; ++c) {
-      const int cx = 2 * bx + (c & 1), cy = 2 * by + (c >> 1);
-      if (cx < region_cull_width(f.width, k - 1) && cy < region_cull_width(f.height, k - 1))
-        stack_k[top] = k - 1, stack_x[top] = cx, stack_y[top] = cy, ++top;
-    }
+    if (k == 0 || !region_walk_descend(&walk, f, k, bx, by)) return 0;
   }
   return 1;
 }
@@ -164,10 +217,9 @@ __kernel void region_end_tables(__global const float* h, __global const float* p
   } else {
     region_sample(table, h, f.width, f.height, absolute, seed, 0U, s, &x, &y, &z);
   }
-  float rec[REGION_END_RECORD];
+  // (written in place, band by band: region_end_table keeps 3 * REGION_END_WEDGES floats of its own)
   region_end_table(pyramid, levels, f.width, f.height, margin, f.curvature, f.cell_x, f.cell_y, x, y, z,
-                   z_bound, other.x, other.y, other.z, other.w, rec);
-  for (int i = 0; i < REGION_END_RECORD; ++i) records[(size_t)s * REGION_END_RECORD + i] = rec[i];
+                   z_bound, other.x, other.y, other.z, other.w, records + (size_t)s * REGION_END_RECORD);
 }
 
 __kernel void region_visibility_bits(__global const float* h, __global const float* pyramid, int levels,
@@ -539,50 +591,19 @@ __kernel void region_bitmask_bits(__global const float* h, __global const float*
     // Front faces culled only under a light above every point of the surfaces (the field's
     // highest plus the rounding).
     const int light_above = Z > field_top + 2.0f * out_margin;
-    const float fx0 = fmin(xr, lo_x), fx1 = fmax(xr, hi_x), fy0 = fmin(yr, lo_y), fy1 = fmax(yr, hi_y);
-    float wedge[4];
-    const int wedged = region_wedge(xr, yr, lo_x, lo_y, hi_x, hi_y, wedge);
-    int stack_k[64], stack_x[64], stack_y[64], top = 0;
-    const int last = levels - 1;  // (no pyramid: no cells, a field one point thick)
-    // (none where the receiver's own cells hide every sample)
+    RegionBlockWalk walk;
+    region_walk_init(&walk, xr, yr, lo_x, lo_y, hi_x, hi_y);
+    // (no pyramid: no cells, a field one point thick; none where the receiver's own cells hide
+    // every sample)
     const int visit = levels > 0 && !region_bitmask_all(near_hidden, near_hidden, samples);
-    for (int by = 0; visit && by < region_cull_width(f.height, last) && !all_uncertain; ++by)
-      for (int bx = 0; bx < region_cull_width(f.width, last); ++bx) {
-        if (top == 64) {
-          all_uncertain = 1;
-          break;
-        }
-        stack_k[top] = last, stack_x[top] = bx, stack_y[top] = by, ++top;
-      }
-    while (top > 0 && !all_uncertain) {
-      --top;
-      const int k = stack_k[top], bx = stack_x[top], by = stack_y[top];
-      const float x0 = (float)(bx << k), y0 = (float)(by << k);
-      const float x1 = fmin((float)((bx + 1) << k), (float)(f.width - 1)),
-                  y1 = fmin((float)((by + 1) << k), (float)(f.height - 1));
-      if (x1 < fx0 || x0 > fx1 || y1 < fy0 || y0 > fy1) continue;
-      if (wedged && region_outside_wedge(xr, yr, wedge, x0, y0, x1, y1)) continue;
-      const float ddx = fmax(0.0f, fmax(x0 - xr, xr - x1)) * f.cell_x,
-                  ddy = fmax(0.0f, fmax(y0 - yr, yr - y1)) * f.cell_y;
-      const float near = sqrt(ddx * ddx + ddy * ddy);
-      const float highest =
-          pyramid[region_cull_offset(f.width, f.height, k) + by * region_cull_width(f.width, k) + bx];
+    if (visit && !all_uncertain && !region_walk_start(&walk, levels, f.width, f.height)) all_uncertain = 1;
+    int k, bx, by;
+    float x0, y0, near, highest;
+    while (!all_uncertain &&
+           region_walk_next(&walk, pyramid, f, 0, &k, &bx, &by, &x0, &y0, &near, &highest)) {
       if (highest + out_margin < zr + slope * near) continue;
       if (k > 0) {
-        if (top + 4 > 64) {
-          all_uncertain = 1;
-          break;
-        }
-        // The child nearest the receiver last, so first visited: near cells hide the most
-        // samples, and once every sample is surely hidden the visit stops.
-        const int child = 1 << (k - 1);
-        const int nearest = (xr >= (float)((2 * bx + 1) * child)) | (yr >= (float)((2 * by + 1) * child))
-                                                                        << 1;
-        for (int c = 3; c >= 0; --c) {
-          const int q = c ^ nearest, cx = 2 * bx + (q & 1), cy = 2 * by + (q >> 1);
-          if (cx < region_cull_width(f.width, k - 1) && cy < region_cull_width(f.height, k - 1))
-            stack_k[top] = k - 1, stack_x[top] = cx, stack_y[top] = cy, ++top;
-        }
+        if (!region_walk_descend(&walk, f, k, bx, by)) all_uncertain = 1;
         continue;
       }
       if (bx >= xi - 1 && bx <= xi && by >= yi - 1 && by <= yi) continue;  // the receiver's own

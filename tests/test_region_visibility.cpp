@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <set>
 #include <string>
 
@@ -1055,18 +1056,136 @@ TEST(RegionVisibility, EachSampleTakesTheColourWhereItLies) {
   });
 }
 
+// A prepared field (RegionField: heights and pyramid built and uploaded once) gives the one-shot
+// calls' results, bit for bit, call after call on the same object: region pairs by every method a
+// pair takes (decorrelated, curved, explicit points), area lights by the culled march, the bitmask
+// scatter, the exact march and the viewsheds, in both layouts, with one-shot calls on another field
+// in between on the same context; and it keeps its own copy of the field (the caller's heights
+// changed after preparing change nothing).
+TEST(RegionVisibility, APreparedFieldGivesTheOneShotBits) {
+  std::uint64_t clear = 0, pairs = 0;
+  int calls = 0;
+  for (const char* name : {"city", "noise", "nan_holes", "terraces"}) {
+    SCOPED_TRACE(name);
+    HeightField field = makeSyntheticField(name, 101, 77, 5);
+    field.cell_size_y = 1.25;
+    const HeightField other = makeSyntheticField("spikes", 64, 48, 9);
+    const std::vector<float> h = detail::prepareHeights(field, detail::HeightOrigin::Zero).heights;
+    double top = -1e30;
+    for (float v : h)
+      if (std::isfinite(v)) top = std::max(top, double(v));
+    forEachLayout([&](const ComputeContext& context) {
+      HeightField callers = field;
+      const RegionField prepared(context, callers);
+      // (the caller's field changed afterwards: the prepared one keeps its copy)
+      for (float& v : callers.heights) v = 2.0f * v + 50.0f;
+      ASSERT_EQ(prepared.field().heights.size(), field.heights.size());
+      EXPECT_EQ(std::memcmp(prepared.field().heights.data(), field.heights.data(),
+                            field.heights.size() * sizeof(float)),
+                0);
+      RegionSampling a, b;
+      a.rectangle = {2, 3, 30, 40};
+      b.rectangle = {98, 70, 60, 20};
+      a.samples = 70, b.samples = 48;
+      a.height = 1.0, b.height = 2.5;
+      try {
+        validate(field, a), validate(field, b);
+      } catch (const InvalidArgument&) {  // nodata under a rectangle: points over valid surface instead
+        a = {}, b = {};
+        for (int i = 0; i < 80; ++i) {
+          const double x = 1.0 + (i * 37) % 97 + 0.25, y = 1.0 + (i * 53) % 73 + 0.5;
+          const float s = detail::region_surface_at(h.data(), field.width, field.height, float(x), float(y));
+          if (std::isfinite(s)) (i % 2 ? a : b).points.push_back({x, y, double(s) + 1.5});
+        }
+        ASSERT_GT(a.points.size(), 4u);
+        ASSERT_GT(b.points.size(), 4u);
+        a.absolute = b.absolute = true;
+      }
+      RegionSampling tiny;  // the other field's: one point each side
+      tiny.rectangle = {1, 1, 1, 1};
+      RegionSampling tiny_far = tiny;
+      tiny_far.rectangle = {60, 40, 60, 40};
+      for (RegionVisibilityMethod method :
+           {RegionVisibilityMethod::Exact, RegionVisibilityMethod::Culled, RegionVisibilityMethod::Auto})
+        for (int variant = 0; variant < 3; ++variant) {
+          SCOPED_TRACE(std::string(regionVisibilityMethodName(method)) + " variant " +
+                       std::to_string(variant));
+          RegionVisibilityOptions options;
+          options.method = method;
+          options.decorrelate = variant == 1;
+          options.curvature = variant == 2 ? 0.0005 : 0.0;
+          options.max_distance = variant == 2 ? 90.0 : 0.0;
+          const RegionPairVisibilityResult got = computeRegionPairVisibility(prepared, a, b, options);
+          // (another field on the same context between the calls)
+          (void)computeRegionPairVisibility(context, other, tiny, tiny_far, options);
+          const RegionPairVisibilityResult want = computeRegionPairVisibility(context, field, a, b, options);
+          ASSERT_EQ(got.bits, want.bits);
+          EXPECT_EQ(got.source_fraction, want.source_fraction);
+          EXPECT_EQ(got.receiver_fraction, want.receiver_fraction);
+          ASSERT_EQ(got.receivers.size(), want.receivers.size());
+          for (std::size_t i = 0; i < got.receivers.size(); ++i)
+            EXPECT_EQ(got.receivers[i].height, want.receivers[i].height);
+          clear += got.clear_pairs, pairs += got.pairs, ++calls;
+        }
+      // Area lights: a planar one (the bitmask scatter, the default's pick at 64 samples) and one
+      // above the surface; a one-point light by the viewsheds.
+      RegionSampling light = sourcesIn(field, 64, top + 3.0, true);
+      RegionSampling low = sourcesIn(field, 40, 2.0, false);
+      RegionSampling point = light;
+      point.rectangle.col1 = point.rectangle.col0, point.rectangle.row1 = point.rectangle.row0;
+      point.samples = 1;
+      const std::pair<const RegionSampling*, RegionVisibilityMethod> runs[] = {
+          {&light, RegionVisibilityMethod::Auto},
+          {&light, RegionVisibilityMethod::Culled},
+          {&low, RegionVisibilityMethod::Exact},
+          {&low, RegionVisibilityMethod::Culled},
+          {&point, RegionVisibilityMethod::Viewsheds}};
+      for (const auto& [sources, method] : runs) {
+        SCOPED_TRACE(regionVisibilityMethodName(method));
+        RegionVisibilityOptions options;
+        options.method = method;
+        options.target_height = 0.5;
+        const RegionVisibilityResult got = computeRegionVisibility(prepared, *sources, options);
+        const RegionVisibilityResult want = computeRegionVisibility(context, field, *sources, options);
+        EXPECT_EQ(got.method, want.method);
+        EXPECT_EQ(got.exact_tested, want.exact_tested);
+        ASSERT_EQ(got.bits, want.bits);
+        for (std::size_t p = 0; p < got.fraction.size(); ++p)
+          ASSERT_TRUE(got.fraction[p] == want.fraction[p] ||
+                      (std::isnan(got.fraction[p]) && std::isnan(want.fraction[p])))
+              << "fraction at " << p;
+        ++calls;
+      }
+    });
+  }
+  EXPECT_EQ(calls, 4 * 2 * (9 + 5));
+  // Both answers occur often among the pairs.
+  EXPECT_GT(clear, pairs / 20);
+  EXPECT_LT(clear, pairs * 19 / 20);
+}
+
 TEST(RegionVisibility, BadInputIsRefused) {
   HeightField field = makeSyntheticField("noise", 20, 10);
   field.heights[5 * 20 + 5] = std::numeric_limits<float>::quiet_NaN();
   const ComputeContext& context = testContext();
+  const RegionField prepared(context, field);
+  // Each refused by the one-shot call and by the call on the prepared field, which checks the
+  // samples against its own prepared heights.
   auto refused = [&](RegionSampling s, RegionVisibilityOptions o, const std::string& says) {
-    try {
-      computeRegionVisibility(context, field, s, o);
-      ADD_FAILURE() << "accepted; expected an error saying " << says;
-    } catch (const InvalidArgument& e) {
-      EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
-    }
+    for (bool on_prepared : {false, true})
+      try {
+        if (on_prepared)
+          computeRegionVisibility(prepared, s, o);
+        else
+          computeRegionVisibility(context, field, s, o);
+        ADD_FAILURE() << "accepted" << (on_prepared ? " on the prepared field" : "")
+                      << "; expected an error saying " << says;
+      } catch (const InvalidArgument& e) {
+        EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+      }
   };
+  // A prepared field is checked as the calls check theirs.
+  EXPECT_THROW(RegionField(context, HeightField{}), InvalidArgument);
   RegionSampling good;
   good.rectangle = {0, 0, 3, 3};
   RegionVisibilityOptions options;
@@ -1107,6 +1226,7 @@ TEST(RegionVisibility, BadInputIsRefused) {
   latlon.row_cell_size_x.assign(field.height, 1.0);
   latlon.row_cell_size_y.assign(field.height, 1.0);
   EXPECT_THROW(computeRegionVisibility(context, latlon, good, options), InvalidArgument);
+  EXPECT_THROW(RegionField(context, latlon), InvalidArgument);
   // A light image: of 3 * width * height finite values >= 0, over a rectangle, every-pixel receivers.
   o = options;
   o.light_image.width = 2, o.light_image.height = 2;
@@ -1153,6 +1273,9 @@ TEST(RegionVisibility, BadInputIsRefused) {
   // A region pair checks both regions.
   EXPECT_THROW(computeRegionPairVisibility(context, field, good, s, options), InvalidArgument);
   EXPECT_THROW(computeRegionPairVisibility(context, field, s, good, options), InvalidArgument);
+  EXPECT_THROW(computeRegionPairVisibility(prepared, good, s, options), InvalidArgument);
+  EXPECT_THROW(computeRegionPairVisibility(prepared, s, good, options), InvalidArgument);
+  EXPECT_THROW(computeRegionPairVisibility(prepared, plane, plane, o), InvalidArgument);
 }
 
 }  // namespace

@@ -446,7 +446,7 @@ inline int region_end_wedge(float first, float span, float x, float y) {
 inline void region_end_table(HFVIS_GLOBAL const float* pyramid, int levels, int width, int height,
                              float margin, float curvature, float cell_x, float cell_y, float ex, float ey,
                              float ez, float z_bound, float ox0, float oy0, float ox1, float oy1,
-                             float* rec) {
+                             HFVIS_GLOBAL float* rec) {
   const float grow = 0.01f, turn_grow = 1e-4f;
   float first = 0.0f, span = 4.0f, far2 = 0.0f;
   for (int c = 0; c < 4; ++c) {
@@ -468,14 +468,23 @@ inline void region_end_table(HFVIS_GLOBAL const float* pyramid, int levels, int 
   int bands = 1;
   while (bands < REGION_END_BANDS && region_band_edge(bands) * region_band_edge(bands) < far2) ++bands;
   rec[0] = first, rec[1] = span, rec[2] = (float)bands, rec[3] = 0.0f;
-  // The bands' values first (the rising maxima's place), the required slopes after.
-  for (int i = 4; i < REGION_END_RECORD; ++i) rec[i] = -INFINITY;
+  // The clearance (for the longest line and both ends' heights at their bound), known before the
+  // bands, so that each band's required slopes follow from its values at once: only the band's
+  // values and the running maxima (3 * REGION_END_WEDGES floats) are kept, the record is written
+  // band by band (a private copy of the whole record, REGION_END_RECORD = 644 floats, would spill
+  // from a GPU's registers).
+  const float cell = fmax(cell_x, cell_y), cdd = curvature * far2 * cell * cell;
+  const float clearance =
+      margin + 1e-5f * (4.0f * (fabs(ez) + z_bound) + fabs(cdd)) + (cdd > 0.0f ? 0.25f * cdd : 0.0f);
+  float value[REGION_END_WEDGES], up_max[REGION_END_WEDGES], down_max[REGION_END_WEDGES];
+  for (int w = 0; w < REGION_END_WEDGES; ++w) up_max[w] = down_max[w] = -INFINITY;
   // The unit directions of the cone's edges, for the bands' bounding boxes.
   float ux0, uy0, ux1, uy1;
   region_pseudo_direction(first, &ux0, &uy0);
   region_pseudo_direction(region_turn(first + span), &ux1, &uy1);
   for (int b = 0; b < bands; ++b) {
     const float r0 = region_band_edge(b), r1 = region_band_edge(b + 1);
+    for (int w = 0; w < REGION_END_WEDGES; ++w) value[w] = -INFINITY;
     int k = 0;
     while (k + 1 < levels && (float)(8 << k) <= r0) ++k;
     // The band's box: the cone's edges at both radii, and the axis directions within it at r1.
@@ -531,30 +540,24 @@ inline void region_end_table(HFVIS_GLOBAL const float* pyramid, int levels, int 
           const int w0 = (int)(fmax(a, 0.0f) * ((float)REGION_END_WEDGES / span));
           int w1 = (int)(fmin(z, span) * ((float)REGION_END_WEDGES / span));
           w1 = w1 < REGION_END_WEDGES - 1 ? w1 : REGION_END_WEDGES - 1;
-          for (int w = w0; w <= w1; ++w) {
-            float* v = rec + 4 + 2 * w * REGION_END_BANDS + b;
-            *v = fmax(*v, top);
-          }
+          for (int w = w0; w <= w1; ++w) value[w] = fmax(value[w], top);
         }
       }
-  }
-  const float cell = fmax(cell_x, cell_y), cdd = curvature * far2 * cell * cell;
-  const float clearance =
-      margin + 1e-5f * (4.0f * (fabs(ez) + z_bound) + fabs(cdd)) + (cdd > 0.0f ? 0.25f * cdd : 0.0f);
-  for (int w = 0; w < REGION_END_WEDGES; ++w) {
-    float* up = rec + 4 + 2 * w * REGION_END_BANDS;
-    float* down = up + REGION_END_BANDS;
-    float up_max = -INFINITY, down_max = -INFINITY;
-    for (int b = 0; b < bands; ++b) {
+    for (int w = 0; w < REGION_END_WEDGES; ++w) {
       // (a band's value is finite or infinite, never NaN: so is `need` but over a NaN height; the
       // divisions by the radii round by a relative 2^-24, a height's rounding, well within the
       // clearance's relative part)
-      const float need = isnan(ez) ? INFINITY : up[b] + clearance - ez;
-      up_max = fmax(up_max, b == 0 ? (need < 0.0f ? -INFINITY : INFINITY) : need / region_band_edge(b));
-      down_max = fmax(down_max, need / region_band_edge(b + 1));
-      up[b] = up_max, down[b] = down_max;
+      const float need = isnan(ez) ? INFINITY : value[w] + clearance - ez;
+      up_max[w] = fmax(up_max[w], b == 0 ? (need < 0.0f ? -INFINITY : INFINITY) : need / region_band_edge(b));
+      down_max[w] = fmax(down_max[w], need / region_band_edge(b + 1));
+      rec[4 + 2 * w * REGION_END_BANDS + b] = up_max[w];
+      rec[4 + (2 * w + 1) * REGION_END_BANDS + b] = down_max[w];
     }
   }
+  // (the bands past the last filled: never looked up)
+  for (int w = 0; w < REGION_END_WEDGES; ++w)
+    for (int b = bands; b < REGION_END_BANDS; ++b)
+      rec[4 + 2 * w * REGION_END_BANDS + b] = rec[4 + (2 * w + 1) * REGION_END_BANDS + b] = -INFINITY;
 }
 
 // How far from the end E (height ze) the sight line of `length` pixels to the other end (height

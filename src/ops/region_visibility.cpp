@@ -103,17 +103,62 @@ float fieldTop(const std::vector<float>& heights) {
   return top;
 }
 
+// The field as the region kernels take it, prepared once (RegionField) or per call: the z-scaled
+// heights (HeightOrigin::Zero: the viewshed's, so both decide the same sight lines) and, for the
+// culled march and the bitmask method, the culling pyramid, on the host and the device; and the
+// bounds of the heights the calls take.
+struct RegionSurface {
+  const HeightField* field = nullptr;
+  detail::PreparedHeights prepared;
+  detail::CullPyramid pyramid;       // levels 0: none built (the exact march, a field one point thick)
+  // The heights' bounds (`bounded`; a one-shot call leaves them to the routine, which takes them
+  // only where it needs them): the largest finite |height| (0 if none), the highest finite height
+  // (-infinity if none).
+  bool bounded = false;
+  float largest = 0.0f, top = 0.0f;
+  cl::Buffer heights, pyramid_top;   // on the device (`device`)
+};
+
+// The largest finite |height| of `h`, 0 if none.
+float largestHeight(const std::vector<float>& h) {
+  float largest = 0.0f;
+  for (const float v : h)
+    if (std::isfinite(v)) largest = std::max(largest, std::fabs(v));
+  return largest;
+}
+
+// `field` validated (validateField). `pyramid`: build the culling pyramid; `device`: upload;
+// `bounded`: take the heights' bounds.
+RegionSurface prepareSurface(detail::ContextState& st, const HeightField& field, bool pyramid, bool device,
+                             bool bounded) {
+  RegionSurface out;
+  out.field = &field;
+  out.prepared = detail::prepareHeights(field, detail::HeightOrigin::Zero);
+  const std::vector<float>& h = out.prepared.heights;
+  if (bounded) out.bounded = true, out.largest = largestHeight(h), out.top = fieldTop(h);
+  if (pyramid) out.pyramid = detail::cullPyramid(h, field.width, field.height);
+  if (!device) return out;
+  const auto upload = [&](const std::vector<float>& values) {
+    if (values.empty()) return detail::deviceBuffer(st, 0);
+    return cl::Buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, values.size() * sizeof(float),
+                      const_cast<float*>(values.data()));
+  };
+  out.heights = upload(h);
+  if (out.pyramid.levels > 0) out.pyramid_top = upload(out.pyramid.top);
+  return out;
+}
+
 // The bits of `count` receivers from the device, receiver-major: one routine item per launch
 // of up to kWordsPerLaunch / words receivers (a work-item marches all its receiver's words:
 // a launch's work stays bounded whatever S).
 class RegionBitsRoutine : public detail::DeviceRoutine {
  public:
-  RegionBitsRoutine(detail::ContextState& st, const HeightField& field, detail::PreparedHeights heights,
-                    const std::vector<float>& sources, const std::vector<float>& source_points,
-                    bool source_absolute, const std::vector<float>* receivers, bool receiver_absolute,
-                    int count, const RegionVisibilityOptions& options)
-      : DeviceRoutine(st, field, options.progress, 0),
-        heights_prepared_(std::move(heights)),
+  RegionBitsRoutine(detail::ContextState& st, const RegionSurface& surface, const std::vector<float>& sources,
+                    const std::vector<float>& source_points, bool source_absolute,
+                    const std::vector<float>* receivers, bool receiver_absolute, int count,
+                    const RegionVisibilityOptions& options)
+      : DeviceRoutine(st, *surface.field, options.progress, 0),
+        surface_(surface),
         sources_(sources),
         source_points_(source_points),
         source_absolute_(source_absolute),
@@ -129,12 +174,14 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
   std::uint64_t exact_tested = 0, exact_tested_visible = 0;
 
  private:
-  // The viewshed's heights (z-scaled, from 0), so both decide the same sight lines: the caller's,
-  // which placed the samples on them.
-  detail::PreparedHeights prepare() override { return std::move(heights_prepared_); }
+  // The heights and the pyramid are the surface's, prepared and uploaded by the caller (which
+  // placed the samples on the same heights), per call or once for many (RegionField).
+  detail::PreparedHeights prepare() override { return {}; }
+  bool heightsResident() const override { return false; }
   std::string programFile() const override { return "region_visibility.cl"; }
 
   void allocate() override {
+    heights_ = surface_.heights;
     receiver_major_ = detail::lineMajorLayout(st_);
     const std::size_t entries = static_cast<std::size_t>(count_) * words_;
     // The bitmasks live whole on the device and on the host, twice there in the word-major
@@ -174,12 +221,12 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
     bool probed_clear = false;
     const bool bitmask = options_.method == RegionVisibilityMethod::Bitmask;
     if (options_.method == RegionVisibilityMethod::Culled || bitmask) {
-      const detail::CullPyramid pyramid = detail::cullPyramid(prepared_.heights, field_.width, field_.height);
+      const detail::CullPyramid& pyramid = surface_.pyramid;
       levels_ = pyramid.levels;
       margin_ = pyramid.margin;
       gradient_ = pyramid.gradient;
       finite_ = pyramid.finite;
-      if (levels_ > 0) pyramid_ = upload(pyramid.top);
+      if (levels_ > 0) pyramid_ = surface_.pyramid_top;
       if (levels_ > 0 && receivers_) probed_clear = probeClear(pyramid, device);
     }
     // The per-end tables that certify clear sight lines (region_end_table), a pair's only: its
@@ -192,9 +239,8 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
     if (certify_sources_ || certify_receivers_) {
       // The tables' bound of the sight lines' end heights: the highest surface plus the largest
       // height over it (an absolute height is bounded by it too).
-      float surface = 0.0f, above = float(options_.target_height);
-      for (const float v : prepared_.heights)
-        if (std::isfinite(v)) surface = std::max(surface, std::fabs(v));
+      const float surface = surface_.bounded ? surface_.largest : largestHeight(surface_.prepared.heights);
+      float above = float(options_.target_height);
       for (const std::vector<float>* table : {&sources_, receivers_})
         for (std::size_t i = 8; table && i < table->size(); i += 5)
           above = std::max(above, std::fabs((*table)[i]));
@@ -232,7 +278,7 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
       tested_ = detail::deviceBuffer(st_, std::size_t(count_) * 2 * sizeof(cl_uint));
       kernel_ = kernel("region_bitmask_bits");
       setSurface(kernel_)
-          .set("field_top", fieldTop(prepared_.heights))
+          .set("field_top", surface_.bounded ? surface_.top : fieldTop(surface_.prepared.heights))
           .set("f", device)
           .set("source_points", source_points_buffer_)
           .set("samples", cl_int(samples_))
@@ -291,7 +337,7 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
   // there).
   bool probeClear(const detail::CullPyramid& pyramid, const DeviceField& device) const {
     constexpr int kProbeLines = 64, kProbeClear = 4;
-    const std::vector<float>& h = prepared_.heights;
+    const std::vector<float>& h = surface_.prepared.heights;
     int clear = 0;
     for (int i = 0; i < kProbeLines; ++i) {
       const int s = int(std::int64_t(i) * samples_ / kProbeLines), r = int(std::int64_t(i) * 37 % count_);
@@ -339,7 +385,7 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
       for (int w = 0; w < words_; ++w) bits[std::size_t(r) * words_ + w] = out[std::size_t(w) * count_ + r];
   }
 
-  detail::PreparedHeights heights_prepared_;  // until prepare()
+  const RegionSurface& surface_;
   const std::vector<float>& sources_;
   const std::vector<float>& source_points_;  // stream 0's samples, x, y, z each
   const bool source_absolute_;
@@ -358,15 +404,15 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
   detail::NamedKernel kernel_;
 };
 
-std::vector<std::uint32_t> runBits(const ComputeContext& context, const HeightField& field,
-                                   detail::PreparedHeights heights, const std::vector<float>& sources,
+std::vector<std::uint32_t> runBits(const ComputeContext& context, const RegionSurface& surface,
+                                   const std::vector<float>& sources,
                                    const std::vector<float>& source_points, bool source_absolute,
                                    const std::vector<float>* receivers, bool receiver_absolute, int count,
                                    const RegionVisibilityOptions& options,
                                    RegionVisibilityResult* tested = nullptr) {
   return detail::translateOpenClErrors([&] {
-    RegionBitsRoutine routine(detail::stateOf(context), field, std::move(heights), sources, source_points,
-                              source_absolute, receivers, receiver_absolute, count, options);
+    RegionBitsRoutine routine(detail::stateOf(context), surface, sources, source_points, source_absolute,
+                              receivers, receiver_absolute, count, options);
     routine.run();
     if (tested) {
       tested->exact_tested = routine.exact_tested;
@@ -627,8 +673,9 @@ void countPairFractions(RegionPairVisibilityResult& out) {
     out.source_fraction[s] = static_cast<float>(static_cast<double>(seen_by[s]) / out.receiver_samples);
 }
 
-std::vector<float> regionSampleTable(const HeightField& field, const RegionSampling& sampling) {
-  validate(field, sampling);
+std::vector<float> regionSampleTable(const HeightField& field, const RegionSampling& sampling,
+                                     const std::vector<float>* heights) {
+  validateSampling(field, sampling, heights);
   std::vector<float> table;
   if (!sampling.points.empty()) {
     float lo_x = std::numeric_limits<float>::max(), lo_y = lo_x, hi_x = -lo_x, hi_y = -lo_x;
@@ -702,12 +749,21 @@ void validate(const RegionVisibilityOptions& options) {
 }
 
 void validate(const HeightField& field, const RegionSampling& sampling) {
+  detail::validateSampling(field, sampling, nullptr);
+}
+
+namespace detail {
+
+void validateSampling(const HeightField& field, const RegionSampling& sampling,
+                      const std::vector<float>* prepared) {
   if (!std::isfinite(sampling.height)) throw InvalidArgument("a region's height must be finite");
   if (!sampling.points.empty()) {
     if (sampling.points.size() > static_cast<std::size_t>(kMaxRegionSamples))
       throw InvalidArgument("a region takes at most " + std::to_string(kMaxRegionSamples) + " points (got " +
                             std::to_string(sampling.points.size()) + ")");
-    const std::vector<float> heights = detail::prepareHeights(field, detail::HeightOrigin::Zero).heights;
+    std::vector<float> own;
+    if (!prepared) own = detail::prepareHeights(field, detail::HeightOrigin::Zero).heights;
+    const std::vector<float>& heights = prepared ? *prepared : own;
     for (const RegionPoint& p : sampling.points) {
       const std::string at = std::to_string(p.col) + "," + std::to_string(p.row);
       if (!(p.col >= 0.0 && p.col <= field.width - 1.0 && p.row >= 0.0 && p.row <= field.height - 1.0))
@@ -738,6 +794,8 @@ void validate(const HeightField& field, const RegionSampling& sampling) {
       if (!std::isfinite(field.at(col, row)))
         throw InvalidArgument("region " + rect + " holds nodata (at " + corner(col, row) + ")");
 }
+
+}  // namespace detail
 
 std::vector<RegionPoint> regionSamplePoints(const HeightField& field, const RegionSampling& sampling,
                                             std::uint32_t seed) {
@@ -798,19 +856,31 @@ RegionVisibilityMethod methodFor(const RegionSampling& sources, const RegionVisi
 
 }  // namespace
 
-RegionVisibilityResult computeRegionVisibility(const ComputeContext& context, const HeightField& field,
-                                               const RegionSampling& sources,
-                                               const RegionVisibilityOptions& options) {
-  validateField(field);
+namespace {
+
+// A run over every pixel of `field` (validated): on `prepared` (a RegionField's surface), or on a
+// surface prepared here for this call alone.
+RegionVisibilityResult regionVisibility(const ComputeContext& context, const HeightField& field,
+                                        const RegionSurface* prepared, const RegionSampling& sources,
+                                        const RegionVisibilityOptions& options) {
   validate(options);
   const bool coloured = options.light_image.width > 0;
   if (coloured && !sources.points.empty())
     throw InvalidArgument("a light image lies over a rectangle light, not over explicit points");
   RegionVisibilityOptions run = options;
   run.method = methodFor(sources, options);
-  const std::vector<float> table = detail::regionSampleTable(field, sources);
-  detail::PreparedHeights prepared = detail::prepareHeights(field, detail::HeightOrigin::Zero);
-  const std::vector<float>& heights = prepared.heights;
+  const std::vector<float> table =
+      detail::regionSampleTable(field, sources, prepared ? &prepared->prepared.heights : nullptr);
+  const bool viewsheds = run.method == RegionVisibilityMethod::Viewsheds;
+  RegionSurface own;
+  if (!prepared)
+    own = detail::translateOpenClErrors([&] {
+      const bool pyramid =
+          run.method == RegionVisibilityMethod::Culled || run.method == RegionVisibilityMethod::Bitmask;
+      return prepareSurface(detail::stateOf(context), field, pyramid, !viewsheds, false);
+    });
+  const RegionSurface& surface = prepared ? *prepared : own;
+  const std::vector<float>& heights = surface.prepared.heights;
   RegionVisibilityResult out;
   out.width = field.width;
   out.height = field.height;
@@ -818,11 +888,10 @@ RegionVisibilityResult computeRegionVisibility(const ComputeContext& context, co
   out.words = (out.samples + 31) / 32;
   const int count = static_cast<int>(field.pixelCount());
   const std::vector<float> points = tableSamplePoints(field, table, heights, sources.absolute, options.seed);
-  if (run.method == RegionVisibilityMethod::Viewsheds)
+  if (viewsheds)
     out.bits = viewshedBits(context, field, regionPoints(points), run);
   else
-    out.bits = runBits(context, field, std::move(prepared), table, points, sources.absolute, nullptr, false,
-                       count, run, &out);
+    out.bits = runBits(context, surface, table, points, sources.absolute, nullptr, false, count, run, &out);
   out.fraction.resize(field.pixelCount());
   for (int p = 0; p < count; ++p) {
     int seen = 0;
@@ -836,12 +905,11 @@ RegionVisibilityResult computeRegionVisibility(const ComputeContext& context, co
   return out;
 }
 
-RegionPairVisibilityResult computeRegionPairVisibility(const ComputeContext& context,
-                                                       const HeightField& field,
-                                                       const RegionSampling& sources,
-                                                       const RegionSampling& receivers,
-                                                       const RegionVisibilityOptions& options) {
-  validateField(field);
+// A region pair on `field` (validated), as regionVisibility.
+RegionPairVisibilityResult regionPairVisibility(const ComputeContext& context, const HeightField& field,
+                                                const RegionSurface* prepared, const RegionSampling& sources,
+                                                const RegionSampling& receivers,
+                                                const RegionVisibilityOptions& options) {
   validate(options);
   if (options.method == RegionVisibilityMethod::Viewsheds ||
       options.method == RegionVisibilityMethod::Bitmask)
@@ -852,10 +920,17 @@ RegionPairVisibilityResult computeRegionPairVisibility(const ComputeContext& con
     throw InvalidArgument("a light image colours every-pixel receivers, not a region pair");
   RegionVisibilityOptions run = options;  // Auto: the culled march (the bitmask method takes no pair)
   if (run.method == RegionVisibilityMethod::Auto) run.method = RegionVisibilityMethod::Culled;
-  const std::vector<float> source_table = detail::regionSampleTable(field, sources);
-  const std::vector<float> receiver_table = detail::regionSampleTable(field, receivers);
-  detail::PreparedHeights prepared = detail::prepareHeights(field, detail::HeightOrigin::Zero);
-  const std::vector<float>& heights = prepared.heights;
+  const std::vector<float>* prepared_heights = prepared ? &prepared->prepared.heights : nullptr;
+  const std::vector<float> source_table = detail::regionSampleTable(field, sources, prepared_heights);
+  const std::vector<float> receiver_table = detail::regionSampleTable(field, receivers, prepared_heights);
+  RegionSurface own;
+  if (!prepared)
+    own = detail::translateOpenClErrors([&] {
+      return prepareSurface(detail::stateOf(context), field, run.method == RegionVisibilityMethod::Culled,
+                            true, false);
+    });
+  const RegionSurface& surface = prepared ? *prepared : own;
+  const std::vector<float>& heights = surface.prepared.heights;
   RegionPairVisibilityResult out;
   out.source_samples = detail::regionTableSamples(source_table);
   out.receiver_samples = detail::regionTableSamples(receiver_table);
@@ -865,10 +940,65 @@ RegionPairVisibilityResult computeRegionPairVisibility(const ComputeContext& con
   out.sources = regionPoints(source_points);
   out.receivers =
       regionPoints(tableSamplePoints(field, receiver_table, heights, receivers.absolute, options.seed));
-  out.bits = runBits(context, field, std::move(prepared), source_table, source_points, sources.absolute,
-                     &receiver_table, receivers.absolute, out.receiver_samples, run);
+  out.bits = runBits(context, surface, source_table, source_points, sources.absolute, &receiver_table,
+                     receivers.absolute, out.receiver_samples, run);
   detail::countPairFractions(out);
   return out;
+}
+
+}  // namespace
+
+struct RegionField::State {
+  State(const ComputeContext& c, const HeightField& f) : context(c), field(f) {}
+  ComputeContext context;
+  HeightField field;      // the caller's, copied
+  RegionSurface surface;  // over `field`, with the pyramid, on the device
+};
+
+class RegionFieldAccess {
+ public:
+  static const RegionField::State& state(const RegionField& f) { return *f.state_; }
+};
+
+RegionField::RegionField(const ComputeContext& context, const HeightField& field) {
+  validateField(field);
+  auto state = std::make_shared<State>(context, field);
+  state->surface = detail::translateOpenClErrors(
+      [&] { return prepareSurface(detail::stateOf(context), state->field, true, true, true); });
+  state_ = std::move(state);
+}
+
+const HeightField& RegionField::field() const { return state_->field; }
+const ComputeContext& RegionField::context() const { return state_->context; }
+
+RegionVisibilityResult computeRegionVisibility(const ComputeContext& context, const HeightField& field,
+                                               const RegionSampling& sources,
+                                               const RegionVisibilityOptions& options) {
+  validateField(field);
+  return regionVisibility(context, field, nullptr, sources, options);
+}
+
+RegionPairVisibilityResult computeRegionPairVisibility(const ComputeContext& context,
+                                                       const HeightField& field,
+                                                       const RegionSampling& sources,
+                                                       const RegionSampling& receivers,
+                                                       const RegionVisibilityOptions& options) {
+  validateField(field);
+  return regionPairVisibility(context, field, nullptr, sources, receivers, options);
+}
+
+RegionVisibilityResult computeRegionVisibility(const RegionField& field, const RegionSampling& sources,
+                                               const RegionVisibilityOptions& options) {
+  const auto& state = RegionFieldAccess::state(field);
+  return regionVisibility(state.context, state.field, &state.surface, sources, options);
+}
+
+RegionPairVisibilityResult computeRegionPairVisibility(const RegionField& field,
+                                                       const RegionSampling& sources,
+                                                       const RegionSampling& receivers,
+                                                       const RegionVisibilityOptions& options) {
+  const auto& state = RegionFieldAccess::state(field);
+  return regionPairVisibility(state.context, state.field, &state.surface, sources, receivers, options);
 }
 
 }  // namespace hfvis

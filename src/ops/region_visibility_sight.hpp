@@ -16,8 +16,15 @@ namespace hfvis::detail {
 #include "../../kernels/shared/region_visibility_sight.cl"
 
 // A region's table for region_sample(): the rectangle (lo_x, lo_y, hi_x, hi_y), then per sample
-// its stratum's corner, size and height (explicit points: the point, size 0). Validates.
-std::vector<float> regionSampleTable(const HeightField& field, const RegionSampling& sampling);
+// its stratum's corner, size and height (explicit points: the point, size 0). Validates
+// (validateSampling).
+std::vector<float> regionSampleTable(const HeightField& field, const RegionSampling& sampling,
+                                     const std::vector<float>* heights = nullptr);
+
+// validate(field, sampling) (hfvis/region_visibility.hpp), explicit points checked against
+// `heights` (the field's prepared as HeightOrigin::Zero; nullptr: prepared here).
+void validateSampling(const HeightField& field, const RegionSampling& sampling,
+                      const std::vector<float>* heights);
 
 // The culling pyramid of kernels/shared/region_visibility_sight.cl (region_cull_*) over the
 // z-scaled heights, and the part of the march's rounding that a block's height must clear which
