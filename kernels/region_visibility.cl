@@ -24,7 +24,7 @@ typedef struct {
   float cell_x, cell_y;  // ground units per pixel
   float curvature;       // c of the drop c d^2
   float max_d2;          // the largest squared ground distance of a visible pair; 0 = any
-} RegionField;
+} RegionDeviceField;
 
 // The cells around the receiver's point, each side, that its sight lines march exactly when the
 // shaft to a word's samples is shown clear beyond them (region_shaft_clear).
@@ -98,7 +98,7 @@ inline int region_walk_start(RegionBlockWalk* w, int levels, int width, int heig
 // The next block of the walk: its level *k and indices (*bx, *by), its box's first corner (*x0,
 // *y0), its ground distance from the receiver (*near) and its pyramid value (*highest); blocks
 // wholly inside `skip` (x0, y0, x1, y1; 0: none) are passed over. 0 when the walk is done.
-inline int region_walk_next(RegionBlockWalk* w, __global const float* pyramid, RegionField f,
+inline int region_walk_next(RegionBlockWalk* w, __global const float* pyramid, RegionDeviceField f,
                             const float* skip, int* k, int* bx, int* by, float* x0, float* y0, float* near,
                             float* highest) {
   while (w->top > 0) {
@@ -122,7 +122,7 @@ inline int region_walk_next(RegionBlockWalk* w, __global const float* pyramid, R
 
 // Pushes the children of block (k > 0, bx, by) that lie inside their level, the one nearest the
 // receiver last, so visited first (near cells decide the most); 0 when the stack cannot hold them.
-inline int region_walk_descend(RegionBlockWalk* w, RegionField f, int k, int bx, int by) {
+inline int region_walk_descend(RegionBlockWalk* w, RegionDeviceField f, int k, int bx, int by) {
   if (w->top + 4 > REGION_WALK_STACK) return 0;
   const int child = 1 << (k - 1);
   const int nearest =
@@ -143,7 +143,7 @@ inline int region_walk_descend(RegionBlockWalk* w, RegionField f, int k, int bx,
 // slope to a sample times the block's ground distance) by the march's clearance. Blocks within
 // the box are left to the segments' own marches; 0 when a cell outside it may reach the shaft.
 int region_shaft_clear(__global const float* h, __global const float* pyramid, int levels, float margin,
-                       RegionField f, float xr, float yr, float zr, const float* xs, const float* ys,
+                       RegionDeviceField f, float xr, float yr, float zr, const float* xs, const float* ys,
                        const float* zs, int n, float* box) {
   float slope = INFINITY, far = 0.0f, zabs = fabs(zr);
   float sx0 = INFINITY, sy0 = INFINITY, sx1 = -INFINITY, sy1 = -INFINITY;
@@ -185,7 +185,7 @@ int region_shaft_clear(__global const float* h, __global const float* pyramid, i
 // the new line from the receiver as that one was of its line, or one cell before or after it,
 // the first that region_cull_hides shows hiding it (lines to neighbouring samples cross a ridge
 // at about the same fraction, in neighbouring cells); -1 when none does.
-int region_hider_along(__global const float* h, RegionField f, float margin, float gradient, int finite_field,
+int region_hider_along(__global const float* h, RegionDeviceField f, float margin, float gradient, int finite_field,
                        float along, int tried, float xr, float yr, float zr, float xs, float ys, float zs) {
   const float dx = xs - xr, dy = ys - yr, pixels = fmax(fabs(dx), fabs(dy));
   if (!(pixels > 0.0f)) return -1;
@@ -206,7 +206,7 @@ int region_hider_along(__global const float* h, RegionField f, float margin, flo
 // samples (`placed`: x, y, z each in `points`, as region_visibility_bits takes them) or a pair's
 // receiver samples (drawn from `table` here, as region_visibility_bits draws them).
 __kernel void region_end_tables(__global const float* h, __global const float* pyramid, int levels,
-                                float margin, float z_bound, RegionField f, int placed,
+                                float margin, float z_bound, RegionDeviceField f, int placed,
                                 __global const float* points, __global const float* table, int absolute,
                                 unsigned int seed, int count, float4 other, __global float* records) {
   const int s = (int)get_global_id(0);
@@ -225,7 +225,7 @@ __kernel void region_end_tables(__global const float* h, __global const float* p
 __kernel void region_visibility_bits(__global const float* h, __global const float* pyramid, int levels,
                                      float margin, float gradient, int finite_field, int certify_receivers,
                                      int certify_sources, __global const float* receiver_records,
-                                     __global const float* source_records, RegionField f,
+                                     __global const float* source_records, RegionDeviceField f,
                                      __global const float* sources, __global const float* source_points,
                                      int source_absolute, int samples, int pixel_receivers,
                                      __global const float* receivers, int receiver_absolute,
@@ -531,7 +531,7 @@ int region_bitmask_all(const unsigned int* a, const unsigned int* b, int samples
 
 __kernel void region_bitmask_bits(__global const float* h, __global const float* pyramid, int levels,
                                   float margin, float gradient, int finite_field, float field_top,
-                                  RegionField f, __global const float* source_points, int samples,
+                                  RegionDeviceField f, __global const float* source_points, int samples,
                                   float light_z, float target_height, __global const unsigned int* table,
                                   BitmaskTable t, float lo_x, float lo_y, float hi_x, float hi_y, int words,
                                   int receiver_count, int receiver_major, int first,

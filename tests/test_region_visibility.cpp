@@ -9,6 +9,7 @@
 #include <cstring>
 #include <set>
 #include <string>
+#include <utility>
 
 #include "core/sweep_geometry.hpp"
 #include "hfvis/errors.hpp"
@@ -1227,6 +1228,12 @@ TEST(RegionVisibility, BadInputIsRefused) {
   latlon.row_cell_size_y.assign(field.height, 1.0);
   EXPECT_THROW(computeRegionVisibility(context, latlon, good, options), InvalidArgument);
   EXPECT_THROW(RegionField(context, latlon), InvalidArgument);
+  // A moved-from prepared field holds nothing: a call on it is refused, not a crash.
+  RegionField moved(context, field);
+  const RegionField taker = std::move(moved);
+  EXPECT_NO_THROW(computeRegionVisibility(taker, good, options));
+  EXPECT_THROW(computeRegionVisibility(moved, good, options), InvalidArgument);  // NOLINT(bugprone-use-after-move)
+  EXPECT_THROW(moved.field(), InvalidArgument);  // NOLINT(bugprone-use-after-move)
   // A light image: of 3 * width * height finite values >= 0, over a rectangle, every-pixel receivers.
   o = options;
   o.light_image.width = 2, o.light_image.height = 2;

@@ -209,7 +209,8 @@ std::vector<RegionPoint> regionSamplePoints(const HeightField& field, const Regi
 // light, a GIS loop over project sites or antenna areas): validated as the calls validate it, its
 // heights prepared as the kernels take them (z-scaled), the culling pyramid (the culled march's
 // and the bitmask method's) built, both uploaded to the context's device, once. Each call on it
-// then costs only its own samples, tables, marches and results: the one-shot calls below do the
+// then costs only its own samples, tables, marches and results (the viewsheds method excepted: it
+// runs the library's viewshed per source sample, which prepares the field itself): the one-shot calls below do the
 // same preparation every call (about 9 ms of CPU on a 1024^2 field on a 2-core CPU, a fifth to a
 // quarter of a hidden region pair's: bench/report/region_visibility.md). The bits and fractions
 // are the one-shot calls', bit for bit (the one-shot calls prepare the same way and run the same
@@ -219,13 +220,17 @@ std::vector<RegionPoint> regionSamplePoints(const HeightField& field, const Regi
 // of the context (a shared handle: the device buffers live as long as the prepared field); copies
 // of a RegionField share the prepared state. Its device memory (the heights and the pyramid, about
 // 2.3 floats a point: 9.3 MiB for 1024^2) stays held while it lives, besides each call's memory
-// budget. Calls on it run on its context, one at a time as every call on a context
-// (hfvis/device.hpp).
+// budget; on the host it keeps the field's copy, its z-scaled heights and the pyramid (which the
+// host's probes read), about 3.3 floats a point (13 MiB for 1024^2). Calls on it run on its
+// context, one at a time as every call on a context (hfvis/device.hpp): copies share the context,
+// so two copies are not called from two threads at once, and a program with one context per
+// thread prepares one RegionField per context (the constructor is a call on the context too). A
+// moved-from RegionField may only be assigned or destroyed; a call on it throws InvalidArgument.
 class RegionField {
  public:
   // Throws InvalidArgument (an empty or inconsistent field, a latitude / longitude grid, a field
   // of 2^31 points or more), OpenClError.
-  RegionField(const ComputeContext& context, const HeightField& field);
+  explicit RegionField(const ComputeContext& context, const HeightField& field);
 
   const HeightField& field() const;
   const ComputeContext& context() const;

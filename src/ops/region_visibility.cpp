@@ -957,7 +957,10 @@ struct RegionField::State {
 
 class RegionFieldAccess {
  public:
-  static const RegionField::State& state(const RegionField& f) { return *f.state_; }
+  static const RegionField::State& state(const RegionField& f) {
+    if (!f.state_) throw InvalidArgument("a moved-from RegionField (it holds no prepared field)");
+    return *f.state_;
+  }
 };
 
 RegionField::RegionField(const ComputeContext& context, const HeightField& field) {
@@ -968,8 +971,8 @@ RegionField::RegionField(const ComputeContext& context, const HeightField& field
   state_ = std::move(state);
 }
 
-const HeightField& RegionField::field() const { return state_->field; }
-const ComputeContext& RegionField::context() const { return state_->context; }
+const HeightField& RegionField::field() const { return RegionFieldAccess::state(*this).field; }
+const ComputeContext& RegionField::context() const { return RegionFieldAccess::state(*this).context; }
 
 RegionVisibilityResult computeRegionVisibility(const ComputeContext& context, const HeightField& field,
                                                const RegionSampling& sources,
