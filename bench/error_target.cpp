@@ -322,6 +322,33 @@ void errorCurve(const ComputeContext& context, const std::vector<ErrorTargetFiel
   }
 }
 
+void nestedCurve(const ComputeContext& context, const std::vector<ErrorTargetField>& fields,
+                 int reference_directions, int max_directions) {
+  std::printf(
+      "\n| field | K | copies | samples nested | samples uniform | SVF p99 nested | SVF p99 uniform | "
+      "AO p99 nested | AO p99 uniform |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+  HorizonOutputs both;
+  both.sky_view_factor = both.ambient_occlusion = true;
+  for (const ErrorTargetField& f : fields) {
+    HorizonOptions options;
+    options.directions = reference_directions;
+    const HorizonResult reference = computeHorizons(context, f.field, options, both);
+    for (int m : {1, 2, 3, 4, 5, 6, 7, 8, 10, 12, 14, 16, 20, 24, 28, 32, 40, 48, 56, 64, 96, 128, 192, 256}) {
+      if (m * detail::kNestedBase > max_directions) break;
+      const HorizonResult nested = detail::computeNestedSet(context, f.field, options, both, m, true);
+      options.directions = m * detail::kNestedBase;
+      const HorizonResult uniform = computeHorizons(context, f.field, options, both);
+      std::printf("| %s | %d | %d | %.0f | %.0f | %.5f | %.5f | %.5f | %.5f |\n", f.name.c_str(),
+                  options.directions, m, nested.samples_per_receiver, uniform.samples_per_receiver,
+                  p99Difference(nested.sky_view_factor, reference.sky_view_factor),
+                  p99Difference(uniform.sky_view_factor, reference.sky_view_factor),
+                  p99Difference(nested.ambient_occlusion, reference.ambient_occlusion),
+                  p99Difference(uniform.ambient_occlusion, reference.ambient_occlusion));
+      std::fflush(stdout);
+    }
+  }
+}
+
 namespace {
 
 constexpr double kDegrees = 180.0 / M_PI;

@@ -47,4 +47,10 @@ void horizonErrorCurve(const ComputeContext& context, const std::vector<ErrorTar
 void errorCurve(const ComputeContext& context, const std::vector<ErrorTargetField>& fields,
                 int reference_directions, int max_directions);
 
+// Per content and K = 8 m up to max_directions: the nested set of m copies (detail::computeNestedSet,
+// one run; HorizonOptions::max_error's sets) against the uniform set of K directions, both
+// outputs' 99th percentile error against the uniform set at reference_directions, and their work.
+void nestedCurve(const ComputeContext& context, const std::vector<ErrorTargetField>& fields,
+                 int reference_directions, int max_directions);
+
 }  // namespace hfvis::bench

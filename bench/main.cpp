@@ -103,7 +103,8 @@ constexpr const char* kUsage =
     "       hfvis_bench viewshed-culling [--levels 1,2,3,4] [--reps N] FIELD...\n"
     "       hfvis_bench error-target [--data DIR] [--dem FILE] [--size N] [--errors E,...] [--contents A,B]\n"
     "                                [--reference-k K] [--reps N] [--tile T] [--curve KMAX]\n"
-    "                                [--output svf-ao|viewcount|horizon]   (horizon: --errors in degrees)\n"
+    "                                [--output svf-ao|viewcount|horizon|nested]   (horizon: --errors in degrees;\n"
+    "                                nested: --curve KMAX, nested sets against uniform ones)\n"
     "       hfvis_bench pvs-rays [--size N] [--rays R] [--reps K] [--dem FILE] FIELD...\n"
     "       hfvis_bench pvs-recall [--size N] [--view-cell C] [--tile T] [--samples N,N,...]\n"
     "                              [--check-rays R] [--methods agvs,sgvs,per-cell] [--reference yes|no]\n"
@@ -533,8 +534,8 @@ int main(int argc, char** argv) {
       const int reps = std::stoi(args.get("--reps", "3"));
       const int curve = std::stoi(args.get("--curve", "0"));
       const std::string output = args.get("--output", "svf-ao");
-      if (output != "svf-ao" && output != "viewcount" && output != "horizon")
-        throw Usage("error-target: --output is svf-ao, viewcount or horizon (--errors in degrees)");
+      if (output != "svf-ao" && output != "viewcount" && output != "horizon" && output != "nested")
+        throw Usage("error-target: --output is svf-ao, viewcount, horizon (--errors in degrees) or nested");
       // (the refined runs' tiles beside the whole field's one K: svf-ao only)
       const std::string tile_text = args.get("--tile");
       if (output != "svf-ao" && !tile_text.empty())
@@ -586,6 +587,11 @@ int main(int argc, char** argv) {
       if (output == "viewcount") {
         viewcountTargetReport(ComputeContext::create(ContextOptions::fromEnvironment()), fields, errors,
                               reference, reps);
+        return 0;
+      }
+      if (output == "nested") {
+        nestedCurve(ComputeContext::create(ContextOptions::fromEnvironment()), fields, reference,
+                    curve > 0 ? curve : 512);
         return 0;
       }
       if (curve > 0) {

@@ -212,7 +212,7 @@ TEST(HorizonMaxError, MeetsTheTargetAgainstADenseRun) {
       // The runs it made: from the first K up, each at more directions, the last the one returned.
       const HorizonResult runs = computeHorizons(testContext(), field, options, svf_only);
       ASSERT_FALSE(runs.runs.empty());
-      EXPECT_EQ(runs.runs.front(), 16);
+      EXPECT_EQ(runs.runs.front(), detail::kNestedBase);  // copy 0 of the nested set
       EXPECT_EQ(runs.runs.back(), r.directions);
       EXPECT_TRUE(std::is_sorted(runs.runs.begin(), runs.runs.end(), std::less_equal<int>()));
       for (int K : runs.pixel_directions) ASSERT_EQ(K, r.directions);
@@ -246,13 +246,14 @@ HeightField cityBesideFlat(const char* name, int width, int height) {
   return field;
 }
 
-// Refinement in tiles (HorizonOptions::error_tile): every pixel's values are those of a whole-field
-// run at the K it records (HorizonResult::pixel_directions), bit for bit, and its estimate that
-// run's over one divisor per tile (the order its tile's runs measured), though the
-// runs after the first sweep only the lines that reach their tiles (cut after them); the estimate
-// meets E; the open part stops at fewer directions than the dense one, and the runs swept fewer
-// receivers than whole-field runs at their K. On the city and nodata hard cases, in both
-// buffer layouts, in one piece and in strips, and within a maximum distance.
+// Refinement in tiles (HorizonOptions::error_tile): every pixel's values are those of the nested
+// set run over the whole field to the K it records (HorizonResult::pixel_directions), run by run,
+// bit for bit, and its estimate that run's last doubling's over one divisor per tile (the order
+// its tile's runs measured), though the runs after the first two sweep only the lines that reach
+// their tiles (cut after them); the estimate meets E; the open part stops at fewer directions
+// than the dense one, and the runs swept fewer receivers than the whole field's nested runs to
+// the largest K. On the city and nodata hard cases, in both buffer layouts, in one piece and in
+// strips, and within a maximum distance.
 TEST(HorizonMaxError, RefinedTilesEqualAWholeFieldRunAtTheirK) {
   testing::forEachLayout([](const ComputeContext& context) {
     for (const char* name : {"city", "nan_holes"}) {
@@ -278,11 +279,8 @@ TEST(HorizonMaxError, RefinedTilesEqualAWholeFieldRunAtTheirK) {
         for (int K : taken) {
           SCOPED_TRACE(K);
           std::map<int, double> divisors;  // tile -> its estimate's divisor at K
-          HorizonOptions fixed = options;
-          fixed.max_error = 0.0;
-          fixed.error_tile = 0;
-          fixed.directions = K;
-          const HorizonResult whole = computeHorizons(context, field, fixed, estimated());
+          const HorizonResult whole =
+              detail::computeNestedSet(context, field, options, both, K / detail::kNestedBase, false);
           std::size_t compared = 0;
           for (std::size_t p = 0; p < field.pixelCount(); ++p) {
             if (refined.pixel_directions[p] != K) continue;
@@ -312,15 +310,10 @@ TEST(HorizonMaxError, RefinedTilesEqualAWholeFieldRunAtTheirK) {
         EXPECT_LE(refined.estimated_error, options.max_error);
         // The levelled far corner needs fewer directions than the city's.
         EXPECT_LT(refined.pixel_directions[field.pixelCount() - 1], refined.directions);
-        // The runs after the first swept fewer receivers than whole-field runs at their K would have.
-        double whole_field_work = 0.0;
-        for (int K : refined.runs) {
-          HorizonOptions fixed = options;
-          fixed.directions = K;
-          for (const auto& d : detail::horizonDirections(field, fixed, estimated()))
-            whole_field_work += static_cast<double>(detail::latticeSamples(d, fixed.samples_per_unit).size());
-        }
-        EXPECT_LT(refined.samples_per_receiver, whole_field_work);
+        // The runs after the first two swept fewer receivers than the whole field's to its largest K.
+        const HorizonResult whole = detail::computeNestedSet(context, field, options, both,
+                                                             refined.directions / detail::kNestedBase, false);
+        EXPECT_LT(refined.samples_per_receiver, whole.samples_per_receiver);
       }
     }
   });
@@ -377,28 +370,27 @@ TEST(HorizonMaxError, TheEstimateIsTheRawOneOverTheRichardsonDivisor) {
     EXPECT_GE(detail::richardsonDivisor(order), last);
     last = detail::richardsonDivisor(order);
   }
-  // A whole-field run: its estimate is the raw estimate of a fixed run at its last K over the
-  // divisor its runs measure, pixel by pixel.
+  // A whole-field run: its estimate is the raw estimate of the nested set's last doubling over the
+  // divisor its doublings measure, pixel by pixel, and the divisor is recorded.
   const HeightField field = makeSyntheticField("city", 48, 40);
   HorizonOptions options;
   options.max_error = 0.01;
   HorizonOutputs svf;
   svf.sky_view_factor = true;
   const HorizonResult chosen = computeHorizons(testContext(), field, options, svf);
-  ASSERT_GE(chosen.runs.size(), 2u) << "one run: nothing measured";
+  ASSERT_GE(chosen.runs.size(), 3u) << "one doubling: nothing measured";
   std::vector<EstimateRun> runs;
   HorizonResult fixed;
-  HorizonOutputs raw = svf;
-  raw.error_estimate = true;
-  for (int K : chosen.runs) {
-    HorizonOptions at = options;
-    at.max_error = 0.0;
-    at.directions = K;
-    fixed = computeHorizons(testContext(), field, at, raw);
-    runs.push_back({K, fixed.estimated_error});
+  for (std::size_t i = 1; i < chosen.runs.size(); ++i) {  // (runs[0]: copy 0 alone, no estimate)
+    fixed = detail::computeNestedSet(testContext(), field, options, svf, chosen.runs[i] / detail::kNestedBase, false);
+    runs.push_back({chosen.runs[i], fixed.estimated_error});
   }
   const double divisor = detail::richardsonDivisor(detail::estimateOrder(runs));
   EXPECT_GT(divisor, 1.0) << "the city's estimate falls faster than K^-1 here";
+  EXPECT_DOUBLE_EQ(chosen.richardson_divisor_least, divisor);
+  EXPECT_DOUBLE_EQ(chosen.richardson_divisor_most, divisor);
+  for (std::size_t p = 0; p < field.pixelCount(); ++p)
+    ASSERT_EQ(chosen.sky_view_factor[p], fixed.sky_view_factor[p]) << p;
   for (std::size_t p = 0; p < field.pixelCount(); ++p)
     ASSERT_NEAR(chosen.error_estimate[p], fixed.error_estimate[p] / divisor, 1e-6 * fixed.error_estimate[p]) << p;
   EXPECT_NEAR(chosen.estimated_error, fixed.estimated_error / divisor, 1e-6 * fixed.estimated_error);
@@ -439,6 +431,111 @@ TEST(HorizonMaxError, TheNextKGrowsAsTheErrorShrinks) {
   const detail::NextErrorRun far = detail::nextDirectionsForError(runs, 0.002);
   EXPECT_EQ(far.directions, 256);
   EXPECT_GT(far.predicted, 256);
+}
+
+// The nested sets (detail::nestedCopySteps): a set of m copies is the one of m / 2 copies and the
+// next m / 2, direction for direction; each copy's weights are its own half gaps (summing to 1);
+// each direction lies strictly within half the spacing of the set its copy completes (the
+// copies' targets of a set of a power of 2 copies are the uniform set's), so the first 2^j
+// copies aim at 2^j kNestedBase evenly spread azimuths.
+TEST(NestedSets, ASetIsTheUnionOfItsHalvesAndEachCopyAQuadrature) {
+  for (const char* name : {"city", "flat"}) {
+    HeightField field = makeSyntheticField(name, 20, 17);
+    field.cell_size_y = 1.3;  // azimuths off the pixel diagonals
+    const double offset = 0.07;
+    const auto whole = detail::nestedCopySteps(field, offset, detail::kNestedBase, 0, 64);
+    ASSERT_EQ(whole.size(), 64u * detail::kNestedBase);
+    for (int m = 1; m <= 32; m *= 2) {
+      auto halves = detail::nestedCopySteps(field, offset, detail::kNestedBase, 0, m);
+      const auto added = detail::nestedCopySteps(field, offset, detail::kNestedBase, m, 2 * m);
+      halves.insert(halves.end(), added.begin(), added.end());
+      ASSERT_EQ(halves.size(), 2u * m * detail::kNestedBase);
+      for (std::size_t i = 0; i < halves.size(); ++i) {
+        EXPECT_EQ(halves[i].a, whole[i].a) << i;
+        EXPECT_EQ(halves[i].b, whole[i].b) << i;
+        EXPECT_EQ(halves[i].azimuth, whole[i].azimuth) << i;
+        EXPECT_EQ(halves[i].weight, whole[i].weight) << i;
+      }
+    }
+    std::vector<double> targets;
+    for (int c = 0; c < 64; ++c) {
+      double sum = 0.0;
+      for (int k = 0; k < detail::kNestedBase; ++k) {
+        const detail::LatticeDirection& d = whole[c * detail::kNestedBase + k];
+        sum += d.weight;
+        const double target = 2.0 * M_PI * (k + detail::vanDerCorput(c)) / detail::kNestedBase + offset;
+        targets.push_back(target);
+        const double spacing = 2.0 * M_PI / (detail::kNestedBase * detail::nestedLevelCopies(c));
+        // Within the window where the lattice has a step there (beyond 0.9 degree of an axis at
+        // steps of up to 64 pixels; the closest step otherwise, as latticeDirections takes).
+        if (spacing > 2.0 * M_PI / 180.0) EXPECT_LT(std::abs(detail::angleDifference(d.azimuth, target)), 0.5 * spacing);
+      }
+      EXPECT_NEAR(sum, 1.0, 1e-12) << c;
+    }
+    for (int m = 1; m <= 64; m *= 2) {  // the targets of m copies: the uniform set of 8 m
+      std::vector<double> first(targets.begin(), targets.begin() + m * detail::kNestedBase);
+      for (double& t : first) t = std::fmod(t - offset + 8.0 * M_PI, 2.0 * M_PI);
+      std::sort(first.begin(), first.end());
+      for (std::size_t j = 0; j < first.size(); ++j)
+        ASSERT_NEAR(first[j], 2.0 * M_PI * j / first.size(), 1e-9) << m << " " << j;
+    }
+  }
+}
+
+// A nested set run doubling by doubling (as max_error adds copies) equals the same set in one run
+// within float rounding (the sums are added in another order), in both buffer layouts, in one
+// piece and in strips, on a latitude / longitude grid (each copy's own weights per row) and
+// within a maximum distance; and a max_error run's result is the run-by-run set's at its K, bit
+// for bit, its estimate that set's last doubling's (half the halves' difference) over its divisor.
+TEST(NestedSets, RunByRunEqualsOneRunAtTheSameSet) {
+  testing::forEachLayout([](const ComputeContext& context) {
+    for (const char* name : {"city", "nan_holes"}) {
+      HeightField field = makeSyntheticField(name, 37, 29, 5);
+      HeightField rows = field;
+      for (int r = 0; r < rows.height; ++r) {
+        rows.row_cell_size_x.push_back(1.0 + 0.03 * r);
+        rows.row_cell_size_y.push_back(1.1);
+      }
+      rows.cell_size_x = rows.row_cell_size_x[rows.height / 2];
+      rows.cell_size_y = 1.1;
+      HorizonOutputs both;
+      both.sky_view_factor = both.ambient_occlusion = true;
+      for (const HeightField* f : {&field, &rows}) {
+        for (const auto& [strip_rows, max_distance] :
+             {std::pair{0, 0.0}, std::pair{7, 0.0}, std::pair{0, 9.5}}) {
+          SCOPED_TRACE(std::string(name) + (f == &rows ? " per-row spacing" : "") + " strip rows " +
+                       std::to_string(strip_rows) + " max distance " + std::to_string(max_distance));
+          HorizonOptions options;
+          options.azimuth_offset = 0.05;
+          options.max_distance = max_distance;
+          const HorizonResult steps = detail::computeNestedSet(context, *f, options, both, 8, false);
+          options.strip_rows = strip_rows;
+          const HorizonResult once = detail::computeNestedSet(context, *f, options, both, 8, true);
+          EXPECT_TRUE(nearlyEqual(steps.sky_view_factor, once.sky_view_factor, 2e-6f));
+          EXPECT_TRUE(nearlyEqual(steps.ambient_occlusion, once.ambient_occlusion, 2e-6f));
+          EXPECT_EQ(steps.azimuths, once.azimuths);
+          EXPECT_EQ(steps.directions, 64);
+          EXPECT_NEAR(steps.samples_per_receiver, once.samples_per_receiver, 1e-9 * once.samples_per_receiver);
+        }
+      }
+      // max_error: the run-by-run set at its K, bit for bit.
+      HorizonOptions options;
+      options.max_error = 0.03;
+      const HorizonResult chosen = computeHorizons(context, field, options, both);
+      const HorizonResult set =
+          detail::computeNestedSet(context, field, options, both, chosen.directions / detail::kNestedBase, false);
+      for (std::size_t p = 0; p < field.pixelCount(); ++p) {
+        const auto same = [](float x, float y) { return x == y || (std::isnan(x) && std::isnan(y)); };
+        ASSERT_TRUE(same(chosen.sky_view_factor[p], set.sky_view_factor[p])) << p;
+        ASSERT_TRUE(same(chosen.ambient_occlusion[p], set.ambient_occlusion[p])) << p;
+        ASSERT_TRUE(same(chosen.error_estimate[p],
+                         static_cast<float>(set.error_estimate[p] / chosen.richardson_divisor_most)))
+            << p;
+      }
+      EXPECT_EQ(chosen.azimuths, set.azimuths);
+      EXPECT_NEAR(chosen.samples_per_receiver, set.samples_per_receiver, 1e-9 * set.samples_per_receiver);
+    }
+  });
 }
 
 TEST(HorizonMaxError, BadRequestsAreRefused) {

@@ -140,6 +140,9 @@ struct HorizonResult {
   std::vector<int> runs;
   // With HorizonOptions::max_error, per pixel: the K of the run its values (and estimate) come from.
   std::vector<int> pixel_directions;
+  // With HorizonOptions::max_error (sky-view factor, occlusion): the least and the most Richardson
+  // divisor 2^p - 1 the raw estimate was divided by, over the tiles (equal with one tile).
+  double richardson_divisor_least = 0.0, richardson_divisor_most = 0.0;
   // The sweep's work, all runs together (with max_error; else this run's): per receiver of the
   // field, the samples of each direction's period times the receivers on the lines it swept
   // (a whole-field run at K: its directions' samples per period summed; 0 for the naive method).

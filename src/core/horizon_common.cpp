@@ -197,6 +197,10 @@ void pixelNormal(const std::vector<float>& h, int width, int height, int c, int 
 
 float swathFactor(float weight) { return hfSin(kPiF * weight) / kPiF; }
 
+float nestedSwath(double weight, int level_copies) {
+  return static_cast<float>(level_copies * std::sin(M_PI * weight / level_copies) / M_PI);
+}
+
 void finishReduction(HorizonResult& result) {
   for (float& v : result.sky_view_factor) v = 1.0f - v;
 }

@@ -111,6 +111,26 @@ LatticeDirection latticeStep(const HeightField& field, int a, int b) {
   return makeDirection(field, {a, b, 0, std::atan2(b * field.cell_size_y, a * field.cell_size_x)});
 }
 
+namespace {
+
+// The cheapest cost class of `all` with a step within `window` of `target`, and in it the closest
+// step; null when none is inside (`closest` then the closest of all).
+const Candidate* cheapestWithin(const std::vector<Candidate>& all, double target, double window,
+                                const Candidate** closest) {
+  const Candidate* chosen = nullptr;
+  double chosen_error = 0.0, closest_error = 0.0;
+  *closest = nullptr;
+  for (const Candidate& c : all) {
+    if (chosen && c.cost > chosen->cost) break;
+    const double error = std::abs(angleDifference(c.azimuth, target));
+    if (error <= window && (!chosen || error < chosen_error)) chosen = &c, chosen_error = error;
+    if (!*closest || error < closest_error) *closest = &c, closest_error = error;
+  }
+  return chosen;
+}
+
+}  // namespace
+
 std::vector<LatticeDirection> latticeDirections(const HeightField& field, const SweepOptions& options,
                                                 bool exact_azimuths, double tolerance, bool parity_apart) {
   const std::vector<Candidate> all = candidates(field);
@@ -120,16 +140,8 @@ std::vector<LatticeDirection> latticeDirections(const HeightField& field, const 
   std::vector<LatticeDirection> out;
   for (int k = 0; k < K; ++k) {
     const double target = directionAzimuth(k, options);
-    // The cheapest cost class with a step inside the window, and in it the closest step;
-    // the closest of all when none is inside.
-    const Candidate *chosen = nullptr, *closest = nullptr;
-    double chosen_error = 0.0, closest_error = 0.0;
-    for (const Candidate& c : all) {
-      if (chosen && c.cost > chosen->cost) break;
-      const double error = std::abs(angleDifference(c.azimuth, target));
-      if (error <= window && (!chosen || error < chosen_error)) chosen = &c, chosen_error = error;
-      if (!closest || error < closest_error) closest = &c, closest_error = error;
-    }
+    const Candidate* closest = nullptr;
+    const Candidate* chosen = cheapestWithin(all, target, window, &closest);
     std::optional<Candidate> longer;
     if (!chosen && exact_azimuths && K == 1) longer = longStep(field, target, window);
     out.push_back(makeDirection(field, chosen ? *chosen : longer ? *longer : *closest));
@@ -140,6 +152,44 @@ std::vector<LatticeDirection> latticeDirections(const HeightField& field, const 
     return out;
   }
   setQuadratureWeights(out, parity_apart);
+  return out;
+}
+
+double vanDerCorput(int c) {
+  double v = 0.0, digit = 0.5;
+  for (; c > 0; c >>= 1, digit *= 0.5)
+    if (c & 1) v += digit;
+  return v;
+}
+
+int nestedLevelCopies(int c) {
+  int copies = 1;
+  while (copies <= c) copies *= 2;
+  return copies;
+}
+
+std::vector<LatticeDirection> nestedCopySteps(const HeightField& field, double azimuth_offset, int base, int first,
+                                              int end) {
+  const std::vector<Candidate> all = candidates(field);
+  std::vector<LatticeDirection> out;
+  for (int c = first; c < end; ++c) {
+    const double window = 0.4999 * kTwoPi / (double(base) * nestedLevelCopies(c));
+    std::vector<LatticeDirection> copy;
+    for (int k = 0; k < base; ++k) {
+      const double target = kTwoPi * (k + vanDerCorput(c)) / base + azimuth_offset;
+      const Candidate* closest = nullptr;
+      const Candidate* chosen = cheapestWithin(all, target, window, &closest);
+      copy.push_back(makeDirection(field, chosen ? *chosen : *closest));
+      copy.back().azimuth = target + angleDifference(copy.back().azimuth, target);  // next to the target
+    }
+    // The copy's own quadrature: its half gaps (its targets lie 2 pi / base apart, farther than
+    // twice any window, so no two of them share a step).
+    std::vector<double> azimuths;
+    for (const LatticeDirection& d : copy) azimuths.push_back(d.azimuth);
+    const std::vector<double> weights = halfGapWeights(azimuths);
+    for (int k = 0; k < base; ++k) copy[k].weight = weights[k];
+    out.insert(out.end(), copy.begin(), copy.end());
+  }
   return out;
 }
 

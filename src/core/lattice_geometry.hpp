@@ -225,6 +225,22 @@ LatticeWindow latticeWindow(const HeightField& field, const LatticeDirection& d,
 // Signed difference of two angles (radians), in (-pi, pi].
 double angleDifference(double x, double y);
 
+// Nested quadrature sets (HorizonOptions::max_error's sky-view factor and occlusion): a run adds
+// directions to those before instead of computing a new set. Copy c = 0, 1, 2, ... holds `base`
+// directions, direction k aimed at 2 pi (k + v(c)) / base + offset, v the van der Corput sequence
+// 0, 1/2, 1/4, 3/4, 1/8, ... (vanDerCorput): the first m copies together aim at the m base
+// azimuths of the uniform set of m base directions when m is a power of 2, and fill its gaps in
+// halves otherwise. Each direction takes the cheapest step strictly within half the spacing of
+// the set its copy completes (nestedLevelCopies(c) copies, the least power of 2 above c; the
+// closest step when none is inside, as latticeDirections does), so that a copy added late is as
+// close to its azimuths as a uniform set of that K, and one added early as cheap as a coarse one.
+// Each copy is weighted by its own half gaps (its weights sum to 1): the set's quadrature is the
+// mean of its copies'. nestedCopySteps gives copies [first, end), in order.
+double vanDerCorput(int c);
+int nestedLevelCopies(int c);
+std::vector<LatticeDirection> nestedCopySteps(const HeightField& field, double azimuth_offset, int base, int first,
+                                              int end);
+
 // Quadrature weights of directions at these azimuths (in increasing order around the circle):
 // half the gap to each neighbour, over 2 pi (1 for one direction, 1/2 each for two).
 std::vector<double> halfGapWeights(const std::vector<double>& azimuths);

@@ -57,6 +57,7 @@ struct RunDirection {
   std::vector<float> row_length, row_terms;
   std::vector<std::uint32_t> row_beyond;
   int index = 0;  // k
+  float swath = 0.0f;  // occlusion's swath factor: swathFactor(weight), or a nested set's nestedSwath
 };
 
 // Planes per pixel an environment's sums take (one per channel), and the bytes of its map and of
@@ -220,13 +221,36 @@ std::vector<LatticeLine> linesReaching(const std::vector<LatticeLine>& lines, in
 
 // `wanted` (null: every pixel): the sweep runs only the lines that reach those pixels
 // (linesReaching); the others' outputs are left unfinished.
+// `nested` (null: the options' K directions): copies [first, end) of the nested set, each copy's
+// weights its own (nestedCopySteps), per row too with per-row spacing, and swaths nestedSwath.
 std::vector<RunDirection> runDirectionsOf(const HeightField& field, const HorizonOptions& options,
-                                          const HorizonOutputs& outputs, const std::vector<char>* wanted) {
+                                          const HorizonOutputs& outputs, const std::vector<char>* wanted,
+                                          const NestedCopies* nested) {
   std::vector<RunDirection> out;
   if (options.method == HorizonMethod::Sweep) {
-    const std::vector<LatticeDirection> directions = horizonDirections(field, options, outputs);
+    std::vector<LatticeDirection> directions;
     std::vector<RowTable> rows;
-    if (hasRowSpacing(field)) rows = latticeRowTables(field, directions, !exactAzimuths(outputs), outputs.error_estimate);
+    std::vector<int> level_copies;  // nested: per direction, nestedLevelCopies of its copy
+    if (nested) {
+      directions = nestedCopySteps(field, options.azimuth_offset, kNestedBase, nested->first, nested->end);
+      for (int c = nested->first; c < nested->end; ++c) {
+        level_copies.insert(level_copies.end(), kNestedBase, nestedLevelCopies(c));
+        if (!hasRowSpacing(field)) continue;
+        // Each copy its own quadrature per row, its swaths nestedSwath's.
+        const auto first = directions.begin() + (c - nested->first) * kNestedBase;
+        std::vector<RowTable> copy =
+            latticeRowTables(field, std::vector<LatticeDirection>(first, first + kNestedBase), true);
+        for (RowTable& table : copy) {
+          for (std::size_t t = 0; t < table.terms.size(); t += 4)
+            table.terms[t + 3] = nestedSwath(table.terms[t + 2], nestedLevelCopies(c));
+          rows.push_back(std::move(table));
+        }
+      }
+    } else {
+      directions = horizonDirections(field, options, outputs);
+      if (hasRowSpacing(field))
+        rows = latticeRowTables(field, directions, !exactAzimuths(outputs), outputs.error_estimate);
+    }
     for (std::size_t k = 0; k < directions.size(); ++k) {
       const LatticeDirection& d = directions[k];
       std::vector<CellSegment> segments = cellSegments(d, options.samples_per_unit);
@@ -245,6 +269,7 @@ std::vector<RunDirection> runDirectionsOf(const HeightField& field, const Horizo
                      {},
                      {},
                      static_cast<int>(k)});
+      out.back().swath = nested ? nestedSwath(d.weight, level_copies[k]) : swathFactor(static_cast<float>(d.weight));
       if (wanted) out.back().lines = linesReaching(out.back().lines, d.a, d.b, field.width, *wanted);
       if (!rows.empty()) {
         out.back().row_length = std::move(rows[k].length);
@@ -263,6 +288,7 @@ std::vector<RunDirection> runDirectionsOf(const HeightField& field, const Horizo
       r.ray = d;
       r.lattice.azimuth = directionAzimuth(k, options);
       r.lattice.weight = 1.0 / options.directions;
+      r.swath = swathFactor(static_cast<float>(r.lattice.weight));
       r.cos_azimuth = d.cos_azimuth;
       r.sin_azimuth = d.sin_azimuth;
       // With per-row spacing the march cuts at the ground length itself (horizon_naive's max_ground).
@@ -287,14 +313,15 @@ struct StacksBeyondStrips : MemoryBudgetError {
 
 class HorizonRoutine : public SweepRoutine {
  public:
-  // `wanted`: as runDirectionsOf takes it.
+  // `wanted`, `nested`: as runDirectionsOf takes them (nested: options.directions their count).
   HorizonRoutine(ContextState& st, const HeightField& field, const HorizonOptions& options,
-                 const HorizonOutputs& outputs, const std::vector<char>* wanted = nullptr)
+                 const HorizonOutputs& outputs, const std::vector<char>* wanted = nullptr,
+                 const NestedCopies* nested = nullptr)
       : SweepRoutine(st, field, options),
         horizon_(options),
         outputs_(outputs),
         lanes_(simdLanes(st)),
-        directions_(runDirectionsOf(field, options, outputs, wanted)),
+        directions_(runDirectionsOf(field, options, outputs, wanted, nested)),
         plan_(planRun(field, options, outputs, directions_, st.info)) {
     // A window's blocks are per line, so its strips, and with per-row spacing its whole sweep
     // (positions differ by line there), run one line per work-item.
@@ -618,7 +645,7 @@ class HorizonRoutine : public SweepRoutine {
     kernel.set("cos_azimuth", d.cos_azimuth);
     kernel.set("sin_azimuth", d.sin_azimuth);
     kernel.set("weight", static_cast<float>(d.lattice.weight));
-    kernel.set("swath", swathFactor(static_cast<float>(d.lattice.weight)));
+    kernel.set("swath", d.swath);
     kernel.set("plane", plane_offset);
     if (horizon_.method == HorizonMethod::Sweep) {  // the stride is set per chunk
       kernel.set("stacks", stacks_);
@@ -915,6 +942,156 @@ class HorizonRoutine : public SweepRoutine {
       placeholder_, env_sum_, env_tables_;
 };
 
+// The field's tiles of side x side pixels (HorizonOptions::error_tile; 0: the whole field in
+// one), row-major; a tile's pixels are found from its rectangle, not kept in lists.
+struct ErrorTiles {
+  ErrorTiles(const HeightField& field, int error_tile)
+      : width(field.width),
+        height(field.height),
+        side(error_tile > 0 ? error_tile : std::max(field.width, field.height)),
+        across((width + side - 1) / side),
+        count(across * ((height + side - 1) / side)) {}
+  int of(std::size_t p) const {
+    return static_cast<int>(p / width) / side * across + static_cast<int>(p % width) / side;
+  }
+  template <class Visit>
+  void forEachPixel(int t, Visit&& visit) const {
+    const int r0 = t / across * side, c0 = t % across * side;
+    for (int r = r0; r < std::min(height, r0 + side); ++r)
+      for (int c = c0; c < std::min(width, c0 + side); ++c) visit(static_cast<std::size_t>(r) * width + c);
+  }
+  std::vector<float> values(const std::vector<float>& plane, int t) const {
+    std::vector<float> out;
+    forEachPixel(t, [&](std::size_t p) { out.push_back(plane[p]); });
+    return out;
+  }
+  // Pixels with data (not NaN in `plane`) the 99th percentile (estimatedError) lets lie above it.
+  static std::size_t allowedAbove(const std::vector<float>& plane) {
+    const std::size_t with_data = static_cast<std::size_t>(
+        std::count_if(plane.begin(), plane.end(), [](float e) { return !std::isnan(e); }));
+    return with_data ? with_data - 1 - std::min(with_data - 1, static_cast<std::size_t>(0.99 * with_data)) : 0;
+  }
+  int width, height, side, across, count;
+};
+
+// A nested run's sums (NestedCopies: each copy's weights sum to 1) made the mean of its
+// `copies` copies: the sky-view factor 1 - sum / copies, the occlusion sum / copies.
+void meanOfCopies(HorizonResult& r, int copies) {
+  for (float& v : r.sky_view_factor) v = static_cast<float>(1.0 - (1.0 - double(v)) / copies);
+  for (float& v : r.ambient_occlusion) v = static_cast<float>(double(v) / copies);
+}
+
+// The nested set doubled at pixel p: `into` holds the mean of the first m copies, `added` that
+// of copies [m, 2 m) (each a uniform set of m kNestedBase directions, turned by half its
+// spacing against the other); `into` becomes their mean, and the raw estimate (half their
+// difference, the larger of the sky-view factor's and occlusion's) is returned; NaN at nodata.
+float doubleNested(HorizonResult& into, const HorizonResult& added, std::size_t p) {
+  float raw = 0.0f;
+  const auto merge = [&](std::vector<float>& plane, const std::vector<float>& more) {
+    if (plane.empty()) return;
+    const double a = plane[p], b = more[p];
+    raw = std::isnan(a) ? plane[p] : std::max(raw, static_cast<float>(0.5 * std::abs(a - b)));
+    plane[p] = static_cast<float>(0.5 * (a + b));
+  };
+  merge(into.sky_view_factor, added.sky_view_factor);
+  merge(into.ambient_occlusion, added.ambient_occlusion);
+  return raw;
+}
+
+using NestedRunner = std::function<HorizonResult(const NestedCopies&, const std::vector<char>*)>;
+
+// HorizonOptions::max_error with the sweep: nested sets. The whole field runs copy 0 and copy 1
+// (K = 16, its first estimate), then, while the estimate's 99th percentile over the field exceeds
+// max_error, the tiles with the most pixels above it (until those left hold at most half the
+// pixels the field's percentile lets above it; error_tile 0: one tile) double their set: a run
+// of copies [m, 2 m) over the lines that reach them (tiles at the same m share it), the pixel's
+// result the mean of the two halves and its raw estimate half their difference, divided by
+// richardsonDivisor at the order the tile's doublings measure (estimateOrder). Refused
+// (beyondAutoDirections) when a tile's prediction (nextDirectionsForError) or its next doubling
+// exceeds kMaxAutoDirections. `run(copies, wanted)`: the sums of those copies over the lines that
+// reach the pixels of `wanted` (null: the whole field).
+HorizonResult runToErrorNested(const HeightField& field, const HorizonOptions& options, const NestedRunner& run) {
+  const ErrorTiles tiles(field, options.error_tile);
+  const std::size_t pixels = field.pixelCount();
+  HorizonResult result = run({0, 1}, nullptr);
+  double work = result.samples_per_receiver;
+  result.runs = {kNestedBase};
+  std::vector<int> copies(tiles.count, 1);
+  std::vector<std::vector<EstimateRun>> history(tiles.count);  // per tile, its doublings' raw estimates
+  std::vector<double> divisor(tiles.count, 1.0);
+  std::vector<float> raw(pixels, 0.0f);
+  result.error_estimate.assign(pixels, 0.0f);
+  // Copies [m, 2 m) of the tiles of `chosen` (all at m copies): their pixels doubled.
+  const auto doubleTiles = [&](int m, const std::vector<char>& chosen) {
+    const bool all = std::count(chosen.begin(), chosen.end(), 1) == tiles.count;
+    std::vector<char> wanted;
+    if (!all) {
+      wanted.assign(pixels, 0);
+      for (int t = 0; t < tiles.count; ++t)
+        if (chosen[t]) tiles.forEachPixel(t, [&](std::size_t p) { wanted[p] = 1; });
+    }
+    HorizonResult part = run({m, 2 * m}, all ? nullptr : &wanted);
+    meanOfCopies(part, m);
+    work += part.samples_per_receiver;
+    const int directions = 2 * m * kNestedBase;
+    result.runs.push_back(directions);
+    for (int t = 0; t < tiles.count; ++t) {
+      if (!chosen[t]) continue;
+      tiles.forEachPixel(t, [&](std::size_t p) { raw[p] = doubleNested(result, part, p); });
+      copies[t] = 2 * m;
+      history[t].push_back({directions, estimatedError(tiles.values(raw, t))});
+      divisor[t] = richardsonDivisor(estimateOrder(history[t]));
+      tiles.forEachPixel(t, [&](std::size_t p) {
+        result.error_estimate[p] = static_cast<float>(raw[p] / divisor[t]);
+        result.pixel_directions[p] = directions;
+      });
+    }
+    result.directions = std::max(result.directions, directions);
+  };
+  result.pixel_directions.assign(pixels, kNestedBase);
+  doubleTiles(1, std::vector<char>(tiles.count, 1));
+  const std::size_t allowed = ErrorTiles::allowedAbove(result.error_estimate);
+  for (;;) {
+    std::vector<std::size_t> above(tiles.count, 0);
+    for (std::size_t p = 0; p < pixels; ++p)
+      above[tiles.of(p)] += result.error_estimate[p] > options.max_error;  // (NaN: not above)
+    std::size_t left = std::accumulate(above.begin(), above.end(), std::size_t{0});
+    if (left <= allowed) break;
+    std::vector<int> order(tiles.count);
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(), [&](int x, int y) { return above[x] > above[y]; });
+    std::map<int, std::vector<char>> next;  // m -> the tiles to double from m copies
+    for (int t : order) {
+      if (left <= allowed / 2 || above[t] == 0) break;
+      left -= above[t];
+      const NextErrorRun asked = nextDirectionsForError(history[t], options.max_error);
+      const int doubled = 2 * copies[t] * kNestedBase;
+      if (asked.predicted > kMaxAutoDirections || doubled > kMaxAutoDirections)
+        throw beyondAutoDirections(options.max_error, std::max(asked.predicted, doubled), history[t].back().directions,
+                                   estimatedError(tiles.values(result.error_estimate, t)),
+                                   tiles.count > 1 ? " in the tile of pixels from column " +
+                                                         std::to_string(t % tiles.across * tiles.side) + ", row " +
+                                                         std::to_string(t / tiles.across * tiles.side)
+                                                   : std::string());
+      std::vector<char>& chosen = next[copies[t]];
+      chosen.resize(tiles.count, 0);
+      chosen[t] = 1;
+    }
+    for (const auto& [m, chosen] : next) doubleTiles(m, chosen);
+  }
+  // The largest set's azimuths, copy by copy.
+  result.azimuths.clear();
+  for (const LatticeDirection& d :
+       nestedCopySteps(field, options.azimuth_offset, kNestedBase, 0, result.directions / kNestedBase))
+    result.azimuths.push_back(d.azimuth);
+  const auto [least, most] = std::minmax_element(divisor.begin(), divisor.end());
+  result.richardson_divisor_least = *least;
+  result.richardson_divisor_most = *most;
+  result.estimated_error = estimatedError(result.error_estimate);
+  result.samples_per_receiver = work;
+  return result;
+}
+
 // HorizonOptions::max_error: the whole field at kFirstAutoDirections, then, while the error
 // estimate's 99th percentile over the field exceeds max_error, tiles again at the K
 // nextDirectionsForError asks for after their own runs, those of one K in one run over the lines
@@ -926,17 +1103,9 @@ class HorizonRoutine : public SweepRoutine {
 // whole field).
 HorizonResult runToError(const HeightField& field, const HorizonOptions& options,
                          const std::function<HorizonResult(int, const std::vector<char>*)>& run) {
-  const int width = field.width, height = field.height;
-  const int side = options.error_tile > 0 ? options.error_tile : std::max(width, height);
-  const int tiles_x = (width + side - 1) / side, tiles = tiles_x * ((height + side - 1) / side);
-  std::vector<int> tile_of(field.pixelCount());
-  std::vector<std::vector<std::size_t>> pixels_of(tiles);
-  for (int r = 0; r < height; ++r)
-    for (int c = 0; c < width; ++c) {
-      const std::size_t p = static_cast<std::size_t>(r) * width + c;
-      tile_of[p] = r / side * tiles_x + c / side;
-      pixels_of[tile_of[p]].push_back(p);
-    }
+  const ErrorTiles grid(field, options.error_tile);
+  const int tiles = grid.count, tiles_x = grid.across, side = grid.side;
+  const std::size_t pixels = field.pixelCount();
   std::vector<std::vector<EstimateRun>> history(tiles);  // per tile, the runs its pixels took
   std::vector<double> divisor(tiles, 1.0);
   // A run at K over the tiles of `chosen`: their raw estimates' percentiles recorded, and the
@@ -944,9 +1113,7 @@ HorizonResult runToError(const HeightField& field, const HorizonOptions& options
   const auto record = [&](const std::vector<float>& raw, int directions, const std::vector<char>& chosen) {
     for (int t = 0; t < tiles; ++t) {
       if (!chosen[t]) continue;
-      std::vector<float> values;
-      for (std::size_t p : pixels_of[t]) values.push_back(raw[p]);
-      history[t].push_back({directions, estimatedError(values)});
+      history[t].push_back({directions, estimatedError(grid.values(raw, t))});
       divisor[t] = richardsonDivisor(estimateOrder(history[t]));
     }
   };
@@ -954,22 +1121,15 @@ HorizonResult runToError(const HeightField& field, const HorizonOptions& options
   result.runs = {kFirstAutoDirections};
   result.pixel_directions.assign(field.pixelCount(), kFirstAutoDirections);
   record(result.error_estimate, kFirstAutoDirections, std::vector<char>(tiles, 1));
-  for (std::size_t p = 0; p < tile_of.size(); ++p)
-    result.error_estimate[p] = static_cast<float>(result.error_estimate[p] / divisor[tile_of[p]]);
+  for (std::size_t p = 0; p < pixels; ++p)
+    result.error_estimate[p] = static_cast<float>(result.error_estimate[p] / divisor[grid.of(p)]);
   double work = result.samples_per_receiver;
   const std::vector<int> ladder = directionLadder();
-  // Pixels with data the 99th percentile (estimatedError) lets lie above it.
-  const std::size_t with_data = static_cast<std::size_t>(std::count_if(
-      result.error_estimate.begin(), result.error_estimate.end(), [](float e) { return !std::isnan(e); }));
-  const std::size_t allowed =
-      with_data ? with_data - 1 - std::min(with_data - 1, static_cast<std::size_t>(0.99 * with_data)) : 0;
+  const std::size_t allowed = ErrorTiles::allowedAbove(result.error_estimate);
   for (;;) {
-    std::vector<std::vector<float>> estimates(tiles);
     std::vector<std::size_t> above(tiles, 0);
-    for (std::size_t p = 0; p < tile_of.size(); ++p) {
-      estimates[tile_of[p]].push_back(result.error_estimate[p]);
-      above[tile_of[p]] += result.error_estimate[p] > options.max_error;  // (NaN: not above)
-    }
+    for (std::size_t p = 0; p < pixels; ++p)
+      above[grid.of(p)] += result.error_estimate[p] > options.max_error;  // (NaN: not above)
     std::size_t left = std::accumulate(above.begin(), above.end(), std::size_t{0});
     if (left <= allowed) break;
     std::vector<int> order(tiles);
@@ -982,7 +1142,7 @@ HorizonResult runToError(const HeightField& field, const HorizonOptions& options
       const NextErrorRun asked = nextDirectionsForError(history[t], options.max_error);
       if (asked.predicted > kMaxAutoDirections)
         throw beyondAutoDirections(options.max_error, asked.predicted, history[t].back().directions,
-                                   estimatedError(estimates[t]),
+                                   estimatedError(grid.values(result.error_estimate, t)),
                                    tiles > 1 ? " in the tile of pixels from column " +
                                                    std::to_string(t % tiles_x * side) + ", row " +
                                                    std::to_string(t / tiles_x * side)
@@ -994,8 +1154,8 @@ HorizonResult runToError(const HeightField& field, const HorizonOptions& options
       chosen[t] = 1;
     }
     for (const auto& [directions, chosen] : next) {
-      std::vector<char> wanted(field.pixelCount());
-      for (std::size_t p = 0; p < wanted.size(); ++p) wanted[p] = chosen[tile_of[p]];
+      std::vector<char> wanted(pixels);
+      for (std::size_t p = 0; p < pixels; ++p) wanted[p] = chosen[grid.of(p)];
       const bool all = std::count(chosen.begin(), chosen.end(), 1) == tiles;
       HorizonResult part = run(directions, all ? nullptr : &wanted);
       result.runs.push_back(directions);
@@ -1010,7 +1170,7 @@ HorizonResult runToError(const HeightField& field, const HorizonOptions& options
       take(result.ambient_occlusion, part.ambient_occlusion);
       for (std::size_t p = 0; p < wanted.size(); ++p)
         if (wanted[p]) {
-          result.error_estimate[p] = static_cast<float>(part.error_estimate[p] / divisor[tile_of[p]]);
+          result.error_estimate[p] = static_cast<float>(part.error_estimate[p] / divisor[grid.of(p)]);
           result.pixel_directions[p] = directions;
         }
       if (directions > result.directions) {
@@ -1019,6 +1179,9 @@ HorizonResult runToError(const HeightField& field, const HorizonOptions& options
       }
     }
   }
+  const auto [least, most] = std::minmax_element(divisor.begin(), divisor.end());
+  result.richardson_divisor_least = *least;
+  result.richardson_divisor_most = *most;
   result.estimated_error = estimatedError(result.error_estimate);
   result.samples_per_receiver = work;
   return result;
@@ -1042,10 +1205,11 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
     // Hull stacks too deep for the room strips leave: again from the start with thinner strips
     // (StacksBeyondStrips::rows), as the sums of the strips done cannot be taken back.
     HorizonOptions attempt = options;
-    const auto run = [&](const HorizonOutputs& wanted, const std::vector<char>* pixels) {
+    const auto run = [&](const HorizonOutputs& wanted, const std::vector<char>* pixels,
+                         const detail::NestedCopies* nested = nullptr) {
       for (;;) {
         try {
-          detail::HorizonRoutine routine(detail::stateOf(context), field, attempt, wanted, pixels);
+          detail::HorizonRoutine routine(detail::stateOf(context), field, attempt, wanted, pixels, nested);
           routine.run();
           return routine.take();
         } catch (const detail::StacksBeyondStrips& error) {
@@ -1070,14 +1234,62 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
       });
     }
     if (options.max_error == 0.0) return run(outputs, nullptr);
-    // Ask for an error: runs at growing K until the estimate meets it (HorizonOptions::max_error).
+    // Ask for an error: runs until the estimate meets it (HorizonOptions::max_error): the sweep's
+    // nested sets, the naive march's ladder of fresh sets at growing K.
+    if (options.method == HorizonMethod::Sweep)
+      return detail::runToErrorNested(field, options, [&](const detail::NestedCopies& copies,
+                                                          const std::vector<char>* wanted) {
+        attempt.directions = (copies.end - copies.first) * detail::kNestedBase;
+        return run(outputs, wanted, &copies);
+      });
     HorizonOutputs estimated = outputs;
     estimated.error_estimate = true;
     return detail::runToError(field, options, [&](int directions, const std::vector<char>* wanted) {
       attempt.directions = directions;
-      return run(estimated, wanted);
+      return run(estimated, wanted, nullptr);
     });
   });
 }
+
+namespace detail {
+
+HorizonResult computeNestedSet(const ComputeContext& context, const HeightField& field, const HorizonOptions& options,
+                               const HorizonOutputs& outputs, int copies, bool one_shot) {
+  hfvis::validate(field);
+  HorizonOptions plain = options;
+  plain.max_error = 0.0;
+  plain.error_tile = 0;
+  hfvis::validate(plain, outputs);
+  if (copies < 1 || (!one_shot && (copies & (copies - 1))) || outputs.error_estimate || exactAzimuths(outputs) ||
+      outputs.environment || options.method != HorizonMethod::Sweep)
+    throw InvalidArgument(
+        "a nested set takes the sweep's sky-view factor and occlusion alone, and a power of 2 copies run by run");
+  return translateOpenClErrors([&] {
+    const auto run = [&](const NestedCopies& range) {
+      plain.directions = (range.end - range.first) * kNestedBase;
+      HorizonRoutine routine(stateOf(context), field, plain, outputs, nullptr, &range);
+      routine.run();
+      HorizonResult result = routine.take();
+      meanOfCopies(result, range.end - range.first);
+      return result;
+    };
+    if (one_shot) return run({0, copies});
+    HorizonResult result = run({0, 1});
+    for (int m = 1; m < copies; m *= 2) {
+      const HorizonResult added = run({m, 2 * m});
+      result.error_estimate.assign(field.pixelCount(), 0.0f);
+      for (std::size_t p = 0; p < field.pixelCount(); ++p) result.error_estimate[p] = doubleNested(result, added, p);
+      result.estimated_error = estimatedError(result.error_estimate);
+      result.samples_per_receiver += added.samples_per_receiver;
+    }
+    result.directions = copies * kNestedBase;
+    result.azimuths.clear();
+    for (const LatticeDirection& d : nestedCopySteps(field, options.azimuth_offset, kNestedBase, 0, copies))
+      result.azimuths.push_back(d.azimuth);
+    return result;
+  });
+}
+
+}  // namespace detail
 
 }  // namespace hfvis
