@@ -329,14 +329,15 @@ void nestedCurve(const ComputeContext& context, const std::vector<ErrorTargetFie
       "AO p99 nested | AO p99 uniform |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   HorizonOutputs both;
   both.sky_view_factor = both.ambient_occlusion = true;
+  constexpr int kBase = 8;  // copies of 8 directions: the deepest sets
   for (const ErrorTargetField& f : fields) {
     HorizonOptions options;
     options.directions = reference_directions;
     const HorizonResult reference = computeHorizons(context, f.field, options, both);
     for (int m : {1, 2, 3, 4, 5, 6, 7, 8, 10, 12, 14, 16, 20, 24, 28, 32, 40, 48, 56, 64, 96, 128, 192, 256}) {
-      if (m * detail::kNestedBase > max_directions) break;
-      const HorizonResult nested = detail::computeNestedSet(context, f.field, options, both, m, true);
-      options.directions = m * detail::kNestedBase;
+      if (m * kBase > max_directions) break;
+      const HorizonResult nested = detail::computeNestedSet(context, f.field, options, both, kBase, m, true);
+      options.directions = m * kBase;
       const HorizonResult uniform = computeHorizons(context, f.field, options, both);
       std::printf("| %s | %d | %d | %.0f | %.0f | %.5f | %.5f | %.5f | %.5f |\n", f.name.c_str(),
                   options.directions, m, nested.samples_per_receiver, uniform.samples_per_receiver,

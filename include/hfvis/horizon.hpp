@@ -143,6 +143,13 @@ struct HorizonResult {
   // With HorizonOptions::max_error (sky-view factor, occlusion): the least and the most Richardson
   // divisor 2^p - 1 the raw estimate was divided by, over the tiles (equal with one tile).
   double richardson_divisor_least = 0.0, richardson_divisor_most = 0.0;
+  // With HorizonOptions::max_error (sky-view factor and occlusion, the sweep), per tile (row-major
+  // tiles of error_tile pixels; one for the whole field): the base of its nested set, the
+  // directions per copy, whose K the tile's pixel_directions give (HorizonOptions::max_error).
+  std::vector<int> tile_bases;
+  // With HorizonOptions::max_error (the sweep's sky-view factor and occlusion), per run (as runs):
+  // the base of the nested set it added to.
+  std::vector<int> run_bases;
   // The sweep's work, all runs together (with max_error; else this run's): per receiver of the
   // field, the samples of each direction's period times the receivers on the lines it swept
   // (a whole-field run at K: its directions' samples per period summed; 0 for the naive method).

@@ -40,11 +40,17 @@ void finishReduction(HorizonResult& result);
 constexpr int kFirstAutoDirections = 16;
 
 // HorizonOptions::max_error's sky-view factor and occlusion run nested direction sets
-// (nestedCopySteps, core/lattice_geometry.hpp): copies of kNestedBase directions, a run adding
-// copies [m, 2 m) to the m before it, so that nothing swept is thrown away and the two halves'
-// difference, each a uniform set of m kNestedBase directions turned by half its spacing, is the
-// error estimate for free.
-constexpr int kNestedBase = 8;
+// (nestedCopySteps, core/lattice_geometry.hpp): a set is m copies of a base set of B directions
+// (K = m B), and a run adds copies [m, 2 m) to the m before it, so that nothing swept is thrown
+// away and the two halves' difference (each a set of m B directions aimed at a uniform one, the
+// second turned by half its spacing) is the error estimate for free. Copy 0 alone is the uniform
+// set of B directions and runs with its own estimate (its even and odd directions' halves).
+// Nesting is exact in the targets but not in the lattice steps (a copy added early keeps the
+// wider window of its coarser set), which costs accuracy as the set deepens: the error of 64
+// copies of 8 falls to only 4 to 5 times the uniform set's at K = 512 on the benchmark's city
+// contents (bench/report/nested_sets.md), 2 copies match it. So a set is started afresh at a base
+// of half the K the estimate predicts whenever that is more than twice its K (a new base), and
+// doubled otherwise: a set rarely goes more than a doubling or two deep.
 
 // The occlusion's swath factor of a nested set's direction of copy weight `weight` (its copy's
 // half gaps, summing to 1) in a copy that completes a set of `level_copies` copies:
@@ -53,23 +59,26 @@ constexpr int kNestedBase = 8;
 // directions' weights are weight / m and their swaths this over m: those of the uniform set of
 // that K where the copy entered: for the copies of the last doubling the uniform set's own, for
 // earlier ones a little smaller than their share of the larger set gives (the swath term alone:
-// at most 2.6 % for copy 0, sin(pi / 8) / pi against 1 / 8, 0.6 % for copy 1).
+// (pi / B)^2 / 6 relative for copy 0 of base B, 2.6 % at B = 8, 0.6 % at B = 16).
 float nestedSwath(double weight, int level_copies);
 
-// A run of copies [first, end) of the nested set (HorizonOptions::max_error): its sky-view
-// factor and occlusion are those copies' sums (each copy's weights summing to 1).
+// A run of copies [first, end) of the nested set of `base` directions per copy
+// (HorizonOptions::max_error): its sky-view factor and occlusion are those copies' sums (each
+// copy's weights summing to 1).
 struct NestedCopies {
-  int first = 0, end = 0;
+  int base = 0, first = 0, end = 0;
 };
 
 // The sky-view factor and occlusion (`outputs`, no estimate, planes or environment; the sweep) of
-// the first `copies` copies of the nested set over the whole field, each the mean of its copies'
-// (HorizonOptions::max_error's results at K = copies * kNestedBase): run by run as max_error adds
-// them (copies [0, 1), [1, 2), [2, 4) ...; `copies` a power of 2), with the raw estimate of the
-// last doubling (error_estimate, estimated_error; none for one copy), or `one_shot`: all in one
-// run. HorizonResult::azimuths: the set's, copy by copy. (Tests and the benchmark compare them.)
+// the first `copies` copies of the nested set of `base` directions per copy over the whole field,
+// each the mean of its copies' (HorizonOptions::max_error's results at K = copies * base): run by
+// run as max_error adds them (copy 0 with its own halves' estimate, then copies [1, 2), [2, 4)
+// ...; `copies` a power of 2), with the raw estimate of the last run (error_estimate,
+// estimated_error: half the difference of its halves), or `one_shot`: all in one run, no
+// estimate. HorizonResult::azimuths: the set's, copy by copy. (Tests and the benchmark compare
+// them.)
 HorizonResult computeNestedSet(const ComputeContext& context, const HeightField& field, const HorizonOptions& options,
-                               const HorizonOutputs& outputs, int copies, bool one_shot);
+                               const HorizonOutputs& outputs, int base, int copies, bool one_shot);
 
 // The error estimate (HorizonOutputs::error_estimate) from the sums of the even-numbered
 // directions in `result` (sky-view factor and occlusion, before finishReduction) and those of the

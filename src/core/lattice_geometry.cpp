@@ -182,12 +182,9 @@ std::vector<LatticeDirection> nestedCopySteps(const HeightField& field, double a
       copy.push_back(makeDirection(field, chosen ? *chosen : *closest));
       copy.back().azimuth = target + angleDifference(copy.back().azimuth, target);  // next to the target
     }
-    // The copy's own quadrature: its half gaps (its targets lie 2 pi / base apart, farther than
-    // twice any window, so no two of them share a step).
-    std::vector<double> azimuths;
-    for (const LatticeDirection& d : copy) azimuths.push_back(d.azimuth);
-    const std::vector<double> weights = halfGapWeights(azimuths);
-    for (int k = 0; k < base; ++k) copy[k].weight = weights[k];
+    // The copy's own quadrature: its half gaps, coinciding steps (near the axes at a large base)
+    // merged within a parity, as a uniform set with the error estimate's halves takes them.
+    setQuadratureWeights(copy, true);
     out.insert(out.end(), copy.begin(), copy.end());
   }
   return out;

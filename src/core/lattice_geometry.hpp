@@ -234,8 +234,10 @@ double angleDifference(double x, double y);
 // the set its copy completes (nestedLevelCopies(c) copies, the least power of 2 above c; the
 // closest step when none is inside, as latticeDirections does), so that a copy added late is as
 // close to its azimuths as a uniform set of that K, and one added early as cheap as a coarse one.
-// Each copy is weighted by its own half gaps (its weights sum to 1): the set's quadrature is the
-// mean of its copies'. nestedCopySteps gives copies [first, end), in order.
+// Each copy is weighted by its own half gaps (setQuadratureWeights with parity_apart: its weights
+// sum to 1): the set's quadrature is the mean of its copies'. Copy 0 alone is the uniform set of
+// `base` directions (latticeDirections' steps and weights with the error estimate's halves).
+// nestedCopySteps gives copies [first, end), in order.
 double vanDerCorput(int c);
 int nestedLevelCopies(int c);
 std::vector<LatticeDirection> nestedCopySteps(const HeightField& field, double azimuth_offset, int base, int first,

@@ -232,14 +232,15 @@ std::vector<RunDirection> runDirectionsOf(const HeightField& field, const Horizo
     std::vector<RowTable> rows;
     std::vector<int> level_copies;  // nested: per direction, nestedLevelCopies of its copy
     if (nested) {
-      directions = nestedCopySteps(field, options.azimuth_offset, kNestedBase, nested->first, nested->end);
+      const int base = nested->base;
+      directions = nestedCopySteps(field, options.azimuth_offset, base, nested->first, nested->end);
       for (int c = nested->first; c < nested->end; ++c) {
-        level_copies.insert(level_copies.end(), kNestedBase, nestedLevelCopies(c));
+        level_copies.insert(level_copies.end(), base, nestedLevelCopies(c));
         if (!hasRowSpacing(field)) continue;
         // Each copy its own quadrature per row, its swaths nestedSwath's.
-        const auto first = directions.begin() + (c - nested->first) * kNestedBase;
+        const auto first = directions.begin() + (c - nested->first) * base;
         std::vector<RowTable> copy =
-            latticeRowTables(field, std::vector<LatticeDirection>(first, first + kNestedBase), true);
+            latticeRowTables(field, std::vector<LatticeDirection>(first, first + base), true, true);
         for (RowTable& table : copy) {
           for (std::size_t t = 0; t < table.terms.size(); t += 4)
             table.terms[t + 3] = nestedSwath(table.terms[t + 2], nestedLevelCopies(c));
@@ -982,9 +983,8 @@ void meanOfCopies(HorizonResult& r, int copies) {
 }
 
 // The nested set doubled at pixel p: `into` holds the mean of the first m copies, `added` that
-// of copies [m, 2 m) (each a uniform set of m kNestedBase directions, turned by half its
-// spacing against the other); `into` becomes their mean, and the raw estimate (half their
-// difference, the larger of the sky-view factor's and occlusion's) is returned; NaN at nodata.
+// of copies [m, 2 m); `into` becomes their mean, and the raw estimate (half their difference,
+// the larger of the sky-view factor's and occlusion's) is returned; NaN at nodata.
 float doubleNested(HorizonResult& into, const HorizonResult& added, std::size_t p) {
   float raw = 0.0f;
   const auto merge = [&](std::vector<float>& plane, const std::vector<float>& more) {
@@ -998,31 +998,48 @@ float doubleNested(HorizonResult& into, const HorizonResult& added, std::size_t 
   return raw;
 }
 
+// `run(copies, wanted)`: the sums of those copies over the lines that reach the pixels of `wanted`
+// (null: the whole field), with the raw error estimate (splitErrorHalves) for copy 0 alone.
 using NestedRunner = std::function<HorizonResult(const NestedCopies&, const std::vector<char>*)>;
 
-// HorizonOptions::max_error with the sweep: nested sets. The whole field runs copy 0 and copy 1
-// (K = 16, its first estimate), then, while the estimate's 99th percentile over the field exceeds
-// max_error, the tiles with the most pixels above it (until those left hold at most half the
-// pixels the field's percentile lets above it; error_tile 0: one tile) double their set: a run
-// of copies [m, 2 m) over the lines that reach them (tiles at the same m share it), the pixel's
-// result the mean of the two halves and its raw estimate half their difference, divided by
-// richardsonDivisor at the order the tile's doublings measure (estimateOrder). Refused
-// (beyondAutoDirections) when a tile's prediction (nextDirectionsForError) or its next doubling
-// exceeds kMaxAutoDirections. `run(copies, wanted)`: the sums of those copies over the lines that
-// reach the pixels of `wanted` (null: the whole field).
+// The K a nested set of `base` directions per copy doubles to, or, where the estimate predicts
+// more than that (`next`, nextDirectionsForError's), a new base: half of it (at least the set's K
+// and 8 more: the new set's copy 0 is a probe whose own estimate may meet max_error already, and
+// its second copy reaches `next`), so that a far prediction never deepens the set.
+// With `ladder` (tiles), the new base is rounded up to directionLadder's next K, so that tiles of
+// about the same need share a run.
+NestedCopies nextNested(int base, int copies, int next, bool ladder) {
+  const int directions = base * copies;
+  if (next <= 2 * directions && 2 * directions <= kMaxAutoDirections) return {base, copies, 2 * copies};
+  int half = std::max(static_cast<int>(std::ceil(next / 16.0) * 8.0), directions + 8);
+  if (ladder) {
+    static const std::vector<int> rungs = directionLadder();
+    half = *std::lower_bound(rungs.begin(), rungs.end(), std::min(half, kMaxAutoDirections));
+  }
+  return {std::min(half, kMaxAutoDirections), 0, 1};
+}
+
+// HorizonOptions::max_error with the sweep: nested sets. The whole field runs copy 0 of the base
+// kFirstAutoDirections (the uniform set of 16, with its halves' estimate), then, while the
+// estimate's 99th percentile over the field exceeds max_error, the tiles with the most pixels
+// above it (until those left hold at most half the pixels the field's percentile lets above it;
+// error_tile 0: one tile) run again as nextNested asks from nextDirectionsForError's K: their set
+// doubled (copies [m, 2 m) of their base over the lines that reach them, each pixel's result the
+// mean of the two halves and its raw estimate half their difference), or copy 0 of a new base;
+// tiles asking for the same run share it. Each pixel's estimate is the raw one over
+// richardsonDivisor at the order its tile's runs measure (estimateOrder). Refused
+// (beyondAutoDirections) when a tile's prediction exceeds kMaxAutoDirections.
 HorizonResult runToErrorNested(const HeightField& field, const HorizonOptions& options, const NestedRunner& run) {
   const ErrorTiles tiles(field, options.error_tile);
   const std::size_t pixels = field.pixelCount();
-  HorizonResult result = run({0, 1}, nullptr);
-  double work = result.samples_per_receiver;
-  result.runs = {kNestedBase};
-  std::vector<int> copies(tiles.count, 1);
-  std::vector<std::vector<EstimateRun>> history(tiles.count);  // per tile, its doublings' raw estimates
+  HorizonResult result;
+  double work = 0.0;
+  std::vector<NestedCopies> set(tiles.count, NestedCopies{kFirstAutoDirections, 0, 0});  // per tile, its set
+  std::vector<std::vector<EstimateRun>> history(tiles.count);  // per tile, its runs' raw estimates
   std::vector<double> divisor(tiles.count, 1.0);
   std::vector<float> raw(pixels, 0.0f);
-  result.error_estimate.assign(pixels, 0.0f);
-  // Copies [m, 2 m) of the tiles of `chosen` (all at m copies): their pixels doubled.
-  const auto doubleTiles = [&](int m, const std::vector<char>& chosen) {
+  // The run `copies` for the tiles of `chosen`.
+  const auto runTiles = [&](const NestedCopies& copies, const std::vector<char>& chosen) {
     const bool all = std::count(chosen.begin(), chosen.end(), 1) == tiles.count;
     std::vector<char> wanted;
     if (!all) {
@@ -1030,26 +1047,42 @@ HorizonResult runToErrorNested(const HeightField& field, const HorizonOptions& o
       for (int t = 0; t < tiles.count; ++t)
         if (chosen[t]) tiles.forEachPixel(t, [&](std::size_t p) { wanted[p] = 1; });
     }
-    HorizonResult part = run({m, 2 * m}, all ? nullptr : &wanted);
-    meanOfCopies(part, m);
+    HorizonResult part = run(copies, all ? nullptr : &wanted);
     work += part.samples_per_receiver;
-    const int directions = 2 * m * kNestedBase;
+    const int directions = copies.base * copies.end;
+    if (result.runs.empty()) {  // the first run: the whole field's
+      part.runs = {};
+      part.run_bases = {};
+      result = std::move(part);
+      raw = result.error_estimate;
+      result.pixel_directions.assign(pixels, directions);
+    } else {
+      meanOfCopies(part, copies.end - copies.first);
+      for (int t = 0; t < tiles.count; ++t) {
+        if (!chosen[t]) continue;
+        tiles.forEachPixel(t, [&](std::size_t p) {
+          if (copies.first > 0) {
+            raw[p] = doubleNested(result, part, p);
+          } else {  // a new base: its copy 0 and that run's own estimate
+            if (!result.sky_view_factor.empty()) result.sky_view_factor[p] = part.sky_view_factor[p];
+            if (!result.ambient_occlusion.empty()) result.ambient_occlusion[p] = part.ambient_occlusion[p];
+            raw[p] = part.error_estimate[p];
+          }
+          result.pixel_directions[p] = directions;
+        });
+      }
+    }
     result.runs.push_back(directions);
+    result.run_bases.push_back(copies.base);
     for (int t = 0; t < tiles.count; ++t) {
       if (!chosen[t]) continue;
-      tiles.forEachPixel(t, [&](std::size_t p) { raw[p] = doubleNested(result, part, p); });
-      copies[t] = 2 * m;
+      set[t] = copies;
       history[t].push_back({directions, estimatedError(tiles.values(raw, t))});
       divisor[t] = richardsonDivisor(estimateOrder(history[t]));
-      tiles.forEachPixel(t, [&](std::size_t p) {
-        result.error_estimate[p] = static_cast<float>(raw[p] / divisor[t]);
-        result.pixel_directions[p] = directions;
-      });
+      tiles.forEachPixel(t, [&](std::size_t p) { result.error_estimate[p] = static_cast<float>(raw[p] / divisor[t]); });
     }
-    result.directions = std::max(result.directions, directions);
   };
-  result.pixel_directions.assign(pixels, kNestedBase);
-  doubleTiles(1, std::vector<char>(tiles.count, 1));
+  runTiles({kFirstAutoDirections, 0, 1}, std::vector<char>(tiles.count, 1));
   const std::size_t allowed = ErrorTiles::allowedAbove(result.error_estimate);
   for (;;) {
     std::vector<std::size_t> above(tiles.count, 0);
@@ -1060,30 +1093,37 @@ HorizonResult runToErrorNested(const HeightField& field, const HorizonOptions& o
     std::vector<int> order(tiles.count);
     std::iota(order.begin(), order.end(), 0);
     std::stable_sort(order.begin(), order.end(), [&](int x, int y) { return above[x] > above[y]; });
-    std::map<int, std::vector<char>> next;  // m -> the tiles to double from m copies
+    std::map<std::array<int, 3>, std::vector<char>> next;  // (base, first, end) -> the tiles to run so
     for (int t : order) {
       if (left <= allowed / 2 || above[t] == 0) break;
       left -= above[t];
       const NextErrorRun asked = nextDirectionsForError(history[t], options.max_error);
-      const int doubled = 2 * copies[t] * kNestedBase;
-      if (asked.predicted > kMaxAutoDirections || doubled > kMaxAutoDirections)
-        throw beyondAutoDirections(options.max_error, std::max(asked.predicted, doubled), history[t].back().directions,
+      if (asked.predicted > kMaxAutoDirections)
+        throw beyondAutoDirections(options.max_error, asked.predicted, history[t].back().directions,
                                    estimatedError(tiles.values(result.error_estimate, t)),
                                    tiles.count > 1 ? " in the tile of pixels from column " +
                                                          std::to_string(t % tiles.across * tiles.side) + ", row " +
                                                          std::to_string(t / tiles.across * tiles.side)
                                                    : std::string());
-      std::vector<char>& chosen = next[copies[t]];
+      const NestedCopies copies = nextNested(set[t].base, set[t].end, asked.directions, options.error_tile > 0);
+      if (copies.base * copies.end <= set[t].base * set[t].end)  // at kMaxAutoDirections already
+        throw beyondAutoDirections(options.max_error, 2 * kMaxAutoDirections, history[t].back().directions,
+                                   estimatedError(tiles.values(result.error_estimate, t)));
+      std::vector<char>& chosen = next[{copies.base, copies.first, copies.end}];
       chosen.resize(tiles.count, 0);
       chosen[t] = 1;
     }
-    for (const auto& [m, chosen] : next) doubleTiles(m, chosen);
+    for (const auto& [key, chosen] : next) runTiles({key[0], key[1], key[2]}, chosen);
   }
-  // The largest set's azimuths, copy by copy.
+  // The largest set: its K and azimuths, copy by copy; each tile's base.
+  int largest = 0;
+  for (int t = 0; t < tiles.count; ++t)
+    if (set[t].base * set[t].end > set[largest].base * set[largest].end) largest = t;
+  result.directions = set[largest].base * set[largest].end;
   result.azimuths.clear();
-  for (const LatticeDirection& d :
-       nestedCopySteps(field, options.azimuth_offset, kNestedBase, 0, result.directions / kNestedBase))
+  for (const LatticeDirection& d : nestedCopySteps(field, options.azimuth_offset, set[largest].base, 0, set[largest].end))
     result.azimuths.push_back(d.azimuth);
+  for (const NestedCopies& s : set) result.tile_bases.push_back(s.base);
   const auto [least, most] = std::minmax_element(divisor.begin(), divisor.end());
   result.richardson_divisor_least = *least;
   result.richardson_divisor_most = *most;
@@ -1236,14 +1276,14 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
     if (options.max_error == 0.0) return run(outputs, nullptr);
     // Ask for an error: runs until the estimate meets it (HorizonOptions::max_error): the sweep's
     // nested sets, the naive march's ladder of fresh sets at growing K.
+    HorizonOutputs estimated = outputs;
+    estimated.error_estimate = true;
     if (options.method == HorizonMethod::Sweep)
       return detail::runToErrorNested(field, options, [&](const detail::NestedCopies& copies,
                                                           const std::vector<char>* wanted) {
-        attempt.directions = (copies.end - copies.first) * detail::kNestedBase;
-        return run(outputs, wanted, &copies);
+        attempt.directions = (copies.end - copies.first) * copies.base;
+        return run(copies.first == 0 ? estimated : outputs, wanted, &copies);
       });
-    HorizonOutputs estimated = outputs;
-    estimated.error_estimate = true;
     return detail::runToError(field, options, [&](int directions, const std::vector<char>* wanted) {
       attempt.directions = directions;
       return run(estimated, wanted, nullptr);
@@ -1254,37 +1294,44 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
 namespace detail {
 
 HorizonResult computeNestedSet(const ComputeContext& context, const HeightField& field, const HorizonOptions& options,
-                               const HorizonOutputs& outputs, int copies, bool one_shot) {
+                               const HorizonOutputs& outputs, int base, int copies, bool one_shot) {
   hfvis::validate(field);
   HorizonOptions plain = options;
   plain.max_error = 0.0;
   plain.error_tile = 0;
   hfvis::validate(plain, outputs);
-  if (copies < 1 || (!one_shot && (copies & (copies - 1))) || outputs.error_estimate || exactAzimuths(outputs) ||
-      outputs.environment || options.method != HorizonMethod::Sweep)
+  if (base < 2 || base > kMaxAutoDirections || copies < 1 || (!one_shot && (copies & (copies - 1))) ||
+      outputs.error_estimate || exactAzimuths(outputs) || outputs.environment ||
+      options.method != HorizonMethod::Sweep)
     throw InvalidArgument(
-        "a nested set takes the sweep's sky-view factor and occlusion alone, and a power of 2 copies run by run");
+        "a nested set takes the sweep's sky-view factor and occlusion alone, a base of 2 .. 4096 directions, and "
+        "a power of 2 copies run by run");
   return translateOpenClErrors([&] {
-    const auto run = [&](const NestedCopies& range) {
-      plain.directions = (range.end - range.first) * kNestedBase;
-      HorizonRoutine routine(stateOf(context), field, plain, outputs, nullptr, &range);
+    const auto run = [&](const NestedCopies& range, bool estimate) {
+      plain.directions = (range.end - range.first) * base;
+      HorizonOutputs wanted = outputs;
+      wanted.error_estimate = estimate;
+      HorizonRoutine routine(stateOf(context), field, plain, wanted, nullptr, &range);
       routine.run();
       HorizonResult result = routine.take();
       meanOfCopies(result, range.end - range.first);
       return result;
     };
-    if (one_shot) return run({0, copies});
-    HorizonResult result = run({0, 1});
+    if (one_shot) {
+      HorizonResult result = run({base, 0, copies}, false);
+      result.directions = copies * base;
+      return result;
+    }
+    HorizonResult result = run({base, 0, 1}, true);
     for (int m = 1; m < copies; m *= 2) {
-      const HorizonResult added = run({m, 2 * m});
-      result.error_estimate.assign(field.pixelCount(), 0.0f);
+      const HorizonResult added = run({base, m, 2 * m}, false);
       for (std::size_t p = 0; p < field.pixelCount(); ++p) result.error_estimate[p] = doubleNested(result, added, p);
       result.estimated_error = estimatedError(result.error_estimate);
       result.samples_per_receiver += added.samples_per_receiver;
     }
-    result.directions = copies * kNestedBase;
+    result.directions = copies * base;
     result.azimuths.clear();
-    for (const LatticeDirection& d : nestedCopySteps(field, options.azimuth_offset, kNestedBase, 0, copies))
+    for (const LatticeDirection& d : nestedCopySteps(field, options.azimuth_offset, base, 0, copies))
       result.azimuths.push_back(d.azimuth);
     return result;
   });
