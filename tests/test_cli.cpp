@@ -730,6 +730,16 @@ TEST_F(Cli, MaxErrorWritesTheChosenKAndTheEstimate) {
     EXPECT_EQ(image->spec.get_string_attribute("hfvis:max_error"), "0.02");
     EXPECT_NEAR(std::stod(image->spec.get_string_attribute("hfvis:estimated_error")), lib.estimated_error,
                 1e-9);
+    // The divisor the raw estimate was divided by (per tile: least .. most), each 1 .. 2^1.1 - 1.
+    const std::string divisor = image->spec.get_string_attribute("hfvis:richardson_divisor");
+    ASSERT_FALSE(divisor.empty());
+    for (const std::string& part : {divisor.substr(0, divisor.find("..")),
+                                    divisor.substr(divisor.find("..") == std::string::npos ? 0 : divisor.find("..") + 2)}) {
+      EXPECT_GE(std::stod(part), 1.0) << divisor;
+      EXPECT_LE(std::stod(part), std::pow(2.0, 1.1) - 1.0 + 1e-9) << divisor;
+    }
+    EXPECT_NE(image->spec.get_string_attribute("hfvis:runs").find("16 (base 16), "), std::string::npos)
+        << image->spec.get_string_attribute("hfvis:runs");
   }
   EXPECT_LE(lib.estimated_error, 0.02);
   fs::remove(out("s.exr"));

@@ -32,6 +32,21 @@ Attributes sweptAttributes(const Job& job, const HorizonResult& result) {
   }
   if (!result.error_estimate.empty())
     attributes.emplace_back("hfvis:estimated_error", formatNumber(result.estimated_error));
+  if (job.run.max_error > 0.0 && result.richardson_divisor_most > 0.0) {
+    // What the raw estimate (half the halves' difference) was divided by: 2^p - 1, p as the runs
+    // measured it (per tile: the least and most); and each run's K and the base of the nested set
+    // it added to (HorizonOptions::max_error).
+    attributes.emplace_back("hfvis:richardson_divisor",
+                            result.richardson_divisor_least == result.richardson_divisor_most
+                                ? formatNumber(result.richardson_divisor_most)
+                                : formatNumber(result.richardson_divisor_least) + ".." +
+                                      formatNumber(result.richardson_divisor_most));
+    std::string runs;
+    for (std::size_t i = 0; i < result.runs.size(); ++i)
+      runs += (runs.empty() ? "" : ", ") + std::to_string(result.runs[i]) +
+              (i < result.run_bases.size() ? " (base " + std::to_string(result.run_bases[i]) + ")" : "");
+    attributes.emplace_back("hfvis:runs", runs);
+  }
   return attributes;
 }
 

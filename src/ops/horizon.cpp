@@ -1276,13 +1276,14 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
     if (options.max_error == 0.0) return run(outputs, nullptr);
     // Ask for an error: runs until the estimate meets it (HorizonOptions::max_error): the sweep's
     // nested sets, the naive march's ladder of fresh sets at growing K.
-    HorizonOutputs estimated = outputs;
+    HorizonOutputs estimated = outputs, sums = outputs;
     estimated.error_estimate = true;
+    sums.error_estimate = false;  // a doubling's estimate is its halves' difference
     if (options.method == HorizonMethod::Sweep)
       return detail::runToErrorNested(field, options, [&](const detail::NestedCopies& copies,
                                                           const std::vector<char>* wanted) {
         attempt.directions = (copies.end - copies.first) * copies.base;
-        return run(copies.first == 0 ? estimated : outputs, wanted, &copies);
+        return run(copies.first == 0 ? estimated : sums, wanted, &copies);
       });
     return detail::runToError(field, options, [&](int directions, const std::vector<char>* wanted) {
       attempt.directions = directions;
