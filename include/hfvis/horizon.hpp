@@ -46,15 +46,26 @@ struct HorizonOptions : SweepOptions {
   // no planes or environment) choose K themselves (options.directions is ignored), so that the
   // 99th percentile of the error estimate (HorizonResult::estimated_error) is at most max_error,
   // in their own unit (absolute, both lie in 0..1); HorizonResult::directions says which K. The
-  // estimate is then that of the K result itself: the halves' difference (error_estimate below)
-  // divided by 2^p - 1 (Richardson: the difference is about |r(K/2) - r(K)|), p the order at which
-  // it fell (as K^-p) between this run and an earlier one of at most half its K, within 1 .. 1.1
-  // (1 when there is none: the difference itself). A first run at 16 directions and each one
-  // after it predicts the K where the estimate meets 0.9 max_error (the fall measured from the
-  // last two runs); a prediction more than 4 times the last K takes a probe first (twice the last
-  // K, or a sixth of the prediction), until the estimate is met. Throws InvalidArgument, naming
-  // the K it would take, when a run predicts more than kMaxAutoDirections (after the first run only
-  // when even a fall as K^-2 would). The samples per unit stay as given.
+  // sweep runs nested direction sets (the naive method a fresh set per run, as below): a set is
+  // m copies of a base set of B directions, copy c aimed at 2 pi (k + v(c)) / B + offset, v the
+  // van der Corput sequence 0, 1/2, 1/4, 3/4 ... (so 2^j copies aim at the uniform set of 2^j B),
+  // each direction the cheapest lattice step within half the spacing of the set its copy
+  // completes, each copy weighted by its own half gaps, the result the mean of the copies'. A
+  // run either doubles the set (copies [m, 2 m): nothing swept before is thrown away, and half
+  // the difference between the two halves is the raw estimate for free) or starts a new base
+  // (copy 0 alone, the uniform set of B directions with its even and odd directions' halves as
+  // the raw estimate). The first run is copy 0 of B = 16; each run after it predicts the K where
+  // the estimate meets 0.9 max_error (the fall measured from the last two runs; a prediction more
+  // than 4 times the last K aims at a sixth of it, or twice the last K, first) and doubles when
+  // that is at most twice the set's K, else starts a base of half of it (a set deepened by many
+  // doublings is less accurate than a uniform one: bench/report/nested_sets.md). The estimate is
+  // then that of the K result itself: the raw one divided by 2^p - 1 (Richardson: the raw one is
+  // about |r(K/2) - r(K)|), p the order at which it fell (as K^-p) between this run and an earlier
+  // one of at most half its K, within 1 .. 1.1 (1 when there is none: the raw estimate itself;
+  // HorizonResult::richardson_divisor_least/most). Throws InvalidArgument, naming the K it would
+  // take, when a run predicts more than kMaxAutoDirections (after the first run only when even a
+  // fall as K^-2 would). The samples per unit stay as given. HorizonResult::azimuths: the final
+  // set's, copy by copy (not in azimuth order); runs and run_bases: each run's set K and base.
   // With the horizon planes (angles alone, or with their distances; no sky-view factor, occlusion
   // or environment in the same run), max_error is in radians, 0 < max_error < pi/2, and bounds the
   // mean horizon angle error: over the pixels with data and over azimuth, |the K planes
@@ -72,14 +83,13 @@ struct HorizonOptions : SweepOptions {
   // With max_error, where the field needs them: after the first run (the whole field at 16
   // directions), while the estimate's 99th percentile over the field exceeds max_error, the tiles
   // of error_tile x error_tile pixels with the most pixels above it (until those left hold at most
-  // half the pixels the percentile lets above it) run again, each at the next K its own runs
-  // choose as the whole field's do (the prediction, or a probe toward a far one), sweeping only
-  // the lines that reach them (each cut after its last receiver there, the horizons still from the
-  // whole line beyond). A pixel's values are those of the whole-field run at its tile's last K, bit
-  // for bit (HorizonResult::pixel_directions), its estimate over its tile's divisor. 0, the
-  // default: the whole field takes one K. On the benchmark's contents refinement cost more work
-  // than one K for the whole field (bench/report/error_target.md: a tile's run also sweeps its
-  // lines' whole upstream, and each tile steps through runs of its own).
+  // half the pixels the percentile lets above it) run again, each as its own runs ask (a doubling
+  // of its set, or a new base rounded up to directionLadder()), tiles asking for the same run
+  // sharing it, sweeping only the lines that reach them (each cut after its last receiver there,
+  // the horizons still from the whole line beyond). A pixel's values are those of the nested set
+  // run over the whole field to its tile's K (HorizonResult::pixel_directions; its base
+  // HorizonResult::tile_bases), bit for bit, its estimate over its tile's divisor. 0, the
+  // default: the whole field takes one set. (bench/report/error_target.md measures both.)
   int error_tile = 0;
 };
 
@@ -123,9 +133,10 @@ struct HorizonResult {
   // With HorizonOutputs::error_estimate or HorizonOptions::max_error, per pixel: half the difference
   // between the results of the even- and the odd-numbered directions alone (each half's sum over
   // its own weights: two interleaved quadratures of K / 2 directions), the larger of the sky-view
-  // factor's and occlusion's; NaN at nodata. With max_error divided by the Richardson divisor
-  // 2^p - 1 (1 .. 1.14) its runs measured, per tile (HorizonOptions::max_error); a run at a K of
-  // your own keeps the difference itself. Measured against the dense azimuthal integral, on the
+  // factor's and occlusion's; NaN at nodata. With max_error (the sweep): half the difference
+  // between the two halves of the nested set (or, for a set of one copy, its own even and odd
+  // directions' halves), divided by the Richardson divisor 2^p - 1 (1 .. 1.14) its runs measured,
+  // per tile (HorizonOptions::max_error); a run at a K of your own keeps the difference itself. Measured against the dense azimuthal integral, on the
   // benchmark's contents the difference lies 1.1 to 4 times above the K result's error
   // (bench/report/error_curve.md), on white-noise heights barely above it
   // (tests/test_horizon_error_target.cpp): the divisor is kept that small for them.
@@ -134,9 +145,11 @@ struct HorizonResult {
   std::vector<float> error_estimate;
   double estimated_error = 0.0;  // its 99th percentile over the pixels with data (horizon angles: its
                                  // mean); 0 without it
-  // With HorizonOptions::max_error: the K of each run it made, in order, so that its whole cost
-  // is known (with error_tile, runs after the first cover only the tiles that needed them); empty
-  // otherwise. `directions` is then the largest K any pixel took, and `azimuths` that run's.
+  // With HorizonOptions::max_error: the K of each run it made, in order (the sweep's sky-view factor
+  // and occlusion: the K of the nested set the run completed, which swept only its new copies;
+  // samples_per_receiver is the whole cost), with error_tile runs after the first covering only
+  // the tiles that needed them; empty otherwise. `directions` is then the largest K any pixel
+  // took, and `azimuths` that set's.
   std::vector<int> runs;
   // With HorizonOptions::max_error, per pixel: the K of the run its values (and estimate) come from.
   std::vector<int> pixel_directions;
