@@ -1002,21 +1002,33 @@ float doubleNested(HorizonResult& into, const HorizonResult& added, std::size_t 
 // (null: the whole field), with the raw error estimate (splitErrorHalves) for copy 0 alone.
 using NestedRunner = std::function<HorizonResult(const NestedCopies&, const std::vector<char>*)>;
 
-// The K a nested set of `base` directions per copy doubles to, or, where the estimate predicts
-// more than that (`next`, nextDirectionsForError's), a new base: half of it (at least the set's K
-// and 8 more: the new set's copy 0 is a probe whose own estimate may meet max_error already, and
-// its second copy reaches `next`), so that a far prediction never deepens the set.
-// With `ladder` (tiles), the new base is rounded up to directionLadder's next K, so that tiles of
-// about the same need share a run.
+// The largest nested set a run may double to. Deeper or larger sets are less accurate than a
+// uniform one of their K, and their estimate (half the halves' difference) stops lying above
+// their error: the early copies keep their coarser set's wider windows, and at a large K the
+// lattice's steps crowd near the axes, so the two halves' errors no longer cancel as a uniform
+// set's interleaved halves do (bench/report/nested_sets.md; at 9f9b184, which doubled sets of any
+// K, the estimate lay below the error in 5 of 25 AO cases and 4 of 25 SVF ones,
+// bench/report/error_target.md's history). Up to 128 a doubled set was as accurate as the
+// uniform one on the benchmark's contents.
+constexpr int kMaxNestedSet = 128;
+
+// The run after a set of `base` directions per copy and `copies` copies, the estimate predicting
+// `next` (nextDirectionsForError's K): the set doubled when `next` is at most twice its K and that
+// is at most kMaxNestedSet; else a new base: half of `next` where `next` is within kMaxNestedSet
+// (its copy 0 a probe whose own estimate may meet max_error already, its doubling reaching
+// `next`), `next` itself beyond (a uniform set of that K, as the naive method's runs are), at least
+// the set's K and 8 more. With `ladder` (tiles), the new base is rounded up to directionLadder's
+// next K, so that tiles of about the same need share a run.
 NestedCopies nextNested(int base, int copies, int next, bool ladder) {
   const int directions = base * copies;
-  if (next <= 2 * directions && 2 * directions <= kMaxAutoDirections) return {base, copies, 2 * copies};
-  int half = std::max(static_cast<int>(std::ceil(next / 16.0) * 8.0), directions + 8);
+  if (next <= 2 * directions && 2 * directions <= kMaxNestedSet) return {base, copies, 2 * copies};
+  int fresh = static_cast<int>(std::ceil(next / (next <= kMaxNestedSet ? 16.0 : 8.0)) * 8.0);
+  fresh = std::max(fresh, directions + 8);
   if (ladder) {
     static const std::vector<int> rungs = directionLadder();
-    half = *std::lower_bound(rungs.begin(), rungs.end(), std::min(half, kMaxAutoDirections));
+    fresh = *std::lower_bound(rungs.begin(), rungs.end(), std::min(fresh, kMaxAutoDirections));
   }
-  return {std::min(half, kMaxAutoDirections), 0, 1};
+  return {std::min(fresh, kMaxAutoDirections), 0, 1};
 }
 
 // HorizonOptions::max_error with the sweep: nested sets. The whole field runs copy 0 of the base
