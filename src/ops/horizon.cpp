@@ -1002,15 +1002,15 @@ float doubleNested(HorizonResult& into, const HorizonResult& added, std::size_t 
 // (null: the whole field), with the raw error estimate (splitErrorHalves) for copy 0 alone.
 using NestedRunner = std::function<HorizonResult(const NestedCopies&, const std::vector<char>*)>;
 
-// The largest nested set a run may double to. Deeper or larger sets are less accurate than a
-// uniform one of their K, and their estimate (half the halves' difference) stops lying above
-// their error: the early copies keep their coarser set's wider windows, and at a large K the
-// lattice's steps crowd near the axes, so the two halves' errors no longer cancel as a uniform
-// set's interleaved halves do (bench/report/nested_sets.md; at 9f9b184, which doubled sets of any
-// K, the estimate lay below the error in 5 of 25 AO cases and 4 of 25 SVF ones,
-// bench/report/error_target.md's history). Up to 128 a doubled set was as accurate as the
-// uniform one on the benchmark's contents.
-constexpr int kMaxNestedSet = 128;
+// The largest nested set a run may double to: kMaxAutoDirections, any. Deep or large doubled sets
+// are less accurate than a uniform one of their K, and their estimate (half the halves'
+// difference) lies less far above their error: the early copies keep their coarser set's wider
+// windows, and at a large K the lattice's steps crowd near the axes, so the two halves' errors
+// cancel less than a uniform set's interleaved halves do (bench/report/nested_sets.md;
+// bench/report/error_target.md: the estimate lay below the achieved error in 4 of 25 SVF and 5 of
+// 25 AO cases, E still met in all). Capped at 128 (each run beyond a fresh uniform set, as before
+// nesting), the stepping cost more than either (docs/PERFORMANCE.md): kept here to be tried.
+constexpr int kMaxNestedSet = kMaxAutoDirections;
 
 // The run after a set of `base` directions per copy and `copies` copies, the estimate predicting
 // `next` (nextDirectionsForError's K): the set doubled when `next` is at most twice its K and that
