@@ -36,6 +36,9 @@
 //                           positions along a line are whole units of ground length summed
 //                           step by step (row_units), not the steps themselves; not with the
 //                           safe zone or the bounce
+//   HFVIS_PEAK_PREPASS      intervisibility_peaks computes the samples' heights and the peaks
+//                           between them before the sweep, into the tree's slots (not with
+//                           per-row spacing or strips); 0 = the sweep computes them itself
 //   HFVIS_STRIPS            intervisibility_lattice sweeps the receivers of one strip of rows
 //                           and resumes each line where the strip before left it (a field in
 //                           strips; not with the bounce)
@@ -87,6 +90,12 @@
 #endif
 #ifndef HFVIS_STRIPS
 #define HFVIS_STRIPS 0
+#endif
+#ifndef HFVIS_PEAK_PREPASS
+#define HFVIS_PEAK_PREPASS 0
+#endif
+#if HFVIS_PEAK_PREPASS && (HFVIS_ROW_SPACING || HFVIS_STRIPS)
+#error "the peaks' prepass takes uniform grids on the whole field (positions from the steps alone)"
 #endif
 #if HFVIS_STRIPS && HFVIS_WANT_BOUNCE
 #error "the bounce reads the radiance of every earlier sample: it needs the whole field"
@@ -333,6 +342,111 @@ HFVIS_INLINE int safe_zone_inside(const SafeZone* z, float p, float h) {
 }
 #endif
 
+// The height of sample q of period i of a line, whose receiver is (col, row) (heights hold rows
+// from row0 on): absent (NaN) where only the first period reaches, outside the field; with
+// HFVIS_CURVATURE lowered by the Earth's drop at d_sample steps from the line's start.
+HFVIS_INLINE float tree_sample_height(__global const float* heights, int width, int height, int row0,
+                                      __global const LatticeSample* samples, int q, int i, int col, int row,
+                                      float drop, float d_sample) {
+  __global const LatticeSample* s = samples + q;
+  const int x0 = col + s->ox, y0 = row + s->oy, ex = s->ex, ey = s->ey;
+  float h_sample = NAN;
+  if (i > 0 || (x0 >= 0 && x0 + ex <= width - 1 && y0 >= 0 && y0 + ey <= height - 1)) {
+    const uint at = (uint)((y0 - row0) * width + x0);
+    // The receiver is its pixel's height as it is (1 h + 0 h would make an infinity NaN).
+    h_sample = ex + ey == 0 ? heights[at]
+                            : lattice_height(heights, at, (uint)ex, (uint)(ey * width), s->w00, s->w10, s->w01, s->w11);
+  }
+#if HFVIS_CURVATURE
+  // The Earth's drop from any receiver p, drop (p - step)^2 (drop per step squared), differs
+  // from drop step^2 by a term linear in step: every slope seen from p shifts alike, so
+  // every visibility decision (and the tree) is that of the heights lowered by drop step^2
+  // (positions with per-row spacing).
+  h_sample = h_sample - drop * d_sample * d_sample;
+#endif
+  return h_sample;
+}
+
+// The peak between step - 1 (height h_sample_prev) and step (h_sample, sample q of period i,
+// its receiver at (col, row)): of the interval's crossings and concave pieces, the point that
+// stands farthest above the chord of its two samples, where it stands strictly above it; NaN
+// where there is none. Its position (position_far + its offset among the step's step_scale
+// positions) in *peak_position.
+HFVIS_INLINE float tree_interval_peak(__global const float* heights, int width, int height, int row0,
+                                      __global const TreePiece* pieces, __global const int* interval_first, int q,
+                                      int i, int col, int row, int step, float h_sample_prev, float h_sample,
+                                      float drop, float inv_scale, float d_sample, int position_far, int step_scale,
+                                      int* peak_position) {
+  if (!(step > 0 && step_scale > 1 && !isnan(h_sample_prev) && !isnan(h_sample))) return NAN;
+  float best_h = -INFINITY, best_excess = 0.0f;
+  int offset = 0;
+  TreePieceCurve curve;  // the piece before (set by the first piece, which has no crossing)
+  float chord_far = h_sample_prev, rise = h_sample - h_sample_prev;
+#if HFVIS_CURVATURE
+  // The candidates are points of the surface before the drop (theirs comes after): so is
+  // the chord they are measured against, else the drop's growth along the interval (2 drop
+  // step per step) would favour the near end's candidates far out on a line.
+  const float d_far = (float)position_far * inv_scale;
+  chord_far = h_sample_prev + drop * d_far * d_far;
+  rise = (h_sample + drop * d_sample * d_sample) - chord_far;
+#endif
+  for (int k = interval_first[q]; k < interval_first[q + 1]; ++k) {
+    __global const TreePiece* g = pieces + k;
+    const int px = col + g->ox, py = row + g->oy;
+    if (i == 0 && (px < 0 || px + 1 > width - 1 || py < 0 || py + 1 > height - 1)) return NAN;
+    const uint at = (uint)((py - row0) * width + px);
+    tree_piece_peak(heights[at], heights[at + 1], heights[at + (uint)width], heights[at + (uint)width + 1], g->fx,
+                    g->fy, g->dx, g->dy, g->t_far, g->t_near, g->inv_span, g->far_crossing, chord_far, rise,
+                    step_scale, &curve, &best_h, &offset, &best_excess);
+  }
+  if (!(best_h > -INFINITY)) return NAN;  // (NaN: a corner was)
+  *peak_position = position_far + offset;
+#if HFVIS_CURVATURE
+  const float d_peak = (float)*peak_position * inv_scale;
+  best_h = best_h - drop * d_peak * d_peak;
+#endif
+  return tree_peak_inserted(h_sample_prev, best_h, h_sample, offset, step_scale) ? best_h : NAN;
+}
+
+#if HFVIS_PEAK_PREPASS
+// The samples' heights and the peaks between them, ahead of the sweep (HFVIS_PEAK_PREPASS):
+// one work-item per step of a line, none waiting on another, where the sweep's one work-item
+// per line would evaluate them between its dependent tree walks. Step s of line j (its sample
+// q of period i, as intervisibility_lattice numbers them) writes its sample's height into the
+// x of the sample's slot SLOT_OF(s) and its peak (height, NaN for none; position) into x and y
+// of PEAK_SLOT(s); the sweep reads both before its nodes take the slots. Arguments as
+// intervisibility_lattice's (uniform grids only: no per-row spacing, no strips).
+// Global size: (lines, steps of the longest line), each rounded up to the local size.
+__kernel void intervisibility_peaks(__global const float* heights, int width, int height, __global const int4* lines,
+                                    int n_lines, __global const LatticeSample* samples, int n_samples, int a, int b,
+                                    float drop, __global const TreePiece* pieces, __global const int* interval_first,
+                                    int position_shift, __global int4* trees, uint stride) {
+  const int j = get_global_id(0), step = get_global_id(1);
+  if (j >= n_lines) return;
+  const int4 line = lines[j];
+  if (step >= line.z * n_samples) return;
+  const float inv_scale = 1.0f / (float)(1 << position_shift);
+  const int i = step / n_samples, q = step - i * n_samples;
+  const int col = line.x - i * a, row = line.y - i * b;
+  const float d_sample = (float)(step << position_shift) * inv_scale;
+  const float h_sample = tree_sample_height(heights, width, height, 0, samples, q, i, col, row, drop, d_sample);
+  float h_prev = NAN;  // the step before's sample: the previous one of the period, or the receiver before
+  if (step > 0) {
+    const int i_prev = q > 0 ? i : i - 1, q_prev = q > 0 ? q - 1 : n_samples - 1;
+    h_prev = tree_sample_height(heights, width, height, 0, samples, q_prev, i_prev, line.x - i_prev * a,
+                                line.y - i_prev * b, drop, (float)((step - 1) << position_shift) * inv_scale);
+  }
+  const int step_scale = 1 << position_shift, position_far = (step - 1) << position_shift;
+  int peak_position = 0;
+  const float h_peak = tree_interval_peak(heights, width, height, 0, pieces, interval_first, q, i, col, row, step,
+                                          h_prev, h_sample, drop, inv_scale, d_sample, position_far, step_scale,
+                                          &peak_position);
+  __global int4* tree = trees + (uint)line.w;
+  tree[(uint)SLOT_OF(step) * stride].x = as_int(h_sample);
+  tree[(uint)PEAK_SLOT(step) * stride].xy = (int2)(as_int(h_peak), peak_position);
+}
+#endif
+
 // What a line's sweep keeps in registers between its samples, saved at the end of a strip and
 // restored at the start of the next one (HFVIS_STRIPS): the tree itself stays in the scratch.
 typedef struct {
@@ -491,70 +605,27 @@ __kernel void intervisibility_lattice(
 #else
       const float p_sample = (float)(step << position_shift);
 #endif
-      __global const LatticeSample* s = samples + q;
-      const int x0 = col + s->ox, y0 = row + s->oy, ex = s->ex, ey = s->ey;
-      float h_sample = NAN;
-      if (i > 0 || (x0 >= 0 && x0 + ex <= width - 1 && y0 >= 0 && y0 + ey <= height - 1)) {
-        const uint at = (uint)((y0 - row0) * width + x0);
-        // The receiver is its pixel's height as it is (1 h + 0 h would make an infinity NaN).
-        h_sample = ex + ey == 0
-                       ? heights[at]
-                       : lattice_height(heights, at, (uint)ex, (uint)(ey * width), s->w00, s->w10, s->w01, s->w11);
-      }
-#if HFVIS_CURVATURE
-      // The Earth's drop from any receiver p, drop (p - step)^2 (drop per step squared), differs
-      // from drop step^2 by a term linear in step: every slope seen from p shifts alike, so
-      // every visibility decision (and the tree) is that of the heights lowered by drop step^2
-      // (positions with per-row spacing).
-      const float d_sample = p_sample * inv_scale;
-      h_sample = h_sample - drop * d_sample * d_sample;
-#endif
-      // The peak between the step before and this one: of the interval's crossings and concave
-      // pieces, the point that stands farthest above the chord of its two samples, where it
-      // stands strictly above it.
-      float h_peak = NAN;
-      int peak_position = 0;
+#if HFVIS_PEAK_PREPASS
+      // The sample's height and the peak before it, as intervisibility_peaks wrote them into the
+      // step's two slots (each is read here once, before its node overwrites it).
+      const int4 precomputed_peak = tree[(uint)PEAK_SLOT(step) * stride];
+      const float h_sample = as_float(tree[(uint)SLOT_OF(step) * stride].x);
+      const float h_peak = as_float(precomputed_peak.x);
+      const int peak_position = precomputed_peak.y;
+#else
 #if HFVIS_ROW_SPACING
       // The step's whole units are its positions (a peak needs one strictly inside).
       const int step_scale = units, position_far = position - units;
 #else
       const int step_scale = 1 << position_shift, position_far = (step - 1) << position_shift;
 #endif
-      if (step > 0 && step_scale > 1 && !isnan(h_sample_prev) && !isnan(h_sample)) {
-        float best_h = -INFINITY, best_excess = 0.0f;
-        int offset = 0;
-        TreePieceCurve curve;  // the piece before (set by the first piece, which has no crossing)
-        float chord_far = h_sample_prev, rise = h_sample - h_sample_prev;
-#if HFVIS_CURVATURE
-        // The candidates are points of the surface before the drop (theirs comes after): so is
-        // the chord they are measured against, else the drop's growth along the interval (2 drop
-        // step per step) would favour the near end's candidates far out on a line.
-        const float d_far = (float)position_far * inv_scale;
-        chord_far = h_sample_prev + drop * d_far * d_far;
-        rise = (h_sample + drop * d_sample * d_sample) - chord_far;
+      const float d_sample = p_sample * inv_scale;  // (for the drop)
+      const float h_sample = tree_sample_height(heights, width, height, row0, samples, q, i, col, row, drop, d_sample);
+      int peak_position = 0;
+      const float h_peak =
+          tree_interval_peak(heights, width, height, row0, pieces, interval_first, q, i, col, row, step, h_sample_prev,
+                             h_sample, drop, inv_scale, d_sample, position_far, step_scale, &peak_position);
 #endif
-        for (int k = interval_first[q]; k < interval_first[q + 1]; ++k) {
-          __global const TreePiece* g = pieces + k;
-          const int px = col + g->ox, py = row + g->oy;
-          if (i == 0 && (px < 0 || px + 1 > width - 1 || py < 0 || py + 1 > height - 1)) {
-            best_h = NAN;
-            break;
-          }
-          const uint at = (uint)((py - row0) * width + px);
-          tree_piece_peak(heights[at], heights[at + 1], heights[at + (uint)width],
-                          heights[at + (uint)width + 1], g->fx, g->fy, g->dx, g->dy, g->t_far, g->t_near,
-                          g->inv_span, g->far_crossing, chord_far, rise, step_scale, &curve, &best_h,
-                          &offset, &best_excess);
-        }
-        if (best_h > -INFINITY) {  // (not NaN)
-          peak_position = position_far + offset;
-#if HFVIS_CURVATURE
-          const float d_peak = (float)peak_position * inv_scale;
-          best_h = best_h - drop * d_peak * d_peak;
-#endif
-          if (tree_peak_inserted(h_sample_prev, best_h, h_sample, offset, step_scale)) h_peak = best_h;
-        }
-      }
       uint t = 0, skipped = 0;  // the step's convexity checks and skipped walks, its peak's included
       // The step's nodes: its peak (where there is one), then its sample.
       for (int part = 0; part < 2; ++part) {

@@ -19,13 +19,15 @@
 namespace hfvis {
 namespace detail {
 
+bool peakPrepass(const TreeProgramFlags& f) { return !f.row_spacing && !f.strips; }
+
 std::string treeProgramOptions(const TreeProgramFlags& f) {
   std::ostringstream s;
   s << "-DHFVIS_HAS_NODATA=" << f.has_nodata << " -DHFVIS_WANT_COUNT=" << f.count
     << " -DHFVIS_WANT_AREA=" << f.area
     << " -DHFVIS_WANT_STATS=" << f.stats << " -DHFVIS_WANT_ENTRY_STATS=" << f.entry_stats;
   s << " -DHFVIS_CURVATURE=" << f.curvature << " -DHFVIS_ROW_SPACING=" << f.row_spacing
-    << " -DHFVIS_STRIPS=" << f.strips;
+    << " -DHFVIS_STRIPS=" << f.strips << " -DHFVIS_PEAK_PREPASS=" << peakPrepass(f);
   const HullTreeTuning tuning = tuningFor(f.tuning, f.row_spacing);
   s << " -DHFVIS_DEFERRED_WRITES=" << tuning.deferred_writes
     << " -DHFVIS_REPLACEMENT_CHECK=" << tuning.replacement_check
@@ -145,7 +147,45 @@ TreeKernel treeKernel(ContextState& st, cl::Program& program, const TreeDirectio
 void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDirection& d, int width, int height,
                           const TreeBuffers& b) {
   TreeKernel k = treeKernel(st, program, d, width, height, b);
-  launchLineChunks(st, k.kernel, d.lines, d.slotsPerPeriod(), b.scratch_entries, 1, kLineGroup);
+  // Per-row spacing computes its peaks in the sweep (peakPrepass: so was its program built).
+  if (d.rowSpacing()) {
+    launchLineChunks(st, k.kernel, d.lines, d.slotsPerPeriod(), b.scratch_entries, 1, kLineGroup);
+    return;
+  }
+  NamedKernel peaks(st, program, "intervisibility_peaks");
+  peaks.set("heights", b.heights);
+  peaks.set("width", width);
+  peaks.set("height", height);
+  peaks.set("samples", k.samples);
+  peaks.set("n_samples", static_cast<int>(d.samples.size()));
+  peaks.set("a", d.lattice.a);
+  peaks.set("b", d.lattice.b);
+  peaks.set("drop", d.drop);
+  peaks.set("pieces", k.pieces);
+  peaks.set("interval_first", k.interval_first);
+  peaks.set("position_shift", d.position_shift);
+  peaks.set("trees", b.trees);
+  // Work-groups along one line's steps where a line's slots lie together (line-major), across
+  // lines at one step where a step's do (step-major).
+  const bool line_major = lineMajorLayout(st);
+  const std::size_t group_lines = line_major ? 1 : kLineGroup, group_steps = line_major ? kLineGroup : 1;
+  std::vector<LatticeLine> lines = d.lines;
+  for (const LineChunk& chunk : chunkLines(lines, d.slotsPerPeriod(), b.scratch_entries, line_major)) {
+    const cl::Buffer chunk_lines(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                 chunk.count * sizeof(LatticeLine), lines.data() + chunk.first);
+    std::size_t steps = 0;
+    for (std::size_t j = chunk.first; j < chunk.first + chunk.count; ++j)
+      steps = std::max(steps, static_cast<std::size_t>(lines[j].receivers) * d.samples.size());
+    for (NamedKernel* kernel : {&peaks, &k.kernel}) {
+      kernel->set("lines", chunk_lines);
+      kernel->set("n_lines", static_cast<int>(chunk.count));
+      kernel->set("stride", static_cast<cl_uint>(chunk.stride));
+    }
+    k.kernel.set("first_line", static_cast<int>(chunk.first));
+    st.launch(peaks, cl::NDRange(roundUp(chunk.count, group_lines), roundUp(steps, group_steps)),
+              cl::NDRange(group_lines, group_steps));
+    st.launch(k.kernel, cl::NDRange(roundUp(chunk.count, kLineGroup)), cl::NDRange(kLineGroup));
+  }
 }
 
 std::string TreeRoutine::programOptions() const {

@@ -41,6 +41,11 @@ struct TreeProgramFlags {
   HullTreeTuning tuning;
 };
 
+// Whether a program with these flags computes the samples' heights and the peaks between them
+// in a prepass (kernel intervisibility_peaks, HFVIS_PEAK_PREPASS), launched before each chunk's
+// sweep by enqueueTreeDirection: on uniform grids without strips.
+bool peakPrepass(const TreeProgramFlags& flags);
+
 // The -D options of kernels/intervisibility.cl with these flags.
 std::string treeProgramOptions(const TreeProgramFlags& flags);
 
