@@ -37,7 +37,7 @@
 //                           step by step (row_units), not the steps themselves; not with the
 //                           safe zone or the bounce
 //   HFVIS_PEAK_PREPASS      intervisibility_peaks computes the samples' heights and the peaks
-//                           between them before the sweep, into the tree's slots (not with
+//                           between them before the sweep, into peak_inputs (not with
 //                           per-row spacing or strips); 0 = the sweep computes them itself
 //   HFVIS_STRIPS            intervisibility_lattice sweeps the receivers of one strip of rows
 //                           and resumes each line where the strip before left it (a field in
@@ -195,7 +195,7 @@ inline int seen_over(float hx, float px, float hn, float pn, float hr, float pr)
 // hidden behind `next`, or `next`. Heights are read from the tree slots (a slot keeps its
 // sample's height for good; absent samples' slots hold NaN). Without absent samples in
 // between, galloping then bisection (O(log run)); otherwise a scan.
-inline int run_end(__global const int4* tree, __global const int2* positions, uint stride, int shift, int start,
+HFVIS_INLINE int run_end(__global const int4* tree, __global const int2* positions, uint stride, int shift, int start,
                    int next, float h_next, float p_next, float p_receiver, float h_receiver, int holes) {
   int lo = SAMPLE_OF(start) - (IS_SAMPLE(start) ? 0 : 1);  // the last sample known visible
   const int last = SAMPLE_OF(next);
@@ -277,9 +277,10 @@ HFVIS_INLINE uint hull_tree_walk(__global int4* tree, __global const int2* posit
       const int side = chord_side(as_float(child.x), as_float(node.x), h,
                                   p_cur - node_position(positions, stride, shift, c, child), p - p_cur);
       if (side <= 0) {
-        tree[(uint)cur * stride].z = child.w;  // the next child becomes the first
-        tree[(uint)c * stride].w = cur;        // back link to resume the parent
-        child.w = cur;
+        node.z = child.w;  // the next child becomes the first
+        tree[(uint)cur * stride] = node;
+        child.w = cur;  // back link to resume the parent
+        tree[(uint)c * stride] = child;
         cur = c;
         node = child;
         continue;
@@ -412,15 +413,16 @@ HFVIS_INLINE float tree_interval_peak(__global const float* heights, int width, 
 // The samples' heights and the peaks between them, ahead of the sweep (HFVIS_PEAK_PREPASS):
 // one work-item per step of a line, none waiting on another, where the sweep's one work-item
 // per line would evaluate them between its dependent tree walks. Step s of line j (its sample
-// q of period i, as intervisibility_lattice numbers them) writes its sample's height into the
-// x of the sample's slot SLOT_OF(s) and its peak (height, NaN for none; position) into x and y
-// of PEAK_SLOT(s); the sweep reads both before its nodes take the slots. Arguments as
+// q of period i, as intervisibility_lattice numbers them) writes its sample's height into
+// peak_inputs[SLOT_OF(s)] (x) and its peak (height, NaN for none; position's bits) into
+// peak_inputs[PEAK_SLOT(s)], laid out as the tree's slots (8 bytes a slot where a node takes 16:
+// the pass costs memory traffic, which decides its gain on a CPU). Arguments as
 // intervisibility_lattice's (uniform grids only: no per-row spacing, no strips).
 // Global size: (lines, steps of the longest line), each rounded up to the local size.
 __kernel void intervisibility_peaks(__global const float* heights, int width, int height, __global const int4* lines,
                                     int n_lines, __global const LatticeSample* samples, int n_samples, int a, int b,
                                     float drop, __global const TreePiece* pieces, __global const int* interval_first,
-                                    int position_shift, __global int4* trees, uint stride) {
+                                    int position_shift, __global float2* peak_inputs, uint stride) {
   const int j = get_global_id(0), step = get_global_id(1);
   if (j >= n_lines) return;
   const int4 line = lines[j];
@@ -441,9 +443,9 @@ __kernel void intervisibility_peaks(__global const float* heights, int width, in
   const float h_peak = tree_interval_peak(heights, width, height, 0, pieces, interval_first, q, i, col, row, step,
                                           h_prev, h_sample, drop, inv_scale, d_sample, position_far, step_scale,
                                           &peak_position);
-  __global int4* tree = trees + (uint)line.w;
-  tree[(uint)SLOT_OF(step) * stride].x = as_int(h_sample);
-  tree[(uint)PEAK_SLOT(step) * stride].xy = (int2)(as_int(h_peak), peak_position);
+  __global float2* inputs = peak_inputs + (uint)line.w;
+  inputs[(uint)SLOT_OF(step) * stride] = (float2)(h_sample, 0.0f);
+  inputs[(uint)PEAK_SLOT(step) * stride] = (float2)(h_peak, as_float(peak_position));
 }
 #endif
 
@@ -535,7 +537,7 @@ __kernel void intervisibility_lattice(
     __global const LatticeSample* samples, int n_samples, int a, int b, float count_factor, float area_factor,
     float drop, int max_steps, __global const int* row_units, __global const float2* row_factors,
     __global const TreePiece* pieces, __global const int* interval_first, int position_shift,
-    __global int4* trees, __global ulong* prefix, __global int2* positions, uint stride, __global float2* visible,
+    __global const float2* peak_inputs, __global int4* trees, __global ulong* prefix, __global int2* positions, uint stride, __global float2* visible,
     __global uint4* entry_stats, __global ulong* line_totals, int first_line, __global float* count_sum,
     __global float* area_sum, __global const float* radiance, __global const float* normals,
     float cos_azimuth, float sin_azimuth, float step_ground, float half_sector, float wedge,
@@ -555,6 +557,7 @@ __kernel void intervisibility_lattice(
   const uint base = (uint)line.w;
   __global int4* tree = trees + base;
   __global int2* line_positions = positions + base;
+  __global const float2* line_peak_inputs = peak_inputs + base;  // (HFVIS_PEAK_PREPASS)
   const uint plane = (uint)(width * height);
   // Positions are in units of 2^-position_shift step: back to steps (exactly) for the drop.
   const float inv_scale = 1.0f / (float)(1 << position_shift);
@@ -606,12 +609,11 @@ __kernel void intervisibility_lattice(
       const float p_sample = (float)(step << position_shift);
 #endif
 #if HFVIS_PEAK_PREPASS
-      // The sample's height and the peak before it, as intervisibility_peaks wrote them into the
-      // step's two slots (each is read here once, before its node overwrites it).
-      const int4 precomputed_peak = tree[(uint)PEAK_SLOT(step) * stride];
-      const float h_sample = as_float(tree[(uint)SLOT_OF(step) * stride].x);
-      const float h_peak = as_float(precomputed_peak.x);
-      const int peak_position = precomputed_peak.y;
+      // The sample's height and the peak before it, as intervisibility_peaks wrote them.
+      const float2 precomputed_peak = line_peak_inputs[(uint)PEAK_SLOT(step) * stride];
+      const float h_sample = line_peak_inputs[(uint)SLOT_OF(step) * stride].x;
+      const float h_peak = precomputed_peak.x;
+      const int peak_position = as_int(precomputed_peak.y);
 #else
 #if HFVIS_ROW_SPACING
       // The step's whole units are its positions (a peak needs one strictly inside).
@@ -679,7 +681,9 @@ __kernel void intervisibility_lattice(
         // 1. Algorithm 1 for the new root: the old root is its only child; the walk gives the
         // root's children in order.
         RootList list = {HFVIS_NONE, HFVIS_NONE, HFVIS_NONE, 0.0f, 0.0f};
-        const int4 old_root = tree[(uint)root * stride];
+        // The old root as the step before wrote it (its node is in registers: no load to wait on;
+        // only a line's first node is a leaf while it is the root).
+        const int4 old_root = (int4)(as_int(h_prev), y_prev + (prev2 == HFVIS_NONE ? HFVIS_LEAF : 0), head, HFVIS_NONE);
         int walk = 1;
 #if HFVIS_REPLACEMENT_CHECK
         // The last child first (Sec. 7): when it fails, every child fails (their slopes from

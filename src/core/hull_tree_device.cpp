@@ -42,7 +42,7 @@ bool needsPrefix(const TreeProgramFlags& f) { return f.area && (f.has_nodata || 
 
 std::size_t treeEntryBytes(const TreeProgramFlags& f) {
   return kTreeNodeBytes + (needsPrefix(f) ? kTreePrefixBytes : 0) + (f.row_spacing ? kTreePositionBytes : 0) +
-         (f.entry_stats ? kTreeVisibleBytes + kTreeEntryStatsBytes : 0);
+         (f.entry_stats ? kTreeVisibleBytes + kTreeEntryStatsBytes : 0) + (peakPrepass(f) ? kTreePeakInputBytes : 0);
 }
 
 TreeScratchNeeds treeScratchNeeds(const std::vector<TreeDirection>& directions, bool line_major) {
@@ -83,6 +83,7 @@ void allocateTreeScratch(ContextState& st, const TreeProgramFlags& flags, const 
   b.trees = st.reusableBuffer("tree nodes", entries * kTreeNodeBytes);
   b.prefix = deviceBuffer(st, needsPrefix(flags) ? entries * kTreePrefixBytes : 0);
   b.positions = deviceBuffer(st, flags.row_spacing ? entries * kTreePositionBytes : 0);
+  b.peak_inputs = deviceBuffer(st, peakPrepass(flags) ? entries * kTreePeakInputBytes : 0);
   b.visible = deviceBuffer(st, flags.entry_stats ? entries * kTreeVisibleBytes : 0);
   b.entry_stats = deviceBuffer(st, flags.entry_stats ? entries * kTreeEntryStatsBytes : 0);
   std::size_t max_lines = 0;
@@ -121,6 +122,7 @@ TreeKernel treeKernel(ContextState& st, cl::Program& program, const TreeDirectio
   kernel.set("pieces", k.pieces);
   kernel.set("interval_first", k.interval_first);
   kernel.set("position_shift", d.position_shift);
+  kernel.set("peak_inputs", b.peak_inputs);
   kernel.set("trees", b.trees);
   kernel.set("prefix", b.prefix);
   kernel.set("positions", b.positions);
@@ -145,7 +147,7 @@ TreeKernel treeKernel(ContextState& st, cl::Program& program, const TreeDirectio
 }
 
 void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDirection& d, int width, int height,
-                          const TreeBuffers& b) {
+                          const TreeBuffers& b, bool sweep) {
   TreeKernel k = treeKernel(st, program, d, width, height, b);
   // Per-row spacing computes its peaks in the sweep (peakPrepass: so was its program built).
   if (d.rowSpacing()) {
@@ -164,7 +166,7 @@ void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDire
   peaks.set("pieces", k.pieces);
   peaks.set("interval_first", k.interval_first);
   peaks.set("position_shift", d.position_shift);
-  peaks.set("trees", b.trees);
+  peaks.set("peak_inputs", b.peak_inputs);
   // Work-groups along one line's steps where a line's slots lie together (line-major), across
   // lines at one step where a step's do (step-major).
   const bool line_major = lineMajorLayout(st);
@@ -184,7 +186,7 @@ void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDire
     k.kernel.set("first_line", static_cast<int>(chunk.first));
     st.launch(peaks, cl::NDRange(roundUp(chunk.count, group_lines), roundUp(steps, group_steps)),
               cl::NDRange(group_lines, group_steps));
-    st.launch(k.kernel, cl::NDRange(roundUp(chunk.count, kLineGroup)), cl::NDRange(kLineGroup));
+    if (sweep) st.launch(k.kernel, cl::NDRange(roundUp(chunk.count, kLineGroup)), cl::NDRange(kLineGroup));
   }
 }
 
@@ -281,6 +283,53 @@ IntervisibilityLines treeLinesOnDevice(ContextState& st, const TreeProgramFlags&
         out.iterations[c] = stats[4 * e + 1];
         out.horizon_hashes[c] = stats[4 * e + 2];
         out.walks_skipped[c] = stats[4 * e + 3];
+      }
+    }
+  }
+  return out;
+}
+
+TreePeakInputs treePeakInputsOnDevice(ContextState& st, const HeightField& field,
+                                      const std::vector<float>& prepared_heights, const TreeDirection& d) {
+  TreeProgramFlags flags;
+  flags.curvature = d.drop != 0.0f;
+  flags.stats = false;
+  if (d.rowSpacing() || !peakPrepass(flags)) throw InvalidArgument("the peaks' prepass takes uniform grids only");
+  cl::Program program = st.program("intervisibility.cl", treeProgramOptions(flags));
+  const std::size_t plane = field.pixelCount();
+  std::size_t entries = 0;
+  for (const LatticeLine& line : d.lines) entries += lineCapacity(line, d.slotsPerPeriod());
+  entries = std::max(entries, d.longestLine() * 2 * d.lines.size());  // (step-major: every line the longest)
+  TreeBuffers b;
+  allocateTreeScratch(st, flags, {d}, entries, b);
+  b.heights = cl::Buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, prepared_heights.size() * sizeof(float),
+                         const_cast<float*>(prepared_heights.data()));
+  b.count_sum = b.area_sum = deviceBuffer(st, plane * sizeof(float));
+  b.radiance = b.normals = b.irradiance = deviceBuffer(st, 0);
+  // NaN everywhere first: an entry the prepass leaves unwritten reads as a wrong sample.
+  const cl_float2 nan2 = {{std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::quiet_NaN()}};
+  st.queue.enqueueFillBuffer(b.peak_inputs, nan2, 0, entries * kTreePeakInputBytes);
+  enqueueTreeDirection(st, program, d, field.width, field.height, b, false);
+  std::vector<cl_float2> inputs(entries);
+  st.queue.enqueueReadBuffer(b.peak_inputs, CL_TRUE, 0, entries * kTreePeakInputBytes, inputs.data());
+
+  // Back to the canonical step-major order, as the launch laid the lines out.
+  std::vector<LatticeLine> lines = d.lines;
+  const auto chunks = chunkLines(lines, d.slotsPerPeriod(), entries, lineMajorLayout(st));
+  const std::size_t n_steps = d.longestLine(), canonical = n_steps * lines.size();
+  TreePeakInputs out;
+  out.samples.assign(canonical, std::numeric_limits<float>::quiet_NaN());
+  out.peaks.assign(canonical, std::numeric_limits<float>::quiet_NaN());
+  out.positions.assign(canonical, 0);
+  for (const LineChunk& chunk : chunks) {
+    for (std::size_t j = chunk.first; j < chunk.first + chunk.count; ++j) {
+      const std::size_t steps = lineCapacity(lines[j], d.samples.size());
+      for (std::size_t i = 0; i < steps; ++i) {
+        const std::size_t base = static_cast<std::size_t>(lines[j].stack), c = i * lines.size() + j;
+        const cl_float2 sample = inputs[base + (2 * i + 1) * chunk.stride], peak = inputs[base + 2 * i * chunk.stride];
+        out.samples[c] = sample.s[0];
+        out.peaks[c] = peak.s[0];
+        std::memcpy(&out.positions[c], &peak.s[1], sizeof(float));
       }
     }
   }
