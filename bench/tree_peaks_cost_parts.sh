@@ -55,11 +55,13 @@ if text.count(old) != 1:
 open(path, "w").write(text.replace(old, new))
 EOF
 }
-edit structure "if (step > 0 && step_scale > 1 && !isnan(h_sample_prev) && !isnan(h_sample)) {" \
-  "if (0 && step > 0 && step_scale > 1 && !isnan(h_sample_prev) && !isnan(h_sample)) {"
-# (the test's result kept alive, so that the compiler cannot drop the evaluation)
-edit pieces "if (tree_peak_inserted(h_sample_prev, best_h, h_sample, offset, step_scale)) h_peak = best_h;" \
-  "if (tree_peak_inserted(h_sample_prev, best_h, h_sample, offset, step_scale)) total_peaks += best_h > 1e30f;"
+# (tree_interval_peak: in the prepass intervisibility_peaks on these inputs, in the sweep elsewhere)
+edit structure "if (!(step > 0 && step_scale > 1 && !isnan(h_sample_prev) && !isnan(h_sample))) return NAN;" \
+  "if (1) return NAN;"
+# (the test's result kept alive, so that the compiler cannot drop the evaluation: no peak is
+# that high)
+edit pieces "return tree_peak_inserted(h_sample_prev, best_h, h_sample, offset, step_scale) ? best_h : NAN;" \
+  "return tree_peak_inserted(h_sample_prev, best_h, h_sample, offset, step_scale) && best_h > 1e30f ? best_h : NAN;"
 
 cmake --build "$build_dir" -j "$(nproc)" --target hfvis_cli hfvis_bench > /dev/null
 inputs=()

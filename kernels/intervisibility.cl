@@ -36,6 +36,9 @@
 //                           positions along a line are whole units of ground length summed
 //                           step by step (row_units), not the steps themselves; not with the
 //                           safe zone or the bounce
+//   HFVIS_PEAK_PREPASS      intervisibility_peaks computes the samples' heights and the peaks
+//                           between them before the sweep, into peak_inputs (not with
+//                           per-row spacing or strips); 0 = the sweep computes them itself
 //   HFVIS_STRIPS            intervisibility_lattice sweeps the receivers of one strip of rows
 //                           and resumes each line where the strip before left it (a field in
 //                           strips; not with the bounce)
@@ -87,6 +90,12 @@
 #endif
 #ifndef HFVIS_STRIPS
 #define HFVIS_STRIPS 0
+#endif
+#ifndef HFVIS_PEAK_PREPASS
+#define HFVIS_PEAK_PREPASS 0
+#endif
+#if HFVIS_PEAK_PREPASS && (HFVIS_ROW_SPACING || HFVIS_STRIPS)
+#error "the peaks' prepass takes uniform grids on the whole field (positions from the steps alone)"
 #endif
 #if HFVIS_STRIPS && HFVIS_WANT_BOUNCE
 #error "the bounce reads the radiance of every earlier sample: it needs the whole field"
@@ -186,7 +195,7 @@ inline int seen_over(float hx, float px, float hn, float pn, float hr, float pr)
 // hidden behind `next`, or `next`. Heights are read from the tree slots (a slot keeps its
 // sample's height for good; absent samples' slots hold NaN). Without absent samples in
 // between, galloping then bisection (O(log run)); otherwise a scan.
-inline int run_end(__global const int4* tree, __global const int2* positions, uint stride, int shift, int start,
+HFVIS_INLINE int run_end(__global const int4* tree, __global const int2* positions, uint stride, int shift, int start,
                    int next, float h_next, float p_next, float p_receiver, float h_receiver, int holes) {
   int lo = SAMPLE_OF(start) - (IS_SAMPLE(start) ? 0 : 1);  // the last sample known visible
   const int last = SAMPLE_OF(next);
@@ -268,9 +277,10 @@ HFVIS_INLINE uint hull_tree_walk(__global int4* tree, __global const int2* posit
       const int side = chord_side(as_float(child.x), as_float(node.x), h,
                                   p_cur - node_position(positions, stride, shift, c, child), p - p_cur);
       if (side <= 0) {
-        tree[(uint)cur * stride].z = child.w;  // the next child becomes the first
-        tree[(uint)c * stride].w = cur;        // back link to resume the parent
-        child.w = cur;
+        node.z = child.w;  // the next child becomes the first
+        tree[(uint)cur * stride] = node;
+        child.w = cur;  // back link to resume the parent
+        tree[(uint)c * stride] = child;
         cur = c;
         node = child;
         continue;
@@ -330,6 +340,112 @@ HFVIS_INLINE void safe_zone_end(SafeZone* z) { z->margin = z->margin * 0x1p-16f 
 HFVIS_INLINE int safe_zone_inside(const SafeZone* z, float p, float h) {
   const float bound = z->z1 + (z->z2 - z->z1) * ((p - z->first) / (z->last - z->first));
   return p <= z->last && h < bound - z->margin;
+}
+#endif
+
+// The height of sample q of period i of a line, whose receiver is (col, row) (heights hold rows
+// from row0 on): absent (NaN) where only the first period reaches, outside the field; with
+// HFVIS_CURVATURE lowered by the Earth's drop at d_sample steps from the line's start.
+HFVIS_INLINE float tree_sample_height(__global const float* heights, int width, int height, int row0,
+                                      __global const LatticeSample* samples, int q, int i, int col, int row,
+                                      float drop, float d_sample) {
+  __global const LatticeSample* s = samples + q;
+  const int x0 = col + s->ox, y0 = row + s->oy, ex = s->ex, ey = s->ey;
+  float h_sample = NAN;
+  if (i > 0 || (x0 >= 0 && x0 + ex <= width - 1 && y0 >= 0 && y0 + ey <= height - 1)) {
+    const uint at = (uint)((y0 - row0) * width + x0);
+    // The receiver is its pixel's height as it is (1 h + 0 h would make an infinity NaN).
+    h_sample = ex + ey == 0 ? heights[at]
+                            : lattice_height(heights, at, (uint)ex, (uint)(ey * width), s->w00, s->w10, s->w01, s->w11);
+  }
+#if HFVIS_CURVATURE
+  // The Earth's drop from any receiver p, drop (p - step)^2 (drop per step squared), differs
+  // from drop step^2 by a term linear in step: every slope seen from p shifts alike, so
+  // every visibility decision (and the tree) is that of the heights lowered by drop step^2
+  // (positions with per-row spacing).
+  h_sample = h_sample - drop * d_sample * d_sample;
+#endif
+  return h_sample;
+}
+
+// The peak between step - 1 (height h_sample_prev) and step (h_sample, sample q of period i,
+// its receiver at (col, row)): of the interval's crossings and concave pieces, the point that
+// stands farthest above the chord of its two samples, where it stands strictly above it; NaN
+// where there is none. Its position (position_far + its offset among the step's step_scale
+// positions) in *peak_position.
+HFVIS_INLINE float tree_interval_peak(__global const float* heights, int width, int height, int row0,
+                                      __global const TreePiece* pieces, __global const int* interval_first, int q,
+                                      int i, int col, int row, int step, float h_sample_prev, float h_sample,
+                                      float drop, float inv_scale, float d_sample, int position_far, int step_scale,
+                                      int* peak_position) {
+  if (!(step > 0 && step_scale > 1 && !isnan(h_sample_prev) && !isnan(h_sample))) return NAN;
+  float best_h = -INFINITY, best_excess = 0.0f;
+  int offset = 0;
+  TreePieceCurve curve;  // the piece before (set by the first piece, which has no crossing)
+  float chord_far = h_sample_prev, rise = h_sample - h_sample_prev;
+#if HFVIS_CURVATURE
+  // The candidates are points of the surface before the drop (theirs comes after): so is
+  // the chord they are measured against, else the drop's growth along the interval (2 drop
+  // step per step) would favour the near end's candidates far out on a line.
+  const float d_far = (float)position_far * inv_scale;
+  chord_far = h_sample_prev + drop * d_far * d_far;
+  rise = (h_sample + drop * d_sample * d_sample) - chord_far;
+#endif
+  for (int k = interval_first[q]; k < interval_first[q + 1]; ++k) {
+    __global const TreePiece* g = pieces + k;
+    const int px = col + g->ox, py = row + g->oy;
+    if (i == 0 && (px < 0 || px + 1 > width - 1 || py < 0 || py + 1 > height - 1)) return NAN;
+    const uint at = (uint)((py - row0) * width + px);
+    tree_piece_peak(heights[at], heights[at + 1], heights[at + (uint)width], heights[at + (uint)width + 1], g->fx,
+                    g->fy, g->dx, g->dy, g->t_far, g->t_near, g->inv_span, g->far_crossing, chord_far, rise,
+                    step_scale, &curve, &best_h, &offset, &best_excess);
+  }
+  if (!(best_h > -INFINITY)) return NAN;  // (NaN: a corner was)
+  *peak_position = position_far + offset;
+#if HFVIS_CURVATURE
+  const float d_peak = (float)*peak_position * inv_scale;
+  best_h = best_h - drop * d_peak * d_peak;
+#endif
+  return tree_peak_inserted(h_sample_prev, best_h, h_sample, offset, step_scale) ? best_h : NAN;
+}
+
+#if HFVIS_PEAK_PREPASS
+// The samples' heights and the peaks between them, ahead of the sweep (HFVIS_PEAK_PREPASS):
+// one work-item per step of a line, none waiting on another, where the sweep's one work-item
+// per line would evaluate them between its dependent tree walks. Step s of line j (its sample
+// q of period i, as intervisibility_lattice numbers them) writes its sample's height into
+// peak_inputs[SLOT_OF(s)] (x) and its peak (height, NaN for none; position's bits) into
+// peak_inputs[PEAK_SLOT(s)], laid out as the tree's slots (8 bytes a slot where a node takes 16:
+// the pass costs memory traffic, which decides its gain on a CPU). Arguments as
+// intervisibility_lattice's (uniform grids only: no per-row spacing, no strips).
+// Global size: (lines, steps of the longest line), each rounded up to the local size.
+__kernel void intervisibility_peaks(__global const float* heights, int width, int height, __global const int4* lines,
+                                    int n_lines, __global const LatticeSample* samples, int n_samples, int a, int b,
+                                    float drop, __global const TreePiece* pieces, __global const int* interval_first,
+                                    int position_shift, __global float2* peak_inputs, uint stride) {
+  const int j = get_global_id(0), step = get_global_id(1);
+  if (j >= n_lines) return;
+  const int4 line = lines[j];
+  if (step >= line.z * n_samples) return;
+  const float inv_scale = 1.0f / (float)(1 << position_shift);
+  const int i = step / n_samples, q = step - i * n_samples;
+  const int col = line.x - i * a, row = line.y - i * b;
+  const float d_sample = (float)(step << position_shift) * inv_scale;
+  const float h_sample = tree_sample_height(heights, width, height, 0, samples, q, i, col, row, drop, d_sample);
+  float h_prev = NAN;  // the step before's sample: the previous one of the period, or the receiver before
+  if (step > 0) {
+    const int i_prev = q > 0 ? i : i - 1, q_prev = q > 0 ? q - 1 : n_samples - 1;
+    h_prev = tree_sample_height(heights, width, height, 0, samples, q_prev, i_prev, line.x - i_prev * a,
+                                line.y - i_prev * b, drop, (float)((step - 1) << position_shift) * inv_scale);
+  }
+  const int step_scale = 1 << position_shift, position_far = (step - 1) << position_shift;
+  int peak_position = 0;
+  const float h_peak = tree_interval_peak(heights, width, height, 0, pieces, interval_first, q, i, col, row, step,
+                                          h_prev, h_sample, drop, inv_scale, d_sample, position_far, step_scale,
+                                          &peak_position);
+  __global float2* inputs = peak_inputs + (uint)line.w;
+  inputs[(uint)SLOT_OF(step) * stride] = (float2)(h_sample, 0.0f);
+  inputs[(uint)PEAK_SLOT(step) * stride] = (float2)(h_peak, as_float(peak_position));
 }
 #endif
 
@@ -421,7 +537,7 @@ __kernel void intervisibility_lattice(
     __global const LatticeSample* samples, int n_samples, int a, int b, float count_factor, float area_factor,
     float drop, int max_steps, __global const int* row_units, __global const float2* row_factors,
     __global const TreePiece* pieces, __global const int* interval_first, int position_shift,
-    __global int4* trees, __global ulong* prefix, __global int2* positions, uint stride, __global float2* visible,
+    __global const float2* peak_inputs, __global int4* trees, __global ulong* prefix, __global int2* positions, uint stride, __global float2* visible,
     __global uint4* entry_stats, __global ulong* line_totals, int first_line, __global float* count_sum,
     __global float* area_sum, __global const float* radiance, __global const float* normals,
     float cos_azimuth, float sin_azimuth, float step_ground, float half_sector, float wedge,
@@ -441,6 +557,7 @@ __kernel void intervisibility_lattice(
   const uint base = (uint)line.w;
   __global int4* tree = trees + base;
   __global int2* line_positions = positions + base;
+  __global const float2* line_peak_inputs = peak_inputs + base;  // (HFVIS_PEAK_PREPASS)
   const uint plane = (uint)(width * height);
   // Positions are in units of 2^-position_shift step: back to steps (exactly) for the drop.
   const float inv_scale = 1.0f / (float)(1 << position_shift);
@@ -491,70 +608,26 @@ __kernel void intervisibility_lattice(
 #else
       const float p_sample = (float)(step << position_shift);
 #endif
-      __global const LatticeSample* s = samples + q;
-      const int x0 = col + s->ox, y0 = row + s->oy, ex = s->ex, ey = s->ey;
-      float h_sample = NAN;
-      if (i > 0 || (x0 >= 0 && x0 + ex <= width - 1 && y0 >= 0 && y0 + ey <= height - 1)) {
-        const uint at = (uint)((y0 - row0) * width + x0);
-        // The receiver is its pixel's height as it is (1 h + 0 h would make an infinity NaN).
-        h_sample = ex + ey == 0
-                       ? heights[at]
-                       : lattice_height(heights, at, (uint)ex, (uint)(ey * width), s->w00, s->w10, s->w01, s->w11);
-      }
-#if HFVIS_CURVATURE
-      // The Earth's drop from any receiver p, drop (p - step)^2 (drop per step squared), differs
-      // from drop step^2 by a term linear in step: every slope seen from p shifts alike, so
-      // every visibility decision (and the tree) is that of the heights lowered by drop step^2
-      // (positions with per-row spacing).
-      const float d_sample = p_sample * inv_scale;
-      h_sample = h_sample - drop * d_sample * d_sample;
-#endif
-      // The peak between the step before and this one: of the interval's crossings and concave
-      // pieces, the point that stands farthest above the chord of its two samples, where it
-      // stands strictly above it.
-      float h_peak = NAN;
-      int peak_position = 0;
+#if HFVIS_PEAK_PREPASS
+      // The sample's height and the peak before it, as intervisibility_peaks wrote them.
+      const float2 precomputed_peak = line_peak_inputs[(uint)PEAK_SLOT(step) * stride];
+      const float h_sample = line_peak_inputs[(uint)SLOT_OF(step) * stride].x;
+      const float h_peak = precomputed_peak.x;
+      const int peak_position = as_int(precomputed_peak.y);
+#else
 #if HFVIS_ROW_SPACING
       // The step's whole units are its positions (a peak needs one strictly inside).
       const int step_scale = units, position_far = position - units;
 #else
       const int step_scale = 1 << position_shift, position_far = (step - 1) << position_shift;
 #endif
-      if (step > 0 && step_scale > 1 && !isnan(h_sample_prev) && !isnan(h_sample)) {
-        float best_h = -INFINITY, best_excess = 0.0f;
-        int offset = 0;
-        TreePieceCurve curve;  // the piece before (set by the first piece, which has no crossing)
-        float chord_far = h_sample_prev, rise = h_sample - h_sample_prev;
-#if HFVIS_CURVATURE
-        // The candidates are points of the surface before the drop (theirs comes after): so is
-        // the chord they are measured against, else the drop's growth along the interval (2 drop
-        // step per step) would favour the near end's candidates far out on a line.
-        const float d_far = (float)position_far * inv_scale;
-        chord_far = h_sample_prev + drop * d_far * d_far;
-        rise = (h_sample + drop * d_sample * d_sample) - chord_far;
+      const float d_sample = p_sample * inv_scale;  // (for the drop)
+      const float h_sample = tree_sample_height(heights, width, height, row0, samples, q, i, col, row, drop, d_sample);
+      int peak_position = 0;
+      const float h_peak =
+          tree_interval_peak(heights, width, height, row0, pieces, interval_first, q, i, col, row, step, h_sample_prev,
+                             h_sample, drop, inv_scale, d_sample, position_far, step_scale, &peak_position);
 #endif
-        for (int k = interval_first[q]; k < interval_first[q + 1]; ++k) {
-          __global const TreePiece* g = pieces + k;
-          const int px = col + g->ox, py = row + g->oy;
-          if (i == 0 && (px < 0 || px + 1 > width - 1 || py < 0 || py + 1 > height - 1)) {
-            best_h = NAN;
-            break;
-          }
-          const uint at = (uint)((py - row0) * width + px);
-          tree_piece_peak(heights[at], heights[at + 1], heights[at + (uint)width],
-                          heights[at + (uint)width + 1], g->fx, g->fy, g->dx, g->dy, g->t_far, g->t_near,
-                          g->inv_span, g->far_crossing, chord_far, rise, step_scale, &curve, &best_h,
-                          &offset, &best_excess);
-        }
-        if (best_h > -INFINITY) {  // (not NaN)
-          peak_position = position_far + offset;
-#if HFVIS_CURVATURE
-          const float d_peak = (float)peak_position * inv_scale;
-          best_h = best_h - drop * d_peak * d_peak;
-#endif
-          if (tree_peak_inserted(h_sample_prev, best_h, h_sample, offset, step_scale)) h_peak = best_h;
-        }
-      }
       uint t = 0, skipped = 0;  // the step's convexity checks and skipped walks, its peak's included
       // The step's nodes: its peak (where there is one), then its sample.
       for (int part = 0; part < 2; ++part) {
@@ -608,7 +681,9 @@ __kernel void intervisibility_lattice(
         // 1. Algorithm 1 for the new root: the old root is its only child; the walk gives the
         // root's children in order.
         RootList list = {HFVIS_NONE, HFVIS_NONE, HFVIS_NONE, 0.0f, 0.0f};
-        const int4 old_root = tree[(uint)root * stride];
+        // The old root as the step before wrote it (its node is in registers: no load to wait on;
+        // only a line's first node is a leaf while it is the root).
+        const int4 old_root = (int4)(as_int(h_prev), y_prev + (prev2 == HFVIS_NONE ? HFVIS_LEAF : 0), head, HFVIS_NONE);
         int walk = 1;
 #if HFVIS_REPLACEMENT_CHECK
         // The last child first (Sec. 7): when it fails, every child fails (their slopes from

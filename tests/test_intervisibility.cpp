@@ -19,6 +19,8 @@
 #include "core/chord_side.hpp"
 #include "core/horizon_common.hpp"
 #include "core/hull_tree.hpp"
+#include "core/hull_tree_device.hpp"
+#include "core/opencl_context.hpp"
 #include "core/lattice_geometry.hpp"
 #include "core/tree_peaks.hpp"
 #include "hfvis/errors.hpp"
@@ -588,6 +590,51 @@ TEST(IntervisibilityKernels, TreeMatchesScalarReferenceInEveryTuning) {
   }
 }
 
+// The peaks' prepass (kernel intervisibility_peaks) alone, in both layouts: every step's sample
+// height and the peak before it that the tree inserts (tree_peak_inserted of the reference's
+// candidate), bit for bit as the reference computes them, and that peak's position; on every
+// hard case and size, in every direction of kSteps, with and without the Earth's drop.
+TEST(IntervisibilityKernels, PeakPrepassMatchesTheReference) {
+  std::size_t samples = 0, peaks = 0;
+  testing::forEachLayout([&](const ComputeContext& context) {
+    for (const auto& name : syntheticFieldNames()) {
+      for (auto [w, h] : awkwardSizes()) {
+        const HeightField field = makeSyntheticField(name, w, h, 5);
+        const auto prepared = detail::prepareHeights(field);
+        for (auto step : kSteps) {
+          for (float drop : {0.0f, 0.05f}) {
+            SCOPED_TRACE(name + " " + std::to_string(w) + "x" + std::to_string(h) + " step " +
+                         std::to_string(step.first) + "," + std::to_string(step.second) + " drop " +
+                         std::to_string(drop));
+            detail::TreeDirection d = treeStep(field, step);
+            d.drop = drop;
+            const auto ref = detail::latticeTreeLines(field, prepared.heights, d, drop != 0.0f);
+            const auto dev = detail::treePeakInputsOnDevice(detail::stateOf(context), field, prepared.heights, d);
+            const int n_lines = ref.geometry.n_lines, scale = 1 << ref.position_shift;
+            ASSERT_EQ(dev.samples.size(), ref.samples.size());
+            for (std::size_t e = 0; e < ref.samples.size(); ++e) {
+              const int i = static_cast<int>(e / n_lines);
+              ASSERT_TRUE(nearlyEqual({dev.samples[e]}, {ref.samples[e]}, 0.0f)) << "entry " << e;
+              float expected = std::numeric_limits<float>::quiet_NaN();
+              if (i > 0 && scale > 1 &&
+                  detail::tree_peak_inserted(ref.samples[e - n_lines], ref.peaks[e], ref.samples[e],
+                                             ref.peak_offsets[e], scale))
+                expected = ref.peaks[e];
+              ASSERT_TRUE(nearlyEqual({dev.peaks[e]}, {expected}, 0.0f)) << "entry " << e;
+              samples += !std::isnan(ref.samples[e]);
+              if (std::isnan(expected)) continue;
+              ++peaks;
+              ASSERT_EQ(dev.positions[e], ((i - 1) << ref.position_shift) + ref.peak_offsets[e]) << "entry " << e;
+            }
+          }
+        }
+      }
+    }
+  });
+  EXPECT_GT(samples, 100000u);
+  EXPECT_GT(peaks, 10000u);
+}
+
 // Earth curvature, large enough to matter on these small fields.
 TEST(IntervisibilityKernels, TreeMatchesScalarReferenceWithCurvature) {
   expectKernelMatchesReference(IntervisibilityMethod::HullTree, 1.0, {}, 0.004);
@@ -1064,9 +1111,10 @@ TEST(IntervisibilityKernels, BatchingUnderATinyMemoryBudgetChangesNothing) {
   const auto outputs = allOutputs();
   const auto whole = computeIntervisibility(context, field, options, outputs);
   int reports = 0, last = 0;
-  // The field's planes take 3 * 4 * 1640 bytes; the tree scratch (16 bytes per sample, at
-  // least 1640 samples per direction) gets room for 700: every direction runs in chunks.
-  options.memory_budget_bytes = 3 * 4 * 1640 + 16 * 700;
+  // The field's planes take 3 * 4 * 1640 bytes; the tree scratch (24 bytes per slot with the
+  // peaks' prepass, at least 1640 slots per direction) gets room for 700: every direction runs
+  // in chunks.
+  options.memory_budget_bytes = 3 * 4 * 1640 + 24 * 700;
   options.progress = [&](int done, int all) {
     ++reports;
     last = done;

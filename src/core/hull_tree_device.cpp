@@ -19,13 +19,15 @@
 namespace hfvis {
 namespace detail {
 
+bool peakPrepass(const TreeProgramFlags& f) { return !f.row_spacing && !f.strips; }
+
 std::string treeProgramOptions(const TreeProgramFlags& f) {
   std::ostringstream s;
   s << "-DHFVIS_HAS_NODATA=" << f.has_nodata << " -DHFVIS_WANT_COUNT=" << f.count
     << " -DHFVIS_WANT_AREA=" << f.area
     << " -DHFVIS_WANT_STATS=" << f.stats << " -DHFVIS_WANT_ENTRY_STATS=" << f.entry_stats;
   s << " -DHFVIS_CURVATURE=" << f.curvature << " -DHFVIS_ROW_SPACING=" << f.row_spacing
-    << " -DHFVIS_STRIPS=" << f.strips;
+    << " -DHFVIS_STRIPS=" << f.strips << " -DHFVIS_PEAK_PREPASS=" << peakPrepass(f);
   const HullTreeTuning tuning = tuningFor(f.tuning, f.row_spacing);
   s << " -DHFVIS_DEFERRED_WRITES=" << tuning.deferred_writes
     << " -DHFVIS_REPLACEMENT_CHECK=" << tuning.replacement_check
@@ -40,7 +42,7 @@ bool needsPrefix(const TreeProgramFlags& f) { return f.area && (f.has_nodata || 
 
 std::size_t treeEntryBytes(const TreeProgramFlags& f) {
   return kTreeNodeBytes + (needsPrefix(f) ? kTreePrefixBytes : 0) + (f.row_spacing ? kTreePositionBytes : 0) +
-         (f.entry_stats ? kTreeVisibleBytes + kTreeEntryStatsBytes : 0);
+         (f.entry_stats ? kTreeVisibleBytes + kTreeEntryStatsBytes : 0) + (peakPrepass(f) ? kTreePeakInputBytes : 0);
 }
 
 TreeScratchNeeds treeScratchNeeds(const std::vector<TreeDirection>& directions, bool line_major) {
@@ -81,6 +83,7 @@ void allocateTreeScratch(ContextState& st, const TreeProgramFlags& flags, const 
   b.trees = st.reusableBuffer("tree nodes", entries * kTreeNodeBytes);
   b.prefix = deviceBuffer(st, needsPrefix(flags) ? entries * kTreePrefixBytes : 0);
   b.positions = deviceBuffer(st, flags.row_spacing ? entries * kTreePositionBytes : 0);
+  b.peak_inputs = deviceBuffer(st, peakPrepass(flags) ? entries * kTreePeakInputBytes : 0);
   b.visible = deviceBuffer(st, flags.entry_stats ? entries * kTreeVisibleBytes : 0);
   b.entry_stats = deviceBuffer(st, flags.entry_stats ? entries * kTreeEntryStatsBytes : 0);
   std::size_t max_lines = 0;
@@ -119,6 +122,7 @@ TreeKernel treeKernel(ContextState& st, cl::Program& program, const TreeDirectio
   kernel.set("pieces", k.pieces);
   kernel.set("interval_first", k.interval_first);
   kernel.set("position_shift", d.position_shift);
+  kernel.set("peak_inputs", b.peak_inputs);
   kernel.set("trees", b.trees);
   kernel.set("prefix", b.prefix);
   kernel.set("positions", b.positions);
@@ -143,9 +147,47 @@ TreeKernel treeKernel(ContextState& st, cl::Program& program, const TreeDirectio
 }
 
 void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDirection& d, int width, int height,
-                          const TreeBuffers& b) {
+                          const TreeBuffers& b, bool sweep) {
   TreeKernel k = treeKernel(st, program, d, width, height, b);
-  launchLineChunks(st, k.kernel, d.lines, d.slotsPerPeriod(), b.scratch_entries, 1, kLineGroup);
+  // Per-row spacing computes its peaks in the sweep (peakPrepass: so was its program built).
+  if (d.rowSpacing()) {
+    launchLineChunks(st, k.kernel, d.lines, d.slotsPerPeriod(), b.scratch_entries, 1, kLineGroup);
+    return;
+  }
+  NamedKernel peaks(st, program, "intervisibility_peaks");
+  peaks.set("heights", b.heights);
+  peaks.set("width", width);
+  peaks.set("height", height);
+  peaks.set("samples", k.samples);
+  peaks.set("n_samples", static_cast<int>(d.samples.size()));
+  peaks.set("a", d.lattice.a);
+  peaks.set("b", d.lattice.b);
+  peaks.set("drop", d.drop);
+  peaks.set("pieces", k.pieces);
+  peaks.set("interval_first", k.interval_first);
+  peaks.set("position_shift", d.position_shift);
+  peaks.set("peak_inputs", b.peak_inputs);
+  // Work-groups along one line's steps where a line's slots lie together (line-major), across
+  // lines at one step where a step's do (step-major).
+  const bool line_major = lineMajorLayout(st);
+  const std::size_t group_lines = line_major ? 1 : kLineGroup, group_steps = line_major ? kLineGroup : 1;
+  std::vector<LatticeLine> lines = d.lines;
+  for (const LineChunk& chunk : chunkLines(lines, d.slotsPerPeriod(), b.scratch_entries, line_major)) {
+    const cl::Buffer chunk_lines(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                 chunk.count * sizeof(LatticeLine), lines.data() + chunk.first);
+    std::size_t steps = 0;
+    for (std::size_t j = chunk.first; j < chunk.first + chunk.count; ++j)
+      steps = std::max(steps, static_cast<std::size_t>(lines[j].receivers) * d.samples.size());
+    for (NamedKernel* kernel : {&peaks, &k.kernel}) {
+      kernel->set("lines", chunk_lines);
+      kernel->set("n_lines", static_cast<int>(chunk.count));
+      kernel->set("stride", static_cast<cl_uint>(chunk.stride));
+    }
+    k.kernel.set("first_line", static_cast<int>(chunk.first));
+    st.launch(peaks, cl::NDRange(roundUp(chunk.count, group_lines), roundUp(steps, group_steps)),
+              cl::NDRange(group_lines, group_steps));
+    if (sweep) st.launch(k.kernel, cl::NDRange(roundUp(chunk.count, kLineGroup)), cl::NDRange(kLineGroup));
+  }
 }
 
 std::string TreeRoutine::programOptions() const {
@@ -241,6 +283,53 @@ IntervisibilityLines treeLinesOnDevice(ContextState& st, const TreeProgramFlags&
         out.iterations[c] = stats[4 * e + 1];
         out.horizon_hashes[c] = stats[4 * e + 2];
         out.walks_skipped[c] = stats[4 * e + 3];
+      }
+    }
+  }
+  return out;
+}
+
+TreePeakInputs treePeakInputsOnDevice(ContextState& st, const HeightField& field,
+                                      const std::vector<float>& prepared_heights, const TreeDirection& d) {
+  TreeProgramFlags flags;
+  flags.curvature = d.drop != 0.0f;
+  flags.stats = false;
+  if (d.rowSpacing() || !peakPrepass(flags)) throw InvalidArgument("the peaks' prepass takes uniform grids only");
+  cl::Program program = st.program("intervisibility.cl", treeProgramOptions(flags));
+  const std::size_t plane = field.pixelCount();
+  std::size_t entries = 0;
+  for (const LatticeLine& line : d.lines) entries += lineCapacity(line, d.slotsPerPeriod());
+  entries = std::max(entries, d.longestLine() * 2 * d.lines.size());  // (step-major: every line the longest)
+  TreeBuffers b;
+  allocateTreeScratch(st, flags, {d}, entries, b);
+  b.heights = cl::Buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, prepared_heights.size() * sizeof(float),
+                         const_cast<float*>(prepared_heights.data()));
+  b.count_sum = b.area_sum = deviceBuffer(st, plane * sizeof(float));
+  b.radiance = b.normals = b.irradiance = deviceBuffer(st, 0);
+  // NaN everywhere first: an entry the prepass leaves unwritten reads as a wrong sample.
+  const cl_float2 nan2 = {{std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::quiet_NaN()}};
+  st.queue.enqueueFillBuffer(b.peak_inputs, nan2, 0, entries * kTreePeakInputBytes);
+  enqueueTreeDirection(st, program, d, field.width, field.height, b, false);
+  std::vector<cl_float2> inputs(entries);
+  st.queue.enqueueReadBuffer(b.peak_inputs, CL_TRUE, 0, entries * kTreePeakInputBytes, inputs.data());
+
+  // Back to the canonical step-major order, as the launch laid the lines out.
+  std::vector<LatticeLine> lines = d.lines;
+  const auto chunks = chunkLines(lines, d.slotsPerPeriod(), entries, lineMajorLayout(st));
+  const std::size_t n_steps = d.longestLine(), canonical = n_steps * lines.size();
+  TreePeakInputs out;
+  out.samples.assign(canonical, std::numeric_limits<float>::quiet_NaN());
+  out.peaks.assign(canonical, std::numeric_limits<float>::quiet_NaN());
+  out.positions.assign(canonical, 0);
+  for (const LineChunk& chunk : chunks) {
+    for (std::size_t j = chunk.first; j < chunk.first + chunk.count; ++j) {
+      const std::size_t steps = lineCapacity(lines[j], d.samples.size());
+      for (std::size_t i = 0; i < steps; ++i) {
+        const std::size_t base = static_cast<std::size_t>(lines[j].stack), c = i * lines.size() + j;
+        const cl_float2 sample = inputs[base + (2 * i + 1) * chunk.stride], peak = inputs[base + 2 * i * chunk.stride];
+        out.samples[c] = sample.s[0];
+        out.peaks[c] = peak.s[0];
+        std::memcpy(&out.positions[c], &peak.s[1], sizeof(float));
       }
     }
   }

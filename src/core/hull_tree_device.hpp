@@ -22,6 +22,7 @@ constexpr std::size_t kTreePrefixBytes = sizeof(std::uint64_t);
 constexpr std::size_t kTreePositionBytes = 2 * sizeof(std::int32_t);  // (position, unit sum), per-row spacing
 constexpr std::size_t kTreeVisibleBytes = 2 * sizeof(float);  // (count, distance sum), per-entry tests only
 constexpr std::size_t kTreeEntryStatsBytes = 4 * sizeof(std::uint32_t);
+constexpr std::size_t kTreePeakInputBytes = 2 * sizeof(float);  // the prepass's, per slot (peakPrepass)
 constexpr std::size_t kTreeLineTotals = 8;  // ulongs per line (HFVIS_LINE_TOTALS)
 constexpr std::size_t kTreeLineStateBytes = 152;  // TreeLineState, per line in strips
 
@@ -41,6 +42,11 @@ struct TreeProgramFlags {
   HullTreeTuning tuning;
 };
 
+// Whether a program with these flags computes the samples' heights and the peaks between them
+// in a prepass (kernel intervisibility_peaks, HFVIS_PEAK_PREPASS), launched before each chunk's
+// sweep by enqueueTreeDirection: on uniform grids without strips.
+bool peakPrepass(const TreeProgramFlags& flags);
+
 // The -D options of kernels/intervisibility.cl with these flags.
 std::string treeProgramOptions(const TreeProgramFlags& flags);
 
@@ -48,7 +54,7 @@ std::string treeProgramOptions(const TreeProgramFlags& flags);
 // (deviceBuffer(st, 0)).
 struct TreeBuffers {
   cl::Buffer heights;
-  cl::Buffer trees, prefix, positions, visible, entry_stats;  // scratch, `scratch_entries` entries
+  cl::Buffer trees, prefix, positions, visible, entry_stats, peak_inputs;  // scratch, `scratch_entries` entries
   std::size_t scratch_entries = 0;
   cl::Buffer line_totals;          // kTreeLineTotals ulongs per line of the direction
   cl::Buffer count_sum, area_sum;  // per pixel
@@ -89,8 +95,21 @@ TreeKernel treeKernel(ContextState& st, cl::Program& program, const TreeDirectio
                       const TreeBuffers& b);
 
 // Launches intervisibility_lattice for direction d, its lines in chunks whose scratch fits.
+// With peakPrepass (a uniform grid), each chunk's prepass intervisibility_peaks first; with
+// `sweep` false only that (the tests read its output).
 void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDirection& d, int width, int height,
-                          const TreeBuffers& b);
+                          const TreeBuffers& b, bool sweep = true);
+
+// The prepass alone (kernel intervisibility_peaks) on direction d of a uniform grid (with its
+// drop where d.drop is not 0), read back in the canonical step-major order of
+// IntervisibilityLines: per entry the sample's height, the peak before it that the tree inserts
+// (NaN for none) and that peak's position (in 2^-position_shift steps). For the tests.
+struct TreePeakInputs {
+  std::vector<float> samples, peaks;
+  std::vector<std::int32_t> positions;
+};
+TreePeakInputs treePeakInputsOnDevice(ContextState& st, const HeightField& field,
+                                      const std::vector<float>& prepared_heights, const TreeDirection& d);
 
 // The routine of an operation built on the tree sweep (visible counts and areas, the
 // bounce): its program, its directions, its scratch, one launch per direction.

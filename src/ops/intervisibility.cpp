@@ -110,12 +110,16 @@ CountPlan planCount(const HeightField& field, const std::vector<TreeDirection>& 
   // lines' states, with as many rows as the budget holds once the scratch has half the rest
   // (or the longest line's tree, if more): a line's tree stays on the device through every
   // strip it crosses.
+  // (in strips the sweep computes its peaks itself: no prepass's inputs, peakPrepass)
+  TreeProgramFlags strip_flags = flags;
+  strip_flags.strips = true;
+  const std::size_t strip_entry = treeEntryBytes(strip_flags), strip_least = needs.longest * strip_entry;
   plan.halo_rows = 0;
   for (const TreeDirection& d : directions) plan.halo_rows = std::max(plan.halo_rows, std::abs(d.lattice.b));
   const std::size_t halo = 2 * static_cast<std::size_t>(plan.halo_rows) * row;
   const std::size_t states = max_lines * (kTreeLineStateBytes + sizeof(cl_int2)) + totals;
   const std::size_t rest = budget > halo + states ? budget - halo - states : 0;
-  const std::size_t scratch = std::max(least, std::min(needs.whole * entry, rest / 2));
+  const std::size_t scratch = std::max(strip_least, std::min(needs.whole * strip_entry, rest / 2));
   std::size_t rows = rest > scratch ? (rest - scratch) / per_row : 0;
   rows = std::min(rows, max_alloc / row > 2 * static_cast<std::size_t>(plan.halo_rows)
                             ? max_alloc / row - 2 * plan.halo_rows : 0);
@@ -123,14 +127,14 @@ CountPlan planCount(const HeightField& field, const std::vector<TreeDirection>& 
   rows = std::min<std::size_t>(rows, field.height);
   const std::size_t strips_bytes = rows * per_row + halo + states;
   if (rows < 1 || needs.longest * kTreeNodeBytes > max_alloc) {
-    throw MemoryBudgetError("one direction needs " + mebibytes(per_row + halo + states + least) +
-                            " of device memory in strips of one row (its longest line's tree " + mebibytes(least) +
+    throw MemoryBudgetError("one direction needs " + mebibytes(per_row + halo + states + strip_least) +
+                            " of device memory in strips of one row (its longest line's tree " + mebibytes(strip_least) +
                             ") but the budget is " + mebibytes(budget) + " (largest single buffer " +
                             mebibytes(max_alloc) + "); raise the memory budget");
   }
   plan.strip_rows = static_cast<int>(rows);
   plan.scratch_entries =
-      std::min({needs.whole, (budget - strips_bytes) / entry, max_alloc / kTreeNodeBytes});
+      std::min({needs.whole, (budget - strips_bytes) / strip_entry, max_alloc / kTreeNodeBytes});
   return plan;
 }
 
