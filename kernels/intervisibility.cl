@@ -414,15 +414,16 @@ HFVIS_INLINE float tree_interval_peak(__global const float* heights, int width, 
 // one work-item per step of a line, none waiting on another, where the sweep's one work-item
 // per line would evaluate them between its dependent tree walks. Step s of line j (its sample
 // q of period i, as intervisibility_lattice numbers them) writes its sample's height into
-// peak_inputs[SLOT_OF(s)] (x) and its peak (height, NaN for none; position's bits) into
-// peak_inputs[PEAK_SLOT(s)], laid out as the tree's slots (8 bytes a slot where a node takes 16:
+// peak_inputs[SLOT_OF(s)] (x, a float's bits) and its peak (the height's bits, NaN for none;
+// the position) into peak_inputs[PEAK_SLOT(s)], as integers (a position's bits as a float would
+// be a denormal, which a device without denormals may flush to zero in a move), laid out as the tree's slots (8 bytes a slot where a node takes 16:
 // the pass costs memory traffic, which decides its gain on a CPU). Arguments as
 // intervisibility_lattice's (uniform grids only: no per-row spacing, no strips).
 // Global size: (lines, steps of the longest line), each rounded up to the local size.
 __kernel void intervisibility_peaks(__global const float* heights, int width, int height, __global const int4* lines,
                                     int n_lines, __global const LatticeSample* samples, int n_samples, int a, int b,
                                     float drop, __global const TreePiece* pieces, __global const int* interval_first,
-                                    int position_shift, __global float2* peak_inputs, uint stride) {
+                                    int position_shift, __global int2* peak_inputs, uint stride) {
   const int j = get_global_id(0), step = get_global_id(1);
   if (j >= n_lines) return;
   const int4 line = lines[j];
@@ -443,9 +444,9 @@ __kernel void intervisibility_peaks(__global const float* heights, int width, in
   const float h_peak = tree_interval_peak(heights, width, height, 0, pieces, interval_first, q, i, col, row, step,
                                           h_prev, h_sample, drop, inv_scale, d_sample, position_far, step_scale,
                                           &peak_position);
-  __global float2* inputs = peak_inputs + (uint)line.w;
-  inputs[(uint)SLOT_OF(step) * stride] = (float2)(h_sample, 0.0f);
-  inputs[(uint)PEAK_SLOT(step) * stride] = (float2)(h_peak, as_float(peak_position));
+  __global int2* inputs = peak_inputs + (uint)line.w;
+  inputs[(uint)SLOT_OF(step) * stride] = (int2)(as_int(h_sample), 0);
+  inputs[(uint)PEAK_SLOT(step) * stride] = (int2)(as_int(h_peak), peak_position);
 }
 #endif
 
@@ -537,7 +538,7 @@ __kernel void intervisibility_lattice(
     __global const LatticeSample* samples, int n_samples, int a, int b, float count_factor, float area_factor,
     float drop, int max_steps, __global const int* row_units, __global const float2* row_factors,
     __global const TreePiece* pieces, __global const int* interval_first, int position_shift,
-    __global const float2* peak_inputs, __global int4* trees, __global ulong* prefix, __global int2* positions, uint stride, __global float2* visible,
+    __global const int2* peak_inputs, __global int4* trees, __global ulong* prefix, __global int2* positions, uint stride, __global float2* visible,
     __global uint4* entry_stats, __global ulong* line_totals, int first_line, __global float* count_sum,
     __global float* area_sum, __global const float* radiance, __global const float* normals,
     float cos_azimuth, float sin_azimuth, float step_ground, float half_sector, float wedge,
@@ -557,7 +558,7 @@ __kernel void intervisibility_lattice(
   const uint base = (uint)line.w;
   __global int4* tree = trees + base;
   __global int2* line_positions = positions + base;
-  __global const float2* line_peak_inputs = peak_inputs + base;  // (HFVIS_PEAK_PREPASS)
+  __global const int2* line_peak_inputs = peak_inputs + base;  // (HFVIS_PEAK_PREPASS)
   const uint plane = (uint)(width * height);
   // Positions are in units of 2^-position_shift step: back to steps (exactly) for the drop.
   const float inv_scale = 1.0f / (float)(1 << position_shift);
@@ -610,10 +611,10 @@ __kernel void intervisibility_lattice(
 #endif
 #if HFVIS_PEAK_PREPASS
       // The sample's height and the peak before it, as intervisibility_peaks wrote them.
-      const float2 precomputed_peak = line_peak_inputs[(uint)PEAK_SLOT(step) * stride];
-      const float h_sample = line_peak_inputs[(uint)SLOT_OF(step) * stride].x;
-      const float h_peak = precomputed_peak.x;
-      const int peak_position = as_int(precomputed_peak.y);
+      const int2 precomputed_peak = line_peak_inputs[(uint)PEAK_SLOT(step) * stride];
+      const float h_sample = as_float(line_peak_inputs[(uint)SLOT_OF(step) * stride].x);
+      const float h_peak = as_float(precomputed_peak.x);
+      const int peak_position = precomputed_peak.y;
 #else
 #if HFVIS_ROW_SPACING
       // The step's whole units are its positions (a peak needs one strictly inside).

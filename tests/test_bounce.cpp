@@ -436,8 +436,9 @@ TEST(BounceKernels, BatchingUnderATinyMemoryBudgetChangesNothing) {
     const auto whole = computeBounce(context, field, radiance, options);
     int reports = 0;
     // The planes (heights, normals, 2 radiance and 2 irradiance channels) take 8 * 4 * 1640
-    // bytes; the tree scratch (16 bytes per sample, at least 1640 samples per direction) gets
-    // room for 700: every direction runs in chunks of lines.
+    // bytes; the tree scratch (24 bytes a slot with the peaks' prepass, two slots a step: at
+    // least 3280 slots per direction) gets room for about 466: every direction runs in chunks
+    // of lines.
     options.memory_budget_bytes = 8 * 4 * 1640 + 16 * 700;
     options.progress = [&](int, int) { ++reports; };
     const auto batched = computeBounce(context, field, radiance, options);

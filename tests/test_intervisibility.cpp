@@ -1112,9 +1112,10 @@ TEST(IntervisibilityKernels, BatchingUnderATinyMemoryBudgetChangesNothing) {
   const auto whole = computeIntervisibility(context, field, options, outputs);
   int reports = 0, last = 0;
   // The field's planes take 3 * 4 * 1640 bytes; the tree scratch (24 bytes per slot with the
-  // peaks' prepass, at least 1640 slots per direction) gets room for 700: every direction runs
-  // in chunks.
+  // peaks' prepass, two slots a step: at least 3280 slots per direction) gets room for 700 less
+  // the statistics' per-line totals: every direction runs whole, in chunks of lines (not strips).
   options.memory_budget_bytes = 3 * 4 * 1640 + 24 * 700;
+  options.strip_progress = [](int, int) { ADD_FAILURE() << "ran in strips, not in chunks of the whole field"; };
   options.progress = [&](int done, int all) {
     ++reports;
     last = done;

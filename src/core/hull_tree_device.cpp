@@ -168,7 +168,9 @@ void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDire
   peaks.set("position_shift", d.position_shift);
   peaks.set("peak_inputs", b.peak_inputs);
   // Work-groups along one line's steps where a line's slots lie together (line-major), across
-  // lines at one step where a step's do (step-major).
+  // lines at one step where a step's do (step-major). Each chunk's sweep reads what its prepass
+  // wrote, and the next chunk's prepass overwrites it: both rely on the context's one in-order
+  // queue (ContextState), which runs each launch after the one before.
   const bool line_major = lineMajorLayout(st);
   const std::size_t group_lines = line_major ? 1 : kLineGroup, group_steps = line_major ? kLineGroup : 1;
   std::vector<LatticeLine> lines = d.lines;
@@ -307,10 +309,13 @@ TreePeakInputs treePeakInputsOnDevice(ContextState& st, const HeightField& field
   b.count_sum = b.area_sum = deviceBuffer(st, plane * sizeof(float));
   b.radiance = b.normals = b.irradiance = deviceBuffer(st, 0);
   // NaN everywhere first: an entry the prepass leaves unwritten reads as a wrong sample.
-  const cl_float2 nan2 = {{std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::quiet_NaN()}};
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  cl_int2 nan2;
+  std::memcpy(&nan2.s[0], &nan, sizeof(float));
+  std::memcpy(&nan2.s[1], &nan, sizeof(float));
   st.queue.enqueueFillBuffer(b.peak_inputs, nan2, 0, entries * kTreePeakInputBytes);
   enqueueTreeDirection(st, program, d, field.width, field.height, b, false);
-  std::vector<cl_float2> inputs(entries);
+  std::vector<cl_int2> inputs(entries);
   st.queue.enqueueReadBuffer(b.peak_inputs, CL_TRUE, 0, entries * kTreePeakInputBytes, inputs.data());
 
   // Back to the canonical step-major order, as the launch laid the lines out.
@@ -326,10 +331,10 @@ TreePeakInputs treePeakInputsOnDevice(ContextState& st, const HeightField& field
       const std::size_t steps = lineCapacity(lines[j], d.samples.size());
       for (std::size_t i = 0; i < steps; ++i) {
         const std::size_t base = static_cast<std::size_t>(lines[j].stack), c = i * lines.size() + j;
-        const cl_float2 sample = inputs[base + (2 * i + 1) * chunk.stride], peak = inputs[base + 2 * i * chunk.stride];
-        out.samples[c] = sample.s[0];
-        out.peaks[c] = peak.s[0];
-        std::memcpy(&out.positions[c], &peak.s[1], sizeof(float));
+        const cl_int2 sample = inputs[base + (2 * i + 1) * chunk.stride], peak = inputs[base + 2 * i * chunk.stride];
+        std::memcpy(&out.samples[c], &sample.s[0], sizeof(float));
+        std::memcpy(&out.peaks[c], &peak.s[0], sizeof(float));
+        out.positions[c] = peak.s[1];
       }
     }
   }

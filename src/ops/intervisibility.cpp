@@ -124,7 +124,9 @@ CountPlan planCount(const HeightField& field, const std::vector<TreeDirection>& 
   rows = std::min(rows, max_alloc / row > 2 * static_cast<std::size_t>(plan.halo_rows)
                             ? max_alloc / row - 2 * plan.halo_rows : 0);
   if (forced) rows = std::min<std::size_t>(rows, options.strip_rows);
-  rows = std::min<std::size_t>(rows, field.height);
+  // Strips of every row would run whole, with the whole field's larger entries (the peaks'
+  // prepass): a field of more than one row runs in two strips at least here.
+  rows = std::min<std::size_t>(rows, field.height > 1 ? field.height - 1 : 1);
   const std::size_t strips_bytes = rows * per_row + halo + states;
   if (rows < 1 || needs.longest * kTreeNodeBytes > max_alloc) {
     throw MemoryBudgetError("one direction needs " + mebibytes(per_row + halo + states + strip_least) +
@@ -133,8 +135,12 @@ CountPlan planCount(const HeightField& field, const std::vector<TreeDirection>& 
                             mebibytes(max_alloc) + "); raise the memory budget");
   }
   plan.strip_rows = static_cast<int>(rows);
+  const std::size_t runs_entry = rows >= static_cast<std::size_t>(field.height) ? entry : strip_entry;
   plan.scratch_entries =
-      std::min({needs.whole, (budget - strips_bytes) / strip_entry, max_alloc / kTreeNodeBytes});
+      std::min({needs.whole, (budget - strips_bytes) / runs_entry, max_alloc / kTreeNodeBytes});
+  if (plan.scratch_entries < needs.longest)  // (a one-row field, whole, in a budget this small)
+    throw MemoryBudgetError("one direction needs " + mebibytes(strips_bytes + least) + " of device memory but the budget is " +
+                            mebibytes(budget) + "; raise the memory budget");
   return plan;
 }
 
