@@ -432,9 +432,10 @@ const std::vector<OptionSpec>& optionTable() {
        "halves' difference over 2^p - 1, p as the runs measured it, 1 .. 1.1;\n"
        "docs/COMMAND_LINE.md); the largest K and the\n"
        "estimate go into the summary and the hfvis:directions and\n"
-       "hfvis:estimated_error attributes (with --error-tile also\n"
-       "hfvis:directions_range, the least and most K, and --error-out's\n"
-       "channel directions, each pixel's)",
+       "hfvis:estimated_error attributes, the sky-view factor and occlusion\n"
+       "also hfvis:richardson_divisor (2^p - 1) and hfvis:runs (each run's K)\n"
+       "(with --error-tile also hfvis:directions_range, the least and most\n"
+       "K, and --error-out's channel directions, each pixel's)",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
          run.max_error = parseNumber(typed, value);
          if (!(run.max_error > 0.0 && run.max_error < 1.0))

@@ -688,7 +688,9 @@ TEST_F(Cli, OpenImageIoIsLoadedOnlyForTheImagesThatNeedIt) {
 // --max-error chooses K and --error-out writes the estimate: the same K, values and estimate as the
 // library's call (hfvis:directions the K run, not -k's default), in both files' attributes; a
 // refused E (beyond 4096 directions) writes neither file. With --error-tile the estimate file also
-// holds each pixel's K (channel directions), and hfvis:directions_range the least and most.
+// holds each pixel's K (channel directions), and hfvis:directions_range the least and most;
+// hfvis:richardson_divisor the tiles' least..most divisor and hfvis:runs each run's K, as the
+// library's result has them.
 TEST_F(Cli, MaxErrorWritesTheChosenKAndTheEstimate) {
   const std::string field = writeField("bumps.exr", 40, 33, [](int col, int row) {
     return 3.0f * std::sin(0.7f * col) * std::cos(0.5f * row) + ((col / 5 + row / 4) % 3 == 0 ? 4.0f : 0.0f);
@@ -713,9 +715,9 @@ TEST_F(Cli, MaxErrorWritesTheChosenKAndTheEstimate) {
   ASSERT_EQ(estimate.pixels.size(), 2 * lib.error_estimate.size());
   hfvis::HorizonOutputs svf_only;
   svf_only.sky_view_factor = true;
-  const std::vector<int> taken =
-      hfvis::computeHorizons(hfvis::testing::testContext(), hfvis::readHeightField(field), options, svf_only)
-          .pixel_directions;
+  const hfvis::HorizonResult runs =
+      hfvis::computeHorizons(hfvis::testing::testContext(), hfvis::readHeightField(field), options, svf_only);
+  const std::vector<int>& taken = runs.pixel_directions;
   ASSERT_EQ(taken.size(), lib.values.size());
   for (std::size_t p = 0; p < lib.values.size(); ++p) {
     ASSERT_EQ(svf.pixels[p], lib.values[p]) << p;
@@ -730,7 +732,25 @@ TEST_F(Cli, MaxErrorWritesTheChosenKAndTheEstimate) {
     EXPECT_EQ(image->spec.get_string_attribute("hfvis:max_error"), "0.02");
     EXPECT_NEAR(std::stod(image->spec.get_string_attribute("hfvis:estimated_error")), lib.estimated_error,
                 1e-9);
+    // The divisor the raw estimate was divided by (per tile: least..most), each 1 .. 2^1.1 - 1,
+    // and each run's K.
+    const std::string divisor = image->spec.get_string_attribute("hfvis:richardson_divisor");
+    const std::size_t dots = divisor.find("..");
+    if (runs.richardson_divisor_least == runs.richardson_divisor_most) ASSERT_EQ(dots, std::string::npos) << divisor;
+    ASSERT_FALSE(divisor.empty());
+    EXPECT_NEAR(std::stod(divisor.substr(0, dots)), runs.richardson_divisor_least, 1e-9) << divisor;
+    EXPECT_NEAR(std::stod(divisor.substr(dots == std::string::npos ? 0 : dots + 2)), runs.richardson_divisor_most,
+                1e-9)
+        << divisor;
+    std::string list;
+    for (int K : runs.runs) list += (list.empty() ? "" : ",") + std::to_string(K);
+    EXPECT_EQ(image->spec.get_string_attribute("hfvis:runs"), list);
   }
+  ASSERT_GE(runs.runs.size(), 2u);  // (tiles refined)
+  EXPECT_EQ(runs.runs.front(), 16);
+  EXPECT_GE(runs.richardson_divisor_least, 1.0);
+  EXPECT_LE(runs.richardson_divisor_least, runs.richardson_divisor_most);
+  EXPECT_LE(runs.richardson_divisor_most, std::pow(2.0, 1.1) - 1.0 + 1e-12);
   EXPECT_LE(lib.estimated_error, 0.02);
   fs::remove(out("s.exr"));
   fs::remove(out("e.exr"));
@@ -766,6 +786,9 @@ TEST_F(Cli, ErrorOutWithAFixedKWritesTheEstimate) {
       ASSERT_EQ(estimate.pixels[p], lib.error_estimate[p]) << command << " " << p;
     }
     EXPECT_EQ(estimate.spec.get_string_attribute("hfvis:directions"), "8");
+    // (no runs chose K: no divisor, no run list)
+    EXPECT_EQ(estimate.spec.get_string_attribute("hfvis:richardson_divisor"), "");
+    EXPECT_EQ(estimate.spec.get_string_attribute("hfvis:runs"), "");
     fs::remove(out("s.exr"));
     fs::remove(out("e.exr"));
   }

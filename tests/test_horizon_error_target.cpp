@@ -299,6 +299,9 @@ TEST(HorizonMaxError, RefinedTilesEqualAWholeFieldRunAtTheirK) {
               const double divisor = whole.error_estimate[p] / static_cast<double>(refined.error_estimate[p]);
               ASSERT_GE(divisor, 1.0 - 1e-6) << p;
               ASSERT_LE(divisor, detail::richardsonDivisor(detail::kMaxRichardsonOrder) * (1 + 1e-6)) << p;
+              // (the tiles' least and most divisor bound it)
+              ASSERT_GE(divisor, refined.richardson_divisor_least * (1 - 1e-5)) << p;
+              ASSERT_LE(divisor, refined.richardson_divisor_most * (1 + 1e-5)) << p;
               const auto [at, fresh] = divisors.emplace(tile, divisor);
               if (!fresh) {
                 ASSERT_NEAR(divisor, at->second, 1e-5 * divisor) << p;
@@ -402,6 +405,9 @@ TEST(HorizonMaxError, TheEstimateIsTheRawOneOverTheRichardsonDivisor) {
   for (std::size_t p = 0; p < field.pixelCount(); ++p)
     ASSERT_NEAR(chosen.error_estimate[p], fixed.error_estimate[p] / divisor, 1e-6 * fixed.error_estimate[p]) << p;
   EXPECT_NEAR(chosen.estimated_error, fixed.estimated_error / divisor, 1e-6 * fixed.estimated_error);
+  // One tile: the least and the most divisor are that one.
+  EXPECT_DOUBLE_EQ(chosen.richardson_divisor_least, divisor);
+  EXPECT_DOUBLE_EQ(chosen.richardson_divisor_most, divisor);
 }
 
 // The next K: more than the last, a multiple of 8; the K predicted to meet E never fewer for a

@@ -127,7 +127,7 @@ class Horizon : public Computation {
       summary.note = "; estimated mean error " + formatFixed(result_.estimated_error * 180.0 / M_PI, 4) + " deg" +
                      (run_.horizon_max_error_deg > 0.0
                           ? " for --max-error " + formatNumber(run_.horizon_max_error_deg) + " (runs at K = " +
-                                runList() + ")"
+                                runList(result_) + ")"
                           : "");
     }
     if (!run_.preview.empty()) {
@@ -146,17 +146,11 @@ class Horizon : public Computation {
       if (name == "hfvis:estimated_error") value = formatNumber(result_.estimated_error * 180.0 / M_PI);
     if (run_.horizon_max_error_deg > 0.0) {
       attributes.emplace_back("hfvis:max_error", formatNumber(run_.horizon_max_error_deg));
-      attributes.emplace_back("hfvis:runs", runList());
+      attributes.emplace_back("hfvis:runs", runList(result_));
     }
     if (!result_.error_estimate.empty())
       attributes.emplace_back("hfvis:error_unit", "degrees, the mean over pixels and azimuths");
     return attributes;
-  }
-
-  std::string runList() const {
-    std::string list;
-    for (int K : result_.runs) list += (list.empty() ? "" : ",") + std::to_string(K);
-    return list;
   }
 
   HorizonResult result_;

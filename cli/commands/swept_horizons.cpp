@@ -32,7 +32,24 @@ Attributes sweptAttributes(const Job& job, const HorizonResult& result) {
   }
   if (!result.error_estimate.empty())
     attributes.emplace_back("hfvis:estimated_error", formatNumber(result.estimated_error));
+  if (job.run.max_error > 0.0 && result.richardson_divisor_most > 0.0) {
+    // What the raw estimate (the halves' difference) was divided by: 2^p - 1, p as the runs
+    // measured it (per tile: the least and most), and each run's K, so that the whole cost is
+    // known (HorizonOptions::max_error).
+    attributes.emplace_back("hfvis:richardson_divisor",
+                            result.richardson_divisor_least == result.richardson_divisor_most
+                                ? formatNumber(result.richardson_divisor_most)
+                                : formatNumber(result.richardson_divisor_least) + ".." +
+                                      formatNumber(result.richardson_divisor_most));
+    attributes.emplace_back("hfvis:runs", runList(result));
+  }
   return attributes;
+}
+
+std::string runList(const HorizonResult& result) {
+  std::string list;
+  for (int K : result.runs) list += (list.empty() ? "" : ",") + std::to_string(K);
+  return list;
 }
 
 void HorizonQuantityComputation::compute(Job& job) {

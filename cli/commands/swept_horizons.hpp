@@ -2,6 +2,7 @@
 // computeHorizons run, the azimuths it swept, and (the latter two) one channel written from it.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "../pipeline.hpp"
@@ -14,7 +15,12 @@ HorizonResult computeSweptHorizons(Job& job, const HorizonOutputs& wanted);
 
 // The run's attributes and hfvis:azimuths_deg: the sweep's directions are lattice steps near
 // phi_k (horizon planes) or quadrature directions (sky-view factor, ambient occlusion).
+// With --max-error (sky-view factor, occlusion) also hfvis:richardson_divisor (least..most with
+// tiles) and hfvis:runs.
 Attributes sweptAttributes(const Job& job, const HorizonResult& result);
+
+// hfvis:runs: each run's K (HorizonResult::runs), comma-separated.
+std::string runList(const HorizonResult& result);
 
 // One channel computed from the horizons.
 struct HorizonQuantity {

@@ -49,12 +49,13 @@ struct HorizonOptions : SweepOptions {
   // estimate is then that of the K result itself: the halves' difference (error_estimate below)
   // divided by 2^p - 1 (Richardson: the difference is about |r(K/2) - r(K)|), p the order at which
   // it fell (as K^-p) between this run and an earlier one of at most half its K, within 1 .. 1.1
-  // (1 when there is none: the difference itself). A first run at 16 directions and each one
-  // after it predicts the K where the estimate meets 0.9 max_error (the fall measured from the
-  // last two runs); a prediction more than 4 times the last K takes a probe first (twice the last
-  // K, or a sixth of the prediction), until the estimate is met. Throws InvalidArgument, naming
-  // the K it would take, when a run predicts more than kMaxAutoDirections (after the first run only
-  // when even a fall as K^-2 would). The samples per unit stay as given.
+  // (1 when there is none: the difference itself; HorizonResult::richardson_divisor_least/most).
+  // A first run at 16 directions and each one after it predicts the K where the estimate meets
+  // 0.9 max_error (the fall measured from the last two runs); a prediction more than 4 times the
+  // last K takes a probe first (twice the last K, or a sixth of the prediction), until the
+  // estimate is met. Throws InvalidArgument, naming the K it would take, when a run predicts more
+  // than kMaxAutoDirections (after the first run only when even a fall as K^-2 would). The
+  // samples per unit stay as given.
   // With the horizon planes (angles alone, or with their distances; no sky-view factor, occlusion
   // or environment in the same run), max_error is in radians, 0 < max_error < pi/2, and bounds the
   // mean horizon angle error: over the pixels with data and over azimuth, |the K planes
@@ -140,6 +141,10 @@ struct HorizonResult {
   std::vector<int> runs;
   // With HorizonOptions::max_error, per pixel: the K of the run its values (and estimate) come from.
   std::vector<int> pixel_directions;
+  // With HorizonOptions::max_error (sky-view factor, occlusion): the least and the most Richardson
+  // divisor 2^p - 1 the raw estimate was divided by, over the tiles (equal with one tile); 0
+  // otherwise (the horizon planes' estimate has none).
+  double richardson_divisor_least = 0.0, richardson_divisor_most = 0.0;
   // The sweep's work, all runs together (with max_error; else this run's): per receiver of the
   // field, the samples of each direction's period times the receivers on the lines it swept
   // (a whole-field run at K: its directions' samples per period summed; 0 for the naive method).

@@ -364,6 +364,9 @@ def _swept_quantity(operation, heights, options, max_error, error_estimate, comm
         return ErrorEstimate(out[operation], out["error"], out["directions"], out["estimated_error"])
     attrs = _attrs(operation, operation, dict(options, directions=out["directions"]), grid)
     attrs["hfvis_estimated_error"] = out["estimated_error"]
+    if "richardson_divisor" in out:  # max_error: the divisor and each run's K (the CLI's attributes)
+        attrs["hfvis_richardson_divisor"] = out["richardson_divisor"]
+        attrs["hfvis_runs"] = list(out["runs"])
     values = grid.result(out[operation], operation, attrs)
     if not error_estimate:
         return values

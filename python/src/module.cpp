@@ -265,6 +265,13 @@ nb::dict horizons(const HeightField& field, HorizonOptions options, bool angles,
     out["error"] = plane(std::move(r.error_estimate), field);
     out["estimated_error"] = r.estimated_error;
   }
+  // With max_error (sky-view factor, occlusion): the Richardson divisor the estimate was divided by
+  // (one tile: the least is the most) and each run's K, as the CLI's hfvis:richardson_divisor and
+  // hfvis:runs.
+  if (r.richardson_divisor_most > 0.0) {
+    out["richardson_divisor"] = r.richardson_divisor_most;
+    out["runs"] = r.runs;
+  }
   return out;
 }
 

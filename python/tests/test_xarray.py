@@ -143,6 +143,9 @@ def test_max_error_on_dataarrays(projected_tif):
     equal(svf, numpy_run.values)
     assert svf.attrs["hfvis_directions"] == numpy_run.directions and svf.attrs["hfvis_max_error"] == 0.01
     assert svf.attrs["hfvis_estimated_error"] == numpy_run.estimated_error <= 0.01
+    # The Richardson divisor (1 .. 2^1.1 - 1) and each run's K, the first 16, the last the K chosen.
+    assert 1.0 <= svf.attrs["hfvis_richardson_divisor"] <= 2.0 ** 1.1 - 1.0 + 1e-12
+    assert svf.attrs["hfvis_runs"][0] == 16 and svf.attrs["hfvis_runs"][-1] == svf.attrs["hfvis_directions"]
     both = hfvis.ambient_occlusion(dem.chunk(100), max_error=0.02, error_estimate=True, max_distance=900)
     assert isinstance(both, xr.Dataset) and set(both) == {"ambient_occlusion", "error"}
     assert both.error.rio.crs == dem.rio.crs and both.error.attrs["hfvis_directions"] > 16

@@ -915,6 +915,35 @@ class HorizonRoutine : public SweepRoutine {
       placeholder_, env_sum_, env_tables_;
 };
 
+// The field's tiles of side x side pixels (HorizonOptions::error_tile; 0: the whole field in
+// one), row-major; a tile's pixels are found from its rectangle, not kept in lists (those took 8
+// bytes a pixel, even with one tile for the whole field).
+struct ErrorTiles {
+  ErrorTiles(const HeightField& field, int error_tile)
+      : width(field.width),
+        height(field.height),
+        side(error_tile > 0 ? error_tile : std::max(field.width, field.height)),
+        across((width + side - 1) / side),
+        count(across * ((height + side - 1) / side)) {}
+  int of(std::size_t p) const {
+    return static_cast<int>(p / width) / side * across + static_cast<int>(p % width) / side;
+  }
+  // visit(p) for the pixels of tile t, row by row.
+  template <class Visit>
+  void forEachPixel(int t, Visit&& visit) const {
+    const int r0 = t / across * side, c0 = t % across * side;
+    for (int r = r0; r < std::min(height, r0 + side); ++r)
+      for (int c = c0; c < std::min(width, c0 + side); ++c) visit(static_cast<std::size_t>(r) * width + c);
+  }
+  // The values of `plane` at the pixels of tile t.
+  std::vector<float> values(const std::vector<float>& plane, int t) const {
+    std::vector<float> out;
+    forEachPixel(t, [&](std::size_t p) { out.push_back(plane[p]); });
+    return out;
+  }
+  int width, height, side, across, count;
+};
+
 // HorizonOptions::max_error: the whole field at kFirstAutoDirections, then, while the error
 // estimate's 99th percentile over the field exceeds max_error, tiles again at the K
 // nextDirectionsForError asks for after their own runs, those of one K in one run over the lines
@@ -926,17 +955,9 @@ class HorizonRoutine : public SweepRoutine {
 // whole field).
 HorizonResult runToError(const HeightField& field, const HorizonOptions& options,
                          const std::function<HorizonResult(int, const std::vector<char>*)>& run) {
-  const int width = field.width, height = field.height;
-  const int side = options.error_tile > 0 ? options.error_tile : std::max(width, height);
-  const int tiles_x = (width + side - 1) / side, tiles = tiles_x * ((height + side - 1) / side);
-  std::vector<int> tile_of(field.pixelCount());
-  std::vector<std::vector<std::size_t>> pixels_of(tiles);
-  for (int r = 0; r < height; ++r)
-    for (int c = 0; c < width; ++c) {
-      const std::size_t p = static_cast<std::size_t>(r) * width + c;
-      tile_of[p] = r / side * tiles_x + c / side;
-      pixels_of[tile_of[p]].push_back(p);
-    }
+  const ErrorTiles grid(field, options.error_tile);
+  const int tiles = grid.count;
+  const std::size_t pixels = field.pixelCount();
   std::vector<std::vector<EstimateRun>> history(tiles);  // per tile, the runs its pixels took
   std::vector<double> divisor(tiles, 1.0);
   // A run at K over the tiles of `chosen`: their raw estimates' percentiles recorded, and the
@@ -944,18 +965,16 @@ HorizonResult runToError(const HeightField& field, const HorizonOptions& options
   const auto record = [&](const std::vector<float>& raw, int directions, const std::vector<char>& chosen) {
     for (int t = 0; t < tiles; ++t) {
       if (!chosen[t]) continue;
-      std::vector<float> values;
-      for (std::size_t p : pixels_of[t]) values.push_back(raw[p]);
-      history[t].push_back({directions, estimatedError(values)});
+      history[t].push_back({directions, estimatedError(grid.values(raw, t))});
       divisor[t] = richardsonDivisor(estimateOrder(history[t]));
     }
   };
   HorizonResult result = run(kFirstAutoDirections, nullptr);
   result.runs = {kFirstAutoDirections};
-  result.pixel_directions.assign(field.pixelCount(), kFirstAutoDirections);
+  result.pixel_directions.assign(pixels, kFirstAutoDirections);
   record(result.error_estimate, kFirstAutoDirections, std::vector<char>(tiles, 1));
-  for (std::size_t p = 0; p < tile_of.size(); ++p)
-    result.error_estimate[p] = static_cast<float>(result.error_estimate[p] / divisor[tile_of[p]]);
+  for (std::size_t p = 0; p < pixels; ++p)
+    result.error_estimate[p] = static_cast<float>(result.error_estimate[p] / divisor[grid.of(p)]);
   double work = result.samples_per_receiver;
   const std::vector<int> ladder = directionLadder();
   // Pixels with data the 99th percentile (estimatedError) lets lie above it.
@@ -964,12 +983,9 @@ HorizonResult runToError(const HeightField& field, const HorizonOptions& options
   const std::size_t allowed =
       with_data ? with_data - 1 - std::min(with_data - 1, static_cast<std::size_t>(0.99 * with_data)) : 0;
   for (;;) {
-    std::vector<std::vector<float>> estimates(tiles);
     std::vector<std::size_t> above(tiles, 0);
-    for (std::size_t p = 0; p < tile_of.size(); ++p) {
-      estimates[tile_of[p]].push_back(result.error_estimate[p]);
-      above[tile_of[p]] += result.error_estimate[p] > options.max_error;  // (NaN: not above)
-    }
+    for (std::size_t p = 0; p < pixels; ++p)
+      above[grid.of(p)] += result.error_estimate[p] > options.max_error;  // (NaN: not above)
     std::size_t left = std::accumulate(above.begin(), above.end(), std::size_t{0});
     if (left <= allowed) break;
     std::vector<int> order(tiles);
@@ -982,10 +998,10 @@ HorizonResult runToError(const HeightField& field, const HorizonOptions& options
       const NextErrorRun asked = nextDirectionsForError(history[t], options.max_error);
       if (asked.predicted > kMaxAutoDirections)
         throw beyondAutoDirections(options.max_error, asked.predicted, history[t].back().directions,
-                                   estimatedError(estimates[t]),
+                                   estimatedError(grid.values(result.error_estimate, t)),
                                    tiles > 1 ? " in the tile of pixels from column " +
-                                                   std::to_string(t % tiles_x * side) + ", row " +
-                                                   std::to_string(t / tiles_x * side)
+                                                   std::to_string(t % grid.across * grid.side) + ", row " +
+                                                   std::to_string(t / grid.across * grid.side)
                                              : std::string());
       int directions = asked.directions;
       if (options.error_tile > 0) directions = *std::lower_bound(ladder.begin(), ladder.end(), directions);
@@ -994,31 +1010,35 @@ HorizonResult runToError(const HeightField& field, const HorizonOptions& options
       chosen[t] = 1;
     }
     for (const auto& [directions, chosen] : next) {
-      std::vector<char> wanted(field.pixelCount());
-      for (std::size_t p = 0; p < wanted.size(); ++p) wanted[p] = chosen[tile_of[p]];
       const bool all = std::count(chosen.begin(), chosen.end(), 1) == tiles;
+      std::vector<char> wanted;
+      if (!all) {
+        wanted.assign(pixels, 0);
+        for (int t = 0; t < tiles; ++t)
+          if (chosen[t]) grid.forEachPixel(t, [&](std::size_t p) { wanted[p] = 1; });
+      }
       HorizonResult part = run(directions, all ? nullptr : &wanted);
       result.runs.push_back(directions);
       work += part.samples_per_receiver;
       record(part.error_estimate, directions, chosen);
-      const auto take = [&](std::vector<float>& into, const std::vector<float>& from) {
-        if (into.empty()) return;
-        for (std::size_t p = 0; p < wanted.size(); ++p)
-          if (wanted[p]) into[p] = from[p];
-      };
-      take(result.sky_view_factor, part.sky_view_factor);
-      take(result.ambient_occlusion, part.ambient_occlusion);
-      for (std::size_t p = 0; p < wanted.size(); ++p)
-        if (wanted[p]) {
-          result.error_estimate[p] = static_cast<float>(part.error_estimate[p] / divisor[tile_of[p]]);
+      for (int t = 0; t < tiles; ++t) {
+        if (!chosen[t]) continue;
+        grid.forEachPixel(t, [&](std::size_t p) {
+          if (!result.sky_view_factor.empty()) result.sky_view_factor[p] = part.sky_view_factor[p];
+          if (!result.ambient_occlusion.empty()) result.ambient_occlusion[p] = part.ambient_occlusion[p];
+          result.error_estimate[p] = static_cast<float>(part.error_estimate[p] / divisor[t]);
           result.pixel_directions[p] = directions;
-        }
+        });
+      }
       if (directions > result.directions) {
         result.directions = directions;
         result.azimuths = std::move(part.azimuths);
       }
     }
   }
+  const auto [least, most] = std::minmax_element(divisor.begin(), divisor.end());
+  result.richardson_divisor_least = *least;
+  result.richardson_divisor_most = *most;
   result.estimated_error = estimatedError(result.error_estimate);
   result.samples_per_receiver = work;
   return result;
