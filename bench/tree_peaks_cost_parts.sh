@@ -6,6 +6,9 @@
 #               slots per step, the peak branches; no piece read, no peak inserted)
 #   pieces      every interval's pieces evaluated and the peak's test made, none inserted
 #   current     this build as it is (the peaks evaluated and inserted)
+# Since the peaks' prepass (3ae7129) the two middle ones edit the prepass's peak function, so
+# they include the prepass's own pass (the samples' heights and an 8-byte write a slot), which
+# the 1311f46 table in bench/report/tree_peaks.md did not have.
 # The two middle ones are the kernel of this checkout edited by sed into bench/out/ (loaded
 # through HFVIS_KERNEL_DIR; their results differ from the current one's by design, and the script
 # stops if the lines it edits have changed). Prints the median CPU (user + system) seconds of
