@@ -736,7 +736,9 @@ TEST_F(Cli, MaxErrorWritesTheChosenKAndTheEstimate) {
     // and each run's K.
     const std::string divisor = image->spec.get_string_attribute("hfvis:richardson_divisor");
     const std::size_t dots = divisor.find("..");
-    if (runs.richardson_divisor_least == runs.richardson_divisor_most) ASSERT_EQ(dots, std::string::npos) << divisor;
+    if (runs.richardson_divisor_least == runs.richardson_divisor_most) {
+      ASSERT_EQ(dots, std::string::npos) << divisor;
+    }
     ASSERT_FALSE(divisor.empty());
     EXPECT_NEAR(std::stod(divisor.substr(0, dots)), runs.richardson_divisor_least, 1e-9) << divisor;
     EXPECT_NEAR(std::stod(divisor.substr(dots == std::string::npos ? 0 : dots + 2)), runs.richardson_divisor_most,
