@@ -91,6 +91,28 @@ void allocateTreeScratch(ContextState& st, const TreeProgramFlags& flags, const 
   b.line_totals = deviceBuffer(st, flags.stats ? max_lines * kTreeLineTotals * sizeof(cl_ulong) : 0);
 }
 
+namespace {
+
+// The arguments intervisibility_lattice and its prepass intervisibility_peaks share: the field,
+// the direction's lattice samples and interval pieces, and the prepass's buffer.
+void setLineSamplingArguments(NamedKernel& kernel, const TreeKernel& k, const TreeDirection& d, int width, int height,
+                              const TreeBuffers& b) {
+  kernel.set("heights", b.heights);
+  kernel.set("width", width);
+  kernel.set("height", height);
+  kernel.set("samples", k.samples);
+  kernel.set("n_samples", static_cast<int>(d.samples.size()));
+  kernel.set("a", d.lattice.a);
+  kernel.set("b", d.lattice.b);
+  kernel.set("drop", d.drop);
+  kernel.set("pieces", k.pieces);
+  kernel.set("interval_first", k.interval_first);
+  kernel.set("position_shift", d.position_shift);
+  kernel.set("peak_inputs", b.peak_inputs);
+}
+
+}  // namespace
+
 TreeKernel treeKernel(ContextState& st, cl::Program& program, const TreeDirection& d, int width, int height,
                       const TreeBuffers& b) {
   auto table = [&](const void* data, std::size_t bytes) {
@@ -106,23 +128,12 @@ TreeKernel treeKernel(ContextState& st, cl::Program& program, const TreeDirectio
   k.no_strips = deviceBuffer(st, 0);
   k.kernel = NamedKernel(st, program, "intervisibility_lattice");  // the chunk's lines set per chunk
   NamedKernel& kernel = k.kernel;
-  kernel.set("heights", b.heights);
-  kernel.set("width", width);
-  kernel.set("height", height);
-  kernel.set("samples", k.samples);
-  kernel.set("n_samples", static_cast<int>(d.samples.size()));
-  kernel.set("a", d.lattice.a);
-  kernel.set("b", d.lattice.b);
+  setLineSamplingArguments(kernel, k, d, width, height, b);
   kernel.set("count_factor", d.count_factor);
   kernel.set("area_factor", d.area_factor);
-  kernel.set("drop", d.drop);
   kernel.set("max_steps", d.max_steps);
   kernel.set("row_units", k.row_units);
   kernel.set("row_factors", k.row_factors);
-  kernel.set("pieces", k.pieces);
-  kernel.set("interval_first", k.interval_first);
-  kernel.set("position_shift", d.position_shift);
-  kernel.set("peak_inputs", b.peak_inputs);
   kernel.set("trees", b.trees);
   kernel.set("prefix", b.prefix);
   kernel.set("positions", b.positions);
@@ -155,18 +166,7 @@ void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDire
     return;
   }
   NamedKernel peaks(st, program, "intervisibility_peaks");
-  peaks.set("heights", b.heights);
-  peaks.set("width", width);
-  peaks.set("height", height);
-  peaks.set("samples", k.samples);
-  peaks.set("n_samples", static_cast<int>(d.samples.size()));
-  peaks.set("a", d.lattice.a);
-  peaks.set("b", d.lattice.b);
-  peaks.set("drop", d.drop);
-  peaks.set("pieces", k.pieces);
-  peaks.set("interval_first", k.interval_first);
-  peaks.set("position_shift", d.position_shift);
-  peaks.set("peak_inputs", b.peak_inputs);
+  setLineSamplingArguments(peaks, k, d, width, height, b);
   // Work-groups along one line's steps where a line's slots lie together (line-major), across
   // lines at one step where a step's do (step-major). Each chunk's sweep reads what its prepass
   // wrote, and the next chunk's prepass overwrites it: both rely on the context's one in-order
