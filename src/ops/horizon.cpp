@@ -1009,7 +1009,10 @@ HorizonResult runToError(const HeightField& field, const HorizonOptions& options
       chosen.resize(tiles, 0);
       chosen[t] = 1;
     }
-    for (const auto& [directions, chosen] : next) {
+    for (const auto& run_tiles : next) {
+      // (not a structured binding: the lambdas below capture it, which C++17 does not allow)
+      const int directions = run_tiles.first;
+      const auto& chosen = run_tiles.second;
       const bool all = std::count(chosen.begin(), chosen.end(), 1) == tiles;
       std::vector<char> wanted;
       if (!all) {
