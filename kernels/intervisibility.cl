@@ -46,6 +46,7 @@
 // change the work (iterations t, memory traffic), never a result.
 #include "shared/chord_side.cl"
 #include "shared/fast_math.cl"
+#include "shared/lanes.cl"
 #include "shared/sweep_framework.cl"
 #include "shared/tree_peaks.cl"
 
@@ -93,6 +94,9 @@
 #endif
 #ifndef HFVIS_PEAK_PREPASS
 #define HFVIS_PEAK_PREPASS 0
+#endif
+#ifndef HFVIS_PEAK_STEPS
+#define HFVIS_PEAK_STEPS 1
 #endif
 #if HFVIS_PEAK_PREPASS && (HFVIS_ROW_SPACING || HFVIS_STRIPS)
 #error "the peaks' prepass takes uniform grids on the whole field (positions from the steps alone)"
@@ -410,43 +414,203 @@ HFVIS_INLINE float tree_interval_peak(__global const float* heights, int width, 
 }
 
 #if HFVIS_PEAK_PREPASS
+// The exact sign of chord_side(ha, hb, hc, dab, dbc) > 0 in every lane: the float filter side
+// by side, the exact expansion lane by lane where the filter does not decide (rare). `want`:
+// the lanes whose answer is used (others may hold anything).
+HFVIS_INLINE lane_int chord_above_lanes(lane_float ha, lane_float hb, lane_float hc, lane_float dab, lane_float dbc,
+                                        lane_int want) {
+  const lane_int flat = (ha == hc) & (hb == hc);
+  const lane_float dac = dab + dbc;
+  const lane_float p1 = (hb - hc) * dac, p2 = (ha - hc) * dbc;
+  const lane_float det = p1 - p2, magnitude = fabs(p1) + fabs(p2);
+  const lane_int decided = (magnitude >= HFVIS_CHORD_FILTER_FLOOR) & (fabs(det) > HFVIS_CHORD_ERROR_BOUND * magnitude);
+  lane_int above = (flat == 0) & decided & (det > 0.0f);
+  const lane_int undecided = want & (flat == 0) & (decided == 0);
+  if (ANY_LANE(undecided)) {
+    for (int l = 0; l < HFVIS_LANES; ++l) {
+      if (ILANE(undecided, l))
+        ILANE(above, l) = exact_chord_side(LANE(ha, l), LANE(hb, l), LANE(hc, l), LANE(dab, l), LANE(dbc, l),
+                                           LANE(dac, l)) > 0
+                              ? ILANE(undecided, l)  // (-1 in a vector lane, 1 in a scalar: a mask)
+                              : 0;
+    }
+  }
+  return above;
+}
+
+// tree_interval_peak (and tree_piece_peak, tree_peak_inserted) for HFVIS_LANES lines side by side
+// at one step, as the prepass runs them: the lines share the step, so its pieces, their ends and
+// the positions a crossing rounds to are the same in every lane; only the corners' heights differ.
+// Every lane takes the scalar functions' operations in their order, so each lane's peak is theirs
+// bit for bit (PeakPrepassMatchesTheReference); their branches become selects. Lanes whose
+// samples are absent (h_far or h_near NaN, lines shorter than the step) get NaN.
+HFVIS_INLINE lane_float tree_interval_peak_lanes(__global const float* heights, int width, int height,
+                                                 __global const TreePiece* pieces, __global const int* interval_first,
+                                                 int q, int i, lane_int col, lane_int row, int step, lane_float h_far,
+                                                 lane_float h_near, float drop, float inv_scale, float d_sample,
+                                                 int position_far, int step_scale, lane_int* peak_position) {
+  *peak_position = (lane_int)(0);
+  if (!(step > 0 && step_scale > 1)) return (lane_float)(NAN);
+  const float fscale = (float)step_scale;
+  lane_int live = (isnan(h_far) == 0) & (isnan(h_near) == 0);
+  lane_float best_h = (lane_float)(-INFINITY), best_excess = (lane_float)(0.0f);
+  lane_int offset = (lane_int)(0);
+  lane_float prev_A = (lane_float)(0.0f), prev_B = prev_A, prev_C = prev_A;  // the piece before's curve
+  float prev_t_far = 0.0f, prev_inv_span = 0.0f;
+  lane_float chord_far = h_far, rise = h_near - h_far;
+#if HFVIS_CURVATURE
+  const float d_far = (float)position_far * inv_scale;
+  chord_far = h_far + drop * d_far * d_far;
+  rise = (h_near + drop * d_sample * d_sample) - chord_far;
+#endif
+  for (int k = interval_first[q]; k < interval_first[q + 1]; ++k) {
+    __global const TreePiece* g = pieces + k;
+    const float fx = g->fx, fy = g->fy, dx = g->dx, dy = g->dy, t_far = g->t_far, t_near = g->t_near,
+                inv_span = g->inv_span;
+    const lane_int px = col + g->ox, py = row + g->oy;
+    if (i == 0)  // outside the field: no peak
+      live = live & (px >= 0) & (px + 1 <= width - 1) & (py >= 0) & (py + 1 <= height - 1);
+    const lane_int at = py * width + px;
+    lane_float h00 = (lane_float)(0.0f), h10 = h00, h01 = h00, h11 = h00;
+    for (int l = 0; l < HFVIS_LANES; ++l) {
+      if (!ILANE(live, l)) continue;  // (its cell may lie outside the field: not read)
+      const uint a = (uint)ILANE(at, l);
+      LANE(h00, l) = heights[a];
+      LANE(h10, l) = heights[a + 1];
+      LANE(h01, l) = heights[a + (uint)width];
+      LANE(h11, l) = heights[a + (uint)width + 1];
+    }
+    const lane_float gx = h10 - h00, gy = h01 - h00, e = (h11 - h01) - gx;
+    const lane_float A = h00 + gx * fx + gy * fy + e * (fx * fy);
+    const lane_float B = gx * dx + gy * dy + e * (fx * dy + fy * dx);
+    const lane_float C = e * (dx * dy);
+    // A non-finite corner: the interval has no peak (tree_piece_peak's NaN, no later candidate).
+    const lane_int infinite = isfinite(A) == 0;
+    best_h = select(best_h, (lane_float)(NAN), infinite);
+    best_excess = select(best_excess, (lane_float)(INFINITY), infinite);
+    if (g->far_crossing) {
+      int off = (int)rint(t_far * fscale);
+      off = off < 1 ? 1 : off > step_scale - 1 ? step_scale - 1 : off;
+      const float t = (float)off / fscale;
+      lane_float v;
+      if (t >= t_far) {
+        const float u = (t - t_far) * inv_span;
+        v = A + (B + C * u) * u;
+      } else {
+        const float u = (t - prev_t_far) * prev_inv_span;
+        v = prev_A + (prev_B + prev_C * u) * u;
+      }
+      const lane_float excess = v - (chord_far + rise * t);
+      const lane_int better = excess > best_excess;
+      best_excess = select(best_excess, excess, better);
+      best_h = select(best_h, v, better);
+      offset = select(offset, (lane_int)(off), better);
+    }
+    const float span = t_near - t_far;
+    const lane_float slope = B - rise * span;
+    int lo = (int)ceil(t_far * fscale), hi = (int)floor(t_near * fscale);
+    lo = lo < 1 ? 1 : lo;
+    hi = hi > step_scale - 1 ? step_scale - 1 : hi;
+    const lane_int concave = (C < 0.0f) & (slope > 0.0f) & (slope < -2.0f * C);
+    if (lo <= hi && ANY_LANE(concave)) {
+      const lane_float u = slope / (-2.0f * C);
+      // Other lanes' u may be anything: their position is replaced before it becomes an integer.
+      const lane_float at_vertex = select((lane_float)((float)lo), rint((t_far + u * span) * fscale), concave);
+      lane_int off = LANE_INT(at_vertex);
+      off = select(off, (lane_int)(lo), off < lo);
+      off = select(off, (lane_int)(hi), off > hi);
+      const lane_float t = LANE_FLOAT(off) / fscale;
+      const lane_float w = (t - t_far) * inv_span;
+      const lane_float v = A + (B + C * w) * w;
+      const lane_float excess = v - (chord_far + rise * t);
+      const lane_int better = concave & (excess > best_excess);
+      best_excess = select(best_excess, excess, better);
+      best_h = select(best_h, v, better);
+      offset = select(offset, off, better);
+    }
+    prev_A = A;
+    prev_B = B;
+    prev_C = C;
+    prev_t_far = t_far;
+    prev_inv_span = inv_span;
+  }
+  live = live & (best_h > -INFINITY);  // (NaN: a corner was)
+  *peak_position = position_far + offset;
+#if HFVIS_CURVATURE
+  const lane_float d_peak = LANE_FLOAT(*peak_position) * inv_scale;
+  best_h = best_h - drop * d_peak * d_peak;
+#endif
+  // tree_peak_inserted
+  const lane_float t = LANE_FLOAT(offset) / (float)step_scale;
+  const lane_float excess = best_h - (h_far + (h_near - h_far) * t);
+  live = live & (isnan(best_h) == 0) & (excess > 0x1p-18f * (fabs(h_far) + fabs(h_near)));
+  live = live & chord_above_lanes(h_far, best_h, h_near, LANE_FLOAT(offset), LANE_FLOAT(step_scale - offset), live);
+  return select((lane_float)(NAN), best_h, live);
+}
+
 // The samples' heights and the peaks between them, ahead of the sweep (HFVIS_PEAK_PREPASS):
-// one work-item per step of a line, none waiting on another, where the sweep's one work-item
-// per line would evaluate them between its dependent tree walks. Step s of line j (its sample
-// q of period i, as intervisibility_lattice numbers them) writes its sample's height into
-// peak_inputs[SLOT_OF(s)] (x, a float's bits) and its peak (the height's bits, NaN for none;
-// the position) into peak_inputs[PEAK_SLOT(s)], as integers (a position's bits as a float would
-// be a denormal, which a device without denormals may flush to zero in a move), laid out as the tree's slots (8 bytes a slot where a node takes 16:
-// the pass costs memory traffic, which decides its gain on a CPU). Arguments as
-// intervisibility_lattice's (uniform grids only: no per-row spacing, no strips).
-// Global size: (lines, steps of the longest line), each rounded up to the local size.
+// one work-item per step of HFVIS_LANES lines (lines j0 .. j0 + HFVIS_LANES - 1, side by side in
+// its SIMD lanes on a CPU), none waiting on another, where the sweep's one work-item per line
+// would evaluate them between its dependent tree walks. Step s of line j (its sample q of period
+// i, as intervisibility_lattice numbers them) writes its sample's height into
+// peak_inputs[SLOT_OF(s)] (x, a float's bits) and its peak (the height's bits, NaN for none; the
+// position) into peak_inputs[PEAK_SLOT(s)], as integers (a position's bits as a float would be a
+// denormal, which a device without denormals may flush to zero in a move), laid out as the tree's
+// slots (8 bytes a slot where a node takes 16: the pass costs memory traffic, which decides its
+// gain on a CPU). Arguments as intervisibility_lattice's (uniform grids only: no per-row spacing,
+// no strips).
+// HFVIS_PEAK_STEPS consecutive steps a work-item, so that each sample's height is computed once
+// (the next step's interval starts at it).
+// Global size: (lines / HFVIS_LANES, steps of the longest line / HFVIS_PEAK_STEPS), each rounded up
+// to the local size.
 __kernel void intervisibility_peaks(__global const float* heights, int width, int height, __global const int4* lines,
                                     int n_lines, __global const LatticeSample* samples, int n_samples, int a, int b,
                                     float drop, __global const TreePiece* pieces, __global const int* interval_first,
                                     int position_shift, __global int2* peak_inputs, uint stride) {
-  const int j = get_global_id(0), step = get_global_id(1);
-  if (j >= n_lines) return;
-  const int4 line = lines[j];
-  if (step >= line.z * n_samples) return;
+  const int j0 = get_global_id(0) * HFVIS_LANES, first_step = get_global_id(1) * HFVIS_PEAK_STEPS;
+  if (j0 >= n_lines) return;
   const float inv_scale = 1.0f / (float)(1 << position_shift);
-  const int i = step / n_samples, q = step - i * n_samples;
-  const int col = line.x - i * a, row = line.y - i * b;
-  const float d_sample = (float)(step << position_shift) * inv_scale;
-  const float h_sample = tree_sample_height(heights, width, height, 0, samples, q, i, col, row, drop, d_sample);
-  float h_prev = NAN;  // the step before's sample: the previous one of the period, or the receiver before
-  if (step > 0) {
-    const int i_prev = q > 0 ? i : i - 1, q_prev = q > 0 ? q - 1 : n_samples - 1;
-    h_prev = tree_sample_height(heights, width, height, 0, samples, q_prev, i_prev, line.x - i_prev * a,
-                                line.y - i_prev * b, drop, (float)((step - 1) << position_shift) * inv_scale);
+  const int step_scale = 1 << position_shift;
+  int4 line[HFVIS_LANES];
+  for (int l = 0; l < HFVIS_LANES; ++l) line[l] = lines[j0 + l < n_lines ? j0 + l : j0];
+  // The sample before the first step (the previous one of its period, or the receiver before);
+  // then each step's sample is the next one's h_prev.
+  lane_float h_prev = (lane_float)(NAN);
+  if (first_step > 0) {
+    const int step = first_step - 1, i = step / n_samples, q = step - i * n_samples;
+    const float d_sample = (float)(step << position_shift) * inv_scale;
+    for (int l = 0; l < HFVIS_LANES; ++l) {
+      if (j0 + l < n_lines && step < line[l].z * n_samples)
+        LANE(h_prev, l) = tree_sample_height(heights, width, height, 0, samples, q, i, line[l].x - i * a,
+                                             line[l].y - i * b, drop, d_sample);
+    }
   }
-  const int step_scale = 1 << position_shift, position_far = (step - 1) << position_shift;
-  int peak_position = 0;
-  const float h_peak = tree_interval_peak(heights, width, height, 0, pieces, interval_first, q, i, col, row, step,
-                                          h_prev, h_sample, drop, inv_scale, d_sample, position_far, step_scale,
-                                          &peak_position);
-  __global int2* inputs = peak_inputs + (uint)line.w;
-  inputs[(uint)SLOT_OF(step) * stride] = (int2)(as_int(h_sample), 0);
-  inputs[(uint)PEAK_SLOT(step) * stride] = (int2)(as_int(h_peak), peak_position);
+  for (int step = first_step; step < first_step + HFVIS_PEAK_STEPS; ++step) {
+    const int i = step / n_samples, q = step - i * n_samples;
+    const float d_sample = (float)(step << position_shift) * inv_scale;
+    lane_float h_sample = (lane_float)(NAN);
+    lane_int col, row, on_line;
+    for (int l = 0; l < HFVIS_LANES; ++l) {
+      ILANE(on_line, l) = j0 + l < n_lines && step < line[l].z * n_samples;
+      ILANE(col, l) = line[l].x - i * a;
+      ILANE(row, l) = line[l].y - i * b;
+      if (ILANE(on_line, l))
+        LANE(h_sample, l) =
+            tree_sample_height(heights, width, height, 0, samples, q, i, ILANE(col, l), ILANE(row, l), drop, d_sample);
+    }
+    if (!ANY_LANE(on_line)) return;  // (lines only end: later steps are past them too)
+    lane_int peak_position;
+    const lane_float h_peak = tree_interval_peak_lanes(heights, width, height, pieces, interval_first, q, i, col, row,
+                                                       step, h_prev, h_sample, drop, inv_scale, d_sample,
+                                                       (step - 1) << position_shift, step_scale, &peak_position);
+    for (int l = 0; l < HFVIS_LANES; ++l) {
+      if (!ILANE(on_line, l)) continue;
+      __global int2* inputs = peak_inputs + (uint)line[l].w;
+      inputs[(uint)SLOT_OF(step) * stride] = (int2)(as_int(LANE(h_sample, l)), 0);
+      inputs[(uint)PEAK_SLOT(step) * stride] = (int2)(as_int(LANE(h_peak, l)), ILANE(peak_position, l));
+    }
+    h_prev = h_sample;
+  }
 }
 #endif
 

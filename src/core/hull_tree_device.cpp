@@ -21,8 +21,9 @@ namespace detail {
 
 bool peakPrepass(const TreeProgramFlags& f) { return !f.row_spacing && !f.strips; }
 
-std::string treeProgramOptions(const TreeProgramFlags& f) {
+std::string treeProgramOptions(const TreeProgramFlags& f, const ContextState& st) {
   std::ostringstream s;
+  s << "-DHFVIS_LANES=" << simdLanes(st) << " -DHFVIS_PEAK_STEPS=" << kTreePeakSteps << " ";
   s << "-DHFVIS_HAS_NODATA=" << f.has_nodata << " -DHFVIS_WANT_COUNT=" << f.count
     << " -DHFVIS_WANT_AREA=" << f.area
     << " -DHFVIS_WANT_STATS=" << f.stats << " -DHFVIS_WANT_ENTRY_STATS=" << f.entry_stats;
@@ -167,11 +168,13 @@ void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDire
   }
   NamedKernel peaks(st, program, "intervisibility_peaks");
   setLineSamplingArguments(peaks, k, d, width, height, b);
-  // Work-groups along one line's steps where a line's slots lie together (line-major), across
-  // lines at one step where a step's do (step-major). Each chunk's sweep reads what its prepass
-  // wrote, and the next chunk's prepass overwrites it: both rely on the context's one in-order
-  // queue (ContextState), which runs each launch after the one before.
+  // A prepass work-item takes `lanes` lines over kTreePeakSteps steps (HFVIS_LANES and
+  // HFVIS_PEAK_STEPS, as the program was built: treeProgramOptions). Work-groups along one line's steps where a line's slots lie together
+  // (line-major), across lines at one step where a step's do (step-major). Each chunk's sweep
+  // reads what its prepass wrote, and the next chunk's prepass overwrites it: both rely on the
+  // context's one in-order queue (ContextState), which runs each launch after the one before.
   const bool line_major = lineMajorLayout(st);
+  const std::size_t lanes = static_cast<std::size_t>(simdLanes(st));
   const std::size_t group_lines = line_major ? 1 : kLineGroup, group_steps = line_major ? kLineGroup : 1;
   std::vector<LatticeLine> lines = d.lines;
   for (const LineChunk& chunk : chunkLines(lines, d.slotsPerPeriod(), b.scratch_entries, line_major)) {
@@ -186,7 +189,9 @@ void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDire
       kernel->set("stride", static_cast<cl_uint>(chunk.stride));
     }
     k.kernel.set("first_line", static_cast<int>(chunk.first));
-    st.launch(peaks, cl::NDRange(roundUp(chunk.count, group_lines), roundUp(steps, group_steps)),
+    st.launch(peaks,
+              cl::NDRange(roundUp((chunk.count + lanes - 1) / lanes, group_lines),
+                          roundUp((steps + kTreePeakSteps - 1) / kTreePeakSteps, group_steps)),
               cl::NDRange(group_lines, group_steps));
     if (sweep) st.launch(k.kernel, cl::NDRange(roundUp(chunk.count, kLineGroup)), cl::NDRange(kLineGroup));
   }
@@ -195,7 +200,7 @@ void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDire
 std::string TreeRoutine::programOptions() const {
   TreeProgramFlags flags = flags_;
   flags.has_nodata = prepared_.has_nodata;
-  return treeProgramOptions(flags);
+  return treeProgramOptions(flags, st_);
 }
 
 void TreeRoutine::allocateScratch(std::size_t fixed_bytes) {
@@ -224,7 +229,7 @@ IntervisibilityLines treeLinesOnDevice(ContextState& st, const TreeProgramFlags&
   TreeProgramFlags flags = program_flags;
   flags.entry_stats = true;
   flags.row_spacing = d.rowSpacing();
-  cl::Program program = st.program("intervisibility.cl", treeProgramOptions(flags));
+  cl::Program program = st.program("intervisibility.cl", treeProgramOptions(flags, st));
   const std::size_t plane = field.pixelCount();
   // Scratch entries are tree slots: two per step (the peak's, then the sample's).
   const std::size_t slots_per_period = d.slotsPerPeriod(), slots_per_step = 2;
@@ -297,7 +302,7 @@ TreePeakInputs treePeakInputsOnDevice(ContextState& st, const HeightField& field
   flags.curvature = d.drop != 0.0f;
   flags.stats = false;
   if (d.rowSpacing() || !peakPrepass(flags)) throw InvalidArgument("the peaks' prepass takes uniform grids only");
-  cl::Program program = st.program("intervisibility.cl", treeProgramOptions(flags));
+  cl::Program program = st.program("intervisibility.cl", treeProgramOptions(flags, st));
   const std::size_t plane = field.pixelCount();
   std::size_t entries = 0;
   for (const LatticeLine& line : d.lines) entries += lineCapacity(line, d.slotsPerPeriod());

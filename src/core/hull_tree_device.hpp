@@ -42,13 +42,18 @@ struct TreeProgramFlags {
   HullTreeTuning tuning;
 };
 
+// Consecutive steps one work-item of the prepass takes (HFVIS_PEAK_STEPS): each sample's height is
+// then computed once, not again as the next interval's far end.
+constexpr std::size_t kTreePeakSteps = 4;
+
 // Whether a program with these flags computes the samples' heights and the peaks between them
 // in a prepass (kernel intervisibility_peaks, HFVIS_PEAK_PREPASS), launched before each chunk's
 // sweep by enqueueTreeDirection: on uniform grids without strips.
 bool peakPrepass(const TreeProgramFlags& flags);
 
-// The -D options of kernels/intervisibility.cl with these flags.
-std::string treeProgramOptions(const TreeProgramFlags& flags);
+// The -D options of kernels/intervisibility.cl with these flags on this context's device (its
+// prepass runs simdLanes(st) lines per work-item: enqueueTreeDirection launches it so).
+std::string treeProgramOptions(const TreeProgramFlags& flags, const ContextState& st);
 
 // The device buffers a run binds; those its program does not use are minimal
 // (deviceBuffer(st, 0)).

@@ -338,7 +338,7 @@ class NaiveCountRoutine : public SweepRoutine {
     flags.stats = false;
     flags.curvature = visibility_.curvature != 0.0;
     flags.row_spacing = hasRowSpacing(field_);
-    return treeProgramOptions(flags);
+    return treeProgramOptions(flags, st_);
   }
 
   void allocate() override {
