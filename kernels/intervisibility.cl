@@ -39,6 +39,9 @@
 //   HFVIS_PEAK_PREPASS      intervisibility_peaks computes the samples' heights and the peaks
 //                           between them before the sweep, into peak_inputs (not with
 //                           per-row spacing or strips); 0 = the sweep computes them itself
+//   HFVIS_LINE_MAJOR        the scratch is line-major (stride 1: src/core/lattice_geometry.cpp,
+//                           chunkLines), known when the program is built, so that the address of
+//                           each dependent node load on the tree walk takes no multiply
 //   HFVIS_STRIPS            intervisibility_lattice sweeps the receivers of one strip of rows
 //                           and resumes each line where the strip before left it (a field in
 //                           strips; not with the bounce)
@@ -92,6 +95,11 @@
 #ifndef HFVIS_STRIPS
 #define HFVIS_STRIPS 0
 #endif
+#ifndef HFVIS_LINE_MAJOR
+#define HFVIS_LINE_MAJOR 0
+#endif
+// A kernel's scratch stride: its argument, or 1 in the line-major layout.
+#define HFVIS_SCRATCH_STRIDE(stride) (HFVIS_LINE_MAJOR ? 1u : (stride))
 #ifndef HFVIS_PEAK_PREPASS
 #define HFVIS_PEAK_PREPASS 0
 #endif
@@ -471,15 +479,19 @@ HFVIS_INLINE lane_float tree_interval_peak_lanes(__global const float* heights, 
     if (i == 0)  // outside the field: no peak
       live = live & (px >= 0) & (px + 1 <= width - 1) & (py >= 0) & (py + 1 <= height - 1);
     const lane_int at = py * width + px;
-    lane_float h00 = (lane_float)(0.0f), h10 = h00, h01 = h00, h11 = h00;
-    for (int l = 0; l < HFVIS_LANES; ++l) {
-      if (!ILANE(live, l)) continue;  // (its cell may lie outside the field: not read)
-      const uint a = (uint)ILANE(at, l);
-      LANE(h00, l) = heights[a];
-      LANE(h10, l) = heights[a + 1];
-      LANE(h01, l) = heights[a + (uint)width];
-      LANE(h11, l) = heights[a + (uint)width + 1];
-    }
+    // A lane's corner, read where the lane is live (its cell may lie outside the field otherwise).
+#define HFVIS_CORNER(l, offset) (ILANE(live, l) ? heights[(uint)ILANE(at, l) + (offset)] : 0.0f)
+#define HFVIS_H00(l) HFVIS_CORNER(l, 0u)
+#define HFVIS_H10(l) HFVIS_CORNER(l, 1u)
+#define HFVIS_H01(l) HFVIS_CORNER(l, (uint)width)
+#define HFVIS_H11(l) HFVIS_CORNER(l, (uint)width + 1u)
+    const lane_float h00 = LANES_FROM(HFVIS_H00), h10 = LANES_FROM(HFVIS_H10), h01 = LANES_FROM(HFVIS_H01),
+                     h11 = LANES_FROM(HFVIS_H11);
+#undef HFVIS_CORNER
+#undef HFVIS_H00
+#undef HFVIS_H10
+#undef HFVIS_H01
+#undef HFVIS_H11
     const lane_float gx = h10 - h00, gy = h01 - h00, e = (h11 - h01) - gx;
     const lane_float A = h00 + gx * fx + gy * fy + e * (fx * fy);
     const lane_float B = gx * dx + gy * dy + e * (fx * dy + fy * dx);
@@ -569,36 +581,37 @@ __kernel void intervisibility_peaks(__global const float* heights, int width, in
                                     int position_shift, __global int2* peak_inputs, uint stride) {
   const int j0 = get_global_id(0) * HFVIS_LANES, first_step = get_global_id(1) * HFVIS_PEAK_STEPS;
   if (j0 >= n_lines) return;
+  stride = HFVIS_SCRATCH_STRIDE(stride);
   const float inv_scale = 1.0f / (float)(1 << position_shift);
   const int step_scale = 1 << position_shift;
   int4 line[HFVIS_LANES];
   for (int l = 0; l < HFVIS_LANES; ++l) line[l] = lines[j0 + l < n_lines ? j0 + l : j0];
+  // Each lane's line: its steps (0 past the last line), its first receiver.
+#define HFVIS_STEPS(l) (j0 + (l) < n_lines ? line[l].z * n_samples : 0)
+#define HFVIS_COL0(l) (line[l].x)
+#define HFVIS_ROW0(l) (line[l].y)
+  const lane_int line_steps = ILANES_FROM(HFVIS_STEPS), col0 = ILANES_FROM(HFVIS_COL0), row0 = ILANES_FROM(HFVIS_ROW0);
+  // The sample of step `step` (period i, sample q) in each lane on its line, NaN past its end.
+#define HFVIS_SAMPLE(l)                                                                                              \
+  (ILANE(on_line, l) ? tree_sample_height(heights, width, height, 0, samples, q, i, ILANE(col0, l) - i * a,          \
+                                          ILANE(row0, l) - i * b, drop, d_sample)                                    \
+                     : NAN)
   // The sample before the first step (the previous one of its period, or the receiver before);
   // then each step's sample is the next one's h_prev.
   lane_float h_prev = (lane_float)(NAN);
   if (first_step > 0) {
     const int step = first_step - 1, i = step / n_samples, q = step - i * n_samples;
     const float d_sample = (float)(step << position_shift) * inv_scale;
-    for (int l = 0; l < HFVIS_LANES; ++l) {
-      if (j0 + l < n_lines && step < line[l].z * n_samples)
-        LANE(h_prev, l) = tree_sample_height(heights, width, height, 0, samples, q, i, line[l].x - i * a,
-                                             line[l].y - i * b, drop, d_sample);
-    }
+    const lane_int on_line = line_steps > step;
+    h_prev = LANES_FROM(HFVIS_SAMPLE);
   }
   for (int step = first_step; step < first_step + HFVIS_PEAK_STEPS; ++step) {
     const int i = step / n_samples, q = step - i * n_samples;
     const float d_sample = (float)(step << position_shift) * inv_scale;
-    lane_float h_sample = (lane_float)(NAN);
-    lane_int col, row, on_line;
-    for (int l = 0; l < HFVIS_LANES; ++l) {
-      ILANE(on_line, l) = j0 + l < n_lines && step < line[l].z * n_samples;
-      ILANE(col, l) = line[l].x - i * a;
-      ILANE(row, l) = line[l].y - i * b;
-      if (ILANE(on_line, l))
-        LANE(h_sample, l) =
-            tree_sample_height(heights, width, height, 0, samples, q, i, ILANE(col, l), ILANE(row, l), drop, d_sample);
-    }
+    const lane_int on_line = line_steps > step;
     if (!ANY_LANE(on_line)) return;  // (lines only end: later steps are past them too)
+    const lane_float h_sample = LANES_FROM(HFVIS_SAMPLE);
+    const lane_int col = col0 - i * a, row = row0 - i * b;
     lane_int peak_position;
     const lane_float h_peak = tree_interval_peak_lanes(heights, width, height, pieces, interval_first, q, i, col, row,
                                                        step, h_prev, h_sample, drop, inv_scale, d_sample,
@@ -611,6 +624,10 @@ __kernel void intervisibility_peaks(__global const float* heights, int width, in
     }
     h_prev = h_sample;
   }
+#undef HFVIS_STEPS
+#undef HFVIS_COL0
+#undef HFVIS_ROW0
+#undef HFVIS_SAMPLE
 }
 #endif
 
@@ -710,6 +727,7 @@ __kernel void intervisibility_lattice(
     __global TreeLineState* states) {
   const int j = get_global_id(0);
   if (j >= n_lines) return;
+  stride = HFVIS_SCRATCH_STRIDE(stride);
   const int4 line = lines[j];
 #if HFVIS_STRIPS
   const int2 strip = strip_receivers[j];

@@ -23,7 +23,8 @@ bool peakPrepass(const TreeProgramFlags& f) { return !f.row_spacing && !f.strips
 
 std::string treeProgramOptions(const TreeProgramFlags& f, const ContextState& st) {
   std::ostringstream s;
-  s << "-DHFVIS_LANES=" << simdLanes(st) << " -DHFVIS_PEAK_STEPS=" << kTreePeakSteps << " ";
+  s << "-DHFVIS_LANES=" << simdLanes(st) << " -DHFVIS_PEAK_STEPS=" << kTreePeakSteps
+    << " -DHFVIS_LINE_MAJOR=" << lineMajorLayout(st) << " ";
   s << "-DHFVIS_HAS_NODATA=" << f.has_nodata << " -DHFVIS_WANT_COUNT=" << f.count
     << " -DHFVIS_WANT_AREA=" << f.area
     << " -DHFVIS_WANT_STATS=" << f.stats << " -DHFVIS_WANT_ENTRY_STATS=" << f.entry_stats;

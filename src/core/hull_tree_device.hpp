@@ -51,8 +51,9 @@ constexpr std::size_t kTreePeakSteps = 4;
 // sweep by enqueueTreeDirection: on uniform grids without strips.
 bool peakPrepass(const TreeProgramFlags& flags);
 
-// The -D options of kernels/intervisibility.cl with these flags on this context's device (its
-// prepass runs simdLanes(st) lines per work-item: enqueueTreeDirection launches it so).
+// The -D options of kernels/intervisibility.cl with these flags on this context's device: its
+// prepass runs simdLanes(st) lines per work-item (enqueueTreeDirection launches it so), and its
+// kernels take the scratch's stride as 1 in the line-major layout (chunkLines gives them 1 there).
 std::string treeProgramOptions(const TreeProgramFlags& flags, const ContextState& st);
 
 // The device buffers a run binds; those its program does not use are minimal
