@@ -380,6 +380,20 @@ HFVIS_INLINE float tree_sample_height(__global const float* heights, int width, 
   return h_sample;
 }
 
+#if HFVIS_CURVATURE
+// The Earth's drop at an interval's two samples (position_far, in 2^-shift steps, and d_sample
+// steps from the line's start), which its peak's candidates and chord add back: the candidates
+// are points of the surface before the drop (theirs comes after), and so is the chord they are
+// measured against, else the drop's growth along the interval (2 drop step per step) would
+// favour the near end's candidates far out on a line.
+HFVIS_INLINE void tree_chord_lifts(float drop, float inv_scale, float d_sample, int position_far, float* far_lift,
+                                   float* near_lift) {
+  const float d_far = (float)position_far * inv_scale;
+  *far_lift = drop * d_far * d_far;
+  *near_lift = drop * d_sample * d_sample;
+}
+#endif
+
 // The peak between step - 1 (height h_sample_prev) and step (h_sample, sample q of period i,
 // its receiver at (col, row)): of the interval's crossings and concave pieces, the point that
 // stands farthest above the chord of its two samples, where it stands strictly above it; NaN
@@ -396,12 +410,10 @@ HFVIS_INLINE float tree_interval_peak(__global const float* heights, int width, 
   TreePieceCurve curve;  // the piece before (set by the first piece, which has no crossing)
   float chord_far = h_sample_prev, rise = h_sample - h_sample_prev;
 #if HFVIS_CURVATURE
-  // The candidates are points of the surface before the drop (theirs comes after): so is
-  // the chord they are measured against, else the drop's growth along the interval (2 drop
-  // step per step) would favour the near end's candidates far out on a line.
-  const float d_far = (float)position_far * inv_scale;
-  chord_far = h_sample_prev + drop * d_far * d_far;
-  rise = (h_sample + drop * d_sample * d_sample) - chord_far;
+  float far_lift, near_lift;
+  tree_chord_lifts(drop, inv_scale, d_sample, position_far, &far_lift, &near_lift);
+  chord_far = h_sample_prev + far_lift;
+  rise = (h_sample + near_lift) - chord_far;
 #endif
   for (int k = interval_first[q]; k < interval_first[q + 1]; ++k) {
     __global const TreePiece* g = pieces + k;
@@ -467,9 +479,10 @@ HFVIS_INLINE lane_float tree_interval_peak_lanes(__global const float* heights, 
   float prev_t_far = 0.0f, prev_inv_span = 0.0f;
   lane_float chord_far = h_far, rise = h_near - h_far;
 #if HFVIS_CURVATURE
-  const float d_far = (float)position_far * inv_scale;
-  chord_far = h_far + drop * d_far * d_far;
-  rise = (h_near + drop * d_sample * d_sample) - chord_far;
+  float far_lift, near_lift;
+  tree_chord_lifts(drop, inv_scale, d_sample, position_far, &far_lift, &near_lift);
+  chord_far = h_far + far_lift;
+  rise = (h_near + near_lift) - chord_far;
 #endif
   for (int k = interval_first[q]; k < interval_first[q + 1]; ++k) {
     __global const TreePiece* g = pieces + k;
