@@ -46,24 +46,33 @@ data=$root/bench/out/data
 mkdir -p "$out" "$data"
 
 # The variants' kernels: the peak's branch never taken (structure), or its result never inserted (pieces).
-edit() {  # VARIANT FROM TO
-  rm -rf "$out/$1"
-  cp -r "$root/kernels" "$out/$1"
-  /usr/bin/python3 - "$out/$1/intervisibility.cl" "$2" "$3" <<'EOF'
+edit() {  # VARIANT FROM TO [FROM TO ...]
+  local name=$1
+  shift
+  rm -rf "$out/$name"
+  cp -r "$root/kernels" "$out/$name"
+  /usr/bin/python3 - "$out/$name/intervisibility.cl" "$@" <<'EOF'
 import sys
-path, old, new = sys.argv[1:]
+path, edits = sys.argv[1], sys.argv[2:]
 text = open(path).read()
-if text.count(old) != 1:
-    sys.exit("tree_peaks_cost_parts.sh: kernels/intervisibility.cl no longer has the line: " + old)
-open(path, "w").write(text.replace(old, new))
+for old, new in zip(edits[::2], edits[1::2]):
+    if text.count(old) != 1:
+        sys.exit("tree_peaks_cost_parts.sh: kernels/intervisibility.cl no longer has the line: " + old)
+    text = text.replace(old, new)
+open(path, "w").write(text)
 EOF
 }
-# (tree_interval_peak: in the prepass intervisibility_peaks on these inputs, in the sweep elsewhere)
-edit structure "if (!(step > 0 && step_scale > 1 && !isnan(h_sample_prev) && !isnan(h_sample))) return NAN;" \
+# Each edit in both peak functions: tree_interval_peak_lanes (the prepass intervisibility_peaks on
+# these inputs) and tree_interval_peak (the sweep, in strips and on latitude / longitude grids).
+edit structure "if (!(step > 0 && step_scale > 1)) return (lane_float)(NAN);" \
+  "if (1) return (lane_float)(NAN);" \
+  "if (!(step > 0 && step_scale > 1 && !isnan(h_sample_prev) && !isnan(h_sample))) return NAN;" \
   "if (1) return NAN;"
 # (the test's result kept alive, so that the compiler cannot drop the evaluation: no peak is
 # that high)
-edit pieces "return tree_peak_inserted(h_sample_prev, best_h, h_sample, offset, step_scale) ? best_h : NAN;" \
+edit pieces "return select((lane_float)(NAN), best_h, live);" \
+  "return select((lane_float)(NAN), best_h, live & (best_h > 1e30f));" \
+  "return tree_peak_inserted(h_sample_prev, best_h, h_sample, offset, step_scale) ? best_h : NAN;" \
   "return tree_peak_inserted(h_sample_prev, best_h, h_sample, offset, step_scale) && best_h > 1e30f ? best_h : NAN;"
 
 cmake --build "$build_dir" -j "$(nproc)" --target hfvis_cli hfvis_bench > /dev/null

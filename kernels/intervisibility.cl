@@ -39,6 +39,9 @@
 //   HFVIS_PEAK_PREPASS      intervisibility_peaks computes the samples' heights and the peaks
 //                           between them before the sweep, into peak_inputs (not with
 //                           per-row spacing or strips); 0 = the sweep computes them itself
+//   HFVIS_LANES             lines a prepass work-item takes side by side (shared/lanes.cl: 8 in
+//                           a CPU's line-major layout, else 1)
+//   HFVIS_PEAK_STEPS        consecutive steps a prepass work-item takes
 //   HFVIS_LINE_MAJOR        the scratch is line-major (stride 1: src/core/lattice_geometry.cpp,
 //                           chunkLines), known when the program is built, so that the address of
 //                           each dependent node load on the tree walk takes no multiply
@@ -574,9 +577,9 @@ HFVIS_INLINE lane_float tree_interval_peak_lanes(__global const float* heights, 
 }
 
 // The samples' heights and the peaks between them, ahead of the sweep (HFVIS_PEAK_PREPASS):
-// one work-item per step of HFVIS_LANES lines (lines j0 .. j0 + HFVIS_LANES - 1, side by side in
-// its SIMD lanes on a CPU), none waiting on another, where the sweep's one work-item per line
-// would evaluate them between its dependent tree walks. Step s of line j (its sample q of period
+// a work-item takes HFVIS_PEAK_STEPS consecutive steps of HFVIS_LANES lines (lines j0 .. j0 +
+// HFVIS_LANES - 1, side by side in its SIMD lanes on a CPU), none waiting on another, where the
+// sweep's one work-item per line would evaluate them between its dependent tree walks. Step s of line j (its sample q of period
 // i, as intervisibility_lattice numbers them) writes its sample's height into
 // peak_inputs[SLOT_OF(s)] (x, a float's bits) and its peak (the height's bits, NaN for none; the
 // position) into peak_inputs[PEAK_SLOT(s)], as integers (a position's bits as a float would be a
@@ -584,10 +587,10 @@ HFVIS_INLINE lane_float tree_interval_peak_lanes(__global const float* heights, 
 // slots (8 bytes a slot where a node takes 16: the pass costs memory traffic, which decides its
 // gain on a CPU). Arguments as intervisibility_lattice's (uniform grids only: no per-row spacing,
 // no strips).
-// HFVIS_PEAK_STEPS consecutive steps a work-item, so that each sample's height is computed once
-// (the next step's interval starts at it).
+// The steps of a work-item follow each other, so that each sample's height is computed once (the
+// next step's interval starts at it). Where the peak is NaN the position is unspecified.
 // Global size: (lines / HFVIS_LANES, steps of the longest line / HFVIS_PEAK_STEPS), each rounded up
-// to the local size.
+// to a whole number, then to the local size.
 __kernel void intervisibility_peaks(__global const float* heights, int width, int height, __global const int4* lines,
                                     int n_lines, __global const LatticeSample* samples, int n_samples, int a, int b,
                                     float drop, __global const TreePiece* pieces, __global const int* interval_first,

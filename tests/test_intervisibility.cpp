@@ -590,10 +590,38 @@ TEST(IntervisibilityKernels, TreeMatchesScalarReferenceInEveryTuning) {
   }
 }
 
-// The peaks' prepass (kernel intervisibility_peaks) alone, in both layouts: every step's sample
-// height and the peak before it that the tree inserts (tree_peak_inserted of the reference's
-// candidate), bit for bit as the reference computes them, and that peak's position; on every
-// hard case and size, in every direction of kSteps, with and without the Earth's drop.
+// The prepass (kernel intervisibility_peaks) on one field and direction against the reference:
+// every step's sample height and the peak before it that the tree inserts (tree_peak_inserted of
+// the reference's candidate), bit for bit, and that peak's position. Counts the present samples
+// and the inserted peaks.
+void expectPeakPrepassMatchesReference(const ComputeContext& context, const HeightField& field,
+                                       const std::vector<float>& prepared, std::pair<int, int> step, float drop,
+                                       std::size_t& samples, std::size_t& peaks) {
+  detail::TreeDirection d = treeStep(field, step);
+  d.drop = drop;
+  const auto ref = detail::latticeTreeLines(field, prepared, d, drop != 0.0f);
+  const auto dev = detail::treePeakInputsOnDevice(detail::stateOf(context), field, prepared, d);
+  const int n_lines = ref.geometry.n_lines, scale = 1 << ref.position_shift;
+  ASSERT_EQ(dev.samples.size(), ref.samples.size());
+  for (std::size_t e = 0; e < ref.samples.size(); ++e) {
+    const int i = static_cast<int>(e / n_lines);
+    ASSERT_TRUE(nearlyEqual({dev.samples[e]}, {ref.samples[e]}, 0.0f)) << "entry " << e;
+    float expected = std::numeric_limits<float>::quiet_NaN();
+    if (i > 0 && scale > 1 &&
+        detail::tree_peak_inserted(ref.samples[e - n_lines], ref.peaks[e], ref.samples[e], ref.peak_offsets[e],
+                                   scale))
+      expected = ref.peaks[e];
+    ASSERT_TRUE(nearlyEqual({dev.peaks[e]}, {expected}, 0.0f)) << "entry " << e;
+    samples += !std::isnan(ref.samples[e]);
+    if (std::isnan(expected)) continue;
+    ++peaks;
+    ASSERT_EQ(dev.positions[e], ((i - 1) << ref.position_shift) + ref.peak_offsets[e]) << "entry " << e;
+  }
+}
+
+// The peaks' prepass alone, in both layouts (8 lines a work-item in the line-major one, 1 in the
+// step-major one), on every hard case and size, in every direction of kSteps, with and without
+// the Earth's drop.
 TEST(IntervisibilityKernels, PeakPrepassMatchesTheReference) {
   std::size_t samples = 0, peaks = 0;
   testing::forEachLayout([&](const ComputeContext& context) {
@@ -606,26 +634,7 @@ TEST(IntervisibilityKernels, PeakPrepassMatchesTheReference) {
             SCOPED_TRACE(name + " " + std::to_string(w) + "x" + std::to_string(h) + " step " +
                          std::to_string(step.first) + "," + std::to_string(step.second) + " drop " +
                          std::to_string(drop));
-            detail::TreeDirection d = treeStep(field, step);
-            d.drop = drop;
-            const auto ref = detail::latticeTreeLines(field, prepared.heights, d, drop != 0.0f);
-            const auto dev = detail::treePeakInputsOnDevice(detail::stateOf(context), field, prepared.heights, d);
-            const int n_lines = ref.geometry.n_lines, scale = 1 << ref.position_shift;
-            ASSERT_EQ(dev.samples.size(), ref.samples.size());
-            for (std::size_t e = 0; e < ref.samples.size(); ++e) {
-              const int i = static_cast<int>(e / n_lines);
-              ASSERT_TRUE(nearlyEqual({dev.samples[e]}, {ref.samples[e]}, 0.0f)) << "entry " << e;
-              float expected = std::numeric_limits<float>::quiet_NaN();
-              if (i > 0 && scale > 1 &&
-                  detail::tree_peak_inserted(ref.samples[e - n_lines], ref.peaks[e], ref.samples[e],
-                                             ref.peak_offsets[e], scale))
-                expected = ref.peaks[e];
-              ASSERT_TRUE(nearlyEqual({dev.peaks[e]}, {expected}, 0.0f)) << "entry " << e;
-              samples += !std::isnan(ref.samples[e]);
-              if (std::isnan(expected)) continue;
-              ++peaks;
-              ASSERT_EQ(dev.positions[e], ((i - 1) << ref.position_shift) + ref.peak_offsets[e]) << "entry " << e;
-            }
+            expectPeakPrepassMatchesReference(context, field, prepared.heights, step, drop, samples, peaks);
           }
         }
       }
@@ -633,6 +642,26 @@ TEST(IntervisibilityKernels, PeakPrepassMatchesTheReference) {
   });
   EXPECT_GT(samples, 100000u);
   EXPECT_GT(peaks, 10000u);
+}
+
+// Heights so small (about 1e-33) that the exact predicate's float filter cannot decide (its
+// magnitudes fall below 2^-100): the prepass's lanes decide whether a peak enters lane by lane
+// with the exact expansion, as the reference does.
+TEST(IntervisibilityKernels, PeakPrepassMatchesTheReferenceOnTinyHeights) {
+  std::size_t samples = 0, peaks = 0;
+  testing::forEachLayout([&](const ComputeContext& context) {
+    for (const char* name : {"noise", "city", "terraces"}) {
+      HeightField field = makeSyntheticField(name, 41, 33, 7);
+      for (float& v : field.heights) v *= 1e-35f;
+      const auto prepared = detail::prepareHeights(field);
+      for (auto step : kSteps) {
+        SCOPED_TRACE(std::string(name) + " step " + std::to_string(step.first) + "," + std::to_string(step.second));
+        expectPeakPrepassMatchesReference(context, field, prepared.heights, step, 0.0f, samples, peaks);
+      }
+    }
+  });
+  EXPECT_GT(samples, 10000u);
+  EXPECT_GT(peaks, 1000u);
 }
 
 // Earth curvature, large enough to matter on these small fields.

@@ -170,10 +170,11 @@ void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDire
   NamedKernel peaks(st, program, "intervisibility_peaks");
   setLineSamplingArguments(peaks, k, d, width, height, b);
   // A prepass work-item takes `lanes` lines over kTreePeakSteps steps (HFVIS_LANES and
-  // HFVIS_PEAK_STEPS, as the program was built: treeProgramOptions). Work-groups along one line's steps where a line's slots lie together
-  // (line-major), across lines at one step where a step's do (step-major). Each chunk's sweep
-  // reads what its prepass wrote, and the next chunk's prepass overwrites it: both rely on the
-  // context's one in-order queue (ContextState), which runs each launch after the one before.
+  // HFVIS_PEAK_STEPS, as the program was built: treeProgramOptions). Work-groups along the steps
+  // of one work-item's lines where a line's slots lie together (line-major), across lines where a
+  // step's do (step-major). Each chunk's sweep reads what its prepass wrote, and the next chunk's
+  // prepass overwrites it: both rely on the context's one in-order queue (ContextState), which
+  // runs each launch after the one before.
   const bool line_major = lineMajorLayout(st);
   const std::size_t lanes = static_cast<std::size_t>(simdLanes(st));
   const std::size_t group_lines = line_major ? 1 : kLineGroup, group_steps = line_major ? kLineGroup : 1;

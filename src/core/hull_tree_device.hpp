@@ -109,7 +109,8 @@ void enqueueTreeDirection(ContextState& st, cl::Program& program, const TreeDire
 // The prepass alone (kernel intervisibility_peaks) on direction d of a uniform grid (with its
 // drop where d.drop is not 0), read back in the canonical step-major order of
 // IntervisibilityLines: per entry the sample's height, the peak before it that the tree inserts
-// (NaN for none) and that peak's position (in 2^-position_shift steps). For the tests.
+// (NaN for none) and that peak's position (in 2^-position_shift steps; unspecified where the peak
+// is NaN). For the tests.
 struct TreePeakInputs {
   std::vector<float> samples, peaks;
   std::vector<std::int32_t> positions;
