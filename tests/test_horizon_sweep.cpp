@@ -510,8 +510,9 @@ TEST(HorizonKernels, StripsEqualTheWholeFieldBitForBit) {
                        std::to_string(rows) + " rows");
           options.strip_rows = rows;
           int strips = 0;
+          const int strips_per_run = (h + rows - 1) / rows;  // (C++17 lambdas take no structured binding)
           options.strip_progress = [&](int done, int all) {
-            EXPECT_EQ(all, (h + rows - 1) / rows);
+            EXPECT_EQ(all, strips_per_run);
             strips += done == all;
           };
           expectBitsEqual(computeHorizons(context, field, options, allOutputs()), whole);
@@ -627,24 +628,29 @@ TEST(HorizonKernels, AFieldCutFromALargerOneEqualsItBitForBitInside) {
                                        whole.row_cell_size_y.begin() + y0 + h);
           }
           // `planes` planes of the cut's values against the larger field's on the pixels inside.
-          auto expectEqualInside = [&](const std::vector<float>& part, const std::vector<float>& full, int planes) {
-            ASSERT_EQ(part.size(), std::size_t(planes) * w * h);
+          const int cut_x0 = x0, cut_y0 = y0, cut_w = w,
+                    cut_h = h;  // (C++17 lambdas take no structured binding)
+          auto expectEqualInside = [&](const std::vector<float>& part, const std::vector<float>& full,
+                                       int planes) {
+            ASSERT_EQ(part.size(), std::size_t(planes) * cut_w * cut_h);
             int compared = 0;
             for (int k = 0; k < planes; ++k) {
-              for (int y = 0; y < h; ++y) {
-                for (int x = 0; x < w; ++x) {
-                  if (!((x0 == 0 || x >= margin) && (y0 == 0 || y >= margin) &&
-                        (x0 + w == whole.width || x < w - margin) && (y0 + h == whole.height || y < h - margin)))
+              for (int y = 0; y < cut_h; ++y) {
+                for (int x = 0; x < cut_w; ++x) {
+                  if (!((cut_x0 == 0 || x >= margin) && (cut_y0 == 0 || y >= margin) &&
+                        (cut_x0 + cut_w == whole.width || x < cut_w - margin) &&
+                        (cut_y0 + cut_h == whole.height || y < cut_h - margin)))
                     continue;
                   ++compared;
-                  const float a = part[(std::size_t(k) * h + y) * w + x];
-                  const float b = full[(std::size_t(k) * whole.height + y0 + y) * whole.width + x0 + x];
+                  const float a = part[(std::size_t(k) * cut_h + y) * cut_w + x];
+                  const float b =
+                      full[(std::size_t(k) * whole.height + cut_y0 + y) * whole.width + cut_x0 + x];
                   ASSERT_TRUE(std::isnan(a) ? std::isnan(b) : std::memcmp(&a, &b, sizeof a) == 0)
                       << "plane " << k << " pixel " << x << "," << y << ": " << a << " vs " << b;
                 }
               }
             }
-            if (planes > 0 && (w > 2 * margin || x0 == 0)) {
+            if (planes > 0 && (cut_w > 2 * margin || cut_x0 == 0)) {
               EXPECT_GT(compared, 0);
             }
           };

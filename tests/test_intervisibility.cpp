@@ -595,8 +595,8 @@ TEST(IntervisibilityKernels, TreeMatchesScalarReferenceInEveryTuning) {
 // the reference's candidate), bit for bit, and that peak's position. Counts the present samples
 // and the inserted peaks.
 void expectPeakPrepassMatchesReference(const ComputeContext& context, const HeightField& field,
-                                       const std::vector<float>& prepared, std::pair<int, int> step, float drop,
-                                       std::size_t& samples, std::size_t& peaks) {
+                                       const std::vector<float>& prepared, std::pair<int, int> step,
+                                       float drop, std::size_t& samples, std::size_t& peaks) {
   detail::TreeDirection d = treeStep(field, step);
   d.drop = drop;
   const auto ref = detail::latticeTreeLines(field, prepared, d, drop != 0.0f);
@@ -608,8 +608,8 @@ void expectPeakPrepassMatchesReference(const ComputeContext& context, const Heig
     ASSERT_TRUE(nearlyEqual({dev.samples[e]}, {ref.samples[e]}, 0.0f)) << "entry " << e;
     float expected = std::numeric_limits<float>::quiet_NaN();
     if (i > 0 && scale > 1 &&
-        detail::tree_peak_inserted(ref.samples[e - n_lines], ref.peaks[e], ref.samples[e], ref.peak_offsets[e],
-                                   scale))
+        detail::tree_peak_inserted(ref.samples[e - n_lines], ref.peaks[e], ref.samples[e],
+                                   ref.peak_offsets[e], scale))
       expected = ref.peaks[e];
     ASSERT_TRUE(nearlyEqual({dev.peaks[e]}, {expected}, 0.0f)) << "entry " << e;
     samples += !std::isnan(ref.samples[e]);
@@ -655,7 +655,8 @@ TEST(IntervisibilityKernels, PeakPrepassMatchesTheReferenceOnTinyHeights) {
       for (float& v : field.heights) v *= 1e-35f;
       const auto prepared = detail::prepareHeights(field);
       for (auto step : kSteps) {
-        SCOPED_TRACE(std::string(name) + " step " + std::to_string(step.first) + "," + std::to_string(step.second));
+        SCOPED_TRACE(std::string(name) + " step " + std::to_string(step.first) + "," +
+                     std::to_string(step.second));
         expectPeakPrepassMatchesReference(context, field, prepared.heights, step, 0.0f, samples, peaks);
       }
     }
@@ -1183,8 +1184,9 @@ TEST(IntervisibilityKernels, StripsEqualTheWholeFieldBitForBit) {
                        std::to_string(rows) + " rows");
           options.strip_rows = rows;
           int strips = 0;
+          const int strips_per_run = (h + rows - 1) / rows;  // (C++17 lambdas take no structured binding)
           options.strip_progress = [&](int done, int all) {
-            EXPECT_EQ(all % ((h + rows - 1) / rows), 0);  // chunks times strips
+            EXPECT_EQ(all % strips_per_run, 0);  // chunks times strips
             strips += done == all;
           };
           expectEqual(computeIntervisibility(context, field, options, allOutputs()), whole);
