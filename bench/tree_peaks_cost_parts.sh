@@ -1,15 +1,20 @@
 #!/usr/bin/env bash
 # bench/tree_peaks_cost_parts.sh: where the hull tree's peaks between samples spend their time.
-# Runs `hfvis viewcount` (default options) with four programs in turn on each input, R rounds:
+# Runs `hfvis viewcount` (default options) with seven programs in turn on each input, R rounds:
 #   base        a build of bad9286 (before the peaks), as given by --base-build
+#   host        this build with both kernels returning at once (reading, planning, writing)
+#   prepass     the sweep's kernel without receivers (the host and the peaks' prepass alone)
 #   structure   this build with the peaks' code in place but no interval evaluated (two tree
 #               slots per step, the peak branches; no piece read, no peak inserted)
 #   pieces      every interval's pieces evaluated and the peak's test made, none inserted
+#   no-count    the peaks inserted, but no receiver reads its visible runs (step 3 of the sweep)
 #   current     this build as it is (the peaks evaluated and inserted)
-# Since the peaks' prepass (3ae7129) the two middle ones edit the prepass's peak function, so
-# they include the prepass's own pass (the samples' heights and an 8-byte write a slot), which
-# the 1311f46 table in bench/report/tree_peaks.md did not have.
-# The two middle ones are the kernel of this checkout edited by sed into bench/out/ (loaded
+# So the prepass costs prepass - host, the counting current - no-count, and the tree's walk the
+# rest of current. Since the peaks' prepass (3ae7129) structure and pieces edit the prepass's
+# peak function (and the sweep's, for strips and latitude / longitude grids), so they include
+# the prepass's own pass (the samples' heights and an 8-byte write a slot), which the 1311f46
+# table in bench/report/tree_peaks.md did not have.
+# All but base and current are the kernel of this checkout edited into bench/out/ (loaded
 # through HFVIS_KERNEL_DIR; their results differ from the current one's by design, and the script
 # stops if the lines it edits have changed). Prints the median CPU (user + system) seconds of
 # each and its ratio to the base, and writes the table to bench/out/tree_peaks_cost_parts.md.
@@ -33,7 +38,7 @@ while [[ $# -gt 0 ]]; do
     -k) k=$2; shift ;;
     --rounds) rounds=$2; shift ;;
     --contents) contents=$2; shift ;;
-    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,23p' "$0"; exit 0 ;;
     *) echo "tree_peaks_cost_parts.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
   shift
@@ -75,6 +80,11 @@ edit pieces "return select((lane_float)(NAN), best_h, live);" \
   "return tree_peak_inserted(h_sample_prev, best_h, h_sample, offset, step_scale) ? best_h : NAN;" \
   "return tree_peak_inserted(h_sample_prev, best_h, h_sample, offset, step_scale) && best_h > 1e30f ? best_h : NAN;"
 
+edit prepass "  const int i_begin = 0, i_end = line.z;" "  const int i_begin = 0, i_end = 0;"
+edit host "  const int i_begin = 0, i_end = line.z;" "  const int i_begin = 0, i_end = 0;" \
+  "  if (j0 >= n_lines) return;" "  if (j0 >= n_lines || 1) return;"
+edit no-count "        if (receiver || HFVIS_ALL_HORIZONS) {" "        if (0) {"
+
 cmake --build "$build_dir" -j "$(nproc)" --target hfvis_cli hfvis_bench > /dev/null
 inputs=()
 for content in $contents; do inputs+=("$(cost_input "$content" "$size" "$build_dir" "$data")"); done
@@ -83,11 +93,11 @@ header="commit $(git -C "$root" rev-parse --short HEAD), $(date -u +%Y-%m-%dT%H:
  $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//'), load average $(cut -d' ' -f1-3 /proc/loadavg);\
  ${size}x${size}, K = $k, median CPU seconds of $rounds rounds"
 echo "$header"
-variants=(base structure pieces current)
+variants=(base host prepass structure pieces no-count current)
 cpu() {  # VARIANT INPUT: CPU seconds of one run
   local v=$1 input=$2 bin=$build_dir/hfvis env=()
   [[ $v == base ]] && bin=$base_build/hfvis
-  [[ $v == structure || $v == pieces ]] && env=(HFVIS_KERNEL_DIR="$out/$v")
+  [[ $v != base && $v != current ]] && env=(HFVIS_KERNEL_DIR="$out/$v")
   env "${env[@]}" /usr/bin/time -f '%U %S' -o "$out/time.txt" "$bin" viewcount "$input" -o "$out/out.exr" -k "$k" -q
   awk '{printf "%.3f\n", $1 + $2}' "$out/time.txt"
 }
@@ -96,8 +106,8 @@ table=$out/../tree_peaks_cost_parts.md
 {
   echo "$header"
   echo
-  echo "| input | base CPU (s) | structure | pieces | current |"
-  echo "| --- | --- | --- | --- | --- |"
+  echo "| input | base CPU (s) | host | prepass | structure | pieces | no-count | current |"
+  echo "| --- | --- | --- | --- | --- | --- | --- | --- |"
 } > "$table"
 for input in "${inputs[@]}"; do
   for v in "${variants[@]}"; do cpu "$v" "$input" > /dev/null; done  # warm-up: PoCL compiles and caches
@@ -112,7 +122,7 @@ for input in "${inputs[@]}"; do
   declare -A med=()
   for v in "${variants[@]}"; do med[$v]=$(tr ' ' '\n' <<< "${times[$v]}" | sed '/^$/d' | median); done
   row="| $(basename "$input" .exr) | ${med[base]}"
-  for v in structure pieces current; do
+  for v in "${variants[@]:1}"; do
     row+=" | ${med[$v]} ($(printf '%.2f' "$(echo "${med[$v]} / ${med[base]}" | bc -l)") x)"
   done
   echo "$row |" | tee -a "$table"
