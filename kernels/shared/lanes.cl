@@ -1,7 +1,7 @@
 // lanes.cl: SIMD lanes of a work-item (compile-time HFVIS_LANES, 1 or 8). On a CPU one
 // work-item can run 8 lines or rays side by side, one per lane, in lock step: data-dependent
-// branches become masked vector steps (horizon.cl's sweep, viewshed.cl's rays); on GPUs each
-// work-item runs one (HFVIS_LANES 1).
+// branches become masked vector steps (horizon.cl's sweep, viewshed.cl's rays, the hull tree's
+// peaks prepass in intervisibility.cl); on GPUs each work-item runs one (HFVIS_LANES 1).
 #ifndef HFVIS_LANES_CL
 #define HFVIS_LANES_CL
 
