@@ -33,15 +33,22 @@ typedef struct {
 // The wedge from the receiver (xr, yr) over the samples' box [sx0, sx1] x [sy0, sy1]: its two
 // edges, toward the box's corners most counter-clockwise (wedge[0], wedge[1]) and most clockwise
 // (wedge[2], wedge[3]) seen from the receiver; 0 (no wedge) when the receiver lies in the box.
+// The corners are ordered by their angle from the direction to the box's centre, taken as a
+// pseudo-angle (monotone over the whole turn): a receiver just outside the box sees it over
+// nearly half a turn, where the corners lie more than a quarter turn from the centre's direction
+// and the sine of that angle (what this took before) no longer orders them, so the wedge left out
+// blocks that lines to the samples cross.
 int region_wedge(float xr, float yr, float sx0, float sy0, float sx1, float sy1, float* wedge) {
   if (!(xr < sx0 || xr > sx1 || yr < sy0 || yr > sy1)) return 0;
   const float cx = 0.5f * (sx0 + sx1) - xr, cy = 0.5f * (sy0 + sy1) - yr;
   float most = -INFINITY, least = INFINITY;
   for (int c = 0; c < 4; ++c) {
     const float vx = (c & 1 ? sx1 : sx0) - xr, vy = (c & 2 ? sy1 : sy0) - yr;
-    const float sine = (cx * vy - cy * vx) / sqrt(vx * vx + vy * vy);
-    if (sine > most) most = sine, wedge[0] = vx, wedge[1] = vy;
-    if (sine < least) least = sine, wedge[2] = vx, wedge[3] = vy;
+    // (counter-clockwise from the centre's direction: 0 .. 2 one way, -2 .. 0 the other)
+    const float p = region_pseudo_angle(cx * vx + cy * vy, cx * vy - cy * vx);
+    const float angle = p > 2.0f ? p - 4.0f : p;
+    if (angle > most) most = angle, wedge[0] = vx, wedge[1] = vy;
+    if (angle < least) least = angle, wedge[2] = vx, wedge[3] = vy;
   }
   return 1;
 }
