@@ -694,7 +694,10 @@ const std::vector<OptionSpec>& optionTable() {
       {"--seed", nullptr, "N", kRegionSamplingGroup, false,
        "the jitter's seed, 0 .. 4294967295 (default 1): the same seed, the\n"
        "same samples",
-       [](const std::string& typed, const std::string& value, RunArguments& run) { run.seed = parseSeed(typed, value); }},
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.seed = parseSeed(typed, value);
+         run.seed_given = true;
+       }},
       {"--light", nullptr, "C0,R0,C1,R1", kAreaLightGroup, false,
        "the light: the rectangle of grid points between two corner pixels\n"
        "(columns and rows, inclusive, in any order)",
@@ -769,7 +772,8 @@ const std::vector<OptionSpec>& optionTable() {
          const double lo = parseBounded(typed, value.substr(0, comma), 0.0, kMostLength, kFloatRange);
          const double hi =
              comma == std::string::npos ? lo : parseBounded(typed, value.substr(comma + 1), 0.0, kMostLength, kFloatRange);
-         if (hi < lo) throw UsageError(typed + ": H1 below H0 in " + inQuotes(value) + " (the band is H0 .. H1)");
+         if (hi < lo)
+           throw UsageError(typed + ": H1 below H0 in " + inQuotes(value) + " (the band is H0 .. H1)");
          run.pvs_grid.band_low = lo;
          run.pvs_grid.band_high = hi;
        }},
@@ -821,7 +825,9 @@ const std::vector<OptionSpec>& optionTable() {
       {"--seed", nullptr, "N", kPvsGroup, false,
        "the sampling's seed, 0 .. 4294967295 (default 1): the same seed and\n"
        "budget of samples, the same sets",
-       [](const std::string& typed, const std::string& value, RunArguments& run) { run.seed = parseSeed(typed, value); }},
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.seed = parseSeed(typed, value);
+       }},
       {"--bitset", nullptr, "OUT.bin", kPvsGroup, false,
        "also the sets as one bitset per view cell (docs/PVS.md, byte by byte)", HFVIS_TEXT(bitset_output)},
   };

@@ -123,6 +123,7 @@ struct RunArguments {
   bool region_samples_given = false;
   RegionVisibilityMethod region_method = RegionVisibilityOptions{}.method;
   std::uint32_t seed = RegionVisibilityOptions{}.seed;
+  bool seed_given = false;  // (arealight refuses it with --sources: points are not jittered)
   std::optional<PixelRectangle> light, from_region, to_region;
   double light_height = RegionSampling{}.height;
   double from_height = RegionSampling{}.height, to_height = RegionSampling{}.height;

@@ -56,6 +56,11 @@ def png(path, w, h, channels, rows):
                 + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
 png("two_channels.png", 4, 3, 2, [[1, 2] * 4 for _ in range(3)])
 png("mask_small.png", 4, 3, 1, [[1] * 4 for _ in range(3)])  # a pvs --view-mask of the wrong size
+# A float field (PFM) with one height of 1e30: beyond what the kernels' float products hold.
+values = [0.0] * 64
+values[3 * 8 + 4] = 1e30
+with open("huge.pfm", "wb") as f:
+    f.write(b"Pf\n8 8\n-1.0\n" + struct.pack("<64f", *values))
 PY
 # Environment maps with a negative and a non-finite radiance (2:1, one channel).
 /usr/bin/python3 - "$root/data" << 'PY'
@@ -239,6 +244,13 @@ try "region without --to" "" -- region field.exr -o out/r.json --from 1,1,4,4
 try "region rectangle outside the field" "" -- region field.exr -o out/r.json --from 1,1,4,4 --to 200,200,300,210
 try "region output not JSON" "" -- region field.exr -o out/r.exr --from 1,1,4,4 --to 8,8,9,9
 try "region rays not CSV" "" -- region field.exr -o out/r.json --from 1,1,4,4 --to 8,8,9,9 --rays out/r.txt
+try "region heights beyond float range" "" -- region huge.pfm -o out/r.json --from 1,1,2,2 --to 5,5,6,6
+try "arealight sources with a seed" "" -- arealight field.exr -o out/o.exr --sources nodata_source.csv --seed 7
+try "arealight sources decorrelated" "" -- arealight field.exr -o out/o.exr --sources nodata_source.csv --decorrelate
+try "arealight memory budget" "" -- arealight field.exr -o out/o.exr --light 1,1,4,4 --memory-budget 64
+try "region memory budget" "" -- region field.exr -o out/r.json --from 1,1,4,4 --to 8,8,9,9 --memory-budget 64
+try "arealight heights beyond float range" "" -- arealight huge.pfm -o out/o.exr --light 1,1,2,2
+try "pvs heights beyond float range" "" -- pvs huge.pfm -o out/p.json --samples 10 --view-cell 4 --tile 2
 try "pvs view cell 0" "" -- pvs field.exr -o out/p.json --samples 10 --view-cell 0
 try "pvs view cell larger than the field" "" -- pvs field.exr -o out/p.json --samples 10 --view-cell 256
 try "pvs tile larger than the field" "" -- pvs field.exr -o out/p.json --samples 10 --tile 1000

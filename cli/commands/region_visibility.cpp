@@ -352,6 +352,12 @@ void checkAreaLight(const std::string&, const RunArguments& run) {
     throw UsageError("--light-image colours a --light rectangle, not --sources points");
   if (!run.sources_file.empty() && run.region_samples_given)
     throw UsageError("--samples is for --light: the --sources file's points are the samples");
+  if (!run.sources_file.empty() && (run.seed_given || run.decorrelate))
+    throw UsageError(std::string(run.decorrelate ? "--decorrelate" : "--seed") +
+                     " jitters a --light's samples; the --sources file's points stand where they are");
+  if (run.memory_budget_bytes != 0)
+    throw UsageError(
+        "--memory-budget is not available with 'hfvis arealight' (its buffers are not budgeted)");
   requireAboveSurface(run, "--light-height", run.light_height);
   if (run.region_method == RegionVisibilityMethod::Viewsheds) {
     if (run.decorrelate)
@@ -386,6 +392,8 @@ void checkAreaLight(const std::string&, const RunArguments& run) {
 }
 
 void checkRegion(const std::string&, const RunArguments& run) {
+  if (run.memory_budget_bytes != 0)
+    throw UsageError("--memory-budget is not available with 'hfvis region' (its buffers are not budgeted)");
   if (!hasExtension(run.output, ".json"))
     throw UsageError("-o: 'hfvis region' writes JSON; the name must end in .json, got " +
                      inQuotes(run.output));

@@ -100,6 +100,17 @@ PreparedHeights prepareHeights(const HeightField& field, HeightOrigin origin) {
             << ": more than the " << kMaxPreparedHeight << " the kernels' float arithmetic holds";
     throw InvalidArgument(message.str());
   }
+  // From 0 (the viewshed's, region visibility's and the ray caster's heights), the heights
+  // themselves: the same products, and beyond float's range a height would become infinite.
+  if (origin == HeightOrigin::Zero && highest >= lowest &&
+      std::max(std::fabs(lowest), std::fabs(highest)) * field.z_scale > kMaxPreparedHeight) {
+    std::ostringstream message;
+    message << "the heights span " << lowest << " .. " << highest << ", up to "
+            << std::max(std::fabs(lowest), std::fabs(highest)) * field.z_scale << " from 0 with the z-scale "
+            << field.z_scale << ": more than the " << kMaxPreparedHeight
+            << " the kernels' float arithmetic holds";
+    throw InvalidArgument(message.str());
+  }
   const double base = origin == HeightOrigin::Lowest ? lowest : 0.0;  // h - 0.0 is h exactly
   PreparedHeights prepared;
   prepared.heights.resize(field.heights.size());

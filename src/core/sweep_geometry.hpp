@@ -62,8 +62,9 @@ float sampleHeight(const std::vector<float>& heights, int width, int height, Poi
 // lowest); every non-finite height becomes NaN. Throws InvalidArgument when a prepared height
 // would exceed kMaxPreparedHeight: the kernels multiply height differences by distances (up to
 // 2^31 pixels) in float, which must stay finite. HeightOrigin::Zero keeps the heights where
-// they are (h * z_scale, unchecked): the viewshed, whose observers and targets may stand at
-// absolute heights.
+// they are (h * z_scale): the viewshed, region visibility and the ray caster, whose observers,
+// sources and targets may stand at absolute heights; it throws when a height itself would
+// exceed kMaxPreparedHeight.
 constexpr double kMaxPreparedHeight = 1e28;
 struct PreparedHeights {
   std::vector<float> heights;
