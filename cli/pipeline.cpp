@@ -25,19 +25,39 @@ std::string formatNumber(double value) {
   return out.str();
 }
 
+// The length of the well-formed UTF-8 sequence at text[i] (lead byte and continuation bytes, no
+// overlong two-byte forms, nothing beyond U+10FFFF), 0 where there is none.
+static std::size_t utf8Sequence(const std::string& text, std::size_t i) {
+  const unsigned char c = static_cast<unsigned char>(text[i]);
+  const std::size_t n = c < 0x80                 ? 1
+                        : c >= 0xC2 && c <= 0xDF ? 2
+                        : c >= 0xE0 && c <= 0xEF ? 3
+                        : c >= 0xF0 && c <= 0xF4 ? 4
+                                                 : 0;
+  if (n == 0 || i + n > text.size()) return 0;
+  for (std::size_t k = 1; k < n; ++k)
+    if ((static_cast<unsigned char>(text[i + k]) & 0xC0) != 0x80) return 0;
+  return n;
+}
+
 std::string jsonString(const std::string& text) {
   std::string out = "\"";
-  for (const char ch : text) {
-    const unsigned char c = static_cast<unsigned char>(ch);
+  for (std::size_t i = 0; i < text.size();) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    const std::size_t n = utf8Sequence(text, i);
     if (c == '"' || c == '\\') {
       out += '\\';
-      out += ch;
-    } else if (c < 0x20) {
+      out += text[i++];
+    } else if (c < 0x20 || n == 0) {
+      // Control characters escaped; a byte that is not UTF-8 (a file name in another encoding)
+      // as the character of that number (its Latin-1 reading), so that the JSON stays valid.
       char escaped[8];
       std::snprintf(escaped, sizeof escaped, "\\u%04x", c);
       out += escaped;
+      ++i;
     } else {
-      out += ch;
+      out.append(text, i, n);
+      i += n;
     }
   }
   return out + "\"";

@@ -24,7 +24,9 @@ namespace hfvis::cli {
 
 std::string formatNumber(double value);
 std::string formatFixed(double value, int digits);
-// A JSON string: quoted, with its escapes (the JSON outputs of horizon-lists and region).
+// A JSON string: quoted, with its escapes (the JSON outputs of horizon-lists, region and pvs);
+// UTF-8 passes through, a byte that is not part of it (a file name in another encoding) becomes
+// \u00XX, so that the output stays valid JSON.
 std::string jsonString(const std::string& text);
 // Mean over the finite values (nodata pixels are NaN and do not count).
 double finiteMean(const std::vector<float>& values);

@@ -3027,3 +3027,24 @@ TEST_F(CliGeoTiff, RegionVisibilityOnAGeoreferencedField) {
     EXPECT_NEAR(std::stod(f[9]), t[3] + (std::stod(f[4]) + 0.5) * t[5], 1e-2);
   }
 }
+
+// A file name in another encoding than UTF-8 (Latin-1's e-acute, byte 0xE9): the JSON that names
+// it stays valid, the byte written as the character of that number; UTF-8 names pass through.
+TEST_F(Cli, JsonNamesTheInputInValidUtf8) {
+  const std::string field = flat();
+  const std::string latin1 = in(std::string("lat") + char(0xE9) + ".exr"), utf8 = in("\xC3\xA9t\xC3\xA9.exr");
+  fs::copy_file(field, latin1);
+  fs::copy_file(field, utf8);
+  ASSERT_EQ(run("region " + shellQuoted(latin1) + " -o " + shellQuoted(out("l.json")) +
+                " --from 1,1,2,2 --to 5,5,6,6 -q")
+                .status,
+            0);
+  ASSERT_EQ(run("region " + shellQuoted(utf8) + " -o " + shellQuoted(out("u.json")) +
+                " --from 1,1,2,2 --to 5,5,6,6 -q")
+                .status,
+            0);
+  const std::string l = readText(out("l.json")), u = readText(out("u.json"));
+  EXPECT_NE(l.find("lat\\u00e9.exr\""), std::string::npos) << l.substr(0, 200);
+  EXPECT_EQ(l.find(char(0xE9)), std::string::npos);
+  EXPECT_NE(u.find("\xC3\xA9t\xC3\xA9.exr\""), std::string::npos) << u.substr(0, 200);
+}
