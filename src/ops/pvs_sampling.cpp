@@ -9,6 +9,7 @@
 #include <cmath>
 #include <deque>
 #include <limits>
+#include <sstream>
 #include <string>
 #include <unordered_map>
 
@@ -27,6 +28,8 @@ constexpr double kMinProbability = 0.02;
 constexpr std::size_t kMutationCandidates = 1 << 16;
 // Discovery rays per silhouette mutation (Sec. 4.4: a search along the perpendicular).
 constexpr int kDiscoveryRays = 4;
+// The most uniform rays a pixel-error budget alone may ask for (at 5M rays a second, days).
+constexpr double kMaxPixelErrorRays = 1e12;
 // The view space-direction samples' least probability in the mixture: the pixel error is
 // estimated from them alone (Sec. 4.5), and at the common floor (kMinProbability) so few are
 // cast late in a run that an error of a few per million rests on no contributing ray at all.
@@ -130,6 +133,8 @@ class Sampler {
     out_.bits.assign(std::size_t(l.viewCells()) * out_.words, 0u);
     only_finder_ = out_.bits;
     out_.computed = grid.mask.empty() ? std::vector<std::uint8_t>(l.viewCells(), 1) : grid.mask;
+    complete_ = std::size_t(std::count(out_.computed.begin(), out_.computed.end(), std::uint8_t(1))) *
+                std::size_t(l.tiles());
     out_.pixel_error = std::numeric_limits<double>::quiet_NaN();
     heights_ = detail::rayHeights(field);
     cx_ = field.cell_size_x;
@@ -179,6 +184,13 @@ class Sampler {
       out_.history.push_back(row);
       if (options_.progress) options_.progress(out_.samples, out_.pixel_error);
       if (options_.pixel_error > 0.0 && out_.pixel_error <= options_.pixel_error) break;
+      if (options_.pixel_error > 0.0 && out_.entries() == complete_) {
+        // Every computed view cell holds every tile: no ray can differ, whatever the estimate's
+        // floor of one entry per uniform ray says (a run would go on for ever toward a small E).
+        out_.pixel_error = 0.0;
+        out_.history.back().pixel_error = 0.0;
+        break;
+      }
       if (options_.seconds > 0.0 && out_.seconds >= options_.seconds) break;
     }
     if (options_.filter > 0.0) filter();
@@ -581,6 +593,7 @@ class Sampler {
   MutationBuffer mutations_;
   std::vector<Silhouette> silhouettes_;
   std::uint64_t uniform_rays_ = 0;  // uniform view rays cast so far (foundAgain)
+  std::size_t complete_ = 0;        // the entries of complete sets: computed view cells x tiles
   // The entries only one uniform view ray has found (foundAgain): a bit per entry as out_.bits,
   // and the finder's lineage by entry (v * tiles + t).
   std::vector<std::uint32_t> only_finder_;
@@ -601,6 +614,18 @@ void validate(const PvsOptions& options) {
     throw InvalidArgument("the pixel error and seconds budgets must be finite and >= 0");
   if (options.samples == 0 && options.pixel_error == 0.0 && options.seconds == 0.0)
     throw InvalidArgument("a PVS run needs a budget above 0: samples, pixel error or seconds");
+  // The estimate never falls below one entry found once (resolution / uniform rays): a pixel
+  // error alone that asks for more uniform rays than days of casting is refused, not run.
+  if (options.pixel_error > 0.0 && options.samples == 0 && options.seconds == 0.0 &&
+      options.resolution / options.pixel_error > kMaxPixelErrorRays) {
+    std::ostringstream message;
+    message << "a pixel error of " << options.pixel_error << " asks for at least "
+            << options.resolution / options.pixel_error
+            << " uniform rays (the estimate is at least " << options.resolution
+            << " over the uniform rays cast), more than " << kMaxPixelErrorRays
+            << ": ask for a larger error, or give a samples or seconds budget as well";
+    throw InvalidArgument(message.str());
+  }
   if (options.batch < 1) throw InvalidArgument("the batch must hold at least 1 sample");
   if (!std::isfinite(options.filter) || options.filter < 0.0)
     throw InvalidArgument("the visibility filter's k must be finite and >= 0");
