@@ -669,5 +669,27 @@ TEST(Pvs, BadInput) {
                InvalidArgument);
 }
 
+// A pixel-error budget on a field whose sets fill up: the run stops once every view cell holds
+// every tile (its estimate 0), where the estimate's floor of one entry per uniform ray would keep
+// it going for about resolution / E rays; a pixel error alone that asks for more than 1e12
+// uniform rays is refused before any work.
+TEST(Pvs, APixelErrorRunStopsWhenTheSetsAreComplete) {
+  const HeightField field = makeSyntheticField("flat", 8, 8, 1);
+  PvsGrid grid;
+  grid.view_cell = 4;
+  grid.tile = 4;
+  PvsOptions options;
+  options.pixel_error = 1e-5;  // (the floor alone: 1e11 uniform rays)
+  options.batch = 4096;
+  const PvsResult pvs = computePvs(testContext(), field, grid, options);
+  EXPECT_EQ(pvs.entries(), std::size_t(pvs.layout.viewCells()) * std::size_t(pvs.layout.tiles()));
+  EXPECT_EQ(pvs.pixel_error, 0.0);
+  EXPECT_LT(pvs.samples, 1000000u);
+  options.pixel_error = 1e-7;
+  EXPECT_THROW(computePvs(testContext(), field, grid, options), InvalidArgument);
+  options.samples = 4096;  // with a samples budget as well it runs
+  EXPECT_NO_THROW(computePvs(testContext(), field, grid, options));
+}
+
 }  // namespace
 }  // namespace hfvis
