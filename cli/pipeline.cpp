@@ -25,10 +25,11 @@ std::string formatNumber(double value) {
   return out.str();
 }
 
-// The length of the well-formed UTF-8 sequence at text[i] (lead byte and continuation bytes, no
-// overlong two-byte forms, nothing beyond U+10FFFF), 0 where there is none.
+// The length of the well-formed UTF-8 sequence at text[i] (Unicode's table of well-formed byte
+// sequences: no overlong forms, no surrogates, nothing beyond U+10FFFF), 0 where there is none.
 static std::size_t utf8Sequence(const std::string& text, std::size_t i) {
-  const unsigned char c = static_cast<unsigned char>(text[i]);
+  const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(text[i + k]); };
+  const unsigned char c = byte(0);
   const std::size_t n = c < 0x80                 ? 1
                         : c >= 0xC2 && c <= 0xDF ? 2
                         : c >= 0xE0 && c <= 0xEF ? 3
@@ -36,7 +37,11 @@ static std::size_t utf8Sequence(const std::string& text, std::size_t i) {
                                                  : 0;
   if (n == 0 || i + n > text.size()) return 0;
   for (std::size_t k = 1; k < n; ++k)
-    if ((static_cast<unsigned char>(text[i + k]) & 0xC0) != 0x80) return 0;
+    if ((byte(k) & 0xC0) != 0x80) return 0;
+  // The second byte's narrower ranges after E0, ED, F0 and F4.
+  if ((c == 0xE0 && byte(1) < 0xA0) || (c == 0xED && byte(1) > 0x9F) || (c == 0xF0 && byte(1) < 0x90) ||
+      (c == 0xF4 && byte(1) > 0x8F))
+    return 0;
   return n;
 }
 

@@ -266,7 +266,7 @@ __kernel void region_visibility_bits(__global const float* h, __global const flo
   // (after a clear one the next is seldom hidden: the tries would cost more than they save); then
   // the two cells that hid lines before it, the more recent first (on a city the lines of one
   // receiver go behind a few walls in turn, so a wall met before often hides the next line again:
-  // 3 - 12 % less CPU time on the city DSM's pairs, bench/report/region_visibility.md); a word
+  // 13 - 22 % less CPU time on the city DSM's pairs, bench/report/region_visibility.md); a word
   // whose predecessor had a hidden line skips the shaft test (it fails where a line is hidden
   // beyond the receiver's surroundings, and then costs more than it saves).
   int blocker = -1, hidden_before = 0, last_hidden = 0;
