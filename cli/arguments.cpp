@@ -779,7 +779,7 @@ const std::vector<OptionSpec>& optionTable() {
        }},
       {"--view-mask", nullptr, "MASK", kPvsGroup, false,
        "compute only the view cells holding a non-zero pixel of MASK, a\n"
-       "raster of the field's size (a trail, a site)",
+       "raster of the field's size (a trail, a site; its first channel)",
        HFVIS_TEXT(pvs_mask)},
       {"--tile", nullptr, "T", kPvsGroup, false, "tiles (the objects) of T x T cells (default 16)",
        [](const std::string& typed, const std::string& value, RunArguments& run) {

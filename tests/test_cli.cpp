@@ -2928,6 +2928,20 @@ TEST_F(Cli, PvsWritesTheLibrarysSetsAsJsonAndBits) {
     ASSERT_TRUE(std::getline(mlines, line));
     EXPECT_NE(line.find("null"), std::string::npos) << "view cell " << v << ": " << line;
   }
+  // The same mask as grey with alpha (Y, A, alpha 1 everywhere): its first channel is the mask.
+  hfvis::ImageChannels grey_alpha;
+  grey_alpha.width = 30, grey_alpha.height = 22;
+  grey_alpha.names = {"Y", "A"};
+  grey_alpha.planes = {std::vector<float>(30 * 22, 0.0f), std::vector<float>(30 * 22, 1.0f)};
+  for (int row = 0; row < 3; ++row)
+    for (int col = 0; col < 3; ++col) grey_alpha.planes[0][row * 30 + col] = 1.0f;
+  hfvis::writeImage(in("mask_ya.exr"), grey_alpha);
+  const CliResult alpha =
+      run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out("a.json")) +
+          " --view-cell 8 --tile 4 --samples 500 --view-mask " + shellQuoted(in("mask_ya.exr")) + " --quiet");
+  ASSERT_EQ(alpha.status, 0) << alpha.err;
+  const std::string ajson = readText(out("a.json"));  // (the same sets; the times differ)
+  EXPECT_EQ(ajson.substr(ajson.find("\"pvs\": [")), mjson.substr(msets));
 }
 
 TEST_F(Cli, RegionVisibilityRefusesBadInput) {

@@ -59,7 +59,10 @@ class Pvs : public Computation {
     grid_ = run_.pvs_grid;
     const PvsLayout layout = layoutOf(field);
     if (!run_.pvs_mask.empty()) {
-      const HeightField mask = readHeightField(run_.pvs_mask);
+      // Its first channel: a grey mask with alpha (Y, A), or a painted RGB one, holds the mask there.
+      HeightFieldReadOptions first;
+      first.channel = "0";
+      const HeightField mask = readHeightField(run_.pvs_mask, first);
       if (mask.width != field.width || mask.height != field.height)
         throw UsageError("--view-mask: " + run_.pvs_mask + " is " + std::to_string(mask.width) + " x " +
                          std::to_string(mask.height) + ", the field " + std::to_string(field.width) + " x " +
@@ -223,7 +226,8 @@ const CommandSpec kPvsCommand{
     "reached: --samples N, --pixel-error E (the paper's estimate, in differing rays per\n"
     "million-ray camera), --seconds S. The same seed and --samples give the same sets.\n"
     "--view-mask MASK (a raster of the field's size): only the view cells holding a non-zero\n"
-    "pixel are computed. --filter K: Sec. 5's object-space filter, K times the sampling's gap.\n"
+    "pixel (its first channel) are computed. --filter K: Sec. 5's object-space filter, K times the "
+    "sampling's gap.\n"
     "Writes JSON: the grids, samples, estimated pixel error, the mixture per batch and, per view\n"
     "cell, its visible tiles' row-major indices. --bitset OUT.bin: the sets as bits, laid out\n"
     "in docs/PVS.md. The preview shows the PVS size per view cell over a hillshade.\n",
