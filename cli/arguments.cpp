@@ -51,13 +51,15 @@ std::string shortened(const std::string& text) {
                           : text;
 }
 
-// Strict number parsing: the whole text must be a finite number.
+// Strict number parsing: the whole text must be a finite decimal number (strtod also reads
+// hexadecimal, "0x10", which the integer options' base-10 parsing refuses: refused here too).
 double parseNumber(const std::string& option, const std::string& text) {
   const char* begin = text.c_str();
   char* end = nullptr;
   errno = 0;
   const double value = std::strtod(begin, &end);
-  if (text.empty() || end != begin + text.size() || errno == ERANGE || !std::isfinite(value)) {
+  if (text.empty() || end != begin + text.size() || errno == ERANGE || !std::isfinite(value) ||
+      text.find_first_of("xX") != std::string::npos) {
     throw UsageError(option + ": expected a number, got " + inQuotes(shortened(text)));
   }
   return value;

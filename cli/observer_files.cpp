@@ -72,8 +72,9 @@ std::vector<CsvPoint> parsePoints(const std::string& path, std::istream& in, dou
       if (a == std::string::npos) return false;
       const std::string t = text.substr(a, b - a + 1);
       char* end = nullptr;
-      value = std::strtod(t.c_str(), &end);
-      return end == t.c_str() + t.size() && std::isfinite(value);
+      value = std::strtod(t.c_str(), &end);  // (decimal only: strtod also reads "0x1")
+      return end == t.c_str() + t.size() && std::isfinite(value) &&
+             t.find_first_of("xX") == std::string::npos;
     };
     if (number == 1 && (line.rfind("\xFF\xFE", 0) == 0 || line.rfind("\xFE\xFF", 0) == 0))
       throw IoError(path, "is UTF-16 text; save it as UTF-8 (or ASCII) with lines col,row[,height]");

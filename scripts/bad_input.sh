@@ -257,6 +257,7 @@ try "pvs tile larger than the field" "" -- pvs field.exr -o out/p.json --samples
 try "pvs band with H1 below H0" "" -- pvs field.exr -o out/p.json --samples 10 --view-height 3,1
 try "pvs mask of the wrong size" "" -- pvs field.exr -o out/p.json --samples 10 --view-mask mask_small.png
 try "pvs budget of 0" "" -- pvs field.exr -o out/p.json --samples 0
+try "pvs view cell in hexadecimal" "" -- pvs field.exr -o out/p.json --samples 10 --view-cell 0x10
 try "pvs pixel error beyond reach" "" -- pvs field.exr -o out/p.json --pixel-error 1e-9
 try "pvs without a budget" "" -- pvs field.exr -o out/p.json
 try "pvs output not JSON" "" -- pvs field.exr -o out/p.exr --samples 10
