@@ -133,7 +133,8 @@ class Sampler {
     out_.bits.assign(std::size_t(l.viewCells()) * out_.words, 0u);
     only_finder_ = out_.bits;
     out_.computed = grid.mask.empty() ? std::vector<std::uint8_t>(l.viewCells(), 1) : grid.mask;
-    complete_ = std::size_t(std::count(out_.computed.begin(), out_.computed.end(), std::uint8_t(1))) *
+    complete_ = std::size_t(std::count_if(out_.computed.begin(), out_.computed.end(),
+                                          [](std::uint8_t c) { return c != 0; })) *
                 std::size_t(l.tiles());
     out_.pixel_error = std::numeric_limits<double>::quiet_NaN();
     heights_ = detail::rayHeights(field);
