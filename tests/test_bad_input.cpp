@@ -71,6 +71,18 @@ TEST(BadInput, Fields) {
   towering.heights[3] = 3e38f;
   towering.heights[4] = -3e38f;
   expectError<InvalidArgument>([&] { horizons(towering); }, "float arithmetic");
+  // The operations that keep heights from 0 (region visibility, the viewshed, the ray caster)
+  // refuse a height beyond the same bound, where a span from the lowest would not show it.
+  HeightField high = good;
+  high.heights.assign(high.heights.size(), 2e28f);
+  RegionSampling a, b;
+  a.rectangle = {0, 0, 1, 1};
+  b.rectangle = {3, 3, 4, 4};
+  expectError<InvalidArgument>(
+      [&] { computeRegionPairVisibility(testContext(), high, a, b, RegionVisibilityOptions{}); },
+      "float arithmetic");
+  expectError<InvalidArgument>([&] { computeViewshed(testContext(), high, Observer{}, ViewshedOptions{}); },
+                               "float arithmetic");
 }
 
 TEST(BadInput, Options) {
