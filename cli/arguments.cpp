@@ -170,6 +170,12 @@ bool hasExtension(const std::string& path, const char* wanted) {
   return extension == wanted;
 }
 
+std::string namedAs(const std::string& path) {
+  const std::string file = std::filesystem::path(path).filename().string();
+  const bool extension_alone = file.size() > 1 && file[0] == '.' && file.find('.', 1) == std::string::npos;
+  return inQuotes(path) + (extension_alone ? " (an extension alone: give a name before it)" : "");
+}
+
 namespace {
 
 // "X" or "X,Y", ground units per pixel along columns and rows.
@@ -312,7 +318,7 @@ const std::vector<OptionSpec>& optionTable() {
          requireNonEmpty(typed, value);
          if (!hasExtension(value, ".png"))
            throw UsageError(typed + ": the preview is a PNG file; its name must end in .png, got " +
-                            inQuotes(value));
+                            namedAs(value));
          run.preview = value;
        }},
       {"--nodata", nullptr, "VALUE", kImageGroup, false,

@@ -163,6 +163,9 @@ std::string inQuotes(const std::string& text);
 bool samePath(const std::string& a, const std::string& b);
 // `path` ends in `wanted` (".json"), in any case.
 bool hasExtension(const std::string& path, const char* wanted);
+// The name as an error about its extension gives it: quoted, and where the file name is an
+// extension alone (".json": a hidden file without one) saying so.
+std::string namedAs(const std::string& path);
 // Runs the library's own checks of options (`check`), their InvalidArgument a UsageError.
 template <typename Check>
 void asUsageError(Check&& check) {

@@ -60,7 +60,7 @@ void checkHorizonLists(const std::string&, const RunArguments& run) {
   if (!hasExtension(run.output, ".json") && !hasExtension(run.output, ".csv")) {
     throw UsageError(
         "-o: the horizon lists are written as JSON or CSV; the name must end in .json or .csv, got " +
-        inQuotes(run.output));
+        namedAs(run.output));
   }
   if (run.receivers.empty()) throw UsageError("missing --at COL,ROW (the receivers whose horizons to list)");
   asUsageError([&] { validate(horizonListOptions(run)); });

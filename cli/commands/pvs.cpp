@@ -192,12 +192,12 @@ class Pvs : public Computation {
 void checkPvs(const std::string& name, const RunArguments& run) {
   if (!hasExtension(run.output, ".json"))
     throw UsageError("-o: 'hfvis " + name + "' writes JSON; the name must end in .json, got " +
-                     inQuotes(run.output));
+                     namedAs(run.output));
   if (!run.bitset_output.empty() && samePath(run.output, run.bitset_output))
     throw UsageError("--bitset must differ from -o, both are " + inQuotes(run.output));
   if (!run.preview.empty() && !hasExtension(run.preview, ".png"))
     throw UsageError("--preview: the preview is a PNG; the name must end in .png, got " +
-                     inQuotes(run.preview));
+                     namedAs(run.preview));
   if (run.pvs.samples == 0 && run.pvs.pixel_error == 0.0 && run.pvs.seconds == 0.0)
     throw UsageError("'hfvis " + name + "' needs a budget: --samples N, --pixel-error E or --seconds S");
   PvsOptions options = run.pvs;

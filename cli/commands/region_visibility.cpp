@@ -396,13 +396,13 @@ void checkRegion(const std::string&, const RunArguments& run) {
     throw UsageError("--memory-budget is not available with 'hfvis region' (its buffers are not budgeted)");
   if (!hasExtension(run.output, ".json"))
     throw UsageError("-o: 'hfvis region' writes JSON; the name must end in .json, got " +
-                     inQuotes(run.output));
+                     namedAs(run.output));
   if (!run.from_region || !run.to_region)
     throw UsageError(std::string("missing ") + (run.from_region ? "--to" : "--from") +
                      " C0,R0,C1,R1 (region pairs need --from and --to rectangles)");
   if (!run.rays_output.empty() && !hasExtension(run.rays_output, ".csv"))
     throw UsageError("--rays: the rays are written as CSV; the name must end in .csv, got " +
-                     inQuotes(run.rays_output));
+                     namedAs(run.rays_output));
   if (run.region_method == RegionVisibilityMethod::Viewsheds ||
       run.region_method == RegionVisibilityMethod::Bitmask)
     throw UsageError(std::string("--method ") + regionVisibilityMethodName(run.region_method) +
