@@ -532,54 +532,64 @@ TEST(RegionVisibility, TheBitmaskScatterIsTheExactOne) {
               (unsigned long long)tested, (unsigned long long)total, (unsigned long long)tested_by_size[0]);
 }
 
-// Receivers just outside the samples' box see it over nearly half a turn, and a tall block
-// beside them hides some samples: the walks over the pyramid (the bitmask scatter's and the
-// culled march's shaft test) leave out only blocks beyond the wedge toward the samples, and the
-// wedge's edges are its corners most turned from the box's centre, more than a quarter turn
-// from it here (ordering them by that angle's sine once dropped the block, and lines through it
-// came out clear). Every method's bits are the exact ones, in both layouts: a light just above
-// the block's top and a region pair whose rectangles touch.
+// Receivers just outside the samples' box (the light's, or a word's of 32 samples) see it over
+// nearly half a turn, and a tall block beside them hides some samples: the walks over the pyramid
+// (the bitmask scatter's and the culled march's shaft test) leave out only blocks beyond the
+// wedge toward the samples, and the wedge's edges are its corners most turned from the box's
+// centre, more than a quarter turn from it here (ordering them by that angle's sine once dropped
+// the block, and lines through it came out clear: the bitmask scatter in the first case, both it
+// and the culled march in the second). Every method's bits are the exact ones, in both layouts:
+// a light just above the block's top, a lower block under a light of 256 samples, and a region
+// pair whose rectangles touch.
 TEST(RegionVisibility, ReceiversBesideTheSamplesBoxSeeTheBlockBetween) {
-  const int w = 32, h = 32;
-  std::vector<float> heights(w * h, 0.0f);
-  for (int row = 12; row <= 13; ++row)
-    for (int col = 12; col <= 13; ++col) heights[row * w + col] = 49.5f;
-  const HeightField field = fieldFrom(w, h, heights);
-  RegionSampling light;
-  light.rectangle = {10, 10, 30, 20};
-  light.samples = 128;
-  light.height = 50.0;
-  light.absolute = true;
-  RegionSampling near_side, far_side;
-  near_side.rectangle = {14, 4, 20, 9};
-  far_side.rectangle = {8, 10, 14, 16};
-  near_side.samples = far_side.samples = 64;
-  near_side.height = 1.0, far_side.height = 45.0;
-  std::size_t clear = 0, total = 0;
-  forEachLayout([&](const ComputeContext& context) {
-    RegionVisibilityOptions exact;
-    exact.method = RegionVisibilityMethod::Exact;
-    const RegionVisibilityResult want = computeRegionVisibility(context, field, light, exact);
-    const RegionPairVisibilityResult want_pair =
-        computeRegionPairVisibility(context, field, near_side, far_side, exact);
-    for (RegionVisibilityMethod method :
-         {RegionVisibilityMethod::Bitmask, RegionVisibilityMethod::Culled, RegionVisibilityMethod::Auto}) {
-      SCOPED_TRACE(regionVisibilityMethodName(method));
-      RegionVisibilityOptions options;
-      options.method = method;
-      const RegionVisibilityResult got = computeRegionVisibility(context, field, light, options);
-      ASSERT_EQ(got.bits.size(), want.bits.size());
-      for (std::size_t i = 0; i < got.bits.size(); ++i)
-        ASSERT_EQ(got.bits[i], want.bits[i]) << "receiver " << i / got.words << " word " << i % got.words;
-      if (method == RegionVisibilityMethod::Bitmask) continue;  // (pairs: no bitmask scatter)
-      EXPECT_EQ(computeRegionPairVisibility(context, field, near_side, far_side, options).bits,
-                want_pair.bits);
-    }
-    for (std::uint32_t word : want.bits) clear += __builtin_popcount(word), total += 32;
-  });
-  // The block hides part of the light from part of the field.
-  EXPECT_GT(clear, total / 2);
-  EXPECT_LT(clear, total);
+  struct Case {
+    int row0;
+    float top;
+    int samples;
+  };
+  for (const Case c : {Case{12, 49.5f, 128}, Case{15, 45.0f, 256}}) {
+    SCOPED_TRACE("block from row " + std::to_string(c.row0));
+    const int w = 32, h = 32;
+    std::vector<float> heights(w * h, 0.0f);
+    for (int row = c.row0; row <= c.row0 + 1; ++row)
+      for (int col = 12; col <= 13; ++col) heights[row * w + col] = c.top;
+    const HeightField field = fieldFrom(w, h, heights);
+    RegionSampling light;
+    light.rectangle = {10, 10, 30, 20};
+    light.samples = c.samples;
+    light.height = 50.0;
+    light.absolute = true;
+    RegionSampling near_side, far_side;
+    near_side.rectangle = {14, 4, 20, 9};
+    far_side.rectangle = {8, 10, 14, 16};
+    near_side.samples = far_side.samples = 64;
+    near_side.height = 1.0, far_side.height = 45.0;
+    std::size_t clear = 0, total = 0;
+    forEachLayout([&](const ComputeContext& context) {
+      RegionVisibilityOptions exact;
+      exact.method = RegionVisibilityMethod::Exact;
+      const RegionVisibilityResult want = computeRegionVisibility(context, field, light, exact);
+      const RegionPairVisibilityResult want_pair =
+          computeRegionPairVisibility(context, field, near_side, far_side, exact);
+      for (RegionVisibilityMethod method :
+           {RegionVisibilityMethod::Culled, RegionVisibilityMethod::Bitmask, RegionVisibilityMethod::Auto}) {
+        SCOPED_TRACE(regionVisibilityMethodName(method));
+        RegionVisibilityOptions options;
+        options.method = method;
+        const RegionVisibilityResult got = computeRegionVisibility(context, field, light, options);
+        ASSERT_EQ(got.bits.size(), want.bits.size());
+        for (std::size_t i = 0; i < got.bits.size(); ++i)
+          ASSERT_EQ(got.bits[i], want.bits[i]) << "receiver " << i / got.words << " word " << i % got.words;
+        if (method == RegionVisibilityMethod::Bitmask) continue;  // (pairs: no bitmask scatter)
+        EXPECT_EQ(computeRegionPairVisibility(context, field, near_side, far_side, options).bits,
+                  want_pair.bits);
+      }
+      for (std::uint32_t word : want.bits) clear += __builtin_popcount(word), total += 32;
+    });
+    // The block hides part of the light from part of the field.
+    EXPECT_GT(clear, total / 2);
+    EXPECT_LT(clear, total);
+  }
 }
 
 // A wall between a light and the ground beyond it: the bitmask method's bits are the exact
