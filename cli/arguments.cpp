@@ -14,7 +14,7 @@
 #include <set>
 #include <tuple>
 
-#include "core/message_numbers.hpp"
+#include "core/number_text.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/insolation.hpp"
 #include "hfvis/sun.hpp"
@@ -51,17 +51,11 @@ std::string shortened(const std::string& text) {
                           : text;
 }
 
-// Strict number parsing: the whole text must be a finite decimal number (strtod also reads
-// hexadecimal, "0x10", which the integer options' base-10 parsing refuses: refused here too).
+// Strict number parsing: the whole text must be a finite decimal number.
 double parseNumber(const std::string& option, const std::string& text) {
-  const char* begin = text.c_str();
-  char* end = nullptr;
-  errno = 0;
-  const double value = std::strtod(begin, &end);
-  if (text.empty() || end != begin + text.size() || errno == ERANGE || !std::isfinite(value) ||
-      text.find_first_of("xX") != std::string::npos) {
+  double value = 0.0;
+  if (!detail::decimalNumber(text, value))
     throw UsageError(option + ": expected a number, got " + inQuotes(shortened(text)));
-  }
   return value;
 }
 
@@ -70,18 +64,11 @@ float parseNodata(const std::string& option, const std::string& text) {
   std::string lower = text;
   for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (lower == "nan") return std::numeric_limits<float>::quiet_NaN();
-  const char* begin = text.c_str();
-  char* end = nullptr;
-  errno = 0;
-  const double value = std::strtod(begin, &end);
-  if (text.empty() || end != begin + text.size() || std::isnan(value)) {
-    throw UsageError(option + ": expected a number or nan, got " + inQuotes(text));
-  }
-  if (!std::isfinite(value) || errno == ERANGE || std::fabs(value) > std::numeric_limits<float>::max()) {
+  double value = 0.0;
+  if (!detail::decimalNumber(text, value) || std::fabs(value) > std::numeric_limits<float>::max())
     throw UsageError(option +
-                     ": the nodata value must be nan or a finite number within float32's range, got " +
-                     inQuotes(text));
-  }
+                     ": expected nan or a decimal number within float32's range (about 3.4e38), got " +
+                     inQuotes(shortened(text)));
   return static_cast<float>(value);
 }
 

@@ -6,24 +6,14 @@
 #include <iomanip>
 #include <sstream>
 
+#include "core/number_text.hpp"
 #include "pipeline.hpp"
 
 namespace hfvis::cli {
 namespace {
 
 // Shortest text that reads back as the same double (JSON and CSV readers parse doubles).
-std::string number(double value) {
-  if (!std::isfinite(value)) return "null";
-  std::ostringstream out;
-  out << std::setprecision(17) << value;
-  const std::string exact = out.str();
-  for (int digits = 6; digits < 17; ++digits) {
-    std::ostringstream shorter;
-    shorter << std::setprecision(digits) << value;
-    if (std::stod(shorter.str()) == value) return shorter.str();
-  }
-  return exact;
-}
+std::string number(double value) { return std::isfinite(value) ? detail::exactNumber(value) : "null"; }
 
 // The same for a float (the input heights): the shortest text that reads back as that float.
 std::string number(float value) {

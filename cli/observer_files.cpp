@@ -11,8 +11,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/number_text.hpp"
 #include "hfvis/errors.hpp"
-#include "core/message_numbers.hpp"
 #include "io/output_files.hpp"
 
 namespace hfvis::cli {
@@ -70,11 +70,7 @@ std::vector<CsvPoint> parsePoints(const std::string& path, std::istream& in, dou
     auto number_in = [](const std::string& text, double& value) {
       const std::size_t a = text.find_first_not_of(" \t"), b = text.find_last_not_of(" \t");
       if (a == std::string::npos) return false;
-      const std::string t = text.substr(a, b - a + 1);
-      char* end = nullptr;
-      value = std::strtod(t.c_str(), &end);  // (decimal only: strtod also reads "0x1")
-      return end == t.c_str() + t.size() && std::isfinite(value) &&
-             t.find_first_of("xX") == std::string::npos;
+      return detail::decimalNumber(text.substr(a, b - a + 1), value);
     };
     if (number == 1 && (line.rfind("\xFF\xFE", 0) == 0 || line.rfind("\xFE\xFF", 0) == 0))
       throw IoError(path, "is UTF-16 text; save it as UTF-8 (or ASCII) with lines col,row[,height]");

@@ -84,6 +84,8 @@ printf '5,3\n' > nodata_source.csv  # nan.exr's NaN
 # An earlier result, write-protected by its owner (mode 0444).
 cp field.tif protected.tif
 chmod 444 protected.tif
+ln -s loop_b.exr loop_a.exr
+ln -s loop_a.exr loop_b.exr
 sum_before=$(cat field.exr field.tif protected.tif | md5sum)
 
 echo "| case | command | status | error (first line) | input intact, nothing written |"
@@ -124,6 +126,7 @@ try "GeoTIFF output is the input by another path" "" -- horizon field.tif -o out
 try "output format unknown" "" -- svf field.exr -o out/o.xyz
 try "output an 8-bit image" "" -- horizon field.exr -o out/o.png -k 4
 try "output write-protected" "" -- svf field.exr -o protected.tif -k 4
+try "output a loop of symbolic links" "" -- svf field.exr -o loop_a.exr -k 4
 try "input is a device" "" -- svf /dev/zero -o out/o.exr -k 4
 try "input is a FIFO" "" -- svf pipe.exr -o out/o.exr -k 4
 try "preview not a PNG" "" -- svf field.exr -o out/o.exr --preview out/p.jpg
@@ -178,6 +181,7 @@ try "maximum distance too short for the field" "" -- svf field.exr -o out/o.exr 
 try "nodata not a number" "" -- svf field.exr -o out/o.tif --nodata none
 try "nodata infinite" "" -- svf field.exr -o out/o.tif --nodata inf
 try "nodata beyond float32" "" -- svf field.exr -o out/o.tif --nodata 1e39
+try "nodata in hexadecimal" "" -- svf field.exr -o out/o.tif --nodata 0x10
 try "nodata without a GeoTIFF output" "" -- svf field.exr -o out/o.exr --nodata -9999
 try "nodata for the horizon lists (text)" "" -- horizons field.exr --at 3,3 -o out/h.json --nodata 0
 try "nodata a value the output holds" "" -- viewshed field.tif -o out/o.tif --observer 3,3 --nodata 0

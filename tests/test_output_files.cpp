@@ -201,6 +201,20 @@ TEST_F(OutputFilesTest, ASymbolicLinkIsWrittenThrough) {
   EXPECT_EQ(readHeightField(path("data/new.exr")).heights, image.planes[0]);
 }
 
+// A loop of links leads to no file: refused, naming the loop, and nothing is written.
+TEST_F(OutputFilesTest, ALoopOfSymbolicLinksIsRefused) {
+  fs::create_symlink("b.exr", dir_ / "a.exr");
+  fs::create_symlink("a.exr", dir_ / "b.exr");
+  try {
+    writeImage(path("a.exr"), noiseImage());
+    FAIL() << "a loop of links was written";
+  } catch (const IoError& error) {
+    EXPECT_NE(std::string(error.what()).find("loop"), std::string::npos) << error.what();
+  }
+  EXPECT_EQ(filesInDir(), (std::vector<std::string>{"a.exr", "b.exr"}));
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(dir_ / "a.exr")));
+}
+
 // Outputs appear together or not at all: a later output that cannot be written leaves the earlier
 // ones' previous files as they were (and removes every temporary file).
 TEST_F(OutputFilesTest, AFailedOutputLeavesEveryPreviousFile) {

@@ -226,8 +226,8 @@ const CommandSpec kPvsCommand{
     "reached: --samples N, --pixel-error E (the paper's estimate, in differing rays per\n"
     "million-ray camera), --seconds S. The same seed and --samples give the same sets.\n"
     "--view-mask MASK (a raster of the field's size): only the view cells holding a non-zero\n"
-    "pixel (its first channel) are computed. --filter K: Sec. 5's object-space filter, K times the "
-    "sampling's gap.\n"
+    "pixel (its first channel) are computed. --filter K: Sec. 5's object-space filter, K\n"
+    "times the sampling's gap.\n"
     "Writes JSON: the grids, samples, estimated pixel error, the mixture per batch and, per view\n"
     "cell, its visible tiles' row-major indices. --bitset OUT.bin: the sets as bits, laid out\n"
     "in docs/PVS.md. The preview shows the PVS size per view cell over a hillshade.\n",

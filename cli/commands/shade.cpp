@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 
+#include "core/number_text.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/sun.hpp"
 #include "light_parts.hpp"
@@ -15,10 +16,8 @@ namespace {
 // --albedo: a number in [0, 1], or an image of the field's size (one channel, or R, G, B), as
 // planes (one value for a number).
 std::vector<std::vector<float>> readAlbedo(const RunArguments& run, const HeightField& field) {
-  const char* begin = run.albedo.c_str();
-  char* end = nullptr;
-  const double number = std::strtod(begin, &end);
-  if (end == begin + run.albedo.size()) {
+  double number = 0.0;
+  if (detail::decimalNumber(run.albedo, number)) {
     if (!(number >= 0.0 && number <= 1.0))
       throw UsageError("--albedo: a number must be in 0 .. 1, got '" + run.albedo + "'");
     return {std::vector<float>(field.pixelCount(), static_cast<float>(number))};

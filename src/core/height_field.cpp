@@ -5,8 +5,8 @@
 #include <cstdio>
 #include <string>
 
+#include "core/number_text.hpp"
 #include "hfvis/errors.hpp"
-#include "core/message_numbers.hpp"
 
 namespace hfvis {
 using detail::shortNumber;

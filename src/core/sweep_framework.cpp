@@ -13,7 +13,13 @@ namespace hfvis::detail {
 std::string mebibytes(std::size_t bytes) {
   std::ostringstream s;
   s.precision(1);
-  s << std::fixed << bytes / (1024.0 * 1024.0) << " MiB";
+  // (a budget under a tenth of a MiB in KiB or bytes: "0.0 MiB" would say nothing)
+  if (bytes >= 1024 * 1024 / 10)
+    s << std::fixed << bytes / (1024.0 * 1024.0) << " MiB";
+  else if (bytes >= 1024)
+    s << std::fixed << bytes / 1024.0 << " KiB";
+  else
+    s << bytes << " bytes";
   return s.str();
 }
 

@@ -37,6 +37,7 @@ std::size_t memoryBudget(std::size_t budget_bytes, const DeviceInfo& device);
 // Half the host's physical memory (or of its cgroup's limit, where lower); 0 when unknown.
 std::size_t hostMemoryBudget();
 
+// A byte count as messages show it: MiB with one decimal, KiB or bytes below a tenth of a MiB.
 std::string mebibytes(std::size_t bytes);
 
 // A read-write buffer of at least `bytes` (never zero-sized, so it can always be bound).

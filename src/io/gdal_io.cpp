@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-#include "core/message_numbers.hpp"
+#include "core/number_text.hpp"
 #include "hfvis/errors.hpp"
 #include "io/output_files.hpp"
 
@@ -233,12 +233,11 @@ std::optional<std::pair<double, double>> storedCellSize(const std::string& path,
                                                         const char* y) {
   if ((!x || !*x) && (!y || !*y)) return std::nullopt;
   auto number = [&](const char* name, const char* text) {
-    char* end = nullptr;
-    const double v = text ? std::strtod(text, &end) : 0.0;
-    if (!text || !*text || *end != '\0' || !std::isfinite(v) || !(v > 0.0) || v > 1e9)
+    double v = 0.0;
+    if (!text || !decimalNumber(text, v) || !(v > 0.0) || v > 1e9)
       throw IoError(path, std::string("the attribute ") + name + " is '" +
                               (text ? std::string(text).substr(0, 40) : "") +
-                              "', not a cell size (a positive number); give --cell-size");
+                              "', not a cell size (a number above 0, at most 1e9); give --cell-size");
     return v;
   };
   return std::make_pair(number("hfvis:cell_size_x", x), number("hfvis:cell_size_y", y));

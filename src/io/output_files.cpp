@@ -81,7 +81,7 @@ const char* kindOf(mode_t mode) {
   if (S_ISBLK(mode)) return "a block device";
   if (S_ISFIFO(mode)) return "a FIFO (named pipe)";
   if (S_ISSOCK(mode)) return "a socket";
-  return "not a regular file";
+  return "a special file";
 }
 
 std::string octalMode(mode_t mode) {
@@ -168,6 +168,10 @@ void requireReplaceableTarget(const std::string& path, const std::string& target
     throw IoError(path, "cannot write here: the directory '" + directory + "' does not exist");
   if (::lstat(target.c_str(), &status) == 0) {
     if (S_ISDIR(status.st_mode)) throw IoError(path, "cannot write here: it is a directory");
+    // (resolvedTarget follows 40 links: a link still after them is a loop, or a chain too long)
+    if (S_ISLNK(status.st_mode))
+      throw IoError(
+          path, "cannot write here: its symbolic links lead round in a loop (or through more than 40 links)");
     if (!S_ISREG(status.st_mode))
       throw IoError(
           path, std::string("cannot write here: it is ") + kindOf(status.st_mode) + ", not a regular file");

@@ -6,12 +6,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <iomanip>
 #include <limits>
-#include <sstream>
 #include <string>
 
 #include "core/horizon_common.hpp"
+#include "core/number_text.hpp"
 #include "core/opencl_context.hpp"
 #include "core/sweep_framework.hpp"
 #include "core/sweep_geometry.hpp"
@@ -767,18 +766,8 @@ void validateSampling(const HeightField& field, const RegionSampling& sampling,
     if (!prepared) own = detail::prepareHeights(field, detail::HeightOrigin::Zero).heights;
     const std::vector<float>& heights = prepared ? *prepared : own;
     for (const RegionPoint& p : sampling.points) {
-      // (the fewest digits that read back as the same double: a point just outside must not
-      // print as one inside)
-      const auto digits = [](double v) {
-        std::ostringstream out;
-        for (int precision = 6; precision <= 17; ++precision) {
-          out.str("");
-          out << std::setprecision(precision) << v;
-          if (std::stod(out.str()) == v) break;
-        }
-        return out.str();
-      };
-      const std::string at = digits(p.col) + "," + digits(p.row);
+      // (a point just outside must not print as one inside)
+      const std::string at = detail::exactNumber(p.col) + "," + detail::exactNumber(p.row);
       if (!(p.col >= 0.0 && p.col <= field.width - 1.0 && p.row >= 0.0 && p.row <= field.height - 1.0))
         throw InvalidArgument("region point " + at + " is outside the " + std::to_string(field.width) +
                               " x " + std::to_string(field.height) + " field");
