@@ -163,6 +163,14 @@ TEST_P(RegionMethods, PairMatchesTheReference) {
   }
 }
 
+// The lowest and highest finite heights of a field.
+std::pair<double, double> finiteHeightRange(const HeightField& field) {
+  double bottom = 1e30, top = -1e30;
+  for (float v : field.heights)
+    if (std::isfinite(v)) top = std::max(top, double(v)), bottom = std::min(bottom, double(v));
+  return {bottom, top};
+}
+
 // The culled march leaps over blocks of up to 2^k cells: on fields large enough for several levels,
 // and sight lines long enough to leap, its bits are the exact march's, bit for bit (both run on
 // the device: no rounding of the reference's division to excuse), in both layouts. Area lights
@@ -177,9 +185,8 @@ TEST(RegionVisibility, TheCulledMarchIsTheExactOne) {
     SCOPED_TRACE(name);
     HeightField field = makeSyntheticField(name, 101, 77, 5);
     field.cell_size_y = 1.25;
-    double top = -1e30, bottom = 1e30;
-    for (float v : field.heights)
-      if (std::isfinite(v)) top = std::max(top, double(v)), bottom = std::min(bottom, double(v));
+    const std::pair<double, double> range = finiteHeightRange(field);
+    const double bottom = range.first, top = range.second;
     forEachLayout([&](const ComputeContext& context) {
       RegionVisibilityOptions exact, culled;
       exact.method = RegionVisibilityMethod::Exact;
@@ -486,9 +493,8 @@ TEST(RegionVisibility, TheBitmaskScatterIsTheExactOne) {
     SCOPED_TRACE(name);
     HeightField field = makeSyntheticField(name, 61, 47, 5);
     field.cell_size_y = 1.25;
-    double top = -1e30, bottom = 1e30;
-    for (float v : field.heights)
-      if (std::isfinite(v)) top = std::max(top, double(v)), bottom = std::min(bottom, double(v));
+    const std::pair<double, double> range = finiteHeightRange(field);
+    const double bottom = range.first, top = range.second;
     forEachLayout([&](const ComputeContext& context) {
       RegionVisibilityOptions exact, bitmask;
       exact.method = RegionVisibilityMethod::Exact;
