@@ -6,9 +6,13 @@
 # bench/report/pvs_recall_tables.md): at --size with the dense reference, then at --estimate-size
 # with the grid (view cells of 32 x 32 cells, tiles of 16 x 16; the DEM at 320 x 320,
 # within its 403 x 344) without it (the dense reference is out of reach there), for the estimate.
+# The part `limits` (not run by default; about 7 minutes) runs past the recall part's budgets, into
+# bench/report/pvs_limits_tables.md: AGVS up to 30M samples at 128^2 with the dense reference, SGVS
+# and per-cell sampling at 3, 9 and 30M on the rough terrain, and AGVS's estimate at the end of ten
+# 1M-sample runs (seeds 1 .. 10) on the DEM at 320^2, where few missing entries are left to count.
 # Each file starts with a line saying how and when it ran.
 #
-#   bench/pvs.sh [--parts rays,recall] [--size 128] [--estimate-size 1024]
+#   bench/pvs.sh [--parts rays,recall,limits] [--size 128] [--estimate-size 1024]
 #                [--samples 10000,30000,100000,300000,1000000] [--rays 1000000]
 #   BUILD_DIR=... selects the build (default build/).
 set -euo pipefail
@@ -25,7 +29,7 @@ while [[ $# -gt 0 ]]; do
     --estimate-size) estimate_size=$2; shift ;;
     --samples) samples=$2; shift ;;
     --rays) rays=$2; shift ;;
-    -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
     *) echo "pvs.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
   shift
@@ -64,10 +68,24 @@ recall_part() {
   echo "## The pixel error against samples (the DEM at 320 x 320, within its 403 x 344; no dense reference)"
   "$bench" pvs-recall --check-rays 4000000 --size 320 --view-cell 32 --tile 16 --samples "$samples" --reference no --dem "$dem" dem
 }
+limits_part() {
+  echo "## Recall past 1M samples ($size x $size fields, view cells 16 x 16, tiles 8 x 8)"
+  "$bench" pvs-recall --check-rays 1000000 --size "$size" --view-cell 16 --tile 8 \
+    --samples 1000000,3000000,10000000,30000000 --methods agvs --dem "$dem" city noise dem
+  echo
+  echo "## SGVS and per-cell sampling at 1x, 3x and 10x the samples AGVS took to 0.99 on the rough terrain"
+  "$bench" pvs-recall --check-rays 1000000 --size "$size" --view-cell 16 --tile 8 \
+    --samples 3000000,9000000,30000000 --methods sgvs,per-cell --dem "$dem" noise
+  echo
+  echo "## AGVS's estimate at the end of ten 1M-sample runs (the DEM at 320 x 320, seeds 1 .. 10)"
+  "$bench" pvs-recall --check-rays 4000000 --size 320 --view-cell 32 --tile 16 --samples 1000000 \
+    --reference no --methods agvs --seeds 1,2,3,4,5,6,7,8,9,10 --dem "$dem" dem
+}
 for part in ${parts//,/ }; do
   case "$part" in
     rays) write "$root/bench/report/pvs_tables.md" rays_part ;;
     recall) write "$root/bench/report/pvs_recall_tables.md" recall_part ;;
-    *) echo "pvs.sh: unknown part '$part' (rays, recall)" >&2; exit 2 ;;
+    limits) write "$root/bench/report/pvs_limits_tables.md" limits_part ;;
+    *) echo "pvs.sh: unknown part '$part' (rays, recall, limits)" >&2; exit 2 ;;
   esac
 done

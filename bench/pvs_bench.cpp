@@ -175,7 +175,8 @@ void pvsScalarReport(const std::vector<std::string>& fields, int size, const std
 void pvsRecallReport(const ComputeContext& context, const std::vector<std::string>& fields, int size,
                      const std::string& dem_path, int view_cell, int tile,
                      const std::vector<std::uint64_t>& samples, int check_rays,
-                     const std::vector<PvsMethod>& methods, bool reference) {
+                     const std::vector<PvsMethod>& methods, bool reference,
+                     const std::vector<std::uint32_t>& seeds) {
   PvsGrid grid;
   grid.view_cell = view_cell;
   grid.tile = tile;
@@ -202,22 +203,26 @@ void pvsRecallReport(const ComputeContext& context, const std::vector<std::strin
         "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
     PvsResult last_agvs;
     for (PvsMethod method : methods) {
-      for (std::uint64_t n : samples) {
-        PvsOptions options;
-        options.method = method;
-        options.samples = n;
-        const PvsResult pvs = computePvs(context, f, grid, options);
-        const std::string recall = reference ? std::to_string(pvsRecall(pvs, dense)).substr(0, 6) : "-";
-        const double measured = measuredPixelError(f, pvs, check, check_hits, options.resolution);
-        std::printf("| %s | %llu | %llu | %s | %.1f | %.0f / %llu | %.1f | %.0f | %.2f |\n",
-                    methodName(method), static_cast<unsigned long long>(n),
-                    static_cast<unsigned long long>(pvs.rays), recall.c_str(), pvs.pixel_error,
-                    pvs.pixel_error * double(pvs.uniform_rays) / options.resolution,
-                    static_cast<unsigned long long>(pvs.uniform_rays), measured,
-                    measured * double(check.size()) / options.resolution, pvs.seconds);
-        std::fflush(stdout);
-        if (method == PvsMethod::Agvs) last_agvs = pvs;
-      }
+      for (std::uint64_t n : samples)
+        for (std::uint32_t seed : seeds) {
+          PvsOptions options;
+          options.method = method;
+          options.samples = n;
+          options.seed = seed;
+          const PvsResult pvs = computePvs(context, f, grid, options);
+          const std::string recall = reference ? std::to_string(pvsRecall(pvs, dense)).substr(0, 6) : "-";
+          const double measured = measuredPixelError(f, pvs, check, check_hits, options.resolution);
+          const std::string sampler = std::string(methodName(method)) +
+                                      (seeds.size() > 1 ? " (seed " + std::to_string(seed) + ")" : "");
+          std::printf("| %s | %llu | %llu | %s | %.1f | %.0f / %llu | %.1f | %.0f | %.2f |\n",
+                      sampler.c_str(), static_cast<unsigned long long>(n),
+                      static_cast<unsigned long long>(pvs.rays), recall.c_str(), pvs.pixel_error,
+                      pvs.pixel_error * double(pvs.uniform_rays) / options.resolution,
+                      static_cast<unsigned long long>(pvs.uniform_rays), measured,
+                      measured * double(check.size()) / options.resolution, pvs.seconds);
+          std::fflush(stdout);
+          if (method == PvsMethod::Agvs) last_agvs = pvs;
+        }
     }
     if (last_agvs.history.empty()) continue;
     std::printf("\nAGVS's mixture over its %llu-sample run (per batch of 65536 samples):\n\n| samples |",

@@ -33,12 +33,14 @@ void pvsScalarReport(const std::vector<std::string>& fields, int size, const std
                      int reps);
 
 // Markdown on stdout: per field, the dense reference's size and time, then for each sampler and
-// budget in `samples` the recall, the estimated and measured pixel error (`check_rays` random
-// view rays), entries and seconds; and AGVS's mixture over its last run. Only the samplers in
-// `methods`; without `reference` no dense reference and no recall (fields too large for it).
+// budget in `samples` (and seed in `seeds`: the sampler's name gives it where there are several) the recall,
+// the estimated and measured pixel error (`check_rays` random view rays), entries and seconds; and AGVS's
+// mixture over its last run. Only the samplers in `methods`; without `reference` no dense reference and no
+// recall (fields too large for it).
 void pvsRecallReport(const ComputeContext& context, const std::vector<std::string>& fields, int size,
                      const std::string& dem_path, int view_cell, int tile,
                      const std::vector<std::uint64_t>& samples, int check_rays,
-                     const std::vector<PvsMethod>& methods, bool reference);
+                     const std::vector<PvsMethod>& methods, bool reference,
+                     const std::vector<std::uint32_t>& seeds = {1});
 
 }  // namespace hfvis::bench
