@@ -822,7 +822,13 @@ const std::vector<OptionSpec>& optionTable() {
        "budget of samples, the same sets",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
          run.seed = parseSeed(typed, value);
+         run.seed_given = true;
        }},
+      {"--resume", nullptr, "PREV.bin", kPvsGroup, false,
+       "start from the sets of an earlier run's --bitset file (the same field\n"
+       "and grid; its view mask unless --view-mask is given) and go on\n"
+       "sampling; needs a --seed the earlier runs did not use",
+       HFVIS_TEXT(pvs_resume)},
       {"--bitset", nullptr, "OUT.bin", kPvsGroup, false,
        "also the sets as one bitset per view cell (docs/PVS.md, byte by byte)", HFVIS_TEXT(bitset_output)},
   };

@@ -132,9 +132,10 @@ struct RunArguments {
   bool decorrelate = false;
   // pvs (hfvis/pvs.hpp): the view cells (--view-cell C, --view-height H0[,H1], --view-mask FILE)
   // and tiles (--tile T); the sampler (--method agvs|sgvs|per-cell) and its budgets (--samples N,
-  // --pixel-error E, --seconds S), --filter K, --bitset OUT.bin. (--seed sets `seed` above.)
+  // --pixel-error E, --seconds S), --filter K, --bitset OUT.bin, --resume PREV.bin (an earlier
+  // --bitset file to start from). (--seed sets `seed` above.)
   PvsGrid pvs_grid;
-  std::string pvs_mask;
+  std::string pvs_mask, pvs_resume;
   PvsOptions pvs;
   std::string bitset_output;
 };

@@ -2944,6 +2944,72 @@ TEST_F(Cli, PvsWritesTheLibrarysSetsAsJsonAndBits) {
   EXPECT_EQ(ajson.substr(ajson.find("\"pvs\": [")), mjson.substr(msets));
 }
 
+// --resume: a run goes on from an earlier run's --bitset file: the library's run from those sets
+// with the new seed, its own samples, the file and its entries in resumed_from; refused without a
+// --seed, on another grid, for a file that is not a bitset, and as an output.
+TEST_F(Cli, PvsResumesFromAnEarlierBitset) {
+  const std::string field = writeField("hills.exr", 30, 22, [](int col, int row) {
+    return 4.0f * std::sin(0.4f * col) * std::cos(0.3f * row) + (col == 15 ? 12.0f : 0.0f);
+  });
+  const std::string grid = " --view-cell 8 --tile 4 --method sgvs --quiet";
+  ASSERT_EQ(run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out("a.json")) +
+                " --samples 300 --bitset " + shellQuoted(out("a.bin")) + grid)
+                .status,
+            0);
+  const CliResult resumed = run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out("b.json")) +
+                                " --samples 400 --seed 7 --bitset " + shellQuoted(out("b.bin")) +
+                                " --resume " + shellQuoted(out("a.bin")) + grid);
+  ASSERT_EQ(resumed.status, 0) << resumed.err;
+  hfvis::PvsGrid g;
+  g.view_cell = 8;
+  g.tile = 4;
+  hfvis::PvsOptions options;
+  options.method = hfvis::PvsMethod::Sgvs;
+  options.samples = 300;
+  const hfvis::HeightField f = hfvis::readHeightField(field);
+  const hfvis::PvsResult first = hfvis::computePvs(hfvis::testing::testContext(), f, g, options);
+  options.samples = 400;
+  options.seed = 7;
+  options.start = first.bits;
+  const hfvis::PvsResult want = hfvis::computePvs(hfvis::testing::testContext(), f, g, options);
+  ASSERT_GT(want.entries(), first.entries());
+  const std::string bits = readText(out("b.bin"));
+  const std::size_t words_at = 40 + (want.layout.viewCells() + 3) / 4 * 4;
+  ASSERT_EQ(bits.size(), words_at + 4 * want.bits.size());
+  for (std::size_t i = 0; i < want.bits.size(); ++i) {
+    std::uint32_t v = 0;
+    for (int k = 0; k < 4; ++k)
+      v |= std::uint32_t(static_cast<unsigned char>(bits[words_at + 4 * i + k])) << (8 * k);
+    EXPECT_EQ(v, want.bits[i]) << i;
+  }
+  const std::string json = readText(out("b.json"));
+  EXPECT_NE(json.find("\"samples\": 400,"), std::string::npos);
+  EXPECT_NE(json.find("\"resumed_from\": {\"file\": \"" + out("a.bin") +
+                      "\", \"entries\": " + std::to_string(first.entries()) + "}"),
+            std::string::npos)
+      << json.substr(0, 400);
+  EXPECT_NE(readText(out("a.json")).find("\"resumed_from\": null"), std::string::npos);
+  // Refused, nothing written.
+  const auto refused = [&](const std::string& args, const std::string& says) {
+    const CliResult r = run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out("c.json")) +
+                            " --samples 100" + args + " --quiet");
+    EXPECT_EQ(r.status, 2) << args;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out("c.json"))) << args;
+  };
+  refused(" --view-cell 8 --tile 4 --resume " + shellQuoted(out("a.bin")), "--resume needs --seed");
+  refused(" --view-cell 8 --tile 2 --seed 3 --resume " + shellQuoted(out("a.bin")),
+          "give the same field, --view-cell and --tile");
+  refused(" --view-cell 8 --tile 4 --seed 3 --bitset " + shellQuoted(out("a.bin")) + " --resume " +
+              shellQuoted(out("a.bin")),
+          "outputs never replace an input");
+  const CliResult not_bits = run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out("c.json")) +
+                                 " --samples 100 --seed 3 --resume " + shellQuoted(out("a.json")) + grid);
+  EXPECT_EQ(not_bits.status, 1);
+  EXPECT_NE(not_bits.err.find("not a PVS bitset file"), std::string::npos) << not_bits.err;
+  EXPECT_FALSE(fs::exists(out("c.json")));
+}
+
 TEST_F(Cli, RegionVisibilityRefusesBadInput) {
   const std::string field = flat();  // 16 x 12
   const std::string light = "arealight " + shellQuoted(field) + " -o " + shellQuoted(out("a.exr"));

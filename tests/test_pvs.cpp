@@ -501,7 +501,8 @@ TEST(Pvs, SamplersAgreeAtConvergenceOnASmallField) {
     options.method = method;
     options.samples = samples;
     runs.push_back(computePvs(testContext(), field, grid, options));
-    EXPECT_GE(pvsRecall(runs.back(), dense), 0.94) << int(method);
+    // (0.92 - 0.97 over seeds 1 - 6 for each sampler: a few of the 73 entries are grazing ones)
+    EXPECT_GE(pvsRecall(runs.back(), dense), 0.9) << int(method);
   }
   for (std::size_t a = 0; a < runs.size(); ++a)
     for (std::size_t b = a + 1; b < runs.size(); ++b) {
@@ -667,6 +668,93 @@ TEST(Pvs, BadInput) {
   EXPECT_THROW(run(smallGrid()), InvalidArgument);
   EXPECT_THROW(castHeightFieldRays(testContext(), field, {HeightRay{NAN, 0, 0, 1, 0, 0, 1}}),
                InvalidArgument);
+}
+
+// Neighbouring seeds draw independent samples: two runs of N samples with seeds 1 and 2 find together
+// about what one run of 2N finds. (A stream that started at the seed times the generator's step was
+// its neighbour's shifted by one number: the two runs found together little more than either.)
+TEST(Pvs, NeighbouringSeedsSampleIndependently) {
+  const HeightField field = makeSyntheticField("noise", 97, 97, 7);
+  PvsGrid grid;
+  grid.view_cell = 16;
+  grid.tile = 8;
+  for (PvsMethod method : {PvsMethod::Agvs, PvsMethod::Sgvs, PvsMethod::PerCell}) {
+    SCOPED_TRACE(int(method));
+    PvsOptions options;
+    options.method = method;
+    options.samples = 20000;
+    const PvsResult one = computePvs(testContext(), field, grid, options);
+    options.seed = 2;
+    const PvsResult two = computePvs(testContext(), field, grid, options);
+    options.seed = 1;
+    options.samples = 40000;
+    const PvsResult both = computePvs(testContext(), field, grid, options);
+    std::size_t together = 0;
+    for (std::size_t i = 0; i < one.bits.size(); ++i)
+      together += std::size_t(__builtin_popcount(one.bits[i] | two.bits[i]));
+    EXPECT_GT(double(together), 0.9 * double(both.entries()))
+        << one.entries() << " and " << two.entries() << " entries, " << together << " together, "
+        << both.entries() << " in one run of both budgets";
+  }
+}
+
+// A run resumed from an earlier one's sets with another seed keeps every entry (in the snapshots
+// after each batch too), goes on finding, and its estimate holds against the measured error; sets
+// of another grid, with bits past the last tile, or with entries in view cells the run does not
+// compute are refused.
+TEST(Pvs, AResumedRunGoesOnFromTheEarlierSets) {
+  const HeightField field = makeSyntheticField("noise", 97, 97, 7);
+  PvsGrid grid;
+  grid.view_cell = 16;
+  grid.tile = 8;
+  const std::vector<HeightRay> check = randomViewRays(field, grid, 2000000, 99);
+  const RayCastResult hits = castHeightFieldRays(testContext(), field, check);
+  PvsResult first;
+  PvsOptions options;
+  for (PvsMethod method : {PvsMethod::Agvs, PvsMethod::Sgvs, PvsMethod::PerCell}) {
+    SCOPED_TRACE(int(method));
+    options = PvsOptions{};
+    options.method = method;
+    options.samples = 5000;
+    options.batch = 5000;
+    first = computePvs(testContext(), field, grid, options);
+    options.start = first.bits;
+    options.seed = 2;
+    options.samples = 15000;
+    std::size_t snapshots = 0;
+    options.progress = [&](const PvsResult& sofar) {
+      ++snapshots;
+      for (std::size_t i = 0; i < first.bits.size(); ++i) ASSERT_EQ(first.bits[i] & ~sofar.bits[i], 0u) << i;
+    };
+    const PvsResult resumed = computePvs(testContext(), field, grid, options);
+    EXPECT_EQ(snapshots, 3u);
+    for (std::size_t i = 0; i < first.bits.size(); ++i) ASSERT_EQ(first.bits[i] & ~resumed.bits[i], 0u) << i;
+    EXPECT_EQ(resumed.samples, 15000u);
+    // It goes on finding entries, and its estimate (this run's uniform rays against the sets as a
+    // whole) holds against the error measured with random view rays (4 - 10 entries found once
+    // for AGVS here, tens for the others: at fewer the count's own noise exceeds 2x).
+    EXPECT_GT(double(resumed.entries()), 1.3 * double(first.entries()));
+    const double measured = measuredPixelError(field, resumed, check, hits, options.resolution);
+    ASSERT_GT(measured, 25.0);
+    EXPECT_GT(resumed.pixel_error, 0.5 * measured) << measured;
+    EXPECT_LT(resumed.pixel_error, 2.0 * measured) << measured;
+  }
+  // Refused: another grid's size, a bit past the last tile, an entry outside the view mask.
+  PvsOptions bad = options;
+  bad.progress = nullptr;
+  bad.start.pop_back();
+  EXPECT_THROW(computePvs(testContext(), field, grid, bad), InvalidArgument);
+  bad.start = first.bits;
+  const PvsLayout l = first.layout;
+  ASSERT_NE(l.tiles() % 32, 0);
+  bad.start[first.words - 1] |= 1u << 31;
+  EXPECT_THROW(computePvs(testContext(), field, grid, bad), InvalidArgument);
+  bad.start = first.bits;
+  PvsGrid masked = grid;
+  masked.mask.assign(l.viewCells(), 1);
+  masked.mask[0] = 0;
+  ASSERT_NE(first.bits[0], 0u);
+  EXPECT_THROW(computePvs(testContext(), field, masked, bad), InvalidArgument);
 }
 
 // A pixel-error budget on a field whose sets fill up: the run stops once every view cell holds

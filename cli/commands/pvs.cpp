@@ -3,14 +3,17 @@
 #include "hfvis/pvs.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <fstream>
 #include <sstream>
 
 #include "../image_outputs.hpp"
 #include "../pipeline.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/image_io.hpp"
+#include "io/output_files.hpp"
 
 namespace hfvis::cli {
 namespace {
@@ -39,6 +42,58 @@ std::string bitsetFile(const PvsResult& r) {
   return out;
 }
 
+// A --bitset file read back (--resume): its grid, computed view cells and sets.
+struct BitsetFile {
+  std::uint32_t view_x = 0, view_y = 0, tiles_x = 0, tiles_y = 0, words = 0, view_cell = 0, tile = 0;
+  std::vector<std::uint8_t> computed;
+  std::vector<std::uint32_t> bits;
+};
+
+BitsetFile readBitsetFile(const std::string& path) {
+  detail::requireInputFile(path);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError(path, std::string("cannot open: ") + std::strerror(errno));
+  const auto fail = [&](const std::string& why) -> IoError {
+    return IoError(path, "not a PVS bitset file of hfvis pvs --bitset (docs/PVS.md): " + why);
+  };
+  char head[40];
+  if (!in.read(head, sizeof(head))) throw fail("shorter than its 40-byte header");
+  if (std::memcmp(head, "HFVPVS1", 8) != 0) throw fail("it does not start with HFVPVS1");
+  const auto u32 = [&](int at) {
+    std::uint32_t v = 0;
+    for (int i = 3; i >= 0; --i) v = (v << 8) | static_cast<unsigned char>(head[at + i]);
+    return v;
+  };
+  if (u32(8) != 1) throw fail("format version " + std::to_string(u32(8)) + ", this hfvis reads version 1");
+  BitsetFile f;
+  f.view_x = u32(12), f.view_y = u32(16), f.tiles_x = u32(20), f.tiles_y = u32(24), f.words = u32(28);
+  f.view_cell = u32(32), f.tile = u32(36);
+  const std::uint64_t views = std::uint64_t(f.view_x) * f.view_y,
+                      tiles = std::uint64_t(f.tiles_x) * f.tiles_y;
+  if (views == 0 || tiles == 0 || views > (1u << 30) || tiles > (1u << 30) || f.words != (tiles + 31) / 32 ||
+      f.view_cell == 0 || f.tile == 0)
+    throw fail("its header's grid does not hold together");
+  const std::uint64_t padded = (views + 3) / 4 * 4, size = 40 + padded + 4 * views * f.words;
+  in.seekg(0, std::ios::end);
+  if (std::uint64_t(in.tellg()) != size)
+    throw fail("it is " + std::to_string(std::uint64_t(in.tellg())) + " bytes, its header asks " +
+               std::to_string(size));
+  in.seekg(40);
+  std::string body(size - 40, '\0');
+  if (!in.read(&body[0], std::streamsize(body.size()))) throw IoError(path, "cannot read it whole");
+  f.computed.assign(body.begin(), body.begin() + std::ptrdiff_t(views));
+  for (std::uint8_t& c : f.computed) {
+    if (c > 1) throw fail("a view cell's computed byte is neither 0 nor 1");
+  }
+  f.bits.resize(views * f.words);
+  for (std::size_t i = 0; i < f.bits.size(); ++i) {
+    const unsigned char* b = reinterpret_cast<const unsigned char*>(body.data()) + padded + 4 * i;
+    f.bits[i] = std::uint32_t(b[0]) | std::uint32_t(b[1]) << 8 | std::uint32_t(b[2]) << 16 |
+                std::uint32_t(b[3]) << 24;
+  }
+  return f;
+}
+
 class Pvs : public Computation {
  public:
   using Computation::Computation;
@@ -49,7 +104,7 @@ class Pvs : public Computation {
     if (!run_.preview.empty()) paths.push_back(run_.preview);
     return paths;
   }
-  std::vector<std::string> otherInputs() const override { return {run_.pvs_mask}; }
+  std::vector<std::string> otherInputs() const override { return {run_.pvs_mask, run_.pvs_resume}; }
   bool writesImages() const override { return false; }
   bool usesDevice() const override { return true; }
   std::string method() const override { return methodName(run_.pvs.method); }
@@ -77,12 +132,14 @@ class Pvs : public Computation {
         }
       layoutOf(field);
     }
+    if (!run_.pvs_resume.empty()) resumeFrom(layout);
   }
 
   void compute(Job& job) override {
     PvsOptions options = run_.pvs;
     options.seed = run_.seed;
     options.memory_budget_bytes = run_.memory_budget_bytes;
+    options.start = start_;
     result_ = computePvs(*job.context, job.input, grid_, options);
   }
 
@@ -98,6 +155,7 @@ class Pvs : public Computation {
          << "  \"input\": " << jsonString(run_.input) << ",\n"
          << "  \"method\": " << jsonString(job.method) << ",\n"
          << "  \"seed\": " << run_.seed << ",\n"
+         << "  \"resumed_from\": " << resumedFrom() << ",\n"
          << "  \"view_cells\": {\"size\": " << l.view_cell << ", \"across\": " << l.view_x
          << ", \"down\": " << l.view_y << ", \"band\": [" << jsonNumber(grid_.band_low) << ", "
          << jsonNumber(grid_.band_high) << "]},\n"
@@ -185,8 +243,41 @@ class Pvs : public Computation {
     }
   }
 
+  // --resume: the earlier run's sets, on this run's grid and view mask (the file's, unless
+  // --view-mask gives one, which must then be the same).
+  void resumeFrom(const PvsLayout& l) {
+    const std::string& path = run_.pvs_resume;
+    BitsetFile f = readBitsetFile(path);
+    if (int(f.view_cell) != l.view_cell || int(f.tile) != l.tile || int(f.view_x) != l.view_x ||
+        int(f.view_y) != l.view_y || int(f.tiles_x) != l.tiles_x || int(f.tiles_y) != l.tiles_y)
+      throw UsageError("--resume: " + path + " holds " + std::to_string(f.view_x) + " x " +
+                       std::to_string(f.view_y) + " view cells of " + std::to_string(f.view_cell) + " and " +
+                       std::to_string(f.tiles_x) + " x " + std::to_string(f.tiles_y) + " tiles of " +
+                       std::to_string(f.tile) + "; this run's grid is " + std::to_string(l.view_x) + " x " +
+                       std::to_string(l.view_y) + " view cells of " + std::to_string(l.view_cell) + " and " +
+                       std::to_string(l.tiles_x) + " x " + std::to_string(l.tiles_y) + " tiles of " +
+                       std::to_string(l.tile) + " (" + run_.input +
+                       "): give the same field, --view-cell and --tile");
+    if (run_.pvs_mask.empty()) {
+      if (std::count(f.computed.begin(), f.computed.end(), 0) > 0) grid_.mask = f.computed;
+    } else if (f.computed != grid_.mask) {
+      throw UsageError("--resume: " + path + " computed other view cells than --view-mask " + run_.pvs_mask +
+                       " selects; leave --view-mask out to take the file's");
+    }
+    start_ = std::move(f.bits);
+  }
+
+  // The JSON's resumed_from: the file and the entries it held, or null.
+  std::string resumedFrom() const {
+    if (run_.pvs_resume.empty()) return "null";
+    std::size_t entries = 0;
+    for (std::uint32_t w : start_) entries += static_cast<std::size_t>(__builtin_popcount(w));
+    return "{\"file\": " + jsonString(run_.pvs_resume) + ", \"entries\": " + std::to_string(entries) + "}";
+  }
+
   PvsGrid grid_;
   PvsResult result_;
+  std::vector<std::uint32_t> start_;
 };
 
 void checkPvs(const std::string& name, const RunArguments& run) {
@@ -198,6 +289,9 @@ void checkPvs(const std::string& name, const RunArguments& run) {
   if (!run.preview.empty() && !hasExtension(run.preview, ".png"))
     throw UsageError("--preview: the preview is a PNG; the name must end in .png, got " +
                      namedAs(run.preview));
+  if (!run.pvs_resume.empty() && !run.seed_given)
+    throw UsageError("--resume needs --seed: a seed the runs that made " + inQuotes(run.pvs_resume) +
+                     " did not use (the same seed casts their samples again)");
   if (run.pvs.samples == 0 && run.pvs.pixel_error == 0.0 && run.pvs.seconds == 0.0)
     throw UsageError("'hfvis " + name + "' needs a budget: --samples N, --pixel-error E or --seconds S");
   PvsOptions options = run.pvs;
@@ -213,7 +307,8 @@ const CommandSpec kPvsCommand{
     "potentially visible sets: the tiles each view cell can see, as JSON",
     "IN -o OUT.json (--samples N | --pixel-error E | --seconds S) [--view-cell C]\n"
     "[--view-height H0[,H1]] [--view-mask MASK] [--tile T] [--method agvs|sgvs|per-cell]\n"
-    "[--filter K] [--seed N] [--bitset OUT.bin] [--preview P.png] [options]",
+    "[--filter K] [--seed N] [--bitset OUT.bin] [--resume PREV.bin] [--preview P.png]\n"
+    "[options]",
     "Potentially visible sets (Bittner, Mattausch, Wonka, Havran & Wimmer 2009): for every view\n"
     "cell, a square of C x C cells (--view-cell, default 32; a cell is the square between four\n"
     "grid points) whose volume is the points H0 .. H1 above the surface (--view-height, default\n"
@@ -230,7 +325,11 @@ const CommandSpec kPvsCommand{
     "times the sampling's gap.\n"
     "Writes JSON: the grids, samples, estimated pixel error, the mixture per batch and, per view\n"
     "cell, its visible tiles' row-major indices. --bitset OUT.bin: the sets as bits, laid out\n"
-    "in docs/PVS.md. The preview shows the PVS size per view cell over a hillshade.\n",
+    "in docs/PVS.md. The preview shows the PVS size per view cell over a hillshade.\n"
+    "--resume PREV.bin --seed S: go on from an earlier run's --bitset file (same field and\n"
+    "grid) with a seed it did not use: runs of a few seconds each, resumed in turn, give the\n"
+    "sets written at every step. samples and the estimate are this run's; resumed_from\n"
+    "names the file and its entries.\n",
     nullptr,
     kOutputGroup | kInputGroup | kImageGroup | kDeviceGroup | kPvsGroup,
     checkPvs,

@@ -106,6 +106,8 @@ enum class PvsMethod {
   PerCell,  // per view cell random sampling (the paper's REF): rays from a view cell feed it alone
 };
 
+struct PvsResult;
+
 struct PvsOptions {
   PvsMethod method = PvsMethod::Agvs;
   // Budgets: the run stops at the first one reached (0 = none); at least one must be set.
@@ -122,8 +124,16 @@ struct PvsOptions {
   double filter = 0.0;
   bool witnesses = false;               // keep each entry's witness (PvsResult::witnesses)
   std::size_t memory_budget_bytes = 0;  // as RayCastOptions::memory_budget_bytes
-  // Called after each batch with the samples cast so far and the estimated pixel error.
-  std::function<void(std::uint64_t, double)> progress;
+  // The sets to start from (empty: none), to resume a run: an earlier run's PvsResult::bits on the
+  // same field and grid, whose view cells not computed now are empty (InvalidArgument otherwise).
+  // Its entries stay, and count as found by earlier samples, never as found once: the estimate is
+  // of this run's uniform rays against the sets as a whole. Give a seed the earlier runs did not
+  // use, or their samples are cast again.
+  std::vector<std::uint32_t> start;
+  // Called after each batch with the result so far (the sets, the samples and rays, the estimate,
+  // the history; the visibility filter comes only at the end): the sets can be used or saved at
+  // any point, and a later run resumed from them (`start`).
+  std::function<void(const PvsResult&)> progress;
 };
 
 // Why an entry is in a PVS: an eye in the view cell's volume and a surface point of the tile

@@ -50,13 +50,11 @@ Vec unit(Vec a) { return (1.0 / std::sqrt(dot(a, a))) * a; }
 // SplitMix64: small, fast, and the same sequence on every platform.
 class Random {
  public:
-  explicit Random(std::uint64_t seed) : state_(seed * 0x9e3779b97f4a7c15ULL + 0x632be59bd9b4e019ULL) {}
-  std::uint64_t next() {
-    std::uint64_t z = (state_ += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-  }
+  // The stream starts at the seed's hash: a start linear in the seed (seed times the step) made
+  // seed s + 1's stream seed s's shifted by one number, so runs with neighbouring seeds cast
+  // nearly the same samples.
+  explicit Random(std::uint64_t seed) : state_(mix(seed ^ 0x632be59bd9b4e019ULL)) {}
+  std::uint64_t next() { return mix(state_ += 0x9e3779b97f4a7c15ULL); }
   double uniform() { return double(next() >> 11) * 0x1p-53; }  // [0, 1)
   std::size_t below(std::size_t n) { return std::size_t(uniform() * double(n)) % n; }
   double gaussian() {  // Box-Muller, one of the pair
@@ -70,6 +68,12 @@ class Random {
   }
 
  private:
+  // SplitMix64's output function (Steele, Lea & Flood 2014).
+  static std::uint64_t mix(std::uint64_t z) {
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+  }
   std::uint64_t state_;
 };
 
@@ -133,6 +137,26 @@ class Sampler {
     out_.bits.assign(std::size_t(l.viewCells()) * out_.words, 0u);
     only_finder_ = out_.bits;
     out_.computed = grid.mask.empty() ? std::vector<std::uint8_t>(l.viewCells(), 1) : grid.mask;
+    if (!options.start.empty()) {
+      // (the entries to resume from: found by earlier samples, so never in only_finder_)
+      if (options.start.size() != out_.bits.size())
+        throw InvalidArgument("the sets to resume from hold " + std::to_string(options.start.size()) +
+                              " words, the grid's " + std::to_string(out_.bits.size()) + " (" +
+                              std::to_string(l.viewCells()) + " view cells of " + std::to_string(out_.words) +
+                              " words): another field or grid");
+      const std::uint32_t last = l.tiles() % 32 ? (1u << (l.tiles() % 32)) - 1u : ~0u;
+      for (int v = 0; v < l.viewCells(); ++v)
+        for (int w = 0; w < out_.words; ++w) {
+          const std::uint32_t word = options.start[std::size_t(v) * out_.words + w];
+          if (word && !out_.computed[v])
+            throw InvalidArgument("the sets to resume from hold entries of view cell " + std::to_string(v) +
+                                  ", which this run does not compute (another view mask)");
+          if (w == out_.words - 1 && (word & ~last))
+            throw InvalidArgument("the sets to resume from have bits past the last tile in view cell " +
+                                  std::to_string(v));
+        }
+      out_.bits = options.start;
+    }
     complete_ = std::size_t(std::count_if(out_.computed.begin(), out_.computed.end(),
                                           [](std::uint8_t c) { return c != 0; })) *
                 std::size_t(l.tiles());
@@ -183,7 +207,7 @@ class Sampler {
       row.pixel_error = out_.pixel_error;
       row.probability = probability_;
       out_.history.push_back(row);
-      if (options_.progress) options_.progress(out_.samples, out_.pixel_error);
+      if (options_.progress) options_.progress(out_);
       if (options_.pixel_error > 0.0 && out_.pixel_error <= options_.pixel_error) break;
       if (options_.pixel_error > 0.0 && out_.entries() == complete_) {
         // Every computed view cell holds every tile: no ray can differ, whatever the estimate's
