@@ -75,6 +75,8 @@ make_data.write_exr_builtin("nan.exr", nan, {})
 PY
 # A GeoTIFF of the field (no georeference: only its name matters here).
 "$hfvis" svf field.exr -o field.tif -k 1 -q
+# An earlier PVS run's sets (pvs --resume), on the default grid.
+"$hfvis" pvs field.exr -o prev_pvs.json --bitset prev_pvs.bin --samples 100 -q
 mkfifo pipe.exr
 printf '1,1\n2,2,-5\n' > negative_height.csv
 printf '1,1\n%s\n' "$(head -c 5000 /dev/zero | tr '\0' 'x')" > long_line.csv
@@ -86,7 +88,7 @@ cp field.tif protected.tif
 chmod 444 protected.tif
 ln -s loop_b.exr loop_a.exr
 ln -s loop_a.exr loop_b.exr
-sum_before=$(cat field.exr field.tif protected.tif | md5sum)
+sum_before=$(cat field.exr field.tif protected.tif prev_pvs.bin | md5sum)
 
 echo "| case | command | status | error (first line) | input intact, nothing written |"
 echo "| --- | --- | ---: | --- | --- |"
@@ -103,7 +105,7 @@ try() {
   message=$(head -1 stderr.txt | sed 's/^hfvis: error: //; s/|/\\|/g')
   [[ $status == 0 ]] && message="(none: it runs)"
   local clean=yes
-  [[ "$(cat field.exr field.tif protected.tif | md5sum)" == "$sum_before" ]] || clean="NO: input changed"
+  [[ "$(cat field.exr field.tif protected.tif prev_pvs.bin | md5sum)" == "$sum_before" ]] || clean="NO: input changed"
   if [[ $status != 0 && -n "$(ls -A out)" ]]; then clean="NO: wrote $(ls -A out | tr '\n' ' ')"; fi
   local shown="hfvis${*:+ $*}"
   [[ -n $env ]] && shown="$env $shown"
@@ -266,6 +268,10 @@ try "pvs pixel error beyond reach" "" -- pvs field.exr -o out/p.json --pixel-err
 try "pvs without a budget" "" -- pvs field.exr -o out/p.json
 try "pvs output not JSON" "" -- pvs field.exr -o out/p.exr --samples 10
 try "pvs bitset is the output" "" -- pvs field.exr -o out/p.json --samples 10 --bitset out/p.json
+try "pvs resume without a seed" "" -- pvs field.exr -o out/p.json --samples 10 --resume prev_pvs.bin
+try "pvs resume on another grid" "" -- pvs field.exr -o out/p.json --samples 10 --seed 2 --resume prev_pvs.bin --tile 8
+try "pvs resume from a file not a bitset" "" -- pvs field.exr -o out/p.json --samples 10 --seed 2 --resume prev_pvs.json
+try "pvs resume file as the output" "" -- pvs field.exr -o out/p.json --samples 10 --seed 2 --resume prev_pvs.bin --bitset prev_pvs.bin
 try "sun position without a time" "" -- sunpos --lat 45 --lon 7
 try "sun position at a time without a zone" "" -- sunpos --lat 45 --lon 7 --at 2026-06-21T12:00:00
 try "sun position at a day that does not exist" "" -- sunpos --lat 45 --lon 7 --at 2026-02-30T12:00:00Z
