@@ -225,6 +225,8 @@ def compute(operation, heights, geometry, options, device="", progress=None):
         _set(o, options, ("samples", "pixel_error", "seconds", "batch", "seed", "resolution", "filter", "witnesses",
                           "memory_budget_bytes"))
         o.method = _enum(_core.PvsMethod, str(options.get("method", "agvs")).replace("-", "_"), "method")
+        if options.get("start") is not None:
+            o.start = options["start"].tolist()
         return _core.pvs(field, grid, o, device=device, progress=progress)
     if operation == "horizon_lists":
         cols, rows = receiver_pixels(options["receivers"])

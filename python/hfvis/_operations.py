@@ -579,7 +579,7 @@ def region_pair_visibility(heights, sources, receivers, *, samples=16, source_he
 
 def pvs(heights, *, samples=0, pixel_error=0.0, seconds=0.0, view_cell=32, band_low=1.7, band_high=1.7, tile=16,
         mask=None, method="agvs", batch=1 << 16, seed=1, resolution=1e6, filter=0.0, witnesses=False,
-        memory_budget_bytes=0, cell_size=None, z_scale=1.0, nodata=None, device="", progress=None):
+        memory_budget_bytes=0, start=None, cell_size=None, z_scale=1.0, nodata=None, device="", progress=None):
     """Potentially visible sets (Bittner, Mattausch, Wonka, Havran & Wimmer 2009): the tiles of
     tile x tile cells each view cell of view_cell x view_cell cells (its volume band_low ..
     band_high above the surface) sees, by sampling; stops at the first budget reached (samples,
@@ -589,12 +589,14 @@ def pvs(heights, *, samples=0, pixel_error=0.0, seconds=0.0, view_cell=32, band_
     the visible tiles' row-major indices, None where not computed), bits (view cells x words
     uint32), computed, layout (a dict of the grid's sizes), the run's counts, history (per
     batch) and witnesses (with witnesses=True). DataArrays: the same (the sets are not on the
-    pixel grid); computed in one piece."""
+    pixel grid); computed in one piece. start: an earlier run's bits (its Pvs.bits) on the same
+    field and grid, to go on from; its entries stay (give another seed, or its samples repeat)."""
     options = {"samples": int(samples), "pixel_error": float(pixel_error), "seconds": float(seconds),
                "view_cell": int(view_cell), "band_low": float(band_low), "band_high": float(band_high),
                "tile": int(tile), "mask": None if mask is None else np.asarray(mask), "method": method,
                "batch": int(batch), "seed": int(seed), "resolution": float(resolution), "filter": float(filter),
-               "witnesses": bool(witnesses), "memory_budget_bytes": int(memory_budget_bytes)}
+               "witnesses": bool(witnesses), "memory_budget_bytes": int(memory_budget_bytes),
+               "start": None if start is None else np.ascontiguousarray(start, dtype=np.uint32).ravel()}
     if _is_dataarray(heights) and _is_dask(heights.data):
         heights = heights.compute()
     out, _ = _run("pvs", heights, options, _common(cell_size, z_scale, nodata, device, progress))

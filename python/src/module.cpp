@@ -238,7 +238,8 @@ void bindOptions(nb::module_& m) {
       .def_rw("resolution", &PvsOptions::resolution)
       .def_rw("filter", &PvsOptions::filter)
       .def_rw("witnesses", &PvsOptions::witnesses)
-      .def_rw("memory_budget_bytes", &PvsOptions::memory_budget_bytes);
+      .def_rw("memory_budget_bytes", &PvsOptions::memory_budget_bytes)
+      .def_rw("start", &PvsOptions::start);
 }
 
 nb::dict horizons(const HeightField& field, HorizonOptions options, bool angles, bool distances,
@@ -453,13 +454,13 @@ nb::dict regionPairVisibility(const HeightField& field, const RegionSampling& so
 
 // PVS progress: Ctrl-C and the user's callback, called as progress(samples, pixel_error); as
 // progressHook.
-std::function<void(std::uint64_t, double)> pvsProgressHook(nb::handle callback) {
+std::function<void(const PvsResult&)> pvsProgressHook(nb::handle callback) {
   PyObject* borrowed = callback.ptr();
-  return [borrowed](std::uint64_t samples, double pixel_error) {
+  return [borrowed](const PvsResult& sofar) {
     nb::gil_scoped_acquire acquired;
     if (PyErr_CheckSignals() != 0) throw nb::python_error();
     const nb::handle user(borrowed);
-    if (!user.is_none()) user(samples, pixel_error);
+    if (!user.is_none()) user(sofar.samples, sofar.pixel_error);
   };
 }
 

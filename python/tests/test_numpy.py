@@ -343,6 +343,13 @@ def test_pvs(tmp_path, projected_tif, dem):
     assert r.entries > 0 and calls and calls[-1] == r.samples
     words = np.frombuffer(bitset.read_bytes(), "<u4")
     np.testing.assert_array_equal(words[-r.bits.size:], r.bits.ravel())
+    # Resumed from those sets with another seed: every entry stays, more are found; another grid's
+    # bits are refused.
+    more = hfvis.pvs(dem, samples=10000, view_cell=48, tile=32, band_low=2, band_high=20, seed=6, cell_size=30,
+                     nodata=NODATA, start=r.bits)
+    assert np.all(r.bits & ~more.bits == 0) and more.entries > r.entries
+    with pytest.raises(hfvis.InvalidArgumentError, match="resume"):
+        hfvis.pvs(dem, samples=100, view_cell=64, tile=32, cell_size=30, nodata=NODATA, start=r.bits)
     # A mask per pixel, as the CLI's --view-mask: only the view cells it touches are computed.
     mask = np.zeros(dem.shape, np.float32)
     mask[10, 10] = mask[300, 390] = 1
