@@ -824,6 +824,13 @@ const std::vector<OptionSpec>& optionTable() {
          run.seed = parseSeed(typed, value);
          run.seed_given = true;
        }},
+      {"--preview-view-cell", nullptr, "COL,ROW", kPvsGroup, false,
+       "the preview shows the tiles seen from the view cell holding pixel\n"
+       "COL,ROW (outlined) instead of every view cell's PVS size",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.pvs_preview_cell = parseReceiver(typed, value);
+         run.pvs_preview_cell_given = true;
+       }},
       {"--resume", nullptr, "PREV.bin", kPvsGroup, false,
        "start from the sets of an earlier run's --bitset file (the same field\n"
        "and grid; its view mask unless --view-mask is given) and go on\n"

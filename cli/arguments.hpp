@@ -134,8 +134,11 @@ struct RunArguments {
   // and tiles (--tile T); the sampler (--method agvs|sgvs|per-cell) and its budgets (--samples N,
   // --pixel-error E, --seconds S), --filter K, --bitset OUT.bin, --resume PREV.bin (an earlier
   // --bitset file to start from). (--seed sets `seed` above.)
+  // --preview-view-cell COL,ROW: the preview draws that pixel's view cell's set.
   PvsGrid pvs_grid;
   std::string pvs_mask, pvs_resume;
+  ReceiverPixel pvs_preview_cell;
+  bool pvs_preview_cell_given = false;
   PvsOptions pvs;
   std::string bitset_output;
 };

@@ -2944,6 +2944,63 @@ TEST_F(Cli, PvsWritesTheLibrarysSetsAsJsonAndBits) {
   EXPECT_EQ(ajson.substr(ajson.find("\"pvs\": [")), mjson.substr(msets));
 }
 
+// --preview-view-cell: the preview shows one view cell's set: the pixels of the tiles it sees
+// brighter than those of the tiles it does not (the same hillshade under both), its outline
+// brightest; refused without --preview, outside the field, and in a view cell the mask leaves out.
+TEST_F(Cli, PvsPreviewOfOneViewCell) {
+  const std::string field = writeField("hills.exr", 30, 22, [](int col, int row) {
+    return 4.0f * std::sin(0.4f * col) * std::cos(0.3f * row) + (col == 15 ? 12.0f : 0.0f);
+  });
+  const std::string args = " --view-cell 8 --tile 4 --samples 6000 --method sgvs --seed 3 --quiet";
+  const CliResult result = run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out("p.json")) + args +
+                               " --preview " + shellQuoted(out("p.png")) + " --preview-view-cell 20,3");
+  ASSERT_EQ(result.status, 0) << result.err;
+  hfvis::PvsGrid grid;
+  grid.view_cell = 8;
+  grid.tile = 4;
+  hfvis::PvsOptions options;
+  options.method = hfvis::PvsMethod::Sgvs;
+  options.samples = 6000;
+  options.seed = 3;
+  const hfvis::HeightField f = hfvis::readHeightField(field);
+  const hfvis::PvsResult want = hfvis::computePvs(hfvis::testing::testContext(), f, grid, options);
+  const int chosen = 2;  // pixel (20, 3): cell (20, 3), view cell (2, 0)
+  const hfvis::ImageChannels png = hfvis::readImage(out("p.png"));
+  ASSERT_EQ(png.width, 30);
+  // Outside the chosen view cell, the seen tiles' pixels are brighter on average than the unseen
+  // ones' (the set adds 0.35 over the same dimmed hillshade).
+  double seen = 0, unseen = 0;
+  int n_seen = 0, n_unseen = 0;
+  for (int y = 0; y < 21; ++y)
+    for (int x = 0; x < 29; ++x) {
+      const int cell = y * 29 + x;
+      if (want.layout.viewOfCell(cell) == chosen) continue;
+      const float v = png.planes[0][std::size_t(y) * 30 + x];
+      if (want.visible(chosen, want.layout.tileOfCell(cell)))
+        seen += v, ++n_seen;
+      else
+        unseen += v, ++n_unseen;
+    }
+  ASSERT_GT(n_seen, 0);
+  ASSERT_GT(n_unseen, 0);
+  EXPECT_GT(seen / n_seen, unseen / n_unseen + 0.2) << n_seen << " seen, " << n_unseen << " unseen pixels";
+  EXPECT_GT(png.planes[0][16], seen / n_seen);  // (16, 0): the chosen view cell's outline
+  const auto refused = [&](const std::string& extra, const std::string& says) {
+    const CliResult r = run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out("q.json")) + args + extra);
+    EXPECT_EQ(r.status, 2) << extra;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out("q.json")));
+  };
+  refused(" --preview-view-cell 20,3", "give --preview");
+  refused(" --preview " + shellQuoted(out("q.png")) + " --preview-view-cell 30,3",
+          "outside the 30 x 22 field");
+  const std::string mask =
+      writeField("corner.exr", 30, 22, [](int col, int row) { return col < 3 && row < 3 ? 1.0f : 0.0f; });
+  refused(" --preview " + shellQuoted(out("q.png")) + " --view-mask " + shellQuoted(mask) +
+              " --preview-view-cell 20,3",
+          "which the view mask leaves out");
+}
+
 // --resume: a run goes on from an earlier run's --bitset file: the library's run from those sets
 // with the new seed, its own samples, the file and its entries in resumed_from; refused without a
 // --seed, on another grid, for a file that is not a bitset, and as an output.

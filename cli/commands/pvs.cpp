@@ -94,6 +94,12 @@ BitsetFile readBitsetFile(const std::string& path) {
   return f;
 }
 
+// The view cell holding pixel (col, row) (pixels on the last row or column: the cells before).
+int viewCellOf(const PvsLayout& l, int col, int row) {
+  const int cx = std::min(col, l.cells_x - 1), cy = std::min(row, l.cells_y - 1);
+  return l.viewOfCell(cy * l.cells_x + cx);
+}
+
 class Pvs : public Computation {
  public:
   using Computation::Computation;
@@ -133,6 +139,17 @@ class Pvs : public Computation {
       layoutOf(field);
     }
     if (!run_.pvs_resume.empty()) resumeFrom(layout);
+    if (run_.pvs_preview_cell_given) {
+      const ReceiverPixel& p = run_.pvs_preview_cell;
+      if (p.col >= field.width || p.row >= field.height)
+        throw UsageError("--preview-view-cell " + std::to_string(p.col) + "," + std::to_string(p.row) +
+                         " is outside the " + std::to_string(field.width) + " x " +
+                         std::to_string(field.height) + " field (" + run_.input + ")");
+      const int v = viewCellOf(layout, p.col, p.row);
+      if (!grid_.mask.empty() && !grid_.mask[v])
+        throw UsageError("--preview-view-cell " + std::to_string(p.col) + "," + std::to_string(p.row) +
+                         " lies in view cell " + std::to_string(v) + ", which the view mask leaves out");
+    }
   }
 
   void compute(Job& job) override {
@@ -207,7 +224,8 @@ class Pvs : public Computation {
     if (!run_.bitset_output.empty()) outputs.text(run_.bitset_output, bitsetFile(r));
     if (!run_.preview.empty()) {
       // PVS size per view cell, bright over a dimmed hillshade; view cells not computed, and
-      // nodata, dark.
+      // nodata, dark. With --preview-view-cell: that view cell (its outline brightest) and the
+      // tiles it sees, bright over the hillshade.
       const HeightField& input = job.input;
       const std::vector<float> shade = hillshade(input);
       float most = 1.0f;
@@ -219,9 +237,20 @@ class Pvs : public Computation {
           const std::size_t p = std::size_t(y) * input.width + x;
           const int cx = std::min(x, l.cells_x - 1), cy = std::min(y, l.cells_y - 1);
           const float s = sizes[l.viewOfCell(cy * l.cells_x + cx)];
-          picture[p] = std::isfinite(input.heights[p])
-                           ? 0.3f * shade[p] + (std::isnan(s) ? 0.0f : 0.15f + 0.55f * s / most)
-                           : NAN;
+          float glow = std::isnan(s) ? 0.0f : 0.15f + 0.55f * s / most;
+          if (run_.pvs_preview_cell_given) {
+            const int chosen = viewCellOf(l, run_.pvs_preview_cell.col, run_.pvs_preview_cell.row);
+            const int v = l.viewOfCell(cy * l.cells_x + cx);
+            // (the outline: the view cell's first and last pixels across and down; the last view
+            // cell of a row or column also holds the field's last pixels)
+            const int x0 = v % l.view_x * l.view_cell, y0 = v / l.view_x * l.view_cell;
+            const int x1 = x0 + l.view_cell >= l.cells_x ? input.width - 1 : x0 + l.view_cell - 1;
+            const int y1 = y0 + l.view_cell >= l.cells_y ? input.height - 1 : y0 + l.view_cell - 1;
+            const bool edge = x == x0 || y == y0 || x == x1 || y == y1;
+            glow = v == chosen ? (edge ? 0.7f : 0.45f)
+                               : (r.visible(chosen, l.tileOfCell(cy * l.cells_x + cx)) ? 0.35f : 0.0f);
+          }
+          picture[p] = std::isfinite(input.heights[p]) ? 0.3f * shade[p] + glow : NAN;
         }
       outputs.previewPng(run_.preview, input.width, input.height, picture, 0.0f, 1.0f);
     }
@@ -289,6 +318,8 @@ void checkPvs(const std::string& name, const RunArguments& run) {
   if (!run.preview.empty() && !hasExtension(run.preview, ".png"))
     throw UsageError("--preview: the preview is a PNG; the name must end in .png, got " +
                      namedAs(run.preview));
+  if (run.pvs_preview_cell_given && run.preview.empty())
+    throw UsageError("--preview-view-cell draws the preview: give --preview P.png as well");
   if (!run.pvs_resume.empty() && !run.seed_given)
     throw UsageError("--resume needs --seed: a seed the runs that made " + inQuotes(run.pvs_resume) +
                      " did not use (the same seed casts their samples again)");
@@ -308,7 +339,7 @@ const CommandSpec kPvsCommand{
     "IN -o OUT.json (--samples N | --pixel-error E | --seconds S) [--view-cell C]\n"
     "[--view-height H0[,H1]] [--view-mask MASK] [--tile T] [--method agvs|sgvs|per-cell]\n"
     "[--filter K] [--seed N] [--bitset OUT.bin] [--resume PREV.bin] [--preview P.png]\n"
-    "[options]",
+    "[--preview-view-cell COL,ROW] [options]",
     "Potentially visible sets (Bittner, Mattausch, Wonka, Havran & Wimmer 2009): for every view\n"
     "cell, a square of C x C cells (--view-cell, default 32; a cell is the square between four\n"
     "grid points) whose volume is the points H0 .. H1 above the surface (--view-height, default\n"
@@ -325,7 +356,8 @@ const CommandSpec kPvsCommand{
     "times the sampling's gap.\n"
     "Writes JSON: the grids, samples, estimated pixel error, the mixture per batch and, per view\n"
     "cell, its visible tiles' row-major indices. --bitset OUT.bin: the sets as bits, laid out\n"
-    "in docs/PVS.md. The preview shows the PVS size per view cell over a hillshade.\n"
+    "in docs/PVS.md. The preview shows the PVS size per view cell over a hillshade, or with\n"
+    "--preview-view-cell COL,ROW the tiles the view cell holding that pixel sees.\n"
     "--resume PREV.bin --seed S: go on from an earlier run's --bitset file (same field and\n"
     "grid) with a seed it did not use: runs of a few seconds each, resumed in turn, give the\n"
     "sets written at every step. samples and the estimate are this run's; resumed_from\n"

@@ -167,8 +167,15 @@ class AreaLight : public Computation {
                               "number sum of 2^b over each visible sample 16*NNN+b",
                               "bit patterns (whole numbers 0 .. 65535)"));
     }
-    if (!run_.preview.empty())
-      outputs.previewPng(run_.preview, input.width, input.height, result_.fraction, 0.0f, 1.0f);
+    if (!run_.preview.empty()) {
+      // The fraction, bright, over a dimmed hillshade: a soft shadow over the relief, or a source
+      // area's visual impact read against the terrain; nodata dark.
+      const std::vector<float> shade = hillshade(input);
+      std::vector<float> picture(result_.fraction.size());
+      for (std::size_t p = 0; p < picture.size(); ++p)
+        picture[p] = std::isfinite(result_.fraction[p]) ? 0.3f * shade[p] + 0.7f * result_.fraction[p] : NAN;
+      outputs.previewPng(run_.preview, input.width, input.height, picture, 0.0f, 1.0f);
+    }
     return {result_.samples, "; mean visible fraction " + formatFixed(finiteMean(result_.fraction), 4),
             "light sample"};
   }
@@ -459,7 +466,7 @@ const CommandSpec kAreaLightCommand{
     "jittered position; channels R, G, B are the colours of the samples a pixel sees, summed,\n"
     "over N (a white image of 1 gives R = G = B = visible; NaN at nodata). A missing image, other\n"
     "channels, or a negative or non-finite value is an error before any work.\n"
-    "The preview shows the fraction from black (0) to white (1).\n",
+    "The preview shows the fraction, bright (1) to dark (0), over a dimmed hillshade.\n",
     nullptr,
     kImageCommandGroups | kEarthGroup | kReachGroup | kRegionSamplingGroup | kAreaLightGroup,
     checkAreaLight,
