@@ -300,6 +300,13 @@ class Cli : public ::testing::Test {
     return in(name);
   }
 
+  // The PVS tests' field: 30 x 22 hills with a wall along column 15.
+  std::string pvsHills() const {
+    return writeField("hills.exr", 30, 22, [](int col, int row) {
+      return 4.0f * std::sin(0.4f * col) * std::cos(0.3f * row) + (col == 15 ? 12.0f : 0.0f);
+    });
+  }
+
   std::string ramp() const {
     return writeField("ramp.exr", 16, 12, [](int col, int row) { return 0.5f * col + 0.25f * row; });
   }
@@ -2855,24 +2862,30 @@ TEST_F(Cli, RegionWritesConsistentJsonAndItsClearRays) {
   EXPECT_EQ(splitText(readText(out("w.csv")), '\n').size(), 2u);
 }
 
-// hfvis pvs: the JSON's sets and the bitset file (docs/PVS.md's layout) are the library's for the
-// same seed and budget; a mask limits the view cells computed.
-TEST_F(Cli, PvsWritesTheLibrarysSetsAsJsonAndBits) {
-  const std::string field = writeField("hills.exr", 30, 22, [](int col, int row) {
-    return 4.0f * std::sin(0.4f * col) * std::cos(0.3f * row) + (col == 15 ? 12.0f : 0.0f);
-  });
-  const CliResult result = run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out("p.json")) +
-                               " --view-cell 8 --tile 4 --samples 6000 --method sgvs --seed 3 --bitset " +
-                               shellQuoted(out("p.bin")) + " --preview " + shellQuoted(out("p.png")) + " --quiet");
-  ASSERT_EQ(result.status, 0) << result.err;
+// The library's SGVS sets on `field` with the PVS tests' grid (view cells of 8, tiles of 4), as
+// `hfvis pvs --method sgvs --view-cell 8 --tile 4` computes them.
+hfvis::PvsResult sgvsSets(const std::string& field, std::uint64_t samples, std::uint32_t seed,
+                          std::vector<std::uint32_t> start = {}) {
   hfvis::PvsGrid grid;
   grid.view_cell = 8;
   grid.tile = 4;
   hfvis::PvsOptions options;
   options.method = hfvis::PvsMethod::Sgvs;
-  options.samples = 6000;
-  options.seed = 3;
-  const hfvis::PvsResult want = hfvis::computePvs(hfvis::testing::testContext(), hfvis::readHeightField(field), grid, options);
+  options.samples = samples;
+  options.seed = seed;
+  options.start = std::move(start);
+  return hfvis::computePvs(hfvis::testing::testContext(), hfvis::readHeightField(field), grid, options);
+}
+
+// hfvis pvs: the JSON's sets and the bitset file (docs/PVS.md's layout) are the library's for the
+// same seed and budget; a mask limits the view cells computed.
+TEST_F(Cli, PvsWritesTheLibrarysSetsAsJsonAndBits) {
+  const std::string field = pvsHills();
+  const CliResult result = run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out("p.json")) +
+                               " --view-cell 8 --tile 4 --samples 6000 --method sgvs --seed 3 --bitset " +
+                               shellQuoted(out("p.bin")) + " --preview " + shellQuoted(out("p.png")) + " --quiet");
+  ASSERT_EQ(result.status, 0) << result.err;
+  const hfvis::PvsResult want = sgvsSets(field, 6000, 3);
   const std::string json = readText(out("p.json"));
   // The sets: "pvs": [ [t, t, ...], ... ] one line per view cell.
   const std::size_t sets = json.find("\"pvs\": [");
@@ -2948,22 +2961,12 @@ TEST_F(Cli, PvsWritesTheLibrarysSetsAsJsonAndBits) {
 // brighter than those of the tiles it does not (the same hillshade under both), its outline
 // brightest; refused without --preview, outside the field, and in a view cell the mask leaves out.
 TEST_F(Cli, PvsPreviewOfOneViewCell) {
-  const std::string field = writeField("hills.exr", 30, 22, [](int col, int row) {
-    return 4.0f * std::sin(0.4f * col) * std::cos(0.3f * row) + (col == 15 ? 12.0f : 0.0f);
-  });
+  const std::string field = pvsHills();
   const std::string args = " --view-cell 8 --tile 4 --samples 6000 --method sgvs --seed 3 --quiet";
   const CliResult result = run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out("p.json")) + args +
                                " --preview " + shellQuoted(out("p.png")) + " --preview-view-cell 20,3");
   ASSERT_EQ(result.status, 0) << result.err;
-  hfvis::PvsGrid grid;
-  grid.view_cell = 8;
-  grid.tile = 4;
-  hfvis::PvsOptions options;
-  options.method = hfvis::PvsMethod::Sgvs;
-  options.samples = 6000;
-  options.seed = 3;
-  const hfvis::HeightField f = hfvis::readHeightField(field);
-  const hfvis::PvsResult want = hfvis::computePvs(hfvis::testing::testContext(), f, grid, options);
+  const hfvis::PvsResult want = sgvsSets(field, 6000, 3);
   const int chosen = 2;  // pixel (20, 3): cell (20, 3), view cell (2, 0)
   const hfvis::ImageChannels png = hfvis::readImage(out("p.png"));
   ASSERT_EQ(png.width, 30);
@@ -3005,9 +3008,7 @@ TEST_F(Cli, PvsPreviewOfOneViewCell) {
 // with the new seed, its own samples, the file and its entries in resumed_from; refused without a
 // --seed, on another grid, for a file that is not a bitset, and as an output.
 TEST_F(Cli, PvsResumesFromAnEarlierBitset) {
-  const std::string field = writeField("hills.exr", 30, 22, [](int col, int row) {
-    return 4.0f * std::sin(0.4f * col) * std::cos(0.3f * row) + (col == 15 ? 12.0f : 0.0f);
-  });
+  const std::string field = pvsHills();
   const std::string grid = " --view-cell 8 --tile 4 --method sgvs --quiet";
   ASSERT_EQ(run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out("a.json")) +
                 " --samples 300 --bitset " + shellQuoted(out("a.bin")) + grid)
@@ -3017,18 +3018,8 @@ TEST_F(Cli, PvsResumesFromAnEarlierBitset) {
                                 " --samples 400 --seed 7 --bitset " + shellQuoted(out("b.bin")) +
                                 " --resume " + shellQuoted(out("a.bin")) + grid);
   ASSERT_EQ(resumed.status, 0) << resumed.err;
-  hfvis::PvsGrid g;
-  g.view_cell = 8;
-  g.tile = 4;
-  hfvis::PvsOptions options;
-  options.method = hfvis::PvsMethod::Sgvs;
-  options.samples = 300;
-  const hfvis::HeightField f = hfvis::readHeightField(field);
-  const hfvis::PvsResult first = hfvis::computePvs(hfvis::testing::testContext(), f, g, options);
-  options.samples = 400;
-  options.seed = 7;
-  options.start = first.bits;
-  const hfvis::PvsResult want = hfvis::computePvs(hfvis::testing::testContext(), f, g, options);
+  const hfvis::PvsResult first = sgvsSets(field, 300, 1);
+  const hfvis::PvsResult want = sgvsSets(field, 400, 7, first.bits);
   ASSERT_GT(want.entries(), first.entries());
   const std::string bits = readText(out("b.bin"));
   const std::size_t words_at = 40 + (want.layout.viewCells() + 3) / 4 * 4;
