@@ -271,6 +271,7 @@ try "pvs bitset is the output" "" -- pvs field.exr -o out/p.json --samples 10 --
 try "pvs preview of a view cell without a preview" "" -- pvs field.exr -o out/p.json --samples 10 --preview-view-cell 3,3
 try "pvs preview of a view cell outside the field" "" -- pvs field.exr -o out/p.json --samples 10 --preview out/p.png --preview-view-cell 300,3
 try "pvs resume without a seed" "" -- pvs field.exr -o out/p.json --samples 10 --resume prev_pvs.bin
+try "pvs resume with the filter" "" -- pvs field.exr -o out/p.json --samples 10 --seed 2 --resume prev_pvs.bin --filter 1
 try "pvs resume on another grid" "" -- pvs field.exr -o out/p.json --samples 10 --seed 2 --resume prev_pvs.bin --tile 8
 try "pvs resume from a file not a bitset" "" -- pvs field.exr -o out/p.json --samples 10 --seed 2 --resume prev_pvs.json
 try "pvs resume file as the output" "" -- pvs field.exr -o out/p.json --samples 10 --seed 2 --resume prev_pvs.bin --bitset prev_pvs.bin

@@ -3046,6 +3046,7 @@ TEST_F(Cli, PvsResumesFromAnEarlierBitset) {
     EXPECT_FALSE(fs::exists(out("c.json"))) << args;
   };
   refused(" --view-cell 8 --tile 4 --resume " + shellQuoted(out("a.bin")), "--resume needs --seed");
+  refused(" --view-cell 8 --tile 4 --seed 3 --filter 2 --resume " + shellQuoted(out("a.bin")), "--filter with --resume");
   refused(" --view-cell 8 --tile 2 --seed 3 --resume " + shellQuoted(out("a.bin")),
           "give the same field, --view-cell and --tile");
   refused(" --view-cell 8 --tile 4 --seed 3 --bitset " + shellQuoted(out("a.bin")) + " --resume " +

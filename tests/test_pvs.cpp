@@ -750,6 +750,9 @@ TEST(Pvs, AResumedRunGoesOnFromTheEarlierSets) {
   bad.start[first.words - 1] |= 1u << 31;
   EXPECT_THROW(computePvs(testContext(), field, grid, bad), InvalidArgument);
   bad.start = first.bits;
+  bad.filter = 1.0;  // (its width would follow this run's samples alone)
+  EXPECT_THROW(computePvs(testContext(), field, grid, bad), InvalidArgument);
+  bad.filter = 0.0;
   PvsGrid masked = grid;
   masked.mask.assign(l.viewCells(), 1);
   masked.mask[0] = 0;

@@ -49,7 +49,8 @@ struct BitsetFile {
   std::vector<std::uint32_t> bits;
 };
 
-BitsetFile readBitsetFile(const std::string& path) {
+// The grid is compared with this run's (`l`) from the header, before the body is read.
+BitsetFile readBitsetFile(const std::string& path, const PvsLayout& l, const std::string& input) {
   detail::requireInputFile(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw IoError(path, std::string("cannot open: ") + std::strerror(errno));
@@ -73,6 +74,16 @@ BitsetFile readBitsetFile(const std::string& path) {
   if (views == 0 || tiles == 0 || views > (1u << 30) || tiles > (1u << 30) || f.words != (tiles + 31) / 32 ||
       f.view_cell == 0 || f.tile == 0)
     throw fail("its header's grid does not hold together");
+  if (int(f.view_cell) != l.view_cell || int(f.tile) != l.tile || int(f.view_x) != l.view_x ||
+      int(f.view_y) != l.view_y || int(f.tiles_x) != l.tiles_x || int(f.tiles_y) != l.tiles_y)
+    throw UsageError("--resume: " + path + " holds " + std::to_string(f.view_x) + " x " +
+                     std::to_string(f.view_y) + " view cells of " + std::to_string(f.view_cell) + " and " +
+                     std::to_string(f.tiles_x) + " x " + std::to_string(f.tiles_y) + " tiles of " +
+                     std::to_string(f.tile) + "; this run's grid is " + std::to_string(l.view_x) + " x " +
+                     std::to_string(l.view_y) + " view cells of " + std::to_string(l.view_cell) + " and " +
+                     std::to_string(l.tiles_x) + " x " + std::to_string(l.tiles_y) + " tiles of " +
+                     std::to_string(l.tile) + " (" + input +
+                     "): give the same field, --view-cell and --tile");
   const std::uint64_t padded = (views + 3) / 4 * 4, size = 40 + padded + 4 * views * f.words;
   in.seekg(0, std::ios::end);
   if (std::uint64_t(in.tellg()) != size)
@@ -276,17 +287,9 @@ class Pvs : public Computation {
   // --view-mask gives one, which must then be the same).
   void resumeFrom(const PvsLayout& l) {
     const std::string& path = run_.pvs_resume;
-    BitsetFile f = readBitsetFile(path);
-    if (int(f.view_cell) != l.view_cell || int(f.tile) != l.tile || int(f.view_x) != l.view_x ||
-        int(f.view_y) != l.view_y || int(f.tiles_x) != l.tiles_x || int(f.tiles_y) != l.tiles_y)
-      throw UsageError("--resume: " + path + " holds " + std::to_string(f.view_x) + " x " +
-                       std::to_string(f.view_y) + " view cells of " + std::to_string(f.view_cell) + " and " +
-                       std::to_string(f.tiles_x) + " x " + std::to_string(f.tiles_y) + " tiles of " +
-                       std::to_string(f.tile) + "; this run's grid is " + std::to_string(l.view_x) + " x " +
-                       std::to_string(l.view_y) + " view cells of " + std::to_string(l.view_cell) + " and " +
-                       std::to_string(l.tiles_x) + " x " + std::to_string(l.tiles_y) + " tiles of " +
-                       std::to_string(l.tile) + " (" + run_.input +
-                       "): give the same field, --view-cell and --tile");
+    BitsetFile f = readBitsetFile(path, l, run_.input);
+    if (std::count(f.computed.begin(), f.computed.end(), 1) == 0)
+      throw UsageError("--resume: " + path + " computed no view cell");
     if (run_.pvs_mask.empty()) {
       if (std::count(f.computed.begin(), f.computed.end(), 0) > 0) grid_.mask = f.computed;
     } else if (f.computed != grid_.mask) {
@@ -320,6 +323,11 @@ void checkPvs(const std::string& name, const RunArguments& run) {
                      namedAs(run.preview));
   if (run.pvs_preview_cell_given && run.preview.empty())
     throw UsageError("--preview-view-cell draws the preview: give --preview P.png as well");
+  if (!run.pvs_resume.empty() && run.pvs.filter > 0.0)
+    throw UsageError(
+        "--filter with --resume: the filter's width follows a run's samples, and a resumed "
+        "step knows only its own; filter a run from the start, and resume only from steps "
+        "run without --filter");
   if (!run.pvs_resume.empty() && !run.seed_given)
     throw UsageError("--resume needs --seed: a seed the runs that made " + inQuotes(run.pvs_resume) +
                      " did not use (the same seed casts their samples again)");
@@ -360,8 +368,8 @@ const CommandSpec kPvsCommand{
     "--preview-view-cell COL,ROW the tiles the view cell holding that pixel sees.\n"
     "--resume PREV.bin --seed S: go on from an earlier run's --bitset file (same field and\n"
     "grid) with a seed it did not use: runs of a few seconds each, resumed in turn, give the\n"
-    "sets written at every step. samples and the estimate are this run's; resumed_from\n"
-    "names the file and its entries.\n",
+    "sets written at every step (no --filter in them). samples and the estimate are this\n"
+    "run's; resumed_from names the file and its entries.\n",
     nullptr,
     kOutputGroup | kInputGroup | kImageGroup | kDeviceGroup | kPvsGroup,
     checkPvs,

@@ -590,7 +590,8 @@ def pvs(heights, *, samples=0, pixel_error=0.0, seconds=0.0, view_cell=32, band_
     uint32), computed, layout (a dict of the grid's sizes), the run's counts, history (per
     batch) and witnesses (with witnesses=True). DataArrays: the same (the sets are not on the
     pixel grid); computed in one piece. start: an earlier run's bits (its Pvs.bits) on the same
-    field and grid, to go on from; its entries stay (give another seed, or its samples repeat)."""
+    field and grid, to go on from; its entries stay (give another seed, or its samples repeat; no
+    filter, and not the bits of a filtered run)."""
     options = {"samples": int(samples), "pixel_error": float(pixel_error), "seconds": float(seconds),
                "view_cell": int(view_cell), "band_low": float(band_low), "band_high": float(band_high),
                "tile": int(tile), "mask": None if mask is None else np.asarray(mask), "method": method,

@@ -139,6 +139,10 @@ class Sampler {
     out_.computed = grid.mask.empty() ? std::vector<std::uint8_t>(l.viewCells(), 1) : grid.mask;
     if (!options.start.empty()) {
       // (the entries to resume from: found by earlier samples, so never in only_finder_)
+      if (options.filter > 0.0)
+        throw InvalidArgument(
+            "the visibility filter takes its width from a run's samples, which a resumed "
+            "run knows only in part: no filter with sets to resume from");
       if (options.start.size() != out_.bits.size())
         throw InvalidArgument("the sets to resume from hold " + std::to_string(options.start.size()) +
                               " words, the grid's " + std::to_string(out_.bits.size()) + " (" +
