@@ -29,6 +29,11 @@ std::string jsonNumber(double value) { return std::isfinite(value) ? formatNumbe
 void putU32(std::string& out, std::uint32_t v) {
   for (int i = 0; i < 4; ++i) out.push_back(static_cast<char>((v >> (8 * i)) & 0xFFu));
 }
+std::uint32_t getU32(const char* at) {
+  const unsigned char* b = reinterpret_cast<const unsigned char*>(at);
+  return std::uint32_t(b[0]) | std::uint32_t(b[1]) << 8 | std::uint32_t(b[2]) << 16 |
+         std::uint32_t(b[3]) << 24;
+}
 
 std::string bitsetFile(const PvsResult& r) {
   std::string out("HFVPVS1", 8);  // 7 letters and a zero byte
@@ -60,11 +65,7 @@ BitsetFile readBitsetFile(const std::string& path, const PvsLayout& l, const std
   char head[40];
   if (!in.read(head, sizeof(head))) throw fail("shorter than its 40-byte header");
   if (std::memcmp(head, "HFVPVS1", 8) != 0) throw fail("it does not start with HFVPVS1");
-  const auto u32 = [&](int at) {
-    std::uint32_t v = 0;
-    for (int i = 3; i >= 0; --i) v = (v << 8) | static_cast<unsigned char>(head[at + i]);
-    return v;
-  };
+  const auto u32 = [&](int at) { return getU32(head + at); };
   if (u32(8) != 1) throw fail("format version " + std::to_string(u32(8)) + ", this hfvis reads version 1");
   BitsetFile f;
   f.view_x = u32(12), f.view_y = u32(16), f.tiles_x = u32(20), f.tiles_y = u32(24), f.words = u32(28);
@@ -97,11 +98,7 @@ BitsetFile readBitsetFile(const std::string& path, const PvsLayout& l, const std
     if (c > 1) throw fail("a view cell's computed byte is neither 0 nor 1");
   }
   f.bits.resize(views * f.words);
-  for (std::size_t i = 0; i < f.bits.size(); ++i) {
-    const unsigned char* b = reinterpret_cast<const unsigned char*>(body.data()) + padded + 4 * i;
-    f.bits[i] = std::uint32_t(b[0]) | std::uint32_t(b[1]) << 8 | std::uint32_t(b[2]) << 16 |
-                std::uint32_t(b[3]) << 24;
-  }
+  for (std::size_t i = 0; i < f.bits.size(); ++i) f.bits[i] = getU32(body.data() + padded + 4 * i);
   return f;
 }
 
@@ -242,6 +239,9 @@ class Pvs : public Computation {
       float most = 1.0f;
       for (float s : sizes)
         if (s > most) most = s;
+      const int chosen = run_.pvs_preview_cell_given
+                             ? viewCellOf(l, run_.pvs_preview_cell.col, run_.pvs_preview_cell.row)
+                             : -1;
       std::vector<float> picture(input.pixelCount());
       for (int y = 0; y < input.height; ++y)
         for (int x = 0; x < input.width; ++x) {
@@ -249,8 +249,7 @@ class Pvs : public Computation {
           const int cx = std::min(x, l.cells_x - 1), cy = std::min(y, l.cells_y - 1);
           const float s = sizes[l.viewOfCell(cy * l.cells_x + cx)];
           float glow = std::isnan(s) ? 0.0f : 0.15f + 0.55f * s / most;
-          if (run_.pvs_preview_cell_given) {
-            const int chosen = viewCellOf(l, run_.pvs_preview_cell.col, run_.pvs_preview_cell.row);
+          if (chosen >= 0) {
             const int v = l.viewOfCell(cy * l.cells_x + cx);
             // (the outline: the view cell's first and last pixels across and down; the last view
             // cell of a row or column also holds the field's last pixels)

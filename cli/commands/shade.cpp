@@ -16,16 +16,14 @@ namespace {
 // --albedo: a number in [0, 1], or an image of the field's size (one channel, or R, G, B), as
 // planes (one value for a number).
 std::vector<std::vector<float>> readAlbedo(const RunArguments& run, const HeightField& field) {
-  double number = 0.0;
-  {
-    // (a number strtod reads that is not a finite decimal one: "nan", "inf", "1e999", "0x1")
-    char* end = nullptr;
-    std::strtod(run.albedo.c_str(), &end);
-    if (!run.albedo.empty() && end == run.albedo.c_str() + run.albedo.size() &&
-        !detail::decimalNumber(run.albedo, number))
+  // A whole string strtod reads is a number, never a file name: a decimal one in 0 .. 1, or refused
+  // ("nan", "inf", "1e999", "0x1").
+  char* end = nullptr;
+  std::strtod(run.albedo.c_str(), &end);
+  if (!run.albedo.empty() && end == run.albedo.c_str() + run.albedo.size()) {
+    double number = 0.0;
+    if (!detail::decimalNumber(run.albedo, number))
       throw UsageError("--albedo: a number must be a decimal number in 0 .. 1, got '" + run.albedo + "'");
-  }
-  if (detail::decimalNumber(run.albedo, number)) {
     if (!(number >= 0.0 && number <= 1.0))
       throw UsageError("--albedo: a number must be in 0 .. 1, got '" + run.albedo + "'");
     return {std::vector<float>(field.pixelCount(), static_cast<float>(number))};
