@@ -197,11 +197,11 @@ void pvsRecallReport(const ComputeContext& context, const std::vector<std::strin
     else
       std::printf("(no dense reference: recall not measured)\n\n");
     std::printf(
-        "| sampler | samples | rays | recall | estimated pixel error | its rays: found once / uniform | "
-        "measured "
-        "pixel error | its rays: wrong | seconds |\n"
-        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+        "| sampler | samples | settling the estimate | rays | recall | estimated pixel error | its rays: found "
+        "once / uniform | measured pixel error | its rays: wrong | seconds |\n"
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
     PvsResult last_agvs;
+    int runs = 0, within = 0;
     for (PvsMethod method : methods) {
       for (std::uint64_t n : samples)
         for (std::uint32_t seed : seeds) {
@@ -214,8 +214,11 @@ void pvsRecallReport(const ComputeContext& context, const std::vector<std::strin
           const double measured = measuredPixelError(f, pvs, check, check_hits, options.resolution);
           const std::string sampler = std::string(methodName(method)) +
                                       (seeds.size() > 1 ? " (seed " + std::to_string(seed) + ")" : "");
-          std::printf("| %s | %llu | %llu | %s | %.1f | %.0f / %llu | %.1f | %.0f | %.2f |\n",
+          ++runs;
+          within += pvs.pixel_error >= 0.5 * measured && pvs.pixel_error <= 2.0 * measured;
+          std::printf("| %s | %llu | %llu | %llu | %s | %.1f | %.0f / %llu | %.1f | %.0f | %.2f |\n",
                       sampler.c_str(), static_cast<unsigned long long>(n),
+                      static_cast<unsigned long long>(pvs.estimate_samples),
                       static_cast<unsigned long long>(pvs.rays), recall.c_str(), pvs.pixel_error,
                       pvs.pixel_error * double(pvs.uniform_rays) / options.resolution,
                       static_cast<unsigned long long>(pvs.uniform_rays), measured,
@@ -224,6 +227,8 @@ void pvsRecallReport(const ComputeContext& context, const std::vector<std::strin
           if (method == PvsMethod::Agvs) last_agvs = pvs;
         }
     }
+    std::printf("\nThe estimate within a factor 2 of the measured pixel error at the end of %d of these %d runs.\n",
+                within, runs);
     if (last_agvs.history.empty()) continue;
     std::printf("\nAGVS's mixture over its %llu-sample run (per batch of 65536 samples):\n\n| samples |",
                 static_cast<unsigned long long>(samples.back()));

@@ -811,6 +811,16 @@ const std::vector<OptionSpec>& optionTable() {
        [](const std::string& typed, const std::string& value, RunArguments& run) {
          run.pvs.seconds = parsePositive(typed, value);
        }},
+      {"--estimate-entries", nullptr, "N", kPvsGroup, false,
+       "settle the estimate: after the budget, uniform view rays go on until N\n"
+       "entries found once carry it, up to the budget again (default 20; 0: off)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         const double n = parseNumber(typed, value);
+         if (!(n >= 0.0 && n <= 1e6 && n == std::floor(n)))
+           throw UsageError(typed + ": expected a whole number of entries, 0 .. 1e6, got " +
+                            inQuotes(shortened(value)));
+         run.pvs.estimate_entries = static_cast<std::size_t>(n);
+       }},
       {"--filter", nullptr, "K", kPvsGroup, false,
        "the visibility filter: add the tiles within K times the sampling's\n"
        "gap of a visible tile (no witness; default 0, none)",

@@ -187,6 +187,7 @@ class Pvs : public Computation {
          << "  \"tiles\": {\"size\": " << l.tile << ", \"across\": " << l.tiles_x
          << ", \"down\": " << l.tiles_y << "},\n"
          << "  \"samples\": " << r.samples << ",\n"
+         << "  \"estimate_samples\": " << r.estimate_samples << ",\n"
          << "  \"rays\": " << r.rays << ",\n"
          << "  \"seconds\": " << jsonNumber(r.seconds) << ",\n"
          << "  \"estimated_pixel_error\": " << jsonNumber(r.pixel_error) << ",\n"
@@ -267,7 +268,9 @@ class Pvs : public Computation {
     int computed = 0;
     for (std::uint8_t c : r.computed) computed += c != 0;
     return {computed,
-            "; " + std::to_string(r.samples) + " samples, " + std::to_string(r.entries()) +
+            "; " + std::to_string(r.samples) + " samples" +
+                (r.estimate_samples ? " (" + std::to_string(r.estimate_samples) + " settling the estimate)" : "") +
+                ", " + std::to_string(r.entries()) +
                 " entries, estimated pixel error " + jsonNumber(r.pixel_error),
             "view cell"};
   }
@@ -358,6 +361,9 @@ const CommandSpec kPvsCommand{
     "per-cell: random rays from each view cell in turn. The run stops at the first budget\n"
     "reached: --samples N, --pixel-error E (the paper's estimate, in differing rays per\n"
     "million-ray camera), --seconds S. The same seed and --samples give the same sets.\n"
+    "When a budget leaves the estimate on fewer than 20 entries found once (a count too\n"
+    "small to hold within 2x), uniform view rays go on until 20 carry it, up to the\n"
+    "budget's samples again (--estimate-entries N; estimate_samples in the JSON).\n"
     "--view-mask MASK (a raster of the field's size): only the view cells holding a non-zero\n"
     "pixel (its first channel) are computed. --filter K: Sec. 5's object-space filter, K\n"
     "times the sampling's gap.\n"

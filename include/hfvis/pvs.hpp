@@ -122,6 +122,14 @@ struct PvsOptions {
   // every tile within k 2 d / sqrt(n) of a visible tile, d its distance from the view cell, n the
   // samples per view cell; counted in PvsResult::filtered, with no witness.
   double filter = 0.0;
+  // Settling the estimate: when a budget ends with fewer than this many entries found once by a
+  // uniform view ray (the entries PvsResult::pixel_error counts), view-direction samples go on
+  // until that many carry it, at most as many as the run's samples so far (so a run casts up to
+  // twice its budget); PvsResult::estimate_samples counts them. With fewer entries the estimate
+  // is a Poisson count of a handful, off by more than 2x in about a third of runs (20: about 1 in
+  // 40; bench/report/pvs.md). A pixel-error budget the settled estimate no longer meets goes on
+  // sampling, within the other budgets. 0: the estimate as the budget left it.
+  std::size_t estimate_entries = 20;
   bool witnesses = false;               // keep each entry's witness (PvsResult::witnesses)
   std::size_t memory_budget_bytes = 0;  // as RayCastOptions::memory_budget_bytes
   // The sets to start from (empty: none), to resume a run: an earlier run's PvsResult::bits on the
@@ -162,7 +170,8 @@ struct PvsResult {
   int words = 0;                       // per view cell: ceil(tiles / 32)
   std::vector<std::uint32_t> bits;     // view cell v's tile j: bit j % 32 of word v * words + j / 32
   std::vector<std::uint8_t> computed;  // per view cell: the grid's mask (all 1 without one)
-  std::uint64_t samples = 0, rays = 0;
+  std::uint64_t samples = 0, rays = 0;  // all of the run's, estimate_samples included
+  std::uint64_t estimate_samples = 0;    // view-direction samples settling the estimate (PvsOptions::estimate_entries)
   std::uint64_t rejected = 0;  // candidate entries whose witness failed the line-of-sight test
   std::uint64_t filtered = 0;  // entries the visibility filter added (no witness)
   double pixel_error = 0.0;    // the estimate at the end (NaN before any estimate)

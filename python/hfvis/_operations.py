@@ -23,7 +23,7 @@ RegionPairVisibility = collections.namedtuple(
     "RegionPairVisibility", "bits sources receivers source_fraction receiver_fraction clear_pairs pairs "
     "visible_fraction sources_xy receivers_xy")
 Pvs = collections.namedtuple("Pvs", "sets bits computed layout samples rays entries rejected filtered pixel_error "
-                                    "seconds history witnesses")
+                                    "seconds history witnesses estimate_samples")
 
 # Lighting and fields of view take row 0 as north: a DataArray whose rows run south-up (or
 # columns west) is computed flipped.
@@ -578,8 +578,8 @@ def region_pair_visibility(heights, sources, receivers, *, samples=16, source_he
 
 
 def pvs(heights, *, samples=0, pixel_error=0.0, seconds=0.0, view_cell=32, band_low=1.7, band_high=1.7, tile=16,
-        mask=None, method="agvs", batch=1 << 16, seed=1, resolution=1e6, filter=0.0, witnesses=False,
-        memory_budget_bytes=0, start=None, cell_size=None, z_scale=1.0, nodata=None, device="", progress=None):
+        mask=None, method="agvs", batch=1 << 16, seed=1, resolution=1e6, filter=0.0, estimate_entries=20,
+        witnesses=False, memory_budget_bytes=0, start=None, cell_size=None, z_scale=1.0, nodata=None, device="", progress=None):
     """Potentially visible sets (Bittner, Mattausch, Wonka, Havran & Wimmer 2009): the tiles of
     tile x tile cells each view cell of view_cell x view_cell cells (its volume band_low ..
     band_high above the surface) sees, by sampling; stops at the first budget reached (samples,
@@ -591,12 +591,17 @@ def pvs(heights, *, samples=0, pixel_error=0.0, seconds=0.0, view_cell=32, band_
     batch) and witnesses (with witnesses=True). DataArrays: the same (the sets are not on the
     pixel grid); computed in one piece. start: an earlier run's bits (its Pvs.bits) on the same
     field and grid, to go on from; its entries stay (give another seed, or its samples repeat; no
-    filter, and not the bits of a filtered run)."""
+    filter, and not the bits of a filtered run). estimate_entries: when a budget leaves the
+    estimate on fewer entries found once, uniform view rays go on until that many carry it, up to
+    the budget's samples again (estimate_samples counts them; 0: off)."""
+    if int(estimate_entries) < 0:
+        raise ValueError(f"estimate_entries must be 0 or more, got {estimate_entries}")
     options = {"samples": int(samples), "pixel_error": float(pixel_error), "seconds": float(seconds),
                "view_cell": int(view_cell), "band_low": float(band_low), "band_high": float(band_high),
                "tile": int(tile), "mask": None if mask is None else np.asarray(mask), "method": method,
                "batch": int(batch), "seed": int(seed), "resolution": float(resolution), "filter": float(filter),
-               "witnesses": bool(witnesses), "memory_budget_bytes": int(memory_budget_bytes),
+               "estimate_entries": int(estimate_entries), "witnesses": bool(witnesses),
+               "memory_budget_bytes": int(memory_budget_bytes),
                "start": None if start is None else np.ascontiguousarray(start, dtype=np.uint32).ravel()}
     if _is_dataarray(heights) and _is_dask(heights.data):
         heights = heights.compute()
@@ -612,7 +617,8 @@ def pvs(heights, *, samples=0, pixel_error=0.0, seconds=0.0, view_cell=32, band_
         sets.append(np.nonzero(seen)[0])
     return Pvs(sets, bits, computed.astype(bool), out["layout"], int(out["samples"]), int(out["rays"]),
                int(out["entries"]), int(out["rejected"]), int(out["filtered"]), float(out["pixel_error"]),
-               float(out["seconds"]), list(out["history"]), out["witnesses"] if witnesses else None)
+               float(out["seconds"]), list(out["history"]), out["witnesses"] if witnesses else None,
+               int(out["estimate_samples"]))
 
 
 def horizon_lists(heights, receivers, *, directions=64, azimuth_offset=0.0, samples_per_unit=1.0, curvature=0.0,

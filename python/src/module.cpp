@@ -237,6 +237,7 @@ void bindOptions(nb::module_& m) {
       .def_rw("seed", &PvsOptions::seed)
       .def_rw("resolution", &PvsOptions::resolution)
       .def_rw("filter", &PvsOptions::filter)
+      .def_rw("estimate_entries", &PvsOptions::estimate_entries)
       .def_rw("witnesses", &PvsOptions::witnesses)
       .def_rw("memory_budget_bytes", &PvsOptions::memory_budget_bytes)
       .def_rw("start", &PvsOptions::start);
@@ -487,6 +488,7 @@ nb::dict pvs(const HeightField& field, const PvsGrid& grid, PvsOptions options, 
   out["bits"] = toArray(std::move(r.bits), {size_t(l.viewCells()), size_t(r.words)});
   out["computed"] = toArray(std::move(r.computed), {size_t(l.viewCells())});
   out["samples"] = r.samples;
+  out["estimate_samples"] = r.estimate_samples;
   out["rays"] = r.rays;
   out["rejected"] = r.rejected;
   out["filtered"] = r.filtered;

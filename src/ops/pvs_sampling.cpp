@@ -198,34 +198,72 @@ class Sampler {
   void run(detail::RayCaster& caster) {
     const auto start = std::chrono::steady_clock::now();
     for (;;) {
-      std::uint64_t n = std::uint64_t(options_.batch);
-      if (options_.samples) n = std::min(n, options_.samples - out_.samples);
-      if (n == 0) break;
-      batch(caster, static_cast<int>(n));
-      out_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      PvsProgress row;
-      row.samples = out_.samples;
-      row.rays = out_.rays;
-      row.entries = out_.entries();
-      row.seconds = out_.seconds;
-      row.pixel_error = out_.pixel_error;
-      row.probability = probability_;
-      out_.history.push_back(row);
-      if (options_.progress) options_.progress(out_);
-      if (options_.pixel_error > 0.0 && out_.pixel_error <= options_.pixel_error) break;
-      if (options_.pixel_error > 0.0 && out_.entries() == complete_) {
-        // Every computed view cell holds every tile: no ray can differ, whatever the estimate's
-        // floor of one entry per uniform ray says (a run would go on for ever toward a small E).
-        out_.pixel_error = 0.0;
-        out_.history.back().pixel_error = 0.0;
-        break;
-      }
-      if (options_.seconds > 0.0 && out_.seconds >= options_.seconds) break;
+      const bool complete = sample(caster, start);
+      if (complete) break;
+      settle(caster, start);
+      // A pixel-error budget the settled estimate no longer meets goes on, within the others.
+      const bool budget_left = (!options_.samples || out_.samples < options_.samples) &&
+                               (options_.seconds <= 0.0 || out_.seconds < options_.seconds);
+      if (!(options_.pixel_error > 0.0 && out_.pixel_error > options_.pixel_error && budget_left)) break;
     }
     if (options_.filter > 0.0) filter();
   }
 
  private:
+  // The sampler's batches until a budget is reached; true when a pixel-error budget ends with the
+  // sets complete (then no ray can differ: the estimate is 0).
+  bool sample(detail::RayCaster& caster, std::chrono::steady_clock::time_point start) {
+    for (;;) {
+      std::uint64_t n = std::uint64_t(options_.batch);
+      if (options_.samples) n = std::min(n, options_.samples - std::min(options_.samples, out_.samples));
+      if (n == 0) return false;
+      batch(caster, static_cast<int>(n));
+      record(start);
+      if (options_.pixel_error > 0.0 && out_.pixel_error <= options_.pixel_error) return false;
+      if (options_.pixel_error > 0.0 && out_.entries() == complete_) {
+        // Every computed view cell holds every tile: no ray can differ, whatever the estimate's
+        // floor of one entry per uniform ray says (a run would go on for ever toward a small E).
+        out_.pixel_error = 0.0;
+        out_.history.back().pixel_error = 0.0;
+        return true;
+      }
+      if (options_.seconds > 0.0 && out_.seconds >= options_.seconds) return false;
+    }
+  }
+
+  // Settles the estimate (PvsOptions::estimate_entries): while fewer entries found once than asked
+  // carry it, view-direction samples (uniform view rays) go on, at most as many as the run's
+  // samples so far. The entries they find join the sets; the mixture and the mutations stay.
+  void settle(detail::RayCaster& caster, std::chrono::steady_clock::time_point start) {
+    const std::uint64_t most = out_.samples - out_.estimate_samples;
+    const auto unsettled = [&] {
+      return options_.estimate_entries > 0 && only_finders_.size() < options_.estimate_entries &&
+             out_.entries() < complete_ && out_.estimate_samples < most;
+    };
+    settling_ = true;
+    while (unsettled()) {
+      const std::uint64_t n = std::min<std::uint64_t>(options_.batch, most - out_.estimate_samples);
+      batch(caster, static_cast<int>(n));
+      out_.estimate_samples += n;
+      record(start);
+    }
+    settling_ = false;
+  }
+
+  // A row of the history after a batch, and the progress callback.
+  void record(std::chrono::steady_clock::time_point start) {
+    out_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    PvsProgress row;
+    row.samples = out_.samples;
+    row.rays = out_.rays;
+    row.entries = out_.entries();
+    row.seconds = out_.seconds;
+    row.pixel_error = out_.pixel_error;
+    row.probability = probability_;
+    out_.history.push_back(row);
+    if (options_.progress) options_.progress(out_);
+  }
+
   // ---- Geometry
 
   float surface(double x, double y) const {  // pixels
@@ -304,7 +342,7 @@ class Sampler {
       s.direction = random_.sphere();
       return s;
     }
-    s.distribution = pick();
+    s.distribution = settling_ ? kViewDirection : pick();
     if ((s.distribution == kTwoPointMutation || s.distribution == kSilhouetteMutation) && mutations_.empty())
       s.distribution = kViewDirection;
     switch (s.distribution) {
@@ -491,7 +529,7 @@ class Sampler {
       if (s.distribution == kViewDirection) uniform_rays_ += 2;
       contribution[s.distribution] += total;
       // Mutation candidates (Sec. 4.4): each end that contributed, the other end its origin.
-      if (options_.method == PvsMethod::Agvs)
+      if (options_.method == PvsMethod::Agvs && !settling_)
         for (int end = 0; end < 2; ++end) {
           if (!end_contribution[end]) continue;
           const std::size_t k = 2 * std::size_t(i) + end, o = 2 * std::size_t(i) + 1 - end;
@@ -516,7 +554,7 @@ class Sampler {
     if (uniform_rays_ > 0)
       out_.pixel_error = options_.resolution * double(std::max<std::size_t>(1, only_finders_.size())) /
                          double(uniform_rays_);
-    if (options_.method == PvsMethod::Agvs) updateMixture(contribution, drawn);
+    if (options_.method == PvsMethod::Agvs && !settling_) updateMixture(contribution, drawn);
   }
 
   Vec hitPoint(const HeightRay& q, float t) const {
@@ -622,6 +660,7 @@ class Sampler {
   MutationBuffer mutations_;
   std::vector<Silhouette> silhouettes_;
   std::uint64_t uniform_rays_ = 0;  // uniform view rays cast so far (foundAgain)
+  bool settling_ = false;           // settle(): view-direction samples alone
   std::size_t complete_ = 0;        // the entries of complete sets: computed view cells x tiles
   // The entries only one uniform view ray has found (foundAgain): a bit per entry as out_.bits,
   // and the finder's lineage by entry (v * tiles + t).
