@@ -265,6 +265,7 @@ try "pvs mask of the wrong size" "" -- pvs field.exr -o out/p.json --samples 10 
 try "pvs budget of 0" "" -- pvs field.exr -o out/p.json --samples 0
 try "pvs view cell in hexadecimal" "" -- pvs field.exr -o out/p.json --samples 10 --view-cell 0x10
 try "pvs pixel error beyond reach" "" -- pvs field.exr -o out/p.json --pixel-error 1e-9
+try "pvs estimate entries negative" "" -- pvs field.exr -o out/p.json --samples 10 --estimate-entries -1
 try "pvs without a budget" "" -- pvs field.exr -o out/p.json
 try "pvs output not JSON" "" -- pvs field.exr -o out/p.exr --samples 10
 try "pvs bitset is the output" "" -- pvs field.exr -o out/p.json --samples 10 --bitset out/p.json

@@ -2957,6 +2957,43 @@ TEST_F(Cli, PvsWritesTheLibrarysSetsAsJsonAndBits) {
   EXPECT_EQ(ajson.substr(ajson.find("\"pvs\": [")), mjson.substr(msets));
 }
 
+// The settled estimate (--estimate-entries): an AGVS budget that leaves fewer than 20 entries found
+// once goes on with uniform view rays, as the library's run does; the JSON's samples include them
+// and estimate_samples counts them; the summary line names them; 0 turns them off; a count that is
+// not a whole number in 0 .. 1e6 is refused.
+TEST_F(Cli, PvsSettlesItsEstimate) {
+  const std::string field = pvsHills();
+  hfvis::PvsGrid grid;
+  grid.view_cell = 8;
+  grid.tile = 4;
+  hfvis::PvsOptions options;
+  options.samples = 20000;
+  const hfvis::PvsResult want =
+      hfvis::computePvs(hfvis::testing::testContext(), hfvis::readHeightField(field), grid, options);
+  ASSERT_GT(want.estimate_samples, 0u);
+  const std::string base = "pvs " + shellQuoted(field) + " --view-cell 8 --tile 4 --samples 20000 -o ";
+  const CliResult settled = run(base + shellQuoted(out("s.json")));
+  ASSERT_EQ(settled.status, 0) << settled.err;
+  const Json s = JsonParser::parse(readText(out("s.json")));
+  EXPECT_EQ(s["samples"].number, double(want.samples));
+  EXPECT_EQ(s["estimate_samples"].number, double(want.estimate_samples));
+  EXPECT_EQ(s["entries"].number, double(want.entries()));
+  EXPECT_NE(settled.out.find(std::to_string(want.estimate_samples) + " settling the estimate"),
+            std::string::npos)
+      << settled.out;
+  const CliResult plain = run(base + shellQuoted(out("p.json")) + " --estimate-entries 0 --quiet");
+  ASSERT_EQ(plain.status, 0) << plain.err;
+  const Json p = JsonParser::parse(readText(out("p.json")));
+  EXPECT_EQ(p["samples"].number, 20000.0);
+  EXPECT_EQ(p["estimate_samples"].number, 0.0);
+  for (const char* bad : {"-1", "2.5", "1e7", "0x10", "nan"}) {
+    const CliResult refused = run(base + shellQuoted(out("b.json")) + " --estimate-entries " + bad);
+    EXPECT_EQ(refused.status, 2) << bad;
+    EXPECT_NE(refused.err.find("--estimate-entries"), std::string::npos) << refused.err;
+    EXPECT_FALSE(fs::exists(out("b.json"))) << bad;
+  }
+}
+
 // --preview-view-cell: the preview shows one view cell's set: the pixels of the tiles it sees
 // brighter than those of the tiles it does not (the same hillshade under both), its outline
 // brightest; refused without --preview, outside the field, and in a view cell the mask leaves out.

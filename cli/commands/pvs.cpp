@@ -348,8 +348,8 @@ const CommandSpec kPvsCommand{
     "potentially visible sets: the tiles each view cell can see, as JSON",
     "IN -o OUT.json (--samples N | --pixel-error E | --seconds S) [--view-cell C]\n"
     "[--view-height H0[,H1]] [--view-mask MASK] [--tile T] [--method agvs|sgvs|per-cell]\n"
-    "[--filter K] [--seed N] [--bitset OUT.bin] [--resume PREV.bin] [--preview P.png]\n"
-    "[--preview-view-cell COL,ROW] [options]",
+    "[--estimate-entries N] [--filter K] [--seed N] [--bitset OUT.bin] [--resume PREV.bin]\n"
+    "[--preview P.png] [--preview-view-cell COL,ROW] [options]",
     "Potentially visible sets (Bittner, Mattausch, Wonka, Havran & Wimmer 2009): for every view\n"
     "cell, a square of C x C cells (--view-cell, default 32; a cell is the square between four\n"
     "grid points) whose volume is the points H0 .. H1 above the surface (--view-height, default\n"

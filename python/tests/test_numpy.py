@@ -348,6 +348,14 @@ def test_pvs(tmp_path, projected_tif, dem):
     more = hfvis.pvs(dem, samples=10000, view_cell=48, tile=32, band_low=2, band_high=20, seed=6, cell_size=30,
                      nodata=NODATA, start=r.bits)
     assert np.all(r.bits & ~more.bits == 0) and more.entries > r.entries
+    # The settled estimate: its samples counted apart, as the CLI's JSON; 0 turns it off.
+    assert r.estimate_samples == printed["estimate_samples"]
+    plain = hfvis.pvs(dem, samples=30000, view_cell=48, tile=32, band_low=2, band_high=20, seed=5, cell_size=30,
+                      nodata=NODATA, estimate_entries=0)
+    assert plain.estimate_samples == 0 and plain.samples == 30000
+    assert r.samples == 30000 + r.estimate_samples
+    with pytest.raises(ValueError, match="estimate_entries"):
+        hfvis.pvs(dem, samples=100, cell_size=30, nodata=NODATA, estimate_entries=-1)
     with pytest.raises(hfvis.InvalidArgumentError, match="resume"):
         hfvis.pvs(dem, samples=100, view_cell=64, tile=32, cell_size=30, nodata=NODATA, start=r.bits)
     # A mask per pixel, as the CLI's --view-mask: only the view cells it touches are computed.
