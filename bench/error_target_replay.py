@@ -13,7 +13,7 @@ meeting E and the median and largest cost over the cheapest fixed K's: for the p
 replays it with another bound on p), the earlier rule (detail::directionsForError, the raw
 estimate), the best of a family of other stepping rules, a single run at the first K whose raw
 estimate meets E (the stepping's floor), and the earlier rule with the estimate scaled down.
---errors and --contents choose the cases (default: all E above, every content in the file)."""
+"a perfect estimate" replays the present stepping with the estimate equal to the error. --errors and --contents choose the cases (default: all E above, every content in the file)."""
 import argparse
 import math
 import re
@@ -64,23 +64,27 @@ def richardson_order(runs, max_order):  # detail::estimateOrder
     return 1.0
 
 
-def present(data, overhead, max_order=1.1, aim=0.9):
-    """detail::nextDirectionsForError and the estimate over detail::richardsonDivisor."""
+def present(data, overhead, max_order=1.1, aim=0.9, perfect=False):
+    """detail::nextDirectionsForError and the estimate over detail::richardsonDivisor; perfect: the
+    same stepping with the estimate replaced by the achieved error (an estimate that is exact), so
+    what is left over the cheapest fixed K is the stepping's own cost."""
     cases = []
     for (output, field), curve in sorted(data.items()):
         for E in ERRORS:
             fixed = next((k for k in sorted(curve) if curve[k][1] <= E), None)
             runs, cost, K = [], 0.0, 16
             while K <= 4096:
-                raw = at(curve, K, 2)
+                raw = at(curve, K, 1 if perfect else 2)
                 cost += at(curve, K, 0) + overhead
                 runs.append((K, raw))
-                if raw / (2 ** richardson_order(runs, max_order) - 1) <= E:
+                divisor = 1.0 if perfect else 2 ** richardson_order(runs, max_order) - 1
+                if raw / divisor <= E:
                     break
                 q = 1.0
                 if len(runs) >= 2 and runs[-2][1] > raw > 0:
                     q = min(2.0, max(1.0, math.log(runs[-2][1] / raw) / math.log(K / runs[-2][0])))
-                wanted = min(K * (raw / (2 ** min(q, max_order) - 1) / (aim * E)) ** (1 / q), 8192)
+                divisor = 1.0 if perfect else 2 ** min(q, max_order) - 1
+                wanted = min(K * (raw / divisor / (aim * E)) ** (1 / q), 8192)
                 if wanted > 4 * K:
                     wanted = min(wanted, max(2 * K, wanted / 6))
                 K = int(max(K + 8, math.ceil(wanted / 8) * 8))
@@ -139,6 +143,7 @@ def main():
     if args.contents:
         data = {key: curve for key, curve in data.items() if key[1] in args.contents.split(",")}
     summary("present rule (p at most %g)" % args.max_order, present(data, args.overhead, args.max_order))
+    summary("present stepping, a perfect estimate", present(data, args.overhead, perfect=True))
     summary("earlier rule", replay(data, rule(), args.overhead))
     best = None
     for first in (8, 16, 24, 32):
