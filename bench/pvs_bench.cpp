@@ -176,7 +176,7 @@ void pvsRecallReport(const ComputeContext& context, const std::vector<std::strin
                      const std::string& dem_path, int view_cell, int tile,
                      const std::vector<std::uint64_t>& samples, int check_rays,
                      const std::vector<PvsMethod>& methods, bool reference,
-                     const std::vector<std::uint32_t>& seeds) {
+                     const std::vector<std::uint32_t>& seeds, std::size_t estimate_entries) {
   PvsGrid grid;
   grid.view_cell = view_cell;
   grid.tile = tile;
@@ -209,6 +209,7 @@ void pvsRecallReport(const ComputeContext& context, const std::vector<std::strin
           options.method = method;
           options.samples = n;
           options.seed = seed;
+          options.estimate_entries = estimate_entries;
           const PvsResult pvs = computePvs(context, f, grid, options);
           const std::string recall = reference ? std::to_string(pvsRecall(pvs, dense)).substr(0, 6) : "-";
           const double measured = measuredPixelError(f, pvs, check, check_hits, options.resolution);
@@ -238,8 +239,10 @@ void pvsRecallReport(const ComputeContext& context, const std::vector<std::strin
     std::printf("\n");
     for (const PvsProgress& p : last_agvs.history) {
       std::printf("| %llu |", static_cast<unsigned long long>(p.samples));
-      for (double q : p.probability) std::printf(" %.3f |", q);
-      std::printf("\n");
+      // (a batch settling the estimate draws view-direction samples alone)
+      for (int d = 0; d < kPvsDistributions; ++d)
+        std::printf(" %.3f |", p.settling ? (d == 0 ? 1.0 : 0.0) : p.probability[d]);
+      std::printf(p.settling ? " settling |\n" : "\n");
     }
   }
   std::printf("\n(pixel errors per million rays; measured with %d random view rays; %s)\n", check_rays,

@@ -807,13 +807,16 @@ const std::vector<OptionSpec>& optionTable() {
        [](const std::string& typed, const std::string& value, RunArguments& run) {
          run.pvs.pixel_error = parsePositive(typed, value);
        }},
-      {"--seconds", nullptr, "S", kPvsGroup, false, "stop after S seconds",
+      {"--seconds", nullptr, "S", kPvsGroup, false,
+       "stop after S seconds (settling the estimate may then take as long\n"
+       "again: --estimate-entries)",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
          run.pvs.seconds = parsePositive(typed, value);
        }},
       {"--estimate-entries", nullptr, "N", kPvsGroup, false,
        "settle the estimate: after the budget, uniform view rays go on until N\n"
-       "entries found once carry it, up to the budget again (default 20; 0: off)",
+       "entries found once carry it, at most as many samples (and seconds) as\n"
+       "the run took before them (default 20; 0: off)",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
          const double n = parseNumber(typed, value);
          if (!(n >= 0.0 && n <= 1e6 && n == std::floor(n)))

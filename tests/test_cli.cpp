@@ -2967,24 +2967,36 @@ TEST_F(Cli, PvsSettlesItsEstimate) {
   grid.view_cell = 8;
   grid.tile = 4;
   hfvis::PvsOptions options;
-  options.samples = 20000;
-  const hfvis::PvsResult want =
-      hfvis::computePvs(hfvis::testing::testContext(), hfvis::readHeightField(field), grid, options);
+  hfvis::PvsResult want;
+  // (the first budget of these that leaves something to settle)
+  for (std::uint64_t samples : {1000u, 2000u, 4000u, 8000u, 16000u}) {
+    options.samples = samples;
+    want = hfvis::computePvs(hfvis::testing::testContext(), hfvis::readHeightField(field), grid, options);
+    if (want.estimate_samples > 0) break;
+  }
   ASSERT_GT(want.estimate_samples, 0u);
-  const std::string base = "pvs " + shellQuoted(field) + " --view-cell 8 --tile 4 --samples 20000 -o ";
+  const std::string budget = std::to_string(options.samples);
+  const std::string base =
+      "pvs " + shellQuoted(field) + " --view-cell 8 --tile 4 --samples " + budget + " -o ";
   const CliResult settled = run(base + shellQuoted(out("s.json")));
   ASSERT_EQ(settled.status, 0) << settled.err;
   const Json s = JsonParser::parse(readText(out("s.json")));
   EXPECT_EQ(s["samples"].number, double(want.samples));
   EXPECT_EQ(s["estimate_samples"].number, double(want.estimate_samples));
   EXPECT_EQ(s["entries"].number, double(want.entries()));
+  // The progress rows say which batches settled the estimate.
+  const Json& rows = s["progress"];
+  ASSERT_EQ(rows.items.size(), want.history.size());
+  for (std::size_t i = 0; i < rows.items.size(); ++i)
+    EXPECT_EQ(rows[i]["settling"].boolean, want.history[i].settling) << i;
+  EXPECT_TRUE(rows.items.back()["settling"].boolean);
   EXPECT_NE(settled.out.find(std::to_string(want.estimate_samples) + " settling the estimate"),
             std::string::npos)
       << settled.out;
   const CliResult plain = run(base + shellQuoted(out("p.json")) + " --estimate-entries 0 --quiet");
   ASSERT_EQ(plain.status, 0) << plain.err;
   const Json p = JsonParser::parse(readText(out("p.json")));
-  EXPECT_EQ(p["samples"].number, 20000.0);
+  EXPECT_EQ(p["samples"].number, double(options.samples));
   EXPECT_EQ(p["estimate_samples"].number, 0.0);
   for (const char* bad : {"-1", "2.5", "1e7", "0x10", "nan"}) {
     const CliResult refused = run(base + shellQuoted(out("b.json")) + " --estimate-entries " + bad);

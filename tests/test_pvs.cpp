@@ -602,19 +602,67 @@ TEST(Pvs, TheEstimateSettlesOnEnoughEntriesFoundOnce) {
   ASSERT_GT(settled.estimate_samples, 0u);
   EXPECT_LE(settled.estimate_samples, 100000u);
   EXPECT_EQ(settled.samples, 100000u + settled.estimate_samples);
-  EXPECT_GT(settled.uniform_rays, plain.uniform_rays);
+  // Every settling sample a view-direction one: two uniform rays each (the first 100000 samples are
+  // the same in both runs).
+  EXPECT_EQ(settled.uniform_rays - plain.uniform_rays, 2 * settled.estimate_samples);
   const double found_once = settled.pixel_error * double(settled.uniform_rays) / options.resolution;
   EXPECT_TRUE(found_once > 19.5 || settled.estimate_samples == 100000u) << found_once;
   for (std::size_t i = 0; i < plain.bits.size(); ++i) ASSERT_EQ(plain.bits[i] & ~settled.bits[i], 0u) << i;
   ASSERT_EQ(settled.history.size(), 5u + (settled.estimate_samples + 19999) / 20000);
-  for (std::size_t i = 5; i < settled.history.size(); ++i)
-    EXPECT_EQ(settled.history[i].probability, settled.history[4].probability) << i;
+  for (std::size_t i = 0; i < settled.history.size(); ++i) {
+    EXPECT_EQ(settled.history[i].settling, i >= 5) << i;
+    if (i >= 5) {
+      EXPECT_EQ(settled.history[i].probability, settled.history[4].probability) << i;
+    }
+  }
   // An early SGVS run's estimate rests on many entries found once: nothing to settle.
   options.method = PvsMethod::Sgvs;
   options.samples = 20000;
   const PvsResult early = computePvs(testContext(), field, grid, options);
   EXPECT_EQ(early.estimate_samples, 0u);
   EXPECT_GT(early.pixel_error * double(early.uniform_rays) / options.resolution, 20.0);
+  // Per-cell sampling settles as well: its samples are all uniform view rays already.
+  options.method = PvsMethod::PerCell;
+  options.samples = 300000;
+  options.batch = 65536;
+  const PvsResult per_cell = computePvs(testContext(), field, grid, options);
+  options.estimate_entries = 0;
+  const PvsResult per_cell_plain = computePvs(testContext(), field, grid, options);
+  if (per_cell_plain.pixel_error * double(per_cell_plain.uniform_rays) / options.resolution < 19.5) {
+    EXPECT_GT(per_cell.estimate_samples, 0u);
+  }
+  EXPECT_EQ(per_cell.uniform_rays, per_cell.samples);
+  EXPECT_EQ(per_cell.samples, 300000u + per_cell.estimate_samples);
+}
+
+// A pixel-error budget that an unsettled estimate meets and the settled one does not goes on
+// sampling (the settling batches followed by more of the mixture's), and ends with the settled
+// estimate at or below the budget; with --estimate-entries 0 the same budget stops at the first.
+TEST(Pvs, APixelErrorBudgetGoesOnWhereTheSettledEstimateMissesIt) {
+  const HeightField field = makeSyntheticField("city", 97, 97, 7);
+  PvsGrid grid;
+  grid.view_cell = 16;
+  grid.tile = 8;
+  int went_on = 0;
+  for (double budget : {1000.0, 400.0, 200.0, 30.0}) {
+    PvsOptions options;
+    options.pixel_error = budget;
+    options.batch = 2000;
+    const PvsResult pvs = computePvs(testContext(), field, grid, options);
+    EXPECT_LE(pvs.pixel_error, budget);
+    bool settled = false;
+    for (std::size_t i = 0; i < pvs.history.size(); ++i) {
+      if (pvs.history[i].settling) settled = true;
+      if (settled && !pvs.history[i].settling) {
+        ++went_on;
+        break;
+      }
+    }
+    options.estimate_entries = 0;
+    const PvsResult plain = computePvs(testContext(), field, grid, options);
+    EXPECT_LE(plain.samples, pvs.samples - pvs.estimate_samples) << budget;
+  }
+  EXPECT_GT(went_on, 0);  // (else this test does not reach what it tests)
 }
 
 // Where every entry is found many times over (a flat field sees everything), no entry rests on one

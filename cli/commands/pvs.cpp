@@ -208,7 +208,8 @@ class Pvs : public Computation {
       const PvsProgress& p = r.history[i];
       json << (i ? "," : "") << "\n    {\"samples\": " << p.samples << ", \"rays\": " << p.rays
            << ", \"entries\": " << p.entries << ", \"seconds\": " << jsonNumber(p.seconds)
-           << ", \"estimated_pixel_error\": " << jsonNumber(p.pixel_error) << ", \"mixture\": {";
+           << ", \"estimated_pixel_error\": " << jsonNumber(p.pixel_error)
+           << ", \"settling\": " << (p.settling ? "true" : "false") << ", \"mixture\": {";
       for (int d = 0; d < kPvsDistributions; ++d)
         json << (d ? ", " : "") << jsonString(pvsDistributionName(d)) << ": " << jsonNumber(p.probability[d]);
       json << "}}";
@@ -362,8 +363,9 @@ const CommandSpec kPvsCommand{
     "reached: --samples N, --pixel-error E (the paper's estimate, in differing rays per\n"
     "million-ray camera), --seconds S. The same seed and --samples give the same sets.\n"
     "When a budget leaves the estimate on fewer than 20 entries found once (a count too\n"
-    "small to hold within 2x), uniform view rays go on until 20 carry it, up to the\n"
-    "budget's samples again (--estimate-entries N; estimate_samples in the JSON).\n"
+    "small to hold within 2x) but one at least, uniform view rays go on until 20 carry\n"
+    "it, at most as many samples (and seconds) as the run took before them\n"
+    "(--estimate-entries N, 0: off; estimate_samples in the JSON).\n"
     "--view-mask MASK (a raster of the field's size): only the view cells holding a non-zero\n"
     "pixel (its first channel) are computed. --filter K: Sec. 5's object-space filter, K\n"
     "times the sampling's gap.\n"

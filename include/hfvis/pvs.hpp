@@ -110,7 +110,8 @@ struct PvsResult;
 
 struct PvsOptions {
   PvsMethod method = PvsMethod::Agvs;
-  // Budgets: the run stops at the first one reached (0 = none); at least one must be set.
+  // Budgets: the run stops at the first one reached (0 = none; then the estimate may settle,
+  // estimate_entries below); at least one must be set.
   std::uint64_t samples = 0;  // visibility samples (a global sample is two rays, a per-cell one one)
   double pixel_error = 0.0;   // the estimated pixel error (Sec. 4.5) at or below this
   double seconds = 0.0;       // wall time
@@ -123,12 +124,14 @@ struct PvsOptions {
   // samples per view cell; counted in PvsResult::filtered, with no witness.
   double filter = 0.0;
   // Settling the estimate: when a budget ends with fewer than this many entries found once by a
-  // uniform view ray (the entries PvsResult::pixel_error counts), view-direction samples go on
-  // until that many carry it, at most as many as the run's samples so far (so a run casts up to
-  // twice its budget); PvsResult::estimate_samples counts them. With fewer entries the estimate
-  // is a Poisson count of a handful, off by more than 2x in about a third of runs (20: about 1 in
-  // 40; bench/report/pvs.md). A pixel-error budget the settled estimate no longer meets goes on
-  // sampling, within the other budgets. 0: the estimate as the budget left it.
+  // uniform view ray (the entries PvsResult::pixel_error counts), but one at least, view-direction
+  // samples go on until that many carry it, at most as many samples as the run cast before them
+  // (so a run casts up to twice its budget; under a seconds budget at most as many seconds again);
+  // PvsResult::estimate_samples counts them, and their rows in the history say `settling`. A count
+  // of a handful is off by more than 2x in about a third of runs (bench/report/pvs.md: ten DEM
+  // runs within 2x in 6 of 10 unsettled, 9 of 10 settled). With none the estimate stays at its
+  // floor (one entry over the uniform rays). A pixel-error budget the settled estimate no longer
+  // meets goes on sampling, within the other budgets. 0: the estimate as the budget left it.
   std::size_t estimate_entries = 20;
   bool witnesses = false;               // keep each entry's witness (PvsResult::witnesses)
   std::size_t memory_budget_bytes = 0;  // as RayCastOptions::memory_budget_bytes
@@ -158,6 +161,8 @@ struct PvsProgress {
   double seconds = 0.0;
   double pixel_error = 0.0;         // the estimate after the batch
   std::vector<double> probability;  // per distribution (kPvsDistributions), the mixture's
+  bool settling = false;            // a batch settling the estimate (PvsOptions::estimate_entries):
+                                    // view-direction samples alone, the mixture as it was
 };
 
 // The distributions of AGVS, in PvsProgress::probability's order.

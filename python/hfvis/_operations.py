@@ -592,10 +592,11 @@ def pvs(heights, *, samples=0, pixel_error=0.0, seconds=0.0, view_cell=32, band_
     pixel grid); computed in one piece. start: an earlier run's bits (its Pvs.bits) on the same
     field and grid, to go on from; its entries stay (give another seed, or its samples repeat; no
     filter, and not the bits of a filtered run). estimate_entries: when a budget leaves the
-    estimate on fewer entries found once, uniform view rays go on until that many carry it, up to
-    the budget's samples again (estimate_samples counts them; 0: off)."""
-    if int(estimate_entries) < 0:
-        raise ValueError(f"estimate_entries must be 0 or more, got {estimate_entries}")
+    estimate on fewer entries found once (one at least), uniform view rays go on until that many
+    carry it, at most as many samples (and seconds) as the run took before them (estimate_samples
+    counts them, history rows say "settling"; 0: off)."""
+    if not (isinstance(estimate_entries, (int, np.integer)) and 0 <= estimate_entries <= 1_000_000):
+        raise InvalidArgumentError(f"estimate_entries must be a whole number in 0 .. 1e6, got {estimate_entries!r}")
     options = {"samples": int(samples), "pixel_error": float(pixel_error), "seconds": float(seconds),
                "view_cell": int(view_cell), "band_low": float(band_low), "band_high": float(band_high),
                "tile": int(tile), "mask": None if mask is None else np.asarray(mask), "method": method,

@@ -517,6 +517,7 @@ nb::dict pvs(const HeightField& field, const PvsGrid& grid, PvsOptions options, 
     row["entries"] = p.entries;
     row["seconds"] = p.seconds;
     row["pixel_error"] = p.pixel_error;
+    row["settling"] = p.settling;
     nb::dict mixture;
     for (int d = 0; d < kPvsDistributions && d < int(p.probability.size()); ++d)
       mixture[pvsDistributionName(d)] = p.probability[d];

@@ -350,12 +350,20 @@ def test_pvs(tmp_path, projected_tif, dem):
     assert np.all(r.bits & ~more.bits == 0) and more.entries > r.entries
     # The settled estimate: its samples counted apart, as the CLI's JSON; 0 turns it off.
     assert r.estimate_samples == printed["estimate_samples"]
-    plain = hfvis.pvs(dem, samples=30000, view_cell=48, tile=32, band_low=2, band_high=20, seed=5, cell_size=30,
-                      nodata=NODATA, estimate_entries=0)
-    assert plain.estimate_samples == 0 and plain.samples == 30000
-    assert r.samples == 30000 + r.estimate_samples
-    with pytest.raises(ValueError, match="estimate_entries"):
-        hfvis.pvs(dem, samples=100, cell_size=30, nodata=NODATA, estimate_entries=-1)
+    assert [row["settling"] for row in r.history] == [row["settling"] for row in printed["progress"]]
+    kw = dict(view_cell=48, tile=32, band_low=2, band_high=20, seed=5, cell_size=30, nodata=NODATA)
+    for n in (60000, 120000, 240000, 480000):  # the first budget that leaves something to settle
+        settled = hfvis.pvs(dem, samples=n, **kw)
+        if settled.estimate_samples:
+            break
+    assert 0 < settled.estimate_samples <= n and settled.samples == n + settled.estimate_samples
+    assert settled.history[-1]["settling"] and not settled.history[0]["settling"]
+    plain = hfvis.pvs(dem, samples=n, estimate_entries=0, **kw)
+    assert plain.estimate_samples == 0 and plain.samples == n
+    assert np.all(plain.bits & ~settled.bits == 0)
+    for bad in (-1, 2.5, 10**7):
+        with pytest.raises(hfvis.InvalidArgumentError, match="estimate_entries"):
+            hfvis.pvs(dem, samples=100, cell_size=30, nodata=NODATA, estimate_entries=bad)
     with pytest.raises(hfvis.InvalidArgumentError, match="resume"):
         hfvis.pvs(dem, samples=100, view_cell=64, tile=32, cell_size=30, nodata=NODATA, start=r.bits)
     # A mask per pixel, as the CLI's --view-mask: only the view cells it touches are computed.

@@ -198,9 +198,9 @@ class Sampler {
   void run(detail::RayCaster& caster) {
     const auto start = std::chrono::steady_clock::now();
     for (;;) {
-      const bool complete = sample(caster, start);
-      if (complete) break;
+      if (sample(caster, start)) break;
       settle(caster, start);
+      if (completeUnderPixelError()) break;
       // A pixel-error budget the settled estimate no longer meets goes on, within the others.
       const bool budget_left = (!options_.samples || out_.samples < options_.samples) &&
                                (options_.seconds <= 0.0 || out_.seconds < options_.seconds);
@@ -211,7 +211,7 @@ class Sampler {
 
  private:
   // The sampler's batches until a budget is reached; true when a pixel-error budget ends with the
-  // sets complete (then no ray can differ: the estimate is 0).
+  // sets complete.
   bool sample(detail::RayCaster& caster, std::chrono::steady_clock::time_point start) {
     for (;;) {
       std::uint64_t n = std::uint64_t(options_.batch);
@@ -220,32 +220,43 @@ class Sampler {
       batch(caster, static_cast<int>(n));
       record(start);
       if (options_.pixel_error > 0.0 && out_.pixel_error <= options_.pixel_error) return false;
-      if (options_.pixel_error > 0.0 && out_.entries() == complete_) {
-        // Every computed view cell holds every tile: no ray can differ, whatever the estimate's
-        // floor of one entry per uniform ray says (a run would go on for ever toward a small E).
-        out_.pixel_error = 0.0;
-        out_.history.back().pixel_error = 0.0;
-        return true;
-      }
+      if (completeUnderPixelError()) return true;
       if (options_.seconds > 0.0 && out_.seconds >= options_.seconds) return false;
     }
   }
 
+  // Every computed view cell holds every tile: no ray can differ, whatever the estimate's floor of
+  // one entry per uniform ray says (a pixel-error budget would go on for ever toward a small E), so
+  // under a pixel-error budget the estimate is 0 and the run ends.
+  bool completeUnderPixelError() {
+    if (!(options_.pixel_error > 0.0 && out_.entries() == complete_)) return false;
+    out_.pixel_error = 0.0;
+    out_.history.back().pixel_error = 0.0;
+    return true;
+  }
+
   // Settles the estimate (PvsOptions::estimate_entries): while fewer entries found once than asked
-  // carry it, view-direction samples (uniform view rays) go on, at most as many as the run's
-  // samples so far. The entries they find join the sets; the mixture and the mutations stay.
+  // carry it, view-direction samples (uniform view rays) go on, at most as many samples as the
+  // run cast before them (and under a seconds budget at most as many seconds as it took). Not
+  // when no entry is found once: the estimate is then its floor, one entry over the uniform rays,
+  // and a run that has converged would cast its budget again for nothing. The entries they find
+  // join the sets; the mixture and the mutations stay.
   void settle(detail::RayCaster& caster, std::chrono::steady_clock::time_point start) {
+    if (options_.estimate_entries == 0 || only_finders_.empty() || out_.entries() == complete_) return;
     const std::uint64_t most = out_.samples - out_.estimate_samples;
+    const double before = out_.seconds - settle_seconds_;
     const auto unsettled = [&] {
-      return options_.estimate_entries > 0 && only_finders_.size() < options_.estimate_entries &&
-             out_.entries() < complete_ && out_.estimate_samples < most;
+      return only_finders_.size() < options_.estimate_entries && out_.entries() < complete_ &&
+             out_.estimate_samples < most && (options_.seconds <= 0.0 || settle_seconds_ < before);
     };
     settling_ = true;
     while (unsettled()) {
       const std::uint64_t n = std::min<std::uint64_t>(options_.batch, most - out_.estimate_samples);
+      const double t0 = out_.seconds;
       batch(caster, static_cast<int>(n));
       out_.estimate_samples += n;
       record(start);
+      settle_seconds_ += out_.seconds - t0;
     }
     settling_ = false;
   }
@@ -260,6 +271,7 @@ class Sampler {
     row.seconds = out_.seconds;
     row.pixel_error = out_.pixel_error;
     row.probability = probability_;
+    row.settling = settling_;
     out_.history.push_back(row);
     if (options_.progress) options_.progress(out_);
   }
@@ -661,6 +673,7 @@ class Sampler {
   std::vector<Silhouette> silhouettes_;
   std::uint64_t uniform_rays_ = 0;  // uniform view rays cast so far (foundAgain)
   bool settling_ = false;           // settle(): view-direction samples alone
+  double settle_seconds_ = 0.0;     // the time settle() took
   std::size_t complete_ = 0;        // the entries of complete sets: computed view cells x tiles
   // The entries only one uniform view ray has found (foundAgain): a bit per entry as out_.bits,
   // and the finder's lineage by entry (v * tiles + t).
