@@ -253,6 +253,16 @@ std::uint32_t parseSeed(const std::string& typed, const std::string& value) {
   return static_cast<std::uint32_t>(n);
 }
 
+// A whole number of `what` in lo .. hi (`range`: the message's words for them).
+double parseWholeIn(const std::string& typed, const std::string& value, double lo, double hi,
+                    const char* what, const char* range) {
+  const double n = parseNumber(typed, value);
+  if (!(n >= lo && n <= hi && n == std::floor(n)))
+    throw UsageError(typed + ": expected a whole number of " + what + ", " + range + ", got " +
+                     inQuotes(shortened(value)));
+  return n;
+}
+
 // A count of cells a side (pvs's --view-cell and --tile): a whole number >= 1 (the field's size
 // bounds it once read).
 int parseCellCount(const std::string& typed, const std::string& value) {
@@ -795,11 +805,8 @@ const std::vector<OptionSpec>& optionTable() {
        }},
       {"--samples", nullptr, "N", kPvsGroup, false, "stop after N visibility samples",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
-         const double n = parseNumber(typed, value);
-         if (!(n >= 1.0 && n <= 1e15 && n == std::floor(n)))
-           throw UsageError(typed + ": expected a whole number of samples, 1 .. 1e15, got " +
-                            inQuotes(shortened(value)));
-         run.pvs.samples = static_cast<std::uint64_t>(n);
+         run.pvs.samples =
+             static_cast<std::uint64_t>(parseWholeIn(typed, value, 1.0, 1e15, "samples", "1 .. 1e15"));
        }},
       {"--pixel-error", nullptr, "E", kPvsGroup, false,
        "stop once the estimated pixel error is at most E (pixels per\n"
@@ -818,11 +825,8 @@ const std::vector<OptionSpec>& optionTable() {
        "entries found once carry it, at most as many samples (and seconds) as\n"
        "the run took before them (default 20; 0: off)",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
-         const double n = parseNumber(typed, value);
-         if (!(n >= 0.0 && n <= 1e6 && n == std::floor(n)))
-           throw UsageError(typed + ": expected a whole number of entries, 0 .. 1e6, got " +
-                            inQuotes(shortened(value)));
-         run.pvs.estimate_entries = static_cast<std::size_t>(n);
+         run.pvs.estimate_entries =
+             static_cast<std::size_t>(parseWholeIn(typed, value, 0.0, 1e6, "entries", "0 .. 1e6"));
        }},
       {"--filter", nullptr, "K", kPvsGroup, false,
        "the visibility filter: add the tiles within K times the sampling's\n"

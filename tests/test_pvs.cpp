@@ -435,6 +435,14 @@ PvsGrid smallGrid() {
   return grid;
 }
 
+// The estimate's tests' grid on 97^2 fields: view cells of 16 x 16 cells, tiles of 8 x 8.
+PvsGrid estimateGrid() {
+  PvsGrid grid;
+  grid.view_cell = 16;
+  grid.tile = 8;
+  return grid;
+}
+
 TEST(Pvs, EveryEntryHasAWitness) {
   const HeightField field = smallCity();
   for (PvsMethod method : {PvsMethod::Agvs, PvsMethod::Sgvs, PvsMethod::PerCell}) {
@@ -551,9 +559,7 @@ TEST(Pvs, FixedSeedsReproduceInBothLayouts) {
 // (a run inside one batch too). Below about ten per million the estimate rests on a handful of
 // entries found once, and the measurement on a handful of rays (docs/PVS.md).
 TEST(Pvs, EstimatedPixelErrorWithinAFactorTwoOfTheMeasured) {
-  PvsGrid grid;
-  grid.view_cell = 16;
-  grid.tile = 8;
+  const PvsGrid grid = estimateGrid();
   for (const char* name : {"city", "noise"}) {
     const HeightField field = makeSyntheticField(name, 97, 97, 7);
     const std::vector<HeightRay> check = randomViewRays(field, grid, 2000000, 99);
@@ -585,9 +591,7 @@ TEST(Pvs, EstimatedPixelErrorWithinAFactorTwoOfTheMeasured) {
 // the same), leave the mixture as it was, and 0 turns them off.
 TEST(Pvs, TheEstimateSettlesOnEnoughEntriesFoundOnce) {
   const HeightField field = makeSyntheticField("noise", 97, 97, 7);
-  PvsGrid grid;
-  grid.view_cell = 16;
-  grid.tile = 8;
+  const PvsGrid grid = estimateGrid();
   PvsOptions options;
   options.samples = 100000;
   options.batch = 20000;
@@ -640,9 +644,7 @@ TEST(Pvs, TheEstimateSettlesOnEnoughEntriesFoundOnce) {
 // estimate at or below the budget; with --estimate-entries 0 the same budget stops at the first.
 TEST(Pvs, APixelErrorBudgetGoesOnWhereTheSettledEstimateMissesIt) {
   const HeightField field = makeSyntheticField("city", 97, 97, 7);
-  PvsGrid grid;
-  grid.view_cell = 16;
-  grid.tile = 8;
+  const PvsGrid grid = estimateGrid();
   int went_on = 0;
   for (double budget : {1000.0, 400.0, 200.0, 30.0}) {
     PvsOptions options;
@@ -761,9 +763,7 @@ TEST(Pvs, BadInput) {
 // its neighbour's shifted by one number: the two runs found together little more than either.)
 TEST(Pvs, NeighbouringSeedsSampleIndependently) {
   const HeightField field = makeSyntheticField("noise", 97, 97, 7);
-  PvsGrid grid;
-  grid.view_cell = 16;
-  grid.tile = 8;
+  const PvsGrid grid = estimateGrid();
   for (PvsMethod method : {PvsMethod::Agvs, PvsMethod::Sgvs, PvsMethod::PerCell}) {
     SCOPED_TRACE(int(method));
     PvsOptions options;
@@ -790,9 +790,7 @@ TEST(Pvs, NeighbouringSeedsSampleIndependently) {
 // compute are refused.
 TEST(Pvs, AResumedRunGoesOnFromTheEarlierSets) {
   const HeightField field = makeSyntheticField("noise", 97, 97, 7);
-  PvsGrid grid;
-  grid.view_cell = 16;
-  grid.tile = 8;
+  const PvsGrid grid = estimateGrid();
   const std::vector<HeightRay> check = randomViewRays(field, grid, 2000000, 99);
   const RayCastResult hits = castHeightFieldRays(testContext(), field, check);
   PvsResult first;
