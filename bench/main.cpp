@@ -110,7 +110,7 @@ constexpr const char* kUsage =
     "       hfvis_bench pvs-scalar [--size N] [--rays R] [--reps K] [--dem FILE] FIELD...\n"
     "       hfvis_bench pvs-recall [--size N] [--view-cell C] [--tile T] [--samples N,N,...]\n"
     "                              [--check-rays R] [--methods agvs,sgvs,per-cell] [--reference yes|no]\n"
-    "                              [--seeds S,S,...] [--estimate-entries N]\n"
+    "                              [--seeds S,S,...] [--estimate-entries N] [--inside yes|no]\n"
     "                              [--dem FILE] FIELD...   (FIELD: city, noise, dem)\n"
     "       hfvis_bench region [--sections arealight,arealight-quick,pair,pair-quick,error,bitmask,\n"
     "                          crossover]\n"
@@ -495,10 +495,12 @@ int main(int argc, char** argv) {
       for (int s : intList(args.get("--seeds", "1"))) seeds.push_back(std::uint32_t(s));
       const int estimate_entries = std::stoi(args.get("--estimate-entries", "20"));
       if (estimate_entries < 0) throw Usage("--estimate-entries: 0 or more");
+      const std::string inside = args.get("--inside", "no");
+      if (inside != "yes" && inside != "no") throw Usage("--inside: yes or no");
       const std::vector<std::string> fields = args.positional();
       args.rejectUnused();
       pvsRecallReport(context, fields, size, dem, view_cell, tile, samples, check, methods,
-                      reference == "yes", seeds, std::size_t(estimate_entries));
+                      reference == "yes", seeds, std::size_t(estimate_entries), inside == "yes");
       return 0;
     }
     if (command == "region") {

@@ -12,7 +12,9 @@
 # 1M-sample runs (seeds 1 .. 10) on the DEM at 320^2, where few missing entries are left to count.
 # Runs settle their estimate (PvsOptions::estimate_entries, the default 20; the tables' column
 # "settling the estimate" gives the samples that took) except where the samplers' recall is
-# compared at equal samples (the limits part's first two sections: --estimate-entries 0).
+# compared at equal samples (the limits part's first two sections: --estimate-entries 0). The
+# limits part's first section also gives recall against the dense reference inside the tiles
+# (DenseTargets::InsideTiles: without the entries seen only at a tile's border).
 # Each file starts with a line saying how and when it ran.
 #
 #   bench/pvs.sh [--parts rays,recall,limits] [--size 128] [--estimate-size 1024]
@@ -74,7 +76,7 @@ recall_part() {
 limits_part() {
   echo "## Recall past 1M samples ($size x $size fields, view cells 16 x 16, tiles 8 x 8; each run ends at its budget, --estimate-entries 0)"
   "$bench" pvs-recall --check-rays 1000000 --size "$size" --view-cell 16 --tile 8 --estimate-entries 0 \
-    --samples 1000000,3000000,10000000,30000000 --methods agvs --dem "$dem" city noise dem
+    --inside yes --samples 1000000,3000000,10000000,30000000 --methods agvs --dem "$dem" city noise dem
   echo
   echo "## SGVS and per-cell sampling at 1x, 3x and 10x the samples AGVS took to 0.99 on the rough terrain (--estimate-entries 0)"
   "$bench" pvs-recall --check-rays 1000000 --size "$size" --view-cell 16 --tile 8 --estimate-entries 0 \

@@ -176,7 +176,7 @@ void pvsRecallReport(const ComputeContext& context, const std::vector<std::strin
                      const std::string& dem_path, int view_cell, int tile,
                      const std::vector<std::uint64_t>& samples, int check_rays,
                      const std::vector<PvsMethod>& methods, bool reference,
-                     const std::vector<std::uint32_t>& seeds, std::size_t estimate_entries) {
+                     const std::vector<std::uint32_t>& seeds, std::size_t estimate_entries, bool inside) {
   PvsGrid grid;
   grid.view_cell = view_cell;
   grid.tile = tile;
@@ -185,6 +185,8 @@ void pvsRecallReport(const ComputeContext& context, const std::vector<std::strin
     auto t0 = std::chrono::steady_clock::now();
     const PvsResult dense = reference ? computeDensePvs(context, f, grid) : PvsResult{};
     const double dense_seconds = seconds(t0);
+    const PvsResult dense_inside =
+        reference && inside ? computeDensePvs(context, f, grid, DenseTargets::InsideTiles) : PvsResult{};
     const std::vector<HeightRay> check = randomViewRays(f, grid, check_rays, 99);
     const RayCastResult check_hits = castHeightFieldRays(context, f, check);
     std::printf("\n### %s %d x %d (view cells %d x %d cells, tiles %d x %d)\n\n", name.c_str(), f.width,
@@ -194,12 +196,16 @@ void pvsRecallReport(const ComputeContext& context, const std::vector<std::strin
                   dense.layout.viewCells() * dense.layout.tiles(),
                   100.0 * double(dense.entries()) / (dense.layout.viewCells() * dense.layout.tiles()),
                   dense_seconds);
-    else
+    if (reference && inside)
+      std::printf("Inside the tiles (their grid points off the tiles' borders): %zu entries; %zu of the "
+                  "reference's are seen only at a tile's border.\n\n",
+                  dense_inside.entries(), dense.entries() - dense_inside.entries());
+    if (!reference)
       std::printf("(no dense reference: recall not measured)\n\n");
     std::printf(
-        "| sampler | samples | settling the estimate | rays | recall | estimated pixel error | its rays: found "
-        "once / uniform | measured pixel error | its rays: wrong | seconds |\n"
-        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+        "| sampler | samples | settling the estimate | rays | recall | recall inside the tiles | estimated pixel "
+        "error | its rays: found once / uniform | measured pixel error | its rays: wrong | seconds |\n"
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
     PvsResult last_agvs;
     int runs = 0, within = 0;
     for (PvsMethod method : methods) {
@@ -212,15 +218,18 @@ void pvsRecallReport(const ComputeContext& context, const std::vector<std::strin
           options.estimate_entries = estimate_entries;
           const PvsResult pvs = computePvs(context, f, grid, options);
           const std::string recall = reference ? std::to_string(pvsRecall(pvs, dense)).substr(0, 6) : "-";
+          const std::string recall_inside =
+              reference && inside ? std::to_string(pvsRecall(pvs, dense_inside)).substr(0, 6) : "-";
           const double measured = measuredPixelError(f, pvs, check, check_hits, options.resolution);
           const std::string sampler = std::string(methodName(method)) +
                                       (seeds.size() > 1 ? " (seed " + std::to_string(seed) + ")" : "");
           ++runs;
           within += pvs.pixel_error >= 0.5 * measured && pvs.pixel_error <= 2.0 * measured;
-          std::printf("| %s | %llu | %llu | %llu | %s | %.1f | %.0f / %llu | %.1f | %.0f | %.2f |\n",
+          std::printf("| %s | %llu | %llu | %llu | %s | %s | %.1f | %.0f / %llu | %.1f | %.0f | %.2f |\n",
                       sampler.c_str(), static_cast<unsigned long long>(n),
                       static_cast<unsigned long long>(pvs.estimate_samples),
-                      static_cast<unsigned long long>(pvs.rays), recall.c_str(), pvs.pixel_error,
+                      static_cast<unsigned long long>(pvs.rays), recall.c_str(), recall_inside.c_str(),
+                      pvs.pixel_error,
                       pvs.pixel_error * double(pvs.uniform_rays) / options.resolution,
                       static_cast<unsigned long long>(pvs.uniform_rays), measured,
                       measured * double(check.size()) / options.resolution, pvs.seconds);

@@ -37,11 +37,12 @@ void pvsScalarReport(const std::vector<std::string>& fields, int size, const std
 // the estimated and measured pixel error (`check_rays` random view rays), entries and seconds; and AGVS's
 // mixture over its last run. Only the samplers in `methods`; without `reference` no dense reference and no
 // recall (fields too large for it). `estimate_entries`: PvsOptions::estimate_entries (0: each run ends at
-// its budget, so that the samples compared are the samplers' own).
+// its budget, so that the samples compared are the samplers' own). `inside`: recall against the dense
+// reference inside the tiles too (DenseTargets::InsideTiles), and how many entries only a border sees.
 void pvsRecallReport(const ComputeContext& context, const std::vector<std::string>& fields, int size,
                      const std::string& dem_path, int view_cell, int tile,
                      const std::vector<std::uint64_t>& samples, int check_rays,
                      const std::vector<PvsMethod>& methods, bool reference,
-                     const std::vector<std::uint32_t>& seeds, std::size_t estimate_entries);
+                     const std::vector<std::uint32_t>& seeds, std::size_t estimate_entries, bool inside);
 
 }  // namespace hfvis::bench

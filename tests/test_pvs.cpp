@@ -372,7 +372,8 @@ PvsGrid flatGrid() {
   return grid;
 }
 
-// A flat field sees everything; a tall wall across the middle hides the far side's ground.
+// A flat field sees everything; a tall wall across the middle hides the far side's ground; the
+// reference inside the tiles leaves out a tile seen only at its border.
 TEST(PvsDense, ClosedCases) {
   const HeightField flat = flatField();
   const PvsGrid grid = flatGrid();
@@ -389,6 +390,17 @@ TEST(PvsDense, ClosedCases) {
   EXPECT_TRUE(walled.visible(0, 3));  // x 12 .. 16: the wall's top
   EXPECT_FALSE(walled.visible(0, 5));
   EXPECT_FALSE(walled.visible(2, 0));  // and from the far side, back
+  // Inside the tiles alone: the wall's top (x = 12) is the border of tiles 2 and 3, and tile 3's
+  // inner points lie beyond it, hidden: an entry of the closed reference only. Tile 2's inner
+  // points face the view cell. The flat field's tiles all have inner points, all seen.
+  const PvsResult inside = computeDensePvs(testContext(), wall, grid, DenseTargets::InsideTiles);
+  EXPECT_TRUE(inside.visible(0, 2));
+  EXPECT_FALSE(inside.visible(0, 3));
+  for (std::size_t i = 0; i < inside.bits.size(); ++i) EXPECT_EQ(inside.bits[i] & ~walled.bits[i], 0u) << i;
+  EXPECT_EQ(computeDensePvs(testContext(), flat, grid, DenseTargets::InsideTiles).entries(), all.entries());
+  PvsGrid ones = grid;
+  ones.tile = 1;
+  EXPECT_THROW(computeDensePvs(testContext(), flat, ones, DenseTargets::InsideTiles), InvalidArgument);
 }
 
 // Every witness: the eye in its view cell's square and band, the target on the surface in its

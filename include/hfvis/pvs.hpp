@@ -202,9 +202,17 @@ void validate(const PvsOptions& options);
 PvsResult computePvs(const ComputeContext& context, const HeightField& field, const PvsGrid& grid,
                      const PvsOptions& options);
 
+// Which of a tile's grid points the dense reference looks at: every one of its closed square (the
+// definition above: a point on a tile's border is a point of it), or those strictly inside it.
+// A tile seen only at its border (the far side of a ridge or roof edge that runs along it) is an
+// entry of the first, of measure zero for sampling: the second leaves such entries out (and
+// misses tiles seen only through slivers holding no inner grid point).
+enum class DenseTargets { ClosedTiles, InsideTiles };
+
 // The dense reference (see above): (C + 1)^2 x (1 or 3) viewsheds per view cell, for small
-// fields. Throws as computePvs.
-PvsResult computeDensePvs(const ComputeContext& context, const HeightField& field, const PvsGrid& grid);
+// fields. Throws as computePvs, and InvalidArgument for InsideTiles with tiles below 2 cells.
+PvsResult computeDensePvs(const ComputeContext& context, const HeightField& field, const PvsGrid& grid,
+                          DenseTargets targets = DenseTargets::ClosedTiles);
 
 // Entries of `got` that `want` holds, over `want`'s entries (1 when `want` has none).
 double pvsRecall(const PvsResult& got, const PvsResult& want);

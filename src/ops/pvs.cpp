@@ -441,10 +441,15 @@ RayCastResult castHeightFieldRays(const ComputeContext& context, const HeightFie
   return out;
 }
 
-PvsResult computeDensePvs(const ComputeContext& context, const HeightField& field, const PvsGrid& grid) {
+PvsResult computeDensePvs(const ComputeContext& context, const HeightField& field, const PvsGrid& grid,
+                          DenseTargets targets) {
   PvsResult out;
   out.layout = pvsLayout(field, grid);
   const PvsLayout& l = out.layout;
+  const bool inside = targets == DenseTargets::InsideTiles;
+  if (inside && l.tile < 2)
+    throw InvalidArgument("a dense reference inside the tiles needs tiles of 2 cells or more (a tile of 1 has "
+                          "no grid point inside it)");
   out.words = (l.tiles() + 31) / 32;
   out.bits.assign(std::size_t(l.viewCells()) * out.words, 0u);
   out.computed = grid.mask.empty() ? std::vector<std::uint8_t>(l.viewCells(), 1) : grid.mask;
@@ -468,11 +473,14 @@ PvsResult computeDensePvs(const ComputeContext& context, const HeightField& fiel
       for (int y = 0; y < field.height; ++y)
         for (int x = 0; x < field.width; ++x) {
           if (!(seen.count[std::size_t(y) * field.width + x] > 0.0f)) continue;
-          // Every tile whose closed square holds (x, y).
+          // Every tile whose closed square holds (x, y) (inside: whose open square does).
           for (int ty = std::max(0, (y - 1) / l.tile); ty <= std::min(l.tiles_y - 1, y / l.tile); ++ty)
             for (int tx = std::max(0, (x - 1) / l.tile); tx <= std::min(l.tiles_x - 1, x / l.tile); ++tx) {
               if (x < tx * l.tile || x > tx * l.tile + l.tile || y < ty * l.tile || y > ty * l.tile + l.tile)
                 continue;
+              // (inside: not on the tile's border; the field's last row and column bound the last tiles)
+              const int x1 = std::min(tx * l.tile + l.tile, l.cells_x), y1 = std::min(ty * l.tile + l.tile, l.cells_y);
+              if (inside && (x == tx * l.tile || x == x1 || y == ty * l.tile || y == y1)) continue;
               const int t = ty * l.tiles_x + tx;
               words[t / 32] |= 1u << (t % 32);
             }
