@@ -197,14 +197,15 @@ void pvsRecallReport(const ComputeContext& context, const std::vector<std::strin
                   100.0 * double(dense.entries()) / (dense.layout.viewCells() * dense.layout.tiles()),
                   dense_seconds);
     if (reference && inside)
-      std::printf("Inside the tiles (their grid points off the tiles' borders): %zu entries; %zu of the "
-                  "reference's are seen only at a tile's border.\n\n",
-                  dense_inside.entries(), dense.entries() - dense_inside.entries());
-    if (!reference)
-      std::printf("(no dense reference: recall not measured)\n\n");
+      std::printf(
+          "Inside the tiles (their grid points off the tiles' borders): %zu entries; %zu of the "
+          "reference's are seen only at a tile's border.\n\n",
+          dense_inside.entries(), dense.entries() - dense_inside.entries());
+    if (!reference) std::printf("(no dense reference: recall not measured)\n\n");
     std::printf(
-        "| sampler | samples | settling the estimate | rays | recall | recall inside the tiles | estimated pixel "
-        "error | its rays: found once / uniform | measured pixel error | its rays: wrong | seconds |\n"
+        "| sampler | samples | settling the estimate | rays | recall | recall inside the tiles | "
+        "estimated pixel error | its rays: found once / uniform | measured pixel error | its rays: wrong | "
+        "seconds |\n"
         "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
     PvsResult last_agvs;
     int runs = 0, within = 0;
@@ -229,8 +230,7 @@ void pvsRecallReport(const ComputeContext& context, const std::vector<std::strin
                       sampler.c_str(), static_cast<unsigned long long>(n),
                       static_cast<unsigned long long>(pvs.estimate_samples),
                       static_cast<unsigned long long>(pvs.rays), recall.c_str(), recall_inside.c_str(),
-                      pvs.pixel_error,
-                      pvs.pixel_error * double(pvs.uniform_rays) / options.resolution,
+                      pvs.pixel_error, pvs.pixel_error * double(pvs.uniform_rays) / options.resolution,
                       static_cast<unsigned long long>(pvs.uniform_rays), measured,
                       measured * double(check.size()) / options.resolution, pvs.seconds);
           std::fflush(stdout);

@@ -579,7 +579,8 @@ def region_pair_visibility(heights, sources, receivers, *, samples=16, source_he
 
 def pvs(heights, *, samples=0, pixel_error=0.0, seconds=0.0, view_cell=32, band_low=1.7, band_high=1.7, tile=16,
         mask=None, method="agvs", batch=1 << 16, seed=1, resolution=1e6, filter=0.0, estimate_entries=20,
-        witnesses=False, memory_budget_bytes=0, start=None, cell_size=None, z_scale=1.0, nodata=None, device="", progress=None):
+        witnesses=False, memory_budget_bytes=0, start=None, cell_size=None, z_scale=1.0, nodata=None, device="",
+        progress=None):
     """Potentially visible sets (Bittner, Mattausch, Wonka, Havran & Wimmer 2009): the tiles of
     tile x tile cells each view cell of view_cell x view_cell cells (its volume band_low ..
     band_high above the surface) sees, by sampling; stops at the first budget reached (samples,

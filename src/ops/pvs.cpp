@@ -448,8 +448,9 @@ PvsResult computeDensePvs(const ComputeContext& context, const HeightField& fiel
   const PvsLayout& l = out.layout;
   const bool inside = targets == DenseTargets::InsideTiles;
   if (inside && l.tile < 2)
-    throw InvalidArgument("a dense reference inside the tiles needs tiles of 2 cells or more (a tile of 1 has "
-                          "no grid point inside it)");
+    throw InvalidArgument(
+        "a dense reference inside the tiles needs tiles of 2 cells or more (a tile of 1 has "
+        "no grid point inside it)");
   out.words = (l.tiles() + 31) / 32;
   out.bits.assign(std::size_t(l.viewCells()) * out.words, 0u);
   out.computed = grid.mask.empty() ? std::vector<std::uint8_t>(l.viewCells(), 1) : grid.mask;
@@ -479,7 +480,8 @@ PvsResult computeDensePvs(const ComputeContext& context, const HeightField& fiel
               if (x < tx * l.tile || x > tx * l.tile + l.tile || y < ty * l.tile || y > ty * l.tile + l.tile)
                 continue;
               // (inside: not on the tile's border; the field's last row and column bound the last tiles)
-              const int x1 = std::min(tx * l.tile + l.tile, l.cells_x), y1 = std::min(ty * l.tile + l.tile, l.cells_y);
+              const int x1 = std::min(tx * l.tile + l.tile, l.cells_x),
+                        y1 = std::min(ty * l.tile + l.tile, l.cells_y);
               if (inside && (x == tx * l.tile || x == x1 || y == ty * l.tile || y == y1)) continue;
               const int t = ty * l.tiles_x + tx;
               words[t / 32] |= 1u << (t % 32);
