@@ -128,7 +128,7 @@ struct PvsOptions {
   // samples go on until that many carry it, at most as many samples as the run cast before them
   // (so a run casts up to twice its budget; under a seconds budget at most as many seconds again);
   // PvsResult::estimate_samples counts them, and their rows in the history say `settling`. A count
-  // of a handful is off by more than 2x in about a third of runs (bench/report/pvs.md: ten DEM
+  // of a handful is off by more than 2x in about a quarter of runs (bench/report/pvs.md: ten DEM
   // runs within 2x in 6 of 10 unsettled, 9 of 10 settled). With none the estimate stays at its
   // floor (one entry over the uniform rays). A pixel-error budget the settled estimate no longer
   // meets goes on sampling, within the other budgets. 0: the estimate as the budget left it.
