@@ -7,6 +7,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "hfvis/height_field.hpp"
@@ -69,6 +70,8 @@ constexpr double kMaxPreparedHeight = 1e28;
 struct PreparedHeights {
   std::vector<float> heights;
   bool has_nodata = false;
+  // The least and the greatest of `heights` that are not NaN (+INFINITY and -INFINITY where all are).
+  float lowest = std::numeric_limits<float>::infinity(), highest = -std::numeric_limits<float>::infinity();
 };
 enum class HeightOrigin { Lowest, Zero };
 PreparedHeights prepareHeights(const HeightField& field, HeightOrigin origin = HeightOrigin::Lowest);

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "core/horizon_common.hpp"
+#include "core/host_bands.hpp"
 #include "core/number_text.hpp"
 #include "core/opencl_context.hpp"
 #include "core/sweep_framework.hpp"
@@ -97,46 +98,29 @@ BitmaskTable bitmaskTable(const std::vector<float>& points, int size) {
 }
 
 // The highest finite height (z-scaled; -infinity if none).
-float fieldTop(const std::vector<float>& heights) {
-  float top = -std::numeric_limits<float>::infinity();
-  for (const float v : heights)
-    if (std::isfinite(v)) top = std::max(top, v);
-  return top;
+float fieldTop(const detail::PreparedHeights& p) { return p.highest; }
+
+// The largest finite |height| (z-scaled; 0 if none).
+float largestHeight(const detail::PreparedHeights& p) {
+  return p.lowest <= p.highest ? std::max(std::fabs(p.lowest), std::fabs(p.highest)) : 0.0f;
 }
 
 // The field as the region kernels take it, prepared once (RegionField) or per call: the z-scaled
 // heights (HeightOrigin::Zero: the viewshed's, so both decide the same sight lines) and, for the
-// culled march and the bitmask method, the culling pyramid, on the host and the device; and the
-// bounds of the heights the calls take.
+// culled march and the bitmask method, the culling pyramid, on the host and the device.
 struct RegionSurface {
   const HeightField* field = nullptr;
   detail::PreparedHeights prepared;
   detail::CullPyramid pyramid;       // levels 0: none built (the exact march, a field one point thick)
-  // The heights' bounds (`bounded`; a one-shot call leaves them to the routine, which takes them
-  // only where it needs them): the largest finite |height| (0 if none), the highest finite height
-  // (-infinity if none).
-  bool bounded = false;
-  float largest = 0.0f, top = 0.0f;
   cl::Buffer heights, pyramid_top;   // on the device (`device`)
 };
 
-// The largest finite |height| of `h`, 0 if none.
-float largestHeight(const std::vector<float>& h) {
-  float largest = 0.0f;
-  for (const float v : h)
-    if (std::isfinite(v)) largest = std::max(largest, std::fabs(v));
-  return largest;
-}
-
-// `field` validated (validateField). `pyramid`: build the culling pyramid; `device`: upload;
-// `bounded`: take the heights' bounds.
-RegionSurface prepareSurface(detail::ContextState& st, const HeightField& field, bool pyramid, bool device,
-                             bool bounded) {
+// `field` validated (validateField). `pyramid`: build the culling pyramid; `device`: upload.
+RegionSurface prepareSurface(detail::ContextState& st, const HeightField& field, bool pyramid, bool device) {
   RegionSurface out;
   out.field = &field;
   out.prepared = detail::prepareHeights(field, detail::HeightOrigin::Zero);
   const std::vector<float>& h = out.prepared.heights;
-  if (bounded) out.bounded = true, out.largest = largestHeight(h), out.top = fieldTop(h);
   if (pyramid) out.pyramid = detail::cullPyramid(h, field.width, field.height);
   if (!device) return out;
   const auto upload = [&](const std::vector<float>& values) {
@@ -144,8 +128,13 @@ RegionSurface prepareSurface(detail::ContextState& st, const HeightField& field,
     return cl::Buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, values.size() * sizeof(float),
                       const_cast<float*>(values.data()));
   };
-  out.heights = upload(h);
-  if (out.pyramid.levels > 0) out.pyramid_top = upload(out.pyramid.top);
+  // (the two copies at once: at 4096^2, 157 MB of fresh pages, about 70 ms one after the other)
+  detail::forEachBand(2, out.pyramid.levels > 0 ? 2 : 1, [&](int band, int, int) {
+    if (band == 0)
+      out.heights = upload(h);
+    else
+      out.pyramid_top = upload(out.pyramid.top);
+  });
   return out;
 }
 
@@ -240,7 +229,7 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
     if (certify_sources_ || certify_receivers_) {
       // The tables' bound of the sight lines' end heights: the highest surface plus the largest
       // height over it (an absolute height is bounded by it too).
-      const float surface = surface_.bounded ? surface_.largest : largestHeight(surface_.prepared.heights);
+      const float surface = largestHeight(surface_.prepared);
       float above = float(options_.target_height);
       for (const std::vector<float>* table : {&sources_, receivers_})
         for (std::size_t i = 8; table && i < table->size(); i += 5)
@@ -279,7 +268,7 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
       tested_ = detail::deviceBuffer(st_, std::size_t(count_) * 2 * sizeof(cl_uint));
       kernel_ = kernel("region_bitmask_bits");
       setSurface(kernel_)
-          .set("field_top", surface_.bounded ? surface_.top : fieldTop(surface_.prepared.heights))
+          .set("field_top", fieldTop(surface_.prepared))
           .set("f", device)
           .set("source_points", source_points_buffer_)
           .set("samples", cl_int(samples_))
@@ -551,38 +540,66 @@ CullPyramid cullPyramid(const std::vector<float>& h, int width, int height, bool
   double largest = 0.0, step = 0.0, twist = 0.0;
   bool any_infinite = false;
   // Every height finite (most fields): the same maxima row by row without the checks (the call's
-  // fixed cost: this pass and level 0 took about half of it, bench/report/region_visibility.md).
+  // fixed cost: this pass and level 0 took about half of it, bench/report/region_visibility.md),
+  // in bands of rows on the host's threads (host_bands.hpp), each band's maxima then combined.
+  const int bands = bandsFor(height, width);
   bool all_finite = !checked;
-  for (const float v : h) all_finite &= bool(std::isfinite(v));
-  // (kLanes running maxima each, so that the maxima do not wait on one another)
-  constexpr int kLanes = 8;
-  std::array<float, kLanes> lane_largest{}, lane_step{};
-  std::array<double, kLanes> lane_twist{};
-  for (int r = 0; all_finite && r < height; ++r) {
-    const float* row = h.data() + std::size_t(r) * width;
-    const float* next = row + width;
-    for (int c = 0; c < width; ++c) {
-      float& l = lane_largest[c % kLanes];
-      l = std::max(l, std::fabs(row[c]));
-    }
-    for (int c = 0; c + 1 < width; ++c) {
-      float& l = lane_step[c % kLanes];
-      l = std::max(l, std::fabs(row[c + 1] - row[c]));
-    }
-    if (r + 1 == height) continue;
-    for (int c = 0; c < width; ++c) {
-      float& l = lane_step[c % kLanes];
-      l = std::max(l, std::fabs(next[c] - row[c]));
-    }
-    for (int c = 0; c + 1 < width; ++c) {
-      double& l = lane_twist[c % kLanes];
-      l = std::max(l, std::fabs(double(row[c]) - row[c + 1] - next[c] + next[c + 1]));
-    }
+  {
+    std::vector<char> band_finite(bands, 1);
+    forEachBand(height, bands, [&](int band, int first, int last) {
+      bool finite = true;
+      for (std::size_t i = std::size_t(first) * width; i < std::size_t(last) * width; ++i)
+        finite &= std::fabs(h[i]) <= std::numeric_limits<float>::max();
+      band_finite[band] = finite;
+    });
+    for (const char finite : band_finite) all_finite = all_finite && finite;
   }
-  for (int i = 0; all_finite && i < kLanes; ++i) {
-    largest = std::max(largest, double(lane_largest[i]));
-    step = std::max(step, double(lane_step[i]));
-    twist = std::max(twist, lane_twist[i]);
+  if (all_finite) {
+    // (kLanes running maxima each, so that the maxima do not wait on one another)
+    constexpr int kLanes = 8;
+    struct Maxima {
+      std::array<float, kLanes> largest{}, step{};
+      std::array<double, kLanes> twist{};
+    };
+    std::vector<Maxima> band_maxima(bands);
+    forEachBand(height, bands, [&](int band, int first, int last) {
+      Maxima m;  // (local: the lanes stay in registers, where the heights' pointer may not alias them)
+      // (whole runs of kLanes columns lane by lane, so that the compiler keeps the lanes in one
+      // vector; then the rest)
+      for (int r = first; r < last; ++r) {
+        const float* row = h.data() + std::size_t(r) * width;
+        const float* next = row + width;
+        const bool below = r + 1 < height;
+        int c = 0;
+        for (; c + kLanes < width; c += kLanes) {
+          for (int i = 0; i < kLanes; ++i) {
+            m.largest[i] = std::max(m.largest[i], std::fabs(row[c + i]));
+            m.step[i] = std::max(m.step[i], std::fabs(row[c + i + 1] - row[c + i]));
+          }
+          if (!below) continue;
+          for (int i = 0; i < kLanes; ++i) {
+            m.step[i] = std::max(m.step[i], std::fabs(next[c + i] - row[c + i]));
+            m.twist[i] = std::max(m.twist[i], std::fabs(double(row[c + i]) - row[c + i + 1] - next[c + i] +
+                                                        next[c + i + 1]));
+          }
+        }
+        for (; c < width; ++c) {
+          m.largest[0] = std::max(m.largest[0], std::fabs(row[c]));
+          if (c + 1 < width) m.step[0] = std::max(m.step[0], std::fabs(row[c + 1] - row[c]));
+          if (!below) continue;
+          m.step[0] = std::max(m.step[0], std::fabs(next[c] - row[c]));
+          if (c + 1 < width)
+            m.twist[0] = std::max(m.twist[0], std::fabs(double(row[c]) - row[c + 1] - next[c] + next[c + 1]));
+        }
+      }
+      band_maxima[band] = m;
+    });
+    for (const Maxima& m : band_maxima)
+      for (int i = 0; i < kLanes; ++i) {
+        largest = std::max(largest, double(m.largest[i]));
+        step = std::max(step, double(m.step[i]));
+        twist = std::max(twist, m.twist[i]);
+      }
   }
   for (int r = 0; !all_finite && r < height; ++r)
     for (int c = 0; c < width; ++c) {
@@ -615,13 +632,16 @@ CullPyramid cullPyramid(const std::vector<float>& h, int width, int height, bool
   // Level 0: per cell its corners' highest valid height; +INFINITY where an infinite height lies
   // on the cell or a cell beside it (the march's values there are unbounded or NaN).
   int w = width - 1, hh = height - 1;
-  for (int r = 0; all_finite && r < hh; ++r) {
-    const float* row = h.data() + std::size_t(r) * width;
-    const float* next = row + width;
-    float* level = out.top.data() + std::size_t(r) * w;
-    for (int c = 0; c < w; ++c)  // (the corners in the order of the loop below: the same zeros' signs)
-      level[c] = std::max(std::max(std::max(row[c], row[c + 1]), next[c]), next[c + 1]);
-  }
+  if (all_finite)
+    forEachBand(hh, bands, [&](int, int first, int last) {
+      for (int r = first; r < last; ++r) {
+        const float* row = h.data() + std::size_t(r) * width;
+        const float* next = row + width;
+        float* level = out.top.data() + std::size_t(r) * w;
+        for (int c = 0; c < w; ++c)  // (the corners in the order of the loop below: the same zeros' signs)
+          level[c] = std::max(std::max(std::max(row[c], row[c + 1]), next[c]), next[c + 1]);
+      }
+    });
   for (int r = 0; !all_finite && r < hh; ++r)
     for (int c = 0; c < w; ++c) {
       bool unbounded = false;
@@ -638,20 +658,22 @@ CullPyramid cullPyramid(const std::vector<float>& h, int width, int height, bool
     float* parent = out.top.data() + offsets[k];
     const int pw = (w + 1) / 2, ph = (hh + 1) / 2;
     // Per parent its children in row order (no value is NaN: the maxima of the pass they replace).
-    for (int r = 0; r < ph; ++r) {
-      const float* upper = child + std::size_t(2 * r) * w;
-      const float* lower = 2 * r + 1 < hh ? upper + w : nullptr;
-      float* p = parent + std::size_t(r) * pw;
-      for (int c = 0; c < pw; ++c) {
-        float v = upper[2 * c];
-        if (2 * c + 1 < w) v = std::max(v, upper[2 * c + 1]);
-        if (lower) {
-          v = std::max(v, lower[2 * c]);
-          if (2 * c + 1 < w) v = std::max(v, lower[2 * c + 1]);
+    forEachBand(ph, bandsFor(ph, 4LL * pw), [&](int, int first, int last) {
+      for (int r = first; r < last; ++r) {
+        const float* upper = child + std::size_t(2 * r) * w;
+        const float* lower = 2 * r + 1 < hh ? upper + w : nullptr;
+        float* p = parent + std::size_t(r) * pw;
+        for (int c = 0; c < pw; ++c) {
+          float v = upper[2 * c];
+          if (2 * c + 1 < w) v = std::max(v, upper[2 * c + 1]);
+          if (lower) {
+            v = std::max(v, lower[2 * c]);
+            if (2 * c + 1 < w) v = std::max(v, lower[2 * c + 1]);
+          }
+          p[c] = v;
         }
-        p[c] = v;
       }
-    }
+    });
     w = pw, hh = ph;
   }
   return out;
@@ -879,7 +901,7 @@ RegionVisibilityResult regionVisibility(const ComputeContext& context, const Hei
     own = detail::translateOpenClErrors([&] {
       const bool pyramid =
           run.method == RegionVisibilityMethod::Culled || run.method == RegionVisibilityMethod::Bitmask;
-      return prepareSurface(detail::stateOf(context), field, pyramid, !viewsheds, false);
+      return prepareSurface(detail::stateOf(context), field, pyramid, !viewsheds);
     });
   const RegionSurface& surface = prepared ? *prepared : own;
   const std::vector<float>& heights = surface.prepared.heights;
@@ -929,7 +951,7 @@ RegionPairVisibilityResult regionPairVisibility(const ComputeContext& context, c
   if (!prepared)
     own = detail::translateOpenClErrors([&] {
       return prepareSurface(detail::stateOf(context), field, run.method == RegionVisibilityMethod::Culled,
-                            true, false);
+                            true);
     });
   const RegionSurface& surface = prepared ? *prepared : own;
   const std::vector<float>& heights = surface.prepared.heights;
@@ -969,7 +991,7 @@ RegionField::RegionField(const ComputeContext& context, const HeightField& field
   validateField(field);
   auto state = std::make_shared<State>(context, field);
   state->surface = detail::translateOpenClErrors(
-      [&] { return prepareSurface(detail::stateOf(context), state->field, true, true, true); });
+      [&] { return prepareSurface(detail::stateOf(context), state->field, true, true); });
   state_ = std::move(state);
 }
 

@@ -11,12 +11,12 @@
 #include <limits>
 #include <functional>
 #include <string>
-#include <thread>
 
 #include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
 #include "hfvis/viewshed.hpp"
 #include "core/horizon_common.hpp"
+#include "core/host_bands.hpp"
 #include "core/lattice_geometry.hpp"
 #include "core/sweep_framework.hpp"
 
@@ -152,7 +152,7 @@ class PyramidBuild {
         plane_(field.pixelCount()),
         nodes_x_((width_ + (1 << k0_) - 1) >> k0_),
         nodes_y_((height_ + (1 << k0_) - 1) >> k0_),
-        threads_(std::max(1u, std::min(8u, std::thread::hardware_concurrency()))),
+        threads_(detail::hostThreads()),
         slopes_(field) {
     describe();
     planNodes();
@@ -346,13 +346,7 @@ class PyramidBuild {
 
   // Runs body(first, last) over bands of rows (or of the finest nodes' rows) on the threads.
   void parallel(int count, const std::function<void(int, int)>& body) const {
-    std::vector<std::thread> pool;
-    for (unsigned t = 0; t < threads_; ++t) {
-      const int first = static_cast<int>(count * t / threads_),
-                last = static_cast<int>(count * (t + 1) / threads_);
-      if (first < last) pool.emplace_back(body, first, last);
-    }
-    for (std::thread& t : pool) t.join();
+    detail::forEachBand(count, threads_, [&](int, int first, int last) { body(first, last); });
   }
 
   // The blockers of call c's directions.
@@ -457,7 +451,7 @@ class PyramidBuild {
   const double target_, c_drop_;
   const std::size_t plane_;
   const int nodes_x_, nodes_y_;  // the finest level's nodes
-  const unsigned threads_;
+  const int threads_;
   const SlopePyramid slopes_;
   ViewshedPyramid p_;
   double breaks_[ViewshedPyramid::kBreakpoints] = {};
