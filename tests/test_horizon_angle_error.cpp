@@ -148,6 +148,40 @@ TEST(HorizonAngleMaxError, RunsTheCheapestKWithinAQuarterAboveTheNeed) {
   EXPECT_DOUBLE_EQ(detail::horizonWork(field, options, angles(), 24), planesAt(field, 24).samples_per_receiver);
 }
 
+// The runs toward a maximum error extend the last one where the directions that adds cost less than
+// a fresh run (work linear in K here: always, where a multiple of the last K reaches the need), each
+// extension handed the run before, and the work all runs' own directions: with an estimate of 1 / K
+// and E = 0.01, 8, then 16, 64 (at most 4 times as far) and 128 (the least multiple of 64 past the
+// need of about 105), each extending the one before, 128 directions' work in all.
+TEST(HorizonAngleMaxError, ExtendsTheLastRunWhereItsNewDirectionsCostLess) {
+  std::vector<std::pair<int, int>> calls;  // (K, the K extended or 0)
+  const auto run = [&](int K, HorizonResult* from) {
+    calls.emplace_back(K, from ? from->directions : 0);
+    HorizonResult r;
+    r.width = r.height = 1;
+    r.directions = K;
+    r.estimated_error = 1.0 / K;
+    r.samples_per_receiver = K - (from ? from->directions : 0);
+    return r;
+  };
+  const HorizonResult r = detail::runHorizonAnglesToError(0.01, run, [](int K) { return double(K); });
+  const std::vector<std::pair<int, int>> expected = {{8, 0}, {16, 8}, {64, 16}, {128, 64}};
+  EXPECT_EQ(calls, expected);
+  EXPECT_EQ(r.runs, (std::vector<int>{8, 16, 64, 128}));
+  EXPECT_EQ(r.directions, 128);
+  EXPECT_DOUBLE_EQ(r.samples_per_receiver, 128.0);
+  // Where a multiple's new directions cost more than a fresh K, the fresh one runs: multiples of 32
+  // cost half but 128 costs 200, so extending 64 to 128 adds 168 where a fresh 112 costs 112.
+  calls.clear();
+  const auto uneven = [](int K) { return K == 128 ? 200.0 : (K % 32 == 0 ? 0.5 * K : double(K)); };
+  const HorizonResult fresh = detail::runHorizonAnglesToError(0.01, run, uneven);
+  ASSERT_EQ(calls.size(), 4u);
+  EXPECT_EQ(calls.back().second, 0);
+  EXPECT_EQ(calls.back().first, 112);
+  EXPECT_EQ(fresh.runs, (std::vector<int>{8, 16, 64, 112}));
+  EXPECT_DOUBLE_EQ(fresh.samples_per_receiver, 8.0 + 8.0 + 48.0 + 112.0);  // (the fake's own counts)
+}
+
 // A maximum error: the K chosen meets it by the estimate and against a dense run, its planes are
 // those of a run at that K bit for bit, and a smaller error never takes fewer directions.
 TEST(HorizonAngleMaxError, MeetsTheTargetAgainstADenseRun) {
@@ -155,7 +189,7 @@ TEST(HorizonAngleMaxError, MeetsTheTargetAgainstADenseRun) {
     SCOPED_TRACE(name);
     const HeightField field = makeSyntheticField(name, 48, 44);
     const HorizonResult dense = denseRun(field);
-    int last_directions = 0;
+    int last_directions = 0, extended_cases = 0;
     for (double degrees : {2.0, 1.0, 0.5, 0.25}) {
       SCOPED_TRACE(degrees);
       const double E = degrees * M_PI / 180.0;
@@ -175,12 +209,29 @@ TEST(HorizonAngleMaxError, MeetsTheTargetAgainstADenseRun) {
       ASSERT_EQ(r.angles.size(), field.pixelCount() * r.directions);
       EXPECT_EQ(r.distances.size(), r.angles.size());
       EXPECT_EQ(r.error_estimate.size(), field.pixelCount());
-      const HorizonResult fixed = planesAt(field, r.directions, true);
+      // The planes a run at that K gives, bit for bit, where the last run extended an earlier
+      // one (its directions turned runs of the earlier K) as where it ran afresh; the azimuths
+      // within their rounding (2 pi k / K + offset there, 2 pi (k m + j) / (m K) + offset here).
+      HorizonOptions at_k;
+      at_k.directions = r.directions;
+      HorizonOutputs both = angles(true);
+      both.horizon_distances = true;
+      const HorizonResult fixed = computeHorizons(testContext(), field, at_k, both);
       EXPECT_EQ(r.angles, fixed.angles);
-      EXPECT_EQ(r.azimuths, fixed.azimuths);
-      EXPECT_EQ(r.estimated_error, fixed.estimated_error);  // (a one-run estimate: the same)
-
+      EXPECT_EQ(r.distances, fixed.distances);
+      ASSERT_EQ(r.azimuths.size(), fixed.azimuths.size());
+      for (std::size_t k = 0; k < r.azimuths.size(); ++k) EXPECT_NEAR(r.azimuths[k], fixed.azimuths[k], 1e-12);
+      EXPECT_NEAR(r.estimated_error, fixed.estimated_error, 1e-9 * fixed.estimated_error);
+      // The work: each run's own directions, so that where every run extended the one before, all
+      // of them together cost what the last K alone does.
+      bool extended = true;
+      for (std::size_t i = 1; i < r.runs.size(); ++i) extended = extended && r.runs[i] % r.runs[i - 1] == 0;
+      if (extended) {
+        EXPECT_NEAR(r.samples_per_receiver, fixed.samples_per_receiver, 1e-9 * fixed.samples_per_receiver);
+        ++extended_cases;
+      }
     }
+    EXPECT_GT(extended_cases, 0);  // (the extension is exercised)
   }
 }
 

@@ -156,13 +156,13 @@ int cheapestDirections(int needed, const std::function<double(int)>& work) {
   return best;
 }
 
-HorizonResult runHorizonAnglesToError(double max_error, const std::function<HorizonResult(int)>& run,
+HorizonResult runHorizonAnglesToError(double max_error, const HorizonAnglesRun& run,
                                       const std::function<double(int)>& work) {
   int directions = kHorizonFirstDirections, earlier = 0;
   double earlier_estimate = 0.0, total = 0.0;
   std::vector<int> runs;
+  HorizonResult result = run(directions, nullptr);
   for (;;) {
-    HorizonResult result = run(directions);
     runs.push_back(directions);
     total += result.samples_per_receiver;
     if (result.estimated_error <= max_error) {
@@ -197,14 +197,31 @@ HorizonResult runHorizonAnglesToError(double max_error, const std::function<Hori
     // After the first run the second (whose work is a few per cent of what follows) measures the
     // order; later runs go at most kHorizonMostStep times as far, where the order is measured again
     // (it rises with K on smooth fields, and the estimate's fall from 8 to 16 predicts badly far off).
-    const int next = earlier == 0 ? kHorizonSecondDirections
-                                  : cheapestDirections(static_cast<int>(std::ceil(std::min(
-                                                           {wanted, kHorizonMostStep * directions,
-                                                            double(kMaxAutoDirections)}))),
-                                                       work);
+    const int reach = earlier == 0 ? kHorizonSecondDirections
+                                   : static_cast<int>(std::ceil(std::min(
+                                         {wanted, kHorizonMostStep * directions, double(kMaxAutoDirections)})));
+    const int fresh = earlier == 0 ? kHorizonSecondDirections : cheapestDirections(reach, work);
+    // Or the last run extended to the least multiple of its K that reaches as far: only the
+    // directions it adds are cast (bench/report/error_target.md, horizon angles).
+    const int extended = (reach + directions - 1) / directions * directions;
+    const bool extend = extended > directions && extended <= kMaxAutoDirections &&
+                        work(extended) - work(directions) <= work(fresh);
     earlier = directions;
     earlier_estimate = result.estimated_error;
-    directions = next;
+    directions = extend ? extended : fresh;
+    result = extend ? run(directions, &result) : run(directions, nullptr);
+  }
+}
+
+void placeHorizonRun(HorizonResult& into, const HorizonResult& part, int m, int j) {
+  const std::size_t plane = static_cast<std::size_t>(into.width) * into.height;
+  for (int k = 0; k < part.directions; ++k) {
+    const std::size_t to = static_cast<std::size_t>(k) * m + j;
+    into.azimuths[to] = part.azimuths[k];
+    if (!part.angles.empty())
+      std::copy_n(part.angles.begin() + k * plane, plane, into.angles.begin() + to * plane);
+    if (!part.distances.empty())
+      std::copy_n(part.distances.begin() + k * plane, plane, into.distances.begin() + to * plane);
   }
 }
 

@@ -76,19 +76,34 @@ double horizonWork(const HeightField& field, const HorizonOptions& options, cons
 int cheapestDirections(int needed, const std::function<double(int)>& work);
 constexpr double kHorizonChoiceSpan = 1.25;
 
+// A run of the horizon angles at K with its estimate: a fresh one (`from` null), or one that
+// extends `from`, the result of a run at K / m (m >= 2), by the directions it lacks: with exact
+// azimuths (the horizon angles' absolute tolerance) a direction's lattice step depends on its
+// azimuth alone, and K / m's azimuths are every m-th of K's, so m - 1 runs of K / m directions, each
+// turned by 2 pi j / K, hold the rest (extendHorizonRun). Takes `from`'s planes.
+using HorizonAnglesRun = std::function<HorizonResult(int directions, HorizonResult* from)>;
+
 // HorizonOptions::max_error for the horizon angles: run(K) with the estimate at
 // kHorizonFirstDirections, then at kHorizonSecondDirections (the two cost a few per cent of any
 // later run: the axes and diagonals, then steps of at most a few pixels), then at the K the
 // estimates predict (the error falling as K^-p, p measured between the last two runs within
-// 0.5 .. 3), 5 % more, at most kHorizonMostStep times the last K, each the cheapest by `work`
-// within kHorizonChoiceSpan of that, until
-// the estimate's mean is at most max_error (and never past kMaxAutoDirections). Throws
+// 0.5 .. 3), 5 % more, at most kHorizonMostStep times the last K: of the multiples of 8 within
+// kHorizonChoiceSpan of that, the cheapest by `work`, or the least multiple of the last K that
+// reaches it, extending the last run, where the directions it adds cost less (so the runs on the
+// way are not cast again), until the estimate's mean is at most max_error (and never past
+// kMaxAutoDirections). Throws
 // InvalidArgument (E in degrees) when a prediction within one such step, a fall as K^-3, or
 // the run at kMaxAutoDirections itself needs more than kMaxAutoDirections. Edge pixels count as they are:
 // the directions whose rays leave the field at once hold -pi/2, and the interpolation between
 // such a direction and its neighbours counts as error there (on small fields a visible share).
-HorizonResult runHorizonAnglesToError(double max_error, const std::function<HorizonResult(int)>& run,
+HorizonResult runHorizonAnglesToError(double max_error, const HorizonAnglesRun& run,
                                       const std::function<double(int)>& work);
+
+// Puts `part`, a run of from.directions / m directions turned by 2 pi j / from.directions past
+// direction 0 of `into` (a result sized for m times as many directions, its planes laid out as a
+// run at that K), into its places: part's direction k becomes into's direction k m + j, with its
+// azimuth, angle and distance planes. For the extension of HorizonAnglesRun.
+void placeHorizonRun(HorizonResult& into, const HorizonResult& part, int m, int j);
 constexpr int kHorizonFirstDirections = 8, kHorizonSecondDirections = 16;
 constexpr double kHorizonMostStep = 4.0;
 
