@@ -8,6 +8,8 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 #include "core/horizon_angle_error.hpp"
 #include "hfvis/errors.hpp"
@@ -180,6 +182,44 @@ TEST(HorizonAngleMaxError, ExtendsTheLastRunWhereItsNewDirectionsCostLess) {
   EXPECT_EQ(calls.back().first, 112);
   EXPECT_EQ(fresh.runs, (std::vector<int>{8, 16, 64, 112}));
   EXPECT_DOUBLE_EQ(fresh.samples_per_receiver, 8.0 + 8.0 + 48.0 + 112.0);  // (the fake's own counts)
+}
+
+// An extended run (extendHorizonRun) from K = 8 to 8 m, by doublings (m = 2, 4) or by m - 1 turned
+// runs (m = 3, 6), with an azimuth offset and distances, against a fresh run at 8 m on a city and on
+// noise: the planes bit for bit, the azimuths within their rounding, the work the new directions'.
+TEST(HorizonAngleMaxError, AnExtendedRunIsAFreshRunsPlanes) {
+  for (const char* name : {"city", "noise"}) {
+    const HeightField field = makeSyntheticField(name, 40, 36);
+    HorizonOutputs both = angles();
+    both.horizon_distances = true;
+    const auto at = [&](int K, double turn) {
+      HorizonOptions options;
+      options.directions = K;
+      options.azimuth_offset = 0.3 + turn;
+      return computeHorizons(testContext(), field, options, both);
+    };
+    const HorizonResult eight = at(8, 0.0);
+    for (const int m : {2, 3, 4, 6}) {
+      SCOPED_TRACE(std::string(name) + " m = " + std::to_string(m));
+      int parts = 0;
+      const HorizonResult extended = detail::extendHorizonRun(eight, 8 * m, [&](int count, double turn) {
+        ++parts;
+        return at(count, turn);
+      });
+      EXPECT_EQ(parts, (m & (m - 1)) == 0 ? int(std::log2(m)) : m - 1);
+      const HorizonResult fresh = at(8 * m, 0.0);
+      EXPECT_EQ(extended.directions, 8 * m);
+      EXPECT_EQ(extended.angles, fresh.angles);
+      EXPECT_EQ(extended.distances, fresh.distances);
+      ASSERT_EQ(extended.azimuths.size(), fresh.azimuths.size());
+      for (std::size_t k = 0; k < fresh.azimuths.size(); ++k)
+        EXPECT_NEAR(extended.azimuths[k], fresh.azimuths[k], 1e-12);
+      EXPECT_NEAR(extended.samples_per_receiver, fresh.samples_per_receiver - eight.samples_per_receiver,
+                  1e-9 * fresh.samples_per_receiver);
+    }
+  }
+  EXPECT_THROW(detail::extendHorizonRun(HorizonResult(), 16, [](int, double) { return HorizonResult(); }),
+               std::logic_error);
 }
 
 // A maximum error: the K chosen meets it by the estimate and against a dense run, its planes are

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <numeric>
 #include <sstream>
+#include <stdexcept>
+#include <string>
 
 #include "core/horizon_common.hpp"
 #include "core/lattice_geometry.hpp"
@@ -157,7 +159,7 @@ int cheapestDirections(int needed, const std::function<double(int)>& work) {
 }
 
 HorizonResult runHorizonAnglesToError(double max_error, const HorizonAnglesRun& run,
-                                      const std::function<double(int)>& work) {
+                                      const std::function<double(int)>& work, bool extend_runs) {
   int directions = kHorizonFirstDirections, earlier = 0;
   double earlier_estimate = 0.0, total = 0.0;
   std::vector<int> runs;
@@ -204,7 +206,7 @@ HorizonResult runHorizonAnglesToError(double max_error, const HorizonAnglesRun& 
     // Or the last run extended to the least multiple of its K that reaches as far: only the
     // directions it adds are cast (bench/report/error_target.md, horizon angles).
     const int extended = (reach + directions - 1) / directions * directions;
-    const bool extend = extended > directions && extended <= kMaxAutoDirections &&
+    const bool extend = extend_runs && extended > directions && extended <= kMaxAutoDirections &&
                         work(extended) - work(directions) <= work(fresh);
     earlier = directions;
     earlier_estimate = result.estimated_error;
@@ -213,16 +215,55 @@ HorizonResult runHorizonAnglesToError(double max_error, const HorizonAnglesRun& 
   }
 }
 
-void placeHorizonRun(HorizonResult& into, const HorizonResult& part, int m, int j) {
+namespace {
+
+// Puts `part`, whose direction k is `into`'s direction k stride + first, in its places: its
+// azimuths, angle and distance planes.
+void placeHorizonRun(HorizonResult& into, const HorizonResult& part, int stride, int first) {
   const std::size_t plane = static_cast<std::size_t>(into.width) * into.height;
   for (int k = 0; k < part.directions; ++k) {
-    const std::size_t to = static_cast<std::size_t>(k) * m + j;
+    const std::size_t to = static_cast<std::size_t>(k) * stride + first;
     into.azimuths[to] = part.azimuths[k];
     if (!part.angles.empty())
       std::copy_n(part.angles.begin() + k * plane, plane, into.angles.begin() + to * plane);
     if (!part.distances.empty())
       std::copy_n(part.distances.begin() + k * plane, plane, into.distances.begin() + to * plane);
   }
+}
+
+}  // namespace
+
+HorizonResult extendHorizonRun(HorizonResult from, int directions,
+                               const std::function<HorizonResult(int count, double turn)>& run) {
+  const int K = from.directions, m = K > 0 ? directions / K : 0;
+  if (m < 2 || directions % K != 0)
+    throw std::logic_error("extendHorizonRun: " + std::to_string(directions) + " directions are no multiple of " +
+                           std::to_string(K));
+  const std::size_t plane = static_cast<std::size_t>(from.width) * from.height;
+  std::vector<float> angles = std::move(from.angles), distances = std::move(from.distances);
+  HorizonResult out = from;  // (the other fields a run sets)
+  from.angles = std::move(angles), from.distances = std::move(distances);
+  out.directions = directions;
+  out.azimuths.assign(std::size_t(directions), 0.0);
+  if (!from.angles.empty()) out.angles.assign(plane * directions, 0.0f);
+  if (!from.distances.empty()) out.distances.assign(plane * directions, 0.0f);
+  placeHorizonRun(out, from, m, 0);
+  from = HorizonResult();
+  double work = 0.0;
+  const auto cast = [&](int count, int first, int stride) {
+    const HorizonResult part = run(count, 2.0 * M_PI * first / directions);
+    placeHorizonRun(out, part, stride, first);
+    work += part.samples_per_receiver;
+  };
+  if ((m & (m - 1)) == 0) {
+    for (int done = K; done < directions; done *= 2) cast(done, directions / (2 * done), directions / done);
+  } else {
+    for (int j = 1; j < m; ++j) cast(K, j, m);
+  }
+  out.samples_per_receiver = work;
+  out.error_estimate.clear();
+  out.estimated_error = 0.0;
+  return out;
 }
 
 }  // namespace hfvis::detail

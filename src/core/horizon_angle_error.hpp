@@ -79,8 +79,8 @@ constexpr double kHorizonChoiceSpan = 1.25;
 // A run of the horizon angles at K with its estimate: a fresh one (`from` null), or one that
 // extends `from`, the result of a run at K / m (m >= 2), by the directions it lacks: with exact
 // azimuths (the horizon angles' absolute tolerance) a direction's lattice step depends on its
-// azimuth alone, and K / m's azimuths are every m-th of K's, so m - 1 runs of K / m directions, each
-// turned by 2 pi j / K, hold the rest (extendHorizonRun). Takes `from`'s planes.
+// azimuth alone, and K / m's azimuths are every m-th of K's, so runs of turned directions hold the
+// rest (extendHorizonRun). Takes `from`'s planes.
 using HorizonAnglesRun = std::function<HorizonResult(int directions, HorizonResult* from)>;
 
 // HorizonOptions::max_error for the horizon angles: run(K) with the estimate at
@@ -90,20 +90,26 @@ using HorizonAnglesRun = std::function<HorizonResult(int directions, HorizonResu
 // 0.5 .. 3), 5 % more, at most kHorizonMostStep times the last K: of the multiples of 8 within
 // kHorizonChoiceSpan of that, the cheapest by `work`, or the least multiple of the last K that
 // reaches it, extending the last run, where the directions it adds cost less (so the runs on the
-// way are not cast again), until the estimate's mean is at most max_error (and never past
-// kMaxAutoDirections). Throws
+// way are not cast again; `extend` false: never), until the estimate's mean is at most max_error
+// (and never past kMaxAutoDirections). Throws
 // InvalidArgument (E in degrees) when a prediction within one such step, a fall as K^-3, or
 // the run at kMaxAutoDirections itself needs more than kMaxAutoDirections. Edge pixels count as they are:
 // the directions whose rays leave the field at once hold -pi/2, and the interpolation between
 // such a direction and its neighbours counts as error there (on small fields a visible share).
 HorizonResult runHorizonAnglesToError(double max_error, const HorizonAnglesRun& run,
-                                      const std::function<double(int)>& work);
+                                      const std::function<double(int)>& work, bool extend = true);
 
-// Puts `part`, a run of from.directions / m directions turned by 2 pi j / from.directions past
-// direction 0 of `into` (a result sized for m times as many directions, its planes laid out as a
-// run at that K), into its places: part's direction k becomes into's direction k m + j, with its
-// azimuth, angle and distance planes. For the extension of HorizonAnglesRun.
-void placeHorizonRun(HorizonResult& into, const HorizonResult& part, int m, int j);
+// The horizon angles (and distances) of a run at `directions` (a multiple m >= 2 of from's K)
+// from `from` and runs of the directions between its own: run(count, turn) runs `count`
+// directions from the first azimuth plus `turn` radians (the result's own fields set as a run
+// sets them). Where m is a power of 2, by doublings (a run of the K so far turned by half its
+// spacing: log2 m runs), else m - 1 runs of K turned by 2 pi j / directions; each part put in its
+// places at once, so that at most one part's planes are held beside the whole (a run has costs of
+// its own besides its directions': buffers, launches). samples_per_receiver: the parts' alone.
+// With the sweep's lattice steps (chosen by azimuth alone) the planes are a run's at `directions`
+// bit for bit; the azimuths within their rounding. The estimate is not taken.
+HorizonResult extendHorizonRun(HorizonResult from, int directions,
+                               const std::function<HorizonResult(int count, double turn)>& run);
 constexpr int kHorizonFirstDirections = 8, kHorizonSecondDirections = 16;
 constexpr double kHorizonMostStep = 4.0;
 

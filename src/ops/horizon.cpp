@@ -1083,42 +1083,28 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
       planes.error_estimate = false;
       const auto estimated = [&](int directions, HorizonResult* from) {
         HorizonResult result;
-        if (!from) {
+        if (!from || directions % from->directions != 0) {
           attempt.directions = directions;
           result = run(planes, nullptr);
         } else {
-          // Extending `from` (detail::HorizonAnglesRun): its planes in their places, then m - 1
-          // runs of its K, each turned by 2 pi j / directions, in theirs, one at a time (so that
-          // at most one part's planes are held beside the whole).
-          const int K = from->directions, m = directions / K;
-          const std::size_t plane = static_cast<std::size_t>(field.width) * field.height;
-          HorizonResult part = std::move(*from);
-          std::vector<float> angles = std::move(part.angles), distances = std::move(part.distances);
-          result = part;  // (the other fields a run sets)
-          part.angles = std::move(angles), part.distances = std::move(distances);
-          result.directions = directions;
-          result.azimuths.assign(std::size_t(directions), 0.0);
-          if (!part.angles.empty()) result.angles.assign(plane * directions, 0.0f);
-          if (!part.distances.empty()) result.distances.assign(plane * directions, 0.0f);
-          detail::placeHorizonRun(result, part, m, 0);
-          double work = 0.0;
-          for (int j = 1; j < m; ++j) {
-            attempt.directions = K;
-            attempt.azimuth_offset = options.azimuth_offset + 2.0 * M_PI * j / directions;
-            part = run(planes, nullptr);
-            detail::placeHorizonRun(result, part, m, j);
-            work += part.samples_per_receiver;
-          }
-          attempt.azimuth_offset = options.azimuth_offset;
-          result.samples_per_receiver = work;
+          result = detail::extendHorizonRun(std::move(*from), directions, [&](int count, double turn) {
+            attempt.directions = count;
+            attempt.azimuth_offset = options.azimuth_offset + turn;
+            HorizonResult part = run(planes, nullptr);
+            attempt.azimuth_offset = options.azimuth_offset;
+            return part;
+          });
         }
         detail::estimateHorizonAngleError(result);
         return result;
       };
       if (options.max_error == 0.0) return estimated(options.directions, nullptr);
-      return detail::runHorizonAnglesToError(options.max_error, estimated, [&](int directions) {
-        return detail::horizonWork(field, options, planes, directions);
-      });
+      // (extending a run: the sweep's lattice steps, chosen by azimuth alone, are the same bit for bit;
+      // the naive method's rays would turn by the azimuths' rounding)
+      return detail::runHorizonAnglesToError(
+          options.max_error, estimated,
+          [&](int directions) { return detail::horizonWork(field, options, planes, directions); },
+          options.method == HorizonMethod::Sweep);
     }
     if (options.max_error == 0.0) return run(outputs, nullptr);
     // Ask for an error: runs at growing K until the estimate meets it (HorizonOptions::max_error).
