@@ -481,7 +481,8 @@ const std::vector<OptionSpec>& optionTable() {
        "azimuth between the directions' azimuths, against the true horizon,\n"
        "at most E degrees (its estimate, see --error-out), 0 < E < 90; runs at\n"
        "8 and 16 directions predict the K needed (the least work within 1.25x\n"
-       "of it), refused when beyond 4096; the samples per unit stay as given.\n"
+       "of it, or a multiple of the last K, extending that run, where that costs\n"
+       "less), refused when beyond 4096; the samples per unit stay as given.\n"
        "K and the estimate go into the summary and the hfvis:directions and\n"
        "hfvis:estimated_error (degrees) attributes",
        [](const std::string& typed, const std::string& value, RunArguments& run) {

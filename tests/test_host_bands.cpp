@@ -1,7 +1,7 @@
 // test_host_bands.cpp: the host passes split into bands of rows (core/host_bands.hpp): every row
 // once, a band's exception rethrown, and the passes that run in bands (prepareHeights, the region
-// culling pyramid) giving what one pass over the whole field gives, on fields large enough to be
-// split (more than a million values a band).
+// culling pyramid) giving what one pass over the whole field gives, in 1, 3 and 7 bands (uneven)
+// and in the bands the machine would take.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -59,10 +59,10 @@ TEST(HostBands, ABandsExceptionReachesTheCaller) {
   EXPECT_EQ(finished.load(), 2);  // the other bands ran to their end first
 }
 
-// A field of 1601 x 1400 (2.2M values: two bands or more where the machine has two threads; the
-// rows do not split evenly) with nodata, infinities, a z-scale and the lowest and highest heights
-// in different bands: prepareHeights gives each height as one conversion would, and the extremes
-// of the prepared heights.
+// A field of 1601 x 1400 with nodata, infinities, a z-scale and the lowest and highest heights in
+// the first and last rows, in 1, 3 and 7 bands (the rows do not split evenly) and the machine's:
+// prepareHeights gives each height as one conversion would, and the extremes of the prepared
+// heights.
 TEST(HostBands, PreparedHeightsAreThoseOfOnePass) {
   HeightField field;
   field.width = 1601, field.height = 1400;
@@ -74,39 +74,41 @@ TEST(HostBands, PreparedHeightsAreThoseOfOnePass) {
   field.heights[1601 * 700 + 3] = std::numeric_limits<float>::quiet_NaN();
   field.heights[1601 * 1300] = std::numeric_limits<float>::infinity();
   field.z_scale = 1.7;
-  for (const auto origin : {detail::HeightOrigin::Zero, detail::HeightOrigin::Lowest}) {
-    const detail::PreparedHeights p = detail::prepareHeights(field, origin);
-    const double base = origin == detail::HeightOrigin::Lowest ? -900.0 : 0.0;
-    ASSERT_EQ(p.heights.size(), field.heights.size());
-    EXPECT_TRUE(p.has_nodata);
-    std::size_t differing = 0;
-    for (std::size_t i = 0; i < field.heights.size(); ++i) {
-      const float h = field.heights[i];
-      if (!std::isfinite(h)) {
-        differing += !std::isnan(p.heights[i]);
-        continue;
+  for (const auto origin : {detail::HeightOrigin::Zero, detail::HeightOrigin::Lowest})
+    for (const int bands : {0, 1, 3, 7}) {
+      SCOPED_TRACE(std::to_string(bands) + " bands");
+      const detail::PreparedHeights p = detail::prepareHeights(field, origin, bands);
+      const double base = origin == detail::HeightOrigin::Lowest ? -900.0 : 0.0;
+      ASSERT_EQ(p.heights.size(), field.heights.size());
+      EXPECT_TRUE(p.has_nodata);
+      std::size_t differing = 0;
+      for (std::size_t i = 0; i < field.heights.size(); ++i) {
+        const float h = field.heights[i];
+        if (!std::isfinite(h)) {
+          differing += !std::isnan(p.heights[i]);
+          continue;
+        }
+        const float want = float((double(h) - base) * 1.7);
+        differing += p.heights[i] != want;
       }
-      const float want = float((double(h) - base) * 1.7);
-      differing += p.heights[i] != want;
+      EXPECT_EQ(differing, 0u);
+      EXPECT_EQ(p.lowest, float((-900.0 - base) * 1.7));
+      EXPECT_EQ(p.highest, float((2000.0 - base) * 1.7));
     }
-    EXPECT_EQ(differing, 0u);
-    EXPECT_EQ(p.lowest, float((-900.0 - base) * 1.7));
-    EXPECT_EQ(p.highest, float((2000.0 - base) * 1.7));
-  }
   // Every height finite: no nodata; and a field with no finite height has no extremes.
   field.heights[1601 * 700 + 3] = 1.0f, field.heights[1601 * 1300] = 2.0f;
-  EXPECT_FALSE(detail::prepareHeights(field, detail::HeightOrigin::Zero).has_nodata);
+  EXPECT_FALSE(detail::prepareHeights(field, detail::HeightOrigin::Zero, 3).has_nodata);
   std::fill(field.heights.begin(), field.heights.end(), std::numeric_limits<float>::quiet_NaN());
-  const detail::PreparedHeights none = detail::prepareHeights(field, detail::HeightOrigin::Zero);
+  const detail::PreparedHeights none = detail::prepareHeights(field, detail::HeightOrigin::Zero, 3);
   EXPECT_TRUE(none.has_nodata);
   EXPECT_GT(none.lowest, none.highest);
 }
 
 // The culling pyramid's pass for fields whose every height is finite runs in bands; the checked
-// pass (for fields with non-finite heights) runs in one: on a city and on noise large enough to
-// be split, and on the noise with a spike in its last rows (the largest height, step and twist in
-// the last band, the lowest in the first), both give the same pyramid, margin and gradient, bit
-// for bit.
+// pass (for fields with non-finite heights) runs in one: on a city, on noise, and on the noise
+// with a spike in its last rows (the largest height, step and twist in the last band, the lowest
+// in the first), in 1, 3 and 7 bands and the machine's, both give the same pyramid, margin and
+// gradient, bit for bit.
 TEST(HostBands, CullPyramidInBandsIsTheCheckedOne) {
   for (const char* name : {"city", "noise", "spike"}) {
     SCOPED_TRACE(name);
@@ -114,18 +116,21 @@ TEST(HostBands, CullPyramidInBandsIsTheCheckedOne) {
     if (name == std::string("spike"))
       field.heights[std::size_t(1405) * 1537 + 1000] = 5000.0f, field.heights[7] = -4000.0f;
     const std::vector<float> h = detail::prepareHeights(field, detail::HeightOrigin::Zero).heights;
-    const detail::CullPyramid banded = detail::cullPyramid(h, field.width, field.height);
     const detail::CullPyramid checked = detail::cullPyramid(h, field.width, field.height, true);
-    ASSERT_GT(banded.levels, 10);
-    EXPECT_EQ(banded.levels, checked.levels);
-    EXPECT_TRUE(banded.finite);
-    EXPECT_EQ(banded.margin, checked.margin);
-    EXPECT_EQ(banded.gradient, checked.gradient);
-    ASSERT_EQ(banded.top.size(), checked.top.size());
-    std::size_t differing = 0;
-    for (std::size_t i = 0; i < banded.top.size(); ++i)
-      differing += std::memcmp(&banded.top[i], &checked.top[i], sizeof(float)) != 0;
-    EXPECT_EQ(differing, 0u);
+    for (const int bands : {0, 1, 3, 7}) {
+      SCOPED_TRACE(std::to_string(bands) + " bands");
+      const detail::CullPyramid banded = detail::cullPyramid(h, field.width, field.height, false, bands);
+      ASSERT_GT(banded.levels, 10);
+      EXPECT_EQ(banded.levels, checked.levels);
+      EXPECT_TRUE(banded.finite);
+      EXPECT_EQ(banded.margin, checked.margin);
+      EXPECT_EQ(banded.gradient, checked.gradient);
+      ASSERT_EQ(banded.top.size(), checked.top.size());
+      std::size_t differing = 0;
+      for (std::size_t i = 0; i < banded.top.size(); ++i)
+        differing += std::memcmp(&banded.top[i], &checked.top[i], sizeof(float)) != 0;
+      EXPECT_EQ(differing, 0u);
+    }
   }
 }
 

@@ -68,7 +68,10 @@ struct HorizonOptions : SweepOptions {
   // (calibrated) and by 2^-p, p the order the pixel's neighbours two places away show (within
   // 0.3 .. 2; src/core/horizon_angle_error.hpp). Runs at 8 and 16 directions,
   // then at the K the last two estimates predict (5 % more, at most 4 times the last K, the least
-  // work within 1.25 times that); one K for the whole field (error_tile refused). bench/report/error_target.md measures it against K = 2048.
+  // work within 1.25 times that, or, where the directions it adds cost less, the least multiple of
+  // the last K reaching it, which extends that run: its planes kept, the directions between them
+  // run; the planes those of a run at that K); one K for the whole field (error_tile refused).
+  // bench/report/error_target.md measures it against K = 2048.
   double max_error = 0.0;
   // With max_error, where the field needs them: after the first run (the whole field at 16
   // directions), while the estimate's 99th percentile over the field exceeds max_error, the tiles
@@ -135,9 +138,11 @@ struct HorizonResult {
   std::vector<float> error_estimate;
   double estimated_error = 0.0;  // its 99th percentile over the pixels with data (horizon angles: its
                                  // mean); 0 without it
-  // With HorizonOptions::max_error: the K of each run it made, in order, so that its whole cost
-  // is known (with error_tile, runs after the first cover only the tiles that needed them); empty
-  // otherwise. `directions` is then the largest K any pixel took, and `azimuths` that run's.
+  // With HorizonOptions::max_error: the K of each run it made, in order (with error_tile, runs
+  // after the first cover only the tiles that needed them; with the horizon angles a run may
+  // extend the one before, casting only the directions it adds: samples_per_receiver is the
+  // cost of them all); empty otherwise. `directions` is then the largest K any pixel took, and `azimuths`
+  // that run's.
   std::vector<int> runs;
   // With HorizonOptions::max_error, per pixel: the K of the run its values (and estimate) come from.
   std::vector<int> pixel_directions;

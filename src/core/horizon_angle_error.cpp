@@ -211,7 +211,12 @@ HorizonResult runHorizonAnglesToError(double max_error, const HorizonAnglesRun& 
     earlier = directions;
     earlier_estimate = result.estimated_error;
     directions = extend ? extended : fresh;
-    result = extend ? run(directions, &result) : run(directions, nullptr);
+    if (extend) {
+      result = run(directions, &result);
+    } else {
+      result = HorizonResult();  // (its planes freed before the fresh run's: one run's planes at a time)
+      result = run(directions, nullptr);
+    }
   }
 }
 

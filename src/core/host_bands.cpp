@@ -2,7 +2,6 @@
 #include "core/host_bands.hpp"
 
 #include <exception>
-#include <system_error>
 
 namespace hfvis::detail {
 
@@ -26,8 +25,8 @@ void forEachBand(int count, int bands, const std::function<void(int band, int fi
   int started = 1;
   try {
     for (; started < bands; ++started) pool.emplace_back(run, started);
-  } catch (const std::system_error&) {
-    // (no thread to be had: the bands not started run here)
+  } catch (...) {
+    // (no thread to be had, or no memory for one: the bands not started run here)
   }
   run(0);
   for (int b = started; b < bands; ++b) run(b);

@@ -84,13 +84,14 @@ float sampleHeight(const std::vector<float>& heights, int width, int height, Poi
   return w00 * h00 + w10 * h10 + w01 * h01 + w11 * h11;
 }
 
-PreparedHeights prepareHeights(const HeightField& field, HeightOrigin origin) {
+PreparedHeights prepareHeights(const HeightField& field, HeightOrigin origin, int bands) {
   // Both passes in bands of rows on the host's threads (host_bands.hpp: at 4096^2 they took about
   // 100 ms on one), each band's extremes in float (exact), then combined.
   const std::size_t count = field.heights.size();
   const int rows = field.height > 0 ? field.height : 1;
   const std::size_t per_row = (count + rows - 1) / rows;
-  const int bands = bandsFor(rows, static_cast<long long>(per_row));
+  if (bands <= 0) bands = bandsFor(rows, static_cast<long long>(per_row));
+  bands = std::min(bands, rows);
   const auto band_range = [&](int first, int last) {
     return std::pair<std::size_t, std::size_t>(std::min(count, std::size_t(first) * per_row),
                                                std::min(count, std::size_t(last) * per_row));

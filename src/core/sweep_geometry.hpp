@@ -70,11 +70,16 @@ constexpr double kMaxPreparedHeight = 1e28;
 struct PreparedHeights {
   std::vector<float> heights;
   bool has_nodata = false;
-  // The least and the greatest of `heights` that are not NaN (+INFINITY and -INFINITY where all are).
+  // The least and the greatest of `heights` that are not NaN (+INFINITY and -INFINITY where all
+  // are), as prepareHeights sets them (a routine preparing heights of its own, as the bounce's,
+  // leaves them so: only the region operation reads them, from prepareHeights).
   float lowest = std::numeric_limits<float>::infinity(), highest = -std::numeric_limits<float>::infinity();
 };
 enum class HeightOrigin { Lowest, Zero };
-PreparedHeights prepareHeights(const HeightField& field, HeightOrigin origin = HeightOrigin::Lowest);
+// `bands`: the bands of rows it runs in (core/host_bands.hpp); 0, bandsFor's (tests give others:
+// the result is the same for any).
+PreparedHeights prepareHeights(const HeightField& field, HeightOrigin origin = HeightOrigin::Lowest,
+                               int bands = 0);
 
 // The kernels index pixels with 32-bit arithmetic: signed within a plane, unsigned across the
 // `planes` planes of one buffer. Throws InvalidArgument for fields beyond that.

@@ -1083,7 +1083,7 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
       planes.error_estimate = false;
       const auto estimated = [&](int directions, HorizonResult* from) {
         HorizonResult result;
-        if (!from || directions % from->directions != 0) {
+        if (!from) {
           attempt.directions = directions;
           result = run(planes, nullptr);
         } else {

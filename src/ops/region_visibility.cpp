@@ -128,12 +128,16 @@ RegionSurface prepareSurface(detail::ContextState& st, const HeightField& field,
     return cl::Buffer(st.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, values.size() * sizeof(float),
                       const_cast<float*>(values.data()));
   };
-  // (the two copies at once: at 4096^2, 157 MB of fresh pages, about 70 ms one after the other)
-  detail::forEachBand(2, out.pyramid.levels > 0 ? 2 : 1, [&](int band, int, int) {
-    if (band == 0)
-      out.heights = upload(h);
-    else
-      out.pyramid_top = upload(out.pyramid.top);
+  // (the two copies at once where the field is split too: at 4096^2, 157 MB of fresh pages, about
+  // 70 ms one after the other)
+  const int uploads = out.pyramid.levels > 0 ? 2 : 1;  // the heights, then the pyramid
+  detail::forEachBand(uploads, detail::bandsFor(field.height, field.width), [&](int, int first, int last) {
+    for (int u = first; u < last; ++u) {
+      if (u == 0)
+        out.heights = upload(h);
+      else
+        out.pyramid_top = upload(out.pyramid.top);
+    }
   });
   return out;
 }
@@ -529,7 +533,7 @@ void colourLight(RegionVisibilityResult& out, const HeightField& field, const st
 
 namespace detail {
 
-CullPyramid cullPyramid(const std::vector<float>& h, int width, int height, bool checked) {
+CullPyramid cullPyramid(const std::vector<float>& h, int width, int height, bool checked, int bands) {
   CullPyramid out;
   if (width < 2 || height < 2) return out;  // no cells: the march runs uncut
   const auto at = [&](int c, int r) { return h[std::size_t(r) * width + c]; };
@@ -542,7 +546,8 @@ CullPyramid cullPyramid(const std::vector<float>& h, int width, int height, bool
   // Every height finite (most fields): the same maxima row by row without the checks (the call's
   // fixed cost: this pass and level 0 took about half of it, bench/report/region_visibility.md),
   // in bands of rows on the host's threads (host_bands.hpp), each band's maxima then combined.
-  const int bands = bandsFor(height, width);
+  const int given_bands = bands;
+  if (bands <= 0) bands = bandsFor(height, width);
   bool all_finite = !checked;
   {
     std::vector<char> band_finite(bands, 1);
@@ -658,7 +663,7 @@ CullPyramid cullPyramid(const std::vector<float>& h, int width, int height, bool
     float* parent = out.top.data() + offsets[k];
     const int pw = (w + 1) / 2, ph = (hh + 1) / 2;
     // Per parent its children in row order (no value is NaN: the maxima of the pass they replace).
-    forEachBand(ph, bandsFor(ph, 4LL * pw), [&](int, int first, int last) {
+    forEachBand(ph, given_bands > 0 ? given_bands : bandsFor(ph, 4LL * pw), [&](int, int first, int last) {
       for (int r = first; r < last; ++r) {
         const float* upper = child + std::size_t(2 * r) * w;
         const float* lower = 2 * r + 1 < hh ? upper + w : nullptr;

@@ -38,8 +38,11 @@ struct CullPyramid {
 };
 
 // `checked`: the path for fields with non-finite heights even where every height is finite (the
-// tests compare the two paths; they must give the same pyramid).
-CullPyramid cullPyramid(const std::vector<float>& h, int width, int height, bool checked = false);
+// tests compare the two paths; they must give the same pyramid). `bands`: the bands of rows the
+// path for finite fields runs in (core/host_bands.hpp); 0, bandsFor's (tests give others: the
+// pyramid is the same for any).
+CullPyramid cullPyramid(const std::vector<float>& h, int width, int height, bool checked = false,
+                        int bands = 0);
 
 // Fills a pair result's clear_pairs, pairs and per-sample fractions from its bits (the samples'
 // counts and words set).
