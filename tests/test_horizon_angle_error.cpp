@@ -184,41 +184,53 @@ TEST(HorizonAngleMaxError, ExtendsTheLastRunWhereItsNewDirectionsCostLess) {
   EXPECT_DOUBLE_EQ(fresh.samples_per_receiver, 8.0 + 8.0 + 48.0 + 112.0);  // (the fake's own counts)
 }
 
-// An extended run (extendHorizonRun) from K = 8 to 8 m, by doublings (m = 2, 4) or by m - 1 turned
-// runs (m = 3, 6), with an azimuth offset and distances, against a fresh run at 8 m on a city and on
-// noise: the planes bit for bit, the azimuths within their rounding, the work the new directions'.
+// An extended run (extendHorizonRun) from K = 8 to 8 m (m = 2, 3, 4, 6), its directions between
+// K's cast in one run of a subset (computeHorizonDirections), with an azimuth offset and
+// distances, against a fresh run at 8 m on a city and on noise: the planes and the azimuths bit
+// for bit, the work the new directions'. And a subset alone: its directions in the order asked,
+// each as the fresh run's.
 TEST(HorizonAngleMaxError, AnExtendedRunIsAFreshRunsPlanes) {
   for (const char* name : {"city", "noise"}) {
     const HeightField field = makeSyntheticField(name, 40, 36);
     HorizonOutputs both = angles();
     both.horizon_distances = true;
-    const auto at = [&](int K, double turn) {
-      HorizonOptions options;
-      options.directions = K;
-      options.azimuth_offset = 0.3 + turn;
-      return computeHorizons(testContext(), field, options, both);
+    HorizonOptions options;
+    options.azimuth_offset = 0.3;
+    const auto at = [&](int K) {
+      HorizonOptions o = options;
+      o.directions = K;
+      return computeHorizons(testContext(), field, o, both);
     };
-    const HorizonResult eight = at(8, 0.0);
+    const HorizonResult eight = at(8);
     for (const int m : {2, 3, 4, 6}) {
       SCOPED_TRACE(std::string(name) + " m = " + std::to_string(m));
-      int parts = 0;
-      const HorizonResult extended = detail::extendHorizonRun(eight, 8 * m, [&](int count, double turn) {
-        ++parts;
-        return at(count, turn);
+      int runs = 0;
+      const HorizonResult extended = detail::extendHorizonRun(eight, 8 * m, [&](const std::vector<int>& indices) {
+        ++runs;
+        EXPECT_EQ(indices.size(), std::size_t(8 * (m - 1)));
+        return detail::computeHorizonDirections(testContext(), field, options, both, {8 * m, indices});
       });
-      EXPECT_EQ(parts, (m & (m - 1)) == 0 ? int(std::log2(m)) : m - 1);
-      const HorizonResult fresh = at(8 * m, 0.0);
+      EXPECT_EQ(runs, 1);
+      const HorizonResult fresh = at(8 * m);
       EXPECT_EQ(extended.directions, 8 * m);
       EXPECT_EQ(extended.angles, fresh.angles);
       EXPECT_EQ(extended.distances, fresh.distances);
-      ASSERT_EQ(extended.azimuths.size(), fresh.azimuths.size());
-      for (std::size_t k = 0; k < fresh.azimuths.size(); ++k)
-        EXPECT_NEAR(extended.azimuths[k], fresh.azimuths[k], 1e-12);
+      EXPECT_EQ(extended.azimuths, fresh.azimuths);
       EXPECT_NEAR(extended.samples_per_receiver, fresh.samples_per_receiver - eight.samples_per_receiver,
                   1e-9 * fresh.samples_per_receiver);
     }
+    // Directions 5, 1 and 6 of 8 (out of order): each the fresh run's plane and azimuth.
+    const HorizonResult some = detail::computeHorizonDirections(testContext(), field, options, both, {8, {5, 1, 6}});
+    ASSERT_EQ(some.directions, 3);
+    const std::size_t plane = field.pixelCount();
+    for (int i = 0; i < 3; ++i) {
+      const int k = std::vector<int>{5, 1, 6}[std::size_t(i)];
+      EXPECT_EQ(some.azimuths[std::size_t(i)], eight.azimuths[std::size_t(k)]);
+      EXPECT_TRUE(std::equal(some.angles.begin() + i * plane, some.angles.begin() + (i + 1) * plane,
+                             eight.angles.begin() + k * plane));
+    }
   }
-  EXPECT_THROW(detail::extendHorizonRun(HorizonResult(), 16, [](int, double) { return HorizonResult(); }),
+  EXPECT_THROW(detail::extendHorizonRun(HorizonResult(), 16, [](const std::vector<int>&) { return HorizonResult(); }),
                std::logic_error);
 }
 
@@ -249,9 +261,8 @@ TEST(HorizonAngleMaxError, MeetsTheTargetAgainstADenseRun) {
       ASSERT_EQ(r.angles.size(), field.pixelCount() * r.directions);
       EXPECT_EQ(r.distances.size(), r.angles.size());
       EXPECT_EQ(r.error_estimate.size(), field.pixelCount());
-      // The planes a run at that K gives, bit for bit, where the last run extended an earlier
-      // one (its directions turned runs of the earlier K) as where it ran afresh; the azimuths
-      // within their rounding (2 pi k / K + offset there, 2 pi (k m + j) / (m K) + offset here).
+      // The planes and azimuths a run at that K gives, bit for bit, where the last run extended
+      // an earlier one as where it ran afresh.
       HorizonOptions at_k;
       at_k.directions = r.directions;
       HorizonOutputs both = angles(true);
@@ -259,9 +270,8 @@ TEST(HorizonAngleMaxError, MeetsTheTargetAgainstADenseRun) {
       const HorizonResult fixed = computeHorizons(testContext(), field, at_k, both);
       EXPECT_EQ(r.angles, fixed.angles);
       EXPECT_EQ(r.distances, fixed.distances);
-      ASSERT_EQ(r.azimuths.size(), fixed.azimuths.size());
-      for (std::size_t k = 0; k < r.azimuths.size(); ++k) EXPECT_NEAR(r.azimuths[k], fixed.azimuths[k], 1e-12);
-      EXPECT_NEAR(r.estimated_error, fixed.estimated_error, 1e-9 * fixed.estimated_error);
+      EXPECT_EQ(r.azimuths, fixed.azimuths);
+      EXPECT_EQ(r.estimated_error, fixed.estimated_error);  // (a one-run estimate: the same)
       // The work: each run's own directions, so that where every run extended the one before, all
       // of them together cost what the last K alone does.
       bool extended = true;

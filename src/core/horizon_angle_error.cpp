@@ -222,12 +222,12 @@ HorizonResult runHorizonAnglesToError(double max_error, const HorizonAnglesRun& 
 
 namespace {
 
-// Puts `part`, whose direction k is `into`'s direction k stride + first, in its places: its
-// azimuths, angle and distance planes.
-void placeHorizonRun(HorizonResult& into, const HorizonResult& part, int stride, int first) {
+// Puts `part`, whose direction k is `into`'s direction indices[k], in its places: its azimuths,
+// angle and distance planes.
+void placeHorizonRun(HorizonResult& into, const HorizonResult& part, const std::vector<int>& indices) {
   const std::size_t plane = static_cast<std::size_t>(into.width) * into.height;
-  for (int k = 0; k < part.directions; ++k) {
-    const std::size_t to = static_cast<std::size_t>(k) * stride + first;
+  for (std::size_t k = 0; k < indices.size(); ++k) {
+    const std::size_t to = static_cast<std::size_t>(indices[k]);
     into.azimuths[to] = part.azimuths[k];
     if (!part.angles.empty())
       std::copy_n(part.angles.begin() + k * plane, plane, into.angles.begin() + to * plane);
@@ -239,7 +239,7 @@ void placeHorizonRun(HorizonResult& into, const HorizonResult& part, int stride,
 }  // namespace
 
 HorizonResult extendHorizonRun(HorizonResult from, int directions,
-                               const std::function<HorizonResult(int count, double turn)>& run) {
+                               const std::function<HorizonResult(const std::vector<int>& indices)>& run) {
   const int K = from.directions, m = K > 0 ? directions / K : 0;
   if (m < 2 || directions % K != 0)
     throw std::logic_error("extendHorizonRun: " + std::to_string(directions) + " directions are no multiple of " +
@@ -252,20 +252,15 @@ HorizonResult extendHorizonRun(HorizonResult from, int directions,
   out.azimuths.assign(std::size_t(directions), 0.0);
   if (!from.angles.empty()) out.angles.assign(plane * directions, 0.0f);
   if (!from.distances.empty()) out.distances.assign(plane * directions, 0.0f);
-  placeHorizonRun(out, from, m, 0);
+  std::vector<int> own, between;
+  for (int i = 0; i < directions; ++i) (i % m == 0 ? own : between).push_back(i);
+  placeHorizonRun(out, from, own);
   from = HorizonResult();
-  double work = 0.0;
-  const auto cast = [&](int count, int first, int stride) {
-    const HorizonResult part = run(count, 2.0 * M_PI * first / directions);
-    placeHorizonRun(out, part, stride, first);
-    work += part.samples_per_receiver;
-  };
-  if ((m & (m - 1)) == 0) {
-    for (int done = K; done < directions; done *= 2) cast(done, directions / (2 * done), directions / done);
-  } else {
-    for (int j = 1; j < m; ++j) cast(K, j, m);
-  }
-  out.samples_per_receiver = work;
+  const HorizonResult part = run(between);
+  if (part.directions != static_cast<int>(between.size()) || part.width != out.width || part.height != out.height)
+    throw std::logic_error("extendHorizonRun: the run did not cast the directions asked for");
+  placeHorizonRun(out, part, between);
+  out.samples_per_receiver = part.samples_per_receiver;
   out.error_estimate.clear();
   out.estimated_error = 0.0;
   return out;

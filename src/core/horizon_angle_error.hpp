@@ -79,8 +79,8 @@ constexpr double kHorizonChoiceSpan = 1.25;
 // A run of the horizon angles at K with its estimate: a fresh one (`from` null), or one that
 // extends `from`, the result of a run at K / m (m >= 2), by the directions it lacks: with exact
 // azimuths (the horizon angles' absolute tolerance) a direction's lattice step depends on its
-// azimuth alone, and K / m's azimuths are every m-th of K's, so runs of turned directions hold the
-// rest (extendHorizonRun). Takes `from`'s planes.
+// azimuth alone, and K / m's azimuths are every m-th of K's, so one run of the directions between
+// them holds the rest (extendHorizonRun). Takes `from`'s planes.
 using HorizonAnglesRun = std::function<HorizonResult(int directions, HorizonResult* from)>;
 
 // HorizonOptions::max_error for the horizon angles: run(K) with the estimate at
@@ -100,19 +100,31 @@ using HorizonAnglesRun = std::function<HorizonResult(int directions, HorizonResu
 HorizonResult runHorizonAnglesToError(double max_error, const HorizonAnglesRun& run,
                                       const std::function<double(int)>& work, bool extend = true);
 
+// Some of the directions of a run at `of`: those at `indices`, in that order, each with the
+// azimuth and lattice step a run at `of` gives it (the sweep's horizon planes alone). One run of
+// the directions an extension adds (extendHorizonRun).
+struct DirectionSubset {
+  int of = 0;
+  std::vector<int> indices;
+};
+
+// Runs the horizon operation (src/ops/horizon.cpp) over `subset` of the directions of a run at
+// subset.of, with `options` otherwise (options.directions is not looked at): result direction i
+// is subset.indices[i]. The sweep's horizon angles (and distances) alone; for extendHorizonRun and
+// its tests.
+HorizonResult computeHorizonDirections(const ComputeContext& context, const HeightField& field,
+                                       const HorizonOptions& options, const HorizonOutputs& outputs,
+                                       const DirectionSubset& subset);
+
 // The horizon angles (and distances) of a run at `directions` (a multiple m >= 2 of from's K)
-// from `from` and runs of the directions between its own: run(count, turn) runs `count`
-// directions from the first azimuth plus `turn` radians (the result's own fields set as a run
-// sets them). Where m is a power of 2, by doublings (a run of the K so far turned by half its
-// spacing: log2 m runs), else m - 1 runs of K turned by 2 pi j / directions; each part put in its
-// places at once, so that at most one part's planes are held beside the whole (a run has costs of
-// its own besides its directions': buffers, launches). samples_per_receiver: the parts' alone.
-// With the sweep's lattice steps (chosen by azimuth alone) the planes are a run's at `directions`
-// (bit for bit in the tests: a turned run's azimuths round differently, which could change a step
-// only where one lies within a rounding of the tolerance's edge); the azimuths within their
-// rounding. The estimate is not taken.
+// from `from` and one run of the directions between its own: run(indices) casts, of the
+// directions of a run at `directions`, those at `indices` (every one but each m-th), as that run
+// casts them, its direction i being indices[i] (its other fields set as a run sets them). Its
+// planes are put in their places. So the planes and azimuths are a run's at `directions`, where
+// each direction's step depends on its azimuth alone (the sweep's exact azimuths).
+// samples_per_receiver: the one run's alone. The estimate is not taken.
 HorizonResult extendHorizonRun(HorizonResult from, int directions,
-                               const std::function<HorizonResult(int count, double turn)>& run);
+                               const std::function<HorizonResult(const std::vector<int>& indices)>& run);
 constexpr int kHorizonFirstDirections = 8, kHorizonSecondDirections = 16;
 constexpr double kHorizonMostStep = 4.0;
 

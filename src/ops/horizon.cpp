@@ -219,12 +219,27 @@ std::vector<LatticeLine> linesReaching(const std::vector<LatticeLine>& lines, in
 }
 
 // `wanted` (null: every pixel): the sweep runs only the lines that reach those pixels
-// (linesReaching); the others' outputs are left unfinished.
+// (linesReaching); the others' outputs are left unfinished. `subset` (the sweep with exact
+// azimuths, the horizon planes alone): of the directions of a run at subset->of, those at
+// subset->indices, in that order (options.directions their count), each as that run takes it.
 std::vector<RunDirection> runDirectionsOf(const HeightField& field, const HorizonOptions& options,
-                                          const HorizonOutputs& outputs, const std::vector<char>* wanted) {
+                                          const HorizonOutputs& outputs, const std::vector<char>* wanted,
+                                          const DirectionSubset* subset) {
   std::vector<RunDirection> out;
+  if (subset && (options.method != HorizonMethod::Sweep || !exactAzimuths(outputs) || outputs.sky_view_factor ||
+                 outputs.ambient_occlusion || outputs.environment ||
+                 int(subset->indices.size()) != options.directions))
+    throw std::logic_error("a subset of directions: the sweep's horizon planes alone, options.directions of them");
   if (options.method == HorizonMethod::Sweep) {
-    const std::vector<LatticeDirection> directions = horizonDirections(field, options, outputs);
+    std::vector<LatticeDirection> directions;
+    if (subset) {
+      HorizonOptions whole = options;
+      whole.directions = subset->of;
+      const std::vector<LatticeDirection> all = horizonDirections(field, whole, outputs);
+      for (const int k : subset->indices) directions.push_back(all.at(std::size_t(k)));
+    } else {
+      directions = horizonDirections(field, options, outputs);
+    }
     std::vector<RowTable> rows;
     if (hasRowSpacing(field)) rows = latticeRowTables(field, directions, !exactAzimuths(outputs), outputs.error_estimate);
     for (std::size_t k = 0; k < directions.size(); ++k) {
@@ -287,14 +302,15 @@ struct StacksBeyondStrips : MemoryBudgetError {
 
 class HorizonRoutine : public SweepRoutine {
  public:
-  // `wanted`: as runDirectionsOf takes it.
+  // `wanted`, `subset`: as runDirectionsOf takes them.
   HorizonRoutine(ContextState& st, const HeightField& field, const HorizonOptions& options,
-                 const HorizonOutputs& outputs, const std::vector<char>* wanted = nullptr)
+                 const HorizonOutputs& outputs, const std::vector<char>* wanted = nullptr,
+                 const DirectionSubset* subset = nullptr)
       : SweepRoutine(st, field, options),
         horizon_(options),
         outputs_(outputs),
         lanes_(simdLanes(st)),
-        directions_(runDirectionsOf(field, options, outputs, wanted)),
+        directions_(runDirectionsOf(field, options, outputs, wanted, subset)),
         plan_(planRun(field, options, outputs, directions_, st.info)) {
     // A window's blocks are per line, so its strips, and with per-row spacing its whole sweep
     // (positions differ by line there), run one line per work-item.
@@ -1047,7 +1063,37 @@ HorizonResult runToError(const HeightField& field, const HorizonOptions& options
   return result;
 }
 
+// One run of the routine (its hull stacks retried in thinner strips).
+HorizonResult runHorizonRoutine(ContextState& st, const HeightField& field, HorizonOptions& attempt,
+                                const HorizonOutputs& outputs, const std::vector<char>* pixels,
+                                const DirectionSubset* subset) {
+  // Hull stacks too deep for the room strips leave: again from the start with thinner strips
+  // (StacksBeyondStrips::rows), as the sums of the strips done cannot be taken back.
+  for (;;) {
+    try {
+      HorizonRoutine routine(st, field, attempt, outputs, pixels, subset);
+      routine.run();
+      return routine.take();
+    } catch (const StacksBeyondStrips& error) {
+      if (error.rows < 1) throw MemoryBudgetError(error.what());
+      attempt.strip_rows = error.rows;
+    }
+  }
+}
+
 }  // namespace
+
+HorizonResult computeHorizonDirections(const ComputeContext& context, const HeightField& field,
+                                       const HorizonOptions& options, const HorizonOutputs& outputs,
+                                       const DirectionSubset& subset) {
+  validate(field);
+  HorizonOptions attempt = options;
+  attempt.directions = static_cast<int>(subset.indices.size());
+  validate(attempt, outputs);
+  return translateOpenClErrors(
+      [&] { return runHorizonRoutine(stateOf(context), field, attempt, outputs, nullptr, &subset); });
+}
+
 }  // namespace detail
 
 HorizonResult computeHorizons(const ComputeContext& context, const HeightField& field,
@@ -1062,20 +1108,10 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
         "differs "
         "by row (reproject it, or give the cell size)");
   return detail::translateOpenClErrors([&] {
-    // Hull stacks too deep for the room strips leave: again from the start with thinner strips
-    // (StacksBeyondStrips::rows), as the sums of the strips done cannot be taken back.
     HorizonOptions attempt = options;
-    const auto run = [&](const HorizonOutputs& wanted, const std::vector<char>* pixels) {
-      for (;;) {
-        try {
-          detail::HorizonRoutine routine(detail::stateOf(context), field, attempt, wanted, pixels);
-          routine.run();
-          return routine.take();
-        } catch (const detail::StacksBeyondStrips& error) {
-          if (error.rows < 1) throw MemoryBudgetError(error.what());
-          attempt.strip_rows = error.rows;
-        }
-      }
+    const auto run = [&](const HorizonOutputs& wanted, const std::vector<char>* pixels,
+                         const detail::DirectionSubset* subset = nullptr) {
+      return detail::runHorizonRoutine(detail::stateOf(context), field, attempt, wanted, pixels, subset);
     };
     if (outputs.horizon_angles && (options.max_error != 0.0 || outputs.error_estimate)) {
       // The horizon angles' own error, from their planes on the host (core/horizon_angle_error.hpp).
@@ -1087,12 +1123,10 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
           attempt.directions = directions;
           result = run(planes, nullptr);
         } else {
-          result = detail::extendHorizonRun(std::move(*from), directions, [&](int count, double turn) {
-            attempt.directions = count;
-            attempt.azimuth_offset = options.azimuth_offset + turn;
-            HorizonResult part = run(planes, nullptr);
-            attempt.azimuth_offset = options.azimuth_offset;
-            return part;
+          result = detail::extendHorizonRun(std::move(*from), directions, [&](const std::vector<int>& indices) {
+            const detail::DirectionSubset subset{directions, indices};
+            attempt.directions = static_cast<int>(indices.size());
+            return run(planes, nullptr, &subset);
           });
         }
         detail::estimateHorizonAngleError(result);
