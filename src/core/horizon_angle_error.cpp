@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numeric>
 #include <sstream>
 #include <stdexcept>
@@ -159,7 +160,13 @@ int cheapestDirections(int needed, const std::function<double(int)>& work) {
 }
 
 HorizonResult runHorizonAnglesToError(double max_error, const HorizonAnglesRun& run,
-                                      const std::function<double(int)>& work, bool extend_runs) {
+                                      const std::function<double(int)>& work_of, bool extend_runs) {
+  // (each K's work once: it builds K's lattice steps, about a millisecond)
+  std::map<int, double> known;
+  const std::function<double(int)> work = [&](int K) {
+    const auto found = known.find(K);
+    return found != known.end() ? found->second : known.emplace(K, work_of(K)).first->second;
+  };
   int directions = kHorizonFirstDirections, earlier = 0;
   double earlier_estimate = 0.0, total = 0.0;
   std::vector<int> runs;
@@ -206,8 +213,9 @@ HorizonResult runHorizonAnglesToError(double max_error, const HorizonAnglesRun& 
     // Or the last run extended to the least multiple of its K that reaches as far: only the
     // directions it adds are cast (bench/report/error_target.md, horizon angles).
     const int extended = (reach + directions - 1) / directions * directions;
+    // (to the same K the extension costs less, whatever the work)
     const bool extend = extend_runs && extended > directions && extended <= kMaxAutoDirections &&
-                        work(extended) - work(directions) <= work(fresh);
+                        (extended == fresh || work(extended) - work(directions) <= work(fresh));
     earlier = directions;
     earlier_estimate = result.estimated_error;
     directions = extend ? extended : fresh;
