@@ -90,13 +90,14 @@ using HorizonAnglesRun = std::function<HorizonResult(int directions, HorizonResu
 // 0.5 .. 3), 5 % more, at most kHorizonMostStep times the last K: of the multiples of 8 within
 // kHorizonChoiceSpan of that, the cheapest by `work`, or the least multiple of the last K that
 // reaches it, extending the last run, where the directions it adds cost less (so the runs on the
-// way are not cast again, for a K up to twice the need and, while a run extends, its planes held
-// beside the result's, up to 1.5 times a fresh run's; `extend` false: never), until the estimate's mean is at
-// most max_error (and never past kMaxAutoDirections). Throws InvalidArgument (E in degrees) when a prediction
-// within one such step, a fall as K^-3, or the run at kMaxAutoDirections itself needs more than
-// kMaxAutoDirections. Edge pixels count as they are: the directions whose rays leave the field at once hold
-// -pi/2, and the interpolation between such a direction and its neighbours counts as error there (on small
-// fields a visible share).
+// way are not cast again, for a K up to twice the need and, while a run extends, the planes of the
+// directions it adds held beside the result's: up to 1.75 times a fresh run's, m <= 4; `extend`
+// false: never), until the estimate's mean is at most max_error (and never past
+// kMaxAutoDirections). Throws InvalidArgument (E in degrees) when a prediction within one such
+// step, a fall as K^-3, or the run at kMaxAutoDirections itself needs more than
+// kMaxAutoDirections. Edge pixels count as they are: the directions whose rays leave the field at
+// once hold -pi/2, and the interpolation between such a direction and its neighbours counts as
+// error there (on small fields a visible share).
 HorizonResult runHorizonAnglesToError(double max_error, const HorizonAnglesRun& run,
                                       const std::function<double(int)>& work, bool extend = true);
 

@@ -1133,8 +1133,8 @@ HorizonResult computeHorizons(const ComputeContext& context, const HeightField& 
         return result;
       };
       if (options.max_error == 0.0) return estimated(options.directions, nullptr);
-      // (extending a run: the sweep's lattice steps, chosen by azimuth alone, are the same bit for bit;
-      // the naive method's rays would turn by the azimuths' rounding)
+      // (a run extends only with the sweep: a subset of directions is the sweep's, whose lattice
+      // steps a direction's azimuth alone chooses)
       return detail::runHorizonAnglesToError(
           options.max_error, estimated,
           [&](int directions) { return detail::horizonWork(field, options, planes, directions); },
