@@ -1090,6 +1090,7 @@ HorizonResult computeHorizonDirections(const ComputeContext& context, const Heig
   HorizonOptions attempt = options;
   attempt.directions = static_cast<int>(subset.indices.size());
   validate(attempt, outputs);
+  checkPixelIndexing(field, 1);
   return translateOpenClErrors(
       [&] { return runHorizonRoutine(stateOf(context), field, attempt, outputs, nullptr, &subset); });
 }
