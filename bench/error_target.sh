@@ -5,7 +5,8 @@
 # occlusion, the K that --max-error chose, its error estimate, the error it achieved against the
 # same sweep at a dense K, and its time against the cheapest fixed K (multiples of 8) meeting E on
 # that field, timed interleaved (`hfvis_bench error-target`, library calls).
-# Writes bench/report/error_target.md (or --out FILE).
+# Writes bench/report/error_target.md (or --out FILE), and redraws its plot beside it
+# (error_target.png: bench/error_target_plot.py, every mode that writes the report).
 #
 #   bench/error_target.sh [--size 128] [--errors 0.001,...,0.05] [--reference-k 2048] [--reps 3] [--tile 64]
 #                         [--contents fractal,...,mixed] [--out FILE]
@@ -79,6 +80,14 @@ later_sections() {
   awk -v a="${kept_sections[0]}" -v b="${kept_sections[1]}" '$0 == a || $0 == b { on = 1 } on { print }' "$out"
 }
 commit=$(git -C "$root" rev-parse --short HEAD)  # before the run: the build it times
+# The report's plot beside it (bench/error_target_plot.py), where Debian's python3 has matplotlib.
+plot() {
+  if /usr/bin/python3 -c "import matplotlib" 2>/dev/null; then
+    /usr/bin/python3 "$root/bench/error_target_plot.py" "$out" -o "${out%.md}.png"
+  else
+    echo "error_target.sh: no matplotlib for /usr/bin/python3: the plot was not redrawn" >&2
+  fi
+}
 if [[ $horizon -eq 1 && $curve -gt 0 ]]; then
   [[ $out == $root/bench/report/error_target.md ]] && out=$root/bench/report/error_curve_horizon.md
   table=$(cd "$root" && "$bench" error-target --output horizon --size "$size" --reference-k "$reference" \
@@ -143,6 +152,7 @@ if [[ $horizon -eq 1 ]]; then
   )
   replace_section "$marker" "$section"
   echo "wrote $out"
+  plot
   exit 0
 fi
 if [[ $viewcount -eq 1 ]]; then
@@ -164,6 +174,7 @@ if [[ $viewcount -eq 1 ]]; then
   )
   replace_section "$marker" "$section"
   echo "wrote $out"
+  plot
   exit 0
 fi
 later=$(later_sections)
@@ -191,7 +202,11 @@ tables=$(cd "$root" && "$bench" error-target --size "$size" --errors "$errors" -
   else
     echo "Not timed (--reps 0): the work ratio stands for the time ratio."
   fi
+  echo "The plot of every section's tables: [$(basename "${out%.md}").png]($(basename "${out%.md}").png)"
+  echo "(bench/error_target_plot.py, redrawn by each run of this script)."
   echo "$tables"
-  [[ -n $later ]] && printf '\n%s\n' "$later"
+  # (an if, not `[[ ]] &&`: the block's status is its last command's, and the move needs 0)
+  if [[ -n $later ]]; then printf '\n%s\n' "$later"; fi
 } > "$out.tmp" && mv "$out.tmp" "$out"
 echo "wrote $out"
+plot
