@@ -15,6 +15,7 @@
 #include "core/horizon_angle_error.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
+#include "hfvis/sweep_options.hpp"
 #include "hfvis_testing/synthetic_fields.hpp"
 #include "test_support.hpp"
 
@@ -154,8 +155,8 @@ TEST(HorizonAngleMaxError, RunsTheCheapestKWithinAQuarterAboveTheNeed) {
 // The runs toward a maximum error extend the last one where the directions that adds cost less than
 // a fresh run (work linear in K here: always, where a multiple of the last K reaches the need), each
 // extension handed the run before, and the work all runs' own directions: with an estimate of 1 / K
-// and E = 0.01, 8, then 16, 64 (at most 4 times as far) and 128 (the least multiple of 64 past the
-// need of about 105), each extending the one before, 128 directions' work in all.
+// and E = 0.01, 8, then 16, 32 (the third run at most twice as far) and 128 (the least multiple of 32
+// past the need of about 105), each extending the one before, 128 directions' work in all.
 TEST(HorizonAngleMaxError, ExtendsTheLastRunWhereItsNewDirectionsCostLess) {
   std::vector<std::pair<int, int>> calls;  // (K, the K extended or 0)
   const auto run = [&](int K, HorizonResult* from) {
@@ -173,21 +174,39 @@ TEST(HorizonAngleMaxError, ExtendsTheLastRunWhereItsNewDirectionsCostLess) {
     return double(K);
   });
   for (const auto& [K, times] : asked) EXPECT_EQ(times, 1) << "K = " << K;
-  const std::vector<std::pair<int, int>> expected = {{8, 0}, {16, 8}, {64, 16}, {128, 64}};
+  const std::vector<std::pair<int, int>> expected = {{8, 0}, {16, 8}, {32, 16}, {128, 32}};
   EXPECT_EQ(calls, expected);
-  EXPECT_EQ(r.runs, (std::vector<int>{8, 16, 64, 128}));
+  EXPECT_EQ(r.runs, (std::vector<int>{8, 16, 32, 128}));
   EXPECT_EQ(r.directions, 128);
   EXPECT_DOUBLE_EQ(r.samples_per_receiver, 128.0);
   // Where a multiple's new directions cost more than a fresh K, the fresh one runs: multiples of 32
-  // cost half but 128 costs 200, so extending 64 to 128 adds 168 where a fresh 112 costs 112.
+  // cost half but 128 costs 200, so extending 32 to 128 adds 184 where a fresh 112 costs 112.
   calls.clear();
   const auto uneven = [](int K) { return K == 128 ? 200.0 : (K % 32 == 0 ? 0.5 * K : double(K)); };
   const HorizonResult fresh = detail::runHorizonAnglesToError(0.01, run, uneven);
   ASSERT_EQ(calls.size(), 4u);
   EXPECT_EQ(calls.back().second, 0);
   EXPECT_EQ(calls.back().first, 112);
-  EXPECT_EQ(fresh.runs, (std::vector<int>{8, 16, 64, 112}));
-  EXPECT_DOUBLE_EQ(fresh.samples_per_receiver, 8.0 + 8.0 + 48.0 + 112.0);  // (the fake's own counts)
+  EXPECT_EQ(fresh.runs, (std::vector<int>{8, 16, 32, 112}));
+  EXPECT_DOUBLE_EQ(fresh.samples_per_receiver, 8.0 + 8.0 + 16.0 + 112.0);  // (the fake's own counts)
+}
+
+// A direction two K share has one azimuth to the bit (directionAzimuth takes k / K in lowest terms),
+// so that an extended run is the larger K's: every K a multiple of 8 up to 2048 against m K, m = 2 ..
+// 8, with and without an offset (2 pi k / K as written differs in about one shared direction in seven).
+TEST(HorizonAngleMaxError, SharedDirectionsHaveOneAzimuth) {
+  for (const double offset : {0.0, 0.3}) {
+    std::size_t shared = 0, differing = 0;
+    for (int K = 8; K <= 2048; K += 8)
+      for (int m = 2; m <= 8; ++m) {
+        HorizonOptions small, large;
+        small.directions = K, large.directions = m * K;
+        small.azimuth_offset = large.azimuth_offset = offset;
+        for (int k = 0; k < K; ++k, ++shared)
+          differing += directionAzimuth(k, small) != directionAzimuth(m * k, large);
+      }
+    EXPECT_EQ(differing, 0u) << "of " << shared << " shared directions, offset " << offset;
+  }
 }
 
 // An extended run (extendHorizonRun) from K = 8 to 8 m (m = 2, 3, 4, 6), its directions between
@@ -208,21 +227,25 @@ TEST(HorizonAngleMaxError, AnExtendedRunIsAFreshRunsPlanes) {
       return computeHorizons(testContext(), field, o, both);
     };
     const HorizonResult eight = at(8);
-    for (const int m : {2, 3, 4, 6}) {
-      SCOPED_TRACE(std::string(name) + " m = " + std::to_string(m));
+    // (16 to 48 too: 2 pi k / K rounded apart for 16 and 48 at k = 11, 13 and 15 before the azimuths
+    // took k / K in lowest terms)
+    for (const auto& [base, m] : std::vector<std::pair<int, int>>{{8, 2}, {8, 3}, {8, 4}, {8, 6}, {16, 3}}) {
+      SCOPED_TRACE(std::string(name) + " " + std::to_string(base) + " times " + std::to_string(m));
+      const HorizonResult from = base == 8 ? eight : at(base);
       int runs = 0;
-      const HorizonResult extended = detail::extendHorizonRun(eight, 8 * m, [&](const std::vector<int>& indices) {
-        ++runs;
-        EXPECT_EQ(indices.size(), std::size_t(8 * (m - 1)));
-        return detail::computeHorizonDirections(testContext(), field, options, both, {8 * m, indices});
-      });
+      const HorizonResult extended =
+          detail::extendHorizonRun(from, base * m, [&](const std::vector<int>& indices) {
+            ++runs;
+            EXPECT_EQ(indices.size(), std::size_t(base * (m - 1)));
+            return detail::computeHorizonDirections(testContext(), field, options, both, {base * m, indices});
+          });
       EXPECT_EQ(runs, 1);
-      const HorizonResult fresh = at(8 * m);
-      EXPECT_EQ(extended.directions, 8 * m);
+      const HorizonResult fresh = at(base * m);
+      EXPECT_EQ(extended.directions, base * m);
       EXPECT_EQ(extended.angles, fresh.angles);
       EXPECT_EQ(extended.distances, fresh.distances);
       EXPECT_EQ(extended.azimuths, fresh.azimuths);
-      EXPECT_NEAR(extended.samples_per_receiver, fresh.samples_per_receiver - eight.samples_per_receiver,
+      EXPECT_NEAR(extended.samples_per_receiver, fresh.samples_per_receiver - from.samples_per_receiver,
                   1e-9 * fresh.samples_per_receiver);
     }
     // Directions 5, 1 and 6 of 8 (out of order): each the fresh run's plane and azimuth.

@@ -49,7 +49,8 @@ struct SweepOptions {
   std::function<void(int, int)> strip_progress;
 };
 
-// Azimuth of direction k, in radians.
+// Azimuth of direction k, in radians: 2 pi k / K + azimuth_offset, k / K taken in lowest terms, so
+// that a direction two K share (every m-th of m K's is one of K's) has one azimuth, to the bit.
 double directionAzimuth(int k, const SweepOptions& options);
 
 // Throws InvalidArgument for K < 1, a sampling density outside (0, 64], a non-finite

@@ -204,11 +204,15 @@ HorizonResult runHorizonAnglesToError(double max_error, const HorizonAnglesRun& 
       throw InvalidArgument(message.str());
     }
     // After the first run the second (whose work is a few per cent of what follows) measures the
-    // order; later runs go at most kHorizonMostStep times as far, where the order is measured again
-    // (it rises with K on smooth fields, and the estimate's fall from 8 to 16 predicts badly far off).
-    const int reach = earlier == 0 ? kHorizonSecondDirections
-                                   : static_cast<int>(std::ceil(std::min(
-                                         {wanted, kHorizonMostStep * directions, double(kMaxAutoDirections)})));
+    // order; the third goes at most kHorizonThirdStep times as far and later runs kHorizonMostStep
+    // times, where the order is measured again (it rises with K on smooth fields, and the estimate's
+    // fall from 8 to 16 predicts badly far off: from 16 straight to 64, a need of 72 .. 104 then took
+    // 128, where 16, 32 and a run near the need cost less: bench/report/error_target.md).
+    const double most_step = earlier == kHorizonFirstDirections ? kHorizonThirdStep : kHorizonMostStep;
+    const int reach =
+        earlier == 0 ? kHorizonSecondDirections
+                     : static_cast<int>(
+                           std::ceil(std::min({wanted, most_step * directions, double(kMaxAutoDirections)})));
     const int fresh = earlier == 0 ? kHorizonSecondDirections : cheapestDirections(reach, work);
     // Or the last run extended to the least multiple of its K that reaches as far: only the
     // directions it adds are cast (bench/report/error_target.md, horizon angles).

@@ -87,7 +87,8 @@ using HorizonAnglesRun = std::function<HorizonResult(int directions, HorizonResu
 // kHorizonFirstDirections, then at kHorizonSecondDirections (the two cost a few per cent of any
 // later run: the axes and diagonals, then steps of at most a few pixels), then at the K the
 // estimates predict (the error falling as K^-p, p measured between the last two runs within
-// 0.5 .. 3), 5 % more, at most kHorizonMostStep times the last K: of the multiples of 8 within
+// 0.5 .. 3), 5 % more, at most kHorizonMostStep times the last K (kHorizonThirdStep times the second's:
+// the fall from the first two predicts badly far off): of the multiples of 8 within
 // kHorizonChoiceSpan of that, the cheapest by `work`, or the least multiple of the last K that
 // reaches it, extending the last run, where the directions it adds cost less (so the runs on the
 // way are not cast again, for a K up to twice the need and, while a run extends, the planes of the
@@ -127,6 +128,6 @@ HorizonResult computeHorizonDirections(const ComputeContext& context, const Heig
 HorizonResult extendHorizonRun(HorizonResult from, int directions,
                                const std::function<HorizonResult(const std::vector<int>& indices)>& run);
 constexpr int kHorizonFirstDirections = 8, kHorizonSecondDirections = 16;
-constexpr double kHorizonMostStep = 4.0;
+constexpr double kHorizonMostStep = 4.0, kHorizonThirdStep = 2.0;
 
 }  // namespace hfvis::detail
