@@ -628,6 +628,32 @@ TEST(RegionVisibility, TheBitmaskScatterBehindAWall) {
   });
 }
 
+// A field one point thick (one row, one column) has no cells for the bitmask method to back-project:
+// asked for, it is refused; the default takes the culled march there, whose bits are the exact
+// ones, and the wall of the row hides the light behind it (the bitmask method had every pixel lit).
+TEST(RegionVisibility, AFieldOnePointThickTakesTheMarch) {
+  const std::vector<float> row = {0, 0, 0, 10, 0, 0, 0, 0};
+  RegionSampling light;
+  light.rectangle = {0, 0, 0, 0};
+  light.samples = 64;
+  light.height = 5.0;
+  light.absolute = true;
+  RegionVisibilityOptions exact, bitmask;
+  exact.method = RegionVisibilityMethod::Exact;
+  bitmask.method = RegionVisibilityMethod::Bitmask;
+  forEachLayout([&](const ComputeContext& context) {
+    for (const bool across : {true, false}) {
+      SCOPED_TRACE(across ? "one row" : "one column");
+      const HeightField field = across ? fieldFrom(8, 1, row) : fieldFrom(1, 8, row);
+      EXPECT_THROW(computeRegionVisibility(context, field, light, bitmask), InvalidArgument);
+      const RegionVisibilityResult got = computeRegionVisibility(context, field, light, {});
+      EXPECT_EQ(got.method, RegionVisibilityMethod::Culled);
+      EXPECT_EQ(got.bits, computeRegionVisibility(context, field, light, exact).bits);
+      for (int p = 0; p < 8; ++p) EXPECT_EQ(got.fraction[p], p <= 3 ? 1.0f : 0.0f) << p;
+    }
+  });
+}
+
 // The default (Auto) takes the bitmask method for a planar light of kBitmaskFromSamples or more
 // samples and the culled march otherwise (fewer samples, a light above the surface, decorrelated
 // samples, a region pair), and either way gives the exact bits.

@@ -100,9 +100,9 @@ enum class RegionVisibilityMethod {
   Culled,
   // The bitmask scatter of Eisemann & Décoret (2007) for a planar light (a rectangle at an
   // absolute height, or points all at one absolute height; shared samples, at most
-  // kMaxBitmaskSamples, every-pixel receivers, no curvature: InvalidArgument
-  // otherwise): per receiver, every cell that may reach the shaft to the light (a max pyramid's
-  // blocks below it left out) is back-projected from the receiver onto the light's plane, and
+  // kMaxBitmaskSamples, every-pixel receivers, no curvature, a field of cells (at least 2 x 2
+  // points): InvalidArgument otherwise): per receiver, every cell that may reach the shaft to the light (a
+  // max pyramid's blocks below it left out) is back-projected from the receiver onto the light's plane, and
   // the samples inside come from a table of edge bitmasks (RegionVisibilityOptions::
   // bitmask_table), ANDed per edge and ORed over the cells. The bilinear cell's back-projection
   // has curved edges, so each cell gives two pairs of polygons: the prisms under the

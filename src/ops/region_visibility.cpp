@@ -852,9 +852,14 @@ std::size_t sourceSamples(const RegionSampling& sources) {
   return sources.points.empty() ? std::size_t(sources.samples) : sources.points.size();
 }
 
-// Why the bitmask method cannot take this light ("" when it can): its occluders are
-// back-projected onto one plane, through one table of the shared samples.
-std::string bitmaskRefusal(const RegionSampling& sources, const RegionVisibilityOptions& options) {
+// Why the bitmask method cannot take this light over `field` ("" when it can): its occluders are
+// back-projected onto one plane, through one table of the shared samples, and they are the field's
+// cells, which a field one point thick has none of (its walls would hide nothing).
+std::string bitmaskRefusal(const HeightField& field, const RegionSampling& sources,
+                           const RegionVisibilityOptions& options) {
+  if (field.width < 2 || field.height < 2)
+    return "the bitmask method takes a field of cells, at least 2 x 2 points (this one is " +
+           std::to_string(field.width) + " x " + std::to_string(field.height) + "): take --method culled";
   bool planar = sources.absolute;
   for (const RegionPoint& p : sources.points) planar = planar && p.height == sources.points[0].height;
   if (!planar)
@@ -872,13 +877,15 @@ std::string bitmaskRefusal(const RegionSampling& sources, const RegionVisibility
 
 // The method an every-pixel run takes: options.method, or for Auto the bitmask method where it
 // takes the light and S is at least kBitmaskFromSamples (same bits, sooner), else the culled march.
-RegionVisibilityMethod methodFor(const RegionSampling& sources, const RegionVisibilityOptions& options) {
+RegionVisibilityMethod methodFor(const HeightField& field, const RegionSampling& sources,
+                                 const RegionVisibilityOptions& options) {
   if (options.method == RegionVisibilityMethod::Bitmask) {
-    const std::string refusal = bitmaskRefusal(sources, options);
+    const std::string refusal = bitmaskRefusal(field, sources, options);
     if (!refusal.empty()) throw InvalidArgument(refusal);
   }
   if (options.method != RegionVisibilityMethod::Auto) return options.method;
-  return sourceSamples(sources) >= std::size_t(kBitmaskFromSamples) && bitmaskRefusal(sources, options).empty()
+  return sourceSamples(sources) >= std::size_t(kBitmaskFromSamples) &&
+                 bitmaskRefusal(field, sources, options).empty()
              ? RegionVisibilityMethod::Bitmask
              : RegionVisibilityMethod::Culled;
 }
@@ -897,7 +904,7 @@ RegionVisibilityResult regionVisibility(const ComputeContext& context, const Hei
   if (coloured && !sources.points.empty())
     throw InvalidArgument("a light image lies over a rectangle light, not over explicit points");
   RegionVisibilityOptions run = options;
-  run.method = methodFor(sources, options);
+  run.method = methodFor(field, sources, options);
   const std::vector<float> table =
       detail::regionSampleTable(field, sources, prepared ? &prepared->prepared.heights : nullptr);
   const bool viewsheds = run.method == RegionVisibilityMethod::Viewsheds;
