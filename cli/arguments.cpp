@@ -450,14 +450,19 @@ const std::vector<OptionSpec>& optionTable() {
                             inQuotes(value));
        }},
       {"--error-tile", nullptr, "N", kErrorTargetGroup, false,
-       "with --max-error: refine in tiles of N x N pixels, each run again at its\n"
-       "own K over the lines that reach it, where the estimate asks for more\n"
+       "with --max-error: refine in tiles of N x N pixels (N >= 16), each run again\n"
+       "at its own K over the lines that reach it, where the estimate asks for more\n"
        "(default 0: the whole field takes one K, which costs less on the\n"
        "benchmark's contents, bench/report/error_target.md)",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
          const double tile = parseNumber(typed, value);
          if (!(tile >= 0.0 && tile <= 1e6 && tile == std::floor(tile)))
            throw UsageError(typed + ": a tile is a whole number of pixels (0: the whole field), got " +
+                            inQuotes(value));
+         if (tile > 0.0 && tile < kMinErrorTile)
+           throw UsageError(typed + ": a tile is at least " + std::to_string(kMinErrorTile) +
+                            " pixels (0: the whole field): a smaller one stops on a few pixels' estimates, "
+                            "low by chance, and misses the error asked for; got " +
                             inQuotes(value));
          run.error_tile = static_cast<int>(tile);
        }},

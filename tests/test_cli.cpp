@@ -766,6 +766,11 @@ TEST_F(Cli, MaxErrorWritesTheChosenKAndTheEstimate) {
   expectFailure(run("svf " + shellQuoted(field) + " -o " + shellQuoted(out("s.exr")) +
                     " --max-error 1e-7 --error-out " + shellQuoted(out("e.exr"))),
                 1, "directions");
+  // A tile of fewer than 16 pixels a side stops on a few pixels' estimates and misses E: refused.
+  for (const char* tile : {"1", "8", "15"})
+    expectFailure(run("svf " + shellQuoted(field) + " -o " + shellQuoted(out("s.exr")) + " --max-error 0.02" +
+                      " --error-tile " + tile + " --error-out " + shellQuoted(out("e.exr"))),
+                  2, "at least 16");
 }
 
 // --error-out with -k (no --max-error): the estimate at the K given, as the library's run asking for
@@ -979,7 +984,7 @@ TEST_F(Cli, HorizonMaxErrorBadRequestsWriteNothing) {
                         shellQuoted(out("e.exr"));
   for (const char* E : {"0", "-1", "nan", "inf", "90", "1e9"}) expectFailure(run(h + " --max-error " + E), 2, "--max-error");
   expectFailure(run(h + " --max-error 1 -k 32"), 2, "-k");
-  expectFailure(run(h + " --max-error 1 --error-tile 8"), 2, "--error-tile");
+  expectFailure(run(h + " --max-error 1 --error-tile 16"), 2, "--error-tile");
   expectFailure(run(h + " -k 4"), 2, "-k 5");
   expectFailure(run(h + " --max-error 1e-7"), 1, "4096");
 }

@@ -263,7 +263,7 @@ TEST(HorizonMaxError, RefinedTilesEqualAWholeFieldRunAtTheirK) {
                      std::to_string(max_distance));
         HorizonOptions options;
         options.max_error = 0.02;
-        options.error_tile = 10;
+        options.error_tile = kMinErrorTile;
         options.strip_rows = strip_rows;
         options.max_distance = max_distance;
         HorizonOutputs both;
@@ -477,8 +477,14 @@ TEST(HorizonMaxError, BadRequestsAreRefused) {
   EXPECT_THROW(computeHorizons(testContext(), field, options, one), InvalidArgument);
   // A tile without an error to refine toward would be ignored: refused.
   HorizonOptions tiled;
-  tiled.error_tile = 8;
+  tiled.error_tile = kMinErrorTile;
   EXPECT_THROW(computeHorizons(testContext(), field, tiled, svf), InvalidArgument);
+  // A tile of fewer pixels stops on a few pixels' estimates, low by chance: refused.
+  tiled.max_error = 0.02;
+  for (const int tile : {1, 8, kMinErrorTile - 1}) {
+    tiled.error_tile = tile;
+    EXPECT_THROW(computeHorizons(testContext(), field, tiled, svf), InvalidArgument) << tile;
+  }
 }
 
 }  // namespace

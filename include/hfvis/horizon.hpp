@@ -83,9 +83,14 @@ struct HorizonOptions : SweepOptions {
   // for bit (HorizonResult::pixel_directions), its estimate over its tile's divisor. 0, the
   // default: the whole field takes one K. On the benchmark's contents refinement cost more work
   // than one K for the whole field (bench/report/error_target.md: a tile's run also sweeps its
-  // lines' whole upstream, and each tile steps through runs of its own).
+  // lines' whole upstream, and each tile steps through runs of its own). At least kMinErrorTile:
+  // a tile of a few pixels stops when their estimates happen to lie low, and the field's error
+  // then exceeds E (a tile of 1 on a 256^2 city DSM: 5x E; tiles of 8 .. 32 met it).
   int error_tile = 0;
 };
+
+// The least HorizonOptions::error_tile (pixels a side) taken.
+constexpr int kMinErrorTile = 16;
 
 // The most directions max_error may choose.
 constexpr int kMaxAutoDirections = 4096;

@@ -23,9 +23,12 @@ void validate(const HorizonOptions& options, const HorizonOutputs& outputs) {
     throw InvalidArgument("no output requested");
   }
   detail::validateStripRows(options.strip_rows, options.method == HorizonMethod::Naive);
-  if (options.error_tile < 0)
-    throw InvalidArgument("the error tile must be 0 (the whole field) or a number of pixels (got " +
-                          std::to_string(options.error_tile) + ")");
+  if (options.error_tile < 0 || (options.error_tile > 0 && options.error_tile < kMinErrorTile))
+    throw InvalidArgument(
+        "the error tile must be 0 (the whole field) or at least " + std::to_string(kMinErrorTile) +
+        " pixels (got " + std::to_string(options.error_tile) +
+        "): a smaller tile stops on a few pixels' estimates, low by chance, and misses the error "
+        "asked for");
   if (options.error_tile > 0 && options.max_error == 0.0)
     throw InvalidArgument("the error tile refines toward max_error: give max_error with it");
   const bool angles_alone = outputs.horizon_angles && !outputs.sky_view_factor && !outputs.ambient_occlusion &&
