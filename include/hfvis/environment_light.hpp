@@ -37,14 +37,17 @@ struct EnvironmentLightResult {
   int directions = 0;               // K: as given, or as options.max_error chose it
   std::vector<std::string> names;   // the map's channels: {"Y"} or {"R", "G", "B"}
   std::vector<float> irradiance;    // one plane of width * height per channel; NaN at nodata
-  // With options.max_error, per pixel: |the irradiance at K - the irradiance at K / 2 (the even
-  // phi_k)|, relative to the field's mean irradiance, the largest over the channels; NaN at
-  // nodata. Not the even and odd halves of one run, as for the sky-view factor: each direction
-  // integrates the environment over its own swath of azimuth, so two halves would differ by the
-  // environment's own azimuthal structure (a sun in one swath), which no error of the result has.
+  // With options.max_error, per pixel: the larger of |the irradiance at K - the irradiance at
+  // K / 2| on K's even directions and on its odd ones (a run at K / 2 turned by one step of K),
+  // relative to the field's mean irradiance, the largest over the channels; NaN at nodata. Not
+  // the even and odd halves of one run, as for the sky-view factor: each direction integrates the
+  // environment over its own swath of azimuth, so two halves would differ by the environment's own
+  // azimuthal structure, which no error of the result has. Both coarse runs, because a sun lights
+  // a pixel through the one direction whose swath holds it: where that direction at K is one of
+  // the even ones, the even run puts every shadow where K's does and misses their misplacement.
   std::vector<float> error_estimate;
   double estimated_error = 0.0;  // its 99th percentile over the pixels with data
-  std::vector<int> runs;         // with options.max_error: the K of each run (each also ran at K / 2)
+  std::vector<int> runs;         // with options.max_error: the K of each run (each also ran twice at K / 2)
 };
 
 // The horizon operation with this output alone (computeHorizons with
@@ -53,7 +56,7 @@ struct EnvironmentLightResult {
 // options.max_error (0 < E < 1, relative): K is chosen as HorizonOptions::max_error chooses it
 // for the sky-view factor (options.directions ignored), so that the 99th percentile of the
 // estimate above (EnvironmentLightResult::estimated_error) is at most E; every run is made at K
-// and at K / 2. Throws InvalidArgument for E outside (0, 1) and, naming the K it would take,
+// and twice at K / 2. Throws InvalidArgument for E outside (0, 1) and, naming the K it would take,
 // when a run predicts more than kMaxAutoDirections.
 EnvironmentLightResult computeEnvironmentLight(const ComputeContext& context, const HeightField& field,
                                                const EnvironmentMap& map, const HorizonOptions& options = {});

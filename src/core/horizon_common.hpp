@@ -2,6 +2,8 @@
 // operation share: direction geometry and the final reduction step.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -109,8 +111,9 @@ NextErrorRun nextDirectionsForError(const std::vector<EstimateRun>& runs, double
 InvalidArgument beyondAutoDirections(double max_error, int next, int directions, double estimated,
                                      const std::string& where = "");
 
-// A maximum error's runs for an operation other than the horizon sweep's (intervisibility):
-// run(K) at K = kFirstAutoDirections, then at directionsForError's K, until a result's
+// A maximum error's runs for an operation other than the horizon sweep's (intervisibility, the
+// environment light): run(K) at K = kFirstAutoDirections, then at directionsForError's K, at most 4
+// times the last K (a prediction beyond kMaxAutoDirections refused only from near), until a result's
 // estimated_error is at most max_error; that result with `runs` (the K of each run) set.
 // Throws beyondAutoDirections' error.
 template <class Result, class Run>
@@ -125,10 +128,19 @@ Result runForMaxError(double max_error, const Run& run) {
       result.runs = std::move(runs);
       return result;
     }
-    const int next =
+    const int wanted =
         directionsForError(directions, result.estimated_error, earlier, earlier_estimate, max_error);
-    if (next > kMaxAutoDirections)
-      throw beyondAutoDirections(max_error, next, directions, result.estimated_error);
+    // Refused where the prediction is near enough to trust (within kMostStep times the last K),
+    // where even a fall as K^-3 would need more, or where the last run took the most directions.
+    // A prediction farther off is a run kMostStep times as far, which measures the fall again: a
+    // 99th percentile can fall off a cliff (the environment's sun misplaces its shadows' edges at a
+    // few per cent of the pixels, then at none), so a fall measured before it predicts badly.
+    constexpr int kMostStep = 4;
+    const double fastest = directions * std::cbrt(result.estimated_error / max_error);
+    if (wanted > kMaxAutoDirections && (wanted <= kMostStep * directions ||
+                                        directions >= kMaxAutoDirections || fastest > kMaxAutoDirections))
+      throw beyondAutoDirections(max_error, wanted, directions, result.estimated_error);
+    const int next = std::min({wanted, kMostStep * directions, kMaxAutoDirections});
     earlier = directions;
     earlier_estimate = result.estimated_error;
     directions = next;

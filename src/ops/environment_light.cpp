@@ -21,9 +21,9 @@ EnvironmentLightResult runAt(const ComputeContext& context, const HeightField& f
   return detail::environmentLightResult(computeHorizons(context, field, options, outputs), map);
 }
 
-// The estimate (EnvironmentLightResult::error_estimate) of `result` from `coarse`, the same run at
-// half its directions.
-void estimateFrom(EnvironmentLightResult& result, const std::vector<float>& coarse) {
+// The estimate (EnvironmentLightResult::error_estimate) of `result` from `coarse`, runs at half its
+// directions (the even ones and the odd ones): per pixel the larger difference.
+void estimateFrom(EnvironmentLightResult& result, const std::vector<std::vector<float>>& coarse) {
   const std::size_t pixels = static_cast<std::size_t>(result.width) * result.height;
   const std::size_t channels = pixels ? result.irradiance.size() / pixels : 0;
   result.error_estimate.assign(pixels, 0.0f);
@@ -34,12 +34,13 @@ void estimateFrom(EnvironmentLightResult& result, const std::vector<float>& coar
     for (std::size_t p = 0; p < pixels; ++p)
       if (!std::isnan(fine[p])) total += fine[p], ++with_data;
     const double mean = with_data ? total / with_data : 0.0;
-    for (std::size_t p = 0; p < pixels; ++p) {
-      const double difference = std::abs(static_cast<double>(fine[p]) - coarse[c * pixels + p]);
-      float& e = result.error_estimate[p];
-      e = std::isnan(fine[p]) ? fine[p]
-                              : std::max(e, static_cast<float>(mean > 0.0 ? difference / mean : 0.0));
-    }
+    for (const std::vector<float>& half : coarse)
+      for (std::size_t p = 0; p < pixels; ++p) {
+        const double difference = std::abs(static_cast<double>(fine[p]) - half[c * pixels + p]);
+        float& e = result.error_estimate[p];
+        e = std::isnan(fine[p]) ? fine[p]
+                                : std::max(e, static_cast<float>(mean > 0.0 ? difference / mean : 0.0));
+      }
   }
   result.estimated_error = detail::estimatedError(result.error_estimate);
 }
@@ -57,9 +58,21 @@ EnvironmentLightResult computeEnvironmentLight(const ComputeContext& context, co
   HorizonOptions attempt = options;
   attempt.max_error = 0.0;
   return detail::runForMaxError<EnvironmentLightResult>(options.max_error, [&](int directions) {
+    // At K / 2 twice: on K's even directions, and on its odd ones (turned by one step of K). A
+    // source narrower than a swath (a sun) lights a pixel through the one direction whose swath
+    // holds it, so its shadow's edge lies where the horizon in that direction crosses it. Where the
+    // sun's nearest direction at K is one of the even ones, the run on them puts every shadow where
+    // the run at K does, and their difference misses how far the shadows are from their place (on
+    // a 64^2 city under a clear sky: 0.04 against 1.7, relative to the mean); the odd ones then put
+    // them a step of K away.
+    std::vector<std::vector<float>> coarse;
     attempt.directions = directions / 2;
-    const std::vector<float> coarse = runAt(context, field, map, attempt).irradiance;
+    for (const int turn : {0, 1}) {
+      attempt.azimuth_offset = options.azimuth_offset + turn * 2.0 * M_PI / directions;
+      coarse.push_back(runAt(context, field, map, attempt).irradiance);
+    }
     attempt.directions = directions;
+    attempt.azimuth_offset = options.azimuth_offset;
     EnvironmentLightResult result = runAt(context, field, map, attempt);
     estimateFrom(result, coarse);
     return result;
