@@ -926,6 +926,71 @@ TEST_F(ImageIoTest, PreviewPngOfFlatOrEmptyPlane) {
 namespace hfvis {
 namespace {
 
+// A one-band GeoTIFF of GDAL type `type` holding `values` (written as float64, GDAL converting),
+// with a scale and offset, a nodata value and a per-dataset mask (0: no data) where given.
+void writeTypedGeoTiff(const std::string& path, int width, int height, GDALDataType type,
+                       const std::vector<double>& values,
+                       std::optional<std::pair<double, double>> scale_offset, std::optional<double> nodata,
+                       const std::vector<unsigned char>& mask = {}) {
+  testing::registerGdal();
+  GDALDatasetH dataset =
+      GDALCreate(GDALGetDriverByName("GTiff"), path.c_str(), width, height, 1, type, nullptr);
+  ASSERT_NE(dataset, nullptr) << CPLGetLastErrorMsg();
+  GDALRasterBandH band = GDALGetRasterBand(dataset, 1);
+  if (scale_offset) {
+    EXPECT_EQ(GDALSetRasterScale(band, scale_offset->first), CE_None);
+    EXPECT_EQ(GDALSetRasterOffset(band, scale_offset->second), CE_None);
+  }
+  if (nodata) EXPECT_EQ(GDALSetRasterNoDataValue(band, *nodata), CE_None);
+  std::vector<double> pixels = values;
+  EXPECT_EQ(
+      GDALRasterIO(band, GF_Write, 0, 0, width, height, pixels.data(), width, height, GDT_Float64, 0, 0),
+      CE_None);
+  if (!mask.empty()) {
+    ASSERT_EQ(GDALCreateDatasetMaskBand(dataset, GMF_PER_DATASET), CE_None);
+    std::vector<unsigned char> bytes = mask;
+    EXPECT_EQ(GDALRasterIO(GDALGetMaskBand(band), GF_Write, 0, 0, width, height, bytes.data(), width, height,
+                           GDT_Byte, 0, 0),
+              CE_None);
+  }
+  GDALClose(dataset);
+}
+
+// A band's scale and offset map its stored values to heights (an int16 DEM of decimetres), its
+// nodata value stays nodata whatever they are, and a per-dataset mask's 0 is nodata too; a float64
+// value beyond float32's range is refused, not made infinite (which would pass for nodata); a
+// float32 nodata value that float64 does not hold (0.1) still matches. All were read as stored.
+TEST(GdalRasters, ScaleOffsetMaskAndRangeAreTheBands) {
+  const std::string dir = std::string(HFVIS_TEST_TMP_DIR);
+  const std::string scaled = dir + "/scaled.tif", masked = dir + "/masked.tif", wide = dir + "/wide.tif",
+                    tenth = dir + "/tenth.tif";
+  writeTypedGeoTiff(scaled, 3, 2, GDT_Int16, {10, 20, -32768, 40, 50, 60}, std::pair{0.1, 5.0}, -32768.0);
+  const HeightField s = readHeightField(scaled);
+  EXPECT_FLOAT_EQ(s.heights[0], 6.0f);
+  EXPECT_FLOAT_EQ(s.heights[1], 7.0f);
+  EXPECT_TRUE(std::isnan(s.heights[2]));
+  EXPECT_FLOAT_EQ(s.heights[5], 11.0f);
+  writeTypedGeoTiff(masked, 3, 2, GDT_Float32, {1, 2, 3, 4, 5, 6}, std::nullopt, std::nullopt,
+                    {255, 0, 255, 255, 255, 0});
+  const HeightField m = readHeightField(masked);
+  EXPECT_EQ(m.heights[0], 1.0f);
+  EXPECT_TRUE(std::isnan(m.heights[1]));
+  EXPECT_EQ(m.heights[4], 5.0f);
+  EXPECT_TRUE(std::isnan(m.heights[5]));
+  EXPECT_EQ(m.nodataCount(), 2u);
+  writeTypedGeoTiff(wide, 2, 2, GDT_Float64, {1, 2, 1e39, 4}, std::nullopt, std::nullopt);
+  try {
+    readHeightField(wide);
+    ADD_FAILURE() << "a value beyond float32 was read";
+  } catch (const IoError& error) {
+    EXPECT_NE(std::string(error.what()).find("column 0, row 1"), std::string::npos) << error.what();
+  }
+  writeTypedGeoTiff(tenth, 2, 1, GDT_Float32, {0.1, 2}, std::nullopt, 0.1);
+  const HeightField t = readHeightField(tenth);
+  EXPECT_TRUE(std::isnan(t.heights[0]));
+  EXPECT_EQ(t.heights[1], 2.0f);
+}
+
 // A georeferenced raster GDAL reads and OpenImageIO does not (ESRI ASCII grid): its nodata
 // value becomes NaN and its cell size the field's.
 TEST(GdalRasters, AsciiGridWithNodataAndCellSize) {

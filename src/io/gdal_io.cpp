@@ -72,7 +72,11 @@ void requireReadable(const std::string& path, GDALDatasetH dataset, int bands, s
                             " is more than the " + std::to_string(limit >> 20) + " MiB read at most");
 }
 
-// Band `band_index` (zero-based) as float32, its nodata cells NaN.
+// Band `band_index` (zero-based) as float32: its values times the band's scale plus its offset
+// (an int16 DEM of decimetres with a scale of 0.1 is metres), NaN where the band's nodata value
+// is or its mask (a per-dataset mask, an alpha band, a mask band of its own) says no data. Read as
+// float64 in blocks of rows, so that nodata compares in the band's own type and a value beyond
+// float32's range is refused rather than made infinite (it would pass for nodata).
 std::vector<float> readBand(const std::string& path, GDALDatasetH dataset, int band_index) {
   const int width = GDALGetRasterXSize(dataset), height = GDALGetRasterYSize(dataset);
   GDALRasterBandH band = GDALGetRasterBand(dataset, band_index + 1);
@@ -83,15 +87,54 @@ std::vector<float> readBand(const std::string& path, GDALDatasetH dataset, int b
     throw IoError(path, "raster is too large to hold in memory (" + std::to_string(width) + " x " +
                             std::to_string(height) + " pixels)");
   }
-  if (GDALRasterIO(band, GF_Read, 0, 0, width, height, values.data(), width, height, GDT_Float32, 0, 0) !=
-      CE_None)
-    throw IoError(path, lastError());
-  int has_nodata = 0;
+  int has_nodata = 0, has_scale = 0, has_offset = 0;
   const double nodata = GDALGetRasterNoDataValue(band, &has_nodata);
-  if (has_nodata && !std::isnan(nodata)) {
-    const float value = static_cast<float>(nodata);
-    for (float& v : values)
-      if (v == value) v = std::numeric_limits<float>::quiet_NaN();
+  double scale = GDALGetRasterScale(band, &has_scale), offset = GDALGetRasterOffset(band, &has_offset);
+  if (!has_scale) scale = 1.0;
+  if (!has_offset) offset = 0.0;
+  if (!std::isfinite(scale) || !std::isfinite(offset) || scale == 0.0)
+    throw IoError(path, "band " + std::to_string(band_index + 1) + " has a scale of " + shortNumber(scale) +
+                            " and an offset of " + shortNumber(offset) +
+                            ": not a usable linear map to heights");
+  const bool in_float = GDALGetRasterDataType(band) == GDT_Float32;
+  const int flags = GDALGetMaskFlags(band);
+  // (the mask of the nodata value is the value itself, compared below)
+  GDALRasterBandH mask = (flags & (GMF_ALL_VALID | GMF_NODATA)) ? nullptr : GDALGetMaskBand(band);
+  const int rows_per_read = std::max(1, std::min(height, (1 << 22) / std::max(width, 1)));
+  std::vector<double> raw;
+  std::vector<unsigned char> valid;
+  for (int y0 = 0; y0 < height; y0 += rows_per_read) {
+    const int rows = std::min(rows_per_read, height - y0);
+    const std::size_t count = std::size_t(width) * rows;
+    raw.resize(count);
+    if (GDALRasterIO(band, GF_Read, 0, y0, width, rows, raw.data(), width, rows, GDT_Float64, 0, 0) !=
+        CE_None)
+      throw IoError(path, lastError());
+    if (mask) {
+      valid.resize(count);
+      if (GDALRasterIO(mask, GF_Read, 0, y0, width, rows, valid.data(), width, rows, GDT_Byte, 0, 0) !=
+          CE_None)
+        throw IoError(path, "cannot read the band's mask: " + lastError());
+    }
+    float* out = values.data() + std::size_t(y0) * width;
+    for (std::size_t i = 0; i < count; ++i) {
+      const double v = raw[i];
+      const bool is_nodata =
+          has_nodata && (std::isnan(nodata) ? std::isnan(v)
+                                            : (in_float ? static_cast<float>(v) == static_cast<float>(nodata)
+                                                        : v == nodata));
+      if (is_nodata || (mask && valid[i] == 0)) {
+        out[i] = std::numeric_limits<float>::quiet_NaN();
+        continue;
+      }
+      const double height_value = v * scale + offset;
+      if (std::isfinite(height_value) && std::fabs(height_value) > std::numeric_limits<float>::max())
+        throw IoError(path, "the value " + shortNumber(height_value) + " at column " +
+                                std::to_string(i % std::size_t(width)) + ", row " +
+                                std::to_string(y0 + i / std::size_t(width)) +
+                                " is beyond float32's range, in which hfvis computes");
+      out[i] = static_cast<float>(height_value);
+    }
   }
   return values;
 }
