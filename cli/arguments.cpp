@@ -601,11 +601,11 @@ const std::vector<OptionSpec>& optionTable() {
        }},
       {"--azimuth-bucket", nullptr, "DEG", kInsolationGroup, false,
        "steps whose sun azimuths fall in one bucket share one sweep\n"
-       "(default 0.25, at most 10)",
+       "(default 0.25, 0.001 .. 10)",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
          run.azimuth_bucket_deg = parsePositive(typed, value);
-         if (run.azimuth_bucket_deg > 10.0)
-           throw UsageError(typed + ": at most 10 degrees, got " + inQuotes(value));
+         if (run.azimuth_bucket_deg > 10.0 || run.azimuth_bucket_deg < kLeastAzimuthBucketDeg)
+           throw UsageError(typed + ": 0.001 .. 10 degrees, got " + inQuotes(value));
        }},
       {"--apparent", nullptr, nullptr, kInsolationGroup, false, "lift the sun by the atmosphere's refraction",
        HFVIS_FLAG(apparent)},
@@ -897,7 +897,8 @@ void validateRun(const CommandSpec& command, const std::string& name, const RunA
   // Only a GeoTIFF declares a nodata value; other outputs keep NaN, so the option would do nothing.
   if (run.nodata && !writesGeoTiff(run.output) &&
       (run.distance_output.empty() || !writesGeoTiff(run.distance_output)) &&
-      (run.error_output.empty() || !writesGeoTiff(run.error_output))) {
+      (run.error_output.empty() || !writesGeoTiff(run.error_output)) &&
+      (run.masks_output.empty() || !writesGeoTiff(run.masks_output))) {
     throw UsageError(
         "--nodata: only GeoTIFF outputs (.tif, .tiff) hold a nodata value, and no output is one; "
         "other outputs keep NaN");

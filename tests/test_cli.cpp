@@ -1913,6 +1913,15 @@ TEST_F(CliGeoTiff, NodataValueIsWrittenAndDeclared) {
   EXPECT_EQ(angles.nodata[3], std::optional<double>(-32768.0));
   EXPECT_EQ(angles.bands[3][0], -32768.0f);
   EXPECT_TRUE(std::isnan(readBack(out("d.exr")).at(0, 0, 0)));
+  // An area light's masks as the one GeoTIFF (the light as EXR): the value goes there (it was
+  // refused, as if no output were a GeoTIFF).
+  const CliResult masks =
+      run("arealight " + shellQuoted(tif) + " -o " + shellQuoted(out("a.exr")) +
+          " --light 1,1,3,3 --samples 8 --masks " + shellQuoted(out("m.tif")) + " -q --nodata -9999");
+  ASSERT_EQ(masks.status, 0) << masks.err;
+  const hfvis::testing::GdalRaster mask_raster = hfvis::testing::readGdalRaster(out("m.tif"));
+  ASSERT_TRUE(mask_raster.nodata[0]);
+  EXPECT_EQ(*mask_raster.nodata[0], -9999.0);
 
   // An output is an input again: a band by its description or its index, its nodata as nodata,
   // its georeference carried on.

@@ -128,6 +128,11 @@ TEST(Insolation, RefusesBadOptions) {
   o.step_minutes = 10.0;
   o.azimuth_bucket_deg = 20.0;
   EXPECT_THROW(computeInsolation(testContext(), flat, o), InvalidArgument);
+  // (a bucket's index is the azimuth over it: 1e-30 degrees put every step in one bucket)
+  for (const double tiny : {1e-30, 1e-17, 0.0009}) {
+    o.azimuth_bucket_deg = tiny;
+    EXPECT_THROW(computeInsolation(testContext(), flat, o), InvalidArgument) << tiny;
+  }
   o.azimuth_bucket_deg = 0.25;
   o.latitude_deg = 91.0;
   EXPECT_THROW(computeInsolation(testContext(), flat, o), InvalidArgument);

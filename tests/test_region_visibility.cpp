@@ -1309,6 +1309,13 @@ TEST(RegionVisibility, BadInputIsRefused) {
   RegionVisibilityOptions o = options;
   o.max_distance = -1.0;
   refused(good, o, "maximum distance");
+  // (its square in float32 would be 0, which means no limit: every pair within it)
+  for (const double tiny : {1e-30, 1e-19}) {
+    o.max_distance = tiny;
+    refused(good, o, "too short");
+  }
+  o.max_distance = kLeastMaxDistance;
+  EXPECT_NO_THROW(computeRegionVisibility(context, field, good, o));
   o = options;
   o.target_height = std::numeric_limits<double>::quiet_NaN();
   refused(good, o, "target height");

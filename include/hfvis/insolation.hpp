@@ -21,12 +21,16 @@ namespace hfvis {
 // horizon sweep, along the cheapest integer step within half a bucket of the bucket's centre (so
 // within a bucket of every sun it lights; the closest step where none is that close), so a year
 // costs a few hundred sweeps, not one per step.
+// The least InsolationOptions::azimuth_bucket_deg taken: finer than the sun's own disc many times
+// over, and a bucket's index (the azimuth over it) stays an integer.
+constexpr double kLeastAzimuthBucketDeg = 0.001;
+
 struct InsolationOptions {
   double latitude_deg = 0.0, longitude_deg = 0.0;
   double from_utc = 0.0, to_utc = 0.0;  // seconds since 1970 (parseUtcTime), from < to
   double step_minutes = 10.0;           // (0, 1440]
   double size_deg = 0.53;               // the sun's disc, as SunLight
-  double azimuth_bucket_deg = 0.25;     // (0, 10]
+  double azimuth_bucket_deg = 0.25;     // [kLeastAzimuthBucketDeg, 10]
   bool apparent = false;                // refraction lifts the sun (sunPosition)
 };
 

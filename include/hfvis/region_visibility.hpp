@@ -62,6 +62,8 @@ constexpr int kMaxBitmaskSamples = 1024;
 // measured, for lights of 16 and 64 pixels 20 and 400 above the top; at S = 32 under the
 // 64-pixel light the two were even (1.03 - 1.07), its cost per receiver shrinking less with S.
 constexpr int kBitmaskFromSamples = 64;
+// The least RegionVisibilityOptions::max_distance taken (its square, in float32, must not vanish).
+constexpr double kLeastMaxDistance = 1e-18;
 
 // A rectangle of grid points, corners included, in any order.
 struct PixelRectangle {
@@ -139,7 +141,8 @@ struct LightImage {
 struct RegionVisibilityOptions {
   RegionVisibilityMethod method = RegionVisibilityMethod::Auto;
   double target_height = 0.0;  // every-pixel receivers stand this high above the surface
-  double max_distance = 0.0;   // ground units; 0 = no limit. Farther pairs are not visible.
+  double max_distance =
+      0.0;  // ground units; 0 = no limit, else >= kLeastMaxDistance. Farther pairs are not visible.
   double curvature = 0.0;      // drop coefficient c (earthCurvature() in hfvis/sweep_options.hpp); 0 = flat
   std::uint32_t seed = 1;      // the jitter's
   bool decorrelate = false;    // each receiver its own jitter of the sources

@@ -2,19 +2,21 @@
 // hfvis/insolation.hpp): the sun's positions step by step, grouped into buckets of azimuth; per
 // bucket one horizon sweep, and insolation_add (kernels/insolation.cl) adds its steps to every
 // pixel's sums on the device.
+#include "hfvis/insolation.hpp"
+
 #include <cmath>
 #include <limits>
 #include <map>
 #include <string>
 
-#include "hfvis/errors.hpp"
-#include "hfvis/horizon.hpp"
-#include "hfvis/insolation.hpp"
-#include "hfvis/sun.hpp"
+#include "core/number_text.hpp"
 #include "core/opencl_context.hpp"
-#include "core/unit_normals.hpp"
 #include "core/sweep_framework.hpp"
 #include "core/sweep_routine.hpp"
+#include "core/unit_normals.hpp"
+#include "hfvis/errors.hpp"
+#include "hfvis/horizon.hpp"
+#include "hfvis/sun.hpp"
 #include "ops/insolation_steps.hpp"
 
 namespace hfvis {
@@ -32,9 +34,10 @@ void validate(const InsolationOptions& o) {
   if (!(o.size_deg >= 0.0 && o.size_deg <= 10.0))
     throw InvalidArgument("the sun's size must be in [0, 10] degrees (got " + std::to_string(o.size_deg) +
                           ")");
-  if (!(o.azimuth_bucket_deg > 0.0 && o.azimuth_bucket_deg <= 10.0))
-    throw InvalidArgument("the azimuth bucket must be in (0, 10] degrees (got " +
-                          std::to_string(o.azimuth_bucket_deg) + ")");
+  // (a bucket's index is the azimuth over it, a long: 1e-30 degrees put every step in one bucket)
+  if (!(o.azimuth_bucket_deg >= kLeastAzimuthBucketDeg && o.azimuth_bucket_deg <= 10.0))
+    throw InvalidArgument("the azimuth bucket must be in [" + detail::shortNumber(kLeastAzimuthBucketDeg) +
+                          ", 10] degrees (got " + detail::shortNumber(o.azimuth_bucket_deg) + ")");
   const double steps = std::ceil((o.to_utc - o.from_utc) / (60.0 * o.step_minutes));
   if (steps > 1e7) throw InvalidArgument("the span holds more than 10 million steps; take a longer step");
   // The ends of the span: sunPosition refuses a place or year beyond its range.

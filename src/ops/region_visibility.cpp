@@ -749,6 +749,11 @@ void validate(const RegionVisibilityOptions& options) {
     throw InvalidArgument("the target height must be finite and at least 0");
   if (!std::isfinite(options.max_distance) || options.max_distance < 0.0)
     throw InvalidArgument("the maximum distance must be finite and at least 0 (0: no limit)");
+  // (the kernels take its square in float32: below about 1e-19 that is 0, which means no limit)
+  if (options.max_distance > 0.0 && options.max_distance < kLeastMaxDistance)
+    throw InvalidArgument("the maximum distance " + detail::shortNumber(options.max_distance) +
+                          " is too short to hold: give at least " + detail::shortNumber(kLeastMaxDistance) +
+                          " ground units, or 0 for no limit");
   if (!std::isfinite(options.curvature)) throw InvalidArgument("the curvature must be finite");
   const LightImage& image = options.light_image;
   if (image.width != 0 || image.height != 0 || !image.rgb.empty()) {
