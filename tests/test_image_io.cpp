@@ -871,6 +871,10 @@ TEST_F(ImageIoTest, GeoTiffWriteFailureLeavesTheOldFileAndNothingElse) {
   EXPECT_THROW(writeImage(file, bad_transform), InvalidArgument);
   expectIoError(
       path("none/r.tif"), [&] { writeImage(path("none/r.tif"), unwritable); }, "does not exist");
+  // Under a file rather than a directory: said so (it was "does not exist").
+  const std::string under_file = file + "/r.tif";
+  expectIoError(
+      under_file, [&] { writeImage(under_file, horizonImage(5, 4, 3)); }, "is a file, not a directory");
 
   EXPECT_EQ(filesInDir(), before_files);
   std::ifstream after_stream(file, std::ios::binary);

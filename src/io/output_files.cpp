@@ -77,6 +77,7 @@ std::string directoryOf(const std::string& path) {
 }
 
 const char* kindOf(mode_t mode) {
+  if (S_ISREG(mode)) return "a file";
   if (S_ISCHR(mode)) return "a character device";
   if (S_ISBLK(mode)) return "a block device";
   if (S_ISFIFO(mode)) return "a FIFO (named pipe)";
@@ -164,8 +165,11 @@ void removeTemporaryFilesNow() {
 void requireReplaceableTarget(const std::string& path, const std::string& target) {
   const std::string directory = directoryOf(target);
   struct stat status {};
-  if (::stat(directory.c_str(), &status) != 0 || !S_ISDIR(status.st_mode))
+  if (::stat(directory.c_str(), &status) != 0)
     throw IoError(path, "cannot write here: the directory '" + directory + "' does not exist");
+  if (!S_ISDIR(status.st_mode))
+    throw IoError(
+        path, "cannot write here: '" + directory + "' is " + kindOf(status.st_mode) + ", not a directory");
   if (::lstat(target.c_str(), &status) == 0) {
     if (S_ISDIR(status.st_mode)) throw IoError(path, "cannot write here: it is a directory");
     // (resolvedTarget follows 40 links: a link still after them is a loop, or a chain too long)
@@ -180,13 +184,18 @@ void requireReplaceableTarget(const std::string& path, const std::string& target
       throw IoError(path, "the file is immutable (chattr +i); hfvis does not replace it");
     if (flags & FS_APPEND_FL)
       throw IoError(path, "the file is append-only (chattr +a); hfvis does not replace it");
+    // (a read-only file system first: its files' modes allow writing, and chmod would not help)
+    if (::faccessat(AT_FDCWD, target.c_str(), W_OK, AT_EACCESS) != 0 && errno == EROFS)
+      throw IoError(path, "cannot write here: the file system is mounted read-only");
     if (::faccessat(AT_FDCWD, target.c_str(), W_OK, AT_EACCESS) != 0 || (status.st_mode & 0222) == 0)
       throw IoError(path, "the file is write-protected (mode " + octalMode(status.st_mode) +
                               "); hfvis replaces only a file that could be written in place (chmod u+w "
                               "to allow it)");
   }
   if (::faccessat(AT_FDCWD, directory.c_str(), W_OK | X_OK, AT_EACCESS) != 0)
-    throw IoError(path, "cannot write here: no permission to create files in '" + directory + "'");
+    throw IoError(path, errno == EROFS
+                            ? "cannot write here: the file system is mounted read-only"
+                            : "cannot write here: no permission to create files in '" + directory + "'");
 }
 
 void requireInputFile(const std::string& path) {
