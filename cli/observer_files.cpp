@@ -87,7 +87,10 @@ std::vector<CsvPoint> parsePoints(const std::string& path, std::istream& in, dou
       header_seen = true;
       continue;
     }
-    if (!numbers || fields.size() > 3 || (fields.size() == 3 && !number_in(fields[2], height)) ||
+    // (getline drops an empty last field: "1,1," would pass for "1,1" and "1,1,2," for "1,1,2")
+    const bool trailing_comma = line[line.find_last_not_of(" \t")] == ',';
+    if (!numbers || trailing_comma || fields.size() > 3 ||
+        (fields.size() == 3 && !number_in(fields[2], height)) ||
         (kind.whole && (col != std::floor(col) || row_index != std::floor(row_index))) ||
         std::fabs(col) > 1e9 || std::fabs(row_index) > 1e9)
       throw IoError(path, "line " + std::to_string(number) + ": expected " + kind.expected + ", got '" +

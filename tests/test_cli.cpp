@@ -2193,6 +2193,17 @@ TEST_F(Cli, ViewshedRefusesBadObservers) {
   expectFailure(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) + " --observers " +
                     shellQuoted(in("bad.csv"))),
                 1, "line 3");
+  // A trailing comma is an empty field, not the end of the line (a height left out by mistake).
+  for (const char* line : {"1,2,", "1,2,3,", "1,2 , "}) {
+    SCOPED_TRACE(line);
+    {
+      std::ofstream csv(in("comma.csv"));
+      csv << "3,3\n" << line << "\n";
+    }
+    expectFailure(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) +
+                      " --observers " + shellQuoted(in("comma.csv"))),
+                  1, "line 2");
+  }
 }
 
 // ---- issue 26: no data loss, no silent garbage ----
