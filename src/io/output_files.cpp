@@ -204,7 +204,7 @@ void requireInputFile(const std::string& path) {
     if (errno == ENOENT || errno == ENOTDIR) throw IoError(path, "no such file");
     throw IoError(path, std::string("cannot read: ") + std::strerror(errno));
   }
-  if (S_ISDIR(status.st_mode)) throw IoError(path, "is a directory, not an image file");
+  if (S_ISDIR(status.st_mode)) throw IoError(path, "is a directory, not a file");
   if (!S_ISREG(status.st_mode))
     throw IoError(path,
                   std::string("is ") + kindOf(status.st_mode) + ", not a regular file; hfvis reads files");
