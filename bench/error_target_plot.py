@@ -112,8 +112,9 @@ def main():
         top.plot([lo / 1.5, hi * 1.5], [lo / 1.5, hi * 1.5], "k--", linewidth=1, label="achieved = E")
         for content, points in sorted(data.items()):
             points = sorted(points)
-            top.plot([p[0] for p in points], [max(p[1], lo / 100) for p in points], linewidth=1, label=content,
-                     **style[content])
+            # (an achieved error of 0, a run at the reference's own K, has no place on a log axis)
+            shown = [p for p in points if p[1] > 0]
+            top.plot([p[0] for p in shown], [p[1] for p in shown], linewidth=1, label=content, **style[content])
             ratios = [(p[0], p[2]) for p in points if p[2] is not None]
             if ratios:
                 bottom.plot([r[0] for r in ratios], [r[1] for r in ratios], linewidth=1, label=content,

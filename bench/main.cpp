@@ -562,7 +562,8 @@ int main(int argc, char** argv) {
       if (output != "svf-ao" && !tile_text.empty())
         throw Usage("error-target: --tile refines svf-ao; the visible count takes one K");
       const int tile = tile_text.empty() ? 64 : std::stoi(tile_text);
-      if (tile < 1) throw Usage("error-target: --tile is a number of pixels");
+      if (tile < kMinErrorTile)
+        throw Usage("error-target: --tile is at least " + std::to_string(kMinErrorTile) + " pixels");
       const std::vector<std::string> names =
           textList(args.get("--contents", "fractal,bricks,sine,blocks,city_dsm,dem,mixed"));
       args.rejectUnused();

@@ -474,7 +474,8 @@ const std::vector<OptionSpec>& optionTable() {
        "count, over the field's mean count), which lies above the error\n"
        "against the dense azimuthal integral on the benchmark's contents;\n"
        "with -k or --max-error (shade --env: with --max-error only, the\n"
-       "difference from the run at K / 2 over the mean irradiance)",
+       "larger difference from the runs at K / 2 on K's even and odd\n"
+       "directions, over the mean irradiance)",
        HFVIS_TEXT(error_output)},
       {"--distance-out", nullptr, "FILE", kHorizonGroup, false,
        "also write K channels d000.. of ground distance to the\n"

@@ -450,10 +450,23 @@ TEST(EnvironmentMaxError, ASunsShadowsAreInTheEstimate) {
         EXPECT_LE(r.estimated_error, E);
         EXPECT_LE(p99RelativeDifference(r.irradiance, dense, pixels), E) << "K = " << r.directions;
       } catch (const InvalidArgument& error) {
+        EXPECT_GT(E, 0.3) << "E = 0.3 must be reached: " << error.what();  // (else the case tests nothing)
         EXPECT_NE(std::string(error.what()).find("directions"), std::string::npos) << error.what();
       }
     }
   }
+  // The user's azimuth offset stays: the result is the run at the K chosen with that offset (the
+  // odd directions' run is turned from it).
+  const EnvironmentMap map = structuredEnvironment(32);
+  HorizonOptions options;
+  options.max_error = 0.05;
+  options.azimuth_offset = 0.7;
+  const EnvironmentLightResult r = computeEnvironmentLight(testContext(), field, map, options);
+  HorizonOptions fixed;
+  fixed.directions = r.directions;
+  fixed.azimuth_offset = 0.7;
+  EXPECT_TRUE(testing::nearlyEqual(
+      r.irradiance, computeEnvironmentLight(testContext(), field, map, fixed).irradiance, 0.0f));
 }
 
 TEST(EnvironmentMaxError, BadRequestsAreRefused) {

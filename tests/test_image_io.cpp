@@ -995,6 +995,29 @@ TEST(GdalRasters, ScaleOffsetMaskAndRangeAreTheBands) {
   EXPECT_EQ(t.heights[1], 2.0f);
 }
 
+// An image's alpha band is a channel, not a mask over its colours: an RGBA GeoTIFF's R, G and B
+// keep their values where its alpha is 0 (a light image, an environment map, an albedo).
+TEST(GdalRasters, AnImagesAlphaMasksNothing) {
+  testing::registerGdal();
+  const std::string path = std::string(HFVIS_TEST_TMP_DIR) + "/rgba.tif";
+  char** create = CSLSetNameValue(nullptr, "ALPHA", "YES");
+  GDALDatasetH dataset = GDALCreate(GDALGetDriverByName("GTiff"), path.c_str(), 2, 1, 4, GDT_Byte, create);
+  CSLDestroy(create);
+  ASSERT_NE(dataset, nullptr) << CPLGetLastErrorMsg();
+  for (int b = 1; b <= 4; ++b) {
+    std::vector<unsigned char> values = {static_cast<unsigned char>(10 * b), b == 4 ? 0 : 200};
+    EXPECT_EQ(GDALRasterIO(GDALGetRasterBand(dataset, b), GF_Write, 0, 0, 2, 1, values.data(), 2, 1, GDT_Byte,
+                           0, 0),
+              CE_None);
+  }
+  ASSERT_NE(GDALGetMaskFlags(GDALGetRasterBand(dataset, 1)) & GMF_ALPHA, 0);  // (what the case is about)
+  GDALClose(dataset);
+  const ImageChannels colour = readColourImage(path, "a light image");
+  ASSERT_EQ(colour.names, (std::vector<std::string>{"R", "G", "B"}));
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(colour.planes[c][0], 10.0f * (c + 1)) << c;  // where alpha is 40
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(colour.planes[c][1], 200.0f) << c;           // where alpha is 0
+}
+
 // A georeferenced raster GDAL reads and OpenImageIO does not (ESRI ASCII grid): its nodata
 // value becomes NaN and its cell size the field's.
 TEST(GdalRasters, AsciiGridWithNodataAndCellSize) {

@@ -117,8 +117,8 @@ class Shade : public Computation {
       outputs.image(
           run_.error_output,
           job.image(field, {"error"}, {environment_.errorEstimate()}, lit.attributes,
-                    "estimated error of the environment's irradiance: |at K - at K / 2|, the largest "
-                    "over the channels",
+                    "estimated error of the environment's irradiance: |at K - at K / 2|, the larger of "
+                    "K / 2 on K's even and on its odd directions, the largest over the channels",
                     "relative (a fraction of the field's mean irradiance); NaN at nodata"));
     }
     if (!run_.preview.empty()) {
@@ -210,8 +210,9 @@ const CommandSpec kShadeCommand{
     "  64) and --method as for ambient-occlusion; --env-rows N bands of zenith angle in the tables\n"
     "  (default the map's rows, exact for a map constant over each pixel; fewer are faster to\n"
     "  build, not to light). -k, --method and --azimuth-offset need --env. --max-error E (0 < E\n"
-    "  < 1): K chosen so that the 99th percentile of |irradiance at K - at K / 2| over the\n"
-    "  field's mean irradiance is at most E (every run also at K / 2); --error-out writes it.\n"
+    "  < 1): K chosen so that the 99th percentile of |irradiance at K - at K / 2| (the larger\n"
+    "  of K / 2 on K's even and on its odd directions) over the field's mean irradiance is at\n"
+    "  most E (every run also twice at K / 2); --error-out writes it.\n"
     "The sun: channel \"sun\" is the fraction of the sun's disc (--sun-size degrees across,\n"
     "  default 0.53; 0 = a point sun, hard shadows) above each pixel's horizon in the sun's\n"
     "  azimuth and above elevation 0 (level ground beyond the field); \"direct\" is sun * max(0,\n"

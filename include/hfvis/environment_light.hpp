@@ -53,11 +53,11 @@ struct EnvironmentLightResult {
 // The horizon operation with this output alone (computeHorizons with
 // HorizonOutputs::environment = &map), on the device of `context`. Throws what computeHorizons
 // throws (a bad map, a latitude / longitude grid).
-// options.max_error (0 < E < 1, relative): K is chosen as HorizonOptions::max_error chooses it
-// for the sky-view factor (options.directions ignored), so that the 99th percentile of the
-// estimate above (EnvironmentLightResult::estimated_error) is at most E; every run is made at K
-// and twice at K / 2. Throws InvalidArgument for E outside (0, 1) and, naming the K it would take,
-// when a run predicts more than kMaxAutoDirections.
+// options.max_error (0 < E < 1, relative): K is chosen as IntervisibilityOptions::max_error
+// chooses it (options.directions ignored), so that the 99th percentile of the estimate above
+// (EnvironmentLightResult::estimated_error) is at most E; every run is made at K and twice at
+// K / 2. Throws InvalidArgument for E outside (0, 1) and, naming the K it would take, where
+// IntervisibilityOptions::max_error does.
 EnvironmentLightResult computeEnvironmentLight(const ComputeContext& context, const HeightField& field,
                                                const EnvironmentMap& map, const HorizonOptions& options = {});
 

@@ -67,7 +67,8 @@ struct HorizonOptions : SweepOptions {
   // K by 2/3 (an interval's mean interpolation error against its midpoint's) times 1.125
   // (calibrated) and by 2^-p, p the order the pixel's neighbours two places away show (within
   // 0.3 .. 2; src/core/horizon_angle_error.hpp). Runs at 8 and 16 directions,
-  // then at the K the last two estimates predict (5 % more, at most 4 times the last K, the least
+  // then at the K the last two estimates predict (5 % more, at most 4 times the last K and the third
+  // run at most twice the second's, the least
   // work within 1.25 times that, or, where the directions it adds cost less, the least multiple of
   // the last K reaching it, which extends that run: its planes kept, the directions between them
   // run; the planes those of a run at that K); one K for the whole field (error_tile refused).

@@ -32,7 +32,9 @@ struct HeightFieldReadOptions {
 
 // Reads a height field. Georeferenced rasters (.tif/.tiff, .hgt, .asc, .vrt, .img, .bil, .dem,
 // .grd, .adf, by extension in any case) go through GDAL: the band (a zero-based index or a band
-// description) is read, its nodata value becomes NaN, the cell size comes from the
+// description) is read, its values times its scale plus its offset where it declares them, its
+// nodata value and where its mask (a per-dataset mask, an alpha band) says no data NaN, a value
+// beyond float32's range an IoError naming its pixel, the cell size comes from the
 // geotransform (geographic degrees in metres on WGS84: per row in row_cell_size_x/y, at the
 // centre latitude in cell_size_x/y), the geotransform and CRS
 // fill `georeference`, and a rotated or sheared geotransform is an IoError. Everything else is
@@ -66,7 +68,8 @@ struct ImageChannels {
 
 // Reads every channel of an image as float32 planes with their names. Rasters GDAL reads (the
 // extensions of readHeightField) give their bands in order, named by their descriptions
-// ("channel<i>" where a band has none), nodata cells as NaN, the dataset's metadata items as
+// ("channel<i>" where a band has none), scaled and offset as readHeightField's, nodata cells as
+// NaN (not the mask: an alpha band is a channel, readColourImage ignores it), the dataset's metadata items as
 // attributes (hfvis_NAME back as hfvis:NAME, see writeImage) and their georeference. Other
 // images give their channels in the order OpenImageIO reports them; for EXR the same order
 // (layers sorted; within each R, G, B, Y, A, Z and their kin first, then the others sorted by

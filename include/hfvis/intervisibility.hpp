@@ -75,11 +75,13 @@ struct IntervisibilityOptions : SweepOptions {
   // HullTree only. Ask for an error, not a direction count: when > 0 (and < 1), K is chosen
   // (options.directions is ignored) so that the 99th percentile over the pixels of the error
   // estimate (IntervisibilityResult::estimated_error) of the visible count, relative to the
-  // field's mean count, is at most max_error (the area is not estimated), as HorizonOptions::max_error
-  // chooses it for the sky-view factor: a first run at 16 directions, each run predicting the K the next
-  // needs, until the estimate meets it; IntervisibilityResult::directions and ::runs say which K. Throws
-  // InvalidArgument, naming the K it would take, when a run predicts more than kMaxAutoDirections
-  // (hfvis/horizon.hpp). The samples per unit stay as given.
+  // field's mean count, is at most max_error (the area is not estimated): a first run at 16
+  // directions, each run predicting the K the next needs (the estimate falling as K^-p, p measured
+  // from the last two runs), at most 4 times the last K, until the estimate meets it;
+  // IntervisibilityResult::directions and ::runs say which K. Throws InvalidArgument, naming the
+  // K it would take, when a run predicts more than kMaxAutoDirections (hfvis/horizon.hpp) from
+  // within 4 times its K, or even a fall as K^-3 would need more, or the run at kMaxAutoDirections
+  // misses it (a far prediction runs 4 times as far first). The samples per unit stay as given.
   double max_error = 0.0;
 };
 

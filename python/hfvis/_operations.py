@@ -477,8 +477,8 @@ def environment_light(heights, environment, *, rotation_deg=0.0, table_rows=0, d
     Westerholm 2010, Sec. 6.2). `environment`: a file (EXR, HDR, ...) or radiance as an
     equirectangular (rows, 2 rows) or (channels, rows, 2 rows) array, row 0 at the zenith, the
     left edge north. Returns (channels, H, W), or (H, W) for one channel. max_error=E chooses K
-    (directions ignored) as the CLI's shade --env --max-error (|irradiance at K - at K / 2| over
-    the mean, relative): numpy ErrorEstimate(values, error, directions, estimated_error); a
+    (directions ignored) as the CLI's shade --env --max-error (|irradiance at K - at K / 2|, the
+    larger of K / 2 on K's even and on its odd directions, over the mean, relative): numpy ErrorEstimate(values, error, directions, estimated_error); a
     DataArray with the K and the estimate in its attrs."""
     options = _horizon(directions, azimuth_offset, samples_per_unit, curvature, max_distance, memory_budget_bytes,
                        method, azimuth_tolerance, 0)

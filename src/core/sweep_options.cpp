@@ -15,6 +15,9 @@ double directionAzimuth(int k, const SweepOptions& options) {
   // azimuth to the bit, so that a run extended by the directions between (the horizon angles'
   // maximum error) is a run at the larger K. 2 pi k / K as written rounds differently for K and
   // 3 K (about one direction in seven, from K = 16 on).
+  if (options.directions < 1)
+    throw InvalidArgument("the number of directions K must be at least 1 (got " +
+                          std::to_string(options.directions) + ")");
   const int common = std::gcd(k, options.directions);
   return 2.0 * M_PI * (k / common) / (options.directions / common) + options.azimuth_offset;
 }

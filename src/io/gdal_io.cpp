@@ -74,10 +74,11 @@ void requireReadable(const std::string& path, GDALDatasetH dataset, int bands, s
 
 // Band `band_index` (zero-based) as float32: its values times the band's scale plus its offset
 // (an int16 DEM of decimetres with a scale of 0.1 is metres), NaN where the band's nodata value
-// is or its mask (a per-dataset mask, an alpha band, a mask band of its own) says no data. Read as
-// float64 in blocks of rows, so that nodata compares in the band's own type and a value beyond
-// float32's range is refused rather than made infinite (it would pass for nodata).
-std::vector<float> readBand(const std::string& path, GDALDatasetH dataset, int band_index) {
+// is and, with `masks` (heights), where its mask (a per-dataset mask, an alpha band, a mask band of
+// its own) says no data; an image's alpha stays ignored (image_io.hpp). Read as float64 in blocks
+// of rows (whole blocks of the file's), so that nodata compares in the band's own type and a
+// value beyond float32's range is refused rather than made infinite (it would pass for nodata).
+std::vector<float> readBand(const std::string& path, GDALDatasetH dataset, int band_index, bool masks) {
   const int width = GDALGetRasterXSize(dataset), height = GDALGetRasterYSize(dataset);
   GDALRasterBandH band = GDALGetRasterBand(dataset, band_index + 1);
   std::vector<float> values;
@@ -99,8 +100,13 @@ std::vector<float> readBand(const std::string& path, GDALDatasetH dataset, int b
   const bool in_float = GDALGetRasterDataType(band) == GDT_Float32;
   const int flags = GDALGetMaskFlags(band);
   // (the mask of the nodata value is the value itself, compared below)
-  GDALRasterBandH mask = (flags & (GMF_ALL_VALID | GMF_NODATA)) ? nullptr : GDALGetMaskBand(band);
-  const int rows_per_read = std::max(1, std::min(height, (1 << 22) / std::max(width, 1)));
+  GDALRasterBandH mask = !masks || (flags & (GMF_ALL_VALID | GMF_NODATA)) ? nullptr : GDALGetMaskBand(band);
+  // (about 4M values a read, in whole rows of the file's blocks: a tiled raster's tile row decoded once)
+  int block_x = 0, block_y = 0;
+  GDALGetBlockSize(band, &block_x, &block_y);
+  block_y = std::max(1, block_y);
+  const int rows_per_read =
+      std::max(1, std::min(height, std::max(block_y, (1 << 22) / std::max(width, 1) / block_y * block_y)));
   std::vector<double> raw;
   std::vector<unsigned char> valid;
   for (int y0 = 0; y0 < height; y0 += rows_per_read) {
@@ -322,7 +328,7 @@ HeightField readGdalHeightField(const std::string& path, const HeightFieldReadOp
   HeightField field;
   field.width = GDALGetRasterXSize(dataset.get());
   field.height = GDALGetRasterYSize(dataset.get());
-  field.heights = readBand(path, dataset.get(), band_index);
+  field.heights = readBand(path, dataset.get(), band_index, true);
   field.georeference = georeferenceOf(dataset.get());
   // A rotated or sheared grid is refused whatever the cell size: the outputs would keep its
   // geotransform while every direction and distance was computed on an axis-aligned one.
@@ -390,7 +396,7 @@ ImageChannels readGdalImage(const std::string& path) {
     GDALRasterBandH band = GDALGetRasterBand(dataset.get(), b + 1);
     const std::string description = GDALGetDescription(band);
     image.names.push_back(description.empty() ? colourName(band, b) : description);
-    image.planes.push_back(readBand(path, dataset.get(), b));
+    image.planes.push_back(readBand(path, dataset.get(), b, false));
   }
   for (char** item = GDALGetMetadata(dataset.get(), nullptr); item && *item; ++item) {
     char* name = nullptr;
