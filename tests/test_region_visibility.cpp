@@ -600,20 +600,30 @@ TEST(RegionVisibility, ReceiversBesideTheSamplesBoxSeeTheBlockBetween) {
 
 // A wall between a light and the ground beyond it: the bitmask method's bits are the exact
 // ones, the far side sees none of the light, the near side all of it; flat ground sees all.
+// A planar light (at an absolute height) over `rectangle`, and options for a method.
+RegionSampling planarLight(const std::array<int, 4>& rectangle, int samples, double height) {
+  RegionSampling light;
+  light.rectangle = {rectangle[0], rectangle[1], rectangle[2], rectangle[3]};
+  light.samples = samples;
+  light.height = height;
+  light.absolute = true;
+  return light;
+}
+RegionVisibilityOptions withMethod(RegionVisibilityMethod method) {
+  RegionVisibilityOptions options;
+  options.method = method;
+  return options;
+}
+
 TEST(RegionVisibility, TheBitmaskScatterBehindAWall) {
   const int w = 41, h = 23;
   std::vector<float> heights(w * h, 0.0f);
   const HeightField open = fieldFrom(w, h, heights);
   for (int row = 0; row < h; ++row) heights[row * w + 20] = 30.0f;
   const HeightField walled = fieldFrom(w, h, heights);
-  RegionSampling light;
-  light.rectangle = {2, 1, 12, 21};
-  light.samples = 1024;
-  light.height = 5.0;
-  light.absolute = true;
-  RegionVisibilityOptions exact, bitmask;
-  exact.method = RegionVisibilityMethod::Exact;
-  bitmask.method = RegionVisibilityMethod::Bitmask;
+  const RegionSampling light = planarLight({2, 1, 12, 21}, 1024, 5.0);
+  const RegionVisibilityOptions exact = withMethod(RegionVisibilityMethod::Exact),
+                                bitmask = withMethod(RegionVisibilityMethod::Bitmask);
   forEachLayout([&](const ComputeContext& context) {
     const RegionVisibilityResult got = computeRegionVisibility(context, walled, light, bitmask);
     EXPECT_EQ(got.bits, computeRegionVisibility(context, walled, light, exact).bits);
@@ -633,14 +643,9 @@ TEST(RegionVisibility, TheBitmaskScatterBehindAWall) {
 // ones, and the wall of the row hides the light behind it (the bitmask method had every pixel lit).
 TEST(RegionVisibility, AFieldOnePointThickTakesTheMarch) {
   const std::vector<float> row = {0, 0, 0, 10, 0, 0, 0, 0};
-  RegionSampling light;
-  light.rectangle = {0, 0, 0, 0};
-  light.samples = 64;
-  light.height = 5.0;
-  light.absolute = true;
-  RegionVisibilityOptions exact, bitmask;
-  exact.method = RegionVisibilityMethod::Exact;
-  bitmask.method = RegionVisibilityMethod::Bitmask;
+  const RegionSampling light = planarLight({0, 0, 0, 0}, 64, 5.0);
+  const RegionVisibilityOptions exact = withMethod(RegionVisibilityMethod::Exact),
+                                bitmask = withMethod(RegionVisibilityMethod::Bitmask);
   forEachLayout([&](const ComputeContext& context) {
     for (const bool across : {true, false}) {
       SCOPED_TRACE(across ? "one row" : "one column");
