@@ -12,6 +12,10 @@
 
 namespace hfvis {
 
+// The least InsolationOptions::azimuth_bucket_deg taken: finer than the sun's own disc many times
+// over, and a bucket's index (the azimuth over it) stays an integer.
+constexpr double kLeastAzimuthBucketDeg = 0.001;
+
 // Sunlight over a span of time at one place: GRASS r.sun's and WhiteboxTools' TimeInDaylight
 // question. The span [from, to) is cut into steps of step_minutes (the last one shorter), each
 // taken at its middle. The sun counts at a step while its centre is above the pixel's horizon in
@@ -21,10 +25,6 @@ namespace hfvis {
 // horizon sweep, along the cheapest integer step within half a bucket of the bucket's centre (so
 // within a bucket of every sun it lights; the closest step where none is that close), so a year
 // costs a few hundred sweeps, not one per step.
-// The least InsolationOptions::azimuth_bucket_deg taken: finer than the sun's own disc many times
-// over, and a bucket's index (the azimuth over it) stays an integer.
-constexpr double kLeastAzimuthBucketDeg = 0.001;
-
 struct InsolationOptions {
   double latitude_deg = 0.0, longitude_deg = 0.0;
   double from_utc = 0.0, to_utc = 0.0;  // seconds since 1970 (parseUtcTime), from < to

@@ -141,8 +141,8 @@ struct LightImage {
 struct RegionVisibilityOptions {
   RegionVisibilityMethod method = RegionVisibilityMethod::Auto;
   double target_height = 0.0;  // every-pixel receivers stand this high above the surface
-  double max_distance =
-      0.0;  // ground units; 0 = no limit, else >= kLeastMaxDistance. Farther pairs are not visible.
+  // Ground units; 0 = no limit, else at least kLeastMaxDistance. Farther pairs are not visible.
+  double max_distance = 0.0;
   double curvature = 0.0;      // drop coefficient c (earthCurvature() in hfvis/sweep_options.hpp); 0 = flat
   std::uint32_t seed = 1;      // the jitter's
   bool decorrelate = false;    // each receiver its own jitter of the sources
