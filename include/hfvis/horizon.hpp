@@ -86,7 +86,8 @@ struct HorizonOptions : SweepOptions {
   // than one K for the whole field (bench/report/error_target.md: a tile's run also sweeps its
   // lines' whole upstream, and each tile steps through runs of its own). At least kMinErrorTile:
   // a tile of a few pixels stops when their estimates happen to lie low, and the field's error
-  // then exceeds E (a tile of 1 on a 256^2 city DSM: 5x E; tiles of 8 .. 32 met it).
+  // then exceeds E (a tile of 1 on a 256^2 city DSM: 5x E; tiles of 8 .. 32 met it; orientation, a throwaway
+  // comparison with K = 2048).
   int error_tile = 0;
 };
 

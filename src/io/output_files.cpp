@@ -184,10 +184,11 @@ void requireReplaceableTarget(const std::string& path, const std::string& target
       throw IoError(path, "the file is immutable (chattr +i); hfvis does not replace it");
     if (flags & FS_APPEND_FL)
       throw IoError(path, "the file is append-only (chattr +a); hfvis does not replace it");
+    const bool writable = ::faccessat(AT_FDCWD, target.c_str(), W_OK, AT_EACCESS) == 0;
     // (a read-only file system first: its files' modes allow writing, and chmod would not help)
-    if (::faccessat(AT_FDCWD, target.c_str(), W_OK, AT_EACCESS) != 0 && errno == EROFS)
+    if (!writable && errno == EROFS)
       throw IoError(path, "cannot write here: the file system is mounted read-only");
-    if (::faccessat(AT_FDCWD, target.c_str(), W_OK, AT_EACCESS) != 0 || (status.st_mode & 0222) == 0)
+    if (!writable || (status.st_mode & 0222) == 0)
       throw IoError(path, "the file is write-protected (mode " + octalMode(status.st_mode) +
                               "); hfvis replaces only a file that could be written in place (chmod u+w "
                               "to allow it)");
