@@ -83,6 +83,7 @@ printf '1,1\n%s\n' "$(head -c 5000 /dev/zero | tr '\0' 'x')" > long_line.csv
 printf 'col,row,height\n1,1,2\n3,x,2\n' > bad_sources.csv
 printf '1,1\n300,2\n' > outside_sources.csv
 printf '5,3\n' > nodata_source.csv  # nan.exr's NaN
+printf 'ncols 3\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2 3\n4 abc 6\n' > words.asc
 # An earlier result, write-protected by its owner (mode 0444).
 cp field.tif protected.tif
 chmod 444 protected.tif
@@ -117,6 +118,7 @@ try "input is a directory" "" -- svf folder.exr -o out/o.exr
 try "input empty" "" -- svf empty.exr -o out/o.exr
 try "input not an image" "" -- svf garbage.exr -o out/o.exr
 try "input truncated" "" -- svf truncated.exr -o out/o.exr
+try "ASCII grid with a word for a height" "" -- svf words.asc -o out/o.exr -k 4
 try "two channels, none chosen" "" -- svf two_channels.png -o out/o.exr
 try "channel that is not there" "" -- svf field.exr -o out/o.exr --channel Z
 try "output directory missing" "" -- svf field.exr -o nowhere/o.exr
@@ -128,6 +130,7 @@ try "GeoTIFF output is the input by another path" "" -- horizon field.tif -o out
 try "output format unknown" "" -- svf field.exr -o out/o.xyz
 try "output an 8-bit image" "" -- horizon field.exr -o out/o.png -k 4
 try "output write-protected" "" -- svf field.exr -o protected.tif -k 4
+try "output where no file can be created" "" -- svf field.exr -o /proc/o.exr -k 4
 try "output a loop of symbolic links" "" -- svf field.exr -o loop_a.exr -k 4
 try "input is a device" "" -- svf /dev/zero -o out/o.exr -k 4
 try "input is a FIFO" "" -- svf pipe.exr -o out/o.exr -k 4

@@ -509,17 +509,51 @@ TEST_F(Cli, FailedRunLeavesAnExistingOutputUntouched) {
 }
 
 TEST_F(Cli, FailedLaterWriteLeavesNoOutputs) {
-  // The outputs are computed and staged first; the preview cannot be written (/proc is
-  // read-only even for root), so neither the horizon map nor the distances may appear,
-  // and an older result at -o stays as it was.
+  // The outputs are computed and staged first, each in a temporary file. Under a file size limit
+  // that a flat field's horizon angles fit (about 130 kB) and their distances (about 8.8 MB) do
+  // not, the distances' write fails: neither output may appear, and an older result at -o stays.
+  // (3 MB: the OpenCL driver under PoCL writes files of about 1 MB even with its kernels cached.)
+  const std::string field = writeField("flat.exr", 1024, 1024, [](int, int) { return 3.0f; });
+  const std::string outputs_args = " -k 16 --distance-out ";
+  // First without the limit, so that the driver has the compiled kernels in its cache.
+  ASSERT_EQ(run("horizon " + shellQuoted(field) + " -o " + shellQuoted(in("h.exr")) + outputs_args +
+                shellQuoted(in("d.exr")))
+                .status,
+            0);
   { std::ofstream(out("h.exr")) << "previous result"; }
-  const std::string preview = "/proc/hfvis_cli_test_preview.png";
-  const CliResult result = run("horizon " + shellQuoted(ramp()) + " -o " + shellQuoted(out("h.exr")) +
-                               " -k 4 --distance-out " + shellQuoted(out("d.exr")) + " --preview " + preview);
+  const CliResult result = run("horizon " + shellQuoted(field) + " -o " + shellQuoted(out("h.exr")) +
+                                   outputs_args + shellQuoted(out("d.exr")),
+                               "prlimit --fsize=3000000:3000000");
   EXPECT_EQ(result.status, 1) << result.err;
-  EXPECT_NE(result.err.find(preview), std::string::npos) << result.err;
+  EXPECT_NE(result.err.find(out("d.exr") + ": cannot write"), std::string::npos) << result.err;
+  EXPECT_NE(result.err.find("ulimit -f"), std::string::npos) << result.err;
   EXPECT_EQ(readText(out("h.exr")), "previous result");
   EXPECT_EQ(listDirectory(outputs()), std::vector<std::string>{"h.exr"});
+}
+
+// Under a file size limit too small for the OpenCL driver's own files (PoCL compiles through
+// files; LLVM then ends the process with a line of its own), the error still comes from hfvis and
+// names the limit; nothing is written. (On a driver that writes no files, the output's own write
+// fails the same way: 130 kB against 10 kB.)
+TEST_F(Cli, AFileSizeLimitTooSmallForTheDriverIsNamed) {
+  const std::string field = writeField("flat.exr", 1024, 1024, [](int, int) { return 3.0f; });
+  const fs::path cache = root_ / "pocl-cache";
+  fs::create_directories(cache);
+  const CliResult result =
+      run("horizon " + shellQuoted(field) + " -o " + shellQuoted(out("h.exr")) + " -k 4",
+          "env POCL_CACHE_DIR=" + shellQuoted(cache.string()) + " prlimit --fsize=10000:10000");
+  expectFailure(result, 1, "ulimit -f");
+}
+
+TEST_F(Cli, AnOutputWhereNoFileCanBeCreatedIsRefusedBeforeComputing) {
+  // /proc passes the superuser's permission check but takes no new files: the preview is refused
+  // by the check before the computation (its words), not when it is first written, and nothing
+  // else appears.
+  const std::string preview = "/proc/hfvis_cli_test_preview.png";
+  const CliResult result = run("horizon " + shellQuoted(ramp()) + " -o " + shellQuoted(out("h.exr")) +
+                               " -k 4 --preview " + preview);
+  expectFailure(result, 1, preview);
+  EXPECT_NE(result.err.find("cannot write here"), std::string::npos) << result.err;
 }
 
 // ---- help and devices ----

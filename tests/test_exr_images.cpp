@@ -193,7 +193,7 @@ TEST_F(ImageIoExrTest, DataWindowAwayFromTheOriginIsTheImage) {
   EXPECT_EQ(field.heights, pixels);
 }
 
-TEST_F(ImageIoExrTest, MultiPartFileReadsItsFirstPart) {
+TEST_F(ImageIoExrTest, MultiPartFileReadsItsFirstPartOrTheOneHoldingTheChannel) {
   const std::string file = path("parts.exr");
   std::vector<Imf::Header> headers(2, Imf::Header(3, 2));
   headers[0].setName("first");
@@ -223,6 +223,52 @@ TEST_F(ImageIoExrTest, MultiPartFileReadsItsFirstPart) {
   EXPECT_EQ(field.heights, (std::vector<float>{1, 2, 3, 4, 5, 6}));
   EXPECT_EQ(field.cell_size_x, 2.5);
   EXPECT_EQ(field.cell_size_y, 4.0);
+  // A channel of another part is read from that part, by its name (an index counts in the first).
+  HeightFieldReadOptions options;
+  options.channel = "G";
+  const HeightField second = readHeightField(file, options);
+  EXPECT_EQ(second.width, 5);
+  EXPECT_EQ(second.heights, std::vector<float>(25, 9.0f));
+  options.channel = "0";
+  EXPECT_EQ(readHeightField(file, options).heights, field.heights);
+  // A channel no part holds: the error lists every part's channels.
+  options.channel = "Z";
+  try {
+    readHeightField(file, options);
+    ADD_FAILURE() << "a channel no part holds was read";
+  } catch (const IoError& error) {
+    EXPECT_NE(error.reason().find("part 1 'second': 'R' 'G'"), std::string::npos) << error.what();
+  }
+}
+
+TEST_F(ImageIoExrTest, AChannelInTwoPartsIsRefused) {
+  const std::string file = path("twice.exr");
+  std::vector<Imf::Header> headers(2, Imf::Header(2, 2));
+  headers[0].setName("left");
+  headers[1].setName("right");
+  for (Imf::Header& h : headers) {
+    h.channels().insert("Y", Imf::Channel(Imf::FLOAT));
+    h.setType(Imf::SCANLINEIMAGE);
+  }
+  {
+    Imf::MultiPartOutputFile out(file.c_str(), headers.data(), 2);
+    std::vector<float> values = {1, 2, 3, 4};
+    for (int p = 0; p < 2; ++p) {
+      Imf::OutputPart part(out, p);
+      Imf::FrameBuffer frame;
+      frame.insert("Y", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(values.data()), 4, 8));
+      part.setFrameBuffer(frame);
+      part.writePixels(2);
+    }
+  }
+  HeightFieldReadOptions options;
+  options.channel = "Y";
+  try {
+    readHeightField(file, options);
+    ADD_FAILURE() << "a channel two parts hold was read from one of them";
+  } catch (const IoError& error) {
+    EXPECT_NE(error.reason().find("part 0 'left' and in part 1 'right'"), std::string::npos) << error.what();
+  }
 }
 
 TEST_F(ImageIoExrTest, ExrUnderAnotherExtensionIsReadByItsContent) {

@@ -945,7 +945,9 @@ void writeTypedGeoTiff(const std::string& path, int width, int height, GDALDataT
     EXPECT_EQ(GDALSetRasterScale(band, scale_offset->first), CE_None);
     EXPECT_EQ(GDALSetRasterOffset(band, scale_offset->second), CE_None);
   }
-  if (nodata) EXPECT_EQ(GDALSetRasterNoDataValue(band, *nodata), CE_None);
+  if (nodata) {
+    EXPECT_EQ(GDALSetRasterNoDataValue(band, *nodata), CE_None);
+  }
   std::vector<double> pixels = values;
   EXPECT_EQ(
       GDALRasterIO(band, GF_Write, 0, 0, width, height, pixels.data(), width, height, GDT_Float64, 0, 0),
@@ -1005,7 +1007,8 @@ TEST(GdalRasters, AnImagesAlphaMasksNothing) {
   CSLDestroy(create);
   ASSERT_NE(dataset, nullptr) << CPLGetLastErrorMsg();
   for (int b = 1; b <= 4; ++b) {
-    std::vector<unsigned char> values = {static_cast<unsigned char>(10 * b), b == 4 ? 0 : 200};
+    std::vector<unsigned char> values = {static_cast<unsigned char>(10 * b),
+                                         static_cast<unsigned char>(b == 4 ? 0 : 200)};
     EXPECT_EQ(GDALRasterIO(GDALGetRasterBand(dataset, b), GF_Write, 0, 0, 2, 1, values.data(), 2, 1, GDT_Byte,
                            0, 0),
               CE_None);
@@ -1035,6 +1038,32 @@ TEST(GdalRasters, AsciiGridWithNodataAndCellSize) {
   EXPECT_TRUE(std::isnan(field.heights[4]));
   EXPECT_DOUBLE_EQ(field.cell_size_x, 30.0);
   EXPECT_DOUBLE_EQ(field.cell_size_y, 30.0);
+}
+
+// GDAL's ASCII grid readers take a value that is not a number as 0 (or as its leading digits):
+// such a grid is refused, naming the line and the value, in ESRI's format and in GRASS's.
+TEST(GdalRasters, AsciiGridValuesThatAreNotNumbersAreRefused) {
+  const std::string path = std::string(HFVIS_TEST_TMP_DIR) + "/words.asc";
+  const std::string esri = "ncols 3\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\nNODATA_value -9999\n";
+  const std::string grass = "north: 2\nsouth: 0\neast: 3\nwest: 0\nrows: 2\ncols: 3\n";
+  for (const std::string& header : {esri, grass}) {
+    for (const std::string bad : {"abc", "1,5", "2x"}) {
+      SCOPED_TRACE(header.substr(0, 6) + bad);
+      { std::ofstream(path) << header << "1 2 3\n4 " << bad << " 6\n"; }
+      try {
+        readHeightField(path);
+        ADD_FAILURE() << "read '" << bad << "' as a height";
+      } catch (const IoError& error) {
+        EXPECT_NE(error.reason().find("line 8: '" + bad + "' is not a number"), std::string::npos)
+            << error.what();
+      }
+    }
+    // The same grid with numbers in every form strtod takes is read.
+    { std::ofstream(path) << header << "1 2e0 +3\n-4.5 .5 6\n"; }
+    const HeightField field = readHeightField(path);
+    EXPECT_EQ(field.heights[3], -4.5f);
+    EXPECT_EQ(field.heights[4], 0.5f);
+  }
 }
 
 }  // namespace

@@ -153,6 +153,23 @@ TEST_F(OutputFilesTest, AWriteProtectedFileIsRefused) {
   EXPECT_EQ(filesInDir(), std::vector<std::string>{"prot.exr"});
 }
 
+// A directory whose permission bits allow writing may still take no new files: /proc, where the
+// superuser's access(2) passes. It is refused before any work (the probe file removed), not
+// after the computation, when the output is first created.
+TEST_F(OutputFilesTest, ADirectoryThatTakesNoFilesIsRefusedBeforeAnyWork) {
+  const std::string target = "/proc/hfvis-output-files-test.exr";
+  try {
+    requireReplaceable(target);
+    ADD_FAILURE() << "/proc was taken as a place to write";
+  } catch (const IoError& error) {
+    EXPECT_EQ(error.path(), target);
+    EXPECT_NE(error.reason().find("cannot write here"), std::string::npos) << error.what();
+  }
+  OutputFiles outputs;
+  EXPECT_THROW(outputs.text(target, "text"), IoError);
+  EXPECT_TRUE(outputs.paths().empty());
+}
+
 // An immutable file (chattr +i) cannot be replaced by anyone; it is refused before anything is
 // written. Setting the attribute needs CAP_LINUX_IMMUTABLE and a file system that keeps it, which
 // a container may lack: the test says so and is skipped then.

@@ -2,6 +2,7 @@
 #include "core/opencl_context.hpp"
 
 #include <fcntl.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -226,6 +227,12 @@ cl::Program ContextState::programFromSource(const std::string& file, const std::
     } catch (const cl::Error&) {
       log = "(no build log)";
     }
+    // A driver that compiles through files (PoCL) fails with a bare line under a small `ulimit -f`.
+    rlimit limit{};
+    if (::getrlimit(RLIMIT_FSIZE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY)
+      log += "\n(the file size limit, ulimit -f, is " + std::to_string(limit.rlim_cur) +
+             " bytes: the OpenCL driver may write its compiled kernels to files, which a limit this small "
+             "stops)";
     throw KernelBuildError(file + " with options '" + build_options + "'", log);
   }
   programs_.emplace(key, program);

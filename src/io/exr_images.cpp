@@ -1,4 +1,4 @@
-// exr_images.cpp: EXR files through OpenEXR's C++ library (exr_images.hpp): reading part 0's
+// exr_images.cpp: EXR files through OpenEXR's C++ library (exr_images.hpp): reading one part's
 // channels as float32 in blocks of rows, after the checks a hostile header needs, and writing
 // float32 outputs through a file whose every write is checked.
 #include "io/exr_images.hpp"
@@ -268,6 +268,37 @@ class CheckedExrFile final : public Imf::OStream {
   std::uint64_t position_ = 0;
 };
 
+// The part of a multi-part file to read: the first, or the one part that holds the channel named
+// `channel` (a channel of another part is reachable by its name; an index counts in the first
+// part). Throws IoError when several parts hold it, or none does (listing every part's channels).
+int partToRead(const std::string& path, const Imf::MultiPartInputFile& file, const std::string* channel) {
+  const int parts = file.parts();
+  if (parts <= 1 || !channel || channel->empty()) return 0;
+  std::vector<int> holding;
+  for (int p = 0; p < parts; ++p)
+    if (file.header(p).channels().findChannel(*channel)) holding.push_back(p);
+  if (holding.size() == 1) return holding.front();
+  const auto partName = [&](int p) {
+    return "part " + std::to_string(p) + (file.header(p).hasName() ? " '" + file.header(p).name() + "'" : "");
+  };
+  if (holding.size() > 1)
+    throw IoError(path, "channel '" + *channel + "' is in " + partName(holding[0]) + " and in " +
+                            partName(holding[1]) +
+                            "; hfvis reads one part (split the file: exrmultipart -separate)");
+  // None by name: an index, or a name part 0 lacks too (its error then lists every part).
+  const std::vector<std::string> first = channelOrder(file.header(0).channels());
+  const bool index = channel->size() <= 9 && std::all_of(channel->begin(), channel->end(),
+                                                         [](char ch) { return ch >= '0' && ch <= '9'; });
+  if (index && std::stoul(*channel) < first.size()) return 0;
+  std::string listed;
+  for (int p = 0; p < parts; ++p) {
+    listed += (p > 0 ? "; " : "") + partName(p) + ":";
+    for (const std::string& name : channelOrder(file.header(p).channels())) listed += " '" + name + "'";
+  }
+  throw IoError(path, "no channel '" + *channel + "' (the file has " + std::to_string(parts) +
+                          " parts: " + listed + ")");
+}
+
 }  // namespace
 
 bool isExrFile(const std::string& path) {
@@ -279,7 +310,8 @@ bool isExrFile(const std::string& path) {
 
 ImageChannels readExr(const std::string& path, std::uint64_t max_image_bytes, const std::string* channel) {
   const std::unique_ptr<Imf::MultiPartInputFile> file = openExr(path);
-  const Imf::Header& header = file->header(0);
+  const int part_index = partToRead(path, *file, channel);
+  const Imf::Header& header = file->header(part_index);
   const Imath::Box2i window = header.dataWindow();
   const std::int64_t width = std::int64_t(window.max.x) - window.min.x + 1;
   const std::int64_t height = std::int64_t(window.max.y) - window.min.y + 1;
@@ -313,7 +345,7 @@ ImageChannels readExr(const std::string& path, std::uint64_t max_image_bytes, co
   try {
     std::unique_ptr<Imf::InputPart> part;
     try {
-      part = std::make_unique<Imf::InputPart>(*file, 0);
+      part = std::make_unique<Imf::InputPart>(*file, part_index);
     } catch (const Iex::BaseExc& e) {
       throw IoError(path, withDetail("cannot read as an image", e.what()));
     }

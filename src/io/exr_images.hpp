@@ -15,14 +15,15 @@ namespace hfvis::detail {
 // for a file that cannot be read.
 bool isExrFile(const std::string& path);
 
-// Part 0 of the EXR `path` as float32 planes (half and float channels as they are, unsigned
-// integer channels as their values, not normalised; the data window's pixels, wherever it lies):
-// the channel `*channel` names (a name or a zero-based index; "" where the image has one
-// channel), or every channel where `channel` is null, in the order OpenImageIO gave them before
-// (see channelOrder in exr_images.cpp). attributes: the string attributes hfvis:cell_size_x and
-// hfvis:cell_size_y where the part has them. Throws IoError (unreadable, empty, a deep image, a
-// subsampled channel, 2^31 pixels or more, a header claiming more than max_image_bytes, 0 =
-// 64 GiB, or attributes larger than the file; a channel it lacks; truncated or corrupt pixels).
+// One part of the EXR `path` (the first; in a multi-part file, the one part that holds the
+// channel `*channel` names, where another does) as float32 planes (half and float channels as they are,
+// unsigned integer channels as their values, not normalised; the data window's pixels, wherever it lies): the
+// channel `*channel` names (a name or a zero-based index; "" where the image has one channel), or every
+// channel where `channel` is null, in the order OpenImageIO gave them before (see channelOrder in
+// exr_images.cpp). attributes: the string attributes hfvis:cell_size_x and hfvis:cell_size_y where the part
+// has them. Throws IoError (unreadable, empty, a deep image, a subsampled channel, 2^31 pixels or more, a
+// header claiming more than max_image_bytes, 0 = 64 GiB, or attributes larger than the file; a channel it
+// lacks; truncated or corrupt pixels).
 ImageChannels readExr(const std::string& path, std::uint64_t max_image_bytes, const std::string* channel);
 
 // Writes `image` (checked by the caller: consistent, unique channel names) to `file` as a

@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -51,11 +52,63 @@ struct DatasetCloser {
 };
 using Dataset = std::unique_ptr<void, DatasetCloser>;
 
+// GDAL's ASCII grid readers (ESRI's and GRASS's) take a value that is not a number as 0 or as its
+// leading digits: `abc` would become ground at height 0, `1,5` at 1. So every value after the header must be
+// a number as a whole (strtod's forms, nan and inf included: those are refused later as heights). The header:
+// the lines before the first value, each led by one of the formats' keys.
+void requireNumbersInAsciiGrid(const std::string& path) {
+  static const char* const kKeys[] = {"ncols",     "nrows",    "xllcorner", "xllcenter", "yllcorner",
+                                      "yllcenter", "cellsize", "dx",        "dy",        "nodata_value",
+                                      "north",     "south",    "east",      "west",      "rows",
+                                      "cols",      "null",     "type",      "multiplier"};
+  std::ifstream in(path, std::ios::binary);
+  std::vector<char> buffer(std::size_t(1) << 20);
+  std::string token;
+  bool header = true, line_start = true, key_line = false;
+  long long line = 1;
+  const auto check = [&]() {
+    if (token.empty()) return;
+    if (header && line_start) {
+      std::string key = token;
+      if (!key.empty() && key.back() == ':') key.pop_back();
+      std::transform(key.begin(), key.end(), key.begin(), [](unsigned char c) { return std::tolower(c); });
+      key_line = std::find_if(std::begin(kKeys), std::end(kKeys), [&](const char* k) { return key == k; }) !=
+                 std::end(kKeys);
+      if (!key_line) header = false;
+    }
+    line_start = false;
+    if (!header) {
+      char* end = nullptr;
+      std::strtod(token.c_str(), &end);
+      if (token.size() > 256 || end != token.c_str() + token.size())
+        throw IoError(path,
+                      "line " + std::to_string(line) + ": '" + token.substr(0, 40) +
+                          "' is not a number (GDAL's ASCII grid reader would read 0 or its leading digits)");
+    }
+    token.clear();
+  };
+  while (in) {
+    in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+    for (std::streamsize i = 0; i < in.gcount(); ++i) {
+      const char c = buffer[static_cast<std::size_t>(i)];
+      if (c == '\n' || c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v') {
+        check();
+        if (c == '\n') ++line, line_start = true;
+      } else if (token.size() <= 256) {  // (longer: cut there, and no number then)
+        token += c;
+      }
+    }
+  }
+  check();
+}
+
 Dataset openRaster(const std::string& path) {
   registerOnce();
   requireInputFile(path);
   Dataset dataset(GDALOpen(path.c_str(), GA_ReadOnly));
   if (!dataset) throw IoError(path, lastError());
+  const std::string driver = GDALGetDriverShortName(GDALGetDatasetDriver(dataset.get()));
+  if (driver == "AAIGrid" || driver == "GRASSASCIIGrid") requireNumbersInAsciiGrid(path);
   if (GDALGetRasterXSize(dataset.get()) <= 0 || GDALGetRasterYSize(dataset.get()) <= 0 ||
       GDALGetRasterCount(dataset.get()) <= 0)
     throw IoError(path, "the raster has no pixels");

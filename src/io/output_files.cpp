@@ -197,6 +197,21 @@ void requireReplaceableTarget(const std::string& path, const std::string& target
     throw IoError(path, errno == EROFS
                             ? "cannot write here: the file system is mounted read-only"
                             : "cannot write here: no permission to create files in '" + directory + "'");
+  // The permission bits do not tell it all: root passes them in /proc and /sys, whose directories
+  // take no new files, and an immutable directory refuses them whatever its mode. A file created
+  // and removed at once shows that the write will be taken, before any work.
+  const std::string probe = temporaryPathFor(target);
+  rememberTemporary(probe);
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  const int error = errno;
+  if (fd >= 0) {
+    ::close(fd);
+    ::unlink(probe.c_str());
+  }
+  forgetTemporary(probe);
+  if (fd < 0)
+    throw IoError(path, "cannot write here: creating a file in '" + directory + "' fails (" +
+                            writeFailure(error) + ")");
 }
 
 void requireInputFile(const std::string& path) {
