@@ -41,10 +41,12 @@ std::vector<float> skipError(const HorizonResult& result, const AzimuthOrder& or
     const double g1 = gapUp(order.azimuth[before], order.azimuth[i]),
                  g2 = gapUp(order.azimuth[i], order.azimuth[after]);
     const double span = g1 + g2, weight = span / (2.0 * skip * kTwoPi);
+    // (the weights of the interpolation once per direction, not a division per pixel)
+    const double to_lo = g2 / span, to_hi = g1 / span;
     const float *h = plane(result, order.index[i]), *lo = plane(result, order.index[before]),
                 *hi = plane(result, order.index[after]);
     for (std::size_t p = 0; p < pixels; ++p) {
-      const double interpolated = (double(lo[p]) * g2 + double(hi[p]) * g1) / span;
+      const double interpolated = double(lo[p]) * to_lo + double(hi[p]) * to_hi;
       sum[p] += weight * std::abs(double(h[p]) - interpolated);  // NaN at nodata stays NaN
     }
   }

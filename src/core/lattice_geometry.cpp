@@ -6,6 +6,8 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <memory>
+#include <mutex>
 #include <numeric>
 #include <optional>
 #include <sstream>
@@ -39,13 +41,13 @@ struct Candidate {
 
 // Every primitive step with |a|, |b| <= kMaxLatticeStep, cheapest first (ties: shorter
 // period first, then a fixed order, so the choice is deterministic).
-std::vector<Candidate> candidates(const HeightField& field) {
+std::vector<Candidate> allCandidates(double cell_size_x, double cell_size_y) {
   std::vector<Candidate> all;
   for (int a = -kMaxLatticeStep; a <= kMaxLatticeStep; ++a) {
     for (int b = -kMaxLatticeStep; b <= kMaxLatticeStep; ++b) {
       if (std::gcd(a, b) != 1) continue;
       const int cost = (a != 0 && b != 0) ? std::abs(a) + std::abs(b) - 1 : 1;
-      all.push_back({a, b, cost, std::atan2(b * field.cell_size_y, a * field.cell_size_x)});
+      all.push_back({a, b, cost, std::atan2(b * cell_size_y, a * cell_size_x)});
     }
   }
   std::stable_sort(all.begin(), all.end(), [](const Candidate& x, const Candidate& y) {
@@ -53,6 +55,27 @@ std::vector<Candidate> candidates(const HeightField& field) {
     return x.a * x.a + x.b * x.b < y.a * y.a + y.b * y.b;
   });
   return all;
+}
+
+// allCandidates for the field's cell size, kept for the last few cell sizes asked: about 10,000
+// steps, an atan2 each and a sort, about a millisecond, which every run's direction set and each K
+// that max_error's chooser weighs (horizonWork) would pay again (several times a small run's own
+// sweep at 128^2).
+std::shared_ptr<const std::vector<Candidate>> candidates(const HeightField& field) {
+  using Key = std::pair<double, double>;
+  static std::mutex mutex;
+  static std::vector<std::pair<Key, std::shared_ptr<const std::vector<Candidate>>>> kept;
+  const Key key{field.cell_size_x, field.cell_size_y};
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    for (const auto& [k, list] : kept)
+      if (k == key) return list;
+  }
+  auto list = std::make_shared<const std::vector<Candidate>>(allCandidates(key.first, key.second));
+  std::lock_guard<std::mutex> lock(mutex);
+  if (kept.size() >= 8) kept.erase(kept.begin());
+  kept.emplace_back(key, list);
+  return list;
 }
 
 // A single direction at an exact azimuth (the sun's sweeps) where no step up to kMaxLatticeStep is
@@ -113,7 +136,8 @@ LatticeDirection latticeStep(const HeightField& field, int a, int b) {
 
 std::vector<LatticeDirection> latticeDirections(const HeightField& field, const SweepOptions& options,
                                                 bool exact_azimuths, double tolerance, bool parity_apart) {
-  const std::vector<Candidate> all = candidates(field);
+  const std::shared_ptr<const std::vector<Candidate>> kept = candidates(field);
+  const std::vector<Candidate>& all = *kept;
   const int K = options.directions;
   // Quadrature windows are strictly inside each direction's half-spacing.
   const double window = exact_azimuths ? tolerance : 0.4999 * kTwoPi / K;
