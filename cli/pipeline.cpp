@@ -14,6 +14,7 @@
 
 #include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
+#include "io/output_files.hpp"
 
 namespace hfvis::cli {
 
@@ -274,16 +275,21 @@ std::string Computation::method() const { return run_.method == HorizonMethod::N
 
 namespace {
 
-// The same file, whether or not it exists yet (links and relative paths resolved).
+// The same file, whether or not it exists yet (links and relative paths resolved). A path not
+// there yet is where a write would put it: through its links (a dangling link writes the file
+// it names) and made absolute first, since weakly_canonical leaves a relative path relative when
+// nothing of it exists ("h.tif" and "$PWD/h.tif" compared unequal, and one output replaced the
+// other).
 bool sameFile(const std::string& a, const std::string& b) {
   std::error_code error;
   if (fs::exists(a, error) && fs::exists(b, error)) return fs::equivalent(a, b, error);
-  std::error_code error_a, error_b;
-  const fs::path canonical_a = fs::weakly_canonical(a, error_a),
-                 canonical_b = fs::weakly_canonical(b, error_b);
-  if (error_a || error_b)  // (an error gives empty paths, which would compare equal)
-    return fs::absolute(a, error).lexically_normal() == fs::absolute(b, error).lexically_normal();
-  return canonical_a == canonical_b;
+  const auto where = [](const std::string& path) {
+    std::error_code failed;
+    const fs::path target = fs::absolute(hfvis::detail::resolvedTarget(path), failed).lexically_normal();
+    const fs::path canonical = fs::weakly_canonical(target, failed);
+    return failed ? target : canonical;
+  };
+  return where(a) == where(b);
 }
 
 // Every output can be written, none is an input (an output never replaces an input), and no
@@ -291,9 +297,11 @@ bool sameFile(const std::string& a, const std::string& b) {
 // input is read.
 void requireOutputs(const RunArguments& run, const Computation& computation) {
   const std::vector<std::string> outputs = computation.outputs();
-  std::vector<std::string> inputs{run.input};
+  // (with the files a GDAL raster reads beside itself: a VRT's sources)
+  std::vector<std::string> inputs = filesRead(run.input);
   for (const std::string& input : computation.otherInputs())
-    if (!input.empty()) inputs.push_back(input);
+    if (!input.empty())
+      for (const std::string& file : filesRead(input)) inputs.push_back(file);
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     requireReplaceable(outputs[i]);
     if (computation.writesImages() && outputs[i] != run.preview)

@@ -499,6 +499,72 @@ TEST_F(Cli, OutputNeverReplacesAnInput) {
   EXPECT_TRUE(listDirectory(outputs()).empty());
 }
 
+// Two outputs that are one file not there yet, spelt two ways (relative and absolute, or through
+// a dangling link to the other): refused before the computation. weakly_canonical left a relative
+// path of nothing that exists relative, so "h.tif" and "$PWD/h.tif" compared unequal, and the
+// distances replaced the angles with exit 0.
+TEST_F(Cli, TwoOutputsThatAreOneNewFileAreRefused) {
+  const std::string field = ramp();
+  const std::string cd = "cd " + shellQuoted(outputs().string()) + " &&";
+  for (const std::string& outputs_part : {"-o " + shellQuoted(out("h.tif")) + " --distance-out h.tif",
+                                          std::string("-o h.tif --distance-out ../outputs/h.tif")}) {
+    SCOPED_TRACE(outputs_part);
+    const CliResult result = run("horizon " + shellQuoted(field) + " -k 4 " + outputs_part, cd);
+    expectFailure(result, 2, "are the same file");
+  }
+  fs::create_symlink("h.exr", out("link.exr"));  // dangling: it names the other output
+  const CliResult linked = run("horizon " + shellQuoted(field) + " -k 4 -o " + shellQuoted(out("h.exr")) +
+                               " --distance-out " + shellQuoted(out("link.exr")));
+  EXPECT_EQ(linked.status, 2) << linked.err;
+  EXPECT_NE(linked.err.find("are the same file"), std::string::npos) << linked.err;
+  EXPECT_EQ(listDirectory(outputs()), std::vector<std::string>{"link.exr"});
+}
+
+// A VRT input reads the files it names: none of them may be an output (the source GeoTIFF was
+// replaced, exit 0), and one that is not a regular file (a FIFO: GDAL opened a raw band's file
+// with the VRT and blocked for good), or standard input, is refused before it is opened.
+TEST_F(Cli, AVrtsSourcesAreInputsToo) {
+  const std::string tif = in("dem.tif");
+  std::vector<float> values;
+  for (int i = 0; i < 20 * 16; ++i) values.push_back(static_cast<float>((i * 7) % 13));
+  hfvis::testing::writeGdalGeoTiff(tif, 20, 16, values, hfvis::testing::kUtmGeotransform,
+                                   hfvis::testing::crsWkt("EPSG:32633"), -9999.0);
+  const std::string tif_before = readText(tif);
+  const std::string vrt = in("wrap.vrt");
+  {
+    std::ofstream(vrt) << "<VRTDataset rasterXSize=\"20\" rasterYSize=\"16\">\n"
+                          "  <VRTRasterBand dataType=\"Float32\" band=\"1\">\n"
+                          "    <SimpleSource><SourceFilename relativeToVRT=\"1\">dem.tif</SourceFilename>"
+                          "<SourceBand>1</SourceBand></SimpleSource>\n"
+                          "  </VRTRasterBand>\n</VRTDataset>\n";
+  }
+  const CliResult replaced = run("svf " + shellQuoted(vrt) + " -o " + shellQuoted(tif) + " -k 4");
+  EXPECT_EQ(replaced.status, 2) << replaced.err;
+  EXPECT_NE(replaced.err.find("outputs never replace an input"), std::string::npos) << replaced.err;
+  EXPECT_EQ(readText(tif), tif_before);
+  // (the VRT itself reads as its source does)
+  const CliResult through = run("svf " + shellQuoted(vrt) + " -o " + shellQuoted(out("s.exr")) + " -k 4 -q");
+  EXPECT_EQ(through.status, 0) << through.err;
+  fs::remove(out("s.exr"));
+  ASSERT_EQ(::mkfifo(in("heights.raw").c_str(), 0600), 0);
+  const std::string raw_band =
+      "<VRTDataset rasterXSize=\"8\" rasterYSize=\"8\">\n"
+      "  <VRTRasterBand dataType=\"Float32\" band=\"1\" subClass=\"VRTRawRasterBand\">\n"
+      "    <SourceFilename relativeToVRT=\"1\">NAME</SourceFilename>\n"
+      "    <ImageOffset>0</ImageOffset><PixelOffset>4</PixelOffset><LineOffset>32</LineOffset>\n"
+      "  </VRTRasterBand>\n</VRTDataset>\n";
+  for (const std::string name : {"heights.raw", "/vsistdin/"}) {
+    SCOPED_TRACE(name);
+    std::string text = raw_band;
+    text.replace(text.find("NAME"), 4, name);
+    { std::ofstream(in("raw.vrt")) << text; }
+    // (`timeout`: a hang fails the test instead of stopping the suite)
+    const CliResult blocked =
+        run("svf " + shellQuoted(in("raw.vrt")) + " -o " + shellQuoted(out("s.exr")) + " -k 4", "timeout 60");
+    expectFailure(blocked, 1, name);
+  }
+}
+
 TEST_F(Cli, FailedRunLeavesAnExistingOutputUntouched) {
   { std::ofstream(out("o.exr")) << "previous result"; }
   const CliResult result =

@@ -77,6 +77,12 @@ struct ImageChannels {
 // readHeightField. Throws IoError as readHeightField.
 ImageChannels readImage(const std::string& path);
 
+// The files reading `path` opens: `path` itself, and for a raster GDAL reads, the files it reads
+// beside it (a VRT's sources, nested VRTs' too; sidecars such as a world file), so that an output
+// can be kept from replacing any of them. Throws IoError where a VRT names a source that is not a
+// regular file (a FIFO, a device: reading it would block) or standard input.
+std::vector<std::string> filesRead(const std::string& path);
+
 // Reads a colour image (readImage): its R, G, B channels in that order (an alpha channel A beside
 // them ignored), or its only channel, named "Y". Throws IoError as readImage, and naming `what`
 // ("an environment map") for an image with other channels.

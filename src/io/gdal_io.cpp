@@ -6,6 +6,7 @@
 #include <cpl_string.h>
 #include <gdal.h>
 #include <ogr_srs_api.h>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <array>
@@ -13,6 +14,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -102,9 +104,75 @@ void requireNumbersInAsciiGrid(const std::string& path) {
   check();
 }
 
+// The XML text `path` holds when it is a VRT (GDAL knows one by its contents, whatever its name),
+// else "".
+std::string vrtText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string head(64, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  const std::size_t first = head.find_first_not_of(" \t\r\n");
+  if (first == std::string::npos || head.compare(first, 11, "<VRTDataset") != 0) return "";
+  in.seekg(0);
+  std::string text;
+  // (a VRT is a description: a few kB; one of more than 64 MiB is read no further)
+  text.resize(std::size_t(64) << 20);
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  return text;
+}
+
+// XML's five entities in a source name.
+std::string xmlUnescaped(std::string text) {
+  static const std::pair<const char*, const char*> kEntities[] = {
+      {"&lt;", "<"}, {"&gt;", ">"}, {"&quot;", "\""}, {"&apos;", "'"}, {"&amp;", "&"}};
+  for (const auto& [entity, character] : kEntities)
+    for (std::size_t at = text.find(entity); at != std::string::npos; at = text.find(entity, at + 1))
+      text.replace(at, std::strlen(entity), character);
+  return text;
+}
+
+// The files the VRT `path` names as its sources (its <SourceFilename> elements, relative to the VRT
+// where they say so), and those of the VRTs among them in turn (to a depth of 8; deeper, GDAL
+// refuses the nesting itself), into `files`. Read from the XML before GDAL opens it, because GDAL
+// opens a raw band's file while it opens the VRT: a FIFO there, or /vsistdin/, blocked for good. So
+// a source that is not a regular file where it exists (a FIFO, a device, a directory) or standard
+// input is refused (IoError), as an input of that kind is; other /vsi paths are left to GDAL.
+void collectVrtSources(const std::string& path, int depth, std::vector<std::string>* files) {
+  const std::string text = vrtText(path);
+  if (text.empty() || depth > 8) return;
+  const std::filesystem::path directory = std::filesystem::path(path).parent_path();
+  for (std::size_t at = text.find("<SourceFilename"); at != std::string::npos;
+       at = text.find("<SourceFilename", at + 1)) {
+    const std::size_t open_end = text.find('>', at), close = text.find("</SourceFilename>", at);
+    if (open_end == std::string::npos || close == std::string::npos || close < open_end) break;
+    const std::string attributes = text.substr(at, open_end - at);
+    const bool relative = attributes.find("relativeToVRT=\"1\"") != std::string::npos ||
+                          attributes.find("relativeToVRT='1'") != std::string::npos;
+    std::string name = xmlUnescaped(text.substr(open_end + 1, close - open_end - 1));
+    name.erase(0, name.find_first_not_of(" \t\r\n"));
+    name.erase(name.find_last_not_of(" \t\r\n") + 1);
+    if (name.empty()) continue;
+    if (name.rfind("/vsistdin", 0) == 0)
+      throw IoError(path, "its source '" + name + "' is standard input; hfvis reads files");
+    if (name.rfind("/vsi", 0) == 0) continue;
+    const std::string source =
+        relative && !std::filesystem::path(name).is_absolute() ? (directory / name).string() : name;
+    struct stat status {};
+    if (::stat(source.c_str(), &status) == 0 && !S_ISREG(status.st_mode))
+      throw IoError(path, "its source '" + source + "' is not a regular file; hfvis reads files");
+    if (std::find(files->begin(), files->end(), source) != files->end())
+      continue;  // (a loop: GDAL's to refuse)
+    files->push_back(source);
+    collectVrtSources(source, depth + 1, files);
+  }
+}
+
 Dataset openRaster(const std::string& path) {
   registerOnce();
   requireInputFile(path);
+  std::vector<std::string> sources;
+  collectVrtSources(path, 0, &sources);
   Dataset dataset(GDALOpen(path.c_str(), GA_ReadOnly));
   if (!dataset) throw IoError(path, lastError());
   const std::string driver = GDALGetDriverShortName(GDALGetDatasetDriver(dataset.get()));
@@ -350,6 +418,21 @@ std::string lowercaseExtension(const std::string& path) {
   std::transform(extension.begin(), extension.end(), extension.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return extension;
+}
+
+std::vector<std::string> gdalFilesRead(const std::string& path) {
+  std::vector<std::string> files{path};
+  struct stat status {};
+  if (::stat(path.c_str(), &status) != 0 || !S_ISREG(status.st_mode)) return files;  // (reading says why)
+  collectVrtSources(path, 0, &files);
+  registerOnce();
+  const Dataset dataset(GDALOpen(path.c_str(), GA_ReadOnly));
+  if (!dataset) return files;
+  char** listed = GDALGetFileList(dataset.get());
+  for (char** file = listed; file && *file; ++file)
+    if (std::find(files.begin(), files.end(), *file) == files.end()) files.emplace_back(*file);
+  CSLDestroy(listed);
+  return files;
 }
 
 bool isGdalRaster(const std::string& path) {

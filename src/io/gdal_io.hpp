@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "hfvis/image_io.hpp"
 
@@ -27,6 +28,11 @@ std::string lowercaseExtension(const std::string& path);
 
 // Whether `path` names a raster format that GDAL reads rather than OpenEXR or OpenImageIO.
 bool isGdalRaster(const std::string& path);
+
+// `path` and the files GDAL reads with it (a VRT's sources, nested VRTs' too, and what the
+// dataset lists: sidecars, world files); `path` alone where it does not open. Throws IoError for
+// a VRT source that is not a regular file, or standard input (see filesRead).
+std::vector<std::string> gdalFilesRead(const std::string& path);
 
 // Reads band `options.channel` ("" = the only band; an index "0".. or a band description) as
 // heights: nodata cells NaN, the georeference from the file, cell sizes from the geotransform

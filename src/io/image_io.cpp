@@ -64,6 +64,10 @@ HeightField readHeightField(const std::string& path, const HeightFieldReadOption
   return field;
 }
 
+std::vector<std::string> filesRead(const std::string& path) {
+  return detail::isGdalRaster(path) ? detail::gdalFilesRead(path) : std::vector<std::string>{path};
+}
+
 ImageChannels readImage(const std::string& path) {
   if (detail::isGdalRaster(path)) return detail::readGdalImage(path);
   ImageChannels image = readOtherImage(path, 0, nullptr);
