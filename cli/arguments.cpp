@@ -91,7 +91,8 @@ double parseBounded(const std::string& option, const std::string& text, double l
 
 // Limits of the ground and height values (ground units): within them, distances, their squares
 // and areas over a field of 2^31 pixels stay inside float32's range with room for the sums.
-constexpr double kLeastCellSize = 1e-6, kMostCellSize = 1e9, kMostLength = 1e12;
+// (kLeastCellSize, kMostCellSize: arguments.hpp)
+constexpr double kMostLength = 1e12;
 // The sweep's largest azimuth tolerance, 0.1 radian (computeHorizons), in degrees as the help
 // gives it (rounded up: the conversion to radians clamps it to 0.1).
 constexpr double kMostAzimuthTolerance = 5.72958;
@@ -907,11 +908,13 @@ void validateRun(const CommandSpec& command, const std::string& name, const RunA
   // A nodata value the outputs can hold as data would make those cells nodata for every reader
   // (a viewshed's hidden 0 or visible 1): it must lie below every value the command writes.
   if (run.nodata && !std::isnan(*run.nodata)) {
-    const double lowest = command.lowest_value ? command.lowest_value(run) : 0.0;
+    // (in float32, as the outputs hold both: -1.57079638 rounds to the angles' float(-pi/2))
+    const float lowest = static_cast<float>(command.lowest_value ? command.lowest_value(run) : 0.0);
     if (*run.nodata >= lowest)
-      throw UsageError("--nodata " + detail::shortNumber(*run.nodata) + ": 'hfvis " + name +
-                       "' writes data values from " + detail::shortNumber(lowest) +
-                       " up, so a reader could not tell those cells from nodata; give a value below " +
+      throw UsageError("--nodata " + detail::exactNumber(*run.nodata) + ": 'hfvis " + name +
+                       "' writes data values from " + detail::exactNumber(lowest) +
+                       " up (in float32), so a reader could not tell those cells from nodata; give a value "
+                       "below " +
                        detail::shortNumber(lowest) + " (such as -9999) or nan");
   }
 }
@@ -977,6 +980,10 @@ RunArguments parseRunArguments(const CommandSpec& command, const std::string& na
       const std::string shown = attached && typed.size() > 2 ? typed : arg;
       throw UsageError("unknown option " + inQuotes(shown) + " for 'hfvis " + name + "'");
     }
+    // ("-o=x.exr" wrote a file named "=x.exr": a short option takes its value attached or next)
+    if (attached && typed.size() == 2 && attached->front() == '=')
+      throw UsageError(inQuotes(arg) + ": a short option takes its value as " + typed + "VALUE or " + typed +
+                       " VALUE, without '='");
     // One rule for every option: once, but for those that add one more of a list (a second -o
     // or -k silently replacing the first would hide a typo).
     if (!spec->repeats && !given.insert(spec).second)

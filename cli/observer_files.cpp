@@ -62,6 +62,8 @@ std::vector<CsvPoint> parsePoints(const std::string& path, std::istream& in, dou
   bool header_seen = false;
   for (int number = 1; std::getline(in, line); ++number) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
+    // A UTF-8 BOM starts the file, whatever its first line holds (a comment, nothing).
+    if (number == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
     const std::size_t first = line.find_first_not_of(" \t");
     if (first == std::string::npos || line[first] == '#') continue;
     std::vector<std::string> fields;
@@ -74,7 +76,6 @@ std::vector<CsvPoint> parsePoints(const std::string& path, std::istream& in, dou
     };
     if (number == 1 && (line.rfind("\xFF\xFE", 0) == 0 || line.rfind("\xFE\xFF", 0) == 0))
       throw IoError(path, "is UTF-16 text; save it as UTF-8 (or ASCII) with lines col,row[,height]");
-    if (points.empty() && fields[0].rfind("\xEF\xBB\xBF", 0) == 0) fields[0].erase(0, 3);  // a UTF-8 BOM
     double col = 0, row_index = 0, height = default_height;
     const bool numbers = fields.size() >= 2 && number_in(fields[0], col) && number_in(fields[1], row_index);
     // A header: before any point, a line whose fields all start with a letter.

@@ -345,6 +345,13 @@ TEST_F(Cli, UnknownOption) {
       "--frobnicate");
 }
 
+// A short option's value comes attached or next, never after '=' ("-o=x.exr" wrote "=x.exr").
+TEST_F(Cli, AShortOptionWithAnEqualsSignIsAUsageError) {
+  const CliResult result =
+      run("horizon " + shellQuoted(ramp()) + " -o=" + shellQuoted(out("o.exr")) + " -k 4");
+  expectFailure(result, 2, "without '='");
+}
+
 TEST_F(Cli, DirectionsOutOfRange) {
   for (const char* k : {"0", "65537", "100000000"}) {
     const CliResult result =
@@ -563,6 +570,24 @@ TEST_F(Cli, AVrtsSourcesAreInputsToo) {
         run("svf " + shellQuoted(in("raw.vrt")) + " -o " + shellQuoted(out("s.exr")) + " -k 4", "timeout 60");
     expectFailure(blocked, 1, name);
   }
+}
+
+// A cell size from the file's georeference goes through --cell-size's range as the option does:
+// a pixel of 1e-30 gave a visible area of 0 everywhere, exit 0. --cell-size still overrides it.
+TEST_F(Cli, AFilesCellSizeOutsideWhatTheKernelsHoldIsRefused) {
+  const std::string tif = in("tiny.tif");
+  std::vector<float> values;
+  for (int i = 0; i < 20 * 16; ++i) values.push_back(static_cast<float>((i * 7) % 13));
+  for (const double pixel : {1e-30, 1e12}) {
+    SCOPED_TRACE(pixel);
+    hfvis::testing::writeGdalGeoTiff(tif, 20, 16, values, {500000.0, pixel, 0.0, 4100000.0, 0.0, -pixel},
+                                     hfvis::testing::crsWkt("EPSG:32633"), -9999.0);
+    expectFailure(run("viewcount " + shellQuoted(tif) + " -o " + shellQuoted(out("v.tif")) + " -k 8"), 1,
+                  "outside 1e-06 .. 1e+09");
+  }
+  const CliResult given =
+      run("viewcount " + shellQuoted(tif) + " -o " + shellQuoted(out("v.tif")) + " -k 8 -q --cell-size 2");
+  EXPECT_EQ(given.status, 0) << given.err;
 }
 
 TEST_F(Cli, FailedRunLeavesAnExistingOutputUntouched) {
@@ -2460,7 +2485,9 @@ TEST_F(CliGeoTiff, NodataThatTheDataCanHoldIsRefused) {
   const std::string tif = geoTiffInput();
   for (const char* args :
        {"viewshed --observer 5,5 --nodata 0", "viewshed --observer 5,5 --nodata 1", "svf -k 4 --nodata 1",
-        "horizon -k 4 --nodata -1", "viewshed --observer 5,5 --angle --nodata -45"}) {
+        "horizon -k 4 --nodata -1", "viewshed --observer 5,5 --angle --nodata -45",
+        // (below -pi/2 in double, float32's -pi/2 itself: the angles hold it)
+        "horizon -k 4 --nodata -1.57079638"}) {
     SCOPED_TRACE(args);
     const std::string command(args);
     const std::size_t space = command.find(' ');
@@ -2892,6 +2919,19 @@ TEST_F(Cli, AreaLightFromASourcesFile) {
     std::ofstream csv(in("sources.csv"), std::ios::binary);
     csv << "\xEF\xBB\xBF"
            "col,row,height\r\n2,3,1\r\n# behind the wall\r\n12.5,6\r\n";
+  }
+  // (the BOM before a comment or a blank line too)
+  for (const char* first : {"# sources\r\n", "\r\n"}) {
+    SCOPED_TRACE(first);
+    {
+      std::ofstream csv(in("commented.csv"), std::ios::binary);
+      csv << "\xEF\xBB\xBF" << first << "2,3,1\r\n12.5,6\r\n";
+    }
+    const CliResult commented =
+        run("arealight " + shellQuoted(field) + " -o " + shellQuoted(out("c.exr")) + " --sources " +
+            shellQuoted(in("commented.csv")) + " --light-height 4 -q");
+    EXPECT_EQ(commented.status, 0) << commented.err;
+    fs::remove(out("c.exr"));
   }
   const CliResult r = run("arealight " + shellQuoted(field) + " -o " + shellQuoted(out("a.exr")) +
                           " --sources " + shellQuoted(in("sources.csv")) + " --light-height 4 -q");

@@ -3,6 +3,9 @@
 // outputs checked with GDAL itself).
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -1038,6 +1041,108 @@ TEST(GdalRasters, AsciiGridWithNodataAndCellSize) {
   EXPECT_TRUE(std::isnan(field.heights[4]));
   EXPECT_DOUBLE_EQ(field.cell_size_x, 30.0);
   EXPECT_DOUBLE_EQ(field.cell_size_y, 30.0);
+}
+
+// A TIFF of a few bytes claiming side x side float32 pixels in one DEFLATE strip that holds 64.
+void writeClaimingTiff(const std::string& path, std::uint32_t side) {
+  std::string data;
+  {
+    // zlib's stream of 64 zero bytes (what Python's zlib.compress(bytes(64)) gives)
+    const unsigned char deflated[] = {0x78, 0x9c, 0x63, 0x60, 0xa0, 0x0c, 0x00, 0x00, 0x00, 0x40, 0x00, 0x01};
+    data.assign(reinterpret_cast<const char*>(deflated), sizeof deflated);
+  }
+  const std::uint32_t ifd = 8 + static_cast<std::uint32_t>(data.size());
+  std::string out = std::string("II") + '\x2a' + '\0';
+  const auto u16 = [&](std::uint16_t v) { out.append(reinterpret_cast<const char*>(&v), 2); };
+  const auto u32 = [&](std::uint32_t v) { out.append(reinterpret_cast<const char*>(&v), 4); };
+  u32(ifd);
+  out += data;
+  const std::uint32_t tags[][3] = {
+      {256, 4, side}, {257, 4, side}, {258, 3, 32},
+      {259, 3, 8},    {262, 3, 1},    {273, 4, 8},
+      {277, 3, 1},    {278, 4, side}, {279, 4, static_cast<std::uint32_t>(data.size())},
+      {284, 3, 1},    {339, 3, 3}};
+  u16(static_cast<std::uint16_t>(std::size(tags)));
+  for (const auto& tag : tags) {
+    u16(static_cast<std::uint16_t>(tag[0]));
+    u16(static_cast<std::uint16_t>(tag[1]));
+    u32(1);
+    if (tag[1] == 3) {
+      u16(static_cast<std::uint16_t>(tag[2]));
+      u16(0);
+    } else {
+      u32(tag[2]);
+    }
+  }
+  u32(0);
+  std::ofstream(path, std::ios::binary) << out;
+}
+
+// A header claiming far more pixels than the file holds fails at its first missing rows, having
+// allocated about one read's worth beside what GDAL itself takes for the strip: the whole claim was
+// allocated first, twice over (float32 values and float64 reads), 6 GB for 158 bytes of TIFF
+// claiming 20000^2. Measured in a child process: the growth of its peak resident memory.
+TEST(GdalRasters, AClaimedSizeIsNotAllocatedBeforeTheRowsAreRead) {
+  const std::string path = std::string(HFVIS_TEST_TMP_DIR) + "/claim.tif";
+  constexpr std::uint32_t kSide = 6000;  // 144 MB of float32, 288 MB as float64
+  writeClaimingTiff(path, kSide);
+  const pid_t child = ::fork();
+  if (child == 0) {
+    rusage before{}, after{};
+    ::getrusage(RUSAGE_SELF, &before);
+    int status = 3;
+    try {
+      readHeightField(path);
+      status = 2;  // read: the file did not claim what it lacks
+    } catch (const IoError&) {
+      ::getrusage(RUSAGE_SELF, &after);
+      const long grown_kb = after.ru_maxrss - before.ru_maxrss;
+      // GDAL's strip (144 MB) and a read's worth; the claim read whole took 576 MB
+      status = grown_kb < 300L * 1024 ? 0 : 1;
+    } catch (...) {
+    }
+    ::_exit(status);
+  }
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "1: the claim was allocated; 2: the file was read; 3: another error";
+}
+
+// A complex band is refused (GDAL gave its real part alone), and so are heights that float32 rounds
+// by more than a thousandth of their range and of a cell (UInt32 heights near 4e9 with walls of
+// 50 came out flat, exit 0). Heights near 4000 in float64 over a range of 0.1 are not.
+TEST(GdalRasters, ComplexBandsAndHeightsFloat32CannotHoldAreRefused) {
+  testing::registerGdal();
+  const std::string path = std::string(HFVIS_TEST_TMP_DIR) + "/typed.tif";
+  const auto write = [&](GDALDataType type, const std::vector<double>& values) {
+    GDALDatasetH dataset = GDALCreate(GDALGetDriverByName("GTiff"), path.c_str(), 4, 2, 1, type, nullptr);
+    ASSERT_NE(dataset, nullptr) << CPLGetLastErrorMsg();
+    std::vector<double> pixels = values;
+    if (GDALDataTypeIsComplex(type)) {  // (real, imaginary) pairs
+      pixels.clear();
+      for (double v : values) pixels.push_back(v), pixels.push_back(v / 2);
+    }
+    EXPECT_EQ(GDALRasterIO(GDALGetRasterBand(dataset, 1), GF_Write, 0, 0, 4, 2, pixels.data(), 4, 2,
+                           GDALDataTypeIsComplex(type) ? GDT_CFloat64 : GDT_Float64, 0, 0),
+              CE_None);
+    GDALClose(dataset);
+  };
+  const auto refusal = [&]() -> std::string {
+    try {
+      readHeightField(path);
+    } catch (const IoError& error) {
+      return error.reason();
+    }
+    return "(read)";
+  };
+  write(GDT_CFloat32, {1, 2, 3, 4, 5, 6, 7, 8});
+  EXPECT_NE(refusal().find("complex numbers (CFloat32)"), std::string::npos) << refusal();
+  write(GDT_UInt32, {4e9, 4e9, 4e9 + 50, 4e9 + 50, 4e9, 4e9, 4e9, 4e9});
+  EXPECT_NE(refusal().find("rounds them by up to"), std::string::npos) << refusal();
+  write(GDT_Float64, {4000.0, 4000.1, 4000.05, 4000.02, 4000.0, 4000.03, 4000.07, 4000.01});
+  EXPECT_EQ(refusal(), "(read)");
+  EXPECT_FLOAT_EQ(readHeightField(path).heights[1], 4000.1f);
 }
 
 // GDAL's ASCII grid readers take a value that is not a number as 0 (or as its leading digits):

@@ -199,16 +199,19 @@ void requireReadable(const std::string& path, GDALDatasetH dataset, int bands, s
 // its own) says no data; an image's alpha stays ignored (image_io.hpp). Read as float64 in blocks
 // of rows (whole blocks of the file's), so that nodata compares in the band's own type and a
 // value beyond float32's range is refused rather than made infinite (it would pass for nodata).
-std::vector<float> readBand(const std::string& path, GDALDatasetH dataset, int band_index, bool masks) {
+// What reading heights into float32 rounded: the largest rounding, and the range of the values.
+struct HeightRounding {
+  double rounding = 0.0, lowest = INFINITY, highest = -INFINITY;
+};
+
+std::vector<float> readBand(const std::string& path, GDALDatasetH dataset, int band_index, bool masks,
+                            HeightRounding* rounded = nullptr) {
   const int width = GDALGetRasterXSize(dataset), height = GDALGetRasterYSize(dataset);
   GDALRasterBandH band = GDALGetRasterBand(dataset, band_index + 1);
+  // The values grow with the rows read, so that a header claiming more pixels than the file holds
+  // fails at its first missing rows, not after allocating the whole claim (158 bytes of TIFF
+  // claiming 20000 x 20000 had taken 6 GB before GDAL's read failed).
   std::vector<float> values;
-  try {
-    values.resize(std::size_t(width) * height);
-  } catch (const std::bad_alloc&) {
-    throw IoError(path, "raster is too large to hold in memory (" + std::to_string(width) + " x " +
-                            std::to_string(height) + " pixels)");
-  }
   int has_nodata = 0, has_scale = 0, has_offset = 0;
   const double nodata = GDALGetRasterNoDataValue(band, &has_nodata);
   double scale = GDALGetRasterScale(band, &has_scale), offset = GDALGetRasterOffset(band, &has_offset);
@@ -218,22 +221,35 @@ std::vector<float> readBand(const std::string& path, GDALDatasetH dataset, int b
     throw IoError(path, "band " + std::to_string(band_index + 1) + " has a scale of " + shortNumber(scale) +
                             " and an offset of " + shortNumber(offset) +
                             ": not a usable linear map to heights");
+  // (GDAL would give a complex band's real part alone)
+  if (GDALDataTypeIsComplex(GDALGetRasterDataType(band)))
+    throw IoError(path, "band " + std::to_string(band_index + 1) + " holds complex numbers (" +
+                            GDALGetDataTypeName(GDALGetRasterDataType(band)) + "); hfvis reads real values");
   const bool in_float = GDALGetRasterDataType(band) == GDT_Float32;
+  HeightRounding seen;
   const int flags = GDALGetMaskFlags(band);
   // (the mask of the nodata value is the value itself, compared below)
   GDALRasterBandH mask = !masks || (flags & (GMF_ALL_VALID | GMF_NODATA)) ? nullptr : GDALGetMaskBand(band);
-  // (about 4M values a read, in whole rows of the file's blocks: a tiled raster's tile row decoded once)
+  // (about 4M values a read, in whole rows of the file's blocks where one holds fewer: a tiled
+  // raster's tile row decoded once; a taller block, a strip of the whole file, read in parts)
   int block_x = 0, block_y = 0;
   GDALGetBlockSize(band, &block_x, &block_y);
   block_y = std::max(1, block_y);
+  const int rows_in_budget = std::max(1, (1 << 22) / std::max(width, 1));
   const int rows_per_read =
-      std::max(1, std::min(height, std::max(block_y, (1 << 22) / std::max(width, 1) / block_y * block_y)));
+      std::min(height, rows_in_budget >= block_y ? rows_in_budget / block_y * block_y : rows_in_budget);
   std::vector<double> raw;
   std::vector<unsigned char> valid;
   for (int y0 = 0; y0 < height; y0 += rows_per_read) {
     const int rows = std::min(rows_per_read, height - y0);
     const std::size_t count = std::size_t(width) * rows;
     raw.resize(count);
+    try {
+      values.resize(std::size_t(width) * (y0 + rows));
+    } catch (const std::bad_alloc&) {
+      throw IoError(path, "raster is too large to hold in memory (" + std::to_string(width) + " x " +
+                              std::to_string(height) + " pixels)");
+    }
     if (GDALRasterIO(band, GF_Read, 0, y0, width, rows, raw.data(), width, rows, GDT_Float64, 0, 0) !=
         CE_None)
       throw IoError(path, lastError());
@@ -261,8 +277,14 @@ std::vector<float> readBand(const std::string& path, GDALDatasetH dataset, int b
                                 std::to_string(y0 + i / std::size_t(width)) +
                                 " is beyond float32's range, in which hfvis computes");
       out[i] = static_cast<float>(height_value);
+      if (rounded && std::isfinite(height_value)) {
+        seen.lowest = std::min(seen.lowest, height_value),
+        seen.highest = std::max(seen.highest, height_value);
+        seen.rounding = std::max(seen.rounding, std::fabs(height_value - static_cast<double>(out[i])));
+      }
     }
   }
+  if (rounded) *rounded = seen;
   return values;
 }
 
@@ -464,7 +486,8 @@ HeightField readGdalHeightField(const std::string& path, const HeightFieldReadOp
   HeightField field;
   field.width = GDALGetRasterXSize(dataset.get());
   field.height = GDALGetRasterYSize(dataset.get());
-  field.heights = readBand(path, dataset.get(), band_index, true);
+  HeightRounding rounded;
+  field.heights = readBand(path, dataset.get(), band_index, true, &rounded);
   field.georeference = georeferenceOf(dataset.get());
   // A rotated or sheared grid is refused whatever the cell size: the outputs would keep its
   // geotransform while every direction and distance was computed on an axis-aligned one.
@@ -498,6 +521,18 @@ HeightField readGdalHeightField(const std::string& path, const HeightFieldReadOp
                   "a geographic raster without a geotransform (no tiepoint) has no cell size in "
                   "metres; give one with --cell-size");
   }
+  // Heights rounded to float32 must keep their differences: UInt32 heights near 4e9 round by up
+  // to 256, and walls of 50 vanished (exit 0). A rounding above a thousandth of the heights' range
+  // and of a cell is refused (a slope error of 0.1 %; a flat lake at 4000 m in float64, rounded by
+  // 2e-4 over a range of 0.1, is not).
+  if (rounded.rounding >
+      1e-3 * std::max(rounded.highest - rounded.lowest, std::min(field.cell_size_x, field.cell_size_y)))
+    throw IoError(path,
+                  "its heights (" + exactNumber(rounded.lowest) + " .. " + exactNumber(rounded.highest) +
+                      ") lie so far from 0 that float32, in which hfvis computes, rounds them by up to " +
+                      shortNumber(rounded.rounding) +
+                      ", more than a thousandth of their range: subtract a "
+                      "constant from them first");
   field.z_scale = options.z_scale;
   return field;
 }
