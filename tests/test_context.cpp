@@ -1,16 +1,19 @@
 // test_context.cpp: ContextOptions and ComputeContext: the library reads no environment
 // variable itself; fromEnvironment() maps HFVIS_* onto options; a context is never empty.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <type_traits>
 
+#include "core/opencl_context.hpp"
+#include "core/sweep_framework.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
 #include "hfvis_testing/synthetic_fields.hpp"
-#include "core/opencl_context.hpp"
-#include "core/sweep_framework.hpp"
 #include "test_support.hpp"
 
 namespace hfvis {
@@ -98,6 +101,35 @@ TEST(ComputeContext, KernelDirectoryThatLacksTheKernelsIsAnIoError) {
   HorizonOutputs outputs;
   outputs.sky_view_factor = true;
   EXPECT_THROW(computeHorizons(context, makeSyntheticField("noise", 9, 7, 1), horizon, outputs), IoError);
+}
+
+// A kernel directory whose kernel is a FIFO (the read blocked for good), a directory or an empty
+// file (a bare OpenCL error -46): an IoError naming the file, at once.
+TEST(ComputeContext, KernelFilesThatAreNotTextAreIoErrors) {
+  const std::filesystem::path dir = std::filesystem::path(HFVIS_TEST_TMP_DIR) / "odd_kernels";
+  HorizonOptions horizon;
+  horizon.directions = 4;
+  HorizonOutputs outputs;
+  outputs.sky_view_factor = true;
+  for (const char* kind : {"fifo", "directory", "empty"}) {
+    SCOPED_TRACE(kind);
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    const std::string kernel = (dir / "horizon.cl").string();
+    if (std::string(kind) == "fifo") ASSERT_EQ(::mkfifo(kernel.c_str(), 0600), 0);
+    if (std::string(kind) == "directory") std::filesystem::create_directory(kernel);
+    if (std::string(kind) == "empty") std::ofstream{kernel};
+    ContextOptions options = ContextOptions::fromEnvironment();
+    options.kernel_dir = dir.string();
+    const ComputeContext context = ComputeContext::create(options);
+    try {
+      computeHorizons(context, makeSyntheticField("noise", 9, 7, 1), horizon, outputs);
+      ADD_FAILURE() << "a run with the kernel as a " << kind;
+    } catch (const IoError& error) {
+      EXPECT_EQ(error.path(), kernel);
+    }
+  }
+  std::filesystem::remove_all(dir);
 }
 
 TEST(ComputeContext, UnknownDeviceListsTheDevices) {

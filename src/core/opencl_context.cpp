@@ -189,6 +189,12 @@ const FoundDevice& selectDevice(const std::vector<FoundDevice>& devices, const s
 std::string kernelSource(const std::string& file, const std::string& kernel_dir, std::string* include_dir) {
   if (!kernel_dir.empty()) {
     const std::string path = kernel_dir + "/" + file;
+    // (a FIFO there blocked for good, a directory or an empty file gave a bare OpenCL error)
+    struct stat status {};
+    if (::stat(path.c_str(), &status) != 0 || !S_ISREG(status.st_mode) || status.st_size == 0)
+      throw IoError(path,
+                    "cannot read kernel source: not a regular file with text (a kernel directory, "
+                    "HFVIS_KERNEL_DIR, is set)");
     std::ifstream in(path);
     if (!in) throw IoError(path, "cannot read kernel source (a kernel directory is set)");
     std::ostringstream text;
