@@ -68,7 +68,8 @@ std::atomic<bool> g_returning{false};
 void explainAnExitFromALibrary() {
   if (g_returning.load()) return;
   hfvis::detail::removeTemporaryFilesNow();
-  std::string why = "the OpenCL driver ended the run (its message above); no output was written";
+  std::string why =
+      "a library (such as the OpenCL driver) ended the run (its message above); no output was written";
   rlimit limit{};
   if (::getrlimit(RLIMIT_FSIZE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY)
     why += ". The file size limit (ulimit -f) is " + std::to_string(limit.rlim_cur) +

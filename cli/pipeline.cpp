@@ -285,9 +285,10 @@ bool sameFile(const std::string& a, const std::string& b) {
   if (fs::exists(a, error) && fs::exists(b, error)) return fs::equivalent(a, b, error);
   const auto where = [](const std::string& path) {
     std::error_code failed;
-    const fs::path target = fs::absolute(hfvis::detail::resolvedTarget(path), failed).lexically_normal();
+    const fs::path target = fs::absolute(hfvis::detail::resolvedTarget(path), failed);
+    // (links in it resolved before ".." is folded: "link/../h.exr" lies in the link's target's parent)
     const fs::path canonical = fs::weakly_canonical(target, failed);
-    return failed ? target : canonical;
+    return failed ? target.lexically_normal() : canonical;
   };
   return where(a) == where(b);
 }

@@ -116,7 +116,9 @@ TEST(ComputeContext, KernelFilesThatAreNotTextAreIoErrors) {
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
     const std::string kernel = (dir / "horizon.cl").string();
-    if (std::string(kind) == "fifo") ASSERT_EQ(::mkfifo(kernel.c_str(), 0600), 0);
+    if (std::string(kind) == "fifo") {
+      ASSERT_EQ(::mkfifo(kernel.c_str(), 0600), 0);
+    }
     if (std::string(kind) == "directory") std::filesystem::create_directory(kernel);
     if (std::string(kind) == "empty") std::ofstream{kernel};
     ContextOptions options = ContextOptions::fromEnvironment();

@@ -1088,6 +1088,7 @@ TEST(GdalRasters, AClaimedSizeIsNotAllocatedBeforeTheRowsAreRead) {
   writeClaimingTiff(path, kSide);
   const pid_t child = ::fork();
   if (child == 0) {
+    ::alarm(120);  // (a hang ends the child, and fails the test, instead of holding the suite)
     rusage before{}, after{};
     ::getrusage(RUSAGE_SELF, &before);
     int status = 3;
@@ -1110,8 +1111,8 @@ TEST(GdalRasters, AClaimedSizeIsNotAllocatedBeforeTheRowsAreRead) {
 }
 
 // A complex band is refused (GDAL gave its real part alone), and so are heights that float32 rounds
-// by more than a thousandth of their range and of a cell (UInt32 heights near 4e9 with walls of
-// 50 came out flat, exit 0). Heights near 4000 in float64 over a range of 0.1 are not.
+// by more than a thousandth of their range and a hundredth of a cell (UInt32 heights near 4e9 with
+// walls of 50 came out flat, exit 0). Heights near 4000 in float64 over a range of 0.1 are not.
 TEST(GdalRasters, ComplexBandsAndHeightsFloat32CannotHoldAreRefused) {
   testing::registerGdal();
   const std::string path = std::string(HFVIS_TEST_TMP_DIR) + "/typed.tif";
@@ -1143,6 +1144,23 @@ TEST(GdalRasters, ComplexBandsAndHeightsFloat32CannotHoldAreRefused) {
   write(GDT_Float64, {4000.0, 4000.1, 4000.05, 4000.02, 4000.0, 4000.03, 4000.07, 4000.01});
   EXPECT_EQ(refusal(), "(read)");
   EXPECT_FLOAT_EQ(readHeightField(path).heights[1], 4000.1f);
+  // The same on cells of 0.1 (a flat roof in a LiDAR DSM): a float32 file rounds as much.
+  {
+    GDALDatasetH dataset = GDALOpen(path.c_str(), GA_Update);
+    std::array<double, 6> geotransform = {500000.0, 0.1, 0.0, 4100000.0, 0.0, -0.1};
+    ASSERT_EQ(GDALSetGeoTransform(dataset, geotransform.data()), CE_None);
+    GDALClose(dataset);
+  }
+  EXPECT_EQ(refusal(), "(read)");
+  // Heights near 1e6 on those cells round by 0.06: over a hundredth of a cell, and of the range.
+  write(GDT_Float64, {1e6, 1e6 + 0.1, 1e6 + 0.05, 1e6 + 0.02, 1e6, 1e6 + 0.03, 1e6 + 0.07, 1e6 + 0.01});
+  {
+    GDALDatasetH dataset = GDALOpen(path.c_str(), GA_Update);
+    std::array<double, 6> geotransform = {500000.0, 0.1, 0.0, 4100000.0, 0.0, -0.1};
+    ASSERT_EQ(GDALSetGeoTransform(dataset, geotransform.data()), CE_None);
+    GDALClose(dataset);
+  }
+  EXPECT_NE(refusal().find("a hundredth of a cell"), std::string::npos) << refusal();
 }
 
 // GDAL's ASCII grid readers take a value that is not a number as 0 (or as its leading digits):

@@ -57,7 +57,8 @@ std::vector<Candidate> allCandidates(double cell_size_x, double cell_size_y) {
   return all;
 }
 
-// allCandidates for the field's cell size, kept for the last few cell sizes asked: about 10,000
+// allCandidates for the field's cell size, kept for the last 8 cell sizes first asked (the oldest
+// dropped): about 10,000
 // steps, an atan2 each and a sort, about a millisecond, which every run's direction set and each K
 // that max_error's chooser weighs (horizonWork) would pay again (several times a small run's own
 // sweep at 128^2).

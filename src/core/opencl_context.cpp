@@ -233,9 +233,11 @@ cl::Program ContextState::programFromSource(const std::string& file, const std::
     } catch (const cl::Error&) {
       log = "(no build log)";
     }
-    // A driver that compiles through files (PoCL) fails with a bare line under a small `ulimit -f`.
+    // A driver that compiles through files (PoCL) fails with a bare line under a small `ulimit -f`
+    // (its files are about a megabyte: a limit of 64 MiB or more is not named).
     rlimit limit{};
-    if (::getrlimit(RLIMIT_FSIZE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY)
+    if (::getrlimit(RLIMIT_FSIZE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY &&
+        limit.rlim_cur < (64u << 20))
       log += "\n(the file size limit, ulimit -f, is " + std::to_string(limit.rlim_cur) +
              " bytes: the OpenCL driver may write its compiled kernels to files, which a limit this small "
              "stops)";

@@ -268,22 +268,23 @@ class CheckedExrFile final : public Imf::OStream {
   std::uint64_t position_ = 0;
 };
 
-// The part of a multi-part file to read: the first, or the one part that holds the channel named
-// `channel` (a channel of another part is reachable by its name; an index counts in the first
-// part). Throws IoError when several parts hold it, or none does (listing every part's channels).
+// The part of a multi-part file to read: the first, where it holds the channel named `channel`
+// (or none is named: as before, and a stereo file's R is its first view's), else the one other
+// part that holds it (an index counts in the first part). Throws IoError when the first lacks it
+// and several others hold it, or none does (listing every part's channels).
 int partToRead(const std::string& path, const Imf::MultiPartInputFile& file, const std::string* channel) {
   const int parts = file.parts();
-  if (parts <= 1 || !channel || channel->empty()) return 0;
+  if (parts <= 1 || !channel || channel->empty() || file.header(0).channels().findChannel(*channel)) return 0;
   std::vector<int> holding;
-  for (int p = 0; p < parts; ++p)
+  for (int p = 1; p < parts; ++p)
     if (file.header(p).channels().findChannel(*channel)) holding.push_back(p);
   if (holding.size() == 1) return holding.front();
   const auto partName = [&](int p) {
     return "part " + std::to_string(p) + (file.header(p).hasName() ? " '" + file.header(p).name() + "'" : "");
   };
   if (holding.size() > 1)
-    throw IoError(path, "channel '" + *channel + "' is in " + partName(holding[0]) + " and in " +
-                            partName(holding[1]) +
+    throw IoError(path, "channel '" + *channel + "' is not in part 0 but in " + partName(holding[0]) +
+                            " and in " + partName(holding[1]) +
                             "; hfvis reads one part (split the file: exrmultipart -separate)");
   // None by name: an index, or a name part 0 lacks too (its error then lists every part).
   const std::vector<std::string> first = channelOrder(file.header(0).channels());

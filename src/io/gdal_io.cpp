@@ -3,6 +3,7 @@
 
 #include <cpl_conv.h>
 #include <cpl_error.h>
+#include <cpl_minixml.h>
 #include <cpl_string.h>
 #include <gdal.h>
 #include <ogr_srs_api.h>
@@ -14,7 +15,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -22,6 +22,7 @@
 #include <mutex>
 #include <new>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -71,8 +72,7 @@ void requireNumbersInAsciiGrid(const std::string& path) {
   const auto check = [&]() {
     if (token.empty()) return;
     if (header && line_start) {
-      std::string key = token;
-      if (!key.empty() && key.back() == ':') key.pop_back();
+      std::string key = token.substr(0, token.find(':'));  // (GRASS writes "north: 3" or "north:3")
       std::transform(key.begin(), key.end(), key.begin(), [](unsigned char c) { return std::tolower(c); });
       key_line = std::find_if(std::begin(kKeys), std::end(kKeys), [&](const char* k) { return key == k; }) !=
                  std::end(kKeys);
@@ -83,9 +83,10 @@ void requireNumbersInAsciiGrid(const std::string& path) {
       char* end = nullptr;
       std::strtod(token.c_str(), &end);
       if (token.size() > 256 || end != token.c_str() + token.size())
-        throw IoError(path,
-                      "line " + std::to_string(line) + ": '" + token.substr(0, 40) +
-                          "' is not a number (GDAL's ASCII grid reader would read 0 or its leading digits)");
+        throw IoError(
+            path, "line " + std::to_string(line) + ": '" + token.substr(0, 40) +
+                      "' is not a number (GDAL's ASCII grid reader would read 0 or its leading digits; write "
+                      "nodata as the number the header names)");
     }
     token.clear();
   };
@@ -104,67 +105,70 @@ void requireNumbersInAsciiGrid(const std::string& path) {
   check();
 }
 
-// The XML text `path` holds when it is a VRT (GDAL knows one by its contents, whatever its name),
-// else "".
-std::string vrtText(const std::string& path) {
+// Whether `path` is a VRT: "<VRTDataset" within its first 1024 bytes (as GDAL knows one, whatever
+// its name, an XML prolog before it or not).
+bool isVrt(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  std::string head(64, '\0');
+  std::string head(1024, '\0');
   in.read(head.data(), static_cast<std::streamsize>(head.size()));
   head.resize(static_cast<std::size_t>(in.gcount()));
-  const std::size_t first = head.find_first_not_of(" \t\r\n");
-  if (first == std::string::npos || head.compare(first, 11, "<VRTDataset") != 0) return "";
-  in.seekg(0);
-  std::string text;
-  // (a VRT is a description: a few kB; one of more than 64 MiB is read no further)
-  text.resize(std::size_t(64) << 20);
-  in.read(text.data(), static_cast<std::streamsize>(text.size()));
-  text.resize(static_cast<std::size_t>(in.gcount()));
-  return text;
+  return head.find("<VRTDataset") != std::string::npos;
 }
 
-// XML's five entities in a source name.
-std::string xmlUnescaped(std::string text) {
-  static const std::pair<const char*, const char*> kEntities[] = {
-      {"&lt;", "<"}, {"&gt;", ">"}, {"&quot;", "\""}, {"&apos;", "'"}, {"&amp;", "&"}};
-  for (const auto& [entity, character] : kEntities)
-    for (std::size_t at = text.find(entity); at != std::string::npos; at = text.find(entity, at + 1))
-      text.replace(at, std::strlen(entity), character);
-  return text;
+// The files a VRT's XML names as sources, depth first: every SourceFilename and SourceDataset (a
+// warped VRT's), relative to the VRT where relativeToVRT says so (GDAL's own reading of it).
+void vrtSourceNames(const CPLXMLNode* node, const std::filesystem::path& directory,
+                    std::vector<std::string>* names) {
+  for (; node; node = node->psNext) {
+    if (node->eType != CXT_Element) continue;
+    const std::string element = node->pszValue;
+    if (element == "SourceFilename" || element == "SourceDataset") {
+      const char* text = CPLGetXMLValue(node, nullptr, "");
+      const bool relative = CPLTestBool(CPLGetXMLValue(node, "relativeToVRT", "0"));
+      const std::string name = text ? text : "";
+      if (!name.empty())
+        names->push_back(relative && !std::filesystem::path(name).is_absolute() ? (directory / name).string()
+                                                                                : name);
+    }
+    vrtSourceNames(node->psChild, directory, names);
+  }
 }
 
-// The files the VRT `path` names as its sources (its <SourceFilename> elements, relative to the VRT
-// where they say so), and those of the VRTs among them in turn (to a depth of 8; deeper, GDAL
-// refuses the nesting itself), into `files`. Read from the XML before GDAL opens it, because GDAL
-// opens a raw band's file while it opens the VRT: a FIFO there, or /vsistdin/, blocked for good. So
-// a source that is not a regular file where it exists (a FIFO, a device, a directory) or standard
-// input is refused (IoError), as an input of that kind is; other /vsi paths are left to GDAL.
-void collectVrtSources(const std::string& path, int depth, std::vector<std::string>* files) {
-  const std::string text = vrtText(path);
-  if (text.empty() || depth > 8) return;
-  const std::filesystem::path directory = std::filesystem::path(path).parent_path();
-  for (std::size_t at = text.find("<SourceFilename"); at != std::string::npos;
-       at = text.find("<SourceFilename", at + 1)) {
-    const std::size_t open_end = text.find('>', at), close = text.find("</SourceFilename>", at);
-    if (open_end == std::string::npos || close == std::string::npos || close < open_end) break;
-    const std::string attributes = text.substr(at, open_end - at);
-    const bool relative = attributes.find("relativeToVRT=\"1\"") != std::string::npos ||
-                          attributes.find("relativeToVRT='1'") != std::string::npos;
-    std::string name = xmlUnescaped(text.substr(open_end + 1, close - open_end - 1));
-    name.erase(0, name.find_first_not_of(" \t\r\n"));
-    name.erase(name.find_last_not_of(" \t\r\n") + 1);
-    if (name.empty()) continue;
-    if (name.rfind("/vsistdin", 0) == 0)
-      throw IoError(path, "its source '" + name + "' is standard input; hfvis reads files");
-    if (name.rfind("/vsi", 0) == 0) continue;
-    const std::string source =
-        relative && !std::filesystem::path(name).is_absolute() ? (directory / name).string() : name;
-    struct stat status {};
-    if (::stat(source.c_str(), &status) == 0 && !S_ISREG(status.st_mode))
-      throw IoError(path, "its source '" + source + "' is not a regular file; hfvis reads files");
-    if (std::find(files->begin(), files->end(), source) != files->end())
-      continue;  // (a loop: GDAL's to refuse)
-    files->push_back(source);
-    collectVrtSources(source, depth + 1, files);
+// Every file the VRT `path` reads (its sources, and those of the VRTs among them, each file once by
+// device and inode), into `files`. Read from the XML before GDAL opens the VRT, because GDAL opens a
+// raw band's file as it opens the VRT: a FIFO there, or /vsistdin/, blocked for good. So a source
+// that is a FIFO, a socket or a device, or standard input, is refused (IoError), as an input of
+// that kind is (a directory may be a dataset: an ESRI grid); other /vsi paths are GDAL's. At most
+// kMostVrtSources files in all, and nested VRTs to the depth GDAL itself allows.
+void collectVrtSources(const std::string& path, std::vector<std::string>* files) {
+  constexpr std::size_t kMostVrtSources = 100000;
+  constexpr int kMostDepth = 16;
+  std::set<std::pair<dev_t, ino_t>> seen;
+  std::vector<std::pair<std::string, int>> pending{{path, 0}};
+  while (!pending.empty()) {
+    const auto [vrt, depth] = pending.back();
+    pending.pop_back();
+    if (depth > kMostDepth || !isVrt(vrt)) continue;
+    CPLXMLNode* root = CPLParseXMLFile(vrt.c_str());
+    if (!root) continue;  // (GDAL's open says what is wrong with it)
+    std::vector<std::string> names;
+    vrtSourceNames(root, std::filesystem::path(vrt).parent_path(), &names);
+    CPLDestroyXMLNode(root);
+    for (const std::string& name : names) {
+      if (name.rfind("/vsistdin", 0) == 0)
+        throw IoError(path, "its source '" + name + "' is standard input; hfvis reads files");
+      if (name.rfind("/vsi", 0) == 0) continue;
+      struct stat status {};
+      if (::stat(name.c_str(), &status) != 0) continue;  // (GDAL's open names what is missing)
+      if (S_ISFIFO(status.st_mode) || S_ISSOCK(status.st_mode) || S_ISCHR(status.st_mode) ||
+          S_ISBLK(status.st_mode))
+        throw IoError(path, "its source '" + name + "' is not a regular file; hfvis reads files");
+      if (!seen.insert({status.st_dev, status.st_ino}).second) continue;
+      if (files->size() >= kMostVrtSources)
+        throw IoError(path, "it names more than " + std::to_string(kMostVrtSources) + " source files");
+      files->push_back(name);
+      if (S_ISREG(status.st_mode)) pending.emplace_back(name, depth + 1);
+    }
   }
 }
 
@@ -172,7 +176,7 @@ Dataset openRaster(const std::string& path) {
   registerOnce();
   requireInputFile(path);
   std::vector<std::string> sources;
-  collectVrtSources(path, 0, &sources);
+  collectVrtSources(path, &sources);
   Dataset dataset(GDALOpen(path.c_str(), GA_ReadOnly));
   if (!dataset) throw IoError(path, lastError());
   const std::string driver = GDALGetDriverShortName(GDALGetDatasetDriver(dataset.get()));
@@ -245,7 +249,11 @@ std::vector<float> readBand(const std::string& path, GDALDatasetH dataset, int b
     const std::size_t count = std::size_t(width) * rows;
     raw.resize(count);
     try {
-      values.resize(std::size_t(width) * (y0 + rows));
+      // (grown as a vector grows, but never past the whole raster: no spare capacity kept)
+      const std::size_t needed = std::size_t(width) * (y0 + rows), whole = std::size_t(width) * height;
+      if (needed > values.capacity())
+        values.reserve(std::min(whole, std::max(needed, 2 * values.capacity())));
+      values.resize(needed);
     } catch (const std::bad_alloc&) {
       throw IoError(path, "raster is too large to hold in memory (" + std::to_string(width) + " x " +
                               std::to_string(height) + " pixels)");
@@ -446,8 +454,8 @@ std::vector<std::string> gdalFilesRead(const std::string& path) {
   std::vector<std::string> files{path};
   struct stat status {};
   if (::stat(path.c_str(), &status) != 0 || !S_ISREG(status.st_mode)) return files;  // (reading says why)
-  collectVrtSources(path, 0, &files);
-  registerOnce();
+  registerOnce();  // (before the VRT's XML is parsed: GDAL's errors go through IoError, not stderr)
+  collectVrtSources(path, &files);
   const Dataset dataset(GDALOpen(path.c_str(), GA_ReadOnly));
   if (!dataset) return files;
   char** listed = GDALGetFileList(dataset.get());
@@ -523,15 +531,15 @@ HeightField readGdalHeightField(const std::string& path, const HeightFieldReadOp
   }
   // Heights rounded to float32 must keep their differences: UInt32 heights near 4e9 round by up
   // to 256, and walls of 50 vanished (exit 0). A rounding above a thousandth of the heights' range
-  // and of a cell is refused (a slope error of 0.1 %; a flat lake at 4000 m in float64, rounded by
-  // 2e-4 over a range of 0.1, is not).
-  if (rounded.rounding >
-      1e-3 * std::max(rounded.highest - rounded.lowest, std::min(field.cell_size_x, field.cell_size_y)))
+  // and above a hundredth of a cell (a slope error of 1 % across a cell) is refused. A float64 DSM
+  // of a flat roof at 4000 on cells of 0.1, rounded by 2.4e-4 as a float32 one is, passes.
+  if (rounded.rounding > std::max(1e-3 * (rounded.highest - rounded.lowest),
+                                  1e-2 * std::min(field.cell_size_x, field.cell_size_y)))
     throw IoError(path,
                   "its heights (" + exactNumber(rounded.lowest) + " .. " + exactNumber(rounded.highest) +
                       ") lie so far from 0 that float32, in which hfvis computes, rounds them by up to " +
                       shortNumber(rounded.rounding) +
-                      ", more than a thousandth of their range: subtract a "
+                      ", more than a thousandth of their range and a hundredth of a cell: subtract a "
                       "constant from them first");
   field.z_scale = options.z_scale;
   return field;

@@ -162,7 +162,7 @@ void removeTemporaryFilesNow() {
     if (slot.state.load() == kReady) ::unlink(slot.path);
 }
 
-void requireReplaceableTarget(const std::string& path, const std::string& target) {
+void requireReplaceableTarget(const std::string& path, const std::string& target, bool probe) {
   const std::string directory = directoryOf(target);
   struct stat status {};
   if (::stat(directory.c_str(), &status) != 0)
@@ -199,19 +199,24 @@ void requireReplaceableTarget(const std::string& path, const std::string& target
                             : "cannot write here: no permission to create files in '" + directory + "'");
   // The permission bits do not tell it all: root passes them in /proc and /sys, whose directories
   // take no new files, and an immutable directory refuses them whatever its mode. A file created
-  // and removed at once shows that the write will be taken, before any work.
-  const std::string probe = temporaryPathFor(target);
-  rememberTemporary(probe);
-  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
-  const int error = errno;
-  if (fd >= 0) {
-    ::close(fd);
-    ::unlink(probe.c_str());
-  }
-  forgetTemporary(probe);
-  if (fd < 0)
+  // and removed at once shows that the write will be taken, before any work. (Its name is a
+  // temporary file's: one left by a killed run of the same process id is passed over.)
+  if (!probe) return;
+  for (int attempt = 0;; ++attempt) {
+    const std::string name = temporaryPathFor(target);
+    const int fd = ::open(name.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+    const int error = errno;
+    if (fd >= 0) {
+      rememberTemporary(name);
+      ::close(fd);
+      ::unlink(name.c_str());
+      forgetTemporary(name);
+      return;
+    }
+    if (error == EEXIST && attempt < 8) continue;
     throw IoError(path, "cannot write here: creating a file in '" + directory + "' fails (" +
                             writeFailure(error) + ")");
+  }
 }
 
 void requireInputFile(const std::string& path) {
@@ -275,7 +280,7 @@ void syncFile(const std::string& file, const std::string& path) {
 }  // namespace detail
 
 void requireReplaceable(const std::string& path) {
-  detail::requireReplaceableTarget(path, detail::resolvedTarget(path));
+  detail::requireReplaceableTarget(path, detail::resolvedTarget(path), true);
 }
 
 OutputFiles::~OutputFiles() { discard(); }

@@ -28,8 +28,10 @@ void forgetTemporary(const std::string& path);
 void removeTemporaryFilesNow();
 
 // Throws IoError naming `path` when hfvis must not replace the file at `target` (the resolved
-// path): see requireReplaceable in hfvis/image_io.hpp.
-void requireReplaceableTarget(const std::string& path, const std::string& target);
+// path): see requireReplaceable in hfvis/image_io.hpp. `probe`: also create a file in its
+// directory and remove it (the check before any work: whether the directory takes files at all;
+// staging and committing need no such probe, their temporary files show it).
+void requireReplaceableTarget(const std::string& path, const std::string& target, bool probe = false);
 
 // Throws IoError naming `path` unless it is a regular file with something in it: a directory,
 // a device (/dev/zero would be read forever), a FIFO or a socket is refused before it is opened.
