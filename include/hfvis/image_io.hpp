@@ -97,7 +97,8 @@ bool writesGeoTiff(const std::string& path);
 void requireImageWriter(const std::string& path);
 
 // Throws IoError naming `path` when hfvis must not write an output there, before anything is
-// computed: its directory is missing or takes no new files for this user, or a file is there that
+// computed: its directory is missing or takes no new files for this user (a file is created there
+// and removed at once to know: /proc passes the superuser's access check), or a file is there that
 // is a directory or not a regular file, or that is protected: one the effective user may not
 // write (access(2) with AT_EACCESS), one with no write permission for anybody (mode 0444; the
 // superuser may write anything, so the mode bits are the owner's statement), or one marked

@@ -58,10 +58,9 @@ std::vector<Candidate> allCandidates(double cell_size_x, double cell_size_y) {
 }
 
 // allCandidates for the field's cell size, kept for the last 8 cell sizes first asked (the oldest
-// dropped): about 10,000
-// steps, an atan2 each and a sort, about a millisecond, which every run's direction set and each K
-// that max_error's chooser weighs (horizonWork) would pay again (several times a small run's own
-// sweep at 128^2).
+// dropped): about 10,000 steps, an atan2 each and a sort, about a millisecond, which every run's
+// direction set and each K that max_error's chooser weighs (horizonWork) would pay again (several
+// times a small run's own sweep at 128^2).
 std::shared_ptr<const std::vector<Candidate>> candidates(const HeightField& field) {
   using Key = std::pair<double, double>;
   static std::mutex mutex;

@@ -197,17 +197,18 @@ void requireReadable(const std::string& path, GDALDatasetH dataset, int bands, s
                             " is more than the " + std::to_string(limit >> 20) + " MiB read at most");
 }
 
+// What reading heights into float32 rounded: the largest rounding, and the range of the values.
+struct HeightRounding {
+  double rounding = 0.0, lowest = INFINITY, highest = -INFINITY;
+};
+
 // Band `band_index` (zero-based) as float32: its values times the band's scale plus its offset
 // (an int16 DEM of decimetres with a scale of 0.1 is metres), NaN where the band's nodata value
 // is and, with `masks` (heights), where its mask (a per-dataset mask, an alpha band, a mask band of
 // its own) says no data; an image's alpha stays ignored (image_io.hpp). Read as float64 in blocks
 // of rows (whole blocks of the file's), so that nodata compares in the band's own type and a
 // value beyond float32's range is refused rather than made infinite (it would pass for nodata).
-// What reading heights into float32 rounded: the largest rounding, and the range of the values.
-struct HeightRounding {
-  double rounding = 0.0, lowest = INFINITY, highest = -INFINITY;
-};
-
+// `rounded`: where given, what the conversion to float32 rounded (for the caller to judge).
 std::vector<float> readBand(const std::string& path, GDALDatasetH dataset, int band_index, bool masks,
                             HeightRounding* rounded = nullptr) {
   const int width = GDALGetRasterXSize(dataset), height = GDALGetRasterYSize(dataset);
