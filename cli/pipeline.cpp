@@ -1,6 +1,7 @@
 // cli/pipeline.cpp: the pipeline every command that reads a height field runs, and its helpers.
 #include "pipeline.hpp"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -290,7 +291,14 @@ bool sameFile(const std::string& a, const std::string& b) {
     const fs::path canonical = fs::weakly_canonical(target, failed);
     return failed ? target.lexically_normal() : canonical;
   };
-  return where(a) == where(b);
+  const fs::path place_a = where(a), place_b = where(b);
+  if (place_a == place_b) return true;
+  // One directory under two paths (a bind mount): the same name in it is the same file.
+  struct stat parent_a {
+  }, parent_b{};
+  return place_a.filename() == place_b.filename() && ::stat(place_a.parent_path().c_str(), &parent_a) == 0 &&
+         ::stat(place_b.parent_path().c_str(), &parent_b) == 0 && parent_a.st_dev == parent_b.st_dev &&
+         parent_a.st_ino == parent_b.st_ino;
 }
 
 // Every output can be written, none is an input (an output never replaces an input), and no

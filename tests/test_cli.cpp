@@ -538,6 +538,23 @@ TEST_F(Cli, TwoOutputsThatAreOneNewFileAreRefused) {
   EXPECT_EQ(listDirectory(outputs()), std::vector<std::string>{"link.exr"});
 }
 
+// One directory under two paths (a bind mount): a new file's name in it under either is one
+// file; the distances replaced the angles, exit 0. A bind mount needs privileges a container may
+// lack: the test says so and is skipped then.
+TEST_F(Cli, TwoOutputsInOneDirectoryMountedTwiceAreRefused) {
+  fs::create_directories(out("a"));
+  fs::create_directories(out("b"));
+  const std::string a = out("a"), b = out("b");
+  if (std::system(("mount --bind " + shellQuoted(a) + " " + shellQuoted(b) + " 2>/dev/null").c_str()) != 0)
+    GTEST_SKIP() << "mount --bind is not permitted here";
+  const CliResult result = run("horizon " + shellQuoted(ramp()) + " -k 4 -o " + shellQuoted(a + "/h.exr") +
+                               " --distance-out " + shellQuoted(b + "/h.exr"));
+  std::system(("umount " + shellQuoted(b)).c_str());
+  EXPECT_EQ(result.status, 2) << result.err;
+  EXPECT_NE(result.err.find("are the same file"), std::string::npos) << result.err;
+  EXPECT_TRUE(listDirectory(out("a")).empty());
+}
+
 // A VRT input reads the files it names: none of them may be an output (the source GeoTIFF was
 // replaced, exit 0), and one that is not a regular file (a FIFO: GDAL opened a raw band's file
 // with the VRT and blocked for good), or standard input, is refused before it is opened.
@@ -560,6 +577,22 @@ TEST_F(Cli, AVrtsSourcesAreInputsToo) {
   EXPECT_EQ(replaced.status, 2) << replaced.err;
   EXPECT_NE(replaced.err.find("outputs never replace an input"), std::string::npos) << replaced.err;
   EXPECT_EQ(readText(tif), tif_before);
+  // Nor through the names GDAL gives a file: a VRT, a GeoTIFF directory, a part of a file.
+  for (const std::string& spelt : {"vrt://" + tif, "GTIFF_DIR:1:" + tif, "/vsisubfile/0_0," + tif}) {
+    SCOPED_TRACE(spelt);
+    {
+      std::ofstream(in("spelt.vrt")) << "<VRTDataset rasterXSize=\"20\" rasterYSize=\"16\">\n"
+                                        "  <VRTRasterBand dataType=\"Float32\" band=\"1\">\n"
+                                        "    <SimpleSource><SourceFilename>"
+                                     << spelt
+                                     << "</SourceFilename><SourceBand>1</SourceBand></SimpleSource>\n"
+                                        "  </VRTRasterBand>\n</VRTDataset>\n";
+    }
+    const CliResult spelt_over =
+        run("svf " + shellQuoted(in("spelt.vrt")) + " -o " + shellQuoted(tif) + " -k 4");
+    EXPECT_EQ(spelt_over.status, 2) << spelt_over.err;
+    EXPECT_EQ(readText(tif), tif_before);
+  }
   // (the VRT itself reads as its source does)
   const CliResult through = run("svf " + shellQuoted(vrt) + " -o " + shellQuoted(out("s.exr")) + " -k 4 -q");
   EXPECT_EQ(through.status, 0) << through.err;
@@ -586,6 +619,11 @@ TEST_F(Cli, AVrtsSourcesAreInputsToo) {
         run("svf " + shellQuoted(in("raw.vrt")) + " -o " + shellQuoted(out("s.exr")) + " -k 4", "timeout 60");
     expectFailure(blocked, 1, name.substr(name.find(':') + 1));
   }
+  // A FIFO beside a raster, where GDAL looks for its auxiliary metadata, blocked the read too.
+  ASSERT_EQ(::mkfifo((tif + ".aux.xml").c_str(), 0600), 0);
+  const CliResult sidecar =
+      run("svf " + shellQuoted(tif) + " -o " + shellQuoted(out("s.exr")) + " -k 4", "timeout 60");
+  expectFailure(sidecar, 1, "dem.tif.aux.xml");
 }
 
 // A cell size from the file's georeference goes through --cell-size's range as the option does:

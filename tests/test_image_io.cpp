@@ -1163,8 +1163,9 @@ TEST(GdalRasters, ComplexBandsAndHeightsFloat32CannotHoldAreRefused) {
   EXPECT_NE(refusal().find("a hundredth of a cell"), std::string::npos) << refusal();
 }
 
-// GDAL's ASCII grid readers take a value that is not a number as 0 (or as its leading digits):
-// such a grid is refused, naming the line and the value, in ESRI's format and in GRASS's.
+// GDAL's ASCII grid readers take a value that is not a number as 0 (or as its leading digits), and
+// read the values in order whatever the lines: such a grid, or one whose values are too few or too
+// many for its header, is refused, in ESRI's format and in GRASS's.
 TEST(GdalRasters, AsciiGridValuesThatAreNotNumbersAreRefused) {
   const std::string path = std::string(HFVIS_TEST_TMP_DIR) + "/words.asc";
   const std::string esri = "ncols 3\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\nNODATA_value -9999\n";
@@ -1186,7 +1187,24 @@ TEST(GdalRasters, AsciiGridValuesThatAreNotNumbersAreRefused) {
     const HeightField field = readHeightField(path);
     EXPECT_EQ(field.heights[3], -4.5f);
     EXPECT_EQ(field.heights[4], 0.5f);
+    // A value short, or one too many (GDAL read them in order: 0 for the missing last one, or
+    // every later row shifted).
+    for (const std::string& values : {std::string("1 2 3\n4 5\n"), std::string("1 2 3 9\n4 5 6\n")}) {
+      { std::ofstream(path) << header << values; }
+      try {
+        readHeightField(path);
+        ADD_FAILURE() << "read " << values;
+      } catch (const IoError& error) {
+        EXPECT_NE(error.reason().find("values where its header says 3 columns of 2 rows"), std::string::npos)
+            << error.what();
+      }
+    }
   }
+  // GRASS's null token (and its keys written without a space) is read as nodata.
+  { std::ofstream(path) << "north:2\nsouth:0\neast:3\nwest:0\nrows:2\ncols:3\nnull: *\n1 * 3\n4 5 6\n"; }
+  const HeightField grass_field = readHeightField(path);
+  EXPECT_TRUE(std::isnan(grass_field.heights[1]));
+  EXPECT_EQ(grass_field.heights[5], 6.0f);
 }
 
 }  // namespace

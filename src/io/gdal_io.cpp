@@ -18,6 +18,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <new>
@@ -56,9 +57,12 @@ struct DatasetCloser {
 using Dataset = std::unique_ptr<void, DatasetCloser>;
 
 // GDAL's ASCII grid readers (ESRI's and GRASS's) take a value that is not a number as 0 or as its
-// leading digits: `abc` would become ground at height 0, `1,5` at 1. So every value after the header must be
-// a number as a whole (strtod's forms, nan and inf included: those are refused later as heights). The header:
-// the lines before the first value, each led by one of the formats' keys.
+// leading digits (`abc` became ground at height 0, `1,5` at 1), and read the values in order
+// whatever the lines (a missing last value became 0; 17 a row under ncols 16 sheared the grid).
+// So every value after the header must be a number as a whole (strtod's forms, nan and inf
+// included: those are refused later as heights) or GRASS's null token, and there must be as many
+// as the header's columns times rows. The header: the lines before the first value, each led by
+// one of the formats' keys ("key value", or GRASS's "key: value" and "key:value").
 void requireNumbersInAsciiGrid(const std::string& path) {
   static const char* const kKeys[] = {"ncols",     "nrows",    "xllcorner", "xllcenter", "yllcorner",
                                       "yllcenter", "cellsize", "dx",        "dy",        "nodata_value",
@@ -66,27 +70,47 @@ void requireNumbersInAsciiGrid(const std::string& path) {
                                       "cols",      "null",     "type",      "multiplier"};
   std::ifstream in(path, std::ios::binary);
   std::vector<char> buffer(std::size_t(1) << 20);
-  std::string token;
-  bool header = true, line_start = true, key_line = false;
-  long long line = 1;
+  std::string token, key;  // key: the header line's, until its value
+  std::map<std::string, std::string> values_of;
+  bool header = true, line_start = true;
+  long long line = 1, count = 0;
   const auto check = [&]() {
     if (token.empty()) return;
     if (header && line_start) {
-      std::string key = token.substr(0, token.find(':'));  // (GRASS writes "north: 3" or "north:3")
+      const std::size_t colon = token.find(':');
+      key = token.substr(0, colon);
       std::transform(key.begin(), key.end(), key.begin(), [](unsigned char c) { return std::tolower(c); });
-      key_line = std::find_if(std::begin(kKeys), std::end(kKeys), [&](const char* k) { return key == k; }) !=
-                 std::end(kKeys);
-      if (!key_line) header = false;
+      if (std::find_if(std::begin(kKeys), std::end(kKeys), [&](const char* k) { return key == k; }) ==
+          std::end(kKeys)) {
+        header = false;
+        key.clear();
+      } else if (colon != std::string::npos && colon + 1 < token.size()) {
+        values_of[key] = token.substr(colon + 1);
+        key.clear();
+      }
+      if (header) {
+        line_start = false;
+        token.clear();
+        return;
+      }
+    } else if (header && !key.empty()) {
+      values_of[key] = token;
+      key.clear();
+      token.clear();
+      return;
     }
     line_start = false;
     if (!header) {
       char* end = nullptr;
       std::strtod(token.c_str(), &end);
-      if (token.size() > 256 || end != token.c_str() + token.size())
+      const auto null = values_of.find("null");
+      if ((token.size() > 256 || end != token.c_str() + token.size()) &&
+          !(null != values_of.end() && token == null->second))
         throw IoError(
             path, "line " + std::to_string(line) + ": '" + token.substr(0, 40) +
                       "' is not a number (GDAL's ASCII grid reader would read 0 or its leading digits; write "
                       "nodata as the number the header names)");
+      ++count;
     }
     token.clear();
   };
@@ -103,6 +127,16 @@ void requireNumbersInAsciiGrid(const std::string& path) {
     }
   }
   check();
+  const auto whole = [&](const char* name, const char* other) -> long long {
+    const auto found = values_of.count(name) ? values_of.find(name) : values_of.find(other);
+    return found == values_of.end() ? -1 : std::atoll(found->second.c_str());
+  };
+  const long long columns = whole("ncols", "cols"), rows = whole("nrows", "rows");
+  if (columns > 0 && rows > 0 && count != columns * rows)
+    throw IoError(path, "it holds " + std::to_string(count) + " values where its header says " +
+                            std::to_string(columns) + " columns of " + std::to_string(rows) +
+                            " rows (GDAL would read them in order, shifting every row after a missing or an "
+                            "extra one)");
 }
 
 // Whether `path` is a VRT: "<VRTDataset" within its first 1024 bytes (as GDAL knows one, whatever
@@ -134,15 +168,78 @@ void vrtSourceNames(const CPLXMLNode* node, const std::filesystem::path& directo
   }
 }
 
+// The local file a GDAL dataset name reads, through the wrappers that name one ("vrt://PATH?...",
+// "GTIFF_DIR:N:PATH", "/vsisubfile/OFFSET_SIZE,PATH", "/vsigzip/PATH", an archive's
+// "/vsizip/PATH/member"); "" where it names none (a network or memory file). A source spelt so had
+// been no input (an output replaced it) and a FIFO behind it blocked the read.
+std::string localFileOf(std::string name) {
+  for (int unwrap = 0; unwrap < 8; ++unwrap) {
+    if (name.rfind("vrt://", 0) == 0) {
+      name = name.substr(6, name.find('?') == std::string::npos ? std::string::npos : name.find('?') - 6);
+    } else if (name.rfind("GTIFF_DIR:", 0) == 0 && name.find(':', 10) != std::string::npos) {
+      name = name.substr(name.find(':', 10) + 1);
+    } else if (name.rfind("/vsisubfile/", 0) == 0 && name.find(',') != std::string::npos) {
+      name = name.substr(name.find(',') + 1);
+    } else if (name.rfind("/vsigzip/", 0) == 0) {
+      name = name.substr(8);
+    } else if (name.rfind("/vsizip/", 0) == 0 || name.rfind("/vsitar/", 0) == 0 ||
+               name.rfind("/vsi7z/", 0) == 0 || name.rfind("/vsirar/", 0) == 0) {
+      // the archive: the longest leading part of the path that is not a directory
+      std::filesystem::path rest = name.substr(name.find('/', 1)), archive;
+      std::string found;
+      for (const auto& part : rest) {
+        archive /= part;
+        struct stat status {};
+        if (::stat(archive.c_str(), &status) == 0 && !S_ISDIR(status.st_mode)) found = archive.string();
+        if (!found.empty()) break;
+      }
+      return found;
+    } else if (name.rfind("/vsi", 0) == 0) {
+      return "";  // (/vsicurl/, /vsimem/, /vsis3/ ...: not a local file)
+    } else {
+      return name;
+    }
+  }
+  return "";
+}
+
+// GDAL opens files beside a raster by its name (an overview, a mask, auxiliary metadata, a world
+// file, a projection): a FIFO there blocked the read for good. Refuses (IoError naming `path`) one
+// that is a FIFO, a socket or a device.
+void requireRegularSidecars(const std::string& path, const std::string& file) {
+  static const char* const kSuffixes[] = {".aux.xml", ".ovr",   ".msk", ".aux",    ".prj", ".tfw",
+                                          ".tifw",    ".tiffw", ".wld", ".hdr",    ".rpb", ".imd",
+                                          ".xml",     ".jgw",   ".pgw", "_rpc.txt"};
+  const std::filesystem::path whole(file);
+  std::filesystem::path stem = whole;
+  stem.replace_extension();
+  for (const std::string& base : {whole.string(), stem.string()})
+    for (const char* suffix : kSuffixes)
+      for (const bool upper : {false, true}) {
+        std::string ending = suffix;
+        if (upper)
+          std::transform(ending.begin(), ending.end(), ending.begin(),
+                         [](unsigned char c) { return std::toupper(c); });
+        struct stat status {};
+        const std::string sidecar = base + ending;
+        if (::stat(sidecar.c_str(), &status) == 0 && (S_ISFIFO(status.st_mode) || S_ISSOCK(status.st_mode) ||
+                                                      S_ISCHR(status.st_mode) || S_ISBLK(status.st_mode)))
+          throw IoError(path, "'" + sidecar + "', a file GDAL reads beside '" + file +
+                                  "', is not a regular file; hfvis reads files");
+      }
+}
+
 // Every file the VRT `path` reads (its sources, and those of the VRTs among them, each file once by
-// device and inode), into `files`. Read from the XML before GDAL opens the VRT, because GDAL opens a
-// raw band's file as it opens the VRT: a FIFO there, or /vsistdin/, blocked for good. So a source
-// that is a FIFO, a socket or a device, or standard input, is refused (IoError), as an input of
-// that kind is (a directory may be a dataset: an ESRI grid); other /vsi paths are GDAL's. At most
-// kMostVrtSources files in all, and nested VRTs to the depth GDAL itself allows.
+// device and inode, through the wrappers that name a local file: localFileOf), into `files`. Read
+// from the XML before GDAL opens the VRT, because GDAL opens a raw band's file as it opens the
+// VRT: a FIFO there, or /vsistdin/, blocked for good. So a source that is a FIFO, a socket or a
+// device (or has such a sidecar), or standard input, is refused (IoError), as an input of that
+// kind is (a directory may be a dataset: an ESRI grid); network and memory files are GDAL's. At
+// most kMostVrtSources files in all, and nested VRTs to the depth GDAL itself allows.
 void collectVrtSources(const std::string& path, std::vector<std::string>* files) {
   constexpr std::size_t kMostVrtSources = 100000;
   constexpr int kMostDepth = 16;
+  requireRegularSidecars(path, path);
   std::set<std::pair<dev_t, ino_t>> seen;
   std::vector<std::pair<std::string, int>> pending{{path, 0}};
   while (!pending.empty()) {
@@ -154,20 +251,24 @@ void collectVrtSources(const std::string& path, std::vector<std::string>* files)
     std::vector<std::string> names;
     vrtSourceNames(root, std::filesystem::path(vrt).parent_path(), &names);
     CPLDestroyXMLNode(root);
-    for (const std::string& name : names) {
-      if (name.rfind("/vsistdin", 0) == 0)
-        throw IoError(path, "its source '" + name + "' is standard input; hfvis reads files");
-      if (name.rfind("/vsi", 0) == 0) continue;
+    for (const std::string& source : names) {
+      if (source.find("/vsistdin") != std::string::npos)
+        throw IoError(path, "its source '" + source + "' is standard input; hfvis reads files");
+      const std::string name = localFileOf(source);
       struct stat status {};
-      if (::stat(name.c_str(), &status) != 0) continue;  // (GDAL's open names what is missing)
+      if (name.empty() || ::stat(name.c_str(), &status) != 0)
+        continue;  // (GDAL's open names what is missing)
       if (S_ISFIFO(status.st_mode) || S_ISSOCK(status.st_mode) || S_ISCHR(status.st_mode) ||
           S_ISBLK(status.st_mode))
-        throw IoError(path, "its source '" + name + "' is not a regular file; hfvis reads files");
+        throw IoError(path, "its source '" + source + "' is not a regular file; hfvis reads files");
       if (!seen.insert({status.st_dev, status.st_ino}).second) continue;
       if (files->size() >= kMostVrtSources)
         throw IoError(path, "it names more than " + std::to_string(kMostVrtSources) + " source files");
       files->push_back(name);
-      if (S_ISREG(status.st_mode)) pending.emplace_back(name, depth + 1);
+      if (S_ISREG(status.st_mode)) {
+        requireRegularSidecars(path, name);
+        pending.emplace_back(name, depth + 1);
+      }
     }
   }
 }
