@@ -871,6 +871,12 @@ const std::vector<OptionSpec>& optionTable() {
 #undef HFVIS_TEXT
 
 bool samePath(const std::string& a, const std::string& b) {
+  // ("lnk/../y.exr" is not "y.exr" when lnk is a link to another directory: a path with ".." is
+  // left to the check that resolves it, before the input is read)
+  const auto up = [](const std::filesystem::path& p) {
+    return std::any_of(p.begin(), p.end(), [](const std::filesystem::path& part) { return part == ".."; });
+  };
+  if (up(a) || up(b)) return false;
   return std::filesystem::path(a).lexically_normal() == std::filesystem::path(b).lexically_normal();
 }
 

@@ -167,7 +167,8 @@ struct CommandLine {
 // For the commands' own checks (CommandSpec::check, cli/commands/):
 // 'text', as the messages quote what was typed.
 std::string inQuotes(const std::string& text);
-// The same path once written plainly ("a/../b" is "b"; links are not followed).
+// The same path once written plainly ("./b" is "b"; links are not followed, so a path with ".."
+// is never the same here: the check of the files themselves, before the input is read, decides it).
 bool samePath(const std::string& a, const std::string& b);
 // `path` ends in `wanted` (".json"), in any case.
 bool hasExtension(const std::string& path, const char* wanted);

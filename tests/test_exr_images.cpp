@@ -241,6 +241,37 @@ TEST_F(ImageIoExrTest, MultiPartFileReadsItsFirstPartOrTheOneHoldingTheChannel) 
   }
 }
 
+// UINT heights beyond 2^24 that float32 rounds by more than a thousandth of their range are
+// refused, as the GDAL reader refuses such a band (near 4.29e9 a wall of 100 came out flat, exit
+// 0); the same heights from 0 are read exactly.
+TEST_F(ImageIoExrTest, UintHeightsFloat32CannotHoldAreRefused) {
+  const std::string file = path("uint.exr");
+  for (const std::uint32_t base : {4294900000u, 0u}) {
+    SCOPED_TRACE(base);
+    std::vector<std::uint32_t> values(16, base);
+    for (int i = 4; i < 8; ++i) values[i] = base + 100;
+    {
+      Imf::Header header(4, 4);
+      header.channels().insert("Y", Imf::Channel(Imf::UINT));
+      Imf::OutputFile out(file.c_str(), header);
+      Imf::FrameBuffer frame;
+      frame.insert("Y", Imf::Slice(Imf::UINT, reinterpret_cast<char*>(values.data()), 4, 16));
+      out.setFrameBuffer(frame);
+      out.writePixels(4);
+    }
+    if (base == 0) {
+      EXPECT_EQ(readHeightField(file).heights[5], 100.0f);
+      continue;
+    }
+    try {
+      readHeightField(file);
+      ADD_FAILURE() << "heights near 4.29e9 were read";
+    } catch (const IoError& error) {
+      EXPECT_NE(error.reason().find("rounds by up to"), std::string::npos) << error.what();
+    }
+  }
+}
+
 TEST_F(ImageIoExrTest, AChannelInTwoLaterPartsIsRefused) {
   // A depth part first, then two views with Y each: Y is read from neither (which one?), Z from
   // the first part.

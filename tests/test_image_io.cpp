@@ -1163,6 +1163,42 @@ TEST(GdalRasters, ComplexBandsAndHeightsFloat32CannotHoldAreRefused) {
   EXPECT_NE(refusal().find("a hundredth of a cell"), std::string::npos) << refusal();
 }
 
+// A geographic raster's degrees become metres on the Earth: one in radians, or on Mars, got cells
+// of the wrong size without a word; both are refused (--cell-size still reads them), EPSG:4326 is
+// read.
+TEST(GdalRasters, GeographicCrssNotInDegreesOnTheEarthAreRefused) {
+  const std::string tif = std::string(HFVIS_TEST_TMP_DIR) + "/geographic.tif";
+  const std::string vrt = std::string(HFVIS_TEST_TMP_DIR) + "/geographic.vrt";
+  testing::writeGdalGeoTiff(tif, 4, 4, std::vector<float>(16, 1.0f), {0.0, 0.001, 0.0, 0.5, 0.0, -0.001},
+                            "EPSG:4326", std::nullopt);
+  EXPECT_NEAR(readHeightField(tif).cell_size_y, 110.6, 0.5);  // (0.001 degree of latitude)
+  // (a VRT keeps the CRS as written; GDAL reads a GeoTIFF's WGS84 datum back as EPSG:4326)
+  const std::string radians =
+      "GEOGCS[\"radians\",DATUM[\"WGS_1984\",SPHEROID[\"WGS 84\",6378137,298.257223563]],"
+      "PRIMEM[\"Greenwich\",0],UNIT[\"radian\",1]]";
+  const std::string mars =
+      "GEOGCS[\"Mars 2000\",DATUM[\"D_Mars_2000\",SPHEROID[\"Mars_2000_IAU_IAG\",3396190,169.894447223612]],"
+      "PRIMEM[\"Reference_Meridian\",0],UNIT[\"degree\",0.0174532925199433]]";
+  for (const auto& [crs, words] :
+       {std::pair<std::string, std::string>{radians, "not degrees"}, {mars, "not the Earth"}}) {
+    SCOPED_TRACE(words);
+    std::ofstream(vrt) << "<VRTDataset rasterXSize=\"4\" rasterYSize=\"4\"><SRS>" << crs
+                       << "</SRS><GeoTransform>0, 1e-5, 0, 0.5, 0, -1e-5</GeoTransform>"
+                          "<VRTRasterBand dataType=\"Float32\" band=\"1\"><SimpleSource><SourceFilename "
+                          "relativeToVRT=\"1\">geographic.tif</SourceFilename><SourceBand>1</SourceBand>"
+                          "</SimpleSource></VRTRasterBand></VRTDataset>\n";
+    try {
+      readHeightField(vrt);
+      ADD_FAILURE() << "read with cell sizes";
+    } catch (const IoError& error) {
+      EXPECT_NE(error.reason().find(words), std::string::npos) << error.what();
+    }
+    HeightFieldReadOptions given;
+    given.cell_size_x = 2.0;
+    EXPECT_EQ(readHeightField(vrt, given).cell_size_y, 2.0);
+  }
+}
+
 // GDAL's ASCII grid readers take a value that is not a number as 0 (or as its leading digits), and
 // read the values in order whatever the lines: such a grid, or one whose values are too few or too
 // many for its header, is refused, in ESRI's format and in GRASS's.

@@ -30,11 +30,31 @@ OUTPUTS = {
 }
 
 
-def heights_array(heights, nodata=None):
+def nodata_holes(a, nodata):
+    """Where the array `a` holds `nodata` (None or NaN: nowhere), compared in a's own dtype, as a
+    file's nodata is compared in its band's type: a float64 -9999.9 is float32 -9999.9's nodata (it
+    had marked nothing). A value the dtype cannot hold marks nothing; a nodata that is not a real
+    number is refused."""
+    if nodata is not None and (isinstance(nodata, (bool, np.bool_)) or
+                               not isinstance(nodata, (int, float, np.integer, np.floating))):
+        raise InvalidArgumentError(f"nodata must be a real number (or None), got {nodata!r}")
+    if nodata is None or math.isnan(float(nodata)):
+        return np.zeros(a.shape, dtype=bool)
+    with np.errstate(over="ignore", invalid="ignore"):
+        typed = np.asarray(nodata).astype(a.dtype)
+    if a.dtype.kind != "f" and float(typed) != float(nodata):
+        return np.zeros(a.shape, dtype=bool)
+    return np.asarray(a == typed)
+
+
+def heights_array(heights, nodata=None, cell_size=1.0):
     """The heights as a new or unmodified C-contiguous native float32 2-D array, nodata (and
-    `nodata`'s value) as NaN. Any real dtype (float16..float128, integers), either byte order,
-    any strides; refused: other dimensions, complex, bool, object."""
-    a = np.asarray(heights)
+    `nodata`'s value, compared in the heights' own dtype, and a masked array's mask) as NaN. Any
+    real dtype (float16..float128, integers), either byte order, any strides; refused: other
+    dimensions, complex, bool, object, and heights that float32 rounds by more than a thousandth of
+    their range and a hundredth of `cell_size` (as the file readers refuse them)."""
+    mask = np.ma.getmaskarray(heights) if np.ma.isMaskedArray(heights) else None
+    a = np.asarray(np.ma.getdata(heights) if mask is not None else heights)
     if a.ndim != 2:
         raise InputTypeError(f"heights must be a 2-D array (rows, columns), got {a.ndim} dimension(s) {a.shape}")
     if a.dtype.kind not in "fiu":
@@ -48,10 +68,24 @@ def heights_array(heights, nodata=None):
         overflow = np.isinf(converted) & np.isfinite(a)
         if overflow.any():
             raise InvalidArgumentError("heights beyond float32's range (about 3.4e38): scale them first")
-    if nodata is not None and not (isinstance(nodata, float) and math.isnan(nodata)):
-        holes = a == nodata
-        if holes.any():
-            converted = np.where(holes, np.float32(np.nan), converted)  # a new array: the input stays
+    holes = nodata_holes(a, nodata)
+    if mask is not None:
+        holes |= mask
+    if a.dtype.itemsize > 4 or a.dtype.kind in "iu" and a.dtype.itemsize == 4:
+        # float32 keeps an integer exactly only to 2^24, and a double's digits to about 7: heights
+        # near 1e10 lost their walls (came out flat) without a word.
+        finite = np.isfinite(converted) & ~holes
+        if finite.any():
+            wide = a[finite].astype(np.float64)
+            rounding = float(np.max(np.abs(wide - converted[finite].astype(np.float64))))
+            spread = float(wide.max() - wide.min())
+            if rounding > max(1e-3 * spread, 1e-2 * cell_size):
+                raise InvalidArgumentError(
+                    f"heights {wide.min():.17g} .. {wide.max():.17g} lie so far from 0 that float32, in which "
+                    f"hfvis computes, rounds them by up to {rounding:g}, more than a thousandth of their range "
+                    "and a hundredth of a cell: subtract a constant from them first")
+    if holes.any():
+        converted = np.where(holes, np.float32(np.nan), converted)  # a new array: the input stays
     return converted
 
 
@@ -70,6 +104,11 @@ def geometry(cell_size=None, z_scale=1.0, row_cell_sizes=None):
         cx, cy = float(pair[0]), float(pair[1])
     rows_x, rows_y = ([], []) if row_cell_sizes is None else (list(map(float, row_cell_sizes[0])),
                                                                list(map(float, row_cell_sizes[1])))
+    # What the kernels' single precision holds (the command line's --cell-size range): 1e300 gave
+    # a sky-view factor of 1 everywhere, 1e-30 garbage, without a word.
+    for size in [cx, cy] + rows_x + rows_y:
+        if not (1e-6 <= size <= 1e9):
+            raise InvalidArgumentError(f"a cell size must lie in 1e-06 .. 1e+09 ground units, got {size:g}")
     return {"cell_size_x": cx, "cell_size_y": cy, "row_cell_size_x": rows_x, "row_cell_size_y": rows_y,
             "z_scale": float(z_scale), "origin": []}
 

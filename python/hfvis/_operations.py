@@ -85,8 +85,8 @@ def _run(operation, heights, options, common):
         raise InputTypeError("a Dask array needs its grid: wrap it in an xarray DataArray "
                              "(xarray.DataArray(array, dims=('y', 'x')))")
     if not _is_dataarray(heights):
-        h = _arrays.heights_array(heights, common["nodata"])
         g = _arrays.geometry(common["cell_size"], common["z_scale"])
+        h = _arrays.heights_array(heights, common["nodata"], min(g["cell_size_x"], g["cell_size_y"]))
         return _arrays.compute(operation, h, g, options, common["device"], common["progress"]), None
     from . import _xarray
 
@@ -104,7 +104,8 @@ def _run(operation, heights, options, common):
 
         if data.dtype.kind not in "fiu":
             raise InputTypeError(f"heights must hold real numbers (a float or integer dtype), got dtype {data.dtype}")
-        if nodata is not None and not (isinstance(nodata, float) and math.isnan(nodata)):
+        _arrays.nodata_holes(np.zeros((1, 1), dtype=data.dtype), nodata)  # (a bad nodata refused now)
+        if nodata is not None and not math.isnan(float(nodata)):
             data = data.map_blocks(_nodata_as_nan, nodata, dtype=np.float32)
         data = _flipped(data.astype(np.float32), flip_rows, flip_cols)
         if operation == "cumulative_viewshed":
@@ -116,7 +117,7 @@ def _run(operation, heights, options, common):
         else:
             raise InvalidArgumentError(f"{operation} does not run chunk by chunk: .compute() the Dask array first")
     else:
-        h = _arrays.heights_array(data, nodata)
+        h = _arrays.heights_array(data, nodata, min(g["cell_size_x"], g["cell_size_y"]))
         h = np.ascontiguousarray(_flipped(h, flip_rows, flip_cols))
         out = _arrays.compute(operation, h, g, options, common["device"], common["progress"])
     if flip_rows or flip_cols:
@@ -126,7 +127,7 @@ def _run(operation, heights, options, common):
 
 
 def _nodata_as_nan(block, value):
-    return np.where(block == value, np.float32(np.nan), block).astype(np.float32)
+    return np.where(_arrays.nodata_holes(block, value), np.float32(np.nan), block).astype(np.float32)
 
 
 def _flipped(a, rows, cols):
@@ -225,6 +226,18 @@ def _pair(operation, kind, heights, options, common):
     return xr.Dataset({n: grid.result(out[n], n, _attrs(operation, n, options, grid)) for n in names})
 
 
+def _whole(name, value, least, most):
+    """An integer option: a whole number (8.0 is 8; 8.5 or "8" is refused, as int() would truncate
+    or parse them) within least .. most (None: the library judges the least and says why)."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)) or \
+            not float(value).is_integer():
+        raise InvalidArgumentError(f"{name} must be a whole number, got {value!r}")
+    whole = int(value)
+    if (least is not None and whole < least) or whole > most:
+        raise InvalidArgumentError(f"{name} must lie in {least if least is not None else '..'} .. {most}, got {whole}")
+    return whole
+
+
 def _common(cell_size, z_scale, nodata, device, progress, pixels=False):
     return {"cell_size": cell_size, "z_scale": z_scale, "nodata": nodata, "device": device or "",
             "progress": progress, "pixels": pixels}
@@ -232,10 +245,10 @@ def _common(cell_size, z_scale, nodata, device, progress, pixels=False):
 
 def _horizon(directions, azimuth_offset, samples_per_unit, curvature, max_distance, memory_budget_bytes, method,
              azimuth_tolerance, strip_rows):
-    return {"directions": int(directions), "azimuth_offset": float(azimuth_offset),
+    return {"directions": _whole("directions", directions, None, 2**31 - 1), "azimuth_offset": float(azimuth_offset),
             "samples_per_unit": float(samples_per_unit), "curvature": float(curvature),
-            "max_distance": float(max_distance), "memory_budget_bytes": int(memory_budget_bytes),
-            "method": method, "azimuth_tolerance": azimuth_tolerance, "strip_rows": int(strip_rows)}
+            "max_distance": float(max_distance), "memory_budget_bytes": _whole("memory_budget_bytes", memory_budget_bytes, 0, 2**63 - 1),
+            "method": method, "azimuth_tolerance": azimuth_tolerance, "strip_rows": _whole("strip_rows", strip_rows, 0, 2**31 - 1)}
 
 
 def _horizon_maps(operation, name, heights, options, common):
@@ -422,7 +435,7 @@ def viewshed(heights, observer, *, observer_height=2.0, absolute=False, target_h
                "target_height": float(target_height), "max_distance": float(max_distance),
                "curvature": float(curvature), "azimuth_from_deg": float(azimuth_from_deg),
                "azimuth_to_deg": float(azimuth_to_deg), "elevation_min_deg": float(elevation_min_deg),
-               "elevation_max_deg": float(elevation_max_deg), "memory_budget_bytes": int(memory_budget_bytes)}
+               "elevation_max_deg": float(elevation_max_deg), "memory_budget_bytes": _whole("memory_budget_bytes", memory_budget_bytes, 0, 2**63 - 1)}
     return _single("viewshed", "visible", heights, options, _common(cell_size, z_scale, nodata, device, None, pixels))
 
 
@@ -437,7 +450,7 @@ def cumulative_viewshed(heights, observers, *, observer_height=2.0, absolute=Fal
                "target_height": float(target_height), "max_distance": float(max_distance),
                "curvature": float(curvature), "azimuth_from_deg": float(azimuth_from_deg),
                "azimuth_to_deg": float(azimuth_to_deg), "elevation_min_deg": float(elevation_min_deg),
-               "elevation_max_deg": float(elevation_max_deg), "memory_budget_bytes": int(memory_budget_bytes)}
+               "elevation_max_deg": float(elevation_max_deg), "memory_budget_bytes": _whole("memory_budget_bytes", memory_budget_bytes, 0, 2**63 - 1)}
     return _single("cumulative_viewshed", "count", heights, options,
                    _common(cell_size, z_scale, nodata, device, progress, pixels))
 
@@ -450,7 +463,7 @@ def sun_shading(heights, azimuth_deg, elevation_deg, *, size_deg=0.53, samples_p
     row 0 north. numpy: SunShading(sun, direct); DataArray: a Dataset."""
     options = {"azimuth_deg": float(azimuth_deg), "elevation_deg": float(elevation_deg), "size_deg": float(size_deg),
                "samples_per_unit": float(samples_per_unit), "curvature": float(curvature),
-               "max_distance": float(max_distance), "memory_budget_bytes": int(memory_budget_bytes)}
+               "max_distance": float(max_distance), "memory_budget_bytes": _whole("memory_budget_bytes", memory_budget_bytes, 0, 2**63 - 1)}
     return _pair("sun_shading", SunShading, heights, options, _common(cell_size, z_scale, nodata, device, progress))
 
 
@@ -465,7 +478,7 @@ def insolation(heights, latitude_deg, longitude_deg, start, end, *, step_minutes
                "step_minutes": float(step_minutes), "size_deg": float(size_deg),
                "azimuth_bucket_deg": float(azimuth_bucket_deg), "apparent": bool(apparent),
                "samples_per_unit": float(samples_per_unit), "curvature": float(curvature),
-               "max_distance": float(max_distance), "memory_budget_bytes": int(memory_budget_bytes)}
+               "max_distance": float(max_distance), "memory_budget_bytes": _whole("memory_budget_bytes", memory_budget_bytes, 0, 2**63 - 1)}
     return _pair("insolation", Insolation, heights, options, _common(cell_size, z_scale, nodata, device, progress))
 
 
@@ -482,7 +495,7 @@ def environment_light(heights, environment, *, rotation_deg=0.0, table_rows=0, d
     DataArray with the K and the estimate in its attrs."""
     options = _horizon(directions, azimuth_offset, samples_per_unit, curvature, max_distance, memory_budget_bytes,
                        method, azimuth_tolerance, 0)
-    options.update(environment=environment, rotation_deg=float(rotation_deg), table_rows=int(table_rows))
+    options.update(environment=environment, rotation_deg=float(rotation_deg), table_rows=_whole("table_rows", table_rows, 0, 2**31 - 1))
     common = _common(cell_size, z_scale, nodata, device, progress)
     if max_error:
         options["max_error"] = float(max_error)
@@ -522,7 +535,7 @@ def region_visibility(heights, sources, *, samples=16, height=2.0, absolute=Fals
     over the rectangle (row 0 along its lowest row), each sample taking the bilinear colour at its
     position (as arealight --light-image); then rgb (3 x H x W; DataArray: a Dataset variable
     "rgb" over "channel" R, G, B): per point the colours of the samples it sees, summed, / S."""
-    options = {"sources": sources, "samples": int(samples), "height": float(height), "absolute": bool(absolute),
+    options = {"sources": sources, "samples": _whole("samples", samples, None, 2**31 - 1), "height": float(height), "absolute": bool(absolute),
                "target_height": float(target_height), "method": method, "seed": int(seed),
                "decorrelate": bool(decorrelate), "max_distance": float(max_distance), "curvature": float(curvature),
                "light_image": light_image}
@@ -556,7 +569,7 @@ def region_pair_visibility(heights, sources, receivers, *, samples=16, source_he
     receiver_fraction (the share of the other region's samples each sees), clear_pairs, pairs,
     visible_fraction, and sources_xy / receivers_xy (map coordinates of a georeferenced
     DataArray, else None). progress as region_visibility's."""
-    options = {"sources": sources, "receivers": receivers, "samples": int(samples),
+    options = {"sources": sources, "receivers": receivers, "samples": _whole("samples", samples, None, 2**31 - 1),
                "source_height": float(source_height), "receiver_height": float(receiver_height),
                "absolute": bool(absolute), "method": method, "seed": int(seed), "decorrelate": bool(decorrelate),
                "max_distance": float(max_distance), "curvature": float(curvature)}
@@ -598,12 +611,12 @@ def pvs(heights, *, samples=0, pixel_error=0.0, seconds=0.0, view_cell=32, band_
     counts them, history rows say "settling"; 0: off)."""
     if not (isinstance(estimate_entries, (int, np.integer)) and 0 <= estimate_entries <= 1_000_000):
         raise InvalidArgumentError(f"estimate_entries must be a whole number in 0 .. 1e6, got {estimate_entries!r}")
-    options = {"samples": int(samples), "pixel_error": float(pixel_error), "seconds": float(seconds),
-               "view_cell": int(view_cell), "band_low": float(band_low), "band_high": float(band_high),
+    options = {"samples": _whole("samples", samples, None, 2**31 - 1), "pixel_error": float(pixel_error), "seconds": float(seconds),
+               "view_cell": _whole("view_cell", view_cell, None, 2**31 - 1), "band_low": float(band_low), "band_high": float(band_high),
                "tile": int(tile), "mask": None if mask is None else np.asarray(mask), "method": method,
                "batch": int(batch), "seed": int(seed), "resolution": float(resolution), "filter": float(filter),
                "estimate_entries": int(estimate_entries), "witnesses": bool(witnesses),
-               "memory_budget_bytes": int(memory_budget_bytes),
+               "memory_budget_bytes": _whole("memory_budget_bytes", memory_budget_bytes, 0, 2**63 - 1),
                "start": None if start is None else np.ascontiguousarray(start, dtype=np.uint32).ravel()}
     if _is_dataarray(heights) and _is_dask(heights.data):
         heights = heights.compute()
@@ -632,7 +645,7 @@ def horizon_lists(heights, receivers, *, directions=64, azimuth_offset=0.0, samp
     sample_spacing, ray_samples, visible_samples, horizons (nearest first: sample, distance,
     elevation_rad, segment_begin, segment_end, near_distance, visible_samples))). The library's
     lists take no maximum distance."""
-    options = {"receivers": receivers, "directions": int(directions), "azimuth_offset": float(azimuth_offset),
+    options = {"receivers": receivers, "directions": _whole("directions", directions, None, 2**31 - 1), "azimuth_offset": float(azimuth_offset),
                "samples_per_unit": float(samples_per_unit), "curvature": float(curvature)}
     if _is_dataarray(heights) and _is_dask(heights.data):
         heights = heights.compute()  # a few rays per receiver: the field in one piece
@@ -647,9 +660,9 @@ def bounce(heights, radiance, *, directions=64, azimuth_offset=0.0, samples_per_
     visible segments of each sweep line (Timonen 2013, Sec. 10.1). Returns the radiance's shape;
     NaN at nodata. The library's bounce takes no maximum distance: a Dask array is computed in one
     piece."""
-    options = {"directions": int(directions), "azimuth_offset": float(azimuth_offset),
+    options = {"directions": _whole("directions", directions, None, 2**31 - 1), "azimuth_offset": float(azimuth_offset),
                "samples_per_unit": float(samples_per_unit), "curvature": float(curvature),
-               "memory_budget_bytes": int(memory_budget_bytes)}
+               "memory_budget_bytes": _whole("memory_budget_bytes", memory_budget_bytes, 0, 2**63 - 1)}
     if _is_dataarray(heights) and _is_dask(heights.data):
         heights = heights.compute()
     one_channel = np.ndim(radiance) == 2

@@ -45,6 +45,9 @@ class Grid:
         t = self.transform
         if not self.geographic:
             return _arrays.geometry((abs(t[1]), abs(t[5])), z_scale)
+        rio = _rio(self.array)
+        if rio is not None and rio.crs is not None:
+            _require_earth_degrees(rio.crs)
         cx, cy, rows_x, rows_y = _core.geographic_cell_sizes(list(t), self.array.shape[0])
         return _arrays.geometry((cx, cy), z_scale, (rows_x, rows_y))
 
@@ -164,10 +167,10 @@ def _is_geographic(array):
     if rio is not None:
         try:
             crs = rio.crs
-            if crs is not None:
-                return bool(crs.is_geographic)
         except Exception:
-            pass
+            crs = None
+        if crs is not None:
+            return bool(crs.is_geographic)
     # Without rioxarray: CF's grid mapping, or the coordinates' names.
     ref = array.coords.get("spatial_ref")
     if ref is not None:
@@ -177,6 +180,25 @@ def _is_geographic(array):
         if ref.attrs.get("grid_mapping_name") == "latitude_longitude":
             return True
     return array.dims[-1] in ("lon", "longitude") and array.dims[-2] in ("lat", "latitude")
+
+
+def _require_earth_degrees(crs):
+    """The degrees-to-metres conversion takes degrees on the Earth (as the file reader does): a
+    geographic CRS in radians or grads, or on another body, got cells of the wrong size."""
+    try:
+        import pyproj
+
+        geodetic = pyproj.CRS.from_wkt(crs.to_wkt())
+        unit = geodetic.axis_info[0].unit_name if geodetic.axis_info else "degree"
+        axis = geodetic.ellipsoid.semi_major_metre if geodetic.ellipsoid else 6378137.0
+    except ImportError:
+        return
+    if "degree" not in unit.lower():
+        raise InvalidArgumentError(f"the geographic CRS counts angles in {unit}, not degrees: reproject it "
+                                   "(rio.reproject('EPSG:4326')), or give cell_size")
+    if abs(axis - 6378137.0) > 6378.137:
+        raise InvalidArgumentError(f"the geographic CRS lies on a body of semi-major axis {axis:g} m, not the Earth: "
+                                   "give cell_size, or reproject it to a projected CRS")
 
 
 def _nodata(array):

@@ -47,6 +47,16 @@ def test_bad_heights(bad, kind, words):
     (lambda h: hfvis.environment_light(h, np.ones((4, 5), np.float32)), "twice as wide"),
     (lambda h: hfvis.sun_position("yesterday", 46, 8), "ISO|time"),
     (lambda h: hfvis.sky_view_factor(h, max_error=1e-9), "4096"),
+    (lambda h: hfvis.sky_view_factor(h, cell_size=1e300), "1e-06 .. 1e\\+09"),
+    (lambda h: hfvis.sky_view_factor(h, cell_size=1e-30), "1e-06 .. 1e\\+09"),
+    (lambda h: hfvis.sky_view_factor(h, azimuth_offset=1e20), "azimuth offset"),
+    (lambda h: hfvis.sky_view_factor(h, nodata="x"), "nodata"),
+    (lambda h: hfvis.sky_view_factor(h, directions=8.5), "whole number"),
+    (lambda h: hfvis.sky_view_factor(h, directions="8"), "whole number"),
+    (lambda h: hfvis.sky_view_factor(h, directions=2**40), "directions must lie"),
+    (lambda h: hfvis.sky_view_factor(h, memory_budget_bytes=-1), "memory_budget_bytes must lie"),
+    (lambda h: hfvis.sky_view_factor(h.astype(np.float64) + 1e10), "rounds them"),
+    (lambda h: hfvis.sky_view_factor((h * 100).astype(np.int64) + 2**40), "rounds them"),
     (lambda h: hfvis.sky_view_factor(h, max_error=-0.1), "error"),
     (lambda h: hfvis.region_visibility(h, (0, 0, 20, 3)), "outside"),
     (lambda h: hfvis.region_visibility(h, (0, 0, 1.5, 3)), "integer"),
@@ -158,3 +168,17 @@ def test_ctrl_c_stops_a_run():
     assert child.returncode == 3 and "interrupted" in out
     done = [int(line.split()[1]) for line in out.splitlines() if line.startswith("progress")]
     assert max(done, default=0) < 4096, "stopped at a batch, not run to the end"
+
+
+def test_nodata_in_the_heights_dtype_and_masked_arrays(small):
+    """A float64 nodata on float32 heights marks the float32 value (it marked nothing: the holes were
+    computed as pits), and a masked array's mask is nodata (its values were taken as heights)."""
+    h = small.copy()
+    h[3:6, 4:8] = np.float32(-9999.9)
+    result = hfvis.sky_view_factor(h, directions=8, nodata=np.float64(-9999.9))
+    assert np.isnan(result[3:6, 4:8]).all() and np.isnan(result).sum() == 12
+    masked = np.ma.masked_greater(small, 0.9)
+    out = hfvis.sky_view_factor(masked, directions=8)
+    assert np.array_equal(np.isnan(out), np.ma.getmaskarray(masked))
+    # heights far from 0 whose float32 rounding stays small against a cell pass
+    assert np.isfinite(hfvis.sky_view_factor(small.astype(np.float64) + 4000.0, directions=8)).all()

@@ -181,3 +181,19 @@ def test_pvs_horizon_lists_and_bounce_on_dataarrays(projected_tif):
     assert lit.dims == ("y", "x") and lit.rio.crs == dem.rio.crs and lit.attrs["hfvis_method"] == "tree"
     assert "re-emits" in lit.attrs["units"]
     equal(lit, hfvis.bounce(plain, np.ones(plain.shape, np.float32), directions=4, cell_size=30, nodata=-9999.0))
+
+
+def test_geographic_crs_not_in_degrees_on_the_earth_is_refused():
+    """Degrees become metres on the Earth, as the file reader converts them: a CRS in radians, or
+    on Mars, got cells of the wrong size without a word; cell_size still runs them."""
+    heights = xr.DataArray(np.random.default_rng(3).random((8, 8), dtype=np.float32), dims=("y", "x"))
+    radians = ('GEOGCS["radians",DATUM["WGS_1984",SPHEROID["WGS 84",6378137,298.257223563]],'
+               'PRIMEM["Greenwich",0],UNIT["radian",1]]')
+    mars = ('GEOGCS["Mars 2000",DATUM["D_Mars_2000",SPHEROID["Mars_2000_IAU_IAG",3396190,169.894447223612]],'
+            'PRIMEM["Reference_Meridian",0],UNIT["degree",0.0174532925199433]]')
+    from affine import Affine
+    for crs, words in ((radians, "not degrees"), (mars, "not the Earth")):
+        da = heights.rio.write_crs(crs).rio.write_transform(Affine(1e-5, 0, 0, 0, -1e-5, 0.5))
+        with pytest.raises(hfvis.Error, match=words):
+            hfvis.sky_view_factor(da, directions=8)
+        assert np.isfinite(hfvis.sky_view_factor(da, directions=8, cell_size=2.0)).all()

@@ -32,7 +32,11 @@ void validate(const SweepOptions& options) {
     throw InvalidArgument("samples per unit must be in (0, 64] (got " +
                           std::to_string(options.samples_per_unit) + ")");
   }
-  if (!std::isfinite(options.azimuth_offset)) throw InvalidArgument("the azimuth offset must be finite");
+  // (every direction has an offset within one turn; far beyond, 1e20 radians, the azimuths lost
+  // every digit and the results were garbage, with no error)
+  if (!std::isfinite(options.azimuth_offset) || std::abs(options.azimuth_offset) > 4.0 * M_PI)
+    throw InvalidArgument("the azimuth offset must lie within -4 pi .. 4 pi radians (two turns), got " +
+                          std::to_string(options.azimuth_offset));
   if (!std::isfinite(options.curvature) || std::abs(options.curvature) > 1.0) {
     throw InvalidArgument("the curvature coefficient must be finite and at most 1 per ground unit (got " +
                           std::to_string(options.curvature) + "); earthCurvature() gives the Earth's in 1/m");

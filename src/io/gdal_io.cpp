@@ -418,6 +418,25 @@ bool isGeographic(GDALDatasetH dataset) {
   return srs && OSRIsGeographic(srs);
 }
 
+// The conversion of a geographic grid's spacing to metres (setGeographicCellSizes) takes degrees
+// on the WGS84 ellipsoid: a CRS in radians or grads, or on another body (Mars), got cells of the
+// wrong size without a word. Refuses those (IoError naming `path`); an Earth ellipsoid other than
+// WGS84 (within 0.1 % of its axis) is taken as it.
+void requireEarthDegrees(const std::string& path, OGRSpatialReferenceH srs) {
+  char* unit = nullptr;
+  const double radians_per_unit = OSRGetAngularUnits(srs, &unit);
+  if (std::fabs(radians_per_unit - M_PI / 180.0) > 1e-9)
+    throw IoError(path, std::string("its geographic CRS counts angles in ") +
+                            (unit ? unit : "an unknown unit") +
+                            ", not degrees: reproject it (gdalwarp -t_srs EPSG:4326), or give --cell-size");
+  OGRErr error = OGRERR_NONE;
+  const double axis = OSRGetSemiMajor(srs, &error);
+  if (error == OGRERR_NONE && std::fabs(axis - 6378137.0) > 6378.137)
+    throw IoError(path, "its geographic CRS lies on a body of semi-major axis " + shortNumber(axis) +
+                            " m, not the Earth, whose degrees hfvis converts to metres: give --cell-size, or "
+                            "reproject it to a projected CRS");
+}
+
 // Metadata names: GDAL's name=value lists also split at ':', so hfvis:units is stored as
 // hfvis_units (and read back as hfvis:units).
 constexpr const char* kStoredPrefix = "hfvis_";
@@ -614,6 +633,7 @@ HeightField readGdalHeightField(const std::string& path, const HeightFieldReadOp
     field.cell_size_x = std::fabs((*gt)[1]);
     field.cell_size_y = std::fabs((*gt)[5]);
     if (isGeographic(dataset.get())) {
+      requireEarthDegrees(path, GDALGetSpatialRef(dataset.get()));
       try {
         setGeographicCellSizes(field, *gt);
       } catch (const InvalidArgument& error) {

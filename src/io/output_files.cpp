@@ -199,20 +199,24 @@ void requireReplaceableTarget(const std::string& path, const std::string& target
                             : "cannot write here: no permission to create files in '" + directory + "'");
   // The permission bits do not tell it all: root passes them in /proc and /sys, whose directories
   // take no new files, and an immutable directory refuses them whatever its mode. A file created
-  // and removed at once shows that the write will be taken, before any work. (Its name is a
-  // temporary file's: one left by a killed run of the same process id is passed over.)
+  // and removed at once shows that the write will be taken, before any work. Its name is no
+  // output's temporary one (a staged output is known by that), and it is remembered for the
+  // signal handlers before it exists (a name a killed run left is passed over).
   if (!probe) return;
+  static std::atomic<unsigned> probes{0};
   for (int attempt = 0;; ++attempt) {
-    const std::string name = temporaryPathFor(target);
+    const std::string name = (fs::path(target).parent_path() / (".hfvis-probe-" + std::to_string(::getpid()) +
+                                                                "-" + std::to_string(probes.fetch_add(1))))
+                                 .string();
+    rememberTemporary(name);
     const int fd = ::open(name.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
     const int error = errno;
     if (fd >= 0) {
-      rememberTemporary(name);
       ::close(fd);
       ::unlink(name.c_str());
-      forgetTemporary(name);
-      return;
     }
+    forgetTemporary(name);
+    if (fd >= 0) return;
     if (error == EEXIST && attempt < 8) continue;
     throw IoError(path, "cannot write here: creating a file in '" + directory + "' fails (" +
                             writeFailure(error) + ")");
