@@ -73,17 +73,22 @@ def heights_array(heights, nodata=None, cell_size=1.0):
         holes |= mask
     if a.dtype.itemsize > 4 or a.dtype.kind in "iu" and a.dtype.itemsize == 4:
         # float32 keeps an integer exactly only to 2^24, and a double's digits to about 7: heights
-        # near 1e10 lost their walls (came out flat) without a word.
-        finite = np.isfinite(converted) & ~holes
-        if finite.any():
-            wide = a[finite].astype(np.float64)
-            rounding = float(np.max(np.abs(wide - converted[finite].astype(np.float64))))
-            spread = float(wide.max() - wide.min())
-            if rounding > max(1e-3 * spread, 1e-2 * cell_size):
-                raise InvalidArgumentError(
-                    f"heights {wide.min():.17g} .. {wide.max():.17g} lie so far from 0 that float32, in which "
-                    f"hfvis computes, rounds them by up to {rounding:g}, more than a thousandth of their range "
-                    "and a hundredth of a cell: subtract a constant from them first")
+        # near 1e10 lost their walls (came out flat) without a word. (In blocks of about a million
+        # values: a float64 copy of the whole field would double its memory.)
+        rounding, low, high = 0.0, math.inf, -math.inf
+        step = max(1, (1 << 20) // a.shape[1])
+        for r in range(0, a.shape[0], step):
+            block = a[r:r + step].astype(np.float64)
+            keep = np.isfinite(block) & ~holes[r:r + step]
+            if keep.any():
+                wide = block[keep]
+                rounding = max(rounding, float(np.max(np.abs(wide - converted[r:r + step][keep]))))
+                low, high = min(low, float(wide.min())), max(high, float(wide.max()))
+        if high >= low and rounding > max(1e-3 * (high - low), 1e-2 * cell_size):
+            raise InvalidArgumentError(
+                f"heights {low:.17g} .. {high:.17g} lie so far from 0 that float32, in which hfvis computes, "
+                f"rounds them by up to {rounding:g}, more than a thousandth of their range and a hundredth of a "
+                "cell: subtract a constant from them first")
     if holes.any():
         converted = np.where(holes, np.float32(np.nan), converted)  # a new array: the input stays
     return converted

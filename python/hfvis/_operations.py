@@ -238,6 +238,10 @@ def _whole(name, value, least, most):
     return whole
 
 
+def _budget(memory_budget_bytes):
+    return _whole("memory_budget_bytes", memory_budget_bytes, 0, 2**63 - 1)
+
+
 def _common(cell_size, z_scale, nodata, device, progress, pixels=False):
     return {"cell_size": cell_size, "z_scale": z_scale, "nodata": nodata, "device": device or "",
             "progress": progress, "pixels": pixels}
@@ -245,10 +249,11 @@ def _common(cell_size, z_scale, nodata, device, progress, pixels=False):
 
 def _horizon(directions, azimuth_offset, samples_per_unit, curvature, max_distance, memory_budget_bytes, method,
              azimuth_tolerance, strip_rows):
-    return {"directions": _whole("directions", directions, None, 2**31 - 1), "azimuth_offset": float(azimuth_offset),
-            "samples_per_unit": float(samples_per_unit), "curvature": float(curvature),
-            "max_distance": float(max_distance), "memory_budget_bytes": _whole("memory_budget_bytes", memory_budget_bytes, 0, 2**63 - 1),
-            "method": method, "azimuth_tolerance": azimuth_tolerance, "strip_rows": _whole("strip_rows", strip_rows, 0, 2**31 - 1)}
+    return {"directions": _whole("directions", directions, None, 2**31 - 1),
+            "azimuth_offset": float(azimuth_offset), "samples_per_unit": float(samples_per_unit),
+            "curvature": float(curvature), "max_distance": float(max_distance),
+            "memory_budget_bytes": _budget(memory_budget_bytes), "method": method,
+            "azimuth_tolerance": azimuth_tolerance, "strip_rows": _whole("strip_rows", strip_rows, 0, 2**31 - 1)}
 
 
 def _horizon_maps(operation, name, heights, options, common):
@@ -435,7 +440,7 @@ def viewshed(heights, observer, *, observer_height=2.0, absolute=False, target_h
                "target_height": float(target_height), "max_distance": float(max_distance),
                "curvature": float(curvature), "azimuth_from_deg": float(azimuth_from_deg),
                "azimuth_to_deg": float(azimuth_to_deg), "elevation_min_deg": float(elevation_min_deg),
-               "elevation_max_deg": float(elevation_max_deg), "memory_budget_bytes": _whole("memory_budget_bytes", memory_budget_bytes, 0, 2**63 - 1)}
+               "elevation_max_deg": float(elevation_max_deg), "memory_budget_bytes": _budget(memory_budget_bytes)}
     return _single("viewshed", "visible", heights, options, _common(cell_size, z_scale, nodata, device, None, pixels))
 
 
@@ -450,7 +455,7 @@ def cumulative_viewshed(heights, observers, *, observer_height=2.0, absolute=Fal
                "target_height": float(target_height), "max_distance": float(max_distance),
                "curvature": float(curvature), "azimuth_from_deg": float(azimuth_from_deg),
                "azimuth_to_deg": float(azimuth_to_deg), "elevation_min_deg": float(elevation_min_deg),
-               "elevation_max_deg": float(elevation_max_deg), "memory_budget_bytes": _whole("memory_budget_bytes", memory_budget_bytes, 0, 2**63 - 1)}
+               "elevation_max_deg": float(elevation_max_deg), "memory_budget_bytes": _budget(memory_budget_bytes)}
     return _single("cumulative_viewshed", "count", heights, options,
                    _common(cell_size, z_scale, nodata, device, progress, pixels))
 
@@ -463,7 +468,7 @@ def sun_shading(heights, azimuth_deg, elevation_deg, *, size_deg=0.53, samples_p
     row 0 north. numpy: SunShading(sun, direct); DataArray: a Dataset."""
     options = {"azimuth_deg": float(azimuth_deg), "elevation_deg": float(elevation_deg), "size_deg": float(size_deg),
                "samples_per_unit": float(samples_per_unit), "curvature": float(curvature),
-               "max_distance": float(max_distance), "memory_budget_bytes": _whole("memory_budget_bytes", memory_budget_bytes, 0, 2**63 - 1)}
+               "max_distance": float(max_distance), "memory_budget_bytes": _budget(memory_budget_bytes)}
     return _pair("sun_shading", SunShading, heights, options, _common(cell_size, z_scale, nodata, device, progress))
 
 
@@ -478,7 +483,7 @@ def insolation(heights, latitude_deg, longitude_deg, start, end, *, step_minutes
                "step_minutes": float(step_minutes), "size_deg": float(size_deg),
                "azimuth_bucket_deg": float(azimuth_bucket_deg), "apparent": bool(apparent),
                "samples_per_unit": float(samples_per_unit), "curvature": float(curvature),
-               "max_distance": float(max_distance), "memory_budget_bytes": _whole("memory_budget_bytes", memory_budget_bytes, 0, 2**63 - 1)}
+               "max_distance": float(max_distance), "memory_budget_bytes": _budget(memory_budget_bytes)}
     return _pair("insolation", Insolation, heights, options, _common(cell_size, z_scale, nodata, device, progress))
 
 
@@ -495,7 +500,8 @@ def environment_light(heights, environment, *, rotation_deg=0.0, table_rows=0, d
     DataArray with the K and the estimate in its attrs."""
     options = _horizon(directions, azimuth_offset, samples_per_unit, curvature, max_distance, memory_budget_bytes,
                        method, azimuth_tolerance, 0)
-    options.update(environment=environment, rotation_deg=float(rotation_deg), table_rows=_whole("table_rows", table_rows, 0, 2**31 - 1))
+    options.update(environment=environment, rotation_deg=float(rotation_deg),
+                   table_rows=_whole("table_rows", table_rows, 0, 2**31 - 1))
     common = _common(cell_size, z_scale, nodata, device, progress)
     if max_error:
         options["max_error"] = float(max_error)
@@ -535,7 +541,8 @@ def region_visibility(heights, sources, *, samples=16, height=2.0, absolute=Fals
     over the rectangle (row 0 along its lowest row), each sample taking the bilinear colour at its
     position (as arealight --light-image); then rgb (3 x H x W; DataArray: a Dataset variable
     "rgb" over "channel" R, G, B): per point the colours of the samples it sees, summed, / S."""
-    options = {"sources": sources, "samples": _whole("samples", samples, None, 2**31 - 1), "height": float(height), "absolute": bool(absolute),
+    options = {"sources": sources, "samples": _whole("samples", samples, None, 2**31 - 1), "height": float(height),
+               "absolute": bool(absolute),
                "target_height": float(target_height), "method": method, "seed": int(seed),
                "decorrelate": bool(decorrelate), "max_distance": float(max_distance), "curvature": float(curvature),
                "light_image": light_image}
@@ -611,12 +618,13 @@ def pvs(heights, *, samples=0, pixel_error=0.0, seconds=0.0, view_cell=32, band_
     counts them, history rows say "settling"; 0: off)."""
     if not (isinstance(estimate_entries, (int, np.integer)) and 0 <= estimate_entries <= 1_000_000):
         raise InvalidArgumentError(f"estimate_entries must be a whole number in 0 .. 1e6, got {estimate_entries!r}")
-    options = {"samples": _whole("samples", samples, None, 2**31 - 1), "pixel_error": float(pixel_error), "seconds": float(seconds),
-               "view_cell": _whole("view_cell", view_cell, None, 2**31 - 1), "band_low": float(band_low), "band_high": float(band_high),
+    options = {"samples": _whole("samples", samples, None, 2**31 - 1), "pixel_error": float(pixel_error),
+               "seconds": float(seconds), "view_cell": _whole("view_cell", view_cell, None, 2**31 - 1),
+               "band_low": float(band_low), "band_high": float(band_high),
                "tile": int(tile), "mask": None if mask is None else np.asarray(mask), "method": method,
                "batch": int(batch), "seed": int(seed), "resolution": float(resolution), "filter": float(filter),
                "estimate_entries": int(estimate_entries), "witnesses": bool(witnesses),
-               "memory_budget_bytes": _whole("memory_budget_bytes", memory_budget_bytes, 0, 2**63 - 1),
+               "memory_budget_bytes": _budget(memory_budget_bytes),
                "start": None if start is None else np.ascontiguousarray(start, dtype=np.uint32).ravel()}
     if _is_dataarray(heights) and _is_dask(heights.data):
         heights = heights.compute()
@@ -645,7 +653,8 @@ def horizon_lists(heights, receivers, *, directions=64, azimuth_offset=0.0, samp
     sample_spacing, ray_samples, visible_samples, horizons (nearest first: sample, distance,
     elevation_rad, segment_begin, segment_end, near_distance, visible_samples))). The library's
     lists take no maximum distance."""
-    options = {"receivers": receivers, "directions": _whole("directions", directions, None, 2**31 - 1), "azimuth_offset": float(azimuth_offset),
+    options = {"receivers": receivers, "directions": _whole("directions", directions, None, 2**31 - 1),
+               "azimuth_offset": float(azimuth_offset),
                "samples_per_unit": float(samples_per_unit), "curvature": float(curvature)}
     if _is_dataarray(heights) and _is_dask(heights.data):
         heights = heights.compute()  # a few rays per receiver: the field in one piece
@@ -662,7 +671,7 @@ def bounce(heights, radiance, *, directions=64, azimuth_offset=0.0, samples_per_
     piece."""
     options = {"directions": _whole("directions", directions, None, 2**31 - 1), "azimuth_offset": float(azimuth_offset),
                "samples_per_unit": float(samples_per_unit), "curvature": float(curvature),
-               "memory_budget_bytes": _whole("memory_budget_bytes", memory_budget_bytes, 0, 2**63 - 1)}
+               "memory_budget_bytes": _budget(memory_budget_bytes)}
     if _is_dataarray(heights) and _is_dask(heights.data):
         heights = heights.compute()
     one_channel = np.ndim(radiance) == 2
