@@ -168,6 +168,9 @@ void vrtSourceNames(const CPLXMLNode* node, const std::filesystem::path& directo
   }
 }
 
+// A file that blocks or never ends when opened and read: a FIFO, a socket, a device.
+bool blocksOnRead(mode_t mode) { return S_ISFIFO(mode) || S_ISSOCK(mode) || S_ISCHR(mode) || S_ISBLK(mode); }
+
 // The local file a GDAL dataset name reads, through the wrappers that name one ("vrt://PATH?...",
 // "GTIFF_DIR:N:PATH", "/vsisubfile/OFFSET_SIZE,PATH", "/vsigzip/PATH", an archive's
 // "/vsizip/PATH/member"); "" where it names none (a network or memory file). A source spelt so had
@@ -222,8 +225,7 @@ void requireRegularSidecars(const std::string& path, const std::string& file) {
                          [](unsigned char c) { return std::toupper(c); });
         struct stat status {};
         const std::string sidecar = base + ending;
-        if (::stat(sidecar.c_str(), &status) == 0 && (S_ISFIFO(status.st_mode) || S_ISSOCK(status.st_mode) ||
-                                                      S_ISCHR(status.st_mode) || S_ISBLK(status.st_mode)))
+        if (::stat(sidecar.c_str(), &status) == 0 && blocksOnRead(status.st_mode))
           throw IoError(path, "'" + sidecar + "', a file GDAL reads beside '" + file +
                                   "', is not a regular file; hfvis reads files");
       }
@@ -258,8 +260,7 @@ void collectVrtSources(const std::string& path, std::vector<std::string>* files)
       struct stat status {};
       if (name.empty() || ::stat(name.c_str(), &status) != 0)
         continue;  // (GDAL's open names what is missing)
-      if (S_ISFIFO(status.st_mode) || S_ISSOCK(status.st_mode) || S_ISCHR(status.st_mode) ||
-          S_ISBLK(status.st_mode))
+      if (blocksOnRead(status.st_mode))
         throw IoError(path, "its source '" + source + "' is not a regular file; hfvis reads files");
       if (!seen.insert({status.st_dev, status.st_ino}).second) continue;
       if (files->size() >= kMostVrtSources)
@@ -276,7 +277,7 @@ void collectVrtSources(const std::string& path, std::vector<std::string>* files)
 Dataset openRaster(const std::string& path) {
   registerOnce();
   requireInputFile(path);
-  std::vector<std::string> sources;
+  std::vector<std::string> sources;  // (here for its checks alone: filesRead gives the list)
   collectVrtSources(path, &sources);
   Dataset dataset(GDALOpen(path.c_str(), GA_ReadOnly));
   if (!dataset) throw IoError(path, lastError());
