@@ -91,7 +91,7 @@ double parseBounded(const std::string& option, const std::string& text, double l
 
 // Limits of the ground and height values (ground units): within them, distances, their squares
 // and areas over a field of 2^31 pixels stay inside float32's range with room for the sums.
-// (kLeastCellSize, kMostCellSize: arguments.hpp)
+// (the cell sizes' range, kLeastCellSize .. kMostCellSize: hfvis/height_field.hpp)
 constexpr double kMostLength = 1e12;
 // The sweep's largest azimuth tolerance, 0.1 radian (computeHorizons), in degrees as the help
 // gives it (rounded up: the conversion to radians clamps it to 0.1).

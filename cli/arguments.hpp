@@ -23,10 +23,6 @@
 
 namespace hfvis::cli {
 
-// The cell sizes (ground units) the kernels' single precision holds: --cell-size's range, and a
-// file's georeference's too.
-constexpr double kLeastCellSize = 1e-6, kMostCellSize = 1e9;
-
 // A malformed command line: unknown option or subcommand, missing or bad value.
 // main() prints it and exits with status 2.
 class UsageError : public std::runtime_error {

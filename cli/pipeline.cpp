@@ -333,21 +333,10 @@ HeightField readValidField(const RunArguments& run) {
   try {
     validate(field);
   } catch (const InvalidArgument& error) {
-    throw Error(run.input + ": " + error.what());
-  }
-  // A cell size from the file (its geotransform, hfvis's attributes) within --cell-size's range:
-  // 1e-30 gave a visible area of 0 everywhere with exit 0.
-  const auto within = [](double size) { return size >= kLeastCellSize && size <= kMostCellSize; };
-  bool usable = within(field.cell_size_x) && within(field.cell_size_y);
-  for (std::size_t r = 0; r < field.row_cell_size_x.size(); ++r)
-    usable = usable && within(field.row_cell_size_x[r]) && within(field.row_cell_size_y[r]);
-  if (!usable) {
-    std::ostringstream message;  // (the range as --cell-size's message gives it: 1e-06 .. 1e+09)
-    message << run.input << ": its cell size (" << field.cell_size_x << " x " << field.cell_size_y
-            << " ground units" << (field.row_cell_size_x.empty() ? "" : ", or that of a row")
-            << ") is outside " << kLeastCellSize << " .. " << kMostCellSize
-            << ", what the kernels' single precision holds; give one with --cell-size";
-    throw Error(message.str());
+    // A cell size from the file (its geotransform, hfvis's attributes) that the kernels cannot
+    // hold: --cell-size gives another.
+    throw Error(run.input + ": " + error.what() +
+                (cellSizesHeld(field) ? "" : "; give one with --cell-size"));
   }
   return field;
 }

@@ -41,16 +41,36 @@ void horizons(const HeightField& field, const HorizonOptions& options = {},
   computeHorizons(testContext(), field, options, outputs);
 }
 
+// One rule for heights that float32 rounds (the GDAL and EXR readers and the Python package ask
+// it): refused above both a thousandth of their range and a hundredth of a cell, kept at either.
+TEST(BadInput, HeightsFloat32RoundsTooFar) {
+  EXPECT_NO_THROW(requireHeightsKeptInFloat32(0.0, 5.0, 5.0, 1.0));       // flat, exact
+  EXPECT_NO_THROW(requireHeightsKeptInFloat32(0.1, 0.0, 100.0, 0.01));    // a thousandth of 100
+  EXPECT_NO_THROW(requireHeightsKeptInFloat32(2.4e-4, 4000, 4000, 0.1));  // a flat roof at 4000
+  expectError<InvalidArgument>([] { requireHeightsKeptInFloat32(256, 4294900000.0, 4294900100.0, 1.0); },
+                               "rounds them by up to 256");
+  expectError<InvalidArgument>([] { requireHeightsKeptInFloat32(0.11, 0.0, 100.0, 10.0); }, "subtract");
+}
+
 TEST(BadInput, Fields) {
   const HeightField good = makeSyntheticField("noise", 9, 7, 1);
   expectError<InvalidArgument>([] { horizons(HeightField{}); }, "empty");
   HeightField short_of_heights = good;
   short_of_heights.heights.pop_back();
   expectError<InvalidArgument>([&] { horizons(short_of_heights); }, "holds");
-  for (double cell : {0.0, -1.0, std::nan("")}) {
+  // Cell sizes: finite, within what single precision holds (1e-30 gave a visible area of 0, 1e300
+  // a sky-view factor of 1, without a word); the range's ends pass.
+  for (double cell : {0.0, -1.0, std::nan(""), 1e-30, 0.99e-6, 1.01e9, 1e300}) {
     HeightField field = good;
     field.cell_size_y = cell;
-    expectError<InvalidArgument>([&] { horizons(field); }, "cell size");
+    expectError<InvalidArgument>([&] { horizons(field); }, "outside 1e-06 .. 1e+09");
+    EXPECT_FALSE(cellSizesHeld(field));
+  }
+  for (double cell : {kLeastCellSize, kMostCellSize}) {
+    HeightField field = good;
+    field.cell_size_x = field.cell_size_y = cell;
+    EXPECT_TRUE(cellSizesHeld(field));
+    EXPECT_NO_THROW(validate(field));
   }
   HeightField row_count = good;  // per-row cell sizes: one per row, finite and positive
   row_count.row_cell_size_x.assign(good.height - 1, 1.0);
@@ -61,6 +81,9 @@ TEST(BadInput, Fields) {
   row_value.row_cell_size_y.assign(good.height, 1.0);
   row_value.row_cell_size_x[2] = std::nan("");
   expectError<InvalidArgument>([&] { horizons(row_value); }, "cell size of row 2");
+  row_value.row_cell_size_x[2] = 1e10;
+  expectError<InvalidArgument>([&] { horizons(row_value); }, "cell size of row 2 (1e+10 x 1)");
+  EXPECT_FALSE(cellSizesHeld(row_value));
   HeightField flat_z = good;
   flat_z.z_scale = 0.0;
   expectError<InvalidArgument>([&] { horizons(flat_z); }, "z-scale");

@@ -267,7 +267,7 @@ TEST_F(ImageIoExrTest, UintHeightsFloat32CannotHoldAreRefused) {
       readHeightField(file);
       ADD_FAILURE() << "heights near 4.29e9 were read";
     } catch (const IoError& error) {
-      EXPECT_NE(error.reason().find("rounds by up to"), std::string::npos) << error.what();
+      EXPECT_NE(error.reason().find("rounds them by up to"), std::string::npos) << error.what();
     }
   }
 }

@@ -76,8 +76,26 @@ struct HeightField {
   std::size_t nodataCount() const;
 };
 
+// The cell sizes (ground units per pixel) the kernels' single precision holds: 1e300 gave a
+// sky-view factor of 1 everywhere and 1e-30 a visible area of 0, without a word.
+constexpr double kLeastCellSize = 1e-6, kMostCellSize = 1e9;
+
+// Whether every cell size of the field (per-row ones included) lies in kLeastCellSize ..
+// kMostCellSize.
+bool cellSizesHeld(const HeightField& field);
+
+// Heights held in float32, in which hfvis computes, keep their differences unless float32 rounded
+// them (`rounding`, the largest rounding of one height) by more than a thousandth of their range
+// (lowest .. highest) and a hundredth of the smaller cell size (a slope error of 1 % across a
+// cell): UInt32 heights near 4e9 round by up to 256, and walls of 50 came out flat. Throws
+// InvalidArgument naming the heights otherwise. The file readers and the Python package ask it of
+// heights of any wider type (a float64 DSM of a flat roof at 4000 on cells of 0.1, rounded by
+// 2.4e-4 as a float32 one is, passes).
+void requireHeightsKeptInFloat32(double rounding, double lowest, double highest, double cell_size);
+
 // Throws InvalidArgument when the field is empty, its sizes disagree, a cell size (per-row
-// ones included, one per row) or the z-scale is not finite and positive, every height is
+// ones included, one per row) is not finite or outside kLeastCellSize .. kMostCellSize, the
+// z-scale is not finite and positive, every height is
 // nodata, or an origin does not place it inside its larger field or gives a lowest height that
 // is not finite or above one of its heights.
 void validate(const HeightField& field);

@@ -47,6 +47,13 @@ def nodata_holes(a, nodata):
     return np.asarray(a == typed)
 
 
+def float32_may_round(dtype):
+    """Whether float32, in which hfvis computes, may round heights of this dtype: it keeps an
+    integer exactly only to 2^24, and a double's digits to about 7 (heights near 1e10 lost their
+    walls, came out flat, without a word)."""
+    return dtype.itemsize > 4 or dtype.kind in "iu" and dtype.itemsize == 4
+
+
 def heights_array(heights, nodata=None, cell_size=1.0):
     """The heights as a new or unmodified C-contiguous native float32 2-D array, nodata (and
     `nodata`'s value, compared in the heights' own dtype, and a masked array's mask) as NaN. Any
@@ -71,10 +78,9 @@ def heights_array(heights, nodata=None, cell_size=1.0):
     holes = nodata_holes(a, nodata)
     if mask is not None:
         holes |= mask
-    if a.dtype.itemsize > 4 or a.dtype.kind in "iu" and a.dtype.itemsize == 4:
-        # float32 keeps an integer exactly only to 2^24, and a double's digits to about 7: heights
-        # near 1e10 lost their walls (came out flat) without a word. (In blocks of about a million
-        # values: a float64 copy of the whole field would double its memory.)
+    if float32_may_round(a.dtype):
+        # (In blocks of about a million values: a float64 copy of the whole field would double its
+        # memory.)
         rounding, low, high = 0.0, math.inf, -math.inf
         step = max(1, (1 << 20) // a.shape[1])
         for r in range(0, a.shape[0], step):
@@ -84,11 +90,8 @@ def heights_array(heights, nodata=None, cell_size=1.0):
                 wide = block[keep]
                 rounding = max(rounding, float(np.max(np.abs(wide - converted[r:r + step][keep]))))
                 low, high = min(low, float(wide.min())), max(high, float(wide.max()))
-        if high >= low and rounding > max(1e-3 * (high - low), 1e-2 * cell_size):
-            raise InvalidArgumentError(
-                f"heights {low:.17g} .. {high:.17g} lie so far from 0 that float32, in which hfvis computes, "
-                f"rounds them by up to {rounding:g}, more than a thousandth of their range and a hundredth of a "
-                "cell: subtract a constant from them first")
+        if high >= low:
+            _core.require_heights_kept_in_float32(rounding, low, high, cell_size)
     if holes.any():
         converted = np.where(holes, np.float32(np.nan), converted)  # a new array: the input stays
     return converted
@@ -109,11 +112,7 @@ def geometry(cell_size=None, z_scale=1.0, row_cell_sizes=None):
         cx, cy = float(pair[0]), float(pair[1])
     rows_x, rows_y = ([], []) if row_cell_sizes is None else (list(map(float, row_cell_sizes[0])),
                                                                list(map(float, row_cell_sizes[1])))
-    # What the kernels' single precision holds (the command line's --cell-size range): 1e300 gave
-    # a sky-view factor of 1 everywhere, 1e-30 garbage, without a word.
-    for size in [cx, cy] + rows_x + rows_y:
-        if not (1e-6 <= size <= 1e9):
-            raise InvalidArgumentError(f"a cell size must lie in 1e-06 .. 1e+09 ground units, got {size:g}")
+    # (the range the kernels' single precision holds, 1e-6 .. 1e9, is the library's check)
     return {"cell_size_x": cx, "cell_size_y": cy, "row_cell_size_x": rows_x, "row_cell_size_y": rows_y,
             "z_scale": float(z_scale), "origin": []}
 

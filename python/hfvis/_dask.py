@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 
-from . import _arrays
+from . import _arrays, _core
 from ._errors import InvalidArgumentError
 
 # Beyond the maximum distance, what a point's result reads: the bilinear surface's cell around a
@@ -59,6 +59,29 @@ def _block(block, lowest, operation, geometry, options, device, depth, chunks, b
         result = _arrays.compute(operation, heights, g, options, device)
         out = np.concatenate([result[name].reshape((-1,) + heights.shape) for name in names])
     return out[:, top:out.shape[1] - bottom, left:out.shape[2] - right]
+
+
+def _kept_block(block, rounding, low, high, nodata, cell_size):
+    if high.flat[0] >= low.flat[0]:
+        _core.require_heights_kept_in_float32(float(rounding.flat[0]), float(low.flat[0]),
+                                              float(high.flat[0]), cell_size)
+    return np.where(_arrays.nodata_holes(block, nodata), np.float32(np.nan), block.astype(np.float32))
+
+
+def kept_in_float32(data, nodata, cell_size):
+    """The Dask array `data` of a dtype float32 may round (_arrays.float32_may_round) as float32,
+    `nodata` as NaN, each block refused, as heights_array refuses an array in memory, where float32
+    rounds the whole field's heights too far: lazily, the field's largest rounding and its range
+    are reductions that every block takes (as the lowest height in chunked)."""
+    import dask.array as da
+
+    wide = data.astype(np.float64)
+    keep = da.isfinite(wide) & ~data.map_blocks(_arrays.nodata_holes, nodata, dtype=bool)
+    rounding = da.where(keep, abs(wide - data.astype(np.float32).astype(np.float64)), 0.0).max()
+    low = da.where(keep, wide, np.inf).min()
+    high = da.where(keep, wide, -np.inf).max()
+    each = [da.broadcast_to(x, data.numblocks, chunks=1) for x in (rounding, low, high)]
+    return da.map_blocks(_kept_block, data, *each, nodata=nodata, cell_size=cell_size, dtype=np.float32)
 
 
 def chunked(operation, heights, geometry, options, device=""):

@@ -105,7 +105,9 @@ def _run(operation, heights, options, common):
         if data.dtype.kind not in "fiu":
             raise InputTypeError(f"heights must hold real numbers (a float or integer dtype), got dtype {data.dtype}")
         _arrays.nodata_holes(np.zeros((1, 1), dtype=data.dtype), nodata)  # (a bad nodata refused now)
-        if nodata is not None and not math.isnan(float(nodata)):
+        if _arrays.float32_may_round(data.dtype):
+            data = _dask.kept_in_float32(data, nodata, min(g["cell_size_x"], g["cell_size_y"]))
+        elif nodata is not None and not math.isnan(float(nodata)):
             data = data.map_blocks(_nodata_as_nan, nodata, dtype=np.float32)
         data = _flipped(data.astype(np.float32), flip_rows, flip_cols)
         if operation == "cumulative_viewshed":

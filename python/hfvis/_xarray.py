@@ -82,9 +82,6 @@ class Grid:
         t = self.transform
         return t[0] + (col + 0.5) * t[1], t[3] + (row + 0.5) * t[5]
 
-    def heights(self):
-        return _arrays.heights_array(self.array.values, self.nodata)
-
     def coords(self):
         """The input's coordinates along y and x (and scalar ones such as spatial_ref)."""
         keep = {self.y_dim, self.x_dim}

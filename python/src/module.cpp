@@ -630,6 +630,8 @@ NB_MODULE(_core, m) {
         "row_cell_size_y"_a, "z_scale"_a, "origin"_a = std::vector<double>{},
         "origin_row_cell_size_x"_a = std::vector<double>{},
         "origin_row_cell_size_y"_a = std::vector<double>{});
+  m.def("require_heights_kept_in_float32", &requireHeightsKeptInFloat32, "rounding"_a, "lowest"_a,
+        "highest"_a, "cell_size"_a);
   m.def(
       "geographic_cell_sizes",
       [](const std::array<double, 6>& geotransform, int height) {

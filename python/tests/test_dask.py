@@ -218,3 +218,21 @@ def test_latitude_longitude_chunked_equals_in_memory_bit_for_bit(latitude_longit
             assert np.array_equal(np.isnan(values), holes), f"{got.name} {chunks}: nodata moved"
             assert np.array_equal(values[~holes].view(np.uint32), wanted[~holes].view(np.uint32)), \
                 f"{got.name} {chunks}: largest difference {np.nanmax(np.abs(values - wanted))}"
+
+
+def test_wide_heights_float32_cannot_hold_are_refused_chunk_by_chunk(field):
+    """Heights of a wider dtype pass the in-memory run's float32 rounding check on a Dask array too
+    (they were converted unchecked: heights near 1e10 came out flat), lazily; where float32 keeps
+    them, with a nodata value of their own dtype, the result is the float32 array's bit for bit."""
+    wide = field.astype(np.float64)
+    far = (wide + 1e10).chunk({"y": 37, "x": 53})
+    with pytest.raises(ValueError, match="rounds them"):
+        hfvis.sky_view_factor(far, directions=8, max_distance=MAX_DISTANCE).compute()
+    with pytest.raises(ValueError, match="rounds them"):  # the in-memory run refuses them alike
+        hfvis.sky_view_factor(wide + 1e10, directions=8, max_distance=MAX_DISTANCE)
+    near = wide.fillna(-9999.0).chunk({"y": 37, "x": 53})
+    got = hfvis.sky_view_factor(near, directions=8, max_distance=MAX_DISTANCE, nodata=-9999.0).values
+    want = hfvis.sky_view_factor(field, directions=8, max_distance=MAX_DISTANCE).values
+    holes = np.isnan(want)
+    assert holes.any() and np.array_equal(np.isnan(got), holes)
+    assert np.array_equal(got[~holes].view(np.uint32), want[~holes].view(np.uint32))

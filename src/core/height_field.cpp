@@ -1,6 +1,7 @@
 // height_field.cpp: HeightField helpers and validation.
 #include "hfvis/height_field.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -9,12 +10,33 @@
 #include "hfvis/errors.hpp"
 
 namespace hfvis {
+using detail::exactNumber;
 using detail::shortNumber;
 
 std::size_t HeightField::nodataCount() const {
   std::size_t count = 0;
   for (float h : heights) count += std::isfinite(h) ? 0 : 1;
   return count;
+}
+
+namespace {
+bool held(double size) { return size >= kLeastCellSize && size <= kMostCellSize; }  // (false for NaN)
+}  // namespace
+
+bool cellSizesHeld(const HeightField& field) {
+  bool all = held(field.cell_size_x) && held(field.cell_size_y);
+  for (std::size_t r = 0; r < field.row_cell_size_x.size(); ++r) all = all && held(field.row_cell_size_x[r]);
+  for (std::size_t r = 0; r < field.row_cell_size_y.size(); ++r) all = all && held(field.row_cell_size_y[r]);
+  return all;
+}
+
+void requireHeightsKeptInFloat32(double rounding, double lowest, double highest, double cell_size) {
+  if (rounding > std::max(1e-3 * (highest - lowest), 1e-2 * cell_size))
+    throw InvalidArgument("its heights (" + exactNumber(lowest) + " .. " + exactNumber(highest) +
+                          ") lie so far from 0 that float32, in which hfvis computes, rounds them by up to " +
+                          shortNumber(rounding) +
+                          ", more than a thousandth of their range and a hundredth of a cell: subtract a "
+                          "constant from them first");
 }
 
 void validate(const HeightField& field) {
@@ -28,9 +50,12 @@ void validate(const HeightField& field) {
                           std::to_string(field.height) + " pixels");
   }
   auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
-  if (!positive(field.cell_size_x) || !positive(field.cell_size_y)) {
-    throw InvalidArgument("cell size must be finite and positive (got " + shortNumber(field.cell_size_x) +
-                          ", " + shortNumber(field.cell_size_y) + ")");
+  const std::string range = " is outside " + shortNumber(kLeastCellSize) + " .. " +
+                            shortNumber(kMostCellSize) +
+                            " ground units, what the kernels' single precision holds";
+  if (!held(field.cell_size_x) || !held(field.cell_size_y)) {
+    throw InvalidArgument("the cell size " + shortNumber(field.cell_size_x) + " x " +
+                          shortNumber(field.cell_size_y) + range);
   }
   if (!field.row_cell_size_x.empty() || !field.row_cell_size_y.empty()) {
     if (field.row_cell_size_x.size() != static_cast<std::size_t>(field.height) ||
@@ -40,8 +65,10 @@ void validate(const HeightField& field) {
                             std::to_string(field.row_cell_size_y.size()));
     }
     for (std::size_t r = 0; r < field.row_cell_size_x.size(); ++r) {
-      if (!positive(field.row_cell_size_x[r]) || !positive(field.row_cell_size_y[r]))
-        throw InvalidArgument("the cell size of row " + std::to_string(r) + " must be finite and positive");
+      if (!held(field.row_cell_size_x[r]) || !held(field.row_cell_size_y[r]))
+        throw InvalidArgument("the cell size of row " + std::to_string(r) + " (" +
+                              shortNumber(field.row_cell_size_x[r]) + " x " +
+                              shortNumber(field.row_cell_size_y[r]) + ")" + range);
     }
   }
   if (!positive(field.z_scale)) {

@@ -309,7 +309,8 @@ bool isExrFile(const std::string& path) {
          magic[2] == 0x31 && magic[3] == 0x01;
 }
 
-ImageChannels readExr(const std::string& path, std::uint64_t max_image_bytes, const std::string* channel) {
+ImageChannels readExr(const std::string& path, std::uint64_t max_image_bytes, const std::string* channel,
+                      double* rounding) {
   const std::unique_ptr<Imf::MultiPartInputFile> file = openExr(path);
   const int part_index = partToRead(path, *file, channel);
   const Imf::Header& header = file->header(part_index);
@@ -360,20 +361,13 @@ ImageChannels readExr(const std::string& path, std::uint64_t max_image_bytes, co
   } catch (const std::exception& e) {
     throw IoError(path, withDetail("cannot read pixel data; the file is truncated or corrupt", e.what()));
   }
-  // A UINT channel read as heights: float32 holds its integers exactly only up to 2^24. Beyond, its
-  // rounding (up to the value over 2^24) must stay under a thousandth of the heights' range, as
-  // the GDAL reader asks of any band (heights near 4.29e9 with walls of 100 came out flat, exit 0).
-  if (channel && header.channels().findChannel(image.names.front())->type == Imf::UINT) {
+  // A UINT channel: float32 holds its integers exactly only up to 2^24, beyond by up to the value
+  // over 2^24 (the reader of heights asks requireHeightsKeptInFloat32 whether that is too much).
+  if (rounding) *rounding = 0.0;
+  if (rounding && channel && header.channels().findChannel(image.names.front())->type == Imf::UINT) {
     const std::vector<float>& plane = image.planes.front();
-    const auto [low, high] = std::minmax_element(plane.begin(), plane.end());
-    if (low != plane.end() && double(*high) > double(1 << 24) &&
-        double(*high) / double(1 << 24) > 1e-3 * (double(*high) - double(*low)))
-      throw IoError(path,
-                    "its UINT channel '" + image.names.front() + "' holds heights up to " +
-                        std::to_string(static_cast<unsigned long long>(*high)) +
-                        ", which float32, in which hfvis computes, rounds by up to " +
-                        std::to_string(static_cast<unsigned long long>(double(*high) / double(1 << 24))) +
-                        ", more than a thousandth of their range: subtract a constant from them first");
+    const auto high = std::max_element(plane.begin(), plane.end());
+    if (high != plane.end() && double(*high) > double(1 << 24)) *rounding = double(*high) / double(1 << 24);
   }
   for (const char* name : {"hfvis:cell_size_x", "hfvis:cell_size_y"}) {
     const auto* value = header.findTypedAttribute<Imf::StringAttribute>(name);

@@ -23,8 +23,10 @@ bool isExrFile(const std::string& path);
 // exr_images.cpp). attributes: the string attributes hfvis:cell_size_x and hfvis:cell_size_y where the part
 // has them. Throws IoError (unreadable, empty, a deep image, a subsampled channel, 2^31 pixels or more, a
 // header claiming more than max_image_bytes, 0 = 64 GiB, or attributes larger than the file; a channel it
-// lacks; truncated or corrupt pixels).
-ImageChannels readExr(const std::string& path, std::uint64_t max_image_bytes, const std::string* channel);
+// lacks; truncated or corrupt pixels). `rounding`, where given and one channel is read: the most
+// float32 may have rounded its values by (a UINT channel's beyond 2^24; 0 for half and float).
+ImageChannels readExr(const std::string& path, std::uint64_t max_image_bytes, const std::string* channel,
+                      double* rounding = nullptr);
 
 // Writes `image` (checked by the caller: consistent, unique channel names) to `file` as a
 // one-part scanline EXR: float32 channels, ZIP compression, the data window at (0, 0), the

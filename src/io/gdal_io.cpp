@@ -652,18 +652,12 @@ HeightField readGdalHeightField(const std::string& path, const HeightFieldReadOp
                   "a geographic raster without a geotransform (no tiepoint) has no cell size in "
                   "metres; give one with --cell-size");
   }
-  // Heights rounded to float32 must keep their differences: UInt32 heights near 4e9 round by up
-  // to 256, and walls of 50 vanished (exit 0). A rounding above a thousandth of the heights' range
-  // and above a hundredth of a cell (a slope error of 1 % across a cell) is refused. A float64 DSM
-  // of a flat roof at 4000 on cells of 0.1, rounded by 2.4e-4 as a float32 one is, passes.
-  if (rounded.rounding > std::max(1e-3 * (rounded.highest - rounded.lowest),
-                                  1e-2 * std::min(field.cell_size_x, field.cell_size_y)))
-    throw IoError(path,
-                  "its heights (" + exactNumber(rounded.lowest) + " .. " + exactNumber(rounded.highest) +
-                      ") lie so far from 0 that float32, in which hfvis computes, rounds them by up to " +
-                      shortNumber(rounded.rounding) +
-                      ", more than a thousandth of their range and a hundredth of a cell: subtract a "
-                      "constant from them first");
+  try {
+    requireHeightsKeptInFloat32(rounded.rounding, rounded.lowest, rounded.highest,
+                                std::min(field.cell_size_x, field.cell_size_y));
+  } catch (const InvalidArgument& error) {
+    throw IoError(path, error.what());
+  }
   field.z_scale = options.z_scale;
   return field;
 }

@@ -26,10 +26,12 @@ namespace fs = std::filesystem;
 
 // Reads an image GDAL does not take: an EXR (by its magic number, whatever its name) through
 // OpenEXR, anything else through OpenImageIO.
+// `rounding`: see readExr (0 for the others, whose channels float32 holds).
 ImageChannels readOtherImage(const std::string& path, std::uint64_t max_image_bytes,
-                             const std::string* channel) {
+                             const std::string* channel, double* rounding = nullptr) {
   detail::requireInputFile(path);
-  if (detail::isExrFile(path)) return detail::readExr(path, max_image_bytes, channel);
+  if (rounding) *rounding = 0.0;
+  if (detail::isExrFile(path)) return detail::readExr(path, max_image_bytes, channel, rounding);
   return detail::oiioImages().read(path, max_image_bytes, channel);
 }
 
@@ -43,7 +45,8 @@ std::string attributeOf(const ImageChannels& image, const std::string& name) {
 
 HeightField readHeightField(const std::string& path, const HeightFieldReadOptions& options) {
   if (detail::isGdalRaster(path)) return detail::readGdalHeightField(path, options);
-  ImageChannels image = readOtherImage(path, options.max_image_bytes, &options.channel);
+  double rounding = 0.0;
+  ImageChannels image = readOtherImage(path, options.max_image_bytes, &options.channel, &rounding);
   HeightField field;
   field.width = image.width;
   field.height = image.height;
@@ -59,6 +62,14 @@ HeightField readHeightField(const std::string& path, const HeightFieldReadOption
                                     attributeOf(image, "hfvis:cell_size_y").c_str())) {
     field.cell_size_x = stored_cell_size->first;
     field.cell_size_y = stored_cell_size->second;
+  }
+  if (rounding > 0.0) {
+    const auto [low, high] = std::minmax_element(field.heights.begin(), field.heights.end());
+    try {
+      requireHeightsKeptInFloat32(rounding, *low, *high, std::min(field.cell_size_x, field.cell_size_y));
+    } catch (const InvalidArgument& error) {
+      throw IoError(path, error.what());
+    }
   }
   field.z_scale = options.z_scale;
   return field;
