@@ -1207,7 +1207,9 @@ TEST(GdalRasters, AsciiGridValuesThatAreNotNumbersAreRefused) {
   const std::string esri = "ncols 3\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\nNODATA_value -9999\n";
   const std::string grass = "north: 2\nsouth: 0\neast: 3\nwest: 0\nrows: 2\ncols: 3\n";
   for (const std::string& header : {esri, grass}) {
-    for (const std::string bad : {"abc", "1,5", "2x"}) {
+    // (a number's prefix among them: the check takes plain decimals without strtod, and asks
+    // strtod of the rest)
+    for (const std::string bad : {"abc", "1,5", "2x", "1e", "1e+", "-", ".", "+.e1", "1.5.2", "--1", "0x"}) {
       SCOPED_TRACE(header.substr(0, 6) + bad);
       { std::ofstream(path) << header << "1 2 3\n4 " << bad << " 6\n"; }
       try {
@@ -1219,10 +1221,16 @@ TEST(GdalRasters, AsciiGridValuesThatAreNotNumbersAreRefused) {
       }
     }
     // The same grid with numbers in every form strtod takes is read.
-    { std::ofstream(path) << header << "1 2e0 +3\n-4.5 .5 6\n"; }
+    { std::ofstream(path) << header << "1 2e0 +3\n-4.5 .5 6.\n"; }
     const HeightField field = readHeightField(path);
     EXPECT_EQ(field.heights[3], -4.5f);
     EXPECT_EQ(field.heights[4], 0.5f);
+    EXPECT_EQ(field.heights[5], 6.0f);
+    { std::ofstream(path) << header << "1E+1 -2.5e-1 0x1p2\n  4\t5\r\n6\n"; }  // (hex: strtod's form)
+    const HeightField more = readHeightField(path);
+    EXPECT_EQ(more.heights[0], 10.0f);
+    EXPECT_EQ(more.heights[1], -0.25f);
+    EXPECT_EQ(more.heights[5], 6.0f);
     // A value short, or one too many (GDAL read them in order: 0 for the missing last one, or
     // every later row shifted).
     for (const std::string& values : {std::string("1 2 3\n4 5\n"), std::string("1 2 3 9\n4 5 6\n")}) {

@@ -56,6 +56,32 @@ struct DatasetCloser {
 };
 using Dataset = std::unique_ptr<void, DatasetCloser>;
 
+// Whether [p, end) is a plain decimal number as a whole: [+-] digits [. digits] [e [+-] digits],
+// with a digit before or after the point. strtod reads such a token whole, so the check below
+// asks strtod only of the others (hex, inf, nan, not numbers). (Orientation, this session's 2-core
+// AMD EPYC: the check took 1.4 s of `svf -k 1`'s 4.3 s on a 4096^2 grid of 132 MB, about 0.3 s
+// now, with the map's look-up and the token's bytes out of the loop over every value.)
+bool plainDecimal(const char* p, const char* end) {
+  const auto digits = [&] {
+    const char* first = p;
+    while (p < end && *p >= '0' && *p <= '9') ++p;
+    return p > first;
+  };
+  if (p < end && (*p == '+' || *p == '-')) ++p;
+  bool some = digits();
+  if (p < end && *p == '.') {
+    ++p;
+    some = digits() || some;
+  }
+  if (!some) return false;
+  if (p < end && (*p == 'e' || *p == 'E')) {
+    ++p;
+    if (p < end && (*p == '+' || *p == '-')) ++p;
+    if (!digits()) return false;
+  }
+  return p == end;
+}
+
 // GDAL's ASCII grid readers (ESRI's and GRASS's) take a value that is not a number as 0 or as its
 // leading digits (`abc` became ground at height 0, `1,5` at 1), and read the values in order
 // whatever the lines (a missing last value became 0; 17 a row under ncols 16 sheared the grid).
@@ -101,11 +127,14 @@ void requireNumbersInAsciiGrid(const std::string& path) {
     }
     line_start = false;
     if (!header) {
-      char* end = nullptr;
-      std::strtod(token.c_str(), &end);
-      const auto null = values_of.find("null");
+      const char* end = token.c_str() + token.size();
+      if (!plainDecimal(token.c_str(), end)) {
+        char* read_to = nullptr;
+        std::strtod(token.c_str(), &read_to);
+        end = read_to;
+      }
       if ((token.size() > 256 || end != token.c_str() + token.size()) &&
-          !(null != values_of.end() && token == null->second))
+          !(values_of.count("null") && token == values_of["null"]))
         throw IoError(
             path, "line " + std::to_string(line) + ": '" + token.substr(0, 40) +
                       "' is not a number (GDAL's ASCII grid reader would read 0 or its leading digits; write "
@@ -114,16 +143,21 @@ void requireNumbersInAsciiGrid(const std::string& path) {
     }
     token.clear();
   };
+  const auto space = [](char c) {
+    return c == ' ' || c == '\n' || c == '\t' || c == '\r' || c == '\f' || c == '\v';
+  };
   while (in) {
     in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
-    for (std::streamsize i = 0; i < in.gcount(); ++i) {
-      const char c = buffer[static_cast<std::size_t>(i)];
-      if (c == '\n' || c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v') {
-        check();
-        if (c == '\n') ++line, line_start = true;
-      } else if (token.size() <= 256) {  // (longer: cut there, and no number then)
-        token += c;
-      }
+    const char *p = buffer.data(), *end = p + in.gcount();
+    while (p < end) {
+      const char* q = p;
+      while (q < end && !space(*q)) ++q;
+      // (a token longer than 256 is cut at 257, and is no number then)
+      token.append(p, std::min<std::size_t>(q - p, 257 - std::min<std::size_t>(token.size(), 257)));
+      if (q == end) break;  // (the token may go on in the next block)
+      check();
+      if (*q == '\n') ++line, line_start = true;
+      p = q + 1;
     }
   }
   check();
