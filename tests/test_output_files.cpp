@@ -195,6 +195,49 @@ TEST_F(OutputFilesTest, AnImmutableFileIsRefused) {
   EXPECT_EQ(filesInDir(), std::vector<std::string>{"fixed.exr"});
 }
 
+// A sticky directory (mode 1777, as /tmp) lets only a file's owner (or the directory's, or the
+// superuser) replace it. Another user's file there, mode 666, passed every check; the rename into
+// place failed after the work and left the second name of the previous file, `.NAME.hfvis-tmp-*`,
+// which that user could not remove either. It is refused before anything is written. Run as
+// another user in a child process, which needs the superuser to set up: skipped, saying so, else.
+TEST_F(OutputFilesTest, AnotherUsersFileInAStickyDirectoryIsRefusedBeforeAnyWrite) {
+  if (::geteuid() != 0) GTEST_SKIP() << "needs the superuser, to give a file to another user and become one";
+  const fs::path sticky = dir_ / "sticky";
+  fs::create_directory(sticky);
+  const std::string theirs = (sticky / "theirs.exr").string();
+  { std::ofstream(theirs) << "their result"; }
+  ASSERT_EQ(::chown(theirs.c_str(), 12345, 12345), 0);
+  ASSERT_EQ(::chmod(theirs.c_str(), 0666), 0);
+  ASSERT_EQ(::chmod(sticky.c_str(), 01777), 0);
+  ::chmod(dir_.c_str(), 0755);  // (the way there, for the other user)
+  const pid_t child = ::fork();
+  if (child == 0) {  // as user 65534: 0 when refused, naming the sticky bit, with nothing written
+    if (::setgid(65534) != 0 || ::setuid(65534) != 0) ::_exit(3);
+    try {
+      requireReplaceable(theirs);
+      ::_exit(4);
+    } catch (const IoError& error) {
+      if (std::string(error.what()).find("is sticky (mode 1777)") == std::string::npos) ::_exit(5);
+    }
+    try {
+      writeImage(theirs, noiseImage());
+      ::_exit(6);
+    } catch (const IoError& error) {
+      ::_exit(std::string(error.what()).find("is sticky") == std::string::npos ? 7 : 0);
+    }
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "child status " << status;
+  EXPECT_EQ(readText(theirs), "their result");
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(sticky)) names.push_back(entry.path().filename().string());
+  EXPECT_EQ(names, std::vector<std::string>{"theirs.exr"});
+  // Their own file, and the superuser, replace it as before.
+  writeImage(theirs, noiseImage());
+  EXPECT_NE(readText(theirs), "their result");
+}
+
 // Issue 26, item 6: an output at a symbolic link replaces what the link names (in that file's
 // directory) and keeps the link; the replaced file's permissions stay.
 TEST_F(OutputFilesTest, ASymbolicLinkIsWrittenThrough) {

@@ -170,6 +170,7 @@ void requireReplaceableTarget(const std::string& path, const std::string& target
   if (!S_ISDIR(status.st_mode))
     throw IoError(
         path, "cannot write here: '" + directory + "' is " + kindOf(status.st_mode) + ", not a directory");
+  const struct stat directory_status = status;
   if (::lstat(target.c_str(), &status) == 0) {
     if (S_ISDIR(status.st_mode)) throw IoError(path, "cannot write here: it is a directory");
     // (resolvedTarget follows 40 links: a link still after them is a loop, or a chain too long)
@@ -184,6 +185,16 @@ void requireReplaceableTarget(const std::string& path, const std::string& target
       throw IoError(path, "the file is immutable (chattr +i); hfvis does not replace it");
     if (flags & FS_APPEND_FL)
       throw IoError(path, "the file is append-only (chattr +a); hfvis does not replace it");
+    // A sticky directory (mode 1777, as /tmp) lets only the file's owner, the directory's or the
+    // superuser replace or remove a file: the rename into place failed after the work, and the
+    // second name kept for the previous file (a hard link to it, another user's) could not be
+    // removed either, so it stayed.
+    const uid_t user = ::geteuid();
+    if ((directory_status.st_mode & S_ISVTX) && user != 0 && status.st_uid != user &&
+        directory_status.st_uid != user)
+      throw IoError(path, "cannot replace it: the directory '" + directory + "' is sticky (mode " +
+                              octalMode(directory_status.st_mode) +
+                              ") and the file belongs to another user; write to another name or directory");
     const bool writable = ::faccessat(AT_FDCWD, target.c_str(), W_OK, AT_EACCESS) == 0;
     // (a read-only file system first: its files' modes allow writing, and chmod would not help)
     if (!writable && errno == EROFS)
