@@ -100,7 +100,10 @@ def chunked(operation, heights, geometry, options, device=""):
     planes = _arrays.planes_of(operation, options)
     body = functools.partial(_block, operation=operation, geometry=geometry, options=options, device=device,
                              depth=depth, chunks=chunks)
-    overlapped = da.overlap.overlap(heights, depth={0: depth, 1: depth}, boundary="none")
+    # (no halo along an axis of one chunk: it has no neighbours, and dask refuses a depth beyond
+    # the array, as for a field 30 rows high with a halo of 52)
+    overlapped = da.overlap.overlap(heights, depth={a: depth if len(chunks[a]) > 1 else 0 for a in (0, 1)},
+                                    boundary="none")
     # The whole field's lowest height, the base of every block's heights: a reduction, handed to
     # each block as a 1 x 1 block of its own (infinite where every height is nodata, and then no
     # block reads it).

@@ -103,6 +103,17 @@ def test_chunks_smaller_than_the_halo_are_rechunked(field):
     assert min(min(c) for c in svf.chunks) >= 12  # the halo: ceil(300 / 30) + 2 pixels
 
 
+def test_a_halo_beyond_the_field_along_one_axis(field):
+    """A field fewer rows high than the halo (10 rows, a halo of 12) is one chunk along them, and
+    none of its halo goes there: dask refused an overlap deeper than the array ("The overlapping
+    depth 12 is larger than your array 10")."""
+    strip = field[:10]
+    whole = hfvis.sky_view_factor(strip, directions=4, max_distance=MAX_DISTANCE)
+    for chunks in ({"y": 3, "x": 40}, {"y": 10, "x": 15}):
+        chunked = hfvis.sky_view_factor(strip.chunk(chunks), directions=4, max_distance=MAX_DISTANCE)
+        np.testing.assert_array_equal(chunked.values, whole.values)
+
+
 def test_no_maximum_distance_is_refused(field):
     with pytest.raises(hfvis.InvalidArgumentError, match="max_distance"):
         hfvis.sky_view_factor(field.chunk(50), directions=4)
