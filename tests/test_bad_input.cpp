@@ -106,6 +106,27 @@ TEST(BadInput, Fields) {
       "float arithmetic");
   expectError<InvalidArgument>([&] { computeViewshed(testContext(), high, Observer{}, ViewshedOptions{}); },
                                "float arithmetic");
+  // Nor heights so far from 0 that float32's spacing there swallows the relief: near 1e9 (steps
+  // of 64, the relief 64) an eye 20 above the ground was lost, exit 0. Near 1e5 (steps of 1/128)
+  // they are kept.
+  for (const float offset : {1e9f, 1e5f}) {
+    SCOPED_TRACE(offset);
+    HeightField far = good;
+    for (float& h : far.heights) h = offset + 64.0f * std::round(h);
+    Observer eye;
+    eye.height = 20.0;
+    const auto viewshed = [&] { computeViewshed(testContext(), far, eye, ViewshedOptions{}); };
+    const auto pair = [&] {
+      computeRegionPairVisibility(testContext(), far, a, b, RegionVisibilityOptions{});
+    };
+    if (offset > 1e8f) {
+      expectError<InvalidArgument>(viewshed, "only in steps of 64");
+      expectError<InvalidArgument>(pair, "subtract a constant");
+    } else {
+      EXPECT_NO_THROW(viewshed());
+      EXPECT_NO_THROW(pair());
+    }
+  }
 }
 
 TEST(BadInput, Options) {

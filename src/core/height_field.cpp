@@ -32,7 +32,7 @@ bool cellSizesHeld(const HeightField& field) {
 
 void requireHeightsKeptInFloat32(double rounding, double lowest, double highest, double cell_size) {
   if (rounding > std::max(1e-3 * (highest - lowest), 1e-2 * cell_size))
-    throw InvalidArgument("its heights (" + exactNumber(lowest) + " .. " + exactNumber(highest) +
+    throw InvalidArgument("the heights (" + exactNumber(lowest) + " .. " + exactNumber(highest) +
                           ") lie so far from 0 that float32, in which hfvis computes, rounds them by up to " +
                           shortNumber(rounding) +
                           ", more than a thousandth of their range and a hundredth of a cell: subtract a "
