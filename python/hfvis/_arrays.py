@@ -70,14 +70,15 @@ def heights_array(heights, nodata=None, cell_size=1.0):
         raise InvalidArgumentError(f"heights are empty ({a.shape[0]} x {a.shape[1]})")
     with np.errstate(over="ignore"):  # refused just below, with a message
         converted = np.ascontiguousarray(a, dtype=np.float32)
-    if a.dtype.kind == "f" and a.dtype.itemsize > 4:
-        # Heights beyond float32's range would turn into infinities, that is nodata, unseen.
-        overflow = np.isinf(converted) & np.isfinite(a)
-        if overflow.any():
-            raise InvalidArgumentError("heights beyond float32's range (about 3.4e38): scale them first")
     holes = nodata_holes(a, nodata)
     if mask is not None:
         holes |= mask
+    if a.dtype.kind == "f" and a.dtype.itemsize > 4:
+        # Heights beyond float32's range would turn into infinities, that is nodata, unseen. (Not
+        # nodata itself: GDAL's and ArcGIS's -1.797e308 was refused.)
+        overflow = np.isinf(converted) & np.isfinite(a) & ~holes
+        if overflow.any():
+            raise InvalidArgumentError("heights beyond float32's range (about 3.4e38): scale them first")
     if float32_may_round(a.dtype):
         # (In blocks of about a million values: a float64 copy of the whole field would double its
         # memory.)

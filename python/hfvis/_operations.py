@@ -97,8 +97,7 @@ def _run(operation, heights, options, common):
     options = _places_as_pixels(operation, options, grid, common["pixels"])
     if flip_rows:
         g = dict(g, row_cell_size_x=g["row_cell_size_x"][::-1], row_cell_size_y=g["row_cell_size_y"][::-1])
-    nodata = common["nodata"] if common["nodata"] is not None else grid.nodata
-    data = grid.array.data
+    data, nodata = _marked(grid.array.data, (grid.nodata, common["nodata"]), *_xarray.scale_offset(grid.array))
     if _is_dask(data):
         from . import _dask
 
@@ -126,6 +125,34 @@ def _run(operation, heights, options, common):
         for name in _arrays.OUTPUTS.get(operation, ("irradiance",)):
             out[name] = _flipped(out[name], flip_rows, flip_cols)
     return out, grid
+
+
+def _marked(data, nodatas, scale, offset):
+    """A DataArray's data, and the nodata value left for heights_array (or the Dask path) to mark:
+    the data as they are with their one nodata value where there is one value and no scale or
+    offset; else a new array (Dask: block by block) with every value of `nodatas` (the array's own
+    and the caller's `nodata`, each compared in the data's dtype: the caller's had replaced the
+    array's) as NaN and the raster's scale and offset applied in float64 (they were ignored)."""
+    values = [v for v in nodatas if v is not None]
+    if scale == 1.0 and offset == 0.0 and len(values) <= 1:
+        return data, values[0] if values else None
+    if data.dtype.kind not in "fiu":
+        raise InputTypeError(f"heights must hold real numbers (a float or integer dtype), got dtype {data.dtype}")
+    for v in values:
+        _arrays.nodata_holes(np.zeros((1, 1), dtype=data.dtype), v)  # (a bad nodata refused now)
+    if _is_dask(data):
+        return data.map_blocks(_marked_block, values, scale, offset, dtype=np.float64), None
+    return _marked_block(np.asarray(data), values, scale, offset), None
+
+
+def _marked_block(block, values, scale, offset):
+    holes = np.zeros(block.shape, dtype=bool)
+    for v in values:
+        holes |= _arrays.nodata_holes(block, v)
+    wide = block.astype(np.float64)
+    if scale != 1.0 or offset != 0.0:
+        wide = wide * scale + offset
+    return np.where(holes, np.nan, wide)
 
 
 def _nodata_as_nan(block, value):
@@ -677,6 +704,8 @@ def bounce(heights, radiance, *, directions=64, azimuth_offset=0.0, samples_per_
     if _is_dataarray(heights) and _is_dask(heights.data):
         heights = heights.compute()
     one_channel = np.ndim(radiance) == 2
+    if _is_dataarray(radiance) and _is_dataarray(heights):
+        _require_grid_of(radiance, heights)
     options["radiance"] = np.asarray(radiance.values if _is_dataarray(radiance) else radiance)
     out, grid = _run("bounce", heights, options, _common(cell_size, z_scale, nodata, device, progress))
     irradiance = out["irradiance"]
@@ -688,6 +717,21 @@ def bounce(heights, radiance, *, directions=64, azimuth_offset=0.0, samples_per_
     channels = radiance[radiance.dims[0]].values if _is_dataarray(radiance) and radiance.dims[0] in radiance.coords \
         else np.arange(irradiance.shape[0])
     return grid.result(irradiance, "irradiance", attrs, leading=("channel", channels))
+
+
+def _require_grid_of(radiance, heights):
+    """A radiance DataArray lies on the heights' grid: its last two dims are theirs, with the same
+    coordinates where both have them (it was taken by position: flipped or on another grid, it lit
+    the wrong places)."""
+    want = [d for d in heights.dims if not (d == "band" and heights.sizes[d] == 1)]
+    got = list(radiance.dims[-2:])
+    if got != want:
+        raise InvalidArgumentError(f"the radiance's dims {tuple(radiance.dims)} must end with the heights' {tuple(want)}")
+    for dim in want:
+        if dim in radiance.coords and dim in heights.coords and \
+                not np.array_equal(radiance[dim].values, heights[dim].values):
+            raise InvalidArgumentError(f"the radiance's {dim} coordinates are not the heights': put it on their grid "
+                                       "(radiance.interp_like(heights), or reindex it)")
 
 
 def sun_position(time, latitude_deg, longitude_deg, *, apparent=False):

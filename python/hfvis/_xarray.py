@@ -15,6 +15,12 @@ AZIMUTH_CONVENTION = ("phi_k = 360*k/K deg + azimuth_offset, on the ground from 
                       "+row; compass azimuth = 90 + phi_k deg when row 0 is north")
 
 
+# Dim names that say which axis is which: a DataArray given as (x, y), as after .T, was read with
+# its columns as rows (its sun and observers turned, a latitude / longitude grid not seen as one).
+_X_NAMES = ("x", "lon", "long", "longitude", "easting")
+_Y_NAMES = ("y", "lat", "latitude", "northing")
+
+
 class Grid:
     """A DataArray's 2-D grid: its dims, geotransform (GDAL's order: x0, dx, 0, y0, 0, dy, of the
     pixel corners; None without coordinates or a transform), whether its CRS is geographic, and
@@ -25,6 +31,10 @@ class Grid:
             array = array.squeeze("band", drop=True)  # rioxarray's open_rasterio: (band, y, x)
         if array.ndim != 2:
             raise InputTypeError(f"a DataArray of heights must be 2-D (y, x), got dims {array.dims}")
+        first, second = (str(d).lower() for d in array.dims)
+        if first in _X_NAMES or second in _Y_NAMES:
+            raise InvalidArgumentError(f"the DataArray's dims are {array.dims}: hfvis takes rows then columns (y, x); "
+                                       f"transpose it first (array.transpose({array.dims[1]!r}, {array.dims[0]!r}))")
         self.array = array
         self.y_dim, self.x_dim = array.dims
         self.transform = _geotransform(array)
@@ -36,7 +46,16 @@ class Grid:
 
     def geometry(self, cell_size, z_scale):
         """The field's cell sizes: given, else from the transform (degrees to metres per row on a
-        geographic CRS, by the library's own conversion), else 1."""
+        geographic CRS, by the library's own conversion), else (no coordinates at all) 1."""
+        if cell_size is None and self.transform is None:
+            for dim in (self.y_dim, self.x_dim):
+                if dim in self.array.coords and self.array.sizes[dim] < 2:
+                    # (a 1 x N field took a cell size of 1, whatever its x coordinates said)
+                    raise InvalidArgumentError(f"the {dim} coordinates hold one value, which gives no spacing: give "
+                                               "cell_size")
+                if dim not in self.array.coords and any(d in self.array.coords for d in (self.y_dim, self.x_dim)):
+                    raise InvalidArgumentError(f"the DataArray has coordinates along one axis but none along {dim}: "
+                                               "give both, or cell_size")
         if cell_size is not None or self.transform is None:
             if cell_size is None and self.geographic:
                 raise InvalidArgumentError("a geographic DataArray without coordinates or a transform has no cell "
@@ -131,6 +150,11 @@ def _geotransform(array):
     """GDAL's geotransform: rioxarray's (its stored GeoTransform, as GDAL read it) where the array
     has a spatial_ref, else from the 1-D coordinates (which must be evenly spaced), else None."""
     y_dim, x_dim = array.dims
+    for dim in (y_dim, x_dim):
+        if dim in array.coords and array[dim].dtype.kind not in "fiu":
+            # (datetimes ran as cells of 86400, complex numbers without their imaginary part)
+            raise InvalidArgumentError(f"the {dim} coordinates hold {array[dim].dtype}, not map coordinates: drop "
+                                       f"them (array.drop_vars({dim!r})) and give cell_size")
     from_coords = None
     if x_dim in array.coords and y_dim in array.coords:
         xs, ys = np.asarray(array[x_dim].values, float), np.asarray(array[y_dim].values, float)
@@ -140,6 +164,8 @@ def _geotransform(array):
     rio = _rio(array)
     if rio is None or "spatial_ref" not in array.coords:
         return from_coords
+    if from_coords is None and "GeoTransform" not in array.coords["spatial_ref"].attrs:
+        return None  # (rioxarray's fallback for an axis it cannot measure is the identity)
     try:
         stored = tuple(float(v) for v in rio.transform(recalc=False).to_gdal())
     except Exception:  # rioxarray finds no spatial dims or transform: the coordinates'
@@ -196,6 +222,22 @@ def _require_earth_degrees(crs):
     if abs(axis - 6378137.0) > 6378.137:
         raise InvalidArgumentError(f"the geographic CRS lies on a body of semi-major axis {axis:g} m, not the Earth: "
                                    "give cell_size, or reproject it to a projected CRS")
+
+
+def scale_offset(array):
+    """A raster's scale and offset not yet applied (rioxarray's open_rasterio, mask_and_scale=False,
+    keeps scale_factor and add_offset in the attributes; the CLI applies them, as GDAL's band
+    does): (1, 0) where there are none. (Those in the encoding were applied when the data were
+    decoded.)"""
+    scale, offset = array.attrs.get("scale_factor", 1.0), array.attrs.get("add_offset", 0.0)
+    try:
+        scale, offset = float(scale), float(offset)
+    except (TypeError, ValueError):
+        raise InvalidArgumentError(f"the DataArray's scale_factor {scale!r} and add_offset {offset!r} must be numbers")
+    if not (math.isfinite(scale) and math.isfinite(offset) and scale != 0.0):
+        raise InvalidArgumentError(f"the DataArray's scale_factor {scale!r} and add_offset {offset!r} must be finite, "
+                                   "the scale not 0")
+    return scale, offset
 
 
 def _nodata(array):

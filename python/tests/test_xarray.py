@@ -197,3 +197,67 @@ def test_geographic_crs_not_in_degrees_on_the_earth_is_refused():
         with pytest.raises(hfvis.Error, match=words):
             hfvis.sky_view_factor(da, directions=8)
         assert np.isfinite(hfvis.sky_view_factor(da, directions=8, cell_size=2.0)).all()
+
+
+def _grid(values, **attrs):
+    rows, cols = values.shape
+    return xr.DataArray(values, dims=("y", "x"), attrs=attrs,
+                        coords={"y": 1200.0 - 30.0 * (np.arange(rows) + 0.5), "x": 30.0 * (np.arange(cols) + 0.5)})
+
+
+def _relief(rows=30, cols=40):
+    return np.random.default_rng(4).normal(size=(rows, cols)).cumsum(0).cumsum(1) * 3
+
+
+def test_a_rasters_scale_and_offset_are_applied(tmp_path):
+    """rioxarray's open_rasterio keeps a band's scale_factor and add_offset in the attributes
+    (mask_and_scale=False, its default): they were ignored (decimetres taken as metres); the CLI
+    applies them. Nodata is compared before scaling, in the raw dtype."""
+    raw = np.round(_relief() * 10).astype(np.int16)
+    raw[3, 4] = -32768
+    scaled = hfvis.sky_view_factor(_grid(raw, scale_factor=0.1, add_offset=5.0, _FillValue=-32768), directions=8,
+                                   cell_size=30)
+    metres = (raw * 0.1 + 5.0).astype(np.float32)
+    metres[3, 4] = np.nan
+    equal(scaled, hfvis.sky_view_factor(metres, directions=8, cell_size=30))
+    with pytest.raises(hfvis.InvalidArgumentError, match="scale_factor"):
+        hfvis.sky_view_factor(_grid(raw, scale_factor=0.0), directions=8)
+
+
+def test_nodata_is_marked_besides_the_arrays_own():
+    """`nodata=` marks its value besides the DataArray's own _FillValue (it replaced it: the
+    -9999 cell was computed as a pit)."""
+    z = _relief().astype(np.float32)
+    z[5, 5], z[10, 10] = -9999, -32768
+    out = hfvis.sky_view_factor(_grid(z, _FillValue=-9999.0), directions=8, nodata=-32768)
+    assert np.isnan(out.values[5, 5]) and np.isnan(out.values[10, 10])
+    # GDAL's and ArcGIS's float64 nodata, -1.797e308, is nodata, not a height beyond float32
+    deep = _relief()
+    deep[3:6, 3:6] = -np.finfo(np.float64).max
+    out = hfvis.sky_view_factor(_grid(deep), directions=8, nodata=-np.finfo(np.float64).max)
+    assert np.isnan(out.values[3:6, 3:6]).all() and np.isfinite(out.values[10:, 10:]).all()
+
+
+def test_grids_hfvis_cannot_read_right_are_refused():
+    """Each of these ran with exit 0 and a wrong answer: dims given as (x, y) (columns taken as
+    rows), an axis of one coordinate or none beside another's (a cell size of 1), coordinates that
+    are no map coordinates (datetimes as cells of 86400), a radiance on another grid."""
+    z = _relief().astype(np.float32)
+    a = _grid(z)
+    with pytest.raises(hfvis.InvalidArgumentError, match=r"transpose it first"):
+        hfvis.sky_view_factor(a.T, directions=8)
+    with pytest.raises(hfvis.InvalidArgumentError, match="transpose"):
+        hfvis.sky_view_factor(xr.DataArray(z.T, dims=("lon", "lat")), directions=8)
+    with pytest.raises(hfvis.InvalidArgumentError, match="one value"):
+        hfvis.horizon_distances(a[:1], directions=4)
+    with pytest.raises(hfvis.InvalidArgumentError, match="none along y"):
+        hfvis.sky_view_factor(xr.DataArray(z, dims=("y", "x"), coords={"x": 30.0 * np.arange(40)}), directions=8)
+    days = a.assign_coords(x=np.datetime64("2020-01-01") + np.arange(40).astype("timedelta64[D]"))
+    with pytest.raises(hfvis.InvalidArgumentError, match="not map coordinates"):
+        hfvis.sky_view_factor(days, directions=8)
+    # (a 1 x N field with its cell size given runs; one with no coordinates at all takes 1)
+    assert hfvis.horizon_distances(a[:1], directions=4, cell_size=30).shape[1:] == (1, 40)
+    radiance = _grid(np.ones_like(z))
+    hfvis.bounce(a, radiance, directions=8)
+    with pytest.raises(hfvis.InvalidArgumentError, match="coordinates are not the heights'"):
+        hfvis.bounce(a, radiance.isel(y=slice(None, None, -1)), directions=8)
