@@ -278,6 +278,7 @@ try "pvs resume without a seed" "" -- pvs field.exr -o out/p.json --samples 10 -
 try "pvs resume with the filter" "" -- pvs field.exr -o out/p.json --samples 10 --seed 2 --resume prev_pvs.bin --filter 1
 try "pvs resume on another grid" "" -- pvs field.exr -o out/p.json --samples 10 --seed 2 --resume prev_pvs.bin --tile 8
 try "pvs resume from a file not a bitset" "" -- pvs field.exr -o out/p.json --samples 10 --seed 2 --resume prev_pvs.json
+try "pvs resume from another field's bitset" "" -- pvs field.exr -o out/p.json --samples 10 --seed 2 --z-scale 2 --resume prev_pvs.bin
 try "pvs resume file as the output" "" -- pvs field.exr -o out/p.json --samples 10 --seed 2 --resume prev_pvs.bin --bitset prev_pvs.bin
 try "sun position without a time" "" -- sunpos --lat 45 --lon 7
 try "sun position at a time without a zone" "" -- sunpos --lat 45 --lon 7 --at 2026-06-21T12:00:00

@@ -3130,9 +3130,9 @@ TEST_F(Cli, PvsWritesTheLibrarysSetsAsJsonAndBits) {
     for (int i = 0; i < 4; ++i) v |= std::uint32_t(static_cast<unsigned char>(bits[at + i])) << (8 * i);
     return v;
   };
-  ASSERT_GE(bits.size(), 40u);
+  ASSERT_GE(bits.size(), 64u);
   EXPECT_EQ(bits.substr(0, 8), std::string("HFVPVS1", 8));
-  EXPECT_EQ(u32(8), 1u);
+  EXPECT_EQ(u32(8), 2u);
   EXPECT_EQ(u32(12), std::uint32_t(want.layout.view_x));
   EXPECT_EQ(u32(16), std::uint32_t(want.layout.view_y));
   EXPECT_EQ(u32(20), std::uint32_t(want.layout.tiles_x));
@@ -3140,9 +3140,14 @@ TEST_F(Cli, PvsWritesTheLibrarysSetsAsJsonAndBits) {
   EXPECT_EQ(u32(28), std::uint32_t(want.words));
   EXPECT_EQ(u32(32), 8u);
   EXPECT_EQ(u32(36), 4u);
-  const std::size_t words_at = 40 + (want.layout.viewCells() + 3) / 4 * 4;
+  // (40: the field's fingerprint, 48 and 52: the view band as float32, 56: no filter, 60: 0)
+  EXPECT_EQ(u32(48), 0x3fd9999au);  // 1.7f
+  EXPECT_EQ(u32(52), 0x3fd9999au);
+  EXPECT_EQ(u32(56), 0u);
+  EXPECT_EQ(u32(60), 0u);
+  const std::size_t words_at = 64 + (want.layout.viewCells() + 3) / 4 * 4;
   ASSERT_EQ(bits.size(), words_at + 4 * want.bits.size());
-  for (int v = 0; v < want.layout.viewCells(); ++v) EXPECT_EQ(bits[40 + v], 1);
+  for (int v = 0; v < want.layout.viewCells(); ++v) EXPECT_EQ(bits[64 + v], 1);
   for (std::size_t i = 0; i < want.bits.size(); ++i) EXPECT_EQ(u32(words_at + 4 * i), want.bits[i]) << i;
   EXPECT_TRUE(fs::exists(out("p.png")));
   // A mask of the field's size selecting one corner: only view cell 0 computed.
@@ -3291,7 +3296,7 @@ TEST_F(Cli, PvsResumesFromAnEarlierBitset) {
   const hfvis::PvsResult want = sgvsSets(field, 400, 7, first.bits);
   ASSERT_GT(want.entries(), first.entries());
   const std::string bits = readText(out("b.bin"));
-  const std::size_t words_at = 40 + (want.layout.viewCells() + 3) / 4 * 4;
+  const std::size_t words_at = 64 + (want.layout.viewCells() + 3) / 4 * 4;
   ASSERT_EQ(bits.size(), words_at + 4 * want.bits.size());
   for (std::size_t i = 0; i < want.bits.size(); ++i) {
     std::uint32_t v = 0;
@@ -3321,6 +3326,29 @@ TEST_F(Cli, PvsResumesFromAnEarlierBitset) {
   refused(" --view-cell 8 --tile 4 --seed 3 --bitset " + shellQuoted(out("a.bin")) + " --resume " +
               shellQuoted(out("a.bin")),
           "outputs never replace an input");
+  // The sets of another field, view band or z-scale, or with the filter's entries: a bitset of a
+  // field without a wall, resumed on one with it, gave every view cell the tiles behind the wall
+  // (exit 0). And a version 1 file, which records none of it.
+  const std::string other =
+      writeField("other.exr", 30, 22, [](int col, int row) { return 0.1f * float(col * row % 7); });
+  refused(" --view-cell 8 --tile 4 --seed 3 --view-height 2 --resume " + shellQuoted(out("a.bin")),
+          "another field");
+  refused(" --view-cell 8 --tile 4 --seed 3 --z-scale 2 --resume " + shellQuoted(out("a.bin")),
+          "another field");
+  const CliResult elsewhere = run("pvs " + shellQuoted(other) + " -o " + shellQuoted(out("c.json")) +
+                                  " --samples 100 --seed 3 --resume " + shellQuoted(out("a.bin")) + grid);
+  EXPECT_EQ(elsewhere.status, 2);
+  EXPECT_NE(elsewhere.err.find("computed on another field"), std::string::npos) << elsewhere.err;
+  ASSERT_EQ(run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out("f.json")) +
+                " --samples 300 --filter 2 " + "--bitset " + shellQuoted(out("f.bin")) + grid)
+                .status,
+            0);
+  refused(" --view-cell 8 --tile 4 --seed 3 --resume " + shellQuoted(out("f.bin")), "written with --filter");
+  std::string first_version = readText(out("a.bin"));
+  first_version[8] = 1;
+  { std::ofstream(out("v1.bin"), std::ios::binary) << first_version; }
+  refused(" --view-cell 8 --tile 4 --seed 3 --resume " + shellQuoted(out("v1.bin")), "format version 1");
+  EXPECT_FALSE(fs::exists(out("c.json")));
   const CliResult not_bits = run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out("c.json")) +
                                  " --samples 100 --seed 3 --resume " + shellQuoted(out("a.json")) + grid);
   EXPECT_EQ(not_bits.status, 1);

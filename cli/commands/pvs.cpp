@@ -13,6 +13,7 @@
 #include "../pipeline.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/image_io.hpp"
+#include "hfvis/viewshed.hpp"
 #include "io/output_files.hpp"
 
 namespace hfvis::cli {
@@ -35,12 +36,45 @@ std::uint32_t getU32(const char* at) {
          std::uint32_t(b[3]) << 24;
 }
 
-std::string bitsetFile(const PvsResult& r) {
+// What a bitset's sets were computed from, which a run resumed from them must share: the field
+// (its heights' bits, size, cell sizes and z-scale, as a 64-bit hash), the view band, and whether
+// the visibility filter added entries. A bitset of another field was resumed, and its sets,
+// seen through a wall this field has, went out as this field's (exit 0).
+struct BitsetOrigin {
+  std::uint64_t field = 0;
+  float band_low = 0.0f, band_high = 0.0f;
+  bool filtered = false;
+};
+
+BitsetOrigin originOf(const HeightField& field, const PvsGrid& grid, const PvsOptions& options) {
+  std::uint64_t hash = heightsFingerprint(field);
+  const auto mix = [&](const void* data, std::size_t size) {
+    for (std::size_t i = 0; i < size; ++i)
+      hash = (hash ^ static_cast<const unsigned char*>(data)[i]) * 1099511628211ull;
+  };
+  for (const int v : {field.width, field.height}) mix(&v, sizeof v);
+  for (const double v : {field.cell_size_x, field.cell_size_y, field.z_scale}) mix(&v, sizeof v);
+  return {hash, static_cast<float>(grid.band_low), static_cast<float>(grid.band_high), options.filter > 0.0};
+}
+
+std::uint32_t floatBits(float v) {
+  std::uint32_t bits;
+  std::memcpy(&bits, &v, sizeof bits);
+  return bits;
+}
+
+std::string bitsetFile(const PvsResult& r, const BitsetOrigin& origin) {
   std::string out("HFVPVS1", 8);  // 7 letters and a zero byte
-  putU32(out, 1);                 // the format's version
+  putU32(out, 2);                 // the format's version
   for (int v : {r.layout.view_x, r.layout.view_y, r.layout.tiles_x, r.layout.tiles_y, r.words,
                 r.layout.view_cell, r.layout.tile})
     putU32(out, static_cast<std::uint32_t>(v));
+  putU32(out, static_cast<std::uint32_t>(origin.field & 0xFFFFFFFFu));
+  putU32(out, static_cast<std::uint32_t>(origin.field >> 32));
+  putU32(out, floatBits(origin.band_low));
+  putU32(out, floatBits(origin.band_high));
+  putU32(out, origin.filtered ? 1u : 0u);
+  putU32(out, 0u);  // (reserved)
   for (std::uint8_t c : r.computed) out.push_back(static_cast<char>(c ? 1 : 0));
   while (out.size() % 4) out.push_back('\0');
   for (std::uint32_t w : r.bits) putU32(out, w);
@@ -54,19 +88,28 @@ struct BitsetFile {
   std::vector<std::uint32_t> bits;
 };
 
-// The grid is compared with this run's (`l`) from the header, before the body is read.
-BitsetFile readBitsetFile(const std::string& path, const PvsLayout& l, const std::string& input) {
+constexpr int kBitsetHeader = 64;  // bytes before the computed view cells
+
+// The grid is compared with this run's (`l`) from the header, before the body is read, and so is
+// what the sets were computed from (`origin`).
+BitsetFile readBitsetFile(const std::string& path, const PvsLayout& l, const BitsetOrigin& origin,
+                          const std::string& input) {
   detail::requireInputFile(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw IoError(path, std::string("cannot open: ") + std::strerror(errno));
   const auto fail = [&](const std::string& why) -> IoError {
     return IoError(path, "not a PVS bitset file of hfvis pvs --bitset (docs/PVS.md): " + why);
   };
-  char head[40];
-  if (!in.read(head, sizeof(head))) throw fail("shorter than its 40-byte header");
+  char head[kBitsetHeader];
+  if (!in.read(head, 12)) throw fail("shorter than its header");
   if (std::memcmp(head, "HFVPVS1", 8) != 0) throw fail("it does not start with HFVPVS1");
   const auto u32 = [&](int at) { return getU32(head + at); };
-  if (u32(8) != 1) throw fail("format version " + std::to_string(u32(8)) + ", this hfvis reads version 1");
+  if (u32(8) == 1)
+    throw UsageError("--resume: " + path +
+                     " is a bitset of format version 1, which records nothing of the field its sets were "
+                     "computed on: run again from the start, or resume from a file this hfvis wrote");
+  if (u32(8) != 2) throw fail("format version " + std::to_string(u32(8)) + ", this hfvis reads version 2");
+  if (!in.read(head + 12, kBitsetHeader - 12)) throw fail("shorter than its 64-byte header");
   BitsetFile f;
   f.view_x = u32(12), f.view_y = u32(16), f.tiles_x = u32(20), f.tiles_y = u32(24), f.words = u32(28);
   f.view_cell = u32(32), f.tile = u32(36);
@@ -85,13 +128,24 @@ BitsetFile readBitsetFile(const std::string& path, const PvsLayout& l, const std
                      std::to_string(l.tiles_x) + " x " + std::to_string(l.tiles_y) + " tiles of " +
                      std::to_string(l.tile) + " (" + input +
                      "): give the same field, --view-cell and --tile");
-  const std::uint64_t padded = (views + 3) / 4 * 4, size = 40 + padded + 4 * views * f.words;
+  const std::uint64_t field = std::uint64_t(u32(40)) | std::uint64_t(u32(44)) << 32;
+  if (field != origin.field || u32(48) != floatBits(origin.band_low) ||
+      u32(52) != floatBits(origin.band_high))
+    throw UsageError("--resume: " + path +
+                     "'s sets were computed on another field (its heights, cell size or " +
+                     "z-scale) or view band than this run's (" + input +
+                     "): a resumed run adds to the sets of the same field and band");
+  if (u32(56) != 0)
+    throw UsageError("--resume: " + path +
+                     " was written with --filter, whose entries a resumed run would take "
+                     "for sampled ones: resume only from steps run without it");
+  const std::uint64_t padded = (views + 3) / 4 * 4, size = kBitsetHeader + padded + 4 * views * f.words;
   in.seekg(0, std::ios::end);
   if (std::uint64_t(in.tellg()) != size)
     throw fail("it is " + std::to_string(std::uint64_t(in.tellg())) + " bytes, its header asks " +
                std::to_string(size));
-  in.seekg(40);
-  std::string body(size - 40, '\0');
+  in.seekg(kBitsetHeader);
+  std::string body(size - kBitsetHeader, '\0');
   if (!in.read(&body[0], std::streamsize(body.size()))) throw IoError(path, "cannot read it whole");
   f.computed.assign(body.begin(), body.begin() + std::ptrdiff_t(views));
   for (std::uint8_t& c : f.computed) {
@@ -146,6 +200,7 @@ class Pvs : public Computation {
         }
       layoutOf(field);
     }
+    origin_ = originOf(field, grid_, run_.pvs);
     if (!run_.pvs_resume.empty()) resumeFrom(layout);
     if (run_.pvs_preview_cell_given) {
       const ReceiverPixel& p = run_.pvs_preview_cell;
@@ -231,7 +286,7 @@ class Pvs : public Computation {
     }
     json << "\n  ]\n}\n";
     outputs.text(run_.output, json.str());
-    if (!run_.bitset_output.empty()) outputs.text(run_.bitset_output, bitsetFile(r));
+    if (!run_.bitset_output.empty()) outputs.text(run_.bitset_output, bitsetFile(r, origin_));
     if (!run_.preview.empty()) {
       // PVS size per view cell, bright over a dimmed hillshade; view cells not computed, and
       // nodata, dark. With --preview-view-cell: that view cell (its outline brightest) and the
@@ -290,7 +345,7 @@ class Pvs : public Computation {
   // --view-mask gives one, which must then be the same).
   void resumeFrom(const PvsLayout& l) {
     const std::string& path = run_.pvs_resume;
-    BitsetFile f = readBitsetFile(path, l, run_.input);
+    BitsetFile f = readBitsetFile(path, l, origin_, run_.input);
     if (std::count(f.computed.begin(), f.computed.end(), 1) == 0)
       throw UsageError("--resume: " + path + " computed no view cell");
     if (run_.pvs_mask.empty()) {
@@ -313,6 +368,7 @@ class Pvs : public Computation {
   PvsGrid grid_;
   PvsResult result_;
   std::vector<std::uint32_t> start_;
+  BitsetOrigin origin_;  // what the sets are computed from: the --bitset header's, and --resume's check
 };
 
 void checkPvs(const std::string& name, const RunArguments& run) {
