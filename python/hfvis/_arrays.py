@@ -351,7 +351,7 @@ def receiver_pixels(receivers):
 
 def observer_pixel(observer):
     pair = np.asarray(observer)
-    if pair.shape != (2,) or pair.dtype.kind not in "iu":
+    if pair.shape != (2,) or pair.dtype.kind not in "iu" or not all(-2**31 <= int(v) < 2**31 for v in pair):
         raise InvalidArgumentError(f"an observer is a pixel (column, row) of two integers, got {observer!r}")
     return int(pair[0]), int(pair[1])
 

@@ -19,6 +19,9 @@ SURFACE_PIXELS = 2
 
 def halo(geometry, max_distance, operation):
     """The halo in pixels that holds everything the results of a chunk depend on."""
+    if max_distance and not math.isfinite(max_distance):
+        raise InvalidArgumentError(f"{operation} on a Dask array needs a finite max_distance (the halo around each "
+                                   f"chunk), got {max_distance!r}")
     if not max_distance or max_distance <= 0:
         raise InvalidArgumentError(
             f"{operation} on a Dask array needs max_distance > 0 (ground units): each chunk is computed with a halo "
@@ -35,6 +38,8 @@ def _block(block, lowest, operation, geometry, options, device, depth, chunks, b
     told where the block lies in the whole field and the whole field's lowest height (`lowest`, a
     1 x 1 block; HeightField::origin), so that it samples every line where the whole field's run does: the
     results inside the halo are that run's bit for bit."""
+    if not math.isfinite(float(lowest.flat[0])):  # (as the whole field in memory is refused)
+        raise InvalidArgumentError("every height is nodata (NaN or infinite)")
     i, j = block_id[-2], block_id[-1]
     top = depth if i > 0 else 0
     left = depth if j > 0 else 0
@@ -90,6 +95,8 @@ def chunked(operation, heights, geometry, options, device=""):
     import dask.array as da
     from dask.array.overlap import ensure_minimum_chunksize
 
+    if 0 in heights.shape:
+        raise InvalidArgumentError(f"heights are empty ({heights.shape[0]} x {heights.shape[1]})")
     depth = halo(geometry, options.get("max_distance"), operation)
     # Every chunk at least the halo deep, so that each block's halo comes from its neighbours alone.
     chunks = tuple(c if len(c) == 1 else (sum(c),) if sum(c) <= depth else ensure_minimum_chunksize(depth, c)

@@ -572,7 +572,7 @@ def region_visibility(heights, sources, *, samples=16, height=2.0, absolute=Fals
     "rgb" over "channel" R, G, B): per point the colours of the samples it sees, summed, / S."""
     options = {"sources": sources, "samples": _whole("samples", samples, None, 2**31 - 1), "height": float(height),
                "absolute": bool(absolute),
-               "target_height": float(target_height), "method": method, "seed": int(seed),
+               "target_height": float(target_height), "method": method, "seed": _whole("seed", seed, 0, 2**32 - 1),
                "decorrelate": bool(decorrelate), "max_distance": float(max_distance), "curvature": float(curvature),
                "light_image": light_image}
     if _is_dataarray(heights) and _is_dask(heights.data):
@@ -607,7 +607,7 @@ def region_pair_visibility(heights, sources, receivers, *, samples=16, source_he
     DataArray, else None). progress as region_visibility's."""
     options = {"sources": sources, "receivers": receivers, "samples": _whole("samples", samples, None, 2**31 - 1),
                "source_height": float(source_height), "receiver_height": float(receiver_height),
-               "absolute": bool(absolute), "method": method, "seed": int(seed), "decorrelate": bool(decorrelate),
+               "absolute": bool(absolute), "method": method, "seed": _whole("seed", seed, 0, 2**32 - 1), "decorrelate": bool(decorrelate),
                "max_distance": float(max_distance), "curvature": float(curvature)}
     if _is_dataarray(heights) and _is_dask(heights.data):
         heights = heights.compute()
@@ -650,8 +650,8 @@ def pvs(heights, *, samples=0, pixel_error=0.0, seconds=0.0, view_cell=32, band_
     options = {"samples": _whole("samples", samples, None, 2**31 - 1), "pixel_error": float(pixel_error),
                "seconds": float(seconds), "view_cell": _whole("view_cell", view_cell, None, 2**31 - 1),
                "band_low": float(band_low), "band_high": float(band_high),
-               "tile": int(tile), "mask": None if mask is None else np.asarray(mask), "method": method,
-               "batch": int(batch), "seed": int(seed), "resolution": float(resolution), "filter": float(filter),
+               "tile": _whole("tile", tile, None, 2**31 - 1), "mask": None if mask is None else np.asarray(mask),
+               "method": method, "batch": _whole("batch", batch, None, 2**31 - 1), "seed": _whole("seed", seed, 0, 2**32 - 1), "resolution": float(resolution), "filter": float(filter),
                "estimate_entries": int(estimate_entries), "witnesses": bool(witnesses),
                "memory_budget_bytes": _budget(memory_budget_bytes),
                "start": None if start is None else np.ascontiguousarray(start, dtype=np.uint32).ravel()}

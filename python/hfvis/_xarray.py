@@ -49,7 +49,7 @@ class Grid:
         geographic CRS, by the library's own conversion), else (no coordinates at all) 1."""
         if cell_size is None and self.transform is None:
             for dim in (self.y_dim, self.x_dim):
-                if dim in self.array.coords and self.array.sizes[dim] < 2:
+                if dim in self.array.coords and self.array.sizes[dim] == 1:
                     # (a 1 x N field took a cell size of 1, whatever its x coordinates said)
                     raise InvalidArgumentError(f"the {dim} coordinates hold one value, which gives no spacing: give "
                                                "cell_size")
@@ -159,7 +159,7 @@ def _geotransform(array):
     if x_dim in array.coords and y_dim in array.coords:
         xs, ys = np.asarray(array[x_dim].values, float), np.asarray(array[y_dim].values, float)
         if len(xs) >= 2 and len(ys) >= 2:
-            dx, dy = _spacing(xs, x_dim), _spacing(ys, y_dim)
+            dx, dy = _spacing(xs, x_dim, array[x_dim].dtype), _spacing(ys, y_dim, array[y_dim].dtype)
             from_coords = (xs[0] - dx / 2, dx, 0.0, ys[0] - dy / 2, 0.0, dy)
     rio = _rio(array)
     if rio is None or "spatial_ref" not in array.coords:
@@ -177,10 +177,13 @@ def _geotransform(array):
     return from_coords
 
 
-def _spacing(values, dim):
+def _spacing(values, dim, dtype):
     steps = np.diff(values)
     step = (values[-1] - values[0]) / (len(values) - 1)
-    if step == 0 or not np.allclose(steps, step, rtol=1e-6, atol=0):
+    # (the coordinates' own rounding allowed for: float32 latitudes of a 3-arc-second grid step
+    # unevenly by 3e-3 of a step, and were refused)
+    rounding = 4 * np.finfo(dtype).eps * float(np.max(np.abs(values))) if dtype.kind == "f" else 0.0
+    if step == 0 or not np.allclose(steps, step, rtol=1e-6, atol=rounding):
         raise InvalidArgumentError(f"the {dim} coordinates are not evenly spaced: hfvis needs a regular grid")
     return step
 

@@ -182,3 +182,46 @@ def test_nodata_in_the_heights_dtype_and_masked_arrays(small):
     assert np.array_equal(np.isnan(out), np.ma.getmaskarray(masked))
     # heights far from 0 whose float32 rounding stays small against a cell pass
     assert np.isfinite(hfvis.sky_view_factor(small.astype(np.float64) + 4000.0, directions=8)).all()
+
+
+def test_integer_options_and_dask_edges_are_refused_clearly():
+    """Integer options beyond their type or not whole gave nanobind's bare TypeError or ran
+    truncated (seed=1.5 as 1, tile=2.5 as 2); a Dask field's infinite or NaN max_distance, empty
+    field or all-nodata one gave numpy's and Python's own errors, or NaN everywhere."""
+    import dask.array as da
+    import xarray as xr
+
+    z = np.random.default_rng(0).normal(size=(30, 40)).cumsum(0).cumsum(1).astype(np.float32)
+    for call in (lambda: hfvis.region_visibility(z, (0, 0, 3, 3), seed=-1),
+                 lambda: hfvis.region_visibility(z, (0, 0, 3, 3), seed=1.5),
+                 lambda: hfvis.pvs(z, samples=100, tile=2.5),
+                 lambda: hfvis.pvs(z, samples=100, batch=2**40),
+                 lambda: hfvis.viewshed(z, (2**40, 0))):
+        with pytest.raises(hfvis.InvalidArgumentError):
+            call()
+    a = xr.DataArray(da.from_array(z, chunks=10), dims=("y", "x"),
+                     coords={"y": -30.0 * np.arange(30), "x": 30.0 * np.arange(40)})
+    for distance in (float("nan"), float("inf")):
+        with pytest.raises(hfvis.InvalidArgumentError, match="finite max_distance"):
+            hfvis.sky_view_factor(a, directions=8, max_distance=distance).compute()
+    with pytest.raises(hfvis.InvalidArgumentError, match="empty"):
+        hfvis.sky_view_factor(a[:0], directions=8, max_distance=100).compute()
+    with pytest.raises(hfvis.InvalidArgumentError, match="every height is nodata"):
+        hfvis.sky_view_factor(a * np.nan, directions=8, max_distance=100).compute()
+
+
+def test_float32_coordinates_of_a_regular_grid_are_taken():
+    """A 3-arc-second latitude / longitude grid with float32 coordinates (as NetCDF often holds
+    them) steps unevenly by their rounding: it was refused as not evenly spaced."""
+    import xarray as xr
+
+    step = 1 / 1200
+    z = np.random.default_rng(1).normal(size=(40, 50)).cumsum(0).cumsum(1).astype(np.float32)
+    lat = (45 - step * (np.arange(40) + 0.5)).astype(np.float32)
+    lon = (7 + step * (np.arange(50) + 0.5)).astype(np.float32)
+    out = hfvis.sky_view_factor(xr.DataArray(z, dims=("lat", "lon"), coords={"lat": lat, "lon": lon}), directions=8)
+    assert np.isfinite(out.values).all()
+    uneven = lat.copy()
+    uneven[5] += step / 10
+    with pytest.raises(hfvis.InvalidArgumentError, match="not evenly spaced"):
+        hfvis.sky_view_factor(xr.DataArray(z, dims=("lat", "lon"), coords={"lat": uneven, "lon": lon}), directions=8)
