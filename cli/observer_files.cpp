@@ -78,11 +78,18 @@ std::vector<CsvPoint> parsePoints(const std::string& path, std::istream& in, dou
       throw IoError(path, "is UTF-16 text; save it as UTF-8 (or ASCII) with lines col,row[,height]");
     double col = 0, row_index = 0, height = default_height;
     const bool numbers = fields.size() >= 2 && number_in(fields[0], col) && number_in(fields[1], row_index);
-    // A header: before any point, a line whose fields all start with a letter.
+    // A header: before any point, a line whose fields all start with a letter and are no numbers
+    // strtod reads ("nan,nan" was passed over as a header, where a later one is refused).
     bool words = true;
     for (const std::string& f : fields) {
-      const std::size_t a = f.find_first_not_of(" \t");
+      const std::size_t a = f.find_first_not_of(" \t"), b = f.find_last_not_of(" \t");
       words = words && a != std::string::npos && std::isalpha(static_cast<unsigned char>(f[a]));
+      if (words) {
+        const std::string word = f.substr(a, b - a + 1);
+        char* end = nullptr;
+        std::strtod(word.c_str(), &end);
+        words = end != word.c_str() + word.size();
+      }
     }
     if (!numbers && points.empty() && !header_seen && words) {
       header_seen = true;

@@ -469,6 +469,14 @@ TEST(BounceKernels, BadRadianceIsRejectedBeforeLaunch) {
   }
   radiance.channels[1][10] = -1.0f;
   EXPECT_THROW(computeBounce(testContext(), field, radiance, options), InvalidArgument);
+  // (3e38 overflowed the gather's sums, and the message blamed the heights)
+  radiance.channels[1][10] = 3e38f;
+  try {
+    computeBounce(testContext(), field, radiance, options);
+    ADD_FAILURE() << "a radiance of 3e38 accepted";
+  } catch (const InvalidArgument& error) {
+    EXPECT_NE(std::string(error.what()).find("at most 1e30"), std::string::npos) << error.what();
+  }
   radiance.channels[1][10] = 1.0f;
   radiance.channels[1].pop_back();
   EXPECT_THROW(computeBounce(testContext(), field, radiance, options), InvalidArgument);

@@ -2988,6 +2988,15 @@ TEST_F(Cli, AreaLightFromASourcesFile) {
     EXPECT_EQ(commented.status, 0) << commented.err;
     fs::remove(out("c.exr"));
   }
+  // A first line of numbers strtod reads, nan or inf, is no header (it was passed over as one, where
+  // a later one is refused): refused, naming the line.
+  for (const char* first : {"nan,nan\n", "inf,Infinity,1\n"}) {
+    SCOPED_TRACE(first);
+    { std::ofstream(in("nan.csv"), std::ios::binary) << first << "2,3,1\n"; }
+    expectFailure(run("arealight " + shellQuoted(field) + " -o " + shellQuoted(out("n.exr")) + " --sources " +
+                      shellQuoted(in("nan.csv")) + " --light-height 4 -q"),
+                  1, "line 1:");
+  }
   const CliResult r = run("arealight " + shellQuoted(field) + " -o " + shellQuoted(out("a.exr")) +
                           " --sources " + shellQuoted(in("sources.csv")) + " --light-height 4 -q");
   ASSERT_EQ(r.status, 0) << r.err;

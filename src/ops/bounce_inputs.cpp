@@ -71,9 +71,11 @@ void validate(const HeightField& field, const ExitRadiance& radiance) {
     }
     for (std::size_t p = 0; p < plane.size(); ++p) {
       if (!std::isfinite(field.heights[p])) continue;  // nodata: ignored
-      if (!std::isfinite(plane[p]) || plane[p] < 0.0f) {
+      // (the gather sums radiance times weights over whole lines in float: 1e30 leaves room, as
+      // for an environment's; 3e38 overflowed there, and the message blamed the heights)
+      if (!(std::isfinite(plane[p]) && plane[p] >= 0.0f && plane[p] <= 1e30f)) {
         throw InvalidArgument(
-            "the exit radiance must be finite and >= 0 where the height is valid; channel " +
+            "the exit radiance must be finite, >= 0 and at most 1e30 where the height is valid; channel " +
             std::to_string(c) + " at pixel (" + std::to_string(p % field.width) + ", " +
             std::to_string(p / field.width) + ") is " + std::to_string(plane[p]));
       }
