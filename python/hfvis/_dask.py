@@ -130,6 +130,8 @@ def _viewshed_window(window, geometry, options, device, first_col, first_row):
     o = dict(options)
     col, row = _arrays.observer_pixel(options["observer"])
     o["observer"] = np.array([col - first_col, row - first_row])
+    if not np.isfinite(window[row - first_row, col - first_col]):  # (named in the window's pixels, it misled)
+        raise InvalidArgumentError(f"observer {col},{row} stands on nodata")
     return _arrays.compute("viewshed", np.ascontiguousarray(window, dtype=np.float32), geometry, o, device)["visible"]
 
 
@@ -158,6 +160,8 @@ def viewshed(heights, geometry, options, device=""):
 
     col, row = _arrays.observer_pixel(options["observer"])
     height, width = heights.shape
+    if not (0 <= col < width and 0 <= row < height):  # (now, not at compute, in the window's pixels)
+        raise InvalidArgumentError(f"observer {col},{row} is outside the {width} x {height} field")
     first_row, first_col, last_row, last_col = 0, 0, height, width
     if options.get("max_distance") and not geometry["row_cell_size_x"]:
         depth = halo(geometry, options["max_distance"], "viewshed")

@@ -208,6 +208,13 @@ def test_integer_options_and_dask_edges_are_refused_clearly():
         hfvis.sky_view_factor(a[:0], directions=8, max_distance=100).compute()
     with pytest.raises(hfvis.InvalidArgumentError, match="every height is nodata"):
         hfvis.sky_view_factor(a * np.nan, directions=8, max_distance=100).compute()
+    # A viewshed's observer outside the field is refused at the call, and one on nodata named in
+    # the field's pixels (the window's were given: "observer 6,6", "outside the 7 x 13 field")
+    with pytest.raises(hfvis.InvalidArgumentError, match="observer 100,6 is outside the 40 x 30 field"):
+        hfvis.viewshed(a, (100, 6), max_distance=100, pixels=True)
+    holed = a.where(~((a.x == 600) & (a.y == -600)))
+    with pytest.raises(hfvis.InvalidArgumentError, match="observer 20,20 stands on nodata"):
+        hfvis.viewshed(holed, (20, 20), max_distance=100, pixels=True).compute()
 
 
 def test_float32_coordinates_of_a_regular_grid_are_taken():
