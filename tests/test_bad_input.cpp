@@ -106,9 +106,9 @@ TEST(BadInput, Fields) {
       "float arithmetic");
   expectError<InvalidArgument>([&] { computeViewshed(testContext(), high, Observer{}, ViewshedOptions{}); },
                                "float arithmetic");
-  // Nor heights so far from 0 that float32's spacing there swallows the relief: near 1e9 (steps
-  // of 64, the relief 64) an eye 20 above the ground was lost, exit 0. Near 1e5 (steps of 1/128)
-  // they are kept.
+  // Nor heights so far from 0 that float32's spacing there passes a tenth of a cell: near 1e9
+  // (steps of 64) an eye 20 above the ground was lost, exit 0. Near 1e5 (steps of 1/128) they are
+  // kept.
   for (const float offset : {1e9f, 1e5f}) {
     SCOPED_TRACE(offset);
     HeightField far = good;

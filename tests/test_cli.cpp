@@ -636,8 +636,10 @@ TEST_F(Cli, AFilesCellSizeOutsideWhatTheKernelsHoldIsRefused) {
     SCOPED_TRACE(pixel);
     hfvis::testing::writeGdalGeoTiff(tif, 20, 16, values, {500000.0, pixel, 0.0, 4100000.0, 0.0, -pixel},
                                      hfvis::testing::crsWkt("EPSG:32633"), -9999.0);
-    expectFailure(run("viewcount " + shellQuoted(tif) + " -o " + shellQuoted(out("v.tif")) + " -k 8"), 1,
-                  "outside 1e-06 .. 1e+09");
+    const CliResult refused =
+        run("viewcount " + shellQuoted(tif) + " -o " + shellQuoted(out("v.tif")) + " -k 8");
+    expectFailure(refused, 1, "outside 1e-06 .. 1e+09");
+    EXPECT_NE(refused.err.find("give one with --cell-size"), std::string::npos) << refused.err;
   }
   const CliResult given =
       run("viewcount " + shellQuoted(tif) + " -o " + shellQuoted(out("v.tif")) + " -k 8 -q --cell-size 2");

@@ -233,7 +233,7 @@ TEST_F(OutputFilesTest, AnotherUsersFileInAStickyDirectoryIsRefusedBeforeAnyWrit
   std::vector<std::string> names;
   for (const auto& entry : fs::directory_iterator(sticky)) names.push_back(entry.path().filename().string());
   EXPECT_EQ(names, std::vector<std::string>{"theirs.exr"});
-  // Their own file, and the superuser, replace it as before.
+  // The superuser replaces it as before.
   writeImage(theirs, noiseImage());
   EXPECT_NE(readText(theirs), "their result");
 }

@@ -178,7 +178,7 @@ void checkViewshed(const std::string&, const RunArguments& run) {
     throw UsageError("missing --observer COL,ROW or --observers FILE.csv (who looks)");
   if ((run.with_angle || run.with_needed_height) && (run.observers.size() > 1 || !run.observers_file.empty()))
     throw UsageError(std::string(run.with_angle ? "--angle" : "--needed-height") +
-                     " is for one observer (several give a count)");
+                     " is for one observer given by --observer (several, or a file of them, give a count)");
   if (run.cull_level_given && !run.culled) throw UsageError("--cull-level is for --method culled");
   if (!run.observers_file.empty() && samePath(run.output, run.observers_file))
     throw UsageError("--observers must differ from -o, both are " + inQuotes(run.output));

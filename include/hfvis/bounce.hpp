@@ -55,8 +55,8 @@ struct BounceOptions : SweepOptions {
 };
 
 // Exit radiance per pixel of the height field: 1..kMaxBounceChannels planes (grey, RGB,
-// ...), each width*height, finite and >= 0 at every pixel whose height is valid (values at
-// nodata pixels are ignored).
+// ...), each width*height, finite, >= 0 and at most 1e30 at every pixel whose height is valid
+// (values at nodata pixels are ignored).
 struct ExitRadiance {
   int width = 0;
   int height = 0;

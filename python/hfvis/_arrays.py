@@ -113,7 +113,13 @@ def geometry(cell_size=None, z_scale=1.0, row_cell_sizes=None):
         cx, cy = float(pair[0]), float(pair[1])
     rows_x, rows_y = ([], []) if row_cell_sizes is None else (list(map(float, row_cell_sizes[0])),
                                                                list(map(float, row_cell_sizes[1])))
-    # (the range the kernels' single precision holds, 1e-6 .. 1e9, is the library's check)
+    # The range the kernels' single precision holds, the library's (its validate refuses the same):
+    # checked here too, as the Dask path divides by the cell sizes before the library sees them.
+    for size in [cx, cy] + rows_x + rows_y:
+        if not (_core.least_cell_size <= size <= _core.most_cell_size):
+            raise InvalidArgumentError(f"the cell size {size:g} is outside {_core.least_cell_size:g} .. "
+                                       f"{_core.most_cell_size:g} ground units, what the kernels' single precision "
+                                       "holds")
     return {"cell_size_x": cx, "cell_size_y": cy, "row_cell_size_x": rows_x, "row_cell_size_y": rows_y,
             "z_scale": float(z_scale), "origin": []}
 

@@ -66,11 +66,21 @@ def _block(block, lowest, operation, geometry, options, device, depth, chunks, b
     return out[:, top:out.shape[1] - bottom, left:out.shape[2] - right]
 
 
+def _through_float32(block):
+    with np.errstate(over="ignore"):  # (beyond float32's range: refused in _kept_block, with a message)
+        return block.astype(np.float32).astype(np.float64)
+
+
 def _kept_block(block, rounding, low, high, nodata, cell_size):
+    if high.flat[0] > np.finfo(np.float32).max or low.flat[0] < -np.finfo(np.float32).max:
+        # (as heights_array says it in memory: they would turn into infinities, that is nodata)
+        raise InvalidArgumentError("heights beyond float32's range (about 3.4e38): scale them first")
     if high.flat[0] >= low.flat[0]:
         _core.require_heights_kept_in_float32(float(rounding.flat[0]), float(low.flat[0]),
                                               float(high.flat[0]), cell_size)
-    return np.where(_arrays.nodata_holes(block, nodata), np.float32(np.nan), block.astype(np.float32))
+    with np.errstate(over="ignore"):  # (infinities only at nodata here: the range is checked above)
+        narrow = block.astype(np.float32)
+    return np.where(_arrays.nodata_holes(block, nodata), np.float32(np.nan), narrow)
 
 
 def kept_in_float32(data, nodata, cell_size):
@@ -82,7 +92,7 @@ def kept_in_float32(data, nodata, cell_size):
 
     wide = data.astype(np.float64)
     keep = da.isfinite(wide) & ~data.map_blocks(_arrays.nodata_holes, nodata, dtype=bool)
-    rounding = da.where(keep, abs(wide - data.astype(np.float32).astype(np.float64)), 0.0).max()
+    rounding = da.where(keep, abs(wide - data.map_blocks(_through_float32, dtype=np.float64)), 0.0).max()
     low = da.where(keep, wide, np.inf).min()
     high = da.where(keep, wide, -np.inf).max()
     each = [da.broadcast_to(x, data.numblocks, chunks=1) for x in (rounding, low, high)]

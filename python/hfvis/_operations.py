@@ -133,7 +133,10 @@ def _marked(data, nodatas, scale, offset):
     offset; else a new array (Dask: block by block) with every value of `nodatas` (the array's own
     and the caller's `nodata`, each compared in the data's dtype: the caller's had replaced the
     array's) as NaN and the raster's scale and offset applied in float64 (they were ignored)."""
-    values = [v for v in nodatas if v is not None]
+    values = []
+    for v in nodatas:  # (the caller's nodata, the array's own: one copy of the field less)
+        if v is not None and not any(v == w or (v != v and w != w) for w in values):
+            values.append(v)
     if scale == 1.0 and offset == 0.0 and len(values) <= 1:
         return data, values[0] if values else None
     if data.dtype.kind not in "fiu":

@@ -228,18 +228,34 @@ def _require_earth_degrees(crs):
 
 
 def scale_offset(array):
-    """A raster's scale and offset not yet applied (rioxarray's open_rasterio, mask_and_scale=False,
-    keeps scale_factor and add_offset in the attributes; the CLI applies them, as GDAL's band
-    does): (1, 0) where there are none. (Those in the encoding were applied when the data were
-    decoded.)"""
-    scale, offset = array.attrs.get("scale_factor", 1.0), array.attrs.get("add_offset", 0.0)
+    """A raster's scale and offset not yet applied: (1, 0) where there are none. rioxarray's
+    open_rasterio (mask_and_scale=False, its default) keeps a band's scale_factor and add_offset in
+    the attributes over its integers; the CLI applies them, as GDAL's band does. Over floats they
+    may be applied already (dem * dem.scale_factor keeps the attributes), and per-band `scales` /
+    `offsets` name no band once one is selected: refused, with the ways out. (Those in the
+    encoding were applied when the data were decoded.)"""
+    attrs = array.attrs
+    scale, offset = attrs.get("scale_factor", 1.0), attrs.get("add_offset", 0.0)
     try:
         scale, offset = float(scale), float(offset)
+        per_band = any(float(v) != 1.0 for v in np.ravel(attrs.get("scales", 1.0))) or \
+            any(float(v) != 0.0 for v in np.ravel(attrs.get("offsets", 0.0)))
     except (TypeError, ValueError):
-        raise InvalidArgumentError(f"the DataArray's scale_factor {scale!r} and add_offset {offset!r} must be numbers")
+        raise InvalidArgumentError(f"the DataArray's scale_factor {scale!r} and add_offset {offset!r} (or scales and "
+                                   "offsets) must be numbers")
+    if per_band:
+        raise InvalidArgumentError("the DataArray's attributes hold per-band scales / offsets: open it with "
+                                   "rioxarray.open_rasterio(..., mask_and_scale=True), or apply them and drop them")
+    if (scale, offset) == (1.0, 0.0):
+        return scale, offset
     if not (math.isfinite(scale) and math.isfinite(offset) and scale != 0.0):
         raise InvalidArgumentError(f"the DataArray's scale_factor {scale!r} and add_offset {offset!r} must be finite, "
                                    "the scale not 0")
+    if array.dtype.kind != "i" and array.dtype.kind != "u":
+        raise InvalidArgumentError(f"the DataArray holds {array.dtype} values and a scale_factor {scale!r} / add_offset "
+                                   f"{offset!r} in its attributes, which may be applied already: open it with "
+                                   "rioxarray.open_rasterio(..., mask_and_scale=True), or drop the attributes once "
+                                   "they are applied")
     return scale, offset
 
 

@@ -630,6 +630,8 @@ NB_MODULE(_core, m) {
         "row_cell_size_y"_a, "z_scale"_a, "origin"_a = std::vector<double>{},
         "origin_row_cell_size_x"_a = std::vector<double>{},
         "origin_row_cell_size_y"_a = std::vector<double>{});
+  m.attr("least_cell_size") = kLeastCellSize;
+  m.attr("most_cell_size") = kMostCellSize;
   m.def("require_heights_kept_in_float32", &requireHeightsKeptInFloat32, "rounding"_a, "lowest"_a,
         "highest"_a, "cell_size"_a);
   m.def(

@@ -201,6 +201,13 @@ def test_integer_options_and_dask_edges_are_refused_clearly():
             call()
     a = xr.DataArray(da.from_array(z, chunks=10), dims=("y", "x"),
                      coords={"y": -30.0 * np.arange(30), "x": 30.0 * np.arange(40)})
+    for size in (0.0, float("nan"), -1.0, 1e-30):  # (before the halo: raw errors, or the field as one chunk)
+        with pytest.raises(hfvis.InvalidArgumentError, match="cell size"):
+            hfvis.sky_view_factor(a, directions=8, max_distance=100, cell_size=size)
+    far = a.astype(np.float64)
+    far[3, 3] = 1e39
+    with pytest.raises(hfvis.InvalidArgumentError, match="beyond float32's range"):
+        hfvis.sky_view_factor(far, directions=8, max_distance=100).compute()
     for distance in (float("nan"), float("inf")):
         with pytest.raises(hfvis.InvalidArgumentError, match="finite max_distance"):
             hfvis.sky_view_factor(a, directions=8, max_distance=distance).compute()

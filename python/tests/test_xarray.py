@@ -222,6 +222,17 @@ def test_a_rasters_scale_and_offset_are_applied(tmp_path):
     equal(scaled, hfvis.sky_view_factor(metres, directions=8, cell_size=30))
     with pytest.raises(hfvis.InvalidArgumentError, match="scale_factor"):
         hfvis.sky_view_factor(_grid(raw, scale_factor=0.0), directions=8)
+    # chunk by chunk, the same bits
+    chunked = hfvis.sky_view_factor(_grid(raw, scale_factor=0.1, add_offset=5.0, _FillValue=-32768).chunk(7),
+                                    directions=8, cell_size=30, max_distance=1e6)
+    equal(chunked, hfvis.sky_view_factor(metres, directions=8, cell_size=30, max_distance=1e6))
+    # over floats the scale may be applied already (dem * dem.scale_factor keeps the attributes:
+    # it was applied again), and per-band scales name no band: refused
+    with pytest.raises(hfvis.InvalidArgumentError, match="may be applied already"):
+        hfvis.sky_view_factor(_grid(raw * 0.1, scale_factor=0.1), directions=8)
+    with pytest.raises(hfvis.InvalidArgumentError, match="per-band scales"):
+        hfvis.sky_view_factor(_grid(raw, scales=(0.1, 0.2), offsets=(0.0, 0.0)), directions=8)
+    assert np.isfinite(hfvis.sky_view_factor(_grid(raw, scales=(1.0,), offsets=(0.0,)), directions=8).values).any()
 
 
 def test_nodata_is_marked_besides_the_arrays_own():

@@ -137,23 +137,22 @@ PreparedHeights prepareHeights(const HeightField& field, HeightOrigin origin, in
   }
   // From 0, float32's spacing grows with the heights themselves: heights near 1e9 keep steps of
   // 64, and an eye 20 above them was lost (a viewshed 11 times too small, exit 0; the sweep's
-  // heights, from their lowest, kept it). Refused where the spacing is coarser than a thousandth
-  // of the relief and a tenth of a cell (a plateau at 1e6 on cells of 1, steps of 1/16, is kept:
-  // a hard case the kernels and their references share).
+  // heights, from their lowest, kept it). Refused where the spacing passes a tenth of a cell (a
+  // slope error of a twentieth across one at most). A rule of the arithmetic near the heights,
+  // apart from requireHeightsKeptInFloat32's of values a reader changed: it takes no relief, so
+  // that a window of a field (a Dask viewshed's) is judged as the whole field is; a plateau at
+  // 1e6 on cells of 1 (steps of 1/16, a hard case the kernels and their references share) is kept.
   if (origin == HeightOrigin::Zero && highest >= lowest) {
     const float top = static_cast<float>(std::max(std::fabs(lowest), std::fabs(highest)) * field.z_scale);
     const double spacing = double(std::nextafter(top, std::numeric_limits<float>::infinity())) - double(top);
-    if (spacing > std::max(1e-3 * (highest - lowest) * field.z_scale,
-                           0.1 * std::min(field.cell_size_x, field.cell_size_y))) {
+    if (spacing > 0.1 * std::min(field.cell_size_x, field.cell_size_y)) {
       std::ostringstream message;
       message << "the heights span " << exactNumber(lowest) << " .. " << exactNumber(highest)
               << " with the z-scale " << field.z_scale
               << ", so far from 0 that float32, in which hfvis follows sight lines from given heights, holds "
                  "them "
                  "only in steps of "
-              << spacing
-              << " there: more than a thousandth of their relief and a tenth of a cell; subtract a "
-              << "constant from them first";
+              << spacing << " there: more than a tenth of a cell; subtract a constant from them first";
       throw InvalidArgument(message.str());
     }
   }

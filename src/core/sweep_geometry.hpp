@@ -65,8 +65,8 @@ float sampleHeight(const std::vector<float>& heights, int width, int height, Poi
 // 2^31 pixels) in float, which must stay finite. HeightOrigin::Zero keeps the heights where
 // they are (h * z_scale): the viewshed, region visibility and the ray caster, whose observers,
 // sources and targets may stand at absolute heights; it throws when a height itself would
-// exceed kMaxPreparedHeight, or lies so far from 0 that float32's spacing there is coarser than
-// a thousandth of the relief and a tenth of a cell.
+// exceed kMaxPreparedHeight, or lies so far from 0 that float32's spacing there passes a tenth
+// of a cell.
 constexpr double kMaxPreparedHeight = 1e28;
 struct PreparedHeights {
   std::vector<float> heights;

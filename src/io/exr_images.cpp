@@ -361,13 +361,15 @@ ImageChannels readExr(const std::string& path, std::uint64_t max_image_bytes, co
   } catch (const std::exception& e) {
     throw IoError(path, withDetail("cannot read pixel data; the file is truncated or corrupt", e.what()));
   }
-  // A UINT channel: float32 holds its integers exactly only up to 2^24, beyond by up to the value
-  // over 2^24 (the reader of heights asks requireHeightsKeptInFloat32 whether that is too much).
+  // A UINT channel: float32 holds its integers exactly only up to 2^24, beyond by up to half its
+  // spacing at the largest (the reader of heights asks requireHeightsKeptInFloat32 whether that
+  // is too much, as the GDAL reader asks of the rounding it measures).
   if (rounding) *rounding = 0.0;
   if (rounding && channel && header.channels().findChannel(image.names.front())->type == Imf::UINT) {
     const std::vector<float>& plane = image.planes.front();
     const auto high = std::max_element(plane.begin(), plane.end());
-    if (high != plane.end() && double(*high) > double(1 << 24)) *rounding = double(*high) / double(1 << 24);
+    if (high != plane.end() && double(*high) > double(1 << 24))
+      *rounding = 0.5 * (double(std::nextafter(*high, INFINITY)) - double(*high));
   }
   for (const char* name : {"hfvis:cell_size_x", "hfvis:cell_size_y"}) {
     const auto* value = header.findTypedAttribute<Imf::StringAttribute>(name);
