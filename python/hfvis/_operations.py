@@ -180,16 +180,24 @@ def _observers_as_pixels(operation, options, grid, flip_rows, flip_cols, pixels)
     def place(col, row):
         return (width - 1 - col if flip_cols else col), (height - 1 - row if flip_rows else row)
 
+    def pixel_of(x, y):
+        if pixels:  # (as a numpy field's: whole numbers; (-0.5, 2.9) ran as (0, 2))
+            return _arrays.observer_pixel((x, y))
+        if not (math.isfinite(float(x)) and math.isfinite(float(y))):
+            raise InvalidArgumentError(f"an observer's map coordinates must be finite, got ({x!r}, {y!r})")
+        return grid.pixel(float(x), float(y))
+
     options = dict(options)
     if operation == "viewshed":
-        x, y = options["observer"]
-        col, row = (int(x), int(y)) if pixels else grid.pixel(float(x), float(y))
-        options["observer"] = np.array(place(col, row))
+        observer = np.asarray(options["observer"])
+        if observer.shape != (2,):
+            raise InvalidArgumentError(f"an observer is a pair (x, y), got {options['observer']!r}")
+        options["observer"] = np.array(place(*pixel_of(*observer)))
     else:
         points = np.asarray(options["observers"])
         if points.ndim != 2 or points.shape[1] != 2:
             raise InvalidArgumentError(f"observers must be an N x 2 array, got shape {points.shape}")
-        placed = [place(*((int(x), int(y)) if pixels else grid.pixel(float(x), float(y)))) for x, y in points]
+        placed = [place(*pixel_of(x, y)) for x, y in points]
         options["observers"] = np.array(placed, dtype=np.int64).reshape(-1, 2)
     return options
 

@@ -224,6 +224,22 @@ def test_integer_options_and_dask_edges_are_refused_clearly():
         hfvis.viewshed(holed, (20, 20), max_distance=100, pixels=True).compute()
 
 
+def test_observers_and_suns_beyond_what_they_can_be_are_refused():
+    """A DataArray's observer pixels that are not whole numbers ran truncated ((-0.5, 2.9) as
+    (0, 2)), map coordinates of NaN gave a raw ValueError, a sun at azimuth 1e20 lit as another."""
+    import xarray as xr
+
+    z = np.random.default_rng(0).normal(size=(30, 40)).cumsum(0).cumsum(1).astype(np.float32)
+    a = xr.DataArray(z, dims=("y", "x"), coords={"y": -30.0 * np.arange(30), "x": 30.0 * np.arange(40)})
+    with pytest.raises(hfvis.InvalidArgumentError, match="two integers"):
+        hfvis.viewshed(a, (-0.5, 2.9), pixels=True)
+    with pytest.raises(hfvis.InvalidArgumentError, match="finite"):
+        hfvis.viewshed(a, (float("nan"), 0.0))
+    assert hfvis.viewshed(a, (3, 2), pixels=True).values[2, 3] == 1
+    with pytest.raises(hfvis.InvalidArgumentError, match="-720 .. 720"):
+        hfvis.sun_shading(z, 1e20, 10)
+
+
 def test_float32_coordinates_of_a_regular_grid_are_taken():
     """A 3-arc-second latitude / longitude grid with float32 coordinates (as NetCDF often holds
     them) steps unevenly by their rounding: it was refused as not evenly spaced."""

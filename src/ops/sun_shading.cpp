@@ -68,8 +68,10 @@ SunShadingResult computeSunShading(const ComputeContext& context, const HeightFi
   if (!(sun.size_deg >= 0.0 && sun.size_deg <= 10.0))
     throw InvalidArgument("the sun's size must be in [0, 10] degrees (got " + std::to_string(sun.size_deg) +
                           ")");
-  if (!std::isfinite(sun.position.azimuth_deg) || !(std::fabs(sun.position.elevation_deg) <= 90.0))
-    throw InvalidArgument("the sun's azimuth must be finite and its elevation in -90 .. 90 degrees");
+  // (two turns at most, as the azimuth offset: 1e20 degrees kept no fraction of a turn, and lit
+  // as another azimuth, exit 0)
+  if (!(std::fabs(sun.position.azimuth_deg) <= 720.0) || !(std::fabs(sun.position.elevation_deg) <= 90.0))
+    throw InvalidArgument("the sun's azimuth must lie in -720 .. 720 degrees and its elevation in -90 .. 90");
   HorizonOutputs outputs;
   outputs.horizon_angles = true;
   const HorizonResult horizons = computeHorizons(context, field, detail::sunSweep(sun, options), outputs);
