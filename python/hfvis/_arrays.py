@@ -4,6 +4,7 @@ arguments, and one operation run on hfvis._core. compute() takes and returns onl
 
 import datetime
 import math
+import os
 
 import numpy as np
 
@@ -173,8 +174,8 @@ def utc_seconds(when):
         return when.timestamp()
     if isinstance(when, np.datetime64):
         return float((when - np.datetime64(0, "s")) / np.timedelta64(1, "s"))
-    if isinstance(when, (int, float)):
-        return float(when)
+    if isinstance(when, (int, float, np.integer, np.floating)) and not isinstance(when, (bool, np.bool_)):
+        return float(when)  # (np.int64 seconds were refused where np.float64 ones were taken)
     raise InputTypeError(f"a time must be an ISO 8601 text, an aware datetime, a datetime64 or seconds, got {when!r}")
 
 
@@ -219,8 +220,8 @@ def compute(operation, heights, geometry, options, device="", progress=None):
         return _core.insolation(field, o, _sweep_options(options), device=device, progress=progress)
     if operation == "environment_light":
         environment = options["environment"]
-        if isinstance(environment, str):
-            env = _core.read_environment_map(environment, float(options["rotation_deg"]), int(options["table_rows"]))
+        if isinstance(environment, (str, os.PathLike)):  # (a pathlib.Path was refused as "not a path")
+            env = _core.read_environment_map(os.fspath(environment), float(options["rotation_deg"]), int(options["table_rows"]))
         else:
             radiance = np.asarray(environment)
             if radiance.ndim == 2:

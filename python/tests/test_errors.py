@@ -238,6 +238,10 @@ def test_observers_and_suns_beyond_what_they_can_be_are_refused():
     assert hfvis.viewshed(a, (3, 2), pixels=True).values[2, 3] == 1
     with pytest.raises(hfvis.InvalidArgumentError, match="-720 .. 720"):
         hfvis.sun_shading(z, 1e20, 10)
+    # (taken as their plain kinds are: np.int64 seconds, a pathlib.Path environment)
+    typed = hfvis.insolation(z, 32.9, -98.1, np.int64(1718978400), 1718985600.0)
+    plain = hfvis.insolation(z, 32.9, -98.1, 1718978400, 1718985600.0)
+    assert all(np.array_equal(a, b, equal_nan=True) for a, b in zip(typed, plain))
 
 
 def test_float32_coordinates_of_a_regular_grid_are_taken():

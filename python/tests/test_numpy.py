@@ -122,6 +122,8 @@ def test_environment_light_and_sun_position(tmp_path, projected_tif, dem):
     ours = hfvis.environment_light(dem, str(sky), directions=8, cell_size=30, nodata=NODATA)
     assert ours.shape == (3,) + dem.shape
     equal(ours, np.stack([r, g, b]))
+    # (a pathlib.Path is a path too: it was refused as "not a path")
+    equal(hfvis.environment_light(dem, sky, directions=8, cell_size=30, nodata=NODATA), ours)
     azimuth, elevation = hfvis.sun_position("2026-06-21T12:00:00Z", 46.6, 8.0)
     done = run_cli("sun-position", "--at", "2026-06-21T12:00:00Z", "--lat", "46.6", "--lon", "8.0", quiet=False)
     printed = dict(item.split("=") for item in done.stdout.split())
