@@ -221,7 +221,8 @@ def compute(operation, heights, geometry, options, device="", progress=None):
     if operation == "environment_light":
         environment = options["environment"]
         if isinstance(environment, (str, os.PathLike)):  # (a pathlib.Path was refused as "not a path")
-            env = _core.read_environment_map(os.fspath(environment), float(options["rotation_deg"]), int(options["table_rows"]))
+            env = _core.read_environment_map(os.fspath(environment), float(options["rotation_deg"]),
+                                             int(options["table_rows"]))
         else:
             radiance = np.asarray(environment)
             if radiance.ndim == 2:

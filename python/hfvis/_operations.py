@@ -618,7 +618,8 @@ def region_pair_visibility(heights, sources, receivers, *, samples=16, source_he
     DataArray, else None). progress as region_visibility's."""
     options = {"sources": sources, "receivers": receivers, "samples": _whole("samples", samples, None, 2**31 - 1),
                "source_height": float(source_height), "receiver_height": float(receiver_height),
-               "absolute": bool(absolute), "method": method, "seed": _whole("seed", seed, 0, 2**32 - 1), "decorrelate": bool(decorrelate),
+               "absolute": bool(absolute), "method": method, "seed": _whole("seed", seed, 0, 2**32 - 1),
+               "decorrelate": bool(decorrelate),
                "max_distance": float(max_distance), "curvature": float(curvature)}
     if _is_dataarray(heights) and _is_dask(heights.data):
         heights = heights.compute()
@@ -662,7 +663,8 @@ def pvs(heights, *, samples=0, pixel_error=0.0, seconds=0.0, view_cell=32, band_
                "seconds": float(seconds), "view_cell": _whole("view_cell", view_cell, None, 2**31 - 1),
                "band_low": float(band_low), "band_high": float(band_high),
                "tile": _whole("tile", tile, None, 2**31 - 1), "mask": None if mask is None else np.asarray(mask),
-               "method": method, "batch": _whole("batch", batch, None, 2**31 - 1), "seed": _whole("seed", seed, 0, 2**32 - 1), "resolution": float(resolution), "filter": float(filter),
+               "method": method, "batch": _whole("batch", batch, None, 2**31 - 1),
+               "seed": _whole("seed", seed, 0, 2**32 - 1), "resolution": float(resolution), "filter": float(filter),
                "estimate_entries": int(estimate_entries), "witnesses": bool(witnesses),
                "memory_budget_bytes": _budget(memory_budget_bytes),
                "start": None if start is None else np.ascontiguousarray(start, dtype=np.uint32).ravel()}
@@ -737,7 +739,8 @@ def _require_grid_of(radiance, heights):
     want = [d for d in heights.dims if not (d == "band" and heights.sizes[d] == 1)]
     got = list(radiance.dims[-2:])
     if got != want:
-        raise InvalidArgumentError(f"the radiance's dims {tuple(radiance.dims)} must end with the heights' {tuple(want)}")
+        raise InvalidArgumentError(f"the radiance's dims {tuple(radiance.dims)} must end with the heights' "
+                                   f"{tuple(want)}")
     for dim in want:
         if dim in radiance.coords and dim in heights.coords and \
                 not np.array_equal(radiance[dim].values, heights[dim].values):

@@ -252,10 +252,10 @@ def scale_offset(array):
         raise InvalidArgumentError(f"the DataArray's scale_factor {scale!r} and add_offset {offset!r} must be finite, "
                                    "the scale not 0")
     if array.dtype.kind != "i" and array.dtype.kind != "u":
-        raise InvalidArgumentError(f"the DataArray holds {array.dtype} values and a scale_factor {scale!r} / add_offset "
-                                   f"{offset!r} in its attributes, which may be applied already: open it with "
-                                   "rioxarray.open_rasterio(..., mask_and_scale=True), or drop the attributes once "
-                                   "they are applied")
+        raise InvalidArgumentError(f"the DataArray holds {array.dtype} values and a scale_factor {scale!r} / "
+                                   f"add_offset {offset!r} in its attributes, which may be applied already: open it "
+                                   "with rioxarray.open_rasterio(..., mask_and_scale=True), or drop the attributes "
+                                   "once they are applied")
     return scale, offset
 
 
