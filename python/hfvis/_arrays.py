@@ -105,13 +105,11 @@ def geometry(cell_size=None, z_scale=1.0, row_cell_sizes=None):
     per-row sequences (x, y) for latitude / longitude grids."""
     if cell_size is None:
         cx = cy = 1.0
-    elif np.ndim(cell_size) == 0:
-        cx = cy = float(cell_size)
     else:
-        pair = tuple(cell_size)
-        if len(pair) != 2:
+        pair = np.asarray(cell_size, dtype=object).ravel() if np.ndim(cell_size) <= 1 else ()
+        if len(pair) not in (1, 2) or not all(np.ndim(v) == 0 and np.asarray(v).dtype.kind in "iuf" for v in pair):
             raise InvalidArgumentError(f"cell_size must be a number or a pair (x, y), got {cell_size!r}")
-        cx, cy = float(pair[0]), float(pair[1])
+        cx, cy = float(pair[0]), float(pair[-1])
     rows_x, rows_y = ([], []) if row_cell_sizes is None else (list(map(float, row_cell_sizes[0])),
                                                                list(map(float, row_cell_sizes[1])))
     # The range the kernels' single precision holds, the library's (its validate refuses the same):
@@ -121,6 +119,8 @@ def geometry(cell_size=None, z_scale=1.0, row_cell_sizes=None):
             raise InvalidArgumentError(f"the cell size {size:g} is outside {_core.least_cell_size:g} .. "
                                        f"{_core.most_cell_size:g} ground units, what the kernels' single precision "
                                        "holds")
+    if np.ndim(z_scale) != 0 or np.asarray(z_scale).dtype.kind not in "iuf":
+        raise InvalidArgumentError(f"z_scale must be a number, got {z_scale!r}")
     return {"cell_size_x": cx, "cell_size_y": cy, "row_cell_size_x": rows_x, "row_cell_size_y": rows_y,
             "z_scale": float(z_scale), "origin": []}
 

@@ -278,11 +278,21 @@ def _whole(name, value, least, most):
     return whole
 
 
+def _real(name, value):
+    """A number option as a float; anything else refused with its name (None, text or a list gave
+    float()'s bare TypeError or ValueError)."""
+    if np.ndim(value) != 0 or np.asarray(value).dtype.kind not in "iuf":
+        raise InvalidArgumentError(f"{name} must be a number, got {value!r}")
+    return float(value)
+
+
 def _budget(memory_budget_bytes):
     return _whole("memory_budget_bytes", memory_budget_bytes, 0, 2**63 - 1)
 
 
 def _common(cell_size, z_scale, nodata, device, progress, pixels=False):
+    if progress is not None and not callable(progress):  # (5 gave "'int' object is not callable" mid-run)
+        raise InvalidArgumentError(f"progress must be a callable or None, got {progress!r}")
     return {"cell_size": cell_size, "z_scale": z_scale, "nodata": nodata, "device": device or "",
             "progress": progress, "pixels": pixels}
 
@@ -290,8 +300,9 @@ def _common(cell_size, z_scale, nodata, device, progress, pixels=False):
 def _horizon(directions, azimuth_offset, samples_per_unit, curvature, max_distance, memory_budget_bytes, method,
              azimuth_tolerance, strip_rows):
     return {"directions": _whole("directions", directions, None, 2**31 - 1),
-            "azimuth_offset": float(azimuth_offset), "samples_per_unit": float(samples_per_unit),
-            "curvature": float(curvature), "max_distance": float(max_distance),
+            "azimuth_offset": _real("azimuth_offset", azimuth_offset),
+            "samples_per_unit": _real("samples_per_unit", samples_per_unit),
+            "curvature": _real("curvature", curvature), "max_distance": _real("max_distance", max_distance),
             "memory_budget_bytes": _budget(memory_budget_bytes), "method": method,
             "azimuth_tolerance": azimuth_tolerance, "strip_rows": _whole("strip_rows", strip_rows, 0, 2**31 - 1)}
 
@@ -476,11 +487,16 @@ def viewshed(heights, observer, *, observer_height=2.0, absolute=False, target_h
     """What an observer sees: 1 visible, 0 hidden or out of range, NaN at nodata. `observer`: a
     pixel (column, row) for a numpy array; map coordinates (x, y) for a DataArray (a pixel with
     pixels=True)."""
-    options = {"observer": observer, "observer_height": float(observer_height), "absolute": bool(absolute),
-               "target_height": float(target_height), "max_distance": float(max_distance),
-               "curvature": float(curvature), "azimuth_from_deg": float(azimuth_from_deg),
-               "azimuth_to_deg": float(azimuth_to_deg), "elevation_min_deg": float(elevation_min_deg),
-               "elevation_max_deg": float(elevation_max_deg), "memory_budget_bytes": _budget(memory_budget_bytes)}
+    options = {"observer": observer, "observer_height": _real("observer_height", observer_height),
+               "absolute": bool(absolute),
+               "target_height": _real("target_height", target_height),
+               "max_distance": _real("max_distance", max_distance),
+               "curvature": _real("curvature", curvature),
+               "azimuth_from_deg": _real("azimuth_from_deg", azimuth_from_deg),
+               "azimuth_to_deg": _real("azimuth_to_deg", azimuth_to_deg),
+               "elevation_min_deg": _real("elevation_min_deg", elevation_min_deg),
+               "elevation_max_deg": _real("elevation_max_deg", elevation_max_deg),
+               "memory_budget_bytes": _budget(memory_budget_bytes)}
     return _single("viewshed", "visible", heights, options, _common(cell_size, z_scale, nodata, device, None, pixels))
 
 
@@ -492,10 +508,14 @@ def cumulative_viewshed(heights, observers, *, observer_height=2.0, absolute=Fal
     for a DataArray) see each point; observer_height a number or one per observer. A Dask-backed
     DataArray splits the observers into groups computed as separate tasks and sums them."""
     options = {"observers": observers, "observer_height": observer_height, "absolute": bool(absolute),
-               "target_height": float(target_height), "max_distance": float(max_distance),
-               "curvature": float(curvature), "azimuth_from_deg": float(azimuth_from_deg),
-               "azimuth_to_deg": float(azimuth_to_deg), "elevation_min_deg": float(elevation_min_deg),
-               "elevation_max_deg": float(elevation_max_deg), "memory_budget_bytes": _budget(memory_budget_bytes)}
+               "target_height": _real("target_height", target_height),
+               "max_distance": _real("max_distance", max_distance),
+               "curvature": _real("curvature", curvature),
+               "azimuth_from_deg": _real("azimuth_from_deg", azimuth_from_deg),
+               "azimuth_to_deg": _real("azimuth_to_deg", azimuth_to_deg),
+               "elevation_min_deg": _real("elevation_min_deg", elevation_min_deg),
+               "elevation_max_deg": _real("elevation_max_deg", elevation_max_deg),
+               "memory_budget_bytes": _budget(memory_budget_bytes)}
     return _single("cumulative_viewshed", "count", heights, options,
                    _common(cell_size, z_scale, nodata, device, progress, pixels))
 
@@ -506,9 +526,11 @@ def sun_shading(heights, azimuth_deg, elevation_deg, *, size_deg=0.53, samples_p
     """The sun's light with cast shadows: the fraction of its disc each point sees (sun) and the
     direct irradiance that brings (direct). The sun at compass azimuth and elevation (degrees),
     row 0 north. numpy: SunShading(sun, direct); DataArray: a Dataset."""
-    options = {"azimuth_deg": float(azimuth_deg), "elevation_deg": float(elevation_deg), "size_deg": float(size_deg),
-               "samples_per_unit": float(samples_per_unit), "curvature": float(curvature),
-               "max_distance": float(max_distance), "memory_budget_bytes": _budget(memory_budget_bytes)}
+    options = {"azimuth_deg": _real("azimuth_deg", azimuth_deg),
+               "elevation_deg": _real("elevation_deg", elevation_deg), "size_deg": _real("size_deg", size_deg),
+               "samples_per_unit": _real("samples_per_unit", samples_per_unit),
+               "curvature": _real("curvature", curvature),
+               "max_distance": _real("max_distance", max_distance), "memory_budget_bytes": _budget(memory_budget_bytes)}
     return _pair("sun_shading", SunShading, heights, options, _common(cell_size, z_scale, nodata, device, progress))
 
 
@@ -517,13 +539,15 @@ def insolation(heights, latitude_deg, longitude_deg, start, end, *, step_minutes
                memory_budget_bytes=0, cell_size=None, z_scale=1.0, nodata=None, device="", progress=None):
     """Hours of sun and direct irradiation from `start` to `end` (ISO 8601 texts with a zone, aware
     datetimes, or seconds since 1970) at a place. numpy: Insolation(sun_hours, direct)."""
-    options = {"latitude_deg": float(latitude_deg), "longitude_deg": float(longitude_deg),
+    options = {"latitude_deg": _real("latitude_deg", latitude_deg),
+               "longitude_deg": _real("longitude_deg", longitude_deg),
                "start": start if isinstance(start, str) else _arrays.utc_seconds(start),
                "end": end if isinstance(end, str) else _arrays.utc_seconds(end),
-               "step_minutes": float(step_minutes), "size_deg": float(size_deg),
-               "azimuth_bucket_deg": float(azimuth_bucket_deg), "apparent": bool(apparent),
-               "samples_per_unit": float(samples_per_unit), "curvature": float(curvature),
-               "max_distance": float(max_distance), "memory_budget_bytes": _budget(memory_budget_bytes)}
+               "step_minutes": _real("step_minutes", step_minutes), "size_deg": _real("size_deg", size_deg),
+               "azimuth_bucket_deg": _real("azimuth_bucket_deg", azimuth_bucket_deg), "apparent": bool(apparent),
+               "samples_per_unit": _real("samples_per_unit", samples_per_unit),
+               "curvature": _real("curvature", curvature),
+               "max_distance": _real("max_distance", max_distance), "memory_budget_bytes": _budget(memory_budget_bytes)}
     return _pair("insolation", Insolation, heights, options, _common(cell_size, z_scale, nodata, device, progress))
 
 
@@ -581,10 +605,13 @@ def region_visibility(heights, sources, *, samples=16, height=2.0, absolute=Fals
     over the rectangle (row 0 along its lowest row), each sample taking the bilinear colour at its
     position (as arealight --light-image); then rgb (3 x H x W; DataArray: a Dataset variable
     "rgb" over "channel" R, G, B): per point the colours of the samples it sees, summed, / S."""
-    options = {"sources": sources, "samples": _whole("samples", samples, None, 2**31 - 1), "height": float(height),
+    options = {"sources": sources, "samples": _whole("samples", samples, None, 2**31 - 1),
+               "height": _real("height", height),
                "absolute": bool(absolute),
-               "target_height": float(target_height), "method": method, "seed": _whole("seed", seed, 0, 2**32 - 1),
-               "decorrelate": bool(decorrelate), "max_distance": float(max_distance), "curvature": float(curvature),
+               "target_height": _real("target_height", target_height), "method": method,
+               "seed": _whole("seed", seed, 0, 2**32 - 1),
+               "decorrelate": bool(decorrelate), "max_distance": _real("max_distance", max_distance),
+               "curvature": _real("curvature", curvature),
                "light_image": light_image}
     if _is_dataarray(heights) and _is_dask(heights.data):
         heights = heights.compute()  # the sources are shared by every point: the field in one piece
@@ -617,10 +644,11 @@ def region_pair_visibility(heights, sources, receivers, *, samples=16, source_he
     visible_fraction, and sources_xy / receivers_xy (map coordinates of a georeferenced
     DataArray, else None). progress as region_visibility's."""
     options = {"sources": sources, "receivers": receivers, "samples": _whole("samples", samples, None, 2**31 - 1),
-               "source_height": float(source_height), "receiver_height": float(receiver_height),
+               "source_height": _real("source_height", source_height),
+               "receiver_height": _real("receiver_height", receiver_height),
                "absolute": bool(absolute), "method": method, "seed": _whole("seed", seed, 0, 2**32 - 1),
                "decorrelate": bool(decorrelate),
-               "max_distance": float(max_distance), "curvature": float(curvature)}
+               "max_distance": _real("max_distance", max_distance), "curvature": _real("curvature", curvature)}
     if _is_dataarray(heights) and _is_dask(heights.data):
         heights = heights.compute()
     out, grid = _run("region_pair_visibility", heights, options,
@@ -659,12 +687,13 @@ def pvs(heights, *, samples=0, pixel_error=0.0, seconds=0.0, view_cell=32, band_
     counts them, history rows say "settling"; 0: off)."""
     if not (isinstance(estimate_entries, (int, np.integer)) and 0 <= estimate_entries <= 1_000_000):
         raise InvalidArgumentError(f"estimate_entries must be a whole number in 0 .. 1e6, got {estimate_entries!r}")
-    options = {"samples": _whole("samples", samples, None, 2**31 - 1), "pixel_error": float(pixel_error),
-               "seconds": float(seconds), "view_cell": _whole("view_cell", view_cell, None, 2**31 - 1),
-               "band_low": float(band_low), "band_high": float(band_high),
+    options = {"samples": _whole("samples", samples, None, 2**31 - 1), "pixel_error": _real("pixel_error", pixel_error),
+               "seconds": _real("seconds", seconds), "view_cell": _whole("view_cell", view_cell, None, 2**31 - 1),
+               "band_low": _real("band_low", band_low), "band_high": _real("band_high", band_high),
                "tile": _whole("tile", tile, None, 2**31 - 1), "mask": None if mask is None else np.asarray(mask),
                "method": method, "batch": _whole("batch", batch, None, 2**31 - 1),
-               "seed": _whole("seed", seed, 0, 2**32 - 1), "resolution": float(resolution), "filter": float(filter),
+               "seed": _whole("seed", seed, 0, 2**32 - 1), "resolution": _real("resolution", resolution),
+               "filter": _real("filter", filter),
                "estimate_entries": int(estimate_entries), "witnesses": bool(witnesses),
                "memory_budget_bytes": _budget(memory_budget_bytes),
                "start": None if start is None else np.ascontiguousarray(start, dtype=np.uint32).ravel()}
@@ -696,8 +725,9 @@ def horizon_lists(heights, receivers, *, directions=64, azimuth_offset=0.0, samp
     elevation_rad, segment_begin, segment_end, near_distance, visible_samples))). The library's
     lists take no maximum distance."""
     options = {"receivers": receivers, "directions": _whole("directions", directions, None, 2**31 - 1),
-               "azimuth_offset": float(azimuth_offset),
-               "samples_per_unit": float(samples_per_unit), "curvature": float(curvature)}
+               "azimuth_offset": _real("azimuth_offset", azimuth_offset),
+               "samples_per_unit": _real("samples_per_unit", samples_per_unit),
+               "curvature": _real("curvature", curvature)}
     if _is_dataarray(heights) and _is_dask(heights.data):
         heights = heights.compute()  # a few rays per receiver: the field in one piece
     out, _ = _run("horizon_lists", heights, options, _common(cell_size, z_scale, nodata, "", None, pixels))
@@ -711,8 +741,10 @@ def bounce(heights, radiance, *, directions=64, azimuth_offset=0.0, samples_per_
     visible segments of each sweep line (Timonen 2013, Sec. 10.1). Returns the radiance's shape;
     NaN at nodata. The library's bounce takes no maximum distance: a Dask array is computed in one
     piece."""
-    options = {"directions": _whole("directions", directions, None, 2**31 - 1), "azimuth_offset": float(azimuth_offset),
-               "samples_per_unit": float(samples_per_unit), "curvature": float(curvature),
+    options = {"directions": _whole("directions", directions, None, 2**31 - 1),
+               "azimuth_offset": _real("azimuth_offset", azimuth_offset),
+               "samples_per_unit": _real("samples_per_unit", samples_per_unit),
+               "curvature": _real("curvature", curvature),
                "memory_budget_bytes": _budget(memory_budget_bytes)}
     if _is_dataarray(heights) and _is_dask(heights.data):
         heights = heights.compute()

@@ -259,3 +259,20 @@ def test_float32_coordinates_of_a_regular_grid_are_taken():
     uneven[5] += step / 10
     with pytest.raises(hfvis.InvalidArgumentError, match="not evenly spaced"):
         hfvis.sky_view_factor(xr.DataArray(z, dims=("lat", "lon"), coords={"lat": uneven, "lon": lon}), directions=8)
+
+
+@pytest.mark.parametrize("call", [
+    lambda h: hfvis.sky_view_factor(h, max_distance=None),
+    lambda h: hfvis.sky_view_factor(h, samples_per_unit="x"),
+    lambda h: hfvis.sky_view_factor(h, z_scale=None),
+    lambda h: hfvis.sky_view_factor(h, cell_size={}),
+    lambda h: hfvis.sky_view_factor(h, cell_size=(1, 2, 3)),
+    lambda h: hfvis.sky_view_factor(h, progress=5),
+    lambda h: hfvis.viewshed(h, (2, 2), observer_height=[1, 2]),
+    lambda h: hfvis.sun_shading(h, "south", 10),
+])
+def test_options_of_the_wrong_kind_are_named(call):
+    """An option of the wrong kind is an InvalidArgumentError naming it (float()'s bare TypeError
+    and ValueError, or a failure mid-run, before)."""
+    with pytest.raises(hfvis.InvalidArgumentError):
+        call(np.random.default_rng(2).random((24, 20), dtype=np.float32))
