@@ -99,11 +99,8 @@ constexpr double kMostAzimuthTolerance = 5.72958;
 constexpr const char* kFloatRange = "what the kernels' single precision holds";
 
 int parseDirectionCount(const std::string& option, const std::string& text) {
-  const char* begin = text.c_str();
-  char* end = nullptr;
-  errno = 0;
-  const long value = std::strtol(begin, &end, 10);
-  if (text.empty() || end != begin + text.size() || errno == ERANGE) {
+  long value = 0;
+  if (!detail::wholeNumber(text, value)) {
     throw UsageError(option + ": expected a whole number of directions, got " + inQuotes(text));
   }
   if (value < 1 || value > kMaxDirections) {
@@ -133,12 +130,9 @@ ReceiverPixel parseReceiver(const std::string& option, const std::string& text) 
   const std::size_t comma = text.find(',');
   if (comma == std::string::npos) throw UsageError(expected);
   auto whole = [&](const std::string& part) {
-    const char* begin = part.c_str();
-    char* end = nullptr;
-    errno = 0;
-    const long value = std::strtol(begin, &end, 10);
-    if (part.empty() || end != begin + part.size() || errno == ERANGE ||
-        value > std::numeric_limits<int>::max() || value < std::numeric_limits<int>::min()) {
+    long value = 0;
+    if (!detail::wholeNumber(part, value) || value > std::numeric_limits<int>::max() ||
+        value < std::numeric_limits<int>::min()) {
       throw UsageError(expected);
     }
     return static_cast<int>(value);
@@ -224,12 +218,9 @@ PixelRectangle parseRectangle(const std::string& typed, const std::string& value
     const std::size_t comma = value.find(',', begin);
     const std::string part =
         value.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin);
-    const char* start = part.c_str();
-    char* end = nullptr;
-    errno = 0;
-    const long number = std::strtol(start, &end, 10);
-    if (part.empty() || end != start + part.size() || errno == ERANGE ||
-        number > std::numeric_limits<int>::max() || number < std::numeric_limits<int>::min())
+    long number = 0;
+    if (!detail::wholeNumber(part, number) || number > std::numeric_limits<int>::max() ||
+        number < std::numeric_limits<int>::min())
       throw UsageError(expected);
     corners.push_back(static_cast<int>(number));
     if (comma == std::string::npos) break;

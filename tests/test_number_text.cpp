@@ -11,6 +11,7 @@ namespace {
 
 using hfvis::detail::decimalNumber;
 using hfvis::detail::exactNumber;
+using hfvis::detail::wholeNumber;
 
 TEST(NumberText, DecimalNumbersAreReadWhole) {
   double v = -1.0;
@@ -26,8 +27,17 @@ TEST(NumberText, AnythingButAFiniteDecimalNumberIsRefused) {
   double v = 0.0;
   for (const std::string& text :
        std::initializer_list<std::string>{"", "0x10", "0X1p3", "inf", "-Infinity", "nan", "1e400", "-1e400",
-                                          "1e-400", "12abc", "1,5", "5 ", std::string("5\0", 2)})
+                                          "1e-400", "12abc", "1,5", "5 ", " 5", "\t5", std::string("5\0", 2)})
     EXPECT_FALSE(decimalNumber(text, v)) << "'" << text << "'";
+}
+
+TEST(NumberText, WholeNumbersAreReadWhole) {
+  long v = 0;
+  EXPECT_TRUE(wholeNumber("-12", v));
+  EXPECT_EQ(v, -12);
+  for (const std::string& text : std::initializer_list<std::string>{"", " 5", "5 ", "\t5", "1e3", "5.0",
+                                                                    "0x10", "99999999999999999999"})
+    EXPECT_FALSE(wholeNumber(text, v)) << "'" << text << "'";
 }
 
 TEST(NumberText, ExactNumbersReadBackAsThemselves) {

@@ -2,6 +2,7 @@
 // Shared by the library's validation and readers and the CLI's parsers and writers.
 #pragma once
 
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -39,8 +40,20 @@ inline bool decimalNumber(const std::string& text, double& value) {
   char* end = nullptr;
   errno = 0;
   value = std::strtod(begin, &end);
-  return !text.empty() && end == begin + text.size() && errno != ERANGE && std::isfinite(value) &&
-         text.find_first_of("xX") == std::string::npos;
+  // (strtod skips leading white space: " 5" was taken where "5 " was refused)
+  return !text.empty() && !std::isspace(static_cast<unsigned char>(text[0])) && end == begin + text.size() &&
+         errno != ERANGE && std::isfinite(value) && text.find_first_of("xX") == std::string::npos;
+}
+
+// Reads all of `text` as a base-10 whole number within long's range into `value`; false for
+// anything else (white space before it too, which strtol would skip).
+inline bool wholeNumber(const std::string& text, long& value) {
+  const char* begin = text.c_str();
+  char* end = nullptr;
+  errno = 0;
+  value = std::strtol(begin, &end, 10);
+  return !text.empty() && !std::isspace(static_cast<unsigned char>(text[0])) && end == begin + text.size() &&
+         errno != ERANGE;
 }
 
 }  // namespace hfvis::detail
