@@ -480,6 +480,18 @@ def intervisibility(heights, *, directions=64, azimuth_offset=0.0, samples_per_u
     return xr.Dataset(variables)
 
 
+def _sight(absolute, target_height, max_distance, curvature, azimuth_from_deg, azimuth_to_deg, elevation_min_deg,
+           elevation_max_deg, memory_budget_bytes):
+    """The options a viewshed and a cumulative viewshed share."""
+    return {"absolute": bool(absolute), "target_height": _real("target_height", target_height),
+            "max_distance": _real("max_distance", max_distance), "curvature": _real("curvature", curvature),
+            "azimuth_from_deg": _real("azimuth_from_deg", azimuth_from_deg),
+            "azimuth_to_deg": _real("azimuth_to_deg", azimuth_to_deg),
+            "elevation_min_deg": _real("elevation_min_deg", elevation_min_deg),
+            "elevation_max_deg": _real("elevation_max_deg", elevation_max_deg),
+            "memory_budget_bytes": _budget(memory_budget_bytes)}
+
+
 def viewshed(heights, observer, *, observer_height=2.0, absolute=False, target_height=0.0, max_distance=0.0,
              curvature=0.0, azimuth_from_deg=0.0, azimuth_to_deg=0.0, elevation_min_deg=-90.0,
              elevation_max_deg=90.0, memory_budget_bytes=0, pixels=False, cell_size=None, z_scale=1.0, nodata=None,
@@ -488,15 +500,8 @@ def viewshed(heights, observer, *, observer_height=2.0, absolute=False, target_h
     pixel (column, row) for a numpy array; map coordinates (x, y) for a DataArray (a pixel with
     pixels=True)."""
     options = {"observer": observer, "observer_height": _real("observer_height", observer_height),
-               "absolute": bool(absolute),
-               "target_height": _real("target_height", target_height),
-               "max_distance": _real("max_distance", max_distance),
-               "curvature": _real("curvature", curvature),
-               "azimuth_from_deg": _real("azimuth_from_deg", azimuth_from_deg),
-               "azimuth_to_deg": _real("azimuth_to_deg", azimuth_to_deg),
-               "elevation_min_deg": _real("elevation_min_deg", elevation_min_deg),
-               "elevation_max_deg": _real("elevation_max_deg", elevation_max_deg),
-               "memory_budget_bytes": _budget(memory_budget_bytes)}
+               **_sight(absolute, target_height, max_distance, curvature, azimuth_from_deg, azimuth_to_deg,
+                        elevation_min_deg, elevation_max_deg, memory_budget_bytes)}
     return _single("viewshed", "visible", heights, options, _common(cell_size, z_scale, nodata, device, None, pixels))
 
 
@@ -507,15 +512,9 @@ def cumulative_viewshed(heights, observers, *, observer_height=2.0, absolute=Fal
     """How many of the observers (an N x 2 array: pixels (column, row), or map coordinates (x, y)
     for a DataArray) see each point; observer_height a number or one per observer. A Dask-backed
     DataArray splits the observers into groups computed as separate tasks and sums them."""
-    options = {"observers": observers, "observer_height": observer_height, "absolute": bool(absolute),
-               "target_height": _real("target_height", target_height),
-               "max_distance": _real("max_distance", max_distance),
-               "curvature": _real("curvature", curvature),
-               "azimuth_from_deg": _real("azimuth_from_deg", azimuth_from_deg),
-               "azimuth_to_deg": _real("azimuth_to_deg", azimuth_to_deg),
-               "elevation_min_deg": _real("elevation_min_deg", elevation_min_deg),
-               "elevation_max_deg": _real("elevation_max_deg", elevation_max_deg),
-               "memory_budget_bytes": _budget(memory_budget_bytes)}
+    options = {"observers": observers, "observer_height": observer_height,
+               **_sight(absolute, target_height, max_distance, curvature, azimuth_from_deg, azimuth_to_deg,
+                        elevation_min_deg, elevation_max_deg, memory_budget_bytes)}
     return _single("cumulative_viewshed", "count", heights, options,
                    _common(cell_size, z_scale, nodata, device, progress, pixels))
 
