@@ -974,6 +974,15 @@ TEST(RegionVisibility, SamplesAreStratifiedAndDeterministic) {
   }
   EXPECT_EQ(strata.size(), 64u);  // one sample in every stratum
   EXPECT_GT(moved, 60u);          // another seed, other jitter
+  // A rectangle of the same size elsewhere, with the same seed: its own jitter (a pair's samples
+  // k and k at the same place in their strata would be correlated).
+  RegionSampling shifted = region;
+  shifted.rectangle = {4 + 9, 4, 20 + 9, 20};
+  const std::vector<RegionPoint> d = regionSamplePoints(field, shifted, 3);
+  ASSERT_EQ(d.size(), a.size());
+  std::size_t same_place = 0;
+  for (std::size_t s = 0; s < a.size(); ++s) same_place += d[s].col - 9.0 == a[s].col || d[s].row == a[s].row;
+  EXPECT_LT(same_place, 4u);
   // 10 samples over a 9 x 1 strip: rows of 4 + 4 + 2 wider strata, still one per stratum.
   region.rectangle = {0, 0, 8, 1};
   region.samples = 10;
