@@ -61,8 +61,16 @@ def heights_array(heights, nodata=None, cell_size=1.0):
     real dtype (float16..float128, integers), either byte order, any strides; refused: other
     dimensions, complex, bool, object, and heights that float32 rounds by more than a thousandth of
     their range and a hundredth of `cell_size` (as the file readers refuse them)."""
+    if hasattr(heights, "data_vars"):  # an xarray.Dataset (not imported here: xarray is optional)
+        names = ", ".join(repr(str(n)) for n in list(heights.data_vars)[:5])
+        raise InputTypeError(f"heights are an xarray.Dataset of variables ({names}): give one of them, "
+                             "a DataArray (dataset['name'])")
     mask = np.ma.getmaskarray(heights) if np.ma.isMaskedArray(heights) else None
-    a = np.asarray(np.ma.getdata(heights) if mask is not None else heights)
+    try:
+        a = np.asarray(np.ma.getdata(heights) if mask is not None else heights)
+    except (ValueError, TypeError) as e:  # a ragged list, or an object numpy cannot take
+        raise InputTypeError(f"heights must be a 2-D array (rows, columns) of real numbers; numpy could not "
+                             f"make one of the {type(heights).__name__} given (rows of different lengths?): {e}") from None
     if a.ndim != 2:
         raise InputTypeError(f"heights must be a 2-D array (rows, columns), got {a.ndim} dimension(s) {a.shape}")
     if a.dtype.kind not in "fiu":

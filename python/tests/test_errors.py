@@ -22,6 +22,8 @@ def small():
     (np.zeros((0, 4), np.float32), ValueError, "empty"),
     (np.full((4, 4), np.nan, np.float32), ValueError, "nodata"),
     (np.full((4, 4), 1e300), ValueError, "float32"),
+    ([[1.0, 2.0], [3.0]], TypeError, "rows of different lengths"),
+    (xr.Dataset({"dem": (("y", "x"), np.zeros((4, 4)))}), TypeError, "Dataset of variables \\('dem'\\)"),
 ])
 def test_bad_heights(bad, kind, words):
     with pytest.raises(kind, match=words) as caught:
