@@ -152,10 +152,13 @@ def _marked_block(block, values, scale, offset):
     holes = np.zeros(block.shape, dtype=bool)
     for v in values:
         holes |= _arrays.nodata_holes(block, v)
-    wide = block.astype(np.float64)
-    if scale != 1.0 or offset != 0.0:
-        wide = wide * scale + offset
-    return np.where(holes, np.nan, wide)
+    wide = block.astype(np.float64)  # (one float64 copy of the block, changed in place below)
+    if scale != 1.0:
+        wide *= scale
+    if offset != 0.0:
+        wide += offset
+    wide[holes] = np.nan
+    return wide
 
 
 def _nodata_as_nan(block, value):
