@@ -26,9 +26,13 @@ Attributes sweptAttributes(const Job& job, const HorizonResult& result) {
     if (name == "hfvis:directions") value = std::to_string(result.directions);
   if (job.run.max_error > 0.0) attributes.emplace_back("hfvis:max_error", formatNumber(job.run.max_error));
   if (job.run.error_tile > 0 && !result.pixel_directions.empty()) {  // refined by tile: least K to most
-    const auto [least, most] =
-        std::minmax_element(result.pixel_directions.begin(), result.pixel_directions.end());
-    attributes.emplace_back("hfvis:directions_range", std::to_string(*least) + ".." + std::to_string(*most));
+    int least = std::numeric_limits<int>::max(), most = 0;           // over the pixels with data
+    for (std::size_t p = 0; p < result.pixel_directions.size(); ++p)
+      if (std::isfinite(job.input.heights[p]))
+        least = std::min(least, result.pixel_directions[p]),
+        most = std::max(most, result.pixel_directions[p]);
+    if (most > 0)
+      attributes.emplace_back("hfvis:directions_range", std::to_string(least) + ".." + std::to_string(most));
   }
   if (!result.error_estimate.empty())
     attributes.emplace_back("hfvis:estimated_error", formatNumber(result.estimated_error));
@@ -73,8 +77,11 @@ Summary HorizonQuantityComputation::write(Job& job, OutputFiles& outputs) {
     std::vector<std::string> names{"error"};
     std::vector<std::vector<float>> planes{result_.error_estimate};
     if (run_.error_tile > 0 && !result_.pixel_directions.empty()) {  // --error-tile: each pixel's K
-      names.push_back("directions");
-      planes.emplace_back(result_.pixel_directions.begin(), result_.pixel_directions.end());
+      names.push_back("directions");                                 // NaN at nodata, as the error is
+      std::vector<float>& k =
+          planes.emplace_back(result_.pixel_directions.begin(), result_.pixel_directions.end());
+      for (std::size_t p = 0; p < k.size(); ++p)
+        if (!std::isfinite(field.heights[p])) k[p] = std::numeric_limits<float>::quiet_NaN();
     }
     outputs.image(
         run_.error_output,
