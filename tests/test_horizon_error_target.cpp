@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -484,6 +485,16 @@ TEST(HorizonMaxError, BadRequestsAreRefused) {
   for (const int tile : {1, 8, kMinErrorTile - 1}) {
     tiled.error_tile = tile;
     EXPECT_THROW(computeHorizons(testContext(), field, tiled, svf), InvalidArgument) << tile;
+  }
+  // A tile past the field is the whole field, up to INT_MAX (whose tile sums overflowed int: a
+  // crash).
+  tiled.error_tile = std::max(field.width, field.height);
+  const HorizonResult whole = computeHorizons(testContext(), field, tiled, svf);
+  for (const int tile : {INT_MAX - 30, INT_MAX}) {
+    tiled.error_tile = tile;
+    const HorizonResult past = computeHorizons(testContext(), field, tiled, svf);
+    EXPECT_EQ(past.sky_view_factor, whole.sky_view_factor) << tile;
+    EXPECT_EQ(past.pixel_directions, whole.pixel_directions) << tile;
   }
 }
 

@@ -1334,8 +1334,10 @@ TEST(RegionVisibility, BadInputIsRefused) {
   o.target_height = std::numeric_limits<double>::quiet_NaN();
   refused(good, o, "target height");
   o = options;
-  o.curvature = std::numeric_limits<double>::infinity();
-  refused(good, o, "curvature");
+  for (const double curvature : {std::numeric_limits<double>::infinity(), 1.5, -1e38}) {
+    o.curvature = curvature;
+    refused(good, o, "curvature");
+  }
   HeightField latlon = field;
   latlon.row_cell_size_x.assign(field.height, 1.0);
   latlon.row_cell_size_y.assign(field.height, 1.0);

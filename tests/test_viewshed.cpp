@@ -292,6 +292,19 @@ TEST(Viewshed, BadInputIsRefused) {
   o.elevation_min_deg = 10.0;
   o.elevation_max_deg = 0.0;
   EXPECT_THROW(computeViewshed(c, f, {1, 1, 2.0}, o), InvalidArgument);
+  // The sweep's curvature rule: within -1 .. 1 per ground unit (far beyond, the drops overflowed
+  // float and the viewshed saw more, with no error); the pyramid's too.
+  for (const double curvature : {1.5, -2.0, 1e36, 1e300}) {
+    o = {};
+    o.curvature = curvature;
+    EXPECT_THROW(computeViewshed(c, f, {1, 1, 2.0}, o), InvalidArgument) << curvature;
+    ViewshedPyramidOptions p;
+    p.curvature = curvature;
+    EXPECT_THROW(buildViewshedPyramid(c, f, p), InvalidArgument) << curvature;
+  }
+  o = {};
+  o.curvature = 1.0;
+  EXPECT_NO_THROW(computeViewshed(c, f, {1, 1, 2.0}, o));
   EXPECT_THROW(computeCumulativeViewshed(c, f, {}, {}), InvalidArgument);
   HeightField geographic = f;
   geographic.row_cell_size_x.assign(10, 1.0);

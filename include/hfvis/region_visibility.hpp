@@ -194,8 +194,8 @@ struct RegionPairVisibilityResult {
 };
 
 // Throws InvalidArgument for a negative or non-finite target height or maximum distance, a
-// non-finite curvature, a light image not of 3 * width * height values or holding a negative or
-// non-finite one (naming the first).
+// curvature not finite or beyond -1 .. 1 per ground unit, a light image not of 3 * width * height
+// values or holding a negative or non-finite one (naming the first).
 void validate(const RegionVisibilityOptions& options);
 
 // Throws InvalidArgument for a rectangle outside the field, S outside 1 .. kMaxRegionSamples, a

@@ -189,8 +189,8 @@ ViewshedPyramid buildViewshedPyramid(const ComputeContext& context, const Height
 std::uint64_t heightsFingerprint(const HeightField& field);
 
 // Throws InvalidArgument for a negative or non-finite target height or maximum distance, a
-// non-finite curvature, azimuths outside [0, 360], or elevation limits outside [-90, 90] or
-// crossed.
+// curvature not finite or beyond -1 .. 1 per ground unit, azimuths outside [0, 360], or
+// elevation limits outside [-90, 90] or crossed.
 void validate(const ViewshedOptions& options);
 
 // Throws InvalidArgument for an observer outside the field, on nodata, or with a non-finite

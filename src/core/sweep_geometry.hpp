@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "hfvis/height_field.hpp"
@@ -48,6 +49,9 @@ std::vector<SweepDirection> runDirections(const HeightField& field, const SweepO
 // Checks an operation's rows per strip: 0 (automatic) or positive, and 0 for a naive method, whose
 // rays read the whole field.
 void validateStripRows(int strip_rows, bool naive);
+// Throws InvalidArgument unless the curvature coefficient is finite and within -1 .. 1 per ground
+// unit (every operation's rule); `what` names it in the message.
+void validateCurvature(double curvature, const std::string& what);
 
 // A point in pixel axes.
 struct Point2 {

@@ -37,10 +37,7 @@ void validate(const SweepOptions& options) {
   if (!std::isfinite(options.azimuth_offset) || std::abs(options.azimuth_offset) > 4.0 * M_PI)
     throw InvalidArgument("the azimuth offset must lie within -4 pi .. 4 pi radians (two turns), got " +
                           std::to_string(options.azimuth_offset));
-  if (!std::isfinite(options.curvature) || std::abs(options.curvature) > 1.0) {
-    throw InvalidArgument("the curvature coefficient must be finite and at most 1 per ground unit (got " +
-                          std::to_string(options.curvature) + "); earthCurvature() gives the Earth's in 1/m");
-  }
+  detail::validateCurvature(options.curvature, "the curvature coefficient");
   if (!std::isfinite(options.max_distance) || options.max_distance < 0.0) {
     throw InvalidArgument("the maximum distance must be finite and >= 0 ground units, 0 for the whole field (got " +
                           std::to_string(options.max_distance) + ")");
@@ -48,6 +45,13 @@ void validate(const SweepOptions& options) {
 }
 
 namespace detail {
+
+void validateCurvature(double curvature, const std::string& what) {
+  // (far beyond, 1e36, the drops overflowed float and the viewshed saw farther: no error)
+  if (!std::isfinite(curvature) || std::abs(curvature) > 1.0)
+    throw InvalidArgument(what + " must be finite and within -1 .. 1 per ground unit (got " +
+                          std::to_string(curvature) + "); earthCurvature() gives the Earth's in 1/m");
+}
 
 std::vector<SweepDirection> runDirections(const HeightField& field, const SweepOptions& options) {
   std::vector<SweepDirection> directions;

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <climits>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -938,7 +939,9 @@ struct ErrorTiles {
   ErrorTiles(const HeightField& field, int error_tile)
       : width(field.width),
         height(field.height),
-        side(error_tile > 0 ? error_tile : std::max(field.width, field.height)),
+        // (a tile past the field is the whole field: kept within it, so that the sums below stay
+        // within int, which error_tile near INT_MAX overflowed)
+        side(std::min(error_tile > 0 ? error_tile : INT_MAX, std::max(field.width, field.height))),
         across((width + side - 1) / side),
         count(across * ((height + side - 1) / side)) {}
   int of(std::size_t p) const {

@@ -754,7 +754,7 @@ void validate(const RegionVisibilityOptions& options) {
     throw InvalidArgument("the maximum distance " + detail::shortNumber(options.max_distance) +
                           " is too short to hold: give at least " + detail::shortNumber(kLeastMaxDistance) +
                           " ground units, or 0 for no limit");
-  if (!std::isfinite(options.curvature)) throw InvalidArgument("the curvature must be finite");
+  detail::validateCurvature(options.curvature, "the curvature");
   const LightImage& image = options.light_image;
   if (image.width != 0 || image.height != 0 || !image.rgb.empty()) {
     if (image.width < 1 || image.height < 1 ||

@@ -7,11 +7,12 @@
 #include <limits>
 #include <string>
 
-#include "hfvis/errors.hpp"
 #include "core/horizon_common.hpp"
 #include "core/opencl_context.hpp"
 #include "core/sweep_framework.hpp"
+#include "core/sweep_geometry.hpp"
 #include "core/sweep_routine.hpp"
+#include "hfvis/errors.hpp"
 
 namespace hfvis {
 namespace {
@@ -478,7 +479,7 @@ void validate(const ViewshedOptions& o) {
     throw InvalidArgument("the target height must be finite and >= 0 (got " + std::to_string(o.target_height) + ")");
   if (!(std::isfinite(o.max_distance) && o.max_distance >= 0.0))
     throw InvalidArgument("the maximum distance must be finite and >= 0 (got " + std::to_string(o.max_distance) + ")");
-  if (!std::isfinite(o.curvature)) throw InvalidArgument("the curvature coefficient must be finite");
+  detail::validateCurvature(o.curvature, "the curvature coefficient");
   if (!finiteIn(o.azimuth_from_deg, 0.0, 360.0) || !finiteIn(o.azimuth_to_deg, 0.0, 360.0))
     throw InvalidArgument("field-of-view azimuths must be in [0, 360] degrees");
   if (!finiteIn(o.elevation_min_deg, -90.0, 90.0) || !finiteIn(o.elevation_max_deg, -90.0, 90.0) ||

@@ -4,21 +4,22 @@
 // rounded the conservative way. The query runs on the device (viewshed_cull in
 // kernels/viewshed.cl, launched by src/ops/viewshed.cpp).
 #include <algorithm>
-#include <chrono>
 #include <cfloat>
+#include <chrono>
 #include <cmath>
 #include <cstring>
-#include <limits>
 #include <functional>
+#include <limits>
 #include <string>
 
-#include "hfvis/errors.hpp"
-#include "hfvis/horizon.hpp"
-#include "hfvis/viewshed.hpp"
 #include "core/horizon_common.hpp"
 #include "core/host_bands.hpp"
 #include "core/lattice_geometry.hpp"
 #include "core/sweep_framework.hpp"
+#include "core/sweep_geometry.hpp"
+#include "hfvis/errors.hpp"
+#include "hfvis/horizon.hpp"
+#include "hfvis/viewshed.hpp"
 
 namespace hfvis {
 namespace {
@@ -99,7 +100,7 @@ class SlopePyramid {
 void validatePyramidOptions(const ViewshedPyramidOptions& o) {
   if (!(std::isfinite(o.target_height) && o.target_height >= 0.0))
     throw InvalidArgument("the pyramid's target height must be finite and >= 0");
-  if (!std::isfinite(o.curvature)) throw InvalidArgument("the pyramid's curvature coefficient must be finite");
+  detail::validateCurvature(o.curvature, "the pyramid's curvature coefficient");
   if (o.sectors < 4 || o.sectors > 256) throw InvalidArgument("the pyramid takes 4 .. 256 sectors");
   if (o.directions_per_sector < 2 || o.directions_per_sector > 64)
     throw InvalidArgument("the pyramid takes 2 .. 64 directions per sector");
