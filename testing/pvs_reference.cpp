@@ -11,7 +11,8 @@ namespace hfvis {
 
 RayCastResult referenceCastHeightFieldRays(const HeightField& field, const std::vector<HeightRay>& rays,
                                            const RayCastOptions& options) {
-  const PvsLayout layout = pvsLayout(field, options.grid);
+  const PvsGrid grid = detail::castGrid(options);
+  const PvsLayout layout = pvsLayout(field, grid);
   const std::vector<float> heights = detail::rayHeights(field);
   const detail::RayPyramid pyramid = detail::buildRayPyramid(heights, field.width, field.height);
   const int cap = options.view_cells ? layout.view_x + layout.view_y : 0;
@@ -24,11 +25,10 @@ RayCastResult referenceCastHeightFieldRays(const HeightField& field, const std::
   for (std::size_t r = 0; r < rays.size(); ++r) {
     const HeightRay& q = rays[r];
     int count = 0;
-    out.t[r] = detail::hf_ray_cast(heights.data(), field.width, field.height, pyramid.values.data(),
-                                   pyramid.levels.data(), pyramid.top, q.ox, q.oy, q.oz, q.dx, q.dy, q.dz,
-                                   q.t_max, options.grid.view_cell, layout.view_x,
-                                   float(options.grid.band_low), float(options.grid.band_high), cap,
-                                   cells.data(), ts.data(), 1, &count, &out.cell[r]);
+    out.t[r] = detail::hf_ray_cast(
+        heights.data(), field.width, field.height, pyramid.values.data(), pyramid.levels.data(), pyramid.top,
+        q.ox, q.oy, q.oz, q.dx, q.dy, q.dz, q.t_max, grid.view_cell, layout.view_x, float(grid.band_low),
+        float(grid.band_high), cap, cells.data(), ts.data(), 1, &count, &out.cell[r]);
     out.view_cell.insert(out.view_cell.end(), cells.begin(), cells.begin() + count);
     out.view_t.insert(out.view_t.end(), ts.begin(), ts.begin() + count);
     out.first.push_back(out.view_cell.size());

@@ -172,6 +172,17 @@ TEST(BadInput, Options) {
   statistics.statistics = true;
   expectError<InvalidArgument>([&] { computeIntervisibility(testContext(), field, naive, statistics); },
                                "statistics");
+  // Enum values cast from bad integers: refused naming the method (an OpenCL error, or a run as
+  // one of the methods, before).
+  HorizonOptions bad_horizon;
+  bad_horizon.method = static_cast<HorizonMethod>(7);
+  expectError<InvalidArgument>([&] { horizons(field, bad_horizon); }, "unknown horizon method 7");
+  IntervisibilityOptions bad_tree;
+  bad_tree.method = static_cast<IntervisibilityMethod>(9);
+  IntervisibilityOutputs counts;
+  counts.visible_count = true;
+  expectError<InvalidArgument>([&] { computeIntervisibility(testContext(), field, bad_tree, counts); },
+                               "unknown intervisibility method 9");
   ExitRadiance radiance;
   radiance.width = 3;
   radiance.height = 3;
@@ -198,6 +209,13 @@ TEST(BadInput, PotentiallyVisibleSets) {
   bad.band_low = 2.0;
   bad.band_high = 1.0;
   expectError<InvalidArgument>([&] { pvs(bad); }, "0 <= H0 <= H1");
+  bad.band_low = 0.0;
+  bad.band_high = 1e39;  // (infinite in float: the rays' origins were blamed)
+  expectError<InvalidArgument>([&] { pvs(bad); }, "0 <= H0 <= H1 <= 1e+28");
+  PvsOptions bad_method = options;
+  bad_method.method = static_cast<PvsMethod>(99);
+  expectError<InvalidArgument>([&] { computePvs(testContext(), field, grid, bad_method); },
+                               "unknown PVS method 99");
   bad = grid;
   bad.mask.assign(3, 1);
   expectError<InvalidArgument>([&] { pvs(bad); }, "mask has 3 entries");

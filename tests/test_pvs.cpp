@@ -104,6 +104,18 @@ void expectSame(const RayCastResult& got, const RayCastResult& want) {
   EXPECT_LE(differ, got.t.size() / 100);
 }
 
+// Without the lists the grid goes unused: the default one (view cells of 32) is not held against
+// a field smaller than it (every field under 33 x 33 was refused).
+TEST(PvsRayCaster, RaysAloneTakeAnyFieldOfTwoByTwo) {
+  const HeightField field = makeSyntheticField("noise", 24, 20);
+  const std::vector<HeightRay> in = raysOver(field, 50, 3);
+  const RayCastResult got = castHeightFieldRays(testContext(), field, in, {});
+  expectSame(got, referenceCastHeightFieldRays(field, in, {}));
+  RayCastOptions lists;
+  lists.view_cells = true;
+  EXPECT_THROW(castHeightFieldRays(testContext(), field, in, lists), InvalidArgument);
+}
+
 TEST(PvsRayCaster, KernelMatchesTheReferenceOnEveryHardCase) {
   std::size_t hits = 0, listed = 0, rays = 0;
   forEachLayout([&](const ComputeContext& context) {

@@ -14,6 +14,9 @@ namespace hfvis {
 
 void validate(const HorizonOptions& options, const HorizonOutputs& outputs) {
   validate(static_cast<const SweepOptions&>(options));
+  // (an enum value cast from a bad integer failed later as an OpenCL error)
+  if (options.method != HorizonMethod::Sweep && options.method != HorizonMethod::Naive)
+    throw InvalidArgument("unknown horizon method " + std::to_string(static_cast<int>(options.method)));
   if (!(options.azimuth_tolerance > 0.0) || !(options.azimuth_tolerance <= 0.1)) {
     throw InvalidArgument("the azimuth tolerance must be in (0, 0.1] radians, (0, 5.73] degrees (got " +
                           std::to_string(options.azimuth_tolerance * 180.0 / M_PI) + " degrees)");

@@ -21,6 +21,10 @@ namespace hfvis {
 
 void validate(const IntervisibilityOptions& options, const IntervisibilityOutputs& outputs) {
   validate(static_cast<const SweepOptions&>(options));
+  // (an enum value cast from a bad integer ran as one of them)
+  if (options.method != IntervisibilityMethod::HullTree && options.method != IntervisibilityMethod::Naive)
+    throw InvalidArgument("unknown intervisibility method " +
+                          std::to_string(static_cast<int>(options.method)));
   validate(options.tree);
   if (!outputs.visible_count && !outputs.visible_area && !outputs.statistics) {
     throw InvalidArgument("no output requested");

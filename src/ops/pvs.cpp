@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "core/horizon_common.hpp"
+#include "core/number_text.hpp"
 #include "core/opencl_context.hpp"
 #include "core/sweep_framework.hpp"
 #include "core/sweep_geometry.hpp"
@@ -48,9 +49,12 @@ PvsLayout pvsLayout(const HeightField& field, const PvsGrid& grid) {
   if (grid.tile < 1 || grid.tile > most)
     throw InvalidArgument("the tile size must be 1 .. " + std::to_string(most) + " cells (got " +
                           std::to_string(grid.tile) + ")");
+  // (a band of 1e39, finite in double, is infinite in the kernels' float: the rays' origins were
+  // blamed)
   if (!std::isfinite(grid.band_low) || !std::isfinite(grid.band_high) || grid.band_low < 0.0 ||
-      grid.band_high < grid.band_low)
-    throw InvalidArgument("the view band needs finite heights 0 <= H0 <= H1 (got " +
+      grid.band_high < grid.band_low || grid.band_high > detail::kMaxPreparedHeight)
+    throw InvalidArgument("the view band needs finite heights 0 <= H0 <= H1 <= " +
+                          detail::shortNumber(detail::kMaxPreparedHeight) + " (got " +
                           std::to_string(grid.band_low) + ", " + std::to_string(grid.band_high) + ")");
   l.view_cell = grid.view_cell;
   l.tile = grid.tile;
@@ -420,7 +424,7 @@ void withRayCaster(const ComputeContext& context, const HeightField& field, cons
 RayCastResult castHeightFieldRays(const ComputeContext& context, const HeightField& field,
                                   const std::vector<HeightRay>& rays, const RayCastOptions& options) {
   detail::RayCasts cast;
-  detail::withRayCaster(context, field, options.grid, options.memory_budget_bytes,
+  detail::withRayCaster(context, field, detail::castGrid(options), options.memory_budget_bytes,
                         [&](detail::RayCaster& caster) { cast = caster.cast(rays, options.view_cells); });
   RayCastResult out;
   out.t = std::move(cast.t);

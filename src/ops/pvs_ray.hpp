@@ -25,6 +25,17 @@ struct RayPyramid {
 };
 RayPyramid buildRayPyramid(const std::vector<float>& heights, int width, int height);
 
+// The grid a cast checks and takes: `options.grid`, or without the lists (which alone use it) one
+// any field of 2 x 2 points holds (its default view cells of 32 refused every field under 33 x 33,
+// naming an option the caller had not given).
+inline PvsGrid castGrid(const RayCastOptions& options) {
+  if (options.view_cells) return options.grid;
+  PvsGrid grid;
+  grid.view_cell = grid.tile = 1;
+  grid.band_low = grid.band_high = 0.0;
+  return grid;
+}
+
 // The heights the ray caster reads: z-scaled, from zero (the viewshed's and the region
 // visibility's, so the witnesses' line-of-sight test sees the same surface).
 std::vector<float> rayHeights(const HeightField& field);

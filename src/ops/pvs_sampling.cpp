@@ -690,6 +690,10 @@ const char* pvsDistributionName(int index) {
 }
 
 void validate(const PvsOptions& options) {
+  // (an enum value cast from a bad integer ran as one of them)
+  if (options.method != PvsMethod::Agvs && options.method != PvsMethod::Sgvs &&
+      options.method != PvsMethod::PerCell)
+    throw InvalidArgument("unknown PVS method " + std::to_string(static_cast<int>(options.method)));
   if (!std::isfinite(options.pixel_error) || options.pixel_error < 0.0 || !std::isfinite(options.seconds) ||
       options.seconds < 0.0)
     throw InvalidArgument("the pixel error and seconds budgets must be finite and >= 0");
