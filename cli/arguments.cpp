@@ -432,7 +432,7 @@ const std::vector<OptionSpec>& optionTable() {
        "hfvis:estimated_error attributes, the sky-view factor and occlusion\n"
        "also hfvis:richardson_divisor (2^p - 1) and hfvis:runs (each run's K)\n"
        "(with --error-tile also hfvis:directions_range, the least and most\n"
-       "K, and --error-out's channel directions, each pixel's)",
+       "K, and --error-out's channel directions, each pixel's, NaN at nodata)",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
          run.max_error = parseNumber(typed, value);
          if (!(run.max_error > 0.0 && run.max_error < 1.0))

@@ -233,7 +233,7 @@ __kernel void region_end_tables(__global const float* h, __global const float* p
   if (placed) {
     x = points[3 * s], y = points[3 * s + 1], z = points[3 * s + 2];
   } else {
-    region_sample(table, h, f.width, f.height, absolute, seed, 0U, s, &x, &y, &z);
+    region_sample(table, h, f.width, f.height, absolute, region_table_seed(table, seed), 0U, s, &x, &y, &z);
   }
   // (written in place, band by band: region_end_table keeps 3 * REGION_END_WEDGES floats of its own)
   region_end_table(pyramid, levels, f.width, f.height, margin, f.curvature, f.cell_x, f.cell_y, x, y, z,
@@ -254,13 +254,15 @@ __kernel void region_visibility_bits(__global const float* h, __global const flo
   if (r >= receiver_count) return;
   float xr, yr, zr;
   if (!pixel_receivers) {
-    region_sample(receivers, h, f.width, f.height, receiver_absolute, seed, 0U, r, &xr, &yr, &zr);
+    region_sample(receivers, h, f.width, f.height, receiver_absolute, region_table_seed(receivers, seed), 0U,
+                  r, &xr, &yr, &zr);
   } else {
     xr = (float)(r % f.width);
     yr = (float)(r / f.width);
     zr = h[r] + target_height;
   }
   const unsigned int key = decorrelate ? (unsigned int)r + 1U : 0U;
+  const unsigned int source_seed = decorrelate ? region_table_seed(sources, seed) : 0U;
   // Culled: the cell that hid the last hidden sight line (and its fraction of that line from the
   // receiver), tried first against the next ones, across words, while the line before was hidden
   // (after a clear one the next is seldom hidden: the tries would cost more than they save); then
@@ -280,7 +282,7 @@ __kernel void region_visibility_bits(__global const float* h, __global const flo
       float xs[32], ys[32], zs[32];
       for (int s = 32 * w; s < end; ++s)
         if (decorrelate) {
-          region_sample(sources, h, f.width, f.height, source_absolute, seed, key, s, &xs[s - 32 * w],
+          region_sample(sources, h, f.width, f.height, source_absolute, source_seed, key, s, &xs[s - 32 * w],
                         &ys[s - 32 * w], &zs[s - 32 * w]);
         } else {
           xs[s - 32 * w] = source_points[3 * s], ys[s - 32 * w] = source_points[3 * s + 1];

@@ -28,7 +28,7 @@ struct Pairs {
       if (std::isnan(z)) break;
       float xs, ys, zs;
       detail::region_sample(sources.data(), heights.data(), field.width, field.height, source_absolute,
-                            options.seed, key, s, &xs, &ys, &zs);
+                            detail::region_table_seed(sources.data(), options.seed), key, s, &xs, &ys, &zs);
       if (detail::region_sight_visible(heights.data(), field.width, field.height, float(field.cell_size_x),
                                        float(field.cell_size_y), float(options.curvature), max_d2, xs, ys, zs,
                                        x, y, z))
@@ -102,7 +102,8 @@ RegionVisibilityResult referenceRegionVisibility(const HeightField& field, const
         if (!((words[s / 32] >> (s % 32)) & 1u)) continue;
         float xs, ys, zs;
         detail::region_sample(table.data(), heights.data(), field.width, field.height, sources.absolute,
-                              options.seed, options.decorrelate ? unsigned(p) + 1u : 0u, s, &xs, &ys, &zs);
+                              detail::region_table_seed(table.data(), options.seed),
+                              options.decorrelate ? unsigned(p) + 1u : 0u, s, &xs, &ys, &zs);
         sum += lightValue(options.light_image, table, c, xs, ys);
       }
       (*planes[c])[p] = std::isnan(heights[p]) ? std::numeric_limits<float>::quiet_NaN()
@@ -132,7 +133,8 @@ RegionPairVisibilityResult referenceRegionPairVisibility(const HeightField& fiel
   for (int r = 0; r < out.receiver_samples; ++r) {
     float x, y, z;
     detail::region_sample(receiver_table.data(), heights.data(), field.width, field.height,
-                          receivers.absolute, options.seed, 0u, r, &x, &y, &z);
+                          receivers.absolute, detail::region_table_seed(receiver_table.data(), options.seed),
+                          0u, r, &x, &y, &z);
     pairs.receiverBits(x, y, z, options.decorrelate ? unsigned(r) + 1u : 0u,
                        &out.bits[std::size_t(r) * out.words]);
   }

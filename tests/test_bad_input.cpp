@@ -211,7 +211,7 @@ TEST(BadInput, PotentiallyVisibleSets) {
   expectError<InvalidArgument>([&] { pvs(bad); }, "0 <= H0 <= H1");
   bad.band_low = 0.0;
   bad.band_high = 1e39;  // (infinite in float: the rays' origins were blamed)
-  expectError<InvalidArgument>([&] { pvs(bad); }, "0 <= H0 <= H1 <= 1e+28");
+  expectError<InvalidArgument>([&] { pvs(bad); }, "0 <= H0 <= H1 <= 1e+12 (got 0, 1e+39)");
   PvsOptions bad_method = options;
   bad_method.method = static_cast<PvsMethod>(99);
   expectError<InvalidArgument>([&] { computePvs(testContext(), field, grid, bad_method); },

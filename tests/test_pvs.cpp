@@ -107,13 +107,20 @@ void expectSame(const RayCastResult& got, const RayCastResult& want) {
 // Without the lists the grid goes unused: the default one (view cells of 32) is not held against
 // a field smaller than it (every field under 33 x 33 was refused).
 TEST(PvsRayCaster, RaysAloneTakeAnyFieldOfTwoByTwo) {
-  const HeightField field = makeSyntheticField("noise", 24, 20);
-  const std::vector<HeightRay> in = raysOver(field, 50, 3);
-  const RayCastResult got = castHeightFieldRays(testContext(), field, in, {});
-  expectSame(got, referenceCastHeightFieldRays(field, in, {}));
-  RayCastOptions lists;
-  lists.view_cells = true;
-  EXPECT_THROW(castHeightFieldRays(testContext(), field, in, lists), InvalidArgument);
+  for (const int n : {2, 24}) {
+    const HeightField field = makeSyntheticField("noise", n, n - (n > 2 ? 4 : 0));
+    const std::vector<HeightRay> in = raysOver(field, 50, 3);
+    const RayCastResult got = castHeightFieldRays(testContext(), field, in, {});
+    expectSame(got, referenceCastHeightFieldRays(field, in, {}));
+    RayCastOptions lists;
+    lists.view_cells = true;
+    try {
+      castHeightFieldRays(testContext(), field, in, lists);
+      ADD_FAILURE() << "the default grid's view cells of 32 were taken on a field of " << n;
+    } catch (const InvalidArgument& e) {
+      EXPECT_NE(std::string(e.what()).find("view cell size"), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(PvsRayCaster, KernelMatchesTheReferenceOnEveryHardCase) {

@@ -704,39 +704,47 @@ TEST(RegionVisibility, TheDefaultPicksTheBitmaskForALargePlanarLight) {
   });
 }
 
+// Also for two rectangles of one size and sample count, whose jitters differ (each rectangle's own
+// share of the seed) and whose samples are each the same on either side.
 TEST(RegionVisibility, AToBIsTheTransposeOfBToA) {
   std::uint64_t clear = 0, pairs = 0;
-  for (const char* name : {"city", "noise", "sine", "terraces"}) {
-    SCOPED_TRACE(name);
-    HeightField field = makeSyntheticField(name, 40, 41, 3);
-    field.cell_size_x = 1.5;
-    RegionSampling a, b;
-    a.rectangle = {1, 2, 12, 9};
-    a.samples = 70;
-    a.height = 12.0;
-    b.rectangle = {38, 39, 25, 20};
-    b.samples = 50;
-    b.height = 0.5;
-    RegionVisibilityOptions options;
-    options.curvature = 0.001;
-    const RegionPairVisibilityResult ab = computeRegionPairVisibility(testContext(), field, a, b, options);
-    const RegionPairVisibilityResult ba = computeRegionPairVisibility(testContext(), field, b, a, options);
-    // The same samples on both sides.
-    ASSERT_EQ(ab.sources.size(), ba.receivers.size());
-    for (std::size_t s = 0; s < ab.sources.size(); ++s) {
-      EXPECT_EQ(ab.sources[s].col, ba.receivers[s].col);
-      EXPECT_EQ(ab.sources[s].height, ba.receivers[s].height);
+  for (const char* name : {"city", "noise", "sine", "terraces"})
+    for (const bool same_size : {false, true}) {
+      SCOPED_TRACE(std::string(name) + (same_size ? ", rectangles of one size" : ""));
+      HeightField field = makeSyntheticField(name, 40, 41, 3);
+      field.cell_size_x = 1.5;
+      RegionSampling a, b;
+      a.rectangle = {1, 2, 12, 9};
+      a.samples = 70;
+      a.height = 12.0;
+      b.rectangle = same_size ? PixelRectangle{38, 39, 27, 32} : PixelRectangle{38, 39, 25, 20};
+      b.samples = same_size ? 70 : 50;
+      b.height = 0.5;
+      RegionVisibilityOptions options;
+      options.curvature = 0.001;
+      const RegionPairVisibilityResult ab = computeRegionPairVisibility(testContext(), field, a, b, options);
+      const RegionPairVisibilityResult ba = computeRegionPairVisibility(testContext(), field, b, a, options);
+      // The same samples on both sides.
+      ASSERT_EQ(ab.sources.size(), ba.receivers.size());
+      std::size_t same_place = 0;  // in their strata: samples k of A and of B
+      for (std::size_t s = 0; s < ab.sources.size(); ++s) {
+        EXPECT_EQ(ab.sources[s].col, ba.receivers[s].col);
+        EXPECT_EQ(ab.sources[s].row, ba.receivers[s].row);
+        EXPECT_EQ(ab.sources[s].height, ba.receivers[s].height);
+        if (same_size && s < ab.receivers.size())
+          same_place += ab.sources[s].col - ab.receivers[s].col == ab.sources[0].col - ab.receivers[0].col;
+      }
+      if (same_size) EXPECT_LT(same_place, 10u) << "samples k of two rectangles of one size moved together";
+      std::size_t differ = 0;
+      for (int r = 0; r < ab.receiver_samples; ++r)
+        for (int s = 0; s < ab.source_samples; ++s) differ += ab.visible(r, s) != ba.visible(s, r);
+      EXPECT_EQ(differ, 0u);
+      EXPECT_EQ(ab.clear_pairs, ba.clear_pairs);
+      EXPECT_EQ(ab.source_fraction, ba.receiver_fraction);
+      clear += ab.clear_pairs, pairs += ab.pairs;
+      std::printf("%s: %llu of %llu pairs clear\n", name, static_cast<unsigned long long>(ab.clear_pairs),
+                  static_cast<unsigned long long>(ab.pairs));
     }
-    std::size_t differ = 0;
-    for (int r = 0; r < ab.receiver_samples; ++r)
-      for (int s = 0; s < ab.source_samples; ++s) differ += ab.visible(r, s) != ba.visible(s, r);
-    EXPECT_EQ(differ, 0u);
-    EXPECT_EQ(ab.clear_pairs, ba.clear_pairs);
-    EXPECT_EQ(ab.source_fraction, ba.receiver_fraction);
-    clear += ab.clear_pairs, pairs += ab.pairs;
-    std::printf("%s: %llu of %llu pairs clear\n", name, static_cast<unsigned long long>(ab.clear_pairs),
-                static_cast<unsigned long long>(ab.pairs));
-  }
   EXPECT_GT(clear, pairs / 20);
   EXPECT_LT(clear, pairs * 19 / 20);
 }
@@ -1313,6 +1321,11 @@ TEST(RegionVisibility, BadInputIsRefused) {
   s = good;
   s.height = std::numeric_limits<double>::infinity();
   refused(s, options, "finite");
+  // (beyond float, a light at 1e300 was seen from everywhere, without a word)
+  s.height = 1e300;
+  refused(s, options, "within +-1e+12 (got 1e+300)");
+  s.height = -1e13;
+  refused(s, options, "within +-1e+12");
   s = good;
   s.points = {{5.5, 4.5, 1.0}};
   refused(s, options, "nodata");
@@ -1320,6 +1333,8 @@ TEST(RegionVisibility, BadInputIsRefused) {
   refused(s, options, "outside");
   s.points = {{1.0, 2.0, std::numeric_limits<double>::quiet_NaN()}};
   refused(s, options, "finite");
+  s.points = {{1.0, 2.0, -1e39}};
+  refused(s, options, "beyond +-1e+12");
   RegionVisibilityOptions o = options;
   o.max_distance = -1.0;
   refused(good, o, "maximum distance");

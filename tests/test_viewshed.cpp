@@ -300,11 +300,19 @@ TEST(Viewshed, BadInputIsRefused) {
     EXPECT_THROW(computeViewshed(c, f, {1, 1, 2.0}, o), InvalidArgument) << curvature;
     ViewshedPyramidOptions p;
     p.curvature = curvature;
-    EXPECT_THROW(buildViewshedPyramid(c, f, p), InvalidArgument) << curvature;
+    try {
+      buildViewshedPyramid(c, f, p);
+      ADD_FAILURE() << "a pyramid for a curvature of " << curvature;
+    } catch (const InvalidArgument& e) {
+      EXPECT_NE(std::string(e.what()).find("within -1 .. 1 per ground unit"), std::string::npos) << e.what();
+    }
   }
   o = {};
   o.curvature = 1.0;
   EXPECT_NO_THROW(computeViewshed(c, f, {1, 1, 2.0}, o));
+  ViewshedPyramidOptions most;
+  most.curvature = -1.0;
+  EXPECT_NO_THROW(buildViewshedPyramid(c, f, most));
   EXPECT_THROW(computeCumulativeViewshed(c, f, {}, {}), InvalidArgument);
   HeightField geographic = f;
   geographic.row_cell_size_x.assign(10, 1.0);

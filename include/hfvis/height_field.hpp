@@ -80,6 +80,11 @@ struct HeightField {
 // sky-view factor of 1 everywhere and 1e-30 a visible area of 0, without a word.
 constexpr double kLeastCellSize = 1e-6, kMostCellSize = 1e9;
 
+// The largest magnitude of a height an operation takes besides the field's (a region's samples,
+// a PVS view band), as the command line's options: beyond float's range (1e39) it became
+// infinite in the kernels and a light at 1e300 was seen from everywhere, without a word.
+constexpr double kMostGivenHeight = 1e12;
+
 // Whether every cell size of the field (per-row ones included) lies in kLeastCellSize ..
 // kMostCellSize.
 bool cellSizesHeld(const HeightField& field);

@@ -64,8 +64,8 @@ struct PvsLayout {
 };
 
 // Throws InvalidArgument for a field under 2 x 2 points, a latitude / longitude grid, C or T
-// below 1 or past max(W, H) - 1, a band not finite, negative or with H1 < H0, a mask of the wrong
-// size or computing no view cell.
+// below 1 or past max(W, H) - 1, a band not finite, negative, with H1 < H0 or above 1e28, a mask
+// of the wrong size or computing no view cell.
 PvsLayout pvsLayout(const HeightField& field, const PvsGrid& grid);
 
 // ---- The ray caster
@@ -93,8 +93,9 @@ struct RayCastResult {
 
 // Casts the rays on the device: the first point where each passes strictly below the bilinear
 // surface (a ray starting below it hits at t = 0; one only touching it goes on), exact to the
-// float rounding of the per-cell quadratic's root. Throws InvalidArgument (bad field or grid, a
-// ray not finite), MemoryBudgetError, OpenClError, KernelBuildError.
+// float rounding of the per-cell quadratic's root. Throws InvalidArgument (bad field, a ray not
+// finite, with `view_cells` a bad grid: without, the grid is not looked at), MemoryBudgetError,
+// OpenClError, KernelBuildError.
 RayCastResult castHeightFieldRays(const ComputeContext& context, const HeightField& field,
                                   const std::vector<HeightRay>& rays, const RayCastOptions& options = {});
 

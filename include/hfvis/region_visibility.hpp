@@ -10,10 +10,11 @@
 // horizontal plane); or an explicit list of points. A rectangle's samples are stratified: rows of
 // about sqrt(S * width / height) strata, so that they are about square (all in one row or column
 // for a rectangle one point thick; the last row holds the rest, its strata wider), each sample
-// jittered uniformly inside its stratum by a hash of (seed, stream, sample), so results are
-// deterministic. With `decorrelate`, each receiver draws its own jitter of the sources (stream
-// receiver + 1), trading the banding of shared samples for noise; else every receiver sees the
-// same samples (stream 0).
+// jittered uniformly inside its stratum by a hash of (seed, the rectangle's corners, stream,
+// sample), so results are deterministic, a rectangle draws the same samples as sources or as
+// receivers, and two rectangles of one size draw unrelated jitters. With `decorrelate`, each receiver draws
+// its own jitter of the sources (stream receiver + 1), trading the banding of shared samples for noise; else
+// every receiver sees the same samples (stream 0).
 //
 // Receivers: every grid point, `target_height` above the surface (a pixel's height: nodata
 // pixels receive nothing, their fraction NaN); or a second rectangle, sampled the same way with

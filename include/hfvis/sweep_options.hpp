@@ -53,8 +53,9 @@ struct SweepOptions {
 // that a direction two K share (every m-th of m K's is one of K's) has one azimuth, to the bit.
 double directionAzimuth(int k, const SweepOptions& options);
 
-// Throws InvalidArgument for K < 1, a sampling density outside (0, 64], a non-finite
-// azimuth offset or curvature, or a negative or non-finite maximum distance.
+// Throws InvalidArgument for K < 1, a sampling density outside (0, 64], an azimuth offset not
+// finite or beyond two turns, a curvature not finite or beyond -1 .. 1 per ground unit, or a
+// negative or non-finite maximum distance.
 void validate(const SweepOptions& options);
 
 }  // namespace hfvis

@@ -649,25 +649,27 @@ inline unsigned int region_hash(unsigned int x) {
   return x;
 }
 
-// A region table's own share of the seed, from its rectangle's corners (whole pixels; a points
-// table's bounds, inside the field, whose samples take no jitter): two rectangles of one size
-// drawn with one seed get unrelated jitters (else a pair's samples k and k would sit at the same
-// place in their strata), and a rectangle draws the same samples as receivers or as sources.
-inline unsigned int region_table_stream(HFVIS_GLOBAL const float* table) {
+// A region table's seed: the run's `seed` mixed with the table's rectangle's corners (whole
+// pixels; a points table's bounds, inside the field, whose samples take no jitter), so that two
+// rectangles of one size drawn with one seed get unrelated jitters (else a pair's samples k and k
+// sat at the same place in their strata) and a rectangle draws the same samples as receivers or
+// as sources. What region_sample takes; computed once per table, not per sample.
+inline unsigned int region_table_seed(HFVIS_GLOBAL const float* table, unsigned int seed) {
   const unsigned int lo = (unsigned int)(int)table[0] + 0x9e3779b9U * (unsigned int)(int)table[1];
   const unsigned int hi = (unsigned int)(int)table[2] + 0x9e3779b9U * (unsigned int)(int)table[3];
-  return region_hash(lo ^ region_hash(hi));
+  return seed ^ region_hash(lo ^ region_hash(hi));
 }
 
 // The jitter in [0, 1) of coordinate `axis` (0 or 1) of sample s of the stream `key` (0 for a
 // region's own samples, receiver + 1 for the sources decorrelated per receiver): 24 bits, exact
-// in float. `seed`: the run's seed mixed with the table's stream (region_table_stream).
+// in float. `seed`: the table's (region_table_seed).
 inline float region_jitter(unsigned int seed, unsigned int key, unsigned int s, unsigned int axis) {
   const unsigned int v = region_hash(seed ^ region_hash(key ^ region_hash(2U * s + axis)));
   return (float)(v >> 8) * 0x1p-24f;
 }
 
-// Sample s of a region's table, drawn from stream `key` of `seed`: the table holds the
+// Sample s of a region's table, drawn from stream `key` of `seed` (the table's: region_table_seed): the
+// table holds the
 // rectangle (lo_x, lo_y, hi_x, hi_y), then per sample its stratum's corner (x, y), its size
 // (x, y) and the height (above the surface, or absolute when `absolute`). The sample is the
 // corner plus the jitter times the size, kept inside the rectangle (a rounding may step past).
@@ -676,9 +678,8 @@ inline void region_sample(HFVIS_GLOBAL const float* table, HFVIS_GLOBAL const fl
                           int absolute, unsigned int seed, unsigned int key, int s, float* x, float* y,
                           float* z) {
   HFVIS_GLOBAL const float* e = table + 4 + 5 * s;
-  const unsigned int stream = seed ^ region_table_stream(table);
-  const float vx = e[0] + region_jitter(stream, key, (unsigned int)s, 0U) * e[2];
-  const float vy = e[1] + region_jitter(stream, key, (unsigned int)s, 1U) * e[3];
+  const float vx = e[0] + region_jitter(seed, key, (unsigned int)s, 0U) * e[2];
+  const float vy = e[1] + region_jitter(seed, key, (unsigned int)s, 1U) * e[3];
   *x = vx < table[0] ? table[0] : (vx > table[2] ? table[2] : vx);
   *y = vy < table[1] ? table[1] : (vy > table[3] ? table[3] : vy);
   *z = absolute ? e[4] : region_surface_at(h, width, height, *x, *y) + e[4];

@@ -55,22 +55,34 @@ def float32_may_round(dtype):
     return dtype.itemsize > 4 or dtype.kind in "iu" and dtype.itemsize == 4
 
 
+def as_array(value, what):
+    """np.asarray(value), or hfvis's InputTypeError naming `what` where numpy cannot make an array of
+    it (a ragged list: numpy's own ValueError) or where it is an xarray.Dataset (several variables:
+    xarray's TypeError)."""
+    if hasattr(value, "data_vars"):  # an xarray.Dataset (not imported here: xarray is optional)
+        names = [str(n) for n in value.data_vars]
+        listed = ", ".join(repr(n) for n in names[:5]) + (", ..." if len(names) > 5 else "")
+        counted = f"{len(names)} variable{'' if len(names) == 1 else 's'}" + (f": {listed}" if names else "")
+        raise InputTypeError(f"{what} must be an array, not an xarray.Dataset ({counted}): give one of its "
+                             "variables, a DataArray (dataset['name'])")
+    try:
+        return np.asarray(value)
+    except ValueError as e:  # numpy's for a ragged list
+        raise InputTypeError(f"{what} must be an array; numpy could not make one of the {type(value).__name__} "
+                             f"given (rows of different lengths?): {e}") from None
+    except TypeError as e:
+        raise InputTypeError(f"{what} must be an array; numpy could not make one of the {type(value).__name__} "
+                             f"given: {e}") from None
+
+
 def heights_array(heights, nodata=None, cell_size=1.0):
     """The heights as a new or unmodified C-contiguous native float32 2-D array, nodata (and
     `nodata`'s value, compared in the heights' own dtype, and a masked array's mask) as NaN. Any
     real dtype (float16..float128, integers), either byte order, any strides; refused: other
     dimensions, complex, bool, object, and heights that float32 rounds by more than a thousandth of
     their range and a hundredth of `cell_size` (as the file readers refuse them)."""
-    if hasattr(heights, "data_vars"):  # an xarray.Dataset (not imported here: xarray is optional)
-        names = ", ".join(repr(str(n)) for n in list(heights.data_vars)[:5])
-        raise InputTypeError(f"heights are an xarray.Dataset of variables ({names}): give one of them, "
-                             "a DataArray (dataset['name'])")
     mask = np.ma.getmaskarray(heights) if np.ma.isMaskedArray(heights) else None
-    try:
-        a = np.asarray(np.ma.getdata(heights) if mask is not None else heights)
-    except (ValueError, TypeError) as e:  # a ragged list, or an object numpy cannot take
-        raise InputTypeError(f"heights must be a 2-D array (rows, columns) of real numbers; numpy could not "
-                             f"make one of the {type(heights).__name__} given (rows of different lengths?): {e}") from None
+    a = as_array(np.ma.getdata(heights) if mask is not None else heights, "heights")
     if a.ndim != 2:
         raise InputTypeError(f"heights must be a 2-D array (rows, columns), got {a.ndim} dimension(s) {a.shape}")
     if a.dtype.kind not in "fiu":
@@ -232,7 +244,7 @@ def compute(operation, heights, geometry, options, device="", progress=None):
             env = _core.read_environment_map(os.fspath(environment), float(options["rotation_deg"]),
                                              int(options["table_rows"]))
         else:
-            radiance = np.asarray(environment)
+            radiance = as_array(environment, "environment")
             if radiance.ndim == 2:
                 radiance = radiance[np.newaxis]
             if radiance.ndim != 3 or radiance.dtype.kind not in "fiu":
@@ -257,7 +269,7 @@ def compute(operation, heights, geometry, options, device="", progress=None):
         o = _region_options(options)
         light_image = options.get("light_image")
         if light_image is not None:
-            light_image = np.asarray(light_image)
+            light_image = as_array(light_image, "light_image")
             if light_image.ndim == 2:
                 light_image = np.broadcast_to(light_image, (3,) + light_image.shape)
             if light_image.ndim != 3 or light_image.shape[0] != 3 or light_image.dtype.kind not in "fiu":
@@ -292,7 +304,7 @@ def compute(operation, heights, geometry, options, device="", progress=None):
         cols, rows = receiver_pixels(options["receivers"])
         return {"lists": _core.horizon_lists(field, _sweep_options(options), cols, rows)}
     if operation == "bounce":
-        radiance = np.asarray(options["radiance"])
+        radiance = as_array(options["radiance"], "radiance")
         if radiance.ndim == 2:
             radiance = radiance[np.newaxis]
         if radiance.ndim != 3 or radiance.dtype.kind not in "fiu":
@@ -319,7 +331,7 @@ def region_sampling(region, samples, height, absolute):
     """A region as hfvis._core.RegionSampling: a rectangle (col0, row0, col1, row1) of grid points,
     corners inclusive, sampled `samples` times; or an N x 2 (col, row) or N x 3 (col, row, height)
     array of points, the samples themselves (a missing height is `height`)."""
-    a = np.asarray(region)
+    a = as_array(region, "a region")
     if a.ndim == 1 and a.shape[0] == 4:
         if a.dtype.kind not in "iu":
             raise InvalidArgumentError(f"a rectangle is four integer pixel corners (col0, row0, col1, row1), "
@@ -337,7 +349,7 @@ def pvs_mask(mask, shape, view_cell):
     columns), or per pixel of the field (its shape), as the CLI's --view-mask: a view cell is
     computed when it holds a non-zero finite pixel (the last row and column count with the cells
     before them)."""
-    m = np.asarray(mask)
+    m = as_array(mask, "mask")
     height, width = shape
     cells_x, cells_y = width - 1, height - 1
     view = view_cell if view_cell >= 1 else 1
@@ -358,7 +370,7 @@ def pvs_mask(mask, shape, view_cell):
 
 def receiver_pixels(receivers):
     """Columns and rows of an N x 2 integer array of pixels (column, row), N >= 1."""
-    pixels = np.asarray(receivers)
+    pixels = as_array(receivers, "receivers")
     if pixels.ndim != 2 or pixels.shape[1] != 2 or pixels.dtype.kind not in "iu" or len(pixels) == 0:
         raise InvalidArgumentError(f"receivers must be an N x 2 array of integer pixels (column, row), N >= 1, "
                                    f"got shape {pixels.shape} and dtype {pixels.dtype}")
@@ -366,7 +378,7 @@ def receiver_pixels(receivers):
 
 
 def observer_pixel(observer):
-    pair = np.asarray(observer)
+    pair = as_array(observer, "observer")
     if pair.shape != (2,) or pair.dtype.kind not in "iu" or not all(-2**31 <= int(v) < 2**31 for v in pair):
         raise InvalidArgumentError(f"an observer is a pixel (column, row) of two integers, got {observer!r}")
     return int(pair[0]), int(pair[1])
@@ -375,9 +387,13 @@ def observer_pixel(observer):
 def observer_pixels(observers, observer_height):
     """Columns, rows and eye heights of an N x 2 integer array of pixels (column, row); the
     height a number or one per observer."""
-    pixels = np.asarray(observers)
+    pixels = as_array(observers, "observers")
     if pixels.ndim != 2 or pixels.shape[1] != 2 or pixels.dtype.kind not in "iu" or len(pixels) == 0:
         raise InvalidArgumentError(f"observers must be an N x 2 array of integer pixels (column, row), N >= 1, "
                                    f"got shape {pixels.shape} and dtype {pixels.dtype}")
-    eyes = np.broadcast_to(np.asarray(observer_height, dtype=np.float64), (len(pixels),))
+    eyes = as_array(observer_height, "observer_height")
+    if eyes.ndim > 1 or eyes.ndim == 1 and len(eyes) != len(pixels) or eyes.dtype.kind not in "fiu":
+        raise InvalidArgumentError(f"observer_height must be a number or one per observer ({len(pixels)}), got shape "
+                                   f"{eyes.shape} and dtype {eyes.dtype}")
+    eyes = np.broadcast_to(eyes.astype(np.float64), (len(pixels),))
     return pixels[:, 0].tolist(), pixels[:, 1].tolist(), eyes.tolist()

@@ -192,12 +192,12 @@ def _observers_as_pixels(operation, options, grid, flip_rows, flip_cols, pixels)
 
     options = dict(options)
     if operation == "viewshed":
-        observer = np.asarray(options["observer"])
+        observer = _arrays.as_array(options["observer"], "observer")
         if observer.shape != (2,):
             raise InvalidArgumentError(f"an observer is a pair (x, y), got {options['observer']!r}")
         options["observer"] = np.array(place(*pixel_of(*observer)))
     else:
-        points = np.asarray(options["observers"])
+        points = _arrays.as_array(options["observers"], "observers")
         if points.ndim != 2 or points.shape[1] != 2:
             raise InvalidArgumentError(f"observers must be an N x 2 array, got shape {points.shape}")
         placed = [place(*pixel_of(x, y)) for x, y in points]
@@ -215,7 +215,7 @@ def _places_as_pixels(operation, options, grid, pixels):
     for key in ("sources", "receivers"):
         if key not in options:
             continue
-        a = np.asarray(options[key])
+        a = _arrays.as_array(options[key], key)
         if operation == "horizon_lists":
             if a.ndim != 2 or a.shape[1] != 2:
                 raise InvalidArgumentError(f"receivers must be an N x 2 array, got shape {a.shape}")
@@ -692,7 +692,7 @@ def pvs(heights, *, samples=0, pixel_error=0.0, seconds=0.0, view_cell=32, band_
     options = {"samples": _whole("samples", samples, None, 2**31 - 1), "pixel_error": _real("pixel_error", pixel_error),
                "seconds": _real("seconds", seconds), "view_cell": _whole("view_cell", view_cell, None, 2**31 - 1),
                "band_low": _real("band_low", band_low), "band_high": _real("band_high", band_high),
-               "tile": _whole("tile", tile, None, 2**31 - 1), "mask": None if mask is None else np.asarray(mask),
+               "tile": _whole("tile", tile, None, 2**31 - 1), "mask": None if mask is None else _arrays.as_array(mask, "mask"),
                "method": method, "batch": _whole("batch", batch, None, 2**31 - 1),
                "seed": _whole("seed", seed, 0, 2**32 - 1), "resolution": _real("resolution", resolution),
                "filter": _real("filter", filter),
@@ -750,10 +750,11 @@ def bounce(heights, radiance, *, directions=64, azimuth_offset=0.0, samples_per_
                "memory_budget_bytes": _budget(memory_budget_bytes)}
     if _is_dataarray(heights) and _is_dask(heights.data):
         heights = heights.compute()
-    one_channel = np.ndim(radiance) == 2
+    radiance_values = _arrays.as_array(radiance.values if _is_dataarray(radiance) else radiance, "radiance")
+    one_channel = radiance_values.ndim == 2
     if _is_dataarray(radiance) and _is_dataarray(heights):
         _require_grid_of(radiance, heights)
-    options["radiance"] = np.asarray(radiance.values if _is_dataarray(radiance) else radiance)
+    options["radiance"] = radiance_values
     out, grid = _run("bounce", heights, options, _common(cell_size, z_scale, nodata, device, progress))
     irradiance = out["irradiance"]
     if grid is None:

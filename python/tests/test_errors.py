@@ -23,7 +23,7 @@ def small():
     (np.full((4, 4), np.nan, np.float32), ValueError, "nodata"),
     (np.full((4, 4), 1e300), ValueError, "float32"),
     ([[1.0, 2.0], [3.0]], TypeError, "rows of different lengths"),
-    (xr.Dataset({"dem": (("y", "x"), np.zeros((4, 4)))}), TypeError, "Dataset of variables \\('dem'\\)"),
+    (xr.Dataset({"dem": (("y", "x"), np.zeros((4, 4)))}), TypeError, "not an xarray.Dataset \\(1 variable: 'dem'\\)"),
 ])
 def test_bad_heights(bad, kind, words):
     with pytest.raises(kind, match=words) as caught:
@@ -184,6 +184,19 @@ def test_nodata_in_the_heights_dtype_and_masked_arrays(small):
     assert np.array_equal(np.isnan(out), np.ma.getmaskarray(masked))
     # heights far from 0 whose float32 rounding stays small against a cell pass
     assert np.isfinite(hfvis.sky_view_factor(small.astype(np.float64) + 4000.0, directions=8)).all()
+
+
+@pytest.mark.parametrize("call, words", [
+    (lambda h: hfvis.cumulative_viewshed(h, [(1, 2), (3,)]), "observers must be an array"),
+    (lambda h: hfvis.region_visibility(h, [(1.0, 2.0, 3.0), (3.0, 4.0)]), "a region must be an array"),
+    (lambda h: hfvis.bounce(h, [[1.0, 2.0], [3.0]]), "radiance must be an array"),
+    (lambda h: hfvis.bounce(h, xr.Dataset({"r": (("y", "x"), np.ones(h.shape))})), "radiance must be an array, not"),
+    (lambda h: hfvis.cumulative_viewshed(h, [(1, 2), (3, 4)], observer_height=[1.0, 2.0, 3.0]), "one per observer"),
+])
+def test_ragged_lists_and_datasets_besides_the_heights_are_refused(small, call, words):
+    """numpy's bare ValueError (a ragged list) or xarray's TypeError (a Dataset) before."""
+    with pytest.raises(hfvis.Error, match=words):
+        call(small)
 
 
 def test_integer_options_and_dask_edges_are_refused_clearly():

@@ -5,6 +5,7 @@
 #include <numeric>
 #include <string>
 
+#include "core/number_text.hpp"
 #include "core/sweep_geometry.hpp"
 #include "hfvis/errors.hpp"
 
@@ -50,7 +51,7 @@ void validateCurvature(double curvature, const std::string& what) {
   // (far beyond, 1e36, the drops overflowed float and the viewshed saw farther: no error)
   if (!std::isfinite(curvature) || std::abs(curvature) > 1.0)
     throw InvalidArgument(what + " must be finite and within -1 .. 1 per ground unit (got " +
-                          std::to_string(curvature) + "); earthCurvature() gives the Earth's in 1/m");
+                          shortNumber(curvature) + "); earthCurvature() gives the Earth's in 1/m");
 }
 
 std::vector<SweepDirection> runDirections(const HeightField& field, const SweepOptions& options) {

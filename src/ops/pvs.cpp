@@ -50,12 +50,12 @@ PvsLayout pvsLayout(const HeightField& field, const PvsGrid& grid) {
     throw InvalidArgument("the tile size must be 1 .. " + std::to_string(most) + " cells (got " +
                           std::to_string(grid.tile) + ")");
   // (a band of 1e39, finite in double, is infinite in the kernels' float: the rays' origins were
-  // blamed)
+  // blamed; kMostGivenHeight, as the command line's --view-height)
   if (!std::isfinite(grid.band_low) || !std::isfinite(grid.band_high) || grid.band_low < 0.0 ||
-      grid.band_high < grid.band_low || grid.band_high > detail::kMaxPreparedHeight)
-    throw InvalidArgument("the view band needs finite heights 0 <= H0 <= H1 <= " +
-                          detail::shortNumber(detail::kMaxPreparedHeight) + " (got " +
-                          std::to_string(grid.band_low) + ", " + std::to_string(grid.band_high) + ")");
+      grid.band_high < grid.band_low || grid.band_high > kMostGivenHeight)
+    throw InvalidArgument(
+        "the view band needs finite heights 0 <= H0 <= H1 <= " + detail::shortNumber(kMostGivenHeight) +
+        " (got " + detail::shortNumber(grid.band_low) + ", " + detail::shortNumber(grid.band_high) + ")");
   l.view_cell = grid.view_cell;
   l.tile = grid.tile;
   l.view_x = (l.cells_x + grid.view_cell - 1) / grid.view_cell;

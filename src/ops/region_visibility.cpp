@@ -337,7 +337,8 @@ class RegionBitsRoutine : public detail::DeviceRoutine {
       const int s = int(std::int64_t(i) * samples_ / kProbeLines), r = int(std::int64_t(i) * 37 % count_);
       float xr, yr, zr;
       detail::region_sample(receivers_->data(), h.data(), field_.width, field_.height, receiver_absolute_,
-                            options_.seed, 0u, r, &xr, &yr, &zr);
+                            detail::region_table_seed(receivers_->data(), options_.seed), 0u, r, &xr, &yr,
+                            &zr);
       int blocked_at;
       if (!std::isnan(zr) &&
           detail::region_sight_visible_culled(h.data(), field_.width, field_.height, device.cell_x,
@@ -447,15 +448,16 @@ std::vector<std::uint32_t> viewshedBits(const ComputeContext& context, const Hei
   return bits;
 }
 
-// A table's samples from stream 0 of `seed` on the z-scaled heights (region_sample, as the kernel
-// places them): x, y, z each.
+// A table's samples from stream 0 of `seed` (mixed with the table's own: region_table_seed) on
+// the z-scaled heights (region_sample, as the kernel places them): x, y, z each.
 std::vector<float> tableSamplePoints(const HeightField& field, const std::vector<float>& table,
                                      const std::vector<float>& heights, bool absolute, std::uint32_t seed) {
   std::vector<float> points;
+  const std::uint32_t table_seed = detail::region_table_seed(table.data(), seed);
   for (int s = 0; s < detail::regionTableSamples(table); ++s) {
     float x, y, z;
-    detail::region_sample(table.data(), heights.data(), field.width, field.height, absolute, seed, 0u, s, &x,
-                          &y, &z);
+    detail::region_sample(table.data(), heights.data(), field.width, field.height, absolute, table_seed, 0u,
+                          s, &x, &y, &z);
     points.insert(points.end(), {x, y, z});
   }
   return points;
@@ -503,6 +505,7 @@ void colourLight(RegionVisibilityResult& out, const HeightField& field, const st
   for (std::size_t i = 0; i + 2 < points.size(); i += 3)
     shared.push_back(lightColour(image, table, points[i], points[i + 1]));
   const std::size_t count = field.pixelCount();
+  const std::uint32_t table_seed = detail::region_table_seed(table.data(), options.seed);
   for (auto* plane : {&out.red, &out.green, &out.blue})
     plane->assign(count, std::numeric_limits<float>::quiet_NaN());
   for (std::size_t p = 0; p < count; ++p) {
@@ -515,7 +518,7 @@ void colourLight(RegionVisibilityResult& out, const HeightField& field, const st
         if (options.decorrelate) {
           // (only the position: absolute spares the surface lookup)
           float x, y, z;
-          detail::region_sample(table.data(), nullptr, field.width, field.height, 1, options.seed,
+          detail::region_sample(table.data(), nullptr, field.width, field.height, 1, table_seed,
                                 static_cast<unsigned>(p) + 1u, s, &x, &y, &z);
           colour = lightColour(image, table, x, y);
         } else {
@@ -775,7 +778,8 @@ void validate(const RegionVisibilityOptions& options) {
       options.method != RegionVisibilityMethod::Viewsheds &&
       options.method != RegionVisibilityMethod::Culled && options.method != RegionVisibilityMethod::Bitmask &&
       options.method != RegionVisibilityMethod::Auto)
-    throw InvalidArgument("unknown region visibility method");
+    throw InvalidArgument("unknown region visibility method " +
+                          std::to_string(static_cast<int>(options.method)));
   if (options.bitmask_table < 8 || options.bitmask_table > 1024)
     throw InvalidArgument("the bitmask table takes 8 .. 1024 angles and offsets (got " +
                           std::to_string(options.bitmask_table) + ")");
@@ -789,7 +793,13 @@ namespace detail {
 
 void validateSampling(const HeightField& field, const RegionSampling& sampling,
                       const std::vector<float>* prepared) {
-  if (!std::isfinite(sampling.height)) throw InvalidArgument("a region's height must be finite");
+  const auto held = [](double height) {
+    return std::isfinite(height) && std::fabs(height) <= kMostGivenHeight;
+  };
+  if (!held(sampling.height))
+    throw InvalidArgument("a region's height must be finite and within +-" +
+                          detail::shortNumber(kMostGivenHeight) + " (got " +
+                          detail::shortNumber(sampling.height) + ")");
   if (!sampling.points.empty()) {
     if (sampling.points.size() > static_cast<std::size_t>(kMaxRegionSamples))
       throw InvalidArgument("a region takes at most " + std::to_string(kMaxRegionSamples) + " points (got " +
@@ -803,7 +813,9 @@ void validateSampling(const HeightField& field, const RegionSampling& sampling,
       if (!(p.col >= 0.0 && p.col <= field.width - 1.0 && p.row >= 0.0 && p.row <= field.height - 1.0))
         throw InvalidArgument("region point " + at + " is outside the " + std::to_string(field.width) +
                               " x " + std::to_string(field.height) + " field");
-      if (!std::isfinite(p.height)) throw InvalidArgument("region point " + at + " has a non-finite height");
+      if (!held(p.height))
+        throw InvalidArgument("region point " + at + " has a height (" + detail::shortNumber(p.height) +
+                              ") not finite or beyond +-" + detail::shortNumber(kMostGivenHeight));
       const float s =
           detail::region_surface_at(heights.data(), field.width, field.height, float(p.col), float(p.row));
       if (std::isnan(s)) throw InvalidArgument("region point " + at + " lies over nodata");
