@@ -1589,6 +1589,20 @@ TEST_F(Cli, ShadeLightsWithAnEnvironment) {
     EXPECT_EQ(r.status, 2) << bad << ": " << r.err;
     EXPECT_TRUE(listDirectory(outputs()).empty()) << bad;
   }
+  // An albedo of NaN where the height is valid is refused, naming the pixel (that pixel's radiance
+  // was NaN, exit 0); where the height is nodata too, it is that pixel's nodata.
+  const std::string holed_albedo = writeField("holed_albedo.exr", 16, 12, [](int col, int row) {
+    return col == 3 && row == 5 ? std::numeric_limits<float>::quiet_NaN() : 0.5f;
+  });
+  expectFailure(run("shade " + shellQuoted(field) + " -o " + shellQuoted(out("bad.exr")) +
+                    " --sun 100,30 --albedo " + shellQuoted(holed_albedo)),
+                1, "NaN (nodata) at column 3, row 5, where the height is valid");
+  const std::string holed = writeField("holed.exr", 16, 12, [](int col, int row) {
+    return col == 3 && row == 5 ? std::numeric_limits<float>::quiet_NaN() : 3.0f;
+  });
+  const CliResult both = run("shade " + shellQuoted(holed) + " -o " + shellQuoted(out("both.exr")) +
+                             " --sun 100,30 --albedo " + shellQuoted(holed_albedo) + " -q");
+  EXPECT_EQ(both.status, 0) << both.err;
 }
 
 // "hfvis insolation": flat ground at the equator on the 2026 March equinox has 12 hours of sun
@@ -1601,8 +1615,15 @@ TEST_F(Cli, InsolationCountsSunHours) {
   const CliResult r = run("insolation " + shellQuoted(field) + " -o " + shellQuoted(out("i.exr")) +
                           " --lat 0 --lon 0 --from 2026-03-20T00:00:00Z --to 2026-03-21T00:00:00Z --step 2 -q");
   ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
   const ReadBack i = readBack(out("i.exr"));
   ASSERT_EQ(i.channels, (std::vector<std::string>{"direct", "sun_hours"}));
+  // Steps of hours alias the day (one of 720 minutes counts the whole day sunny): a warning.
+  const CliResult coarse =
+      run("insolation " + shellQuoted(field) + " -o " + shellQuoted(out("c.exr")) +
+          " --lat 0 --lon 0 --from 2026-03-20T00:00:00Z --to 2026-03-21T00:00:00Z --step 720 -q");
+  ASSERT_EQ(coarse.status, 0) << coarse.err;
+  EXPECT_NE(coarse.err.find("hfvis: warning: --step 720 minutes"), std::string::npos) << coarse.err;
   EXPECT_NEAR(i.at(4, 4, 1), 12.0, 0.05);
   // The integral of sin(elevation) over a day at the equator's equinox: 24 / pi hours.
   EXPECT_NEAR(i.at(4, 4, 0), 24.0 / M_PI, 0.01);
@@ -1617,17 +1638,44 @@ TEST_F(Cli, InsolationCountsSunHours) {
                                    "EPSG:32631", std::nullopt);
   hfvis::testing::writeGdalGeoTiff(s, width, height, south_up, {500000.0, 1.0, 0.0, 5000000.0, 0.0, 1.0},
                                    "EPSG:32631", std::nullopt);
+  // An albedo raster beside each, of its orientation: 0.2 over the northern half, 0.8 over the
+  // southern; the radiance takes each pixel's own (the field is lit flipped, the albedo is not).
+  std::vector<float> albedo_north(width * height), albedo_south(width * height);
+  for (int r = 0; r < height; ++r)
+    for (int c = 0; c < width; ++c) {
+      albedo_north[r * width + c] = r < height / 2 ? 0.2f : 0.8f;
+      albedo_south[r * width + c] = r < height / 2 ? 0.8f : 0.2f;
+    }
+  hfvis::testing::writeGdalGeoTiff(in("north_albedo.tif"), width, height, albedo_north,
+                                   {500000.0, 1.0, 0.0, 5000024.0, 0.0, -1.0}, "EPSG:32631", std::nullopt);
+  hfvis::testing::writeGdalGeoTiff(in("south_albedo.tif"), width, height, albedo_south,
+                                   {500000.0, 1.0, 0.0, 5000000.0, 0.0, 1.0}, "EPSG:32631", std::nullopt);
   for (const std::string& tif : {n, s}) {
     const std::string o = out(fs::path(tif).stem().string() + ".exr");
+    const std::string albedo = in(fs::path(tif).stem().string() + "_albedo.tif");
     const CliResult w = run("shade " + shellQuoted(tif) + " -o " + shellQuoted(o) +
-                            " --at 2026-12-21T11:47:00Z --lat 45 --lon 3 -q");
+                            " --at 2026-12-21T11:47:00Z --lat 45 --lon 3 --albedo " + shellQuoted(albedo) +
+                            " --sun-irradiance 2 -q");
     ASSERT_EQ(w.status, 0) << w.err;
     const ReadBack shade = readBack(o);
+    const auto channel = [&](const std::string& name) {
+      return int(std::find(shade.channels.begin(), shade.channels.end(), name) - shade.channels.begin());
+    };
+    const int direct = channel("direct"), sun = channel("sun"), radiance = channel("radiance");
+    ASSERT_LT(std::max({direct, sun, radiance}), int(shade.channels.size()));
     const bool south = tif == s;
     // The rows 2 m north of the wall (in file order) are in shadow, 2 m south lit.
     const int north_row = south ? 13 : 10, south_row = south ? 9 : 14;
-    EXPECT_EQ(shade.at(3, north_row, 1), 0.0f) << tif;
-    EXPECT_EQ(shade.at(3, south_row, 1), 1.0f) << tif;
+    EXPECT_EQ(shade.at(3, north_row, sun), 0.0f) << tif;
+    EXPECT_EQ(shade.at(3, south_row, sun), 1.0f) << tif;
+    // Radiance albedo / pi times the irradiance, the albedo of the pixel's own place.
+    for (const int north_up_row : {1, 14, 18, 22}) {
+      const int row = south ? height - 1 - north_up_row : north_up_row;
+      const float a = (south ? albedo_south : albedo_north)[row * width + 3];
+      EXPECT_GT(shade.at(3, row, direct), 0.1f) << tif << " row " << row;
+      EXPECT_NEAR(shade.at(3, row, radiance), a / M_PI * 2.0 * shade.at(3, row, direct), 1e-6)
+          << tif << " row " << row;
+    }
   }
   for (const char* bad : {" --lat 0 --lon 0 --from 2026-03-20T00:00:00Z",
                           " --lat 0 --lon 0 --from 2026-03-21T00:00:00Z --to 2026-03-20T00:00:00Z",

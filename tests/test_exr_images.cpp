@@ -6,15 +6,19 @@
 #include <ImfChannelList.h>
 #include <ImfDeepFrameBuffer.h>
 #include <ImfDeepScanLineOutputFile.h>
+#include <ImfDoubleAttribute.h>
+#include <ImfFloatAttribute.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
+#include <ImfIntAttribute.h>
 #include <ImfMultiPartOutputFile.h>
 #include <ImfOutputFile.h>
 #include <ImfOutputPart.h>
 #include <ImfPartType.h>
 #include <ImfStringAttribute.h>
 #include <ImfTiledOutputFile.h>
+#include <ImfVecAttribute.h>
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
@@ -24,6 +28,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <memory>
 #include <string>
@@ -191,6 +196,87 @@ TEST_F(ImageIoExrTest, DataWindowAwayFromTheOriginIsTheImage) {
   EXPECT_EQ(field.width, 6);
   EXPECT_EQ(field.height, 40);
   EXPECT_EQ(field.heights, pixels);
+}
+
+// The cell size as hfvis writes it (strings) or as other tools write it (oiiotool --attrib writes
+// 3 as an int): numbers were passed over and the cell size taken as 1, without a word. An
+// attribute of another type is refused, naming it.
+TEST_F(ImageIoExrTest, CellSizeAttributesAreReadAsStringsOrNumbers) {
+  const auto write = [&](const std::string& name, const std::function<void(Imf::Header&)>& attributes) {
+    const std::string file = path(name);
+    Imf::Header header(4, 3);
+    header.channels().insert("Y", Imf::Channel(Imf::FLOAT));
+    attributes(header);
+    std::vector<float> pixels(12, 1.0f);
+    Imf::OutputFile out(file.c_str(), header);
+    Imf::FrameBuffer frame;
+    frame.insert("Y", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(pixels.data()), sizeof(float),
+                                 4 * sizeof(float)));
+    out.setFrameBuffer(frame);
+    out.writePixels(3);
+    return file;
+  };
+  const HeightField ints = readHeightField(write("ints.exr", [](Imf::Header& h) {
+    h.insert("hfvis:cell_size_x", Imf::IntAttribute(3));
+    h.insert("hfvis:cell_size_y", Imf::IntAttribute(2));
+  }));
+  EXPECT_EQ(ints.cell_size_x, 3.0);
+  EXPECT_EQ(ints.cell_size_y, 2.0);
+  const HeightField floats = readHeightField(write("floats.exr", [](Imf::Header& h) {
+    h.insert("hfvis:cell_size_x", Imf::FloatAttribute(0.1f));
+    h.insert("hfvis:cell_size_y", Imf::DoubleAttribute(0.25));
+  }));
+  EXPECT_EQ(floats.cell_size_x, double(0.1f));
+  EXPECT_EQ(floats.cell_size_y, 0.25);
+  const HeightField mixed = readHeightField(write("mixed.exr", [](Imf::Header& h) {
+    h.insert("hfvis:cell_size_x", Imf::StringAttribute("1.5"));
+    h.insert("hfvis:cell_size_y", Imf::IntAttribute(4));
+  }));
+  EXPECT_EQ(mixed.cell_size_x, 1.5);
+  EXPECT_EQ(mixed.cell_size_y, 4.0);
+  const std::string vector = write("vector.exr", [](Imf::Header& h) {
+    h.insert("hfvis:cell_size_x", Imf::V2fAttribute(Imath::V2f(1.0f, 2.0f)));
+    h.insert("hfvis:cell_size_y", Imf::IntAttribute(4));
+  });
+  try {
+    readHeightField(vector);
+    ADD_FAILURE() << "a vector cell size was taken";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("hfvis:cell_size_x is of type v2f"), std::string::npos) << e.what();
+  }
+}
+
+// An environment map covers the sphere with its whole extent: one whose data window is not its
+// display window is refused (its data window alone was taken as the sphere: twice the light of the
+// same map written whole). Heights still read their data window wherever it lies.
+TEST_F(ImageIoExrTest, AnEnvironmentMapWithADataWindowInsideItsDisplayIsRefused) {
+  const auto write = [&](const std::string& name, const Imath::Box2i& data) {
+    const std::string file = path(name);
+    Imf::Header header(windowOf(8, 4), data);
+    header.channels().insert("Y", Imf::Channel(Imf::FLOAT));
+    const int width = data.max.x - data.min.x + 1, height = data.max.y - data.min.y + 1;
+    std::vector<float> pixels(std::size_t(width) * height, 1.0f);
+    Imf::OutputFile out(file.c_str(), header);
+    Imf::FrameBuffer frame;
+    frame.insert("Y", Imf::Slice::Make(Imf::FLOAT, pixels.data(), data.min, width, height));
+    out.setFrameBuffer(frame);
+    out.writePixels(height);
+    return file;
+  };
+  const std::string inside = write("inside.exr", windowOf(4, 2, 2, 0));
+  try {
+    readEnvironmentMap(inside);
+    ADD_FAILURE() << "an environment map of part of its display window was taken";
+  } catch (const IoError& e) {
+    EXPECT_NE(
+        std::string(e.what()).find("data window (2, 0) .. (5, 1) is not its display window (0, 0) .. (7, 3)"),
+        std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(readHeightField(inside).width, 4);
+  const EnvironmentMap whole = readEnvironmentMap(write("whole.exr", windowOf(8, 4)));
+  EXPECT_EQ(whole.width, 8);
+  EXPECT_EQ(whole.height, 4);
 }
 
 TEST_F(ImageIoExrTest, MultiPartFileReadsItsFirstPartOrTheOneHoldingTheChannel) {

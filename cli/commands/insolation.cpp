@@ -2,10 +2,14 @@
 // span of time (hfvis/insolation.hpp).
 #include "hfvis/insolation.hpp"
 
+#include <iostream>
+
 #include "../pipeline.hpp"
 
 namespace hfvis::cli {
 namespace {
+
+constexpr double kMostUnaliasedStep = 60.0;  // minutes (--step): past it, a warning
 
 class Insolation : public Computation {
  public:
@@ -16,6 +20,15 @@ class Insolation : public Computation {
   // Row 0 is taken as north: a south-up or west-up field is computed flipped (and only the
   // input's size is read from here on).
   void prepare(HeightField& field) override {
+    // Each step takes the sun at its middle: steps of hours alias the day's course (a step of 1440
+    // minutes counted every hour of a day as sunny, exit 0 without a word).
+    const InsolationOptions options = insolationOptions(run_);
+    if (options.step_minutes > kMostUnaliasedStep &&
+        options.to_utc - options.from_utc > 60.0 * options.step_minutes)
+      std::cerr << "hfvis: warning: --step " << formatNumber(options.step_minutes)
+                << " minutes takes the sun once per step, at its middle: steps past " << kMostUnaliasedStep
+                << " minutes alias its course over the day (sun hours and irradiation may be far off; the "
+                   "default is 10)\n";
     lit_ = northUp(field);
     if (lit_.flipped()) field.heights = {};
   }

@@ -41,10 +41,19 @@ std::vector<std::vector<float>> readAlbedo(const RunArguments& run, const Height
     if (image.planes.size() != 1) throw IoError(run.albedo, "an albedo image needs one channel or R, G, B");
     planes = {image.planes[0]};
   }
+  // NaN (an albedo raster's nodata) only where the height is nodata too: where it is valid, a NaN
+  // made that pixel's radiance NaN, exit 0.
   for (const auto& plane : planes)
-    for (float v : plane)
-      if (!(v >= 0.0f && v <= 1.0f) && !std::isnan(v))
+    for (std::size_t p = 0; p < plane.size(); ++p) {
+      const float v = plane[p];
+      if (std::isnan(v) && !std::isfinite(field.heights[p])) continue;
+      if (std::isnan(v))
+        throw IoError(run.albedo, "the albedo is NaN (nodata) at column " + std::to_string(p % field.width) +
+                                      ", row " + std::to_string(p / field.width) +
+                                      ", where the height is valid: give an albedo there");
+      if (!(v >= 0.0f && v <= 1.0f))
         throw IoError(run.albedo, "albedo values must be in 0 .. 1 (found " + formatNumber(v) + ")");
+    }
   return planes;
 }
 
@@ -56,11 +65,13 @@ class Shade : public Computation {
 
   // Row 0 is taken as north: a south-up or west-up field is lit flipped (and only the input's size
   // is read from here on).
+  // The albedo stays in the input's order, as the irradiance comes back in it; its NaN are checked
+  // against the input's heights, before a flipped field lets them go.
   void prepare(HeightField& field) override {
+    if (!run_.albedo.empty()) albedo_ = readAlbedo(run_, field);
     lit_ = northUp(field);
     if (lit_.flipped()) field.heights = {};
     if (environment_.given()) environment_.read();
-    if (!run_.albedo.empty()) albedo_ = readAlbedo(run_, lit_.field());
   }
 
   void compute(Job& job) override {

@@ -5,10 +5,13 @@
 
 #include <Iex.h>
 #include <ImfChannelList.h>
+#include <ImfDoubleAttribute.h>
+#include <ImfFloatAttribute.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfIO.h>
 #include <ImfInputPart.h>
+#include <ImfIntAttribute.h>
 #include <ImfMultiPartInputFile.h>
 #include <ImfOutputFile.h>
 #include <ImfPartType.h>
@@ -33,6 +36,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/number_text.hpp"
 #include "hfvis/errors.hpp"
 #include "io/image_reading.hpp"
 #include "io/output_files.hpp"
@@ -371,9 +375,37 @@ ImageChannels readExr(const std::string& path, std::uint64_t max_image_bytes, co
     if (high != plane.end() && double(*high) > double(1 << 24))
       *rounding = 0.5 * (double(std::nextafter(*high, INFINITY)) - double(*high));
   }
+  // Where the data window is not the display window, a note of both (readColourImage refuses such
+  // an environment map or light image, which map over their whole extent: the data window alone
+  // was taken as the whole sphere, twice as bright).
+  const Imath::Box2i display = header.displayWindow();
+  if (display != window) {
+    const auto box = [](const Imath::Box2i& b) {
+      return "(" + std::to_string(b.min.x) + ", " + std::to_string(b.min.y) + ") .. (" +
+             std::to_string(b.max.x) + ", " + std::to_string(b.max.y) + ")";
+    };
+    image.attributes.emplace_back(
+        "exr:windows", "data window " + box(window) + " is not its display window " + box(display));
+  }
+  // The cell size as hfvis writes it (a string), or as other tools write a number (oiiotool
+  // --attrib writes 3 as an int): a number was passed over and the cell size taken as 1.
   for (const char* name : {"hfvis:cell_size_x", "hfvis:cell_size_y"}) {
-    const auto* value = header.findTypedAttribute<Imf::StringAttribute>(name);
-    if (value && !value->value().empty()) image.attributes.emplace_back(name, value->value());
+    const auto found = header.find(name);
+    if (found == header.end()) continue;
+    const Imf::Attribute* any = &found.attribute();
+    std::string text;
+    if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(any))
+      text = s->value();
+    else if (const auto* i = dynamic_cast<const Imf::IntAttribute*>(any))
+      text = std::to_string(i->value());
+    else if (const auto* f = dynamic_cast<const Imf::FloatAttribute*>(any))
+      text = detail::exactNumber(f->value());
+    else if (const auto* d = dynamic_cast<const Imf::DoubleAttribute*>(any))
+      text = detail::exactNumber(d->value());
+    else
+      throw IoError(path, std::string("the attribute ") + name + " is of type " + any->typeName() +
+                              ": a cell size is a number or a string holding one");
+    if (!text.empty()) image.attributes.emplace_back(name, text);
   }
   return image;
 }

@@ -20,10 +20,11 @@ bool isExrFile(const std::string& path);
 // unsigned integer channels as their values, not normalised; the data window's pixels, wherever it lies): the
 // channel `*channel` names (a name or a zero-based index; "" where the image has one channel), or every
 // channel where `channel` is null, in the order OpenImageIO gave them before (see channelOrder in
-// exr_images.cpp). attributes: the string attributes hfvis:cell_size_x and hfvis:cell_size_y where the part
-// has them. Throws IoError (unreadable, empty, a deep image, a subsampled channel, 2^31 pixels or more, a
-// header claiming more than max_image_bytes, 0 = 64 GiB, or attributes larger than the file; a channel it
-// lacks; truncated or corrupt pixels). `rounding`, where given and one channel is read: the most
+// exr_images.cpp). attributes: hfvis:cell_size_x and hfvis:cell_size_y where the part has them (strings, or
+// numbers as text; another type is refused), and exr:windows where its data window is not its display window
+// (a note of both). Throws IoError (unreadable, empty, a deep image, a subsampled channel, 2^31 pixels or
+// more, a header claiming more than max_image_bytes, 0 = 64 GiB, or attributes larger than the file; a
+// channel it lacks; truncated or corrupt pixels). `rounding`, where given and one channel is read: the most
 // float32 may have rounded its values by (a UINT channel's beyond 2^24; 0 for half and float).
 ImageChannels readExr(const std::string& path, std::uint64_t max_image_bytes, const std::string* channel,
                       double* rounding = nullptr);

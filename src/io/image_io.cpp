@@ -87,7 +87,11 @@ ImageChannels readImage(const std::string& path) {
 }
 
 ImageChannels readColourImage(const std::string& path, const std::string& what) {
-  ImageChannels image = readImage(path);
+  ImageChannels image = detail::isGdalRaster(path) ? readImage(path) : readOtherImage(path, 0, nullptr);
+  if (const std::string windows = attributeOf(image, "exr:windows"); !windows.empty())
+    throw IoError(path, what + " covers its whole extent, but the EXR's " + windows +
+                            ": write it with the two windows the same");
+  image.attributes.clear();
   const auto find = [&](const char* name) {
     for (std::size_t i = 0; i < image.names.size(); ++i)
       if (image.names[i] == name) return static_cast<int>(i);

@@ -195,9 +195,15 @@ ImageChannels read(const std::string& path, std::uint64_t max_image_bytes, const
                             (channel ? std::string() : ", " + std::to_string(spec.nchannels) + " channels") +
                             ")");
   }
+  // A string as hfvis writes it, or a number as other tools write it (a number was passed over:
+  // a cell size of 1); anything else (an array) reaches storedCellSize as text and is refused there.
   for (const char* name : {"hfvis:cell_size_x", "hfvis:cell_size_y"}) {
-    const std::string value = spec.get_string_attribute(name);
-    if (!value.empty()) image.attributes.emplace_back(name, value);
+    const OIIO::ParamValue* value = spec.find_attribute(name);
+    if (!value) continue;
+    const std::string text = value->type() == OIIO::TypeDesc::STRING
+                                 ? std::string(spec.get_string_attribute(name))
+                                 : std::string(value->get_string());
+    if (!text.empty()) image.attributes.emplace_back(name, text);
   }
   in->close();
   return image;
