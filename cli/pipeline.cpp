@@ -72,7 +72,12 @@ std::string jsonString(const std::string& text) {
 
 std::string formatFixed(double value, int digits) {
   std::ostringstream out;
-  out << std::fixed << std::setprecision(digits) << value;
+  // (a mean of 2.6e-5 printed as 0.0000 and one of 1e30 as 31 digits: those in significant digits)
+  if (value != 0.0 && std::isfinite(value) &&
+      (std::fabs(value) < 0.5 * std::pow(10.0, -digits) || std::fabs(value) >= 1e9))
+    out << std::setprecision(std::max(digits, 1)) << value;
+  else
+    out << std::fixed << std::setprecision(digits) << value;
   return out.str();
 }
 

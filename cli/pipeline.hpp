@@ -23,6 +23,8 @@
 namespace hfvis::cli {
 
 std::string formatNumber(double value);
+// `digits` decimals; a value that would print as 0 or with 10 digits or more before the point, in
+// `digits` significant digits instead.
 std::string formatFixed(double value, int digits);
 // A JSON string: quoted, with its escapes (the JSON outputs of horizon-lists, region and pvs);
 // UTF-8 passes through, a byte that is not part of it (a file name in another encoding) becomes
