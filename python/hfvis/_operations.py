@@ -67,6 +67,21 @@ def _is_dask(value):
     return type(value).__module__.startswith("dask.")
 
 
+def _require_known_chunks(heights):
+    """A Dask-backed DataArray's chunk sizes must be known (boolean indexing leaves them NaN: Dask's,
+    xarray's or a "100 x nan field" error before)."""
+    data = getattr(heights, "data", None)
+    if _is_dask(data) and any(math.isnan(n) for n in data.shape):
+        raise InvalidArgumentError(f"the Dask array's chunk sizes are unknown (shape {data.shape}, as after boolean "
+                                   "indexing): call .compute_chunk_sizes() on the array first")
+
+
+def _computed(heights):
+    """A Dask-backed DataArray computed, for the operations that take the field in one piece."""
+    _require_known_chunks(heights)
+    return heights.compute()
+
+
 def _method(operation, options):
     if operation in ("viewshed", "cumulative_viewshed"):
         return "exact sight lines on the bilinear surface"
@@ -90,6 +105,7 @@ def _run(operation, heights, options, common):
         return _arrays.compute(operation, h, g, options, common["device"], common["progress"]), None
     from . import _xarray
 
+    _require_known_chunks(heights)
     grid = _xarray.Grid(heights)
     g = grid.geometry(common["cell_size"], common["z_scale"])
     flip_rows, flip_cols = grid.flips() if operation in _LIT else (False, False)
@@ -188,7 +204,13 @@ def _observers_as_pixels(operation, options, grid, flip_rows, flip_cols, pixels)
             return _arrays.observer_pixel((x, y))
         if not (math.isfinite(float(x)) and math.isfinite(float(y))):
             raise InvalidArgumentError(f"an observer's map coordinates must be finite, got ({x!r}, {y!r})")
-        return grid.pixel(float(x), float(y))
+        col, row = grid.pixel(float(x), float(y))
+        if not (0 <= col < width and 0 <= row < height):  # (far off, the pixel overflowed int64: a raw error)
+            t = grid.transform
+            xs, ys = sorted((t[0], t[0] + width * t[1])), sorted((t[3], t[3] + height * t[5]))
+            raise InvalidArgumentError(f"observer ({float(x):.10g}, {float(y):.10g}) in map coordinates lies outside the "
+                                       f"field's extent, x {xs[0]:.10g} .. {xs[1]:.10g}, y {ys[0]:.10g} .. {ys[1]:.10g}")
+        return col, row
 
     options = dict(options)
     if operation == "viewshed":
@@ -296,7 +318,12 @@ def _budget(memory_budget_bytes):
 def _common(cell_size, z_scale, nodata, device, progress, pixels=False):
     if progress is not None and not callable(progress):  # (5 gave "'int' object is not callable" mid-run)
         raise InvalidArgumentError(f"progress must be a callable or None, got {progress!r}")
-    return {"cell_size": cell_size, "z_scale": z_scale, "nodata": nodata, "device": device or "",
+    # (an int, as devices()'s "index", was nanobind's bare TypeError)
+    if device is not None and not isinstance(device, (str, int, np.integer)) or isinstance(device, bool):
+        raise InvalidArgumentError(f"device must be a selector string (\"cpu\", \"gpu\", a name) or an index of "
+                                   f"hfvis.devices(), got {device!r}")
+    return {"cell_size": cell_size, "z_scale": z_scale, "nodata": nodata,
+            "device": str(int(device)) if isinstance(device, (int, np.integer)) else device or "",
             "progress": progress, "pixels": pixels}
 
 
@@ -307,7 +334,8 @@ def _horizon(directions, azimuth_offset, samples_per_unit, curvature, max_distan
             "samples_per_unit": _real("samples_per_unit", samples_per_unit),
             "curvature": _real("curvature", curvature), "max_distance": _real("max_distance", max_distance),
             "memory_budget_bytes": _budget(memory_budget_bytes), "method": method,
-            "azimuth_tolerance": azimuth_tolerance, "strip_rows": _whole("strip_rows", strip_rows, 0, 2**31 - 1)}
+            "azimuth_tolerance": None if azimuth_tolerance is None else _real("azimuth_tolerance", azimuth_tolerance),
+            "strip_rows": _whole("strip_rows", strip_rows, 0, 2**31 - 1)}
 
 
 def _horizon_maps(operation, name, heights, options, common):
@@ -340,12 +368,12 @@ def _azimuths_deg(options):
 def _with_estimate(options, heights, max_error, error_estimate):
     """Adds max_error and error_estimate to the options; a Dask-backed DataArray is computed, since
     K and the estimate's mean or percentile are the whole field's: it runs in one piece."""
-    if max_error:
-        options["max_error"] = float(max_error)
+    if max_error is not None and _real("max_error", max_error):  # ("x" was float()'s bare ValueError)
+        options["max_error"] = _real("max_error", max_error)
     if error_estimate:
         options["error_estimate"] = True
     if _is_dataarray(heights) and _is_dask(heights.data):
-        heights = heights.compute()
+        heights = _computed(heights)
     return heights
 
 
@@ -566,13 +594,13 @@ def environment_light(heights, environment, *, rotation_deg=0.0, table_rows=0, d
     DataArray with the K and the estimate in its attrs."""
     options = _horizon(directions, azimuth_offset, samples_per_unit, curvature, max_distance, memory_budget_bytes,
                        method, azimuth_tolerance, 0)
-    options.update(environment=environment, rotation_deg=float(rotation_deg),
+    options.update(environment=environment, rotation_deg=_real("rotation_deg", rotation_deg),
                    table_rows=_whole("table_rows", table_rows, 0, 2**31 - 1))
     common = _common(cell_size, z_scale, nodata, device, progress)
-    if max_error:
-        options["max_error"] = float(max_error)
+    if max_error is not None and _real("max_error", max_error):
+        options["max_error"] = _real("max_error", max_error)
         if _is_dataarray(heights) and _is_dask(heights.data):
-            heights = heights.compute()  # K and the estimate's percentile are the whole field's: in one piece
+            heights = _computed(heights)  # K and the estimate's percentile are the whole field's: in one piece
     if _is_dataarray(heights) and _is_dask(heights.data):
         # Chunk by chunk within the maximum distance: the channels, which each block's planes
         # follow, from a one-cell field's run (they depend on the environment alone).
@@ -616,7 +644,7 @@ def region_visibility(heights, sources, *, samples=16, height=2.0, absolute=Fals
                "curvature": _real("curvature", curvature),
                "light_image": light_image}
     if _is_dataarray(heights) and _is_dask(heights.data):
-        heights = heights.compute()  # the sources are shared by every point: the field in one piece
+        heights = _computed(heights)  # the sources are shared by every point: the field in one piece
     out, grid = _run("region_visibility", heights, options,
                      _common(cell_size, z_scale, nodata, device, progress, pixels))
     if grid is None:
@@ -652,7 +680,7 @@ def region_pair_visibility(heights, sources, receivers, *, samples=16, source_he
                "decorrelate": bool(decorrelate),
                "max_distance": _real("max_distance", max_distance), "curvature": _real("curvature", curvature)}
     if _is_dataarray(heights) and _is_dask(heights.data):
-        heights = heights.compute()
+        heights = _computed(heights)
     out, grid = _run("region_pair_visibility", heights, options,
                      _common(cell_size, z_scale, nodata, device, progress, pixels))
 
@@ -701,7 +729,7 @@ def pvs(heights, *, samples=0, pixel_error=0.0, seconds=0.0, view_cell=32, band_
                "memory_budget_bytes": _budget(memory_budget_bytes),
                "start": None if start is None else np.ascontiguousarray(start, dtype=np.uint32).ravel()}
     if _is_dataarray(heights) and _is_dask(heights.data):
-        heights = heights.compute()
+        heights = _computed(heights)
     out, _ = _run("pvs", heights, options, _common(cell_size, z_scale, nodata, device, progress))
     bits, computed = out["bits"], out["computed"]
     tiles = out["layout"]["tiles_x"] * out["layout"]["tiles_y"]
@@ -732,7 +760,7 @@ def horizon_lists(heights, receivers, *, directions=64, azimuth_offset=0.0, samp
                "samples_per_unit": _real("samples_per_unit", samples_per_unit),
                "curvature": _real("curvature", curvature)}
     if _is_dataarray(heights) and _is_dask(heights.data):
-        heights = heights.compute()  # a few rays per receiver: the field in one piece
+        heights = _computed(heights)  # a few rays per receiver: the field in one piece
     out, _ = _run("horizon_lists", heights, options, _common(cell_size, z_scale, nodata, "", None, pixels))
     return list(out["lists"])
 
@@ -750,7 +778,7 @@ def bounce(heights, radiance, *, directions=64, azimuth_offset=0.0, samples_per_
                "curvature": _real("curvature", curvature),
                "memory_budget_bytes": _budget(memory_budget_bytes)}
     if _is_dataarray(heights) and _is_dask(heights.data):
-        heights = heights.compute()
+        heights = _computed(heights)
     radiance_values = _arrays.as_array(radiance.values if _is_dataarray(radiance) else radiance, "radiance")
     one_channel = radiance_values.ndim == 2
     if _is_dataarray(radiance) and _is_dataarray(heights):

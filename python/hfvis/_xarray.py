@@ -19,6 +19,7 @@ AZIMUTH_CONVENTION = ("phi_k = 360*k/K deg + azimuth_offset, on the ground from 
 # its columns as rows (its sun and observers turned, a latitude / longitude grid not seen as one).
 _X_NAMES = ("x", "lon", "long", "longitude", "easting")
 _Y_NAMES = ("y", "lat", "latitude", "northing")
+_COLUMN_NAMES, _ROW_NAMES = ("col", "cols", "column", "columns"), ("row", "rows")  # (pixel dims: no coordinates)
 
 
 class Grid:
@@ -32,7 +33,7 @@ class Grid:
         if array.ndim != 2:
             raise InputTypeError(f"a DataArray of heights must be 2-D (y, x), got dims {array.dims}")
         first, second = (str(d).lower() for d in array.dims)
-        if first in _X_NAMES or second in _Y_NAMES:
+        if first in _X_NAMES + _COLUMN_NAMES or second in _Y_NAMES + _ROW_NAMES:
             raise InvalidArgumentError(f"the DataArray's dims are {array.dims}: hfvis takes rows then columns (y, x); "
                                        f"transpose it first (array.transpose({array.dims[1]!r}, {array.dims[0]!r}))")
         self.array = array
@@ -60,6 +61,19 @@ class Grid:
             if cell_size is None and self.geographic:
                 raise InvalidArgumentError("a geographic DataArray without coordinates or a transform has no cell "
                                            "size in metres; give cell_size")
+            if cell_size is None:
+                # (each ran with cells of 1, without a word: 30 m cells gave horizons 30 times too near)
+                rio = _rio(self.array)
+                if rio is not None and rio.crs is not None:
+                    raise InvalidArgumentError("the DataArray has a CRS but no x / y coordinates or transform to take "
+                                               "its cell size from: give cell_size, or its coordinates")
+                spatial = [str(n) for n in self.array.coords if str(n).lower() in _X_NAMES + _Y_NAMES
+                           and n not in (self.y_dim, self.x_dim)]
+                if spatial:
+                    raise InvalidArgumentError(f"the DataArray's map coordinates {spatial} are not its dimensions' "
+                                               f"({self.y_dim}, {self.x_dim}), and hfvis takes the cell size from "
+                                               "those: give cell_size, or make them the dimensions "
+                                               "(DataArray.swap_dims)")
             return _arrays.geometry(cell_size, z_scale)
         t = self.transform
         if not self.geographic:
@@ -120,6 +134,14 @@ class Grid:
         out.attrs.update(attrs)
         if "spatial_ref" in self.array.coords or _has_rio(self.array):
             _copy_crs(self.array, out)
+            # NaN is a float result's nodata (the command line declares it on every band): declared,
+            # so that rio.to_raster tags it (the GeoTIFF had no nodata, the input's -9999 gone); the
+            # bitmask words (uint32) have none
+            if np.issubdtype(out.dtype, np.floating):
+                try:
+                    out.rio.write_nodata(np.nan, encoded=False, inplace=True)
+                except AttributeError:  # rioxarray absent
+                    pass
         return out
 
 

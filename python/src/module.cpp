@@ -9,6 +9,7 @@
 #include <nanobind/stl/vector.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -35,20 +36,30 @@ struct SharedContext {
   ComputeContext context;
 };
 
+// The process that first set OpenCL up (a context, or the device list), or 0. A process forked
+// from it inherits none of OpenCL's threads and driver state, and its first call hung for good
+// (multiprocessing's default fork start method on Linux, after any hfvis call in the parent; the
+// comment here said such a child made its own context): such a child is refused, naming the start
+// methods that work. A child forked before the parent touched OpenCL sets it up as its own.
+void requireOpenClOfThisProcess() {
+  static std::atomic<pid_t> first{0};
+  pid_t expected = 0;
+  if (first.compare_exchange_strong(expected, getpid()) || expected == getpid()) return;
+  throw NoDeviceError(
+      "this process was forked from one that had already set OpenCL up (an hfvis call there): OpenCL "
+      "cannot run in such a child (its threads and the driver's state are the parent's; a call hung). Start "
+      "workers with multiprocessing's 'spawn' or 'forkserver' method (multiprocessing.get_context('spawn')), "
+      "use Dask's distributed LocalCluster, or make the processes before the first hfvis call");
+}
+
 // One context per device selector, made on first use and kept for the process, so that repeated
 // calls pay no start-up (device discovery, kernel builds). The contexts are never destroyed: an
-// OpenCL runtime torn down while the interpreter exits can hang or crash. A process forked from
-// one that held contexts (multiprocessing, Dask's forked workers) makes its own: the parent's
-// OpenCL state is not usable in the child.
+// OpenCL runtime torn down while the interpreter exits can hang or crash.
 std::shared_ptr<SharedContext> contextFor(const std::string& device) {
   static std::mutex guard;
-  static pid_t owner = getpid();
   static auto* contexts = new std::map<std::string, std::shared_ptr<SharedContext>>();
   std::lock_guard<std::mutex> lock(guard);
-  if (getpid() != owner) {
-    contexts = new std::map<std::string, std::shared_ptr<SharedContext>>();  // the parent's, left alone
-    owner = getpid();
-  }
+  requireOpenClOfThisProcess();
   auto found = contexts->find(device);
   if (found != contexts->end()) return found->second;
   ContextOptions options;
@@ -597,6 +608,7 @@ nb::dict bounce(const HeightField& field, Planes radiance, BounceOptions options
 }
 
 nb::list devices() {
+  requireOpenClOfThisProcess();
   nb::list out;
   for (const DeviceInfo& d : listDevices()) {
     nb::dict info;

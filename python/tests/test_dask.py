@@ -247,3 +247,21 @@ def test_wide_heights_float32_cannot_hold_are_refused_chunk_by_chunk(field):
     holes = np.isnan(want)
     assert holes.any() and np.array_equal(np.isnan(got), holes)
     assert np.array_equal(got[~holes].view(np.uint32), want[~holes].view(np.uint32))
+
+
+@pytest.mark.parametrize("call", [
+    lambda a: hfvis.sky_view_factor(a, directions=8, max_distance=10),
+    lambda a: hfvis.intervisibility(a, directions=8, max_distance=10),
+    lambda a: hfvis.cumulative_viewshed(a, [(5, 5)], pixels=True),
+    lambda a: hfvis.viewshed(a, (5, 5), pixels=True),
+    lambda a: hfvis.region_visibility(a, (1, 1, 3, 3)),
+    lambda a: hfvis.sky_view_factor(a, max_error=0.05),
+])
+def test_unknown_chunk_sizes_are_refused_naming_the_cure(call):
+    """Boolean indexing leaves a Dask array's chunk sizes NaN: Dask's or xarray's own errors, or
+    "outside the 100 x nan field", before."""
+    z = (100 + 20 * np.random.default_rng(0).random((120, 100))).astype(np.float32)
+    d = da.from_array(z, chunks=30)
+    a = xr.DataArray(d[d[:, 0] > -1e9], dims=("y", "x"))
+    with pytest.raises(hfvis.InvalidArgumentError, match="compute_chunk_sizes"):
+        call(a)

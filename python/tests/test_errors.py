@@ -187,6 +187,39 @@ def test_nodata_in_the_heights_dtype_and_masked_arrays(small):
 
 
 @pytest.mark.parametrize("call, words", [
+    (lambda h: hfvis.horizon_angles(h, azimuth_tolerance="x"), "azimuth_tolerance must be a number"),
+    (lambda h: hfvis.horizon_angles(h, azimuth_tolerance=[0.01]), "azimuth_tolerance must be a number"),
+    (lambda h: hfvis.sky_view_factor(h, max_error="x"), "max_error must be a number"),
+    (lambda h: hfvis.intervisibility(h, max_error=[0.1]), "max_error must be a number"),
+    (lambda h: hfvis.environment_light(h, np.ones((4, 8)), rotation_deg="x"), "rotation_deg must be a number"),
+    (lambda h: hfvis.environment_light(h, np.ones((4, 8)), rotation_deg=None), "rotation_deg must be a number"),
+    (lambda h: hfvis.sky_view_factor(h, device=3.5), "device must be a selector string"),
+    (lambda h: hfvis.sky_view_factor(h, device=99), "99"),
+])
+def test_more_options_of_the_wrong_kind_are_refused_naming_them(small, call, words):
+    """nanobind's bare TypeError or float()'s ValueError before; an int device is an index."""
+    with pytest.raises(hfvis.Error, match=words):
+        call(small)
+
+
+def test_a_device_index_as_an_int_is_taken(small):
+    assert np.array_equal(hfvis.sky_view_factor(small, directions=4, device=0),
+                          hfvis.sky_view_factor(small, directions=4))
+
+
+def test_observers_far_outside_in_map_coordinates_are_refused_naming_the_extent():
+    """An OverflowError (cumulative) or a message about pixels with a 30-digit array before."""
+    z = (100 + 20 * np.random.default_rng(0).random((60, 50))).astype(np.float32)
+    a = xr.DataArray(z, dims=("y", "x"), coords={"y": 46e5 - 10 * np.arange(60) - 5.0,
+                                                 "x": 5e5 + 10 * np.arange(50) + 5.0})
+    for call in (lambda: hfvis.cumulative_viewshed(a, [(1e30, 1e30)]), lambda: hfvis.viewshed(a, (1e30, 1e30)),
+                 lambda: hfvis.viewshed(a, (5e5 - 1.0, 46e5 - 5.0))):
+        with pytest.raises(hfvis.InvalidArgumentError, match="outside the field's extent, x 500000 .. 500500"):
+            call()
+    assert hfvis.viewshed(a, (5e5 + 1.0, 46e5 - 5.0)).shape == (60, 50)
+
+
+@pytest.mark.parametrize("call, words", [
     (lambda h: hfvis.cumulative_viewshed(h, [(1, 2), (3,)]), "observers must be an array"),
     (lambda h: hfvis.region_visibility(h, [(1.0, 2.0, 3.0), (3.0, 4.0)]), "a region must be an array"),
     (lambda h: hfvis.bounce(h, [[1.0, 2.0], [3.0]]), "radiance must be an array"),

@@ -175,6 +175,28 @@ def test_devices_and_context_reuse():
         hfvis.sky_view_factor(small, device="no such device")
 
 
+def _svf_in_a_child():
+    """Run in a forked child: the error's type and message (a call hung there before)."""
+    try:
+        hfvis.sky_view_factor(np.zeros((8, 8), np.float32), directions=4)
+        return "ran", ""
+    except hfvis.Error as e:
+        return type(e).__name__, str(e)
+
+
+def test_a_child_forked_after_opencl_was_set_up_is_refused_not_hung():
+    import multiprocessing
+    if "fork" not in multiprocessing.get_all_start_methods():
+        pytest.skip("no fork start method on this platform")
+    hfvis.devices()  # the parent has set OpenCL up
+    with multiprocessing.get_context("fork").Pool(1) as pool:
+        kind, message = pool.apply_async(_svf_in_a_child).get(timeout=120)
+    assert kind == "NoDeviceError", (kind, message)
+    assert "'spawn'" in message and "forked" in message
+    # The parent goes on.
+    assert np.isfinite(hfvis.sky_view_factor(np.zeros((8, 8), np.float32), directions=4)).all()
+
+
 def test_sky_view_factor_and_ambient_occlusion_with_max_error(tmp_path, projected_tif, dem):
     """max_error=E chooses K as the CLI's --max-error does; error_estimate gives its --error-out."""
     import rasterio

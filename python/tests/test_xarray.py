@@ -34,6 +34,8 @@ def test_projected_geotiff_round_trip(tmp_path, projected_tif):
     again = rioxarray.open_rasterio(tmp_path / "again.tif").squeeze("band", drop=True)
     assert again.rio.crs == dem.rio.crs and again.rio.transform() == dem.rio.transform()
     equal(again, cli)
+    # NaN declared as the nodata (as the command line's bands): the GeoTIFF tags it (it had none)
+    assert np.isnan(svf.rio.nodata) and np.isnan(again.rio.nodata)
 
 
 def test_masked_read_and_fill_value(projected_tif):
@@ -268,6 +270,21 @@ def test_grids_hfvis_cannot_read_right_are_refused():
         hfvis.sky_view_factor(days, directions=8)
     # (a 1 x N field with its cell size given runs; one with no coordinates at all takes 1)
     assert hfvis.horizon_distances(a[:1], directions=4, cell_size=30).shape[1:] == (1, 40)
+    # Map coordinates or a CRS that are not the dimensions' coordinates: each ran with cells of 1.
+    rows, cols = z.shape
+    for array, words in (
+            (xr.DataArray(z, dims=("y", "x")).rio.write_crs("EPSG:32633"), "has a CRS but no x / y coordinates"),
+            (xr.DataArray(z, dims=("y", "x"), coords={"lat": (("y", "x"), np.zeros(z.shape)),
+                                                      "lon": (("y", "x"), np.zeros(z.shape))}), r"\['lat', 'lon'\]"),
+            (xr.DataArray(z, dims=("row", "col"), coords={"y": ("row", 30.0 * np.arange(rows)),
+                                                          "x": ("col", 30.0 * np.arange(cols))}), "swap_dims"),
+            (xr.DataArray(z, dims=("r", "c"), coords={"northing": ("r", 30.0 * np.arange(rows)),
+                                                      "easting": ("c", 30.0 * np.arange(cols))}), "swap_dims")):
+        with pytest.raises(hfvis.InvalidArgumentError, match=words):
+            hfvis.sky_view_factor(array, directions=4)
+        assert hfvis.sky_view_factor(array, directions=4, cell_size=30.0).shape == z.shape
+    with pytest.raises(hfvis.InvalidArgumentError, match="transpose"):
+        hfvis.sky_view_factor(xr.DataArray(z.T, dims=("col", "row")), directions=8)
     radiance = _grid(np.ones_like(z))
     hfvis.bounce(a, radiance, directions=8)
     with pytest.raises(hfvis.InvalidArgumentError, match="coordinates are not the heights'"):
