@@ -208,8 +208,9 @@ def _observers_as_pixels(operation, options, grid, flip_rows, flip_cols, pixels)
         if not (0 <= col < width and 0 <= row < height):  # (far off, the pixel overflowed int64: a raw error)
             t = grid.transform
             xs, ys = sorted((t[0], t[0] + width * t[1])), sorted((t[3], t[3] + height * t[5]))
-            raise InvalidArgumentError(f"observer ({float(x):.10g}, {float(y):.10g}) in map coordinates lies outside the "
-                                       f"field's extent, x {xs[0]:.10g} .. {xs[1]:.10g}, y {ys[0]:.10g} .. {ys[1]:.10g}")
+            raise InvalidArgumentError(f"observer ({float(x):.10g}, {float(y):.10g}) in map coordinates lies outside "
+                                       f"the field's extent, x {xs[0]:.10g} .. {xs[1]:.10g}, "
+                                       f"y {ys[0]:.10g} .. {ys[1]:.10g}")
         return col, row
 
     options = dict(options)
