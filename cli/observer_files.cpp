@@ -9,7 +9,9 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <initializer_list>
 #include <sstream>
+#include <utility>
 
 #include "core/number_text.hpp"
 #include "hfvis/errors.hpp"
@@ -59,7 +61,7 @@ std::vector<CsvPoint> parsePoints(const std::string& path, std::istream& in, dou
   };
   std::vector<CsvPoint> points;
   std::string line;
-  bool header_seen = false;
+  bool header_seen = false, row_first = false;
   for (int number = 1; std::getline(in, line); ++number) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
     // A UTF-8 BOM starts the file, whatever its first line holds (a comment, nothing).
@@ -92,8 +94,36 @@ std::vector<CsvPoint> parsePoints(const std::string& path, std::istream& in, dou
       }
     }
     if (!numbers && points.empty() && !header_seen && words) {
-      header_seen = true;
-      continue;
+      // Its names say the columns' order: col,row[,height] or row,col[,height]. Any other (x,y,
+      // lat,lon: map coordinates) is refused: every header was passed over, and a row,col file was
+      // read as col,row, exit 0.
+      std::vector<std::string> names;
+      for (const std::string& f : fields) {
+        const std::size_t a = f.find_first_not_of(" \t"), b = f.find_last_not_of(" \t");
+        std::string name = f.substr(a, b - a + 1);
+        for (char& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+        names.push_back(name);
+      }
+      const auto is = [](const std::string& name, std::initializer_list<const char*> any) {
+        for (const char* n : any)
+          if (name == n) return true;
+        return false;
+      };
+      const auto column = [&](const std::string& n) { return is(n, {"col", "column", "c"}); };
+      const auto row_name = [&](const std::string& n) { return is(n, {"row", "r"}); };
+      const bool two = names.size() == 2 || (names.size() == 3 && is(names[2], {"height", "h", "z"}));
+      if (two && column(names[0]) && row_name(names[1])) {
+        header_seen = true;
+        continue;
+      }
+      if (two && row_name(names[0]) && column(names[1])) {
+        header_seen = row_first = true;
+        continue;
+      }
+      throw IoError(path, "line " + std::to_string(number) + ": the header '" + shown(line) +
+                              "' names columns hfvis does not read: the file holds pixel columns and rows, "
+                              "with a header col,row[,height] or row,col[,height] (map coordinates: convert "
+                              "them to pixels first)");
     }
     // (getline drops an empty last field: "1,1," would pass for "1,1" and "1,1,2," for "1,1,2")
     const bool trailing_comma = line[line.find_last_not_of(" \t")] == ',';
@@ -109,6 +139,7 @@ std::vector<CsvPoint> parsePoints(const std::string& path, std::istream& in, dou
     if (std::fabs(height) > 1e12)  // as --observer-height: what the kernels' single precision holds
       throw IoError(path, "line " + std::to_string(number) + ": the height " + shortNumber(height) +
                               " is beyond 1e+12, more than the kernels' single precision holds");
+    if (row_first) std::swap(col, row_index);
     points.push_back({col, row_index, height});
   }
   if (points.empty()) throw IoError(path, kind.none);

@@ -2374,6 +2374,27 @@ TEST_F(Cli, ViewshedSeesOverAWall) {
   EXPECT_EQ(count.at(8, 3, 0), 3.0f);   // the wall's top: everyone
   // Behind the wall from column 2, in front of it from 14, and seen from the eye on the wall's end.
   EXPECT_EQ(count.at(12, 3, 0), 2.0f);
+  // The header says the columns' order: row,col gives the same observers; a header of other names
+  // (map coordinates) is refused (every header was passed over: row,col read as col,row, exit 0).
+  {
+    std::ofstream csv(in("row_first.csv"));
+    csv << "Row,Col,Height\n3,14\n# a comment\n\n0,8,1\n";
+  }
+  const CliResult swapped = run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("r.exr")) +
+                                " --observer 2,3 --observers " + shellQuoted(in("row_first.csv")) + " -q");
+  ASSERT_EQ(swapped.status, 0) << swapped.err;
+  EXPECT_EQ(readBack(out("r.exr")).pixels, count.pixels);
+  for (const char* header : {"x,y", "lat,lon", "col,row,elevation", "col,col"}) {
+    {
+      std::ofstream csv(in("named.csv"));
+      csv << header << "\n3,4\n";
+    }
+    const CliResult named = run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("named.exr")) +
+                                " --observers " + shellQuoted(in("named.csv")));
+    EXPECT_EQ(named.status, 1) << header;
+    EXPECT_NE(named.err.find("names columns hfvis does not read"), std::string::npos) << named.err;
+    EXPECT_FALSE(fs::exists(out("named.exr"))) << header;
+  }
 }
 
 TEST_F(Cli, ViewshedCulledEqualsExact) {
@@ -3500,7 +3521,8 @@ TEST_F(CliGeoTiff, RegionVisibilityOnAGeoreferencedField) {
       ASSERT_TRUE(light.bands[0][p] >= 0.0f && light.bands[0][p] <= 1.0f) << p;
     }
   }
-  // region's rays: map coordinates of the pixel centres through the geotransform.
+  // region's rays: map coordinates of the pixel centres through the geotransform, to the micrometre
+  // (they were cut to 10 significant digits: a millimetre apart at northings of 4e6).
   const CliResult r =
       run("region " + shellQuoted(dem) + " --from 1,1,4,4 --to 15,10,20,14 --from-height 50 -o " +
           shellQuoted(out("r.json")) + " --rays " + shellQuoted(out("r.csv")) + " -q");
@@ -3508,8 +3530,8 @@ TEST_F(CliGeoTiff, RegionVisibilityOnAGeoreferencedField) {
   const Json j = JsonParser::parse(readText(out("r.json")));
   const std::array<double, 6>& t = hfvis::testing::kUtmGeotransform;
   for (const Json& s : j["from_samples"].items) {
-    EXPECT_NEAR(s["x"].number, t[0] + (s["col"].number + 0.5) * t[1], 1e-3);
-    EXPECT_NEAR(s["y"].number, t[3] + (s["row"].number + 0.5) * t[5], 1e-3);
+    EXPECT_NEAR(s["x"].number, t[0] + (s["col"].number + 0.5) * t[1], 1e-6);
+    EXPECT_NEAR(s["y"].number, t[3] + (s["row"].number + 0.5) * t[5], 1e-6);
   }
   const std::vector<std::string> lines = splitText(readText(out("r.csv")), '\n');
   EXPECT_GT(j["clear_pairs"].number, 0.0);
@@ -3518,8 +3540,8 @@ TEST_F(CliGeoTiff, RegionVisibilityOnAGeoreferencedField) {
   for (std::size_t i = 1; i + 1 < lines.size(); ++i) {
     const std::vector<std::string> f = splitText(lines[i], ',');
     ASSERT_EQ(f.size(), 10u);
-    EXPECT_NEAR(std::stod(f[8]), t[0] + (std::stod(f[3]) + 0.5) * t[1], 1e-2);
-    EXPECT_NEAR(std::stod(f[9]), t[3] + (std::stod(f[4]) + 0.5) * t[5], 1e-2);
+    EXPECT_NEAR(std::stod(f[8]), t[0] + (std::stod(f[3]) + 0.5) * t[1], 1e-6);
+    EXPECT_NEAR(std::stod(f[9]), t[3] + (std::stod(f[4]) + 0.5) * t[5], 1e-6);
   }
 }
 

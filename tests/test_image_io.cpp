@@ -1041,6 +1041,20 @@ TEST(GdalRasters, AsciiGridWithNodataAndCellSize) {
   EXPECT_TRUE(std::isnan(field.heights[4]));
   EXPECT_DOUBLE_EQ(field.cell_size_x, 30.0);
   EXPECT_DOUBLE_EQ(field.cell_size_y, 30.0);
+  // A corner GDAL reads as infinite or NaN is refused, naming the input (the run went on: "x":
+  // null in a region's JSON, inf in its CSV).
+  for (const char* corner : {"1e309", "nan"}) {
+    {
+      std::ofstream out(path);
+      out << "ncols 3\nnrows 2\nxllcorner " << corner << "\nyllcorner 4000000\ncellsize 30\n1 2 3\n4 5 6\n";
+    }
+    try {
+      readHeightField(path);
+      ADD_FAILURE() << "a geotransform with " << corner << " was taken";
+    } catch (const IoError& e) {
+      EXPECT_NE(std::string(e.what()).find("the geotransform is not finite"), std::string::npos) << e.what();
+    }
+  }
 }
 
 // A TIFF of a few bytes claiming side x side float32 pixels in one DEFLATE strip that holds 64.

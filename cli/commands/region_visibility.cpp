@@ -13,6 +13,7 @@
 #include "../image_outputs.hpp"
 #include "../observer_files.hpp"
 #include "../pipeline.hpp"
+#include "core/number_text.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/image_io.hpp"
 
@@ -204,8 +205,14 @@ class AreaLight : public Computation {
   RegionVisibilityResult result_;
 };
 
-// A number for JSON: 10 significant digits (as the other outputs' numbers), NaN as null.
+// A number for JSON: 10 significant digits (as the other outputs' numbers: enough for a float32's
+// pixel position, height or fraction), NaN as null.
 std::string jsonNumber(double value) { return std::isfinite(value) ? formatNumber(value) : "null"; }
+
+// A map coordinate or an echoed option: the fewest digits that read back as the same double (10
+// digits left northings of 4.6e6 a millimetre apart, half a cell of 1 mm, and 1e15 the same x
+// for every sample).
+std::string jsonExact(double value) { return std::isfinite(value) ? detail::exactNumber(value) : "null"; }
 
 // A ratio in full: a reader recomputing clear_pairs / pairs gets the same double.
 std::string exactNumber(double value) {
@@ -266,14 +273,14 @@ class Region : public Computation {
                ", \"row\": " + jsonNumber(p.row) + ", \"height\": " + jsonNumber(p.height);
         if (transform) {
           const auto [x, y] = mapPosition(*transform, p.col, p.row);
-          out += ", \"x\": " + jsonNumber(x) + ", \"y\": " + jsonNumber(y);
+          out += ", \"x\": " + jsonExact(x) + ", \"y\": " + jsonExact(y);
         }
         out += ", \"visible_fraction\": " + jsonNumber(fractions[i]) + "}";
       }
       return out + "\n  ]";
     };
     const auto region = [&](const PixelRectangle& rect, double height, int count) {
-      return "{\"rectangle\": [" + rectangleText(rect) + "], \"height\": " + jsonNumber(height) +
+      return "{\"rectangle\": [" + rectangleText(rect) + "], \"height\": " + jsonExact(height) +
              ", \"height_is\": " + jsonString(run_.absolute ? "absolute (z-scaled)" : "above the surface") +
              ", \"samples\": " + std::to_string(count) + "}";
     };
@@ -282,7 +289,7 @@ class Region : public Computation {
          << "  \"input\": " << jsonString(run_.input) << ",\n"
          << "  \"method\": " << jsonString(job.method) << ",\n"
          << "  \"seed\": " << run_.seed << ",\n"
-         << "  \"max_distance\": " << jsonNumber(run_.max_distance) << ",\n"
+         << "  \"max_distance\": " << jsonExact(run_.max_distance) << ",\n"
          << "  \"curvature\": "
          << (run_.curvature ? jsonNumber(regionVisibilityOptions(run_).curvature) : std::string("0")) << ",\n"
          << "  \"from\": " << region(*run_.from_region, run_.from_height, r.source_samples) << ",\n"
@@ -315,8 +322,8 @@ class Region : public Computation {
           if (transform) {
             const auto [ax, ay] = mapPosition(*transform, a.col, a.row);
             const auto [bx, by] = mapPosition(*transform, b.col, b.row);
-            csv += "," + formatNumber(ax) + "," + formatNumber(ay) + "," + formatNumber(bx) + "," +
-                   formatNumber(by);
+            csv += "," + detail::exactNumber(ax) + "," + detail::exactNumber(ay) + "," +
+                   detail::exactNumber(bx) + "," + detail::exactNumber(by);
           }
           csv += "\n";
         }

@@ -656,9 +656,17 @@ HeightField readGdalHeightField(const std::string& path, const HeightFieldReadOp
   // A rotated or sheared grid is refused whatever the cell size: the outputs would keep its
   // geotransform while every direction and distance was computed on an axis-aligned one.
   if (const auto& gt = field.georeference.geotransform; gt && ((*gt)[2] != 0.0 || (*gt)[4] != 0.0))
-    throw IoError(path, "rotated or sheared geotransforms are not supported (terms " +
-                            std::to_string((*gt)[2]) + ", " + std::to_string((*gt)[4]) +
-                            "); warp the raster north-up first (gdalwarp)");
+    throw IoError(path, "rotated or sheared geotransforms are not supported (terms " + shortNumber((*gt)[2]) +
+                            ", " + shortNumber((*gt)[4]) + "); warp the raster north-up first (gdalwarp)");
+  // A corner of 1e309 or NaN (an ASCII grid's xllcorner): the run went on, and wrote "x": null to
+  // its JSON and inf to its CSV, or failed after the work naming the output.
+  if (const auto& gt = field.georeference.geotransform)
+    for (const double term : *gt)
+      if (!std::isfinite(term))
+        throw IoError(path, "the geotransform is not finite (" + shortNumber((*gt)[0]) + ", " +
+                                shortNumber((*gt)[1]) + ", " + shortNumber((*gt)[3]) + ", " +
+                                shortNumber((*gt)[5]) +
+                                "): fix the raster's georeference first (gdal_edit.py -a_ullr, or -unsetgt)");
   // Cell sizes: given, else from the geotransform (north-up or south-up only), else as hfvis
   // stored them.
   if (options.cell_size_x > 0.0 || options.cell_size_y > 0.0) {
