@@ -327,7 +327,9 @@ class Pvs : public Computation {
             "; " + std::to_string(r.samples) + " samples" +
                 (r.estimate_samples ? " (" + std::to_string(r.estimate_samples) + " settling the estimate)" : "") +
                 ", " + std::to_string(r.entries()) +
-                " entries, estimated pixel error " + jsonNumber(r.pixel_error),
+                " entries, estimated pixel error " +
+                (std::isfinite(r.pixel_error) ? formatNumber(r.pixel_error)
+                                              : std::string("none (no uniform view rays were cast to estimate it)")),
             "view cell"};
   }
 
