@@ -607,7 +607,9 @@ const std::vector<OptionSpec>& optionTable() {
          run.observers.push_back(parseReceiver(typed, value));
        }},
       {"--observers", nullptr, "FILE.csv", kViewshedGroup, false,
-       "observers, one col,row[,height] a line (a header line allowed)", HFVIS_TEXT(observers_file)},
+       "observers, one col,row[,height] a line (a header line allowed: row,col\n"
+       "for that order; map coordinates x,y refused)",
+       HFVIS_TEXT(observers_file)},
       {"--observer-height", nullptr, "H", kViewshedGroup, false,
        "the eye's height above the surface (default 2)",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
@@ -716,7 +718,8 @@ const std::vector<OptionSpec>& optionTable() {
        }},
       {"--sources", nullptr, "FILE.csv", kAreaLightGroup, false,
        "the light's samples, one col,row[,height] a line (a header line\n"
-       "allowed; fractional columns and rows lie between pixel centres)",
+       "allowed: row,col for that order; map coordinates x,y refused;\n"
+       "fractional columns and rows lie between pixel centres)",
        HFVIS_TEXT(sources_file)},
       {"--light-image", nullptr, "FILE", kAreaLightGroup, false,
        "colours the --light rectangle: an R, G, B image (or one grey\n"

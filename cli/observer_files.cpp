@@ -37,7 +37,8 @@ struct PointKind {
 };
 
 // "col,row[,height]" per line; blank lines, lines starting with '#' and one header line before
-// the first point (fields that start with letters) are skipped; a missing height is
+// the first point (fields that start with letters: row,col reads the columns in that order, names
+// of map coordinates such as x,y are refused) are skipped; a missing height is
 // `default_height`. Throws IoError naming `path`, the line and its first 60 bytes (control and
 // non-ASCII bytes escaped) for a malformed line, a UTF-16 file, a negative height unless
 // `absolute`, or no point at all.
@@ -94,9 +95,10 @@ std::vector<CsvPoint> parsePoints(const std::string& path, std::istream& in, dou
       }
     }
     if (!numbers && points.empty() && !header_seen && words) {
-      // Its names say the columns' order: col,row[,height] or row,col[,height]. Any other (x,y,
-      // lat,lon: map coordinates) is refused: every header was passed over, and a row,col file was
-      // read as col,row, exit 0.
+      // Its first two names may say the columns' order: row,col reads them so (every header was
+      // passed over: a row,col file was read as col,row, exit 0). Names of map coordinates (x,y,
+      // lat,lon, easting,northing) are refused: such a file was read as pixels. Others (col,row,
+      // column,row, x_pixel,y_pixel) are taken as col,row, as before; a third name is not judged.
       std::vector<std::string> names;
       for (const std::string& f : fields) {
         const std::size_t a = f.find_first_not_of(" \t"), b = f.find_last_not_of(" \t");
@@ -109,21 +111,21 @@ std::vector<CsvPoint> parsePoints(const std::string& path, std::istream& in, dou
           if (name == n) return true;
         return false;
       };
-      const auto column = [&](const std::string& n) { return is(n, {"col", "column", "c"}); };
-      const auto row_name = [&](const std::string& n) { return is(n, {"row", "r"}); };
-      const bool two = names.size() == 2 || (names.size() == 3 && is(names[2], {"height", "h", "z"}));
-      if (two && column(names[0]) && row_name(names[1])) {
-        header_seen = true;
-        continue;
-      }
-      if (two && row_name(names[0]) && column(names[1])) {
-        header_seen = row_first = true;
-        continue;
-      }
-      throw IoError(path, "line " + std::to_string(number) + ": the header '" + shown(line) +
-                              "' names columns hfvis does not read: the file holds pixel columns and rows, "
-                              "with a header col,row[,height] or row,col[,height] (map coordinates: convert "
-                              "them to pixels first)");
+      const auto column = [&](const std::string& n) {
+        return is(n, {"col", "cols", "column", "columns", "c"});
+      };
+      const auto row_name = [&](const std::string& n) { return is(n, {"row", "rows", "r"}); };
+      const auto map = [&](const std::string& n) {
+        return is(n, {"x", "y", "lon", "lat", "long", "longitude", "latitude", "easting", "northing"});
+      };
+      if (names.size() >= 2 && (map(names[0]) || map(names[1])))
+        throw IoError(path,
+                      "line " + std::to_string(number) + ": the header '" + shown(line) +
+                          "' names map coordinates: the file holds pixel columns and rows, col,row[,height] "
+                          "(or row,col[,height]); convert the coordinates to pixels first");
+      header_seen = true;
+      row_first = names.size() >= 2 && row_name(names[0]) && column(names[1]);
+      continue;
     }
     // (getline drops an empty last field: "1,1," would pass for "1,1" and "1,1,2," for "1,1,2")
     const bool trailing_comma = line[line.find_last_not_of(" \t")] == ',';

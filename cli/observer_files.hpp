@@ -12,7 +12,8 @@
 namespace hfvis::cli {
 
 // "col,row[,height]" per line; blank lines, lines starting with '#' and one header line before
-// the first observer (fields that start with letters) are skipped; a missing height is
+// the first observer (fields that start with letters: row,col reads the columns in that order,
+// names of map coordinates such as x,y are refused) are skipped; a missing height is
 // `default_height`. Throws IoError naming `path`, the line and its first 60 bytes (control and
 // non-ASCII bytes escaped) for a malformed line, a UTF-16 file, an eye below the surface (a
 // negative height unless `absolute`) or no observer at all.

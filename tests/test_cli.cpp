@@ -2374,8 +2374,9 @@ TEST_F(Cli, ViewshedSeesOverAWall) {
   EXPECT_EQ(count.at(8, 3, 0), 3.0f);   // the wall's top: everyone
   // Behind the wall from column 2, in front of it from 14, and seen from the eye on the wall's end.
   EXPECT_EQ(count.at(12, 3, 0), 2.0f);
-  // The header says the columns' order: row,col gives the same observers; a header of other names
-  // (map coordinates) is refused (every header was passed over: row,col read as col,row, exit 0).
+  // The header says the columns' order: row,col gives the same observers; one naming map coordinates
+  // is refused (every header was passed over: row,col read as col,row, exit 0); others (x_pixel)
+  // are taken as col,row.
   {
     std::ofstream csv(in("row_first.csv"));
     csv << "Row,Col,Height\n3,14\n# a comment\n\n0,8,1\n";
@@ -2384,7 +2385,7 @@ TEST_F(Cli, ViewshedSeesOverAWall) {
                                 " --observer 2,3 --observers " + shellQuoted(in("row_first.csv")) + " -q");
   ASSERT_EQ(swapped.status, 0) << swapped.err;
   EXPECT_EQ(readBack(out("r.exr")).pixels, count.pixels);
-  for (const char* header : {"x,y", "lat,lon", "col,row,elevation", "col,col"}) {
+  for (const char* header : {"x,y", "lat,lon", "Easting,Northing,height"}) {
     {
       std::ofstream csv(in("named.csv"));
       csv << header << "\n3,4\n";
@@ -2392,9 +2393,17 @@ TEST_F(Cli, ViewshedSeesOverAWall) {
     const CliResult named = run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("named.exr")) +
                                 " --observers " + shellQuoted(in("named.csv")));
     EXPECT_EQ(named.status, 1) << header;
-    EXPECT_NE(named.err.find("names columns hfvis does not read"), std::string::npos) << named.err;
+    EXPECT_NE(named.err.find("names map coordinates"), std::string::npos) << named.err;
     EXPECT_FALSE(fs::exists(out("named.exr"))) << header;
   }
+  {
+    std::ofstream csv(in("pixels.csv"));
+    csv << "x_pixel,y_pixel,observer_height\n14,3\n8,0,1\n";
+  }
+  const CliResult pixels = run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("p.exr")) +
+                               " --observer 2,3 --observers " + shellQuoted(in("pixels.csv")) + " -q");
+  ASSERT_EQ(pixels.status, 0) << pixels.err;
+  EXPECT_EQ(readBack(out("p.exr")).pixels, count.pixels);
 }
 
 TEST_F(Cli, ViewshedCulledEqualsExact) {

@@ -320,7 +320,8 @@ def _common(cell_size, z_scale, nodata, device, progress, pixels=False):
     if progress is not None and not callable(progress):  # (5 gave "'int' object is not callable" mid-run)
         raise InvalidArgumentError(f"progress must be a callable or None, got {progress!r}")
     # (an int, as devices()'s "index", was nanobind's bare TypeError)
-    if device is not None and not isinstance(device, (str, int, np.integer)) or isinstance(device, bool):
+    if device is not None and not isinstance(device, (str, int, np.integer)) or isinstance(device, bool) or \
+            isinstance(device, (int, np.integer)) and device < 0:
         raise InvalidArgumentError(f"device must be a selector string (\"cpu\", \"gpu\", a name) or an index of "
                                    f"hfvis.devices(), got {device!r}")
     return {"cell_size": cell_size, "z_scale": z_scale, "nodata": nodata,
@@ -369,7 +370,7 @@ def _azimuths_deg(options):
 def _with_estimate(options, heights, max_error, error_estimate):
     """Adds max_error and error_estimate to the options; a Dask-backed DataArray is computed, since
     K and the estimate's mean or percentile are the whole field's: it runs in one piece."""
-    if max_error is not None and _real("max_error", max_error):  # ("x" was float()'s bare ValueError)
+    if max_error not in (None, False) and _real("max_error", max_error):  # ("x" was float()'s bare ValueError)
         options["max_error"] = _real("max_error", max_error)
     if error_estimate:
         options["error_estimate"] = True
@@ -598,7 +599,7 @@ def environment_light(heights, environment, *, rotation_deg=0.0, table_rows=0, d
     options.update(environment=environment, rotation_deg=_real("rotation_deg", rotation_deg),
                    table_rows=_whole("table_rows", table_rows, 0, 2**31 - 1))
     common = _common(cell_size, z_scale, nodata, device, progress)
-    if max_error is not None and _real("max_error", max_error):
+    if max_error not in (None, False) and _real("max_error", max_error):
         options["max_error"] = _real("max_error", max_error)
         if _is_dataarray(heights) and _is_dask(heights.data):
             heights = _computed(heights)  # K and the estimate's percentile are the whole field's: in one piece

@@ -68,7 +68,7 @@ class Grid:
                     raise InvalidArgumentError("the DataArray has a CRS but no x / y coordinates or transform to take "
                                                "its cell size from: give cell_size, or its coordinates")
                 spatial = [str(n) for n in self.array.coords if str(n).lower() in _X_NAMES + _Y_NAMES
-                           and n not in (self.y_dim, self.x_dim)]
+                           and n not in (self.y_dim, self.x_dim) and self.array.coords[n].ndim > 0]
                 if spatial:
                     raise InvalidArgumentError(f"the DataArray's map coordinates {spatial} are not its dimensions' "
                                                f"({self.y_dim}, {self.x_dim}), and hfvis takes the cell size from "

@@ -56,10 +56,12 @@ void requireOpenClOfThisProcess() {
 // calls pay no start-up (device discovery, kernel builds). The contexts are never destroyed: an
 // OpenCL runtime torn down while the interpreter exits can hang or crash.
 std::shared_ptr<SharedContext> contextFor(const std::string& device) {
+  // (before the lock: a child forked while another thread held it, building a context, would wait
+  // on it for good)
+  requireOpenClOfThisProcess();
   static std::mutex guard;
   static auto* contexts = new std::map<std::string, std::shared_ptr<SharedContext>>();
   std::lock_guard<std::mutex> lock(guard);
-  requireOpenClOfThisProcess();
   auto found = contexts->find(device);
   if (found != contexts->end()) return found->second;
   ContextOptions options;

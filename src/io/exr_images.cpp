@@ -25,6 +25,8 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <memory>
@@ -313,6 +315,21 @@ bool isExrFile(const std::string& path) {
          magic[2] == 0x31 && magic[3] == 0x01;
 }
 
+namespace {
+
+// The fewest significant digits that read back as the same float.
+std::string shortestFloat(float value) {
+  char text[32];
+  for (int digits = 6; digits < 9; ++digits) {
+    std::snprintf(text, sizeof(text), "%.*g", digits, double(value));
+    if (std::strtof(text, nullptr) == value) return text;
+  }
+  std::snprintf(text, sizeof(text), "%.9g", double(value));
+  return text;
+}
+
+}  // namespace
+
 ImageChannels readExr(const std::string& path, std::uint64_t max_image_bytes, const std::string* channel,
                       double* rounding) {
   const std::unique_ptr<Imf::MultiPartInputFile> file = openExr(path);
@@ -399,7 +416,7 @@ ImageChannels readExr(const std::string& path, std::uint64_t max_image_bytes, co
     else if (const auto* i = dynamic_cast<const Imf::IntAttribute*>(any))
       text = std::to_string(i->value());
     else if (const auto* f = dynamic_cast<const Imf::FloatAttribute*>(any))
-      text = detail::exactNumber(f->value());
+      text = shortestFloat(f->value());  // (0.1f as 0.1, not its double 0.100000001490116)
     else if (const auto* d = dynamic_cast<const Imf::DoubleAttribute*>(any))
       text = detail::exactNumber(d->value());
     else
