@@ -668,11 +668,11 @@ inline float region_jitter(unsigned int seed, unsigned int key, unsigned int s, 
   return (float)(v >> 8) * 0x1p-24f;
 }
 
-// Sample s of a region's table, drawn from stream `key` of `seed` (the table's: region_table_seed): the
-// table holds the
-// rectangle (lo_x, lo_y, hi_x, hi_y), then per sample its stratum's corner (x, y), its size
-// (x, y) and the height (above the surface, or absolute when `absolute`). The sample is the
-// corner plus the jitter times the size, kept inside the rectangle (a rounding may step past).
+// Sample s of a region's table, drawn from stream `key` of `seed` (the table's: region_table_seed):
+// the table holds the rectangle (lo_x, lo_y, hi_x, hi_y), then per sample its stratum's corner
+// (x, y), its size (x, y) and the height (above the surface, or absolute when `absolute`). The
+// sample is the corner plus the jitter times the size, kept inside the rectangle (a rounding may
+// step past).
 // *z: its absolute height (NaN over a nodata surface).
 inline void region_sample(HFVIS_GLOBAL const float* table, HFVIS_GLOBAL const float* h, int width, int height,
                           int absolute, unsigned int seed, unsigned int key, int s, float* x, float* y,
