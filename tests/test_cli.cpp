@@ -2376,15 +2376,19 @@ TEST_F(Cli, ViewshedSeesOverAWall) {
   EXPECT_EQ(count.at(12, 3, 0), 2.0f);
   // The header says the columns' order: row,col gives the same observers; one naming map coordinates
   // is refused (every header was passed over: row,col read as col,row, exit 0); others (x_pixel)
-  // are taken as col,row.
-  {
-    std::ofstream csv(in("row_first.csv"));
-    csv << "Row,Col,Height\n3,14\n# a comment\n\n0,8,1\n";
-  }
-  const CliResult swapped = run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("r.exr")) +
-                                " --observer 2,3 --observers " + shellQuoted(in("row_first.csv")) + " -q");
-  ASSERT_EQ(swapped.status, 0) << swapped.err;
-  EXPECT_EQ(readBack(out("r.exr")).pixels, count.pixels);
+  // are taken as col,row. Each file holds the observers above, with its header.
+  const auto sameObservers = [&](const std::string& name, const std::string& text) {
+    {
+      std::ofstream csv(in(name + ".csv"));
+      csv << text;
+    }
+    const CliResult r = run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out(name + ".exr")) +
+                            " --observer 2,3 --observers " + shellQuoted(in(name + ".csv")) + " -q");
+    ASSERT_EQ(r.status, 0) << name << ": " << r.err;
+    EXPECT_EQ(readBack(out(name + ".exr")).pixels, count.pixels) << name;
+  };
+  sameObservers("row_first", "Row,Col,Height\n3,14\n# a comment\n\n0,8,1\n");
+  sameObservers("pixels", "x_pixel,y_pixel,observer_height\n14,3\n8,0,1\n");
   for (const char* header : {"x,y", "lat,lon", "Easting,Northing,height"}) {
     {
       std::ofstream csv(in("named.csv"));
@@ -2396,14 +2400,6 @@ TEST_F(Cli, ViewshedSeesOverAWall) {
     EXPECT_NE(named.err.find("names map coordinates"), std::string::npos) << named.err;
     EXPECT_FALSE(fs::exists(out("named.exr"))) << header;
   }
-  {
-    std::ofstream csv(in("pixels.csv"));
-    csv << "x_pixel,y_pixel,observer_height\n14,3\n8,0,1\n";
-  }
-  const CliResult pixels = run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("p.exr")) +
-                               " --observer 2,3 --observers " + shellQuoted(in("pixels.csv")) + " -q");
-  ASSERT_EQ(pixels.status, 0) << pixels.err;
-  EXPECT_EQ(readBack(out("p.exr")).pixels, count.pixels);
 }
 
 TEST_F(Cli, ViewshedCulledEqualsExact) {
