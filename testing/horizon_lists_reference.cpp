@@ -27,7 +27,6 @@ HorizonListReference referenceHorizonList(const std::vector<float>& ray, float h
   const int n = static_cast<int>(ray.size());
   HorizonListReference out;
   out.visible.assign(n + 1, false);
-  out.exactly.assign(n + 1, false);
   // The nodes, farthest first, the receiver last: present samples and admitted peaks, at their
   // positions (distances from the receiver); `sample` is i for sample i, -1 - j for the peak of
   // interval j.
@@ -53,33 +52,13 @@ HorizonListReference referenceHorizonList(const std::vector<float>& ray, float h
   nodes.push_back({hr, 0.0f, 0});
   const std::size_t receiver = nodes.size() - 1;
   // Visible: no node nearer lies strictly above the sight line from the receiver.
-  std::vector<bool> exact(receiver, false);
   for (std::size_t x = 0; x < receiver; ++x) {
+    if (nodes[x].sample < 0) continue;
     bool hidden = false;
     for (std::size_t y = x + 1; y < receiver && !hidden; ++y)
       hidden = detail::chordSide(nodes[x].h, nodes[y].h, hr, nodes[x].distance - nodes[y].distance,
                                  nodes[y].distance) > 0;
-    exact[x] = !hidden;
-    if (nodes[x].sample > 0) out.visible[nodes[x].sample] = out.exactly[nodes[x].sample] = !hidden;
-  }
-  // The tie rule forgives the heights' rounding (kernels/shared/chord_side.cl): a hidden sample
-  // is visible where the steepest nearer node (the farthest on ties) hides it only within that
-  // rounding, as it does every hidden sample between them. Outward from the receiver, so that
-  // the steepest node is the latest visible one; `stretch` is each visible node's farthest
-  // forgiven sample (0: none).
-  std::vector<int> stretch(receiver, 0);
-  std::size_t best = receiver;
-  bool forgiving = false;
-  for (std::size_t x = receiver; x-- > 0;) {
-    if (exact[x]) {
-      best = x;
-      forgiving = true;
-    } else if (nodes[x].sample > 0) {
-      forgiving = forgiving && detail::seen_within_rounding(nodes[x].h, nodes[best].h, hr,
-                                                            nodes[x].distance - nodes[best].distance,
-                                                            nodes[best].distance);
-      if (forgiving) out.visible[nodes[x].sample] = true, stretch[best] = nodes[x].sample;
-    }
+    out.visible[nodes[x].sample] = !hidden;
   }
   // Eq. 1 in sweep order: the first node is a segment start, then every convex node after a
   // concave one (class from the chord of its two neighbours; collinear keeps the previous
@@ -105,14 +84,10 @@ HorizonListReference referenceHorizonList(const std::vector<float>& ray, float h
                             nodes[x].distance) > 0)
         best = x;
     }
-    // Listed by the farthest sample of its forgiven stretch, else by its own; a peak by the
-    // sample right after it, where that one is visible.
     const int sample = nodes[best].sample;
-    if (stretch[best] > 0)
-      horizons.insert(stretch[best]);
-    else if (sample > 0)
+    if (sample > 0)
       horizons.insert(sample);
-    else if (-1 - sample >= 1 && out.visible[-1 - sample])
+    else if (-1 - sample >= 1 && out.visible[-1 - sample])  // a peak: the sample after it
       horizons.insert(-1 - sample);
   }
   out.horizons.assign(horizons.begin(), horizons.end());

@@ -138,7 +138,6 @@ void naiveReference(const HeightField& field, const std::vector<float>& h,
         const float step_y = d.step_length * d.dir_y;
         float best_h = 0.0f, weighted = 0.0f;
         int best_step = 0, count = 0, position = 0;
-        bool forgiving = false;  // every hidden sample since the latest visible one was forgiven
         std::uint32_t distance_sum = 0;
         // March until the ray has left the field for good (the kernel may march further;
         // those samples are outside and masked).
@@ -154,13 +153,10 @@ void naiveReference(const HeightField& field, const std::vector<float>& h,
           }
           const float q = sampleHeight(h, width, height, p) -
                           (options.curvature != 0.0 ? drop * static_cast<float>(at) * static_cast<float>(at) : 0.0f);
-          if (std::isnan(q)) continue;
-          // Visible, or hidden only within the heights' rounding after a visible sample (as
-          // every hidden one since it).
-          const float dab = static_cast<float>(at - best_step), dbc = static_cast<float>(best_step);
-          const bool hidden = best_step > 0 && chordSide(q, best_h, hp, dab, dbc) > 0;
-          if (hidden) forgiving = forgiving && seen_within_rounding(q, best_h, hp, dab, dbc);
-          if (!hidden || forgiving) {
+          const bool seen =
+              !std::isnan(q) && (best_step == 0 || chordSide(q, best_h, hp, static_cast<float>(at - best_step),
+                                                             static_cast<float>(best_step)) <= 0);
+          if (seen) {
             if (at <= counted_steps) {
               ++count;
               if (row_spacing)
@@ -168,9 +164,6 @@ void naiveReference(const HeightField& field, const std::vector<float>& h,
               else
                 distance_sum += static_cast<std::uint32_t>(i);
             }
-          }
-          if (!hidden) {
-            forgiving = true;
             best_h = q;
             best_step = at;
           }

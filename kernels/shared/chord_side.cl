@@ -96,26 +96,6 @@ HFVIS_INLINE int chord_side(float ha, float hb, float hc, float dab, float dbc) 
   return exact_chord_side(ha, hb, hc, dab, dbc, dac);
 }
 
-// The heights' rounding, which the tie rule forgives (docs/ALGORITHMS.md, "Grazing samples and
-// the heights' rounding"). A sample's height is a bilinear interpolation rounded to a float, a
-// few units in the last place of the heights off the surface; on a tilted plane that tips
-// collinear samples above or below one another's sight lines, and the exact sign then hides
-// about half of them. So a sample that the exact predicate hides behind its horizon sample b is
-// still seen where it is seen with its own height raised, and b's lowered, by
-// 2^-18 (|ha| + |hb| + |hc|): dozens of units in the last place of the largest of the three.
-// Exact on those shifted heights, so every implementation takes the same decision.
-#define HFVIS_ROUNDING_FORGIVEN 0x1p-18f
-
-HFVIS_INLINE float rounding_forgiven(float ha, float hb, float hc) {
-  return HFVIS_ROUNDING_FORGIVEN * (fabs(ha) + fabs(hb) + fabs(hc));
-}
-
-// Whether sample a (farther) is seen from c over sample b within the heights' rounding.
-HFVIS_INLINE int seen_within_rounding(float ha, float hb, float hc, float dab, float dbc) {
-  const float d = rounding_forgiven(ha, hb, hc);
-  return chord_side(ha + d, hb - d, hc, dab, dbc) <= 0;
-}
-
 // The float filter of chord_side() alone, branch-free: returns whether it decides, and
 // then *side is the exact sign. For the naive march, whose straight-line loop PoCL
 // vectorises across work-items; rays with an undecided step are marched again with

@@ -1,10 +1,9 @@
 """Grazing samples on planes: the visible count (intervisibility, hull tree and naive march) and
 the viewshed of an eye on the surface, on a flat plane and on tilted ones, where under the tie
-rule (grazing samples see) every sample of the plane is visible from every other. The samples'
-float heights are rounded, which tips collinear samples of a tilted plane above or below one
-another's sight lines; the visible counts forgive that rounding, the viewshed's march does not yet
-(docs/ALGORITHMS.md, "Grazing samples and the heights' rounding"). Writes a Markdown table to
-stdout.
+rule (grazing samples see) every sample of the plane is visible from every other. The rule is
+decided exactly on the samples' float heights, whose rounding tips collinear samples of a tilted
+plane above or below one another's sight lines (docs/ALGORITHMS.md, "Grazing samples on tilted
+planes"). Writes a Markdown table to stdout.
 
     build/python-venv/bin/python python/bench/tilted_plane.py
 """

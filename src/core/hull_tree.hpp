@@ -182,12 +182,9 @@ struct IntervisibilityLines {
   std::vector<std::uint32_t> horizon_hashes;  // FNV-1a over the horizons' steps, farthest first
   std::vector<std::uint32_t> walks_skipped;   // 1 where the safe zone skipped the walk
   // Reference only, when asked: the horizons' steps, farthest first, and where each one's
-  // visible run begins (the horizon, or the farthest sample of the hidden ones farther out that
-  // it hides only within the heights' rounding: forgiven_stretch()) and ends (run_end(): the
-  // first hidden sample, the next horizon or the receiver), so horizon h's visible samples are
-  // the present ones of slots [start, end).
+  // visible run ends (run_end(): the first hidden sample, the next horizon or the receiver),
+  // so horizon h's visible samples are the present ones of steps [h, end).
   std::vector<std::vector<int>> horizon_steps;
-  std::vector<std::vector<int>> horizon_run_starts;
   std::vector<std::vector<int>> horizon_run_ends;
 
   // Every per-entry result for samples.size() entries: NaN counts and sums, zero statistics.

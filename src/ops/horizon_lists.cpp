@@ -152,16 +152,12 @@ DirectionHorizons listDirection(const HeightField& field, const std::vector<floa
   detail::sweepPresampledLines(line, HullTreeTuning{}, true);
 
   // The horizons and their runs are tree slots (with peaks, 2 s + 1 for step s's sample and 2 s
-  // for the peak before it): a run [start, end) holds the samples of steps [start >> 1, end >> 1).
-  // A run starts at its horizon, or farther out where the horizon hides samples only within the
-  // heights' rounding (the tie rule forgives it); the segment is then listed by the farthest of
-  // those, which may stand a hair lower than the next nearer horizon.
+  // for the peak before it): a run [slot, end) holds the samples of steps [slot >> 1, end >> 1).
   const int slot_shift = samples.peaks.empty() ? 0 : 1;
   const std::vector<int>& slots = line.horizon_steps[n];  // farthest first
-  const std::vector<int>& starts = line.horizon_run_starts[n];
   const std::vector<int>& ends = line.horizon_run_ends[n];
   for (std::size_t idx = slots.size(); idx-- > 0;) {  // nearest first
-    const int first_step = starts[idx] >> slot_shift, end_step = ends[idx] >> slot_shift;
+    const int first_step = slots[idx] >> slot_shift, end_step = ends[idx] >> slot_shift;
     // A peak is no sample: its segment is the samples nearer than it up to the first hidden one
     // (the sample right after it, a present one, when any), listed by the farthest of them;
     // where even that one is hidden, the peak bounds no segment.
