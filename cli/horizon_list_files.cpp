@@ -37,10 +37,14 @@ constexpr const char* kRayConvention =
 constexpr const char* kVisibleConvention =
     "a sample is visible when its slope from the receiver is >= the slope of every sample between them "
     "and of every peak between them, the bilinear surface's highest point above the chord of two "
-    "consecutive samples where it rises above it (grazing samples are visible; decided exactly)";
+    "consecutive samples where it rises above it (grazing samples are visible), or when the steepest of them "
+    "hides it only within the heights' rounding (2^-22 of the sum of the heights compared, above the "
+    "field's lowest, and of the highest one's absolute value), as it does every hidden sample between "
+    "them (each decision an exact sign)";
 constexpr const char* kHorizonConvention =
     "nearest first; a horizon is the farthest visible sample of its segment (a peak that is a horizon: the "
-    "sample right after it); its segment is the visible "
+    "sample right after it; a sample forgiven its rounding farther out, which may stand a hair lower than "
+    "the next horizon); its segment is the visible "
     "samples [segment_begin, segment_end) toward the receiver, up to the first hidden sample or the next "
     "horizon; the segments hold every visible sample once";
 constexpr const char* kUnits =

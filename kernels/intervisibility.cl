@@ -8,12 +8,17 @@
 // Visibility (the tie rule, the same everywhere, tests included): on one line, a farther
 // sample q is visible from receiver p when no sample strictly between them lies strictly
 // above the chord from q to p; equivalently q's slope from p is >= the slope of every
-// sample in between. Grazing samples are visible, so on a flat plane everything is. Only
-// present samples count (outside the field or without a valid corner: absent). Every
-// geometric decision is chord_side(), an exact sign, so the tree, the scalar reference and
-// the brute-force oracles agree exactly (see src/core/chord_side.hpp for why).
+// sample in between. Grazing samples are visible, so on a flat plane everything is. So is a
+// hidden sample that the steepest sample between hides only within the heights' rounding, as it
+// does every hidden sample between them (seen_within_rounding, forgiven_stretch): so on a
+// tilted plane everything is too. Only present samples count (outside the field or without a
+// valid corner: absent). Every geometric decision is an exact sign (chord_side()), so the
+// tree, the scalar reference and the brute-force oracles agree exactly (see
+// src/core/chord_side.hpp for why).
 //
-// Heights arrive offset and z-scaled (see prepareHeights); NaN = nodata.
+// Heights arrive offset and z-scaled (see prepareHeights); NaN = nodata. height_base (both
+// kernels' last argument): the height their 0 stands for (PreparedHeights::base), for the rounding
+// the tie rule forgives.
 //
 // Compile-time parameters, besides those of sweep_framework.cl:
 //   HFVIS_WANT_COUNT        add the visible counts to count_sum
@@ -244,6 +249,29 @@ HFVIS_INLINE int run_end(__global const int4* tree, __global const int2* positio
       return SLOT_OF(x);
   }
   return next;
+}
+
+// The stretch of hidden samples that `horizon` (slot; height h_h, position p_h) hides only
+// within the heights' rounding (chord_side.cl): going farther out from it, down to step `floor`
+// and no farther than the line's first present sample, every present sample seen over it within
+// the rounding, up to the first that is not. Such samples are seen (the tie rule: on a tilted
+// plane every sample is, though the rounding tips about half of them below the sight line of a
+// nearer one). Returns the step of the farthest, or -1 where there is none. Absent samples
+// neither count nor end the stretch.
+HFVIS_INLINE int forgiven_stretch(__global const int4* tree, __global const int2* positions, uint stride,
+                                  int shift, int floor, int horizon, float h_h, float p_h, float p_receiver,
+                                  float h_receiver, float height_base) {
+  int farthest = -1;
+  for (int x = SAMPLE_OF(horizon) - 1; x >= floor; --x) {
+    const int4 node = tree[(uint)SLOT_OF(x) * stride];
+    const float hx = as_float(node.x);
+    if (isnan(hx)) continue;
+    const float px = sample_position(positions, stride, shift, x);
+    if (!seen_within_rounding(hx, h_h, h_receiver, p_h - px, p_receiver - p_h, height_base)) break;
+    farthest = x;
+    if ((node.y >> 1) == 0) break;  // the line's first present sample
+  }
+  return farthest;
 }
 
 #if HFVIS_WANT_BOUNCE
@@ -735,12 +763,12 @@ __kernel void intervisibility_lattice(
     __global const LatticeSample* samples, int n_samples, int a, int b, float count_factor, float area_factor,
     float drop, int max_steps, __global const int* row_units, __global const float2* row_factors,
     __global const TreePiece* pieces, __global const int* interval_first, int position_shift,
-    __global const int2* peak_inputs, __global int4* trees, __global ulong* prefix, __global int2* positions, uint stride, __global float2* visible,
-    __global uint4* entry_stats, __global ulong* line_totals, int first_line, __global float* count_sum,
-    __global float* area_sum, __global const float* radiance, __global const float* normals,
-    float cos_azimuth, float sin_azimuth, float step_ground, float half_sector, float wedge,
-    __global float* irradiance, int row0, int out_row0, __global const int2* strip_receivers,
-    __global TreeLineState* states) {
+    __global const int2* peak_inputs, __global int4* trees, __global ulong* prefix, __global int2* positions,
+    uint stride, __global float2* visible, __global uint4* entry_stats, __global ulong* line_totals,
+    int first_line, __global float* count_sum, __global float* area_sum, __global const float* radiance,
+    __global const float* normals, float cos_azimuth, float sin_azimuth, float step_ground, float half_sector,
+    float wedge, __global float* irradiance, int row0, int out_row0, __global const int2* strip_receivers,
+    __global TreeLineState* states, float height_base) {
   const int j = get_global_id(0);
   if (j >= n_lines) return;
   stride = HFVIS_SCRATCH_STRIDE(stride);
@@ -992,6 +1020,21 @@ __kernel void intervisibility_lattice(
           int hp = head;
           int4 hz = tree[(uint)hp * stride];
           int hp_rank = node_rank(tree, stride, hp, hz);
+          // A horizon's run begins with the stretch of hidden samples farther out that it hides
+          // only within the heights' rounding (forgiven_stretch): from slot run_first, of rank
+          // run_first_rank. The farthest horizon's reaches back to the line's first sample. No
+          // stretch goes past the maximum distance's cut: what lies beyond it does not count.
+          int run_first = hp, run_first_rank = hp_rank;
+          if (hp_rank > 0) {
+            const int f = forgiven_stretch(
+                tree, line_positions, stride, position_shift, max(cut, 0), hp, as_float(hz.x),
+                node_position(line_positions, stride, position_shift, hp, hz), p, h, height_base);
+            if (f >= 0) {
+              run_first = SLOT_OF(f);
+              run_first_rank =
+                  HFVIS_HAS_NODATA ? tree[(uint)run_first * stride].y >> 1 : hp_rank - (SAMPLE_OF(hp) - f);
+            }
+          }
           for (;;) {
             const int np = hz.w;
             ++m;
@@ -1021,8 +1064,25 @@ __kernel void intervisibility_lattice(
                          : holes   ? tree[(uint)end * stride].y >> 1
                                    : hp_rank + (SAMPLE_OF(end) - SAMPLE_OF(hp));
             }
+            // The next horizon's run begins with its forgiven stretch, over the hidden samples
+            // [end, np).
+            int np_first = np, np_first_rank = np_rank;
+            if (np != HFVIS_NONE && end != np) {
+              const int f = forgiven_stretch(
+                  tree, line_positions, stride, position_shift, max(SAMPLE_OF(end), cut), np, as_float(nz.x),
+                  node_position(line_positions, stride, position_shift, np, nz), p, h, height_base);
+              if (f >= 0) {
+                np_first = SLOT_OF(f);
+                np_first_rank =
+                    HFVIS_HAS_NODATA ? tree[(uint)np_first * stride].y >> 1 : np_rank - (SAMPLE_OF(np) - f);
+              }
+            }
+            // Absent samples within the run [run_first, end) (the ranks' and steps' closed forms
+            // need none).
+            const int run_holes =
+                HFVIS_HAS_NODATA && end_rank - run_first_rank != SAMPLE_OF(end) - SAMPLE_OF(run_first);
 #if HFVIS_WANT_BOUNCE
-            for (int x = hp; receiver && x < end; ++x) {
+            for (int x = run_first; receiver && x < end; ++x) {
               if (!IS_SAMPLE(x)) continue;  // peaks carry no radiance
               const float hx = as_float(tree[(uint)x * stride].x);
               if (!isnan(hx)) {
@@ -1031,15 +1091,18 @@ __kernel void intervisibility_lattice(
                 bounce_visit(&gather, hx, SAMPLE_OF(x), emitted);
               }
             }
-            gather.adjacent = end == np;  // no hidden node before the next visible one
+            // No hidden sample before the next visible one: the run reached the next one's, and
+            // where it visited none (a peak's, or one whose first sample is forgiven to the next
+            // horizon) so did the run before it.
+            gather.adjacent = gather.adjacent && end == np_first;
 #endif
             // Within the maximum distance only the run's samples from `first` on count (terrain
             // farther away neither counts nor hides anything nearer): from the slot of the first
             // step within it (its peak's). Every sample's slot holds its rank.
-            const int first = cut > SAMPLE_OF(hp) ? PEAK_SLOT(cut) : hp;
-            const int first_rank = first == hp ? hp_rank
-                                   : holes     ? tree[(uint)SLOT_OF(SAMPLE_OF(first)) * stride].y >> 1
-                                               : hp_rank + (SAMPLE_OF(first) - SAMPLE_OF(hp));
+            const int first = cut > SAMPLE_OF(run_first) ? PEAK_SLOT(cut) : run_first;
+            const int first_rank = first == run_first ? run_first_rank
+                                   : run_holes        ? tree[(uint)SLOT_OF(SAMPLE_OF(first)) * stride].y >> 1
+                                               : run_first_rank + (SAMPLE_OF(first) - SAMPLE_OF(run_first));
             const int run = first < end ? end_rank - first_rank : 0;
             count += run;
 #if HFVIS_WANT_AREA
@@ -1059,7 +1122,7 @@ __kernel void intervisibility_lattice(
 #else
             ulong steps_sum = 0;
             if (run == 0) {
-            } else if (!holes) {  // x = first .. end - 1
+            } else if (!run_holes) {  // x = first .. end - 1
               steps_sum = (ulong)run * (ulong)(SAMPLE_OF(first) + SAMPLE_OF(end) - 1) / 2;
             } else {
               const ulong end_sum = end == slot ? step_sum : prefix[base + (uint)SLOT_OF(SAMPLE_OF(end)) * stride];
@@ -1072,6 +1135,8 @@ __kernel void intervisibility_lattice(
             hz = nz;
             hp = np;
             hp_rank = np_rank;
+            run_first = np_first;
+            run_first_rank = np_first_rank;
           }
 #if HFVIS_SAFE_ZONE
           if (refresh_zone) {
@@ -1198,7 +1263,9 @@ HFVIS_INLINE void accumulate_visible(uint pixel, int nodata, float count, float 
 
 // Naive method (Timonen 2013, Sec. 1): for every pixel, march the ray in steps of
 // step_length pixels, sample bilinearly, and count the samples that reach the steepest
-// slope so far (the same tie rule and predicate as the sweep). The trip count is uniform
+// slope so far (the same tie rule and predicate as the sweep), and the hidden ones after such
+// a sample that it hides only within the heights' rounding, up to the first that it hides
+// beyond it (forgiven_stretch's rule). The trip count is uniform
 // over the work-group (the longest ray of its tile), as in horizon_naive; samples outside
 // the field are masked. Global size: (W, H) rounded up to the local size.
 // With HFVIS_ROW_SPACING the ray is straight in pixels and positions along it are whole
@@ -1211,7 +1278,7 @@ __kernel void intervisibility_naive(__global const float* heights, int width, in
                                     __global const SweepDirection* directions, int batch_size, float sector,
                                     float curvature, __global const int* max_steps,
                                     __global const int* row_units, __global const float2* row_factors,
-                                    __global float* count_sum, __global float* area_sum) {
+                                    __global float* count_sum, __global float* area_sum, float height_base) {
   int c = get_global_id(0), r = get_global_id(1);
   int c_lo = get_group_id(0) * get_local_size(0), r_lo = get_group_id(1) * get_local_size(1);
   int c_hi = min(c_lo + (int)get_local_size(0), width) - 1;
@@ -1243,6 +1310,7 @@ __kernel void intervisibility_naive(__global const float* heights, int width, in
     const int counted_steps = max_steps[b];  // samples farther away are not counted
     float best_h = 0.0f;  // the steepest sample so far (the latest visible one)
     int best_step = 0;    // its position, 0 = none yet
+    int forgiving = 0;    // every hidden sample since it was forgiven its rounding
     int count = 0, undecided = 0;
     uint distance_sum = 0;
 #if HFVIS_ROW_SPACING
@@ -1268,11 +1336,16 @@ __kernel void intervisibility_naive(__global const float* heights, int width, in
       q = q - drop * (float)at * (float)at;
 #endif
       int present = inside_field(px, py, width, height) && !isnan(q);
-      int side;
-      // best_step = 0 (none yet) would make the chord degenerate; its answer is ignored.
-      int decided = chord_side_filter(q, best_h, h, (float)(at - best_step), (float)max(best_step, 1), &side);
-      undecided |= present && best_step > 0 && !decided;
-      int seen = present && (best_step == 0 || side <= 0);
+      int side, side_forgiven;
+      // best_step = 0 (none yet) would make the chord degenerate; its answers are ignored.
+      const float dab = (float)(at - best_step), dbc = (float)max(best_step, 1);
+      int decided = chord_side_filter(q, best_h, h, dab, dbc, &side);
+      const float slack = rounding_forgiven(q, best_h, h, height_base);
+      int decided_forgiven = chord_side_filter(q + slack, best_h - slack, h, dab, dbc, &side_forgiven);
+      undecided |= present && best_step > 0 && !(decided && (side <= 0 || !forgiving || decided_forgiven));
+      int visible = present && (best_step == 0 || side <= 0);
+      int seen = visible || (present && forgiving && side_forgiven <= 0);
+      forgiving = present ? seen : forgiving;
       int counted = seen && at <= counted_steps;
       count += counted;
 #if HFVIS_ROW_SPACING
@@ -1280,12 +1353,12 @@ __kernel void intervisibility_naive(__global const float* heights, int width, in
 #else
       distance_sum += counted ? (uint)i : 0u;
 #endif
-      best_h = seen ? q : best_h;
-      best_step = seen ? at : best_step;
+      best_h = visible ? q : best_h;
+      best_step = visible ? at : best_step;
     }
     if (undecided) {  // a near-tie somewhere on this ray: march it again, exactly
       best_h = 0.0f;
-      best_step = count = 0;
+      best_step = count = forgiving = 0;
       distance_sum = 0;
 #if HFVIS_ROW_SPACING
       position = 0;
@@ -1305,7 +1378,10 @@ __kernel void intervisibility_naive(__global const float* heights, int width, in
         q = q - drop * (float)at * (float)at;
 #endif
         if (!inside_field(px, py, width, height) || isnan(q)) continue;
-        if (best_step > 0 && chord_side(q, best_h, h, (float)(at - best_step), (float)best_step) > 0) continue;
+        const float dab = (float)(at - best_step), dbc = (float)best_step;
+        const int hidden = best_step > 0 && chord_side(q, best_h, h, dab, dbc) > 0;
+        if (hidden) forgiving = forgiving && seen_within_rounding(q, best_h, h, dab, dbc, height_base);
+        if (hidden && !forgiving) continue;
         if (at <= counted_steps) {
           ++count;
 #if HFVIS_ROW_SPACING
@@ -1314,6 +1390,8 @@ __kernel void intervisibility_naive(__global const float* heights, int width, in
           distance_sum += (uint)i;
 #endif
         }
+        if (hidden) continue;
+        forgiving = 1;
         best_h = q;
         best_step = at;
       }

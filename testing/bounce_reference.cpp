@@ -20,6 +20,7 @@ BounceLineView referenceBounceLines(const HeightField& field, const BounceInputs
                                     const HullTreeTuning& tuning, bool all_horizons) {
   BounceLineView view;
   view.lines = latticeTreeLines(field, inputs.heights, d);
+  view.lines.height_base = inputs.height_base;
   view.lines.horizons_at_every_sample = all_horizons;
   const int channels = inputs.channels();
   const int stride = channels + kBounceNormalFloats;

@@ -23,10 +23,12 @@ std::vector<float> referenceRay(const HeightField& field, const std::vector<floa
   return ray;
 }
 
-HorizonListReference referenceHorizonList(const std::vector<float>& ray, float hr, const RayPeaks& peaks) {
+HorizonListReference referenceHorizonList(const std::vector<float>& ray, float hr, const RayPeaks& peaks,
+                                          float height_base) {
   const int n = static_cast<int>(ray.size());
   HorizonListReference out;
   out.visible.assign(n + 1, false);
+  out.exactly.assign(n + 1, false);
   // The nodes, farthest first, the receiver last: present samples and admitted peaks, at their
   // positions (distances from the receiver); `sample` is i for sample i, -1 - j for the peak of
   // interval j.
@@ -52,13 +54,33 @@ HorizonListReference referenceHorizonList(const std::vector<float>& ray, float h
   nodes.push_back({hr, 0.0f, 0});
   const std::size_t receiver = nodes.size() - 1;
   // Visible: no node nearer lies strictly above the sight line from the receiver.
+  std::vector<bool> exact(receiver, false);
   for (std::size_t x = 0; x < receiver; ++x) {
-    if (nodes[x].sample < 0) continue;
     bool hidden = false;
     for (std::size_t y = x + 1; y < receiver && !hidden; ++y)
       hidden = detail::chordSide(nodes[x].h, nodes[y].h, hr, nodes[x].distance - nodes[y].distance,
                                  nodes[y].distance) > 0;
-    out.visible[nodes[x].sample] = !hidden;
+    exact[x] = !hidden;
+    if (nodes[x].sample > 0) out.visible[nodes[x].sample] = out.exactly[nodes[x].sample] = !hidden;
+  }
+  // The tie rule forgives the heights' rounding (kernels/shared/chord_side.cl): a hidden sample
+  // is visible where the steepest nearer node (the farthest on ties) hides it only within that
+  // rounding, as it does every hidden sample between them. Outward from the receiver, so that
+  // the steepest node is the latest visible one; `stretch` is each visible node's farthest
+  // forgiven sample (0: none).
+  std::vector<int> stretch(receiver, 0);
+  std::size_t best = receiver;
+  bool forgiving = false;
+  for (std::size_t x = receiver; x-- > 0;) {
+    if (exact[x]) {
+      best = x;
+      forgiving = true;
+    } else if (nodes[x].sample > 0) {
+      forgiving = forgiving && detail::seen_within_rounding(nodes[x].h, nodes[best].h, hr,
+                                                            nodes[x].distance - nodes[best].distance,
+                                                            nodes[best].distance, height_base);
+      if (forgiving) out.visible[nodes[x].sample] = true, stretch[best] = nodes[x].sample;
+    }
   }
   // Eq. 1 in sweep order: the first node is a segment start, then every convex node after a
   // concave one (class from the chord of its two neighbours; collinear keeps the previous
@@ -84,10 +106,14 @@ HorizonListReference referenceHorizonList(const std::vector<float>& ray, float h
                             nodes[x].distance) > 0)
         best = x;
     }
+    // Listed by the farthest sample of its forgiven stretch, else by its own; a peak by the
+    // sample right after it, where that one is visible.
     const int sample = nodes[best].sample;
-    if (sample > 0)
+    if (stretch[best] > 0)
+      horizons.insert(stretch[best]);
+    else if (sample > 0)
       horizons.insert(sample);
-    else if (-1 - sample >= 1 && out.visible[-1 - sample])  // a peak: the sample after it
+    else if (-1 - sample >= 1 && out.visible[-1 - sample])
       horizons.insert(-1 - sample);
   }
   out.horizons.assign(horizons.begin(), horizons.end());

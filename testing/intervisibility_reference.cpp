@@ -54,7 +54,7 @@ void finish(IntervisibilityResult& result, const std::vector<PixelSums>& sums,
 
 // With `halves` (the error estimate) the odd-numbered directions' sums apart, split as the
 // device path splits them.
-void sweepReference(const HeightField& field, const std::vector<float>& h,
+void sweepReference(const HeightField& field, const std::vector<float>& h, float height_base,
                     const IntervisibilityOptions& options, bool statistics, bool halves,
                     IntervisibilityResult& result) {
   std::vector<PixelSums> halves_sums[2] = {std::vector<PixelSums>(field.pixelCount()),
@@ -66,6 +66,7 @@ void sweepReference(const HeightField& field, const std::vector<float>& h,
     std::vector<PixelSums>& sums = halves_sums[half];
     weights[half] += d.lattice.weight;
     IntervisibilityLines lines = latticeTreeLines(field, h, d, options.curvature != 0.0);
+    lines.height_base = height_base;
     lines.horizons_at_every_sample = statistics;  // as the kernel without statistics
     sweepPresampledLines(lines, options.tree, false);
     const auto& g = lines.geometry;
@@ -113,7 +114,7 @@ void sweepReference(const HeightField& field, const std::vector<float>& h,
   splitVisibilityHalves(result, odd_count, odd_area, weights[0], weights[1]);
 }
 
-void naiveReference(const HeightField& field, const std::vector<float>& h,
+void naiveReference(const HeightField& field, const std::vector<float>& h, float height_base,
                     const IntervisibilityOptions& options, IntervisibilityResult& result) {
   const int width = field.width, height = field.height;
   const auto directions = runDirections(field, options);
@@ -138,6 +139,7 @@ void naiveReference(const HeightField& field, const std::vector<float>& h,
         const float step_y = d.step_length * d.dir_y;
         float best_h = 0.0f, weighted = 0.0f;
         int best_step = 0, count = 0, position = 0;
+        bool forgiving = false;  // every hidden sample since the latest visible one was forgiven
         std::uint32_t distance_sum = 0;
         // March until the ray has left the field for good (the kernel may march further;
         // those samples are outside and masked).
@@ -153,10 +155,13 @@ void naiveReference(const HeightField& field, const std::vector<float>& h,
           }
           const float q = sampleHeight(h, width, height, p) -
                           (options.curvature != 0.0 ? drop * static_cast<float>(at) * static_cast<float>(at) : 0.0f);
-          const bool seen =
-              !std::isnan(q) && (best_step == 0 || chordSide(q, best_h, hp, static_cast<float>(at - best_step),
-                                                             static_cast<float>(best_step)) <= 0);
-          if (seen) {
+          if (std::isnan(q)) continue;
+          // Visible, or hidden only within the heights' rounding after a visible sample (as
+          // every hidden one since it).
+          const float dab = static_cast<float>(at - best_step), dbc = static_cast<float>(best_step);
+          const bool hidden = best_step > 0 && chordSide(q, best_h, hp, dab, dbc) > 0;
+          if (hidden) forgiving = forgiving && seen_within_rounding(q, best_h, hp, dab, dbc, height_base);
+          if (!hidden || forgiving) {
             if (at <= counted_steps) {
               ++count;
               if (row_spacing)
@@ -164,6 +169,9 @@ void naiveReference(const HeightField& field, const std::vector<float>& h,
               else
                 distance_sum += static_cast<std::uint32_t>(i);
             }
+          }
+          if (!hidden) {
+            forgiving = true;
             best_h = q;
             best_step = at;
           }
@@ -299,11 +307,11 @@ IntervisibilityResult referenceIntervisibility(const HeightField& field,
   if (outputs.visible_count || outputs.error_estimate) result.visible_count.assign(field.pixelCount(), nan);
   if (outputs.visible_area) result.visible_area.assign(field.pixelCount(), nan);
   if (options.method == IntervisibilityMethod::HullTree) {
-    detail::sweepReference(field, prepared.heights, options, outputs.statistics, outputs.error_estimate,
-                           result);
+    detail::sweepReference(field, prepared.heights, prepared.base, options, outputs.statistics,
+                           outputs.error_estimate, result);
     if (!outputs.visible_count) result.visible_count.clear();
   } else {
-    detail::naiveReference(field, prepared.heights, options, result);
+    detail::naiveReference(field, prepared.heights, prepared.base, options, result);
   }
   if (!outputs.statistics) result.statistics = {};
   return result;

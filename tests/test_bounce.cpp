@@ -95,8 +95,11 @@ Wedge wedgeFor(const float* normal, double cos_az, double sin_az, double sector)
 // Expected irradiance of every present receiver entry of line j: for receiver r, sample x
 // (farther) is visible when no present node (a sample, or a peak between two samples, an
 // occluder alone: detail::IntervisibilityLines) strictly between lies strictly above the chord
-// x-r. The visible samples' elevations split into bands: at the mean elevation between two
-// visible samples with no hidden node between them, else at the nearer one's elevation.
+// x-r, or when the steepest of them hides it only within the heights' rounding, as it does
+// every hidden sample between them (the tie rule, as tests/test_intervisibility.cpp's brute
+// force takes it). The visible samples' elevations split
+// into bands: at the mean elevation between two visible samples with no hidden sample between
+// them, else at the nearer one's elevation.
 // `sector`: the direction's wedge of azimuth.
 void expectBruteForceGather(const detail::BounceLineView& view, double sector) {
   const auto& d = view.lines.geometry;
@@ -128,15 +131,22 @@ void expectBruteForceGather(const detail::BounceLineView& view, double sector) {
       // Visible flags, nearest first, keeping the steepest node so far.
       std::vector<bool> visible(r, false);
       int best = -1;
+      bool forgiving = false;  // every hidden sample since `best` was forgiven its rounding
       for (int x = r - 1; x >= 0; --x) {
-        const bool hidden = best >= 0 && detail::chordSide(height(x), height(best), height(r),
-                                                           nodes[best].position - nodes[x].position,
-                                                           nodes[r].position - nodes[best].position) > 0;
-        if (!hidden) visible[x] = true, best = x;
+        const float dab = nodes[best < 0 ? x : best].position - nodes[x].position,
+                    dbc = nodes[r].position - nodes[best < 0 ? x : best].position;
+        const bool hidden = best >= 0 && detail::chordSide(height(x), height(best), height(r), dab, dbc) > 0;
+        if (!hidden) {
+          visible[x] = true, best = x, forgiving = true;
+        } else if (!nodes[x].peak) {
+          forgiving = forgiving && detail::seen_within_rounding(height(x), height(best), height(r), dab, dbc,
+                                                                view.lines.height_base);
+          visible[x] = forgiving;
+        }
       }
-      auto adjacent = [&](int a, int b) {  // no hidden node between visible samples a < b
+      auto adjacent = [&](int a, int b) {  // no hidden sample between visible samples a < b
         for (int k = a + 1; k < b; ++k)
-          if (!visible[k]) return false;
+          if (!visible[k] && !nodes[k].peak) return false;
         return true;
       };
       std::vector<int> seen;  // visible samples, farthest first

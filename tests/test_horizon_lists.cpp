@@ -59,11 +59,12 @@ std::vector<bool> listedVisible(const DirectionHorizons& list, const std::vector
 // The lists of one receiver and direction against brute force (with per-row spacing, `unit` the
 // ground length of the positions' units); adds the peaks it admits to *peaks_admitted.
 void expectListEqualsBruteForce(const DirectionHorizons& list, const std::vector<float>& ray, float hr,
-                                const RayPeaks& peaks, double unit = 0.0, long* peaks_admitted = nullptr) {
+                                const RayPeaks& peaks, float height_base, double unit = 0.0,
+                                long* peaks_admitted = nullptr) {
   auto distance = [&](int i) {
     return peaks.positions.empty() ? i * list.sample_spacing : peaks.positions[i - 1] * unit;
   };
-  const HorizonListReference expected = referenceHorizonList(ray, hr, peaks);
+  const HorizonListReference expected = referenceHorizonList(ray, hr, peaks, height_base);
   if (peaks_admitted) *peaks_admitted += expected.peaks_admitted;
   ASSERT_EQ(list.ray_samples, static_cast<int>(ray.size()));
   std::vector<int> horizons;
@@ -80,8 +81,13 @@ void expectListEqualsBruteForce(const DirectionHorizons& list, const std::vector
     ASSERT_TRUE(expected.visible[h.sample]);
     ASSERT_DOUBLE_EQ(h.distance, distance(h.sample));
     ASSERT_DOUBLE_EQ(h.elevation, std::atan2(double(ray[h.sample - 1]) - hr, h.distance));
-    ASSERT_GE(h.elevation, previous_elevation - 1e-12);
-    previous_elevation = h.elevation;
+    // Farther horizons stand higher, but for a sample seen only with the heights' rounding
+    // forgiven (listed as the farthest of a horizon's forgiven stretch), which may stand a hair
+    // lower.
+    if (expected.exactly[h.sample]) {
+      ASSERT_GE(h.elevation, previous_elevation - 1e-12);
+      previous_elevation = h.elevation;
+    }
     ASSERT_EQ(h.segment_end, h.sample + 1);
     ASSERT_GT(h.segment_begin, previous);
     ASSERT_DOUBLE_EQ(h.near_distance, distance(h.segment_begin));
@@ -145,7 +151,7 @@ void expectListsEqualBruteForceOnEveryHardCase(bool row_spacing) {
             continue;
           }
           const RayPeaks peaks = rayPeaks(field, prepared.heights, directions, k, c, r, options);
-          expectListEqualsBruteForce(list, ray, hr, peaks, unit);
+          expectListEqualsBruteForce(list, ray, hr, peaks, prepared.base, unit);
           if (::testing::Test::HasFatalFailure()) return;
           const bool differs =
               referenceHorizonList(ray, hr, {peaks.shift, peaks.positions, {}, {}}).visible !=
@@ -347,7 +353,8 @@ void cityAgainstTheLineOfSight(bool row_spacing, LineOfSightCounts& counts) {
       const detail::SweepDirection& d = directions[k];
       const auto ray = referenceRay(field, prepared.heights, d, c, r);
       const RayPeaks peaks = rayPeaks(field, prepared.heights, directions, k, c, r, options);
-      expectListEqualsBruteForce(lists[n].directions[k], ray, float(hr), peaks, unit, &counts.peaks_inserted);
+      expectListEqualsBruteForce(lists[n].directions[k], ray, float(hr), peaks, prepared.base, unit,
+                                 &counts.peaks_inserted);
       if (::testing::Test::HasFatalFailure()) return;
       ASSERT_EQ(peaks.positions.size(), row_spacing ? ray.size() : 0u)
           << "positions in units on rows of their own spacing";
@@ -468,7 +475,7 @@ void expectListsAgreeWithTheKernels(double curvature, bool row_spacing = false) 
         const float at = row_spacing ? float(peaks.positions[i - 1]) : float(i);  // steps, or units
         ray[i - 1] = ray[i - 1] - (row_spacing ? unit_drop : drop) * at * at;
       }
-      expectListEqualsBruteForce(list, ray, prepared.heights[p], peaks, unit);
+      expectListEqualsBruteForce(list, ray, prepared.heights[p], peaks, prepared.base, unit);
       if (::testing::Test::HasFatalFailure()) return;
     }
   }
@@ -520,7 +527,8 @@ TEST(HorizonLists, FarthestHorizonIsTheHorizonWhereNoPeakHidesIt) {
       const std::size_t p = std::size_t(k) * field.pixelCount() + std::size_t(r) * field.width + c;
       const auto ray = referenceRay(field, prepared.heights, directions[k], c, r);
       const auto visible =
-          referenceHorizonList(ray, hr, rayPeaks(field, prepared.heights, directions, k, c, r, options))
+          referenceHorizonList(ray, hr, rayPeaks(field, prepared.heights, directions, k, c, r, options),
+                               prepared.base)
               .visible;
       double highest = -M_PI / 2, highest_visible = -M_PI / 2;
       for (std::size_t i = 1; i <= ray.size(); ++i) {

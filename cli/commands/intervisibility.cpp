@@ -33,9 +33,13 @@ class Intervisibility : public Computation {
     requireFiniteResult(result_.visible_area, field, "visible area");
 
     Attributes attributes = job.attributes(field);
-    attributes.emplace_back("hfvis:tie_rule",
-                            "a sample is visible when its slope from the receiver is >= the slope of every "
-                            "sample between them (grazing samples are visible), decided exactly");
+    attributes.emplace_back(
+        "hfvis:tie_rule",
+        "a sample is visible when its slope from the receiver is >= the slope of every "
+        "sample between them (grazing samples are visible), or when the steepest of them "
+        "hides it only within the heights' rounding (2^-22 of the sum of the heights compared, "
+        "above the field's lowest, and of the highest one's absolute value), as it does every "
+        "hidden sample between them; each decision an exact sign");
     // The K run, which --max-error chooses, and the error estimate when there is one.
     for (auto& [name, value] : attributes)
       if (name == "hfvis:directions") value = std::to_string(result_.directions);
@@ -128,7 +132,9 @@ const CommandSpec kIntervisibilityCommand{
     "Tie rule   along direction k a pixel sees the samples q_i = p + i/S * d_k (S samples per\n"
     "           unit, bilinear heights, inside the field); q is visible when its slope from p is\n"
     "           >= the slope of every sample between them (grazing samples are visible: on a flat\n"
-    "           plane every sample is), decided exactly. Count: the visible samples summed over\n"
+    "           plane every sample is), or the steepest of them hides it only within the heights'\n"
+    "           rounding (a few units in the last place), as it does every hidden sample between\n"
+    "           them: on a tilted plane too every sample is. Count: the visible samples summed over\n"
     "           the K directions, each counting its step times S; an N x M flat plane gives\n"
     "           N + M - 2 at K = 4. The tree method runs on lines through the pixel centres along\n"
     "           integer steps (a, b) close to d_k, each pixel the receiver of its own line, its\n"

@@ -7,9 +7,10 @@
 // ground units, as ambient occlusion uses). Direction k stands for an azimuthal wedge of
 // width D around it (about 2*pi/K; see below). In the vertical plane of direction k, the visible samples x
 // at ground distance r_x and height difference dz_x are seen at elevations
-// theta_x = atan2(dz_x, r_x), which never decrease outward (visibility, tie rule as in
-// hfvis/intervisibility.hpp). Together they cover the elevations from the nearest visible
-// sample's to the farthest's, split into one band per visible sample:
+// theta_x = atan2(dz_x, r_x), which never decrease outward but within the heights' rounding
+// (visibility, tie rule as in hfvis/intervisibility.hpp: a sample hidden only within it is seen). Together
+// they cover the elevations from the nearest visible sample's to the farthest's, split into one band per
+// visible sample:
 //   - between two visible samples with no hidden sample between them (the surface piece
 //     between them is visible) at the mean of their two elevations;
 //   - across hidden samples (between a segment's horizon and the nearest visible sample of

@@ -26,7 +26,10 @@
 // samples (and peaks) from one segment start (Eq. 1 of the paper) to the receiver; its visible
 // segment runs from it toward the receiver up to the first hidden sample or the next horizon. A
 // horizon that is a peak is listed by the sample right after it (nearer), the farthest of its
-// segment, and not at all where that sample is hidden. The segments together hold every visible
+// segment, and not at all where that sample is hidden. A segment also takes the hidden samples
+// farther out that its horizon hides only within the heights' rounding (the tie rule forgives
+// it); it is then listed by the farthest of them, which may stand a hair lower than the next
+// nearer horizon. The segments together hold every visible
 // sample, each once; on a flat plane there is one horizon, the farthest sample, whose segment is
 // the whole ray.
 //
@@ -69,7 +72,8 @@ struct DirectionHorizons {
                                             // step's with per-row spacing)
   int ray_samples = 0;                      // samples on the ray inside the field, present or not
   int visible_samples = 0;                  // visible samples, the sum over the segments
-  std::vector<VisibilityHorizon> horizons;  // nearest first; elevations never decrease
+  std::vector<VisibilityHorizon> horizons;  // nearest first; elevations never decrease, but within
+                                            // the heights' rounding (a forgiven sample's)
 };
 
 struct ReceiverHorizons {

@@ -96,6 +96,32 @@ HFVIS_INLINE int chord_side(float ha, float hb, float hc, float dab, float dbc) 
   return exact_chord_side(ha, hb, hc, dab, dbc, dac);
 }
 
+// The heights' rounding, which the tie rule forgives (docs/ALGORITHMS.md, "Grazing samples and
+// the heights' rounding"). A sample's height is a bilinear interpolation rounded to a float, a
+// few units in the last place of the heights off the surface, and the heights themselves were
+// rounded to float32 at their absolute value (the kernels see them less the field's base,
+// `base`: the height of their 0). On a tilted plane that tips collinear samples above or below
+// one another's sight lines, and the exact sign then hides about half of them. So a sample that
+// the exact predicate hides behind sample b is still seen where it is seen with its own height
+// raised, and b's lowered, by 2^-22 of the sum of the three heights and of the highest one's
+// absolute value (a few times the roundings it covers, no more: a wall of a dozen units in the
+// last place still hides). Exact on those shifted heights, so every
+// implementation takes the same decision.
+// Sums, not the largest of the three (compares and selects made the hull tree 25 % slower on
+// a city of blocks); the absolute value taken is the highest height's (heights above the field's
+// lowest rise with their absolute values): with each height's own, PoCL no longer vectorised the
+// naive march's loop (4x slower).
+HFVIS_INLINE float rounding_forgiven(float ha, float hb, float hc, float base) {
+  const float highest = ha > hb ? (ha > hc ? ha : hc) : (hb > hc ? hb : hc);
+  return 0x1p-22f * (fabs(ha) + fabs(hb) + fabs(hc) + fabs(highest + base));
+}
+
+// Whether sample a (farther) is seen from c over sample b within the heights' rounding.
+HFVIS_INLINE int seen_within_rounding(float ha, float hb, float hc, float dab, float dbc, float base) {
+  const float d = rounding_forgiven(ha, hb, hc, base);
+  return chord_side(ha + d, hb - d, hc, dab, dbc) <= 0;
+}
+
 // The float filter of chord_side() alone, branch-free: returns whether it decides, and
 // then *side is the exact sign. For the naive march, whose straight-line loop PoCL
 // vectorises across work-items; rays with an undecided step are marched again with

@@ -1,9 +1,12 @@
 """Grazing samples on planes: the visible count (intervisibility, hull tree and naive march) and
 the viewshed of an eye on the surface, on a flat plane and on tilted ones, where under the tie
-rule (grazing samples see) every sample of the plane is visible from every other. The rule is
-decided exactly on the samples' float heights, whose rounding tips collinear samples of a tilted
-plane above or below one another's sight lines (docs/ALGORITHMS.md, "Grazing samples on tilted
-planes"). Writes a Markdown table to stdout.
+rule (grazing samples see) every sample of the plane is visible from every other. The samples'
+float heights are rounded, which tips collinear samples of a tilted plane above or below one
+another's sight lines; the visible counts forgive that rounding, the viewshed's march does not yet
+(docs/ALGORITHMS.md, "Grazing samples and the heights' rounding"). A second table shows what the
+tolerance also takes as ties: the Earth's drop between neighbouring samples on tilted planes, and
+sub-millimetre noise on a field at 1000 m (with and without one pixel at 0, which moves the
+heights above the field's lowest). Writes Markdown tables to stdout.
 
     build/python-venv/bin/python python/bench/tilted_plane.py
 """
@@ -33,6 +36,28 @@ def main():
                                                              method=method).visible_count))
                       for method in ("hull_tree", "naive")]
             print(f"| {name} | {k} | {counts[0]:.1f} | {counts[1]:.1f} | {seen:.3f} |")
+    print()
+    print("| field (K = 8) | hull tree | naive |")
+    print("| --- | ---: | ---: |")
+    cols = np.arange(64)[None, :] * np.ones((64, 1))
+    earth = 1.0 / (2.0 * 6371000.0)  # the drop per ground unit squared, no refraction
+    for grade in (0.0, 0.1, 0.3):
+        field = (100.0 + grade * 30.0 * cols).astype(np.float32)
+        counts = [float(np.nanmean(hfvis.intervisibility(field, directions=8, cell_size=30.0, curvature=earth,
+                                                         method=method).visible_count))
+                  for method in ("hull_tree", "naive")]
+        print(f"| 64 x 64, cells of 30, h = 100 + {grade * 30:g} column, the Earth's drop: mean count | "
+              f"{counts[0]:.2f} | {counts[1]:.2f} |")
+    noise = (1000.0 + np.random.default_rng(0).uniform(0.0, 0.002, (128, 128))).astype(np.float32)
+    for pit in (False, True):
+        field = noise.copy()
+        if pit:
+            field[0, 0] = 0.0
+        counts = [float(np.nanmedian(hfvis.intervisibility(field, directions=8, cell_size=1.0,
+                                                           method=method).visible_count))
+                  for method in ("hull_tree", "naive")]
+        print(f"| 128 x 128, 1000 + U(0, 2 mm){', one pixel at 0' if pit else ''}: median count | "
+              f"{counts[0]:.1f} | {counts[1]:.1f} |")
 
 
 if __name__ == "__main__":

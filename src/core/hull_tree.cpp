@@ -191,6 +191,7 @@ void IntervisibilityLines::resetResults(bool keep_horizons) {
   walks_skipped.assign(entries, 0);
   peak_horizons.assign(peaks.empty() ? 0 : entries, 0);
   horizon_steps.assign(keep_horizons ? entries : 0, {});
+  horizon_run_starts.assign(keep_horizons ? entries : 0, {});
   horizon_run_ends.assign(keep_horizons ? entries : 0, {});
 }
 

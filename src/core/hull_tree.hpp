@@ -172,6 +172,7 @@ struct IntervisibilityLines {
   int position_shift = 0;
   std::vector<float> peaks;
   std::vector<std::int32_t> peak_offsets;
+  float height_base = 0.0f;                  // the height the samples' 0 stands for (PreparedHeights::base)
   std::vector<std::uint32_t> peak_horizons;  // output: an inserted peak's m (statistics' bound)
   bool horizons_at_every_sample = true;  // else only receivers read theirs (the kernels without statistics)
   std::vector<float> samples;                 // sampled heights
@@ -182,9 +183,12 @@ struct IntervisibilityLines {
   std::vector<std::uint32_t> horizon_hashes;  // FNV-1a over the horizons' steps, farthest first
   std::vector<std::uint32_t> walks_skipped;   // 1 where the safe zone skipped the walk
   // Reference only, when asked: the horizons' steps, farthest first, and where each one's
-  // visible run ends (run_end(): the first hidden sample, the next horizon or the receiver),
-  // so horizon h's visible samples are the present ones of steps [h, end).
+  // visible run begins (the horizon, or the farthest sample of the hidden ones farther out that
+  // it hides only within the heights' rounding: forgiven_stretch()) and ends (run_end(): the
+  // first hidden sample, the next horizon or the receiver), so horizon h's visible samples are
+  // the present ones of slots [start, end).
   std::vector<std::vector<int>> horizon_steps;
+  std::vector<std::vector<int>> horizon_run_starts;
   std::vector<std::vector<int>> horizon_run_ends;
 
   // Every per-entry result for samples.size() entries: NaN counts and sums, zero statistics.
@@ -214,6 +218,7 @@ constexpr int kBounceNormalFloats = 3;
 // normals and radiance NaN at nodata pixels.
 struct BounceInputs {
   std::vector<float> heights;
+  float height_base = 0.0f;  // PreparedHeights::base of `heights`
   bool has_nodata = false;
   std::vector<std::vector<float>> normals;   // 3 planes
   std::vector<std::vector<float>> radiance;  // 1..4 planes

@@ -131,6 +131,7 @@ TreeKernel treeKernel(ContextState& st, cl::Program& program, const TreeDirectio
   k.kernel = NamedKernel(st, program, "intervisibility_lattice");  // the chunk's lines set per chunk
   NamedKernel& kernel = k.kernel;
   setLineSamplingArguments(kernel, k, d, width, height, b);
+  kernel.set("height_base", b.height_base);
   kernel.set("count_factor", d.count_factor);
   kernel.set("area_factor", d.area_factor);
   kernel.set("max_steps", d.max_steps);
@@ -218,6 +219,7 @@ void TreeRoutine::allocateScratch(std::size_t fixed_bytes) {
                                       st_.info, lineMajorLayout(st_)),
                       buffers_);
   buffers_.heights = heights_;
+  buffers_.height_base = prepared_.base;
 }
 
 void TreeRoutine::sweep(int direction, int) {
@@ -252,6 +254,7 @@ IntervisibilityLines treeLinesOnDevice(ContextState& st, const TreeProgramFlags&
   };
   const int channels = bounce ? bounce->channels() : 0;
   b.heights = upload(prepared_heights);
+  b.height_base = bounce ? bounce->height_base : 0.0f;
   b.count_sum = deviceBuffer(st, plane * sizeof(float));
   b.area_sum = deviceBuffer(st, plane * sizeof(float));
   b.radiance = bounce ? upload(joined(bounce->radiance)) : deviceBuffer(st, 0);
@@ -278,6 +281,7 @@ IntervisibilityLines treeLinesOnDevice(ContextState& st, const TreeProgramFlags&
   const auto chunks = chunkLines(lines, slots_per_period, entries, lineMajorLayout(st));
   IntervisibilityLines out = canonicalTreeLines(d);
   out.resetResults();
+  out.height_base = b.height_base;
   for (const LineChunk& chunk : chunks) {
     for (std::size_t j = chunk.first; j < chunk.first + chunk.count; ++j) {
       const std::size_t steps = lineCapacity(lines[j], d.samples.size());

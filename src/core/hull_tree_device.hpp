@@ -60,6 +60,7 @@ std::string treeProgramOptions(const TreeProgramFlags& flags, const ContextState
 // (deviceBuffer(st, 0)).
 struct TreeBuffers {
   cl::Buffer heights;
+  float height_base = 0.0f;  // PreparedHeights::base of `heights`
   cl::Buffer trees, prefix, positions, visible, entry_stats, peak_inputs;  // scratch, `scratch_entries` entries
   std::size_t scratch_entries = 0;
   cl::Buffer line_totals;          // kTreeLineTotals ulongs per line of the direction

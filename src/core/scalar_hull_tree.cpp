@@ -106,6 +106,26 @@ int runEnd(const LineView& line, int start, int next, float h_next, int receiver
   return next;
 }
 
+// Mirror of forgiven_stretch(): going farther out from horizon `horizon` (slot, height h_h) down
+// to step `floor`, no farther than the line's first present sample (rank 0), the present samples
+// it hides only within the heights' rounding, up to the first that is not; the farthest's step,
+// or -1.
+int forgivenStretch(const LineView& line, const std::vector<int>& ranks, int floor, int horizon, float h_h,
+                    int receiver, float h_receiver) {
+  const float p_h = line.position(horizon), p_r = line.position(receiver);
+  int farthest = -1;
+  for (int x = line.sampleOf(horizon) - 1; x >= floor; --x) {
+    const float hx = line.sampleHeight(x);
+    if (std::isnan(hx)) continue;
+    if (!seen_within_rounding(hx, h_h, h_receiver, p_h - line.position(line.slotOf(x)), p_r - p_h,
+                              line.lines.height_base))
+      break;
+    farthest = x;
+    if (ranks[line.slotOf(x)] == 0) break;  // the line's first present sample
+  }
+  return farthest;
+}
+
 // Mirror of the bounce gather of kernels/intervisibility.cl (BounceGather and its helpers):
 // the visible samples of one receiver, visited farthest first, each adding its radiance
 // times the projected solid angle of its elevation band.
@@ -140,8 +160,9 @@ class BounceGather {
     adjacent_ = true;
   }
 
-  // Whether the next sample visited is adjacent to the last one (no hidden sample between).
-  void setAdjacent(bool adjacent) { adjacent_ = adjacent; }
+  // At a run's end: whether the next sample visited stays adjacent to the last one (no hidden
+  // sample between). A run that visited none keeps the run's before it unless it breaks it.
+  void endRun(bool reached_next) { adjacent_ = adjacent_ && reached_next; }
 
   void finish(float* irradiance) {
     if (have_prev_) {
@@ -287,7 +308,7 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
       std::uint32_t m = 0, hash = kHorizonHashSeed;
       int count = 0;
       std::uint64_t distance_sum = 0;
-      std::vector<int> horizons, run_ends;
+      std::vector<int> horizons, run_starts, run_ends;
       const bool receiver = !peak && step % out.receiver_every == out.receiver_every - 1;
       const bool visit = receiver || out.horizons_at_every_sample;  // a peak's only for the statistics
       std::optional<BounceGather> gather;
@@ -380,6 +401,13 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
           int hp = head;
           Node hz = tree[hp];
           int hp_rank = ranks[hp];
+          // A horizon's run begins with its forgiven stretch (forgivenStretch), the farthest
+          // horizon's reaching back to the line's first sample, none past the cut.
+          int run_first = hp, run_first_rank = hp_rank;
+          if (hp_rank > 0) {
+            const int f = forgivenStretch(line, ranks, std::max(cut, 0), hp, hz.h, slot, h);
+            if (f >= 0) run_first = line.slotOf(f), run_first_rank = ranks[run_first];
+          }
           for (;;) {
             const int np = hz.next;
             ++m;
@@ -402,22 +430,31 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
                          : holes   ? ranks[end]
                                    : hp_rank + (line.sampleOf(end) - line.sampleOf(hp));
             }
-            if (keep_horizons) run_ends.push_back(end);
+            // The next horizon's forgiven stretch, over the hidden samples [end, np).
+            int np_first = np, np_first_rank = np_rank;
+            if (np != kNone && end != np) {
+              const int f =
+                  forgivenStretch(line, ranks, std::max(line.sampleOf(end), cut), np, nz.h, slot, h);
+              if (f >= 0) np_first = line.slotOf(f), np_first_rank = ranks[np_first];
+            }
+            const bool run_holes = end_rank - run_first_rank != line.sampleOf(end) - line.sampleOf(run_first);
+            if (keep_horizons) run_starts.push_back(run_first), run_ends.push_back(end);
             if (gather) {
-              for (int x = hp; x < end; ++x) {
+              for (int x = run_first; x < end; ++x) {
                 if (!line.isSample(x)) continue;
                 const int xs = line.sampleOf(x);
                 const float hx = line.sampleHeight(xs);
                 if (!std::isnan(hx)) gather->visit(hx, xs, line.entry(xs));
               }
-              gather->setAdjacent(end == np);
+              gather->endRun(end == np_first);
             }
             // Within the maximum distance: the run's samples from `first` on (the slot of the
             // first step within it, its peak's with peaks).
-            const int first = cut > line.sampleOf(hp) ? (line.peaks() ? 2 * cut : cut) : hp;
-            const int first_rank = first == hp ? hp_rank
-                                   : holes     ? ranks[first]
-                                               : hp_rank + (line.sampleOf(first) - line.sampleOf(hp));
+            const int first = cut > line.sampleOf(run_first) ? (line.peaks() ? 2 * cut : cut) : run_first;
+            const int first_rank = first == run_first ? run_first_rank
+                                   : run_holes
+                                       ? ranks[first]
+                                       : run_first_rank + (line.sampleOf(first) - line.sampleOf(run_first));
             const int run = first < end ? end_rank - first_rank : 0;
             count += run;
             std::uint64_t steps_sum = 0;
@@ -427,7 +464,7 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
               const std::uint64_t units = unit_sums[end] - unit_sums[first];
               distance_sum += static_cast<std::uint64_t>(out.positions[line.entry(step)]) * units -
                               (weighted_sums[end] - weighted_sums[first]);
-            } else if (!holes) {
+            } else if (!run_holes) {
               steps_sum = static_cast<std::uint64_t>(run) *
                           static_cast<std::uint64_t>(line.sampleOf(first) + line.sampleOf(end) - 1) / 2;
             } else {
@@ -440,6 +477,8 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
             hz = nz;
             hp = np;
             hp_rank = np_rank;
+            run_first = np_first;
+            run_first_rank = np_first_rank;
           }
           if (refresh_zone) {
             zone.end();
@@ -456,6 +495,7 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
         out.horizon_hashes[e] = hash;
         if (keep_horizons) {
           out.horizon_steps[e] = std::move(horizons);
+          out.horizon_run_starts[e] = std::move(run_starts);
           out.horizon_run_ends[e] = std::move(run_ends);
         }
         if (gather) gather->finish(&bounce->irradiance[e * bounce->channels]);

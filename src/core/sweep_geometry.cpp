@@ -158,6 +158,7 @@ PreparedHeights prepareHeights(const HeightField& field, HeightOrigin origin, in
   }
   const double base = origin == HeightOrigin::Lowest ? lowest : 0.0;  // h - 0.0 is h exactly
   PreparedHeights prepared;
+  if (base != std::numeric_limits<double>::max()) prepared.base = static_cast<float>(base * field.z_scale);
   prepared.heights.resize(count);
   std::vector<char> band_nodata(bands, 0);
   const double z_scale = field.z_scale;

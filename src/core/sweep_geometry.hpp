@@ -79,6 +79,10 @@ struct PreparedHeights {
   // are), as prepareHeights sets them (a routine preparing heights of its own, as the bounce's,
   // leaves them so: only the region operation reads them, from prepareHeights).
   float lowest = std::numeric_limits<float>::infinity(), highest = -std::numeric_limits<float>::infinity();
+  // The z-scaled height that `heights` hold as 0 (the shift: the lowest finite height, or the
+  // base of the field this one was cut from; 0 from HeightOrigin::Zero). The visibility tie rule
+  // forgives the rounding of heights at their absolute value, prepared height + base.
+  float base = 0.0f;
 };
 enum class HeightOrigin { Lowest, Zero };
 // `bands`: the bands of rows it runs in (core/host_bands.hpp); 0, bandsFor's (tests give others:

@@ -43,7 +43,9 @@ class BounceRoutine : public TreeRoutine {
  private:
   PreparedHeights prepare() override {
     inputs_ = prepareBounce(field_, radiance_);
-    return {inputs_.heights, inputs_.has_nodata};
+    PreparedHeights prepared{inputs_.heights, inputs_.has_nodata};
+    prepared.base = inputs_.height_base;
+    return prepared;
   }
 
   void allocate() override {

@@ -20,6 +20,7 @@ BounceInputs prepareBounce(const HeightField& field, const ExitRadiance& radianc
   BounceInputs in;
   PreparedHeights prepared = prepareHeights(field);
   in.heights = std::move(prepared.heights);
+  in.height_base = prepared.base;
   in.has_nodata = prepared.has_nodata;
   const std::size_t plane = field.pixelCount();
   in.normals.assign(3, std::vector<float>(plane, kNaN));

@@ -101,9 +101,10 @@ HorizonRay horizonRay(const HeightField& field, const std::vector<float>& height
 
 namespace {
 
-DirectionHorizons listDirection(const HeightField& field, const std::vector<float>& heights,
+DirectionHorizons listDirection(const HeightField& field, const detail::PreparedHeights& prepared,
                                 const detail::SweepDirection& d, int k, double azimuth, int c, int r,
                                 double curvature, const std::int32_t* units, double unit, int shift) {
+  const std::vector<float>& heights = prepared.heights;
   DirectionHorizons out;
   out.direction = k;
   out.azimuth = azimuth;
@@ -126,6 +127,7 @@ DirectionHorizons listDirection(const HeightField& field, const std::vector<floa
   line.geometry.n_lines = 1;
   line.geometry.n_steps = n + 1;
   line.geometry.buffer_offset = 0;
+  line.height_base = prepared.base;
   line.samples.resize(static_cast<std::size_t>(n) + 1);
   for (int s = 0; s < n; ++s) line.samples[s] = ray[n - 1 - s];
   line.samples[n] = h;
@@ -152,12 +154,16 @@ DirectionHorizons listDirection(const HeightField& field, const std::vector<floa
   detail::sweepPresampledLines(line, HullTreeTuning{}, true);
 
   // The horizons and their runs are tree slots (with peaks, 2 s + 1 for step s's sample and 2 s
-  // for the peak before it): a run [slot, end) holds the samples of steps [slot >> 1, end >> 1).
+  // for the peak before it): a run [start, end) holds the samples of steps [start >> 1, end >> 1).
+  // A run starts at its horizon, or farther out where the horizon hides samples only within the
+  // heights' rounding (the tie rule forgives it); the segment is then listed by the farthest of
+  // those, which may stand a hair lower than the next nearer horizon.
   const int slot_shift = samples.peaks.empty() ? 0 : 1;
   const std::vector<int>& slots = line.horizon_steps[n];  // farthest first
+  const std::vector<int>& starts = line.horizon_run_starts[n];
   const std::vector<int>& ends = line.horizon_run_ends[n];
   for (std::size_t idx = slots.size(); idx-- > 0;) {  // nearest first
-    const int first_step = slots[idx] >> slot_shift, end_step = ends[idx] >> slot_shift;
+    const int first_step = starts[idx] >> slot_shift, end_step = ends[idx] >> slot_shift;
     // A peak is no sample: its segment is the samples nearer than it up to the first hidden one
     // (the sample right after it, a present one, when any), listed by the farthest of them;
     // where even that one is hidden, the peak bounds no segment.
@@ -228,7 +234,7 @@ std::vector<ReceiverHorizons> computeHorizonLists(const HeightField& field, cons
     for (int k = 0; k < options.directions; ++k) {
       const std::int32_t* units =
           row_spacing ? &rows.units[k * (2 * static_cast<std::size_t>(field.height) - 1)] : nullptr;
-      receiver.directions.push_back(listDirection(field, prepared.heights, directions[k], k,
+      receiver.directions.push_back(listDirection(field, prepared, directions[k], k,
                                                   directionAzimuth(k, options), p.col, p.row,
                                                   options.curvature, units, unit, shift));
     }

@@ -188,6 +188,7 @@ class CountRoutine : public TreeRoutine {
     allocateTreeScratch(st_, flags_, directions_, plan_.scratch_entries, buffers_);
     buffers_.radiance = buffers_.normals = buffers_.irradiance = deviceBuffer(st_, 0);
     const bool halves = outputs_.error_estimate;
+    buffers_.height_base = prepared_.base;
     if (!inStrips()) {
       const std::size_t plane = field_.pixelCount();
       buffers_.heights = heights_;
@@ -382,6 +383,7 @@ class NaiveCountRoutine : public SweepRoutine {
     naive.set("directions", directions);
     naive.set("batch_size", count);
     naive.set("sector", intervisibilitySector(visibility_));
+    naive.set("height_base", prepared_.base);
     // With per-row spacing positions are units: the drop per unit squared, distances in units.
     const double per_unit = unit_ * unit_;
     naive.set("curvature", static_cast<float>(visibility_.curvature * (unit_ > 0.0 ? per_unit : 1.0)));

@@ -20,6 +20,7 @@ std::vector<float> referenceRay(const HeightField& field, const std::vector<floa
 
 struct HorizonListReference {
   std::vector<bool> visible;  // by sample index i (0 unused)
+  std::vector<bool> exactly;  // visible without the rounding forgiven
   std::vector<int> horizons;  // sample indices, nearest first
   int peaks_admitted = 0;     // the peaks among the occluders
 };
@@ -39,10 +40,13 @@ struct RayPeaks {
 // Brute force on the ray (sample i at ray[i - 1], receiver height hr at distance 0), every node
 // at its position: a sample is visible when it is present and no present sample and no peak
 // nearer than it (one that tree_peak_inserted admits: strictly above the chord of its interval's
-// samples, at its offset of the interval's positions) lies strictly above the sight line.
+// samples, at its offset of the interval's positions) lies strictly above the sight line, or
+// where the steepest of them hides it only within the heights' rounding and so do the hidden
+// samples between it and the next visible node farther out (kernels/shared/chord_side.cl).
 // Horizons by Eq. 1 and 2 over the samples and those peaks alike; a peak that is a horizon is
-// listed by the sample right after it (nearer) where that one is visible.
-HorizonListReference referenceHorizonList(const std::vector<float>& ray, float hr,
-                                          const RayPeaks& peaks = {});
+// listed by the sample right after it (nearer) where that one is visible. `height_base`: the
+// height the ray's 0 stands for (PreparedHeights::base), for the rounding forgiven.
+HorizonListReference referenceHorizonList(const std::vector<float>& ray, float hr, const RayPeaks& peaks = {},
+                                          float height_base = 0.0f);
 
 }  // namespace hfvis
