@@ -252,17 +252,17 @@ HFVIS_INLINE int run_end(__global const int4* tree, __global const int2* positio
 }
 
 // The stretch of hidden samples that `horizon` (slot; height h_h, position p_h) hides only
-// within the heights' rounding (chord_side.cl): going farther out from it, down to step `floor`
+// within the heights' rounding (chord_side.cl): going farther out from it, down to step `last_step`
 // and no farther than the line's first present sample, every present sample seen over it within
 // the rounding, up to the first that is not. Such samples are seen (the tie rule: on a tilted
 // plane every sample is, though the rounding tips about half of them below the sight line of a
 // nearer one). Returns the step of the farthest, or -1 where there is none. Absent samples
 // neither count nor end the stretch.
 HFVIS_INLINE int forgiven_stretch(__global const int4* tree, __global const int2* positions, uint stride,
-                                  int shift, int floor, int horizon, float h_h, float p_h, float p_receiver,
-                                  float h_receiver, float height_base) {
+                                  int shift, int last_step, int horizon, float h_h, float p_h,
+                                  float p_receiver, float h_receiver, float height_base) {
   int farthest = -1;
-  for (int x = SAMPLE_OF(horizon) - 1; x >= floor; --x) {
+  for (int x = SAMPLE_OF(horizon) - 1; x >= last_step; --x) {
     const int4 node = tree[(uint)SLOT_OF(x) * stride];
     const float hx = as_float(node.x);
     if (isnan(hx)) continue;

@@ -107,14 +107,14 @@ int runEnd(const LineView& line, int start, int next, float h_next, int receiver
 }
 
 // Mirror of forgiven_stretch(): going farther out from horizon `horizon` (slot, height h_h) down
-// to step `floor`, no farther than the line's first present sample (rank 0), the present samples
+// to step `last_step`, no farther than the line's first present sample (rank 0), the present samples
 // it hides only within the heights' rounding, up to the first that is not; the farthest's step,
 // or -1.
-int forgivenStretch(const LineView& line, const std::vector<int>& ranks, int floor, int horizon, float h_h,
-                    int receiver, float h_receiver) {
+int forgivenStretch(const LineView& line, const std::vector<int>& ranks, int last_step, int horizon,
+                    float h_h, int receiver, float h_receiver) {
   const float p_h = line.position(horizon), p_r = line.position(receiver);
   int farthest = -1;
-  for (int x = line.sampleOf(horizon) - 1; x >= floor; --x) {
+  for (int x = line.sampleOf(horizon) - 1; x >= last_step; --x) {
     const float hx = line.sampleHeight(x);
     if (std::isnan(hx)) continue;
     if (!seen_within_rounding(hx, h_h, h_receiver, p_h - line.position(line.slotOf(x)), p_r - p_h,
