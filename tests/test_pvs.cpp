@@ -474,6 +474,8 @@ PvsGrid estimateGrid() {
   return grid;
 }
 
+// (AGVS's among them from the silhouette mutations that follow depth discontinuities, Sec. 4.4:
+// the city's walls give some, and only AGVS draws silhouette mutations.)
 TEST(Pvs, EveryEntryHasAWitness) {
   const HeightField field = smallCity();
   for (PvsMethod method : {PvsMethod::Agvs, PvsMethod::Sgvs, PvsMethod::PerCell}) {
@@ -487,6 +489,11 @@ TEST(Pvs, EveryEntryHasAWitness) {
     const PvsResult pvs = computePvs(testContext(), field, grid, options);
     EXPECT_GT(pvs.entries(), 100u);
     checkWitnesses(field, grid, pvs);
+    if (method == PvsMethod::Agvs) {
+      EXPECT_GT(pvs.discontinuities, 0u);
+    } else {
+      EXPECT_EQ(pvs.discontinuities, 0u);
+    }
   }
 }
 
@@ -596,7 +603,7 @@ TEST(Pvs, EstimatedPixelErrorWithinAFactorTwoOfTheMeasured) {
     const std::vector<HeightRay> check = randomViewRays(field, grid, 2000000, 99);
     const RayCastResult hits = castHeightFieldRays(testContext(), field, check);
     for (PvsMethod method : {PvsMethod::Agvs, PvsMethod::Sgvs, PvsMethod::PerCell})
-      for (std::uint64_t samples : {30000u, 100000u, 200000u}) {
+      for (std::uint64_t samples : {30000u, 100000u, 150000u}) {
         PvsOptions options;
         options.method = method;
         options.samples = samples;
@@ -681,6 +688,7 @@ TEST(Pvs, APixelErrorBudgetGoesOnWhereTheSettledEstimateMissesIt) {
     PvsOptions options;
     options.pixel_error = budget;
     options.batch = 2000;
+    options.seed = 3;  // (one whose runs go on at 400 and 200; seed 1's all settle within the budget)
     const PvsResult pvs = computePvs(testContext(), field, grid, options);
     EXPECT_LE(pvs.pixel_error, budget);
     bool settled = false;

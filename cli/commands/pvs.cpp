@@ -249,6 +249,7 @@ class Pvs : public Computation {
          << "  \"entries\": " << r.entries() << ",\n"
          << "  \"filtered_entries\": " << r.filtered << ",\n"
          << "  \"rejected_witnesses\": " << r.rejected << ",\n"
+         << "  \"discontinuities\": " << r.discontinuities << ",\n"
          << "  \"conventions\": "
          << jsonString(
                 "cells are the squares between grid points (column, row of their lower corner); view cell "

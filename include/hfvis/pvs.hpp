@@ -180,6 +180,9 @@ struct PvsResult {
   std::uint64_t estimate_samples = 0;    // view-direction samples settling the estimate (PvsOptions::estimate_entries)
   std::uint64_t rejected = 0;  // candidate entries whose witness failed the line-of-sight test
   std::uint64_t filtered = 0;  // entries the visibility filter added (no witness)
+  // Silhouette mutations drawn from a depth discontinuity (AGVS; Sec. 4.4): a silhouette ray that
+  // passed its object's silhouette and hit a surface more than 3 tile radii beyond it.
+  std::uint64_t discontinuities = 0;
   double pixel_error = 0.0;    // the estimate at the end (NaN before any estimate)
   // The uniform view rays the estimate rests on (view-direction and per-cell samples' rays): it is
   // pixel_error * uniform_rays / resolution of them that found an entry no other sample found

@@ -23,7 +23,7 @@ RegionPairVisibility = collections.namedtuple(
     "RegionPairVisibility", "bits sources receivers source_fraction receiver_fraction clear_pairs pairs "
     "visible_fraction sources_xy receivers_xy")
 Pvs = collections.namedtuple("Pvs", "sets bits computed layout samples rays entries rejected filtered pixel_error "
-                                    "seconds history witnesses estimate_samples")
+                                    "seconds history witnesses estimate_samples discontinuities")
 
 # Lighting and fields of view take row 0 as north: a DataArray whose rows run south-up (or
 # columns west) is computed flipped.
@@ -745,7 +745,7 @@ def pvs(heights, *, samples=0, pixel_error=0.0, seconds=0.0, view_cell=32, band_
     return Pvs(sets, bits, computed.astype(bool), out["layout"], int(out["samples"]), int(out["rays"]),
                int(out["entries"]), int(out["rejected"]), int(out["filtered"]), float(out["pixel_error"]),
                float(out["seconds"]), list(out["history"]), out["witnesses"] if witnesses else None,
-               int(out["estimate_samples"]))
+               int(out["estimate_samples"]), int(out["discontinuities"]))
 
 
 def horizon_lists(heights, receivers, *, directions=64, azimuth_offset=0.0, samples_per_unit=1.0, curvature=0.0,

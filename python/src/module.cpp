@@ -505,6 +505,7 @@ nb::dict pvs(const HeightField& field, const PvsGrid& grid, PvsOptions options, 
   out["rays"] = r.rays;
   out["rejected"] = r.rejected;
   out["filtered"] = r.filtered;
+  out["discontinuities"] = r.discontinuities;
   out["pixel_error"] = r.pixel_error;
   out["seconds"] = r.seconds;
   std::vector<int> view_cells, tiles;

@@ -28,6 +28,9 @@ constexpr double kMinProbability = 0.02;
 constexpr std::size_t kMutationCandidates = 1 << 16;
 // Discovery rays per silhouette mutation (Sec. 4.4: a search along the perpendicular).
 constexpr int kDiscoveryRays = 4;
+// A silhouette ray whose hit lies beyond its end by more than this many object radii reports a
+// depth discontinuity (Sec. 4.4, after Wonka et al. 2006's reverse sampling; the paper's k = 3).
+constexpr double kDiscontinuityRadii = 3.0;
 // The most uniform rays a pixel-error budget alone may ask for (at 5M rays a second, days).
 constexpr double kMaxPixelErrorRays = 1e12;
 // The view space-direction samples' least probability in the mixture: the pixel error is
@@ -125,6 +128,8 @@ struct Sample {
   // The first sample of its line of mutations (itself when not a mutation): the pixel error's
   // leave-one-out does not count a sample's own mutations as finding its entry again.
   std::uint64_t lineage = 0;
+  // A silhouette mutation drawn from a depth discontinuity (Sec. 4.4): it reports none itself.
+  bool follow_up = false;
 };
 
 class Sampler {
@@ -383,7 +388,12 @@ class Sampler {
       }
       case kSilhouetteMutation: {
         // The discovery rays are cast first (silhouette()); here the candidate and the direction.
-        const MutationCandidate c = mutations_.take();
+        // A depth discontinuity an earlier silhouette ray reported comes first (Sec. 4.4: its
+        // segment from the silhouette point to the far hit is mutated in turn).
+        const bool follow_up = !discontinuities_.empty();
+        const MutationCandidate c = follow_up ? discontinuities_.front() : mutations_.take();
+        if (follow_up) discontinuities_.pop_front(), ++out_.discontinuities;
+        s.follow_up = follow_up;
         s.lineage = c.lineage;
         const Vec axis = c.target - c.origin;
         const Vec off = perpendicularGaussian(Vec{}, axis, 1.0);
@@ -540,6 +550,7 @@ class Sampler {
       }
       if (s.distribution == kViewDirection) uniform_rays_ += 2;
       contribution[s.distribution] += total;
+      if (s.distribution == kSilhouetteMutation && !s.follow_up && !settling_) discontinuity(s, rays, r, i);
       // Mutation candidates (Sec. 4.4): each end that contributed, the other end its origin.
       if (options_.method == PvsMethod::Agvs && !settling_)
         for (int end = 0; end < 2; ++end) {
@@ -567,6 +578,27 @@ class Sampler {
       out_.pixel_error = options_.resolution * double(std::max<std::size_t>(1, only_finders_.size())) /
                          double(uniform_rays_);
     if (options_.method == PvsMethod::Agvs && !settling_) updateMixture(contribution, drawn);
+  }
+
+  // Sec. 4.4's depth discontinuity: the silhouette sample's forward ray passed its end (the point
+  // just off the object's silhouette, at t = 1/2 from the segment's middle) and hit a surface more
+  // than kDiscontinuityRadii object radii beyond it. Instead of searching for the discontinuity
+  // itself (Wonka et al. 2006's reverse sampling), the segment from that end to the far hit is
+  // queued for a silhouette mutation of its own (drawn before the buffer's candidates), so the
+  // samples go along the far object's visible edge behind the silhouette. Only hits beyond the
+  // end: a hit before it is an occluder the search's own rays did not meet, not a silhouette.
+  void discontinuity(const Sample& s, const std::vector<HeightRay>& rays, const detail::RayCasts& r, int i) {
+    const std::size_t k = 2 * std::size_t(i);
+    if (r.cell[k] < 0 || !(r.t[k] > 0.5f)) return;
+    const Vec end = s.origin + 0.5 * s.direction, hit = hitPoint(rays[k], r.t[k]), gap = hit - end;
+    if (!(dot(gap, gap) > kDiscontinuityRadii * kDiscontinuityRadii * tile_radius_ * tile_radius_)) return;
+    MutationCandidate c;
+    c.origin = end;
+    c.target = hit;
+    c.origin_radius = c.target_radius = tile_radius_;
+    c.tile = out_.layout.tileOfCell(r.cell[k]);
+    c.lineage = s.lineage;
+    discontinuities_.push_back(c);
   }
 
   Vec hitPoint(const HeightRay& q, float t) const {
@@ -671,6 +703,7 @@ class Sampler {
   double last_weight_[kPvsDistributions] = {0, 0, 0, 0, 0};
   MutationBuffer mutations_;
   std::vector<Silhouette> silhouettes_;
+  std::deque<MutationCandidate> discontinuities_;  // Sec. 4.4's depth discontinuities, to mutate next
   std::uint64_t uniform_rays_ = 0;  // uniform view rays cast so far (foundAgain)
   bool settling_ = false;           // settle(): view-direction samples alone
   double settle_seconds_ = 0.0;     // the time settle() took
