@@ -684,25 +684,28 @@ TEST(Pvs, APixelErrorBudgetGoesOnWhereTheSettledEstimateMissesIt) {
   const HeightField field = makeSyntheticField("city", 97, 97, 7);
   const PvsGrid grid = estimateGrid();
   int went_on = 0;
-  for (double budget : {1000.0, 400.0, 200.0, 30.0}) {
-    PvsOptions options;
-    options.pixel_error = budget;
-    options.batch = 2000;
-    options.seed = 3;  // (one whose runs go on at 400 and 200; seed 1's all settle within the budget)
-    const PvsResult pvs = computePvs(testContext(), field, grid, options);
-    EXPECT_LE(pvs.pixel_error, budget);
-    bool settled = false;
-    for (std::size_t i = 0; i < pvs.history.size(); ++i) {
-      if (pvs.history[i].settling) settled = true;
-      if (settled && !pvs.history[i].settling) {
-        ++went_on;
-        break;
+  // Seeds in turn until one run goes on: whether a budget's settled estimate misses it is a matter
+  // of the stream (of seeds 1 - 5 at these budgets, some go on at one budget or two, others at none).
+  for (std::uint32_t seed = 1; seed <= 5 && went_on == 0; ++seed)
+    for (double budget : {1000.0, 400.0, 200.0, 30.0}) {
+      PvsOptions options;
+      options.pixel_error = budget;
+      options.batch = 2000;
+      options.seed = seed;
+      const PvsResult pvs = computePvs(testContext(), field, grid, options);
+      EXPECT_LE(pvs.pixel_error, budget);
+      bool settled = false;
+      for (std::size_t i = 0; i < pvs.history.size(); ++i) {
+        if (pvs.history[i].settling) settled = true;
+        if (settled && !pvs.history[i].settling) {
+          ++went_on;
+          break;
+        }
       }
+      options.estimate_entries = 0;
+      const PvsResult plain = computePvs(testContext(), field, grid, options);
+      EXPECT_LE(plain.samples, pvs.samples - pvs.estimate_samples) << budget << " seed " << seed;
     }
-    options.estimate_entries = 0;
-    const PvsResult plain = computePvs(testContext(), field, grid, options);
-    EXPECT_LE(plain.samples, pvs.samples - pvs.estimate_samples) << budget;
-  }
   EXPECT_GT(went_on, 0);  // (else this test does not reach what it tests)
 }
 

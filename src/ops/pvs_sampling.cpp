@@ -26,8 +26,11 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kMinProbability = 0.02;
 // Mutation candidates kept (Sec. 4.4: the highest mutation count is dropped when full).
 constexpr std::size_t kMutationCandidates = 1 << 16;
-// Discovery rays per silhouette mutation (Sec. 4.4: a search along the perpendicular).
+// The silhouette mutation's search along the perpendicular (Sec. 4.4): rounds of discovery rays,
+// each splitting the interval that holds the silhouette in kDiscoveryRays (the paper's quaternary
+// search of depth 3: "packets of 4 rays").
 constexpr int kDiscoveryRays = 4;
+constexpr int kSearchRounds = 3;
 // A silhouette ray whose hit lies beyond its end by more than this many object radii reports a
 // depth discontinuity (Sec. 4.4, after Wonka et al. 2006's reverse sampling; the paper's k = 3).
 constexpr double kDiscontinuityRadii = 3.0;
@@ -410,32 +413,62 @@ class Sampler {
     return s;
   }
 
-  // Sec. 4.4's silhouette search: from s_o toward s_t + lambda r(o) d, lambda = 1/4 .. 1, the
-  // least lambda whose ray misses the object becomes the sample's target (lambda = 1 when all hit).
+  // Sec. 4.4's silhouette search: from s_o toward s_t + lambda r(o) d. The first round casts
+  // lambda = 1/4 .. 1; each later round splits the interval between the last lambda that hit the
+  // object and the first that missed it in four (three new rays, the miss known), kSearchRounds in
+  // all. The least lambda found to miss becomes the sample's target (lambda = 1 when all hit: then
+  // no later round). The rays each sample cast are counted in silhouette_rays_ (the mixture's cost).
   void silhouettes(detail::RayCaster& caster, std::vector<Sample>& samples) {
     if (silhouettes_.empty()) return;
-    std::vector<HeightRay> rays;
-    for (const Silhouette& s : silhouettes_)
-      for (int i = 1; i <= kDiscoveryRays; ++i) {
-        const Vec end = s.candidate.target + (s.candidate.target_radius * i / kDiscoveryRays) * s.direction;
-        rays.push_back(ray(s.candidate.origin, end - s.candidate.origin));
+    const std::size_t n = silhouettes_.size();
+    std::vector<double> hit(n, 0.0), missed(n, 1.0);  // the interval holding the silhouette
+    std::vector<char> searching(n, 1);
+    silhouette_rays_ = 0;
+    for (int round = 0; round < kSearchRounds; ++round) {
+      const int last = round == 0 ? kDiscoveryRays : kDiscoveryRays - 1;
+      std::vector<HeightRay> rays;
+      std::vector<std::size_t> owner;
+      for (std::size_t j = 0; j < n; ++j) {
+        if (!searching[j]) continue;
+        const Silhouette& s = silhouettes_[j];
+        for (int i = 1; i <= last; ++i) {
+          const double lambda = hit[j] + (missed[j] - hit[j]) * i / kDiscoveryRays;
+          const Vec end = s.candidate.target + (s.candidate.target_radius * lambda) * s.direction;
+          rays.push_back(ray(s.candidate.origin, end - s.candidate.origin));
+        }
+        owner.push_back(j);
       }
-    const detail::RayCasts hits = caster.cast(rays, false);
-    out_.rays += rays.size();
+      if (rays.empty()) break;
+      const detail::RayCasts hits = caster.cast(rays, false);
+      out_.rays += rays.size();
+      silhouette_rays_ += rays.size();
+      const int per = last;
+      for (std::size_t o = 0; o < owner.size(); ++o) {
+        const std::size_t j = owner[o];
+        const Silhouette& s = silhouettes_[j];
+        const double low = hit[j], high = missed[j];
+        int miss = -1;
+        for (int i = 1; i <= last; ++i) {
+          const int cell = hits.cell[o * per + (i - 1)];
+          if (cell < 0 || out_.layout.tileOfCell(cell) != s.candidate.tile) {
+            miss = i;
+            break;
+          }
+        }
+        if (miss < 0 && round == 0) {  // every ray hit the object: lambda = 1, no narrowing
+          searching[j] = 0;
+          continue;
+        }
+        const int at = miss < 0 ? kDiscoveryRays : miss;  // (later rounds: the known miss)
+        hit[j] = low + (high - low) * (at - 1) / kDiscoveryRays;
+        missed[j] = low + (high - low) * at / kDiscoveryRays;
+      }
+    }
     std::size_t next = 0;
     for (Sample& sample : samples) {
       if (sample.distribution != kSilhouetteMutation) continue;
       const Silhouette& s = silhouettes_[next];
-      int chosen = kDiscoveryRays;
-      for (int i = 1; i <= kDiscoveryRays; ++i) {
-        const int cell = hits.cell[next * kDiscoveryRays + i - 1];
-        if (cell < 0 || out_.layout.tileOfCell(cell) != s.candidate.tile) {
-          chosen = i;
-          break;
-        }
-      }
-      const Vec end =
-          s.candidate.target + (s.candidate.target_radius * chosen / kDiscoveryRays) * s.direction;
+      const Vec end = s.candidate.target + (s.candidate.target_radius * missed[next]) * s.direction;
       sample.origin = 0.5 * (s.candidate.origin + end);
       sample.direction = end - s.candidate.origin;
       ++next;
@@ -625,7 +658,8 @@ class Sampler {
   }
 
   // Sec. 4.2 with the window one batch: weight = contribution per sample per cost, the cost
-  // counted in rays (a silhouette mutation casts kDiscoveryRays more), so that a seed reproduces
+  // counted in rays (a silhouette mutation casts its discovery rays more, silhouette_rays_ over the
+  // batch's), so that a seed reproduces
   // the run exactly (a wall-clock cost would not).
   void updateMixture(const std::vector<double>& contribution, const std::vector<double>& drawn) {
     std::vector<double> weight(kPvsDistributions, 0.0);
@@ -633,7 +667,8 @@ class Sampler {
     for (int d = 0; d < kPvsDistributions; ++d) {
       const bool available = d < kTwoPointMutation || !mutations_.empty();
       if (!available) continue;
-      const double cost = d == kSilhouetteMutation ? 2.0 + kDiscoveryRays : 2.0;
+      const double cost =
+          d == kSilhouetteMutation && drawn[d] > 0.0 ? 2.0 + double(silhouette_rays_) / drawn[d] : 2.0;
       // A distribution not drawn this batch keeps its last weight.
       weight[d] = drawn[d] > 0.0 ? contribution[d] / drawn[d] / cost : last_weight_[d];
       if (!(weight[d] > 0.0)) weight[d] = 1e-12;
@@ -703,6 +738,7 @@ class Sampler {
   double last_weight_[kPvsDistributions] = {0, 0, 0, 0, 0};
   MutationBuffer mutations_;
   std::vector<Silhouette> silhouettes_;
+  std::size_t silhouette_rays_ = 0;                // the discovery rays of this batch's silhouette mutations
   std::deque<MutationCandidate> discontinuities_;  // Sec. 4.4's depth discontinuities, to mutate next
   std::uint64_t uniform_rays_ = 0;  // uniform view rays cast so far (foundAgain)
   bool settling_ = false;           // settle(): view-direction samples alone
