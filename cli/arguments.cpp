@@ -836,6 +836,13 @@ const std::vector<OptionSpec>& optionTable() {
        [](const std::string& typed, const std::string& value, RunArguments& run) {
          run.pvs.filter = parseBounded(typed, value, 0.0, 1e6, "1e6");
        }},
+      {"--view-filter", nullptr, "N", kPvsGroup, false,
+       "the view-space filter: each view cell also takes the sampled sets of\n"
+       "its N neighbours (0 .. 8) whose sets are the most like its own (no\n"
+       "witness; default 0, none)",
+       [](const std::string& typed, const std::string& value, RunArguments& run) {
+         run.pvs.view_filter = static_cast<int>(parseWholeIn(typed, value, 0.0, 8.0, "neighbours", "0 .. 8"));
+       }},
       {"--seed", nullptr, "N", kPvsGroup, false,
        "the sampling's seed, 0 .. 4294967295 (default 1): the same seed and\n"
        "budget of samples, the same sets",

@@ -3439,6 +3439,11 @@ TEST_F(Cli, PvsResumesFromAnEarlierBitset) {
                 .status,
             0);
   refused(" --view-cell 8 --tile 4 --seed 3 --resume " + shellQuoted(out("f.bin")), "written with --filter");
+  ASSERT_EQ(run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out("g.json")) +
+                " --samples 300 --view-filter 3 " + "--bitset " + shellQuoted(out("g.bin")) + grid)
+                .status,
+            0);
+  refused(" --view-cell 8 --tile 4 --seed 3 --resume " + shellQuoted(out("g.bin")), "--view-filter");
   std::string first_version = readText(out("a.bin"));
   first_version[8] = 1;
   { std::ofstream(out("v1.bin"), std::ios::binary) << first_version; }

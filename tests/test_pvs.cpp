@@ -766,6 +766,64 @@ TEST(Pvs, FilterOnlyAdds) {
     EXPECT_EQ(filtered.bits[i] & plain.bits[i], plain.bits[i]);
 }
 
+// The object-space filter adds no tile without a surface: a tile whose every cell has a nodata
+// corner is no object (it added such tiles around every visible neighbour).
+TEST(Pvs, FilterAddsNoTileWithoutASurface) {
+  HeightField field = smallCity();
+  for (int row = 12; row <= 16; ++row)  // tile (3, 3) of 4 x 4 cells: cells 12 .. 15, points 12 .. 16
+    for (int col = 12; col <= 16; ++col) field.heights[std::size_t(row) * field.width + col] = NAN;
+  const PvsGrid grid = smallGrid();
+  PvsOptions options;
+  options.method = PvsMethod::Sgvs;
+  options.samples = 20000;
+  options.filter = 4.0;
+  const PvsResult pvs = computePvs(testContext(), field, grid, options);
+  const int hole = 3 * pvs.layout.tiles_x + 3;
+  EXPECT_GT(pvs.filtered, 0u);
+  EXPECT_TRUE(pvs.visible(0, hole - 1) || pvs.visible(1, hole - 1));  // (a neighbour is seen)
+  for (int v = 0; v < pvs.layout.viewCells(); ++v) EXPECT_FALSE(pvs.visible(v, hole)) << v;
+}
+
+// Sec. 5's view-space filter: each view cell gets the sampled sets of its `view_filter` most
+// similar neighbours (Jaccard's index, ties to the lower index), worked out here from the
+// unfiltered run; with 8 every neighbour that shares an entry.
+TEST(Pvs, ViewFilterTakesTheMostSimilarNeighbours) {
+  const HeightField field = smallCity();
+  const PvsGrid grid = smallGrid();
+  PvsOptions options;
+  options.method = PvsMethod::Sgvs;
+  options.samples = 3000;
+  const PvsResult plain = computePvs(testContext(), field, grid, options);
+  const PvsLayout& l = plain.layout;
+  ASSERT_GE(l.view_x, 3);
+  for (int neighbours : {1, 3, 8}) {
+    options.view_filter = neighbours;
+    const PvsResult filtered = computePvs(testContext(), field, grid, options);
+    std::vector<std::uint32_t> expected = plain.bits;
+    for (int v = 0; v < l.viewCells(); ++v) {
+      std::vector<std::pair<double, int>> like;
+      for (int u = 0; u < l.viewCells(); ++u) {
+        const int dx = u % l.view_x - v % l.view_x, dy = u / l.view_x - v / l.view_x;
+        if (u == v || std::abs(dx) > 1 || std::abs(dy) > 1) continue;
+        int both = 0, either = 0;
+        for (int t = 0; t < l.tiles(); ++t) {
+          both += plain.visible(v, t) && plain.visible(u, t);
+          either += plain.visible(v, t) || plain.visible(u, t);
+        }
+        if (both > 0) like.push_back({-double(both) / either, u});
+      }
+      std::sort(like.begin(), like.end());
+      for (int i = 0; i < int(like.size()) && i < neighbours; ++i)
+        for (int w = 0; w < plain.words; ++w)
+          expected[std::size_t(v) * plain.words + w] |=
+              plain.bits[std::size_t(like[i].second) * plain.words + w];
+    }
+    EXPECT_EQ(filtered.bits, expected) << neighbours;
+    EXPECT_EQ(filtered.entries(), plain.entries() + filtered.filtered);
+    EXPECT_GT(filtered.filtered, 0u) << neighbours;
+  }
+}
+
 TEST(Pvs, BadInput) {
   const HeightField field = smallCity();
   PvsOptions options;
@@ -796,6 +854,14 @@ TEST(Pvs, BadInput) {
   options.samples = 10;
   options.batch = 0;
   EXPECT_THROW(run(smallGrid()), InvalidArgument);
+  options.batch = 1 << 16;
+  for (int neighbours : {-1, 9}) {
+    options.view_filter = neighbours;
+    EXPECT_THROW(run(smallGrid()), InvalidArgument) << neighbours;
+  }
+  options.view_filter = 8;
+  EXPECT_NO_THROW(run(smallGrid()));
+  options.view_filter = 0;
   EXPECT_THROW(castHeightFieldRays(testContext(), field, {HeightRay{NAN, 0, 0, 1, 0, 0, 1}}),
                InvalidArgument);
 }

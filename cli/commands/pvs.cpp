@@ -38,8 +38,8 @@ std::uint32_t getU32(const char* at) {
 
 // What a bitset's sets were computed from, which a run resumed from them must share: the field
 // (its heights' bits, size, cell sizes and z-scale, as a 64-bit hash), the view band, and whether
-// the visibility filter added entries. A bitset of another field was resumed, and its sets,
-// seen through a wall this field has, went out as this field's (exit 0).
+// a visibility filter (--filter, --view-filter) added entries. A bitset of another field was resumed, and its
+// sets, seen through a wall this field has, went out as this field's (exit 0).
 struct BitsetOrigin {
   std::uint64_t field = 0;
   float band_low = 0.0f, band_high = 0.0f;
@@ -54,7 +54,8 @@ BitsetOrigin originOf(const HeightField& field, const PvsGrid& grid, const PvsOp
   };
   for (const int v : {field.width, field.height}) mix(&v, sizeof v);
   for (const double v : {field.cell_size_x, field.cell_size_y, field.z_scale}) mix(&v, sizeof v);
-  return {hash, static_cast<float>(grid.band_low), static_cast<float>(grid.band_high), options.filter > 0.0};
+  return {hash, static_cast<float>(grid.band_low), static_cast<float>(grid.band_high),
+          options.filter > 0.0 || options.view_filter > 0};
 }
 
 std::uint32_t floatBits(float v) {
@@ -137,8 +138,8 @@ BitsetFile readBitsetFile(const std::string& path, const PvsLayout& l, const Bit
                      "): a resumed run adds to the sets of the same field and band");
   if (u32(56) != 0)
     throw UsageError("--resume: " + path +
-                     " was written with --filter, whose entries a resumed run would take "
-                     "for sampled ones: resume only from steps run without it");
+                     " was written with --filter or --view-filter, whose entries a resumed run "
+                     "would take for sampled ones: resume only from steps run without them");
   const std::uint64_t padded = (views + 3) / 4 * 4, size = kBitsetHeader + padded + 4 * views * f.words;
   in.seekg(0, std::ios::end);
   if (std::uint64_t(in.tellg()) != size)
@@ -408,7 +409,8 @@ const CommandSpec kPvsCommand{
     "potentially visible sets: the tiles each view cell can see, as JSON",
     "IN -o OUT.json (--samples N | --pixel-error E | --seconds S) [--view-cell C]\n"
     "[--view-height H0[,H1]] [--view-mask MASK] [--tile T] [--method agvs|sgvs|per-cell]\n"
-    "[--estimate-entries N] [--filter K] [--seed N] [--bitset OUT.bin] [--resume PREV.bin]\n"
+    "[--estimate-entries N] [--filter K] [--view-filter N] [--seed N] [--bitset OUT.bin]\n"
+    "[--resume PREV.bin] "
     "[--preview P.png] [--preview-view-cell COL,ROW] [options]",
     "Potentially visible sets (Bittner, Mattausch, Wonka, Havran & Wimmer 2009): for every view\n"
     "cell, a square of C x C cells (--view-cell, default 32; a cell is the square between four\n"
@@ -427,14 +429,15 @@ const CommandSpec kPvsCommand{
     "(--estimate-entries N, 0: off; estimate_samples in the JSON).\n"
     "--view-mask MASK (a raster of the field's size): only the view cells holding a non-zero\n"
     "pixel (its first channel) are computed. --filter K: Sec. 5's object-space filter, K\n"
-    "times the sampling's gap.\n"
+    "times the sampling's gap. --view-filter N: Sec. 5's view-space filter, each view cell\n"
+    "taking the sampled sets of its N most similar neighbours (of 8).\n"
     "Writes JSON: the grids, samples, estimated pixel error, the mixture per batch and, per view\n"
     "cell, its visible tiles' row-major indices. --bitset OUT.bin: the sets as bits, laid out\n"
     "in docs/PVS.md. The preview shows the PVS size per view cell over a hillshade, or with\n"
     "--preview-view-cell COL,ROW the tiles the view cell holding that pixel sees.\n"
     "--resume PREV.bin --seed S: go on from an earlier run's --bitset file (same field and\n"
     "grid) with a seed it did not use: runs of a few seconds each, resumed in turn, give the\n"
-    "sets written at every step (no --filter in them). samples and the estimate are this\n"
+    "sets written at every step (no filter in them). samples and the estimate are this\n"
     "run's; resumed_from names the file and its entries.\n",
     nullptr,
     kOutputGroup | kInputGroup | kImageGroup | kDeviceGroup | kPvsGroup,

@@ -124,6 +124,11 @@ struct PvsOptions {
   // every tile within k 2 d / sqrt(n) of a visible tile, d its distance from the view cell, n the
   // samples per view cell; counted in PvsResult::filtered, with no witness.
   double filter = 0.0;
+  // Sec. 5's view-space filter (0 = none, at most 8): each computed view cell's set also takes the
+  // sampled entries of the view_filter neighbouring computed view cells (of its 8) whose sampled
+  // sets are the most like its own (Jaccard's index; ties to the lower index); counted in
+  // PvsResult::filtered with the object-space filter's, with no witness.
+  int view_filter = 0;
   // Settling the estimate: when a budget ends with fewer than this many entries found once by a
   // uniform view ray (the entries PvsResult::pixel_error counts), but one at least, view-direction
   // samples go on until that many carry it, at most as many samples as the run cast before them
@@ -198,7 +203,7 @@ struct PvsResult {
 };
 
 // Throws InvalidArgument for no budget, a negative or non-finite budget, a batch below 1, a
-// negative or non-finite filter or resolution below 1.
+// negative or non-finite filter, a view filter outside 0 .. 8 or resolution below 1.
 void validate(const PvsOptions& options);
 
 // The sampled PVS of every computed view cell. Throws InvalidArgument (bad field, grid or

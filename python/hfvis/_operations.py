@@ -699,7 +699,7 @@ def region_pair_visibility(heights, sources, receivers, *, samples=16, source_he
 
 
 def pvs(heights, *, samples=0, pixel_error=0.0, seconds=0.0, view_cell=32, band_low=1.7, band_high=1.7, tile=16,
-        mask=None, method="agvs", batch=1 << 16, seed=1, resolution=1e6, filter=0.0, estimate_entries=20,
+        mask=None, method="agvs", batch=1 << 16, seed=1, resolution=1e6, filter=0.0, view_filter=0, estimate_entries=20,
         witnesses=False, memory_budget_bytes=0, start=None, cell_size=None, z_scale=1.0, nodata=None, device="",
         progress=None):
     """Potentially visible sets (Bittner, Mattausch, Wonka, Havran & Wimmer 2009): the tiles of
@@ -713,7 +713,9 @@ def pvs(heights, *, samples=0, pixel_error=0.0, seconds=0.0, view_cell=32, band_
     batch) and witnesses (with witnesses=True). DataArrays: the same (the sets are not on the
     pixel grid); computed in one piece. start: an earlier run's bits (its Pvs.bits) on the same
     field and grid, to go on from; its entries stay (give another seed, or its samples repeat; no
-    filter, and not the bits of a filtered run). estimate_entries: when a budget leaves the
+    filter, and not the bits of a filtered run). filter: the object-space filter's k; view_filter:
+    the view-space filter's neighbours, 0 .. 8 (both add entries without witness, counted in
+    filtered). estimate_entries: when a budget leaves the
     estimate on fewer entries found once (one at least), uniform view rays go on until that many
     carry it, at most as many samples (and seconds) as the run took before them (estimate_samples
     counts them, history rows say "settling"; 0: off)."""
@@ -726,7 +728,7 @@ def pvs(heights, *, samples=0, pixel_error=0.0, seconds=0.0, view_cell=32, band_
                "mask": None if mask is None else _arrays.as_array(mask, "mask"),
                "method": method, "batch": _whole("batch", batch, None, 2**31 - 1),
                "seed": _whole("seed", seed, 0, 2**32 - 1), "resolution": _real("resolution", resolution),
-               "filter": _real("filter", filter),
+               "filter": _real("filter", filter), "view_filter": _whole("view_filter", view_filter, 0, 8),
                "estimate_entries": int(estimate_entries), "witnesses": bool(witnesses),
                "memory_budget_bytes": _budget(memory_budget_bytes),
                "start": None if start is None else np.ascontiguousarray(start, dtype=np.uint32).ravel()}

@@ -362,6 +362,7 @@ def test_pvs(tmp_path, projected_tif, dem):
     r = hfvis.pvs(dem, samples=30000, view_cell=48, tile=32, band_low=2, band_high=20, seed=5, cell_size=30,
                   nodata=NODATA, progress=lambda samples, error: calls.append(samples))
     assert r.samples == printed["samples"] and r.rays == printed["rays"] and r.entries == printed["entries"]
+    assert r.discontinuities == printed["discontinuities"]
     assert r.layout["view_x"] == printed["view_cells"]["across"] and r.layout["tiles_y"] == printed["tiles"]["down"]
     assert [None if s is None else s.tolist() for s in r.sets] == printed["pvs"]
     assert r.entries > 0 and calls and calls[-1] == r.samples
@@ -372,6 +373,12 @@ def test_pvs(tmp_path, projected_tif, dem):
     more = hfvis.pvs(dem, samples=10000, view_cell=48, tile=32, band_low=2, band_high=20, seed=6, cell_size=30,
                      nodata=NODATA, start=r.bits)
     assert np.all(r.bits & ~more.bits == 0) and more.entries > r.entries
+    # The view-space filter only adds, its entries counted in filtered; 9 neighbours are refused.
+    merged = hfvis.pvs(dem, samples=30000, view_cell=48, tile=32, band_low=2, band_high=20, seed=5, cell_size=30,
+                       nodata=NODATA, view_filter=8)
+    assert np.all(r.bits & ~merged.bits == 0) and merged.entries == r.entries + merged.filtered > r.entries
+    with pytest.raises(hfvis.InvalidArgumentError, match="view_filter"):
+        hfvis.pvs(dem, samples=100, cell_size=30, nodata=NODATA, view_filter=9)
     # The settled estimate: its samples counted apart, as the CLI's JSON; 0 turns it off.
     assert r.estimate_samples == printed["estimate_samples"]
     assert [row["settling"] for row in r.history] == [row["settling"] for row in printed["progress"]]

@@ -214,7 +214,7 @@ class Sampler {
                                (options_.seconds <= 0.0 || out_.seconds < options_.seconds);
       if (!(options_.pixel_error > 0.0 && out_.pixel_error > options_.pixel_error && budget_left)) break;
     }
-    if (options_.filter > 0.0) filter();
+    if (options_.filter > 0.0 || options_.view_filter > 0) filters();
   }
 
  private:
@@ -688,12 +688,25 @@ class Sampler {
     }
   }
 
-  // Sec. 5's object-space filter with the global extension e = k 2 d / sqrt(n_v): n_v the
-  // samples that reached view cell v (counted while sampling), d the distance between v's and
-  // the tile's centres; every tile within e of a visible tile is added (no witness).
-  void filter() {
+  // Sec. 5's filters, both from the sampled sets: what they add is counted in PvsResult::filtered.
+  void filters() {
+    const std::vector<std::uint32_t> sampled = out_.bits;
+    if (options_.filter > 0.0) objectFilter(sampled);
+    if (options_.view_filter > 0) viewFilter(sampled);
+    out_.filtered = 0;
+    for (std::size_t i = 0; i < sampled.size(); ++i)
+      out_.filtered += __builtin_popcount(out_.bits[i] & ~sampled[i]);
+  }
+
+  // Sec. 5's object-space filter with the global extension e = k 2 d / sqrt(n): n the run's
+  // samples per sampled view cell, d the distance between the view cell's and the tile's centres;
+  // every tile within e of a visible tile is added (no witness), if it has a surface (a tile whose
+  // every cell has a nodata corner is no object). Tiles adjoin, so any e > 0 reaches the ring
+  // around a tile: the paper's local extension (at most the tile's radius over the root of the
+  // samples that hit it) would cap e below a tile's width for k < sqrt 2, where it already adds
+  // one ring, and is not built.
+  void objectFilter(const std::vector<std::uint32_t>& sampled) {
     const PvsLayout& l = out_.layout;
-    std::vector<std::uint32_t> bits = out_.bits;
     const double samples_per_cell =
         double(out_.samples) / double(std::max<std::size_t>(1, sampled_views_.size()));
     for (int v = 0; v < l.viewCells(); ++v) {
@@ -701,7 +714,7 @@ class Sampler {
       const double vx = ((v % l.view_x) + 0.5) * l.view_cell * cx_,
                    vy = ((v / l.view_x) + 0.5) * l.view_cell * cy_;
       for (int t = 0; t < l.tiles(); ++t) {
-        if (!out_.visible(v, t)) continue;
+        if (!((sampled[std::size_t(v) * out_.words + t / 32] >> (t % 32)) & 1u)) continue;
         const double tx = ((t % l.tiles_x) + 0.5) * l.tile * cx_, ty = ((t / l.tiles_x) + 0.5) * l.tile * cy_;
         const double e = options_.filter * 2.0 * std::hypot(tx - vx, ty - vy) / std::sqrt(samples_per_cell);
         const int rx = int(std::ceil(e / (l.tile * cx_))), ry = int(std::ceil(e / (l.tile * cy_)));
@@ -709,14 +722,41 @@ class Sampler {
           for (int x = std::max(0, t % l.tiles_x - rx); x <= std::min(l.tiles_x - 1, t % l.tiles_x + rx);
                ++x) {
             const int u = y * l.tiles_x + x;
-            bits[std::size_t(v) * out_.words + u / 32] |= 1u << (u % 32);
+            if (!tile_cells_[u].empty()) out_.bits[std::size_t(v) * out_.words + u / 32] |= 1u << (u % 32);
           }
       }
     }
-    out_.filtered = 0;
-    for (std::size_t i = 0; i < bits.size(); ++i)
-      out_.filtered += __builtin_popcount(bits[i] & ~out_.bits[i]);
-    out_.bits = std::move(bits);
+  }
+
+  // Sec. 5's view-space filter: each computed view cell takes the sampled sets of the
+  // view_filter computed neighbours (of its 8) whose sampled sets are the most like its own by
+  // Jaccard's index (shared entries over the union's; ties to the lower index; neighbours with
+  // no entries in common are not taken).
+  void viewFilter(const std::vector<std::uint32_t>& sampled) {
+    const PvsLayout& l = out_.layout;
+    const int words = out_.words;
+    for (int v = 0; v < l.viewCells(); ++v) {
+      if (!out_.computed[v]) continue;
+      std::vector<std::pair<double, int>> like;  // (- similarity, neighbour)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int x = v % l.view_x + dx, y = v / l.view_x + dy, u = y * l.view_x + x;
+          if ((dx == 0 && dy == 0) || x < 0 || y < 0 || x >= l.view_x || y >= l.view_y || !out_.computed[u])
+            continue;
+          std::size_t both = 0, either = 0;
+          for (int w = 0; w < words; ++w) {
+            const std::uint32_t a = sampled[std::size_t(v) * words + w],
+                                b = sampled[std::size_t(u) * words + w];
+            both += __builtin_popcount(a & b);
+            either += __builtin_popcount(a | b);
+          }
+          if (both > 0) like.push_back({-double(both) / double(either), u});
+        }
+      std::sort(like.begin(), like.end());
+      for (std::size_t i = 0; i < like.size() && int(i) < options_.view_filter; ++i)
+        for (int w = 0; w < words; ++w)
+          out_.bits[std::size_t(v) * words + w] |= sampled[std::size_t(like[i].second) * words + w];
+    }
   }
 
   struct Silhouette {
@@ -783,6 +823,9 @@ void validate(const PvsOptions& options) {
   if (options.batch < 1) throw InvalidArgument("the batch must hold at least 1 sample");
   if (!std::isfinite(options.filter) || options.filter < 0.0)
     throw InvalidArgument("the visibility filter's k must be finite and >= 0");
+  if (options.view_filter < 0 || options.view_filter > 8)
+    throw InvalidArgument("the view-space filter takes 0 .. 8 neighbouring view cells, not " +
+                          std::to_string(options.view_filter));
   if (!std::isfinite(options.resolution) || options.resolution < 1.0)
     throw InvalidArgument("the pixel error's resolution must be at least 1 ray");
 }
