@@ -433,8 +433,16 @@ class Sampler {
         const Silhouette& s = silhouettes_[j];
         for (int i = 1; i <= last; ++i) {
           const double lambda = hit[j] + (missed[j] - hit[j]) * i / kDiscoveryRays;
-          const Vec end = s.candidate.target + (s.candidate.target_radius * lambda) * s.direction;
-          rays.push_back(ray(s.candidate.origin, end - s.candidate.origin));
+          const Vec end = s.candidate.target + (s.candidate.target_radius * lambda) * s.direction,
+                    span = end - s.candidate.origin;
+          rays.push_back(ray(s.candidate.origin, span));
+          // Only whether the ray meets the object first matters (Sec. 4.4: "the region of
+          // interest can be restricted to the bounding volume of the object"): it ends once it is
+          // 4 radii past the end across the ground (the end lies within a radius of the hit
+          // point, the object within two of it), so a ray that misses the object stops there
+          // instead of crossing the field. The same hit or miss as an unbounded ray.
+          const double across = std::hypot(span.x, span.y);
+          if (across > 0.0) rays.back().t_max = float(1.0 + 4.0 * s.candidate.target_radius / across);
         }
         owner.push_back(j);
       }
