@@ -1071,32 +1071,34 @@ TEST(IntervisibilityAnalytic, EveryPointOfATiltedPlaneSeesEveryOther) {
 // behind it, also where one pixel far away (an unflagged -9999) moves the field's lowest (the
 // heights above it, about 10 100, are then rounded to about a millimetre, and the tolerance is a
 // few of those: an earlier one, 2^-18 of their sum, made a 5 cm wall transparent), and on a
-// tilted plane.
+// tilted plane; in both layouts.
 TEST(IntervisibilityAnalytic, AWallOfTwoCentimetresHidesWhateverTheFieldsLowest) {
-  for (float tilt : {0.0f, 0.1f}) {
-    for (bool pit : {false, true}) {
-      for (auto method : {IntervisibilityMethod::HullTree, IntervisibilityMethod::Naive}) {
-        SCOPED_TRACE(std::string(method == IntervisibilityMethod::Naive ? "naive" : "tree") + ", tilt " +
-                     std::to_string(tilt) + (pit ? ", a pixel at -9999" : ""));
-        const int w = 64, h = 16;
-        std::vector<float> open(static_cast<std::size_t>(w) * h);
-        for (int r = 0; r < h; ++r)
-          for (int c = 0; c < w; ++c) open[static_cast<std::size_t>(r) * w + c] = 100.0f + tilt * float(c);
-        if (pit) open.back() = -9999.0f;
-        std::vector<float> walled = open;
-        for (int r = 0; r < h; ++r) walled[static_cast<std::size_t>(r) * w + 32] += 0.02f;
-        IntervisibilityOptions options;
-        options.directions = 8;
-        options.method = method;
-        IntervisibilityOutputs outputs;
-        outputs.visible_count = true;
-        const auto without = computeIntervisibility(testContext(), fieldFrom(w, h, open), options, outputs);
-        const auto with = computeIntervisibility(testContext(), fieldFrom(w, h, walled), options, outputs);
-        const std::size_t before_wall = static_cast<std::size_t>(8) * w + 10;
-        EXPECT_LT(with.visible_count[before_wall] + 20.0f, without.visible_count[before_wall]);
+  testing::forEachLayout([&](const ComputeContext& context) {
+    for (float tilt : {0.0f, 0.1f}) {
+      for (bool pit : {false, true}) {
+        for (auto method : {IntervisibilityMethod::HullTree, IntervisibilityMethod::Naive}) {
+          SCOPED_TRACE(std::string(method == IntervisibilityMethod::Naive ? "naive" : "tree") + ", tilt " +
+                       std::to_string(tilt) + (pit ? ", a pixel at -9999" : ""));
+          const int w = 64, h = 16;
+          std::vector<float> open(static_cast<std::size_t>(w) * h);
+          for (int r = 0; r < h; ++r)
+            for (int c = 0; c < w; ++c) open[static_cast<std::size_t>(r) * w + c] = 100.0f + tilt * float(c);
+          if (pit) open.back() = -9999.0f;
+          std::vector<float> walled = open;
+          for (int r = 0; r < h; ++r) walled[static_cast<std::size_t>(r) * w + 32] += 0.02f;
+          IntervisibilityOptions options;
+          options.directions = 8;
+          options.method = method;
+          IntervisibilityOutputs outputs;
+          outputs.visible_count = true;
+          const auto without = computeIntervisibility(context, fieldFrom(w, h, open), options, outputs);
+          const auto with = computeIntervisibility(context, fieldFrom(w, h, walled), options, outputs);
+          const std::size_t before_wall = static_cast<std::size_t>(8) * w + 10;
+          EXPECT_LT(with.visible_count[before_wall] + 20.0f, without.visible_count[before_wall]);
+        }
       }
     }
-  }
+  });
 }
 
 // Analytic: behind a wall nothing farther is seen; the wall's top is.
