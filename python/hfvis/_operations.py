@@ -367,11 +367,19 @@ def _azimuths_deg(options):
     return np.degrees(np.asarray(probe["azimuths"]))
 
 
+def _max_error(value):
+    """max_error as a float, or None where it asks for none (None, False or 0)."""
+    if value in (None, False):
+        return None
+    return _real("max_error", value) or None  # ("x" was float()'s bare ValueError)
+
+
 def _with_estimate(options, heights, max_error, error_estimate):
     """Adds max_error and error_estimate to the options; a Dask-backed DataArray is computed, since
     K and the estimate's mean or percentile are the whole field's: it runs in one piece."""
-    if max_error not in (None, False) and _real("max_error", max_error):  # ("x" was float()'s bare ValueError)
-        options["max_error"] = _real("max_error", max_error)
+    error = _max_error(max_error)
+    if error is not None:
+        options["max_error"] = error
     if error_estimate:
         options["error_estimate"] = True
     if _is_dataarray(heights) and _is_dask(heights.data):
@@ -599,8 +607,9 @@ def environment_light(heights, environment, *, rotation_deg=0.0, table_rows=0, d
     options.update(environment=environment, rotation_deg=_real("rotation_deg", rotation_deg),
                    table_rows=_whole("table_rows", table_rows, 0, 2**31 - 1))
     common = _common(cell_size, z_scale, nodata, device, progress)
-    if max_error not in (None, False) and _real("max_error", max_error):
-        options["max_error"] = _real("max_error", max_error)
+    error = _max_error(max_error)
+    if error is not None:
+        options["max_error"] = error
         if _is_dataarray(heights) and _is_dask(heights.data):
             heights = _computed(heights)  # K and the estimate's percentile are the whole field's: in one piece
     if _is_dataarray(heights) and _is_dask(heights.data):
