@@ -630,31 +630,36 @@ TEST(Pvs, EstimatedPixelErrorWithinAFactorTwoOfTheMeasured) {
 TEST(Pvs, TheEstimateSettlesOnEnoughEntriesFoundOnce) {
   const HeightField field = makeSyntheticField("noise", 97, 97, 7);
   const PvsGrid grid = estimateGrid();
+  // (A budget that leaves the sets short of complete, on fewer than 20 entries found once: with the
+  // sets complete no ray can differ, and nothing settles.)
+  const std::uint64_t budget = 60000;
   PvsOptions options;
-  options.samples = 100000;
+  options.samples = budget;
   options.batch = 20000;
   options.estimate_entries = 0;
   const PvsResult plain = computePvs(testContext(), field, grid, options);
   EXPECT_EQ(plain.estimate_samples, 0u);
-  EXPECT_EQ(plain.samples, 100000u);
+  EXPECT_EQ(plain.samples, budget);
   const double plain_found_once = plain.pixel_error * double(plain.uniform_rays) / options.resolution;
   ASSERT_LT(plain_found_once, 19.5);  // (so that this budget leaves something to settle)
+  ASSERT_LT(plain.entries(), std::size_t(plain.layout.viewCells()) * plain.layout.tiles());
   options.estimate_entries = 20;
   const PvsResult settled = computePvs(testContext(), field, grid, options);
   ASSERT_GT(settled.estimate_samples, 0u);
-  EXPECT_LE(settled.estimate_samples, 100000u);
-  EXPECT_EQ(settled.samples, 100000u + settled.estimate_samples);
-  // Every settling sample a view-direction one: two uniform rays each (the first 100000 samples are
-  // the same in both runs).
+  EXPECT_LE(settled.estimate_samples, budget);
+  EXPECT_EQ(settled.samples, budget + settled.estimate_samples);
+  // Every settling sample a view-direction one: two uniform rays each (the first samples are the
+  // same in both runs).
   EXPECT_EQ(settled.uniform_rays - plain.uniform_rays, 2 * settled.estimate_samples);
   const double found_once = settled.pixel_error * double(settled.uniform_rays) / options.resolution;
-  EXPECT_TRUE(found_once > 19.5 || settled.estimate_samples == 100000u) << found_once;
+  EXPECT_TRUE(found_once > 19.5 || settled.estimate_samples == budget) << found_once;
   for (std::size_t i = 0; i < plain.bits.size(); ++i) ASSERT_EQ(plain.bits[i] & ~settled.bits[i], 0u) << i;
-  ASSERT_EQ(settled.history.size(), 5u + (settled.estimate_samples + 19999) / 20000);
+  const std::size_t batches = budget / 20000;
+  ASSERT_EQ(settled.history.size(), batches + (settled.estimate_samples + 19999) / 20000);
   for (std::size_t i = 0; i < settled.history.size(); ++i) {
-    EXPECT_EQ(settled.history[i].settling, i >= 5) << i;
-    if (i >= 5) {
-      EXPECT_EQ(settled.history[i].probability, settled.history[4].probability) << i;
+    EXPECT_EQ(settled.history[i].settling, i >= batches) << i;
+    if (i >= batches) {
+      EXPECT_EQ(settled.history[i].probability, settled.history[batches - 1].probability) << i;
     }
   }
   // An early SGVS run's estimate rests on many entries found once: nothing to settle.

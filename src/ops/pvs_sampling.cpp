@@ -422,11 +422,11 @@ class Sampler {
   // all. The least lambda found to miss becomes the sample's target (lambda = 1 when all hit: then
   // no later round). The rays each sample cast are counted in silhouette_rays_ (the mixture's cost).
   void silhouettes(detail::RayCaster& caster, std::vector<Sample>& samples) {
+    silhouette_rays_ = 0;
     if (silhouettes_.empty()) return;
     const std::size_t n = silhouettes_.size();
     std::vector<double> hit(n, 0.0), missed(n, 1.0);  // the interval holding the silhouette
     std::vector<char> searching(n, 1);
-    silhouette_rays_ = 0;
     for (int round = 0; round < kSearchRounds; ++round) {
       const int last = round == 0 ? kDiscoveryRays : kDiscoveryRays - 1;
       std::vector<HeightRay> rays;
