@@ -716,20 +716,52 @@ TEST(Pvs, APixelErrorBudgetGoesOnWhereTheSettledEstimateMissesIt) {
 
 // Where every entry is found many times over (a flat field sees everything), no entry rests on one
 // uniform ray: the estimate is its floor, one entry in the run's uniform rays, and never 0.
+// (The flat field with a tile of nodata: every other entry is found, and the sets are never
+// complete, so the run casts its budget.)
 TEST(Pvs, EstimateOfCompleteSetsIsOneRayInTheRun) {
-  const HeightField flat = flatField();
+  HeightField flat = flatField();
+  for (int row = 4; row <= 8; ++row)  // tile (1, 1) of 4 x 4 cells: cells 4 .. 7, points 4 .. 8
+    for (int col = 4; col <= 8; ++col) flat.heights[std::size_t(row) * flat.width + col] = NAN;
   const PvsGrid grid = flatGrid();
   for (PvsMethod method : {PvsMethod::Agvs, PvsMethod::Sgvs, PvsMethod::PerCell}) {
     PvsOptions options;
     options.method = method;
     options.samples = 100000;
+    options.batch = 20000;
+    options.estimate_entries = 0;  // (the estimate as the budget leaves it)
     const PvsResult pvs = computePvs(testContext(), flat, grid, options);
-    ASSERT_EQ(pvs.entries(), std::size_t(pvs.layout.viewCells()) * pvs.layout.tiles()) << int(method);
+    const PvsLayout& l = pvs.layout;
+    std::size_t reachable = 0;  // every view cell, times every tile but the one of nodata
+    for (int v = 0; v < l.viewCells(); ++v)
+      for (int t = 0; t < l.tiles(); ++t) reachable += t != 1 * l.tiles_x + 1;
+    ASSERT_EQ(pvs.entries(), reachable) << int(method);
+    EXPECT_EQ(pvs.samples, 100000u) << int(method);
     ASSERT_GT(pvs.uniform_rays, 0u);
     EXPECT_EQ(pvs.pixel_error, options.resolution / double(pvs.uniform_rays)) << int(method);
     // Early in the run entries were still found by one ray alone: the estimate was above its floor.
     EXPECT_GT(pvs.history.front().pixel_error, pvs.pixel_error) << int(method);
   }
+}
+
+// Complete sets (every computed view cell holds every tile) end the run at once, whatever its
+// budget: no sample can add an entry, and no ray can differ (the estimate 0).
+TEST(Pvs, CompleteSetsEndTheRunWhateverTheBudget) {
+  const HeightField flat = flatField();
+  const PvsGrid grid = flatGrid();
+  for (PvsMethod method : {PvsMethod::Agvs, PvsMethod::Sgvs, PvsMethod::PerCell})
+    for (int budget = 0; budget < 2; ++budget) {
+      PvsOptions options;
+      options.method = method;
+      options.batch = 500;  // (the first batch leaves the sets short of complete)
+      if (budget == 0) options.samples = 10000000;
+      if (budget == 1) options.seconds = 60.0;
+      const PvsResult pvs = computePvs(testContext(), flat, grid, options);
+      ASSERT_EQ(pvs.entries(), std::size_t(pvs.layout.viewCells()) * pvs.layout.tiles()) << int(method);
+      EXPECT_LT(pvs.samples, 1000000u) << int(method);
+      EXPECT_EQ(pvs.pixel_error, 0.0) << int(method);
+      EXPECT_EQ(pvs.history.back().pixel_error, 0.0);
+      EXPECT_GT(pvs.history.front().pixel_error, 0.0) << int(method);
+    }
 }
 
 TEST(Pvs, PixelErrorBudgetStopsTheRun) {

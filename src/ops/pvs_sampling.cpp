@@ -211,7 +211,7 @@ class Sampler {
     for (;;) {
       if (sample(caster, start)) break;
       settle(caster, start);
-      if (completeUnderPixelError()) break;
+      if (complete()) break;
       // A pixel-error budget the settled estimate no longer meets goes on, within the others.
       const bool budget_left = (!options_.samples || out_.samples < options_.samples) &&
                                (options_.seconds <= 0.0 || out_.seconds < options_.seconds);
@@ -221,8 +221,7 @@ class Sampler {
   }
 
  private:
-  // The sampler's batches until a budget is reached; true when a pixel-error budget ends with the
-  // sets complete.
+  // The sampler's batches until a budget is reached or the sets are complete (then true).
   bool sample(detail::RayCaster& caster, std::chrono::steady_clock::time_point start) {
     for (;;) {
       std::uint64_t n = std::uint64_t(options_.batch);
@@ -230,17 +229,18 @@ class Sampler {
       if (n == 0) return false;
       batch(caster, static_cast<int>(n));
       record(start);
+      if (complete()) return true;
       if (options_.pixel_error > 0.0 && out_.pixel_error <= options_.pixel_error) return false;
-      if (completeUnderPixelError()) return true;
       if (options_.seconds > 0.0 && out_.seconds >= options_.seconds) return false;
     }
   }
 
   // Every computed view cell holds every tile: no ray can differ, whatever the estimate's floor of
-  // one entry per uniform ray says (a pixel-error budget would go on for ever toward a small E), so
-  // under a pixel-error budget the estimate is 0 and the run ends.
-  bool completeUnderPixelError() {
-    if (!(options_.pixel_error > 0.0 && out_.entries() == complete_)) return false;
+  // one entry per uniform ray says (a pixel-error budget would go on for ever toward a small E), and
+  // no sample can add anything (a samples or seconds budget would be spent for nothing), so the
+  // estimate is 0 and the run ends, whatever its budget.
+  bool complete() {
+    if (out_.entries() != complete_) return false;
     out_.pixel_error = 0.0;
     out_.history.back().pixel_error = 0.0;
     return true;
@@ -669,9 +669,8 @@ class Sampler {
   }
 
   // Sec. 4.2 with the window one batch: weight = contribution per sample per cost, the cost
-  // counted in rays (a silhouette mutation casts its discovery rays more, silhouette_rays_ over the
-  // batch's), so that a seed reproduces
-  // the run exactly (a wall-clock cost would not).
+  // counted in rays (a silhouette mutation casts its discovery rays more: silhouette_rays_ over
+  // the batch's), so that a seed reproduces the run exactly (a wall-clock cost would not).
   void updateMixture(const std::vector<double>& contribution, const std::vector<double>& drawn) {
     std::vector<double> weight(kPvsDistributions, 0.0);
     double sum = 0.0;
