@@ -755,12 +755,23 @@ TEST(Pvs, CompleteSetsEndTheRunWhateverTheBudget) {
       options.batch = 500;  // (the first batch leaves the sets short of complete)
       if (budget == 0) options.samples = 10000000;
       if (budget == 1) options.seconds = 60.0;
+      double told = -1.0;  // the progress callback's last estimate: the result's
+      options.progress = [&](const PvsResult& so_far) { told = so_far.pixel_error; };
       const PvsResult pvs = computePvs(testContext(), flat, grid, options);
       ASSERT_EQ(pvs.entries(), std::size_t(pvs.layout.viewCells()) * pvs.layout.tiles()) << int(method);
       EXPECT_LT(pvs.samples, 1000000u) << int(method);
       EXPECT_EQ(pvs.pixel_error, 0.0) << int(method);
       EXPECT_EQ(pvs.history.back().pixel_error, 0.0);
+      EXPECT_EQ(told, 0.0);
       EXPECT_GT(pvs.history.front().pixel_error, 0.0) << int(method);
+      // Resumed from them, a run casts nothing.
+      PvsOptions resumed = options;
+      resumed.start = pvs.bits;
+      resumed.seed = 2;
+      const PvsResult again = computePvs(testContext(), flat, grid, resumed);
+      EXPECT_EQ(again.samples, 0u);
+      EXPECT_EQ(again.bits, pvs.bits);
+      EXPECT_EQ(again.pixel_error, 0.0);
     }
 }
 

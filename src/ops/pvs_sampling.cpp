@@ -208,6 +208,11 @@ class Sampler {
 
   void run(detail::RayCaster& caster) {
     const auto start = std::chrono::steady_clock::now();
+    if (complete()) {  // (sets to resume from that are complete already: nothing to cast)
+      out_.pixel_error = 0.0;
+      if (options_.filter > 0.0 || options_.view_filter > 0) filters();
+      return;
+    }
     for (;;) {
       if (sample(caster, start)) break;
       settle(caster, start);
@@ -238,13 +243,9 @@ class Sampler {
   // Every computed view cell holds every tile: no ray can differ, whatever the estimate's floor of
   // one entry per uniform ray says (a pixel-error budget would go on for ever toward a small E), and
   // no sample can add anything (a samples or seconds budget would be spent for nothing), so the
-  // estimate is 0 and the run ends, whatever its budget.
-  bool complete() {
-    if (out_.entries() != complete_) return false;
-    out_.pixel_error = 0.0;
-    out_.history.back().pixel_error = 0.0;
-    return true;
-  }
+  // estimate is 0 (batch() sets it, before the history and the progress callback see it) and the
+  // run ends, whatever its budget.
+  bool complete() const { return out_.entries() == complete_; }
 
   // Settles the estimate (PvsOptions::estimate_entries): while fewer entries found once than asked
   // carry it, view-direction samples (uniform view rays) go on, at most as many samples as the
@@ -621,6 +622,7 @@ class Sampler {
     if (uniform_rays_ > 0)
       out_.pixel_error = options_.resolution * double(std::max<std::size_t>(1, only_finders_.size())) /
                          double(uniform_rays_);
+    if (complete()) out_.pixel_error = 0.0;  // (no ray can differ)
     if (options_.method == PvsMethod::Agvs && !settling_) updateMixture(contribution, drawn);
   }
 
