@@ -38,8 +38,9 @@ std::uint32_t getU32(const char* at) {
 
 // What a bitset's sets were computed from, which a run resumed from them must share: the field
 // (its heights' bits, size, cell sizes and z-scale, as a 64-bit hash), the view band, and whether
-// a visibility filter (--filter, --view-filter) added entries. A bitset of another field was resumed, and its
-// sets, seen through a wall this field has, went out as this field's (exit 0).
+// a visibility filter (--filter, --view-filter) was asked for (whether or not it added entries).
+// A bitset of another field was resumed, and its sets, seen through a wall this field has, went
+// out as this field's (exit 0).
 struct BitsetOrigin {
   std::uint64_t field = 0;
   float band_low = 0.0f, band_high = 0.0f;

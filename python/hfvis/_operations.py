@@ -711,23 +711,23 @@ def pvs(heights, *, samples=0, pixel_error=0.0, seconds=0.0, view_cell=32, band_
         mask=None, method="agvs", batch=1 << 16, seed=1, resolution=1e6, filter=0.0, view_filter=0, estimate_entries=20,
         witnesses=False, memory_budget_bytes=0, start=None, cell_size=None, z_scale=1.0, nodata=None, device="",
         progress=None):
-    """Potentially visible sets (Bittner, Mattausch, Wonka, Havran & Wimmer 2009): the tiles of
-    tile x tile cells each view cell of view_cell x view_cell cells (its volume band_low ..
-    band_high above the surface) sees, by sampling; stops at the first budget reached (samples,
-    pixel_error, seconds; one at least), or once every view cell holds every tile. mask: the view cells to compute, per view cell or per
-    pixel (as the CLI's --view-mask). method: "agvs", "sgvs", "per_cell". progress is called as
-    progress(samples, pixel_error) after each batch. Returns Pvs: sets (per view cell, row-major:
-    the visible tiles' row-major indices, None where not computed), bits (view cells x words
-    uint32), computed, layout (a dict of the grid's sizes), the run's counts, history (per
-    batch) and witnesses (with witnesses=True). DataArrays: the same (the sets are not on the
-    pixel grid); computed in one piece. start: an earlier run's bits (its Pvs.bits) on the same
-    field and grid, to go on from; its entries stay (give another seed, or its samples repeat; no
-    filter, and not the bits of a filtered run). filter: the object-space filter's k; view_filter:
-    the view-space filter's neighbours, 0 .. 8 (both add entries without witness, counted in
-    filtered). estimate_entries: when a budget leaves the
-    estimate on fewer entries found once (one at least), uniform view rays go on until that many
-    carry it, at most as many samples (and seconds) as the run took before them (estimate_samples
-    counts them, history rows say "settling"; 0: off)."""
+    """Potentially visible sets (Bittner, Mattausch, Wonka, Havran & Wimmer 2009): the tiles of tile
+    x tile cells each view cell of view_cell x view_cell cells (its volume band_low .. band_high
+    above the surface) sees, by sampling; stops at the first budget reached (samples, pixel_error,
+    seconds; one at least), or once every view cell holds every tile. mask: the view cells to
+    compute, per view cell or per pixel (as the CLI's --view-mask). method: "agvs", "sgvs",
+    "per_cell". progress is called as progress(samples, pixel_error) after each batch. Returns Pvs:
+    sets (per view cell, row-major: the visible tiles' row-major indices, None where not computed),
+    bits (view cells x words uint32), computed, layout (a dict of the grid's sizes), the run's
+    counts, history (per batch) and witnesses (with witnesses=True). DataArrays: the same (the sets
+    are not on the pixel grid); computed in one piece. start: an earlier run's bits (its Pvs.bits)
+    on the same field and grid, to go on from; its entries stay (give another seed, or its samples
+    repeat; no object-space filter, and not the bits of a filtered run). filter: its k;
+    view_filter: the view-space filter's neighbours, 0 to 8 (both add entries without witness,
+    counted in filtered). estimate_entries: when a budget leaves the estimate on fewer entries found
+    once (one at least), uniform view rays go on until that many carry it, at most as many samples
+    (and seconds) as the run took before them (estimate_samples counts them, history rows say
+    "settling"; 0: off)."""
     if not (isinstance(estimate_entries, (int, np.integer)) and 0 <= estimate_entries <= 1_000_000):
         raise InvalidArgumentError(f"estimate_entries must be a whole number in 0 .. 1e6, got {estimate_entries!r}")
     options = {"samples": _whole("samples", samples, None, 2**31 - 1), "pixel_error": _real("pixel_error", pixel_error),
