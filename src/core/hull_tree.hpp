@@ -237,11 +237,12 @@ inline std::uint32_t hashHorizon(std::uint32_t hash, int step) {
   return (hash ^ static_cast<std::uint32_t>(step)) * 16777619u;
 }
 
-// The hull-tree sweep kernel for one direction on prepared heights (see prepareHeights),
-// with per-entry statistics, as lattice lines in the canonical order above (lines in the
-// order of direction.lines, each padded with absent samples to the longest).
+// The hull-tree sweep kernel for one direction on prepared heights (see prepareHeights: their
+// base sets the tie rule's rounding, as in production), with per-entry statistics, as lattice
+// lines in the canonical order above (lines in the order of direction.lines, each padded with
+// absent samples to the longest).
 IntervisibilityLines intervisibilityLinesOnDevice(const ComputeContext& context, const HeightField& field,
-                                                  const std::vector<float>& prepared_heights,
+                                                  const PreparedHeights& prepared,
                                                   const TreeDirection& direction,
                                                   const HullTreeTuning& tuning = {});
 

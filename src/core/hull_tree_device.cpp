@@ -228,7 +228,7 @@ void TreeRoutine::sweep(int direction, int) {
 
 IntervisibilityLines treeLinesOnDevice(ContextState& st, const TreeProgramFlags& program_flags,
                                        const HeightField& field, const std::vector<float>& prepared_heights,
-                                       const TreeDirection& d, const BounceInputs* bounce,
+                                       float height_base, const TreeDirection& d, const BounceInputs* bounce,
                                        std::vector<float>* irradiance) {
   TreeProgramFlags flags = program_flags;
   flags.entry_stats = true;
@@ -254,7 +254,7 @@ IntervisibilityLines treeLinesOnDevice(ContextState& st, const TreeProgramFlags&
   };
   const int channels = bounce ? bounce->channels() : 0;
   b.heights = upload(prepared_heights);
-  b.height_base = bounce ? bounce->height_base : 0.0f;
+  b.height_base = height_base;
   b.count_sum = deviceBuffer(st, plane * sizeof(float));
   b.area_sum = deviceBuffer(st, plane * sizeof(float));
   b.radiance = bounce ? upload(joined(bounce->radiance)) : deviceBuffer(st, 0);
@@ -353,13 +353,14 @@ TreePeakInputs treePeakInputsOnDevice(ContextState& st, const HeightField& field
 }
 
 IntervisibilityLines intervisibilityLinesOnDevice(const ComputeContext& context, const HeightField& field,
-                                                  const std::vector<float>& prepared_heights,
-                                                  const TreeDirection& d, const HullTreeTuning& tuning) {
+                                                  const PreparedHeights& prepared, const TreeDirection& d,
+                                                  const HullTreeTuning& tuning) {
   validate(tuning);
   return translateOpenClErrors([&] {
     TreeProgramFlags flags;
     flags.tuning = tuning;
-    return treeLinesOnDevice(stateOf(context), flags, field, prepared_heights, d, nullptr, nullptr);
+    return treeLinesOnDevice(stateOf(context), flags, field, prepared.heights, prepared.base, d, nullptr,
+                             nullptr);
   });
 }
 

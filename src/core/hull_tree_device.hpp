@@ -139,12 +139,14 @@ class TreeRoutine : public SweepRoutine {
   TreeBuffers buffers_;
 };
 
-
 // One direction's sweep with per-entry statistics (and with `bounce`, its gather: the
 // per-pixel irradiance of that direction into `irradiance`, channel planes), read back as
-// canonical lines (IntervisibilityLines, every sample's horizons read). For the tests' hooks.
-IntervisibilityLines treeLinesOnDevice(ContextState& st, const TreeProgramFlags& flags, const HeightField& field,
-                                       const std::vector<float>& prepared_heights, const TreeDirection& d,
-                                       const BounceInputs* bounce, std::vector<float>* irradiance);
+// canonical lines (IntervisibilityLines, every sample's horizons read). `height_base`: the
+// prepared heights' base (PreparedHeights::base), which the tie rule's rounding takes. For the
+// tests' hooks.
+IntervisibilityLines treeLinesOnDevice(ContextState& st, const TreeProgramFlags& flags,
+                                       const HeightField& field, const std::vector<float>& prepared_heights,
+                                       float height_base, const TreeDirection& d, const BounceInputs* bounce,
+                                       std::vector<float>* irradiance);
 
 }  // namespace hfvis::detail

@@ -89,7 +89,8 @@ BounceLineView bounceLinesOnDevice(const ComputeContext& context, const HeightFi
     std::vector<float> irradiance;
     TreeProgramFlags flags = bounceFlags(inputs.channels(), tuning);
     flags.has_nodata = inputs.has_nodata;
-    view.lines = treeLinesOnDevice(stateOf(context), flags, field, inputs.heights, d, &inputs, &irradiance);
+    view.lines = treeLinesOnDevice(stateOf(context), flags, field, inputs.heights, inputs.height_base, d,
+                                   &inputs, &irradiance);
     // Each receiver entry takes its pixel's irradiance of this one direction.
     const int channels = inputs.channels();
     const std::size_t plane = field.pixelCount();
