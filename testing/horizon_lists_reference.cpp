@@ -7,6 +7,7 @@
 #include "core/chord_side.hpp"
 #include "core/horizon_common.hpp"
 #include "core/tree_peaks.hpp"
+#include "hfvis_testing/sight_along_line.hpp"
 
 namespace hfvis {
 
@@ -53,34 +54,20 @@ HorizonListReference referenceHorizonList(const std::vector<float>& ray, float h
   }
   nodes.push_back({hr, 0.0f, 0});
   const std::size_t receiver = nodes.size() - 1;
-  // Visible: no node nearer lies strictly above the sight line from the receiver.
-  std::vector<bool> exact(receiver, false);
-  for (std::size_t x = 0; x < receiver; ++x) {
-    bool hidden = false;
-    for (std::size_t y = x + 1; y < receiver && !hidden; ++y)
-      hidden = detail::chordSide(nodes[x].h, nodes[y].h, hr, nodes[x].distance - nodes[y].distance,
-                                 nodes[y].distance) > 0;
-    exact[x] = !hidden;
-    if (nodes[x].sample > 0) out.visible[nodes[x].sample] = out.exactly[nodes[x].sample] = !hidden;
-  }
-  // The tie rule forgives the heights' rounding (kernels/shared/chord_side.cl): a hidden sample
-  // is visible where the steepest nearer node (the farthest on ties) hides it only within that
-  // rounding, as it does every hidden sample between them. Outward from the receiver, so that
-  // the steepest node is the latest visible one; `stretch` is each visible node's farthest
-  // forgiven sample (0: none).
+  // Visible: no node nearer lies strictly above the sight line from the receiver, or the steepest
+  // nearer node (the farthest on ties) hides it only within the heights' rounding, as it does every
+  // hidden sample between them (the tie rule, sightAlongLine; positions: minus the distances);
+  // `stretch` is each visible node's farthest forgiven sample (0: none).
+  std::vector<LineNode> line(nodes.size());
+  for (std::size_t x = 0; x < nodes.size(); ++x)
+    line[x] = {nodes[x].h, -nodes[x].distance, nodes[x].sample <= 0};
+  const LineSight sight = sightAlongLine(line, receiver, height_base);
   std::vector<int> stretch(receiver, 0);
-  std::size_t best = receiver;
-  bool forgiving = false;
   for (std::size_t x = receiver; x-- > 0;) {
-    if (exact[x]) {
-      best = x;
-      forgiving = true;
-    } else if (nodes[x].sample > 0) {
-      forgiving = forgiving && detail::seen_within_rounding(nodes[x].h, nodes[best].h, hr,
-                                                            nodes[x].distance - nodes[best].distance,
-                                                            nodes[best].distance, height_base);
-      if (forgiving) out.visible[nodes[x].sample] = true, stretch[best] = nodes[x].sample;
-    }
+    if (nodes[x].sample <= 0) continue;
+    out.exactly[nodes[x].sample] = sight.exactly[x];
+    out.visible[nodes[x].sample] = sight.exactly[x] || sight.forgiven[x];
+    if (sight.forgiven[x]) stretch[sight.steepest[x]] = nodes[x].sample;
   }
   // Eq. 1 in sweep order: the first node is a segment start, then every convex node after a
   // concave one (class from the chord of its two neighbours; collinear keeps the previous

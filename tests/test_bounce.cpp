@@ -17,6 +17,7 @@
 #include "hfvis/horizon.hpp"
 #include "hfvis/image_io.hpp"
 #include "hfvis_testing/bounce_reference.hpp"
+#include "hfvis_testing/sight_along_line.hpp"
 #include "hfvis_testing/synthetic_fields.hpp"
 #include "ops/bounce_internal.hpp"
 #include "test_support.hpp"
@@ -128,22 +129,12 @@ void expectBruteForceGather(const detail::BounceLineView& view, double sector) {
     for (int r = 0; r < static_cast<int>(nodes.size()); ++r) {
       if (nodes[r].peak || nodes[r].step % every != every - 1) continue;  // not a receiver
       const std::size_t er = std::size_t(nodes[r].step) * d.n_lines + j;
-      // Visible flags, nearest first, keeping the steepest node so far.
+      // Visible flags: exactly, or within the heights' rounding (the tie rule).
+      std::vector<LineNode> line(static_cast<std::size_t>(r) + 1);
+      for (int k = 0; k <= r; ++k) line[k] = {nodes[k].h, nodes[k].position, nodes[k].peak};
+      const LineSight sight = sightAlongLine(line, static_cast<std::size_t>(r), view.lines.height_base);
       std::vector<bool> visible(r, false);
-      int best = -1;
-      bool forgiving = false;  // every hidden sample since `best` was forgiven its rounding
-      for (int x = r - 1; x >= 0; --x) {
-        const float dab = nodes[best < 0 ? x : best].position - nodes[x].position,
-                    dbc = nodes[r].position - nodes[best < 0 ? x : best].position;
-        const bool hidden = best >= 0 && detail::chordSide(height(x), height(best), height(r), dab, dbc) > 0;
-        if (!hidden) {
-          visible[x] = true, best = x, forgiving = true;
-        } else if (!nodes[x].peak) {
-          forgiving = forgiving && detail::seen_within_rounding(height(x), height(best), height(r), dab, dbc,
-                                                                view.lines.height_base);
-          visible[x] = forgiving;
-        }
-      }
+      for (int x = 0; x < r; ++x) visible[x] = sight.exactly[x] || sight.forgiven[x];
       auto adjacent = [&](int a, int b) {  // no hidden sample between visible samples a < b
         for (int k = a + 1; k < b; ++k)
           if (!visible[k] && !nodes[k].peak) return false;

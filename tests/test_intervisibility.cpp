@@ -28,6 +28,7 @@
 #include "hfvis/image_io.hpp"
 #include "hfvis/intervisibility.hpp"
 #include "hfvis_testing/intervisibility_reference.hpp"
+#include "hfvis_testing/sight_along_line.hpp"
 #include "hfvis_testing/synthetic_fields.hpp"
 #include "reference_internal.hpp"
 #include "test_support.hpp"
@@ -214,17 +215,6 @@ std::vector<LineSample> presentSamples(const detail::IntervisibilityLines& lines
   return present;
 }
 
-// Whether sample a is strictly above the chord from far sample q to receiver r (q < a < r).
-bool above(const LineSample& q, const LineSample& a, const LineSample& r) {
-  return detail::chordSide(q.h, a.h, r.h, a.position - q.position, r.position - a.position) > 0;
-}
-
-// Whether q is seen over a from r within the heights' rounding (kernels/shared/chord_side.cl).
-bool seenWithinRounding(const LineSample& q, const LineSample& a, const LineSample& r, float height_base) {
-  return detail::seen_within_rounding(q.h, a.h, r.h, a.position - q.position, r.position - a.position,
-                                      height_base) != 0;
-}
-
 // Eq. 1 segment starts of a line's present samples: the first, and every convex sample
 // after a concave one. Sample i's class needs sample i + 1 only, so for a receiver r the
 // starts before r are the same whatever follows r.
@@ -248,29 +238,20 @@ struct BruteForce {
   std::vector<int> horizons;  // steps, farthest first, distinct
 };
 
-// For receiver present[r]: O(r) sweeps outward keeping the steepest sample so far. A hidden
-// sample is seen too where the steepest sample hides it only within the heights' rounding, as
-// it does every hidden sample between them (peaks aside: they are never counted); the tie rule,
-// kernels/intervisibility.cl's forgiven_stretch.
+// For receiver present[r]: what it sees of the samples before it (sightAlongLine: the tie rule,
+// kernels/intervisibility.cl's forgiven_stretch), and for each segment start x (Eq. 1) its
+// horizon (Eq. 2): the farthest sample of maximal slope in [x, r), the steepest node from x.
 BruteForce bruteForce(const std::vector<LineSample>& s, const std::vector<bool>& starts, int r,
                       float height_base) {
+  std::vector<LineNode> nodes(static_cast<std::size_t>(r) + 1);
+  for (int x = 0; x <= r; ++x) nodes[x] = {s[x].h, s[x].position, s[x].peak};
+  const LineSight sight = sightAlongLine(nodes, static_cast<std::size_t>(r), height_base);
   BruteForce out;
-  int best = -1;  // the visible sample of maximal slope, the farthest on ties
   std::set<int> horizons;
-  bool forgiving = false;  // every hidden sample since `best` was forgiven
   for (int x = r - 1; x >= 0; --x) {
-    // x is visible when the steepest nearer sample is not strictly above the chord x-r.
-    if (best < 0 || !above(s[x], s[best], s[r])) {
-      out.visible.push_back(x);
-      best = x;
-      forgiving = true;
-    } else if (!s[x].peak) {
-      forgiving = forgiving && seenWithinRounding(s[x], s[best], s[r], height_base);
-      if (forgiving) out.forgiven.push_back(x);
-    }
-    // A segment starts at x: its horizon (Eq. 2) is the farthest sample of maximal slope
-    // in [x, r), which is `best` (ties go to the farther).
-    if (starts[x]) horizons.insert(s[best].step);
+    if (sight.exactly[x]) out.visible.push_back(x);
+    if (sight.forgiven[x]) out.forgiven.push_back(x);
+    if (starts[x]) horizons.insert(s[sight.steepest[x]].step);
   }
   out.horizons.assign(horizons.begin(), horizons.end());
   return out;
