@@ -716,25 +716,26 @@ TEST(Pvs, APixelErrorBudgetGoesOnWhereTheSettledEstimateMissesIt) {
 
 // Where every entry is found many times over (a flat field sees everything), no entry rests on one
 // uniform ray: the estimate is its floor, one entry in the run's uniform rays, and never 0.
-// (The flat field with a tile of nodata: every other entry is found, and the sets are never
-// complete, so the run casts its budget.)
+// (The sets must stay short of complete, or the run ends with an estimate of 0: tile 0 is the
+// floor of a pit 1000 deep, its walls in the tiles around it, and view cell 0 above it is not
+// computed; from every other view cell the walls hide its floor by far, so the run casts its
+// budget with every other entry found.)
 TEST(Pvs, EstimateOfCompleteSetsIsOneRayInTheRun) {
-  HeightField flat = flatField();
-  for (int row = 4; row <= 8; ++row)  // tile (1, 1) of 4 x 4 cells: cells 4 .. 7, points 4 .. 8
-    for (int col = 4; col <= 8; ++col) flat.heights[std::size_t(row) * flat.width + col] = NAN;
-  const PvsGrid grid = flatGrid();
+  HeightField pit = flatField();
+  for (int row = 0; row <= 4; ++row)  // tile 0's points: cells 0 .. 3, points 0 .. 4
+    for (int col = 0; col <= 4; ++col) pit.heights[std::size_t(row) * pit.width + col] = -997.0f;
+  PvsGrid grid = flatGrid();
+  grid.mask = {0, 1, 1, 1, 1, 1};
   for (PvsMethod method : {PvsMethod::Agvs, PvsMethod::Sgvs, PvsMethod::PerCell}) {
     PvsOptions options;
     options.method = method;
     options.samples = 100000;
     options.batch = 20000;
     options.estimate_entries = 0;  // (the estimate as the budget leaves it)
-    const PvsResult pvs = computePvs(testContext(), flat, grid, options);
+    const PvsResult pvs = computePvs(testContext(), pit, grid, options);
     const PvsLayout& l = pvs.layout;
-    std::size_t reachable = 0;  // every view cell, times every tile but the one of nodata
     for (int v = 0; v < l.viewCells(); ++v)
-      for (int t = 0; t < l.tiles(); ++t) reachable += t != 1 * l.tiles_x + 1;
-    ASSERT_EQ(pvs.entries(), reachable) << int(method);
+      for (int t = 0; t < l.tiles(); ++t) EXPECT_EQ(pvs.visible(v, t), v > 0 && t > 0) << v << " " << t;
     EXPECT_EQ(pvs.samples, 100000u) << int(method);
     ASSERT_GT(pvs.uniform_rays, 0u);
     EXPECT_EQ(pvs.pixel_error, options.resolution / double(pvs.uniform_rays)) << int(method);
@@ -743,36 +744,57 @@ TEST(Pvs, EstimateOfCompleteSetsIsOneRayInTheRun) {
   }
 }
 
-// Complete sets (every computed view cell holds every tile) end the run at once, whatever its
-// budget: no sample can add an entry, and no ray can differ (the estimate 0).
+// Complete sets end the run at once, whatever its budget (no sample can add an entry, and no ray
+// can differ: the estimate 0): every computed view cell that holds a valid cell holds every tile
+// that holds one. On the flat field that is every pair; with a corner of nodata (pixels x >= 16,
+// y >= 8: view cell 5 and the tiles over x >= 16, y >= 8 hold no valid cell) the pairs that
+// remain, which the old stop (every pair) never reached.
 TEST(Pvs, CompleteSetsEndTheRunWhateverTheBudget) {
-  const HeightField flat = flatField();
   const PvsGrid grid = flatGrid();
-  for (PvsMethod method : {PvsMethod::Agvs, PvsMethod::Sgvs, PvsMethod::PerCell})
-    for (int budget = 0; budget < 2; ++budget) {
-      PvsOptions options;
-      options.method = method;
-      options.batch = 500;  // (the first batch leaves the sets short of complete)
-      if (budget == 0) options.samples = 10000000;
-      if (budget == 1) options.seconds = 60.0;
-      double told = -1.0;  // the progress callback's last estimate: the result's
-      options.progress = [&](const PvsResult& so_far) { told = so_far.pixel_error; };
-      const PvsResult pvs = computePvs(testContext(), flat, grid, options);
-      ASSERT_EQ(pvs.entries(), std::size_t(pvs.layout.viewCells()) * pvs.layout.tiles()) << int(method);
-      EXPECT_LT(pvs.samples, 1000000u) << int(method);
-      EXPECT_EQ(pvs.pixel_error, 0.0) << int(method);
-      EXPECT_EQ(pvs.history.back().pixel_error, 0.0);
-      EXPECT_EQ(told, 0.0);
-      EXPECT_GT(pvs.history.front().pixel_error, 0.0) << int(method);
-      // Resumed from them, a run casts nothing.
-      PvsOptions resumed = options;
-      resumed.start = pvs.bits;
-      resumed.seed = 2;
-      const PvsResult again = computePvs(testContext(), flat, grid, resumed);
-      EXPECT_EQ(again.samples, 0u);
-      EXPECT_EQ(again.bits, pvs.bits);
-      EXPECT_EQ(again.pixel_error, 0.0);
-    }
+  const HeightField flat = flatField();
+  HeightField holed = flat;
+  for (int y = 8; y < holed.height; ++y)
+    for (int x = 16; x < holed.width; ++x) holed.heights[std::size_t(y) * holed.width + x] = NAN;
+  for (const HeightField* field : {&flat, static_cast<const HeightField*>(&holed)}) {
+    const bool hole = field == &holed;
+    for (PvsMethod method : {PvsMethod::Agvs, PvsMethod::Sgvs, PvsMethod::PerCell})
+      for (int budget = 0; budget < 2; ++budget) {
+        SCOPED_TRACE(std::string(hole ? "holed" : "flat") + " method " + std::to_string(int(method)));
+        PvsOptions options;
+        options.method = method;
+        options.batch = 500;  // (the first batch leaves the sets short of complete)
+        if (budget == 0) options.samples = 10000000;
+        if (budget == 1) options.seconds = 60.0;
+        double told = -1.0;  // the progress callback's last estimate: the result's
+        options.progress = [&](const PvsResult& so_far) { told = so_far.pixel_error; };
+        const PvsResult pvs = computePvs(testContext(), *field, grid, options);
+        const int views = pvs.layout.viewCells(), tiles = pvs.layout.tiles();
+        ASSERT_EQ(views, 6);
+        ASSERT_EQ(tiles, 24);
+        // Independently of the sampler: view cells 3 x 2 of 8 cells, tiles 6 x 4 of 4.
+        std::size_t expected = 0;
+        for (int v = 0; v < views; ++v)
+          for (int t = 0; t < tiles; ++t) {
+            const bool nodata_view = hole && v == 5, nodata_tile = hole && t % 6 >= 4 && t / 6 >= 2;
+            EXPECT_EQ(pvs.visible(v, t), !nodata_view && !nodata_tile) << v << " " << t;
+            expected += !nodata_view && !nodata_tile;
+          }
+        ASSERT_EQ(pvs.entries(), expected);
+        EXPECT_LT(pvs.samples, 1000000u);
+        EXPECT_EQ(pvs.pixel_error, 0.0);
+        EXPECT_EQ(pvs.history.back().pixel_error, 0.0);
+        EXPECT_EQ(told, 0.0);
+        EXPECT_GT(pvs.history.front().pixel_error, 0.0);
+        // Resumed from them, a run casts nothing.
+        PvsOptions resumed = options;
+        resumed.start = pvs.bits;
+        resumed.seed = 2;
+        const PvsResult again = computePvs(testContext(), *field, grid, resumed);
+        EXPECT_EQ(again.samples, 0u);
+        EXPECT_EQ(again.bits, pvs.bits);
+        EXPECT_EQ(again.pixel_error, 0.0);
+      }
+  }
 }
 
 TEST(Pvs, PixelErrorBudgetStopsTheRun) {

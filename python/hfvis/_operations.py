@@ -714,7 +714,7 @@ def pvs(heights, *, samples=0, pixel_error=0.0, seconds=0.0, view_cell=32, band_
     """Potentially visible sets (Bittner, Mattausch, Wonka, Havran & Wimmer 2009): the tiles of tile
     x tile cells each view cell of view_cell x view_cell cells (its volume band_low .. band_high
     above the surface) sees, by sampling; stops at the first budget reached (samples, pixel_error,
-    seconds; one at least), or once every view cell holds every tile. mask: the view cells to
+    seconds; one at least), or once every view cell holds every tile (nodata aside). mask: the view cells to
     compute, per view cell or per pixel (as the CLI's --view-mask). method: "agvs", "sgvs",
     "per_cell". progress is called as progress(samples, pixel_error) after each batch. Returns Pvs:
     sets (per view cell, row-major: the visible tiles' row-major indices, None where not computed),

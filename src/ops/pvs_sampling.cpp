@@ -172,9 +172,6 @@ class Sampler {
         }
       out_.bits = options.start;
     }
-    complete_ = std::size_t(std::count_if(out_.computed.begin(), out_.computed.end(),
-                                          [](std::uint8_t c) { return c != 0; })) *
-                std::size_t(l.tiles());
     out_.pixel_error = std::numeric_limits<double>::quiet_NaN();
     heights_ = detail::rayHeights(field);
     cx_ = field.cell_size_x;
@@ -196,6 +193,11 @@ class Sampler {
       if (!view_cells_[v].empty()) sampled_views_.push_back(v);
     for (int t = 0; t < l.tiles(); ++t)
       if (!tile_cells_[t].empty()) objects_.push_back(t);
+    // The entries a sample can find: an eye stands on a valid cell of its view cell and a hit is on
+    // a valid cell of its tile, so view cells and tiles all nodata never pair.
+    reachable_tiles_.assign(out_.words, 0u);
+    for (int t : objects_) reachable_tiles_[t / 32] |= 1u << (t % 32);
+    reachable_ = sampled_views_.size() * objects_.size();
     if (view_space_.empty()) throw InvalidArgument("the computed view cells hold no valid cell (all nodata)");
     tile_radius_ = 0.5 * l.tile * std::hypot(cx_, cy_);
     view_radius_ = 0.5 * l.view_cell * std::hypot(cx_, cy_);
@@ -240,12 +242,21 @@ class Sampler {
     }
   }
 
-  // Every computed view cell holds every tile: no ray can differ, whatever the estimate's floor of
-  // one entry per uniform ray says (a pixel-error budget would go on for ever toward a small E), and
-  // no sample can add anything (a samples or seconds budget would be spent for nothing), so the
-  // estimate is 0 (batch() sets it, before the history and the progress callback see it) and the
-  // run ends, whatever its budget.
-  bool complete() const { return out_.entries() == complete_; }
+  // Every computed view cell with a valid cell holds every tile with a surface (every entry a
+  // sample can find; nodata tiles and view cells pair with nothing): no ray can differ, whatever
+  // the estimate's floor of one entry per uniform ray says (a pixel-error budget would go on for
+  // ever toward a small E), and no sample can add anything (a samples or seconds budget would be
+  // spent for nothing), so the estimate is 0 (batch() sets it, before the history and the progress
+  // callback see it) and the run ends, whatever its budget. (Counts only those entries: sets to
+  // resume from may hold others.)
+  bool complete() const {
+    std::size_t found = 0;
+    for (int v : sampled_views_)
+      for (int w = 0; w < out_.words; ++w)
+        found +=
+            std::size_t(__builtin_popcount(out_.bits[std::size_t(v) * out_.words + w] & reachable_tiles_[w]));
+    return found == reachable_;
+  }
 
   // Settles the estimate (PvsOptions::estimate_entries): while fewer entries found once than asked
   // carry it, view-direction samples (uniform view rays) go on, at most as many samples as the
@@ -254,11 +265,11 @@ class Sampler {
   // and a run that has converged would cast its budget again for nothing. The entries they find
   // join the sets; the mixture and the mutations stay.
   void settle(detail::RayCaster& caster, std::chrono::steady_clock::time_point start) {
-    if (options_.estimate_entries == 0 || only_finders_.empty() || out_.entries() == complete_) return;
+    if (options_.estimate_entries == 0 || only_finders_.empty() || complete()) return;
     const std::uint64_t most = out_.samples - out_.estimate_samples;
     const double before = out_.seconds - settle_seconds_;
     const auto unsettled = [&] {
-      return only_finders_.size() < options_.estimate_entries && out_.entries() < complete_ &&
+      return only_finders_.size() < options_.estimate_entries && !complete() &&
              out_.estimate_samples < most && (options_.seconds <= 0.0 || settle_seconds_ < before);
     };
     settling_ = true;
@@ -795,7 +806,8 @@ class Sampler {
   std::uint64_t uniform_rays_ = 0;  // uniform view rays cast so far (foundAgain)
   bool settling_ = false;           // settle(): view-direction samples alone
   double settle_seconds_ = 0.0;     // the time settle() took
-  std::size_t complete_ = 0;        // the entries of complete sets: computed view cells x tiles
+  std::vector<std::uint32_t> reachable_tiles_;  // the tiles with a surface (objects_), a bit each
+  std::size_t reachable_ = 0;                   // the entries a sample can find: sampled_views_ x objects_
   // The entries only one uniform view ray has found (foundAgain): a bit per entry as out_.bits,
   // and the finder's lineage by entry (v * tiles + t).
   std::vector<std::uint32_t> only_finder_;
