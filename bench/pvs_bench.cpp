@@ -65,7 +65,7 @@ void pvsRaysReport(const ComputeContext& context, const std::vector<std::string>
     std::size_t hits = 0;
     // The caster as the samplers use it: the field uploaded and its pyramid built once, then
     // batch after batch.
-    detail::withRayCaster(context, f, plain.grid, 0, [&](detail::RayCaster& caster) {
+    detail::withRayCaster(context, f, plain.grid, 0.0, 0, [&](detail::RayCaster& caster) {
       // Warm-up: two full launches each way, so that the launches' buffers are allocated (and
       // their pages touched) before the timing, as they are after a sampler's first batch.
       const std::vector<HeightRay> warm(in.begin(), in.begin() + std::min<std::size_t>(in.size(), 1 << 17));
@@ -151,8 +151,9 @@ void pvsScalarReport(const std::vector<std::string>& fields, int size, const std
           int count = 0, cell = -1;
           const float t = detail::hf_ray_cast(
               h.data(), f.width, f.height, p.values.data(), p.levels.data(), p.top, ray.ox, ray.oy, ray.oz,
-              ray.dx, ray.dy, ray.dz, ray.t_max, grid.view_cell, l.view_x, float(grid.band_low),
-              float(grid.band_high), lists ? cap : 0, pierced.data(), pierced_t.data(), 1, &count, &cell);
+              ray.dx, ray.dy, ray.dz, ray.t_max, 0.0f, float(f.cell_size_x), float(f.cell_size_y),
+              grid.view_cell, l.view_x, float(grid.band_low), float(grid.band_high), lists ? cap : 0,
+              pierced.data(), pierced_t.data(), 1, &count, &cell);
           mix(bits(t));
           mix(std::uint32_t(cell));
           mix(std::uint32_t(count));

@@ -14,18 +14,19 @@
 // pierced / pierced_t in the layout's list r. Returns how many.
 inline int pvs_cast_ray(__global const float* h, int width, int height, __global const float* pyramid,
                         __global const int* levels, int top, __global const float* rays, int n,
-                        int line_major, int view, int view_x, float band_lo, float band_hi, int cap,
-                        __global float* hit_t, __global int* hit_cell, __global int* pierced,
-                        __global float* pierced_t, int r) {
+                        int line_major, float curvature, float cell_x, float cell_y, int view, int view_x,
+                        float band_lo, float band_hi, int cap, __global float* hit_t, __global int* hit_cell,
+                        __global int* pierced, __global float* pierced_t, int r) {
   const size_t base = line_major ? (size_t)r * 8 : (size_t)r;
   const size_t step = line_major ? 1 : (size_t)n;
   __global const float* ray = rays + base;
   const size_t list = cap == 0 ? 0 : (line_major ? (size_t)r * cap : (size_t)r);  // no list: no buffer
   const int stride = line_major ? 1 : n;
   int count = 0, cell = -1;
-  hit_t[r] = hf_ray_cast(h, width, height, pyramid, levels, top, ray[0], ray[step], ray[2 * step],
-                         ray[3 * step], ray[4 * step], ray[5 * step], ray[6 * step], view, view_x, band_lo,
-                         band_hi, cap, pierced + list, pierced_t + list, stride, &count, &cell);
+  hit_t[r] =
+      hf_ray_cast(h, width, height, pyramid, levels, top, ray[0], ray[step], ray[2 * step], ray[3 * step],
+                  ray[4 * step], ray[5 * step], ray[6 * step], curvature, cell_x, cell_y, view, view_x,
+                  band_lo, band_hi, cap, pierced + list, pierced_t + list, stride, &count, &cell);
   hit_cell[r] = cell;
   return count;
 }
@@ -33,12 +34,12 @@ inline int pvs_cast_ray(__global const float* h, int width, int height, __global
 // The hits alone.
 __kernel void pvs_cast(__global const float* h, int width, int height, __global const float* pyramid,
                        __global const int* levels, int top, __global const float* rays, int n, int line_major,
-                       int view, int view_x, float band_lo, float band_hi, __global float* hit_t,
-                       __global int* hit_cell) {
+                       float curvature, float cell_x, float cell_y, int view, int view_x, float band_lo,
+                       float band_hi, __global float* hit_t, __global int* hit_cell) {
   const int r = get_global_id(0);
   if (r >= n) return;
-  pvs_cast_ray(h, width, height, pyramid, levels, top, rays, n, line_major, view, view_x, band_lo, band_hi, 0,
-               hit_t, hit_cell, 0, 0, r);
+  pvs_cast_ray(h, width, height, pyramid, levels, top, rays, n, line_major, curvature, cell_x, cell_y, view,
+               view_x, band_lo, band_hi, 0, hit_t, hit_cell, 0, 0, r);
 }
 
 // The hits and the view-cell lists (cap > 0), each list cast into `pierced` / `pierced_t` and
@@ -50,15 +51,15 @@ __kernel void pvs_cast(__global const float* h, int width, int height, __global 
 // work-item of a group.
 __kernel void pvs_cast_lists(__global const float* h, int width, int height, __global const float* pyramid,
                              __global const int* levels, int top, __global const float* rays, int n,
-                             int line_major, int view, int view_x, float band_lo, float band_hi, int cap,
-                             __global float* hit_t, __global int* hit_cell, __global int* counts,
-                             __global int* pierced, __global float* pierced_t, __global int* lists,
-                             __local int* group_counts) {
+                             int line_major, float curvature, float cell_x, float cell_y, int view,
+                             int view_x, float band_lo, float band_hi, int cap, __global float* hit_t,
+                             __global int* hit_cell, __global int* counts, __global int* pierced,
+                             __global float* pierced_t, __global int* lists, __local int* group_counts) {
   const int r = get_global_id(0), lid = get_local_id(0);
   // No return before the barrier: every work-item of the group reaches it.
-  const int count = r < n ? pvs_cast_ray(h, width, height, pyramid, levels, top, rays, n, line_major, view,
-                                         view_x, band_lo, band_hi, cap, hit_t, hit_cell, pierced,
-                                         pierced_t, r)
+  const int count = r < n ? pvs_cast_ray(h, width, height, pyramid, levels, top, rays, n, line_major,
+                                         curvature, cell_x, cell_y, view, view_x, band_lo, band_hi, cap,
+                                         hit_t, hit_cell, pierced, pierced_t, r)
                           : 0;
   group_counts[lid] = count;
   barrier(CLK_LOCAL_MEM_FENCE);

@@ -27,8 +27,9 @@ RayCastResult referenceCastHeightFieldRays(const HeightField& field, const std::
     int count = 0;
     out.t[r] = detail::hf_ray_cast(
         heights.data(), field.width, field.height, pyramid.values.data(), pyramid.levels.data(), pyramid.top,
-        q.ox, q.oy, q.oz, q.dx, q.dy, q.dz, q.t_max, grid.view_cell, layout.view_x, float(grid.band_low),
-        float(grid.band_high), cap, cells.data(), ts.data(), 1, &count, &out.cell[r]);
+        q.ox, q.oy, q.oz, q.dx, q.dy, q.dz, q.t_max, float(options.curvature), float(field.cell_size_x),
+        float(field.cell_size_y), grid.view_cell, layout.view_x, float(grid.band_low), float(grid.band_high),
+        cap, cells.data(), ts.data(), 1, &count, &out.cell[r]);
     out.view_cell.insert(out.view_cell.end(), cells.begin(), cells.begin() + count);
     out.view_t.insert(out.view_t.end(), ts.begin(), ts.begin() + count);
     out.first.push_back(out.view_cell.size());
@@ -36,9 +37,10 @@ RayCastResult referenceCastHeightFieldRays(const HeightField& field, const std::
   return out;
 }
 
-double rayClearance(const HeightField& field, const HeightRay& ray, double t) {
+double rayClearance(const HeightField& field, const HeightRay& ray, double t, double curvature) {
   double x = ray.ox + t * double(ray.dx), y = ray.oy + t * double(ray.dy);
-  const double z = ray.oz + t * double(ray.dz);
+  const double gx = ray.dx * field.cell_size_x, gy = ray.dy * field.cell_size_y;
+  const double z = ray.oz + t * double(ray.dz) + curvature * (gx * gx + gy * gy) * t * t;
   // Within 1e-4 pixel of the box: on its edge (the caster's float rounding).
   if (!(x >= -1e-4 && y >= -1e-4 && x <= field.width - 1 + 1e-4 && y <= field.height - 1 + 1e-4)) return NAN;
   x = std::clamp(x, 0.0, double(field.width - 1));
@@ -59,10 +61,10 @@ double rayClearance(const HeightField& field, const HeightRay& ray, double t) {
   return NAN;  // over nodata
 }
 
-double bruteForceRayHit(const HeightField& field, const HeightRay& ray, double step) {
+double bruteForceRayHit(const HeightField& field, const HeightRay& ray, double step, double curvature) {
   // Samples midway between the steps: never exactly on the grid point a ray may start from.
   for (double t = 0.5 * step; t <= double(ray.t_max); t += step) {
-    const double c = rayClearance(field, ray, t);
+    const double c = rayClearance(field, ray, t, curvature);
     if (c < 0.0) return t;
     const double x = ray.ox + t * double(ray.dx), y = ray.oy + t * double(ray.dy);
     // Once out of the box moving away, nothing more.

@@ -3444,6 +3444,22 @@ TEST_F(Cli, PvsResumesFromAnEarlierBitset) {
                 .status,
             0);
   refused(" --view-cell 8 --tile 4 --seed 3 --resume " + shellQuoted(out("g.bin")), "--view-filter");
+  // The curvature: recorded in the JSON and the bitset (byte 60), and resumed only alike.
+  refused(" --view-cell 8 --tile 4 --seed 3 --curvature --resume " + shellQuoted(out("a.bin")),
+          "computed without curvature");
+  ASSERT_EQ(run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out("e.json")) +
+                " --samples 300 --curvature --bitset " + shellQuoted(out("e.bin")) + grid)
+                .status,
+            0);
+  EXPECT_NE(readText(out("e.json")).find("\"curvature\": 6."), std::string::npos);  // 6.7e-08 per m^2
+  EXPECT_NE(readText(out("a.json")).find("\"curvature\": 0,"), std::string::npos);
+  refused(" --view-cell 8 --tile 4 --seed 3 --refraction 0.3 --resume " + shellQuoted(out("e.bin")),
+          "with another curvature");
+  refused(" --view-cell 8 --tile 4 --seed 3 --resume " + shellQuoted(out("e.bin")), "with another curvature");
+  ASSERT_EQ(run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out("e2.json")) +
+                " --samples 300 --seed 4 --curvature --resume " + shellQuoted(out("e.bin")) + grid)
+                .status,
+            0);
   std::string first_version = readText(out("a.bin"));
   first_version[8] = 1;
   { std::ofstream(out("v1.bin"), std::ios::binary) << first_version; }

@@ -18,6 +18,7 @@
 #include "hfvis/errors.hpp"
 #include "hfvis/pvs.hpp"
 #include "hfvis/region_visibility.hpp"
+#include "hfvis/sweep_options.hpp"
 #include "hfvis_testing/pvs_reference.hpp"
 #include "hfvis_testing/region_visibility_reference.hpp"
 #include "hfvis_testing/synthetic_fields.hpp"
@@ -136,19 +137,22 @@ TEST(PvsRayCaster, KernelMatchesTheReferenceOnEveryHardCase) {
       }
       // A band, and the walker's single height (the samplers' default, where the band point is
       // an end only to within rounding).
-      for (const auto& [low, high] : {std::pair{0.5, 2.0}, std::pair{1.7, 1.7}}) {
-        options.grid.band_low = low;
-        options.grid.band_high = high;
-        for (bool view_cells : {false, true}) {
-          options.view_cells = view_cells;
-          const std::vector<HeightRay> in = raysOver(field, 300, 7);
-          const RayCastResult got = castHeightFieldRays(context, field, in, options);
-          const RayCastResult want = referenceCastHeightFieldRays(field, in, options);
-          expectSame(got, want);
-          for (std::size_t r = 0; r < in.size(); ++r) hits += got.cell[r] >= 0, listed += got.count(r);
-          rays += in.size();
+      // (With curvature the rays bend up over the grid: a c of 0.01 lifts a ray 1 over 10 cells.)
+      for (const auto& [low, high] : {std::pair{0.5, 2.0}, std::pair{1.7, 1.7}})
+        for (double curvature : {0.0, 0.01, -0.004}) {
+          options.grid.band_low = low;
+          options.grid.band_high = high;
+          options.curvature = curvature;
+          for (bool view_cells : {false, true}) {
+            options.view_cells = view_cells;
+            const std::vector<HeightRay> in = raysOver(field, 300, 7);
+            const RayCastResult got = castHeightFieldRays(context, field, in, options);
+            const RayCastResult want = referenceCastHeightFieldRays(field, in, options);
+            expectSame(got, want);
+            for (std::size_t r = 0; r < in.size(); ++r) hits += got.cell[r] >= 0, listed += got.count(r);
+            rays += in.size();
+          }
         }
-      }
     });
   });
   // The rays must exercise both outcomes and the lists (else the test proves little).
@@ -159,7 +163,8 @@ TEST(PvsRayCaster, KernelMatchesTheReferenceOnEveryHardCase) {
 
 // The brute-force march in double precision: no sample strictly below the surface before the
 // hit, the hit on the surface and the ray entering it there, no hit missed that a sample finds.
-void checkAgainstBruteForce(const HeightField& field, double band_low, double band_high) {
+void checkAgainstBruteForce(const HeightField& field, double band_low, double band_high,
+                            double curvature = 0.0) {
   float top = 0.0f;
   for (float h : field.heights) top = std::max(top, std::fabs(h) * float(field.z_scale));
   const double tolerance = 2e-5 * (1.0 + top), step = 1.0 / 64;
@@ -171,13 +176,17 @@ void checkAgainstBruteForce(const HeightField& field, double band_low, double ba
   options.grid.band_low = band_low;
   options.grid.band_high = band_high;
   options.view_cells = true;
+  options.curvature = curvature;
   const RayCastResult got = castHeightFieldRays(testContext(), field, in, options);
   const PvsLayout layout = pvsLayout(field, options.grid);
+  const auto rayClearance = [&](const HeightField& f, const HeightRay& q, double t) {
+    return hfvis::rayClearance(f, q, t, curvature);
+  };
   int hits = 0;
   for (std::size_t r = 0; r < in.size(); ++r) {
     SCOPED_TRACE("ray " + std::to_string(r));
     const HeightRay& q = in[r];
-    const double t = got.t[r], brute = bruteForceRayHit(field, q, step);
+    const double t = got.t[r], brute = bruteForceRayHit(field, q, step, curvature);
     const double t_tol = 1e-4 * (1.0 + t);
     EXPECT_GE(brute, t - t_tol - (rayClearance(field, q, brute) > -tolerance ? step : 0.0))
         << "a hit skipped: brute " << brute << " clearance " << rayClearance(field, q, brute) << " t " << t
@@ -265,6 +274,9 @@ TEST(PvsRayCaster, AgreesWithBruteForceOnCityAndTerrain) {
     field.cell_size_x = 1.5;
     checkAgainstBruteForce(field, 0.5, 3.0);
     checkAgainstBruteForce(field, 1.7, 1.7);  // the walker's band of one height: points in it to rounding
+    // Curved rays (a c of 0.005 over cells of 1.5 x 1: a ray rises 1.1 over 10 cells), both signs.
+    checkAgainstBruteForce(field, 0.5, 3.0, 0.005);
+    checkAgainstBruteForce(field, 1.7, 1.7, -0.003);
   }
 }
 
@@ -358,7 +370,7 @@ TEST(PvsRayCaster, ListsLongerThanReadWithTheHitsAreReadToo) {
     // The same cast on a caster, which says how many launches had their lists read again: the
     // test holds only where some did (else it shows nothing about that read).
     detail::withRayCaster(
-        context, field, options.grid, options.memory_budget_bytes, [&](detail::RayCaster& caster) {
+        context, field, options.grid, 0.0, options.memory_budget_bytes, [&](detail::RayCaster& caster) {
           const detail::RayCasts cast = caster.cast(in, true);
           EXPECT_GT(cast.lists_read_again, 0);
           ASSERT_EQ(cast.list_count.size(), in.size());
@@ -424,7 +436,8 @@ TEST(PvsDense, ClosedCases) {
 
 // Every witness: the eye in its view cell's square and band, the target on the surface in its
 // tile's square, and the segment passing the region visibility's exact line-of-sight test.
-void checkWitnesses(const HeightField& field, const PvsGrid& grid, const PvsResult& pvs) {
+void checkWitnesses(const HeightField& field, const PvsGrid& grid, const PvsResult& pvs,
+                    double curvature = 0.0) {
   ASSERT_EQ(pvs.witnesses.size(), pvs.entries() - pvs.filtered);
   const PvsLayout& l = pvs.layout;
   std::size_t checked = 0;
@@ -446,7 +459,9 @@ void checkWitnesses(const HeightField& field, const PvsGrid& grid, const PvsResu
     eye.points = {RegionPoint{w.eye[0], w.eye[1], w.eye[2]}};
     target.points = {RegionPoint{w.target[0], w.target[1], w.target[2]}};
     if (checked++ % 7 != 0) continue;  // a seventh of them: the reference is slow per call
-    const RegionPairVisibilityResult seen = referenceRegionPairVisibility(field, eye, target, {});
+    RegionVisibilityOptions sight;
+    sight.curvature = curvature;
+    const RegionPairVisibilityResult seen = referenceRegionPairVisibility(field, eye, target, sight);
     EXPECT_EQ(seen.clear_pairs, 1u) << "witness of view cell " << w.view_cell << ", tile " << w.tile;
   }
 }
@@ -494,6 +509,75 @@ TEST(Pvs, EveryEntryHasAWitness) {
     } else {
       EXPECT_EQ(pvs.discontinuities, 0u);
     }
+  }
+  // Over a curved surface (a c of 0.002 per metre squared over the 64 m field: 8 m of drop across
+  // it) the witnesses pass the curved line of sight.
+  for (PvsMethod method : {PvsMethod::Agvs, PvsMethod::PerCell}) {
+    PvsGrid grid = smallGrid();
+    grid.band_high = 6.0;
+    PvsOptions options;
+    options.method = method;
+    options.samples = 20000;
+    options.batch = 4096;
+    options.witnesses = true;
+    options.curvature = 0.002;
+    const PvsResult pvs = computePvs(testContext(), field, grid, options);
+    EXPECT_GT(pvs.entries(), 100u);
+    checkWitnesses(field, grid, pvs, options.curvature);
+  }
+}
+
+// Over the sea, curved (c of the Earth without refraction, cells of 1 km), an eye 1.7 m up sees the
+// ground out to sqrt(1.7 / c), about 4.65 km, and no farther: the dense reference holds exactly the
+// pairs of a view cell's and a tile's grid points that close, and sampling finds no pair farther
+// apart than that, and (AGVS) every pair within 3 km; without curvature AGVS finds every pair.
+TEST(Pvs, CurvatureHidesWhatLiesBeyondTheHorizon) {
+  HeightField sea;
+  sea.width = sea.height = 41;
+  sea.cell_size_x = sea.cell_size_y = 1000.0;
+  sea.heights.assign(41 * 41, 0.0f);
+  PvsGrid grid;
+  grid.view_cell = 8;
+  grid.tile = 4;
+  const double c = earthCurvature(0.0), reach = std::sqrt(1.7 / c);  // (no refraction)
+  ASSERT_GT(reach, 4583.0);  // sqrt(21) km: grid points that close are seen ...
+  ASSERT_LT(reach, 4690.0);  // ... sqrt(22) km apart are not
+  const PvsLayout l = pvsLayout(sea, grid);
+  // The least distance (km) between view cell v's and tile t's closed squares, and between their
+  // grid points (the same here: the squares' corners are grid points).
+  auto apart = [&](int v, int t) {
+    const int vx = (v % l.view_x) * 8, vy = (v / l.view_x) * 8, tx = (t % l.tiles_x) * 4,
+              ty = (t / l.tiles_x) * 4;
+    const int gx = std::max({0, tx - (vx + 8), vx - (tx + 4)}),
+              gy = std::max({0, ty - (vy + 8), vy - (ty + 4)});
+    return std::hypot(double(gx), double(gy));
+  };
+  const PvsResult dense = computeDensePvs(testContext(), sea, grid, DenseTargets::ClosedTiles, c);
+  std::size_t beyond = 0;
+  for (int v = 0; v < l.viewCells(); ++v)
+    for (int t = 0; t < l.tiles(); ++t) {
+      EXPECT_EQ(dense.visible(v, t), apart(v, t) * 1000.0 <= reach) << v << " " << t;
+      beyond += apart(v, t) * 1000.0 > reach;
+    }
+  ASSERT_GT(beyond, 500u);  // (most pairs lie beyond the horizon)
+  // (Only AGVS finds the far pairs at all: from 1.7 m up, a uniform direction meets the ground
+  // kilometres away about once in ten thousand; its two-point samples aim there.)
+  for (PvsMethod method : {PvsMethod::Agvs, PvsMethod::Sgvs, PvsMethod::PerCell}) {
+    SCOPED_TRACE(int(method));
+    PvsOptions options;
+    options.method = method;
+    options.samples = 200000;
+    options.curvature = c;
+    const PvsResult pvs = computePvs(testContext(), sea, grid, options);
+    for (int v = 0; v < l.viewCells(); ++v)
+      for (int t = 0; t < l.tiles(); ++t) {
+        if (apart(v, t) * 1000.0 > reach) EXPECT_FALSE(pvs.visible(v, t)) << v << " " << t;
+        if (method == PvsMethod::Agvs && apart(v, t) <= 3.0) EXPECT_TRUE(pvs.visible(v, t)) << v << " " << t;
+      }
+    if (method != PvsMethod::Agvs) continue;
+    options.curvature = 0.0;
+    const PvsResult flat = computePvs(testContext(), sea, grid, options);
+    EXPECT_EQ(flat.entries(), std::size_t(l.viewCells()) * l.tiles());
   }
 }
 

@@ -45,7 +45,15 @@ struct BitsetOrigin {
   std::uint64_t field = 0;
   float band_low = 0.0f, band_high = 0.0f;
   bool filtered = false;
+  float curvature = 0.0f;  // the drop coefficient (0 in files from before it was kept: flat)
 };
+
+// The run's PVS options as its arguments give them (the curvature from --curvature / --refraction).
+PvsOptions pvsOptions(const RunArguments& run) {
+  PvsOptions options = run.pvs;
+  options.curvature = run.curvature ? earthCurvature(run.refraction) : 0.0;
+  return options;
+}
 
 BitsetOrigin originOf(const HeightField& field, const PvsGrid& grid, const PvsOptions& options) {
   std::uint64_t hash = heightsFingerprint(field);
@@ -56,7 +64,7 @@ BitsetOrigin originOf(const HeightField& field, const PvsGrid& grid, const PvsOp
   for (const int v : {field.width, field.height}) mix(&v, sizeof v);
   for (const double v : {field.cell_size_x, field.cell_size_y, field.z_scale}) mix(&v, sizeof v);
   return {hash, static_cast<float>(grid.band_low), static_cast<float>(grid.band_high),
-          options.filter > 0.0 || options.view_filter > 0};
+          options.filter > 0.0 || options.view_filter > 0, static_cast<float>(options.curvature)};
 }
 
 std::uint32_t floatBits(float v) {
@@ -76,7 +84,7 @@ std::string bitsetFile(const PvsResult& r, const BitsetOrigin& origin) {
   putU32(out, floatBits(origin.band_low));
   putU32(out, floatBits(origin.band_high));
   putU32(out, origin.filtered ? 1u : 0u);
-  putU32(out, 0u);  // (reserved)
+  putU32(out, floatBits(origin.curvature));
   for (std::uint8_t c : r.computed) out.push_back(static_cast<char>(c ? 1 : 0));
   while (out.size() % 4) out.push_back('\0');
   for (std::uint32_t w : r.bits) putU32(out, w);
@@ -137,6 +145,11 @@ BitsetFile readBitsetFile(const std::string& path, const PvsLayout& l, const Bit
                      "'s sets were computed on another field (its heights, cell size or " +
                      "z-scale) or view band than this run's (" + input +
                      "): a resumed run adds to the sets of the same field and band");
+  if (u32(60) != floatBits(origin.curvature))
+    throw UsageError("--resume: " + path + "'s sets were computed " +
+                     (u32(60) == 0 ? std::string("without curvature, which this run takes")
+                                   : std::string("with another curvature than this run's")) +
+                     ": give the same --curvature and --refraction");
   if (u32(56) != 0)
     throw UsageError("--resume: " + path +
                      " was written with --filter or --view-filter, whose entries a resumed run "
@@ -202,7 +215,7 @@ class Pvs : public Computation {
         }
       layoutOf(field);
     }
-    origin_ = originOf(field, grid_, run_.pvs);
+    origin_ = originOf(field, grid_, pvsOptions(run_));
     if (!run_.pvs_resume.empty()) resumeFrom(layout);
     if (run_.pvs_preview_cell_given) {
       const ReceiverPixel& p = run_.pvs_preview_cell;
@@ -218,7 +231,7 @@ class Pvs : public Computation {
   }
 
   void compute(Job& job) override {
-    PvsOptions options = run_.pvs;
+    PvsOptions options = pvsOptions(run_);
     options.seed = run_.seed;
     options.memory_budget_bytes = run_.memory_budget_bytes;
     options.start = start_;
@@ -237,6 +250,7 @@ class Pvs : public Computation {
          << "  \"input\": " << jsonString(run_.input) << ",\n"
          << "  \"method\": " << jsonString(job.method) << ",\n"
          << "  \"seed\": " << run_.seed << ",\n"
+         << "  \"curvature\": " << jsonNumber(pvsOptions(run_).curvature) << ",\n"
          << "  \"resumed_from\": " << resumedFrom() << ",\n"
          << "  \"view_cells\": {\"size\": " << l.view_cell << ", \"across\": " << l.view_x
          << ", \"down\": " << l.view_y << ", \"band\": [" << jsonNumber(grid_.band_low) << ", "
@@ -397,7 +411,7 @@ void checkPvs(const std::string& name, const RunArguments& run) {
                      " did not use (the same seed casts their samples again)");
   if (run.pvs.samples == 0 && run.pvs.pixel_error == 0.0 && run.pvs.seconds == 0.0)
     throw UsageError("'hfvis " + name + "' needs a budget: --samples N, --pixel-error E or --seconds S");
-  PvsOptions options = run.pvs;
+  const PvsOptions options = pvsOptions(run);
   asUsageError([&] { validate(options); });
 }
 
@@ -411,7 +425,7 @@ const CommandSpec kPvsCommand{
     "IN -o OUT.json (--samples N | --pixel-error E | --seconds S) [--view-cell C]\n"
     "[--view-height H0[,H1]] [--view-mask MASK] [--tile T] [--method agvs|sgvs|per-cell]\n"
     "[--estimate-entries N] [--filter K] [--view-filter N] [--seed N] [--bitset OUT.bin]\n"
-    "[--resume PREV.bin] "
+    "[--resume PREV.bin] [--curvature] [--refraction K] "
     "[--preview P.png] [--preview-view-cell COL,ROW] [options]",
     "Potentially visible sets (Bittner, Mattausch, Wonka, Havran & Wimmer 2009): for every view\n"
     "cell, a square of C x C cells (--view-cell, default 32; a cell is the square between four\n"
@@ -444,7 +458,7 @@ const CommandSpec kPvsCommand{
     "sets written at every step (no filter in them). samples and the estimate are this\n"
     "run's; resumed_from names the file and its entries.\n",
     nullptr,
-    kOutputGroup | kInputGroup | kImageGroup | kDeviceGroup | kPvsGroup,
+    kOutputGroup | kInputGroup | kImageGroup | kDeviceGroup | kEarthGroup | kPvsGroup,
     checkPvs,
     nullptr,
     pipelined<Pvs>,

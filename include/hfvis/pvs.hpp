@@ -23,7 +23,10 @@
 // grid points at heights H0, (H0 + H1) / 2 and H1 (one height when H0 = H1) against the targets
 // on t's grid points (its closed square: a grid point on a tile border counts for every tile
 // around it) by exact viewsheds: tile visible when any of its grid points is visible from any
-// of those eyes. No curvature; projected grids only.
+// of those eyes. With curvature c (PvsOptions::curvature, the viewshed's drop coefficient) every
+// sight line is the straight one over a curved surface: the test takes the surface c d (D - d)
+// higher relative to the segment, the rays are cast so (RayCastOptions::curvature), and the dense
+// reference's viewsheds take c. Projected grids only.
 #pragma once
 
 #include <cstdint>
@@ -74,6 +77,11 @@ struct RayCastOptions {
   // Also list the view cells of `grid` whose volume each ray passes through before its hit.
   bool view_cells = false;
   PvsGrid grid;
+  // The drop coefficient c of hfvis/viewshed.hpp (earthCurvature() in hfvis/sweep_options.hpp;
+  // 0 = flat, |c| <= 1 per ground unit): each ray is a straight line over a curved surface, a
+  // point at ground distance d from its origin lying c d^2 lower relative to it, so that over
+  // the grid the ray's height is oz + t dz + c g^2 t^2, g its ground length per unit of t.
+  double curvature = 0.0;
   // Device memory for the rays and lists of the two launches in flight at a time (the host
   // packs one while the device casts the other); 0 = half the device's memory. Rays are cast in
   // launches that fit it (MemoryBudgetError when one ray in each does not).
@@ -120,6 +128,9 @@ struct PvsOptions {
   double seconds = 0.0;       // wall time
   int batch = 1 << 16;        // samples per device launch (the mixture adapts once per batch)
   std::uint32_t seed = 1;     // a run is a function of the inputs and the seed
+  // The Earth's curvature: the drop coefficient c of hfvis/viewshed.hpp (earthCurvature() in
+  // hfvis/sweep_options.hpp, for ground units in metres; 0 = flat, |c| <= 1 per ground unit).
+  double curvature = 0.0;
   // The pixel error's camera resolution (rays per camera; Sec. 4.5's `resolution`).
   double resolution = 1e6;
   // The visibility filter's k (Sec. 5's object-space filter, global extension; 0 = none): adds
@@ -221,9 +232,10 @@ PvsResult computePvs(const ComputeContext& context, const HeightField& field, co
 enum class DenseTargets { ClosedTiles, InsideTiles };
 
 // The dense reference (see above): (C + 1)^2 x (1 or 3) viewsheds per view cell, for small
-// fields. Throws as computePvs, and InvalidArgument for InsideTiles with tiles below 2 cells.
+// fields, over a surface of `curvature` (PvsOptions::curvature). Throws as computePvs, and
+// InvalidArgument for InsideTiles with tiles below 2 cells.
 PvsResult computeDensePvs(const ComputeContext& context, const HeightField& field, const PvsGrid& grid,
-                          DenseTargets targets = DenseTargets::ClosedTiles);
+                          DenseTargets targets = DenseTargets::ClosedTiles, double curvature = 0.0);
 
 // Entries of `got` that `want` holds, over `want`'s entries (1 when `want` has none).
 double pvsRecall(const PvsResult& got, const PvsResult& want);

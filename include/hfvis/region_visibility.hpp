@@ -26,7 +26,7 @@
 // rising above the segment beside it, except from a point straight above or below it: a vertical
 // segment has no surface strictly between its ends and sees); a cell with a nodata corner has no surface
 // inside and hides nothing, though an edge between two valid heights is surface. With curvature c, the
-// surface at ground distance d from one end and D - d from the other lies c d (D - d) lower
+// surface at ground distance d from one end and D - d from the other lies c d (D - d) higher
 // relative to the straight segment (the viewshed's c d^2 drop from an eye, the target lowered
 // c D^2, written symmetrically). Pairs farther apart than max_distance are not visible. The test
 // runs in single precision, the pair in a canonical order (so that A sees B exactly when B sees

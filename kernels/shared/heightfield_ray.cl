@@ -117,9 +117,32 @@ inline float hf_ray_band_point(float f0, float f1, float bump, float s_end, floa
   return s;
 }
 
+// Whether a ray bends (C != 0, hf_ray_cast): a program built for a flat surface alone
+// (-DHF_RAY_FLAT, src/ops/pvs.cpp) drops the test and the curved terms, so that flat runs cast
+// as they did before curvature; the C++ reference and curved programs test C.
+#ifdef HF_RAY_FLAT
+#define HF_RAY_CURVED(C) 0
+#else
+#define HF_RAY_CURVED(C) ((C) != 0.0f)
+#endif
+
+// The ray's height at t: oz + t dz, and with curvature + C t^2. (Only then: a vertical ray, C = 0,
+// may run to t = INFINITY, where C t^2 would be NaN.)
+inline float hf_ray_height(float oz, float dz, float C, float t) {
+  return HF_RAY_CURVED(C) ? oz + t * dz + C * t * t : oz + t * dz;
+}
+
 // Casts the ray o + t d, t in [0, t_max], through the field's box [0, width - 1] x [0, height - 1]
 // (a ray starting outside it enters first). Returns the hit's t, *cell = its cell (cy (width - 1)
 // + cx); or where the ray leaves the box or reaches t_max, *cell = -1.
+//
+// With curvature c (the drop coefficient of hfvis/viewshed.hpp, per ground unit squared; cells
+// cell_x x cell_y ground units), the ray is a straight line over a curved surface: a point at
+// ground distance d from o lies c d^2 lower relative to it, so over the grid its height is
+// oz + t dz + C t^2, C = c ((dx cell_x)^2 + (dy cell_y)^2) (the region visibility's c D^2 t (1 - t)
+// between two points of it). Along a cell the height over the surface is still a quadratic in t:
+// C adds to its curvature (bump), and a block is skipped by the ray's lowest point over it (an
+// end, or the vertex where C > 0). c = 0 gives the straight ray's operations exactly.
 //
 // With `cap` > 0, also the view cells (squares of `view` x `view` cells, view_x across) whose band
 // the ray passes through before the hit: the points whose height above the surface lies in
@@ -128,10 +151,15 @@ inline float hf_ray_band_point(float f0, float f1, float bump, float s_end, floa
 // most view_x + view_y - 1 squares).
 inline float hf_ray_cast(HFVIS_GLOBAL const float* h, int width, int height,
                          HFVIS_GLOBAL const float* pyramid, HFVIS_GLOBAL const int* levels, int top, float ox,
-                         float oy, float oz, float dx, float dy, float dz, float t_max, int view, int view_x,
-                         float band_lo, float band_hi, int cap, HFVIS_GLOBAL int* pierced,
-                         HFVIS_GLOBAL float* pierced_t, int stride, int* count, int* cell) {
+                         float oy, float oz, float dx, float dy, float dz, float t_max, float curvature,
+                         float cell_x, float cell_y, int view, int view_x, float band_lo, float band_hi,
+                         int cap, HFVIS_GLOBAL int* pierced, HFVIS_GLOBAL float* pierced_t, int stride,
+                         int* count, int* cell) {
   const int cells_x = width - 1, cells_y = height - 1;
+  const float gx = dx * cell_x, gy = dy * cell_y;
+  const float C = curvature * (gx * gx + gy * gy);
+  // The vertex of the ray's height (its lowest point where C > 0; never reached where C <= 0).
+  const float t_vertex = HF_RAY_CURVED(C) && C > 0.0f ? -dz / (2.0f * C) : -INFINITY;
   *cell = -1;
   *count = 0;
   // Clip to the box.
@@ -181,8 +209,12 @@ inline float hf_ray_cast(HFVIS_GLOBAL const float* h, int width, int height,
       const float ey = hf_ray_crossing((float)((dy < 0.0f ? by : by + 1) * size), oy, dy);
       float te = ex < ey ? ex : ey;
       te = te < t_hi ? te : t_hi;
-      const float za = oz + t * dz, zb = oz + te * dz;
-      const float low = za < zb ? za : zb;
+      const float za = hf_ray_height(oz, dz, C, t), zb = hf_ray_height(oz, dz, C, te);
+      float low = za < zb ? za : zb;
+      if (t_vertex > t && t_vertex < te) {
+        const float zv = hf_ray_height(oz, dz, C, t_vertex);
+        low = zv < low ? zv : low;
+      }
       const float top_height = pyramid[levels[4 * k + 2] + by * bw + bx];
       const float above = te <= listed_to ? 0.0f : clearance;
       if (te > t && !(low - top_height <= above)) {  // above the block (or the block all nodata)
@@ -221,13 +253,15 @@ inline float hf_ray_cast(HFVIS_GLOBAL const float* h, int width, int height,
     // The surface at the cell's entry: the last cell's exit where the march goes on into this
     // one (the same point of the continuous surface), else evaluated here.
     const float f0 = !isnan(carried) ? carried
-                                     : hf_ray_bilinear(h00, h10, h01, h11, x - (float)cx, y - (float)cy) - (oz + t * dz);
-    const float f1 = s1 - (oz + t1 * dz);
+                                     : hf_ray_bilinear(h00, h10, h01, h11, x - (float)cx, y - (float)cy) -
+                                           hf_ray_height(oz, dz, C, t);
+    const float f1 = s1 - hf_ray_height(oz, dz, C, t1);
     carried = NAN;
     if (!isnan(f0) && !isnan(f1)) {
       const float span = t1 - t;
       const float twist = h00 - h10 - h01 + h11;
-      const float bump = -(twist * dx * dy) * span * span;
+      const float bump = HF_RAY_CURVED(C) ? -(twist * dx * dy) * span * span + C * span * span
+                                          : -(twist * dx * dy) * span * span;
       // Where the piece turns positive, if it does: s_end.
       float s_end = 1.0f;
       int hit = 0;

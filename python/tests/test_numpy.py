@@ -379,6 +379,16 @@ def test_pvs(tmp_path, projected_tif, dem):
     assert np.all(r.bits & ~merged.bits == 0) and merged.entries == r.entries + merged.filtered > r.entries
     with pytest.raises(hfvis.InvalidArgumentError, match="view_filter"):
         hfvis.pvs(dem, samples=100, cell_size=30, nodata=NODATA, view_filter=9)
+    # The Earth's curvature, as the CLI's --curvature gives it (its JSON's drop coefficient).
+    run_cli("pvs", projected_tif, "-o", out, "--samples", "30000", "--view-cell", "48", "--tile", "32",
+            "--view-height", "2,20", "--seed", "5", "--curvature")
+    curved_cli = json.loads(out.read_text())
+    assert 6e-8 < curved_cli["curvature"] < 7e-8 and printed["curvature"] == 0
+    curved = hfvis.pvs(dem, samples=30000, view_cell=48, tile=32, band_low=2, band_high=20, seed=5, cell_size=30,
+                       nodata=NODATA, curvature=curved_cli["curvature"])
+    assert [None if s is None else s.tolist() for s in curved.sets] == curved_cli["pvs"]
+    with pytest.raises(hfvis.InvalidArgumentError, match="curvature"):
+        hfvis.pvs(dem, samples=100, cell_size=30, nodata=NODATA, curvature=2.0)
     # The settled estimate: its samples counted apart, as the CLI's JSON; 0 turns it off.
     assert r.estimate_samples == printed["estimate_samples"]
     assert [row["settling"] for row in r.history] == [row["settling"] for row in printed["progress"]]

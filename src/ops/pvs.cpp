@@ -133,10 +133,11 @@ constexpr int kRaysPerLaunch = 1 << 16;
 
 class RayCastRoutine : public DeviceRoutine, public RayCaster {
  public:
-  RayCastRoutine(ContextState& st, const HeightField& field, const PvsGrid& grid,
+  RayCastRoutine(ContextState& st, const HeightField& field, const PvsGrid& grid, double curvature,
                  std::size_t memory_budget_bytes, const std::function<void(RayCaster&)>& body)
       : DeviceRoutine(st, field, nullptr, memory_budget_bytes),
         grid_(grid),
+        curvature_(curvature),
         layout_(pvsLayout(field, grid)),
         body_(body) {}
 
@@ -196,6 +197,8 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
  private:
   PreparedHeights prepare() override { return prepareHeights(field_, HeightOrigin::Zero); }
   std::string programFile() const override { return "pvs.cl"; }
+  // A flat surface's program leaves the curved terms out (kernels/shared/heightfield_ray.cl).
+  std::string programOptions() const override { return curvature_ == 0.0 ? "-DHF_RAY_FLAT" : ""; }
 
   void allocate() override {
     line_major_ = lineMajorLayout(st_);
@@ -211,6 +214,9 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
           .set("levels", levels_)
           .set("top", cl_int(pyramid.top))
           .set("line_major", cl_int(line_major_))
+          .set("curvature", static_cast<float>(curvature_))
+          .set("cell_x", static_cast<float>(field_.cell_size_x))
+          .set("cell_y", static_cast<float>(field_.cell_size_y))
           .set("view", cl_int(grid_.view_cell))
           .set("view_x", cl_int(layout_.view_x))
           .set("band_lo", static_cast<float>(grid_.band_low))
@@ -395,6 +401,7 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
   }
 
   const PvsGrid& grid_;
+  const double curvature_;
   const PvsLayout layout_;
   const std::function<void(RayCaster&)>& body_;
   bool line_major_ = true;
@@ -412,9 +419,11 @@ class RayCastRoutine : public DeviceRoutine, public RayCaster {
 }  // namespace
 
 void withRayCaster(const ComputeContext& context, const HeightField& field, const PvsGrid& grid,
-                   std::size_t memory_budget_bytes, const std::function<void(RayCaster&)>& body) {
+                   double curvature, std::size_t memory_budget_bytes,
+                   const std::function<void(RayCaster&)>& body) {
+  validateCurvature(curvature, "the curvature");
   translateOpenClErrors([&] {
-    RayCastRoutine routine(stateOf(context), field, grid, memory_budget_bytes, body);
+    RayCastRoutine routine(stateOf(context), field, grid, curvature, memory_budget_bytes, body);
     routine.run();
   });
 }
@@ -424,7 +433,8 @@ void withRayCaster(const ComputeContext& context, const HeightField& field, cons
 RayCastResult castHeightFieldRays(const ComputeContext& context, const HeightField& field,
                                   const std::vector<HeightRay>& rays, const RayCastOptions& options) {
   detail::RayCasts cast;
-  detail::withRayCaster(context, field, detail::castGrid(options), options.memory_budget_bytes,
+  detail::withRayCaster(context, field, detail::castGrid(options), options.curvature,
+                        options.memory_budget_bytes,
                         [&](detail::RayCaster& caster) { cast = caster.cast(rays, options.view_cells); });
   RayCastResult out;
   out.t = std::move(cast.t);
@@ -446,7 +456,7 @@ RayCastResult castHeightFieldRays(const ComputeContext& context, const HeightFie
 }
 
 PvsResult computeDensePvs(const ComputeContext& context, const HeightField& field, const PvsGrid& grid,
-                          DenseTargets targets) {
+                          DenseTargets targets, double curvature) {
   PvsResult out;
   out.layout = pvsLayout(field, grid);
   const PvsLayout& l = out.layout;
@@ -463,6 +473,7 @@ PvsResult computeDensePvs(const ComputeContext& context, const HeightField& fiel
     heights = {grid.band_low, 0.5 * (grid.band_low + grid.band_high), grid.band_high};
   ViewshedOptions vo;
   vo.target_height = 0.0;
+  vo.curvature = curvature;
   for (int v = 0; v < l.viewCells(); ++v) {
     if (!out.computed[v]) continue;
     const int x0 = (v % l.view_x) * l.view_cell, y0 = (v / l.view_x) * l.view_cell;

@@ -76,9 +76,11 @@ class RayCaster {
   virtual RayCasts cast(const std::vector<HeightRay>& rays, bool view_cells) = 0;
 };
 
-// Runs `body` with a caster of `field` and `grid` (validated) on the device, its launches within
+// Runs `body` with a caster of `field` and `grid` (validated) on the device, its rays over a
+// surface of `curvature` (validated; RayCastOptions::curvature), its launches within
 // `memory_budget_bytes` (0: the default budget).
 void withRayCaster(const ComputeContext& context, const HeightField& field, const PvsGrid& grid,
-                   std::size_t memory_budget_bytes, const std::function<void(RayCaster&)>& body);
+                   double curvature, std::size_t memory_budget_bytes,
+                   const std::function<void(RayCaster&)>& body);
 
 }  // namespace hfvis::detail

@@ -13,6 +13,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "core/sweep_geometry.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/pvs.hpp"
 #include "ops/pvs_ray.hpp"
@@ -176,6 +177,7 @@ class Sampler {
     heights_ = detail::rayHeights(field);
     cx_ = field.cell_size_x;
     cy_ = field.cell_size_y;
+    curvature_ = options.curvature;
     // Valid cells by view cell (view space) and by tile (objects).
     view_cells_.resize(l.viewCells());
     tile_cells_.resize(l.tiles());
@@ -305,12 +307,34 @@ class Sampler {
     return detail::region_surface_at(heights_.data(), field_.width, field_.height, float(x), float(y));
   }
   Vec ground(double x, double y, double z) const { return {x * cx_, y * cy_, z}; }
+  // The ray from o along d: with curvature the straight line over the curved surface, whose height
+  // over the grid is o.z + t d.z + C t^2 (rise(d): C; the caster's own, hf_ray_cast). A sample's
+  // line is its origin and direction so: the reverse ray, from o along -d, is the same line.
   HeightRay ray(Vec o, Vec d) const {
     HeightRay r;
     r.ox = float(o.x / cx_), r.oy = float(o.y / cy_), r.oz = float(o.z);
     r.dx = float(d.x / cx_), r.dy = float(d.y / cy_), r.dz = float(d.z);
     r.t_max = INFINITY;
     return r;
+  }
+  double rise(Vec d) const { return curvature_ * (d.x * d.x + d.y * d.y); }
+  // The point at t of the line from o along d (ray(o, d)).
+  Vec along(Vec o, Vec d, double t) const { return o + t * d + Vec{0.0, 0.0, rise(d) * t * t}; }
+  // The line through a and b, a at t = -u and b at t = 1 - u from its origin (the origin at a for
+  // u = 0, halfway for u = 1/2): the origin into `origin` and the direction into `direction`.
+  // Without curvature the straight segment's; with it, its height's slope and the origin's height
+  // are moved so that the curved line meets both points.
+  void through(Vec a, Vec b, double u, Vec& origin, Vec& direction) const {
+    direction = b - a;
+    const double c = rise(direction);
+    direction.z -= c * (1.0 - 2.0 * u);
+    origin = a + u * (b - a);
+    origin.z = a.z + direction.z * u - c * u * u;
+  }
+  // The height at t of the cast ray q (hf_ray_height, in double).
+  double heightAt(const HeightRay& q, double t) const {
+    const double gx = q.dx * cx_, gy = q.dy * cy_;
+    return q.oz + t * q.dz + curvature_ * (gx * gx + gy * gy) * t * t;
   }
   // A uniform point of a cell (pixels), and the cell's corner.
   void inCell(int cell, double& x, double& y) {
@@ -390,8 +414,7 @@ class Sampler {
       case kTwoPoint: {
         int cell;
         const Vec v = viewPoint(), o = objectPoint(cell);
-        s.origin = v;
-        s.direction = o - v;
+        through(v, o, 0.0, s.origin, s.direction);
         break;
       }
       case kTwoPointMutation: {
@@ -400,8 +423,7 @@ class Sampler {
         const Vec axis = c.target - c.origin;
         const Vec so = perpendicularGaussian(c.origin, axis, c.origin_radius);
         const Vec st = perpendicularGaussian(c.target, axis, c.target_radius);
-        s.origin = 0.5 * (so + st);
-        s.direction = st - so;
+        through(so, st, 0.5, s.origin, s.direction);
         break;
       }
       case kSilhouetteMutation: {
@@ -450,7 +472,9 @@ class Sampler {
           const double lambda = hit[j] + (missed[j] - hit[j]) * i / kDiscoveryRays;
           const Vec end = s.candidate.target + (s.candidate.target_radius * lambda) * s.direction,
                     span = end - s.candidate.origin;
-          rays.push_back(ray(s.candidate.origin, span));
+          Vec origin, direction;
+          through(s.candidate.origin, end, 0.0, origin, direction);
+          rays.push_back(ray(origin, direction));
           // Only whether the ray meets the object first matters (Sec. 4.4: "the region of
           // interest can be restricted to the bounding volume of the object"): it ends once it is
           // 4 radii past the end across the ground (the end lies within a radius of the hit
@@ -492,8 +516,7 @@ class Sampler {
       if (sample.distribution != kSilhouetteMutation) continue;
       const Silhouette& s = silhouettes_[next];
       const Vec end = s.candidate.target + (s.candidate.target_radius * missed[next]) * s.direction;
-      sample.origin = 0.5 * (s.candidate.origin + end);
-      sample.direction = end - s.candidate.origin;
+      through(s.candidate.origin, end, 0.5, sample.origin, sample.direction);
       ++next;
     }
     silhouettes_.clear();
@@ -519,7 +542,7 @@ class Sampler {
     const float lo = s + float(grid_.band_low), hi = s + float(grid_.band_high);
     ez = ez < lo ? lo : (ez > hi ? hi : ez);
     if (!detail::region_sight_visible(heights_.data(), field_.width, field_.height, float(cx_), float(cy_),
-                                      0.0f, 0.0f, ex, ey, ez, tx, ty, tz)) {
+                                      float(curvature_), 0.0f, ex, ey, ez, tx, ty, tz)) {
       ++out_.rejected;
       return 0;
     }
@@ -597,8 +620,8 @@ class Sampler {
           for (int j = 0; j < r.list_count[m]; ++j) {
             const int v = list[j].view_cell;
             const float t = list[j].t;
-            const int c =
-                add(v, tile, p.ox + t * p.dx, p.oy + t * p.dy, p.oz + t * p.dz, tx, ty, s.lineage, false);
+            const int c = add(v, tile, p.ox + t * p.dx, p.oy + t * p.dy, float(heightAt(p, t)), tx, ty,
+                              s.lineage, false);
             end_contribution[end] += c;
             total += c;
           }
@@ -647,7 +670,7 @@ class Sampler {
   void discontinuity(const Sample& s, const std::vector<HeightRay>& rays, const detail::RayCasts& r, int i) {
     const std::size_t k = 2 * std::size_t(i);
     if (r.cell[k] < 0 || !(r.t[k] > 0.5f)) return;
-    const Vec end = s.origin + 0.5 * s.direction, hit = hitPoint(rays[k], r.t[k]), gap = hit - end;
+    const Vec end = along(s.origin, s.direction, 0.5), hit = hitPoint(rays[k], r.t[k]), gap = hit - end;
     if (!(dot(gap, gap) > kDiscontinuityRadii * kDiscontinuityRadii * tile_radius_ * tile_radius_)) return;
     MutationCandidate c;
     c.origin = end;
@@ -660,7 +683,7 @@ class Sampler {
 
   Vec hitPoint(const HeightRay& q, float t) const {
     const double x = q.ox + double(t) * q.dx, y = q.oy + double(t) * q.dy;
-    return ground(x, y, q.oz + double(t) * q.dz);
+    return ground(x, y, heightAt(q, t));
   }
 
   // Sec. 4.5's pixel error, estimated by leaving one sample out: a uniform view ray (the
@@ -794,6 +817,7 @@ class Sampler {
   Random random_;
   std::vector<float> heights_;
   double cx_ = 1, cy_ = 1, tile_radius_ = 0, view_radius_ = 0;
+  double curvature_ = 0;  // PvsOptions::curvature
   std::vector<std::vector<int>> view_cells_, tile_cells_;
   std::vector<int> view_space_, sampled_views_, objects_;
   std::size_t per_cell_next_ = 0;
@@ -852,6 +876,7 @@ void validate(const PvsOptions& options) {
                           std::to_string(options.view_filter));
   if (!std::isfinite(options.resolution) || options.resolution < 1.0)
     throw InvalidArgument("the pixel error's resolution must be at least 1 ray");
+  detail::validateCurvature(options.curvature, "the curvature");
 }
 
 PvsResult computePvs(const ComputeContext& context, const HeightField& field, const PvsGrid& grid,
@@ -859,7 +884,7 @@ PvsResult computePvs(const ComputeContext& context, const HeightField& field, co
   validate(options);
   PvsResult out;
   Sampler sampler(field, grid, options, out);
-  detail::withRayCaster(context, field, grid, options.memory_budget_bytes,
+  detail::withRayCaster(context, field, grid, options.curvature, options.memory_budget_bytes,
                         [&](detail::RayCaster& caster) { sampler.run(caster); });
   return out;
 }

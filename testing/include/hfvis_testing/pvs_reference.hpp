@@ -16,12 +16,13 @@ RayCastResult referenceCastHeightFieldRays(const HeightField& field, const std::
 
 // The first sample t = (k + 1/2) step (k = 0, 1, ...) of the ray inside the field's box and within t_max
 // where the ray lies strictly below the bilinear surface (cells with a nodata corner have none),
-// in double precision; INFINITY when there is none.
-double bruteForceRayHit(const HeightField& field, const HeightRay& ray, double step);
+// in double precision; INFINITY when there is none. `curvature`: RayCastOptions::curvature.
+double bruteForceRayHit(const HeightField& field, const HeightRay& ray, double step, double curvature = 0.0);
 
 // The ray's height above the surface at t, in double precision (NaN outside the box or over a
-// cell with a nodata corner).
-double rayClearance(const HeightField& field, const HeightRay& ray, double t);
+// cell with a nodata corner); with curvature c the ray's height is oz + t dz + c g^2 t^2, g its
+// ground length per unit of t (RayCastOptions::curvature).
+double rayClearance(const HeightField& field, const HeightRay& ray, double t, double curvature = 0.0);
 
 // Random rays from the view band (uniform over the valid cells' squares, at H0 .. H1 above the
 // surface) in uniform directions (ground units), unbounded; a seed gives the same rays.
