@@ -367,7 +367,8 @@ const std::vector<OptionSpec>& optionTable() {
       {"--max-distance", nullptr, "D", kReachGroup, false,
        "only terrain within D ground units of the receiver counts (farther\n"
        "terrain neither casts a horizon nor hides anything nearer; r.horizon's\n"
-       "maxdistance, RVT's svf_r_max); viewshed: only targets within D",
+       "maxdistance, RVT's svf_r_max); viewshed: only targets within D;\n"
+       "region, arealight, pvs: only pairs of points within D",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
          parsePositive(typed, value);
          run.max_distance = parseBounded(typed, value, 0.0, kMostLength, kFloatRange);

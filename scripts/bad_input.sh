@@ -266,6 +266,7 @@ try "pvs tile larger than the field" "" -- pvs field.exr -o out/p.json --samples
 try "pvs view filter of 9 neighbours" "" -- pvs field.exr -o out/p.json --samples 10 --view-filter 9
 try "pvs refraction beyond 1" "" -- pvs field.exr -o out/p.json --samples 10 --refraction 1.5
 try "pvs resumed with another curvature" "" -- pvs field.exr -o out/p.json --samples 10 --seed 9 --curvature --resume prev_pvs.bin
+try "pvs maximum distance below the least" "" -- pvs field.exr -o out/p.json --samples 10 --max-distance 0
 try "pvs band with H1 below H0" "" -- pvs field.exr -o out/p.json --samples 10 --view-height 3,1
 try "pvs mask of the wrong size" "" -- pvs field.exr -o out/p.json --samples 10 --view-mask mask_small.png
 try "pvs budget of 0" "" -- pvs field.exr -o out/p.json --samples 0

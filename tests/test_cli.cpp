@@ -3225,9 +3225,9 @@ TEST_F(Cli, PvsWritesTheLibrarysSetsAsJsonAndBits) {
     for (int i = 0; i < 4; ++i) v |= std::uint32_t(static_cast<unsigned char>(bits[at + i])) << (8 * i);
     return v;
   };
-  ASSERT_GE(bits.size(), 64u);
+  ASSERT_GE(bits.size(), 72u);
   EXPECT_EQ(bits.substr(0, 8), std::string("HFVPVS1", 8));
-  EXPECT_EQ(u32(8), 2u);
+  EXPECT_EQ(u32(8), 3u);
   EXPECT_EQ(u32(12), std::uint32_t(want.layout.view_x));
   EXPECT_EQ(u32(16), std::uint32_t(want.layout.view_y));
   EXPECT_EQ(u32(20), std::uint32_t(want.layout.tiles_x));
@@ -3235,14 +3235,17 @@ TEST_F(Cli, PvsWritesTheLibrarysSetsAsJsonAndBits) {
   EXPECT_EQ(u32(28), std::uint32_t(want.words));
   EXPECT_EQ(u32(32), 8u);
   EXPECT_EQ(u32(36), 4u);
-  // (40: the field's fingerprint, 48 and 52: the view band as float32, 56: no filter, 60: 0)
+  // (40: the field's fingerprint, 48 and 52: the view band as float32, 56: no filter, 60: no
+  // curvature, 64: no maximum distance, 68: reserved)
   EXPECT_EQ(u32(48), 0x3fd9999au);  // 1.7f
   EXPECT_EQ(u32(52), 0x3fd9999au);
   EXPECT_EQ(u32(56), 0u);
   EXPECT_EQ(u32(60), 0u);
-  const std::size_t words_at = 64 + (want.layout.viewCells() + 3) / 4 * 4;
+  EXPECT_EQ(u32(64), 0u);
+  EXPECT_EQ(u32(68), 0u);
+  const std::size_t words_at = 72 + (want.layout.viewCells() + 3) / 4 * 4;
   ASSERT_EQ(bits.size(), words_at + 4 * want.bits.size());
-  for (int v = 0; v < want.layout.viewCells(); ++v) EXPECT_EQ(bits[64 + v], 1);
+  for (int v = 0; v < want.layout.viewCells(); ++v) EXPECT_EQ(bits[72 + v], 1);
   for (std::size_t i = 0; i < want.bits.size(); ++i) EXPECT_EQ(u32(words_at + 4 * i), want.bits[i]) << i;
   EXPECT_TRUE(fs::exists(out("p.png")));
   // A mask of the field's size selecting one corner: only view cell 0 computed.
@@ -3391,7 +3394,7 @@ TEST_F(Cli, PvsResumesFromAnEarlierBitset) {
   const hfvis::PvsResult want = sgvsSets(field, 400, 7, first.bits);
   ASSERT_GT(want.entries(), first.entries());
   const std::string bits = readText(out("b.bin"));
-  const std::size_t words_at = 64 + (want.layout.viewCells() + 3) / 4 * 4;
+  const std::size_t words_at = 72 + (want.layout.viewCells() + 3) / 4 * 4;
   ASSERT_EQ(bits.size(), words_at + 4 * want.bits.size());
   for (std::size_t i = 0; i < want.bits.size(); ++i) {
     std::uint32_t v = 0;
@@ -3451,7 +3454,7 @@ TEST_F(Cli, PvsResumesFromAnEarlierBitset) {
                 " --samples 300 --curvature --bitset " + shellQuoted(out("e.bin")) + grid)
                 .status,
             0);
-  EXPECT_NE(readText(out("e.json")).find("\"curvature\": 6."), std::string::npos);  // 6.7e-08 per m^2
+  EXPECT_NE(readText(out("e.json")).find("\"curvature\": 6."), std::string::npos);  // 6.7e-08 per m
   EXPECT_NE(readText(out("a.json")).find("\"curvature\": 0,"), std::string::npos);
   refused(" --view-cell 8 --tile 4 --seed 3 --refraction 0.3 --resume " + shellQuoted(out("e.bin")),
           "with another curvature");
@@ -3460,6 +3463,28 @@ TEST_F(Cli, PvsResumesFromAnEarlierBitset) {
                 " --samples 300 --seed 4 --curvature --resume " + shellQuoted(out("e.bin")) + grid)
                 .status,
             0);
+  // The maximum distance: in the JSON and the bitset (byte 64), resumed only alike.
+  refused(" --view-cell 8 --tile 4 --seed 3 --max-distance 10 --resume " + shellQuoted(out("a.bin")),
+          "without a maximum distance");
+  ASSERT_EQ(run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out("m.json")) +
+                " --samples 300 --max-distance 10 --bitset " + shellQuoted(out("m.bin")) + grid)
+                .status,
+            0);
+  EXPECT_NE(readText(out("m.json")).find("\"max_distance\": 10,"), std::string::npos);
+  refused(" --view-cell 8 --tile 4 --seed 3 --max-distance 12 --resume " + shellQuoted(out("m.bin")),
+          "with another maximum distance");
+  // A version 2 file (64-byte header: no maximum distance) is read as one without.
+  {
+    std::string v2 = readText(out("a.bin"));
+    v2[8] = 2;
+    v2.erase(64, 8);
+    std::ofstream(out("v2.bin"), std::ios::binary) << v2;
+  }
+  const CliResult from_v2 = run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out("v2.json")) +
+                                " --samples 100 --seed 5 --resume " + shellQuoted(out("v2.bin")) + grid);
+  EXPECT_EQ(from_v2.status, 0) << from_v2.err;
+  EXPECT_NE(readText(out("v2.json")).find("\"entries\": " + std::to_string(first.entries())),
+            std::string::npos);
   std::string first_version = readText(out("a.bin"));
   first_version[8] = 1;
   { std::ofstream(out("v1.bin"), std::ios::binary) << first_version; }

@@ -510,7 +510,7 @@ TEST(Pvs, EveryEntryHasAWitness) {
       EXPECT_EQ(pvs.discontinuities, 0u);
     }
   }
-  // Over a curved surface (a c of 0.002 per metre squared over the 64 m field: 8 m of drop across
+  // Over a curved surface (a c of 0.002 per metre over the 64 m field: 8 m of drop across
   // it) the witnesses pass the curved line of sight.
   for (PvsMethod method : {PvsMethod::Agvs, PvsMethod::PerCell}) {
     PvsGrid grid = smallGrid();
@@ -579,6 +579,60 @@ TEST(Pvs, CurvatureHidesWhatLiesBeyondTheHorizon) {
     const PvsResult flat = computePvs(testContext(), sea, grid, options);
     EXPECT_EQ(flat.entries(), std::size_t(l.viewCells()) * l.tiles());
   }
+}
+
+// A maximum distance of 5.5 m on flat ground of cells of 1 m: the dense reference holds exactly the
+// pairs of a view cell and a tile at most 5.5 m apart; sampling (and either filter) adds no pair
+// farther apart; and since every pair within reach is seen (the squares lie 0, 4, 5.7, 8 ... m
+// apart: those 4 m apart have pairs of points well within reach), the sets complete and the run
+// ends long before its budget.
+TEST(Pvs, AMaximumDistanceBoundsTheSets) {
+  HeightField ground;
+  ground.width = ground.height = 41;
+  ground.heights.assign(41 * 41, 0.0f);
+  PvsGrid grid;
+  grid.view_cell = 8;
+  grid.tile = 4;
+  const double reach = 5.5;
+  const PvsLayout l = pvsLayout(ground, grid);
+  auto apart = [&](int v, int t) {  // between the closed squares
+    const int vx = (v % l.view_x) * 8, vy = (v / l.view_x) * 8, tx = (t % l.tiles_x) * 4,
+              ty = (t / l.tiles_x) * 4;
+    const int gx = std::max({0, tx - (vx + 8), vx - (tx + 4)}),
+              gy = std::max({0, ty - (vy + 8), vy - (ty + 4)});
+    return std::hypot(double(gx), double(gy));
+  };
+  std::size_t within = 0;
+  const PvsResult dense = computeDensePvs(testContext(), ground, grid, DenseTargets::ClosedTiles, 0.0, reach);
+  for (int v = 0; v < l.viewCells(); ++v)
+    for (int t = 0; t < l.tiles(); ++t) {
+      EXPECT_EQ(dense.visible(v, t), apart(v, t) <= 5.5) << v << " " << t;
+      within += apart(v, t) <= 5.5;
+    }
+  ASSERT_GT(within, 500u);
+  ASSERT_LT(within, std::size_t(l.viewCells()) * l.tiles() - 500);
+  for (PvsMethod method : {PvsMethod::Agvs, PvsMethod::PerCell}) {
+    SCOPED_TRACE(int(method));
+    PvsOptions options;
+    options.method = method;
+    options.samples = 200000;
+    options.max_distance = reach;
+    options.filter = 3.0;
+    options.view_filter = 8;
+    const PvsResult pvs = computePvs(testContext(), ground, grid, options);
+    for (int v = 0; v < l.viewCells(); ++v)
+      for (int t = 0; t < l.tiles(); ++t)
+        if (apart(v, t) > 5.5) EXPECT_FALSE(pvs.visible(v, t)) << v << " " << t;
+  }
+  PvsOptions options;
+  options.samples = 10000000;
+  options.max_distance = reach;
+  const PvsResult pvs = computePvs(testContext(), ground, grid, options);
+  EXPECT_EQ(pvs.entries(), within);
+  EXPECT_LT(pvs.samples, options.samples / 4);  // (1.4M here)
+  EXPECT_EQ(pvs.pixel_error, 0.0);
+  options.max_distance = 1e-19;  // below kLeastMaxDistance
+  EXPECT_THROW(computePvs(testContext(), ground, grid, options), InvalidArgument);
 }
 
 // Recall against the dense reference rises with the samples for every sampler, and sampling

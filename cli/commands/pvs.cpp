@@ -45,13 +45,15 @@ struct BitsetOrigin {
   std::uint64_t field = 0;
   float band_low = 0.0f, band_high = 0.0f;
   bool filtered = false;
-  float curvature = 0.0f;  // the drop coefficient (0 in files from before it was kept: flat)
+  float curvature = 0.0f;     // the drop coefficient (0 in files from before it was kept: flat)
+  float max_distance = 0.0f;  // 0: none (version 2 files: none)
 };
 
 // The run's PVS options as its arguments give them (the curvature from --curvature / --refraction).
 PvsOptions pvsOptions(const RunArguments& run) {
   PvsOptions options = run.pvs;
   options.curvature = run.curvature ? earthCurvature(run.refraction) : 0.0;
+  options.max_distance = run.max_distance;
   return options;
 }
 
@@ -63,8 +65,12 @@ BitsetOrigin originOf(const HeightField& field, const PvsGrid& grid, const PvsOp
   };
   for (const int v : {field.width, field.height}) mix(&v, sizeof v);
   for (const double v : {field.cell_size_x, field.cell_size_y, field.z_scale}) mix(&v, sizeof v);
-  return {hash, static_cast<float>(grid.band_low), static_cast<float>(grid.band_high),
-          options.filter > 0.0 || options.view_filter > 0, static_cast<float>(options.curvature)};
+  return {hash,
+          static_cast<float>(grid.band_low),
+          static_cast<float>(grid.band_high),
+          options.filter > 0.0 || options.view_filter > 0,
+          static_cast<float>(options.curvature),
+          static_cast<float>(options.max_distance)};
 }
 
 std::uint32_t floatBits(float v) {
@@ -75,7 +81,7 @@ std::uint32_t floatBits(float v) {
 
 std::string bitsetFile(const PvsResult& r, const BitsetOrigin& origin) {
   std::string out("HFVPVS1", 8);  // 7 letters and a zero byte
-  putU32(out, 2);                 // the format's version
+  putU32(out, 3);                 // the format's version
   for (int v : {r.layout.view_x, r.layout.view_y, r.layout.tiles_x, r.layout.tiles_y, r.words,
                 r.layout.view_cell, r.layout.tile})
     putU32(out, static_cast<std::uint32_t>(v));
@@ -85,6 +91,8 @@ std::string bitsetFile(const PvsResult& r, const BitsetOrigin& origin) {
   putU32(out, floatBits(origin.band_high));
   putU32(out, origin.filtered ? 1u : 0u);
   putU32(out, floatBits(origin.curvature));
+  putU32(out, floatBits(origin.max_distance));
+  putU32(out, 0u);  // (reserved)
   for (std::uint8_t c : r.computed) out.push_back(static_cast<char>(c ? 1 : 0));
   while (out.size() % 4) out.push_back('\0');
   for (std::uint32_t w : r.bits) putU32(out, w);
@@ -98,7 +106,9 @@ struct BitsetFile {
   std::vector<std::uint32_t> bits;
 };
 
-constexpr int kBitsetHeader = 64;  // bytes before the computed view cells
+// Bytes before the computed view cells: 72 in format version 3 (the maximum distance at 64),
+// 64 in version 2 (read as no maximum distance).
+constexpr int kBitsetHeader = 72, kBitsetHeader2 = 64;
 
 // The grid is compared with this run's (`l`) from the header, before the body is read, and so is
 // what the sets were computed from (`origin`).
@@ -118,8 +128,12 @@ BitsetFile readBitsetFile(const std::string& path, const PvsLayout& l, const Bit
     throw UsageError("--resume: " + path +
                      " is a bitset of format version 1, which records nothing of the field its sets were "
                      "computed on: run again from the start, or resume from a file this hfvis wrote");
-  if (u32(8) != 2) throw fail("format version " + std::to_string(u32(8)) + ", this hfvis reads version 2");
-  if (!in.read(head + 12, kBitsetHeader - 12)) throw fail("shorter than its 64-byte header");
+  if (u32(8) != 2 && u32(8) != 3)
+    throw fail("format version " + std::to_string(u32(8)) + ", this hfvis reads versions 2 and 3");
+  const int header = u32(8) == 2 ? kBitsetHeader2 : kBitsetHeader;
+  if (!in.read(head + 12, header - 12))
+    throw fail("shorter than its " + std::to_string(header) + "-byte header");
+  if (header == kBitsetHeader2) std::memset(head + kBitsetHeader2, 0, kBitsetHeader - kBitsetHeader2);
   BitsetFile f;
   f.view_x = u32(12), f.view_y = u32(16), f.tiles_x = u32(20), f.tiles_y = u32(24), f.words = u32(28);
   f.view_cell = u32(32), f.tile = u32(36);
@@ -145,6 +159,11 @@ BitsetFile readBitsetFile(const std::string& path, const PvsLayout& l, const Bit
                      "'s sets were computed on another field (its heights, cell size or " +
                      "z-scale) or view band than this run's (" + input +
                      "): a resumed run adds to the sets of the same field and band");
+  if (u32(64) != floatBits(origin.max_distance))
+    throw UsageError("--resume: " + path + "'s sets were computed " +
+                     (u32(64) == 0 ? std::string("without a maximum distance, which this run takes")
+                                   : std::string("with another maximum distance than this run's")) +
+                     ": give the same --max-distance");
   if (u32(60) != floatBits(origin.curvature))
     throw UsageError("--resume: " + path + "'s sets were computed " +
                      (u32(60) == 0 ? std::string("without curvature, which this run takes")
@@ -154,13 +173,13 @@ BitsetFile readBitsetFile(const std::string& path, const PvsLayout& l, const Bit
     throw UsageError("--resume: " + path +
                      " was written with --filter or --view-filter, whose entries a resumed run "
                      "would take for sampled ones: resume only from steps run without them");
-  const std::uint64_t padded = (views + 3) / 4 * 4, size = kBitsetHeader + padded + 4 * views * f.words;
+  const std::uint64_t padded = (views + 3) / 4 * 4, size = header + padded + 4 * views * f.words;
   in.seekg(0, std::ios::end);
   if (std::uint64_t(in.tellg()) != size)
     throw fail("it is " + std::to_string(std::uint64_t(in.tellg())) + " bytes, its header asks " +
                std::to_string(size));
-  in.seekg(kBitsetHeader);
-  std::string body(size - kBitsetHeader, '\0');
+  in.seekg(header);
+  std::string body(size - header, '\0');
   if (!in.read(&body[0], std::streamsize(body.size()))) throw IoError(path, "cannot read it whole");
   f.computed.assign(body.begin(), body.begin() + std::ptrdiff_t(views));
   for (std::uint8_t& c : f.computed) {
@@ -251,6 +270,7 @@ class Pvs : public Computation {
          << "  \"method\": " << jsonString(job.method) << ",\n"
          << "  \"seed\": " << run_.seed << ",\n"
          << "  \"curvature\": " << jsonNumber(pvsOptions(run_).curvature) << ",\n"
+         << "  \"max_distance\": " << jsonNumber(pvsOptions(run_).max_distance) << ",\n"
          << "  \"resumed_from\": " << resumedFrom() << ",\n"
          << "  \"view_cells\": {\"size\": " << l.view_cell << ", \"across\": " << l.view_x
          << ", \"down\": " << l.view_y << ", \"band\": [" << jsonNumber(grid_.band_low) << ", "
@@ -425,7 +445,7 @@ const CommandSpec kPvsCommand{
     "IN -o OUT.json (--samples N | --pixel-error E | --seconds S) [--view-cell C]\n"
     "[--view-height H0[,H1]] [--view-mask MASK] [--tile T] [--method agvs|sgvs|per-cell]\n"
     "[--estimate-entries N] [--filter K] [--view-filter N] [--seed N] [--bitset OUT.bin]\n"
-    "[--resume PREV.bin] [--curvature] [--refraction K] "
+    "[--resume PREV.bin] [--curvature] [--refraction K] [--max-distance D]\n"
     "[--preview P.png] [--preview-view-cell COL,ROW] [options]",
     "Potentially visible sets (Bittner, Mattausch, Wonka, Havran & Wimmer 2009): for every view\n"
     "cell, a square of C x C cells (--view-cell, default 32; a cell is the square between four\n"
@@ -453,12 +473,13 @@ const CommandSpec kPvsCommand{
     "cell, its visible tiles' row-major indices. --bitset OUT.bin: the sets as bits, laid out\n"
     "in docs/PVS.md. The preview shows the PVS size per view cell over a hillshade, or with\n"
     "--preview-view-cell COL,ROW the tiles the view cell holding that pixel sees.\n"
-    "--resume PREV.bin --seed S: go on from an earlier run's --bitset file (same field and\n"
-    "grid) with a seed it did not use: runs of a few seconds each, resumed in turn, give the\n"
+    "--resume PREV.bin --seed S: go on from an earlier run's --bitset file (same field,\n"
+    "grid, band, curvature and maximum distance) with a seed it did not use: runs of a few seconds each, "
+    "resumed in turn, give the\n"
     "sets written at every step (no filter in them). samples and the estimate are this\n"
     "run's; resumed_from names the file and its entries.\n",
     nullptr,
-    kOutputGroup | kInputGroup | kImageGroup | kDeviceGroup | kEarthGroup | kPvsGroup,
+    kOutputGroup | kInputGroup | kImageGroup | kDeviceGroup | kEarthGroup | kReachGroup | kPvsGroup,
     checkPvs,
     nullptr,
     pipelined<Pvs>,

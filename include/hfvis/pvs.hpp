@@ -26,7 +26,8 @@
 // of those eyes. With curvature c (PvsOptions::curvature, the viewshed's drop coefficient) every
 // sight line is the straight one over a curved surface: the test takes the surface c d (D - d)
 // higher relative to the segment, the rays are cast so (RayCastOptions::curvature), and the dense
-// reference's viewsheds take c. Projected grids only.
+// reference's viewsheds take c. With a maximum distance D (PvsOptions::max_distance) the eye and
+// the point it sees lie at most D apart on the ground. Projected grids only.
 #pragma once
 
 #include <cstdint>
@@ -131,6 +132,10 @@ struct PvsOptions {
   // The Earth's curvature: the drop coefficient c of hfvis/viewshed.hpp (earthCurvature() in
   // hfvis/sweep_options.hpp, for ground units in metres; 0 = flat, |c| <= 1 per ground unit).
   double curvature = 0.0;
+  // The largest ground distance between an eye and what it sees (ground units; 0 = none, else
+  // at least kLeastMaxDistance of hfvis/region_visibility.hpp): farther pairs are not visible, as
+  // in the viewshed and the region visibility, and no filter adds a tile beyond it.
+  double max_distance = 0.0;
   // The pixel error's camera resolution (rays per camera; Sec. 4.5's `resolution`).
   double resolution = 1e6;
   // The visibility filter's k (Sec. 5's object-space filter, global extension; 0 = none): adds
@@ -155,7 +160,8 @@ struct PvsOptions {
   bool witnesses = false;               // keep each entry's witness (PvsResult::witnesses)
   std::size_t memory_budget_bytes = 0;  // as RayCastOptions::memory_budget_bytes
   // The sets to start from (empty: none), to resume a run: an earlier run's PvsResult::bits on the
-  // same field and grid, whose view cells not computed now are empty (InvalidArgument otherwise).
+  // same field and grid, whose view cells not computed now are empty (InvalidArgument otherwise),
+  // computed with the same band, curvature and maximum distance (not checked: the bits do not say).
   // Its entries stay, and count as found by earlier samples, never as found once: the estimate is
   // of this run's uniform rays against the sets as a whole. Give a seed the earlier runs did not
   // use, or their samples are cast again.
@@ -232,10 +238,12 @@ PvsResult computePvs(const ComputeContext& context, const HeightField& field, co
 enum class DenseTargets { ClosedTiles, InsideTiles };
 
 // The dense reference (see above): (C + 1)^2 x (1 or 3) viewsheds per view cell, for small
-// fields, over a surface of `curvature` (PvsOptions::curvature). Throws as computePvs, and
-// InvalidArgument for InsideTiles with tiles below 2 cells.
+// fields, over a surface of `curvature` (PvsOptions::curvature), targets within `max_distance`
+// of the eyes (PvsOptions::max_distance). Throws as computePvs, and InvalidArgument for
+// InsideTiles with tiles below 2 cells.
 PvsResult computeDensePvs(const ComputeContext& context, const HeightField& field, const PvsGrid& grid,
-                          DenseTargets targets = DenseTargets::ClosedTiles, double curvature = 0.0);
+                          DenseTargets targets = DenseTargets::ClosedTiles, double curvature = 0.0,
+                          double max_distance = 0.0);
 
 // Entries of `got` that `want` holds, over `want`'s entries (1 when `want` has none).
 double pvsRecall(const PvsResult& got, const PvsResult& want);

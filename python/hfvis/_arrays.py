@@ -295,7 +295,7 @@ def compute(operation, heights, geometry, options, device="", progress=None):
             grid.mask = pvs_mask(options["mask"], heights.shape, grid.view_cell)
         o = _core.PvsOptions()
         _set(o, options, ("samples", "pixel_error", "seconds", "batch", "seed", "resolution", "filter", "view_filter",
-                          "witnesses", "memory_budget_bytes", "estimate_entries", "curvature"))
+                          "witnesses", "memory_budget_bytes", "estimate_entries", "curvature", "max_distance"))
         o.method = _enum(_core.PvsMethod, str(options.get("method", "agvs")).replace("-", "_"), "method")
         if options.get("start") is not None:
             o.start = options["start"].tolist()

@@ -709,8 +709,8 @@ def region_pair_visibility(heights, sources, receivers, *, samples=16, source_he
 
 def pvs(heights, *, samples=0, pixel_error=0.0, seconds=0.0, view_cell=32, band_low=1.7, band_high=1.7, tile=16,
         mask=None, method="agvs", batch=1 << 16, seed=1, resolution=1e6, filter=0.0, view_filter=0, estimate_entries=20,
-        witnesses=False, memory_budget_bytes=0, start=None, curvature=0.0, cell_size=None, z_scale=1.0, nodata=None,
-        device="", progress=None):
+        witnesses=False, memory_budget_bytes=0, start=None, curvature=0.0, max_distance=0.0, cell_size=None,
+        z_scale=1.0, nodata=None, device="", progress=None):
     """Potentially visible sets (Bittner, Mattausch, Wonka, Havran & Wimmer 2009): the tiles of tile
     x tile cells each view cell of view_cell x view_cell cells (its volume band_low .. band_high
     above the surface) sees, by sampling; stops at the first budget reached (samples, pixel_error,
@@ -721,15 +721,17 @@ def pvs(heights, *, samples=0, pixel_error=0.0, seconds=0.0, view_cell=32, band_
     bits (view cells x words uint32), computed, layout (a dict of the grid's sizes), the run's
     counts, history (per batch) and witnesses (with witnesses=True). DataArrays: the same (the sets
     are not on the pixel grid); computed in one piece. start: an earlier run's bits (its Pvs.bits)
-    on the same field and grid, to go on from; its entries stay (give another seed, or its samples
-    repeat; no object-space filter, and not the bits of a filtered run). filter: its k;
+    on the same field and grid (and band, curvature, max_distance), to go on from; its entries
+    stay (give another seed, or its samples repeat; no object-space filter, and not the bits of a
+    filtered run). filter: its k;
     view_filter: the view-space filter's neighbours, 0 to 8 (both add entries without witness,
     counted in filtered). estimate_entries: when a budget leaves the estimate on fewer entries found
     once (one at least), uniform view rays go on until that many carry it, at most as many samples
     (and seconds) as the run took before them (estimate_samples counts them, history rows say
-    "settling"; 0: off). curvature: the drop coefficient c per ground unit squared, (1 - k) / (2 R)
-    (about 6.7e-8 per m^2 for the Earth, as the CLI's --curvature; 0: flat), every sight line the
-    straight one over the curved surface."""
+    "settling"; 0: off). curvature: the drop coefficient c (a drop c d^2), (1 - k) / (2 R) per ground unit
+    (about 6.7e-8 per m for the Earth, as the CLI's --curvature; 0: flat), every sight line the
+    straight one over the curved surface. max_distance: the largest ground distance between an eye
+    and what it sees (0: none)."""
     if not (isinstance(estimate_entries, (int, np.integer)) and 0 <= estimate_entries <= 1_000_000):
         raise InvalidArgumentError(f"estimate_entries must be a whole number in 0 .. 1e6, got {estimate_entries!r}")
     options = {"samples": _whole("samples", samples, None, 2**31 - 1), "pixel_error": _real("pixel_error", pixel_error),
@@ -742,6 +744,7 @@ def pvs(heights, *, samples=0, pixel_error=0.0, seconds=0.0, view_cell=32, band_
                "filter": _real("filter", filter), "view_filter": _whole("view_filter", view_filter, 0, 8),
                "estimate_entries": int(estimate_entries), "witnesses": bool(witnesses),
                "memory_budget_bytes": _budget(memory_budget_bytes), "curvature": _real("curvature", curvature),
+               "max_distance": _real("max_distance", max_distance),
                "start": None if start is None else np.ascontiguousarray(start, dtype=np.uint32).ravel()}
     if _is_dataarray(heights) and _is_dask(heights.data):
         heights = _computed(heights)

@@ -252,6 +252,7 @@ void bindOptions(nb::module_& m) {
       .def_rw("filter", &PvsOptions::filter)
       .def_rw("view_filter", &PvsOptions::view_filter)
       .def_rw("curvature", &PvsOptions::curvature)
+      .def_rw("max_distance", &PvsOptions::max_distance)
       .def_rw("estimate_entries", &PvsOptions::estimate_entries)
       .def_rw("witnesses", &PvsOptions::witnesses)
       .def_rw("memory_budget_bytes", &PvsOptions::memory_budget_bytes)

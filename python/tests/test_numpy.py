@@ -389,6 +389,14 @@ def test_pvs(tmp_path, projected_tif, dem):
     assert [None if s is None else s.tolist() for s in curved.sets] == curved_cli["pvs"]
     with pytest.raises(hfvis.InvalidArgumentError, match="curvature"):
         hfvis.pvs(dem, samples=100, cell_size=30, nodata=NODATA, curvature=2.0)
+    # A maximum distance (ground units), as the CLI's --max-distance: fewer entries.
+    run_cli("pvs", projected_tif, "-o", out, "--samples", "30000", "--view-cell", "48", "--tile", "32",
+            "--view-height", "2,20", "--seed", "5", "--max-distance", "1500")
+    near_cli = json.loads(out.read_text())
+    near = hfvis.pvs(dem, samples=30000, view_cell=48, tile=32, band_low=2, band_high=20, seed=5, cell_size=30,
+                     nodata=NODATA, max_distance=1500)
+    assert near_cli["max_distance"] == 1500 and near.entries == near_cli["entries"] < r.entries
+    assert [None if s is None else s.tolist() for s in near.sets] == near_cli["pvs"]
     # The settled estimate: its samples counted apart, as the CLI's JSON; 0 turns it off.
     assert r.estimate_samples == printed["estimate_samples"]
     assert [row["settling"] for row in r.history] == [row["settling"] for row in printed["progress"]]

@@ -456,7 +456,7 @@ RayCastResult castHeightFieldRays(const ComputeContext& context, const HeightFie
 }
 
 PvsResult computeDensePvs(const ComputeContext& context, const HeightField& field, const PvsGrid& grid,
-                          DenseTargets targets, double curvature) {
+                          DenseTargets targets, double curvature, double max_distance) {
   PvsResult out;
   out.layout = pvsLayout(field, grid);
   const PvsLayout& l = out.layout;
@@ -474,6 +474,7 @@ PvsResult computeDensePvs(const ComputeContext& context, const HeightField& fiel
   ViewshedOptions vo;
   vo.target_height = 0.0;
   vo.curvature = curvature;
+  vo.max_distance = max_distance;
   for (int v = 0; v < l.viewCells(); ++v) {
     if (!out.computed[v]) continue;
     const int x0 = (v % l.view_x) * l.view_cell, y0 = (v / l.view_x) * l.view_cell;

@@ -16,6 +16,7 @@
 #include "core/sweep_geometry.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/pvs.hpp"
+#include "hfvis/region_visibility.hpp"
 #include "ops/pvs_ray.hpp"
 
 namespace hfvis {
@@ -195,11 +196,46 @@ class Sampler {
       if (!view_cells_[v].empty()) sampled_views_.push_back(v);
     for (int t = 0; t < l.tiles(); ++t)
       if (!tile_cells_[t].empty()) objects_.push_back(t);
+    // The tiles within the maximum distance of each view cell (every tile without one): their
+    // closed squares less than D apart on the ground (squares exactly D apart meet only where a
+    // pair of their points is, which no sample finds; the tiles looked at: those of the view
+    // cell's square widened by D).
+    max_d2_ = options.max_distance > 0.0 ? float(options.max_distance * options.max_distance) : 0.0f;
+    in_reach_.assign(std::size_t(l.viewCells()) * out_.words, max_d2_ > 0.0f ? 0u : ~0u);
+    if (max_d2_ == 0.0f && l.tiles() % 32)
+      for (int v = 0; v < l.viewCells(); ++v)
+        in_reach_[std::size_t(v) * out_.words + out_.words - 1] = (1u << (l.tiles() % 32)) - 1u;
+    const double reach = options.max_distance;
+    for (int v = 0; max_d2_ > 0.0f && v < l.viewCells(); ++v) {
+      const int vx0 = (v % l.view_x) * l.view_cell, vy0 = (v / l.view_x) * l.view_cell,
+                vx1 = std::min(vx0 + l.view_cell, l.cells_x), vy1 = std::min(vy0 + l.view_cell, l.cells_y);
+      const auto first = [&](int p0, double cell) {
+        return int(std::max(0.0, std::floor((p0 - reach / cell) / l.tile)));  // (clamped before the int)
+      };
+      const auto last = [&](int p1, double cell, int tiles) {
+        return int(std::min<double>(tiles - 1, std::floor((p1 + reach / cell) / l.tile)));
+      };
+      for (int ty = first(vy0, cy_); ty <= last(vy1, cy_, l.tiles_y); ++ty)
+        for (int tx = first(vx0, cx_); tx <= last(vx1, cx_, l.tiles_x); ++tx) {
+          const int tx0 = tx * l.tile, ty0 = ty * l.tile, tx1 = std::min(tx0 + l.tile, l.cells_x),
+                    ty1 = std::min(ty0 + l.tile, l.cells_y);
+          const double gx = std::max({0, tx0 - vx1, vx0 - tx1}) * cx_,
+                       gy = std::max({0, ty0 - vy1, vy0 - ty1}) * cy_;
+          const int t = ty * l.tiles_x + tx;
+          if (gx * gx + gy * gy < reach * reach)
+            in_reach_[std::size_t(v) * out_.words + t / 32] |= 1u << (t % 32);
+        }
+    }
     // The entries a sample can find: an eye stands on a valid cell of its view cell and a hit is on
-    // a valid cell of its tile, so view cells and tiles all nodata never pair.
+    // a valid cell of its tile, so view cells and tiles all nodata never pair; nor do those farther
+    // apart than the maximum distance.
     reachable_tiles_.assign(out_.words, 0u);
     for (int t : objects_) reachable_tiles_[t / 32] |= 1u << (t % 32);
-    reachable_ = sampled_views_.size() * objects_.size();
+    reachable_ = 0;
+    for (int v : sampled_views_)
+      for (int w = 0; w < out_.words; ++w)
+        reachable_ +=
+            std::size_t(__builtin_popcount(in_reach_[std::size_t(v) * out_.words + w] & reachable_tiles_[w]));
     if (view_space_.empty()) throw InvalidArgument("the computed view cells hold no valid cell (all nodata)");
     tile_radius_ = 0.5 * l.tile * std::hypot(cx_, cy_);
     view_radius_ = 0.5 * l.view_cell * std::hypot(cx_, cy_);
@@ -256,7 +292,8 @@ class Sampler {
     for (int v : sampled_views_)
       for (int w = 0; w < out_.words; ++w)
         found +=
-            std::size_t(__builtin_popcount(out_.bits[std::size_t(v) * out_.words + w] & reachable_tiles_[w]));
+            std::size_t(__builtin_popcount(out_.bits[std::size_t(v) * out_.words + w] &
+                                           in_reach_[std::size_t(v) * out_.words + w] & reachable_tiles_[w]));
     return found == reachable_;
   }
 
@@ -541,8 +578,12 @@ class Sampler {
     if (std::isnan(s) || std::isnan(tz)) return 0;
     const float lo = s + float(grid_.band_low), hi = s + float(grid_.band_high);
     ez = ez < lo ? lo : (ez > hi ? hi : ez);
+    // Beyond the maximum distance: not visible, and no witness rejected (the sight test's own
+    // check, in its float operations).
+    const float gx = (tx - ex) * float(cx_), gy = (ty - ey) * float(cy_);
+    if (max_d2_ > 0.0f && gx * gx + gy * gy > max_d2_) return 0;
     if (!detail::region_sight_visible(heights_.data(), field_.width, field_.height, float(cx_), float(cy_),
-                                      float(curvature_), 0.0f, ex, ey, ez, tx, ty, tz)) {
+                                      float(curvature_), max_d2_, ex, ey, ez, tx, ty, tz)) {
       ++out_.rejected;
       return 0;
     }
@@ -768,7 +809,9 @@ class Sampler {
           for (int x = std::max(0, t % l.tiles_x - rx); x <= std::min(l.tiles_x - 1, t % l.tiles_x + rx);
                ++x) {
             const int u = y * l.tiles_x + x;
-            if (!tile_cells_[u].empty()) out_.bits[std::size_t(v) * out_.words + u / 32] |= 1u << (u % 32);
+            const std::size_t word = std::size_t(v) * out_.words + u / 32;
+            if (!tile_cells_[u].empty() && (in_reach_[word] >> (u % 32)) & 1u)
+              out_.bits[word] |= 1u << (u % 32);
           }
       }
     }
@@ -801,7 +844,8 @@ class Sampler {
       std::sort(like.begin(), like.end());
       for (std::size_t i = 0; i < like.size() && int(i) < options_.view_filter; ++i)
         for (int w = 0; w < words; ++w)
-          out_.bits[std::size_t(v) * words + w] |= sampled[std::size_t(like[i].second) * words + w];
+          out_.bits[std::size_t(v) * words + w] |=
+              sampled[std::size_t(like[i].second) * words + w] & in_reach_[std::size_t(v) * words + w];
     }
   }
 
@@ -831,7 +875,9 @@ class Sampler {
   bool settling_ = false;           // settle(): view-direction samples alone
   double settle_seconds_ = 0.0;     // the time settle() took
   std::vector<std::uint32_t> reachable_tiles_;  // the tiles with a surface (objects_), a bit each
-  std::size_t reachable_ = 0;                   // the entries a sample can find: sampled_views_ x objects_
+  std::vector<std::uint32_t> in_reach_;         // per view cell, the tiles within the maximum distance
+  std::size_t reachable_ = 0;  // the entries a sample can find: sampled_views_ x objects_ within reach
+  float max_d2_ = 0.0f;        // the maximum distance squared (float, as the sight test takes it); 0: none
   // The entries only one uniform view ray has found (foundAgain): a bit per entry as out_.bits,
   // and the finder's lineage by entry (v * tiles + t).
   std::vector<std::uint32_t> only_finder_;
@@ -877,6 +923,10 @@ void validate(const PvsOptions& options) {
   if (!std::isfinite(options.resolution) || options.resolution < 1.0)
     throw InvalidArgument("the pixel error's resolution must be at least 1 ray");
   detail::validateCurvature(options.curvature, "the curvature");
+  if (!std::isfinite(options.max_distance) || options.max_distance < 0.0 ||
+      (options.max_distance > 0.0 && options.max_distance < kLeastMaxDistance))
+    throw InvalidArgument("the maximum distance must be 0 (none) or " + std::to_string(kLeastMaxDistance) +
+                          " .. a finite length (got " + std::to_string(options.max_distance) + ")");
 }
 
 PvsResult computePvs(const ComputeContext& context, const HeightField& field, const PvsGrid& grid,
