@@ -105,6 +105,60 @@ void expectSame(const RayCastResult& got, const RayCastResult& want) {
   EXPECT_LE(differ, got.t.size() / 100);
 }
 
+// A vertical ray with no end (t_max infinite) stays over one point: straight down from above the
+// surface it hits it where its height is the bilinear surface's (it went through the surface: its
+// one cell ended at t = INFINITY, where the point's x was 0 * INFINITY); from below it hits at
+// once; up, or over a nodata corner, it misses, unbounded. Kernel and reference in both layouts,
+// with and without curvature (a vertical ray has no ground length: none bends it), and with the
+// view cells listed (the band over the point).
+TEST(PvsRayCaster, AVerticalRayWithNoEndHitsTheSurfaceUnderIt) {
+  HeightField field = makeSyntheticField("noise", 23, 17, 3);
+  field.heights[std::size_t(9) * 23 + 15] = NAN;  // cells (14 .. 15, 8 .. 9) have no surface
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  std::vector<HeightRay> in;
+  std::vector<float> surface;
+  for (int i = 0; i < 200; ++i) {
+    const float x = 22.0f * u(rng), y = 16.0f * u(rng);
+    const HeightRay at{x, y, 0.0f, 0, 0, 0, 0};
+    const float s = float(-rayClearance(field, at, 0.0));  // the surface there (NaN over nodata)
+    const float dz = i % 4 == 3 ? 1.0f : -(0.5f + u(rng));
+    const float oz = i % 4 == 2 ? s - 0.5f : s + 1.0f + 20.0f * u(rng);  // below it, or above
+    in.push_back({x, y, std::isnan(s) ? 5.0f : oz, 0.0f, 0.0f, dz, INFINITY});
+    surface.push_back(s);
+  }
+  forEachLayout([&](const ComputeContext& context) {
+    for (double curvature : {0.0, 0.01})
+      for (bool view_cells : {false, true}) {
+        RayCastOptions options;
+        options.curvature = curvature;
+        options.view_cells = view_cells;
+        options.grid.view_cell = 4;
+        options.grid.tile = 2;
+        options.grid.band_low = options.grid.band_high = 1.7;
+        const RayCastResult got = castHeightFieldRays(context, field, in, options);
+        expectSame(got, referenceCastHeightFieldRays(field, in, options));
+        int hits = 0;
+        for (std::size_t r = 0; r < in.size(); ++r) {
+          SCOPED_TRACE("ray " + std::to_string(r));
+          const HeightRay& q = in[r];
+          if (std::isnan(surface[r]) || q.dz > 0.0f) {
+            EXPECT_EQ(got.cell[r], -1);
+            EXPECT_EQ(got.t[r], INFINITY);
+          } else if (r % 4 == 2) {
+            EXPECT_GE(got.cell[r], 0);
+            EXPECT_EQ(got.t[r], 0.0f);
+          } else {
+            ++hits;
+            ASSERT_GE(got.cell[r], 0);
+            EXPECT_NEAR(q.oz + got.t[r] * q.dz, surface[r], 1e-4f * (1.0f + std::fabs(surface[r])));
+          }
+        }
+        EXPECT_GT(hits, 80);  // (half the rays go down from above)
+      }
+  });
+}
+
 // Without the lists the grid goes unused: the default one (view cells of 32) is not held against
 // a field smaller than it (every field under 33 x 33 was refused).
 TEST(PvsRayCaster, RaysAloneTakeAnyFieldOfTwoByTwo) {

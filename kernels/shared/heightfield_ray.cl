@@ -136,7 +136,7 @@ inline float hf_ray_height(float oz, float dz, float C, float t) {
 // (a ray starting outside it enters first). Returns the hit's t, *cell = its cell (cy (width - 1)
 // + cx); or where the ray leaves the box or reaches t_max, *cell = -1.
 //
-// With curvature c (the drop coefficient of hfvis/viewshed.hpp, per ground unit squared; cells
+// With curvature c (the drop coefficient of hfvis/viewshed.hpp, per ground unit: a drop c d^2; cells
 // cell_x x cell_y ground units), the ray is a straight line over a curved surface: a point at
 // ground distance d from o lies c d^2 lower relative to it, so over the grid its height is
 // oz + t dz + C t^2, C = c ((dx cell_x)^2 + (dy cell_y)^2) (the region visibility's c D^2 t (1 - t)
@@ -149,12 +149,12 @@ inline float hf_ray_height(float oz, float dz, float C, float t) {
 // [band_lo, band_hi]; each one once, in order along the ray, entry j at pierced[j * stride] with
 // a t of such a point at pierced_t[j * stride]; *count of them (at most cap: a segment meets at
 // most view_x + view_y - 1 squares).
-inline float hf_ray_cast(HFVIS_GLOBAL const float* h, int width, int height,
-                         HFVIS_GLOBAL const float* pyramid, HFVIS_GLOBAL const int* levels, int top, float ox,
-                         float oy, float oz, float dx, float dy, float dz, float t_max, float curvature,
-                         float cell_x, float cell_y, int view, int view_x, float band_lo, float band_hi,
-                         int cap, HFVIS_GLOBAL int* pierced, HFVIS_GLOBAL float* pierced_t, int stride,
-                         int* count, int* cell) {
+inline float hf_ray_cast_within(HFVIS_GLOBAL const float* h, int width, int height,
+                                HFVIS_GLOBAL const float* pyramid, HFVIS_GLOBAL const int* levels, int top,
+                                float ox, float oy, float oz, float dx, float dy, float dz, float t_max,
+                                float curvature, float cell_x, float cell_y, int view, int view_x,
+                                float band_lo, float band_hi, int cap, HFVIS_GLOBAL int* pierced,
+                                HFVIS_GLOBAL float* pierced_t, int stride, int* count, int* cell) {
   const int cells_x = width - 1, cells_y = height - 1;
   const float gx = dx * cell_x, gy = dy * cell_y;
   const float C = curvature * (gx * gx + gy * gy);
@@ -323,6 +323,36 @@ inline float hf_ray_cast(HFVIS_GLOBAL const float* h, int width, int height,
       k = top > 0 ? 1 : 0;
     }
   }
+}
+
+// hf_ray_cast_within, and a vertical ray (no ground motion) with no end: it stays over one point, so
+// its one cell would end at t = INFINITY, where x = ox + t dx is 0 * INFINITY (NaN) and no hit is
+// seen (a ray straight down from above the surface went through it). It is cast to where it has
+// passed below the lowest corner of the cell under it (going down) or above its highest corner
+// and the band (going up), beyond which nothing can happen to it, and without a hit reported as
+// unbounded, as before. (Over a nodata corner the bound is not finite: no surface, nothing to hit.)
+inline float hf_ray_cast(HFVIS_GLOBAL const float* h, int width, int height,
+                         HFVIS_GLOBAL const float* pyramid, HFVIS_GLOBAL const int* levels, int top, float ox,
+                         float oy, float oz, float dx, float dy, float dz, float t_max, float curvature,
+                         float cell_x, float cell_y, int view, int view_x, float band_lo, float band_hi,
+                         int cap, HFVIS_GLOBAL int* pierced, HFVIS_GLOBAL float* pierced_t, int stride,
+                         int* count, int* cell) {
+  float t_end = t_max;
+  const int vertical = dx == 0.0f && dy == 0.0f && dz != 0.0f && !(t_max < INFINITY) && ox >= 0.0f &&
+                       ox <= (float)(width - 1) && oy >= 0.0f && oy <= (float)(height - 1);
+  if (vertical) {
+    const int cx = hf_ray_cell_of(ox, 1.0f, width - 1), cy = hf_ray_cell_of(oy, 1.0f, height - 1);
+    const int p = cy * width + cx;
+    const float h00 = h[p], h10 = h[p + 1], h01 = h[p + width], h11 = h[p + width + 1];
+    const float lo = fmin(fmin(h00, h10), fmin(h01, h11)), hi = fmax(fmax(h00, h10), fmax(h01, h11));
+    const float cut = dz < 0.0f ? (oz - (lo - 1.0f)) / -dz : ((hi + band_hi + 1.0f) - oz) / dz;
+    // (fmin and fmax skip a NaN corner: any NaN corner leaves the cell without surface)
+    if (!isnan(h00 + h10 + h01 + h11) && cut < INFINITY) t_end = cut > 0.0f ? cut : 0.0f;
+  }
+  const float t = hf_ray_cast_within(h, width, height, pyramid, levels, top, ox, oy, oz, dx, dy, dz, t_end,
+                                     curvature, cell_x, cell_y, view, view_x, band_lo, band_hi, cap, pierced,
+                                     pierced_t, stride, count, cell);
+  return *cell < 0 && t_end != t_max ? t_max : t;
 }
 
 #endif  // HFVIS_HEIGHTFIELD_RAY_CL
