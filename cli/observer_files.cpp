@@ -79,6 +79,12 @@ std::vector<CsvPoint> parsePoints(const std::string& path, std::istream& in, dou
     };
     if (number == 1 && (line.rfind("\xFF\xFE", 0) == 0 || line.rfind("\xFE\xFF", 0) == 0))
       throw IoError(path, "is UTF-16 text; save it as UTF-8 (or ASCII) with lines col,row[,height]");
+    // Without a byte-order mark UTF-16 shows as zero bytes between the characters (text has none).
+    if (line.find('\0') != std::string::npos)
+      throw IoError(path,
+                    "line " + std::to_string(number) +
+                        " holds zero bytes: UTF-16 text without a byte-order mark, or not text; save it "
+                        "as UTF-8 (or ASCII) with lines col,row[,height]");
     double col = 0, row_index = 0, height = default_height;
     const bool numbers = fields.size() >= 2 && number_in(fields[0], col) && number_in(fields[1], row_index);
     // A header: before any point, a line whose fields all start with a letter and are no numbers
@@ -131,10 +137,14 @@ std::vector<CsvPoint> parsePoints(const std::string& path, std::istream& in, dou
     const bool trailing_comma = line[line.find_last_not_of(" \t")] == ',';
     if (!numbers || trailing_comma || fields.size() > 3 ||
         (fields.size() == 3 && !number_in(fields[2], height)) ||
-        (kind.whole && (col != std::floor(col) || row_index != std::floor(row_index))) ||
-        std::fabs(col) > 1e9 || std::fabs(row_index) > 1e9)
+        (kind.whole && (col != std::floor(col) || row_index != std::floor(row_index))))
       throw IoError(path, "line " + std::to_string(number) + ": expected " + kind.expected + ", got '" +
                               shown(line) + "'");
+    // (beyond 1e9 a column or row lies outside any field this hfvis reads, and would not fit an int)
+    if (!(std::fabs(col) <= 1e9 && std::fabs(row_index) <= 1e9))
+      throw IoError(path, "line " + std::to_string(number) + ": the point " + shortNumber(col) + "," +
+                              shortNumber(row_index) +
+                              " lies outside the field (a column or row beyond 1e9)");
     if (!absolute && height < 0.0)
       throw IoError(path, "line " + std::to_string(number) + ": the height " + shortNumber(height) + " " +
                               kind.below + "; give a height >= 0 (or --absolute)");

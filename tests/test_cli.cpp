@@ -2459,6 +2459,22 @@ TEST_F(Cli, ViewshedRefusesBadObservers) {
   expectFailure(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) + " --observers " +
                     shellQuoted(in("bad.csv"))),
                 1, "line 3");
+  // UTF-16 without a byte-order mark (zero bytes between the characters), and a point beyond any
+  // field: said as such, not as a malformed line.
+  {
+    std::ofstream csv(in("utf16.csv"), std::ios::binary);
+    for (char c : std::string("1,2\n")) csv << c << '\0';
+  }
+  expectFailure(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) + " --observers " +
+                    shellQuoted(in("utf16.csv"))),
+                1, "UTF-16 text without a byte-order mark");
+  {
+    std::ofstream csv(in("far.csv"));
+    csv << "1,2\n3e9,4\n";
+  }
+  expectFailure(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) + " --observers " +
+                    shellQuoted(in("far.csv"))),
+                1, "line 2: the point 3e+09,4 lies outside the field");
   // A trailing comma is an empty field, not the end of the line (a height left out by mistake).
   for (const char* line : {"1,2,", "1,2,3,", "1,2 , "}) {
     SCOPED_TRACE(line);
