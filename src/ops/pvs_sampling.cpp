@@ -362,11 +362,13 @@ class Sampler {
   // Without curvature the straight segment's; with it, its height's slope and the origin's height
   // are moved so that the curved line meets both points.
   void through(Vec a, Vec b, double u, Vec& origin, Vec& direction) const {
+    // ((1 - u) a + u b: without curvature the very operations of the straight segment's origin, a
+    // or the midpoint (a + b) / 2, so that flat runs draw the samples they drew before curvature)
     direction = b - a;
     const double c = rise(direction);
     direction.z -= c * (1.0 - 2.0 * u);
-    origin = a + u * (b - a);
-    origin.z = a.z + direction.z * u - c * u * u;
+    origin = (1.0 - u) * a + u * b;
+    origin.z -= c * u * (1.0 - u);
   }
   // The height at t of the cast ray q (hf_ray_height, in double).
   double heightAt(const HeightRay& q, double t) const {
