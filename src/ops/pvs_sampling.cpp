@@ -280,8 +280,9 @@ class Sampler {
     }
   }
 
-  // Every computed view cell with a valid cell holds every tile with a surface (every entry a
-  // sample can find; nodata tiles and view cells pair with nothing): no ray can differ, whatever
+  // Every computed view cell with a valid cell holds every tile with a surface within reach (every
+  // entry a sample can find; nodata tiles and view cells pair with nothing, nor do a view cell and
+  // a tile farther apart than the maximum distance): no ray can differ, whatever
   // the estimate's floor of one entry per uniform ray says (a pixel-error budget would go on for
   // ever toward a small E), and no sample can add anything (a samples or seconds budget would be
   // spent for nothing), so the estimate is 0 (batch() sets it, before the history and the progress
@@ -663,8 +664,9 @@ class Sampler {
           for (int j = 0; j < r.list_count[m]; ++j) {
             const int v = list[j].view_cell;
             const float t = list[j].t;
-            const int c = add(v, tile, p.ox + t * p.dx, p.oy + t * p.dy, float(heightAt(p, t)), tx, ty,
-                              s.lineage, false);
+            // (flat: the float operations of before curvature, so that flat runs add what they did)
+            const float ez = curvature_ == 0.0 ? p.oz + t * p.dz : float(heightAt(p, t));
+            const int c = add(v, tile, p.ox + t * p.dx, p.oy + t * p.dy, ez, tx, ty, s.lineage, false);
             end_contribution[end] += c;
             total += c;
           }
