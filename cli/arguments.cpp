@@ -860,9 +860,9 @@ const std::vector<OptionSpec>& optionTable() {
        }},
       {"--resume", nullptr, "PREV.bin", kPvsGroup, false,
        "start from the sets of an earlier run's --bitset file (the same field,\n"
-       "view band and grid, run without --filter or --view-filter; its view\n"
-       "mask unless --view-mask is given) and go on sampling; needs a --seed\n"
-       "the earlier runs did not use",
+       "view band, grid, curvature and maximum distance, run without --filter\n"
+       "or --view-filter; its view mask unless --view-mask is given) and go on\n"
+       "sampling; needs a --seed the earlier runs did not use",
        HFVIS_TEXT(pvs_resume)},
       {"--bitset", nullptr, "OUT.bin", kPvsGroup, false,
        "also the sets as one bitset per view cell (docs/PVS.md, byte by byte)", HFVIS_TEXT(bitset_output)},

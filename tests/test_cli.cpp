@@ -3474,7 +3474,7 @@ TEST_F(Cli, PvsResumesFromAnEarlierBitset) {
   EXPECT_NE(readText(out("a.json")).find("\"curvature\": 0,"), std::string::npos);
   refused(" --view-cell 8 --tile 4 --seed 3 --refraction 0.3 --resume " + shellQuoted(out("e.bin")),
           "with another curvature");
-  refused(" --view-cell 8 --tile 4 --seed 3 --resume " + shellQuoted(out("e.bin")), "with another curvature");
+  refused(" --view-cell 8 --tile 4 --seed 3 --resume " + shellQuoted(out("e.bin")), "with curvature, which this run has not");
   ASSERT_EQ(run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out("e2.json")) +
                 " --samples 300 --seed 4 --curvature --resume " + shellQuoted(out("e.bin")) + grid)
                 .status,

@@ -157,6 +157,21 @@ TEST(PvsRayCaster, AVerticalRayWithNoEndHitsTheSurfaceUnderIt) {
         EXPECT_GT(hits, 80);  // (half the rays go down from above)
       }
   });
+  // Far from 0 (a plane at 3e7, where floats lie 2 apart), a ray of a denormal ground component (it
+  // never reaches a grid line) and one of no direction starting below the surface.
+  HeightField high = makeSyntheticField("flat", 9, 7, 3);
+  for (float& z : high.heights) z = 3e7f;       // (3e7 - 1 rounds to 3e7)
+  high.cell_size_x = high.cell_size_y = 100.0;  // (the library's rule: float steps under a tenth of a cell)
+  const std::vector<HeightRay> odd = {{3.3f, 4.4f, 3e7f + 1000.0f, 0.0f, 0.0f, -1.0f, INFINITY},
+                                      {3.3f, 4.4f, 3e7f + 1000.0f, 1e-40f, 0.0f, -1.0f, INFINITY},
+                                      {3.3f, 4.4f, 2e7f, 0.0f, 0.0f, 0.0f, INFINITY}};
+  forEachLayout([&](const ComputeContext& context) {
+    const RayCastResult got = castHeightFieldRays(context, high, odd);
+    expectSame(got, referenceCastHeightFieldRays(high, odd));
+    for (std::size_t r = 0; r < odd.size(); ++r) EXPECT_GE(got.cell[r], 0) << r;
+    EXPECT_NEAR(odd[0].oz - got.t[0], -rayClearance(high, {3.3f, 4.4f, 0.0f, 0, 0, 0, 0}, 0.0), 4.0);
+    EXPECT_EQ(got.t[2], 0.0f);
+  });
 }
 
 // Without the lists the grid goes unused: the default one (view cells of 32) is not held against
@@ -687,6 +702,41 @@ TEST(Pvs, AMaximumDistanceBoundsTheSets) {
   EXPECT_EQ(pvs.pixel_error, 0.0);
   options.max_distance = 1e-19;  // below kLeastMaxDistance
   EXPECT_THROW(computePvs(testContext(), ground, grid, options), InvalidArgument);
+  // A maximum distance beyond the field's diagonal: the sets of none.
+  options.samples = 30000;
+  options.max_distance = 0.0;
+  const PvsResult unbounded = computePvs(testContext(), ground, grid, options);
+  options.max_distance = 1e9;
+  EXPECT_EQ(computePvs(testContext(), ground, grid, options).bits, unbounded.bits);
+  // With nodata between (grid columns 8 .. 14: cells 7 .. 14 hold no surface) the pairs in reach are
+  // those whose valid cells come within D, not their squares: every one of them is found (a
+  // brute force over the valid cells) and the run stops there, as without nodata.
+  HeightField holed = ground;
+  for (int y = 0; y < 41; ++y)
+    for (int x = 8; x <= 14; ++x) holed.heights[std::size_t(y) * 41 + x] = NAN;
+  std::size_t findable = 0;
+  for (int v = 0; v < l.viewCells(); ++v)
+    for (int t = 0; t < l.tiles(); ++t) {
+      bool near = false;
+      const int vx = (v % l.view_x) * 8, vy = (v / l.view_x) * 8, tx = (t % l.tiles_x) * 4,
+                ty = (t / l.tiles_x) * 4;
+      for (int a = vx; a < vx + 8 && !near; ++a)
+        for (int b = tx; b < tx + 4 && !near; ++b) {
+          if ((a >= 7 && a <= 14) || (b >= 7 && b <= 14)) continue;  // cells without surface
+          const int gx = std::max({0, b - (a + 1), a - (b + 1)});
+          for (int c = vy; c < vy + 8 && !near; ++c)
+            for (int e = ty; e < ty + 4 && !near; ++e) {
+              const int gy = std::max({0, e - (c + 1), c - (e + 1)});
+              near = gx * gx + gy * gy < reach * reach;
+            }
+        }
+      findable += near;
+    }
+  options.samples = 10000000;
+  options.max_distance = reach;
+  const PvsResult gapped = computePvs(testContext(), holed, grid, options);
+  EXPECT_EQ(gapped.entries(), findable);
+  EXPECT_LT(gapped.samples, options.samples / 4);
 }
 
 // Recall against the dense reference rises with the samples for every sampler, and sampling

@@ -162,12 +162,15 @@ BitsetFile readBitsetFile(const std::string& path, const PvsLayout& l, const Bit
   if (u32(64) != floatBits(origin.max_distance))
     throw UsageError("--resume: " + path + "'s sets were computed " +
                      (u32(64) == 0 ? std::string("without a maximum distance, which this run takes")
-                                   : std::string("with another maximum distance than this run's")) +
+                      : origin.max_distance == 0.0f
+                          ? std::string("with a maximum distance, which this run has not")
+                          : std::string("with another maximum distance than this run's")) +
                      ": give the same --max-distance");
   if (u32(60) != floatBits(origin.curvature))
     throw UsageError("--resume: " + path + "'s sets were computed " +
-                     (u32(60) == 0 ? std::string("without curvature, which this run takes")
-                                   : std::string("with another curvature than this run's")) +
+                     (u32(60) == 0               ? std::string("without curvature, which this run takes")
+                      : origin.curvature == 0.0f ? std::string("with curvature, which this run has not")
+                                                 : std::string("with another curvature than this run's")) +
                      ": give the same --curvature and --refraction");
   if (u32(56) != 0)
     throw UsageError("--resume: " + path +
@@ -459,7 +462,8 @@ const CommandSpec kPvsCommand{
     "per-cell: random rays from each view cell in turn. The run stops at the first budget\n"
     "reached: --samples N, --pixel-error E (the paper's estimate, in differing rays per\n"
     "million-ray camera), --seconds S; or at once when every view cell holds every tile\n"
-    "(nodata aside: a view cell or a tile with no valid cell pairs with nothing).\n"
+    "(nodata and --max-distance aside: a view cell or a tile with no valid cell pairs\n"
+    "with nothing, nor do they farther apart than D).\n"
     "The same seed and --samples give the same sets.\n"
     "When a budget leaves the estimate on fewer than 20 entries found once (a count too\n"
     "small to hold within 2x) but one at least, uniform view rays go on until 20 carry\n"

@@ -122,8 +122,9 @@ struct PvsOptions {
   PvsMethod method = PvsMethod::Agvs;
   // Budgets: the run stops at the first one reached (0 = none; then the estimate may settle,
   // estimate_entries below), or at once when the sets are complete: every computed view cell that
-  // holds a valid cell holds every tile that holds one (nodata pairs with nothing; the estimate
-  // then 0; sets to resume from that are complete already cast nothing); at least one must be set.
+  // holds a valid cell holds every tile that holds one, less than max_distance away (nodata pairs
+  // with nothing; the estimate then 0; sets to resume from that are complete already cast
+  // nothing); at least one must be set.
   std::uint64_t samples = 0;  // visibility samples (a global sample is two rays, a per-cell one one)
   double pixel_error = 0.0;   // the estimated pixel error (Sec. 4.5) at or below this
   double seconds = 0.0;       // wall time

@@ -325,12 +325,15 @@ inline float hf_ray_cast_within(HFVIS_GLOBAL const float* h, int width, int heig
   }
 }
 
-// hf_ray_cast_within, and a vertical ray (no ground motion) with no end: it stays over one point, so
-// its one cell would end at t = INFINITY, where x = ox + t dx is 0 * INFINITY (NaN) and no hit is
-// seen (a ray straight down from above the surface went through it). It is cast to where it has
-// passed below the lowest corner of the cell under it (going down) or above its highest corner
-// and the band (going up), beyond which nothing can happen to it, and without a hit reported as
-// unbounded, as before. (Over a nodata corner the bound is not finite: no surface, nothing to hit.)
+// hf_ray_cast_within, and a vertical ray (no ground motion: it never crosses a grid line of the cell
+// it starts in, a direction of 0 across or too small to reach one) with no end: it stays over one
+// point, so its one cell would end at t = INFINITY, where x = ox + t dx is 0 * INFINITY (NaN) and
+// no hit is seen (a ray straight down from above the surface went through it). It is cast to
+// where it has passed below the lowest corner of the cell under it (going down) or above its
+// highest corner and the band (going up), by a margin its heights' float spacing cannot swallow,
+// beyond which nothing can happen to it (a ray of no direction: to t = 0, where it hits if it
+// starts below the surface); and without a hit it is reported unbounded, as before. (Over a
+// nodata corner the bound is not finite: no surface, nothing to hit.)
 inline float hf_ray_cast(HFVIS_GLOBAL const float* h, int width, int height,
                          HFVIS_GLOBAL const float* pyramid, HFVIS_GLOBAL const int* levels, int top, float ox,
                          float oy, float oz, float dx, float dy, float dz, float t_max, float curvature,
@@ -338,16 +341,21 @@ inline float hf_ray_cast(HFVIS_GLOBAL const float* h, int width, int height,
                          int cap, HFVIS_GLOBAL int* pierced, HFVIS_GLOBAL float* pierced_t, int stride,
                          int* count, int* cell) {
   float t_end = t_max;
-  const int vertical = dx == 0.0f && dy == 0.0f && dz != 0.0f && !(t_max < INFINITY) && ox >= 0.0f &&
-                       ox <= (float)(width - 1) && oy >= 0.0f && oy <= (float)(height - 1);
-  if (vertical) {
-    const int cx = hf_ray_cell_of(ox, 1.0f, width - 1), cy = hf_ray_cell_of(oy, 1.0f, height - 1);
-    const int p = cy * width + cx;
-    const float h00 = h[p], h10 = h[p + 1], h01 = h[p + width], h11 = h[p + width + 1];
-    const float lo = fmin(fmin(h00, h10), fmin(h01, h11)), hi = fmax(fmax(h00, h10), fmax(h01, h11));
-    const float cut = dz < 0.0f ? (oz - (lo - 1.0f)) / -dz : ((hi + band_hi + 1.0f) - oz) / dz;
-    // (fmin and fmax skip a NaN corner: any NaN corner leaves the cell without surface)
-    if (!isnan(h00 + h10 + h01 + h11) && cut < INFINITY) t_end = cut > 0.0f ? cut : 0.0f;
+  const int inside = ox >= 0.0f && ox <= (float)(width - 1) && oy >= 0.0f && oy <= (float)(height - 1);
+  if (!(t_max < INFINITY) && inside) {
+    const int cx = hf_ray_cell_of(ox, dx, width - 1), cy = hf_ray_cell_of(oy, dy, height - 1);
+    const float tx = hf_ray_crossing((float)(dx < 0.0f ? cx : cx + 1), ox, dx);
+    const float ty = hf_ray_crossing((float)(dy < 0.0f ? cy : cy + 1), oy, dy);
+    if (!(tx < INFINITY) && !(ty < INFINITY)) {
+      const int p = cy * width + cx;
+      const float h00 = h[p], h10 = h[p + 1], h01 = h[p + width], h11 = h[p + width + 1];
+      const float lo = fmin(fmin(h00, h10), fmin(h01, h11)), hi = fmax(fmax(h00, h10), fmax(h01, h11));
+      const float below = lo - fmax(1.0f, fabs(lo) * 0x1p-20f),
+                  above = hi + band_hi + fmax(1.0f, fabs(hi) * 0x1p-20f);
+      const float cut = dz < 0.0f ? (oz - below) / -dz : (dz > 0.0f ? (above - oz) / dz : 0.0f);
+      // (fmin and fmax pass over a NaN corner: any NaN corner leaves the cell without surface)
+      if (!isnan(h00 + h10 + h01 + h11) && cut < INFINITY) t_end = cut > 0.0f ? cut : 0.0f;
+    }
   }
   const float t = hf_ray_cast_within(h, width, height, pyramid, levels, top, ox, oy, oz, dx, dy, dz, t_end,
                                      curvature, cell_x, cell_y, view, view_x, band_lo, band_hi, cap, pierced,

@@ -13,6 +13,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "core/number_text.hpp"
 #include "core/sweep_geometry.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/pvs.hpp"
@@ -196,36 +197,8 @@ class Sampler {
       if (!view_cells_[v].empty()) sampled_views_.push_back(v);
     for (int t = 0; t < l.tiles(); ++t)
       if (!tile_cells_[t].empty()) objects_.push_back(t);
-    // The tiles within the maximum distance of each view cell (every tile without one): their
-    // closed squares less than D apart on the ground (squares exactly D apart meet only where a
-    // pair of their points is, which no sample finds; the tiles looked at: those of the view
-    // cell's square widened by D).
     max_d2_ = options.max_distance > 0.0 ? float(options.max_distance * options.max_distance) : 0.0f;
-    in_reach_.assign(std::size_t(l.viewCells()) * out_.words, max_d2_ > 0.0f ? 0u : ~0u);
-    if (max_d2_ == 0.0f && l.tiles() % 32)
-      for (int v = 0; v < l.viewCells(); ++v)
-        in_reach_[std::size_t(v) * out_.words + out_.words - 1] = (1u << (l.tiles() % 32)) - 1u;
-    const double reach = options.max_distance;
-    for (int v = 0; max_d2_ > 0.0f && v < l.viewCells(); ++v) {
-      const int vx0 = (v % l.view_x) * l.view_cell, vy0 = (v / l.view_x) * l.view_cell,
-                vx1 = std::min(vx0 + l.view_cell, l.cells_x), vy1 = std::min(vy0 + l.view_cell, l.cells_y);
-      const auto first = [&](int p0, double cell) {
-        return int(std::max(0.0, std::floor((p0 - reach / cell) / l.tile)));  // (clamped before the int)
-      };
-      const auto last = [&](int p1, double cell, int tiles) {
-        return int(std::min<double>(tiles - 1, std::floor((p1 + reach / cell) / l.tile)));
-      };
-      for (int ty = first(vy0, cy_); ty <= last(vy1, cy_, l.tiles_y); ++ty)
-        for (int tx = first(vx0, cx_); tx <= last(vx1, cx_, l.tiles_x); ++tx) {
-          const int tx0 = tx * l.tile, ty0 = ty * l.tile, tx1 = std::min(tx0 + l.tile, l.cells_x),
-                    ty1 = std::min(ty0 + l.tile, l.cells_y);
-          const double gx = std::max({0, tx0 - vx1, vx0 - tx1}) * cx_,
-                       gy = std::max({0, ty0 - vy1, vy0 - ty1}) * cy_;
-          const int t = ty * l.tiles_x + tx;
-          if (gx * gx + gy * gy < reach * reach)
-            in_reach_[std::size_t(v) * out_.words + t / 32] |= 1u << (t % 32);
-        }
-    }
+    reachIn(options.max_distance);
     // The entries a sample can find: an eye stands on a valid cell of its view cell and a hit is on
     // a valid cell of its tile, so view cells and tiles all nodata never pair; nor do those farther
     // apart than the maximum distance.
@@ -234,8 +207,7 @@ class Sampler {
     reachable_ = 0;
     for (int v : sampled_views_)
       for (int w = 0; w < out_.words; ++w)
-        reachable_ +=
-            std::size_t(__builtin_popcount(in_reach_[std::size_t(v) * out_.words + w] & reachable_tiles_[w]));
+        reachable_ += std::size_t(__builtin_popcount(reach(v, w) & reachable_tiles_[w]));
     if (view_space_.empty()) throw InvalidArgument("the computed view cells hold no valid cell (all nodata)");
     tile_radius_ = 0.5 * l.tile * std::hypot(cx_, cy_);
     view_radius_ = 0.5 * l.view_cell * std::hypot(cx_, cy_);
@@ -280,6 +252,76 @@ class Sampler {
     }
   }
 
+  // Word w of view cell v's tiles within the maximum distance (all: no maximum distance, or one
+  // beyond the field's diagonal).
+  std::uint32_t reach(int v, int w) const {
+    return in_reach_.empty() ? ~0u : in_reach_[std::size_t(v) * out_.words + w];
+  }
+
+  // Fills in_reach_: for each computed view cell, the tiles whose valid cells come less than d
+  // from its own on the ground (the bounding boxes of the valid cells, so that nodata between
+  // leaves out pairs no eye and hit can make; squares exactly d apart meet only where a pair of
+  // their points is, which no sample finds). Row by row of tiles: the run of tiles whose squares
+  // are in reach is set a word at a time, then the tiles with nodata at their edges (a valid box
+  // smaller than their square) tested alone. Without d, or with d across the field, nothing.
+  void reachIn(double d) {
+    const PvsLayout& l = out_.layout;
+    if (!(d > 0.0) || d > std::hypot(l.cells_x * cx_, l.cells_y * cy_)) return;
+    struct Box {
+      int x0, y0, x1, y1;  // pixels
+    };
+    const auto valid = [&](const std::vector<int>& cells, Box square) {
+      if (cells.empty()) return square;
+      Box b{l.cells_x, l.cells_y, 0, 0};
+      for (int c : cells) {
+        const int x = c % l.cells_x, y = c / l.cells_x;
+        b = {std::min(b.x0, x), std::min(b.y0, y), std::max(b.x1, x + 1), std::max(b.y1, y + 1)};
+      }
+      return b;
+    };
+    const auto gap = [](int a0, int a1, int b0, int b1) { return std::max({0, b0 - a1, a0 - b1}); };
+    const auto near = [&](const Box& a, const Box& b) {
+      const double gx = gap(a.x0, a.x1, b.x0, b.x1) * cx_, gy = gap(a.y0, a.y1, b.y0, b.y1) * cy_;
+      return gx * gx + gy * gy < d * d;
+    };
+    const auto square = [&](int t) {
+      const int x = (t % l.tiles_x) * l.tile, y = (t / l.tiles_x) * l.tile;
+      return Box{x, y, std::min(x + l.tile, l.cells_x), std::min(y + l.tile, l.cells_y)};
+    };
+    std::vector<Box> tile_box(l.tiles());
+    std::vector<std::vector<int>> edged(l.tiles_y);  // per row of tiles, those with nodata at an edge
+    for (int t = 0; t < l.tiles(); ++t) {
+      const Box full = square(t), b = tile_box[t] = valid(tile_cells_[t], full);
+      if (b.x0 != full.x0 || b.y0 != full.y0 || b.x1 != full.x1 || b.y1 != full.y1)
+        edged[t / l.tiles_x].push_back(t);
+    }
+    in_reach_.assign(std::size_t(l.viewCells()) * out_.words, 0u);
+    for (int v = 0; v < l.viewCells(); ++v) {
+      if (!out_.computed[v]) continue;
+      const int sx = (v % l.view_x) * l.view_cell, sy = (v / l.view_x) * l.view_cell;
+      const Box vb = valid(view_cells_[v], {sx, sy, std::min(sx + l.view_cell, l.cells_x),
+                                            std::min(sy + l.view_cell, l.cells_y)});
+      std::uint32_t* words = &in_reach_[std::size_t(v) * out_.words];
+      for (int ty = 0; ty < l.tiles_y; ++ty) {
+        const double gy = gap(vb.y0, vb.y1, ty * l.tile, std::min(ty * l.tile + l.tile, l.cells_y)) * cy_;
+        if (!(gy * gy < d * d)) continue;
+        const double rest = std::sqrt(d * d - gy * gy) / cx_;  // pixels across
+        int a = int(std::max(0.0, std::floor((vb.x0 - rest) / l.tile)));
+        int b = int(std::min<double>(l.tiles_x - 1, std::floor((vb.x1 + rest) / l.tile)));
+        while (a <= b && !near(vb, square(ty * l.tiles_x + a))) ++a;
+        while (b >= a && !near(vb, square(ty * l.tiles_x + b))) --b;
+        for (int t = ty * l.tiles_x + a, end = ty * l.tiles_x + b; t <= end;) {  // the run, a word at a time
+          const int first = t % 32, last = std::min(31, first + (end - t));
+          words[t / 32] |= (last == 31 ? ~0u : (1u << (last + 1)) - 1u) & ~((1u << first) - 1u);
+          t += last - first + 1;
+        }
+        for (int t : edged[ty])
+          if (t % l.tiles_x >= a && t % l.tiles_x <= b && !near(vb, tile_box[t]))
+            words[t / 32] &= ~(1u << (t % 32));
+      }
+    }
+  }
+
   // Every computed view cell with a valid cell holds every tile with a surface within reach (every
   // entry a sample can find; nodata tiles and view cells pair with nothing, nor do a view cell and
   // a tile farther apart than the maximum distance): no ray can differ, whatever
@@ -292,9 +334,8 @@ class Sampler {
     std::size_t found = 0;
     for (int v : sampled_views_)
       for (int w = 0; w < out_.words; ++w)
-        found +=
-            std::size_t(__builtin_popcount(out_.bits[std::size_t(v) * out_.words + w] &
-                                           in_reach_[std::size_t(v) * out_.words + w] & reachable_tiles_[w]));
+        found += std::size_t(__builtin_popcount(out_.bits[std::size_t(v) * out_.words + w] & reach(v, w) &
+                                                reachable_tiles_[w]));
     return found == reachable_;
   }
 
@@ -570,6 +611,11 @@ class Sampler {
   int add(int v, int tile, float ex, float ey, float ez, float tx, float ty, std::uint64_t lineage,
           bool uniform) {
     if (!out_.computed[v]) return 0;
+    // Beyond the maximum distance: no sighting (not even of an entry found before, which would take
+    // it from the entries found once), and no witness rejected (the sight test's own check, in its
+    // float operations).
+    const float gx = (tx - ex) * float(cx_), gy = (ty - ey) * float(cy_);
+    if (max_d2_ > 0.0f && gx * gx + gy * gy > max_d2_) return 0;
     const std::size_t word = std::size_t(v) * out_.words + tile / 32;
     const std::uint32_t bit = 1u << (tile % 32);
     if (out_.bits[word] & bit) {
@@ -581,10 +627,6 @@ class Sampler {
     if (std::isnan(s) || std::isnan(tz)) return 0;
     const float lo = s + float(grid_.band_low), hi = s + float(grid_.band_high);
     ez = ez < lo ? lo : (ez > hi ? hi : ez);
-    // Beyond the maximum distance: not visible, and no witness rejected (the sight test's own
-    // check, in its float operations).
-    const float gx = (tx - ex) * float(cx_), gy = (ty - ey) * float(cy_);
-    if (max_d2_ > 0.0f && gx * gx + gy * gy > max_d2_) return 0;
     if (!detail::region_sight_visible(heights_.data(), field_.width, field_.height, float(cx_), float(cy_),
                                       float(curvature_), max_d2_, ex, ey, ez, tx, ty, tz)) {
       ++out_.rejected;
@@ -813,9 +855,8 @@ class Sampler {
           for (int x = std::max(0, t % l.tiles_x - rx); x <= std::min(l.tiles_x - 1, t % l.tiles_x + rx);
                ++x) {
             const int u = y * l.tiles_x + x;
-            const std::size_t word = std::size_t(v) * out_.words + u / 32;
-            if (!tile_cells_[u].empty() && (in_reach_[word] >> (u % 32)) & 1u)
-              out_.bits[word] |= 1u << (u % 32);
+            if (!tile_cells_[u].empty() && (reach(v, u / 32) >> (u % 32)) & 1u)
+              out_.bits[std::size_t(v) * out_.words + u / 32] |= 1u << (u % 32);
           }
       }
     }
@@ -849,7 +890,7 @@ class Sampler {
       for (std::size_t i = 0; i < like.size() && int(i) < options_.view_filter; ++i)
         for (int w = 0; w < words; ++w)
           out_.bits[std::size_t(v) * words + w] |=
-              sampled[std::size_t(like[i].second) * words + w] & in_reach_[std::size_t(v) * words + w];
+              sampled[std::size_t(like[i].second) * words + w] & reach(v, w);
     }
   }
 
@@ -879,7 +920,8 @@ class Sampler {
   bool settling_ = false;           // settle(): view-direction samples alone
   double settle_seconds_ = 0.0;     // the time settle() took
   std::vector<std::uint32_t> reachable_tiles_;  // the tiles with a surface (objects_), a bit each
-  std::vector<std::uint32_t> in_reach_;         // per view cell, the tiles within the maximum distance
+  // Per view cell (words of tiles), the tiles within the maximum distance (reach(); empty: all)
+  std::vector<std::uint32_t> in_reach_;
   std::size_t reachable_ = 0;  // the entries a sample can find: sampled_views_ x objects_ within reach
   float max_d2_ = 0.0f;        // the maximum distance squared (float, as the sight test takes it); 0: none
   // The entries only one uniform view ray has found (foundAgain): a bit per entry as out_.bits,
@@ -929,8 +971,9 @@ void validate(const PvsOptions& options) {
   detail::validateCurvature(options.curvature, "the curvature");
   if (!std::isfinite(options.max_distance) || options.max_distance < 0.0 ||
       (options.max_distance > 0.0 && options.max_distance < kLeastMaxDistance))
-    throw InvalidArgument("the maximum distance must be 0 (none) or " + std::to_string(kLeastMaxDistance) +
-                          " .. a finite length (got " + std::to_string(options.max_distance) + ")");
+    throw InvalidArgument("the maximum distance must be 0 (none) or a finite length of at least " +
+                          detail::shortNumber(kLeastMaxDistance) + " (got " +
+                          detail::shortNumber(options.max_distance) + ")");
 }
 
 PvsResult computePvs(const ComputeContext& context, const HeightField& field, const PvsGrid& grid,
