@@ -3433,6 +3433,12 @@ TEST_F(Cli, PvsResumesFromAnEarlierBitset) {
     EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(out("c.json"))) << args;
   };
+  // A run of 300 samples with `args`, its JSON and bitset NAME.json and NAME.bin.
+  const auto written = [&](const std::string& name, const std::string& args) {
+    const CliResult r = run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out(name + ".json")) +
+                            " --samples 300 " + args + " --bitset " + shellQuoted(out(name + ".bin")) + grid);
+    ASSERT_EQ(r.status, 0) << args << ": " << r.err;
+  };
   refused(" --view-cell 8 --tile 4 --resume " + shellQuoted(out("a.bin")), "--resume needs --seed");
   refused(" --view-cell 8 --tile 4 --seed 3 --filter 2 --resume " + shellQuoted(out("a.bin")), "--filter with --resume");
   refused(" --view-cell 8 --tile 2 --seed 3 --resume " + shellQuoted(out("a.bin")),
@@ -3453,23 +3459,14 @@ TEST_F(Cli, PvsResumesFromAnEarlierBitset) {
                                   " --samples 100 --seed 3 --resume " + shellQuoted(out("a.bin")) + grid);
   EXPECT_EQ(elsewhere.status, 2);
   EXPECT_NE(elsewhere.err.find("computed on another field"), std::string::npos) << elsewhere.err;
-  ASSERT_EQ(run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out("f.json")) +
-                " --samples 300 --filter 2 " + "--bitset " + shellQuoted(out("f.bin")) + grid)
-                .status,
-            0);
+  written("f", "--filter 2");
   refused(" --view-cell 8 --tile 4 --seed 3 --resume " + shellQuoted(out("f.bin")), "written with --filter");
-  ASSERT_EQ(run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out("g.json")) +
-                " --samples 300 --view-filter 3 " + "--bitset " + shellQuoted(out("g.bin")) + grid)
-                .status,
-            0);
+  written("g", "--view-filter 3");
   refused(" --view-cell 8 --tile 4 --seed 3 --resume " + shellQuoted(out("g.bin")), "--view-filter");
   // The curvature: recorded in the JSON and the bitset (byte 60), and resumed only alike.
   refused(" --view-cell 8 --tile 4 --seed 3 --curvature --resume " + shellQuoted(out("a.bin")),
           "computed without curvature");
-  ASSERT_EQ(run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out("e.json")) +
-                " --samples 300 --curvature --bitset " + shellQuoted(out("e.bin")) + grid)
-                .status,
-            0);
+  written("e", "--curvature");
   EXPECT_NE(readText(out("e.json")).find("\"curvature\": 6."), std::string::npos);  // 6.7e-08 per m
   EXPECT_NE(readText(out("a.json")).find("\"curvature\": 0,"), std::string::npos);
   refused(" --view-cell 8 --tile 4 --seed 3 --refraction 0.3 --resume " + shellQuoted(out("e.bin")),
@@ -3482,10 +3479,7 @@ TEST_F(Cli, PvsResumesFromAnEarlierBitset) {
   // The maximum distance: in the JSON and the bitset (byte 64), resumed only alike.
   refused(" --view-cell 8 --tile 4 --seed 3 --max-distance 10 --resume " + shellQuoted(out("a.bin")),
           "without a maximum distance");
-  ASSERT_EQ(run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out("m.json")) +
-                " --samples 300 --max-distance 10 --bitset " + shellQuoted(out("m.bin")) + grid)
-                .status,
-            0);
+  written("m", "--max-distance 10");
   EXPECT_NE(readText(out("m.json")).find("\"max_distance\": 10,"), std::string::npos);
   refused(" --view-cell 8 --tile 4 --seed 3 --max-distance 12 --resume " + shellQuoted(out("m.bin")),
           "with another maximum distance");
