@@ -463,7 +463,9 @@ const CommandSpec kPvsCommand{
     "reached: --samples N, --pixel-error E (the paper's estimate, in differing rays per\n"
     "million-ray camera), --seconds S; or at once when every view cell holds every tile\n"
     "(nodata and --max-distance aside: a view cell or a tile with no valid cell pairs\n"
-    "with nothing, nor do they farther apart than D).\n"
+    "with nothing, nor does a view cell with a tile D or more away).\n"
+    "--curvature (--refraction K): sight lines over the curved Earth, as the viewshed's;\n"
+    "--max-distance D: an eye and the point it sees at most D ground units apart.\n"
     "The same seed and --samples give the same sets.\n"
     "When a budget leaves the estimate on fewer than 20 entries found once (a count too\n"
     "small to hold within 2x) but one at least, uniform view rays go on until 20 carry\n"
@@ -478,10 +480,10 @@ const CommandSpec kPvsCommand{
     "in docs/PVS.md. The preview shows the PVS size per view cell over a hillshade, or with\n"
     "--preview-view-cell COL,ROW the tiles the view cell holding that pixel sees.\n"
     "--resume PREV.bin --seed S: go on from an earlier run's --bitset file (same field,\n"
-    "grid, band, curvature and maximum distance) with a seed it did not use: runs of a few seconds each, "
-    "resumed in turn, give the\n"
-    "sets written at every step (no filter in them). samples and the estimate are this\n"
-    "run's; resumed_from names the file and its entries.\n",
+    "grid, band, curvature and maximum distance) with a seed it did not use: runs of a\n"
+    "few seconds each, resumed in turn, give the sets written at every step (no filter in\n"
+    "them). samples and the estimate are this run's; resumed_from names the file and its\n"
+    "entries.\n",
     nullptr,
     kOutputGroup | kInputGroup | kImageGroup | kDeviceGroup | kEarthGroup | kReachGroup | kPvsGroup,
     checkPvs,
