@@ -582,9 +582,10 @@ __kernel void region_bitmask_bits(__global const float* h, __global const float*
   unsigned int outer[32], inner[32], near_open[32], near_hidden[32];
   for (int w = 0; w < words; ++w) outer[w] = inner[w] = near_open[w] = near_hidden[w] = 0U;
   const float Z = light_z, dz = Z - zr;
-  // The march's rounding (region_sight_visible_culled's clearance, doubled): a cell whose highest
-  // corner lies this far below a line cannot hide it.
-  const float out_margin = 2.0f * margin + 4e-5f * (fabs(zr) + fabs(Z));
+  // The march's rounding (region_sight_visible_culled's clearance, doubled) and the rounding it
+  // forgives: a cell whose highest corner lies this far below a line cannot hide it, and one that
+  // rises this far above it (and more, in_margin) surely does.
+  const float out_margin = 2.0f * margin + 4e-5f * (fabs(zr) + fabs(Z)) + region_forgiven(zr, Z, 0.0f);
   // A light plane not above the receiver: every sample left to the march.
   int all_uncertain = !(dz > 0.0f);
   if (!isnan(zr) && !all_uncertain) {

@@ -157,13 +157,25 @@ inline float excess_on_piece(float t0, float t1, float f0, float f1, float a_t) 
   return best;
 }
 
+// How far the surface may rise above a sight line from the eye at height ze (rise: the target's
+// height less ze; drop: the curvature's c D^2) and still not hide the target: the heights'
+// rounding, which a grazing sight line forgives, as region visibility's march
+// (region_forgiven) and viewcount's tie rule do (docs/ALGORITHMS.md, "Grazing samples and the
+// heights' rounding"). On a tilted plane a sight line between two points of the surface runs
+// along it, and an exact sign hid nearly every such target (all of them on a plane at 8848).
+// 2^-21 of |ze| + |the target's height| + |drop|: about 8 units in the last place of the larger.
+inline float forgiven_rise(float ze, float rise, float drop) {
+  return 0x1p-21f * (fabs(ze) + fabs(ze + rise) + fabs(drop));
+}
+
 // March of the sight line from E (ex, ey) along (dx, dy) over t in [ta, tb] (0 <= ta < tb <= 1),
 // cell by cell. rise: zt - ze; d2: D^2; target_height: the sight line's height above the surface
 // at t = 1, taken as it is rather than as the rounded difference of the two. Returns 1 where the
-// surface rises strictly above the sight line somewhere on [ta, tb]: at a grid-line crossing,
-// or inside a cell without nodata at the top of its quadratic. With `excess` (not null) it marches
-// all of [ta, tb] and raises *excess to the largest f(t) / t met (f the surface less the sight
-// line): a target needs max(0, target_height + that) above the surface to be seen.
+// surface rises above the sight line by more than the rounding it forgives (forgiven_rise)
+// somewhere on [ta, tb]: at a grid-line crossing, or inside a cell without nodata at the top of its
+// quadratic. With `excess` (not null) it marches all of [ta, tb] and raises *excess to the largest
+// (f(t) - forgiven) / t met (f the surface less the sight line): a target needs
+// max(0, target_height + that) above the surface to be seen.
 int sight_walk(__global const float* h, Field f, float ex, float ey, float dx, float dy, float ze, float rise,
                float d2, float target_height, float ta, float tb, float* excess) {
   const float inv_dx = dx != 0.0f ? 1.0f / dx : 0.0f, inv_dy = dy != 0.0f ? 1.0f / dy : 0.0f;
@@ -171,6 +183,7 @@ int sight_walk(__global const float* h, Field f, float ex, float ey, float dx, f
   Axis ax = axis_start(dx > 0.0f ? floor(ex + ta * dx) + 1.0f : ceil(ex + ta * dx) - 1.0f, ex, dx, inv_dx, dy);
   Axis ay = axis_start(dy > 0.0f ? floor(ey + ta * dy) + 1.0f : ceil(ey + ta * dy) - 1.0f, ey, dy, inv_dy, dx);
   const float drop = f.curvature * d2;
+  const float forgiven = forgiven_rise(ze, rise, drop);
   const float pixels = hf_max(fabs(dx), fabs(dy));
   float t0 = ta, f0 = NAN;
   if (ta == 0.0f) f0 = h[(int)ey * f.width + (int)ex] - ze;
@@ -195,10 +208,11 @@ int sight_walk(__global const float* h, Field f, float ex, float ey, float dx, f
     // target) rises at most |twist| 2.5e-7 above its ends: its vertex would be rounding noise.
     const float bump = span * pixels > 1e-3f ? quadratic_bump(f0, f1, a) : -INFINITY;
     if (excess) {
-      if (!isnan(f1)) *excess = hf_max(*excess, f1 / t1);
+      if (!isnan(f1)) *excess = hf_max(*excess, (f1 - forgiven) / t1);
       if (!isnan(f0) && !isnan(f1) && span > 0.0f)
-        *excess = hf_max(*excess, excess_on_piece(t0, t1, f0, f1, span * pixels > 1e-3f ? a / (span * span) : 0.0f));
-    } else if (f0 > 0.0f || f1 > 0.0f || bump > 0.0f) {
+        *excess = hf_max(*excess, excess_on_piece(t0, t1, f0 - forgiven, f1 - forgiven,
+                                                  span * pixels > 1e-3f ? a / (span * span) : 0.0f));
+    } else if (f0 > forgiven || f1 > forgiven || bump > forgiven) {
       return 1;
     }
     f0 = f1;
@@ -601,7 +615,9 @@ HFVIS_INLINE Ray ray_setup(int r, int rays, Field f, int ex_i, int ey_i, int4 bo
 // A ray's bounds over one piece [t0, t1] of it within one cell, where f (the surface's height
 // above the eye, curvature taken) runs from f0 to f1 with t^2 coefficient alpha, lip the
 // surface's slope bound around the cell: *lo, *hi_ray (along the ray itself) and *hi (for every
-// sight line of the wedge) raised where `live`. The largest slope
+// sight line of the wedge) raised where `live`. *lo takes the surface lowered by `forgiven` (at
+// least forgiven_rise's of every target the ray settles), so that a target below it is hidden by
+// more than the rounding its march forgives. The largest slope
 // f / (t D) on the piece is at most its top over the nearest distance (the farthest where the
 // top is negative); on the first piece (t0 = 0, f0 = -eye height <= 0) f / t <= (f - f0) / t,
 // which is linear in t: at most its value at an end. The widening is lip * angle while t D
@@ -609,24 +625,25 @@ HFVIS_INLINE Ray ray_setup(int r, int rays, Field f, int ex_i, int ey_i, int4 bo
 // delta, so the bound over the prefix is a maximum of linear functions of delta, from *hi_ray at
 // 0 to *hi at the wedge's angle. For scalars and lane vectors alike.
 #define HF_MAX(a, b) ((a) > (b) ? (a) : (b))
-#define HFVIS_RAY_BOUNDS(F, I)                                                                                    \
-  HFVIS_INLINE HFVIS_OVERLOADABLE void ray_bounds(F t0, F t1, F f0, F f1, F alpha, F length, F arc_limit, F lip, \
-                                                  F angle, I live, F* lo, F* hi_ray, F* hi) {                   \
-    const F span = t1 - t0;                                                                                     \
-    /* With a nodata end (f NaN) HF_MAX keeps the other: -INFINITY past a nodata crossing. */                      \
-    const F top = HF_MAX(HF_MAX(f0, f1), quadratic_bump(f0, f1, alpha * span * span));                                  \
-    const F rise = (f1 - f0) / t1;                                                                              \
-    const F first = f0 > 0.0f ? (F)INFINITY : HF_MAX(rise - alpha * t1, rise) / length;                         \
-    F seg_hi = t0 > 0.0f ? native_divide(top, (top >= 0.0f ? t0 : t1) * length) : first;                        \
-    const F seg_lo = native_divide(f1, t1 * length);                                                            \
-    const F widen = t1 * length <= arc_limit ? lip * angle : (F)INFINITY;                                       \
-    seg_hi = isnan(seg_hi) ? (F)INFINITY : seg_hi;                                                              \
-    *hi_ray = live ? HF_MAX(*hi_ray, seg_hi) : *hi_ray;                                                         \
-    /* No bound for the wedge where the widening has none (a nodata cell near, or past the arc */               \
-    /* limit), whatever the ray itself meets (-INFINITY in a nodata cell). */                                      \
-    *hi = live ? HF_MAX(*hi, !(widen < INFINITY) ? (F)INFINITY : seg_hi + widen) : *hi;                          \
-    /* a surface point the sight lines pass near */                                                             \
-    *lo = (live & !isnan(seg_lo)) ? HF_MAX(*lo, seg_lo - widen) : *lo;                                          \
+#define HFVIS_RAY_BOUNDS(F, I)                                                                              \
+  HFVIS_INLINE HFVIS_OVERLOADABLE void ray_bounds(F t0, F t1, F f0, F f1, F alpha, F length, F arc_limit,   \
+                                                  F lip, F angle, float forgiven, I live, F* lo, F* hi_ray, \
+                                                  F* hi) {                                                  \
+    const F span = t1 - t0;                                                                                 \
+    /* With a nodata end (f NaN) HF_MAX keeps the other: -INFINITY past a nodata crossing. */               \
+    const F top = HF_MAX(HF_MAX(f0, f1), quadratic_bump(f0, f1, alpha * span * span));                      \
+    const F rise = (f1 - f0) / t1;                                                                          \
+    const F first = f0 > 0.0f ? (F)INFINITY : HF_MAX(rise - alpha * t1, rise) / length;                     \
+    F seg_hi = t0 > 0.0f ? native_divide(top, (top >= 0.0f ? t0 : t1) * length) : first;                    \
+    const F seg_lo = native_divide(f1 - forgiven, t1 * length);                                             \
+    const F widen = t1 * length <= arc_limit ? lip * angle : (F)INFINITY;                                   \
+    seg_hi = isnan(seg_hi) ? (F)INFINITY : seg_hi;                                                          \
+    *hi_ray = live ? HF_MAX(*hi_ray, seg_hi) : *hi_ray;                                                     \
+    /* No bound for the wedge where the widening has none (a nodata cell near, or past the arc */           \
+    /* limit), whatever the ray itself meets (-INFINITY in a nodata cell). */                               \
+    *hi = live ? HF_MAX(*hi, !(widen < INFINITY) ? (F)INFINITY : seg_hi + widen) : *hi;                     \
+    /* a surface point the sight lines pass near */                                                         \
+    *lo = (live & !isnan(seg_lo)) ? HF_MAX(*lo, seg_lo - widen) : *lo;                                      \
   }
 HFVIS_RAY_BOUNDS(float, int)
 #if HFVIS_LANES > 1
@@ -636,9 +653,9 @@ HFVIS_RAY_BOUNDS(lane_float, lane_int)
 // Ray r marched alone, event by event (grid-line crossings in order); it settles the targets of
 // its wedge (viewshed_rays).
 HFVIS_INLINE void one_ray(int r, __global const float* h, Field f, __global const float* lipschitz, int ex_i,
-                          int ey_i, float ze, float target_height, int4 box, int rays, __global const int* need,
-                          int use_need, float unit, __global uchar* pending, __global float* ray_hi,
-                          __global float* out_visible, int accumulate) {
+                          int ey_i, float ze, float target_height, float forgiven, int4 box, int rays,
+                          __global const int* need, int use_need, float unit, __global uchar* pending,
+                          __global float* ray_hi, __global float* out_visible, int accumulate) {
   Ray y = ray_setup(r, rays, f, ex_i, ey_i, box, need, use_need, unit);
   if (!y.ok) return;
   const float ex = ex_i, ey = ey_i;
@@ -656,8 +673,8 @@ HFVIS_INLINE void one_ray(int r, __global const float* h, Field f, __global cons
                                 : h[(int)y.end.y * f.width + (int)y.end.x];
     const float f1 = (s1 - ze) - y.drop * t1 * t1;
     const float alpha = surface_curve(h, f.width, c, y.dx, y.dy) - y.drop;  // t^2 coefficient of f
-    ray_bounds(t0, t1, f0, f1, alpha, y.length, y.arc_limit, lipschitz[c.y * cells_x + c.x], y.angle, 1, &lo,
-               &hi_ray, &hi);
+    ray_bounds(t0, t1, f0, f1, alpha, y.length, y.arc_limit, lipschitz[c.y * cells_x + c.x], y.angle,
+               forgiven, 1, &lo, &hi_ray, &hi);
     const float d_ray = t1 * y.length;
     const int crossed = y.x_major ? tx <= t1 : ty <= t1;  // a grid line of the major axis, at t1
     f0 = f1;
@@ -719,10 +736,11 @@ HFVIS_INLINE lane_float lane_surface_at_crossing(__global const float* h, int wi
 
 // The bounds over the piece [t0, t1] of the lanes' rays (t1 where `live`), from its cell (at the
 // piece's middle) and f1 at its end.
-HFVIS_INLINE void lane_piece(__global const float* h, Field f, __global const float* lipschitz, float ex, float ey,
-                             lane_float dx, lane_float dy, lane_float drop, lane_float length, lane_float arc_limit,
-                             lane_float angle, lane_float t0, lane_float t1, lane_float f0, lane_float f1,
-                             lane_int live, lane_float* lo, lane_float* hi_ray, lane_float* hi) {
+HFVIS_INLINE void lane_piece(__global const float* h, Field f, __global const float* lipschitz, float ex,
+                             float ey, lane_float dx, lane_float dy, lane_float drop, lane_float length,
+                             lane_float arc_limit, lane_float angle, float forgiven, lane_float t0,
+                             lane_float t1, lane_float f0, lane_float f1, lane_int live, lane_float* lo,
+                             lane_float* hi_ray, lane_float* hi) {
   const lane_float tm = 0.5f * (t0 + t1);
   const lane_int cx = clamp(convert_int8(floor(ex + tm * dx)), 0, f.width > 2 ? f.width - 2 : 0);
   const lane_int cy = clamp(convert_int8(floor(ey + tm * dy)), 0, f.height > 2 ? f.height - 2 : 0);
@@ -732,7 +750,7 @@ HFVIS_INLINE void lane_piece(__global const float* h, Field f, __global const fl
   const lane_float twist = gather(h, y0 + x0) - gather(h, y0 + x1) - gather(h, y1 + x0) + gather(h, y1 + x1);
   const lane_float alpha = (dx * dy != 0.0f ? twist * dx * dy : (lane_float)0.0f) - drop;  // t^2 coefficient of f
   const lane_float lip = gather(lipschitz, live ? cy * max(f.width - 1, 1) + cx : (lane_int)0);
-  ray_bounds(t0, t1, f0, f1, alpha, length, arc_limit, lip, angle, live, lo, hi_ray, hi);
+  ray_bounds(t0, t1, f0, f1, alpha, length, arc_limit, lip, angle, forgiven, live, lo, hi_ray, hi);
 }
 
 // Rays r0 .. r0 + 7 in lanes, column by column (row by row for rays nearer the y axis): one step
@@ -740,10 +758,11 @@ HFVIS_INLINE void lane_piece(__global const float* h, Field f, __global const fl
 // (one at most, as the rays run at most 45 degrees from the major axis, but for a rounding that
 // puts the next one just before instead of just after it). Returns 0, marching
 // nothing, where the rays to march do not all share the major axis and its direction.
-HFVIS_INLINE int rays_in_lanes(int r0, __global const float* h, Field f, __global const float* lipschitz, int ex_i,
-                               int ey_i, float ze, float target_height, int4 box, int rays, __global const int* need,
-                               int use_need, float unit, __global uchar* pending, __global float* ray_hi,
-                               __global float* out_visible, int accumulate) {
+HFVIS_INLINE int rays_in_lanes(int r0, __global const float* h, Field f, __global const float* lipschitz,
+                               int ex_i, int ey_i, float ze, float target_height, float forgiven, int4 box,
+                               int rays, __global const int* need, int use_need, float unit,
+                               __global uchar* pending, __global float* ray_hi, __global float* out_visible,
+                               int accumulate) {
   Ray ray[HFVIS_LANES];
   int x_major = -1, forward = 0;
   for (int l = 0; l < HFVIS_LANES; ++l) {
@@ -790,14 +809,14 @@ HFVIS_INLINE int rays_in_lanes(int r0, __global const float* h, Field f, __globa
       const lane_float t_minor = minor->t;
       const lane_float s_minor = lane_surface_at_crossing(h, f.width, !x_major, minor, ex_i, ey_i, go);
       const lane_float f_minor = (s_minor - ze) - drop * t_minor * t_minor;
-      lane_piece(h, f, lipschitz, ex, ey, dx, dy, drop, length, arc_limit, angle, t0, t_minor, f0, f_minor, go, &lo,
-                 &hi_ray, &hi);
+      lane_piece(h, f, lipschitz, ex, ey, dx, dy, drop, length, arc_limit, angle, forgiven, t0, t_minor, f0,
+                 f_minor, go, &lo, &hi_ray, &hi);
       t0 = go ? t_minor : t0;
       f0 = go ? f_minor : f0;
       lane_axis_next(minor, e_minor, d_minor, inv_minor, go);
     }
-    lane_piece(h, f, lipschitz, ex, ey, dx, dy, drop, length, arc_limit, angle, t0, t_end, f0, f_end, live, &lo,
-               &hi_ray, &hi);
+    lane_piece(h, f, lipschitz, ex, ey, dx, dy, drop, length, arc_limit, angle, forgiven, t0, t_end, f0,
+               f_end, live, &lo, &hi_ray, &hi);
     // A crossing of both axes at once (a grid point) moves both on.
     lane_axis_next(minor, e_minor, d_minor, inv_minor, live & (minor->t <= t_end));
     lane_axis_next(major, e_major, d_major, inv_major, live & at_major);
@@ -840,24 +859,24 @@ HFVIS_INLINE int rays_in_lanes(int r0, __global const float* h, Field f, __globa
 // The margins of the distance tests (1e-5 relative) take native_sqrt and native_divide within
 // a few ulp, as PoCL and the GPU drivers give them; the exact marches use correctly rounded
 // operations.
-__kernel void viewshed_rays(__global const float* h, Field f, __global const float* lipschitz, int ex_i, int ey_i,
-                            float ze, float target_height, int4 box, int rays, __global const int* need,
-                            int use_need, float unit, __global uchar* pending, __global float* ray_hi,
-                            __global float* out_visible, int accumulate) {
+__kernel void viewshed_rays(__global const float* h, Field f, __global const float* lipschitz, int ex_i,
+                            int ey_i, float ze, float target_height, float forgiven, int4 box, int rays,
+                            __global const int* need, int use_need, float unit, __global uchar* pending,
+                            __global float* ray_hi, __global float* out_visible, int accumulate) {
 #if HFVIS_LANES == 1
   const int r = get_global_id(0);
   if (r < rays)
-    one_ray(r, h, f, lipschitz, ex_i, ey_i, ze, target_height, box, rays, need, use_need, unit, pending, ray_hi,
-            out_visible, accumulate);
+    one_ray(r, h, f, lipschitz, ex_i, ey_i, ze, target_height, forgiven, box, rays, need, use_need, unit,
+            pending, ray_hi, out_visible, accumulate);
 #else
   // Lanes whose rays do not run alike (around a diagonal or a corner of the box) go one by one.
   const int r0 = get_global_id(0) * HFVIS_LANES;
   if (r0 >= rays) return;
-  if (!rays_in_lanes(r0, h, f, lipschitz, ex_i, ey_i, ze, target_height, box, rays, need, use_need, unit, pending,
-                     ray_hi, out_visible, accumulate))
+  if (!rays_in_lanes(r0, h, f, lipschitz, ex_i, ey_i, ze, target_height, forgiven, box, rays, need, use_need,
+                     unit, pending, ray_hi, out_visible, accumulate))
     for (int r = r0; r < min(r0 + HFVIS_LANES, rays); ++r)
-      one_ray(r, h, f, lipschitz, ex_i, ey_i, ze, target_height, box, rays, need, use_need, unit, pending, ray_hi,
-              out_visible, accumulate);
+      one_ray(r, h, f, lipschitz, ex_i, ey_i, ze, target_height, forgiven, box, rays, need, use_need, unit,
+              pending, ray_hi, out_visible, accumulate);
 #endif
 }
 

@@ -45,6 +45,8 @@ SightLine referenceSightLine(const HeightField& f, const Observer& o, const View
   const double d2 = std::pow(dx * f.cell_size_x, 2) + std::pow(dy * f.cell_size_y, 2);
   const double drop = options.curvature * d2;
   const double zt = heightAt(f, col, row) + options.target_height - drop;
+  // The heights' rounding, which the sight line forgives (forgiven_rise in kernels/viewshed.cl).
+  const double forgiven = std::ldexp(std::fabs(ze) + std::fabs(zt) + std::fabs(drop), -21);
   // Where the line crosses grid lines, in order: (t, column line i or -1, row line j or -1);
   // both at a grid point.
   struct Crossing {
@@ -100,7 +102,7 @@ SightLine referenceSightLine(const HeightField& f, const Observer& o, const View
     if (std::isnan(fs[s])) continue;
     rise = std::max(rise, fs[s]);
     if (s > 0 && s + 1 < merged.size()) interior = std::max(interior, fs[s]);
-    if (s > 0) excess = std::max(excess, fs[s] / merged[s].t);
+    if (s > 0) excess = std::max(excess, (fs[s] - forgiven) / merged[s].t);
   }
   for (std::size_t s = 0; s + 1 < merged.size(); ++s) {
     const double t0 = merged[s].t, t1 = merged[s + 1].t, tm = 0.5 * (t0 + t1);
@@ -113,14 +115,16 @@ SightLine referenceSightLine(const HeightField& f, const Observer& o, const View
     if (std::isnan(twist) || std::isnan(fs[s]) || std::isnan(fs[s + 1]))
       continue;  // a cell with a nodata corner has no surface inside
     const double a = twist * dx * dy - drop;  // t^2 coefficient of f
-    if (s == 0) {  // f / t next to the eye
-      if (fs[0] > 0.0) excess = std::numeric_limits<double>::infinity();
-      if (fs[0] == 0.0) excess = std::max(excess, (fs[1] - fs[0]) / t1 - a * t1);
+    // The excess is that of f less the rounding forgiven.
+    const double g0 = fs[s] - forgiven, g1 = fs[s + 1] - forgiven;
+    if (s == 0) {  // (f - forgiven) / t next to the eye
+      if (g0 > 0.0) excess = std::numeric_limits<double>::infinity();
+      if (g0 == 0.0) excess = std::max(excess, (g1 - g0) / t1 - a * t1);
     }
-    if (a < 0.0) {  // where (f / t)' = 0: t^2 = t0 t1 + f_lin(0) / a
-      const double tt = t0 * t1 + (fs[s] * t1 - fs[s + 1] * t0) / (t1 - t0) / a;
+    if (a < 0.0) {  // where (g / t)' = 0: t^2 = t0 t1 + g_lin(0) / a
+      const double tt = t0 * t1 + (g0 * t1 - g1 * t0) / (t1 - t0) / a;
       const double tv = tt > 0.0 ? std::sqrt(tt) : 0.0;
-      if (tv > t0 && tv < t1) excess = std::max(excess, inCell(cx, cy, tv) / tv);
+      if (tv > t0 && tv < t1) excess = std::max(excess, (inCell(cx, cy, tv) - forgiven) / tv);
     }
     if (a < 0.0) {
       const double tv = -(((fs[s + 1] - fs[s]) / (t1 - t0)) - a * (t0 + t1)) / (2.0 * a);  // vertex of f
@@ -130,7 +134,7 @@ SightLine referenceSightLine(const HeightField& f, const Observer& o, const View
       }
     }
   }
-  return {!(rise > 0.0), rise, interior, excess};
+  return {!(rise > forgiven), rise, interior, excess};
 }
 
 ViewshedResult referenceViewshed(const HeightField& f, const Observer& o, const ViewshedOptions& options,

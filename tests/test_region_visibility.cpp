@@ -766,6 +766,55 @@ TEST(RegionVisibility, FlatGroundIsAllClear) {
   }
 }
 
+TEST(RegionVisibility, ATiltedPlaneSeesItselfWhereverItLies) {
+  // Sight lines between points of a tilted plane run along it: every pair sees (the tie rule), as on
+  // flat ground, though the float32 heights and the march's values round a hair above or below the
+  // line (an exact sign hid nearly every pair on the plane at 8848). A bowl sees itself too: its
+  // chords run above it. A wall of 2 cm across the plane at 8848 (about 20 units in the last place
+  // there) still hides the pairs on either side of it.
+  const int w = 61, h = 37;
+  struct Surface {
+    const char* name;
+    double base, along_x, along_y, bowl;
+  };
+  for (const Surface& surface :
+       {Surface{"gentle at 8848", 8848.0, 0.001, 0.0, 0.0}, Surface{"steep", 0.0, 0.37, 0.11, 0.0},
+        Surface{"at 3e5", 3e5, 1.7, -0.9, 0.0}, Surface{"bowl", 100.0, 0.0, 0.0, 0.013}}) {
+    std::vector<float> heights(w * h);
+    for (int row = 0; row < h; ++row)
+      for (int col = 0; col < w; ++col)
+        heights[row * w + col] =
+            static_cast<float>(surface.base + surface.along_x * col + surface.along_y * row +
+                               surface.bowl * ((col - 30) * (col - 30) + (row - 18) * (row - 18)));
+    const HeightField field = fieldFrom(w, h, heights);
+    RegionSampling a, b;
+    a.rectangle = {1, 2, 17, 34};
+    a.samples = 64;
+    a.height = 0.0;
+    b.rectangle = {40, 0, 59, 36};
+    b.samples = 64;
+    b.height = 0.0;
+    for (const RegionVisibilityMethod method :
+         {RegionVisibilityMethod::Exact, RegionVisibilityMethod::Culled}) {
+      RegionVisibilityOptions options;
+      options.method = method;
+      forEachLayout([&](const ComputeContext& context) {
+        EXPECT_EQ(computeRegionPairVisibility(context, field, a, b, options).clear_pairs, 64u * 64u)
+            << surface.name;
+        const RegionVisibilityResult pixels = computeRegionVisibility(context, field, a, options);
+        EXPECT_EQ(std::count(pixels.fraction.begin(), pixels.fraction.end(), 1.0f), w * h) << surface.name;
+      });
+      if (surface.base != 8848.0) continue;
+      std::vector<float> walled = heights;
+      for (int row = 0; row < h; ++row) walled[row * w + 30] += 0.02f;
+      forEachLayout([&](const ComputeContext& context) {
+        EXPECT_EQ(computeRegionPairVisibility(context, fieldFrom(w, h, walled), a, b, options).clear_pairs,
+                  0u);
+      });
+    }
+  }
+}
+
 TEST(RegionVisibility, AWallBlocksEveryPair) {
   // Two regions on flat ground either side of a wall across the whole field.
   const int w = 41, h = 23;

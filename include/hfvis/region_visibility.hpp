@@ -30,7 +30,8 @@
 // relative to the straight segment (the viewshed's c d^2 drop from an eye, the target lowered
 // c D^2, written symmetrically). Pairs farther apart than max_distance are not visible. The test
 // runs in single precision, the pair in a canonical order (so that A sees B exactly when B sees
-// A): segments that graze the surface within its rounding may go either way, as the viewshed's.
+// A), and forgives the heights' rounding as the viewshed's does: a segment is hidden only where
+// the surface rises above it by more than 2^-21 of |its ends' heights| + |the curvature's c D^2|.
 //
 // Methods: the exact one, one line-of-sight march per (receiver, source sample) pair on the
 // device (kernels/region_visibility.cl): O(receivers * S * (W + H)); the same march culled by a

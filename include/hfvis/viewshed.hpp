@@ -25,8 +25,10 @@
 // last 2.5 pixels, and over the rest of the line (skipping the blocks of a maximum pyramid that
 // lie below it) unless that bound settles them. The few targets no ray settles (beside the eye,
 // along the border through an eye on it) are marched whole. The kernels
-// decide in single precision: sight lines that graze the surface within its rounding may go
-// either way, and pieces of a line shorter than 1e-3 pixel skip their vertex test.
+// decide in single precision and forgive the heights' rounding: a target is hidden only where the
+// surface rises above its sight line by more than 2^-21 of |eye height| + |target height| + |the
+// Earth's drop| (about 8 units in the last place; so an eye on a tilted plane sees all of it), and
+// pieces of a line shorter than 1e-3 pixel skip their vertex test.
 //
 // A culling pyramid (ViewshedPyramid, after Stewart 1997, "Hierarchical visibility in
 // terrains") lets a viewshed skip whole blocks of targets hidden from the eye: built once per

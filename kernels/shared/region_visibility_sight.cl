@@ -72,6 +72,18 @@ inline float region_rise(float s, float t, float za, float dz, float cdd) {
   return (s - (za + t * dz)) + cdd * t * (1.0f - t);
 }
 
+// How far the surface may rise above a segment from height za to zb (cdd: c D^2, the curvature's
+// term) and still not hide it: the heights' rounding, which grazing lines forgive as the tie rule
+// of `viewcount` does (docs/ALGORITHMS.md, "Grazing samples and the heights' rounding"). A float32
+// raster holds each height to the float's spacing at its absolute value, and the march's values
+// round again by a few units in the last place; on a tilted plane a segment between two points of
+// the surface runs along it, and an exact sign hid nearly every such pair (a plane at 8848 m: all
+// of them). 2^-21 of |za| + |zb| + |cdd|: about 8 units in the last place of the larger end's
+// height, no more (a wall of a dozen units in the last place still hides).
+inline float region_forgiven(float za, float zb, float cdd) {
+  return 0x1p-21f * (fabs(za) + fabs(zb) + fabs(cdd));
+}
+
 // The culling pyramid (a max pyramid over the cells): level k holds, per block of 2^k x 2^k cells
 // (the last ones in a row or column cut by the field), the highest point of the surface over the
 // block's closed square, +INFINITY where the march's values there can run unbounded (an infinite
@@ -141,12 +153,12 @@ inline int region_cell_at(int width, int height, float x, float y) {
 
 // Whether the point (xb, yb, zb) is visible from (xa, ya, za) (pixel positions inside the field,
 // heights z-scaled and finite): 1 when no point of the surface strictly between them rises
-// strictly above the segment (an end below the surface counts: the surface rises above the
-// segment right beside it), the surface lowered by the curvature (cell_x, cell_y: ground units
-// per pixel; curvature: c of a drop c d^2; max_d2: the largest squared ground distance seen, 0 =
-// any). A cell with a nodata corner has no surface inside; an edge or grid point between valid
-// heights is surface. Pieces shorter than 1e-3 pixel skip their inside test, as the viewshed's
-// do (their top would be rounding noise).
+// above the segment by more than the heights' rounding (region_forgiven; an end below the surface
+// by more counts: the surface rises above the segment right beside it), the surface lowered by the curvature
+// (cell_x, cell_y: ground units per pixel; curvature: c of a drop c d^2; max_d2: the largest squared ground
+// distance seen, 0 = any). A cell with a nodata corner has no surface inside; an edge or grid point between
+// valid heights is surface. Pieces shorter than 1e-3 pixel skip their inside test, as the viewshed's do
+// (their top would be rounding noise).
 //
 // With a culling pyramid (`levels` > 0: region_cull_* below), the march leaps over every block of
 // cells that provably cannot reach the segment: it resumes at the crossing where the segment leaves
@@ -176,6 +188,7 @@ HFVIS_SIGHT_INLINE int region_sight_visible_culled(HFVIS_GLOBAL const float* h, 
   const float d2 = gx * gx + gy * gy;
   if (max_d2 > 0.0f && d2 > max_d2) return 0;
   const float cdd = curvature * d2;
+  const float forgiven = region_forgiven(za, zb, cdd);
   const float pixels = dx > (dy < 0.0f ? -dy : dy) ? dx : (dy < 0.0f ? -dy : dy);
   // The ends' certified stretches (region_end_reach) meet: no cell along the segment comes near it.
   const float length = reach_a > 0.0f || reach_b > 0.0f ? sqrt(dx * dx + dy * dy) : 0.0f;
@@ -189,7 +202,7 @@ HFVIS_SIGHT_INLINE int region_sight_visible_culled(HFVIS_GLOBAL const float* h, 
   // An end below the surface has surface above the segment right beside it (the viewshed's
   // eye below its own ground sees nothing).
   float f0 = region_surface_at(h, width, height, xa, ya) - za;
-  if (f0 > 0.0f) return 0;
+  if (f0 > forgiven) return 0;
   // The culling: the clearance a block must leave below the segment (the rounding of the march's
   // values: `margin`, the field's part from the host's cullPyramid, and the segment's; and the
   // curvature's largest rise c D^2 / 4), and the level tried next (one up after a leap, down to
@@ -223,7 +236,7 @@ HFVIS_SIGHT_INLINE int region_sight_visible_culled(HFVIS_GLOBAL const float* h, 
         region_cull_resume(xa, ya, dx, dy, on_column, box_x0, ly, tC, &gxl, &gyl);
         f0 = region_cull_crossing_rise(h, width, height, xa, ya, za, dx, dy, dz, cdd, on_column, box_x0, ly,
                                        tC);
-        if (f0 > 0.0f) return 0;
+        if (f0 > forgiven) return 0;
       }
     }
     const float tX = xb > box_x1 ? (box_x1 - xa) / dx : INFINITY;
@@ -250,7 +263,7 @@ HFVIS_SIGHT_INLINE int region_sight_visible_culled(HFVIS_GLOBAL const float* h, 
       t0 = tC;
       region_cull_resume(xa, ya, dx, dy, on_column, lx, ly, tC, &gxl, &gyl);
       f0 = region_cull_crossing_rise(h, width, height, xa, ya, za, dx, dy, dz, cdd, on_column, lx, ly, tC);
-      if (f0 > 0.0f) return 0;
+      if (f0 > forgiven) return 0;
     }
   }
   if (reach_b > 0.01f) {
@@ -318,7 +331,7 @@ HFVIS_SIGHT_INLINE int region_sight_visible_culled(HFVIS_GLOBAL const float* h, 
         region_cull_resume(xa, ya, dx, dy, pending_on_column, pending_lx, pending_ly, t0, &gxl, &gyl);
         f0 = region_cull_crossing_rise(h, width, height, xa, ya, za, dx, dy, dz, cdd, pending_on_column,
                                        pending_lx, pending_ly, t0);
-        if (f0 > 0.0f) return 0;
+        if (f0 > forgiven) return 0;
         pending = 0;
         tx = dx > 0.0f && gxl < xb ? (gxl - xa) / dx : INFINITY;
         ty = dy > 0.0f ? (gyl < yb ? (gyl - ya) / dy : INFINITY)
@@ -331,13 +344,13 @@ HFVIS_SIGHT_INLINE int region_sight_visible_culled(HFVIS_GLOBAL const float* h, 
     if (t1 >= 1.0f) {  // no crossing left before the far end
       t1 = 1.0f;
       f1 = region_surface_at(h, width, height, xb, yb) - zb;
-      if (f1 > 0.0f) return 0;
+      if (f1 > forgiven) return 0;
     } else {
       // A crossing: on a column line x = gxl exactly, or on a row line y = gyl.
       const float s = x_first ? region_surface_at(h, width, height, gxl, ya + t1 * dy)
                               : region_surface_at(h, width, height, xa + t1 * dx, gyl);
       f1 = region_rise(s, t1, za, dz, cdd);
-      if (f1 > 0.0f) {  // NaN (nodata) hides nothing
+      if (f1 > forgiven) {  // NaN (nodata) hides nothing
         *blocked_at = region_cell_at(width, height, xa + 0.5f * (t0 + t1) * dx, ya + 0.5f * (t0 + t1) * dy);
         return 0;
       }
@@ -351,7 +364,7 @@ HFVIS_SIGHT_INLINE int region_sight_visible_culled(HFVIS_GLOBAL const float* h, 
         const float bump = -((dx * dy != 0.0f ? twist * dx * dy : 0.0f) - cdd) * span * span;
         if (bump > 0.0f) {
           const float s = 0.5f + (f1 - f0) / (2.0f * bump);
-          if (s > 0.0f && s < 1.0f && f0 + (f1 - f0) * s + bump * s * (1.0f - s) > 0.0f) {
+          if (s > 0.0f && s < 1.0f && f0 + (f1 - f0) * s + bump * s * (1.0f - s) > forgiven) {
             *blocked_at = region_cell_at(width, height, xa + tm * dx, ya + tm * dy);
             return 0;
           }
@@ -592,10 +605,10 @@ inline float region_end_reach(HFVIS_GLOBAL const float* wedge, int bands, float 
 // Whether the surface over cell `cell` (the index of its first corner) rises above the segment
 // from (xa, ya, za) to (xb, yb, zb) by so much that the march (region_sight_visible) must find it
 // hidden: at the middle of the segment's stretch over the cell, by more than the march's
-// rounding (`margin`, the field's part, and the segment's own) and more than its values can
-// change over the 1e-3 pixel of a piece whose inside it skips (`gradient`: a bound of the
-// surface's slope per pixel). Only over a cell whose 4 x 4 heights around are finite, so that
-// every value the march takes near there is a number (not looked at where `finite_field` says
+// rounding (`margin`, the field's part, and the segment's own), more than the rounding it forgives
+// (region_forgiven) and more than its values can change over the 1e-3 pixel of a piece whose inside it skips
+// (`gradient`: a bound of the surface's slope per pixel). Only over a cell whose 4 x 4 heights around are
+// finite, so that every value the march takes near there is a number (not looked at where `finite_field` says
 // every height of the field is). The cheap test of a sight line against the
 // cell that hid the previous one (sight lines to neighbouring samples are often hidden by the
 // same cell); 0 decides nothing.
@@ -635,7 +648,8 @@ HFVIS_SIGHT_INLINE int region_cull_hides(HFVIS_GLOBAL const float* h, int width,
   const float s = h00 + (h10 - h00) * u + (h01 - h00) * v + (h00 - h10 - h01 + h11) * u * v;
   const float f = region_rise(s, tm, za, dz, cdd);
   const float slack = margin + 1e-5f * (2.0f * (fabs(za) + fabs(zb)) + fabs(cdd)) +
-                      1.5e-3f * (1.5f * gradient + (fabs(dz) + fabs(cdd)) / pixels);
+                      1.5e-3f * (1.5f * gradient + (fabs(dz) + fabs(cdd)) / pixels) +
+                      region_forgiven(za, zb, cdd);
   return f > slack;
 }
 

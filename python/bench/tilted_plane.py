@@ -2,11 +2,13 @@
 the viewshed of an eye on the surface, on a flat plane and on tilted ones, where under the tie
 rule (grazing samples see) every sample of the plane is visible from every other. The samples'
 float heights are rounded, which tips collinear samples of a tilted plane above or below one
-another's sight lines; the visible counts forgive that rounding, the viewshed's march does not yet
-(docs/ALGORITHMS.md, "Grazing samples and the heights' rounding"). A second table shows what the
-tolerance also takes as ties: the Earth's drop between neighbouring samples on tilted planes, and
-sub-millimetre noise on a field at 1000 m (with and without one pixel at 0, which moves the
-heights above the field's lowest). Writes Markdown tables to stdout.
+another's sight lines; the visible counts, the viewshed and region visibility forgive that
+rounding (docs/ALGORITHMS.md, "Grazing samples and the heights' rounding"). A second table shows
+what the tolerance also takes as ties: the Earth's drop between neighbouring samples on tilted
+planes, and sub-millimetre noise on a field at 1000 m (with and without one pixel at 0, which
+moves the heights above the field's lowest). A third gives the viewshed and a region pair with
+both ends on the surface (heights 0) on planes at 8848 m and far from 0, and on the same plane with
+a wall of 2 cm (still hiding). Writes Markdown tables to stdout.
 
     build/python-venv/bin/python python/bench/tilted_plane.py
 """
@@ -58,6 +60,24 @@ def main():
                   for method in ("hull_tree", "naive")]
         print(f"| 128 x 128, 1000 + U(0, 2 mm){', one pixel at 0' if pit else ''}: median count | "
               f"{counts[0]:.1f} | {counts[1]:.1f} |")
+    print()
+    print("| 128 x 96 field, cells of 1 | viewshed from (64, 48), eye and targets at 0: visible share | "
+          "region pair (4, 4)-(40, 91) to (88, 4)-(124, 91), 1024 x 1024 samples at 0: clear share |")
+    print("| --- | ---: | ---: |")
+    x = np.arange(128)[None, :] * np.ones((96, 1))
+    y = np.arange(96)[:, None] * np.ones((1, 128))
+    surfaces = {
+        "8848 + 0.001 column": 8848.0 + 0.001 * x,
+        "100 + 2.6255 column": 100.0 + 2.6255 * x,
+        "3e5 + 1.7 column - 0.9 row": 3e5 + 1.7 * x - 0.9 * y,
+        "8848 + 0.001 column, a wall of 2 cm at column 100": 8848.0 + 0.001 * x + 0.02 * (x == 100),
+    }
+    for name, heights in surfaces.items():
+        field = heights.astype(np.float32)
+        seen = float(np.nanmean(hfvis.viewshed(field, (64, 48), observer_height=0.0)))
+        pair = hfvis.region_pair_visibility(field, (4, 4, 40, 91), (88, 4, 124, 91), samples=1024,
+                                            source_height=0.0, receiver_height=0.0)
+        print(f"| {name} | {seen:.4f} | {pair.visible_fraction:.4f} |")
 
 
 if __name__ == "__main__":

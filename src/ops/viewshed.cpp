@@ -116,6 +116,7 @@ class ViewshedRoutine : public detail::DeviceRoutine {
             ? o.height
             : prepared_.heights[static_cast<std::size_t>(o.row) * field_.width + o.col] + o.height);
     const cl_int4 box = targetBox(field_, o, options_.max_distance);
+    forgiven_ = forgivenRise(ze);
     const cl_int4 cull_leaf = cull(o, ze);
     const int w1 = box.s[2] - box.s[0], h1 = box.s[3] - box.s[1];
     const double far_pixels = std::max({o.col - box.s[0], box.s[2] - o.col, o.row - box.s[1], box.s[3] - o.row});
@@ -127,6 +128,20 @@ class ViewshedRoutine : public detail::DeviceRoutine {
     marchPending(o, ze, use_rays);
     if (!counting() && outputs_->needed_height) markNeeded(o, ze);
     st_.queue.finish();  // before this observer's ray buffers go
+  }
+
+  // The most that a sight line from an eye at height ze to any target forgives (forgiven_rise in
+  // kernels/viewshed.cl: 2^-21 of |ze| + the target's |height| + the curvature's drop, bounded
+  // by the field's largest |height| plus the target height and the drop across the field): the
+  // rays hide a target only where the surface rises above its sight line by more.
+  float forgivenRise(float ze) const {
+    const double top = std::max(std::fabs(double(prepared_.lowest)), std::fabs(double(prepared_.highest)));
+    const double across = std::hypot(field_.width * field_.cell_size_x, field_.height * field_.cell_size_y);
+    const double drop = std::fabs(options_.curvature) * across * across;
+    return static_cast<float>(std::ldexp(std::fabs(double(ze)) + (std::isfinite(top) ? top : 0.0) +
+                                             options_.target_height + 2.0 * drop,
+                                         -21) *
+                              (1.0 + 1e-5));
   }
 
   // The arguments of the kernels that follow sight lines from eye o at height ze: the field,
@@ -199,6 +214,7 @@ class ViewshedRoutine : public detail::DeviceRoutine {
     detail::NamedKernel r = kernel("viewshed_rays");
     setEye(r, o, ze);
     r.set("lipschitz", lipschitz_);
+    r.set("forgiven", forgiven_);
     r.set("box", box);
     r.set("rays", rays);
     r.set("need", need);
@@ -305,8 +321,17 @@ class ViewshedRoutine : public detail::DeviceRoutine {
 
   // The culling pyramid's query for eye o at height ze, level by level from the coarsest: the
   // finest level's table entry (nodes across 0: no pyramid), its flags at its first node.
+  // None where the rounding a sight line forgives (forgiven_) passes a quarter of the least margin
+  // by which the pyramid's blockers rise above the sight lines they cut (buildViewshedPyramid: 1e-5
+  // of 1 + the field's largest |height| + the target height, and 2e-3 of the larger cell side):
+  // an eye far above or below the field's heights.
   cl_int4 cull(const Observer& o, float ze) {
+    leaf_flags_.clear();
     if (cull_levels_.empty()) return cl_int4{{0, 0, 0, 0}};
+    const double top = std::max(std::fabs(double(prepared_.lowest)), std::fabs(double(prepared_.highest)));
+    const double least_margin = 1e-5 * (1.0 + (std::isfinite(top) ? top : 0.0) + options_.target_height) +
+                                2e-3 * std::max(field_.cell_size_x, field_.cell_size_y);
+    if (forgiven_ > 0.25 * least_margin) return cl_int4{{0, 0, 0, 0}};
     for (std::size_t l = 0; l < cull_levels_.size(); ++l) {
       const cl_int4 level = cull_levels_[l];
       detail::NamedKernel k = kernel("viewshed_cull");
@@ -422,6 +447,7 @@ class ViewshedRoutine : public detail::DeviceRoutine {
   const std::vector<std::uint32_t>* valid_points_ = nullptr;
   std::size_t culled_targets_ = 0;
   std::vector<unsigned char> leaf_flags_;  // the last query's finest level
+  float forgiven_ = 0.0f;                  // forgivenRise of the observer being computed
   int top_ = 0;
   ViewshedResult result_;
 };

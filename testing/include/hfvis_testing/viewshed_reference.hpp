@@ -10,15 +10,16 @@
 
 namespace hfvis {
 
-// One sight line: visible, and how far the surface rises above the sight line at most over
-// [0, 1] (height units; <= 0 where visible), and the same strictly between eye and target
+// One sight line: visible (the surface rising above it nowhere by more than the heights' rounding
+// it forgives, forgiven_rise in kernels/viewshed.cl), and how far the surface rises above the sight line at
+// most over [0, 1] (height units; <= 0 where visible), and the same strictly between eye and target
 // (-infinity where the line crosses no grid line): how near to grazing it is, not counting the
 // target's own point, where a target on the surface always touches its sight line.
 struct SightLine {
   bool visible = false;
   double rise = 0.0;
   double interior_rise = 0.0;
-  double excess = 0.0;  // the largest f(t) / t over (0, 1], f the surface less the sight line
+  double excess = 0.0;  // the largest (f(t) - forgiven) / t over (0, 1], f the surface less the sight line
 };
 
 // The sight line from `observer` to the target on grid point (col, row), in range or not.
