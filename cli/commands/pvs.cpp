@@ -159,19 +159,19 @@ BitsetFile readBitsetFile(const std::string& path, const PvsLayout& l, const Bit
                      "'s sets were computed on another field (its heights, cell size or " +
                      "z-scale) or view band than this run's (" + input +
                      "): a resumed run adds to the sets of the same field and band");
-  if (u32(64) != floatBits(origin.max_distance))
+  // A setting the sets were computed with (`kept`, the file's bits) that this run (`wanted`) must
+  // share: `some` names one (with its article), `setting` the kind.
+  const auto requireSame = [&](std::uint32_t kept, float wanted, const std::string& some,
+                               const std::string& setting, const std::string& options) {
+    if (kept == floatBits(wanted)) return;
     throw UsageError("--resume: " + path + "'s sets were computed " +
-                     (u32(64) == 0 ? std::string("without a maximum distance, which this run takes")
-                      : origin.max_distance == 0.0f
-                          ? std::string("with a maximum distance, which this run has not")
-                          : std::string("with another maximum distance than this run's")) +
-                     ": give the same --max-distance");
-  if (u32(60) != floatBits(origin.curvature))
-    throw UsageError("--resume: " + path + "'s sets were computed " +
-                     (u32(60) == 0               ? std::string("without curvature, which this run takes")
-                      : origin.curvature == 0.0f ? std::string("with curvature, which this run has not")
-                                                 : std::string("with another curvature than this run's")) +
-                     ": give the same --curvature and --refraction");
+                     (kept == 0        ? "without " + some + ", which this run takes"
+                      : wanted == 0.0f ? "with " + some + ", which this run has not"
+                                       : "with another " + setting + " than this run's") +
+                     ": give the same " + options);
+  };
+  requireSame(u32(64), origin.max_distance, "a maximum distance", "maximum distance", "--max-distance");
+  requireSame(u32(60), origin.curvature, "curvature", "curvature", "--curvature and --refraction");
   if (u32(56) != 0)
     throw UsageError("--resume: " + path +
                      " was written with --filter or --view-filter, whose entries a resumed run "
