@@ -204,10 +204,13 @@ class Sampler {
     // apart than the maximum distance.
     reachable_tiles_.assign(out_.words, 0u);
     for (int t : objects_) reachable_tiles_[t / 32] |= 1u << (t % 32);
-    reachable_ = 0;
+    reachable_ = reachable_found_ = 0;
     for (int v : sampled_views_)
-      for (int w = 0; w < out_.words; ++w)
-        reachable_ += std::size_t(__builtin_popcount(reach(v, w) & reachable_tiles_[w]));
+      for (int w = 0; w < out_.words; ++w) {
+        const std::uint32_t can = reach(v, w) & reachable_tiles_[w];
+        reachable_ += std::size_t(__builtin_popcount(can));
+        reachable_found_ += std::size_t(__builtin_popcount(out_.bits[std::size_t(v) * out_.words + w] & can));
+      }
     if (view_space_.empty()) throw InvalidArgument("the computed view cells hold no valid cell (all nodata)");
     tile_radius_ = 0.5 * l.tile * std::hypot(cx_, cy_);
     view_radius_ = 0.5 * l.view_cell * std::hypot(cx_, cy_);
@@ -330,14 +333,7 @@ class Sampler {
   // spent for nothing), so the estimate is 0 (batch() sets it, before the history and the progress
   // callback see it) and the run ends, whatever its budget. (Counts only those entries: sets to
   // resume from may hold others.)
-  bool complete() const {
-    std::size_t found = 0;
-    for (int v : sampled_views_)
-      for (int w = 0; w < out_.words; ++w)
-        found += std::size_t(__builtin_popcount(out_.bits[std::size_t(v) * out_.words + w] & reach(v, w) &
-                                                reachable_tiles_[w]));
-    return found == reachable_;
-  }
+  bool complete() const { return reachable_found_ == reachable_; }
 
   // Settles the estimate (PvsOptions::estimate_entries): while fewer entries found once than asked
   // carry it, view-direction samples (uniform view rays) go on, at most as many samples as the
@@ -633,6 +629,9 @@ class Sampler {
       return 0;
     }
     out_.bits[word] |= bit;
+    // (counted as complete() counts: a view cell of sampled_views_, a tile within reach)
+    if (!view_cells_[v].empty() && (reach(v, tile / 32) & reachable_tiles_[tile / 32] & bit))
+      ++reachable_found_;
     if (uniform) {
       only_finder_[word] |= bit;
       only_finders_[std::size_t(v) * out_.layout.tiles() + tile] = lineage;
@@ -923,6 +922,7 @@ class Sampler {
   // Per view cell (words of tiles), the tiles within the maximum distance (reach(); empty: all)
   std::vector<std::uint32_t> in_reach_;
   std::size_t reachable_ = 0;  // the entries a sample can find: sampled_views_ x objects_ within reach
+  std::size_t reachable_found_ = 0;  // those of them in the sets (counted as add() finds them)
   float max_d2_ = 0.0f;        // the maximum distance squared (float, as the sight test takes it); 0: none
   // The entries only one uniform view ray has found (foundAgain): a bit per entry as out_.bits,
   // and the finder's lineage by entry (v * tiles + t).
