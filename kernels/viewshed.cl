@@ -163,9 +163,10 @@ inline float excess_on_piece(float t0, float t1, float f0, float f1, float a_t) 
 // (region_forgiven) and viewcount's tie rule do (docs/ALGORITHMS.md, "Grazing samples and the
 // heights' rounding"). On a tilted plane a sight line between two points of the surface runs
 // along it, and an exact sign hid nearly every such target (all of them on a plane at 8848).
-// 2^-21 of |ze| + |the target's height| + |drop|: about 8 units in the last place of the larger.
+// 2^-21 of |ze| + |the target's height| + |drop| (region_forgiven's of the same segment): about 8
+// units in the last place of the larger height.
 inline float forgiven_rise(float ze, float rise, float drop) {
-  return 0x1p-21f * (fabs(ze) + fabs(ze + rise) + fabs(drop));
+  return 0x1p-21f * (fabs(ze) + fabs(ze + rise + drop) + fabs(drop));
 }
 
 // March of the sight line from E (ex, ey) along (dx, dy) over t in [ta, tb] (0 <= ta < tb <= 1),

@@ -46,7 +46,7 @@ SightLine referenceSightLine(const HeightField& f, const Observer& o, const View
   const double drop = options.curvature * d2;
   const double zt = heightAt(f, col, row) + options.target_height - drop;
   // The heights' rounding, which the sight line forgives (forgiven_rise in kernels/viewshed.cl).
-  const double forgiven = std::ldexp(std::fabs(ze) + std::fabs(zt) + std::fabs(drop), -21);
+  const double forgiven = std::ldexp(std::fabs(ze) + std::fabs(zt + drop) + std::fabs(drop), -21);
   // Where the line crosses grid lines, in order: (t, column line i or -1, row line j or -1);
   // both at a grid point.
   struct Crossing {

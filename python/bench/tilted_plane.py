@@ -8,7 +8,10 @@ what the tolerance also takes as ties: the Earth's drop between neighbouring sam
 planes, and sub-millimetre noise on a field at 1000 m (with and without one pixel at 0, which
 moves the heights above the field's lowest). A third gives the viewshed and a region pair with
 both ends on the surface (heights 0) on planes at 8848 m and far from 0, and on the same plane with
-a wall of 2 cm (still hiding). Writes Markdown tables to stdout.
+a wall of 2 cm (still hiding). A fourth shows the price of that tolerance: a sight line that
+grazes a wall top beside the eye forgives it by a few units in the last place there, which lets a
+target far beyond lie lower by as much times their distances' ratio, so the field's datum moves
+the edge of what is seen. Writes Markdown tables to stdout.
 
     build/python-venv/bin/python python/bench/tilted_plane.py
 """
@@ -78,6 +81,17 @@ def main():
         pair = hfvis.region_pair_visibility(field, (4, 4, 40, 91), (88, 4, 124, 91), samples=1024,
                                             source_height=0.0, receiver_height=0.0)
         print(f"| {name} | {seen:.4f} | {pair.visible_fraction:.4f} |")
+    print()
+    print("| 300 x 21 field, cells of 1: ground flat to column 100, then rising 1 cm a column; a wall 1.7 high at "
+          "column 5; the eye 1.7 above (0, 10), level with the wall's top | first column seen past the wall "
+          "(exactly: 270) |")
+    print("| --- | ---: |")
+    cols = np.arange(300)[None, :] * np.ones((21, 1))
+    ground = np.where(cols <= 100, 0.0, 0.01 * (cols - 100)) + np.where(cols == 5, 1.7, 0.0)
+    for base in (0.0, 1000.0, 4000.0, 8848.0):
+        seen = np.asarray(hfvis.viewshed((base + ground).astype(np.float32), (0, 10), observer_height=1.7))[10]
+        past = [c for c in range(6, 300) if seen[c] == 1.0]
+        print(f"| heights {base:g} + that | {past[0] if past else 'none'} |")
 
 
 if __name__ == "__main__":

@@ -272,9 +272,11 @@ def compute(operation, heights, geometry, options, device="", progress=None):
             light_image = as_array(light_image, "light_image")
             if light_image.ndim == 2:
                 light_image = np.broadcast_to(light_image, (3,) + light_image.shape)
-            if light_image.ndim != 3 or light_image.shape[0] != 3 or light_image.dtype.kind not in "fiu":
-                raise InputTypeError("light_image must be a real 2-D (rows, columns: grey) or 3-D (3: R, G, B, rows, "
-                                     f"columns) array, got shape {light_image.shape} and dtype {light_image.dtype}")
+            if (light_image.ndim != 3 or light_image.shape[0] != 3 or light_image.dtype.kind not in "fiu" or
+                    light_image.size == 0):
+                raise InputTypeError("light_image must be a real, non-empty 2-D (rows, columns: grey) or 3-D (3: R, G, B, "
+                                     f"rows, columns) array, got shape {light_image.shape} and dtype "
+                                     f"{light_image.dtype}")
             light_image = np.ascontiguousarray(light_image, dtype=np.float32)
         r = _core.region_visibility(field, region_sampling(options["sources"], options["samples"], options["height"],
                                                            options["absolute"]), o, device=device,

@@ -162,18 +162,18 @@ def viewshed(heights, geometry, options, device=""):
     """One observer's viewshed over a Dask array, chunked as the input: within a maximum distance
     computed on the window it reaches (a task of its own), the rest out of range (0, NaN at
     nodata). The viewshed's heights count from zero and its rays from the observer, so the window's
-    result is the whole field's there bit for bit. Without a maximum distance, or on a latitude /
-    longitude grid (whose rows' spacing is counted from the field's first row), the window is the
-    whole field."""
+    result is the whole field's there bit for bit. Without a maximum distance the window is the
+    whole field. Latitude / longitude grids are refused now, as the library refuses them."""
     import dask
     import dask.array as da
 
+    _refuse_rows_spacing(geometry)
     col, row = _arrays.observer_pixel(options["observer"])
     height, width = heights.shape
     if not (0 <= col < width and 0 <= row < height):  # (now, not at compute, in the window's pixels)
         raise InvalidArgumentError(f"observer {col},{row} is outside the {width} x {height} field")
     first_row, first_col, last_row, last_col = 0, 0, height, width
-    if options.get("max_distance") and not geometry["row_cell_size_x"]:
+    if options.get("max_distance"):
         depth = halo(geometry, options["max_distance"], "viewshed")
         first_row, first_col = max(0, min(row, height - 1) - depth), max(0, min(col, width - 1) - depth)
         last_row, last_col = min(height, max(row, 0) + depth + 1), min(width, max(col, 0) + depth + 1)
@@ -181,6 +181,14 @@ def viewshed(heights, geometry, options, device=""):
                                             device, first_col, first_row)
     return da.map_blocks(_viewshed_block, heights, window, first_col, first_row, dtype=np.float32,
                          meta=np.empty((0, 0), np.float32))
+
+
+def _refuse_rows_spacing(geometry):
+    """The library's refusal of viewsheds on latitude / longitude grids, when the graph is built
+    rather than when it is computed."""
+    if geometry["row_cell_size_x"]:
+        raise InvalidArgumentError("viewsheds on latitude / longitude grids (per-row spacing) are not supported; "
+                                   "reproject the DEM to a projected CRS")
 
 
 def _observer_group(heights, geometry, options, device, group):
@@ -195,6 +203,7 @@ def cumulative_viewshed(heights, geometry, options, device="", group_size=None):
     import dask
     import dask.array as da
 
+    _refuse_rows_spacing(geometry)
     cols, rows, eyes = _arrays.observer_pixels(options["observers"], options["observer_height"])
     pixels = np.stack([cols, rows], axis=1)
     eyes = np.asarray(eyes)

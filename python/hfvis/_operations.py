@@ -4,6 +4,7 @@ arguments are named as the C++ library's options (docs/python.md lists them)."""
 
 import collections
 import math
+import re
 
 import numpy as np
 
@@ -136,11 +137,28 @@ def _run(operation, heights, options, common):
     else:
         h = _arrays.heights_array(data, nodata, min(g["cell_size_x"], g["cell_size_y"]))
         h = np.ascontiguousarray(_flipped(h, flip_rows, flip_cols))
-        out = _arrays.compute(operation, h, g, options, common["device"], common["progress"])
+        try:
+            out = _arrays.compute(operation, h, g, options, common["device"], common["progress"])
+        except InvalidArgumentError as error:
+            raise _observer_unflipped(error, h.shape, flip_rows, flip_cols) from None
     if flip_rows or flip_cols:
         for name in _arrays.OUTPUTS.get(operation, ("irradiance",)):
             out[name] = _flipped(out[name], flip_rows, flip_cols)
     return out, grid
+
+
+def _observer_unflipped(error, shape, flip_rows, flip_cols):
+    """The library's error naming an observer's pixel in the field as computed (flipped to north up,
+    west left) with the pixel as the caller's array has it."""
+    if not (flip_rows or flip_cols):
+        return error
+    height, width = shape
+
+    def caller(match):
+        col, row = int(match.group(1)), int(match.group(2))
+        return f"observer {width - 1 - col if flip_cols else col},{height - 1 - row if flip_rows else row}"
+
+    return type(error)(re.sub(r"observer (-?\d+),(-?\d+)", caller, str(error)))
 
 
 def _marked(data, nodatas, scale, offset):
@@ -201,7 +219,10 @@ def _observers_as_pixels(operation, options, grid, flip_rows, flip_cols, pixels)
 
     def pixel_of(x, y):
         if pixels:  # (as a numpy field's: whole numbers; (-0.5, 2.9) ran as (0, 2))
-            return _arrays.observer_pixel((x, y))
+            col, row = _arrays.observer_pixel((x, y))
+            if not (0 <= col < width and 0 <= row < height):  # (named here: flipped, the library's would not be)
+                raise InvalidArgumentError(f"observer {col},{row} is outside the {width} x {height} field")
+            return col, row
         if not (math.isfinite(float(x)) and math.isfinite(float(y))):
             raise InvalidArgumentError(f"an observer's map coordinates must be finite, got ({x!r}, {y!r})")
         col, row = grid.pixel(float(x), float(y))
@@ -345,7 +366,7 @@ def _horizon_maps(operation, name, heights, options, common):
     if grid is None:
         return Horizons(out[name], out["azimuths"])
     azimuths = np.degrees(np.asarray(out["azimuths"])) if "azimuths" in out else \
-        _azimuths_deg(options)
+        _azimuths_deg(options, grid.geometry(common["cell_size"], common["z_scale"]))
     attrs = _attrs(operation, name, options, grid)
     attrs["azimuth_convention"] = _xarray_convention()
     result = grid.result(out[name], "horizon_" + name, attrs, leading=("azimuth", azimuths))
@@ -360,10 +381,12 @@ def _xarray_convention():
     return AZIMUTH_CONVENTION
 
 
-def _azimuths_deg(options):
-    """The azimuths a chunked run computes (each chunk takes the same ones: they depend on K and
-    the tolerance alone), from a one-pixel field's sweep."""
-    probe = _arrays.compute("horizon_angles", np.zeros((2, 2), np.float32), _arrays.geometry(), options)
+def _azimuths_deg(options, geometry):
+    """The azimuths a chunked run computes (each chunk takes the whole field's: they depend on K,
+    the tolerance and the cell sizes), from the sweep of a field two pixels wide with the field's
+    geometry (its rows' spacing too, on a latitude / longitude grid)."""
+    rows = max(2, len(geometry["row_cell_size_x"]))
+    probe = _arrays.compute("horizon_angles", np.zeros((rows, 2), np.float32), dict(geometry, origin=[]), options)
     return np.degrees(np.asarray(probe["azimuths"]))
 
 

@@ -283,16 +283,34 @@ def scale_offset(array):
 
 def _nodata(array):
     """The value that marks nodata: rioxarray's nodata, else _FillValue or nodata in the attributes
-    or encoding; None when there is none (NaN is nodata anyway)."""
+    or encoding; None when there is none (NaN is nodata anyway). rioxarray's nodata is NaN wherever
+    the encoding holds a fill value (it takes the data for masked on reading): the attributes and
+    the encoding are read then too, so that a fill value counts whether rioxarray is imported or
+    not."""
+    found = None
     rio = _rio(array)
     if rio is not None:
         try:
-            if rio.nodata is not None:
-                return rio.nodata
+            found = rio.nodata
         except Exception:
-            pass
+            found = None
+        if found is not None and not _is_nan(found):
+            return _one_value(found)
     for where in (array.attrs, array.encoding):
         for key in ("_FillValue", "nodata", "missing_value"):
             if key in where and where[key] is not None:
-                return where[key]
-    return None
+                return _one_value(where[key])
+    return found
+
+
+def _one_value(value):
+    """A fill value as one number where it comes as a one-element array (netCDF backends give
+    attributes so)."""
+    return np.asarray(value).item() if np.ndim(value) > 0 and np.size(value) == 1 else value
+
+
+def _is_nan(value):
+    try:
+        return bool(np.isnan(value))
+    except (TypeError, ValueError):
+        return False

@@ -265,3 +265,26 @@ def test_unknown_chunk_sizes_are_refused_naming_the_cure(call):
     a = xr.DataArray(d[d[:, 0] > -1e9], dims=("y", "x"))
     with pytest.raises(hfvis.InvalidArgumentError, match="compute_chunk_sizes"):
         call(a)
+
+
+def test_latitude_longitude_azimuths_are_those_computed(latitude_longitude_field):
+    """The azimuths of a chunked horizon run are the whole field's as computed (its cells' aspect
+    moves them off the even spacing), as in memory: a probe of cells of 1 gave 0, 45, 90, ..., and
+    subtracting the two runs kept half the azimuths."""
+    field = latitude_longitude_field
+    d = LATITUDE_LONGITUDE_DISTANCE
+    whole = hfvis.horizon_angles(field, directions=8, max_distance=d)
+    chunked = hfvis.horizon_angles(field.chunk({"lat": 20, "lon": 20}), directions=8, max_distance=d)
+    assert not np.allclose(whole.azimuth.values % 45.0, 0.0)  # the aspect moved them
+    assert np.array_equal(chunked.azimuth.values, whole.azimuth.values)
+    assert (whole - chunked).sizes["azimuth"] == 8
+
+
+def test_viewsheds_on_latitude_longitude_grids_are_refused_when_asked(latitude_longitude_field):
+    """As the library refuses them, at once: not a lazy array that fails when computed."""
+    field = latitude_longitude_field.chunk(20)
+    lon, lat = float(field.lon[5]), float(field.lat[5])
+    with pytest.raises(hfvis.InvalidArgumentError, match="latitude / longitude"):
+        hfvis.viewshed(field, (lon, lat), max_distance=LATITUDE_LONGITUDE_DISTANCE)
+    with pytest.raises(hfvis.InvalidArgumentError, match="latitude / longitude"):
+        hfvis.cumulative_viewshed(field, [(lon, lat)])

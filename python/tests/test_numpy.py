@@ -323,6 +323,9 @@ def test_region_visibility_light_image(tmp_path, projected_tif, dem):
         equal(white.rgb[c], white.fraction)
     with pytest.raises(hfvis.InputTypeError):
         hfvis.region_visibility(dem, (200, 170, 206, 175), cell_size=30, nodata=NODATA, light_image=np.ones((2, 4, 5)))
+    for empty in (np.ones((0, 0)), np.ones((3, 0, 0))):  # (was run without its image, rgb None)
+        with pytest.raises(hfvis.InputTypeError, match="non-empty"):
+            hfvis.region_visibility(dem, (200, 170, 206, 175), cell_size=30, nodata=NODATA, light_image=empty)
 
 
 def test_region_pair_visibility(tmp_path, projected_tif, dem):
@@ -460,3 +463,16 @@ def test_bounce(tmp_path, projected_tif, dem):
     assert ours.shape == (2,) + dem.shape and np.isnan(ours[0, 100, 150])
     equal(ours, irradiance)
     equal(hfvis.bounce(dem, radiance[1], directions=8, cell_size=30, nodata=NODATA), irradiance[1])
+
+
+def test_ambient_occlusion_and_sky_view_factor_stay_within_0_and_1():
+    """Shares of the sky: the azimuthal quadrature passed 1 by its error on steep noise (1.006 at
+    K = 16), and the integral lies inside."""
+    steep = (np.random.default_rng(21).standard_normal((64, 64)) * 100).astype(np.float32)
+    for k in (8, 16):
+        ao = hfvis.ambient_occlusion(steep, directions=k)
+        svf = hfvis.sky_view_factor(steep, directions=k)
+        assert 0.0 <= ao.min() and ao.max() <= 1.0
+        assert 0.0 <= svf.min() and svf.max() <= 1.0
+        if k == 16:
+            assert ao.max() == 1.0  # (clamped there: without the clamp 7 pixels pass it)

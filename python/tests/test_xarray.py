@@ -289,3 +289,35 @@ def test_grids_hfvis_cannot_read_right_are_refused():
     hfvis.bounce(a, radiance, directions=8)
     with pytest.raises(hfvis.InvalidArgumentError, match="coordinates are not the heights'"):
         hfvis.bounce(a, radiance.isel(y=slice(None, None, -1)), directions=8)
+
+
+def test_an_encoded_fill_value_counts_with_rioxarray_imported_too():
+    """rioxarray (imported here) gives nodata NaN where the encoding holds a fill value; the value
+    itself still marks nodata, as it does without rioxarray's accessor. So does a fill value given
+    as a one-element array, as netCDF backends give attributes."""
+    heights = _relief(20, 20)
+    heights[5, 5] = -9999.0
+    encoded = xr.DataArray(heights, dims=("y", "x"))
+    encoded.encoding["_FillValue"] = -9999.0
+    assert np.isnan(encoded.rio.nodata)
+    assert np.isnan(hfvis.sky_view_factor(encoded, directions=8).values[5, 5])
+    listed = xr.DataArray(heights, dims=("y", "x"), attrs={"_FillValue": np.array([-9999.0])})
+    assert np.isnan(hfvis.sky_view_factor(listed, directions=8).values[5, 5])
+
+
+def test_an_observers_pixel_is_named_as_the_caller_gave_it():
+    """A south-up or west-up grid is computed flipped; errors name the caller's pixel, not the
+    flipped field's."""
+    heights = np.ones((20, 24), np.float32)
+    heights[5, 3] = np.nan
+    south_up = xr.DataArray(heights, dims=("y", "x"),
+                            coords={"y": 10.0 * np.arange(20) + 5.0, "x": 10.0 * np.arange(24) + 5.0})
+    with pytest.raises(hfvis.InvalidArgumentError, match="observer 3,5 stands on nodata"):
+        hfvis.viewshed(south_up, (3, 5), pixels=True)
+    with pytest.raises(hfvis.InvalidArgumentError, match="observer 3,25 is outside the 24 x 20 field"):
+        hfvis.viewshed(south_up, (3, 25), pixels=True)
+    west_up = south_up.isel(x=slice(None, None, -1))
+    with pytest.raises(hfvis.InvalidArgumentError, match="observer 20,5 stands on nodata"):
+        hfvis.viewshed(west_up, (20, 5), pixels=True)
+    with pytest.raises(hfvis.InvalidArgumentError, match="observer 3,5 stands on nodata"):
+        hfvis.cumulative_viewshed(south_up, [(1, 1), (3, 5)], pixels=True)

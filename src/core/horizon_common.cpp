@@ -204,7 +204,12 @@ void pixelNormal(const std::vector<float>& h, int width, int height, int c, int 
 float swathFactor(float weight) { return hfSin(kPiF * weight) / kPiF; }
 
 void finishReduction(HorizonResult& result) {
-  for (float& v : result.sky_view_factor) v = 1.0f - v;
+  // Both are shares of the sky, within 0 .. 1 (NaN kept); the azimuthal quadrature can pass an end
+  // by its error (ambient occlusion up to 1.006 on steep noise at K = 16), and the integral it
+  // approximates lies inside: clamping only brings a value nearer it.
+  const auto share = [](float v) { return v > 1.0f ? 1.0f : (v < 0.0f ? 0.0f : v); };
+  for (float& v : result.sky_view_factor) v = share(1.0f - v);
+  for (float& v : result.ambient_occlusion) v = share(v);
 }
 
 void splitErrorHalves(HorizonResult& result, const std::vector<float>& odd_svf, const std::vector<float>& odd_ao,

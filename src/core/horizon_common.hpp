@@ -35,7 +35,8 @@ void pixelNormal(const std::vector<float>& h, int width, int height, int c, int 
 // weight (ambient_term in kernels/horizon.cl), computed once per direction on the host.
 float swathFactor(float weight);
 
-// Turns the accumulated sums into the outputs: svf = 1 - weighted sum; ao is the sum itself.
+// Turns the accumulated sums into the outputs: svf = 1 - weighted sum; ao is the sum itself; each
+// clamped to 0 .. 1.
 void finishReduction(HorizonResult& result);
 
 // The directions of HorizonOptions::max_error's first run.
