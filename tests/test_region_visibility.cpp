@@ -601,11 +601,16 @@ TEST(RegionVisibility, ReceiversBesideTheSamplesBoxSeeTheBlockBetween) {
 // A wall between a light and the ground beyond it: the bitmask method's bits are the exact
 // ones, the far side sees none of the light, the near side all of it; flat ground sees all.
 // A planar light (at an absolute height) over `rectangle`, and options for a method.
+// A rectangle's samples, `height` above the surface.
+RegionSampling regionOf(const std::array<int, 4>& rectangle, int samples, double height) {
+  RegionSampling region;
+  region.rectangle = {rectangle[0], rectangle[1], rectangle[2], rectangle[3]};
+  region.samples = samples;
+  region.height = height;
+  return region;
+}
 RegionSampling planarLight(const std::array<int, 4>& rectangle, int samples, double height) {
-  RegionSampling light;
-  light.rectangle = {rectangle[0], rectangle[1], rectangle[2], rectangle[3]};
-  light.samples = samples;
-  light.height = height;
+  RegionSampling light = regionOf(rectangle, samples, height);
   light.absolute = true;
   return light;
 }
@@ -773,27 +778,10 @@ TEST(RegionVisibility, ATiltedPlaneSeesItselfWhereverItLies) {
   // chords run above it. A wall of 2 cm across the plane at 8848 (about 20 units in the last place
   // there) still hides the pairs on either side of it.
   const int w = 61, h = 37;
-  struct Surface {
-    const char* name;
-    double base, along_x, along_y, bowl;
-  };
-  for (const Surface& surface :
-       {Surface{"gentle at 8848", 8848.0, 0.001, 0.0, 0.0}, Surface{"steep", 0.0, 0.37, 0.11, 0.0},
-        Surface{"at 3e5", 3e5, 1.7, -0.9, 0.0}, Surface{"bowl", 100.0, 0.0, 0.0, 0.013}}) {
-    std::vector<float> heights(w * h);
-    for (int row = 0; row < h; ++row)
-      for (int col = 0; col < w; ++col)
-        heights[row * w + col] =
-            static_cast<float>(surface.base + surface.along_x * col + surface.along_y * row +
-                               surface.bowl * ((col - 30) * (col - 30) + (row - 18) * (row - 18)));
+  for (const testing::GrazingSurface& surface : testing::grazingSurfaces()) {
+    const std::vector<float> heights = testing::grazingHeights(surface, w, h);
     const HeightField field = fieldFrom(w, h, heights);
-    RegionSampling a, b;
-    a.rectangle = {1, 2, 17, 34};
-    a.samples = 64;
-    a.height = 0.0;
-    b.rectangle = {40, 0, 59, 36};
-    b.samples = 64;
-    b.height = 0.0;
+    const RegionSampling a = regionOf({1, 2, 17, 34}, 64, 0.0), b = regionOf({40, 0, 59, 36}, 64, 0.0);
     for (const RegionVisibilityMethod method :
          {RegionVisibilityMethod::Exact, RegionVisibilityMethod::Culled}) {
       RegionVisibilityOptions options;
@@ -822,13 +810,7 @@ TEST(RegionVisibility, AWallBlocksEveryPair) {
   HeightField open = fieldFrom(w, h, heights);
   for (int row = 0; row < h; ++row) heights[row * w + 20] = 30.0f;
   const HeightField walled = fieldFrom(w, h, heights);
-  RegionSampling a, b;
-  a.rectangle = {2, 1, 12, 21};
-  a.samples = 50;
-  a.height = 5.0;
-  b.rectangle = {28, 0, 39, 22};
-  b.samples = 30;
-  b.height = 5.0;
+  const RegionSampling a = regionOf({2, 1, 12, 21}, 50, 5.0), b = regionOf({28, 0, 39, 22}, 30, 5.0);
   forEachLayout([&](const ComputeContext& context) {
     const RegionPairVisibilityResult blocked = computeRegionPairVisibility(context, walled, a, b, {});
     EXPECT_EQ(blocked.clear_pairs, 0u);

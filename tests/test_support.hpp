@@ -136,6 +136,31 @@ inline HeightField fieldFrom(int width, int height, std::vector<float> heights) 
   return f;
 }
 
+// Surfaces whose sight lines between two of their points graze them everywhere (the viewshed's and
+// region visibility's tie rule under the heights' rounding): tilted planes at 8848, near 0 and
+// steep, and at 3e5, and a bowl, whose chords run above it.
+struct GrazingSurface {
+  const char* name;
+  double base, along_x, along_y, bowl;
+};
+inline std::vector<GrazingSurface> grazingSurfaces() {
+  return {{"gentle at 8848", 8848.0, 0.001, 0.0, 0.0},
+          {"steep", 0.0, 0.37, 0.11, 0.0},
+          {"at 3e5", 3e5, 1.7, -0.9, 0.0},
+          {"bowl", 100.0, 0.0, 0.0, 0.013}};
+}
+// Its float32 heights over width x height pixels (the bowl's bottom at the middle).
+inline std::vector<float> grazingHeights(const GrazingSurface& s, int width, int height) {
+  std::vector<float> heights(static_cast<std::size_t>(width) * height);
+  for (int row = 0; row < height; ++row)
+    for (int col = 0; col < width; ++col) {
+      const double x = col - width / 2, y = row - height / 2;
+      heights[static_cast<std::size_t>(row) * width + col] =
+          static_cast<float>(s.base + s.along_x * col + s.along_y * row + s.bowl * (x * x + y * y));
+    }
+  return heights;
+}
+
 // Heights of long random lines, width * height values by kind: 0 tie-rich small integers
 // 0..3, 1 a smooth random walk (steps in [-1, 1]), 2 float noise in [0, noise_range), 3 two
 // levels 0.5 apart at 1000 (ties at a large offset).

@@ -223,20 +223,9 @@ TEST(Viewshed, ATiltedPlaneSeesItselfWhereverItLies) {
   // bowl's, whose chords run above it. The needed height is 0 there. A wall of 2 cm across the
   // plane at 8848 (about 20 units in the last place there) still hides what lies behind it.
   const int w = 97, h = 71;
-  struct Surface {
-    const char* name;
-    double base, along_x, along_y, bowl;
-  };
-  for (const Surface& surface :
-       {Surface{"gentle at 8848", 8848.0, 0.001, 0.0, 0.0}, Surface{"steep", 0.0, 0.37, 0.11, 0.0},
-        Surface{"at 3e5", 3e5, 1.7, -0.9, 0.0}, Surface{"bowl", 100.0, 0.0, 0.0, 0.013}}) {
+  for (const testing::GrazingSurface& surface : testing::grazingSurfaces()) {
     SCOPED_TRACE(surface.name);
-    std::vector<float> heights(w * h);
-    for (int row = 0; row < h; ++row)
-      for (int col = 0; col < w; ++col)
-        heights[row * w + col] =
-            static_cast<float>(surface.base + surface.along_x * col + surface.along_y * row +
-                               surface.bowl * ((col - 48) * (col - 48) + (row - 35) * (row - 35)));
+    const std::vector<float> heights = testing::grazingHeights(surface, w, h);
     HeightField field = testing::fieldFrom(w, h, heights);
     ViewshedOutputs outputs;
     outputs.needed_height = true;
