@@ -11,10 +11,14 @@ both ends on the surface (heights 0) on planes at 8848 m and far from 0, and on 
 a wall of 2 cm (still hiding). A fourth shows the price of that tolerance: a sight line that
 grazes a wall top beside the eye forgives it by a few units in the last place there, which lets a
 target far beyond lie lower by as much times their distances' ratio, so the field's datum moves
-the edge of what is seen. Writes Markdown tables to stdout.
+the edge of what is seen. A fifth times `intervisibility` on a tilted plane against noise: the
+hull tree walks each horizon's forgiven stretch sample by sample, and on a plane every stretch
+runs back to the line's start. Writes Markdown tables to stdout.
 
     build/python-venv/bin/python python/bench/tilted_plane.py
 """
+
+import time
 
 import numpy as np
 
@@ -92,6 +96,20 @@ def main():
         seen = np.asarray(hfvis.viewshed((base + ground).astype(np.float32), (0, 10), observer_height=1.7))[10]
         past = [c for c in range(6, 300) if seen[c] == 1.0]
         print(f"| heights {base:g} + that | {past[0] if past else 'none'} |")
+    print()
+    print("| N x N, K = 16 | tilted plane 0.3 column + 0.1 row: seconds | normal noise: seconds | ratio |")
+    print("| --- | ---: | ---: | ---: |")
+    for n in (128, 256, 512):
+        rows, columns = np.mgrid[0:n, 0:n].astype(np.float64)
+        fields = [(0.3 * columns + 0.1 * rows).astype(np.float32),
+                  np.random.default_rng(1).normal(0.0, 1.0, (n, n)).astype(np.float32)]
+        seconds = []
+        for field in fields:
+            hfvis.intervisibility(field[:8, :8], directions=16)  # (the kernels built before the timing)
+            start = time.perf_counter()
+            hfvis.intervisibility(field, directions=16)
+            seconds.append(time.perf_counter() - start)
+        print(f"| {n} | {seconds[0]:.2f} | {seconds[1]:.2f} | {seconds[0] / seconds[1]:.1f} |")
 
 
 if __name__ == "__main__":
