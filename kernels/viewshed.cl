@@ -158,8 +158,8 @@ inline float excess_on_piece(float t0, float t1, float f0, float f1, float a_t) 
 }
 
 // How far the surface may rise above a sight line from the eye at height ze (rise: the target's
-// height less ze; drop: the curvature's c D^2) and still not hide the target: the heights'
-// rounding, which a grazing sight line forgives, as region visibility's march
+// height, lowered by drop, less ze; drop: the curvature's c D^2) and still not hide the target:
+// the heights' rounding, which a grazing sight line forgives, as region visibility's march
 // (region_forgiven) and viewcount's tie rule do (docs/ALGORITHMS.md, "Grazing samples and the
 // heights' rounding"). On a tilted plane a sight line between two points of the surface runs
 // along it, and an exact sign hid nearly every such target (all of them on a plane at 8848).
