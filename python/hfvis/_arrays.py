@@ -5,6 +5,7 @@ arguments, and one operation run on hfvis._core. compute() takes and returns onl
 import datetime
 import math
 import os
+import re
 
 import numpy as np
 
@@ -274,8 +275,8 @@ def compute(operation, heights, geometry, options, device="", progress=None):
                 light_image = np.broadcast_to(light_image, (3,) + light_image.shape)
             if (light_image.ndim != 3 or light_image.shape[0] != 3 or light_image.dtype.kind not in "fiu" or
                     light_image.size == 0):
-                raise InputTypeError("light_image must be a real, non-empty 2-D (rows, columns: grey) or 3-D (3: R, G, B, "
-                                     f"rows, columns) array, got shape {light_image.shape} and dtype "
+                raise InputTypeError("light_image must be a real, non-empty 2-D (rows, columns: grey) or 3-D (3: R, G, "
+                                     f"B, rows, columns) array, got shape {light_image.shape} and dtype "
                                      f"{light_image.dtype}")
             light_image = np.ascontiguousarray(light_image, dtype=np.float32)
         r = _core.region_visibility(field, region_sampling(options["sources"], options["samples"], options["height"],
@@ -377,6 +378,21 @@ def receiver_pixels(receivers):
         raise InvalidArgumentError(f"receivers must be an N x 2 array of integer pixels (column, row), N >= 1, "
                                    f"got shape {pixels.shape} and dtype {pixels.dtype}")
     return pixels[:, 0].tolist(), pixels[:, 1].tolist()
+
+
+def observer_unflipped(error, shape, flips):
+    """The library's error naming an observer's pixel in the field as computed (flipped to north up,
+    west left: `flips`, rows and columns) with the pixel as the caller's array has it."""
+    flip_rows, flip_cols = flips
+    if not (flip_rows or flip_cols):
+        return error
+    height, width = shape
+
+    def caller(match):
+        col, row = int(match.group(1)), int(match.group(2))
+        return f"observer {width - 1 - col if flip_cols else col},{height - 1 - row if flip_rows else row}"
+
+    return type(error)(re.sub(r"observer (-?\d+),(-?\d+)", caller, str(error)))
 
 
 def observer_pixel(observer):

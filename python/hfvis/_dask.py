@@ -136,12 +136,13 @@ def chunked(operation, heights, geometry, options, device=""):
     return out
 
 
-def _viewshed_window(window, geometry, options, device, first_col, first_row):
+def _viewshed_window(window, geometry, options, device, first_col, first_row, shape, flips):
     o = dict(options)
     col, row = _arrays.observer_pixel(options["observer"])
     o["observer"] = np.array([col - first_col, row - first_row])
     if not np.isfinite(window[row - first_row, col - first_col]):  # (named in the window's pixels, it misled)
-        raise InvalidArgumentError(f"observer {col},{row} stands on nodata")
+        raise _arrays.observer_unflipped(InvalidArgumentError(f"observer {col},{row} stands on nodata"), shape,
+                                         flips)
     return _arrays.compute("viewshed", np.ascontiguousarray(window, dtype=np.float32), geometry, o, device)["visible"]
 
 
@@ -158,12 +159,13 @@ def _viewshed_block(block, window, first_col, first_row, block_info=None):
     return out
 
 
-def viewshed(heights, geometry, options, device=""):
+def viewshed(heights, geometry, options, device="", flips=(False, False)):
     """One observer's viewshed over a Dask array, chunked as the input: within a maximum distance
     computed on the window it reaches (a task of its own), the rest out of range (0, NaN at
     nodata). The viewshed's heights count from zero and its rays from the observer, so the window's
     result is the whole field's there bit for bit. Without a maximum distance the window is the
-    whole field. Latitude / longitude grids are refused now, as the library refuses them."""
+    whole field. Latitude / longitude grids are refused now, as the library refuses them. `flips`
+    (rows, columns): how the field was flipped from the caller's, whose pixel an error names."""
     import dask
     import dask.array as da
 
@@ -178,7 +180,7 @@ def viewshed(heights, geometry, options, device=""):
         first_row, first_col = max(0, min(row, height - 1) - depth), max(0, min(col, width - 1) - depth)
         last_row, last_col = min(height, max(row, 0) + depth + 1), min(width, max(col, 0) + depth + 1)
     window = dask.delayed(_viewshed_window)(heights[first_row:last_row, first_col:last_col], geometry, options,
-                                            device, first_col, first_row)
+                                            device, first_col, first_row, heights.shape, flips)
     return da.map_blocks(_viewshed_block, heights, window, first_col, first_row, dtype=np.float32,
                          meta=np.empty((0, 0), np.float32))
 
@@ -191,13 +193,16 @@ def _refuse_rows_spacing(geometry):
                                    "reproject the DEM to a projected CRS")
 
 
-def _observer_group(heights, geometry, options, device, group):
+def _observer_group(heights, geometry, options, device, group, flips):
     o = dict(options, observers=group[0], observer_height=group[1])
-    return _arrays.compute("cumulative_viewshed", np.ascontiguousarray(heights, dtype=np.float32), geometry, o,
-                           device)["count"]
+    try:
+        return _arrays.compute("cumulative_viewshed", np.ascontiguousarray(heights, dtype=np.float32), geometry, o,
+                               device)["count"]
+    except InvalidArgumentError as error:
+        raise _arrays.observer_unflipped(error, heights.shape, flips) from None
 
 
-def cumulative_viewshed(heights, geometry, options, device="", group_size=None):
+def cumulative_viewshed(heights, geometry, options, device="", group_size=None, flips=(False, False)):
     """The cumulative viewshed of many observers over a Dask array: groups of observers, each a
     task over the whole field, and their counts summed (whole numbers: the sum is exact)."""
     import dask
@@ -213,7 +218,7 @@ def cumulative_viewshed(heights, geometry, options, device="", group_size=None):
     counts = []
     for start in range(0, len(pixels), group_size):
         group = (pixels[start:start + group_size], eyes[start:start + group_size])
-        task = dask.delayed(_observer_group)(whole, geometry, options, device, group)
+        task = dask.delayed(_observer_group)(whole, geometry, options, device, group, flips)
         counts.append(da.from_delayed(task, shape=heights.shape, dtype=np.float32))
     total = functools.reduce(lambda a, b: a + b, counts)
     return total.rechunk(heights.chunks)

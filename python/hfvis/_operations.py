@@ -4,7 +4,6 @@ arguments are named as the C++ library's options (docs/python.md lists them)."""
 
 import collections
 import math
-import re
 
 import numpy as np
 
@@ -127,9 +126,10 @@ def _run(operation, heights, options, common):
             data = data.map_blocks(_nodata_as_nan, nodata, dtype=np.float32)
         data = _flipped(data.astype(np.float32), flip_rows, flip_cols)
         if operation == "cumulative_viewshed":
-            out = {"count": _dask.cumulative_viewshed(data, g, options, common["device"])}
+            out = {"count": _dask.cumulative_viewshed(data, g, options, common["device"],
+                                                       flips=(flip_rows, flip_cols))}
         elif operation == "viewshed":
-            out = {"visible": _dask.viewshed(data, g, options, common["device"])}
+            out = {"visible": _dask.viewshed(data, g, options, common["device"], flips=(flip_rows, flip_cols))}
         elif operation in _arrays.DISTANCE_LIMITED:
             out = _dask.chunked(operation, data, g, options, common["device"])
         else:
@@ -140,25 +140,11 @@ def _run(operation, heights, options, common):
         try:
             out = _arrays.compute(operation, h, g, options, common["device"], common["progress"])
         except InvalidArgumentError as error:
-            raise _observer_unflipped(error, h.shape, flip_rows, flip_cols) from None
+            raise _arrays.observer_unflipped(error, h.shape, (flip_rows, flip_cols)) from None
     if flip_rows or flip_cols:
         for name in _arrays.OUTPUTS.get(operation, ("irradiance",)):
             out[name] = _flipped(out[name], flip_rows, flip_cols)
     return out, grid
-
-
-def _observer_unflipped(error, shape, flip_rows, flip_cols):
-    """The library's error naming an observer's pixel in the field as computed (flipped to north up,
-    west left) with the pixel as the caller's array has it."""
-    if not (flip_rows or flip_cols):
-        return error
-    height, width = shape
-
-    def caller(match):
-        col, row = int(match.group(1)), int(match.group(2))
-        return f"observer {width - 1 - col if flip_cols else col},{height - 1 - row if flip_rows else row}"
-
-    return type(error)(re.sub(r"observer (-?\d+),(-?\d+)", caller, str(error)))
 
 
 def _marked(data, nodatas, scale, offset):

@@ -321,3 +321,9 @@ def test_an_observers_pixel_is_named_as_the_caller_gave_it():
         hfvis.viewshed(west_up, (20, 5), pixels=True)
     with pytest.raises(hfvis.InvalidArgumentError, match="observer 3,5 stands on nodata"):
         hfvis.cumulative_viewshed(south_up, [(1, 1), (3, 5)], pixels=True)
+    # A Dask array's (when computed: the heights are read then).
+    lazy = south_up.chunk(10)
+    with pytest.raises(hfvis.InvalidArgumentError, match="observer 3,5 stands on nodata"):
+        hfvis.viewshed(lazy, (3, 5), pixels=True, max_distance=50.0).values
+    with pytest.raises(hfvis.InvalidArgumentError, match="observer 3,5 stands on nodata"):
+        hfvis.cumulative_viewshed(lazy, [(1, 1), (3, 5)], pixels=True).values
