@@ -175,8 +175,9 @@ inline float forgiven_rise(float ze, float rise, float drop) {
 // surface rises above the sight line by more than the rounding it forgives (forgiven_rise)
 // somewhere on [ta, tb]: at a grid-line crossing, or inside a cell without nodata at the top of its
 // quadratic. With `excess` (not null) it marches all of [ta, tb] and raises *excess to the largest
-// (f(t) - forgiven) / t met (f the surface less the sight line): a target needs
-// max(0, target_height + that) above the surface to be seen.
+// f(t) / t met (f the surface less the sight line, nothing forgiven: a rounding forgiven near the
+// eye would lower a far target's need by it times their distances' ratio): a target needs
+// max(0, target_height + that) above the surface to be seen exactly.
 int sight_walk(__global const float* h, Field f, float ex, float ey, float dx, float dy, float ze, float rise,
                float d2, float target_height, float ta, float tb, float* excess) {
   const float inv_dx = dx != 0.0f ? 1.0f / dx : 0.0f, inv_dy = dy != 0.0f ? 1.0f / dy : 0.0f;
@@ -209,10 +210,10 @@ int sight_walk(__global const float* h, Field f, float ex, float ey, float dx, f
     // target) rises at most |twist| 2.5e-7 above its ends: its vertex would be rounding noise.
     const float bump = span * pixels > 1e-3f ? quadratic_bump(f0, f1, a) : -INFINITY;
     if (excess) {
-      if (!isnan(f1)) *excess = hf_max(*excess, (f1 - forgiven) / t1);
+      if (!isnan(f1)) *excess = hf_max(*excess, f1 / t1);
       if (!isnan(f0) && !isnan(f1) && span > 0.0f)
-        *excess = hf_max(*excess, excess_on_piece(t0, t1, f0 - forgiven, f1 - forgiven,
-                                                  span * pixels > 1e-3f ? a / (span * span) : 0.0f));
+        *excess = hf_max(*excess,
+                         excess_on_piece(t0, t1, f0, f1, span * pixels > 1e-3f ? a / (span * span) : 0.0f));
     } else if (f0 > forgiven || f1 > forgiven || bump > forgiven) {
       return 1;
     }
@@ -1090,5 +1091,11 @@ __kernel void viewshed_needed(__global const float* h, Field f, int ex_i, int ey
   float excess = -INFINITY;
   sight_blocked_pyramid(h, pyramid, levels, top_level, f, ex_i, ey_i, dx, dy, ze, rise, d2, target_height, 0.0f, 1.0f,
                         &excess);
-  out_needed[p] = hf_max(0.0f, target_height + excess);
+  float needed = hf_max(0.0f, target_height + excess);
+  // 0 where a target on the surface is seen, its sight line grazing within the rounding forgiven
+  // (on a tilted plane the exact need is rounding noise).
+  if (needed > 0.0f && !sight_blocked_pyramid(h, pyramid, levels, top_level, f, ex_i, ey_i, dx, dy, ze,
+                                              (ht - f.curvature * d2) - ze, d2, 0.0f, 0.0f, 1.0f, 0))
+    needed = 0.0f;
+  out_needed[p] = needed;
 }

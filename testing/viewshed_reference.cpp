@@ -102,7 +102,7 @@ SightLine referenceSightLine(const HeightField& f, const Observer& o, const View
     if (std::isnan(fs[s])) continue;
     rise = std::max(rise, fs[s]);
     if (s > 0 && s + 1 < merged.size()) interior = std::max(interior, fs[s]);
-    if (s > 0) excess = std::max(excess, (fs[s] - forgiven) / merged[s].t);
+    if (s > 0) excess = std::max(excess, fs[s] / merged[s].t);
   }
   for (std::size_t s = 0; s + 1 < merged.size(); ++s) {
     const double t0 = merged[s].t, t1 = merged[s + 1].t, tm = 0.5 * (t0 + t1);
@@ -115,16 +115,14 @@ SightLine referenceSightLine(const HeightField& f, const Observer& o, const View
     if (std::isnan(twist) || std::isnan(fs[s]) || std::isnan(fs[s + 1]))
       continue;  // a cell with a nodata corner has no surface inside
     const double a = twist * dx * dy - drop;  // t^2 coefficient of f
-    // The excess is that of f less the rounding forgiven.
-    const double g0 = fs[s] - forgiven, g1 = fs[s + 1] - forgiven;
-    if (s == 0) {  // (f - forgiven) / t next to the eye
-      if (g0 > 0.0) excess = std::numeric_limits<double>::infinity();
-      if (g0 == 0.0) excess = std::max(excess, (g1 - g0) / t1 - a * t1);
+    if (s == 0) {                             // f / t next to the eye
+      if (fs[0] > 0.0) excess = std::numeric_limits<double>::infinity();
+      if (fs[0] == 0.0) excess = std::max(excess, (fs[1] - fs[0]) / t1 - a * t1);
     }
-    if (a < 0.0) {  // where (g / t)' = 0: t^2 = t0 t1 + g_lin(0) / a
-      const double tt = t0 * t1 + (g0 * t1 - g1 * t0) / (t1 - t0) / a;
+    if (a < 0.0) {  // where (f / t)' = 0: t^2 = t0 t1 + f_lin(0) / a
+      const double tt = t0 * t1 + (fs[s] * t1 - fs[s + 1] * t0) / (t1 - t0) / a;
       const double tv = tt > 0.0 ? std::sqrt(tt) : 0.0;
-      if (tv > t0 && tv < t1) excess = std::max(excess, (inCell(cx, cy, tv) - forgiven) / tv);
+      if (tv > t0 && tv < t1) excess = std::max(excess, inCell(cx, cy, tv) / tv);
     }
     if (a < 0.0) {
       const double tv = -(((fs[s + 1] - fs[s]) / (t1 - t0)) - a * (t0 + t1)) / (2.0 * a);  // vertex of f
@@ -169,6 +167,12 @@ ViewshedResult referenceViewshed(const HeightField& f, const Observer& o, const 
       const SightLine s = referenceSightLine(f, o, options, col, row);
       r.visible[p] = s.visible ? 1.0f : 0.0f;
       r.needed_height[p] = static_cast<float>(std::max(0.0, options.target_height + s.excess));
+      // 0 where a target on the surface is seen (its line grazing within the rounding forgiven).
+      if (r.needed_height[p] > 0.0f) {
+        ViewshedOptions on_surface = options;
+        on_surface.target_height = 0.0;
+        if (referenceSightLine(f, o, on_surface, col, row).visible) r.needed_height[p] = 0.0f;
+      }
       if (rises) (*rises)[p] = s.rise;
     }
   return r;

@@ -832,8 +832,13 @@ TEST(HorizonKernels, HeightSpanBeyondFloatArithmeticIsRefused) {
   field.heights[0] = field.heights[7] = 1.0f;
   field.z_scale = 1e30;
   EXPECT_THROW(computeHorizons(testContext(), field, options, outputs), InvalidArgument);
-  field.z_scale = 1e20;  // heights of noise in [0, 1): spans up to 1e20, fine
+  field.z_scale = 1e20;  // heights of noise in [0, 1): spans up to 1e20, whose squares overflow
+  EXPECT_THROW(computeHorizons(testContext(), field, options, outputs), InvalidArgument);
+  field.z_scale = 1e17;  // spans up to 1e17: fine
   EXPECT_NO_THROW(computeHorizons(testContext(), field, options, outputs));
+  field.z_scale = 1.0;  // a cliff of 2e19 (a sky-view factor of 1 at its foot when it ran)
+  field.heights[7] = 2e19f;
+  EXPECT_THROW(computeHorizons(testContext(), field, options, outputs), InvalidArgument);
 }
 
 // An origin that does not place the field inside its larger field, or whose lowest height is not

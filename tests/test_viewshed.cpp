@@ -254,6 +254,34 @@ TEST(Viewshed, ATiltedPlaneSeesItselfWhereverItLies) {
   }
 }
 
+TEST(Viewshed, NeededHeightKeepsToTheGeometryFarFromZero) {
+  // The needed height is the exact one: the city of whole-number heights raised by 8848 (exactly,
+  // in float32) needs what it needs at 0 to within the rounding of its values. Taken with the
+  // rounding the visibility forgives, a roof near the eye lowered far targets' needs by it times
+  // the ratio of their distances (0.3 of 43.8 at 8848).
+  const HeightField city = makeSyntheticField("city", 64, 64);
+  HeightField raised = city;
+  for (float& v : raised.heights) v += 8848.0f;
+  ViewshedOptions options;
+  ViewshedOutputs outputs;
+  outputs.needed_height = true;
+  const Observer o{32, 32, 1.5};
+  const ViewshedResult low = computeViewshed(testContext(), city, o, options, outputs);
+  const ViewshedResult high = computeViewshed(testContext(), raised, o, options, outputs);
+  // (A need within the rounding forgiven at 8848 is 0 there: a target on the surface is seen.)
+  double most = 0.0, most_zeroed = 0.0;
+  for (std::size_t p = 0; p < low.needed_height.size(); ++p) {
+    const double a = low.needed_height[p], b = high.needed_height[p];
+    if (b == 0.0 && a > 0.0)
+      most_zeroed = std::max(most_zeroed, a);
+    else
+      most = std::max(most, std::fabs(a - b));
+  }
+  EXPECT_LT(most, 0.02);
+  EXPECT_LT(most_zeroed, 0.02);
+  std::printf("largest difference %.4f, largest need zeroed at 8848 %.4f\n", most, most_zeroed);
+}
+
 TEST(Viewshed, CurvatureHidesFlatGroundBeyondTheHorizon) {
   // Flat ground, an eye h above it, targets on the ground: visible out to sqrt(2 R h / (1 - K)).
   HeightField f;

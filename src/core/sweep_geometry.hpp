@@ -66,12 +66,14 @@ float sampleHeight(const std::vector<float>& heights, int width, int height, Poi
 // a plane at 8848 m keeps its millimetres (a field with an origin takes its larger field's
 // lowest); every non-finite height becomes NaN. Throws InvalidArgument when a prepared height
 // would exceed kMaxPreparedHeight: the kernels multiply height differences by distances (up to
-// 2^31 pixels) in float, which must stay finite. HeightOrigin::Zero keeps the heights where
+// 2^31 pixels) and square them (the sky-view factor's and occlusion's terms) in float, which
+// must stay finite (a cliff of 2e19 gave a sky-view factor of 1 at its foot, exit 0, when the
+// bound was 1e28). HeightOrigin::Zero keeps the heights where
 // they are (h * z_scale): the viewshed, region visibility and the ray caster, whose observers,
 // sources and targets may stand at absolute heights; it throws when a height itself would
 // exceed kMaxPreparedHeight, or lies so far from 0 that float32's spacing there passes a tenth
 // of a cell.
-constexpr double kMaxPreparedHeight = 1e28;
+constexpr double kMaxPreparedHeight = 1e18;
 struct PreparedHeights {
   std::vector<float> heights;
   bool has_nodata = false;

@@ -19,7 +19,7 @@ struct SightLine {
   bool visible = false;
   double rise = 0.0;
   double interior_rise = 0.0;
-  double excess = 0.0;  // the largest (f(t) - forgiven) / t over (0, 1], f the surface less the sight line
+  double excess = 0.0;  // the largest f(t) / t over (0, 1], f the surface less the sight line
 };
 
 // The sight line from `observer` to the target on grid point (col, row), in range or not.
