@@ -269,8 +269,8 @@ StackStats hullStackStatistics(const HeightField& field, int directions) {
           const int x0 = c + s.ox, y0 = r + s.oy;
           if (x0 < 0 || x0 + s.ex > w - 1 || y0 < 0 || y0 + s.ey > h - 1) continue;
           const std::size_t at = static_cast<std::size_t>(y0) * w + x0;
-          const float height = s.w00 * heights[at] + s.w10 * heights[at + s.ex] +
-                               s.w01 * heights[at + s.ey * w] + s.w11 * heights[at + s.ey * w + s.ex];
+          const float height = detail::cornerBilinear(heights[at], heights[at + s.ex], heights[at + s.ey * w],
+                                                      heights[at + s.ey * w + s.ex], s.w10, s.w01, s.w11);
           push(height, base - s.tau);
         }
         push(heights[static_cast<std::size_t>(r) * w + c], base);

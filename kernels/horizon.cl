@@ -299,7 +299,7 @@ HFVIS_INLINE lane_float lane_sample_height(__global const float* heights, int wi
     }
     // The receiver (ex = ey = 0, weight 1) is its pixel's height as it is (1 h + 0 h would
     // turn an infinite height into NaN).
-    h = ex + ey == 0 ? h0 : w00 * h0 + (ex ? w10 : w01) * h1;
+    h = ex + ey == 0 ? h0 : h0 + (ex ? w10 : w01) * (h1 - h0);
     *corner0 = h0;
     *corner1 = h1;
 #if HFVIS_HAS_NODATA

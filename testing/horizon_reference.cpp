@@ -169,15 +169,8 @@ DirectionOutputs outputsOf(const LatticeDirection& d, int k) {
 float latticeHeight(const std::vector<float>& h, std::size_t at, std::size_t right, std::size_t down,
                     const LatticeSample& s) {
   const float h00 = h[at], h10 = h[at + right], h01 = h[at + down], h11 = h[at + down + right];
-  const float plain = s.w00 * h00 + s.w10 * h10 + s.w01 * h01 + s.w11 * h11;
-  if (!std::isnan(plain)) return plain;
-  const bool v00 = s.w00 > 0.0f && !std::isnan(h00), v10 = s.w10 > 0.0f && !std::isnan(h10);
-  const bool v01 = s.w01 > 0.0f && !std::isnan(h01), v11 = s.w11 > 0.0f && !std::isnan(h11);
-  const float sum = (v00 ? s.w00 * h00 : 0.0f) + (v10 ? s.w10 * h10 : 0.0f) + (v01 ? s.w01 * h01 : 0.0f) +
-                    (v11 ? s.w11 * h11 : 0.0f);
-  const float weight =
-      (v00 ? s.w00 : 0.0f) + (v10 ? s.w10 : 0.0f) + (v01 ? s.w01 : 0.0f) + (v11 ? s.w11 : 0.0f);
-  return weight > 0.0f ? sum / weight : kNaN;
+  const float plain = cornerBilinear(h00, h10, h01, h11, s.w10, s.w01, s.w11);
+  return std::isnan(plain) ? renormalisedBilinear(h00, h10, h01, h11, s.w00, s.w10, s.w01, s.w11) : plain;
 }
 
 namespace {

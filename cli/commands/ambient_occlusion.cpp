@@ -22,7 +22,7 @@ const CommandSpec kAmbientOcclusionCommand{
     "ambient-occlusion",
     "ao",
     "one float32 channel \"ao\": ambient occlusion, 0..1 (1 = unoccluded flat ground)",
-    "IN -o OUT.exr [-k K] [options]",
+    "IN -o OUT.exr [-k K | --max-error E] [--error-out ERR.exr] [options]",
     "Writes one float32 channel \"ao\": ambient occlusion under a uniform sky of radiance 1,\n"
     "normalised so a flat plane gives 1 (0 = fully occluded).\n"
     "The preview (--preview) stretches its 1st to 99th percentile over black..white (the\n"

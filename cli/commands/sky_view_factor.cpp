@@ -22,7 +22,7 @@ const CommandSpec kSkyViewFactorCommand{
     "sky-view-factor",
     "svf",
     "one float32 channel \"svf\": sky-view factor, 0..1",
-    "IN -o OUT.exr [-k K] [options]",
+    "IN -o OUT.exr [-k K | --max-error E] [--error-out ERR.exr] [options]",
     "Writes one float32 channel \"svf\": sky-view factor 1 - mean_k sin(max(0, elevation_k)),\n"
     "the fraction of the sky visible from each pixel (a flat plane gives 1).\n"
     "The preview (--preview) stretches its 1st to 99th percentile over black..white (the\n"

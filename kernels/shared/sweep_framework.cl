@@ -99,9 +99,32 @@ HFVIS_INLINE int inside_field(float x, float y, int width, int height) {
          y <= (float)(height - 1) + HFVIS_EDGE_EPS;
 }
 
+// The bilinear surface from the weights of a cell's corners (w00 = 1 - the others), as the
+// corner h00 plus the weighted differences from it: exact where the corners are equal, so a flat
+// plateau far from 0 stays flat (the weighted sum of its heights rounds by units in the last
+// place of the height, and a unit of 3e7 one pixel away is a horizon of 63 degrees).
+// src/core/sweep_geometry.hpp's cornerBilinear is the same expression.
+HFVIS_INLINE float corner_bilinear(float h00, float h10, float h01, float h11, float w10, float w01, float w11) {
+  return h00 + (w10 * (h10 - h00) + w01 * (h01 - h00) + w11 * (h11 - h00));
+}
+
+// The same over the corners of positive weight that are not nodata, the weights renormalised
+// (NaN when none): from the first such corner, so that equal corners give their height exactly.
+// Branch-free (masked sums add exact zeros), so it vectorises. src/core/sweep_geometry.hpp's
+// renormalisedBilinear is the same.
+HFVIS_INLINE float renormalised_bilinear(float h00, float h10, float h01, float h11, float w00, float w10,
+                                         float w01, float w11) {
+  int v00 = w00 > 0.0f && !isnan(h00), v10 = w10 > 0.0f && !isnan(h10);
+  int v01 = w01 > 0.0f && !isnan(h01), v11 = w11 > 0.0f && !isnan(h11);
+  float base = v00 ? h00 : (v10 ? h10 : (v01 ? h01 : h11));
+  float sum = (v00 ? w00 * (h00 - base) : 0.0f) + (v10 ? w10 * (h10 - base) : 0.0f) +
+              (v01 ? w01 * (h01 - base) : 0.0f) + (v11 ? w11 * (h11 - base) : 0.0f);
+  float weight = (v00 ? w00 : 0.0f) + (v10 ? w10 : 0.0f) + (v01 ? w01 : 0.0f) + (v11 ? w11 : 0.0f);
+  return weight > 0.0f ? base + sum / weight : NAN;
+}
+
 // Bilinear height at (px, py), clamped into the field. With nodata, only the valid corners
 // count and their weights are renormalised; NaN when no corner with weight is valid.
-// Branch-free (masked sums add exact zeros), so it vectorises.
 HFVIS_INLINE float sample_height(__global const float* heights, int width, int height, float px, float py) {
   // Plain comparisons instead of clamp/floor/min builtins, which PoCL leaves as calls that
   // stop vectorisation. After clamping x, y >= 0, so truncation is floor.
@@ -122,20 +145,9 @@ HFVIS_INLINE float sample_height(__global const float* heights, int width, int h
   float w10 = fx * (1.0f - fy);
   float w01 = (1.0f - fx) * fy;
   float w11 = fx * fy;
-  float plain = w00 * h00 + w10 * h10 + w01 * h01 + w11 * h11;
+  float plain = corner_bilinear(h00, h10, h01, h11, w10, w01, w11);
 #if HFVIS_HAS_NODATA
-  int n00 = h00 != h00, n10 = h10 != h10, n01 = h01 != h01, n11 = h11 != h11;  // isnan
-  float sum = 0.0f, weight = 0.0f;
-  sum += n00 ? 0.0f : w00 * h00;
-  weight += n00 ? 0.0f : w00;
-  sum += n10 ? 0.0f : w10 * h10;
-  weight += n10 ? 0.0f : w10;
-  sum += n01 ? 0.0f : w01 * h01;
-  weight += n01 ? 0.0f : w01;
-  sum += n11 ? 0.0f : w11 * h11;
-  weight += n11 ? 0.0f : w11;
-  float renormalised = weight > 0.0f ? sum / weight : NAN;
-  return (n00 || n10 || n01 || n11) ? renormalised : plain;
+  return isnan(plain) ? renormalised_bilinear(h00, h10, h01, h11, w00, w10, w01, w11) : plain;
 #else
   return plain;
 #endif
@@ -157,14 +169,9 @@ HFVIS_INLINE float lattice_height(__global const float* heights, uint at, uint r
                                   float w10, float w01, float w11) {
   float h00 = heights[at], h10 = heights[at + right], h01 = heights[at + down],
         h11 = heights[at + down + right];
-  float plain = w00 * h00 + w10 * h10 + w01 * h01 + w11 * h11;
+  float plain = corner_bilinear(h00, h10, h01, h11, w10, w01, w11);
 #if HFVIS_HAS_NODATA
-  int v00 = w00 > 0.0f && !isnan(h00), v10 = w10 > 0.0f && !isnan(h10);
-  int v01 = w01 > 0.0f && !isnan(h01), v11 = w11 > 0.0f && !isnan(h11);
-  float sum = (v00 ? w00 * h00 : 0.0f) + (v10 ? w10 * h10 : 0.0f) + (v01 ? w01 * h01 : 0.0f) +
-              (v11 ? w11 * h11 : 0.0f);
-  float weight = (v00 ? w00 : 0.0f) + (v10 ? w10 : 0.0f) + (v01 ? w01 : 0.0f) + (v11 ? w11 : 0.0f);
-  return isnan(plain) ? (weight > 0.0f ? sum / weight : NAN) : plain;
+  return isnan(plain) ? renormalised_bilinear(h00, h10, h01, h11, w00, w10, w01, w11) : plain;
 #else
   return plain;
 #endif

@@ -380,17 +380,22 @@ def receiver_pixels(receivers):
     return pixels[:, 0].tolist(), pixels[:, 1].tolist()
 
 
+def flipped_pixel(col, row, shape, flips):
+    """The pixel (col, row) of a field of `shape` flipped by `flips` (rows, columns): the caller's
+    pixel in the field as computed (flipped to north up, west left), and back."""
+    height, width = shape
+    return (width - 1 - col if flips[1] else col), (height - 1 - row if flips[0] else row)
+
+
 def observer_unflipped(error, shape, flips):
     """The library's error naming an observer's pixel in the field as computed (flipped to north up,
     west left: `flips`, rows and columns) with the pixel as the caller's array has it."""
-    flip_rows, flip_cols = flips
-    if not (flip_rows or flip_cols):
+    if not (flips[0] or flips[1]):
         return error
-    height, width = shape
 
     def caller(match):
-        col, row = int(match.group(1)), int(match.group(2))
-        return f"observer {width - 1 - col if flip_cols else col},{height - 1 - row if flip_rows else row}"
+        col, row = flipped_pixel(int(match.group(1)), int(match.group(2)), shape, flips)
+        return f"observer {col},{row}"
 
     return type(error)(re.sub(r"observer (-?\d+),(-?\d+)", caller, str(error)))
 

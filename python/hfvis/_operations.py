@@ -201,7 +201,7 @@ def _observers_as_pixels(operation, options, grid, flip_rows, flip_cols, pixels)
     height, width = grid.array.shape
 
     def place(col, row):
-        return (width - 1 - col if flip_cols else col), (height - 1 - row if flip_rows else row)
+        return _arrays.flipped_pixel(col, row, (height, width), (flip_rows, flip_cols))
 
     def pixel_of(x, y):
         if pixels:  # (as a numpy field's: whole numbers; (-0.5, 2.9) ran as (0, 2))

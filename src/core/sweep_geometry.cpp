@@ -74,15 +74,8 @@ float sampleHeight(const std::vector<float>& heights, int width, int height, Poi
   const float h01 = heights[y1 * width + x0], h11 = heights[y1 * width + x1];
   const float w00 = (1.0f - fx) * (1.0f - fy), w10 = fx * (1.0f - fy);
   const float w01 = (1.0f - fx) * fy, w11 = fx * fy;
-  if (std::isnan(h00) || std::isnan(h10) || std::isnan(h01) || std::isnan(h11)) {
-    float sum = 0.0f, weight = 0.0f;
-    if (!std::isnan(h00)) sum += w00 * h00, weight += w00;
-    if (!std::isnan(h10)) sum += w10 * h10, weight += w10;
-    if (!std::isnan(h01)) sum += w01 * h01, weight += w01;
-    if (!std::isnan(h11)) sum += w11 * h11, weight += w11;
-    return weight > 0.0f ? sum / weight : std::numeric_limits<float>::quiet_NaN();
-  }
-  return w00 * h00 + w10 * h10 + w01 * h01 + w11 * h11;
+  const float plain = cornerBilinear(h00, h10, h01, h11, w10, w01, w11);
+  return std::isnan(plain) ? renormalisedBilinear(h00, h10, h01, h11, w00, w10, w01, w11) : plain;
 }
 
 PreparedHeights prepareHeights(const HeightField& field, HeightOrigin origin, int bands) {

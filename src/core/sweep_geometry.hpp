@@ -60,6 +60,27 @@ struct Point2 {
 
 // Mirrors of the kernels' helpers (same operations, same order, same rounding).
 bool insideField(Point2 p, int width, int height);
+
+// The bilinear surface from its corners' weights (w00 = 1 - the others) as h00 plus the weighted
+// differences from it, exact where the corners are equal (kernels/shared/sweep_framework.cl,
+// corner_bilinear, says why).
+inline float cornerBilinear(float h00, float h10, float h01, float h11, float w10, float w01, float w11) {
+  return h00 + (w10 * (h10 - h00) + w01 * (h01 - h00) + w11 * (h11 - h00));
+}
+
+// The same over the corners of positive weight that are not NaN, renormalised, from the first of
+// them; NaN when none (renormalised_bilinear).
+inline float renormalisedBilinear(float h00, float h10, float h01, float h11, float w00, float w10, float w01,
+                                  float w11) {
+  const bool v00 = w00 > 0.0f && h00 == h00, v10 = w10 > 0.0f && h10 == h10;
+  const bool v01 = w01 > 0.0f && h01 == h01, v11 = w11 > 0.0f && h11 == h11;
+  const float base = v00 ? h00 : (v10 ? h10 : (v01 ? h01 : h11));
+  const float sum = (v00 ? w00 * (h00 - base) : 0.0f) + (v10 ? w10 * (h10 - base) : 0.0f) +
+                    (v01 ? w01 * (h01 - base) : 0.0f) + (v11 ? w11 * (h11 - base) : 0.0f);
+  const float weight = (v00 ? w00 : 0.0f) + (v10 ? w10 : 0.0f) + (v01 ? w01 : 0.0f) + (v11 ? w11 : 0.0f);
+  return weight > 0.0f ? base + sum / weight : std::numeric_limits<float>::quiet_NaN();
+}
+
 float sampleHeight(const std::vector<float>& heights, int width, int height, Point2 p);
 
 // Heights as the kernels see them: (h - lowest finite height) * z_scale in float, so that

@@ -130,18 +130,23 @@ class ViewshedRoutine : public detail::DeviceRoutine {
     st_.queue.finish();  // before this observer's ray buffers go
   }
 
+  // The field's largest |height| as the kernels see it (0 when none is finite): what bounds the
+  // rounding a sight line forgives and the culling pyramid's margins.
+  double largestHeight() const {
+    const double top = std::max(std::fabs(double(prepared_.lowest)), std::fabs(double(prepared_.highest)));
+    return std::isfinite(top) ? top : 0.0;
+  }
+
   // The most that a sight line from an eye at height ze to any target forgives (forgiven_rise in
   // kernels/viewshed.cl: 2^-21 of |ze| + the target's |height| + the curvature's drop, bounded
   // by the field's largest |height| plus the target height and the drop across the field): the
   // rays hide a target only where the surface rises above its sight line by more.
   float forgivenRise(float ze) const {
-    const double top = std::max(std::fabs(double(prepared_.lowest)), std::fabs(double(prepared_.highest)));
     const double across = std::hypot(field_.width * field_.cell_size_x, field_.height * field_.cell_size_y);
     const double drop = std::fabs(options_.curvature) * across * across;
-    return static_cast<float>(std::ldexp(std::fabs(double(ze)) + (std::isfinite(top) ? top : 0.0) +
-                                             options_.target_height + 2.0 * drop,
-                                         -21) *
-                              (1.0 + 1e-5));
+    return static_cast<float>(
+        std::ldexp(std::fabs(double(ze)) + largestHeight() + options_.target_height + 2.0 * drop, -21) *
+        (1.0 + 1e-5));
   }
 
   // The arguments of the kernels that follow sight lines from eye o at height ze: the field,
@@ -328,8 +333,7 @@ class ViewshedRoutine : public detail::DeviceRoutine {
   cl_int4 cull(const Observer& o, float ze) {
     leaf_flags_.clear();
     if (cull_levels_.empty()) return cl_int4{{0, 0, 0, 0}};
-    const double top = std::max(std::fabs(double(prepared_.lowest)), std::fabs(double(prepared_.highest)));
-    const double least_margin = 1e-5 * (1.0 + (std::isfinite(top) ? top : 0.0) + options_.target_height) +
+    const double least_margin = 1e-5 * (1.0 + largestHeight() + options_.target_height) +
                                 2e-3 * std::max(field_.cell_size_x, field_.cell_size_y);
     if (forgiven_ > 0.25 * least_margin) return cl_int4{{0, 0, 0, 0}};
     for (std::size_t l = 0; l < cull_levels_.size(); ++l) {
