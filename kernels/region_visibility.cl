@@ -586,6 +586,10 @@ __kernel void region_bitmask_bits(__global const float* h, __global const float*
   // forgives: a cell whose highest corner lies this far below a line cannot hide it, and one that
   // rises this far above it (and more, in_margin) surely does.
   const float out_margin = 2.0f * margin + 4e-5f * (fabs(zr) + fabs(Z)) + region_forgiven(zr, Z, 0.0f);
+  // The positions' rounding the march forgives at a crossing (region_position_reach, times the
+  // surface's slope there, at most `gradient`): added to the margins by which a cell surely hides.
+  const float reach =
+      region_position_reach(xr, yr, fmax(fabs(lo_x), fabs(hi_x)), fmax(fabs(lo_y), fabs(hi_y)));
   // A light plane not above the receiver: every sample left to the march.
   int all_uncertain = !(dz > 0.0f);
   if (!isnan(zr) && !all_uncertain) {
@@ -609,7 +613,7 @@ __kernel void region_bitmask_bits(__global const float* h, __global const float*
           float most, surely;
           region_bitmask_near(h[r], h10, h01, h11, zr, ax, ay, dz, &most, &surely);
           open = open || most > -out_margin;
-          hidden = hidden || surely > in_margin;
+          hidden = hidden || surely > in_margin + reach * gradient;
         }
       if (hidden)
         near_hidden[s / 32] |= 1U << (s % 32);
@@ -679,9 +683,10 @@ __kernel void region_bitmask_bits(__global const float* h, __global const float*
       // Inner: the triangulation below it, lowered by the march's rounding and the most its
       // values change over a piece it skips; only below the light (above it, the prism's points
       // lie beyond the line's end), where the march's values near the cell are numbers.
-      if (around && highest - in_margin <= Z && highest - in_margin > low) {
-        region_bitmask_cell(x0, y0, h00, h10, h01, h11, -in_margin, twist < 0.0f, cull_front, low, xr, yr, zr,
-                            Z, table, t, words, 0, inner);
+      const float cell_margin = in_margin + reach * gradient;
+      if (around && highest - cell_margin <= Z && highest - cell_margin > low) {
+        region_bitmask_cell(x0, y0, h00, h10, h01, h11, -cell_margin, twist < 0.0f, cull_front, low, xr, yr,
+                            zr, Z, table, t, words, 0, inner);
         if (region_bitmask_all(inner, near_hidden, samples)) break;  // nothing left to decide
       }
     }

@@ -54,6 +54,29 @@ inline float region_surface_at(HFVIS_GLOBAL const float* h, int width, int heigh
   return a + (b - a) * u;
 }
 
+// How much the surface changes per pixel along a grid line (`on_column`: the column line x =
+// `line`, else the row line y = `line`) at coordinate `at` along it: |the difference of the edge's
+// two heights|, the larger of the two edges' where `at` is a grid point. A crossing's position
+// along its line rounds (region_position_reach); this is what a pixel of it costs. A number
+// always (nodata and infinite heights count 0).
+inline float region_crossing_slope(HFVIS_GLOBAL const float* h, int width, int height, int on_column,
+                                   float line, float at) {
+  const int n = on_column ? height : width, step = on_column ? width : 1;
+  if (n < 2) return 0.0f;
+  at = at < 0.0f ? 0.0f : (at > (float)(n - 1) ? (float)(n - 1) : at);
+  const int k = (int)at < n - 2 ? (int)at : n - 2;
+  const int base = on_column ? (int)line : (int)line * width;
+  HFVIS_GLOBAL const float* e = h + base + k * step;
+  // (an infinite height: the value there is infinite or NaN, and forgives nothing more)
+  const float own = fabs(e[step] - e[0]);
+  float slope = isfinite(own) ? own : 0.0f;
+  const float before = at == (float)k && k > 0 ? fabs(e[0] - e[-step]) : 0.0f;
+  const float after = at == (float)(k + 1) && k + 2 < n ? fabs(e[2 * step] - e[step]) : 0.0f;
+  if (isfinite(before)) slope = fmax(slope, before);
+  if (isfinite(after)) slope = fmax(slope, after);
+  return slope;
+}
+
 // The twist h00 - h10 - h01 + h11 of the cell under (x, y) (clamped to the field; a field one
 // pixel wide or high has none): the t^2 coefficient of the surface along a segment of steps
 // (dx, dy) through it is twist dx dy. NaN where a corner is nodata.
@@ -82,6 +105,16 @@ inline float region_rise(float s, float t, float za, float dz, float cdd) {
 // height, no more (a wall of a dozen units in the last place still hides).
 inline float region_forgiven(float za, float zb, float cdd) {
   return 0x1p-21f * (fabs(za) + fabs(zb) + fabs(cdd));
+}
+
+// The march also rounds the positions of the segment's grid crossings, by a few units in the last
+// place of the coordinates (pixels from the field's corner): the surface there rounds by that
+// times its slope, which the heights do not bound (a plane h = x - 200 holds heights near 0 at
+// x = 200, where the rounding of x is 1.5e-5; it hid nearly every pair there). A crossing forgives
+// its surface's slope along its line (region_crossing_slope) times this reach: 2^-21 of the
+// largest |x| + the largest |y| of the segment's ends, plus 2 (pixels).
+inline float region_position_reach(float xa, float ya, float xb, float yb) {
+  return 0x1p-21f * (fmax(fabs(xa), fabs(xb)) + fmax(fabs(ya), fabs(yb)) + 2.0f);
 }
 
 // The culling pyramid (a max pyramid over the cells): level k holds, per block of 2^k x 2^k cells
@@ -133,13 +166,27 @@ inline void region_cull_resume(float xa, float ya, float dx, float dy, int on_co
   }
 }
 
-// The march's value (region_rise) at that crossing.
+// The march's value (region_rise) at that crossing; *at: the crossing's position along its line.
 inline float region_cull_crossing_rise(HFVIS_GLOBAL const float* h, int width, int height, float xa, float ya,
                                        float za, float dx, float dy, float dz, float cdd, int on_column,
-                                       float lx, float ly, float tC) {
-  const float s = on_column ? region_surface_at(h, width, height, lx, ya + tC * dy)
-                            : region_surface_at(h, width, height, xa + tC * dx, ly);
+                                       float lx, float ly, float tC, float* at) {
+  *at = on_column ? ya + tC * dy : xa + tC * dx;
+  const float s =
+      on_column ? region_surface_at(h, width, height, lx, *at) : region_surface_at(h, width, height, *at, ly);
   return region_rise(s, tC, za, dz, cdd);
+}
+
+// A crossing as the march keeps it, for its slope (region_crossing_slope), which is looked up only
+// where its value passes the heights' rounding (rarely: not on a line clear there): on the column
+// line (`on_column` 1) or the row line (0) `line` at `at` along it; on_column -1: an end of the
+// segment, whose position is given, not rounded (slope 0).
+typedef struct {
+  int on_column;
+  float line, at;
+} RegionCrossing;
+
+inline float region_slope_of(HFVIS_GLOBAL const float* h, int width, int height, RegionCrossing c) {
+  return c.on_column < 0 ? 0.0f : region_crossing_slope(h, width, height, c.on_column, c.line, c.at);
 }
 
 // The index of the first corner of the cell under (x, y), clamped into the field (for
@@ -189,6 +236,9 @@ HFVIS_SIGHT_INLINE int region_sight_visible_culled(HFVIS_GLOBAL const float* h, 
   if (max_d2 > 0.0f && d2 > max_d2) return 0;
   const float cdd = curvature * d2;
   const float forgiven = region_forgiven(za, zb, cdd);
+  // (and at each crossing the surface's slope there times `reach`: c0 is f0's crossing, c1 f1's)
+  const float reach = region_position_reach(xa, ya, xb, yb);
+  RegionCrossing c0 = {-1, 0.0f, 0.0f}, c1 = {-1, 0.0f, 0.0f};
   const float pixels = dx > (dy < 0.0f ? -dy : dy) ? dx : (dy < 0.0f ? -dy : dy);
   // The ends' certified stretches (region_end_reach) meet: no cell along the segment comes near it.
   const float length = reach_a > 0.0f || reach_b > 0.0f ? sqrt(dx * dx + dy * dy) : 0.0f;
@@ -235,8 +285,9 @@ HFVIS_SIGHT_INLINE int region_sight_visible_culled(HFVIS_GLOBAL const float* h, 
         t0 = tC;
         region_cull_resume(xa, ya, dx, dy, on_column, box_x0, ly, tC, &gxl, &gyl);
         f0 = region_cull_crossing_rise(h, width, height, xa, ya, za, dx, dy, dz, cdd, on_column, box_x0, ly,
-                                       tC);
-        if (f0 > forgiven) return 0;
+                                       tC, &c0.at);
+        c0.on_column = on_column, c0.line = on_column ? box_x0 : ly;
+        if (f0 > forgiven && f0 > forgiven + reach * region_slope_of(h, width, height, c0)) return 0;
       }
     }
     const float tX = xb > box_x1 ? (box_x1 - xa) / dx : INFINITY;
@@ -262,8 +313,10 @@ HFVIS_SIGHT_INLINE int region_sight_visible_culled(HFVIS_GLOBAL const float* h, 
     if (tC > t0 && tC < 1.0f) {
       t0 = tC;
       region_cull_resume(xa, ya, dx, dy, on_column, lx, ly, tC, &gxl, &gyl);
-      f0 = region_cull_crossing_rise(h, width, height, xa, ya, za, dx, dy, dz, cdd, on_column, lx, ly, tC);
-      if (f0 > forgiven) return 0;
+      f0 = region_cull_crossing_rise(h, width, height, xa, ya, za, dx, dy, dz, cdd, on_column, lx, ly, tC,
+                                     &c0.at);
+      c0.on_column = on_column, c0.line = on_column ? lx : ly;
+      if (f0 > forgiven && f0 > forgiven + reach * region_slope_of(h, width, height, c0)) return 0;
     }
   }
   if (reach_b > 0.01f) {
@@ -330,8 +383,9 @@ HFVIS_SIGHT_INLINE int region_sight_visible_culled(HFVIS_GLOBAL const float* h, 
       if (pending) {
         region_cull_resume(xa, ya, dx, dy, pending_on_column, pending_lx, pending_ly, t0, &gxl, &gyl);
         f0 = region_cull_crossing_rise(h, width, height, xa, ya, za, dx, dy, dz, cdd, pending_on_column,
-                                       pending_lx, pending_ly, t0);
-        if (f0 > forgiven) return 0;
+                                       pending_lx, pending_ly, t0, &c0.at);
+        c0.on_column = pending_on_column, c0.line = pending_on_column ? pending_lx : pending_ly;
+        if (f0 > forgiven && f0 > forgiven + reach * region_slope_of(h, width, height, c0)) return 0;
         pending = 0;
         tx = dx > 0.0f && gxl < xb ? (gxl - xa) / dx : INFINITY;
         ty = dy > 0.0f ? (gyl < yb ? (gyl - ya) / dy : INFINITY)
@@ -344,13 +398,16 @@ HFVIS_SIGHT_INLINE int region_sight_visible_culled(HFVIS_GLOBAL const float* h, 
     if (t1 >= 1.0f) {  // no crossing left before the far end
       t1 = 1.0f;
       f1 = region_surface_at(h, width, height, xb, yb) - zb;
+      c1.on_column = -1;
       if (f1 > forgiven) return 0;
     } else {
       // A crossing: on a column line x = gxl exactly, or on a row line y = gyl.
-      const float s = x_first ? region_surface_at(h, width, height, gxl, ya + t1 * dy)
-                              : region_surface_at(h, width, height, xa + t1 * dx, gyl);
+      c1.on_column = x_first, c1.line = x_first ? gxl : gyl, c1.at = x_first ? ya + t1 * dy : xa + t1 * dx;
+      const float s = x_first ? region_surface_at(h, width, height, gxl, c1.at)
+                              : region_surface_at(h, width, height, c1.at, gyl);
       f1 = region_rise(s, t1, za, dz, cdd);
-      if (f1 > forgiven) {  // NaN (nodata) hides nothing
+      if (f1 > forgiven &&
+          f1 > forgiven + reach * region_slope_of(h, width, height, c1)) {  // NaN hides nothing
         *blocked_at = region_cell_at(width, height, xa + 0.5f * (t0 + t1) * dx, ya + 0.5f * (t0 + t1) * dy);
         return 0;
       }
@@ -364,7 +421,10 @@ HFVIS_SIGHT_INLINE int region_sight_visible_culled(HFVIS_GLOBAL const float* h, 
         const float bump = -((dx * dy != 0.0f ? twist * dx * dy : 0.0f) - cdd) * span * span;
         if (bump > 0.0f) {
           const float s = 0.5f + (f1 - f0) / (2.0f * bump);
-          if (s > 0.0f && s < 1.0f && f0 + (f1 - f0) * s + bump * s * (1.0f - s) > forgiven) {
+          const float top = f0 + (f1 - f0) * s + bump * s * (1.0f - s);
+          if (s > 0.0f && s < 1.0f && top > forgiven &&
+              top > forgiven + reach * fmax(region_slope_of(h, width, height, c0),
+                                            region_slope_of(h, width, height, c1))) {
             *blocked_at = region_cell_at(width, height, xa + tm * dx, ya + tm * dy);
             return 0;
           }
@@ -378,6 +438,7 @@ HFVIS_SIGHT_INLINE int region_sight_visible_culled(HFVIS_GLOBAL const float* h, 
       gyl += dy > 0.0f ? 1.0f : -1.0f;
     t0 = t1;
     f0 = f1;
+    c0 = c1;
   }
 }
 
@@ -606,7 +667,8 @@ inline float region_end_reach(HFVIS_GLOBAL const float* wedge, int bands, float 
 // from (xa, ya, za) to (xb, yb, zb) by so much that the march (region_sight_visible) must find it
 // hidden: at the middle of the segment's stretch over the cell, by more than the march's
 // rounding (`margin`, the field's part, and the segment's own), more than the rounding it forgives
-// (region_forgiven) and more than its values can change over the 1e-3 pixel of a piece whose inside it skips
+// (region_forgiven, and region_position_reach times `gradient`) and more than its values can change
+// over the 1e-3 pixel of a piece whose inside it skips
 // (`gradient`: a bound of the surface's slope per pixel). Only over a cell whose 4 x 4 heights around are
 // finite, so that every value the march takes near there is a number (not looked at where `finite_field` says
 // every height of the field is). The cheap test of a sight line against the
@@ -649,7 +711,7 @@ HFVIS_SIGHT_INLINE int region_cull_hides(HFVIS_GLOBAL const float* h, int width,
   const float f = region_rise(s, tm, za, dz, cdd);
   const float slack = margin + 1e-5f * (2.0f * (fabs(za) + fabs(zb)) + fabs(cdd)) +
                       1.5e-3f * (1.5f * gradient + (fabs(dz) + fabs(cdd)) / pixels) +
-                      region_forgiven(za, zb, cdd);
+                      region_forgiven(za, zb, cdd) + region_position_reach(xa, ya, xb, yb) * gradient;
   return f > slack;
 }
 
