@@ -196,12 +196,18 @@ int sight_walk(__global const float* h, Field f, float ex, float ey, float dx, f
     const int4 c = cell_of(ex + tm * dx, ey + tm * dy, f.width, f.height);
     // At a grid-line crossing (a march may also end on one) the grid line's surface; at an end
     // inside a cell the cell's.
-    const float s1 = t1 == tx   ? surface_at_crossing(h, f.width, 1, &ax, (int)ex, (int)ey)
-                     : t1 == ty ? surface_at_crossing(h, f.width, 0, &ay, (int)ex, (int)ey)
-                                : sample_cell(h, f.width, c.x, c.y, c.z, c.w, ex + t1 * dx - c.x, ey + t1 * dy - c.y);
+    const float s1 =
+        t1 == tx   ? surface_at_crossing(h, f.width, 1, &ax, (int)ex, (int)ey)
+        : t1 == ty ? surface_at_crossing(h, f.width, 0, &ay, (int)ex, (int)ey)
+                   : sample_cell(h, f.width, c.x, c.y, c.z, c.w, (ex - c.x) + t1 * dx, (ey - c.y) + t1 * dy);
     const float f1 = t1 == 1.0f ? (isnan(s1) ? NAN : -target_height) : (s1 - ze) - t1 * rise - drop * t1 * t1;
     if (isnan(f0)) {  // the start of a march past the eye
-      const float s0 = sample_cell(h, f.width, c.x, c.y, c.z, c.w, ex + t0 * dx - c.x, ey + t0 * dy - c.y);
+      // (the fraction from the eye's grid point, a whole number of pixels from the cell's corner: the
+      // absolute position ex + t0 dx would round by units in the last place of the column, which
+      // times the surface's slope passed the rounding forgiven where a plane crosses 0 far from the
+      // field's corner, and hid 6970 of 65536 targets on h = column - 200 seen from column 200)
+      const float s0 =
+          sample_cell(h, f.width, c.x, c.y, c.z, c.w, (ex - c.x) + t0 * dx, (ey - c.y) + t0 * dy);
       f0 = (s0 - ze) - t0 * rise - drop * t0 * t0;
     }
     const float span = t1 - t0;

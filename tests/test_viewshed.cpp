@@ -254,6 +254,39 @@ TEST(Viewshed, ATiltedPlaneSeesItselfWhereverItLies) {
   }
 }
 
+TEST(Viewshed, APlaneCrossingZeroFarFromTheCornerSeesItself) {
+  // Where a plane crosses 0 far from the field's corner its heights there are near 0, and so is the
+  // rounding forgiven, but a march begun inside a cell (past what the rays or the culling settled)
+  // evaluated the surface at the absolute position, which rounds by units in the last place of the
+  // column: from column 200 on h = column - 200, 6970 of 65536 targets were hidden (the region
+  // probe's plane). The position is now taken from the eye's grid point.
+  const int w = 216, h = 40;
+  for (const std::pair<double, double> slope : {std::pair{1.0, 0.0}, std::pair{0.7, 0.3}}) {
+    std::vector<float> heights(std::size_t(w) * h);
+    for (int row = 0; row < h; ++row)
+      for (int col = 0; col < w; ++col)
+        heights[std::size_t(row) * w + col] = float(slope.first * (col - 200) + slope.second * (row - 20));
+    const HeightField field = testing::fieldFrom(w, h, heights);
+    ViewshedOutputs outputs;
+    outputs.needed_height = true;
+    for (const Observer& o : {Observer{200, 0, 0.0}, Observer{201, 39, 0.0}, Observer{150, 20, 0.0}})
+      for (const bool every : {false, true}) {
+        SCOPED_TRACE(std::to_string(slope.first) + " from " + std::to_string(o.col) + "," +
+                     std::to_string(o.row));
+        ViewshedOptions options;
+        options.target_height = 0.0;
+        options.march_every_target = every;
+        const ViewshedResult want = referenceViewshed(field, o, options);
+        EXPECT_EQ(std::count(want.visible.begin(), want.visible.end(), 1.0f), w * h);
+        forEachLayout([&](const ComputeContext& context) {
+          const ViewshedResult got = computeViewshed(context, field, o, options, outputs);
+          EXPECT_EQ(std::count(got.visible.begin(), got.visible.end(), 1.0f), w * h);
+          EXPECT_EQ(std::count(got.needed_height.begin(), got.needed_height.end(), 0.0f), w * h);
+        });
+      }
+  }
+}
+
 TEST(Viewshed, NeededHeightKeepsToTheGeometryFarFromZero) {
   // The needed height is the exact one: the city of whole-number heights raised by 8848 (exactly,
   // in float32) needs what it needs at 0 to within the rounding of its values. Taken with the
