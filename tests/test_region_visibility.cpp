@@ -771,6 +771,24 @@ TEST(RegionVisibility, FlatGroundIsAllClear) {
   }
 }
 
+// Every pair of a and b sees, and every pixel sees all of a, by the exact and the culled march, in
+// both layouts.
+void expectEverySampleSeen(const HeightField& field, const RegionSampling& a, const RegionSampling& b,
+                           const std::string& what) {
+  for (const RegionVisibilityMethod method :
+       {RegionVisibilityMethod::Exact, RegionVisibilityMethod::Culled}) {
+    RegionVisibilityOptions options;
+    options.method = method;
+    forEachLayout([&](const ComputeContext& context) {
+      const RegionPairVisibilityResult pair = computeRegionPairVisibility(context, field, a, b, options);
+      EXPECT_EQ(pair.clear_pairs, pair.pairs) << what;
+      const RegionVisibilityResult pixels = computeRegionVisibility(context, field, a, options);
+      EXPECT_EQ(std::count(pixels.fraction.begin(), pixels.fraction.end(), 1.0f), long(field.pixelCount()))
+          << what;
+    });
+  }
+}
+
 TEST(RegionVisibility, ATiltedPlaneSeesItselfWhereverItLies) {
   // Sight lines between points of a tilted plane run along it: every pair sees (the tie rule), as on
   // flat ground, though the float32 heights and the march's values round a hair above or below the
@@ -778,23 +796,17 @@ TEST(RegionVisibility, ATiltedPlaneSeesItselfWhereverItLies) {
   // chords run above it. A wall of 2 cm across the plane at 8848 (about 20 units in the last place
   // there) still hides the pairs on either side of it.
   const int w = 61, h = 37;
+  const RegionSampling a = regionOf({1, 2, 17, 34}, 64, 0.0), b = regionOf({40, 0, 59, 36}, 64, 0.0);
   for (const testing::GrazingSurface& surface : testing::grazingSurfaces()) {
     const std::vector<float> heights = testing::grazingHeights(surface, w, h);
-    const HeightField field = fieldFrom(w, h, heights);
-    const RegionSampling a = regionOf({1, 2, 17, 34}, 64, 0.0), b = regionOf({40, 0, 59, 36}, 64, 0.0);
+    expectEverySampleSeen(fieldFrom(w, h, heights), a, b, surface.name);
+    if (surface.base != 8848.0) continue;
+    std::vector<float> walled = heights;
+    for (int row = 0; row < h; ++row) walled[row * w + 30] += 0.02f;
     for (const RegionVisibilityMethod method :
          {RegionVisibilityMethod::Exact, RegionVisibilityMethod::Culled}) {
       RegionVisibilityOptions options;
       options.method = method;
-      forEachLayout([&](const ComputeContext& context) {
-        EXPECT_EQ(computeRegionPairVisibility(context, field, a, b, options).clear_pairs, 64u * 64u)
-            << surface.name;
-        const RegionVisibilityResult pixels = computeRegionVisibility(context, field, a, options);
-        EXPECT_EQ(std::count(pixels.fraction.begin(), pixels.fraction.end(), 1.0f), w * h) << surface.name;
-      });
-      if (surface.base != 8848.0) continue;
-      std::vector<float> walled = heights;
-      for (int row = 0; row < h; ++row) walled[row * w + 30] += 0.02f;
       forEachLayout([&](const ComputeContext& context) {
         EXPECT_EQ(computeRegionPairVisibility(context, fieldFrom(w, h, walled), a, b, options).clear_pairs,
                   0u);
@@ -811,25 +823,10 @@ TEST(RegionVisibility, APlaneCrossingZeroFarFromTheCornerSeesItself) {
   // the slope's rounding forgiven alone (region_position_reach). Every pair sees, and every pixel
   // sees all of a region on it.
   const int w = 216, h = 40;
-  for (const std::pair<double, double> slope : {std::pair{1.0, 0.0}, std::pair{0.7, 0.3}}) {
-    std::vector<float> heights(std::size_t(w) * h);
-    for (int row = 0; row < h; ++row)
-      for (int col = 0; col < w; ++col)
-        heights[std::size_t(row) * w + col] = float(slope.first * (col - 200) + slope.second * (row - 20));
-    const HeightField field = fieldFrom(w, h, heights);
-    const RegionSampling a = regionOf({199, 0, 203, 39}, 64, 0.0), b = regionOf({196, 1, 201, 38}, 64, 0.0);
-    for (const RegionVisibilityMethod method :
-         {RegionVisibilityMethod::Exact, RegionVisibilityMethod::Culled}) {
-      RegionVisibilityOptions options;
-      options.method = method;
-      forEachLayout([&](const ComputeContext& context) {
-        EXPECT_EQ(computeRegionPairVisibility(context, field, a, b, options).clear_pairs, 64u * 64u)
-            << slope.first;
-        const RegionVisibilityResult pixels = computeRegionVisibility(context, field, a, options);
-        EXPECT_EQ(std::count(pixels.fraction.begin(), pixels.fraction.end(), 1.0f), w * h) << slope.first;
-      });
-    }
-  }
+  for (const testing::GrazingSurface& surface : testing::planesCrossingZeroFarFromTheCorner())
+    expectEverySampleSeen(fieldFrom(w, h, testing::grazingHeights(surface, w, h)),
+                          regionOf({199, 0, 203, 39}, 64, 0.0), regionOf({196, 1, 201, 38}, 64, 0.0),
+                          surface.name);
 }
 
 TEST(RegionVisibility, AWallBlocksEveryPair) {

@@ -149,6 +149,11 @@ inline std::vector<GrazingSurface> grazingSurfaces() {
           {"at 3e5", 3e5, 1.7, -0.9, 0.0},
           {"bowl", 100.0, 0.0, 0.0, 0.013}};
 }
+// Planes that cross 0 far from the field's corner (at column 200; fields at least 216 wide): their
+// heights near 0 round little, the positions there by units in the last place of 200.
+inline std::vector<GrazingSurface> planesCrossingZeroFarFromTheCorner() {
+  return {{"column - 200", -200.0, 1.0, 0.0, 0.0}, {"0.7 column + 0.3 row - 146", -146.0, 0.7, 0.3, 0.0}};
+}
 // Its float32 heights over width x height pixels (the bowl's bottom at the middle).
 inline std::vector<float> grazingHeights(const GrazingSurface& s, int width, int height) {
   std::vector<float> heights(static_cast<std::size_t>(width) * height);

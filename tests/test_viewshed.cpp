@@ -216,6 +216,26 @@ TEST(Viewshed, OptionsMatchBruteForce) {
   EXPECT_EQ(computeViewshed(testContext(), f, o, tiny).visible, computeViewshed(testContext(), f, o, {}).visible);
 }
 
+// The eye o sees every point of the field and needs no height for any, by the double-precision
+// reference and the kernels, with and without the rays, in both layouts.
+void expectEyeSeesAll(const HeightField& field, const Observer& o) {
+  const long all = long(field.pixelCount());
+  ViewshedOutputs outputs;
+  outputs.needed_height = true;
+  for (const bool every : {false, true}) {
+    ViewshedOptions options;
+    options.target_height = 0.0;
+    options.march_every_target = every;
+    const ViewshedResult want = referenceViewshed(field, o, options);
+    EXPECT_EQ(std::count(want.visible.begin(), want.visible.end(), 1.0f), all);
+    forEachLayout([&](const ComputeContext& context) {
+      const ViewshedResult got = computeViewshed(context, field, o, options, outputs);
+      EXPECT_EQ(std::count(got.visible.begin(), got.visible.end(), 1.0f), all);
+      EXPECT_EQ(std::count(got.needed_height.begin(), got.needed_height.end(), 0.0f), all);
+    });
+  }
+}
+
 TEST(Viewshed, ATiltedPlaneSeesItselfWhereverItLies) {
   // An eye on a tilted plane sees every point of it (the tie rule: grazing sees, as on flat
   // ground), though the float32 heights and the march's values round a hair above or below the
@@ -226,22 +246,8 @@ TEST(Viewshed, ATiltedPlaneSeesItselfWhereverItLies) {
   for (const testing::GrazingSurface& surface : testing::grazingSurfaces()) {
     SCOPED_TRACE(surface.name);
     const std::vector<float> heights = testing::grazingHeights(surface, w, h);
-    HeightField field = testing::fieldFrom(w, h, heights);
-    ViewshedOutputs outputs;
-    outputs.needed_height = true;
     for (const Observer& o : {Observer{48, 35, 0.0}, Observer{3, 66, 0.0}}) {
-      for (const bool every : {false, true}) {
-        ViewshedOptions options;
-        options.target_height = 0.0;
-        options.march_every_target = every;
-        const ViewshedResult want = referenceViewshed(field, o, options);
-        EXPECT_EQ(std::count(want.visible.begin(), want.visible.end(), 1.0f), w * h);
-        forEachLayout([&](const ComputeContext& context) {
-          const ViewshedResult got = computeViewshed(context, field, o, options, outputs);
-          EXPECT_EQ(std::count(got.visible.begin(), got.visible.end(), 1.0f), w * h);
-          EXPECT_EQ(std::count(got.needed_height.begin(), got.needed_height.end(), 0.0f), w * h);
-        });
-      }
+      expectEyeSeesAll(testing::fieldFrom(w, h, heights), o);
       if (surface.base != 8848.0) continue;
       std::vector<float> walled = heights;
       for (int row = 0; row < h; ++row) walled[row * w + 60] += 0.02f;
@@ -260,30 +266,13 @@ TEST(Viewshed, APlaneCrossingZeroFarFromTheCornerSeesItself) {
   // evaluated the surface at the absolute position, which rounds by units in the last place of the
   // column: from column 200 on h = column - 200, 6970 of 65536 targets were hidden (the region
   // probe's plane). The position is now taken from the eye's grid point.
-  const int w = 216, h = 40;
-  for (const std::pair<double, double> slope : {std::pair{1.0, 0.0}, std::pair{0.7, 0.3}}) {
-    std::vector<float> heights(std::size_t(w) * h);
-    for (int row = 0; row < h; ++row)
-      for (int col = 0; col < w; ++col)
-        heights[std::size_t(row) * w + col] = float(slope.first * (col - 200) + slope.second * (row - 20));
-    const HeightField field = testing::fieldFrom(w, h, heights);
-    ViewshedOutputs outputs;
-    outputs.needed_height = true;
-    for (const Observer& o : {Observer{200, 0, 0.0}, Observer{201, 39, 0.0}, Observer{150, 20, 0.0}})
-      for (const bool every : {false, true}) {
-        SCOPED_TRACE(std::to_string(slope.first) + " from " + std::to_string(o.col) + "," +
-                     std::to_string(o.row));
-        ViewshedOptions options;
-        options.target_height = 0.0;
-        options.march_every_target = every;
-        const ViewshedResult want = referenceViewshed(field, o, options);
-        EXPECT_EQ(std::count(want.visible.begin(), want.visible.end(), 1.0f), w * h);
-        forEachLayout([&](const ComputeContext& context) {
-          const ViewshedResult got = computeViewshed(context, field, o, options, outputs);
-          EXPECT_EQ(std::count(got.visible.begin(), got.visible.end(), 1.0f), w * h);
-          EXPECT_EQ(std::count(got.needed_height.begin(), got.needed_height.end(), 0.0f), w * h);
-        });
-      }
+  for (const testing::GrazingSurface& surface : testing::planesCrossingZeroFarFromTheCorner()) {
+    const HeightField field = testing::fieldFrom(216, 40, testing::grazingHeights(surface, 216, 40));
+    for (const Observer& o : {Observer{200, 0, 0.0}, Observer{201, 39, 0.0}, Observer{150, 20, 0.0}}) {
+      SCOPED_TRACE(std::string(surface.name) + " from " + std::to_string(o.col) + "," +
+                   std::to_string(o.row));
+      expectEyeSeesAll(field, o);
+    }
   }
 }
 

@@ -857,7 +857,12 @@ def read_height_field(path, *, channel=""):
     """Reads a height field as the CLI does (GeoTIFF and the rasters GDAL reads, EXR, PNG, ...),
     through the library (no Python GDAL): HeightFieldFile(heights (H x W float32, nodata NaN),
     cell_size (x, y) in ground units, row_cell_sizes ((x, y) per row on latitude / longitude
-    grids, else None), geotransform (GDAL's 6 numbers or None), crs_wkt ("" when none))."""
+    grids, else None), geotransform (GDAL's 6 numbers or None), crs_wkt ("" when none)).
+    `channel`: a channel's (band's) name or zero-based index, as the CLI's --channel."""
+    if isinstance(channel, (int, np.integer)) and not isinstance(channel, bool):
+        channel = str(int(channel))
+    elif not isinstance(channel, str):
+        raise InvalidArgumentError(f"channel is a name or a zero-based index, got {channel!r}")
     heights, cx, cy, rows_x, rows_y, transform, wkt = _core.read_height_field(str(path), channel)
     rows = (np.asarray(rows_x), np.asarray(rows_y)) if rows_x else None
     return HeightFieldFile(heights, (cx, cy), rows, None if transform is None else tuple(transform), wkt)

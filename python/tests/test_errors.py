@@ -6,6 +6,7 @@ import pytest
 import xarray as xr
 
 import hfvis
+from conftest import ROOT
 
 
 @pytest.fixture()
@@ -105,6 +106,17 @@ def test_files_are_os_errors(tmp_path, small):
     assert isinstance(caught.value, hfvis.IoError)
     with pytest.raises(hfvis.IoError):
         hfvis.environment_light(small, str(tmp_path / "no_sky.exr"))
+
+
+def test_a_channel_is_a_name_or_an_index():
+    dem = ROOT / "data" / "jacksboro_fault_dem.exr"
+    by_index = hfvis.read_height_field(dem, channel=0).heights  # (an int raised nanobind's TypeError)
+    assert np.array_equal(by_index, hfvis.read_height_field(dem, channel="0").heights, equal_nan=True)
+    assert np.array_equal(by_index, hfvis.read_height_field(dem).heights, equal_nan=True)
+    with pytest.raises(hfvis.InvalidArgumentError, match="channel"):
+        hfvis.read_height_field(dem, channel=0.5)
+    with pytest.raises(hfvis.IoError):
+        hfvis.read_height_field(dem, channel=3)
 
 
 def test_dataarrays(small):
