@@ -31,7 +31,9 @@
 // c D^2, written symmetrically). Pairs farther apart than max_distance are not visible. The test
 // runs in single precision, the pair in a canonical order (so that A sees B exactly when B sees
 // A), and forgives the heights' rounding as the viewshed's does: a segment is hidden only where
-// the surface rises above it by more than 2^-21 of |its ends' heights| + |the curvature's c D^2|.
+// the surface rises above it by more than 2^-21 of |its ends' heights| + |the curvature's c D^2|,
+// and at a grid crossing also the surface's slope along that grid line times 2^-21 of (the ends'
+// largest |column| + largest |row| + 2), what the crossing's position rounds by.
 //
 // Methods: the exact one, one line-of-sight march per (receiver, source sample) pair on the
 // device (kernels/region_visibility.cl): O(receivers * S * (W + H)); the same march culled by a

@@ -200,7 +200,8 @@ inline int region_cell_at(int width, int height, float x, float y) {
 
 // Whether the point (xb, yb, zb) is visible from (xa, ya, za) (pixel positions inside the field,
 // heights z-scaled and finite): 1 when no point of the surface strictly between them rises
-// above the segment by more than the heights' rounding (region_forgiven; an end below the surface
+// above the segment by more than the heights' rounding (region_forgiven, and at a grid crossing the
+// rounding of its position, region_position_reach; an end below the surface
 // by more counts: the surface rises above the segment right beside it), the surface lowered by the curvature
 // (cell_x, cell_y: ground units per pixel; curvature: c of a drop c d^2; max_d2: the largest squared ground
 // distance seen, 0 = any). A cell with a nodata corner has no surface inside; an edge or grid point between
