@@ -819,9 +819,9 @@ TEST(RegionVisibility, APlaneCrossingZeroFarFromTheCornerSeesItself) {
   // The march rounds its crossings' positions by units in the last place of the coordinates, which
   // the heights' rounding does not bound where a plane crosses 0 far from the field's corner: on h =
   // x - 200 the pairs between points on it near x = 200 (heights 0 .. 3, positions rounding by 1e-5)
-  // were hidden but for 1568 of 65536 (the region probe's find), and 22 of 65536 with the heights' and
-  // the slope's rounding forgiven alone (region_position_reach). Every pair sees, and every pixel
-  // sees all of a region on it.
+  // were hidden but for 1568 of 65536 (the region probe's find); the march now forgives that
+  // rounding (region_position_reach, region_crossing_slope). Every pair sees, and every pixel sees
+  // all of a region on it.
   const int w = 216, h = 40;
   for (const testing::GrazingSurface& surface : testing::planesCrossingZeroFarFromTheCorner())
     expectEverySampleSeen(fieldFrom(w, h, testing::grazingHeights(surface, w, h)),
