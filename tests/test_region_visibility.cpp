@@ -598,9 +598,6 @@ TEST(RegionVisibility, ReceiversBesideTheSamplesBoxSeeTheBlockBetween) {
   }
 }
 
-// A wall between a light and the ground beyond it: the bitmask method's bits are the exact
-// ones, the far side sees none of the light, the near side all of it; flat ground sees all.
-// A planar light (at an absolute height) over `rectangle`, and options for a method.
 // A rectangle's samples, `height` above the surface.
 RegionSampling regionOf(const std::array<int, 4>& rectangle, int samples, double height) {
   RegionSampling region;
@@ -609,6 +606,7 @@ RegionSampling regionOf(const std::array<int, 4>& rectangle, int samples, double
   region.height = height;
   return region;
 }
+// A planar light (at an absolute height) over `rectangle`, and options for a method.
 RegionSampling planarLight(const std::array<int, 4>& rectangle, int samples, double height) {
   RegionSampling light = regionOf(rectangle, samples, height);
   light.absolute = true;
@@ -620,6 +618,8 @@ RegionVisibilityOptions withMethod(RegionVisibilityMethod method) {
   return options;
 }
 
+// A wall between a light and the ground beyond it: the bitmask method's bits are the exact
+// ones, the far side sees none of the light, the near side all of it; flat ground sees all.
 TEST(RegionVisibility, TheBitmaskScatterBehindAWall) {
   const int w = 41, h = 23;
   std::vector<float> heights(w * h, 0.0f);
