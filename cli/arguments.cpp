@@ -51,12 +51,19 @@ std::string shortened(const std::string& text) {
                           : text;
 }
 
-// Strict number parsing: the whole text must be a finite decimal number.
+// Strict number parsing: the whole text must be a finite decimal number. One that double cannot
+// hold (1e400, or 5e-324 below its normal numbers) is named as such, not as "not a number".
 double parseNumber(const std::string& option, const std::string& text) {
   double value = 0.0;
-  if (!detail::decimalNumber(text, value))
-    throw UsageError(option + ": expected a number, got " + inQuotes(shortened(text)));
-  return value;
+  if (detail::decimalNumber(text, value)) return value;
+  char* end = nullptr;
+  errno = 0;
+  const double read = std::strtod(text.c_str(), &end);
+  if (!text.empty() && !std::isspace(static_cast<unsigned char>(text[0])) && end == text.c_str() + text.size() &&
+      errno == ERANGE && text.find_first_of("xX") == std::string::npos && !std::isnan(read))
+    throw UsageError(option + ": " + inQuotes(shortened(text)) +
+                     " is beyond the numbers hfvis computes with (magnitudes about 2.2e-308 .. 1.8e308, or 0)");
+  throw UsageError(option + ": expected a number, got " + inQuotes(shortened(text)));
 }
 
 // A nodata value for float32 bands: "nan" (any case), or a finite number float32 holds.

@@ -162,6 +162,7 @@ try "error estimate with one direction" "" -- svf field.exr -o out/o.exr -k 1 --
 try "viewcount: maximum error zero" "" -- viewcount field.exr -o out/o.exr --max-error 0
 try "viewcount: maximum error of 1 or more (relative)" "" -- viewcount field.exr -o out/o.exr --max-error 1
 try "viewcount: maximum error not finite" "" -- viewcount field.exr -o out/o.exr --max-error inf
+try "maximum error below double's normal numbers" "" -- svf field.exr -o out/o.exr --max-error 5e-324
 try "viewcount: maximum error with -k" "" -- viewcount field.exr -o out/o.exr --max-error 0.1 -k 16
 try "viewcount: maximum error of the naive method" "" -- viewcount field.exr -o out/o.exr --max-error 0.1 --method naive
 try "viewcount: maximum error beyond 4096 directions" "" -- viewcount field.exr -o out/o.exr --max-error 1e-7 --error-out out/e.exr
