@@ -113,7 +113,7 @@ def _run(operation, heights, options, common):
     options = _places_as_pixels(operation, options, grid, common["pixels"])
     if flip_rows:
         g = dict(g, row_cell_size_x=g["row_cell_size_x"][::-1], row_cell_size_y=g["row_cell_size_y"][::-1])
-    data, nodata = _marked(grid.array.data, (grid.nodata, common["nodata"]), *_xarray.scale_offset(grid.array))
+    data, nodata = _marked(grid.array.data, grid.nodata + (common["nodata"],), *_xarray.scale_offset(grid.array))
     if _is_dask(data):
         from . import _dask
 
@@ -152,7 +152,8 @@ def _marked(data, nodatas, scale, offset):
     the data as they are with their one nodata value where there is one value and no scale or
     offset; else a new array (Dask: block by block) with every value of `nodatas` (the array's own
     and the caller's `nodata`, each compared in the data's dtype: the caller's had replaced the
-    array's) as NaN and the raster's scale and offset applied in float64 (they were ignored)."""
+    array's) as NaN and the raster's scale and offset applied in float64 (they were ignored).
+    None in `nodatas` is no value."""
     values = []
     for v in nodatas:  # (the caller's nodata, the array's own: one copy of the field less)
         if v is not None and not any(v == w or (v != v and w != w) for w in values):

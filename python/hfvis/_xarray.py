@@ -4,6 +4,7 @@ CLI's GeoTIFF reader does, nodata as NaN), and results that carry the input's co
 spatial_ref and CRS, with units and method in their attributes."""
 
 import math
+import re
 
 import numpy as np
 import xarray as xr
@@ -25,7 +26,7 @@ _COLUMN_NAMES, _ROW_NAMES = ("col", "cols", "column", "columns"), ("row", "rows"
 class Grid:
     """A DataArray's 2-D grid: its dims, geotransform (GDAL's order: x0, dx, 0, y0, 0, dy, of the
     pixel corners; None without coordinates or a transform), whether its CRS is geographic, and
-    its nodata value."""
+    its nodata values."""
 
     def __init__(self, array):
         if "band" in array.dims and array.sizes["band"] == 1 and array.ndim == 3:
@@ -79,8 +80,9 @@ class Grid:
         if not self.geographic:
             return _arrays.geometry((abs(t[1]), abs(t[5])), z_scale)
         rio = _rio(self.array)
-        if rio is not None and rio.crs is not None:
-            _require_earth_degrees(rio.crs)
+        wkt = rio.crs.to_wkt() if rio is not None and rio.crs is not None else _cf_wkt(self.array)
+        if wkt:
+            _require_earth_degrees(wkt)
         cx, cy, rows_x, rows_y = _core.geographic_cell_sizes(list(t), self.array.shape[0])
         return _arrays.geometry((cx, cy), z_scale, (rows_x, rows_y))
 
@@ -219,24 +221,61 @@ def _is_geographic(array):
             crs = None
         if crs is not None:
             return bool(crs.is_geographic)
-    # Without rioxarray: CF's grid mapping, or the coordinates' names.
+    # Without rioxarray: CF's grid mapping, or the coordinates' names or units.
+    wkt = _cf_wkt(array)
+    if wkt:
+        return _wkt_is_geographic(wkt)
     ref = array.coords.get("spatial_ref")
-    if ref is not None:
-        wkt = ref.attrs.get("crs_wkt") or ref.attrs.get("spatial_ref") or ""
-        if wkt:
-            return wkt.lstrip().upper().startswith(("GEOGCS", "GEOGCRS", "GEODCRS"))
-        if ref.attrs.get("grid_mapping_name") == "latitude_longitude":
-            return True
-    return array.dims[-1] in ("lon", "longitude") and array.dims[-2] in ("lat", "latitude")
+    if ref is not None and ref.attrs.get("grid_mapping_name") == "latitude_longitude":
+        return True
+    y_dim, x_dim = (str(d).lower() for d in array.dims[-2:])
+    if x_dim in _LONGITUDE_NAMES and y_dim in _LATITUDE_NAMES:
+        return True
+    # (CF's units of latitude and longitude, whatever the dims are called)
+    units = [str(array.coords[d].attrs.get("units", "")).lower() if d in array.coords else ""
+             for d in array.dims[-2:]]
+    return units[0] in _LATITUDE_UNITS and units[1] in _LONGITUDE_UNITS
 
 
-def _require_earth_degrees(crs):
+_LONGITUDE_NAMES = ("lon", "long", "longitude")
+_LATITUDE_NAMES = ("lat", "latitude")
+_LATITUDE_UNITS = ("degrees_north", "degree_north", "degree_n", "degrees_n", "degreen", "degreesn")
+_LONGITUDE_UNITS = ("degrees_east", "degree_east", "degree_e", "degrees_e", "degreee", "degreese")
+
+# The CRS keywords of WKT 1 and 2 that name a horizontal (or other) CRS; wrappers (COMPOUNDCRS,
+# COMPD_CS, BOUNDCRS and its SOURCECRS) are not among them, so that the first one found is the
+# horizontal part of a compound CRS (EPSG:4326+5773, SRTM's and Copernicus' declaration) or the
+# source of a bound one (a +towgs84 CRS): both had been taken as projected, degrees as ground units.
+_WKT_CRS = re.compile(r"\b(PROJCS|PROJCRS|PROJECTEDCRS|GEOGCS|GEOGCRS|GEOGRAPHICCRS|GEODCRS|GEODETICCRS|GEOCCS|"
+                      r"VERT_CS|VERTCRS|VERTICALCRS|ENGCRS|ENGINEERINGCRS|LOCAL_CS)\s*\[", re.IGNORECASE)
+
+
+def _cf_wkt(array):
+    """The WKT of CF's grid mapping (the spatial_ref coordinate's crs_wkt or spatial_ref), or ''."""
+    ref = array.coords.get("spatial_ref")
+    if ref is None:
+        return ""
+    return str(ref.attrs.get("crs_wkt") or ref.attrs.get("spatial_ref") or "")
+
+
+def _wkt_is_geographic(wkt):
+    first = _WKT_CRS.search(wkt)
+    return first is not None and first.group(1).upper() in ("GEOGCS", "GEOGCRS", "GEOGRAPHICCRS", "GEODCRS",
+                                                              "GEODETICCRS")
+
+
+def _require_earth_degrees(wkt):
     """The degrees-to-metres conversion takes degrees on the Earth (as the file reader does): a
-    geographic CRS in radians or grads, or on another body, got cells of the wrong size."""
+    geographic CRS (given as WKT) in radians or grads, or on another body, got cells of the wrong
+    size. Checked with pyproj where it is installed (rioxarray brings it)."""
     try:
         import pyproj
 
-        geodetic = pyproj.CRS.from_wkt(crs.to_wkt())
+        geodetic = pyproj.CRS.from_wkt(wkt)
+        if geodetic.is_compound:
+            geodetic = geodetic.sub_crs_list[0]
+        if geodetic.is_bound:
+            geodetic = geodetic.source_crs
         unit = geodetic.axis_info[0].unit_name if geodetic.axis_info else "degree"
         axis = geodetic.ellipsoid.semi_major_metre if geodetic.ellipsoid else 6378137.0
     except ImportError:
@@ -282,25 +321,29 @@ def scale_offset(array):
 
 
 def _nodata(array):
-    """The value that marks nodata: rioxarray's nodata, else _FillValue or nodata in the attributes
-    or encoding; None when there is none (NaN is nodata anyway). rioxarray's nodata is NaN wherever
-    the encoding holds a fill value (it takes the data for masked on reading): the attributes and
-    the encoding are read then too, so that a fill value counts whether rioxarray is imported or
-    not."""
-    found = None
+    """The values that mark nodata (a tuple, empty where there is none: NaN is nodata anyway):
+    rioxarray's nodata, and every _FillValue, nodata and missing_value in the attributes or the
+    encoding (CF allows _FillValue and missing_value side by side; only the first had counted, the
+    other's cells taken as heights). rioxarray's nodata is NaN wherever the encoding holds a fill
+    value (it takes the data for masked on reading): the encoding is read then too, so that a fill
+    value counts whether rioxarray is imported or not. But not an encoding that also holds a
+    scale_factor or add_offset: its fill values are raw, the data decoded (and masked) from them,
+    and a decoded height equal to the raw fill value had become nodata."""
+    found = []
     rio = _rio(array)
     if rio is not None:
         try:
-            found = rio.nodata
+            value = rio.nodata
         except Exception:
-            found = None
-        if found is not None and not _is_nan(found):
-            return _one_value(found)
-    for where in (array.attrs, array.encoding):
+            value = None
+        if value is not None and not _is_nan(value):
+            found.append(_one_value(value))
+    decoded = any(key in array.encoding for key in ("scale_factor", "add_offset"))
+    for where in (array.attrs,) + (() if decoded else (array.encoding,)):
         for key in ("_FillValue", "nodata", "missing_value"):
             if key in where and where[key] is not None:
-                return _one_value(where[key])
-    return found
+                found.append(_one_value(where[key]))
+    return tuple(found)
 
 
 def _one_value(value):

@@ -327,3 +327,73 @@ def test_an_observers_pixel_is_named_as_the_caller_gave_it():
         hfvis.viewshed(lazy, (3, 5), pixels=True, max_distance=50.0).values
     with pytest.raises(hfvis.InvalidArgumentError, match="observer 3,5 stands on nodata"):
         hfvis.cumulative_viewshed(lazy, [(1, 1), (3, 5)], pixels=True).values
+
+
+def test_a_decoded_rasters_raw_fill_value_is_no_height(tmp_path):
+    """Opened decoded (mask_and_scale=True), a scaled raster's encoding keeps its raw fill value
+    (0 here, over heights 0.5 raw - 10): the decoded heights of 0.0 m (raw 20) had become nodata.
+    The decoded data hold NaN where the raw value was the fill value; that pixel alone is nodata,
+    in memory and chunk by chunk, as the file reader has it."""
+    raw = np.full((16, 16), 60, np.uint16)
+    raw[4:8, 4:8] = 20  # 0.0 m: valid ground at sea level
+    raw[12, 12] = 0
+    written = _grid(raw).rio.write_crs("EPSG:32633").rio.write_nodata(0, encoded=False)
+    written.attrs.update(scale_factor=0.5, add_offset=-10.0)
+    written.rio.to_raster(tmp_path / "scaled.tif")
+    dem = rioxarray.open_rasterio(tmp_path / "scaled.tif", mask_and_scale=True).squeeze("band", drop=True)
+    assert dem.encoding["_FillValue"] == 0 and float(dem[5, 5]) == 0.0
+    svf = hfvis.sky_view_factor(dem, directions=8)
+    assert int(svf.isnull().sum()) == 1 and np.isnan(svf[12, 12])
+    chunked = hfvis.sky_view_factor(dem.chunk(8), directions=8, max_distance=100.0)
+    assert int(chunked.isnull().sum()) == 1
+    assert int(np.isnan(hfvis.read_height_field(tmp_path / "scaled.tif").heights).sum()) == 1
+
+
+def test_every_nodata_marker_counts():
+    """CF lets _FillValue and missing_value stand side by side (undecoded netCDF): only the first
+    key found had counted, the other's cells taken as heights (a pit of 10 km beside the field)."""
+    heights = (100 + 20 * np.random.default_rng(0).random((16, 16))).astype(np.float32)
+    heights[8, 8] = -9999.0
+    for attrs in ({"missing_value": -9999.0}, {"_FillValue": np.float32(np.nan), "missing_value": -9999.0},
+                  {"_FillValue": -32768.0, "missing_value": -9999.0}, {"nodata": -32768.0, "_FillValue": -9999.0}):
+        ao = hfvis.ambient_occlusion(_grid(heights, **attrs), directions=8)
+        assert np.isnan(ao[8, 8]) and int(ao.isnull().sum()) == 1, attrs
+
+
+def test_a_geographic_grid_is_seen_without_rioxarray():
+    """Without rioxarray's accessor (xarray alone, a CF spatial_ref as xr.open_dataset gives it), a
+    latitude / longitude grid declared by a compound CRS (WGS 84 with EGM96 heights, as SRTM and
+    Copernicus DEMs are) or a bound one (+towgs84), or without a CRS by dims named in any case or
+    by CF's units, had its degrees taken as ground units (cells of 0.00083 against heights in
+    metres). Each now gives EPSG:4326's result; a projected CRS stays projected."""
+    script = r'''
+import sys
+import numpy as np, pyproj, xarray as xr
+import hfvis
+assert "rioxarray" not in sys.modules
+z = (100 + 50 * np.random.default_rng(0).random((24, 28))).astype(np.float32)
+lon, lat = 7 + (np.arange(28) + 0.5) / 1200, 46.1 - (np.arange(24) + 0.5) / 1200
+def with_crs(crs):
+    ref = xr.Variable((), 0, {"crs_wkt": pyproj.CRS(crs).to_wkt()})
+    return xr.DataArray(z, dims=("y", "x"), coords={"y": lat, "x": lon, "spatial_ref": ref})
+want = hfvis.sky_view_factor(with_crs("EPSG:4326"), directions=8).values
+assert 0.8 < np.nanmean(want) < 0.9, np.nanmean(want)
+arrays = [with_crs("EPSG:4326+5773"), with_crs("+proj=longlat +ellps=WGS84 +towgs84=0,0,0 +no_defs")]
+for dims in (("Lat", "Lon"), ("LATITUDE", "LONGITUDE"), ("latitude", "long")):
+    arrays.append(xr.DataArray(z, dims=dims, coords={dims[0]: lat, dims[1]: lon}))
+arrays.append(xr.DataArray(z, dims=("j", "i"), coords={"j": ("j", lat, {"units": "degrees_north"}),
+                                                       "i": ("i", lon, {"units": "degrees_east"})}))
+for array in arrays:
+    np.testing.assert_array_equal(hfvis.sky_view_factor(array, directions=8).values, want)
+metres = dict(y=4600000 - 30.0 * np.arange(24), x=30.0 * np.arange(28))
+compound, plain = (with_crs(c).assign_coords(**metres) for c in ("EPSG:32633+5773", "EPSG:32633"))
+np.testing.assert_array_equal(hfvis.sky_view_factor(compound, directions=8).values,
+                              hfvis.sky_view_factor(plain, directions=8).values)
+assert not np.array_equal(hfvis.sky_view_factor(plain, directions=8).values, want)
+print("ok")
+'''
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0 and done.stdout.strip() == "ok", done.stderr[-2000:]
