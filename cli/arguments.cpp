@@ -450,8 +450,9 @@ const std::vector<OptionSpec>& optionTable() {
                             inQuotes(value));
        }},
       {"--error-tile", nullptr, "N", kErrorTargetGroup, false,
-       "with --max-error: refine in tiles of N x N pixels (N >= 16), each run again\n"
-       "at its own K over the lines that reach it, where the estimate asks for more\n"
+       "sky-view-factor and ambient-occlusion, with --max-error: refine\n"
+       "in tiles of N x N pixels (N >= 16), each run again at its own K\n"
+       "over the lines that reach it, where the estimate asks for more\n"
        "(default 0: the whole field takes one K, which costs less on the\n"
        "benchmark's contents, bench/report/error_target.md)",
        [](const std::string& typed, const std::string& value, RunArguments& run) {

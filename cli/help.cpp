@@ -42,9 +42,10 @@ Conventions and units:
   GIS        A georeferenced input keeps its CRS (projected or geographic, copied as it is)
              and geotransform in GeoTIFF outputs, so they overlay it. Cell sizes come from
              the geotransform in the CRS's units; geographic degrees become metres (WGS84,
-             at each row's latitude: every command follows each row's spacing but bounce, which
-             takes the centre latitude's); rotated geotransforms are refused. A band's
-             nodata value reads as nodata. GeoTIFF outputs: one float32 band per channel,
+             at each row's latitude; bounce takes the centre latitude's for the whole field,
+             and viewshed, arealight, region, pvs and shade --env refuse such grids: reproject
+             them first); rotated geotransforms are refused. A band's nodata value reads as
+             nodata. GeoTIFF outputs: one float32 band per channel,
              named by its description (h000.., svf, ao, count, visible_area), nodata declared
              on every band (NaN, or --nodata VALUE written in those cells), DEFLATE with the
              floating-point predictor, 256x256 tiles, BigTIFF when needed; the hfvis:*

@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
-# scripts/compare_outputs.sh: behaviour unchanged? Runs every hfvis command (every output kind,
-# EXR and GeoTIFF outputs, the options that take other code paths) on the bundled data with a
-# base commit's build and with this checkout's build, and compares what they write: bit for
-# bit, and where the bytes differ (an image's metadata), pixel for pixel (idiff). A refactor
-# must leave every output identical; a change that alters one explains it in its commit.
+# scripts/compare_outputs.sh: behaviour unchanged? Runs 24 cases of horizon, svf, ao, viewcount,
+# horizons, bounce, shade, insolation, viewshed and sunpos (every output kind, EXR and GeoTIFF in
+# and out, the options that take other code paths; not arealight, region, pvs or devices) on the
+# bundled data with a base commit's build and this checkout's, and compares the outputs bit for bit
+# or pixel for pixel (idiff: metadata aside). A change that alters one explains it in its commit.
 #
 #   scripts/compare_outputs.sh [--base COMMIT] [--keep]
 #     --base: default HEAD (then it checks the working tree's uncommitted changes)
