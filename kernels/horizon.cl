@@ -251,7 +251,9 @@ HFVIS_INLINE void emit_lanes(lane_int live, lane_int pixel, lane_int nodata, lan
 // The exact limit of the receivers' elevation slope at t -> 0 along (a, b): the bilinear
 // surface's directional derivative into the first cell, from each receiver's height h and
 // its neighbours along the two axes, as a rise over the period |(a, b)| (the caller's run).
-// NaN where the ray leaves the field at once or a needed neighbour is nodata; lanes not
+// NaN where the ray leaves the field at once or the first cell (off the axes; on an axis, the
+// first edge) has a nodata corner: it has no surface there (the diagonal corner's weight
+// vanishes at the receiver, but a nodata one takes the whole cell's surface). Lanes not
 // `live` read the buffer's first height. `heights` holds the field's rows from row0 on.
 HFVIS_INLINE lane_float near_rise(__global const float* heights, int width, int height, int row0, lane_int live,
                                   lane_int c, lane_int r, lane_float h, int a, int b) {
@@ -266,7 +268,16 @@ HFVIS_INLINE lane_float near_rise(__global const float* heights, int width, int 
     LANE(hy, l) = heights[ILANE(y_at, l)];
   }
   const lane_float rise = (hx - h) * (float)abs(a) + (hy - h) * (float)abs(b);
+#if HFVIS_HAS_NODATA
+  // (on an axis the diagonal corner is hx or hy itself)
+  const lane_int d_at = select((lane_int)0, x_at + (y_at - (r - row0) * width - c), live);
+  lane_float hd;
+#pragma unroll
+  for (int l = 0; l < HFVIS_LANES; ++l) LANE(hd, l) = heights[ILANE(d_at, l)];
+  return select(rise, (lane_float)NAN, leaves | isnan(hd));
+#else
   return select(rise, (lane_float)NAN, leaves);
+#endif
 }
 
 // The height of lattice sample s for the lanes' period receivers at (c, r): `ok` are the lanes

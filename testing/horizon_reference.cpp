@@ -170,7 +170,7 @@ float latticeHeight(const std::vector<float>& h, std::size_t at, std::size_t rig
                     const LatticeSample& s) {
   const float h00 = h[at], h10 = h[at + right], h01 = h[at + down], h11 = h[at + down + right];
   const float plain = cornerBilinear(h00, h10, h01, h11, s.w10, s.w01, s.w11);
-  return std::isnan(plain) ? renormalisedBilinear(h00, h10, h01, h11, s.w00, s.w10, s.w01, s.w11) : plain;
+  return std::isnan(plain) ? bilinearBesideNodata(h00, h10, h01, h11, s.w00, s.w10, s.w01, s.w11) : plain;
 }
 
 namespace {
@@ -181,6 +181,8 @@ float nearRise(const std::vector<float>& h, int width, int height, int c, int r,
   if (c + sx < 0 || c + sx >= width || r + sy < 0 || r + sy >= height) return kNaN;
   const float hx = h[static_cast<std::size_t>(r) * width + (c + sx)];
   const float hy = h[static_cast<std::size_t>(r + sy) * width + c];
+  // (the first cell, or on an axis its first edge, with a nodata corner has no surface)
+  if (std::isnan(h[static_cast<std::size_t>(r + sy) * width + (c + sx)])) return kNaN;
   return (hx - hp) * static_cast<float>(std::abs(a)) + (hy - hp) * static_cast<float>(std::abs(b));
 }
 

@@ -49,10 +49,11 @@ struct FieldOrigin {
 // Pixel (col, row) sits at ground position (col * cell_size_x, row * cell_size_y);
 // between grid points the surface is the bilinear interpolation of the four corners.
 //
-// Nodata policy: every non-finite height (NaN, +inf, -inf) is nodata. A nodata cell
-// neither casts nor receives: outputs at nodata receivers are NaN, and a bilinear sample
-// uses only the valid corners of its cell (weights renormalised), so a hole never turns
-// a valid neighbour's result into NaN. A sample with no valid corner is simply absent.
+// Nodata policy: every non-finite height (NaN, +inf, -inf) is nodata. A nodata point
+// neither casts nor receives: outputs at nodata receivers are NaN. A cell with a nodata corner
+// has no surface inside, an edge with a nodata end none along it (a valid grid point, and an
+// edge between two, are surface): a sample there is absent, so a hole never turns a valid
+// neighbour's result into NaN.
 struct HeightField {
   int width = 0;
   int height = 0;

@@ -9,8 +9,8 @@
 // first entry and the stride between its entries.
 //
 // Compile-time parameters (prepended #defines; every kernel compiles with the defaults):
-//   HFVIS_HAS_NODATA  the field holds NaN heights: bilinear samples renormalise over the
-//                     valid corners (0 = the faster path without checks)
+//   HFVIS_HAS_NODATA  the field holds NaN heights: a bilinear sample with a nodata corner of
+//                     positive weight is absent (0 = the faster path without checks)
 //   HFVIS_EDGE_EPS    how far outside [0, W-1] x [0, H-1] (pixels) a sample still counts as
 //                     inside (absorbs rounding of directions that are exactly axis-aligned)
 #ifndef HFVIS_SWEEP_FRAMEWORK_CL
@@ -108,23 +108,30 @@ HFVIS_INLINE float corner_bilinear(float h00, float h10, float h01, float h11, f
   return h00 + (w10 * (h10 - h00) + w01 * (h01 - h00) + w11 * (h11 - h00));
 }
 
-// The same over the corners of positive weight that are not nodata, the weights renormalised
-// (NaN when none): from the first such corner, so that equal corners give their height exactly.
+// A sample beside nodata (corner_bilinear gave NaN): NaN where a corner of positive weight is
+// nodata, since a cell with a nodata corner has no surface inside and an edge with a nodata end
+// none along it (the viewshed's, region visibility's and the ray caster's rule: one surface for
+// every operation); else the bilinear value over the corners of positive weight (on an edge or
+// at a grid point beside a hole, whose other corners weigh 0), from the first of them, so that
+// equal corners give their height exactly. (Renormalising over a partial cell's valid corners,
+// as before, put surface inside it that the sweeps, sampling grid-line crossings and the peaks
+// of whole cells, never saw: a diagonal line through a nodata corner missed a rise of 15 m.)
 // Branch-free (masked sums add exact zeros), so it vectorises. src/core/sweep_geometry.hpp's
-// renormalisedBilinear is the same.
-HFVIS_INLINE float renormalised_bilinear(float h00, float h10, float h01, float h11, float w00, float w10,
-                                         float w01, float w11) {
+// bilinearBesideNodata is the same.
+HFVIS_INLINE float bilinear_beside_nodata(float h00, float h10, float h01, float h11, float w00, float w10,
+                                          float w01, float w11) {
   int v00 = w00 > 0.0f && !isnan(h00), v10 = w10 > 0.0f && !isnan(h10);
   int v01 = w01 > 0.0f && !isnan(h01), v11 = w11 > 0.0f && !isnan(h11);
+  int holed = (w00 > 0.0f && !v00) || (w10 > 0.0f && !v10) || (w01 > 0.0f && !v01) || (w11 > 0.0f && !v11);
   float base = v00 ? h00 : (v10 ? h10 : (v01 ? h01 : h11));
   float sum = (v00 ? w00 * (h00 - base) : 0.0f) + (v10 ? w10 * (h10 - base) : 0.0f) +
               (v01 ? w01 * (h01 - base) : 0.0f) + (v11 ? w11 * (h11 - base) : 0.0f);
   float weight = (v00 ? w00 : 0.0f) + (v10 ? w10 : 0.0f) + (v01 ? w01 : 0.0f) + (v11 ? w11 : 0.0f);
-  return weight > 0.0f ? base + sum / weight : NAN;
+  return !holed && weight > 0.0f ? base + sum / weight : NAN;
 }
 
-// Bilinear height at (px, py), clamped into the field. With nodata, only the valid corners
-// count and their weights are renormalised; NaN when no corner with weight is valid.
+// Bilinear height at (px, py), clamped into the field; NaN where a corner of positive weight is
+// nodata (bilinear_beside_nodata).
 HFVIS_INLINE float sample_height(__global const float* heights, int width, int height, float px, float py) {
   // Plain comparisons instead of clamp/floor/min builtins, which PoCL leaves as calls that
   // stop vectorisation. After clamping x, y >= 0, so truncation is floor.
@@ -147,7 +154,7 @@ HFVIS_INLINE float sample_height(__global const float* heights, int width, int h
   float w11 = fx * fy;
   float plain = corner_bilinear(h00, h10, h01, h11, w10, w01, w11);
 #if HFVIS_HAS_NODATA
-  return isnan(plain) ? renormalised_bilinear(h00, h10, h01, h11, w00, w10, w01, w11) : plain;
+  return isnan(plain) ? bilinear_beside_nodata(h00, h10, h01, h11, w00, w10, w01, w11) : plain;
 #else
   return plain;
 #endif
@@ -162,16 +169,16 @@ typedef struct {
   float w00, w10, w01, w11;  // bilinear weights of the cell's corners
 } LatticeSample;
 
-// Height of the bilinear surface at a lattice sample whose cell corner is at entry `at`;
-// with nodata, only the valid corners of positive weight count, renormalised (NaN when
-// none). Crossing samples have ex or ey 0: their zero-weight corners repeat a used one.
+// Height of the bilinear surface at a lattice sample whose cell corner is at entry `at`; NaN
+// where a corner of positive weight is nodata (bilinear_beside_nodata). Crossing samples have ex
+// or ey 0: their zero-weight corners repeat a used one.
 HFVIS_INLINE float lattice_height(__global const float* heights, uint at, uint right, uint down, float w00,
                                   float w10, float w01, float w11) {
   float h00 = heights[at], h10 = heights[at + right], h01 = heights[at + down],
         h11 = heights[at + down + right];
   float plain = corner_bilinear(h00, h10, h01, h11, w10, w01, w11);
 #if HFVIS_HAS_NODATA
-  return isnan(plain) ? renormalised_bilinear(h00, h10, h01, h11, w00, w10, w01, w11) : plain;
+  return isnan(plain) ? bilinear_beside_nodata(h00, h10, h01, h11, w00, w10, w01, w11) : plain;
 #else
   return plain;
 #endif

@@ -75,7 +75,7 @@ float sampleHeight(const std::vector<float>& heights, int width, int height, Poi
   const float w00 = (1.0f - fx) * (1.0f - fy), w10 = fx * (1.0f - fy);
   const float w01 = (1.0f - fx) * fy, w11 = fx * fy;
   const float plain = cornerBilinear(h00, h10, h01, h11, w10, w01, w11);
-  return std::isnan(plain) ? renormalisedBilinear(h00, h10, h01, h11, w00, w10, w01, w11) : plain;
+  return std::isnan(plain) ? bilinearBesideNodata(h00, h10, h01, h11, w00, w10, w01, w11) : plain;
 }
 
 PreparedHeights prepareHeights(const HeightField& field, HeightOrigin origin, int bands) {

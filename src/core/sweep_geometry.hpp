@@ -68,12 +68,15 @@ inline float cornerBilinear(float h00, float h10, float h01, float h11, float w1
   return h00 + (w10 * (h10 - h00) + w01 * (h01 - h00) + w11 * (h11 - h00));
 }
 
-// The same over the corners of positive weight that are not NaN, renormalised, from the first of
-// them; NaN when none (renormalised_bilinear).
-inline float renormalisedBilinear(float h00, float h10, float h01, float h11, float w00, float w10, float w01,
+// A sample beside nodata: NaN where a corner of positive weight is NaN (no surface inside a cell
+// with a nodata corner, none along an edge with a nodata end), else the bilinear value over the
+// corners of positive weight, from the first of them (bilinear_beside_nodata).
+inline float bilinearBesideNodata(float h00, float h10, float h01, float h11, float w00, float w10, float w01,
                                   float w11) {
   const bool v00 = w00 > 0.0f && h00 == h00, v10 = w10 > 0.0f && h10 == h10;
   const bool v01 = w01 > 0.0f && h01 == h01, v11 = w11 > 0.0f && h11 == h11;
+  if ((w00 > 0.0f && !v00) || (w10 > 0.0f && !v10) || (w01 > 0.0f && !v01) || (w11 > 0.0f && !v11))
+    return std::numeric_limits<float>::quiet_NaN();
   const float base = v00 ? h00 : (v10 ? h10 : (v01 ? h01 : h11));
   const float sum = (v00 ? w00 * (h00 - base) : 0.0f) + (v10 ? w10 * (h10 - base) : 0.0f) +
                     (v01 ? w01 * (h01 - base) : 0.0f) + (v11 ? w11 * (h11 - base) : 0.0f);
