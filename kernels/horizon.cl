@@ -1042,6 +1042,31 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
       rise = select(rise, rise2, use2);
       run = select(run, run2, use2);
     }
+#if !HFVIS_ROW_SPACING
+    // The surface at the window's far end, the maximum distance from the receiver exactly: the
+    // surface between the last sample within it and the first beyond rises there too (toward a
+    // wall just beyond it), which no sample sees. The farthest point of the window, it wins ties;
+    // outside the field or beside nodata it is absent. (With per-row spacing, where the window is
+    // ground length, not taken.)
+    {
+      // The point lies reach (a, b) from the receiver; placed in the larger field's pixels and
+      // moved back (exactly), a cut of it takes the very fractions the larger field's run does.
+      const float reach = window / period;
+      lane_float end_h;
+#pragma unroll
+      for (int l = 0; l < HFVIS_LANES; ++l) {
+        const float px = ((float)(ILANE(c, l) + origin_col) + (float)a * reach) - (float)origin_col;
+        const float py = ((float)(ILANE(r, l) + origin_row) + (float)b * reach) - (float)origin_row;
+        LANE(end_h, l) = ILANE(live, l) && inside_field(px, py, width, height)
+                             ? sample_height_rows(heights, width, height, row0, px, py)
+                             : NAN;
+      }
+      const lane_float end_rise = HFVIS_STACK_HEIGHT(end_h, base - window) - HFVIS_STACK_HEIGHT(h, base);
+      const lane_int use_end = !isnan(end_rise) & ((run <= 0.0f) | (end_rise * run >= rise * window));
+      rise = select(rise, end_rise, use_end);
+      run = select(run, (lane_float)window, use_end);
+    }
+#endif
 #endif
     // The receivers (the last sample of the period, h its height): the steeper of the hull's
     // occluder and the limit at the receiver, compared without a division (both runs are

@@ -226,11 +226,26 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
           out.sin_azimuth = table->terms[4 * r + 1];
           out.weight = table->terms[4 * r + 2];
         }
+        float rise = s.occluder_rise, run = s.occluder_run;
+        if (!table && window.window > 0.0f) {  // the window's far end (horizon_lattice's end_h)
+          const float reach = window.window / static_cast<float>(d.period);
+          const int oc = field.origin.col, orow = field.origin.row;
+          const Point2 p{
+              (static_cast<float>(c + oc) + static_cast<float>(d.a) * reach) - static_cast<float>(oc),
+              (static_cast<float>(r + orow) + static_cast<float>(d.b) * reach) - static_cast<float>(orow)};
+          if (insideField(p, width, height)) {
+            const float end = s.position - window.window;
+            const float end_rise = (sampleHeight(h, width, height, p) - drop * end * end) -
+                                   (s.height - drop * s.position * s.position);
+            if (!std::isnan(end_rise) && (run <= 0.0f || end_rise * run >= rise * window.window))
+              rise = end_rise, run = window.window;
+          }
+        }
         const float near = nearRise(h, width, height, c, r, s.height, d.a, d.b);
-        const bool has_far = s.occluder_run > 0.0f, has_near = !std::isnan(near);
-        const float ground = has_far ? s.occluder_run * gpp : 0.0f;
+        const bool has_far = run > 0.0f, has_near = !std::isnan(near);
+        const float ground = has_far ? run * gpp : 0.0f;
         // The kernel's far_rise (its curvature correction is an exact 0 without curvature).
-        const float far_rise = s.occluder_rise - 2.0f * drop * s.position * s.occluder_run;
+        const float far_rise = rise - 2.0f * drop * s.position * run;
         const bool use_near = has_near && (!has_far || near * ground > far_rise * period_ground);
         const float distance = has_far && !use_near ? ground : 0.0f;
         emitDirection(result, pixel, false, has_far || has_near, use_near ? near : far_rise,

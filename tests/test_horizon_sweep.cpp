@@ -835,6 +835,34 @@ TEST(HorizonKernels, ACellWithANodataCornerHasNoSurfaceInside) {
   }
 }
 
+// Within a maximum distance D the surface at D itself counts: a wall 8 pixels away, one pixel
+// thick and 50 high, rises to 25 at 7.5, so within D = 7.5 the horizon is atan(25 / 7.5) at
+// distance 7.5. The sweep took only samples within D (the grid line at 7 and 0) and found 0 at
+// any sampling density (the hostile probe's find: on a city with walls the sweep's sky-view factor
+// within D was worse than the naive march's at 4 samples a pixel); it now takes the surface at D.
+TEST(HorizonKernels, TheSurfaceAtTheMaximumDistanceCounts) {
+  const int w = 20, h = 5, receiver = 10;
+  std::vector<float> heights(w * h, 0.0f);
+  for (int row = 0; row < h; ++row) heights[row * w + 2] = 50.0f;
+  const HeightField field = testing::fieldFrom(w, h, heights);
+  HorizonOptions options;
+  options.directions = 4;  // direction 2: azimuth 180 degrees, toward the wall
+  HorizonOutputs outputs;
+  outputs.horizon_angles = outputs.horizon_distances = true;
+  testing::forEachLayout([&](const ComputeContext& context) {
+    for (const double samples : {1.0, 4.0})
+      for (const auto& [distance, angle] : {std::pair{7.5, std::atan2(25.0, 7.5)},
+                                            std::pair{8.0, std::atan2(50.0, 8.0)}, std::pair{5.0, 0.0}}) {
+        options.samples_per_unit = samples;
+        options.max_distance = distance;
+        const HorizonResult r = computeHorizons(context, field, options, outputs);
+        const std::size_t at = std::size_t(2) * w * h + 2 * w + receiver;
+        EXPECT_NEAR(r.angles[at], angle, 1e-5) << "D " << distance << ", samples " << samples;
+        if (angle > 0.0) EXPECT_NEAR(r.distances[at], distance, 1e-5) << "D " << distance;
+      }
+  });
+}
+
 TEST(HorizonKernels, AzimuthOffsetRotatesTheDirections) {
   const HeightField field = makeSyntheticField("sine", 20, 17, 1);
   HorizonOptions options;

@@ -131,8 +131,10 @@ HFVIS_INLINE float bilinear_beside_nodata(float h00, float h10, float h01, float
 }
 
 // Bilinear height at (px, py), clamped into the field; NaN where a corner of positive weight is
-// nodata (bilinear_beside_nodata).
-HFVIS_INLINE float sample_height(__global const float* heights, int width, int height, float px, float py) {
+// nodata (bilinear_beside_nodata). `heights` holds the field's rows from row0 on (rows beside
+// (px, py) among them).
+HFVIS_INLINE float sample_height_rows(__global const float* heights, int width, int height, int row0, float px,
+                                      float py) {
   // Plain comparisons instead of clamp/floor/min builtins, which PoCL leaves as calls that
   // stop vectorisation. After clamping x, y >= 0, so truncation is floor.
   float x = px < 0.0f ? 0.0f : (px > (float)(width - 1) ? (float)(width - 1) : px);
@@ -144,10 +146,10 @@ HFVIS_INLINE float sample_height(__global const float* heights, int width, int h
   int y1 = y0 + 1 < height ? y0 + 1 : y0;
   float fx = x - (float)x0;
   float fy = y - (float)y0;
-  float h00 = heights[y0 * width + x0];
-  float h10 = heights[y0 * width + x1];
-  float h01 = heights[y1 * width + x0];
-  float h11 = heights[y1 * width + x1];
+  float h00 = heights[(y0 - row0) * width + x0];
+  float h10 = heights[(y0 - row0) * width + x1];
+  float h01 = heights[(y1 - row0) * width + x0];
+  float h11 = heights[(y1 - row0) * width + x1];
   float w00 = (1.0f - fx) * (1.0f - fy);
   float w10 = fx * (1.0f - fy);
   float w01 = (1.0f - fx) * fy;
@@ -158,6 +160,10 @@ HFVIS_INLINE float sample_height(__global const float* heights, int width, int h
 #else
   return plain;
 #endif
+}
+
+HFVIS_INLINE float sample_height(__global const float* heights, int width, int height, float px, float py) {
+  return sample_height_rows(heights, width, height, 0, px, py);
 }
 
 // One sample of a period (src/core/lattice_geometry.hpp, struct LatticeSample): nine 4-byte
