@@ -122,6 +122,16 @@ TEST(Insolation, RefusesBadOptions) {
   o.from_utc = parseUtcTime("2026-06-21T00:00:00Z");
   o.to_utc = o.from_utc;  // empty span
   EXPECT_THROW(computeInsolation(testContext(), flat, o), InvalidArgument);
+  // (the message named no value and ended "from before to")
+  try {
+    o.to_utc = o.from_utc - 60.0;
+    computeInsolation(testContext(), flat, o);
+    ADD_FAILURE() << "a span backwards ran";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("got 1.782e+09 to 1.78199994e+09 seconds since 1970"),
+              std::string::npos)
+        << e.what();
+  }
   o.to_utc = o.from_utc + 3600.0;
   o.step_minutes = 0.0;
   EXPECT_THROW(computeInsolation(testContext(), flat, o), InvalidArgument);

@@ -4,6 +4,7 @@ arguments are named as the C++ library's options (docs/python.md lists them)."""
 
 import collections
 import math
+import os
 
 import numpy as np
 
@@ -214,11 +215,8 @@ def _observers_as_pixels(operation, options, grid, flip_rows, flip_cols, pixels)
             raise InvalidArgumentError(f"an observer's map coordinates must be finite, got ({x!r}, {y!r})")
         col, row = grid.pixel(float(x), float(y))
         if not (0 <= col < width and 0 <= row < height):  # (far off, the pixel overflowed int64: a raw error)
-            t = grid.transform
-            xs, ys = sorted((t[0], t[0] + width * t[1])), sorted((t[3], t[3] + height * t[5]))
             raise InvalidArgumentError(f"observer ({float(x):.10g}, {float(y):.10g}) in map coordinates lies outside "
-                                       f"the field's extent, x {xs[0]:.10g} .. {xs[1]:.10g}, "
-                                       f"y {ys[0]:.10g} .. {ys[1]:.10g}")
+                                       f"{_extent(grid)}")
         return col, row
 
     options = dict(options)
@@ -247,18 +245,45 @@ def _places_as_pixels(operation, options, grid, pixels):
         if key not in options:
             continue
         a = _arrays.as_array(options[key], key)
+        what = key[:-1]  # (a source, a receiver)
         if operation == "horizon_lists":
             if a.ndim != 2 or a.shape[1] != 2:
                 raise InvalidArgumentError(f"receivers must be an N x 2 array, got shape {a.shape}")
-            options[key] = np.array([grid.pixel(float(x), float(y)) for x, y in a], dtype=np.int64).reshape(-1, 2)
+            options[key] = np.array([_mapped(grid, grid.pixel, x, y, what) for x, y in a],
+                                    dtype=np.int64).reshape(-1, 2)
         elif a.ndim == 1 and a.shape == (4,):
-            options[key] = np.array(grid.pixel(float(a[0]), float(a[1])) + grid.pixel(float(a[2]), float(a[3])))
+            options[key] = np.array(_mapped(grid, grid.pixel, a[0], a[1], f"{what} rectangle's corner") +
+                                    _mapped(grid, grid.pixel, a[2], a[3], f"{what} rectangle's corner"))
         elif a.ndim == 2 and a.shape[1] in (2, 3):
             placed = np.array(a, dtype=np.float64)
             for point in placed:
-                point[0], point[1] = grid.position(point[0], point[1])
+                point[0], point[1] = _mapped(grid, grid.position, point[0], point[1], f"{what} point")
             options[key] = placed
     return options
+
+
+def _mapped(grid, convert, x, y, what):
+    """The pixel (or pixel position) of map coordinates (x, y): refused, naming them as given, where
+    they are not finite or lie so far outside the field that the pixel would not be a number the
+    library takes (NaN and inf raised Python's own ValueError and OverflowError; 1e300 a message
+    about an array of 300 digits)."""
+    try:
+        x, y = float(x), float(y)
+    except (TypeError, ValueError):
+        raise InvalidArgumentError(f"a {what}'s map coordinates must be numbers, got ({x!r}, {y!r})") from None
+    if not (math.isfinite(x) and math.isfinite(y)):
+        raise InvalidArgumentError(f"a {what}'s map coordinates must be finite, got ({x!r}, {y!r})")
+    col, row = convert(x, y)
+    if not (abs(col) < 2 ** 30 and abs(row) < 2 ** 30):
+        raise InvalidArgumentError(f"{what} ({x:.10g}, {y:.10g}) in map coordinates lies outside {_extent(grid)}")
+    return col, row
+
+
+def _extent(grid):
+    """The field's extent in map coordinates, as messages give it."""
+    t, (height, width) = grid.transform, grid.array.shape
+    xs, ys = sorted((t[0], t[0] + width * t[1])), sorted((t[3], t[3] + height * t[5]))
+    return f"the field's extent, x {xs[0]:.10g} .. {xs[1]:.10g}, y {ys[0]:.10g} .. {ys[1]:.10g}"
 
 
 _COUNT_ERROR = ("relative to the field's mean count (the even- and odd-numbered directions' counts' difference); "
@@ -864,6 +889,7 @@ def read_height_field(path, *, channel=""):
         channel = str(int(channel))
     elif not isinstance(channel, str):
         raise InvalidArgumentError(f"channel is a name or a zero-based index, got {channel!r}")
-    heights, cx, cy, rows_x, rows_y, transform, wkt = _core.read_height_field(str(path), channel)
+    # (os.fspath and fsdecode: a pathlib.Path or bytes path, which str() had written "b'dem.tif'")
+    heights, cx, cy, rows_x, rows_y, transform, wkt = _core.read_height_field(os.fsdecode(os.fspath(path)), channel)
     rows = (np.asarray(rows_x), np.asarray(rows_y)) if rows_x else None
     return HeightFieldFile(heights, (cx, cy), rows, None if transform is None else tuple(transform), wkt)

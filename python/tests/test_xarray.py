@@ -397,3 +397,26 @@ print("ok")
 
     done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0 and done.stdout.strip() == "ok", done.stderr[-2000:]
+
+
+def test_map_coordinates_not_finite_or_far_off_are_named():
+    """A region's rectangle and points and horizon_lists' receivers in map coordinates that are not
+    finite or lie far off raised Python's own ValueError or OverflowError (or a message about an
+    array of 300 digits): each is an hfvis error naming what was given."""
+    heights = _relief(12, 14).astype(np.float32)
+    dem = _grid(heights)
+    x, y = float(dem.x[5]), float(dem.y[3])
+    for call, words in ((lambda: hfvis.horizon_lists(dem, [[np.nan, y]], directions=4), "must be finite"),
+                        (lambda: hfvis.horizon_lists(dem, [[np.inf, y]], directions=4), "must be finite"),
+                        (lambda: hfvis.horizon_lists(dem, [[1e300, y]], directions=4), "outside the field's extent"),
+                        (lambda: hfvis.region_visibility(dem, (np.nan, y, x, y)), "must be finite"),
+                        (lambda: hfvis.region_visibility(dem, (1e300, y, x, y)), "lies outside the field's extent"),
+                        (lambda: hfvis.region_pair_visibility(dem, (x, y, x, y), [[np.inf, y]]), "must be finite")):
+        with pytest.raises(hfvis.InvalidArgumentError, match=words):
+            call()
+
+
+def test_a_path_may_be_bytes(tmp_path, projected_tif):
+    """read_height_field took str() of a bytes path ("b'dem.tif'": no such file)."""
+    assert hfvis.read_height_field(str(projected_tif).encode()).heights.shape == \
+        hfvis.read_height_field(projected_tif).heights.shape

@@ -28,7 +28,9 @@ constexpr double kDegree = M_PI / 180.0;
 
 void validate(const InsolationOptions& o) {
   if (!(std::isfinite(o.from_utc) && std::isfinite(o.to_utc) && o.from_utc < o.to_utc))
-    throw InvalidArgument("the span of time must run forward: from before to");
+    throw InvalidArgument("the span of time must run forward, `from` before `to`, both finite (got " +
+                          detail::exactNumber(o.from_utc) + " to " + detail::exactNumber(o.to_utc) +
+                          " seconds since 1970, UTC)");
   if (!(o.step_minutes > 0.0 && o.step_minutes <= 1440.0))
     throw InvalidArgument("the step must be in (0, 1440] minutes (got " + std::to_string(o.step_minutes) + ")");
   if (!(o.size_deg >= 0.0 && o.size_deg <= 10.0))
