@@ -5,6 +5,7 @@ arguments are named as the C++ library's options (docs/python.md lists them)."""
 import collections
 import math
 import os
+import warnings
 
 import numpy as np
 
@@ -839,6 +840,9 @@ def bounce(heights, radiance, *, directions=64, azimuth_offset=0.0, samples_per_
     options["radiance"] = radiance_values
     out, grid = _run("bounce", heights, options, _common(cell_size, z_scale, nodata, device, progress))
     irradiance = out["irradiance"]
+    if grid is not None and grid.geographic and cell_size is None:  # (the CLI warns too; Python had not)
+        warnings.warn("bounce takes the centre latitude's cell size for the whole latitude / longitude grid "
+                      "(the other operations follow each row's spacing)", stacklevel=2)
     if grid is None:
         return irradiance[0] if one_channel else irradiance
     attrs = _attrs("bounce", "irradiance", options, grid)

@@ -420,3 +420,12 @@ def test_a_path_may_be_bytes(tmp_path, projected_tif):
     """read_height_field took str() of a bytes path ("b'dem.tif'": no such file)."""
     assert hfvis.read_height_field(str(projected_tif).encode()).heights.shape == \
         hfvis.read_height_field(projected_tif).heights.shape
+
+
+def test_bounce_on_a_latitude_longitude_grid_warns(geographic_tif):
+    """bounce takes the centre latitude's cell size for a whole latitude / longitude grid, as the
+    CLI does; the CLI says so, and now Python too (it was silent)."""
+    dem = rioxarray.open_rasterio(geographic_tif).squeeze("band", drop=True)
+    radiance = xr.ones_like(dem, dtype=np.float32)
+    with pytest.warns(UserWarning, match="centre latitude"):
+        hfvis.bounce(dem, radiance, directions=4)
