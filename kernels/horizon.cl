@@ -408,7 +408,10 @@ HFVIS_INLINE SegmentQuadratic segment_quadratic(__global const float* heights, i
   w.e = (h11 - h01) - w.gx;
   w.B = w.gx * dx + w.gy * dy + w.e * (fx * dy + fy * dx);
   w.C = w.e * (dx * dy);
-  w.candidate = ok & (w.C < 0.0f) & (w.B > 0.0f) & (w.B < -2.0f * w.C);
+  // (strictly inside by a thousandth of the segment: a peak within rounding of the receiver, the
+  // segment's near end at S > 1, had its height a rounding above the receiver's at a distance of
+  // 1e-7, a horizon of 88 degrees on a wall top; so close to an end the end's sample is the peak)
+  w.candidate = ok & (w.C < 0.0f) & (w.B > -2e-3f * w.C) & (w.B < -1.998f * w.C);
   return w;
 }
 
@@ -616,8 +619,11 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
   int ci = q > 0 ? i : i - 1, cq = q > 0 ? q - 1 : n_samples - 1;  // the nearest sample before (i, q)
   // Backwards, the peak inside the segment from sample (ci, cq) to the one after it comes just
   // before (ci, cq): it is taken with it, once (ci, cq) is within the window and in block k - 1,
-  // and where it lies in block k - 1 itself (as the forward sweep takes it).
-  lane_int n = 0;
+  // and where it lies in block k - 1 itself (as the forward sweep takes it); or before, where
+  // (ci, cq) lies beyond the window's far end (or the block's) and the peak within it: the
+  // segment straddles the end (a peak at 3.5 pixels within a window of 4.1 was dropped, its
+  // segment's far end at 4.2). `taken`: the lanes whose peak before (ci, cq) is on the stack.
+  lane_int n = 0, taken = 0;
   lane_float top_h = 0.0f, top_p = 0.0f, below_h = 0.0f, below_p = 0.0f, rise = 0.0f, run = 0.0f;
   for (int j = end - 1; j >= max(i, 0); --j) {
 #if HFVIS_ROW_SPACING
@@ -636,7 +642,7 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
 #else
       const float here = (float)(offset + shift + ci) * period - s->tau;
 #endif
-      if ((int)floor(here * inv_window) != k - 1 || x - here > window) break;
+      const int reached = (int)floor(here * inv_window) == k - 1 && x - here <= window;
       const int gq = cq + 1 < n_samples ? cq + 1 : 0, gi = cq + 1 < n_samples ? ci : ci + 1;
       __global const CellSegment* g = segments + gq;
       if (g->curved) {
@@ -654,12 +660,15 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
                                                gi < receivers, offset + gi == 0, 0, 0.0f, 0.0f, 0.0f, 0.0f, &tau_peak,
                                                &valid);
         const lane_float here_peak = segment_base - tau_peak * segment_scale;
-        valid = valid & (here_peak > here) & (here_peak < here_near) &
+        valid = valid & !taken & (here_peak > here) & (here_peak < here_near) &
                 (LANE_INT(floor(here_peak * inv_window)) == k - 1);
+        if (!reached) valid = valid & (x - here_peak <= window);
         if (ANY_LANE(valid))
           hull_step(stacks, stack, entry, valid, HFVIS_STACK_HEIGHT(h_peak, here_peak), here_peak, -1.0f, &n,
                     &top_h, &top_p, &below_h, &below_p, &rise, &run);
+        taken = taken | valid;
       }
+      if (!reached) break;
       lane_int valid;
       lane_float unused0, unused1;
       const lane_float h = lane_sample_height(heights, width, height, row0, s, c - (ci - i) * a, r - (ci - i) * b,
@@ -667,6 +676,7 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
       hull_step(stacks, stack, entry, valid, HFVIS_STACK_HEIGHT(h, here), (lane_float)here, -1.0f, &n, &top_h,
                 &top_p, &below_h, &below_p, &rise, &run);
       if (--cq < 0) cq = n_samples - 1, --ci;
+      taken = 0;
     }
     // The tangent from receiver j: the peak of the slopes along the stack (entry 0 nearest).
     const lane_int live = j < receivers;

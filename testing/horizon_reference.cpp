@@ -400,7 +400,8 @@ std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, cons
           const float u = B / (-2.0f * C);
           const float tau = g.tau_far - u * (g.tau_far - g.tau_near);
           const float position = rows ? base - tau * tau_scale : base - tau;
-          if (C < 0.0f && B > 0.0f && B < -2.0f * C && std::isfinite(A) && position > here_before && position < here) {
+          if (C < 0.0f && B > -2e-3f * C && B < -1.998f * C && std::isfinite(A) && position > here_before &&
+              position < here) {
             e.sample.height = A + 0.5f * B * u;
             e.sample.position = position;
             e.span = rows ? (g.tau_far - g.tau_near) * tau_scale : g.tau_far - g.tau_near;
@@ -488,7 +489,17 @@ std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, cons
         for (;;) {
           if (cursor == 0 || (cursor == 1 && raw[0].sample.peak)) break;  // (the line's first peak is never present)
           const std::size_t next = raw[cursor - 1].sample.peak ? cursor - 2 : cursor - 1;  // the sample tested
-          if (raw[next].block != k - 1 || x - raw[next].sample.position > window.window) break;
+          if (raw[next].block != k - 1 || x - raw[next].sample.position > window.window) {
+            // (its segment's peak within reach before it: the segment straddles the window's far
+            // end or the block's, as window_pass takes it)
+            const Raw& p = raw[cursor - 1];
+            if (p.sample.peak && !std::isnan(p.sample.height) && p.block == k - 1 &&
+                x - p.sample.position <= window.window) {
+              push(p);
+              --cursor;
+            }
+            break;
+          }
           if (raw[cursor - 1].sample.peak) {
             const Raw& p = raw[cursor - 1];
             if (p.block == k - 1) push(p);

@@ -124,13 +124,10 @@ TEST(HorizonSweepLine, WindowedStackEqualsBruteForceWithinTheWindow) {
                 if (std::isnan(s.height) || s.receiver < 0) continue;
                 double brute = -M_PI;  // steepest farther sample within the window
                 for (std::size_t k = 0; k < q; ++k) {
-                  // A peak inside a segment in the receiver's block counts; in an earlier block
-                  // once the segment's far end (the sample before it) is within the window.
-                  const bool same_block =
-                      std::floor(samples[k].position * cut.inv_window) == std::floor(s.position * cut.inv_window);
-                  const float gate =
-                      samples[k].peak && k > 0 && !same_block ? samples[k - 1].position : samples[k].position;
-                  if (std::isnan(samples[k].height) || s.position - gate > window) continue;
+                  // A peak inside a segment counts where it lies within the window, though its
+                  // segment's far end (the sample before it) may not (it had counted only once
+                  // that end was within: a peak at 3.5 pixels dropped within 4.1).
+                  if (std::isnan(samples[k].height) || s.position - samples[k].position > window) continue;
                   brute = std::max(brute, std::atan2(double(samples[k].height) - s.height,
                                                      double(s.position) - samples[k].position));
                 }
@@ -860,6 +857,54 @@ TEST(HorizonKernels, TheSurfaceAtTheMaximumDistanceCounts) {
         EXPECT_NEAR(r.angles[at], angle, 1e-5) << "D " << distance << ", samples " << samples;
         if (angle > 0.0) EXPECT_NEAR(r.distances[at], distance, 1e-5) << "D " << distance;
       }
+  });
+}
+
+// A peak inside D counts whatever its cell's far side: two walls 50 high touching at a corner
+// across the diagonal from the receiver raise the surface along it to a peak 25 high at 3.54
+// pixels, in a segment that ends beyond 4.1. Within D = 4.1 (and 3.7) the sweep found the surface
+// at D alone (65.7 degrees where the peak stands at 82: the window's pass took a peak only once the
+// segment's far end was within reach; the second probe's find); now the peak as without D, in
+// both layouts.
+TEST(HorizonKernels, APeakWithinTheMaximumDistanceCountsWhereItsSegmentEndsBeyond) {
+  const int n = 16, c = 4;
+  std::vector<float> heights(n * n, 0.0f);
+  heights[(c + 2) * n + (c + 3)] = heights[(c + 3) * n + (c + 2)] = 50.0f;
+  const HeightField field = testing::fieldFrom(n, n, heights);
+  HorizonOptions options;
+  options.directions = 8;  // direction 1: the step (1, 1)
+  HorizonOutputs outputs;
+  outputs.horizon_angles = true;
+  testing::forEachLayout([&](const ComputeContext& context) {
+    const std::size_t at = std::size_t(1) * n * n + c * n + c;
+    const float open = computeHorizons(context, field, options, outputs).angles[at];
+    EXPECT_GT(open, 1.43f);  // about 82 degrees
+    for (const double distance : {3.7, 4.1, 5.0}) {
+      options.max_distance = distance;
+      EXPECT_EQ(computeHorizons(context, field, options, outputs).angles[at], open) << "D " << distance;
+    }
+    options.max_distance = 0.0;
+  });
+}
+
+// A cell's peak within rounding of the receiver is the receiver: along the diagonal from (1, 1)
+// toward (0, 0) the surface of corners 0, 10, 10 and 9.999999 peaks a ten-millionth of the
+// way from the receiver, a rounding above it: at 2 samples a pixel the sweep took it, a horizon of
+// 83 degrees at a distance of 1e-7 where the surface falls away (the second probe's find: 88
+// degrees on the tops of a city's walls). Peaks within a thousandth of a segment's end are left
+// to the end's sample, in both layouts.
+TEST(HorizonKernels, APeakWithinRoundingOfTheReceiverIsTheReceiver) {
+  const HeightField field =
+      testing::fieldFrom(3, 3, {0.0f, 10.0f, 0.0f, 10.0f, 9.999999f, 0.0f, 0.0f, 0.0f, 0.0f});
+  HorizonOptions options;
+  options.directions = 8;  // direction 5: the step (-1, -1)
+  HorizonOutputs outputs;
+  outputs.horizon_angles = true;
+  testing::forEachLayout([&](const ComputeContext& context) {
+    for (const double samples : {1.0, 2.0, 4.0}) {
+      options.samples_per_unit = samples;
+      EXPECT_LT(computeHorizons(context, field, options, outputs).angles[5 * 9 + 4], 1e-3f) << samples;
+    }
   });
 }
 
