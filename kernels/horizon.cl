@@ -382,7 +382,7 @@ typedef struct {
 HFVIS_INLINE SegmentQuadratic segment_quadratic(__global const float* heights, int width, int height, int row0,
                                                 __global const CellSegment* g, lane_int c, lane_int r, lane_int ok,
                                                 int edge, int reuse, lane_float far0, lane_float far1,
-                                                lane_float near0, lane_float near1) {
+                                                lane_float near0, lane_float near1, int at_receiver) {
   const lane_int x0 = c + g->ox, y0 = r + g->oy;
   if (edge) ok = ok & (x0 >= 0) & (x0 + 1 <= width - 1) & (y0 >= 0) & (y0 + 1 <= height - 1);
   const int from00 = g->from00, from10 = g->from10, from01 = g->from01, from11 = g->from11;
@@ -408,10 +408,11 @@ HFVIS_INLINE SegmentQuadratic segment_quadratic(__global const float* heights, i
   w.e = (h11 - h01) - w.gx;
   w.B = w.gx * dx + w.gy * dy + w.e * (fx * dy + fy * dx);
   w.C = w.e * (dx * dy);
-  // (strictly inside by a thousandth of the segment: a peak within rounding of the receiver, the
-  // segment's near end at S > 1, had its height a rounding above the receiver's at a distance of
-  // 1e-7, a horizon of 88 degrees on a wall top; so close to an end the end's sample is the peak)
-  w.candidate = ok & (w.C < 0.0f) & (w.B > -2e-3f * w.C) & (w.B < -1.998f * w.C);
+  // (`at_receiver`: the segment ends at its period's receiver, where a peak within a thousandth of
+  // the segment of it is left to the receiver's own slope limit: within rounding of the receiver,
+  // at S > 1, it stood a rounding above it at a distance of 1e-7, a horizon of 88 degrees on a
+  // wall top; the limit differs from such a peak's slope by about the thousandth)
+  w.candidate = ok & (w.C < 0.0f) & (w.B > 0.0f) & (w.B < (at_receiver ? -1.998f : -2.0f) * w.C);
   return w;
 }
 
@@ -430,9 +431,9 @@ HFVIS_INLINE lane_float segment_peak_height(__global const CellSegment* g, Segme
 HFVIS_INLINE lane_float segment_peak(__global const float* heights, int width, int height, int row0,
                                      __global const CellSegment* g, lane_int c, lane_int r, lane_int ok, int edge,
                                      int reuse, lane_float far0, lane_float far1, lane_float near0,
-                                     lane_float near1, lane_float* tau, lane_int* valid) {
-  const SegmentQuadratic w =
-      segment_quadratic(heights, width, height, row0, g, c, r, ok, edge, reuse, far0, far1, near0, near1);
+                                     lane_float near1, int at_receiver, lane_float* tau, lane_int* valid) {
+  const SegmentQuadratic w = segment_quadratic(heights, width, height, row0, g, c, r, ok, edge, reuse, far0, far1,
+                                               near0, near1, at_receiver);
   return segment_peak_height(g, w, tau, valid);
 }
 
@@ -657,8 +658,8 @@ HFVIS_INLINE void window_pass(__global const float* heights, int width, int heig
         lane_int valid;
         lane_float tau_peak;
         const lane_float h_peak = segment_peak(heights, width, height, row0, g, c - (gi - i) * a, r - (gi - i) * b,
-                                               gi < receivers, offset + gi == 0, 0, 0.0f, 0.0f, 0.0f, 0.0f, &tau_peak,
-                                               &valid);
+                                               gi < receivers, offset + gi == 0, 0, 0.0f, 0.0f, 0.0f, 0.0f,
+                                               gq == n_samples - 1, &tau_peak, &valid);
         const lane_float here_peak = segment_base - tau_peak * segment_scale;
         valid = valid & !taken & (here_peak > here) & (here_peak < here_near) &
                 (LANE_INT(floor(here_peak * inv_window)) == k - 1);
@@ -986,7 +987,7 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
       const __global CellSegment* g = segments + q;
       if (g->curved) {
         const SegmentQuadratic w = segment_quadratic(heights, width, height, row0, g, c, r, live, i == 0,
-                                                     i > 0 || q > 0, far0, far1, near0, near1);
+                                                     i > 0 || q > 0, far0, far1, near0, near1, q == n_samples - 1);
         // Seen from this sample, the peak (at u = -B / 2C of the segment's span) rises
         // -(B / 2 + C) over (1 - u) span: a slope of -(B / 2 + C) / span, compared with the
         // occluder's rise / run without a division (both runs are positive), and without the
@@ -1067,9 +1068,10 @@ __kernel void horizon_lattice(__global const float* heights, int width, int heig
       for (int l = 0; l < HFVIS_LANES; ++l) {
         const float px = ((float)(ILANE(c, l) + origin_col) + (float)a * reach) - (float)origin_col;
         const float py = ((float)(ILANE(r, l) + origin_row) + (float)b * reach) - (float)origin_row;
-        LANE(end_h, l) = ILANE(live, l) && inside_field(px, py, width, height)
-                             ? sample_height_rows(heights, width, height, row0, px, py)
-                             : NAN;
+        // (inside the field exactly: sample_height_rows clamps, and a point past the edge by
+        // inside_field's margin read the border's surface up to a dozen pixels along it)
+        const int inside = px >= 0.0f && px <= (float)(width - 1) && py >= 0.0f && py <= (float)(height - 1);
+        LANE(end_h, l) = ILANE(live, l) && inside ? sample_height_rows(heights, width, height, row0, px, py) : NAN;
       }
       const lane_float end_rise = HFVIS_STACK_HEIGHT(end_h, base - window) - HFVIS_STACK_HEIGHT(h, base);
       const lane_int use_end = !isnan(end_rise) & ((run <= 0.0f) | (end_rise * run >= rise * window));

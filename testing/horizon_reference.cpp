@@ -233,7 +233,8 @@ void sweepReference(const HeightField& field, const PreparedHeights& prepared, c
           const Point2 p{
               (static_cast<float>(c + oc) + static_cast<float>(d.a) * reach) - static_cast<float>(oc),
               (static_cast<float>(r + orow) + static_cast<float>(d.b) * reach) - static_cast<float>(orow)};
-          if (insideField(p, width, height)) {
+          if (p.x >= 0.0f && p.x <= static_cast<float>(width - 1) && p.y >= 0.0f &&
+              p.y <= static_cast<float>(height - 1)) {  // (inside exactly, as horizon_lattice)
             const float end = s.position - window.window;
             const float end_rise = (sampleHeight(h, width, height, p) - drop * end * end) -
                                    (s.height - drop * s.position * s.position);
@@ -400,7 +401,9 @@ std::vector<LatticeLineSample> latticeLineSamples(const HeightField& field, cons
           const float u = B / (-2.0f * C);
           const float tau = g.tau_far - u * (g.tau_far - g.tau_near);
           const float position = rows ? base - tau * tau_scale : base - tau;
-          if (C < 0.0f && B > -2e-3f * C && B < -1.998f * C && std::isfinite(A) && position > here_before &&
+          // (horizon_lattice's at_receiver: the segment ending at the period's receiver)
+          const float limit = q + 1 == samples.size() ? -1.998f : -2.0f;
+          if (C < 0.0f && B > 0.0f && B < limit * C && std::isfinite(A) && position > here_before &&
               position < here) {
             e.sample.height = A + 0.5f * B * u;
             e.sample.position = position;

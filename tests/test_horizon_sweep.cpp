@@ -908,6 +908,32 @@ TEST(HorizonKernels, APeakWithinRoundingOfTheReceiverIsTheReceiver) {
   });
 }
 
+// The surface at D lies inside the field or nowhere: a receiver on the field's edge looking out
+// within D = 0.0005 sees nothing (-90 degrees). The point at D had been tested with the sweep's
+// margin of 1e-3 pixel and its height read clamped onto the border: 0 and -59 degrees there, and
+// along a steep step (1, 9) the border's surface read a dozen thousandths of a pixel away (a
+// wall's 42 degrees; the third probe's find).
+TEST(HorizonKernels, TheSurfaceAtTheMaximumDistanceLiesInsideTheField) {
+  const int n = 12;
+  std::vector<float> heights(n * n);
+  for (int p = 0; p < n * n; ++p) heights[p] = static_cast<float>((p * 37) % 11) - 5.0f;
+  const HeightField field = testing::fieldFrom(n, n, heights);
+  HorizonOptions options;
+  options.directions = 8;
+  options.max_distance = 0.0005;
+  HorizonOutputs outputs;
+  outputs.horizon_angles = true;
+  testing::forEachLayout([&](const ComputeContext& context) {
+    const HorizonResult r = computeHorizons(context, field, options, outputs);
+    const float none = static_cast<float>(-M_PI / 2.0);
+    for (int row = 0; row < n; ++row) {  // looking out of the field: direction 4 (-x) from column 0
+      EXPECT_EQ(r.angles[std::size_t(4) * n * n + row * n], none) << row;
+      EXPECT_EQ(r.angles[std::size_t(0) * n * n + row * n + n - 1], none) << row;  // direction 0 (+x)
+    }
+    EXPECT_EQ(r.angles[std::size_t(5) * n * n + 1], none);  // (1, 0) toward (-1, -1)
+  });
+}
+
 TEST(HorizonKernels, AzimuthOffsetRotatesTheDirections) {
   const HeightField field = makeSyntheticField("sine", 20, 17, 1);
   HorizonOptions options;
