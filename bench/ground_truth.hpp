@@ -39,15 +39,17 @@ Ray rayForAzimuth(const HeightField& field, double azimuth);
 // ray is cut at every grid line it crosses; on each cell the surface is a quadratic in t,
 // so the largest elevation over the piece is at an end or where d/dt (h(t) - h0) / t = 0.
 // Near the receiver this is the surface's slope, the limit t -> 0. -pi/2 when the ray
-// leaves the field at once. Heights are used times z_scale; no nodata (checked by callers).
+// leaves the field at once, NaN from a nodata receiver. Heights are used times z_scale; nodata
+// (every non-finite height) as the surface model has it: a cell with a nodata corner has no
+// surface inside, an edge with a nodata end none along it, a valid grid point is surface.
 double exactHorizon(const HeightField& field, int c, int r, const Ray& ray);
 
 // The same by dense sampling (every `step` pixels, plus the exit point): the check that
-// exactHorizon is the limit of a dense march.
+// exactHorizon is the limit of a dense march (fields without nodata).
 double denseHorizon(const HeightField& field, int c, int r, const Ray& ray, double step);
 
-// `receiver_count` receivers drawn uniformly without replacement (all pixels when the field
-// has fewer), fixed seed; `threads` workers.
+// `receiver_count` receivers drawn uniformly without replacement among the pixels with a height
+// (all of them when there are fewer), fixed seed; `threads` workers.
 GroundTruth computeGroundTruth(const HeightField& field, int directions, int receiver_count, int threads);
 
 // computeGroundTruth, cached in `cache_dir` under a name made of `label` and a hash of the

@@ -138,7 +138,8 @@ Timing timeRepeated(const std::function<void()>& run, const TimingPolicy& policy
 
 Normal surfaceNormal(const HeightField& field, int c, int r) {
   // The sum of the normals of the (up to) four quads around the pixel, as surface_normal
-  // in kernels/horizon.cl, with heights times z_scale and lengths in ground units.
+  // in kernels/horizon.cl (quads touching nodata or the border left out), with heights times
+  // z_scale and lengths in ground units.
   auto at = [&](int col, int row) {
     return static_cast<double>(field.heights[static_cast<std::size_t>(row) * field.width + col]) *
            field.z_scale;
@@ -149,6 +150,7 @@ Normal surfaceNormal(const HeightField& field, int c, int r) {
     for (int sx = -1; sx <= 1; sx += 2) {
       const int cx = c + sx, ry = r + sy;
       if (cx < 0 || cx >= field.width || ry < 0 || ry >= field.height) continue;
+      if (!std::isfinite(at(cx, r)) || !std::isfinite(at(c, ry))) continue;  // quads touching nodata
       nx -= (at(cx, r) - h) / (sx * field.cell_size_x);
       ny -= (at(c, ry) - h) / (sy * field.cell_size_y);
       nz += 1.0;

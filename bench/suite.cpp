@@ -74,7 +74,7 @@ struct Config {
 Config configFor(const std::string& mode) {
   Config c;
   if (mode == "full") {
-    c.contents = {"fractal", "bricks", "sine", "blocks", "city_dsm"};
+    c.contents = {"fractal", "bricks", "sine", "blocks", "city_dsm", "city_holes"};
     c.plane_n = 256;
     c.naive_ks = {8, 16, 32, 64, 128, 256};
     c.headline_n = 1024;
@@ -86,7 +86,7 @@ Config configFor(const std::string& mode) {
     c.azimuth_reference_k = 1024;
     c.policy = {2, 5, 2.0};
   } else if (mode == "quick") {
-    c.contents = {"fractal", "bricks", "sine", "blocks", "city_dsm"};
+    c.contents = {"fractal", "bricks", "sine", "blocks", "city_dsm", "city_holes"};
     c.plane_n = 128;
     c.ks = {8, 32, 128};
     c.naive_ks = {8, 32, 128};
@@ -100,7 +100,7 @@ Config configFor(const std::string& mode) {
     c.policy = {2, 3, 0.3};
     c.max_scale_run_seconds = 20.0;
   } else {  // tiny: the smoke test; every code path on fields of a few thousand pixels
-    c.contents = {"sine", "noise", "city_dsm"};
+    c.contents = {"sine", "noise", "city_dsm", "city_holes"};
     c.plane_n = 40;
     c.ks = {4, 8};
     c.naive_ks = {4, 8};
@@ -296,12 +296,16 @@ class Suite {
   GroundTruth truthFor(const Content& content, int directions) {
     const GroundTruth t = cachedGroundTruth(content.field, content.label, directions, config_.truth_receivers,
                                             threads(), options_.cache_dir);
-    Row row = metricRow(
-        "truth", content.name, &content.field, t.from_cache ? "cached" : "computed_seconds", t.seconds,
-        std::to_string(t.receivers.size()) + " receivers x " + std::to_string(t.directions) + " directions");
+    const std::size_t nodata = content.field.nodataCount();
+    const std::string holes =
+        nodata ? "; nodata " + num(100.0 * double(nodata) / double(content.field.pixelCount())) + " %" : "";
+    Row row = metricRow("truth", content.name, &content.field, t.from_cache ? "cached" : "computed_seconds",
+                        t.seconds,
+                        std::to_string(t.receivers.size()) + " receivers x " + std::to_string(t.directions) +
+                            " directions" + holes);
     results_.write(row);
-    say("[truth] %s: %zu receivers x %d directions (%s)", content.label.c_str(), t.receivers.size(),
-        t.directions, t.from_cache ? "from cache" : (num(t.seconds) + " s").c_str());
+    say("[truth] %s: %zu receivers x %d directions (%s)%s", content.label.c_str(), t.receivers.size(),
+        t.directions, t.from_cache ? "from cache" : (num(t.seconds) + " s").c_str(), holes.c_str());
     return t;
   }
 
@@ -388,6 +392,7 @@ class Suite {
           timed("plane", c, spec(MethodKind::Sweep, k, true, 0, spu), &truth);
         if (std::count(config_.naive_ks.begin(), config_.naive_ks.end(), k))
           timed("plane", c, spec(MethodKind::Naive, k), &truth);
+        if (c.field.nodataCount() > 0) continue;  // (the baselines take no nodata)
         for (int r : config_.radii) timed("plane", c, spec(MethodKind::Radius, k, true, r), &truth);
         for (int p : config_.pyramid_near) timed("plane", c, spec(MethodKind::Pyramid, k, true, p), &truth);
       }
@@ -482,6 +487,7 @@ class Suite {
     std::vector<Content> contents = planeContents();
     contents.push_back(loadContent(options_, "fractal", config_.headline_n));
     for (const Content& c : contents) {
+      if (c.field.nodataCount() > 0) continue;  // (the statistics' replay of the stack takes no nodata)
       const StackStats s = hullStackStatistics(c.field, config_.stack_directions);
       const std::string note =
           std::to_string(config_.stack_directions) + " directions, " + std::to_string(s.samples) + " samples";
@@ -677,7 +683,8 @@ std::vector<std::pair<std::string, int>> requiredInputs(const std::string& mode)
   const Config c = configFor(mode);
   std::set<std::pair<std::string, int>> inputs;
   for (const auto& name : c.contents)
-    if (name != "city_dsm") inputs.emplace(name, c.plane_n);  // generated in loadContent
+    if (name != "city_dsm" && name != "city_holes")
+      inputs.emplace(name, c.plane_n);   // generated in loadContent
   inputs.emplace("fractal", c.plane_n);  // the error sources study
   inputs.emplace("fractal", c.headline_n);
   inputs.emplace("fractal", c.scale_k_n);

@@ -3,9 +3,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdarg>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
+#include <random>
 #include <thread>
 
 #include "hfvis/errors.hpp"
@@ -59,18 +62,55 @@ HeightField crop(const HeightField& field, int width, int height) {
   return c;
 }
 
+namespace {
+
+// A city DSM as surveys deliver it (the "city_holes" content): the city with nodata where the
+// sensor saw nothing: a void (a lake, a glass roof: an ellipse), the survey's footprint clipped
+// across one corner, and dropouts of 1 - 3 x 1 - 3 pixels, mostly at the foot of walls (the
+// shadows of tall buildings), about 1.5 % of the field. Fixed seed.
+void punchHoles(HeightField& f) {
+  const int w = f.width, h = f.height;
+  const float nodata = std::numeric_limits<float>::quiet_NaN();
+  auto at = [&](int c, int r) -> float& { return f.heights[static_cast<std::size_t>(r) * w + c]; };
+  const double cx = 0.68 * w, cy = 0.3 * h, rx = 0.1 * w + 1.0, ry = 0.07 * h + 1.0;
+  for (int r = 0; r < h; ++r)
+    for (int c = 0; c < w; ++c)
+      if ((c - cx) * (c - cx) / (rx * rx) + (r - cy) * (r - cy) / (ry * ry) <= 1.0 || c + r < (w + h) / 10)
+        at(c, r) = nodata;
+  // Beside a step of more than 2 (a wall's foot or top).
+  auto at_wall = [&](int c, int r) {
+    for (const auto& [dc, dr] : {std::pair<int, int>{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
+      const int nc = c + dc, nr = r + dr;
+      if (nc >= 0 && nr >= 0 && nc < w && nr < h && std::fabs(at(nc, nr) - at(c, r)) > 2.0f) return true;
+    }
+    return false;
+  };
+  std::mt19937 rng(29);
+  std::uniform_int_distribution<int> col(0, w - 1), row(0, h - 1), side(1, 3);
+  for (int n = 0; n < w * h / 300; ++n) {
+    int c = col(rng), r = row(rng);
+    for (int tries = 0; tries < 8 && !at_wall(c, r); ++tries) c = col(rng), r = row(rng);
+    const int sw = side(rng), sh = side(rng);
+    for (int y = r; y < std::min(h, r + sh); ++y)
+      for (int x = c; x < std::min(w, c + sw); ++x) at(x, y) = nodata;
+  }
+}
+
+}  // namespace
+
 Content loadContent(const SuiteOptions& options, const std::string& name, int n) {
   Content c;
   c.name = name;
+  const bool city = name == "city_dsm" || name == "city_holes";
   if (options.mode == "tiny") {
     // Odd, non-square sizes; the "dome" stands in for the DEM with non-square cells.
     if (name == "dem") {
       c.field = makeSyntheticField("dome", n + 5, n - 1, 3);
       c.field.cell_size_x = 1.5, c.field.cell_size_y = 0.75;
     } else {
-      c.field = makeSyntheticField(name == "fractal" ? "noise" : name == "city_dsm" ? "city" : name, n, n - 3, 3);
+      c.field = makeSyntheticField(name == "fractal" ? "noise" : city ? "city" : name, n, n - 3, 3);
     }
-  } else if (name == "city_dsm") {
+  } else if (city) {
     // The city DSM hard case (testing's synthetic "city"): one-pixel streets and walls, roofs
     // touching at corners, courtyards, towers, an axis grid and a rotated one, generated here.
     c.field = makeSyntheticField("city", n, n, 1);
@@ -89,6 +129,7 @@ Content loadContent(const SuiteOptions& options, const std::string& name, int n)
     c.field =
         readHeightField((fs::path(options.data_dir) / (name + "_" + std::to_string(n) + ".exr")).string());
   }
+  if (name == "city_holes") punchHoles(c.field);
   c.label = name + "_" + std::to_string(c.field.width) + "x" + std::to_string(c.field.height);
   return c;
 }

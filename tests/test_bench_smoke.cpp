@@ -111,8 +111,11 @@ TEST_F(BenchSmoke, TinySuiteMeasuresEveryMethodInEverySection) {
   const std::size_t section = csv.column("section"), method = csv.column("method");
   const std::size_t error = csv.column("err_mean_deg"), metric = csv.column("metric"), value = csv.column("value");
   const std::size_t outputs = csv.column("outputs"), spu = csv.column("spu"), svf_error = csv.column("svf_mean_abs");
+  const std::size_t content = csv.column("content"), k = csv.column("K"), p99 = csv.column("err_p99_deg");
   std::set<std::string> sections, methods, plane_sweep_spus;
   int rows_with_errors = 0, svf_only_with_errors = 0;
+  // The city with nodata: per K, the unit sweep's and the naive march's mean and p99 errors.
+  std::map<std::string, std::map<std::string, std::pair<double, double>>> holes;
   for (const auto& f : csv.rows) {
     if (f.size() != csv.columns.size()) continue;  // reported by readCsv
     const std::string line = f[section] + "," + f[method] + ",...";
@@ -123,6 +126,8 @@ TEST_F(BenchSmoke, TinySuiteMeasuresEveryMethodInEverySection) {
       EXPECT_TRUE(std::isfinite(std::stod(f[error]))) << line;
     }
     if (f[section] == "plane" && f[method] == "sweep") plane_sweep_spus.insert(f[spu]);
+    if (f[section] == "plane" && f[content] == "city_holes" && f[spu] == "1" && !f[error].empty())
+      holes[f[k]][f[method]] = {std::stod(f[error]), std::stod(f[p99])};
     // The headline's SVF-only runs (sweep and naive) carry their SVF error against the truth.
     if (f[section] == "headline" && f[outputs] == "svf") {
       EXPECT_FALSE(f[svf_error].empty()) << line;
@@ -149,6 +154,16 @@ TEST_F(BenchSmoke, TinySuiteMeasuresEveryMethodInEverySection) {
   for (const auto& c : csv.columns) EXPECT_NE(c, "lpu");
   EXPECT_GT(rows_with_errors, 0);
   EXPECT_EQ(svf_only_with_errors, 2);  // sweep and naive
+  // On the city with nodata the sweep is no less accurate than the naive march (the baselines take
+  // no nodata), against the exact horizons of the nodata rule; before the sweep took that rule
+  // (b2fcc17) it saw nothing along diagonals through cells with a nodata corner.
+  EXPECT_EQ(holes.size(), 2u) << "the tiny suite's two K on city_holes";
+  for (const auto& [kk, by_method] : holes) {
+    ASSERT_TRUE(by_method.count("sweep") && by_method.count("naive")) << "K = " << kk;
+    EXPECT_EQ(by_method.size(), 2u) << "K = " << kk << ": only the library's methods on nodata";
+    EXPECT_LE(by_method.at("sweep").first, by_method.at("naive").first) << "mean, K = " << kk;
+    EXPECT_LE(by_method.at("sweep").second, by_method.at("naive").second) << "p99, K = " << kk;
+  }
   EXPECT_TRUE(fs::exists(dir_ / "report" / "environment.txt"));
 }
 
