@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -277,6 +278,68 @@ TEST_F(OutputFilesTest, ALoopOfSymbolicLinksIsRefused) {
   }
   EXPECT_EQ(filesInDir(), (std::vector<std::string>{"a.exr", "b.exr"}));
   EXPECT_TRUE(fs::is_symlink(fs::symlink_status(dir_ / "a.exr")));
+}
+
+// A GeoTIFF replaces the files GDAL reads beside it as part of it (hfvis::OutputFiles): a stale
+// FILE.aux.xml gave the new file the old one's nodata value, scale and offset (GDAL prefers it to
+// the file's own); overviews and a mask too; world files and a TAB file only where the new file
+// has no georeference of its own (else GDAL takes the file's). Where the commit fails, every one
+// of them is back as it was.
+TEST_F(OutputFilesTest, AGeoTiffTakesTheSideFilesOfThePreviousFileWithIt) {
+  const std::string pam =
+      "<PAMDataset><PAMRasterBand band=\"1\"><NoDataValue>1</NoDataValue><Offset>100</Offset>"
+      "<Scale>-1</Scale></PAMRasterBand></PAMDataset>\n";
+  const std::vector<std::string> sides = {"a.tif.aux.xml", "a.tif.ovr", "a.tif.MSK", "a.tif.aux"};
+  const std::vector<std::string> world = {"a.tfw", "a.wld", "a.TAB"};
+  const auto previous = [&] {
+    writeText("a.tif", "previous a");
+    for (const std::string& name : sides) writeText(name, name == "a.tif.aux.xml" ? pam : "previous " + name);
+    for (const std::string& name : world) writeText(name, "previous " + name);
+    writeText("a.exr.aux.xml", "not a GeoTIFF's");
+  };
+  ImageChannels image = noiseImage();
+  image.planes[0][0] = 1.0f;  // the stale nodata value
+  const auto sorted = [](std::vector<std::string> names) {
+    std::sort(names.begin(), names.end());
+    return names;
+  };
+
+  // No georeference: every side file goes, and the new file reads as written.
+  previous();
+  writeImage(path("a.tif"), image);
+  EXPECT_EQ(filesInDir(), sorted({"a.tif", "a.exr.aux.xml"}));
+  const ImageChannels read = readImage(path("a.tif"));
+  ASSERT_EQ(read.planes.size(), 1u);
+  EXPECT_EQ(read.planes[0], image.planes[0]);
+
+  // A georeference of its own: the world and TAB files stay (GDAL reads the file's own).
+  previous();
+  ImageChannels placed = image;
+  placed.georeference.geotransform = std::array<double, 6>{500000.0, 10.0, 0.0, 4000000.0, 0.0, -10.0};
+  writeImage(path("a.tif"), placed);
+  EXPECT_EQ(filesInDir(), sorted({"a.tif", "a.exr.aux.xml", "a.tfw", "a.wld", "a.TAB"}));
+  for (const std::string& name : world) EXPECT_EQ(readText(path(name)), "previous " + name);
+
+  // A failed commit (the second output's finished file gone) puts the first one's side files back.
+  for (const std::string& name : filesInDir()) fs::remove(dir_ / name);
+  previous();
+  {
+    OutputFiles files;
+    files.image(path("a.tif"), image);
+    files.image(path("b.exr"), image);
+    for (const std::string& name : filesInDir())
+      if (name.rfind(".b.hfvis-tmp-", 0) == 0) fs::remove(dir_ / name);
+    EXPECT_THROW(files.commit(), IoError);
+  }
+  std::vector<std::string> all = sides;
+  all.insert(all.end(), world.begin(), world.end());
+  all.push_back("a.tif");
+  all.push_back("a.exr.aux.xml");
+  EXPECT_EQ(filesInDir(), sorted(all));
+  EXPECT_EQ(readText(path("a.tif")), "previous a");
+  EXPECT_EQ(readText(path("a.tif.aux.xml")), pam);
+  EXPECT_EQ(readText(path("a.tif.ovr")), "previous a.tif.ovr");
+  EXPECT_EQ(readText(path("a.tfw")), "previous a.tfw");
 }
 
 // Outputs appear together or not at all: a later output that cannot be written leaves the earlier

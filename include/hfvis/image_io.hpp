@@ -113,8 +113,15 @@ void requireReplaceable(const std::string& path);
 // and the close checked; commit() then checks every target again (requireReplaceable) and
 // renames each file into place, keeping the mode of the file it replaces. When a rename fails,
 // the files already renamed are put back as they were (the previous files restored, new ones
-// removed), so a failure leaves every file that existed before exactly as it was. Whatever is
-// not committed is removed by the destructor, and by SIGINT, SIGTERM or SIGHUP where
+// removed), so a failure leaves every file that existed before exactly as it was. A GeoTIFF
+// replaces the files GDAL reads beside it as part of it too, as GDAL's own drivers delete them
+// with the file they belong to: its auxiliary metadata (FILE.aux.xml, FILE.aux: a nodata value,
+// scale, offset, even a georeference, which GDAL prefers to the file's own), overviews
+// (FILE.ovr) and mask (FILE.msk), and for an output without a georeference its world files
+// (STEM.tfw, .tifw, .tiffw, .wld) and MapInfo TAB file (STEM.tab), which would georeference it;
+// left in place, a reader took the new file with the old one's nodata and scale. They are set
+// aside as the previous file is and removed once every output is in place. Whatever is not
+// committed is removed by the destructor, and by SIGINT, SIGTERM or SIGHUP where
 // removeTemporaryOutputsOnSignals() is in force (a signal during commit() waits for its end).
 class OutputFiles {
  public:
@@ -146,11 +153,15 @@ class OutputFiles {
   void commit();
 
  private:
+  // Which side files of the target go with it (see above).
+  enum class SideFiles { None, GeoTiff, GeoTiffWithoutGeoreference };
   struct Entry {
     std::string path, target, temp;
+    SideFiles side_files = SideFiles::None;
   };
   // Stages `path`: write(temp) writes the file's contents to the temporary path.
-  void stage(const std::string& path, const std::function<void(const std::string&)>& write);
+  void stage(const std::string& path, const std::function<void(const std::string&)>& write,
+             SideFiles side_files = SideFiles::None);
   void discard() noexcept;
   std::vector<Entry> entries_;
 };

@@ -9,7 +9,9 @@
 #include <sys/statvfs.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <csignal>
 #include <cstring>
@@ -314,7 +316,41 @@ std::vector<std::string> OutputFiles::paths() const {
   return paths;
 }
 
-void OutputFiles::stage(const std::string& path, const std::function<void(const std::string&)>& write) {
+namespace {
+
+// The side files of a GeoTIFF output at `name` (and at `target`, the file a link there names, where
+// GDAL opening either name looks) that exist, as regular files or links (see OutputFiles):
+// NAME.aux.xml, NAME.aux, NAME.ovr, NAME.msk, and with `world` STEM.tfw, .tifw, .tiffw, .wld, .tab,
+// each suffix in lower or upper case.
+std::vector<std::string> existingSideFiles(const std::string& name, const std::string& target, bool world) {
+  static const char* const kWhole[] = {".aux.xml", ".aux", ".ovr", ".msk"};
+  static const char* const kStem[] = {".tfw", ".tifw", ".tiffw", ".wld", ".tab"};
+  std::vector<std::string> found;
+  const auto add = [&](const std::string& base, const char* suffix) {
+    for (const bool upper : {false, true}) {
+      std::string ending = suffix;
+      if (upper)
+        std::transform(ending.begin(), ending.end(), ending.begin(),
+                       [](unsigned char c) { return std::toupper(c); });
+      const std::string side = base + ending;
+      struct stat status {};
+      if (::lstat(side.c_str(), &status) != 0 || !(S_ISREG(status.st_mode) || S_ISLNK(status.st_mode)))
+        continue;
+      if (std::find(found.begin(), found.end(), side) == found.end()) found.push_back(side);
+    }
+  };
+  for (const std::string& base : {name, target}) {
+    for (const char* suffix : kWhole) add(base, suffix);
+    if (world)
+      for (const char* suffix : kStem) add(std::filesystem::path(base).replace_extension().string(), suffix);
+  }
+  return found;
+}
+
+}  // namespace
+
+void OutputFiles::stage(const std::string& path, const std::function<void(const std::string&)>& write,
+                        SideFiles side_files) {
   const std::string target = detail::resolvedTarget(path);
   for (const Entry& entry : entries_)
     if (std::filesystem::path(entry.target).lexically_normal() ==
@@ -323,7 +359,7 @@ void OutputFiles::stage(const std::string& path, const std::function<void(const 
   detail::requireReplaceableTarget(path, target);
   const std::string temp = detail::temporaryPathFor(target);
   detail::rememberTemporary(temp);
-  entries_.push_back({path, target, temp});
+  entries_.push_back({path, target, temp, side_files});
   write(temp);
 }
 
@@ -341,23 +377,39 @@ void OutputFiles::commit() {
   struct Placed {
     const Entry* entry;
     std::string backup;  // "" where no file was there
+    std::vector<std::pair<std::string, std::string>> sides;  // side files set aside: (name, aside)
   };
   std::vector<Placed> placed;
-  const auto restore = [](const Entry& entry, const std::string& backup) {
-    if (backup.empty()) {
+  const auto restore = [](const Placed& p) {
+    const Entry& entry = *p.entry;
+    if (p.backup.empty()) {
       ::unlink(entry.target.c_str());
     } else {
-      ::rename(backup.c_str(), entry.target.c_str());
-      ::unlink(backup.c_str());  // a hard link to the target itself: rename(2) left it
+      ::rename(p.backup.c_str(), entry.target.c_str());
+      ::unlink(p.backup.c_str());  // a hard link to the target itself: rename(2) left it
     }
+    for (const auto& [name, aside] : p.sides) ::rename(aside.c_str(), name.c_str());
   };
+  // (`current`: the entry being placed, its side files set aside so far)
+  Placed current{nullptr, "", {}};
   const auto fail = [&](const Entry& entry, const std::string& reason) {
     const std::string path = entry.path;  // (discard() takes the entries)
-    for (auto it = placed.rbegin(); it != placed.rend(); ++it) restore(*it->entry, it->backup);
+    for (const auto& [name, aside] : current.sides) ::rename(aside.c_str(), name.c_str());
+    for (auto it = placed.rbegin(); it != placed.rend(); ++it) restore(*it);
     discard();
     throw IoError(path, reason);
   };
   for (const Entry& entry : entries_) {
+    current = {&entry, "", {}};
+    if (entry.side_files != SideFiles::None)
+      for (const std::string& side : existingSideFiles(
+               entry.path, entry.target, entry.side_files == SideFiles::GeoTiffWithoutGeoreference)) {
+        const std::string aside = detail::temporaryPathFor(side);
+        if (::rename(side.c_str(), aside.c_str()) != 0)
+          fail(entry, "cannot set aside '" + side +
+                          "', which GDAL would read with the new file: " + detail::writeFailure(errno));
+        current.sides.emplace_back(side, aside);
+      }
     std::string backup;
     struct stat previous {};
     if (::lstat(entry.target.c_str(), &previous) == 0) {
@@ -383,10 +435,16 @@ void OutputFiles::commit() {
                       (error == EISDIR ? "a directory is there now" : detail::writeFailure(error)));
     }
     detail::forgetTemporary(entry.temp);
-    placed.push_back({&entry, backup});
+    current.backup = backup;
+    placed.push_back(current);
+    current = {nullptr, "", {}};
   }
   for (const Placed& p : placed) {
     if (!p.backup.empty()) ::unlink(p.backup.c_str());
+    for (const auto& side : p.sides) {
+      ::unlink(side.second.c_str());
+      detail::syncDirectory(detail::directoryOf(side.first));
+    }
     detail::syncDirectory(detail::directoryOf(p.entry->target));
   }
   entries_.clear();
