@@ -1263,6 +1263,26 @@ TEST(GdalRasters, AsciiGridValuesThatAreNotNumbersAreRefused) {
   const HeightField grass_field = readHeightField(path);
   EXPECT_TRUE(std::isnan(grass_field.heights[1]));
   EXPECT_EQ(grass_field.heights[5], 6.0f);
+  // The header's values are numbers too: GDAL read `NODATA_value abc` as 0 (every height 0 a
+  // hole) and `xllcorner abc` as 0, and a cell size of 0 placed every pixel at one point.
+  const std::vector<std::pair<std::string, std::string>> headers = {
+      {"ncols 3\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\nNODATA_value abc\n",
+       "line 6: the header's nodata_value 'abc' is not a number"},
+      {"ncols 3\nnrows 2\nxllcorner abc\nyllcorner 0\ncellsize 1\n", "line 3: the header's xllcorner 'abc'"},
+      {"north: 2\nsouth: 0x\neast: 3\nwest: 0\nrows: 2\ncols: 3\n", "line 2: the header's south '0x'"},
+      {"ncols 3\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 0\n", "the geotransform's pixel size is 0"}};
+  HeightFieldReadOptions given;  // (with --cell-size too)
+  given.cell_size_x = given.cell_size_y = 1.0;
+  for (const auto& [header, reason] : headers) {
+    SCOPED_TRACE(header);
+    { std::ofstream(path) << header << "0 2 3\n4 5 6\n"; }
+    try {
+      readHeightField(path, given);
+      ADD_FAILURE() << "read";
+    } catch (const IoError& error) {
+      EXPECT_NE(error.reason().find(reason), std::string::npos) << error.what();
+    }
+  }
 }
 
 }  // namespace

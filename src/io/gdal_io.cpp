@@ -98,6 +98,7 @@ void requireNumbersInAsciiGrid(const std::string& path) {
   std::vector<char> buffer(std::size_t(1) << 20);
   std::string token, key;  // key: the header line's, until its value
   std::map<std::string, std::string> values_of;
+  std::map<std::string, long long> line_of;  // each header key's line
   bool header = true, line_start = true;
   long long line = 1, count = 0;
   const auto check = [&]() {
@@ -112,6 +113,7 @@ void requireNumbersInAsciiGrid(const std::string& path) {
         key.clear();
       } else if (colon != std::string::npos && colon + 1 < token.size()) {
         values_of[key] = token.substr(colon + 1);
+        line_of[key] = line;
         key.clear();
       }
       if (header) {
@@ -121,6 +123,7 @@ void requireNumbersInAsciiGrid(const std::string& path) {
       }
     } else if (header && !key.empty()) {
       values_of[key] = token;
+      line_of[key] = line;
       key.clear();
       token.clear();
       return;
@@ -161,6 +164,18 @@ void requireNumbersInAsciiGrid(const std::string& path) {
     }
   }
   check();
+  // The header's values are numbers too (GDAL read `NODATA_value abc` as 0, making every height 0
+  // a hole, and `xllcorner abc` as 0, exit 0), but for GRASS's type and null token.
+  for (const auto& [name, value] : values_of) {
+    if (name == "type" || name == "null") continue;
+    char* read_to = nullptr;
+    std::strtod(value.c_str(), &read_to);
+    if (value.size() > 256 || read_to != value.c_str() + value.size())
+      throw IoError(path, "line " + std::to_string(line_of[name]) + ": the header's " + name + " '" +
+                              value.substr(0, 40) +
+                              "' is not a number (GDAL's ASCII grid reader would read 0 or "
+                              "its leading digits)");
+  }
   const auto whole = [&](const char* name, const char* other) -> long long {
     const auto found = values_of.count(name) ? values_of.find(name) : values_of.find(other);
     return found == values_of.end() ? -1 : std::atoll(found->second.c_str());
@@ -667,6 +682,13 @@ HeightField readGdalHeightField(const std::string& path, const HeightFieldReadOp
                                 shortNumber((*gt)[1]) + ", " + shortNumber((*gt)[3]) + ", " +
                                 shortNumber((*gt)[5]) +
                                 "): fix the raster's georeference first (gdal_edit.py -a_ullr, or -unsetgt)");
+  // A pixel of size 0 (an ASCII grid's `cellsize 0`, a VRT's geotransform) places every pixel at
+  // one point: refused whatever the cell size, as a rotated grid is (with --cell-size the run wrote
+  // GeoTIFFs with a ground control point for a georeference, and region JSON with every "x" 0).
+  if (const auto& gt = field.georeference.geotransform; gt && ((*gt)[1] == 0.0 || (*gt)[5] == 0.0))
+    throw IoError(path, "the geotransform's pixel size is 0 (" + shortNumber((*gt)[1]) + " by " +
+                            shortNumber((*gt)[5]) +
+                            "): fix the raster's georeference first (gdal_edit.py -a_ullr, or -unsetgt)");
   // Cell sizes: given, else from the geotransform (north-up or south-up only), else as hfvis
   // stored them.
   if (options.cell_size_x > 0.0 || options.cell_size_y > 0.0) {
