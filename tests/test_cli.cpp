@@ -3505,6 +3505,24 @@ TEST_F(Cli, PvsResumesFromAnEarlierBitset) {
   EXPECT_EQ(not_bits.status, 1);
   EXPECT_NE(not_bits.err.find("not a PVS bitset file"), std::string::npos) << not_bits.err;
   EXPECT_FALSE(fs::exists(out("c.json")));
+  // Bits past the last tile (a damaged file) are refused naming the file (the library's refusal
+  // named none).
+  const int tiles = first.layout.tiles(), words = (tiles + 31) / 32;
+  ASSERT_NE(tiles % 32, 0) << "no bits past the last tile on this grid";
+  std::string damaged = readText(out("a.bin"));
+  const std::size_t last_word = 72 + (first.layout.viewCells() + 3) / 4 * 4 + 4 * std::size_t(words - 1);
+  damaged[last_word + 3] = static_cast<char>(0x80);  // the word's highest bit
+  { std::ofstream(out("damaged.bin"), std::ios::binary) << damaged; }
+  const CliResult past = run("pvs " + shellQuoted(field) + " -o " + shellQuoted(out("c.json")) +
+                             " --samples 100 --seed 3 --resume " + shellQuoted(out("damaged.bin")) + grid);
+  EXPECT_EQ(past.status, 1);
+  EXPECT_NE(
+      past.err.find("damaged.bin: not a PVS bitset file of hfvis pvs --bitset (docs/PVS.md): view cell 0 has "
+                    "bits past the last of the " +
+                    std::to_string(tiles) + " tiles"),
+      std::string::npos)
+      << past.err;
+  EXPECT_FALSE(fs::exists(out("c.json")));
 }
 
 TEST_F(Cli, RegionVisibilityRefusesBadInput) {

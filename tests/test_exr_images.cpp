@@ -244,6 +244,17 @@ TEST_F(ImageIoExrTest, CellSizeAttributesAreReadAsStringsOrNumbers) {
   } catch (const IoError& e) {
     EXPECT_NE(std::string(e.what()).find("hfvis:cell_size_x is of type v2f"), std::string::npos) << e.what();
   }
+  // One axis's alone is named as missing (it was named as '', "not a cell size").
+  const std::string alone =
+      write("alone.exr", [](Imf::Header& h) { h.insert("hfvis:cell_size_x", Imf::IntAttribute(3)); });
+  try {
+    readHeightField(alone);
+    ADD_FAILURE() << "one axis's cell size was taken";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("hfvis:cell_size_y is missing or empty beside hfvis:cell_size_x"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 // An environment map covers the sphere with its whole extent: one whose data window is not its

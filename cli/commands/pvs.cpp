@@ -190,6 +190,12 @@ BitsetFile readBitsetFile(const std::string& path, const PvsLayout& l, const Bit
   }
   f.bits.resize(views * f.words);
   for (std::size_t i = 0; i < f.bits.size(); ++i) f.bits[i] = getU32(body.data() + padded + 4 * i);
+  // (the library refuses these too, without naming the file)
+  const std::uint32_t last = tiles % 32 ? (1u << (tiles % 32)) - 1u : ~0u;
+  for (std::uint64_t v = 0; v < views; ++v)
+    if (f.bits[v * f.words + f.words - 1] & ~last)
+      throw fail("view cell " + std::to_string(v) + " has bits past the last of the " +
+                 std::to_string(tiles) + " tiles");
   return f;
 }
 

@@ -604,10 +604,13 @@ std::optional<std::pair<double, double>> storedCellSize(const std::string& path,
                                                         const char* y) {
   if ((!x || !*x) && (!y || !*y)) return std::nullopt;
   auto number = [&](const char* name, const char* text) {
+    if (!text || !*text)  // (the other one is given)
+      throw IoError(path, std::string("the attribute ") + name + " is missing or empty beside " +
+                              (name[16] == 'x' ? "hfvis:cell_size_y" : "hfvis:cell_size_x") +
+                              "; give --cell-size");
     double v = 0.0;
-    if (!text || !decimalNumber(text, v) || !(v > 0.0) || v > 1e9)
-      throw IoError(path, std::string("the attribute ") + name + " is '" +
-                              (text ? std::string(text).substr(0, 40) : "") +
+    if (!decimalNumber(text, v) || !(v > 0.0) || v > 1e9)
+      throw IoError(path, std::string("the attribute ") + name + " is '" + std::string(text).substr(0, 40) +
                               "', not a cell size (a number above 0, at most 1e9); give --cell-size");
     return v;
   };
