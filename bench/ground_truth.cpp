@@ -65,8 +65,7 @@ std::uint64_t fieldHash(const HeightField& f) {
 }
 
 // `count` receivers drawn without replacement (all when there are fewer) among the pixels with a
-// height: a nodata pixel receives nothing, so a method's NaN there is no error and one at a
-// receiver is.
+// height: a nodata pixel receives nothing (a method's NaN at a receiver is counted apart, err_nan).
 std::vector<std::int32_t> chooseReceivers(const HeightField& f, int count) {
   std::vector<std::int32_t> valid;
   for (std::size_t p = 0; p < f.pixelCount(); ++p)

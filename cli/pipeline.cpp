@@ -1,10 +1,12 @@
 // cli/pipeline.cpp: the pipeline every command that reads a height field runs, and its helpers.
 #include "pipeline.hpp"
 
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -288,7 +290,8 @@ namespace {
 // other).
 bool sameFile(const std::string& a, const std::string& b) {
   std::error_code error;
-  if (fs::exists(a, error) && fs::exists(b, error)) return fs::equivalent(a, b, error);
+  const bool exists_a = fs::exists(a, error), exists_b = fs::exists(b, error);
+  if (exists_a && exists_b) return fs::equivalent(a, b, error);
   const auto where = [](const std::string& path) {
     std::error_code failed;
     const fs::path target = fs::absolute(hfvis::detail::resolvedTarget(path), failed);
@@ -301,9 +304,34 @@ bool sameFile(const std::string& a, const std::string& b) {
   // One directory under two paths (a bind mount): the same name in it is the same file.
   struct stat parent_a {
   }, parent_b{};
-  return place_a.filename() == place_b.filename() && ::stat(place_a.parent_path().c_str(), &parent_a) == 0 &&
-         ::stat(place_b.parent_path().c_str(), &parent_b) == 0 && parent_a.st_dev == parent_b.st_dev &&
-         parent_a.st_ino == parent_b.st_ino;
+  if (::stat(place_a.parent_path().c_str(), &parent_a) != 0 ||
+      ::stat(place_b.parent_path().c_str(), &parent_b) != 0 || parent_a.st_dev != parent_b.st_dev ||
+      parent_a.st_ino != parent_b.st_ino)
+    return false;
+  const std::string name_a = place_a.filename().string(), name_b = place_b.filename().string();
+  if (name_a == name_b) return true;
+  // Names that differ in case alone, neither there yet: one file where the directory ignores case
+  // (vfat, exFAT, an ext4 casefold directory), where the second output's rename would replace the
+  // first. Told by creating the first name (exclusively: nothing of the user's is touched) and
+  // looking for the second. (Where one exists, so does the other if the directory ignores case,
+  // and the check above compared the files: one there alone is another file.) ASCII letters only.
+  const bool case_alone =
+      name_a.size() == name_b.size() &&
+      std::equal(name_a.begin(), name_a.end(), name_b.begin(), [](char x, char y) {
+        return std::tolower(static_cast<unsigned char>(x)) == std::tolower(static_cast<unsigned char>(y));
+      });
+  if (!case_alone || exists_a || exists_b) return false;
+  hfvis::detail::rememberTemporary(place_a.string());  // (removed on a signal)
+  const int probe = ::open(place_a.c_str(), O_CREAT | O_EXCL | O_WRONLY | O_CLOEXEC, 0600);
+  bool one = false;
+  if (probe >= 0) {
+    ::close(probe);
+    struct stat other {};
+    one = ::lstat(place_b.c_str(), &other) == 0;
+    ::unlink(place_a.c_str());
+  }
+  hfvis::detail::forgetTemporary(place_a.string());
+  return one;
 }
 
 // Every output can be written, none is an input (an output never replaces an input), and no
@@ -328,6 +356,21 @@ void requireOutputs(const RunArguments& run, const Computation& computation) {
     for (std::size_t j = 0; j < i; ++j) {
       if (sameFile(outputs[i], outputs[j]))
         throw UsageError("outputs '" + outputs[j] + "' and '" + outputs[i] + "' are the same file");
+    }
+    // A GeoTIFF takes away the files GDAL reads beside it as part of it (OutputFiles): none may be
+    // an input or another output, and each must be one this user may remove, known before the work.
+    if (!writesGeoTiff(outputs[i])) continue;
+    for (const std::string& side : hfvis::detail::geoTiffSideFiles(outputs[i])) {
+      for (const std::string& input : inputs)
+        if (sameFile(side, input))
+          throw UsageError("output '" + outputs[i] + "' would take away '" + side +
+                           "' (GDAL reads it as part of the GeoTIFF it replaces), which is the input '" +
+                           input + "': outputs never replace an input");
+      for (const std::string& other : outputs)
+        if (sameFile(side, other))
+          throw UsageError("output '" + other + "' is '" + side + "', which GDAL reads as part of output '" +
+                           outputs[i] + "': name it otherwise");
+      hfvis::detail::requireReplaceableTarget(side, side);
     }
   }
 }

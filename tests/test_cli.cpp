@@ -478,6 +478,16 @@ TEST_F(Cli, OutputNeverReplacesAnInput) {
   const CliResult preview = run("svf " + shellQuoted(field) + " -o " + shellQuoted(out("svf.exr")) +
                                 " --preview " + shellQuoted(field) + " -k 4");
   EXPECT_EQ(preview.status, 2) << preview.err;
+  // Nor by taking away a file GDAL reads as part of a GeoTIFF output (here the input, an EXR read
+  // by its content, at the output's overview name), which writing the output removes.
+  fs::copy_file(field, out("s.tif.ovr"));
+  const CliResult side =
+      run("svf " + shellQuoted(out("s.tif.ovr")) + " -o " + shellQuoted(out("s.tif")) + " -k 4");
+  EXPECT_EQ(side.status, 2) << side.err;
+  EXPECT_NE(side.err.find("would take away"), std::string::npos) << side.err;
+  EXPECT_EQ(readText(out("s.tif.ovr")), before);
+  EXPECT_FALSE(fs::exists(out("s.tif")));
+  fs::remove(out("s.tif.ovr"));
   const std::string radiance = writeField("radiance.exr", 16, 12, [](int, int) { return 1.0f; });
   const std::string radiance_before = readText(radiance);
   const std::string radiance_link = in("radiance_link.exr");
@@ -536,6 +546,24 @@ TEST_F(Cli, TwoOutputsThatAreOneNewFileAreRefused) {
   EXPECT_EQ(linked.status, 2) << linked.err;
   EXPECT_NE(linked.err.find("are the same file"), std::string::npos) << linked.err;
   EXPECT_EQ(listDirectory(outputs()), std::vector<std::string>{"link.exr"});
+  fs::remove(out("link.exr"));
+  // Names that differ in case alone: one file where the directory ignores case (the second
+  // rename replaced the first), two where it does not; the check's probe leaves nothing behind.
+  const bool ignores_case = [&] {
+    std::ofstream(out("probe")) << "x";
+    const bool one = fs::exists(out("PROBE"));
+    fs::remove(out("probe"));
+    return one;
+  }();
+  const CliResult cased = run("horizon " + shellQuoted(field) + " -k 4 -o " + shellQuoted(out("H.exr")) +
+                              " --distance-out " + shellQuoted(out("h.exr")));
+  if (ignores_case) {
+    expectFailure(cased, 2, "are the same file");
+    EXPECT_TRUE(listDirectory(outputs()).empty());
+  } else {
+    EXPECT_EQ(cased.status, 0) << cased.err;
+    EXPECT_EQ(listDirectory(outputs()), (std::vector<std::string>{"H.exr", "h.exr"}));
+  }
 }
 
 // One directory under two paths (a bind mount): a new file's name in it under either is one

@@ -282,20 +282,18 @@ TEST_F(OutputFilesTest, ALoopOfSymbolicLinksIsRefused) {
 
 // A GeoTIFF replaces the files GDAL reads beside it as part of it (hfvis::OutputFiles): a stale
 // FILE.aux.xml gave the new file the old one's nodata value, scale and offset (GDAL prefers it to
-// the file's own); overviews and a mask too; world files and a TAB file only where the new file
-// has no georeference of its own (else GDAL takes the file's). Where the commit fails, every one
-// of them is back as it was.
+// the file's own); overviews and a mask too. World files stay (named by the stem, they may belong
+// to another file of it), as do an EXR's. Where the commit fails, every one is back as it was.
 TEST_F(OutputFilesTest, AGeoTiffTakesTheSideFilesOfThePreviousFileWithIt) {
   const std::string pam =
       "<PAMDataset><PAMRasterBand band=\"1\"><NoDataValue>1</NoDataValue><Offset>100</Offset>"
       "<Scale>-1</Scale></PAMRasterBand></PAMDataset>\n";
   const std::vector<std::string> sides = {"a.tif.aux.xml", "a.tif.ovr", "a.tif.MSK", "a.tif.aux"};
-  const std::vector<std::string> world = {"a.tfw", "a.wld", "a.TAB"};
+  const std::vector<std::string> others = {"a.tfw", "a.wld", "a.exr.aux.xml"};
   const auto previous = [&] {
     writeText("a.tif", "previous a");
     for (const std::string& name : sides) writeText(name, name == "a.tif.aux.xml" ? pam : "previous " + name);
-    for (const std::string& name : world) writeText(name, "previous " + name);
-    writeText("a.exr.aux.xml", "not a GeoTIFF's");
+    for (const std::string& name : others) writeText(name, "previous " + name);
   };
   ImageChannels image = noiseImage();
   image.planes[0][0] = 1.0f;  // the stale nodata value
@@ -304,21 +302,13 @@ TEST_F(OutputFilesTest, AGeoTiffTakesTheSideFilesOfThePreviousFileWithIt) {
     return names;
   };
 
-  // No georeference: every side file goes, and the new file reads as written.
   previous();
   writeImage(path("a.tif"), image);
-  EXPECT_EQ(filesInDir(), sorted({"a.tif", "a.exr.aux.xml"}));
+  EXPECT_EQ(filesInDir(), sorted({"a.tif", "a.tfw", "a.wld", "a.exr.aux.xml"}));
+  for (const std::string& name : others) EXPECT_EQ(readText(path(name)), "previous " + name);
   const ImageChannels read = readImage(path("a.tif"));
   ASSERT_EQ(read.planes.size(), 1u);
   EXPECT_EQ(read.planes[0], image.planes[0]);
-
-  // A georeference of its own: the world and TAB files stay (GDAL reads the file's own).
-  previous();
-  ImageChannels placed = image;
-  placed.georeference.geotransform = std::array<double, 6>{500000.0, 10.0, 0.0, 4000000.0, 0.0, -10.0};
-  writeImage(path("a.tif"), placed);
-  EXPECT_EQ(filesInDir(), sorted({"a.tif", "a.exr.aux.xml", "a.tfw", "a.wld", "a.TAB"}));
-  for (const std::string& name : world) EXPECT_EQ(readText(path(name)), "previous " + name);
 
   // A failed commit (the second output's finished file gone) puts the first one's side files back.
   for (const std::string& name : filesInDir()) fs::remove(dir_ / name);
@@ -332,14 +322,13 @@ TEST_F(OutputFilesTest, AGeoTiffTakesTheSideFilesOfThePreviousFileWithIt) {
     EXPECT_THROW(files.commit(), IoError);
   }
   std::vector<std::string> all = sides;
-  all.insert(all.end(), world.begin(), world.end());
+  all.insert(all.end(), others.begin(), others.end());
   all.push_back("a.tif");
-  all.push_back("a.exr.aux.xml");
   EXPECT_EQ(filesInDir(), sorted(all));
   EXPECT_EQ(readText(path("a.tif")), "previous a");
   EXPECT_EQ(readText(path("a.tif.aux.xml")), pam);
   EXPECT_EQ(readText(path("a.tif.ovr")), "previous a.tif.ovr");
-  EXPECT_EQ(readText(path("a.tfw")), "previous a.tfw");
+  EXPECT_EQ(readText(path("a.tif.MSK")), "previous a.tif.MSK");
 }
 
 // Outputs appear together or not at all: a later output that cannot be written leaves the earlier

@@ -117,12 +117,12 @@ void requireReplaceable(const std::string& path);
 // replaces the files GDAL reads beside it as part of it too, as GDAL's own drivers delete them
 // with the file they belong to: its auxiliary metadata (FILE.aux.xml, FILE.aux: a nodata value,
 // scale, offset, even a georeference, which GDAL prefers to the file's own), overviews
-// (FILE.ovr) and mask (FILE.msk), and for an output without a georeference its world files
-// (STEM.tfw, .tifw, .tiffw, .wld) and MapInfo TAB file (STEM.tab), which would georeference it;
-// left in place, a reader took the new file with the old one's nodata and scale. They are set
-// aside as the previous file is and removed once every output is in place. Whatever is not
-// committed is removed by the destructor, and by SIGINT, SIGTERM or SIGHUP where
-// removeTemporaryOutputsOnSignals() is in force (a signal during commit() waits for its end).
+// (FILE.ovr) and mask (FILE.msk); left in place, a reader took the new file with the old one's
+// nodata and scale. They are set aside as the previous file is and removed once every output is
+// in place. (World files, STEM.tfw and kin, are named by the stem alone and may belong to another
+// file of that stem, a PNG: they stay.) Whatever is not committed is removed by the destructor,
+// and by SIGINT, SIGTERM or SIGHUP where removeTemporaryOutputsOnSignals() is in force (a signal
+// during commit() waits for its end).
 class OutputFiles {
  public:
   OutputFiles() = default;
@@ -153,15 +153,13 @@ class OutputFiles {
   void commit();
 
  private:
-  // Which side files of the target go with it (see above).
-  enum class SideFiles { None, GeoTiff, GeoTiffWithoutGeoreference };
   struct Entry {
     std::string path, target, temp;
-    SideFiles side_files = SideFiles::None;
+    bool geotiff = false;  // its side files go with the file it replaces (see above)
   };
   // Stages `path`: write(temp) writes the file's contents to the temporary path.
   void stage(const std::string& path, const std::function<void(const std::string&)>& write,
-             SideFiles side_files = SideFiles::None);
+             bool geotiff = false);
   void discard() noexcept;
   std::vector<Entry> entries_;
 };

@@ -118,8 +118,8 @@ HFVIS_INLINE float corner_bilinear(float h00, float h10, float h01, float h11, f
 // of whole cells, never saw: a diagonal line through a nodata corner missed a rise of 15 m.)
 // Branch-free (masked sums add exact zeros), so it vectorises; NaN is told by x != x, not by
 // isnan, which PoCL leaves as a call that stops the vectoriser: with isnan here and in the
-// callers' test below, the naive march (horizon_naive) ran 2.5 - 3x slower on any field holding
-// nodata (hfvis_bench run, a 256^2 city with one NaN, 2-core AMD EPYC). The kernels are built
+// callers' test below, the naive marches ran 3 - 4x slower on any field holding nodata
+// (docs/PERFORMANCE.md, "Nodata"). The kernels are built
 // without finite-math options, so x != x stays the IEEE test on every device.
 // src/core/sweep_geometry.hpp's bilinearBesideNodata is the same.
 HFVIS_INLINE float bilinear_beside_nodata(float h00, float h10, float h01, float h11, float w00, float w10,

@@ -171,10 +171,11 @@ void requireNumbersInAsciiGrid(const std::string& path) {
     char* read_to = nullptr;
     std::strtod(value.c_str(), &read_to);
     if (value.size() > 256 || read_to != value.c_str() + value.size())
-      throw IoError(path, "line " + std::to_string(line_of[name]) + ": the header's " + name + " '" +
-                              value.substr(0, 40) +
-                              "' is not a number (GDAL's ASCII grid reader would read 0 or "
-                              "its leading digits)");
+      throw IoError(
+          path, "line " + std::to_string(line_of[name]) + ": the header's " + name + " '" +
+                    value.substr(0, 40) + "' is not a number" +
+                    (value.find(',') != std::string::npos ? " (write a decimal point, not a comma)" : "") +
+                    " (GDAL's ASCII grid reader would read 0 or its leading digits)");
   }
   const auto whole = [&](const char* name, const char* other) -> long long {
     const auto found = values_of.count(name) ? values_of.find(name) : values_of.find(other);

@@ -206,11 +206,8 @@ void writeImageFile(const std::string& file, const std::string& path, const Imag
 void OutputFiles::image(const std::string& path, const ImageChannels& image) {
   requireConsistent(path, image);
   requireImageWriter(path);
-  const SideFiles side = !writesGeoTiff(path)              ? SideFiles::None
-                         : image.georeference.geotransform ? SideFiles::GeoTiff
-                                                           : SideFiles::GeoTiffWithoutGeoreference;
   stage(
-      path, [&](const std::string& file) { writeImageFile(file, path, image); }, side);
+      path, [&](const std::string& file) { writeImageFile(file, path, image); }, writesGeoTiff(path));
 }
 
 void OutputFiles::text(const std::string& path, const std::string& text) {

@@ -286,6 +286,28 @@ int likelyWriteError(const std::string& file) {
   return 0;
 }
 
+std::vector<std::string> geoTiffSideFiles(const std::string& path) {
+  std::vector<std::string> found;
+  std::vector<std::pair<dev_t, ino_t>> seen;  // (a directory that ignores case finds one file twice)
+  for (const std::string& base : {path, resolvedTarget(path)})
+    for (const char* suffix : {".aux.xml", ".aux", ".ovr", ".msk"})
+      for (const bool upper : {false, true}) {
+        std::string ending = suffix;
+        if (upper)
+          std::transform(ending.begin(), ending.end(), ending.begin(),
+                         [](unsigned char c) { return std::toupper(c); });
+        const std::string side = base + ending;
+        struct stat status {};
+        if (::lstat(side.c_str(), &status) != 0 || !(S_ISREG(status.st_mode) || S_ISLNK(status.st_mode)))
+          continue;
+        const std::pair<dev_t, ino_t> id{status.st_dev, status.st_ino};
+        if (std::find(seen.begin(), seen.end(), id) != seen.end()) continue;
+        seen.push_back(id);
+        found.push_back(side);
+      }
+  return found;
+}
+
 void syncFile(const std::string& file, const std::string& path) {
   const int fd = ::open(file.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) throw IoError(path, "cannot write: " + writeFailure(errno));
@@ -316,41 +338,8 @@ std::vector<std::string> OutputFiles::paths() const {
   return paths;
 }
 
-namespace {
-
-// The side files of a GeoTIFF output at `name` (and at `target`, the file a link there names, where
-// GDAL opening either name looks) that exist, as regular files or links (see OutputFiles):
-// NAME.aux.xml, NAME.aux, NAME.ovr, NAME.msk, and with `world` STEM.tfw, .tifw, .tiffw, .wld, .tab,
-// each suffix in lower or upper case.
-std::vector<std::string> existingSideFiles(const std::string& name, const std::string& target, bool world) {
-  static const char* const kWhole[] = {".aux.xml", ".aux", ".ovr", ".msk"};
-  static const char* const kStem[] = {".tfw", ".tifw", ".tiffw", ".wld", ".tab"};
-  std::vector<std::string> found;
-  const auto add = [&](const std::string& base, const char* suffix) {
-    for (const bool upper : {false, true}) {
-      std::string ending = suffix;
-      if (upper)
-        std::transform(ending.begin(), ending.end(), ending.begin(),
-                       [](unsigned char c) { return std::toupper(c); });
-      const std::string side = base + ending;
-      struct stat status {};
-      if (::lstat(side.c_str(), &status) != 0 || !(S_ISREG(status.st_mode) || S_ISLNK(status.st_mode)))
-        continue;
-      if (std::find(found.begin(), found.end(), side) == found.end()) found.push_back(side);
-    }
-  };
-  for (const std::string& base : {name, target}) {
-    for (const char* suffix : kWhole) add(base, suffix);
-    if (world)
-      for (const char* suffix : kStem) add(std::filesystem::path(base).replace_extension().string(), suffix);
-  }
-  return found;
-}
-
-}  // namespace
-
 void OutputFiles::stage(const std::string& path, const std::function<void(const std::string&)>& write,
-                        SideFiles side_files) {
+                        bool geotiff) {
   const std::string target = detail::resolvedTarget(path);
   for (const Entry& entry : entries_)
     if (std::filesystem::path(entry.target).lexically_normal() ==
@@ -359,7 +348,7 @@ void OutputFiles::stage(const std::string& path, const std::function<void(const 
   detail::requireReplaceableTarget(path, target);
   const std::string temp = detail::temporaryPathFor(target);
   detail::rememberTemporary(temp);
-  entries_.push_back({path, target, temp, side_files});
+  entries_.push_back({path, target, temp, geotiff});
   write(temp);
 }
 
@@ -401,9 +390,14 @@ void OutputFiles::commit() {
   };
   for (const Entry& entry : entries_) {
     current = {&entry, "", {}};
-    if (entry.side_files != SideFiles::None)
-      for (const std::string& side : existingSideFiles(
-               entry.path, entry.target, entry.side_files == SideFiles::GeoTiffWithoutGeoreference)) {
+    if (entry.geotiff)
+      for (const std::string& side : detail::geoTiffSideFiles(entry.path)) {
+        // (an output of this commit at such a name is what the caller asked for)
+        if (std::any_of(entries_.begin(), entries_.end(), [&](const Entry& other) {
+              return std::filesystem::path(other.target).lexically_normal() ==
+                     std::filesystem::path(detail::resolvedTarget(side)).lexically_normal();
+            }))
+          continue;
         const std::string aside = detail::temporaryPathFor(side);
         if (::rename(side.c_str(), aside.c_str()) != 0)
           fail(entry, "cannot set aside '" + side +

@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <cstring>
 #include <string>
+#include <vector>
 
 namespace hfvis::detail {
 
@@ -45,6 +46,12 @@ void writeFileChecked(const std::string& file, const std::string& path, const vo
 // afterwards: ENOSPC when its file system has less than 1 MiB left, EFBIG when the file reached
 // the file size limit; 0 otherwise.
 int likelyWriteError(const std::string& file);
+
+// The files GDAL reads beside a GeoTIFF at `path` as part of it that exist, regular files or links
+// (each file once): PATH.aux.xml, PATH.aux, PATH.ovr and PATH.msk, in lower or upper case, beside
+// `path` and beside the file a link there names. Writing a GeoTIFF there takes them away
+// (OutputFiles in hfvis/image_io.hpp).
+std::vector<std::string> geoTiffSideFiles(const std::string& path);
 
 // Flushes an already written file to the disk (fsync), or throws IoError naming `path`.
 void syncFile(const std::string& file, const std::string& path);
