@@ -563,6 +563,15 @@ TEST_F(Cli, TwoOutputsThatAreOneNewFileAreRefused) {
   } else {
     EXPECT_EQ(cased.status, 0) << cased.err;
     EXPECT_EQ(listDirectory(outputs()), (std::vector<std::string>{"H.exr", "h.exr"}));
+    // One of the names there already (an input, an earlier output) is another file: the probe
+    // refused both.
+    const CliResult again = run("horizon " + shellQuoted(field) + " -k 4 -o " + shellQuoted(out("H.exr")) +
+                                " --distance-out " + shellQuoted(out("h.exr")));
+    EXPECT_EQ(again.status, 0) << again.err;
+    fs::copy_file(field, out("in.exr"));
+    const CliResult beside_input =
+        run("svf " + shellQuoted(out("in.exr")) + " -k 4 -o " + shellQuoted(out("IN.exr")));
+    EXPECT_EQ(beside_input.status, 0) << beside_input.err;
   }
 }
 
