@@ -67,7 +67,7 @@ namespace {
 // A city DSM as surveys deliver it (the "city_holes" content): the city with nodata where the
 // sensor saw nothing: a void (a lake, a glass roof: an ellipse), the survey's footprint clipped
 // across one corner, and dropouts of 1 - 3 x 1 - 3 pixels, mostly at the foot of walls (the
-// shadows of tall buildings), about 1.5 % of the field. Fixed seed.
+// shadows of tall buildings; about 1.5 % of the field, all the holes about 6 %). Fixed seed.
 void punchHoles(HeightField& f) {
   const int w = f.width, h = f.height;
   const float nodata = std::numeric_limits<float>::quiet_NaN();
