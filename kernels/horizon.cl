@@ -1150,16 +1150,18 @@ HFVIS_INLINE float row_ground_at(__global const float* row_length, int height, f
 // inside each step, the
 // one loop it vectorises (the march ran 5x faster that way on PoCL); samples past a
 // pixel's own exit are masked; with a maximum distance the march ends after `max_steps`
-// (else INT_MAX). With HFVIS_ROW_SPACING the ray is straight in pixels and its ground length
-// is summed step by step, a maximum distance is `max_ground` of it (INFINITY for none; then
+// (else INT_MAX) and takes the surface at the distance itself, `max_reach` pixels along the ray
+// (INFINITY for none), as the sweep does (between the last step and the first beyond it the
+// surface may rise toward a wall out of reach). With HFVIS_ROW_SPACING the ray is straight in pixels and its
+// ground length is summed step by step, a maximum distance is `max_ground` of it (INFINITY for none; then
 // max_steps is INT_MAX), row_length[r] is the ground length per pixel along it at row r,
 // row_terms[r] its unit ground direction, weight and swath there, and drop is per ground unit
 // squared. Global size: (W, H) rounded up to the local size (the tile).
 __kernel void horizon_naive(__global const float* heights, int width, int height, float dir_x, float dir_y,
                             float step_length, float ground_per_pixel, float drop, int max_steps,
-                            float max_ground, __global const float* row_length, __global const float4* row_terms,
-                            float cos_azimuth, float sin_azimuth, float weight, float swath, uint plane,
-                            __global const float2* normals,
+                            float max_reach, float max_ground, __global const float* row_length,
+                            __global const float4* row_terms, float cos_azimuth, float sin_azimuth,
+                            float weight, float swath, uint plane, __global const float2* normals,
                             __global float* angles, __global float* distances, __global float* svf_sum,
                             __global float* ao_sum HFVIS_ENV_PARAMS) {
   int c = get_global_id(0), r = get_global_id(1);
@@ -1206,12 +1208,33 @@ __kernel void horizon_naive(__global const float* heights, int width, int height
 #endif
     barrier(CLK_LOCAL_MEM_FENCE);
   }
+#if !HFVIS_ROW_SPACING
+  // The surface at the maximum distance itself, the farthest point within it (it wins ties),
+  // where it lies past the last step, inside the field and on the surface. (With per-row
+  // spacing, where the distance is ground length, not taken, as in the sweep.)
+  float best_t = (float)best_step * step_length;
+  if (max_reach > (float)steps * step_length) {
+    const float px = (float)cc + max_reach * dir_x, py = (float)rr + max_reach * dir_y;
+    const float q = px >= 0.0f && px <= (float)(width - 1) && py >= 0.0f && py <= (float)(height - 1)
+                        ? sample_height(heights, width, height, px, py)
+                        : NAN;
+#if HFVIS_CURVATURE
+    const float rise = q - h - drop * max_reach * max_reach;
+#else
+    const float rise = q - h;
+#endif
+    if (!isnan(rise) && (best_step == 0 || rise * best_t >= best_rise * max_reach)) {
+      best_rise = rise, best_t = max_reach;
+      best_step = max(best_step, 1);  // (a sample found: only its being non-zero counts below)
+    }
+  }
+#endif
 #if HFVIS_ROW_SPACING
   const float ground = best_along;
   const float4 terms = row_terms[rr];
   const float cos_az = terms.x, sin_az = terms.y, weight_r = terms.z, swath_r = terms.w;
 #else
-  const float ground = (float)best_step * step_length * ground_per_pixel;
+  const float ground = best_t * ground_per_pixel;
   const float cos_az = cos_azimuth, sin_az = sin_azimuth, weight_r = weight, swath_r = swath;
 #endif
   const float distance = best_step > 0 ? ground : 0.0f;

@@ -294,6 +294,11 @@ void naiveReference(const HeightField& field, const PreparedHeights& prepared, c
         rows ? kAllSteps : stepsWithin(options.max_distance, double(d.step_length) * d.ground_per_pixel);
     const float max_ground = rows && options.max_distance > 0.0 ? static_cast<float>(options.max_distance)
                                                                  : std::numeric_limits<float>::infinity();
+    // Without per-row spacing the march also takes the surface at the maximum distance itself
+    // (horizon_naive's max_reach), where it lies past the last step within it.
+    const float max_reach = !rows && options.max_distance > 0.0
+                                ? static_cast<float>(options.max_distance / d.ground_per_pixel)
+                                : std::numeric_limits<float>::infinity();
     for (int r = 0; r < height; ++r) {
       for (int c = 0; c < width; ++c) {
         const std::size_t pixel = static_cast<std::size_t>(r) * width + c;
@@ -322,8 +327,21 @@ void naiveReference(const HeightField& field, const PreparedHeights& prepared, c
             best_along = along;
           }
         }
-        const float ground =
-            rows ? best_along : static_cast<float>(best_step) * d.step_length * d.ground_per_pixel;
+        float best_t = static_cast<float>(best_step) * d.step_length;
+        if (max_reach < std::numeric_limits<float>::infinity() &&
+            max_reach > static_cast<float>(max_steps) * d.step_length) {
+          const float px = static_cast<float>(c) + max_reach * d.dir_x;
+          const float py = static_cast<float>(r) + max_reach * d.dir_y;
+          if (px >= 0.0f && px <= static_cast<float>(width - 1) && py >= 0.0f &&
+              py <= static_cast<float>(height - 1)) {
+            const float rise = sampleHeight(h, width, height, {px, py}) - hp - drop * max_reach * max_reach;
+            if (!std::isnan(rise) && (best_step == 0 || rise * best_t >= best_rise * max_reach)) {
+              best_rise = rise, best_t = max_reach;
+              best_step = std::max(best_step, 1);
+            }
+          }
+        }
+        const float ground = rows ? best_along : best_t * d.ground_per_pixel;
         const float distance = best_step > 0 ? ground : 0.0f;
         if (rows) {
           out.cos_azimuth = table.terms[4 * r];

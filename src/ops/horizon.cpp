@@ -909,6 +909,9 @@ class HorizonRoutine : public SweepRoutine {
     kernel.set("ground_per_pixel", d.ray.ground_per_pixel);
     kernel.set("drop", curvatureDrop(rayUnit(d.ray.ground_per_pixel)));
     kernel.set("max_steps", d.max_steps);
+    kernel.set("max_reach", !hasRowSpacing(field_) && horizon_.max_distance > 0.0
+                                ? static_cast<float>(horizon_.max_distance / d.ray.ground_per_pixel)
+                                : std::numeric_limits<float>::infinity());
     kernel.set("max_ground", hasRowSpacing(field_) && horizon_.max_distance > 0.0
                                  ? static_cast<float>(horizon_.max_distance)
                                  : std::numeric_limits<float>::infinity());
