@@ -510,9 +510,10 @@ const std::vector<OptionSpec>& optionTable() {
        HFVIS_TEXT(error_output)},
       {"--azimuth-tolerance", nullptr, "DEG", kHorizonGroup, false,
        "the sweep's direction k is the cheapest integer pixel step within\n"
-       "DEG of phi_k (default 0.25; at most 5.72958, 0.1 radian). Smaller\n"
-       "is closer to phi_k and slower: steps with more grid crossings per\n"
-       "pixel",
+       "DEG of phi_k (default 0.25; at most 5.72958, 0.1 radian), the\n"
+       "closest step of up to 64 pixels where none is (the azimuths used:\n"
+       "hfvis:azimuths_deg). Smaller is closer to phi_k and slower: steps\n"
+       "with more grid crossings per pixel",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
          parsePositive(typed, value);
          run.azimuth_tolerance_deg = parseBounded(typed, value, 0.0, kMostAzimuthTolerance,

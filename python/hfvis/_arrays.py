@@ -40,12 +40,22 @@ def nodata_holes(a, nodata):
     if nodata is not None and (isinstance(nodata, (bool, np.bool_)) or
                                not isinstance(nodata, (int, float, np.integer, np.floating))):
         raise InvalidArgumentError(f"nodata must be a real number (or None), got {nodata!r}")
-    if nodata is None or math.isnan(float(nodata)):
+    if nodata is None or isinstance(nodata, (float, np.floating)) and math.isnan(nodata):
         return np.zeros(a.shape, dtype=bool)
+    nowhere = np.zeros(a.shape, dtype=bool)
+    if a.dtype.kind in "iu":
+        # (compared as Python numbers: a nodata beyond int64, 2**70, was numpy's bare OverflowError)
+        if isinstance(nodata, (float, np.floating)) and not float(nodata).is_integer():
+            return nowhere
+        whole = int(nodata)
+        limits = np.iinfo(a.dtype)
+        return nowhere if not limits.min <= whole <= limits.max else np.asarray(a == a.dtype.type(whole))
+    try:
+        value = float(nodata)
+    except OverflowError:  # an integer beyond any float: no height holds it
+        return nowhere
     with np.errstate(over="ignore", invalid="ignore"):
-        typed = np.asarray(nodata).astype(a.dtype)
-    if a.dtype.kind != "f" and float(typed) != float(nodata):
-        return np.zeros(a.shape, dtype=bool)
+        typed = np.asarray(value).astype(a.dtype)
     return np.asarray(a == typed)
 
 
@@ -54,6 +64,15 @@ def float32_may_round(dtype):
     integer exactly only to 2^24, and a double's digits to about 7 (heights near 1e10 lost their
     walls, came out flat, without a word)."""
     return dtype.itemsize > 4 or dtype.kind in "iu" and dtype.itemsize == 4
+
+
+def file_path(path, what):
+    """A file's path (str, bytes or os.PathLike) as the str the library opens; one holding a NUL
+    refused (the library's C string ended there: "dem.tif\\0.exr" opened dem.tif)."""
+    text = os.fsdecode(os.fspath(path))
+    if "\0" in text:
+        raise InvalidArgumentError(f"{what} {text!r} holds a NUL character, which no file name can")
+    return text
 
 
 def as_array(value, what):
@@ -242,8 +261,8 @@ def compute(operation, heights, geometry, options, device="", progress=None):
     if operation == "environment_light":
         environment = options["environment"]
         if isinstance(environment, (str, os.PathLike)):  # (a pathlib.Path was refused as "not a path")
-            env = _core.read_environment_map(os.fspath(environment), float(options["rotation_deg"]),
-                                             int(options["table_rows"]))
+            env = _core.read_environment_map(file_path(environment, "the environment map"),
+                                             float(options["rotation_deg"]), int(options["table_rows"]))
         else:
             radiance = as_array(environment, "environment")
             if radiance.ndim == 2:
@@ -336,9 +355,9 @@ def region_sampling(region, samples, height, absolute):
     array of points, the samples themselves (a missing height is `height`)."""
     a = as_array(region, "a region")
     if a.ndim == 1 and a.shape[0] == 4:
-        if a.dtype.kind not in "iu":
+        if a.dtype.kind not in "iu" or not all(-2**31 <= int(v) < 2**31 for v in a):
             raise InvalidArgumentError(f"a rectangle is four integer pixel corners (col0, row0, col1, row1), "
-                                       f"got {region!r}")
+                                       f"each within -2**31 .. 2**31 - 1, got {region!r}")
         return _core.region_sampling([int(v) for v in a], [], int(samples), float(height), bool(absolute))
     if a.ndim == 2 and a.shape[1] in (2, 3) and len(a) > 0 and a.dtype.kind in "fiu":
         points = [(float(p[0]), float(p[1]), float(p[2]) if len(p) == 3 else float(height)) for p in a]
@@ -377,7 +396,11 @@ def receiver_pixels(receivers):
     if pixels.ndim != 2 or pixels.shape[1] != 2 or pixels.dtype.kind not in "iu" or len(pixels) == 0:
         raise InvalidArgumentError(f"receivers must be an N x 2 array of integer pixels (column, row), N >= 1, "
                                    f"got shape {pixels.shape} and dtype {pixels.dtype}")
-    return pixels[:, 0].tolist(), pixels[:, 1].tolist()
+    cols, rows = pixels[:, 0].tolist(), pixels[:, 1].tolist()
+    for col, row in zip(cols, rows):
+        if not (-2**31 <= col < 2**31 and -2**31 <= row < 2**31):  # (nanobind's bare TypeError)
+            raise InvalidArgumentError(f"receiver {col},{row} lies outside the field")
+    return cols, rows
 
 
 def flipped_pixel(col, row, shape, flips):
@@ -402,7 +425,10 @@ def observer_unflipped(error, shape, flips):
 
 def observer_pixel(observer):
     pair = as_array(observer, "observer")
-    if pair.shape != (2,) or pair.dtype.kind not in "iu" or not all(-2**31 <= int(v) < 2**31 for v in pair):
+    # (a bool is no pixel: numpy made (True, 3) the pixel (1, 3))
+    booleans = isinstance(observer, (tuple, list)) and any(isinstance(v, (bool, np.bool_)) for v in observer)
+    if booleans or pair.shape != (2,) or pair.dtype.kind not in "iu" or \
+            not all(-2**31 <= int(v) < 2**31 for v in pair):
         raise InvalidArgumentError(f"an observer is a pixel (column, row) of two integers, got {observer!r}")
     return int(pair[0]), int(pair[1])
 

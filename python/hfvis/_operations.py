@@ -4,7 +4,6 @@ arguments are named as the C++ library's options (docs/python.md lists them)."""
 
 import collections
 import math
-import os
 import warnings
 
 import numpy as np
@@ -346,6 +345,14 @@ def _real(name, value):
     return float(value)
 
 
+def _flag(name, value):
+    """A yes / no option: True, False (numpy's too) or the integers 1 and 0; anything else refused
+    (bool() took absolute="no" for True)."""
+    if isinstance(value, (bool, np.bool_)) or isinstance(value, (int, np.integer)) and value in (0, 1):
+        return bool(value)
+    raise InvalidArgumentError(f"{name} must be True or False, got {value!r}")
+
+
 def _budget(memory_budget_bytes):
     return _whole("memory_budget_bytes", memory_budget_bytes, 0, 2**63 - 1)
 
@@ -435,6 +442,7 @@ def horizon_angles(heights, *, directions=64, azimuth_offset=0.0, samples_per_un
     HorizonEstimate(values, azimuths, error, directions, estimated_error), the error per pixel in
     radians; a DataArray with the K and the estimate in its attrs (and a Dataset with the per-pixel
     error under error_estimate=True)."""
+    error_estimate = _flag("error_estimate", error_estimate)
     options = _horizon(directions, azimuth_offset, samples_per_unit, curvature, max_distance, memory_budget_bytes,
                        method, azimuth_tolerance, strip_rows)
     common = _common(cell_size, z_scale, nodata, device, progress)
@@ -502,6 +510,7 @@ def ambient_occlusion(heights, *, directions=64, azimuth_offset=0.0, samples_per
 def _swept_quantity(operation, heights, options, max_error, error_estimate, common):
     """The sky-view factor or occlusion; with max_error or error_estimate, the K run and the error
     estimate too, as the CLI's --max-error and --error-out give them."""
+    error_estimate = _flag("error_estimate", error_estimate)
     if not max_error and not error_estimate:
         return _single(operation, operation, heights, options, common)
     heights = _with_estimate(options, heights, max_error, error_estimate)
@@ -535,6 +544,7 @@ def intervisibility(heights, *, directions=64, azimuth_offset=0.0, samples_per_u
     IntervisibilityEstimate(visible_count, visible_area, error, directions, estimated_error); a
     Dataset with the K and the estimate in its variables' attrs (and the per-pixel error as the
     variable "error" under error_estimate=True)."""
+    error_estimate = _flag("error_estimate", error_estimate)
     options = _horizon(directions, azimuth_offset, samples_per_unit, curvature, max_distance, memory_budget_bytes,
                        method, None, strip_rows)
     del options["azimuth_tolerance"]
@@ -560,7 +570,7 @@ def intervisibility(heights, *, directions=64, azimuth_offset=0.0, samples_per_u
 def _sight(absolute, target_height, max_distance, curvature, azimuth_from_deg, azimuth_to_deg, elevation_min_deg,
            elevation_max_deg, memory_budget_bytes):
     """The options a viewshed and a cumulative viewshed share."""
-    return {"absolute": bool(absolute), "target_height": _real("target_height", target_height),
+    return {"absolute": _flag("absolute", absolute), "target_height": _real("target_height", target_height),
             "max_distance": _real("max_distance", max_distance), "curvature": _real("curvature", curvature),
             "azimuth_from_deg": _real("azimuth_from_deg", azimuth_from_deg),
             "azimuth_to_deg": _real("azimuth_to_deg", azimuth_to_deg),
@@ -620,7 +630,8 @@ def insolation(heights, latitude_deg, longitude_deg, start, end, *, step_minutes
                "start": start if isinstance(start, str) else _arrays.utc_seconds(start),
                "end": end if isinstance(end, str) else _arrays.utc_seconds(end),
                "step_minutes": _real("step_minutes", step_minutes), "size_deg": _real("size_deg", size_deg),
-               "azimuth_bucket_deg": _real("azimuth_bucket_deg", azimuth_bucket_deg), "apparent": bool(apparent),
+               "azimuth_bucket_deg": _real("azimuth_bucket_deg", azimuth_bucket_deg),
+               "apparent": _flag("apparent", apparent),
                "samples_per_unit": _real("samples_per_unit", samples_per_unit),
                "curvature": _real("curvature", curvature),
                "max_distance": _real("max_distance", max_distance), "memory_budget_bytes": _budget(memory_budget_bytes)}
@@ -684,10 +695,10 @@ def region_visibility(heights, sources, *, samples=16, height=2.0, absolute=Fals
     "rgb" over "channel" R, G, B): per point the colours of the samples it sees, summed, / S."""
     options = {"sources": sources, "samples": _whole("samples", samples, None, 2**31 - 1),
                "height": _real("height", height),
-               "absolute": bool(absolute),
+               "absolute": _flag("absolute", absolute),
                "target_height": _real("target_height", target_height), "method": method,
                "seed": _whole("seed", seed, 0, 2**32 - 1),
-               "decorrelate": bool(decorrelate), "max_distance": _real("max_distance", max_distance),
+               "decorrelate": _flag("decorrelate", decorrelate), "max_distance": _real("max_distance", max_distance),
                "curvature": _real("curvature", curvature),
                "light_image": light_image}
     if _is_dataarray(heights) and _is_dask(heights.data):
@@ -723,8 +734,8 @@ def region_pair_visibility(heights, sources, receivers, *, samples=16, source_he
     options = {"sources": sources, "receivers": receivers, "samples": _whole("samples", samples, None, 2**31 - 1),
                "source_height": _real("source_height", source_height),
                "receiver_height": _real("receiver_height", receiver_height),
-               "absolute": bool(absolute), "method": method, "seed": _whole("seed", seed, 0, 2**32 - 1),
-               "decorrelate": bool(decorrelate),
+               "absolute": _flag("absolute", absolute), "method": method, "seed": _whole("seed", seed, 0, 2**32 - 1),
+               "decorrelate": _flag("decorrelate", decorrelate),
                "max_distance": _real("max_distance", max_distance), "curvature": _real("curvature", curvature)}
     if _is_dataarray(heights) and _is_dask(heights.data):
         heights = _computed(heights)
@@ -778,7 +789,7 @@ def pvs(heights, *, samples=0, pixel_error=0.0, seconds=0.0, view_cell=32, band_
                "method": method, "batch": _whole("batch", batch, None, 2**31 - 1),
                "seed": _whole("seed", seed, 0, 2**32 - 1), "resolution": _real("resolution", resolution),
                "filter": _real("filter", filter), "view_filter": _whole("view_filter", view_filter, 0, 8),
-               "estimate_entries": int(estimate_entries), "witnesses": bool(witnesses),
+               "estimate_entries": int(estimate_entries), "witnesses": _flag("witnesses", witnesses),
                "memory_budget_bytes": _budget(memory_budget_bytes), "curvature": _real("curvature", curvature),
                "max_distance": _real("max_distance", max_distance),
                "start": None if start is None else np.ascontiguousarray(start, dtype=np.uint32).ravel()}
@@ -872,7 +883,8 @@ def _require_grid_of(radiance, heights):
 def sun_position(time, latitude_deg, longitude_deg, *, apparent=False):
     """Where the sun stands (Meeus 1998, ch. 25): (compass azimuth, elevation) in degrees, at a
     time (ISO 8601 text with a zone, aware datetime, or seconds since 1970) and place."""
-    return _core.sun_position(_arrays.utc_seconds(time), float(latitude_deg), float(longitude_deg), bool(apparent))
+    return _core.sun_position(_arrays.utc_seconds(time), float(latitude_deg), float(longitude_deg),
+                              _flag("apparent", apparent))
 
 
 def devices():
@@ -893,7 +905,8 @@ def read_height_field(path, *, channel=""):
         channel = str(int(channel))
     elif not isinstance(channel, str):
         raise InvalidArgumentError(f"channel is a name or a zero-based index, got {channel!r}")
-    # (os.fspath and fsdecode: a pathlib.Path or bytes path, which str() had written "b'dem.tif'")
-    heights, cx, cy, rows_x, rows_y, transform, wkt = _core.read_height_field(os.fsdecode(os.fspath(path)), channel)
+    # (a pathlib.Path or bytes path as the text it names: str() had written "b'dem.tif'")
+    path = _arrays.file_path(path, "the file")
+    heights, cx, cy, rows_x, rows_y, transform, wkt = _core.read_height_field(path, channel)
     rows = (np.asarray(rows_x), np.asarray(rows_y)) if rows_x else None
     return HeightFieldFile(heights, (cx, cy), rows, None if transform is None else tuple(transform), wkt)

@@ -205,8 +205,11 @@ def _spacing(values, dim, dtype):
     steps = np.diff(values)
     step = (values[-1] - values[0]) / (len(values) - 1)
     # (the coordinates' own rounding allowed for: float32 latitudes of a 3-arc-second grid step
-    # unevenly by 3e-3 of a step, and were refused)
-    rounding = 4 * np.finfo(dtype).eps * float(np.max(np.abs(values))) if dtype.kind == "f" else 0.0
+    # unevenly by 3e-3 of a step, and were refused). Each coordinate rounds by half a unit in the
+    # last place of the largest, or a unit where it was computed as start + i * step, so a step by
+    # two; three allowed. (4 eps times the largest, 4 - 8 units, took float32 northings near 4e6
+    # stepping 1 and 3 for a grid of 2.)
+    rounding = 3 * float(np.spacing(np.max(np.abs(values)).astype(dtype))) if dtype.kind == "f" else 0.0
     if step == 0 or not np.allclose(steps, step, rtol=1e-6, atol=rounding):
         raise InvalidArgumentError(f"the {dim} coordinates are not evenly spaced: hfvis needs a regular grid")
     return step

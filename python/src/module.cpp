@@ -9,11 +9,13 @@
 #include <nanobind/stl/vector.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <utility>
+#include <vector>
 
 #include "hfvis/hfvis.hpp"
 
@@ -72,12 +74,24 @@ std::shared_ptr<SharedContext> contextFor(const std::string& device) {
   return shared;
 }
 
+// The contexts this thread holds: a progress callback that calls hfvis again on the same device
+// would wait for good on the lock its own thread holds (a probe's find: the call hung).
+thread_local std::vector<const SharedContext*> held_here;
+
 // Runs body(context) on the device's context without the GIL.
 template <typename Body>
 auto onDevice(const std::string& device, Body&& body) {
   nb::gil_scoped_release released;
   const std::shared_ptr<SharedContext> shared = contextFor(device);
+  if (std::find(held_here.begin(), held_here.end(), shared.get()) != held_here.end())
+    throw Error(
+        "hfvis was called from within the progress callback of a run on the same device, which "
+        "waits for the callback: call it after the run returns (or on another device)");
   std::lock_guard<std::mutex> lock(shared->running);
+  held_here.push_back(shared.get());
+  struct Release {
+    ~Release() { held_here.pop_back(); }
+  } release;
   return body(shared->context);
 }
 

@@ -80,6 +80,16 @@ def test_bad_heights(bad, kind, words):
     (lambda h: hfvis.bounce(h, np.ones((4, 4), np.float32)), "one value per height"),
     (lambda h: hfvis.bounce(h, -np.ones((24, 20), np.float32)), "radiance"),
     (lambda h: hfvis.bounce(h, np.ones((5, 24, 20), np.float32)), "channel"),
+    # (beyond int32: nanobind's bare TypeError; a bool or "no" as a flag: bool() took them)
+    (lambda h: hfvis.region_visibility(h, np.array([0, 0, 2**40, 3])), "2\\*\\*31"),
+    (lambda h: hfvis.region_pair_visibility(h, (0, 0, 3, 3), np.array([0, 0, 2**63, 3], np.uint64)), "2\\*\\*31"),
+    (lambda h: hfvis.horizon_lists(h, np.array([[2**31, 3]])), "outside"),
+    (lambda h: hfvis.viewshed(h, (True, 3)), "integers"),
+    (lambda h: hfvis.viewshed(h, (3, 3), absolute="no"), "absolute must be True or False"),
+    (lambda h: hfvis.region_visibility(h, (0, 0, 3, 3), decorrelate="yes"), "decorrelate"),
+    (lambda h: hfvis.sky_view_factor(h, directions=8, error_estimate="no"), "error_estimate"),
+    (lambda h: hfvis.sun_position("2026-06-21T12:00Z", 46, 8, apparent=2), "apparent"),
+    (lambda h: hfvis.read_height_field("dem.tif\0.exr"), "NUL"),
 ])
 def test_bad_arguments_are_value_errors(small, call, words):
     before = small.copy()
@@ -87,6 +97,31 @@ def test_bad_arguments_are_value_errors(small, call, words):
         call(small)
     assert isinstance(caught.value, hfvis.InvalidArgumentError)
     np.testing.assert_array_equal(small, before)
+
+
+def test_a_call_from_a_progress_callback_is_refused_not_hung(small):
+    # (the callback runs while its call holds the device: calling hfvis there waited for good)
+    inner = []
+
+    def progress(done, total):
+        with pytest.raises(hfvis.Error, match="progress callback"):
+            hfvis.sky_view_factor(small, directions=4)
+        inner.append(done)
+
+    outer = hfvis.sky_view_factor(small, directions=8, progress=progress)
+    assert inner and np.array_equal(outer, hfvis.sky_view_factor(small, directions=8))
+
+
+def test_a_nodata_no_integer_dtype_holds_marks_nothing(small):
+    heights = (small * 100).astype(np.int16)
+    plain = hfvis.sky_view_factor(heights, directions=4)
+    for nodata in (2**70, -2**70, 2**64 - 1, 1e300, float("inf"), 0.5):  # (2**70: a bare OverflowError)
+        assert np.array_equal(hfvis.sky_view_factor(heights, directions=4, nodata=nodata), plain), nodata
+    heights[3, 4] = 7
+    assert np.isnan(hfvis.sky_view_factor(heights, directions=4, nodata=7.0)[3, 4])
+    assert np.isnan(hfvis.sky_view_factor(heights, directions=4, nodata=np.int64(7))[3, 4])
+    assert np.array_equal(hfvis.sky_view_factor(small, directions=4, nodata=2**1100),
+                          hfvis.sky_view_factor(small, directions=4))
 
 
 def test_region_over_nodata_and_wrong_types(small):
@@ -319,6 +354,15 @@ def test_float32_coordinates_of_a_regular_grid_are_taken():
     uneven[5] += step / 10
     with pytest.raises(hfvis.InvalidArgumentError, match="not evenly spaced"):
         hfvis.sky_view_factor(xr.DataArray(z, dims=("lat", "lon"), coords={"lat": uneven, "lon": lon}), directions=8)
+    # float32 northings near 4e6 (steps of 0.25) stepping 1 and 3 in turn are no grid of 2: the
+    # allowance for their rounding had been about 2 (four float32 epsilons of the largest)
+    north = (4e6 - np.r_[0, np.cumsum(np.where(np.arange(39) % 2, 3.0, 1.0))]).astype(np.float32)
+    east = (5e5 + 2.0 * np.arange(50)).astype(np.float32)
+    with pytest.raises(hfvis.InvalidArgumentError, match="not evenly spaced"):
+        hfvis.sky_view_factor(xr.DataArray(z, dims=("y", "x"), coords={"y": north, "x": east}), directions=8)
+    regular = (4e6 - 2.0 * np.arange(40)).astype(np.float32)
+    assert np.isfinite(hfvis.sky_view_factor(xr.DataArray(z, dims=("y", "x"), coords={"y": regular, "x": east}),
+                                             directions=8).values).all()
 
 
 @pytest.mark.parametrize("call", [
