@@ -38,8 +38,9 @@ constexpr const char* kVisibleConvention =
     "a sample is visible when its slope from the receiver is >= the slope of every sample between them "
     "and of every peak between them, the bilinear surface's highest point above the chord of two "
     "consecutive samples where it rises above it (grazing samples are visible), or when the steepest of them "
-    "hides it only within the heights' rounding (2^-22 of the sum of the heights compared, above the "
-    "field's lowest, and of the highest one's absolute value), as it does every hidden sample between "
+    "hides it only within the heights' rounding (2^-22 of the sum of the heights compared, counted from "
+    "the field's base height, and of the highest one's absolute value), as it does every hidden sample "
+    "between "
     "them (each decision an exact sign)";
 constexpr const char* kHorizonConvention =
     "nearest first; a horizon is the farthest visible sample of its segment (a peak that is a horizon: the "

@@ -13,8 +13,8 @@
 // point the bilinear surface is a quadratic in the first cell, so (h(t) - h0) / t is linear
 // there and its supremum is that limit or the first crossing, which is a sample.
 //
-// Heights arrive offset and z-scaled (h' = (h - lowest) * z_scale) so that tilted planes at
-// large offsets keep their precision; NaN = nodata.
+// Heights arrive offset and z-scaled (h' = (h - base) * z_scale, base the field's heightBase, so
+// h' may be negative) so that tilted planes at large offsets keep their precision; NaN = nodata.
 //
 // Compile-time parameters, besides those of sweep_framework.cl:
 //   HFVIS_WANT_ANGLES, HFVIS_WANT_DISTANCES  write the direction's planes

@@ -119,7 +119,9 @@ TEST_P(HorizonAnalytic, LongWallBeyondTheMaximumDistanceIsNotSeen) {
           EXPECT_NEAR(r.angles[p], on_slope ? std::atan(10.0 * foot / max_distance) : 0.0, 1e-6)
               << c << "," << row;
           EXPECT_LE(r.distances[p], max_distance) << c << "," << row;
-          if (on_slope) EXPECT_NEAR(r.distances[p], max_distance, 1e-4) << c << "," << row;
+          if (on_slope) {
+            EXPECT_NEAR(r.distances[p], max_distance, 1e-4) << c << "," << row;
+          }
         }
       }
     }

@@ -595,8 +595,6 @@ TEST(HorizonKernels, AFieldCutFromALargerOneEqualsItBitForBitInside) {
     for (const char* name : {"nan_holes", "city", "spikes", "noise"}) {
       HeightField whole = makeSyntheticField(name, 61, 53, 4);
       whole.cell_size_x = 1.5;
-      float lowest = INFINITY;
-      for (float v : whole.heights) lowest = std::isfinite(v) ? std::min(lowest, v) : lowest;
       for (int variant = 0; variant < 7; ++variant) {
         const bool rows = variant >= 4;  // then variants 0 .. 2's options again
         if (variant == 4) testing::setRowSpacing(whole);
@@ -615,7 +613,7 @@ TEST(HorizonKernels, AFieldCutFromALargerOneEqualsItBitForBitInside) {
                        "," + std::to_string(y0) + " " + std::to_string(w) + "x" + std::to_string(h));
           HeightField cut = testing::cropField(whole, x0, y0, w, h);
           if (std::all_of(cut.heights.begin(), cut.heights.end(), [](float v) { return std::isnan(v); })) continue;
-          cut.origin = {x0, y0, whole.width, whole.height, double(lowest)};
+          cut.origin = {x0, y0, whole.width, whole.height, heightBase(whole)};
           if (rows) {  // the cut's rows of the larger field's spacing (its centre's cell sizes kept)
             cut.origin.row_cell_size_x = whole.row_cell_size_x;
             cut.origin.row_cell_size_y = whole.row_cell_size_y;
@@ -861,7 +859,9 @@ TEST(HorizonKernels, TheSurfaceAtTheMaximumDistanceCounts) {
           const std::size_t at = std::size_t(2) * w * h + 2 * w + receiver;
           const char* name = method == HorizonMethod::Sweep ? "sweep" : "naive";
           EXPECT_NEAR(r.angles[at], angle, 1e-5) << name << ", D " << distance << ", samples " << samples;
-          if (angle > 0.0) EXPECT_NEAR(r.distances[at], distance, 1e-5) << name << ", D " << distance;
+          if (angle > 0.0) {
+            EXPECT_NEAR(r.distances[at], distance, 1e-5) << name << ", D " << distance;
+          }
         }
   });
 }
@@ -1013,18 +1013,67 @@ TEST(HorizonKernels, APlateauOnAHighCliffStaysFlatInside) {
   });
 }
 
-// An origin that does not place the field inside its larger field, or whose lowest height is not
-// finite or lies above one of the field's heights, is refused.
-TEST(HorizonKernels, AnOriginOutsideItsLargerFieldOrAboveAHeightIsRefused) {
+// One height far below the rest (an undeclared void: -32768, -1e6) costs the others no precision:
+// counted from the lowest, a plane 8848 + 0.001 column was held to steps of 1/16 beside a pixel at
+// -1e6 and its horizon uphill came out up to 5 degrees where it is 0.057 (a probe's find; 0.2
+// degrees beside -32768). Heights now count from the median of a lattice of them (heightBase).
+TEST(HorizonKernels, OneHeightFarBelowTheRestCostsTheOthersNoPrecision) {
+  const int n = 48;
+  HeightField field = makeSyntheticField("flat", n, n);
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) field.heights[std::size_t(y) * n + x] = float(8848.0 + 0.001 * x);
+  EXPECT_EQ(heightBase(field), field.heights[23]);  // the lower of the lattice's two middle heights
+  HorizonOptions options;
+  options.directions = 4;  // direction 0: azimuth 0, along +x, uphill
+  HorizonOutputs outputs;
+  outputs.horizon_angles = true;
+  testing::forEachLayout([&](const ComputeContext& context) {
+    for (const float pit : {-32768.0f, -1e6f}) {
+      field.heights[0] = pit;
+      EXPECT_EQ(heightBase(field), field.heights[23]) << pit;
+      for (HorizonMethod method : {HorizonMethod::Sweep, HorizonMethod::Naive}) {
+        options.method = method;
+        const HorizonResult r = computeHorizons(context, field, options, outputs);
+        double worst = 0.0;
+        for (int y = 4; y < n; ++y)
+          for (int x = 4; x < n - 4; ++x) {
+            // Along the row the surface is linear between grid points: the steepest of them, in
+            // double, on the float32 heights (whose steps of 2^-10 make the plane's slope ragged).
+            const float* row = &field.heights[std::size_t(y) * n];
+            double steepest = -INFINITY;
+            for (int s = x + 1; s < n; ++s)
+              steepest = std::max(steepest, (double(row[s]) - row[x]) / (s - x));
+            worst = std::max(worst, std::fabs(r.angles[std::size_t(y) * n + x] - std::atan(steepest)));
+          }
+        EXPECT_LT(worst, 1e-5) << pit << (method == HorizonMethod::Sweep ? " sweep" : " naive");
+      }
+    }
+  });
+  // The lattice's finite heights only; none finite there: the lowest finite height.
+  HeightField holes = makeSyntheticField("flat", 3, 1);
+  holes.heights = {NAN, 5.0f, 7.0f};
+  EXPECT_EQ(heightBase(holes), 5.0f);
+  holes.heights = {2.0f, NAN, 7.0f, NAN};
+  holes.width = 4;
+  EXPECT_EQ(heightBase(holes), 2.0f);
+  holes.heights = {9.0f, NAN, -3.0f, NAN};  // lattice columns 0 .. 3 all sampled: 9, -3 -> -3
+  EXPECT_EQ(heightBase(holes), -3.0f);
+}
+
+// An origin that does not place the field inside its larger field, or whose base is not finite, is
+// refused; a base among the heights or above them is a base (heights count from it either way).
+TEST(HorizonKernels, AnOriginOutsideItsLargerFieldOrWithoutAFiniteBaseIsRefused) {
   HeightField field = makeSyntheticField("noise", 6, 5, 1);  // heights in [0, 1)
   HorizonOptions options;
   options.directions = 4;
   options.max_distance = 2.0;
-  field.origin = {2, 3, 8, 8, -1.0};
-  EXPECT_NO_THROW(computeHorizons(testContext(), field, options, allOutputs()));
+  for (const double base : {-1.0, 0.5, 7.0}) {
+    field.origin = {2, 3, 8, 8, base};
+    EXPECT_NO_THROW(computeHorizons(testContext(), field, options, allOutputs())) << base;
+  }
   for (FieldOrigin bad :
        {FieldOrigin{3, 3, 8, 8, -1.0}, FieldOrigin{2, 4, 8, 8, -1.0}, FieldOrigin{-1, 0, 8, 8, -1.0},
-        FieldOrigin{0, 0, 5, 0, -1.0}, FieldOrigin{2, 3, 8, 8, 0.5}, FieldOrigin{2, 3, 8, 8, NAN},
+        FieldOrigin{0, 0, 5, 0, -1.0}, FieldOrigin{2, 3, 8, 8, INFINITY}, FieldOrigin{2, 3, 8, 8, NAN},
         FieldOrigin{2, 3, 8, 8, -1.0, std::vector<double>(8, 1.0), std::vector<double>(8, 1.0)}}) {
     field.origin = bad;
     EXPECT_THROW(computeHorizons(testContext(), field, options, allOutputs()), InvalidArgument);

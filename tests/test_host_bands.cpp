@@ -74,11 +74,11 @@ TEST(HostBands, PreparedHeightsAreThoseOfOnePass) {
   field.heights[1601 * 700 + 3] = std::numeric_limits<float>::quiet_NaN();
   field.heights[1601 * 1300] = std::numeric_limits<float>::infinity();
   field.z_scale = 1.7;
-  for (const auto origin : {detail::HeightOrigin::Zero, detail::HeightOrigin::Lowest})
+  for (const auto origin : {detail::HeightOrigin::Zero, detail::HeightOrigin::Base})
     for (const int bands : {0, 1, 3, 7}) {
       SCOPED_TRACE(std::to_string(bands) + " bands");
       const detail::PreparedHeights p = detail::prepareHeights(field, origin, bands);
-      const double base = origin == detail::HeightOrigin::Lowest ? -900.0 : 0.0;
+      const double base = origin == detail::HeightOrigin::Base ? heightBase(field) : 0.0;
       ASSERT_EQ(p.heights.size(), field.heights.size());
       EXPECT_TRUE(p.has_nodata);
       std::size_t differing = 0;

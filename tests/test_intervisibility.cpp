@@ -1049,7 +1049,7 @@ TEST(IntervisibilityAnalytic, EveryPointOfATiltedPlaneSeesEveryOther) {
                           {"both axes, below zero", -50.0f, 0.75f, -1.3f},
                           {"steep, far from zero", 8848.0f, -40.0f, 17.0f},
                           // float32 rounds these at 500 and 1000, a spacing near the rise per cell
-                          // less the field's lowest
+                          // (counted from the field's base, the same spacing or less)
                           {"gentle, far from zero", 500.0f, 0.1f, 0.0f},
                           {"half a per mille, far from zero", 1000.0f, 0.0f, 0.005f}};
   HeightField flat = makeSyntheticField("flat", w, h);
@@ -1091,31 +1091,33 @@ TEST(IntervisibilityAnalytic, EveryPointOfATiltedPlaneSeesEveryOther) {
 }
 
 // What the rounding's tolerance must not forgive: a wall of 2 cm on a plane at 100 hides what is
-// behind it, also where one pixel far away (an unflagged -9999) moves the field's lowest (the
-// heights above it, about 10 100, are then rounded to about a millimetre, and the tolerance is a
-// few of those: an earlier one, 2^-18 of their sum, made a 5 cm wall transparent), and on a
+// behind it, also where the heights are counted from far below (a base of -9999: a Dask chunk's
+// origin may hold any base; the heights, about 10 100 above it, are then rounded to about a
+// millimetre, and the tolerance is a few of those: an earlier one, 2^-18 of their sum, made a
+// 5 cm wall transparent; counted from the lowest, one unflagged -9999 pixel did that), and on a
 // tilted plane; in both layouts.
-TEST(IntervisibilityAnalytic, AWallOfTwoCentimetresHidesWhateverTheFieldsLowest) {
+TEST(IntervisibilityAnalytic, AWallOfTwoCentimetresHidesWhateverTheBase) {
   testing::forEachLayout([&](const ComputeContext& context) {
     for (float tilt : {0.0f, 0.1f}) {
-      for (bool pit : {false, true}) {
+      for (bool far_base : {false, true}) {
         for (auto method : {IntervisibilityMethod::HullTree, IntervisibilityMethod::Naive}) {
           SCOPED_TRACE(std::string(method == IntervisibilityMethod::Naive ? "naive" : "tree") + ", tilt " +
-                       std::to_string(tilt) + (pit ? ", a pixel at -9999" : ""));
+                       std::to_string(tilt) + (far_base ? ", counted from -9999" : ""));
           const int w = 64, h = 16;
           std::vector<float> open(static_cast<std::size_t>(w) * h);
           for (int r = 0; r < h; ++r)
             for (int c = 0; c < w; ++c) open[static_cast<std::size_t>(r) * w + c] = 100.0f + tilt * float(c);
-          if (pit) open.back() = -9999.0f;
           std::vector<float> walled = open;
           for (int r = 0; r < h; ++r) walled[static_cast<std::size_t>(r) * w + 32] += 0.02f;
+          HeightField plain = fieldFrom(w, h, open), wall = fieldFrom(w, h, walled);
+          if (far_base) plain.origin = wall.origin = {0, 0, w, h, -9999.0};  // (its own larger field)
           IntervisibilityOptions options;
           options.directions = 8;
           options.method = method;
           IntervisibilityOutputs outputs;
           outputs.visible_count = true;
-          const auto without = computeIntervisibility(context, fieldFrom(w, h, open), options, outputs);
-          const auto with = computeIntervisibility(context, fieldFrom(w, h, walled), options, outputs);
+          const auto without = computeIntervisibility(context, plain, options, outputs);
+          const auto with = computeIntervisibility(context, wall, options, outputs);
           const std::size_t before_wall = static_cast<std::size_t>(8) * w + 10;
           EXPECT_LT(with.visible_count[before_wall] + 20.0f, without.visible_count[before_wall]);
         }

@@ -38,7 +38,7 @@ class Intervisibility : public Computation {
         "a sample is visible when its slope from the receiver is >= the slope of every "
         "sample between them (grazing samples are visible), or when the steepest of them "
         "hides it only within the heights' rounding (2^-22 of the sum of the heights compared, "
-        "above the field's lowest, and of the highest one's absolute value), as it does every "
+        "counted from the field's base height, and of the highest one's absolute value), as it does every "
         "hidden sample between them; each decision an exact sign");
     // The K run, which --max-error chooses, and the error estimate when there is one.
     for (auto& [name, value] : attributes)

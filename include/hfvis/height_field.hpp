@@ -26,7 +26,7 @@ struct Georeference {
 // Where a field lies within a larger one it was cut from: a tile or a chunk computed apart, with
 // a halo around the part whose results are kept (hfvis's Python package does so for Dask
 // arrays). The horizon sweep then places every line's positions as along the larger field's
-// lines and takes the larger field's lowest height as the heights' base, so that a pixel's
+// lines and takes the larger field's base (heightBase) as the heights' base, so that a pixel's
 // horizon, sky-view factor, occlusion and sun are the larger field's bit for bit wherever its
 // maximum distance (and the bilinear cell and normal beyond it) lies inside this field: a
 // pixel's samples and the cut at the maximum distance fall where they fall in the larger field.
@@ -37,7 +37,7 @@ struct Georeference {
 struct FieldOrigin {
   int col = 0, row = 0;                  // this field's pixel (0, 0) in the larger field
   int whole_width = 0, whole_height = 0;  // the larger field's size; 0 x 0: no larger field
-  double lowest = 0.0;                    // the larger field's lowest finite height (before z_scale)
+  double base = 0.0;                      // the larger field's heightBase() (before z_scale)
   // With per-row spacing: the larger field's per-row cell sizes (whole_height each), whose rows
   // [row, row + height) are this field's; empty without per-row spacing.
   std::vector<double> row_cell_size_x, row_cell_size_y;
@@ -99,11 +99,21 @@ bool cellSizesHeld(const HeightField& field);
 // 2.4e-4 as a float32 one is, passes).
 void requireHeightsKeptInFloat32(double rounding, double lowest, double highest, double cell_size);
 
+// The height the sweeps count a field's heights from on the device (before z_scale): the median
+// of the finite heights at up to 64 x 64 pixels spread evenly over it (rows (2 i + 1) H / (2 n),
+// i < n = min(H, 64), and columns likewise, in integers; the lower of the two middle ones), or
+// the lowest finite height
+// where none of those is finite. Float32 holds a height counted from it to the spacing at its
+// distance from it: counted from the lowest, one height far below the rest (an undeclared void of
+// -32768 or -1e6) held every other to steps of 1/16 near 8848 and horizons came out degrees off.
+// A field cut from a larger one takes the larger one's (FieldOrigin::base).
+double heightBase(const HeightField& field);
+
 // Throws InvalidArgument when the field is empty, its sizes disagree, a cell size (per-row
 // ones included, one per row) is not finite or outside kLeastCellSize .. kMostCellSize, the
 // z-scale is not finite and positive, every height is
-// nodata, or an origin does not place it inside its larger field or gives a lowest height that
-// is not finite or above one of its heights.
+// nodata, or an origin does not place it inside its larger field or gives a base that is not
+// finite.
 void validate(const HeightField& field);
 
 }  // namespace hfvis

@@ -108,9 +108,11 @@ HFVIS_INLINE int chord_side(float ha, float hb, float hc, float dab, float dbc) 
 // last place still hides). Exact on those shifted heights, so every
 // implementation takes the same decision.
 // Sums, not the largest of the three (compares and selects made the hull tree 25 % slower on
-// a city of blocks); the absolute value taken is the highest height's (heights above the field's
-// lowest rise with their absolute values): with each height's own, PoCL no longer vectorised the
-// naive march's loop (4x slower).
+// a city of blocks); the absolute height taken is the highest one's (the base added back: the
+// heights are counted from the field's base, either sign, and the highest of three has the
+// largest absolute height unless all lie below 0, where the three shifted ones' own absolute
+// values still hold it): with each height's own, PoCL no longer vectorised the naive march's loop
+// (4x slower).
 HFVIS_INLINE float rounding_forgiven(float ha, float hb, float hc, float base) {
   const float highest = ha > hb ? (ha > hc ? ha : hc) : (hb > hc ? hb : hc);
   return 0x1p-22f * (fabs(ha) + fabs(hb) + fabs(hc) + fabs(highest + base));

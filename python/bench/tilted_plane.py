@@ -6,7 +6,7 @@ another's sight lines; the visible counts, the viewshed and region visibility fo
 rounding (docs/ALGORITHMS.md, "Grazing samples and the heights' rounding"). A second table shows
 what the tolerance also takes as ties: the Earth's drop between neighbouring samples on tilted
 planes, and sub-millimetre noise on a field at 1000 m (with and without one pixel at 0, which
-moves the heights above the field's lowest). A third gives the viewshed and a region pair with
+moved the heights a thousand metres above the base while the base was the lowest height). A third gives the viewshed and a region pair with
 both ends on the surface (heights 0) on planes at 8848 m and far from 0, and on the same plane with
 a wall of 2 cm (still hiding). A fourth shows the price of that tolerance: a sight line that
 grazes a wall top beside the eye forgives it by a few units in the last place there, which lets a

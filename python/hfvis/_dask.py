@@ -32,13 +32,21 @@ def halo(geometry, max_distance, operation):
     return int(math.ceil(max_distance / min(sizes))) + SURFACE_PIXELS
 
 
-def _block(block, lowest, operation, geometry, options, device, depth, chunks, block_id=None):
+def _base_of(sample, lowest):
+    """The library's heightBase from its lattice of heights (`sample`) and the whole field's lowest
+    finite height: the lower of the lattice's two middle finite heights, else the lowest."""
+    finite = np.sort(sample[np.isfinite(sample)], kind="stable")
+    base = finite[(finite.size - 1) // 2] if finite.size else lowest.flat[0]
+    return np.full((1, 1), base, np.float64)
+
+
+def _block(block, base, operation, geometry, options, device, depth, chunks, block_id=None):
     """One chunk with its halo (overlap, boundary 'none': no halo beyond the field's own edges,
     which stay edges) -> its planes, the halo trimmed, stacked along a leading axis. The library is
-    told where the block lies in the whole field and the whole field's lowest height (`lowest`, a
-    1 x 1 block; HeightField::origin), so that it samples every line where the whole field's run does: the
-    results inside the halo are that run's bit for bit."""
-    if not math.isfinite(float(lowest.flat[0])):  # (as the whole field in memory is refused)
+    told where the block lies in the whole field and the whole field's base height (`base`, a 1 x 1
+    block; HeightField::origin), so that it samples every line where the whole field's run does
+    and holds the same floats: the results inside the halo are that run's bit for bit."""
+    if not math.isfinite(float(base.flat[0])):  # (as the whole field in memory is refused)
         raise InvalidArgumentError("every height is nodata (NaN or infinite)")
     i, j = block_id[-2], block_id[-1]
     top = depth if i > 0 else 0
@@ -48,7 +56,7 @@ def _block(block, lowest, operation, geometry, options, device, depth, chunks, b
     first_row = sum(chunks[0][:i]) - top
     first_col = sum(chunks[1][:j]) - left
     g = dict(geometry)
-    g["origin"] = [first_col, first_row, sum(chunks[1]), sum(chunks[0]), float(lowest.flat[0])]
+    g["origin"] = [first_col, first_row, sum(chunks[1]), sum(chunks[0]), float(base.flat[0])]
     if g["row_cell_size_x"]:  # a latitude / longitude grid: the block's own rows' spacing, and the
         # whole field's rows, along which positions are counted
         g["origin_row_cell_size_x"] = g["row_cell_size_x"]
@@ -87,7 +95,7 @@ def kept_in_float32(data, nodata, cell_size):
     """The Dask array `data` of a dtype float32 may round (_arrays.float32_may_round) as float32,
     `nodata` as NaN, each block refused, as heights_array refuses an array in memory, where float32
     rounds the whole field's heights too far: lazily, the field's largest rounding and its range
-    are reductions that every block takes (as the lowest height in chunked)."""
+    are reductions that every block takes (as the base height in chunked)."""
     import dask.array as da
 
     wide = data.astype(np.float64)
@@ -121,12 +129,16 @@ def chunked(operation, heights, geometry, options, device=""):
     # the array, as for a field 30 rows high with a halo of 52)
     overlapped = da.overlap.overlap(heights, depth={a: depth if len(chunks[a]) > 1 else 0 for a in (0, 1)},
                                     boundary="none")
-    # The whole field's lowest height, the base of every block's heights: a reduction, handed to
-    # each block as a 1 x 1 block of its own (infinite where every height is nodata, and then no
-    # block reads it).
-    lowest = da.where(da.isfinite(heights), heights, np.float32(np.inf)).min()
-    lowest = da.broadcast_to(lowest, overlapped.numblocks, chunks=1)
-    stacked = da.map_blocks(body, overlapped, lowest, dtype=np.float32, new_axis=0,
+    # The whole field's base (the library's heightBase: the median of the finite heights at up to
+    # 64 x 64 pixels spread evenly over it, else its lowest finite height), the base of every
+    # block's heights: handed to each block as a 1 x 1 block of its own (infinite where every
+    # height is nodata, and then no block reads it).
+    rows, cols = ((2 * np.arange(min(n, 64)) + 1) * n // (2 * min(n, 64)) for n in heights.shape)
+    sample = heights[rows, :][:, cols].rechunk(-1)
+    lowest = da.where(da.isfinite(heights), heights, np.float32(np.inf)).min().reshape(1, 1)
+    base = da.map_blocks(_base_of, sample, lowest, chunks=((1,), (1,)), dtype=np.float64)
+    base = da.broadcast_to(base[0, 0], overlapped.numblocks, chunks=1)
+    stacked = da.map_blocks(body, overlapped, base, dtype=np.float32, new_axis=0,
                             chunks=((len(names) * planes,),) + chunks, meta=np.empty((0, 0, 0), np.float32))
     out = {}
     for n, name in enumerate(names):

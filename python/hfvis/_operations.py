@@ -346,9 +346,10 @@ def _real(name, value):
 
 
 def _flag(name, value):
-    """A yes / no option: True, False (numpy's too) or the integers 1 and 0; anything else refused
-    (bool() took absolute="no" for True)."""
-    if isinstance(value, (bool, np.bool_)) or isinstance(value, (int, np.integer)) and value in (0, 1):
+    """A yes / no option: True or False, numpy's too (a 0-d array among them), or the integers 1
+    and 0; anything else refused (bool() took absolute="no" for True)."""
+    kind = np.asarray(value).dtype.kind if isinstance(value, (bool, int, np.generic, np.ndarray)) else ""
+    if np.ndim(value) == 0 and (kind == "b" or kind in "iu" and kind and value in (0, 1)):
         return bool(value)
     raise InvalidArgumentError(f"{name} must be True or False, got {value!r}")
 

@@ -139,11 +139,11 @@ HeightField makeField(Heights heights, double cell_size_x, double cell_size_y,
   field.row_cell_size_y = std::move(row_cell_size_y);
   field.z_scale = z_scale;
   // Empty, or where the field lies in a larger one (a Dask chunk with its halo): column, row,
-  // the larger field's width and height and its lowest height, and with per-row spacing its rows'
-  // cell sizes (HeightField::origin).
+  // the larger field's width and height and its base (heightBase: python/hfvis/_dask.py computes
+  // the same), and with per-row spacing its rows' cell sizes (HeightField::origin).
   if (!origin.empty()) {
     if (origin.size() != 5)
-      throw InvalidArgument("origin must be (col, row, whole_width, whole_height, lowest)");
+      throw InvalidArgument("origin must be (col, row, whole_width, whole_height, base)");
     field.origin = {static_cast<int>(origin[0]),
                     static_cast<int>(origin[1]),
                     static_cast<int>(origin[2]),

@@ -47,7 +47,7 @@ def _random_chunks(rng, total):
     return sizes
 
 
-# Each block is told where it lies in the whole field and the whole field's lowest height
+# Each block is told where it lies in the whole field and the whole field's base height
 # (HeightField::origin), so the sweep samples and cuts every line where the in-memory run does.
 EXACT = {
     "intervisibility": lambda a: hfvis.intervisibility(a, directions=8, max_distance=MAX_DISTANCE),
@@ -88,8 +88,24 @@ def test_chunked_equals_in_memory_bit_for_bit(field, operation):
                 np.testing.assert_array_equal(got[name], coord)
 
 
+def test_a_height_far_below_the_rest_moves_nothing_beyond_its_reach(field):
+    """An undeclared void of -1e6 at a corner: the heights count from the median of a lattice of
+    them (the library's heightBase, which the chunks are told), not from the lowest, which held
+    every other height to steps of 1/16: beyond the void's reach the result is the one without it,
+    bit for bit, chunked as in memory."""
+    pitted = field.copy()
+    pitted.values[0, 0] = -1e6  # (not on the lattice: the base stays the field's)
+    plain = hfvis.sky_view_factor(field, directions=8, max_distance=MAX_DISTANCE).values
+    whole = hfvis.sky_view_factor(pitted, directions=8, max_distance=MAX_DISTANCE).values
+    reach = 13  # the halo's 12 pixels and the cell beyond
+    assert np.array_equal(whole[reach:, reach:], plain[reach:, reach:], equal_nan=True)
+    assert whole[0, 0] < plain[0, 0]  # (the void is there: a well a million deep at the corner)
+    chunked = hfvis.sky_view_factor(pitted.chunk({"y": 37, "x": 53}), directions=8, max_distance=MAX_DISTANCE)
+    assert np.array_equal(chunked.values, whole, equal_nan=True)
+
+
 def test_infinite_heights_are_nodata_as_in_memory(field):
-    """+-inf are nodata (as NaN): the base of every block's heights is the lowest finite one."""
+    """+-inf are nodata (as NaN): the base of every block's heights is taken from finite ones."""
     holes = field.copy()
     holes.values[10, 10] = -np.inf
     holes.values[100, 150] = np.inf

@@ -3,8 +3,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdio>
+#include <limits>
 #include <string>
+#include <vector>
 
 #include "core/number_text.hpp"
 #include "hfvis/errors.hpp"
@@ -37,6 +40,28 @@ void requireHeightsKeptInFloat32(double rounding, double lowest, double highest,
                           shortNumber(rounding) +
                           ", more than a thousandth of their range and a hundredth of a cell: subtract a "
                           "constant from them first");
+}
+
+double heightBase(const HeightField& field) {
+  const long rows = std::min(field.height, 64), cols = std::min(field.width, 64);
+  std::vector<float> sample;
+  sample.reserve(static_cast<std::size_t>(rows * cols));
+  for (long i = 0; i < rows; ++i) {
+    const std::size_t row = static_cast<std::size_t>((2 * i + 1) * field.height / (2 * rows));
+    for (long j = 0; j < cols; ++j) {
+      const std::size_t col = static_cast<std::size_t>((2 * j + 1) * field.width / (2 * cols));
+      const float h = field.heights[row * static_cast<std::size_t>(field.width) + col];
+      if (std::isfinite(h)) sample.push_back(h);
+    }
+  }
+  if (sample.empty()) {
+    float lowest = std::numeric_limits<float>::infinity();
+    for (const float h : field.heights) lowest = std::isfinite(h) ? std::min(lowest, h) : lowest;
+    return lowest;
+  }
+  const auto middle = sample.begin() + static_cast<std::ptrdiff_t>((sample.size() - 1) / 2);
+  std::nth_element(sample.begin(), middle, sample.end());
+  return *middle;
 }
 
 void validate(const HeightField& field) {
@@ -86,11 +111,8 @@ void validate(const HeightField& field) {
                             std::to_string(o.row) + "), not inside its larger field of " +
                             std::to_string(o.whole_width) + " x " + std::to_string(o.whole_height));
     }
-    bool above = std::isfinite(o.lowest);
-    for (float h : field.heights) above = above && !(std::isfinite(h) && double(h) < o.lowest);
-    if (!above)
-      throw InvalidArgument("the origin's lowest height (" + shortNumber(o.lowest) +
-                            ") must be finite and at most every height of the field");
+    if (!std::isfinite(o.base))
+      throw InvalidArgument("the origin's base height (" + shortNumber(o.base) + ") must be finite");
     // With per-row spacing the larger field's rows, this field's among them; none without.
     const bool rows = !field.row_cell_size_x.empty();
     const std::size_t whole_rows = rows ? static_cast<std::size_t>(o.whole_height) : 0;

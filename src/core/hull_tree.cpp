@@ -252,7 +252,7 @@ void checkStepLimits(std::size_t longest, const std::vector<float>& prepared_hei
     throw InvalidArgument("a sweep line would have " + std::to_string(longest) +
                           " samples; at most 2^24 are supported: lower the samples per unit");
   }
-  float highest = 0.0f;  // prepared heights are >= 0 (offset by the lowest one)
+  float highest = 0.0f;  // the largest |prepared height| (counted from the base: either sign)
   for (float h : prepared_heights)
     if (!std::isnan(h)) highest = std::max(highest, std::fabs(h));
   if (!(static_cast<double>(highest) * 4.0 * static_cast<double>(longest) < 1e37)) {

@@ -106,14 +106,16 @@ PreparedHeights prepareHeights(const HeightField& field, HeightOrigin origin, in
   for (int b = 0; b < bands; ++b)
     if (band_lowest[b] <= band_highest[b])
       lowest = std::min(lowest, double(band_lowest[b])), highest = std::max(highest, double(band_highest[b]));
-  // A field cut from a larger one takes that one's base, so that its heights are the same floats.
-  if (field.origin.present()) lowest = field.origin.lowest;
+  // (a field cut from a larger one takes that one's base, so that its heights are the same floats)
+  const double base = origin == HeightOrigin::Zero ? 0.0  // h - 0.0 is h exactly
+                      : field.origin.present()     ? field.origin.base
+                                                   : heightBase(field);
   // The kernels multiply height differences by distances in float: keep the products finite.
-  if (origin == HeightOrigin::Lowest && highest >= lowest &&
-      (highest - lowest) * field.z_scale > kMaxPreparedHeight) {
+  const double rise = std::max(highest, base) - std::min(lowest, base);
+  if (origin == HeightOrigin::Base && highest >= lowest && rise * field.z_scale > kMaxPreparedHeight) {
     std::ostringstream message;
-    message << "the heights span " << lowest << " .. " << highest << ", a rise of "
-            << (highest - lowest) * field.z_scale << " with the z-scale " << field.z_scale
+    message << "the heights span " << lowest << " .. " << highest << " (counted from " << base
+            << "), a rise of " << rise * field.z_scale << " with the z-scale " << field.z_scale
             << ": more than the " << kMaxPreparedHeight << " the kernels' float arithmetic holds";
     throw InvalidArgument(message.str());
   }
@@ -149,9 +151,8 @@ PreparedHeights prepareHeights(const HeightField& field, HeightOrigin origin, in
       throw InvalidArgument(message.str());
     }
   }
-  const double base = origin == HeightOrigin::Lowest ? lowest : 0.0;  // h - 0.0 is h exactly
   PreparedHeights prepared;
-  if (base != std::numeric_limits<double>::max()) prepared.base = static_cast<float>(base * field.z_scale);
+  if (std::isfinite(base)) prepared.base = static_cast<float>(base * field.z_scale);  // (none: no height is)
   prepared.heights.resize(count);
   std::vector<char> band_nodata(bands, 0);
   const double z_scale = field.z_scale;

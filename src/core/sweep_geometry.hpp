@@ -86,9 +86,10 @@ inline float bilinearBesideNodata(float h00, float h10, float h01, float h11, fl
 
 float sampleHeight(const std::vector<float>& heights, int width, int height, Point2 p);
 
-// Heights as the kernels see them: (h - lowest finite height) * z_scale in float, so that
-// a plane at 8848 m keeps its millimetres (a field with an origin takes its larger field's
-// lowest); every non-finite height becomes NaN. Throws InvalidArgument when a prepared height
+// Heights as the kernels see them: (h - heightBase(field)) * z_scale in float, so that a plane
+// at 8848 m keeps its millimetres, a pixel far below the rest or not (a field with an origin
+// takes its larger field's base; prepared heights may be negative); every non-finite height
+// becomes NaN. Throws InvalidArgument when a prepared height
 // would exceed kMaxPreparedHeight: the kernels multiply height differences by distances (up to
 // 2^31 pixels) and square them (the sky-view factor's and occlusion's terms) in float, which
 // must stay finite (a cliff of 2e19 gave a sky-view factor of 1 at its foot, exit 0, when the
@@ -105,15 +106,15 @@ struct PreparedHeights {
   // are), as prepareHeights sets them (a routine preparing heights of its own, as the bounce's,
   // leaves them so: only the region operation reads them, from prepareHeights).
   float lowest = std::numeric_limits<float>::infinity(), highest = -std::numeric_limits<float>::infinity();
-  // The z-scaled height that `heights` hold as 0 (the shift: the lowest finite height, or the
-  // base of the field this one was cut from; 0 from HeightOrigin::Zero). The visibility tie rule
+  // The z-scaled height that `heights` hold as 0 (the shift: heightBase, or the base of the
+  // field this one was cut from; 0 from HeightOrigin::Zero). The visibility tie rule
   // forgives the rounding of heights at their absolute value, prepared height + base.
   float base = 0.0f;
 };
-enum class HeightOrigin { Lowest, Zero };
+enum class HeightOrigin { Base, Zero };
 // `bands`: the bands of rows it runs in (core/host_bands.hpp); 0, bandsFor's (tests give others:
 // the result is the same for any).
-PreparedHeights prepareHeights(const HeightField& field, HeightOrigin origin = HeightOrigin::Lowest,
+PreparedHeights prepareHeights(const HeightField& field, HeightOrigin origin = HeightOrigin::Base,
                                int bands = 0);
 
 // The kernels index pixels with 32-bit arithmetic: signed within a plane, unsigned across the
