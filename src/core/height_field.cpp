@@ -43,7 +43,9 @@ void requireHeightsKeptInFloat32(double rounding, double lowest, double highest,
 }
 
 double heightBase(const HeightField& field) {
-  const long rows = std::min(field.height, 64), cols = std::min(field.width, 64);
+  // (a field whose heights are not width x height, which validate refuses, samples nothing)
+  const bool sized = field.heights.size() == field.pixelCount();
+  const long rows = sized ? std::min(field.height, 64) : 0, cols = std::min(field.width, 64);
   std::vector<float> sample;
   sample.reserve(static_cast<std::size_t>(rows * cols));
   for (long i = 0; i < rows; ++i) {
