@@ -1152,11 +1152,11 @@ HFVIS_INLINE float row_ground_at(__global const float* row_length, int height, f
 // pixel's own exit are masked; with a maximum distance the march ends after `max_steps`
 // (else INT_MAX) and takes the surface at the distance itself, `max_reach` pixels along the ray
 // (INFINITY for none), as the sweep does (between the last step and the first beyond it the
-// surface may rise toward a wall out of reach). With HFVIS_ROW_SPACING the ray is straight in pixels and its
-// ground length is summed step by step, a maximum distance is `max_ground` of it (INFINITY for none; then
-// max_steps is INT_MAX), row_length[r] is the ground length per pixel along it at row r,
-// row_terms[r] its unit ground direction, weight and swath there, and drop is per ground unit
-// squared. Global size: (W, H) rounded up to the local size (the tile).
+// surface may rise toward a wall out of reach). With HFVIS_ROW_SPACING the ray is straight in
+// pixels and its ground length is summed step by step, a maximum distance is `max_ground` of it
+// (INFINITY for none; then max_steps is INT_MAX), row_length[r] is the ground length per pixel
+// along it at row r, row_terms[r] its unit ground direction, weight and swath there, and drop is
+// per ground unit squared. Global size: (W, H) rounded up to the local size (the tile).
 __kernel void horizon_naive(__global const float* heights, int width, int height, float dir_x, float dir_y,
                             float step_length, float ground_per_pixel, float drop, int max_steps,
                             float max_reach, float max_ground, __global const float* row_length,

@@ -17,11 +17,10 @@
 // between them (grazing samples are visible; on a flat plane every sample is). The samples'
 // rounding is forgiven: a hidden q is visible too where the steepest sample (or peak) between
 // hides it only within that rounding (2^-22 of the sum of the heights compared, counted from the
-// field's heightBase, and of the highest one's absolute value), as it does every hidden sample between them,
-// so on a tilted plane every sample is visible as well (docs/ALGORITHMS.md, "Grazing samples and
-// the heights' rounding"). Every decision is an exact
-// sign, so the sweep, the naive march and brute force agree sample for sample on identical
-// samples.
+// field's heightBase, and of the highest one's absolute value), as it does every hidden sample
+// between them, so on a tilted plane every sample is visible as well (docs/ALGORITHMS.md,
+// "Grazing samples and the heights' rounding"). Every decision is an exact sign, so the sweep,
+// the naive march and brute force agree sample for sample on identical samples.
 #pragma once
 
 #include <cstdint>
