@@ -15,8 +15,10 @@
 #include <sstream>
 #include <system_error>
 
+#include "core/number_text.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/horizon.hpp"
+#include "io/gdal_io.hpp"
 #include "io/output_files.hpp"
 
 namespace hfvis::cli {
@@ -385,6 +387,16 @@ HeightField readValidField(const RunArguments& run) {
     // hold: --cell-size gives another.
     throw Error(run.input + ": " + error.what() +
                 (cellSizesHeld(field) ? "" : "; give one with --cell-size"));
+  }
+  // The Earth's drop takes distances in metres: cells of a CRS in feet counted as metres made it
+  // 3.28 times too small, exit 0 (a probe's find). Given cell sizes are the user's metres.
+  if (run.curvature && run.cell_size_x <= 0.0 && run.cell_size_y <= 0.0) {
+    const auto unit = detail::projectedLinearUnit(field.georeference.crs_wkt);
+    if (unit && std::fabs(unit->second - 1.0) > 1e-9)
+      throw UsageError("--curvature needs cell sizes in metres, and " + run.input + "'s CRS counts them in " +
+                       unit->first + " (" + detail::exactNumber(unit->second) +
+                       " m): give --cell-size in metres (and --z-scale " + detail::exactNumber(unit->second) +
+                       " for heights in " + unit->first + ")");
   }
   return field;
 }

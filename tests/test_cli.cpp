@@ -1374,6 +1374,27 @@ TEST_F(Cli, CurvatureLowersFarTerrainByTheEarthsDrop) {
                 2, "--curvature");
   expectFailure(run("svf " + shellQuoted(wall) + " -o " + shellQuoted(out("s.exr")) + " --refraction 2"), 2,
                 "--refraction");
+  // A CRS in US survey feet: its cells are no metres, and the drop would be 3.28 times too small
+  // (a probe's find: exit 0); refused unless --cell-size gives metres. A CRS in metres runs.
+  const std::string feet = in("feet.tif"), metres = in("metres.tif");
+  hfvis::testing::writeGdalGeoTiff(feet, 20, 16, std::vector<float>(20 * 16, 1.0f),
+                                   hfvis::testing::kUtmGeotransform, hfvis::testing::crsWkt("EPSG:2230"),
+                                   std::nullopt);
+  hfvis::testing::writeGdalGeoTiff(metres, 20, 16, std::vector<float>(20 * 16, 1.0f),
+                                   hfvis::testing::kUtmGeotransform, hfvis::testing::crsWkt("EPSG:32633"),
+                                   std::nullopt);
+  expectFailure(run("svf " + shellQuoted(feet) + " -o " + shellQuoted(out("s.exr")) + " -k 4 --curvature"), 2,
+                "US survey foot");
+  EXPECT_EQ(run("svf " + shellQuoted(feet) + " -o " + shellQuoted(out("s.exr")) + " -k 4 -q").status, 0);
+  fs::remove(out("s.exr"));
+  EXPECT_EQ(run("svf " + shellQuoted(feet) + " -o " + shellQuoted(out("s.exr")) +
+                " -k 4 -q --curvature --cell-size 9.144")
+                .status,
+            0);
+  fs::remove(out("s.exr"));
+  EXPECT_EQ(
+      run("svf " + shellQuoted(metres) + " -o " + shellQuoted(out("s.exr")) + " -k 4 -q --curvature").status,
+      0);
 }
 
 // --max-distance D: a wall 30 high 500 m of ground away is the horizon with D = 600 m and

@@ -1000,6 +1000,80 @@ TEST(GdalRasters, ScaleOffsetMaskAndRangeAreTheBands) {
   EXPECT_EQ(t.heights[1], 2.0f);
 }
 
+// A signed-byte band is read as signed: GDAL before 3.7 stores Int8 as a Byte band marked
+// PIXELTYPE=SIGNEDBYTE and hands its values over as 0 .. 255 (-55 was read as 201, exit 0), its
+// nodata -128 among them.
+TEST(GdalRasters, SignedByteBandsAreSigned) {
+  testing::registerGdal();
+  const std::string path = std::string(HFVIS_TEST_TMP_DIR) + "/signed_byte.tif";
+  const std::vector<double> values = {-55.0, 29.0, -128.0, 127.0, -1.0, 0.0};
+#if GDAL_VERSION_NUM >= 3070000
+  GDALDatasetH dataset = GDALCreate(GDALGetDriverByName("GTiff"), path.c_str(), 3, 2, 1, GDT_Int8, nullptr);
+  ASSERT_NE(dataset, nullptr) << CPLGetLastErrorMsg();
+  std::vector<double> pixels = values;
+  EXPECT_EQ(GDALRasterIO(GDALGetRasterBand(dataset, 1), GF_Write, 0, 0, 3, 2, pixels.data(), 3, 2,
+                         GDT_Float64, 0, 0),
+            CE_None);
+#else
+  const char* const options[] = {"PIXELTYPE=SIGNEDBYTE", nullptr};
+  GDALDatasetH dataset =
+      GDALCreate(GDALGetDriverByName("GTiff"), path.c_str(), 3, 2, 1, GDT_Byte, const_cast<char**>(options));
+  ASSERT_NE(dataset, nullptr) << CPLGetLastErrorMsg();
+  std::vector<unsigned char> bytes;
+  for (double v : values) bytes.push_back(static_cast<unsigned char>(static_cast<signed char>(v)));
+  EXPECT_EQ(
+      GDALRasterIO(GDALGetRasterBand(dataset, 1), GF_Write, 0, 0, 3, 2, bytes.data(), 3, 2, GDT_Byte, 0, 0),
+      CE_None);
+#endif
+  EXPECT_EQ(GDALSetRasterNoDataValue(GDALGetRasterBand(dataset, 1), -128.0), CE_None);
+  GDALClose(dataset);
+  const HeightField field = readHeightField(path);
+  EXPECT_EQ(field.heights[0], -55.0f);
+  EXPECT_EQ(field.heights[1], 29.0f);
+  EXPECT_TRUE(std::isnan(field.heights[2]));
+  EXPECT_EQ(field.heights[3], 127.0f);
+  EXPECT_EQ(field.heights[4], -1.0f);
+  EXPECT_EQ(field.heights[5], 0.0f);
+}
+
+// A raster georeferenced by ground control points alone has no grid of known spacing: refused
+// (GDAL answers the identity geotransform; the run went on with cells of 1 and wrote outputs
+// without the CRS, exit 0), with --cell-size too.
+TEST(GdalRasters, GroundControlPointsWithoutAGeotransformAreRefused) {
+  testing::registerGdal();
+  const std::string path = std::string(HFVIS_TEST_TMP_DIR) + "/gcps.tif";
+  GDALDatasetH dataset =
+      GDALCreate(GDALGetDriverByName("GTiff"), path.c_str(), 4, 4, 1, GDT_Float32, nullptr);
+  ASSERT_NE(dataset, nullptr) << CPLGetLastErrorMsg();
+  std::vector<float> heights(16, 1.0f);
+  EXPECT_EQ(GDALRasterIO(GDALGetRasterBand(dataset, 1), GF_Write, 0, 0, 4, 4, heights.data(), 4, 4,
+                         GDT_Float32, 0, 0),
+            CE_None);
+  OGRSpatialReferenceH utm = OSRNewSpatialReference(nullptr);
+  ASSERT_EQ(OSRImportFromEPSG(utm, 32633), OGRERR_NONE);
+  GDAL_GCP gcps[3];
+  GDALInitGCPs(3, gcps);
+  const double points[3][4] = {{0, 0, 500000, 4000040}, {4, 0, 500040, 4000040}, {0, 4, 500000, 4000000}};
+  for (int i = 0; i < 3; ++i) {
+    gcps[i].dfGCPPixel = points[i][0], gcps[i].dfGCPLine = points[i][1];
+    gcps[i].dfGCPX = points[i][2], gcps[i].dfGCPY = points[i][3];
+  }
+  EXPECT_EQ(GDALSetGCPs2(dataset, 3, gcps, utm), CE_None);
+  GDALDeinitGCPs(3, gcps);
+  OSRDestroySpatialReference(utm);
+  GDALClose(dataset);
+  for (const double cell : {0.0, 10.0}) {
+    HeightFieldReadOptions options;
+    options.cell_size_x = cell;
+    try {
+      readHeightField(path, options);
+      ADD_FAILURE() << "read with cells of " << cell;
+    } catch (const IoError& error) {
+      EXPECT_NE(error.reason().find("ground control points"), std::string::npos) << error.what();
+    }
+  }
+}
+
 // An image's alpha band is a channel, not a mask over its colours: an RGBA GeoTIFF's R, G and B
 // keep their values where its alpha is 0 (a light image, an environment map, an albedo).
 TEST(GdalRasters, AnImagesAlphaMasksNothing) {

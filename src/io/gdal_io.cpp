@@ -383,6 +383,11 @@ std::vector<float> readBand(const std::string& path, GDALDatasetH dataset, int b
     throw IoError(path, "band " + std::to_string(band_index + 1) + " holds complex numbers (" +
                             GDALGetDataTypeName(GDALGetRasterDataType(band)) + "); hfvis reads real values");
   const bool in_float = GDALGetRasterDataType(band) == GDT_Float32;
+  // A signed-byte band before GDAL 3.7 (which has GDT_Int8): a Byte band marked so, whose values
+  // GDAL hands over as 0 .. 255 (-55 was read as 201, exit 0; a probe's find).
+  const char* pixel_type = GDALGetMetadataItem(band, "PIXELTYPE", "IMAGE_STRUCTURE");
+  const bool signed_byte =
+      GDALGetRasterDataType(band) == GDT_Byte && pixel_type && std::string(pixel_type) == "SIGNEDBYTE";
   HeightRounding seen;
   const int flags = GDALGetMaskFlags(band);
   // (the mask of the nodata value is the value itself, compared below)
@@ -422,7 +427,7 @@ std::vector<float> readBand(const std::string& path, GDALDatasetH dataset, int b
     }
     float* out = values.data() + std::size_t(y0) * width;
     for (std::size_t i = 0; i < count; ++i) {
-      const double v = raw[i];
+      const double v = signed_byte && raw[i] >= 128.0 ? raw[i] - 256.0 : raw[i];
       const bool is_nodata =
           has_nodata && (std::isnan(nodata) ? std::isnan(v)
                                             : (in_float ? static_cast<float>(v) == static_cast<float>(nodata)
@@ -448,6 +453,22 @@ std::vector<float> readBand(const std::string& path, GDALDatasetH dataset, int b
   if (rounded) *rounded = seen;
   return values;
 }
+
+}  // namespace
+
+std::optional<std::pair<std::string, double>> projectedLinearUnit(const std::string& wkt) {
+  if (wkt.empty()) return std::nullopt;
+  registerOnce();
+  std::unique_ptr<void, void (*)(OGRSpatialReferenceH)> srs(OSRNewSpatialReference(nullptr),
+                                                            OSRDestroySpatialReference);
+  if (!srs || OSRSetFromUserInput(srs.get(), wkt.c_str()) != OGRERR_NONE || !OSRIsProjected(srs.get()))
+    return std::nullopt;
+  char* name = nullptr;
+  const double metres = OSRGetLinearUnits(srs.get(), &name);
+  return std::pair<std::string, double>(name ? name : "unknown", metres);
+}
+
+namespace {
 
 Georeference georeferenceOf(GDALDatasetH dataset) {
   Georeference georeference;
@@ -693,6 +714,12 @@ HeightField readGdalHeightField(const std::string& path, const HeightFieldReadOp
     throw IoError(path, "the geotransform's pixel size is 0 (" + shortNumber((*gt)[1]) + " by " +
                             shortNumber((*gt)[5]) +
                             "): fix the raster's georeference first (gdal_edit.py -a_ullr, or -unsetgt)");
+  // Ground control points without a geotransform: no grid of known spacing (GDAL answers the
+  // identity; the run went on with cells of 1 and wrote outputs without the CRS, exit 0).
+  if (!field.georeference.geotransform && GDALGetGCPCount(dataset.get()) > 0)
+    throw IoError(path, "georeferenced by " + std::to_string(GDALGetGCPCount(dataset.get())) +
+                            " ground control points, not a geotransform: hfvis needs a regular grid; warp "
+                            "it onto one first (gdalwarp IN OUT.tif)");
   // Cell sizes: given, else from the geotransform (north-up or south-up only), else as hfvis
   // stored them.
   if (options.cell_size_x > 0.0 || options.cell_size_y > 0.0) {

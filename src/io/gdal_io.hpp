@@ -41,6 +41,11 @@ std::vector<std::string> gdalFilesRead(const std::string& path);
 // (unreadable, rotated or sheared geotransform, too large).
 HeightField readGdalHeightField(const std::string& path, const HeightFieldReadOptions& options);
 
+// A projected CRS's linear unit (given as WKT): its name and metres per unit; nullopt where the
+// WKT is empty, unreadable or not projected (a geographic raster's cell sizes become metres when
+// read).
+std::optional<std::pair<std::string, double>> projectedLinearUnit(const std::string& wkt);
+
 // Reads every band (see readImage). Throws IoError.
 ImageChannels readGdalImage(const std::string& path);
 
