@@ -8,7 +8,8 @@
 // horizons, each from its horizon toward the receiver). A sample's elevation band reaches
 // up to the mean of its and its farther neighbour's elevations when the two are adjacent
 // (no hidden sample between), else up to its own elevation (the gap's band went to the
-// farther sample); it reaches down likewise toward its nearer neighbour. Each band adds
+// farther sample); it reaches down likewise toward its nearer neighbour, the nearest one down to
+// the tangent elevation (the surface between the receiver and it). Each band adds
 // radiance * (G(upper) - G(lower)), G the wedge integral of the projected solid angle,
 // clipped below at the tangent elevation.
 //
@@ -79,10 +80,12 @@ HFVIS_INLINE void bounce_visit(BounceGather* g, float hx, int x, const float* ra
   g->adjacent = 1;
 }
 
-// The nearest visible sample's band ends at its own elevation; gives the sums.
+// The nearest visible sample's band reaches down to the tangent clip (the surface between the
+// receiver and it, a pit's or a wall's foot's: ended at its own elevation, a pixel whose nearest
+// sample is its horizon gathered nothing, a probe's find); gives the sums.
 HFVIS_INLINE void bounce_finish(BounceGather* g, float* irradiance) {
   if (g->have_prev) {
-    float g_lo = bounce_g(g, g->prev_theta);
+    float g_lo = bounce_g(g, g->tangent);
     for (int c = 0; c < HFVIS_CHANNELS; ++c) g->sum[c] += g->prev_radiance[c] * (g->prev_g_hi - g_lo);
   }
   for (int c = 0; c < HFVIS_CHANNELS; ++c) irradiance[c] = g->sum[c];

@@ -9,13 +9,19 @@
 // at ground distance r_x and height difference dz_x are seen at elevations
 // theta_x = atan2(dz_x, r_x), which never decrease outward but within the heights' rounding
 // (visibility, tie rule as in hfvis/intervisibility.hpp: a sample hidden only within it is seen). Together
-// they cover the elevations from the nearest visible sample's to the farthest's, split into one band per
-// visible sample:
+// they cover the elevations from the receiver's tangent elevation (theta_t below) to the farthest
+// visible sample's, split into one band per visible sample:
 //   - between two visible samples with no hidden sample between them (the surface piece
 //     between them is visible) at the mean of their two elevations;
 //   - across hidden samples (between a segment's horizon and the nearest visible sample of
 //     the next farther segment) the whole band goes to the farther sample: what shows there
-//     is the surface rising toward it.
+//     is the surface rising toward it;
+//   - below the nearest visible sample, down to theta_t, the band goes to that sample: what shows
+//     there is the surface between the receiver and it (a pit's walls, a wall beside the
+//     receiver; when it ended at the nearest sample's elevation, a pixel whose nearest sample
+//     was its horizon gathered nothing). Where the receiver's own cells rise above every sample
+//     (the floor of a pit of one pixel, off the axes) no sample is visible and nothing is
+//     gathered in that direction: peaks carry no radiance (not mended yet).
 // A band [a, b] of sample x adds L_x * (G(b) - G(a)), where
 //   G(theta) = n_z * (D/2) * sin^2(theta) + (n . d_k) * 2 sin(D/2) * (theta + sin(theta) cos(theta)) / 2
 // is the exact integral over the wedge of the projected solid angle (n . w) dw up to
@@ -23,9 +29,9 @@
 // below at theta_t = atan2(-(n . d_k) * 2 sin(D/2), n_z * D), where the wedge's cosine factor
 // changes sign: surface behind the receiver's tangent plane adds nothing, and every band
 // adds a non-negative amount. The irradiance is E = sum_k sum_x L_x (G_k(hi_x) - G_k(lo_x)).
-// A uniform radiance L gives L * (G(theta_farthest) - G(theta_nearest)) per direction (the
-// bands telescope); a flat plane gives 0 (every band is empty); and since the sky above the
-// horizon is what ambient occlusion integrates with the same G, E / (pi L) + AO stays <= about 1.
+// A uniform radiance L gives L * (G(theta_farthest) - G(theta_t)) per direction (the bands
+// telescope); a flat plane gives 0 (every band is empty); and since the sky above the horizon is
+// what ambient occlusion integrates with the same G, E / (pi L) + AO is about 1 (at most).
 //
 // Units: E is in radiance units times steradians (W/m^2 for W m^-2 sr^-1). A Lambertian
 // surface of albedo rho re-emits rho * E / pi, which can feed the next bounce.

@@ -166,7 +166,7 @@ class BounceGather {
 
   void finish(float* irradiance) {
     if (have_prev_) {
-      const float g_lo = g(prev_theta_);
+      const float g_lo = g(tangent_);  // (the nearest sample's band reaches down to the tangent)
       for (int c = 0; c < in_.channels; ++c) sum_[c] += prev_radiance_[c] * (prev_g_hi_ - g_lo);
     }
     for (int c = 0; c < in_.channels; ++c) irradiance[c] = sum_[c];
