@@ -144,6 +144,14 @@ TEST(Insolation, RefusesBadOptions) {
     EXPECT_THROW(computeInsolation(testContext(), flat, o), InvalidArgument) << tiny;
   }
   o.azimuth_bucket_deg = 0.25;
+  // The span is [from, to): it may end as 2201 begins (its excluded end was refused), not after.
+  o.from_utc = parseUtcTime("2200-12-31T00:00:00Z");
+  o.to_utc = parseUtcTime("2201-01-01T00:00:00Z");
+  o.step_minutes = 60.0;
+  EXPECT_NO_THROW(computeInsolation(testContext(), flat, o));
+  o.to_utc += 1.0;
+  EXPECT_THROW(computeInsolation(testContext(), flat, o), InvalidArgument);
+  o.to_utc -= 1.0;
   o.latitude_deg = 91.0;
   EXPECT_THROW(computeInsolation(testContext(), flat, o), InvalidArgument);
 }

@@ -20,6 +20,7 @@ TEST(SunTime, ParsesIso8601WithAZone) {
   EXPECT_EQ(parseUtcTime("2026-06-21T14:00:00+02:00"), 1782043200.0);
   EXPECT_EQ(parseUtcTime("2026-06-21T07:30-0430"), 1782043200.0);
   EXPECT_EQ(parseUtcTime("2026-06-21 12:00Z"), 1782043200.0);
+  EXPECT_EQ(parseUtcTime("2026-06-21t12:00:00z"), 1782043200.0);  // RFC 3339's lower case
   EXPECT_DOUBLE_EQ(parseUtcTime("2026-06-21T12:00:00.25Z"), 1782043200.25);
   EXPECT_EQ(parseUtcTime("2000-02-29T00:00:00Z"), 951782400.0);  // a leap day
   EXPECT_EQ(parseUtcTime("1900-03-01T00:00:00Z"), -2203891200.0);  // 1900 has no 29 February

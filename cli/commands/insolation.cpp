@@ -2,6 +2,7 @@
 // span of time (hfvis/insolation.hpp).
 #include "hfvis/insolation.hpp"
 
+#include <algorithm>
 #include <iostream>
 
 #include "../pipeline.hpp"
@@ -21,10 +22,12 @@ class Insolation : public Computation {
   // input's size is read from here on).
   void prepare(HeightField& field) override {
     // Each step takes the sun at its middle: steps of hours alias the day's course (a step of 1440
-    // minutes counted every hour of a day as sunny, exit 0 without a word).
+    // minutes counted every hour of a day as sunny, exit 0 without a word). A span shorter than
+    // the step is one step of the span's length: it aliases as much where that is past the limit
+    // (a day in one step of 1440 was the worst case and had no warning, a probe's find).
     const InsolationOptions options = insolationOptions(run_);
-    if (options.step_minutes > kMostUnaliasedStep &&
-        options.to_utc - options.from_utc > 60.0 * options.step_minutes)
+    const double longest_step = std::min(60.0 * options.step_minutes, options.to_utc - options.from_utc);
+    if (longest_step > 60.0 * kMostUnaliasedStep)
       std::cerr << "hfvis: warning: --step " << formatNumber(options.step_minutes)
                 << " minutes takes the sun once per step, at its middle: steps past " << kMostUnaliasedStep
                 << " minutes alias its course over the day (sun hours and irradiation may be far off; the "
@@ -50,7 +53,9 @@ class Insolation : public Computation {
     lit_.restore(result_.sun_hours);
     lit_.restore(result_.direct);
     const InsolationOptions options = insolationOptions(run_);
-    Attributes attributes = job.attributes(field);
+    // One sweep per azimuth bucket the sun passes (hfvis:sweeps), no K directions.
+    Attributes attributes = job.attributes(field, false);
+    attributes.emplace_back("hfvis:samples_per_unit", formatNumber(job.run.samples_per_unit));
     attributes.emplace_back("hfvis:latitude_deg", formatNumber(options.latitude_deg));
     attributes.emplace_back("hfvis:longitude_deg", formatNumber(options.longitude_deg));
     attributes.emplace_back("hfvis:from_utc_s", formatNumber(options.from_utc));

@@ -86,7 +86,11 @@ class Shade : public Computation {
     const HeightField& field = lit_.field();
     const std::size_t pixels = field.pixelCount();
     LitOutput lit;
-    lit.attributes = job.attributes(field);
+    // The sun alone sweeps its own azimuth (hfvis:swept_azimuth_deg), no K directions: it wrote
+    // the default K of 64 (a probe's find).
+    lit.attributes = job.attributes(field, environment_.given());
+    if (!environment_.given())
+      lit.attributes.emplace_back("hfvis:samples_per_unit", formatNumber(job.run.samples_per_unit));
     if (environment_.given()) environment_.describe(lit, pixels);
     if (sun_.given()) sun_.describe(lit);
     // --albedo: the radiance a Lambertian surface of that albedo sends out, albedo / pi times the
@@ -160,7 +164,16 @@ void checkShade(const std::string&, const RunArguments& run) {
   if (run.sun && placed)
     throw UsageError("--sun AZ,EL or --at TIME --lat LAT --lon LON: give the sun one way, not both");
   const bool sun = run.sun || (run.sun_time && run.latitude && run.longitude);
-  if (!sun && (placed || run.environment.empty()))
+  if (!sun && placed) {  // a placed sun with a part missing: name it
+    std::string missing;
+    for (const auto& [given, name] : {std::pair{bool(run.sun_time), "--at TIME"},
+                                      {bool(run.latitude), "--lat LAT"},
+                                      {bool(run.longitude), "--lon LON"}})
+      if (!given) missing += (missing.empty() ? "" : ", ") + std::string(name);
+    throw UsageError("missing " + missing +
+                     ": the sun at a time and place needs --at TIME --lat LAT --lon LON");
+  }
+  if (!sun && run.environment.empty())
     throw UsageError(
         "missing the light: --env ENV.exr and / or the sun, --sun AZ,EL (compass azimuth, elevation) or --at "
         "TIME "

@@ -42,9 +42,11 @@ void validate(const InsolationOptions& o) {
                           ", 10] degrees (got " + detail::shortNumber(o.azimuth_bucket_deg) + ")");
   const double steps = std::ceil((o.to_utc - o.from_utc) / (60.0 * o.step_minutes));
   if (steps > 1e7) throw InvalidArgument("the span holds more than 10 million steps; take a longer step");
-  // The ends of the span: sunPosition refuses a place or year beyond its range.
+  // The ends of the span: sunPosition refuses a place or year beyond its range. The span is
+  // [from, to) and the sun is taken at each step's middle: a span that ends as 2201 begins runs
+  // (it was refused for its excluded end).
   sunPosition(o.from_utc, o.latitude_deg, o.longitude_deg);
-  sunPosition(o.to_utc, o.latitude_deg, o.longitude_deg);
+  sunPosition(std::nextafter(o.to_utc, o.from_utc), o.latitude_deg, o.longitude_deg);
 }
 
 namespace detail {

@@ -64,7 +64,9 @@ double parseUtcTime(const std::string& text) {
     throw bad("no date YYYY-MM-DD");
   if (month < 1 || month > 12 || day < 1 || day > static_cast<int>(daysInMonth(year, month)))
     throw bad("no such day");
-  if (at >= text.size() || (text[at] != 'T' && text[at] != ' ')) throw bad("no time after the date");
+  // (RFC 3339 allows 't' and 'z' in lower case)
+  if (at >= text.size() || (text[at] != 'T' && text[at] != 't' && text[at] != ' '))
+    throw bad("no time after the date");
   ++at;
   if (!readDigits(text, &at, 2, &hour) || at >= text.size() || text[at++] != ':' ||
       !readDigits(text, &at, 2, &minute))
