@@ -339,13 +339,19 @@ bool sameFile(const std::string& a, const std::string& b) {
 // Every output can be written, none is an input (an output never replaces an input), and no
 // two outputs are the same file (the second would replace the first). Checked before the
 // input is read.
-void requireOutputs(const RunArguments& run, const Computation& computation) {
-  const std::vector<std::string> outputs = computation.outputs();
-  // (with the files a GDAL raster reads beside itself: a VRT's sources)
+// Every file a run reads: the input and the others, with the files a GDAL raster reads beside
+// itself (a VRT's sources).
+std::vector<std::string> filesOfInputs(const RunArguments& run, const Computation& computation) {
   std::vector<std::string> inputs = filesRead(run.input);
   for (const std::string& input : computation.otherInputs())
     if (!input.empty())
       for (const std::string& file : filesRead(input)) inputs.push_back(file);
+  return inputs;
+}
+
+void requireOutputs(const RunArguments& run, const Computation& computation) {
+  const std::vector<std::string> outputs = computation.outputs();
+  const std::vector<std::string> inputs = filesOfInputs(run, computation);
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     requireReplaceable(outputs[i]);
     if (computation.writesImages() && outputs[i] != run.preview)
@@ -420,6 +426,7 @@ std::string joinPaths(const std::vector<std::string>& paths) {
 int runPipeline(const CommandLine& line, Computation& computation) {
   const RunArguments& run = line.run;
   requireOutputs(run, computation);
+  const std::vector<std::string> inputs_read = filesOfInputs(run, computation);
   HeightField input = readValidField(run);
   computation.prepare(input);
   // (a command on the host, writing text, opens no device; region writes text from the device)
@@ -432,8 +439,11 @@ int runPipeline(const CommandLine& line, Computation& computation) {
   computation.compute(job);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
-  // Everything is computed; now stage every file, then move them all into place.
+  // Everything is computed; now stage every file, then move them all into place. The inputs as
+  // they were read stay protected whatever their paths name by then (requireOutputs checked
+  // the paths before the work; a link made to an input since must not let an output replace it).
   OutputFiles outputs;
+  outputs.protect(inputs_read);
   const Summary summary = computation.write(job, outputs);
   const std::vector<std::string> written = outputs.paths();
   outputs.commit();

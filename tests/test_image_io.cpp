@@ -514,8 +514,9 @@ TEST_F(ImageIoTest, GeoTiffGeographicWithoutTiepointIsAnError) {
   EXPECT_EQ(readHeightField(path("notie.tif"), options).cell_size_y, 20.0);
 }
 
-TEST_F(ImageIoTest, TiffBytesUnderAnotherExtensionReadWithoutGeoreference) {
-  // OpenImageIO reads what GDAL is not asked to (by extension); it reads no GeoTIFF tags.
+TEST_F(ImageIoTest, TiffBytesUnderAnotherExtensionAreAGeoTiff) {
+  // Known by their first bytes, read by GDAL with their tags (through OpenImageIO, which reads no
+  // GeoTIFF tags, they had cells of 1 and no CRS).
   GeoTiffSpec g;
   g.pixel_scale = {30.0, 25.0, 0.0};
   g.tiepoint = {0, 0, 0, 500000.0, 4100000.0, 0};
@@ -523,9 +524,9 @@ TEST_F(ImageIoTest, TiffBytesUnderAnotherExtensionReadWithoutGeoreference) {
   const std::vector<float> pixels = writeGeoTiff(path("utm.hdr"), g);
   const HeightField field = readHeightField(path("utm.hdr"));
   EXPECT_EQ(field.heights, pixels);
-  EXPECT_EQ(field.cell_size_x, 1.0);
-  EXPECT_EQ(field.cell_size_y, 1.0);
-  EXPECT_TRUE(field.georeference.empty());
+  EXPECT_EQ(field.cell_size_x, 30.0);
+  EXPECT_EQ(field.cell_size_y, 25.0);
+  EXPECT_FALSE(field.georeference.empty());
 }
 
 TEST_F(ImageIoTest, GeoTiffInputFillsTheGeoreference) {
@@ -540,6 +541,16 @@ TEST_F(ImageIoTest, GeoTiffInputFillsTheGeoreference) {
   EXPECT_EQ(field.cell_size_y, 30.0);
   EXPECT_TRUE(std::isnan(field.heights[3]));
   EXPECT_EQ(field.heights[4], 5.0f);
+  // TIFF bytes under another name (.gtif, .cog, none) are the same GeoTIFF: through OpenImageIO
+  // they lost the nodata (-9999 became a pit), the cells and the CRS, exit 0 (a probe's find).
+  for (const char* name : {"dem.gtif", "dem.cog", "dem"}) {
+    fs::copy_file(file, path(name));
+    const HeightField same = readHeightField(path(name));
+    EXPECT_EQ(same.georeference.geotransform, field.georeference.geotransform) << name;
+    EXPECT_EQ(same.cell_size_x, 30.0) << name;
+    EXPECT_TRUE(std::isnan(same.heights[3])) << name;
+    EXPECT_EQ(filesRead(path(name)), std::vector<std::string>{path(name)}) << name;
+  }
   // Images OpenImageIO reads have none, as a field filled in memory.
   writeWithOiio(path("f.exr"), 3, 2, 1, OIIO::TypeDesc::FLOAT, heights.data());
   EXPECT_TRUE(readHeightField(path("f.exr")).georeference.empty());

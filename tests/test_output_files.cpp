@@ -282,14 +282,17 @@ TEST_F(OutputFilesTest, ALoopOfSymbolicLinksIsRefused) {
 
 // A GeoTIFF replaces the files GDAL reads beside it as part of it (hfvis::OutputFiles): a stale
 // FILE.aux.xml gave the new file the old one's nodata value, scale and offset (GDAL prefers it to
-// the file's own); overviews and a mask too. World files stay (named by the stem, they may belong
-// to another file of it), as do an EXR's. Where the commit fails, every one is back as it was.
+// the file's own); overviews and a mask too; and a TIFF's world files (a stale a.tfw gave a new
+// file without georeferencing the old one's cells of 40 m, a probe's find). STEM.wld stays (any
+// image of that stem may own it), as do an EXR's. Where the commit fails, every one is back as it
+// was.
 TEST_F(OutputFilesTest, AGeoTiffTakesTheSideFilesOfThePreviousFileWithIt) {
   const std::string pam =
       "<PAMDataset><PAMRasterBand band=\"1\"><NoDataValue>1</NoDataValue><Offset>100</Offset>"
       "<Scale>-1</Scale></PAMRasterBand></PAMDataset>\n";
-  const std::vector<std::string> sides = {"a.tif.aux.xml", "a.tif.ovr", "a.tif.MSK", "a.tif.aux"};
-  const std::vector<std::string> others = {"a.tfw", "a.wld", "a.exr.aux.xml"};
+  const std::vector<std::string> sides = {"a.tif.aux.xml", "a.tif.ovr", "a.tif.MSK",
+                                          "a.tif.aux",     "a.tfw",     "a.TIFW"};
+  const std::vector<std::string> others = {"a.wld", "a.exr.aux.xml", "a.pgw"};
   const auto previous = [&] {
     writeText("a.tif", "previous a");
     for (const std::string& name : sides) writeText(name, name == "a.tif.aux.xml" ? pam : "previous " + name);
@@ -304,7 +307,7 @@ TEST_F(OutputFilesTest, AGeoTiffTakesTheSideFilesOfThePreviousFileWithIt) {
 
   previous();
   writeImage(path("a.tif"), image);
-  EXPECT_EQ(filesInDir(), sorted({"a.tif", "a.tfw", "a.wld", "a.exr.aux.xml"}));
+  EXPECT_EQ(filesInDir(), sorted({"a.tif", "a.wld", "a.exr.aux.xml", "a.pgw"}));
   for (const std::string& name : others) EXPECT_EQ(readText(path(name)), "previous " + name);
   const ImageChannels read = readImage(path("a.tif"));
   ASSERT_EQ(read.planes.size(), 1u);
@@ -329,6 +332,40 @@ TEST_F(OutputFilesTest, AGeoTiffTakesTheSideFilesOfThePreviousFileWithIt) {
   EXPECT_EQ(readText(path("a.tif.aux.xml")), pam);
   EXPECT_EQ(readText(path("a.tif.ovr")), "previous a.tif.ovr");
   EXPECT_EQ(readText(path("a.tif.MSK")), "previous a.tif.MSK");
+  EXPECT_EQ(readText(path("a.tfw")), "previous a.tfw");
+}
+
+// An output never replaces an input, even where its path comes to name the input during the run
+// (a probe's find: a link made to the input after the CLI's check, or a directory of the output's
+// path turned into a link to the input's, and the input was replaced, exit 0). Files protect()
+// names are refused as each output is staged and again at the commit; nothing is written.
+TEST_F(OutputFilesTest, AnOutputNeverReplacesAProtectedInputWhateverItsPathBecomes) {
+  writeText("in.exr", "the input");
+  const ImageChannels image = noiseImage();
+  {  // a link made before the output is staged
+    fs::create_symlink("in.exr", dir_ / "new.exr");
+    OutputFiles files;
+    files.protect({path("in.exr")});
+    EXPECT_THROW(files.image(path("new.exr"), image), IoError);
+    fs::remove(dir_ / "new.exr");
+  }
+  {  // a directory of the path turned into a link to the input's, between staging and commit
+    fs::create_directories(dir_ / "od");
+    OutputFiles files;
+    files.protect({path("in.exr")});
+    files.image(path("od/in.exr"), image);
+    fs::remove_all(dir_ / "od");
+    fs::create_directory_symlink(".", dir_ / "od");
+    try {
+      files.commit();
+      ADD_FAILURE() << "the input was replaced";
+    } catch (const IoError& error) {
+      EXPECT_NE(std::string(error.what()).find("names the input"), std::string::npos) << error.what();
+    }
+    fs::remove(dir_ / "od");
+  }
+  EXPECT_EQ(readText(path("in.exr")), "the input");
+  EXPECT_EQ(filesInDir(), std::vector<std::string>{"in.exr"});  // (no temporary file left)
 }
 
 // Outputs appear together or not at all: a later output that cannot be written leaves the earlier
@@ -396,7 +433,8 @@ TEST_F(OutputFilesTest, AFailedOutputLeavesEveryPreviousFile) {
 // Issue 26, item 7: SIGINT, SIGTERM and SIGHUP remove the temporary files of unfinished outputs
 // (removeTemporaryOutputsOnSignals), and the process still ends of the signal.
 TEST_F(OutputFilesTest, SignalsRemoveTemporaryFiles) {
-  for (const int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
+  // (SIGXCPU: a CPU time limit, ulimit -t; SIGALRM: an alarm; both left the files, a probe's find)
+  for (const int signal_number : {SIGINT, SIGTERM, SIGHUP, SIGXCPU, SIGALRM}) {
     SCOPED_TRACE(signal_number);
     const pid_t child = ::fork();
     if (child == 0) {

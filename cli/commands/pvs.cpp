@@ -425,6 +425,10 @@ void checkPvs(const std::string& name, const RunArguments& run) {
                      namedAs(run.output));
   if (!run.bitset_output.empty() && samePath(run.output, run.bitset_output))
     throw UsageError("--bitset must differ from -o, both are " + inQuotes(run.output));
+  // (a bitset named .exr or .tif was written as raw bits, and read back as a broken image)
+  if (!run.bitset_output.empty() && !hasExtension(run.bitset_output, ".bin"))
+    throw UsageError("--bitset: the sets are a binary file of bits; the name must end in .bin, got " +
+                     namedAs(run.bitset_output));
   if (!run.preview.empty() && !hasExtension(run.preview, ".png"))
     throw UsageError("--preview: the preview is a PNG; the name must end in .png, got " +
                      namedAs(run.preview));

@@ -119,10 +119,13 @@ void requireReplaceable(const std::string& path);
 // scale, offset, even a georeference, which GDAL prefers to the file's own), overviews
 // (FILE.ovr) and mask (FILE.msk); left in place, a reader took the new file with the old one's
 // nodata and scale. They are set aside as the previous file is and removed once every output is
-// in place. (World files, STEM.tfw and kin, are named by the stem alone and may belong to another
-// file of that stem, a PNG: they stay.) Whatever is not committed is removed by the destructor,
-// and by SIGINT, SIGTERM or SIGHUP where removeTemporaryOutputsOnSignals() is in force (a signal
-// during commit() waits for its end).
+// in place; so are a TIFF's world files (STEM.tfw, STEM.tifw, STEM.tiffw: a stale one gave a new
+// file without georeferencing the old one's cells). (STEM.wld, which any image of that stem may
+// own, stays.) Files named by protect() are never replaced: checked as each output is staged and
+// again right before its rename, since a path may change during a long run (a link made to an
+// input). Whatever is not committed is removed by the destructor, and by the signals that end
+// the process where removeTemporaryOutputsOnSignals() is in force (a signal during commit() waits
+// for its end).
 class OutputFiles {
  public:
   OutputFiles() = default;
@@ -146,6 +149,9 @@ class OutputFiles {
   // The bytes as they are.
   void text(const std::string& path, const std::string& text);
 
+  // The files at `inputs` as they are now (those that exist; links followed), which no output
+  // may replace, whatever path comes to name them later.
+  void protect(const std::vector<std::string>& inputs);
   // The paths staged so far, in order.
   std::vector<std::string> paths() const;
   // Moves every staged file into place, or none (see above); throws IoError naming the output
@@ -161,7 +167,15 @@ class OutputFiles {
   void stage(const std::string& path, const std::function<void(const std::string&)>& write,
              bool geotiff = false);
   void discard() noexcept;
+  // Throws IoError naming `path` where `file` is now one of the protected inputs.
+  void requireNotAnInput(const std::string& path, const std::string& file) const;
   std::vector<Entry> entries_;
+  struct Protected {
+    std::string path;
+    dev_t device;
+    ino_t inode;
+  };
+  std::vector<Protected> inputs_;
 };
 
 // Installs handlers of SIGINT, SIGTERM and SIGHUP (those not ignored, so nohup keeps working)

@@ -665,7 +665,14 @@ bool isGdalRaster(const std::string& path) {
   const std::string extension = lowercaseExtension(path);
   for (const char* gdal : {".tif", ".tiff", ".hgt", ".asc", ".vrt", ".img", ".bil", ".dem", ".grd", ".adf"})
     if (extension == gdal) return true;
-  return false;
+  // TIFF bytes under another name (.gtif, .gtiff, .cog, none) are a GeoTIFF still: read through
+  // OpenImageIO they lost their nodata (-9999 became a pit 10 km deep), cell size and CRS, exit 0
+  // (a probe's find). Classic (II*, MM*) and BigTIFF (II+, MM+) headers.
+  unsigned char magic[4] = {};
+  std::ifstream in(path, std::ios::binary);
+  if (!in.read(reinterpret_cast<char*>(magic), 4)) return false;
+  return (magic[0] == 'I' && magic[1] == 'I' && (magic[2] == 42 || magic[2] == 43) && magic[3] == 0) ||
+         (magic[0] == 'M' && magic[1] == 'M' && magic[2] == 0 && (magic[3] == 42 || magic[3] == 43));
 }
 
 HeightField readGdalHeightField(const std::string& path, const HeightFieldReadOptions& options) {

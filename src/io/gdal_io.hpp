@@ -26,7 +26,8 @@ std::optional<std::pair<double, double>> storedCellSize(const std::string& path,
 // The extension of `path` in lower case, with its dot ("" when it has none).
 std::string lowercaseExtension(const std::string& path);
 
-// Whether `path` names a raster format that GDAL reads rather than OpenEXR or OpenImageIO.
+// Whether `path` names a raster format that GDAL reads rather than OpenEXR or OpenImageIO: by its
+// extension, or a TIFF by its first bytes whatever its name.
 bool isGdalRaster(const std::string& path);
 
 // `path` and the files GDAL reads with it (a VRT's sources, nested VRTs' too, and what the

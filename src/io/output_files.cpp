@@ -289,14 +289,18 @@ int likelyWriteError(const std::string& file) {
 std::vector<std::string> geoTiffSideFiles(const std::string& path) {
   std::vector<std::string> found;
   std::vector<std::pair<dev_t, ino_t>> seen;  // (a directory that ignores case finds one file twice)
+  // PATH + suffix; and a TIFF's world files, STEM + ending (no other image's: a PNG's is .pgw).
+  constexpr const char* kEndings[] = {".aux.xml", ".aux", ".ovr", ".msk", "+.tfw", "+.tifw", "+.tiffw"};
   for (const std::string& base : {path, resolvedTarget(path)})
-    for (const char* suffix : {".aux.xml", ".aux", ".ovr", ".msk"})
+    for (const char* suffix : kEndings)
       for (const bool upper : {false, true}) {
-        std::string ending = suffix;
+        const bool of_stem = suffix[0] == '+';
+        std::string ending = suffix + (of_stem ? 1 : 0);
         if (upper)
           std::transform(ending.begin(), ending.end(), ending.begin(),
                          [](unsigned char c) { return std::toupper(c); });
-        const std::string side = base + ending;
+        const std::string side =
+            of_stem ? fs::path(base).replace_extension().string() + ending : base + ending;
         struct stat status {};
         if (::lstat(side.c_str(), &status) != 0 || !(S_ISREG(status.st_mode) || S_ISLNK(status.st_mode)))
           continue;
@@ -332,6 +336,24 @@ void OutputFiles::discard() noexcept {
   entries_.clear();
 }
 
+void OutputFiles::protect(const std::vector<std::string>& inputs) {
+  for (const std::string& input : inputs) {
+    struct stat status {};
+    if (!input.empty() && ::stat(input.c_str(), &status) == 0)
+      inputs_.push_back({input, status.st_dev, status.st_ino});
+  }
+}
+
+void OutputFiles::requireNotAnInput(const std::string& path, const std::string& file) const {
+  struct stat status {};
+  if (inputs_.empty() || ::stat(file.c_str(), &status) != 0) return;
+  for (const Protected& input : inputs_)
+    if (input.device == status.st_dev && input.inode == status.st_ino)
+      throw IoError(path, "names the input '" + input.path +
+                              "' now (a link or directory changed during the run): outputs never replace an "
+                              "input; nothing was written");
+}
+
 std::vector<std::string> OutputFiles::paths() const {
   std::vector<std::string> paths;
   for (const Entry& entry : entries_) paths.push_back(entry.path);
@@ -346,6 +368,7 @@ void OutputFiles::stage(const std::string& path, const std::function<void(const 
         std::filesystem::path(target).lexically_normal())
       throw InvalidArgument("'" + path + "' is staged twice (as '" + entry.path + "')");
   detail::requireReplaceableTarget(path, target);
+  requireNotAnInput(path, target);
   const std::string temp = detail::temporaryPathFor(target);
   detail::rememberTemporary(temp);
   entries_.push_back({path, target, temp, geotiff});
@@ -356,7 +379,13 @@ void OutputFiles::commit() {
   const detail::CommitWindow window;
   // A long run gives time for a target to change: each is checked again right before.
   try {
-    for (const Entry& entry : entries_) detail::requireReplaceableTarget(entry.path, entry.target);
+    for (const Entry& entry : entries_) {
+      detail::requireReplaceableTarget(entry.path, entry.target);
+      requireNotAnInput(entry.path, entry.target);
+      if (entry.geotiff)
+        for (const std::string& side : detail::geoTiffSideFiles(entry.path))
+          requireNotAnInput(entry.path, side);
+    }
   } catch (...) {
     discard();
     throw;
@@ -445,7 +474,10 @@ void OutputFiles::commit() {
 }
 
 void removeTemporaryOutputsOnSignals() {
-  for (const int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
+  // Every signal whose default ends the process, bar the core dumps of a fault: a CPU time limit
+  // (SIGXCPU, ulimit -t) and an alarm left the temporary files behind (a probe's find).
+  for (const int signal_number :
+       {SIGINT, SIGTERM, SIGHUP, SIGXCPU, SIGALRM, SIGVTALRM, SIGPROF, SIGUSR1, SIGUSR2, SIGPIPE}) {
     struct sigaction current {};
     if (::sigaction(signal_number, nullptr, &current) != 0 || current.sa_handler == SIG_IGN) continue;
     struct sigaction action {};
