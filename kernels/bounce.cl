@@ -4,8 +4,9 @@
 // these helpers turn them into the receiver's irradiance. Mirrored by BounceGather in
 // src/core/scalar_hull_tree.cpp.
 //
-// For one receiver, the visible samples are visited farthest first (the runs of the
-// horizons, each from its horizon toward the receiver). A sample's elevation band reaches
+// For one receiver, the visible samples and peaks are visited farthest first (the runs of the
+// horizons, each from its horizon toward the receiver); a peak's radiance lies between its two
+// samples', as its position does. A node's elevation band reaches
 // up to the mean of its and its farther neighbour's elevations when the two are adjacent
 // (no hidden sample between), else up to its own elevation (the gap's band went to the
 // farther sample); it reaches down likewise toward its nearer neighbour, the nearest one down to
@@ -26,8 +27,7 @@ typedef struct {
   float nh_term;  // (n . d) * 2 sin(D / 2)
   float tangent;  // lower clip of G: where its wedge-integrated cosine factor vanishes
   float ground;   // ground length of one step
-  float h;        // the receiver's height and step
-  int step;
+  float h;        // the receiver's height
   int have_prev;  // a farther visible sample awaits its lower band edge
   int adjacent;   // the next sample visited is adjacent to it
   float prev_theta, prev_g_hi;
@@ -44,7 +44,7 @@ HFVIS_INLINE float bounce_g(const BounceGather* g, float theta) {
 // The receiver's unit normal (nx, ny, nz), the direction on the ground, its step's ground
 // length, and half_sector = D / 2 and wedge = 2 sin(D / 2) of its wedge D.
 HFVIS_INLINE void bounce_begin(BounceGather* g, float nx, float ny, float nz, float cos_azimuth,
-                               float sin_azimuth, float step_ground, float h, int step, float half_sector,
+                               float sin_azimuth, float step_ground, float h, float half_sector,
                                float wedge) {
   float toward = nx * cos_azimuth + ny * sin_azimuth;
   g->nz_term = nz * half_sector;
@@ -52,7 +52,6 @@ HFVIS_INLINE void bounce_begin(BounceGather* g, float nx, float ny, float nz, fl
   g->tangent = atan2(-g->nh_term, 2.0f * g->nz_term);
   g->ground = step_ground;
   g->h = h;
-  g->step = step;
   g->have_prev = 0;
   g->adjacent = 0;
   g->prev_theta = 0.0f;
@@ -60,10 +59,10 @@ HFVIS_INLINE void bounce_begin(BounceGather* g, float nx, float ny, float nz, fl
   for (int c = 0; c < HFVIS_CHANNELS; ++c) g->prev_radiance[c] = g->sum[c] = 0.0f;
 }
 
-// Visible sample x at height hx with exit radiance `radiance`, nearer than every sample
-// visited before it.
-HFVIS_INLINE void bounce_visit(BounceGather* g, float hx, int x, const float* radiance) {
-  float theta = atan2(hx - g->h, (float)(g->step - x) * g->ground);
+// Visible node (a sample, or a peak of the surface between two) at height hx, `distance` steps
+// from the receiver, with exit radiance `radiance`, nearer than every node visited before it.
+HFVIS_INLINE void bounce_visit(BounceGather* g, float hx, float distance, const float* radiance) {
+  float theta = atan2(hx - g->h, distance * g->ground);
   float g_hi;
   if (!g->have_prev) {
     g_hi = bounce_g(g, theta);

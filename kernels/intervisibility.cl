@@ -861,10 +861,16 @@ __kernel void intervisibility_lattice(
         const int is_peak = part == 0, slot = 2 * step + part;
         const float h = is_peak ? h_peak : h_sample;
         const float p = is_peak ? (float)peak_position : p_sample;
-        if (is_peak && isnan(h)) continue;
-      const uint e = (uint)slot * stride;
-      const int receiver = !is_peak && q == n_samples - 1;
-      if (!is_peak) {
+        if (is_peak && isnan(h)) {
+#if HFVIS_WANT_BOUNCE
+          tree[(uint)slot * stride] =
+              (int4)(as_int(NAN), 0, HFVIS_NONE, HFVIS_NONE);  // no peak: the gather skips it
+#endif
+          continue;
+        }
+        const uint e = (uint)slot * stride;
+        const int receiver = !is_peak && q == n_samples - 1;
+        if (!is_peak) {
 #if HFVIS_ROW_SPACING && HFVIS_WANT_AREA
         prefix[base + e] = weighted_sum;
 #elif HFVIS_HAS_NODATA && HFVIS_WANT_AREA  // step sums serve runs with holes only
@@ -898,8 +904,8 @@ __kernel void intervisibility_lattice(
 #if HFVIS_WANT_BOUNCE
       BounceGather gather;
       if (receiver)
-        bounce_begin(&gather, normals[pixel], normals[plane + pixel], normals[2u * plane + pixel], cos_azimuth,
-                     sin_azimuth, step_ground, h, step, half_sector, wedge);
+        bounce_begin(&gather, normals[pixel], normals[plane + pixel], normals[2u * plane + pixel],
+                     cos_azimuth, sin_azimuth, step_ground, h, half_sector, wedge);
 #endif
       if (root == HFVIS_NONE) {
         tree[e] = (int4)(as_int(h), HFVIS_LEAF, HFVIS_NONE, HFVIS_NONE);  // rank 0
@@ -1082,18 +1088,38 @@ __kernel void intervisibility_lattice(
             const int run_holes =
                 HFVIS_HAS_NODATA && end_rank - run_first_rank != SAMPLE_OF(end) - SAMPLE_OF(run_first);
 #if HFVIS_WANT_BOUNCE
+            // The run's visible samples and peaks. A peak (the surface's top between two samples,
+            // which may hide every sample, as the rim of a pit of one pixel does off the axes)
+            // shows where it is seen: the horizon itself, or before a sample of the run (the
+            // visible nodes are a prefix), or seen over the next horizon; never in the forgiven
+            // stretch before the horizon (peaks are not forgiven). It shows the radiance between
+            // its two samples', weighted as its position lies between them.
             for (int x = run_first; receiver && x < end; ++x) {
-              if (!IS_SAMPLE(x)) continue;  // peaks carry no radiance
-              const float hx = as_float(tree[(uint)x * stride].x);
-              if (!isnan(hx)) {
-                float emitted[HFVIS_CHANNELS];
-                lattice_radiance(radiance, width, plane, line, samples, n_samples, a, b, SAMPLE_OF(x), emitted);
-                bounce_visit(&gather, hx, SAMPLE_OF(x), emitted);
+              const int4 node = tree[(uint)x * stride];
+              const float hx = as_float(node.x);
+              if (isnan(hx)) continue;  // nodata, or no peak
+              if (!IS_SAMPLE(x) &&
+                  (x < hp ||
+                   (x != hp && x + 1 >= end && np != HFVIS_NONE &&
+                    !seen_over(hx, (float)(node.y >> 1), as_float(nz.x),
+                               node_position(line_positions, stride, position_shift, np, nz), h, p))))
+                continue;
+              float emitted[HFVIS_CHANNELS];
+              lattice_radiance(radiance, width, plane, line, samples, n_samples, a, b, SAMPLE_OF(x), emitted);
+              float distance = (float)(step - SAMPLE_OF(x));
+              if (!IS_SAMPLE(x)) {
+                const int offset = (node.y >> 1) - ((SAMPLE_OF(x) - 1) << position_shift);
+                const float toward = (float)offset * inv_scale;  // of the step, from the sample before
+                float before[HFVIS_CHANNELS];
+                lattice_radiance(radiance, width, plane, line, samples, n_samples, a, b, SAMPLE_OF(x) - 1,
+                                 before);
+                for (int c = 0; c < HFVIS_CHANNELS; ++c)
+                  emitted[c] = before[c] + toward * (emitted[c] - before[c]);
+                distance += 1.0f - toward;
               }
+              bounce_visit(&gather, hx, distance, emitted);
             }
-            // No hidden sample before the next visible one: the run reached the next one's, and
-            // where it visited none (a peak's, or one whose first sample is forgiven to the next
-            // horizon) so did the run before it.
+            // No hidden sample before the next visible one: the run reached the next one's.
             gather.adjacent = gather.adjacent && end == np_first;
 #endif
             // Within the maximum distance only the run's samples from `first` on count (terrain

@@ -1564,6 +1564,9 @@ TEST_F(Cli, ShadeLightsFlatGroundWithTheSun) {
       ASSERT_NEAR(s.at(x, y, 0), 0.5f, 1e-6f) << x << "," << y;
     }
   EXPECT_EQ(s.spec.get_string_attribute("hfvis:sun_elevation_deg"), "30");
+  // One azimuth swept, no K: no hfvis:directions (it said the default 64).
+  EXPECT_EQ(s.spec.get_string_attribute("hfvis:directions"), "");
+  EXPECT_EQ(s.spec.get_string_attribute("hfvis:samples_per_unit"), "1");
   // At the SPA worked example's time and place the sun stands 39.87 degrees up.
   const CliResult placed = run("shade " + shellQuoted(field) + " -o " + shellQuoted(out("p.exr")) +
                                " --at 2003-10-17T12:30:30-07:00 --lat 39.742476 --lon -105.1786 -q");
@@ -1575,6 +1578,10 @@ TEST_F(Cli, ShadeLightsFlatGroundWithTheSun) {
     EXPECT_EQ(r.status, 2) << bad << ": " << r.err;
     EXPECT_FALSE(fs::exists(out("bad.exr"))) << bad;
   }
+  // A placed sun missing a part is told which.
+  const CliResult no_lon = run("shade " + shellQuoted(field) + " -o " + shellQuoted(out("bad.exr")) +
+                               " --at 2026-06-21T12:00Z --lat 40");
+  EXPECT_NE(no_lon.err.find("missing --lon LON"), std::string::npos) << no_lon.err;
 }
 
 // "hfvis shade --env": a uniform one-channel environment of radiance 2 gives channel Y = 2 pi on
@@ -1676,12 +1683,23 @@ TEST_F(Cli, InsolationCountsSunHours) {
   EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
   const ReadBack i = readBack(out("i.exr"));
   ASSERT_EQ(i.channels, (std::vector<std::string>{"direct", "sun_hours"}));
+  EXPECT_EQ(i.spec.get_string_attribute("hfvis:directions"), "");  // (one sweep per azimuth bucket)
+  EXPECT_NE(i.spec.get_string_attribute("hfvis:sweeps"), "");
   // Steps of hours alias the day (one of 720 minutes counts the whole day sunny): a warning.
   const CliResult coarse =
       run("insolation " + shellQuoted(field) + " -o " + shellQuoted(out("c.exr")) +
           " --lat 0 --lon 0 --from 2026-03-20T00:00:00Z --to 2026-03-21T00:00:00Z --step 720 -q");
   ASSERT_EQ(coarse.status, 0) << coarse.err;
   EXPECT_NE(coarse.err.find("hfvis: warning: --step 720 minutes"), std::string::npos) << coarse.err;
+  // The worst of them, the day in one step (every hour sunny), warns too; a span of an hour in
+  // one step of 1440 does not (the step is the span's hour).
+  for (const auto& [to, warns] : {std::pair{"2026-03-21T00:00:00Z", true}, {"2026-03-20T01:00:00Z", false}}) {
+    const CliResult day = run("insolation " + shellQuoted(field) + " -o " + shellQuoted(out("d.exr")) +
+                              " --lat 0 --lon 0 --from 2026-03-20T00:00:00Z --to " + to + " --step 1440 -q");
+    ASSERT_EQ(day.status, 0) << day.err;
+    EXPECT_EQ(day.err.find("hfvis: warning: --step 1440 minutes") != std::string::npos, warns)
+        << to << day.err;
+  }
   EXPECT_NEAR(i.at(4, 4, 1), 12.0, 0.05);
   // The integral of sin(elevation) over a day at the equator's equinox: 24 / pi hours.
   EXPECT_NEAR(i.at(4, 4, 0), 24.0 / M_PI, 0.01);
@@ -3448,6 +3466,8 @@ TEST_F(Cli, PvsPreviewOfOneViewCell) {
   refused(" --preview " + shellQuoted(out("q.png")) + " --view-mask " + shellQuoted(mask) +
               " --preview-view-cell 20,3",
           "which the view mask leaves out");
+  // (a bitset named as an image was written as raw bits, a probe's find)
+  refused(" --bitset " + shellQuoted(out("sets.exr")), "must end in .bin");
 }
 
 // --resume: a run goes on from an earlier run's --bitset file: the library's run from those sets

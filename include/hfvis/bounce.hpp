@@ -8,20 +8,23 @@
 // width D around it (about 2*pi/K; see below). In the vertical plane of direction k, the visible samples x
 // at ground distance r_x and height difference dz_x are seen at elevations
 // theta_x = atan2(dz_x, r_x), which never decrease outward but within the heights' rounding
-// (visibility, tie rule as in hfvis/intervisibility.hpp: a sample hidden only within it is seen). Together
-// they cover the elevations from the receiver's tangent elevation (theta_t below) to the farthest
-// visible sample's, split into one band per visible sample:
-//   - between two visible samples with no hidden sample between them (the surface piece
+// (visibility, tie rule as in hfvis/intervisibility.hpp: a sample hidden only within it is seen).
+// So are the visible peaks: the surface's highest point between two samples where it rises above
+// their chord (the tree's peaks, hfvis/intervisibility.hpp; seen exactly, never by the tie rule),
+// with the exit radiance between its two samples', weighted as its position lies between them.
+// Together the visible nodes (samples and peaks) cover the elevations from the receiver's tangent
+// elevation (theta_t below) to the farthest one's, split into one band per visible node:
+//   - between two visible nodes with no hidden sample between them (the surface piece
 //     between them is visible) at the mean of their two elevations;
-//   - across hidden samples (between a segment's horizon and the nearest visible sample of
-//     the next farther segment) the whole band goes to the farther sample: what shows there
+//   - across hidden samples (between a segment's horizon and the nearest visible node of
+//     the next farther segment) the whole band goes to the farther node: what shows there
 //     is the surface rising toward it;
-//   - below the nearest visible sample, down to theta_t, the band goes to that sample: what shows
+//   - below the nearest visible node, down to theta_t, the band goes to that node: what shows
 //     there is the surface between the receiver and it (a pit's walls, a wall beside the
-//     receiver; when it ended at the nearest sample's elevation, a pixel whose nearest sample
-//     was its horizon gathered nothing). Where the receiver's own cells rise above every sample
-//     (the floor of a pit of one pixel, off the axes) no sample is visible and nothing is
-//     gathered in that direction: peaks carry no radiance (not mended yet).
+//     receiver; when it ended at the nearest node's elevation, a pixel whose nearest sample
+//     was its horizon gathered nothing). At the floor of a pit of one pixel the rim of its own
+//     cells, a peak, hides every sample off the axes: until peaks carried radiance, nothing was
+//     gathered there in those directions (E / (pi L) + AO was 0.07 instead of 1).
 // A band [a, b] of sample x adds L_x * (G(b) - G(a)), where
 //   G(theta) = n_z * (D/2) * sin^2(theta) + (n . d_k) * 2 sin(D/2) * (theta + sin(theta) cos(theta)) / 2
 // is the exact integral over the wedge of the projected solid angle (n . w) dw up to

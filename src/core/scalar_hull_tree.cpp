@@ -131,8 +131,8 @@ int forgivenStretch(const LineView& line, const std::vector<int>& ranks, int las
 // times the projected solid angle of its elevation band.
 class BounceGather {
  public:
-  BounceGather(const BounceLines& in, const SweepDirection& d, std::size_t receiver_entry, float h, int step)
-      : in_(in), h_(h), step_(step), ground_(in.step_ground) {
+  BounceGather(const BounceLines& in, const SweepDirection& d, std::size_t receiver_entry, float h)
+      : in_(in), h_(h), ground_(in.step_ground) {
     const float* normal = &in.attributes[receiver_entry * (in.channels + kBounceNormalFloats) + in.channels];
     const float toward = normal[0] * d.cos_azimuth + normal[1] * d.sin_azimuth;
     nz_term_ = normal[2] * in.half_sector;
@@ -140,28 +140,26 @@ class BounceGather {
     tangent_ = std::atan2(-nh_term_, 2.0f * nz_term_);
   }
 
-  // Visible sample x at height hx; nearer than every sample visited before it.
-  void visit(float hx, int x, std::size_t entry) {
-    const float theta = std::atan2(hx - h_, static_cast<float>(step_ - x) * ground_);
-    float g_hi;
-    if (!have_prev_) {
-      g_hi = g(theta);
-    } else {
-      const float edge = adjacent_ ? 0.5f * (prev_theta_ + theta) : theta;
-      const float g_edge = g(edge);
-      for (int c = 0; c < in_.channels; ++c) sum_[c] += prev_radiance_[c] * (prev_g_hi_ - g_edge);
-      g_hi = g_edge;
+  // Visible sample of `entry` at height hx, `distance` steps from the receiver; nearer than
+  // every node visited before it.
+  void visit(float hx, float distance, std::size_t entry) {
+    visit(hx, distance, &in_.attributes[entry * (in_.channels + kBounceNormalFloats)]);
+  }
+
+  // Visible peak at height hx, `distance` steps from the receiver, `toward` of the step from the
+  // sample before it (entry `before`) to the one after it (`after`): their radiance so weighted.
+  void visitPeak(float hx, float distance, std::size_t before, std::size_t after, float toward) {
+    const int stride = in_.channels + kBounceNormalFloats;
+    float radiance[kMaxBounceChannels];
+    for (int c = 0; c < in_.channels; ++c) {
+      const float r0 = in_.attributes[before * stride + c], r1 = in_.attributes[after * stride + c];
+      radiance[c] = r0 + toward * (r1 - r0);
     }
-    prev_theta_ = theta;
-    prev_g_hi_ = g_hi;
-    const float* radiance = &in_.attributes[entry * (in_.channels + kBounceNormalFloats)];
-    for (int c = 0; c < in_.channels; ++c) prev_radiance_[c] = radiance[c];
-    have_prev_ = true;
-    adjacent_ = true;
+    visit(hx, distance, radiance);
   }
 
   // At a run's end: whether the next sample visited stays adjacent to the last one (no hidden
-  // sample between). A run that visited none keeps the run's before it unless it breaks it.
+  // sample between).
   void endRun(bool reached_next) { adjacent_ = adjacent_ && reached_next; }
 
   void finish(float* irradiance) {
@@ -173,6 +171,24 @@ class BounceGather {
   }
 
  private:
+  void visit(float hx, float distance, const float* radiance) {
+    const float theta = std::atan2(hx - h_, distance * ground_);
+    float g_hi;
+    if (!have_prev_) {
+      g_hi = g(theta);
+    } else {
+      const float edge = adjacent_ ? 0.5f * (prev_theta_ + theta) : theta;
+      const float g_edge = g(edge);
+      for (int c = 0; c < in_.channels; ++c) sum_[c] += prev_radiance_[c] * (prev_g_hi_ - g_edge);
+      g_hi = g_edge;
+    }
+    prev_theta_ = theta;
+    prev_g_hi_ = g_hi;
+    for (int c = 0; c < in_.channels; ++c) prev_radiance_[c] = radiance[c];
+    have_prev_ = true;
+    adjacent_ = true;
+  }
+
   float g(float theta) const {
     const float t = hfMax(theta, tangent_);
     const float s = std::sin(t), c = std::cos(t);
@@ -181,7 +197,6 @@ class BounceGather {
 
   const BounceLines& in_;
   float h_;
-  int step_;
   float ground_;
   float nz_term_ = 0.0f, nh_term_ = 0.0f, tangent_ = 0.0f;
   bool have_prev_ = false, adjacent_ = false;
@@ -301,9 +316,12 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
       weighted_sums[slot] = weighted_sum;
       const float h = peak ? out.peaks[e] : h_sample;
       // (Step 0 has no step before it, nor a peak.)
-      if (peak ? step == 0 || !tree_peak_inserted(h_sample_prev, h, h_sample, out.peak_offsets[e], line.stepScale(step))
-               : std::isnan(h))
-        continue;  // outputs stay NaN / zero
+      if (peak ? step == 0 || !tree_peak_inserted(h_sample_prev, h, h_sample, out.peak_offsets[e],
+                                                  line.stepScale(step))
+               : std::isnan(h)) {
+        if (peak) tree[slot].h = kNaN;  // no peak (the bounce's gather skips its slot)
+        continue;                       // outputs stay NaN / zero
+      }
       const float p = line.position(slot);
       std::uint32_t m = 0, hash = kHorizonHashSeed;
       int count = 0;
@@ -312,7 +330,7 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
       const bool receiver = !peak && step % out.receiver_every == out.receiver_every - 1;
       const bool visit = receiver || out.horizons_at_every_sample;  // a peak's only for the statistics
       std::optional<BounceGather> gather;
-      if (bounce && receiver) gather.emplace(*bounce, d, e, h, step);
+      if (bounce && receiver) gather.emplace(*bounce, d, e, h);
       if (root == kNone) {
         tree[slot] = {h, true, kNone, kNone};
         head = tail = kNone;
@@ -441,10 +459,21 @@ void sweepLine(const SweepDirection& d, int j, const HullTreeTuning& tuning, Int
             if (keep_horizons) run_starts.push_back(run_first), run_ends.push_back(end);
             if (gather) {
               for (int x = run_first; x < end; ++x) {
-                if (!line.isSample(x)) continue;
                 const int xs = line.sampleOf(x);
-                const float hx = line.sampleHeight(xs);
-                if (!std::isnan(hx)) gather->visit(hx, xs, line.entry(xs));
+                const float distance = static_cast<float>(step - xs);
+                if (line.isSample(x)) {
+                  const float hx = line.sampleHeight(xs);
+                  if (!std::isnan(hx)) gather->visit(hx, distance, line.entry(xs));
+                  continue;
+                }
+                // A peak where it is seen (as the kernel's gather takes it).
+                const float hx = tree[x].h;
+                if (std::isnan(hx) || x < hp ||
+                    (x != hp && x + 1 >= end && np != kNone && !seenOver(line, hx, x, nz.h, np, h, slot)))
+                  continue;
+                const float toward = static_cast<float>(out.peak_offsets[line.entry(xs)]) /
+                                     static_cast<float>(1 << line.shift);
+                gather->visitPeak(hx, distance + (1.0f - toward), line.entry(xs - 1), line.entry(xs), toward);
               }
               gather->endRun(end == np_first);
             }
