@@ -356,6 +356,8 @@ const std::vector<OptionSpec>& optionTable() {
        "(default 1: the crossings alone)",
        [](const std::string& typed, const std::string& value, RunArguments& run) {
          run.samples_per_unit = parsePositive(typed, value);
+         if (run.samples_per_unit > 64.0)  // (the library's bound, named here with the option)
+           throw UsageError(typed + ": at most 64 samples per pixel length, got " + inQuotes(value));
        }},
       {"--curvature", nullptr, nullptr, kEarthGroup, false,
        "lower every point at ground distance d by the Earth's drop\n"
@@ -642,6 +644,11 @@ const std::vector<OptionSpec>& optionTable() {
          const double a = parseNumber(typed, from), b = parseNumber(typed, to);
          if (!(a >= 0.0 && a <= 360.0 && b >= 0.0 && b <= 360.0))
            throw UsageError(typed + ": compass azimuths are in 0 .. 360 degrees, got " + inQuotes(value));
+         // (the library takes FROM = TO for the whole circle: 90,90 saw everything, exit 0)
+         if (a == b)
+           throw UsageError(typed + ": " + inQuotes(value) +
+                            " is no field of view (FROM = TO); leave --fov out, or give 0,360, for the whole "
+                            "circle");
          run.field_of_view = std::make_pair(a, b);
        }},
       {"--elevation-range", nullptr, "LO,HI", kViewshedGroup, false,

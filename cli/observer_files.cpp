@@ -135,8 +135,11 @@ std::vector<CsvPoint> parsePoints(const std::string& path, std::istream& in, dou
     }
     // (getline drops an empty last field: "1,1," would pass for "1,1" and "1,1,2," for "1,1,2")
     const bool trailing_comma = line[line.find_last_not_of(" \t")] == ',';
+    // (a third field that is no finite number: named, not taken for a bad column or row)
+    if (numbers && !trailing_comma && fields.size() == 3 && !number_in(fields[2], height))
+      throw IoError(path, "line " + std::to_string(number) + ": the height '" + shown(fields[2]) +
+                              "' is not a finite number, in '" + shown(line) + "'");
     if (!numbers || trailing_comma || fields.size() > 3 ||
-        (fields.size() == 3 && !number_in(fields[2], height)) ||
         (kind.whole && (col != std::floor(col) || row_index != std::floor(row_index))))
       throw IoError(path, "line " + std::to_string(number) + ": expected " + kind.expected + ", got '" +
                               shown(line) + "'");

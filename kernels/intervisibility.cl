@@ -1351,7 +1351,7 @@ __kernel void intervisibility_naive(__global const float* heights, int width, in
       barrier(CLK_LOCAL_MEM_FENCE);
       float t = (float)i * d.step_length;
       float px = (float)cc + t * d.dir_x, py = (float)rr + t * d.dir_y;
-      float q = sample_height(heights, width, height, px, py);
+      float q = sample_height_from(heights, width, height, cc, rr, t * d.dir_x, t * d.dir_y);
 #if HFVIS_ROW_SPACING
       int ring;
       const int at = ray_step(units, rr, i, step_y, height, &position, &ring);
@@ -1393,7 +1393,7 @@ __kernel void intervisibility_naive(__global const float* heights, int width, in
       for (int i = 1; i <= steps; ++i) {
         float t = (float)i * d.step_length;
         float px = (float)cc + t * d.dir_x, py = (float)rr + t * d.dir_y;
-        float q = sample_height(heights, width, height, px, py);
+        float q = sample_height_from(heights, width, height, cc, rr, t * d.dir_x, t * d.dir_y);
 #if HFVIS_ROW_SPACING
         int ring;
         const int at = ray_step(units, rr, i, step_y, height, &position, &ring);

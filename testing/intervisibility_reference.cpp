@@ -153,8 +153,9 @@ void naiveReference(const HeightField& field, const std::vector<float>& h, float
             position += ring;
             at = position;
           }
-          const float q = sampleHeight(h, width, height, p) -
-                          (options.curvature != 0.0 ? drop * static_cast<float>(at) * static_cast<float>(at) : 0.0f);
+          const float q =
+              sampleHeightFrom(h, width, height, c, r, t * d.dir_x, t * d.dir_y) -
+              (options.curvature != 0.0 ? drop * static_cast<float>(at) * static_cast<float>(at) : 0.0f);
           if (std::isnan(q)) continue;
           // Visible, or hidden only within the heights' rounding after a visible sample (as
           // every hidden one since it).

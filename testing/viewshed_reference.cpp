@@ -95,6 +95,18 @@ SightLine referenceSightLine(const HeightField& f, const Observer& o, const View
     const double bottom = heightAt(f, cx, y1) + (heightAt(f, x1, y1) - heightAt(f, cx, y1)) * u;
     return top + (bottom - top) * v - line(t);
   };
+  // What the line forgives over cell (cx, cy): `forgiven`, or where more 2^-21 of the cell's largest
+  // |corner| (cell_forgiven in kernels/viewshed.cl: the surface there rounds by units in the last
+  // place of its corners).
+  auto cellForgiven = [&](int cx, int cy) {
+    const int x1 = std::min(cx + 1, f.width - 1), y1 = std::min(cy + 1, f.height - 1);
+    double corners = 0.0;
+    for (const double v :
+         {heightAt(f, cx, cy), heightAt(f, x1, cy), heightAt(f, cx, y1), heightAt(f, x1, y1)})
+      if (!std::isnan(v)) corners = std::max(corners, std::fabs(v));
+    return std::max(forgiven, std::ldexp(corners, -21));
+  };
+  bool hidden = false;
   double rise = -std::numeric_limits<double>::infinity(), interior = rise, excess = rise;
   std::vector<double> fs(merged.size());
   for (std::size_t s = 0; s < merged.size(); ++s) {
@@ -109,6 +121,8 @@ SightLine referenceSightLine(const HeightField& f, const Observer& o, const View
     const int cx = std::clamp(static_cast<int>(std::floor(o.col + tm * dx)), 0, std::max(f.width - 2, 0));
     const int cy = std::clamp(static_cast<int>(std::floor(o.row + tm * dy)), 0, std::max(f.height - 2, 0));
     const int x1 = std::min(cx + 1, f.width - 1), y1 = std::min(cy + 1, f.height - 1);
+    const double tolerance = cellForgiven(cx, cy);
+    hidden = hidden || fs[s] > tolerance || fs[s + 1] > tolerance;
     // Along a grid line (dx dy = 0) the surface is the edge's straight line, beside nodata too.
     const double twist =
         dx * dy != 0.0 ? heightAt(f, cx, cy) - heightAt(f, x1, cy) - heightAt(f, cx, y1) + heightAt(f, x1, y1) : 0.0;
@@ -129,10 +143,11 @@ SightLine referenceSightLine(const HeightField& f, const Observer& o, const View
       if (tv > t0 && tv < t1) {
         rise = std::max(rise, inCell(cx, cy, tv));
         interior = std::max(interior, inCell(cx, cy, tv));
+        hidden = hidden || inCell(cx, cy, tv) > tolerance;
       }
     }
   }
-  return {!(rise > forgiven), rise, interior, excess};
+  return {!hidden, rise, interior, excess};
 }
 
 ViewshedResult referenceViewshed(const HeightField& f, const Observer& o, const ViewshedOptions& options,

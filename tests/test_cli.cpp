@@ -389,6 +389,7 @@ TEST_F(Cli, NonNumericValues) {
   expectFailure(run(base + " --z-scale tall"), 2, "--z-scale");
   expectFailure(run(base + " --cell-size 1,abc"), 2, "--cell-size");
   expectFailure(run(base + " --samples-per-unit -1"), 2, "--samples-per-unit");
+  expectFailure(run(base + " --samples-per-unit 1000"), 2, "--samples-per-unit: at most 64");
   expectFailure(run(base + " --method fast"), 2, "'fast'");
 }
 
@@ -2476,6 +2477,19 @@ TEST_F(Cli, ViewshedSeesOverAWall) {
     EXPECT_NE(named.err.find("names map coordinates"), std::string::npos) << named.err;
     EXPECT_FALSE(fs::exists(out("named.exr"))) << header;
   }
+  // A height that is no number is named as such (the message spoke of whole columns and rows).
+  for (const char* height : {"nan", "inf", "abc"}) {
+    {
+      std::ofstream csv(in("height.csv"));
+      csv << "1,1," << height << "\n";
+    }
+    const CliResult bad = run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("h.exr")) +
+                              " --observers " + shellQuoted(in("height.csv")));
+    EXPECT_EQ(bad.status, 1) << height;
+    EXPECT_NE(bad.err.find("the height '" + std::string(height) + "' is not a finite number"),
+              std::string::npos)
+        << bad.err;
+  }
 }
 
 TEST_F(Cli, ViewshedCulledEqualsExact) {
@@ -2521,6 +2535,10 @@ TEST_F(Cli, ViewshedRefusesBadObservers) {
   expectFailure(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) +
                     " --observer 1,2 --fov 10,400"),
                 2, "--fov");
+  // (FROM = TO, the library's whole circle, saw everything where the user asked for nothing)
+  expectFailure(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) +
+                    " --observer 1,2 --fov 90,90"),
+                2, "is no field of view");
   expectFailure(run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("v.exr")) + " --observer 1,2 -k 4"), 2,
                 "-k");
   const std::string holes = writeField("holes.exr", 8, 8, [](int col, int row) {

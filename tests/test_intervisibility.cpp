@@ -1051,7 +1051,13 @@ TEST(IntervisibilityAnalytic, EveryPointOfATiltedPlaneSeesEveryOther) {
                           // float32 rounds these at 500 and 1000, a spacing near the rise per cell
                           // (counted from the field's base, the same spacing or less)
                           {"gentle, far from zero", 500.0f, 0.1f, 0.0f},
-                          {"half a per mille, far from zero", 1000.0f, 0.0f, 0.005f}};
+                          {"half a per mille, far from zero", 1000.0f, 0.0f, 0.005f},
+                          // crossing 0 mid-field, where the heights (counted from the base, their
+                          // median) are near 0 and a sample's rounded position times the slope
+                          // passed the tie rule's rounding: the naive count fell from 300 to 3 on
+                          // a row of 2 (column - 50) (a probe's find)
+                          {"steep, crossing 0 mid-field", -48.0f, 2.0f, 0.0f},
+                          {"crossing 0 on a diagonal", -35.0f, 0.375f, 1.25f}};
   HeightField flat = makeSyntheticField("flat", w, h);
   flat.cell_size_x = flat.cell_size_y = 10.0;
   IntervisibilityOutputs outputs;

@@ -134,6 +134,9 @@ HFVIS_INLINE float bilinear_beside_nodata(float h00, float h10, float h01, float
   return !holed & (weight > 0.0f) ? base + sum / weight : NAN;
 }
 
+HFVIS_INLINE float sample_cell_at(__global const float* heights, int width, int height, int row0, int x0,
+                                  int y0, float fx, float fy);
+
 // Bilinear height at (px, py), clamped into the field; NaN where a corner of positive weight is
 // nodata (bilinear_beside_nodata). `heights` holds the field's rows from row0 on (rows beside
 // (px, py) among them).
@@ -146,10 +149,15 @@ HFVIS_INLINE float sample_height_rows(__global const float* heights, int width, 
   int x0 = (int)x, y0 = (int)y;
   x0 = x0 > width - 2 ? (width > 1 ? width - 2 : 0) : x0;
   y0 = y0 > height - 2 ? (height > 1 ? height - 2 : 0) : y0;
+  return sample_cell_at(heights, width, height, row0, x0, y0, x - (float)x0, y - (float)y0);
+}
+
+// The bilinear height in the cell of lower corner (x0, y0) (the far corner clamped to the field)
+// at fractions (fx, fy) of it; NaN where a corner of positive weight is nodata.
+HFVIS_INLINE float sample_cell_at(__global const float* heights, int width, int height, int row0, int x0,
+                                  int y0, float fx, float fy) {
   int x1 = x0 + 1 < width ? x0 + 1 : x0;
   int y1 = y0 + 1 < height ? y0 + 1 : y0;
-  float fx = x - (float)x0;
-  float fy = y - (float)y0;
   float h00 = heights[(y0 - row0) * width + x0];
   float h10 = heights[(y0 - row0) * width + x1];
   float h01 = heights[(y1 - row0) * width + x0];
@@ -168,6 +176,26 @@ HFVIS_INLINE float sample_height_rows(__global const float* heights, int width, 
 
 HFVIS_INLINE float sample_height(__global const float* heights, int width, int height, float px, float py) {
   return sample_height_rows(heights, width, height, 0, px, py);
+}
+
+// sample_height at (c + ox, r + oy), the fractions in the cell taken from the offsets, (c - x0) +
+// ox, exact where |ox| >= 2 (Sterbenz) and within a unit in the last place of 1 below: the absolute
+// position c + ox rounds by units in the last place of the column, which times a steep slope
+// passed the visibility tie rule's rounding where a plane crosses 0 far from the field's corner
+// (the naive visible count fell from 300 to 3 on h = 2 (column - 50), a probe's find). The cell is
+// the absolute position's (a fraction a rounding below 0 or above 1 extends the cell's surface).
+// src/core/sweep_geometry.hpp's sampleHeightFrom is the same.
+HFVIS_INLINE float sample_height_from(__global const float* heights, int width, int height, int c, int r,
+                                      float ox, float oy) {
+  const float px = (float)c + ox, py = (float)r + oy;
+  const float x = px < 0.0f ? 0.0f : (px > (float)(width - 1) ? (float)(width - 1) : px);
+  const float y = py < 0.0f ? 0.0f : (py > (float)(height - 1) ? (float)(height - 1) : py);
+  int x0 = (int)x, y0 = (int)y;
+  x0 = x0 > width - 2 ? (width > 1 ? width - 2 : 0) : x0;
+  y0 = y0 > height - 2 ? (height > 1 ? height - 2 : 0) : y0;
+  const float fx = x == px ? (float)(c - x0) + ox : x - (float)x0;  // (clamped: as sample_height)
+  const float fy = y == py ? (float)(r - y0) + oy : y - (float)y0;
+  return sample_cell_at(heights, width, height, 0, x0, y0, fx, fy);
 }
 
 // One sample of a period (src/core/lattice_geometry.hpp, struct LatticeSample): nine 4-byte

@@ -63,19 +63,41 @@ bool insideField(Point2 p, int width, int height) {
          p.y >= -kEdgeEpsilon && p.y <= static_cast<float>(height - 1) + kEdgeEpsilon;
 }
 
-float sampleHeight(const std::vector<float>& heights, int width, int height, Point2 p) {
-  const float x = std::clamp(p.x, 0.0f, static_cast<float>(width - 1));
-  const float y = std::clamp(p.y, 0.0f, static_cast<float>(height - 1));
-  const int x0 = std::min(static_cast<int>(std::floor(x)), std::max(width - 2, 0));
-  const int y0 = std::min(static_cast<int>(std::floor(y)), std::max(height - 2, 0));
+namespace {
+
+// The bilinear height in the cell of lower corner (x0, y0) at fractions (fx, fy) of it (the
+// kernels' sample_cell_at).
+float sampleCellAt(const std::vector<float>& heights, int width, int height, int x0, int y0, float fx,
+                   float fy) {
   const int x1 = std::min(x0 + 1, width - 1), y1 = std::min(y0 + 1, height - 1);
-  const float fx = x - static_cast<float>(x0), fy = y - static_cast<float>(y0);
   const float h00 = heights[y0 * width + x0], h10 = heights[y0 * width + x1];
   const float h01 = heights[y1 * width + x0], h11 = heights[y1 * width + x1];
   const float w00 = (1.0f - fx) * (1.0f - fy), w10 = fx * (1.0f - fy);
   const float w01 = (1.0f - fx) * fy, w11 = fx * fy;
   const float plain = cornerBilinear(h00, h10, h01, h11, w10, w01, w11);
   return std::isnan(plain) ? bilinearBesideNodata(h00, h10, h01, h11, w00, w10, w01, w11) : plain;
+}
+
+}  // namespace
+
+float sampleHeight(const std::vector<float>& heights, int width, int height, Point2 p) {
+  const float x = std::clamp(p.x, 0.0f, static_cast<float>(width - 1));
+  const float y = std::clamp(p.y, 0.0f, static_cast<float>(height - 1));
+  const int x0 = std::min(static_cast<int>(std::floor(x)), std::max(width - 2, 0));
+  const int y0 = std::min(static_cast<int>(std::floor(y)), std::max(height - 2, 0));
+  return sampleCellAt(heights, width, height, x0, y0, x - static_cast<float>(x0), y - static_cast<float>(y0));
+}
+
+float sampleHeightFrom(const std::vector<float>& heights, int width, int height, int c, int r, float ox,
+                       float oy) {
+  const float px = static_cast<float>(c) + ox, py = static_cast<float>(r) + oy;
+  const float x = std::clamp(px, 0.0f, static_cast<float>(width - 1));
+  const float y = std::clamp(py, 0.0f, static_cast<float>(height - 1));
+  const int x0 = std::min(static_cast<int>(std::floor(x)), std::max(width - 2, 0));
+  const int y0 = std::min(static_cast<int>(std::floor(y)), std::max(height - 2, 0));
+  const float fx = x == px ? static_cast<float>(c - x0) + ox : x - static_cast<float>(x0);
+  const float fy = y == py ? static_cast<float>(r - y0) + oy : y - static_cast<float>(y0);
+  return sampleCellAt(heights, width, height, x0, y0, fx, fy);
 }
 
 PreparedHeights prepareHeights(const HeightField& field, HeightOrigin origin, int bands) {

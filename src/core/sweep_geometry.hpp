@@ -85,6 +85,11 @@ inline float bilinearBesideNodata(float h00, float h10, float h01, float h11, fl
 }
 
 float sampleHeight(const std::vector<float>& heights, int width, int height, Point2 p);
+// sampleHeight at (c + ox, r + oy), the fractions in its cell taken from the offsets, exact where
+// |ox| >= 2 (the absolute position's rounding times a steep slope passed the tie rule's; the
+// kernels' sample_height_from): the naive visible count's samples.
+float sampleHeightFrom(const std::vector<float>& heights, int width, int height, int c, int r, float ox,
+                       float oy);
 
 // Heights as the kernels see them: (h - heightBase(field)) * z_scale in float, so that a plane
 // at 8848 m keeps its millimetres, a pixel far below the rest or not (a field with an origin
