@@ -336,9 +336,6 @@ bool sameFile(const std::string& a, const std::string& b) {
   return one;
 }
 
-// Every output can be written, none is an input (an output never replaces an input), and no
-// two outputs are the same file (the second would replace the first). Checked before the
-// input is read.
 // Every file a run reads: the input and the others, with the files a GDAL raster reads beside
 // itself (a VRT's sources).
 std::vector<std::string> filesOfInputs(const RunArguments& run, const Computation& computation) {
@@ -349,6 +346,9 @@ std::vector<std::string> filesOfInputs(const RunArguments& run, const Computatio
   return inputs;
 }
 
+// Every output can be written, none is an input (an output never replaces an input), and no
+// two outputs are the same file (the second would replace the first). Checked before the
+// input is read.
 void requireOutputs(const RunArguments& run, const Computation& computation) {
   const std::vector<std::string> outputs = computation.outputs();
   const std::vector<std::string> inputs = filesOfInputs(run, computation);
@@ -426,7 +426,11 @@ std::string joinPaths(const std::vector<std::string>& paths) {
 int runPipeline(const CommandLine& line, Computation& computation) {
   const RunArguments& run = line.run;
   requireOutputs(run, computation);
-  const std::vector<std::string> inputs_read = filesOfInputs(run, computation);
+  // The inputs' files as they are read stay protected whatever their paths name by the time the
+  // outputs are written (requireOutputs checked the paths before the work; a link made to an
+  // input since must not let an output replace it).
+  OutputFiles outputs;
+  outputs.protect(filesOfInputs(run, computation));
   HeightField input = readValidField(run);
   computation.prepare(input);
   // (a command on the host, writing text, opens no device; region writes text from the device)
@@ -439,11 +443,7 @@ int runPipeline(const CommandLine& line, Computation& computation) {
   computation.compute(job);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
-  // Everything is computed; now stage every file, then move them all into place. The inputs as
-  // they were read stay protected whatever their paths name by then (requireOutputs checked
-  // the paths before the work; a link made to an input since must not let an output replace it).
-  OutputFiles outputs;
-  outputs.protect(inputs_read);
+  // Everything is computed; now stage every file, then move them all into place.
   const Summary summary = computation.write(job, outputs);
   const std::vector<std::string> written = outputs.paths();
   outputs.commit();

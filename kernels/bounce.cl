@@ -1,6 +1,6 @@
 // bounce.cl: the one-bounce gather (Timonen 2013, Sec. 10.1, alternative 3;
 // include/hfvis/bounce.hpp states the formula), included by intervisibility.cl when
-// HFVIS_WANT_BOUNCE is set: the lattice sweep visits each receiver's visible samples, and
+// HFVIS_WANT_BOUNCE is set: the lattice sweep visits each receiver's visible samples and peaks, and
 // these helpers turn them into the receiver's irradiance. Mirrored by BounceGather in
 // src/core/scalar_hull_tree.cpp.
 //

@@ -19,7 +19,7 @@ std::vector<float> referenceRay(const HeightField& field, const std::vector<floa
     const float t = float(i) * d.step_length;
     const detail::Point2 p{float(c) + t * d.dir_x, float(r) + t * d.dir_y};
     if (!detail::insideField(p, field.width, field.height)) break;
-    ray.push_back(detail::sampleHeight(h, field.width, field.height, p));
+    ray.push_back(detail::sampleHeightFrom(h, field.width, field.height, c, r, t * d.dir_x, t * d.dir_y));
   }
   return ray;
 }

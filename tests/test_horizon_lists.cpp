@@ -563,6 +563,25 @@ TEST(HorizonLists, FarthestHorizonIsTheHorizonWhereNoPeakHidesIt) {
 // +x (k = 0), one horizon: the wall top, 7 away, whose segment holds the ground up to it
 // (grazing ground is visible) and itself; the ground behind the wall is hidden. Looking
 // toward -x (k = 2), the farthest ground sample, 3 away, with the whole ray.
+// On an exact plane crossing 0 at the receiver every sample of every ray is seen: the samples'
+// absolute positions rounded by units in the last place of the column, which times the slope of
+// 2 passed the tie rule's rounding near 0 (1 of 10 samples seen in some directions at column 49,
+// a review's find); they come from the offsets from the receiver now, as the naive count's. (Not
+// yet at column 50 itself, height 0: there a peak between samples, chosen on the rounded surface,
+// rises a rounding above its chord and hides 2 of 4 samples in 2 of 16 directions; ALGORITHMS.md.)
+TEST(HorizonLists, APlaneCrossingZeroAtTheReceiverIsSeenWhole) {
+  const int w = 101, h = 9;
+  std::vector<float> heights(std::size_t(w) * h);
+  for (int r = 0; r < h; ++r)
+    for (int c = 0; c < w; ++c) heights[std::size_t(r) * w + c] = 2.0f * float(c - 50);
+  SweepOptions options;
+  options.directions = 16;
+  for (const auto& receiver : {ReceiverPixel{49, 4}, ReceiverPixel{51, 2}, ReceiverPixel{20, 4}})
+    for (const DirectionHorizons& d :
+         computeHorizonLists(fieldFrom(w, h, heights), options, {receiver})[0].directions)
+      EXPECT_EQ(d.visible_samples, d.ray_samples) << receiver.col << " k = " << d.direction;
+}
+
 TEST(HorizonLists, WallAnalytic) {
   const int w = 21;
   std::vector<float> heights(w * 5, 0.0f);

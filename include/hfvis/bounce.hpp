@@ -1,7 +1,8 @@
 // hfvis/bounce.hpp: one diffuse light bounce on a height field: from a given exit radiance
 // per surface point, the incident indirect irradiance at every pixel, gathered over the
 // visible segments of each sweep line (Timonen 2013, Sec. 10.1, alternative 3: step through
-// the visible samples of each visibility horizon's segment).
+// the visible samples, and the surface's peaks between them, of each visibility horizon's
+// segment).
 //
 // The formula. Receiver p has the unit normal n of the four quads around its pixel (in
 // ground units, as ambient occlusion uses). Direction k stands for an azimuthal wedge of

@@ -31,7 +31,8 @@ struct HeightFieldReadOptions {
 };
 
 // Reads a height field. Georeferenced rasters (.tif/.tiff, .hgt, .asc, .vrt, .img, .bil, .dem,
-// .grd, .adf, by extension in any case) go through GDAL: the band (a zero-based index or a band
+// .grd, .adf, by extension in any case, and a regular file of TIFF bytes whatever its name) go
+// through GDAL: the band (a zero-based index or a band
 // description) is read, its values times its scale plus its offset where it declares them, its
 // nodata value and where its mask (a per-dataset mask, an alpha band) says no data NaN, a value
 // beyond float32's range an IoError naming its pixel, the cell size comes from the
@@ -40,7 +41,7 @@ struct HeightFieldReadOptions {
 // fill `georeference`, and a rotated or sheared geotransform is an IoError. Everything else is
 // read without georeference: an EXR (known by its magic number, whatever its name; part 0 of a
 // multi-part file, its data window) through OpenEXR, other images (PNG 8/16-bit, ...) through
-// OpenImageIO, TIFF bytes under another extension too (no GeoTIFF tags are read then). Integer
+// OpenImageIO. Integer
 // pixels are converted to their stored integer values (a 16-bit PNG holds heights 0..65535), not
 // normalised. Throws IoError naming the file and reason (missing, unreadable, truncated,
 // zero-sized, multi-channel without a channel choice, unknown channel).
@@ -178,7 +179,9 @@ class OutputFiles {
   std::vector<Protected> inputs_;
 };
 
-// Installs handlers of SIGINT, SIGTERM and SIGHUP (those not ignored, so nohup keeps working)
+// Installs handlers of SIGINT, SIGTERM, SIGHUP and the other signals that end a process by default
+// (SIGXCPU, SIGALRM, SIGUSR1, SIGPIPE, ...; those whose default is in force: nohup's ignored
+// SIGHUP and a program's own handlers stay)
 // that remove the temporary files of unfinished outputs, then end the process of the same
 // signal as before. For programs (the hfvis CLI installs them); a library never sets handlers.
 void removeTemporaryOutputsOnSignals();

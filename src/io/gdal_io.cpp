@@ -665,9 +665,17 @@ bool isGdalRaster(const std::string& path) {
   const std::string extension = lowercaseExtension(path);
   for (const char* gdal : {".tif", ".tiff", ".hgt", ".asc", ".vrt", ".img", ".bil", ".dem", ".grd", ".adf"})
     if (extension == gdal) return true;
+  return false;
+}
+
+bool isGdalHeightField(const std::string& path) {
+  if (isGdalRaster(path)) return true;
   // TIFF bytes under another name (.gtif, .gtiff, .cog, none) are a GeoTIFF still: read through
   // OpenImageIO they lost their nodata (-9999 became a pit 10 km deep), cell size and CRS, exit 0
-  // (a probe's find). Classic (II*, MM*) and BigTIFF (II+, MM+) headers.
+  // (a probe's find). Classic (II*, MM*) and BigTIFF (II+, MM+) headers; a regular file's alone
+  // (opening a FIFO would wait for a writer: it is refused as an input later, at once).
+  struct stat status {};
+  if (::stat(path.c_str(), &status) != 0 || !S_ISREG(status.st_mode)) return false;
   unsigned char magic[4] = {};
   std::ifstream in(path, std::ios::binary);
   if (!in.read(reinterpret_cast<char*>(magic), 4)) return false;

@@ -26,9 +26,14 @@ std::optional<std::pair<double, double>> storedCellSize(const std::string& path,
 // The extension of `path` in lower case, with its dot ("" when it has none).
 std::string lowercaseExtension(const std::string& path);
 
-// Whether `path` names a raster format that GDAL reads rather than OpenEXR or OpenImageIO: by its
-// extension, or a TIFF by its first bytes whatever its name.
+// Whether `path` names a raster format that GDAL reads rather than OpenEXR or OpenImageIO, by its
+// extension.
 bool isGdalRaster(const std::string& path);
+// As isGdalRaster, and a regular file of TIFF bytes whatever its name: a height field (a GeoTIFF
+// named .gtif, .cog or nothing keeps its nodata, cells and CRS). Other images (radiance,
+// environments, albedo, light images) go by the extension: OpenImageIO reads a TIFF's channels
+// by their names, and TIFF containers (.tx textures, camera raws) as the images they hold.
+bool isGdalHeightField(const std::string& path);
 
 // `path` and the files GDAL reads with it (a VRT's sources, nested VRTs' too, and what the
 // dataset lists: sidecars, world files); `path` alone where it does not open. Throws IoError for

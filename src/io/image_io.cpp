@@ -44,7 +44,7 @@ std::string attributeOf(const ImageChannels& image, const std::string& name) {
 }  // namespace
 
 HeightField readHeightField(const std::string& path, const HeightFieldReadOptions& options) {
-  if (detail::isGdalRaster(path)) return detail::readGdalHeightField(path, options);
+  if (detail::isGdalHeightField(path)) return detail::readGdalHeightField(path, options);
   double rounding = 0.0;
   ImageChannels image = readOtherImage(path, options.max_image_bytes, &options.channel, &rounding);
   HeightField field;
@@ -76,7 +76,7 @@ HeightField readHeightField(const std::string& path, const HeightFieldReadOption
 }
 
 std::vector<std::string> filesRead(const std::string& path) {
-  return detail::isGdalRaster(path) ? detail::gdalFilesRead(path) : std::vector<std::string>{path};
+  return detail::isGdalHeightField(path) ? detail::gdalFilesRead(path) : std::vector<std::string>{path};
 }
 
 ImageChannels readImage(const std::string& path) {

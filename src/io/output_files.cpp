@@ -290,11 +290,25 @@ std::vector<std::string> geoTiffSideFiles(const std::string& path) {
   std::vector<std::string> found;
   std::vector<std::pair<dev_t, ino_t>> seen;  // (a directory that ignores case finds one file twice)
   // PATH + suffix; and a TIFF's world files, STEM + ending (no other image's: a PNG's is .pgw).
+  // A world file goes only where no other TIFF of the stem may own it (STEM.tif beside STEM.tiff).
   constexpr const char* kEndings[] = {".aux.xml", ".aux", ".ovr", ".msk", "+.tfw", "+.tifw", "+.tiffw"};
+  const auto shared_stem = [](const std::string& base) {
+    struct stat own {};
+    const bool exists = ::stat(base.c_str(), &own) == 0;
+    for (const char* extension : {".tif", ".tiff", ".TIF", ".TIFF"}) {
+      struct stat other {};
+      const std::string name = fs::path(base).replace_extension(extension).string();
+      if (name != base && ::stat(name.c_str(), &other) == 0 &&
+          !(exists && other.st_dev == own.st_dev && other.st_ino == own.st_ino))
+        return true;
+    }
+    return false;
+  };
   for (const std::string& base : {path, resolvedTarget(path)})
     for (const char* suffix : kEndings)
       for (const bool upper : {false, true}) {
         const bool of_stem = suffix[0] == '+';
+        if (of_stem && shared_stem(base)) continue;
         std::string ending = suffix + (of_stem ? 1 : 0);
         if (upper)
           std::transform(ending.begin(), ending.end(), ending.begin(),
@@ -474,12 +488,16 @@ void OutputFiles::commit() {
 }
 
 void removeTemporaryOutputsOnSignals() {
-  // Every signal whose default ends the process, bar the core dumps of a fault: a CPU time limit
-  // (SIGXCPU, ulimit -t) and an alarm left the temporary files behind (a probe's find).
+  // The signals that end a process by default, bar a fault's: a CPU time limit (SIGXCPU, ulimit
+  // -t) and an alarm left the temporary files behind (a probe's find). Only where the default is
+  // in force: a handler of the program's own (a profiler's SIGPROF) or an ignored signal (nohup's
+  // SIGHUP) stays as it is.
   for (const int signal_number :
        {SIGINT, SIGTERM, SIGHUP, SIGXCPU, SIGALRM, SIGVTALRM, SIGPROF, SIGUSR1, SIGUSR2, SIGPIPE}) {
     struct sigaction current {};
-    if (::sigaction(signal_number, nullptr, &current) != 0 || current.sa_handler == SIG_IGN) continue;
+    if (::sigaction(signal_number, nullptr, &current) != 0 || (current.sa_flags & SA_SIGINFO) ||
+        current.sa_handler != SIG_DFL)
+      continue;
     struct sigaction action {};
     action.sa_handler = detail::onSignal;
     sigemptyset(&action.sa_mask);

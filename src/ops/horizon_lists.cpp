@@ -49,7 +49,7 @@ HorizonRay horizonRay(const HeightField& field, const std::vector<float>& height
       ray.rings.push_back(ring);
       at = static_cast<float>(position);
     }
-    const float q = sampleHeight(heights, field.width, field.height, p);
+    const float q = sampleHeightFrom(heights, field.width, field.height, c, r, t * d.dir_x, t * d.dir_y);
     ray.points.push_back(p);
     ray.surface.push_back(q);
     ray.heights.push_back(curvature != 0.0 ? q - drop * at * at : q);
