@@ -576,10 +576,12 @@ TEST(HorizonLists, APlaneCrossingZeroAtTheReceiverIsSeenWhole) {
     for (int c = 0; c < w; ++c) heights[std::size_t(r) * w + c] = 2.0f * float(c - 50);
   SweepOptions options;
   options.directions = 16;
-  for (const auto& receiver : {ReceiverPixel{49, 4}, ReceiverPixel{51, 2}, ReceiverPixel{20, 4}})
-    for (const DirectionHorizons& d :
-         computeHorizonLists(fieldFrom(w, h, heights), options, {receiver})[0].directions)
+  for (const auto& receiver : {ReceiverPixel{49, 4}, ReceiverPixel{51, 2}, ReceiverPixel{20, 4}}) {
+    const std::vector<ReceiverHorizons> lists = computeHorizonLists(fieldFrom(w, h, heights), options, {receiver});
+    ASSERT_EQ(lists.size(), 1u);
+    for (const DirectionHorizons& d : lists[0].directions)
       EXPECT_EQ(d.visible_samples, d.ray_samples) << receiver.col << " k = " << d.direction;
+  }
 }
 
 TEST(HorizonLists, WallAnalytic) {
