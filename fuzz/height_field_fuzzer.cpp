@@ -1,7 +1,7 @@
 // height_field_fuzzer: libFuzzer over the height-field loader. The input's first byte picks
-// the file's extension (.exr, .png, .tif through GDAL, or .hdr), the rest is the file: EXR bytes
-// go to OpenEXR under any of the others, the rest to OpenImageIO, which guesses the format from
-// the bytes. Reading must either give a valid field or throw hfvis::Error: any other
+// the file's extension (.exr, .png, .tif through GDAL, or .hdr), the rest is the file: TIFF bytes
+// go to GDAL and EXR bytes to OpenEXR under any of the others, the rest to OpenImageIO, which
+// guesses the format from the bytes. Reading must either give a valid field or throw hfvis::Error: any other
 // exception, a crash or a sanitizer report is a bug.
 #include <cstdint>
 
