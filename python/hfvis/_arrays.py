@@ -139,6 +139,21 @@ def heights_array(heights, nodata=None, cell_size=1.0):
     return converted
 
 
+def pvs_start(bits, shape, view_cell, tile):
+    """An earlier run's bits (2-D uint32) flat, once their shape is the grid's: view cells x words
+    (hfvis/pvs.hpp's PvsLayout: view cells and tiles over the W - 1 x H - 1 cells; the library
+    checks the count alone)."""
+    cells_y, cells_x = shape[0] - 1, shape[1] - 1
+    if view_cell >= 1 and tile >= 1 and cells_x >= 1 and cells_y >= 1:
+        views = -(-cells_x // view_cell) * -(-cells_y // view_cell)
+        words = -(-(-(-cells_x // tile) * -(-cells_y // tile)) // 32)
+        if bits.shape != (views, words):
+            raise InvalidArgumentError(f"start holds {bits.shape[0]} x {bits.shape[1]} words, where this field and grid "
+                                       f"have {views} view cells of {words} words: give the bits of a run on the same "
+                                       "field and grid")
+    return bits.ravel()
+
+
 def geometry(cell_size=None, z_scale=1.0, row_cell_sizes=None):
     """The field's cell sizes and z-scale as hfvis._core.height_field takes them. cell_size: a
     number (square cells), a pair (x, y), or None (1). row_cell_sizes: None, or a pair of
@@ -161,6 +176,9 @@ def geometry(cell_size=None, z_scale=1.0, row_cell_sizes=None):
                                        "holds")
     if np.ndim(z_scale) != 0 or np.asarray(z_scale).dtype.kind not in "iuf":
         raise InvalidArgumentError(f"z_scale must be a number, got {z_scale!r}")
+    if not (1e-12 <= float(z_scale) <= 1e12):  # (the CLI's --z-scale range)
+        raise InvalidArgumentError(f"z_scale must lie in 1e-12 .. 1e12, what the kernels' single precision holds, "
+                                   f"got {float(z_scale):g}")
     return {"cell_size_x": cx, "cell_size_y": cy, "row_cell_size_x": rows_x, "row_cell_size_y": rows_y,
             "z_scale": float(z_scale), "origin": []}
 
@@ -320,7 +338,7 @@ def compute(operation, heights, geometry, options, device="", progress=None):
                           "witnesses", "memory_budget_bytes", "estimate_entries", "curvature", "max_distance"))
         o.method = _enum(_core.PvsMethod, str(options.get("method", "agvs")).replace("-", "_"), "method")
         if options.get("start") is not None:
-            o.start = options["start"].tolist()
+            o.start = pvs_start(options["start"], heights.shape, grid.view_cell, grid.tile).tolist()
         return _core.pvs(field, grid, o, device=device, progress=progress)
     if operation == "horizon_lists":
         cols, rows = receiver_pixels(options["receivers"])

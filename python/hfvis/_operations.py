@@ -126,6 +126,9 @@ def _run(operation, heights, options, common):
         elif nodata is not None and not math.isnan(float(nodata)):
             data = data.map_blocks(_nodata_as_nan, nodata, dtype=np.float32)
         data = _flipped(data.astype(np.float32), flip_rows, flip_cols)
+        if common["progress"] is not None:  # (it was accepted and never called)
+            warnings.warn("progress is not called for a Dask array (its chunks run as Dask's tasks): use Dask's "
+                          "own progress bar (dask.diagnostics.ProgressBar)", stacklevel=3)
         if operation == "cumulative_viewshed":
             out = {"count": _dask.cumulative_viewshed(data, g, options, common["device"],
                                                        flips=(flip_rows, flip_cols))}
@@ -333,16 +336,67 @@ def _whole(name, value, least, most):
         raise InvalidArgumentError(f"{name} must be a whole number, got {value!r}")
     whole = int(value)
     if (least is not None and whole < least) or whole > most:
-        raise InvalidArgumentError(f"{name} must lie in {least if least is not None else '..'} .. {most}, got {whole}")
+        bound = f"lie in {least} .. {most}" if least is not None else f"be at most {most}"
+        raise InvalidArgumentError(f"{name} must {bound}, got {whole}")
     return whole
 
 
-def _real(name, value):
+def _real(name, value, least=None, most=None):
     """A number option as a float; anything else refused with its name (None, text or a list gave
-    float()'s bare TypeError or ValueError)."""
+    float()'s bare TypeError or ValueError); within least .. most where given (the CLI's ranges)."""
     if np.ndim(value) != 0 or np.asarray(value).dtype.kind not in "iuf":
         raise InvalidArgumentError(f"{name} must be a number, got {value!r}")
-    return float(value)
+    number = float(value)
+    if least is not None and not (least <= number <= most):
+        raise InvalidArgumentError(f"{name} must lie in {least:g} .. {most:g}, what the kernels' single precision "
+                                   f"holds, got {number:g}")
+    return number
+
+
+# The CLI's limits of lengths and heights (ground units): within them distances, their squares and
+# the sums over a field stay inside single precision.
+_MOST_LENGTH = 1e12
+
+
+def _height(name, value, absolute, what):
+    """A height above the surface (absolute: above 0): within the CLI's range, and >= 0 unless
+    absolute, as the CLI's (a negative one put the eye or sample below the surface: `what`)."""
+    number = _real(name, value, -_MOST_LENGTH, _MOST_LENGTH)
+    if number < 0 and not absolute:
+        raise InvalidArgumentError(f"{name} {number:g}: {what}; give a height >= 0 (or absolute=True)")
+    return number
+
+
+def _heights(name, value, absolute, what):
+    """A height or one per point (an array, left as given for the library's own checks of its
+    shape), each as _height's."""
+    if np.ndim(value) == 0:
+        return _height(name, value, absolute, what)
+    values = np.asarray(value)
+    if values.dtype.kind in "iuf" and values.size:
+        lowest, highest = float(np.nanmin(values)), float(np.nanmax(values))
+        if highest > _MOST_LENGTH or lowest < -_MOST_LENGTH:
+            raise InvalidArgumentError(f"{name} must lie in {-_MOST_LENGTH:g} .. {_MOST_LENGTH:g}, what the kernels' "
+                                       f"single precision holds, got {highest if highest > _MOST_LENGTH else lowest:g}")
+        if lowest < 0 and not absolute:
+            raise InvalidArgumentError(f"{name} {lowest:g}: {what}; give heights >= 0 (or absolute=True)")
+    return value
+
+
+def _points(name, value, absolute, what):
+    """A region: a rectangle (4 numbers, left to the library) or N x 2 / N x 3 points, whose
+    heights (the third column) _heights checks."""
+    try:
+        values = np.asarray(value) if not isinstance(value, (str, bytes)) else None
+    except ValueError:  # (ragged: the library's own message names it)
+        values = None
+    if values is not None and values.ndim == 2 and values.shape[1] == 3 and values.dtype.kind in "iuf":
+        _heights(f"{name}' heights", values[:, 2], absolute, what)
+    return value
+
+
+_EYE_BELOW = "an eye below the surface sees nothing"
+_SAMPLE_BELOW = "a sample below the surface is hidden from everything"
 
 
 def _flag(name, value):
@@ -376,7 +430,7 @@ def _horizon(directions, azimuth_offset, samples_per_unit, curvature, max_distan
     return {"directions": _whole("directions", directions, None, 2**31 - 1),
             "azimuth_offset": _real("azimuth_offset", azimuth_offset),
             "samples_per_unit": _real("samples_per_unit", samples_per_unit),
-            "curvature": _real("curvature", curvature), "max_distance": _real("max_distance", max_distance),
+            "curvature": _real("curvature", curvature), "max_distance": _real("max_distance", max_distance, 0.0, _MOST_LENGTH),
             "memory_budget_bytes": _budget(memory_budget_bytes), "method": method,
             "azimuth_tolerance": None if azimuth_tolerance is None else _real("azimuth_tolerance", azimuth_tolerance),
             "strip_rows": _whole("strip_rows", strip_rows, 0, 2**31 - 1)}
@@ -568,39 +622,55 @@ def intervisibility(heights, *, directions=64, azimuth_offset=0.0, samples_per_u
     return xr.Dataset(variables)
 
 
+def _field_of_view(azimuth_from_deg, azimuth_to_deg):
+    """The azimuths of a field of view (both None: the whole circle). The library takes FROM = TO
+    for the whole circle, so equal ones given are refused, as the CLI's --fov (90, 90 saw
+    everything)."""
+    if azimuth_from_deg is None and azimuth_to_deg is None:
+        return {"azimuth_from_deg": 0.0, "azimuth_to_deg": 0.0}
+    if azimuth_from_deg is None or azimuth_to_deg is None:
+        raise InvalidArgumentError("give both azimuth_from_deg and azimuth_to_deg (or neither, for the whole circle)")
+    start, end = _real("azimuth_from_deg", azimuth_from_deg), _real("azimuth_to_deg", azimuth_to_deg)
+    if start == end:
+        raise InvalidArgumentError(f"azimuth_from_deg = azimuth_to_deg = {start:g} is no field of view; leave both out, "
+                                   "or give 0 and 360, for the whole circle")
+    return {"azimuth_from_deg": start, "azimuth_to_deg": end}
+
+
 def _sight(absolute, target_height, max_distance, curvature, azimuth_from_deg, azimuth_to_deg, elevation_min_deg,
            elevation_max_deg, memory_budget_bytes):
     """The options a viewshed and a cumulative viewshed share."""
-    return {"absolute": _flag("absolute", absolute), "target_height": _real("target_height", target_height),
-            "max_distance": _real("max_distance", max_distance), "curvature": _real("curvature", curvature),
-            "azimuth_from_deg": _real("azimuth_from_deg", azimuth_from_deg),
-            "azimuth_to_deg": _real("azimuth_to_deg", azimuth_to_deg),
+    return {"absolute": _flag("absolute", absolute), "target_height": _real("target_height", target_height, 0.0, _MOST_LENGTH),
+            "max_distance": _real("max_distance", max_distance, 0.0, _MOST_LENGTH), "curvature": _real("curvature", curvature),
+            **_field_of_view(azimuth_from_deg, azimuth_to_deg),
             "elevation_min_deg": _real("elevation_min_deg", elevation_min_deg),
             "elevation_max_deg": _real("elevation_max_deg", elevation_max_deg),
             "memory_budget_bytes": _budget(memory_budget_bytes)}
 
 
 def viewshed(heights, observer, *, observer_height=2.0, absolute=False, target_height=0.0, max_distance=0.0,
-             curvature=0.0, azimuth_from_deg=0.0, azimuth_to_deg=0.0, elevation_min_deg=-90.0,
+             curvature=0.0, azimuth_from_deg=None, azimuth_to_deg=None, elevation_min_deg=-90.0,
              elevation_max_deg=90.0, memory_budget_bytes=0, pixels=False, cell_size=None, z_scale=1.0, nodata=None,
              device=""):
     """What an observer sees: 1 visible, 0 hidden or out of range, NaN at nodata. `observer`: a
     pixel (column, row) for a numpy array; map coordinates (x, y) for a DataArray (a pixel with
     pixels=True)."""
-    options = {"observer": observer, "observer_height": _real("observer_height", observer_height),
+    options = {"observer": observer,
+               "observer_height": _height("observer_height", observer_height, _flag("absolute", absolute), _EYE_BELOW),
                **_sight(absolute, target_height, max_distance, curvature, azimuth_from_deg, azimuth_to_deg,
                         elevation_min_deg, elevation_max_deg, memory_budget_bytes)}
     return _single("viewshed", "visible", heights, options, _common(cell_size, z_scale, nodata, device, None, pixels))
 
 
 def cumulative_viewshed(heights, observers, *, observer_height=2.0, absolute=False, target_height=0.0,
-                        max_distance=0.0, curvature=0.0, azimuth_from_deg=0.0, azimuth_to_deg=0.0,
+                        max_distance=0.0, curvature=0.0, azimuth_from_deg=None, azimuth_to_deg=None,
                         elevation_min_deg=-90.0, elevation_max_deg=90.0, memory_budget_bytes=0, pixels=False,
                         cell_size=None, z_scale=1.0, nodata=None, device="", progress=None):
     """How many of the observers (an N x 2 array: pixels (column, row), or map coordinates (x, y)
     for a DataArray) see each point; observer_height a number or one per observer. A Dask-backed
     DataArray splits the observers into groups computed as separate tasks and sums them."""
-    options = {"observers": observers, "observer_height": observer_height,
+    options = {"observers": observers, "observer_height": _heights("observer_height", observer_height,
+                                                                   _flag("absolute", absolute), _EYE_BELOW),
                **_sight(absolute, target_height, max_distance, curvature, azimuth_from_deg, azimuth_to_deg,
                         elevation_min_deg, elevation_max_deg, memory_budget_bytes)}
     return _single("cumulative_viewshed", "count", heights, options,
@@ -617,7 +687,7 @@ def sun_shading(heights, azimuth_deg, elevation_deg, *, size_deg=0.53, samples_p
                "elevation_deg": _real("elevation_deg", elevation_deg), "size_deg": _real("size_deg", size_deg),
                "samples_per_unit": _real("samples_per_unit", samples_per_unit),
                "curvature": _real("curvature", curvature),
-               "max_distance": _real("max_distance", max_distance), "memory_budget_bytes": _budget(memory_budget_bytes)}
+               "max_distance": _real("max_distance", max_distance, 0.0, _MOST_LENGTH), "memory_budget_bytes": _budget(memory_budget_bytes)}
     return _pair("sun_shading", SunShading, heights, options, _common(cell_size, z_scale, nodata, device, progress))
 
 
@@ -635,7 +705,7 @@ def insolation(heights, latitude_deg, longitude_deg, start, end, *, step_minutes
                "apparent": _flag("apparent", apparent),
                "samples_per_unit": _real("samples_per_unit", samples_per_unit),
                "curvature": _real("curvature", curvature),
-               "max_distance": _real("max_distance", max_distance), "memory_budget_bytes": _budget(memory_budget_bytes)}
+               "max_distance": _real("max_distance", max_distance, 0.0, _MOST_LENGTH), "memory_budget_bytes": _budget(memory_budget_bytes)}
     return _pair("insolation", Insolation, heights, options, _common(cell_size, z_scale, nodata, device, progress))
 
 
@@ -694,12 +764,13 @@ def region_visibility(heights, sources, *, samples=16, height=2.0, absolute=Fals
     over the rectangle (row 0 along its lowest row), each sample taking the bilinear colour at its
     position (as arealight --light-image); then rgb (3 x H x W; DataArray: a Dataset variable
     "rgb" over "channel" R, G, B): per point the colours of the samples it sees, summed, / S."""
-    options = {"sources": sources, "samples": _whole("samples", samples, None, 2**31 - 1),
-               "height": _real("height", height),
+    options = {"sources": _points("sources", sources, _flag("absolute", absolute), _SAMPLE_BELOW),
+               "samples": _whole("samples", samples, None, 2**31 - 1),
+               "height": _height("height", height, _flag("absolute", absolute), _SAMPLE_BELOW),
                "absolute": _flag("absolute", absolute),
-               "target_height": _real("target_height", target_height), "method": method,
+               "target_height": _real("target_height", target_height, 0.0, _MOST_LENGTH), "method": method,
                "seed": _whole("seed", seed, 0, 2**32 - 1),
-               "decorrelate": _flag("decorrelate", decorrelate), "max_distance": _real("max_distance", max_distance),
+               "decorrelate": _flag("decorrelate", decorrelate), "max_distance": _real("max_distance", max_distance, 0.0, _MOST_LENGTH),
                "curvature": _real("curvature", curvature),
                "light_image": light_image}
     if _is_dataarray(heights) and _is_dask(heights.data):
@@ -732,12 +803,15 @@ def region_pair_visibility(heights, sources, receivers, *, samples=16, source_he
     receiver_fraction (the share of the other region's samples each sees), clear_pairs, pairs,
     visible_fraction, and sources_xy / receivers_xy (map coordinates of a georeferenced
     DataArray, else None). progress as region_visibility's."""
-    options = {"sources": sources, "receivers": receivers, "samples": _whole("samples", samples, None, 2**31 - 1),
-               "source_height": _real("source_height", source_height),
-               "receiver_height": _real("receiver_height", receiver_height),
+    above_zero = _flag("absolute", absolute)
+    options = {"sources": _points("sources", sources, above_zero, _SAMPLE_BELOW),
+               "receivers": _points("receivers", receivers, above_zero, _SAMPLE_BELOW),
+               "samples": _whole("samples", samples, None, 2**31 - 1),
+               "source_height": _height("source_height", source_height, above_zero, _SAMPLE_BELOW),
+               "receiver_height": _height("receiver_height", receiver_height, above_zero, _SAMPLE_BELOW),
                "absolute": _flag("absolute", absolute), "method": method, "seed": _whole("seed", seed, 0, 2**32 - 1),
                "decorrelate": _flag("decorrelate", decorrelate),
-               "max_distance": _real("max_distance", max_distance), "curvature": _real("curvature", curvature)}
+               "max_distance": _real("max_distance", max_distance, 0.0, _MOST_LENGTH), "curvature": _real("curvature", curvature)}
     if _is_dataarray(heights) and _is_dask(heights.data):
         heights = _computed(heights)
     out, grid = _run("region_pair_visibility", heights, options,
@@ -753,6 +827,20 @@ def region_pair_visibility(heights, sources, receivers, *, samples=16, source_he
                                 out["receiver_fraction"], int(out["clear_pairs"]), pairs,
                                 int(out["clear_pairs"]) / pairs if pairs else 0.0, xy(out["sources"]),
                                 xy(out["receivers"]))
+
+
+def _pvs_start(start):
+    """An earlier run's bits (its Pvs.bits: view cells x words) as uint32; their shape is checked
+    against the grid's when the field's size is known (_arrays). Another dtype, a shape other than
+    2-D or values outside uint32 are refused (text gave int()'s bare ValueError; float64 or a square
+    of the right count passed)."""
+    bits = np.asarray(start)
+    if bits.dtype.kind not in "iu" or bits.ndim != 2:
+        raise InvalidArgumentError(f"start must be an earlier run's bits (Pvs.bits: a 2-D uint32 array, view cells x "
+                                   f"words), got {bits.ndim}-D {bits.dtype}")
+    if bits.size and (int(bits.min()) < 0 or int(bits.max()) > 0xFFFFFFFF):
+        raise InvalidArgumentError("start must be an earlier run's bits (Pvs.bits): values outside uint32")
+    return np.ascontiguousarray(bits, dtype=np.uint32)
 
 
 def pvs(heights, *, samples=0, pixel_error=0.0, seconds=0.0, view_cell=32, band_low=1.7, band_high=1.7, tile=16,
@@ -782,7 +870,7 @@ def pvs(heights, *, samples=0, pixel_error=0.0, seconds=0.0, view_cell=32, band_
     and what it sees (0: none)."""
     if not (isinstance(estimate_entries, (int, np.integer)) and 0 <= estimate_entries <= 1_000_000):
         raise InvalidArgumentError(f"estimate_entries must be a whole number in 0 .. 1e6, got {estimate_entries!r}")
-    options = {"samples": _whole("samples", samples, None, 2**31 - 1), "pixel_error": _real("pixel_error", pixel_error),
+    options = {"samples": _whole("samples", samples, 0, 2**31 - 1), "pixel_error": _real("pixel_error", pixel_error),
                "seconds": _real("seconds", seconds), "view_cell": _whole("view_cell", view_cell, None, 2**31 - 1),
                "band_low": _real("band_low", band_low), "band_high": _real("band_high", band_high),
                "tile": _whole("tile", tile, None, 2**31 - 1),
@@ -792,8 +880,8 @@ def pvs(heights, *, samples=0, pixel_error=0.0, seconds=0.0, view_cell=32, band_
                "filter": _real("filter", filter), "view_filter": _whole("view_filter", view_filter, 0, 8),
                "estimate_entries": int(estimate_entries), "witnesses": _flag("witnesses", witnesses),
                "memory_budget_bytes": _budget(memory_budget_bytes), "curvature": _real("curvature", curvature),
-               "max_distance": _real("max_distance", max_distance),
-               "start": None if start is None else np.ascontiguousarray(start, dtype=np.uint32).ravel()}
+               "max_distance": _real("max_distance", max_distance, 0.0, _MOST_LENGTH),
+               "start": None if start is None else _pvs_start(start)}
     if _is_dataarray(heights) and _is_dask(heights.data):
         heights = _computed(heights)
     out, _ = _run("pvs", heights, options, _common(cell_size, z_scale, nodata, device, progress))

@@ -202,6 +202,8 @@ def _geotransform(array):
 
 
 def _spacing(values, dim, dtype):
+    if not np.all(np.isfinite(values)):  # (numpy's allclose warned of its tolerance first)
+        raise InvalidArgumentError(f"the {dim} coordinates hold a NaN or an infinity: hfvis needs a regular grid")
     steps = np.diff(values)
     step = (values[-1] - values[0]) / (len(values) - 1)
     # (the coordinates' own rounding allowed for: float32 latitudes of a 3-arc-second grid step

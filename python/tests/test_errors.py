@@ -36,7 +36,7 @@ def test_bad_heights(bad, kind, words):
     (lambda h: hfvis.sky_view_factor(h, directions=0), "K"),
     (lambda h: hfvis.sky_view_factor(h, cell_size=-1.0), "cell size"),
     (lambda h: hfvis.sky_view_factor(h, cell_size=(1.0, 2.0, 3.0)), "pair"),
-    (lambda h: hfvis.sky_view_factor(h, z_scale=0.0), "z-scale"),
+    (lambda h: hfvis.sky_view_factor(h, z_scale=0.0), "z_scale must lie in 1e-12 .. 1e12"),
     (lambda h: hfvis.sky_view_factor(h, max_distance=-5.0), "distance"),
     (lambda h: hfvis.sky_view_factor(h, method="ray"), "method"),
     (lambda h: hfvis.viewshed(h, (20, 3)), "outside"),
@@ -56,7 +56,7 @@ def test_bad_heights(bad, kind, words):
     (lambda h: hfvis.sky_view_factor(h, nodata="x"), "nodata"),
     (lambda h: hfvis.sky_view_factor(h, directions=8.5), "whole number"),
     (lambda h: hfvis.sky_view_factor(h, directions="8"), "whole number"),
-    (lambda h: hfvis.sky_view_factor(h, directions=2**40), "directions must lie"),
+    (lambda h: hfvis.sky_view_factor(h, directions=2**40), "directions must be at most"),
     (lambda h: hfvis.sky_view_factor(h, memory_budget_bytes=-1), "memory_budget_bytes must lie"),
     (lambda h: hfvis.sky_view_factor(h.astype(np.float64) + 1e10), "rounds them"),
     (lambda h: hfvis.sky_view_factor((h * 100).astype(np.int64) + 2**40), "rounds them"),
@@ -68,7 +68,7 @@ def test_bad_heights(bad, kind, words):
     (lambda h: hfvis.region_visibility(h, [(3.0, 30.0)]), "outside"),
     (lambda h: hfvis.region_visibility(h, np.zeros((0, 2))), "rectangle"),
     (lambda h: hfvis.region_visibility(h, (0, 0, 3, 3), method="bogus"), "method"),
-    (lambda h: hfvis.region_visibility(h, (0, 0, 3, 3), target_height=-1), "target height"),
+    (lambda h: hfvis.region_visibility(h, (0, 0, 3, 3), target_height=-1), "target_height must lie in 0"),
     (lambda h: hfvis.region_pair_visibility(h, (0, 0, 3, 3), (5, 5, 6, 6), method="viewsheds"), "viewsheds"),
     (lambda h: hfvis.region_pair_visibility(h, (0, 0, 3, 3), (5, 5, 6, 60)), "outside"),
     (lambda h: hfvis.pvs(h), "budget"),
@@ -304,7 +304,7 @@ def test_integer_options_and_dask_edges_are_refused_clearly():
     with pytest.raises(hfvis.InvalidArgumentError, match="beyond float32's range"):
         hfvis.sky_view_factor(far, directions=8, max_distance=100).compute()
     for distance in (float("nan"), float("inf")):
-        with pytest.raises(hfvis.InvalidArgumentError, match="finite max_distance"):
+        with pytest.raises(hfvis.InvalidArgumentError, match="max_distance must lie in 0 .. 1e\\+12"):
             hfvis.sky_view_factor(a, directions=8, max_distance=distance).compute()
     with pytest.raises(hfvis.InvalidArgumentError, match="empty"):
         hfvis.sky_view_factor(a[:0], directions=8, max_distance=100).compute()
@@ -380,3 +380,54 @@ def test_options_of_the_wrong_kind_are_named(call):
     and ValueError, or a failure mid-run, before)."""
     with pytest.raises(hfvis.InvalidArgumentError):
         call(np.random.default_rng(2).random((24, 20), dtype=np.float32))
+
+
+@pytest.mark.parametrize("call, words", [
+    (lambda h: hfvis.viewshed(h, (5, 5), observer_height=-1), "an eye below the surface sees nothing"),
+    (lambda h: hfvis.cumulative_viewshed(h, [(5, 5), (6, 6)], observer_height=[1.0, -3.0]), "observer_height -3"),
+    (lambda h: hfvis.region_visibility(h, (5, 5, 10, 10), samples=8, height=-1), "a sample below the surface"),
+    (lambda h: hfvis.region_pair_visibility(h, (1, 1, 4, 4), (12, 12, 15, 15), samples=8, receiver_height=-1),
+     "receiver_height -1"),
+    (lambda h: hfvis.region_pair_visibility(h, np.array([[5.0, 5.0, -1.0]]), (12, 12, 15, 15), samples=8),
+     "sources' heights -1"),
+    (lambda h: hfvis.viewshed(h, (5, 5), azimuth_from_deg=90, azimuth_to_deg=90), "is no field of view"),
+    (lambda h: hfvis.cumulative_viewshed(h, [(5, 5)], azimuth_from_deg=90), "give both azimuth_from_deg"),
+    (lambda h: hfvis.sky_view_factor(h, z_scale=1e13), "z_scale must lie in 1e-12 .. 1e12"),
+    (lambda h: hfvis.viewshed(h, (5, 5), observer_height=1e13), "observer_height must lie in"),
+    (lambda h: hfvis.viewshed(h, (5, 5), target_height=1e13), "target_height must lie in 0 .. 1e\\+12"),
+    (lambda h: hfvis.sky_view_factor(h, directions=2**40), "directions must be at most 2147483647"),
+    (lambda h: hfvis.pvs(h, samples=-1), "samples must lie in 0 .."),
+    (lambda h: hfvis.pvs(h, samples=100, start="junk"), "start must be an earlier run's bits"),
+    (lambda h: hfvis.pvs(h, samples=100, view_cell=8, tile=4, start=np.zeros((3, 3), np.uint32)),
+     "start holds 3 x 3 words, where this field and grid have 9 view cells of 1 words"),
+    (lambda h: hfvis.pvs(h, samples=100, view_cell=8, tile=4, start=np.zeros((9, 1))), "2-D float64"),
+])
+def test_what_the_cli_refuses_python_refuses_too(small, call, words):
+    """A probe's finds (2026-12-07): these ran, the CLI refusing each (a negative eye height saw
+    one point, equal azimuths the whole circle), or gave nanobind's or int()'s bare errors."""
+    with pytest.raises(hfvis.InvalidArgumentError, match=words):
+        call(small)
+
+
+def test_heights_below_zero_run_when_absolute_and_the_whole_circle_by_default(small):
+    assert hfvis.viewshed(small, (5, 5), observer_height=-1, absolute=True).shape == small.shape
+    whole = hfvis.viewshed(small, (5, 5))
+    assert np.array_equal(whole, hfvis.viewshed(small, (5, 5), azimuth_from_deg=0, azimuth_to_deg=360))
+    assert hfvis.viewshed(small, (5, 5), azimuth_from_deg=90, azimuth_to_deg=91).sum() < whole.sum()
+
+
+def test_an_earlier_runs_bits_resume_a_pvs_and_a_dask_progress_is_warned_of(small):
+    first = hfvis.pvs(small, samples=200, view_cell=8, tile=4)
+    assert hfvis.pvs(small, samples=200, view_cell=8, tile=4, start=first.bits, seed=2).bits.shape == first.bits.shape
+    import dask.array as da
+
+    a = xr.DataArray(da.from_array(small, chunks=8), dims=("y", "x"))
+    with pytest.warns(UserWarning, match="progress is not called for a Dask array"):
+        hfvis.sky_view_factor(a, directions=4, max_distance=3, progress=lambda *args: None).compute()
+
+
+def test_a_nan_coordinate_is_named():
+    z = np.zeros((4, 5), np.float32)
+    a = xr.DataArray(z, dims=("y", "x"), coords={"y": np.arange(4.0), "x": np.r_[np.arange(4.0), np.nan]})
+    with pytest.raises(hfvis.InvalidArgumentError, match="the x coordinates hold a NaN"):
+        hfvis.sky_view_factor(a, directions=4)

@@ -304,11 +304,12 @@ std::vector<std::string> geoTiffSideFiles(const std::string& path) {
     }
     return false;
   };
-  for (const std::string& base : {path, resolvedTarget(path)})
+  for (const std::string& base : {path, resolvedTarget(path)}) {
+    const bool stem_shared = shared_stem(base);
     for (const char* suffix : kEndings)
       for (const bool upper : {false, true}) {
         const bool of_stem = suffix[0] == '+';
-        if (of_stem && shared_stem(base)) continue;
+        if (of_stem && stem_shared) continue;
         std::string ending = suffix + (of_stem ? 1 : 0);
         if (upper)
           std::transform(ending.begin(), ending.end(), ending.begin(),
@@ -323,6 +324,7 @@ std::vector<std::string> geoTiffSideFiles(const std::string& path) {
         seen.push_back(id);
         found.push_back(side);
       }
+  }
   return found;
 }
 
