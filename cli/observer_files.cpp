@@ -129,6 +129,21 @@ std::vector<CsvPoint> parsePoints(const std::string& path, std::istream& in, dou
                       "line " + std::to_string(number) + ": the header '" + shown(line) +
                           "' names map coordinates: the file holds pixel columns and rows, col,row[,height] "
                           "(or row,col[,height]); convert the coordinates to pixels first");
+      // The columns are read by position: a header that names a column or a row in another place,
+      // or a height among the first two, says the file is laid out otherwise (id,col,row was read
+      // as column 7, row 30, height 40, exit 0).
+      const auto height_name = [&](const std::string& n) {
+        return is(n, {"height", "heights", "h", "z", "elevation", "altitude", "alt", "eye"});
+      };
+      const auto place = [&](const std::string& n) { return column(n) || row_name(n); };
+      bool elsewhere = names.size() >= 2 && (place(names[0]) != place(names[1]) ||
+                                             (place(names[0]) && column(names[0]) == column(names[1])) ||
+                                             height_name(names[0]) || height_name(names[1]));
+      for (std::size_t i = 2; i < names.size(); ++i) elsewhere = elsewhere || place(names[i]);
+      if (elsewhere)
+        throw IoError(path, "line " + std::to_string(number) + ": the header '" + shown(line) +
+                                "' lays the columns out otherwise: the file's fields are read by position, "
+                                "col,row[,height] (or row,col[,height]); reorder them");
       header_seen = true;
       row_first = names.size() >= 2 && row_name(names[0]) && column(names[1]);
       continue;

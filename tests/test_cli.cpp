@@ -593,6 +593,47 @@ TEST_F(Cli, TwoOutputsInOneDirectoryMountedTwiceAreRefused) {
   EXPECT_TRUE(listDirectory(out("a")).empty());
 }
 
+// A raster read beside a georeferenced field and taken pixel by pixel (an albedo, an exit radiance,
+// a view mask) must lie on the field's grid: a south-up one beside a north-up field lay mirrored,
+// one of another place or CRS was taken, exit 0. Without a georeference it is taken by position.
+TEST_F(Cli, SideRastersOnAnotherGridAreRefused) {
+  const std::string tif = in("dem.tif");
+  std::vector<float> values, albedo(20 * 16, 0.5f);
+  for (int i = 0; i < 20 * 16; ++i) values.push_back(static_cast<float>((i * 7) % 13));
+  const std::array<double, 6> north = hfvis::testing::kUtmGeotransform;
+  const std::array<double, 6> south = {north[0], north[1], 0.0, north[3] + 16 * north[5], 0.0, -north[5]};
+  const std::array<double, 6> shifted = {north[0] + 30.0, north[1], 0.0, north[3], 0.0, north[5]};
+  const std::string utm33 = hfvis::testing::crsWkt("EPSG:32633");
+  hfvis::testing::writeGdalGeoTiff(tif, 20, 16, values, north, utm33, -9999.0);
+  struct Case {
+    const char* name;
+    std::array<double, 6> transform;
+    std::string crs;
+    const char* words;  // "" = taken
+  };
+  for (const Case& c : {Case{"same", north, utm33, ""}, Case{"south", south, utm33, "lies on another grid"},
+                        Case{"shifted", shifted, utm33, "lies on another grid"},
+                        Case{"zone34", north, hfvis::testing::crsWkt("EPSG:32634"), "is in another CRS"}}) {
+    SCOPED_TRACE(c.name);
+    const std::string side = in(std::string(c.name) + ".tif");
+    hfvis::testing::writeGdalGeoTiff(side, 20, 16, albedo, c.transform, c.crs, std::nullopt);
+    for (const std::string& command :
+         {"shade " + shellQuoted(tif) + " --sun 120,25 --albedo " + shellQuoted(side),
+          "bounce " + shellQuoted(tif) + " -k 4 --radiance " + shellQuoted(side),
+          "pvs " + shellQuoted(tif) + " --samples 1000 --view-cell 8 --view-mask " + shellQuoted(side)}) {
+      const std::string output = out(std::string(c.name) + (command[0] == 'p' ? ".json" : ".tif"));
+      const CliResult r = run(command + " -o " + shellQuoted(output) + " -q");
+      if (*c.words == 0) {
+        EXPECT_EQ(r.status, 0) << command << ": " << r.err;
+        continue;
+      }
+      EXPECT_EQ(r.status, 1) << command;
+      EXPECT_NE(r.err.find(c.words), std::string::npos) << r.err;
+      EXPECT_FALSE(fs::exists(output)) << command;
+    }
+  }
+}
+
 // A VRT input reads the files it names: none of them may be an output (the source GeoTIFF was
 // replaced, exit 0), and one that is not a regular file (a FIFO: GDAL opened a raw band's file
 // with the VRT and blocked for good), or standard input, is refused before it is opened.
@@ -2476,6 +2517,19 @@ TEST_F(Cli, ViewshedSeesOverAWall) {
     EXPECT_EQ(named.status, 1) << header;
     EXPECT_NE(named.err.find("names map coordinates"), std::string::npos) << named.err;
     EXPECT_FALSE(fs::exists(out("named.exr"))) << header;
+  }
+  // The fields are read by position: a header naming a column or a row elsewhere, or a height
+  // among the first two, is refused (id,col,row was read as column 7, row 30, height 40, exit 0).
+  for (const char* header : {"id,col,row", "height,col,row", "col,col", "row,height", "a,b,col", "h,row,col"}) {
+    {
+      std::ofstream csv(in("other.csv"));
+      csv << header << "\n3,4,1\n";
+    }
+    const CliResult other = run("viewshed " + shellQuoted(field) + " -o " + shellQuoted(out("other.exr")) +
+                                " --observers " + shellQuoted(in("other.csv")));
+    EXPECT_EQ(other.status, 1) << header;
+    EXPECT_NE(other.err.find("lays the columns out otherwise"), std::string::npos) << other.err;
+    EXPECT_FALSE(fs::exists(out("other.exr"))) << header;
   }
   // A height that is no number is named as such (the message spoke of whole columns and rows).
   for (const char* height : {"nan", "inf", "abc"}) {

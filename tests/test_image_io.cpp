@@ -320,6 +320,27 @@ TEST_F(ImageIoTest, Png8BitReadsStoredIntegers) {
     EXPECT_EQ(field.heights[i], static_cast<float>(values[i])) << i;
 }
 
+// Radiance is linear floats: an 8- or 16-bit environment or light image is refused (its 0 .. 255
+// were taken as radiance, 256 times the float image's, exit 0); readImage flags integer pixels
+// (the exit radiance of `bounce` is refused by them), float ones stay unflagged.
+TEST_F(ImageIoTest, IntegerImagesAreNoRadiance) {
+  const std::vector<std::uint8_t> grey(8 * 4 * 3, 128);
+  writeWithOiio(path("env8.png"), 8, 4, 3, OIIO::TypeDesc::UINT8, grey.data());
+  const std::vector<std::uint16_t> grey16(8 * 4 * 3, 32768);
+  writeWithOiio(path("env16.png"), 8, 4, 3, OIIO::TypeDesc::UINT16, grey16.data());
+  const std::vector<float> half(8 * 4 * 3, 0.5f);
+  writeWithOiio(path("env.tif"), 8, 4, 3, OIIO::TypeDesc::FLOAT, half.data());
+  for (const char* name : {"env8.png", "env16.png"}) {
+    expectIoError(
+        path(name), [&] { readEnvironmentMap(path(name)); }, "holds integers");
+    expectIoError(
+        path(name), [&] { readColourImage(path(name), "--light-image"); }, "--light-image holds integers");
+    EXPECT_TRUE(readImage(path(name)).integers) << name;
+  }
+  EXPECT_FALSE(readImage(path("env.tif")).integers);
+  EXPECT_EQ(readEnvironmentMap(path("env.tif")).radiance.front(), 0.5f);
+}
+
 TEST_F(ImageIoTest, Int16TiffKeepsNegativeValues) {
   const std::vector<std::int16_t> values = {-32768, -1000, -1, 0, 1, 32767};
   writeWithOiio(path("bathy.tif"), 3, 2, 1, OIIO::TypeDesc::INT16, values.data());
@@ -1103,10 +1124,13 @@ TEST(GdalRasters, AnImagesAlphaMasksNothing) {
   }
   ASSERT_NE(GDALGetMaskFlags(GDALGetRasterBand(dataset, 1)) & GMF_ALPHA, 0);  // (what the case is about)
   GDALClose(dataset);
-  const ImageChannels colour = readColourImage(path, "a light image");
-  ASSERT_EQ(colour.names, (std::vector<std::string>{"R", "G", "B"}));
-  for (int c = 0; c < 3; ++c) EXPECT_EQ(colour.planes[c][0], 10.0f * (c + 1)) << c;  // where alpha is 40
-  for (int c = 0; c < 3; ++c) EXPECT_EQ(colour.planes[c][1], 200.0f) << c;           // where alpha is 0
+  // (GDAL takes an alpha band for a mask only over bytes and 16-bit integers, which a colour image
+  // refuses as radiance: ImageIoTest.IntegerImagesAreNoRadiance)
+  EXPECT_THROW(readColourImage(path, "a light image"), IoError);
+  const ImageChannels image = readImage(path);
+  ASSERT_EQ(image.planes.size(), 4u);
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(image.planes[c][0], 10.0f * (c + 1)) << c;  // where alpha is 40
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(image.planes[c][1], 200.0f) << c;           // where alpha is 0
 }
 
 // A georeferenced raster GDAL reads and OpenImageIO does not (ESRI ASCII grid): its nodata

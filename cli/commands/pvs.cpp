@@ -14,6 +14,7 @@
 #include "hfvis/errors.hpp"
 #include "hfvis/image_io.hpp"
 #include "hfvis/viewshed.hpp"
+#include "io/gdal_io.hpp"
 #include "io/output_files.hpp"
 
 namespace hfvis::cli {
@@ -229,6 +230,7 @@ class Pvs : public Computation {
       HeightFieldReadOptions first;
       first.channel = "0";
       const HeightField mask = readHeightField(run_.pvs_mask, first);
+      detail::requireSameGrid(run_.pvs_mask, mask.georeference, run_.input, field.georeference);
       if (mask.width != field.width || mask.height != field.height)
         throw UsageError("--view-mask: " + run_.pvs_mask + " is " + std::to_string(mask.width) + " x " +
                          std::to_string(mask.height) + ", the field " + std::to_string(field.width) + " x " +

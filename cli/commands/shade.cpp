@@ -8,6 +8,7 @@
 #include "core/number_text.hpp"
 #include "hfvis/errors.hpp"
 #include "hfvis/sun.hpp"
+#include "io/gdal_io.hpp"
 #include "light_parts.hpp"
 
 namespace hfvis::cli {
@@ -29,6 +30,8 @@ std::vector<std::vector<float>> readAlbedo(const RunArguments& run, const Height
     return {std::vector<float>(field.pixelCount(), static_cast<float>(number))};
   }
   ImageChannels image = readImage(run.albedo);
+  // (a south-up albedo beside a north-up field lay mirrored, one of another place was taken, exit 0)
+  detail::requireSameGrid(run.albedo, image.georeference, run.input, field.georeference);
   if (image.width != field.width || image.height != field.height)
     throw IoError(run.albedo, "the albedo is " + std::to_string(image.width) + "x" +
                                   std::to_string(image.height) + ", the height field " +

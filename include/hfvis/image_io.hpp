@@ -61,6 +61,10 @@ struct ImageChannels {
   std::vector<std::string> names;                               // one per channel
   std::vector<std::vector<float>> planes;                       // one per channel, row-major
   std::vector<std::pair<std::string, std::string>> attributes;  // string metadata
+  // Read: whether a channel holds integers taken as their stored values (an 8- or 16-bit PNG's
+  // 0 .. 255 or 0 .. 65535; a GDAL band of integers without a scale or offset), so that readers of
+  // radiance can refuse them.
+  bool integers = false;
   // GeoTIFF only (other formats have neither): where the image lies, and the value its NaN
   // (nodata) cells hold, declared as every band's nodata value. NaN keeps them NaN.
   Georeference georeference;
@@ -86,8 +90,9 @@ std::vector<std::string> filesRead(const std::string& path);
 
 // Reads a colour image (readImage): its R, G, B channels in that order (an alpha channel A beside
 // them ignored), or its only channel, named "Y". Throws IoError as readImage, and naming `what`
-// ("an environment map") for an image with other channels or an EXR whose data window is not its
-// display window (the image covers its whole extent: a sphere, a light's rectangle).
+// ("an environment map") for an image with other channels, an EXR whose data window is not its
+// display window (the image covers its whole extent: a sphere, a light's rectangle) or integer
+// pixels (ImageChannels::integers: radiance is linear floats).
 ImageChannels readColourImage(const std::string& path, const std::string& what);
 
 // Whether writeImage writes `path` as a GeoTIFF through GDAL: its name ends in .tif or .tiff,

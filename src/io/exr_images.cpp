@@ -373,6 +373,8 @@ ImageChannels readExr(const std::string& path, std::uint64_t max_image_bytes, co
       throw IoError(path, withDetail("cannot read as an image", e.what()));
     }
     readPlanes(*part, window, chunk_rows, image.names, &image.planes);
+    for (const std::string& name : image.names)
+      image.integers = image.integers || header.channels().findChannel(name)->type == Imf::UINT;
   } catch (const Error&) {
     throw;
   } catch (const std::bad_alloc&) {

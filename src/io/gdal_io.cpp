@@ -468,6 +468,41 @@ std::optional<std::pair<std::string, double>> projectedLinearUnit(const std::str
   return std::pair<std::string, double>(name ? name : "unknown", metres);
 }
 
+void requireSameGrid(const std::string& path, const Georeference& side, const std::string& input,
+                     const Georeference& field) {
+  if (side.geotransform && field.geotransform) {
+    const std::array<double, 6>& a = *side.geotransform;
+    const std::array<double, 6>& b = *field.geotransform;
+    const double pixel = std::max({std::fabs(b[1]), std::fabs(b[2]), std::fabs(b[4]), std::fabs(b[5])});
+    bool same = std::fabs(a[0] - b[0]) <= 1e-3 * pixel && std::fabs(a[3] - b[3]) <= 1e-3 * pixel;
+    for (const int i : {1, 2, 4, 5}) same = same && std::fabs(a[i] - b[i]) <= 1e-6 * pixel;
+    if (!same) {
+      const auto text = [](const std::array<double, 6>& t) {
+        std::string out;
+        for (const double v : t) out += (out.empty() ? "" : ", ") + exactNumber(v);
+        return "(" + out + ")";
+      };
+      throw IoError(path, "lies on another grid than the height field " + input + " (geotransform " + text(a) +
+                              " against " + text(b) +
+                              "; a south-up raster beside a north-up field too): it is taken pixel by pixel, so "
+                              "warp it onto the field's grid first (gdalwarp -te, -ts, or -tr and -tap)");
+    }
+  }
+  if (side.crs_wkt.empty() || field.crs_wkt.empty()) return;
+  registerOnce();
+  using Srs = std::unique_ptr<void, void (*)(OGRSpatialReferenceH)>;
+  Srs a(OSRNewSpatialReference(nullptr), OSRDestroySpatialReference);
+  Srs b(OSRNewSpatialReference(nullptr), OSRDestroySpatialReference);
+  if (a && b && OSRSetFromUserInput(a.get(), side.crs_wkt.c_str()) == OGRERR_NONE &&
+      OSRSetFromUserInput(b.get(), field.crs_wkt.c_str()) == OGRERR_NONE && !OSRIsSame(a.get(), b.get())) {
+    const char* name_a = OSRGetName(a.get());
+    const char* name_b = OSRGetName(b.get());
+    throw IoError(path, "is in another CRS (" + std::string(name_a ? name_a : "unnamed") + ") than the height field " +
+                            input + " (" + (name_b ? name_b : "unnamed") +
+                            "): it is taken pixel by pixel, so warp it onto the field's grid first (gdalwarp -t_srs)");
+  }
+}
+
 namespace {
 
 Georeference georeferenceOf(GDALDatasetH dataset) {
@@ -803,6 +838,10 @@ ImageChannels readGdalImage(const std::string& path) {
     const std::string description = GDALGetDescription(band);
     image.names.push_back(description.empty() ? colourName(band, b) : description);
     image.planes.push_back(readBand(path, dataset.get(), b, false));
+    int has_scale = 0, has_offset = 0;
+    const double scale = GDALGetRasterScale(band, &has_scale), offset = GDALGetRasterOffset(band, &has_offset);
+    image.integers = image.integers || (GDALDataTypeIsInteger(GDALGetRasterDataType(band)) &&
+                                        !(has_scale && scale != 1.0) && !(has_offset && offset != 0.0));
   }
   for (char** item = GDALGetMetadata(dataset.get(), nullptr); item && *item; ++item) {
     char* name = nullptr;

@@ -182,11 +182,13 @@ ImageChannels read(const std::string& path, std::uint64_t max_image_bytes, const
       const int c = chooseChannel(path, names, *channel);
       image.names.push_back(names[c]);
       image.planes.push_back(readChannel(path, *in, c));
+      image.integers = !spec.channelformat(c).is_floating_point();
     } else {
       for (int c = 0; c < spec.nchannels; ++c) {
         const bool named = c < static_cast<int>(spec.channelnames.size()) && !spec.channelnames[c].empty();
         image.names.push_back(named ? spec.channelnames[c] : "channel" + std::to_string(c));
         image.planes.push_back(readChannel(path, *in, c));
+        image.integers = image.integers || !spec.channelformat(c).is_floating_point();
       }
     }
   } catch (const std::bad_alloc&) {
