@@ -611,9 +611,13 @@ HorizonResult referenceHorizons(const HeightField& field, const HorizonOptions& 
     HorizonResult odd = detail::allocateResult(field, options, outputs);
     run(result, 0);
     run(odd, 1);
-    double even_weight = 0.0, odd_weight = 0.0;
-    for (int k = 0; k < options.directions; ++k) (k % 2 ? odd_weight : even_weight) += weights[k];
-    detail::splitErrorHalves(result, odd.sky_view_factor, odd.ambient_occlusion, even_weight, odd_weight);
+    double even_weight = 0.0, odd_weight = 0.0, cubes = 0.0;
+    for (int k = 0; k < options.directions; ++k) {
+      (k % 2 ? odd_weight : even_weight) += weights[k];
+      cubes += weights[k] * weights[k] * weights[k];
+    }
+    detail::splitErrorHalves(result, odd.sky_view_factor, odd.ambient_occlusion, even_weight, odd_weight, field,
+                             cubes / (even_weight + odd_weight));
   } else {
     run(result, -1);
   }

@@ -8,6 +8,7 @@
 
 #include "core/fast_math.hpp"
 #include "core/surface_normal.hpp"
+#include "core/unit_normals.hpp"
 #include "hfvis/errors.hpp"
 
 namespace hfvis {
@@ -212,20 +213,33 @@ void finishReduction(HorizonResult& result) {
   for (float& v : result.ambient_occlusion) v = share(v);
 }
 
+double swathBias(double sin2_tilt, double square_weight) {
+  constexpr double kPi = 3.14159265358979323846;
+  return 1.15 * (kPi * kPi / 6.0) * square_weight * sin2_tilt;
+}
+
 void splitErrorHalves(HorizonResult& result, const std::vector<float>& odd_svf, const std::vector<float>& odd_ao,
-                      double even_weight, double odd_weight) {
+                      double even_weight, double odd_weight, const HeightField& field, double square_weight) {
+  std::vector<float> tilt;  // sin^2 of each pixel's tilt, nx^2 + ny^2
+  if (!result.ambient_occlusion.empty()) {
+    const std::vector<float> normals = unitNormals(field);
+    tilt.resize(normals.size() / 4);
+    for (std::size_t p = 0; p < tilt.size(); ++p)
+      tilt[p] = normals[4 * p] * normals[4 * p] + normals[4 * p + 1] * normals[4 * p + 1];
+  }
   std::vector<float>& estimate = result.error_estimate;
   estimate.assign(static_cast<std::size_t>(result.width) * result.height, 0.0f);
-  const auto split = [&](std::vector<float>& sum, const std::vector<float>& odd) {
+  const auto split = [&](std::vector<float>& sum, const std::vector<float>& odd, const std::vector<float>* bias) {
     for (std::size_t p = 0; p < sum.size(); ++p) {
       // SVF = 1 - sum and AO = sum: either way half the halves' difference of the sums.
-      const double half_difference = 0.5 * std::abs(sum[p] / even_weight - odd[p] / odd_weight);
+      const double half_difference = 0.5 * std::abs(sum[p] / even_weight - odd[p] / odd_weight) +
+                                     (bias ? swathBias((*bias)[p], square_weight) : 0.0);
       estimate[p] = std::isnan(sum[p]) ? sum[p] : std::max(estimate[p], static_cast<float>(half_difference));
       sum[p] += odd[p];
     }
   };
-  split(result.sky_view_factor, odd_svf);
-  split(result.ambient_occlusion, odd_ao);
+  split(result.sky_view_factor, odd_svf, nullptr);
+  split(result.ambient_occlusion, odd_ao, &tilt);
   result.estimated_error = estimatedError(estimate);
 }
 

@@ -505,9 +505,13 @@ class HorizonRoutine : public SweepRoutine {
 
   // The error estimate (HorizonOutputs::error_estimate) from the halves' sums.
   void splitHalves() {
-    double even_weight = 0.0, odd_weight = 0.0;
-    for (const RunDirection& d : directions_) (d.index % 2 ? odd_weight : even_weight) += d.lattice.weight;
-    splitErrorHalves(result_, svf_odd_host_, ao_odd_host_, even_weight, odd_weight);
+    double even_weight = 0.0, odd_weight = 0.0, cubes = 0.0;
+    for (const RunDirection& d : directions_) {
+      (d.index % 2 ? odd_weight : even_weight) += d.lattice.weight;
+      cubes += d.lattice.weight * d.lattice.weight * d.lattice.weight;
+    }
+    splitErrorHalves(result_, svf_odd_host_, ao_odd_host_, even_weight, odd_weight, field_,
+                     cubes / (even_weight + odd_weight));
   }
 
   // The occlusion and irradiance sums of the rows on the device made those of unit normals
