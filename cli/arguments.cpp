@@ -437,6 +437,7 @@ const std::vector<OptionSpec>& optionTable() {
        "refused when beyond 4096 (see --error-tile); for the sky-view factor\n"
        "and occlusion the estimate is then that of the K result itself (the\n"
        "halves' difference over 2^p - 1, p as the runs measured it, 1 .. 1.1;\n"
+       "occlusion's plus its swaths' bias from the pixel's tilt;\n"
        "docs/COMMAND_LINE.md); the largest K and the\n"
        "estimate go into the summary and the hfvis:directions and\n"
        "hfvis:estimated_error attributes, the sky-view factor and occlusion\n"

@@ -617,7 +617,7 @@ HorizonResult referenceHorizons(const HeightField& field, const HorizonOptions& 
       cubes += weights[k] * weights[k] * weights[k];
     }
     detail::splitErrorHalves(result, odd.sky_view_factor, odd.ambient_occlusion, even_weight, odd_weight, field,
-                             cubes / (even_weight + odd_weight));
+                             prepared.heights, cubes / (even_weight + odd_weight));
   } else {
     run(result, -1);
   }

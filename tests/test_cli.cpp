@@ -611,7 +611,8 @@ TEST_F(Cli, SideRastersOnAnotherGridAreRefused) {
     std::string crs;
     const char* words;  // "" = taken
   };
-  for (const Case& c : {Case{"same", north, utm33, ""}, Case{"south", south, utm33, "lies on another grid"},
+  for (const Case& c : {Case{"same", north, utm33, ""}, Case{"datum", north, hfvis::testing::crsWkt("EPSG:32633+5773"), ""},
+                        Case{"south", south, utm33, "lies on another grid"},
                         Case{"shifted", shifted, utm33, "lies on another grid"},
                         Case{"zone34", north, hfvis::testing::crsWkt("EPSG:32634"), "is in another CRS"}}) {
     SCOPED_TRACE(c.name);
@@ -2507,6 +2508,8 @@ TEST_F(Cli, ViewshedSeesOverAWall) {
   };
   sameObservers("row_first", "Row,Col,Height\n3,14\n# a comment\n\n0,8,1\n");
   sameObservers("pixels", "x_pixel,y_pixel,observer_height\n14,3\n8,0,1\n");
+  sameObservers("line", "col,line\n14,3\n8,0,1\n");  // (names it does not know stay col,row)
+  sameObservers("pixel_col", "pixel_col,row,eye\n14,3\n8,0,1\n");
   for (const char* header : {"x,y", "lat,lon", "Easting,Northing,height"}) {
     {
       std::ofstream csv(in("named.csv"));
@@ -2520,7 +2523,8 @@ TEST_F(Cli, ViewshedSeesOverAWall) {
   }
   // The fields are read by position: a header naming a column or a row elsewhere, or a height
   // among the first two, is refused (id,col,row was read as column 7, row 30, height 40, exit 0).
-  for (const char* header : {"id,col,row", "height,col,row", "col,col", "row,height", "a,b,col", "h,row,col"}) {
+  for (const char* header :
+       {"id,col,row", "height,col,row", "col,col", "row,height", "a,b,col", "h,row,col", "id,col", "row,line"}) {
     {
       std::ofstream csv(in("other.csv"));
       csv << header << "\n3,4,1\n";

@@ -320,9 +320,10 @@ TEST_F(ImageIoTest, Png8BitReadsStoredIntegers) {
     EXPECT_EQ(field.heights[i], static_cast<float>(values[i])) << i;
 }
 
-// Radiance is linear floats: an 8- or 16-bit environment or light image is refused (its 0 .. 255
-// were taken as radiance, 256 times the float image's, exit 0); readImage flags integer pixels
-// (the exit radiance of `bounce` is refused by them), float ones stay unflagged.
+// Radiance is linear floats: an 8- or 16-bit environment is refused (its 0 .. 255 were taken as
+// radiance, 256 times the float image's, exit 0); readImage flags integer pixels (the exit
+// radiance of `bounce` is refused by them), float ones stay unflagged; a light image's colours
+// (the output in their units) may be integers.
 TEST_F(ImageIoTest, IntegerImagesAreNoRadiance) {
   const std::vector<std::uint8_t> grey(8 * 4 * 3, 128);
   writeWithOiio(path("env8.png"), 8, 4, 3, OIIO::TypeDesc::UINT8, grey.data());
@@ -333,8 +334,7 @@ TEST_F(ImageIoTest, IntegerImagesAreNoRadiance) {
   for (const char* name : {"env8.png", "env16.png"}) {
     expectIoError(
         path(name), [&] { readEnvironmentMap(path(name)); }, "holds integers");
-    expectIoError(
-        path(name), [&] { readColourImage(path(name), "--light-image"); }, "--light-image holds integers");
+    EXPECT_TRUE(readColourImage(path(name), "--light-image").integers) << name;
     EXPECT_TRUE(readImage(path(name)).integers) << name;
   }
   EXPECT_FALSE(readImage(path("env.tif")).integers);
@@ -1124,13 +1124,10 @@ TEST(GdalRasters, AnImagesAlphaMasksNothing) {
   }
   ASSERT_NE(GDALGetMaskFlags(GDALGetRasterBand(dataset, 1)) & GMF_ALPHA, 0);  // (what the case is about)
   GDALClose(dataset);
-  // (GDAL takes an alpha band for a mask only over bytes and 16-bit integers, which a colour image
-  // refuses as radiance: ImageIoTest.IntegerImagesAreNoRadiance)
-  EXPECT_THROW(readColourImage(path, "a light image"), IoError);
-  const ImageChannels image = readImage(path);
-  ASSERT_EQ(image.planes.size(), 4u);
-  for (int c = 0; c < 3; ++c) EXPECT_EQ(image.planes[c][0], 10.0f * (c + 1)) << c;  // where alpha is 40
-  for (int c = 0; c < 3; ++c) EXPECT_EQ(image.planes[c][1], 200.0f) << c;           // where alpha is 0
+  const ImageChannels colour = readColourImage(path, "a light image");
+  ASSERT_EQ(colour.names, (std::vector<std::string>{"R", "G", "B"}));
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(colour.planes[c][0], 10.0f * (c + 1)) << c;  // where alpha is 40
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(colour.planes[c][1], 200.0f) << c;           // where alpha is 0
 }
 
 // A georeferenced raster GDAL reads and OpenImageIO does not (ESRI ASCII grid): its nodata

@@ -133,8 +133,10 @@ struct HorizonResult {
   std::vector<float> irradiance;         // the environment's channels' planes of width*height, if asked
   // With HorizonOutputs::error_estimate or HorizonOptions::max_error, per pixel: half the difference
   // between the results of the even- and the odd-numbered directions alone (each half's sum over
-  // its own weights: two interleaved quadratures of K / 2 directions), the larger of the sky-view
-  // factor's and occlusion's; NaN at nodata. With max_error divided by the Richardson divisor
+  // its own weights: two interleaved quadratures of K / 2 directions), occlusion's plus the bias
+  // its swaths share, which the difference cannot show (detail::swathBias: (pi^2 / 6) w^2
+  // sin^2(tilt) times 1.15), the larger of the sky-view factor's and occlusion's; NaN at nodata.
+  // With max_error divided by the Richardson divisor
   // 2^p - 1 (1 .. 1.14) its runs measured, per tile (HorizonOptions::max_error); a run at a K of
   // your own keeps the difference itself. Measured against the dense azimuthal integral, on the
   // benchmark's contents the difference lies 1.1 to 4 times above the K result's error

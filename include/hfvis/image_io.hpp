@@ -90,9 +90,9 @@ std::vector<std::string> filesRead(const std::string& path);
 
 // Reads a colour image (readImage): its R, G, B channels in that order (an alpha channel A beside
 // them ignored), or its only channel, named "Y". Throws IoError as readImage, and naming `what`
-// ("an environment map") for an image with other channels, an EXR whose data window is not its
-// display window (the image covers its whole extent: a sphere, a light's rectangle) or integer
-// pixels (ImageChannels::integers: radiance is linear floats).
+// ("an environment map") for an image with other channels or an EXR whose data window is not its
+// display window (the image covers its whole extent: a sphere, a light's rectangle). Keeps
+// ImageChannels::integers (readEnvironmentMap refuses them: radiance is linear floats).
 ImageChannels readColourImage(const std::string& path, const std::string& what);
 
 // Whether writeImage writes `path` as a GeoTIFF through GDAL: its name ends in .tif or .tiff,

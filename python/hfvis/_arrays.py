@@ -144,7 +144,8 @@ def pvs_start(bits, shape, view_cell, tile):
     (hfvis/pvs.hpp's PvsLayout: view cells and tiles over the W - 1 x H - 1 cells; the library
     checks the count alone)."""
     cells_y, cells_x = shape[0] - 1, shape[1] - 1
-    if view_cell >= 1 and tile >= 1 and cells_x >= 1 and cells_y >= 1:
+    most = max(cells_x, cells_y)  # (beyond, the library refuses the grid itself, naming it)
+    if 1 <= view_cell <= most and 1 <= tile <= most and cells_x >= 1 and cells_y >= 1:
         views = -(-cells_x // view_cell) * -(-cells_y // view_cell)
         words = -(-(-(-cells_x // tile) * -(-cells_y // tile)) // 32)
         if bits.shape != (views, words):

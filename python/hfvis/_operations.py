@@ -48,7 +48,8 @@ _UNITS = {
     "bits": "bit patterns: bit s % 32 of plane s // 32 set where source sample s is seen; 0 at nodata",
     "rgb": "the light image's values (the colours of the source samples seen, summed, / S)",
     "error": ("absolute, in the output's unit (sky-view factor, occlusion: half the difference of the even- and "
-              "odd-numbered directions' results, with max_error over the Richardson divisor its runs measured; "
+              "odd-numbered directions' results, occlusion's plus its swaths' bias from the pixel's tilt, with "
+              "max_error over the Richardson divisor its runs measured; "
               "horizon angles: the estimated mean interpolation error over azimuth, radians)"),
 }
 _INSOLATION_DIRECT = "hours (direct irradiation from a sun of normal irradiance 1; times W/m^2 it is Wh/m^2)"

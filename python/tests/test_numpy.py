@@ -416,7 +416,7 @@ def test_pvs(tmp_path, projected_tif, dem):
     for bad in (-1, 2.5, 10**7):
         with pytest.raises(hfvis.InvalidArgumentError, match="estimate_entries"):
             hfvis.pvs(dem, samples=100, cell_size=30, nodata=NODATA, estimate_entries=bad)
-    with pytest.raises(hfvis.InvalidArgumentError, match="resume"):
+    with pytest.raises(hfvis.InvalidArgumentError, match="where this field and grid have 42 view cells"):
         hfvis.pvs(dem, samples=100, view_cell=64, tile=32, cell_size=30, nodata=NODATA, start=r.bits)
     # A mask per pixel, as the CLI's --view-mask: only the view cells it touches are computed.
     mask = np.zeros(dem.shape, np.float32)

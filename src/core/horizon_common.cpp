@@ -8,7 +8,6 @@
 
 #include "core/fast_math.hpp"
 #include "core/surface_normal.hpp"
-#include "core/unit_normals.hpp"
 #include "hfvis/errors.hpp"
 
 namespace hfvis {
@@ -219,27 +218,33 @@ double swathBias(double sin2_tilt, double square_weight) {
 }
 
 void splitErrorHalves(HorizonResult& result, const std::vector<float>& odd_svf, const std::vector<float>& odd_ao,
-                      double even_weight, double odd_weight, const HeightField& field, double square_weight) {
-  std::vector<float> tilt;  // sin^2 of each pixel's tilt, nx^2 + ny^2
-  if (!result.ambient_occlusion.empty()) {
-    const std::vector<float> normals = unitNormals(field);
-    tilt.resize(normals.size() / 4);
-    for (std::size_t p = 0; p < tilt.size(); ++p)
-      tilt[p] = normals[4 * p] * normals[4 * p] + normals[4 * p + 1] * normals[4 * p + 1];
-  }
+                      double even_weight, double odd_weight, const HeightField& field,
+                      const std::vector<float>& prepared, double square_weight) {
   std::vector<float>& estimate = result.error_estimate;
   estimate.assign(static_cast<std::size_t>(result.width) * result.height, 0.0f);
-  const auto split = [&](std::vector<float>& sum, const std::vector<float>& odd, const std::vector<float>* bias) {
+  const bool rows = hasRowSpacing(field);
+  const auto split = [&](std::vector<float>& sum, const std::vector<float>& odd, bool occlusion) {
     for (std::size_t p = 0; p < sum.size(); ++p) {
+      if (std::isnan(sum[p])) {
+        estimate[p] = sum[p];
+        continue;
+      }
       // SVF = 1 - sum and AO = sum: either way half the halves' difference of the sums.
-      const double half_difference = 0.5 * std::abs(sum[p] / even_weight - odd[p] / odd_weight) +
-                                     (bias ? swathBias((*bias)[p], square_weight) : 0.0);
-      estimate[p] = std::isnan(sum[p]) ? sum[p] : std::max(estimate[p], static_cast<float>(half_difference));
+      double half_difference = 0.5 * std::abs(sum[p] / even_weight - odd[p] / odd_weight);
+      if (occlusion) {  // and its swaths' own bias, from the pixel's tilt (nx^2 + ny^2 of its normal)
+        const int c = static_cast<int>(p % field.width), r = static_cast<int>(p / field.width);
+        float n[3];
+        pixelNormal(prepared, field.width, field.height, c, r,
+                    static_cast<float>(rows ? field.row_cell_size_x[r] : field.cell_size_x),
+                    static_cast<float>(rows ? field.row_cell_size_y[r] : field.cell_size_y), n);
+        half_difference += swathBias(n[0] * n[0] + n[1] * n[1], square_weight);
+      }
+      estimate[p] = std::max(estimate[p], static_cast<float>(half_difference));
       sum[p] += odd[p];
     }
   };
-  split(result.sky_view_factor, odd_svf, nullptr);
-  split(result.ambient_occlusion, odd_ao, &tilt);
+  split(result.sky_view_factor, odd_svf, false);
+  split(result.ambient_occlusion, odd_ao, true);
   result.estimated_error = estimatedError(estimate);
 }
 

@@ -46,10 +46,12 @@ constexpr int kFirstAutoDirections = 16;
 // directions in `result` (sky-view factor and occlusion, before finishReduction) and those of the
 // odd-numbered ones, the directions' weights summed by half: fills error_estimate and
 // estimated_error, and leaves the two sums' total in `result`. The occlusion's part adds its own
-// bias, which the halves share (swathBias), from each pixel's tilt in `field` (its unit normal)
-// and `square_weight`, the directions' squared weight averaged over the circle (sum w^3 / sum w).
+// bias, which the halves share (swathBias), from each pixel's tilt (its normal, pixelNormal, over
+// `prepared`: the field's prepared heights) and `square_weight`, the directions' squared weight
+// averaged over the circle (sum w^3 / sum w).
 void splitErrorHalves(HorizonResult& result, const std::vector<float>& odd_svf, const std::vector<float>& odd_ao,
-                      double even_weight, double odd_weight, const HeightField& field, double square_weight);
+                      double even_weight, double odd_weight, const HeightField& field,
+                      const std::vector<float>& prepared, double square_weight);
 
 // The bias of Timonen & Westerholm's Eq. 5 (ambient_term), which takes the horizon as constant
 // over each direction's swath of azimuth while integrating the normal's cosine over it exactly,

@@ -493,8 +493,14 @@ void requireSameGrid(const std::string& path, const Georeference& side, const st
   using Srs = std::unique_ptr<void, void (*)(OGRSpatialReferenceH)>;
   Srs a(OSRNewSpatialReference(nullptr), OSRDestroySpatialReference);
   Srs b(OSRNewSpatialReference(nullptr), OSRDestroySpatialReference);
-  if (a && b && OSRSetFromUserInput(a.get(), side.crs_wkt.c_str()) == OGRERR_NONE &&
-      OSRSetFromUserInput(b.get(), field.crs_wkt.c_str()) == OGRERR_NONE && !OSRIsSame(a.get(), b.get())) {
+  if (!a || !b || OSRSetFromUserInput(a.get(), side.crs_wkt.c_str()) != OGRERR_NONE ||
+      OSRSetFromUserInput(b.get(), field.crs_wkt.c_str()) != OGRERR_NONE)
+    return;
+  // The horizontal parts alone: a DEM's compound CRS names its heights' datum, which an albedo
+  // made from imagery does not (EPSG:32633+5773 beside EPSG:32633 was refused).
+  OSRStripVertical(a.get());
+  OSRStripVertical(b.get());
+  if (!OSRIsSame(a.get(), b.get())) {
     const char* name_a = OSRGetName(a.get());
     const char* name_b = OSRGetName(b.get());
     throw IoError(path, "is in another CRS (" + std::string(name_a ? name_a : "unnamed") + ") than the height field " +

@@ -58,7 +58,8 @@ ImageChannels readGdalImage(const std::string& path);
 // Throws IoError naming `path` (a raster read beside the height field `input`: an albedo, an exit
 // radiance, a view mask, all taken pixel by pixel) when both are georeferenced and lie on other
 // grids: other geotransforms (origins more than a thousandth of a pixel apart, pixel sizes more
-// than a relative 1e-6; a south-up raster beside a north-up field) or other CRSs (OSRIsSame). A
+// than a relative 1e-6; a south-up raster beside a north-up field) or other CRSs (OSRIsSame of
+// their horizontal parts: a vertical datum on one side alone is no difference). A
 // raster without a georeference, or beside a field without one, is taken by position.
 void requireSameGrid(const std::string& path, const Georeference& side, const std::string& input,
                      const Georeference& field);

@@ -92,11 +92,6 @@ ImageChannels readColourImage(const std::string& path, const std::string& what) 
     throw IoError(path, what + " covers its whole extent, but the EXR's " + windows +
                             ": write it with the two windows the same");
   image.attributes.clear();
-  // (an 8-bit PNG's 0 .. 255 were taken as radiance, 256 times the float image's, exit 0)
-  if (image.integers)
-    throw IoError(path, what + " holds integers (an 8- or 16-bit image), which would be taken as radiance at "
-                               "their stored values (0 .. 255, 0 .. 65535): give linear floats (EXR, HDR, a float "
-                               "TIFF), e.g. oiiotool IN --colorconvert sRGB linear -d float -o OUT.exr");
   const auto find = [&](const char* name) {
     for (std::size_t i = 0; i < image.names.size(); ++i)
       if (image.names[i] == name) return static_cast<int>(i);
@@ -108,6 +103,7 @@ ImageChannels readColourImage(const std::string& path, const std::string& what) 
   ImageChannels out;
   out.width = image.width;
   out.height = image.height;
+  out.integers = image.integers;
   if (rgb && others == 0) {
     out.names = {"R", "G", "B"};
     for (const int i : {r, g, b}) out.planes.push_back(std::move(image.planes[i]));

@@ -510,7 +510,7 @@ class HorizonRoutine : public SweepRoutine {
       (d.index % 2 ? odd_weight : even_weight) += d.lattice.weight;
       cubes += d.lattice.weight * d.lattice.weight * d.lattice.weight;
     }
-    splitErrorHalves(result_, svf_odd_host_, ao_odd_host_, even_weight, odd_weight, field_,
+    splitErrorHalves(result_, svf_odd_host_, ao_odd_host_, even_weight, odd_weight, field_, prepared_.heights,
                      cubes / (even_weight + odd_weight));
   }
 
