@@ -137,11 +137,11 @@ std::vector<CsvPoint> parsePoints(const std::string& path, std::istream& in, dou
       };
       const auto place = [&](const std::string& n) { return column(n) || row_name(n); };
       // (a name the rule does not know beside a known one stays col,row: col,line, pixel_col,row)
-      bool elsewhere = names.size() >= 2 && (height_name(names[0]) || height_name(names[1]) ||
-                                             (column(names[1]) && !row_name(names[0])) ||
-                                             (row_name(names[0]) && !column(names[1])) ||
-                                             (column(names[0]) && column(names[1])) ||
-                                             (row_name(names[0]) && row_name(names[1])));
+      bool elsewhere =
+          names.size() >= 2 &&
+          (height_name(names[0]) || height_name(names[1]) || (column(names[1]) && !row_name(names[0])) ||
+           (row_name(names[0]) && !column(names[1])) || (column(names[0]) && column(names[1])) ||
+           (row_name(names[0]) && row_name(names[1])));
       for (std::size_t i = 2; i < names.size(); ++i) elsewhere = elsewhere || place(names[i]);
       if (elsewhere)
         throw IoError(path, "line " + std::to_string(number) + ": the header '" + shown(line) +

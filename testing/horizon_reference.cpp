@@ -616,8 +616,8 @@ HorizonResult referenceHorizons(const HeightField& field, const HorizonOptions& 
       (k % 2 ? odd_weight : even_weight) += weights[k];
       cubes += weights[k] * weights[k] * weights[k];
     }
-    detail::splitErrorHalves(result, odd.sky_view_factor, odd.ambient_occlusion, even_weight, odd_weight, field,
-                             prepared.heights, cubes / (even_weight + odd_weight));
+    detail::splitErrorHalves(result, odd.sky_view_factor, odd.ambient_occlusion, even_weight, odd_weight,
+                             field, prepared.heights, cubes / (even_weight + odd_weight));
   } else {
     run(result, -1);
   }

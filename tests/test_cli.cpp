@@ -611,10 +611,11 @@ TEST_F(Cli, SideRastersOnAnotherGridAreRefused) {
     std::string crs;
     const char* words;  // "" = taken
   };
-  for (const Case& c : {Case{"same", north, utm33, ""}, Case{"datum", north, hfvis::testing::crsWkt("EPSG:32633+5773"), ""},
-                        Case{"south", south, utm33, "lies on another grid"},
-                        Case{"shifted", shifted, utm33, "lies on another grid"},
-                        Case{"zone34", north, hfvis::testing::crsWkt("EPSG:32634"), "is in another CRS"}}) {
+  for (const Case& c :
+       {Case{"same", north, utm33, ""}, Case{"datum", north, hfvis::testing::crsWkt("EPSG:32633+5773"), ""},
+        Case{"south", south, utm33, "lies on another grid"},
+        Case{"shifted", shifted, utm33, "lies on another grid"},
+        Case{"zone34", north, hfvis::testing::crsWkt("EPSG:32634"), "is in another CRS"}}) {
     SCOPED_TRACE(c.name);
     const std::string side = in(std::string(c.name) + ".tif");
     hfvis::testing::writeGdalGeoTiff(side, 20, 16, albedo, c.transform, c.crs, std::nullopt);
@@ -2523,8 +2524,8 @@ TEST_F(Cli, ViewshedSeesOverAWall) {
   }
   // The fields are read by position: a header naming a column or a row elsewhere, or a height
   // among the first two, is refused (id,col,row was read as column 7, row 30, height 40, exit 0).
-  for (const char* header :
-       {"id,col,row", "height,col,row", "col,col", "row,height", "a,b,col", "h,row,col", "id,col", "row,line"}) {
+  for (const char* header : {"id,col,row", "height,col,row", "col,col", "row,height", "a,b,col", "h,row,col",
+                             "id,col", "row,line"}) {
     {
       std::ofstream csv(in("other.csv"));
       csv << header << "\n3,4,1\n";

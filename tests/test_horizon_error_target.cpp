@@ -158,7 +158,8 @@ TEST(HorizonErrorEstimate, ATiltedPlanesOcclusionBiasIsInTheEstimate) {
   HeightField field = makeSyntheticField("flat", 33, 33);
   for (int r = 0; r < 33; ++r)
     for (int c = 0; c < 33; ++c) field.heights[r * 33 + c] = static_cast<float>(0.76 * (0.92 * c + 0.39 * r));
-  const double sin2 = 0.76 * 0.76 * (0.92 * 0.92 + 0.39 * 0.39) / (1.0 + 0.76 * 0.76 * (0.92 * 0.92 + 0.39 * 0.39));
+  const double sin2 =
+      0.76 * 0.76 * (0.92 * 0.92 + 0.39 * 0.39) / (1.0 + 0.76 * 0.76 * (0.92 * 0.92 + 0.39 * 0.39));
   for (HorizonMethod method : {HorizonMethod::Sweep, HorizonMethod::Naive}) {
     for (int K : {8, 16, 32}) {
       SCOPED_TRACE((method == HorizonMethod::Sweep ? "sweep K " : "naive K ") + std::to_string(K));
@@ -171,7 +172,8 @@ TEST(HorizonErrorEstimate, ATiltedPlanesOcclusionBiasIsInTheEstimate) {
       // The bias as predicted (within 10 %: the lattice's weights are not all 1 / K), and in the estimate.
       EXPECT_NEAR(error, detail::swathBias(sin2, 1.0 / (K * K)) / 1.15, 0.1 * error);
       for (int row = 4; row < 29; ++row)
-        for (int c = 4; c < 29; ++c) EXPECT_GE(r.error_estimate[row * 33 + c], 1.0 - r.ambient_occlusion[row * 33 + c]);
+        for (int c = 4; c < 29; ++c)
+          EXPECT_GE(r.error_estimate[row * 33 + c], 1.0 - r.ambient_occlusion[row * 33 + c]);
     }
   }
   for (double max_error : {0.005, 0.002}) {

@@ -217,9 +217,9 @@ double swathBias(double sin2_tilt, double square_weight) {
   return 1.15 * (kPi * kPi / 6.0) * square_weight * sin2_tilt;
 }
 
-void splitErrorHalves(HorizonResult& result, const std::vector<float>& odd_svf, const std::vector<float>& odd_ao,
-                      double even_weight, double odd_weight, const HeightField& field,
-                      const std::vector<float>& prepared, double square_weight) {
+void splitErrorHalves(HorizonResult& result, const std::vector<float>& odd_svf,
+                      const std::vector<float>& odd_ao, double even_weight, double odd_weight,
+                      const HeightField& field, const std::vector<float>& prepared, double square_weight) {
   std::vector<float>& estimate = result.error_estimate;
   estimate.assign(static_cast<std::size_t>(result.width) * result.height, 0.0f);
   const bool rows = hasRowSpacing(field);

@@ -49,9 +49,9 @@ constexpr int kFirstAutoDirections = 16;
 // bias, which the halves share (swathBias), from each pixel's tilt (its normal, pixelNormal, over
 // `prepared`: the field's prepared heights) and `square_weight`, the directions' squared weight
 // averaged over the circle (sum w^3 / sum w).
-void splitErrorHalves(HorizonResult& result, const std::vector<float>& odd_svf, const std::vector<float>& odd_ao,
-                      double even_weight, double odd_weight, const HeightField& field,
-                      const std::vector<float>& prepared, double square_weight);
+void splitErrorHalves(HorizonResult& result, const std::vector<float>& odd_svf,
+                      const std::vector<float>& odd_ao, double even_weight, double odd_weight,
+                      const HeightField& field, const std::vector<float>& prepared, double square_weight);
 
 // The bias of Timonen & Westerholm's Eq. 5 (ambient_term), which takes the horizon as constant
 // over each direction's swath of azimuth while integrating the normal's cosine over it exactly,

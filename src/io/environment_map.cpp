@@ -47,9 +47,10 @@ EnvironmentMap readEnvironmentMap(const std::string& path) {
   // (an 8-bit PNG's 0 .. 255 were taken as radiance, 256 times the float image's, exit 0; a light
   // image's colours, in the output's units, may be integers)
   if (image.integers)
-    throw IoError(path, "an environment map holds integers (an 8- or 16-bit image), which would be taken as "
-                        "radiance at their stored values (0 .. 255, 0 .. 65535): give linear floats (EXR, HDR, a "
-                        "float TIFF), e.g. oiiotool IN --colorconvert sRGB linear -d float -o OUT.exr");
+    throw IoError(path,
+                  "an environment map holds integers (an 8- or 16-bit image), which would be taken as "
+                  "radiance at their stored values (0 .. 255, 0 .. 65535): give linear floats (EXR, HDR, a "
+                  "float TIFF), e.g. oiiotool IN --colorconvert sRGB linear -d float -o OUT.exr");
   EnvironmentMap map;
   map.width = image.width;
   map.height = image.height;

@@ -482,10 +482,11 @@ void requireSameGrid(const std::string& path, const Georeference& side, const st
         for (const double v : t) out += (out.empty() ? "" : ", ") + exactNumber(v);
         return "(" + out + ")";
       };
-      throw IoError(path, "lies on another grid than the height field " + input + " (geotransform " + text(a) +
-                              " against " + text(b) +
-                              "; a south-up raster beside a north-up field too): it is taken pixel by pixel, so "
-                              "warp it onto the field's grid first (gdalwarp -te, -ts, or -tr and -tap)");
+      throw IoError(path,
+                    "lies on another grid than the height field " + input + " (geotransform " + text(a) +
+                        " against " + text(b) +
+                        "; a south-up raster beside a north-up field too): it is taken pixel by pixel, so "
+                        "warp it onto the field's grid first (gdalwarp -te, -ts, or -tr and -tap)");
     }
   }
   if (side.crs_wkt.empty() || field.crs_wkt.empty()) return;
@@ -503,9 +504,10 @@ void requireSameGrid(const std::string& path, const Georeference& side, const st
   if (!OSRIsSame(a.get(), b.get())) {
     const char* name_a = OSRGetName(a.get());
     const char* name_b = OSRGetName(b.get());
-    throw IoError(path, "is in another CRS (" + std::string(name_a ? name_a : "unnamed") + ") than the height field " +
-                            input + " (" + (name_b ? name_b : "unnamed") +
-                            "): it is taken pixel by pixel, so warp it onto the field's grid first (gdalwarp -t_srs)");
+    throw IoError(
+        path, "is in another CRS (" + std::string(name_a ? name_a : "unnamed") + ") than the height field " +
+                  input + " (" + (name_b ? name_b : "unnamed") +
+                  "): it is taken pixel by pixel, so warp it onto the field's grid first (gdalwarp -t_srs)");
   }
 }
 
@@ -845,7 +847,8 @@ ImageChannels readGdalImage(const std::string& path) {
     image.names.push_back(description.empty() ? colourName(band, b) : description);
     image.planes.push_back(readBand(path, dataset.get(), b, false));
     int has_scale = 0, has_offset = 0;
-    const double scale = GDALGetRasterScale(band, &has_scale), offset = GDALGetRasterOffset(band, &has_offset);
+    const double scale = GDALGetRasterScale(band, &has_scale),
+                 offset = GDALGetRasterOffset(band, &has_offset);
     image.integers = image.integers || (GDALDataTypeIsInteger(GDALGetRasterDataType(band)) &&
                                         !(has_scale && scale != 1.0) && !(has_offset && offset != 0.0));
   }
