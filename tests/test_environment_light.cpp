@@ -316,6 +316,29 @@ TEST(Environment, StripsEqualTheWholeField) {
   });
 }
 
+// A rotation of many turns is the rotation within one (1e300 degrees lost every digit of the
+// columns' edges and the run never ended; -1e300 gave 0 everywhere: a probe's find).
+TEST(Environment, ARotationOfManyTurnsIsItsRotationWithinOne) {
+  const HeightField field = makeSyntheticField("city", 24, 20);
+  HorizonOptions options;
+  options.directions = 8;
+  EnvironmentMap map = uniformEnvironment(1.0f, 8);
+  for (int c = 0; c < map.width; ++c) map.radiance[map.width + c] = 1.0f + c;  // (not uniform in azimuth)
+  map.rotation_deg = std::fmod(1e300, 360.0);
+  const std::vector<float> within =
+      computeHorizons(testContext(), field, options, environmentOutputs(map)).irradiance;
+  for (const double turns : {1e300, -1e300, 1e18}) {
+    map.rotation_deg = turns;
+    EnvironmentMap reduced = map;
+    reduced.rotation_deg = std::fmod(turns, 360.0);
+    const std::vector<float> many =
+        computeHorizons(testContext(), field, options, environmentOutputs(map)).irradiance;
+    EXPECT_EQ(many, computeHorizons(testContext(), field, options, environmentOutputs(reduced)).irradiance)
+        << turns;
+  }
+  EXPECT_FALSE(within.empty());
+}
+
 TEST(Environment, RefusesBadMaps) {
   const HeightField field = makeSyntheticField("flat", 5, 5);
   HorizonOptions options;

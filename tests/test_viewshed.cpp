@@ -391,6 +391,10 @@ TEST(Viewshed, BadInputIsRefused) {
   EXPECT_THROW(computeViewshed(c, f, {-1, 0, 2.0}, {}), InvalidArgument);
   EXPECT_THROW(computeViewshed(c, f, {4, 3, 2.0}, {}), InvalidArgument);
   EXPECT_THROW(computeViewshed(c, f, {1, 1, NAN}, {}), InvalidArgument);
+  // (an eye 1e39 below the surface saw every target: a probe's find; the CLI's range)
+  for (const double height : {-1e39, 1e300, -1.1e12})
+    EXPECT_THROW(computeViewshed(c, f, {1, 1, height}, {}), InvalidArgument) << height;
+  EXPECT_NO_THROW(computeViewshed(c, f, {1, 1, -1e12}, {}));
   ViewshedOptions o;
   o.target_height = -1.0;
   EXPECT_THROW(computeViewshed(c, f, {1, 1, 2.0}, o), InvalidArgument);

@@ -31,7 +31,10 @@ EnvironmentSwaths environmentSwaths(const EnvironmentMap& map, const std::vector
     spans[owner].push_back({azimuth - 0.5 * before, azimuth + 0.5 * after});
   }
   const double column = 2.0 * M_PI / map.width;
-  const double origin = map.rotation_deg * M_PI / 180.0 - 0.5 * M_PI;  // column 0's left edge, hfvis azimuth
+  // Column 0's left edge, hfvis azimuth; the rotation within a turn first (exact: fmod rounds
+  // nothing), as 1e300 degrees lost every digit of the edges and the kernel's walk over the
+  // columns never ended.
+  const double origin = std::fmod(map.rotation_deg, 360.0) * M_PI / 180.0 - 0.5 * M_PI;
   EnvironmentSwaths out;
   for (std::size_t k = 0; k < K; ++k) {
     out.spans.push_back({static_cast<int>(out.bins.size()), static_cast<int>(spans[k].size())});

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "core/horizon_common.hpp"
+#include "core/number_text.hpp"
 #include "core/opencl_context.hpp"
 #include "core/sweep_framework.hpp"
 #include "core/sweep_geometry.hpp"
@@ -523,7 +524,11 @@ void validate(const HeightField& field, const Observer& o) {
                           std::to_string(field.width) + " x " + std::to_string(field.height) + " field");
   if (!std::isfinite(field.at(o.col, o.row)))
     throw InvalidArgument("observer " + std::to_string(o.col) + "," + std::to_string(o.row) + " stands on nodata");
-  if (!std::isfinite(o.height)) throw InvalidArgument("the observer's height must be finite");
+  // (an eye 1e39 below the surface saw every target: the CLI's range, as regions' and PVS's)
+  if (!std::isfinite(o.height) || std::fabs(o.height) > kMostGivenHeight)
+    throw InvalidArgument(
+        "the observer's height must be finite and within +-" + detail::shortNumber(kMostGivenHeight) +
+        ", what the kernels' single precision holds (got " + detail::shortNumber(o.height) + ")");
 }
 
 ViewshedResult computeViewshed(const ComputeContext& context, const HeightField& field, const Observer& observer,
