@@ -35,7 +35,7 @@ class Bounce : public Computation {
     }
     radiance_image_ = readImage(run_.radiance);
     detail::requireSameGrid(run_.radiance, radiance_image_.georeference, run_.input, field.georeference);
-X
+    if (radiance_image_.integers)  // (as readEnvironmentMap's environments)
       throw IoError(run_.radiance,
                     "the exit radiance holds integers (an 8- or 16-bit image), which would be "
                     "taken at their stored values (0 .. 255, 0 .. 65535): give linear floats "
