@@ -9,6 +9,7 @@
 #include "../pipeline.hpp"
 #include "hfvis/errors.hpp"
 #include "io/gdal_io.hpp"
+#include "io/image_reading.hpp"
 
 namespace hfvis::cli {
 namespace {
@@ -35,11 +36,7 @@ class Bounce : public Computation {
     }
     radiance_image_ = readImage(run_.radiance);
     detail::requireSameGrid(run_.radiance, radiance_image_.georeference, run_.input, field.georeference);
-    if (radiance_image_.integers)  // (as readEnvironmentMap's environments)
-      throw IoError(run_.radiance,
-                    "the exit radiance holds integers (an 8- or 16-bit image), which would be "
-                    "taken at their stored values (0 .. 255, 0 .. 65535): give linear floats "
-                    "(EXR, HDR, a float TIFF), e.g. oiiotool IN -d float -o OUT.exr, scaled");
+    detail::requireFloatRadiance(radiance_image_.integers, run_.radiance, "the exit radiance");
     if (radiance_image_.width != field.width || radiance_image_.height != field.height) {
       throw IoError(run_.radiance, "is " + std::to_string(radiance_image_.width) + "x" +
                                        std::to_string(radiance_image_.height) + ", the height field " +

@@ -370,18 +370,22 @@ def _height(name, value, absolute, what):
 
 def _heights(name, value, absolute, what):
     """A height or one per point (an array, left as given for the library's own checks of its
-    shape), each as _height's."""
+    shape), its least and greatest each as _height's."""
     if np.ndim(value) == 0:
         return _height(name, value, absolute, what)
     values = np.asarray(value)
     if values.dtype.kind in "iuf" and values.size:
-        lowest, highest = float(np.nanmin(values)), float(np.nanmax(values))
-        if highest > _MOST_LENGTH or lowest < -_MOST_LENGTH:
-            raise InvalidArgumentError(f"{name} must lie in {-_MOST_LENGTH:g} .. {_MOST_LENGTH:g}, what the kernels' "
-                                       f"single precision holds, got {highest if highest > _MOST_LENGTH else lowest:g}")
-        if lowest < 0 and not absolute:
-            raise InvalidArgumentError(f"{name} {lowest:g}: {what}; give heights >= 0 (or absolute=True)")
+        _height(name, np.nanmin(values), absolute, what)
+        _height(name, np.nanmax(values), absolute, what)
     return value
+
+
+def _max_distance(value):
+    return _real("max_distance", value, 0.0, _MOST_LENGTH)
+
+
+def _target_height(value):
+    return _real("target_height", value, 0.0, _MOST_LENGTH)
 
 
 def _points(name, value, absolute, what):
@@ -431,7 +435,7 @@ def _horizon(directions, azimuth_offset, samples_per_unit, curvature, max_distan
     return {"directions": _whole("directions", directions, None, 2**31 - 1),
             "azimuth_offset": _real("azimuth_offset", azimuth_offset),
             "samples_per_unit": _real("samples_per_unit", samples_per_unit),
-            "curvature": _real("curvature", curvature), "max_distance": _real("max_distance", max_distance, 0.0, _MOST_LENGTH),
+            "curvature": _real("curvature", curvature), "max_distance": _max_distance(max_distance),
             "memory_budget_bytes": _budget(memory_budget_bytes), "method": method,
             "azimuth_tolerance": None if azimuth_tolerance is None else _real("azimuth_tolerance", azimuth_tolerance),
             "strip_rows": _whole("strip_rows", strip_rows, 0, 2**31 - 1)}
@@ -641,8 +645,8 @@ def _field_of_view(azimuth_from_deg, azimuth_to_deg):
 def _sight(absolute, target_height, max_distance, curvature, azimuth_from_deg, azimuth_to_deg, elevation_min_deg,
            elevation_max_deg, memory_budget_bytes):
     """The options a viewshed and a cumulative viewshed share."""
-    return {"absolute": _flag("absolute", absolute), "target_height": _real("target_height", target_height, 0.0, _MOST_LENGTH),
-            "max_distance": _real("max_distance", max_distance, 0.0, _MOST_LENGTH), "curvature": _real("curvature", curvature),
+    return {"absolute": _flag("absolute", absolute), "target_height": _target_height(target_height),
+            "max_distance": _max_distance(max_distance), "curvature": _real("curvature", curvature),
             **_field_of_view(azimuth_from_deg, azimuth_to_deg),
             "elevation_min_deg": _real("elevation_min_deg", elevation_min_deg),
             "elevation_max_deg": _real("elevation_max_deg", elevation_max_deg),
@@ -688,7 +692,7 @@ def sun_shading(heights, azimuth_deg, elevation_deg, *, size_deg=0.53, samples_p
                "elevation_deg": _real("elevation_deg", elevation_deg), "size_deg": _real("size_deg", size_deg),
                "samples_per_unit": _real("samples_per_unit", samples_per_unit),
                "curvature": _real("curvature", curvature),
-               "max_distance": _real("max_distance", max_distance, 0.0, _MOST_LENGTH), "memory_budget_bytes": _budget(memory_budget_bytes)}
+               "max_distance": _max_distance(max_distance), "memory_budget_bytes": _budget(memory_budget_bytes)}
     return _pair("sun_shading", SunShading, heights, options, _common(cell_size, z_scale, nodata, device, progress))
 
 
@@ -706,7 +710,7 @@ def insolation(heights, latitude_deg, longitude_deg, start, end, *, step_minutes
                "apparent": _flag("apparent", apparent),
                "samples_per_unit": _real("samples_per_unit", samples_per_unit),
                "curvature": _real("curvature", curvature),
-               "max_distance": _real("max_distance", max_distance, 0.0, _MOST_LENGTH), "memory_budget_bytes": _budget(memory_budget_bytes)}
+               "max_distance": _max_distance(max_distance), "memory_budget_bytes": _budget(memory_budget_bytes)}
     return _pair("insolation", Insolation, heights, options, _common(cell_size, z_scale, nodata, device, progress))
 
 
@@ -765,13 +769,14 @@ def region_visibility(heights, sources, *, samples=16, height=2.0, absolute=Fals
     over the rectangle (row 0 along its lowest row), each sample taking the bilinear colour at its
     position (as arealight --light-image); then rgb (3 x H x W; DataArray: a Dataset variable
     "rgb" over "channel" R, G, B): per point the colours of the samples it sees, summed, / S."""
-    options = {"sources": _points("sources", sources, _flag("absolute", absolute), _SAMPLE_BELOW),
+    is_absolute = _flag("absolute", absolute)
+    options = {"sources": _points("sources", sources, is_absolute, _SAMPLE_BELOW),
                "samples": _whole("samples", samples, None, 2**31 - 1),
-               "height": _height("height", height, _flag("absolute", absolute), _SAMPLE_BELOW),
-               "absolute": _flag("absolute", absolute),
-               "target_height": _real("target_height", target_height, 0.0, _MOST_LENGTH), "method": method,
+               "height": _height("height", height, is_absolute, _SAMPLE_BELOW),
+               "absolute": is_absolute,
+               "target_height": _target_height(target_height), "method": method,
                "seed": _whole("seed", seed, 0, 2**32 - 1),
-               "decorrelate": _flag("decorrelate", decorrelate), "max_distance": _real("max_distance", max_distance, 0.0, _MOST_LENGTH),
+               "decorrelate": _flag("decorrelate", decorrelate), "max_distance": _max_distance(max_distance),
                "curvature": _real("curvature", curvature),
                "light_image": light_image}
     if _is_dataarray(heights) and _is_dask(heights.data):
@@ -804,15 +809,15 @@ def region_pair_visibility(heights, sources, receivers, *, samples=16, source_he
     receiver_fraction (the share of the other region's samples each sees), clear_pairs, pairs,
     visible_fraction, and sources_xy / receivers_xy (map coordinates of a georeferenced
     DataArray, else None). progress as region_visibility's."""
-    above_zero = _flag("absolute", absolute)
-    options = {"sources": _points("sources", sources, above_zero, _SAMPLE_BELOW),
-               "receivers": _points("receivers", receivers, above_zero, _SAMPLE_BELOW),
+    is_absolute = _flag("absolute", absolute)
+    options = {"sources": _points("sources", sources, is_absolute, _SAMPLE_BELOW),
+               "receivers": _points("receivers", receivers, is_absolute, _SAMPLE_BELOW),
                "samples": _whole("samples", samples, None, 2**31 - 1),
-               "source_height": _height("source_height", source_height, above_zero, _SAMPLE_BELOW),
-               "receiver_height": _height("receiver_height", receiver_height, above_zero, _SAMPLE_BELOW),
-               "absolute": _flag("absolute", absolute), "method": method, "seed": _whole("seed", seed, 0, 2**32 - 1),
+               "source_height": _height("source_height", source_height, is_absolute, _SAMPLE_BELOW),
+               "receiver_height": _height("receiver_height", receiver_height, is_absolute, _SAMPLE_BELOW),
+               "absolute": is_absolute, "method": method, "seed": _whole("seed", seed, 0, 2**32 - 1),
                "decorrelate": _flag("decorrelate", decorrelate),
-               "max_distance": _real("max_distance", max_distance, 0.0, _MOST_LENGTH), "curvature": _real("curvature", curvature)}
+               "max_distance": _max_distance(max_distance), "curvature": _real("curvature", curvature)}
     if _is_dataarray(heights) and _is_dask(heights.data):
         heights = _computed(heights)
     out, grid = _run("region_pair_visibility", heights, options,
@@ -881,7 +886,7 @@ def pvs(heights, *, samples=0, pixel_error=0.0, seconds=0.0, view_cell=32, band_
                "filter": _real("filter", filter), "view_filter": _whole("view_filter", view_filter, 0, 8),
                "estimate_entries": int(estimate_entries), "witnesses": _flag("witnesses", witnesses),
                "memory_budget_bytes": _budget(memory_budget_bytes), "curvature": _real("curvature", curvature),
-               "max_distance": _real("max_distance", max_distance, 0.0, _MOST_LENGTH),
+               "max_distance": _max_distance(max_distance),
                "start": None if start is None else _pvs_start(start)}
     if _is_dataarray(heights) and _is_dask(heights.data):
         heights = _computed(heights)

@@ -8,6 +8,7 @@
 
 #include "hfvis/errors.hpp"
 #include "hfvis/image_io.hpp"
+#include "io/image_reading.hpp"
 
 namespace hfvis {
 
@@ -44,13 +45,7 @@ void validate(const EnvironmentMap& map) {
 
 EnvironmentMap readEnvironmentMap(const std::string& path) {
   ImageChannels image = readColourImage(path, "an environment map");
-  // (an 8-bit PNG's 0 .. 255 were taken as radiance, 256 times the float image's, exit 0; a light
-  // image's colours, in the output's units, may be integers)
-  if (image.integers)
-    throw IoError(path,
-                  "an environment map holds integers (an 8- or 16-bit image), which would be taken as "
-                  "radiance at their stored values (0 .. 255, 0 .. 65535): give linear floats (EXR, HDR, a "
-                  "float TIFF), e.g. oiiotool IN --colorconvert sRGB linear -d float -o OUT.exr");
+  detail::requireFloatRadiance(image.integers, path, "an environment map");
   EnvironmentMap map;
   map.width = image.width;
   map.height = image.height;

@@ -73,4 +73,16 @@ inline int chooseChannel(const std::string& path, const std::vector<std::string>
   throw IoError(path, "no channel '" + choice + "' (image has " + available + ")");
 }
 
+// Refuses radiance read from an image of integers (ImageChannels::integers: an 8- or 16-bit
+// image, a GDAL band of integers without a scale or offset), `what` naming it ("an environment
+// map"): its stored values 0 .. 255 were taken as radiance, 256 times the float image's, exit 0.
+// Radiance is linear floats; a light image's colours, in the output's units, may be integers.
+inline void requireFloatRadiance(bool integers, const std::string& path, const std::string& what) {
+  if (integers)
+    throw IoError(path, what +
+                            " holds integers (an 8- or 16-bit image), which would be taken as radiance at "
+                            "their stored values (0 .. 255, 0 .. 65535): give linear floats (EXR, HDR, a "
+                            "float TIFF), e.g. oiiotool IN --colorconvert sRGB linear -d float -o OUT.exr");
+}
+
 }  // namespace hfvis::detail
